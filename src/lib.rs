@@ -22,4 +22,5 @@ pub use texmap_impostor as impostor;
 pub use texmap_md_io as md_io;
 pub use texmap_raster as raster;
 pub use texmap_reftrace as reftrace;
+pub use texmap_study as study;
 pub use texmap_terrain as terrain;

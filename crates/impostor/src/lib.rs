@@ -1,1 +1,244 @@
-//! (being built)
+//! # texmap-impostor — sphere sets drawn four ways
+//!
+//! Molecules and particle systems are sets of spheres. This crate draws a [`SphereScene`] with a
+//! [`Camera`] and [`Lighting`] by one of four methods behind one face, so that they can be
+//! compared pixel for pixel and millisecond for millisecond:
+//!
+//! | [`Method`] | what it is | exact? |
+//! |---|---|---|
+//! | `Polygon` | tessellated spheres (the papers' baseline), tessellation chosen per sphere from its projected size, drawn with `texmap-raster` | silhouette to within the tessellation error |
+//! | `Lut` | Seed 002: a square of side 2R per sphere textured with a colour image (lit once per scene per material, 1-bit mask) and a depth image (once ever); `z = z0 + D(s,t)·R/d0` | exact for an orthographic camera; errs with perspective as documented |
+//! | `Template` | Seed 004: disc billboards textured with a window cut from a template texture at `x_tex = 0.5 − r·sin(θ/2)`, `y_tex = 0.5 − r·sin(φ/2)` | pseudo-shading |
+//! | `Raycast` | per-fragment ray–sphere intersection over the sphere's exact perspective bounding quad | exact depth, normals and silhouette |
+//!
+//! All methods cull to the view frustum, do no work for spheres behind the camera, handle spheres
+//! crossing the near plane and sub-pixel spheres, and skip (and count) spheres with a non-finite
+//! centre or a non-positive or non-finite radius.
+//!
+//! A [`Renderer`] keeps the per-scene tables (Seed 002 images, Seed 004 template pyramid) between
+//! frames, as the papers do; [`render`] is the one-shot convenience.
+//!
+//! ```
+//! use texmap_impostor::{render, Method, Options, SphereScene};
+//! use texmap_core::{camera::Camera, glam::Vec3, shade::{Lighting, Material}};
+//!
+//! let mut scene = SphereScene::new(vec![Material::plastic(Vec3::new(0.8, 0.1, 0.1))]);
+//! scene.push(Vec3::ZERO, 1.0, 0);
+//! let cam = Camera::perspective_look_at(Vec3::new(0.0, 0.0, 10.0), Vec3::ZERO, Vec3::Y, 30.0, 64, 64).unwrap();
+//! let opts = Options::new(Method::Raycast, Lighting::default_for(&cam));
+//! let out = render(&scene, &cam, &opts);
+//! // The sphere covers the image centre, at depth 10 − 1.
+//! let c = out.frame.index(32, 32);
+//! assert!((out.frame.depth[c] - 9.0).abs() < 1e-3);
+//! assert_eq!(out.stats.skipped_invalid, 0);
+//! ```
+//!
+//! **Architecture invariant:** this crate depends on `texmap-core` and `texmap-raster` only; the
+//! reference ray tracer appears in its tests alone (the comparison harness lives in `texmap-study`).
+
+use glam::Vec3;
+use texmap_core::camera::Camera;
+use texmap_core::frame::Frame;
+use texmap_core::shade::{Lighting, Material};
+
+/// A set of spheres (and optional bonds drawn as cylinders by the methods that support them).
+///
+/// Spheres are stored as structure-of-arrays so that transform and culling can run over lanes.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SphereScene {
+    pub centers: Vec<Vec3>,
+    pub radii: Vec<f32>,
+    /// Index into `materials` per sphere.
+    pub kinds: Vec<u16>,
+    /// One material per kind (element, type…); linear RGB.
+    pub materials: Vec<Material>,
+    /// Pairs of sphere indices joined by a cylinder of radius `bond_radius`.
+    pub bonds: Vec<[u32; 2]>,
+    pub bond_radius: f32,
+}
+
+impl SphereScene {
+    /// An empty scene with these materials (kinds index into them).
+    pub fn new(materials: Vec<Material>) -> SphereScene {
+        SphereScene {
+            materials,
+            bond_radius: 0.15,
+            ..Default::default()
+        }
+    }
+
+    /// Add one sphere.
+    pub fn push(&mut self, center: Vec3, radius: f32, kind: u16) {
+        self.centers.push(center);
+        self.radii.push(radius);
+        self.kinds.push(kind);
+    }
+
+    /// Number of spheres.
+    pub fn len(&self) -> usize {
+        self.centers.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.centers.is_empty()
+    }
+
+    /// Whether sphere `i` can be drawn: finite centre, finite positive radius, known kind.
+    #[inline]
+    pub fn is_valid(&self, i: usize) -> bool {
+        let r = self.radii[i];
+        self.centers[i].is_finite()
+            && r.is_finite()
+            && r > 0.0
+            && (self.kinds[i] as usize) < self.materials.len()
+    }
+
+    /// Axis-aligned bounds `(min, max)` of the valid spheres including their radii, or `None`
+    /// when there is none.
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        let mut any = false;
+        for i in 0..self.len() {
+            if self.is_valid(i) {
+                let r = Vec3::splat(self.radii[i]);
+                lo = lo.min(self.centers[i] - r);
+                hi = hi.max(self.centers[i] + r);
+                any = true;
+            }
+        }
+        any.then_some((lo, hi))
+    }
+}
+
+/// The drawing methods (a closed set).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Method {
+    Polygon,
+    Lut,
+    Template,
+    Raycast,
+}
+
+impl Method {
+    pub const ALL: [Method; 4] = [
+        Method::Polygon,
+        Method::Lut,
+        Method::Template,
+        Method::Raycast,
+    ];
+
+    /// The lower-case name used on the command line and in results files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Polygon => "polygon",
+            Method::Lut => "lut",
+            Method::Template => "template",
+            Method::Raycast => "raycast",
+        }
+    }
+
+    /// Parse [`Method::name`].
+    pub fn from_name(s: &str) -> Option<Method> {
+        Method::ALL.into_iter().find(|m| m.name() == s)
+    }
+}
+
+/// How the Seed 004 template method writes depth.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TemplateDepth {
+    /// The billboard plane through the sphere centre, as the paper does.
+    Billboard,
+    /// Seed 002's depth image: `z = z0 + D(s,t)·R/d0`.
+    DepthImage,
+}
+
+/// How the Seed 004 template method colours spheres.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TemplateColoring {
+    /// One grey template recoloured per sphere by the material's HSV hue and saturation.
+    HueRecolor,
+    /// One template per material.
+    PerKind,
+}
+
+/// Drawing options shared by all methods; fields a method does not use are ignored by it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Options {
+    pub method: Method,
+    pub lighting: Lighting,
+    /// Background colour, sRGB RGBA.
+    pub background: [u8; 4],
+    /// Side of the Seed 002 colour/depth images (texels).
+    pub lut_size: u32,
+    /// Side of the finest Seed 004 template (texels); coarser levels halve it.
+    pub template_size: u32,
+    pub template_depth: TemplateDepth,
+    pub template_coloring: TemplateColoring,
+    /// Polygon method: largest allowed distance, in pixels, between the true silhouette and the
+    /// tessellated one; the tessellation level per sphere is chosen from it.
+    pub polygon_max_error_px: f32,
+    /// Draw `SphereScene::bonds` (methods without bond support ignore it and say so in their docs).
+    pub draw_bonds: bool,
+}
+
+impl Options {
+    /// Defaults for a method: 256² Seed 002 images, 128² finest template with billboard depth and
+    /// hue recolouring, polygon silhouettes within 0.25 px, bonds drawn.
+    pub fn new(method: Method, lighting: Lighting) -> Options {
+        Options {
+            method,
+            lighting,
+            background: [0, 0, 0, 255],
+            lut_size: 256,
+            template_size: 128,
+            template_depth: TemplateDepth::Billboard,
+            template_coloring: TemplateColoring::HueRecolor,
+            polygon_max_error_px: 0.25,
+            draw_bonds: true,
+        }
+    }
+}
+
+/// What happened to the spheres of a frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RenderStats {
+    /// Spheres that reached the pixel stage.
+    pub drawn: usize,
+    /// Valid spheres outside the view frustum (including behind the camera).
+    pub culled: usize,
+    /// Spheres skipped for a non-finite centre, a non-positive or non-finite radius or an unknown
+    /// kind.
+    pub skipped_invalid: usize,
+}
+
+/// A rendered frame and its statistics.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Render {
+    pub frame: Frame,
+    pub stats: RenderStats,
+}
+
+/// Draws sphere scenes, keeping per-scene tables between frames.
+#[derive(Debug, Default)]
+pub struct Renderer {
+    // Filled in by the method modules: cached Seed 002 images per material, Seed 004 template
+    // pyramid, reusable bin buffers.
+}
+
+impl Renderer {
+    pub fn new() -> Renderer {
+        Renderer::default()
+    }
+
+    /// Draw `scene` as `camera` sees it with `options.method`.
+    pub fn render(&mut self, scene: &SphereScene, camera: &Camera, options: &Options) -> Render {
+        let _ = (scene, camera, options);
+        unimplemented!("method modules are being written")
+    }
+}
+
+/// One-shot [`Renderer::render`].
+pub fn render(scene: &SphereScene, camera: &Camera, options: &Options) -> Render {
+    Renderer::new().render(scene, camera, options)
+}
