@@ -224,6 +224,59 @@ impl Camera {
         })
     }
 
+    /// A camera that frames a bounding sphere (`center`, `radius`) seen along `view_dir`:
+    /// perspective with horizontal field of view `hfov_deg`, or orthographic when `hfov_deg` is
+    /// `None`. The sphere fills the smaller image side up to `margin` (1.0 = touching; 1.1 leaves
+    /// 10 % space). Used by the command line's automatic camera.
+    #[allow(clippy::too_many_arguments)]
+    pub fn fit_sphere(
+        center: Vec3,
+        radius: f32,
+        view_dir: Vec3,
+        up: Vec3,
+        hfov_deg: Option<f32>,
+        width: u32,
+        height: u32,
+        margin: f32,
+    ) -> Result<Camera, CameraError> {
+        check_size(width, height)?;
+        if !(center.is_finite() && view_dir.is_finite() && radius.is_finite() && margin.is_finite())
+        {
+            return Err(CameraError::NonFinite);
+        }
+        let radius = radius.max(1e-6) * margin.max(1e-3);
+        let dir = view_dir.normalize_or_zero();
+        if dir == Vec3::ZERO {
+            return Err(CameraError::EyeAtTarget);
+        }
+        let aspect = height as f32 / width as f32;
+        match hfov_deg {
+            Some(hfov) => {
+                if !(hfov.is_finite() && hfov > 0.0 && hfov < 180.0) {
+                    return Err(CameraError::BadFov { hfov_deg: hfov });
+                }
+                // Half-angle of the narrower image side; the sphere's tangent cone must fit in it.
+                let half_h = (hfov.to_radians() * 0.5).tan();
+                let half = half_h.min(half_h * aspect).atan();
+                let dist = radius / half.sin();
+                Camera::perspective_look_at(center - dir * dist, center, up, hfov, width, height)
+            }
+            None => {
+                let view_width = 2.0 * radius * (1.0f32).max(1.0 / aspect);
+                let cam = Camera::orthographic_look_at(
+                    center - dir * (2.0 * radius),
+                    center,
+                    up,
+                    view_width,
+                    width,
+                    height,
+                )?;
+                let near = radius * 1e-3;
+                cam.with_clip(near, f32::INFINITY)
+            }
+        }
+    }
+
     /// The same camera with other clip distances (eye-space depths). `far` may be infinite.
     pub fn with_clip(mut self, near: f32, far: f32) -> Result<Camera, CameraError> {
         if !(near.is_finite() && near > 0.0 && far > near) {
@@ -485,6 +538,30 @@ mod tests {
         let (r, u, b) = (c.right(), c.up(), -c.forward());
         assert!((r.cross(u) - b).length() < 1e-6);
         assert!(r.dot(u).abs() < 1e-6 && (r.length() - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn fitted_sphere_touches_the_narrow_side() {
+        // A unit sphere framed in a 200x100 image at 90° horizontal FOV with margin 1: its
+        // tangent cone must touch the top and bottom edges (the narrower side).
+        let c = Camera::fit_sphere(
+            Vec3::ZERO,
+            1.0,
+            -Vec3::Z,
+            Vec3::Y,
+            Some(90.0),
+            200,
+            100,
+            1.0,
+        )
+        .unwrap();
+        let half_v = (0.5f64).atan(); // tan(half_v) = (h/2)/k = 50/100
+        let dist = 1.0 / half_v.sin();
+        assert!((c.eye().z as f64 - dist).abs() < 1e-4, "eye {}", c.eye());
+        let o = Camera::fit_sphere(Vec3::ONE, 2.0, Vec3::X, Vec3::Y, None, 100, 200, 1.0).unwrap();
+        assert!(o.is_orthographic());
+        // Orthographic: the narrower side (width, 100 px) spans exactly the diameter 4.
+        assert!((o.scale() - 25.0).abs() < 1e-4, "{}", o.scale());
     }
 
     #[test]
