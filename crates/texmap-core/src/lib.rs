@@ -30,4 +30,6 @@ pub mod camera;
 pub mod color;
 pub mod frame;
 pub mod metrics;
+pub mod mip;
+pub mod sample;
 pub mod shade;

@@ -1,0 +1,447 @@
+//! Mip pyramids: the texel storage every sampler of [`crate::sample`] reads.
+//!
+//! A [`MipTexture`] holds all levels of one image as linear-light RGBA `f32` texels ([`Vec4`],
+//! 16 bytes, SIMD-aligned) in ONE contiguous buffer, level 0 (finest) first, each level row-major
+//! with row 0 at map `v = 0`. Per level it keeps the offset, size and the reciprocal-free `f32`
+//! sizes the samplers need, so the hot path does no division and (after validation here) no
+//! bounds checks.
+//!
+//! # Level sizes and the non-power-of-two (NPOT) reduction
+//! Level `i + 1` has `max(1, ⌊w_i / 2⌋) x max(1, ⌊h_i / 2⌋)` texels, down to 1x1. Each axis is
+//! reduced separably with an exact box over the destination texel's footprint:
+//! - even size `2m`: destination `x` averages sources `2x, 2x+1` (weights ½, ½);
+//! - odd size `2m+1` (m ≥ 1): destination `x` covers `(2m+1)/m` source texels, so it takes
+//!   sources `2x, 2x+1, 2x+2` with weights `(m−x)/(2m+1), m/(2m+1), (x+1)/(2m+1)`;
+//! - size 1: copied.
+//!
+//! Every source texel then carries the same total weight `m/(2m+1)`, so the mean of a level equals
+//! the mean of the level above it exactly (up to float rounding), and the 1x1 top level is the mean
+//! of the whole image. Rounding up to a power of two was rejected: it resamples level 0 and so
+//! changes the image the user gave.
+//!
+//! # Box versus gamma-correct reduction
+//! [`Reduction::GammaCorrect`] averages LINEAR light (sRGB input is decoded first, the stored
+//! texels stay linear): a black/white checkerboard reduces to 0.5 linear = sRGB code 188.
+//! [`Reduction::Box`] averages the values in the input's own encoding — for sRGB input, the
+//! encoded values, as naive mip generators do (the same checkerboard gives code 128, too dark);
+//! for linear input the two reductions coincide. Alpha is straight (not premultiplied) and always
+//! averaged linearly.
+//!
+//! # Wrap modes
+//! [`Wrap::Repeat`] tiles the map (`u = 1` is `u = 0`); [`Wrap::Clamp`] repeats the edge texels.
+//! A texture whose level 0 is a power of two on both axes wraps with bit masks; others with a
+//! Euclidean remainder ([`MipTexture::is_pow2`]).
+//!
+//! Texel centres: texel `(x, y)` of a `w x h` level is centred at map coordinates
+//! `((x + ½)/w, (y + ½)/h)` (map widths), so box-filtered levels stay registered. Seed 000 Eq. (3)
+//! writes `a_c = ⌊2^L r_m⌋` without the half-texel offset; [`crate::sample`] applies Eq. (3) to
+//! `2^L r_m − ½`.
+//!
+//! ```
+//! use texmap_core::mip::{MipTexture, Reduction, Wrap};
+//! // A 2x2 black/white checkerboard in sRGB8.
+//! let px = [[0u8, 0, 0, 255], [255, 255, 255, 255], [255, 255, 255, 255], [0, 0, 0, 255]];
+//! let tex = MipTexture::from_srgb8(2, 2, px.as_flattened(), Reduction::GammaCorrect, Wrap::Repeat)
+//!     .unwrap();
+//! assert_eq!(tex.level_count(), 2);
+//! // The 1x1 level is 50% linear light: sRGB code 188, not the naive 128.
+//! assert_eq!(tex.texel_srgb8(1, 0, 0)[0], 188);
+//! ```
+
+use glam::Vec4;
+
+use crate::color::{linear_to_srgb, linear_to_srgb8_exact, srgb_to_linear, srgb8_to_linear};
+
+/// The largest level-0 side accepted (the same bound as camera images).
+pub const MAX_TEXTURE_SIDE: u32 = 16384;
+
+/// How texel addresses outside a level are folded back into it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Wrap {
+    /// Tile the map: texel `x` is texel `x mod w`.
+    Repeat,
+    /// Clamp to the edge texel.
+    Clamp,
+}
+
+/// How one level is averaged into the next.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Reduction {
+    /// Average the values in the input's own encoding (naive for sRGB input).
+    Box,
+    /// Average linear light (decode sRGB, average, keep linear).
+    GammaCorrect,
+}
+
+/// Why a texture could not be built.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum MipError {
+    /// A side is zero or larger than [`MAX_TEXTURE_SIDE`].
+    BadSize { width: u32, height: u32 },
+    /// The pixel buffer does not hold `width * height` pixels.
+    DataLength { expected: usize, actual: usize },
+    /// A linear input texel holds NaN or an infinity.
+    NonFinite { x: u32, y: u32 },
+}
+
+impl std::fmt::Display for MipError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            MipError::BadSize { width, height } => write!(
+                f,
+                "texture size {width}x{height} is not allowed (each side must be 1..={MAX_TEXTURE_SIDE})"
+            ),
+            MipError::DataLength { expected, actual } => {
+                write!(f, "texture data holds {actual} values, expected {expected}")
+            }
+            MipError::NonFinite { x, y } => {
+                write!(f, "texel ({x}, {y}) is not finite")
+            }
+        }
+    }
+}
+
+impl std::error::Error for MipError {}
+
+/// Where one level lives in the texel buffer.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LevelInfo {
+    /// Index of texel (0, 0) in [`MipTexture::texels`].
+    pub offset: usize,
+    pub width: u32,
+    pub height: u32,
+    /// `width as f32`, `height as f32`: map widths -> texels.
+    pub width_f: f32,
+    pub height_f: f32,
+    /// `width / width_0`, `height / height_0`: level-0 texel coordinates -> this level's
+    /// (exactly `2^-i` for power-of-two textures).
+    pub scale_x: f32,
+    pub scale_y: f32,
+}
+
+/// A validated mip pyramid of linear RGBA `f32` texels.
+///
+/// # Guarantees
+/// At least one level; level 0 is the input size; each next level follows the module's size rule
+/// down to 1x1; every texel is finite; `texels.len()` is the sum of the level areas.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MipTexture {
+    texels: Vec<Vec4>,
+    levels: Vec<LevelInfo>,
+    wrap: Wrap,
+    reduction: Reduction,
+    pow2: bool,
+}
+
+/// The input's encoding, which decides the averaging space of [`Reduction::Box`].
+#[derive(Clone, Copy, PartialEq)]
+enum Encoding {
+    Srgb,
+    Linear,
+}
+
+fn check_size(width: u32, height: u32) -> Result<(), MipError> {
+    if width == 0 || height == 0 || width > MAX_TEXTURE_SIDE || height > MAX_TEXTURE_SIDE {
+        return Err(MipError::BadSize { width, height });
+    }
+    Ok(())
+}
+
+impl MipTexture {
+    /// A pyramid from RGBA8 pixels whose RGB is sRGB-encoded and alpha linear (the usual PNG).
+    /// `data` holds `4 * width * height` bytes, row 0 first.
+    pub fn from_srgb8(
+        width: u32,
+        height: u32,
+        data: &[u8],
+        reduction: Reduction,
+        wrap: Wrap,
+    ) -> Result<MipTexture, MipError> {
+        check_size(width, height)?;
+        let n = width as usize * height as usize;
+        if data.len() != 4 * n {
+            return Err(MipError::DataLength {
+                expected: 4 * n,
+                actual: data.len(),
+            });
+        }
+        // Decode to the averaging space: linear light, or (Box) the encoded values in 0..1.
+        let work: Vec<Vec4> = data
+            .chunks_exact(4)
+            .map(|p| match reduction {
+                Reduction::GammaCorrect => Vec4::new(
+                    srgb8_to_linear(p[0]),
+                    srgb8_to_linear(p[1]),
+                    srgb8_to_linear(p[2]),
+                    p[3] as f32 / 255.0,
+                ),
+                Reduction::Box => Vec4::new(
+                    p[0] as f32 / 255.0,
+                    p[1] as f32 / 255.0,
+                    p[2] as f32 / 255.0,
+                    p[3] as f32 / 255.0,
+                ),
+            })
+            .collect();
+        Ok(Self::build(
+            width,
+            height,
+            work,
+            Encoding::Srgb,
+            reduction,
+            wrap,
+        ))
+    }
+
+    /// A pyramid from linear-light RGBA `f32` texels (row 0 first). Every value must be finite.
+    pub fn from_linear(
+        width: u32,
+        height: u32,
+        data: &[Vec4],
+        reduction: Reduction,
+        wrap: Wrap,
+    ) -> Result<MipTexture, MipError> {
+        check_size(width, height)?;
+        let n = width as usize * height as usize;
+        if data.len() != n {
+            return Err(MipError::DataLength {
+                expected: n,
+                actual: data.len(),
+            });
+        }
+        if let Some(i) = data.iter().position(|t| !t.is_finite()) {
+            return Err(MipError::NonFinite {
+                x: (i % width as usize) as u32,
+                y: (i / width as usize) as u32,
+            });
+        }
+        Ok(Self::build(
+            width,
+            height,
+            data.to_vec(),
+            Encoding::Linear,
+            reduction,
+            wrap,
+        ))
+    }
+
+    /// Reduce level by level in the averaging space; store every level as linear light.
+    fn build(
+        width: u32,
+        height: u32,
+        mut work: Vec<Vec4>,
+        encoding: Encoding,
+        reduction: Reduction,
+        wrap: Wrap,
+    ) -> MipTexture {
+        let encoded = encoding == Encoding::Srgb && reduction == Reduction::Box;
+        let to_linear = |t: Vec4| {
+            if encoded {
+                Vec4::new(
+                    srgb_to_linear(t.x),
+                    srgb_to_linear(t.y),
+                    srgb_to_linear(t.z),
+                    t.w,
+                )
+            } else {
+                t
+            }
+        };
+        let (mut w, mut h) = (width, height);
+        let mut levels = Vec::new();
+        let mut texels: Vec<Vec4> = Vec::new();
+        loop {
+            levels.push(LevelInfo {
+                offset: texels.len(),
+                width: w,
+                height: h,
+                width_f: w as f32,
+                height_f: h as f32,
+                scale_x: w as f32 / width as f32,
+                scale_y: h as f32 / height as f32,
+            });
+            texels.extend(work.iter().map(|&t| to_linear(t)));
+            if w == 1 && h == 1 {
+                break;
+            }
+            let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
+            // Reduce along x, then along y (separable exact box).
+            let mut tmp = vec![Vec4::ZERO; nw as usize * h as usize];
+            for y in 0..h as usize {
+                let src = &work[y * w as usize..(y + 1) * w as usize];
+                let dst = &mut tmp[y * nw as usize..(y + 1) * nw as usize];
+                reduce_line(src, 1, dst, 1);
+            }
+            let mut next = vec![Vec4::ZERO; nw as usize * nh as usize];
+            for x in 0..nw as usize {
+                reduce_strided(&tmp, x, nw as usize, h as usize, &mut next, nh as usize);
+            }
+            work = next;
+            w = nw;
+            h = nh;
+        }
+        // Linear-light storage of sRGB Box levels can only drift by float rounding: keep it finite.
+        debug_assert!(texels.iter().all(|t| t.is_finite()));
+        let pow2 = width.is_power_of_two() && height.is_power_of_two();
+        MipTexture {
+            texels,
+            levels,
+            wrap,
+            reduction,
+            pow2,
+        }
+    }
+
+    /// The same texels with another wrap mode.
+    pub fn with_wrap(mut self, wrap: Wrap) -> MipTexture {
+        self.wrap = wrap;
+        self
+    }
+
+    #[inline]
+    pub fn wrap(&self) -> Wrap {
+        self.wrap
+    }
+    #[inline]
+    pub fn reduction(&self) -> Reduction {
+        self.reduction
+    }
+    /// Whether level 0 is a power of two on both axes (then every level is, and Repeat uses masks).
+    #[inline]
+    pub fn is_pow2(&self) -> bool {
+        self.pow2
+    }
+    #[inline]
+    pub fn width(&self) -> u32 {
+        self.levels[0].width
+    }
+    #[inline]
+    pub fn height(&self) -> u32 {
+        self.levels[0].height
+    }
+    /// Number of levels, level 0 (the input) to the 1x1 top.
+    #[inline]
+    pub fn level_count(&self) -> usize {
+        self.levels.len()
+    }
+    /// Size and offset of level `i`, or `None` past the top.
+    #[inline]
+    pub fn level(&self, i: usize) -> Option<&LevelInfo> {
+        self.levels.get(i)
+    }
+    /// All levels, finest first.
+    #[inline]
+    pub fn levels(&self) -> &[LevelInfo] {
+        &self.levels
+    }
+    /// All texels of all levels (linear RGBA), level 0 first, row-major.
+    #[inline]
+    pub fn texels(&self) -> &[Vec4] {
+        &self.texels
+    }
+    /// `log2` of the larger level-0 side: the `n` of a `2^n`-texel map (fractional for NPOT).
+    pub fn size_log2(&self) -> f32 {
+        (self.width().max(self.height()) as f32).log2()
+    }
+
+    /// Texel `(x, y)` of level `level` with the texture's wrap mode applied to any integer address;
+    /// `None` if the level does not exist.
+    pub fn texel(&self, level: usize, x: i64, y: i64) -> Option<Vec4> {
+        let l = self.levels.get(level)?;
+        let (xi, yi) = match self.wrap {
+            Wrap::Repeat => (x.rem_euclid(l.width as i64), y.rem_euclid(l.height as i64)),
+            Wrap::Clamp => (
+                x.clamp(0, l.width as i64 - 1),
+                y.clamp(0, l.height as i64 - 1),
+            ),
+        };
+        Some(self.texels[l.offset + yi as usize * l.width as usize + xi as usize])
+    }
+
+    /// Texel `(x, y)` of `level` encoded as RGBA8 sRGB (exact encoder); `[0; 4]` if the level does
+    /// not exist.
+    pub fn texel_srgb8(&self, level: usize, x: i64, y: i64) -> [u8; 4] {
+        match self.texel(level, x, y) {
+            Some(t) => [
+                linear_to_srgb8_exact(t.x),
+                linear_to_srgb8_exact(t.y),
+                linear_to_srgb8_exact(t.z),
+                (t.w.clamp(0.0, 1.0) * 255.0 + 0.5) as u8,
+            ],
+            None => [0; 4],
+        }
+    }
+
+    /// Mean linear value of a level (f64 accumulation), for checks and tests.
+    pub fn level_mean(&self, level: usize) -> Option<[f64; 4]> {
+        let l = self.levels.get(level)?;
+        let n = l.width as usize * l.height as usize;
+        let mut s = [0f64; 4];
+        for t in &self.texels[l.offset..l.offset + n] {
+            for (c, v) in s.iter_mut().zip(t.to_array()) {
+                *c += v as f64;
+            }
+        }
+        Some(s.map(|v| v / n as f64))
+    }
+}
+
+/// Reduce one line of `src.len()` texels (stride `ss`) into `dst` (stride `ds`) with the module's
+/// exact box weights.
+fn reduce_line(src: &[Vec4], ss: usize, dst: &mut [Vec4], ds: usize) {
+    let n = src.len().div_ceil(ss);
+    let get = |i: usize| src[i * ss];
+    let m = dst.len().div_ceil(ds);
+    if n == 1 {
+        dst[0] = get(0);
+    } else if n % 2 == 0 {
+        // Even: pairs with weights ½, ½.
+        for x in 0..m {
+            dst[x * ds] = (get(2 * x) + get(2 * x + 1)) * 0.5;
+        }
+    } else {
+        // Odd 2m+1: three taps (m−x, m, x+1)/(2m+1).
+        let inv = 1.0 / n as f32;
+        let mf = m as f32;
+        for x in 0..m {
+            let xf = x as f32;
+            dst[x * ds] = get(2 * x) * ((mf - xf) * inv)
+                + get(2 * x + 1) * (mf * inv)
+                + get(2 * x + 2) * ((xf + 1.0) * inv);
+        }
+    }
+}
+
+/// Reduce column `x` of a `width`-wide image of `h` rows into column `x` of `dst` (`nh` rows).
+fn reduce_strided(src: &[Vec4], x: usize, width: usize, h: usize, dst: &mut [Vec4], nh: usize) {
+    // Gather the column, reduce it, scatter it: columns are short and this keeps one code path.
+    let col: Vec<Vec4> = (0..h).map(|y| src[y * width + x]).collect();
+    let mut out = vec![Vec4::ZERO; nh];
+    reduce_line(&col, 1, &mut out, 1);
+    for (y, v) in out.into_iter().enumerate() {
+        dst[y * width + x] = v;
+    }
+}
+
+/// Encode a linear value to sRGB in 0..1 (helper for callers building Box-encoded references).
+#[inline]
+pub fn encode_srgb(c: f32) -> f32 {
+    linear_to_srgb(c.clamp(0.0, 1.0))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn odd_weights_sum_to_one_and_preserve_the_mean() {
+        // A ramp of 7 values: the reduced 3 values must have the same mean (f64 check).
+        let src: Vec<Vec4> = (0..7).map(|i| Vec4::splat(i as f32 * i as f32)).collect();
+        let mut dst = vec![Vec4::ZERO; 3];
+        reduce_line(&src, 1, &mut dst, 1);
+        let ms: f64 = src.iter().map(|v| v.x as f64).sum::<f64>() / 7.0;
+        let md: f64 = dst.iter().map(|v| v.x as f64).sum::<f64>() / 3.0;
+        assert!((ms - md).abs() < 1e-5, "expected {ms}, got {md}, tol 1e-5");
+    }
+}

@@ -1,0 +1,855 @@
+//! Texture samplers behind one enum: nearest, bilinear, trilinear (Seed 000 Eq. 4), the
+//! span-parallel sampler of Seed 000 §3 (Eq. 8–10) with K x K memory banks, and an anisotropic
+//! many-tap reference.
+//!
+//! # Coordinates and API
+//! Map coordinates `uv` are in map widths (Seed 000's `r_m`): `u = 1` is one map width; texel
+//! centres sit at `(x + ½)/w` (see [`crate::mip`]). Derivatives `duv_dx`, `duv_dy` are the change of
+//! `uv` per pixel step to the right and per pixel step DOWN (screen y grows downward).
+//!
+//! - [`Sampler::sample`] — one pixel with its derivatives.
+//! - [`Sampler::sample_quad`] — a 2x2 quad, pixels in the order `[(x,y), (x+1,y), (x,y+1),
+//!   (x+1,y+1)]`; per-pixel samplers take the quad's coarse derivatives (`uv[1]−uv[0]`,
+//!   `uv[2]−uv[0]`), the span sampler uses the four images directly (Eq. 9). All four `uv` must be
+//!   given, also for pixels outside the triangle (extrapolate them from the plane, as GPUs do).
+//! - [`Sampler::sample_quad_with_derivatives`] — the same with analytic per-pixel derivatives.
+//! - [`Sampler::sample_pixels`], [`Sampler::sample_quads`] — many at once, the kernel chosen once
+//!   outside the loop.
+//!
+//! Nothing here panics on bad input: NaN coordinates are treated as 0, infinite or huge ones are
+//! clamped to ±2^30 texels, NaN/zero derivatives select level 0, and no NaN reaches the output
+//! (the texels are finite by [`crate::mip::MipTexture`]'s guarantees).
+//!
+//! # Levels
+//! Seed 000 Eq. (2) gives the level `l = −log2(max |∂r_m/∂(x_s, y_s)|)` with LARGER l = FINER. The
+//! samplers use the usual `λ = log2(max |∂(u·w0, v·h0)/∂(x_s, y_s)|)` in level-0 texels (larger =
+//! coarser, level index `i`, level 0 finest). For a square `2^n` map the two are related by
+//! `λ = n − l`, pyramid index `i = n − L`, and Eq. (4)'s finer weight `γ = frac(l)` is the
+//! coarser weight `1 − frac(λ)` seen from the other side: both blend the same two levels with the
+//! same weights.
+//!
+//! # The span sampler and its bank emulator (Seed 000 §3)
+//! A span is a 2x2 quad. Eq. (9) takes the span level from the extent of its four map images,
+//! `λ_span = log2(max(u_max − u_min, v_max − v_min))` in level-0 texels. Each level is stored as
+//! K x K banks: texel `(X, Y)` lives in bank `(X mod K, Y mod K)` at address `(X div K, Y div K)`;
+//! ONE parallel read of all K² banks, at the Eq. (10) addresses
+//! `a_i = ⌊X0/K⌋ + δ(i, X0)`, `δ(i, X0) = 1 if i < X0 mod K`, fetches the K x K window whose corner
+//! `X0 = ⌊min_j x_j⌋` is the span's lowest texel. Each pixel then takes its own 2x2 from the window
+//! and blends two levels with Eq. (4).
+//!
+//! **Level policy (verified):** the bilinear neighbourhood of pixel `j` is texels `⌊x_j⌋, ⌊x_j⌋+1`,
+//! so the window holds all four neighbourhoods iff `⌊x_max⌋ + 1 − ⌊x_min⌋ ≤ K − 1`, which holds
+//! whenever the span extent at that level is `< K − 2 + 1`, and is guaranteed for an extent
+//! `≤ K − 2`... precisely: with `e = x_max − x_min < K − 2 + 1` it can still fail, with `e < 1`
+//! (K = 3) or `e < 2` (K = 4) it cannot (`⌊x_min + e⌋ ≤ ⌊x_min⌋ + K − 2`). At level
+//! `i = ⌊λ_span⌋` the extent is `2^(λ−i) ∈ [1, 2)` texels, at `i + 1` it is `< 1`. Hence:
+//! - **K = 3** forces the pair `(⌊λ⌋ + 1, ⌊λ⌋ + 2)` — in the paper's convention
+//!   `(⌊l⌋ − 1, ⌊l⌋)` — one level coarser than conventional trilinear: the blur the paper reports;
+//! - **K = 4** allows the conventional pair `(⌊λ⌋, ⌊λ⌋ + 1)` = `(⌊l⌋, ⌊l⌋ + 1)`.
+//!
+//! The brief's reading is therefore confirmed, with two details the paper does not mention:
+//! (1) `⌊λ⌋` is taken EXACTLY from the float exponent of the extent (no `log2` rounding), and the
+//! extent is measured on the very coordinates used for addressing (after the repeat shift), so
+//! rounding cannot push a span over the bound; (2) the span extent of Eq. (9) measures the
+//! diagonal, `|∂u/∂x| + |∂u/∂y|`, so even K = 4 can be up to one level blurrier than per-pixel
+//! trilinear with Eq. (2)'s `max`.
+//!
+//! **Wrap-around:** `2^n` is never a multiple of 3, so with [`Wrap::Repeat`] the window
+//! `w−1, 0, 1` would put texels `w−1` and `0` in the same bank. The emulator stores each level
+//! PADDED with an apron of `K − 1` texels past the right and bottom edges (wrapped texels for
+//! Repeat, edge texels for Clamp); the window corner is reduced into `[0, w)` so windows never
+//! wrap in bank space. With Clamp the pixel coordinates are first clamped to `[0, w − 1]` texel
+//! centres (bilinear clamp-to-edge is unchanged by that). On levels narrower than `K` texels a
+//! repeat-wrapped offset is folded back into the window (`offset mod w`), which is the same texel.
+//! A property test (`tests/span_banks.rs`) runs the emulator over random planes, eyes and spans
+//! and asserts zero conflicts.
+//!
+//! The fast path ([`Sampler::Span`]) reads the same K x K window from the row-major pyramid
+//! instead of the banks; a test asserts it is bit-identical to the emulator ([`BankedTexture`]).
+//!
+//! # References
+//! Seed 000 (Kajihara), Eq. (2)–(4), (8)–(10); /work/shared/SEEDS.md.
+
+use glam::{Vec2, Vec4};
+
+use crate::mip::{LevelInfo, MipTexture, Wrap};
+
+/// Memory banks per side for the span sampler.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Banks {
+    /// 3x3 banks (the paper's design): one level blurrier than trilinear.
+    K3,
+    /// 4x4 banks: the conventional trilinear level pair.
+    K4,
+}
+
+impl Banks {
+    /// K, the banks per side.
+    #[inline]
+    pub const fn k(self) -> usize {
+        match self {
+            Banks::K3 => 3,
+            Banks::K4 => 4,
+        }
+    }
+}
+
+/// The samplers. A closed set: `enum` + `match`, the kernel chosen outside pixel loops.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Sampler {
+    /// Nearest texel of level 0 (no mip mapping; aliases under minification).
+    Nearest,
+    /// Bilinear on level 0 (no mip mapping).
+    Bilinear,
+    /// Seed 000 Eq. (4): bilinear on two adjacent levels blended by the fractional level (Eq. 2).
+    Trilinear,
+    /// Seed 000 Eq. (8)–(10): 2x2 span, level from the span extent, K x K bank window per level.
+    Span(Banks),
+    /// Reference: a box filter over the pixel's parallelogram footprint (`uv ± ½duv_dx ± ½duv_dy`),
+    /// `n_x x n_y` trilinear taps with `n = ⌈footprint side in texels⌉`, at most `max_taps` per
+    /// side (clamped to 1..=64).
+    Anisotropic { max_taps: u32 },
+}
+
+/// Largest texel coordinate magnitude: keeps `f32 -> i32` conversions and `+1` in range.
+const COORD_LIMIT: f32 = (1u32 << 30) as f32;
+
+// ---------------------------------------------------------------------------------------------
+// Addressing kernels (wrap modes), chosen once per call.
+
+trait Addr {
+    const REPEAT: bool;
+    /// Fold an integer texel address into `0..n`.
+    fn wrap(i: i32, n: i32) -> i32;
+}
+
+/// Repeat on a power-of-two level: a mask.
+struct RepeatPow2;
+/// Repeat on any size: Euclidean remainder.
+struct RepeatAny;
+/// Clamp to edge.
+struct ClampEdge;
+
+impl Addr for RepeatPow2 {
+    const REPEAT: bool = true;
+    #[inline(always)]
+    fn wrap(i: i32, n: i32) -> i32 {
+        i & (n - 1)
+    }
+}
+impl Addr for RepeatAny {
+    const REPEAT: bool = true;
+    #[inline(always)]
+    fn wrap(i: i32, n: i32) -> i32 {
+        i.rem_euclid(n)
+    }
+}
+impl Addr for ClampEdge {
+    const REPEAT: bool = false;
+    #[inline(always)]
+    fn wrap(i: i32, n: i32) -> i32 {
+        i.max(0).min(n - 1)
+    }
+}
+
+/// Clamp a texel coordinate to ±2^30; NaN becomes −2^30 (then the weights stay finite).
+#[inline(always)]
+fn clampc(x: f32) -> f32 {
+    x.max(-COORD_LIMIT).min(COORD_LIMIT)
+}
+
+/// ⌊x⌋ for |x| ≤ 2^30 (finite): truncate, then step down for negative fractions.
+#[inline(always)]
+fn floor_i32(x: f32) -> i32 {
+    debug_assert!(x.is_finite() && x.abs() <= COORD_LIMIT);
+    // SAFETY: callers pass finite values clamped to ±2^30, which fit in i32.
+    let t: i32 = unsafe { x.to_int_unchecked() };
+    t - ((t as f32 > x) as i32)
+}
+
+/// Exact ⌊log2 x⌋ for positive normal x from the float exponent; −127 for 0 and subnormals,
+/// 128 for infinity.
+#[inline(always)]
+fn floor_log2(x: f32) -> i32 {
+    ((x.to_bits() >> 23) & 0xff) as i32 - 127
+}
+
+#[inline(always)]
+fn lerp(a: Vec4, b: Vec4, t: f32) -> Vec4 {
+    a + (b - a) * t
+}
+
+#[inline(always)]
+fn texel(texels: &[Vec4], i: usize) -> Vec4 {
+    debug_assert!(i < texels.len());
+    // SAFETY: every index is `offset + y*w + x` with x, y folded into the level by `Addr::wrap`
+    // and the level inside the buffer (MipTexture guarantees).
+    unsafe { *texels.get_unchecked(i) }
+}
+
+/// Nearest texel of level 0.
+#[inline(always)]
+fn nearest<A: Addr>(texels: &[Vec4], l: &LevelInfo, uv: Vec2) -> Vec4 {
+    let (w, h) = (l.width as i32, l.height as i32);
+    let x = A::wrap(floor_i32(clampc(uv.x * l.width_f)), w);
+    let y = A::wrap(floor_i32(clampc(uv.y * l.height_f)), h);
+    texel(texels, l.offset + (y * w + x) as usize)
+}
+
+/// Seed 000 Eq. (4), one level: bilinear of the four texels around `2^L r_m − ½` with weights
+/// `(α, β) = frac(2^L r_m − ½)`, texel addresses per Eq. (3).
+#[inline(always)]
+fn bilinear<A: Addr>(texels: &[Vec4], l: &LevelInfo, uv: Vec2) -> Vec4 {
+    let x = clampc(uv.x * l.width_f - 0.5);
+    let y = clampc(uv.y * l.height_f - 0.5);
+    let (fx, fy) = (floor_i32(x), floor_i32(y));
+    let (ax, ay) = (x - fx as f32, y - fy as f32);
+    let (w, h) = (l.width as i32, l.height as i32);
+    let x0 = A::wrap(fx, w);
+    let x1 = A::wrap(fx + 1, w);
+    let r0 = l.offset + (A::wrap(fy, h) * w) as usize;
+    let r1 = l.offset + (A::wrap(fy + 1, h) * w) as usize;
+    let t00 = texel(texels, r0 + x0 as usize);
+    let t10 = texel(texels, r0 + x1 as usize);
+    let t01 = texel(texels, r1 + x0 as usize);
+    let t11 = texel(texels, r1 + x1 as usize);
+    lerp(lerp(t00, t10, ax), lerp(t01, t11, ax), ay)
+}
+
+/// λ (larger = coarser, level-0 texels) from Eq. (2)'s max of the four partial derivatives.
+/// NaN or zero derivatives give −∞ (level 0).
+#[inline(always)]
+fn lambda(l0: &LevelInfo, duv_dx: Vec2, duv_dy: Vec2) -> f32 {
+    let s = Vec2::new(l0.width_f, l0.height_f);
+    let m = (duv_dx * s).abs().max((duv_dy * s).abs()).max_element();
+    if m > 0.0 { m.log2() } else { f32::NEG_INFINITY }
+}
+
+/// Seed 000 Eq. (4): blend the bilinear samples of levels ⌊λ⌋ and ⌊λ⌋+1 by frac(λ), clamped to the
+/// pyramid.
+#[inline(always)]
+fn trilinear<A: Addr>(tex: &MipTexture, uv: Vec2, lam: f32) -> Vec4 {
+    let levels = tex.levels();
+    let texels = tex.texels();
+    let last = levels.len() - 1;
+    if !(lam > 0.0) {
+        return bilinear::<A>(texels, &levels[0], uv);
+    }
+    if lam >= last as f32 {
+        return bilinear::<A>(texels, &levels[last], uv);
+    }
+    let i = lam as usize;
+    let f = lam - i as f32;
+    let a = bilinear::<A>(texels, &levels[i], uv);
+    let b = bilinear::<A>(texels, &levels[i + 1], uv);
+    lerp(a, b, f)
+}
+
+/// The box-filtered footprint reference (see [`Sampler::Anisotropic`]).
+fn anisotropic<A: Addr>(
+    tex: &MipTexture,
+    uv: Vec2,
+    duv_dx: Vec2,
+    duv_dy: Vec2,
+    max_taps: u32,
+) -> Vec4 {
+    let l0 = &tex.levels()[0];
+    let s = Vec2::new(l0.width_f, l0.height_f);
+    let cap = max_taps.clamp(1, 64) as f32;
+    // Taps per side: one per texel of the footprint side (NaN -> 1).
+    let nx = (duv_dx * s).length().ceil().max(1.0).min(cap) as u32;
+    let ny = (duv_dy * s).length().ceil().max(1.0).min(cap) as u32;
+    let (ddx, ddy) = (duv_dx / nx as f32, duv_dy / ny as f32);
+    let lam = lambda(l0, ddx, ddy);
+    let mut sum = Vec4::ZERO;
+    for j in 0..ny {
+        let fy = (j as f32 + 0.5) / ny as f32 - 0.5;
+        for i in 0..nx {
+            let fx = (i as f32 + 0.5) / nx as f32 - 0.5;
+            sum += trilinear::<A>(tex, uv + duv_dx * fx + duv_dy * fy, lam);
+        }
+    }
+    sum / (nx * ny) as f32
+}
+
+// ---------------------------------------------------------------------------------------------
+// Span sampler (Seed 000 §3).
+
+/// A K x K texel window (K ≤ 4), `w[row][col]`.
+type Window = [[Vec4; 4]; 4];
+
+/// Where a span's K x K windows come from: the row-major pyramid (fast path) or the bank
+/// emulator (counts reads and conflicts).
+trait WindowSource {
+    /// The window whose corner is texel `(x0, y0)` of `level` (any integers; wrapped).
+    fn window<A: Addr, const K: usize>(
+        &mut self,
+        tex: &MipTexture,
+        level: usize,
+        x0: i32,
+        y0: i32,
+    ) -> Window;
+    /// A texel access fell outside the window.
+    fn conflict(&mut self);
+}
+
+/// Fast path: gather the window from the row-major level (K wrapped columns, K wrapped rows).
+struct Direct;
+
+impl WindowSource for Direct {
+    #[inline(always)]
+    fn window<A: Addr, const K: usize>(
+        &mut self,
+        tex: &MipTexture,
+        level: usize,
+        x0: i32,
+        y0: i32,
+    ) -> Window {
+        let l = &tex.levels()[level];
+        let texels = tex.texels();
+        let (w, h) = (l.width as i32, l.height as i32);
+        let mut cols = [0usize; 4];
+        for (o, c) in cols.iter_mut().enumerate().take(K) {
+            *c = A::wrap(x0 + o as i32, w) as usize;
+        }
+        let mut win = [[Vec4::ZERO; 4]; 4];
+        for (o, row) in win.iter_mut().enumerate().take(K) {
+            let r = l.offset + (A::wrap(y0 + o as i32, h) * w) as usize;
+            for (t, &c) in row.iter_mut().zip(cols.iter()).take(K) {
+                *t = texel(texels, r + c);
+            }
+        }
+        win
+    }
+    #[inline(always)]
+    fn conflict(&mut self) {}
+}
+
+/// One span: Eq. (8)'s four pixel images `uv`, Eq. (9)'s level, Eq. (10)'s windows, Eq. (4)'s
+/// per-pixel blend.
+#[inline(always)]
+fn span_quad<A: Addr, S: WindowSource, const K: usize>(
+    tex: &MipTexture,
+    uv: [Vec2; 4],
+    src: &mut S,
+) -> [Vec4; 4] {
+    let levels = tex.levels();
+    let l0 = &levels[0];
+    let last = levels.len() - 1;
+    // Level-0 texel coordinates (no half-texel offset yet), clamped; NaN -> −2^30.
+    let mut sx = uv.map(|p| clampc(p.x * l0.width_f));
+    let mut sy = uv.map(|p| clampc(p.y * l0.height_f));
+    let min4 = |a: [f32; 4]| a[0].min(a[1]).min(a[2].min(a[3]));
+    let max4 = |a: [f32; 4]| a[0].max(a[1]).max(a[2].max(a[3]));
+    // Repeat: shift the whole span by whole periods so its corner lies in the first period.
+    if A::REPEAT {
+        let px = floor_i32(min4(sx) / l0.width_f) as f32 * l0.width_f;
+        let py = floor_i32(min4(sy) / l0.height_f) as f32 * l0.height_f;
+        sx = sx.map(|v| v - px);
+        sy = sy.map(|v| v - py);
+    }
+    // Seed 000 Eq. (9): span level from the extent of the four images (level-0 texels).
+    let ext = (max4(sx) - min4(sx)).max(max4(sy) - min4(sy));
+    let shift = if K == 3 { 1 } else { 0 };
+    // Exact ⌊λ⌋ from the exponent; frac(λ) from log2, kept in [0, 1).
+    let e = floor_log2(ext);
+    let frac = if ext > 0.0 {
+        (ext.log2() - e as f32).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let fine = e + shift;
+    // Clamp the level pair to the pyramid.
+    let (i0, i1, t) = if fine < 0 {
+        (0, 0, 0.0)
+    } else if fine as usize >= last {
+        (last, last, 0.0)
+    } else {
+        (fine as usize, fine as usize + 1, frac)
+    };
+    let a = span_level::<A, S, K>(tex, i0, sx, sy, src);
+    if i1 == i0 || t == 0.0 {
+        return a;
+    }
+    let b = span_level::<A, S, K>(tex, i1, sx, sy, src);
+    [
+        lerp(a[0], b[0], t),
+        lerp(a[1], b[1], t),
+        lerp(a[2], b[2], t),
+        lerp(a[3], b[3], t),
+    ]
+}
+
+/// The four bilinear samples of one level from ONE window read.
+#[inline(always)]
+fn span_level<A: Addr, S: WindowSource, const K: usize>(
+    tex: &MipTexture,
+    level: usize,
+    sx: [f32; 4],
+    sy: [f32; 4],
+    src: &mut S,
+) -> [Vec4; 4] {
+    let l = &tex.levels()[level];
+    let (w, h) = (l.width as i32, l.height as i32);
+    // This level's texel coordinates, texel centres at integers (Eq. 3 applied to 2^L r_m − ½).
+    let mut x = sx.map(|v| v * l.scale_x - 0.5);
+    let mut y = sy.map(|v| v * l.scale_y - 0.5);
+    if !A::REPEAT {
+        // Clamp-to-edge bilinear equals bilinear at the clamped coordinate.
+        x = x.map(|v| v.max(0.0).min(l.width_f - 1.0));
+        y = y.map(|v| v.max(0.0).min(l.height_f - 1.0));
+    }
+    let fx = x.map(floor_i32);
+    let fy = y.map(floor_i32);
+    let x0 = fx[0].min(fx[1]).min(fx[2].min(fx[3]));
+    let y0 = fy[0].min(fy[1]).min(fy[2].min(fy[3]));
+    // Seed 000 Eq. (10): one parallel read of the K x K window at corner (x0, y0).
+    let win = src.window::<A, K>(tex, level, x0, y0);
+    let mut out = [Vec4::ZERO; 4];
+    for j in 0..4 {
+        let mut ox = fx[j] - x0;
+        let mut oy = fy[j] - y0;
+        let (ax, ay) = (x[j] - fx[j] as f32, y[j] - fy[j] as f32);
+        let lim = K as i32 - 2;
+        if ox > lim || oy > lim {
+            // Fold repeat-wrapped offsets on narrow levels back into the window (same texel).
+            if A::REPEAT {
+                if ox > lim {
+                    ox = ox.rem_euclid(w);
+                }
+                if oy > lim {
+                    oy = oy.rem_euclid(h);
+                }
+            }
+            if ox > lim || oy > lim {
+                // A bank conflict: the policy makes this unreachable; serve it from memory.
+                src.conflict();
+                out[j] = bilinear::<A>(
+                    tex.texels(),
+                    l,
+                    Vec2::new((x[j] + 0.5) / l.width_f, (y[j] + 0.5) / l.height_f),
+                );
+                continue;
+            }
+        }
+        let (ox, oy) = (ox as usize, oy as usize);
+        let r0 = &win[oy];
+        let r1 = &win[oy + 1];
+        out[j] = lerp(
+            lerp(r0[ox], r0[ox + 1], ax),
+            lerp(r1[ox], r1[ox + 1], ax),
+            ay,
+        );
+    }
+    out
+}
+
+// ---------------------------------------------------------------------------------------------
+// Public API.
+
+/// Call `$body` with `$A` bound to the texture's addressing kernel.
+macro_rules! with_addr {
+    ($tex:expr, $A:ident, $body:expr) => {
+        match ($tex.wrap(), $tex.is_pow2()) {
+            (Wrap::Repeat, true) => {
+                type $A = RepeatPow2;
+                $body
+            }
+            (Wrap::Repeat, false) => {
+                type $A = RepeatAny;
+                $body
+            }
+            (Wrap::Clamp, _) => {
+                type $A = ClampEdge;
+                $body
+            }
+        }
+    };
+}
+
+/// Why a bulk sampling call was refused.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum SampleError {
+    /// Input and output slices differ in length.
+    LengthMismatch { expected: usize, actual: usize },
+}
+
+impl std::fmt::Display for SampleError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            SampleError::LengthMismatch { expected, actual } => {
+                write!(f, "slice holds {actual} elements, expected {expected}")
+            }
+        }
+    }
+}
+
+impl std::error::Error for SampleError {}
+
+/// The quad's span images for a single pixel: the pixel is the top-left of its own span (Eq. 8
+/// with the span centre at `uv + ½duv_dx + ½duv_dy`).
+#[inline(always)]
+fn quad_from_pixel(uv: Vec2, duv_dx: Vec2, duv_dy: Vec2) -> [Vec2; 4] {
+    [uv, uv + duv_dx, uv + duv_dy, uv + duv_dx + duv_dy]
+}
+
+impl Sampler {
+    /// One pixel: `uv` in map widths and its screen derivatives. The span sampler treats the pixel
+    /// as the top-left of a span whose other pixels follow the derivatives (Eq. 8).
+    pub fn sample(&self, tex: &MipTexture, uv: Vec2, duv_dx: Vec2, duv_dy: Vec2) -> Vec4 {
+        with_addr!(tex, A, self.sample_one::<A>(tex, uv, duv_dx, duv_dy))
+    }
+
+    #[inline(always)]
+    fn sample_one<A: Addr>(&self, tex: &MipTexture, uv: Vec2, duv_dx: Vec2, duv_dy: Vec2) -> Vec4 {
+        let l0 = &tex.levels()[0];
+        match *self {
+            Sampler::Nearest => nearest::<A>(tex.texels(), l0, uv),
+            Sampler::Bilinear => bilinear::<A>(tex.texels(), l0, uv),
+            Sampler::Trilinear => trilinear::<A>(tex, uv, lambda(l0, duv_dx, duv_dy)),
+            Sampler::Span(Banks::K3) => {
+                span_quad::<A, Direct, 3>(tex, quad_from_pixel(uv, duv_dx, duv_dy), &mut Direct)[0]
+            }
+            Sampler::Span(Banks::K4) => {
+                span_quad::<A, Direct, 4>(tex, quad_from_pixel(uv, duv_dx, duv_dy), &mut Direct)[0]
+            }
+            Sampler::Anisotropic { max_taps } => {
+                anisotropic::<A>(tex, uv, duv_dx, duv_dy, max_taps)
+            }
+        }
+    }
+
+    /// A 2x2 quad `[(x,y), (x+1,y), (x,y+1), (x+1,y+1)]`. Per-pixel samplers use the quad's coarse
+    /// derivatives `uv[1] − uv[0]` and `uv[2] − uv[0]`; the span sampler uses Eq. (9).
+    pub fn sample_quad(&self, tex: &MipTexture, uv: [Vec2; 4]) -> [Vec4; 4] {
+        with_addr!(tex, A, self.quad_one::<A>(tex, uv))
+    }
+
+    #[inline(always)]
+    fn quad_one<A: Addr>(&self, tex: &MipTexture, uv: [Vec2; 4]) -> [Vec4; 4] {
+        match *self {
+            Sampler::Span(Banks::K3) => span_quad::<A, Direct, 3>(tex, uv, &mut Direct),
+            Sampler::Span(Banks::K4) => span_quad::<A, Direct, 4>(tex, uv, &mut Direct),
+            _ => {
+                let dx = uv[1] - uv[0];
+                let dy = uv[2] - uv[0];
+                uv.map(|p| self.sample_one::<A>(tex, p, dx, dy))
+            }
+        }
+    }
+
+    /// A 2x2 quad with analytic per-pixel derivatives (e.g. from [`crate::transform`]). The span
+    /// sampler ignores the derivatives (its level is Eq. 9's).
+    pub fn sample_quad_with_derivatives(
+        &self,
+        tex: &MipTexture,
+        uv: [Vec2; 4],
+        duv_dx: [Vec2; 4],
+        duv_dy: [Vec2; 4],
+    ) -> [Vec4; 4] {
+        with_addr!(tex, A, {
+            match *self {
+                Sampler::Span(_) => self.quad_one::<A>(tex, uv),
+                _ => [0, 1, 2, 3].map(|j| self.sample_one::<A>(tex, uv[j], duv_dx[j], duv_dy[j])),
+            }
+        })
+    }
+
+    /// Many pixels: `out[i] = sample(uv[i], duv_dx[i], duv_dy[i])`, the kernel chosen once.
+    pub fn sample_pixels(
+        &self,
+        tex: &MipTexture,
+        uv: &[Vec2],
+        duv_dx: &[Vec2],
+        duv_dy: &[Vec2],
+        out: &mut [Vec4],
+    ) -> Result<(), SampleError> {
+        let n = uv.len();
+        for len in [duv_dx.len(), duv_dy.len(), out.len()] {
+            if len != n {
+                return Err(SampleError::LengthMismatch {
+                    expected: n,
+                    actual: len,
+                });
+            }
+        }
+        macro_rules! run {
+            ($A:ty, $f:expr) => {
+                for i in 0..n {
+                    out[i] = $f(uv[i], duv_dx[i], duv_dy[i]);
+                }
+            };
+        }
+        with_addr!(tex, A, {
+            let texels = tex.texels();
+            let l0 = &tex.levels()[0];
+            match *self {
+                Sampler::Nearest => run!(A, |p, _, _| nearest::<A>(texels, l0, p)),
+                Sampler::Bilinear => run!(A, |p, _, _| bilinear::<A>(texels, l0, p)),
+                Sampler::Trilinear => {
+                    run!(A, |p, dx, dy| trilinear::<A>(tex, p, lambda(l0, dx, dy)))
+                }
+                s => run!(A, |p, dx, dy| s.sample_one::<A>(tex, p, dx, dy)),
+            }
+        });
+        Ok(())
+    }
+
+    /// Many quads: `out[i] = sample_quad(quads[i])`, the kernel chosen once.
+    pub fn sample_quads(
+        &self,
+        tex: &MipTexture,
+        quads: &[[Vec2; 4]],
+        out: &mut [[Vec4; 4]],
+    ) -> Result<(), SampleError> {
+        if quads.len() != out.len() {
+            return Err(SampleError::LengthMismatch {
+                expected: quads.len(),
+                actual: out.len(),
+            });
+        }
+        with_addr!(tex, A, {
+            match *self {
+                Sampler::Span(Banks::K3) => {
+                    for (o, q) in out.iter_mut().zip(quads) {
+                        *o = span_quad::<A, Direct, 3>(tex, *q, &mut Direct);
+                    }
+                }
+                Sampler::Span(Banks::K4) => {
+                    for (o, q) in out.iter_mut().zip(quads) {
+                        *o = span_quad::<A, Direct, 4>(tex, *q, &mut Direct);
+                    }
+                }
+                s => {
+                    for (o, q) in out.iter_mut().zip(quads) {
+                        *o = s.quad_one::<A>(tex, *q);
+                    }
+                }
+            }
+        });
+        Ok(())
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Bank emulator.
+
+/// Counters of the bank emulator.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct BankStats {
+    /// Spans sampled.
+    pub spans: u64,
+    /// Parallel window reads (one per level per span).
+    pub window_reads: u64,
+    /// Individual bank reads (K² per window read; each bank read once per window).
+    pub bank_reads: u64,
+    /// Texel accesses that fell outside the fetched window (would need another memory cycle).
+    pub conflicts: u64,
+}
+
+/// One level stored as K x K banks of the padded level (apron of K − 1 texels, see module doc).
+#[derive(Clone, Debug)]
+struct BankedLevel {
+    /// Addresses per bank row (bank width).
+    bank_w: usize,
+    /// `banks[j * K + i]` holds texels with `X mod K = i`, `Y mod K = j`.
+    banks: Vec<Vec<Vec4>>,
+}
+
+/// A [`MipTexture`] re-laid out as K x K memory banks per level (Seed 000 Eq. 10), for emulating
+/// the span sampler's parallel reads and counting bank conflicts. Slow by design: it is the
+/// model the fast path is checked against, not a renderer.
+#[derive(Clone, Debug)]
+pub struct BankedTexture {
+    banks: Banks,
+    levels: Vec<BankedLevel>,
+}
+
+impl BankedTexture {
+    /// Split every level of `tex` into `banks.k()`² banks (with the wrap apron).
+    pub fn new(tex: &MipTexture, banks: Banks) -> BankedTexture {
+        let k = banks.k();
+        let levels = (0..tex.level_count())
+            .map(|li| {
+                let l = tex.levels()[li];
+                let (pw, ph) = (l.width as usize + k - 1, l.height as usize + k - 1);
+                let (bw, bh) = (pw.div_ceil(k), ph.div_ceil(k));
+                let mut bk = vec![vec![Vec4::ZERO; bw * bh]; k * k];
+                for py in 0..ph {
+                    for px in 0..pw {
+                        // Padded texel (px, py) holds the wrapped (Repeat) or edge (Clamp) texel.
+                        let t = tex.texel(li, px as i64, py as i64).unwrap_or(Vec4::ZERO);
+                        bk[(py % k) * k + px % k][(py / k) * bw + px / k] = t;
+                    }
+                }
+                BankedLevel {
+                    bank_w: bw,
+                    banks: bk,
+                }
+            })
+            .collect();
+        BankedTexture { banks, levels }
+    }
+
+    /// K, banks per side.
+    pub fn banks(&self) -> Banks {
+        self.banks
+    }
+
+    /// The span sampler through the banks: same output as [`Sampler::Span`] (bit-identical),
+    /// counting reads and conflicts in `stats`. `tex` must be the texture this was built from.
+    pub fn sample_quad(&self, tex: &MipTexture, uv: [Vec2; 4], stats: &mut BankStats) -> [Vec4; 4] {
+        stats.spans += 1;
+        let mut src = BankSource { bt: self, stats };
+        with_addr!(tex, A, {
+            match self.banks {
+                Banks::K3 => span_quad::<A, _, 3>(tex, uv, &mut src),
+                Banks::K4 => span_quad::<A, _, 4>(tex, uv, &mut src),
+            }
+        })
+    }
+}
+
+struct BankSource<'a> {
+    bt: &'a BankedTexture,
+    stats: &'a mut BankStats,
+}
+
+impl WindowSource for BankSource<'_> {
+    fn window<A: Addr, const K: usize>(
+        &mut self,
+        tex: &MipTexture,
+        level: usize,
+        x0: i32,
+        y0: i32,
+    ) -> Window {
+        let l = &tex.levels()[level];
+        let bl = &self.bt.levels[level];
+        // Reduce the corner into the level (the window never wraps in the padded bank space).
+        let (x0, y0) = if A::REPEAT {
+            (
+                x0.rem_euclid(l.width as i32) as usize,
+                y0.rem_euclid(l.height as i32) as usize,
+            )
+        } else {
+            (
+                x0.clamp(0, l.width as i32 - 1) as usize,
+                y0.clamp(0, l.height as i32 - 1) as usize,
+            )
+        };
+        self.stats.window_reads += 1;
+        let mut win = [[Vec4::ZERO; 4]; 4];
+        for j in 0..K {
+            // Seed 000 Eq. (10): a_j = ⌊Y0/K⌋ + δ(j, Y0), δ = 1 if j < Y0 mod K.
+            let ay = y0 / K + usize::from(j < y0 % K);
+            let oy = ay * K + j - y0;
+            for i in 0..K {
+                let ax = x0 / K + usize::from(i < x0 % K);
+                let ox = ax * K + i - x0;
+                debug_assert!(ox < K && oy < K);
+                win[oy][ox] = bl.banks[j * K + i][ay * bl.bank_w + ax];
+                self.stats.bank_reads += 1;
+            }
+        }
+        win
+    }
+    fn conflict(&mut self) {
+        self.stats.conflicts += 1;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mip::Reduction;
+
+    fn ramp(w: u32, h: u32, wrap: Wrap) -> MipTexture {
+        let data: Vec<Vec4> = (0..w * h)
+            .map(|i| Vec4::new((i % w) as f32, (i / w) as f32, 1.0, 1.0))
+            .collect();
+        MipTexture::from_linear(w, h, &data, Reduction::GammaCorrect, wrap).unwrap()
+    }
+
+    #[test]
+    fn bilinear_at_texel_centres_and_midpoints_is_exact() {
+        let t = ramp(8, 8, Wrap::Clamp);
+        // Centre of texel (3, 5) is ((3.5)/8, (5.5)/8).
+        let c =
+            Sampler::Bilinear.sample(&t, Vec2::new(3.5 / 8.0, 5.5 / 8.0), Vec2::ZERO, Vec2::ZERO);
+        assert!(
+            (c - Vec4::new(3.0, 5.0, 1.0, 1.0)).abs().max_element() < 1e-6,
+            "{c}"
+        );
+        let m =
+            Sampler::Bilinear.sample(&t, Vec2::new(4.0 / 8.0, 2.25 / 8.0), Vec2::ZERO, Vec2::ZERO);
+        let expect = Vec4::new(3.5, 1.75, 1.0, 1.0);
+        assert!(
+            (m - expect).abs().max_element() < 1e-6,
+            "expected {expect}, got {m}, tol 1e-6"
+        );
+    }
+
+    #[test]
+    fn nan_and_huge_inputs_give_finite_output() {
+        for wrap in [Wrap::Repeat, Wrap::Clamp] {
+            let t = ramp(6, 10, wrap);
+            for s in [
+                Sampler::Nearest,
+                Sampler::Bilinear,
+                Sampler::Trilinear,
+                Sampler::Span(Banks::K3),
+                Sampler::Span(Banks::K4),
+                Sampler::Anisotropic { max_taps: 8 },
+            ] {
+                for uv in [
+                    Vec2::NAN,
+                    Vec2::splat(1e30),
+                    Vec2::splat(-f32::INFINITY),
+                    Vec2::new(0.3, 0.7),
+                ] {
+                    for d in [
+                        Vec2::NAN,
+                        Vec2::ZERO,
+                        Vec2::splat(1e30),
+                        Vec2::new(0.01, 0.0),
+                    ] {
+                        let c = s.sample(&t, uv, d, d.perp());
+                        assert!(c.is_finite(), "{s:?} {wrap:?} {uv} {d} -> {c}");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn span_fast_path_matches_bank_emulator_bit_for_bit() {
+        let t = ramp(64, 32, Wrap::Repeat);
+        for banks in [Banks::K3, Banks::K4] {
+            let bt = BankedTexture::new(&t, banks);
+            let mut st = BankStats::default();
+            let mut rng = 0x1234_5678u32;
+            let mut r = || {
+                rng ^= rng << 13;
+                rng ^= rng >> 17;
+                rng ^= rng << 5;
+                rng as f32 / u32::MAX as f32
+            };
+            for _ in 0..2000 {
+                let p = Vec2::new(r() * 4.0 - 2.0, r() * 4.0 - 2.0);
+                let dx = Vec2::new(r() - 0.5, r() - 0.5) * 0.2 * r();
+                let dy = Vec2::new(r() - 0.5, r() - 0.5) * 0.2 * r();
+                let q = [p, p + dx, p + dy, p + dx + dy];
+                let a = Sampler::Span(banks).sample_quad(&t, q);
+                let b = bt.sample_quad(&t, q, &mut st);
+                for j in 0..4 {
+                    assert_eq!(
+                        a[j].to_array().map(f32::to_bits),
+                        b[j].to_array().map(f32::to_bits)
+                    );
+                }
+            }
+            assert_eq!(st.conflicts, 0, "{banks:?}: {st:?}");
+        }
+    }
+}
