@@ -363,7 +363,7 @@ impl<R: Read + Seek> XtcReader<R> {
 }
 
 /// A copy of an error kept for re-reporting (io errors keep their kind and message).
-fn clone_error(e: &Error) -> Error {
+pub(crate) fn clone_error(e: &Error) -> Error {
     match e {
         Error::Parse {
             at,
