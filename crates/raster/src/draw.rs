@@ -1,0 +1,376 @@
+//! Draw calls: vertex stage, binning, parallel tile rasterisation.
+//!
+//! Every draw runs the same three stages:
+//! 1. **vertices** (parallel): world -> eye -> fixed-point screen ([`crate::project`]);
+//! 2. **primitives** (parallel over fixed chunks of [`CHUNK`] primitives): facing, bounding box,
+//!    clipping of the few triangles that need it, one packed tile rectangle per primitive, and
+//!    per-chunk tile counts; then a serial prefix sum and fill in primitive order ([`crate::bin`]);
+//! 3. **tiles** (parallel): each tile walks its entries in submission order and rasterises them
+//!    into its own pixels.
+//!
+//! Nothing in stages 1–3 depends on how rayon splits the work, and every pixel is written by the
+//! one worker that owns its tile, so the output is byte-identical for any thread count.
+
+use rayon::prelude::*;
+use texmap_core::camera::Camera;
+
+use crate::RasterError;
+use crate::bin::{Bins, CHUNK, ChunkBins, PIECE, RECT_CLIPPED, RECT_EMPTY, pack_rect};
+use crate::framebuffer::{Framebuffer, Grid};
+use crate::mesh::Mesh;
+use crate::program::{
+    FlatProg, FragProgram, LitFlatProg, LitSmoothProg, QuadSampler, Shading, TexturedProg,
+    VertexColorProg,
+};
+use crate::project::{ClipTri, FLAG_INVALID, MAX_VAR, PVert, Proj};
+use crate::sprite::{QuadShader, Sprite, raster_sprite};
+use crate::state::{Cull, DrawState};
+use crate::tri::{RasterCtx, area2, facing, pixel_bounds, raster_tri};
+
+/// What happened to the primitives of one draw call (integer counts, identical for any thread
+/// count).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct DrawStats {
+    /// Primitives submitted.
+    pub submitted: usize,
+    /// Primitives (or clipped pieces' sources) binned to at least one tile.
+    pub binned: usize,
+    /// Triangles discarded by the cull mode.
+    pub culled: usize,
+    /// Triangles of zero area after snapping to the fixed-point grid.
+    pub degenerate: usize,
+    /// Primitives whose bounding box holds no pixel centre of the image.
+    pub no_pixels: usize,
+    /// Primitives with a non-finite vertex (or an invalid sprite): skipped.
+    pub skipped_invalid: usize,
+    /// Triangles that crossed the near plane or the guard band and were clipped.
+    pub clipped: usize,
+}
+
+impl DrawStats {
+    fn add(&mut self, o: &DrawStats) {
+        self.submitted += o.submitted;
+        self.binned += o.binned;
+        self.culled += o.culled;
+        self.degenerate += o.degenerate;
+        self.no_pixels += o.no_pixels;
+        self.skipped_invalid += o.skipped_invalid;
+        self.clipped += o.clipped;
+    }
+}
+
+/// Buffers reused from draw to draw (no per-draw allocation once warm).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Scratch {
+    pverts: Vec<PVert>,
+    rects: Vec<u32>,
+    bins: Bins,
+}
+
+impl std::fmt::Debug for Bins {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Bins({} entries)", self.entries.len())
+    }
+}
+
+impl Clone for Bins {
+    fn clone(&self) -> Self {
+        Bins::default()
+    }
+}
+
+/// Classify a snapped triangle: its packed tile rectangle or why it draws nothing.
+#[inline]
+fn tri_rect(v: &[PVert; 3], cull: Cull, grid: &Grid, stats: &mut DrawStats) -> u32 {
+    let a = area2(v);
+    if a == 0 {
+        stats.degenerate += 1;
+        return RECT_EMPTY;
+    }
+    if facing(a, cull).is_none() {
+        stats.culled += 1;
+        return RECT_EMPTY;
+    }
+    match pixel_bounds(v, grid.width, grid.height) {
+        Some([x0, y0, x1, y1]) => pack_rect(x0, y0, x1, y1),
+        None => {
+            stats.no_pixels += 1;
+            RECT_EMPTY
+        }
+    }
+}
+
+impl Framebuffer {
+    fn check_camera(&self, camera: &Camera) -> Result<(), RasterError> {
+        if camera.width() != self.grid.width || camera.height() != self.grid.height {
+            return Err(RasterError::SizeMismatch {
+                camera: (camera.width(), camera.height()),
+                target: (self.grid.width, self.grid.height),
+            });
+        }
+        Ok(())
+    }
+
+    /// Draw a triangle mesh seen by `camera` with a [`Shading`] program.
+    ///
+    /// Errors: the camera's image size differs from the framebuffer's, or the program needs an
+    /// attribute the mesh lacks (`VertexColor` needs colours, `LitSmooth` normals). Triangles
+    /// with a non-finite vertex, zero area or the culled facing are skipped and counted.
+    pub fn draw_mesh(
+        &mut self,
+        camera: &Camera,
+        mesh: &Mesh,
+        shading: &Shading,
+        state: &DrawState,
+    ) -> Result<DrawStats, RasterError> {
+        self.check_camera(camera)?;
+        let proj = Proj::new(camera);
+        Ok(match *shading {
+            Shading::Flat(c) => self.draw_program(&proj, mesh, &FlatProg(c), state),
+            Shading::VertexColor => {
+                if mesh.colors().is_none() {
+                    return Err(RasterError::MissingAttribute {
+                        attribute: "colors",
+                    });
+                }
+                self.draw_program(&proj, mesh, &VertexColorProg, state)
+            }
+            Shading::LitFlat { lighting, material } => {
+                let prog = LitFlatProg {
+                    lighting: lighting.to_eye(camera),
+                    material,
+                    proj,
+                };
+                self.draw_program(&proj, mesh, &prog, state)
+            }
+            Shading::LitSmooth { lighting, material } => {
+                if mesh.normals().is_none() {
+                    return Err(RasterError::MissingAttribute {
+                        attribute: "normals",
+                    });
+                }
+                let prog = LitSmoothProg {
+                    lighting: lighting.to_eye(camera),
+                    material,
+                    proj,
+                };
+                self.draw_program(&proj, mesh, &prog, state)
+            }
+        })
+    }
+
+    /// Draw a textured mesh: perspective-correct uvs, sampled a 2x2 quad at a time by `sampler`
+    /// (see [`QuadSampler`]). The mesh must carry uvs.
+    pub fn draw_textured<S: QuadSampler + ?Sized>(
+        &mut self,
+        camera: &Camera,
+        mesh: &Mesh,
+        sampler: &S,
+        state: &DrawState,
+    ) -> Result<DrawStats, RasterError> {
+        self.check_camera(camera)?;
+        if mesh.uvs().is_none() {
+            return Err(RasterError::MissingAttribute { attribute: "uvs" });
+        }
+        let proj = Proj::new(camera);
+        Ok(self.draw_program(&proj, mesh, &TexturedProg(sampler), state))
+    }
+
+    fn draw_program<P: FragProgram>(
+        &mut self,
+        proj: &Proj,
+        mesh: &Mesh,
+        prog: &P,
+        state: &DrawState,
+    ) -> DrawStats {
+        debug_assert!(P::NV <= MAX_VAR);
+        let grid = self.grid;
+        let Framebuffer { tiles, scratch, .. } = self;
+        let positions = mesh.positions();
+        let indices = mesh.indices();
+
+        // Stage 1: vertices.
+        positions
+            .par_iter()
+            .with_min_len(4096)
+            .map(|&p| proj.project(p))
+            .collect_into_vec(&mut scratch.pverts);
+        let pverts = &scratch.pverts;
+
+        // Stage 2: primitives, in fixed chunks.
+        scratch.rects.resize(indices.len(), RECT_EMPTY);
+        let cull = state.cull;
+        let chunks: Vec<(ChunkBins<ClipTri>, DrawStats)> = scratch
+            .rects
+            .par_chunks_mut(CHUNK)
+            .zip(indices.par_chunks(CHUNK))
+            .enumerate()
+            .map(|(ci, (rects, tris))| {
+                let mut bins = ChunkBins::new(&grid);
+                let mut stats = DrawStats {
+                    submitted: tris.len(),
+                    ..DrawStats::default()
+                };
+                for (j, (rect, tri)) in rects.iter_mut().zip(tris).enumerate() {
+                    let t = ci * CHUNK + j;
+                    let v = tri.map(|i| pverts[i as usize]);
+                    let r = if v.iter().any(PVert::flagged) {
+                        if v.iter().any(|p| p.flagged() && p.y == FLAG_INVALID) {
+                            stats.skipped_invalid += 1;
+                            RECT_EMPTY
+                        } else {
+                            // Slow path: clip against the near plane and the guard band.
+                            stats.clipped += 1;
+                            let start = bins.pieces.len();
+                            let p = tri.map(|i| positions[i as usize]);
+                            let var = tri.map(|i| prog.vertex_var(mesh, i as usize));
+                            proj.clip_triangle(p, var, t as u32, &mut bins.pieces);
+                            let mut any = false;
+                            for k in start..bins.pieces.len() {
+                                let mut s = DrawStats::default();
+                                let pr = tri_rect(&bins.pieces[k].v, cull, &grid, &mut s);
+                                bins.pieces[k].rect = pr;
+                                if pr != RECT_EMPTY {
+                                    bins.count(&grid, pr);
+                                    any = true;
+                                }
+                            }
+                            if any {
+                                stats.binned += 1;
+                            }
+                            RECT_CLIPPED
+                        }
+                    } else {
+                        let r = tri_rect(&v, cull, &grid, &mut stats);
+                        if r != RECT_EMPTY {
+                            bins.count(&grid, r);
+                            stats.binned += 1;
+                        }
+                        r
+                    };
+                    *rect = r;
+                }
+                (bins, stats)
+            })
+            .collect();
+        let mut stats = DrawStats::default();
+        let mut chunk_bins = Vec::with_capacity(chunks.len());
+        for (b, s) in chunks {
+            stats.add(&s);
+            chunk_bins.push(b);
+        }
+        scratch
+            .bins
+            .fill(&grid, &scratch.rects, &chunk_bins, |p| p.rect, |p| p.tri);
+        let pieces: Vec<ClipTri> = chunk_bins.into_iter().flat_map(|c| c.pieces).collect();
+
+        // Stage 3: tiles.
+        let ctx = RasterCtx {
+            state: *state,
+            far: proj.far,
+            width: grid.width,
+            height: grid.height,
+        };
+        let bins = &scratch.bins;
+        tiles.par_iter_mut().enumerate().for_each(|(ti, tile)| {
+            for &e in bins.tile(ti) {
+                let (mut v, mut var, tri) = if e & PIECE != 0 {
+                    let p = &pieces[(e & !PIECE) as usize];
+                    (p.v, p.var, indices[p.tri as usize])
+                } else {
+                    let tri = indices[e as usize];
+                    let v = tri.map(|i| pverts[i as usize]);
+                    let mut var = [[0.0; MAX_VAR]; 3];
+                    if P::NV > 0 {
+                        var = tri.map(|i| prog.vertex_var(mesh, i as usize));
+                    }
+                    (v, var, tri)
+                };
+                let Some(front) = facing(area2(&v), state.cull) else {
+                    continue;
+                };
+                if front {
+                    // Orient clockwise on screen (positive area) for the edge functions.
+                    v.swap(1, 2);
+                    var.swap(1, 2);
+                }
+                let cst = prog.tri_const(mesh, tri, front);
+                raster_tri(tile, &ctx, prog, &cst, &v, &var, front);
+            }
+        });
+        stats
+    }
+
+    /// Draw sprites (screen-space rectangles, see [`crate::sprite`]) coloured by `shader`.
+    /// Invalid sprites (non-finite or empty rectangles, NaN `depth_min`) are skipped and counted.
+    /// `state.cull` does not apply to sprites.
+    pub fn draw_sprites<S: QuadShader + ?Sized>(
+        &mut self,
+        sprites: &[Sprite],
+        shader: &S,
+        state: &DrawState,
+    ) -> Result<DrawStats, RasterError> {
+        if sprites.len() > i32::MAX as usize {
+            return Err(RasterError::TooManyPrimitives {
+                count: sprites.len(),
+            });
+        }
+        let grid = self.grid;
+        let Framebuffer { tiles, scratch, .. } = self;
+        scratch.rects.resize(sprites.len(), RECT_EMPTY);
+        let chunks: Vec<(ChunkBins<()>, DrawStats)> = scratch
+            .rects
+            .par_chunks_mut(CHUNK)
+            .zip(sprites.par_chunks(CHUNK))
+            .map(|(rects, sps)| {
+                let mut bins = ChunkBins::new(&grid);
+                let mut stats = DrawStats {
+                    submitted: sps.len(),
+                    ..DrawStats::default()
+                };
+                for (rect, sp) in rects.iter_mut().zip(sps) {
+                    *rect = if !sp.is_valid() {
+                        stats.skipped_invalid += 1;
+                        RECT_EMPTY
+                    } else if let Some([x0, y0, x1, y1]) = sp.pixel_bounds(grid.width, grid.height)
+                    {
+                        let r = pack_rect(x0, y0, x1, y1);
+                        bins.count(&grid, r);
+                        stats.binned += 1;
+                        r
+                    } else {
+                        stats.no_pixels += 1;
+                        RECT_EMPTY
+                    };
+                }
+                (bins, stats)
+            })
+            .collect();
+        let mut stats = DrawStats::default();
+        let mut chunk_bins = Vec::with_capacity(chunks.len());
+        for (b, s) in chunks {
+            stats.add(&s);
+            chunk_bins.push(b);
+        }
+        scratch.bins.fill(
+            &grid,
+            &scratch.rects,
+            &chunk_bins,
+            |_| RECT_EMPTY,
+            |_| u32::MAX,
+        );
+        let ctx = RasterCtx {
+            state: *state,
+            far: f32::INFINITY,
+            width: grid.width,
+            height: grid.height,
+        };
+        let bins = &scratch.bins;
+        tiles.par_iter_mut().enumerate().for_each(|(ti, tile)| {
+            for &e in bins.tile(ti) {
+                raster_sprite(tile, &ctx, shader, &sprites[e as usize]);
+            }
+        });
+        Ok(stats)
+    }
+}

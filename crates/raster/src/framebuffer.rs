@@ -1,0 +1,214 @@
+//! The colour + depth framebuffer, stored as independent screen tiles.
+//!
+//! Each [`TILE`] x [`TILE`] tile owns contiguous planes (depth, r, g, b) in *quad order*: the four
+//! pixels of a 2x2 quad are adjacent (`(0,0), (1,0), (0,1), (1,1)`), quads row-major within the
+//! tile. A quad's depth is then one 16-byte load, and tiles can be handed to rayon workers as
+//! disjoint `&mut` borrows — no locking, no `unsafe`, and each pixel is written by exactly one
+//! worker, which is what makes the output independent of the thread count.
+//!
+//! Colour is linear f32 (so additive blending and counting are exact); [`Framebuffer::to_frame`]
+//! resolves it to the workspace's sRGB8 + depth [`Frame`].
+
+use glam::Vec3;
+use texmap_core::camera::MAX_IMAGE_SIDE;
+use texmap_core::color::{linear_to_srgb8, srgb8_to_linear_rgb};
+use texmap_core::frame::Frame;
+
+use crate::RasterError;
+
+/// Side of a screen tile in pixels (a multiple of 2).
+pub const TILE: u32 = 64;
+pub(crate) const TILE_SHIFT: u32 = 6;
+pub(crate) const QUADS_PER_ROW: usize = (TILE / 2) as usize;
+pub(crate) const TILE_PIXELS: usize = (TILE * TILE) as usize;
+
+/// One tile's pixel planes, in quad order.
+#[derive(Clone, Debug)]
+pub(crate) struct Tile {
+    pub depth: Box<[f32]>,
+    pub r: Box<[f32]>,
+    pub g: Box<[f32]>,
+    pub b: Box<[f32]>,
+    /// Pixel origin of the tile.
+    pub x0: u32,
+    pub y0: u32,
+}
+
+/// Index of pixel (lx, ly) inside a tile, in quad order.
+#[inline]
+pub(crate) fn tile_index(lx: u32, ly: u32) -> usize {
+    (((ly >> 1) as usize * QUADS_PER_ROW + (lx >> 1) as usize) << 2)
+        | (((ly & 1) << 1) | (lx & 1)) as usize
+}
+
+/// The tile grid of a framebuffer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Grid {
+    pub width: u32,
+    pub height: u32,
+    pub tiles_x: u32,
+    pub tiles_y: u32,
+}
+
+impl Grid {
+    #[inline]
+    pub fn tile_count(&self) -> usize {
+        (self.tiles_x * self.tiles_y) as usize
+    }
+}
+
+/// A colour + depth render target. Create it once per image size, [`clear`](Self::clear) it,
+/// draw into it, then [`to_frame`](Self::to_frame).
+///
+/// # Guarantees
+/// Width and height are in `1..=MAX_IMAGE_SIDE`. Depth holds eye-space distance along the view
+/// axis, `INFINITY` where nothing was drawn; no NaN is ever stored in the depth planes.
+#[derive(Clone, Debug)]
+pub struct Framebuffer {
+    pub(crate) grid: Grid,
+    pub(crate) tiles: Vec<Tile>,
+    background: [u8; 4],
+    clear_linear: Vec3,
+    pub(crate) scratch: crate::draw::Scratch,
+}
+
+impl Framebuffer {
+    /// A `width` x `height` framebuffer cleared to black (opaque) and infinite depth.
+    pub fn new(width: u32, height: u32) -> Result<Framebuffer, RasterError> {
+        if width == 0 || height == 0 || width > MAX_IMAGE_SIDE || height > MAX_IMAGE_SIDE {
+            return Err(RasterError::BadSize { width, height });
+        }
+        let tiles_x = width.div_ceil(TILE);
+        let tiles_y = height.div_ceil(TILE);
+        let grid = Grid {
+            width,
+            height,
+            tiles_x,
+            tiles_y,
+        };
+        let mut tiles = Vec::with_capacity(grid.tile_count());
+        for ty in 0..tiles_y {
+            for tx in 0..tiles_x {
+                tiles.push(Tile {
+                    depth: vec![f32::INFINITY; TILE_PIXELS].into_boxed_slice(),
+                    r: vec![0.0; TILE_PIXELS].into_boxed_slice(),
+                    g: vec![0.0; TILE_PIXELS].into_boxed_slice(),
+                    b: vec![0.0; TILE_PIXELS].into_boxed_slice(),
+                    x0: tx * TILE,
+                    y0: ty * TILE,
+                });
+            }
+        }
+        Ok(Framebuffer {
+            grid,
+            tiles,
+            background: [0, 0, 0, 255],
+            clear_linear: Vec3::ZERO,
+            scratch: Default::default(),
+        })
+    }
+
+    #[inline]
+    pub fn width(&self) -> u32 {
+        self.grid.width
+    }
+    #[inline]
+    pub fn height(&self) -> u32 {
+        self.grid.height
+    }
+
+    /// Clear depth to `INFINITY` and colour to `background` (sRGB8 RGBA). Uncovered pixels keep
+    /// exactly these bytes in [`to_frame`](Self::to_frame).
+    pub fn clear(&mut self, background: [u8; 4]) {
+        let lin = srgb8_to_linear_rgb(background);
+        self.background = background;
+        self.clear_linear = lin;
+        for t in &mut self.tiles {
+            t.depth.fill(f32::INFINITY);
+            t.r.fill(lin.x);
+            t.g.fill(lin.y);
+            t.b.fill(lin.z);
+        }
+    }
+
+    #[inline]
+    fn locate(&self, x: u32, y: u32) -> Option<(&Tile, usize)> {
+        if x >= self.grid.width || y >= self.grid.height {
+            return None;
+        }
+        let t = &self.tiles[((y >> TILE_SHIFT) * self.grid.tiles_x + (x >> TILE_SHIFT)) as usize];
+        Some((t, tile_index(x & (TILE - 1), y & (TILE - 1))))
+    }
+
+    /// Stored depth of pixel (x, y) (`None` outside the image).
+    pub fn depth_at(&self, x: u32, y: u32) -> Option<f32> {
+        self.locate(x, y).map(|(t, i)| t.depth[i])
+    }
+
+    /// Stored linear colour of pixel (x, y) (`None` outside the image). With [`crate::Blend::Add`]
+    /// and a flat colour of 1 this is the number of fragments written there.
+    pub fn color_at(&self, x: u32, y: u32) -> Option<Vec3> {
+        self.locate(x, y)
+            .map(|(t, i)| Vec3::new(t.r[i], t.g[i], t.b[i]))
+    }
+
+    /// Resolve to a [`Frame`]: sRGB8 colour (alpha 255 where drawn) and depth. A pixel whose
+    /// depth is infinite and whose colour still equals the clear colour keeps the background bytes.
+    pub fn to_frame(&self) -> Frame {
+        let (w, h) = (self.grid.width as usize, self.grid.height as usize);
+        let mut frame = Frame::new(self.grid.width, self.grid.height, self.background);
+        let bg = self.clear_linear;
+        for t in &self.tiles {
+            let xe = (t.x0 + TILE).min(self.grid.width);
+            let ye = (t.y0 + TILE).min(self.grid.height);
+            for y in t.y0..ye {
+                let row = y as usize * w;
+                for x in t.x0..xe {
+                    let i = tile_index(x - t.x0, y - t.y0);
+                    let c = Vec3::new(t.r[i], t.g[i], t.b[i]);
+                    let d = t.depth[i];
+                    let o = row + x as usize;
+                    frame.depth[o] = d;
+                    if d.is_finite()
+                        || c.to_array().map(f32::to_bits) != bg.to_array().map(f32::to_bits)
+                    {
+                        frame.color[o] = linear_to_srgb8(c, 255);
+                    }
+                }
+            }
+        }
+        debug_assert_eq!(frame.len(), w * h);
+        frame
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quad_order_index_is_a_bijection() {
+        let mut seen = vec![false; TILE_PIXELS];
+        for y in 0..TILE {
+            for x in 0..TILE {
+                let i = tile_index(x, y);
+                assert!(!seen[i], "({x},{y}) -> {i} twice");
+                seen[i] = true;
+            }
+        }
+        assert_eq!(tile_index(1, 1), 3);
+        assert_eq!(tile_index(2, 0), 4);
+        assert_eq!(tile_index(0, 2), 4 * QUADS_PER_ROW);
+    }
+
+    #[test]
+    fn clear_and_resolve_keep_background_bytes() {
+        let mut fb = Framebuffer::new(70, 3).unwrap();
+        fb.clear([10, 20, 30, 0]);
+        let f = fb.to_frame();
+        assert!(f.color.iter().all(|&c| c == [10, 20, 30, 0]));
+        assert_eq!(f.coverage_count(), 0);
+        assert!(Framebuffer::new(0, 5).is_err());
+        assert_eq!(fb.depth_at(70, 0), None);
+    }
+}

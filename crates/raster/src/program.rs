@@ -1,0 +1,268 @@
+//! Fragment programs: what colour a covered pixel gets.
+//!
+//! The program of a draw is chosen once, before any pixel loop: [`Shading`] (a closed set) and
+//! textured draws are turned into a concrete type implementing `FragProgram`, and the tile
+//! rasteriser is monomorphised over it, so the per-quad code holds no `dyn`, no allocation and no
+//! per-pixel `match` on the shading mode.
+//!
+//! Every program works on a whole 2x2 quad at once: that is where texture derivatives (and Seed
+//! 000's spans) come from.
+
+use glam::{Vec2, Vec3};
+use texmap_core::shade::{Lighting, Material};
+
+use crate::mesh::Mesh;
+use crate::project::{MAX_VAR, Proj, Var};
+
+/// How the triangles of [`crate::Framebuffer::draw_mesh`] are coloured. All colours are linear RGB.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum Shading {
+    /// One constant colour.
+    Flat(Vec3),
+    /// Gouraud: per-vertex colours (the mesh must carry colours), interpolated
+    /// perspective-correctly.
+    VertexColor,
+    /// [`Lighting::shade`] with one face normal per triangle (from the winding), evaluated once
+    /// per triangle at its centroid.
+    LitFlat {
+        lighting: Lighting,
+        material: Material,
+    },
+    /// Phong: [`Lighting::shade`] per pixel with the perspective-correct interpolated vertex
+    /// normal (the mesh must carry normals) and the exact view direction of the pixel.
+    LitSmooth {
+        lighting: Lighting,
+        material: Material,
+    },
+}
+
+/// The four fragments of a 2x2 quad, lanes in the order `(0,0), (1,0), (0,1), (1,1)`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct QuadFrag {
+    /// Pixel-centre screen coordinates.
+    pub x: [f32; 4],
+    pub y: [f32; 4],
+    /// Perspective-correct varyings, `var[k][lane]`.
+    pub var: [[f32; 4]; MAX_VAR],
+    /// Lanes that will be written (bit l = lane l).
+    pub mask: u8,
+}
+
+/// A per-draw fragment program (see the module docs).
+pub(crate) trait FragProgram: Sync {
+    /// Varyings used (at most [`MAX_VAR`]).
+    const NV: usize;
+    /// What the program computes once per triangle.
+    type TriConst: Copy;
+    /// The varyings of mesh vertex `vi`.
+    fn vertex_var(&self, mesh: &Mesh, vi: usize) -> Var;
+    /// Per-triangle constants of source triangle `tri`; `front` says how it faces the viewer.
+    fn tri_const(&self, mesh: &Mesh, tri: [u32; 3], front: bool) -> Self::TriConst;
+    /// Planar linear RGB of the four lanes.
+    fn shade(&self, c: &Self::TriConst, f: &QuadFrag, front: bool) -> [[f32; 4]; 3];
+}
+
+const NO_VAR: Var = [0.0; MAX_VAR];
+
+/// `Shading::Flat`.
+pub(crate) struct FlatProg(pub Vec3);
+
+impl FragProgram for FlatProg {
+    const NV: usize = 0;
+    type TriConst = ();
+    #[inline]
+    fn vertex_var(&self, _: &Mesh, _: usize) -> Var {
+        NO_VAR
+    }
+    #[inline]
+    fn tri_const(&self, _: &Mesh, _: [u32; 3], _: bool) {}
+    #[inline]
+    fn shade(&self, _: &(), _: &QuadFrag, _: bool) -> [[f32; 4]; 3] {
+        [[self.0.x; 4], [self.0.y; 4], [self.0.z; 4]]
+    }
+}
+
+/// `Shading::VertexColor`.
+pub(crate) struct VertexColorProg;
+
+impl FragProgram for VertexColorProg {
+    const NV: usize = 3;
+    type TriConst = ();
+    #[inline]
+    fn vertex_var(&self, mesh: &Mesh, vi: usize) -> Var {
+        let c = mesh.colors().map_or(Vec3::ONE, |c| c[vi]);
+        [c.x, c.y, c.z, 0.0]
+    }
+    #[inline]
+    fn tri_const(&self, _: &Mesh, _: [u32; 3], _: bool) {}
+    #[inline]
+    fn shade(&self, _: &(), f: &QuadFrag, _: bool) -> [[f32; 4]; 3] {
+        [f.var[0], f.var[1], f.var[2]]
+    }
+}
+
+/// `Shading::LitFlat`: lighting in eye space, one colour per triangle.
+pub(crate) struct LitFlatProg {
+    pub lighting: Lighting,
+    pub material: Material,
+    pub proj: Proj,
+}
+
+impl FragProgram for LitFlatProg {
+    const NV: usize = 0;
+    type TriConst = Vec3;
+    #[inline]
+    fn vertex_var(&self, _: &Mesh, _: usize) -> Var {
+        NO_VAR
+    }
+    fn tri_const(&self, mesh: &Mesh, tri: [u32; 3], front: bool) -> Vec3 {
+        let p = mesh.positions();
+        let e = tri.map(|i| self.proj.to_eye(p[i as usize]));
+        // Face normal from the counter-clockwise winding, toward the viewer when front-facing.
+        let mut n = (e[1] - e[0]).cross(e[2] - e[0]).normalize_or_zero();
+        if !front {
+            n = -n;
+        }
+        let centroid = (e[0] + e[1] + e[2]) / 3.0;
+        let v = if self.proj.persp {
+            (-centroid).normalize_or(Vec3::Z)
+        } else {
+            Vec3::Z
+        };
+        self.lighting.shade(&self.material, n, v)
+    }
+    #[inline]
+    fn shade(&self, c: &Vec3, _: &QuadFrag, _: bool) -> [[f32; 4]; 3] {
+        [[c.x; 4], [c.y; 4], [c.z; 4]]
+    }
+}
+
+/// `Shading::LitSmooth`: eye-space normals interpolated, lit per pixel.
+pub(crate) struct LitSmoothProg {
+    pub lighting: Lighting,
+    pub material: Material,
+    pub proj: Proj,
+}
+
+impl FragProgram for LitSmoothProg {
+    const NV: usize = 3;
+    type TriConst = ();
+    #[inline]
+    fn vertex_var(&self, mesh: &Mesh, vi: usize) -> Var {
+        let n = mesh
+            .normals()
+            .map_or(Vec3::Z, |n| self.proj.dir_to_eye(n[vi]));
+        [n.x, n.y, n.z, 0.0]
+    }
+    #[inline]
+    fn tri_const(&self, _: &Mesh, _: [u32; 3], _: bool) {}
+    #[inline]
+    fn shade(&self, _: &(), f: &QuadFrag, front: bool) -> [[f32; 4]; 3] {
+        let mut out = [[0.0; 4]; 3];
+        let sign = if front { 1.0 } else { -1.0 };
+        for l in 0..4 {
+            if f.mask & (1 << l) == 0 {
+                continue;
+            }
+            // Normalised interpolated normal (two-sided: flipped on back faces).
+            let n = Vec3::new(f.var[0][l], f.var[1][l], f.var[2][l]).normalize_or_zero() * sign;
+            let v = self.proj.view_dir(f.x[l], f.y[l]);
+            let c = self.lighting.shade(&self.material, n, v);
+            out[0][l] = c.x;
+            out[1][l] = c.y;
+            out[2][l] = c.z;
+        }
+        out
+    }
+}
+
+/// The texture coordinates of a 2x2 quad of pixels, handed to a [`QuadSampler`].
+///
+/// Lanes are in the order `(0,0), (1,0), (0,1), (1,1)` (x right, y down). All four lanes carry
+/// perspective-correct coordinates, including pixels outside the triangle ("helper" lanes,
+/// extrapolated on the triangle's plane), so derivatives are available at every covered pixel;
+/// a helper lane whose extrapolation is not finite gets the coordinates of a covered lane.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TexQuad {
+    /// Texture coordinates (map units) at the four pixel centres.
+    pub uv: [Vec2; 4],
+    /// Pixel-centre screen position of lane 0 (the quad's top-left pixel).
+    pub origin: Vec2,
+    /// Lanes whose colour will be used (bit l = lane l).
+    pub mask: u8,
+}
+
+impl TexQuad {
+    /// Coarse screen derivatives `(∂uv/∂x, ∂uv/∂y)` of the quad (lane 1 − lane 0, lane 2 − lane 0),
+    /// the finite differences a 2x2 span provides for free.
+    #[inline]
+    pub fn derivatives(&self) -> (Vec2, Vec2) {
+        (self.uv[1] - self.uv[0], self.uv[2] - self.uv[0])
+    }
+}
+
+/// A texture lookup for textured triangles: linear RGB at the four pixels of a quad.
+///
+/// Implement it for any sampler; per-pixel samplers use [`TexQuad::derivatives`] for their level
+/// of detail, and a Seed 000 span sampler takes the whole quad (its four map coordinates are
+/// exactly the span's `r_m(u, v)` of Eq. 8). Closures `Fn(&TexQuad) -> [Vec3; 4]` implement it.
+pub trait QuadSampler: Sync {
+    /// Linear RGB at the four lanes (values of lanes outside `quad.mask` are ignored).
+    fn sample_quad(&self, quad: &TexQuad) -> [Vec3; 4];
+}
+
+impl<F> QuadSampler for F
+where
+    F: Fn(&TexQuad) -> [Vec3; 4] + Sync,
+{
+    #[inline]
+    fn sample_quad(&self, quad: &TexQuad) -> [Vec3; 4] {
+        self(quad)
+    }
+}
+
+/// Textured triangles: uv varyings handed to a [`QuadSampler`].
+pub(crate) struct TexturedProg<'s, S: QuadSampler + ?Sized>(pub &'s S);
+
+impl<S: QuadSampler + ?Sized> FragProgram for TexturedProg<'_, S> {
+    const NV: usize = 2;
+    type TriConst = ();
+    #[inline]
+    fn vertex_var(&self, mesh: &Mesh, vi: usize) -> Var {
+        let uv = mesh.uvs().map_or(Vec2::ZERO, |u| u[vi]);
+        [uv.x, uv.y, 0.0, 0.0]
+    }
+    #[inline]
+    fn tri_const(&self, _: &Mesh, _: [u32; 3], _: bool) {}
+    #[inline]
+    fn shade(&self, _: &(), f: &QuadFrag, _: bool) -> [[f32; 4]; 3] {
+        let mut uv = [Vec2::ZERO; 4];
+        for (l, v) in uv.iter_mut().enumerate() {
+            *v = Vec2::new(f.var[0][l], f.var[1][l]);
+        }
+        // Helper lanes far outside the triangle can extrapolate past the horizon (1/W <= 0):
+        // give them a covered lane's coordinates so samplers never see a non-finite value.
+        let first = f.mask.trailing_zeros().min(3) as usize;
+        let fallback = if uv[first].is_finite() {
+            uv[first]
+        } else {
+            Vec2::ZERO
+        };
+        for v in &mut uv {
+            if !v.is_finite() {
+                *v = fallback;
+            }
+        }
+        let c = self.0.sample_quad(&TexQuad {
+            uv,
+            origin: Vec2::new(f.x[0], f.y[0]),
+            mask: f.mask,
+        });
+        [
+            [c[0].x, c[1].x, c[2].x, c[3].x],
+            [c[0].y, c[1].y, c[2].y, c[3].y],
+            [c[0].z, c[1].z, c[2].z, c[3].z],
+        ]
+    }
+}
