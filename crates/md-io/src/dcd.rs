@@ -42,6 +42,7 @@ use std::io::{self, Read, Seek, SeekFrom, Write};
 use std::sync::Arc;
 
 use crate::error::{Error, Location};
+use crate::frame::{Frame, UnitCell};
 
 /// Size of the DCD header record payload: "CORD" + 20 control words.
 const HEADER_LEN: u64 = 84;
@@ -144,6 +145,8 @@ pub struct DcdReader<R> {
     buf: Vec<u8>,
     /// Where `src` is now, to skip needless seeks when reading in order.
     pos: u64,
+    /// The frame `read_next` reads.
+    next: usize,
 }
 
 /// Location of a header problem (no frame yet).
@@ -439,6 +442,7 @@ impl<R: Read + Seek> DcdReader<R> {
             fixed: Vec::new(),
             buf: Vec::new(),
             pos: first_offset,
+            next: 0,
         };
         // Keep frame 0: later frames take their fixed atoms from it.
         if n_fixed > 0 && n_complete > 0 {
@@ -455,7 +459,7 @@ impl<R: Read + Seek> DcdReader<R> {
     }
 
     /// The number of complete frames in the file.
-    pub fn n_frames(&self) -> usize {
+    pub fn frame_count(&self) -> usize {
         self.layout.n_complete
     }
 
@@ -610,6 +614,64 @@ impl<R: Read + Seek> DcdReader<R> {
             });
         }
         Ok(cell)
+    }
+
+    /// Reads the next frame into `frame` (the `Trajectory` contract): positions, cell, step and
+    /// time (ISTART + k NSAVC steps of DELTA). `Ok(false)` after the last frame; on error the
+    /// frame is left empty and the reader stays at the damaged frame.
+    pub fn read_next(&mut self, frame: &mut Frame) -> Result<bool, Error> {
+        frame.clear();
+        let index = self.next;
+        if index >= self.layout.n_complete && self.truncation().is_none() {
+            return Ok(false);
+        }
+        let r = self
+            .read_frame(index, &mut frame.positions)
+            .and_then(|cell| {
+                cell.map(|c| {
+                    UnitCell::from_lengths_angles(c.lengths, c.angles).map_err(|e| Error::Parse {
+                        at: Location::binary(
+                            &self.file,
+                            index,
+                            self.layout.span(index).0 + self.layout.marker,
+                        ),
+                        expected: "a unit cell with volume > 0",
+                        found: e.to_string(),
+                    })
+                })
+                .transpose()
+            });
+        match r {
+            Ok(cell) => {
+                frame.cell = cell;
+                let step = self.info.first_step + index as i64 * self.info.steps_per_frame;
+                frame.step = Some(step);
+                frame.time = Some(step as f64 * self.info.timestep_ps);
+                self.next += 1;
+                Ok(true)
+            }
+            Err(e) => {
+                frame.clear();
+                Err(e)
+            }
+        }
+    }
+
+    /// Makes `read_next` read frame `n`; `Ok(false)` if there is no frame `n` (a truncated frame
+    /// counts as present, so that reading it reports the damage).
+    pub fn seek_frame(&mut self, n: usize) -> Result<bool, Error> {
+        let l = &self.layout;
+        if n < l.n_complete || (n == l.n_complete && self.truncation().is_some()) {
+            self.next = n;
+            Ok(true)
+        } else {
+            Ok(false)
+        }
+    }
+
+    /// Number of complete frames (the `Trajectory` contract; offset arithmetic, no scan).
+    pub fn n_frames(&mut self) -> Result<usize, Error> {
+        Ok(self.layout.n_complete)
     }
 
     /// Gives back the underlying stream.
@@ -767,16 +829,20 @@ fn cell_from_charmm(u: [f64; 6]) -> Result<Option<DcdCell>, String> {
 
 /// Writes CHARMM-flavour, little-endian DCD files with a unit cell in every frame.
 ///
-/// The cell is written as lengths and angle cosines (`sin(90° - angle)`, exact for 90°), the
-/// NAMD/VMD/MDAnalysis convention. Call [`DcdWriter::finish`] to record the frame count in the
-/// header (readers of ours do not need it, other programs may).
+/// The header is written with the first frame (which fixes the atom count) and kept current
+/// after every frame (NSET, NSTEP; ISTART from the first frame's step, NSAVC and DELTA from the
+/// first two frames' steps and times), so the file is complete whenever a frame has been
+/// written. The cell is written as lengths and angle cosines (`sin(90° - angle)`, exact for
+/// 90°), the NAMD/VMD/MDAnalysis convention; a frame without a cell gets an all-zero record,
+/// which readers take as "no cell".
 #[derive(Debug)]
 pub struct DcdWriter<W: Write + Seek> {
-    out: W,
+    pub(crate) out: W,
     file: Arc<str>,
     n_atoms: usize,
     n_written: usize,
-    steps_per_frame: i32,
+    first: (Option<i64>, Option<f64>),
+    nsavc: i64,
     buf: Vec<u8>,
 }
 
@@ -784,76 +850,64 @@ fn put_u32(buf: &mut Vec<u8>, v: u32) {
     buf.extend_from_slice(&v.to_le_bytes());
 }
 
+/// Byte offset of ICNTRL[k] in a file with 32-bit markers.
+fn icntrl_at(k: u64) -> u64 {
+    8 + 4 * k
+}
+
 impl<W: Write + Seek> DcdWriter<W> {
-    /// Starts a DCD file for `n_atoms` atoms, `timestep_ps` between integration steps and
-    /// `steps_per_frame` steps between frames, and writes its header.
-    pub fn new(
-        mut out: W,
-        file: Arc<str>,
-        n_atoms: usize,
-        timestep_ps: f64,
-        steps_per_frame: u32,
-        title: &str,
-    ) -> Result<Self, Error> {
-        if n_atoms == 0 || n_atoms > i32::MAX as usize / 4 {
-            return Err(Error::InvalidValue {
-                what: format!("DCD atom count {n_atoms} (must be 1..={})", i32::MAX / 4),
-            });
+    /// A DCD writer on `out`; `file` names it in errors.
+    pub fn new(out: W, file: Arc<str>) -> Self {
+        DcdWriter {
+            out,
+            file,
+            n_atoms: 0,
+            n_written: 0,
+            first: (None, None),
+            nsavc: 1,
+            buf: Vec::new(),
         }
-        if !timestep_ps.is_finite() || steps_per_frame == 0 || steps_per_frame > i32::MAX as u32 {
-            return Err(Error::InvalidValue {
-                what: format!("DCD time step {timestep_ps} ps, {steps_per_frame} steps per frame"),
-            });
-        }
-        let mut buf = Vec::with_capacity(256);
-        // Header record: "CORD" + ICNTRL; NSET and NSTEP are patched by finish().
-        put_u32(&mut buf, HEADER_LEN as u32);
+    }
+
+    /// Writes the header records for `n_atoms` atoms (NSET and friends patched later).
+    fn header(&mut self, n_atoms: usize, first_step: i64) -> io::Result<()> {
+        let buf = &mut self.buf;
+        buf.clear();
+        // Header record: "CORD" + ICNTRL.
+        put_u32(buf, HEADER_LEN as u32);
         buf.extend_from_slice(b"CORD");
         let mut icntrl = [0u32; 20];
-        icntrl[1] = 0; // ISTART
-        icntrl[2] = steps_per_frame; // NSAVC
-        icntrl[9] = ((timestep_ps / AKMA_PS) as f32).to_bits(); // DELTA in AKMA units
+        icntrl[1] = first_step.clamp(0, i32::MAX as i64) as u32; // ISTART
+        icntrl[2] = 1; // NSAVC
+        icntrl[9] = ((1.0 / AKMA_PS) as f32).to_bits(); // DELTA: 1 ps until known
         icntrl[10] = 1; // unit cell in every frame
         icntrl[19] = 24; // CHARMM version
         for v in icntrl {
-            put_u32(&mut buf, v);
+            put_u32(buf, v);
         }
-        put_u32(&mut buf, HEADER_LEN as u32);
+        put_u32(buf, HEADER_LEN as u32);
         // Title record: two 80-byte lines.
-        let mut line1 = [b' '; TITLE_LEN];
-        let t = title.as_bytes();
-        let t = &t[..t.len().min(TITLE_LEN)];
-        line1[..t.len()].copy_from_slice(t);
-        let mut line2 = [b' '; TITLE_LEN];
-        let who = b"REMARKS written by texmap-md-io";
-        line2[..who.len()].copy_from_slice(who);
-        put_u32(&mut buf, 4 + 2 * TITLE_LEN as u32);
-        put_u32(&mut buf, 2);
-        buf.extend_from_slice(&line1);
-        buf.extend_from_slice(&line2);
-        put_u32(&mut buf, 4 + 2 * TITLE_LEN as u32);
+        let mut line = [b' '; TITLE_LEN];
+        let who = b"REMARKS written by texmap-md-io (CHARMM DCD, cell as cosines)";
+        line[..who.len()].copy_from_slice(who);
+        put_u32(buf, 4 + TITLE_LEN as u32);
+        put_u32(buf, 1);
+        buf.extend_from_slice(&line);
+        put_u32(buf, 4 + TITLE_LEN as u32);
         // Atom record.
-        put_u32(&mut buf, 4);
-        put_u32(&mut buf, n_atoms as u32);
-        put_u32(&mut buf, 4);
-        out.write_all(&buf)
-            .map_err(|e| io_error(&file, None, 0, e))?;
-        Ok(DcdWriter {
-            out,
-            file,
-            n_atoms,
-            n_written: 0,
-            steps_per_frame: steps_per_frame as i32,
-            buf,
-        })
+        put_u32(buf, 4);
+        put_u32(buf, n_atoms as u32);
+        put_u32(buf, 4);
+        self.out.write_all(buf)
     }
 
-    /// Appends one frame: positions in Å, and a unit cell (`None` writes an all-zero cell, which
-    /// readers take as "no cell").
-    pub fn write_frame(
+    /// Appends one frame: positions in Å and an optional cell.
+    pub fn write_positions(
         &mut self,
         positions: &[[f32; 3]],
         cell: Option<&DcdCell>,
+        step: Option<i64>,
+        time: Option<f64>,
     ) -> Result<(), Error> {
         let frame = self.n_written;
         let invalid = |what: String| Error::InvalidFrame {
@@ -861,7 +915,16 @@ impl<W: Write + Seek> DcdWriter<W> {
             frame,
             what,
         };
-        if positions.len() != self.n_atoms {
+        let file = self.file.clone();
+        let io = |e| io_error(&file, Some(frame), 0, e);
+        if frame == 0 {
+            if positions.is_empty() || positions.len() > i32::MAX as usize / 4 {
+                return Err(invalid(format!(
+                    "{} atoms (DCD needs 1..=2^29)",
+                    positions.len()
+                )));
+            }
+        } else if positions.len() != self.n_atoms {
             return Err(invalid(format!(
                 "{} atoms, the file has {}",
                 positions.len(),
@@ -888,6 +951,12 @@ impl<W: Write + Seek> DcdWriter<W> {
                 [a, cos(gamma), b, cos(beta), cos(alpha), c_]
             }
         };
+        if frame == 0 {
+            self.header(positions.len(), step.unwrap_or(0))
+                .map_err(io)?;
+            self.n_atoms = positions.len();
+            self.first = (step, time);
+        }
         // Assemble the frame: cell record, then X, Y, Z records.
         let buf = &mut self.buf;
         buf.clear();
@@ -902,34 +971,68 @@ impl<W: Write + Seek> DcdWriter<W> {
             buf.extend(positions.iter().flat_map(|p| p[axis].to_le_bytes()));
             put_u32(buf, len);
         }
-        self.out
-            .write_all(buf)
-            .map_err(|e| io_error(&self.file, Some(frame), 0, e))?;
+        self.out.write_all(buf).map_err(io)?;
         self.n_written += 1;
-        Ok(())
+        // Keep the header current.
+        let mut patch: Vec<(u64, u32)> = Vec::with_capacity(4);
+        if frame == 1 {
+            // Steps per frame and time step from the first two frames.
+            if let ((Some(s0), t0), Some(s1)) = (self.first, step) {
+                if s1 > s0 && s1 - s0 <= i64::from(i32::MAX) {
+                    self.nsavc = s1 - s0;
+                    patch.push((icntrl_at(2), self.nsavc as u32));
+                    if let (Some(t0), Some(t1)) = (t0, time) {
+                        let delta = ((t1 - t0) / self.nsavc as f64 / AKMA_PS) as f32;
+                        if delta.is_finite() && delta > 0.0 {
+                            patch.push((icntrl_at(9), delta.to_bits()));
+                        }
+                    }
+                }
+            }
+        }
+        let nstep = (self.n_written as i64 * self.nsavc).min(i64::from(i32::MAX));
+        patch.push((icntrl_at(0), self.n_written as u32));
+        patch.push((icntrl_at(3), nstep as u32));
+        let out = &mut self.out;
+        let r: io::Result<()> = (|| {
+            let end = out.stream_position()?;
+            for (at, v) in patch {
+                out.seek(SeekFrom::Start(at))?;
+                out.write_all(&v.to_le_bytes())?;
+            }
+            out.seek(SeekFrom::Start(end))?;
+            Ok(())
+        })();
+        r.map_err(|e| io_error(&self.file, Some(frame), 8, e))
+    }
+
+    /// Appends a [`Frame`] (the `Writer` contract): positions, cell lengths and angles, step
+    /// and time. Everything else in the frame has no place in DCD.
+    pub fn write_frame(&mut self, frame: &Frame) -> io::Result<()> {
+        let cell = frame.cell.map(|c| DcdCell {
+            lengths: c.lengths(),
+            angles: c.angles(),
+        });
+        self.write_positions(&frame.positions, cell.as_ref(), frame.step, frame.time)
+            .map_err(|e| match e {
+                Error::Io { source, .. } => source,
+                other => io::Error::new(io::ErrorKind::InvalidInput, other.to_string()),
+            })
+    }
+
+    /// Flushes (the header is already current).
+    pub fn finish(&mut self) -> io::Result<()> {
+        self.out.flush()
     }
 
     /// Frames written so far.
-    pub fn n_frames(&self) -> usize {
+    pub fn frame_count(&self) -> usize {
         self.n_written
     }
 
-    /// Records the frame count in the header (NSET, NSTEP), flushes, and gives back the stream.
-    pub fn finish(mut self) -> Result<W, Error> {
-        let nset = self.n_written as u32;
-        let nstep = (self.n_written as i64 * i64::from(self.steps_per_frame)).min(i32::MAX as i64);
-        let file = self.file.clone();
-        let patch = |out: &mut W| -> io::Result<()> {
-            let end = out.stream_position()?;
-            out.seek(SeekFrom::Start(8))?;
-            out.write_all(&nset.to_le_bytes())?;
-            out.seek(SeekFrom::Start(8 + 12))?;
-            out.write_all(&(nstep as u32).to_le_bytes())?;
-            out.seek(SeekFrom::Start(end))?;
-            out.flush()
-        };
-        patch(&mut self.out).map_err(|e| io_error(&file, None, 8, e))?;
-        Ok(self.out)
+    /// Gives back the stream.
+    pub fn into_inner(self) -> W {
+        self.out
     }
 }
 
@@ -1105,7 +1208,7 @@ mod tests {
                     assert_eq!(r.info().wide_markers, wide);
                     assert_eq!(r.info().titles, vec!["hello".to_string()]);
                     close(r.info().timestep_ps, 2.0 * AKMA_PS, 1e-12);
-                    assert_eq!(r.n_frames(), 3);
+                    assert_eq!(r.frame_count(), 3);
                     assert!(r.truncation().is_none());
                     let mut p = Vec::new();
                     // Out of order on purpose: the index is offset arithmetic.
@@ -1146,7 +1249,7 @@ mod tests {
         b.frame([10.0, 0.0, 10.0, 0.0, 0.0, 10.0], &free1);
         let mut r = DcdReader::new(Cursor::new(b.bytes), name()).unwrap();
         assert_eq!(r.info().n_fixed, 3);
-        assert_eq!(r.n_frames(), 2);
+        assert_eq!(r.frame_count(), 2);
         let mut p = Vec::new();
         r.read_frame(1, &mut p).unwrap();
         let mut want = f0.clone();
@@ -1197,21 +1300,24 @@ mod tests {
 
     #[test]
     fn writer_output_reads_back_exactly() {
-        let mut w = DcdWriter::new(Cursor::new(Vec::new()), name(), 7, 0.002, 5, "t").unwrap();
+        let mut w = DcdWriter::new(Cursor::new(Vec::new()), name());
         let cell = DcdCell {
             lengths: [20.0, 21.0, 22.0],
             angles: [90.0, 100.0, 75.0],
         };
         for f in 0..4 {
-            w.write_frame(&atoms(7, f), Some(&cell)).unwrap();
+            let (step, time) = (Some(100 + 5 * f as i64), Some(0.01 * f as f64));
+            w.write_positions(&atoms(7, f), Some(&cell), step, time)
+                .unwrap();
         }
-        w.write_frame(&atoms(7, 4), None).unwrap();
-        let bytes = w.finish().unwrap().into_inner();
+        w.write_positions(&atoms(7, 4), None, None, None).unwrap();
+        let bytes = w.into_inner().into_inner();
         let mut r = DcdReader::new(Cursor::new(bytes), name()).unwrap();
         assert_eq!(r.info().declared_frames, 5);
         assert_eq!(r.info().steps_per_frame, 5);
+        assert_eq!(r.info().first_step, 100);
         close(r.info().timestep_ps, 0.002, 1e-9);
-        assert_eq!(r.n_frames(), 5);
+        assert_eq!(r.frame_count(), 5);
         let mut p = Vec::new();
         for f in 0..4 {
             let c = r.read_frame(f, &mut p).unwrap().unwrap();
@@ -1227,18 +1333,26 @@ mod tests {
 
     #[test]
     fn writer_rejects_bad_frames() {
-        let mut w = DcdWriter::new(Cursor::new(Vec::new()), name(), 2, 0.001, 1, "").unwrap();
+        let mut w = DcdWriter::new(Cursor::new(Vec::new()), name());
+        assert!(w.write_positions(&[], None, None, None).is_err());
+        w.write_positions(&atoms(2, 0), None, None, None).unwrap();
         assert!(matches!(
-            w.write_frame(&atoms(3, 0), None),
+            w.write_positions(&atoms(3, 0), None, None, None),
             Err(Error::InvalidFrame { .. })
         ));
-        assert!(w.write_frame(&[[f32::NAN, 0.0, 0.0]; 2], None).is_err());
+        assert!(
+            w.write_positions(&[[f32::NAN, 0.0, 0.0]; 2], None, None, None)
+                .is_err()
+        );
         let bad = DcdCell {
             lengths: [1.0, 1.0, 1.0],
             angles: [90.0, 190.0, 90.0],
         };
-        assert!(w.write_frame(&atoms(2, 0), Some(&bad)).is_err());
-        assert!(DcdWriter::new(Cursor::new(Vec::new()), name(), 0, 0.001, 1, "").is_err());
+        assert!(
+            w.write_positions(&atoms(2, 0), Some(&bad), None, None)
+                .is_err()
+        );
+        assert_eq!(w.frame_count(), 1);
     }
 
     #[test]
@@ -1253,7 +1367,7 @@ mod tests {
         // Cut inside frame 3.
         let cut = full.len() - 7;
         let mut r = DcdReader::new(Cursor::new(full[..cut].to_vec()), name()).unwrap();
-        assert_eq!(r.n_frames(), 3);
+        assert_eq!(r.frame_count(), 3);
         let mut p = Vec::new();
         r.read_frame(2, &mut p).unwrap();
         assert_eq!(p, atoms(3, 2));
@@ -1263,7 +1377,7 @@ mod tests {
         // Cut exactly at a frame boundary: NSET tells.
         let (off, _) = r.layout.span(3);
         let r = DcdReader::new(Cursor::new(full[..off as usize].to_vec()), name()).unwrap();
-        assert_eq!(r.n_frames(), 3);
+        assert_eq!(r.frame_count(), 3);
         assert!(matches!(r.truncation(), Some(Error::Truncated { .. })));
     }
 

@@ -23,6 +23,7 @@ use std::io::{self, Read, Seek, SeekFrom};
 use std::sync::Arc;
 
 use crate::error::{Error, Location};
+use crate::frame::{Frame, UnitCell};
 
 /// Magic number of every TRR frame.
 pub const MAGIC: i32 = 1993;
@@ -95,6 +96,8 @@ pub struct TrrReader<R> {
     tail: Option<Error>,
     buf: Vec<u8>,
     pos: u64,
+    /// The frame `read_next` reads.
+    next: usize,
 }
 
 fn be_u32(b: &[u8], at: usize) -> u32 {
@@ -288,6 +291,7 @@ impl<R: Read + Seek> TrrReader<R> {
             tail,
             buf: Vec::new(),
             pos: u64::MAX,
+            next: 0,
         })
     }
 
@@ -297,7 +301,7 @@ impl<R: Read + Seek> TrrReader<R> {
     }
 
     /// The number of complete frames before the end of the file or the first damaged frame.
-    pub fn n_frames(&self) -> usize {
+    pub fn frame_count(&self) -> usize {
         self.frames.len()
     }
 
@@ -415,6 +419,64 @@ impl<R: Read + Seek> TrrReader<R> {
         })
     }
 
+    /// Reads the next frame into `frame` (the `Trajectory` contract). `Ok(false)` after the
+    /// last frame; on error the frame is left empty and the reader stays at the damaged frame.
+    pub fn read_next(&mut self, frame: &mut Frame) -> Result<bool, Error> {
+        frame.clear();
+        let index = self.next;
+        if index >= self.frames.len() && self.tail.is_none() {
+            return Ok(false);
+        }
+        let r = self
+            .read_frame(index, &mut frame.positions, &mut frame.velocities)
+            .and_then(|info| {
+                let offset = self.frames[index].0;
+                frame.step = Some(info.step);
+                frame.time = Some(info.time);
+                if !info.has_positions {
+                    // Velocities without positions would break the frame's invariant.
+                    frame.velocities.clear();
+                }
+                match info.box_vectors {
+                    Some(m) => cell_of(
+                        m,
+                        &self.file,
+                        index,
+                        offset + (FIXED + 2 * if info.double { 8 } else { 4 }) as u64,
+                    ),
+                    None => Ok(None),
+                }
+            });
+        match r {
+            Ok(cell) => {
+                frame.cell = cell;
+                self.next += 1;
+                Ok(true)
+            }
+            Err(e) => {
+                frame.clear();
+                Err(e)
+            }
+        }
+    }
+
+    /// Makes `read_next` read frame `n`; `Ok(false)` if there is no frame `n` (a damaged frame
+    /// right after the last good one counts as present, so that reading it reports the damage).
+    pub fn seek_frame(&mut self, n: usize) -> Result<bool, Error> {
+        let len = self.frames.len();
+        if n < len || (n == len && self.tail.is_some()) {
+            self.next = n;
+            Ok(true)
+        } else {
+            Ok(false)
+        }
+    }
+
+    /// Number of complete frames (the `Trajectory` contract; the index is built at open time).
+    pub fn n_frames(&mut self) -> Result<usize, Error> {
+        Ok(self.frames.len())
+    }
+
     /// Gives back the underlying stream.
     pub fn into_inner(self) -> R {
         self.src
@@ -434,6 +496,25 @@ fn convert<const REAL: usize>(bytes: &[u8], out: &mut Vec<[f32; 3]>) {
             }
         })
     }));
+}
+
+/// The cell of a GROMACS box (rows, Å); an all-zero box means none.
+fn cell_of(
+    m: [[f64; 3]; 3],
+    file: &Arc<str>,
+    index: usize,
+    byte: u64,
+) -> Result<Option<UnitCell>, Error> {
+    if m.as_flattened().iter().all(|v| *v == 0.0) {
+        return Ok(None);
+    }
+    UnitCell::from_matrix(m)
+        .map(Some)
+        .map_err(|e| Error::Parse {
+            at: Location::binary(file, index, byte),
+            expected: "box vectors with volume > 0",
+            found: e.to_string(),
+        })
 }
 
 #[cfg(test)]
@@ -522,7 +603,7 @@ mod tests {
             bytes.extend(frame(double, n, 20, Some(bx), None, Some(&v0), None));
             bytes.extend(frame(double, n, 30, None, None, None, Some(&f0)));
             let mut r = TrrReader::new(Cursor::new(bytes), name()).unwrap();
-            assert_eq!(r.n_frames(), 4);
+            assert_eq!(r.frame_count(), 4);
             assert_eq!(r.n_atoms(), n);
             let (mut p, mut v) = (Vec::new(), Vec::new());
             let want = |vals: &[f64]| -> Vec<[f32; 3]> {
@@ -580,7 +661,7 @@ mod tests {
             let complete = ends.iter().filter(|&&e| e <= cut as u64).count();
             match TrrReader::new(Cursor::new(bytes[..cut].to_vec()), name()) {
                 Ok(mut r) => {
-                    assert_eq!(r.n_frames(), complete, "cut at {cut}");
+                    assert_eq!(r.frame_count(), complete, "cut at {cut}");
                     let (mut p, mut v) = (Vec::new(), Vec::new());
                     for f in 0..complete {
                         r.read_frame(f, &mut p, &mut v).unwrap();
@@ -607,7 +688,7 @@ mod tests {
                 b[at] ^= bit;
                 if let Ok(mut r) = TrrReader::new(Cursor::new(b), name()) {
                     let (mut p, mut v) = (Vec::new(), Vec::new());
-                    for f in 0..r.n_frames() + 1 {
+                    for f in 0..r.frame_count() + 1 {
                         let _ = r.read_frame(f, &mut p, &mut v);
                     }
                 }
@@ -623,7 +704,7 @@ mod tests {
         let second = bytes.len() / 2;
         bytes[second + 24 + 4 * 7 + 3] ^= 0x04; // x_size of frame 1
         let mut r = TrrReader::new(Cursor::new(bytes), name()).unwrap();
-        assert_eq!(r.n_frames(), 1);
+        assert_eq!(r.frame_count(), 1);
         let e = r
             .read_frame(1, &mut Vec::new(), &mut Vec::new())
             .unwrap_err();

@@ -41,6 +41,7 @@ use std::io::{self, Read, Seek, SeekFrom, Write};
 use std::sync::Arc;
 
 use crate::error::{Error, Location};
+use crate::frame::{Frame, UnitCell};
 
 /// Magic number of the classic format (32-bit byte count).
 pub const MAGIC_1995: i32 = 1995;
@@ -101,6 +102,8 @@ pub struct XtcReader<R> {
     tail: Option<Error>,
     buf: Vec<u8>,
     pos: u64,
+    /// The frame `read_next` reads.
+    next: usize,
 }
 
 fn be_u32(b: &[u8], at: usize) -> u32 {
@@ -285,6 +288,7 @@ impl<R: Read + Seek> XtcReader<R> {
             tail,
             buf: Vec::new(),
             pos: u64::MAX,
+            next: 0,
         })
     }
 
@@ -294,12 +298,12 @@ impl<R: Read + Seek> XtcReader<R> {
     }
 
     /// The number of complete frames before the end of the file or the first damaged frame.
-    pub fn n_frames(&self) -> usize {
+    pub fn frame_count(&self) -> usize {
         self.frames.len()
     }
 
     /// Why indexing stopped before the end of the file, if it did (the error of frame
-    /// [`XtcReader::n_frames`]).
+    /// [`XtcReader::frame_count`]).
     pub fn truncation(&self) -> Option<&Error> {
         self.tail.as_ref()
     }
@@ -354,6 +358,52 @@ impl<R: Read + Seek> XtcReader<R> {
             offset,
             positions,
         )
+    }
+
+    /// Reads the next frame into `frame` (the `Trajectory` contract). `Ok(false)` after the
+    /// last frame; on error the frame is left empty and the reader stays at the damaged frame.
+    pub fn read_next(&mut self, frame: &mut Frame) -> Result<bool, Error> {
+        frame.clear();
+        let index = self.next;
+        if index >= self.frames.len() && self.tail.is_none() {
+            return Ok(false);
+        }
+        let r = self
+            .read_frame(index, &mut frame.positions)
+            .and_then(|info| {
+                let offset = self.frames[index].offset;
+                frame.step = Some(info.step);
+                frame.time = Some(info.time);
+                cell_of(info.box_vectors, &self.file, index, offset + 16)
+            });
+        match r {
+            Ok(cell) => {
+                frame.cell = cell;
+                self.next += 1;
+                Ok(true)
+            }
+            Err(e) => {
+                frame.clear();
+                Err(e)
+            }
+        }
+    }
+
+    /// Makes `read_next` read frame `n`; `Ok(false)` if there is no frame `n` (a damaged frame
+    /// right after the last good one counts as present, so that reading it reports the damage).
+    pub fn seek_frame(&mut self, n: usize) -> Result<bool, Error> {
+        let len = self.frames.len();
+        if n < len || (n == len && self.tail.is_some()) {
+            self.next = n;
+            Ok(true)
+        } else {
+            Ok(false)
+        }
+    }
+
+    /// Number of complete frames (the `Trajectory` contract; the index is built at open time).
+    pub fn n_frames(&mut self) -> Result<usize, Error> {
+        Ok(self.frames.len())
     }
 
     /// Gives back the underlying stream.
@@ -824,6 +874,25 @@ impl<W: Write> XtcWriter<W> {
     }
 }
 
+/// The cell of a GROMACS box (rows, Å); an all-zero box means none.
+fn cell_of(
+    m: [[f64; 3]; 3],
+    file: &Arc<str>,
+    index: usize,
+    byte: u64,
+) -> Result<Option<UnitCell>, Error> {
+    if m.as_flattened().iter().all(|v| *v == 0.0) {
+        return Ok(None);
+    }
+    UnitCell::from_matrix(m)
+        .map(Some)
+        .map_err(|e| Error::Parse {
+            at: Location::binary(file, index, byte),
+            expected: "box vectors with volume > 0",
+            found: e.to_string(),
+        })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -882,7 +951,7 @@ mod tests {
                 let want = m.read_all_frames().unwrap();
                 // ...and so do we, in reverse order.
                 let mut r = XtcReader::new(Cursor::new(bytes), name()).unwrap();
-                assert_eq!(r.n_frames(), 3);
+                assert_eq!(r.frame_count(), 3);
                 assert_eq!(r.n_atoms(), n);
                 assert!(r.truncation().is_none());
                 let mut p = Vec::new();
@@ -978,7 +1047,7 @@ mod tests {
             let complete = ends.iter().filter(|&&e| e <= cut as u64).count();
             match XtcReader::new(Cursor::new(bytes[..cut].to_vec()), name()) {
                 Ok(mut r) => {
-                    assert_eq!(r.n_frames(), complete, "cut at {cut}");
+                    assert_eq!(r.frame_count(), complete, "cut at {cut}");
                     let mut p = Vec::new();
                     for f in 0..complete {
                         r.read_frame(f, &mut p).unwrap();
@@ -1006,7 +1075,7 @@ mod tests {
                 b[at] ^= bit;
                 if let Ok(mut r) = XtcReader::new(Cursor::new(b), name()) {
                     let mut p = Vec::new();
-                    for f in 0..r.n_frames() + 1 {
+                    for f in 0..r.frame_count() + 1 {
                         let _ = r.read_frame(f, &mut p);
                     }
                 }
