@@ -33,3 +33,4 @@ pub mod metrics;
 pub mod mip;
 pub mod sample;
 pub mod shade;
+pub mod transform;
