@@ -28,6 +28,7 @@ pub use glam;
 
 pub mod camera;
 pub mod color;
+pub mod coverage;
 pub mod frame;
 pub mod metrics;
 pub mod mip;
