@@ -17,6 +17,6 @@ pub use draw::DrawStats;
 pub use error::RasterError;
 pub use framebuffer::{Framebuffer, TILE};
 pub use mesh::Mesh;
-pub use program::{QuadSampler, Shading, TexQuad};
+pub use program::{MipSampler, QuadSampler, Shading, TexQuad};
 pub use sprite::{QuadOut, QuadShader, Sprite, SpriteQuad};
 pub use state::{Blend, Cull, DepthTest, DrawState};

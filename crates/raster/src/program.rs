@@ -9,6 +9,8 @@
 //! 000's spans) come from.
 
 use glam::{Vec2, Vec3};
+use texmap_core::mip::MipTexture;
+use texmap_core::sample::Sampler;
 use texmap_core::shade::{Lighting, Material};
 
 use crate::mesh::Mesh;
@@ -219,6 +221,24 @@ where
     #[inline]
     fn sample_quad(&self, quad: &TexQuad) -> [Vec3; 4] {
         self(quad)
+    }
+}
+
+/// A texmap-core [`Sampler`] bound to its [`MipTexture`]: the way to texture triangles with
+/// nearest, bilinear, trilinear (Seed 000 Eq. 4), span-parallel (Eq. 8–10, the whole quad is the
+/// span) or anisotropic sampling. Colour is the texture's linear RGB (alpha is dropped).
+#[derive(Clone, Copy, Debug)]
+pub struct MipSampler<'a> {
+    pub texture: &'a MipTexture,
+    pub sampler: Sampler,
+}
+
+impl QuadSampler for MipSampler<'_> {
+    #[inline]
+    fn sample_quad(&self, quad: &TexQuad) -> [Vec3; 4] {
+        self.sampler
+            .sample_quad(self.texture, quad.uv)
+            .map(|c| c.truncate())
     }
 }
 
