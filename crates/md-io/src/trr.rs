@@ -125,11 +125,6 @@ fn io_error(file: &Arc<str>, frame: usize, byte: u64, source: io::Error) -> Erro
     }
 }
 
-/// True if `head` starts like a TRR file.
-pub fn sniff(head: &[u8]) -> bool {
-    head.len() >= 24 && be_i32(head, 0) == MAGIC && &head[12..24] == b"GMX_trn_file"
-}
-
 /// Parses and checks a header from `h` (which holds at least `FIXED` bytes; `MAX_HEADER` if
 /// available). `Ok(None)` means more bytes are needed for t and lambda.
 fn parse_header(
@@ -296,21 +291,25 @@ impl<R: Read + Seek> TrrReader<R> {
     }
 
     /// Atoms in the first frame (0 for an empty file).
+    #[cfg_attr(not(test), allow(dead_code))]
     pub fn n_atoms(&self) -> usize {
         self.n_atoms
     }
 
     /// The number of complete frames before the end of the file or the first damaged frame.
+    #[cfg_attr(not(test), allow(dead_code))]
     pub fn frame_count(&self) -> usize {
         self.frames.len()
     }
 
     /// Why indexing stopped before the end of the file, if it did.
+    #[cfg_attr(not(test), allow(dead_code))]
     pub fn truncation(&self) -> Option<&Error> {
         self.tail.as_ref()
     }
 
     /// Byte offset of frame `index`.
+    #[cfg_attr(not(test), allow(dead_code))]
     pub fn frame_offset(&self, index: usize) -> Option<u64> {
         self.frames.get(index).map(|(o, _)| *o)
     }
@@ -478,6 +477,7 @@ impl<R: Read + Seek> TrrReader<R> {
     }
 
     /// Gives back the underlying stream.
+    #[cfg_attr(not(test), allow(dead_code))]
     pub fn into_inner(self) -> R {
         self.src
     }

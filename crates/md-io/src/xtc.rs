@@ -125,11 +125,6 @@ fn io_error(file: &Arc<str>, frame: usize, byte: u64, source: io::Error) -> Erro
     }
 }
 
-/// True if `head` starts like an XTC file.
-pub fn sniff(head: &[u8]) -> bool {
-    head.len() >= 4 && matches!(be_i32(head, 0), MAGIC_1995 | MAGIC_2023)
-}
-
 /// Checks the magic number and the two atom counts of a header: (magic, natoms).
 fn check_counts(
     head: &[u8],
@@ -293,22 +288,26 @@ impl<R: Read + Seek> XtcReader<R> {
     }
 
     /// Atoms per frame (0 for an empty file).
+    #[cfg_attr(not(test), allow(dead_code))]
     pub fn n_atoms(&self) -> usize {
         self.n_atoms
     }
 
     /// The number of complete frames before the end of the file or the first damaged frame.
+    #[cfg_attr(not(test), allow(dead_code))]
     pub fn frame_count(&self) -> usize {
         self.frames.len()
     }
 
     /// Why indexing stopped before the end of the file, if it did (the error of frame
     /// [`XtcReader::frame_count`]).
+    #[cfg_attr(not(test), allow(dead_code))]
     pub fn truncation(&self) -> Option<&Error> {
         self.tail.as_ref()
     }
 
     /// Byte offset of frame `index`.
+    #[cfg_attr(not(test), allow(dead_code))]
     pub fn frame_offset(&self, index: usize) -> Option<u64> {
         self.frames.get(index).map(|e| e.offset)
     }
@@ -407,6 +406,7 @@ impl<R: Read + Seek> XtcReader<R> {
     }
 
     /// Gives back the underlying stream.
+    #[cfg_attr(not(test), allow(dead_code))]
     pub fn into_inner(self) -> R {
         self.src
     }
@@ -764,10 +764,10 @@ impl Decoder<'_> {
     }
 }
 
-/// Writes XTC files with molly's compressor (magic 1995).
+/// Writes XTC files (magic 1995) with molly's compressor.
 #[derive(Debug)]
-pub struct XtcWriter<W: Write> {
-    inner: molly::XTCWriter<W>,
+pub struct XtcWriter<W> {
+    pub(crate) out: W,
     file: Arc<str>,
     n_atoms: Option<usize>,
     n_written: usize,
@@ -779,13 +779,13 @@ pub struct XtcWriter<W: Write> {
 impl<W: Write> XtcWriter<W> {
     /// An XTC writer with `precision` in 1/nm (GROMACS writes 1000).
     pub fn new(out: W, file: Arc<str>, precision: f32) -> Result<Self, Error> {
-        if !(precision.is_finite() && precision >= 1.0 && precision <= 1e6) {
+        if !(precision.is_finite() && (1.0..=1e6).contains(&precision)) {
             return Err(Error::InvalidValue {
                 what: format!("XTC precision {precision} (must be in 1..=1e6 per nm)"),
             });
         }
         Ok(XtcWriter {
-            inner: molly::XTCWriter::new(out),
+            out,
             file,
             n_atoms: None,
             n_written: 0,
@@ -795,7 +795,7 @@ impl<W: Write> XtcWriter<W> {
     }
 
     /// Appends a frame: positions in Å, box rows in Å (`None`: zero box), step and time (ps).
-    pub fn write_frame(
+    pub fn write_positions(
         &mut self,
         positions: &[[f32; 3]],
         box_vectors: Option<[[f64; 3]; 3]>,
@@ -840,6 +840,7 @@ impl<W: Write> XtcWriter<W> {
         for (o, v) in bv.iter_mut().zip(boxvec.as_flattened()) {
             *o = (*v / f64::from(NM)) as f32;
         }
+        // Convert Å → nm into the reused buffer, lend it to molly's frame, take it back.
         self.nm.clear();
         self.nm
             .extend(positions.as_flattened().iter().map(|v| v / NM));
@@ -850,7 +851,7 @@ impl<W: Write> XtcWriter<W> {
             precision: self.precision,
             positions: std::mem::take(&mut self.nm),
         };
-        let r = self.inner.write_frame(&mframe);
+        let r = molly::XTCWriter::new(&mut self.out).write_frame(&mframe);
         self.nm = mframe.positions;
         r.map_err(|e| Error::Io {
             at: Location {
@@ -864,13 +865,30 @@ impl<W: Write> XtcWriter<W> {
         Ok(())
     }
 
-    /// Flushes and gives back the stream.
-    pub fn finish(mut self) -> Result<W, Error> {
-        self.inner.file.flush().map_err(|e| Error::Io {
-            at: Location::file(&self.file),
-            source: e,
-        })?;
-        Ok(self.inner.file)
+    /// Appends a [`Frame`] (the `Writer` contract): positions, cell matrix, step and time.
+    pub fn write_frame(&mut self, frame: &Frame) -> io::Result<()> {
+        self.write_positions(
+            &frame.positions,
+            frame.cell.map(|c| c.matrix()),
+            frame.step.unwrap_or(self.n_written as i64),
+            frame.time.unwrap_or(0.0),
+        )
+        .map_err(|e| match e {
+            Error::Io { source, .. } => source,
+            other => io::Error::new(io::ErrorKind::InvalidInput, other.to_string()),
+        })
+    }
+
+    /// Flushes.
+    #[cfg_attr(not(test), allow(dead_code))]
+    pub fn finish(&mut self) -> io::Result<()> {
+        self.out.flush()
+    }
+
+    /// Gives back the stream.
+    #[cfg_attr(not(test), allow(dead_code))]
+    pub fn into_inner(self) -> W {
+        self.out
     }
 }
 
@@ -1004,10 +1022,10 @@ mod tests {
         let mut w = XtcWriter::new(Vec::new(), name(), 1000.0).unwrap();
         let bx = [[30.0, 0.0, 0.0], [0.0, 31.0, 0.0], [1.0, 2.0, 32.0]];
         for f in &frames {
-            w.write_frame(f, Some(bx), 7, 1.5).unwrap();
+            w.write_positions(f, Some(bx), 7, 1.5).unwrap();
         }
-        assert!(w.write_frame(&frames[0][..3], None, 0, 0.0).is_err());
-        let bytes = w.finish().unwrap();
+        assert!(w.write_positions(&frames[0][..3], None, 0, 0.0).is_err());
+        let bytes = w.into_inner();
         let mut r = XtcReader::new(Cursor::new(bytes), name()).unwrap();
         let mut p = Vec::new();
         let info = r.read_frame(1, &mut p).unwrap();
