@@ -1,1 +1,61 @@
-//! (being built)
+//! Molecular-dynamics trajectories for the sphere renderers: readers and writers of the usual
+//! file formats, streaming frames, and element tables (radius, colour).
+//!
+//! - [`Trajectory`] reads XYZ / extended XYZ, PDB, GRO and LAMMPS text dumps (and the binary
+//!   DCD, XTC, TRR) one frame at a time into a reusable [`Frame`], or any frame by index.
+//! - [`Writer`] writes XYZ and PDB.
+//! - [`elements`] maps atom names to elements, gives van der Waals radii and CPK colours, and
+//!   [`AtomStyle`] resolves each atom's radius and colour with user overrides.
+//!
+//! Positions are in Å whatever the file's units; errors name the file, frame, line and byte.
+//!
+//! **Architecture invariant:** md-io depends on no other crate of texmap; it is reusable alone.
+//!
+//! # Example
+//! ```
+//! use texmap_md_io::{Format, Frame, Trajectory};
+//! let xyz = "2\nwater fragment\nO 0.0 0.0 0.0\nH 0.96 0.0 0.0\n";
+//! let mut traj = Trajectory::from_reader(std::io::Cursor::new(xyz), Format::Xyz, "frag.xyz")?;
+//! let mut frame = Frame::new();
+//! while traj.read_next(&mut frame)? {
+//!     assert_eq!(frame.n_atoms(), 2);
+//!     assert_eq!(frame.elements[0].symbol(), "O");
+//!     assert_eq!(frame.positions[1], [0.96, 0.0, 0.0]);
+//! }
+//! # Ok::<(), texmap_md_io::Error>(())
+//! ```
+//!
+//! # How a format plugs in
+//! Formats are a closed set: the [`Format`] enum plus one variant per format in the private
+//! `Reader` enum (src/trajectory.rs) and `WriterKind` enum (src/writer.rs), dispatched by the
+//! `each_reader!` / `each_writer!` macros there. To add a format:
+//! 1. write `src/<fmt>.rs` with a reader type `XxxReader<R: Read + Seek>` having
+//!    - `fn new(src: R, file: Arc<str>) -> Result<Self, Error>` (read and check the header),
+//!    - `fn read_next(&mut self, frame: &mut Frame) -> Result<bool, Error>`: clear `frame`,
+//!      fill it (Å, finite, per-atom vectors empty or n_atoms long), `Ok(false)` at the end; on
+//!      a damaged frame return an error with a [`Location`] and stay at that frame,
+//!    - `fn seek_frame(&mut self, n: usize) -> Result<bool, Error>`: make `read_next` read frame
+//!      `n` next, `Ok(false)` when there is no frame `n` (build the frame index lazily),
+//!    - `fn n_frames(&mut self) -> Result<usize, Error>` that keeps the read position;
+//! 2. add the variant to `Reader`, an arm to `each_reader!` and to `Trajectory::from_reader`;
+//! 3. for a writer, a type with `fn write_frame(&mut self, frame: &Frame) -> std::io::Result<()>`
+//!    and `fn finish(&mut self) -> std::io::Result<()>`, a `WriterKind` variant and arms.
+//! Text formats instead implement the private `TextFormat` trait (src/text.rs) and get
+//! streaming, the line-scan index and error positions from `TextReader`.
+
+pub mod elements;
+mod error;
+mod format;
+mod frame;
+pub mod parse;
+mod text;
+mod trajectory;
+mod writer;
+mod xyz;
+
+pub use elements::{Appearance, AtomStyle, Element, Selector};
+pub use error::{Error, Location};
+pub use format::Format;
+pub use frame::{Frame, Label, UnitCell};
+pub use trajectory::Trajectory;
+pub use writer::Writer;

@@ -1,0 +1,531 @@
+//! Element tables (van der Waals radius, CPK/Jmol colour), the rule that maps atom names to
+//! elements, and [`AtomStyle`]: user overrides of radius and colour per type, name or element.
+//!
+//! # Tables
+//! - Radii: S. Alvarez, "A cartography of the van der Waals territories", Dalton Trans. 42
+//!   (2013) 8617, for every element it covers (H..Cf except Pm, Po..Ra). Where Alvarez gives
+//!   none: M. Mantina et al., J. Phys. Chem. A 113 (2009) 5806 for Po, At, Rn, Fr, Ra, and 2.00 Å
+//!   for Pm and Fm..Lr. Note Alvarez's radii are larger than Bondi's (1964) for metals (Na 2.50
+//!   vs 2.27 Å) and for C (1.77 vs 1.70 Å).
+//! - Colours: the Jmol CPK colours (8-bit sRGB), H..Lr.
+//! Both were generated from ASE 3.29 (`ase.data.vdw_alvarez`, `ase.data.colors.jmol_colors`) by
+//! `tests/data/gen_elements.py --rust`; `tests/elements.rs` checks every entry against the JSON
+//! that script writes.
+//!
+//! # From an atom name to an element ([`guess_element`])
+//! 1. An explicit element (PDB columns 77-78, an `element` column) wins when it is a symbol
+//!    (case-insensitive: "CL", "Cl" and "cl" are chlorine).
+//! 2. Leading digits are dropped ("1HB" → "HB") and the letters up to the first non-letter kept
+//!    ("HG1" → "HG", "FE2+" → "FE"): call them L.
+//! 3. In a standard biomolecular residue (the 20 amino acids and common protonation variants,
+//!    nucleotides, water, ACE/NME caps) the element is L's first letter: "CA" is the α carbon,
+//!    "HG1" a hydrogen, "OW" an oxygen.
+//! 4. Otherwise, when L is exactly two letters that form a symbol, and either the name has no
+//!    digits, or its second letter is lower case, or the residue name has the same letters (an
+//!    ion named after itself), it is that element: "CA" alone or in residue
+//!    "CA" is calcium, "Cl", "FE", "Fe2" are chlorine and iron; but "HO2" (a hydroxyl hydrogen)
+//!    and "CD1" are hydrogen and carbon.
+//! 5. Otherwise the first letter of L if it is a one-letter symbol (H B C N O F P S K V Y I W U),
+//!    else the first two letters if they form a symbol, else [`Element::UNKNOWN`].
+//!
+//! Integer LAMMPS types ("1", "2") have no element: give them one with an `element` column or
+//! style them by type with [`AtomStyle`].
+
+use crate::error::Error;
+use crate::frame::{Frame, Label};
+
+/// (symbol, van der Waals radius in Å, Jmol colour as 8-bit sRGB) for Z = 1..=103.
+const TABLE: [(&str, f32, [u8; 3]); 103] = [
+    ("H", 1.20, [255, 255, 255]),
+    ("He", 1.43, [217, 255, 255]),
+    ("Li", 2.12, [204, 128, 255]),
+    ("Be", 1.98, [194, 255, 0]),
+    ("B", 1.91, [255, 181, 181]),
+    ("C", 1.77, [144, 144, 144]),
+    ("N", 1.66, [48, 80, 248]),
+    ("O", 1.50, [255, 13, 13]),
+    ("F", 1.46, [144, 224, 80]),
+    ("Ne", 1.58, [179, 227, 245]),
+    ("Na", 2.50, [171, 92, 242]),
+    ("Mg", 2.51, [138, 255, 0]),
+    ("Al", 2.25, [191, 166, 166]),
+    ("Si", 2.19, [240, 200, 160]),
+    ("P", 1.90, [255, 128, 0]),
+    ("S", 1.89, [255, 255, 48]),
+    ("Cl", 1.82, [31, 240, 31]),
+    ("Ar", 1.83, [128, 209, 227]),
+    ("K", 2.73, [143, 64, 212]),
+    ("Ca", 2.62, [61, 255, 0]),
+    ("Sc", 2.58, [230, 230, 230]),
+    ("Ti", 2.46, [191, 194, 199]),
+    ("V", 2.42, [166, 166, 171]),
+    ("Cr", 2.45, [138, 153, 199]),
+    ("Mn", 2.45, [156, 122, 199]),
+    ("Fe", 2.44, [224, 102, 51]),
+    ("Co", 2.40, [240, 144, 160]),
+    ("Ni", 2.40, [80, 208, 80]),
+    ("Cu", 2.38, [200, 128, 51]),
+    ("Zn", 2.39, [125, 128, 176]),
+    ("Ga", 2.32, [194, 143, 143]),
+    ("Ge", 2.29, [102, 143, 143]),
+    ("As", 1.88, [189, 128, 227]),
+    ("Se", 1.82, [255, 161, 0]),
+    ("Br", 1.86, [166, 41, 41]),
+    ("Kr", 2.25, [92, 184, 209]),
+    ("Rb", 3.21, [112, 46, 176]),
+    ("Sr", 2.84, [0, 255, 0]),
+    ("Y", 2.75, [148, 255, 255]),
+    ("Zr", 2.52, [148, 224, 224]),
+    ("Nb", 2.56, [115, 194, 201]),
+    ("Mo", 2.45, [84, 181, 181]),
+    ("Tc", 2.44, [59, 158, 158]),
+    ("Ru", 2.46, [36, 143, 143]),
+    ("Rh", 2.44, [10, 125, 140]),
+    ("Pd", 2.15, [0, 105, 133]),
+    ("Ag", 2.53, [192, 192, 192]),
+    ("Cd", 2.49, [255, 217, 143]),
+    ("In", 2.43, [166, 117, 115]),
+    ("Sn", 2.42, [102, 128, 128]),
+    ("Sb", 2.47, [158, 99, 181]),
+    ("Te", 1.99, [212, 122, 0]),
+    ("I", 2.04, [148, 0, 148]),
+    ("Xe", 2.06, [66, 158, 176]),
+    ("Cs", 3.48, [87, 23, 143]),
+    ("Ba", 3.03, [0, 201, 0]),
+    ("La", 2.98, [112, 212, 255]),
+    ("Ce", 2.88, [255, 255, 199]),
+    ("Pr", 2.92, [217, 255, 199]),
+    ("Nd", 2.95, [199, 255, 199]),
+    ("Pm", 2.00, [163, 255, 199]),
+    ("Sm", 2.90, [143, 255, 199]),
+    ("Eu", 2.87, [97, 255, 199]),
+    ("Gd", 2.83, [69, 255, 199]),
+    ("Tb", 2.79, [48, 255, 199]),
+    ("Dy", 2.87, [31, 255, 199]),
+    ("Ho", 2.81, [0, 255, 156]),
+    ("Er", 2.83, [0, 230, 117]),
+    ("Tm", 2.79, [0, 212, 82]),
+    ("Yb", 2.80, [0, 191, 56]),
+    ("Lu", 2.74, [0, 171, 36]),
+    ("Hf", 2.63, [77, 194, 255]),
+    ("Ta", 2.53, [77, 166, 255]),
+    ("W", 2.57, [33, 148, 214]),
+    ("Re", 2.49, [38, 125, 171]),
+    ("Os", 2.48, [38, 102, 150]),
+    ("Ir", 2.41, [23, 84, 135]),
+    ("Pt", 2.29, [208, 208, 224]),
+    ("Au", 2.32, [255, 209, 35]),
+    ("Hg", 2.45, [184, 184, 208]),
+    ("Tl", 2.47, [166, 84, 77]),
+    ("Pb", 2.60, [87, 89, 97]),
+    ("Bi", 2.54, [158, 79, 181]),
+    ("Po", 1.97, [171, 92, 0]),
+    ("At", 2.02, [117, 79, 69]),
+    ("Rn", 2.20, [66, 130, 150]),
+    ("Fr", 3.48, [66, 0, 102]),
+    ("Ra", 2.83, [0, 125, 0]),
+    ("Ac", 2.80, [112, 171, 250]),
+    ("Th", 2.93, [0, 186, 255]),
+    ("Pa", 2.88, [0, 161, 255]),
+    ("U", 2.71, [0, 143, 255]),
+    ("Np", 2.82, [0, 128, 255]),
+    ("Pu", 2.81, [0, 107, 255]),
+    ("Am", 2.83, [84, 92, 242]),
+    ("Cm", 3.05, [120, 92, 227]),
+    ("Bk", 3.40, [138, 79, 227]),
+    ("Cf", 3.05, [161, 54, 212]),
+    ("Es", 2.70, [179, 31, 212]),
+    ("Fm", 2.00, [179, 31, 186]),
+    ("Md", 2.00, [179, 13, 166]),
+    ("No", 2.00, [189, 13, 135]),
+    ("Lr", 2.00, [199, 0, 102]),
+];
+
+/// A chemical element by atomic number; `Element::UNKNOWN` (0) when it could not be told.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Element(u8);
+
+impl Element {
+    /// No known element.
+    pub const UNKNOWN: Element = Element(0);
+    /// Radius used for unknown elements, in Å.
+    pub const UNKNOWN_RADIUS: f32 = 1.5;
+    /// Colour used for unknown elements (8-bit sRGB): a pink that no element has.
+    pub const UNKNOWN_COLOR: [u8; 3] = [255, 20, 147];
+
+    /// The element of atomic number `z` (1..=103), else `None`.
+    pub fn from_z(z: u8) -> Option<Element> {
+        (1..=TABLE.len() as u8).contains(&z).then_some(Element(z))
+    }
+
+    /// The element whose symbol is `s`, ignoring case and surrounding spaces ("fe", "FE", "Fe").
+    pub fn from_symbol(s: &str) -> Option<Element> {
+        let s = s.trim().as_bytes();
+        if s.is_empty() || s.len() > 2 {
+            return None;
+        }
+        TABLE
+            .iter()
+            .position(|(sym, _, _)| sym.as_bytes().eq_ignore_ascii_case(s))
+            .map(|i| Element(i as u8 + 1))
+    }
+
+    /// Atomic number (0 for unknown).
+    pub fn z(self) -> u8 {
+        self.0
+    }
+
+    /// True for [`Element::UNKNOWN`].
+    pub fn is_unknown(self) -> bool {
+        self.0 == 0
+    }
+
+    /// Chemical symbol ("X" for unknown).
+    pub fn symbol(self) -> &'static str {
+        match self.0 {
+            0 => "X",
+            z => TABLE[z as usize - 1].0,
+        }
+    }
+
+    /// Van der Waals radius in Å (see the module doc for the sources).
+    pub fn vdw_radius(self) -> f32 {
+        match self.0 {
+            0 => Element::UNKNOWN_RADIUS,
+            z => TABLE[z as usize - 1].1,
+        }
+    }
+
+    /// Jmol CPK colour, 8-bit sRGB.
+    pub fn color_srgb8(self) -> [u8; 3] {
+        match self.0 {
+            0 => Element::UNKNOWN_COLOR,
+            z => TABLE[z as usize - 1].2,
+        }
+    }
+
+    /// Jmol CPK colour as sRGB-encoded values in [0, 1] (the convention of file colour columns).
+    pub fn color(self) -> [f32; 3] {
+        self.color_srgb8().map(|c| c as f32 / 255.0)
+    }
+}
+
+/// Residues in which an atom name's first letter is its element (rule 3 of the module doc).
+const BIO_RESIDUES: &[&str] = &[
+    "ALA", "ARG", "ASN", "ASP", "CYS", "GLN", "GLU", "GLY", "HIS", "ILE", "LEU", "LYS", "MET",
+    "PHE", "PRO", "SER", "THR", "TRP", "TYR", "VAL", "HID", "HIE", "HIP", "HSD", "HSE", "HSP",
+    "CYX", "CYM", "ASH", "GLH", "LYN", "MSE", "SEC", "ACE", "NME", "NMA", "NH2", "A", "C", "G",
+    "U", "T", "DA", "DC", "DG", "DT", "DU", "RA", "RC", "RG", "RU", "ADE", "CYT", "GUA", "URA",
+    "THY", "HOH", "WAT", "SOL", "TIP3", "TIP4", "TIP5", "SPC", "T3P", "T4P", "H2O",
+];
+
+/// True when `res` is a standard biomolecular residue (rule 3 of the module doc).
+pub fn is_bio_residue(res: &str) -> bool {
+    let r = res.trim();
+    BIO_RESIDUES.iter().any(|b| b.eq_ignore_ascii_case(r))
+}
+
+/// The element of an atom from its name, its residue (if the format has residues) and an
+/// explicit element field (if the file has one), by the rule in the module doc.
+pub fn guess_element(name: &str, residue: Option<&str>, explicit: Option<&str>) -> Element {
+    // Rule 1: an explicit element column wins.
+    if let Some(e) = explicit.and_then(Element::from_symbol) {
+        return e;
+    }
+    // Rule 2: drop leading digits and keep the run of letters.
+    let name = name.trim();
+    let body = name.trim_start_matches(|c: char| c.is_ascii_digit());
+    let n_letters = body.bytes().take_while(|b| b.is_ascii_alphabetic()).count();
+    let letters = &body[..n_letters];
+    if letters.is_empty() {
+        return Element::UNKNOWN;
+    }
+    let first = Element::from_symbol(&letters[..1]);
+    // Rule 3: biomolecular residues name atoms by element letter + position.
+    if residue.is_some_and(is_bio_residue) {
+        return first.unwrap_or(Element::UNKNOWN);
+    }
+    // Rule 4: an exact two-letter symbol ("CA" alone, "Cl", "Fe2").
+    let two = if letters.len() >= 2 {
+        Element::from_symbol(&letters[..2])
+    } else {
+        None
+    };
+    if let Some(e) = two {
+        let has_digit = name.bytes().any(|b| b.is_ascii_digit());
+        let second_lower = letters.as_bytes()[1].is_ascii_lowercase();
+        // An ion names its residue after itself: "CA" in "CA", "FE2+" in "FE2".
+        let res_letters = residue.map(|r| {
+            let r = r.trim();
+            &r[..r.bytes().take_while(|b| b.is_ascii_alphabetic()).count()]
+        });
+        let ion = res_letters.is_some_and(|r| r.eq_ignore_ascii_case(letters));
+        if letters.len() == 2 && (!has_digit || second_lower || ion) {
+            return e;
+        }
+        if second_lower && letters.len() > 2 {
+            return e;
+        }
+    }
+    // Rule 5: the first letter, else the first two.
+    first.or(two).unwrap_or(Element::UNKNOWN)
+}
+
+/// What a user sets for a selection of atoms: radius (Å) and/or colour (sRGB in [0, 1]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Appearance {
+    /// Radius in Å.
+    pub radius: Option<f32>,
+    /// Colour, sRGB-encoded in [0, 1].
+    pub color: Option<[f32; 3]>,
+}
+
+/// Which atoms an [`AtomStyle`] rule applies to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Selector {
+    /// Atoms whose type (LAMMPS `type`) is this.
+    Type(Label),
+    /// Atoms whose name is this.
+    Name(Label),
+    /// Atoms of this element.
+    Element(Element),
+}
+
+/// Per-atom radius and colour for drawing a frame.
+///
+/// For each atom the first of these that exists wins (the OVITO order: file columns first):
+/// 1. the frame's `radii` / `colors` column (from a `radius` / `color` column in the file);
+/// 2. a rule for the atom's type, then for its name, then for its element (the latest rule set
+///    for the same selector replaces the earlier one);
+/// 3. the element table ([`Element::vdw_radius`] times [`AtomStyle::radius_scale`],
+///    [`Element::color`]), the element being the frame's `elements` entry or else guessed from
+///    the name (or type) by [`guess_element`];
+/// 4. [`Element::UNKNOWN_RADIUS`] and [`Element::UNKNOWN_COLOR`].
+///
+/// Radius and colour are resolved independently (a rule may set only one of them).
+#[derive(Clone, Debug, PartialEq)]
+pub struct AtomStyle {
+    rules: Vec<(Selector, Appearance)>,
+    radius_scale: f32,
+}
+
+impl Default for AtomStyle {
+    fn default() -> Self {
+        AtomStyle::new()
+    }
+}
+
+impl AtomStyle {
+    /// No rules, table radii at scale 1.
+    pub fn new() -> AtomStyle {
+        AtomStyle {
+            rules: Vec::new(),
+            radius_scale: 1.0,
+        }
+    }
+
+    /// Scale applied to table radii (not to file columns or rules), e.g. 0.3 for ball-and-stick.
+    pub fn radius_scale(&self) -> f32 {
+        self.radius_scale
+    }
+
+    /// Sets the scale applied to table radii; it must be finite and > 0.
+    pub fn set_radius_scale(&mut self, s: f32) -> Result<(), Error> {
+        if !(s.is_finite() && s > 0.0) {
+            return Err(Error::InvalidValue {
+                what: format!("radius scale must be finite and > 0, got {s}"),
+            });
+        }
+        self.radius_scale = s;
+        Ok(())
+    }
+
+    /// Sets (or replaces) the appearance of the atoms `sel` selects. A radius must be finite and
+    /// > 0, colour channels finite and in [0, 1].
+    pub fn set(&mut self, sel: Selector, look: Appearance) -> Result<(), Error> {
+        if let Some(r) = look.radius
+            && !(r.is_finite() && r > 0.0)
+        {
+            return Err(Error::InvalidValue {
+                what: format!("radius must be finite and > 0, got {r}"),
+            });
+        }
+        if let Some(c) = look.color
+            && c.iter()
+                .any(|v| !(v.is_finite() && (0.0..=1.0).contains(v)))
+        {
+            return Err(Error::InvalidValue {
+                what: format!("colour channels must be in [0, 1], got {c:?}"),
+            });
+        }
+        match self.rules.iter_mut().find(|(s, _)| *s == sel) {
+            Some(slot) => slot.1 = look,
+            None => self.rules.push((sel, look)),
+        }
+        Ok(())
+    }
+
+    fn rule(&self, sel: Selector) -> Option<&Appearance> {
+        self.rules.iter().find(|(s, _)| *s == sel).map(|(_, a)| a)
+    }
+
+    /// Radius (Å) and colour (sRGB in [0, 1]) of atom `i` of `frame`, by the order in the type doc.
+    /// `i` must be < `frame.n_atoms()`; an out-of-range `i` gets the unknown-element look.
+    pub fn resolve(&self, frame: &Frame, i: usize) -> (f32, [f32; 3]) {
+        let mut radius = frame.radii.get(i).copied();
+        let mut color = frame.colors.get(i).copied();
+        // Rules: type, then name, then element.
+        let ty = frame.types.get(i).copied();
+        let name = frame.names.get(i).copied();
+        let element = match frame.elements.get(i) {
+            Some(e) if !e.is_unknown() => *e,
+            _ => {
+                let res = frame.res_names.get(i).map(|r| r.as_str());
+                match (name, ty) {
+                    (Some(n), _) => guess_element(&n, res, None),
+                    (None, Some(t)) => guess_element(&t, None, None),
+                    (None, None) => Element::UNKNOWN,
+                }
+            }
+        };
+        let sels = [
+            ty.map(Selector::Type),
+            name.map(Selector::Name),
+            Some(Selector::Element(element)),
+        ];
+        for sel in sels.into_iter().flatten() {
+            if radius.is_some() && color.is_some() {
+                break;
+            }
+            if let Some(a) = self.rule(sel) {
+                radius = radius.or(a.radius);
+                color = color.or(a.color);
+            }
+        }
+        // Table, with the unknown-element look built into the table accessors.
+        let radius = radius.unwrap_or_else(|| element.vdw_radius() * self.radius_scale);
+        let color = color.unwrap_or_else(|| element.color());
+        (radius, color)
+    }
+
+    /// Fills `radii` and `colors` (cleared first) with every atom's look, allocation-free once
+    /// they have the capacity.
+    pub fn apply(&self, frame: &Frame, radii: &mut Vec<f32>, colors: &mut Vec<[f32; 3]>) {
+        radii.clear();
+        colors.clear();
+        for i in 0..frame.n_atoms() {
+            let (r, c) = self.resolve(frame, i);
+            radii.push(r);
+            colors.push(c);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn el(s: &str) -> Element {
+        Element::from_symbol(s).unwrap()
+    }
+
+    #[test]
+    fn symbols_round_trip() {
+        for z in 1..=103u8 {
+            let e = Element::from_z(z).unwrap();
+            assert_eq!(Element::from_symbol(e.symbol()), Some(e));
+            assert_eq!(Element::from_symbol(&e.symbol().to_uppercase()), Some(e));
+        }
+        assert_eq!(Element::from_z(0), None);
+        assert_eq!(Element::from_z(104), None);
+        assert_eq!(Element::from_symbol("Xx"), None);
+    }
+
+    #[test]
+    fn name_rules_of_the_module_doc() {
+        // Rule 1: explicit element column.
+        assert_eq!(guess_element("CA", Some("ALA"), Some("CA")), el("Ca"));
+        // Rule 3: biomolecular residues.
+        assert_eq!(guess_element("CA", Some("ALA"), None), el("C"));
+        assert_eq!(guess_element("1HB", Some("ALA"), None), el("H"));
+        assert_eq!(guess_element("HG1", Some("THR"), None), el("H"));
+        assert_eq!(guess_element("OW", Some("SOL"), None), el("O"));
+        // Rule 4: exact two-letter symbols.
+        assert_eq!(guess_element("CA", Some("CA"), None), el("Ca"));
+        assert_eq!(guess_element("CA", None, None), el("Ca"));
+        assert_eq!(guess_element("Cl", None, None), el("Cl"));
+        assert_eq!(guess_element("FE2+", Some("FE2"), None), el("Fe"));
+        assert_eq!(guess_element("Fe2", Some("LIG"), None), el("Fe"));
+        assert_eq!(guess_element("HO2", Some("LIG"), None), el("H"));
+        assert_eq!(guess_element("CD1", Some("LIG"), None), el("C"));
+        // Rule 5: first letter, then two.
+        assert_eq!(guess_element("C12", Some("LIG"), None), el("C"));
+        assert_eq!(guess_element("Zn", None, None), el("Zn"));
+        assert_eq!(guess_element("ZNA", None, None), el("Zn"));
+        assert_eq!(guess_element("1", None, None), Element::UNKNOWN);
+        assert_eq!(guess_element("", None, None), Element::UNKNOWN);
+    }
+
+    #[test]
+    fn style_precedence_file_then_type_then_name_then_element_then_table() {
+        let mut f = Frame::new();
+        f.positions = vec![[0.0; 3]; 3];
+        f.names = ["O", "H", "C"].map(|s| Label::new(s).unwrap()).to_vec();
+        f.types = ["1", "2", "2"].map(|s| Label::new(s).unwrap()).to_vec();
+        let mut st = AtomStyle::new();
+        st.set(
+            Selector::Element(el("O")),
+            Appearance {
+                radius: Some(9.0),
+                color: Some([0.0, 0.0, 1.0]),
+            },
+        )
+        .unwrap();
+        st.set(
+            Selector::Type(Label::new("1").unwrap()),
+            Appearance {
+                radius: Some(2.0),
+                color: None,
+            },
+        )
+        .unwrap();
+        st.set(
+            Selector::Name(Label::new("H").unwrap()),
+            Appearance {
+                radius: None,
+                color: Some([1.0, 0.0, 0.0]),
+            },
+        )
+        .unwrap();
+        // Atom 0: type rule radius, element rule colour.
+        assert_eq!(st.resolve(&f, 0), (2.0, [0.0, 0.0, 1.0]));
+        // Atom 1: table radius for H, name rule colour.
+        assert_eq!(st.resolve(&f, 1), (1.2, [1.0, 0.0, 0.0]));
+        // Atom 2: table for C.
+        assert_eq!(st.resolve(&f, 2), (1.77, el("C").color()));
+        // File columns win over everything.
+        f.radii = vec![0.5; 3];
+        f.colors = vec![[0.5; 3]; 3];
+        assert_eq!(st.resolve(&f, 0), (0.5, [0.5; 3]));
+        assert!(
+            st.set(
+                Selector::Element(el("C")),
+                Appearance {
+                    radius: Some(-1.0),
+                    color: None
+                }
+            )
+            .is_err()
+        );
+        assert!(
+            st.set(
+                Selector::Element(el("C")),
+                Appearance {
+                    radius: None,
+                    color: Some([2.0, 0.0, 0.0])
+                }
+            )
+            .is_err()
+        );
+    }
+}

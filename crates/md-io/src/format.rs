@@ -1,0 +1,183 @@
+//! The closed set of file formats, told from a file's extension or its first bytes.
+
+use std::path::Path;
+
+/// A trajectory file format.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum Format {
+    /// XYZ, plain or extended (ASE/OVITO key=value comment line): `.xyz`, `.extxyz`.
+    Xyz,
+    /// Protein Data Bank, multi-MODEL: `.pdb`, `.ent`.
+    Pdb,
+    /// GROMACS .gro: `.gro`.
+    Gro,
+    /// LAMMPS text dump: `.lammpstrj`, `.lammpsdump`, `.dump`.
+    LammpsDump,
+    /// CHARMM/NAMD DCD: `.dcd`.
+    Dcd,
+    /// GROMACS compressed XTC: `.xtc`.
+    Xtc,
+    /// GROMACS TRR: `.trr`.
+    Trr,
+}
+
+impl Format {
+    /// Every format, in declaration order.
+    pub const ALL: [Format; 7] = [
+        Format::Xyz,
+        Format::Pdb,
+        Format::Gro,
+        Format::LammpsDump,
+        Format::Dcd,
+        Format::Xtc,
+        Format::Trr,
+    ];
+
+    /// The format a file extension names (case-insensitive), e.g. "xyz", "lammpstrj".
+    pub fn from_extension(ext: &str) -> Option<Format> {
+        let e = ext.to_ascii_lowercase();
+        Some(match e.as_str() {
+            "xyz" | "extxyz" => Format::Xyz,
+            "pdb" | "ent" => Format::Pdb,
+            "gro" => Format::Gro,
+            "lammpstrj" | "lammpsdump" | "dump" => Format::LammpsDump,
+            "dcd" => Format::Dcd,
+            "xtc" => Format::Xtc,
+            "trr" => Format::Trr,
+            _ => return None,
+        })
+    }
+
+    /// The format a path's extension names.
+    pub fn from_path(path: &Path) -> Option<Format> {
+        Format::from_extension(path.extension()?.to_str()?)
+    }
+
+    /// The format the first bytes of a file show (give at least 256 bytes when the file has
+    /// them). Binary formats are told by their magic numbers, text formats by their first
+    /// lines: `ITEM: TIMESTEP` (LAMMPS), a PDB record name, an integer first line (XYZ), an
+    /// integer second line (GRO).
+    pub fn from_magic(head: &[u8]) -> Option<Format> {
+        let be = |k: usize| {
+            head.get(k..k + 4)
+                .map(|b| i32::from_be_bytes([b[0], b[1], b[2], b[3]]))
+        };
+        let le = |k: usize| {
+            head.get(k..k + 4)
+                .map(|b| i32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        };
+        // DCD: a Fortran record of 84 bytes (either endianness) starting with "CORD".
+        if (le(0) == Some(84) || be(0) == Some(84)) && head.get(4..8) == Some(b"CORD") {
+            return Some(Format::Dcd);
+        }
+        // XTC and TRR: big-endian magic numbers 1995 and 1993.
+        match be(0) {
+            Some(1995) => return Some(Format::Xtc),
+            Some(1993) => return Some(Format::Trr),
+            _ => {}
+        }
+        let mut lines = head.split(|b| *b == b'\n');
+        let first = lines.next().unwrap_or(&[]);
+        let t = crate::parse::trim(first);
+        if t.starts_with(b"ITEM:") {
+            return Some(Format::LammpsDump);
+        }
+        const PDB_RECORDS: [&[u8]; 12] = [
+            b"HEADER", b"TITLE ", b"CRYST1", b"ATOM  ", b"HETATM", b"MODEL ", b"REMARK", b"COMPND",
+            b"SOURCE", b"AUTHOR", b"EXPDTA", b"KEYWDS",
+        ];
+        if PDB_RECORDS.iter().any(|r| first.starts_with(r)) {
+            return Some(Format::Pdb);
+        }
+        let is_count = |l: &[u8]| {
+            let t = crate::parse::trim(l);
+            !t.is_empty() && crate::parse::parse_usize(t).is_some()
+        };
+        if is_count(first) {
+            return Some(Format::Xyz);
+        }
+        if lines.next().is_some_and(is_count) {
+            return Some(Format::Gro);
+        }
+        None
+    }
+
+    /// True for the text formats (line numbers in errors, line-scan frame index).
+    pub fn is_text(self) -> bool {
+        matches!(
+            self,
+            Format::Xyz | Format::Pdb | Format::Gro | Format::LammpsDump
+        )
+    }
+
+    /// A short lower-case name ("xyz", "lammps-dump").
+    pub fn name(self) -> &'static str {
+        match self {
+            Format::Xyz => "xyz",
+            Format::Pdb => "pdb",
+            Format::Gro => "gro",
+            Format::LammpsDump => "lammps-dump",
+            Format::Dcd => "dcd",
+            Format::Xtc => "xtc",
+            Format::Trr => "trr",
+        }
+    }
+}
+
+impl std::fmt::Display for Format {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn extensions() {
+        assert_eq!(Format::from_path(Path::new("a/b.XYZ")), Some(Format::Xyz));
+        assert_eq!(
+            Format::from_path(Path::new("run.lammpstrj")),
+            Some(Format::LammpsDump)
+        );
+        assert_eq!(Format::from_path(Path::new("x.trr")), Some(Format::Trr));
+        assert_eq!(Format::from_path(Path::new("noext")), None);
+        for f in Format::ALL {
+            assert_eq!(
+                Format::from_extension(f.name().split('-').next().unwrap()).is_some(),
+                f != Format::LammpsDump
+            );
+        }
+    }
+
+    #[test]
+    fn magic() {
+        let mut dcd = 84i32.to_le_bytes().to_vec();
+        dcd.extend_from_slice(b"CORD");
+        assert_eq!(Format::from_magic(&dcd), Some(Format::Dcd));
+        assert_eq!(
+            Format::from_magic(&1995i32.to_be_bytes()),
+            Some(Format::Xtc)
+        );
+        assert_eq!(
+            Format::from_magic(&1993i32.to_be_bytes()),
+            Some(Format::Trr)
+        );
+        assert_eq!(
+            Format::from_magic(b"ITEM: TIMESTEP\n0\n"),
+            Some(Format::LammpsDump)
+        );
+        assert_eq!(Format::from_magic(b"CRYST1   10.000"), Some(Format::Pdb));
+        assert_eq!(
+            Format::from_magic(b"3\ncomment\nC 0 0 0\n"),
+            Some(Format::Xyz)
+        );
+        assert_eq!(
+            Format::from_magic(b"Water\n   3\n    1SOL"),
+            Some(Format::Gro)
+        );
+        assert_eq!(Format::from_magic(b"hello\nworld\n"), None);
+    }
+}

@@ -1,0 +1,417 @@
+//! One frame of a trajectory: positions in Ångström plus whatever per-atom information the file
+//! had, and the periodic cell.
+//!
+//! A [`Frame`] is a set of reusable buffers: readers fill it in place (`read_next(&mut frame)`),
+//! so streaming a trajectory allocates nothing per frame once the buffers have grown to the
+//! largest frame.
+//!
+//! # Guarantees of a frame filled by a reader
+//! - every per-atom vector is either empty (the file does not have that column) or exactly
+//!   [`Frame::n_atoms`] long;
+//! - positions (and velocities, radii, colours) are finite: a reader rejects NaN and infinities;
+//! - positions are in Å, velocities in Å/ps, time in ps, whatever the file's units.
+
+use crate::elements::Element;
+use crate::error::Error;
+use std::fmt;
+
+/// A short string stored inline (at most [`Label::CAPACITY`] bytes of UTF-8): atom names, types,
+/// residue names. `Copy`, so filling per-atom labels allocates nothing.
+#[derive(Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub struct Label {
+    len: u8,
+    bytes: [u8; Label::CAPACITY],
+}
+
+impl Label {
+    /// Longest label in bytes.
+    pub const CAPACITY: usize = 15;
+
+    /// The label for `s`, or `None` when `s` is longer than [`Label::CAPACITY`] bytes.
+    pub fn new(s: &str) -> Option<Label> {
+        Label::from_utf8(s.as_bytes())
+    }
+
+    /// The label for UTF-8 bytes, or `None` when they are too long or not UTF-8.
+    pub fn from_utf8(b: &[u8]) -> Option<Label> {
+        if b.len() > Label::CAPACITY || std::str::from_utf8(b).is_err() {
+            return None;
+        }
+        let mut bytes = [0u8; Label::CAPACITY];
+        bytes[..b.len()].copy_from_slice(b);
+        Some(Label {
+            len: b.len() as u8,
+            bytes,
+        })
+    }
+
+    /// The label as a string slice.
+    pub fn as_str(&self) -> &str {
+        // Constructors accept UTF-8 only, so this cannot fail; fall back to "" defensively.
+        std::str::from_utf8(&self.bytes[..self.len as usize]).unwrap_or("")
+    }
+
+    /// True for the empty label.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+}
+
+impl std::ops::Deref for Label {
+    type Target = str;
+    fn deref(&self) -> &str {
+        self.as_str()
+    }
+}
+
+impl fmt::Debug for Label {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        fmt::Debug::fmt(self.as_str(), f)
+    }
+}
+
+impl fmt::Display for Label {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+impl PartialEq<str> for Label {
+    fn eq(&self, other: &str) -> bool {
+        self.as_str() == other
+    }
+}
+
+impl PartialEq<&str> for Label {
+    fn eq(&self, other: &&str) -> bool {
+        self.as_str() == *other
+    }
+}
+
+/// A periodic cell: three edge vectors (the rows of [`UnitCell::matrix`], in Å) and an origin.
+///
+/// Lengths a, b, c (Å) and angles α = ∠(b,c), β = ∠(a,c), γ = ∠(a,b) (degrees) are kept beside
+/// the matrix so that a cell read as lengths and angles writes back exactly.
+///
+/// # Guarantees
+/// Lengths are finite and > 0, angles in (0°, 180°), the volume is > 0 (right-handed edges).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UnitCell {
+    lengths: [f64; 3],
+    angles: [f64; 3],
+    matrix: [[f64; 3]; 3],
+    origin: [f64; 3],
+}
+
+fn cos_deg(a: f64) -> f64 {
+    // Exact zero for right angles, so orthorhombic cells have an exactly diagonal matrix.
+    if a == 90.0 { 0.0 } else { a.to_radians().cos() }
+}
+
+fn det3(m: &[[f64; 3]; 3]) -> f64 {
+    m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+impl UnitCell {
+    /// An orthorhombic box with edges along x, y, z.
+    pub fn orthorhombic(a: f64, b: f64, c: f64) -> Result<UnitCell, Error> {
+        UnitCell::from_lengths_angles([a, b, c], [90.0, 90.0, 90.0])
+    }
+
+    /// The cell from lengths (Å) and angles (degrees), in the usual orientation: a along x, b in
+    /// the xy plane, c completing a right-handed set (the convention of PDB CRYST1 and LAMMPS).
+    pub fn from_lengths_angles(lengths: [f64; 3], angles: [f64; 3]) -> Result<UnitCell, Error> {
+        if lengths.iter().any(|l| !(l.is_finite() && *l > 0.0)) {
+            return Err(Error::InvalidValue {
+                what: format!("cell lengths must be finite and > 0, got {lengths:?}"),
+            });
+        }
+        if angles
+            .iter()
+            .any(|a| !(a.is_finite() && *a > 0.0 && *a < 180.0))
+        {
+            return Err(Error::InvalidValue {
+                what: format!("cell angles must be in (0, 180) degrees, got {angles:?}"),
+            });
+        }
+        let [a, b, c] = lengths;
+        let (ca, cb, cg) = (cos_deg(angles[0]), cos_deg(angles[1]), cos_deg(angles[2]));
+        let sg = if angles[2] == 90.0 {
+            1.0
+        } else {
+            angles[2].to_radians().sin()
+        };
+        // Build the edge vectors: a along x, b in xy, c from the two remaining dot products.
+        let cx = c * cb;
+        let cy = c * (ca - cb * cg) / sg;
+        let cz2 = c * c - cx * cx - cy * cy;
+        if !(cz2 > 0.0) {
+            return Err(Error::InvalidValue {
+                what: format!("cell angles {angles:?} do not describe a cell with volume > 0"),
+            });
+        }
+        let matrix = [[a, 0.0, 0.0], [b * cg, b * sg, 0.0], [cx, cy, cz2.sqrt()]];
+        Ok(UnitCell {
+            lengths,
+            angles,
+            matrix,
+            origin: [0.0; 3],
+        })
+    }
+
+    /// The cell from its three edge vectors (rows, Å), in any orientation.
+    pub fn from_matrix(matrix: [[f64; 3]; 3]) -> Result<UnitCell, Error> {
+        if matrix.iter().flatten().any(|v| !v.is_finite()) {
+            return Err(Error::InvalidValue {
+                what: format!("cell matrix must be finite, got {matrix:?}"),
+            });
+        }
+        let vol = det3(&matrix);
+        if !(vol > 0.0) {
+            return Err(Error::InvalidValue {
+                what: format!(
+                    "cell edge vectors must be right-handed with volume > 0, got {matrix:?}"
+                ),
+            });
+        }
+        let len = |v: [f64; 3]| dot(v, v).sqrt();
+        let lengths = [len(matrix[0]), len(matrix[1]), len(matrix[2])];
+        let angle = |u: [f64; 3], v: [f64; 3], lu: f64, lv: f64| {
+            (dot(u, v) / (lu * lv)).clamp(-1.0, 1.0).acos().to_degrees()
+        };
+        let angles = [
+            angle(matrix[1], matrix[2], lengths[1], lengths[2]),
+            angle(matrix[0], matrix[2], lengths[0], lengths[2]),
+            angle(matrix[0], matrix[1], lengths[0], lengths[1]),
+        ];
+        Ok(UnitCell {
+            lengths,
+            angles,
+            matrix,
+            origin: [0.0; 3],
+        })
+    }
+
+    /// The same cell with its corner at `origin` (Å), e.g. LAMMPS (xlo, ylo, zlo).
+    pub fn with_origin(mut self, origin: [f64; 3]) -> UnitCell {
+        self.origin = origin;
+        self
+    }
+
+    /// Edge lengths a, b, c in Å.
+    pub fn lengths(&self) -> [f64; 3] {
+        self.lengths
+    }
+
+    /// Angles α, β, γ in degrees.
+    pub fn angles(&self) -> [f64; 3] {
+        self.angles
+    }
+
+    /// Edge vectors as rows, in Å.
+    pub fn matrix(&self) -> [[f64; 3]; 3] {
+        self.matrix
+    }
+
+    /// The corner of the cell, in Å (zero unless the file gave one).
+    pub fn origin(&self) -> [f64; 3] {
+        self.origin
+    }
+
+    /// Volume in Å³.
+    pub fn volume(&self) -> f64 {
+        det3(&self.matrix)
+    }
+
+    /// True when all three angles are 90°.
+    pub fn is_orthorhombic(&self) -> bool {
+        self.angles.iter().all(|a| (a - 90.0).abs() < 1e-9)
+    }
+
+    /// Cartesian position (Å) of fractional coordinates `f`: origin + f·M.
+    pub fn to_cartesian(&self, f: [f64; 3]) -> [f64; 3] {
+        let m = &self.matrix;
+        let mut out = self.origin;
+        for (k, o) in out.iter_mut().enumerate() {
+            *o += f[0] * m[0][k] + f[1] * m[1][k] + f[2] * m[2][k];
+        }
+        out
+    }
+}
+
+/// One frame: positions and optional per-atom information (empty vector = absent).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Frame {
+    /// Positions in Å.
+    pub positions: Vec<[f32; 3]>,
+    /// Velocities in Å/ps (empty when the file has none).
+    pub velocities: Vec<[f32; 3]>,
+    /// The periodic cell, if the frame has one.
+    pub cell: Option<UnitCell>,
+    /// MD step number, if the file gives one.
+    pub step: Option<i64>,
+    /// Simulation time in ps, if the file gives one.
+    pub time: Option<f64>,
+    /// Atom names (PDB/GRO atom name, XYZ species).
+    pub names: Vec<Label>,
+    /// Elements (from an element column, else guessed from names: see [`crate::elements`]).
+    pub elements: Vec<Element>,
+    /// Atom types (LAMMPS `type`, extended-XYZ `type`).
+    pub types: Vec<Label>,
+    /// Atom ids / serial numbers as written in the file.
+    pub ids: Vec<i64>,
+    /// Residue names (PDB, GRO).
+    pub res_names: Vec<Label>,
+    /// Residue numbers (PDB, GRO).
+    pub res_ids: Vec<i64>,
+    /// Per-atom radii in Å from a `radius` column (OVITO convention).
+    pub radii: Vec<f32>,
+    /// Per-atom colours from a `color` column, RGB in [0, 1] as written (sRGB-encoded).
+    pub colors: Vec<[f32; 3]>,
+    /// The frame's title / comment line (XYZ comment, GRO title, PDB TITLE), if any.
+    pub comment: String,
+}
+
+impl Frame {
+    /// An empty frame.
+    pub fn new() -> Frame {
+        Frame::default()
+    }
+
+    /// Number of atoms (the length of `positions`).
+    pub fn n_atoms(&self) -> usize {
+        self.positions.len()
+    }
+
+    /// Empties every buffer, keeping its capacity.
+    pub fn clear(&mut self) {
+        self.positions.clear();
+        self.velocities.clear();
+        self.cell = None;
+        self.step = None;
+        self.time = None;
+        self.names.clear();
+        self.elements.clear();
+        self.types.clear();
+        self.ids.clear();
+        self.res_names.clear();
+        self.res_ids.clear();
+        self.radii.clear();
+        self.colors.clear();
+        self.comment.clear();
+    }
+
+    /// Checks the guarantees of a frame (see the module doc); the message names the first broken
+    /// one. Writers call this before writing.
+    pub fn check(&self) -> Result<(), String> {
+        let n = self.n_atoms();
+        let lens = [
+            ("velocities", self.velocities.len()),
+            ("names", self.names.len()),
+            ("elements", self.elements.len()),
+            ("types", self.types.len()),
+            ("ids", self.ids.len()),
+            ("res_names", self.res_names.len()),
+            ("res_ids", self.res_ids.len()),
+            ("radii", self.radii.len()),
+            ("colors", self.colors.len()),
+        ];
+        for (what, len) in lens {
+            if len != 0 && len != n {
+                return Err(format!("{what} has {len} entries but there are {n} atoms"));
+            }
+        }
+        let finite3 = |v: &[[f32; 3]]| v.iter().position(|p| p.iter().any(|x| !x.is_finite()));
+        if let Some(i) = finite3(&self.positions) {
+            return Err(format!("position of atom {i} is not finite"));
+        }
+        if let Some(i) = finite3(&self.velocities) {
+            return Err(format!("velocity of atom {i} is not finite"));
+        }
+        if let Some(i) = self
+            .radii
+            .iter()
+            .position(|r| !(r.is_finite() && *r >= 0.0))
+        {
+            return Err(format!("radius of atom {i} is not finite and >= 0"));
+        }
+        if let Some(i) = finite3(&self.colors) {
+            return Err(format!("colour of atom {i} is not finite"));
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn close(expected: f64, actual: f64, tol: f64) {
+        assert!(
+            (expected - actual).abs() <= tol,
+            "expected {expected}, actual {actual}, tolerance {tol}"
+        );
+    }
+
+    #[test]
+    fn label_round_trip_and_limits() {
+        let l = Label::new("CA").unwrap();
+        assert_eq!(l, "CA");
+        assert_eq!(l.len(), 2);
+        assert!(Label::new("0123456789abcdef").is_none());
+        assert!(Label::from_utf8(&[0xff]).is_none());
+    }
+
+    #[test]
+    fn lengths_angles_round_trip_through_matrix() {
+        // A triclinic cell: rebuild lengths and angles from the matrix by dot products (f64).
+        let c = UnitCell::from_lengths_angles([10.0, 12.0, 15.0], [70.0, 80.0, 100.0]).unwrap();
+        let c2 = UnitCell::from_matrix(c.matrix()).unwrap();
+        for k in 0..3 {
+            close(c.lengths()[k], c2.lengths()[k], 1e-12);
+            close(c.angles()[k], c2.angles()[k], 1e-10);
+        }
+        // Volume against the closed form abc·sqrt(1 - cos²α - cos²β - cos²γ + 2 cosα cosβ cosγ).
+        let (ca, cb, cg) = (
+            70f64.to_radians().cos(),
+            80f64.to_radians().cos(),
+            100f64.to_radians().cos(),
+        );
+        let v =
+            10.0 * 12.0 * 15.0 * (1.0 - ca * ca - cb * cb - cg * cg + 2.0 * ca * cb * cg).sqrt();
+        close(v, c.volume(), 1e-9);
+    }
+
+    #[test]
+    fn bad_cells_are_rejected() {
+        assert!(UnitCell::orthorhombic(0.0, 1.0, 1.0).is_err());
+        assert!(UnitCell::orthorhombic(f64::NAN, 1.0, 1.0).is_err());
+        assert!(UnitCell::from_lengths_angles([1.0; 3], [120.0, 120.0, 130.0]).is_err());
+        assert!(
+            UnitCell::from_matrix([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0]]).is_err()
+        );
+        let c = UnitCell::orthorhombic(2.0, 3.0, 4.0).unwrap();
+        assert_eq!(
+            c.matrix(),
+            [[2.0, 0.0, 0.0], [0.0, 3.0, 0.0], [0.0, 0.0, 4.0]]
+        );
+        assert!(c.is_orthorhombic());
+    }
+
+    #[test]
+    fn check_finds_ragged_columns_and_nan() {
+        let mut f = Frame::new();
+        f.positions = vec![[0.0; 3]; 2];
+        f.names = vec![Label::new("C").unwrap()];
+        assert!(f.check().unwrap_err().contains("names"));
+        f.names.clear();
+        f.positions[1][2] = f32::NAN;
+        assert!(f.check().unwrap_err().contains("atom 1"));
+    }
+}

@@ -1,0 +1,402 @@
+//! The machinery every text format shares: a line splitter over a big buffered chunk
+//! ([`LineReader`]), the lazily built frame index, and [`TextReader`], which turns a per-format
+//! frame parser ([`TextFormat`]) into streaming and random access.
+//!
+//! Lines are found with `memchr` in a 1 MiB chunk read straight from the source (no `BufRead`
+//! and no copy per line); a line is handed out as a slice of the chunk with its 1-based number
+//! and the byte offset of its first byte, which is all an error needs to say where it happened.
+//!
+//! The frame index holds (byte offset, line number) of every frame start seen so far: streaming
+//! fills it for free, and random access past the known frames scans forward with the format's
+//! `skip`, which splits lines but parses no numbers.
+
+use crate::error::{Error, Location};
+use crate::frame::Frame;
+use std::io::{Read, Seek, SeekFrom};
+use std::sync::Arc;
+
+/// Size of the chunk lines are split from.
+const CHUNK: usize = 1 << 20;
+
+/// Where a line starts: its 1-based number and the byte offset of its first byte.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct Pos {
+    pub line: u64,
+    pub byte: u64,
+}
+
+/// Splits a byte source into lines ('\n', with a trailing '\r' removed).
+pub(crate) struct LineReader<R> {
+    src: R,
+    buf: Vec<u8>,
+    /// Valid bytes are `buf[start..end]`.
+    start: usize,
+    end: usize,
+    eof: bool,
+    /// File offset of `buf[start]`.
+    offset: u64,
+    /// Number of the next line.
+    line: u64,
+}
+
+impl<R: Read> LineReader<R> {
+    pub fn new(src: R) -> LineReader<R> {
+        LineReader {
+            src,
+            buf: vec![0; CHUNK],
+            start: 0,
+            end: 0,
+            eof: false,
+            offset: 0,
+            line: 1,
+        }
+    }
+
+    /// Position of the next line.
+    pub fn pos(&self) -> Pos {
+        Pos {
+            line: self.line,
+            byte: self.offset,
+        }
+    }
+
+    /// Moves the data left and reads more; grows the buffer when one line fills it.
+    fn refill(&mut self) -> std::io::Result<()> {
+        if self.start > 0 {
+            self.buf.copy_within(self.start..self.end, 0);
+            self.end -= self.start;
+            self.start = 0;
+        }
+        if self.end == self.buf.len() {
+            let n = self.buf.len();
+            self.buf.resize(n * 2, 0);
+        }
+        loop {
+            match self.src.read(&mut self.buf[self.end..]) {
+                Ok(0) => {
+                    self.eof = true;
+                    return Ok(());
+                }
+                Ok(k) => {
+                    self.end += k;
+                    return Ok(());
+                }
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+                Err(e) => return Err(e),
+            }
+        }
+    }
+
+    /// The next line and where it starts, `None` at the end of the data. A last line without
+    /// '\n' is returned as a line.
+    #[inline]
+    pub fn next_line(&mut self) -> std::io::Result<Option<(Pos, &[u8])>> {
+        let mut searched = 0;
+        loop {
+            let hay = &self.buf[self.start + searched..self.end];
+            if let Some(k) = memchr::memchr(b'\n', hay) {
+                let s = self.start;
+                let e = s + searched + k;
+                let pos = self.pos();
+                self.start = e + 1;
+                self.offset += (e + 1 - s) as u64;
+                self.line += 1;
+                let mut line = &self.buf[s..e];
+                if let [rest @ .., b'\r'] = line {
+                    line = rest;
+                }
+                return Ok(Some((pos, line)));
+            }
+            if self.eof {
+                if self.start == self.end {
+                    return Ok(None);
+                }
+                let (s, e) = (self.start, self.end);
+                let pos = self.pos();
+                self.start = e;
+                self.offset += (e - s) as u64;
+                self.line += 1;
+                let mut line = &self.buf[s..e];
+                if let [rest @ .., b'\r'] = line {
+                    line = rest;
+                }
+                return Ok(Some((pos, line)));
+            }
+            searched = self.end - self.start;
+            self.refill()?;
+            // After a refill the data starts at 0 and the first `searched` bytes hold no '\n'.
+        }
+    }
+
+    /// Gives back the line just returned by `next_line`, which started at `pos`: its bytes are
+    /// still in the buffer, just before `start`, because `next_line` never refills after
+    /// finding a line.
+    pub fn unread(&mut self, pos: Pos) {
+        let back = (self.offset - pos.byte) as usize;
+        debug_assert!(back <= self.start);
+        self.start -= back;
+        self.offset = pos.byte;
+        self.line = pos.line;
+    }
+
+    /// Skips `n` lines; returns how many could not be skipped because the data ended.
+    pub fn skip_lines(&mut self, mut n: usize) -> std::io::Result<usize> {
+        while n > 0 {
+            let hay = &self.buf[self.start..self.end];
+            // Count newlines in the chunk, stopping at the n-th.
+            let mut consumed = 0;
+            let mut found = 0;
+            for k in memchr::memchr_iter(b'\n', hay) {
+                found += 1;
+                consumed = k + 1;
+                if found == n {
+                    break;
+                }
+            }
+            self.start += consumed;
+            self.offset += consumed as u64;
+            self.line += found as u64;
+            n -= found;
+            if n == 0 {
+                break;
+            }
+            if self.eof {
+                // A last line without '\n' counts as a line.
+                if self.start < self.end {
+                    self.offset += (self.end - self.start) as u64;
+                    self.start = self.end;
+                    self.line += 1;
+                    n -= 1;
+                }
+                return Ok(n);
+            }
+            self.refill()?;
+        }
+        Ok(0)
+    }
+}
+
+impl<R: Read + Seek> LineReader<R> {
+    /// Continues reading at `pos`.
+    pub fn seek(&mut self, pos: Pos) -> std::io::Result<()> {
+        self.src.seek(SeekFrom::Start(pos.byte))?;
+        self.start = 0;
+        self.end = 0;
+        self.eof = false;
+        self.offset = pos.byte;
+        self.line = pos.line;
+        Ok(())
+    }
+}
+
+/// What a format's parser needs to build an error: the file and the frame being read.
+#[derive(Clone, Debug)]
+pub(crate) struct Ctx {
+    pub file: Arc<str>,
+    pub frame: usize,
+}
+
+impl Ctx {
+    pub fn at(&self, pos: Pos) -> Location {
+        Location::text(&self.file, self.frame, pos.line, pos.byte)
+    }
+
+    pub fn io(&self, pos: Pos, source: std::io::Error) -> Error {
+        Error::Io {
+            at: self.at(pos),
+            source,
+        }
+    }
+
+    /// A parse error at `token`, a sub-slice of `line` (which starts at `pos`): the byte offset
+    /// points at the token itself.
+    pub fn parse(&self, pos: Pos, line: &[u8], token: &[u8], expected: &'static str) -> Error {
+        let col = (token.as_ptr() as usize).wrapping_sub(line.as_ptr() as usize);
+        let col = if col <= line.len() { col } else { 0 };
+        Error::Parse {
+            at: self.at(Pos {
+                line: pos.line,
+                byte: pos.byte + col as u64,
+            }),
+            expected,
+            found: Error::found(token),
+        }
+    }
+
+    pub fn truncated(&self, pos: Pos, expected: String) -> Error {
+        Error::Truncated {
+            at: self.at(pos),
+            expected,
+        }
+    }
+}
+
+/// One text format's frame parser.
+pub(crate) trait TextFormat {
+    /// Parses the frame starting at the next line into `frame` (cleared by the caller); `Ok(false)`
+    /// when the data ends cleanly before a frame starts.
+    fn read<R: Read>(
+        &mut self,
+        lines: &mut LineReader<R>,
+        ctx: &Ctx,
+        frame: &mut Frame,
+    ) -> Result<bool, Error>;
+
+    /// Moves past the frame starting at the next line without parsing numbers; `Ok(false)` at a
+    /// clean end of data. Must accept exactly the frames `read` accepts, or fail.
+    fn skip<R: Read>(&mut self, lines: &mut LineReader<R>, ctx: &Ctx) -> Result<bool, Error>;
+}
+
+/// Skips blank lines; returns the first non-blank line's position, or `None` at the end.
+pub(crate) fn skip_blank<R: Read>(
+    lines: &mut LineReader<R>,
+    ctx: &Ctx,
+) -> Result<Option<Pos>, Error> {
+    loop {
+        let pos = lines.pos();
+        // Peek: read a line, and give it back if it is not blank.
+        match lines.next_line().map_err(|e| ctx.io(pos, e))? {
+            None => return Ok(None),
+            Some((_, l)) if crate::parse::trim(l).is_empty() => continue,
+            Some((p, _)) => {
+                lines.unread(p);
+                return Ok(Some(pos));
+            }
+        }
+    }
+}
+
+/// Streaming and random access over a text format.
+pub(crate) struct TextReader<R, F> {
+    lines: LineReader<R>,
+    format: F,
+    file: Arc<str>,
+    /// Starts of the frames seen so far.
+    starts: Vec<Pos>,
+    /// True once a scan reached the end of the data.
+    complete: bool,
+    /// Index of the frame the next `read_next` reads.
+    next: usize,
+}
+
+impl<R: Read + Seek, F: TextFormat> TextReader<R, F> {
+    pub fn new(src: R, format: F, file: Arc<str>) -> TextReader<R, F> {
+        TextReader {
+            lines: LineReader::new(src),
+            format,
+            file,
+            starts: Vec::new(),
+            complete: false,
+            next: 0,
+        }
+    }
+
+    fn ctx(&self) -> Ctx {
+        Ctx {
+            file: self.file.clone(),
+            frame: self.next,
+        }
+    }
+
+    /// Reads the next frame; `Ok(false)` at the end.
+    pub fn read_next(&mut self, frame: &mut Frame) -> Result<bool, Error> {
+        let ctx = self.ctx();
+        frame.clear();
+        let Some(start) = skip_blank(&mut self.lines, &ctx)? else {
+            if self.next == self.starts.len() {
+                self.complete = true;
+            }
+            return Ok(false);
+        };
+        if self.next == self.starts.len() {
+            self.starts.push(start);
+        }
+        let ok = self.format.read(&mut self.lines, &ctx, frame);
+        match ok {
+            Ok(true) => {
+                self.next += 1;
+                Ok(true)
+            }
+            Ok(false) => Ok(false),
+            Err(e) => {
+                // Leave the cursor at the damaged frame so a retry gives the same error.
+                frame.clear();
+                let _ = self.lines.seek(self.starts[self.next]);
+                Err(e)
+            }
+        }
+    }
+
+    /// Scans forward until `n + 1` frame starts are known or the data ends.
+    fn scan_to(&mut self, n: usize) -> Result<(), Error> {
+        if self.complete || n < self.starts.len() {
+            return Ok(());
+        }
+        // Continue from the end of the last known frame.
+        if let Some(&last) = self.starts.last() {
+            self.next = self.starts.len() - 1;
+            self.lines.seek(last).map_err(|e| self.ctx().io(last, e))?;
+            let ctx = self.ctx();
+            if !self.format.skip(&mut self.lines, &ctx)? {
+                self.complete = true;
+                return Ok(());
+            }
+            self.next += 1;
+        } else {
+            self.next = 0;
+            let p = Pos { line: 1, byte: 0 };
+            self.lines.seek(p).map_err(|e| self.ctx().io(p, e))?;
+        }
+        while self.starts.len() <= n {
+            let ctx = self.ctx();
+            let Some(start) = skip_blank(&mut self.lines, &ctx)? else {
+                self.complete = true;
+                return Ok(());
+            };
+            self.starts.push(start);
+            if !self.format.skip(&mut self.lines, &ctx)? {
+                self.starts.pop();
+                self.complete = true;
+                return Ok(());
+            }
+            self.next += 1;
+        }
+        Ok(())
+    }
+
+    /// Positions the reader so that `read_next` reads frame `n`; false when there is no frame `n`.
+    pub fn seek_frame(&mut self, n: usize) -> Result<bool, Error> {
+        if let Err(e) = self.scan_to(n) {
+            // A damaged frame stopped the scan; its start is the last one known: stay there so
+            // that `read_next` reports the same damage.
+            if let Some(&p) = self.starts.last() {
+                self.next = self.starts.len() - 1;
+                let _ = self.lines.seek(p);
+            }
+            return Err(e);
+        }
+        if n < self.starts.len() {
+            let p = self.starts[n];
+            self.lines.seek(p).map_err(|e| self.ctx().io(p, e))?;
+            self.next = n;
+            Ok(true)
+        } else {
+            Ok(false)
+        }
+    }
+
+    /// Number of frames (scans the whole file once; keeps the read position).
+    pub fn n_frames(&mut self) -> Result<usize, Error> {
+        if !self.complete {
+            let keep = self.next;
+            self.scan_to(usize::MAX - 1)?;
+            if keep < self.starts.len() {
+                self.seek_frame(keep)?;
+            } else {
+                // Every frame had been read: the scan ended at the end of the data, as we had.
+                self.next = keep;
+            }
+        }
+        Ok(self.starts.len())
+    }
+}

@@ -1,0 +1,169 @@
+//! [`Trajectory`]: one reader for every format, streaming or random access.
+
+use crate::error::Error;
+use crate::format::Format;
+use crate::frame::Frame;
+use crate::text::TextReader;
+use crate::xyz::Xyz;
+use std::fs::File;
+use std::io::{Read, Seek};
+use std::path::Path;
+use std::sync::Arc;
+
+/// The per-format readers: a closed set, dispatched by `match` (see the contract in lib.rs).
+enum Reader<R> {
+    Xyz(TextReader<R, Xyz>),
+}
+
+/// Runs `$body` with `$r` bound to the format's reader, whatever the format.
+macro_rules! each_reader {
+    ($reader:expr, $r:ident => $body:expr) => {
+        match $reader {
+            Reader::Xyz($r) => $body,
+        }
+    };
+}
+
+/// A trajectory file opened for reading.
+///
+/// Frames are read one at a time into a caller's [`Frame`] ([`Trajectory::read_next`]), so
+/// memory does not grow with the number of frames and buffers are reused. Random access
+/// ([`Trajectory::read_frame`]) goes through an index of frame starts built lazily: streaming
+/// fills it as it goes, and a jump past the known frames scans forward (a line scan for text
+/// formats).
+///
+/// A damaged frame gives an [`Error`] naming the file, the frame and the line / byte offset;
+/// every frame before it stays readable.
+pub struct Trajectory<R: Read + Seek = File> {
+    reader: Reader<R>,
+    file: Arc<str>,
+    format: Format,
+    n_atoms: Option<usize>,
+    next: usize,
+}
+
+impl Trajectory<File> {
+    /// Opens `path`, telling the format from the extension or else from the first bytes.
+    pub fn open(path: impl AsRef<Path>) -> Result<Trajectory<File>, Error> {
+        let path = path.as_ref();
+        let name: Arc<str> = path.display().to_string().into();
+        let io = |source| Error::Io {
+            at: crate::error::Location::file(&name),
+            source,
+        };
+        let mut file = File::open(path).map_err(io)?;
+        let format = match Format::from_path(path) {
+            Some(f) => f,
+            None => {
+                let mut head = Vec::with_capacity(512);
+                (&mut file).take(512).read_to_end(&mut head).map_err(io)?;
+                file.rewind().map_err(io)?;
+                Format::from_magic(&head).ok_or(Error::UnknownFormat { file: name.clone() })?
+            }
+        };
+        Trajectory::from_reader(file, format, &name)
+    }
+
+    /// Opens `path` as `format`, whatever its extension.
+    pub fn open_as(path: impl AsRef<Path>, format: Format) -> Result<Trajectory<File>, Error> {
+        let path = path.as_ref();
+        let name: Arc<str> = path.display().to_string().into();
+        let file = File::open(path).map_err(|source| Error::Io {
+            at: crate::error::Location::file(&name),
+            source,
+        })?;
+        Trajectory::from_reader(file, format, &name)
+    }
+}
+
+impl<R: Read + Seek> Trajectory<R> {
+    /// Reads `src` as `format`; `name` is what errors call the file.
+    pub fn from_reader(src: R, format: Format, name: &str) -> Result<Trajectory<R>, Error> {
+        let file: Arc<str> = name.into();
+        let reader = match format {
+            Format::Xyz => Reader::Xyz(TextReader::new(src, Xyz::default(), file.clone())),
+            _ => {
+                return Err(Error::Unsupported {
+                    file,
+                    what: "reading this format is not built in yet",
+                });
+            }
+        };
+        Ok(Trajectory {
+            reader,
+            file,
+            format,
+            n_atoms: None,
+            next: 0,
+        })
+    }
+
+    /// The file's format.
+    pub fn format(&self) -> Format {
+        self.format
+    }
+
+    /// The file's name as errors give it.
+    pub fn name(&self) -> &str {
+        &self.file
+    }
+
+    /// Reads the next frame into `frame` (cleared first); `Ok(false)` after the last frame.
+    /// On error `frame` is left empty and the reader stays at the damaged frame.
+    pub fn read_next(&mut self, frame: &mut Frame) -> Result<bool, Error> {
+        let ok = each_reader!(&mut self.reader, r => r.read_next(frame))?;
+        if ok {
+            if self.next == 0 {
+                self.n_atoms = Some(frame.n_atoms());
+            }
+            self.next += 1;
+        }
+        Ok(ok)
+    }
+
+    /// Reads frame `n` (0-based) into `frame`; the next `read_next` then reads frame `n + 1`.
+    pub fn read_frame(&mut self, n: usize, frame: &mut Frame) -> Result<(), Error> {
+        let found = each_reader!(&mut self.reader, r => r.seek_frame(n))?;
+        if !found {
+            let n_frames = self.n_frames()?;
+            return Err(Error::FrameOutOfRange {
+                file: self.file.clone(),
+                requested: n,
+                n_frames,
+            });
+        }
+        self.next = n;
+        if !self.read_next(frame)? {
+            let n_frames = self.n_frames()?;
+            return Err(Error::FrameOutOfRange {
+                file: self.file.clone(),
+                requested: n,
+                n_frames,
+            });
+        }
+        Ok(())
+    }
+
+    /// Number of frames. The first call may scan the whole file (once); the read position is
+    /// kept.
+    pub fn n_frames(&mut self) -> Result<usize, Error> {
+        each_reader!(&mut self.reader, r => r.n_frames())
+    }
+
+    /// Number of atoms in the first frame (frames of a LAMMPS dump may differ: use
+    /// [`Frame::n_atoms`] per frame). Reads the first frame if none was read; the read position
+    /// is kept.
+    pub fn n_atoms(&mut self) -> Result<usize, Error> {
+        if let Some(n) = self.n_atoms {
+            return Ok(n);
+        }
+        let keep = self.next;
+        let mut scratch = Frame::new();
+        self.read_frame(0, &mut scratch)?;
+        let n = scratch.n_atoms();
+        self.n_atoms = Some(n);
+        each_reader!(&mut self.reader, r => r.seek_frame(keep))?;
+        self.next = keep;
+        Ok(n)
+    }
+}

@@ -1,0 +1,406 @@
+//! XYZ and extended XYZ.
+//!
+//! A frame is an atom-count line, a comment line and one line per atom. Plain XYZ atom lines are
+//! `name x y z` (further columns ignored). When the comment line is extended XYZ (key=value pairs
+//! as written by ASE, OVITO, QUIP), these keys are used:
+//! - `Lattice="ax ay az bx by bz cx cy cz"`: the cell edge vectors (rows), Å;
+//! - `Properties=name:type:count:...` with type S (string), R (real), I (integer), L (logical):
+//!   the columns of the atom lines. Known names: `species` (→ names and elements), `pos`,
+//!   `velo`/`vel`/`velocities` (Å/ps, stored as given), `radius`/`radii`, `color`/`colors`
+//!   (R:3, sRGB in [0, 1]), `type` (→ types), `id` (→ ids), `Z` (→ elements); other columns are
+//!   skipped. Without `Properties` the columns are `species:S:1:pos:R:3`.
+//! - `Time=` (ps) and `step=`/`Step=`/`timestep=` when present.
+//!
+//! Elements come from the species by [`crate::elements::guess_element`] (species are normally
+//! symbols, so "Ca" and "CA" are calcium).
+
+use crate::elements::{Element, guess_element};
+use crate::error::Error;
+use crate::frame::{Frame, Label, UnitCell};
+use crate::parse::{fields, parse_f32, parse_f64, parse_i64, parse_usize, trim};
+use crate::text::{Ctx, LineReader, Pos, TextFormat};
+use std::io::Read;
+
+/// What one atom-line column group holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Col {
+    Species,
+    Pos,
+    Velo,
+    Radius,
+    Color,
+    Type,
+    Id,
+    Z,
+    Skip(usize),
+}
+
+/// XYZ frame parser state: the columns of the current frame and a species → element cache.
+#[derive(Default)]
+pub(crate) struct Xyz {
+    cols: Vec<Col>,
+    species: Vec<(Label, Element)>,
+}
+
+impl Xyz {
+    fn element(&mut self, name: Label) -> Element {
+        // Few distinct species per file: a short linear cache beats the name rules per atom.
+        if let Some((_, e)) = self.species.iter().find(|(l, _)| *l == name) {
+            return *e;
+        }
+        let e = guess_element(&name, None, None);
+        if self.species.len() < 64 {
+            self.species.push((name, e));
+        }
+        e
+    }
+}
+
+/// Splits an extended-XYZ comment into key=value pairs (values may be "double quoted").
+fn key_values(line: &[u8]) -> impl Iterator<Item = (&[u8], &[u8])> {
+    let mut i = 0;
+    std::iter::from_fn(move || {
+        loop {
+            while i < line.len() && (line[i] == b' ' || line[i] == b'\t') {
+                i += 1;
+            }
+            if i >= line.len() {
+                return None;
+            }
+            let ks = i;
+            while i < line.len() && !matches!(line[i], b'=' | b' ' | b'\t') {
+                i += 1;
+            }
+            let key = &line[ks..i];
+            if i >= line.len() || line[i] != b'=' {
+                // A bare word: not a pair.
+                if key.is_empty() {
+                    i += 1;
+                }
+                continue;
+            }
+            i += 1;
+            let value = if line.get(i) == Some(&b'"') {
+                i += 1;
+                let vs = i;
+                while i < line.len() && line[i] != b'"' {
+                    i += 1;
+                }
+                let v = &line[vs..i];
+                i += 1;
+                v
+            } else {
+                let vs = i;
+                while i < line.len() && line[i] != b' ' && line[i] != b'\t' {
+                    i += 1;
+                }
+                &line[vs..i]
+            };
+            return Some((key, value));
+        }
+    })
+}
+
+impl Xyz {
+    /// Reads the comment line's keys into `frame` and `self.cols`.
+    fn parse_comment(
+        &mut self,
+        ctx: &Ctx,
+        pos: Pos,
+        line: &[u8],
+        frame: &mut Frame,
+    ) -> Result<(), Error> {
+        self.cols.clear();
+        for (key, value) in key_values(line) {
+            if key.eq_ignore_ascii_case(b"Lattice") {
+                let mut m = [0.0f64; 9];
+                let mut k = 0;
+                for f in fields(value) {
+                    if k == 9 {
+                        return Err(ctx.parse(pos, line, value, "9 numbers in Lattice"));
+                    }
+                    m[k] = parse_f64(f)
+                        .ok_or_else(|| ctx.parse(pos, line, f, "a number in Lattice"))?;
+                    k += 1;
+                }
+                if k != 9 {
+                    return Err(ctx.parse(pos, line, value, "9 numbers in Lattice"));
+                }
+                let cell = UnitCell::from_matrix([
+                    [m[0], m[1], m[2]],
+                    [m[3], m[4], m[5]],
+                    [m[6], m[7], m[8]],
+                ])
+                .map_err(|_| ctx.parse(pos, line, value, "a Lattice with volume > 0"))?;
+                frame.cell = Some(cell);
+            } else if key.eq_ignore_ascii_case(b"Properties") {
+                self.parse_properties(ctx, pos, line, value)?;
+            } else if key.eq_ignore_ascii_case(b"Time") {
+                frame.time = parse_f64(value);
+            } else if key.eq_ignore_ascii_case(b"step") || key.eq_ignore_ascii_case(b"timestep") {
+                frame.step = parse_i64(value);
+            }
+        }
+        if self.cols.is_empty() {
+            self.cols.extend([Col::Species, Col::Pos]);
+        }
+        Ok(())
+    }
+
+    fn parse_properties(
+        &mut self,
+        ctx: &Ctx,
+        pos: Pos,
+        line: &[u8],
+        value: &[u8],
+    ) -> Result<(), Error> {
+        let mut parts = value.split(|b| *b == b':');
+        let mut has_pos = false;
+        while let Some(name) = parts.next() {
+            let (Some(ty), Some(count)) = (parts.next(), parts.next()) else {
+                return Err(ctx.parse(pos, line, value, "Properties as name:type:count triples"));
+            };
+            let count = parse_usize(count)
+                .filter(|c| *c >= 1)
+                .ok_or_else(|| ctx.parse(pos, line, count, "a column count >= 1 in Properties"))?;
+            let real3 = ty == b"R" && count == 3;
+            let col = match name {
+                b"species" if ty == b"S" && count == 1 => Col::Species,
+                b"pos" if real3 => Col::Pos,
+                b"velo" | b"vel" | b"velocities" if real3 => Col::Velo,
+                b"radius" | b"radii" if ty == b"R" && count == 1 => Col::Radius,
+                b"color" | b"colors" | b"Color" if real3 => Col::Color,
+                b"type" if count == 1 => Col::Type,
+                b"id" if ty == b"I" && count == 1 => Col::Id,
+                b"Z" if ty == b"I" && count == 1 => Col::Z,
+                _ => Col::Skip(count),
+            };
+            has_pos |= col == Col::Pos;
+            self.cols.push(col);
+        }
+        if !has_pos {
+            return Err(ctx.parse(pos, line, value, "a pos:R:3 column in Properties"));
+        }
+        Ok(())
+    }
+
+    /// Parses one atom line by the column list.
+    fn atom(&mut self, ctx: &Ctx, pos: Pos, line: &[u8], frame: &mut Frame) -> Result<(), Error> {
+        let mut it = fields(line);
+        let end = &line[line.len()..];
+        for ci in 0..self.cols.len() {
+            let col = self.cols[ci];
+            match col {
+                Col::Species | Col::Type => {
+                    let f = it
+                        .next()
+                        .ok_or_else(|| ctx.parse(pos, line, end, "an atom name"))?;
+                    let l = Label::from_utf8(f)
+                        .ok_or_else(|| ctx.parse(pos, line, f, "a name of at most 15 bytes"))?;
+                    if col == Col::Species {
+                        let e = self.element(l);
+                        frame.names.push(l);
+                        frame.elements.push(e);
+                    } else {
+                        frame.types.push(l);
+                    }
+                }
+                Col::Pos | Col::Velo | Col::Color => {
+                    let mut v = [0f32; 3];
+                    for x in &mut v {
+                        let f = it.next().unwrap_or(end);
+                        *x = parse_f32(f).ok_or_else(|| {
+                            ctx.parse(pos, line, f, "3 coordinates after atom name")
+                        })?;
+                    }
+                    match col {
+                        Col::Pos => frame.positions.push(v),
+                        Col::Velo => frame.velocities.push(v),
+                        _ => frame.colors.push(v),
+                    }
+                }
+                Col::Radius => {
+                    let f = it.next().unwrap_or(end);
+                    let r = parse_f32(f)
+                        .filter(|r| *r >= 0.0)
+                        .ok_or_else(|| ctx.parse(pos, line, f, "a radius >= 0"))?;
+                    frame.radii.push(r);
+                }
+                Col::Id | Col::Z => {
+                    let f = it.next().unwrap_or(end);
+                    let v = parse_i64(f).ok_or_else(|| ctx.parse(pos, line, f, "an integer"))?;
+                    if col == Col::Id {
+                        frame.ids.push(v);
+                    } else {
+                        let e = u8::try_from(v)
+                            .ok()
+                            .and_then(Element::from_z)
+                            .ok_or_else(|| ctx.parse(pos, line, f, "an atomic number 1..=103"))?;
+                        frame.elements.push(e);
+                    }
+                }
+                Col::Skip(n) => {
+                    for _ in 0..n {
+                        it.next()
+                            .ok_or_else(|| ctx.parse(pos, line, end, "more columns"))?;
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The plain `name x y z` kernel, the hot loop of most XYZ files.
+    #[inline]
+    fn plain_atom(
+        &mut self,
+        ctx: &Ctx,
+        pos: Pos,
+        line: &[u8],
+        frame: &mut Frame,
+    ) -> Result<(), Error> {
+        let mut it = fields(line);
+        let end = &line[line.len()..];
+        let f = it
+            .next()
+            .ok_or_else(|| ctx.parse(pos, line, end, "an atom name"))?;
+        let name = Label::from_utf8(f)
+            .ok_or_else(|| ctx.parse(pos, line, f, "a name of at most 15 bytes"))?;
+        let mut v = [0f32; 3];
+        for x in &mut v {
+            let f = it.next().unwrap_or(end);
+            *x = parse_f32(f)
+                .ok_or_else(|| ctx.parse(pos, line, f, "3 coordinates after atom name"))?;
+        }
+        let e = self.element(name);
+        frame.names.push(name);
+        frame.elements.push(e);
+        frame.positions.push(v);
+        Ok(())
+    }
+
+    fn count<R: Read>(lines: &mut LineReader<R>, ctx: &Ctx) -> Result<Option<usize>, Error> {
+        let p0 = lines.pos();
+        let Some((pos, line)) = lines.next_line().map_err(|e| ctx.io(p0, e))? else {
+            return Ok(None);
+        };
+        let t = trim(line);
+        let n = parse_usize(fields(t).next().unwrap_or(t))
+            .ok_or_else(|| ctx.parse(pos, line, t, "the number of atoms"))?;
+        Ok(Some(n))
+    }
+}
+
+impl TextFormat for Xyz {
+    fn read<R: Read>(
+        &mut self,
+        lines: &mut LineReader<R>,
+        ctx: &Ctx,
+        frame: &mut Frame,
+    ) -> Result<bool, Error> {
+        // Atom count line.
+        let Some(n) = Xyz::count(lines, ctx)? else {
+            return Ok(false);
+        };
+        // Comment line (extended XYZ keys).
+        let p = lines.pos();
+        let Some((pos, line)) = lines.next_line().map_err(|e| ctx.io(p, e))? else {
+            return Err(ctx.truncated(p, "the comment line".into()));
+        };
+        frame.comment.push_str(&String::from_utf8_lossy(line));
+        self.parse_comment(ctx, pos, line, frame)?;
+        // Atom lines, with the kernel chosen once per frame.
+        frame.positions.reserve(n);
+        let plain = self.cols == [Col::Species, Col::Pos];
+        for i in 0..n {
+            let p = lines.pos();
+            let Some((pos, line)) = lines.next_line().map_err(|e| ctx.io(p, e))? else {
+                return Err(ctx.truncated(p, format!("{} more atom lines", n - i)));
+            };
+            if plain {
+                self.plain_atom(ctx, pos, line, frame)?;
+            } else {
+                self.atom(ctx, pos, line, frame)?;
+            }
+        }
+        Ok(true)
+    }
+
+    fn skip<R: Read>(&mut self, lines: &mut LineReader<R>, ctx: &Ctx) -> Result<bool, Error> {
+        let Some(n) = Xyz::count(lines, ctx)? else {
+            return Ok(false);
+        };
+        let p = lines.pos();
+        let missing = lines.skip_lines(n + 1).map_err(|e| ctx.io(p, e))?;
+        if missing > 0 {
+            return Err(ctx.truncated(lines.pos(), format!("{} more lines", missing)));
+        }
+        Ok(true)
+    }
+}
+
+/// Writes frames as extended XYZ, which plain XYZ readers also read: the comment line carries
+/// `Properties=` (species, pos, and velo / radius / color when the frame has them), `Lattice=`
+/// when it has a cell, `Time=` and `step=` when known. Numbers are written in Rust's shortest
+/// round-trip form, so reading them back gives the same f32 bits.
+pub(crate) struct XyzWriter<W> {
+    pub out: W,
+}
+
+impl<W: std::io::Write> XyzWriter<W> {
+    pub fn write_frame(&mut self, frame: &Frame) -> std::io::Result<()> {
+        let w = &mut self.out;
+        let n = frame.n_atoms();
+        writeln!(w, "{n}")?;
+        // Comment line: cell, columns, time and step.
+        if let Some(c) = &frame.cell {
+            let m = c.matrix();
+            write!(
+                w,
+                "Lattice=\"{} {} {} {} {} {} {} {} {}\" ",
+                m[0][0], m[0][1], m[0][2], m[1][0], m[1][1], m[1][2], m[2][0], m[2][1], m[2][2]
+            )?;
+        }
+        write!(w, "Properties=species:S:1:pos:R:3")?;
+        if !frame.velocities.is_empty() {
+            write!(w, ":velo:R:3")?;
+        }
+        if !frame.radii.is_empty() {
+            write!(w, ":radius:R:1")?;
+        }
+        if !frame.colors.is_empty() {
+            write!(w, ":color:R:3")?;
+        }
+        if let Some(t) = frame.time {
+            write!(w, " Time={t}")?;
+        }
+        if let Some(s) = frame.step {
+            write!(w, " step={s}")?;
+        }
+        if frame.cell.is_some() {
+            write!(w, " pbc=\"T T T\"")?;
+        }
+        writeln!(w)?;
+        // Atom lines.
+        for i in 0..n {
+            let name = match (frame.names.get(i), frame.elements.get(i)) {
+                (Some(l), _) if !l.is_empty() => l.as_str(),
+                (_, Some(e)) => e.symbol(),
+                _ => "X",
+            };
+            let p = frame.positions[i];
+            write!(w, "{name} {} {} {}", p[0], p[1], p[2])?;
+            if let Some(v) = frame.velocities.get(i) {
+                write!(w, " {} {} {}", v[0], v[1], v[2])?;
+            }
+            if let Some(r) = frame.radii.get(i) {
+                write!(w, " {r}")?;
+            }
+            if let Some(c) = frame.colors.get(i) {
+                write!(w, " {} {} {}", c[0], c[1], c[2])?;
+            }
+            writeln!(w)?;
+        }
+        Ok(())
+    }
+}
