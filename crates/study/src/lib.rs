@@ -1,1 +1,8 @@
-//! (being built) The comparison harness: every sphere method and the reference on the same scene.
+//! # texmap-study — the speed-versus-accuracy study of the sphere methods
+//!
+//! (being built)
+
+pub mod elements;
+pub mod md;
+pub mod rng;
+pub mod scenes;
