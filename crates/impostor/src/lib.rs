@@ -37,8 +37,10 @@
 //! **Architecture invariant:** this crate depends on `texmap-core` and `texmap-raster` only; the
 //! reference ray tracer appears in its tests alone (the comparison harness lives in `texmap-study`).
 
+mod lut;
 mod pipeline;
 mod raycast;
+mod template;
 
 use glam::Vec3;
 use texmap_core::camera::Camera;
@@ -227,7 +229,14 @@ pub struct Render {
 #[derive(Debug, Default)]
 pub struct Renderer {
     bins: pipeline::Bins,
+    lut: Option<lut::LutTables>,
+    template: Option<template::TemplateTables>,
 }
+
+/// Smallest and largest accepted side of the Seed 002 images and Seed 004 templates; other
+/// values of [`Options::lut_size`] and [`Options::template_size`] are clamped into this range.
+pub const MIN_TABLE_SIZE: u32 = 4;
+pub const MAX_TABLE_SIZE: u32 = 4096;
 
 impl Renderer {
     pub fn new() -> Renderer {
@@ -255,9 +264,9 @@ impl Renderer {
         }
         let view = pipeline::View::new(camera);
         let lighting = options.lighting.to_eye(camera);
+        let bg = options.background;
         match options.method {
-            // Interim: lut, template and polygon are still drawn by the ray-cast kernels.
-            Method::Raycast | Method::Lut | Method::Template | Method::Polygon => {
+            Method::Raycast => {
                 let stats = self
                     .bins
                     .build(scene, &view, |c, r, k| raycast::project(&view, c, r, k));
@@ -267,15 +276,74 @@ impl Renderer {
                         lighting,
                         materials: &scene.materials,
                     };
-                    pipeline::draw_tiles(&self.bins, &view, &k, options.background, frame);
+                    pipeline::draw_tiles(&self.bins, &view, &k, bg, frame);
                 } else {
                     let k = raycast::Perspective {
                         view,
                         lighting,
                         materials: &scene.materials,
                     };
-                    pipeline::draw_tiles(&self.bins, &view, &k, options.background, frame);
+                    pipeline::draw_tiles(&self.bins, &view, &k, bg, frame);
                 }
+                stats
+            }
+            Method::Lut => {
+                let size = options.lut_size.clamp(MIN_TABLE_SIZE, MAX_TABLE_SIZE);
+                // Seed 002: the colour images are lit once per scene (rebuilt only on change).
+                if !self
+                    .lut
+                    .as_ref()
+                    .is_some_and(|t| t.matches(size, &lighting, &scene.materials))
+                {
+                    self.lut = Some(lut::LutTables::build(size, &lighting, &scene.materials));
+                }
+                let tables = self.lut.as_ref().expect("built above");
+                let stats = self
+                    .bins
+                    .build(scene, &view, |c, r, k| lut::project(&view, c, r, k));
+                let k = lut::LutKernel { view, tables };
+                pipeline::draw_tiles(&self.bins, &view, &k, bg, frame);
+                stats
+            }
+            Method::Template => {
+                let size = options.template_size.clamp(MIN_TABLE_SIZE, MAX_TABLE_SIZE);
+                let coloring = options.template_coloring;
+                if !self
+                    .template
+                    .as_ref()
+                    .is_some_and(|t| t.matches(size, coloring, &lighting, &scene.materials))
+                {
+                    self.template = Some(template::TemplateTables::build(
+                        size,
+                        coloring,
+                        &lighting,
+                        &scene.materials,
+                    ));
+                }
+                let tables = self.template.as_ref().expect("built above");
+                let dirs = template::LightDirs::new(&lighting);
+                let stats = self.bins.build(scene, &view, |c, r, k| {
+                    template::project(&view, &dirs, c, r, k)
+                });
+                let k = template::TemplateKernel {
+                    view,
+                    tables,
+                    depth_mode: options.template_depth,
+                };
+                pipeline::draw_tiles(&self.bins, &view, &k, bg, frame);
+                stats
+            }
+            // Interim: polygon is still drawn by the ray-cast kernels.
+            Method::Polygon => {
+                let stats = self
+                    .bins
+                    .build(scene, &view, |c, r, k| raycast::project(&view, c, r, k));
+                let k = raycast::Perspective {
+                    view,
+                    lighting,
+                    materials: &scene.materials,
+                };
+                pipeline::draw_tiles(&self.bins, &view, &k, bg, frame);
                 stats
             }
         }
