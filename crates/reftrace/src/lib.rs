@@ -1,1 +1,63 @@
-//! (being built)
+//! # texmap-reftrace — the reference ray tracer (the oracle)
+//!
+//! Every drawing method of texmap is measured against the images this crate makes. It ray-traces
+//! analytic spheres, capped cylinders (bonds) and triangle meshes held in one obvhs BVH, with the
+//! workspace's camera ([`texmap_core::camera::Camera`]: horizontal field of view, pixel centres at
+//! `i + 0.5`, depth along the view axis) and shading model ([`texmap_core::shade::Lighting::shade`]),
+//! so a difference between a method and the reference is the method's own error.
+//!
+//! - [`SceneBuilder`] → [`Scene`]: add spheres, cylinders and meshes (from [`load`]ed OBJ or glTF,
+//!   or from slices), build the BVH once; [`Scene::intersect`] answers closest-hit queries.
+//! - [`Scene::render`] / [`Scene::render_with_environment`] → [`Frame`]: exact primary visibility
+//!   and depth, mirror and refraction rays with an environment for escaped rays, `n × n` stratified
+//!   supersampling, a footprint-integrated texture reference. Parallel over rows with rayon and
+//!   byte-identical for any thread count. Writes no files.
+//! - [`geom`]: the robust leaf tests — pbrt's cancellation-free sphere discriminant and the
+//!   watertight ray/triangle test of Woop, Benthin and Wald (2013), which leaves no pinholes on
+//!   shared edges (obvhs's own triangle test does; it is not used).
+//!
+//! Correctness and robustness come first; it still traces a million spheres at 1080p in well under
+//! a second on two cores (docs/fragments/reftrace.md).
+//!
+//! ```
+//! use texmap_core::camera::Camera;
+//! use texmap_core::shade::{Lighting, Material};
+//! use texmap_reftrace::{RenderOptions, SceneBuilder, SurfaceMaterial, glam::Vec3};
+//!
+//! let mut builder = SceneBuilder::new();
+//! builder.add_sphere(Vec3::ZERO, 1.0, 0);
+//! let scene = builder.build();
+//!
+//! let cam = Camera::perspective_look_at(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y, 40.0, 64, 48)
+//!     .unwrap();
+//! let materials = [SurfaceMaterial::opaque(Material::plastic(Vec3::new(0.8, 0.2, 0.2)))];
+//! let opts = RenderOptions::new(Lighting::default_for(&cam), &materials);
+//! let frame = scene.render(&cam, &opts).unwrap();
+//!
+//! // The sphere's nearest point is 5 − 1 = 4 units down the view axis, at the image centre.
+//! let d = frame.depth[frame.index(32, 24)];
+//! assert!((d - 4.0).abs() < 1e-3, "{d}");
+//! // A corner pixel sees the background.
+//! assert_eq!(frame.depth[0], f32::INFINITY);
+//! ```
+//!
+//! **Architecture invariant:** this crate depends on `texmap-core` and never on `texmap-raster`:
+//! the oracle shares nothing with the methods it judges except the camera and the shading model.
+
+pub use glam;
+
+pub mod error;
+pub mod geom;
+pub mod load;
+mod render;
+mod scene;
+mod texture;
+
+pub use error::{LoadError, RenderError, SceneError, TextureError};
+pub use geom::CylinderPart;
+pub use render::{
+    MAX_RECURSION_DEPTH, MAX_SAMPLES_PER_AXIS, Optics, RenderOptions, SurfaceMaterial,
+};
+pub use scene::{BuildStats, BvhKind, Hit, HitKind, MeshData, Scene, SceneBuilder};
+pub use texmap_core::frame::Frame;
+pub use texture::Texture;

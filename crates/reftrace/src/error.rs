@@ -1,0 +1,217 @@
+//! Error types of the reference ray tracer.
+
+use std::path::PathBuf;
+
+/// Why a mesh was refused by [`crate::SceneBuilder::add_mesh`].
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum SceneError {
+    /// The index list length is not a multiple of 3.
+    IndicesNotTriangles { len: usize },
+    /// A triangle refers to a vertex that does not exist.
+    IndexOutOfRange {
+        triangle: usize,
+        index: u32,
+        vertex_count: usize,
+    },
+    /// Texture coordinates were given but not one per vertex.
+    UvCountMismatch { uvs: usize, vertices: usize },
+    /// More primitives than the 32-bit ids can name.
+    TooManyPrimitives,
+}
+
+impl std::fmt::Display for SceneError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            SceneError::IndicesNotTriangles { len } => {
+                write!(f, "{len} indices is not a whole number of triangles")
+            }
+            SceneError::IndexOutOfRange {
+                triangle,
+                index,
+                vertex_count,
+            } => write!(
+                f,
+                "triangle {triangle} refers to vertex {index}, but the mesh has {vertex_count} vertices"
+            ),
+            SceneError::UvCountMismatch { uvs, vertices } => write!(
+                f,
+                "{uvs} texture coordinates given for {vertices} vertices (need one per vertex)"
+            ),
+            SceneError::TooManyPrimitives => write!(f, "more than 2^32 - 1 primitives"),
+        }
+    }
+}
+
+impl std::error::Error for SceneError {}
+
+/// Why a render was refused. Checked once before any ray is traced.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum RenderError {
+    /// `samples_per_axis` is 0 or above [`crate::MAX_SAMPLES_PER_AXIS`].
+    BadSamples { samples_per_axis: u32 },
+    /// `max_depth` is above [`crate::MAX_RECURSION_DEPTH`].
+    BadMaxDepth { max_depth: u32 },
+    /// The scene uses a material id that `materials` does not hold.
+    MissingMaterial { material_id: u32, materials: usize },
+    /// A material names a texture that `textures` does not hold.
+    MissingTexture {
+        material: usize,
+        texture: u32,
+        textures: usize,
+    },
+    /// A material parameter is out of range (non-finite colour, reflectance outside [0, 1],
+    /// index of refraction not finite and positive).
+    BadMaterial { material: usize, what: &'static str },
+    /// The background colour is not finite.
+    BadBackground,
+}
+
+impl std::fmt::Display for RenderError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            RenderError::BadSamples { samples_per_axis } => write!(
+                f,
+                "samples_per_axis = {samples_per_axis}; must be 1..={}",
+                crate::MAX_SAMPLES_PER_AXIS
+            ),
+            RenderError::BadMaxDepth { max_depth } => write!(
+                f,
+                "max_depth = {max_depth}; must be at most {}",
+                crate::MAX_RECURSION_DEPTH
+            ),
+            RenderError::MissingMaterial {
+                material_id,
+                materials,
+            } => write!(
+                f,
+                "the scene uses material {material_id} but only {materials} materials were given"
+            ),
+            RenderError::MissingTexture {
+                material,
+                texture,
+                textures,
+            } => write!(
+                f,
+                "material {material} uses texture {texture} but only {textures} textures were given"
+            ),
+            RenderError::BadMaterial { material, what } => {
+                write!(f, "material {material}: {what}")
+            }
+            RenderError::BadBackground => write!(f, "background colour must be finite"),
+        }
+    }
+}
+
+impl std::error::Error for RenderError {}
+
+/// Why a texture was refused by [`crate::Texture::new`].
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum TextureError {
+    /// Width or height is zero.
+    Empty { width: u32, height: u32 },
+    /// The texel count is not `width * height`.
+    SizeMismatch {
+        width: u32,
+        height: u32,
+        texels: usize,
+    },
+    /// A texel holds a NaN or infinity.
+    NonFinite { x: u32, y: u32 },
+}
+
+impl std::fmt::Display for TextureError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            TextureError::Empty { width, height } => {
+                write!(f, "texture size {width}x{height} is empty")
+            }
+            TextureError::SizeMismatch {
+                width,
+                height,
+                texels,
+            } => write!(f, "{texels} texels given for a {width}x{height} texture"),
+            TextureError::NonFinite { x, y } => write!(f, "texel ({x}, {y}) is not finite"),
+        }
+    }
+}
+
+impl std::error::Error for TextureError {}
+
+/// Why a mesh file (or in-memory mesh bytes) could not be loaded. Every variant names the source:
+/// the file path, or the name the caller gave the bytes.
+#[derive(Debug)]
+#[non_exhaustive]
+pub enum LoadError {
+    /// The file could not be read.
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    /// The OBJ parser refused the input.
+    Obj { source: String, message: String },
+    /// The glTF parser refused the input, or a buffer could not be resolved.
+    Gltf { source: String, message: String },
+    /// A primitive of a glTF mesh is not made of triangles.
+    UnsupportedPrimitive {
+        source: String,
+        mesh: usize,
+        mode: String,
+    },
+    /// A mesh in the file is malformed (bad index, coordinate count, ...).
+    BadMesh {
+        source: String,
+        mesh: usize,
+        error: SceneError,
+    },
+    /// A mesh in the file has a vertex attribute of the wrong length.
+    BadAttribute {
+        source: String,
+        mesh: usize,
+        attribute: &'static str,
+        len: usize,
+    },
+    /// The input holds no triangle at all.
+    NoTriangles { source: String },
+}
+
+impl std::fmt::Display for LoadError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            LoadError::Io { path, source } => write!(f, "{}: {source}", path.display()),
+            LoadError::Obj { source, message } => write!(f, "{source}: OBJ: {message}"),
+            LoadError::Gltf { source, message } => write!(f, "{source}: glTF: {message}"),
+            LoadError::UnsupportedPrimitive { source, mesh, mode } => write!(
+                f,
+                "{source}: mesh {mesh}: primitive mode {mode} is not supported (need triangles)"
+            ),
+            LoadError::BadMesh {
+                source,
+                mesh,
+                error,
+            } => write!(f, "{source}: mesh {mesh}: {error}"),
+            LoadError::BadAttribute {
+                source,
+                mesh,
+                attribute,
+                len,
+            } => write!(
+                f,
+                "{source}: mesh {mesh}: attribute {attribute} has {len} values, not a whole number of vectors"
+            ),
+            LoadError::NoTriangles { source } => write!(f, "{source}: no triangles"),
+        }
+    }
+}
+
+impl std::error::Error for LoadError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            LoadError::Io { source, .. } => Some(source),
+            LoadError::BadMesh { error, .. } => Some(error),
+            _ => None,
+        }
+    }
+}

@@ -1,0 +1,351 @@
+//! Mesh loading: Wavefront OBJ (tobj) and glTF 2.0 (gltf), from files or from bytes in memory.
+//!
+//! Both readers return one [`MeshData`] per mesh (OBJ object/group, glTF primitive) with
+//! positions, triangle indices and, when present, the first set of texture coordinates. OBJ faces
+//! are triangulated and re-indexed so that positions and uvs share one index. glTF meshes are
+//! placed by their nodes' world transforms in the default scene (or the first one); meshes not
+//! referenced by any node are not returned. Only triangle-list primitives are read; other modes
+//! are an error. Images and materials are not read. Bytes are given a `source` name that every
+//! error message carries.
+
+use std::path::Path;
+
+use glam::{Mat4, Vec2, Vec3};
+
+use crate::error::LoadError;
+use crate::scene::MeshData;
+
+/// Read the OBJ file at `path` (materials are not read).
+pub fn load_obj(path: impl AsRef<Path>) -> Result<Vec<MeshData>, LoadError> {
+    let path = path.as_ref();
+    let bytes = std::fs::read(path).map_err(|source| LoadError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    load_obj_bytes(&bytes, &path.display().to_string())
+}
+
+/// Parse OBJ text held in memory; `source` names it in errors.
+pub fn load_obj_bytes(bytes: &[u8], source: &str) -> Result<Vec<MeshData>, LoadError> {
+    let opts = tobj::LoadOptions {
+        single_index: true,
+        triangulate: true,
+        ignore_points: true,
+        ignore_lines: true,
+        ..Default::default()
+    };
+    let mut reader = std::io::BufReader::new(bytes);
+    let (models, _materials) =
+        tobj::load_obj_buf(&mut reader, &opts, |_| Err(tobj::LoadError::OpenFileFailed)).map_err(
+            |e| LoadError::Obj {
+                source: source.to_string(),
+                message: e.to_string(),
+            },
+        )?;
+    let mut out = Vec::with_capacity(models.len());
+    for (k, model) in models.into_iter().enumerate() {
+        let m = model.mesh;
+        let bad = |attribute, len| LoadError::BadAttribute {
+            source: source.to_string(),
+            mesh: k,
+            attribute,
+            len,
+        };
+        if m.positions.len() % 3 != 0 {
+            return Err(bad("positions", m.positions.len()));
+        }
+        let positions: Vec<Vec3> = m
+            .positions
+            .chunks_exact(3)
+            .map(|p| Vec3::new(p[0], p[1], p[2]))
+            .collect();
+        let uvs = if m.texcoords.is_empty() {
+            None
+        } else {
+            if m.texcoords.len() != 2 * positions.len() {
+                return Err(bad("texcoords", m.texcoords.len()));
+            }
+            // OBJ's v axis points up; ours (like glTF's) points down the rows.
+            Some(
+                m.texcoords
+                    .chunks_exact(2)
+                    .map(|t| Vec2::new(t[0], 1.0 - t[1]))
+                    .collect(),
+            )
+        };
+        let mesh = MeshData {
+            positions,
+            indices: m.indices,
+            uvs,
+        };
+        check_mesh(&mesh, source, k)?;
+        if !mesh.indices.is_empty() {
+            out.push(mesh);
+        }
+    }
+    if out.is_empty() {
+        return Err(LoadError::NoTriangles {
+            source: source.to_string(),
+        });
+    }
+    Ok(out)
+}
+
+/// Read a glTF (`.gltf` with its buffers resolved next to it, or `.glb`) file.
+pub fn load_gltf(path: impl AsRef<Path>) -> Result<Vec<MeshData>, LoadError> {
+    let path = path.as_ref();
+    let bytes = std::fs::read(path).map_err(|source| LoadError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    load_gltf_impl(&bytes, &path.display().to_string(), path.parent())
+}
+
+/// Parse glTF held in memory (a `.glb`, or `.gltf` JSON whose buffers are embedded as data URIs);
+/// `source` names it in errors. External buffer files cannot be resolved from memory.
+pub fn load_gltf_bytes(bytes: &[u8], source: &str) -> Result<Vec<MeshData>, LoadError> {
+    load_gltf_impl(bytes, source, None)
+}
+
+fn load_gltf_impl(
+    bytes: &[u8],
+    source: &str,
+    base: Option<&Path>,
+) -> Result<Vec<MeshData>, LoadError> {
+    let gerr = |e: gltf::Error| LoadError::Gltf {
+        source: source.to_string(),
+        message: e.to_string(),
+    };
+    let gltf = gltf::Gltf::from_slice(bytes).map_err(gerr)?;
+    let gltf::Gltf { document, blob } = gltf;
+    let base = base.map(|b| {
+        if b.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            b
+        }
+    });
+    let buffers = gltf::import_buffers(&document, base, blob).map_err(gerr)?;
+    let mut out = Vec::new();
+    let scene = document
+        .default_scene()
+        .or_else(|| document.scenes().next());
+    if let Some(scene) = scene {
+        // Walk the node tree with an explicit stack (no recursion on untrusted depth).
+        let mut stack: Vec<(gltf::Node, Mat4)> =
+            scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect();
+        let mut visited = 0usize;
+        while let Some((node, parent)) = stack.pop() {
+            visited += 1;
+            if visited > 1_000_000 {
+                return Err(LoadError::Gltf {
+                    source: source.to_string(),
+                    message: "node hierarchy too large or cyclic".to_string(),
+                });
+            }
+            let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+            if let Some(mesh) = node.mesh() {
+                read_gltf_mesh(&mesh, &buffers, world, source, &mut out)?;
+            }
+            for child in node.children() {
+                stack.push((child, world));
+            }
+        }
+    }
+    if out.is_empty() {
+        return Err(LoadError::NoTriangles {
+            source: source.to_string(),
+        });
+    }
+    Ok(out)
+}
+
+fn read_gltf_mesh(
+    mesh: &gltf::Mesh,
+    buffers: &[gltf::buffer::Data],
+    world: Mat4,
+    source: &str,
+    out: &mut Vec<MeshData>,
+) -> Result<(), LoadError> {
+    for prim in mesh.primitives() {
+        let k = out.len();
+        if prim.mode() != gltf::mesh::Mode::Triangles {
+            return Err(LoadError::UnsupportedPrimitive {
+                source: source.to_string(),
+                mesh: mesh.index(),
+                mode: format!("{:?}", prim.mode()),
+            });
+        }
+        let reader = prim.reader(|b| buffers.get(b.index()).map(|d| d.0.as_slice()));
+        let Some(pos) = reader.read_positions() else {
+            continue;
+        };
+        let positions: Vec<Vec3> = pos
+            .map(|p| world.transform_point3(Vec3::from_array(p)))
+            .collect();
+        let indices: Vec<u32> = match reader.read_indices() {
+            Some(ix) => ix.into_u32().collect(),
+            None => (0..positions.len() as u32).collect(),
+        };
+        let uvs = reader
+            .read_tex_coords(0)
+            .map(|t| t.into_f32().map(Vec2::from_array).collect::<Vec<_>>());
+        if let Some(uv) = &uvs {
+            if uv.len() != positions.len() {
+                return Err(LoadError::BadAttribute {
+                    source: source.to_string(),
+                    mesh: k,
+                    attribute: "TEXCOORD_0",
+                    len: uv.len(),
+                });
+            }
+        }
+        let m = MeshData {
+            positions,
+            indices,
+            uvs,
+        };
+        check_mesh(&m, source, k)?;
+        if !m.indices.is_empty() {
+            out.push(m);
+        }
+    }
+    Ok(())
+}
+
+/// Index checks shared with `SceneBuilder::add_mesh`, done at the file boundary so that the error
+/// names the file.
+fn check_mesh(m: &MeshData, source: &str, k: usize) -> Result<(), LoadError> {
+    let err = |error| LoadError::BadMesh {
+        source: source.to_string(),
+        mesh: k,
+        error,
+    };
+    if m.indices.len() % 3 != 0 {
+        return Err(err(crate::SceneError::IndicesNotTriangles {
+            len: m.indices.len(),
+        }));
+    }
+    if let Some(p) = m
+        .indices
+        .iter()
+        .position(|&i| i as usize >= m.positions.len())
+    {
+        return Err(err(crate::SceneError::IndexOutOfRange {
+            triangle: p / 3,
+            index: m.indices[p],
+            vertex_count: m.positions.len(),
+        }));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const QUAD_OBJ: &str = "# a unit quad\n\
+        v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n\
+        vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n\
+        f 1/1 2/2 3/3 4/4\n";
+
+    #[test]
+    fn obj_quad_is_two_triangles_with_flipped_v() {
+        let m = load_obj_bytes(QUAD_OBJ.as_bytes(), "quad.obj").unwrap();
+        assert_eq!(m.len(), 1);
+        assert_eq!(m[0].indices.len(), 6);
+        assert_eq!(m[0].positions.len(), 4);
+        let uvs = m[0].uvs.as_ref().unwrap();
+        // Vertex (1, 1, 0) has vt (1, 1) -> our (1, 0).
+        let k = m[0]
+            .positions
+            .iter()
+            .position(|p| *p == Vec3::new(1.0, 1.0, 0.0))
+            .unwrap();
+        assert_eq!(uvs[k], Vec2::new(1.0, 0.0));
+    }
+
+    #[test]
+    fn obj_errors_name_the_source() {
+        let e = load_obj_bytes(b"v 0 0 0\nf 1 2 3\n", "broken.obj").unwrap_err();
+        assert!(e.to_string().contains("broken.obj"), "{e}");
+        let e = load_obj_bytes(b"# nothing\n", "empty.obj").unwrap_err();
+        assert!(matches!(e, LoadError::NoTriangles { .. }), "{e}");
+        let e = load_obj("/nonexistent/dir/x.obj").unwrap_err();
+        assert!(e.to_string().contains("/nonexistent/dir/x.obj"), "{e}");
+    }
+
+    /// A one-triangle glTF with an embedded base64 buffer (positions f32 x3, indices u16 x3).
+    fn triangle_gltf(translation: [f32; 3]) -> String {
+        let mut buf = Vec::new();
+        for p in [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] {
+            for c in p {
+                buf.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+        for i in [0u16, 1, 2] {
+            buf.extend_from_slice(&i.to_le_bytes());
+        }
+        buf.extend_from_slice(&[0, 0]); // pad to 4 bytes
+        let b64 = base64_encode(&buf);
+        format!(
+            r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],
+            "nodes":[{{"mesh":0,"translation":[{},{},{}]}}],
+            "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"indices":1}}]}}],
+            "buffers":[{{"byteLength":{},"uri":"data:application/octet-stream;base64,{}"}}],
+            "bufferViews":[{{"buffer":0,"byteOffset":0,"byteLength":36}},{{"buffer":0,"byteOffset":36,"byteLength":6}}],
+            "accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}},
+                         {{"bufferView":1,"componentType":5123,"count":3,"type":"SCALAR"}}]}}"#,
+            translation[0],
+            translation[1],
+            translation[2],
+            buf.len(),
+            b64
+        )
+    }
+
+    /// Standard base64 (RFC 4648) for the test fixture.
+    fn base64_encode(data: &[u8]) -> String {
+        const T: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+        let mut s = String::new();
+        for chunk in data.chunks(3) {
+            let b = [
+                chunk[0],
+                *chunk.get(1).unwrap_or(&0),
+                *chunk.get(2).unwrap_or(&0),
+            ];
+            let n = (b[0] as u32) << 16 | (b[1] as u32) << 8 | b[2] as u32;
+            for k in 0..4 {
+                if k <= chunk.len() {
+                    s.push(T[(n >> (18 - 6 * k)) as usize & 63] as char);
+                } else {
+                    s.push('=');
+                }
+            }
+        }
+        s
+    }
+
+    #[test]
+    fn gltf_embedded_triangle_is_placed_by_its_node() {
+        let text = triangle_gltf([0.0, 0.0, -3.0]);
+        let m = load_gltf_bytes(text.as_bytes(), "tri.gltf").unwrap();
+        assert_eq!(m.len(), 1);
+        assert_eq!(m[0].indices, vec![0, 1, 2]);
+        assert_eq!(m[0].positions[1], Vec3::new(1.0, 0.0, -3.0));
+        assert!(m[0].uvs.is_none());
+    }
+
+    #[test]
+    fn gltf_errors_name_the_source() {
+        let e = load_gltf_bytes(b"{not json", "bad.gltf").unwrap_err();
+        assert!(e.to_string().contains("bad.gltf"), "{e}");
+        // An index past the vertex count is refused at the file boundary.
+        let text = triangle_gltf([0.0; 3]).replace(
+            "\"count\":3,\"type\":\"VEC3\"",
+            "\"count\":2,\"type\":\"VEC3\"",
+        );
+        let e = load_gltf_bytes(text.as_bytes(), "short.gltf").unwrap_err();
+        assert!(e.to_string().contains("short.gltf"), "{e}");
+    }
+}

@@ -1,0 +1,552 @@
+//! Rendering a [`Scene`] into a [`Frame`]: primary visibility, shading with the workspace's one
+//! shading model, mirror and refraction rays, stratified supersampling and the footprint-integrated
+//! texture reference.
+//!
+//! # What a pixel holds
+//! - **Colour:** the average, in linear light, of `n × n` samples at the centres of the pixel's
+//!   `n × n` strata (`x = i + (a + 0.5)/n`, `y = j + (b + 0.5)/n`; `n = samples_per_axis`, a regular
+//!   grid, no jitter, so the result is deterministic). Each sample is clamped to [0, 1] before
+//!   averaging (as a rasteriser's resolve of stored colours does); the mean is encoded with
+//!   [`linear_to_srgb8`]. Alpha is 255.
+//! - **Depth and coverage:** from the single ray through the pixel centre `(i + 0.5, j + 0.5)`,
+//!   exactly the ray of a 1-sample render (for odd `n` it is one of the samples). So coverage and
+//!   depth match a rasteriser's pixel-centre rule whatever `n` is, and a pixel partly covered may
+//!   carry a blended colour with infinite depth. Depth is `t · (dir · forward)`, the eye-space
+//!   distance along the view axis; only hits with depth in the camera's `[near, far]` count.
+//! - **Misses:** primary rays that hit nothing give [`RenderOptions::background`] (or the
+//!   environment, with [`RenderOptions::environment_on_primary_miss`]); secondary rays that escape
+//!   look up the environment function in their direction.
+//!
+//! # Shading
+//! `Lighting::shade(material, n, v)` with `n` the unit geometric normal turned toward the viewer
+//! (surfaces are two-sided) and `v = −dir`, the unit vector toward the viewer. Meshes are flat
+//! shaded (geometric normal). Optics:
+//! - [`Optics::Mirror`]: `(1 − k)·local + k·L(reflected)` with the reflection
+//!   `r = d − 2 (d·n) n` (Seed 003's `E' = 2(N·E)N − E` with `E = −d`);
+//! - [`Optics::Refractive`]: Snell refraction with relative index `1/ior` entering and `ior`
+//!   leaving, total internal reflection when it has no solution, and optionally the exact
+//!   unpolarised Fresnel reflectance mixing the two; no local shading term.
+//!
+//! `max_depth` is the number of secondary bounces traced: a secondary ray that would exceed it is
+//! not traced but takes the environment in its direction (so `max_depth = 0` with a mirror gives
+//! exactly "environment in the reflected direction", the ideal an environment map approximates).
+//! Secondary rays start at the hit point offset along the normal by `SECONDARY_EPS_REL` of the
+//! coordinates' magnitude.
+//!
+//! # Textures
+//! A material's texture multiplies its base colour on mesh triangles that have uvs (spheres and
+//! cylinders ignore it). On primary hits the texture value is the **box integral of the level-0
+//! texels over the sample's exact screen footprint** (the `1/n × 1/n` pixel stratum): the stratum is
+//! cut into `m × m` cells, each cell-centre ray is intersected with the hit triangle's plane, and
+//! the nearest texel at that uv is averaged; `m = ⌈2·e⌉` where `e` is the longest footprint edge in
+//! texels, at most 64 — at least two points per texel along each axis of the footprint. Secondary
+//! hits take the nearest texel at the hit's uv.
+
+use glam::{DVec3, Vec2, Vec3};
+use rayon::prelude::*;
+use texmap_core::camera::{Camera, Ray};
+use texmap_core::color::linear_to_srgb8;
+use texmap_core::frame::Frame;
+use texmap_core::shade::{Lighting, Material};
+
+use crate::error::RenderError;
+use crate::geom::RayPre;
+use crate::scene::{Hit, Scene, valid_ray};
+use crate::texture::Texture;
+
+/// The largest `samples_per_axis` accepted (256 samples per pixel).
+pub const MAX_SAMPLES_PER_AXIS: u32 = 16;
+/// The largest `max_depth` accepted.
+pub const MAX_RECURSION_DEPTH: u32 = 16;
+/// Cap on the footprint-integration grid per axis.
+const MAX_FOOTPRINT_GRID: u32 = 64;
+/// Secondary-ray origin offset, relative to the magnitude of the coordinates involved.
+const SECONDARY_EPS_REL: f32 = 8.0 * f32::EPSILON;
+
+/// How light leaves a surface besides the local shading.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Optics {
+    /// Local shading only.
+    Opaque,
+    /// Mirror reflection mixed with local shading: `(1 − reflectance)·local + reflectance·L(r)`.
+    Mirror { reflectance: f32 },
+    /// A dielectric of index `ior` (outside index 1). With `fresnel`, reflection and refraction
+    /// are mixed by the exact unpolarised Fresnel reflectance; without, light is only refracted
+    /// (total internal reflection still reflects).
+    Refractive { ior: f32, fresnel: bool },
+}
+
+/// A material as the ray tracer sees it: the shared shading model's [`Material`], optics and an
+/// optional texture (index into [`RenderOptions::textures`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfaceMaterial {
+    pub shading: Material,
+    pub optics: Optics,
+    pub texture: Option<u32>,
+}
+
+impl SurfaceMaterial {
+    /// An opaque, untextured material.
+    pub fn opaque(shading: Material) -> SurfaceMaterial {
+        SurfaceMaterial {
+            shading,
+            optics: Optics::Opaque,
+            texture: None,
+        }
+    }
+
+    /// A mirror: `reflectance` 1 shows only what is reflected.
+    pub fn mirror(shading: Material, reflectance: f32) -> SurfaceMaterial {
+        SurfaceMaterial {
+            shading,
+            optics: Optics::Mirror { reflectance },
+            texture: None,
+        }
+    }
+
+    /// A clear dielectric of index `ior` (Fresnel-weighted reflection on).
+    pub fn refractive(ior: f32) -> SurfaceMaterial {
+        SurfaceMaterial {
+            shading: Material::matte(Vec3::ZERO),
+            optics: Optics::Refractive { ior, fresnel: true },
+            texture: None,
+        }
+    }
+
+    /// The same material modulated by texture `texture`.
+    pub fn with_texture(mut self, texture: u32) -> SurfaceMaterial {
+        self.texture = Some(texture);
+        self
+    }
+}
+
+/// Everything a render needs besides the scene and the camera.
+#[derive(Clone, Debug)]
+pub struct RenderOptions<'a> {
+    pub lighting: Lighting,
+    /// Indexed by the primitives' material ids.
+    pub materials: &'a [SurfaceMaterial],
+    /// Indexed by [`SurfaceMaterial::texture`].
+    pub textures: &'a [Texture],
+    /// `n` for `n × n` stratified samples per pixel, 1..=[`MAX_SAMPLES_PER_AXIS`].
+    pub samples_per_axis: u32,
+    /// Linear RGB colour of pixels (and samples) whose primary ray hits nothing.
+    pub background: Vec3,
+    /// Primary misses show the environment instead of the background.
+    pub environment_on_primary_miss: bool,
+    /// Secondary bounces traced, at most [`MAX_RECURSION_DEPTH`].
+    pub max_depth: u32,
+}
+
+impl<'a> RenderOptions<'a> {
+    /// One sample per pixel, black background, 8 bounces, no textures.
+    pub fn new(lighting: Lighting, materials: &'a [SurfaceMaterial]) -> RenderOptions<'a> {
+        RenderOptions {
+            lighting,
+            materials,
+            textures: &[],
+            samples_per_axis: 1,
+            background: Vec3::ZERO,
+            environment_on_primary_miss: false,
+            max_depth: 8,
+        }
+    }
+
+    /// Check everything once, before tracing.
+    fn validate(&self, scene: &Scene) -> Result<(), RenderError> {
+        if !(1..=MAX_SAMPLES_PER_AXIS).contains(&self.samples_per_axis) {
+            return Err(RenderError::BadSamples {
+                samples_per_axis: self.samples_per_axis,
+            });
+        }
+        if self.max_depth > MAX_RECURSION_DEPTH {
+            return Err(RenderError::BadMaxDepth {
+                max_depth: self.max_depth,
+            });
+        }
+        if !self.background.is_finite() {
+            return Err(RenderError::BadBackground);
+        }
+        if let Some(m) = scene.max_material_id() {
+            if m as usize >= self.materials.len() {
+                return Err(RenderError::MissingMaterial {
+                    material_id: m,
+                    materials: self.materials.len(),
+                });
+            }
+        }
+        for (i, m) in self.materials.iter().enumerate() {
+            let bad = |what| Err(RenderError::BadMaterial { material: i, what });
+            let s = &m.shading;
+            if !(s.base_color.is_finite() && s.specular.is_finite() && s.shininess.is_finite()) {
+                return bad("shading parameters must be finite");
+            }
+            match m.optics {
+                Optics::Opaque => {}
+                Optics::Mirror { reflectance } => {
+                    if !(0.0..=1.0).contains(&reflectance) {
+                        return bad("mirror reflectance must be in [0, 1]");
+                    }
+                }
+                Optics::Refractive { ior, .. } => {
+                    if !(ior.is_finite() && ior > 0.0) {
+                        return bad("index of refraction must be finite and positive");
+                    }
+                }
+            }
+            if let Some(t) = m.texture {
+                if t as usize >= self.textures.len() {
+                    return Err(RenderError::MissingTexture {
+                        material: i,
+                        texture: t,
+                        textures: self.textures.len(),
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Per-render constants shared by every pixel.
+struct Tracer<'a, E> {
+    scene: &'a Scene,
+    cam: &'a Camera,
+    opts: &'a RenderOptions<'a>,
+    env: &'a E,
+    forward: Vec3,
+}
+
+impl Scene {
+    /// Render with escaped secondary rays taking the background colour.
+    ///
+    /// Deterministic: the same scene, camera and options give the same bytes for any rayon thread
+    /// count (every pixel is computed independently of the schedule).
+    pub fn render(&self, camera: &Camera, opts: &RenderOptions) -> Result<Frame, RenderError> {
+        let bg = opts.background;
+        self.render_with_environment(camera, opts, &move |_d: Vec3| bg)
+    }
+
+    /// Render with an environment: `env(d)` is the linear RGB radiance arriving along unit
+    /// direction `d` from infinity, used for secondary rays that escape (and primary misses if
+    /// [`RenderOptions::environment_on_primary_miss`]). Non-finite values are taken as black.
+    pub fn render_with_environment<E>(
+        &self,
+        camera: &Camera,
+        opts: &RenderOptions,
+        env: &E,
+    ) -> Result<Frame, RenderError>
+    where
+        E: Fn(Vec3) -> Vec3 + Sync,
+    {
+        opts.validate(self)?;
+        let tracer = Tracer {
+            scene: self,
+            cam: camera,
+            opts,
+            env,
+            forward: camera.forward(),
+        };
+        let (w, h) = (camera.width() as usize, camera.height() as usize);
+        let mut color = vec![[0u8; 4]; w * h];
+        let mut depth = vec![f32::INFINITY; w * h];
+        // Parallel over rows; each pixel depends only on its coordinates.
+        color
+            .par_chunks_mut(w)
+            .zip(depth.par_chunks_mut(w))
+            .enumerate()
+            .for_each(|(j, (crow, drow))| {
+                for i in 0..w {
+                    let (c, d) = tracer.pixel(i as u32, j as u32);
+                    crow[i] = linear_to_srgb8(c, 255);
+                    drow[i] = d;
+                }
+            });
+        Ok(
+            Frame::from_parts(camera.width(), camera.height(), color, depth)
+                .expect("buffers sized width * height"),
+        )
+    }
+}
+
+impl<E: Fn(Vec3) -> Vec3 + Sync> Tracer<'_, E> {
+    /// Linear colour (mean of the samples) and depth (centre ray) of pixel (i, j).
+    fn pixel(&self, i: u32, j: u32) -> (Vec3, f32) {
+        let n = self.opts.samples_per_axis;
+        let nf = n as f32;
+        let half = 0.5 / nf;
+        let mut acc = Vec3::ZERO;
+        let mut centre_depth = None;
+        for b in 0..n {
+            for a in 0..n {
+                let x = i as f32 + (a as f32 + 0.5) / nf;
+                let y = j as f32 + (b as f32 + 0.5) / nf;
+                let (c, d) = self.primary_sample(x, y, half);
+                acc += c.clamp(Vec3::ZERO, Vec3::ONE);
+                if n % 2 == 1 && a == n / 2 && b == n / 2 {
+                    centre_depth = Some(d);
+                }
+            }
+        }
+        let depth = match centre_depth {
+            Some(d) => d,
+            None => self.primary_depth(i as f32 + 0.5, j as f32 + 0.5),
+        };
+        (acc / (n * n) as f32, depth)
+    }
+
+    /// The primary ray through (x, y) and its parameter interval from the clip planes.
+    #[inline]
+    fn primary_ray(&self, x: f32, y: f32) -> (Ray, f32, f32, f32) {
+        let ray = self.cam.ray(x, y);
+        let cos = ray.dir.dot(self.forward);
+        (ray, cos, self.cam.near() / cos, self.cam.far() / cos)
+    }
+
+    /// Depth of the primary ray through (x, y), INFINITY on a miss.
+    fn primary_depth(&self, x: f32, y: f32) -> f32 {
+        let (ray, cos, tmin, tmax) = self.primary_ray(x, y);
+        if !(valid_ray(&ray) && cos > 0.0) {
+            return f32::INFINITY;
+        }
+        let pre = RayPre::new(ray.origin, ray.dir);
+        match self.scene.closest(&pre, tmin, tmax) {
+            Some(r) => finite_depth(r.t * cos),
+            None => f32::INFINITY,
+        }
+    }
+
+    /// One primary sample: linear colour and depth.
+    fn primary_sample(&self, x: f32, y: f32, half: f32) -> (Vec3, f32) {
+        let (ray, cos, tmin, tmax) = self.primary_ray(x, y);
+        let miss = || {
+            let c = if self.opts.environment_on_primary_miss {
+                self.env_lookup(ray.dir)
+            } else {
+                self.opts.background
+            };
+            (c, f32::INFINITY)
+        };
+        if !(valid_ray(&ray) && cos > 0.0) {
+            return miss();
+        }
+        let pre = RayPre::new(ray.origin, ray.dir);
+        let Some(raw) = self.scene.closest(&pre, tmin, tmax) else {
+            return miss();
+        };
+        let hit = self.scene.finish(&pre, &raw);
+        let mat = &self.opts.materials[hit.material_id as usize];
+        let tex = self.texture_value(&hit, mat, Some((x, y, half)));
+        let c = self.shade(&hit, ray.dir, mat, tex, 0);
+        (c, finite_depth(raw.t * cos))
+    }
+
+    /// The environment in direction `d`, never non-finite.
+    #[inline]
+    fn env_lookup(&self, d: Vec3) -> Vec3 {
+        let c = (self.env)(d);
+        if c.is_finite() { c } else { Vec3::ZERO }
+    }
+
+    /// Texture multiplier of a hit (ONE when untextured): footprint-integrated for primary
+    /// samples (`footprint = (x, y, half-size)` in pixels), nearest texel otherwise.
+    fn texture_value(
+        &self,
+        hit: &Hit,
+        mat: &SurfaceMaterial,
+        footprint: Option<(f32, f32, f32)>,
+    ) -> Vec3 {
+        let Some(ti) = mat.texture else {
+            return Vec3::ONE;
+        };
+        let tex = &self.opts.textures[ti as usize];
+        let Some((verts, uvs)) = self.scene.triangle_uv_data(hit) else {
+            return Vec3::ONE;
+        };
+        let crate::scene::HitKind::Triangle { bary, .. } = hit.kind else {
+            return Vec3::ONE;
+        };
+        let uv_hit = uvs[0] * (1.0 - bary.x - bary.y) + uvs[1] * bary.x + uvs[2] * bary.y;
+        match footprint {
+            Some((x, y, half)) => footprint_integral(self.cam, tex, &verts, &uvs, x, y, half)
+                .unwrap_or_else(|| tex.nearest(uv_hit).truncate()),
+            None => tex.nearest(uv_hit).truncate(),
+        }
+    }
+
+    /// Outgoing radiance at a hit seen along `dir`, at bounce `depth`.
+    fn shade(&self, hit: &Hit, dir: Vec3, mat: &SurfaceMaterial, tex: Vec3, depth: u32) -> Vec3 {
+        let d = dir.normalize();
+        let front = hit.normal.dot(d) < 0.0;
+        let ns = if front { hit.normal } else { -hit.normal };
+        let v = -d;
+        let local = |m: &SurfaceMaterial| {
+            let mut s = m.shading;
+            s.base_color *= tex;
+            self.opts.lighting.shade(&s, ns, v)
+        };
+        let eps = SECONDARY_EPS_REL * (1.0 + hit.point.abs().max_element() + hit.t.abs());
+        let reflect = || {
+            let r = d - ns * (2.0 * d.dot(ns));
+            self.secondary(hit.point + ns * eps, r, depth + 1)
+        };
+        match mat.optics {
+            Optics::Opaque => local(mat),
+            Optics::Mirror { reflectance: k } => {
+                let l = if k < 1.0 { local(mat) } else { Vec3::ZERO };
+                let r = if k > 0.0 { reflect() } else { Vec3::ZERO };
+                l * (1.0 - k) + r * k
+            }
+            Optics::Refractive { ior, fresnel } => {
+                // Snell's law with relative index eta = n_from / n_to.
+                let eta = if front { 1.0 / ior } else { ior };
+                let cos_i = (-d.dot(ns)).clamp(0.0, 1.0);
+                let sin2_t = eta * eta * (1.0 - cos_i * cos_i);
+                if sin2_t >= 1.0 {
+                    // Total internal reflection.
+                    return reflect();
+                }
+                let cos_t = (1.0 - sin2_t).sqrt();
+                let t_dir = d * eta + ns * (eta * cos_i - cos_t);
+                let refr = self.secondary(hit.point - ns * eps, t_dir, depth + 1);
+                if !fresnel {
+                    return refr;
+                }
+                let f = fresnel_dielectric(cos_i, cos_t, eta);
+                let refl = if f > 0.0 { reflect() } else { Vec3::ZERO };
+                refl * f + refr * (1.0 - f)
+            }
+        }
+    }
+
+    /// Radiance arriving along a secondary ray (environment beyond the depth limit).
+    fn secondary(&self, origin: Vec3, dir: Vec3, depth: u32) -> Vec3 {
+        let dir = dir.normalize_or_zero();
+        if depth > self.opts.max_depth || !origin.is_finite() || dir == Vec3::ZERO {
+            return self.env_lookup(dir);
+        }
+        let pre = RayPre::new(origin, dir);
+        let Some(raw) = self.scene.closest(&pre, 0.0, f32::INFINITY) else {
+            return self.env_lookup(dir);
+        };
+        let hit = self.scene.finish(&pre, &raw);
+        let mat = &self.opts.materials[hit.material_id as usize];
+        let tex = self.texture_value(&hit, mat, None);
+        self.shade(&hit, dir, mat, tex, depth)
+    }
+}
+
+/// A depth that is finite or INFINITY, never NaN.
+#[inline]
+fn finite_depth(d: f32) -> f32 {
+    if d.is_finite() { d } else { f32::INFINITY }
+}
+
+/// Exact unpolarised Fresnel reflectance of a dielectric interface (`eta = n_from / n_to`).
+fn fresnel_dielectric(cos_i: f32, cos_t: f32, eta: f32) -> f32 {
+    // r_s and r_p with n_from = eta, n_to = 1 (only the ratio matters).
+    let rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    let rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    let f = 0.5 * (rs * rs + rp * rp);
+    if f.is_finite() {
+        f.clamp(0.0, 1.0)
+    } else {
+        1.0
+    }
+}
+
+/// Box integral of the level-0 texels over the screen square of half-size `half` pixels centred
+/// at (x, y), mapped through the triangle's plane (see module docs). `None` when the plane is seen
+/// edge-on at a corner (the caller falls back to the nearest texel).
+fn footprint_integral(
+    cam: &Camera,
+    tex: &Texture,
+    v: &[Vec3; 3],
+    uv: &[Vec2; 3],
+    x: f32,
+    y: f32,
+    half: f32,
+) -> Option<Vec3> {
+    // Set up the plane and the barycentric solve in f64.
+    let v0 = v[0].as_dvec3();
+    let e1 = v[1].as_dvec3() - v0;
+    let e2 = v[2].as_dvec3() - v0;
+    let n = e1.cross(e2);
+    let (d00, d01, d11) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+    let den = d00 * d11 - d01 * d01;
+    if !(den > 0.0) {
+        return None;
+    }
+    let (uv0, du1, du2) = (
+        uv[0].as_dvec2(),
+        (uv[1] - uv[0]).as_dvec2(),
+        (uv[2] - uv[0]).as_dvec2(),
+    );
+    let uv_at = |sx: f32, sy: f32| -> Option<glam::DVec2> {
+        // Intersect the ray through (sx, sy) with the triangle's plane.
+        let r = cam.ray(sx, sy);
+        let (o, d) = (r.origin.as_dvec3(), r.dir.as_dvec3());
+        let denom = n.dot(d);
+        if denom == 0.0 {
+            return None;
+        }
+        let t = n.dot(v0 - o) / denom;
+        let p: DVec3 = o + d * t - v0;
+        let (p1, p2) = (p.dot(e1), p.dot(e2));
+        let b1 = (d11 * p1 - d01 * p2) / den;
+        let b2 = (d00 * p2 - d01 * p1) / den;
+        let uv = uv0 + du1 * b1 + du2 * b2;
+        uv.is_finite().then_some(uv)
+    };
+    // Footprint corners in texels decide the integration grid.
+    let scale = glam::DVec2::new(tex.width() as f64, tex.height() as f64);
+    let c00 = uv_at(x - half, y - half)? * scale;
+    let c10 = uv_at(x + half, y - half)? * scale;
+    let c01 = uv_at(x - half, y + half)? * scale;
+    let c11 = uv_at(x + half, y + half)? * scale;
+    let edge = |a: glam::DVec2, b: glam::DVec2| (a - b).abs().max_element();
+    let e = edge(c00, c10)
+        .max(edge(c01, c11))
+        .max(edge(c00, c01))
+        .max(edge(c10, c11));
+    let m = ((2.0 * e).ceil() as u32).clamp(1, MAX_FOOTPRINT_GRID);
+    // Midpoint rule over the m x m cells of the screen square.
+    let step = 2.0 * half / m as f32;
+    let mut sum = Vec3::ZERO;
+    let mut count = 0u32;
+    for b in 0..m {
+        for a in 0..m {
+            let sx = x - half + (a as f32 + 0.5) * step;
+            let sy = y - half + (b as f32 + 0.5) * step;
+            if let Some(u) = uv_at(sx, sy) {
+                sum += tex.nearest(u.as_vec2()).truncate();
+                count += 1;
+            }
+        }
+    }
+    (count > 0).then(|| sum / count as f32)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fresnel_matches_known_values() {
+        // Normal incidence air -> glass (n = 1.5): ((1 - 1.5)/(1 + 1.5))² = 0.04.
+        let f = fresnel_dielectric(1.0, 1.0, 1.0 / 1.5);
+        assert!((f - 0.04).abs() < 1e-6, "expected 0.04, got {f}, tol 1e-6");
+        // Brewster's angle: r_p = 0, so F = r_s²/2; at tan θ = 1.5.
+        let th = 1.5f32.atan();
+        let (ci, si) = (th.cos(), th.sin());
+        let st = si / 1.5;
+        let ct = (1.0 - st * st).sqrt();
+        let rs = (ci - 1.5 * ct) / (ci + 1.5 * ct);
+        let f = fresnel_dielectric(ci, ct, 1.0 / 1.5);
+        assert!(
+            (f - 0.5 * rs * rs).abs() < 1e-6,
+            "expected {}, got {f}",
+            0.5 * rs * rs
+        );
+    }
+}

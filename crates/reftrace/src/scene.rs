@@ -1,0 +1,640 @@
+//! Scenes: primitives collected by a [`SceneBuilder`], one obvhs BVH built over all of them, and
+//! closest-hit queries.
+//!
+//! Every primitive kind lives in one BVH; the leaf callback dispatches on a small `Prim` enum stored
+//! in BVH leaf order (so a leaf's primitives are contiguous in memory and a sphere needs no second
+//! lookup). Intersection is ours ([`crate::geom`]), not obvhs's: its triangle test is not watertight.
+//!
+//! # Degenerate input
+//! Nothing here panics on bad data:
+//! - a sphere with a non-finite centre or a radius that is not finite and positive is **skipped and
+//!   counted** ([`BuildStats::skipped_spheres`]); it still consumes its id, so ids stay aligned with
+//!   the caller's arrays;
+//! - a cylinder with non-finite end points or radius, a radius ≤ 0 or coincident end points is
+//!   skipped and counted the same way;
+//! - a triangle with a non-finite vertex or exactly zero area is skipped and counted
+//!   ([`BuildStats::skipped_triangles`]); a mesh whose indices are out of range or not a multiple of
+//!   three, or whose uv count differs from its vertex count, is **rejected** with a [`SceneError`];
+//! - an empty scene builds and every ray misses.
+//!
+//! # BVH robustness
+//! Each primitive's box is padded by a small relative margin (`BOX_PAD_REL`) before the build, so the
+//! BVH's slab tests, which round, can never cull a ray that grazes a primitive exactly on its box
+//! boundary (a ray along a shared heightfield edge is the typical case). The leaf tests decide.
+
+use std::time::Duration;
+
+use glam::{Vec2, Vec3, Vec3A};
+use obvhs::{
+    BvhBuildParams,
+    aabb::Aabb,
+    bvh2::{Bvh2, builder::build_bvh2},
+    cwbvh::{CwBvh, builder::build_cwbvh},
+    ray::{Ray as BvhRay, RayHit},
+};
+use texmap_core::camera::Ray;
+
+use crate::error::SceneError;
+use crate::geom::{CylinderPart, RayPre, intersect_cylinder, intersect_sphere, intersect_triangle};
+
+/// Relative padding of primitive boxes (see module docs "BVH robustness").
+const BOX_PAD_REL: f32 = 1e-5;
+
+/// Which obvhs BVH layout the scene is built with.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum BvhKind {
+    /// Binary BVH (PLOC + reinsertion + leaf collapse).
+    Bvh2,
+    /// Compressed 8-wide BVH (Ylitie et al. 2017) converted from a PLOC BVH2. The default: it
+    /// traced 100k-sphere and 1M-sphere scenes faster here (see docs/fragments/reftrace.md).
+    #[default]
+    CwBvh,
+}
+
+/// A triangle mesh given as shared vertices and an index list, as loaded from OBJ or glTF.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct MeshData {
+    pub positions: Vec<Vec3>,
+    /// Three indices per triangle.
+    pub indices: Vec<u32>,
+    /// One texture coordinate per vertex, if any.
+    pub uvs: Option<Vec<Vec2>>,
+}
+
+/// What was added and what was skipped as degenerate.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct BuildStats {
+    pub spheres: usize,
+    pub cylinders: usize,
+    pub triangles: usize,
+    pub meshes: usize,
+    pub skipped_spheres: usize,
+    pub skipped_cylinders: usize,
+    pub skipped_triangles: usize,
+}
+
+/// What kind of primitive a [`Hit`] is on.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum HitKind {
+    Sphere,
+    Cylinder {
+        part: CylinderPart,
+    },
+    /// A mesh triangle; `bary` are the barycentric weights of the triangle's 2nd and 3rd vertex.
+    Triangle {
+        mesh: u32,
+        bary: Vec2,
+    },
+}
+
+/// The closest intersection along a ray.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    /// Ray parameter (distance for a unit direction).
+    pub t: f32,
+    /// World-space hit point (re-projected onto the sphere for spheres, barycentric for triangles,
+    /// which is more accurate than `origin + t·dir`).
+    pub point: Vec3,
+    /// Unit geometric normal: outward for spheres and cylinders, `(v1 − v0) × (v2 − v0)` for
+    /// triangles (not flipped toward the ray).
+    pub normal: Vec3,
+    /// Sphere id, cylinder id (the return values of `add_sphere`/`add_cylinder`), or the
+    /// triangle's index within its mesh.
+    pub prim_id: u32,
+    pub material_id: u32,
+    pub kind: HitKind,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Cylinder {
+    a: Vec3,
+    b: Vec3,
+    radius: f32,
+    material: u32,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct TriMeta {
+    mesh: u32,
+    index: u32,
+    idx: [u32; 3],
+}
+
+#[derive(Clone, Debug)]
+struct MeshInfo {
+    uvs: Option<Vec<Vec2>>,
+    material: u32,
+}
+
+/// One BVH leaf entry; spheres carry their geometry inline.
+#[derive(Clone, Copy, Debug)]
+enum Prim {
+    Sphere { center: Vec3, radius: f32, id: u32 },
+    Cylinder { id: u32 },
+    Triangle { tri: u32 },
+}
+
+/// Collects primitives; [`SceneBuilder::build`] builds the BVH once.
+///
+/// ```
+/// use texmap_reftrace::{SceneBuilder, glam::Vec3};
+/// use texmap_core::camera::Ray;
+/// let mut b = SceneBuilder::new();
+/// let id = b.add_sphere(Vec3::ZERO, 1.0, 0);
+/// let scene = b.build();
+/// let hit = scene.intersect(&Ray { origin: Vec3::new(0.0, 0.0, 5.0), dir: Vec3::NEG_Z }).unwrap();
+/// assert_eq!(hit.prim_id, id);
+/// assert!((hit.t - 4.0).abs() < 1e-6);
+/// ```
+#[derive(Clone, Debug, Default)]
+pub struct SceneBuilder {
+    kind: BvhKind,
+    spheres: Vec<[f32; 4]>,
+    sphere_material: Vec<u32>,
+    cylinders: Vec<Cylinder>,
+    tris: Vec<[Vec3; 3]>,
+    tri_meta: Vec<TriMeta>,
+    meshes: Vec<MeshInfo>,
+    stats: BuildStats,
+}
+
+impl SceneBuilder {
+    pub fn new() -> SceneBuilder {
+        SceneBuilder::default()
+    }
+
+    /// A builder with room for `spheres` spheres (no reallocation while adding them).
+    pub fn with_sphere_capacity(spheres: usize) -> SceneBuilder {
+        SceneBuilder {
+            spheres: Vec::with_capacity(spheres),
+            sphere_material: Vec::with_capacity(spheres),
+            ..SceneBuilder::default()
+        }
+    }
+
+    /// Choose the BVH layout (default [`BvhKind::CwBvh`]).
+    pub fn bvh(mut self, kind: BvhKind) -> SceneBuilder {
+        self.kind = kind;
+        self
+    }
+
+    /// Add a sphere; returns its id (ids count from 0 in call order, skipped spheres included).
+    /// A sphere with a non-finite centre or a radius that is not finite and positive is skipped
+    /// and counted in [`BuildStats::skipped_spheres`].
+    pub fn add_sphere(&mut self, center: Vec3, radius: f32, material_id: u32) -> u32 {
+        let id = self.spheres.len() as u32;
+        self.spheres.push([center.x, center.y, center.z, radius]);
+        self.sphere_material.push(material_id);
+        id
+    }
+
+    /// Add a capped cylinder (a bond) from `a` to `b`; returns its id (call order, from 0).
+    /// Degenerate cylinders are skipped and counted (see module docs).
+    pub fn add_cylinder(&mut self, a: Vec3, b: Vec3, radius: f32, material_id: u32) -> u32 {
+        let id = self.cylinders.len() as u32;
+        self.cylinders.push(Cylinder {
+            a,
+            b,
+            radius,
+            material: material_id,
+        });
+        id
+    }
+
+    /// Add a triangle mesh; returns the mesh id (call order, from 0). Zero-area triangles and
+    /// triangles with a non-finite vertex are skipped and counted; malformed index or uv lists are
+    /// refused.
+    pub fn add_mesh(
+        &mut self,
+        positions: &[Vec3],
+        indices: &[u32],
+        uvs: Option<&[Vec2]>,
+        material_id: u32,
+    ) -> Result<u32, SceneError> {
+        // Validate the whole mesh before touching the builder.
+        if indices.len() % 3 != 0 {
+            return Err(SceneError::IndicesNotTriangles { len: indices.len() });
+        }
+        if let Some(uv) = uvs {
+            if uv.len() != positions.len() {
+                return Err(SceneError::UvCountMismatch {
+                    uvs: uv.len(),
+                    vertices: positions.len(),
+                });
+            }
+        }
+        for (k, &i) in indices.iter().enumerate() {
+            if i as usize >= positions.len() {
+                return Err(SceneError::IndexOutOfRange {
+                    triangle: k / 3,
+                    index: i,
+                    vertex_count: positions.len(),
+                });
+            }
+        }
+        if self.tris.len() + indices.len() / 3 >= u32::MAX as usize
+            || self.meshes.len() >= u32::MAX as usize
+        {
+            return Err(SceneError::TooManyPrimitives);
+        }
+        let mesh = self.meshes.len() as u32;
+        self.meshes.push(MeshInfo {
+            uvs: uvs.map(|u| u.to_vec()),
+            material: material_id,
+        });
+        self.stats.meshes += 1;
+        // Copy each usable triangle's vertices (bit-exact, so shared edges stay shared).
+        self.tris.reserve(indices.len() / 3);
+        self.tri_meta.reserve(indices.len() / 3);
+        for (k, t) in indices.chunks_exact(3).enumerate() {
+            let v = [
+                positions[t[0] as usize],
+                positions[t[1] as usize],
+                positions[t[2] as usize],
+            ];
+            let area2 = (v[1] - v[0]).cross(v[2] - v[0]);
+            let ok = v.iter().all(|p| p.is_finite())
+                && area2.is_finite()
+                && area2.length_squared() > 0.0;
+            if !ok {
+                self.stats.skipped_triangles += 1;
+                continue;
+            }
+            self.tris.push(v);
+            self.tri_meta.push(TriMeta {
+                mesh,
+                index: k as u32,
+                idx: [t[0], t[1], t[2]],
+            });
+        }
+        Ok(mesh)
+    }
+
+    /// [`SceneBuilder::add_mesh`] for a loaded [`MeshData`].
+    pub fn add_mesh_data(&mut self, mesh: &MeshData, material_id: u32) -> Result<u32, SceneError> {
+        self.add_mesh(
+            &mesh.positions,
+            &mesh.indices,
+            mesh.uvs.as_deref(),
+            material_id,
+        )
+    }
+
+    /// Build the BVH over every valid primitive.
+    pub fn build(self) -> Scene {
+        let SceneBuilder {
+            kind,
+            spheres,
+            sphere_material,
+            cylinders,
+            tris,
+            tri_meta,
+            meshes,
+            mut stats,
+        } = self;
+        // Gather valid primitives and their boxes.
+        let mut prims = Vec::with_capacity(spheres.len() + cylinders.len() + tris.len());
+        let mut boxes = Vec::with_capacity(prims.capacity());
+        let mut max_material: Option<u32> = None;
+        let mut use_material = |m: u32| {
+            max_material = Some(max_material.map_or(m, |x| x.max(m)));
+        };
+        for (id, s) in spheres.iter().enumerate() {
+            let c = Vec3::new(s[0], s[1], s[2]);
+            let r = s[3];
+            if !(c.is_finite() && r.is_finite() && r > 0.0 && (c.abs() + r).is_finite()) {
+                stats.skipped_spheres += 1;
+                continue;
+            }
+            stats.spheres += 1;
+            use_material(sphere_material[id]);
+            prims.push(Prim::Sphere {
+                center: c,
+                radius: r,
+                id: id as u32,
+            });
+            boxes.push(padded(c - Vec3::splat(r), c + Vec3::splat(r)));
+        }
+        for (id, c) in cylinders.iter().enumerate() {
+            let ok = c.a.is_finite()
+                && c.b.is_finite()
+                && c.radius.is_finite()
+                && c.radius > 0.0
+                && (c.b - c.a).length() > 0.0
+                && (c.b - c.a).length().is_finite();
+            if !ok {
+                stats.skipped_cylinders += 1;
+                continue;
+            }
+            stats.cylinders += 1;
+            use_material(c.material);
+            prims.push(Prim::Cylinder { id: id as u32 });
+            // Box of the two end discs: per axis, the disc extent is r·sqrt(1 − u_k²).
+            let u = (c.b - c.a).normalize();
+            let e = Vec3::splat(c.radius) * (Vec3::ONE - u * u).max(Vec3::ZERO).sqrt();
+            boxes.push(padded(c.a.min(c.b) - e, c.a.max(c.b) + e));
+        }
+        for (i, t) in tris.iter().enumerate() {
+            prims.push(Prim::Triangle { tri: i as u32 });
+            boxes.push(padded(t[0].min(t[1]).min(t[2]), t[0].max(t[1]).max(t[2])));
+        }
+        stats.triangles = tris.len();
+        for m in &meshes {
+            if stats.triangles > 0 {
+                use_material(m.material);
+            }
+        }
+        // Build the BVH and lay the primitives out in leaf order.
+        let params = BvhBuildParams::medium_build();
+        let mut t = Duration::ZERO;
+        let accel = if boxes.is_empty() {
+            Accel::Empty
+        } else {
+            match kind {
+                BvhKind::Bvh2 => Accel::Bvh2(build_bvh2(&boxes, params, &mut t)),
+                BvhKind::CwBvh => Accel::CwBvh(build_cwbvh(&boxes, params, &mut t)),
+            }
+        };
+        let order: &[u32] = match &accel {
+            Accel::Empty => &[],
+            Accel::Bvh2(b) => &b.primitive_indices,
+            Accel::CwBvh(b) => &b.primitive_indices,
+        };
+        let leaf_prims: Vec<Prim> = order.iter().map(|&i| prims[i as usize]).collect();
+        Scene {
+            accel,
+            prims: leaf_prims,
+            spheres,
+            sphere_material,
+            cylinders,
+            tris,
+            tri_meta,
+            meshes,
+            stats,
+            max_material,
+        }
+    }
+}
+
+/// A primitive box padded by [`BOX_PAD_REL`] of its magnitude.
+fn padded(lo: Vec3, hi: Vec3) -> Aabb {
+    let mag = lo.abs().max(hi.abs()).max_element() + (hi - lo).max_element();
+    let pad = Vec3::splat(mag * BOX_PAD_REL + f32::MIN_POSITIVE);
+    Aabb::new(Vec3A::from(lo - pad), Vec3A::from(hi + pad))
+}
+
+#[derive(Clone)]
+enum Accel {
+    Empty,
+    Bvh2(Bvh2),
+    CwBvh(CwBvh),
+}
+
+/// The closest hit found so far during traversal (slot index into leaf order).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct RawHit {
+    pub t: f32,
+    slot: u32,
+    b1: f32,
+    b2: f32,
+    part: CylinderPart,
+    normal: Vec3,
+}
+
+/// A built scene: immutable, `Sync`, queried by many threads at once.
+#[derive(Clone)]
+pub struct Scene {
+    accel: Accel,
+    prims: Vec<Prim>,
+    spheres: Vec<[f32; 4]>,
+    sphere_material: Vec<u32>,
+    cylinders: Vec<Cylinder>,
+    tris: Vec<[Vec3; 3]>,
+    tri_meta: Vec<TriMeta>,
+    meshes: Vec<MeshInfo>,
+    stats: BuildStats,
+    max_material: Option<u32>,
+}
+
+impl std::fmt::Debug for Scene {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Scene")
+            .field("stats", &self.stats)
+            .field("max_material", &self.max_material)
+            .finish_non_exhaustive()
+    }
+}
+
+impl Scene {
+    /// Counts of primitives added and skipped.
+    pub fn stats(&self) -> BuildStats {
+        self.stats
+    }
+
+    /// The largest material id a primitive of the scene uses (`None` for an empty scene).
+    pub fn max_material_id(&self) -> Option<u32> {
+        self.max_material
+    }
+
+    /// The BVH layout in use (`None` for an empty scene).
+    pub fn bvh_kind(&self) -> Option<BvhKind> {
+        match self.accel {
+            Accel::Empty => None,
+            Accel::Bvh2(_) => Some(BvhKind::Bvh2),
+            Accel::CwBvh(_) => Some(BvhKind::CwBvh),
+        }
+    }
+
+    /// Closest hit with `t > 0`. A ray with a non-finite origin, or a direction that is zero or
+    /// not finite, misses.
+    pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        self.intersect_range(ray, 0.0, f32::INFINITY)
+    }
+
+    /// Closest hit with `tmin < t < tmax`.
+    pub fn intersect_range(&self, ray: &Ray, tmin: f32, tmax: f32) -> Option<Hit> {
+        if !valid_ray(ray) || tmin.is_nan() || tmax.is_nan() {
+            return None;
+        }
+        let pre = RayPre::new(ray.origin, ray.dir);
+        self.closest(&pre, tmin, tmax)
+            .map(|r| self.finish(&pre, &r))
+    }
+
+    /// The same query by testing every primitive (no BVH): slow, exact same leaf tests. For
+    /// tests of the BVH and of other crates.
+    pub fn intersect_brute_force(&self, ray: &Ray) -> Option<Hit> {
+        if !valid_ray(ray) {
+            return None;
+        }
+        let pre = RayPre::new(ray.origin, ray.dir);
+        let mut best = RawHit::none(f32::INFINITY);
+        for slot in 0..self.prims.len() {
+            self.test_prim(&pre, 0.0, slot, &mut best);
+        }
+        (best.t < f32::INFINITY).then(|| self.finish(&pre, &best))
+    }
+
+    /// Test primitive `slot` and keep it in `best` if nearer.
+    #[inline(always)]
+    fn test_prim(&self, pre: &RayPre, tmin: f32, slot: usize, best: &mut RawHit) -> f32 {
+        match self.prims[slot] {
+            Prim::Sphere { center, radius, .. } => {
+                if let Some(t) = intersect_sphere(pre.origin, pre.dir, center, radius, tmin, best.t)
+                {
+                    *best = RawHit {
+                        t,
+                        slot: slot as u32,
+                        ..*best
+                    };
+                    return t;
+                }
+            }
+            Prim::Cylinder { id } => {
+                let c = &self.cylinders[id as usize];
+                if let Some(h) =
+                    intersect_cylinder(pre.origin, pre.dir, c.a, c.b, c.radius, tmin, best.t)
+                {
+                    *best = RawHit {
+                        t: h.t,
+                        slot: slot as u32,
+                        b1: 0.0,
+                        b2: 0.0,
+                        part: h.part,
+                        normal: h.normal,
+                    };
+                    return h.t;
+                }
+            }
+            Prim::Triangle { tri } => {
+                let v = &self.tris[tri as usize];
+                if let Some(h) = intersect_triangle(pre, v[0], v[1], v[2], tmin, best.t) {
+                    *best = RawHit {
+                        t: h.t,
+                        slot: slot as u32,
+                        b1: h.b1,
+                        b2: h.b2,
+                        ..*best
+                    };
+                    return h.t;
+                }
+            }
+        }
+        f32::INFINITY
+    }
+
+    /// BVH closest-hit query on a precomputed ray. `pre` must hold a valid ray.
+    #[inline]
+    pub(crate) fn closest(&self, pre: &RayPre, tmin: f32, tmax: f32) -> Option<RawHit> {
+        let mut best = RawHit::none(tmax);
+        let ray = BvhRay::new(Vec3A::from(pre.origin), Vec3A::from(pre.dir), tmin, tmax);
+        let mut rh = RayHit::none();
+        match &self.accel {
+            Accel::Empty => {}
+            Accel::Bvh2(b) => {
+                b.ray_traverse(ray, &mut rh, |_, i| self.test_prim(pre, tmin, i, &mut best));
+            }
+            Accel::CwBvh(b) => {
+                b.ray_traverse(ray, &mut rh, |_, i| self.test_prim(pre, tmin, i, &mut best));
+            }
+        }
+        (best.t < tmax).then_some(best)
+    }
+
+    /// Turn a raw hit into a public [`Hit`] (normal, exact point, ids).
+    pub(crate) fn finish(&self, pre: &RayPre, r: &RawHit) -> Hit {
+        match self.prims[r.slot as usize] {
+            Prim::Sphere { center, radius, id } => {
+                // Re-project the hit point onto the sphere to remove the error of o + t·d.
+                let p = pre.origin + pre.dir * r.t;
+                let n = (p - center).normalize_or(-pre.dir.normalize());
+                Hit {
+                    t: r.t,
+                    point: center + n * radius,
+                    normal: n,
+                    prim_id: id,
+                    material_id: self.sphere_material[id as usize],
+                    kind: HitKind::Sphere,
+                }
+            }
+            Prim::Cylinder { id } => Hit {
+                t: r.t,
+                point: pre.origin + pre.dir * r.t,
+                normal: r.normal,
+                prim_id: id,
+                material_id: self.cylinders[id as usize].material,
+                kind: HitKind::Cylinder { part: r.part },
+            },
+            Prim::Triangle { tri } => {
+                let v = &self.tris[tri as usize];
+                let m = &self.tri_meta[tri as usize];
+                let b0 = 1.0 - r.b1 - r.b2;
+                let n = (v[1] - v[0])
+                    .cross(v[2] - v[0])
+                    .normalize_or(-pre.dir.normalize());
+                Hit {
+                    t: r.t,
+                    point: v[0] * b0 + v[1] * r.b1 + v[2] * r.b2,
+                    normal: n,
+                    prim_id: m.index,
+                    material_id: self.meshes[m.mesh as usize].material,
+                    kind: HitKind::Triangle {
+                        mesh: m.mesh,
+                        bary: Vec2::new(r.b1, r.b2),
+                    },
+                }
+            }
+        }
+    }
+
+    /// For a triangle hit: the triangle's vertices and its texture coordinates (if its mesh has
+    /// any).
+    pub(crate) fn triangle_uv_data(&self, hit: &Hit) -> Option<([Vec3; 3], [Vec2; 3])> {
+        let HitKind::Triangle { mesh, .. } = hit.kind else {
+            return None;
+        };
+        let info = &self.meshes[mesh as usize];
+        let uvs = info.uvs.as_ref()?;
+        // Find the triangle's record: meshes are stored contiguously, search by (mesh, index).
+        let k = self
+            .tri_meta
+            .partition_point(|m| (m.mesh, m.index) < (mesh, hit.prim_id));
+        let m = self.tri_meta.get(k)?;
+        debug_assert!(m.mesh == mesh && m.index == hit.prim_id);
+        let idx = m.idx;
+        Some((
+            self.tris[k],
+            [
+                uvs[idx[0] as usize],
+                uvs[idx[1] as usize],
+                uvs[idx[2] as usize],
+            ],
+        ))
+    }
+
+    /// The sphere with id `id` as (centre, radius), as added (also for skipped ones).
+    pub fn sphere(&self, id: u32) -> Option<(Vec3, f32)> {
+        self.spheres
+            .get(id as usize)
+            .map(|s| (Vec3::new(s[0], s[1], s[2]), s[3]))
+    }
+}
+
+impl RawHit {
+    #[inline]
+    fn none(tmax: f32) -> RawHit {
+        RawHit {
+            t: tmax,
+            slot: u32::MAX,
+            b1: 0.0,
+            b2: 0.0,
+            part: CylinderPart::Side,
+            normal: Vec3::ZERO,
+        }
+    }
+}
+
+#[inline]
+pub(crate) fn valid_ray(ray: &Ray) -> bool {
+    ray.origin.is_finite() && ray.dir.is_finite() && ray.dir.length_squared() > 0.0
+}
