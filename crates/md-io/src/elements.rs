@@ -141,6 +141,41 @@ const TABLE: [(&str, f32, [u8; 3]); 103] = [
     ("Lr", 2.00, [199, 0, 102]),
 ];
 
+/// Index of a one- or two-letter symbol in [`SYMBOL_LUT`] (case-insensitive).
+const fn symbol_slot(a: u8, b: Option<u8>) -> Option<usize> {
+    let a = a.to_ascii_uppercase();
+    if !a.is_ascii_uppercase() {
+        return None;
+    }
+    let second = match b {
+        None => 0,
+        Some(b) => {
+            let b = b.to_ascii_uppercase();
+            if !b.is_ascii_uppercase() {
+                return None;
+            }
+            (b - b'A') as usize + 1
+        }
+    };
+    Some((a - b'A') as usize * 27 + second)
+}
+
+/// Symbol → atomic number in O(1): 26 first letters x (no second letter + 26 second letters).
+const SYMBOL_LUT: [u8; 26 * 27] = {
+    let mut lut = [0u8; 26 * 27];
+    let mut z = 0;
+    while z < TABLE.len() {
+        let sym = TABLE[z].0.as_bytes();
+        let b = if sym.len() == 2 { Some(sym[1]) } else { None };
+        match symbol_slot(sym[0], b) {
+            Some(slot) => lut[slot] = z as u8 + 1,
+            None => panic!("element table symbol is not 1-2 letters"),
+        }
+        z += 1;
+    }
+    lut
+};
+
 /// A chemical element by atomic number; `Element::UNKNOWN` (0) when it could not be told.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct Element(u8);
@@ -159,15 +194,18 @@ impl Element {
     }
 
     /// The element whose symbol is `s`, ignoring case and surrounding spaces ("fe", "FE", "Fe").
+    #[inline]
     pub fn from_symbol(s: &str) -> Option<Element> {
         let s = s.trim().as_bytes();
-        if s.is_empty() || s.len() > 2 {
-            return None;
+        let slot = match *s {
+            [a] => symbol_slot(a, None)?,
+            [a, b] => symbol_slot(a, Some(b))?,
+            _ => return None,
+        };
+        match SYMBOL_LUT[slot] {
+            0 => None,
+            z => Some(Element(z)),
         }
-        TABLE
-            .iter()
-            .position(|(sym, _, _)| sym.as_bytes().eq_ignore_ascii_case(s))
-            .map(|i| Element(i as u8 + 1))
     }
 
     /// Atomic number (0 for unknown).

@@ -242,8 +242,9 @@ pub(crate) trait TextFormat {
         frame: &mut Frame,
     ) -> Result<bool, Error>;
 
-    /// Moves past the frame starting at the next line without parsing numbers; `Ok(false)` at a
-    /// clean end of data. Must accept exactly the frames `read` accepts, or fail.
+    /// Moves past the frame starting at the next line, checking its structure (line counts,
+    /// record order) but parsing no coordinates; `Ok(false)` when no frame starts there. A frame
+    /// `skip` accepts may still fail in `read` (a bad number), never the other way round.
     fn skip<R: Read>(&mut self, lines: &mut LineReader<R>, ctx: &Ctx) -> Result<bool, Error>;
 }
 
@@ -308,7 +309,8 @@ impl<R: Read + Seek, F: TextFormat> TextReader<R, F> {
             }
             return Ok(false);
         };
-        if self.next == self.starts.len() {
+        let pushed = self.next == self.starts.len();
+        if pushed {
             self.starts.push(start);
         }
         let ok = self.format.read(&mut self.lines, &ctx, frame);
@@ -317,7 +319,15 @@ impl<R: Read + Seek, F: TextFormat> TextReader<R, F> {
                 self.next += 1;
                 Ok(true)
             }
-            Ok(false) => Ok(false),
+            Ok(false) => {
+                // Only trailer records (e.g. PDB CONECT/END) were left: no frame starts here.
+                if pushed {
+                    self.starts.pop();
+                    self.complete = true;
+                }
+                frame.clear();
+                Ok(false)
+            }
             Err(e) => {
                 // Leave the cursor at the damaged frame so a retry gives the same error.
                 frame.clear();

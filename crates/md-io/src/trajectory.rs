@@ -3,6 +3,9 @@
 use crate::error::Error;
 use crate::format::Format;
 use crate::frame::Frame;
+use crate::gro::Gro;
+use crate::lammps::Lammps;
+use crate::pdb::Pdb;
 use crate::text::TextReader;
 use crate::xyz::Xyz;
 use std::fs::File;
@@ -13,6 +16,9 @@ use std::sync::Arc;
 /// The per-format readers: a closed set, dispatched by `match` (see the contract in lib.rs).
 enum Reader<R> {
     Xyz(TextReader<R, Xyz>),
+    Pdb(TextReader<R, Pdb>),
+    Gro(TextReader<R, Gro>),
+    Lammps(TextReader<R, Lammps>),
 }
 
 /// Runs `$body` with `$r` bound to the format's reader, whatever the format.
@@ -20,6 +26,9 @@ macro_rules! each_reader {
     ($reader:expr, $r:ident => $body:expr) => {
         match $reader {
             Reader::Xyz($r) => $body,
+            Reader::Pdb($r) => $body,
+            Reader::Gro($r) => $body,
+            Reader::Lammps($r) => $body,
         }
     };
 }
@@ -82,6 +91,11 @@ impl<R: Read + Seek> Trajectory<R> {
         let file: Arc<str> = name.into();
         let reader = match format {
             Format::Xyz => Reader::Xyz(TextReader::new(src, Xyz::default(), file.clone())),
+            Format::Pdb => Reader::Pdb(TextReader::new(src, Pdb::default(), file.clone())),
+            Format::Gro => Reader::Gro(TextReader::new(src, Gro, file.clone())),
+            Format::LammpsDump => {
+                Reader::Lammps(TextReader::new(src, Lammps::default(), file.clone()))
+            }
             _ => {
                 return Err(Error::Unsupported {
                     file,

@@ -3,6 +3,7 @@
 use crate::error::{Error, Location};
 use crate::format::Format;
 use crate::frame::Frame;
+use crate::pdb::PdbWriter;
 use crate::xyz::XyzWriter;
 use std::fs::File;
 use std::io::{BufWriter, Seek, Write};
@@ -12,6 +13,7 @@ use std::sync::Arc;
 /// The per-format writers: a closed set, dispatched by `match`.
 enum WriterKind<W> {
     Xyz(XyzWriter<W>),
+    Pdb(PdbWriter<W>),
 }
 
 /// Runs `$body` with `$w` bound to the format's writer, whatever the format.
@@ -19,6 +21,7 @@ macro_rules! each_writer {
     ($writer:expr, $w:ident => $body:expr) => {
         match $writer {
             WriterKind::Xyz($w) => $body,
+            WriterKind::Pdb($w) => $body,
         }
     };
 }
@@ -51,6 +54,7 @@ impl<W: Write + Seek> Writer<W> {
         let file: Arc<str> = name.into();
         let kind = match format {
             Format::Xyz => WriterKind::Xyz(XyzWriter { out }),
+            Format::Pdb => WriterKind::Pdb(PdbWriter { out, models: 0 }),
             _ => {
                 return Err(Error::Unsupported {
                     file,
@@ -83,6 +87,14 @@ impl<W: Write + Seek> Writer<W> {
             frame: self.written,
             what,
         })?;
+        // Format limits (e.g. PDB's fixed columns).
+        if let WriterKind::Pdb(_) = &self.kind {
+            PdbWriter::<W>::check(frame).map_err(|what| Error::InvalidFrame {
+                file: self.file.clone(),
+                frame: self.written,
+                what,
+            })?;
+        }
         let r = each_writer!(&mut self.kind, w => w.write_frame(frame));
         r.map_err(|source| self.io(source))?;
         self.written += 1;
@@ -103,7 +115,7 @@ impl<W: Write + Seek> Writer<W> {
 
     /// Writes the trailer, flushes, and returns the output.
     pub fn finish(mut self) -> Result<W, Error> {
-        let r = each_writer!(&mut self.kind, w => w.out.flush());
+        let r = each_writer!(&mut self.kind, w => w.finish().and_then(|()| w.out.flush()));
         r.map_err(|source| self.io(source))?;
         Ok(each_writer!(self.kind, w => w.out))
     }

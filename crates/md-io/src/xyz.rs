@@ -348,6 +348,11 @@ pub(crate) struct XyzWriter<W> {
 }
 
 impl<W: std::io::Write> XyzWriter<W> {
+    /// XYZ has no trailer.
+    pub fn finish(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+
     pub fn write_frame(&mut self, frame: &Frame) -> std::io::Result<()> {
         let w = &mut self.out;
         let n = frame.n_atoms();

@@ -1,0 +1,459 @@
+//! LAMMPS text dump (`dump atom` / `dump custom`).
+//!
+//! A frame is a series of `ITEM:` sections ending with `ITEM: ATOMS <columns>` and one line per
+//! atom: `UNITS` and `TIME` (optional), `TIMESTEP`, `NUMBER OF ATOMS` (may change from frame to
+//! frame), `BOX BOUNDS`, `ATOMS`.
+//!
+//! Box: `BOX BOUNDS pp pp pp` gives `lo hi` per axis; `BOX BOUNDS xy xz yz pp pp pp` gives
+//! the bounds of the triclinic box's bounding box plus the tilt factors, from which the box is
+//! recovered as the LAMMPS manual ("Triclinic (non-orthogonal) simulation boxes") documents:
+//! `xlo = xlo_bound − min(0, xy, xz, xy+xz)`, `xhi = xhi_bound − max(0, xy, xz, xy+xz)`,
+//! `ylo = ylo_bound − min(0, yz)`, `yhi = yhi_bound − max(0, yz)`; edges a = (xhi−xlo, 0, 0),
+//! b = (xy, yhi−ylo, 0), c = (xz, yz, zhi−zlo), origin (xlo, ylo, zlo). `BOX BOUNDS abc origin`
+//! (general triclinic, LAMMPS 2024+) gives each edge vector followed by one origin component.
+//!
+//! Columns may come in any order. Positions come from the first present of `x y z` (wrapped),
+//! `xs ys zs` (scaled), `xu yu zu` (unwrapped), `xsu ysu zsu` (scaled unwrapped); scaled ones
+//! become Cartesian as origin + s·M with the frame's box (f64). Also read: `id`, `type`,
+//! `element` (→ elements; else elements are guessed from non-numeric types), `vx vy vz`,
+//! `radius`, `diameter` (halved), `mass`/`q`/others skipped.
+//!
+//! Atoms are returned sorted by `id` when there is an id column (LAMMPS writes them in
+//! processor order), as MDAnalysis and chemfiles do.
+//!
+//! Units: positions are taken as Å (LAMMPS `real` and `metal` units). `TIME` becomes ps and
+//! velocities Å/ps when `UNITS` says `metal` or `real` (fs → ps); without `UNITS` velocities are
+//! stored as written and the time is left out.
+
+use crate::elements::{Element, guess_element};
+use crate::error::Error;
+use crate::frame::{Frame, Label, UnitCell};
+use crate::parse::{fields, parse_f32, parse_f64, parse_i64, parse_usize, trim};
+use crate::text::{Ctx, LineReader, Pos, TextFormat};
+use std::io::Read;
+
+/// What one atom column is read into.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Act {
+    Id,
+    Type,
+    Element,
+    Pos(usize),
+    Vel(usize),
+    Radius,
+    Diameter,
+    Skip,
+}
+
+/// How the position columns are expressed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum PosKind {
+    Cartesian,
+    Scaled,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Units {
+    Unknown,
+    Real,
+    Metal,
+}
+
+/// LAMMPS dump parser state: column actions and the scratch buffers of the sort by id.
+pub(crate) struct Lammps {
+    acts: Vec<Act>,
+    units: Units,
+    perm: Vec<(i64, u32)>,
+    s3: Vec<[f32; 3]>,
+    sl: Vec<Label>,
+    se: Vec<Element>,
+    si: Vec<i64>,
+    sf: Vec<f32>,
+}
+
+impl Default for Lammps {
+    fn default() -> Self {
+        Lammps {
+            acts: Vec::new(),
+            units: Units::Unknown,
+            perm: Vec::new(),
+            s3: Vec::new(),
+            sl: Vec::new(),
+            se: Vec::new(),
+            si: Vec::new(),
+            sf: Vec::new(),
+        }
+    }
+}
+
+/// Replaces `v` by `v` permuted by `perm` (v'[k] = v[perm[k]]), using `scratch`.
+fn permute<T: Copy>(v: &mut Vec<T>, perm: &[(i64, u32)], scratch: &mut Vec<T>) {
+    if v.is_empty() {
+        return;
+    }
+    scratch.clear();
+    scratch.extend(perm.iter().map(|&(_, i)| v[i as usize]));
+    std::mem::swap(v, scratch);
+}
+
+/// The header of one frame, up to the ATOMS line.
+struct Header {
+    n: usize,
+    cell: Option<UnitCell>,
+    pos_kind: PosKind,
+}
+
+impl Lammps {
+    /// The next line, or a truncation error saying what was expected.
+    fn line<'a, R: Read>(
+        lines: &'a mut LineReader<R>,
+        ctx: &Ctx,
+        expected: &str,
+    ) -> Result<(Pos, &'a [u8]), Error> {
+        let p = lines.pos();
+        match lines.next_line().map_err(|e| ctx.io(p, e))? {
+            Some(x) => Ok(x),
+            None => Err(ctx.truncated(p, expected.to_string())),
+        }
+    }
+
+    fn bounds(ctx: &Ctx, pos: Pos, line: &[u8], n: usize) -> Result<[f64; 4], Error> {
+        let mut v = [0f64; 4];
+        let mut k = 0;
+        for f in fields(line) {
+            if k == n {
+                break;
+            }
+            v[k] = parse_f64(f).ok_or_else(|| ctx.parse(pos, line, f, "a box bound"))?;
+            k += 1;
+        }
+        if k < n {
+            return Err(ctx.parse(pos, line, line, "the box bounds (lo hi [tilt])"));
+        }
+        Ok(v)
+    }
+
+    fn boxes<R: Read>(
+        lines: &mut LineReader<R>,
+        ctx: &Ctx,
+        kind: u8,
+    ) -> Result<Option<UnitCell>, Error> {
+        let mut rows = [[0f64; 4]; 3];
+        let width = if kind == 0 {
+            2
+        } else if kind == 1 {
+            3
+        } else {
+            4
+        };
+        for row in &mut rows {
+            let (pos, line) = Lammps::line(lines, ctx, "3 box bound lines")?;
+            *row = Lammps::bounds(ctx, pos, line, width)?;
+        }
+        let cell = match kind {
+            2 => {
+                // General triclinic: edge vectors and origin components.
+                let m = [
+                    [rows[0][0], rows[0][1], rows[0][2]],
+                    [rows[1][0], rows[1][1], rows[1][2]],
+                    [rows[2][0], rows[2][1], rows[2][2]],
+                ];
+                UnitCell::from_matrix(m)
+                    .map(|c| c.with_origin([rows[0][3], rows[1][3], rows[2][3]]))
+            }
+            _ => {
+                // Restricted triclinic: remove the tilt from the bounding box (LAMMPS manual).
+                let (xy, xz, yz) = if kind == 1 {
+                    (rows[0][2], rows[1][2], rows[2][2])
+                } else {
+                    (0.0, 0.0, 0.0)
+                };
+                let xlo = rows[0][0] - 0f64.min(xy).min(xz).min(xy + xz);
+                let xhi = rows[0][1] - 0f64.max(xy).max(xz).max(xy + xz);
+                let ylo = rows[1][0] - 0f64.min(yz);
+                let yhi = rows[1][1] - 0f64.max(yz);
+                let (zlo, zhi) = (rows[2][0], rows[2][1]);
+                let m = [
+                    [xhi - xlo, 0.0, 0.0],
+                    [xy, yhi - ylo, 0.0],
+                    [xz, yz, zhi - zlo],
+                ];
+                UnitCell::from_matrix(m).map(|c| c.with_origin([xlo, ylo, zlo]))
+            }
+        };
+        // A degenerate box (e.g. a 2-D run with zero thickness) is reported as no cell.
+        Ok(cell.ok())
+    }
+
+    /// Reads the ITEM sections up to and including `ITEM: ATOMS`; `None` at a clean end.
+    fn header<R: Read>(
+        &mut self,
+        lines: &mut LineReader<R>,
+        ctx: &Ctx,
+        mut frame: Option<&mut Frame>,
+    ) -> Result<Option<Header>, Error> {
+        let mut n = None;
+        let mut cell = None;
+        let mut time = None;
+        let mut first = true;
+        loop {
+            let p = lines.pos();
+            let Some((pos, line)) = lines.next_line().map_err(|e| ctx.io(p, e))? else {
+                if first {
+                    return Ok(None);
+                }
+                return Err(ctx.truncated(p, "ITEM: ATOMS".into()));
+            };
+            first = false;
+            let t = trim(line);
+            let Some(item) = t.strip_prefix(b"ITEM:") else {
+                return Err(ctx.parse(pos, line, t, "an 'ITEM:' line"));
+            };
+            let item = trim(item);
+            if item == b"TIMESTEP" {
+                let (pos, line) = Lammps::line(lines, ctx, "the timestep")?;
+                let t = trim(line);
+                let step =
+                    parse_i64(t).ok_or_else(|| ctx.parse(pos, line, t, "an integer timestep"))?;
+                if let Some(f) = frame.as_deref_mut() {
+                    f.step = Some(step);
+                }
+            } else if item == b"TIME" {
+                let (pos, line) = Lammps::line(lines, ctx, "the time")?;
+                let t = trim(line);
+                time = Some(parse_f64(t).ok_or_else(|| ctx.parse(pos, line, t, "a time"))?);
+            } else if item == b"UNITS" {
+                let (_, line) = Lammps::line(lines, ctx, "the units")?;
+                self.units = match trim(line) {
+                    b"real" => Units::Real,
+                    b"metal" => Units::Metal,
+                    _ => Units::Unknown,
+                };
+            } else if item == b"NUMBER OF ATOMS" {
+                let (pos, line) = Lammps::line(lines, ctx, "the number of atoms")?;
+                let t = trim(line);
+                n = Some(
+                    parse_usize(t).ok_or_else(|| ctx.parse(pos, line, t, "the number of atoms"))?,
+                );
+            } else if let Some(spec) = item.strip_prefix(b"BOX BOUNDS") {
+                // 0: orthogonal, 1: restricted triclinic (tilts), 2: general triclinic.
+                let kind = match fields(spec).next() {
+                    Some(b"abc") => 2,
+                    Some(b"xy") => 1,
+                    _ => 0,
+                };
+                cell = Lammps::boxes(lines, ctx, kind)?;
+            } else if let Some(spec) = item.strip_prefix(b"ATOMS") {
+                let Some(n) = n else {
+                    return Err(ctx.parse(
+                        pos,
+                        line,
+                        t,
+                        "ITEM: NUMBER OF ATOMS before ITEM: ATOMS",
+                    ));
+                };
+                let pos_kind = self.columns(ctx, pos, line, spec)?;
+                if pos_kind == PosKind::Scaled && cell.is_none() {
+                    return Err(ctx.parse(pos, line, spec, "a box before scaled coordinates"));
+                }
+                if let Some(f) = frame.as_deref_mut() {
+                    f.cell = cell;
+                    f.time = match (time, self.units) {
+                        (Some(t), Units::Metal) => Some(t),
+                        (Some(t), Units::Real) => Some(t * 1e-3),
+                        _ => None,
+                    };
+                }
+                return Ok(Some(Header { n, cell, pos_kind }));
+            } else {
+                return Err(ctx.parse(
+                    pos,
+                    line,
+                    t,
+                    "ITEM: TIMESTEP, TIME, UNITS, NUMBER OF ATOMS, BOX BOUNDS or ATOMS",
+                ));
+            }
+        }
+    }
+
+    /// Maps the ATOMS column names to actions.
+    fn columns(&mut self, ctx: &Ctx, pos: Pos, line: &[u8], spec: &[u8]) -> Result<PosKind, Error> {
+        self.acts.clear();
+        const SETS: [(&[&[u8]; 3], PosKind); 4] = [
+            (&[b"x", b"y", b"z"], PosKind::Cartesian),
+            (&[b"xs", b"ys", b"zs"], PosKind::Scaled),
+            (&[b"xu", b"yu", b"zu"], PosKind::Cartesian),
+            (&[b"xsu", b"ysu", b"zsu"], PosKind::Scaled),
+        ];
+        let Some(&(set, kind)) = SETS
+            .iter()
+            .find(|(set, _)| set.iter().all(|c| fields(spec).any(|n| n == *c)))
+        else {
+            return Err(ctx.parse(
+                pos,
+                line,
+                spec,
+                "position columns x y z, xs ys zs, xu yu zu or xsu ysu zsu",
+            ));
+        };
+        for name in fields(spec) {
+            let act = match name {
+                b"id" => Act::Id,
+                b"type" => Act::Type,
+                b"element" => Act::Element,
+                b"vx" => Act::Vel(0),
+                b"vy" => Act::Vel(1),
+                b"vz" => Act::Vel(2),
+                b"radius" => Act::Radius,
+                b"diameter" => Act::Diameter,
+                c => match set.iter().position(|s| *s == c) {
+                    Some(k) => Act::Pos(k),
+                    None => Act::Skip,
+                },
+            };
+            // Only the first column of a kind counts.
+            let act = if act != Act::Skip && self.acts.contains(&act) {
+                Act::Skip
+            } else {
+                act
+            };
+            self.acts.push(act);
+        }
+        let vel = (0..3).filter(|k| self.acts.contains(&Act::Vel(*k))).count();
+        if vel != 0 && vel != 3 {
+            // A partial velocity is not a velocity: skip those columns.
+            for a in &mut self.acts {
+                if matches!(a, Act::Vel(_)) {
+                    *a = Act::Skip;
+                }
+            }
+        }
+        Ok(kind)
+    }
+}
+
+impl TextFormat for Lammps {
+    fn read<R: Read>(
+        &mut self,
+        lines: &mut LineReader<R>,
+        ctx: &Ctx,
+        frame: &mut Frame,
+    ) -> Result<bool, Error> {
+        let Some(h) = self.header(lines, ctx, Some(frame))? else {
+            return Ok(false);
+        };
+        let has = |a: Act| self.acts.contains(&a);
+        let (has_vel, has_id, has_type) = (has(Act::Vel(0)), has(Act::Id), has(Act::Type));
+        let has_el = has(Act::Element);
+        let vel_scale = if self.units == Units::Real {
+            1000.0
+        } else {
+            1.0
+        };
+        frame.positions.reserve(h.n);
+        // Atom lines: one pass over each line's fields with the column actions.
+        for i in 0..h.n {
+            let p = lines.pos();
+            let Some((pos, line)) = lines.next_line().map_err(|e| ctx.io(p, e))? else {
+                return Err(ctx.truncated(p, format!("{} more atom lines", h.n - i)));
+            };
+            let mut xyz = [0f64; 3];
+            let mut v = [0f32; 3];
+            let mut it = fields(line);
+            for &act in &self.acts {
+                let Some(f) = it.next() else {
+                    let end = &line[line.len()..];
+                    return Err(ctx.parse(pos, line, end, "as many values as ITEM: ATOMS columns"));
+                };
+                match act {
+                    Act::Pos(k) => {
+                        xyz[k] =
+                            parse_f64(f).ok_or_else(|| ctx.parse(pos, line, f, "a coordinate"))?;
+                    }
+                    Act::Vel(k) => {
+                        v[k] = parse_f32(f)
+                            .map(|x| x * vel_scale)
+                            .ok_or_else(|| ctx.parse(pos, line, f, "a velocity"))?;
+                    }
+                    Act::Id => {
+                        let id = parse_i64(f)
+                            .ok_or_else(|| ctx.parse(pos, line, f, "an integer atom id"))?;
+                        frame.ids.push(id);
+                    }
+                    Act::Type => {
+                        let l = Label::from_utf8(f)
+                            .ok_or_else(|| ctx.parse(pos, line, f, "a type of at most 15 bytes"))?;
+                        frame.types.push(l);
+                    }
+                    Act::Element => {
+                        let s = std::str::from_utf8(f).unwrap_or("");
+                        let e = Element::from_symbol(s)
+                            .ok_or_else(|| ctx.parse(pos, line, f, "an element symbol"))?;
+                        frame.elements.push(e);
+                    }
+                    Act::Radius | Act::Diameter => {
+                        let r = parse_f32(f)
+                            .filter(|r| *r >= 0.0)
+                            .ok_or_else(|| ctx.parse(pos, line, f, "a radius >= 0"))?;
+                        frame
+                            .radii
+                            .push(if act == Act::Diameter { r * 0.5 } else { r });
+                    }
+                    Act::Skip => {}
+                }
+            }
+            // Scaled → Cartesian with the frame's box.
+            let p = match (h.pos_kind, &h.cell) {
+                (PosKind::Scaled, Some(c)) => c.to_cartesian(xyz),
+                _ => xyz,
+            };
+            let p = [p[0] as f32, p[1] as f32, p[2] as f32];
+            if p.iter().any(|x| !x.is_finite()) {
+                return Err(ctx.parse(pos, line, line, "coordinates within f32 range"));
+            }
+            frame.positions.push(p);
+            if has_vel {
+                frame.velocities.push(v);
+            }
+        }
+        // Elements from non-numeric types when there is no element column.
+        if !has_el
+            && has_type
+            && frame
+                .types
+                .iter()
+                .any(|t| parse_i64(t.as_bytes()).is_none())
+        {
+            for t in &frame.types {
+                frame.elements.push(guess_element(t, None, None));
+            }
+        }
+        // Sort atoms by id (processor order → id order).
+        if has_id && !frame.ids.is_sorted() {
+            self.perm.clear();
+            self.perm
+                .extend(frame.ids.iter().enumerate().map(|(k, id)| (*id, k as u32)));
+            self.perm.sort_unstable();
+            let perm = &self.perm;
+            permute(&mut frame.positions, perm, &mut self.s3);
+            permute(&mut frame.velocities, perm, &mut self.s3);
+            permute(&mut frame.types, perm, &mut self.sl);
+            permute(&mut frame.elements, perm, &mut self.se);
+            permute(&mut frame.radii, perm, &mut self.sf);
+            permute(&mut frame.ids, perm, &mut self.si);
+        }
+        Ok(true)
+    }
+
+    fn skip<R: Read>(&mut self, lines: &mut LineReader<R>, ctx: &Ctx) -> Result<bool, Error> {
+        let Some(h) = self.header(lines, ctx, None)? else {
+            return Ok(false);
+        };
+        let p = lines.pos();
+        let missing = lines.skip_lines(h.n).map_err(|e| ctx.io(p, e))?;
+        if missing > 0 {
+            return Err(ctx.truncated(lines.pos(), format!("{missing} more atom lines")));
+        }
+        Ok(true)
+    }
+}

@@ -1,0 +1,378 @@
+//! PDB (Protein Data Bank) coordinates, multi-MODEL.
+//!
+//! Records used (1-based columns, PDB format v3.3):
+//! - `ATOM`/`HETATM`: serial 7-11 (hybrid-36 past 99,999), name 13-16, residue name 18-21,
+//!   residue number 23-26 (hybrid-36 past 9,999), x y z 31-38, 39-46, 47-54, element 77-78;
+//! - `CRYST1`: a b c 7-15, 16-24, 25-33, α β γ 34-40, 41-47, 48-54. A cell of 1 Å x 1 Å x 1 Å
+//!   with right angles is the conventional "no cell" placeholder and is dropped (as MDAnalysis
+//!   does). A CRYST1 holds for the frames after it until the next CRYST1;
+//! - `MODEL` / `ENDMDL`: frame boundaries. Without them the whole file is one frame;
+//! - `TITLE`: the frame's comment. Everything else (REMARK, TER, CONECT, MASTER, END, ...) is
+//!   skipped, so trailing CONECT/MASTER/END records do not make a frame.
+//!
+//! Elements: columns 77-78 when they hold a symbol, else [`crate::elements::guess_element`] from
+//! the atom and residue names.
+//!
+//! Hybrid-36 (Grosse-Kunstleve, 2007): a field of width w holds decimal numbers up to 10^w - 1,
+//! then base-36 with upper-case digits ("A0000" = 100,000 for w = 5), then lower-case digits.
+//!
+//! # References
+//! - wwPDB, Protein Data Bank Contents Guide: Atomic Coordinate Entry Format v3.3.
+//! - R. W. Grosse-Kunstleve, "Hybrid-36", cctbx iotbx/pdb/hybrid_36 documentation (2007).
+
+use crate::elements::guess_element;
+use crate::error::Error;
+use crate::frame::{Frame, Label, UnitCell};
+use crate::parse::{parse_f32, parse_f64, trim};
+use crate::text::{Ctx, LineReader, Pos, TextFormat};
+use std::io::Read;
+
+/// Value of a base-36 digit in the given alphabet half (upper or lower case), else `None`.
+fn digit36(b: u8, upper: bool) -> Option<u64> {
+    match b {
+        b'0'..=b'9' => Some((b - b'0') as u64),
+        b'A'..=b'Z' if upper => Some((b - b'A') as u64 + 10),
+        b'a'..=b'z' if !upper => Some((b - b'a') as u64 + 10),
+        _ => None,
+    }
+}
+
+/// Decodes a hybrid-36 field of width `w` (spaces allowed around decimal numbers).
+pub(crate) fn hy36_decode(field: &[u8], w: u32) -> Option<i64> {
+    let t = trim(field);
+    let first = *t.first()?;
+    if first.is_ascii_digit() || first == b'-' {
+        return crate::parse::parse_i64(t);
+    }
+    // Letters: the field must be full width.
+    if field.len() != w as usize || t.len() != w as usize {
+        return None;
+    }
+    let upper = first.is_ascii_uppercase();
+    let mut v: u64 = 0;
+    for &b in t {
+        v = v * 36 + digit36(b, upper)?;
+    }
+    let p36 = 36u64.pow(w - 1);
+    let p10 = 10u64.pow(w);
+    // Upper case starts at 10^w with "A000…" (= 10·36^(w-1)); lower case follows upper case.
+    let base = if upper { p10 } else { p10 + 26 * p36 };
+    Some((v - 10 * p36 + base) as i64)
+}
+
+/// Encodes `v` as hybrid-36 of width `w`; `None` past the largest lower-case number.
+pub(crate) fn hy36_encode(v: i64, w: u32) -> Option<String> {
+    let p10 = 10i64.pow(w);
+    let p36 = 36i64.pow(w - 1);
+    if v > -(10i64.pow(w - 1)) && v < p10 {
+        return Some(format!("{v:>width$}", width = w as usize));
+    }
+    if v < 0 {
+        return None;
+    }
+    let (mut r, digits) = if v < p10 + 26 * p36 {
+        (v - p10 + 10 * p36, b"0123456789ABCDEFGHIJKLMNOPQRSTUVWXYZ")
+    } else if v < p10 + 52 * p36 {
+        (
+            v - p10 - 26 * p36 + 10 * p36,
+            b"0123456789abcdefghijklmnopqrstuvwxyz",
+        )
+    } else {
+        return None;
+    };
+    let mut out = vec![b'0'; w as usize];
+    for k in (0..w as usize).rev() {
+        out[k] = digits[(r % 36) as usize];
+        r /= 36;
+    }
+    String::from_utf8(out).ok()
+}
+
+/// Bytes `a..=b` (1-based, inclusive) of a line, cut to its length.
+fn cols(line: &[u8], a: usize, b: usize) -> &[u8] {
+    let s = (a - 1).min(line.len());
+    let e = b.min(line.len());
+    &line[s..e]
+}
+
+/// PDB frame parser state: the cell of the last CRYST1.
+#[derive(Default)]
+pub(crate) struct Pdb {
+    cell: Option<UnitCell>,
+}
+
+/// Record name of a line: its first 6 bytes, trailing spaces removed.
+fn record(line: &[u8]) -> &[u8] {
+    trim(cols(line, 1, 6))
+}
+
+impl Pdb {
+    fn cryst1(&mut self, ctx: &Ctx, pos: Pos, line: &[u8]) -> Result<(), Error> {
+        let mut v = [0f64; 6];
+        let spans = [(7, 15), (16, 24), (25, 33), (34, 40), (41, 47), (48, 54)];
+        for (x, (a, b)) in v.iter_mut().zip(spans) {
+            let f = trim(cols(line, a, b));
+            *x = parse_f64(f).ok_or_else(|| ctx.parse(pos, line, f, "a number in CRYST1"))?;
+        }
+        if v == [1.0, 1.0, 1.0, 90.0, 90.0, 90.0] || v[..3] == [0.0; 3] {
+            self.cell = None;
+            return Ok(());
+        }
+        let cell = UnitCell::from_lengths_angles([v[0], v[1], v[2]], [v[3], v[4], v[5]])
+            .map_err(|_| ctx.parse(pos, line, line, "a CRYST1 cell with volume > 0"))?;
+        self.cell = Some(cell);
+        Ok(())
+    }
+
+    fn atom(ctx: &Ctx, pos: Pos, line: &[u8], frame: &mut Frame) -> Result<(), Error> {
+        // Coordinates, columns 31-54.
+        let mut p = [0f32; 3];
+        for (k, x) in p.iter_mut().enumerate() {
+            let f = trim(cols(line, 31 + 8 * k, 38 + 8 * k));
+            *x = parse_f32(f)
+                .ok_or_else(|| ctx.parse(pos, line, f, "a coordinate in columns 31-54"))?;
+        }
+        let serial_field = cols(line, 7, 11);
+        let serial = if trim(serial_field).is_empty() {
+            frame.n_atoms() as i64 + 1
+        } else {
+            hy36_decode(serial_field, 5).ok_or_else(|| {
+                ctx.parse(pos, line, serial_field, "a serial number in columns 7-11")
+            })?
+        };
+        let name_f = trim(cols(line, 13, 16));
+        let res_f = trim(cols(line, 18, 21));
+        let name = Label::from_utf8(name_f)
+            .ok_or_else(|| ctx.parse(pos, line, name_f, "an atom name in columns 13-16"))?;
+        let res = Label::from_utf8(res_f)
+            .ok_or_else(|| ctx.parse(pos, line, res_f, "a residue name in columns 18-21"))?;
+        let resid_field = cols(line, 23, 26);
+        let resid = if trim(resid_field).is_empty() {
+            0
+        } else {
+            hy36_decode(resid_field, 4).ok_or_else(|| {
+                ctx.parse(pos, line, resid_field, "a residue number in columns 23-26")
+            })?
+        };
+        let elem = std::str::from_utf8(trim(cols(line, 77, 78))).ok();
+        let element = guess_element(&name, Some(&res), elem.filter(|e| !e.is_empty()));
+        frame.positions.push(p);
+        frame.ids.push(serial);
+        frame.names.push(name);
+        frame.res_names.push(res);
+        frame.res_ids.push(resid);
+        frame.elements.push(element);
+        Ok(())
+    }
+
+    /// Walks the records of one frame; `atoms` parses ATOM/HETATM lines when given a frame.
+    fn walk<R: Read>(
+        &mut self,
+        lines: &mut LineReader<R>,
+        ctx: &Ctx,
+        mut frame: Option<&mut Frame>,
+    ) -> Result<bool, Error> {
+        let mut in_model = false;
+        let mut n_atoms = 0usize;
+        loop {
+            let p = lines.pos();
+            let Some((pos, line)) = lines.next_line().map_err(|e| ctx.io(p, e))? else {
+                if in_model {
+                    return Err(ctx.truncated(p, "ENDMDL closing the MODEL".into()));
+                }
+                break;
+            };
+            match record(line) {
+                b"ATOM" | b"HETATM" => {
+                    n_atoms += 1;
+                    if let Some(f) = frame.as_deref_mut() {
+                        Pdb::atom(ctx, pos, line, f)?;
+                    }
+                }
+                b"MODEL" => {
+                    if in_model || n_atoms > 0 {
+                        // A new model without ENDMDL before it: this frame ends here.
+                        lines.unread(pos);
+                        break;
+                    }
+                    in_model = true;
+                }
+                b"ENDMDL" => {
+                    if let Some(f) = frame.as_deref_mut() {
+                        f.cell = self.cell;
+                    }
+                    return Ok(true);
+                }
+                b"END" if n_atoms > 0 => break,
+                b"CRYST1" => self.cryst1(ctx, pos, line)?,
+                b"TITLE" => {
+                    if let Some(f) = frame.as_deref_mut() {
+                        let t = String::from_utf8_lossy(trim(cols(line, 11, 80)));
+                        if !f.comment.is_empty() {
+                            f.comment.push(' ');
+                        }
+                        f.comment.push_str(&t);
+                    }
+                }
+                _ => {}
+            }
+        }
+        if let Some(f) = frame {
+            f.cell = self.cell;
+        }
+        Ok(n_atoms > 0 || in_model)
+    }
+}
+
+impl TextFormat for Pdb {
+    fn read<R: Read>(
+        &mut self,
+        lines: &mut LineReader<R>,
+        ctx: &Ctx,
+        frame: &mut Frame,
+    ) -> Result<bool, Error> {
+        self.walk(lines, ctx, Some(frame))
+    }
+
+    fn skip<R: Read>(&mut self, lines: &mut LineReader<R>, ctx: &Ctx) -> Result<bool, Error> {
+        self.walk(lines, ctx, None)
+    }
+}
+
+/// Writes frames as PDB: one MODEL … ENDMDL per frame, a CRYST1 when the frame has a cell,
+/// hybrid-36 serial and residue numbers, element symbols in columns 77-78, END at `finish`.
+pub(crate) struct PdbWriter<W> {
+    pub out: W,
+    pub models: usize,
+}
+
+/// Largest and smallest coordinate that fit `%8.3f`.
+const PDB_MAX: f32 = 9999.999;
+const PDB_MIN: f32 = -999.999;
+
+impl<W: std::io::Write> PdbWriter<W> {
+    /// Why `frame` cannot be written as PDB, if it cannot.
+    pub fn check(frame: &Frame) -> Result<(), String> {
+        if let Some(i) = frame
+            .positions
+            .iter()
+            .position(|p| p.iter().any(|x| !(PDB_MIN..=PDB_MAX).contains(x)))
+        {
+            return Err(format!(
+                "atom {i} has a coordinate outside PDB's [-999.999, 9999.999] Å"
+            ));
+        }
+        if let Some(i) = frame.ids.iter().position(|v| hy36_encode(*v, 5).is_none()) {
+            return Err(format!("atom {i}'s id does not fit 5 hybrid-36 columns"));
+        }
+        if let Some(i) = frame
+            .res_ids
+            .iter()
+            .position(|v| hy36_encode(*v, 4).is_none())
+        {
+            return Err(format!(
+                "atom {i}'s residue number does not fit 4 hybrid-36 columns"
+            ));
+        }
+        if let Some(i) = frame.names.iter().position(|l| l.len() > 4) {
+            return Err(format!("atom {i}'s name is longer than 4 characters"));
+        }
+        if let Some(i) = frame.res_names.iter().position(|l| l.len() > 4) {
+            return Err(format!(
+                "atom {i}'s residue name is longer than 4 characters"
+            ));
+        }
+        if frame.n_atoms() > 87_440_031 {
+            return Err("more atoms than hybrid-36 serial numbers".into());
+        }
+        Ok(())
+    }
+
+    pub fn write_frame(&mut self, frame: &Frame) -> std::io::Result<()> {
+        let w = &mut self.out;
+        self.models += 1;
+        if let Some(c) = &frame.cell {
+            let [a, b, cc] = c.lengths();
+            let [al, be, ga] = c.angles();
+            writeln!(
+                w,
+                "CRYST1{a:9.3}{b:9.3}{cc:9.3}{al:7.2}{be:7.2}{ga:7.2} P 1           1"
+            )?;
+        }
+        writeln!(w, "MODEL     {:>4}", self.models)?;
+        for (i, p) in frame.positions.iter().enumerate() {
+            let serial = frame.ids.get(i).copied().unwrap_or(i as i64 + 1);
+            // Serials past hybrid-36's range were rejected by `check`; wrap defensively.
+            let serial = hy36_encode(serial, 5).unwrap_or_else(|| "*****".into());
+            let element = frame
+                .elements
+                .get(i)
+                .filter(|e| !e.is_unknown())
+                .copied()
+                .unwrap_or_else(|| {
+                    let n = frame.names.get(i).map_or("", |l| l.as_str());
+                    let r = frame.res_names.get(i).map(|l| l.as_str());
+                    guess_element(n, r, None)
+                });
+            let sym = if element.is_unknown() {
+                String::new()
+            } else {
+                element.symbol().to_ascii_uppercase()
+            };
+            let name = frame
+                .names
+                .get(i)
+                .map_or_else(|| element.symbol().to_string(), |l| l.to_string());
+            // Atom names start in column 14 unless they have 4 characters or a 2-letter element.
+            let name = if name.len() >= 4 || sym.len() == 2 {
+                format!("{name:<4}")
+            } else {
+                format!(" {name:<3}")
+            };
+            let res = frame.res_names.get(i).map_or("UNK", |l| l.as_str());
+            let resid = frame.res_ids.get(i).copied().unwrap_or(1);
+            let resid = hy36_encode(resid, 4).unwrap_or_else(|| "****".into());
+            writeln!(
+                w,
+                "ATOM  {serial}{name:>5} {res:<4} {resid}    {:8.3}{:8.3}{:8.3}{:6.2}{:6.2}          {sym:>2}",
+                p[0], p[1], p[2], 1.0, 0.0
+            )?;
+        }
+        writeln!(w, "ENDMDL")
+    }
+
+    pub fn finish(&mut self) -> std::io::Result<()> {
+        writeln!(self.out, "END")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hybrid36_matches_the_published_examples() {
+        // Values from the hybrid-36 documentation.
+        assert_eq!(hy36_decode(b"99999", 5), Some(99_999));
+        assert_eq!(hy36_decode(b"A0000", 5), Some(100_000));
+        assert_eq!(hy36_decode(b"A0001", 5), Some(100_001));
+        assert_eq!(hy36_decode(b"ZZZZZ", 5), Some(43_770_015));
+        assert_eq!(hy36_decode(b"a0000", 5), Some(43_770_016));
+        assert_eq!(hy36_decode(b"zzzzz", 5), Some(87_440_031));
+        assert_eq!(hy36_decode(b"A000", 4), Some(10_000));
+        assert_eq!(hy36_decode(b"  12 ", 5), Some(12));
+        assert_eq!(hy36_decode(b"A00", 5), None);
+        assert_eq!(hy36_decode(b"A0a00", 5), None);
+        // Encoding inverts decoding over the whole range boundaries and a stride through it.
+        for v in (-9999..100_000)
+            .step_by(7)
+            .chain((99_990..87_440_032).step_by(9_973))
+        {
+            let s = hy36_encode(v, 5).unwrap();
+            assert_eq!(s.len(), 5);
+            assert_eq!(hy36_decode(s.as_bytes(), 5), Some(v), "{s}");
+        }
+        assert_eq!(hy36_encode(87_440_032, 5), None);
+        assert_eq!(hy36_encode(10_000, 4).as_deref(), Some("A000"));
+    }
+}
