@@ -37,6 +37,7 @@
 //! **Architecture invariant:** this crate depends on `texmap-core` and `texmap-raster` only; the
 //! reference ray tracer appears in its tests alone (the comparison harness lives in `texmap-study`).
 
+mod fastshade;
 mod lut;
 mod pipeline;
 mod raycast;

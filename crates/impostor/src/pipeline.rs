@@ -272,10 +272,17 @@ pub(crate) struct TileRect {
     pub h: u32,
 }
 
+/// Lane width of the vectorised kernels.
+pub(crate) const LANES: usize = 8;
+/// Tile buffer length: a row stride of [`TILE`] plus [`LANES`] slack, so that a full 8-lane
+/// chunk starting anywhere in a row stays inside the buffer (lanes past the sphere's box carry
+/// an infinite depth and never win).
+pub(crate) const TILE_BUF: usize = TILE_PX + LANES;
+
 /// A tile's depth and winner buffers (row stride [`TILE`]).
 pub(crate) struct TileBuf {
-    pub depth: [f32; TILE_PX],
-    pub win: [u32; TILE_PX],
+    pub depth: [f32; TILE_BUF],
+    pub win: [u32; TILE_BUF],
 }
 
 /// A method's per-pixel work, chosen once per frame (static dispatch).
@@ -285,6 +292,30 @@ pub(crate) trait Kernel: Sync {
     fn raster(&self, recs: &[Proj], tile: TileRect, buf: &mut TileBuf);
     /// Colour of pixel `(x, y)` won by `rec` at `depth` (sRGB RGBA8).
     fn resolve(&self, rec: &Proj, x: u32, y: u32, depth: f32, flags: u32) -> [u8; 4];
+
+    /// Colours of one tile row: pixels `x0..x0 + out.len()` of image row `y`, with the row's
+    /// winners and depths from the tile buffer (`win[i] == NONE`: background). The default calls
+    /// [`Kernel::resolve`] per pixel; kernels with costly shading override it with lanes.
+    fn resolve_row(
+        &self,
+        recs: &[Proj],
+        x0: u32,
+        y: u32,
+        win: &[u32],
+        depth: &[f32],
+        background: [u8; 4],
+        out: &mut [[u8; 4]],
+    ) {
+        for (i, o) in out.iter_mut().enumerate() {
+            let wv = win[i];
+            *o = if wv == NONE {
+                background
+            } else {
+                let rec = &recs[(wv & !FLAG_INSIDE) as usize];
+                self.resolve(rec, x0 + i as u32, y, depth[i], wv & FLAG_INSIDE)
+            };
+        }
+    }
 }
 
 /// Clip a record's box to a tile: `(x0, y0, x1, y1)` in tile-local pixels, or `None`.
@@ -314,8 +345,8 @@ pub(crate) fn draw_tiles<K: Kernel>(
         .enumerate()
         .for_each(|(ty, (color, depth))| {
             let mut buf = TileBuf {
-                depth: [f32::INFINITY; TILE_PX],
-                win: [NONE; TILE_PX],
+                depth: [f32::INFINITY; TILE_BUF],
+                win: [NONE; TILE_BUF],
             };
             let y0 = ty as u32 * TILE;
             let th = (view.height - y0).min(TILE);
@@ -344,20 +375,22 @@ pub(crate) fn draw_tiles<K: Kernel>(
                 // Depth pass over the bin in sphere order.
                 kernel.raster(recs, tile, &mut buf);
                 // Resolve pass: colour each covered pixel once.
-                for j in 0..th {
-                    let o = j as usize * w + x0 as usize;
-                    for i in 0..tw {
-                        let b = (j * TILE + i) as usize;
-                        let wv = buf.win[b];
-                        let (c, d) = if wv == NONE {
-                            (background, f32::INFINITY)
-                        } else {
-                            let rec = &recs[(wv & !FLAG_INSIDE) as usize];
-                            let d = buf.depth[b];
-                            (kernel.resolve(rec, x0 + i, y0 + j, d, wv & FLAG_INSIDE), d)
-                        };
-                        color[o + i as usize] = c;
-                        depth[o + i as usize] = d;
+                for j in 0..th as usize {
+                    let o = j * w + x0 as usize;
+                    let bw = j * TILE as usize;
+                    let win = &buf.win[bw..bw + tw as usize];
+                    let dep = &buf.depth[bw..bw + tw as usize];
+                    kernel.resolve_row(
+                        recs,
+                        x0,
+                        y0 + j as u32,
+                        win,
+                        dep,
+                        background,
+                        &mut color[o..o + tw as usize],
+                    );
+                    for ((d, &wv), &bd) in depth[o..o + tw as usize].iter_mut().zip(win).zip(dep) {
+                        *d = if wv == NONE { f32::INFINITY } else { bd };
                     }
                 }
             }

@@ -30,7 +30,11 @@ use glam::Vec3;
 use texmap_core::color::linear_to_srgb8;
 use texmap_core::shade::{Lighting, Material};
 
-use crate::pipeline::{FLAG_INSIDE, Kernel, Proj, Projected, TILE, TileBuf, TileRect, View, clip};
+use crate::fastshade::{self, Surf8, W};
+use crate::pipeline::{
+    FLAG_INSIDE, Kernel, LANES, NONE, Proj, Projected, TILE, TILE_BUF, TileBuf, TileRect, View,
+    clip,
+};
 
 /// Bounds of `x/(−z)` over the circle of radius `r` around `(a, b)` in a plane through the eye
 /// (`b` is the eye-space z of the centre): the tangent directions from the origin.
@@ -118,57 +122,114 @@ pub(crate) struct Perspective<'a> {
     pub materials: &'a [Material],
 }
 
-/// Intersect the eye ray `d` (with `d.z = −1`) with a record's sphere. Returns the depth and
-/// whether the far (inside) intersection was taken.
+/// Per-tile ray tables: `d = (dx[i], dy[j], −1)` and `1/|d|²` per pixel.
+struct RayTable {
+    dx: [f32; TILE as usize + LANES],
+    dy: [f32; TILE as usize],
+    inv_a: [f32; TILE_BUF],
+}
+
+impl RayTable {
+    fn new(v: &View, tile: TileRect) -> RayTable {
+        let mut t = RayTable {
+            dx: [0.0; TILE as usize + LANES],
+            dy: [0.0; TILE as usize],
+            inv_a: [0.0; TILE_BUF],
+        };
+        for (i, dx) in t.dx.iter_mut().enumerate() {
+            *dx = ((tile.x0 + i as u32) as f32 + 0.5 - v.cx) * v.inv_k;
+        }
+        for (j, dy) in t.dy.iter_mut().enumerate() {
+            *dy = (v.cy - ((tile.y0 + j as u32) as f32 + 0.5)) * v.inv_k;
+        }
+        for (p, ia) in t.inv_a.iter_mut().enumerate() {
+            let i = p % TILE as usize;
+            let j = (p / TILE as usize).min(TILE as usize - 1);
+            *ia = 1.0 / (t.dx[i] * t.dx[i] + t.dy[j] * t.dy[j] + 1.0);
+        }
+        t
+    }
+}
+
+/// Intersect the eye rays of 8 neighbouring pixels of one row with a record's sphere.
+///
+/// The ray `d = (dx, dy, −1)` has parameter = depth. With `s = (d·c)/|d|²` the parameter of the
+/// point nearest the centre and `v = c − s·d` the vector to it (pbrt's stable discriminant), the
+/// half chord is `sqrt((r² − |v|²)/|d|²)`, so `t = s ∓ sqrt((r² − |v|²)/|d|²)`: no division
+/// per pixel (`1/|d|²` comes from the tile table) and no cancellation for distant spheres.
+/// Returns the depths (`INFINITY` for a miss or a clipped hit) and the inside flags.
 #[inline(always)]
-fn hit_perspective(f: &[f32; 5], d: Vec3, near: f32, far: f32) -> Option<(f32, bool)> {
-    let c = Vec3::new(f[0], f[1], f[2]);
-    // Compute the stable discriminant from the centre-to-closest-point vector.
-    let a = d.length_squared();
-    let b = d.dot(c);
-    let v = c - d * (b / a);
-    let disc = a * (f[3] - v.length_squared());
-    if !(disc >= 0.0) {
-        return None;
+fn hit8(
+    f: &[f32; 5],
+    dx: &[f32],
+    dy: f32,
+    inv_a: &[f32],
+    near: f32,
+    far: f32,
+) -> ([f32; LANES], [u32; LANES]) {
+    let (cx, cy, cz, r2) = (f[0], f[1], f[2], f[3]);
+    let mut t = [f32::INFINITY; LANES];
+    let mut flag = [0u32; LANES];
+    let by = dy * cy - cz;
+    for l in 0..LANES {
+        let ia = inv_a[l];
+        let dxl = dx[l];
+        // Compute the closest point and the stable discriminant.
+        let s = (dxl * cx + by) * ia;
+        let vx = cx - dxl * s;
+        let vy = cy - dy * s;
+        let vz = cz + s;
+        let h2 = r2 - (vx * vx + vy * vy + vz * vz);
+        let hc = (if h2 > 0.0 { h2 } else { 0.0 } * ia).sqrt();
+        let tn = s - hc;
+        let tf = s + hc;
+        // Clip at the near plane: the near hit if in range, else the far (interior) one.
+        let inside = tn < near;
+        let th = if inside { tf } else { tn };
+        let ok = h2 >= 0.0 && th >= near && th <= far;
+        t[l] = if ok { th } else { f32::INFINITY };
+        flag[l] = if inside { FLAG_INSIDE } else { 0 };
     }
-    // Compute both roots without cancellation.
-    let q = b + disc.sqrt().copysign(b);
-    if q == 0.0 {
-        return None;
-    }
-    let t0 = f[4] / q;
-    let t1 = q / a;
-    let (tn, tf) = if t0 <= t1 { (t0, t1) } else { (t1, t0) };
-    // Clip at the near plane: the near hit if in range, else the far (interior) one.
-    if tn >= near && tn <= far {
-        Some((tn, false))
-    } else if tn < near && tf >= near && tf <= far {
-        Some((tf, true))
-    } else {
-        None
-    }
+    (t, flag)
 }
 
 impl Kernel for Perspective<'_> {
     fn raster(&self, recs: &[Proj], tile: TileRect, buf: &mut TileBuf) {
         let v = &self.view;
+        let rt = RayTable::new(v, tile);
         for (idx, p) in recs.iter().enumerate() {
             let Some((x0, y0, x1, y1)) = clip(p, tile) else {
                 continue;
             };
             for j in y0..y1 {
-                let dy = (v.cy - ((tile.y0 + j) as f32 + 0.5)) * v.inv_k;
                 let row = (j * TILE) as usize;
-                for i in x0..x1 {
-                    let dx = ((tile.x0 + i) as f32 + 0.5 - v.cx) * v.inv_k;
-                    let d = Vec3::new(dx, dy, -1.0);
-                    if let Some((t, inside)) = hit_perspective(&p.f, d, v.near, v.far) {
-                        let b = row + i as usize;
-                        if t < buf.depth[b] {
-                            buf.depth[b] = t;
-                            buf.win[b] = idx as u32 | if inside { FLAG_INSIDE } else { 0 };
+                let mut i = x0 as usize;
+                while i < x1 as usize {
+                    let b = row + i;
+                    let (mut t, flag) = hit8(
+                        &p.f,
+                        &rt.dx[i..i + LANES],
+                        rt.dy[j as usize],
+                        &rt.inv_a[b..b + LANES],
+                        v.near,
+                        v.far,
+                    );
+                    // Lanes past the box must not write.
+                    let valid = x1 as usize - i;
+                    for (l, tl) in t.iter_mut().enumerate() {
+                        if l >= valid {
+                            *tl = f32::INFINITY;
                         }
                     }
+                    // Depth test (strict: the earlier sphere wins ties).
+                    let depth = &mut buf.depth[b..b + LANES];
+                    let win = &mut buf.win[b..b + LANES];
+                    for l in 0..LANES {
+                        let closer = t[l] < depth[l];
+                        depth[l] = if closer { t[l] } else { depth[l] };
+                        win[l] = if closer { idx as u32 | flag[l] } else { win[l] };
+                    }
+                    i += LANES;
                 }
             }
         }
@@ -183,16 +244,74 @@ impl Kernel for Perspective<'_> {
         );
         let c = Vec3::new(rec.f[0], rec.f[1], rec.f[2]);
         // Exact normal at the hit point; flipped toward the viewer on the interior.
-        let mut n = (d * depth - c).normalize_or_zero();
+        let mut n = (d * depth - c) * (1.0 / rec.f[3].sqrt());
         if flags & FLAG_INSIDE != 0 {
             n = -n;
         }
-        let to_eye = -d.normalize();
+        let to_eye = d * -(1.0 / d.length());
         let m = &self.materials[rec.kind as usize];
-        linear_to_srgb8(self.lighting.shade(m, n, to_eye), 255)
+        linear_to_srgb8(fastshade::shade(&self.lighting, m, n, to_eye), 255)
+    }
+
+    fn resolve_row(
+        &self,
+        recs: &[Proj],
+        x0: u32,
+        y: u32,
+        win: &[u32],
+        depth: &[f32],
+        background: [u8; 4],
+        out: &mut [[u8; 4]],
+    ) {
+        let v = &self.view;
+        let dy = (v.cy - (y as f32 + 0.5)) * v.inv_k;
+        let mut i0 = 0;
+        while i0 < out.len() {
+            let n = (out.len() - i0).min(W);
+            // Gather the winners' hit points into lanes.
+            let mut s = Surf8::default();
+            for l in 0..W {
+                let i = i0 + l;
+                let (rec, t, fl) = if l < n && win[i] != NONE {
+                    (
+                        &recs[(win[i] & !FLAG_INSIDE) as usize],
+                        depth[i],
+                        win[i] & FLAG_INSIDE,
+                    )
+                } else {
+                    (&recs[0], 0.0, 0)
+                };
+                let dx = ((x0 + i as u32) as f32 + 0.5 - v.cx) * v.inv_k;
+                let m = &self.materials[rec.kind as usize];
+                let inv_r = 1.0 / rec.f[3].sqrt();
+                let sign = if fl != 0 { -inv_r } else { inv_r };
+                // Exact normal at the hit point; flipped toward the viewer on the interior.
+                s.n[0][l] = (dx * t - rec.f[0]) * sign;
+                s.n[1][l] = (dy * t - rec.f[1]) * sign;
+                s.n[2][l] = (-t - rec.f[2]) * sign;
+                let id = 1.0 / (dx * dx + dy * dy + 1.0).sqrt();
+                s.v[0][l] = -dx * id;
+                s.v[1][l] = -dy * id;
+                s.v[2][l] = id;
+                for k in 0..3 {
+                    s.base[k][l] = m.base_color[k];
+                }
+                s.spec[l] = m.specular;
+                s.shin[l] = m.shininess;
+            }
+            let c = fastshade::shade8(&self.lighting, &s);
+            for l in 0..n {
+                let i = i0 + l;
+                out[i] = if win[i] == NONE {
+                    background
+                } else {
+                    linear_to_srgb8(Vec3::new(c[0][l], c[1][l], c[2][l]), 255)
+                };
+            }
+            i0 += W;
+        }
     }
 }
-
 /// Ray-cast kernel, orthographic camera (parallel rays along −z).
 pub(crate) struct Orthographic<'a> {
     pub view: View,
@@ -251,6 +370,6 @@ impl Kernel for Orthographic<'_> {
             n = -n;
         }
         let m = &self.materials[rec.kind as usize];
-        linear_to_srgb8(self.lighting.shade(m, n, Vec3::Z), 255)
+        linear_to_srgb8(fastshade::shade(&self.lighting, m, n, Vec3::Z), 255)
     }
 }
