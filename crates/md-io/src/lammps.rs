@@ -29,7 +29,7 @@ use crate::elements::{Element, guess_element};
 use crate::error::Error;
 use crate::frame::{Frame, Label, UnitCell};
 use crate::parse::{fields, parse_f32, parse_f64, parse_i64, parse_usize, trim};
-use crate::text::{Ctx, LineReader, Pos, TextFormat};
+use crate::text::{Ctx, LineReader, MAX_RESERVE, Pos, TextFormat};
 use std::io::Read;
 
 /// What one atom column is read into.
@@ -350,7 +350,7 @@ impl TextFormat for Lammps {
         } else {
             1.0
         };
-        frame.positions.reserve(h.n);
+        frame.positions.reserve(h.n.min(MAX_RESERVE));
         // Atom lines: one pass over each line's fields with the column actions.
         for i in 0..h.n {
             let p = lines.pos();

@@ -15,6 +15,10 @@ use crate::frame::Frame;
 use std::io::{Read, Seek, SeekFrom};
 use std::sync::Arc;
 
+/// Most atoms a reader reserves room for from a count in the file before seeing the atoms: a
+/// corrupt count must not make a huge allocation; larger frames grow as they are read.
+pub(crate) const MAX_RESERVE: usize = 1 << 16;
+
 /// Size of the chunk lines are split from.
 const CHUNK: usize = 1 << 20;
 

@@ -1,0 +1,179 @@
+//! Damaged text files built from the good ones in tests/data: cut at every byte (so at every
+//! line boundary and inside every line) and with bytes replaced at every position. Nothing may
+//! panic; every frame that ends before the damage reads back unchanged; an error names the file,
+//! the frame and the line and byte.
+//!
+//! Frame boundaries are found here independently of the readers, from each format's markers.
+
+use std::io::Cursor;
+use std::path::PathBuf;
+use texmap_md_io::{Error, Format, Frame, Trajectory};
+
+const FILES: [(&str, Format); 7] = [
+    ("ase_ext.xyz", Format::Xyz),
+    ("ase_plain.xyz", Format::Xyz),
+    ("mda_multi.pdb", Format::Pdb),
+    ("mda_vel.gro", Format::Gro),
+    ("py_prec5.gro", Format::Gro),
+    ("lmp_tri.lammpstrj", Format::LammpsDump),
+    ("lmp_scaled.lammpstrj", Format::LammpsDump),
+];
+
+fn data(name: &str) -> Vec<u8> {
+    std::fs::read(
+        PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/data")
+            .join(name),
+    )
+    .unwrap()
+}
+
+/// Byte offsets where each frame's text ends, from the format's markers.
+fn frame_ends(bytes: &[u8], format: Format) -> Vec<usize> {
+    let text = std::str::from_utf8(bytes).unwrap();
+    let mut line_starts = vec![0];
+    for (i, b) in bytes.iter().enumerate() {
+        if *b == b'\n' {
+            line_starts.push(i + 1);
+        }
+    }
+    let lines: Vec<&str> = text.split_inclusive('\n').collect();
+    let mut ends = Vec::new();
+    match format {
+        Format::Xyz | Format::Gro => {
+            // XYZ: count line, comment, n atoms. GRO: title, count, n atoms, box.
+            let mut l = 0;
+            while l < lines.len() {
+                let (count_line, extra) = if format == Format::Xyz {
+                    (l, 2)
+                } else {
+                    (l + 1, 3)
+                };
+                let n: usize = lines[count_line].trim().parse().unwrap();
+                l += n + extra;
+                ends.push(line_starts[l]);
+            }
+        }
+        Format::Pdb => {
+            for (k, l) in lines.iter().enumerate() {
+                if l.starts_with("ENDMDL") {
+                    ends.push(line_starts[k + 1]);
+                }
+            }
+        }
+        Format::LammpsDump => {
+            let mut starts: Vec<usize> = lines
+                .iter()
+                .enumerate()
+                .filter(|(_, l)| l.starts_with("ITEM: TIMESTEP"))
+                .map(|(k, _)| line_starts[k])
+                .collect();
+            starts.remove(0);
+            starts.push(bytes.len());
+            ends = starts;
+        }
+        _ => unreachable!(),
+    }
+    ends
+}
+
+/// Reads until the end or the first error; returns the frames and the error.
+fn read_all(bytes: &[u8], format: Format) -> (Vec<Frame>, Option<Error>) {
+    let mut t = Trajectory::from_reader(Cursor::new(bytes.to_vec()), format, "damaged").unwrap();
+    let mut out = Vec::new();
+    let mut f = Frame::new();
+    loop {
+        match t.read_next(&mut f) {
+            Ok(true) => out.push(f.clone()),
+            Ok(false) => return (out, None),
+            Err(e) => return (out, Some(e)),
+        }
+        assert!(out.len() < 100, "reader does not stop");
+    }
+}
+
+fn check_error_names_the_place(e: &Error, frames_before: usize) {
+    let msg = e.to_string();
+    assert!(msg.starts_with("damaged: frame "), "{msg}");
+    let loc = e
+        .location()
+        .unwrap_or_else(|| panic!("no location in {msg}"));
+    assert_eq!(loc.frame, Some(frames_before), "{msg}");
+    assert!(loc.line.is_some() && loc.byte.is_some(), "{msg}");
+    assert!(msg.contains("line ") && msg.contains("byte "), "{msg}");
+}
+
+#[test]
+fn cut_at_every_byte_keeps_the_frames_before_the_cut() {
+    for (name, format) in FILES {
+        let good = data(name);
+        let (all, err) = read_all(&good, format);
+        assert!(err.is_none(), "{name}: {err:?}");
+        let ends = frame_ends(&good, format);
+        assert_eq!(ends.len(), all.len(), "{name}: frame count");
+        for cut in 0..good.len() {
+            let (got, err) = read_all(&good[..cut], format);
+            let complete = ends.iter().filter(|e| **e <= cut).count();
+            assert!(
+                got.len() >= complete,
+                "{name} cut at {cut}: {} frames, {complete} complete",
+                got.len()
+            );
+            // Every frame complete before the cut is unchanged.
+            for k in 0..complete {
+                assert_eq!(got[k], all[k], "{name} cut at {cut}: frame {k}");
+            }
+            if let Some(e) = err {
+                check_error_names_the_place(&e, got.len());
+            }
+        }
+    }
+}
+
+#[test]
+fn replaced_bytes_never_panic_and_keep_earlier_frames() {
+    for (name, format) in FILES {
+        let good = data(name);
+        let (all, _) = read_all(&good, format);
+        let ends = frame_ends(&good, format);
+        for at in 0..good.len() {
+            for junk in [b'x', b'\n', b' ', 0xff] {
+                let mut bad = good.clone();
+                bad[at] = junk;
+                let (got, err) = read_all(&bad, format);
+                // Frames that end before the damaged byte read back unchanged.
+                let before = ends.iter().filter(|e| **e <= at).count();
+                assert!(
+                    got.len() >= before,
+                    "{name} byte {at} -> {junk}: {} < {before}",
+                    got.len()
+                );
+                for k in 0..before {
+                    assert_eq!(got[k], all[k], "{name} byte {at} -> {junk}: frame {k}");
+                }
+                if let Some(e) = err {
+                    check_error_names_the_place(&e, got.len());
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn error_after_good_frames_then_random_access_still_reaches_them() {
+    // Cut the 3-frame PDB inside the last model: frames 0 and 1 stay reachable by index.
+    let good = data("mda_multi.pdb");
+    let ends = frame_ends(&good, Format::Pdb);
+    let cut = &good[..ends[1] + 100];
+    let mut t = Trajectory::from_reader(Cursor::new(cut.to_vec()), Format::Pdb, "cut.pdb").unwrap();
+    let e = t.n_frames().unwrap_err();
+    assert!(matches!(e, Error::Truncated { .. }), "{e}");
+    assert!(e.to_string().starts_with("cut.pdb: frame 2, line "), "{e}");
+    let mut f = Frame::new();
+    t.read_frame(1, &mut f).unwrap();
+    let (all, _) = read_all(&good, Format::Pdb);
+    assert_eq!(f, all[1]);
+    t.read_frame(0, &mut f).unwrap();
+    assert_eq!(f, all[0]);
+    assert!(t.read_frame(2, &mut f).is_err());
+}
