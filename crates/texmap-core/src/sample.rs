@@ -155,7 +155,25 @@ impl Addr for ClampEdge {
 /// Clamp a texel coordinate to ±2^30; NaN becomes −2^30 (then the weights stay finite).
 #[inline(always)]
 fn clampc(x: f32) -> f32 {
-    x.max(-COORD_LIMIT).min(COORD_LIMIT)
+    // Plain comparisons (a NaN fails the first and becomes −2^30): cheaper than f32::max/min.
+    let x = if x >= -COORD_LIMIT { x } else { -COORD_LIMIT };
+    if x <= COORD_LIMIT { x } else { COORD_LIMIT }
+}
+
+/// `log2 x` split into its integer part `⌊log2 x⌋` (exact, from the exponent) and an approximate
+/// fraction in `[0, 1]`: a degree-4 polynomial in the mantissa `t = x/2^e − 1` with `p(0) = 0`,
+/// `p(1) = 1` (continuous across octaves), fitted to `log2(1 + t)` with max error 1.2e-4 (tested).
+/// For positive normal `x` only; the callers route 0, NaN and subnormals elsewhere.
+#[inline(always)]
+fn log2_split(x: f32) -> (i32, f32) {
+    let bits = x.to_bits();
+    let e = ((bits >> 23) & 0xff) as i32 - 127;
+    let t = f32::from_bits((bits & 0x007f_ffff) | 0x3f80_0000) - 1.0;
+    const C1: f32 = 1.438_725_7;
+    const C2: f32 = -0.677_783_9;
+    const C3: f32 = 0.321_188_76;
+    const C4: f32 = 1.0 - C1 - C2 - C3;
+    (e, t * (C1 + t * (C2 + t * (C3 + t * C4))))
 }
 
 /// ⌊x⌋ for |x| ≤ 2^30 (finite): truncate, then step down for negative fractions.
@@ -165,13 +183,6 @@ fn floor_i32(x: f32) -> i32 {
     // SAFETY: callers pass finite values clamped to ±2^30, which fit in i32.
     let t: i32 = unsafe { x.to_int_unchecked() };
     t - ((t as f32 > x) as i32)
-}
-
-/// Exact ⌊log2 x⌋ for positive normal x from the float exponent; −127 for 0 and subnormals,
-/// 128 for infinity.
-#[inline(always)]
-fn floor_log2(x: f32) -> i32 {
-    ((x.to_bits() >> 23) & 0xff) as i32 - 127
 }
 
 #[inline(always)]
@@ -216,17 +227,43 @@ fn bilinear<A: Addr>(texels: &[Vec4], l: &LevelInfo, uv: Vec2) -> Vec4 {
     lerp(lerp(t00, t10, ax), lerp(t01, t11, ax), ay)
 }
 
-/// λ (larger = coarser, level-0 texels) from Eq. (2)'s max of the four partial derivatives.
-/// NaN or zero derivatives give −∞ (level 0).
+/// Eq. (2)'s max of the four partial derivatives, in level-0 texels per pixel: `λ = log2` of it.
+#[inline(always)]
+fn footprint(l0: &LevelInfo, duv_dx: Vec2, duv_dy: Vec2) -> f32 {
+    let s = Vec2::new(l0.width_f, l0.height_f);
+    (duv_dx * s).abs().max((duv_dy * s).abs()).max_element()
+}
+
+/// λ (larger = coarser) of a footprint; NaN or zero give −∞ (level 0). Exact `log2`, for the
+/// reference sampler.
 #[inline(always)]
 fn lambda(l0: &LevelInfo, duv_dx: Vec2, duv_dy: Vec2) -> f32 {
-    let s = Vec2::new(l0.width_f, l0.height_f);
-    let m = (duv_dx * s).abs().max((duv_dy * s).abs()).max_element();
+    let m = footprint(l0, duv_dx, duv_dy);
     if m > 0.0 { m.log2() } else { f32::NEG_INFINITY }
 }
 
 /// Seed 000 Eq. (4): blend the bilinear samples of levels ⌊λ⌋ and ⌊λ⌋+1 by frac(λ), clamped to the
-/// pyramid.
+/// pyramid; `m` is the footprint in level-0 texels (λ = log2 m, split by [`log2_split`]).
+#[inline(always)]
+fn trilinear_fp<A: Addr>(tex: &MipTexture, uv: Vec2, m: f32) -> Vec4 {
+    let levels = tex.levels();
+    let texels = tex.texels();
+    let last = levels.len() - 1;
+    // Magnification (λ ≤ 0), zero or NaN footprint: level 0 alone.
+    if !(m > 1.0) {
+        return bilinear::<A>(texels, &levels[0], uv);
+    }
+    let (i, f) = log2_split(m);
+    let i = i as usize;
+    if i >= last {
+        return bilinear::<A>(texels, &levels[last], uv);
+    }
+    let a = bilinear::<A>(texels, &levels[i], uv);
+    let b = bilinear::<A>(texels, &levels[i + 1], uv);
+    lerp(a, b, f)
+}
+
+/// [`trilinear_fp`] at an explicit λ (used by the anisotropic reference's taps).
 #[inline(always)]
 fn trilinear<A: Addr>(tex: &MipTexture, uv: Vec2, lam: f32) -> Vec4 {
     let levels = tex.levels();
@@ -275,12 +312,12 @@ fn anisotropic<A: Addr>(
 // ---------------------------------------------------------------------------------------------
 // Span sampler (Seed 000 §3).
 
-/// A K x K texel window (K ≤ 4), `w[row][col]`.
-type Window = [[Vec4; 4]; 4];
-
 /// Where a span's K x K windows come from: the row-major pyramid (fast path) or the bank
-/// emulator (counts reads and conflicts).
+/// emulator (counts reads and conflicts). The per-pixel arithmetic is shared, so both give the
+/// same bits.
 trait WindowSource {
+    /// A fetched window.
+    type Win;
     /// The window whose corner is texel `(x0, y0)` of `level` (any integers; wrapped).
     fn window<A: Addr, const K: usize>(
         &mut self,
@@ -288,15 +325,30 @@ trait WindowSource {
         level: usize,
         x0: i32,
         y0: i32,
-    ) -> Window;
+    ) -> Self::Win;
+    /// Texels `(ox, oy), (ox+1, oy), (ox, oy+1), (ox+1, oy+1)` of a fetched window
+    /// (offsets from its corner, `ox, oy ≤ K − 2`).
+    fn quad(tex: &MipTexture, win: &Self::Win, ox: usize, oy: usize) -> [Vec4; 4];
     /// A texel access fell outside the window.
     fn conflict(&mut self);
 }
 
-/// Fast path: gather the window from the row-major level (K wrapped columns, K wrapped rows).
+/// Fast path: a window inside the level is just its corner index in the row-major level (pixels
+/// read `corner + oy·w + ox`, no wrap); a window crossing an edge keeps K wrapped column indices
+/// and K wrapped row starts. Either way no texel is copied.
 struct Direct;
 
+/// A window of the fast path.
+struct DirectWin {
+    /// Index of the corner texel when the window lies inside the level, else `usize::MAX`.
+    corner: usize,
+    width: usize,
+    cols: [usize; 4],
+    rows: [usize; 4],
+}
+
 impl WindowSource for Direct {
+    type Win = DirectWin;
     #[inline(always)]
     fn window<A: Addr, const K: usize>(
         &mut self,
@@ -304,29 +356,96 @@ impl WindowSource for Direct {
         level: usize,
         x0: i32,
         y0: i32,
-    ) -> Window {
+    ) -> DirectWin {
         let l = &tex.levels()[level];
-        let texels = tex.texels();
         let (w, h) = (l.width as i32, l.height as i32);
+        let k = K as i32;
+        if x0 >= 0 && y0 >= 0 && x0 + k <= w && y0 + k <= h {
+            return DirectWin {
+                corner: l.offset + (y0 * w + x0) as usize,
+                width: w as usize,
+                cols: [0; 4],
+                rows: [0; 4],
+            };
+        }
         let mut cols = [0usize; 4];
-        for (o, c) in cols.iter_mut().enumerate().take(K) {
-            *c = A::wrap(x0 + o as i32, w) as usize;
+        let mut rows = [l.offset; 4];
+        for o in 0..K {
+            cols[o] = A::wrap(x0 + o as i32, w) as usize;
+            rows[o] = l.offset + (A::wrap(y0 + o as i32, h) * w) as usize;
         }
-        let mut win = [[Vec4::ZERO; 4]; 4];
-        for (o, row) in win.iter_mut().enumerate().take(K) {
-            let r = l.offset + (A::wrap(y0 + o as i32, h) * w) as usize;
-            for (t, &c) in row.iter_mut().zip(cols.iter()).take(K) {
-                *t = texel(texels, r + c);
-            }
+        DirectWin {
+            corner: usize::MAX,
+            width: w as usize,
+            cols,
+            rows,
         }
-        win
+    }
+    #[inline(always)]
+    fn quad(tex: &MipTexture, win: &DirectWin, ox: usize, oy: usize) -> [Vec4; 4] {
+        let t = tex.texels();
+        if win.corner != usize::MAX {
+            let i = win.corner + oy * win.width + ox;
+            [
+                texel(t, i),
+                texel(t, i + 1),
+                texel(t, i + win.width),
+                texel(t, i + win.width + 1),
+            ]
+        } else {
+            let (c0, c1) = (win.cols[ox & 3], win.cols[(ox + 1) & 3]);
+            let (r0, r1) = (win.rows[oy & 3], win.rows[(oy + 1) & 3]);
+            [
+                texel(t, r0 + c0),
+                texel(t, r0 + c1),
+                texel(t, r1 + c0),
+                texel(t, r1 + c1),
+            ]
+        }
     }
     #[inline(always)]
     fn conflict(&mut self) {}
 }
 
+/// `(⌊v⌋, ⌊v⌋ as i32)` per lane for finite lanes with `|v| ≤ 2^30`: truncate, then step down
+/// where truncation rounded up. SSE2 (baseline on x86_64) converts four lanes at once; other
+/// targets use the scalar [`floor_i32`]. Both give the same values.
+#[inline(always)]
+fn floor4(v: Vec4) -> (Vec4, [i32; 4]) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use core::arch::x86_64::{__m128, _mm_cvtepi32_ps, _mm_cvttps_epi32};
+        // SAFETY: SSE2 is part of the x86_64 baseline; lanes are finite and within i32.
+        let (t, tf) = unsafe {
+            let m: __m128 = v.into();
+            let t = _mm_cvttps_epi32(m);
+            (t, Vec4::from(_mm_cvtepi32_ps(t)))
+        };
+        // SAFETY: __m128i and [i32; 4] have the same size and no invalid bit patterns.
+        let ti: [i32; 4] = unsafe { core::mem::transmute(t) };
+        let down = tf.cmpgt(v);
+        let fl = Vec4::select(down, tf - Vec4::ONE, tf);
+        let bits = down.bitmask();
+        let ti = [0, 1, 2, 3].map(|j| ti[j] - ((bits >> j) & 1) as i32);
+        (fl, ti)
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        let ti = v.to_array().map(floor_i32);
+        (Vec4::from(ti.map(|t| t as f32)), ti)
+    }
+}
+
+/// Replace NaN lanes by 0 and clamp to ±2^30.
+#[inline(always)]
+fn clamp4(v: Vec4) -> Vec4 {
+    Vec4::select(v.cmpeq(v), v, Vec4::ZERO)
+        .max(Vec4::splat(-COORD_LIMIT))
+        .min(Vec4::splat(COORD_LIMIT))
+}
+
 /// One span: Eq. (8)'s four pixel images `uv`, Eq. (9)'s level, Eq. (10)'s windows, Eq. (4)'s
-/// per-pixel blend.
+/// per-pixel blend. The four pixels travel as the four lanes of a `Vec4`.
 #[inline(always)]
 fn span_quad<A: Addr, S: WindowSource, const K: usize>(
     tex: &MipTexture,
@@ -336,28 +455,21 @@ fn span_quad<A: Addr, S: WindowSource, const K: usize>(
     let levels = tex.levels();
     let l0 = &levels[0];
     let last = levels.len() - 1;
-    // Level-0 texel coordinates (no half-texel offset yet), clamped; NaN -> −2^30.
-    let mut sx = uv.map(|p| clampc(p.x * l0.width_f));
-    let mut sy = uv.map(|p| clampc(p.y * l0.height_f));
-    let min4 = |a: [f32; 4]| a[0].min(a[1]).min(a[2].min(a[3]));
-    let max4 = |a: [f32; 4]| a[0].max(a[1]).max(a[2].max(a[3]));
+    // Level-0 texel coordinates (no half-texel offset yet), one lane per pixel; NaN -> 0.
+    let mut sx = clamp4(Vec4::new(uv[0].x, uv[1].x, uv[2].x, uv[3].x) * l0.width_f);
+    let mut sy = clamp4(Vec4::new(uv[0].y, uv[1].y, uv[2].y, uv[3].y) * l0.height_f);
     // Repeat: shift the whole span by whole periods so its corner lies in the first period.
     if A::REPEAT {
-        let px = floor_i32(min4(sx) / l0.width_f) as f32 * l0.width_f;
-        let py = floor_i32(min4(sy) / l0.height_f) as f32 * l0.height_f;
-        sx = sx.map(|v| v - px);
-        sy = sy.map(|v| v - py);
+        let px = floor_i32(sx.min_element() / l0.width_f) as f32 * l0.width_f;
+        let py = floor_i32(sy.min_element() / l0.height_f) as f32 * l0.height_f;
+        sx -= Vec4::splat(px);
+        sy -= Vec4::splat(py);
     }
     // Seed 000 Eq. (9): span level from the extent of the four images (level-0 texels).
-    let ext = (max4(sx) - min4(sx)).max(max4(sy) - min4(sy));
+    let ext = (sx.max_element() - sx.min_element()).max(sy.max_element() - sy.min_element());
     let shift = if K == 3 { 1 } else { 0 };
-    // Exact ⌊λ⌋ from the exponent; frac(λ) from log2, kept in [0, 1).
-    let e = floor_log2(ext);
-    let frac = if ext > 0.0 {
-        (ext.log2() - e as f32).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
+    // Exact ⌊λ⌋ from the exponent (0 and subnormals give −127), frac(λ) from the mantissa.
+    let (e, frac) = log2_split(ext);
     let fine = e + shift;
     // Clamp the level pair to the pyramid.
     let (i0, i1, t) = if fine < 0 {
@@ -385,40 +497,38 @@ fn span_quad<A: Addr, S: WindowSource, const K: usize>(
 fn span_level<A: Addr, S: WindowSource, const K: usize>(
     tex: &MipTexture,
     level: usize,
-    sx: [f32; 4],
-    sy: [f32; 4],
+    sx: Vec4,
+    sy: Vec4,
     src: &mut S,
 ) -> [Vec4; 4] {
     let l = &tex.levels()[level];
-    let (w, h) = (l.width as i32, l.height as i32);
     // This level's texel coordinates, texel centres at integers (Eq. 3 applied to 2^L r_m − ½).
-    let mut x = sx.map(|v| v * l.scale_x - 0.5);
-    let mut y = sy.map(|v| v * l.scale_y - 0.5);
+    let mut x = sx * l.scale_x - Vec4::splat(0.5);
+    let mut y = sy * l.scale_y - Vec4::splat(0.5);
     if !A::REPEAT {
         // Clamp-to-edge bilinear equals bilinear at the clamped coordinate.
-        x = x.map(|v| v.max(0.0).min(l.width_f - 1.0));
-        y = y.map(|v| v.max(0.0).min(l.height_f - 1.0));
+        x = x.max(Vec4::ZERO).min(Vec4::splat(l.width_f - 1.0));
+        y = y.max(Vec4::ZERO).min(Vec4::splat(l.height_f - 1.0));
     }
-    let fx = x.map(floor_i32);
-    let fy = y.map(floor_i32);
+    let (flx, fx) = floor4(x);
+    let (fly, fy) = floor4(y);
+    let (ax, ay) = (x - flx, y - fly);
     let x0 = fx[0].min(fx[1]).min(fx[2].min(fx[3]));
     let y0 = fy[0].min(fy[1]).min(fy[2].min(fy[3]));
     // Seed 000 Eq. (10): one parallel read of the K x K window at corner (x0, y0).
     let win = src.window::<A, K>(tex, level, x0, y0);
+    let lim = K as i32 - 2;
     let mut out = [Vec4::ZERO; 4];
     for j in 0..4 {
-        let mut ox = fx[j] - x0;
-        let mut oy = fy[j] - y0;
-        let (ax, ay) = (x[j] - fx[j] as f32, y[j] - fy[j] as f32);
-        let lim = K as i32 - 2;
+        let (mut ox, mut oy) = (fx[j] - x0, fy[j] - y0);
         if ox > lim || oy > lim {
             // Fold repeat-wrapped offsets on narrow levels back into the window (same texel).
             if A::REPEAT {
                 if ox > lim {
-                    ox = ox.rem_euclid(w);
+                    ox = ox.rem_euclid(l.width as i32);
                 }
                 if oy > lim {
-                    oy = oy.rem_euclid(h);
+                    oy = oy.rem_euclid(l.height as i32);
                 }
             }
             if ox > lim || oy > lim {
@@ -432,14 +542,8 @@ fn span_level<A: Addr, S: WindowSource, const K: usize>(
                 continue;
             }
         }
-        let (ox, oy) = (ox as usize, oy as usize);
-        let r0 = &win[oy];
-        let r1 = &win[oy + 1];
-        out[j] = lerp(
-            lerp(r0[ox], r0[ox + 1], ax),
-            lerp(r1[ox], r1[ox + 1], ax),
-            ay,
-        );
+        let [t00, t10, t01, t11] = S::quad(tex, &win, ox as usize, oy as usize);
+        out[j] = lerp(lerp(t00, t10, ax[j]), lerp(t01, t11, ax[j]), ay[j]);
     }
     out
 }
@@ -507,7 +611,7 @@ impl Sampler {
         match *self {
             Sampler::Nearest => nearest::<A>(tex.texels(), l0, uv),
             Sampler::Bilinear => bilinear::<A>(tex.texels(), l0, uv),
-            Sampler::Trilinear => trilinear::<A>(tex, uv, lambda(l0, duv_dx, duv_dy)),
+            Sampler::Trilinear => trilinear_fp::<A>(tex, uv, footprint(l0, duv_dx, duv_dy)),
             Sampler::Span(Banks::K3) => {
                 span_quad::<A, Direct, 3>(tex, quad_from_pixel(uv, duv_dx, duv_dy), &mut Direct)[0]
             }
@@ -588,7 +692,11 @@ impl Sampler {
                 Sampler::Nearest => run!(A, |p, _, _| nearest::<A>(texels, l0, p)),
                 Sampler::Bilinear => run!(A, |p, _, _| bilinear::<A>(texels, l0, p)),
                 Sampler::Trilinear => {
-                    run!(A, |p, dx, dy| trilinear::<A>(tex, p, lambda(l0, dx, dy)))
+                    run!(A, |p, dx, dy| trilinear_fp::<A>(
+                        tex,
+                        p,
+                        footprint(l0, dx, dy)
+                    ))
                 }
                 s => run!(A, |p, dx, dy| s.sample_one::<A>(tex, p, dx, dy)),
             }
@@ -717,13 +825,14 @@ struct BankSource<'a> {
 }
 
 impl WindowSource for BankSource<'_> {
+    type Win = [[Vec4; 4]; 4];
     fn window<A: Addr, const K: usize>(
         &mut self,
         tex: &MipTexture,
         level: usize,
         x0: i32,
         y0: i32,
-    ) -> Window {
+    ) -> Self::Win {
         let l = &tex.levels()[level];
         let bl = &self.bt.levels[level];
         // Reduce the corner into the level (the window never wraps in the padded bank space).
@@ -754,6 +863,14 @@ impl WindowSource for BankSource<'_> {
         }
         win
     }
+    fn quad(_tex: &MipTexture, win: &Self::Win, ox: usize, oy: usize) -> [Vec4; 4] {
+        [
+            win[oy][ox],
+            win[oy][ox + 1],
+            win[oy + 1][ox],
+            win[oy + 1][ox + 1],
+        ]
+    }
     fn conflict(&mut self) {
         self.stats.conflicts += 1;
     }
@@ -769,6 +886,24 @@ mod tests {
             .map(|i| Vec4::new((i % w) as f32, (i / w) as f32, 1.0, 1.0))
             .collect();
         MipTexture::from_linear(w, h, &data, Reduction::GammaCorrect, wrap).unwrap()
+    }
+
+    #[test]
+    fn log2_split_is_exact_in_its_integer_part_and_close_in_its_fraction() {
+        let mut worst = 0f64;
+        let mut prev = f64::NEG_INFINITY;
+        for i in 0..200_000 {
+            let x = 2f32.powf(-20.0 + 40.0 * i as f32 / 200_000.0);
+            let (e, f) = log2_split(x);
+            let exact = (x as f64).log2();
+            assert_eq!(e, exact.floor() as i32, "x = {x}");
+            assert!((0.0..=1.0).contains(&f), "x = {x}: fraction {f}");
+            let got = e as f64 + f as f64;
+            worst = worst.max((got - exact).abs());
+            assert!(got >= prev, "not monotone at {x}");
+            prev = got;
+        }
+        assert!(worst < 1.3e-4, "expected |error| < 1.3e-4, worst {worst}");
     }
 
     #[test]
