@@ -1,11 +1,10 @@
 //! Binning primitives into screen tiles: count, prefix sum, fill.
 //!
-//! The primitive pass (parallel over fixed-size chunks, so the result does not depend on the
-//! thread count) writes one packed tile rectangle per primitive and counts, per chunk, how many
-//! entries each tile receives. The fill pass then writes each primitive's entry into every tile it
-//! overlaps, in primitive order, so each tile sees its primitives in submission order.
-//!
-//! An entry is a `u32`: a primitive index, or `PIECE | i` for clipped piece `i` of the draw.
+//! The count pass (parallel over fixed-size chunks, so the result does not depend on the thread
+//! count) writes one packed tile rectangle per primitive and counts, per chunk, how many records
+//! each tile receives. A prefix sum reserves a slot range per (chunk, tile); the fill pass (also
+//! parallel over chunks) copies each primitive's record into every tile it overlaps, so every tile
+//! holds its primitives in submission order.
 
 use crate::framebuffer::{Grid, TILE_SHIFT};
 
@@ -17,8 +16,6 @@ pub(crate) const RECT_EMPTY: u32 = 1;
 /// Rectangle value: the primitive was clipped; its pieces carry their own rectangles
 /// (x0 = 2 > x1 = 0, impossible for a real rectangle).
 pub(crate) const RECT_CLIPPED: u32 = 2;
-/// Entry bit marking a clipped piece.
-pub(crate) const PIECE: u32 = 1 << 31;
 
 /// Pack the tiles overlapped by the inclusive pixel rectangle (x0..=x1, y0..=y1), which must lie
 /// inside the image. Tile indices fit in 8 bits (16384 / 64 = 256).
@@ -64,82 +61,127 @@ impl<P> ChunkBins<P> {
     }
 }
 
-/// Per-tile entry lists: tile `t` owns `entries[starts[t]..starts[t + 1]]`.
-#[derive(Default)]
-pub(crate) struct Bins {
+/// Per-tile lists of copied primitive records: tile `t` owns `items[starts[t]..starts[t + 1]]`.
+///
+/// Records are copied into the bins rather than referenced by index: the tile pass then reads its
+/// primitives as one sequential stream instead of gathering vertices from all over memory (with
+/// indices, 1M scattered small triangles spent ~80% of their time in two cache-missing loads).
+pub(crate) struct Bins<T> {
     pub starts: Vec<u32>,
-    pub entries: Vec<u32>,
+    pub items: Vec<T>,
+    cursors: Vec<u32>,
+    ends: Vec<u32>,
 }
 
-impl Bins {
+impl<T> Default for Bins<T> {
+    fn default() -> Self {
+        Bins {
+            starts: Vec::new(),
+            items: Vec::new(),
+            cursors: Vec::new(),
+            ends: Vec::new(),
+        }
+    }
+}
+
+/// A raw pointer to the bins' storage, shared by the fill workers (see [`Emitter::put`]).
+#[derive(Clone, Copy)]
+struct SyncPtr<T>(*mut T);
+// SAFETY: workers write through the pointer only into disjoint, bounds-checked ranges.
+unsafe impl<T: Send> Send for SyncPtr<T> {}
+unsafe impl<T: Send> Sync for SyncPtr<T> {}
+
+/// Writes one chunk's records into its reserved slots of every tile.
+pub(crate) struct Emitter<'a, T> {
+    ptr: SyncPtr<T>,
+    cur: &'a mut [u32],
+    end: &'a [u32],
+    tiles_x: u32,
+}
+
+impl<T> Emitter<'_, T> {
+    /// Append `item` to every tile of the packed rectangle `rect`.
     #[inline]
-    pub fn tile(&self, t: usize) -> &[u32] {
-        &self.entries[self.starts[t] as usize..self.starts[t + 1] as usize]
+    pub fn put(&mut self, rect: u32, item: T)
+    where
+        T: Copy,
+    {
+        let (tx0, ty0, tx1, ty1) = unpack_rect(rect);
+        for ty in ty0..=ty1 {
+            let row = (ty * self.tiles_x) as usize;
+            for tx in tx0..=tx1 {
+                let t = row + tx as usize;
+                let c = self.cur[t];
+                // Stay inside this chunk's reserved range of tile t (the count pass reserved
+                // exactly what the fill pass puts; a mismatch would be a bug, never a race).
+                if c < self.end[t] {
+                    // SAFETY: `c` lies in [start, end) of the range reserved for this
+                    // (chunk, tile) pair; the ranges of all pairs are disjoint and inside
+                    // `items` (see `Bins::fill`), so no other worker writes this slot.
+                    unsafe { self.ptr.0.add(c as usize).write(item) };
+                    self.cur[t] = c + 1;
+                } else {
+                    debug_assert!(false, "fill put more records than were counted");
+                }
+            }
+        }
+    }
+}
+
+impl<T: Copy + Default + Send + Sync> Bins<T> {
+    #[inline]
+    pub fn tile(&self, t: usize) -> &[T] {
+        &self.items[self.starts[t] as usize..self.starts[t + 1] as usize]
     }
 
-    /// Fill from the per-primitive rectangles and the chunks' counts and pieces (`piece_rect`
-    /// reads a piece's rectangle, `piece_prim` its source primitive).
-    pub fn fill<P>(
-        &mut self,
-        grid: &Grid,
-        rects: &[u32],
-        chunks: &[ChunkBins<P>],
-        piece_rect: impl Fn(&P) -> u32,
-        piece_prim: impl Fn(&P) -> u32,
-    ) {
+    /// Lay out the bins from the per-chunk tile counts, then let `emit(chunk, emitter)` write
+    /// each chunk's records in primitive order, all chunks in parallel. Chunk `c`'s records for
+    /// tile `t` follow those of chunks `< c`, so every tile lists its primitives in submission
+    /// order whatever the thread count.
+    pub fn fill<F>(&mut self, grid: &Grid, counts: &[&[u32]], emit: F)
+    where
+        F: Fn(usize, &mut Emitter<'_, T>) + Sync,
+    {
+        use rayon::prelude::*;
         let nt = grid.tile_count();
-        // Prefix sum of the counts over tiles.
+        let nc = counts.len();
+        // Prefix sums: tile starts, then each chunk's slot range within each tile.
         self.starts.clear();
         self.starts.resize(nt + 1, 0);
+        self.cursors.clear();
+        self.cursors.resize(nc * nt, 0);
+        self.ends.clear();
+        self.ends.resize(nc * nt, 0);
         let mut total = 0u32;
-        let mut cursor = vec![0u32; nt];
         for t in 0..nt {
             self.starts[t] = total;
-            cursor[t] = total;
-            for c in chunks {
-                total += c.counts[t];
+            for c in 0..nc {
+                self.cursors[c * nt + t] = total;
+                total += counts[c][t];
+                self.ends[c * nt + t] = total;
             }
         }
         self.starts[nt] = total;
-        self.entries.clear();
-        self.entries.resize(total as usize, 0);
-        // Fill in primitive order.
-        let tiles_x = grid.tiles_x;
-        let entries = &mut self.entries;
-        let mut put = |rect: u32, e: u32| {
-            let (tx0, ty0, tx1, ty1) = unpack_rect(rect);
-            for ty in ty0..=ty1 {
-                let row = (ty * tiles_x) as usize;
-                for tx in tx0..=tx1 {
-                    let c = &mut cursor[row + tx as usize];
-                    entries[*c as usize] = e;
-                    *c += 1;
-                }
-            }
-        };
-        let mut piece_base = 0u32;
-        for (ci, chunk) in chunks.iter().enumerate() {
-            let lo = ci * CHUNK;
-            let hi = (lo + CHUNK).min(rects.len());
-            let mut pc = 0usize;
-            for (prim, &r) in (lo..hi).zip(&rects[lo..hi]) {
-                if r == RECT_EMPTY {
-                    continue;
-                }
-                if r == RECT_CLIPPED {
-                    while pc < chunk.pieces.len() && piece_prim(&chunk.pieces[pc]) == prim as u32 {
-                        let pr = piece_rect(&chunk.pieces[pc]);
-                        if pr != RECT_EMPTY {
-                            put(pr, PIECE | (piece_base + pc as u32));
-                        }
-                        pc += 1;
-                    }
-                    continue;
-                }
-                put(r, prim as u32);
-            }
-            piece_base += chunk.pieces.len() as u32;
+        // Every slot is overwritten by the fill below; growing fills with defaults.
+        self.items.resize(total as usize, T::default());
+        if nt == 0 || nc == 0 {
+            return;
         }
+        let ptr = SyncPtr(self.items.as_mut_ptr());
+        let tiles_x = grid.tiles_x;
+        self.cursors
+            .par_chunks_mut(nt)
+            .zip(self.ends.par_chunks(nt))
+            .enumerate()
+            .for_each(|(c, (cur, end))| {
+                let mut em = Emitter {
+                    ptr,
+                    cur,
+                    end,
+                    tiles_x,
+                };
+                emit(c, &mut em);
+            });
     }
 }
 

@@ -4,8 +4,9 @@
 //! 1. **vertices** (parallel): world -> eye -> fixed-point screen ([`crate::project`]);
 //! 2. **primitives** (parallel over fixed chunks of [`CHUNK`] primitives): facing, bounding box,
 //!    clipping of the few triangles that need it, one packed tile rectangle per primitive, and
-//!    per-chunk tile counts; then a serial prefix sum and fill in primitive order ([`crate::bin`]);
-//! 3. **tiles** (parallel): each tile walks its entries in submission order and rasterises them
+//!    per-chunk tile counts; then a prefix sum and a parallel fill that copies each primitive's
+//!    record into its tiles in primitive order (`bin`);
+//! 3. **tiles** (parallel): each tile walks its records in submission order and rasterises them
 //!    into its own pixels.
 //!
 //! Nothing in stages 1–3 depends on how rayon splits the work, and every pixel is written by the
@@ -15,14 +16,14 @@ use rayon::prelude::*;
 use texmap_core::camera::Camera;
 
 use crate::RasterError;
-use crate::bin::{Bins, CHUNK, ChunkBins, PIECE, RECT_CLIPPED, RECT_EMPTY, pack_rect};
+use crate::bin::{Bins, CHUNK, ChunkBins, RECT_CLIPPED, RECT_EMPTY, pack_rect};
 use crate::framebuffer::{Framebuffer, Grid};
 use crate::mesh::Mesh;
 use crate::program::{
     FlatProg, FragProgram, LitFlatProg, LitSmoothProg, QuadSampler, Shading, TexturedProg,
     VertexColorProg,
 };
-use crate::project::{ClipTri, FLAG_INVALID, MAX_VAR, PVert, Proj};
+use crate::project::{ClipTri, FLAG_INVALID, MAX_VAR, PVert, Proj, Var};
 use crate::sprite::{QuadShader, Sprite, raster_sprite};
 use crate::state::{Cull, DrawState};
 use crate::tri::{RasterCtx, area2, facing, pixel_bounds, raster_tri};
@@ -59,23 +60,33 @@ impl DrawStats {
     }
 }
 
-/// Buffers reused from draw to draw (no per-draw allocation once warm).
-#[derive(Clone, Debug, Default)]
+/// A binned triangle: snapped vertices, varyings and its source triangle.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Rec {
+    v: [PVert; 3],
+    var: [Var; 3],
+    tri: u32,
+}
+
+/// Buffers reused from draw to draw (no per-draw allocation of the big arrays once warm).
+#[derive(Default)]
 pub(crate) struct Scratch {
     pverts: Vec<PVert>,
     rects: Vec<u32>,
-    bins: Bins,
+    tris: Bins<Rec>,
+    sprites: Bins<Sprite>,
 }
 
-impl std::fmt::Debug for Bins {
+impl std::fmt::Debug for Scratch {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "Bins({} entries)", self.entries.len())
+        write!(f, "Scratch({} binned triangles)", self.tris.items.len())
     }
 }
 
-impl Clone for Bins {
+impl Clone for Scratch {
+    /// Scratch holds no state between draws: a clone starts empty.
     fn clone(&self) -> Self {
-        Bins::default()
+        Scratch::default()
     }
 }
 
@@ -259,10 +270,48 @@ impl Framebuffer {
             stats.add(&s);
             chunk_bins.push(b);
         }
-        scratch
-            .bins
-            .fill(&grid, &scratch.rects, &chunk_bins, |p| p.rect, |p| p.tri);
-        let pieces: Vec<ClipTri> = chunk_bins.into_iter().flat_map(|c| c.pieces).collect();
+
+        // Fill: copy each triangle's record into its tiles, chunks in parallel.
+        let counts: Vec<&[u32]> = chunk_bins.iter().map(|c| c.counts.as_slice()).collect();
+        let rects = &scratch.rects;
+        scratch.tris.fill(&grid, &counts, |ci, em| {
+            let lo = ci * CHUNK;
+            let hi = (lo + CHUNK).min(rects.len());
+            let pieces = &chunk_bins[ci].pieces;
+            let mut pc = 0usize;
+            for t in lo..hi {
+                let r = rects[t];
+                if r == RECT_EMPTY {
+                    continue;
+                }
+                if r == RECT_CLIPPED {
+                    while pc < pieces.len() && pieces[pc].tri == t as u32 {
+                        let p = &pieces[pc];
+                        if p.rect != RECT_EMPTY {
+                            let rec = Rec {
+                                v: p.v,
+                                var: p.var,
+                                tri: p.tri,
+                            };
+                            em.put(p.rect, rec);
+                        }
+                        pc += 1;
+                    }
+                    continue;
+                }
+                let tri = indices[t];
+                let mut var = [[0.0; MAX_VAR]; 3];
+                if P::NV > 0 {
+                    var = tri.map(|i| prog.vertex_var(mesh, i as usize));
+                }
+                let rec = Rec {
+                    v: tri.map(|i| pverts[i as usize]),
+                    var,
+                    tri: t as u32,
+                };
+                em.put(r, rec);
+            }
+        });
 
         // Stage 3: tiles.
         let ctx = RasterCtx {
@@ -271,21 +320,10 @@ impl Framebuffer {
             width: grid.width,
             height: grid.height,
         };
-        let bins = &scratch.bins;
+        let bins = &scratch.tris;
         tiles.par_iter_mut().enumerate().for_each(|(ti, tile)| {
-            for &e in bins.tile(ti) {
-                let (mut v, mut var, tri) = if e & PIECE != 0 {
-                    let p = &pieces[(e & !PIECE) as usize];
-                    (p.v, p.var, indices[p.tri as usize])
-                } else {
-                    let tri = indices[e as usize];
-                    let v = tri.map(|i| pverts[i as usize]);
-                    let mut var = [[0.0; MAX_VAR]; 3];
-                    if P::NV > 0 {
-                        var = tri.map(|i| prog.vertex_var(mesh, i as usize));
-                    }
-                    (v, var, tri)
-                };
+            for rec in bins.tile(ti) {
+                let (mut v, mut var) = (rec.v, rec.var);
                 let Some(front) = facing(area2(&v), state.cull) else {
                     continue;
                 };
@@ -294,7 +332,7 @@ impl Framebuffer {
                     v.swap(1, 2);
                     var.swap(1, 2);
                 }
-                let cst = prog.tri_const(mesh, tri, front);
+                let cst = prog.tri_const(mesh, rec.tri, front);
                 raster_tri(tile, &ctx, prog, &cst, &v, &var, front);
             }
         });
@@ -352,23 +390,27 @@ impl Framebuffer {
             stats.add(&s);
             chunk_bins.push(b);
         }
-        scratch.bins.fill(
-            &grid,
-            &scratch.rects,
-            &chunk_bins,
-            |_| RECT_EMPTY,
-            |_| u32::MAX,
-        );
+        let counts: Vec<&[u32]> = chunk_bins.iter().map(|c| c.counts.as_slice()).collect();
+        let rects = &scratch.rects;
+        scratch.sprites.fill(&grid, &counts, |ci, em| {
+            let lo = ci * CHUNK;
+            let hi = (lo + CHUNK).min(rects.len());
+            for i in lo..hi {
+                if rects[i] != RECT_EMPTY {
+                    em.put(rects[i], sprites[i]);
+                }
+            }
+        });
         let ctx = RasterCtx {
             state: *state,
             far: f32::INFINITY,
             width: grid.width,
             height: grid.height,
         };
-        let bins = &scratch.bins;
+        let bins = &scratch.sprites;
         tiles.par_iter_mut().enumerate().for_each(|(ti, tile)| {
-            for &e in bins.tile(ti) {
-                raster_sprite(tile, &ctx, shader, &sprites[e as usize]);
+            for sp in bins.tile(ti) {
+                raster_sprite(tile, &ctx, shader, sp);
             }
         });
         Ok(stats)

@@ -60,7 +60,7 @@ pub(crate) trait FragProgram: Sync {
     /// The varyings of mesh vertex `vi`.
     fn vertex_var(&self, mesh: &Mesh, vi: usize) -> Var;
     /// Per-triangle constants of source triangle `tri`; `front` says how it faces the viewer.
-    fn tri_const(&self, mesh: &Mesh, tri: [u32; 3], front: bool) -> Self::TriConst;
+    fn tri_const(&self, mesh: &Mesh, tri: u32, front: bool) -> Self::TriConst;
     /// Planar linear RGB of the four lanes.
     fn shade(&self, c: &Self::TriConst, f: &QuadFrag, front: bool) -> [[f32; 4]; 3];
 }
@@ -78,7 +78,7 @@ impl FragProgram for FlatProg {
         NO_VAR
     }
     #[inline]
-    fn tri_const(&self, _: &Mesh, _: [u32; 3], _: bool) {}
+    fn tri_const(&self, _: &Mesh, _: u32, _: bool) {}
     #[inline]
     fn shade(&self, _: &(), _: &QuadFrag, _: bool) -> [[f32; 4]; 3] {
         [[self.0.x; 4], [self.0.y; 4], [self.0.z; 4]]
@@ -94,10 +94,10 @@ impl FragProgram for VertexColorProg {
     #[inline]
     fn vertex_var(&self, mesh: &Mesh, vi: usize) -> Var {
         let c = mesh.colors().map_or(Vec3::ONE, |c| c[vi]);
-        [c.x, c.y, c.z, 0.0]
+        [c.x, c.y, c.z]
     }
     #[inline]
-    fn tri_const(&self, _: &Mesh, _: [u32; 3], _: bool) {}
+    fn tri_const(&self, _: &Mesh, _: u32, _: bool) {}
     #[inline]
     fn shade(&self, _: &(), f: &QuadFrag, _: bool) -> [[f32; 4]; 3] {
         [f.var[0], f.var[1], f.var[2]]
@@ -118,9 +118,9 @@ impl FragProgram for LitFlatProg {
     fn vertex_var(&self, _: &Mesh, _: usize) -> Var {
         NO_VAR
     }
-    fn tri_const(&self, mesh: &Mesh, tri: [u32; 3], front: bool) -> Vec3 {
+    fn tri_const(&self, mesh: &Mesh, tri: u32, front: bool) -> Vec3 {
         let p = mesh.positions();
-        let e = tri.map(|i| self.proj.to_eye(p[i as usize]));
+        let e = mesh.indices()[tri as usize].map(|i| self.proj.to_eye(p[i as usize]));
         // Face normal from the counter-clockwise winding, toward the viewer when front-facing.
         let mut n = (e[1] - e[0]).cross(e[2] - e[0]).normalize_or_zero();
         if !front {
@@ -155,10 +155,10 @@ impl FragProgram for LitSmoothProg {
         let n = mesh
             .normals()
             .map_or(Vec3::Z, |n| self.proj.dir_to_eye(n[vi]));
-        [n.x, n.y, n.z, 0.0]
+        [n.x, n.y, n.z]
     }
     #[inline]
-    fn tri_const(&self, _: &Mesh, _: [u32; 3], _: bool) {}
+    fn tri_const(&self, _: &Mesh, _: u32, _: bool) {}
     #[inline]
     fn shade(&self, _: &(), f: &QuadFrag, front: bool) -> [[f32; 4]; 3] {
         let mut out = [[0.0; 4]; 3];
@@ -251,10 +251,10 @@ impl<S: QuadSampler + ?Sized> FragProgram for TexturedProg<'_, S> {
     #[inline]
     fn vertex_var(&self, mesh: &Mesh, vi: usize) -> Var {
         let uv = mesh.uvs().map_or(Vec2::ZERO, |u| u[vi]);
-        [uv.x, uv.y, 0.0, 0.0]
+        [uv.x, uv.y, 0.0]
     }
     #[inline]
-    fn tri_const(&self, _: &Mesh, _: [u32; 3], _: bool) {}
+    fn tri_const(&self, _: &Mesh, _: u32, _: bool) {}
     #[inline]
     fn shade(&self, _: &(), f: &QuadFrag, _: bool) -> [[f32; 4]; 3] {
         let mut uv = [Vec2::ZERO; 4];

@@ -24,7 +24,7 @@ pub(crate) const GUARD: f32 = (1 << 18) as f32;
 const CLIP_GUARD: f32 = GUARD * 0.5;
 
 /// Most varyings (per-vertex values interpolated perspective-correctly) one program uses.
-pub(crate) const MAX_VAR: usize = 4;
+pub(crate) const MAX_VAR: usize = 3;
 pub(crate) type Var = [f32; MAX_VAR];
 
 /// A projected vertex: fixed-point screen position, `1/W` and `depth/W`.

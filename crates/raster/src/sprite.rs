@@ -18,7 +18,7 @@ use crate::state::DepthTest;
 use crate::tri::{RasterCtx, write_quad};
 
 /// A screen-space rectangle to be shaded by a [`QuadShader`].
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Sprite {
     /// Top-left corner in pixels (x right, y down).
     pub min: Vec2,
