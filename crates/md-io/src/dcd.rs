@@ -491,12 +491,6 @@ impl<R: Read + Seek> DcdReader<R> {
         }
     }
 
-    /// Byte offset of frame `index` (which may be past the end).
-    #[cfg_attr(not(test), allow(dead_code))]
-    pub fn frame_offset(&self, index: usize) -> u64 {
-        self.layout.span(index).0
-    }
-
     /// Reads frame `index` into `positions` (Å, one entry per atom) and returns its unit cell
     /// (`None` if the file has none or it is all zero).
     pub fn read_frame(
@@ -675,12 +669,6 @@ impl<R: Read + Seek> DcdReader<R> {
     /// Number of complete frames (the `Trajectory` contract; offset arithmetic, no scan).
     pub fn n_frames(&mut self) -> Result<usize, Error> {
         Ok(self.layout.n_complete)
-    }
-
-    /// Gives back the underlying stream.
-    #[cfg_attr(not(test), allow(dead_code))]
-    pub fn into_inner(self) -> R {
-        self.src
     }
 }
 
@@ -1017,12 +1005,6 @@ impl<W: Write + Seek> DcdWriter<W> {
                 Error::Io { source, .. } => source,
                 other => io::Error::new(io::ErrorKind::InvalidInput, other.to_string()),
             })
-    }
-
-    /// Flushes (the header is already current).
-    #[cfg_attr(not(test), allow(dead_code))]
-    pub fn finish(&mut self) -> io::Result<()> {
-        self.out.flush()
     }
 
     /// Frames written so far.

@@ -302,18 +302,6 @@ impl<R: Read + Seek> TrrReader<R> {
         self.frames.len()
     }
 
-    /// Why indexing stopped before the end of the file, if it did.
-    #[cfg_attr(not(test), allow(dead_code))]
-    pub fn truncation(&self) -> Option<&Error> {
-        self.tail.as_ref()
-    }
-
-    /// Byte offset of frame `index`.
-    #[cfg_attr(not(test), allow(dead_code))]
-    pub fn frame_offset(&self, index: usize) -> Option<u64> {
-        self.frames.get(index).map(|(o, _)| *o)
-    }
-
     /// Reads frame `index`: positions (Å) and velocities (Å/ps) into the vectors (left empty
     /// when the frame lacks them), the rest returned.
     pub fn read_frame(
@@ -474,12 +462,6 @@ impl<R: Read + Seek> TrrReader<R> {
     /// Number of complete frames (the `Trajectory` contract; the index is built at open time).
     pub fn n_frames(&mut self) -> Result<usize, Error> {
         Ok(self.frames.len())
-    }
-
-    /// Gives back the underlying stream.
-    #[cfg_attr(not(test), allow(dead_code))]
-    pub fn into_inner(self) -> R {
-        self.src
     }
 }
 

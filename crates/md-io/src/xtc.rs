@@ -404,12 +404,6 @@ impl<R: Read + Seek> XtcReader<R> {
     pub fn n_frames(&mut self) -> Result<usize, Error> {
         Ok(self.frames.len())
     }
-
-    /// Gives back the underlying stream.
-    #[cfg_attr(not(test), allow(dead_code))]
-    pub fn into_inner(self) -> R {
-        self.src
-    }
 }
 
 /// A copy of an error kept for re-reporting (io errors keep their kind and message).
@@ -877,12 +871,6 @@ impl<W: Write> XtcWriter<W> {
             Error::Io { source, .. } => source,
             other => io::Error::new(io::ErrorKind::InvalidInput, other.to_string()),
         })
-    }
-
-    /// Flushes.
-    #[cfg_attr(not(test), allow(dead_code))]
-    pub fn finish(&mut self) -> io::Result<()> {
-        self.out.flush()
     }
 
     /// Gives back the stream.
