@@ -301,7 +301,7 @@ impl Renderer {
                 let tables = self.lut.as_ref().expect("built above");
                 let stats = self
                     .bins
-                    .build(scene, &view, |c, r, k| lut::project(&view, c, r, k));
+                    .build(scene, &view, |c, r, k| lut::project(&view, tables, c, r, k));
                 let k = lut::LutKernel { view, tables };
                 pipeline::draw_tiles(&self.bins, &view, &k, bg, frame);
                 stats

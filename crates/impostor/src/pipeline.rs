@@ -112,12 +112,27 @@ impl View {
         // A tiny widening (1e-3 px plus a relative term) keeps the bound conservative against
         // rounding in the projection; the kernels' exact tests decide coverage.
         let eps = 1e-3 + 1e-6 * lo.abs().max(hi.abs());
-        let lo = (lo - 0.5 - eps).ceil().max(0.0);
-        let hi = ((hi - 0.5 + eps).floor() + 1.0).min(n as f32);
-        if !(lo < hi) {
+        // Clamp first (the bounds may be huge near the eye plane, or NaN: then nothing), then
+        // floor/ceil by integer conversion (no libm call in the portable baseline).
+        let nf = n as f32;
+        let a = lo - 0.5 - eps;
+        let b = hi - 0.5 + eps;
+        if !(a < nf && b >= -1.0 && a <= b) {
             return (0, 0);
         }
-        (lo as u16, hi as u16)
+        let a = a.max(-1.0);
+        let b = b.min(nf);
+        // ceil(a) for a ≥ −1 and floor(b) for b ≥ −1.
+        let ai = a as i32;
+        let ceil_a = ai + ((ai as f32) < a) as i32;
+        let bi = b as i32;
+        let floor_b = bi - ((bi as f32) > b) as i32;
+        let i0 = ceil_a.max(0);
+        let i1 = (floor_b + 1).min(n as i32);
+        if i0 >= i1 {
+            return (0, 0);
+        }
+        (i0 as u16, i1 as u16)
     }
 }
 

@@ -242,7 +242,10 @@ impl Kernel for TemplateKernel<'_> {
                         TemplateDepth::DepthImage => {
                             let ti = (((u + 1.0) * 0.5 * dn) as u32).min(DEPTH_SIZE - 1);
                             let tj = (((w + 1.0) * 0.5 * dn) as u32).min(DEPTH_SIZE - 1);
-                            z0 + self.tables.depth[(tj * DEPTH_SIZE + ti) as usize] * r
+                            // Seed 002's depth image (finite inside the disc tested above).
+                            let dd = self.tables.depth[(tj * DEPTH_SIZE + ti) as usize];
+                            let dd = if dd.is_finite() { dd } else { 0.0 };
+                            z0 + dd * r
                         }
                     };
                     if z < near {
