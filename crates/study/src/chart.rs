@@ -1,0 +1,500 @@
+//! Charts of the study, as SVG text or PNG/RGB pixels, drawn with plotters and an embedded font
+//! (DejaVu Sans, shipped in `assets/` with its licence), so no system font is needed.
+//!
+//! - [`speed_accuracy`]: speed on the x axis (ms per frame, log scale) against accuracy on the y
+//!   axis (PSNR against the 1-spp reference), one labelled point per method per scene.
+//! - [`sweep`]: one chart per sweep, one line per method, for a chosen [`SweepMetric`].
+//!
+//! Log axes are drawn as linear axes over `log10(x)` with tick labels written back as `x`: one
+//! code path for both kinds of axis. Infinite PSNR (identical images) is drawn at
+//! [`PSNR_CEILING_DB`].
+
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::FontStyle;
+
+use crate::error::StudyError;
+use crate::harness::{Metrics, Record};
+use crate::sweeps::{SweepKind, SweepSeries};
+
+/// The embedded font (DejaVu Sans, Bitstream Vera licence: `assets/DejaVuSans-LICENSE.txt`).
+static FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
+
+/// Infinite PSNR is plotted at this height.
+pub const PSNR_CEILING_DB: f64 = 100.0;
+
+/// Smallest relative depth error drawn on the log axis (a zero error sits here).
+pub const DEPTH_REL_FLOOR: f64 = 1e-8;
+
+/// Register the embedded font once as plotters' "sans-serif".
+fn ensure_font() -> Result<(), StudyError> {
+    static DONE: OnceLock<bool> = OnceLock::new();
+    let ok = *DONE.get_or_init(|| {
+        plotters::style::register_font("sans-serif", FontStyle::Normal, FONT).is_ok()
+    });
+    if ok {
+        Ok(())
+    } else {
+        Err(StudyError::Chart {
+            chart: "font".into(),
+            message: "the embedded DejaVu Sans could not be parsed".into(),
+        })
+    }
+}
+
+/// What a sweep chart plots on its y axis.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum SweepMetric {
+    /// Mean silhouette displacement (px), linear axis.
+    SilhouettePx,
+    /// PSNR (dB), linear axis, infinite drawn at [`PSNR_CEILING_DB`].
+    PsnrDb,
+    /// Maximum depth error over the reference's depth range, log axis floored at
+    /// [`DEPTH_REL_FLOOR`].
+    DepthErrRel,
+}
+
+impl SweepMetric {
+    pub const ALL: [SweepMetric; 3] = [
+        SweepMetric::SilhouettePx,
+        SweepMetric::PsnrDb,
+        SweepMetric::DepthErrRel,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            SweepMetric::SilhouettePx => "silhouette",
+            SweepMetric::PsnrDb => "psnr",
+            SweepMetric::DepthErrRel => "depth",
+        }
+    }
+
+    fn label(self) -> &'static str {
+        match self {
+            SweepMetric::SilhouettePx => "silhouette displacement (px)",
+            SweepMetric::PsnrDb => "PSNR vs reference (dB)",
+            SweepMetric::DepthErrRel => "max depth error / depth range",
+        }
+    }
+
+    fn log(self) -> bool {
+        self == SweepMetric::DepthErrRel
+    }
+
+    fn value(self, m: &Metrics) -> f64 {
+        match self {
+            SweepMetric::SilhouettePx => m.silhouette_px,
+            SweepMetric::PsnrDb => m.psnr_db.min(PSNR_CEILING_DB),
+            SweepMetric::DepthErrRel => m.depth_err_rel().clamp(DEPTH_REL_FLOOR, 1e3),
+        }
+    }
+}
+
+/// The colour of a method's points and lines (fixed, so charts agree with each other).
+fn method_color(method: &str) -> RGBColor {
+    match method {
+        "polygon" => RGBColor(31, 119, 180),
+        "lut" => RGBColor(255, 127, 14),
+        "template" => RGBColor(44, 160, 44),
+        "raycast" => RGBColor(214, 39, 40),
+        _ => RGBColor(90, 90, 90),
+    }
+}
+
+/// A linear or log10 axis mapping.
+#[derive(Clone, Copy)]
+struct Axis {
+    log: bool,
+}
+
+impl Axis {
+    fn map(self, v: f64) -> f64 {
+        if self.log { v.max(1e-300).log10() } else { v }
+    }
+    fn label(self, t: f64) -> String {
+        if self.log {
+            let v = 10f64.powf(t);
+            if (1e-3..1e4).contains(&v) {
+                format!("{}", (v * 1000.0).round() / 1000.0)
+            } else {
+                format!("{v:.0e}")
+            }
+        } else {
+            format!("{}", (t * 100.0).round() / 100.0)
+        }
+    }
+}
+
+/// Padded range of mapped values (never empty).
+fn range(vals: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for v in vals.filter(|v| v.is_finite()) {
+        lo = lo.min(v);
+        hi = hi.max(v);
+    }
+    if !lo.is_finite() {
+        return 0.0..1.0;
+    }
+    let pad = ((hi - lo) * 0.08).max(0.05 * hi.abs().max(1.0)).max(1e-9);
+    (lo - pad)..(hi + pad)
+}
+
+fn chart_err(chart: &str) -> impl Fn(String) -> StudyError + '_ {
+    move |message| StudyError::Chart {
+        chart: chart.to_string(),
+        message,
+    }
+}
+
+/// Draw the speed-versus-accuracy chart of the records measured against the 1-spp reference.
+fn draw_speed_accuracy<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    records: &[Record],
+) -> Result<(), String> {
+    let pts: Vec<&Record> = records
+        .iter()
+        .filter(|r| r.reference == "reftrace-1spp" && r.method != "reftrace")
+        .filter(|r| r.ms_per_frame.is_finite() && r.ms_per_frame > 0.0)
+        .collect();
+    let xa = Axis { log: true };
+    let ya = Axis { log: false };
+    let xr = range(pts.iter().map(|r| xa.map(r.ms_per_frame)));
+    let yr = range(pts.iter().map(|r| r.psnr_db.min(PSNR_CEILING_DB)));
+    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(
+            "Speed versus accuracy of the sphere methods",
+            ("sans-serif", 22),
+        )
+        .margin(16)
+        .x_label_area_size(44)
+        .y_label_area_size(56)
+        .build_cartesian_2d(xr, yr)
+        .map_err(|e| e.to_string())?;
+    chart
+        .configure_mesh()
+        .x_desc("milliseconds per frame (log scale)")
+        .y_desc("PSNR vs reference ray tracer (dB)")
+        .x_label_formatter(&|t| xa.label(*t))
+        .y_label_formatter(&|t| ya.label(*t))
+        .label_style(("sans-serif", 14))
+        .axis_desc_style(("sans-serif", 15))
+        .draw()
+        .map_err(|e| e.to_string())?;
+    for method in ["polygon", "lut", "template", "raycast"] {
+        let color = method_color(method);
+        let mine: Vec<&&Record> = pts.iter().filter(|r| r.method == method).collect();
+        if mine.is_empty() {
+            continue;
+        }
+        chart
+            .draw_series(mine.iter().map(|r| {
+                let p = (xa.map(r.ms_per_frame), r.psnr_db.min(PSNR_CEILING_DB));
+                EmptyElement::at(p)
+                    + Circle::new((0, 0), 6, color.filled())
+                    + Text::new(
+                        format!("{} {}", r.method, r.scene),
+                        (8, -14),
+                        ("sans-serif", 13).into_font().color(&BLACK),
+                    )
+            }))
+            .map_err(|e| e.to_string())?
+            .label(method)
+            .legend(move |(x, y)| Circle::new((x + 8, y), 6, color.filled()));
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 14))
+        .position(SeriesLabelPosition::LowerRight)
+        .draw()
+        .map_err(|e| e.to_string())?;
+    root.present().map_err(|e| e.to_string())
+}
+
+/// Draw one sweep chart (all series must be of one kind).
+fn draw_sweep<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    series: &[SweepSeries],
+    metric: SweepMetric,
+) -> Result<(), String> {
+    let kind = series.first().map(|s| s.kind).unwrap_or(SweepKind::Fov);
+    let xa = Axis { log: kind.log_x() };
+    let ya = Axis { log: metric.log() };
+    let xr = range(
+        series
+            .iter()
+            .flat_map(|s| s.points.iter().map(|p| xa.map(p.x))),
+    );
+    let yr = range(
+        series
+            .iter()
+            .flat_map(|s| s.points.iter().map(|p| ya.map(metric.value(&p.metrics)))),
+    );
+    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(
+            format!("{} versus {}", metric.label(), kind.x_label()),
+            ("sans-serif", 18),
+        )
+        .margin(16)
+        .x_label_area_size(44)
+        .y_label_area_size(64)
+        .build_cartesian_2d(xr, yr)
+        .map_err(|e| e.to_string())?;
+    chart
+        .configure_mesh()
+        .x_desc(kind.x_label())
+        .y_desc(metric.label())
+        .x_label_formatter(&|t| xa.label(*t))
+        .y_label_formatter(&|t| ya.label(*t))
+        .label_style(("sans-serif", 14))
+        .axis_desc_style(("sans-serif", 15))
+        .draw()
+        .map_err(|e| e.to_string())?;
+    for s in series {
+        let color = method_color(s.method.name());
+        let pts: Vec<(f64, f64)> = s
+            .points
+            .iter()
+            .map(|p| (xa.map(p.x), ya.map(metric.value(&p.metrics))))
+            .collect();
+        chart
+            .draw_series(LineSeries::new(pts.iter().copied(), color.stroke_width(2)))
+            .map_err(|e| e.to_string())?
+            .label(s.method.name())
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2))
+            });
+        chart
+            .draw_series(pts.iter().map(|&p| Circle::new(p, 4, color.filled())))
+            .map_err(|e| e.to_string())?;
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 14))
+        .position(SeriesLabelPosition::UpperLeft)
+        .draw()
+        .map_err(|e| e.to_string())?;
+    root.present().map_err(|e| e.to_string())
+}
+
+/// Where a chart goes.
+#[derive(Debug)]
+pub enum Target<'a> {
+    /// SVG text appended to the string.
+    Svg(&'a mut String),
+    /// RGB8 pixels written into the buffer (`3 · w · h` bytes).
+    Rgb(&'a mut [u8]),
+    /// A PNG file.
+    Png(&'a Path),
+}
+
+/// Chart size in pixels (SVG user units).
+pub const CHART_SIZE: (u32, u32) = (960, 640);
+
+fn draw_on(
+    name: &str,
+    target: Target,
+    size: (u32, u32),
+    svg: impl FnOnce(DrawingArea<SVGBackend, Shift>) -> Result<(), String>,
+    bmp: impl FnOnce(DrawingArea<BitMapBackend, Shift>) -> Result<(), String>,
+) -> Result<(), StudyError> {
+    ensure_font()?;
+    let err = chart_err(name);
+    match target {
+        Target::Svg(s) => svg(SVGBackend::with_string(s, size).into_drawing_area()).map_err(err),
+        Target::Rgb(buf) => {
+            let need = 3 * size.0 as usize * size.1 as usize;
+            if buf.len() != need {
+                return Err(StudyError::BadOption {
+                    what: "rgb buffer length",
+                    value: format!("{} (need {need})", buf.len()),
+                });
+            }
+            bmp(BitMapBackend::with_buffer(buf, size).into_drawing_area()).map_err(err)
+        }
+        Target::Png(path) => bmp(BitMapBackend::new(path, size).into_drawing_area()).map_err(err),
+    }
+}
+
+/// Draw the speed-versus-accuracy chart at [`CHART_SIZE`].
+pub fn speed_accuracy(records: &[Record], target: Target) -> Result<(), StudyError> {
+    draw_on(
+        "speed_accuracy",
+        target,
+        CHART_SIZE,
+        |a| draw_speed_accuracy(a, records),
+        |a| draw_speed_accuracy(a, records),
+    )
+}
+
+/// Draw one sweep chart at [`CHART_SIZE`]; `series` should all be of one [`SweepKind`].
+pub fn sweep(
+    series: &[SweepSeries],
+    metric: SweepMetric,
+    target: Target,
+) -> Result<(), StudyError> {
+    draw_on(
+        "sweep",
+        target,
+        CHART_SIZE,
+        |a| draw_sweep(a, series, metric),
+        |a| draw_sweep(a, series, metric),
+    )
+}
+
+/// Write `speed_accuracy.{svg,png}` and, per sweep kind and metric,
+/// `sweep_<kind>_<metric>.{svg,png}` into `dir`; returns the paths written.
+pub fn write_charts(
+    dir: &Path,
+    records: &[Record],
+    series: &[SweepSeries],
+) -> Result<Vec<PathBuf>, StudyError> {
+    let mut written = Vec::new();
+    let mut emit =
+        |stem: String, draw: &dyn Fn(Target) -> Result<(), StudyError>| -> Result<(), StudyError> {
+            let mut svg = String::new();
+            draw(Target::Svg(&mut svg))?;
+            let svg_path = dir.join(format!("{stem}.svg"));
+            crate::error::write_file(svg_path.clone(), svg.as_bytes())?;
+            let png_path = dir.join(format!("{stem}.png"));
+            draw(Target::Png(&png_path))?;
+            written.push(svg_path);
+            written.push(png_path);
+            Ok(())
+        };
+    if !records.is_empty() {
+        emit("speed_accuracy".into(), &|t| speed_accuracy(records, t))?;
+    }
+    for kind in SweepKind::ALL {
+        let mine: Vec<SweepSeries> = series.iter().filter(|s| s.kind == kind).cloned().collect();
+        if mine.is_empty() {
+            continue;
+        }
+        for metric in SweepMetric::ALL {
+            emit(format!("sweep_{}_{}", kind.name(), metric.name()), &|t| {
+                sweep(&mine, metric, t)
+            })?;
+        }
+    }
+    Ok(written)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sweeps::SweepPoint;
+    use texmap_impostor::Method;
+
+    fn rec(method: &str, scene: &str, ms: f64, psnr: f64) -> Record {
+        Record {
+            scene: scene.into(),
+            method: method.into(),
+            reference: "reftrace-1spp".into(),
+            width: 500,
+            height: 500,
+            ms_per_frame: ms,
+            psnr_db: psnr,
+            ssim: 0.9,
+            depth_err_mean: 0.0,
+            depth_err_max: 0.0,
+            silhouette_px: 0.1,
+            silhouette_mismatched: 3,
+        }
+    }
+
+    fn distinct_colors(rgb: &[u8]) -> usize {
+        let mut set = std::collections::HashSet::new();
+        for p in rgb.chunks_exact(3) {
+            set.insert([p[0], p[1], p[2]]);
+        }
+        set.len()
+    }
+
+    fn records() -> Vec<Record> {
+        vec![
+            rec("polygon", "s1", 12.0, 38.0),
+            rec("lut", "s1", 1.5, 31.0),
+            rec("template", "s1", 1.1, 24.0),
+            rec("raycast", "s1", 2.0, f64::INFINITY),
+            rec("raycast", "molecule", 0.9, 52.0),
+        ]
+    }
+
+    #[test]
+    fn speed_accuracy_chart_renders_text_points_and_colours() {
+        let mut buf = vec![0u8; 3 * 960 * 640];
+        speed_accuracy(&records(), Target::Rgb(&mut buf)).unwrap();
+        // White background, four method colours, anti-aliased text: many distinct colours.
+        let n = distinct_colors(&buf);
+        assert!(n > 50, "only {n} distinct colours");
+        // The raycast colour appears (its points were drawn).
+        assert!(buf.chunks_exact(3).any(|p| p == [214, 39, 40]));
+        let mut svg = String::new();
+        speed_accuracy(&records(), Target::Svg(&mut svg)).unwrap();
+        assert!(
+            svg.starts_with("<svg")
+                && svg.contains("template s1")
+                && svg.contains("raycast molecule")
+        );
+        assert!(svg.matches("<circle").count() >= 5);
+    }
+
+    #[test]
+    fn png_files_decode_to_the_chart_size() {
+        let dir = tempfile::tempdir().unwrap();
+        let m = |s: f64| Metrics {
+            psnr_db: 40.0 + s,
+            ssim: 0.99,
+            depth_err_mean: 1e-6 * s,
+            depth_err_max: 1e-5 * s,
+            depth_range: 1.0,
+            silhouette_px: 0.1 * s,
+            silhouette_mismatched: s as usize,
+            reference_coverage: 1000,
+        };
+        let series: Vec<SweepSeries> = [Method::Lut, Method::Raycast]
+            .into_iter()
+            .map(|method| SweepSeries {
+                kind: SweepKind::ScreenRadius,
+                method,
+                points: [0.3, 1.0, 10.0, 100.0]
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &x)| SweepPoint {
+                        x,
+                        metrics: m(i as f64),
+                    })
+                    .collect(),
+            })
+            .collect();
+        let paths = write_charts(dir.path(), &records(), &series).unwrap();
+        // speed_accuracy + 3 metrics of one sweep, SVG and PNG each.
+        assert_eq!(paths.len(), 2 * (1 + 3));
+        for p in paths
+            .iter()
+            .filter(|p| p.extension().is_some_and(|e| e == "png"))
+        {
+            let img = image::open(p).unwrap().to_rgb8();
+            assert_eq!(img.dimensions(), CHART_SIZE, "{}", p.display());
+            let n = distinct_colors(img.as_raw());
+            assert!(n > 50, "{}: only {n} distinct colours", p.display());
+        }
+    }
+
+    #[test]
+    fn wrong_buffer_size_is_an_error() {
+        let mut buf = vec![0u8; 10];
+        assert!(matches!(
+            speed_accuracy(&records(), Target::Rgb(&mut buf)),
+            Err(StudyError::BadOption { .. })
+        ));
+    }
+}

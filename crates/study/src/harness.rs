@@ -1,0 +1,518 @@
+//! The comparison harness: every sphere method and the reference ray tracer on the same scene,
+//! camera and shading, measured for speed and accuracy.
+//!
+//! For a [`NamedScene`] the harness
+//! 1. builds the reference ([`texmap_reftrace`]) from the same spheres and materials and traces it
+//!    at one sample per pixel (and, optionally, `n x n` supersampled for an anti-aliased colour
+//!    reference) with the same [`Lighting`] and background;
+//! 2. draws the scene with each [`Method`] through one [`Renderer`] that is reused across runs,
+//!    as the papers' per-scene tables intend (Seed 002 lights its colour images once per scene,
+//!    Seed 004 builds its template pyramid once), after `warmup` untimed runs, and reports the
+//!    median of `runs` timed runs;
+//! 3. compares each frame with the reference through [`texmap_core::metrics`]: PSNR and SSIM of
+//!    the 8-bit sRGB colour, depth error over the pixels both cover, silhouette mismatch.
+//!
+//! Bonds are not drawn (`Options::draw_bonds = false`) and not traced: in the space-filling
+//! scenes they lie inside the atoms, and not every method draws them.
+//!
+//! Everything returns data; files are written only by the explicit `write_*` functions, which
+//! take a directory.
+
+use std::path::Path;
+use std::time::Instant;
+
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+use texmap_core::camera::Camera;
+use texmap_core::color::srgb8_to_linear_rgb;
+use texmap_core::frame::Frame;
+use texmap_core::metrics;
+use texmap_core::shade::Lighting;
+use texmap_impostor::{Method, Options, Renderer, SphereScene};
+use texmap_reftrace::{RenderOptions, SceneBuilder, SurfaceMaterial};
+
+use crate::error::{StudyError, write_file};
+use crate::scenes::NamedScene;
+
+/// One method on one scene: the machine-readable result row (results.json / results.csv).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Record {
+    pub scene: String,
+    /// `polygon`, `lut`, `template`, `raycast`, or `reftrace` (the reference's own time; its
+    /// error fields are then against itself, i.e. zero / infinite PSNR).
+    pub method: String,
+    /// What the errors are measured against: `reftrace-1spp` or `reftrace-NxN`.
+    pub reference: String,
+    pub width: u32,
+    pub height: u32,
+    /// Median wall-clock milliseconds per frame (tables reused across frames).
+    pub ms_per_frame: f64,
+    /// PSNR of the RGB colour in dB; infinite (JSON `null`) for identical images.
+    #[serde(with = "inf_as_null")]
+    pub psnr_db: f64,
+    pub ssim: f64,
+    /// Mean and maximum absolute depth difference (scene units) over pixels both frames cover.
+    pub depth_err_mean: f64,
+    pub depth_err_max: f64,
+    /// Mean silhouette displacement in pixels (mismatched pixels over reference outline length).
+    pub silhouette_px: f64,
+    /// Pixels covered in exactly one of the frame and the reference.
+    pub silhouette_mismatched: u64,
+}
+
+/// Serialise an infinite PSNR as JSON `null` and read it back as infinity (JSON has no infinity).
+mod inf_as_null {
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
+        if v.is_finite() {
+            s.serialize_f64(*v)
+        } else {
+            s.serialize_none()
+        }
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+        Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::INFINITY))
+    }
+}
+
+/// Every accuracy figure of one frame against a reference.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Metrics {
+    pub psnr_db: f64,
+    pub ssim: f64,
+    pub depth_err_mean: f64,
+    pub depth_err_max: f64,
+    /// Range of the reference's finite depths (max − min; 0 if it covers at most one depth).
+    pub depth_range: f64,
+    /// Mean silhouette displacement in pixels ([`metrics::silhouette_error`]).
+    pub silhouette_px: f64,
+    pub silhouette_mismatched: usize,
+    /// Pixels the reference covers.
+    pub reference_coverage: usize,
+}
+
+impl Metrics {
+    /// `depth_err_max / depth_range` (0 when the range is 0 and the error is 0, infinite when only
+    /// the range is 0).
+    pub fn depth_err_rel(&self) -> f64 {
+        if self.depth_range > 0.0 {
+            self.depth_err_max / self.depth_range
+        } else if self.depth_err_max == 0.0 {
+            0.0
+        } else {
+            f64::INFINITY
+        }
+    }
+}
+
+/// Compare a frame with the reference.
+pub fn compare(frame: &Frame, reference: &Frame) -> Result<Metrics, StudyError> {
+    let de = metrics::depth_error(frame, reference)?;
+    let sil = metrics::silhouette_error(frame, reference)?;
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for &d in reference.depth.iter().filter(|d| d.is_finite()) {
+        lo = lo.min(d as f64);
+        hi = hi.max(d as f64);
+    }
+    Ok(Metrics {
+        psnr_db: metrics::psnr(frame, reference)?,
+        ssim: metrics::ssim(frame, reference)?,
+        depth_err_mean: de.mean_abs,
+        depth_err_max: de.max_abs,
+        depth_range: if hi > lo { hi - lo } else { 0.0 },
+        silhouette_px: sil.mean_displacement_px,
+        silhouette_mismatched: sil.mismatched_pixels,
+        reference_coverage: reference.coverage_count(),
+    })
+}
+
+/// The reference ray tracer's scene for a sphere set: the same spheres with material id = kind.
+/// Invalid spheres (non-finite, non-positive radius) are skipped by the builder, as the methods
+/// skip them; spheres of an unknown kind are left out here for the same reason.
+pub fn reference_scene(spheres: &SphereScene) -> texmap_reftrace::Scene {
+    let mut b = SceneBuilder::with_sphere_capacity(spheres.len());
+    for i in 0..spheres.len() {
+        if (spheres.kinds[i] as usize) < spheres.materials.len() {
+            b.add_sphere(
+                spheres.centers[i],
+                spheres.radii[i],
+                spheres.kinds[i] as u32,
+            );
+        }
+    }
+    b.build()
+}
+
+/// The reference materials: every kind's shading material, opaque.
+pub fn reference_materials(spheres: &SphereScene) -> Vec<SurfaceMaterial> {
+    spheres
+        .materials
+        .iter()
+        .map(|m| SurfaceMaterial::opaque(*m))
+        .collect()
+}
+
+/// Trace the reference: `samples_per_axis²` stratified samples per pixel, the same lighting and
+/// the background of `background` (sRGB RGBA, as in [`Options::background`]).
+pub fn render_reference(
+    scene: &texmap_reftrace::Scene,
+    materials: &[SurfaceMaterial],
+    camera: &Camera,
+    lighting: Lighting,
+    background: [u8; 4],
+    samples_per_axis: u32,
+) -> Result<Frame, StudyError> {
+    let mut o = RenderOptions::new(lighting, materials);
+    o.samples_per_axis = samples_per_axis;
+    o.background = srgb8_to_linear_rgb(background);
+    Ok(scene.render(camera, &o)?)
+}
+
+/// How the harness runs.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HarnessOptions {
+    pub methods: Vec<Method>,
+    /// Untimed runs before timing (at least the first run builds the per-scene tables).
+    pub warmup: usize,
+    /// Timed runs; the median is reported (at least 1).
+    pub runs: usize,
+    /// Also trace an `n x n` supersampled reference and report every method against it too.
+    pub supersample: Option<u32>,
+    /// Time the reference too (a `reftrace` record).
+    pub time_reference: bool,
+}
+
+impl Default for HarnessOptions {
+    /// All four methods, 1 warm-up and 5 timed runs, no supersampled reference, reference timed.
+    fn default() -> HarnessOptions {
+        HarnessOptions {
+            methods: Method::ALL.to_vec(),
+            warmup: 1,
+            runs: 5,
+            supersample: None,
+            time_reference: true,
+        }
+    }
+}
+
+/// The options every method is drawn with in the study: the method's defaults, the scene's
+/// lighting, no bonds.
+pub fn study_options(method: Method, lighting: Lighting) -> Options {
+    let mut o = Options::new(method, lighting);
+    o.draw_bonds = false;
+    o
+}
+
+/// One method's outcome on a scene.
+#[derive(Clone, Debug)]
+pub struct MethodRun {
+    pub method: Method,
+    pub frame: Frame,
+    /// Against the 1-spp reference.
+    pub metrics: Metrics,
+    /// Against the supersampled reference, when asked for.
+    pub metrics_ss: Option<Metrics>,
+    pub ms_per_frame: f64,
+}
+
+/// Everything the harness found on one scene.
+#[derive(Clone, Debug)]
+pub struct SceneReport {
+    pub scene: String,
+    pub reference: Frame,
+    pub reference_ss: Option<Frame>,
+    /// Median ms per reference frame at 1 spp (BVH built once, outside the timing).
+    pub reference_ms: Option<f64>,
+    pub runs: Vec<MethodRun>,
+    pub records: Vec<Record>,
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n == 0 {
+        f64::NAN
+    } else if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+/// Median wall-clock milliseconds of `runs` calls of `f` after `warmup` calls.
+fn time_ms<T>(warmup: usize, runs: usize, mut f: impl FnMut() -> T) -> (f64, T) {
+    let mut last = None;
+    for _ in 0..warmup {
+        last = Some(f());
+    }
+    let mut times = Vec::with_capacity(runs);
+    for _ in 0..runs.max(1) {
+        let t = Instant::now();
+        let out = f();
+        times.push(t.elapsed().as_secs_f64() * 1e3);
+        last = Some(out);
+    }
+    (median(times), last.expect("at least one run"))
+}
+
+fn record(
+    scene: &str,
+    method: &str,
+    reference: &str,
+    frame: &Frame,
+    ms: f64,
+    m: &Metrics,
+) -> Record {
+    Record {
+        scene: scene.to_string(),
+        method: method.to_string(),
+        reference: reference.to_string(),
+        width: frame.width(),
+        height: frame.height(),
+        ms_per_frame: ms,
+        psnr_db: m.psnr_db,
+        ssim: m.ssim,
+        depth_err_mean: m.depth_err_mean,
+        depth_err_max: m.depth_err_max,
+        silhouette_px: m.silhouette_px,
+        silhouette_mismatched: m.silhouette_mismatched as u64,
+    }
+}
+
+/// Run every asked-for method and the reference on `scene`.
+pub fn run_scene(scene: &NamedScene, opts: &HarnessOptions) -> Result<SceneReport, StudyError> {
+    if let Some(n) = opts.supersample
+        && !(1..=texmap_reftrace::MAX_SAMPLES_PER_AXIS).contains(&n)
+    {
+        return Err(StudyError::BadOption {
+            what: "supersample",
+            value: n.to_string(),
+        });
+    }
+    let background = study_options(Method::Raycast, scene.lighting).background;
+    let rscene = reference_scene(&scene.spheres);
+    let mats = reference_materials(&scene.spheres);
+    let trace = |spp| {
+        render_reference(
+            &rscene,
+            &mats,
+            &scene.camera,
+            scene.lighting,
+            background,
+            spp,
+        )
+    };
+    let (reference_ms, reference) = if opts.time_reference {
+        let (ms, f) = time_ms(0, opts.runs.min(3), || trace(1));
+        (Some(ms), f?)
+    } else {
+        (None, trace(1)?)
+    };
+    let reference_ss = opts.supersample.map(trace).transpose()?;
+    let ss_name = opts.supersample.map(|n| format!("reftrace-{n}x{n}"));
+
+    let name = scene.name();
+    let mut records = Vec::new();
+    if let Some(ms) = reference_ms {
+        let m = compare(&reference, &reference)?;
+        records.push(record(
+            name,
+            "reftrace",
+            "reftrace-1spp",
+            &reference,
+            ms,
+            &m,
+        ));
+    }
+    let mut runs = Vec::new();
+    for &method in &opts.methods {
+        let o = study_options(method, scene.lighting);
+        let mut renderer = Renderer::new();
+        let (ms, out) = time_ms(opts.warmup, opts.runs, || {
+            renderer.render(&scene.spheres, &scene.camera, &o)
+        });
+        let frame = out.frame;
+        let m = compare(&frame, &reference)?;
+        records.push(record(name, method.name(), "reftrace-1spp", &frame, ms, &m));
+        let metrics_ss = match (&reference_ss, &ss_name) {
+            (Some(r), Some(n)) => {
+                let mss = compare(&frame, r)?;
+                records.push(record(name, method.name(), n, &frame, ms, &mss));
+                Some(mss)
+            }
+            _ => None,
+        };
+        runs.push(MethodRun {
+            method,
+            frame,
+            metrics: m,
+            metrics_ss,
+            ms_per_frame: ms,
+        });
+    }
+    Ok(SceneReport {
+        scene: name.to_string(),
+        reference,
+        reference_ss,
+        reference_ms,
+        runs,
+        records,
+    })
+}
+
+/// An error image: per-pixel absolute colour difference times `gain` (clamped to 255) where both
+/// frames agree on coverage; magenta where only the frame covers the pixel, green where only the
+/// reference does. Frames of different sizes give [`StudyError::Metric`].
+pub fn error_image(frame: &Frame, reference: &Frame, gain: f32) -> Result<Frame, StudyError> {
+    if frame.width() != reference.width() || frame.height() != reference.height() {
+        return Err(StudyError::Metric(metrics::MetricError::SizeMismatch {
+            a: (frame.width(), frame.height()),
+            b: (reference.width(), reference.height()),
+        }));
+    }
+    let mut out = Frame::new(frame.width(), frame.height(), [0, 0, 0, 255]);
+    for i in 0..frame.len() {
+        let (a, r) = (frame.covered(i), reference.covered(i));
+        out.color[i] = match (a, r) {
+            (true, false) => [255, 0, 255, 255],
+            (false, true) => [0, 255, 0, 255],
+            _ => {
+                let (p, q) = (frame.color[i], reference.color[i]);
+                let d =
+                    |c: usize| ((p[c] as f32 - q[c] as f32).abs() * gain).clamp(0.0, 255.0) as u8;
+                [d(0), d(1), d(2), 255]
+            }
+        };
+        out.depth[i] = reference.depth[i];
+    }
+    Ok(out)
+}
+
+/// The records as CSV: a header line, then one line per record (`inf` for an infinite PSNR).
+pub fn records_to_csv(records: &[Record]) -> String {
+    let mut s = String::from(
+        "scene,method,reference,width,height,ms_per_frame,psnr_db,ssim,depth_err_mean,depth_err_max,silhouette_px,silhouette_mismatched\n",
+    );
+    for r in records {
+        s.push_str(&format!(
+            "{},{},{},{},{},{:.4},{:.3},{:.5},{:.6e},{:.6e},{:.4},{}\n",
+            r.scene,
+            r.method,
+            r.reference,
+            r.width,
+            r.height,
+            r.ms_per_frame,
+            r.psnr_db,
+            r.ssim,
+            r.depth_err_mean,
+            r.depth_err_max,
+            r.silhouette_px,
+            r.silhouette_mismatched
+        ));
+    }
+    s
+}
+
+/// The records as a pretty-printed JSON array.
+pub fn records_to_json(records: &[Record]) -> Result<String, StudyError> {
+    serde_json::to_string_pretty(records).map_err(StudyError::Json)
+}
+
+/// Write `results.json` and `results.csv` into `dir` (which must exist).
+pub fn write_results(dir: &Path, records: &[Record]) -> Result<(), StudyError> {
+    write_file(
+        dir.join("results.json"),
+        records_to_json(records)?.as_bytes(),
+    )?;
+    write_file(dir.join("results.csv"), records_to_csv(records).as_bytes())
+}
+
+/// Mean linear-light colour of the covered pixels (a quick sanity figure for reports).
+pub fn mean_covered_color(frame: &Frame) -> Vec3 {
+    let mut sum = Vec3::ZERO;
+    let mut n = 0u32;
+    for i in 0..frame.len() {
+        if frame.covered(i) {
+            sum += srgb8_to_linear_rgb(frame.color[i]);
+            n += 1;
+        }
+    }
+    if n == 0 { Vec3::ZERO } else { sum / n as f32 }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenes::{SceneId, build_sized};
+
+    #[test]
+    fn records_round_trip_through_json_including_infinite_psnr() {
+        let r = Record {
+            scene: "s1".into(),
+            method: "raycast".into(),
+            reference: "reftrace-1spp".into(),
+            width: 5,
+            height: 4,
+            ms_per_frame: 1.25,
+            psnr_db: f64::INFINITY,
+            ssim: 1.0,
+            depth_err_mean: 0.0,
+            depth_err_max: 0.0,
+            silhouette_px: 0.0,
+            silhouette_mismatched: 0,
+        };
+        let json = records_to_json(std::slice::from_ref(&r)).unwrap();
+        assert!(json.contains("\"psnr_db\": null"), "{json}");
+        let back: Vec<Record> = serde_json::from_str(&json).unwrap();
+        assert_eq!(back, vec![r.clone()]);
+        let csv = records_to_csv(&[r]);
+        let lines: Vec<&str> = csv.lines().collect();
+        assert_eq!(lines.len(), 2);
+        // Same number of columns in header and row.
+        assert_eq!(lines[0].split(',').count(), lines[1].split(',').count());
+        assert!(lines[1].contains(",inf,"), "{}", lines[1]);
+    }
+
+    #[test]
+    fn error_image_marks_coverage_mismatch_and_amplifies_differences() {
+        let mut a = Frame::new(3, 1, [0, 0, 0, 255]);
+        let mut r = Frame::new(3, 1, [0, 0, 0, 255]);
+        a.depth[0] = 1.0; // only the frame covers pixel 0
+        r.depth[1] = 1.0; // only the reference covers pixel 1
+        a.depth[2] = 1.0;
+        r.depth[2] = 1.0;
+        a.color[2] = [100, 100, 100, 255];
+        r.color[2] = [90, 100, 140, 255];
+        let e = error_image(&a, &r, 4.0).unwrap();
+        assert_eq!(e.color[0], [255, 0, 255, 255]);
+        assert_eq!(e.color[1], [0, 255, 0, 255]);
+        assert_eq!(e.color[2], [40, 0, 160, 255]);
+        assert!(error_image(&a, &Frame::new(2, 1, [0; 4]), 1.0).is_err());
+    }
+
+    #[test]
+    fn reference_agrees_with_itself_and_harness_reports_every_method() {
+        // A small S1 view keeps the test fast; the figures themselves are checked in sweeps.
+        let scene = build_sized(SceneId::S1, 96, 96).unwrap();
+        let opts = HarnessOptions {
+            warmup: 0,
+            runs: 1,
+            supersample: Some(2),
+            ..HarnessOptions::default()
+        };
+        let rep = run_scene(&scene, &opts).unwrap();
+        // reftrace + 4 methods x (1 spp + 2x2).
+        assert_eq!(rep.records.len(), 1 + 4 * 2);
+        let own = &rep.records[0];
+        assert_eq!(own.method, "reftrace");
+        assert!(own.psnr_db.is_infinite() && own.silhouette_mismatched == 0);
+        assert!(rep.reference.coverage_count() > 96 * 96 / 4);
+        for r in &rep.records[1..] {
+            assert_eq!((r.width, r.height), (96, 96));
+            assert!(r.ms_per_frame.is_finite() && r.ms_per_frame >= 0.0);
+            assert!(r.ssim.is_finite() && r.psnr_db > 0.0, "{r:?}");
+        }
+    }
+}
