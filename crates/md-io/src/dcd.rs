@@ -1007,6 +1007,11 @@ impl<W: Write + Seek> DcdWriter<W> {
             })
     }
 
+    /// Ends the file (the `Writer` contract): nothing to add, the stream is flushed.
+    pub fn finish(&mut self) -> io::Result<()> {
+        self.out.flush()
+    }
+
     /// Frames written so far.
     #[cfg_attr(not(test), allow(dead_code))]
     pub fn frame_count(&self) -> usize {

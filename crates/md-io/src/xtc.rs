@@ -873,6 +873,11 @@ impl<W: Write> XtcWriter<W> {
         })
     }
 
+    /// Ends the file (the `Writer` contract): nothing to add, the stream is flushed.
+    pub fn finish(&mut self) -> io::Result<()> {
+        self.out.flush()
+    }
+
     /// Gives back the stream.
     #[cfg_attr(not(test), allow(dead_code))]
     pub fn into_inner(self) -> W {
