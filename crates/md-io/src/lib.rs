@@ -44,6 +44,7 @@
 //! streaming, the line-scan index and error positions from `TextReader`.
 
 pub mod elements;
+mod dcd;
 mod error;
 mod format;
 mod frame;
@@ -52,8 +53,10 @@ mod lammps;
 pub mod parse;
 mod pdb;
 mod text;
+mod trr;
 mod trajectory;
 mod writer;
+mod xtc;
 mod xyz;
 
 pub use elements::{Appearance, AtomStyle, Element, Selector};
@@ -62,3 +65,7 @@ pub use format::Format;
 pub use frame::{Frame, Label, UnitCell};
 pub use trajectory::Trajectory;
 pub use writer::Writer;
+
+/// molly, the XTC crate our decoder is measured against (benches/md_io.rs); not part of the API.
+#[doc(hidden)]
+pub use molly;

@@ -1,5 +1,6 @@
 //! [`Trajectory`]: one reader for every format, streaming or random access.
 
+use crate::dcd::DcdReader;
 use crate::error::Error;
 use crate::format::Format;
 use crate::frame::Frame;
@@ -7,6 +8,8 @@ use crate::gro::Gro;
 use crate::lammps::Lammps;
 use crate::pdb::Pdb;
 use crate::text::TextReader;
+use crate::trr::TrrReader;
+use crate::xtc::XtcReader;
 use crate::xyz::Xyz;
 use std::fs::File;
 use std::io::{Read, Seek};
@@ -16,6 +19,9 @@ use std::sync::Arc;
 /// The per-format readers: a closed set, dispatched by `match` (see the contract in lib.rs).
 enum Reader<R> {
     Xyz(TextReader<R, Xyz>),
+    Dcd(DcdReader<R>),
+    Xtc(XtcReader<R>),
+    Trr(TrrReader<R>),
     Pdb(TextReader<R, Pdb>),
     Gro(TextReader<R, Gro>),
     Lammps(TextReader<R, Lammps>),
@@ -26,6 +32,9 @@ macro_rules! each_reader {
     ($reader:expr, $r:ident => $body:expr) => {
         match $reader {
             Reader::Xyz($r) => $body,
+            Reader::Dcd($r) => $body,
+            Reader::Xtc($r) => $body,
+            Reader::Trr($r) => $body,
             Reader::Pdb($r) => $body,
             Reader::Gro($r) => $body,
             Reader::Lammps($r) => $body,
@@ -91,16 +100,13 @@ impl<R: Read + Seek> Trajectory<R> {
         let file: Arc<str> = name.into();
         let reader = match format {
             Format::Xyz => Reader::Xyz(TextReader::new(src, Xyz::default(), file.clone())),
+            Format::Dcd => Reader::Dcd(DcdReader::new(src, file.clone())?),
+            Format::Xtc => Reader::Xtc(XtcReader::new(src, file.clone())?),
+            Format::Trr => Reader::Trr(TrrReader::new(src, file.clone())?),
             Format::Pdb => Reader::Pdb(TextReader::new(src, Pdb::default(), file.clone())),
             Format::Gro => Reader::Gro(TextReader::new(src, Gro, file.clone())),
             Format::LammpsDump => {
                 Reader::Lammps(TextReader::new(src, Lammps::default(), file.clone()))
-            }
-            _ => {
-                return Err(Error::Unsupported {
-                    file,
-                    what: "reading this format is not built in yet",
-                });
             }
         };
         Ok(Trajectory {

@@ -1,9 +1,11 @@
 //! [`Writer`]: one writer for every format that has one.
 
+use crate::dcd::DcdWriter;
 use crate::error::{Error, Location};
 use crate::format::Format;
 use crate::frame::Frame;
 use crate::pdb::PdbWriter;
+use crate::xtc::XtcWriter;
 use crate::xyz::XyzWriter;
 use std::fs::File;
 use std::io::{BufWriter, Seek, Write};
@@ -13,6 +15,8 @@ use std::sync::Arc;
 /// The per-format writers: a closed set, dispatched by `match`.
 enum WriterKind<W> {
     Xyz(XyzWriter<W>),
+    Dcd(DcdWriter<W>),
+    Xtc(XtcWriter<W>),
     Pdb(PdbWriter<W>),
 }
 
@@ -21,6 +25,8 @@ macro_rules! each_writer {
     ($writer:expr, $w:ident => $body:expr) => {
         match $writer {
             WriterKind::Xyz($w) => $body,
+            WriterKind::Dcd($w) => $body,
+            WriterKind::Xtc($w) => $body,
             WriterKind::Pdb($w) => $body,
         }
     };
@@ -54,6 +60,8 @@ impl<W: Write + Seek> Writer<W> {
         let file: Arc<str> = name.into();
         let kind = match format {
             Format::Xyz => WriterKind::Xyz(XyzWriter { out }),
+            Format::Dcd => WriterKind::Dcd(DcdWriter::new(out, file.clone())),
+            Format::Xtc => WriterKind::Xtc(XtcWriter::new(out, file.clone(), 1000.0)?),
             Format::Pdb => WriterKind::Pdb(PdbWriter { out, models: 0 }),
             _ => {
                 return Err(Error::Unsupported {
