@@ -118,6 +118,9 @@ pub struct LevelInfo {
     /// (exactly `2^-i` for power-of-two textures).
     pub scale_x: f32,
     pub scale_y: f32,
+    /// `1 / width_f`, `1 / height_f`.
+    pub inv_width_f: f32,
+    pub inv_height_f: f32,
 }
 
 /// A validated mip pyramid of linear RGBA `f32` texels.
@@ -260,6 +263,8 @@ impl MipTexture {
                 height_f: h as f32,
                 scale_x: w as f32 / width as f32,
                 scale_y: h as f32 / height as f32,
+                inv_width_f: 1.0 / w as f32,
+                inv_height_f: 1.0 / h as f32,
             });
             texels.extend(work.iter().map(|&t| to_linear(t)));
             if w == 1 && h == 1 {

@@ -70,7 +70,7 @@
 //! # References
 //! Seed 000 (Kajihara), Eq. (2)–(4), (8)–(10); /work/shared/SEEDS.md.
 
-use glam::{Vec2, Vec4};
+use glam::{Vec2, Vec4, Vec4Swizzles};
 
 use crate::mip::{LevelInfo, MipTexture, Wrap};
 
@@ -407,33 +407,55 @@ impl WindowSource for Direct {
     fn conflict(&mut self) {}
 }
 
-/// `(⌊v⌋, ⌊v⌋ as i32)` per lane for finite lanes with `|v| ≤ 2^30`: truncate, then step down
-/// where truncation rounded up. SSE2 (baseline on x86_64) converts four lanes at once; other
-/// targets use the scalar [`floor_i32`]. Both give the same values.
+/// `⌊v⌋` per lane for finite lanes with `|v| ≤ 2^30`: truncate, then step down where truncation
+/// rounded up. SSE2 (baseline on x86_64) converts four lanes at once; other targets use the
+/// scalar [`floor_i32`]. Both give the same values.
 #[inline(always)]
-fn floor4(v: Vec4) -> (Vec4, [i32; 4]) {
+fn floor4(v: Vec4) -> Vec4 {
+    let tf = trunc_lanes(v);
+    Vec4::select(tf.cmpgt(v), tf - Vec4::ONE, tf)
+}
+
+/// Lanes truncated toward zero (finite, `|v| ≤ 2^30`), as floats.
+#[inline(always)]
+fn trunc_lanes(v: Vec4) -> Vec4 {
     #[cfg(target_arch = "x86_64")]
     {
         use core::arch::x86_64::{__m128, _mm_cvtepi32_ps, _mm_cvttps_epi32};
-        // SAFETY: SSE2 is part of the x86_64 baseline; lanes are finite and within i32.
-        let (t, tf) = unsafe {
+        // SAFETY: SSE2 is part of the x86_64 baseline.
+        unsafe {
             let m: __m128 = v.into();
-            let t = _mm_cvttps_epi32(m);
-            (t, Vec4::from(_mm_cvtepi32_ps(t)))
-        };
-        // SAFETY: __m128i and [i32; 4] have the same size and no invalid bit patterns.
-        let ti: [i32; 4] = unsafe { core::mem::transmute(t) };
-        let down = tf.cmpgt(v);
-        let fl = Vec4::select(down, tf - Vec4::ONE, tf);
-        let bits = down.bitmask();
-        let ti = [0, 1, 2, 3].map(|j| ti[j] - ((bits >> j) & 1) as i32);
-        (fl, ti)
+            Vec4::from(_mm_cvtepi32_ps(_mm_cvttps_epi32(m)))
+        }
     }
     #[cfg(not(target_arch = "x86_64"))]
     {
-        let ti = v.to_array().map(floor_i32);
-        (Vec4::from(ti.map(|t| t as f32)), ti)
+        Vec4::from(v.to_array().map(|x| floor_i32(x.abs()) as f32 * x.signum()))
     }
+}
+
+/// Integer-valued lanes (`|v| ≤ 2^30`) as `i32`.
+#[inline(always)]
+fn lanes_i32(v: Vec4) -> [i32; 4] {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use core::arch::x86_64::{__m128, _mm_cvttps_epi32};
+        // SAFETY: SSE2 is part of the x86_64 baseline; __m128i and [i32; 4] have the same size
+        // and no invalid bit patterns.
+        unsafe {
+            let m: __m128 = v.into();
+            core::mem::transmute::<_, [i32; 4]>(_mm_cvttps_epi32(m))
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        v.to_array().map(floor_i32)
+    }
+}
+
+#[inline(always)]
+fn lerp4(a: Vec4, b: Vec4, t: Vec4) -> Vec4 {
+    a + (b - a) * t
 }
 
 /// Replace NaN lanes by 0 and clamp to ±2^30.
@@ -444,14 +466,19 @@ fn clamp4(v: Vec4) -> Vec4 {
         .min(Vec4::splat(COORD_LIMIT))
 }
 
-/// One span: Eq. (8)'s four pixel images `uv`, Eq. (9)'s level, Eq. (10)'s windows, Eq. (4)'s
-/// per-pixel blend. The four pixels travel as the four lanes of a `Vec4`.
+/// A span's level decision (Seed 000 Eq. 9) and its lane coordinates.
+#[derive(Clone, Copy)]
+struct SpanPlan {
+    sx: Vec4,
+    sy: Vec4,
+    i0: usize,
+    i1: usize,
+    t: f32,
+}
+
+/// First half of a span: Eq. (8)'s four pixel images `uv` as lanes, Eq. (9)'s level pair.
 #[inline(always)]
-fn span_quad<A: Addr, S: WindowSource, const K: usize>(
-    tex: &MipTexture,
-    uv: [Vec2; 4],
-    src: &mut S,
-) -> [Vec4; 4] {
+fn span_plan<A: Addr, const K: usize>(tex: &MipTexture, uv: [Vec2; 4], bias: i32) -> SpanPlan {
     let levels = tex.levels();
     let l0 = &levels[0];
     let last = levels.len() - 1;
@@ -460,8 +487,8 @@ fn span_quad<A: Addr, S: WindowSource, const K: usize>(
     let mut sy = clamp4(Vec4::new(uv[0].y, uv[1].y, uv[2].y, uv[3].y) * l0.height_f);
     // Repeat: shift the whole span by whole periods so its corner lies in the first period.
     if A::REPEAT {
-        let px = floor_i32(sx.min_element() / l0.width_f) as f32 * l0.width_f;
-        let py = floor_i32(sy.min_element() / l0.height_f) as f32 * l0.height_f;
+        let px = floor_i32(sx.min_element() * l0.inv_width_f) as f32 * l0.width_f;
+        let py = floor_i32(sy.min_element() * l0.inv_height_f) as f32 * l0.height_f;
         sx -= Vec4::splat(px);
         sy -= Vec4::splat(py);
     }
@@ -470,7 +497,7 @@ fn span_quad<A: Addr, S: WindowSource, const K: usize>(
     let shift = if K == 3 { 1 } else { 0 };
     // Exact ⌊λ⌋ from the exponent (0 and subnormals give −127), frac(λ) from the mantissa.
     let (e, frac) = log2_split(ext);
-    let fine = e + shift;
+    let fine = e + shift + bias;
     // Clamp the level pair to the pyramid.
     let (i0, i1, t) = if fine < 0 {
         (0, 0, 0.0)
@@ -479,17 +506,59 @@ fn span_quad<A: Addr, S: WindowSource, const K: usize>(
     } else {
         (fine as usize, fine as usize + 1, frac)
     };
-    let a = span_level::<A, S, K>(tex, i0, sx, sy, src);
-    if i1 == i0 || t == 0.0 {
+    SpanPlan { sx, sy, i0, i1, t }
+}
+
+/// Second half of a span: Eq. (10)'s window per level and Eq. (4)'s per-pixel blend.
+#[inline(always)]
+fn span_finish<A: Addr, S: WindowSource, const K: usize>(
+    tex: &MipTexture,
+    p: SpanPlan,
+    src: &mut S,
+) -> [Vec4; 4] {
+    let a = span_level::<A, S, K>(tex, p.i0, p.sx, p.sy, src);
+    if p.i1 == p.i0 || p.t == 0.0 {
         return a;
     }
-    let b = span_level::<A, S, K>(tex, i1, sx, sy, src);
-    [
-        lerp(a[0], b[0], t),
-        lerp(a[1], b[1], t),
-        lerp(a[2], b[2], t),
-        lerp(a[3], b[3], t),
-    ]
+    let b = span_level::<A, S, K>(tex, p.i1, p.sx, p.sy, src);
+    let mut out = a;
+    for j in 0..4 {
+        out[j] = lerp(a[j], b[j], p.t);
+    }
+    out
+}
+
+/// One span (Seed 000 §3): [`span_plan`] then [`span_finish`].
+#[inline(always)]
+fn span_quad<A: Addr, S: WindowSource, const K: usize>(
+    tex: &MipTexture,
+    uv: [Vec2; 4],
+    bias: i32,
+    src: &mut S,
+) -> [Vec4; 4] {
+    span_finish::<A, S, K>(tex, span_plan::<A, K>(tex, uv, bias), src)
+}
+
+/// Many spans, software-pipelined: the level decision of span `n + 1` is issued before the texel
+/// work of span `n`, so the two dependency chains overlap (one span alone is latency-bound).
+#[inline(always)]
+fn span_quads<A: Addr, const K: usize>(
+    tex: &MipTexture,
+    quads: &[[Vec2; 4]],
+    out: &mut [[Vec4; 4]],
+) {
+    let n = quads.len().min(out.len());
+    if n == 0 {
+        return;
+    }
+    let mut next = span_plan::<A, K>(tex, quads[0], 0);
+    for i in 0..n {
+        let cur = next;
+        if i + 1 < n {
+            next = span_plan::<A, K>(tex, quads[i + 1], 0);
+        }
+        out[i] = span_finish::<A, Direct, K>(tex, cur, &mut Direct);
+    }
 }
 
 /// The four bilinear samples of one level from ONE window read.
@@ -510,17 +579,33 @@ fn span_level<A: Addr, S: WindowSource, const K: usize>(
         x = x.max(Vec4::ZERO).min(Vec4::splat(l.width_f - 1.0));
         y = y.max(Vec4::ZERO).min(Vec4::splat(l.height_f - 1.0));
     }
-    let (flx, fx) = floor4(x);
-    let (fly, fy) = floor4(y);
+    let (flx, fly) = (floor4(x), floor4(y));
     let (ax, ay) = (x - flx, y - fly);
-    let x0 = fx[0].min(fx[1]).min(fx[2].min(fx[3]));
-    let y0 = fy[0].min(fy[1]).min(fy[2].min(fy[3]));
+    let (mx, my) = (flx.min_element(), fly.min_element());
+    // (Integer-valued already: truncation is exact.)
+    let (x0, y0) = (floor_i32(mx), floor_i32(my));
+    // Offsets of each pixel's texel from the window corner (small integers, exact in f32).
+    let (ox, oy) = (flx - Vec4::splat(mx), fly - Vec4::splat(my));
     // Seed 000 Eq. (10): one parallel read of the K x K window at corner (x0, y0).
     let win = src.window::<A, K>(tex, level, x0, y0);
+    let lim = (K - 2) as f32;
+    let (oxi, oyi) = (lanes_i32(ox), lanes_i32(oy));
+    if ox.max_element() <= lim && oy.max_element() <= lim {
+        // Every bilinear neighbourhood lies in the window (the level policy's guarantee).
+        let axs = [ax.xxxx(), ax.yyyy(), ax.zzzz(), ax.wwww()];
+        let ays = [ay.xxxx(), ay.yyyy(), ay.zzzz(), ay.wwww()];
+        // (A plain loop: `<[_; 4]>::map` does not inline here and cost 2x.)
+        let mut out = [Vec4::ZERO; 4];
+        for j in 0..4 {
+            let [t00, t10, t01, t11] = S::quad(tex, &win, oxi[j] as usize, oyi[j] as usize);
+            out[j] = lerp4(lerp4(t00, t10, axs[j]), lerp4(t01, t11, axs[j]), ays[j]);
+        }
+        return out;
+    }
     let lim = K as i32 - 2;
     let mut out = [Vec4::ZERO; 4];
     for j in 0..4 {
-        let (mut ox, mut oy) = (fx[j] - x0, fy[j] - y0);
+        let (mut ox, mut oy) = (oxi[j], oyi[j]);
         if ox > lim || oy > lim {
             // Fold repeat-wrapped offsets on narrow levels back into the window (same texel).
             if A::REPEAT {
@@ -543,7 +628,8 @@ fn span_level<A: Addr, S: WindowSource, const K: usize>(
             }
         }
         let [t00, t10, t01, t11] = S::quad(tex, &win, ox as usize, oy as usize);
-        out[j] = lerp(lerp(t00, t10, ax[j]), lerp(t01, t11, ax[j]), ay[j]);
+        let (axj, ayj) = (Vec4::splat(ax[j]), Vec4::splat(ay[j]));
+        out[j] = lerp4(lerp4(t00, t10, axj), lerp4(t01, t11, axj), ayj);
     }
     out
 }
@@ -613,10 +699,12 @@ impl Sampler {
             Sampler::Bilinear => bilinear::<A>(tex.texels(), l0, uv),
             Sampler::Trilinear => trilinear_fp::<A>(tex, uv, footprint(l0, duv_dx, duv_dy)),
             Sampler::Span(Banks::K3) => {
-                span_quad::<A, Direct, 3>(tex, quad_from_pixel(uv, duv_dx, duv_dy), &mut Direct)[0]
+                span_quad::<A, Direct, 3>(tex, quad_from_pixel(uv, duv_dx, duv_dy), 0, &mut Direct)
+                    [0]
             }
             Sampler::Span(Banks::K4) => {
-                span_quad::<A, Direct, 4>(tex, quad_from_pixel(uv, duv_dx, duv_dy), &mut Direct)[0]
+                span_quad::<A, Direct, 4>(tex, quad_from_pixel(uv, duv_dx, duv_dy), 0, &mut Direct)
+                    [0]
             }
             Sampler::Anisotropic { max_taps } => {
                 anisotropic::<A>(tex, uv, duv_dx, duv_dy, max_taps)
@@ -633,12 +721,16 @@ impl Sampler {
     #[inline(always)]
     fn quad_one<A: Addr>(&self, tex: &MipTexture, uv: [Vec2; 4]) -> [Vec4; 4] {
         match *self {
-            Sampler::Span(Banks::K3) => span_quad::<A, Direct, 3>(tex, uv, &mut Direct),
-            Sampler::Span(Banks::K4) => span_quad::<A, Direct, 4>(tex, uv, &mut Direct),
+            Sampler::Span(Banks::K3) => span_quad::<A, Direct, 3>(tex, uv, 0, &mut Direct),
+            Sampler::Span(Banks::K4) => span_quad::<A, Direct, 4>(tex, uv, 0, &mut Direct),
             _ => {
                 let dx = uv[1] - uv[0];
                 let dy = uv[2] - uv[0];
-                uv.map(|p| self.sample_one::<A>(tex, p, dx, dy))
+                let mut out = [Vec4::ZERO; 4];
+                for j in 0..4 {
+                    out[j] = self.sample_one::<A>(tex, uv[j], dx, dy);
+                }
+                out
             }
         }
     }
@@ -655,7 +747,13 @@ impl Sampler {
         with_addr!(tex, A, {
             match *self {
                 Sampler::Span(_) => self.quad_one::<A>(tex, uv),
-                _ => [0, 1, 2, 3].map(|j| self.sample_one::<A>(tex, uv[j], duv_dx[j], duv_dy[j])),
+                _ => {
+                    let mut out = [Vec4::ZERO; 4];
+                    for j in 0..4 {
+                        out[j] = self.sample_one::<A>(tex, uv[j], duv_dx[j], duv_dy[j]);
+                    }
+                    out
+                }
             }
         })
     }
@@ -719,16 +817,8 @@ impl Sampler {
         }
         with_addr!(tex, A, {
             match *self {
-                Sampler::Span(Banks::K3) => {
-                    for (o, q) in out.iter_mut().zip(quads) {
-                        *o = span_quad::<A, Direct, 3>(tex, *q, &mut Direct);
-                    }
-                }
-                Sampler::Span(Banks::K4) => {
-                    for (o, q) in out.iter_mut().zip(quads) {
-                        *o = span_quad::<A, Direct, 4>(tex, *q, &mut Direct);
-                    }
-                }
+                Sampler::Span(Banks::K3) => span_quads::<A, 3>(tex, quads, out),
+                Sampler::Span(Banks::K4) => span_quads::<A, 4>(tex, quads, out),
                 s => {
                     for (o, q) in out.iter_mut().zip(quads) {
                         *o = s.quad_one::<A>(tex, *q);
@@ -754,6 +844,8 @@ pub struct BankStats {
     pub bank_reads: u64,
     /// Texel accesses that fell outside the fetched window (would need another memory cycle).
     pub conflicts: u64,
+    /// Window reads that crossed the right or bottom edge of their level (served by the apron).
+    pub edge_windows: u64,
 }
 
 /// One level stored as K x K banks of the padded level (apron of K − 1 texels, see module doc).
@@ -772,6 +864,7 @@ struct BankedLevel {
 pub struct BankedTexture {
     banks: Banks,
     levels: Vec<BankedLevel>,
+    bias: i32,
 }
 
 impl BankedTexture {
@@ -797,7 +890,19 @@ impl BankedTexture {
                 }
             })
             .collect();
-        BankedTexture { banks, levels }
+        BankedTexture {
+            banks,
+            levels,
+            bias: 0,
+        }
+    }
+
+    /// For experiments: add `bias` to the policy's finer level index (negative = finer). Any
+    /// negative bias breaks the no-conflict guarantee — e.g. K = 3 with bias −1 is the
+    /// conventional trilinear pair — and the conflicts show up in [`BankStats::conflicts`].
+    pub fn with_level_bias(mut self, bias: i32) -> BankedTexture {
+        self.bias = bias.clamp(-64, 64);
+        self
     }
 
     /// K, banks per side.
@@ -812,8 +917,8 @@ impl BankedTexture {
         let mut src = BankSource { bt: self, stats };
         with_addr!(tex, A, {
             match self.banks {
-                Banks::K3 => span_quad::<A, _, 3>(tex, uv, &mut src),
-                Banks::K4 => span_quad::<A, _, 4>(tex, uv, &mut src),
+                Banks::K3 => span_quad::<A, _, 3>(tex, uv, self.bias, &mut src),
+                Banks::K4 => span_quad::<A, _, 4>(tex, uv, self.bias, &mut src),
             }
         })
     }
@@ -848,6 +953,9 @@ impl WindowSource for BankSource<'_> {
             )
         };
         self.stats.window_reads += 1;
+        if x0 + K > l.width as usize || y0 + K > l.height as usize {
+            self.stats.edge_windows += 1;
+        }
         let mut win = [[Vec4::ZERO; 4]; 4];
         for j in 0..K {
             // Seed 000 Eq. (10): a_j = ⌊Y0/K⌋ + δ(j, Y0), δ = 1 if j < Y0 mod K.
