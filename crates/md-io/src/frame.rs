@@ -34,7 +34,7 @@ impl Label {
 
     /// The label for UTF-8 bytes, or `None` when they are too long or not UTF-8.
     pub fn from_utf8(b: &[u8]) -> Option<Label> {
-        if b.len() > Label::CAPACITY || std::str::from_utf8(b).is_err() {
+        if b.len() > Label::CAPACITY || !(b.is_ascii() || std::str::from_utf8(b).is_ok()) {
             return None;
         }
         let mut bytes = [0u8; Label::CAPACITY];
@@ -43,6 +43,12 @@ impl Label {
             len: b.len() as u8,
             bytes,
         })
+    }
+
+    /// The label's bytes (UTF-8).
+    #[inline]
+    pub fn as_bytes(&self) -> &[u8] {
+        &self.bytes[..self.len as usize]
     }
 
     /// The label as a string slice.

@@ -43,8 +43,8 @@
 //! Text formats instead implement the private `TextFormat` trait (src/text.rs) and get
 //! streaming, the line-scan index and error positions from `TextReader`.
 
-pub mod elements;
 mod dcd;
+pub mod elements;
 mod error;
 mod format;
 mod frame;
@@ -53,8 +53,8 @@ mod lammps;
 pub mod parse;
 mod pdb;
 mod text;
-mod trr;
 mod trajectory;
+mod trr;
 mod writer;
 mod xtc;
 mod xyz;

@@ -53,46 +53,129 @@ fn slow<T: std::str::FromStr>(s: &[u8]) -> Option<T> {
 /// Clinger's fast path; `None` when the input is not a plain decimal within its exact range.
 #[inline]
 fn fast_f64(s: &[u8]) -> Option<f64> {
-    let mut i = 0;
+    match fast_prefix(s, 0) {
+        Some((v, end)) if end == s.len() => Some(v),
+        _ => None,
+    }
+}
+
+/// Eight bytes at `s[i..i + 8]` as a little-endian word.
+#[inline(always)]
+fn load8(s: &[u8], i: usize) -> u64 {
+    let mut b = [0u8; 8];
+    b.copy_from_slice(&s[i..i + 8]);
+    u64::from_le_bytes(b)
+}
+
+/// True when all eight bytes of `v` are ASCII digits: each byte's high nibble is 3 and adding
+/// 6 does not carry into it.
+#[cfg(test)]
+fn all_digits8(v: u64) -> bool {
+    let a = v & 0xF0F0_F0F0_F0F0_F0F0;
+    let b = (v.wrapping_add(0x0606_0606_0606_0606) & 0xF0F0_F0F0_F0F0_F0F0) >> 4;
+    (a | b) == 0x3333_3333_3333_3333
+}
+
+/// The value of eight ASCII digits (first digit in the lowest byte) by three multiply-adds
+/// that combine pairs, then quads, then the two halves.
+#[inline(always)]
+#[cfg(test)]
+fn value8(v: u64) -> u64 {
+    combine8(v - 0x3030_3030_3030_3030)
+}
+
+/// Number of leading ASCII digits (0..=8) in the little-endian word `v`: per byte, a high
+/// nibble other than 3 or a low nibble above 9 marks a non-digit. Adding 6 may carry out of a
+/// non-digit byte into later bytes, which only disturbs bytes after the first non-digit.
+#[inline(always)]
+fn leading_digits8(v: u64) -> usize {
+    let high = (v & 0xF0F0_F0F0_F0F0_F0F0) ^ 0x3030_3030_3030_3030;
+    let over = ((v.wrapping_add(0x0606_0606_0606_0606) & 0xF0F0_F0F0_F0F0_F0F0)
+        ^ 0x3030_3030_3030_3030)
+        >> 4;
+    let bad = high | over;
+    (bad.trailing_zeros() / 8) as usize
+}
+
+/// The value of eight decimal digit values 0..=9 (first digit in the lowest byte).
+#[inline(always)]
+fn combine8(v: u64) -> u64 {
+    let v = (v * 10) + (v >> 8);
+    let lo = (v & 0x0000_00FF_0000_00FF).wrapping_mul(100 + (1_000_000 << 32));
+    let hi = ((v >> 16) & 0x0000_00FF_0000_00FF).wrapping_mul(1 + (10_000 << 32));
+    (lo.wrapping_add(hi) >> 32) & 0xFFFF_FFFF
+}
+
+const POW10_U64: [u64; 9] = [
+    1,
+    10,
+    100,
+    1_000,
+    10_000,
+    100_000,
+    1_000_000,
+    10_000_000,
+    100_000_000,
+];
+
+/// Digits from `s[*i]` on into `mant` (wrapping; the caller rejects more than 19 digits),
+/// eight bytes at a time while eight bytes remain: the run of leading digits in the word is
+/// shifted to the top (zeros below) and combined. Returns how many digits there were.
+#[inline(always)]
+fn digits(s: &[u8], i: &mut usize, mant: &mut u64) -> usize {
+    let start = *i;
+    while *i + 8 <= s.len() {
+        let v = load8(s, *i);
+        let k = leading_digits8(v);
+        if k == 0 {
+            return *i - start;
+        }
+        // Digit values of the first k bytes, moved up so that the value reads as 8 digits.
+        let d = (v ^ 0x3030_3030_3030_3030) << (8 * (8 - k));
+        *mant = mant.wrapping_mul(POW10_U64[k]).wrapping_add(combine8(d));
+        *i += k;
+        if k < 8 {
+            return *i - start;
+        }
+    }
+    while *i < s.len() && s[*i].is_ascii_digit() {
+        *mant = mant.wrapping_mul(10).wrapping_add((s[*i] - b'0') as u64);
+        *i += 1;
+    }
+    *i - start
+}
+
+/// Parses the plain decimal starting at `s[start]` and returns it with the index just past
+/// it; `None` when it is not a plain decimal within the exact range (then use the slow path).
+#[inline(always)]
+fn fast_prefix(s: &[u8], start: usize) -> Option<(f64, usize)> {
+    let mut i = start;
     let n = s.len();
     // Sign.
-    let neg = match s.first() {
+    let neg = match s.get(i) {
         Some(b'-') => {
-            i = 1;
+            i += 1;
             true
         }
         Some(b'+') => {
-            i = 1;
+            i += 1;
             false
         }
         _ => false,
     };
     // Integer digits, then fraction digits, into one mantissa.
     let mut mant: u64 = 0;
-    let mut ndig = 0u32;
-    let mut exp: i32 = 0;
-    let start = i;
-    while i < n && s[i].is_ascii_digit() {
-        mant = mant.wrapping_mul(10).wrapping_add((s[i] - b'0') as u64);
-        ndig += 1;
-        i += 1;
-    }
-    let int_digits = i - start;
+    let int_digits = digits(s, &mut i, &mut mant);
     let mut frac_digits = 0;
     if i < n && s[i] == b'.' {
         i += 1;
-        let fs = i;
-        while i < n && s[i].is_ascii_digit() {
-            mant = mant.wrapping_mul(10).wrapping_add((s[i] - b'0') as u64);
-            ndig += 1;
-            i += 1;
-        }
-        frac_digits = i - fs;
-        exp = -(frac_digits as i32);
+        frac_digits = digits(s, &mut i, &mut mant);
     }
-    if int_digits + frac_digits == 0 {
+    let ndig = int_digits + frac_digits;
+    if ndig == 0 {
         return None;
     }
+    let mut exp = -(frac_digits as i32);
     // Exponent.
     if i < n && (s[i] == b'e' || s[i] == b'E') {
         i += 1;
@@ -113,16 +196,12 @@ fn fast_f64(s: &[u8]) -> Option<f64> {
             e = e * 10 + (s[i] - b'0') as i32;
             i += 1;
         }
-        if i == es {
+        if i == es || (i < n && s[i].is_ascii_digit()) {
             return None;
         }
         exp += if eneg { -e } else { e };
     }
-    // Anything left (more exponent digits, letters) goes to the slow path.
-    if i != n || ndig > 19 {
-        return None;
-    }
-    if mant > (1u64 << 53) || !(-22..=22).contains(&exp) {
+    if ndig > 19 || mant > (1u64 << 53) || !(-22..=22).contains(&exp) {
         return None;
     }
     let m = mant as f64;
@@ -131,7 +210,31 @@ fn fast_f64(s: &[u8]) -> Option<f64> {
     } else {
         m / POW10[(-exp) as usize]
     };
-    Some(if neg { -v } else { v })
+    Some((if neg { -v } else { v }, i))
+}
+
+/// Parses the next space/tab separated field of `line` from `*i` as f32 (as [`parse_f32`]),
+/// in one pass over the bytes for plain decimals. On failure returns the offending field (for
+/// the error message). Advances `*i` past the field.
+#[inline(always)]
+pub fn field_f32<'a>(line: &'a [u8], i: &mut usize) -> Result<f32, &'a [u8]> {
+    let mut k = *i;
+    while k < line.len() && (line[k] == b' ' || line[k] == b'\t') {
+        k += 1;
+    }
+    if let Some((v, end)) = fast_prefix(line, k)
+        && (end == line.len() || line[end] == b' ' || line[end] == b'\t')
+        && v.to_bits() & 0x1FFF_FFFF != 0x1000_0000
+    {
+        let f = v as f32;
+        if f.is_finite() {
+            *i = end;
+            return Ok(f);
+        }
+    }
+    // Anything else: the whole field through the general parser.
+    let f = next_field(line, i);
+    parse_f32(f).ok_or(f)
 }
 
 /// Parses a decimal integer with optional sign; `None` on anything else or overflow.
@@ -163,6 +266,22 @@ pub fn parse_i64(s: &[u8]) -> Option<i64> {
 #[inline]
 pub fn parse_usize(s: &[u8]) -> Option<usize> {
     parse_i64(s).and_then(|v| usize::try_from(v).ok())
+}
+
+/// The next space/tab separated field of `line` at or after `*i` (empty at the end of the
+/// line, as a slice at the line's end so that errors can point there); advances `*i`.
+#[inline(always)]
+pub fn next_field<'a>(line: &'a [u8], i: &mut usize) -> &'a [u8] {
+    let mut k = *i;
+    while k < line.len() && (line[k] == b' ' || line[k] == b'\t') {
+        k += 1;
+    }
+    let start = k;
+    while k < line.len() && line[k] != b' ' && line[k] != b'\t' {
+        k += 1;
+    }
+    *i = k;
+    &line[start..k]
 }
 
 /// Whitespace (space, tab) separated fields of a line.
@@ -228,6 +347,52 @@ mod tests {
                     "{s}"
                 );
             }
+        }
+    }
+
+    #[test]
+    fn field_parser_agrees_with_parse_f32() {
+        let mut rng = Rng(12345);
+        for k in 0..100_000 {
+            let x = f64::from_bits(rng.next() >> 2) % 1e4;
+            let prec = (rng.next() % 16) as usize;
+            let s = match k % 3 {
+                0 => format!("  {x:.prec$}\t-{x:.prec$} x"),
+                1 => format!("{x:e} {:.prec$}", x * 1e-9),
+                _ => format!("{x:.prec$}1234567890123 1e400 "),
+            };
+            let b = s.as_bytes();
+            let (mut i, mut j) = (0, 0);
+            loop {
+                let f = next_field(b, &mut j);
+                if f.is_empty() {
+                    break;
+                }
+                let got = field_f32(b, &mut i);
+                assert_eq!(i, j, "{s}");
+                match parse_f32(f) {
+                    Some(v) => assert_eq!(got.map(f32::to_bits), Ok(v.to_bits()), "{s}"),
+                    None => assert_eq!(got, Err(f), "{s}"),
+                }
+            }
+        }
+        // Eight-digit groups, with and without a non-digit inside.
+        assert_eq!(
+            field_f32(b"12345678.87654321", &mut 0),
+            Ok(12345678.87654321)
+        );
+        assert_eq!(field_f32(b"1234a678", &mut 0), Err(&b"1234a678"[..]));
+        assert_eq!(value8(u64::from_le_bytes(*b"01234567")), 1_234_567);
+        assert!(!all_digits8(u64::from_le_bytes(*b"0123456:")));
+        assert!(!all_digits8(u64::from_le_bytes(*b"/1234567")));
+        for (w, k) in [
+            (b"12.45678", 2),
+            (b"12345678", 8),
+            (b"-1234567", 0),
+            (b"1234567\xff", 7),
+            (b"9\xfa\xff34567", 1),
+        ] {
+            assert_eq!(leading_digits8(u64::from_le_bytes(*w)), k, "{w:?}");
         }
     }
 

@@ -17,7 +17,9 @@
 use crate::elements::{Element, guess_element};
 use crate::error::Error;
 use crate::frame::{Frame, Label, UnitCell};
-use crate::parse::{fields, parse_f32, parse_f64, parse_i64, parse_usize, trim};
+use crate::parse::{
+    field_f32, fields, next_field, parse_f32, parse_f64, parse_i64, parse_usize, trim,
+};
 use crate::text::{Ctx, LineReader, MAX_RESERVE, Pos, TextFormat};
 use std::io::Read;
 
@@ -53,6 +55,17 @@ impl Xyz {
             self.species.push((name, e));
         }
         e
+    }
+}
+
+/// A name of 1 to 3 bytes packed with its length into a `u32`; 0 for other lengths.
+#[inline(always)]
+fn short_key(b: &[u8]) -> u32 {
+    match *b {
+        [a] => 1 | (a as u32) << 8,
+        [a, c] => 2 | (a as u32) << 8 | (c as u32) << 16,
+        [a, c, d] => 3 | (a as u32) << 8 | (c as u32) << 16 | (d as u32) << 24,
+        _ => 0,
     }
 }
 
@@ -250,7 +263,8 @@ impl Xyz {
         Ok(())
     }
 
-    /// The plain `name x y z` kernel, the hot loop of most XYZ files.
+    /// The plain `name x y z` kernel, the hot loop of most XYZ files. A species seen before is
+    /// found by a byte compare in the species cache (no UTF-8 check, no name rules).
     #[inline]
     fn plain_atom(
         &mut self,
@@ -259,20 +273,33 @@ impl Xyz {
         line: &[u8],
         frame: &mut Frame,
     ) -> Result<(), Error> {
-        let mut it = fields(line);
-        let end = &line[line.len()..];
-        let f = it
-            .next()
-            .ok_or_else(|| ctx.parse(pos, line, end, "an atom name"))?;
-        let name = Label::from_utf8(f)
-            .ok_or_else(|| ctx.parse(pos, line, f, "a name of at most 15 bytes"))?;
+        let mut i = 0;
+        let f = next_field(line, &mut i);
+        if f.is_empty() {
+            return Err(ctx.parse(pos, line, f, "an atom name"));
+        }
+        // Species of up to 3 bytes are compared as one integer (no memcmp call).
+        let key = short_key(f);
+        let hit = if key != 0 {
+            self.species
+                .iter()
+                .find(|(l, _)| short_key(l.as_bytes()) == key)
+        } else {
+            self.species.iter().find(|(l, _)| l.as_bytes() == f)
+        };
+        let (name, e) = match hit {
+            Some(&(l, e)) => (l, e),
+            None => {
+                let l = Label::from_utf8(f)
+                    .ok_or_else(|| ctx.parse(pos, line, f, "a name of at most 15 bytes"))?;
+                (l, self.element(l))
+            }
+        };
         let mut v = [0f32; 3];
         for x in &mut v {
-            let f = it.next().unwrap_or(end);
-            *x = parse_f32(f)
-                .ok_or_else(|| ctx.parse(pos, line, f, "3 coordinates after atom name"))?;
+            *x = field_f32(line, &mut i)
+                .map_err(|f| ctx.parse(pos, line, f, "3 coordinates after atom name"))?;
         }
-        let e = self.element(name);
         frame.names.push(name);
         frame.elements.push(e);
         frame.positions.push(v);

@@ -137,7 +137,14 @@ fn replaced_bytes_never_panic_and_keep_earlier_frames() {
         let (all, _) = read_all(&good, format);
         let ends = frame_ends(&good, format);
         for at in 0..good.len() {
-            for junk in [b'x', b'\n', b' ', 0xff] {
+            // A letter, a line break, a space and a non-UTF-8 byte (the last two at every third
+            // byte, to keep the test quick).
+            let all_junk: &[u8] = if at % 3 == 0 {
+                &[b'x', b'\n', b' ', 0xff]
+            } else {
+                &[b'x', b'\n']
+            };
+            for &junk in all_junk {
                 let mut bad = good.clone();
                 bad[at] = junk;
                 let (got, err) = read_all(&bad, format);
