@@ -42,14 +42,26 @@ fn main() {
     let mut rend = Renderer::new();
     let mut frame = Frame::new(w, h, [0, 0, 0, 255]);
     let st = rend.render_into(&s, &cam, &opts, &mut frame);
+    let cpu0 = cpu_ms();
     let t = Instant::now();
     for _ in 0..iters {
         rend.render_into(&s, &cam, &opts, &mut frame);
     }
     let ms = t.elapsed().as_secs_f64() * 1e3 / iters as f64;
+    let cpu = (cpu_ms() - cpu0) / iters as f64;
     println!(
-        "{name} {} {ms:.2} ms/frame, coverage {:.3}, {st:?}",
+        "{name} {} {ms:.2} ms/frame wall, {cpu:.2} ms/frame CPU (all threads), coverage {:.3}, {st:?}",
         method.name(),
         frame.coverage_count() as f64 / frame.len() as f64
     );
+}
+
+/// User + system CPU time of this process in ms (Linux `/proc/self/stat`, 10 ms ticks).
+fn cpu_ms() -> f64 {
+    let s = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
+    let rest = s.rsplit(')').next().unwrap_or("");
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let ticks: f64 = f.get(11).and_then(|v| v.parse().ok()).unwrap_or(0.0)
+        + f.get(12).and_then(|v| v.parse().ok()).unwrap_or(0.0);
+    ticks * 10.0
 }

@@ -308,27 +308,35 @@ pub(crate) trait Kernel: Sync {
     /// Colour of pixel `(x, y)` won by `rec` at `depth` (sRGB RGBA8).
     fn resolve(&self, rec: &Proj, x: u32, y: u32, depth: f32, flags: u32) -> [u8; 4];
 
-    /// Colours of one tile row: pixels `x0..x0 + out.len()` of image row `y`, with the row's
-    /// winners and depths from the tile buffer (`win[i] == NONE`: background). The default calls
-    /// [`Kernel::resolve`] per pixel; kernels with costly shading override it with lanes.
-    fn resolve_row(
+    /// Colours of one tile: `color[j * stride + i]` for tile pixel `(i, j)` (background where
+    /// nothing won). The default calls [`Kernel::resolve`] per pixel; kernels with costly
+    /// shading override it with lanes over the covered pixels.
+    fn resolve_tile(
         &self,
         recs: &[Proj],
-        x0: u32,
-        y: u32,
-        win: &[u32],
-        depth: &[f32],
+        tile: TileRect,
+        buf: &TileBuf,
         background: [u8; 4],
-        out: &mut [[u8; 4]],
+        color: &mut [[u8; 4]],
+        stride: usize,
     ) {
-        for (i, o) in out.iter_mut().enumerate() {
-            let wv = win[i];
-            *o = if wv == NONE {
-                background
-            } else {
-                let rec = &recs[(wv & !FLAG_INSIDE) as usize];
-                self.resolve(rec, x0 + i as u32, y, depth[i], wv & FLAG_INSIDE)
-            };
+        for j in 0..tile.h {
+            for i in 0..tile.w {
+                let b = (j * TILE + i) as usize;
+                let wv = buf.win[b];
+                color[j as usize * stride + i as usize] = if wv == NONE {
+                    background
+                } else {
+                    let rec = &recs[(wv & !FLAG_INSIDE) as usize];
+                    self.resolve(
+                        rec,
+                        tile.x0 + i,
+                        tile.y0 + j,
+                        buf.depth[b],
+                        wv & FLAG_INSIDE,
+                    )
+                };
+            }
         }
     }
 }
@@ -390,20 +398,12 @@ pub(crate) fn draw_tiles<K: Kernel>(
                 // Depth pass over the bin in sphere order.
                 kernel.raster(recs, tile, &mut buf);
                 // Resolve pass: colour each covered pixel once.
+                kernel.resolve_tile(recs, tile, &buf, background, &mut color[x0 as usize..], w);
                 for j in 0..th as usize {
                     let o = j * w + x0 as usize;
                     let bw = j * TILE as usize;
                     let win = &buf.win[bw..bw + tw as usize];
                     let dep = &buf.depth[bw..bw + tw as usize];
-                    kernel.resolve_row(
-                        recs,
-                        x0,
-                        y0 + j as u32,
-                        win,
-                        dep,
-                        background,
-                        &mut color[o..o + tw as usize],
-                    );
                     for ((d, &wv), &bd) in depth[o..o + tw as usize].iter_mut().zip(win).zip(dep) {
                         *d = if wv == NONE { f32::INFINITY } else { bd };
                     }
