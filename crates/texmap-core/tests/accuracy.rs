@@ -99,7 +99,6 @@ fn span_blur_versus_trilinear_on_the_tilted_plane() {
 }
 
 fn compare(tex: &MipTexture, face: &TexturedFace) {
-    let tex = tex;
     // Reference (a): 8x8 supersampling with sub-pixel footprints.
     let n = 8;
     let supersampled = {
