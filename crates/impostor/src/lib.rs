@@ -40,6 +40,7 @@
 mod fastshade;
 mod lut;
 mod pipeline;
+mod polygon;
 mod raycast;
 mod template;
 
@@ -169,6 +170,15 @@ pub enum TemplateColoring {
     PerKind,
 }
 
+/// How the polygon method lights its triangles.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PolygonShading {
+    /// Per pixel with the interpolated vertex normal.
+    Phong,
+    /// Per vertex, colours interpolated.
+    Gouraud,
+}
+
 /// Drawing options shared by all methods; fields a method does not use are ignored by it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Options {
@@ -185,6 +195,8 @@ pub struct Options {
     /// Polygon method: largest allowed distance, in pixels, between the true silhouette and the
     /// tessellated one; the tessellation level per sphere is chosen from it.
     pub polygon_max_error_px: f32,
+    /// Polygon method: Phong (default) or Gouraud.
+    pub polygon_shading: PolygonShading,
     /// Draw `SphereScene::bonds` (methods without bond support ignore it and say so in their docs).
     pub draw_bonds: bool,
 }
@@ -202,6 +214,7 @@ impl Options {
             template_depth: TemplateDepth::Billboard,
             template_coloring: TemplateColoring::HueRecolor,
             polygon_max_error_px: 0.25,
+            polygon_shading: PolygonShading::Phong,
             draw_bonds: true,
         }
     }
@@ -232,6 +245,7 @@ pub struct Renderer {
     bins: pipeline::Bins,
     lut: Option<lut::LutTables>,
     template: Option<template::TemplateTables>,
+    polygon: polygon::PolygonState,
 }
 
 /// Smallest and largest accepted side of the Seed 002 images and Seed 004 templates; other
@@ -334,19 +348,7 @@ impl Renderer {
                 pipeline::draw_tiles(&self.bins, &view, &k, bg, frame);
                 stats
             }
-            // Interim: polygon is still drawn by the ray-cast kernels.
-            Method::Polygon => {
-                let stats = self
-                    .bins
-                    .build(scene, &view, |c, r, k| raycast::project(&view, c, r, k));
-                let k = raycast::Perspective {
-                    view,
-                    lighting,
-                    materials: &scene.materials,
-                };
-                pipeline::draw_tiles(&self.bins, &view, &k, bg, frame);
-                stats
-            }
+            Method::Polygon => self.polygon.render(scene, camera, options, frame),
         }
     }
 }
