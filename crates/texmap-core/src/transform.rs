@@ -171,6 +171,11 @@ impl MapSample {
 
 /// A textured planar face seen by a perspective camera: Seed 000 Eq. (1)–(3) precomputed.
 ///
+/// A NaN eye or a field of view of 0° or 180° cannot reach this type: [`Camera`] refuses them
+/// (`CameraError::NonFinite`, `CameraError::BadFov`). A face seen edge-on (eye in its plane) is
+/// [`TransformError::EdgeOn`]; a face seen at a grazing angle is accepted and its pixels near the
+/// horizon return `None` from [`TexturedFace::map`].
+///
 /// # Guarantees
 /// Built only from finite data with non-parallel axes, a positive map width, a perspective camera
 /// and an eye off the plane; every stored coefficient is finite. [`TexturedFace::map`] returns

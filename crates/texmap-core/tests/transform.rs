@@ -307,6 +307,11 @@ fn degenerate_faces_are_errors_and_horizon_pixels_are_none() {
         TexturedFace::new(Vec3::ZERO, Vec3::X, Vec3::Z, 1.0, &ortho),
         Err(TransformError::Orthographic)
     );
+    // FOV 0° / 180° and a NaN eye never become a camera, so never reach a face.
+    for fov in [0.0, 180.0] {
+        assert!(Camera::perspective_look_at(Vec3::Z, Vec3::ZERO, Vec3::Y, fov, 8, 8).is_err());
+    }
+    assert!(Camera::perspective_look_at(Vec3::NAN, Vec3::ZERO, Vec3::Y, 60.0, 8, 8).is_err());
     // Ground plane y = 0 seen from above at a shallow angle: the top rows see the sky.
     let face = TexturedFace::new(Vec3::ZERO, Vec3::X, Vec3::Z, 1.0, &cam).unwrap();
     let mut sky = 0;
