@@ -8,6 +8,7 @@
 //!   for Pm and Fm..Lr. Note Alvarez's radii are larger than Bondi's (1964) for metals (Na 2.50
 //!   vs 2.27 Å) and for C (1.77 vs 1.70 Å).
 //! - Colours: the Jmol CPK colours (8-bit sRGB), H..Lr.
+//!
 //! Both were generated from ASE 3.29 (`ase.data.vdw_alvarez`, `ase.data.colors.jmol_colors`) by
 //! `tests/data/gen_elements.py --rust`; `tests/elements.rs` checks every entry against the JSON
 //! that script writes.

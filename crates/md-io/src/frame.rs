@@ -157,7 +157,7 @@ impl UnitCell {
         let cx = c * cb;
         let cy = c * (ca - cb * cg) / sg;
         let cz2 = c * c - cx * cx - cy * cy;
-        if !(cz2 > 0.0) {
+        if cz2.is_nan() || cz2 <= 0.0 {
             return Err(Error::InvalidValue {
                 what: format!("cell angles {angles:?} do not describe a cell with volume > 0"),
             });
@@ -179,7 +179,7 @@ impl UnitCell {
             });
         }
         let vol = det3(&matrix);
-        if !(vol > 0.0) {
+        if vol.is_nan() || vol <= 0.0 {
             return Err(Error::InvalidValue {
                 what: format!(
                     "cell edge vectors must be right-handed with volume > 0, got {matrix:?}"

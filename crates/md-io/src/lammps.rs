@@ -244,6 +244,7 @@ impl Lammps {
                 };
                 cell = Lammps::boxes(lines, ctx, kind)?;
             } else if let Some(spec) = item.strip_prefix(b"ATOMS") {
+                let spec = trim(spec);
                 let Some(n) = n else {
                     return Err(ctx.parse(
                         pos,

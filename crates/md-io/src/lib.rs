@@ -40,6 +40,7 @@
 //! 2. add the variant to `Reader`, an arm to `each_reader!` and to `Trajectory::from_reader`;
 //! 3. for a writer, a type with `fn write_frame(&mut self, frame: &Frame) -> std::io::Result<()>`
 //!    and `fn finish(&mut self) -> std::io::Result<()>`, a `WriterKind` variant and arms.
+//!
 //! Text formats instead implement the private `TextFormat` trait (src/text.rs) and get
 //! streaming, the line-scan index and error positions from `TextReader`.
 

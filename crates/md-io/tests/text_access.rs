@@ -347,8 +347,8 @@ fn python_reads_our_xyz_and_pdb_as_we_wrote_them() {
         }
         let dims = e["dimensions"].as_array().unwrap();
         let c = f.cell.unwrap();
-        for k in 0..3 {
-            assert!((dims[k].as_f64().unwrap() - c.lengths()[k]).abs() <= 5e-4);
+        for (d, l) in dims.iter().zip(c.lengths()) {
+            assert!((d.as_f64().unwrap() - l).abs() <= 5e-4);
         }
     }
 }

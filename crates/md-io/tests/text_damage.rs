@@ -139,11 +139,7 @@ fn replaced_bytes_never_panic_and_keep_earlier_frames() {
         for at in 0..good.len() {
             // A letter, a line break, a space and a non-UTF-8 byte (the last two at every third
             // byte, to keep the test quick).
-            let all_junk: &[u8] = if at % 3 == 0 {
-                &[b'x', b'\n', b' ', 0xff]
-            } else {
-                &[b'x', b'\n']
-            };
+            let all_junk: &[u8] = if at % 3 == 0 { b"x\n \xff" } else { b"x\n" };
             for &junk in all_junk {
                 let mut bad = good.clone();
                 bad[at] = junk;

@@ -224,13 +224,7 @@ fn lammps_reference() -> Vec<LmpRef> {
                 e["yz"].as_f64().unwrap(),
             );
             let rows = |k: &str| -> Vec<[f64; 3]> {
-                let flat: Vec<f64> = e[k]
-                    .as_array()
-                    .unwrap()
-                    .iter()
-                    .map(|v| v3(v))
-                    .flatten()
-                    .collect();
+                let flat: Vec<f64> = e[k].as_array().unwrap().iter().flat_map(v3).collect();
                 flat.chunks(3).map(|c| [c[0], c[1], c[2]]).collect()
             };
             // LAMMPS packs image flags as 10-bit fields (IMGBITS = 10, IMGMAX = 512).
