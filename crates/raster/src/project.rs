@@ -137,12 +137,22 @@ impl Proj {
             return clip;
         }
         PVert {
-            x: ((self.cx + sx) * SUB).round() as i32,
-            y: ((self.cy + sy) * SUB).round() as i32,
+            x: snap((self.cx + sx) * SUB),
+            y: snap((self.cy + sy) * SUB),
             q,
             dw,
         }
     }
+}
+
+/// Round to the nearest integer, halves away from zero (same as `f32::round`, but a truncating
+/// conversion instead of a libm call on baseline x86-64, which lacks SSE4.1 `roundss`).
+/// Exact below 2^23 (32768 pixels of 256 steps); farther out in the guard band f32 has no
+/// fraction and the result may differ from `round` by one step (1/256 px). Snapping stays a
+/// function of the vertex alone, so shared edges remain watertight either way.
+#[inline(always)]
+fn snap(v: f32) -> i32 {
+    (v + 0.5f32.copysign(v)) as i32
 }
 
 /// A clip-space vertex: `[X, Y, W, depth]` and its varyings.
@@ -261,8 +271,8 @@ impl Proj {
                 return 0;
             }
             pv[i] = PVert {
-                x: (sx * SUB).round() as i32,
-                y: (sy * SUB).round() as i32,
+                x: snap(sx * SUB),
+                y: snap(sy * SUB),
                 q,
                 dw: depth * q,
             };

@@ -142,10 +142,6 @@ pub(crate) fn raster_tri<P: FragProgram>(
         step_x[i] = -dy * 256;
         step_y[i] = dx * 256;
     }
-    // Lane offsets of the quad (0,0), (1,0), (0,1), (1,1).
-    let lane_off = |i: usize| [0, step_x[i], step_y[i], step_x[i] + step_y[i]];
-    let off = [lane_off(0), lane_off(1), lane_off(2)];
-
     // Plane equations (set up in f64, evaluated in f32 relative to the first quad).
     let fx0 = v[0].x as f64 / 256.0;
     let fy0 = v[0].y as f64 / 256.0;
@@ -177,6 +173,103 @@ pub(crate) fn raster_tri<P: FragProgram>(
         );
     }
 
+    let setup = Setup {
+        px0,
+        py0,
+        px1,
+        py1,
+        xl,
+        yl,
+        p_q,
+        p_dw,
+        p_var,
+    };
+    // Edge values stay within i32 when every pixel centre the loop can reach (the quad-aligned
+    // range plus one step past it) has |E| < 2^30: E is affine, so checking the corners suffices.
+    // Small triangles (the common case) then run on 32-bit lanes, twice as wide per register.
+    let reach = |i: usize, cx: i64, cy: i64| (e_row[i] + cx * step_x[i] + cy * step_y[i]).abs();
+    let (ex, ey) = ((px1 - px0 + 3) as i64, (py1 - py0 + 3) as i64);
+    let small = (0..3).all(|i| {
+        reach(i, 0, 0)
+            .max(reach(i, ex, 0))
+            .max(reach(i, 0, ey))
+            .max(reach(i, ex, ey))
+            < (1 << 30)
+    });
+    if small {
+        let cv = |a: [i64; 3]| a.map(|x| x as i32);
+        quad_loop::<P, i32>(
+            tile,
+            ctx,
+            prog,
+            cst,
+            front,
+            &setup,
+            cv(e_row),
+            cv(step_x),
+            cv(step_y),
+        );
+    } else {
+        quad_loop::<P, i64>(tile, ctx, prog, cst, front, &setup, e_row, step_x, step_y);
+    }
+}
+
+/// What the quad loop needs from the triangle set-up.
+struct Setup {
+    px0: i32,
+    py0: i32,
+    px1: i32,
+    py1: i32,
+    /// Last pixel column / row of the tile inside the image.
+    xl: i32,
+    yl: i32,
+    p_q: Plane,
+    p_dw: Plane,
+    p_var: [Plane; MAX_VAR],
+}
+
+/// Integer lanes for the edge functions (i32 for small triangles, i64 otherwise).
+trait EdgeInt:
+    Copy + Default + std::ops::Add<Output = Self> + std::ops::BitOr<Output = Self> + PartialOrd
+{
+    const ZERO: Self;
+}
+impl EdgeInt for i32 {
+    const ZERO: Self = 0;
+}
+impl EdgeInt for i64 {
+    const ZERO: Self = 0;
+}
+
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn quad_loop<P: FragProgram, E: EdgeInt>(
+    tile: &mut Tile,
+    ctx: &RasterCtx,
+    prog: &P,
+    cst: &P::TriConst,
+    front: bool,
+    s: &Setup,
+    mut e_row: [E; 3],
+    step_x: [E; 3],
+    step_y: [E; 3],
+) {
+    let Setup {
+        px0,
+        py0,
+        px1,
+        py1,
+        xl,
+        yl,
+        p_q,
+        p_dw,
+        ref p_var,
+    } = *s;
+    // Lane offsets of the quad (0,0), (1,0), (0,1), (1,1), and steps of two pixels.
+    let lane_off = |i: usize| [E::ZERO, step_x[i], step_y[i], step_x[i] + step_y[i]];
+    let off = [lane_off(0), lane_off(1), lane_off(2)];
+    let step2_x = step_x.map(|v| v + v);
+    let step2_y = step_y.map(|v| v + v);
     let st = ctx.state;
     let far = ctx.far;
     let mut qy = py0;
@@ -192,7 +285,7 @@ pub(crate) fn raster_tri<P: FragProgram>(
             let mut mask = 0u8;
             for l in 0..4 {
                 let s = (e[0] + off[0][l]) | (e[1] + off[1][l]) | (e[2] + off[2][l]);
-                mask |= ((s >= 0) as u8) << l;
+                mask |= ((s >= E::ZERO) as u8) << l;
             }
             let col_mask: u8 = if qx + 1 > xl { 0b0101 } else { 0b1111 };
             mask &= row_mask & col_mask;
@@ -211,7 +304,7 @@ pub(crate) fn raster_tri<P: FragProgram>(
                     depth[l] = dwv[l] * w[l];
                 }
                 // Depth test (NaN and out-of-range depths fail every comparison below).
-                let stored: [f32; 4] = tile.depth[base..base + 4].try_into().unwrap_or([0.0; 4]);
+                let stored = &tile.depth[base..base + 4];
                 let mut zmask = 0u8;
                 for l in 0..4 {
                     let d = depth[l];
@@ -253,12 +346,12 @@ pub(crate) fn raster_tri<P: FragProgram>(
                 }
             }
             for i in 0..3 {
-                e[i] += 2 * step_x[i];
+                e[i] = e[i] + step2_x[i];
             }
             qx += 2;
         }
         for i in 0..3 {
-            e_row[i] += 2 * step_y[i];
+            e_row[i] = e_row[i] + step2_y[i];
         }
         qy += 2;
     }
