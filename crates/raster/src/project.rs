@@ -122,7 +122,8 @@ impl Proj {
             q: 0.0,
             dw: 0.0,
         };
-        if !(depth >= self.near) {
+        // (`e` is finite here, so `depth` is not NaN.)
+        if depth < self.near {
             return clip;
         }
         let (q, dw) = if self.persp {
@@ -232,11 +233,9 @@ impl Proj {
                 let b = poly[(i + 1) % n];
                 let da = self.plane_dist(plane, &a.h);
                 let db = self.plane_dist(plane, &b.h);
-                if da >= 0.0 {
-                    if m < MAX_POLY {
-                        next[m] = a;
-                        m += 1;
-                    }
+                if da >= 0.0 && m < MAX_POLY {
+                    next[m] = a;
+                    m += 1;
                 }
                 if (da >= 0.0) != (db >= 0.0) {
                     // The edge crosses the plane: emit the intersection.

@@ -131,7 +131,7 @@ fn random_triangle_pixel_count_matches_f64_brute_force() {
                     edge(p[2], p[0], x, y),
                     edge(p[0], p[1], x, y),
                 ];
-                if e.iter().any(|&v| v == 0.0) {
+                if e.contains(&0.0) {
                     on_edge = true;
                 }
                 if e.iter().all(|&v| v * area > 0.0) {
