@@ -385,7 +385,11 @@ impl<R: Read + Seek> TrrReader<R> {
             } else {
                 convert::<4>(bytes, out);
             }
-            if let Some(bad) = out.iter().position(|v| !v.iter().all(|c| c.is_finite())) {
+            if !all_finite(out) {
+                let bad = out
+                    .iter()
+                    .position(|v| !v.iter().all(|c| c.is_finite()))
+                    .unwrap_or(0);
                 return Err(Error::Parse {
                     at: Location::binary(&self.file, index, offset + (p + 3 * r * bad) as u64),
                     expected: what,
@@ -465,10 +469,12 @@ impl<R: Read + Seek> TrrReader<R> {
     }
 }
 
-/// Big-endian reals (4 or 8 bytes) in nm to f32 triples in Å.
+/// Big-endian reals (4 or 8 bytes) in nm to f32 triples in Å (precision chosen outside the
+/// loop, output written in place: no per-atom push).
 fn convert<const REAL: usize>(bytes: &[u8], out: &mut Vec<[f32; 3]>) {
-    out.extend(bytes.chunks_exact(3 * REAL).map(|c| {
-        std::array::from_fn(|d| {
+    out.resize(bytes.len() / (3 * REAL), [0.0; 3]);
+    for (o, c) in out.iter_mut().zip(bytes.chunks_exact(3 * REAL)) {
+        *o = std::array::from_fn(|d| {
             let b = &c[d * REAL..];
             if REAL == 8 {
                 let v = f64::from_be_bytes([b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7]]);
@@ -476,8 +482,23 @@ fn convert<const REAL: usize>(bytes: &[u8], out: &mut Vec<[f32; 3]>) {
             } else {
                 f32::from_be_bytes([b[0], b[1], b[2], b[3]]) * 10.0
             }
-        })
-    }));
+        });
+    }
+}
+
+/// True if every value is finite (branch-free over chunks of 8 values).
+fn all_finite(p: &[[f32; 3]]) -> bool {
+    let flat = p.as_flattened();
+    let mut chunks = flat.chunks_exact(8);
+    let mut ok = true;
+    for c in &mut chunks {
+        let mut lane = true;
+        for v in c {
+            lane &= v.is_finite();
+        }
+        ok &= lane;
+    }
+    ok && chunks.remainder().iter().all(|v| v.is_finite())
 }
 
 /// The cell of a GROMACS box (rows, Å); an all-zero box means none.
