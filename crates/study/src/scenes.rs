@@ -298,7 +298,7 @@ pub struct Molecule {
     pub bonds: Vec<[u32; 2]>,
 }
 
-/// Seed 002 builds on ideal geometry; these are the standard peptide values (Engh & Huber 1991).
+/// Ideal peptide geometry: standard bond lengths and angles (Engh & Huber 1991).
 mod peptide {
     pub const N_CA: f64 = 1.458;
     pub const CA_C: f64 = 1.525;
@@ -394,6 +394,21 @@ impl Molecule {
             el.extend([Element::C, Element::O]);
             pos.extend([c, o]);
         }
+        // Lay the helix axis along world x, centred at the origin, so the study's oblique camera
+        // sees it from the side. The axis is the difference of the centroids of two 5-turn
+        // stretches of CA atoms (18 residues = 5 turns at 3.6 residues a turn).
+        let ca_centroid = |r: std::ops::Range<usize>| {
+            let n = r.len() as f64;
+            r.map(|i| pos[i * 10 + 2]).sum::<DVec3>() / n
+        };
+        if residues >= 19 {
+            let axis = (ca_centroid(residues - 18..residues) - ca_centroid(0..18)).normalize();
+            let rot = glam::DQuat::from_rotation_arc(axis, DVec3::X);
+            let centre = pos.iter().sum::<DVec3>() / pos.len() as f64;
+            for p in &mut pos {
+                *p = rot * (*p - centre);
+            }
+        }
         // Bonds by distance (O(N²) is fine for a few hundred atoms).
         let mut bonds = Vec::new();
         for i in 0..pos.len() {
@@ -482,6 +497,9 @@ mod tests {
             assert!((2.6..3.3).contains(&d), "O{i}..N{}: {d} Å", i + 4);
         }
         let rise = ca(0).distance(ca(18)) / 18.0;
+        // The helix axis was laid along x: the 5-turn span CA(0)→CA(18) is along x.
+        let along = (ca(18) - ca(0)).normalize();
+        assert!(along.x.abs() > 0.99, "helix axis not along x: {along}");
         assert!(
             (rise - 1.5).abs() < 0.1,
             "rise per residue: expected 1.5, got {rise}, tolerance 0.1"
