@@ -28,7 +28,9 @@
 use crate::elements::{Element, guess_element};
 use crate::error::Error;
 use crate::frame::{Frame, Label, UnitCell};
-use crate::parse::{fields, parse_f32, parse_f64, parse_i64, parse_usize, trim};
+use crate::parse::{
+    field_f32, field_f64, fields, next_field, parse_f32, parse_f64, parse_i64, parse_usize, trim,
+};
 use crate::text::{Ctx, LineReader, MAX_RESERVE, Pos, TextFormat};
 use std::io::Read;
 
@@ -360,17 +362,31 @@ impl TextFormat for Lammps {
             };
             let mut xyz = [0f64; 3];
             let mut v = [0f32; 3];
-            let mut it = fields(line);
+            let mut at = 0;
             for &act in &self.acts {
-                let Some(f) = it.next() else {
-                    let end = &line[line.len()..];
-                    return Err(ctx.parse(pos, line, end, "as many values as ITEM: ATOMS columns"));
-                };
-                match act {
-                    Act::Pos(k) => {
-                        xyz[k] =
-                            parse_f64(f).ok_or_else(|| ctx.parse(pos, line, f, "a coordinate"))?;
+                // Coordinates are parsed in place (one pass); other columns as fields.
+                if let Act::Pos(k) = act {
+                    xyz[k] = if h.pos_kind == PosKind::Scaled {
+                        field_f64(line, &mut at)
+                    } else {
+                        // Cartesian: correctly rounded to f32 once (exact in f64).
+                        field_f32(line, &mut at).map(f64::from)
                     }
+                    .map_err(|f| {
+                        if f.is_empty() {
+                            ctx.parse(pos, line, f, "as many values as ITEM: ATOMS columns")
+                        } else {
+                            ctx.parse(pos, line, f, "a coordinate")
+                        }
+                    })?;
+                    continue;
+                }
+                let f = next_field(line, &mut at);
+                if f.is_empty() {
+                    return Err(ctx.parse(pos, line, f, "as many values as ITEM: ATOMS columns"));
+                }
+                match act {
+                    Act::Pos(_) => {}
                     Act::Vel(k) => {
                         v[k] = parse_f32(f)
                             .map(|x| x * vel_scale)
