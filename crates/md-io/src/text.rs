@@ -402,14 +402,15 @@ impl<R: Read + Seek, F: TextFormat> TextReader<R, F> {
     /// Number of frames (scans the whole file once; keeps the read position).
     pub fn n_frames(&mut self) -> Result<usize, Error> {
         if !self.complete {
-            let keep = self.next;
-            self.scan_to(usize::MAX - 1)?;
-            if keep < self.starts.len() {
-                self.seek_frame(keep)?;
-            } else {
-                // Every frame had been read: the scan ended at the end of the data, as we had.
-                self.next = keep;
-            }
+            // Scan, then resume exactly where the next read would have started, even when the
+            // scan stopped at a damaged frame.
+            let (keep, resume) = (self.next, self.lines.pos());
+            let scanned = self.scan_to(usize::MAX - 1);
+            self.lines
+                .seek(resume)
+                .map_err(|e| self.ctx().io(resume, e))?;
+            self.next = keep;
+            scanned?;
         }
         Ok(self.starts.len())
     }
