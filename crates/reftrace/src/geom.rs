@@ -597,4 +597,95 @@ mod tests {
             }
         }
     }
+
+    /// Textbook Möller–Trumbore in f32, NOT watertight: only here to show that the pinhole test
+    /// below can fail.
+    fn moller_trumbore(o: Vec3, d: Vec3, v0: Vec3, v1: Vec3, v2: Vec3) -> bool {
+        let (e1, e2) = (v1 - v0, v2 - v0);
+        let p = d.cross(e2);
+        let det = e1.dot(p);
+        if det == 0.0 {
+            return false;
+        }
+        let inv = 1.0 / det;
+        let s = o - v0;
+        let u = s.dot(p) * inv;
+        if !(0.0..=1.0).contains(&u) {
+            return false;
+        }
+        let q = s.cross(e1);
+        let v = d.dot(q) * inv;
+        if v < 0.0 || u + v > 1.0 {
+            return false;
+        }
+        e2.dot(q) * inv > 0.0
+    }
+
+    #[test]
+    fn shared_edges_leak_with_moller_trumbore_but_not_with_the_watertight_test() {
+        // A 24x24-vertex heightfield with irregular heights and irregular x/z spacing; rays aimed
+        // exactly at vertices and edge midpoints from several directions, tested against every
+        // triangle (brute force). Surface slopes (< 0.4) are below every ray's slope (> 1.2), so
+        // the surface projects one-to-one along each ray: no tangent rays, every ray must hit.
+        let n = 24usize;
+        let mut rng = Lcg(99);
+        let xs: Vec<f32> = (0..n)
+            .map(|i| i as f32 * 0.37 + rng.range(0.0, 0.2))
+            .collect();
+        let zs: Vec<f32> = (0..n)
+            .map(|j| j as f32 * 0.41 + rng.range(0.0, 0.2))
+            .collect();
+        let mut pos = Vec::new();
+        for &z in &zs {
+            for &x in &xs {
+                pos.push(Vec3::new(x, rng.range(-0.05, 0.05), z));
+            }
+        }
+        let mut tris = Vec::new();
+        for j in 0..n - 1 {
+            for i in 0..n - 1 {
+                let a = j * n + i;
+                tris.push([pos[a], pos[a + n], pos[a + 1]]);
+                tris.push([pos[a + 1], pos[a + n], pos[a + n + 1]]);
+            }
+        }
+        let (mut ours, mut mt, mut rays) = (0, 0, 0);
+        for dir in [
+            Vec3::new(0.0, -1.0, 0.0),
+            Vec3::new(0.31, -0.9, 0.17).normalize(),
+            Vec3::new(-0.2, -0.7, 0.55).normalize(),
+        ] {
+            for j in 1..n - 1 {
+                for i in 1..n - 1 {
+                    let k = j * n + i;
+                    for target in [
+                        pos[k],
+                        (pos[k] + pos[k + 1]) * 0.5,
+                        (pos[k] + pos[k + n]) * 0.5,
+                        (pos[k] + pos[k + n + 1]) * 0.5,
+                    ] {
+                        let o = target - dir * 2.0;
+                        let pre = RayPre::new(o, dir);
+                        rays += 1;
+                        if !tris.iter().any(|t| {
+                            intersect_triangle(&pre, t[0], t[1], t[2], 0.0, f32::INFINITY).is_some()
+                        }) {
+                            ours += 1;
+                        }
+                        if !tris
+                            .iter()
+                            .any(|t| moller_trumbore(o, dir, t[0], t[1], t[2]))
+                        {
+                            mt += 1;
+                        }
+                    }
+                }
+            }
+        }
+        assert_eq!(ours, 0, "watertight test leaked {ours} of {rays} rays");
+        assert!(
+            mt > 0,
+            "Möller–Trumbore leaked none of {rays}: the test does not discriminate"
+        );
+    }
 }
