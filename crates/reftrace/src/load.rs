@@ -348,4 +348,21 @@ mod tests {
         let e = load_gltf_bytes(text.as_bytes(), "short.gltf").unwrap_err();
         assert!(e.to_string().contains("short.gltf"), "{e}");
     }
+
+    #[test]
+    fn files_load_like_bytes() {
+        // Write the fixtures to a private temporary directory, read them back by path.
+        let dir = std::env::temp_dir().join(format!("texmap-reftrace-load-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let obj = dir.join("quad.obj");
+        std::fs::write(&obj, QUAD_OBJ).unwrap();
+        let gltf = dir.join("tri.gltf");
+        std::fs::write(&gltf, triangle_gltf([1.0, 2.0, 3.0])).unwrap();
+        let a = load_obj(&obj).unwrap();
+        let b = load_obj_bytes(QUAD_OBJ.as_bytes(), "quad.obj").unwrap();
+        let c = load_gltf(&gltf).unwrap();
+        std::fs::remove_dir_all(&dir).ok();
+        assert_eq!(a, b);
+        assert_eq!(c[0].positions[0], Vec3::new(1.0, 2.0, 3.0));
+    }
 }
