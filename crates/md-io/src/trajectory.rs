@@ -182,7 +182,11 @@ impl<R: Read + Seek> Trajectory<R> {
         self.read_frame(0, &mut scratch)?;
         let n = scratch.n_atoms();
         self.n_atoms = Some(n);
-        each_reader!(&mut self.reader, r => r.seek_frame(keep))?;
+        // Back to frame `keep`; when every frame had been read there is no frame `keep` to
+        // seek to, so read on to the end instead.
+        if !each_reader!(&mut self.reader, r => r.seek_frame(keep))? {
+            while each_reader!(&mut self.reader, r => r.read_next(&mut scratch))? {}
+        }
         self.next = keep;
         Ok(n)
     }

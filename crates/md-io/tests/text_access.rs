@@ -65,6 +65,12 @@ fn random_access_equals_streaming_in_any_order() {
         t.read_frame(all.len() - 1, &mut f).unwrap();
         assert_eq!(f, *all.last().unwrap());
         assert!(!t.read_next(&mut f).unwrap());
+        // n_atoms after the last frame keeps the reader at the end.
+        assert_eq!(t.n_atoms().unwrap(), all[0].n_atoms());
+        assert!(
+            !t.read_next(&mut f).unwrap(),
+            "{name}: n_atoms moved the reader"
+        );
         match t.read_frame(all.len(), &mut f) {
             Err(Error::FrameOutOfRange {
                 requested,
