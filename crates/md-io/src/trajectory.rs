@@ -52,6 +52,9 @@ macro_rules! each_reader {
 ///
 /// A damaged frame gives an [`Error`] naming the file, the frame and the line / byte offset;
 /// every frame before it stays readable.
+///
+/// Memory: the current frame's buffers, a 1 MiB read chunk for text formats, and the frame
+/// index (16 bytes per frame seen: byte offset and line number of its start).
 pub struct Trajectory<R: Read + Seek = File> {
     reader: Reader<R>,
     file: Arc<str>,

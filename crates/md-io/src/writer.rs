@@ -96,13 +96,16 @@ impl<W: Write + Seek> Writer<W> {
             what,
         })?;
         // Format limits (e.g. PDB's fixed columns).
-        if let WriterKind::Pdb(_) = &self.kind {
-            PdbWriter::<W>::check(frame).map_err(|what| Error::InvalidFrame {
-                file: self.file.clone(),
-                frame: self.written,
-                what,
-            })?;
-        }
+        let limits = match &self.kind {
+            WriterKind::Pdb(_) => PdbWriter::<W>::check(frame),
+            WriterKind::Xyz(_) => XyzWriter::<W>::check(frame),
+            _ => Ok(()),
+        };
+        limits.map_err(|what| Error::InvalidFrame {
+            file: self.file.clone(),
+            frame: self.written,
+            what,
+        })?;
         let r = each_writer!(&mut self.kind, w => w.write_frame(frame));
         r.map_err(|source| self.io(source))?;
         self.written += 1;

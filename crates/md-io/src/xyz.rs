@@ -375,6 +375,22 @@ pub(crate) struct XyzWriter<W> {
 }
 
 impl<W: std::io::Write> XyzWriter<W> {
+    /// Why `frame` cannot be written as XYZ, if it cannot: a name with spaces would shift the
+    /// columns of its line.
+    pub fn check(frame: &Frame) -> Result<(), String> {
+        match frame
+            .names
+            .iter()
+            .position(|l| l.bytes().any(|b| b.is_ascii_whitespace()))
+        {
+            Some(i) => Err(format!(
+                "atom {i}'s name '{}' contains white space",
+                frame.names[i]
+            )),
+            None => Ok(()),
+        }
+    }
+
     /// XYZ has no trailer.
     pub fn finish(&mut self) -> std::io::Result<()> {
         Ok(())

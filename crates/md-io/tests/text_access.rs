@@ -207,6 +207,17 @@ fn pdb_writer_rejects_what_the_columns_cannot_hold() {
 }
 
 #[test]
+fn xyz_writer_rejects_names_with_white_space() {
+    let mut f = Frame::new();
+    f.positions = vec![[0.0; 3]];
+    f.names = vec![Label::new("C 1").unwrap()];
+    let mut w = Writer::new(Cursor::new(Vec::new()), Format::Xyz, "sp.xyz").unwrap();
+    let e = w.write_frame(&f).unwrap_err();
+    assert!(e.to_string().contains("white space"), "{e}");
+    assert_eq!(w.frames_written(), 0);
+}
+
+#[test]
 fn hybrid36_serials_past_99999_atoms_round_trip() {
     // 100,010 atoms: serials 100,000.. are written as A0000..; residue numbers past 9,999 too.
     let n = 100_010;
