@@ -88,7 +88,7 @@ impl Default for MdParams {
         MdParams {
             dt: 0.005,
             temperature: 1.0,
-            seed: 0x5EED_004,
+            seed: 0x05EE_D004,
         }
     }
 }

@@ -403,6 +403,28 @@ mod tests {
     }
 
     #[test]
+    fn lut_outline_error_matches_the_tangent_cone_formula() {
+        // Seed 002 draws a disc of radius ρ_lut = k·r/d (centre depth) where the true on-axis
+        // silhouette has radius ρ = k·r/√(d² − r²). With ρ held at 0.3·128 px the uncovered
+        // annulus has area π(ρ² − ρ_lut²), ρ_lut = ρk/√(ρ² + k²); the mismatched pixel count must
+        // match it up to pixelation of its two rims (10 % + 30 px).
+        let s = series(SweepKind::Fov, Method::Lut);
+        let rho = (FOV_SWEEP_RADIUS_FRACTION * SIZE as f32) as f64;
+        for p in s.points.iter().filter(|p| p.x >= 45.0) {
+            let k = SIZE as f64 / (2.0 * (p.x.to_radians() * 0.5).tan());
+            let rho_lut = rho * k / (rho * rho + k * k).sqrt();
+            let expect = std::f64::consts::PI * (rho * rho - rho_lut * rho_lut);
+            let got = p.metrics.silhouette_mismatched as f64;
+            let tol = 0.1 * expect + 30.0;
+            assert!(
+                (got - expect).abs() <= tol,
+                "fov {}: expected {expect:.0} mismatched px, got {got}, tolerance {tol:.0}",
+                p.x
+            );
+        }
+    }
+
+    #[test]
     fn polygon_silhouette_is_within_its_tessellation_bound() {
         // Options::polygon_max_error_px = 0.25, plus up to 0.5 px of pixel-centre sampling.
         let s = series(SweepKind::Fov, Method::Polygon);
