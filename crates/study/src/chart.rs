@@ -26,6 +26,9 @@ static FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
 /// Infinite PSNR is plotted at this height.
 pub const PSNR_CEILING_DB: f64 = 100.0;
 
+/// Smallest silhouette displacement drawn on the log axis (a zero error sits here).
+pub const SILHOUETTE_FLOOR_PX: f64 = 1e-3;
+
 /// Smallest relative depth error drawn on the log axis (a zero error sits here).
 pub const DEPTH_REL_FLOOR: f64 = 1e-8;
 
@@ -48,7 +51,8 @@ fn ensure_font() -> Result<(), StudyError> {
 /// What a sweep chart plots on its y axis.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum SweepMetric {
-    /// Mean silhouette displacement (px), linear axis.
+    /// Mean silhouette displacement (px), log axis floored at [`SILHOUETTE_FLOOR_PX`] (a sweep
+    /// spans 0 to thousands of pixels when a method stops drawing a sphere that fills the view).
     SilhouettePx,
     /// PSNR (dB), linear axis, infinite drawn at [`PSNR_CEILING_DB`].
     PsnrDb,
@@ -74,19 +78,19 @@ impl SweepMetric {
 
     fn label(self) -> &'static str {
         match self {
-            SweepMetric::SilhouettePx => "silhouette displacement (px)",
+            SweepMetric::SilhouettePx => "silhouette displacement (px, 0 drawn at 0.001)",
             SweepMetric::PsnrDb => "PSNR vs reference (dB)",
             SweepMetric::DepthErrRel => "max depth error / depth range",
         }
     }
 
     fn log(self) -> bool {
-        self == SweepMetric::DepthErrRel
+        self != SweepMetric::PsnrDb
     }
 
     fn value(self, m: &Metrics) -> f64 {
         match self {
-            SweepMetric::SilhouettePx => m.silhouette_px,
+            SweepMetric::SilhouettePx => m.silhouette_px.clamp(SILHOUETTE_FLOOR_PX, 1e6),
             SweepMetric::PsnrDb => m.psnr_db.min(PSNR_CEILING_DB),
             SweepMetric::DepthErrRel => m.depth_err_rel().clamp(DEPTH_REL_FLOOR, 1e3),
         }

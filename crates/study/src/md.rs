@@ -494,6 +494,12 @@ mod tests {
         for p in a.positions() {
             assert!(p.min_element() >= 0.0 && p.max_element() < 30.0, "{p}");
         }
+        // A frame becomes the S1 scene with moved spheres; frame 0 is S1 itself.
+        let sys = Seed004System::generate(SCENE_SEED);
+        let s0 = sys.frame_scene(&fa[0], 500, 500).unwrap();
+        let s1 = crate::scenes::build(crate::scenes::SceneId::S1);
+        assert_eq!(s0.spheres, s1.spheres);
+        assert_eq!(s0.camera, s1.camera);
         // The particles really moved.
         let moved = fa[0]
             .iter()

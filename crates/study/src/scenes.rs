@@ -284,6 +284,31 @@ impl Seed004System {
     }
 }
 
+impl Seed004System {
+    /// The S1 scene (camera and lighting of [`SceneId::S1`]) with the particles at an MD frame's
+    /// positions (as [`crate::md::MdSystem::run`] yields them), for animations.
+    pub fn frame_scene(
+        &self,
+        frame: &[Vec3],
+        width: u32,
+        height: u32,
+    ) -> Result<NamedScene, CameraError> {
+        let mats = SEED004_SPECIES.iter().map(|s| s.0.material()).collect();
+        let mut spheres = SphereScene::new(mats);
+        for (i, p) in frame.iter().enumerate().take(self.species.len()) {
+            spheres.push(*p, self.radius(i), self.species[i] as u16);
+        }
+        let l = self.box_len as f32;
+        let camera = box_camera(Vec3::splat(0.5 * l), l, width, height)?;
+        Ok(NamedScene {
+            id: SceneId::S1,
+            lighting: Lighting::default_for(&camera),
+            spheres,
+            camera,
+        })
+    }
+}
+
 /// The minimum-image displacement in a periodic cube of side `l`.
 #[inline]
 pub(crate) fn min_image(d: DVec3, l: f64) -> DVec3 {
