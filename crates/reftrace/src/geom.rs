@@ -160,7 +160,8 @@ pub fn intersect_sphere(
     let v = f - dir * (b / (2.0 * a));
     let len = v.length();
     let disc = 4.0 * a * (radius + len) * (radius - len);
-    if !(disc >= 0.0) {
+    // A negative (or NaN) discriminant misses.
+    if disc.is_nan() || disc < 0.0 {
         return None;
     }
     // Compute the roots with the cancellation-free form q = −(b + sign(b)√disc)/2.

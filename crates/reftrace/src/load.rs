@@ -32,7 +32,6 @@ pub fn load_obj_bytes(bytes: &[u8], source: &str) -> Result<Vec<MeshData>, LoadE
         triangulate: true,
         ignore_points: true,
         ignore_lines: true,
-        ..Default::default()
     };
     let mut reader = std::io::BufReader::new(bytes);
     let (models, _materials) =

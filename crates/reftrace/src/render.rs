@@ -474,7 +474,8 @@ fn footprint_integral(
     let n = e1.cross(e2);
     let (d00, d01, d11) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
     let den = d00 * d11 - d01 * d01;
-    if !(den > 0.0) {
+    // Reject a degenerate triangle (den ≤ 0 or NaN).
+    if den.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
         return None;
     }
     let (uv0, du1, du2) = (
