@@ -24,7 +24,7 @@ fn main() {
     let name = args.get(1).map(String::as_str).unwrap_or("S2");
     let method = Method::from_name(args.get(2).map(String::as_str).unwrap_or("raycast")).unwrap();
     let iters: usize = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(10);
-    let fov: f32 = args.get(4).and_then(|s| s.parse().ok()).unwrap_or(65.0);
+    let fov: f32 = args.get(4).and_then(|s| s.parse().ok()).unwrap_or(69.0);
     let (n, side, r, w, h) = match name {
         "S1" => (1115, 24.0, 1.0, 500, 500),
         "S2" => (100_000, 100.0, 0.5, 1920, 1080),
