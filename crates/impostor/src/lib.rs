@@ -7,8 +7,8 @@
 //! | [`Method`] | what it is | exact? |
 //! |---|---|---|
 //! | `Polygon` | tessellated spheres (the papers' baseline), tessellation chosen per sphere from its projected size, drawn with `texmap-raster` | silhouette to within the tessellation error |
-//! | `Lut` | Seed 002: a square of side 2R per sphere textured with a colour image (lit once per scene per material, 1-bit mask) and a depth image (once ever); `z = z0 + D(s,t)·R/d0` | exact for an orthographic camera; errs with perspective as documented |
-//! | `Template` | Seed 004: disc billboards textured with a window cut from a template texture at `x_tex = 0.5 − r·sin(θ/2)`, `y_tex = 0.5 − r·sin(φ/2)` | pseudo-shading |
+//! | `Lut` | Seed 002: a square of side 2R per sphere textured with a colour image (lit once per scene per material, 1-bit mask) and a depth image (once ever); `z = z0 + D(s,t)·R/d0`, which in our linear eye-space depth is `z0 + D·R` (see the `lut` module) | exact for an orthographic camera; errs with perspective as documented |
+//! | `Template` | Seed 004: disc billboards textured with a window cut from a template texture at `x_tex = 0.5 − r·sin(θ/2)`, `y_tex = 0.5 − r·sin(φ/2)` (our texture rows run downward, so `+` there) | pseudo-shading |
 //! | `Raycast` | per-fragment ray–sphere intersection over the sphere's exact perspective bounding quad | exact depth, normals and silhouette |
 //!
 //! All methods cull to the view frustum, do no work for spheres behind the camera, handle spheres
@@ -16,7 +16,28 @@
 //! centre or a non-positive or non-finite radius.
 //!
 //! A [`Renderer`] keeps the per-scene tables (Seed 002 images, Seed 004 template pyramid) between
-//! frames, as the papers do; [`render`] is the one-shot convenience.
+//! frames, as the papers do, and the per-frame bin buffers; [`Renderer::render_into`] also reuses
+//! the output frame. [`render`] is the one-shot convenience.
+//!
+//! # How a frame is drawn
+//! `Lut`, `Template` and `Raycast` share one pipeline (module `pipeline`): transform + cull +
+//! project every sphere (parallel over fixed chunks) → two-pass binning of a 32-byte copy of each
+//! projected sphere into 32x32 tiles (count, prefix sum, fill) → per tile, a depth pass over its
+//! bin in sphere order (8-pixel lanes) and a resolve pass that colours each covered pixel once,
+//! in parallel over bands of tiles. The per-method kernel is chosen once per frame (static
+//! dispatch). `Polygon` batches shared icosphere levels into `texmap-raster`.
+//!
+//! - **Near plane.** `Raycast`: the exact answer — fragments nearer than the near plane are
+//!   clipped and the ray takes the far intersection, so a cut sphere (or one the eye is inside)
+//!   shows its interior, lit with the normal turned toward the viewer (as the reference ray
+//!   tracer's two-sided surfaces). `Lut`/`Template`: spheres whose centre is not in front of the
+//!   near plane are skipped (counted as culled); their other fragments nearer than it are clipped.
+//!   `Polygon`: the rasteriser clips triangles; spheres reaching the near plane are drawn
+//!   two-sided.
+//! - **Sub-pixel spheres** follow the pixel-centre rule: a sphere is drawn where it covers a pixel
+//!   centre; one that covers none is counted as culled.
+//! - **Determinism.** The same input gives the same bytes for any number of rayon threads (fixed
+//!   chunking, sphere order kept per tile, strict depth test); tested with pools of 1 and 2.
 //!
 //! ```
 //! use texmap_impostor::{render, Method, Options, SphereScene};
