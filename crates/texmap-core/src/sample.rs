@@ -269,6 +269,8 @@ fn lambda(l0: &LevelInfo, duv_dx: Vec2, duv_dy: Vec2) -> f32 {
 /// Seed 000 Eq. (4): blend the bilinear samples of levels ⌊λ⌋ and ⌊λ⌋+1 by frac(λ), clamped to the
 /// pyramid; `m` is the footprint in level-0 texels (λ = log2 m, split by [`log2_split`]).
 #[inline(always)]
+// `!(a > b)` on purpose: NaN must take the fallback branch.
+#[allow(clippy::neg_cmp_op_on_partial_ord)]
 fn trilinear_fp<A: Addr>(tex: &MipTexture, uv: Vec2, m: f32) -> Vec4 {
     let levels = tex.levels();
     let texels = tex.texels();
@@ -289,6 +291,8 @@ fn trilinear_fp<A: Addr>(tex: &MipTexture, uv: Vec2, m: f32) -> Vec4 {
 
 /// [`trilinear_fp`] at an explicit λ (used by the anisotropic reference's taps).
 #[inline(always)]
+// `!(a > b)` on purpose: NaN must take the fallback branch.
+#[allow(clippy::neg_cmp_op_on_partial_ord)]
 fn trilinear<A: Addr>(tex: &MipTexture, uv: Vec2, lam: f32) -> Vec4 {
     let levels = tex.levels();
     let texels = tex.texels();

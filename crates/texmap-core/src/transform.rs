@@ -198,6 +198,8 @@ pub struct TexturedFace {
 impl TexturedFace {
     /// The face through `origin` spanned by `u_axis`, `v_axis` (world), `map_width` world units per
     /// map width, seen by `camera`.
+    // `!(a > b)` on purpose: NaN must take the fallback branch.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)]
     pub fn new(
         origin: Vec3,
         u_axis: Vec3,
@@ -286,6 +288,8 @@ impl TexturedFace {
     /// centres): the map point, its screen derivatives and `z⁻¹`. `None` where the ray misses the
     /// face (`z⁻¹ ≤ 0`) or the result is not finite (at the horizon).
     #[inline]
+    // `!(a > b)` on purpose: NaN must take the fallback branch.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)]
     pub fn map(&self, x: f32, y: f32) -> Option<MapSample> {
         let rs = Vec3::new(x - self.cx, y - self.cy, self.k);
         // z⁻¹ = (T_eb n)ᵗ r_s / (k c).

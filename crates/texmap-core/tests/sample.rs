@@ -47,7 +47,7 @@ fn trilinear_f64(t: &MipTexture, uv: Vec2, dx: Vec2, dy: Vec2) -> DVec4 {
         .max((dy.y as f64 * h).abs());
     let last = t.level_count() - 1;
     let lam = m.log2();
-    if !(lam > 0.0) {
+    if lam.is_nan() || lam <= 0.0 {
         return bilinear_f64(t, 0, uv);
     }
     if lam >= last as f64 {
