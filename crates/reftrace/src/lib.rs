@@ -16,8 +16,8 @@
 //!   watertight ray/triangle test of Woop, Benthin and Wald (2013), which leaves no pinholes on
 //!   shared edges (obvhs's own triangle test does; it is not used).
 //!
-//! Correctness and robustness come first; it still traces a million spheres at 1080p in well under
-//! a second on two cores (docs/fragments/reftrace.md).
+//! Correctness and robustness come first; it still traces a million spheres at 1080p in about a
+//! second on two cores, plus about a second to build the BVH (docs/fragments/reftrace.md).
 //!
 //! ```
 //! use texmap_core::camera::Camera;
