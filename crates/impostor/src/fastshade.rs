@@ -6,6 +6,11 @@
 //! test bounds the difference from [`Lighting::shade`] (≤ 2e-5 absolute on random inputs, far
 //! under half an 8-bit sRGB step).
 
+// Comparisons written `!(a > b)` are deliberate: they also reject NaN.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+// Lane loops index several fixed-width arrays with one lane counter (the vectorised form).
+#![allow(clippy::needless_range_loop)]
+
 use glam::Vec3;
 use texmap_core::shade::{Lighting, Material};
 

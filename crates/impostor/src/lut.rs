@@ -32,6 +32,9 @@
 //! Record layout ([`Proj::f`]): `[sx, sy, 1/(2h), z0, R]` (screen centre in pixels); `aux` is the
 //! pyramid level ([`LutTables`]).
 
+// Comparisons written `!(a > b)` are deliberate: they also reject NaN.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 use glam::Vec3;
 use texmap_core::color::linear_to_srgb8;
 use texmap_core::shade::{Lighting, Material};
@@ -210,7 +213,7 @@ impl Kernel for LutKernel<'_> {
             for j in y0..y1 {
                 // t ∈ [0, 1) down the square; rows off the square are skipped.
                 let tt = ((tile.y0 + j) as f32 + 0.5 - sy) * inv2h + 0.5;
-                if !(tt >= 0.0 && tt < 1.0) {
+                if !(0.0..1.0).contains(&tt) {
                     continue;
                 }
                 let trow = ((tt * nf) as u32).min(n - 1) * n;
@@ -221,7 +224,7 @@ impl Kernel for LutKernel<'_> {
                     let mut z = [f32::INFINITY; LANES];
                     for (l, zl) in z.iter_mut().enumerate() {
                         let s = base_s + (i + l) as f32 * inv2h;
-                        let inside = s >= 0.0 && s < 1.0 && i + l < x1 as usize;
+                        let inside = (0.0..1.0).contains(&s) && i + l < x1 as usize;
                         let ti = ((if s > 0.0 { s } else { 0.0 } * nf) as u32).min(n - 1);
                         // Seed 002 §3.3: z = z0 + D(s,t)·R (linear eye-space form, module docs);
                         // D is infinite outside the mask.

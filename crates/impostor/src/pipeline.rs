@@ -22,6 +22,9 @@
 //!
 //! All per-frame buffers live in [`Bins`], which the [`crate::Renderer`] keeps between frames.
 
+// Comparisons written `!(a > b)` are deliberate: they also reject NaN.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 use glam::Vec3;
 use rayon::prelude::*;
 use texmap_core::camera::Camera;
@@ -100,7 +103,7 @@ impl View {
     }
 
     #[inline]
-    pub fn to_eye(&self, p: Vec3) -> Vec3 {
+    pub fn eye_space(&self, p: Vec3) -> Vec3 {
         let d = p - self.eye;
         Vec3::new(d.dot(self.right), d.dot(self.up), d.dot(self.back))
     }
@@ -192,7 +195,7 @@ impl Bins {
                         stats.skipped_invalid += 1;
                         continue;
                     }
-                    let c = view.to_eye(scene.centers[i]);
+                    let c = view.eye_space(scene.centers[i]);
                     match project(c, scene.radii[i], scene.kinds[i]) {
                         Projected::Draw(p) => {
                             stats.drawn += 1;
@@ -235,6 +238,9 @@ impl Bins {
             .par_iter()
             .zip(self.chunk_counts[..nchunks].par_iter_mut())
             .for_each(|(recs, offs)| {
+                // Capture the whole `SendPtr` (edition 2024 closures would capture the raw
+                // pointer field alone, which is not `Send`).
+                #[allow(clippy::redundant_locals)]
                 let base = base;
                 for p in recs {
                     let (tx0, ty0, tx1, ty1) = tile_range(p);

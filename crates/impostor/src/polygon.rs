@@ -23,6 +23,9 @@
 //! Batching by material changes the drawing order between materials; the z-buffer makes the
 //! result independent of it except for exactly equal depths, and the output is deterministic.
 
+// Comparisons written `!(a > b)` are deliberate: they also reject NaN.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 use glam::Vec3;
 use texmap_core::camera::Camera;
 use texmap_core::frame::Frame;
@@ -244,7 +247,7 @@ impl PolygonState {
                     if !scene.is_valid(i) {
                         continue;
                     }
-                    let c = view.to_eye(scene.centers[i]);
+                    let c = view.eye_space(scene.centers[i]);
                     let r = scene.radii[i];
                     let p = match raycast::project(&view, c, r, scene.kinds[i]) {
                         Projected::Draw(p) => p,

@@ -29,6 +29,11 @@
 //!
 //! Record layout ([`Proj::f`]): `[c.x, c.y, c.z, r², 1/r]` in eye space.
 
+// Comparisons written `!(a > b)` are deliberate: they also reject NaN.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+// Lane loops index several fixed-width arrays with one lane counter (the vectorised form).
+#![allow(clippy::needless_range_loop)]
+
 use glam::Vec3;
 use texmap_core::color::linear_to_srgb8;
 use texmap_core::shade::{Lighting, Material};

@@ -29,6 +29,9 @@
 //! Record layout ([`Proj::f`]): `[sx, sy, 1/h, z0, R]`; `aux` packs the window offsets
 //! `sin(θ/2)`, `sin(φ/2)` as two `i8` in units of 1/127.
 
+// Comparisons written `!(a > b)` are deliberate: they also reject NaN.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 use glam::Vec3;
 use texmap_core::color::{hsv_to_rgb, linear_to_srgb8, rgb_to_hsv};
 use texmap_core::shade::{Lighting, Material};
