@@ -1,0 +1,495 @@
+//! The subcommands: glue between files, the libraries and the terminal.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use indicatif::{ProgressBar, ProgressStyle};
+use serde_json::json;
+use texmap_core::camera::Camera;
+use texmap_core::shade::Lighting;
+use texmap_impostor::{Method, Renderer, SphereScene};
+use texmap_md_io::{Format, Frame as MdFrame, Trajectory};
+use texmap_study::harness::{self, HarnessOptions, SceneReport};
+use texmap_study::scenes::{self, NamedScene, SceneId};
+
+use crate::args::{Cli, Command, CompareArgs, MethodArg, RenderArgs, SceneArg, usage};
+use crate::output::{frame_path, write_atomic, write_depth_exr, write_png};
+use crate::scene::{SceneBuilder, camera_for, parse_background, parse_size};
+
+pub fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        Command::Info { file, format } => info(&file, format.as_deref()),
+        Command::Render(a) => render(&a),
+        Command::Compare(a) => compare(&a),
+        Command::Demo {
+            out,
+            steps,
+            every,
+            size,
+        } => demo(&out, steps, every, &size),
+    }
+}
+
+fn progress(len: u64, what: &str) -> ProgressBar {
+    let pb = ProgressBar::new(len);
+    pb.set_style(
+        ProgressStyle::with_template(&format!(
+            "{{spinner}} {what} [{{bar:30}}] {{pos}}/{{len}} {{per_sec}} ETA {{eta}}"
+        ))
+        .expect("static template")
+        .progress_chars("=> "),
+    );
+    pb
+}
+
+fn open_trajectory(file: &Path, format: Option<&str>) -> Result<Trajectory> {
+    if !file.exists() {
+        bail!("{}: no such file", file.display());
+    }
+    match format {
+        Some(name) => {
+            let Some(f) = Format::from_extension(name) else {
+                return usage(format!(
+                    "--format {name:?}: expected one of xyz, extxyz, pdb, gro, lammpstrj, dcd, xtc, trr"
+                ));
+            };
+            Ok(Trajectory::open_as(file, f)?)
+        }
+        None => Ok(Trajectory::open(file)?),
+    }
+}
+
+fn info(file: &Path, format: Option<&str>) -> Result<()> {
+    let mut traj = open_trajectory(file, format)?;
+    let mut frame = MdFrame::new();
+    let frames = traj.n_frames()?;
+    if frames == 0 {
+        bail!("{}: the file holds no frame", file.display());
+    }
+    traj.read_frame(0, &mut frame)?;
+    let bx = frame.cell.as_ref().map(|c| {
+        let l = c.lengths();
+        let a = c.angles();
+        json!([l[0], l[1], l[2], a[0], a[1], a[2]])
+    });
+    let first: Vec<_> = frame
+        .positions
+        .iter()
+        .take(3)
+        .map(|p| json!([p[0], p[1], p[2]]))
+        .collect();
+    let obj = json!({
+        "format": traj.format().name(),
+        "atoms": frame.n_atoms(),
+        "frames": frames,
+        "box": bx,
+        "first_positions": first,
+    });
+    println!("{obj}");
+    Ok(())
+}
+
+/// Parse `A:B:STEP` against `n` frames (B exclusive, each part optional, a lone `A` is one frame).
+pub fn parse_frames(spec: &str, n: usize) -> Result<Vec<usize>> {
+    let bad = |why: &str| -> Result<Vec<usize>> {
+        usage(format!(
+            "--frames {spec:?}: {why} (expected A:B:STEP, e.g. 0:100:10)"
+        ))
+    };
+    let parts: Vec<&str> = spec.split(':').collect();
+    if parts.len() > 3 {
+        return bad("too many ':'");
+    }
+    let num = |s: &str, default: usize| -> Option<usize> {
+        if s.trim().is_empty() {
+            Some(default)
+        } else {
+            s.trim().parse().ok()
+        }
+    };
+    let Some(a) = num(parts[0], 0) else {
+        return bad("start is not a whole number");
+    };
+    let b = if parts.len() == 1 {
+        a + 1
+    } else {
+        match num(parts[1], n) {
+            Some(b) => b.min(n),
+            None => return bad("end is not a whole number"),
+        }
+    };
+    let step = match parts.get(2).map(|s| num(s, 1)) {
+        None => 1,
+        Some(Some(0)) => return bad("step must be at least 1"),
+        Some(Some(s)) => s,
+        Some(None) => return bad("step is not a whole number"),
+    };
+    if a >= n {
+        return bad(&format!(
+            "start frame {a} is past the last frame ({n} frames)"
+        ));
+    }
+    Ok((a..b).step_by(step).collect())
+}
+
+fn method_of(m: MethodArg) -> Option<Method> {
+    match m {
+        MethodArg::Raycast => Some(Method::Raycast),
+        MethodArg::Lut => Some(Method::Lut),
+        MethodArg::Template => Some(Method::Template),
+        MethodArg::Polygon => Some(Method::Polygon),
+        MethodArg::Reference => None,
+    }
+}
+
+fn render(a: &RenderArgs) -> Result<()> {
+    let background = parse_background(&a.background)?;
+    parse_size(&a.size)?;
+    let mut traj = open_trajectory(&a.file, a.format.as_deref())?;
+    let n = traj.n_frames()?;
+    if n == 0 {
+        bail!("{}: the file holds no frame", a.file.display());
+    }
+    let frames = parse_frames(&a.frames, n)?;
+    let multi = frames.len() > 1;
+    let mut builder = SceneBuilder::new(a.color_by, a.radius_scale)?;
+    let mut md = MdFrame::new();
+    let mut scene = SphereScene::default();
+    let mut renderer = Renderer::new();
+    let mut camera: Option<Camera> = None;
+    let pb = progress(frames.len() as u64, "rendering");
+    let mut skipped_total = 0usize;
+    for &f in &frames {
+        traj.read_frame(f, &mut md)?;
+        builder.build(&mut md, &mut scene);
+        if a.box_outline {
+            add_box_outline(&md, &mut scene);
+        }
+        let cam = match &camera {
+            Some(c) => c.clone(),
+            None => {
+                let c = camera_for(a, &md, &scene)?;
+                camera = Some(c.clone());
+                c
+            }
+        };
+        let lighting = Lighting::default_for(&cam);
+        let out = match method_of(a.method) {
+            Some(m) => {
+                let mut o = texmap_impostor::Options::new(m, lighting);
+                o.background = background;
+                let r = renderer.render(&scene, &cam, &o);
+                skipped_total += r.stats.skipped_invalid;
+                r.frame
+            }
+            None => harness::render_reference(
+                &harness::reference_scene(&scene),
+                &harness::reference_materials(&scene),
+                &cam,
+                lighting,
+                background,
+                1,
+            )?,
+        };
+        let path = frame_path(&a.output, f, multi)?;
+        write_png(&out, &path)?;
+        if a.depth {
+            write_depth_exr(&out, &path.with_extension("exr"))?;
+        }
+        pb.inc(1);
+    }
+    pb.finish_and_clear();
+    if skipped_total > 0 {
+        eprintln!(
+            "texmap: warning: {skipped_total} atoms skipped over {} frames (non-finite position or radius)",
+            frames.len()
+        );
+    }
+    eprintln!("texmap: wrote {} frame(s)", frames.len());
+    Ok(())
+}
+
+/// The periodic box outline as rows of small grey spheres along its 12 edges (every method draws
+/// spheres; none draws lines), spaced at one radius so they read as a line.
+fn add_box_outline(md: &MdFrame, scene: &mut SphereScene) {
+    let Some(cell) = &md.cell else { return };
+    let grey = scene.materials.len() as u16;
+    scene
+        .materials
+        .push(texmap_core::shade::Material::matte(glam::Vec3::splat(0.6)));
+    let l = cell.lengths();
+    let r = (l[0].min(l[1]).min(l[2]) as f32 * 0.004).max(1e-3);
+    let corners = crate::scene::cell_corners(cell);
+    for a in 0..8u32 {
+        for bit in [1u32, 2, 4] {
+            if a & bit == 0 {
+                let (p, q) = (corners[a as usize], corners[(a | bit) as usize]);
+                // At most 2,000 spheres an edge, whatever the box.
+                let n = ((p.distance(q) / r).ceil() as usize).clamp(1, 2000);
+                for k in 0..=n {
+                    scene.push(p.lerp(q, k as f32 / n as f32), r, grey);
+                }
+            }
+        }
+    }
+}
+
+fn named_scene(a: &CompareArgs) -> Result<NamedScene> {
+    match (&a.scene, &a.file) {
+        (Some(s), None) => {
+            let id = match s {
+                SceneArg::S1 => SceneId::S1,
+                SceneArg::S2 => SceneId::S2,
+                SceneArg::S3 => SceneId::S3,
+                SceneArg::Molecule => SceneId::Molecule,
+            };
+            Ok(scenes::build(id))
+        }
+        (None, Some(_)) => {
+            usage("comparing a trajectory file is not supported yet; use --scene S1|S2|S3|molecule")
+        }
+        _ => usage("give a trajectory FILE or --scene S1|S2|S3|molecule"),
+    }
+}
+
+fn write_report(out: &Path, report: &SceneReport) -> Result<()> {
+    let dir = out.join(report.scene.as_str());
+    write_png(&report.reference, &dir.join("reference.png"))?;
+    for run in &report.runs {
+        let name = run.method.name();
+        write_png(&run.frame, &dir.join(format!("{name}.png")))?;
+        let err = harness::error_image(&run.frame, &report.reference, 8.0)?;
+        write_png(&err, &dir.join(format!("{name}_error.png")))?;
+    }
+    Ok(())
+}
+
+fn write_results(out: &Path, records: &[harness::Record]) -> Result<()> {
+    let csv = harness::records_to_csv(records);
+    let json = harness::records_to_json(records)?;
+    write_atomic(&out.join("results.csv"), |p| {
+        std::fs::write(p, &csv).context("results.csv")
+    })?;
+    write_atomic(&out.join("results.json"), |p| {
+        std::fs::write(p, &json).context("results.json")
+    })?;
+    Ok(())
+}
+
+fn compare(a: &CompareArgs) -> Result<()> {
+    if a.runs == 0 {
+        return usage("--runs must be at least 1");
+    }
+    let scene = named_scene(a)?;
+    let opts = HarnessOptions {
+        runs: a.runs,
+        ..HarnessOptions::default()
+    };
+    eprintln!(
+        "texmap: comparing {} methods and the reference on {} ({} spheres, {}x{})",
+        opts.methods.len(),
+        scene.name(),
+        scene.spheres.len(),
+        scene.camera.width(),
+        scene.camera.height()
+    );
+    let report = harness::run_scene(&scene, &opts)?;
+    write_report(&a.out, &report)?;
+    write_results(&a.out, &report.records)?;
+    let series = if a.sweeps {
+        eprintln!("texmap: running the stability sweeps");
+        let s = texmap_study::sweeps::run_all_sweeps(128)?;
+        let csv = texmap_study::sweeps::series_to_csv(&s);
+        write_atomic(&a.out.join("sweeps.csv"), |p| {
+            std::fs::write(p, &csv).context("sweeps.csv")
+        })?;
+        s
+    } else {
+        Vec::new()
+    };
+    texmap_study::chart::write_charts(&a.out, &report.records, &series)?;
+    print_table(&report.records);
+    Ok(())
+}
+
+fn print_table(records: &[harness::Record]) {
+    println!(
+        "{:<10} {:<10} {:>12} {:>9} {:>7} {:>12} {:>12}",
+        "scene", "method", "ms/frame", "PSNR dB", "SSIM", "depth mean", "silhouette px"
+    );
+    for r in records {
+        println!(
+            "{:<10} {:<10} {:>12.3} {:>9.2} {:>7.4} {:>12.3e} {:>12.3}",
+            r.scene, r.method, r.ms_per_frame, r.psnr_db, r.ssim, r.depth_err_mean, r.silhouette_px
+        );
+    }
+}
+
+struct AnimationSummary {
+    method: &'static str,
+    frames: usize,
+    ms_per_frame: f64,
+}
+
+fn demo(out: &Path, steps: usize, every: usize, size: &str) -> Result<()> {
+    use texmap_study::md::{MdParams, MdSystem};
+    use texmap_study::scenes::{SCENE_SEED, Seed004System, box_camera};
+    let (w, h) = parse_size(size)?;
+    if steps == 0 || every == 0 {
+        return usage("--steps and --every must be at least 1");
+    }
+    if steps / every > 5000 {
+        return usage("at most 5000 frames: raise --every or lower --steps");
+    }
+    std::fs::create_dir_all(out)
+        .with_context(|| format!("cannot create output directory {}", out.display()))?;
+
+    // Simulate the Seed 004 system.
+    eprintln!(
+        "texmap: simulating the Seed 004 silicate system (1,115 particles, {steps} LJ steps)"
+    );
+    let system = Seed004System::generate(SCENE_SEED);
+    let mut md = MdSystem::new(&system, MdParams::default())?;
+    let frames = md.run(steps, every);
+    let center = glam::Vec3::splat(Seed004System::BOX_LEN as f32 * 0.5);
+    let cam = box_camera(center, Seed004System::BOX_LEN as f32, w, h)?;
+    let lighting = Lighting::default_for(&cam);
+
+    // Animate with every method.
+    let pb = progress((frames.len() * Method::ALL.len()) as u64, "animating");
+    let mut summaries = Vec::new();
+    for method in Method::ALL {
+        let mut renderer = Renderer::new();
+        let opts = harness::study_options(method, lighting);
+        let mut total = 0.0;
+        for (i, pos) in frames.iter().enumerate() {
+            let p64: Vec<glam::DVec3> = pos.iter().map(|v| v.as_dvec3()).collect();
+            let scene = system.to_scene(&p64);
+            let t = Instant::now();
+            let r = renderer.render(&scene, &cam, &opts);
+            total += t.elapsed().as_secs_f64() * 1e3;
+            write_png(
+                &r.frame,
+                &out.join("frames")
+                    .join(method.name())
+                    .join(format!("{i:04}.png")),
+            )?;
+            pb.inc(1);
+        }
+        summaries.push(AnimationSummary {
+            method: method.name(),
+            frames: frames.len(),
+            ms_per_frame: total / frames.len() as f64,
+        });
+    }
+    pb.finish_and_clear();
+
+    // Compare every method with the reference on S1 and run the sweeps.
+    eprintln!("texmap: comparing every method with the reference ray tracer (S1)");
+    let scene = scenes::build_sized(SceneId::S1, w, h)?;
+    let report = harness::run_scene(&scene, &HarnessOptions::default())?;
+    write_report(out, &report)?;
+    write_results(out, &report.records)?;
+    eprintln!("texmap: stability sweeps");
+    let series = texmap_study::sweeps::run_all_sweeps(128)?;
+    let csv = texmap_study::sweeps::series_to_csv(&series);
+    write_atomic(&out.join("sweeps.csv"), |p| {
+        std::fs::write(p, &csv).context("sweeps.csv")
+    })?;
+    let charts = texmap_study::chart::write_charts(out, &report.records, &series)?;
+    let html = index_html(&summaries, &report, &charts, out);
+    write_atomic(&out.join("index.html"), |p| {
+        std::fs::write(p, &html).context("index.html")
+    })?;
+    print_table(&report.records);
+    eprintln!("texmap: open {}", out.join("index.html").display());
+    Ok(())
+}
+
+fn rel(path: &Path, base: &Path) -> String {
+    path.strip_prefix(base)
+        .unwrap_or(path)
+        .to_string_lossy()
+        .replace('\\', "/")
+}
+
+fn index_html(
+    anim: &[AnimationSummary],
+    report: &SceneReport,
+    charts: &[PathBuf],
+    out: &Path,
+) -> String {
+    let mut s = String::from(
+        "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>texmap demo</title>\n<style>\
+body{font-family:sans-serif;margin:2em;max-width:1200px}table{border-collapse:collapse}\
+td,th{border:1px solid #bbb;padding:4px 8px;text-align:right}th{background:#eee}\
+.anim{display:inline-block;margin:0 1em 1em 0;text-align:center}img{max-width:100%}\
+</style></head><body>\n<h1>texmap demo: the Seed 004 silicate system</h1>\n\
+<p>1,115 particles (409 O, 50 Si, 6 Al, 50 Mg, 500 H, 100 He) moved by a Lennard-Jones MD integrator \
+(velocity Verlet), drawn by four sphere methods on the CPU and compared with a BVH reference ray tracer.</p>\n\
+<h2>Animation</h2>\n<p><button onclick=\"play=!play\">play / pause</button> \
+<input type=\"range\" id=\"slider\" min=\"0\" value=\"0\" oninput=\"show(+this.value)\"> frame <span id=\"fno\">0</span></p>\n",
+    );
+    for a in anim {
+        s.push_str(&format!(
+            "<div class=\"anim\"><img class=\"frame\" data-method=\"{m}\" src=\"frames/{m}/0000.png\" width=\"320\"><br>{m}: {ms:.2} ms/frame</div>\n",
+            m = a.method,
+            ms = a.ms_per_frame
+        ));
+    }
+    let n = anim.first().map(|a| a.frames).unwrap_or(0);
+    s.push_str(&format!(
+        "<script>\nconst N={n};let cur=0,play=true;const sl=document.getElementById('slider');sl.max=N-1;\n\
+function show(i){{cur=i;sl.value=i;document.getElementById('fno').textContent=i;\
+for(const im of document.querySelectorAll('img.frame')){{im.src='frames/'+im.dataset.method+'/'+String(i).padStart(4,'0')+'.png';}}}}\n\
+setInterval(()=>{{if(play&&N>0)show((cur+1)%N);}},100);\n</script>\n"
+    ));
+    s.push_str("<h2>Speed against accuracy (S1, reference: reftrace, 1 sample per pixel)</h2>\n<table><tr><th>method</th><th>ms/frame</th><th>PSNR dB</th><th>SSIM</th><th>depth err mean</th><th>depth err max</th><th>silhouette px</th></tr>\n");
+    for r in &report.records {
+        s.push_str(&format!(
+            "<tr><td style=\"text-align:left\">{}</td><td>{:.3}</td><td>{:.2}</td><td>{:.4}</td><td>{:.3e}</td><td>{:.3e}</td><td>{:.3}</td></tr>\n",
+            r.method, r.ms_per_frame, r.psnr_db, r.ssim, r.depth_err_mean, r.depth_err_max, r.silhouette_px
+        ));
+    }
+    s.push_str("</table>\n<p>Machine-readable: <a href=\"results.json\">results.json</a>, <a href=\"results.csv\">results.csv</a>, <a href=\"sweeps.csv\">sweeps.csv</a>.</p>\n<h2>Images (S1): method and error against the reference (×8)</h2>\n");
+    let scene_dir = report.scene.as_str();
+    s.push_str(&format!(
+        "<div class=\"anim\"><img src=\"{scene_dir}/reference.png\" width=\"300\"><br>reference</div>\n"
+    ));
+    for run in &report.runs {
+        let m = run.method.name();
+        s.push_str(&format!(
+            "<div class=\"anim\"><img src=\"{scene_dir}/{m}.png\" width=\"300\"><br>{m}</div>\
+<div class=\"anim\"><img src=\"{scene_dir}/{m}_error.png\" width=\"300\"><br>{m} error</div>\n"
+        ));
+    }
+    s.push_str("<h2>Charts</h2>\n");
+    for c in charts
+        .iter()
+        .filter(|c| c.extension().is_some_and(|e| e == "svg"))
+    {
+        s.push_str(&format!(
+            "<div><img src=\"{}\" width=\"720\"></div>\n",
+            rel(c, out)
+        ));
+    }
+    s.push_str("</body></html>\n");
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frame_ranges_parse_like_python_slices() {
+        assert_eq!(parse_frames("0:", 5).unwrap(), vec![0, 1, 2, 3, 4]);
+        assert_eq!(parse_frames("::2", 5).unwrap(), vec![0, 2, 4]);
+        assert_eq!(parse_frames("1:100:2", 6).unwrap(), vec![1, 3, 5]);
+        assert_eq!(parse_frames("3", 5).unwrap(), vec![3]);
+        for bad in ["7", "0:5:0", "a:b", "1:2:3:4", "-1:"] {
+            assert!(parse_frames(bad, 5).is_err(), "{bad}");
+        }
+    }
+}

@@ -1,0 +1,144 @@
+//! Files out: PNG colour, EXR depth, output-name patterns. Every file is written to a temporary
+//! name beside its destination and renamed into place only when complete, so an interrupted or
+//! failed run never leaves a partial image under the final name.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use texmap_core::frame::Frame;
+
+/// Expand a printf-style frame pattern: the first `%0Nd` or `%d` becomes the frame number.
+/// Without a pattern, a multi-frame render inserts `_NNNN` before the extension.
+pub fn frame_path(pattern: &Path, frame: usize, multi: bool) -> Result<PathBuf> {
+    let s = pattern.to_string_lossy();
+    if let Some(start) = s.find('%') {
+        let rest = &s[start + 1..];
+        let digits: String = rest.chars().take_while(|c| c.is_ascii_digit()).collect();
+        let after = &rest[digits.len()..];
+        if !after.starts_with('d') {
+            bail!("output pattern {s:?}: after '%' expected digits then 'd' (as in %04d)");
+        }
+        let width: usize = if digits.is_empty() {
+            0
+        } else {
+            digits.parse().context("pattern width")?
+        };
+        if width > 12 {
+            bail!("output pattern {s:?}: width {width} is absurd (at most 12 digits)");
+        }
+        let num = format!("{frame:0width$}");
+        return Ok(PathBuf::from(format!(
+            "{}{}{}",
+            &s[..start],
+            num,
+            &after[1..]
+        )));
+    }
+    if !multi {
+        return Ok(pattern.to_path_buf());
+    }
+    let stem = pattern
+        .file_stem()
+        .map(|x| x.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let ext = pattern
+        .extension()
+        .map(|x| format!(".{}", x.to_string_lossy()))
+        .unwrap_or_default();
+    Ok(pattern.with_file_name(format!("{stem}_{frame:04}{ext}")))
+}
+
+fn temp_beside(path: &Path) -> PathBuf {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "out".into());
+    path.with_file_name(format!(".{name}.partial-{}", std::process::id()))
+}
+
+/// Write `bytes` to `path` atomically (temporary file + rename).
+pub fn write_atomic(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("cannot create directory {}", dir.display()))?;
+    }
+    let tmp = temp_beside(path);
+    let result = write(&tmp).and_then(|()| {
+        std::fs::rename(&tmp, path)
+            .with_context(|| format!("cannot move {} into place", path.display()))
+    });
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
+
+/// Write the colour of a frame as an 8-bit sRGB RGBA PNG.
+pub fn write_png(frame: &Frame, path: &Path) -> Result<()> {
+    write_atomic(path, |tmp| {
+        image::save_buffer_with_format(
+            tmp,
+            frame.color_bytes(),
+            frame.width(),
+            frame.height(),
+            image::ExtendedColorType::Rgba8,
+            image::ImageFormat::Png,
+        )
+        .with_context(|| format!("cannot write PNG {}", path.display()))
+    })
+}
+
+/// Write the depth of a frame as a one-channel (`Z`, f32) OpenEXR file; uncovered pixels hold
+/// +infinity, as OpenEXR depth conventions expect for "no surface".
+pub fn write_depth_exr(frame: &Frame, path: &Path) -> Result<()> {
+    use exr::prelude::*;
+    let w = frame.width() as usize;
+    let depth = &frame.depth;
+    write_atomic(path, |tmp| {
+        let channels = SpecificChannels::build()
+            .with_channel("Z")
+            .with_pixel_fn(|p: Vec2<usize>| (depth[p.y() * w + p.x()],));
+        Image::from_channels((w, frame.height() as usize), channels)
+            .write()
+            .to_file(tmp)
+            .with_context(|| format!("cannot write EXR {}", path.display()))
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn patterns_expand() {
+        let p = |s: &str, f, m| frame_path(Path::new(s), f, m).unwrap();
+        assert_eq!(p("out/f%04d.png", 7, true), PathBuf::from("out/f0007.png"));
+        assert_eq!(p("f%d.png", 12, true), PathBuf::from("f12.png"));
+        assert_eq!(p("one.png", 3, false), PathBuf::from("one.png"));
+        assert_eq!(p("dir/a.png", 3, true), PathBuf::from("dir/a_0003.png"));
+        assert!(frame_path(Path::new("f%s.png"), 1, true).is_err());
+    }
+
+    #[test]
+    fn png_and_exr_round_trip() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut f = Frame::new(5, 3, [10, 20, 30, 255]);
+        f.depth[4] = 2.5;
+        let png = dir.path().join("a.png");
+        write_png(&f, &png).unwrap();
+        let img = image::open(&png).unwrap().to_rgba8();
+        assert_eq!(img.dimensions(), (5, 3));
+        assert_eq!(img.get_pixel(1, 1).0, [10, 20, 30, 255]);
+        let exr_path = dir.path().join("d.exr");
+        write_depth_exr(&f, &exr_path).unwrap();
+        let back = exr::prelude::read_first_flat_layer_from_file(&exr_path).unwrap();
+        let ch = &back.layer_data.channel_data.list[0];
+        assert_eq!(ch.name, exr::prelude::Text::from("Z"));
+        let v: Vec<f32> = ch.sample_data.values_as_f32().collect();
+        assert_eq!(v[4], 2.5);
+        assert!(v[0].is_infinite());
+        // No partial files left behind.
+        let names: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+        assert_eq!(names.len(), 2);
+    }
+}
