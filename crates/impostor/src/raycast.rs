@@ -170,7 +170,7 @@ impl RayTable {
 fn hit8(
     f: &[f32; 5],
     dx: &[f32],
-    dy: f32,
+    dy: &[f32; LANES],
     inv_a: &[f32],
     near: f32,
     far: f32,
@@ -178,14 +178,14 @@ fn hit8(
     let (cx, cy, cz, r2) = (f[0], f[1], f[2], f[3]);
     let mut t = [f32::INFINITY; LANES];
     let mut flag = [0u32; LANES];
-    let by = dy * cy - cz;
     for l in 0..LANES {
         let ia = inv_a[l];
         let dxl = dx[l];
+        let dyl = dy[l];
         // Compute the closest point and the stable discriminant.
-        let s = (dxl * cx + by) * ia;
+        let s = (dxl * cx + dyl * cy - cz) * ia;
         let vx = cx - dxl * s;
-        let vy = cy - dy * s;
+        let vy = cy - dyl * s;
         let vz = cz + s;
         let h2 = r2 - (vx * vx + vy * vy + vz * vz);
         let hc = (if h2 > 0.0 { h2 } else { 0.0 } * ia).sqrt();
@@ -209,6 +209,38 @@ impl Kernel for Perspective<'_> {
             let Some((x0, y0, x1, y1)) = clip(p, tile) else {
                 continue;
             };
+            if x1 - x0 <= 4 {
+                // Narrow boxes (small spheres): two rows of up to 4 pixels per 8-lane test.
+                let w = (x1 - x0) as usize;
+                let mut j = y0 as usize;
+                while j < y1 as usize {
+                    let rows = if j + 1 < y1 as usize { 2 } else { 1 };
+                    let mut dx = [0f32; LANES];
+                    let mut dy = [0f32; LANES];
+                    let mut ia = [0f32; LANES];
+                    for l in 0..LANES {
+                        let jj = (j + l / 4).min(TILE as usize - 1);
+                        let ii = x0 as usize + l % 4;
+                        dx[l] = rt.dx[ii];
+                        dy[l] = rt.dy[jj];
+                        ia[l] = rt.inv_a[jj * TILE as usize + ii];
+                    }
+                    let (t, flag) = hit8(&p.f, &dx, &dy, &ia, v.near, v.far);
+                    for r in 0..rows {
+                        for c in 0..w {
+                            let l = r * 4 + c;
+                            let b = (j + r) * TILE as usize + x0 as usize + c;
+                            // Depth test (strict: the earlier sphere wins ties).
+                            if t[l] < buf.depth[b] {
+                                buf.depth[b] = t[l];
+                                buf.win[b] = idx as u32 | flag[l];
+                            }
+                        }
+                    }
+                    j += 2;
+                }
+                continue;
+            }
             for j in y0..y1 {
                 let row = (j * TILE) as usize;
                 let mut i = x0 as usize;
@@ -217,7 +249,7 @@ impl Kernel for Perspective<'_> {
                     let (mut t, flag) = hit8(
                         &p.f,
                         &rt.dx[i..i + LANES],
-                        rt.dy[j as usize],
+                        &[rt.dy[j as usize]; LANES],
                         &rt.inv_a[b..b + LANES],
                         v.near,
                         v.far,
