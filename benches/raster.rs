@@ -86,7 +86,10 @@ fn terrain() -> (Camera, Vec<Vec3>, Vec<Vec2>, Vec<[u32; 3]>) {
             let z = j as f32 - 256.0;
             let y = 6.0 * (x * 0.05).sin() * (z * 0.043).cos() + 2.0 * (x * 0.21 + z * 0.17).sin();
             pos.push(Vec3::new(x, y, z));
-            uv.push(Vec2::new(i as f32 / (n - 1) as f32, j as f32 / (n - 1) as f32));
+            uv.push(Vec2::new(
+                i as f32 / (n - 1) as f32,
+                j as f32 / (n - 1) as f32,
+            ));
         }
     }
     let mut idx = Vec::with_capacity(2 * (n - 1) * (n - 1));
@@ -118,7 +121,12 @@ fn texture() -> MipTexture {
     for y in 0..s {
         for x in 0..s {
             let c = (((x >> 4) ^ (y >> 4)) & 1) as f32;
-            data.push(Vec4::new(0.2 + 0.6 * c, (x & 255) as f32 / 255.0, (y & 255) as f32 / 255.0, 1.0));
+            data.push(Vec4::new(
+                0.2 + 0.6 * c,
+                (x & 255) as f32 / 255.0,
+                (y & 255) as f32 / 255.0,
+                1.0,
+            ));
         }
     }
     MipTexture::from_linear(s, s, &data, Reduction::Box, Wrap::Repeat).unwrap()
@@ -153,17 +161,26 @@ fn bench(c: &mut Criterion) {
 
     // Fill rate: two triangles covering the image.
     {
-        let cam = Camera::orthographic_look_at(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y, 2.0, W, H)
-            .unwrap();
+        let cam =
+            Camera::orthographic_look_at(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y, 2.0, W, H)
+                .unwrap();
         let e = 2.0;
-        let pos = [Vec3::new(-e, -e, 0.0), Vec3::new(e, -e, 0.0), Vec3::new(e, e, 0.0), Vec3::new(-e, e, 0.0)];
+        let pos = [
+            Vec3::new(-e, -e, 0.0),
+            Vec3::new(e, -e, 0.0),
+            Vec3::new(e, e, 0.0),
+            Vec3::new(-e, e, 0.0),
+        ];
         let idx = [[0, 1, 2], [0, 2, 3]];
         let mesh = Mesh::new(&pos, &idx).unwrap();
         g.throughput(Throughput::Elements((W * H) as u64));
         g.bench_function("fill_large", |b| {
             b.iter(|| {
                 fb.clear([0, 0, 0, 255]);
-                black_box(fb.draw_mesh(&cam, &mesh, &Shading::Flat(Vec3::ONE), &state).unwrap())
+                black_box(
+                    fb.draw_mesh(&cam, &mesh, &Shading::Flat(Vec3::ONE), &state)
+                        .unwrap(),
+                )
             })
         });
     }
@@ -181,7 +198,10 @@ fn bench(c: &mut Criterion) {
         g.bench_function("small_tris_1m", |b| {
             b.iter(|| {
                 fb.clear([0, 0, 0, 255]);
-                black_box(fb.draw_mesh(&cam, &mesh, &Shading::Flat(Vec3::ONE), &state).unwrap())
+                black_box(
+                    fb.draw_mesh(&cam, &mesh, &Shading::Flat(Vec3::ONE), &state)
+                        .unwrap(),
+                )
             })
         });
         g.bench_function("small_tris_1m_lit", |b| {

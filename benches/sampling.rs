@@ -46,13 +46,19 @@ fn texture() -> MipTexture {
 /// the ground. One map width = 8 world units.
 fn scene() -> (Vec<Vec2>, Vec<Vec2>, Vec<Vec2>, Vec<[Vec2; 4]>) {
     let eye = Vec3::new(0.0, 2.0, 0.0);
-    let fwd = Vec3::new(0.0, -(30f32.to_radians().sin()), -(30f32.to_radians().cos()));
+    let fwd = Vec3::new(
+        0.0,
+        -(30f32.to_radians().sin()),
+        -(30f32.to_radians().cos()),
+    );
     let cam = Camera::perspective_look_at(eye, eye + fwd, Vec3::Y, 60.0, W, H).unwrap();
     let face = TexturedFace::new(Vec3::ZERO, Vec3::X, Vec3::Z, 8.0, &cam).unwrap();
     let (mut uv, mut dx, mut dy) = (Vec::new(), Vec::new(), Vec::new());
     for j in 0..H {
         for i in 0..W {
-            let s = face.map(i as f32 + 0.5, j as f32 + 0.5).expect("ground everywhere");
+            let s = face
+                .map(i as f32 + 0.5, j as f32 + 0.5)
+                .expect("ground everywhere");
             uv.push(s.uv);
             dx.push(s.duv_dx);
             dy.push(s.duv_dy);
@@ -170,7 +176,8 @@ fn run<M: Measurement>(c: &mut Criterion<M>, group: &str) {
     ] {
         g.bench_function(name, |b| {
             b.iter(|| {
-                s.sample_pixels(&tex, black_box(&uv), &dx, &dy, &mut out).unwrap();
+                s.sample_pixels(&tex, black_box(&uv), &dx, &dy, &mut out)
+                    .unwrap();
                 black_box(&out);
             })
         });

@@ -246,15 +246,48 @@ fn named_scene(a: &CompareArgs) -> Result<NamedScene> {
             };
             Ok(scenes::build(id))
         }
-        (None, Some(_)) => {
-            usage("comparing a trajectory file is not supported yet; use --scene S1|S2|S3|molecule")
+        (None, Some(file)) => {
+            // The first frame of the file, coloured by element, with the automatic camera.
+            let mut traj = open_trajectory(file, None)?;
+            let mut md = MdFrame::new();
+            if !traj.read_next(&mut md)? {
+                bail!("{}: the file holds no frame", file.display());
+            }
+            let mut builder = SceneBuilder::new(crate::args::ColorBy::Element, 1.0)?;
+            let mut spheres = SphereScene::default();
+            builder.build(&mut md, &mut spheres);
+            let render_args = RenderArgs {
+                file: file.clone(),
+                format: None,
+                frames: "0".into(),
+                method: MethodArg::Raycast,
+                size: a.size.clone(),
+                ortho: false,
+                fov: 40.0,
+                view: "auto".into(),
+                eye: None,
+                target: None,
+                up: None,
+                color_by: crate::args::ColorBy::Element,
+                radius_scale: 1.0,
+                background: "0,0,0".into(),
+                box_outline: false,
+                depth: false,
+                output: PathBuf::new(),
+            };
+            let camera = camera_for(&render_args, &md, &spheres)?;
+            let stem = file
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_else(|| "file".into());
+            Ok(NamedScene::custom(&stem, spheres, camera))
         }
         _ => usage("give a trajectory FILE or --scene S1|S2|S3|molecule"),
     }
 }
 
 fn write_report(out: &Path, report: &SceneReport) -> Result<()> {
-    let dir = out.join(report.scene.as_str());
+    let dir = out.join(&report.scene);
     write_png(&report.reference, &dir.join("reference.png"))?;
     for run in &report.runs {
         let name = run.method.name();

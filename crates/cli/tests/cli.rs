@@ -218,3 +218,56 @@ fn every_method_renders_with_an_explicit_camera() {
         assert_eq!(img.get_pixel(0, 0).0, [0, 0, 0, 255], "{m}: corner");
     }
 }
+
+#[test]
+fn compare_a_trajectory_file_writes_results_images_and_charts() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("cmp");
+    let o = texmap(&[
+        "compare",
+        data("mda_multi.pdb").to_str().unwrap(),
+        "--size",
+        "200x150",
+        "--runs",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("results.json")).unwrap()).unwrap();
+    let recs = v.as_array().unwrap();
+    for key in [
+        "scene",
+        "method",
+        "width",
+        "height",
+        "ms_per_frame",
+        "psnr_db",
+        "ssim",
+        "depth_err_mean",
+        "depth_err_max",
+        "silhouette_px",
+    ] {
+        assert!(
+            recs.iter().all(|r| r.get(key).is_some()),
+            "every record has {key}"
+        );
+    }
+    let raycast = recs
+        .iter()
+        .find(|r| r["method"] == "raycast" && r["reference"] == "reftrace-1spp")
+        .expect("a raycast record");
+    assert_eq!(raycast["scene"], "mda_multi");
+    assert!(raycast["psnr_db"].is_null() || raycast["psnr_db"].as_f64().unwrap() >= 45.0);
+    for f in [
+        "results.csv",
+        "speed_accuracy.svg",
+        "speed_accuracy.png",
+        "mda_multi/reference.png",
+        "mda_multi/raycast.png",
+        "mda_multi/lut_error.png",
+    ] {
+        assert!(out.join(f).exists(), "{f}");
+    }
+}

@@ -73,7 +73,8 @@ impl SceneId {
 /// A scene ready to draw: spheres, camera and lighting.
 #[derive(Clone, Debug)]
 pub struct NamedScene {
-    pub id: SceneId,
+    /// The name used in results files and directory names (`s1`, `s2`, …, or a file's stem).
+    pub name: String,
     pub spheres: SphereScene,
     pub camera: Camera,
     pub lighting: Lighting,
@@ -81,15 +82,25 @@ pub struct NamedScene {
 
 impl NamedScene {
     /// The scene's name.
-    pub fn name(&self) -> &'static str {
-        self.id.name()
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// A scene of the caller's own (e.g. a trajectory frame) under a name of its choosing.
+    pub fn custom(name: &str, spheres: SphereScene, camera: Camera) -> NamedScene {
+        NamedScene {
+            name: name.to_string(),
+            lighting: Lighting::default_for(&camera),
+            spheres,
+            camera,
+        }
     }
 
     /// The same scene seen at another image size (same pose and field of view).
     pub fn with_size(&self, width: u32, height: u32) -> Result<NamedScene, CameraError> {
         let camera = self.camera.with_size(width, height)?;
         Ok(NamedScene {
-            id: self.id,
+            name: self.name.clone(),
             spheres: self.spheres.clone(),
             lighting: Lighting::default_for(&camera),
             camera,
@@ -173,7 +184,7 @@ pub fn build_sized(id: SceneId, width: u32, height: u32) -> Result<NamedScene, C
     };
     let camera = box_camera(center, box_len, width, height)?;
     Ok(NamedScene {
-        id,
+        name: id.name().to_string(),
         lighting: Lighting::default_for(&camera),
         spheres,
         camera,
@@ -301,7 +312,7 @@ impl Seed004System {
         let l = self.box_len as f32;
         let camera = box_camera(Vec3::splat(0.5 * l), l, width, height)?;
         Ok(NamedScene {
-            id: SceneId::S1,
+            name: SceneId::S1.name().to_string(),
             lighting: Lighting::default_for(&camera),
             spheres,
             camera,
