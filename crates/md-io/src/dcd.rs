@@ -638,32 +638,23 @@ impl<R: Read + Seek> DcdReader<R> {
                 })
                 .transpose()
             });
-        match r {
-            Ok(cell) => {
-                frame.cell = cell;
-                let step = self.info.first_step + index as i64 * self.info.steps_per_frame;
-                frame.step = Some(step);
-                frame.time = Some(step as f64 * self.info.timestep_ps);
-                self.next += 1;
-                Ok(true)
-            }
-            Err(e) => {
-                frame.clear();
-                Err(e)
-            }
-        }
+        crate::cursor::settle(r, frame, &mut self.next)?;
+        let step = self.info.first_step + index as i64 * self.info.steps_per_frame;
+        frame.step = Some(step);
+        frame.time = Some(step as f64 * self.info.timestep_ps);
+        Ok(true)
     }
 
     /// Makes `read_next` read frame `n`; `Ok(false)` if there is no frame `n` (a truncated frame
     /// counts as present, so that reading it reports the damage).
     pub fn seek_frame(&mut self, n: usize) -> Result<bool, Error> {
-        let l = &self.layout;
-        if n < l.n_complete || (n == l.n_complete && self.truncation().is_some()) {
-            self.next = n;
-            Ok(true)
-        } else {
-            Ok(false)
-        }
+        let damaged = self.truncation().is_some();
+        Ok(crate::cursor::seek(
+            &mut self.next,
+            n,
+            self.layout.n_complete,
+            damaged,
+        ))
     }
 
     /// Number of complete frames (the `Trajectory` contract; offset arithmetic, no scan).

@@ -44,6 +44,7 @@
 //! Text formats instead implement the private `TextFormat` trait (src/text.rs) and get
 //! streaming, the line-scan index and error positions from `TextReader`.
 
+mod cursor;
 mod dcd;
 pub mod elements;
 mod error;

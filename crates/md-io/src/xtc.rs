@@ -375,29 +375,18 @@ impl<R: Read + Seek> XtcReader<R> {
                 frame.time = Some(info.time);
                 cell_of(info.box_vectors, &self.file, index, offset + 16)
             });
-        match r {
-            Ok(cell) => {
-                frame.cell = cell;
-                self.next += 1;
-                Ok(true)
-            }
-            Err(e) => {
-                frame.clear();
-                Err(e)
-            }
-        }
+        crate::cursor::settle(r, frame, &mut self.next)
     }
 
     /// Makes `read_next` read frame `n`; `Ok(false)` if there is no frame `n` (a damaged frame
     /// right after the last good one counts as present, so that reading it reports the damage).
     pub fn seek_frame(&mut self, n: usize) -> Result<bool, Error> {
-        let len = self.frames.len();
-        if n < len || (n == len && self.tail.is_some()) {
-            self.next = n;
-            Ok(true)
-        } else {
-            Ok(false)
-        }
+        Ok(crate::cursor::seek(
+            &mut self.next,
+            n,
+            self.frames.len(),
+            self.tail.is_some(),
+        ))
     }
 
     /// Number of complete frames (the `Trajectory` contract; the index is built at open time).
