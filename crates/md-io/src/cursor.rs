@@ -1,8 +1,11 @@
-//! The frame cursor the binary readers (DCD, XTC, TRR) share: their frame index is complete at
+//! What the binary readers (DCD, XTC, TRR) share: the coordinate and GROMACS-box checks, and the
+//! frame cursor: their frame index is complete at
 //! open time, and a damaged frame right after the last good one still counts as present, so
 //! that reading it reports the damage instead of a silent end.
 
-use crate::error::Error;
+use std::sync::Arc;
+
+use crate::error::{Error, Location};
 use crate::frame::{Frame, UnitCell};
 
 /// Point `next` at frame `n` when it exists: `n < complete`, or `n == complete` with a damaged
@@ -34,4 +37,38 @@ pub(crate) fn settle(
             Err(e)
         }
     }
+}
+
+/// True if every value is finite (branch-free over chunks of 8 values).
+pub(crate) fn all_finite(p: &[[f32; 3]]) -> bool {
+    let flat = p.as_flattened();
+    let mut chunks = flat.chunks_exact(8);
+    let mut ok = true;
+    for c in &mut chunks {
+        let mut lane = true;
+        for v in c {
+            lane &= v.is_finite();
+        }
+        ok &= lane;
+    }
+    ok && chunks.remainder().iter().all(|v| v.is_finite())
+}
+
+/// The cell of a GROMACS box (rows, Å); an all-zero box means none.
+pub(crate) fn cell_of(
+    m: [[f64; 3]; 3],
+    file: &Arc<str>,
+    index: usize,
+    byte: u64,
+) -> Result<Option<UnitCell>, Error> {
+    if m.as_flattened().iter().all(|v| *v == 0.0) {
+        return Ok(None);
+    }
+    UnitCell::from_matrix(m)
+        .map(Some)
+        .map_err(|e| Error::Parse {
+            at: Location::binary(file, index, byte),
+            expected: "box vectors with volume > 0",
+            found: e.to_string(),
+        })
 }

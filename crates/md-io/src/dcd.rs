@@ -41,6 +41,7 @@
 use std::io::{self, Read, Seek, SeekFrom, Write};
 use std::sync::Arc;
 
+use crate::cursor::all_finite;
 use crate::error::{Error, Location};
 use crate::frame::{Frame, UnitCell};
 
@@ -744,21 +745,6 @@ fn scatter<const BIG: bool>(out: &mut [[f32; 3]], free: &[u32], xs: &[u8], ys: &
         // Indices were checked at open time.
         out[i as usize] = [f32_at::<BIG>(x), f32_at::<BIG>(y), f32_at::<BIG>(z)];
     }
-}
-
-/// True if every coordinate is finite (branch-free over chunks of 8 values).
-fn all_finite(p: &[[f32; 3]]) -> bool {
-    let flat = p.as_flattened();
-    let mut chunks = flat.chunks_exact(8);
-    let mut ok = true;
-    for c in &mut chunks {
-        let mut lane = true;
-        for v in c {
-            lane &= v.is_finite();
-        }
-        ok &= lane;
-    }
-    ok && chunks.remainder().iter().all(|v| v.is_finite())
 }
 
 /// Converts the cell record `[A, gamma, B, beta, alpha, C]` to lengths and angles.

@@ -22,8 +22,9 @@
 use std::io::{self, Read, Seek, SeekFrom};
 use std::sync::Arc;
 
+use crate::cursor::{all_finite, cell_of};
 use crate::error::{Error, Location};
-use crate::frame::{Frame, UnitCell};
+use crate::frame::Frame;
 
 /// Magic number of every TRR frame.
 pub const MAGIC: i32 = 1993;
@@ -473,40 +474,6 @@ fn convert<const REAL: usize>(bytes: &[u8], out: &mut Vec<[f32; 3]>) {
             }
         });
     }
-}
-
-/// True if every value is finite (branch-free over chunks of 8 values).
-fn all_finite(p: &[[f32; 3]]) -> bool {
-    let flat = p.as_flattened();
-    let mut chunks = flat.chunks_exact(8);
-    let mut ok = true;
-    for c in &mut chunks {
-        let mut lane = true;
-        for v in c {
-            lane &= v.is_finite();
-        }
-        ok &= lane;
-    }
-    ok && chunks.remainder().iter().all(|v| v.is_finite())
-}
-
-/// The cell of a GROMACS box (rows, Å); an all-zero box means none.
-fn cell_of(
-    m: [[f64; 3]; 3],
-    file: &Arc<str>,
-    index: usize,
-    byte: u64,
-) -> Result<Option<UnitCell>, Error> {
-    if m.as_flattened().iter().all(|v| *v == 0.0) {
-        return Ok(None);
-    }
-    UnitCell::from_matrix(m)
-        .map(Some)
-        .map_err(|e| Error::Parse {
-            at: Location::binary(file, index, byte),
-            expected: "box vectors with volume > 0",
-            found: e.to_string(),
-        })
 }
 
 #[cfg(test)]

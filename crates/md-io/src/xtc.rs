@@ -40,8 +40,9 @@
 use std::io::{self, Read, Seek, SeekFrom, Write};
 use std::sync::Arc;
 
+use crate::cursor::cell_of;
 use crate::error::{Error, Location};
-use crate::frame::{Frame, UnitCell};
+use crate::frame::Frame;
 
 /// Magic number of the classic format (32-bit byte count).
 pub const MAGIC_1995: i32 = 1995;
@@ -872,25 +873,6 @@ impl<W: Write> XtcWriter<W> {
     pub fn into_inner(self) -> W {
         self.out
     }
-}
-
-/// The cell of a GROMACS box (rows, Å); an all-zero box means none.
-fn cell_of(
-    m: [[f64; 3]; 3],
-    file: &Arc<str>,
-    index: usize,
-    byte: u64,
-) -> Result<Option<UnitCell>, Error> {
-    if m.as_flattened().iter().all(|v| *v == 0.0) {
-        return Ok(None);
-    }
-    UnitCell::from_matrix(m)
-        .map(Some)
-        .map_err(|e| Error::Parse {
-            at: Location::binary(file, index, byte),
-            expected: "box vectors with volume > 0",
-            found: e.to_string(),
-        })
 }
 
 #[cfg(test)]
