@@ -1,0 +1,2 @@
+//! Bond (cylinder impostor) pass benchmark: being written this session; see docs/PERFORMANCE.md.
+fn main() {}
