@@ -196,7 +196,12 @@ impl Framebuffer {
     ) -> DrawStats {
         debug_assert!(P::NV <= MAX_VAR);
         let grid = self.grid;
-        let Framebuffer { tiles, scratch, .. } = self;
+        let Framebuffer {
+            tiles,
+            scratch,
+            block_path,
+            ..
+        } = self;
         let positions = mesh.positions();
         let indices = mesh.indices();
 
@@ -319,6 +324,7 @@ impl Framebuffer {
             far: proj.far,
             width: grid.width,
             height: grid.height,
+            block_path: *block_path,
         };
         let bins = &scratch.tris;
         tiles.par_iter_mut().enumerate().for_each(|(ti, tile)| {
@@ -406,6 +412,7 @@ impl Framebuffer {
             far: f32::INFINITY,
             width: grid.width,
             height: grid.height,
+            block_path: true,
         };
         let bins = &scratch.sprites;
         tiles.par_iter_mut().enumerate().for_each(|(ti, tile)| {
@@ -414,5 +421,130 @@ impl Framebuffer {
             }
         });
         Ok(stats)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+    use texmap_core::camera::Camera;
+    use texmap_core::shade::{Lighting, Material};
+
+    use super::*;
+    use crate::state::{Blend, DepthTest};
+    use crate::tri::BLOCK;
+
+    /// Many small triangles (1..14 px across, some straddling tile borders and the image edge,
+    /// random depths and windings) with colours and normals.
+    fn small_scene(cam: &Camera, n: usize) -> (Vec<Vec3>, Vec<Vec3>, Vec<[u32; 3]>) {
+        let mut s = 7u64;
+        let mut r = || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let (w, h, k) = (cam.width() as f32, cam.height() as f32, cam.scale());
+        let mut pos = Vec::new();
+        let mut col = Vec::new();
+        let mut idx = Vec::new();
+        for t in 0..n as u32 {
+            let depth = 2.0 + 20.0 * r();
+            let c = Vec3::new((r() - 0.5) * w, (r() - 0.5) * h, 0.0) * (depth / k);
+            let size = (1.0 + 13.0 * r()) * depth / k;
+            for _ in 0..3 {
+                let off = Vec3::new(r() - 0.5, r() - 0.5, (r() - 0.5) * 0.5);
+                pos.push(Vec3::new(c.x, c.y, -depth) + off * size);
+                col.push(Vec3::new(r(), r(), r()));
+            }
+            idx.push([3 * t, 3 * t + 1, 3 * t + 2]);
+        }
+        (pos, col, idx)
+    }
+
+    fn bits(fb: &Framebuffer) -> Vec<u32> {
+        let mut out = Vec::new();
+        for y in 0..fb.height() {
+            for x in 0..fb.width() {
+                let c = fb.color_at(x, y).unwrap();
+                out.extend([fb.depth_at(x, y).unwrap(), c.x, c.y, c.z].map(f32::to_bits));
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn block_path_gives_the_same_pixels_as_the_quad_loop() {
+        let (w, h) = (203u32, 131u32);
+        let cam = Camera::perspective_look_at(Vec3::ZERO, Vec3::NEG_Z, Vec3::Y, 60.0, w, h)
+            .unwrap()
+            .with_clip(0.1, 100.0)
+            .unwrap();
+        let (pos, col, idx) = small_scene(&cam, 3000);
+        let mesh = Mesh::new(&pos, &idx)
+            .unwrap()
+            .with_colors(&col)
+            .unwrap()
+            .with_normals(&col)
+            .unwrap();
+        // The scene must exercise both paths: count triangles whose pixel range fits a block.
+        let proj = Proj::new(&cam);
+        let fits = idx
+            .iter()
+            .filter_map(|t| pixel_bounds(&t.map(|i| proj.project(pos[i as usize])), w, h))
+            .filter(|b| b[2] - (b[0] & !1) < BLOCK as i32 && b[3] - (b[1] & !1) < BLOCK as i32)
+            .count();
+        assert!(fits > 1000 && fits < 2900, "{fits} of 3000 fit a block");
+        let lit = Shading::LitSmooth {
+            lighting: Lighting::default_for(&cam),
+            material: Material::plastic(Vec3::new(0.3, 0.5, 0.8)),
+        };
+        let states = [
+            DrawState {
+                cull: Cull::None,
+                ..DrawState::default()
+            },
+            DrawState {
+                depth_test: DepthTest::LessEqual,
+                ..DrawState::default()
+            },
+            DrawState::additive_overlay(),
+            DrawState {
+                depth_test: DepthTest::Always,
+                depth_write: false,
+                cull: Cull::Front,
+                blend: Blend::Replace,
+            },
+        ];
+        for shading in [
+            Shading::Flat(Vec3::new(0.2, 0.7, 1.0)),
+            Shading::VertexColor,
+            lit,
+        ] {
+            for st in &states {
+                let draw = |block: bool| {
+                    let mut fb = Framebuffer::new(w, h).unwrap();
+                    fb.block_path = block;
+                    fb.clear([10, 20, 30, 255]);
+                    let stats = fb.draw_mesh(&cam, &mesh, &shading, st).unwrap();
+                    // Draw twice so that the depth test meets stored values of the same draw.
+                    fb.draw_mesh(&cam, &mesh, &shading, st).unwrap();
+                    (bits(&fb), stats)
+                };
+                let (fast, sf) = draw(true);
+                let (general, sg) = draw(false);
+                assert_eq!(sf, sg);
+                let diff = fast.iter().zip(&general).filter(|(a, b)| a != b).count();
+                assert_eq!(diff, 0, "{shading:?} {st:?}: {diff} values differ");
+                let drawn = fast
+                    .chunks(4)
+                    .filter(|p| f32::from_bits(p[0]).is_finite() || p[1] != fast[1])
+                    .count();
+                assert!(
+                    drawn > 3000,
+                    "{shading:?} {st:?}: only {drawn} pixels drawn"
+                );
+            }
+        }
     }
 }

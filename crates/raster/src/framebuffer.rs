@@ -70,6 +70,9 @@ pub struct Framebuffer {
     background: [u8; 4],
     clear_linear: Vec3,
     pub(crate) scratch: crate::draw::Scratch,
+    /// Small triangles take the block path (`false` only in tests comparing it with the general
+    /// quad loop).
+    pub(crate) block_path: bool,
 }
 
 impl Framebuffer {
@@ -105,6 +108,7 @@ impl Framebuffer {
             background: [0, 0, 0, 255],
             clear_linear: Vec3::ZERO,
             scratch: Default::default(),
+            block_path: true,
         })
     }
 

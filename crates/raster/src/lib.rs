@@ -75,6 +75,7 @@ mod framebuffer;
 mod mesh;
 mod program;
 mod project;
+mod simd;
 pub mod sprite;
 mod state;
 mod tri;

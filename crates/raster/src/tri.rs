@@ -13,6 +13,7 @@
 use crate::framebuffer::{QUADS_PER_ROW, TILE, Tile};
 use crate::program::{FragProgram, QuadFrag};
 use crate::project::{MAX_VAR, PVert, Var};
+use crate::simd::{F32x4, I32x4};
 use crate::state::{Blend, Cull, DepthTest, DrawState};
 
 /// What the quad loop needs besides the triangle.
@@ -22,6 +23,8 @@ pub(crate) struct RasterCtx {
     pub far: f32,
     pub width: u32,
     pub height: u32,
+    /// Whether small triangles take the block path (`false` only in tests comparing the paths).
+    pub block_path: bool,
 }
 
 /// Twice the signed area of a fixed-point triangle (y down): positive when the vertices run
@@ -83,13 +86,12 @@ struct Plane {
 }
 
 impl Plane {
-    #[inline]
-    fn eval(&self, fx: &[f32; 4], fy: &[f32; 4]) -> [f32; 4] {
-        let mut o = [0.0; 4];
-        for l in 0..4 {
-            o[l] = self.base + self.gx * fx[l] + self.gy * fy[l];
-        }
-        o
+    /// The plane at four pixel offsets: `base + gx·fx + gy·fy` lane by lane (no FMA).
+    #[inline(always)]
+    fn eval4(&self, fx: F32x4, fy: F32x4) -> F32x4 {
+        F32x4::splat(self.base)
+            .add(F32x4::splat(self.gx).mul(fx))
+            .add(F32x4::splat(self.gy).mul(fy))
     }
 }
 
@@ -196,8 +198,21 @@ pub(crate) fn raster_tri<P: FragProgram>(
             .max(reach(i, ex, ey))
             < (1 << 30)
     });
-    if small {
-        let cv = |a: [i64; 3]| a.map(|x| x as i32);
+    let cv = |a: [i64; 3]| a.map(|x| x as i32);
+    if small && ctx.block_path && px1 - px0 < BLOCK as i32 && py1 - py0 < BLOCK as i32 {
+        // Small-triangle fast path: the whole (at most 8 x 8) pixel range at once.
+        block_loop::<P>(
+            tile,
+            ctx,
+            prog,
+            cst,
+            front,
+            &setup,
+            cv(e_row),
+            cv(step_x),
+            cv(step_y),
+        );
+    } else if small {
         quad_loop::<P, i32>(
             tile,
             ctx,
@@ -213,6 +228,9 @@ pub(crate) fn raster_tri<P: FragProgram>(
         quad_loop::<P, i64>(tile, ctx, prog, cst, front, &setup, e_row, step_x, step_y);
     }
 }
+
+/// Side in pixels of the block the small-triangle path covers in one go.
+pub(crate) const BLOCK: u32 = 8;
 
 /// What the quad loop needs from the triangle set-up.
 struct Setup {
@@ -241,6 +259,163 @@ impl EdgeInt for i64 {
     const ZERO: Self = 0;
 }
 
+/// The depth test as lane masks, so that the per-quad test is branch-free:
+/// `pass = (d < stored) | (eq & d == stored) | always`, then `0 < d <= far`.
+#[derive(Clone, Copy)]
+struct ZTest {
+    eq: F32x4,
+    always: F32x4,
+    far: F32x4,
+}
+
+impl ZTest {
+    #[inline]
+    fn new(ctx: &RasterCtx) -> ZTest {
+        let flag = |b: bool| F32x4::from_bits(if b { 0b1111 } else { 0 });
+        ZTest {
+            eq: flag(ctx.state.depth_test == DepthTest::LessEqual),
+            always: flag(ctx.state.depth_test == DepthTest::Always),
+            far: F32x4::splat(ctx.far),
+        }
+    }
+
+    /// Lanes of `depth` that pass against `stored` (NaN and out-of-range depths fail).
+    #[inline(always)]
+    fn mask(&self, d: F32x4, stored: F32x4) -> u8 {
+        let pass = d
+            .lt(stored)
+            .or(self.eq.and(d.eq(stored)))
+            .or(self.always)
+            .and(F32x4::splat(0.0).lt(d))
+            .and(d.le(self.far));
+        pass.bits() as u8
+    }
+}
+
+/// Depth-test, shade and write the quad whose top-left pixel is (qx, qy), lanes `mask` covered.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn shade_quad<P: FragProgram>(
+    tile: &mut Tile,
+    st: DrawState,
+    zt: &ZTest,
+    prog: &P,
+    cst: &P::TriConst,
+    front: bool,
+    s: &Setup,
+    qx: i32,
+    qy: i32,
+    mut mask: u8,
+) {
+    let lx = qx as u32 - tile.x0;
+    let ly = qy as u32 - tile.y0;
+    let base = ((ly >> 1) as usize * QUADS_PER_ROW + (lx >> 1) as usize) << 2;
+    let fxb = (qx - s.px0) as f32;
+    let fyb = (qy - s.py0) as f32;
+    let fx = F32x4::splat(fxb).add(F32x4::new([0.0, 1.0, 0.0, 1.0]));
+    let fy = F32x4::splat(fyb).add(F32x4::new([0.0, 0.0, 1.0, 1.0]));
+    // Perspective division: W = 1 / (1/W), depth = (depth/W)·W.
+    let w = F32x4::splat(1.0).div(s.p_q.eval4(fx, fy));
+    let depth = s.p_dw.eval4(fx, fy).mul(w);
+    // Depth test (NaN and out-of-range depths fail every comparison).
+    mask &= zt.mask(depth, F32x4::load(&tile.depth[base..base + 4]));
+    if mask == 0 {
+        return;
+    }
+    // Perspective-correct varyings.
+    let mut frag = QuadFrag {
+        x: [
+            qx as f32 + 0.5,
+            qx as f32 + 1.5,
+            qx as f32 + 0.5,
+            qx as f32 + 1.5,
+        ],
+        y: [
+            qy as f32 + 0.5,
+            qy as f32 + 0.5,
+            qy as f32 + 1.5,
+            qy as f32 + 1.5,
+        ],
+        var: [[0.0; 4]; MAX_VAR],
+        mask,
+    };
+    for k in 0..P::NV {
+        frag.var[k] = s.p_var[k].eval4(fx, fy).mul(w).to_array();
+    }
+    let c = prog.shade(cst, &frag, front);
+    write_quad(tile, base, mask, &depth.to_array(), &c, st);
+}
+
+/// The small-triangle path: coverage of the whole pixel range (at most [`BLOCK`] x [`BLOCK`],
+/// starting on the quad grid) as one bit mask per row, eight lanes per edge and row, then only
+/// the quads with a covered pixel are visited. Same edge values, same fill rule and same plane
+/// origin as [`quad_loop`], so the pixels (coverage, depth, colour) are identical.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn block_loop<P: FragProgram>(
+    tile: &mut Tile,
+    ctx: &RasterCtx,
+    prog: &P,
+    cst: &P::TriConst,
+    front: bool,
+    s: &Setup,
+    e_row: [i32; 3],
+    step_x: [i32; 3],
+    step_y: [i32; 3],
+) {
+    const B: usize = BLOCK as usize;
+    let ncols = (s.px1 - s.px0 + 1) as u32;
+    let nrows = (s.py1 - s.py0 + 1) as usize;
+    debug_assert!(ncols as usize <= B && nrows <= B);
+    // Columns past the range lie outside the triangle's bounding box or outside this tile.
+    let col_ok = ((1u32 << ncols) - 1) as u8;
+    // Edge values of the first row at the eight columns (two 4-lane halves). Lanes past the
+    // range may wrap (they are masked out); lanes inside it are exact (|E| < 2^30, checked by
+    // the caller).
+    let half = |i: usize, c0: i32| {
+        I32x4::new([0, 1, 2, 3].map(|l| e_row[i].wrapping_add(step_x[i].wrapping_mul(c0 + l))))
+    };
+    let mut lo = [half(0, 0), half(1, 0), half(2, 0)];
+    let mut hi = [half(0, 4), half(1, 4), half(2, 4)];
+    let dy = step_y.map(I32x4::splat);
+    // Row masks: bit c = pixel (px0 + c, py0 + r) covered (every edge function >= 0).
+    let mut rows = [0u8; B + 1];
+    for row in rows.iter_mut().take(nrows) {
+        let neg =
+            lo[0].or(lo[1]).or(lo[2]).neg_bits() | (hi[0].or(hi[1]).or(hi[2]).neg_bits() << 4);
+        *row = !(neg as u8) & col_ok;
+        for i in 0..3 {
+            lo[i] = lo[i].add(dy[i]);
+            hi[i] = hi[i].add(dy[i]);
+        }
+    }
+    let st = ctx.state;
+    let zt = ZTest::new(ctx);
+    // Visit the covered quads, row pair by row pair, left to right.
+    for j in 0..nrows.div_ceil(2) {
+        let (r0, r1) = (rows[2 * j] as u32, rows[2 * j + 1] as u32);
+        let any = r0 | r1;
+        let mut pairs = (any | (any >> 1)) & 0x55;
+        while pairs != 0 {
+            let b = pairs.trailing_zeros();
+            pairs &= pairs - 1;
+            let mask = (((r0 >> b) & 3) | (((r1 >> b) & 3) << 2)) as u8;
+            shade_quad(
+                tile,
+                st,
+                &zt,
+                prog,
+                cst,
+                front,
+                s,
+                s.px0 + b as i32,
+                s.py0 + 2 * j as i32,
+                mask,
+            );
+        }
+    }
+}
+
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn quad_loop<P: FragProgram, E: EdgeInt>(
@@ -261,9 +436,7 @@ fn quad_loop<P: FragProgram, E: EdgeInt>(
         py1,
         xl,
         yl,
-        p_q,
-        p_dw,
-        ref p_var,
+        ..
     } = *s;
     // Lane offsets of the quad (0,0), (1,0), (0,1), (1,1), and steps of two pixels.
     let lane_off = |i: usize| [E::ZERO, step_x[i], step_y[i], step_x[i] + step_y[i]];
@@ -271,14 +444,11 @@ fn quad_loop<P: FragProgram, E: EdgeInt>(
     let step2_x = step_x.map(|v| v + v);
     let step2_y = step_y.map(|v| v + v);
     let st = ctx.state;
-    let far = ctx.far;
+    let zt = ZTest::new(ctx);
     let mut qy = py0;
     while qy <= py1 {
         let mut e = e_row;
         let row_mask: u8 = if qy + 1 > yl { 0b0011 } else { 0b1111 };
-        let fy_base = (qy - py0) as f32;
-        let fy = [fy_base, fy_base, fy_base + 1.0, fy_base + 1.0];
-        let ly = qy as u32 - tile.y0;
         let mut qx = px0;
         while qx <= px1 {
             // Coverage of the four lanes: every edge function >= 0 (sign bits OR-ed).
@@ -290,60 +460,7 @@ fn quad_loop<P: FragProgram, E: EdgeInt>(
             let col_mask: u8 = if qx + 1 > xl { 0b0101 } else { 0b1111 };
             mask &= row_mask & col_mask;
             if mask != 0 {
-                let lx = qx as u32 - tile.x0;
-                let base = ((ly >> 1) as usize * QUADS_PER_ROW + (lx >> 1) as usize) << 2;
-                let fxb = (qx - px0) as f32;
-                let fx = [fxb, fxb + 1.0, fxb, fxb + 1.0];
-                // Perspective division: W = 1 / (1/W), depth = (depth/W)·W.
-                let qv = p_q.eval(&fx, &fy);
-                let dwv = p_dw.eval(&fx, &fy);
-                let mut w = [0.0f32; 4];
-                let mut depth = [0.0f32; 4];
-                for l in 0..4 {
-                    w[l] = 1.0 / qv[l];
-                    depth[l] = dwv[l] * w[l];
-                }
-                // Depth test (NaN and out-of-range depths fail every comparison below).
-                let stored = &tile.depth[base..base + 4];
-                let mut zmask = 0u8;
-                for l in 0..4 {
-                    let d = depth[l];
-                    let pass = match st.depth_test {
-                        DepthTest::Less => d < stored[l],
-                        DepthTest::LessEqual => d <= stored[l],
-                        DepthTest::Always => true,
-                    } && d > 0.0
-                        && d <= far;
-                    zmask |= (pass as u8) << l;
-                }
-                mask &= zmask;
-                if mask != 0 {
-                    // Perspective-correct varyings.
-                    let mut frag = QuadFrag {
-                        x: [
-                            qx as f32 + 0.5,
-                            qx as f32 + 1.5,
-                            qx as f32 + 0.5,
-                            qx as f32 + 1.5,
-                        ],
-                        y: [
-                            qy as f32 + 0.5,
-                            qy as f32 + 0.5,
-                            qy as f32 + 1.5,
-                            qy as f32 + 1.5,
-                        ],
-                        var: [[0.0; 4]; MAX_VAR],
-                        mask,
-                    };
-                    for k in 0..P::NV {
-                        let pv = p_var[k].eval(&fx, &fy);
-                        for l in 0..4 {
-                            frag.var[k][l] = pv[l] * w[l];
-                        }
-                    }
-                    let c = prog.shade(cst, &frag, front);
-                    write_quad(tile, base, mask, &depth, &c, st);
-                }
+                shade_quad(tile, st, &zt, prog, cst, front, s, qx, qy, mask);
             }
             for i in 0..3 {
                 e[i] = e[i] + step2_x[i];
@@ -357,7 +474,8 @@ fn quad_loop<P: FragProgram, E: EdgeInt>(
     }
 }
 
-/// Write the masked lanes of a quad at tile index `base`.
+/// Write the masked lanes of a quad at tile index `base` (a select per lane, no per-lane
+/// branch; the depth-write and blend modes are chosen once per quad).
 #[inline]
 pub(crate) fn write_quad(
     tile: &mut Tile,
@@ -367,25 +485,20 @@ pub(crate) fn write_quad(
     c: &[[f32; 4]; 3],
     st: DrawState,
 ) {
-    for l in 0..4 {
-        if mask & (1 << l) == 0 {
-            continue;
-        }
-        let i = base + l;
-        if st.depth_write {
-            tile.depth[i] = depth[l];
-        }
-        match st.blend {
-            Blend::Replace => {
-                tile.r[i] = c[0][l];
-                tile.g[i] = c[1][l];
-                tile.b[i] = c[2][l];
-            }
-            Blend::Add => {
-                tile.r[i] += c[0][l];
-                tile.g[i] += c[1][l];
-                tile.b[i] += c[2][l];
-            }
-        }
+    let on = F32x4::from_bits(mask);
+    if st.depth_write {
+        let d = &mut tile.depth[base..base + 4];
+        F32x4::select(on, F32x4::new(*depth), F32x4::load(d)).store(d);
+    }
+    let planes = [&mut tile.r, &mut tile.g, &mut tile.b];
+    for (plane, c) in planes.into_iter().zip(c) {
+        let p = &mut plane[base..base + 4];
+        let old = F32x4::load(p);
+        let c = F32x4::new(*c);
+        let new = match st.blend {
+            Blend::Replace => c,
+            Blend::Add => old.add(c),
+        };
+        F32x4::select(on, new, old).store(p);
     }
 }
