@@ -342,6 +342,10 @@ pub enum Selector {
 /// 4. [`Element::UNKNOWN_RADIUS`] and [`Element::UNKNOWN_COLOR`].
 ///
 /// Radius and colour are resolved independently (a rule may set only one of them).
+///
+/// A file colour is used as a colour for drawing: each channel is clamped to [0, 1] (files may
+/// hold values outside it, and readers keep them as written); a file colour or radius that is not
+/// finite (possible only in a frame built by hand, readers reject them) counts as absent.
 #[derive(Clone, Debug, PartialEq)]
 pub struct AtomStyle {
     rules: Vec<(Selector, Appearance)>,
@@ -411,8 +415,13 @@ impl AtomStyle {
     /// Radius (Å) and colour (sRGB in [0, 1]) of atom `i` of `frame`, by the order in the type doc.
     /// `i` must be < `frame.n_atoms()`; an out-of-range `i` gets the unknown-element look.
     pub fn resolve(&self, frame: &Frame, i: usize) -> (f32, [f32; 3]) {
-        let mut radius = frame.radii.get(i).copied();
-        let mut color = frame.colors.get(i).copied();
+        // File columns: clamp colours into [0, 1]; non-finite entries count as absent.
+        let mut radius = frame.radii.get(i).copied().filter(|r| r.is_finite());
+        let mut color = frame
+            .colors
+            .get(i)
+            .filter(|c| c.iter().all(|v| v.is_finite()))
+            .map(|c| c.map(|v| v.clamp(0.0, 1.0)));
         // Rules: type, then name, then element.
         let ty = frame.types.get(i).copied();
         let name = frame.names.get(i).copied();
@@ -546,6 +555,12 @@ mod tests {
         f.radii = vec![0.5; 3];
         f.colors = vec![[0.5; 3]; 3];
         assert_eq!(st.resolve(&f, 0), (0.5, [0.5; 3]));
+        // Out-of-range file colours are clamped for drawing; non-finite ones count as absent.
+        f.colors[0] = [1.25, -0.5, 0.75];
+        f.colors[1] = [f32::NAN, 0.0, 0.0];
+        f.radii[1] = f32::INFINITY;
+        assert_eq!(st.resolve(&f, 0), (0.5, [1.0, 0.0, 0.75]));
+        assert_eq!(st.resolve(&f, 1), (1.2, [1.0, 0.0, 0.0]));
         assert!(
             st.set(
                 Selector::Element(el("C")),

@@ -278,7 +278,9 @@ pub struct Frame {
     pub res_ids: Vec<i64>,
     /// Per-atom radii in Å from a `radius` column (OVITO convention).
     pub radii: Vec<f32>,
-    /// Per-atom colours from a `color` column, RGB in [0, 1] as written (sRGB-encoded).
+    /// Per-atom colours from colour columns (extended XYZ `color`, LAMMPS dump `ColorR ColorG
+    /// ColorB` / `Color.R …`), sRGB-encoded RGB stored as written: normally in [0, 1], but a file
+    /// may hold values outside it ([`crate::AtomStyle`] clamps them for drawing).
     pub colors: Vec<[f32; 3]>,
     /// The frame's title / comment line (XYZ comment, GRO title, PDB TITLE), if any.
     pub comment: String,

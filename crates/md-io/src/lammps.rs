@@ -16,7 +16,24 @@
 //! `xs ys zs` (scaled), `xu yu zu` (unwrapped), `xsu ysu zsu` (scaled unwrapped); scaled ones
 //! become Cartesian as origin + s·M with the frame's box (f64). Also read: `id`, `type`,
 //! `element` (→ elements; else elements are guessed from non-numeric types), `vx vy vz`,
-//! `radius`, `diameter` (halved), `mass`/`q`/others skipped.
+//! `radius`, `diameter` (halved), the colour columns below, `mass`/`q`/others skipped.
+//!
+//! # Colour columns
+//! Per-atom colours (sRGB in [0, 1], into [`Frame::colors`]) come from the column names OVITO's
+//! LAMMPS dump importer maps to its `Color` property by itself: `Color.R Color.G Color.B` or
+//! `ColorR ColorG ColorB`, in any letter case (OVITO 3.17 `LAMMPSTextDumpImporter::
+//! generateAutomaticColumnMapping` lower-cases the column name and compares it with the standard
+//! property name plus component, with and without the dot). OVITO's own dump exporter writes
+//! `ColorR ColorG ColorB`. LAMMPS has no colour keyword: a run dumps colours as variables or
+//! compute columns and names them with `dump_modify colname`, e.g.
+//! `dump_modify d colname v_red ColorR colname v_green ColorG colname v_blue ColorB`.
+//! Like OVITO, `c_color[1]`, `v_r`, `red`, `r`… are not colours (checked against OVITO 3.17.2
+//! itself: `tests/data/color_reference.json`, `ovito_mapping`).
+//!
+//! The three columns may sit anywhere in the line, in any order; fewer than three is not a
+//! colour and those columns are skipped. Values are stored as written (finite, not clamped, as
+//! OVITO keeps them): a value outside [0, 1] is clamped only when a colour is chosen for drawing
+//! ([`crate::AtomStyle::resolve`]), so reading then writing a file does not change it.
 //!
 //! Atoms are returned sorted by `id` when there is an id column (LAMMPS writes them in
 //! processor order), as MDAnalysis and chemfiles do.
@@ -42,6 +59,7 @@ enum Act {
     Element,
     Pos(usize),
     Vel(usize),
+    Color(usize),
     Radius,
     Diameter,
     Skip,
@@ -71,6 +89,20 @@ pub(crate) struct Lammps {
     se: Vec<Element>,
     si: Vec<i64>,
     sf: Vec<f32>,
+}
+
+/// The colour component (0 = R, 1 = G, 2 = B) an OVITO-style colour column name gives:
+/// `Color.R`/`ColorR` … in any letter case (see the module doc).
+fn color_component(name: &[u8]) -> Option<usize> {
+    let rest = name
+        .get(..5)
+        .filter(|p| p.eq_ignore_ascii_case(b"color"))
+        .map(|_| &name[5..])?;
+    let rest = rest.strip_prefix(b".").unwrap_or(rest);
+    match rest {
+        [c] => b"rgb".iter().position(|k| k.eq_ignore_ascii_case(c)),
+        _ => None,
+    }
 }
 
 impl Default for Lammps {
@@ -309,9 +341,10 @@ impl Lammps {
                 b"vz" => Act::Vel(2),
                 b"radius" => Act::Radius,
                 b"diameter" => Act::Diameter,
-                c => match set.iter().position(|s| *s == c) {
-                    Some(k) => Act::Pos(k),
-                    None => Act::Skip,
+                c => match (set.iter().position(|s| *s == c), color_component(c)) {
+                    (Some(k), _) => Act::Pos(k),
+                    (None, Some(k)) => Act::Color(k),
+                    (None, None) => Act::Skip,
                 },
             };
             // Only the first column of a kind counts.
@@ -322,11 +355,21 @@ impl Lammps {
             };
             self.acts.push(act);
         }
+        // A partial velocity or colour is not one: skip those columns.
         let vel = (0..3).filter(|k| self.acts.contains(&Act::Vel(*k))).count();
         if vel != 0 && vel != 3 {
-            // A partial velocity is not a velocity: skip those columns.
             for a in &mut self.acts {
                 if matches!(a, Act::Vel(_)) {
+                    *a = Act::Skip;
+                }
+            }
+        }
+        let rgb = (0..3)
+            .filter(|k| self.acts.contains(&Act::Color(*k)))
+            .count();
+        if rgb != 0 && rgb != 3 {
+            for a in &mut self.acts {
+                if matches!(a, Act::Color(_)) {
                     *a = Act::Skip;
                 }
             }
@@ -348,6 +391,7 @@ impl TextFormat for Lammps {
         let has = |a: Act| self.acts.contains(&a);
         let (has_vel, has_id, has_type) = (has(Act::Vel(0)), has(Act::Id), has(Act::Type));
         let has_el = has(Act::Element);
+        let has_color = has(Act::Color(0));
         let vel_scale = if self.units == Units::Real {
             1000.0
         } else {
@@ -362,6 +406,7 @@ impl TextFormat for Lammps {
             };
             let mut xyz = [0f64; 3];
             let mut v = [0f32; 3];
+            let mut rgb = [0f32; 3];
             let mut at = 0;
             for &act in &self.acts {
                 // Coordinates are parsed in place (one pass); other columns as fields.
@@ -391,6 +436,10 @@ impl TextFormat for Lammps {
                         v[k] = parse_f32(f)
                             .map(|x| x * vel_scale)
                             .ok_or_else(|| ctx.parse(pos, line, f, "a velocity"))?;
+                    }
+                    Act::Color(k) => {
+                        rgb[k] = parse_f32(f)
+                            .ok_or_else(|| ctx.parse(pos, line, f, "a finite colour component"))?;
                     }
                     Act::Id => {
                         let id = parse_i64(f)
@@ -432,6 +481,9 @@ impl TextFormat for Lammps {
             if has_vel {
                 frame.velocities.push(v);
             }
+            if has_color {
+                frame.colors.push(rgb);
+            }
         }
         // Elements from non-numeric types when there is no element column.
         if !has_el
@@ -454,6 +506,7 @@ impl TextFormat for Lammps {
             let perm = &self.perm;
             permute(&mut frame.positions, perm, &mut self.s3);
             permute(&mut frame.velocities, perm, &mut self.s3);
+            permute(&mut frame.colors, perm, &mut self.s3);
             permute(&mut frame.types, perm, &mut self.sl);
             permute(&mut frame.elements, perm, &mut self.se);
             permute(&mut frame.radii, perm, &mut self.sf);
