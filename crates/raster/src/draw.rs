@@ -319,13 +319,7 @@ impl Framebuffer {
         });
 
         // Stage 3: tiles.
-        let ctx = RasterCtx {
-            state: *state,
-            far: proj.far,
-            width: grid.width,
-            height: grid.height,
-            block_path: *block_path,
-        };
+        let ctx = RasterCtx::new(*state, proj.far, grid.width, grid.height, *block_path);
         let bins = &scratch.tris;
         tiles.par_iter_mut().enumerate().for_each(|(ti, tile)| {
             for rec in bins.tile(ti) {
@@ -407,13 +401,7 @@ impl Framebuffer {
                 }
             }
         });
-        let ctx = RasterCtx {
-            state: *state,
-            far: f32::INFINITY,
-            width: grid.width,
-            height: grid.height,
-            block_path: true,
-        };
+        let ctx = RasterCtx::new(*state, f32::INFINITY, grid.width, grid.height, true);
         let bins = &scratch.sprites;
         tiles.par_iter_mut().enumerate().for_each(|(ti, tile)| {
             for sp in bins.tile(ti) {

@@ -21,17 +21,36 @@ pub const TILE: u32 = 64;
 pub(crate) const TILE_SHIFT: u32 = 6;
 pub(crate) const QUADS_PER_ROW: usize = (TILE / 2) as usize;
 pub(crate) const TILE_PIXELS: usize = (TILE * TILE) as usize;
+/// 2x2 quads per tile (a power of two, so a masked quad index needs no bounds check).
+pub(crate) const TILE_QUADS: usize = TILE_PIXELS / 4;
+
+/// One pixel plane of a tile: `TILE_QUADS` quads of four lanes, in quad order.
+pub(crate) type QuadPlane = Box<[[f32; 4]; TILE_QUADS]>;
+
+fn quad_plane(v: f32) -> QuadPlane {
+    let quads: Box<[[f32; 4]]> = vec![[v; 4]; TILE_QUADS].into_boxed_slice();
+    match quads.try_into() {
+        Ok(p) => p,
+        Err(_) => unreachable!("the vector has TILE_QUADS elements"),
+    }
+}
 
 /// One tile's pixel planes, in quad order.
 #[derive(Clone, Debug)]
 pub(crate) struct Tile {
-    pub depth: Box<[f32]>,
-    pub r: Box<[f32]>,
-    pub g: Box<[f32]>,
-    pub b: Box<[f32]>,
+    pub depth: QuadPlane,
+    pub r: QuadPlane,
+    pub g: QuadPlane,
+    pub b: QuadPlane,
     /// Pixel origin of the tile.
     pub x0: u32,
     pub y0: u32,
+}
+
+/// Index of the quad holding pixel (lx, ly) of a tile (masked: always in range).
+#[inline]
+pub(crate) fn quad_index(lx: u32, ly: u32) -> usize {
+    ((ly >> 1) as usize * QUADS_PER_ROW + (lx >> 1) as usize) & (TILE_QUADS - 1)
 }
 
 /// Index of pixel (lx, ly) inside a tile, in quad order.
@@ -93,10 +112,10 @@ impl Framebuffer {
         for ty in 0..tiles_y {
             for tx in 0..tiles_x {
                 tiles.push(Tile {
-                    depth: vec![f32::INFINITY; TILE_PIXELS].into_boxed_slice(),
-                    r: vec![0.0; TILE_PIXELS].into_boxed_slice(),
-                    g: vec![0.0; TILE_PIXELS].into_boxed_slice(),
-                    b: vec![0.0; TILE_PIXELS].into_boxed_slice(),
+                    depth: quad_plane(f32::INFINITY),
+                    r: quad_plane(0.0),
+                    g: quad_plane(0.0),
+                    b: quad_plane(0.0),
                     x0: tx * TILE,
                     y0: ty * TILE,
                 });
@@ -128,10 +147,10 @@ impl Framebuffer {
         self.background = background;
         self.clear_linear = lin;
         for t in &mut self.tiles {
-            t.depth.fill(f32::INFINITY);
-            t.r.fill(lin.x);
-            t.g.fill(lin.y);
-            t.b.fill(lin.z);
+            t.depth.fill([f32::INFINITY; 4]);
+            t.r.fill([lin.x; 4]);
+            t.g.fill([lin.y; 4]);
+            t.b.fill([lin.z; 4]);
         }
     }
 
@@ -146,14 +165,14 @@ impl Framebuffer {
 
     /// Stored depth of pixel (x, y) (`None` outside the image).
     pub fn depth_at(&self, x: u32, y: u32) -> Option<f32> {
-        self.locate(x, y).map(|(t, i)| t.depth[i])
+        self.locate(x, y).map(|(t, i)| t.depth[i >> 2][i & 3])
     }
 
     /// Stored linear colour of pixel (x, y) (`None` outside the image). With [`crate::Blend::Add`]
     /// and a flat colour of 1 this is the number of fragments written there.
     pub fn color_at(&self, x: u32, y: u32) -> Option<Vec3> {
         self.locate(x, y)
-            .map(|(t, i)| Vec3::new(t.r[i], t.g[i], t.b[i]))
+            .map(|(t, i)| Vec3::new(t.r[i >> 2][i & 3], t.g[i >> 2][i & 3], t.b[i >> 2][i & 3]))
     }
 
     /// Resolve to a [`Frame`]: sRGB8 colour (alpha 255 where drawn) and depth. A pixel whose
@@ -169,8 +188,9 @@ impl Framebuffer {
                 let row = y as usize * w;
                 for x in t.x0..xe {
                     let i = tile_index(x - t.x0, y - t.y0);
-                    let c = Vec3::new(t.r[i], t.g[i], t.b[i]);
-                    let d = t.depth[i];
+                    let (q, l) = (i >> 2, i & 3);
+                    let c = Vec3::new(t.r[q][l], t.g[q][l], t.b[q][l]);
+                    let d = t.depth[q][l];
                     let o = row + x as usize;
                     frame.depth[o] = d;
                     if d.is_finite()

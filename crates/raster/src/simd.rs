@@ -62,13 +62,6 @@ mod imp {
             // SAFETY: SSE2 is part of the x86-64 baseline, always enabled on this target.
             unsafe { F32x4(_mm_set1_ps(v)) }
         }
-        /// The first four values of `s` (which must hold at least four).
-        #[inline(always)]
-        pub fn load(s: &[f32]) -> F32x4 {
-            let s = &s[..4];
-            // SAFETY: `s` holds four f32 (checked above); unaligned load.
-            F32x4(unsafe { _mm_loadu_ps(s.as_ptr()) })
-        }
         /// Store into the first four values of `s`.
         #[inline(always)]
         pub fn store(self, s: &mut [f32]) {
@@ -198,10 +191,6 @@ mod imp {
         #[inline(always)]
         pub fn splat(v: f32) -> F32x4 {
             F32x4([v; 4])
-        }
-        #[inline(always)]
-        pub fn load(s: &[f32]) -> F32x4 {
-            F32x4([s[0], s[1], s[2], s[3]])
         }
         #[inline(always)]
         pub fn store(self, s: &mut [f32]) {

@@ -13,7 +13,7 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::framebuffer::{QUADS_PER_ROW, TILE, Tile};
+use crate::framebuffer::{TILE, Tile, quad_index};
 use crate::state::DepthTest;
 use crate::tri::{RasterCtx, write_quad};
 
@@ -144,12 +144,11 @@ pub(crate) fn raster_sprite<S: QuadShader + ?Sized>(
             if qx + 1 > px1 {
                 mask &= 0b0101;
             }
-            let lx = qx as u32 - tile.x0;
-            let base = ((ly >> 1) as usize * QUADS_PER_ROW + (lx >> 1) as usize) << 2;
+            let qi = quad_index(qx as u32 - tile.x0, ly);
             // Early depth rejection against the sprite's nearest possible depth.
             if st.depth_test != DepthTest::Always {
                 for l in 0..4 {
-                    let stored = tile.depth[base + l];
+                    let stored = tile.depth[qi][l];
                     let hopeless = match st.depth_test {
                         DepthTest::LessEqual => stored < sp.depth_min,
                         _ => stored <= sp.depth_min,
@@ -188,7 +187,7 @@ pub(crate) fn raster_sprite<S: QuadShader + ?Sized>(
                 let mut keep = mask & out.mask;
                 for l in 0..4 {
                     let d = out.depth[l];
-                    let stored = tile.depth[base + l];
+                    let stored = tile.depth[qi][l];
                     let pass = match st.depth_test {
                         DepthTest::Less => d < stored,
                         DepthTest::LessEqual => d <= stored,
@@ -205,7 +204,7 @@ pub(crate) fn raster_sprite<S: QuadShader + ?Sized>(
                         out.color.map(|c| c.y),
                         out.color.map(|c| c.z),
                     ];
-                    write_quad(tile, base, keep, &out.depth, &c, st);
+                    write_quad(tile, qi, keep, &out.depth, &c, st);
                 }
             }
             qx += 2;

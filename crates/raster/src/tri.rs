@@ -10,14 +10,14 @@
 //! affine in (x, y); per pixel, `W = 1 / (1/W)` recovers depth and the perspective-correct
 //! varyings (the perspective-correct form of Seed 000 Eq. 1: `z⁻¹` is affine on the screen).
 
-use crate::framebuffer::{QUADS_PER_ROW, TILE, Tile};
+use crate::framebuffer::{TILE, Tile, quad_index};
 use crate::program::{FragProgram, QuadFrag};
-use crate::project::{MAX_VAR, PVert, Var};
+use crate::project::{MAX_VAR, PVert, SUB_BITS, Var};
 use crate::simd::{F32x4, I32x4};
 use crate::state::{Blend, Cull, DepthTest, DrawState};
 
 /// What the quad loop needs besides the triangle.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy)]
 pub(crate) struct RasterCtx {
     pub state: DrawState,
     pub far: f32,
@@ -25,6 +25,21 @@ pub(crate) struct RasterCtx {
     pub height: u32,
     /// Whether small triangles take the block path (`false` only in tests comparing the paths).
     pub block_path: bool,
+    /// The depth test of `state` as lane masks.
+    zt: ZTest,
+}
+
+impl RasterCtx {
+    pub fn new(state: DrawState, far: f32, width: u32, height: u32, block_path: bool) -> Self {
+        RasterCtx {
+            state,
+            far,
+            width,
+            height,
+            block_path,
+            zt: ZTest::new(state, far),
+        }
+    }
 }
 
 /// Twice the signed area of a fixed-point triangle (y down): positive when the vertices run
@@ -127,23 +142,6 @@ pub(crate) fn raster_tri<P: FragProgram>(
     let px0 = px0 & !1;
     let py0 = py0 & !1;
 
-    // Edge functions E_i (edge opposite vertex i), top-left rule as a bias of −1 on the others.
-    let sx = (px0 as i64) * 256 + 128;
-    let sy = (py0 as i64) * 256 + 128;
-    let mut e_row = [0i64; 3];
-    let mut step_x = [0i64; 3];
-    let mut step_y = [0i64; 3];
-    for i in 0..3 {
-        let a = v[(i + 1) % 3];
-        let b = v[(i + 2) % 3];
-        let dx = b.x as i64 - a.x as i64;
-        let dy = b.y as i64 - a.y as i64;
-        let top_left = (dy == 0 && dx > 0) || dy < 0;
-        let bias = if top_left { 0 } else { -1 };
-        e_row[i] = dx * (sy - a.y as i64) - dy * (sx - a.x as i64) + bias;
-        step_x[i] = -dy * 256;
-        step_y[i] = dx * 256;
-    }
     // Plane equations (set up in f64, evaluated in f32 relative to the first quad).
     let fx0 = v[0].x as f64 / 256.0;
     let fy0 = v[0].y as f64 / 256.0;
@@ -174,7 +172,6 @@ pub(crate) fn raster_tri<P: FragProgram>(
             var[2][k] as f64 * q[2],
         );
     }
-
     let setup = Setup {
         px0,
         py0,
@@ -186,6 +183,52 @@ pub(crate) fn raster_tri<P: FragProgram>(
         p_dw,
         p_var,
     };
+    // Small-triangle fast path: a triangle at most TINY_SPAN across whose pixel range in this
+    // tile fits one block. Its edge functions (|dx|, |dy| <= 16 px; pixel centres of the block
+    // at most 16 + 2 + 8 px from a vertex) stay below 2 · 4096 · 26 · 256 < 2^26 in magnitude:
+    // set up and evaluated exactly in i32.
+    if ctx.block_path
+        && px1 - px0 < BLOCK as i32
+        && py1 - py0 < BLOCK as i32
+        && tri_span(v) <= TINY_SPAN
+    {
+        let sx = px0 * 256 + 128;
+        let sy = py0 * 256 + 128;
+        let mut e_row = [0i32; 3];
+        let mut step_x = [0i32; 3];
+        let mut step_y = [0i32; 3];
+        for i in 0..3 {
+            let a = v[(i + 1) % 3];
+            let b = v[(i + 2) % 3];
+            let dx = b.x - a.x;
+            let dy = b.y - a.y;
+            let top_left = (dy == 0 && dx > 0) || dy < 0;
+            let bias = if top_left { 0 } else { -1 };
+            e_row[i] = dx * (sy - a.y) - dy * (sx - a.x) + bias;
+            step_x[i] = -dy * 256;
+            step_y[i] = dx * 256;
+        }
+        block_loop::<P>(tile, ctx, prog, cst, front, &setup, e_row, step_x, step_y);
+        return;
+    }
+
+    // Edge functions E_i (edge opposite vertex i), top-left rule as a bias of −1 on the others.
+    let sx = (px0 as i64) * 256 + 128;
+    let sy = (py0 as i64) * 256 + 128;
+    let mut e_row = [0i64; 3];
+    let mut step_x = [0i64; 3];
+    let mut step_y = [0i64; 3];
+    for i in 0..3 {
+        let a = v[(i + 1) % 3];
+        let b = v[(i + 2) % 3];
+        let dx = b.x as i64 - a.x as i64;
+        let dy = b.y as i64 - a.y as i64;
+        let top_left = (dy == 0 && dx > 0) || dy < 0;
+        let bias = if top_left { 0 } else { -1 };
+        e_row[i] = dx * (sy - a.y as i64) - dy * (sx - a.x as i64) + bias;
+        step_x[i] = -dy * 256;
+        step_y[i] = dx * 256;
+    }
     // Edge values stay within i32 when every pixel centre the loop can reach (the quad-aligned
     // range plus one step past it) has |E| < 2^30: E is affine, so checking the corners suffices.
     // Small triangles (the common case) then run on 32-bit lanes, twice as wide per register.
@@ -199,20 +242,7 @@ pub(crate) fn raster_tri<P: FragProgram>(
             < (1 << 30)
     });
     let cv = |a: [i64; 3]| a.map(|x| x as i32);
-    if small && ctx.block_path && px1 - px0 < BLOCK as i32 && py1 - py0 < BLOCK as i32 {
-        // Small-triangle fast path: the whole (at most 8 x 8) pixel range at once.
-        block_loop::<P>(
-            tile,
-            ctx,
-            prog,
-            cst,
-            front,
-            &setup,
-            cv(e_row),
-            cv(step_x),
-            cv(step_y),
-        );
-    } else if small {
+    if small {
         quad_loop::<P, i32>(
             tile,
             ctx,
@@ -231,6 +261,16 @@ pub(crate) fn raster_tri<P: FragProgram>(
 
 /// Side in pixels of the block the small-triangle path covers in one go.
 pub(crate) const BLOCK: u32 = 8;
+/// Largest bounding-box side (fixed point: 16 pixels) of a triangle on the small-triangle path.
+const TINY_SPAN: i32 = 16 << SUB_BITS;
+
+/// The larger side of a triangle's fixed-point bounding box.
+#[inline]
+fn tri_span(v: &[PVert; 3]) -> i32 {
+    let w = v[0].x.max(v[1].x).max(v[2].x) - v[0].x.min(v[1].x).min(v[2].x);
+    let h = v[0].y.max(v[1].y).max(v[2].y) - v[0].y.min(v[1].y).min(v[2].y);
+    w.max(h)
+}
 
 /// What the quad loop needs from the triangle set-up.
 struct Setup {
@@ -269,13 +309,12 @@ struct ZTest {
 }
 
 impl ZTest {
-    #[inline]
-    fn new(ctx: &RasterCtx) -> ZTest {
+    fn new(state: DrawState, far: f32) -> ZTest {
         let flag = |b: bool| F32x4::from_bits(if b { 0b1111 } else { 0 });
         ZTest {
-            eq: flag(ctx.state.depth_test == DepthTest::LessEqual),
-            always: flag(ctx.state.depth_test == DepthTest::Always),
-            far: F32x4::splat(ctx.far),
+            eq: flag(state.depth_test == DepthTest::LessEqual),
+            always: flag(state.depth_test == DepthTest::Always),
+            far: F32x4::splat(far),
         }
     }
 
@@ -307,9 +346,7 @@ fn shade_quad<P: FragProgram>(
     qy: i32,
     mut mask: u8,
 ) {
-    let lx = qx as u32 - tile.x0;
-    let ly = qy as u32 - tile.y0;
-    let base = ((ly >> 1) as usize * QUADS_PER_ROW + (lx >> 1) as usize) << 2;
+    let qi = quad_index(qx as u32 - tile.x0, qy as u32 - tile.y0);
     let fxb = (qx - s.px0) as f32;
     let fyb = (qy - s.py0) as f32;
     let fx = F32x4::splat(fxb).add(F32x4::new([0.0, 1.0, 0.0, 1.0]));
@@ -318,7 +355,7 @@ fn shade_quad<P: FragProgram>(
     let w = F32x4::splat(1.0).div(s.p_q.eval4(fx, fy));
     let depth = s.p_dw.eval4(fx, fy).mul(w);
     // Depth test (NaN and out-of-range depths fail every comparison).
-    mask &= zt.mask(depth, F32x4::load(&tile.depth[base..base + 4]));
+    mask &= zt.mask(depth, F32x4::new(tile.depth[qi]));
     if mask == 0 {
         return;
     }
@@ -343,7 +380,7 @@ fn shade_quad<P: FragProgram>(
         frag.var[k] = s.p_var[k].eval4(fx, fy).mul(w).to_array();
     }
     let c = prog.shade(cst, &frag, front);
-    write_quad(tile, base, mask, &depth.to_array(), &c, st);
+    write_quad(tile, qi, mask, &depth.to_array(), &c, st);
 }
 
 /// The small-triangle path: coverage of the whole pixel range (at most [`BLOCK`] x [`BLOCK`],
@@ -390,7 +427,7 @@ fn block_loop<P: FragProgram>(
         }
     }
     let st = ctx.state;
-    let zt = ZTest::new(ctx);
+    let zt = ctx.zt;
     // Visit the covered quads, row pair by row pair, left to right.
     for j in 0..nrows.div_ceil(2) {
         let (r0, r1) = (rows[2 * j] as u32, rows[2 * j + 1] as u32);
@@ -444,7 +481,7 @@ fn quad_loop<P: FragProgram, E: EdgeInt>(
     let step2_x = step_x.map(|v| v + v);
     let step2_y = step_y.map(|v| v + v);
     let st = ctx.state;
-    let zt = ZTest::new(ctx);
+    let zt = ctx.zt;
     let mut qy = py0;
     while qy <= py1 {
         let mut e = e_row;
@@ -474,12 +511,12 @@ fn quad_loop<P: FragProgram, E: EdgeInt>(
     }
 }
 
-/// Write the masked lanes of a quad at tile index `base` (a select per lane, no per-lane
-/// branch; the depth-write and blend modes are chosen once per quad).
+/// Write the masked lanes of quad `qi` of a tile (a select per lane, no per-lane branch; the
+/// depth-write and blend modes are chosen once per quad).
 #[inline]
 pub(crate) fn write_quad(
     tile: &mut Tile,
-    base: usize,
+    qi: usize,
     mask: u8,
     depth: &[f32; 4],
     c: &[[f32; 4]; 3],
@@ -487,18 +524,18 @@ pub(crate) fn write_quad(
 ) {
     let on = F32x4::from_bits(mask);
     if st.depth_write {
-        let d = &mut tile.depth[base..base + 4];
-        F32x4::select(on, F32x4::new(*depth), F32x4::load(d)).store(d);
+        let d = &mut tile.depth[qi];
+        *d = F32x4::select(on, F32x4::new(*depth), F32x4::new(*d)).to_array();
     }
     let planes = [&mut tile.r, &mut tile.g, &mut tile.b];
     for (plane, c) in planes.into_iter().zip(c) {
-        let p = &mut plane[base..base + 4];
-        let old = F32x4::load(p);
+        let p = &mut plane[qi];
+        let old = F32x4::new(*p);
         let c = F32x4::new(*c);
         let new = match st.blend {
             Blend::Replace => c,
             Blend::Add => old.add(c),
         };
-        F32x4::select(on, new, old).store(p);
+        *p = F32x4::select(on, new, old).to_array();
     }
 }
