@@ -1,56 +1,56 @@
-//! Profiling driver: `cargo run --release -p texmap-impostor --example sphere_prof -- S2 raycast 20`
-//! renders a named scene repeatedly and prints the mean time per frame and the covered fraction.
+//! Profiling driver on texmap-study's canonical scenes (the ones `benches/spheres.rs` measures):
+//!
+//! `cargo run --release -p texmap-impostor --example sphere_prof -- <s1|s2|s3|empty> <method> [iters]`
+//!
+//! renders the scene `iters` times (after one untimed frame that builds the tables) and prints
+//! the wall and CPU time per frame and the covered fraction. `empty` is S1's camera with no
+//! sphere: the fixed per-frame cost at 500x500. For instruction counts per stage run it under
+//! callgrind, collecting inside the frames only:
+//!
+//! `valgrind --tool=callgrind --toggle-collect='*Renderer*render_into*' <binary> s1 raycast 5`
 
 use std::time::Instant;
-use texmap_core::camera::Camera;
 use texmap_core::frame::Frame;
-use texmap_core::glam::Vec3;
-use texmap_core::shade::{Lighting, Material};
 use texmap_impostor::{Method, Options, Renderer, SphereScene};
-
-struct Lcg(u64);
-impl Lcg {
-    fn next(&mut self) -> f32 {
-        self.0 = self
-            .0
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        (self.0 >> 40) as f32 / (1u64 << 24) as f32
-    }
-}
+use texmap_study::scenes::{SceneId, build};
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    let name = args.get(1).map(String::as_str).unwrap_or("S2");
-    let method = Method::from_name(args.get(2).map(String::as_str).unwrap_or("raycast")).unwrap();
-    let iters: usize = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(10);
-    let fov: f32 = args.get(4).and_then(|s| s.parse().ok()).unwrap_or(69.0);
-    let (n, side, r, w, h) = match name {
-        "S1" => (1115, 24.0, 1.0, 500, 500),
-        "S2" => (100_000, 100.0, 0.5, 1920, 1080),
-        _ => (1_000_000, 200.0, 0.3, 1920, 1080),
+    let name = args.get(1).map(String::as_str).unwrap_or("s2");
+    let Some(method) = Method::from_name(args.get(2).map(String::as_str).unwrap_or("raycast"))
+    else {
+        eprintln!("method: polygon, lut, template or raycast");
+        std::process::exit(2);
     };
-    let mut rng = Lcg(1);
-    let mut s = SphereScene::new(vec![Material::plastic(Vec3::new(0.8, 0.3, 0.2)); 6]);
-    for i in 0..n {
-        let c = (Vec3::new(rng.next(), rng.next(), rng.next()) - 0.5) * side;
-        s.push(c, r, (i % 6) as u16);
+    let iters: usize = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(10);
+    let (id, empty) = match name {
+        "empty" => (SceneId::S1, true),
+        n => match SceneId::from_name(&n.to_lowercase()) {
+            Some(id) => (id, false),
+            None => {
+                eprintln!("scene: s1, s2, s3, molecule or empty");
+                std::process::exit(2);
+            }
+        },
+    };
+    let mut s = build(id);
+    if empty {
+        s.spheres = SphereScene::new(s.spheres.materials.clone());
     }
-    let eye = Vec3::new(0.55, 0.35, 0.76).normalize() * (2.4 * side);
-    let cam = Camera::perspective_look_at(eye, Vec3::ZERO, Vec3::Y, fov, w, h).unwrap();
-    let opts = Options::new(method, Lighting::default_for(&cam));
+    let (w, h) = (s.camera.width(), s.camera.height());
+    let opts = Options::new(method, s.lighting);
     let mut rend = Renderer::new();
-    let mut frame = Frame::new(w, h, [0, 0, 0, 255]);
-    let st = rend.render_into(&s, &cam, &opts, &mut frame);
+    let mut frame = Frame::new(w, h, opts.background);
+    let st = rend.render_into(&s.spheres, &s.camera, &opts, &mut frame);
     let cpu0 = cpu_ms();
     let t = Instant::now();
     for _ in 0..iters {
-        rend.render_into(&s, &cam, &opts, &mut frame);
+        rend.render_into(&s.spheres, &s.camera, &opts, &mut frame);
     }
-    let ms = t.elapsed().as_secs_f64() * 1e3 / iters as f64;
-    let cpu = (cpu_ms() - cpu0) / iters as f64;
+    let ms = t.elapsed().as_secs_f64() * 1e3 / iters.max(1) as f64;
+    let cpu = (cpu_ms() - cpu0) / iters.max(1) as f64;
     println!(
-        "{name} {} {ms:.2} ms/frame wall, {cpu:.2} ms/frame CPU (all threads), coverage {:.3}, {st:?}",
+        "{name} {} {ms:.3} ms/frame wall, {cpu:.2} ms/frame CPU (all threads), coverage {:.3}, {st:?}",
         method.name(),
         frame.coverage_count() as f64 / frame.len() as f64
     );

@@ -197,6 +197,7 @@ pub(crate) struct LutKernel<'a> {
 }
 
 impl Kernel for LutKernel<'_> {
+    #[inline(never)]
     fn raster(&self, recs: &[Proj], tile: TileRect, buf: &mut TileBuf) {
         let near = self.view.near;
         let t = self.tables;

@@ -184,33 +184,9 @@ impl Bins {
             .zip(self.chunk_stats[..nchunks].par_iter_mut())
             .enumerate()
             .for_each(|(ci, ((recs, counts), stats))| {
-                recs.clear();
-                counts.clear();
-                counts.resize(ntiles, 0);
-                *stats = RenderStats::default();
                 let lo = ci * CHUNK;
                 let hi = (lo + CHUNK).min(n);
-                for i in lo..hi {
-                    if !scene.is_valid(i) {
-                        stats.skipped_invalid += 1;
-                        continue;
-                    }
-                    let c = view.eye_space(scene.centers[i]);
-                    match project(c, scene.radii[i], scene.kinds[i]) {
-                        Projected::Draw(p) => {
-                            stats.drawn += 1;
-                            let (tx0, ty0, tx1, ty1) = tile_range(&p);
-                            for ty in ty0..=ty1 {
-                                let row = &mut counts[ty * tiles_x..];
-                                for c in &mut row[tx0..=tx1] {
-                                    *c += 1;
-                                }
-                            }
-                            recs.push(p);
-                        }
-                        Projected::Culled => stats.culled += 1,
-                    }
-                }
+                project_chunk(scene, view, &project, lo..hi, recs, counts, stats);
             });
 
         // Pass 2: prefix sum over (tile, chunk); counts become write offsets.
@@ -242,21 +218,9 @@ impl Bins {
                 // pointer field alone, which is not `Send`).
                 #[allow(clippy::redundant_locals)]
                 let base = base;
-                for p in recs {
-                    let (tx0, ty0, tx1, ty1) = tile_range(p);
-                    for ty in ty0..=ty1 {
-                        for tx in tx0..=tx1 {
-                            let t = ty * tiles_x + tx;
-                            let slot = tile_start[t] + offs[t] as usize;
-                            offs[t] += 1;
-                            debug_assert!(slot < tile_start[t + 1]);
-                            // SAFETY: `slot` lies in this chunk's own run of tile `t` (prefix
-                            // sum above), which no other chunk writes, and below `total`, the
-                            // reserved capacity.
-                            unsafe { base.0.add(slot).write(*p) };
-                        }
-                    }
-                }
+                // SAFETY: as `fill_chunk` requires, `offs` are this chunk's write offsets from
+                // the prefix sum and `base` has capacity `total`.
+                unsafe { fill_chunk(recs, offs, tile_start, tiles_x, base) };
             });
         // SAFETY: the runs of all (tile, chunk) pairs partition 0..total and each slot was
         // written exactly once above.
@@ -269,6 +233,78 @@ impl Bins {
             stats.skipped_invalid += s.skipped_invalid;
         }
         stats
+    }
+}
+
+/// Pass 1 of [`Bins::build`] for one chunk of spheres: transform, cull, project, count per
+/// tile. Not inlined, so that profiles show the stage.
+#[inline(never)]
+fn project_chunk<F>(
+    scene: &SphereScene,
+    view: &View,
+    project: &F,
+    range: std::ops::Range<usize>,
+    recs: &mut Vec<Proj>,
+    counts: &mut Vec<u32>,
+    stats: &mut RenderStats,
+) where
+    F: Fn(Vec3, f32, u16) -> Projected + Sync,
+{
+    let ntiles = (view.tiles_x * view.tiles_y) as usize;
+    let tiles_x = view.tiles_x as usize;
+    recs.clear();
+    counts.clear();
+    counts.resize(ntiles, 0);
+    *stats = RenderStats::default();
+    for i in range {
+        if !scene.is_valid(i) {
+            stats.skipped_invalid += 1;
+            continue;
+        }
+        let c = view.eye_space(scene.centers[i]);
+        match project(c, scene.radii[i], scene.kinds[i]) {
+            Projected::Draw(p) => {
+                stats.drawn += 1;
+                let (tx0, ty0, tx1, ty1) = tile_range(&p);
+                for ty in ty0..=ty1 {
+                    let row = &mut counts[ty * tiles_x..];
+                    for c in &mut row[tx0..=tx1] {
+                        *c += 1;
+                    }
+                }
+                recs.push(p);
+            }
+            Projected::Culled => stats.culled += 1,
+        }
+    }
+}
+
+/// Pass 3 of [`Bins::build`] for one chunk: copy every record into the bins it touches.
+///
+/// # Safety
+/// `offs[t]` must be this chunk's write offset in tile `t`'s run (from the prefix sum), so that
+/// the slots written are disjoint from every other chunk's and below the capacity behind `base`.
+#[inline(never)]
+unsafe fn fill_chunk(
+    recs: &[Proj],
+    offs: &mut [u32],
+    tile_start: &[usize],
+    tiles_x: usize,
+    base: SendPtr,
+) {
+    for p in recs {
+        let (tx0, ty0, tx1, ty1) = tile_range(p);
+        for ty in ty0..=ty1 {
+            for tx in tx0..=tx1 {
+                let t = ty * tiles_x + tx;
+                let slot = tile_start[t] + offs[t] as usize;
+                offs[t] += 1;
+                debug_assert!(slot < tile_start[t + 1]);
+                // SAFETY: `slot` lies in this chunk's own run of tile `t` (prefix sum), which no
+                // other chunk writes, and below `total`, the reserved capacity.
+                unsafe { base.0.add(slot).write(*p) };
+            }
+        }
     }
 }
 

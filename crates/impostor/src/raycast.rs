@@ -202,6 +202,7 @@ fn hit8(
 }
 
 impl Kernel for Perspective<'_> {
+    #[inline(never)]
     fn raster(&self, recs: &[Proj], tile: TileRect, buf: &mut TileBuf) {
         let v = &self.view;
         let rt = RayTable::new(v, tile);
@@ -293,6 +294,7 @@ impl Kernel for Perspective<'_> {
         linear_to_srgb8(fastshade::shade(&self.lighting, m, n, to_eye), 255)
     }
 
+    #[inline(never)]
     fn resolve_tile(
         &self,
         recs: &[Proj],
@@ -303,6 +305,14 @@ impl Kernel for Perspective<'_> {
         stride: usize,
     ) {
         let v = &self.view;
+        // Ray directions of the tile's columns and rows (pixel centres).
+        let mut dxs = [0f32; TILE as usize];
+        let mut dys = [0f32; TILE as usize];
+        for i in 0..TILE as usize {
+            dxs[i] = ((tile.x0 as usize + i) as f32 + 0.5 - v.cx) * v.inv_k;
+            dys[i] = (v.cy - ((tile.y0 as usize + i) as f32 + 0.5)) * v.inv_k;
+        }
+        let enc = fastshade::srgb_table();
         // Compact the covered pixels, so that lanes are spent on them only.
         let mut list = [0u16; TILE_PX];
         let mut n = 0;
@@ -327,8 +337,8 @@ impl Kernel for Perspective<'_> {
                 let wv = buf.win[b];
                 let rec = &recs[(wv & !FLAG_INSIDE) as usize];
                 t[l] = buf.depth[b];
-                dx[l] = ((tile.x0 as usize + b % TILE as usize) as f32 + 0.5 - v.cx) * v.inv_k;
-                dy[l] = (v.cy - ((tile.y0 as usize + b / TILE as usize) as f32 + 0.5)) * v.inv_k;
+                dx[l] = dxs[b % TILE as usize];
+                dy[l] = dys[b / TILE as usize];
                 for k in 0..3 {
                     c[k][l] = rec.f[k];
                 }
@@ -356,9 +366,20 @@ impl Kernel for Perspective<'_> {
                 s.v[2][l] = id;
             }
             let c = fastshade::shade8(&self.lighting, &s);
+            // Encode to sRGB8 (texmap-core's table, indices over lanes).
+            let idx = [
+                fastshade::srgb_index8(&c[0]),
+                fastshade::srgb_index8(&c[1]),
+                fastshade::srgb_index8(&c[2]),
+            ];
             for (l, &b) in chunk.iter().enumerate() {
                 let (i, j) = (b as usize % TILE as usize, b as usize / TILE as usize);
-                color[j * stride + i] = linear_to_srgb8(Vec3::new(c[0][l], c[1][l], c[2][l]), 255);
+                color[j * stride + i] = [
+                    enc[idx[0][l] as usize],
+                    enc[idx[1][l] as usize],
+                    enc[idx[2][l] as usize],
+                    255,
+                ];
             }
         }
     }
@@ -371,6 +392,7 @@ pub(crate) struct Orthographic<'a> {
 }
 
 impl Kernel for Orthographic<'_> {
+    #[inline(never)]
     fn raster(&self, recs: &[Proj], tile: TileRect, buf: &mut TileBuf) {
         let v = &self.view;
         for (idx, p) in recs.iter().enumerate() {

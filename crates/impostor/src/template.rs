@@ -223,6 +223,7 @@ pub(crate) struct TemplateKernel<'a> {
 }
 
 impl Kernel for TemplateKernel<'_> {
+    #[inline(never)]
     fn raster(&self, recs: &[Proj], tile: TileRect, buf: &mut TileBuf) {
         let near = self.view.near;
         let dn = DEPTH_SIZE as f32;

@@ -43,6 +43,11 @@ fn check(scene: &SphereScene, cam: &Camera, what: &str) {
     let p = psnr(&out.frame, &refr).unwrap();
     let d = depth_error(&out.frame, &refr).unwrap();
     let s = silhouette_error(&out.frame, &refr).unwrap();
+    // Reported for the docs (`cargo test --test vs_reftrace -- --nocapture`).
+    eprintln!(
+        "{what}: PSNR {p:.2} dB, depth mean {:.3e} max {:.3e} (range {range:.3}), silhouette {:.4} px",
+        d.mean_abs, d.max_abs, s.mean_displacement_px
+    );
     assert!(p >= 45.0, "{what}: PSNR expected ≥ 45 dB, got {p}");
     // Depth: over pixels where both see the same surface. A pixel centre within f32 rounding of
     // a silhouette may be covered by the front sphere in one renderer and by the one behind in
