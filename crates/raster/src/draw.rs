@@ -206,11 +206,12 @@ impl Framebuffer {
         let indices = mesh.indices();
 
         // Stage 1: vertices.
-        positions
-            .par_iter()
-            .with_min_len(4096)
-            .map(|&p| proj.project(p))
-            .collect_into_vec(&mut scratch.pverts);
+        scratch.pverts.resize(positions.len(), PVert::default());
+        scratch
+            .pverts
+            .par_chunks_mut(4096)
+            .zip(positions.par_chunks(4096))
+            .for_each(|(out, p)| proj.project_slice(p, out));
         let pverts = &scratch.pverts;
 
         // Stage 2: primitives, in fixed chunks.

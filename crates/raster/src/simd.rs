@@ -43,6 +43,12 @@ mod imp {
             // SAFETY: SSE2 is part of the x86-64 baseline, always enabled on this target.
             unsafe { I32x4(_mm_or_si128(self.0, o.0)) }
         }
+        /// The lanes' bits as f32 lanes.
+        #[inline(always)]
+        pub fn cast_f32(self) -> F32x4 {
+            // SAFETY: SSE2 is part of the x86-64 baseline, always enabled on this target.
+            unsafe { F32x4(_mm_castsi128_ps(self.0)) }
+        }
         /// Bit l set when lane l is negative.
         #[inline(always)]
         pub fn neg_bits(self) -> u32 {
@@ -115,6 +121,40 @@ mod imp {
             // SAFETY: SSE2 is part of the x86-64 baseline, always enabled on this target.
             unsafe { F32x4(_mm_or_ps(self.0, o.0)) }
         }
+        #[inline(always)]
+        pub fn sub(self, o: F32x4) -> F32x4 {
+            // SAFETY: SSE2 is part of the x86-64 baseline, always enabled on this target.
+            unsafe { F32x4(_mm_sub_ps(self.0, o.0)) }
+        }
+        /// `self & !o` bit by bit.
+        #[inline(always)]
+        pub fn and_not(self, o: F32x4) -> F32x4 {
+            // SAFETY: SSE2 is part of the x86-64 baseline, always enabled on this target.
+            unsafe { F32x4(_mm_andnot_ps(o.0, self.0)) }
+        }
+        /// Truncation toward zero (lanes outside the i32 range give `i32::MIN`).
+        #[inline(always)]
+        pub fn trunc_i32(self) -> I32x4 {
+            // SAFETY: SSE2 is part of the x86-64 baseline, always enabled on this target.
+            unsafe { I32x4(_mm_cvttps_epi32(self.0)) }
+        }
+        /// Four rows of four lanes transposed: lane l of output i = lane i of input l.
+        #[inline(always)]
+        pub fn transpose(r: [F32x4; 4]) -> [F32x4; 4] {
+            // SAFETY: SSE2 is part of the x86-64 baseline, always enabled on this target.
+            unsafe {
+                let t0 = _mm_unpacklo_ps(r[0].0, r[1].0);
+                let t1 = _mm_unpacklo_ps(r[2].0, r[3].0);
+                let t2 = _mm_unpackhi_ps(r[0].0, r[1].0);
+                let t3 = _mm_unpackhi_ps(r[2].0, r[3].0);
+                [
+                    F32x4(_mm_movelh_ps(t0, t1)),
+                    F32x4(_mm_movehl_ps(t1, t0)),
+                    F32x4(_mm_movelh_ps(t2, t3)),
+                    F32x4(_mm_movehl_ps(t3, t2)),
+                ]
+            }
+        }
         /// Bit l set when the sign bit of lane l is set (for masks: lane l true).
         #[inline(always)]
         pub fn bits(self) -> u32 {
@@ -178,6 +218,10 @@ mod imp {
             I32x4(std::array::from_fn(|l| self.0[l] | o.0[l]))
         }
         #[inline(always)]
+        pub fn cast_f32(self) -> F32x4 {
+            F32x4(self.0.map(|v| f32::from_bits(v as u32)))
+        }
+        #[inline(always)]
         pub fn neg_bits(self) -> u32 {
             (0..4).fold(0, |m, l| m | (((self.0[l] < 0) as u32) << l))
         }
@@ -235,6 +279,31 @@ mod imp {
             F32x4(std::array::from_fn(|l| {
                 f32::from_bits(self.0[l].to_bits() | o.0[l].to_bits())
             }))
+        }
+        #[inline(always)]
+        pub fn sub(self, o: F32x4) -> F32x4 {
+            F32x4(std::array::from_fn(|l| self.0[l] - o.0[l]))
+        }
+        #[inline(always)]
+        pub fn and_not(self, o: F32x4) -> F32x4 {
+            F32x4(std::array::from_fn(|l| {
+                f32::from_bits(self.0[l].to_bits() & !o.0[l].to_bits())
+            }))
+        }
+        #[inline(always)]
+        pub fn trunc_i32(self) -> I32x4 {
+            I32x4(std::array::from_fn(|l| {
+                let v = self.0[l];
+                if v > -2147483904.0 && v < 2147483648.0 {
+                    v as i32
+                } else {
+                    i32::MIN
+                }
+            }))
+        }
+        #[inline(always)]
+        pub fn transpose(r: [F32x4; 4]) -> [F32x4; 4] {
+            std::array::from_fn(|i| F32x4(std::array::from_fn(|l| r[l].0[i])))
         }
         #[inline(always)]
         pub fn bits(self) -> u32 {
