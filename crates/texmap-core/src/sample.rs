@@ -98,6 +98,9 @@ use glam::{Vec2, Vec4, Vec4Swizzles};
 
 use crate::mip::{LevelInfo, MipTexture, Wrap};
 
+#[cfg(target_arch = "x86_64")]
+mod lanes;
+
 /// Memory banks per side for the span sampler.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Banks {
@@ -193,12 +196,17 @@ fn log2_split(x: f32) -> (i32, f32) {
     let bits = x.to_bits();
     let e = ((bits >> 23) & 0xff) as i32 - 127;
     let t = f32::from_bits((bits & 0x007f_ffff) | 0x3f80_0000) - 1.0;
-    const C1: f32 = 1.438_725_7;
-    const C2: f32 = -0.677_783_9;
-    const C3: f32 = 0.321_188_76;
-    const C4: f32 = 1.0 - C1 - C2 - C3;
-    (e, t * (C1 + t * (C2 + t * (C3 + t * C4))))
+    (
+        e,
+        t * (LOG2_C1 + t * (LOG2_C2 + t * (LOG2_C3 + t * LOG2_C4))),
+    )
 }
+
+/// [`log2_split`]'s mantissa polynomial (shared with the lane kernels).
+const LOG2_C1: f32 = 1.438_725_7;
+const LOG2_C2: f32 = -0.677_783_9;
+const LOG2_C3: f32 = 0.321_188_76;
+const LOG2_C4: f32 = 1.0 - LOG2_C1 - LOG2_C2 - LOG2_C3;
 
 /// ⌊x⌋ for |x| ≤ 2^30 (finite): truncate, then step down for negative fractions.
 #[inline(always)]
@@ -585,8 +593,100 @@ fn span_quads<A: Addr, const K: usize>(
         if i + 1 < n {
             next = span_plan::<A, K>(tex, quads[i + 1], 0);
         }
-        out[i] = span_finish::<A, Direct, K>(tex, cur, &mut Direct);
+        out[i] = span_finish_direct::<A, K>(tex, cur);
     }
+}
+
+/// One level of a span on the fast path, set up for [`span_finish_direct`]: when every pixel's
+/// bilinear neighbourhood lies in a K x K window inside the level (the common case), the window
+/// corner's index and each pixel's offset from it (`oy·w + ox`), else `None`.
+struct DirectLevel {
+    corner: usize,
+    width: usize,
+    idx: [i32; 4],
+    ax: Vec4,
+    ay: Vec4,
+}
+
+/// Seed 000 Eq. (10) for the fast path: the level's texel coordinates, floors and weights
+/// exactly as [`span_level`] computes them, and the interior window if there is one.
+#[inline(always)]
+fn direct_level<A: Addr, const K: usize>(
+    tex: &MipTexture,
+    level: usize,
+    sx: Vec4,
+    sy: Vec4,
+) -> Option<DirectLevel> {
+    let l = &tex.levels()[level];
+    let mut x = sx * l.scale_x - Vec4::splat(0.5);
+    let mut y = sy * l.scale_y - Vec4::splat(0.5);
+    if !A::REPEAT {
+        x = x.max(Vec4::ZERO).min(Vec4::splat(l.width_f - 1.0));
+        y = y.max(Vec4::ZERO).min(Vec4::splat(l.height_f - 1.0));
+    }
+    let (flx, fly) = (floor4(x), floor4(y));
+    let (mx, my) = (flx.min_element(), fly.min_element());
+    let (ox, oy) = (flx - Vec4::splat(mx), fly - Vec4::splat(my));
+    let lim = Vec4::splat((K - 2) as f32);
+    // SAFETY: mx, my are floors of lanes clamped to ±2^30: integer-valued and within i32.
+    let (x0, y0): (i32, i32) = unsafe { (mx.to_int_unchecked(), my.to_int_unchecked()) };
+    let (w, h) = (l.width as i32, l.height as i32);
+    let k = K as i32;
+    if (ox.cmpgt(lim) | oy.cmpgt(lim)).any() || x0 < 0 || y0 < 0 || x0 + k > w || y0 + k > h {
+        return None;
+    }
+    Some(DirectLevel {
+        corner: l.offset + (y0 * w + x0) as usize,
+        width: w as usize,
+        // oy·w + ox: small non-negative integers, exact in f32 (w ≤ 2^14, oy ≤ 2).
+        idx: lanes_i32(oy * Vec4::splat(l.width_f) + ox),
+        ax: x - flx,
+        ay: y - fly,
+    })
+}
+
+/// Bilinear of pixel `j` from an interior window (Eq. 4 weights, the arithmetic of
+/// [`span_level`]).
+#[inline(always)]
+fn direct_pixel(t: &[Vec4], d: &DirectLevel, ax: Vec4, ay: Vec4, j: usize) -> Vec4 {
+    let i = d.corner + d.idx[j] as usize;
+    let t00 = texel(t, i);
+    let t10 = texel(t, i + 1);
+    let t01 = texel(t, i + d.width);
+    let t11 = texel(t, i + d.width + 1);
+    lerp4(lerp4(t00, t10, ax), lerp4(t01, t11, ax), ay)
+}
+
+/// [`span_finish`] for the fast path with both levels fused per pixel: when both windows are
+/// interior, each pixel reads its 2x2 on each level and blends, results staying in registers.
+/// Bit-identical to [`span_finish`] (same operations in the same order); other spans take it.
+#[inline(always)]
+fn span_finish_direct<A: Addr, const K: usize>(tex: &MipTexture, p: SpanPlan) -> [Vec4; 4] {
+    let t = tex.texels();
+    let Some(a) = direct_level::<A, K>(tex, p.i0, p.sx, p.sy) else {
+        return span_finish::<A, Direct, K>(tex, p, &mut Direct);
+    };
+    let axs = [a.ax.xxxx(), a.ax.yyyy(), a.ax.zzzz(), a.ax.wwww()];
+    let ays = [a.ay.xxxx(), a.ay.yyyy(), a.ay.zzzz(), a.ay.wwww()];
+    let mut out = [Vec4::ZERO; 4];
+    if p.i1 == p.i0 || p.t == 0.0 {
+        for j in 0..4 {
+            out[j] = direct_pixel(t, &a, axs[j], ays[j], j);
+        }
+        return out;
+    }
+    let Some(b) = direct_level::<A, K>(tex, p.i1, p.sx, p.sy) else {
+        return span_finish::<A, Direct, K>(tex, p, &mut Direct);
+    };
+    let bxs = [b.ax.xxxx(), b.ax.yyyy(), b.ax.zzzz(), b.ax.wwww()];
+    let bys = [b.ay.xxxx(), b.ay.yyyy(), b.ay.zzzz(), b.ay.wwww()];
+    let tt = Vec4::splat(p.t);
+    for j in 0..4 {
+        let ca = direct_pixel(t, &a, axs[j], ays[j], j);
+        let cb = direct_pixel(t, &b, bxs[j], bys[j], j);
+        out[j] = lerp4(ca, cb, tt);
+    }
+    out
 }
 
 /// The four bilinear samples of one level from ONE window read.
@@ -819,11 +919,18 @@ impl Sampler {
                 Sampler::Nearest => run!(A, |p, _, _| nearest::<A>(texels, l0, p)),
                 Sampler::Bilinear => run!(A, |p, _, _| bilinear::<A>(texels, l0, p)),
                 Sampler::Trilinear => {
-                    run!(A, |p, dx, dy| trilinear_fp::<A>(
-                        tex,
-                        p,
-                        footprint(l0, dx, dy)
-                    ))
+                    // Four pixels per step in lanes (power-of-two pyramids), then the tail.
+                    #[cfg(target_arch = "x86_64")]
+                    let done = if tex.is_pow2() {
+                        lanes::trilinear_pixels::<A>(tex, uv, duv_dx, duv_dy, out)
+                    } else {
+                        0
+                    };
+                    #[cfg(not(target_arch = "x86_64"))]
+                    let done = 0;
+                    for i in done..n {
+                        out[i] = trilinear_fp::<A>(tex, uv[i], footprint(l0, duv_dx[i], duv_dy[i]));
+                    }
                 }
                 s => run!(A, |p, dx, dy| s.sample_one::<A>(tex, p, dx, dy)),
             }
@@ -846,8 +953,22 @@ impl Sampler {
         }
         with_addr!(tex, A, {
             match *self {
-                Sampler::Span(Banks::K3) => span_quads::<A, 3>(tex, quads, out),
-                Sampler::Span(Banks::K4) => span_quads::<A, 4>(tex, quads, out),
+                Sampler::Span(banks) => {
+                    // Four spans per step in lanes (power-of-two pyramids), then the tail.
+                    #[cfg(target_arch = "x86_64")]
+                    let done = match (tex.is_pow2(), banks) {
+                        (true, Banks::K3) => lanes::span_quads4::<A, 3>(tex, quads, out),
+                        (true, Banks::K4) => lanes::span_quads4::<A, 4>(tex, quads, out),
+                        (false, _) => 0,
+                    };
+                    #[cfg(not(target_arch = "x86_64"))]
+                    let done = 0;
+                    let (q, o) = (&quads[done..], &mut out[done..]);
+                    match banks {
+                        Banks::K3 => span_quads::<A, 3>(tex, q, o),
+                        Banks::K4 => span_quads::<A, 4>(tex, q, o),
+                    }
+                }
                 s => {
                     for (o, q) in out.iter_mut().zip(quads) {
                         *o = s.quad_one::<A>(tex, *q);
@@ -1092,6 +1213,118 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Random pixels from every regime: magnified, minified, past the top level, NaN and huge
+    /// coordinates and derivatives, zero derivatives.
+    fn random_pixels(n: usize, seed: u32) -> (Vec<Vec2>, Vec<Vec2>, Vec<Vec2>) {
+        let mut rng = seed;
+        let mut r = move || {
+            rng ^= rng << 13;
+            rng ^= rng >> 17;
+            rng ^= rng << 5;
+            (rng >> 8) as f32 / (1u32 << 24) as f32
+        };
+        let (mut uv, mut dx, mut dy) = (vec![], vec![], vec![]);
+        for i in 0..n {
+            let mut p = Vec2::new(r() * 6.0 - 3.0, r() * 6.0 - 3.0);
+            let s = 10f32.powf(r() * 7.0 - 5.0);
+            let mut a = Vec2::new(r() - 0.5, r() - 0.5) * s;
+            let mut b = Vec2::new(r() - 0.5, r() - 0.5) * s;
+            match i % 23 {
+                0 => p = Vec2::NAN,
+                1 => a = Vec2::NAN,
+                2 => (a, b) = (Vec2::NAN, Vec2::NAN),
+                3 => p = Vec2::splat(1e30),
+                4 => (a, b) = (Vec2::ZERO, Vec2::ZERO),
+                5 => a = Vec2::splat(f32::INFINITY),
+                6 => p.x = -f32::INFINITY,
+                _ => {}
+            }
+            uv.push(p);
+            dx.push(a);
+            dy.push(b);
+        }
+        (uv, dx, dy)
+    }
+
+    #[test]
+    fn bulk_trilinear_lanes_match_the_per_pixel_sampler_bit_for_bit() {
+        // The lane kernel (power-of-two pyramids) against `sample`, which always takes the scalar
+        // per-pixel path; odd lengths exercise the scalar tail; NPOT takes the scalar path.
+        let mut reached_pair = false;
+        for (w, h) in [(64, 64), (64, 16), (1, 8), (1, 1), (256, 128), (48, 20)] {
+            for wrap in [Wrap::Repeat, Wrap::Clamp] {
+                let t = ramp(w, h, wrap);
+                let (uv, dx, dy) = random_pixels(4003, w * 31 + h);
+                let mut out = vec![Vec4::ZERO; uv.len()];
+                Sampler::Trilinear
+                    .sample_pixels(&t, &uv, &dx, &dy, &mut out)
+                    .unwrap();
+                for i in 0..uv.len() {
+                    let e = Sampler::Trilinear.sample(&t, uv[i], dx[i], dy[i]);
+                    assert_eq!(
+                        out[i].to_array().map(f32::to_bits),
+                        e.to_array().map(f32::to_bits),
+                        "{w}x{h} {wrap:?} pixel {i}: uv {} dx {} dy {}: expected {e}, got {}",
+                        uv[i],
+                        dx[i],
+                        dy[i],
+                        out[i]
+                    );
+                    let m = footprint(&t.levels()[0], dx[i], dy[i]);
+                    reached_pair |= m > 1.0 && m.log2() < (t.level_count() - 1) as f32;
+                }
+            }
+        }
+        assert!(reached_pair, "no pixel blended two levels");
+    }
+
+    #[test]
+    fn bulk_span_lanes_match_the_bank_emulator_bit_for_bit() {
+        // `sample_quads` (four spans per step in lanes on power-of-two pyramids, generic path for
+        // edge windows, the tail and NPOT) against the bank emulator, quad by quad.
+        let mut lane_spans = 0usize;
+        for (w, h) in [(64, 64), (64, 16), (1, 8), (2, 2), (256, 128), (48, 20)] {
+            for wrap in [Wrap::Repeat, Wrap::Clamp] {
+                let t = ramp(w, h, wrap);
+                let (uv, dx, dy) = random_pixels(2001, w * 17 + h);
+                let quads: Vec<[Vec2; 4]> = (0..uv.len())
+                    .map(|i| {
+                        let s = if i % 3 == 0 { 0.02 } else { 1.0 };
+                        quad_from_pixel(uv[i], dx[i] * s, dy[i] * s)
+                    })
+                    .collect();
+                for banks in [Banks::K3, Banks::K4] {
+                    let bt = BankedTexture::new(&t, banks);
+                    let mut st = BankStats::default();
+                    let mut out = vec![[Vec4::ZERO; 4]; quads.len()];
+                    Sampler::Span(banks)
+                        .sample_quads(&t, &quads, &mut out)
+                        .unwrap();
+                    for (i, q) in quads.iter().enumerate() {
+                        let e = bt.sample_quad(&t, *q, &mut st);
+                        for j in 0..4 {
+                            assert_eq!(
+                                out[i][j].to_array().map(f32::to_bits),
+                                e[j].to_array().map(f32::to_bits),
+                                "{w}x{h} {wrap:?} {banks:?} quad {i} pixel {j}: {q:?}: expected {}, got {}",
+                                e[j],
+                                out[i][j]
+                            );
+                        }
+                    }
+                    assert_eq!(st.conflicts, 0, "{w}x{h} {wrap:?} {banks:?}: {st:?}");
+                    if t.is_pow2() {
+                        lane_spans += st.window_reads as usize - st.edge_windows as usize;
+                    }
+                }
+            }
+        }
+        assert!(
+            lane_spans > 10_000,
+            "too few interior windows: {lane_spans}"
+        );
     }
 
     #[test]
