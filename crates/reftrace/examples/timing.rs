@@ -1,5 +1,5 @@
 //! Quick wall-clock timing of BVH build and primary rays on S2/S3-like sphere scenes, for
-//! profiling (`cargo run --release -p texmap-reftrace --example timing -- [count] [side] [r]`).
+//! profiling (`cargo run --release -p texmap-reftrace --example timing -- [count] [side] [r] [w] [h] [reps] [bvh2|cwbvh|wide4]`).
 //! The criterion bench `benches/reftrace.rs` is the measurement of record.
 
 use std::time::Instant;
@@ -28,6 +28,9 @@ fn main() {
     let count: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(100_000);
     let side: f32 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(100.0);
     let r: f32 = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(0.5);
+    let w: u32 = args.get(4).and_then(|s| s.parse().ok()).unwrap_or(1920);
+    let h: u32 = args.get(5).and_then(|s| s.parse().ok()).unwrap_or(1080);
+    let reps: usize = args.get(6).and_then(|s| s.parse().ok()).unwrap_or(3);
     let mut state = 2024u64;
     let mut rnd = || {
         state = state
@@ -43,15 +46,19 @@ fn main() {
         Vec3::ZERO,
         Vec3::Y,
         40.0,
-        1920,
-        1080,
+        w,
+        h,
     )
     .unwrap();
     let mats = [SurfaceMaterial::opaque(Material::plastic(Vec3::new(
         0.8, 0.3, 0.2,
     )))];
     let opts = RenderOptions::new(Lighting::default_for(&cam), &mats);
-    for kind in [BvhKind::Bvh2, BvhKind::CwBvh] {
+    let only = args.get(7).cloned().unwrap_or_default();
+    for kind in [BvhKind::Bvh2, BvhKind::CwBvh, BvhKind::Wide4] {
+        if !only.is_empty() && !format!("{kind:?}").eq_ignore_ascii_case(&only) {
+            continue;
+        }
         let mut b = SceneBuilder::with_sphere_capacity(count).bvh(kind);
         for p in &pts {
             b.add_sphere(*p, r, 0);
@@ -62,16 +69,16 @@ fn main() {
         let mut best = f64::INFINITY;
         let mut best_cpu = f64::INFINITY;
         let mut covered = 0;
-        for _ in 0..3 {
+        for _ in 0..reps {
             let (t0, c0) = (Instant::now(), cpu_seconds());
             let f = scene.render(&cam, &opts).unwrap();
             best = best.min(t0.elapsed().as_secs_f64());
             best_cpu = best_cpu.min(cpu_seconds() - c0);
             covered = f.coverage_count();
         }
-        let rays = 1920.0 * 1080.0;
+        let rays = w as f64 * h as f64;
         println!(
-            "{kind:?}: {count} spheres, build {:.1} ms wall / {:.2} s CPU, render 1920x1080 {:.1} ms wall ({:.2} M rays/s) / {:.2} s CPU ({:.2} M rays per CPU-second), {:.1}% covered, {} threads",
+            "{kind:?}: {count} spheres, build {:.1} ms wall / {:.2} s CPU, render {w}x{h} {:.1} ms wall ({:.2} M rays/s) / {:.2} s CPU ({:.2} M rays per CPU-second), {:.1}% covered, {} threads",
             build * 1e3,
             build_cpu,
             best * 1e3,

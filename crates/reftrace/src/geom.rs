@@ -158,7 +158,12 @@ pub fn intersect_sphere(
     let c = f.length_squared() - radius * radius;
     // Compute sphere discriminant b² − 4ac = 4a (r + |v|)(r − |v|), v = f − (b / 2a) d.
     let v = f - dir * (b / (2.0 * a));
-    let len = v.length();
+    // Reject before the square root when the line passes outside the sphere.
+    let vv = v.length_squared();
+    if !(vv <= radius * radius) {
+        return None;
+    }
+    let len = vv.sqrt();
     let disc = 4.0 * a * (radius + len) * (radius - len);
     // A negative (or NaN) discriminant misses.
     if disc.is_nan() || disc < 0.0 {

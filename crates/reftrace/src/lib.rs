@@ -52,6 +52,7 @@ pub mod load;
 mod render;
 mod scene;
 mod texture;
+mod wide;
 
 pub use error::{LoadError, RenderError, SceneError, TextureError};
 pub use geom::CylinderPart;

@@ -24,7 +24,7 @@
 
 use std::time::Duration;
 
-use glam::{Vec2, Vec3, Vec3A};
+use glam::{Vec2, Vec3, Vec3A, Vec4};
 use obvhs::{
     BvhBuildParams,
     aabb::Aabb,
@@ -36,19 +36,33 @@ use texmap_core::camera::Ray;
 
 use crate::error::SceneError;
 use crate::geom::{CylinderPart, RayPre, intersect_cylinder, intersect_sphere, intersect_triangle};
+use crate::wide::{SlabRay, TraversalStack, Wide4};
+
+thread_local! {
+    /// Each thread's traversal stack for [`Wide4`] (no allocation per ray; never re-entered,
+    /// since leaf tests do not trace).
+    static STACK: std::cell::RefCell<TraversalStack> =
+        const { std::cell::RefCell::new(TraversalStack::new()) };
+}
 
 /// Relative padding of primitive boxes (see module docs "BVH robustness").
 const BOX_PAD_REL: f32 = 1e-5;
 
-/// Which obvhs BVH layout the scene is built with.
+/// Which BVH layout and traversal the scene uses. All three are built by obvhs (PLOC +
+/// reinsertion); they differ in layout and in who walks them.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum BvhKind {
-    /// Binary BVH (PLOC + reinsertion + leaf collapse).
+    /// obvhs's binary BVH (PLOC + reinsertion + leaf collapse) and its traversal.
     Bvh2,
-    /// Compressed 8-wide BVH (Ylitie et al. 2017) converted from a PLOC BVH2. The default: it
-    /// traced 100k-sphere and 1M-sphere scenes faster here (see docs/fragments/reftrace.md).
-    #[default]
+    /// obvhs's compressed 8-wide BVH (Ylitie et al. 2017) converted from a PLOC BVH2, and its
+    /// traversal.
     CwBvh,
+    /// obvhs's binary BVH collapsed into a 4-wide BVH with full-precision boxes in SIMD lanes,
+    /// walked by this crate (`wide` module). The default: the fastest here (see
+    /// docs/fragments/reftrace.md). A tree too deep for its fixed stack keeps the binary
+    /// traversal ([`Scene::bvh_kind`] then says [`BvhKind::Bvh2`]).
+    #[default]
+    Wide4,
 }
 
 /// A triangle mesh given as shared vertices and an index list, as loaded from OBJ or glTF.
@@ -346,6 +360,14 @@ impl SceneBuilder {
         }
         // Build the BVH and lay the primitives out in leaf order.
         let params = BvhBuildParams::medium_build();
+        // The 4-wide tree wants one primitive per binary leaf: its four-box test is cheaper than
+        // a second leaf test (callgrind, S2-like scene: leaves of ≤ 8 / 4 / 2 / 1 primitives
+        // cost 496 / 480 / 439 / 424 M instructions per 480x270 frame).
+        let wide_params = BvhBuildParams {
+            max_prims_per_leaf: 1,
+            collapse_traversal_cost: 1.0,
+            ..params
+        };
         let mut t = Duration::ZERO;
         let accel = if boxes.is_empty() {
             Accel::Empty
@@ -353,17 +375,38 @@ impl SceneBuilder {
             match kind {
                 BvhKind::Bvh2 => Accel::Bvh2(build_bvh2(&boxes, params, &mut t)),
                 BvhKind::CwBvh => Accel::CwBvh(build_cwbvh(&boxes, params, &mut t)),
+                BvhKind::Wide4 => {
+                    let b2 = build_bvh2(&boxes, wide_params, &mut t);
+                    match Wide4::from_bvh2(&b2) {
+                        Some(w) => Accel::Wide4(w, b2.primitive_indices),
+                        None => Accel::Bvh2(b2),
+                    }
+                }
             }
         };
         let order: &[u32] = match &accel {
             Accel::Empty => &[],
+            Accel::Wide4(_, order) => order,
             Accel::Bvh2(b) => &b.primitive_indices,
             Accel::CwBvh(b) => &b.primitive_indices,
         };
         let leaf_prims: Vec<Prim> = order.iter().map(|&i| prims[i as usize]).collect();
+        // A scene of spheres alone gets the sphere-only leaf kernel over a flat array.
+        let sphere_slots = if stats.cylinders == 0 && stats.triangles == 0 {
+            leaf_prims
+                .iter()
+                .map(|p| match *p {
+                    Prim::Sphere { center, radius, .. } => center.extend(radius),
+                    _ => Vec4::ZERO,
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
         Scene {
             accel,
             prims: leaf_prims,
+            sphere_slots,
             spheres,
             sphere_material,
             cylinders,
@@ -388,6 +431,8 @@ enum Accel {
     Empty,
     Bvh2(Bvh2),
     CwBvh(CwBvh),
+    /// The 4-wide tree and the leaf order of the primitives.
+    Wide4(Wide4, Vec<u32>),
 }
 
 /// The closest hit found so far during traversal (slot index into leaf order).
@@ -406,6 +451,8 @@ pub(crate) struct RawHit {
 pub struct Scene {
     accel: Accel,
     prims: Vec<Prim>,
+    /// `(centre, radius)` per leaf slot when the scene holds spheres only, else empty.
+    sphere_slots: Vec<Vec4>,
     spheres: Vec<[f32; 4]>,
     sphere_material: Vec<u32>,
     cylinders: Vec<Cylinder>,
@@ -442,6 +489,7 @@ impl Scene {
             Accel::Empty => None,
             Accel::Bvh2(_) => Some(BvhKind::Bvh2),
             Accel::CwBvh(_) => Some(BvhKind::CwBvh),
+            Accel::Wide4(..) => Some(BvhKind::Wide4),
         }
     }
 
@@ -527,15 +575,51 @@ impl Scene {
     #[inline]
     pub(crate) fn closest(&self, pre: &RayPre, tmin: f32, tmax: f32) -> Option<RawHit> {
         let mut best = RawHit::none(tmax);
-        let ray = BvhRay::new(Vec3A::from(pre.origin), Vec3A::from(pre.dir), tmin, tmax);
-        let mut rh = RayHit::none();
+        let bvh_ray = || BvhRay::new(Vec3A::from(pre.origin), Vec3A::from(pre.dir), tmin, tmax);
         match &self.accel {
             Accel::Empty => {}
             Accel::Bvh2(b) => {
-                b.ray_traverse(ray, &mut rh, |_, i| self.test_prim(pre, tmin, i, &mut best));
+                b.ray_traverse(bvh_ray(), &mut RayHit::none(), |_, i| {
+                    self.test_prim(pre, tmin, i, &mut best)
+                });
             }
             Accel::CwBvh(b) => {
-                b.ray_traverse(ray, &mut rh, |_, i| self.test_prim(pre, tmin, i, &mut best));
+                b.ray_traverse(bvh_ray(), &mut RayHit::none(), |_, i| {
+                    self.test_prim(pre, tmin, i, &mut best)
+                });
+            }
+            Accel::Wide4(w, _) if !self.sphere_slots.is_empty() => {
+                // Spheres only: the kernel is chosen here, outside the traversal loop.
+                let slab = SlabRay::new(pre.origin, pre.dir);
+                let spheres = &self.sphere_slots[..];
+                let (o, d) = (pre.origin, pre.dir);
+                let mut best_slot = u32::MAX;
+                let mut best_t = tmax;
+                STACK.with(|s| {
+                    let mut stack = s.borrow_mut();
+                    w.traverse(&slab, tmin, tmax, &mut stack, |slot| {
+                        let s = spheres[slot];
+                        if let Some(t) = intersect_sphere(o, d, s.truncate(), s.w, tmin, best_t) {
+                            best_t = t;
+                            best_slot = slot as u32;
+                        }
+                        best_t
+                    });
+                });
+                if best_slot != u32::MAX {
+                    best.t = best_t;
+                    best.slot = best_slot;
+                }
+            }
+            Accel::Wide4(w, _) => {
+                let slab = SlabRay::new(pre.origin, pre.dir);
+                STACK.with(|s| {
+                    let mut stack = s.borrow_mut();
+                    w.traverse(&slab, tmin, tmax, &mut stack, |slot| {
+                        self.test_prim(pre, tmin, slot, &mut best);
+                        best.t
+                    });
+                });
             }
         }
         (best.t < tmax).then_some(best)

@@ -57,7 +57,7 @@ fn unlit_lighting() -> Lighting {
 
 #[test]
 fn bvh_traversal_equals_brute_force_on_random_scenes() {
-    for kind in [BvhKind::Bvh2, BvhKind::CwBvh] {
+    for kind in [BvhKind::Bvh2, BvhKind::CwBvh, BvhKind::Wide4] {
         let scene = random_scene(42, kind);
         let mut rng = Lcg(9);
         let (mut hits, mut kinds) = (0, [0usize; 3]);
@@ -85,6 +85,73 @@ fn bvh_traversal_equals_brute_force_on_random_scenes() {
             hits > 5000 && kinds.iter().all(|&k| k > 300),
             "{kind:?}: too few hits to be a test: {hits}, per kind {kinds:?}"
         );
+    }
+}
+
+#[test]
+fn sphere_only_scenes_match_brute_force_in_every_layout() {
+    // Sphere-only scenes take the sphere kernel of the 4-wide traversal; sizes 1..=3000 cover a
+    // root that is a single leaf, a root with empty lanes and a deep tree. Rays: random, and
+    // axis-parallel rays (two zero direction components) through sphere centres and along
+    // sphere tangent planes, where the slab test meets 0·∞.
+    for count in [1usize, 2, 5, 37, 3000] {
+        for kind in [BvhKind::Bvh2, BvhKind::CwBvh, BvhKind::Wide4] {
+            let mut rng = Lcg(100 + count as u64);
+            let mut b = SceneBuilder::new().bvh(kind);
+            let mut spheres = Vec::new();
+            for _ in 0..count {
+                let (c, r) = (rng.vec(-10.0, 10.0), rng.range(0.05, 1.0));
+                b.add_sphere(c, r, 0);
+                spheres.push((c, r));
+            }
+            let scene = b.build();
+            let mut rays = Vec::new();
+            for _ in 0..4000 {
+                let origin = rng.vec(-14.0, 14.0);
+                rays.push(Ray {
+                    origin,
+                    dir: rng.vec(-1.0, 1.0).normalize_or(Vec3::X),
+                });
+            }
+            for &(c, r) in spheres.iter().take(300) {
+                for axis in [Vec3::X, Vec3::Y, Vec3::Z] {
+                    let side = if axis == Vec3::X { Vec3::Y } else { Vec3::X };
+                    for off in [Vec3::ZERO, side * r, side * (r * 0.999)] {
+                        rays.push(Ray {
+                            origin: c + off - axis * 20.0,
+                            dir: axis,
+                        });
+                        rays.push(Ray {
+                            origin: c + off + axis * 20.0,
+                            dir: -axis,
+                        });
+                    }
+                }
+            }
+            let (mut hits, mut wrong) = (0, Vec::new());
+            for ray in &rays {
+                let a = scene.intersect(ray).map(|h| (h.t, h.prim_id));
+                let b = scene.intersect_brute_force(ray).map(|h| (h.t, h.prim_id));
+                if a != b {
+                    wrong.push((ray, a, b));
+                }
+                hits += a.is_some() as usize;
+            }
+            eprintln!(
+                "{kind:?}, {count} spheres: {} of {} disagree",
+                wrong.len(),
+                rays.len()
+            );
+            if kind != BvhKind::CwBvh {
+                assert!(
+                    wrong.is_empty(),
+                    "{kind:?}, {count} spheres: BVH and brute force disagree for {} rays, first {:?}",
+                    wrong.len(),
+                    wrong.first()
+                );
+            }
+            assert!(hits > 0, "{kind:?}, {count} spheres: no ray hit");
+        }
     }
 }
 
@@ -246,7 +313,7 @@ fn heightfield(n: u32) -> (Vec<Vec3>, Vec<u32>) {
 fn heightfield_has_no_pinholes_at_grazing_and_steep_angles() {
     let n = 256;
     let (pos, idx) = heightfield(n);
-    for kind in [BvhKind::Bvh2, BvhKind::CwBvh] {
+    for kind in [BvhKind::Bvh2, BvhKind::CwBvh, BvhKind::Wide4] {
         let mut b = SceneBuilder::new().bvh(kind);
         b.add_mesh(&pos, &idx, None, 0).unwrap();
         let scene = b.build();
