@@ -4,12 +4,20 @@
 //! [`Camera`] and [`Lighting`] by one of four methods behind one face, so that they can be
 //! compared pixel for pixel and millisecond for millisecond:
 //!
-//! | [`Method`] | what it is | exact? |
-//! |---|---|---|
-//! | `Polygon` | tessellated spheres (the papers' baseline), tessellation chosen per sphere from its projected size, drawn with `texmap-raster` | silhouette to within the tessellation error |
-//! | `Lut` | Seed 002: a square of side 2R per sphere textured with a colour image (lit once per scene per material, 1-bit mask) and a depth image (once ever); `z = z0 + D(s,t)·R/d0`, which in our linear eye-space depth is `z0 + D·R` (see the `lut` module) | exact for an orthographic camera; errs with perspective as documented |
-//! | `Template` | Seed 004: disc billboards textured with a window cut from a template texture at `x_tex = 0.5 − r·sin(θ/2)`, `y_tex = 0.5 − r·sin(φ/2)` (our texture rows run downward, so `+` there) | pseudo-shading |
-//! | `Raycast` | per-fragment ray–sphere intersection over the sphere's exact perspective bounding quad | exact depth, normals and silhouette |
+//! | [`Method`] | what it is | exact? | bonds? |
+//! |---|---|---|---|
+//! | `Polygon` | tessellated spheres (the papers' baseline), tessellation chosen per sphere from its projected size, drawn with `texmap-raster` | silhouette to within the tessellation error | exact cylinders (shared pass) |
+//! | `Lut` | Seed 002: a square of side 2R per sphere textured with a colour image (lit once per scene per material, 1-bit mask) and a depth image (once ever); `z = z0 + D(s,t)·R/d0`, which in our linear eye-space depth is `z0 + D·R` (see the `lut` module) | exact for an orthographic camera; errs with perspective as documented | exact cylinders (shared pass) |
+//! | `Template` | Seed 004: disc billboards textured with a window cut from a template texture at `x_tex = 0.5 − r·sin(θ/2)`, `y_tex = 0.5 − r·sin(φ/2)` (our texture rows run downward, so `+` there) | pseudo-shading | exact cylinders (shared pass) |
+//! | `Raycast` | per-fragment ray–sphere intersection over the sphere's exact perspective bounding quad | exact depth, normals and silhouette | exact cylinders (shared pass) |
+//!
+//! **Bonds.** Every method draws [`SphereScene::bonds`] (when [`Options::draw_bonds`] is on, the
+//! default) in one pass after its spheres: exact ray-cast cylinders of radius
+//! [`SphereScene::bond_radius`] between the atom centres, half-bond coloured (each half in its
+//! atom's material), flat-capped where a bond is thicker than its atom, depth-tested against the
+//! spheres so that atoms and bonds interpenetrate correctly (module `bonds`). A bond's accuracy
+//! is the ray caster's whatever method drew the atoms; invalid bonds are skipped and counted in
+//! [`RenderStats::bonds_skipped`].
 //!
 //! All methods cull to the view frustum, do no work for spheres behind the camera, handle spheres
 //! crossing the near plane and sub-pixel spheres, and skip (and count) spheres with a non-finite
@@ -53,11 +61,23 @@
 //! let c = out.frame.index(32, 32);
 //! assert!((out.frame.depth[c] - 9.0).abs() < 5e-3);
 //! assert_eq!(out.stats.skipped_invalid, 0);
+//!
+//! // Ball and stick: a second atom and a bond of radius 0.2 between them, drawn as a cylinder.
+//! scene.push(Vec3::new(3.0, 0.0, 0.0), 1.0, 0);
+//! scene.bonds.push([0, 1]);
+//! scene.bond_radius = 0.2;
+//! let out = render(&scene, &cam, &opts);
+//! assert_eq!(out.stats.bonds_drawn, 1);
+//! // Halfway between the atoms (world x = 1.5), the bond's front at depth 10 − 0.2.
+//! let x = (32.0 + 1.5 * cam.scale() / 10.0) as u32;
+//! let d = out.frame.depth[out.frame.index(x, 32)];
+//! assert!((d - 9.8).abs() < 1e-2, "depth {d}");
 //! ```
 //!
 //! **Architecture invariant:** this crate depends on `texmap-core` and `texmap-raster` only; the
 //! reference ray tracer appears in its tests alone (the comparison harness lives in `texmap-study`).
 
+mod bonds;
 mod fastshade;
 mod lut;
 mod pipeline;
@@ -70,7 +90,7 @@ use texmap_core::camera::Camera;
 use texmap_core::frame::Frame;
 use texmap_core::shade::{Lighting, Material};
 
-/// A set of spheres (and optional bonds drawn as cylinders by the methods that support them).
+/// A set of spheres and optional bonds (drawn as cylinders by every method).
 ///
 /// Spheres are stored as structure-of-arrays so that transform and culling can run over lanes.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -218,7 +238,7 @@ pub struct Options {
     pub polygon_max_error_px: f32,
     /// Polygon method: Phong (default) or Gouraud.
     pub polygon_shading: PolygonShading,
-    /// Draw `SphereScene::bonds` (methods without bond support ignore it and say so in their docs).
+    /// Draw `SphereScene::bonds` as cylinders after the spheres (every method; see the crate docs).
     pub draw_bonds: bool,
 }
 
@@ -251,6 +271,15 @@ pub struct RenderStats {
     /// Spheres skipped for a non-finite centre, a non-positive or non-finite radius or an unknown
     /// kind.
     pub skipped_invalid: usize,
+    /// Bonds that reached the pixel stage (0 when [`Options::draw_bonds`] is off).
+    pub bonds_drawn: usize,
+    /// Valid bonds outside the view frustum (including behind the camera) or covering no pixel
+    /// centre.
+    pub bonds_culled: usize,
+    /// Bonds skipped: an atom index out of range, an atom that is itself skipped (see
+    /// `skipped_invalid`), two atoms at the same centre, or a non-positive or non-finite
+    /// [`SphereScene::bond_radius`] (then every bond is skipped).
+    pub bonds_skipped: usize,
 }
 
 /// A rendered frame and its statistics.
@@ -267,6 +296,7 @@ pub struct Renderer {
     lut: Option<lut::LutTables>,
     template: Option<template::TemplateTables>,
     polygon: polygon::PolygonState,
+    bonds: bonds::BondBins,
 }
 
 /// Smallest and largest accepted side of the Seed 002 images and Seed 004 templates; other
@@ -301,7 +331,7 @@ impl Renderer {
         let view = pipeline::View::new(camera);
         let lighting = options.lighting.to_eye(camera);
         let bg = options.background;
-        match options.method {
+        let mut stats = match options.method {
             Method::Raycast => {
                 let stats = self
                     .bins
@@ -370,7 +400,15 @@ impl Renderer {
                 stats
             }
             Method::Polygon => self.polygon.render(scene, camera, options, frame),
+        };
+        // Bonds: exact cylinder impostors depth-tested against the sphere pass (module `bonds`).
+        if options.draw_bonds && !scene.bonds.is_empty() {
+            let b = bonds::draw(&mut self.bonds, scene, &view, &lighting, frame);
+            stats.bonds_drawn = b.drawn;
+            stats.bonds_culled = b.culled;
+            stats.bonds_skipped = b.skipped;
         }
+        stats
     }
 }
 
