@@ -850,8 +850,22 @@ impl Sampler {
     #[inline(always)]
     fn quad_one<A: Addr>(&self, tex: &MipTexture, uv: [Vec2; 4]) -> [Vec4; 4] {
         match *self {
-            Sampler::Span(Banks::K3) => span_quad::<A, Direct, 3>(tex, uv, 0, &mut Direct),
-            Sampler::Span(Banks::K4) => span_quad::<A, Direct, 4>(tex, uv, 0, &mut Direct),
+            Sampler::Span(Banks::K3) => {
+                span_finish_direct::<A, 3>(tex, span_plan::<A, 3>(tex, uv, 0))
+            }
+            Sampler::Span(Banks::K4) => {
+                span_finish_direct::<A, 4>(tex, span_plan::<A, 4>(tex, uv, 0))
+            }
+            #[cfg(target_arch = "x86_64")]
+            Sampler::Trilinear if tex.is_pow2() => {
+                // The quad's four pixels in the lanes of one trilinear kernel (same bits).
+                let m = footprint(&tex.levels()[0], uv[1] - uv[0], uv[2] - uv[0]);
+                let u = Vec4::new(uv[0].x, uv[1].x, uv[2].x, uv[3].x);
+                let v = Vec4::new(uv[0].y, uv[1].y, uv[2].y, uv[3].y);
+                // NaN footprint -> 0, as the lane kernel expects (both mean level 0).
+                let m = if m > 0.0 { m } else { 0.0 };
+                lanes::trilinear4::<A>(tex, u, v, Vec4::splat(m))
+            }
             _ => {
                 let dx = uv[1] - uv[0];
                 let dy = uv[2] - uv[0];
@@ -922,7 +936,7 @@ impl Sampler {
                     // Four pixels per step in lanes (power-of-two pyramids), then the tail.
                     #[cfg(target_arch = "x86_64")]
                     let done = if tex.is_pow2() {
-                        lanes::trilinear_pixels::<A>(tex, uv, duv_dx, duv_dy, out)
+                        lanes::trilinear_pixels_best::<A>(tex, uv, duv_dx, duv_dy, out)
                     } else {
                         0
                     };
@@ -957,8 +971,8 @@ impl Sampler {
                     // Four spans per step in lanes (power-of-two pyramids), then the tail.
                     #[cfg(target_arch = "x86_64")]
                     let done = match (tex.is_pow2(), banks) {
-                        (true, Banks::K3) => lanes::span_quads4::<A, 3>(tex, quads, out),
-                        (true, Banks::K4) => lanes::span_quads4::<A, 4>(tex, quads, out),
+                        (true, Banks::K3) => lanes::span_quads4_best::<A, 3>(tex, quads, out),
+                        (true, Banks::K4) => lanes::span_quads4_best::<A, 4>(tex, quads, out),
                         (false, _) => 0,
                     };
                     #[cfg(not(target_arch = "x86_64"))]
@@ -1325,6 +1339,57 @@ mod tests {
             lane_spans > 10_000,
             "too few interior windows: {lane_spans}"
         );
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn sse2_and_runtime_chosen_lane_builds_agree_bit_for_bit() {
+        // The bulk calls above test the build chosen for this CPU (AVX2 here); the SSE2 baseline
+        // build must give the same bits.
+        let t = ramp(128, 64, Wrap::Repeat);
+        let (uv, dx, dy) = random_pixels(4000, 99);
+        let mut a = vec![Vec4::ZERO; uv.len()];
+        let mut b = vec![Vec4::ZERO; uv.len()];
+        let na = lanes::trilinear_pixels::<RepeatPow2>(&t, &uv, &dx, &dy, &mut a);
+        let nb = lanes::trilinear_pixels_best::<RepeatPow2>(&t, &uv, &dx, &dy, &mut b);
+        assert_eq!((na, nb), (4000, 4000));
+        let bits = |v: &[Vec4]| {
+            v.iter()
+                .map(|c| c.to_array().map(f32::to_bits))
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(bits(&a), bits(&b));
+        let quads: Vec<[Vec2; 4]> = (0..uv.len())
+            .map(|i| quad_from_pixel(uv[i], dx[i] * 0.05, dy[i] * 0.05))
+            .collect();
+        let mut qa = vec![[Vec4::ZERO; 4]; quads.len()];
+        let mut qb = vec![[Vec4::ZERO; 4]; quads.len()];
+        lanes::span_quads4::<RepeatPow2, 3>(&t, &quads, &mut qa);
+        lanes::span_quads4_best::<RepeatPow2, 3>(&t, &quads, &mut qb);
+        assert_eq!(bits(qa.as_flattened()), bits(qb.as_flattened()));
+    }
+
+    #[test]
+    fn trilinear_quad_lanes_match_per_pixel_sampling_bit_for_bit() {
+        // `sample_quad` (trilinear in lanes on pow2) against four `sample` calls with the quad's
+        // coarse derivatives.
+        for wrap in [Wrap::Repeat, Wrap::Clamp] {
+            let t = ramp(64, 32, wrap);
+            let (uv, dx, dy) = random_pixels(3000, 5);
+            for i in 0..uv.len() {
+                let q = quad_from_pixel(uv[i], dx[i], dy[i]);
+                let got = Sampler::Trilinear.sample_quad(&t, q);
+                for j in 0..4 {
+                    let e = Sampler::Trilinear.sample(&t, q[j], q[1] - q[0], q[2] - q[0]);
+                    assert_eq!(
+                        got[j].to_array().map(f32::to_bits),
+                        e.to_array().map(f32::to_bits),
+                        "{wrap:?} quad {i} pixel {j}: expected {e}, got {}",
+                        got[j]
+                    );
+                }
+            }
+        }
     }
 
     #[test]

@@ -598,3 +598,72 @@ pub(super) fn span_quads4<A: Addr, const K: usize>(
     }
     n
 }
+
+// ---------------------------------------------------------------------------------------------
+// Entry points: the same kernels compiled twice, for the SSE2 baseline and (chosen at run time)
+// for AVX2, whose three-operand encoding drops the register copies SSE2's two-operand form needs
+// (same instructions otherwise: no FMA, so the results are the same bits).
+
+/// Whether the AVX2 build of the kernels can run here (cached by the standard library).
+#[inline]
+fn has_avx2() -> bool {
+    std::arch::is_x86_feature_detected!("avx2")
+}
+
+/// [`trilinear_pixels`] compiled for AVX2.
+///
+/// # Safety
+/// The CPU must support AVX2.
+#[target_feature(enable = "avx2")]
+unsafe fn trilinear_pixels_avx2<A: Addr>(
+    tex: &MipTexture,
+    uv: &[Vec2],
+    dx: &[Vec2],
+    dy: &[Vec2],
+    out: &mut [Vec4],
+) -> usize {
+    trilinear_pixels::<A>(tex, uv, dx, dy, out)
+}
+
+/// [`span_quads4`] compiled for AVX2.
+///
+/// # Safety
+/// The CPU must support AVX2.
+#[target_feature(enable = "avx2")]
+unsafe fn span_quads4_avx2<A: Addr, const K: usize>(
+    tex: &MipTexture,
+    quads: &[[Vec2; 4]],
+    out: &mut [[Vec4; 4]],
+) -> usize {
+    span_quads4::<A, K>(tex, quads, out)
+}
+
+/// Bulk per-pixel trilinear in lanes, the build chosen for this CPU; returns the pixels done.
+pub(super) fn trilinear_pixels_best<A: Addr>(
+    tex: &MipTexture,
+    uv: &[Vec2],
+    dx: &[Vec2],
+    dy: &[Vec2],
+    out: &mut [Vec4],
+) -> usize {
+    if has_avx2() {
+        // SAFETY: AVX2 was detected just above.
+        unsafe { trilinear_pixels_avx2::<A>(tex, uv, dx, dy, out) }
+    } else {
+        trilinear_pixels::<A>(tex, uv, dx, dy, out)
+    }
+}
+
+/// Bulk span sampling in lanes, the build chosen for this CPU; returns the quads done.
+pub(super) fn span_quads4_best<A: Addr, const K: usize>(
+    tex: &MipTexture,
+    quads: &[[Vec2; 4]],
+    out: &mut [[Vec4; 4]],
+) -> usize {
+    if has_avx2() {
+        // SAFETY: AVX2 was detected just above.
+        unsafe { span_quads4_avx2::<A, K>(tex, quads, out) }
+    } else {
+        span_quads4::<A, K>(tex, quads, out)
+    }
+}
