@@ -15,6 +15,7 @@ use texmap_core::shade::{Lighting, Material};
 
 use crate::mesh::Mesh;
 use crate::project::{MAX_VAR, Proj, Var};
+use crate::simd::F32x4;
 
 /// How the triangles of [`crate::Framebuffer::draw_mesh`] are coloured. All colours are linear RGB.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -161,22 +162,101 @@ impl FragProgram for LitSmoothProg {
     fn tri_const(&self, _: &Mesh, _: u32, _: bool) {}
     #[inline]
     fn shade(&self, _: &(), f: &QuadFrag, front: bool) -> [[f32; 4]; 3] {
-        let mut out = [[0.0; 4]; 3];
-        let sign = if front { 1.0 } else { -1.0 };
-        for l in 0..4 {
-            if f.mask & (1 << l) == 0 {
-                continue;
-            }
-            // Normalised interpolated normal (two-sided: flipped on back faces).
-            let n = Vec3::new(f.var[0][l], f.var[1][l], f.var[2][l]).normalize_or_zero() * sign;
-            let v = self.proj.view_dir(f.x[l], f.y[l]);
-            let c = self.lighting.shade(&self.material, n, v);
-            out[0][l] = c.x;
-            out[1][l] = c.y;
-            out[2][l] = c.z;
-        }
-        out
+        let s = F32x4::splat;
+        // Normalised interpolated normal (two-sided: flipped on back faces).
+        let sign = s(if front { 1.0 } else { -1.0 });
+        let n =
+            normalize_or_zero4([f.var[0], f.var[1], f.var[2]].map(F32x4::new)).map(|c| c.mul(sign));
+        // Unit vector toward the viewer, per pixel (`Proj::view_dir`).
+        let v = if self.proj.persp {
+            let k = s(self.proj.k);
+            normalize4([
+                s(self.proj.cx).sub(F32x4::new(f.x)).div(k),
+                F32x4::new(f.y).sub(s(self.proj.cy)).div(k),
+                s(1.0),
+            ])
+        } else {
+            [s(0.0), s(0.0), s(1.0)]
+        };
+        shade4(&self.lighting, &self.material, n, v, f.mask)
     }
+}
+
+/// `a·b` over four lanes, summed as glam's `Vec3::dot`: `(x·x + y·y) + z·z`.
+#[inline(always)]
+fn dot4(a: &[F32x4; 3], b: &[F32x4; 3]) -> F32x4 {
+    a[0].mul(b[0]).add(a[1].mul(b[1])).add(a[2].mul(b[2]))
+}
+
+/// glam's `Vec3::normalize` over four lanes: `v · (1 / sqrt(v·v))`.
+#[inline(always)]
+fn normalize4(v: [F32x4; 3]) -> [F32x4; 3] {
+    let rcp = F32x4::splat(1.0).div(dot4(&v, &v).sqrt());
+    v.map(|c| c.mul(rcp))
+}
+
+/// glam's `Vec3::normalize_or_zero` over four lanes (zero where `1 / |v|` is not finite and
+/// positive).
+#[inline(always)]
+fn normalize_or_zero4(v: [F32x4; 3]) -> [F32x4; 3] {
+    let rcp = F32x4::splat(1.0).div(dot4(&v, &v).sqrt());
+    let ok = F32x4::splat(0.0)
+        .lt(rcp)
+        .and(rcp.lt(F32x4::splat(f32::INFINITY)));
+    v.map(|c| F32x4::select(ok, c.mul(rcp), F32x4::splat(0.0)))
+}
+
+/// [`Lighting::shade`] for the four lanes of a quad, the same operations in the same order
+/// (bit-identical to four scalar calls, tested); `powf` stays scalar and runs only for the lanes
+/// in `mask` that face the light.
+#[inline(always)]
+fn shade4(
+    lighting: &Lighting,
+    m: &Material,
+    n: [F32x4; 3],
+    v: [F32x4; 3],
+    mask: u8,
+) -> [[f32; 4]; 3] {
+    let s = F32x4::splat;
+    let base = [s(m.base_color.x), s(m.base_color.y), s(m.base_color.z)];
+    let amb = lighting.ambient;
+    let mut c = [
+        s(amb.x * m.base_color.x),
+        s(amb.y * m.base_color.y),
+        s(amb.z * m.base_color.z),
+    ];
+    for light in lighting.lights() {
+        let l = [
+            s(light.to_light.x),
+            s(light.to_light.y),
+            s(light.to_light.z),
+        ];
+        let ndl = dot4(&n, &l);
+        let lit = s(0.0).lt(ndl);
+        let lit_bits = lit.bits() as u8 & mask;
+        if lit_bits == 0 {
+            continue;
+        }
+        let mut term = base.map(|b| b.mul(ndl));
+        if m.specular > 0.0 {
+            // Blinn-Phong half vector, n·h clamped at 0, raised to the shininess per lane.
+            let h = normalize_or_zero4([l[0].add(v[0]), l[1].add(v[1]), l[2].add(v[2])]);
+            let ndh = dot4(&n, &h).max(s(0.0)).to_array();
+            let mut spec = [0.0f32; 4];
+            for (lane, sp) in spec.iter_mut().enumerate() {
+                if lit_bits & (1 << lane) != 0 {
+                    *sp = m.specular * ndh[lane].powf(m.shininess);
+                }
+            }
+            let spec = F32x4::new(spec);
+            term = term.map(|t| t.add(spec));
+        }
+        let col = [s(light.color.x), s(light.color.y), s(light.color.z)];
+        for k in 0..3 {
+            c[k] = F32x4::select(lit, c[k].add(col[k].mul(term[k])), c[k]);
+        }
+    }
+    c.map(F32x4::to_array)
 }
 
 /// The texture coordinates of a 2x2 quad of pixels, handed to a [`QuadSampler`].
@@ -284,5 +364,115 @@ impl<S: QuadSampler + ?Sized> FragProgram for TexturedProg<'_, S> {
             [c[0].y, c[1].y, c[2].y, c[3].y],
             [c[0].z, c[1].z, c[2].z, c[3].z],
         ]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use texmap_core::camera::Camera;
+
+    use super::*;
+
+    #[test]
+    fn four_lane_smooth_lighting_is_bit_identical_to_the_shared_model() {
+        let mut st = 11u64;
+        let mut r = || {
+            st = st
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (st >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
+        };
+        let cams = [
+            Camera::perspective_look_at(
+                Vec3::new(1.0, 2.0, 5.0),
+                Vec3::ZERO,
+                Vec3::Y,
+                55.0,
+                320,
+                200,
+            )
+            .unwrap(),
+            Camera::orthographic_look_at(
+                Vec3::new(0.0, 0.0, 5.0),
+                Vec3::ZERO,
+                Vec3::Y,
+                4.0,
+                64,
+                64,
+            )
+            .unwrap(),
+        ];
+        let mut checked = [0usize; 2];
+        for (ci, cam) in cams.iter().enumerate() {
+            for round in 0..200 {
+                let nl = round % 5;
+                let lights: Vec<(Vec3, Vec3)> = (0..nl)
+                    .map(|_| {
+                        (
+                            Vec3::new(r(), r(), r() + 1.2),
+                            Vec3::new(r(), r(), r()).abs(),
+                        )
+                    })
+                    .collect();
+                let lighting = Lighting::new(Vec3::new(r(), r(), r()).abs() * 0.2, &lights)
+                    .unwrap()
+                    .to_eye(cam);
+                let material = if round % 3 == 0 {
+                    Material::matte(Vec3::new(r(), r(), r()).abs())
+                } else {
+                    Material {
+                        base_color: Vec3::new(r(), r(), r()).abs(),
+                        specular: r().abs(),
+                        shininess: 1.0 + 80.0 * r().abs(),
+                    }
+                };
+                let prog = LitSmoothProg {
+                    lighting,
+                    material,
+                    proj: Proj::new(cam),
+                };
+                let mut f = QuadFrag {
+                    x: [0.0; 4],
+                    y: [0.0; 4],
+                    var: [[0.0; 4]; MAX_VAR],
+                    mask: (round % 16) as u8 | 1,
+                };
+                for l in 0..4 {
+                    f.x[l] = (r() + 1.0) * 200.0;
+                    f.y[l] = (r() + 1.0) * 120.0;
+                    for k in 0..3 {
+                        // Some zero and some huge normals reach the normalize_or_zero fallback.
+                        f.var[k][l] = match round % 7 {
+                            0 => 0.0,
+                            1 => r() * 1e-30,
+                            _ => r(),
+                        };
+                    }
+                }
+                let front = round % 2 == 0;
+                let got = prog.shade(&(), &f, front);
+                for l in 0..4 {
+                    if f.mask & (1 << l) == 0 {
+                        continue;
+                    }
+                    let sign = if front { 1.0 } else { -1.0 };
+                    let n =
+                        Vec3::new(f.var[0][l], f.var[1][l], f.var[2][l]).normalize_or_zero() * sign;
+                    let v = prog.proj.view_dir(f.x[l], f.y[l]);
+                    let want = lighting.shade(&material, n, v);
+                    for k in 0..3 {
+                        assert_eq!(
+                            got[k][l].to_bits(),
+                            want[k].to_bits(),
+                            "lane {l} channel {k}: expected {} got {}",
+                            want[k],
+                            got[k][l]
+                        );
+                    }
+                    checked[ci] += 1;
+                }
+            }
+        }
+        assert!(checked.iter().all(|&c| c > 300), "{checked:?}");
     }
 }

@@ -94,8 +94,9 @@ impl Proj {
     }
 
     /// Unit vector from the surface toward the viewer for the fragment at screen (x, y), in eye
-    /// space (the depth does not matter: the eye ray direction does).
-    #[inline]
+    /// space (the depth does not matter: the eye ray direction does). The scalar reference of
+    /// the four-lane version in `program`.
+    #[cfg(test)]
     pub fn view_dir(&self, x: f32, y: f32) -> Vec3 {
         if self.persp {
             Vec3::new((self.cx - x) / self.k, (y - self.cy) / self.k, 1.0).normalize()

@@ -126,6 +126,18 @@ mod imp {
             // SAFETY: SSE2 is part of the x86-64 baseline, always enabled on this target.
             unsafe { F32x4(_mm_sub_ps(self.0, o.0)) }
         }
+        /// IEEE square root.
+        #[inline(always)]
+        pub fn sqrt(self) -> F32x4 {
+            // SAFETY: SSE2 is part of the x86-64 baseline, always enabled on this target.
+            unsafe { F32x4(_mm_sqrt_ps(self.0)) }
+        }
+        /// `if self > o { self } else { o }` lane by lane (so NaN in `self` gives `o`).
+        #[inline(always)]
+        pub fn max(self, o: F32x4) -> F32x4 {
+            // SAFETY: SSE2 is part of the x86-64 baseline, always enabled on this target.
+            unsafe { F32x4(_mm_max_ps(self.0, o.0)) }
+        }
         /// `self & !o` bit by bit.
         #[inline(always)]
         pub fn and_not(self, o: F32x4) -> F32x4 {
@@ -285,6 +297,20 @@ mod imp {
             F32x4(std::array::from_fn(|l| self.0[l] - o.0[l]))
         }
         #[inline(always)]
+        pub fn sqrt(self) -> F32x4 {
+            F32x4(self.0.map(f32::sqrt))
+        }
+        #[inline(always)]
+        pub fn max(self, o: F32x4) -> F32x4 {
+            F32x4(std::array::from_fn(|l| {
+                if self.0[l] > o.0[l] {
+                    self.0[l]
+                } else {
+                    o.0[l]
+                }
+            }))
+        }
+        #[inline(always)]
         pub fn and_not(self, o: F32x4) -> F32x4 {
             F32x4(std::array::from_fn(|l| {
                 f32::from_bits(self.0[l].to_bits() & !o.0[l].to_bits())
@@ -342,9 +368,10 @@ mod tests {
         assert_eq!(va.lt(vb).bits(), bits(|x, y| x < y));
         assert_eq!(va.le(vb).bits(), bits(|x, y| x <= y));
         assert_eq!(va.eq(vb).bits(), bits(|x, y| x == y));
-        let sum = va.add(vb).mul(vb).div(vb).to_array();
+        let sum = va.add(vb).mul(vb).div(vb).sqrt().max(vb).to_array();
         for l in 0..4 {
-            let e = (a[l] + b[l]) * b[l] / b[l];
+            let e = ((a[l] + b[l]) * b[l] / b[l]).sqrt();
+            let e = if e > b[l] { e } else { b[l] };
             assert_eq!(
                 sum[l].to_bits(),
                 e.to_bits(),
