@@ -18,6 +18,8 @@ pub enum SceneError {
     UvCountMismatch { uvs: usize, vertices: usize },
     /// More primitives than the 32-bit ids can name.
     TooManyPrimitives,
+    /// Vertex normals were given but not one per vertex.
+    NormalCountMismatch { normals: usize, vertices: usize },
 }
 
 impl std::fmt::Display for SceneError {
@@ -39,6 +41,10 @@ impl std::fmt::Display for SceneError {
                 "{uvs} texture coordinates given for {vertices} vertices (need one per vertex)"
             ),
             SceneError::TooManyPrimitives => write!(f, "more than 2^32 - 1 primitives"),
+            SceneError::NormalCountMismatch { normals, vertices } => write!(
+                f,
+                "{normals} vertex normals given for {vertices} vertices (need one per vertex)"
+            ),
         }
     }
 }

@@ -158,9 +158,10 @@ pub fn intersect_sphere(
     let c = f.length_squared() - radius * radius;
     // Compute sphere discriminant b² − 4ac = 4a (r + |v|)(r − |v|), v = f − (b / 2a) d.
     let v = f - dir * (b / (2.0 * a));
-    // Reject before the square root when the line passes outside the sphere.
+    // Reject before the square root when the line passes outside the sphere (a NaN `vv`
+    // passes here and is caught by the discriminant test below).
     let vv = v.length_squared();
-    if !(vv <= radius * radius) {
+    if vv > radius * radius {
         return None;
     }
     let len = vv.sqrt();

@@ -59,6 +59,6 @@ pub use geom::CylinderPart;
 pub use render::{
     MAX_RECURSION_DEPTH, MAX_SAMPLES_PER_AXIS, Optics, RenderOptions, SurfaceMaterial,
 };
-pub use scene::{BuildStats, BvhKind, Hit, HitKind, MeshData, Scene, SceneBuilder};
+pub use scene::{BuildStats, BvhKind, Hit, HitKind, MeshData, MeshShading, Scene, SceneBuilder};
 pub use texmap_core::frame::Frame;
 pub use texture::Texture;

@@ -1,7 +1,9 @@
 //! Mesh loading: Wavefront OBJ (tobj) and glTF 2.0 (gltf), from files or from bytes in memory.
 //!
 //! Both readers return one [`MeshData`] per mesh (OBJ object/group, glTF primitive) with
-//! positions, triangle indices and, when present, the first set of texture coordinates. OBJ faces
+//! positions, triangle indices and, when present, the first set of texture coordinates and the
+//! vertex normals (glTF normals are carried through the inverse transpose of the node transform;
+//! [`crate::MeshShading`] decides whether they are used). OBJ faces
 //! are triangulated and re-indexed so that positions and uvs share one index. glTF meshes are
 //! placed by their nodes' world transforms in the default scene (or the first one); meshes not
 //! referenced by any node are not returned. Only triangle-list primitives are read; other modes
@@ -72,10 +74,24 @@ pub fn load_obj_bytes(bytes: &[u8], source: &str) -> Result<Vec<MeshData>, LoadE
                     .collect(),
             )
         };
+        let normals = if m.normals.is_empty() {
+            None
+        } else {
+            if m.normals.len() != 3 * positions.len() {
+                return Err(bad("normals", m.normals.len()));
+            }
+            Some(
+                m.normals
+                    .chunks_exact(3)
+                    .map(|n| Vec3::new(n[0], n[1], n[2]))
+                    .collect(),
+            )
+        };
         let mesh = MeshData {
             positions,
             indices: m.indices,
             uvs,
+            normals,
         };
         check_mesh(&mesh, source, k)?;
         if !mesh.indices.is_empty() {
@@ -199,10 +215,28 @@ fn read_gltf_mesh(
                 });
             }
         }
+        // Normals go through the inverse transpose of the node transform (unit length is
+        // restored when the mesh is added).
+        let normal_matrix = glam::Mat3::from_mat4(world).inverse().transpose();
+        let normals = reader.read_normals().map(|n| {
+            n.map(|v| normal_matrix * Vec3::from_array(v))
+                .collect::<Vec<_>>()
+        });
+        if let Some(n) = &normals {
+            if n.len() != positions.len() {
+                return Err(LoadError::BadAttribute {
+                    source: source.to_string(),
+                    mesh: k,
+                    attribute: "NORMAL",
+                    len: n.len(),
+                });
+            }
+        }
         let m = MeshData {
             positions,
             indices,
             uvs,
+            normals,
         };
         check_mesh(&m, source, k)?;
         if !m.indices.is_empty() {
@@ -265,6 +299,32 @@ mod tests {
     }
 
     #[test]
+    fn obj_and_gltf_vertex_normals_are_read() {
+        // OBJ: a triangle whose vertices carry three different normals.
+        let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvn 1 0 0\nvn 0 1 0\n\
+            f 1//1 2//2 3//3\n";
+        let m = load_obj_bytes(text.as_bytes(), "n.obj").unwrap();
+        let n = m[0].normals.as_ref().expect("normals read");
+        for (p, want) in [
+            (Vec3::ZERO, Vec3::Z),
+            (Vec3::X, Vec3::X),
+            (Vec3::Y, Vec3::Y),
+        ] {
+            let k = m[0].positions.iter().position(|q| *q == p).unwrap();
+            assert_eq!(n[k], want, "normal of vertex {p}");
+        }
+        // No vn lines: no normals.
+        assert!(
+            load_obj_bytes(QUAD_OBJ.as_bytes(), "q.obj").unwrap()[0]
+                .normals
+                .is_none()
+        );
+        // glTF without NORMAL: none.
+        let g = load_gltf_bytes(triangle_gltf([0.0; 3]).as_bytes(), "t.gltf").unwrap();
+        assert!(g[0].normals.is_none());
+    }
+
+    #[test]
     fn obj_errors_name_the_source() {
         let e = load_obj_bytes(b"v 0 0 0\nf 1 2 3\n", "broken.obj").unwrap_err();
         assert!(e.to_string().contains("broken.obj"), "{e}");
@@ -301,6 +361,50 @@ mod tests {
             buf.len(),
             b64
         )
+    }
+
+    /// A one-triangle glTF with a NORMAL accessor, placed by a node with scale `scale`.
+    fn normal_triangle_gltf(scale: [f32; 3], normal: [f32; 3]) -> String {
+        let mut buf = Vec::new();
+        for p in [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] {
+            for c in p {
+                buf.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+        for _ in 0..3 {
+            for c in normal {
+                buf.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+        format!(
+            r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],
+            "nodes":[{{"mesh":0,"scale":[{},{},{}]}}],
+            "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0,"NORMAL":1}}}}]}}],
+            "buffers":[{{"byteLength":{},"uri":"data:application/octet-stream;base64,{}"}}],
+            "bufferViews":[{{"buffer":0,"byteOffset":0,"byteLength":36}},{{"buffer":0,"byteOffset":36,"byteLength":36}}],
+            "accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}},
+                         {{"bufferView":1,"componentType":5126,"count":3,"type":"VEC3"}}]}}"#,
+            scale[0],
+            scale[1],
+            scale[2],
+            buf.len(),
+            base64_encode(&buf)
+        )
+    }
+
+    #[test]
+    fn gltf_normals_follow_the_inverse_transpose_of_the_node_transform() {
+        // Scale x by 2: a normal (1, 1, 0)/√2 becomes (1/2, 1, 0) up to length, i.e. it stays
+        // perpendicular to the scaled surface, unlike a normal scaled like a position.
+        let s = std::f32::consts::FRAC_1_SQRT_2;
+        let text = normal_triangle_gltf([2.0, 1.0, 1.0], [s, s, 0.0]);
+        let m = load_gltf_bytes(text.as_bytes(), "n.gltf").unwrap();
+        let n = m[0].normals.as_ref().expect("normals read")[0].normalize();
+        let want = Vec3::new(0.5, 1.0, 0.0).normalize();
+        assert!(
+            (n - want).length() < 1e-6,
+            "expected {want}, got {n}, tolerance 1e-6"
+        );
     }
 
     /// Standard base64 (RFC 4648) for the test fixture.

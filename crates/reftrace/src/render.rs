@@ -18,9 +18,12 @@
 //!   look up the environment function in their direction.
 //!
 //! # Shading
-//! `Lighting::shade(material, n, v)` with `n` the unit geometric normal turned toward the viewer
-//! (surfaces are two-sided) and `v = −dir`, the unit vector toward the viewer. Meshes are flat
-//! shaded (geometric normal). Optics:
+//! `Lighting::shade(material, n, v)` with `n` the unit shading normal ([`crate::Hit::shading_normal`])
+//! turned to the viewer's side of the surface (surfaces are two-sided; the side is decided by the
+//! geometric normal) and `v = −dir`, the unit vector toward the viewer. Meshes are flat shaded
+//! unless added with a smooth [`crate::MeshShading`], which interpolates vertex normals (Phong);
+//! mirror and refraction directions use the same shading normal, secondary-ray origins are
+//! offset along the geometric one. Optics:
 //! - [`Optics::Mirror`]: `(1 − k)·local + k·L(reflected)` with the reflection
 //!   `r = d − 2 (d·n) n` (Seed 003's `E' = 2(N·E)N − E` with `E = −d`);
 //! - [`Optics::Refractive`]: Snell refraction with relative index `1/ior` entering and `ior`
@@ -377,8 +380,15 @@ impl<E: Fn(Vec3) -> Vec3 + Sync> Tracer<'_, E> {
     /// Outgoing radiance at a hit seen along `dir`, at bounce `depth`.
     fn shade(&self, hit: &Hit, dir: Vec3, mat: &SurfaceMaterial, tex: Vec3, depth: u32) -> Vec3 {
         let d = dir.normalize();
+        // The geometric normal decides the side (and offsets secondary origins); the shading
+        // normal (interpolated on smooth meshes, else the same) shades and bends rays.
         let front = hit.normal.dot(d) < 0.0;
-        let ns = if front { hit.normal } else { -hit.normal };
+        let ng = if front { hit.normal } else { -hit.normal };
+        let ns = if front {
+            hit.shading_normal
+        } else {
+            -hit.shading_normal
+        };
         let v = -d;
         let local = |m: &SurfaceMaterial| {
             let mut s = m.shading;
@@ -388,7 +398,7 @@ impl<E: Fn(Vec3) -> Vec3 + Sync> Tracer<'_, E> {
         let eps = SECONDARY_EPS_REL * (1.0 + hit.point.abs().max_element() + hit.t.abs());
         let reflect = || {
             let r = d - ns * (2.0 * d.dot(ns));
-            self.secondary(hit.point + ns * eps, r, depth + 1)
+            self.secondary(hit.point + ng * eps, r, depth + 1)
         };
         match mat.optics {
             Optics::Opaque => local(mat),
@@ -408,7 +418,7 @@ impl<E: Fn(Vec3) -> Vec3 + Sync> Tracer<'_, E> {
                 }
                 let cos_t = (1.0 - sin2_t).sqrt();
                 let t_dir = d * eta + ns * (eta * cos_i - cos_t);
-                let refr = self.secondary(hit.point - ns * eps, t_dir, depth + 1);
+                let refr = self.secondary(hit.point - ng * eps, t_dir, depth + 1);
                 if !fresnel {
                     return refr;
                 }

@@ -73,6 +73,26 @@ pub struct MeshData {
     pub indices: Vec<u32>,
     /// One texture coordinate per vertex, if any.
     pub uvs: Option<Vec<Vec2>>,
+    /// One vertex normal per vertex, if the file has them (any length; normalised when added).
+    pub normals: Option<Vec<Vec3>>,
+}
+
+/// How a mesh's surface normal is chosen at a hit (for shading and secondary-ray directions;
+/// the geometric normal always decides the side and the secondary-ray offset).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum MeshShading {
+    /// The triangle's geometric normal (faceted look). The default, and what
+    /// [`SceneBuilder::add_mesh`] gives.
+    #[default]
+    Flat,
+    /// The vertex normals interpolated with the hit's barycentric weights and renormalised
+    /// (Phong 1975); a mesh given without normals is flat shaded.
+    VertexNormals,
+    /// As [`MeshShading::VertexNormals`]; a mesh given without normals gets, at each vertex, the
+    /// angle-weighted mean of the unit normals of the triangles that share it (Thürmer and
+    /// Wüthrich 1998). Only triangles that share a vertex *index* are averaged: a mesh whose
+    /// vertices are duplicated per face stays faceted.
+    VertexNormalsOrAveraged,
 }
 
 /// What was added and what was skipped as degenerate.
@@ -112,6 +132,10 @@ pub struct Hit {
     /// Unit geometric normal: outward for spheres and cylinders, `(v1 − v0) × (v2 − v0)` for
     /// triangles (not flipped toward the ray).
     pub normal: Vec3,
+    /// Unit shading normal: equal to `normal` except on smooth-shaded meshes
+    /// ([`MeshShading`]), where it is the interpolated vertex normal turned to the same side as
+    /// `normal`.
+    pub shading_normal: Vec3,
     /// Sphere id, cylinder id (the return values of `add_sphere`/`add_cylinder`), or the
     /// triangle's index within its mesh.
     pub prim_id: u32,
@@ -137,6 +161,8 @@ struct TriMeta {
 #[derive(Clone, Debug)]
 struct MeshInfo {
     uvs: Option<Vec<Vec2>>,
+    /// Unit vertex normals (zero where the given one was unusable), or `None` for flat shading.
+    normals: Option<Vec<Vec3>>,
     material: u32,
 }
 
@@ -225,7 +251,38 @@ impl SceneBuilder {
         uvs: Option<&[Vec2]>,
         material_id: u32,
     ) -> Result<u32, SceneError> {
+        self.add_mesh_shaded(
+            positions,
+            indices,
+            uvs,
+            None,
+            MeshShading::Flat,
+            material_id,
+        )
+    }
+
+    /// [`SceneBuilder::add_mesh`] with vertex normals (one per vertex, any length) and a choice
+    /// of [`MeshShading`]. A given normal that is zero or not finite makes the shading normal
+    /// fall back to the geometric one wherever that vertex has weight; a normal-count mismatch is
+    /// refused.
+    pub fn add_mesh_shaded(
+        &mut self,
+        positions: &[Vec3],
+        indices: &[u32],
+        uvs: Option<&[Vec2]>,
+        normals: Option<&[Vec3]>,
+        shading: MeshShading,
+        material_id: u32,
+    ) -> Result<u32, SceneError> {
         // Validate the whole mesh before touching the builder.
+        if let Some(n) = normals {
+            if n.len() != positions.len() {
+                return Err(SceneError::NormalCountMismatch {
+                    normals: n.len(),
+                    vertices: positions.len(),
+                });
+            }
+        }
         if indices.len() % 3 != 0 {
             return Err(SceneError::IndicesNotTriangles { len: indices.len() });
         }
@@ -252,8 +309,24 @@ impl SceneBuilder {
             return Err(SceneError::TooManyPrimitives);
         }
         let mesh = self.meshes.len() as u32;
+        // Vertex normals for smooth shading: given ones normalised, or averaged from the faces.
+        let vertex_normals = match (shading, normals) {
+            (MeshShading::Flat, _) | (MeshShading::VertexNormals, None) => None,
+            (_, Some(n)) => Some(
+                n.iter()
+                    .map(|v| {
+                        let u = v.normalize_or_zero();
+                        if u.is_finite() { u } else { Vec3::ZERO }
+                    })
+                    .collect(),
+            ),
+            (MeshShading::VertexNormalsOrAveraged, None) => {
+                Some(averaged_vertex_normals(positions, indices))
+            }
+        };
         self.meshes.push(MeshInfo {
             uvs: uvs.map(|u| u.to_vec()),
+            normals: vertex_normals,
             material: material_id,
         });
         self.stats.meshes += 1;
@@ -284,12 +357,25 @@ impl SceneBuilder {
         Ok(mesh)
     }
 
-    /// [`SceneBuilder::add_mesh`] for a loaded [`MeshData`].
+    /// [`SceneBuilder::add_mesh`] for a loaded [`MeshData`] (flat shaded).
     pub fn add_mesh_data(&mut self, mesh: &MeshData, material_id: u32) -> Result<u32, SceneError> {
-        self.add_mesh(
+        self.add_mesh_data_shaded(mesh, MeshShading::Flat, material_id)
+    }
+
+    /// [`SceneBuilder::add_mesh_shaded`] for a loaded [`MeshData`]: its normals (if the file had
+    /// them) with the chosen [`MeshShading`].
+    pub fn add_mesh_data_shaded(
+        &mut self,
+        mesh: &MeshData,
+        shading: MeshShading,
+        material_id: u32,
+    ) -> Result<u32, SceneError> {
+        self.add_mesh_shaded(
             &mesh.positions,
             &mesh.indices,
             mesh.uvs.as_deref(),
+            mesh.normals.as_deref(),
+            shading,
             material_id,
         )
     }
@@ -417,6 +503,36 @@ impl SceneBuilder {
             max_material,
         }
     }
+}
+
+/// Angle-weighted vertex normals (Thürmer and Wüthrich 1998): each triangle adds its unit
+/// normal, weighted by its interior angle at the vertex, to its three vertices; computed in f64.
+/// Zero-area and non-finite triangles add nothing; a vertex no usable triangle touches gets zero
+/// (its weight then falls back to the geometric normal at a hit). Indices must be in range.
+fn averaged_vertex_normals(positions: &[Vec3], indices: &[u32]) -> Vec<Vec3> {
+    let mut acc = vec![glam::DVec3::ZERO; positions.len()];
+    for t in indices.chunks_exact(3) {
+        let p = [t[0], t[1], t[2]].map(|i| positions[i as usize].as_dvec3());
+        let n = (p[1] - p[0]).cross(p[2] - p[0]);
+        let len = n.length();
+        if !(len > 0.0 && len.is_finite()) {
+            continue;
+        }
+        let n = n / len;
+        for k in 0..3 {
+            // Interior angle at corner k from the two unit edges leaving it.
+            let e1 = (p[(k + 1) % 3] - p[k]).normalize_or_zero();
+            let e2 = (p[(k + 2) % 3] - p[k]).normalize_or_zero();
+            let angle = e1.dot(e2).clamp(-1.0, 1.0).acos();
+            acc[t[k] as usize] += n * angle;
+        }
+    }
+    acc.iter()
+        .map(|a| {
+            let u = a.normalize_or_zero().as_vec3();
+            if u.is_finite() { u } else { Vec3::ZERO }
+        })
+        .collect()
 }
 
 /// A primitive box padded by [`BOX_PAD_REL`] of its magnitude.
@@ -636,6 +752,7 @@ impl Scene {
                     t: r.t,
                     point: center + n * radius,
                     normal: n,
+                    shading_normal: n,
                     prim_id: id,
                     material_id: self.sphere_material[id as usize],
                     kind: HitKind::Sphere,
@@ -645,6 +762,7 @@ impl Scene {
                 t: r.t,
                 point: pre.origin + pre.dir * r.t,
                 normal: r.normal,
+                shading_normal: r.normal,
                 prim_id: id,
                 material_id: self.cylinders[id as usize].material,
                 kind: HitKind::Cylinder { part: r.part },
@@ -656,12 +774,32 @@ impl Scene {
                 let n = (v[1] - v[0])
                     .cross(v[2] - v[0])
                     .normalize_or(-pre.dir.normalize());
+                let info = &self.meshes[m.mesh as usize];
+                let shading_normal = match &info.normals {
+                    None => n,
+                    Some(vn) => {
+                        // Phong: interpolate the vertex normals with the hit's barycentrics,
+                        // renormalise, and turn to the geometric normal's side.
+                        let s = vn[m.idx[0] as usize] * b0
+                            + vn[m.idx[1] as usize] * r.b1
+                            + vn[m.idx[2] as usize] * r.b2;
+                        let s = s.normalize_or_zero();
+                        if s == Vec3::ZERO || !s.is_finite() {
+                            n
+                        } else if s.dot(n) < 0.0 {
+                            -s
+                        } else {
+                            s
+                        }
+                    }
+                };
                 Hit {
                     t: r.t,
                     point: v[0] * b0 + v[1] * r.b1 + v[2] * r.b2,
                     normal: n,
+                    shading_normal,
                     prim_id: m.index,
-                    material_id: self.meshes[m.mesh as usize].material,
+                    material_id: info.material,
                     kind: HitKind::Triangle {
                         mesh: m.mesh,
                         bary: Vec2::new(r.b1, r.b2),

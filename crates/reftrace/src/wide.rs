@@ -415,8 +415,8 @@ mod tests {
                     );
                     if n.leaf_bits & (1 << k) != 0 {
                         let start = n.child[k] as usize;
-                        for slot in start..start + n.count[k] as usize {
-                            seen[slot] += 1;
+                        for c in &mut seen[start..start + n.count[k] as usize] {
+                            *c += 1;
                         }
                     } else {
                         todo.push((n.child[k], lo, hi));
