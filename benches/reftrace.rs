@@ -1,6 +1,19 @@
 //! Reference ray tracer speed: BVH build time and primary rays per second on the named sphere
 //! scenes S2 (100k spheres r 0.5 in a 100³ box) and S3 (1M spheres r 0.3 in a 200³ box) at
-//! 1920x1080, and on a 2M-triangle heightfield; both obvhs layouts (bvh2, cwbvh).
+//! 1920x1080, and on a 2M-triangle heightfield; for every layout (obvhs's bvh2 and cwbvh with
+//! their own traversals, and our 4-wide traversal `wide4`, the default).
+//!
+//! Two measurements per scene and layout, so that the comparison with issue #3's anchor (an obvhs
+//! demo tracing primary rays for closest hits only) is fair:
+//! - `trace` — trace only: the closest hit and its exact depth for every pixel
+//!   ([`Scene::depth_image`]);
+//! - `trace_shade` — the full reference render: trace, shade with the shared model, sRGB encode
+//!   ([`Scene::render`], one sample per pixel).
+//!
+//! S2 is measured with two cameras: `s2_100k_spheres` keeps this bench's original view (40°
+//! horizontal field of view, 68% of the pixels covered), `s2_study_view` uses texmap-study's
+//! canonical S2 view (the box framed in the image: 69.0° for 1080p, eye along (0.45, 0.35, 1),
+//! 28% covered), the view of PERFORMANCE-NOTES.md.
 //!
 //! Run: `cargo bench --bench reftrace -- --warm-up-time 1 --measurement-time 3`.
 //! In test mode (`cargo test --bench reftrace`) the scenes shrink 10x and the image to 192x108 so
@@ -73,15 +86,16 @@ fn materials() -> Vec<SurfaceMaterial> {
     .to_vec()
 }
 
-fn camera(eye: Vec3, w: u32, h: u32) -> Camera {
-    Camera::perspective_look_at(eye, Vec3::ZERO, Vec3::Y, 40.0, w, h).expect("valid camera")
+/// A perspective camera looking at the origin with horizontal field of view `hfov`.
+fn camera(eye: Vec3, hfov: f32, w: u32, h: u32) -> Camera {
+    Camera::perspective_look_at(eye, Vec3::ZERO, Vec3::Y, hfov, w, h).expect("valid camera")
 }
 
 fn bench_scene(
     c: &mut Criterion,
     name: &str,
     make: &dyn Fn(BvhKind) -> SceneBuilder,
-    eye: Vec3,
+    (eye, hfov): (Vec3, f32),
     kinds: &[BvhKind],
 ) {
     let (w, h) = if full_size() {
@@ -106,11 +120,15 @@ fn bench_scene(
                 criterion::BatchSize::PerIteration,
             )
         });
-        let cam = camera(eye, w, h);
+        let cam = camera(eye, hfov, w, h);
         let opts = RenderOptions::new(Lighting::default_for(&cam), &mats);
-        // Render: throughput in primary rays per second (one sample per pixel, shaded).
+        // Trace only: closest hit and exact depth per pixel; throughput in primary rays.
         g.throughput(Throughput::Elements(w as u64 * h as u64));
-        g.bench_function(BenchmarkId::new("primary_rays", &label), |b| {
+        g.bench_function(BenchmarkId::new("trace", &label), |b| {
+            b.iter(|| black_box(scene.depth_image(&cam)))
+        });
+        // Trace + shade: the full reference render at one sample per pixel.
+        g.bench_function(BenchmarkId::new("trace_shade", &label), |b| {
             b.iter(|| black_box(scene.render(&cam, &opts).expect("valid options")))
         });
     }
@@ -119,33 +137,36 @@ fn bench_scene(
 
 fn benches(c: &mut Criterion) {
     let scale = if full_size() { 1 } else { 10 };
-    let both = [BvhKind::Bvh2, BvhKind::CwBvh];
+    let all = [BvhKind::Wide4, BvhKind::CwBvh, BvhKind::Bvh2];
+    let oblique = Vec3::new(0.3, 0.4, 1.0).normalize();
     // S2: 100k spheres r 0.5 in a 100³ box, eye 2.4 box lengths from the centre.
     let n2 = 100_000 / scale;
+    let s2 = |k| spheres(n2, 100.0, 0.5, k);
+    bench_scene(c, "s2_100k_spheres", &s2, (oblique * 240.0, 40.0), &all);
+    // The same scene from texmap-study's S2 view: VIEW_DIRECTION (0.45, 0.35, 1), 2.4 box
+    // lengths, the horizontal FOV that frames the box's circumscribed sphere in 1920x1080
+    // (scenes::framing_hfov_deg: 69.0°).
+    let study = Vec3::new(0.45, 0.35, 1.0).normalize() * 240.0;
     bench_scene(
         c,
-        "s2_100k_spheres",
-        &|k| spheres(n2, 100.0, 0.5, k),
-        Vec3::new(0.3, 0.4, 1.0).normalize() * 240.0,
-        &both,
+        "s2_study_view",
+        &s2,
+        (study, 69.0),
+        &[BvhKind::Wide4, BvhKind::CwBvh],
     );
     // S3: 1M spheres r 0.3 in a 200³ box.
     let n3 = 1_000_000 / scale;
-    bench_scene(
-        c,
-        "s3_1m_spheres",
-        &|k| spheres(n3, 200.0, 0.3, k),
-        Vec3::new(0.3, 0.4, 1.0).normalize() * 480.0,
-        &both,
-    );
+    let s3 = |k| spheres(n3, 200.0, 0.3, k);
+    bench_scene(c, "s3_1m_spheres", &s3, (oblique * 480.0, 40.0), &all);
     // 2M-triangle heightfield (1001 x 1001 vertices) seen obliquely.
     let hn = if full_size() { 1001 } else { 101 };
+    let hf = |k| heightfield(hn, k);
     bench_scene(
         c,
         "heightfield_2m_tris",
-        &|k| heightfield(hn, k),
-        Vec3::new(0.0, 60.0, 110.0),
-        &both,
+        &hf,
+        (Vec3::new(0.0, 60.0, 110.0), 40.0),
+        &all,
     );
 }
 

@@ -230,6 +230,22 @@ impl Scene {
         self.render_with_environment(camera, opts, &move |_d: Vec3| bg)
     }
 
+    /// Primary visibility only (trace, no shading): the depth of the closest hit through each
+    /// pixel centre, row-major, INFINITY on a miss — bit for bit the depth buffer of
+    /// [`Scene::render`] at any `samples_per_axis`. Parallel over rows, deterministic.
+    pub fn depth_image(&self, camera: &Camera) -> Vec<f32> {
+        let (w, h) = (camera.width() as usize, camera.height() as usize);
+        let forward = camera.forward();
+        let mut depth = vec![f32::INFINITY; w * h];
+        depth.par_chunks_mut(w).enumerate().for_each(|(j, row)| {
+            let y = j as f32 + 0.5;
+            for (i, d) in row.iter_mut().enumerate() {
+                *d = primary_depth(self, camera, forward, i as f32 + 0.5, y);
+            }
+        });
+        depth
+    }
+
     /// Render with an environment: `env(d)` is the linear RGB radiance arriving along unit
     /// direction `d` from infinity, used for secondary rays that escape (and primary misses if
     /// [`RenderOptions::environment_on_primary_miss`]). Non-finite values are taken as black.
@@ -301,22 +317,12 @@ impl<E: Fn(Vec3) -> Vec3 + Sync> Tracer<'_, E> {
     /// The primary ray through (x, y) and its parameter interval from the clip planes.
     #[inline]
     fn primary_ray(&self, x: f32, y: f32) -> (Ray, f32, f32, f32) {
-        let ray = self.cam.ray(x, y);
-        let cos = ray.dir.dot(self.forward);
-        (ray, cos, self.cam.near() / cos, self.cam.far() / cos)
+        primary_ray(self.cam, self.forward, x, y)
     }
 
     /// Depth of the primary ray through (x, y), INFINITY on a miss.
     fn primary_depth(&self, x: f32, y: f32) -> f32 {
-        let (ray, cos, tmin, tmax) = self.primary_ray(x, y);
-        if !(valid_ray(&ray) && cos > 0.0) {
-            return f32::INFINITY;
-        }
-        let pre = RayPre::new(ray.origin, ray.dir);
-        match self.scene.closest(&pre, tmin, tmax) {
-            Some(r) => finite_depth(r.t * cos),
-            None => f32::INFINITY,
-        }
+        primary_depth(self.scene, self.cam, self.forward, x, y)
     }
 
     /// One primary sample: linear colour and depth.
@@ -443,6 +449,29 @@ impl<E: Fn(Vec3) -> Vec3 + Sync> Tracer<'_, E> {
         let mat = &self.opts.materials[hit.material_id as usize];
         let tex = self.texture_value(&hit, mat, None);
         self.shade(&hit, dir, mat, tex, depth)
+    }
+}
+
+/// The primary ray through (x, y), the cosine of its angle to the view axis and its parameter
+/// interval from the clip planes.
+#[inline]
+fn primary_ray(cam: &Camera, forward: Vec3, x: f32, y: f32) -> (Ray, f32, f32, f32) {
+    let ray = cam.ray(x, y);
+    let cos = ray.dir.dot(forward);
+    (ray, cos, cam.near() / cos, cam.far() / cos)
+}
+
+/// Depth of the primary ray through (x, y), INFINITY on a miss.
+#[inline]
+fn primary_depth(scene: &Scene, cam: &Camera, forward: Vec3, x: f32, y: f32) -> f32 {
+    let (ray, cos, tmin, tmax) = primary_ray(cam, forward, x, y);
+    if !(valid_ray(&ray) && cos > 0.0) {
+        return f32::INFINITY;
+    }
+    let pre = RayPre::new(ray.origin, ray.dir);
+    match scene.closest(&pre, tmin, tmax) {
+        Some(r) => finite_depth(r.t * cos),
+        None => f32::INFINITY,
     }
 }
 

@@ -496,6 +496,27 @@ fn busy_scene() -> (Scene, Camera, Vec<SurfaceMaterial>) {
 }
 
 #[test]
+fn depth_image_is_the_render_depth_buffer() {
+    let (scene, cam, mats) = busy_scene();
+    let mut opts = RenderOptions::new(Lighting::default_for(&cam), &mats);
+    for n in [1, 2] {
+        opts.samples_per_axis = n;
+        let frame = scene.render(&cam, &opts).unwrap();
+        let depth = scene.depth_image(&cam);
+        assert_eq!(depth.len(), frame.depth.len());
+        let same = depth
+            .iter()
+            .zip(&frame.depth)
+            .all(|(a, b)| a.to_bits() == b.to_bits());
+        assert!(
+            same,
+            "depth_image differs from the render's depth ({n}x{n} samples)"
+        );
+        assert!(depth.iter().any(|d| d.is_finite()) && depth.iter().any(|d| d.is_infinite()));
+    }
+}
+
+#[test]
 fn render_is_byte_identical_for_one_and_two_threads() {
     let (scene, cam, mats) = busy_scene();
     let mut opts = RenderOptions::new(Lighting::default_for(&cam), &mats);
@@ -516,6 +537,36 @@ fn render_is_byte_identical_for_one_and_two_threads() {
         a.depth.iter().map(|d| d.to_bits()).collect::<Vec<_>>(),
         b.depth.iter().map(|d| d.to_bits()).collect::<Vec<_>>()
     );
+    // A sphere-only scene (the sphere kernel of the 4-wide traversal) and the trace-only path.
+    let mut rng = Lcg(77);
+    let mut sb = SceneBuilder::new();
+    for k in 0..5000 {
+        sb.add_sphere(rng.vec(-5.0, 5.0), rng.range(0.05, 0.3), k % 4);
+    }
+    let spheres = sb.build();
+    let pool = |threads| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+    };
+    let (f1, d1) = pool(1).install(|| {
+        (
+            spheres.render(&cam, &opts).unwrap(),
+            spheres.depth_image(&cam),
+        )
+    });
+    let (f2, d2) = pool(2).install(|| {
+        (
+            spheres.render(&cam, &opts).unwrap(),
+            spheres.depth_image(&cam),
+        )
+    });
+    assert!(f1.coverage_count() > 1000);
+    assert_eq!(f1.color, f2.color);
+    let bits = |v: &[f32]| v.iter().map(|d| d.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&f1.depth), bits(&f2.depth));
+    assert_eq!(bits(&d1), bits(&d2));
 }
 
 #[test]
