@@ -60,12 +60,74 @@ impl DrawStats {
     }
 }
 
-/// A binned triangle: snapped vertices, varyings and its source triangle.
+/// A binned triangle: snapped vertices oriented for the edge functions (positive
+/// [`area2`]), varyings in the program's storage `V`, and its source triangle with the facing in
+/// the top bit (triangle indices are below 2^31, see [`Mesh`]).
 #[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct Rec {
+pub(crate) struct Rec<V> {
     v: [PVert; 3],
-    var: [Var; 3],
-    tri: u32,
+    var: V,
+    tri_front: u32,
+}
+
+const FRONT_BIT: u32 = 1 << 31;
+
+impl<V: VarStore> Rec<V> {
+    /// The record of a snapped triangle with `area2(v) != 0` whose facing survives culling:
+    /// front faces are re-oriented (vertices 1 and 2 swapped) so that every record is clockwise.
+    #[inline]
+    fn new(mut v: [PVert; 3], mut var: [Var; 3], tri: u32, front: bool) -> Self {
+        if front {
+            v.swap(1, 2);
+            var.swap(1, 2);
+        }
+        Rec {
+            v,
+            var: V::pack(var),
+            tri_front: tri | if front { FRONT_BIT } else { 0 },
+        }
+    }
+}
+
+/// How a record stores its varyings: not at all (52-byte records for programs without
+/// varyings), or all three vertices' (88 bytes).
+pub(crate) trait VarStore: Copy + Default + Send + Sync + 'static {
+    fn pack(var: [Var; 3]) -> Self;
+    fn unpack(&self) -> [Var; 3];
+    fn bins(s: &mut TriBins) -> &mut Bins<Rec<Self>>;
+}
+
+impl VarStore for () {
+    #[inline]
+    fn pack(_: [Var; 3]) {}
+    #[inline]
+    fn unpack(&self) -> [Var; 3] {
+        [[0.0; MAX_VAR]; 3]
+    }
+    fn bins(s: &mut TriBins) -> &mut Bins<Rec<()>> {
+        &mut s.bare
+    }
+}
+
+impl VarStore for [Var; 3] {
+    #[inline]
+    fn pack(var: [Var; 3]) -> Self {
+        var
+    }
+    #[inline]
+    fn unpack(&self) -> [Var; 3] {
+        *self
+    }
+    fn bins(s: &mut TriBins) -> &mut Bins<Rec<[Var; 3]>> {
+        &mut s.with_var
+    }
+}
+
+/// Triangle bins for both record layouts.
+#[derive(Default)]
+pub(crate) struct TriBins {
+    bare: Bins<Rec<()>>,
+    with_var: Bins<Rec<[Var; 3]>>,
 }
 
 /// Buffers reused from draw to draw (no per-draw allocation of the big arrays once warm).
@@ -73,13 +135,14 @@ pub(crate) struct Rec {
 pub(crate) struct Scratch {
     pverts: Vec<PVert>,
     rects: Vec<u32>,
-    tris: Bins<Rec>,
+    tris: TriBins,
     sprites: Bins<Sprite>,
 }
 
 impl std::fmt::Debug for Scratch {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "Scratch({} binned triangles)", self.tris.items.len())
+        let n = self.tris.bare.items.len() + self.tris.with_var.items.len();
+        write!(f, "Scratch({n} binned triangles)")
     }
 }
 
@@ -280,7 +343,8 @@ impl Framebuffer {
         // Fill: copy each triangle's record into its tiles, chunks in parallel.
         let counts: Vec<&[u32]> = chunk_bins.iter().map(|c| c.counts.as_slice()).collect();
         let rects = &scratch.rects;
-        scratch.tris.fill(&grid, &counts, |ci, em| {
+        let bins = P::Vars::bins(&mut scratch.tris);
+        bins.fill(&grid, &counts, |ci, em| {
             let lo = ci * CHUNK;
             let hi = (lo + CHUNK).min(rects.len());
             let pieces = &chunk_bins[ci].pieces;
@@ -294,47 +358,37 @@ impl Framebuffer {
                     while pc < pieces.len() && pieces[pc].tri == t as u32 {
                         let p = &pieces[pc];
                         if p.rect != RECT_EMPTY {
-                            let rec = Rec {
-                                v: p.v,
-                                var: p.var,
-                                tri: p.tri,
-                            };
-                            em.put(p.rect, rec);
+                            // A binned piece has a non-zero area and survives culling.
+                            if let Some(front) = facing(area2(&p.v), cull) {
+                                em.put(p.rect, Rec::new(p.v, p.var, p.tri, front));
+                            }
                         }
                         pc += 1;
                     }
                     continue;
                 }
                 let tri = indices[t];
+                let v = tri.map(|i| pverts[i as usize]);
+                let Some(front) = facing(area2(&v), cull) else {
+                    continue;
+                };
                 let mut var = [[0.0; MAX_VAR]; 3];
                 if P::NV > 0 {
                     var = tri.map(|i| prog.vertex_var(mesh, i as usize));
                 }
-                let rec = Rec {
-                    v: tri.map(|i| pverts[i as usize]),
-                    var,
-                    tri: t as u32,
-                };
-                em.put(r, rec);
+                em.put(r, Rec::new(v, var, t as u32, front));
             }
         });
 
         // Stage 3: tiles.
         let ctx = RasterCtx::new(*state, proj.far, grid.width, grid.height, *block_path);
-        let bins = &scratch.tris;
+        let bins = &*bins;
         tiles.par_iter_mut().enumerate().for_each(|(ti, tile)| {
             for rec in bins.tile(ti) {
-                let (mut v, mut var) = (rec.v, rec.var);
-                let Some(front) = facing(area2(&v), state.cull) else {
-                    continue;
-                };
-                if front {
-                    // Orient clockwise on screen (positive area) for the edge functions.
-                    v.swap(1, 2);
-                    var.swap(1, 2);
-                }
-                let cst = prog.tri_const(mesh, rec.tri, front);
-                raster_tri(tile, &ctx, prog, &cst, &v, &var, front);
+                let front = rec.tri_front & FRONT_BIT != 0;
+                let tri = rec.tri_front & !FRONT_BIT;
+                let cst = prog.tri_const(mesh, tri, front);
+                raster_tri(tile, &ctx, prog, &cst, &rec.v, &rec.var.unpack(), front);
             }
         });
         stats

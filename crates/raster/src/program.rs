@@ -13,6 +13,7 @@ use texmap_core::mip::MipTexture;
 use texmap_core::sample::Sampler;
 use texmap_core::shade::{Lighting, Material};
 
+use crate::draw::VarStore;
 use crate::mesh::Mesh;
 use crate::project::{MAX_VAR, Proj, Var};
 use crate::simd::F32x4;
@@ -58,6 +59,8 @@ pub(crate) trait FragProgram: Sync {
     const NV: usize;
     /// What the program computes once per triangle.
     type TriConst: Copy;
+    /// How binned records store the varyings: `()` when `NV == 0`, else `[Var; 3]`.
+    type Vars: VarStore;
     /// The varyings of mesh vertex `vi`.
     fn vertex_var(&self, mesh: &Mesh, vi: usize) -> Var;
     /// Per-triangle constants of source triangle `tri`; `front` says how it faces the viewer.
@@ -73,6 +76,7 @@ pub(crate) struct FlatProg(pub Vec3);
 
 impl FragProgram for FlatProg {
     const NV: usize = 0;
+    type Vars = ();
     type TriConst = ();
     #[inline]
     fn vertex_var(&self, _: &Mesh, _: usize) -> Var {
@@ -91,6 +95,7 @@ pub(crate) struct VertexColorProg;
 
 impl FragProgram for VertexColorProg {
     const NV: usize = 3;
+    type Vars = [Var; 3];
     type TriConst = ();
     #[inline]
     fn vertex_var(&self, mesh: &Mesh, vi: usize) -> Var {
@@ -114,6 +119,7 @@ pub(crate) struct LitFlatProg {
 
 impl FragProgram for LitFlatProg {
     const NV: usize = 0;
+    type Vars = ();
     type TriConst = Vec3;
     #[inline]
     fn vertex_var(&self, _: &Mesh, _: usize) -> Var {
@@ -150,6 +156,7 @@ pub(crate) struct LitSmoothProg {
 
 impl FragProgram for LitSmoothProg {
     const NV: usize = 3;
+    type Vars = [Var; 3];
     type TriConst = ();
     #[inline]
     fn vertex_var(&self, mesh: &Mesh, vi: usize) -> Var {
@@ -327,6 +334,7 @@ pub(crate) struct TexturedProg<'s, S: QuadSampler + ?Sized>(pub &'s S);
 
 impl<S: QuadSampler + ?Sized> FragProgram for TexturedProg<'_, S> {
     const NV: usize = 2;
+    type Vars = [Var; 3];
     type TriConst = ();
     #[inline]
     fn vertex_var(&self, mesh: &Mesh, vi: usize) -> Var {
