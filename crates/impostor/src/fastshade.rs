@@ -324,7 +324,6 @@ mod lanes {
     bin!(lt, _mm_cmplt_ps);
     bin!(gt, _mm_cmpgt_ps);
     bin!(and, _mm_and_ps);
-    bin!(or, _mm_or_ps);
     #[inline(always)]
     pub fn sqrt(a: Repr) -> Repr {
         unsafe { [_mm_sqrt_ps(a[0]), _mm_sqrt_ps(a[1])] }
@@ -370,6 +369,28 @@ mod lanes {
             );
         }
         out
+    }
+    bin!(le, _mm_cmple_ps);
+    bin!(ge, _mm_cmpge_ps);
+    /// Lanes 0–3 from `a[..4]`, lanes 4–7 from `b[..4]`.
+    #[inline(always)]
+    pub fn load_halves(a: &[f32; 4], b: &[f32; 4]) -> Repr {
+        unsafe { [_mm_loadu_ps(a.as_ptr()), _mm_loadu_ps(b.as_ptr())] }
+    }
+    #[inline(always)]
+    pub fn store_lo(r: Repr, a: &mut [f32; 4]) {
+        unsafe { _mm_storeu_ps(a.as_mut_ptr(), r[0]) }
+    }
+    #[inline(always)]
+    pub fn store_hi(r: Repr, b: &mut [f32; 4]) {
+        unsafe { _mm_storeu_ps(b.as_mut_ptr(), r[1]) }
+    }
+    #[inline(always)]
+    pub fn store_to(r: Repr, a: &mut [f32; 8]) {
+        unsafe {
+            _mm_storeu_ps(a.as_mut_ptr(), r[0]);
+            _mm_storeu_ps(a.as_mut_ptr().add(4), r[1]);
+        }
     }
 }
 
@@ -439,10 +460,6 @@ mod lanes {
         map2(a, b, |x, y| mask(on(x) && on(y)))
     }
     #[inline(always)]
-    pub fn or(a: Repr, b: Repr) -> Repr {
-        map2(a, b, |x, y| mask(on(x) || on(y)))
-    }
-    #[inline(always)]
     pub fn sqrt(a: Repr) -> Repr {
         a.map(f32::sqrt)
     }
@@ -461,6 +478,30 @@ mod lanes {
     #[inline(always)]
     pub fn trunc_u32(a: Repr) -> [u32; 8] {
         a.map(|x| x as u32)
+    }
+    #[inline(always)]
+    pub fn le(a: Repr, b: Repr) -> Repr {
+        map2(a, b, |x, y| mask(x <= y))
+    }
+    #[inline(always)]
+    pub fn ge(a: Repr, b: Repr) -> Repr {
+        map2(a, b, |x, y| mask(x >= y))
+    }
+    #[inline(always)]
+    pub fn load_halves(a: &[f32; 4], b: &[f32; 4]) -> Repr {
+        std::array::from_fn(|i| if i < 4 { a[i] } else { b[i - 4] })
+    }
+    #[inline(always)]
+    pub fn store_lo(r: Repr, a: &mut [f32; 4]) {
+        a.copy_from_slice(&r[..4]);
+    }
+    #[inline(always)]
+    pub fn store_hi(r: Repr, b: &mut [f32; 4]) {
+        b.copy_from_slice(&r[4..]);
+    }
+    #[inline(always)]
+    pub fn store_to(r: Repr, a: &mut [f32; 8]) {
+        *a = r;
     }
 }
 
@@ -502,6 +543,59 @@ impl V8 {
     pub fn select(m: M8, a: V8, b: V8) -> V8 {
         V8(lanes::select(m.0, a.0, b.0))
     }
+    #[inline(always)]
+    pub fn le(self, o: V8) -> M8 {
+        M8(lanes::le(self.0, o.0))
+    }
+    #[inline(always)]
+    pub fn ge(self, o: V8) -> M8 {
+        M8(lanes::ge(self.0, o.0))
+    }
+    /// The first 8 values of `a`.
+    #[inline(always)]
+    pub fn load_from(a: &[f32]) -> V8 {
+        V8::load(a[..W].try_into().expect("8 values"))
+    }
+    /// Store into the first 8 values of `a`.
+    #[inline(always)]
+    pub fn store_to(self, a: &mut [f32]) {
+        lanes::store_to(self.0, (&mut a[..W]).try_into().expect("8 values"))
+    }
+    /// Lanes 0–3 from `a[..4]`, lanes 4–7 from `b[..4]` (two rows of a narrow box).
+    #[inline(always)]
+    pub fn load_halves(a: &[f32], b: &[f32]) -> V8 {
+        V8(lanes::load_halves(
+            a[..4].try_into().expect("4 values"),
+            b[..4].try_into().expect("4 values"),
+        ))
+    }
+    /// Store lanes 0–3 into `a[..4]`.
+    #[inline(always)]
+    pub fn store_lo(self, a: &mut [f32]) {
+        lanes::store_lo(self.0, (&mut a[..4]).try_into().expect("4 values"))
+    }
+    /// Store lanes 4–7 into `b[..4]`.
+    #[inline(always)]
+    pub fn store_hi(self, b: &mut [f32]) {
+        lanes::store_hi(self.0, (&mut b[..4]).try_into().expect("4 values"))
+    }
+    /// The `u32` bit patterns of `a[..8]` as lanes (for selecting winner indices bit-exactly).
+    #[inline(always)]
+    pub fn load_bits(a: &[u32]) -> V8 {
+        let f: &[u32; W] = a[..W].try_into().expect("8 values");
+        V8::load(&f.map(f32::from_bits))
+    }
+    /// A `u32` bit pattern in every lane.
+    #[inline(always)]
+    pub fn splat_bits(x: u32) -> V8 {
+        V8::splat(f32::from_bits(x))
+    }
+    /// Store the lanes' bit patterns into `a[..8]`.
+    #[inline(always)]
+    pub fn store_bits(self, a: &mut [u32]) {
+        let f = self.store();
+        a[..W].copy_from_slice(&f.map(f32::to_bits));
+    }
     /// Truncation toward zero of lanes known to lie in `[0, 2^31)` (the caller clamps).
     #[inline(always)]
     pub fn trunc_u32(self) -> [u32; W] {
@@ -519,9 +613,17 @@ impl M8 {
     pub fn and(self, o: M8) -> M8 {
         M8(lanes::and(self.0, o.0))
     }
+    /// The first `n` lanes of each half (lanes `l` with `l % 4 < n`).
     #[inline(always)]
-    pub fn or(self, o: M8) -> M8 {
-        M8(lanes::or(self.0, o.0))
+    pub fn first_of_halves(n: usize) -> M8 {
+        const IOTA: F8 = [0.0, 1.0, 2.0, 3.0, 0.0, 1.0, 2.0, 3.0];
+        V8::load(&IOTA).lt(V8::splat(n as f32))
+    }
+    /// The first `n` lanes (`n ≤ 8`).
+    #[inline(always)]
+    pub fn first(n: usize) -> M8 {
+        const IOTA: F8 = [0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0];
+        V8::load(&IOTA).lt(V8::splat(n as f32))
     }
     /// One bit per lane (lane 0 in bit 0).
     #[inline(always)]

@@ -38,7 +38,7 @@ use glam::Vec3;
 use texmap_core::color::linear_to_srgb8;
 use texmap_core::shade::{Lighting, Material};
 
-use crate::fastshade::{self, Surf8, W};
+use crate::fastshade::{self, M8, Surf8, V8, W};
 use crate::pipeline::{
     FLAG_INSIDE, Kernel, LANES, NONE, Proj, Projected, TILE, TILE_BUF, TILE_PX, TileBuf, TileRect,
     View, clip,
@@ -150,10 +150,14 @@ impl RayTable {
         for (j, dy) in t.dy.iter_mut().enumerate() {
             *dy = (v.cy - ((tile.y0 + j as u32) as f32 + 0.5)) * v.inv_k;
         }
-        for (p, ia) in t.inv_a.iter_mut().enumerate() {
-            let i = p % TILE as usize;
-            let j = (p / TILE as usize).min(TILE as usize - 1);
-            *ia = 1.0 / (t.dx[i] * t.dx[i] + t.dy[j] * t.dy[j] + 1.0);
+        // 1/|d|² per pixel, 8 lanes at a time (the slack past the last row repeats it).
+        let one = V8::splat(1.0);
+        for (p, ia) in t.inv_a.chunks_exact_mut(LANES).enumerate() {
+            let j = (p * LANES / TILE as usize).min(TILE as usize - 1);
+            let i = p * LANES % TILE as usize;
+            let dx = V8::load_from(&t.dx[i..]);
+            let dy = V8::splat(t.dy[j]);
+            (one / (dx * dx + dy * dy + one)).store_to(ia);
         }
         t
     }
@@ -167,38 +171,45 @@ impl RayTable {
 /// per pixel (`1/|d|²` comes from the tile table) and no cancellation for distant spheres.
 /// Returns the depths (`INFINITY` for a miss or a clipped hit) and the inside flags.
 #[inline(always)]
-fn hit8(
-    f: &[f32; 5],
-    dx: &[f32],
-    dy: &[f32; LANES],
-    inv_a: &[f32],
-    near: f32,
-    far: f32,
-) -> ([f32; LANES], [u32; LANES]) {
-    let (cx, cy, cz, r2) = (f[0], f[1], f[2], f[3]);
-    let mut t = [f32::INFINITY; LANES];
-    let mut flag = [0u32; LANES];
-    for l in 0..LANES {
-        let ia = inv_a[l];
-        let dxl = dx[l];
-        let dyl = dy[l];
-        // Compute the closest point and the stable discriminant.
-        let s = (dxl * cx + dyl * cy - cz) * ia;
-        let vx = cx - dxl * s;
-        let vy = cy - dyl * s;
-        let vz = cz + s;
-        let h2 = r2 - (vx * vx + vy * vy + vz * vz);
-        let hc = (if h2 > 0.0 { h2 } else { 0.0 } * ia).sqrt();
-        let tn = s - hc;
-        let tf = s + hc;
-        // Clip at the near plane: the near hit if in range, else the far (interior) one.
-        let inside = tn < near;
-        let th = if inside { tf } else { tn };
-        let ok = h2 >= 0.0 && th >= near && th <= far;
-        t[l] = if ok { th } else { f32::INFINITY };
-        flag[l] = if inside { FLAG_INSIDE } else { 0 };
+fn hit8(f: &[f32; 5], dx: V8, dy: V8, ia: V8, near: V8, far: V8) -> (V8, M8) {
+    let (cx, cy, cz, r2) = (
+        V8::splat(f[0]),
+        V8::splat(f[1]),
+        V8::splat(f[2]),
+        V8::splat(f[3]),
+    );
+    // Compute the closest point and the stable discriminant.
+    let s = (dx * cx + dy * cy - cz) * ia;
+    let vx = cx - dx * s;
+    let vy = cy - dy * s;
+    let vz = cz + s;
+    let h2 = r2 - (vx * vx + vy * vy + vz * vz);
+    let zero = V8::splat(0.0);
+    let hc = (h2.max(zero) * ia).sqrt();
+    let tn = s - hc;
+    let tf = s + hc;
+    // Clip at the near plane: the near hit if in range, else the far (interior) one.
+    let inside = tn.lt(near);
+    let th = V8::select(inside, tf, tn);
+    let ok = h2.ge(zero).and(th.ge(near)).and(th.le(far));
+    (V8::select(ok, th, V8::splat(f32::INFINITY)), inside)
+}
+
+/// Strict depth test of 8 lanes against `depth`/`win` (the earlier record wins ties).
+#[inline(always)]
+fn depth_test8(t: V8, inside: M8, idx: u32, depth: &mut [f32], win: &mut [u32]) {
+    let d = V8::load_from(depth);
+    let closer = t.lt(d);
+    if closer.bits() == 0 {
+        return;
     }
-    (t, flag)
+    V8::select(closer, t, d).store_to(depth);
+    let w = V8::select(
+        inside,
+        V8::splat_bits(idx | FLAG_INSIDE),
+        V8::splat_bits(idx),
+    );
+    V8::select(closer, w, V8::load_bits(win)).store_bits(win);
 }
 
 impl Kernel for Perspective<'_> {
@@ -206,35 +217,55 @@ impl Kernel for Perspective<'_> {
     fn raster(&self, recs: &[Proj], tile: TileRect, buf: &mut TileBuf) {
         let v = &self.view;
         let rt = RayTable::new(v, tile);
+        let (near, far) = (V8::splat(v.near), V8::splat(v.far));
+        let inf = V8::splat(f32::INFINITY);
+        const T: usize = TILE as usize;
         for (idx, p) in recs.iter().enumerate() {
             let Some((x0, y0, x1, y1)) = clip(p, tile) else {
                 continue;
             };
+            let (x0, y0, x1, y1) = (x0 as usize, y0 as usize, x1 as usize, y1 as usize);
+            let idx = idx as u32;
+            // Nearest depth the sphere can reach (widened by 1e-5 relative against rounding in
+            // `hit8`): chunks whose 8 stored depths are all nearer are skipped, a cheap
+            // hierarchical-z test.
+            let z_front = -p.f[2] - p.f[3].sqrt();
+            let zmin = V8::splat((z_front - 1e-5 * z_front.abs()).max(v.near));
             if x1 - x0 <= 4 {
                 // Narrow boxes (small spheres): two rows of up to 4 pixels per 8-lane test.
-                let w = (x1 - x0) as usize;
-                let mut j = y0 as usize;
-                while j < y1 as usize {
-                    let rows = if j + 1 < y1 as usize { 2 } else { 1 };
-                    let mut dx = [0f32; LANES];
-                    let mut dy = [0f32; LANES];
-                    let mut ia = [0f32; LANES];
-                    for l in 0..LANES {
-                        let jj = (j + l / 4).min(TILE as usize - 1);
-                        let ii = x0 as usize + l % 4;
-                        dx[l] = rt.dx[ii];
-                        dy[l] = rt.dy[jj];
-                        ia[l] = rt.inv_a[jj * TILE as usize + ii];
-                    }
-                    let (t, flag) = hit8(&p.f, &dx, &dy, &ia, v.near, v.far);
-                    for r in 0..rows {
-                        for c in 0..w {
-                            let l = r * 4 + c;
-                            let b = (j + r) * TILE as usize + x0 as usize + c;
-                            // Depth test (strict: the earlier sphere wins ties).
-                            if t[l] < buf.depth[b] {
-                                buf.depth[b] = t[l];
-                                buf.win[b] = idx as u32 | flag[l];
+                let cols = M8::first_of_halves(x1 - x0);
+                let dx4 = &rt.dx[x0..];
+                let mut j = y0;
+                while j < y1 {
+                    let two = j + 1 < y1;
+                    let j1 = if two { j + 1 } else { j };
+                    let (b0, b1) = (j * T + x0, j1 * T + x0);
+                    let d = V8::load_halves(&buf.depth[b0..], &buf.depth[b1..]);
+                    let lanes = if two { cols } else { cols.and(M8::first(4)) };
+                    if zmin.lt(d).and(lanes).bits() != 0 {
+                        let dx = V8::load_halves(dx4, dx4);
+                        let dy = V8::load_halves(&[rt.dy[j]; 4], &[rt.dy[j1]; 4]);
+                        let ia = V8::load_halves(&rt.inv_a[b0..], &rt.inv_a[b1..]);
+                        let (t, inside) = hit8(&p.f, dx, dy, ia, near, far);
+                        let t = V8::select(lanes, t, inf);
+                        let closer = t.lt(d);
+                        if closer.bits() != 0 {
+                            let nd = V8::select(closer, t, d);
+                            let w = V8::select(
+                                inside,
+                                V8::splat_bits(idx | FLAG_INSIDE),
+                                V8::splat_bits(idx),
+                            );
+                            let mut wins = [0u32; LANES];
+                            wins[..4].copy_from_slice(&buf.win[b0..b0 + 4]);
+                            wins[4..].copy_from_slice(&buf.win[b1..b1 + 4]);
+                            let nw = V8::select(closer, w, V8::load_bits(&wins));
+                            nw.store_bits(&mut wins);
+                            nd.store_lo(&mut buf.depth[b0..]);
+                            buf.win[b0..b0 + 4].copy_from_slice(&wins[..4]);
+                            if two {
+                                nd.store_hi(&mut buf.depth[b1..]);
+                                buf.win[b1..b1 + 4].copy_from_slice(&wins[4..]);
                             }
                         }
                     }
@@ -243,32 +274,31 @@ impl Kernel for Perspective<'_> {
                 continue;
             }
             for j in y0..y1 {
-                let row = (j * TILE) as usize;
-                let mut i = x0 as usize;
-                while i < x1 as usize {
+                let row = j * T;
+                let dy = V8::splat(rt.dy[j]);
+                let mut i = x0;
+                while i < x1 {
                     let b = row + i;
-                    let (mut t, flag) = hit8(
-                        &p.f,
-                        &rt.dx[i..i + LANES],
-                        &[rt.dy[j as usize]; LANES],
-                        &rt.inv_a[b..b + LANES],
-                        v.near,
-                        v.far,
-                    );
                     // Lanes past the box must not write.
-                    let valid = x1 as usize - i;
-                    for (l, tl) in t.iter_mut().enumerate() {
-                        if l >= valid {
-                            *tl = f32::INFINITY;
-                        }
-                    }
-                    // Depth test (strict: the earlier sphere wins ties).
-                    let depth = &mut buf.depth[b..b + LANES];
-                    let win = &mut buf.win[b..b + LANES];
-                    for l in 0..LANES {
-                        let closer = t[l] < depth[l];
-                        depth[l] = if closer { t[l] } else { depth[l] };
-                        win[l] = if closer { idx as u32 | flag[l] } else { win[l] };
+                    let lanes = M8::first(x1 - i);
+                    let d = V8::load_from(&buf.depth[b..]);
+                    if zmin.lt(d).and(lanes).bits() != 0 {
+                        let (t, inside) = hit8(
+                            &p.f,
+                            V8::load_from(&rt.dx[i..]),
+                            dy,
+                            V8::load_from(&rt.inv_a[b..]),
+                            near,
+                            far,
+                        );
+                        let t = V8::select(lanes, t, inf);
+                        depth_test8(
+                            t,
+                            inside,
+                            idx,
+                            &mut buf.depth[b..b + LANES],
+                            &mut buf.win[b..b + LANES],
+                        );
                     }
                     i += LANES;
                 }
