@@ -163,7 +163,18 @@ pub(crate) fn raster_tri<P: FragProgram>(
     };
     let q = [v[0].q as f64, v[1].q as f64, v[2].q as f64];
     let p_q = plane(q[0], q[1], q[2]);
-    let p_dw = plane(v[0].dw as f64, v[1].dw as f64, v[2].dw as f64);
+    // Perspective vertices carry depth/W = 1 exactly: the depth plane is then the constant 1
+    // (gradients ±0, base 1) and depth = W, so the plane is skipped with identical results.
+    let dw_one = v[0].dw == 1.0 && v[1].dw == 1.0 && v[2].dw == 1.0;
+    let p_dw = if dw_one {
+        Plane {
+            base: 1.0,
+            gx: 0.0,
+            gy: 0.0,
+        }
+    } else {
+        plane(v[0].dw as f64, v[1].dw as f64, v[2].dw as f64)
+    };
     let mut p_var = [Plane::default(); MAX_VAR];
     for k in 0..P::NV {
         p_var[k] = plane(
@@ -181,6 +192,7 @@ pub(crate) fn raster_tri<P: FragProgram>(
         yl,
         p_q,
         p_dw,
+        dw_one,
         p_var,
     };
     // Small-triangle fast path: a triangle at most TINY_SPAN across whose pixel range in this
@@ -283,6 +295,8 @@ struct Setup {
     yl: i32,
     p_q: Plane,
     p_dw: Plane,
+    /// `p_dw` is the constant 1 (depth = W).
+    dw_one: bool,
     p_var: [Plane; MAX_VAR],
 }
 
@@ -353,7 +367,11 @@ fn shade_quad<P: FragProgram>(
     let fy = F32x4::splat(fyb).add(F32x4::new([0.0, 0.0, 1.0, 1.0]));
     // Perspective division: W = 1 / (1/W), depth = (depth/W)·W.
     let w = F32x4::splat(1.0).div(s.p_q.eval4(fx, fy));
-    let depth = s.p_dw.eval4(fx, fy).mul(w);
+    let depth = if s.dw_one {
+        w
+    } else {
+        s.p_dw.eval4(fx, fy).mul(w)
+    };
     // Depth test (NaN and out-of-range depths fail every comparison).
     mask &= zt.mask(depth, F32x4::new(tile.depth[qi]));
     if mask == 0 {
