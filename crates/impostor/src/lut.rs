@@ -26,8 +26,15 @@
 //! and the lighting of an off-axis sphere is seen from the wrong direction; both errors grow with
 //! the angle off the view axis and with `R/z0` (measured by the study harness).
 //!
-//! **Near plane.** Spheres whose centre is not in front of the near plane are skipped (counted as
-//! culled); fragments nearer than the near plane are clipped.
+//! **Near plane** (as the ray-cast method does): a fragment `z0 + D·R` nearer than the near plane
+//! is clipped and the texel shows the sphere's far side `z0 − D·R` instead when that is in range
+//! (the interior of a cut sphere, coloured from the mirrored texel, i.e. the normal turned toward
+//! the viewer). A sphere whose centre is not in front of the near plane but which reaches past it
+//! is drawn the same way; its square cannot be scaled by `1/z0`, so its half-side is taken from
+//! the tangent length instead, `h = k·R/sqrt(|c|² − R²)` (the exact silhouette radius of a
+//! sphere on the view axis), centred at the centre's direction scaled alike; when the eye is
+//! inside the sphere or its centre is behind the eye, the square covers the whole image.
+//! Spheres wholly nearer than the near plane are culled.
 //!
 //! Record layout ([`Proj::f`]): `[sx, sy, 1/(2h), z0, R]` (screen centre in pixels); `aux` is the
 //! pyramid level ([`LutTables`]).
@@ -39,7 +46,9 @@ use glam::Vec3;
 use texmap_core::color::linear_to_srgb8;
 use texmap_core::shade::{Lighting, Material};
 
-use crate::pipeline::{Kernel, LANES, Proj, Projected, TILE, TileBuf, TileRect, View, clip};
+use crate::pipeline::{
+    FLAG_INSIDE, Kernel, LANES, Proj, Projected, TILE, TileBuf, TileRect, View, clip,
+};
 
 /// Texels per screen pixel the pyramid level must keep. Measured on the orthographic test scene
 /// (`tests/sprites.rs`, PSNR against the exact render): 1 → 25.2 dB, 2 → 27.8 dB, 4 → over 30 dB,
@@ -150,25 +159,42 @@ impl LutTables {
 }
 
 /// Project one eye-space sphere as a Seed 002 / Seed 004 screen square: centre, half-side.
-/// Returns `(sx, sy, h, z0)` or `None` when the centre is not in front of the near plane.
+/// Returns `(sx, sy, h, z0)`, or `None` when the sphere lies wholly nearer than the near plane
+/// or beyond the far plane. Spheres crossing the near plane with their centre behind it get the
+/// square described in the module docs.
 #[inline]
 pub(crate) fn square(view: &View, c: Vec3, r: f32) -> Option<(f32, f32, f32, f32)> {
     let z0 = -c.z;
-    if !(z0 >= view.near) || z0 - r > view.far {
+    if !(z0 + r >= view.near) || z0 - r > view.far {
         return None;
     }
     if view.ortho {
-        Some((
+        return Some((
             view.cx + c.x * view.k,
             view.cy - c.y * view.k,
             r * view.k,
             z0,
-        ))
-    } else {
+        ));
+    }
+    if z0 >= view.near {
         // Only the centre is perspective-projected; the sphere scales with 1/z0 (Seed 002 §6).
         let s = view.k / z0;
-        Some((view.cx + c.x * s, view.cy - c.y * s, r * s, z0))
+        return Some((view.cx + c.x * s, view.cy - c.y * s, r * s, z0));
     }
+    // Crossing the near plane with the centre behind it: scale by the tangent length.
+    let t2 = c.length_squared() - r * r;
+    let zs = if t2 > 0.0 { t2.sqrt() } else { 0.0 };
+    if z0 > 0.0 && zs > 1e-6 * r {
+        let s = view.k / zs;
+        let h = r * s;
+        if h < 4.0 * (view.width + view.height) as f32 {
+            return Some((view.cx + c.x * s, view.cy - c.y * s, h, z0));
+        }
+    }
+    // Eye inside the sphere, centre behind the eye, or a square far larger than the image:
+    // the whole image.
+    let h = (view.width.max(view.height)) as f32;
+    Some((view.cx, view.cy, h, z0))
 }
 
 /// Project one eye-space sphere for the LUT kernel.
@@ -223,25 +249,31 @@ impl Kernel for LutKernel<'_> {
                 while i < x1 as usize {
                     let b = row + i;
                     let mut z = [f32::INFINITY; LANES];
+                    let mut flag = [0u32; LANES];
                     for (l, zl) in z.iter_mut().enumerate() {
                         let s = base_s + (i + l) as f32 * inv2h;
                         let inside = (0.0..1.0).contains(&s) && i + l < x1 as usize;
                         let ti = ((if s > 0.0 { s } else { 0.0 } * nf) as u32).min(n - 1);
                         // Seed 002 §3.3: z = z0 + D(s,t)·R (linear eye-space form, module docs);
                         // D is infinite outside the mask.
-                        let zz = z0 + dimg[(trow + ti) as usize] * r;
-                        *zl = if inside && zz >= near {
+                        let dd = dimg[(trow + ti) as usize];
+                        let zz = z0 + dd * r;
+                        // Clipped by the near plane: the far side z0 − D·R (module docs).
+                        let back = !(zz >= near);
+                        let zz = if back { z0 - dd * r } else { zz };
+                        *zl = if inside && zz >= near && dd.is_finite() {
                             zz
                         } else {
                             f32::INFINITY
                         };
+                        flag[l] = if back { FLAG_INSIDE } else { 0 };
                     }
                     let depth = &mut buf.depth[b..b + LANES];
                     let win = &mut buf.win[b..b + LANES];
                     for l in 0..LANES {
                         let closer = z[l] < depth[l];
                         depth[l] = if closer { z[l] } else { depth[l] };
-                        win[l] = if closer { idx as u32 } else { win[l] };
+                        win[l] = if closer { idx as u32 | flag[l] } else { win[l] };
                     }
                     i += LANES;
                 }
@@ -249,7 +281,7 @@ impl Kernel for LutKernel<'_> {
         }
     }
 
-    fn resolve(&self, rec: &Proj, x: u32, y: u32, _depth: f32, _flags: u32) -> [u8; 4] {
+    fn resolve(&self, rec: &Proj, x: u32, y: u32, _depth: f32, flags: u32) -> [u8; 4] {
         let t = self.tables;
         let level = rec.aux as u32;
         let n = t.size >> level;
@@ -257,6 +289,12 @@ impl Kernel for LutKernel<'_> {
         // (s, t) ∈ [0, 1]² across the square, t down; nearest texel.
         let s = (x as f32 + 0.5 - rec.f[0]) * rec.f[2] + 0.5;
         let tt = (y as f32 + 0.5 - rec.f[1]) * rec.f[2] + 0.5;
+        // The far side seen from inside: the mirrored texel (normal turned toward the viewer).
+        let (s, tt) = if flags & FLAG_INSIDE != 0 {
+            (1.0 - s, 1.0 - tt)
+        } else {
+            (s, tt)
+        };
         let i = ((s.max(0.0) * nf) as u32).min(n - 1);
         let j = ((tt.max(0.0) * nf) as u32).min(n - 1);
         let img = (n * n) as usize;

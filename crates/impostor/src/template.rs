@@ -22,9 +22,11 @@
 //!   appears on the side of the light, at the half angle (where the Blinn highlight sits).
 //! - **Depth.** [`TemplateDepth::Billboard`]: the billboard plane through the centre (`z0`), as the
 //!   paper; [`TemplateDepth::DepthImage`]: Seed 002's depth image, `z = z0 + D·R`.
-//! - **Projection** as Seed 002 ([`crate::lut::square`]): centre projected, radius `k·R/z0`. Spheres
-//!   whose centre is not in front of the near plane are skipped; fragments nearer than it are
-//!   clipped.
+//! - **Projection** as Seed 002 ([`crate::lut::square`]): centre projected, radius `k·R/z0`.
+//! - **Near plane** as Seed 002 (the `lut` module): a fragment nearer than the near plane is
+//!   replaced by the sphere's far side (`z0 + R·sqrt(1 − ρ²)` with billboard depth, `z0 − D·R`
+//!   with the depth image) when that is in range, so spheres cut by the near plane, including
+//!   those whose centre is behind it, are drawn; only spheres wholly nearer are culled.
 //!
 //! Record layout ([`Proj::f`]): `[sx, sy, 1/h, z0, R]`; `aux` packs the window offsets
 //! `sin(θ/2)`, `sin(φ/2)` as two `i8` in units of 1/127.
@@ -252,7 +254,13 @@ impl Kernel for TemplateKernel<'_> {
                             z0 + dd * r
                         }
                     };
-                    if z < near {
+                    // Clipped by the near plane: the far side of the sphere instead.
+                    let z = if z < near {
+                        z0 + r * (1.0 - (u * u + w * w)).max(0.0).sqrt()
+                    } else {
+                        z
+                    };
+                    if !(z >= near) {
                         continue;
                     }
                     let b = row + i as usize;

@@ -185,3 +185,87 @@ fn sprites_skip_spheres_behind_the_near_plane_and_clip_fragments() {
         assert!(out.frame.coverage_count() > 0, "{m:?}");
     }
 }
+
+/// Issue #4: spheres crossing the near plane are drawn by every method, their fragments in front
+/// of the near plane only, including a sphere whose centre is behind the near plane and one the
+/// eye is inside. Compared with the exact ray-cast method (independent of the sprite code): the
+/// sprites must cover most pixels the ray caster covers. Not all: Seed 002 scales a sphere by
+/// `R/z0`, which for a sphere 2.3 radii away is ~10% narrower than its true silhouette (the
+/// documented perspective error of the method), so 75% is required, 98% on the view axis where
+/// the tangent-length square of a sphere whose centre is behind the near plane is exact.
+#[test]
+fn sprites_draw_spheres_crossing_the_near_plane_in_front_of_it() {
+    let cam =
+        Camera::perspective_look_at(Vec3::new(0.0, 0.0, 10.0), Vec3::ZERO, Vec3::Y, 60.0, 64, 64)
+            .unwrap()
+            .with_clip(2.0, 100.0)
+            .unwrap();
+    let cases = [
+        // Centre at depth 1.5 < near 2, reaching to depth 2.5: a cap beyond the near plane.
+        (
+            "centre behind the near plane",
+            Vec3::new(0.0, 0.0, 8.5),
+            1.0,
+            false,
+            0.98,
+        ),
+        // Centre at depth 2.3, front cut by the near plane.
+        (
+            "centre just past the near plane",
+            Vec3::new(0.3, 0.0, 7.7),
+            1.0,
+            false,
+            0.75,
+        ),
+        // The eye inside the sphere: the whole image shows its far side.
+        ("eye inside", Vec3::new(0.0, 0.0, 9.0), 3.0, true, 0.98),
+    ];
+    for (what, c, r, whole, share) in cases {
+        let mut scene = SphereScene::new(common::materials());
+        scene.push(c, r, 0);
+        let exact = render(
+            &scene,
+            &cam,
+            &Options::new(Method::Raycast, Lighting::default_for(&cam)),
+        );
+        let n_exact = exact.frame.coverage_count();
+        assert!(n_exact > 0, "{what}: raycast covers nothing");
+        for (m, depth) in [
+            (Method::Lut, TemplateDepth::Billboard),
+            (Method::Template, TemplateDepth::Billboard),
+            (Method::Template, TemplateDepth::DepthImage),
+        ] {
+            let mut o = Options::new(m, Lighting::default_for(&cam));
+            o.template_depth = depth;
+            let out = render(&scene, &cam, &o);
+            assert_eq!(out.stats.culled, 0, "{what} {m:?}");
+            assert_eq!(out.stats.drawn, 1, "{what} {m:?}");
+            let min = out
+                .frame
+                .depth
+                .iter()
+                .cloned()
+                .fold(f32::INFINITY, f32::min);
+            assert!(
+                min >= 2.0,
+                "{what} {m:?}: depth {min} nearer than the near plane 2"
+            );
+            // The pixels the exact method covers are covered (`share` of them).
+            let both = (0..exact.frame.len())
+                .filter(|&i| exact.frame.depth[i].is_finite() && out.frame.depth[i].is_finite())
+                .count();
+            assert!(
+                both as f64 >= share * n_exact as f64,
+                "{what} {m:?} {depth:?}: covers {both} of the {n_exact} pixels raycast covers, \
+                 expected ≥ {share}"
+            );
+            if whole {
+                assert_eq!(
+                    out.frame.coverage_count(),
+                    out.frame.len(),
+                    "{what} {m:?}: the whole image"
+                );
+            }
+        }
+    }
+}
