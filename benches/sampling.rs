@@ -6,6 +6,11 @@
 //! Map coordinates and derivatives are precomputed per pixel (Seed 000 Eq. 1–2), so only the
 //! sampling is timed.
 //!
+//! Cases: `nearest`, `bilinear`, `trilinear` through `sample_pixels` (trilinear runs four pixels
+//! per step in SIMD lanes); `trilinear_quads`, `span_k3`, `span_k4` through `sample_quads` (the
+//! span sampler runs four spans per step in lanes); `*_quad_api` one `sample_quad` call per quad,
+//! as the rasteriser calls it.
+//!
 //! Two groups: `sampling_*` measures wall-clock time (criterion's default); `sampling_cpu_*`
 //! measures the benchmark thread's CPU time (`CLOCK_THREAD_CPUTIME_ID`, Linux), which stays
 //! meaningful when other processes share the cores (time spent waiting for a core is not
@@ -190,6 +195,20 @@ fn run<M: Measurement>(c: &mut Criterion<M>, group: &str) {
         g.bench_function(name, |b| {
             b.iter(|| {
                 s.sample_quads(&tex, black_box(&quads), &mut qout).unwrap();
+                black_box(&qout);
+            })
+        });
+    }
+    // The per-quad API the rasteriser calls (one 2x2 quad per call).
+    for (name, s) in [
+        ("trilinear_quad_api", Sampler::Trilinear),
+        ("span_k3_quad_api", Sampler::Span(Banks::K3)),
+    ] {
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                for (o, q) in qout.iter_mut().zip(black_box(&quads)) {
+                    *o = s.sample_quad(&tex, *q);
+                }
                 black_box(&qout);
             })
         });
