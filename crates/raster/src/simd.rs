@@ -43,6 +43,34 @@ mod imp {
             // SAFETY: SSE2 is part of the x86-64 baseline, always enabled on this target.
             unsafe { I32x4(_mm_or_si128(self.0, o.0)) }
         }
+        #[inline(always)]
+        pub fn sub(self, o: I32x4) -> I32x4 {
+            // SAFETY: SSE2 is part of the x86-64 baseline, always enabled on this target.
+            unsafe { I32x4(_mm_sub_epi32(self.0, o.0)) }
+        }
+        #[inline(always)]
+        pub fn and(self, o: I32x4) -> I32x4 {
+            // SAFETY: SSE2 is part of the x86-64 baseline, always enabled on this target.
+            unsafe { I32x4(_mm_and_si128(self.0, o.0)) }
+        }
+        /// Arithmetic shift right by `N`.
+        #[inline(always)]
+        pub fn shr<const N: i32>(self) -> I32x4 {
+            // SAFETY: SSE2 is part of the x86-64 baseline, always enabled on this target.
+            unsafe { I32x4(_mm_srai_epi32::<N>(self.0)) }
+        }
+        /// Shift left by `N`.
+        #[inline(always)]
+        pub fn shl<const N: i32>(self) -> I32x4 {
+            // SAFETY: SSE2 is part of the x86-64 baseline, always enabled on this target.
+            unsafe { I32x4(_mm_slli_epi32::<N>(self.0)) }
+        }
+        /// Exact conversion of each lane to f32 (rounded to nearest above 2^24).
+        #[inline(always)]
+        pub fn to_f32(self) -> F32x4 {
+            // SAFETY: SSE2 is part of the x86-64 baseline, always enabled on this target.
+            unsafe { F32x4(_mm_cvtepi32_ps(self.0)) }
+        }
         /// The lanes' bits as f32 lanes.
         #[inline(always)]
         pub fn cast_f32(self) -> F32x4 {
@@ -144,6 +172,12 @@ mod imp {
             // SAFETY: SSE2 is part of the x86-64 baseline, always enabled on this target.
             unsafe { F32x4(_mm_andnot_ps(o.0, self.0)) }
         }
+        /// The lanes' bits as i32 lanes.
+        #[inline(always)]
+        pub fn cast_i32(self) -> I32x4 {
+            // SAFETY: SSE2 is part of the x86-64 baseline, always enabled on this target.
+            unsafe { I32x4(_mm_castps_si128(self.0)) }
+        }
         /// Truncation toward zero (lanes outside the i32 range give `i32::MIN`).
         #[inline(always)]
         pub fn trunc_i32(self) -> I32x4 {
@@ -228,6 +262,26 @@ mod imp {
         #[inline(always)]
         pub fn or(self, o: I32x4) -> I32x4 {
             I32x4(std::array::from_fn(|l| self.0[l] | o.0[l]))
+        }
+        #[inline(always)]
+        pub fn sub(self, o: I32x4) -> I32x4 {
+            I32x4(std::array::from_fn(|l| self.0[l].wrapping_sub(o.0[l])))
+        }
+        #[inline(always)]
+        pub fn and(self, o: I32x4) -> I32x4 {
+            I32x4(std::array::from_fn(|l| self.0[l] & o.0[l]))
+        }
+        #[inline(always)]
+        pub fn shr<const N: i32>(self) -> I32x4 {
+            I32x4(self.0.map(|v| v >> N))
+        }
+        #[inline(always)]
+        pub fn shl<const N: i32>(self) -> I32x4 {
+            I32x4(self.0.map(|v| v << N))
+        }
+        #[inline(always)]
+        pub fn to_f32(self) -> F32x4 {
+            F32x4(self.0.map(|v| v as f32))
         }
         #[inline(always)]
         pub fn cast_f32(self) -> F32x4 {
@@ -317,6 +371,10 @@ mod imp {
             }))
         }
         #[inline(always)]
+        pub fn cast_i32(self) -> I32x4 {
+            I32x4(self.0.map(|v| v.to_bits() as i32))
+        }
+        #[inline(always)]
         pub fn trunc_i32(self) -> I32x4 {
             I32x4(std::array::from_fn(|l| {
                 let v = self.0[l];
@@ -353,6 +411,52 @@ mod imp {
 }
 
 pub(crate) use imp::{F32x4, I32x4};
+
+/// `x^p` for four lanes with `x` in `[0, 1]` and `0 < p <= 65536`, as `exp2(p · log2 x)`:
+/// relative error below 1e-5 against `f32::powf` (tested); lanes with `x` below the smallest
+/// normal f32 give 0, as `powf` does up to its own rounding.
+///
+/// `log2 x = e + log2 m` with `m ∈ [√½, √2)`, `log2 m = 2/ln2 · atanh(t)`, `t = (m − 1)/(m + 1)`,
+/// odd series to `t⁹` (|t| < 0.172: truncation < 1e-9); `2^y = 2^n · 2^f` with
+/// `n = trunc(y − ½)`, `f ∈ (−½, ½]`, Taylor series of `e^(f·ln2)` to degree 7 (< 1e-8).
+#[inline(always)]
+pub(crate) fn pow4(x: F32x4, p: f32) -> F32x4 {
+    let s = F32x4::splat;
+    let i = I32x4::splat;
+    // Split x = 2^e · m, m in [1, 2), then fold m into [√½, √2).
+    let bits = x.cast_i32();
+    let e = bits.shr::<23>().sub(i(127));
+    let m = bits.and(i(0x007f_ffff)).or(i(0x3f80_0000)).cast_f32();
+    let big = s(std::f32::consts::SQRT_2).lt(m);
+    let m = F32x4::select(big, m.mul(s(0.5)), m);
+    let e = F32x4::select(big, e.to_f32().add(s(1.0)), e.to_f32());
+    // log2 m by the atanh series.
+    let t = m.sub(s(1.0)).div(m.add(s(1.0)));
+    let t2 = t.mul(t);
+    let c = |k: f32| s((2.0 / std::f64::consts::LN_2 / k as f64) as f32);
+    let poly = c(9.0)
+        .mul(t2)
+        .add(c(7.0))
+        .mul(t2)
+        .add(c(5.0))
+        .mul(t2)
+        .add(c(3.0))
+        .mul(t2)
+        .add(c(1.0));
+    let log2x = e.add(t.mul(poly));
+    // y = p · log2 x <= 0, clamped where 2^y is below the normal range anyway.
+    let y = s(p).mul(log2x).max(s(-126.0));
+    // 2^y = 2^n · 2^f.
+    let n = y.sub(s(0.5)).trunc_i32();
+    let f = y.sub(n.to_f32()).mul(s(std::f32::consts::LN_2));
+    let mut ef = s(1.0 / 5040.0);
+    for k in [720.0f32, 120.0, 24.0, 6.0, 2.0, 1.0, 1.0] {
+        ef = ef.mul(f).add(s(1.0 / k));
+    }
+    let two_n = n.add(i(127)).shl::<23>().cast_f32();
+    let r = ef.mul(two_n);
+    F32x4::select(s(f32::MIN_POSITIVE).le(x), r, s(0.0))
+}
 
 #[cfg(test)]
 mod tests {
@@ -394,5 +498,32 @@ mod tests {
             I32x4::new([-1, 2, -3, 4]).or(I32x4::splat(0)).neg_bits(),
             0b0101
         );
+    }
+
+    #[test]
+    fn pow4_matches_powf_within_1e_5() {
+        let mut worst = 0.0f64;
+        for p in [1.0f32, 2.5, 5.0, 40.0, 128.0, 1000.0, 65536.0] {
+            for k in 0..=4096u32 {
+                // Uniform in [0, 1] plus a dense set just below 1 and a few tiny values.
+                let xs = [
+                    k as f32 / 4096.0,
+                    1.0 - k as f32 * 1e-7,
+                    f32::MIN_POSITIVE * k as f32,
+                    1e-20 * k as f32,
+                ];
+                let got = pow4(F32x4::new(xs), p).to_array();
+                for (x, g) in xs.into_iter().zip(got) {
+                    let want = (x as f64).powf(p as f64);
+                    let err = (g as f64 - want).abs();
+                    let tol = 1e-5 * want + 1e-37;
+                    assert!(err <= tol, "{x}^{p}: expected {want} got {g} tol {tol}");
+                    if want > 1e-30 {
+                        worst = worst.max(err / want);
+                    }
+                }
+            }
+        }
+        assert!(worst > 0.0 && worst < 1e-5, "worst relative error {worst}");
     }
 }
