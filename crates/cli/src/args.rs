@@ -86,15 +86,137 @@ pub enum MethodArg {
 
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ColorBy {
-    /// Element colours (CPK/Jmol), from element columns or atom names.
-    Element,
-    /// One distinct colour per atom type/name.
-    Type,
-    /// Per-atom colour columns in the file (extended XYZ, LAMMPS dump), element colours otherwise.
+    /// The file's per-atom colour columns (extended XYZ `color`, LAMMPS dump `ColorR ColorG
+    /// ColorB`) where it has them, else --type-color, else element colours.
     Property,
+    /// --type-color, else element colours (CPK/Jmol); colour columns in the file are ignored.
+    Element,
+    /// --type-color, else one distinct colour per atom type (or name).
+    Type,
+}
+
+/// `--type-radius NAME=R`: the radius in Å of the atoms NAME selects.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TypeRadius {
+    pub name: String,
+    pub radius: f32,
+}
+
+/// `--type-color NAME=COLOUR`: the colour (8-bit sRGB) of the atoms NAME selects.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TypeColor {
+    pub name: String,
+    pub rgb: [u8; 3],
+}
+
+/// Longest NAME: md-io keeps types and names in 15-byte labels.
+const MAX_NAME: usize = texmap_md_io::Label::CAPACITY;
+
+/// Splits `NAME=VALUE`, checking NAME.
+fn name_value(s: &str) -> Result<(&str, &str), String> {
+    let Some((name, value)) = s.split_once('=') else {
+        return Err("expected NAME=VALUE".into());
+    };
+    let name = name.trim();
+    if name.is_empty() {
+        return Err("NAME before '=' is empty".into());
+    }
+    if name.len() > MAX_NAME || name.chars().any(char::is_whitespace) {
+        return Err(format!(
+            "NAME {name:?} must be one word of at most {MAX_NAME} bytes (a type, atom name or element)"
+        ));
+    }
+    Ok((name, value.trim()))
+}
+
+/// Parses `--type-radius NAME=R` (R in Å, finite and > 0).
+pub fn parse_type_radius(s: &str) -> Result<TypeRadius, String> {
+    let (name, value) = name_value(s)?;
+    match value.parse::<f32>() {
+        Ok(r) if r.is_finite() && r > 0.0 => Ok(TypeRadius {
+            name: name.into(),
+            radius: r,
+        }),
+        _ => Err(format!(
+            "radius {value:?} is not a number > 0 (Å), e.g. --type-radius O=1.4"
+        )),
+    }
+}
+
+/// Parses a colour: `#rrggbb` (hex) or `R,G,B` with each 0-255, as --background.
+pub fn parse_color(value: &str) -> Result<[u8; 3], String> {
+    let bad = || {
+        format!(
+            "colour {value:?}: expected #rrggbb (e.g. #ff8000) or R,G,B with each 0-255 (e.g. 255,128,0)"
+        )
+    };
+    if let Some(hex) = value.strip_prefix('#') {
+        if hex.len() != 6 || !hex.bytes().all(|b| b.is_ascii_hexdigit()) {
+            return Err(bad());
+        }
+        let ch = |k: usize| u8::from_str_radix(&hex[2 * k..2 * k + 2], 16).map_err(|_| bad());
+        return Ok([ch(0)?, ch(1)?, ch(2)?]);
+    }
+    let parts: Vec<Option<u8>> = value.split(',').map(|p| p.trim().parse().ok()).collect();
+    match parts.as_slice() {
+        [Some(r), Some(g), Some(b)] => Ok([*r, *g, *b]),
+        _ => Err(bad()),
+    }
+}
+
+/// Parses `--type-color NAME=#rrggbb|R,G,B`.
+pub fn parse_type_color(s: &str) -> Result<TypeColor, String> {
+    let (name, value) = name_value(s)?;
+    Ok(TypeColor {
+        name: name.into(),
+        rgb: parse_color(value)?,
+    })
+}
+
+/// How atoms look: shared by `render` and `compare FILE`.
+#[derive(Args, Clone, Debug)]
+#[command(next_help_heading = "Atom style")]
+pub struct StyleArgs {
+    /// How atoms are coloured.
+    #[arg(long, value_enum, default_value_t = ColorBy::Property)]
+    pub color_by: ColorBy,
+    /// Multiply every atom radius (file column, --type-radius or table) by S.
+    #[arg(long, default_value_t = 1.0, value_name = "S")]
+    pub radius_scale: f32,
+    /// Radius in Å of the atoms NAME selects; repeatable. NAME is a type (LAMMPS `type`), an atom
+    /// name or an element symbol. Example: --type-radius 1=0.8 --type-radius O=1.4
+    #[arg(
+        long,
+        value_name = "NAME=R",
+        value_parser = parse_type_radius,
+        long_help = "Radius in Å of the atoms NAME selects; repeatable.\n\
+NAME is matched against each atom's type (LAMMPS `type`), its name (PDB/GRO atom name, XYZ\n\
+species) and its element (a symbol, any case): an atom takes the rule of its type first, then\n\
+of its name, then of its element. A radius column in the file (`radius`, LAMMPS `diameter`)\n\
+wins over this flag. --radius-scale multiplies the result.\n\
+Examples: --type-radius 1=0.8 --type-radius 2=1.2 (LAMMPS types 1 and 2)\n          \
+--type-radius O=1.4 (every oxygen)   --type-radius CA=2.0 (atoms named CA)"
+    )]
+    pub type_radius: Vec<TypeRadius>,
+    /// Colour of the atoms NAME selects, #rrggbb or R,G,B (0-255); repeatable. NAME as for
+    /// --type-radius. Example: --type-color 1=#ff8000 --type-color O=255,0,0
+    #[arg(
+        long,
+        value_name = "NAME=COLOUR",
+        value_parser = parse_type_color,
+        long_help = "Colour of the atoms NAME selects, #rrggbb or R,G,B (each 0-255, sRGB); repeatable.\n\
+NAME is matched as for --type-radius (type, then name, then element). With --color-by\n\
+property (the default) a colour column in the file (extended XYZ `color`, LAMMPS `ColorR\n\
+ColorG ColorB`) wins over this flag; with --color-by element this flag wins over the element\n\
+colours; with --color-by type over the per-type palette.\n\
+Examples: --type-color 1=#ff8000 --type-color 2=40,40,255 (LAMMPS types 1 and 2)\n          \
+--type-color C=#909090 --type-color CA=#00ff00 (alpha carbons green, other carbons grey)"
+    )]
+    pub type_color: Vec<TypeColor>,
 }
 
 #[derive(Args, Debug)]
+#[command(after_help = RENDER_AFTER_HELP)]
 pub struct RenderArgs {
     /// Trajectory file.
     pub file: PathBuf,
@@ -128,12 +250,6 @@ pub struct RenderArgs {
     /// Up direction X,Y,Z.
     #[arg(long, allow_hyphen_values = true)]
     pub up: Option<String>,
-    /// How atoms are coloured.
-    #[arg(long, value_enum, default_value_t = ColorBy::Element)]
-    pub color_by: ColorBy,
-    /// Multiply every atom radius by S.
-    #[arg(long, default_value_t = 1.0)]
-    pub radius_scale: f32,
     /// Background colour R,G,B (0-255).
     #[arg(long, default_value = "0,0,0")]
     pub background: String,
@@ -146,7 +262,27 @@ pub struct RenderArgs {
     /// Output PNG; may hold a %04d frame-number pattern. Without one, several frames get _NNNN.
     #[arg(short, long)]
     pub output: PathBuf,
+    /// How atoms look (last: its help heading applies to the fields after it).
+    #[command(flatten)]
+    pub style: StyleArgs,
 }
+
+/// How an atom's look is chosen and examples, after `texmap render --help`.
+const RENDER_AFTER_HELP: &str = "\
+How each atom's look is chosen (the first that applies):
+  colour: the file's colour column (--color-by property, the default; extended XYZ `color`,
+          LAMMPS dump `ColorR ColorG ColorB` or `Color.R ...` as OVITO names them; values are
+          fractions of 1, clamped to [0, 1]) > --type-color > element colour (CPK/Jmol), or one
+          colour per type with --color-by type
+  radius: the file's radius column (`radius`, LAMMPS `diameter` / 2) > --type-radius >
+          van der Waals radius of the element; then times --radius-scale
+  A NAME rule matches the atom's type first, then its name, then its element.
+
+Examples:
+  texmap render traj.pdb --frames 0:100:10 --size 1280x720 -o frames/f%04d.png
+  texmap render dump.lammpstrj --type-color 1=#ff8000 --type-color 2=40,40,255 --type-radius 2=0.6 -o f.png
+  texmap render water.gro --color-by element --type-color OW=#ff0000 --radius-scale 0.5 -o w.png
+  texmap render md.xyz --eye 0,0,50 --target 0,0,0 --up 0,1,0 --fov 30 --depth -o md.png";
 
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SceneArg {
@@ -162,7 +298,11 @@ pub struct CompareArgs {
     pub file: Option<PathBuf>,
     /// A built-in scene: S1 (Seed 004 system, 1,115 atoms, 500x500), S2 (100k spheres, 1080p),
     /// S3 (1M spheres, 1080p), molecule (~300 atoms, Seed 002).
-    #[arg(long, value_enum, conflicts_with = "file")]
+    #[arg(
+        long,
+        value_enum,
+        conflicts_with_all = ["file", "color_by", "radius_scale", "type_radius", "type_color"]
+    )]
     pub scene: Option<SceneArg>,
     /// Output directory for results.csv, results.json, images and charts.
     #[arg(long)]
@@ -176,4 +316,48 @@ pub struct CompareArgs {
     /// Image size WxH for a trajectory file.
     #[arg(long, default_value = "800x600")]
     pub size: String,
+    /// How a trajectory file's atoms look (not with --scene).
+    #[command(flatten)]
+    pub style: StyleArgs,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn type_values_parse_or_explain() {
+        assert_eq!(
+            parse_type_radius(" 1 = 0.75 ").unwrap(),
+            TypeRadius {
+                name: "1".into(),
+                radius: 0.75
+            }
+        );
+        assert_eq!(parse_type_color("CA=#00Ff80").unwrap().rgb, [0, 255, 128]);
+        assert_eq!(parse_type_color("2=1, 2 ,3").unwrap().rgb, [1, 2, 3]);
+        for bad in [
+            "O",
+            "=1",
+            "O=0",
+            "O=-2",
+            "O=inf",
+            "a b=1",
+            "ABCDEFGHIJKLMNOP=1",
+        ] {
+            assert!(parse_type_radius(bad).is_err(), "{bad}");
+        }
+        for bad in [
+            "O=#fff",
+            "O=#ff00000",
+            "O=#xx0000",
+            "O=256,0,0",
+            "O=1,2",
+            "O=0.5,0,0",
+            "O=",
+        ] {
+            let e = parse_type_color(bad).unwrap_err();
+            assert!(!e.is_empty(), "{bad}");
+        }
+    }
 }

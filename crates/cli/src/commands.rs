@@ -153,7 +153,7 @@ fn render(a: &RenderArgs) -> Result<()> {
     }
     let frames = parse_frames(&a.frames, n)?;
     let multi = frames.len() > 1;
-    let mut builder = SceneBuilder::new(a.color_by, a.radius_scale)?;
+    let mut builder = SceneBuilder::new(&a.style)?;
     let mut md = MdFrame::new();
     let mut scene = SphereScene::default();
     let mut renderer = Renderer::new();
@@ -169,6 +169,10 @@ fn render(a: &RenderArgs) -> Result<()> {
         let cam = match &camera {
             Some(c) => c.clone(),
             None => {
+                // First frame: the camera, and warnings about the style flags.
+                for w in builder.warnings(&md) {
+                    pb.suspend(|| eprintln!("texmap: warning: {w}"));
+                }
                 let c = camera_for(a, &md, &scene)?;
                 camera = Some(c.clone());
                 c
@@ -200,6 +204,14 @@ fn render(a: &RenderArgs) -> Result<()> {
         pb.inc(1);
     }
     pb.finish_and_clear();
+    if builder.merged_colors() > 0 {
+        eprintln!(
+            "texmap: warning: {} more distinct colours than the {} materials a scene holds; each was drawn with the nearest of the first {}",
+            builder.merged_colors(),
+            crate::scene::MAX_MATERIALS,
+            crate::scene::MAX_MATERIALS
+        );
+    }
     if skipped_total > 0 {
         eprintln!(
             "texmap: warning: {skipped_total} atoms skipped over {} frames (non-finite position or radius)",
@@ -247,15 +259,18 @@ fn named_scene(a: &CompareArgs) -> Result<NamedScene> {
             Ok(scenes::build(id))
         }
         (None, Some(file)) => {
-            // The first frame of the file, coloured by element, with the automatic camera.
+            // The first frame of the file, styled as `render` would, with the automatic camera.
+            let mut builder = SceneBuilder::new(&a.style)?;
             let mut traj = open_trajectory(file, None)?;
             let mut md = MdFrame::new();
             if !traj.read_next(&mut md)? {
                 bail!("{}: the file holds no frame", file.display());
             }
-            let mut builder = SceneBuilder::new(crate::args::ColorBy::Element, 1.0)?;
             let mut spheres = SphereScene::default();
             builder.build(&mut md, &mut spheres);
+            for w in builder.warnings(&md) {
+                eprintln!("texmap: warning: {w}");
+            }
             let render_args = RenderArgs {
                 file: file.clone(),
                 format: None,
@@ -268,8 +283,7 @@ fn named_scene(a: &CompareArgs) -> Result<NamedScene> {
                 eye: None,
                 target: None,
                 up: None,
-                color_by: crate::args::ColorBy::Element,
-                radius_scale: 1.0,
+                style: a.style.clone(),
                 background: "0,0,0".into(),
                 box_outline: false,
                 depth: false,

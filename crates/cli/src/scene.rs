@@ -1,22 +1,36 @@
 //! Glue: an md-io frame (atoms in Å) becomes an impostor `SphereScene`, and a camera is chosen.
 
+use std::collections::HashMap;
+
 use anyhow::{Context, Result};
 use glam::Vec3;
 use texmap_core::camera::Camera;
 use texmap_core::color::{hsv_to_rgb, srgb_to_linear};
 use texmap_core::shade::Material;
 use texmap_impostor::SphereScene;
-use texmap_md_io::{AtomStyle, Frame};
+use texmap_md_io::{Appearance, AtomStyle, Element, Frame, Label, Selector, atom_element};
 
-use crate::args::{ColorBy, RenderArgs, usage};
+use crate::args::{ColorBy, RenderArgs, StyleArgs, usage};
+
+/// Most materials a scene gets: every method handles this many cheaply (the LUT and template
+/// methods build tables per material). Colours past the first `MAX_MATERIALS` distinct ones
+/// (after 8-bit quantisation) are drawn with the nearest of those.
+pub const MAX_MATERIALS: usize = 256;
 
 /// Reusable conversion from md-io frames to sphere scenes: one material per distinct colour,
 /// kept stable across frames so per-material tables survive from frame to frame.
 pub struct SceneBuilder {
     style: AtomStyle,
     color_by: ColorBy,
-    palette: Vec<[u32; 3]>,
-    types: Vec<String>,
+    radius_scale: f32,
+    /// The NAMEs of --type-radius / --type-color, for the no-match warning.
+    names: Vec<(&'static str, String)>,
+    palette: Vec<[u8; 3]>,
+    /// 8-bit colour -> material (exact, or the nearest palette entry once the palette is full).
+    kinds: HashMap<[u8; 3], u16>,
+    /// Distinct colours drawn with a nearest palette entry.
+    merged: usize,
+    types: Vec<Label>,
     radii: Vec<f32>,
     colors: Vec<[f32; 3]>,
 }
@@ -27,45 +41,167 @@ fn type_color(i: usize) -> [f32; 3] {
     [c.x, c.y, c.z]
 }
 
-impl SceneBuilder {
-    pub fn new(color_by: ColorBy, radius_scale: f32) -> Result<SceneBuilder> {
-        let mut style = AtomStyle::new();
-        if !(radius_scale.is_finite() && radius_scale > 0.0) {
-            return usage(format!(
-                "--radius-scale must be finite and > 0, got {radius_scale}"
-            ));
+/// The selectors a NAME of --type-radius / --type-color stands for: the type and the atom name
+/// NAME, and the element whose symbol NAME is (any case), if any.
+fn selectors(name: &str) -> Result<Vec<Selector>> {
+    let Some(label) = Label::new(name) else {
+        return usage(format!(
+            "NAME {name:?} is longer than {} bytes",
+            Label::CAPACITY
+        ));
+    };
+    let mut v = vec![Selector::Type(label), Selector::Name(label)];
+    if let Some(e) = Element::from_symbol(name) {
+        v.push(Selector::Element(e));
+    }
+    Ok(v)
+}
+
+/// The md-io style for the CLI flags: one rule per selector, later flags replacing earlier
+/// ones field by field (so `--type-radius O=1 --type-color O=#f00` sets both).
+pub fn style_from(args: &StyleArgs) -> Result<AtomStyle> {
+    let mut rules: Vec<(Selector, Appearance)> = Vec::new();
+    let mut merge = |sel: Selector, look: Appearance| match rules.iter_mut().find(|r| r.0 == sel) {
+        Some(r) => {
+            r.1.radius = look.radius.or(r.1.radius);
+            r.1.color = look.color.or(r.1.color);
         }
-        style.set_radius_scale(radius_scale)?;
+        None => rules.push((sel, look)),
+    };
+    for t in &args.type_radius {
+        for sel in selectors(&t.name)? {
+            merge(
+                sel,
+                Appearance {
+                    radius: Some(t.radius),
+                    color: None,
+                },
+            );
+        }
+    }
+    for t in &args.type_color {
+        for sel in selectors(&t.name)? {
+            merge(
+                sel,
+                Appearance {
+                    radius: None,
+                    color: Some(t.rgb.map(|c| c as f32 / 255.0)),
+                },
+            );
+        }
+    }
+    let mut style = AtomStyle::new();
+    for (sel, look) in rules {
+        style
+            .set(sel, look)
+            .map_err(|e| crate::args::UsageError(format!("--type-radius/--type-color: {e}")))?;
+    }
+    Ok(style)
+}
+
+impl SceneBuilder {
+    pub fn new(args: &StyleArgs) -> Result<SceneBuilder> {
+        let s = args.radius_scale;
+        if !(s.is_finite() && s > 0.0) {
+            return usage(format!("--radius-scale {s}: must be a finite number > 0"));
+        }
+        let names = args
+            .type_radius
+            .iter()
+            .map(|t| ("--type-radius", t.name.clone()))
+            .chain(
+                args.type_color
+                    .iter()
+                    .map(|t| ("--type-color", t.name.clone())),
+            )
+            .collect();
         Ok(SceneBuilder {
-            style,
-            color_by,
+            style: style_from(args)?,
+            color_by: args.color_by,
+            radius_scale: s,
+            names,
             palette: Vec::new(),
+            kinds: HashMap::new(),
+            merged: 0,
             types: Vec::new(),
             radii: Vec::new(),
             colors: Vec::new(),
         })
     }
 
+    /// The material of an sRGB colour in [0, 1] (quantised to 8 bits per channel).
     fn kind_of(&mut self, srgb: [f32; 3]) -> u16 {
-        // Quantise to 8 bits per channel so near-identical colours share a material.
-        let key = srgb.map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u32);
-        match self.palette.iter().position(|p| *p == key) {
-            Some(i) => i as u16,
-            None => {
-                self.palette.push(key);
-                (self.palette.len() - 1) as u16
+        let key = srgb.map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8);
+        if let Some(k) = self.kinds.get(&key) {
+            return *k;
+        }
+        let k = if self.palette.len() < MAX_MATERIALS {
+            // A new material for a new colour.
+            self.palette.push(key);
+            (self.palette.len() - 1) as u16
+        } else {
+            // Palette full: the nearest entry (squared 8-bit distance, lowest index on ties).
+            self.merged += 1;
+            let d2 =
+                |p: &[u8; 3]| -> i32 { (0..3).map(|c| (p[c] as i32 - key[c] as i32).pow(2)).sum() };
+            let mut best = 0;
+            for (i, p) in self.palette.iter().enumerate() {
+                if d2(p) < d2(&self.palette[best]) {
+                    best = i;
+                }
+            }
+            best as u16
+        };
+        self.kinds.insert(key, k);
+        k
+    }
+
+    /// Distinct colours so far drawn with the nearest of the first [`MAX_MATERIALS`].
+    pub fn merged_colors(&self) -> usize {
+        self.merged
+    }
+
+    /// Warnings worth one line each about `frame` (the first one rendered): a --type-radius or
+    /// --type-color NAME that selects no atom; colour-column values outside [0, 1].
+    pub fn warnings(&self, frame: &Frame) -> Vec<String> {
+        let mut out = Vec::new();
+        for (flag, name) in &self.names {
+            let element = Element::from_symbol(name);
+            let hit = frame.types.iter().any(|t| t.as_str() == name)
+                || frame.names.iter().any(|n| n.as_str() == name)
+                || element
+                    .is_some_and(|e| (0..frame.n_atoms()).any(|i| atom_element(frame, i) == e));
+            if !hit {
+                out.push(format!(
+                    "{flag} {name}: no atom of the first frame has this type, name or element"
+                ));
             }
         }
+        if self.color_by == ColorBy::Property {
+            let outside = frame
+                .colors
+                .iter()
+                .flatten()
+                .filter(|v| !(0.0..=1.0).contains(*v))
+                .count();
+            if outside > 0 {
+                out.push(format!(
+                    "{outside} colour-column values of the first frame are outside [0, 1] and were clamped (colours are fractions of 1, not 0-255)"
+                ));
+            }
+        }
+        out
     }
 
     /// Fill `scene` (cleared first) from `frame` (whose colour column is dropped unless colouring
-    /// by property). Atoms with non-finite coordinates are kept as
-    /// they are: the renderers skip and count them.
+    /// by property). Atoms with non-finite coordinates are kept as they are: the renderers skip
+    /// and count them.
     pub fn build(&mut self, frame: &mut Frame, scene: &mut SphereScene) {
         if self.color_by != ColorBy::Property {
             // Element and type colouring ignore colour columns in the file.
             frame.colors.clear();
         }
+        // Radius and colour per atom: file column > --type-* rule > element table.
         self.style.apply(frame, &mut self.radii, &mut self.colors);
         scene.centers.clear();
         scene.radii.clear();
@@ -74,26 +210,30 @@ impl SceneBuilder {
         for i in 0..frame.n_atoms() {
             let p = frame.positions[i];
             let color = match self.color_by {
-                ColorBy::Type => {
-                    let label = frame
-                        .types
-                        .get(i)
-                        .or(frame.names.get(i))
-                        .map(|l| l.as_str().to_string())
-                        .unwrap_or_default();
-                    let idx = match self.types.iter().position(|t| *t == label) {
-                        Some(j) => j,
-                        None => {
-                            self.types.push(label);
-                            self.types.len() - 1
-                        }
-                    };
-                    type_color(idx)
-                }
+                ColorBy::Type => match self.style.rules_for(frame, i).color {
+                    Some(c) => c,
+                    None => {
+                        // One palette colour per type (or name), in order of appearance.
+                        let label = frame
+                            .types
+                            .get(i)
+                            .or(frame.names.get(i))
+                            .copied()
+                            .unwrap_or_default();
+                        let idx = match self.types.iter().position(|t| *t == label) {
+                            Some(j) => j,
+                            None => {
+                                self.types.push(label);
+                                self.types.len() - 1
+                            }
+                        };
+                        type_color(idx)
+                    }
+                },
                 _ => self.colors[i],
             };
             let kind = self.kind_of(color);
-            scene.push(Vec3::from(p), self.radii[i], kind);
+            scene.push(Vec3::from(p), self.radii[i] * self.radius_scale, kind);
         }
         scene.materials = self
             .palette
@@ -265,5 +405,73 @@ mod tests {
             Vec3::new(1.0, -2.5, 3.0)
         );
         assert!(parse_vec3("1,nan,3", "x").is_err());
+    }
+
+    fn style_args(radius: &[(&str, f32)], color: &[(&str, [u8; 3])]) -> StyleArgs {
+        StyleArgs {
+            color_by: ColorBy::Property,
+            radius_scale: 1.0,
+            type_radius: radius
+                .iter()
+                .map(|(n, r)| crate::args::TypeRadius {
+                    name: n.to_string(),
+                    radius: *r,
+                })
+                .collect(),
+            type_color: color
+                .iter()
+                .map(|(n, c)| crate::args::TypeColor {
+                    name: n.to_string(),
+                    rgb: *c,
+                })
+                .collect(),
+        }
+    }
+
+    #[test]
+    fn type_flags_merge_per_selector_and_match_type_name_or_element() {
+        // "O" as radius and "o" as colour: both reach the oxygen element rule.
+        let st = style_from(&style_args(&[("O", 1.0)], &[("o", [255, 0, 0])])).unwrap();
+        let mut f = Frame::new();
+        f.positions = vec![[0.0; 3]; 2];
+        f.names = ["OW", "O"].map(|s| Label::new(s).unwrap()).to_vec();
+        let look = st.rules_for(&f, 0);
+        assert_eq!(look.radius, Some(1.0), "element rule radius for OW");
+        assert_eq!(
+            look.color,
+            Some([1.0, 0.0, 0.0]),
+            "element rule colour for OW"
+        );
+        // Atom named exactly "O": the name rule (radius only) then the element rule (colour).
+        assert_eq!(st.rules_for(&f, 1).radius, Some(1.0));
+        assert_eq!(st.rules_for(&f, 1).color, Some([1.0, 0.0, 0.0]));
+    }
+
+    #[test]
+    fn palette_is_capped_and_overflow_colours_take_the_nearest() {
+        let mut b = SceneBuilder::new(&style_args(&[], &[])).unwrap();
+        // MAX_MATERIALS distinct greys 0..=255 fill the palette exactly.
+        for g in 0..MAX_MATERIALS {
+            let v = g as f32 / 255.0;
+            assert_eq!(b.kind_of([v, v, v]) as usize, g);
+        }
+        assert_eq!(b.merged_colors(), 0);
+        // Pure red is nearest (squared 8-bit distance, computed here by brute force) to the grey
+        // g minimising (255 − g)² + 2g²: g = 85.
+        let best = (0..256i32)
+            .min_by_key(|g| (255 - g).pow(2) + 2 * g * g)
+            .unwrap();
+        assert_eq!(best, 85);
+        assert_eq!(b.kind_of([1.0, 0.0, 0.0]) as usize, best as usize);
+        assert_eq!(b.merged_colors(), 1);
+        // Asked again: same material, counted once.
+        assert_eq!(b.kind_of([1.0, 0.0, 0.0]) as usize, best as usize);
+        assert_eq!(b.merged_colors(), 1);
+        // The palette never grows past the cap, so u16 kinds cannot wrap.
+        for i in 0..5000u32 {
+            let c = [(i % 97) as f32 / 96.0, (i % 89) as f32 / 88.0, 0.5];
+            assert!((b.kind_of(c) as usize) < MAX_MATERIALS);
+        }
+        assert_eq!(b.palette.len(), MAX_MATERIALS);
     }
 }

@@ -310,6 +310,23 @@ pub fn guess_element(name: &str, residue: Option<&str>, explicit: Option<&str>) 
     first.or(two).unwrap_or(Element::UNKNOWN)
 }
 
+/// The element atom `i` of `frame` is drawn as: its `elements` entry when that is known, else
+/// the element [`guess_element`] tells from its name (with its residue) or, without names, from
+/// its type; [`Element::UNKNOWN`] when none does (or `i` is out of range).
+pub fn atom_element(frame: &Frame, i: usize) -> Element {
+    match frame.elements.get(i) {
+        Some(e) if !e.is_unknown() => *e,
+        _ => {
+            let res = frame.res_names.get(i).map(|r| r.as_str());
+            match (frame.names.get(i), frame.types.get(i)) {
+                (Some(n), _) => guess_element(n, res, None),
+                (None, Some(t)) => guess_element(t, None, None),
+                (None, None) => Element::UNKNOWN,
+            }
+        }
+    }
+}
+
 /// What a user sets for a selection of atoms: radius (Å) and/or colour (sRGB in [0, 1]).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Appearance {
@@ -412,6 +429,25 @@ impl AtomStyle {
         self.rules.iter().find(|(s, _)| *s == sel).map(|(_, a)| a)
     }
 
+    /// The look the rules alone give atom `i` (step 2 of the type doc: the type rule, then the
+    /// name rule, then the element rule, radius and colour each from the first rule that sets
+    /// it), without file columns or tables; `None` fields where no rule applies.
+    pub fn rules_for(&self, frame: &Frame, i: usize) -> Appearance {
+        let sels = [
+            frame.types.get(i).copied().map(Selector::Type),
+            frame.names.get(i).copied().map(Selector::Name),
+            Some(Selector::Element(atom_element(frame, i))),
+        ];
+        let mut look = Appearance::default();
+        for sel in sels.into_iter().flatten() {
+            if let Some(a) = self.rule(sel) {
+                look.radius = look.radius.or(a.radius);
+                look.color = look.color.or(a.color);
+            }
+        }
+        look
+    }
+
     /// Radius (Å) and colour (sRGB in [0, 1]) of atom `i` of `frame`, by the order in the type doc.
     /// `i` must be < `frame.n_atoms()`; an out-of-range `i` gets the unknown-element look.
     pub fn resolve(&self, frame: &Frame, i: usize) -> (f32, [f32; 3]) {
@@ -423,37 +459,22 @@ impl AtomStyle {
             .filter(|c| c.iter().all(|v| v.is_finite()))
             .map(|c| c.map(|v| v.clamp(0.0, 1.0)));
         // Rules: type, then name, then element.
-        let ty = frame.types.get(i).copied();
-        let name = frame.names.get(i).copied();
-        let element = match frame.elements.get(i) {
-            Some(e) if !e.is_unknown() => *e,
-            _ => {
-                let res = frame.res_names.get(i).map(|r| r.as_str());
-                match (name, ty) {
-                    (Some(n), _) => guess_element(&n, res, None),
-                    (None, Some(t)) => guess_element(&t, None, None),
-                    (None, None) => Element::UNKNOWN,
-                }
-            }
-        };
-        let sels = [
-            ty.map(Selector::Type),
-            name.map(Selector::Name),
-            Some(Selector::Element(element)),
-        ];
-        for sel in sels.into_iter().flatten() {
-            if radius.is_some() && color.is_some() {
-                break;
-            }
-            if let Some(a) = self.rule(sel) {
-                radius = radius.or(a.radius);
-                color = color.or(a.color);
-            }
+        if radius.is_none() || color.is_none() {
+            let look = self.rules_for(frame, i);
+            radius = radius.or(look.radius);
+            color = color.or(look.color);
         }
         // Table, with the unknown-element look built into the table accessors.
-        let radius = radius.unwrap_or_else(|| element.vdw_radius() * self.radius_scale);
-        let color = color.unwrap_or_else(|| element.color());
-        (radius, color)
+        match (radius, color) {
+            (Some(r), Some(c)) => (r, c),
+            (r, c) => {
+                let element = atom_element(frame, i);
+                (
+                    r.unwrap_or_else(|| element.vdw_radius() * self.radius_scale),
+                    c.unwrap_or_else(|| element.color()),
+                )
+            }
+        }
     }
 
     /// Fills `radii` and `colors` (cleared first) with every atom's look, allocation-free once
@@ -549,6 +570,17 @@ mod tests {
         assert_eq!(st.resolve(&f, 0), (2.0, [0.0, 0.0, 1.0]));
         // Atom 1: table radius for H, name rule colour.
         assert_eq!(st.resolve(&f, 1), (1.2, [1.0, 0.0, 0.0]));
+        // The rules alone, without file columns: atom 0 has the type radius and element colour.
+        assert_eq!(
+            st.rules_for(&f, 0),
+            Appearance {
+                radius: Some(2.0),
+                color: Some([0.0, 0.0, 1.0])
+            }
+        );
+        assert_eq!(st.rules_for(&f, 2), Appearance::default());
+        assert_eq!(atom_element(&f, 2), el("C"));
+        assert_eq!(atom_element(&f, 9), Element::UNKNOWN);
         // Atom 2: table for C.
         assert_eq!(st.resolve(&f, 2), (1.77, el("C").color()));
         // File columns win over everything.

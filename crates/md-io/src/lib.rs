@@ -61,7 +61,7 @@ mod writer;
 mod xtc;
 mod xyz;
 
-pub use elements::{Appearance, AtomStyle, Element, Selector};
+pub use elements::{Appearance, AtomStyle, Element, Selector, atom_element};
 pub use error::{Error, Location};
 pub use format::Format;
 pub use frame::{Frame, Label, UnitCell};
