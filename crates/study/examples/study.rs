@@ -45,7 +45,7 @@ fn main() -> Result<(), Box<dyn Error>> {
     std::fs::create_dir_all(&out)?;
 
     // 1. Every method on the named scenes.
-    let mut ids = vec![SceneId::S1, SceneId::Molecule];
+    let mut ids = vec![SceneId::S1, SceneId::Molecule, SceneId::MoleculeBallStick];
     if big {
         ids.extend([SceneId::S2, SceneId::S3]);
     }

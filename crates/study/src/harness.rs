@@ -12,8 +12,11 @@
 //! 3. compares each frame with the reference through [`texmap_core::metrics`]: PSNR and SSIM of
 //!    the 8-bit sRGB colour, depth error over the pixels both cover, silhouette mismatch.
 //!
-//! Bonds are not drawn (`Options::draw_bonds = false`) and not traced: in the space-filling
-//! scenes they lie inside the atoms, and not every method draws them.
+//! Bonds are drawn and traced only in scenes that ask for it ([`NamedScene::draw_bonds`], the
+//! ball-and-stick molecule): every method then draws them with the shared exact cylinder pass and
+//! the reference traces each bond as two capped half-cylinders in the two atoms' materials
+//! ([`reference_scene_with_bonds`]). In the space-filling scenes they lie inside the atoms and
+//! are neither drawn nor traced.
 //!
 //! Everything returns data; files are written only by the explicit `write_*` functions, which
 //! take a directory.
@@ -132,6 +135,14 @@ pub fn compare(frame: &Frame, reference: &Frame) -> Result<Metrics, StudyError> 
 /// Invalid spheres (non-finite, non-positive radius) are skipped by the builder, as the methods
 /// skip them; spheres of an unknown kind are left out here for the same reason.
 pub fn reference_scene(spheres: &SphereScene) -> texmap_reftrace::Scene {
+    reference_scene_with_bonds(spheres, false)
+}
+
+/// [`reference_scene`] plus, when `bonds` is set, every drawable bond of `spheres` as two capped
+/// cylinders of radius `bond_radius`, from each atom's centre to the bond's midpoint in that
+/// atom's material (half-bond colouring, as the methods draw it). Bonds the methods skip (an
+/// index out of range, an invalid atom, coincident centres, a bad radius) are left out.
+pub fn reference_scene_with_bonds(spheres: &SphereScene, bonds: bool) -> texmap_reftrace::Scene {
     let mut b = SceneBuilder::with_sphere_capacity(spheres.len());
     for i in 0..spheres.len() {
         if (spheres.kinds[i] as usize) < spheres.materials.len() {
@@ -140,6 +151,23 @@ pub fn reference_scene(spheres: &SphereScene) -> texmap_reftrace::Scene {
                 spheres.radii[i],
                 spheres.kinds[i] as u32,
             );
+        }
+    }
+    let r = spheres.bond_radius;
+    if bonds && r.is_finite() && r > 0.0 {
+        for &[i, j] in &spheres.bonds {
+            let (i, j) = (i as usize, j as usize);
+            if i < spheres.len()
+                && j < spheres.len()
+                && spheres.is_valid(i)
+                && spheres.is_valid(j)
+                && spheres.centers[i] != spheres.centers[j]
+            {
+                let (pa, pb) = (spheres.centers[i], spheres.centers[j]);
+                let mid = (pa + pb) * 0.5;
+                b.add_cylinder(pa, mid, r, spheres.kinds[i] as u32);
+                b.add_cylinder(mid, pb, r, spheres.kinds[j] as u32);
+            }
         }
     }
     b.build()
@@ -198,7 +226,7 @@ impl Default for HarnessOptions {
 }
 
 /// The options every method is drawn with in the study: the method's defaults, the scene's
-/// lighting, no bonds.
+/// lighting, no bonds (the harness turns them on for scenes with [`NamedScene::draw_bonds`]).
 pub fn study_options(method: Method, lighting: Lighting) -> Options {
     let mut o = Options::new(method, lighting);
     o.draw_bonds = false;
@@ -292,7 +320,7 @@ pub fn run_scene(scene: &NamedScene, opts: &HarnessOptions) -> Result<SceneRepor
         });
     }
     let background = study_options(Method::Raycast, scene.lighting).background;
-    let rscene = reference_scene(&scene.spheres);
+    let rscene = reference_scene_with_bonds(&scene.spheres, scene.draw_bonds);
     let mats = reference_materials(&scene.spheres);
     let trace = |spp| {
         render_reference(
@@ -328,7 +356,8 @@ pub fn run_scene(scene: &NamedScene, opts: &HarnessOptions) -> Result<SceneRepor
     }
     let mut runs = Vec::new();
     for &method in &opts.methods {
-        let o = study_options(method, scene.lighting);
+        let mut o = study_options(method, scene.lighting);
+        o.draw_bonds = scene.draw_bonds;
         let mut renderer = Renderer::new();
         let (ms, out) = time_ms(opts.warmup, opts.runs, || {
             renderer.render(&scene.spheres, &scene.camera, &o)
@@ -446,6 +475,40 @@ pub fn mean_covered_color(frame: &Frame) -> Vec3 {
 mod tests {
     use super::*;
     use crate::scenes::{SceneId, build_sized};
+
+    #[test]
+    fn ball_and_stick_scene_draws_and_traces_its_bonds() {
+        let scene = build_sized(SceneId::MoleculeBallStick, 160, 160).unwrap();
+        let opts = HarnessOptions {
+            methods: vec![Method::Raycast, Method::Lut],
+            warmup: 0,
+            runs: 1,
+            supersample: None,
+            time_reference: false,
+        };
+        let rep = run_scene(&scene, &opts).unwrap();
+        // Without the bonds in the reference the sticks would be silhouette errors; with them the
+        // exact method agrees with the reference as on the space-filling scenes.
+        let bare = reference_scene_with_bonds(&scene.spheres, false);
+        let mats = reference_materials(&scene.spheres);
+        let bg = study_options(Method::Raycast, scene.lighting).background;
+        let no_bonds =
+            render_reference(&bare, &mats, &scene.camera, scene.lighting, bg, 1).unwrap();
+        let raycast = &rep.runs[0];
+        let m_bare = compare(&raycast.frame, &no_bonds).unwrap();
+        assert!(
+            m_bare.silhouette_mismatched > 60,
+            "the bonds should cover many pixels: {} mismatched against the bond-less reference",
+            m_bare.silhouette_mismatched
+        );
+        assert!(
+            raycast.metrics.psnr_db >= 45.0 && raycast.metrics.silhouette_px <= 0.05,
+            "raycast vs reference with bonds: PSNR {} dB (expected ≥ 45), silhouette {} px \
+             (expected ≤ 0.05)",
+            raycast.metrics.psnr_db,
+            raycast.metrics.silhouette_px
+        );
+    }
 
     #[test]
     fn records_round_trip_through_json_including_infinite_psnr() {

@@ -6,6 +6,7 @@
 //! | [`SceneId::S2`] | 100,000 spheres of radius 0.5 uniformly at random in a 100³ box, 4 materials | 1920x1080 |
 //! | [`SceneId::S3`] | 1,000,000 spheres of radius 0.3 uniformly at random in a 200³ box, 4 materials | 1920x1080 |
 //! | [`SceneId::Molecule`] | Seed 002's "molecule of about 300 atoms": an ideal α-helix of 30 alanines (Ala₃₀, 300 atoms with hydrogens), space-filling with CPK colours and Bondi radii, bonds by distance | 500x500 |
+//! | [`SceneId::MoleculeBallStick`] | the same helix as ball and stick: atoms at [`BALL_AND_STICK_RADIUS_SCALE`] of their Bondi radii, its 299 bonds drawn (and traced by the reference) as cylinders of radius [`BALL_AND_STICK_BOND_RADIUS`] Å | 500x500 |
 //!
 //! **Cameras.** Every scene is seen in perspective from a fixed oblique direction
 //! ([`VIEW_DIRECTION`]), looking at the centre of its box from [`EYE_DISTANCE_IN_BOX_LENGTHS`] = 2.4
@@ -24,6 +25,12 @@ use texmap_impostor::SphereScene;
 use crate::elements::{Element, SEED004_SPECIES};
 use crate::rng::SplitMix64;
 
+/// Ball-and-stick atoms are this fraction of their Bondi (van der Waals) radii.
+pub const BALL_AND_STICK_RADIUS_SCALE: f32 = 0.3;
+/// Ball-and-stick bond radius in Å: thinner than the smallest scaled atom (H, 0.36 Å), so the
+/// bond ends are hidden inside the atoms.
+pub const BALL_AND_STICK_BOND_RADIUS: f32 = 0.2;
+
 /// The eye sits this many box lengths from the box centre.
 pub const EYE_DISTANCE_IN_BOX_LENGTHS: f32 = 2.4;
 
@@ -41,10 +48,18 @@ pub enum SceneId {
     S2,
     S3,
     Molecule,
+    /// The molecule as ball and stick: the one named scene whose bonds are drawn.
+    MoleculeBallStick,
 }
 
 impl SceneId {
-    pub const ALL: [SceneId; 4] = [SceneId::S1, SceneId::S2, SceneId::S3, SceneId::Molecule];
+    pub const ALL: [SceneId; 5] = [
+        SceneId::S1,
+        SceneId::S2,
+        SceneId::S3,
+        SceneId::Molecule,
+        SceneId::MoleculeBallStick,
+    ];
 
     /// The name used in results files and on the command line.
     pub fn name(self) -> &'static str {
@@ -53,6 +68,7 @@ impl SceneId {
             SceneId::S2 => "s2",
             SceneId::S3 => "s3",
             SceneId::Molecule => "molecule",
+            SceneId::MoleculeBallStick => "molecule-bs",
         }
     }
 
@@ -64,7 +80,7 @@ impl SceneId {
     /// The scene's default image size.
     pub fn default_size(self) -> (u32, u32) {
         match self {
-            SceneId::S1 | SceneId::Molecule => (500, 500),
+            SceneId::S1 | SceneId::Molecule | SceneId::MoleculeBallStick => (500, 500),
             SceneId::S2 | SceneId::S3 => (1920, 1080),
         }
     }
@@ -78,6 +94,9 @@ pub struct NamedScene {
     pub spheres: SphereScene,
     pub camera: Camera,
     pub lighting: Lighting,
+    /// Draw (and let the reference trace) `spheres.bonds`: true for the ball-and-stick scene,
+    /// false for the space-filling ones, whose bonds lie inside the atoms.
+    pub draw_bonds: bool,
 }
 
 impl NamedScene {
@@ -93,6 +112,7 @@ impl NamedScene {
             lighting: Lighting::default_for(&camera),
             spheres,
             camera,
+            draw_bonds: false,
         }
     }
 
@@ -104,6 +124,7 @@ impl NamedScene {
             spheres: self.spheres.clone(),
             lighting: Lighting::default_for(&camera),
             camera,
+            draw_bonds: self.draw_bonds,
         })
     }
 }
@@ -172,9 +193,13 @@ pub fn build_sized(id: SceneId, width: u32, height: u32) -> Result<NamedScene, C
             Vec3::splat(100.0),
             200.0,
         ),
-        SceneId::Molecule => {
+        SceneId::Molecule | SceneId::MoleculeBallStick => {
             let m = Molecule::alanine_helix(30);
-            let s = m.to_scene();
+            let s = if id == SceneId::Molecule {
+                m.to_scene()
+            } else {
+                m.to_ball_and_stick(BALL_AND_STICK_RADIUS_SCALE, BALL_AND_STICK_BOND_RADIUS)
+            };
             let (lo, hi) = s.bounds().expect("the molecule has atoms");
             let c = (lo + hi) * 0.5;
             // The cube whose circumscribed sphere is the bounding sphere of the atoms.
@@ -188,6 +213,7 @@ pub fn build_sized(id: SceneId, width: u32, height: u32) -> Result<NamedScene, C
         lighting: Lighting::default_for(&camera),
         spheres,
         camera,
+        draw_bonds: id == SceneId::MoleculeBallStick,
     })
 }
 
@@ -316,6 +342,7 @@ impl Seed004System {
             lighting: Lighting::default_for(&camera),
             spheres,
             camera,
+            draw_bonds: false,
         })
     }
 }
@@ -479,6 +506,15 @@ impl Molecule {
         s.bonds = self.bonds.clone();
         s
     }
+
+    /// Ball and stick: [`Molecule::to_scene`] with every radius times `radius_scale` and bonds of
+    /// radius `bond_radius`.
+    pub fn to_ball_and_stick(&self, radius_scale: f32, bond_radius: f32) -> SphereScene {
+        let mut s = self.to_scene();
+        s.radii.iter_mut().for_each(|r| *r *= radius_scale);
+        s.bond_radius = bond_radius;
+        s
+    }
 }
 
 #[cfg(test)]
@@ -567,6 +603,23 @@ mod tests {
         let m = build(SceneId::Molecule);
         assert_eq!(m.spheres.len(), 300);
         assert_eq!(m.spheres.bonds.len(), 299);
+        assert!(!m.draw_bonds);
+        let bs = build(SceneId::MoleculeBallStick);
+        assert!(bs.draw_bonds && bs.spheres.bonds.len() == 299);
+        // Every bond is thinner than both its atoms (hidden ends) and longer than their radii
+        // together (a visible stick).
+        for &[i, j] in &bs.spheres.bonds {
+            let (ri, rj) = (bs.spheres.radii[i as usize], bs.spheres.radii[j as usize]);
+            let l = (bs.spheres.centers[i as usize] - bs.spheres.centers[j as usize]).length();
+            assert!(
+                bs.spheres.bond_radius < ri.min(rj) && l > ri + rj,
+                "bond {i}-{j}"
+            );
+        }
+        assert_eq!(
+            SceneId::from_name("molecule-bs"),
+            Some(SceneId::MoleculeBallStick)
+        );
         // Every atom of the molecule projects inside the image.
         for c in &m.spheres.centers {
             let (p, _) = m.camera.project(*c).unwrap();
