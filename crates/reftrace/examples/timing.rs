@@ -1,5 +1,5 @@
 //! Quick wall-clock timing of BVH build and primary rays on S2/S3-like sphere scenes, for
-//! profiling (`cargo run --release -p texmap-reftrace --example timing -- [count] [side] [r] [w] [h] [reps] [bvh2|cwbvh|wide4]`).
+//! profiling (`cargo run --release -p texmap-reftrace --example timing -- [count] [side] [r] [w] [h] [reps] [bvh2|cwbvh|wide4] [trace|shade] [study]`).
 //! The criterion bench `benches/reftrace.rs` is the measurement of record.
 
 use std::time::Instant;
@@ -41,11 +41,18 @@ fn main() {
     let pts: Vec<Vec3> = (0..count)
         .map(|_| (Vec3::new(rnd(), rnd(), rnd()) - 0.5) * side)
         .collect();
+    // "study": texmap-study's S2 view (direction (0.45, 0.35, 1), FOV framing the box: 69°).
+    let study = args.get(9).is_some_and(|a| a == "study");
+    let (dir, hfov) = if study {
+        (Vec3::new(0.45, 0.35, 1.0), 69.0)
+    } else {
+        (Vec3::new(0.3, 0.4, 1.0), 40.0)
+    };
     let cam = Camera::perspective_look_at(
-        Vec3::new(0.3, 0.4, 1.0).normalize() * side * 2.4,
+        dir.normalize() * side * 2.4,
         Vec3::ZERO,
         Vec3::Y,
-        40.0,
+        hfov,
         w,
         h,
     )
@@ -55,6 +62,8 @@ fn main() {
     )))];
     let opts = RenderOptions::new(Lighting::default_for(&cam), &mats);
     let only = args.get(7).cloned().unwrap_or_default();
+    // "trace": primary visibility only (Scene::depth_image), no shading.
+    let trace_only = args.get(8).is_some_and(|a| a == "trace");
     for kind in [BvhKind::Bvh2, BvhKind::CwBvh, BvhKind::Wide4] {
         if !only.is_empty() && !format!("{kind:?}").eq_ignore_ascii_case(&only) {
             continue;
@@ -71,10 +80,14 @@ fn main() {
         let mut covered = 0;
         for _ in 0..reps {
             let (t0, c0) = (Instant::now(), cpu_seconds());
-            let f = scene.render(&cam, &opts).unwrap();
+            covered = if trace_only {
+                let d = scene.depth_image(&cam);
+                d.iter().filter(|d| d.is_finite()).count()
+            } else {
+                scene.render(&cam, &opts).unwrap().coverage_count()
+            };
             best = best.min(t0.elapsed().as_secs_f64());
             best_cpu = best_cpu.min(cpu_seconds() - c0);
-            covered = f.coverage_count();
         }
         let rays = w as f64 * h as f64;
         println!(

@@ -265,6 +265,23 @@ impl SceneBuilder {
     /// of [`MeshShading`]. A given normal that is zero or not finite makes the shading normal
     /// fall back to the geometric one wherever that vertex has weight; a normal-count mismatch is
     /// refused.
+    ///
+    /// ```
+    /// use texmap_core::camera::Ray;
+    /// use texmap_reftrace::{MeshShading, SceneBuilder, glam::Vec3};
+    /// // One triangle in the plane z = 0 whose vertex normals lean apart.
+    /// let p = [Vec3::ZERO, Vec3::X, Vec3::Y];
+    /// let n = [Vec3::Z, Vec3::new(1.0, 0.0, 1.0), Vec3::new(0.0, 1.0, 1.0)];
+    /// let mut b = SceneBuilder::new();
+    /// b.add_mesh_shaded(&p, &[0, 1, 2], None, Some(&n), MeshShading::VertexNormals, 0)
+    ///     .unwrap();
+    /// let ray = Ray { origin: Vec3::new(0.25, 0.25, 1.0), dir: Vec3::NEG_Z };
+    /// let hit = b.build().intersect(&ray).unwrap();
+    /// assert_eq!(hit.normal, Vec3::Z); // geometric
+    /// // Interpolated with weights (0.5, 0.25, 0.25): leans toward +x and +y.
+    /// let s = hit.shading_normal;
+    /// assert!(s.x > 0.1 && (s.x - s.y).abs() < 1e-6 && (s.length() - 1.0).abs() < 1e-6);
+    /// ```
     pub fn add_mesh_shaded(
         &mut self,
         positions: &[Vec3],
