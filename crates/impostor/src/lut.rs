@@ -237,6 +237,9 @@ impl Kernel for LutKernel<'_> {
             let nf = n as f32;
             let dimg = &t.depth[t.offsets[level as usize]..][..(n * n) as usize];
             let base_s = (tile.x0 as f32 + 0.5 - sx) * inv2h + 0.5;
+            // Nearest depth a fragment can have: 8-pixel chunks whose stored depths are all
+            // nearer are skipped (hierarchical z, as the ray-cast kernel does).
+            let zmin = (z0 - r).max(near);
             for j in y0..y1 {
                 // t ∈ [0, 1) down the square; rows off the square are skipped.
                 let tt = ((tile.y0 + j) as f32 + 0.5 - sy) * inv2h + 0.5;
@@ -248,12 +251,19 @@ impl Kernel for LutKernel<'_> {
                 let mut i = x0 as usize;
                 while i < x1 as usize {
                     let b = row + i;
+                    if buf.depth[b..b + LANES].iter().all(|&d| d <= zmin) {
+                        i += LANES;
+                        continue;
+                    }
                     let mut z = [f32::INFINITY; LANES];
                     let mut flag = [0u32; LANES];
                     for (l, zl) in z.iter_mut().enumerate() {
                         let s = base_s + (i + l) as f32 * inv2h;
                         let inside = (0.0..1.0).contains(&s) && i + l < x1 as usize;
-                        let ti = ((if s > 0.0 { s } else { 0.0 } * nf) as u32).min(n - 1);
+                        let sc = if s > 0.0 { s } else { 0.0 };
+                        let sc = if sc < 1.0 { sc } else { 1.0 };
+                        // SAFETY: sc·n ∈ [0, n] (NaN became 0 above): exact truncation, in range.
+                        let ti = (unsafe { (sc * nf).to_int_unchecked::<i32>() } as u32).min(n - 1);
                         // Seed 002 §3.3: z = z0 + D(s,t)·R (linear eye-space form, module docs);
                         // D is infinite outside the mask.
                         let dd = dimg[(trow + ti) as usize];
