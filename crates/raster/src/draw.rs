@@ -223,11 +223,7 @@ impl Framebuffer {
                         attribute: "normals",
                     });
                 }
-                let prog = LitSmoothProg {
-                    lighting: lighting.to_eye(camera),
-                    material,
-                    proj,
-                };
+                let prog = LitSmoothProg::new(lighting.to_eye(camera), material, proj);
                 self.draw_program(&proj, mesh, &prog, state)
             }
         })

@@ -11,7 +11,7 @@
 use glam::{Vec2, Vec3};
 use texmap_core::mip::MipTexture;
 use texmap_core::sample::Sampler;
-use texmap_core::shade::{Lighting, Material};
+use texmap_core::shade::{Lighting, MAX_LIGHTS, Material};
 
 use crate::draw::VarStore;
 use crate::mesh::Mesh;
@@ -149,9 +149,66 @@ impl FragProgram for LitFlatProg {
 
 /// `Shading::LitSmooth`: eye-space normals interpolated, lit per pixel.
 pub(crate) struct LitSmoothProg {
-    pub lighting: Lighting,
-    pub material: Material,
     pub proj: Proj,
+    /// The lighting and material as four-lane constants, made once per draw.
+    lanes: LightLanes,
+}
+
+impl LitSmoothProg {
+    /// `lighting` in eye space.
+    pub fn new(lighting: Lighting, material: Material, proj: Proj) -> Self {
+        LitSmoothProg {
+            proj,
+            lanes: LightLanes::new(&lighting, &material),
+        }
+    }
+}
+
+/// One directional light as four-lane constants.
+#[derive(Clone, Copy)]
+struct LightLane {
+    to_light: [F32x4; 3],
+    color: [F32x4; 3],
+}
+
+/// A [`Lighting`] and [`Material`] splatted into lanes once per draw, so the per-quad shading
+/// builds no constants.
+#[derive(Clone, Copy)]
+struct LightLanes {
+    base: [F32x4; 3],
+    /// `ambient · base`, computed as `Lighting::shade` does.
+    ambient: [F32x4; 3],
+    lights: [LightLane; MAX_LIGHTS],
+    count: usize,
+    specular: F32x4,
+    specular_f: f32,
+    shininess: f32,
+}
+
+impl LightLanes {
+    fn new(l: &Lighting, m: &Material) -> Self {
+        let v3 = |v: Vec3| [F32x4::splat(v.x), F32x4::splat(v.y), F32x4::splat(v.z)];
+        let zero = LightLane {
+            to_light: v3(Vec3::ZERO),
+            color: v3(Vec3::ZERO),
+        };
+        let mut lights = [zero; MAX_LIGHTS];
+        for (dst, src) in lights.iter_mut().zip(l.lights()) {
+            *dst = LightLane {
+                to_light: v3(src.to_light),
+                color: v3(src.color),
+            };
+        }
+        LightLanes {
+            base: v3(m.base_color),
+            ambient: v3(l.ambient * m.base_color),
+            lights,
+            count: l.lights().len(),
+            specular: F32x4::splat(m.specular),
+            specular_f: m.specular,
+            shininess: m.shininess,
+        }
+    }
 }
 
 impl FragProgram for LitSmoothProg {
@@ -185,7 +242,7 @@ impl FragProgram for LitSmoothProg {
         } else {
             [s(0.0), s(0.0), s(1.0)]
         };
-        shade4(&self.lighting, &self.material, n, v, f.mask)
+        shade4(&self.lanes, n, v, f.mask)
     }
 }
 
@@ -218,56 +275,39 @@ fn normalize_or_zero4(v: [F32x4; 3]) -> [F32x4; 3] {
 /// `(0, 65536]`, `powf` per lit lane otherwise. Without a specular term the result is
 /// bit-identical to four scalar calls; with it, within 1e-5 of them (tested).
 #[inline(always)]
-fn shade4(
-    lighting: &Lighting,
-    m: &Material,
-    n: [F32x4; 3],
-    v: [F32x4; 3],
-    mask: u8,
-) -> [[f32; 4]; 3] {
+fn shade4(ll: &LightLanes, n: [F32x4; 3], v: [F32x4; 3], mask: u8) -> [[f32; 4]; 3] {
     let s = F32x4::splat;
-    let base = [s(m.base_color.x), s(m.base_color.y), s(m.base_color.z)];
-    let amb = lighting.ambient;
-    let mut c = [
-        s(amb.x * m.base_color.x),
-        s(amb.y * m.base_color.y),
-        s(amb.z * m.base_color.z),
-    ];
-    for light in lighting.lights() {
-        let l = [
-            s(light.to_light.x),
-            s(light.to_light.y),
-            s(light.to_light.z),
-        ];
+    let mut c = ll.ambient;
+    for light in &ll.lights[..ll.count] {
+        let l = light.to_light;
         let ndl = dot4(&n, &l);
         let lit = s(0.0).lt(ndl);
         let lit_bits = lit.bits() as u8 & mask;
         if lit_bits == 0 {
             continue;
         }
-        let mut term = base.map(|b| b.mul(ndl));
-        if m.specular > 0.0 {
+        let mut term = ll.base.map(|b| b.mul(ndl));
+        if ll.specular_f > 0.0 {
             // Blinn-Phong half vector, n·h clamped at 0, raised to the shininess per lane.
             let h = normalize_or_zero4([l[0].add(v[0]), l[1].add(v[1]), l[2].add(v[2])]);
             let ndh = dot4(&n, &h).max(s(0.0));
-            let spec = if m.shininess > 0.0 && m.shininess <= 65536.0 {
-                s(m.specular).mul(pow4(ndh, m.shininess))
+            let spec = if ll.shininess > 0.0 && ll.shininess <= 65536.0 {
+                ll.specular.mul(pow4(ndh, ll.shininess))
             } else {
                 // Exponents outside pow4's range: powf per lit lane.
                 let ndh = ndh.to_array();
                 let mut spec = [0.0f32; 4];
                 for (lane, sp) in spec.iter_mut().enumerate() {
                     if lit_bits & (1 << lane) != 0 {
-                        *sp = m.specular * ndh[lane].powf(m.shininess);
+                        *sp = ll.specular_f * ndh[lane].powf(ll.shininess);
                     }
                 }
                 F32x4::new(spec)
             };
             term = term.map(|t| t.add(spec));
         }
-        let col = [s(light.color.x), s(light.color.y), s(light.color.z)];
         for k in 0..3 {
-            c[k] = F32x4::select(lit, c[k].add(col[k].mul(term[k])), c[k]);
+            c[k] = F32x4::select(lit, c[k].add(light.color[k].mul(term[k])), c[k]);
         }
     }
     c.map(F32x4::to_array)
@@ -441,11 +481,7 @@ mod tests {
                         shininess: 1.0 + 80.0 * r().abs(),
                     }
                 };
-                let prog = LitSmoothProg {
-                    lighting,
-                    material,
-                    proj: Proj::new(cam),
-                };
+                let prog = LitSmoothProg::new(lighting, material, Proj::new(cam));
                 let mut f = QuadFrag {
                     x: [0.0; 4],
                     y: [0.0; 4],
