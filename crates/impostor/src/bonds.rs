@@ -80,7 +80,7 @@ const PARALLEL_A: f32 = 1e-12;
 /// to the cap planes is inside the slab everywhere or nowhere, which the huge quotients keep).
 const MIN_DU: f32 = 1e-30;
 
-/// One projected bond, copied into every tile bin it touches (64 bytes).
+/// One projected bond, copied into every tile bin it touches (96 bytes).
 ///
 /// All vectors in eye space: `a` the first end point (atom `i`), `u` the unit axis toward atom
 /// `j`, `len` the axis length.
@@ -100,11 +100,52 @@ pub(crate) struct BondRec {
     inv_r: f32,
     /// Pixel rectangle `[x0, x1) x [y0, y1)` whose centres the bond may cover.
     bbox: [u16; 4],
+    /// The screen rectangles (pixels) of the two end spheres, `[x0, x1, y0, y1]` each: the
+    /// bond's image lies in their convex hull, which narrows every row to a span
+    /// ([`row_span`]). `±HUGE` bounds where a rectangle is unbounded.
+    ends: [[f32; 4]; 2],
     /// Material index of the half at `a` and of the half at the other end.
     kind: [u16; 2],
 }
 
-const _: () = assert!(std::mem::size_of::<BondRec>() == 64);
+const _: () = assert!(std::mem::size_of::<BondRec>() == 96);
+
+/// Stand-in for an unbounded screen coordinate (finite, so that interpolation cannot give NaN).
+const HUGE: f32 = 1e9;
+
+/// The x-range (pixels) of the convex hull of two axis-aligned rectangles at height `y`, or
+/// `None` when the row misses the hull.
+///
+/// The hull is the union over `λ ∈ [0, 1]` of the rectangles `(1 − λ)·A + λ·B`, whose bounds
+/// interpolate linearly: the row meets those with `y0(λ) ≤ y ≤ y1(λ)`, an interval of `λ`, and
+/// the x-range is spanned by the interpolated bounds at its two ends.
+#[inline]
+fn row_span(ends: &[[f32; 4]; 2], y: f32) -> Option<(f32, f32)> {
+    let [a, b] = ends;
+    let (mut lo, mut hi) = (0f32, 1f32);
+    // y0(λ) − y ≤ e and y − y1(λ) ≤ e, each `α + β·λ ≤ 0`; `e` (a thousandth of a pixel plus
+    // a relative term) keeps the bound conservative against rounding, as `View::pixel_range`.
+    let e = 1e-3 + 1e-6 * y.abs();
+    for (alpha, beta) in [(a[2] - y - e, b[2] - a[2]), (y - a[3] - e, a[3] - b[3])] {
+        if beta > 0.0 {
+            let l = -alpha / beta;
+            hi = if l < hi { l } else { hi };
+        } else if beta < 0.0 {
+            let l = -alpha / beta;
+            lo = if l > lo { l } else { lo };
+        } else if alpha > 0.0 {
+            return None;
+        }
+    }
+    if !(lo <= hi) {
+        return None;
+    }
+    let x0 = |l: f32| a[0] + (b[0] - a[0]) * l;
+    let x1 = |l: f32| a[1] + (b[1] - a[1]) * l;
+    let (p, q) = (x0(lo), x0(hi));
+    let (r, t) = (x1(lo), x1(hi));
+    Some((if p < q { p } else { q }, if r > t { r } else { t }))
+}
 
 impl BondRec {
     /// The first end point, `q + (a·u)·u`.
@@ -218,6 +259,13 @@ fn project(view: &View, a: DVec3, b: DVec3, r: f32, kind: [u16; 2]) -> Option<Bo
     // Screen rectangle: the union of the two end spheres' rectangles.
     let [ax, ay] = sphere_rect(view, ca, r);
     let [bx, by] = sphere_rect(view, cb, r);
+    let rect = |x: Option<(f32, f32)>, y: Option<(f32, f32)>| -> [f32; 4] {
+        let (x0, x1) = x.unwrap_or((-HUGE, HUGE));
+        let (y0, y1) = y.unwrap_or((-HUGE, HUGE));
+        let c = |v: f32| v.clamp(-HUGE, HUGE);
+        [c(x0), c(x1), c(y0), c(y1)]
+    };
+    let ends = [rect(ax, ay), rect(bx, by)];
     let union = |p: Option<(f32, f32)>, q: Option<(f32, f32)>, n: u32| -> (u16, u16) {
         match (p, q) {
             (Some((p0, p1)), Some((q0, q1))) => View::pixel_range(
@@ -246,6 +294,7 @@ fn project(view: &View, a: DVec3, b: DVec3, r: f32, kind: [u16; 2]) -> Option<Bo
         r2: r * r,
         inv_r: 1.0 / r,
         bbox: [x0, y0, x1, y1],
+        ends,
         kind,
     })
 }
@@ -534,13 +583,24 @@ impl Kernel<'_> {
             if bx0 >= bx1 || by0 >= by1 {
                 continue;
             }
+            let view_w = v.width;
             let a_eye = rec.a();
             let qq = Vec3::from(rec.q).length_squared();
             for y in by0..by1 {
                 let j = (y - y0t) as usize;
                 let ys = (v.cy - (y as f32 + 0.5)) * v.inv_k;
-                let mut i = (bx0 - x0t) as usize;
-                let i1 = (bx1 - x0t) as usize;
+                // This row's span of the hull of the end spheres' rectangles.
+                let Some((sx0, sx1)) = row_span(&rec.ends, y as f32 + 0.5) else {
+                    continue;
+                };
+                let (px0, px1) = View::pixel_range(sx0, sx1, view_w);
+                let px0 = (px0 as u32).max(bx0);
+                let px1 = (px1 as u32).min(bx1);
+                if px0 >= px1 {
+                    continue;
+                }
+                let mut i = (px0 - x0t) as usize;
+                let i1 = (px1 - x0t) as usize;
                 while i < i1 {
                     let lanes = if v.ortho {
                         lanes_ortho(rec, &xs[i..i + LANES], ys, a_eye)
@@ -706,4 +766,58 @@ pub(crate) fn draw(
             }
         });
     stats
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Tiny deterministic RNG (LCG).
+    struct Lcg(u64);
+    impl Lcg {
+        fn f(&mut self, lo: f32, hi: f32) -> f32 {
+            self.0 = self
+                .0
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            lo + (hi - lo) * ((self.0 >> 40) as f32 / (1u64 << 24) as f32)
+        }
+    }
+
+    #[test]
+    fn row_span_contains_every_point_of_the_hull_and_is_tight() {
+        let mut rng = Lcg(3);
+        let mut hits = 0;
+        for _ in 0..2000 {
+            let mut ends = [[0f32; 4]; 2];
+            for e in &mut ends {
+                let (x, y) = (rng.f(0.0, 100.0), rng.f(0.0, 100.0));
+                let (w, h) = (rng.f(0.0, 20.0), rng.f(0.0, 20.0));
+                *e = [x, x + w, y, y + h];
+            }
+            // Points of the hull: (1 − λ)·p + λ·q with p in A and q in B.
+            for _ in 0..50 {
+                let l = rng.f(0.0, 1.0);
+                let (pa, pb) = (rng.f(0.0, 1.0), rng.f(0.0, 1.0));
+                let (qa, qb) = (rng.f(0.0, 1.0), rng.f(0.0, 1.0));
+                let [a, b] = ends;
+                let px = a[0] + (a[1] - a[0]) * pa;
+                let py = a[2] + (a[3] - a[2]) * pb;
+                let qx = b[0] + (b[1] - b[0]) * qa;
+                let qy = b[2] + (b[3] - b[2]) * qb;
+                let (x, y) = (px + (qx - px) * l, py + (qy - py) * l);
+                let (s0, s1) = row_span(&ends, y).expect("a hull point's row meets the hull");
+                assert!(
+                    x >= s0 - 1e-3 && x <= s1 + 1e-3,
+                    "x {x} outside span [{s0}, {s1}] at y {y} for {ends:?}"
+                );
+                hits += 1;
+            }
+            // Tight: the span's ends are hull points (x of an interpolated corner), so a row
+            // beyond both rectangles' y-ranges misses.
+            let top = ends[0][2].min(ends[1][2]) - 1.0;
+            assert!(row_span(&ends, top).is_none(), "{ends:?}");
+        }
+        assert_eq!(hits, 100_000);
+    }
 }
