@@ -231,8 +231,10 @@ mod imp {
     }
 }
 
-#[cfg(not(target_arch = "x86_64"))]
-mod imp {
+/// The portable lanes: the implementation off x86-64, and the reference the SSE2 lanes are
+/// tested against on x86-64.
+#[cfg(any(not(target_arch = "x86_64"), test))]
+mod scalar {
     /// Four i32 lanes (wrapping arithmetic).
     #[derive(Clone, Copy)]
     pub(crate) struct I32x4([i32; 4]);
@@ -410,6 +412,9 @@ mod imp {
     }
 }
 
+#[cfg(not(target_arch = "x86_64"))]
+use scalar as imp;
+
 pub(crate) use imp::{F32x4, I32x4};
 
 /// `x^p` for four lanes with `x` in `[0, 1]` and `0 < p <= 65536`, as `exp2(p · log2 x)`:
@@ -498,6 +503,102 @@ mod tests {
             I32x4::new([-1, 2, -3, 4]).or(I32x4::splat(0)).neg_bits(),
             0b0101
         );
+    }
+
+    /// Run one sequence of lane operations with a lane implementation; every result as bits.
+    macro_rules! op_trace {
+        ($f:ty, $i:ty, $a:expr, $b:expr, $ia:expr, $ib:expr, $m:expr) => {{
+            let (a, b) = (<$f>::new($a), <$f>::new($b));
+            let (ia, ib) = (<$i>::new($ia), <$i>::new($ib));
+            let fs = [
+                a.add(b),
+                a.sub(b),
+                a.mul(b),
+                a.div(b),
+                a.sqrt(),
+                a.max(b),
+                a.lt(b),
+                a.le(b),
+                a.eq(b),
+                a.and(b),
+                a.or(b),
+                a.and_not(b),
+                <$f>::select(<$f>::from_bits($m), a, b),
+                ia.add(ib).cast_f32(),
+                ia.sub(ib).cast_f32(),
+                ia.and(ib).or(ib).cast_f32(),
+                ia.shr::<7>().cast_f32(),
+                ia.shl::<9>().cast_f32(),
+                ia.to_f32(),
+                a.trunc_i32().cast_f32(),
+                a.cast_i32().cast_f32(),
+                a.add(<$f>::splat(0.25)),
+                ia.add(<$i>::splat(3)).cast_f32(),
+            ];
+            let mut out: Vec<u32> = fs
+                .iter()
+                .flat_map(|v| v.to_array().map(f32::to_bits))
+                .collect();
+            out.extend([
+                a.bits(),
+                a.lt(b).bits(),
+                ia.neg_bits(),
+                <$f>::from_bits($m).bits(),
+            ]);
+            let mut stored = [0.0f32; 5];
+            b.store(&mut stored[1..]);
+            out.extend(stored.map(f32::to_bits));
+            let t = <$f>::transpose([a, b, a.add(b), a.mul(b)]);
+            out.extend(t.iter().flat_map(|v| v.to_array().map(f32::to_bits)));
+            out
+        }};
+    }
+
+    #[test]
+    fn sse2_lanes_equal_the_portable_lanes() {
+        let mut st = 5u64;
+        let mut bits = || {
+            st = st
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (st >> 32) as u32
+        };
+        let specials = [
+            0.0f32,
+            -0.0,
+            1.0,
+            -1.5,
+            1e30,
+            -3e9,
+            f32::INFINITY,
+            f32::NAN,
+            2.5e-40,
+        ];
+        for round in 0..5000 {
+            let mut f = |k: usize| {
+                let v = bits();
+                match (round + k) % 3 {
+                    0 => specials[v as usize % specials.len()],
+                    1 => (v as i32 as f32) * 1e-6,
+                    _ => f32::from_bits(v),
+                }
+            };
+            let a = [f(0), f(1), f(2), f(3)];
+            let b = [f(4), f(5), f(6), f(7)];
+            let ia = [bits() as i32, bits() as i32, -(round as i32), round as i32];
+            let ib = [bits() as i32, 7, i32::MIN, i32::MAX];
+            let m = (round % 16) as u8;
+            let fast = op_trace!(F32x4, I32x4, a, b, ia, ib, m);
+            let portable = op_trace!(scalar::F32x4, scalar::I32x4, a, b, ia, ib, m);
+            // NaN payloads may differ between implementations; NaN-ness may not.
+            for (k, (x, y)) in fast.iter().zip(&portable).enumerate() {
+                let nan = |v: u32| f32::from_bits(v).is_nan();
+                assert!(
+                    x == y || (nan(*x) && nan(*y)),
+                    "round {round} value {k}: sse2 {x:#x} portable {y:#x} ({a:?} {b:?} {ia:?} {ib:?})"
+                );
+            }
+        }
     }
 
     #[test]
