@@ -76,20 +76,40 @@
 //!
 //! # Performance notes (what was measured and rejected)
 //! Texels are linear RGBA `f32` (`Vec4`, one SSE register): filtering is gamma-correct for free
-//! and a lerp is three SIMD instructions; RGBA8 storage would need an sRGB decode per texel.
-//! The level's `log2` uses the float exponent plus a degree-4 mantissa polynomial
-//! (`log2_split`, |error| ≤ 1.2e-4 in λ) instead of libm's `log2f`; Repeat on power-of-two
-//! levels is a mask; texel reads skip bounds checks (indices are folded by construction).
-//! The span sampler keeps its four pixels in the lanes of a `Vec4`, reads an interior window by
-//! its corner index, and is software-pipelined over spans ([`Sampler::sample_quads`]): one span
-//! alone is a long dependency chain (extent -> level -> window -> texels). Measured on the
-//! 1024x768 tilted plane (CPU time per sample on the loaded 2-core VM, so ±20%):
-//! `<[_; 4]>::map` in the span loop did not inline and cost ~1.6x (23 -> 15 ns); copying the
-//! window into a stack array instead of indexing it gained nothing (21 ns); pipelining took the
-//! span from ~17 to ~14 ns. The span sampler then runs at about the speed of per-pixel trilinear,
-//! not 1.5x: both perform the same 8 texel loads and 7 four-wide lerps per pixel; the span saves
-//! only the per-pixel level and wrap arithmetic, which is already cheap here. Its real gain is
-//! the one the paper claims — one shared memory with K² banks instead of per-pixel copies.
+//! and a lerp is three SIMD instructions. The level's `log2` uses the float exponent plus a
+//! degree-4 mantissa polynomial (`log2_split`, |error| ≤ 1.2e-4 in λ) instead of libm's `log2f`;
+//! Repeat on power-of-two levels is a mask; texel reads skip bounds checks (indices are folded by
+//! construction).
+//!
+//! **Lane kernels** (`sample/lanes.rs`, x86_64, power-of-two pyramids): the bulk calls run
+//! per-pixel trilinear four PIXELS per step and the span sampler four SPANS per step, with the
+//! footprint, level split, level sizes (from the float exponent), texel coordinates, floors,
+//! fractions and wrapped addresses computed once for four lanes; the texel loads and lerps stay
+//! per pixel. Each kernel is built twice, SSE2 (baseline) and AVX2 (three-operand encoding, fewer
+//! register copies; chosen at run time with `is_x86_feature_detected!`), no FMA in either, and
+//! both are bit-identical to the scalar kernels and to the bank emulator (tests below). Spans whose
+//! window crosses a level edge, NPOT pyramids, the tail of a call and other targets take the
+//! scalar path. `sample_quad` runs trilinear's four pixels in one lane kernel and the span
+//! through a fused fast path (both levels' texels per pixel in registers).
+//!
+//! Measured with callgrind (instructions per sample, tilted plane 1024x768, 4096² pyramid, one
+//! frame; the figures in docs/fragments/sampling.md): trilinear 209 -> 134, span K3 181 -> 121,
+//! span K4 184 -> 120 (AVX2 build; SSE2 146 / 134 / 133). Both samplers now spend most instructions
+//! on the same per-pixel work — two bilinear taps (8 texel loads, 6 four-wide lerps) and the
+//! Eq. (4) blend — which is why the span sampler is only ~1.1x per-pixel trilinear, not 1.5x: what it
+//! saves (one level decision and one window per span instead of per pixel) is what the trilinear
+//! lane kernel already shares across its four lanes. On a CPU the paper's gain is the memory
+//! organisation, not the arithmetic: the span reads 0.56 L1-missing lines per sample against
+//! trilinear's 0.93.
+//!
+//! Rejected by operation count (not built): keeping the K x K window in registers (the 2x2 of each
+//! pixel is then picked with blends, ~9 SSE2 operations per texel against one L1 load); a weighted
+//! sum over the whole 3x3 window per pixel (17 operations per level against 13). Not done, by
+//! measurement: RGBA16/RGBA8 texel storage for the samplers — the same scene on a 256² pyramid
+//! (L2-resident) runs only ~30% faster than on 4096² (a bound on what halving the bytes could give)
+//! while the decode adds ~3 instructions per texel to an instruction-bound loop; not done.
+//! Earlier: `<[_; 4]>::map` in the span loop did not inline and cost ~1.6x; copying the window
+//! into a stack array gained nothing; pipelining the scalar span loop took ~17 to ~14 ns/sample.
 //!
 //! # References
 //! Seed 000 (Kajihara), Eq. (2)–(4), (8)–(10); /work/shared/SEEDS.md.
