@@ -38,8 +38,10 @@
 //! - **Near plane.** `Raycast`: the exact answer — fragments nearer than the near plane are
 //!   clipped and the ray takes the far intersection, so a cut sphere (or one the eye is inside)
 //!   shows its interior, lit with the normal turned toward the viewer (as the reference ray
-//!   tracer's two-sided surfaces). `Lut`/`Template`: spheres whose centre is not in front of the
-//!   near plane are skipped (counted as culled); their other fragments nearer than it are clipped.
+//!   tracer's two-sided surfaces). `Lut`/`Template` do the same with their sprites: a fragment
+//!   nearer than the near plane shows the sphere's far side instead, also for spheres whose
+//!   centre is behind the near plane (their square is sized from the tangent length; see the
+//!   `lut` module). Only spheres wholly nearer than the near plane are culled.
 //!   `Polygon`: the rasteriser clips triangles; spheres reaching the near plane are drawn
 //!   two-sided.
 //! - **Sub-pixel spheres** follow the pixel-centre rule: a sphere is drawn where it covers a pixel
