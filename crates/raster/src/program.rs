@@ -429,6 +429,7 @@ mod tests {
     use super::*;
 
     #[test]
+    #[allow(clippy::needless_range_loop)] // a lane index addresses several arrays
     fn four_lane_smooth_lighting_matches_the_shared_model() {
         let mut st = 11u64;
         let mut r = || {
