@@ -11,14 +11,19 @@
 //! docs/fragments/reftrace.md): obvhs's cwbvh traversal decodes eight quantised child boxes from
 //! bytes at every node (48 `u8 → f32` conversions) and its bvh2 traversal tests two boxes per step
 //! with a data-dependent swap. The 4-wide layout keeps full-precision boxes (128 bytes a node, two
-//! cache lines) and halves the depth of the binary tree.
+//! cache lines) and halves the depth of the binary tree: 2,469 instructions per primary ray
+//! (trace only) against 4,119 for cwbvh and 4,202 for bvh2. Besides, obvhs's cwbvh traversal
+//! misses some rays with a zero direction component (axis-parallel rays; see
+//! `tests/reference.rs`), which this one and obvhs's bvh2 do not.
 //!
 //! # Robustness
 //! - The slab test picks the near and far plane per axis from the sign of the direction (chosen
 //!   once per ray), so an empty child slot (lo = +∞, hi = −∞) never hits.
-//! - `max`/`min` of the slab distances are written as comparisons that keep the running value
-//!   when the new one is NaN (`0 · ∞` when the origin lies on a slab plane of an axis the ray
-//!   runs parallel to): a NaN never culls a box, it only fails to narrow the interval.
+//! - `max`/`min` of the slab distances keep the running value when the new one is NaN (`0 · ∞`
+//!   when the origin lies on a slab plane of an axis the ray runs parallel to): glam's
+//!   `Vec4::max(t, running)` is SSE `maxps`, which returns its second operand when either is NaN,
+//!   and `f32::max` in the scalar fallback ignores a NaN operand. So a NaN never culls a box, it
+//!   only fails to narrow the interval (unit test `nan_never_culls_and_empty_lanes_never_hit`).
 //! - The boxes are the padded primitive boxes of [`crate::scene`], so rounding in the slab test
 //!   cannot cull a ray that grazes a primitive; the leaf tests decide.
 //! - The traversal stack has a fixed capacity ([`STACK_SIZE`]); [`Wide4::from_bvh2`] refuses a
@@ -27,15 +32,16 @@
 use glam::Vec4;
 use obvhs::bvh2::Bvh2;
 
-/// Capacity of the traversal stack. Each visited node pops one entry and pushes at most four, so
-/// a tree of depth `d` needs at most `3·d + 1` entries.
+/// Capacity of the traversal stack. A visited node descends into its nearest inner child and
+/// pushes the others (at most three, written as a fixed block of three), so at depth `d` the
+/// stack holds at most `3·(d − 1)` entries and the block ends below `3·d ≤ STACK_SIZE`.
 pub(crate) const STACK_SIZE: usize = 128;
 
 /// Number of set bits of a 4-bit mask.
 const POPCOUNT4: [u8; 16] = [0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4];
 
 /// The deepest tree the fixed stack can walk.
-const MAX_DEPTH: usize = (STACK_SIZE - 1) / 3;
+const MAX_DEPTH: usize = STACK_SIZE / 3;
 
 /// Up to four child boxes (planes in lanes `[lo_x, lo_y, lo_z, hi_x, hi_y, hi_z]`) and what each
 /// child is: bit `k` of `leaf_bits` clear for an inner node (`child[k]` = node index), set for a
