@@ -582,15 +582,15 @@ pub(super) fn span_quads4<A: Addr, const K: usize>(
                     continue;
                 }
                 if single & (1 << s) != 0 {
-                    for j in 0..4 {
-                        o[s][j] = span_pixel(texels, &a, s, j);
+                    for (j, oj) in o[s].iter_mut().enumerate() {
+                        *oj = span_pixel(texels, &a, s, j);
                     }
                 } else {
                     let tt = splat_lane(frac, s);
-                    for j in 0..4 {
+                    for (j, oj) in o[s].iter_mut().enumerate() {
                         let ca = span_pixel(texels, &a, s, j);
                         let cb = span_pixel(texels, &b, s, j);
-                        o[s][j] = lerp4(ca, cb, tt);
+                        *oj = lerp4(ca, cb, tt);
                     }
                 }
             }
