@@ -239,7 +239,7 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = 40.0)]
     pub fov: f32,
     /// View direction for the automatic camera: auto (a three-quarter view), x, y, z, -x, -y, -z.
-    #[arg(long, default_value = "auto")]
+    #[arg(long, default_value = "auto", allow_hyphen_values = true)]
     pub view: String,
     /// Camera position X,Y,Z in Å (with --target and --up: exactly this camera, no auto-fit).
     #[arg(long, allow_hyphen_values = true)]

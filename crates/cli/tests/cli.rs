@@ -657,3 +657,44 @@ fn compare_a_file_honours_the_style_flags() {
         "all lit pixels green-dominant"
     );
 }
+
+#[test]
+fn ortho_view_and_background_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let xyz = dir.path().join("two.xyz");
+    // Two atoms along z: seen from the x axis (--view x) they are side by side.
+    std::fs::write(&xyz, "2\npair\nC 0 0 -3\nO 0 0 3\n").unwrap();
+    for view in ["x", "-y", "auto"] {
+        let out = dir.path().join(format!("o{view}.png"));
+        let o = texmap(&[
+            "render",
+            xyz.to_str().unwrap(),
+            "--ortho",
+            "--view",
+            view,
+            "--background",
+            "10,20,30",
+            "--size",
+            "64x48",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{view}: {}", stderr(&o));
+        // The auto-fitted camera frames the atoms: the corner is background, the atoms cover
+        // a good part of the 64x48 image.
+        assert_eq!(pixel(&out, 0, 0), [10, 20, 30], "{view}: background");
+        let img = image::open(&out).unwrap().to_rgba8();
+        let lit = img.pixels().filter(|p| p.0[..3] != [10, 20, 30]).count();
+        assert!(lit > 200, "{view}: atoms drawn ({lit} px)");
+    }
+    let o = texmap(&[
+        "render",
+        xyz.to_str().unwrap(),
+        "--view",
+        "diagonal",
+        "-o",
+        dir.path().join("v.png").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--view"), "{}", stderr(&o));
+}
