@@ -290,6 +290,9 @@ pub enum SceneArg {
     S2,
     S3,
     Molecule,
+    /// The molecule as ball and stick (atoms at 0.3 of their radii, bonds drawn and traced).
+    #[value(name = "molecule-bs")]
+    MoleculeBallStick,
 }
 
 #[derive(Args, Debug)]
@@ -297,7 +300,8 @@ pub struct CompareArgs {
     /// A trajectory file whose first frame is the scene (instead of --scene).
     pub file: Option<PathBuf>,
     /// A built-in scene: S1 (Seed 004 system, 1,115 atoms, 500x500), S2 (100k spheres, 1080p),
-    /// S3 (1M spheres, 1080p), molecule (~300 atoms, Seed 002).
+    /// S3 (1M spheres, 1080p), molecule (~300 atoms, Seed 002), molecule-bs (the same molecule
+    /// as ball and stick: 299 bonds drawn as cylinders by every method and traced by the reference).
     #[arg(
         long,
         value_enum,

@@ -255,6 +255,7 @@ fn named_scene(a: &CompareArgs) -> Result<NamedScene> {
                 SceneArg::S2 => SceneId::S2,
                 SceneArg::S3 => SceneId::S3,
                 SceneArg::Molecule => SceneId::Molecule,
+                SceneArg::MoleculeBallStick => SceneId::MoleculeBallStick,
             };
             Ok(scenes::build(id))
         }
@@ -296,7 +297,7 @@ fn named_scene(a: &CompareArgs) -> Result<NamedScene> {
                 .unwrap_or_else(|| "file".into());
             Ok(NamedScene::custom(&stem, spheres, camera))
         }
-        _ => usage("give a trajectory FILE or --scene S1|S2|S3|molecule"),
+        _ => usage("give a trajectory FILE or --scene S1|S2|S3|molecule|molecule-bs"),
     }
 }
 

@@ -272,6 +272,40 @@ fn compare_a_trajectory_file_writes_results_images_and_charts() {
     }
 }
 
+#[test]
+fn compare_the_ball_and_stick_scene_draws_and_traces_its_bonds() {
+    // The reference traces the 299 bonds as capped cylinders: a method that left them out would
+    // lose whole bond silhouettes (hundreds of pixels) and fall far below 45 dB.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("bs");
+    let o = texmap(&[
+        "compare",
+        "--scene",
+        "molecule-bs",
+        "--runs",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("results.json")).unwrap()).unwrap();
+    let raycast = v
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|r| r["method"] == "raycast" && r["reference"] == "reftrace-1spp")
+        .expect("a raycast record");
+    assert_eq!(raycast["scene"], "molecule-bs");
+    let psnr = raycast["psnr_db"].as_f64().unwrap_or(f64::INFINITY);
+    assert!(
+        psnr >= 45.0,
+        "raycast + bonds vs reftrace: {psnr} dB, expected >= 45"
+    );
+    let sil = raycast["silhouette_px"].as_f64().unwrap();
+    assert!(sil <= 0.5, "silhouette mismatch {sil} px, expected <= 0.5");
+}
+
 // ---------------------------------------------------------------- atom style flags
 
 /// Render `file` at 65x65 (odd, so pixel 32 is centred on the axis) looking down -z from
