@@ -305,6 +305,7 @@ pub struct CompareArgs {
     #[arg(
         long,
         value_enum,
+        ignore_case = true,
         conflicts_with_all = ["file", "color_by", "radius_scale", "type_radius", "type_color"]
     )]
     pub scene: Option<SceneArg>,

@@ -281,7 +281,7 @@ fn compare_the_ball_and_stick_scene_draws_and_traces_its_bonds() {
     let o = texmap(&[
         "compare",
         "--scene",
-        "molecule-bs",
+        "Molecule-BS", // scene names are case-insensitive (the README writes S1)
         "--runs",
         "1",
         "--out",
