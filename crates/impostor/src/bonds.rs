@@ -66,7 +66,7 @@ use texmap_core::shade::{Lighting, Material};
 
 use crate::SphereScene;
 use crate::fastshade::{self, Surf8, W};
-use crate::pipeline::{FLAG_INSIDE, LANES, NONE, TILE, TILE_BUF, TILE_PX, View};
+use crate::pipeline::{self, FLAG_INSIDE, LANES, NONE, TILE, TILE_BUF, TILE_PX, View};
 
 /// Bonds per projection chunk: fixed, so results do not depend on the thread count.
 pub(crate) const BOND_CHUNK: usize = 8192;
@@ -377,19 +377,11 @@ impl BondBins {
             });
 
         // Pass 2: prefix sum over (tile, chunk); counts become offsets within the tile's run.
-        self.tile_start.clear();
-        self.tile_start.reserve(ntiles + 1);
-        let mut run = 0usize;
-        for t in 0..ntiles {
-            self.tile_start.push(run);
-            for counts in &mut self.chunk_counts[..nchunks] {
-                let c = counts[t] as usize;
-                counts[t] = (run - self.tile_start[t]) as u32;
-                run += c;
-            }
-        }
-        self.tile_start.push(run);
-        let total = run;
+        let total = pipeline::prefix_tile_offsets(
+            &mut self.tile_start,
+            &mut self.chunk_counts[..nchunks],
+            ntiles,
+        );
 
         // Pass 3: fill (parallel over chunks, each writing its own disjoint runs).
         self.recs.clear();

@@ -192,20 +192,11 @@ impl Bins {
             });
 
         // Pass 2: prefix sum over (tile, chunk); counts become write offsets.
-        self.tile_start.clear();
-        self.tile_start.reserve(ntiles + 1);
-        let mut run = 0usize;
-        for t in 0..ntiles {
-            self.tile_start.push(run);
-            for counts in &mut self.chunk_counts[..nchunks] {
-                let c = counts[t] as usize;
-                // Offsets fit u32 only if the total does; keep them relative to the tile start.
-                counts[t] = (run - self.tile_start[t]) as u32;
-                run += c;
-            }
-        }
-        self.tile_start.push(run);
-        let total = run;
+        let total = prefix_tile_offsets(
+            &mut self.tile_start,
+            &mut self.chunk_counts[..nchunks],
+            ntiles,
+        );
 
         // Pass 3: fill (parallel over chunks, each writing its own disjoint runs).
         self.recs.clear();
@@ -236,6 +227,30 @@ impl Bins {
         }
         stats
     }
+}
+
+/// Pass 2 of the two-pass binning (shared by the sphere pipeline and the bond pass): a prefix sum
+/// over (tile, chunk). `tile_start` becomes the start of every tile's run (plus the total at the
+/// end) and each chunk's per-tile count becomes its write offset *relative to the tile start*
+/// (so offsets fit u32 whenever one tile's run does). Returns the total number of records.
+pub(crate) fn prefix_tile_offsets(
+    tile_start: &mut Vec<usize>,
+    chunk_counts: &mut [Vec<u32>],
+    ntiles: usize,
+) -> usize {
+    tile_start.clear();
+    tile_start.reserve(ntiles + 1);
+    let mut run = 0usize;
+    for t in 0..ntiles {
+        tile_start.push(run);
+        for counts in chunk_counts.iter_mut() {
+            let c = counts[t] as usize;
+            counts[t] = (run - tile_start[t]) as u32;
+            run += c;
+        }
+    }
+    tile_start.push(run);
+    run
 }
 
 /// Pass 1 of [`Bins::build`] for one chunk of spheres: transform, cull, project, count per
