@@ -42,6 +42,32 @@ fn splat_lane(v: __m128, j: usize) -> Vec4 {
 
 /// `⌊x⌋` per lane as `i32` and the fraction `x − ⌊x⌋`, for finite lanes with `|x| ≤ 2^30`:
 /// [`super::floor_i32`] lane-wise (truncate, step down where truncation rounded up).
+/// log2 of four positive floats split into ⌊log2 x⌋ (the exponent) and frac(log2 x) (the
+/// mantissa polynomial), lane for lane the same operations as the scalar `log2_split`.
+#[inline(always)]
+fn log2_split4(x: __m128) -> (__m128i, __m128) {
+    // SAFETY: SSE2 is part of the x86_64 baseline.
+    unsafe {
+        let bits = _mm_castps_si128(x);
+        let e = _mm_sub_epi32(
+            _mm_and_si128(_mm_srli_epi32::<23>(bits), _mm_set1_epi32(0xff)),
+            _mm_set1_epi32(127),
+        );
+        let t = _mm_sub_ps(
+            _mm_castsi128_ps(_mm_or_si128(
+                _mm_and_si128(bits, _mm_set1_epi32(0x007f_ffff)),
+                _mm_set1_epi32(0x3f80_0000),
+            )),
+            _mm_set1_ps(1.0),
+        );
+        let c = |k: f32| _mm_set1_ps(k);
+        let poly = _mm_add_ps(c(super::LOG2_C3), _mm_mul_ps(t, c(super::LOG2_C4)));
+        let poly = _mm_add_ps(c(super::LOG2_C2), _mm_mul_ps(t, poly));
+        let poly = _mm_add_ps(c(super::LOG2_C1), _mm_mul_ps(t, poly));
+        (e, _mm_mul_ps(t, poly))
+    }
+}
+
 #[inline(always)]
 fn floor_frac(x: __m128) -> (__m128i, __m128) {
     // SAFETY: SSE2 is part of the x86_64 baseline.
@@ -168,35 +194,7 @@ pub(super) fn trilinear4<A: Addr>(tex: &MipTexture, u: Vec4, v: Vec4, m: Vec4) -
     unsafe {
         let (u, v, m): (__m128, __m128, __m128) = (u.into(), v.into(), m.into());
         // λ = log2 m split into ⌊λ⌋ (exponent) and frac(λ) (mantissa polynomial), as log2_split.
-        let bits = _mm_castps_si128(m);
-        let e = _mm_sub_epi32(
-            _mm_and_si128(_mm_srli_epi32::<23>(bits), _mm_set1_epi32(0xff)),
-            _mm_set1_epi32(127),
-        );
-        let t = _mm_sub_ps(
-            _mm_castsi128_ps(_mm_or_si128(
-                _mm_and_si128(bits, _mm_set1_epi32(0x007f_ffff)),
-                _mm_set1_epi32(0x3f80_0000),
-            )),
-            _mm_set1_ps(1.0),
-        );
-        let c = |k: f32| _mm_set1_ps(k);
-        let frac = _mm_mul_ps(
-            t,
-            _mm_add_ps(
-                c(super::LOG2_C1),
-                _mm_mul_ps(
-                    t,
-                    _mm_add_ps(
-                        c(super::LOG2_C2),
-                        _mm_mul_ps(
-                            t,
-                            _mm_add_ps(c(super::LOG2_C3), _mm_mul_ps(t, c(super::LOG2_C4))),
-                        ),
-                    ),
-                ),
-            ),
-        );
+        let (e, frac) = log2_split4(m);
         // Level pair per lane: magnification (λ ≤ 0, also NaN/0) -> level 0 alone; λ past the
         // top -> the top level alone; else (⌊λ⌋, ⌊λ⌋ + 1) blended by frac(λ).
         let minified = _mm_castps_si128(_mm_cmpgt_ps(m, _mm_set1_ps(1.0)));
@@ -528,35 +526,7 @@ pub(super) fn span_quads4<A: Addr, const K: usize>(
                 _mm_sub_ps(max4(&sx), min4(&sx)),
                 _mm_sub_ps(max4(&sy), min4(&sy)),
             );
-            let bits = _mm_castps_si128(ext);
-            let e = _mm_sub_epi32(
-                _mm_and_si128(_mm_srli_epi32::<23>(bits), _mm_set1_epi32(0xff)),
-                _mm_set1_epi32(127),
-            );
-            let t = _mm_sub_ps(
-                _mm_castsi128_ps(_mm_or_si128(
-                    _mm_and_si128(bits, _mm_set1_epi32(0x007f_ffff)),
-                    _mm_set1_epi32(0x3f80_0000),
-                )),
-                _mm_set1_ps(1.0),
-            );
-            let c = |k: f32| _mm_set1_ps(k);
-            let frac = _mm_mul_ps(
-                t,
-                _mm_add_ps(
-                    c(super::LOG2_C1),
-                    _mm_mul_ps(
-                        t,
-                        _mm_add_ps(
-                            c(super::LOG2_C2),
-                            _mm_mul_ps(
-                                t,
-                                _mm_add_ps(c(super::LOG2_C3), _mm_mul_ps(t, c(super::LOG2_C4))),
-                            ),
-                        ),
-                    ),
-                ),
-            );
+            let (e, frac) = log2_split4(ext);
             // K = 3 takes the pair one level coarser (see the module doc's level policy).
             let fine = _mm_add_epi32(e, _mm_set1_epi32(if K == 3 { 1 } else { 0 }));
             let below = _mm_cmplt_epi32(fine, _mm_setzero_si128());
