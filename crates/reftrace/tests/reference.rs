@@ -762,3 +762,64 @@ fn supersampling_averages_coverage_and_keeps_centre_depth() {
         assert!(partial > 20, "n = {n}: only {partial} edge pixels blended");
     }
 }
+
+#[test]
+fn a_tree_too_deep_for_the_wide_stack_falls_back_to_the_binary_bvh() {
+    // Spheres whose spacing grows geometrically along a line: every sphere's nearest neighbour is
+    // the cluster of all smaller ones, so the binary tree is a chain ~one level per sphere, deeper
+    // than the 4-wide traversal's fixed stack allows. Asking for Wide4 must then give the binary
+    // layout (not an overflow), and it must still agree with brute force.
+    let mut b = SceneBuilder::new().bvh(BvhKind::Wide4);
+    let mut spheres = Vec::new();
+    let mut x = 1.0f32;
+    // (×1.2 per sphere and 190 spheres keep every quadratic far from f32 overflow: r < 2e14.)
+    for _ in 0..190 {
+        b.add_sphere(Vec3::new(x, 0.0, 0.0), 0.15 * x, 0);
+        spheres.push((x, 0.15 * x));
+        x *= 1.2;
+    }
+    let scene = b.build();
+    assert_eq!(
+        scene.bvh_kind(),
+        Some(BvhKind::Bvh2),
+        "a chain of 190 geometrically spaced spheres should be too deep for Wide4"
+    );
+    // Rays across the line through every sphere (hits) and just outside it (misses), plus a ray
+    // along the line, which meets sphere 0 first.
+    let mut rng = Lcg(77);
+    let (mut hits, mut rays) = (0, 0);
+    for &(cx, r) in &spheres {
+        for dy in [0.0, 0.5 * r, 0.99 * r, 1.01 * r] {
+            let origin = Vec3::new(cx + rng.range(-0.1, 0.1) * r, dy, -10.0 * r);
+            let ray = Ray {
+                origin,
+                dir: Vec3::Z,
+            };
+            let a = scene.intersect(&ray).map(|h| (h.t, h.prim_id));
+            let e = scene.intersect_brute_force(&ray).map(|h| (h.t, h.prim_id));
+            assert_eq!(a, e, "BVH and brute force disagree for {ray:?}");
+            hits += a.is_some() as usize;
+            rays += 1;
+        }
+    }
+    let along = Ray {
+        origin: Vec3::new(-5.0, 0.0, 0.0),
+        dir: Vec3::X,
+    };
+    let a = scene.intersect(&along).map(|h| (h.t, h.prim_id));
+    assert_eq!(
+        a,
+        scene
+            .intersect_brute_force(&along)
+            .map(|h| (h.t, h.prim_id))
+    );
+    assert_eq!(
+        a.map(|(_, id)| id),
+        Some(0),
+        "the ray along the line meets sphere 0 first"
+    );
+    assert!(
+        hits >= 3 * spheres.len() && hits < rays,
+        "too few hits ({hits} of {rays}) or no miss: not a test"
+    );
+}
