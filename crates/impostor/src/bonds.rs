@@ -65,7 +65,7 @@ use texmap_core::frame::Frame;
 use texmap_core::shade::{Lighting, Material};
 
 use crate::SphereScene;
-use crate::fastshade::{self, Surf8, W};
+use crate::fastshade::{self, M8, Surf8, V8, W};
 use crate::pipeline::{self, FLAG_INSIDE, LANES, NONE, TILE, TILE_BUF, TILE_PX, View};
 
 /// Bonds per projection chunk: fixed, so results do not depend on the thread count.
@@ -152,6 +152,17 @@ impl BondRec {
     #[inline]
     fn a(&self) -> Vec3 {
         Vec3::from(self.q) + Vec3::from(self.u) * self.au
+    }
+
+    /// A lower bound of the depth of every fragment of the bond: the nearer end's depth minus
+    /// `r` (the capped cylinder lies in the capsule around its axis), widened by 1e-4 of itself
+    /// against rounding in the per-pixel intersection.
+    #[inline]
+    fn zmin(&self) -> f32 {
+        let za = self.q[2] + self.u[2] * self.au;
+        let zb = za + self.u[2] * self.len;
+        let d = (if za > zb { -za } else { -zb }) - self.r2.sqrt();
+        d - 1e-4 * d.abs()
     }
 }
 
@@ -425,122 +436,194 @@ impl BondBins {
     }
 }
 
-/// Per-lane ray data of 8 pixels in one row, in the generic form of the intersection.
-struct Lanes {
-    /// `A = |d × u|²`.
-    a: [f32; LANES],
-    /// `g·(d × u)` (up to sign): `√A` times the ray–axis distance.
-    dn: [f32; LANES],
-    /// Closest approach `s = num / A`.
-    num: [f32; LANES],
-    /// `h(o)`: axial coordinate of the ray origin.
-    h0: [f32; LANES],
-    /// `d·u`.
-    du: [f32; LANES],
-    /// For rays parallel to the axis: whether the ray runs inside the infinite cylinder.
-    par_in: [bool; LANES],
+/// The per-(bond, tile) constants of the intersection, splatted into lanes once.
+struct BondV {
+    u: [V8; 3],
+    n: [V8; 3],
+    q: [V8; 3],
+    /// `a`, the first end point (orthographic rays start on the eye plane, so need `g = o − a`).
+    a: [V8; 3],
+    /// `a·u` and its negation `h(0)` (perspective rays start at the eye).
+    au: V8,
+    neg_au: V8,
+    len: V8,
+    r2: V8,
+    /// Orthographic `A = ux² + uy²` and `d·u = −uz` (the same for every ray).
+    a_ortho: V8,
+    du_ortho: V8,
+    /// Perspective: 1 where the eye lies inside the infinite cylinder (`|q|² ≤ r²`), else 0.
+    par_in_persp: V8,
 }
 
-/// Intersect 8 rays with one bond: depths (`INFINITY` for a miss or a clipped hit) and flags.
+impl BondV {
+    #[inline(always)]
+    fn new(rec: &BondRec) -> BondV {
+        let sp = |v: [f32; 3]| v.map(V8::splat);
+        let a = rec.a();
+        let [ux, uy, uz] = rec.u;
+        let qq = Vec3::from(rec.q).length_squared();
+        BondV {
+            u: sp(rec.u),
+            n: sp(rec.n),
+            q: sp(rec.q),
+            a: sp(a.to_array()),
+            au: V8::splat(rec.au),
+            neg_au: V8::splat(-rec.au),
+            len: V8::splat(rec.len),
+            r2: V8::splat(rec.r2),
+            a_ortho: V8::splat(ux * ux + uy * uy),
+            du_ortho: V8::splat(-uz),
+            par_in_persp: V8::splat(if qq <= rec.r2 { 1.0 } else { 0.0 }),
+        }
+    }
+}
+
+/// Ray data of 8 pixels (any rows), in the generic form of the intersection.
+struct Rays {
+    /// `A = |d × u|²`.
+    a: V8,
+    /// `g·(d × u)` (up to sign): `√A` times the ray–axis distance.
+    dn: V8,
+    /// Closest approach `s = num / A`.
+    num: V8,
+    /// `h(o)`: axial coordinate of the ray origin, and its negation.
+    h0: V8,
+    neg_h0: V8,
+    /// `d·u`.
+    du: V8,
+    /// For rays parallel to the axis: 1 where the ray runs inside the infinite cylinder, else 0.
+    par_in: V8,
+}
+
+/// Rays of a perspective camera: `o = 0`, `d = (x, y, −1)` per lane.
+#[inline(always)]
+fn rays_persp(b: &BondV, x: V8, y: V8) -> Rays {
+    let [ux, uy, uz] = b.u;
+    let [nx, ny, nz] = b.n;
+    let [qx, qy, qz] = b.q;
+    let zero = V8::splat(0.0);
+    // d × u, component by component (z of d is −1).
+    let c1 = y * uz + uy;
+    let c2 = (zero - ux) - x * uz;
+    let c3 = x * uy - y * ux;
+    Rays {
+        a: c1 * c1 + c2 * c2 + c3 * c3,
+        dn: x * nx + y * ny - nz,
+        num: x * qx + y * qy - qz,
+        h0: b.neg_au,
+        neg_h0: b.au,
+        du: x * ux + y * uy - uz,
+        par_in: b.par_in_persp,
+    }
+}
+
+/// Rays of an orthographic camera: `o = (x, y, 0)` per lane, `d = (0, 0, −1)`.
+#[inline(always)]
+fn rays_ortho(b: &BondV, x: V8, y: V8) -> Rays {
+    let [ux, uy, uz] = b.u;
+    let [ax, ay, az] = b.a;
+    let zero = V8::splat(0.0);
+    // g = o − a; d × u = (uy, −ux, 0).
+    let (gx, gy, gz) = (x - ax, y - ay, zero - az);
+    let gxy = gx * ux + gy * uy;
+    let gu = gxy + gz * uz;
+    let par_in = (gx * gx + gy * gy + gz * gz - gu * gu).le(b.r2);
+    Rays {
+        a: b.a_ortho,
+        dn: gx * uy - gy * ux,
+        // s = −(g·w)/A with w = d − (d·u)u = (uz·ux, uz·uy, −A) (as |u| = 1): written so, not
+        // as `gz − uz·(g·u)`, which cancels two terms of the size of the depth when the bond is
+        // seen nearly end-on.
+        num: gz * b.a_ortho - uz * gxy,
+        h0: gu,
+        neg_h0: zero - gu,
+        du: b.du_ortho,
+        par_in: V8::select(par_in, V8::splat(1.0), zero),
+    }
+}
+
+/// Intersect 8 rays with one bond: depths (`INFINITY` for a miss, a clipped hit or a lane
+/// outside `lanes`) and the winner words `idx | flags` of [`Words`].
 ///
 /// Entry and exit of the solid capped cylinder are `max`/`min` of the infinite-cylinder interval
 /// and the cap slab (module docs); entry nearer than the near plane takes the exit instead.
 #[inline(always)]
-fn solve8(
-    rec: &BondRec,
-    l: &Lanes,
-    valid: usize,
-    near: f32,
-    far: f32,
-) -> ([f32; LANES], [u32; LANES]) {
-    let mut t = [f32::INFINITY; LANES];
-    let mut flag = [0u32; LANES];
-    for k in 0..LANES {
-        let a = l.a[k];
-        let par = !(a > PARALLEL_A);
-        // Infinite cylinder: s ∓ √(r²A − dn²)/A.
-        let ia = 1.0 / if par { 1.0 } else { a };
-        let disc = rec.r2 * a - l.dn[k] * l.dn[k];
-        let hc = (if disc > 0.0 { disc } else { 0.0 }).sqrt() * ia;
-        let s = l.num[k] * ia;
-        let side_hit = if par { l.par_in[k] } else { disc >= 0.0 };
-        let t0 = if par { f32::NEG_INFINITY } else { s - hc };
-        let t1 = if par { f32::INFINITY } else { s + hc };
-        // Cap slab: 0 ≤ h0 + t·du ≤ len.
-        let du = l.du[k];
-        let du = if du.abs() > MIN_DU { du } else { MIN_DU };
-        let inv = 1.0 / du;
-        let ta = -l.h0[k] * inv;
-        let tb = (rec.len - l.h0[k]) * inv;
-        let (s0, s1) = if ta < tb { (ta, tb) } else { (tb, ta) };
-        // Entry and exit of the solid.
-        let en = if t0 > s0 { t0 } else { s0 };
-        let ex = if t1 < s1 { t1 } else { s1 };
-        let front = en >= near;
-        let th = if front { en } else { ex };
-        let cap = if front { s0 > t0 } else { s1 < t1 };
-        let ok = side_hit && en <= ex && th >= near && th <= far && k < valid;
-        t[k] = if ok { th } else { f32::INFINITY };
-        flag[k] = (if front { 0 } else { FLAG_INSIDE }) | (if cap { FLAG_CAP } else { 0 });
-    }
-    (t, flag)
+fn solve8(b: &BondV, l: &Rays, lanes: M8, near: V8, far: V8, w: &Words) -> (V8, V8) {
+    let zero = V8::splat(0.0);
+    let one = V8::splat(1.0);
+    let inf = V8::splat(f32::INFINITY);
+    // Infinite cylinder: s ∓ √(r²A − dn²)/A; a ray parallel to the axis (A ≤ 1e-12) is inside
+    // everywhere or nowhere.
+    let par = l.a.le(V8::splat(PARALLEL_A));
+    let ia = one / V8::select(par, one, l.a);
+    let disc = b.r2 * l.a - l.dn * l.dn;
+    let hc = disc.max(zero).sqrt() * ia;
+    let s = l.num * ia;
+    let side_hit = V8::select(par, l.par_in, V8::select(disc.ge(zero), one, zero));
+    let t0 = V8::select(par, V8::splat(f32::NEG_INFINITY), s - hc);
+    let t1 = V8::select(par, inf, s + hc);
+    // Cap slab: 0 ≤ h0 + t·du ≤ len (|du| ≤ MIN_DU replaced by MIN_DU).
+    let du = V8::select(
+        l.du.lt(V8::splat(-MIN_DU)),
+        l.du,
+        V8::select(l.du.gt(V8::splat(MIN_DU)), l.du, V8::splat(MIN_DU)),
+    );
+    let inv = one / du;
+    let ta = l.neg_h0 * inv;
+    let tb = (b.len - l.h0) * inv;
+    let lt = ta.lt(tb);
+    let s0 = V8::select(lt, ta, tb);
+    let s1 = V8::select(lt, tb, ta);
+    // Entry and exit of the solid.
+    let en = t0.max(s0);
+    let ex = t1.min(s1);
+    let front = en.ge(near);
+    let th = V8::select(front, en, ex);
+    let ok = side_hit
+        .gt(zero)
+        .and(en.le(ex))
+        .and(th.ge(near))
+        .and(th.le(far))
+        .and(lanes);
+    // Winner words: inside flag where the exit was taken, cap flag where the hit is on a cap.
+    let word = V8::select(
+        front,
+        V8::select(s0.gt(t0), w.cap, w.side),
+        V8::select(s1.lt(t1), w.in_cap, w.in_side),
+    );
+    (V8::select(ok, th, inf), word)
 }
 
-/// Fill the lanes of a perspective camera: `o = 0`, `d = (dx, dy, −1)`.
-#[inline(always)]
-fn lanes_persp(rec: &BondRec, dx: &[f32], dy: f32, qq: f32) -> Lanes {
-    let [ux, uy, uz] = rec.u;
-    let [nx, ny, nz] = rec.n;
-    let [qx, qy, qz] = rec.q;
-    let mut l = Lanes {
-        a: [0.0; LANES],
-        dn: [0.0; LANES],
-        num: [0.0; LANES],
-        h0: [-rec.au; LANES],
-        du: [0.0; LANES],
-        par_in: [qq <= rec.r2; LANES],
-    };
-    for k in 0..LANES {
-        let x = dx[k];
-        // d × u, component by component (z of d is −1).
-        let c1 = dy * uz + uy;
-        let c2 = -ux - x * uz;
-        let c3 = x * uy - dy * ux;
-        l.a[k] = c1 * c1 + c2 * c2 + c3 * c3;
-        l.dn[k] = x * nx + dy * ny - nz;
-        l.num[k] = x * qx + dy * qy - qz;
-        l.du[k] = x * ux + dy * uy - uz;
-    }
-    l
+/// The four winner words of one bond (`idx` with the cap and inside flags), as lane bits.
+struct Words {
+    side: V8,
+    cap: V8,
+    in_side: V8,
+    in_cap: V8,
 }
 
-/// Fill the lanes of an orthographic camera: `o = (ox, oy, 0)`, `d = (0, 0, −1)`.
-#[inline(always)]
-fn lanes_ortho(rec: &BondRec, ox: &[f32], oy: f32, a_eye: Vec3) -> Lanes {
-    let [ux, uy, uz] = rec.u;
-    let a = ux * ux + uy * uy;
-    let mut l = Lanes {
-        a: [a; LANES],
-        dn: [0.0; LANES],
-        num: [0.0; LANES],
-        h0: [0.0; LANES],
-        du: [-uz; LANES],
-        par_in: [false; LANES],
-    };
-    for k in 0..LANES {
-        let x = ox[k];
-        // g = o − a; d × u = (uy, −ux, 0).
-        let (gx, gy, gz) = (x - a_eye.x, oy - a_eye.y, -a_eye.z);
-        let gu = gx * ux + gy * uy + gz * uz;
-        l.dn[k] = gx * uy - gy * ux;
-        // s = −(g·w)/A with w = d − (d·u)u = (uz·ux, uz·uy, −A) (as |u| = 1): written so,
-        // not as `gz − uz·(g·u)`, which cancels two terms of the size of the depth when the
-        // bond is seen nearly end-on.
-        l.num[k] = gz * a - uz * (gx * ux + gy * uy);
-        l.h0[k] = gu;
-        l.par_in[k] = gx * gx + gy * gy + gz * gz - gu * gu <= rec.r2;
+impl Words {
+    #[inline(always)]
+    fn new(idx: u32) -> Words {
+        Words {
+            side: V8::splat_bits(idx),
+            cap: V8::splat_bits(idx | FLAG_CAP),
+            in_side: V8::splat_bits(idx | FLAG_INSIDE),
+            in_cap: V8::splat_bits(idx | FLAG_INSIDE | FLAG_CAP),
+        }
     }
-    l
+}
+
+/// Strict depth test of 8 lanes against `depth`/`win` (the atom, then the earlier bond, wins ties).
+#[inline(always)]
+fn depth_test8(t: V8, word: V8, depth: &mut [f32], win: &mut [u32]) {
+    let d = V8::load_from(depth);
+    let closer = t.lt(d);
+    if closer.bits() == 0 {
+        return;
+    }
+    V8::select(closer, t, d).store_to(depth);
+    V8::select(closer, word, V8::load_bits(win)).store_bits(win);
 }
 
 /// A tile's bond depth test: the depth buffer starts from the sphere pass.
@@ -559,15 +642,42 @@ struct Kernel<'a> {
 impl Kernel<'_> {
     /// Depth pass of one tile over its bin, in bond order.
     fn raster(&self, recs: &[BondRec], x0t: u32, y0t: u32, w: u32, h: u32, buf: &mut TileBuf) {
+        if self.view.ortho {
+            self.raster_with(recs, x0t, y0t, w, h, buf, rays_ortho);
+        } else {
+            self.raster_with(recs, x0t, y0t, w, h, buf, rays_persp);
+        }
+    }
+
+    /// [`Kernel::raster`] with the camera's ray generator chosen outside the loops.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn raster_with(
+        &self,
+        recs: &[BondRec],
+        x0t: u32,
+        y0t: u32,
+        w: u32,
+        h: u32,
+        buf: &mut TileBuf,
+        rays: impl Fn(&BondV, V8, V8) -> Rays,
+    ) {
+        const T: usize = TILE as usize;
         let v = &self.view;
         // Per-tile coordinate tables: perspective ray slopes, or orthographic ray origins (both
         // are `(pixel centre − image centre)/k`).
-        let mut xs = [0f32; TILE as usize + LANES];
+        let mut xs = [0f32; T + LANES];
         for (i, x) in xs.iter_mut().enumerate() {
             *x = ((x0t + i as u32) as f32 + 0.5 - v.cx) * v.inv_k;
         }
+        let mut ys = [0f32; T];
+        for (j, y) in ys.iter_mut().enumerate() {
+            *y = (v.cy - ((y0t + j as u32) as f32 + 0.5)) * v.inv_k;
+        }
+        let (near, far) = (V8::splat(v.near), V8::splat(v.far));
+        let view_w = v.width;
         for (idx, rec) in recs.iter().enumerate() {
-            // Clip the bond's rectangle to the tile.
+            // Clip the bond's rectangle to the tile (tile-local columns i0..i1, rows j0..j1).
             let bx0 = (rec.bbox[0] as u32).max(x0t);
             let by0 = (rec.bbox[1] as u32).max(y0t);
             let bx1 = (rec.bbox[2] as u32).min(x0t + w);
@@ -575,39 +685,80 @@ impl Kernel<'_> {
             if bx0 >= bx1 || by0 >= by1 {
                 continue;
             }
-            let view_w = v.width;
-            let a_eye = rec.a();
-            let qq = Vec3::from(rec.q).length_squared();
-            for y in by0..by1 {
-                let j = (y - y0t) as usize;
-                let ys = (v.cy - (y as f32 + 0.5)) * v.inv_k;
-                // This row's span of the hull of the end spheres' rectangles.
-                let Some((sx0, sx1)) = row_span(&rec.ends, y as f32 + 0.5) else {
-                    continue;
-                };
-                let (px0, px1) = View::pixel_range(sx0, sx1, view_w);
-                let px0 = (px0 as u32).max(bx0);
-                let px1 = (px1 as u32).min(bx1);
-                if px0 >= px1 {
-                    continue;
+            let (i0, i1) = ((bx0 - x0t) as usize, (bx1 - x0t) as usize);
+            let (j0, j1) = ((by0 - y0t) as usize, (by1 - y0t) as usize);
+            let b = BondV::new(rec);
+            let words = Words::new(idx as u32);
+            // Hierarchical z: no fragment of the bond is nearer than its nearest end minus r
+            // (the capped cylinder lies in the capsule around its axis), so 8 pixels whose
+            // stored depths are all at least that near are skipped. The bound is widened by
+            // 1e-4 of itself against rounding in `solve8`.
+            let zmin = V8::splat(rec.zmin());
+            if i1 - i0 <= 4 {
+                // Narrow boxes (thin or short bonds): two rows of up to 4 pixels per 8 lanes.
+                let cols = M8::first_of_halves(i1 - i0);
+                let x = V8::load_halves(&xs[i0..], &xs[i0..]);
+                let mut j = j0;
+                while j < j1 {
+                    let two = j + 1 < j1;
+                    let jb = if two { j + 1 } else { j };
+                    let (o0, o1) = (j * T + i0, jb * T + i0);
+                    let d = V8::load_halves(&buf.depth[o0..], &buf.depth[o1..]);
+                    let lanes = if two { cols } else { cols.and(M8::first(4)) };
+                    if zmin.lt(d).and(lanes).bits() != 0 {
+                        let y = V8::load_halves(&[ys[j]; 4], &[ys[jb]; 4]);
+                        let (t, word) = solve8(&b, &rays(&b, x, y), lanes, near, far, &words);
+                        let closer = t.lt(d);
+                        if closer.bits() != 0 {
+                            let nd = V8::select(closer, t, d);
+                            let mut wins = [0u32; LANES];
+                            wins[..4].copy_from_slice(&buf.win[o0..o0 + 4]);
+                            wins[4..].copy_from_slice(&buf.win[o1..o1 + 4]);
+                            V8::select(closer, word, V8::load_bits(&wins)).store_bits(&mut wins);
+                            nd.store_lo(&mut buf.depth[o0..]);
+                            buf.win[o0..o0 + 4].copy_from_slice(&wins[..4]);
+                            if two {
+                                nd.store_hi(&mut buf.depth[o1..]);
+                                buf.win[o1..o1 + 4].copy_from_slice(&wins[4..]);
+                            }
+                        }
+                    }
+                    j += 2;
                 }
-                let mut i = (px0 - x0t) as usize;
-                let i1 = (px1 - x0t) as usize;
-                while i < i1 {
-                    let lanes = if v.ortho {
-                        lanes_ortho(rec, &xs[i..i + LANES], ys, a_eye)
-                    } else {
-                        lanes_persp(rec, &xs[i..i + LANES], ys, qq)
+                continue;
+            }
+            for j in j0..j1 {
+                // Wider boxes: this row's span of the hull of the end spheres' rectangles.
+                let (a, e) = if i1 - i0 > LANES {
+                    let y = (y0t as usize + j) as f32 + 0.5;
+                    let Some((sx0, sx1)) = row_span(&rec.ends, y) else {
+                        continue;
                     };
-                    let (t, flag) = solve8(rec, &lanes, i1 - i, v.near, v.far);
-                    // Strict depth test: the atom (or the earlier bond) wins ties.
-                    let b = j * TILE as usize + i;
-                    let depth = &mut buf.depth[b..b + LANES];
-                    let win = &mut buf.win[b..b + LANES];
-                    for k in 0..LANES {
-                        let closer = t[k] < depth[k];
-                        depth[k] = if closer { t[k] } else { depth[k] };
-                        win[k] = if closer { idx as u32 | flag[k] } else { win[k] };
+                    let (px0, px1) = View::pixel_range(sx0, sx1, view_w);
+                    let a = (px0 as u32).max(bx0);
+                    let e = (px1 as u32).min(bx1);
+                    if a >= e {
+                        continue;
+                    }
+                    ((a - x0t) as usize, (e - x0t) as usize)
+                } else {
+                    (i0, i1)
+                };
+                let y = V8::splat(ys[j]);
+                let mut i = a;
+                while i < e {
+                    let o = j * T + i;
+                    let lanes = M8::first(e - i);
+                    let d = V8::load_from(&buf.depth[o..]);
+                    if zmin.lt(d).and(lanes).bits() != 0 {
+                        let x = V8::load_from(&xs[i..]);
+                        let (t, word) = solve8(&b, &rays(&b, x, y), lanes, near, far, &words);
+                        depth_test8(
+                            t,
+                            word,
+                            &mut buf.depth[o..o + LANES],
+                            &mut buf.win[o..o + LANES],
+                        );
                     }
                     i += LANES;
                 }
@@ -811,5 +962,222 @@ mod tests {
             assert!(row_span(&ends, top).is_none(), "{ends:?}");
         }
         assert_eq!(hits, 100_000);
+    }
+
+    // The previous scalar kernel (one lane at a time, validated against reftrace), kept as the
+    // reference of the lane kernel: the same IEEE operations in the same order.
+    /// Per-lane ray data of 8 pixels in one row, in the generic form of the intersection.
+    struct Lanes {
+        /// `A = |d × u|²`.
+        a: [f32; LANES],
+        /// `g·(d × u)` (up to sign): `√A` times the ray–axis distance.
+        dn: [f32; LANES],
+        /// Closest approach `s = num / A`.
+        num: [f32; LANES],
+        /// `h(o)`: axial coordinate of the ray origin.
+        h0: [f32; LANES],
+        /// `d·u`.
+        du: [f32; LANES],
+        /// For rays parallel to the axis: whether the ray runs inside the infinite cylinder.
+        par_in: [bool; LANES],
+    }
+
+    /// Intersect 8 rays with one bond: depths (`INFINITY` for a miss or a clipped hit) and flags.
+    ///
+    /// Entry and exit of the solid capped cylinder are `max`/`min` of the infinite-cylinder interval
+    /// and the cap slab (module docs); entry nearer than the near plane takes the exit instead.
+    #[inline(always)]
+    fn solve8_scalar(
+        rec: &BondRec,
+        l: &Lanes,
+        valid: usize,
+        near: f32,
+        far: f32,
+    ) -> ([f32; LANES], [u32; LANES]) {
+        let mut t = [f32::INFINITY; LANES];
+        let mut flag = [0u32; LANES];
+        for k in 0..LANES {
+            let a = l.a[k];
+            let par = !(a > PARALLEL_A);
+            // Infinite cylinder: s ∓ √(r²A − dn²)/A.
+            let ia = 1.0 / if par { 1.0 } else { a };
+            let disc = rec.r2 * a - l.dn[k] * l.dn[k];
+            let hc = (if disc > 0.0 { disc } else { 0.0 }).sqrt() * ia;
+            let s = l.num[k] * ia;
+            let side_hit = if par { l.par_in[k] } else { disc >= 0.0 };
+            let t0 = if par { f32::NEG_INFINITY } else { s - hc };
+            let t1 = if par { f32::INFINITY } else { s + hc };
+            // Cap slab: 0 ≤ h0 + t·du ≤ len.
+            let du = l.du[k];
+            let du = if du.abs() > MIN_DU { du } else { MIN_DU };
+            let inv = 1.0 / du;
+            let ta = -l.h0[k] * inv;
+            let tb = (rec.len - l.h0[k]) * inv;
+            let (s0, s1) = if ta < tb { (ta, tb) } else { (tb, ta) };
+            // Entry and exit of the solid.
+            let en = if t0 > s0 { t0 } else { s0 };
+            let ex = if t1 < s1 { t1 } else { s1 };
+            let front = en >= near;
+            let th = if front { en } else { ex };
+            let cap = if front { s0 > t0 } else { s1 < t1 };
+            let ok = side_hit && en <= ex && th >= near && th <= far && k < valid;
+            t[k] = if ok { th } else { f32::INFINITY };
+            flag[k] = (if front { 0 } else { FLAG_INSIDE }) | (if cap { FLAG_CAP } else { 0 });
+        }
+        (t, flag)
+    }
+
+    /// Fill the lanes of a perspective camera: `o = 0`, `d = (dx, dy, −1)`.
+    #[inline(always)]
+    fn lanes_persp(rec: &BondRec, dx: &[f32], dy: f32, qq: f32) -> Lanes {
+        let [ux, uy, uz] = rec.u;
+        let [nx, ny, nz] = rec.n;
+        let [qx, qy, qz] = rec.q;
+        let mut l = Lanes {
+            a: [0.0; LANES],
+            dn: [0.0; LANES],
+            num: [0.0; LANES],
+            h0: [-rec.au; LANES],
+            du: [0.0; LANES],
+            par_in: [qq <= rec.r2; LANES],
+        };
+        for k in 0..LANES {
+            let x = dx[k];
+            // d × u, component by component (z of d is −1).
+            let c1 = dy * uz + uy;
+            let c2 = -ux - x * uz;
+            let c3 = x * uy - dy * ux;
+            l.a[k] = c1 * c1 + c2 * c2 + c3 * c3;
+            l.dn[k] = x * nx + dy * ny - nz;
+            l.num[k] = x * qx + dy * qy - qz;
+            l.du[k] = x * ux + dy * uy - uz;
+        }
+        l
+    }
+
+    /// Fill the lanes of an orthographic camera: `o = (ox, oy, 0)`, `d = (0, 0, −1)`.
+    #[inline(always)]
+    fn lanes_ortho(rec: &BondRec, ox: &[f32], oy: f32, a_eye: Vec3) -> Lanes {
+        let [ux, uy, uz] = rec.u;
+        let a = ux * ux + uy * uy;
+        let mut l = Lanes {
+            a: [a; LANES],
+            dn: [0.0; LANES],
+            num: [0.0; LANES],
+            h0: [0.0; LANES],
+            du: [-uz; LANES],
+            par_in: [false; LANES],
+        };
+        for k in 0..LANES {
+            let x = ox[k];
+            // g = o − a; d × u = (uy, −ux, 0).
+            let (gx, gy, gz) = (x - a_eye.x, oy - a_eye.y, -a_eye.z);
+            let gu = gx * ux + gy * uy + gz * uz;
+            l.dn[k] = gx * uy - gy * ux;
+            // s = −(g·w)/A with w = d − (d·u)u = (uz·ux, uz·uy, −A) (as |u| = 1): written so,
+            // not as `gz − uz·(g·u)`, which cancels two terms of the size of the depth when the
+            // bond is seen nearly end-on.
+            l.num[k] = gz * a - uz * (gx * ux + gy * uy);
+            l.h0[k] = gu;
+            l.par_in[k] = gx * gx + gy * gy + gz * gz - gu * gu <= rec.r2;
+        }
+        l
+    }
+
+    /// The lane kernel (`rays_*` + `solve8`) against the scalar reference on random bonds, views
+    /// and pixels, including bonds seen exactly end-on (rays parallel to the axis) and bonds
+    /// crossing the near plane: the same depths (bit for bit, up to the sign of zero) and the
+    /// same flags wherever a lane hits.
+    #[test]
+    fn lane_kernel_matches_the_scalar_reference() {
+        use texmap_core::camera::Camera;
+        let mut rng = Lcg(11);
+        let (mut hits, mut compared, mut par_lanes) = (0usize, 0usize, 0usize);
+        for trial in 0..600 {
+            let ortho = trial % 3 == 2;
+            let eye = if trial % 5 == 0 {
+                Vec3::new(0.0, 0.0, 8.0)
+            } else {
+                Vec3::new(rng.f(-9.0, 9.0), rng.f(-9.0, 9.0), rng.f(4.0, 12.0))
+            };
+            let cam = if ortho {
+                Camera::orthographic_look_at(eye, Vec3::ZERO, Vec3::Y, rng.f(3.0, 9.0), 96, 80)
+            } else {
+                Camera::perspective_look_at(eye, Vec3::ZERO, Vec3::Y, rng.f(10.0, 150.0), 96, 80)
+            }
+            .unwrap();
+            let view = View::new(&cam);
+            // Bond: random, or exactly along the view axis of the axis-aligned eye.
+            let (pa, pb) = if trial % 5 == 0 {
+                let p = Vec3::new(rng.f(-1.0, 1.0), rng.f(-1.0, 1.0), rng.f(-2.0, 2.0));
+                (p, p - Vec3::Z * rng.f(0.5, 2.0))
+            } else {
+                let p = Vec3::new(rng.f(-3.0, 3.0), rng.f(-3.0, 3.0), rng.f(-3.0, 3.0));
+                let q = Vec3::new(rng.f(-1.5, 1.5), rng.f(-1.5, 1.5), rng.f(-1.5, 1.5));
+                (p, p + q)
+            };
+            let r = rng.f(0.05, 0.8);
+            let a = eye_space_f64(&view, pa);
+            let b = eye_space_f64(&view, pb);
+            let Some(rec) = project(&view, a, b, r, [0, 1]) else {
+                continue;
+            };
+            let bv = BondV::new(&rec);
+            let words = Words::new(5);
+            let qq = Vec3::from(rec.q).length_squared();
+            let (near, far) = (V8::splat(view.near), V8::splat(view.far));
+            let [x0, y0, x1, y1] = rec.bbox.map(|v| v as u32);
+            for y in y0.saturating_sub(2)..(y1 + 2).min(view.height) {
+                let ys = (view.cy - (y as f32 + 0.5)) * view.inv_k;
+                let mut xs = [0f32; LANES];
+                let mut i = x0.saturating_sub(3);
+                while i < (x1 + 3).min(view.width) {
+                    for (k, x) in xs.iter_mut().enumerate() {
+                        *x = ((i + k as u32) as f32 + 0.5 - view.cx) * view.inv_k;
+                    }
+                    let lanes_ref = if view.ortho {
+                        lanes_ortho(&rec, &xs, ys, rec.a())
+                    } else {
+                        lanes_persp(&rec, &xs, ys, qq)
+                    };
+                    let (t_ref, f_ref) =
+                        solve8_scalar(&rec, &lanes_ref, LANES, view.near, view.far);
+                    let (x, yv) = (V8::load(&xs), V8::splat(ys));
+                    let rays = if view.ortho {
+                        rays_ortho(&bv, x, yv)
+                    } else {
+                        rays_persp(&bv, x, yv)
+                    };
+                    let (t, word) = solve8(&bv, &rays, M8::first(LANES), near, far, &words);
+                    let (t, word) = (t.store(), word.store());
+                    for k in 0..LANES {
+                        par_lanes += !(lanes_ref.a[k] > PARALLEL_A) as usize;
+                        compared += 1;
+                        assert!(
+                            t[k] == t_ref[k] || (t[k].is_infinite() && t_ref[k].is_infinite()),
+                            "trial {trial} pixel ({}, {y}): lane t {} vs scalar {}",
+                            i + k as u32,
+                            t[k],
+                            t_ref[k]
+                        );
+                        if t[k].is_finite() {
+                            hits += 1;
+                            assert_eq!(
+                                word[k].to_bits(),
+                                5 | f_ref[k],
+                                "trial {trial} pixel ({}, {y}): flags",
+                                i + k as u32
+                            );
+                        }
+                    }
+                    i += LANES as u32;
+                }
+            }
+        }
+        eprintln!("{hits} hits, {par_lanes} parallel lanes of {compared} lanes compared");
+        assert!(
+            hits > 20_000 && par_lanes > 10,
+            "{hits} hits, {par_lanes} parallel lanes"
+        );
     }
 }
