@@ -135,6 +135,10 @@ pub struct MipTexture {
     wrap: Wrap,
     reduction: Reduction,
     pow2: bool,
+    /// Texel index of level `min(i, last)`'s texel (0, 0), as `i32` (the sum of all level areas is
+    /// at most 4/3 · 16384² < 2^31): a 16-entry table the AVX2 sampling kernels look levels up in
+    /// with two register permutes instead of per-pixel loads.
+    offsets16: [i32; 16],
 }
 
 /// The input's encoding, which decides the averaging space of [`Reduction::Box`].
@@ -289,12 +293,15 @@ impl MipTexture {
         // Linear-light storage of sRGB Box levels can only drift by float rounding: keep it finite.
         debug_assert!(texels.iter().all(|t| t.is_finite()));
         let pow2 = width.is_power_of_two() && height.is_power_of_two();
+        let last = levels.len() - 1;
+        let offsets16 = std::array::from_fn(|i| levels[i.min(last)].offset as i32);
         MipTexture {
             texels,
             levels,
             wrap,
             reduction,
             pow2,
+            offsets16,
         }
     }
 
@@ -339,6 +346,12 @@ impl MipTexture {
     #[inline]
     pub fn levels(&self) -> &[LevelInfo] {
         &self.levels
+    }
+    /// Texel index of each level's texel (0, 0) for levels `0..16`, entries past the top level
+    /// repeating the top level's (for the sampling kernels' table look-ups).
+    #[inline]
+    pub(crate) fn level_offsets16(&self) -> &[i32; 16] {
+        &self.offsets16
     }
     /// All texels of all levels (linear RGBA), level 0 first, row-major.
     #[inline]

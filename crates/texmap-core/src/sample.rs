@@ -119,6 +119,8 @@ use glam::{Vec2, Vec4, Vec4Swizzles};
 use crate::mip::{LevelInfo, MipTexture, Wrap};
 
 #[cfg(target_arch = "x86_64")]
+mod avx2;
+#[cfg(target_arch = "x86_64")]
 mod lanes;
 
 /// Memory banks per side for the span sampler.

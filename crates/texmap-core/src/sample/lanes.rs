@@ -45,7 +45,7 @@ fn splat_lane(v: __m128, j: usize) -> Vec4 {
 /// log2 of four positive floats split into ⌊log2 x⌋ (the exponent) and frac(log2 x) (the
 /// mantissa polynomial), lane for lane the same operations as the scalar `log2_split`.
 #[inline(always)]
-fn log2_split4(x: __m128) -> (__m128i, __m128) {
+pub(super) fn log2_split4(x: __m128) -> (__m128i, __m128) {
     // SAFETY: SSE2 is part of the x86_64 baseline.
     unsafe {
         let bits = _mm_castps_si128(x);
@@ -82,7 +82,7 @@ fn floor_frac(x: __m128) -> (__m128i, __m128) {
 /// [`super::clampc`] lane-wise: NaN -> −2^30, then clamp to ±2^30 (`maxps` returns its second
 /// operand when the first is NaN).
 #[inline(always)]
-fn clamp_coord(x: __m128) -> __m128 {
+pub(super) fn clamp_coord(x: __m128) -> __m128 {
     // SAFETY: SSE2 is part of the x86_64 baseline.
     unsafe {
         _mm_min_ps(
@@ -94,7 +94,7 @@ fn clamp_coord(x: __m128) -> __m128 {
 
 /// `Addr::wrap` on four lanes: `n` holds the level size per lane.
 #[inline(always)]
-fn wrap4<A: Addr>(i: __m128i, n: __m128i) -> __m128i {
+pub(super) fn wrap4<A: Addr>(i: __m128i, n: __m128i) -> __m128i {
     // SAFETY: SSE2 is part of the x86_64 baseline.
     unsafe {
         let nm1 = _mm_sub_epi32(n, _mm_set1_epi32(1));
@@ -297,7 +297,7 @@ fn lane_i32(v: &[i32; 4], s: usize) -> i32 {
 
 /// `[a0 a1 a2 a3], [b..], [c..], [d..]` -> the four columns (a 4x4 transpose).
 #[inline(always)]
-fn transpose(a: __m128, b: __m128, c: __m128, d: __m128) -> [__m128; 4] {
+pub(super) fn transpose(a: __m128, b: __m128, c: __m128, d: __m128) -> [__m128; 4] {
     // SAFETY: SSE2 is part of the x86_64 baseline.
     unsafe {
         let t0 = _mm_unpacklo_ps(a, b); // a0 b0 a1 b1
@@ -315,7 +315,7 @@ fn transpose(a: __m128, b: __m128, c: __m128, d: __m128) -> [__m128; 4] {
 
 /// [`super::clamp4`] lane-wise: NaN -> 0, then clamp to ±2^30.
 #[inline(always)]
-fn clamp_nan0(v: __m128) -> __m128 {
+pub(super) fn clamp_nan0(v: __m128) -> __m128 {
     // SAFETY: SSE2 is part of the x86_64 baseline.
     unsafe {
         let v = _mm_and_ps(_mm_cmpeq_ps(v, v), v);
@@ -592,7 +592,8 @@ unsafe fn trilinear_pixels_avx2<A: Addr>(
     dy: &[Vec2],
     out: &mut [Vec4],
 ) -> usize {
-    trilinear_pixels::<A>(tex, uv, dx, dy, out)
+    // SAFETY: this function's own contract (AVX2 present); the callers check `tex.is_pow2()`.
+    unsafe { super::avx2::trilinear_pixels::<A>(tex, uv, dx, dy, out) }
 }
 
 /// [`span_quads4`] compiled for AVX2.
@@ -605,7 +606,8 @@ unsafe fn span_quads4_avx2<A: Addr, const K: usize>(
     quads: &[[Vec2; 4]],
     out: &mut [[Vec4; 4]],
 ) -> usize {
-    span_quads4::<A, K>(tex, quads, out)
+    // SAFETY: this function's own contract (AVX2 present); the callers check `tex.is_pow2()`.
+    unsafe { super::avx2::span_quads4::<A, K>(tex, quads, out) }
 }
 
 /// Bulk per-pixel trilinear in lanes, the build chosen for this CPU; returns the pixels done.
