@@ -25,10 +25,7 @@ use core::arch::x86_64::*;
 
 use glam::{Vec2, Vec4};
 
-use super::Addr;
-use super::lanes::{
-    clamp_coord, clamp_nan0, deinterleave, footprint4, log2_split4, transpose, wrap4,
-};
+use super::{Addr, COORD_LIMIT};
 use crate::mip::MipTexture;
 
 /// The level-offset table of a texture in two registers (levels 0–7 and 8–15).
@@ -49,37 +46,6 @@ fn offsets(tex: &MipTexture) -> Offsets {
             hi: _mm256_loadu_si256(t.as_ptr().add(8) as *const __m256i),
         }
     }
-}
-
-/// Texel index of level `lvl`'s texel (0, 0) per lane (`0 ≤ lvl < 16`).
-#[inline]
-#[target_feature(enable = "avx2")]
-fn level_offset(t: Offsets, lvl: __m128i) -> __m128i {
-    let l = _mm256_castsi128_si256(lvl);
-    let a = _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(t.lo, l));
-    let b = _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(t.hi, l));
-    _mm_blendv_epi8(a, b, _mm_cmpgt_epi32(lvl, _mm_set1_epi32(7)))
-}
-
-/// Four `i32` lanes as an array (stored once, read per pixel).
-#[inline(always)]
-fn to_u32(v: __m128i) -> [u32; 4] {
-    // SAFETY: same size, no invalid bit patterns.
-    unsafe { core::mem::transmute::<__m128i, [u32; 4]>(v) }
-}
-
-/// The permute indices that spread lanes `a` and `b` of a 128-bit vector over the two halves.
-#[inline]
-#[target_feature(enable = "avx2")]
-fn pair_idx(a: i32, b: i32) -> __m256i {
-    _mm256_setr_epi32(a, a, a, a, b, b, b, b)
-}
-
-/// Lanes `a` and `b` of `v` spread over the two halves of a 256-bit register.
-#[inline]
-#[target_feature(enable = "avx2")]
-fn pair_of(v: __m128, idx: __m256i) -> __m256 {
-    _mm256_permutevar8x32_ps(_mm256_castps128_ps256(v), idx)
 }
 
 /// `a + (b − a)·t` lane-wise: the 128-bit `lerp4` on two pixels at once (same operations).
@@ -106,62 +72,180 @@ unsafe fn load_pair(base: *const u8, i0: usize, i1: usize) -> __m256 {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Per-pixel trilinear (Seed 000 Eq. 2 + 4), four pixels per step.
+// Eight-lane versions of the SSE2 lane helpers (same operations per lane).
 
-/// One level of four pixels: the doubled texel indices of their 2x2 taps and their weights.
-struct TriLevel {
-    /// `[t00, t10, t01, t11][lane]`.
-    idx: [[u32; 4]; 4],
-    ax: __m128,
-    ay: __m128,
+/// [`super::lanes::log2_split4`] on eight lanes.
+#[inline]
+#[target_feature(enable = "avx2")]
+fn log2_split8(x: __m256) -> (__m256i, __m256) {
+    let bits = _mm256_castps_si256(x);
+    let e = _mm256_sub_epi32(
+        _mm256_and_si256(_mm256_srli_epi32::<23>(bits), _mm256_set1_epi32(0xff)),
+        _mm256_set1_epi32(127),
+    );
+    let t = _mm256_sub_ps(
+        _mm256_castsi256_ps(_mm256_or_si256(
+            _mm256_and_si256(bits, _mm256_set1_epi32(0x007f_ffff)),
+            _mm256_set1_epi32(0x3f80_0000),
+        )),
+        _mm256_set1_ps(1.0),
+    );
+    let c = |k: f32| _mm256_set1_ps(k);
+    let poly = _mm256_add_ps(c(super::LOG2_C3), _mm256_mul_ps(t, c(super::LOG2_C4)));
+    let poly = _mm256_add_ps(c(super::LOG2_C2), _mm256_mul_ps(t, poly));
+    let poly = _mm256_add_ps(c(super::LOG2_C1), _mm256_mul_ps(t, poly));
+    (e, _mm256_mul_ps(t, poly))
 }
 
-/// Seed 000 Eq. (3) on `2^L r_m − ½` for four pixels at levels `lvl`: the SSE2 `level_lanes`
-/// arithmetic, then the texel indices in lanes.
+/// [`super::clampc`] on eight lanes: NaN -> −2^30 (`maxps` returns its second operand when the
+/// first is NaN), then clamp to ±2^30.
+#[inline]
+#[target_feature(enable = "avx2")]
+fn clamp_coord8(x: __m256) -> __m256 {
+    _mm256_min_ps(
+        _mm256_max_ps(x, _mm256_set1_ps(-COORD_LIMIT)),
+        _mm256_set1_ps(COORD_LIMIT),
+    )
+}
+
+/// [`super::clamp4`] on eight lanes: NaN -> 0, then clamp to ±2^30.
+#[inline]
+#[target_feature(enable = "avx2")]
+fn clamp_nan0_8(v: __m256) -> __m256 {
+    let v = _mm256_and_ps(_mm256_cmp_ps::<_CMP_EQ_OQ>(v, v), v);
+    _mm256_min_ps(
+        _mm256_max_ps(v, _mm256_set1_ps(-COORD_LIMIT)),
+        _mm256_set1_ps(COORD_LIMIT),
+    )
+}
+
+/// `Addr::wrap` on eight lanes (`n`: the level size per lane; Repeat on power-of-two levels).
+#[inline]
+#[target_feature(enable = "avx2")]
+fn wrap8<A: Addr>(i: __m256i, n: __m256i) -> __m256i {
+    let nm1 = _mm256_sub_epi32(n, _mm256_set1_epi32(1));
+    if A::REPEAT {
+        _mm256_and_si256(i, nm1)
+    } else {
+        _mm256_min_epi32(_mm256_max_epi32(i, _mm256_setzero_si256()), nm1)
+    }
+}
+
+/// Level size per lane, `max(2^(b − 127 − lvl), 1)` built from the float exponent (exact).
+#[inline]
+#[target_feature(enable = "avx2")]
+fn pow2_lanes(b: i32, lvl: __m256i) -> __m256 {
+    _mm256_castsi256_ps(_mm256_slli_epi32::<23>(_mm256_sub_epi32(
+        _mm256_set1_epi32(b),
+        lvl,
+    )))
+}
+
+/// Texel index of level `lvl`'s texel (0, 0) per lane (`0 ≤ lvl < 16`): two table permutes.
+#[inline]
+#[target_feature(enable = "avx2")]
+fn level_offset8(t: Offsets, lvl: __m256i) -> __m256i {
+    let a = _mm256_permutevar8x32_epi32(t.lo, lvl);
+    let b = _mm256_permutevar8x32_epi32(t.hi, lvl);
+    _mm256_blendv_epi8(a, b, _mm256_cmpgt_epi32(lvl, _mm256_set1_epi32(7)))
+}
+
+/// Eight `i32` lanes as an array (stored once, read per pixel).
+#[inline(always)]
+fn to_u32x8(v: __m256i) -> [u32; 8] {
+    // SAFETY: same size, no invalid bit patterns.
+    unsafe { core::mem::transmute::<__m256i, [u32; 8]>(v) }
+}
+
+/// In-lane 4x4 transposes of four rows: `[a b c d]` -> the four columns, in each 128-bit half.
+#[inline]
+#[target_feature(enable = "avx2")]
+fn transpose8(a: __m256, b: __m256, c: __m256, d: __m256) -> [__m256; 4] {
+    let pd = _mm256_castps_pd;
+    let ps = _mm256_castpd_ps;
+    let t0 = _mm256_unpacklo_ps(a, b);
+    let t1 = _mm256_unpacklo_ps(c, d);
+    let t2 = _mm256_unpackhi_ps(a, b);
+    let t3 = _mm256_unpackhi_ps(c, d);
+    [
+        ps(_mm256_unpacklo_pd(pd(t0), pd(t1))),
+        ps(_mm256_unpackhi_pd(pd(t0), pd(t1))),
+        ps(_mm256_unpacklo_pd(pd(t2), pd(t3))),
+        ps(_mm256_unpackhi_pd(pd(t2), pd(t3))),
+    ]
+}
+
+/// Eight `Vec2` as `(x lanes, y lanes)` in the order `[0 2 4 6 | 1 3 5 7]`: pixels `2k` and
+/// `2k + 1` share lane `k` of the two halves, so one in-lane permute gives a pair's weights.
+///
+/// # Safety
+/// `p` must point to at least 16 readable floats.
+#[inline]
+#[target_feature(enable = "avx2")]
+unsafe fn deinterleave8(p: *const f32) -> (__m256, __m256) {
+    // SAFETY: the caller's contract.
+    let (a, b) = unsafe { (_mm256_loadu_ps(p), _mm256_loadu_ps(p.add(8))) };
+    // [x0 y0 x1 y1 | x2 y2 x3 y3] -> [x0 y0 x2 y2 | x1 y1 x3 y3] (64-bit lanes 0 2 1 3).
+    let a = _mm256_castpd_ps(_mm256_permute4x64_pd::<0xD8>(_mm256_castps_pd(a)));
+    let b = _mm256_castpd_ps(_mm256_permute4x64_pd::<0xD8>(_mm256_castps_pd(b)));
+    (
+        _mm256_shuffle_ps::<0b10_00_10_00>(a, b),
+        _mm256_shuffle_ps::<0b11_01_11_01>(a, b),
+    )
+}
+
+/// Lane `I / 0x55` of each half broadcast over that half.
+#[inline]
+#[target_feature(enable = "avx2")]
+fn bc<const I: i32>(v: __m256) -> __m256 {
+    _mm256_permute_ps::<I>(v)
+}
+
+// ---------------------------------------------------------------------------------------------
+// Per-pixel trilinear (Seed 000 Eq. 2 + 4), eight pixels per step.
+
+/// One level of eight pixels (lanes `[0 2 4 6 | 1 3 5 7]`): the doubled texel indices of their
+/// 2x2 taps and their weights.
+struct TriLevel {
+    /// `[t00, t10, t01, t11][lane]`.
+    idx: [[u32; 8]; 4],
+    ax: __m256,
+    ay: __m256,
+}
+
+/// Seed 000 Eq. (3) on `2^L r_m − ½` for eight pixels at levels `lvl`: the SSE2 `level_lanes`
+/// arithmetic lane for lane, then the texel indices in lanes.
 #[inline]
 #[target_feature(enable = "avx2")]
 fn tri_level<A: Addr>(
-    u: __m128,
-    v: __m128,
-    lvl: __m128i,
+    u: __m256,
+    v: __m256,
+    lvl: __m256i,
     nw: i32,
     nh: i32,
     offs: Offsets,
 ) -> TriLevel {
-    // Level size per lane: max(2^(n − i), 1) from the float exponent (exact).
-    let one = _mm_set1_ps(1.0);
-    let wf = _mm_max_ps(
-        _mm_castsi128_ps(_mm_slli_epi32::<23>(_mm_sub_epi32(
-            _mm_set1_epi32(127 + nw),
-            lvl,
-        ))),
-        one,
-    );
-    let hf = _mm_max_ps(
-        _mm_castsi128_ps(_mm_slli_epi32::<23>(_mm_sub_epi32(
-            _mm_set1_epi32(127 + nh),
-            lvl,
-        ))),
-        one,
-    );
-    let half = _mm_set1_ps(0.5);
+    let one = _mm256_set1_ps(1.0);
+    let wf = _mm256_max_ps(pow2_lanes(127 + nw, lvl), one);
+    let hf = _mm256_max_ps(pow2_lanes(127 + nh, lvl), one);
+    let half = _mm256_set1_ps(0.5);
     // Texel coordinates with texel centres at integers, floors and Eq. (4) weights.
-    let x = clamp_coord(_mm_sub_ps(_mm_mul_ps(u, wf), half));
-    let y = clamp_coord(_mm_sub_ps(_mm_mul_ps(v, hf), half));
-    let (flx, fly) = (_mm_floor_ps(x), _mm_floor_ps(y));
-    let (ax, ay) = (_mm_sub_ps(x, flx), _mm_sub_ps(y, fly));
-    let (fx, fy) = (_mm_cvttps_epi32(flx), _mm_cvttps_epi32(fly));
-    let (wi, hi) = (_mm_cvttps_epi32(wf), _mm_cvttps_epi32(hf));
-    let one_i = _mm_set1_epi32(1);
+    let x = clamp_coord8(_mm256_sub_ps(_mm256_mul_ps(u, wf), half));
+    let y = clamp_coord8(_mm256_sub_ps(_mm256_mul_ps(v, hf), half));
+    let (flx, fly) = (_mm256_floor_ps(x), _mm256_floor_ps(y));
+    let (ax, ay) = (_mm256_sub_ps(x, flx), _mm256_sub_ps(y, fly));
+    let (fx, fy) = (_mm256_cvttps_epi32(flx), _mm256_cvttps_epi32(fly));
+    let (wi, hi) = (_mm256_cvttps_epi32(wf), _mm256_cvttps_epi32(hf));
+    let one_i = _mm256_set1_epi32(1);
     // Wrapped columns and rows (Addr), then texel indices offset + y·w + x, doubled.
-    let x0 = wrap4::<A>(fx, wi);
-    let x1 = wrap4::<A>(_mm_add_epi32(fx, one_i), wi);
-    let y0 = wrap4::<A>(fy, hi);
-    let y1 = wrap4::<A>(_mm_add_epi32(fy, one_i), hi);
-    let off = level_offset(offs, lvl);
-    let r0 = _mm_add_epi32(off, _mm_mullo_epi32(y0, wi));
-    let r1 = _mm_add_epi32(off, _mm_mullo_epi32(y1, wi));
-    let d = |r: __m128i, c: __m128i| to_u32(_mm_slli_epi32::<1>(_mm_add_epi32(r, c)));
+    let x0 = wrap8::<A>(fx, wi);
+    let x1 = wrap8::<A>(_mm256_add_epi32(fx, one_i), wi);
+    let y0 = wrap8::<A>(fy, hi);
+    let y1 = wrap8::<A>(_mm256_add_epi32(fy, one_i), hi);
+    let off = level_offset8(offs, lvl);
+    let r0 = _mm256_add_epi32(off, _mm256_mullo_epi32(y0, wi));
+    let r1 = _mm256_add_epi32(off, _mm256_mullo_epi32(y1, wi));
+    let d = |r: __m256i, c: __m256i| to_u32x8(_mm256_slli_epi32::<1>(_mm256_add_epi32(r, c)));
     TriLevel {
         idx: [d(r0, x0), d(r0, x1), d(r1, x0), d(r1, x1)],
         ax,
@@ -169,25 +253,61 @@ fn tri_level<A: Addr>(
     }
 }
 
-/// Bilinear of lanes `j`, `j + 1` of a prepared level (`ix`, `iy`: their weight permutes).
+/// Bilinear of pixels `2k`, `2k + 1` (lanes `k`, `4 + k`; `I = 0x55·k`) of a prepared level.
 ///
 /// # Safety
-/// `p` must come from [`tri_level`] on `tex` (indices inside the texel buffer).
+/// `p` must come from [`tri_level`] on the texture whose texels start at `base`.
 #[inline]
 #[target_feature(enable = "avx2")]
-unsafe fn tri_pair(base: *const u8, p: &TriLevel, j: usize, ix: __m256i) -> __m256 {
+unsafe fn tri_pair<const K: usize, const I: i32>(base: *const u8, p: &TriLevel) -> __m256 {
+    let ld = |c: usize| {
+        // SAFETY: the caller's contract (indices inside the texel buffer).
+        unsafe { load_pair(base, p.idx[c][K] as usize, p.idx[c][K + 4] as usize) }
+    };
+    let (t00, t10, t01, t11) = (ld(0), ld(1), ld(2), ld(3));
+    let (wx, wy) = (bc::<I>(p.ax), bc::<I>(p.ay));
+    lerp8(lerp8(t00, t10, wx), lerp8(t01, t11, wx), wy)
+}
+
+/// Pixels `2k`, `2k + 1` of a step: level `a`, or Eq. (4)'s blend with level `b` by `frac`
+/// where the pixel blends two levels (`single`: lane mask of single-level pixels).
+///
+/// # Safety
+/// As [`tri_pair`]; `o` must hold eight `Vec4`.
+#[inline]
+#[target_feature(enable = "avx2")]
+#[allow(clippy::too_many_arguments)]
+unsafe fn tri_out<const K: usize, const I: i32>(
+    base: *const u8,
+    pa: &TriLevel,
+    pb: &TriLevel,
+    frac: __m256,
+    single_v: __m256,
+    single: i32,
+    o: *mut f32,
+) {
+    let pair = ((single >> K) & 1) | (((single >> (K + 4)) & 1) << 1);
     // SAFETY: the caller's contract.
     unsafe {
-        let t00 = load_pair(base, p.idx[0][j] as usize, p.idx[0][j + 1] as usize);
-        let t10 = load_pair(base, p.idx[1][j] as usize, p.idx[1][j + 1] as usize);
-        let t01 = load_pair(base, p.idx[2][j] as usize, p.idx[2][j + 1] as usize);
-        let t11 = load_pair(base, p.idx[3][j] as usize, p.idx[3][j + 1] as usize);
-        let (wx, wy) = (pair_of(p.ax, ix), pair_of(p.ay, ix));
-        lerp8(lerp8(t00, t10, wx), lerp8(t01, t11, wx), wy)
+        let ca = tri_pair::<K, I>(base, pa);
+        let r = if pair == 3 {
+            ca
+        } else {
+            // Seed 000 Eq. (4): blend the two levels by frac(λ); single pixels keep `ca`.
+            let cb = tri_pair::<K, I>(base, pb);
+            let r = lerp8(ca, cb, bc::<I>(frac));
+            if pair == 0 {
+                r
+            } else {
+                _mm256_blendv_ps(r, ca, bc::<I>(single_v))
+            }
+        };
+        _mm256_storeu_ps(o.add(8 * K), r);
     }
 }
 
-/// [`super::lanes::trilinear_pixels`] for AVX2: bit-identical, whole chunks of four pixels.
+/// [`super::lanes::trilinear_pixels`] for AVX2, eight pixels per step: bit-identical, whole
+/// chunks of eight (the caller does the tail).
 ///
 /// # Safety
 /// The CPU must support AVX2; the texture must be a power of two (`tex.is_pow2()`).
@@ -201,201 +321,188 @@ pub(super) unsafe fn trilinear_pixels<A: Addr>(
 ) -> usize {
     debug_assert!(tex.is_pow2());
     let l0 = &tex.levels()[0];
-    let (w0, h0) = (l0.width_f, l0.height_f);
     let last = tex.level_count() as i32 - 1;
     let nw = tex.width().trailing_zeros() as i32;
     let nh = tex.height().trailing_zeros() as i32;
     let offs = offsets(tex);
     let base = tex.texels().as_ptr() as *const u8;
-    let n = uv.len().min(dx.len()).min(dy.len()).min(out.len()) / 4 * 4;
-    let ix = [pair_idx(0, 1), pair_idx(2, 3)];
-    for ((o, p), (a, b)) in out[..n]
-        .chunks_exact_mut(4)
-        .zip(uv[..n].chunks_exact(4))
-        .zip(dx[..n].chunks_exact(4).zip(dy[..n].chunks_exact(4)))
-    {
-        let (u, v) = deinterleave(p);
-        let m: __m128 = footprint4(w0, h0, a, b).into();
-        // Seed 000 Eq. (2): λ = log2 m split into ⌊λ⌋ and frac(λ); level pair as `trilinear4`.
-        let (e, frac) = log2_split4(m);
-        let minified = _mm_castps_si128(_mm_cmpgt_ps(m, _mm_set1_ps(1.0)));
-        let past_top = _mm_cmpgt_epi32(e, _mm_set1_epi32(last - 1));
-        let top = _mm_set1_epi32(last);
-        let i0 = _mm_and_si128(
-            minified,
-            _mm_or_si128(_mm_and_si128(past_top, top), _mm_andnot_si128(past_top, e)),
-        );
-        let single_v = _mm_or_si128(_mm_andnot_si128(minified, _mm_set1_epi32(-1)), past_top);
-        let i1 = _mm_sub_epi32(i0, _mm_andnot_si128(single_v, _mm_set1_epi32(-1)));
-        let pa = tri_level::<A>(u, v, i0, nw, nh, offs);
-        let pb = tri_level::<A>(u, v, i1, nw, nh, offs);
-        let single = _mm_movemask_ps(_mm_castsi128_ps(single_v));
-        for (k, ixk) in ix.iter().enumerate() {
-            let j = 2 * k;
-            let pair = (single >> j) & 3;
-            // SAFETY: indices from `tri_level` on this texture; `o` holds four Vec4 (16 floats).
-            unsafe {
-                let ca = tri_pair(base, &pa, j, *ixk);
-                let r = if pair == 3 {
-                    ca
-                } else {
-                    // Seed 000 Eq. (4): blend the two levels by frac(λ); single lanes keep `ca`.
-                    let cb = tri_pair(base, &pb, j, *ixk);
-                    let r = lerp8(ca, cb, pair_of(frac, *ixk));
-                    if pair == 0 {
-                        r
-                    } else {
-                        _mm256_blendv_ps(r, ca, pair_of(_mm_castsi128_ps(single_v), *ixk))
-                    }
-                };
-                _mm256_storeu_ps(o.as_mut_ptr().add(j) as *mut f32, r);
-            }
+    let n = uv.len().min(dx.len()).min(dy.len()).min(out.len()) / 8 * 8;
+    let (sw, sh) = (_mm256_set1_ps(l0.width_f), _mm256_set1_ps(l0.height_f));
+    let abs = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fff_ffff));
+    for i in (0..n).step_by(8) {
+        // SAFETY: i + 8 ≤ n ≤ every slice's length (8 Vec2 = 16 floats, 8 Vec4 = 32 floats);
+        // the indices come from `tri_level` on this texture.
+        unsafe {
+            let (u, v) = deinterleave8(uv.as_ptr().add(i) as *const f32);
+            let (dxu, dxv) = deinterleave8(dx.as_ptr().add(i) as *const f32);
+            let (dyu, dyv) = deinterleave8(dy.as_ptr().add(i) as *const f32);
+            // Seed 000 Eq. (2): the footprint, NaN terms as 0 (as `footprint4`).
+            let z = _mm256_setzero_ps();
+            let a =
+                |d: __m256, s: __m256| _mm256_max_ps(_mm256_and_ps(_mm256_mul_ps(d, s), abs), z);
+            let m = _mm256_max_ps(
+                _mm256_max_ps(a(dxu, sw), a(dyu, sw)),
+                _mm256_max_ps(a(dxv, sh), a(dyv, sh)),
+            );
+            // λ = log2 m split into ⌊λ⌋ and frac(λ); level pair as `trilinear4`.
+            let (e, frac) = log2_split8(m);
+            let minified = _mm256_castps_si256(_mm256_cmp_ps::<_CMP_GT_OQ>(m, _mm256_set1_ps(1.0)));
+            let past_top = _mm256_cmpgt_epi32(e, _mm256_set1_epi32(last - 1));
+            let top = _mm256_set1_epi32(last);
+            let all = _mm256_set1_epi32(-1);
+            let i0 = _mm256_and_si256(
+                minified,
+                _mm256_or_si256(
+                    _mm256_and_si256(past_top, top),
+                    _mm256_andnot_si256(past_top, e),
+                ),
+            );
+            let single_v = _mm256_or_si256(_mm256_andnot_si256(minified, all), past_top);
+            let i1 = _mm256_sub_epi32(i0, _mm256_andnot_si256(single_v, all));
+            let pa = tri_level::<A>(u, v, i0, nw, nh, offs);
+            let pb = tri_level::<A>(u, v, i1, nw, nh, offs);
+            let sv = _mm256_castsi256_ps(single_v);
+            let single = _mm256_movemask_ps(sv);
+            let o = out.as_mut_ptr().add(i) as *mut f32;
+            tri_out::<0, 0x00>(base, &pa, &pb, frac, sv, single, o);
+            tri_out::<1, 0x55>(base, &pa, &pb, frac, sv, single, o);
+            tri_out::<2, 0xAA>(base, &pa, &pb, frac, sv, single, o);
+            tri_out::<3, 0xFF>(base, &pa, &pb, frac, sv, single, o);
         }
     }
     n
 }
 
 // ---------------------------------------------------------------------------------------------
-// Span sampler (Seed 000 Eq. 8–10), four spans per step (lanes = spans).
+// Span sampler (Seed 000 Eq. 8–10), eight spans per step (lanes = spans).
 
-/// One level of four spans: per pixel `j` and span `s` the doubled index of its 2x2's corner
-/// texel (window corner + `oy·w + ox`), per span the doubled row stride and the weights of its
-/// four pixels `[ax0 ax1 ax2 ax3 | ay0 ay1 ay2 ay3]`; `ok` as in the SSE2 `SpanLevel4`.
+/// One level of eight spans: per pixel `j` and span `s` the doubled index of its 2x2's corner
+/// texel (window corner + `oy·w + ox`), per span the doubled row stride; the weights as
+/// `wx[h][p] = [ax_2p | ax_2p+1]` of spans `4h..4h+4` (`wy` likewise), so one in-lane permute
+/// gives a pixel pair's weights; `ok` as in the SSE2 `SpanLevel4`.
 struct SpanLevel {
-    idx: [[u32; 4]; 4],
-    w2: [u32; 4],
-    wts: [__m256; 4],
+    idx: [[u32; 8]; 4],
+    w2: [u32; 8],
+    wx: [[__m256; 2]; 2],
+    wy: [[__m256; 2]; 2],
     ok: i32,
 }
 
-/// Seed 000 Eq. (10) for four spans at levels `lvl`: the SSE2 `span_level4` arithmetic, then
-/// the indices in lanes and the weights transposed to one register per span.
+/// Seed 000 Eq. (10) for eight spans at levels `lvl`: the SSE2 `span_level4` arithmetic lane
+/// for lane, then the indices in lanes and the weights arranged by pixel pair.
 #[inline]
 #[target_feature(enable = "avx2")]
 fn span_level<A: Addr, const K: usize>(
     tex: &MipTexture,
-    lvl: __m128i,
-    sx: &[__m128; 4],
-    sy: &[__m128; 4],
+    lvl: __m256i,
+    sx: &[__m256; 4],
+    sy: &[__m256; 4],
     offs: Offsets,
 ) -> SpanLevel {
     let l0 = &tex.levels()[0];
     let nw = tex.width().trailing_zeros() as i32;
     let nh = tex.height().trailing_zeros() as i32;
     // Level scale (exactly w_i / w_0 = max(2^−i, 1/w_0)) and size per lane.
-    let pow =
-        |b: i32| _mm_castsi128_ps(_mm_slli_epi32::<23>(_mm_sub_epi32(_mm_set1_epi32(b), lvl)));
-    let scx = _mm_max_ps(pow(127), _mm_set1_ps(l0.inv_width_f));
-    let scy = _mm_max_ps(pow(127), _mm_set1_ps(l0.inv_height_f));
-    let one = _mm_set1_ps(1.0);
-    let wf = _mm_max_ps(pow(127 + nw), one);
-    let hf = _mm_max_ps(pow(127 + nh), one);
-    let half = _mm_set1_ps(0.5);
-    let mut flx = [_mm_setzero_ps(); 4];
-    let mut fly = [_mm_setzero_ps(); 4];
-    let mut ax = [_mm_setzero_ps(); 4];
-    let mut ay = [_mm_setzero_ps(); 4];
+    let scx = _mm256_max_ps(pow2_lanes(127, lvl), _mm256_set1_ps(l0.inv_width_f));
+    let scy = _mm256_max_ps(pow2_lanes(127, lvl), _mm256_set1_ps(l0.inv_height_f));
+    let one = _mm256_set1_ps(1.0);
+    let wf = _mm256_max_ps(pow2_lanes(127 + nw, lvl), one);
+    let hf = _mm256_max_ps(pow2_lanes(127 + nh, lvl), one);
+    let half = _mm256_set1_ps(0.5);
+    let z = _mm256_setzero_ps();
+    let mut flx = [z; 4];
+    let mut fly = [z; 4];
+    let mut ax = [z; 4];
+    let mut ay = [z; 4];
     for j in 0..4 {
         // This level's texel coordinates (Eq. 3 on 2^L r_m − ½), floors and weights.
-        let mut x = _mm_sub_ps(_mm_mul_ps(sx[j], scx), half);
-        let mut y = _mm_sub_ps(_mm_mul_ps(sy[j], scy), half);
+        let mut x = _mm256_sub_ps(_mm256_mul_ps(sx[j], scx), half);
+        let mut y = _mm256_sub_ps(_mm256_mul_ps(sy[j], scy), half);
         if !A::REPEAT {
             // Clamp-to-edge bilinear equals bilinear at the clamped coordinate.
-            x = _mm_min_ps(_mm_max_ps(x, _mm_setzero_ps()), _mm_sub_ps(wf, one));
-            y = _mm_min_ps(_mm_max_ps(y, _mm_setzero_ps()), _mm_sub_ps(hf, one));
+            x = _mm256_min_ps(_mm256_max_ps(x, z), _mm256_sub_ps(wf, one));
+            y = _mm256_min_ps(_mm256_max_ps(y, z), _mm256_sub_ps(hf, one));
         }
-        flx[j] = _mm_floor_ps(x);
-        fly[j] = _mm_floor_ps(y);
-        ax[j] = _mm_sub_ps(x, flx[j]);
-        ay[j] = _mm_sub_ps(y, fly[j]);
+        flx[j] = _mm256_floor_ps(x);
+        fly[j] = _mm256_floor_ps(y);
+        ax[j] = _mm256_sub_ps(x, flx[j]);
+        ay[j] = _mm256_sub_ps(y, fly[j]);
     }
     // The window corner: the span's lowest texel.
-    let mx = _mm_min_ps(_mm_min_ps(flx[0], flx[1]), _mm_min_ps(flx[2], flx[3]));
-    let my = _mm_min_ps(_mm_min_ps(fly[0], fly[1]), _mm_min_ps(fly[2], fly[3]));
-    let (x0, y0) = (_mm_cvttps_epi32(mx), _mm_cvttps_epi32(my));
-    let (wi, hi) = (_mm_cvttps_epi32(wf), _mm_cvttps_epi32(hf));
-    let corner = _mm_add_epi32(
-        _mm_add_epi32(level_offset(offs, lvl), _mm_mullo_epi32(y0, wi)),
+    let mx = _mm256_min_ps(_mm256_min_ps(flx[0], flx[1]), _mm256_min_ps(flx[2], flx[3]));
+    let my = _mm256_min_ps(_mm256_min_ps(fly[0], fly[1]), _mm256_min_ps(fly[2], fly[3]));
+    let (x0, y0) = (_mm256_cvttps_epi32(mx), _mm256_cvttps_epi32(my));
+    let (wi, hi) = (_mm256_cvttps_epi32(wf), _mm256_cvttps_epi32(hf));
+    let corner = _mm256_add_epi32(
+        _mm256_add_epi32(level_offset8(offs, lvl), _mm256_mullo_epi32(y0, wi)),
         x0,
     );
-    let lim = _mm_set1_ps((K - 2) as f32);
-    let mut over = _mm_setzero_ps();
-    let mut idx = [[0u32; 4]; 4];
+    let lim = _mm256_set1_ps((K - 2) as f32);
+    let mut over = z;
+    let mut idx = [[0u32; 8]; 4];
     for j in 0..4 {
-        let ox = _mm_sub_ps(flx[j], mx);
-        let oy = _mm_sub_ps(fly[j], my);
-        over = _mm_or_ps(
+        let ox = _mm256_sub_ps(flx[j], mx);
+        let oy = _mm256_sub_ps(fly[j], my);
+        over = _mm256_or_ps(
             over,
-            _mm_or_ps(_mm_cmpgt_ps(ox, lim), _mm_cmpgt_ps(oy, lim)),
+            _mm256_or_ps(
+                _mm256_cmp_ps::<_CMP_GT_OQ>(ox, lim),
+                _mm256_cmp_ps::<_CMP_GT_OQ>(oy, lim),
+            ),
         );
         // corner + oy·w + ox (oy·w + ox: small non-negative integers, exact in f32), doubled.
-        let o = _mm_cvttps_epi32(_mm_add_ps(_mm_mul_ps(oy, wf), ox));
-        idx[j] = to_u32(_mm_slli_epi32::<1>(_mm_add_epi32(corner, o)));
+        let o = _mm256_cvttps_epi32(_mm256_add_ps(_mm256_mul_ps(oy, wf), ox));
+        idx[j] = to_u32x8(_mm256_slli_epi32::<1>(_mm256_add_epi32(corner, o)));
     }
     // Interior: x0 ≥ 0, y0 ≥ 0, x0 + K ≤ w, y0 + K ≤ h.
-    let k = _mm_set1_epi32(K as i32);
-    let outside = _mm_or_si128(
-        _mm_or_si128(
-            _mm_cmplt_epi32(x0, _mm_setzero_si128()),
-            _mm_cmplt_epi32(y0, _mm_setzero_si128()),
-        ),
-        _mm_or_si128(
-            _mm_cmpgt_epi32(_mm_add_epi32(x0, k), wi),
-            _mm_cmpgt_epi32(_mm_add_epi32(y0, k), hi),
+    let k = _mm256_set1_epi32(K as i32);
+    let zi = _mm256_setzero_si256();
+    let outside = _mm256_or_si256(
+        _mm256_or_si256(_mm256_cmpgt_epi32(zi, x0), _mm256_cmpgt_epi32(zi, y0)),
+        _mm256_or_si256(
+            _mm256_cmpgt_epi32(_mm256_add_epi32(x0, k), wi),
+            _mm256_cmpgt_epi32(_mm256_add_epi32(y0, k), hi),
         ),
     );
-    let ok = !_mm_movemask_ps(_mm_or_ps(over, _mm_castsi128_ps(outside))) & 0xf;
-    // Weights per span: rows [ax_j | ay_j] (lanes = spans), transposed within each half.
-    let r: [__m256; 4] = core::array::from_fn(|j| _mm256_set_m128(ay[j], ax[j]));
-    let t0 = _mm256_unpacklo_ps(r[0], r[1]);
-    let t1 = _mm256_unpacklo_ps(r[2], r[3]);
-    let t2 = _mm256_unpackhi_ps(r[0], r[1]);
-    let t3 = _mm256_unpackhi_ps(r[2], r[3]);
-    let wts = [
-        _mm256_castpd_ps(_mm256_unpacklo_pd(
-            _mm256_castps_pd(t0),
-            _mm256_castps_pd(t1),
-        )),
-        _mm256_castpd_ps(_mm256_unpackhi_pd(
-            _mm256_castps_pd(t0),
-            _mm256_castps_pd(t1),
-        )),
-        _mm256_castpd_ps(_mm256_unpacklo_pd(
-            _mm256_castps_pd(t2),
-            _mm256_castps_pd(t3),
-        )),
-        _mm256_castpd_ps(_mm256_unpackhi_pd(
-            _mm256_castps_pd(t2),
-            _mm256_castps_pd(t3),
-        )),
-    ];
+    let ok = !_mm256_movemask_ps(_mm256_or_ps(over, _mm256_castsi256_ps(outside))) & 0xff;
+    // Weights by pixel pair: [w_2p | w_2p+1] of spans 0-3 (h = 0) and 4-7 (h = 1).
+    let pp = |w: &[__m256; 4]| {
+        [
+            [
+                _mm256_permute2f128_ps::<0x20>(w[0], w[1]),
+                _mm256_permute2f128_ps::<0x20>(w[2], w[3]),
+            ],
+            [
+                _mm256_permute2f128_ps::<0x31>(w[0], w[1]),
+                _mm256_permute2f128_ps::<0x31>(w[2], w[3]),
+            ],
+        ]
+    };
     SpanLevel {
         idx,
-        w2: to_u32(_mm_slli_epi32::<1>(wi)),
-        wts,
+        w2: to_u32x8(_mm256_slli_epi32::<1>(wi)),
+        wx: pp(&ax),
+        wy: pp(&ay),
         ok,
     }
 }
 
-/// Bilinear of pixels `j`, `j + 1` of span `s` from its interior window (`ix`, `iy`: the weight
-/// permutes of the pair).
+/// Bilinear of pixels `2p`, `2p + 1` of span `S` from its interior window (`I = 0x55·(S mod 4)`).
 ///
 /// # Safety
-/// `d` must come from [`span_level`] on this texture with span `s` interior (`d.ok` bit set).
+/// `d` must come from [`span_level`] on the texture whose texels start at `base`, with span `S`
+/// interior (`d.ok` bit set).
 #[inline]
 #[target_feature(enable = "avx2")]
-unsafe fn span_pair(
+unsafe fn span_pair<const S: usize, const I: i32>(
     base: *const u8,
     d: &SpanLevel,
-    s: usize,
-    j: usize,
-    ix: __m256i,
-    iy: __m256i,
+    p: usize,
 ) -> __m256 {
     let (i0, i1, w) = (
-        d.idx[j][s] as usize,
-        d.idx[j + 1][s] as usize,
-        d.w2[s] as usize,
+        d.idx[2 * p][S] as usize,
+        d.idx[2 * p + 1][S] as usize,
+        d.w2[S] as usize,
     );
     // SAFETY: the caller's contract: the 2x2 of every pixel lies in the window inside the level.
     unsafe {
@@ -403,18 +510,61 @@ unsafe fn span_pair(
         let t10 = load_pair(base, i0 + 2, i1 + 2);
         let t01 = load_pair(base, i0 + w, i1 + w);
         let t11 = load_pair(base, i0 + w + 2, i1 + w + 2);
-        let wx = _mm256_permutevar8x32_ps(d.wts[s], ix);
-        let wy = _mm256_permutevar8x32_ps(d.wts[s], iy);
+        let wx = bc::<I>(d.wx[S / 4][p]);
+        let wy = bc::<I>(d.wy[S / 4][p]);
         lerp8(lerp8(t00, t10, wx), lerp8(t01, t11, wx), wy)
     }
 }
 
-/// [`super::lanes::span_quads4`] for AVX2: bit-identical, whole groups of four spans.
+/// Span `S` of a step: its four pixels from the levels `a` (and `b`, blended by `frac`, per
+/// Eq. 4), or the generic path when its window is not interior.
+///
+/// # Safety
+/// As [`span_pair`] for spans whose `fast` bit is set; `o` must hold four `Vec4`.
+#[inline]
+#[target_feature(enable = "avx2")]
+#[allow(clippy::too_many_arguments)]
+unsafe fn span_out<A: Addr, const K: usize, const S: usize, const I: i32>(
+    tex: &MipTexture,
+    base: *const u8,
+    a: &SpanLevel,
+    b: &SpanLevel,
+    frac: &[__m256; 2],
+    fast: i32,
+    single: i32,
+    q: [Vec2; 4],
+    o: &mut [Vec4; 4],
+) {
+    if fast & (1 << S) == 0 {
+        // A window crossing a level edge (or a conflict): the generic path.
+        *o = super::span_quad::<A, super::Direct, K>(tex, q, 0, &mut super::Direct);
+        return;
+    }
+    let dst = o.as_mut_ptr() as *mut f32;
+    // SAFETY: the caller's contract; `dst` holds 16 floats.
+    unsafe {
+        if single & (1 << S) != 0 {
+            _mm256_storeu_ps(dst, span_pair::<S, I>(base, a, 0));
+            _mm256_storeu_ps(dst.add(8), span_pair::<S, I>(base, a, 1));
+        } else {
+            // Seed 000 Eq. (4): one blend weight per span.
+            let tt = bc::<I>(frac[S / 4]);
+            for p in 0..2 {
+                let ca = span_pair::<S, I>(base, a, p);
+                let cb = span_pair::<S, I>(base, b, p);
+                _mm256_storeu_ps(dst.add(8 * p), lerp8(ca, cb, tt));
+            }
+        }
+    }
+}
+
+/// [`super::lanes::span_quads4`] for AVX2, eight spans per step: bit-identical, whole groups
+/// of eight spans (the caller does the tail).
 ///
 /// # Safety
 /// The CPU must support AVX2; the texture must be a power of two (`tex.is_pow2()`).
 #[target_feature(enable = "avx2")]
-pub(super) unsafe fn span_quads4<A: Addr, const K: usize>(
+pub(super) unsafe fn span_quads<A: Addr, const K: usize>(
     tex: &MipTexture,
     quads: &[[Vec2; 4]],
     out: &mut [[Vec4; 4]],
@@ -424,95 +574,91 @@ pub(super) unsafe fn span_quads4<A: Addr, const K: usize>(
     let last = tex.level_count() as i32 - 1;
     let offs = offsets(tex);
     let base = tex.texels().as_ptr() as *const u8;
-    let n = quads.len().min(out.len()) / 4 * 4;
-    // Weight permutes of the pixel pairs (0, 1) and (2, 3): ax in the low four lanes of a span's
-    // weights, ay in the high four.
-    let ix = [pair_idx(0, 1), pair_idx(2, 3)];
-    let iy = [pair_idx(4, 5), pair_idx(6, 7)];
-    let (sw, sh) = (_mm_set1_ps(l0.width_f), _mm_set1_ps(l0.height_f));
-    for (o, q) in out[..n].chunks_exact_mut(4).zip(quads[..n].chunks_exact(4)) {
-        // Load the 16 images and transpose: x[j], y[j] hold pixel j of the four spans.
+    let n = quads.len().min(out.len()) / 8 * 8;
+    let (sw, sh) = (_mm256_set1_ps(l0.width_f), _mm256_set1_ps(l0.height_f));
+    for (o, q) in out[..n].chunks_exact_mut(8).zip(quads[..n].chunks_exact(8)) {
+        // Load the 32 images, spans s and s + 4 in the two halves, and transpose: x[j], y[j]
+        // hold pixel j of the eight spans.
         // SAFETY: each quad is 4 Vec2 = 8 floats, read unaligned.
-        let ld =
-            |s: usize, h: usize| unsafe { _mm_loadu_ps((q[s].as_ptr() as *const f32).add(4 * h)) };
-        let xy01 = transpose(ld(0, 0), ld(1, 0), ld(2, 0), ld(3, 0)); // x0 y0 x1 y1
-        let xy23 = transpose(ld(0, 1), ld(1, 1), ld(2, 1), ld(3, 1)); // x2 y2 x3 y3
+        let ld = |s: usize, h: usize| unsafe {
+            _mm256_loadu2_m128(
+                (q[s + 4].as_ptr() as *const f32).add(4 * h),
+                (q[s].as_ptr() as *const f32).add(4 * h),
+            )
+        };
+        let xy01 = transpose8(ld(0, 0), ld(1, 0), ld(2, 0), ld(3, 0)); // x0 y0 x1 y1
+        let xy23 = transpose8(ld(0, 1), ld(1, 1), ld(2, 1), ld(3, 1)); // x2 y2 x3 y3
         let mut sx = [
-            clamp_nan0(_mm_mul_ps(xy01[0], sw)),
-            clamp_nan0(_mm_mul_ps(xy01[2], sw)),
-            clamp_nan0(_mm_mul_ps(xy23[0], sw)),
-            clamp_nan0(_mm_mul_ps(xy23[2], sw)),
+            clamp_nan0_8(_mm256_mul_ps(xy01[0], sw)),
+            clamp_nan0_8(_mm256_mul_ps(xy01[2], sw)),
+            clamp_nan0_8(_mm256_mul_ps(xy23[0], sw)),
+            clamp_nan0_8(_mm256_mul_ps(xy23[2], sw)),
         ];
         let mut sy = [
-            clamp_nan0(_mm_mul_ps(xy01[1], sh)),
-            clamp_nan0(_mm_mul_ps(xy01[3], sh)),
-            clamp_nan0(_mm_mul_ps(xy23[1], sh)),
-            clamp_nan0(_mm_mul_ps(xy23[3], sh)),
+            clamp_nan0_8(_mm256_mul_ps(xy01[1], sh)),
+            clamp_nan0_8(_mm256_mul_ps(xy01[3], sh)),
+            clamp_nan0_8(_mm256_mul_ps(xy23[1], sh)),
+            clamp_nan0_8(_mm256_mul_ps(xy23[3], sh)),
         ];
-        let min4 = |v: &[__m128; 4]| _mm_min_ps(_mm_min_ps(v[0], v[1]), _mm_min_ps(v[2], v[3]));
-        let max4 = |v: &[__m128; 4]| _mm_max_ps(_mm_max_ps(v[0], v[1]), _mm_max_ps(v[2], v[3]));
+        let min4 =
+            |v: &[__m256; 4]| _mm256_min_ps(_mm256_min_ps(v[0], v[1]), _mm256_min_ps(v[2], v[3]));
+        let max4 =
+            |v: &[__m256; 4]| _mm256_max_ps(_mm256_max_ps(v[0], v[1]), _mm256_max_ps(v[2], v[3]));
         if A::REPEAT {
             // Shift each span by whole periods so its corner lies in the first period.
-            let px = _mm_mul_ps(
-                _mm_floor_ps(_mm_mul_ps(min4(&sx), _mm_set1_ps(l0.inv_width_f))),
+            let px = _mm256_mul_ps(
+                _mm256_floor_ps(_mm256_mul_ps(min4(&sx), _mm256_set1_ps(l0.inv_width_f))),
                 sw,
             );
-            let py = _mm_mul_ps(
-                _mm_floor_ps(_mm_mul_ps(min4(&sy), _mm_set1_ps(l0.inv_height_f))),
+            let py = _mm256_mul_ps(
+                _mm256_floor_ps(_mm256_mul_ps(min4(&sy), _mm256_set1_ps(l0.inv_height_f))),
                 sh,
             );
             for j in 0..4 {
-                sx[j] = _mm_sub_ps(sx[j], px);
-                sy[j] = _mm_sub_ps(sy[j], py);
+                sx[j] = _mm256_sub_ps(sx[j], px);
+                sy[j] = _mm256_sub_ps(sy[j], py);
             }
         }
         // Seed 000 Eq. (9): span level from the extent of the four images.
-        let ext = _mm_max_ps(
-            _mm_sub_ps(max4(&sx), min4(&sx)),
-            _mm_sub_ps(max4(&sy), min4(&sy)),
+        let ext = _mm256_max_ps(
+            _mm256_sub_ps(max4(&sx), min4(&sx)),
+            _mm256_sub_ps(max4(&sy), min4(&sy)),
         );
-        let (e, frac) = log2_split4(ext);
+        let (e, frac) = log2_split8(ext);
         // K = 3 takes the pair one level coarser (see the module doc's level policy).
-        let fine = _mm_add_epi32(e, _mm_set1_epi32(if K == 3 { 1 } else { 0 }));
-        let below = _mm_cmplt_epi32(fine, _mm_setzero_si128());
-        let above = _mm_cmpgt_epi32(fine, _mm_set1_epi32(last - 1));
-        let top = _mm_set1_epi32(last);
-        let i0 = _mm_andnot_si128(
+        let fine = _mm256_add_epi32(e, _mm256_set1_epi32(if K == 3 { 1 } else { 0 }));
+        let below = _mm256_cmpgt_epi32(_mm256_setzero_si256(), fine);
+        let above = _mm256_cmpgt_epi32(fine, _mm256_set1_epi32(last - 1));
+        let top = _mm256_set1_epi32(last);
+        let i0 = _mm256_andnot_si256(
             below,
-            _mm_or_si128(_mm_and_si128(above, top), _mm_andnot_si128(above, fine)),
+            _mm256_or_si256(
+                _mm256_and_si256(above, top),
+                _mm256_andnot_si256(above, fine),
+            ),
         );
         // Blend two levels unless clamped to the pyramid or frac(λ) = 0.
-        let clamped = _mm_or_si128(below, above);
-        let zero_t = _mm_castps_si128(_mm_cmpeq_ps(frac, _mm_setzero_ps()));
-        let single = _mm_movemask_ps(_mm_castsi128_ps(_mm_or_si128(clamped, zero_t)));
-        let i1 = _mm_sub_epi32(i0, _mm_andnot_si128(clamped, _mm_set1_epi32(-1)));
+        let clamped = _mm256_or_si256(below, above);
+        let zero_t = _mm256_castps_si256(_mm256_cmp_ps::<_CMP_EQ_OQ>(frac, _mm256_setzero_ps()));
+        let single = _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_or_si256(clamped, zero_t)));
+        let i1 = _mm256_sub_epi32(i0, _mm256_andnot_si256(clamped, _mm256_set1_epi32(-1)));
         let a = span_level::<A, K>(tex, i0, &sx, &sy, offs);
         let b = span_level::<A, K>(tex, i1, &sx, &sy, offs);
         let fast = a.ok & (b.ok | single);
-        for s in 0..4 {
-            if fast & (1 << s) == 0 {
-                // A window crossing a level edge (or a conflict): the generic path.
-                o[s] = super::span_quad::<A, super::Direct, K>(tex, q[s], 0, &mut super::Direct);
-                continue;
-            }
-            let dst = o[s].as_mut_ptr() as *mut f32;
-            // SAFETY: span `s` is interior on the levels read (`fast`); `dst` holds 16 floats.
-            unsafe {
-                if single & (1 << s) != 0 {
-                    for k in 0..2 {
-                        let ca = span_pair(base, &a, s, 2 * k, ix[k], iy[k]);
-                        _mm256_storeu_ps(dst.add(8 * k), ca);
-                    }
-                } else {
-                    // Seed 000 Eq. (4): one blend weight per span.
-                    let tt = pair_of(frac, pair_idx(s as i32, s as i32));
-                    for k in 0..2 {
-                        let ca = span_pair(base, &a, s, 2 * k, ix[k], iy[k]);
-                        let cb = span_pair(base, &b, s, 2 * k, ix[k], iy[k]);
-                        _mm256_storeu_ps(dst.add(8 * k), lerp8(ca, cb, tt));
-                    }
-                }
-            }
+        let fr = [
+            _mm256_permute2f128_ps::<0x00>(frac, frac),
+            _mm256_permute2f128_ps::<0x11>(frac, frac),
+        ];
+        // SAFETY: `span_out`'s contract: levels from `span_level` on this texture.
+        unsafe {
+            span_out::<A, K, 0, 0x00>(tex, base, &a, &b, &fr, fast, single, q[0], &mut o[0]);
+            span_out::<A, K, 1, 0x55>(tex, base, &a, &b, &fr, fast, single, q[1], &mut o[1]);
+            span_out::<A, K, 2, 0xAA>(tex, base, &a, &b, &fr, fast, single, q[2], &mut o[2]);
+            span_out::<A, K, 3, 0xFF>(tex, base, &a, &b, &fr, fast, single, q[3], &mut o[3]);
+            span_out::<A, K, 4, 0x00>(tex, base, &a, &b, &fr, fast, single, q[4], &mut o[4]);
+            span_out::<A, K, 5, 0x55>(tex, base, &a, &b, &fr, fast, single, q[5], &mut o[5]);
+            span_out::<A, K, 6, 0xAA>(tex, base, &a, &b, &fr, fast, single, q[6], &mut o[6]);
+            span_out::<A, K, 7, 0xFF>(tex, base, &a, &b, &fr, fast, single, q[7], &mut o[7]);
         }
     }
     n

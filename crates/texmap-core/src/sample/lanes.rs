@@ -607,7 +607,7 @@ unsafe fn span_quads4_avx2<A: Addr, const K: usize>(
     out: &mut [[Vec4; 4]],
 ) -> usize {
     // SAFETY: this function's own contract (AVX2 present); the callers check `tex.is_pow2()`.
-    unsafe { super::avx2::span_quads4::<A, K>(tex, quads, out) }
+    unsafe { super::avx2::span_quads::<A, K>(tex, quads, out) }
 }
 
 /// Bulk per-pixel trilinear in lanes, the build chosen for this CPU; returns the pixels done.
