@@ -329,6 +329,61 @@ struct SendPtr(*mut BondRec);
 unsafe impl Send for SendPtr {}
 unsafe impl Sync for SendPtr {}
 
+/// Pass 1 of [`BondBins::build`] for one chunk of bonds: validate, transform, cull, project and
+/// count per tile.
+#[inline(never)]
+#[allow(clippy::too_many_arguments)]
+fn project_chunk(
+    scene: &SphereScene,
+    view: &View,
+    ci: usize,
+    n: usize,
+    ntiles: usize,
+    recs: &mut Vec<BondRec>,
+    counts: &mut Vec<u32>,
+    stats: &mut BondStats,
+) {
+    let tiles_x = view.tiles_x as usize;
+    let r = scene.bond_radius;
+    let radius_ok = r.is_finite() && r > 0.0;
+    let natoms = scene.len();
+    recs.clear();
+    counts.clear();
+    counts.resize(ntiles, 0);
+    *stats = BondStats::default();
+    let lo = ci * BOND_CHUNK;
+    let hi = (lo + BOND_CHUNK).min(n);
+    for &[i, j] in &scene.bonds[lo..hi] {
+        let (i, j) = (i as usize, j as usize);
+        // Validate: radius, indices, both atoms drawable, distinct centres.
+        if !(radius_ok
+            && i < natoms
+            && j < natoms
+            && scene.is_valid(i)
+            && scene.is_valid(j)
+            && scene.centers[i] != scene.centers[j])
+        {
+            stats.skipped += 1;
+            continue;
+        }
+        let a = eye_space_f64(view, scene.centers[i]);
+        let b = eye_space_f64(view, scene.centers[j]);
+        match project(view, a, b, r, [scene.kinds[i], scene.kinds[j]]) {
+            Some(p) => {
+                stats.drawn += 1;
+                let (tx0, ty0, tx1, ty1) = tile_range(&p);
+                for ty in ty0..=ty1 {
+                    for c in &mut counts[ty * tiles_x + tx0..=ty * tiles_x + tx1] {
+                        *c += 1;
+                    }
+                }
+                recs.push(p);
+            }
+            None => stats.culled += 1,
+        }
+    }
+}
+
 impl BondBins {
     /// Validate, project and bin every bond of `scene`. Returns the counts.
     fn build(&mut self, scene: &SphereScene, view: &View) -> BondStats {
@@ -339,9 +394,6 @@ impl BondBins {
         self.chunk_recs.resize_with(nchunks, Vec::new);
         self.chunk_counts.resize_with(nchunks, Vec::new);
         self.chunk_stats.resize(nchunks, BondStats::default());
-        let r = scene.bond_radius;
-        let radius_ok = r.is_finite() && r > 0.0;
-        let natoms = scene.len();
 
         // Pass 1: validate, transform, cull, project, count per tile (parallel over chunks).
         self.chunk_recs[..nchunks]
@@ -350,41 +402,7 @@ impl BondBins {
             .zip(self.chunk_stats[..nchunks].par_iter_mut())
             .enumerate()
             .for_each(|(ci, ((recs, counts), stats))| {
-                recs.clear();
-                counts.clear();
-                counts.resize(ntiles, 0);
-                *stats = BondStats::default();
-                let lo = ci * BOND_CHUNK;
-                let hi = (lo + BOND_CHUNK).min(n);
-                for &[i, j] in &scene.bonds[lo..hi] {
-                    let (i, j) = (i as usize, j as usize);
-                    // Validate: radius, indices, both atoms drawable, distinct centres.
-                    if !(radius_ok
-                        && i < natoms
-                        && j < natoms
-                        && scene.is_valid(i)
-                        && scene.is_valid(j)
-                        && scene.centers[i] != scene.centers[j])
-                    {
-                        stats.skipped += 1;
-                        continue;
-                    }
-                    let a = eye_space_f64(view, scene.centers[i]);
-                    let b = eye_space_f64(view, scene.centers[j]);
-                    match project(view, a, b, r, [scene.kinds[i], scene.kinds[j]]) {
-                        Some(p) => {
-                            stats.drawn += 1;
-                            let (tx0, ty0, tx1, ty1) = tile_range(&p);
-                            for ty in ty0..=ty1 {
-                                for c in &mut counts[ty * tiles_x + tx0..=ty * tiles_x + tx1] {
-                                    *c += 1;
-                                }
-                            }
-                            recs.push(p);
-                        }
-                        None => stats.culled += 1,
-                    }
-                }
+                project_chunk(scene, view, ci, n, ntiles, recs, counts, stats);
             });
 
         // Pass 2: prefix sum over (tile, chunk); counts become offsets within the tile's run.
@@ -547,8 +565,75 @@ fn rays_ortho(b: &BondV, x: V8, y: V8) -> Rays {
 ///
 /// Entry and exit of the solid capped cylinder are `max`/`min` of the infinite-cylinder interval
 /// and the cap slab (module docs); entry nearer than the near plane takes the exit instead.
+///
+/// Chosen per 8 lanes: when no ray is parallel to the axis (`A > 1e-12`) or to the cap planes
+/// (`(d·u)² > 1e-30`, so `|d·u| > MIN_DU`), and no hit lies behind the near plane (almost every
+/// group), [`solve8_regular`] computes the same operations on the same values without the
+/// selects those cases need; otherwise [`solve8_general`].
 #[inline(always)]
 fn solve8(b: &BondV, l: &Rays, lanes: M8, near: V8, far: V8, w: &Words) -> (V8, V8) {
+    let regular =
+        l.a.gt(V8::splat(PARALLEL_A))
+            .and((l.du * l.du).gt(V8::splat(1e-30)));
+    if regular.bits() == 0xff {
+        if let Some(r) = solve8_regular(b, l, lanes, near, far, w) {
+            return r;
+        }
+    }
+    solve8_general(b, l, lanes, near, far, w)
+}
+
+/// [`solve8`] for 8 regular lanes, or `None` when a hit lane took the exit (near plane).
+#[inline(always)]
+fn solve8_regular(
+    b: &BondV,
+    l: &Rays,
+    lanes: M8,
+    near: V8,
+    far: V8,
+    w: &Words,
+) -> Option<(V8, V8)> {
+    let zero = V8::splat(0.0);
+    let one = V8::splat(1.0);
+    let inf = V8::splat(f32::INFINITY);
+    // Infinite cylinder: s ∓ √(r²A − dn²)/A.
+    let ia = one / l.a;
+    let disc = b.r2 * l.a - l.dn * l.dn;
+    let hc = disc.max(zero).sqrt() * ia;
+    let s = l.num * ia;
+    let t0 = s - hc;
+    let t1 = s + hc;
+    // Cap slab: 0 ≤ h0 + t·du ≤ len.
+    let inv = one / l.du;
+    let ta = l.neg_h0 * inv;
+    let tb = (b.len - l.h0) * inv;
+    let s0 = ta.min(tb);
+    let s1 = tb.max(ta);
+    // Entry and exit of the solid.
+    let en = t0.max(s0);
+    let ex = t1.min(s1);
+    let front = en.ge(near);
+    let th = V8::select(front, en, ex);
+    let ok = disc
+        .ge(zero)
+        .and(en.le(ex))
+        .and(th.ge(near))
+        .and(th.le(far))
+        .and(lanes);
+    if ok.bits() == 0 {
+        return Some((inf, zero));
+    }
+    if en.lt(near).and(ok).bits() != 0 {
+        return None;
+    }
+    // Every hit is the entry: the cap flag where the entry is on a cap.
+    let word = V8::select(s0.gt(t0), w.cap, w.side);
+    Some((V8::select(ok, th, inf), word))
+}
+
+/// [`solve8`] for any lanes: rays parallel to the axis or the cap planes, and exits.
+#[inline(never)]
+fn solve8_general(b: &BondV, l: &Rays, lanes: M8, near: V8, far: V8, w: &Words) -> (V8, V8) {
     let zero = V8::splat(0.0);
     let one = V8::splat(1.0);
     let inf = V8::splat(f32::INFINITY);
@@ -571,9 +656,8 @@ fn solve8(b: &BondV, l: &Rays, lanes: M8, near: V8, far: V8, w: &Words) -> (V8, 
     let inv = one / du;
     let ta = l.neg_h0 * inv;
     let tb = (b.len - l.h0) * inv;
-    let lt = ta.lt(tb);
-    let s0 = V8::select(lt, ta, tb);
-    let s1 = V8::select(lt, tb, ta);
+    let s0 = ta.min(tb);
+    let s1 = tb.max(ta);
     // Entry and exit of the solid.
     let en = t0.max(s0);
     let ex = t1.min(s1);
@@ -651,7 +735,7 @@ impl Kernel<'_> {
 
     /// [`Kernel::raster`] with the camera's ray generator chosen outside the loops.
     #[allow(clippy::too_many_arguments)]
-    #[inline(always)]
+    #[inline(never)]
     fn raster_with(
         &self,
         recs: &[BondRec],
@@ -768,6 +852,7 @@ impl Kernel<'_> {
 
     /// Shade the pixels of one tile won by a bond and write them (colour and depth) to the frame.
     #[allow(clippy::too_many_arguments)]
+    #[inline(never)]
     fn resolve(
         &self,
         recs: &[BondRec],
