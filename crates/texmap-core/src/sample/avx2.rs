@@ -359,8 +359,11 @@ pub(super) unsafe fn trilinear_pixels<A: Addr>(
             );
             let single_v = _mm256_or_si256(_mm256_andnot_si256(minified, all), past_top);
             let i1 = _mm256_sub_epi32(i0, _mm256_andnot_si256(single_v, all));
-            let pa = tri_level::<A>(u, v, i0, nw, nh, offs);
-            let pb = tri_level::<A>(u, v, i1, nw, nh, offs);
+            let mut pa = tri_level::<A>(u, v, i0, nw, nh, offs);
+            let mut pb = tri_level::<A>(u, v, i1, nw, nh, offs);
+            // Keep the indices in memory: one load per index (else LLVM keeps the vectors and
+            // extracts lanes, three instructions per index).
+            core::hint::black_box((&mut pa.idx, &mut pb.idx));
             let sv = _mm256_castsi256_ps(single_v);
             let single = _mm256_movemask_ps(sv);
             let o = out.as_mut_ptr().add(i) as *mut f32;
@@ -642,8 +645,11 @@ pub(super) unsafe fn span_quads<A: Addr, const K: usize>(
         let zero_t = _mm256_castps_si256(_mm256_cmp_ps::<_CMP_EQ_OQ>(frac, _mm256_setzero_ps()));
         let single = _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_or_si256(clamped, zero_t)));
         let i1 = _mm256_sub_epi32(i0, _mm256_andnot_si256(clamped, _mm256_set1_epi32(-1)));
-        let a = span_level::<A, K>(tex, i0, &sx, &sy, offs);
-        let b = span_level::<A, K>(tex, i1, &sx, &sy, offs);
+        let mut a = span_level::<A, K>(tex, i0, &sx, &sy, offs);
+        let mut b = span_level::<A, K>(tex, i1, &sx, &sy, offs);
+        // Keep the indices in memory: one load per index (else LLVM keeps the vectors and
+        // extracts lanes, three instructions per index).
+        core::hint::black_box((&mut a.idx, &mut a.w2, &mut b.idx, &mut b.w2));
         let fast = a.ok & (b.ok | single);
         let fr = [
             _mm256_permute2f128_ps::<0x00>(frac, frac),
