@@ -8,6 +8,9 @@
 //! callgrind, collecting inside the frames only:
 //!
 //! `valgrind --tool=callgrind --toggle-collect='*Renderer*render_into*' <binary> s1 raycast 5`
+//!
+//! The printed `hash` (FNV-1a over the colour bytes and the depth bits of the last frame) shows
+//! whether an optimisation changed any output byte: compare it before and after.
 
 use std::time::Instant;
 use texmap_core::frame::Frame;
@@ -50,10 +53,27 @@ fn main() {
     let ms = t.elapsed().as_secs_f64() * 1e3 / iters.max(1) as f64;
     let cpu = (cpu_ms() - cpu0) / iters.max(1) as f64;
     println!(
-        "{name} {} {ms:.3} ms/frame wall, {cpu:.2} ms/frame CPU (all threads), coverage {:.3}, {st:?}",
+        "{name} {} {ms:.3} ms/frame wall, {cpu:.2} ms/frame CPU (all threads), coverage {:.3}, hash {:016x}, {st:?}",
         method.name(),
-        frame.coverage_count() as f64 / frame.len() as f64
+        frame.coverage_count() as f64 / frame.len() as f64,
+        frame_hash(&frame)
     );
+}
+
+/// FNV-1a over the colour bytes and the depth bit patterns.
+fn frame_hash(f: &Frame) -> u64 {
+    let mut h = 0xcbf2_9ce4_8422_2325u64;
+    let mut eat = |b: u8| {
+        h ^= b as u64;
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    };
+    for px in &f.color {
+        px.iter().for_each(|&b| eat(b));
+    }
+    for d in &f.depth {
+        d.to_bits().to_le_bytes().iter().for_each(|&b| eat(b));
+    }
+    h
 }
 
 /// User + system CPU time of this process in ms (Linux `/proc/self/stat`, 10 ms ticks).

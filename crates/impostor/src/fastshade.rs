@@ -161,8 +161,8 @@ fn int_exponents(e: &F8) -> Option<([u32; W], u32)> {
 /// `2·bits` rounded products, so within ~`2·bits` ulp of the exact power. When the 8 exponents
 /// are equal (one material, the common case) the bit tests are scalar.
 #[inline(always)]
-fn pow_int8(x: V8, e: &[u32; W], bits: u32) -> V8 {
-    let mut acc = V8::splat(1.0);
+fn pow_int8<V: Simd8>(x: V, e: &[u32; W], bits: u32) -> V {
+    let mut acc = V::splat(1.0);
     let mut p = x;
     if e.iter().all(|&k| k == e[0]) {
         let k = e[0];
@@ -174,7 +174,7 @@ fn pow_int8(x: V8, e: &[u32; W], bits: u32) -> V8 {
         }
     } else {
         for b in 0..bits {
-            acc = V8::select(M8::bit_set(e, b), acc * p, acc);
+            acc = V::select(V::bit_set(e, b), acc * p, acc);
             p = p * p;
         }
     }
@@ -199,12 +199,12 @@ pub(crate) fn srgb_table() -> &'static [u8; SRGB_N] {
 pub(crate) const SRGB_N: usize = 4096;
 
 /// Table indices of 8 linear values: `floor(c·4096)` clamped to `[0, 4095]`, NaN → 0, exactly
-/// as [`linear_to_srgb8_fast`] computes them, in a form that vectorises.
+/// as [`linear_to_srgb8_fast`] computes them, over lanes.
 #[inline(always)]
-pub(crate) fn srgb_index8(c: &F8) -> [u32; W] {
-    let x = V8::load(c) * V8::splat(SRGB_N as f32);
+pub(crate) fn srgb_index_lanes<V: Simd8>(c: V) -> [u32; W] {
+    let x = c * V::splat(SRGB_N as f32);
     // `max` first: NaN lanes become 0 (SSE `max(NaN, 0)` returns the second operand).
-    let x = x.max(V8::splat(0.0)).min(V8::splat((SRGB_N - 1) as f32));
+    let x = x.max(V::splat(0.0)).min(V::splat((SRGB_N - 1) as f32));
     x.trunc_u32()
 }
 
@@ -221,27 +221,56 @@ pub(crate) struct Surf8 {
 /// [`shade`] over 8 lanes: the same formula, masks instead of branches, on [`V8`] lanes.
 #[inline(always)]
 pub(crate) fn shade8(l: &Lighting, s: &Surf8) -> [F8; 3] {
-    // Choose the specular power once for the 8 lanes: by squaring when every exponent is a
-    // small integer (exact to a few ulp, and cheaper), else exp2(e·log2 x).
-    let int_bits = int_exponents(&s.shin);
-    let n = [V8::load(&s.n[0]), V8::load(&s.n[1]), V8::load(&s.n[2])];
-    let v = [V8::load(&s.v[0]), V8::load(&s.v[1]), V8::load(&s.v[2])];
-    let base = [
-        V8::load(&s.base[0]),
-        V8::load(&s.base[1]),
-        V8::load(&s.base[2]),
-    ];
-    let spec_k = V8::load(&s.spec);
+    let ld = |a: &[F8; 3]| [V8::load(&a[0]), V8::load(&a[1]), V8::load(&a[2])];
+    let c = shade_lanes(
+        l,
+        ld(&s.n),
+        ld(&s.v),
+        ld(&s.base),
+        V8::load(&s.spec),
+        V8::load(&s.shin),
+        int_exponents(&s.shin),
+    );
+    [c[0].store(), c[1].store(), c[2].store()]
+}
+
+/// The specular exponents of 8 lanes as integers (see [`shade_lanes`]) when they all are small
+/// integers; `None` otherwise.
+pub(crate) type IntExponents = Option<([u32; W], u32)>;
+
+/// The exponents as integers when every one of `shin` is a small integer (see [`shade_lanes`]).
+#[inline(always)]
+pub(crate) fn int_exponents_of<V: Simd8>(shin: V) -> IntExponents {
+    let mut e = [0f32; W];
+    shin.store_to(&mut e);
+    int_exponents(&e)
+}
+
+/// [`shade`] over 8 lanes of any [`Simd8`] backend: the same formula, masks instead of
+/// branches. `int_bits` is [`int_exponents_of`]`(shin)` (the caller may know it for the whole
+/// frame): with it the specular power is taken by squaring (exact to a few ulp, and cheaper),
+/// without it by exp2(e·log2 x). Every backend performs the same IEEE operations in the same
+/// order, so all give the same bits.
+#[inline(always)]
+pub(crate) fn shade_lanes<V: Simd8>(
+    l: &Lighting,
+    n: [V; 3],
+    v: [V; 3],
+    base: [V; 3],
+    spec_k: V,
+    shin: V,
+    int_bits: IntExponents,
+) -> [V; 3] {
     let mut c = [
-        base[0] * V8::splat(l.ambient.x),
-        base[1] * V8::splat(l.ambient.y),
-        base[2] * V8::splat(l.ambient.z),
+        base[0] * V::splat(l.ambient.x),
+        base[1] * V::splat(l.ambient.y),
+        base[2] * V::splat(l.ambient.z),
     ];
-    let zero = V8::splat(0.0);
-    let tiny = V8::splat(1e-30);
+    let zero = V::splat(0.0);
+    let tiny = V::splat(1e-30);
     for light in l.lights() {
         let a = light.to_light;
-        let (ax, ay, az) = (V8::splat(a.x), V8::splat(a.y), V8::splat(a.z));
+        let (ax, ay, az) = (V::splat(a.x), V::splat(a.y), V::splat(a.z));
         // Lambert term n·l.
         let ndl = n[0] * ax + n[1] * ay + n[2] * az;
         // Blinn half vector h = l + v and n·h/|h|.
@@ -253,23 +282,26 @@ pub(crate) fn shade8(l: &Lighting, s: &Surf8) -> [F8; 3] {
         let q = nh / hh.sqrt();
         // Clamp to (0, 1]; lanes at 0 (or NaN from hh = 0) are masked after the pow.
         let pos = q.gt(tiny);
-        let ndh = V8::select(pos, q.min(V8::splat(1.0)), tiny);
+        let ndh = V::select(pos, q.min(V::splat(1.0)), tiny);
         let pw = match int_bits {
             Some((ei, bits)) => pow_int8(ndh, &ei, bits),
             None => {
-                let lg = V8::load(&log2_8(&ndh.store()));
-                let z = (V8::load(&s.shin) * lg).min(zero);
-                V8::load(&exp2_neg8(&z.store()))
+                let mut x = [0f32; W];
+                ndh.store_to(&mut x);
+                let lg = V::load_from(&log2_8(&x));
+                let z = (shin * lg).min(zero);
+                z.store_to(&mut x);
+                V::load_from(&exp2_neg8(&x))
             }
         };
-        let spec = V8::select(pos, spec_k * pw, zero);
+        let spec = V::select(pos, spec_k * pw, zero);
         let lit = ndl.gt(zero);
         for k in 0..3 {
             let term = base[k] * ndl + spec;
-            c[k] = c[k] + V8::select(lit, V8::splat(light.color[k]) * term, zero);
+            c[k] = c[k] + V::select(lit, V::splat(light.color[k]) * term, zero);
         }
     }
-    [c[0].store(), c[1].store(), c[2].store()]
+    c
 }
 
 /// Eight `f32` lanes: two SSE registers on x86-64 (SSE2 is part of the x86-64 baseline, so no
@@ -392,6 +424,59 @@ mod lanes {
             _mm_storeu_ps(a.as_mut_ptr().add(4), r[1]);
         }
     }
+    bin!(xor, _mm_xor_ps);
+    /// Lanes whose bit patterns are equal.
+    #[inline(always)]
+    pub fn eq_bits(a: Repr, b: Repr) -> Repr {
+        unsafe {
+            [
+                _mm_castsi128_ps(_mm_cmpeq_epi32(
+                    _mm_castps_si128(a[0]),
+                    _mm_castps_si128(b[0]),
+                )),
+                _mm_castsi128_ps(_mm_cmpeq_epi32(
+                    _mm_castps_si128(a[1]),
+                    _mm_castps_si128(b[1]),
+                )),
+            ]
+        }
+    }
+    /// Columns of the 4x4 block `[a, b, c, d]` (rows).
+    #[inline(always)]
+    fn transpose4(a: __m128, b: __m128, c: __m128, d: __m128) -> [__m128; 4] {
+        unsafe {
+            let t0 = _mm_unpacklo_ps(a, b);
+            let t1 = _mm_unpacklo_ps(c, d);
+            let t2 = _mm_unpackhi_ps(a, b);
+            let t3 = _mm_unpackhi_ps(c, d);
+            [
+                _mm_movelh_ps(t0, t1),
+                _mm_movehl_ps(t1, t0),
+                _mm_movelh_ps(t2, t3),
+                _mm_movehl_ps(t3, t2),
+            ]
+        }
+    }
+    /// Lane vectors of the columns of 8 rows: `out[k][l] = rows[l][k]`.
+    #[inline(always)]
+    pub fn transpose(rows: [&[f32; 8]; 8]) -> [Repr; 8] {
+        let lo = |r: &[f32; 8]| unsafe { _mm_loadu_ps(r.as_ptr()) };
+        let hi = |r: &[f32; 8]| unsafe { _mm_loadu_ps(r.as_ptr().add(4)) };
+        let a = transpose4(lo(rows[0]), lo(rows[1]), lo(rows[2]), lo(rows[3]));
+        let b = transpose4(hi(rows[0]), hi(rows[1]), hi(rows[2]), hi(rows[3]));
+        let c = transpose4(lo(rows[4]), lo(rows[5]), lo(rows[6]), lo(rows[7]));
+        let d = transpose4(hi(rows[4]), hi(rows[5]), hi(rows[6]), hi(rows[7]));
+        [
+            [a[0], c[0]],
+            [a[1], c[1]],
+            [a[2], c[2]],
+            [a[3], c[3]],
+            [b[0], d[0]],
+            [b[1], d[1]],
+            [b[2], d[2]],
+            [b[3], d[3]],
+        ]
+    }
 }
 
 #[cfg(not(target_arch = "x86_64"))]
@@ -457,7 +542,7 @@ mod lanes {
     }
     #[inline(always)]
     pub fn and(a: Repr, b: Repr) -> Repr {
-        map2(a, b, |x, y| mask(on(x) && on(y)))
+        map2(a, b, |x, y| f32::from_bits(x.to_bits() & y.to_bits()))
     }
     #[inline(always)]
     pub fn sqrt(a: Repr) -> Repr {
@@ -502,6 +587,18 @@ mod lanes {
     #[inline(always)]
     pub fn store_to(r: Repr, a: &mut [f32; 8]) {
         *a = r;
+    }
+    #[inline(always)]
+    pub fn xor(a: Repr, b: Repr) -> Repr {
+        map2(a, b, |x, y| f32::from_bits(x.to_bits() ^ y.to_bits()))
+    }
+    #[inline(always)]
+    pub fn eq_bits(a: Repr, b: Repr) -> Repr {
+        map2(a, b, |x, y| mask(x.to_bits() == y.to_bits()))
+    }
+    #[inline(always)]
+    pub fn transpose(rows: [&[f32; 8]; 8]) -> [Repr; 8] {
+        std::array::from_fn(|k| std::array::from_fn(|l| rows[l][k]))
     }
 }
 
@@ -630,6 +727,416 @@ impl M8 {
     pub fn bits(self) -> u32 {
         lanes::bits(self.0)
     }
+}
+
+/// Eight `f32` lanes, whatever the backend: the portable/SSE2 [`V8`] or, on x86-64 CPUs that
+/// have it, the AVX2 [`V8x`]. The hot kernels are written once, generic over this trait, and
+/// compiled once per backend; every operation is one IEEE single-precision operation per lane
+/// (no fused multiply-add, the same `min`/`max`/`select` semantics), so every backend gives the
+/// same bits.
+///
+/// # Safety
+/// An implementation may execute instructions beyond the x86-64 baseline; [`Simd8::available`]
+/// says whether this CPU has them, and code may use the implementation's operations only after
+/// it returned `true` (the kernels check it once per frame, when they are chosen).
+pub(crate) unsafe trait Simd8:
+    Copy
+    + std::ops::Add<Output = Self>
+    + std::ops::Sub<Output = Self>
+    + std::ops::Mul<Output = Self>
+    + std::ops::Div<Output = Self>
+{
+    /// A lane mask (all bits set where true).
+    type M: Mask8;
+    /// Whether this CPU can run the backend.
+    fn available() -> bool;
+    fn splat(x: f32) -> Self;
+    /// The first 8 values of `a`.
+    fn load_from(a: &[f32]) -> Self;
+    /// Store into the first 8 values of `a`.
+    fn store_to(self, a: &mut [f32]);
+    /// Lanes 0–3 from `a[..4]`, lanes 4–7 from `b[..4]`.
+    fn load_halves(a: &[f32], b: &[f32]) -> Self;
+    /// Store lanes 0–3 into `a[..4]`.
+    fn store_lo(self, a: &mut [f32]);
+    /// Store lanes 4–7 into `b[..4]`.
+    fn store_hi(self, b: &mut [f32]);
+    fn sqrt(self) -> Self;
+    /// `if self < o { self } else { o }` per lane (SSE semantics).
+    fn min(self, o: Self) -> Self;
+    /// `if self > o { self } else { o }` per lane (SSE semantics).
+    fn max(self, o: Self) -> Self;
+    fn lt(self, o: Self) -> Self::M;
+    fn gt(self, o: Self) -> Self::M;
+    fn le(self, o: Self) -> Self::M;
+    fn ge(self, o: Self) -> Self::M;
+    /// Lanes whose bit patterns are equal.
+    fn eq_bits(self, o: Self) -> Self::M;
+    /// `m ? a : b` per lane.
+    fn select(m: Self::M, a: Self, b: Self) -> Self;
+    /// Bitwise and / exclusive or of the lanes' bit patterns.
+    fn and_bits(self, o: Self) -> Self;
+    fn xor_bits(self, o: Self) -> Self;
+    /// A `u32` bit pattern in every lane.
+    fn splat_bits(x: u32) -> Self;
+    /// The `u32` bit patterns of `a[..8]` as lanes.
+    fn load_bits(a: &[u32]) -> Self;
+    /// Store the lanes' bit patterns into `a[..8]`.
+    fn store_bits(self, a: &mut [u32]);
+    /// Truncation toward zero of lanes known to lie in `[0, 2^31)` (the caller clamps).
+    fn trunc_u32(self) -> [u32; W];
+    /// Lanes whose `e` has bit `b` set.
+    fn bit_set(e: &[u32; W], b: u32) -> Self::M;
+    /// The columns of 8 rows of 8 values as lanes: `out[k]` holds `rows[l][k]` in lane `l`
+    /// (an array-of-structures to structure-of-arrays transpose).
+    fn transpose(rows: [&[f32; 8]; 8]) -> [Self; 8];
+}
+
+/// A lane mask of a [`Simd8`] backend.
+pub(crate) trait Mask8: Copy {
+    fn and(self, o: Self) -> Self;
+    /// One bit per lane (lane 0 in bit 0).
+    fn bits(self) -> u32;
+    /// The first `n` lanes (`n ≤ 8`).
+    fn first(n: usize) -> Self;
+    /// The first `n` lanes of each half (lanes `l` with `l % 4 < n`).
+    fn first_of_halves(n: usize) -> Self;
+}
+
+// SAFETY: V8 uses SSE2 (x86-64 baseline) or plain arrays: available everywhere.
+unsafe impl Simd8 for V8 {
+    type M = M8;
+    #[inline(always)]
+    fn available() -> bool {
+        true
+    }
+    #[inline(always)]
+    fn splat(x: f32) -> V8 {
+        V8::splat(x)
+    }
+    #[inline(always)]
+    fn load_from(a: &[f32]) -> V8 {
+        V8::load_from(a)
+    }
+    #[inline(always)]
+    fn store_to(self, a: &mut [f32]) {
+        V8::store_to(self, a)
+    }
+    #[inline(always)]
+    fn load_halves(a: &[f32], b: &[f32]) -> V8 {
+        V8::load_halves(a, b)
+    }
+    #[inline(always)]
+    fn store_lo(self, a: &mut [f32]) {
+        V8::store_lo(self, a)
+    }
+    #[inline(always)]
+    fn store_hi(self, b: &mut [f32]) {
+        V8::store_hi(self, b)
+    }
+    #[inline(always)]
+    fn sqrt(self) -> V8 {
+        V8::sqrt(self)
+    }
+    #[inline(always)]
+    fn min(self, o: V8) -> V8 {
+        V8::min(self, o)
+    }
+    #[inline(always)]
+    fn max(self, o: V8) -> V8 {
+        V8::max(self, o)
+    }
+    #[inline(always)]
+    fn lt(self, o: V8) -> M8 {
+        V8::lt(self, o)
+    }
+    #[inline(always)]
+    fn gt(self, o: V8) -> M8 {
+        V8::gt(self, o)
+    }
+    #[inline(always)]
+    fn le(self, o: V8) -> M8 {
+        V8::le(self, o)
+    }
+    #[inline(always)]
+    fn ge(self, o: V8) -> M8 {
+        V8::ge(self, o)
+    }
+    #[inline(always)]
+    fn eq_bits(self, o: V8) -> M8 {
+        M8(lanes::eq_bits(self.0, o.0))
+    }
+    #[inline(always)]
+    fn select(m: M8, a: V8, b: V8) -> V8 {
+        V8::select(m, a, b)
+    }
+    #[inline(always)]
+    fn and_bits(self, o: V8) -> V8 {
+        V8(lanes::and(self.0, o.0))
+    }
+    #[inline(always)]
+    fn xor_bits(self, o: V8) -> V8 {
+        V8(lanes::xor(self.0, o.0))
+    }
+    #[inline(always)]
+    fn splat_bits(x: u32) -> V8 {
+        V8::splat_bits(x)
+    }
+    #[inline(always)]
+    fn load_bits(a: &[u32]) -> V8 {
+        V8::load_bits(a)
+    }
+    #[inline(always)]
+    fn store_bits(self, a: &mut [u32]) {
+        V8::store_bits(self, a)
+    }
+    #[inline(always)]
+    fn trunc_u32(self) -> [u32; W] {
+        V8::trunc_u32(self)
+    }
+    #[inline(always)]
+    fn bit_set(e: &[u32; W], b: u32) -> M8 {
+        M8::bit_set(e, b)
+    }
+    #[inline(always)]
+    fn transpose(rows: [&[f32; 8]; 8]) -> [V8; 8] {
+        lanes::transpose(rows).map(V8)
+    }
+}
+
+impl Mask8 for M8 {
+    #[inline(always)]
+    fn and(self, o: M8) -> M8 {
+        M8::and(self, o)
+    }
+    #[inline(always)]
+    fn bits(self) -> u32 {
+        M8::bits(self)
+    }
+    #[inline(always)]
+    fn first(n: usize) -> M8 {
+        M8::first(n)
+    }
+    #[inline(always)]
+    fn first_of_halves(n: usize) -> M8 {
+        M8::first_of_halves(n)
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+pub(crate) use avx::V8x;
+
+/// The AVX2 backend: 8 lanes in one `__m256`. Chosen at run time (`is_x86_feature_detected!`);
+/// the kernels that use it are compiled inside `#[target_feature(enable = "avx2")]` functions
+/// so that these wrappers and the intrinsics inline into them. No FMA: the same IEEE operations
+/// as [`V8`], so the same bits.
+#[cfg(target_arch = "x86_64")]
+mod avx {
+    use super::{Mask8, Simd8, W};
+    use std::arch::x86_64::*;
+
+    #[derive(Clone, Copy, Debug)]
+    pub(crate) struct V8x(__m256);
+    #[derive(Clone, Copy, Debug)]
+    pub(crate) struct M8x(__m256);
+
+    // SAFETY (every `unsafe` block of this module): values of these types are only created and
+    // used by code that runs after `V8x::available()` returned true (the `Simd8` contract), so
+    // the AVX/AVX2 instructions exist; the loads and stores go through slices of checked length.
+
+    // SAFETY: see the module note; `available` checks the CPU.
+    unsafe impl Simd8 for V8x {
+        type M = M8x;
+        #[inline(always)]
+        fn available() -> bool {
+            std::arch::is_x86_feature_detected!("avx2")
+        }
+        #[inline(always)]
+        fn splat(x: f32) -> V8x {
+            V8x(unsafe { _mm256_set1_ps(x) })
+        }
+        #[inline(always)]
+        fn load_from(a: &[f32]) -> V8x {
+            let a = &a[..W];
+            V8x(unsafe { _mm256_loadu_ps(a.as_ptr()) })
+        }
+        #[inline(always)]
+        fn store_to(self, a: &mut [f32]) {
+            let a = &mut a[..W];
+            unsafe { _mm256_storeu_ps(a.as_mut_ptr(), self.0) }
+        }
+        #[inline(always)]
+        fn load_halves(a: &[f32], b: &[f32]) -> V8x {
+            let (a, b) = (&a[..4], &b[..4]);
+            V8x(unsafe { _mm256_loadu2_m128(b.as_ptr(), a.as_ptr()) })
+        }
+        #[inline(always)]
+        fn store_lo(self, a: &mut [f32]) {
+            let a = &mut a[..4];
+            unsafe { _mm_storeu_ps(a.as_mut_ptr(), _mm256_castps256_ps128(self.0)) }
+        }
+        #[inline(always)]
+        fn store_hi(self, b: &mut [f32]) {
+            let b = &mut b[..4];
+            unsafe { _mm_storeu_ps(b.as_mut_ptr(), _mm256_extractf128_ps::<1>(self.0)) }
+        }
+        #[inline(always)]
+        fn sqrt(self) -> V8x {
+            V8x(unsafe { _mm256_sqrt_ps(self.0) })
+        }
+        #[inline(always)]
+        fn min(self, o: V8x) -> V8x {
+            V8x(unsafe { _mm256_min_ps(self.0, o.0) })
+        }
+        #[inline(always)]
+        fn max(self, o: V8x) -> V8x {
+            V8x(unsafe { _mm256_max_ps(self.0, o.0) })
+        }
+        #[inline(always)]
+        fn lt(self, o: V8x) -> M8x {
+            M8x(unsafe { _mm256_cmp_ps::<_CMP_LT_OQ>(self.0, o.0) })
+        }
+        #[inline(always)]
+        fn gt(self, o: V8x) -> M8x {
+            M8x(unsafe { _mm256_cmp_ps::<_CMP_GT_OQ>(self.0, o.0) })
+        }
+        #[inline(always)]
+        fn le(self, o: V8x) -> M8x {
+            M8x(unsafe { _mm256_cmp_ps::<_CMP_LE_OQ>(self.0, o.0) })
+        }
+        #[inline(always)]
+        fn ge(self, o: V8x) -> M8x {
+            M8x(unsafe { _mm256_cmp_ps::<_CMP_GE_OQ>(self.0, o.0) })
+        }
+        #[inline(always)]
+        fn eq_bits(self, o: V8x) -> M8x {
+            M8x(unsafe {
+                _mm256_castsi256_ps(_mm256_cmpeq_epi32(
+                    _mm256_castps_si256(self.0),
+                    _mm256_castps_si256(o.0),
+                ))
+            })
+        }
+        #[inline(always)]
+        fn select(m: M8x, a: V8x, b: V8x) -> V8x {
+            // Masks are all ones or all zeros per lane, so the sign-bit blend equals and/andnot.
+            V8x(unsafe { _mm256_blendv_ps(b.0, a.0, m.0) })
+        }
+        #[inline(always)]
+        fn and_bits(self, o: V8x) -> V8x {
+            V8x(unsafe { _mm256_and_ps(self.0, o.0) })
+        }
+        #[inline(always)]
+        fn xor_bits(self, o: V8x) -> V8x {
+            V8x(unsafe { _mm256_xor_ps(self.0, o.0) })
+        }
+        #[inline(always)]
+        fn splat_bits(x: u32) -> V8x {
+            V8x(unsafe { _mm256_castsi256_ps(_mm256_set1_epi32(x as i32)) })
+        }
+        #[inline(always)]
+        fn load_bits(a: &[u32]) -> V8x {
+            let a = &a[..W];
+            V8x(unsafe { _mm256_castsi256_ps(_mm256_loadu_si256(a.as_ptr() as *const __m256i)) })
+        }
+        #[inline(always)]
+        fn store_bits(self, a: &mut [u32]) {
+            let a = &mut a[..W];
+            unsafe {
+                _mm256_storeu_si256(a.as_mut_ptr() as *mut __m256i, _mm256_castps_si256(self.0))
+            }
+        }
+        #[inline(always)]
+        fn trunc_u32(self) -> [u32; W] {
+            let mut out = [0u32; W];
+            unsafe {
+                _mm256_storeu_si256(
+                    out.as_mut_ptr() as *mut __m256i,
+                    _mm256_cvttps_epi32(self.0),
+                )
+            };
+            out
+        }
+        #[inline(always)]
+        fn bit_set(e: &[u32; W], b: u32) -> M8x {
+            M8x(unsafe {
+                let one = _mm256_set1_epi32(1);
+                let v = _mm256_loadu_si256(e.as_ptr() as *const __m256i);
+                let t = _mm256_and_si256(_mm256_srl_epi32(v, _mm_cvtsi32_si128(b as i32)), one);
+                _mm256_castsi256_ps(_mm256_cmpeq_epi32(t, one))
+            })
+        }
+        #[inline(always)]
+        fn transpose(rows: [&[f32; 8]; 8]) -> [V8x; 8] {
+            unsafe {
+                let r = rows.map(|r| _mm256_loadu_ps(r.as_ptr()));
+                // Interleave pairs of rows, then pairs of pairs, then swap 128-bit halves.
+                let t0 = _mm256_unpacklo_ps(r[0], r[1]);
+                let t1 = _mm256_unpackhi_ps(r[0], r[1]);
+                let t2 = _mm256_unpacklo_ps(r[2], r[3]);
+                let t3 = _mm256_unpackhi_ps(r[2], r[3]);
+                let t4 = _mm256_unpacklo_ps(r[4], r[5]);
+                let t5 = _mm256_unpackhi_ps(r[4], r[5]);
+                let t6 = _mm256_unpacklo_ps(r[6], r[7]);
+                let t7 = _mm256_unpackhi_ps(r[6], r[7]);
+                let u0 = _mm256_shuffle_ps::<0x44>(t0, t2);
+                let u1 = _mm256_shuffle_ps::<0xEE>(t0, t2);
+                let u2 = _mm256_shuffle_ps::<0x44>(t1, t3);
+                let u3 = _mm256_shuffle_ps::<0xEE>(t1, t3);
+                let u4 = _mm256_shuffle_ps::<0x44>(t4, t6);
+                let u5 = _mm256_shuffle_ps::<0xEE>(t4, t6);
+                let u6 = _mm256_shuffle_ps::<0x44>(t5, t7);
+                let u7 = _mm256_shuffle_ps::<0xEE>(t5, t7);
+                [
+                    V8x(_mm256_permute2f128_ps::<0x20>(u0, u4)),
+                    V8x(_mm256_permute2f128_ps::<0x20>(u1, u5)),
+                    V8x(_mm256_permute2f128_ps::<0x20>(u2, u6)),
+                    V8x(_mm256_permute2f128_ps::<0x20>(u3, u7)),
+                    V8x(_mm256_permute2f128_ps::<0x31>(u0, u4)),
+                    V8x(_mm256_permute2f128_ps::<0x31>(u1, u5)),
+                    V8x(_mm256_permute2f128_ps::<0x31>(u2, u6)),
+                    V8x(_mm256_permute2f128_ps::<0x31>(u3, u7)),
+                ]
+            }
+        }
+    }
+
+    impl Mask8 for M8x {
+        #[inline(always)]
+        fn and(self, o: M8x) -> M8x {
+            M8x(unsafe { _mm256_and_ps(self.0, o.0) })
+        }
+        #[inline(always)]
+        fn bits(self) -> u32 {
+            unsafe { _mm256_movemask_ps(self.0) as u32 }
+        }
+        #[inline(always)]
+        fn first(n: usize) -> M8x {
+            const IOTA: [f32; 8] = [0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0];
+            V8x::load_from(&IOTA).lt(V8x::splat(n as f32))
+        }
+        #[inline(always)]
+        fn first_of_halves(n: usize) -> M8x {
+            const IOTA: [f32; 8] = [0.0, 1.0, 2.0, 3.0, 0.0, 1.0, 2.0, 3.0];
+            V8x::load_from(&IOTA).lt(V8x::splat(n as f32))
+        }
+    }
+
+    macro_rules! op {
+        ($tr:ident, $f:ident, $i:ident) => {
+            impl std::ops::$tr for V8x {
+                type Output = V8x;
+                #[inline(always)]
+                fn $f(self, o: V8x) -> V8x {
+                    V8x(unsafe { $i(self.0, o.0) })
+                }
+            }
+        };
+    }
+    op!(Add, add, _mm256_add_ps);
+    op!(Sub, sub, _mm256_sub_ps);
+    op!(Mul, mul, _mm256_mul_ps);
+    op!(Div, div, _mm256_div_ps);
 }
 
 macro_rules! v8_op {

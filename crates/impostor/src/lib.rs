@@ -299,6 +299,10 @@ pub struct Renderer {
     template: Option<template::TemplateTables>,
     polygon: polygon::PolygonState,
     bonds: bonds::BondBins,
+    /// The ray-cast kernel's per-material lane rows (rebuilt every frame, buffer reused).
+    material_rows: Vec<raycast::MaterialRow>,
+    /// The ray-cast kernel's lane backend (AVX2 when available unless a test asks otherwise).
+    backend: raycast::Backend,
 }
 
 /// Smallest and largest accepted side of the Seed 002 images and Seed 004 templates; other
@@ -346,12 +350,16 @@ impl Renderer {
                     };
                     pipeline::draw_tiles(&self.bins, &view, &k, bg, frame);
                 } else {
-                    let k = raycast::Perspective {
-                        view,
+                    raycast::draw_perspective(
+                        &self.bins,
+                        &view,
                         lighting,
-                        materials: &scene.materials,
-                    };
-                    pipeline::draw_tiles(&self.bins, &view, &k, bg, frame);
+                        &scene.materials,
+                        &mut self.material_rows,
+                        bg,
+                        frame,
+                        self.backend,
+                    );
                 }
                 stats
             }

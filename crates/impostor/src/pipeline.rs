@@ -57,6 +57,18 @@ pub(crate) struct Proj {
 }
 
 const _: () = assert!(std::mem::size_of::<Proj>() == 32);
+const _: () = assert!(std::mem::align_of::<Proj>() == 4);
+
+impl Proj {
+    /// The record's 32 bytes as 8 `f32` lanes (`f`, then the bit patterns of `bbox` and
+    /// `kind | aux << 16`), the rows of the resolve passes' lane transposes.
+    #[inline(always)]
+    pub fn as_lanes(&self) -> &[f32; 8] {
+        // SAFETY: `Proj` is `repr(C)`, 32 bytes with alignment 4 (asserted above) and no
+        // padding (5 f32 + 6 u16), and every bit pattern is a valid `f32`.
+        unsafe { &*(self as *const Proj as *const [f32; 8]) }
+    }
+}
 
 /// Per-frame camera constants in the form the kernels use.
 #[derive(Clone, Copy, Debug)]
