@@ -227,6 +227,40 @@ fn sphere_rect(view: &View, c: Vec3, r: f32) -> [Option<(f32, f32)>; 2] {
     [x, y]
 }
 
+/// [`sphere_rect`] of two spheres of radius `r` at once for a perspective camera: the eight
+/// tangent slopes of [`slope_bounds`] (2 spheres x 2 axes x 2 tangents) on the 8 lanes, with the
+/// same operations in the same order, so the rectangles are bit-identical to it.
+#[inline]
+fn sphere_rects_persp(view: &View, a: Vec3, b: Vec3, r: f32) -> [[Option<(f32, f32)>; 2]; 2] {
+    // Lane k: sphere k / 4, axis (k / 2) % 2 (x, then y), tangent k % 2 (turned by ±asin(r/l)).
+    let x = V8::load(&[a.x, a.x, a.y, a.y, b.x, b.x, b.y, b.y]);
+    let z = V8::load(&[a.z, a.z, a.z, a.z, b.z, b.z, b.z, b.z]);
+    let rs = V8::load(&[r, -r, r, -r, r, -r, r, -r]);
+    let zero = V8::splat(0.0);
+    let l2 = x * x + z * z;
+    let t2 = l2 - V8::splat(r * r);
+    let t = t2.max(zero).sqrt();
+    // Tangent directions (scaled by the centre distance): cos = t/l, sin = ±r/l.
+    let xt = t * x - rs * z;
+    let zt = rs * x + t * z;
+    // Both tangents of a pair must point in front of the eye plane, with a margin against
+    // rounding; then the slopes x/(−z) map to pixels (x: cx + s·k, y: cy − s·k).
+    let ok = t2.gt(zero).and(zt.lt(zero - V8::splat(1e-6) * l2)).bits();
+    let s = xt / (zero - zt);
+    let (k, cx, cy) = (view.k, view.cx, view.cy);
+    let px = (V8::load(&[cx, cx, cy, cy, cx, cx, cy, cy])
+        + s * V8::load(&[k, k, -k, -k, k, k, -k, -k]))
+    .store();
+    let pair = |i: usize| -> Option<(f32, f32)> {
+        if ok >> i & 3 != 3 {
+            return None;
+        }
+        let (p, q) = (px[i], px[i + 1]);
+        Some(if p < q { (p, q) } else { (q, p) })
+    };
+    [[pair(0), pair(2)], [pair(4), pair(6)]]
+}
+
 /// A world point in eye space, in f64: the per-bond constants below are differences and cross
 /// products of nearly parallel vectors when a bond is seen end-on, so they are formed in f64 and
 /// rounded once (per bond, not per pixel).
@@ -268,8 +302,11 @@ fn project(view: &View, a: DVec3, b: DVec3, r: f32, kind: [u16; 2]) -> Option<Bo
     let ca = clip_end(af, da, bf, db);
     let cb = clip_end(bf, db, af, da);
     // Screen rectangle: the union of the two end spheres' rectangles.
-    let [ax, ay] = sphere_rect(view, ca, r);
-    let [bx, by] = sphere_rect(view, cb, r);
+    let [[ax, ay], [bx, by]] = if view.ortho {
+        [sphere_rect(view, ca, r), sphere_rect(view, cb, r)]
+    } else {
+        sphere_rects_persp(view, ca, cb, r)
+    };
     let rect = |x: Option<(f32, f32)>, y: Option<(f32, f32)>| -> [f32; 4] {
         let (x0, x1) = x.unwrap_or((-HUGE, HUGE));
         let (y0, y1) = y.unwrap_or((-HUGE, HUGE));
@@ -456,42 +493,56 @@ impl BondBins {
 
 /// The per-(bond, tile) constants of the intersection, splatted into lanes once.
 struct BondV {
-    u: [V8; 3],
-    n: [V8; 3],
-    q: [V8; 3],
+    u: [f32; 3],
+    n: [f32; 3],
+    q: [f32; 3],
     /// `a`, the first end point (orthographic rays start on the eye plane, so need `g = o − a`).
-    a: [V8; 3],
+    a: [f32; 3],
     /// `a·u` and its negation `h(0)` (perspective rays start at the eye).
-    au: V8,
-    neg_au: V8,
-    len: V8,
-    r2: V8,
+    au: f32,
+    neg_au: f32,
+    len: f32,
+    r2: f32,
     /// Orthographic `A = ux² + uy²` and `d·u = −uz` (the same for every ray).
-    a_ortho: V8,
-    du_ortho: V8,
+    a_ortho: f32,
+    du_ortho: f32,
     /// Perspective: 1 where the eye lies inside the infinite cylinder (`|q|² ≤ r²`), else 0.
-    par_in_persp: V8,
+    par_in_persp: f32,
+    /// `−ux`; orthographic `gz·uz`, `gz²` and `gz·A` with `gz = −az`.
+    neg_ux: f32,
+    gzuz: f32,
+    gz2: f32,
+    gza: f32,
+    /// The bond's index in the tile's bin (the winner word).
+    idx: u32,
 }
 
 impl BondV {
+    /// The constants of `rec`, the `idx`-th record of the bin. Scalars: the kernels splat them
+    /// where they are used (an 8-lane value held for a whole bond costs two registers or two
+    /// stack slots, and most bonds are rejected by the hierarchical-z test before any use).
     #[inline(always)]
-    fn new(rec: &BondRec) -> BondV {
-        let sp = |v: [f32; 3]| v.map(V8::splat);
+    fn new(rec: &BondRec, idx: u32) -> BondV {
         let a = rec.a();
         let [ux, uy, uz] = rec.u;
         let qq = Vec3::from(rec.q).length_squared();
         BondV {
-            u: sp(rec.u),
-            n: sp(rec.n),
-            q: sp(rec.q),
-            a: sp(a.to_array()),
-            au: V8::splat(rec.au),
-            neg_au: V8::splat(-rec.au),
-            len: V8::splat(rec.len),
-            r2: V8::splat(rec.r2),
-            a_ortho: V8::splat(ux * ux + uy * uy),
-            du_ortho: V8::splat(-uz),
-            par_in_persp: V8::splat(if qq <= rec.r2 { 1.0 } else { 0.0 }),
+            u: rec.u,
+            n: rec.n,
+            q: rec.q,
+            a: a.to_array(),
+            au: rec.au,
+            neg_au: -rec.au,
+            len: rec.len,
+            r2: rec.r2,
+            a_ortho: ux * ux + uy * uy,
+            du_ortho: -uz,
+            par_in_persp: if qq <= rec.r2 { 1.0 } else { 0.0 },
+            neg_ux: -ux,
+            gzuz: -a.z * uz,
+            gz2: -a.z * -a.z,
+            gza: -a.z * (ux * ux + uy * uy),
+            idx,
         }
     }
 }
@@ -513,55 +564,104 @@ struct Rays {
     par_in: V8,
 }
 
-/// Rays of a perspective camera: `o = 0`, `d = (x, y, −1)` per lane.
-#[inline(always)]
-fn rays_persp(b: &BondV, x: V8, y: V8) -> Rays {
-    let [ux, uy, uz] = b.u;
-    let [nx, ny, nz] = b.n;
-    let [qx, qy, qz] = b.q;
-    let zero = V8::splat(0.0);
-    // d × u, component by component (z of d is −1).
-    let c1 = y * uz + uy;
-    let c2 = (zero - ux) - x * uz;
-    let c3 = x * uy - y * ux;
-    Rays {
-        a: c1 * c1 + c2 * c2 + c3 * c3,
-        dn: x * nx + y * ny - nz,
-        num: x * qx + y * qy - qz,
-        h0: b.neg_au,
-        neg_h0: b.au,
-        du: x * ux + y * uy - uz,
-        par_in: b.par_in_persp,
+/// A camera's rays over lanes, in two steps: what depends on the row (`y`) once per row, then
+/// what depends on the column (`x`) per 8 pixels. Both implementations keep the operations and
+/// their order of the one-step form (so the results are bit-identical to it).
+trait RayGen {
+    type Row;
+    fn row(b: &BondV, y: V8) -> Self::Row;
+    fn rays(b: &BondV, r: &Self::Row, x: V8) -> Rays;
+}
+
+/// Perspective rays: `o = 0`, `d = (x, y, −1)` per lane.
+struct Persp;
+
+/// The row terms of a perspective ray: `c1 = y·uz + uy` and the products of `y`.
+struct PerspRow {
+    c1: V8,
+    yux: V8,
+    yuy: V8,
+    yny: V8,
+    yqy: V8,
+}
+
+impl RayGen for Persp {
+    type Row = PerspRow;
+    #[inline(always)]
+    fn row(b: &BondV, y: V8) -> PerspRow {
+        let [ux, uy, uz] = b.u.map(V8::splat);
+        PerspRow {
+            c1: y * uz + uy,
+            yux: y * ux,
+            yuy: y * uy,
+            yny: y * V8::splat(b.n[1]),
+            yqy: y * V8::splat(b.q[1]),
+        }
+    }
+    #[inline(always)]
+    fn rays(b: &BondV, r: &PerspRow, x: V8) -> Rays {
+        let [ux, uy, uz] = b.u.map(V8::splat);
+        // d × u, component by component (z of d is −1).
+        let c2 = V8::splat(b.neg_ux) - x * uz;
+        let c3 = x * uy - r.yux;
+        Rays {
+            a: r.c1 * r.c1 + c2 * c2 + c3 * c3,
+            dn: x * V8::splat(b.n[0]) + r.yny - V8::splat(b.n[2]),
+            num: x * V8::splat(b.q[0]) + r.yqy - V8::splat(b.q[2]),
+            h0: V8::splat(b.neg_au),
+            neg_h0: V8::splat(b.au),
+            du: x * ux + r.yuy - uz,
+            par_in: V8::splat(b.par_in_persp),
+        }
     }
 }
 
-/// Rays of an orthographic camera: `o = (x, y, 0)` per lane, `d = (0, 0, −1)`.
-#[inline(always)]
-fn rays_ortho(b: &BondV, x: V8, y: V8) -> Rays {
-    let [ux, uy, uz] = b.u;
-    let [ax, ay, az] = b.a;
-    let zero = V8::splat(0.0);
-    // g = o − a; d × u = (uy, −ux, 0).
-    let (gx, gy, gz) = (x - ax, y - ay, zero - az);
-    let gxy = gx * ux + gy * uy;
-    let gu = gxy + gz * uz;
-    let par_in = (gx * gx + gy * gy + gz * gz - gu * gu).le(b.r2);
-    Rays {
-        a: b.a_ortho,
-        dn: gx * uy - gy * ux,
-        // s = −(g·w)/A with w = d − (d·u)u = (uz·ux, uz·uy, −A) (as |u| = 1): written so, not
-        // as `gz − uz·(g·u)`, which cancels two terms of the size of the depth when the bond is
-        // seen nearly end-on.
-        num: gz * b.a_ortho - uz * gxy,
-        h0: gu,
-        neg_h0: zero - gu,
-        du: b.du_ortho,
-        par_in: V8::select(par_in, V8::splat(1.0), zero),
+/// Orthographic rays: `o = (x, y, 0)` per lane, `d = (0, 0, −1)`.
+struct Ortho;
+
+/// The row terms of an orthographic ray: products of `gy = y − ay`.
+struct OrthoRow {
+    gyux: V8,
+    gyuy: V8,
+    gy2: V8,
+}
+
+impl RayGen for Ortho {
+    type Row = OrthoRow;
+    #[inline(always)]
+    fn row(b: &BondV, y: V8) -> OrthoRow {
+        let gy = y - V8::splat(b.a[1]);
+        OrthoRow {
+            gyux: gy * V8::splat(b.u[0]),
+            gyuy: gy * V8::splat(b.u[1]),
+            gy2: gy * gy,
+        }
+    }
+    #[inline(always)]
+    fn rays(b: &BondV, r: &OrthoRow, x: V8) -> Rays {
+        let [ux, uy, uz] = b.u.map(V8::splat);
+        // g = o − a (gz = −az, the same for every ray); d × u = (uy, −ux, 0).
+        let gx = x - V8::splat(b.a[0]);
+        let gxy = gx * ux + r.gyuy;
+        let gu = gxy + V8::splat(b.gzuz);
+        let par_in = (gx * gx + r.gy2 + V8::splat(b.gz2) - gu * gu).le(V8::splat(b.r2));
+        Rays {
+            a: V8::splat(b.a_ortho),
+            dn: gx * uy - r.gyux,
+            // s = −(g·w)/A with w = d − (d·u)u = (uz·ux, uz·uy, −A) (as |u| = 1): written so,
+            // not as `gz − uz·(g·u)`, which cancels two terms of the size of the depth when the
+            // bond is seen nearly end-on.
+            num: V8::splat(b.gza) - uz * gxy,
+            h0: gu,
+            neg_h0: V8::splat(0.0) - gu,
+            du: V8::splat(b.du_ortho),
+            par_in: V8::select(par_in, V8::splat(1.0), V8::splat(0.0)),
+        }
     }
 }
 
 /// Intersect 8 rays with one bond: depths (`INFINITY` for a miss, a clipped hit or a lane
-/// outside `lanes`) and the winner words `idx | flags` of [`Words`].
+/// outside `lanes`) and the winner words `idx | flags`.
 ///
 /// Entry and exit of the solid capped cylinder are `max`/`min` of the infinite-cylinder interval
 /// and the cap slab (module docs); entry nearer than the near plane takes the exit instead.
@@ -571,34 +671,27 @@ fn rays_ortho(b: &BondV, x: V8, y: V8) -> Rays {
 /// group), [`solve8_regular`] computes the same operations on the same values without the
 /// selects those cases need; otherwise [`solve8_general`].
 #[inline(always)]
-fn solve8(b: &BondV, l: &Rays, lanes: M8, near: V8, far: V8, w: &Words) -> (V8, V8) {
+fn solve8(b: &BondV, l: &Rays, lanes: M8, near: V8, far: V8) -> (V8, V8) {
     let regular =
         l.a.gt(V8::splat(PARALLEL_A))
             .and((l.du * l.du).gt(V8::splat(1e-30)));
     if regular.bits() == 0xff {
-        if let Some(r) = solve8_regular(b, l, lanes, near, far, w) {
+        if let Some(r) = solve8_regular(b, l, lanes, near, far) {
             return r;
         }
     }
-    solve8_general(b, l, lanes, near, far, w)
+    solve8_general(b, l, lanes, near, far)
 }
 
 /// [`solve8`] for 8 regular lanes, or `None` when a hit lane took the exit (near plane).
 #[inline(always)]
-fn solve8_regular(
-    b: &BondV,
-    l: &Rays,
-    lanes: M8,
-    near: V8,
-    far: V8,
-    w: &Words,
-) -> Option<(V8, V8)> {
+fn solve8_regular(b: &BondV, l: &Rays, lanes: M8, near: V8, far: V8) -> Option<(V8, V8)> {
     let zero = V8::splat(0.0);
     let one = V8::splat(1.0);
     let inf = V8::splat(f32::INFINITY);
     // Infinite cylinder: s ∓ √(r²A − dn²)/A.
     let ia = one / l.a;
-    let disc = b.r2 * l.a - l.dn * l.dn;
+    let disc = V8::splat(b.r2) * l.a - l.dn * l.dn;
     let hc = disc.max(zero).sqrt() * ia;
     let s = l.num * ia;
     let t0 = s - hc;
@@ -606,7 +699,7 @@ fn solve8_regular(
     // Cap slab: 0 ≤ h0 + t·du ≤ len.
     let inv = one / l.du;
     let ta = l.neg_h0 * inv;
-    let tb = (b.len - l.h0) * inv;
+    let tb = (V8::splat(b.len) - l.h0) * inv;
     let s0 = ta.min(tb);
     let s1 = tb.max(ta);
     // Entry and exit of the solid.
@@ -627,13 +720,17 @@ fn solve8_regular(
         return None;
     }
     // Every hit is the entry: the cap flag where the entry is on a cap.
-    let word = V8::select(s0.gt(t0), w.cap, w.side);
+    let word = V8::select(
+        s0.gt(t0),
+        V8::splat_bits(b.idx | FLAG_CAP),
+        V8::splat_bits(b.idx),
+    );
     Some((V8::select(ok, th, inf), word))
 }
 
 /// [`solve8`] for any lanes: rays parallel to the axis or the cap planes, and exits.
 #[inline(never)]
-fn solve8_general(b: &BondV, l: &Rays, lanes: M8, near: V8, far: V8, w: &Words) -> (V8, V8) {
+fn solve8_general(b: &BondV, l: &Rays, lanes: M8, near: V8, far: V8) -> (V8, V8) {
     let zero = V8::splat(0.0);
     let one = V8::splat(1.0);
     let inf = V8::splat(f32::INFINITY);
@@ -641,7 +738,7 @@ fn solve8_general(b: &BondV, l: &Rays, lanes: M8, near: V8, far: V8, w: &Words) 
     // everywhere or nowhere.
     let par = l.a.le(V8::splat(PARALLEL_A));
     let ia = one / V8::select(par, one, l.a);
-    let disc = b.r2 * l.a - l.dn * l.dn;
+    let disc = V8::splat(b.r2) * l.a - l.dn * l.dn;
     let hc = disc.max(zero).sqrt() * ia;
     let s = l.num * ia;
     let side_hit = V8::select(par, l.par_in, V8::select(disc.ge(zero), one, zero));
@@ -655,7 +752,7 @@ fn solve8_general(b: &BondV, l: &Rays, lanes: M8, near: V8, far: V8, w: &Words) 
     );
     let inv = one / du;
     let ta = l.neg_h0 * inv;
-    let tb = (b.len - l.h0) * inv;
+    let tb = (V8::splat(b.len) - l.h0) * inv;
     let s0 = ta.min(tb);
     let s1 = tb.max(ta);
     // Entry and exit of the solid.
@@ -672,30 +769,18 @@ fn solve8_general(b: &BondV, l: &Rays, lanes: M8, near: V8, far: V8, w: &Words) 
     // Winner words: inside flag where the exit was taken, cap flag where the hit is on a cap.
     let word = V8::select(
         front,
-        V8::select(s0.gt(t0), w.cap, w.side),
-        V8::select(s1.lt(t1), w.in_cap, w.in_side),
+        V8::select(
+            s0.gt(t0),
+            V8::splat_bits(b.idx | FLAG_CAP),
+            V8::splat_bits(b.idx),
+        ),
+        V8::select(
+            s1.lt(t1),
+            V8::splat_bits(b.idx | FLAG_INSIDE | FLAG_CAP),
+            V8::splat_bits(b.idx | FLAG_INSIDE),
+        ),
     );
     (V8::select(ok, th, inf), word)
-}
-
-/// The four winner words of one bond (`idx` with the cap and inside flags), as lane bits.
-struct Words {
-    side: V8,
-    cap: V8,
-    in_side: V8,
-    in_cap: V8,
-}
-
-impl Words {
-    #[inline(always)]
-    fn new(idx: u32) -> Words {
-        Words {
-            side: V8::splat_bits(idx),
-            cap: V8::splat_bits(idx | FLAG_CAP),
-            in_side: V8::splat_bits(idx | FLAG_INSIDE),
-            in_cap: V8::splat_bits(idx | FLAG_INSIDE | FLAG_CAP),
-        }
-    }
 }
 
 /// Strict depth test of 8 lanes against `depth`/`win` (the atom, then the earlier bond, wins ties).
@@ -727,16 +812,16 @@ impl Kernel<'_> {
     /// Depth pass of one tile over its bin, in bond order.
     fn raster(&self, recs: &[BondRec], x0t: u32, y0t: u32, w: u32, h: u32, buf: &mut TileBuf) {
         if self.view.ortho {
-            self.raster_with(recs, x0t, y0t, w, h, buf, rays_ortho);
+            self.raster_with::<Ortho>(recs, x0t, y0t, w, h, buf);
         } else {
-            self.raster_with(recs, x0t, y0t, w, h, buf, rays_persp);
+            self.raster_with::<Persp>(recs, x0t, y0t, w, h, buf);
         }
     }
 
     /// [`Kernel::raster`] with the camera's ray generator chosen outside the loops.
     #[allow(clippy::too_many_arguments)]
     #[inline(never)]
-    fn raster_with(
+    fn raster_with<G: RayGen>(
         &self,
         recs: &[BondRec],
         x0t: u32,
@@ -744,7 +829,6 @@ impl Kernel<'_> {
         w: u32,
         h: u32,
         buf: &mut TileBuf,
-        rays: impl Fn(&BondV, V8, V8) -> Rays,
     ) {
         const T: usize = TILE as usize;
         let v = &self.view;
@@ -771,8 +855,8 @@ impl Kernel<'_> {
             }
             let (i0, i1) = ((bx0 - x0t) as usize, (bx1 - x0t) as usize);
             let (j0, j1) = ((by0 - y0t) as usize, (by1 - y0t) as usize);
-            let b = BondV::new(rec);
-            let words = Words::new(idx as u32);
+            // The lane constants, made when the first 8 pixels pass the hierarchical-z test.
+            let mut bv: Option<BondV> = None;
             // Hierarchical z: no fragment of the bond is nearer than its nearest end minus r
             // (the capped cylinder lies in the capsule around its axis), so 8 pixels whose
             // stored depths are all at least that near are skipped. The bound is widened by
@@ -791,7 +875,9 @@ impl Kernel<'_> {
                     let lanes = if two { cols } else { cols.and(M8::first(4)) };
                     if zmin.lt(d).and(lanes).bits() != 0 {
                         let y = V8::load_halves(&[ys[j]; 4], &[ys[jb]; 4]);
-                        let (t, word) = solve8(&b, &rays(&b, x, y), lanes, near, far, &words);
+                        let b = bv.get_or_insert_with(|| BondV::new(rec, idx as u32));
+                        let rays = G::rays(b, &G::row(b, y), x);
+                        let (t, word) = solve8(b, &rays, lanes, near, far);
                         let closer = t.lt(d);
                         if closer.bits() != 0 {
                             let nd = V8::select(closer, t, d);
@@ -813,7 +899,7 @@ impl Kernel<'_> {
             }
             for j in j0..j1 {
                 // Wider boxes: this row's span of the hull of the end spheres' rectangles.
-                let (a, e) = if i1 - i0 > LANES {
+                let (a, e) = if i1 - i0 > 2 * LANES {
                     let y = (y0t as usize + j) as f32 + 0.5;
                     let Some((sx0, sx1)) = row_span(&rec.ends, y) else {
                         continue;
@@ -836,7 +922,9 @@ impl Kernel<'_> {
                     let d = V8::load_from(&buf.depth[o..]);
                     if zmin.lt(d).and(lanes).bits() != 0 {
                         let x = V8::load_from(&xs[i..]);
-                        let (t, word) = solve8(&b, &rays(&b, x, y), lanes, near, far, &words);
+                        let b = bv.get_or_insert_with(|| BondV::new(rec, idx as u32));
+                        let rays = G::rays(b, &G::row(b, y), x);
+                        let (t, word) = solve8(b, &rays, lanes, near, far);
                         depth_test8(
                             t,
                             word,
@@ -1207,8 +1295,7 @@ mod tests {
             let Some(rec) = project(&view, a, b, r, [0, 1]) else {
                 continue;
             };
-            let bv = BondV::new(&rec);
-            let words = Words::new(5);
+            let bv = BondV::new(&rec, 5);
             let qq = Vec3::from(rec.q).length_squared();
             let (near, far) = (V8::splat(view.near), V8::splat(view.far));
             let [x0, y0, x1, y1] = rec.bbox.map(|v| v as u32);
@@ -1229,11 +1316,11 @@ mod tests {
                         solve8_scalar(&rec, &lanes_ref, LANES, view.near, view.far);
                     let (x, yv) = (V8::load(&xs), V8::splat(ys));
                     let rays = if view.ortho {
-                        rays_ortho(&bv, x, yv)
+                        Ortho::rays(&bv, &Ortho::row(&bv, yv), x)
                     } else {
-                        rays_persp(&bv, x, yv)
+                        Persp::rays(&bv, &Persp::row(&bv, yv), x)
                     };
-                    let (t, word) = solve8(&bv, &rays, M8::first(LANES), near, far, &words);
+                    let (t, word) = solve8(&bv, &rays, M8::first(LANES), near, far);
                     let (t, word) = (t.store(), word.store());
                     for k in 0..LANES {
                         par_lanes += !(lanes_ref.a[k] > PARALLEL_A) as usize;
@@ -1263,6 +1350,46 @@ mod tests {
         assert!(
             hits > 20_000 && par_lanes > 10,
             "{hits} hits, {par_lanes} parallel lanes"
+        );
+    }
+
+    /// The 8-lane rectangles of two end spheres against the scalar [`sphere_rect`]: bit-equal,
+    /// including spheres that reach or cross the eye plane (no finite bound: `None`).
+    #[test]
+    fn lane_sphere_rects_match_the_scalar_ones() {
+        use texmap_core::camera::Camera;
+        let mut rng = Lcg(7);
+        let mut nones = 0;
+        for trial in 0..20_000 {
+            let fov = rng.f(5.0, 160.0);
+            let cam = Camera::perspective_look_at(
+                Vec3::new(0.0, 0.0, 5.0),
+                Vec3::ZERO,
+                Vec3::Y,
+                fov,
+                64,
+                48,
+            )
+            .unwrap();
+            let view = View::new(&cam);
+            let mut p = || Vec3::new(rng.f(-6.0, 6.0), rng.f(-6.0, 6.0), rng.f(-12.0, 1.0));
+            let (a, b) = (p(), p());
+            let r = rng.f(0.01, 2.0);
+            let lanes = sphere_rects_persp(&view, a, b, r);
+            let scalar = [sphere_rect(&view, a, r), sphere_rect(&view, b, r)];
+            nones += lanes.iter().flatten().filter(|o| o.is_none()).count();
+            let bits = |v: [[Option<(f32, f32)>; 2]; 2]| {
+                v.map(|e| e.map(|o| o.map(|(lo, hi)| (lo.to_bits(), hi.to_bits()))))
+            };
+            assert_eq!(
+                bits(lanes),
+                bits(scalar),
+                "trial {trial}: {a} {b} r {r} fov {fov}"
+            );
+        }
+        assert!(
+            nones > 100,
+            "only {nones} unbounded axes: the eye-plane cases are not tested"
         );
     }
 }
