@@ -137,10 +137,21 @@ fn exp2_neg8(z: &F8) -> F8 {
 /// Largest exponent [`pow_int8`] takes (16 squarings).
 const MAX_INT_EXPONENT: f32 = 65_535.0;
 
-/// The exponents as integers and the number of bits they need, when all 8 are integers in
-/// `[0, MAX_INT_EXPONENT]`.
+/// How [`shade_lanes`] takes the specular power `x^e` of 8 lanes, chosen once per chunk (or
+/// once per frame when every material has the same shininess).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum SpecPow {
+    /// All 8 exponents are the same integer `k < 2^bits`: squarings, bit tests on a scalar.
+    Same { k: u32, bits: u32 },
+    /// Every exponent is an integer below `2^bits`: squarings, bit tests over lanes.
+    Ints { e: [u32; W], bits: u32 },
+    /// Otherwise: `exp2(e·log2 x)` with the polynomials.
+    Poly,
+}
+
+/// The [`SpecPow`] of 8 exponents: integers in `[0, MAX_INT_EXPONENT]` are taken by squaring.
 #[inline(always)]
-fn int_exponents(e: &F8) -> Option<([u32; W], u32)> {
+fn spec_pow(e: &F8) -> SpecPow {
     let mut ei = [0u32; W];
     let mut ok = true;
     let mut any = 0u32;
@@ -154,29 +165,47 @@ fn int_exponents(e: &F8) -> Option<([u32; W], u32)> {
         ei[i] = n;
         any |= n;
     }
-    ok.then(|| (ei, u32::BITS - any.leading_zeros()))
+    let bits = u32::BITS - any.leading_zeros();
+    if !ok {
+        SpecPow::Poly
+    } else if ei.iter().all(|&k| k == ei[0]) {
+        SpecPow::Same { k: ei[0], bits }
+    } else {
+        SpecPow::Ints { e: ei, bits }
+    }
 }
 
-/// `x^e` for integer `e < 2^bits` by repeated squaring over 8 lanes (`x ∈ [0, 1]`): at most
-/// `2·bits` rounded products, so within ~`2·bits` ulp of the exact power. When the 8 exponents
-/// are equal (one material, the common case) the bit tests are scalar.
+/// The [`SpecPow`] of the exponents in the lanes of `shin`.
 #[inline(always)]
-fn pow_int8<V: Simd8>(x: V, e: &[u32; W], bits: u32) -> V {
+pub(crate) fn spec_pow_of<V: Simd8>(shin: V) -> SpecPow {
+    let mut e = [0f32; W];
+    shin.store_to(&mut e);
+    spec_pow(&e)
+}
+
+/// `x^e` by repeated squaring over 8 lanes (`x ∈ [0, 1]`, integer exponents below `2^bits`):
+/// at most `2·bits` rounded products, so within ~`2·bits` ulp of the exact power. `Same` and
+/// `Ints` perform the same products, so they give the same bits.
+#[inline(always)]
+fn pow_int8<V: Simd8>(x: V, pw: &SpecPow) -> V {
     let mut acc = V::splat(1.0);
     let mut p = x;
-    if e.iter().all(|&k| k == e[0]) {
-        let k = e[0];
-        for b in 0..bits {
-            if (k >> b) & 1 != 0 {
-                acc = acc * p;
+    match *pw {
+        SpecPow::Same { k, bits } => {
+            for b in 0..bits {
+                if (k >> b) & 1 != 0 {
+                    acc = acc * p;
+                }
+                p = p * p;
             }
-            p = p * p;
         }
-    } else {
-        for b in 0..bits {
-            acc = V::select(V::bit_set(e, b), acc * p, acc);
-            p = p * p;
+        SpecPow::Ints { ref e, bits } => {
+            for b in 0..bits {
+                acc = V::select(V::bit_set(e, b), acc * p, acc);
+                p = p * p;
+            }
         }
+        SpecPow::Poly => unreachable!("pow_int8 takes integer exponents"),
     }
     acc
 }
@@ -195,17 +224,26 @@ pub(crate) fn srgb_table() -> &'static [u8; SRGB_N] {
     })
 }
 
+/// [`srgb_table`] widened to `u32` entries, for gathers over lanes.
+pub(crate) fn srgb_table32() -> &'static [u32; SRGB_N] {
+    static T: OnceLock<[u32; SRGB_N]> = OnceLock::new();
+    T.get_or_init(|| srgb_table().map(u32::from))
+}
+
 /// Entries of [`srgb_table`] (texmap-core's encoder uses 2^12 bins).
 pub(crate) const SRGB_N: usize = 4096;
 
-/// Table indices of 8 linear values: `floor(c·4096)` clamped to `[0, 4095]`, NaN → 0, exactly
-/// as [`linear_to_srgb8_fast`] computes them, over lanes.
+/// sRGB8 RGBA of 8 linear colours, as little-endian `u32` lanes (alpha 255): table indices
+/// `floor(c·4096)` clamped to `[0, 4095]`, NaN → 0, exactly as [`linear_to_srgb8_fast`]
+/// computes them, then [`srgb_table32`] lookups.
 #[inline(always)]
-pub(crate) fn srgb_index_lanes<V: Simd8>(c: V) -> [u32; W] {
-    let x = c * V::splat(SRGB_N as f32);
-    // `max` first: NaN lanes become 0 (SSE `max(NaN, 0)` returns the second operand).
-    let x = x.max(V::splat(0.0)).min(V::splat((SRGB_N - 1) as f32));
-    x.trunc_u32()
+pub(crate) fn srgb_rgba_lanes<V: Simd8>(r: V, g: V, b: V, table: &[u32; SRGB_N]) -> V {
+    let q = |c: V| {
+        let x = c * V::splat(SRGB_N as f32);
+        // `max` first: NaN lanes become 0 (SSE `max(NaN, 0)` returns the second operand).
+        x.max(V::splat(0.0)).min(V::splat((SRGB_N - 1) as f32))
+    };
+    V::srgb_pack(q(r), q(g), q(b), table)
 }
 
 /// Surface and material of 8 pixels, structure-of-arrays.
@@ -229,27 +267,15 @@ pub(crate) fn shade8(l: &Lighting, s: &Surf8) -> [F8; 3] {
         ld(&s.base),
         V8::load(&s.spec),
         V8::load(&s.shin),
-        int_exponents(&s.shin),
+        spec_pow(&s.shin),
     );
     [c[0].store(), c[1].store(), c[2].store()]
 }
 
-/// The specular exponents of 8 lanes as integers (see [`shade_lanes`]) when they all are small
-/// integers; `None` otherwise.
-pub(crate) type IntExponents = Option<([u32; W], u32)>;
-
-/// The exponents as integers when every one of `shin` is a small integer (see [`shade_lanes`]).
-#[inline(always)]
-pub(crate) fn int_exponents_of<V: Simd8>(shin: V) -> IntExponents {
-    let mut e = [0f32; W];
-    shin.store_to(&mut e);
-    int_exponents(&e)
-}
-
 /// [`shade`] over 8 lanes of any [`Simd8`] backend: the same formula, masks instead of
-/// branches. `int_bits` is [`int_exponents_of`]`(shin)` (the caller may know it for the whole
-/// frame): with it the specular power is taken by squaring (exact to a few ulp, and cheaper),
-/// without it by exp2(e·log2 x). Every backend performs the same IEEE operations in the same
+/// branches. `pw` is [`spec_pow_of`]`(shin)` (the caller may know it for the whole frame):
+/// integer exponents are taken by squaring (exact to a few ulp, and cheaper), others by
+/// exp2(e·log2 x). Every backend performs the same IEEE operations in the same
 /// order, so all give the same bits.
 #[inline(always)]
 pub(crate) fn shade_lanes<V: Simd8>(
@@ -259,7 +285,7 @@ pub(crate) fn shade_lanes<V: Simd8>(
     base: [V; 3],
     spec_k: V,
     shin: V,
-    int_bits: IntExponents,
+    pw: SpecPow,
 ) -> [V; 3] {
     let mut c = [
         base[0] * V::splat(l.ambient.x),
@@ -283,9 +309,9 @@ pub(crate) fn shade_lanes<V: Simd8>(
         // Clamp to (0, 1]; lanes at 0 (or NaN from hh = 0) are masked after the pow.
         let pos = q.gt(tiny);
         let ndh = V::select(pos, q.min(V::splat(1.0)), tiny);
-        let pw = match int_bits {
-            Some((ei, bits)) => pow_int8(ndh, &ei, bits),
-            None => {
+        let pw = match pw {
+            SpecPow::Same { .. } | SpecPow::Ints { .. } => pow_int8(ndh, &pw),
+            SpecPow::Poly => {
                 let mut x = [0f32; W];
                 ndh.store_to(&mut x);
                 let lg = V::load_from(&log2_8(&x));
@@ -783,13 +809,29 @@ pub(crate) unsafe trait Simd8:
     fn load_bits(a: &[u32]) -> Self;
     /// Store the lanes' bit patterns into `a[..8]`.
     fn store_bits(self, a: &mut [u32]);
-    /// Truncation toward zero of lanes known to lie in `[0, 2^31)` (the caller clamps).
-    fn trunc_u32(self) -> [u32; W];
     /// Lanes whose `e` has bit `b` set.
     fn bit_set(e: &[u32; W], b: u32) -> Self::M;
     /// The columns of 8 rows of 8 values as lanes: `out[k]` holds `rows[l][k]` in lane `l`
     /// (an array-of-structures to structure-of-arrays transpose).
     fn transpose(rows: [&[f32; 8]; 8]) -> [Self; 8];
+    /// `table[r] | table[g] << 8 | table[b] << 16 | 255 << 24` per lane, the indices being the
+    /// lanes truncated toward zero (the caller clamps them to `[0, SRGB_N − 1]`; other values
+    /// are wrapped into the table, never read outside it).
+    fn srgb_pack(r: Self, g: Self, b: Self, table: &[u32; SRGB_N]) -> Self;
+    /// Store the lanes' bit patterns as 8 little-endian RGBA pixels into `out[..8]`.
+    fn store_rgba(self, out: &mut [[u8; 4]]);
+}
+
+/// [`Simd8::srgb_pack`] one lane at a time.
+#[inline(always)]
+fn srgb_pack_scalar(r: [u32; W], g: [u32; W], b: [u32; W], table: &[u32; SRGB_N]) -> [u32; W] {
+    let m = SRGB_N - 1;
+    std::array::from_fn(|l| {
+        table[r[l] as usize & m]
+            | table[g[l] as usize & m] << 8
+            | table[b[l] as usize & m] << 16
+            | 0xff00_0000
+    })
 }
 
 /// A lane mask of a [`Simd8`] backend.
@@ -891,16 +933,25 @@ unsafe impl Simd8 for V8 {
         V8::store_bits(self, a)
     }
     #[inline(always)]
-    fn trunc_u32(self) -> [u32; W] {
-        V8::trunc_u32(self)
-    }
-    #[inline(always)]
     fn bit_set(e: &[u32; W], b: u32) -> M8 {
         M8::bit_set(e, b)
     }
     #[inline(always)]
     fn transpose(rows: [&[f32; 8]; 8]) -> [V8; 8] {
         lanes::transpose(rows).map(V8)
+    }
+    #[inline(always)]
+    fn srgb_pack(r: V8, g: V8, b: V8, table: &[u32; SRGB_N]) -> V8 {
+        let px = srgb_pack_scalar(r.trunc_u32(), g.trunc_u32(), b.trunc_u32(), table);
+        V8::load_bits(&px)
+    }
+    #[inline(always)]
+    fn store_rgba(self, out: &mut [[u8; 4]]) {
+        let mut px = [0u32; W];
+        self.store_bits(&mut px);
+        for (o, p) in out[..W].iter_mut().zip(px) {
+            *o = p.to_le_bytes();
+        }
     }
 }
 
@@ -932,7 +983,7 @@ pub(crate) use avx::V8x;
 /// as [`V8`], so the same bits.
 #[cfg(target_arch = "x86_64")]
 mod avx {
-    use super::{Mask8, Simd8, W};
+    use super::{Mask8, SRGB_N, Simd8, W};
     use std::arch::x86_64::*;
 
     #[derive(Clone, Copy, Debug)]
@@ -1047,17 +1098,6 @@ mod avx {
             }
         }
         #[inline(always)]
-        fn trunc_u32(self) -> [u32; W] {
-            let mut out = [0u32; W];
-            unsafe {
-                _mm256_storeu_si256(
-                    out.as_mut_ptr() as *mut __m256i,
-                    _mm256_cvttps_epi32(self.0),
-                )
-            };
-            out
-        }
-        #[inline(always)]
         fn bit_set(e: &[u32; W], b: u32) -> M8x {
             M8x(unsafe {
                 let one = _mm256_set1_epi32(1);
@@ -1097,6 +1137,36 @@ mod avx {
                     V8x(_mm256_permute2f128_ps::<0x31>(u2, u6)),
                     V8x(_mm256_permute2f128_ps::<0x31>(u3, u7)),
                 ]
+            }
+        }
+        #[inline(always)]
+        fn srgb_pack(r: V8x, g: V8x, b: V8x, table: &[u32; SRGB_N]) -> V8x {
+            unsafe {
+                let m = _mm256_set1_epi32(SRGB_N as i32 - 1);
+                let t = table.as_ptr() as *const i32;
+                // The indices are masked into [0, SRGB_N), so every gather reads inside `table`.
+                let look = |c: V8x| {
+                    let i = _mm256_and_si256(_mm256_cvttps_epi32(c.0), m);
+                    _mm256_i32gather_epi32::<4>(t, i)
+                };
+                let px = _mm256_or_si256(
+                    _mm256_or_si256(look(r), _mm256_slli_epi32::<8>(look(g))),
+                    _mm256_or_si256(
+                        _mm256_slli_epi32::<16>(look(b)),
+                        _mm256_set1_epi32(0xff00_0000_u32 as i32),
+                    ),
+                );
+                V8x(_mm256_castsi256_ps(px))
+            }
+        }
+        #[inline(always)]
+        fn store_rgba(self, out: &mut [[u8; 4]]) {
+            let out = &mut out[..W];
+            unsafe {
+                _mm256_storeu_si256(
+                    out.as_mut_ptr() as *mut __m256i,
+                    _mm256_castps_si256(self.0),
+                )
             }
         }
     }

@@ -43,7 +43,7 @@ use texmap_core::shade::{Lighting, Material};
 
 #[cfg(target_arch = "x86_64")]
 use crate::fastshade::V8x;
-use crate::fastshade::{self, IntExponents, Mask8, Simd8, V8};
+use crate::fastshade::{self, Mask8, Simd8, SpecPow, V8};
 use crate::pipeline::{
     self, Bins, FLAG_INSIDE, Kernel, LANES, NONE, Proj, Projected, TILE, TILE_BUF, TileBuf,
     TileRect, View, clip,
@@ -150,9 +150,9 @@ pub(crate) struct Perspective<'a, V> {
     materials: &'a [Material],
     /// [`MaterialRow`] per material.
     rows: &'a [MaterialRow],
-    /// The specular exponents as integers when every material has the same small integer
-    /// shininess (the common case): then no chunk needs to check its lanes.
-    int_shin: IntExponents,
+    /// The specular power when every material has the same shininess (the common case): then
+    /// no chunk needs to check its lanes.
+    pow: Option<SpecPow>,
     _lanes: PhantomData<V>,
 }
 
@@ -173,9 +173,9 @@ impl<'a, V: Simd8> Perspective<'a, V> {
             let b = m.base_color;
             [b.x, b.y, b.z, m.specular, m.shininess, 0.0, 0.0, 0.0]
         }));
-        let int_shin = match materials.first() {
+        let pow = match materials.first() {
             Some(m0) if materials.iter().all(|m| m.shininess == m0.shininess) => {
-                fastshade::int_exponents_of(V::splat(m0.shininess))
+                Some(fastshade::spec_pow_of(V::splat(m0.shininess)))
             }
             _ => None,
         };
@@ -184,7 +184,7 @@ impl<'a, V: Simd8> Perspective<'a, V> {
             lighting,
             materials,
             rows,
-            int_shin,
+            pow,
             _lanes: PhantomData,
         })
     }
@@ -404,7 +404,8 @@ fn resolve_persp<V: Simd8>(
     for (i, dx) in dxs.iter_mut().enumerate() {
         *dx = ((tile.x0 as usize + i) as f32 + 0.5 - v.cx) * v.inv_k;
     }
-    let enc = fastshade::srgb_table();
+    let enc = fastshade::srgb_table32();
+    let bgv = V::splat_bits(u32::from_le_bytes(background));
     let none = V::splat_bits(NONE);
     let sign = V::splat_bits(FLAG_INSIDE);
     let (one, tw) = (V::splat(1.0), tile.w as usize);
@@ -423,17 +424,23 @@ fn resolve_persp<V: Simd8>(
                 i += LANES;
                 continue;
             }
-            // Gather the winners' records and materials as rows.
-            let first = buf.win[b + covered.trailing_zeros() as usize] & !FLAG_INSIDE;
-            let mut rec_rows = [recs[first as usize].as_lanes(); LANES];
-            let mut mat_rows = [&k.rows[recs[first as usize].kind as usize]; LANES];
+            // Gather the winners' records and materials as rows (uncovered lanes repeat the first
+            // covered pixel's winner).
+            let first = buf.win[b + covered.trailing_zeros() as usize];
+            let mut rec_rows = [recs[0].as_lanes(); LANES];
+            let mut mat_rows = [&k.rows[0]; LANES];
             for l in 0..LANES {
                 let wv = buf.win[b + l];
-                if wv != NONE {
-                    let rec = &recs[(wv & !FLAG_INSIDE) as usize];
-                    rec_rows[l] = rec.as_lanes();
-                    mat_rows[l] = &k.rows[rec.kind as usize];
-                }
+                let ri = (if wv == NONE { first } else { wv } & !FLAG_INSIDE) as usize;
+                debug_assert!(ri < recs.len());
+                // SAFETY: winner entries other than NONE are indices into this tile's `recs`
+                // (written by the depth pass), and `first` is one of them.
+                let rec = unsafe { recs.get_unchecked(ri) };
+                debug_assert!((rec.kind as usize) < k.rows.len());
+                rec_rows[l] = rec.as_lanes();
+                // SAFETY: only valid spheres are projected, and a valid sphere's kind indexes
+                // `materials`, whose rows these are.
+                mat_rows[l] = unsafe { k.rows.get_unchecked(rec.kind as usize) };
             }
             let [cx, cy, cz, _, inv_r, _, _, _] = V::transpose(rec_rows);
             let [br, bg, bb, spec, shin, _, _, _] = V::transpose(mat_rows);
@@ -450,36 +457,23 @@ fn resolve_persp<V: Simd8>(
             // Unit vector toward the eye.
             let id = one / (dx * dx + dy * dy + one).sqrt();
             let to_eye = [dx.xor_bits(sign) * id, dy.xor_bits(sign) * id, id];
-            let int_bits = match k.int_shin {
-                Some(e) => Some(e),
-                None => fastshade::int_exponents_of(shin),
+            let pow = match k.pow {
+                Some(p) => p,
+                None => fastshade::spec_pow_of(shin),
             };
-            let c = fastshade::shade_lanes(
-                &k.lighting,
-                nrm,
-                to_eye,
-                [br, bg, bb],
-                spec,
-                shin,
-                int_bits,
+            let c = fastshade::shade_lanes(&k.lighting, nrm, to_eye, [br, bg, bb], spec, shin, pow);
+            // Encode to sRGB8 (texmap-core's table), background where nothing won.
+            let px = V::select(
+                win.eq_bits(none),
+                bgv,
+                fastshade::srgb_rgba_lanes(c[0], c[1], c[2], enc),
             );
-            // Encode to sRGB8 (texmap-core's table, indices over lanes).
-            let idx = [
-                fastshade::srgb_index_lanes(c[0]),
-                fastshade::srgb_index_lanes(c[1]),
-                fastshade::srgb_index_lanes(c[2]),
-            ];
-            for l in 0..n {
-                if covered & (1 << l) != 0 {
-                    out[i + l] = [
-                        enc[idx[0][l] as usize & (fastshade::SRGB_N - 1)],
-                        enc[idx[1][l] as usize & (fastshade::SRGB_N - 1)],
-                        enc[idx[2][l] as usize & (fastshade::SRGB_N - 1)],
-                        255,
-                    ];
-                } else {
-                    out[i + l] = background;
-                }
+            if n == LANES {
+                px.store_rgba(&mut out[i..]);
+            } else {
+                let mut tmp = [[0u8; 4]; LANES];
+                px.store_rgba(&mut tmp);
+                out[i..i + n].copy_from_slice(&tmp[..n]);
             }
             i += LANES;
         }
