@@ -453,6 +453,28 @@ mod tests {
     use super::*;
 
     #[test]
+    fn level_offset_table_matches_the_levels() {
+        // The largest level count (a 16384-wide side: 15 levels) and small pyramids; entries
+        // past the top repeat the top level's offset, and offsets are the running sums of the
+        // level areas (recomputed here).
+        for (w, h) in [(1, 1), (64, 16), (48, 20), (MAX_TEXTURE_SIDE, 2)] {
+            let data = vec![Vec4::ONE; (w * h) as usize];
+            let t = MipTexture::from_linear(w, h, &data, Reduction::Box, Wrap::Repeat).unwrap();
+            let (mut sum, mut lw, mut lh) = (0usize, w as usize, h as usize);
+            let mut expect = Vec::new();
+            for _ in 0..t.level_count() {
+                expect.push(sum as i32);
+                sum += lw * lh;
+                (lw, lh) = ((lw / 2).max(1), (lh / 2).max(1));
+            }
+            for (i, &got) in t.level_offsets16().iter().enumerate() {
+                let e = expect[i.min(expect.len() - 1)];
+                assert_eq!(got, e, "{w}x{h} level {i}: expected offset {e}, got {got}");
+            }
+        }
+    }
+
+    #[test]
     fn odd_weights_sum_to_one_and_preserve_the_mean() {
         // A ramp of 7 values: the reduced 3 values must have the same mean (f64 check).
         let src: Vec<Vec4> = (0..7).map(|i| Vec4::splat(i as f32 * i as f32)).collect();

@@ -669,3 +669,128 @@ pub(super) unsafe fn span_quads<A: Addr, const K: usize>(
     }
     n
 }
+
+// ---------------------------------------------------------------------------------------------
+// One span per call (`Sampler::sample_quad`, the rasteriser's path): lanes = its four pixels.
+
+/// One level of one span from an interior window: the doubled index of each pixel's 2x2 corner
+/// texel, the doubled row stride and the weights of the pixel pairs `[w_2p | w_2p+1]`.
+struct QuadLevel {
+    idx: [u32; 4],
+    w2: usize,
+    wx: [__m256; 2],
+    wy: [__m256; 2],
+}
+
+/// Seed 000 Eq. (10) for one span at `level` with [`super::direct_level`]'s arithmetic; `None`
+/// when the window is not interior (the caller takes the generic path).
+#[inline]
+#[target_feature(enable = "avx2")]
+fn quad_level<A: Addr, const K: usize>(
+    tex: &MipTexture,
+    level: usize,
+    sx: Vec4,
+    sy: Vec4,
+) -> Option<QuadLevel> {
+    let l = &tex.levels()[level];
+    // This level's texel coordinates (Eq. 3 on 2^L r_m − ½), floors and weights.
+    let mut x = sx * l.scale_x - Vec4::splat(0.5);
+    let mut y = sy * l.scale_y - Vec4::splat(0.5);
+    if !A::REPEAT {
+        x = x.max(Vec4::ZERO).min(Vec4::splat(l.width_f - 1.0));
+        y = y.max(Vec4::ZERO).min(Vec4::splat(l.height_f - 1.0));
+    }
+    let (x, y): (__m128, __m128) = (x.into(), y.into());
+    let (flx, fly) = (_mm_floor_ps(x), _mm_floor_ps(y));
+    let (ax, ay) = (_mm_sub_ps(x, flx), _mm_sub_ps(y, fly));
+    // The window corner (the lowest texel) and each pixel's offset from it.
+    let hmin = |v: __m128| {
+        let m = _mm_min_ps(v, _mm_shuffle_ps::<0b01_00_11_10>(v, v));
+        _mm_min_ps(m, _mm_shuffle_ps::<0b10_11_00_01>(m, m))
+    };
+    let (mx, my) = (hmin(flx), hmin(fly));
+    let (ox, oy) = (_mm_sub_ps(flx, mx), _mm_sub_ps(fly, my));
+    let lim = _mm_set1_ps((K - 2) as f32);
+    let over = _mm_movemask_ps(_mm_or_ps(_mm_cmpgt_ps(ox, lim), _mm_cmpgt_ps(oy, lim)));
+    let (x0, y0) = (_mm_cvtss_si32(mx), _mm_cvtss_si32(my));
+    let (w, h) = (l.width as i32, l.height as i32);
+    let k = K as i32;
+    if over != 0 || x0 < 0 || y0 < 0 || x0 + k > w || y0 + k > h {
+        return None;
+    }
+    // corner + oy·w + ox (small non-negative integers, exact in f32), doubled.
+    let corner = _mm_set1_epi32((l.offset + (y0 * w + x0) as usize) as i32);
+    let o = _mm_cvttps_epi32(_mm_add_ps(_mm_mul_ps(oy, _mm_set1_ps(l.width_f)), ox));
+    let idx = _mm_slli_epi32::<1>(_mm_add_epi32(corner, o));
+    let pair = |v: __m128, a: i32, b: i32| {
+        _mm256_permutevar8x32_ps(
+            _mm256_castps128_ps256(v),
+            _mm256_setr_epi32(a, a, a, a, b, b, b, b),
+        )
+    };
+    Some(QuadLevel {
+        // SAFETY: same size, no invalid bit patterns.
+        idx: unsafe { core::mem::transmute::<__m128i, [u32; 4]>(idx) },
+        w2: 2 * w as usize,
+        wx: [pair(ax, 0, 1), pair(ax, 2, 3)],
+        wy: [pair(ay, 0, 1), pair(ay, 2, 3)],
+    })
+}
+
+/// Bilinear of pixels `2p`, `2p + 1` from an interior window.
+///
+/// # Safety
+/// `d` must come from [`quad_level`] on the texture whose texels start at `base`.
+#[inline]
+#[target_feature(enable = "avx2")]
+unsafe fn quad_pair(base: *const u8, d: &QuadLevel, p: usize) -> __m256 {
+    let (i0, i1, w) = (d.idx[2 * p] as usize, d.idx[2 * p + 1] as usize, d.w2);
+    // SAFETY: the caller's contract: every pixel's 2x2 lies in the window inside the level.
+    unsafe {
+        let t00 = load_pair(base, i0, i1);
+        let t10 = load_pair(base, i0 + 2, i1 + 2);
+        let t01 = load_pair(base, i0 + w, i1 + w);
+        let t11 = load_pair(base, i0 + w + 2, i1 + w + 2);
+        lerp8(lerp8(t00, t10, d.wx[p]), lerp8(t01, t11, d.wx[p]), d.wy[p])
+    }
+}
+
+/// The span sampler on one span (Seed 000 Eq. 8–10, Eq. 4 blend): bit-identical to
+/// [`super::span_finish_direct`] after [`super::span_plan`], which it replaces on AVX2 CPUs.
+///
+/// # Safety
+/// The CPU must support AVX2.
+#[target_feature(enable = "avx2")]
+pub(super) unsafe fn span_quad<A: Addr, const K: usize>(
+    tex: &MipTexture,
+    uv: [Vec2; 4],
+) -> [Vec4; 4] {
+    let p = super::span_plan::<A, K>(tex, uv, 0);
+    let Some(a) = quad_level::<A, K>(tex, p.i0, p.sx, p.sy) else {
+        return super::span_finish::<A, super::Direct, K>(tex, p, &mut super::Direct);
+    };
+    let base = tex.texels().as_ptr() as *const u8;
+    let mut out = [Vec4::ZERO; 4];
+    let dst = out.as_mut_ptr() as *mut f32;
+    if p.i1 == p.i0 || p.t == 0.0 {
+        // SAFETY: `a` is interior (quad_level); `out` holds 16 floats.
+        unsafe {
+            _mm256_storeu_ps(dst, quad_pair(base, &a, 0));
+            _mm256_storeu_ps(dst.add(8), quad_pair(base, &a, 1));
+        }
+        return out;
+    }
+    let Some(b) = quad_level::<A, K>(tex, p.i1, p.sx, p.sy) else {
+        return super::span_finish::<A, super::Direct, K>(tex, p, &mut super::Direct);
+    };
+    // Seed 000 Eq. (4): one blend weight for the span.
+    let tt = _mm256_set1_ps(p.t);
+    for k in 0..2 {
+        // SAFETY: both levels interior; `out` holds 16 floats.
+        unsafe {
+            let r = lerp8(quad_pair(base, &a, k), quad_pair(base, &b, k), tt);
+            _mm256_storeu_ps(dst.add(8 * k), r);
+        }
+    }
+    out
+}

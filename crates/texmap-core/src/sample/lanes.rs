@@ -576,7 +576,7 @@ pub(super) fn span_quads4<A: Addr, const K: usize>(
 
 /// Whether the AVX2 build of the kernels can run here (cached by the standard library).
 #[inline]
-fn has_avx2() -> bool {
+pub(super) fn has_avx2() -> bool {
     std::arch::is_x86_feature_detected!("avx2")
 }
 
