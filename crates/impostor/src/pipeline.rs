@@ -374,7 +374,9 @@ pub(crate) struct TileBuf {
 /// A method's per-pixel work, chosen once per frame (static dispatch).
 pub(crate) trait Kernel: Sync {
     /// Depth pass: test every record of the bin (in order) against the tile's pixels, keeping
-    /// in `buf` the nearest depth and the index of its record (plus [`FLAG_INSIDE`]).
+    /// in `buf` the nearest depth and the index of its record (plus [`FLAG_INSIDE`]). A depth
+    /// is written only together with its winner, so pixels left at [`NONE`] keep an infinite
+    /// depth ([`draw_tiles`] copies the depths as they are).
     fn raster(&self, recs: &[Proj], tile: TileRect, buf: &mut TileBuf);
     /// Colour of pixel `(x, y)` won by `rec` at `depth` (sRGB RGBA8).
     fn resolve(&self, rec: &Proj, x: u32, y: u32, depth: f32, flags: u32) -> [u8; 4];
@@ -470,14 +472,12 @@ pub(crate) fn draw_tiles<K: Kernel>(
                 kernel.raster(recs, tile, &mut buf);
                 // Resolve pass: colour each covered pixel once.
                 kernel.resolve_tile(recs, tile, &buf, background, &mut color[x0 as usize..], w);
+                // Depths: every kernel writes a depth and its winner together (strict `<` against
+                // an infinite start), so pixels nothing won still hold INFINITY: a plain copy.
                 for j in 0..th as usize {
                     let o = j * w + x0 as usize;
                     let bw = j * TILE as usize;
-                    let win = &buf.win[bw..bw + tw as usize];
-                    let dep = &buf.depth[bw..bw + tw as usize];
-                    for ((d, &wv), &bd) in depth[o..o + tw as usize].iter_mut().zip(win).zip(dep) {
-                        *d = if wv == NONE { f32::INFINITY } else { bd };
-                    }
+                    depth[o..o + tw as usize].copy_from_slice(&buf.depth[bw..bw + tw as usize]);
                 }
             }
         });
