@@ -82,8 +82,19 @@ fn main() {
         rend.render_into(&s.spheres, &s.camera, &opts, &mut frame);
     }
     let ms = t.elapsed().as_secs_f64() * 1e3 / iters.max(1) as f64;
+    // FNV-1a of the colour and depth bytes: the same image gives the same hash.
+    let mut hash = 0xcbf2_9ce4_8422_2325_u64;
+    let bytes = frame
+        .color
+        .iter()
+        .flatten()
+        .copied()
+        .chain(frame.depth.iter().flat_map(|d| d.to_le_bytes()));
+    for byte in bytes {
+        hash = (hash ^ byte as u64).wrapping_mul(0x100_0000_01b3);
+    }
     println!(
-        "{} bonds={bonds} {ms:.3} ms/frame wall, coverage {:.4}, {st:?}",
+        "{} bonds={bonds} {ms:.3} ms/frame wall, coverage {:.4}, image hash {hash:016x}, {st:?}",
         s.name,
         frame.coverage_count() as f64 / frame.len() as f64
     );

@@ -65,7 +65,9 @@ use texmap_core::frame::Frame;
 use texmap_core::shade::{Lighting, Material};
 
 use crate::SphereScene;
-use crate::fastshade::{self, M8, Surf8, V8, W};
+#[cfg(target_arch = "x86_64")]
+use crate::fastshade::V8x;
+use crate::fastshade::{self, M8, Mask8, Simd8, Surf8, V8, W};
 use crate::pipeline::{self, FLAG_INSIDE, LANES, NONE, TILE, TILE_BUF, TILE_PX, View};
 
 /// Bonds per projection chunk: fixed, so results do not depend on the thread count.
@@ -548,70 +550,70 @@ impl BondV {
 }
 
 /// Ray data of 8 pixels (any rows), in the generic form of the intersection.
-struct Rays {
+struct Rays<V> {
     /// `A = |d × u|²`.
-    a: V8,
+    a: V,
     /// `g·(d × u)` (up to sign): `√A` times the ray–axis distance.
-    dn: V8,
+    dn: V,
     /// Closest approach `s = num / A`.
-    num: V8,
+    num: V,
     /// `h(o)`: axial coordinate of the ray origin, and its negation.
-    h0: V8,
-    neg_h0: V8,
+    h0: V,
+    neg_h0: V,
     /// `d·u`.
-    du: V8,
+    du: V,
     /// For rays parallel to the axis: 1 where the ray runs inside the infinite cylinder, else 0.
-    par_in: V8,
+    par_in: V,
 }
 
 /// A camera's rays over lanes, in two steps: what depends on the row (`y`) once per row, then
 /// what depends on the column (`x`) per 8 pixels. Both implementations keep the operations and
 /// their order of the one-step form (so the results are bit-identical to it).
-trait RayGen {
+trait RayGen<V: Simd8> {
     type Row;
-    fn row(b: &BondV, y: V8) -> Self::Row;
-    fn rays(b: &BondV, r: &Self::Row, x: V8) -> Rays;
+    fn row(b: &BondV, y: V) -> Self::Row;
+    fn rays(b: &BondV, r: &Self::Row, x: V) -> Rays<V>;
 }
 
 /// Perspective rays: `o = 0`, `d = (x, y, −1)` per lane.
 struct Persp;
 
 /// The row terms of a perspective ray: `c1 = y·uz + uy` and the products of `y`.
-struct PerspRow {
-    c1: V8,
-    yux: V8,
-    yuy: V8,
-    yny: V8,
-    yqy: V8,
+struct PerspRow<V> {
+    c1: V,
+    yux: V,
+    yuy: V,
+    yny: V,
+    yqy: V,
 }
 
-impl RayGen for Persp {
-    type Row = PerspRow;
+impl<V: Simd8> RayGen<V> for Persp {
+    type Row = PerspRow<V>;
     #[inline(always)]
-    fn row(b: &BondV, y: V8) -> PerspRow {
-        let [ux, uy, uz] = b.u.map(V8::splat);
+    fn row(b: &BondV, y: V) -> PerspRow<V> {
+        let [ux, uy, uz] = b.u.map(V::splat);
         PerspRow {
             c1: y * uz + uy,
             yux: y * ux,
             yuy: y * uy,
-            yny: y * V8::splat(b.n[1]),
-            yqy: y * V8::splat(b.q[1]),
+            yny: y * V::splat(b.n[1]),
+            yqy: y * V::splat(b.q[1]),
         }
     }
     #[inline(always)]
-    fn rays(b: &BondV, r: &PerspRow, x: V8) -> Rays {
-        let [ux, uy, uz] = b.u.map(V8::splat);
+    fn rays(b: &BondV, r: &PerspRow<V>, x: V) -> Rays<V> {
+        let [ux, uy, uz] = b.u.map(V::splat);
         // d × u, component by component (z of d is −1).
-        let c2 = V8::splat(b.neg_ux) - x * uz;
+        let c2 = V::splat(b.neg_ux) - x * uz;
         let c3 = x * uy - r.yux;
         Rays {
             a: r.c1 * r.c1 + c2 * c2 + c3 * c3,
-            dn: x * V8::splat(b.n[0]) + r.yny - V8::splat(b.n[2]),
-            num: x * V8::splat(b.q[0]) + r.yqy - V8::splat(b.q[2]),
-            h0: V8::splat(b.neg_au),
-            neg_h0: V8::splat(b.au),
+            dn: x * V::splat(b.n[0]) + r.yny - V::splat(b.n[2]),
+            num: x * V::splat(b.q[0]) + r.yqy - V::splat(b.q[2]),
+            h0: V::splat(b.neg_au),
+            neg_h0: V::splat(b.au),
             du: x * ux + r.yuy - uz,
-            par_in: V8::splat(b.par_in_persp),
+            par_in: V::splat(b.par_in_persp),
         }
     }
 }
@@ -620,42 +622,42 @@ impl RayGen for Persp {
 struct Ortho;
 
 /// The row terms of an orthographic ray: products of `gy = y − ay`.
-struct OrthoRow {
-    gyux: V8,
-    gyuy: V8,
-    gy2: V8,
+struct OrthoRow<V> {
+    gyux: V,
+    gyuy: V,
+    gy2: V,
 }
 
-impl RayGen for Ortho {
-    type Row = OrthoRow;
+impl<V: Simd8> RayGen<V> for Ortho {
+    type Row = OrthoRow<V>;
     #[inline(always)]
-    fn row(b: &BondV, y: V8) -> OrthoRow {
-        let gy = y - V8::splat(b.a[1]);
+    fn row(b: &BondV, y: V) -> OrthoRow<V> {
+        let gy = y - V::splat(b.a[1]);
         OrthoRow {
-            gyux: gy * V8::splat(b.u[0]),
-            gyuy: gy * V8::splat(b.u[1]),
+            gyux: gy * V::splat(b.u[0]),
+            gyuy: gy * V::splat(b.u[1]),
             gy2: gy * gy,
         }
     }
     #[inline(always)]
-    fn rays(b: &BondV, r: &OrthoRow, x: V8) -> Rays {
-        let [ux, uy, uz] = b.u.map(V8::splat);
+    fn rays(b: &BondV, r: &OrthoRow<V>, x: V) -> Rays<V> {
+        let [ux, uy, uz] = b.u.map(V::splat);
         // g = o − a (gz = −az, the same for every ray); d × u = (uy, −ux, 0).
-        let gx = x - V8::splat(b.a[0]);
+        let gx = x - V::splat(b.a[0]);
         let gxy = gx * ux + r.gyuy;
-        let gu = gxy + V8::splat(b.gzuz);
-        let par_in = (gx * gx + r.gy2 + V8::splat(b.gz2) - gu * gu).le(V8::splat(b.r2));
+        let gu = gxy + V::splat(b.gzuz);
+        let par_in = (gx * gx + r.gy2 + V::splat(b.gz2) - gu * gu).le(V::splat(b.r2));
         Rays {
-            a: V8::splat(b.a_ortho),
+            a: V::splat(b.a_ortho),
             dn: gx * uy - r.gyux,
             // s = −(g·w)/A with w = d − (d·u)u = (uz·ux, uz·uy, −A) (as |u| = 1): written so,
             // not as `gz − uz·(g·u)`, which cancels two terms of the size of the depth when the
             // bond is seen nearly end-on.
-            num: V8::splat(b.gza) - uz * gxy,
+            num: V::splat(b.gza) - uz * gxy,
             h0: gu,
-            neg_h0: V8::splat(0.0) - gu,
-            du: V8::splat(b.du_ortho),
-            par_in: V8::select(par_in, V8::splat(1.0), V8::splat(0.0)),
+            neg_h0: V::splat(0.0) - gu,
+            du: V::splat(b.du_ortho),
+            par_in: V::select(par_in, V::splat(1.0), V::splat(0.0)),
         }
     }
 }
@@ -671,10 +673,10 @@ impl RayGen for Ortho {
 /// group), [`solve8_regular`] computes the same operations on the same values without the
 /// selects those cases need; otherwise [`solve8_general`].
 #[inline(always)]
-fn solve8(b: &BondV, l: &Rays, lanes: M8, near: V8, far: V8) -> (V8, V8) {
+fn solve8<V: Simd8>(b: &BondV, l: &Rays<V>, lanes: V::M, near: V, far: V) -> (V, V) {
     let regular =
-        l.a.gt(V8::splat(PARALLEL_A))
-            .and((l.du * l.du).gt(V8::splat(1e-30)));
+        l.a.gt(V::splat(PARALLEL_A))
+            .and((l.du * l.du).gt(V::splat(1e-30)));
     if regular.bits() == 0xff {
         if let Some(r) = solve8_regular(b, l, lanes, near, far) {
             return r;
@@ -685,13 +687,19 @@ fn solve8(b: &BondV, l: &Rays, lanes: M8, near: V8, far: V8) -> (V8, V8) {
 
 /// [`solve8`] for 8 regular lanes, or `None` when a hit lane took the exit (near plane).
 #[inline(always)]
-fn solve8_regular(b: &BondV, l: &Rays, lanes: M8, near: V8, far: V8) -> Option<(V8, V8)> {
-    let zero = V8::splat(0.0);
-    let one = V8::splat(1.0);
-    let inf = V8::splat(f32::INFINITY);
+fn solve8_regular<V: Simd8>(
+    b: &BondV,
+    l: &Rays<V>,
+    lanes: V::M,
+    near: V,
+    far: V,
+) -> Option<(V, V)> {
+    let zero = V::splat(0.0);
+    let one = V::splat(1.0);
+    let inf = V::splat(f32::INFINITY);
     // Infinite cylinder: s ∓ √(r²A − dn²)/A.
     let ia = one / l.a;
-    let disc = V8::splat(b.r2) * l.a - l.dn * l.dn;
+    let disc = V::splat(b.r2) * l.a - l.dn * l.dn;
     let hc = disc.max(zero).sqrt() * ia;
     let s = l.num * ia;
     let t0 = s - hc;
@@ -699,14 +707,14 @@ fn solve8_regular(b: &BondV, l: &Rays, lanes: M8, near: V8, far: V8) -> Option<(
     // Cap slab: 0 ≤ h0 + t·du ≤ len.
     let inv = one / l.du;
     let ta = l.neg_h0 * inv;
-    let tb = (V8::splat(b.len) - l.h0) * inv;
+    let tb = (V::splat(b.len) - l.h0) * inv;
     let s0 = ta.min(tb);
     let s1 = tb.max(ta);
     // Entry and exit of the solid.
     let en = t0.max(s0);
     let ex = t1.min(s1);
     let front = en.ge(near);
-    let th = V8::select(front, en, ex);
+    let th = V::select(front, en, ex);
     let ok = disc
         .ge(zero)
         .and(en.le(ex))
@@ -720,46 +728,46 @@ fn solve8_regular(b: &BondV, l: &Rays, lanes: M8, near: V8, far: V8) -> Option<(
         return None;
     }
     // Every hit is the entry: the cap flag where the entry is on a cap.
-    let word = V8::select(
+    let word = V::select(
         s0.gt(t0),
-        V8::splat_bits(b.idx | FLAG_CAP),
-        V8::splat_bits(b.idx),
+        V::splat_bits(b.idx | FLAG_CAP),
+        V::splat_bits(b.idx),
     );
-    Some((V8::select(ok, th, inf), word))
+    Some((V::select(ok, th, inf), word))
 }
 
 /// [`solve8`] for any lanes: rays parallel to the axis or the cap planes, and exits.
-#[inline(never)]
-fn solve8_general(b: &BondV, l: &Rays, lanes: M8, near: V8, far: V8) -> (V8, V8) {
-    let zero = V8::splat(0.0);
-    let one = V8::splat(1.0);
-    let inf = V8::splat(f32::INFINITY);
+#[inline(always)]
+fn solve8_general<V: Simd8>(b: &BondV, l: &Rays<V>, lanes: V::M, near: V, far: V) -> (V, V) {
+    let zero = V::splat(0.0);
+    let one = V::splat(1.0);
+    let inf = V::splat(f32::INFINITY);
     // Infinite cylinder: s ∓ √(r²A − dn²)/A; a ray parallel to the axis (A ≤ 1e-12) is inside
     // everywhere or nowhere.
-    let par = l.a.le(V8::splat(PARALLEL_A));
-    let ia = one / V8::select(par, one, l.a);
-    let disc = V8::splat(b.r2) * l.a - l.dn * l.dn;
+    let par = l.a.le(V::splat(PARALLEL_A));
+    let ia = one / V::select(par, one, l.a);
+    let disc = V::splat(b.r2) * l.a - l.dn * l.dn;
     let hc = disc.max(zero).sqrt() * ia;
     let s = l.num * ia;
-    let side_hit = V8::select(par, l.par_in, V8::select(disc.ge(zero), one, zero));
-    let t0 = V8::select(par, V8::splat(f32::NEG_INFINITY), s - hc);
-    let t1 = V8::select(par, inf, s + hc);
+    let side_hit = V::select(par, l.par_in, V::select(disc.ge(zero), one, zero));
+    let t0 = V::select(par, V::splat(f32::NEG_INFINITY), s - hc);
+    let t1 = V::select(par, inf, s + hc);
     // Cap slab: 0 ≤ h0 + t·du ≤ len (|du| ≤ MIN_DU replaced by MIN_DU).
-    let du = V8::select(
-        l.du.lt(V8::splat(-MIN_DU)),
+    let du = V::select(
+        l.du.lt(V::splat(-MIN_DU)),
         l.du,
-        V8::select(l.du.gt(V8::splat(MIN_DU)), l.du, V8::splat(MIN_DU)),
+        V::select(l.du.gt(V::splat(MIN_DU)), l.du, V::splat(MIN_DU)),
     );
     let inv = one / du;
     let ta = l.neg_h0 * inv;
-    let tb = (V8::splat(b.len) - l.h0) * inv;
+    let tb = (V::splat(b.len) - l.h0) * inv;
     let s0 = ta.min(tb);
     let s1 = tb.max(ta);
     // Entry and exit of the solid.
     let en = t0.max(s0);
     let ex = t1.min(s1);
     let front = en.ge(near);
-    let th = V8::select(front, en, ex);
+    let th = V::select(front, en, ex);
     let ok = side_hit
         .gt(zero)
         .and(en.le(ex))
@@ -767,32 +775,32 @@ fn solve8_general(b: &BondV, l: &Rays, lanes: M8, near: V8, far: V8) -> (V8, V8)
         .and(th.le(far))
         .and(lanes);
     // Winner words: inside flag where the exit was taken, cap flag where the hit is on a cap.
-    let word = V8::select(
+    let word = V::select(
         front,
-        V8::select(
+        V::select(
             s0.gt(t0),
-            V8::splat_bits(b.idx | FLAG_CAP),
-            V8::splat_bits(b.idx),
+            V::splat_bits(b.idx | FLAG_CAP),
+            V::splat_bits(b.idx),
         ),
-        V8::select(
+        V::select(
             s1.lt(t1),
-            V8::splat_bits(b.idx | FLAG_INSIDE | FLAG_CAP),
-            V8::splat_bits(b.idx | FLAG_INSIDE),
+            V::splat_bits(b.idx | FLAG_INSIDE | FLAG_CAP),
+            V::splat_bits(b.idx | FLAG_INSIDE),
         ),
     );
-    (V8::select(ok, th, inf), word)
+    (V::select(ok, th, inf), word)
 }
 
 /// Strict depth test of 8 lanes against `depth`/`win` (the atom, then the earlier bond, wins ties).
 #[inline(always)]
-fn depth_test8(t: V8, word: V8, depth: &mut [f32], win: &mut [u32]) {
-    let d = V8::load_from(depth);
+fn depth_test8<V: Simd8>(t: V, word: V, depth: &mut [f32], win: &mut [u32]) {
+    let d = V::load_from(depth);
     let closer = t.lt(d);
     if closer.bits() == 0 {
         return;
     }
-    V8::select(closer, t, d).store_to(depth);
-    V8::select(closer, word, V8::load_bits(win)).store_bits(win);
+    V::select(closer, t, d).store_to(depth);
+    V::select(closer, word, V::load_bits(win)).store_bits(win);
 }
 
 /// A tile's bond depth test: the depth buffer starts from the sphere pass.
@@ -804,24 +812,62 @@ struct TileBuf {
 /// Per-frame constants of the tile kernel.
 struct Kernel<'a> {
     view: View,
+    /// Run the depth pass on AVX2 lanes (the CPU has them).
+    avx2: bool,
     lighting: Lighting,
     materials: &'a [Material],
+}
+
+/// [`Kernel::raster_with`] on SSE2 lanes (the x86-64 baseline, or plain arrays elsewhere).
+#[inline(never)]
+fn raster_sse(k: &Kernel, recs: &[BondRec], x0t: u32, y0t: u32, w: u32, h: u32, buf: &mut TileBuf) {
+    if k.view.ortho {
+        k.raster_with::<Ortho, V8>(recs, x0t, y0t, w, h, buf);
+    } else {
+        k.raster_with::<Persp, V8>(recs, x0t, y0t, w, h, buf);
+    }
+}
+
+/// [`Kernel::raster_with`] on AVX2 lanes (the generic body and the intrinsics inline here; the
+/// same IEEE operations, so the same bits as [`raster_sse`]).
+///
+/// # Safety
+/// The CPU must support AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline(never)]
+unsafe fn raster_avx2(
+    k: &Kernel,
+    recs: &[BondRec],
+    x0t: u32,
+    y0t: u32,
+    w: u32,
+    h: u32,
+    buf: &mut TileBuf,
+) {
+    if k.view.ortho {
+        k.raster_with::<Ortho, V8x>(recs, x0t, y0t, w, h, buf);
+    } else {
+        k.raster_with::<Persp, V8x>(recs, x0t, y0t, w, h, buf);
+    }
 }
 
 impl Kernel<'_> {
     /// Depth pass of one tile over its bin, in bond order.
     fn raster(&self, recs: &[BondRec], x0t: u32, y0t: u32, w: u32, h: u32, buf: &mut TileBuf) {
-        if self.view.ortho {
-            self.raster_with::<Ortho>(recs, x0t, y0t, w, h, buf);
-        } else {
-            self.raster_with::<Persp>(recs, x0t, y0t, w, h, buf);
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            // SAFETY: `avx2` is set only where `V8x::available()` returned true.
+            unsafe { raster_avx2(self, recs, x0t, y0t, w, h, buf) };
+            return;
         }
+        raster_sse(self, recs, x0t, y0t, w, h, buf);
     }
 
     /// [`Kernel::raster`] with the camera's ray generator chosen outside the loops.
     #[allow(clippy::too_many_arguments)]
-    #[inline(never)]
-    fn raster_with<G: RayGen>(
+    #[inline(always)]
+    fn raster_with<G: RayGen<V>, V: Simd8>(
         &self,
         recs: &[BondRec],
         x0t: u32,
@@ -842,7 +888,7 @@ impl Kernel<'_> {
         for (j, y) in ys.iter_mut().enumerate() {
             *y = (v.cy - ((y0t + j as u32) as f32 + 0.5)) * v.inv_k;
         }
-        let (near, far) = (V8::splat(v.near), V8::splat(v.far));
+        let (near, far) = (V::splat(v.near), V::splat(v.far));
         let view_w = v.width;
         for (idx, rec) in recs.iter().enumerate() {
             // Clip the bond's rectangle to the tile (tile-local columns i0..i1, rows j0..j1).
@@ -861,30 +907,34 @@ impl Kernel<'_> {
             // (the capped cylinder lies in the capsule around its axis), so 8 pixels whose
             // stored depths are all at least that near are skipped. The bound is widened by
             // 1e-4 of itself against rounding in `solve8`.
-            let zmin = V8::splat(rec.zmin());
+            let zmin = V::splat(rec.zmin());
             if i1 - i0 <= 4 {
                 // Narrow boxes (thin or short bonds): two rows of up to 4 pixels per 8 lanes.
-                let cols = M8::first_of_halves(i1 - i0);
-                let x = V8::load_halves(&xs[i0..], &xs[i0..]);
+                let cols = <V::M as Mask8>::first_of_halves(i1 - i0);
+                let x = V::load_halves(&xs[i0..], &xs[i0..]);
                 let mut j = j0;
                 while j < j1 {
                     let two = j + 1 < j1;
                     let jb = if two { j + 1 } else { j };
                     let (o0, o1) = (j * T + i0, jb * T + i0);
-                    let d = V8::load_halves(&buf.depth[o0..], &buf.depth[o1..]);
-                    let lanes = if two { cols } else { cols.and(M8::first(4)) };
+                    let d = V::load_halves(&buf.depth[o0..], &buf.depth[o1..]);
+                    let lanes = if two {
+                        cols
+                    } else {
+                        cols.and(<V::M as Mask8>::first(4))
+                    };
                     if zmin.lt(d).and(lanes).bits() != 0 {
-                        let y = V8::load_halves(&[ys[j]; 4], &[ys[jb]; 4]);
+                        let y = V::load_halves(&[ys[j]; 4], &[ys[jb]; 4]);
                         let b = bv.get_or_insert_with(|| BondV::new(rec, idx as u32));
                         let rays = G::rays(b, &G::row(b, y), x);
                         let (t, word) = solve8(b, &rays, lanes, near, far);
                         let closer = t.lt(d);
                         if closer.bits() != 0 {
-                            let nd = V8::select(closer, t, d);
+                            let nd = V::select(closer, t, d);
                             let mut wins = [0u32; LANES];
                             wins[..4].copy_from_slice(&buf.win[o0..o0 + 4]);
                             wins[4..].copy_from_slice(&buf.win[o1..o1 + 4]);
-                            V8::select(closer, word, V8::load_bits(&wins)).store_bits(&mut wins);
+                            V::select(closer, word, V::load_bits(&wins)).store_bits(&mut wins);
                             nd.store_lo(&mut buf.depth[o0..]);
                             buf.win[o0..o0 + 4].copy_from_slice(&wins[..4]);
                             if two {
@@ -914,14 +964,14 @@ impl Kernel<'_> {
                 } else {
                     (i0, i1)
                 };
-                let y = V8::splat(ys[j]);
+                let y = V::splat(ys[j]);
                 let mut i = a;
                 while i < e {
                     let o = j * T + i;
-                    let lanes = M8::first(e - i);
-                    let d = V8::load_from(&buf.depth[o..]);
+                    let lanes = <V::M as Mask8>::first(e - i);
+                    let d = V::load_from(&buf.depth[o..]);
                     if zmin.lt(d).and(lanes).bits() != 0 {
-                        let x = V8::load_from(&xs[i..]);
+                        let x = V::load_from(&xs[i..]);
                         let b = bv.get_or_insert_with(|| BondV::new(rec, idx as u32));
                         let rays = G::rays(b, &G::row(b, y), x);
                         let (t, word) = solve8(b, &rays, lanes, near, far);
@@ -966,42 +1016,71 @@ impl Kernel<'_> {
                 }
             }
         }
+        // Pixel-centre tables (the formula of the depth pass, so the rays are the same).
+        let mut xs = [0f32; TILE as usize];
+        for (i, x) in xs.iter_mut().enumerate() {
+            *x = ((x0t + i as u32) as f32 + 0.5 - v.cx) * v.inv_k;
+        }
+        let mut ys = [0f32; TILE as usize];
+        for (j, y) in ys.iter_mut().enumerate() {
+            *y = (v.cy - ((y0t + j as u32) as f32 + 0.5)) * v.inv_k;
+        }
+        let zero = V8::splat(0.0);
         for chunk in list[..n].chunks(W) {
-            let mut s = Surf8::default();
+            // Gather the lanes' ray, depth and bond (short chunks repeat their first pixel).
+            let mut g = [[0f32; W]; 12];
+            let mut kinds = [[0u16; 2]; W];
             for l in 0..W {
-                // Short chunks repeat their first pixel.
                 let b = chunk[if l < chunk.len() { l } else { 0 }] as usize;
                 let wv = buf.win[b];
                 let rec = &recs[(wv & INDEX_MASK) as usize];
-                let t = buf.depth[b];
-                let xs = ((x0t as usize + b % TILE as usize) as f32 + 0.5 - v.cx) * v.inv_k;
-                let ys = (v.cy - ((y0t as usize + b / TILE as usize) as f32 + 0.5)) * v.inv_k;
-                // Hit point and unit vector toward the eye.
-                let (p, to_eye) = if v.ortho {
-                    (Vec3::new(xs, ys, -t), Vec3::Z)
-                } else {
-                    let d = Vec3::new(xs, ys, -1.0);
-                    (d * t, -d * (1.0 / d.length()))
-                };
-                let u = Vec3::from(rec.u);
-                let pa = p - rec.a();
-                let hax = pa.dot(u);
-                // Half-bond colouring: the half at `a` in atom i's material.
-                let first = hax < 0.5 * rec.len;
-                // Outward normal: ±u on a cap, the radial direction on the side.
-                let mut nrm = if wv & FLAG_CAP != 0 {
-                    if first { -u } else { u }
-                } else {
-                    (pa - u * hax) * rec.inv_r
-                };
-                // The inside of a bond cut by the near plane faces the viewer.
-                if wv & FLAG_INSIDE != 0 {
-                    nrm = -nrm;
-                }
-                let m = &self.materials[rec.kind[if first { 0 } else { 1 }] as usize];
+                let a = rec.a();
+                g[0][l] = xs[b % TILE as usize];
+                g[1][l] = ys[b / TILE as usize];
+                g[2][l] = buf.depth[b];
+                g[3][l] = a.x;
+                g[4][l] = a.y;
+                g[5][l] = a.z;
+                g[6][l] = rec.u[0];
+                g[7][l] = rec.u[1];
+                g[8][l] = rec.u[2];
+                g[9][l] = 0.5 * rec.len;
+                g[10][l] = rec.inv_r;
+                // Flags as lane bits: cap in bit 30, inside in bit 31 (`FLAG_*`).
+                g[11][l] = f32::from_bits(wv & !INDEX_MASK);
+                kinds[l] = rec.kind;
+            }
+            let [x, y, t, ax, ay, az, ux, uy, uz, half, inv_r, flags] = g.map(|c| V8::load(&c));
+            // Hit point and unit vector toward the eye.
+            let (p, to_eye) = if v.ortho {
+                ([x, y, zero - t], [zero, zero, V8::splat(1.0)])
+            } else {
+                let il = V8::splat(1.0) / (x * x + y * y + V8::splat(1.0)).sqrt();
+                (
+                    [x * t, y * t, zero - t],
+                    [(zero - x) * il, (zero - y) * il, il],
+                )
+            };
+            let pa = [p[0] - ax, p[1] - ay, p[2] - az];
+            let hax = pa[0] * ux + pa[1] * uy + pa[2] * uz;
+            // Half-bond colouring: the half at `a` in atom i's material.
+            let first = hax.lt(half);
+            // Outward normal: ±u on a cap, the radial direction on the side; the inside of a
+            // bond cut by the near plane faces the viewer.
+            let cap = M8::bit_set(&flags.store().map(f32::to_bits), 30);
+            let inside = M8::bit_set(&flags.store().map(f32::to_bits), 31);
+            let mut s = Surf8::default();
+            for (k, uk) in [ux, uy, uz].into_iter().enumerate() {
+                let side = (pa[k] - uk * hax) * inv_r;
+                let capn = V8::select(first, zero - uk, uk);
+                let nk = V8::select(cap, capn, side);
+                s.n[k] = V8::select(inside, zero - nk, nk).store();
+                s.v[k] = to_eye[k].store();
+            }
+            let first = first.bits();
+            for l in 0..W {
+                let m = &self.materials[kinds[l][if first >> l & 1 != 0 { 0 } else { 1 }] as usize];
                 for k in 0..3 {
-                    s.n[k][l] = nrm[k];
-                    s.v[k][l] = to_eye[k];
                     s.base[k][l] = m.base_color[k];
                 }
                 s.spec[l] = m.specular;
@@ -1015,6 +1094,18 @@ impl Kernel<'_> {
                 depth[o] = buf.depth[b as usize];
             }
         }
+    }
+}
+
+/// Whether the depth pass may use AVX2 lanes (checked once per frame).
+fn avx2_available() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        V8x::available()
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
     }
 }
 
@@ -1033,6 +1124,7 @@ pub(crate) fn draw(
     }
     let kernel = Kernel {
         view: *view,
+        avx2: avx2_available(),
         lighting: *lighting,
         materials: &scene.materials,
     };
@@ -1391,5 +1483,83 @@ mod tests {
             nones > 100,
             "only {nones} unbounded axes: the eye-plane cases are not tested"
         );
+    }
+
+    /// The AVX2 depth pass against the SSE2 one on every tile of random ball-and-stick scenes
+    /// (perspective and orthographic, a near plane cutting bonds): the same depths and winners,
+    /// bit for bit. Skipped (with a note) on a CPU without AVX2.
+    #[test]
+    #[cfg(target_arch = "x86_64")]
+    fn avx2_and_sse_depth_passes_are_bit_identical() {
+        use texmap_core::camera::Camera;
+        use texmap_core::shade::Material;
+        if !V8x::available() {
+            eprintln!("no AVX2 on this CPU: nothing to compare");
+            return;
+        }
+        let mut rng = Lcg(23);
+        let mut compared = 0usize;
+        for trial in 0..12 {
+            let mats = vec![Material::plastic(Vec3::ONE); 2];
+            let mut scene = SphereScene::new(mats);
+            scene.bond_radius = rng.f(0.05, 0.5);
+            for i in 0..300u32 {
+                let c = Vec3::new(rng.f(-4.0, 4.0), rng.f(-4.0, 4.0), rng.f(-4.0, 4.0));
+                scene.push(c, rng.f(0.1, 0.5), (i % 2) as u16);
+                if i > 0 {
+                    scene.bonds.push([i - 1, i]);
+                }
+            }
+            let eye = Vec3::new(rng.f(-3.0, 3.0), rng.f(-3.0, 3.0), rng.f(2.0, 12.0));
+            let cam = if trial % 3 == 2 {
+                Camera::orthographic_look_at(eye, Vec3::ZERO, Vec3::Y, 9.0, 150, 110)
+            } else {
+                Camera::perspective_look_at(eye, Vec3::ZERO, Vec3::Y, rng.f(20.0, 120.0), 150, 110)
+            }
+            .unwrap();
+            let view = View::new(&cam);
+            let mut bins = BondBins::default();
+            bins.build(&scene, &view);
+            let k = Kernel {
+                view,
+                avx2: false,
+                lighting: Lighting::default_for(&cam),
+                materials: &scene.materials,
+            };
+            for ty in 0..view.tiles_y {
+                for tx in 0..view.tiles_x {
+                    let t = (ty * view.tiles_x + tx) as usize;
+                    let recs = &bins.recs[bins.tile_start[t]..bins.tile_start[t + 1]];
+                    let (x0, y0) = (tx * TILE, ty * TILE);
+                    let (w, h) = ((view.width - x0).min(TILE), (view.height - y0).min(TILE));
+                    // A sphere-pass depth to test against: a slanted plane through the scene.
+                    let mut a = TileBuf {
+                        depth: [f32::INFINITY; TILE_BUF],
+                        win: [NONE; TILE_BUF],
+                    };
+                    for (i, d) in a.depth[..TILE_PX].iter_mut().enumerate() {
+                        let (x, y) = ((x0 as usize + i % 32) as f32, (y0 as usize + i / 32) as f32);
+                        let z = eye.length() + 0.02 * x - 0.03 * y;
+                        *d = if (i / 7) % 3 == 0 { f32::INFINITY } else { z };
+                    }
+                    let mut b = TileBuf {
+                        depth: a.depth,
+                        win: a.win,
+                    };
+                    raster_sse(&k, recs, x0, y0, w, h, &mut a);
+                    // SAFETY: AVX2 checked above.
+                    unsafe { raster_avx2(&k, recs, x0, y0, w, h, &mut b) };
+                    let bits = |d: &[f32; TILE_BUF]| d.map(f32::to_bits);
+                    assert!(
+                        bits(&a.depth) == bits(&b.depth),
+                        "trial {trial} tile {tx},{ty}"
+                    );
+                    assert!(a.win == b.win, "trial {trial} tile {tx},{ty}: winners");
+                    compared += a.win.iter().filter(|&&w| w != NONE).count();
+                }
+            }
+        }
+        eprintln!("{compared} bond pixels compared");
+        assert!(compared > 5_000, "only {compared} bond pixels");
     }
 }
