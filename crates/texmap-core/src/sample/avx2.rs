@@ -540,7 +540,7 @@ unsafe fn span_out<A: Addr, const K: usize, const S: usize, const I: i32>(
 ) {
     if fast & (1 << S) == 0 {
         // A window crossing a level edge (or a conflict): the generic path.
-        *o = super::span_quad::<A, super::Direct, K>(tex, q, 0, &mut super::Direct);
+        *o = edge_span::<A, K>(tex, q);
         return;
     }
     let dst = o.as_mut_ptr() as *mut f32;
@@ -559,6 +559,15 @@ unsafe fn span_out<A: Addr, const K: usize, const S: usize, const I: i32>(
             }
         }
     }
+}
+
+/// The generic path for a span whose window crosses a level edge, kept out of line: inlined into
+/// the eight unrolled spans of [`span_quads`] it made the kernel's code large enough to miss the
+/// instruction cache (callgrind cache simulation: 0.25 I1 misses per sample).
+#[cold]
+#[inline(never)]
+fn edge_span<A: Addr, const K: usize>(tex: &MipTexture, q: [Vec2; 4]) -> [Vec4; 4] {
+    super::span_quad::<A, super::Direct, K>(tex, q, 0, &mut super::Direct)
 }
 
 /// [`super::lanes::span_quads4`] for AVX2, eight spans per step: bit-identical, whole groups
