@@ -60,7 +60,6 @@
 
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
-use texmap_core::color::linear_to_srgb8;
 use texmap_core::frame::Frame;
 use texmap_core::shade::{Lighting, Material};
 
@@ -1026,6 +1025,7 @@ impl Kernel<'_> {
             *y = (v.cy - ((y0t + j as u32) as f32 + 0.5)) * v.inv_k;
         }
         let zero = V8::splat(0.0);
+        let enc = fastshade::srgb_table32();
         for chunk in list[..n].chunks(W) {
             // Gather the lanes' ray, depth and bond (short chunks repeat their first pixel).
             let mut g = [[0f32; W]; 12];
@@ -1086,11 +1086,14 @@ impl Kernel<'_> {
                 s.spec[l] = m.specular;
                 s.shin[l] = m.shininess;
             }
-            let c = fastshade::shade8(&self.lighting, &s);
+            let c = fastshade::shade8(&self.lighting, &s).map(|c| V8::load(&c));
+            // sRGB encode over lanes: the 4096-bin table of `linear_to_srgb8` (same bytes).
+            let mut px = [0u32; W];
+            fastshade::srgb_rgba_lanes(c[0], c[1], c[2], enc).store_bits(&mut px);
             for (l, &b) in chunk.iter().enumerate() {
                 let (i, j) = (b as usize % TILE as usize, b as usize / TILE as usize);
                 let o = j * stride + i;
-                color[o] = linear_to_srgb8(Vec3::new(c[0][l], c[1][l], c[2][l]), 255);
+                color[o] = px[l].to_le_bytes();
                 depth[o] = buf.depth[b as usize];
             }
         }
