@@ -211,6 +211,9 @@ struct TriLevel {
     idx: [[u32; 8]; 4],
     ax: __m256,
     ay: __m256,
+    /// Lane mask of pixels whose 2x2 is split by the level edge (`x1 ≠ x0 + 1` or
+    /// `y1 ≠ y0 + 1`); where it is 0, `t10 = t00 + 1` and `t11 = t01 + 1`.
+    edge: i32,
 }
 
 /// Seed 000 Eq. (3) on `2^L r_m − ½` for eight pixels at levels `lvl`: the SSE2 `level_lanes`
@@ -246,10 +249,16 @@ fn tri_level<A: Addr>(
     let r0 = _mm256_add_epi32(off, _mm256_mullo_epi32(y0, wi));
     let r1 = _mm256_add_epi32(off, _mm256_mullo_epi32(y1, wi));
     let d = |r: __m256i, c: __m256i| to_u32x8(_mm256_slli_epi32::<1>(_mm256_add_epi32(r, c)));
+    // Pixels whose 2x2 is not split by wrap-around or clamping at the level edge.
+    let inside = _mm256_and_si256(
+        _mm256_cmpeq_epi32(x1, _mm256_add_epi32(x0, one_i)),
+        _mm256_cmpeq_epi32(y1, _mm256_add_epi32(y0, one_i)),
+    );
     TriLevel {
         idx: [d(r0, x0), d(r0, x1), d(r1, x0), d(r1, x1)],
         ax,
         ay,
+        edge: !_mm256_movemask_ps(_mm256_castsi256_ps(inside)) & 0xff,
     }
 }
 
@@ -259,12 +268,22 @@ fn tri_level<A: Addr>(
 /// `p` must come from [`tri_level`] on the texture whose texels start at `base`.
 #[inline]
 #[target_feature(enable = "avx2")]
-unsafe fn tri_pair<const K: usize, const I: i32>(base: *const u8, p: &TriLevel) -> __m256 {
-    let ld = |c: usize| {
+unsafe fn tri_pair<const K: usize, const I: i32, const INSIDE: bool>(
+    base: *const u8,
+    p: &TriLevel,
+) -> __m256 {
+    let ld = |c: usize, d: usize| {
         // SAFETY: the caller's contract (indices inside the texel buffer).
-        unsafe { load_pair(base, p.idx[c][K] as usize, p.idx[c][K + 4] as usize) }
+        unsafe { load_pair(base, p.idx[c][K] as usize + d, p.idx[c][K + 4] as usize + d) }
     };
-    let (t00, t10, t01, t11) = (ld(0), ld(1), ld(2), ld(3));
+    // No pixel's 2x2 split by the level edge: two indices per pixel (t10 = t00 + 1 texel, two
+    // doubled units); else the four wrapped ones.
+    let (t00, t01) = (ld(0, 0), ld(2, 0));
+    let (t10, t11) = if INSIDE {
+        (ld(0, 2), ld(2, 2))
+    } else {
+        (ld(1, 0), ld(3, 0))
+    };
     let (wx, wy) = (bc::<I>(p.ax), bc::<I>(p.ay));
     lerp8(lerp8(t00, t10, wx), lerp8(t01, t11, wx), wy)
 }
@@ -277,7 +296,7 @@ unsafe fn tri_pair<const K: usize, const I: i32>(base: *const u8, p: &TriLevel) 
 #[inline]
 #[target_feature(enable = "avx2")]
 #[allow(clippy::too_many_arguments)]
-unsafe fn tri_out<const K: usize, const I: i32>(
+unsafe fn tri_out<const K: usize, const I: i32, const INSIDE: bool>(
     base: *const u8,
     pa: &TriLevel,
     pb: &TriLevel,
@@ -289,12 +308,12 @@ unsafe fn tri_out<const K: usize, const I: i32>(
     let pair = ((single >> K) & 1) | (((single >> (K + 4)) & 1) << 1);
     // SAFETY: the caller's contract.
     unsafe {
-        let ca = tri_pair::<K, I>(base, pa);
+        let ca = tri_pair::<K, I, INSIDE>(base, pa);
         let r = if pair == 3 {
             ca
         } else {
             // Seed 000 Eq. (4): blend the two levels by frac(λ); single pixels keep `ca`.
-            let cb = tri_pair::<K, I>(base, pb);
+            let cb = tri_pair::<K, I, INSIDE>(base, pb);
             let r = lerp8(ca, cb, bc::<I>(frac));
             if pair == 0 {
                 r
@@ -367,10 +386,17 @@ pub(super) unsafe fn trilinear_pixels<A: Addr>(
             let sv = _mm256_castsi256_ps(single_v);
             let single = _mm256_movemask_ps(sv);
             let o = out.as_mut_ptr().add(i) as *mut f32;
-            tri_out::<0, 0x00>(base, &pa, &pb, frac, sv, single, o);
-            tri_out::<1, 0x55>(base, &pa, &pb, frac, sv, single, o);
-            tri_out::<2, 0xAA>(base, &pa, &pb, frac, sv, single, o);
-            tri_out::<3, 0xFF>(base, &pa, &pb, frac, sv, single, o);
+            if pa.edge | pb.edge == 0 {
+                tri_out::<0, 0x00, true>(base, &pa, &pb, frac, sv, single, o);
+                tri_out::<1, 0x55, true>(base, &pa, &pb, frac, sv, single, o);
+                tri_out::<2, 0xAA, true>(base, &pa, &pb, frac, sv, single, o);
+                tri_out::<3, 0xFF, true>(base, &pa, &pb, frac, sv, single, o);
+            } else {
+                tri_out::<0, 0x00, false>(base, &pa, &pb, frac, sv, single, o);
+                tri_out::<1, 0x55, false>(base, &pa, &pb, frac, sv, single, o);
+                tri_out::<2, 0xAA, false>(base, &pa, &pb, frac, sv, single, o);
+                tri_out::<3, 0xFF, false>(base, &pa, &pb, frac, sv, single, o);
+            }
         }
     }
     n
