@@ -191,12 +191,16 @@ fn pow_int8<V: Simd8>(x: V, pw: &SpecPow) -> V {
     let mut acc = V::splat(1.0);
     let mut p = x;
     match *pw {
-        SpecPow::Same { k, bits } => {
-            for b in 0..bits {
-                if (k >> b) & 1 != 0 {
+        SpecPow::Same { mut k, .. } => {
+            // The same products as the `Ints` loop (its last squaring is never used).
+            while k != 0 {
+                if k & 1 != 0 {
                     acc = acc * p;
                 }
-                p = p * p;
+                k >>= 1;
+                if k != 0 {
+                    p = p * p;
+                }
             }
         }
         SpecPow::Ints { ref e, bits } => {

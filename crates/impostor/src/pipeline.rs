@@ -439,6 +439,7 @@ pub(crate) fn draw_tiles<K: Kernel>(
         .par_chunks_mut(band)
         .zip(frame.depth.par_chunks_mut(band))
         .enumerate()
+        .with_max_len(1)
         .for_each(|(ty, (color, depth))| {
             let mut buf = TileBuf {
                 depth: [f32::INFINITY; TILE_BUF],
