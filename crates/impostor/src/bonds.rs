@@ -12,14 +12,21 @@
 //!    produce a fragment at depth ≥ near), cull against the far plane, and bound the screen
 //!    rectangle of the capped cylinder by the union of the rectangles of the two spheres of radius
 //!    `r` around the clipped end points: the capped cylinder lies in the convex hull of those two
-//!    spheres, and a perspective projection maps that hull onto the hull of their images. A
-//!    64-byte [`BondRec`] holds the per-bond constants of the intersection below.
+//!    spheres, and a perspective projection maps that hull onto the hull of their images (the
+//!    eight tangent slopes of both spheres on one set of 8 lanes). A 96-byte [`BondRec`] holds
+//!    the per-bond constants of the intersection below, formed in f64 and rounded once.
 //! 2. **Bin** into the sphere pipeline's 32x32 tiles: count, prefix sum, fill (a copy of the
 //!    record per tile, bond order kept within every tile).
 //! 3. **Tiles** (parallel over bands of 32 rows): the tile's depth buffer starts as the depth the
 //!    sphere pass wrote, so bonds and atoms interpenetrate correctly; every bond of the bin is
-//!    intersected with the tile's eye rays in 8-pixel lanes under a strict depth test (an atom wins
-//!    a tie, then the earlier bond); then each pixel won by a bond is shaded once and written.
+//!    intersected with the tile's eye rays 8 pixels at a time (one row, or two rows of 4 for
+//!    boxes at most 4 px wide; rows of boxes wider than 16 px narrowed to the hull of the end
+//!    rectangles) under a strict depth test (an atom wins a tie, then the earlier bond). A
+//!    **hierarchical-z** test skips the 8 pixels when the stored depths are all nearer than the
+//!    bond's nearest point (most bond pixels of a ball-and-stick image lie behind atoms). The
+//!    lanes are SSE2 or, where the CPU has it, AVX2 (chosen once per frame; the same IEEE
+//!    operations, so the same bits). Then each pixel won by a bond is shaded once (8 lanes,
+//!    sRGB encoded over lanes) and written.
 //!
 //! # The intersection
 //! A bond is the solid capped cylinder `{p : 0 ≤ h(p) ≤ L, |p − a − h(p)·u| ≤ r}` with
