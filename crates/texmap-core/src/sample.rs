@@ -81,26 +81,59 @@
 //! Repeat on power-of-two levels is a mask; texel reads skip bounds checks (indices are folded by
 //! construction).
 //!
-//! **Lane kernels** (`sample/lanes.rs`, x86_64, power-of-two pyramids): the bulk calls run
-//! per-pixel trilinear four PIXELS per step and the span sampler four SPANS per step, with the
-//! footprint, level split, level sizes (from the float exponent), texel coordinates, floors,
-//! fractions and wrapped addresses computed once for four lanes; the texel loads and lerps stay
-//! per pixel. Each kernel is built twice, SSE2 (baseline) and AVX2 (three-operand encoding, fewer
-//! register copies; chosen at run time with `is_x86_feature_detected!`), no FMA in either, and
-//! both are bit-identical to the scalar kernels and to the bank emulator (tests below). Spans whose
-//! window crosses a level edge, NPOT pyramids, the tail of a call and other targets take the
-//! scalar path. `sample_quad` runs trilinear's four pixels in one lane kernel and the span
-//! through a fused fast path (both levels' texels per pixel in registers).
+//! **Lane kernels** (x86_64, power-of-two pyramids; the tail of a call, NPOT pyramids and other
+//! targets take the scalar path): the bulk calls run per-pixel trilinear several PIXELS per step
+//! and the span sampler several SPANS per step, the footprint, level split, level sizes (from the
+//! float exponent), texel coordinates, floors and fractions computed once per group of lanes.
+//! - `sample/lanes.rs`: the SSE2 baseline, four lanes per step.
+//! - `sample/avx2.rs`: the build chosen at run time (`is_x86_feature_detected!("avx2")`), eight
+//!   lanes per step; each pixel's texel indices computed in lanes (level base from a 16-entry
+//!   table with two `vpermd`, rows by `vpmulld`, doubled so that `base + 8·index` addresses a
+//!   texel) and stored once, one load per index; two pixels per 256-bit register for the taps,
+//!   lerps and blend, their weights by one in-lane `vpermilps` (lanes ordered so that a pixel
+//!   pair shares a lane of the two halves), one 256-bit store per pair; `roundps` floors.
 //!
-//! Measured with callgrind (instructions per sample, tilted plane 1024x768, 4096² pyramid, one
-//! frame; the figures in docs/fragments/sampling.md): trilinear 209 -> 134, span K3 181 -> 121,
-//! span K4 184 -> 120 (AVX2 build; SSE2 146 / 134 / 133). Both samplers now spend most instructions
-//! on the same per-pixel work — two bilinear taps (8 texel loads, 6 four-wide lerps) and the
-//! Eq. (4) blend — which is why the span sampler is only ~1.1x per-pixel trilinear, not 1.5x: what it
-//! saves (one level decision and one window per span instead of per pixel) is what the trilinear
-//! lane kernel already shares across its four lanes. On a CPU the paper's gain is the memory
-//! organisation, not the arithmetic: the span reads 0.56 L1-missing lines per sample against
-//! trilinear's 0.93.
+//! Both builds are bit-identical to the scalar kernels and to the bank emulator (no FMA anywhere;
+//! tests below, which fail under mutations of the weights, blend masks and indices).
+//! `sample_quad` runs trilinear's four pixels in one SSE2 lane kernel, and the span through an
+//! AVX2 one-span kernel (same pixel-pair taps) or, without AVX2, a fused scalar path.
+//!
+//! The comparison is kept fair: every general technique is in both kernels. The span kernel only
+//! adds what Seed 000's structure gives it: one level pair, one blend weight, one window corner
+//! and one row stride per span, and ONE index per pixel and level (its 2x2 lies in an interior
+//! K x K window, `corner + oy·w + ox + {0, 1, w, w+1}`); trilinear needs four (wrap-around may
+//! split its 2x2) except where no pixel of the eight sits on a level edge (98% of groups here),
+//! where it takes two.
+//!
+//! Measured with callgrind (instructions per sample, `examples/sampling_prof.rs`: the bench's
+//! tilted plane 1024x768 on a 4096² pyramid, one frame; details in docs/fragments/span.md):
+//!
+//! | kernel | first lanes (SSE2 / AVX2 build) | now (AVX2 build) |
+//! |---|---|---|
+//! | trilinear, `sample_pixels` | 146 / 134 | 58.6 |
+//! | span K3, `sample_quads` | 134 / 121 | 49.9 |
+//! | span K4, `sample_quads` | 133 / 120 | 48.5 |
+//!
+//! Of span K3's 49.9: set-up per eight spans 19.0, per pixel 26.5 (8 texel loads, 10.5 in lerps
+//! and the Eq. 4 blend, 2.8 weight permutes, 5.6 index loads, stores and branches) and 4.4 in the
+//! generic path of spans whose window crosses a level edge; trilinear's 58.6: set-up 28.6, per
+//! pixel 30 (8.8 of it index loads, stores and branches). So the span sampler runs 1.17x fewer
+//! instructions; its other gain is the memory organisation the paper designed it for (callgrind
+//! cache simulation, per sample): 0.30 L1 read misses and 0.04 last-level misses for K3 against
+//! trilinear's 0.93 and 0.27 (K4: 0.56 and 0.26, its level pair is trilinear's), which is worth
+//! more as the instruction counts fall: in thread CPU time K3 ran 1.3–1.5x trilinear on the
+//! shared machine (figures, commands and load in the fragment; the quiet re-measurement decides).
+//!
+//! Measured and rejected or left: LLVM turns a constant-index `vpermps` into `vshufps` +
+//! `vpermpd` (two instructions per weight): the lane order `[0 2 4 6 | 1 3 5 7]` (trilinear) and
+//! the `[w_2p | w_2p+1]` weight registers (span) make it one `vpermilps`. With the indices in a
+//! plain array LLVM kept the vectors and extracted lanes (three instructions per index); a
+//! `black_box` on the arrays keeps them in memory (span 55 -> 51, trilinear 64 -> 59). Inlining
+//! the edge-window fallback into the eight unrolled spans made the kernel miss the instruction
+//! cache (0.25 I1 misses per sample): it is out of line now. Left: a padded (apron) pyramid, as
+//! the emulator has, would make every window interior and save most of the 4.4 instructions of
+//! the edge fallback; the 3x3 window's shared texels (9 distinct of 16 loads per level) are not
+//! exploited: loads are the cheapest part of the per-pixel work.
 //!
 //! Rejected by operation count (not built): keeping the K x K window in registers (the 2x2 of each
 //! pixel is then picked with blends, ~9 SSE2 operations per texel against one L1 load); a weighted

@@ -1,25 +1,31 @@
-//! AVX2 builds of the two bulk lane kernels (chosen at run time by [`super::lanes`]'s `*_best`
-//! entry points; the SSE2 kernels of `lanes.rs` stay the baseline): per-pixel trilinear, four
-//! pixels per step, and the span sampler, four spans per step, on power-of-two pyramids.
+//! AVX2 builds of the lane kernels (chosen at run time by [`super::lanes`]'s `*_best` entry
+//! points and by `Sampler::sample_quad`; the SSE2 kernels of `lanes.rs` stay the baseline), on
+//! power-of-two pyramids: per-pixel trilinear eight pixels per step, the span sampler eight spans
+//! per step, and the span sampler one span per call.
 //!
-//! The arithmetic is the SSE2 kernels' operation for operation (no FMA), so the results are the
-//! same bits (tested in `super::tests`). What changes is the bookkeeping around it, the same way
-//! in both kernels so that their comparison stays fair:
+//! The arithmetic is the SSE2 / scalar kernels' operation for operation (no FMA), so the results
+//! are the same bits (tested in `super::tests`). What changes is the bookkeeping around it, the
+//! same way in both samplers so that their comparison stays fair:
+//! - **eight lanes per step:** the set-up (footprint or span extent, level split, level sizes,
+//!   texel coordinates, floors, weights) runs once per eight pixels or spans in 256-bit lanes;
 //! - **texel indices in lanes, stored once:** the level's base index comes from a 16-entry table
 //!   with two register permutes (`vpermd`), rows from `vpmulld`, and each pixel's texel indices
-//!   (`offset + y·w + x`, doubled so that the load addresses `base + 8·index` need no shift) are
-//!   stored to a small array once per four lanes: a pixel then costs one load per index, where
-//!   the SSE2 kernels extract lanes, sign-extend, look the level up and multiply per pixel;
+//!   (`offset + y·w + x`, doubled so that the load address `base + 8·index` needs no shift) are
+//!   stored once per step and kept in memory (`black_box`: otherwise LLVM extracts lanes, three
+//!   instructions per index): a pixel then costs one load per index;
 //! - **two pixels per 256-bit register:** the bilinear taps of two pixels are loaded into the two
-//!   halves of one register and lerped together (each lane does exactly the 128-bit lerp), the
-//!   weights of the pair come from one `vpermps`, and the pair is stored with one 256-bit store;
+//!   halves of one register and lerped together (each lane does exactly the 128-bit lerp); the
+//!   pair's weights come from one in-lane `vpermilps` (trilinear's lanes are ordered
+//!   `[0 2 4 6 | 1 3 5 7]`, the span's weights are kept as `[w_2p | w_2p+1]` per four spans), and
+//!   the pair is stored with one 256-bit store;
 //! - **`roundps` floors** (SSE4.1, implied by AVX2) instead of the truncate-and-correct sequence
 //!   (the same values: both are exact).
 //!
-//! The span kernel also takes what the paper's structure gives it and trilinear cannot: one level
-//! pair, one blend weight, one window corner and one row stride per span, shared by its four
-//! pixels (trilinear needs four texel indices per pixel and level because wrap-around may split
-//! its 2x2; the span's interior window cannot split, so a pixel needs one index per level).
+//! The span kernel also takes what the paper's structure gives it: one level pair, one blend
+//! weight, one window corner and one row stride per span, shared by its four pixels, and one
+//! texel index per pixel and level (its 2x2 lies in the interior K x K window). Trilinear needs
+//! four indices per pixel and level because wrap-around or clamping may split its 2x2; where no
+//! pixel of the eight sits on a level edge it takes two (the same idea, applied for fairness).
 
 use core::arch::x86_64::*;
 
