@@ -5,6 +5,16 @@
 //! Blinn-Phong sum, only `x^e` becomes `exp2(e·log2 x)` with the two polynomials below; a unit
 //! test bounds the difference from [`Lighting::shade`] (≤ 2e-5 absolute on random inputs, far
 //! under half an 8-bit sRGB step).
+//!
+//! **Lanes.** [`shade_lanes`] and the ray-cast kernels are written once over [`Simd8`], eight
+//! `f32` lanes with two backends: [`V8`] (two SSE2 registers, the x86-64 baseline, or a plain
+//! array elsewhere) and `V8x` (one AVX2 register, x86-64 only, chosen at run time with
+//! `is_x86_feature_detected!` and compiled inside `#[target_feature(enable = "avx2")]`
+//! functions). Both perform the same IEEE single operations in the same order — no FMA — so
+//! they give the same bits; a test renders a busy scene with both and compares the bytes. The
+//! trait also carries the two steps that make the resolve pass cheap: an 8x8 transpose (the
+//! winners' 32-byte records and material rows loaded whole, then turned into lanes) and the
+//! sRGB encode over lanes (AVX2 gathers from a `u32` copy of the table).
 
 // Comparisons written `!(a > b)` are deliberate: they also reject NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]

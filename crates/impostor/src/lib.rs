@@ -33,7 +33,8 @@
 //! projected sphere into 32x32 tiles (count, prefix sum, fill) → per tile, a depth pass over its
 //! bin in sphere order (8-pixel lanes) and a resolve pass that colours each covered pixel once,
 //! in parallel over bands of tiles. The per-method kernel is chosen once per frame (static
-//! dispatch). `Polygon` batches shared icosphere levels into `texmap-raster`.
+//! dispatch); `Raycast` runs its lanes on AVX2 when the CPU has it (run-time detection, no
+//! FMA) and on SSE2 otherwise, with the same bytes either way. `Polygon` batches shared icosphere levels into `texmap-raster`.
 //!
 //! - **Near plane.** `Raycast`: the exact answer — fragments nearer than the near plane are
 //!   clipped and the ray takes the far intersection, so a cut sphere (or one the eye is inside)
