@@ -167,7 +167,7 @@ fn spec_pow(e: &F8) -> SpecPow {
     let mut any = 0u32;
     for i in 0..W {
         let x = e[i];
-        let in_range = x >= 0.0 && x <= MAX_INT_EXPONENT;
+        let in_range = (0.0..=MAX_INT_EXPONENT).contains(&x);
         let xc = if in_range { x } else { 0.0 };
         // SAFETY: xc ∈ [0, 65535], so truncation is exact and in range.
         let n = unsafe { xc.to_int_unchecked::<i32>() } as u32;
@@ -262,6 +262,7 @@ pub(crate) fn srgb_rgba_lanes<V: Simd8>(r: V, g: V, b: V, table: &[u32; SRGB_N])
 
 /// Surface and material of 8 pixels, structure-of-arrays.
 #[derive(Clone, Copy, Debug, Default)]
+#[cfg_attr(not(test), allow(dead_code))] // the SoA form of the tests (and of the bond pass)
 pub(crate) struct Surf8 {
     pub n: [F8; 3],
     pub v: [F8; 3],
@@ -272,6 +273,7 @@ pub(crate) struct Surf8 {
 
 /// [`shade`] over 8 lanes: the same formula, masks instead of branches, on [`V8`] lanes.
 #[inline(always)]
+#[cfg_attr(not(test), allow(dead_code))] // as `Surf8`
 pub(crate) fn shade8(l: &Lighting, s: &Surf8) -> [F8; 3] {
     let ld = |a: &[F8; 3]| [V8::load(&a[0]), V8::load(&a[1]), V8::load(&a[2])];
     let c = shade_lanes(

@@ -208,6 +208,7 @@ impl<'a, V: Simd8> Perspective<'a, V> {
 
 /// Draw the binned records with the perspective kernel on the best available backend (or the
 /// baseline when asked).
+#[allow(clippy::too_many_arguments)] // the frame's inputs, passed through once per frame
 pub(crate) fn draw_perspective(
     bins: &Bins,
     view: &View,
@@ -497,6 +498,7 @@ fn resolve_persp<V: Simd8>(
 }
 
 /// Colour of one pixel (the per-pixel [`Kernel::resolve`]).
+#[allow(clippy::too_many_arguments)] // the kernel's fields and the pixel, shared by two impls
 fn resolve_px(
     v: &View,
     lighting: &Lighting,
