@@ -571,8 +571,9 @@ unsafe fn span_out<A: Addr, const K: usize, const S: usize, const I: i32>(
     o: &mut [Vec4; 4],
 ) {
     if fast & (1 << S) == 0 {
-        // A window crossing a level edge (or a conflict): the generic path.
-        *o = edge_span::<A, K>(tex, q);
+        // A window crossing a level edge (or a conflict).
+        // SAFETY: `span_out`'s contract (AVX2, power-of-two texture).
+        *o = unsafe { edge_span::<A, K>(tex, q) };
         return;
     }
     let dst = o.as_mut_ptr() as *mut f32;
@@ -593,13 +594,145 @@ unsafe fn span_out<A: Addr, const K: usize, const S: usize, const I: i32>(
     }
 }
 
-/// The generic path for a span whose window crosses a level edge, kept out of line: inlined into
-/// the eight unrolled spans of [`span_quads`] it made the kernel's code large enough to miss the
-/// instruction cache (callgrind cache simulation: 0.25 I1 misses per sample).
+/// A span whose window crosses a level edge (or does not hold every neighbourhood), kept out of
+/// line: inlined into the eight unrolled spans of [`span_quads`] it made the kernel's code large
+/// enough to miss the instruction cache (callgrind cache simulation: 0.25 I1 misses per sample).
+/// Each pixel takes its own four wrapped texel indices per level (as trilinear does) instead of
+/// one window index; spans with an offset past the window (narrow levels, or a conflict, which
+/// the level policy excludes) take the generic path, which folds or counts them.
+///
+/// # Safety
+/// The CPU must support AVX2; the texture must be a power of two.
 #[cold]
 #[inline(never)]
-fn edge_span<A: Addr, const K: usize>(tex: &MipTexture, q: [Vec2; 4]) -> [Vec4; 4] {
-    super::span_quad::<A, super::Direct, K>(tex, q, 0, &mut super::Direct)
+#[target_feature(enable = "avx2")]
+unsafe fn edge_span<A: Addr, const K: usize>(tex: &MipTexture, q: [Vec2; 4]) -> [Vec4; 4] {
+    let p = super::span_plan::<A, K>(tex, q, 0);
+    let generic = || super::span_finish::<A, super::Direct, K>(tex, p, &mut super::Direct);
+    let Some(a) = edge_level::<A, K>(tex, p.i0, p.sx, p.sy) else {
+        return generic();
+    };
+    let base = tex.texels().as_ptr() as *const u8;
+    let mut out = [Vec4::ZERO; 4];
+    let dst = out.as_mut_ptr() as *mut f32;
+    if p.i1 == p.i0 || p.t == 0.0 {
+        // SAFETY: indices wrapped into the level (edge_level); `out` holds 16 floats.
+        unsafe {
+            _mm256_storeu_ps(dst, edge_pair(base, &a, 0));
+            _mm256_storeu_ps(dst.add(8), edge_pair(base, &a, 1));
+        }
+        return out;
+    }
+    let Some(b) = edge_level::<A, K>(tex, p.i1, p.sx, p.sy) else {
+        return generic();
+    };
+    // Seed 000 Eq. (4): one blend weight for the span.
+    let tt = _mm256_set1_ps(p.t);
+    for k in 0..2 {
+        // SAFETY: as above.
+        unsafe {
+            let r = lerp8(edge_pair(base, &a, k), edge_pair(base, &b, k), tt);
+            _mm256_storeu_ps(dst.add(8 * k), r);
+        }
+    }
+    out
+}
+
+/// One level of an edge span: per pixel its four wrapped texel indices (doubled,
+/// `[t00, t10, t01, t11][pixel]`) and the pixel pairs' weights.
+struct EdgeLevel {
+    idx: [[u32; 4]; 4],
+    wx: [__m256; 2],
+    wy: [__m256; 2],
+}
+
+/// [`super::span_level`]'s coordinates, floors and weights for one span; `None` if a pixel's
+/// offset from the window corner exceeds `K − 2` (the generic path handles it).
+#[inline]
+#[target_feature(enable = "avx2")]
+fn edge_level<A: Addr, const K: usize>(
+    tex: &MipTexture,
+    level: usize,
+    sx: Vec4,
+    sy: Vec4,
+) -> Option<EdgeLevel> {
+    debug_assert!(tex.is_pow2());
+    let l = &tex.levels()[level];
+    let mut x = sx * l.scale_x - Vec4::splat(0.5);
+    let mut y = sy * l.scale_y - Vec4::splat(0.5);
+    if !A::REPEAT {
+        x = x.max(Vec4::ZERO).min(Vec4::splat(l.width_f - 1.0));
+        y = y.max(Vec4::ZERO).min(Vec4::splat(l.height_f - 1.0));
+    }
+    let (x, y): (__m128, __m128) = (x.into(), y.into());
+    let (flx, fly) = (_mm_floor_ps(x), _mm_floor_ps(y));
+    let (ax, ay) = (_mm_sub_ps(x, flx), _mm_sub_ps(y, fly));
+    let hmin = |v: __m128| {
+        let m = _mm_min_ps(v, _mm_shuffle_ps::<0b01_00_11_10>(v, v));
+        _mm_min_ps(m, _mm_shuffle_ps::<0b10_11_00_01>(m, m))
+    };
+    let lim = _mm_set1_ps((K - 2) as f32);
+    let over = _mm_or_ps(
+        _mm_cmpgt_ps(_mm_sub_ps(flx, hmin(flx)), lim),
+        _mm_cmpgt_ps(_mm_sub_ps(fly, hmin(fly)), lim),
+    );
+    if _mm_movemask_ps(over) != 0 {
+        return None;
+    }
+    // Wrapped columns and rows (Repeat on a power-of-two level: a mask; Clamp: to the edge).
+    let (fx, fy) = (_mm_cvttps_epi32(flx), _mm_cvttps_epi32(fly));
+    let (w, h) = (
+        _mm_set1_epi32(l.width as i32),
+        _mm_set1_epi32(l.height as i32),
+    );
+    let one = _mm_set1_epi32(1);
+    let wrap = |i: __m128i, n: __m128i| {
+        let nm1 = _mm_sub_epi32(n, one);
+        if A::REPEAT {
+            _mm_and_si128(i, nm1)
+        } else {
+            _mm_min_epi32(_mm_max_epi32(i, _mm_setzero_si128()), nm1)
+        }
+    };
+    let (c0, c1) = (wrap(fx, w), wrap(_mm_add_epi32(fx, one), w));
+    let off = _mm_set1_epi32(l.offset as i32);
+    let r0 = _mm_add_epi32(off, _mm_mullo_epi32(wrap(fy, h), w));
+    let r1 = _mm_add_epi32(off, _mm_mullo_epi32(wrap(_mm_add_epi32(fy, one), h), w));
+    let d = |r: __m128i, c: __m128i| {
+        // SAFETY: same size, no invalid bit patterns.
+        unsafe {
+            core::mem::transmute::<__m128i, [u32; 4]>(_mm_slli_epi32::<1>(_mm_add_epi32(r, c)))
+        }
+    };
+    let pair = |v: __m128, a: i32, b: i32| {
+        _mm256_permutevar8x32_ps(
+            _mm256_castps128_ps256(v),
+            _mm256_setr_epi32(a, a, a, a, b, b, b, b),
+        )
+    };
+    Some(EdgeLevel {
+        idx: [d(r0, c0), d(r0, c1), d(r1, c0), d(r1, c1)],
+        wx: [pair(ax, 0, 1), pair(ax, 2, 3)],
+        wy: [pair(ay, 0, 1), pair(ay, 2, 3)],
+    })
+}
+
+/// Bilinear of pixels `2p`, `2p + 1` of an edge span.
+///
+/// # Safety
+/// `d` must come from [`edge_level`] on the texture whose texels start at `base`.
+#[inline]
+#[target_feature(enable = "avx2")]
+unsafe fn edge_pair(base: *const u8, d: &EdgeLevel, p: usize) -> __m256 {
+    let (j, k) = (2 * p, 2 * p + 1);
+    // SAFETY: the caller's contract: wrapped indices inside the level.
+    unsafe {
+        let t00 = load_pair(base, d.idx[0][j] as usize, d.idx[0][k] as usize);
+        let t10 = load_pair(base, d.idx[1][j] as usize, d.idx[1][k] as usize);
+        let t01 = load_pair(base, d.idx[2][j] as usize, d.idx[2][k] as usize);
+        let t11 = load_pair(base, d.idx[3][j] as usize, d.idx[3][k] as usize);
+        lerp8(lerp8(t00, t10, d.wx[p]), lerp8(t01, t11, d.wx[p]), d.wy[p])
+    }
 }
 
 /// [`super::lanes::span_quads4`] for AVX2, eight spans per step: bit-identical, whole groups
