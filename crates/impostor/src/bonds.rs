@@ -73,7 +73,7 @@ use texmap_core::shade::{Lighting, Material};
 use crate::SphereScene;
 #[cfg(target_arch = "x86_64")]
 use crate::fastshade::V8x;
-use crate::fastshade::{self, M8, Mask8, Simd8, Surf8, V8, W};
+use crate::fastshade::{self, Mask8, Simd8, SpecPow, V8, W};
 use crate::pipeline::{self, FLAG_INSIDE, LANES, NONE, TILE, TILE_BUF, TILE_PX, View};
 
 /// Bonds per projection chunk: fixed, so results do not depend on the thread count.
@@ -818,8 +818,10 @@ struct TileBuf {
 /// Per-frame constants of the tile kernel.
 struct Kernel<'a> {
     view: View,
-    /// Run the depth pass on AVX2 lanes (the CPU has them).
+    /// Run the depth and shading passes on AVX2 lanes (the CPU has them).
     avx2: bool,
+    /// The specular power of every material when they all share one shininess (else per chunk).
+    spec_pow: Option<SpecPow>,
     lighting: Lighting,
     materials: &'a [Material],
 }
@@ -856,6 +858,47 @@ unsafe fn raster_avx2(
     } else {
         k.raster_with::<Persp, V8x>(recs, x0t, y0t, w, h, buf);
     }
+}
+
+/// [`Kernel::resolve_with`] on SSE2 lanes.
+#[allow(clippy::too_many_arguments)]
+#[inline(never)]
+fn resolve_sse(
+    k: &Kernel,
+    recs: &[BondRec],
+    x0t: u32,
+    y0t: u32,
+    w: u32,
+    h: u32,
+    buf: &TileBuf,
+    color: &mut [[u8; 4]],
+    depth: &mut [f32],
+    stride: usize,
+) {
+    k.resolve_with::<V8>(recs, x0t, y0t, w, h, buf, color, depth, stride);
+}
+
+/// [`Kernel::resolve_with`] on AVX2 lanes (same IEEE operations, so the same bytes).
+///
+/// # Safety
+/// The CPU must support AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[allow(clippy::too_many_arguments)]
+#[inline(never)]
+unsafe fn resolve_avx2(
+    k: &Kernel,
+    recs: &[BondRec],
+    x0t: u32,
+    y0t: u32,
+    w: u32,
+    h: u32,
+    buf: &TileBuf,
+    color: &mut [[u8; 4]],
+    depth: &mut [f32],
+    stride: usize,
+) {
+    k.resolve_with::<V8x>(recs, x0t, y0t, w, h, buf, color, depth, stride);
 }
 
 impl Kernel<'_> {
@@ -996,8 +1039,31 @@ impl Kernel<'_> {
 
     /// Shade the pixels of one tile won by a bond and write them (colour and depth) to the frame.
     #[allow(clippy::too_many_arguments)]
-    #[inline(never)]
     fn resolve(
+        &self,
+        recs: &[BondRec],
+        x0t: u32,
+        y0t: u32,
+        w: u32,
+        h: u32,
+        buf: &TileBuf,
+        color: &mut [[u8; 4]],
+        depth: &mut [f32],
+        stride: usize,
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            // SAFETY: `avx2` is set only where `V8x::available()` returned true.
+            unsafe { resolve_avx2(self, recs, x0t, y0t, w, h, buf, color, depth, stride) };
+            return;
+        }
+        resolve_sse(self, recs, x0t, y0t, w, h, buf, color, depth, stride);
+    }
+
+    /// [`Kernel::resolve`] on the lanes `V`.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn resolve_with<V: Simd8>(
         &self,
         recs: &[BondRec],
         x0t: u32,
@@ -1031,11 +1097,13 @@ impl Kernel<'_> {
         for (j, y) in ys.iter_mut().enumerate() {
             *y = (v.cy - ((y0t + j as u32) as f32 + 0.5)) * v.inv_k;
         }
-        let zero = V8::splat(0.0);
+        let zero = V::splat(0.0);
         let enc = fastshade::srgb_table32();
         for chunk in list[..n].chunks(W) {
-            // Gather the lanes' ray, depth and bond (short chunks repeat their first pixel).
+            // Gather the lanes' ray, depth, bond and materials (short chunks repeat their first
+            // pixel).
             let mut g = [[0f32; W]; 12];
+            let mut flags = [0u32; W];
             let mut kinds = [[0u16; 2]; W];
             for l in 0..W {
                 let b = chunk[if l < chunk.len() { l } else { 0 }] as usize;
@@ -1053,16 +1121,15 @@ impl Kernel<'_> {
                 g[8][l] = rec.u[2];
                 g[9][l] = 0.5 * rec.len;
                 g[10][l] = rec.inv_r;
-                // Flags as lane bits: cap in bit 30, inside in bit 31 (`FLAG_*`).
-                g[11][l] = f32::from_bits(wv & !INDEX_MASK);
+                flags[l] = wv;
                 kinds[l] = rec.kind;
             }
-            let [x, y, t, ax, ay, az, ux, uy, uz, half, inv_r, flags] = g.map(|c| V8::load(&c));
+            let [x, y, t, ax, ay, az, ux, uy, uz, half, inv_r, _] = g.map(|c| V::load_from(&c));
             // Hit point and unit vector toward the eye.
             let (p, to_eye) = if v.ortho {
-                ([x, y, zero - t], [zero, zero, V8::splat(1.0)])
+                ([x, y, zero - t], [zero, zero, V::splat(1.0)])
             } else {
-                let il = V8::splat(1.0) / (x * x + y * y + V8::splat(1.0)).sqrt();
+                let il = V::splat(1.0) / (x * x + y * y + V::splat(1.0)).sqrt();
                 (
                     [x * t, y * t, zero - t],
                     [(zero - x) * il, (zero - y) * il, il],
@@ -1074,26 +1141,33 @@ impl Kernel<'_> {
             let first = hax.lt(half);
             // Outward normal: ±u on a cap, the radial direction on the side; the inside of a
             // bond cut by the near plane faces the viewer.
-            let cap = M8::bit_set(&flags.store().map(f32::to_bits), 30);
-            let inside = M8::bit_set(&flags.store().map(f32::to_bits), 31);
-            let mut s = Surf8::default();
+            let cap = V::bit_set(&flags, 30);
+            let inside = V::bit_set(&flags, 31);
+            let mut nrm = [zero; 3];
             for (k, uk) in [ux, uy, uz].into_iter().enumerate() {
                 let side = (pa[k] - uk * hax) * inv_r;
-                let capn = V8::select(first, zero - uk, uk);
-                let nk = V8::select(cap, capn, side);
-                s.n[k] = V8::select(inside, zero - nk, nk).store();
-                s.v[k] = to_eye[k].store();
+                let capn = V::select(first, zero - uk, uk);
+                let nk = V::select(cap, capn, side);
+                nrm[k] = V::select(inside, zero - nk, nk);
             }
             let first = first.bits();
+            let mut m = [[0f32; W]; 5];
             for l in 0..W {
-                let m = &self.materials[kinds[l][if first >> l & 1 != 0 { 0 } else { 1 }] as usize];
+                let mat =
+                    &self.materials[kinds[l][if first >> l & 1 != 0 { 0 } else { 1 }] as usize];
                 for k in 0..3 {
-                    s.base[k][l] = m.base_color[k];
+                    m[k][l] = mat.base_color[k];
                 }
-                s.spec[l] = m.specular;
-                s.shin[l] = m.shininess;
+                m[3][l] = mat.specular;
+                m[4][l] = mat.shininess;
             }
-            let c = fastshade::shade8(&self.lighting, &s).map(|c| V8::load(&c));
+            let [br, bg, bb, spec, shin] = m.map(|c| V::load_from(&c));
+            let pow = match self.spec_pow {
+                Some(pw) => pw,
+                None => fastshade::spec_pow_of(shin),
+            };
+            let c =
+                fastshade::shade_lanes(&self.lighting, nrm, to_eye, [br, bg, bb], spec, shin, pow);
             // sRGB encode over lanes: the 4096-bin table of `linear_to_srgb8` (same bytes).
             let mut px = [0u32; W];
             fastshade::srgb_rgba_lanes(c[0], c[1], c[2], enc).store_bits(&mut px);
@@ -1105,6 +1179,15 @@ impl Kernel<'_> {
             }
         }
     }
+}
+
+/// The [`SpecPow`] of the materials when they all have the same shininess.
+fn shared_spec_pow(materials: &[Material]) -> Option<SpecPow> {
+    let m0 = materials.first()?;
+    materials
+        .iter()
+        .all(|m| m.shininess.to_bits() == m0.shininess.to_bits())
+        .then(|| fastshade::spec_pow_of(V8::splat(m0.shininess)))
 }
 
 /// Whether the depth pass may use AVX2 lanes (checked once per frame).
@@ -1135,6 +1218,7 @@ pub(crate) fn draw(
     let kernel = Kernel {
         view: *view,
         avx2: avx2_available(),
+        spec_pow: shared_spec_pow(&scene.materials),
         lighting: *lighting,
         materials: &scene.materials,
     };
@@ -1422,7 +1506,7 @@ mod tests {
                     } else {
                         Persp::rays(&bv, &Persp::row(&bv, yv), x)
                     };
-                    let (t, word) = solve8(&bv, &rays, M8::first(LANES), near, far);
+                    let (t, word) = solve8(&bv, &rays, fastshade::M8::first(LANES), near, far);
                     let (t, word) = (t.store(), word.store());
                     for k in 0..LANES {
                         par_lanes += !(lanes_ref.a[k] > PARALLEL_A) as usize;
@@ -1495,9 +1579,9 @@ mod tests {
         );
     }
 
-    /// The AVX2 depth pass against the SSE2 one on every tile of random ball-and-stick scenes
-    /// (perspective and orthographic, a near plane cutting bonds): the same depths and winners,
-    /// bit for bit. Skipped (with a note) on a CPU without AVX2.
+    /// The AVX2 depth and shading passes against the SSE2 ones on every tile of random
+    /// ball-and-stick scenes (perspective and orthographic): the same depths and winners, bit for
+    /// bit, then the same colours and depths. Skipped (with a note) on a CPU without AVX2.
     #[test]
     #[cfg(target_arch = "x86_64")]
     fn avx2_and_sse_depth_passes_are_bit_identical() {
@@ -1533,6 +1617,7 @@ mod tests {
             let k = Kernel {
                 view,
                 avx2: false,
+                spec_pow: None,
                 lighting: Lighting::default_for(&cam),
                 materials: &scene.materials,
             };
@@ -1566,6 +1651,17 @@ mod tests {
                     );
                     assert!(a.win == b.win, "trial {trial} tile {tx},{ty}: winners");
                     compared += a.win.iter().filter(|&&w| w != NONE).count();
+                    // Shading: the same colours and depths from both backends.
+                    let mut out = [([[0u8; 4]; TILE_PX], [0f32; TILE_PX]); 2];
+                    let [(ca, da), (cb, db)] = &mut out;
+                    resolve_sse(&k, recs, x0, y0, w, h, &a, ca, da, TILE as usize);
+                    // SAFETY: AVX2 checked above.
+                    unsafe { resolve_avx2(&k, recs, x0, y0, w, h, &a, cb, db, TILE as usize) };
+                    assert!(ca == cb, "trial {trial} tile {tx},{ty}: colours");
+                    assert!(
+                        da.map(f32::to_bits) == db.map(f32::to_bits),
+                        "trial {trial}: depths"
+                    );
                 }
             }
         }
