@@ -111,14 +111,14 @@
 //! | kernel | first lanes (SSE2 / AVX2 build) | now (AVX2 build) |
 //! |---|---|---|
 //! | trilinear, `sample_pixels` | 146 / 134 | 58.6 |
-//! | span K3, `sample_quads` | 134 / 121 | 49.9 |
-//! | span K4, `sample_quads` | 133 / 120 | 48.5 |
+//! | span K3, `sample_quads` | 134 / 121 | 46.8 |
+//! | span K4, `sample_quads` | 133 / 120 | 46.0 |
 //!
-//! Of span K3's 49.9: set-up per eight spans 19.0, per pixel 26.5 (8 texel loads, 10.5 in lerps
-//! and the Eq. 4 blend, 2.8 weight permutes, 5.6 index loads, stores and branches) and 4.4 in the
-//! generic path of spans whose window crosses a level edge; trilinear's 58.6: set-up 28.6, per
-//! pixel 30 (8.8 of it index loads, stores and branches). So the span sampler runs 1.17x fewer
-//! instructions; its other gain is the memory organisation the paper designed it for (callgrind
+//! Of span K3's 46.8: set-up per eight spans 18.1, per pixel 26.7 (8 texel loads, 10.5 in lerps
+//! and the Eq. 4 blend, 2.9 weight permutes, 5.3 index loads, stores and branches) and 2.0 for
+//! spans whose window crosses a level edge (out of line; each pixel takes four wrapped indices
+//! there, as trilinear does); trilinear's 58.6: set-up 28.6, per pixel 30 (8.8 of it index
+//! loads, stores and branches). So the span sampler runs 1.25x fewer instructions; its other gain is the memory organisation the paper designed it for (callgrind
 //! cache simulation, per sample): 0.30 L1 read misses and 0.04 last-level misses for K3 against
 //! trilinear's 0.93 and 0.27 (K4: 0.56 and 0.26, its level pair is trilinear's), which is worth
 //! more as the instruction counts fall: in thread CPU time K3 ran 1.3–1.5x trilinear on the
@@ -130,10 +130,11 @@
 //! plain array LLVM kept the vectors and extracted lanes (three instructions per index); a
 //! `black_box` on the arrays keeps them in memory (span 55 -> 51, trilinear 64 -> 59). Inlining
 //! the edge-window fallback into the eight unrolled spans made the kernel miss the instruction
-//! cache (0.25 I1 misses per sample): it is out of line now. Left: a padded (apron) pyramid, as
-//! the emulator has, would make every window interior and save most of the 4.4 instructions of
-//! the edge fallback; the 3x3 window's shared texels (9 distinct of 16 loads per level) are not
-//! exploited: loads are the cheapest part of the per-pixel work.
+//! cache (0.25 I1 misses per sample): it is out of line now, with its own four-index path (the
+//! generic scalar path it replaced cost 4.4 instructions per sample, now 2.0). Left: a padded
+//! (apron) pyramid, as the emulator has, would make every window interior; the 3x3 window's
+//! shared texels (9 distinct of 16 loads per level) are not exploited: loads are the cheapest
+//! part of the per-pixel work.
 //!
 //! Rejected by operation count (not built): keeping the K x K window in registers (the 2x2 of each
 //! pixel is then picked with blends, ~9 SSE2 operations per texel against one L1 load); a weighted
