@@ -1230,6 +1230,9 @@ pub(crate) fn draw(
         .par_chunks_mut(band)
         .zip(frame.depth.par_chunks_mut(band))
         .enumerate()
+        // One job per band: the bands' costs differ a lot (bonds crowd the image centre), and
+        // rayon's default splitting would leave one thread with the dense half.
+        .with_max_len(1)
         .for_each(|(ty, (color, depth))| {
             let mut buf = TileBuf {
                 depth: [f32::INFINITY; TILE_BUF],
