@@ -121,8 +121,9 @@
 //! loads, stores and branches). So the span sampler runs 1.25x fewer instructions; its other gain is the memory organisation the paper designed it for (callgrind
 //! cache simulation, per sample): 0.30 L1 read misses and 0.04 last-level misses for K3 against
 //! trilinear's 0.93 and 0.27 (K4: 0.56 and 0.26, its level pair is trilinear's), which is worth
-//! more as the instruction counts fall: in thread CPU time K3 ran 1.3–1.5x trilinear on the
-//! shared machine (figures, commands and load in the fragment; the quiet re-measurement decides).
+//! more as the instruction counts fall: in thread CPU time (best frame) K3 ran ~1.4x and K4
+//! ~1.3x trilinear on the shared machine, not the 1.5x of issue #2 (figures, commands and load in
+//! the fragment; the quiet re-measurement decides).
 //!
 //! Measured and rejected or left: LLVM turns a constant-index `vpermps` into `vshufps` +
 //! `vpermpd` (two instructions per weight): the lane order `[0 2 4 6 | 1 3 5 7]` (trilinear) and
