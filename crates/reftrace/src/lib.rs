@@ -24,7 +24,7 @@
 //!   shared edges (obvhs's own triangle test does; it is not used).
 //!
 //! Correctness and robustness come first; speed is measured in `benches/reftrace.rs` and
-//! docs/fragments/reftrace.md (on the 100k-sphere S2 scene the 4-wide traversal executes about
+//! docs/PERFORMANCE.md, "Second round: reftrace" (on the 100k-sphere S2 scene the 4-wide traversal executes about
 //! 1.5x fewer instructions per primary ray than obvhs's cwbvh traversal).
 //!
 //! ```

@@ -106,7 +106,8 @@
 //! where it takes two.
 //!
 //! Measured with callgrind (instructions per sample, `examples/sampling_prof.rs`: the bench's
-//! tilted plane 1024x768 on a 4096² pyramid, one frame; details in docs/fragments/span.md):
+//! tilted plane 1024x768 on a 4096² pyramid, one frame; details in docs/PERFORMANCE.md, "Third
+//! round: the span sampler"):
 //!
 //! | kernel | first lanes (SSE2 / AVX2 build) | now (AVX2 build) |
 //! |---|---|---|

@@ -3,7 +3,7 @@
 //! (1024x768, 60° FOV, eye 2 units up looking 30° down, one map = 8 units, 1024² texture):
 //! (a) 8x8 supersampling, each sub-sample trilinear with the 1/8-pixel footprint;
 //! (b) the many-tap anisotropic box filter over each pixel's footprint (≤ 64 x 64 taps).
-//! Numbers go to docs/fragments/seed000.md; run with `-- --nocapture` to print them.
+//! Numbers are in docs/ACCURACY.md; run with `-- --nocapture` to print them.
 
 use texmap_core::camera::Camera;
 use texmap_core::color::linear_to_srgb8;
