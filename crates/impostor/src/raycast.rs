@@ -499,16 +499,15 @@ fn resolve_persp<V: Simd8>(
 
 /// Colour of one pixel (the per-pixel [`Kernel::resolve`]).
 #[allow(clippy::too_many_arguments)] // the kernel's fields and the pixel, shared by two impls
-fn resolve_px(
-    v: &View,
-    lighting: &Lighting,
-    materials: &[Material],
+fn resolve_px<V>(
+    k: &Perspective<V>,
     rec: &Proj,
     x: u32,
     y: u32,
     depth: f32,
     flags: u32,
 ) -> [u8; 4] {
+    let (v, lighting, materials) = (&k.view, &k.lighting, k.materials);
     let d = Vec3::new(
         (x as f32 + 0.5 - v.cx) * v.inv_k,
         (v.cy - (y as f32 + 0.5)) * v.inv_k,
@@ -532,16 +531,7 @@ impl Kernel for Perspective<'_, V8> {
     }
 
     fn resolve(&self, rec: &Proj, x: u32, y: u32, depth: f32, flags: u32) -> [u8; 4] {
-        resolve_px(
-            &self.view,
-            &self.lighting,
-            self.materials,
-            rec,
-            x,
-            y,
-            depth,
-            flags,
-        )
+        resolve_px(self, rec, x, y, depth, flags)
     }
 
     #[inline(never)]
@@ -566,16 +556,7 @@ impl Kernel for Perspective<'_, V8x> {
     }
 
     fn resolve(&self, rec: &Proj, x: u32, y: u32, depth: f32, flags: u32) -> [u8; 4] {
-        resolve_px(
-            &self.view,
-            &self.lighting,
-            self.materials,
-            rec,
-            x,
-            y,
-            depth,
-            flags,
-        )
+        resolve_px(self, rec, x, y, depth, flags)
     }
 
     fn resolve_tile(
