@@ -32,7 +32,7 @@ use core::arch::x86_64::*;
 use glam::{Vec2, Vec4};
 
 use super::{Addr, COORD_LIMIT};
-use crate::mip::MipTexture;
+use crate::mip::{LevelInfo, MipTexture};
 
 /// The level-offset table of a texture in two registers (levels 0–7 and 8–15).
 #[derive(Clone, Copy)]
@@ -638,6 +638,48 @@ unsafe fn edge_span<A: Addr, const K: usize>(tex: &MipTexture, q: [Vec2; 4]) -> 
     out
 }
 
+/// One level's texel coordinates of a span's four pixels (Seed 000 Eq. 3 on `2^L·r_m − ½`,
+/// clamped to the edge texels for Clamp): their floors and fractions `(⌊x⌋, ⌊y⌋, αx, αy)`.
+#[inline]
+#[target_feature(enable = "avx2")]
+fn span_texel_coords<A: Addr>(
+    l: &LevelInfo,
+    sx: Vec4,
+    sy: Vec4,
+) -> (__m128, __m128, __m128, __m128) {
+    let mut x = sx * l.scale_x - Vec4::splat(0.5);
+    let mut y = sy * l.scale_y - Vec4::splat(0.5);
+    if !A::REPEAT {
+        x = x.max(Vec4::ZERO).min(Vec4::splat(l.width_f - 1.0));
+        y = y.max(Vec4::ZERO).min(Vec4::splat(l.height_f - 1.0));
+    }
+    let (x, y): (__m128, __m128) = (x.into(), y.into());
+    let (flx, fly) = (_mm_floor_ps(x), _mm_floor_ps(y));
+    (flx, fly, _mm_sub_ps(x, flx), _mm_sub_ps(y, fly))
+}
+
+/// The smallest of four lanes, in every lane.
+#[inline]
+#[target_feature(enable = "avx2")]
+fn hmin(v: __m128) -> __m128 {
+    let m = _mm_min_ps(v, _mm_shuffle_ps::<0b01_00_11_10>(v, v));
+    _mm_min_ps(m, _mm_shuffle_ps::<0b10_11_00_01>(m, m))
+}
+
+/// A span's four per-pixel weights as the two pixel pairs' registers `[w0 ×4 | w1 ×4]`,
+/// `[w2 ×4 | w3 ×4]`.
+#[inline]
+#[target_feature(enable = "avx2")]
+fn pair_weights(v: __m128) -> [__m256; 2] {
+    let pair = |a: i32, b: i32| {
+        _mm256_permutevar8x32_ps(
+            _mm256_castps128_ps256(v),
+            _mm256_setr_epi32(a, a, a, a, b, b, b, b),
+        )
+    };
+    [pair(0, 1), pair(2, 3)]
+}
+
 /// One level of an edge span: per pixel its four wrapped texel indices (doubled,
 /// `[t00, t10, t01, t11][pixel]`) and the pixel pairs' weights.
 struct EdgeLevel {
@@ -658,19 +700,7 @@ fn edge_level<A: Addr, const K: usize>(
 ) -> Option<EdgeLevel> {
     debug_assert!(tex.is_pow2());
     let l = &tex.levels()[level];
-    let mut x = sx * l.scale_x - Vec4::splat(0.5);
-    let mut y = sy * l.scale_y - Vec4::splat(0.5);
-    if !A::REPEAT {
-        x = x.max(Vec4::ZERO).min(Vec4::splat(l.width_f - 1.0));
-        y = y.max(Vec4::ZERO).min(Vec4::splat(l.height_f - 1.0));
-    }
-    let (x, y): (__m128, __m128) = (x.into(), y.into());
-    let (flx, fly) = (_mm_floor_ps(x), _mm_floor_ps(y));
-    let (ax, ay) = (_mm_sub_ps(x, flx), _mm_sub_ps(y, fly));
-    let hmin = |v: __m128| {
-        let m = _mm_min_ps(v, _mm_shuffle_ps::<0b01_00_11_10>(v, v));
-        _mm_min_ps(m, _mm_shuffle_ps::<0b10_11_00_01>(m, m))
-    };
+    let (flx, fly, ax, ay) = span_texel_coords::<A>(l, sx, sy);
     let lim = _mm_set1_ps((K - 2) as f32);
     let over = _mm_or_ps(
         _mm_cmpgt_ps(_mm_sub_ps(flx, hmin(flx)), lim),
@@ -704,16 +734,10 @@ fn edge_level<A: Addr, const K: usize>(
             core::mem::transmute::<__m128i, [u32; 4]>(_mm_slli_epi32::<1>(_mm_add_epi32(r, c)))
         }
     };
-    let pair = |v: __m128, a: i32, b: i32| {
-        _mm256_permutevar8x32_ps(
-            _mm256_castps128_ps256(v),
-            _mm256_setr_epi32(a, a, a, a, b, b, b, b),
-        )
-    };
     Some(EdgeLevel {
         idx: [d(r0, c0), d(r0, c1), d(r1, c0), d(r1, c1)],
-        wx: [pair(ax, 0, 1), pair(ax, 2, 3)],
-        wy: [pair(ay, 0, 1), pair(ay, 2, 3)],
+        wx: pair_weights(ax),
+        wy: pair_weights(ay),
     })
 }
 
@@ -868,20 +892,8 @@ fn quad_level<A: Addr, const K: usize>(
 ) -> Option<QuadLevel> {
     let l = &tex.levels()[level];
     // This level's texel coordinates (Eq. 3 on 2^L r_m − ½), floors and weights.
-    let mut x = sx * l.scale_x - Vec4::splat(0.5);
-    let mut y = sy * l.scale_y - Vec4::splat(0.5);
-    if !A::REPEAT {
-        x = x.max(Vec4::ZERO).min(Vec4::splat(l.width_f - 1.0));
-        y = y.max(Vec4::ZERO).min(Vec4::splat(l.height_f - 1.0));
-    }
-    let (x, y): (__m128, __m128) = (x.into(), y.into());
-    let (flx, fly) = (_mm_floor_ps(x), _mm_floor_ps(y));
-    let (ax, ay) = (_mm_sub_ps(x, flx), _mm_sub_ps(y, fly));
+    let (flx, fly, ax, ay) = span_texel_coords::<A>(l, sx, sy);
     // The window corner (the lowest texel) and each pixel's offset from it.
-    let hmin = |v: __m128| {
-        let m = _mm_min_ps(v, _mm_shuffle_ps::<0b01_00_11_10>(v, v));
-        _mm_min_ps(m, _mm_shuffle_ps::<0b10_11_00_01>(m, m))
-    };
     let (mx, my) = (hmin(flx), hmin(fly));
     let (ox, oy) = (_mm_sub_ps(flx, mx), _mm_sub_ps(fly, my));
     let lim = _mm_set1_ps((K - 2) as f32);
@@ -896,18 +908,12 @@ fn quad_level<A: Addr, const K: usize>(
     let corner = _mm_set1_epi32((l.offset + (y0 * w + x0) as usize) as i32);
     let o = _mm_cvttps_epi32(_mm_add_ps(_mm_mul_ps(oy, _mm_set1_ps(l.width_f)), ox));
     let idx = _mm_slli_epi32::<1>(_mm_add_epi32(corner, o));
-    let pair = |v: __m128, a: i32, b: i32| {
-        _mm256_permutevar8x32_ps(
-            _mm256_castps128_ps256(v),
-            _mm256_setr_epi32(a, a, a, a, b, b, b, b),
-        )
-    };
     Some(QuadLevel {
         // SAFETY: same size, no invalid bit patterns.
         idx: unsafe { core::mem::transmute::<__m128i, [u32; 4]>(idx) },
         w2: 2 * w as usize,
-        wx: [pair(ax, 0, 1), pair(ax, 2, 3)],
-        wy: [pair(ay, 0, 1), pair(ay, 2, 3)],
+        wx: pair_weights(ax),
+        wy: pair_weights(ay),
     })
 }
 
