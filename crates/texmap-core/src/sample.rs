@@ -573,12 +573,25 @@ struct SpanPlan {
 /// First half of a span: Eq. (8)'s four pixel images `uv` as lanes, Eq. (9)'s level pair.
 #[inline(always)]
 fn span_plan<A: Addr, const K: usize>(tex: &MipTexture, uv: [Vec2; 4], bias: i32) -> SpanPlan {
+    let u = Vec4::new(uv[0].x, uv[1].x, uv[2].x, uv[3].x);
+    let v = Vec4::new(uv[0].y, uv[1].y, uv[2].y, uv[3].y);
+    span_plan_lanes::<A, K>(tex, u, v, bias)
+}
+
+/// [`span_plan`] on the images already in lanes (`u`, `v`: pixel `j` in lane `j`).
+#[inline(always)]
+fn span_plan_lanes<A: Addr, const K: usize>(
+    tex: &MipTexture,
+    u: Vec4,
+    v: Vec4,
+    bias: i32,
+) -> SpanPlan {
     let levels = tex.levels();
     let l0 = &levels[0];
     let last = levels.len() - 1;
     // Level-0 texel coordinates (no half-texel offset yet), one lane per pixel; NaN -> 0.
-    let mut sx = clamp4(Vec4::new(uv[0].x, uv[1].x, uv[2].x, uv[3].x) * l0.width_f);
-    let mut sy = clamp4(Vec4::new(uv[0].y, uv[1].y, uv[2].y, uv[3].y) * l0.height_f);
+    let mut sx = clamp4(u * l0.width_f);
+    let mut sy = clamp4(v * l0.height_f);
     // Repeat: shift the whole span by whole periods so its corner lies in the first period.
     if A::REPEAT {
         let px = floor_i32(sx.min_element() * l0.inv_width_f) as f32 * l0.width_f;
@@ -588,19 +601,26 @@ fn span_plan<A: Addr, const K: usize>(tex: &MipTexture, uv: [Vec2; 4], bias: i32
     }
     // Seed 000 Eq. (9): span level from the extent of the four images (level-0 texels).
     let ext = (sx.max_element() - sx.min_element()).max(sy.max_element() - sy.min_element());
+    let (i0, i1, t) = span_levels::<K>(ext, last, bias);
+    SpanPlan { sx, sy, i0, i1, t }
+}
+
+/// Eq. (9)'s level pair `(i0, i1)` and blend weight of a span whose images span `ext` level-0
+/// texels, clamped to the pyramid (`last`: its top level); K = 3 takes the pair one level
+/// coarser (the module doc's level policy).
+#[inline(always)]
+fn span_levels<const K: usize>(ext: f32, last: usize, bias: i32) -> (usize, usize, f32) {
     let shift = if K == 3 { 1 } else { 0 };
     // Exact ⌊λ⌋ from the exponent (0 and subnormals give −127), frac(λ) from the mantissa.
     let (e, frac) = log2_split(ext);
     let fine = e + shift + bias;
-    // Clamp the level pair to the pyramid.
-    let (i0, i1, t) = if fine < 0 {
+    if fine < 0 {
         (0, 0, 0.0)
     } else if fine as usize >= last {
         (last, last, 0.0)
     } else {
         (fine as usize, fine as usize + 1, frac)
-    };
-    SpanPlan { sx, sy, i0, i1, t }
+    }
 }
 
 /// Second half of a span: Eq. (10)'s window per level and Eq. (4)'s per-pixel blend.
@@ -910,10 +930,12 @@ impl Sampler {
         match *self {
             // One span per call: the AVX2 kernel where the CPU has it (same bits).
             #[cfg(target_arch = "x86_64")]
-            Sampler::Span(banks) if lanes::has_avx2() => match banks {
-                // SAFETY: AVX2 was detected just above.
-                Banks::K3 => unsafe { avx2::span_quad::<A, 3>(tex, uv) },
-                Banks::K4 => unsafe { avx2::span_quad::<A, 4>(tex, uv) },
+            Sampler::Span(banks) if lanes::has_avx2() => match (tex.is_pow2(), banks) {
+                // SAFETY: AVX2 was detected just above; the pow2 kernels check nothing else.
+                (true, Banks::K3) => unsafe { avx2::span_quad_pow2::<A, 3>(tex, uv) },
+                (true, Banks::K4) => unsafe { avx2::span_quad_pow2::<A, 4>(tex, uv) },
+                (false, Banks::K3) => unsafe { avx2::span_quad::<A, 3>(tex, uv) },
+                (false, Banks::K4) => unsafe { avx2::span_quad::<A, 4>(tex, uv) },
             },
             Sampler::Span(Banks::K3) => {
                 span_finish_direct::<A, 3>(tex, span_plan::<A, 3>(tex, uv, 0))
@@ -1359,6 +1381,49 @@ mod tests {
         assert!(reached_pair, "no pixel blended two levels");
     }
 
+    /// Spans from [`random_pixels`]' regimes, every third one small (mostly interior windows).
+    fn random_quads(n: usize, seed: u32) -> Vec<[Vec2; 4]> {
+        let (uv, dx, dy) = random_pixels(n, seed);
+        (0..n)
+            .map(|i| {
+                let s = if i % 3 == 0 { 0.02 } else { 1.0 };
+                quad_from_pixel(uv[i], dx[i] * s, dy[i] * s)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn one_span_calls_match_the_bank_emulator_bit_for_bit() {
+        // `sample_quad(Span)` (the AVX2 power-of-two one-span kernel where the CPU has it) on
+        // square, wide, tall and tiny pyramids, every input regime, against the emulator.
+        let mut interior = 0u64;
+        for (w, h) in [(64, 64), (64, 16), (16, 128), (1, 8), (2, 2), (256, 128)] {
+            for wrap in [Wrap::Repeat, Wrap::Clamp] {
+                let t = ramp(w, h, wrap);
+                let quads = random_quads(3001, w * 13 + h);
+                for banks in [Banks::K3, Banks::K4] {
+                    let bt = BankedTexture::new(&t, banks);
+                    let mut st = BankStats::default();
+                    for (i, q) in quads.iter().enumerate() {
+                        let bits = |c: [Vec4; 4]| c.map(|p| p.to_array().map(f32::to_bits));
+                        let (got, e) = (
+                            Sampler::Span(banks).sample_quad(&t, *q),
+                            bt.sample_quad(&t, *q, &mut st),
+                        );
+                        assert_eq!(
+                            bits(got),
+                            bits(e),
+                            "{w}x{h} {wrap:?} {banks:?} quad {i} {q:?}: expected {e:?}, got {got:?}"
+                        );
+                    }
+                    assert_eq!(st.conflicts, 0, "{w}x{h} {wrap:?} {banks:?}: {st:?}");
+                    interior += st.window_reads - st.edge_windows;
+                }
+            }
+        }
+        assert!(interior > 20_000, "too few interior windows: {interior}");
+    }
+
     #[test]
     fn bulk_span_lanes_match_the_bank_emulator_bit_for_bit() {
         // `sample_quads` (four spans per step in lanes on power-of-two pyramids, generic path for
@@ -1367,13 +1432,7 @@ mod tests {
         for (w, h) in [(64, 64), (64, 16), (1, 8), (2, 2), (256, 128), (48, 20)] {
             for wrap in [Wrap::Repeat, Wrap::Clamp] {
                 let t = ramp(w, h, wrap);
-                let (uv, dx, dy) = random_pixels(2001, w * 17 + h);
-                let quads: Vec<[Vec2; 4]> = (0..uv.len())
-                    .map(|i| {
-                        let s = if i % 3 == 0 { 0.02 } else { 1.0 };
-                        quad_from_pixel(uv[i], dx[i] * s, dy[i] * s)
-                    })
-                    .collect();
+                let quads = random_quads(2001, w * 17 + h);
                 for banks in [Banks::K3, Banks::K4] {
                     let bt = BankedTexture::new(&t, banks);
                     let mut st = BankStats::default();

@@ -114,15 +114,17 @@ fn clamp_coord8(x: __m256) -> __m256 {
     )
 }
 
-/// [`super::clamp4`] on eight lanes: NaN -> 0, then clamp to ±2^30.
+/// [`super::clamp4`] on eight lanes: NaN -> 0, then clamp to ±2^30. The NaN mask is applied
+/// last (a NaN lane clamps to −2^30, then masks to +0, as `clamp4`'s +0 clamps to +0), so the
+/// compare runs beside the clamp instead of before it (the one-span kernel's chain).
 #[inline]
 #[target_feature(enable = "avx2")]
 fn clamp_nan0_8(v: __m256) -> __m256 {
-    let v = _mm256_and_ps(_mm256_cmp_ps::<_CMP_EQ_OQ>(v, v), v);
-    _mm256_min_ps(
+    let c = _mm256_min_ps(
         _mm256_max_ps(v, _mm256_set1_ps(-COORD_LIMIT)),
         _mm256_set1_ps(COORD_LIMIT),
-    )
+    );
+    _mm256_and_ps(_mm256_cmp_ps::<_CMP_EQ_OQ>(v, v), c)
 }
 
 /// `Addr::wrap` on eight lanes (`n`: the level size per lane; Repeat on power-of-two levels).
@@ -945,7 +947,18 @@ pub(super) unsafe fn span_quad<A: Addr, const K: usize>(
     tex: &MipTexture,
     uv: [Vec2; 4],
 ) -> [Vec4; 4] {
-    let p = super::span_plan::<A, K>(tex, uv, 0);
+    // The images as two 16-byte loads, each inside one half of the quad: a load straddling
+    // the halves (what LLVM made of `Vec4::new(uv[0].x, ..)`, bytes 4..20) cannot be forwarded
+    // from the caller's two 16-byte stores of the quad and waited for them to retire
+    // (`perf` on the one-span calls: ~15 % of the samples there).
+    // SAFETY: `uv` is 8 floats.
+    let (h0, h1) = unsafe {
+        let f = uv.as_ptr() as *const f32;
+        (_mm_loadu_ps(f), _mm_loadu_ps(f.add(4)))
+    };
+    let u = _mm_shuffle_ps::<0b10_00_10_00>(h0, h1);
+    let v = _mm_shuffle_ps::<0b11_01_11_01>(h0, h1);
+    let p = super::span_plan_lanes::<A, K>(tex, u.into(), v.into(), 0);
     let Some(a) = quad_level::<A, K>(tex, p.i0, p.sx, p.sy) else {
         return super::span_finish::<A, super::Direct, K>(tex, p, &mut super::Direct);
     };
@@ -970,6 +983,213 @@ pub(super) unsafe fn span_quad<A: Addr, const K: usize>(
         unsafe {
             let r = lerp8(quad_pair(base, &a, k), quad_pair(base, &b, k), tt);
             _mm256_storeu_ps(dst.add(8 * k), r);
+        }
+    }
+    out
+}
+
+// ---------------------------------------------------------------------------------------------
+// One span per call on a power-of-two pyramid: x and y of the four pixels in the two halves of
+// one 256-bit register, the level sizes from the level index's bits, no window corner on the
+// index path. One call is a dependency chain (images -> repeat shift -> extent -> level ->
+// coordinates -> floors -> indices -> texels -> lerps), so what counts here is its length and
+// the instruction count (how much of the next call the core can overlap), not lane width.
+
+/// The smallest x (even lanes) and y (odd lanes) of `[x0 y0 x2 y2 | x1 y1 x3 y3]`, in every
+/// even and odd lane respectively.
+#[inline]
+#[target_feature(enable = "avx2")]
+fn min_xy(v: __m256) -> __m256 {
+    let m = _mm256_min_ps(v, _mm256_permute_ps::<0b01_00_11_10>(v));
+    _mm256_min_ps(m, _mm256_permute2f128_ps::<0x01>(m, m))
+}
+
+/// See [`min_xy`].
+#[inline]
+#[target_feature(enable = "avx2")]
+fn max_xy(v: __m256) -> __m256 {
+    let m = _mm256_max_ps(v, _mm256_permute_ps::<0b01_00_11_10>(v));
+    _mm256_max_ps(m, _mm256_permute2f128_ps::<0x01>(m, m))
+}
+
+/// `[a b a b | a b a b]`.
+#[inline]
+#[target_feature(enable = "avx2")]
+fn xy(a: f32, b: f32) -> __m256 {
+    _mm256_setr_ps(a, b, a, b, a, b, a, b)
+}
+
+/// One level of a span on a power-of-two pyramid: the doubled index of each pixel's 2x2
+/// corner texel, the doubled row stride, the pixel pairs' weights `[wx01, wx23, wy01, wy23]`
+/// and whether the K x K window is NOT interior (then the caller takes the edge path).
+struct Pow2Level {
+    idx: [u32; 4],
+    w2: usize,
+    w: [__m256; 4],
+    outside: bool,
+}
+
+/// [`quad_level`]'s arithmetic on `s = [x0 y0 x2 y2 | x1 y1 x3 y3]` at level `i` whose scale
+/// (`w_i/w_0` in x lanes, `h_i/h_0` in y lanes; for power-of-two pyramids `max(2^−i, 1/w_0)`,
+/// built from `i` by the caller, as
+/// the eight-span kernel does), with each pixel's index `offset + ⌊y⌋·w + ⌊x⌋` straight from its
+/// coordinates (for an interior window the same texel as `corner + oy·w + ox`).
+#[inline]
+#[target_feature(enable = "avx2")]
+fn pow2_level<A: Addr, const K: usize>(
+    tex: &MipTexture,
+    s: __m256,
+    scale: __m256,
+    i: usize,
+    size0: __m256,
+) -> Pow2Level {
+    debug_assert!(i < tex.level_count());
+    // max(2^(n − i), 1) = scale · 2^n, exactly.
+    let size = _mm256_mul_ps(scale, size0);
+    // This level's texel coordinates (Eq. 3 on 2^L r_m − ½), clamped for Clamp; floors, weights.
+    let mut x = _mm256_sub_ps(_mm256_mul_ps(s, scale), _mm256_set1_ps(0.5));
+    if !A::REPEAT {
+        x = _mm256_min_ps(
+            _mm256_max_ps(x, _mm256_setzero_ps()),
+            _mm256_sub_ps(size, _mm256_set1_ps(1.0)),
+        );
+    }
+    let fl = _mm256_floor_ps(x);
+    let a = _mm256_sub_ps(x, fl);
+    // Interior: corner ≥ 0, corner + K ≤ size, every offset from the corner ≤ K − 2.
+    let mn = min_xy(fl);
+    let bad = _mm256_or_ps(
+        _mm256_cmp_ps::<_CMP_GT_OQ>(_mm256_sub_ps(fl, mn), _mm256_set1_ps((K - 2) as f32)),
+        _mm256_or_ps(
+            _mm256_cmp_ps::<_CMP_LT_OQ>(mn, _mm256_setzero_ps()),
+            _mm256_cmp_ps::<_CMP_GT_OQ>(_mm256_add_ps(mn, _mm256_set1_ps(K as f32)), size),
+        ),
+    );
+    // In an interior window every x ≥ 0, so truncation is the floor: the indices need not wait
+    // for `roundps` (other spans take the edge path and ignore them).
+    let fi = _mm256_cvttps_epi32(x);
+    // Row stride: the level width max(w_0 >> i, 1) as a shift; ⌊y⌋ moved under ⌊x⌋ (the even
+    // lanes: pixels 0 and 2 in the low half, 1 and 3 in the high one).
+    let lw = tex.width().trailing_zeros().saturating_sub(i as u32);
+    let off = tex.level_offsets16()[i.min(15)];
+    let rows = _mm256_sll_epi32(_mm256_srli_epi64::<32>(fi), _mm_cvtsi32_si128(lw as i32));
+    let idx = _mm256_add_epi32(_mm256_add_epi32(fi, rows), _mm256_set1_epi32(off));
+    let idx = to_u32x8(_mm256_slli_epi32::<1>(idx));
+    Pow2Level {
+        idx: [idx[0], idx[4], idx[2], idx[6]],
+        w2: 2 << lw,
+        // [ax0 ×4 | ax1 ×4], [ax2 | ax3], [ay0 | ay1], [ay2 | ay3]: in-lane broadcasts.
+        w: [bc::<0x00>(a), bc::<0xAA>(a), bc::<0x55>(a), bc::<0xFF>(a)],
+        outside: _mm256_movemask_ps(bad) != 0,
+    }
+}
+
+/// Bilinear of pixels `2p`, `2p + 1` from an interior window of a [`Pow2Level`].
+///
+/// # Safety
+/// `d` must come from [`pow2_level`] on the texture whose texels start at `base`, interior.
+#[inline]
+#[target_feature(enable = "avx2")]
+unsafe fn pow2_pair(base: *const u8, d: &Pow2Level, p: usize) -> __m256 {
+    let (i0, i1, w) = (d.idx[2 * p] as usize, d.idx[2 * p + 1] as usize, d.w2);
+    let (wx, wy) = (d.w[p], d.w[2 + p]);
+    // SAFETY: the caller's contract: every pixel's 2x2 lies in the window inside the level.
+    unsafe {
+        let t00 = load_pair(base, i0, i1);
+        let t10 = load_pair(base, i0 + 2, i1 + 2);
+        let t01 = load_pair(base, i0 + w, i1 + w);
+        let t11 = load_pair(base, i0 + w + 2, i1 + w + 2);
+        lerp8(lerp8(t00, t10, wx), lerp8(t01, t11, wx), wy)
+    }
+}
+
+/// The span sampler on one span of a power-of-two pyramid (Seed 000 Eq. 8–10, Eq. 4 blend):
+/// bit-identical to [`super::span_finish_direct`] after [`super::span_plan`]; spans whose
+/// window is not interior take [`edge_span`].
+///
+/// # Safety
+/// The CPU must support AVX2; the texture must be a power of two (`tex.is_pow2()`).
+#[target_feature(enable = "avx2")]
+pub(super) unsafe fn span_quad_pow2<A: Addr, const K: usize>(
+    tex: &MipTexture,
+    uv: [Vec2; 4],
+) -> [Vec4; 4] {
+    debug_assert!(tex.is_pow2());
+    let l0 = &tex.levels()[0];
+    let last = tex.level_count() - 1;
+    // The images as two 16-byte loads, each inside one half of the quad (a load straddling
+    // the halves cannot be forwarded from the caller's stores of the quad), then [u | v].
+    // SAFETY: `uv` is 8 floats.
+    let q = unsafe {
+        let f = uv.as_ptr() as *const f32;
+        _mm256_loadu2_m128(f.add(4), f)
+    };
+    // [x0 y0 x2 y2 | x1 y1 x3 y3]: pixels 2p and 2p + 1 share lanes of the two halves, so a
+    // pixel pair's weights are in-lane broadcasts.
+    let uv8 = _mm256_castpd_ps(_mm256_permute4x64_pd::<0xD8>(_mm256_castps_pd(q)));
+    let size0 = xy(l0.width_f, l0.height_f);
+    let inv0 = xy(l0.inv_width_f, l0.inv_height_f);
+    // Level-0 texel coordinates [sx | sy]. `span_plan` clamps them (NaN -> 0, ±2^30), which
+    // changes nothing for finite lanes within the limit: those lanes skip the clamp, others
+    // take the edge path (a check beside the chain instead of two steps in it).
+    let mut s = _mm256_mul_ps(uv8, size0);
+    let abs = _mm256_and_ps(s, _mm256_castsi256_ps(_mm256_set1_epi32(0x7fff_ffff)));
+    let finite = _mm256_cmp_ps::<_CMP_LE_OQ>(abs, _mm256_set1_ps(COORD_LIMIT));
+    let (mut lo, mut hi) = (min_xy(s), max_xy(s));
+    if A::REPEAT {
+        // Whole periods off so that the span's corner lies in the first period (span_plan).
+        let p = _mm256_mul_ps(_mm256_floor_ps(_mm256_mul_ps(lo, inv0)), size0);
+        s = _mm256_sub_ps(s, p);
+        // The shifted lanes' extremes are the extremes shifted (rounding is monotone: the
+        // same lanes stay smallest and largest), the same bits as reducing `s` again. (The
+        // extent before the shift is NOT always the same: lanes small next to the width lose
+        // bits in the shift; on the bench's plane two spans in three differ.)
+        (lo, hi) = (_mm256_sub_ps(lo, p), _mm256_sub_ps(hi, p));
+    }
+    if _mm256_movemask_ps(finite) != 0xff {
+        // SAFETY: the caller's contract.
+        return unsafe { edge_span::<A, K>(tex, uv) };
+    }
+    // Seed 000 Eq. (9): the level pair from the extent of the four images.
+    let d = _mm256_castps256_ps128(_mm256_sub_ps(hi, lo));
+    let ext = _mm_max_ss(d, _mm_movehdup_ps(d));
+    let (i0, i1, t) = super::span_levels::<K>(_mm_cvtss_f32(ext), last, 0);
+    // The same level pair in lanes (no round trip through the integer registers on the way
+    // to the coordinates): ⌊λ⌋ from the exponent (ext ≥ 0), clamped to the pyramid; the level
+    // scales max(2^−i, 1/w_0) from the levels' bits.
+    let fine = _mm_add_epi32(
+        _mm_srli_epi32::<23>(_mm_castps_si128(ext)),
+        _mm_set1_epi32(if K == 3 { 1 - 127 } else { -127 }),
+    );
+    let top = _mm_set1_epi32(last as i32);
+    let lvl = |f: __m128i| _mm_min_epi32(_mm_max_epi32(f, _mm_setzero_si128()), top);
+    let scale = |l: __m128i| {
+        let b = _mm_slli_epi32::<23>(_mm_sub_epi32(_mm_set1_epi32(127), l));
+        _mm256_max_ps(_mm256_castsi256_ps(_mm256_broadcastd_epi32(b)), inv0)
+    };
+    let sa = scale(lvl(fine));
+    let sb = scale(lvl(_mm_add_epi32(fine, _mm_set1_epi32(1))));
+    let a = pow2_level::<A, K>(tex, s, sa, i0, size0);
+    let b = pow2_level::<A, K>(tex, s, sb, i1, size0);
+    if a.outside | b.outside {
+        // SAFETY: the caller's contract.
+        return unsafe { edge_span::<A, K>(tex, uv) };
+    }
+    let base = tex.texels().as_ptr() as *const u8;
+    let mut out = [Vec4::ZERO; 4];
+    let dst = out.as_mut_ptr() as *mut f32;
+    // SAFETY: both windows interior (pow2_level); `out` holds 16 floats.
+    unsafe {
+        if i1 == i0 || t == 0.0 {
+            _mm256_storeu_ps(dst, pow2_pair(base, &a, 0));
+            _mm256_storeu_ps(dst.add(8), pow2_pair(base, &a, 1));
+        } else {
+            // Seed 000 Eq. (4): one blend weight for the span.
+            let tt = _mm256_set1_ps(t);
+            for p in 0..2 {
+                let r = lerp8(pow2_pair(base, &a, p), pow2_pair(base, &b, p), tt);
+                _mm256_storeu_ps(dst.add(8 * p), r);
+            }
         }
     }
     out
