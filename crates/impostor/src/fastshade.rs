@@ -196,27 +196,37 @@ pub(crate) fn spec_pow_of<V: Simd8>(shin: V) -> SpecPow {
 /// `x^e` by repeated squaring over 8 lanes (`x ∈ [0, 1]`, integer exponents below `2^bits`):
 /// at most `2·bits` rounded products, so within ~`2·bits` ulp of the exact power. `Same` and
 /// `Ints` perform the same products, so they give the same bits.
+///
+/// `N` powers (one per light) are taken in one loop: the loop control is shared and the `N`
+/// dependency chains of squarings overlap. Every power sees the same products as alone.
 #[inline(always)]
-fn pow_int8<V: Simd8>(x: V, pw: &SpecPow) -> V {
-    let mut acc = V::splat(1.0);
+fn pow_int8<V: Simd8, const N: usize>(x: [V; N], pw: &SpecPow) -> [V; N] {
+    let mut acc = [V::splat(1.0); N];
     let mut p = x;
     match *pw {
         SpecPow::Same { mut k, .. } => {
             // The same products as the `Ints` loop (its last squaring is never used).
             while k != 0 {
                 if k & 1 != 0 {
-                    acc = acc * p;
+                    for n in 0..N {
+                        acc[n] = acc[n] * p[n];
+                    }
                 }
                 k >>= 1;
                 if k != 0 {
-                    p = p * p;
+                    for p in &mut p {
+                        *p = *p * *p;
+                    }
                 }
             }
         }
         SpecPow::Ints { ref e, bits } => {
             for b in 0..bits {
-                acc = V::select(V::bit_set(e, b), acc * p, acc);
-                p = p * p;
+                let m = V::bit_set(e, b);
+                for n in 0..N {
+                    acc[n] = V::select(m, acc[n] * p[n], acc[n]);
+                    p[n] = p[n] * p[n];
+                }
             }
         }
         SpecPow::Poly => unreachable!("pow_int8 takes integer exponents"),
@@ -310,40 +320,54 @@ pub(crate) fn shade_lanes<V: Simd8>(
     ];
     let zero = V::splat(0.0);
     let tiny = V::splat(1e-30);
-    for light in l.lights() {
-        let a = light.to_light;
-        let (ax, ay, az) = (V::splat(a.x), V::splat(a.y), V::splat(a.z));
-        // Lambert term n·l.
-        let ndl = n[0] * ax + n[1] * ay + n[2] * az;
-        // Blinn half vector h = l + v and n·h/|h|.
-        let hx = ax + v[0];
-        let hy = ay + v[1];
-        let hz = az + v[2];
-        let hh = hx * hx + hy * hy + hz * hz;
-        let nh = n[0] * hx + n[1] * hy + n[2] * hz;
-        let q = nh / hh.sqrt();
-        // Clamp to (0, 1]; lanes at 0 (or NaN from hh = 0) are masked after the pow.
-        let pos = q.gt(tiny);
-        let ndh = V::select(pos, q.min(V::splat(1.0)), tiny);
-        let pw = match pw {
-            SpecPow::Same { .. } | SpecPow::Ints { .. } => pow_int8(ndh, &pw),
-            SpecPow::Poly => {
-                let mut x = [0f32; W];
-                ndh.store_to(&mut x);
-                let lg = V::load_from(&log2_8(&x));
-                let z = (shin * lg).min(zero);
-                z.store_to(&mut x);
-                V::load_from(&exp2_neg8(&x))
-            }
+    // Lights two at a time: their specular powers share one squaring loop (see `pow_int8`);
+    // the terms are added in the lights' order, so the sums are the same as one at a time.
+    for pair in l.lights().chunks(2) {
+        let mut ndl = [zero; 2];
+        let mut ndh = [zero; 2];
+        let mut pos = [zero.lt(zero); 2];
+        for (i, light) in pair.iter().enumerate() {
+            let a = light.to_light;
+            let (ax, ay, az) = (V::splat(a.x), V::splat(a.y), V::splat(a.z));
+            // Lambert term n·l.
+            ndl[i] = n[0] * ax + n[1] * ay + n[2] * az;
+            // Blinn half vector h = l + v and n·h/|h|.
+            let hx = ax + v[0];
+            let hy = ay + v[1];
+            let hz = az + v[2];
+            let hh = hx * hx + hy * hy + hz * hz;
+            let nh = n[0] * hx + n[1] * hy + n[2] * hz;
+            let q = nh / hh.sqrt();
+            // Clamp to (0, 1]; lanes at 0 (or NaN from hh = 0) are masked after the pow.
+            pos[i] = q.gt(tiny);
+            ndh[i] = V::select(pos[i], q.min(V::splat(1.0)), tiny);
+        }
+        let pw2 = match pw {
+            SpecPow::Same { .. } | SpecPow::Ints { .. } if pair.len() == 2 => pow_int8(ndh, &pw),
+            SpecPow::Same { .. } | SpecPow::Ints { .. } => [pow_int8([ndh[0]], &pw)[0], zero],
+            SpecPow::Poly => ndh.map(|x| pow_poly8(x, shin)),
         };
-        let spec = V::select(pos, spec_k * pw, zero);
-        let lit = ndl.gt(zero);
-        for k in 0..3 {
-            let term = base[k] * ndl + spec;
-            c[k] = c[k] + V::select(lit, V::splat(light.color[k]) * term, zero);
+        for (i, light) in pair.iter().enumerate() {
+            let spec = V::select(pos[i], spec_k * pw2[i], zero);
+            let lit = ndl[i].gt(zero);
+            for k in 0..3 {
+                let term = base[k] * ndl[i] + spec;
+                c[k] = c[k] + V::select(lit, V::splat(light.color[k]) * term, zero);
+            }
         }
     }
     c
+}
+
+/// `x^e = exp2(e·log2 x)` over 8 lanes with the polynomials (`x ∈ (0, 1]`, any `e ≥ 0`).
+#[inline(always)]
+fn pow_poly8<V: Simd8>(x: V, shin: V) -> V {
+    let mut a = [0f32; W];
+    x.store_to(&mut a);
+    let lg = V::load_from(&log2_8(&a));
+    let z = (shin * lg).min(V::splat(0.0));
+    z.store_to(&mut a);
+    V::load_from(&exp2_neg8(&a))
 }
 
 /// Eight `f32` lanes: two SSE registers on x86-64 (SSE2 is part of the x86-64 baseline, so no
