@@ -456,37 +456,50 @@ fn resolve_persp<V: Simd8>(
                 i += LANES;
                 continue;
             }
-            // The winners' records and materials as lanes. Uncovered lanes repeat the first
+            // The winners' records and materials as lanes. Uncovered lanes take the first
             // covered pixel's winner.
             let first = buf.win[b + covered.trailing_zeros() as usize] & !FLAG_INSIDE;
-            let idx_bits = V::splat_bits(!FLAG_INSIDE);
-            let one_sphere = win.and_bits(idx_bits).eq_bits(V::splat_bits(first)).bits() | !covered;
-            let ([cx, cy, cz, _, inv_r, _, _, _], [br, bg, bb, spec, shin, _, _, _]) =
-                if one_sphere & 0xff == 0xff {
-                    // One sphere under all covered pixels (most chunks of a scene of large
-                    // spheres): its record and material as constants.
-                    let rec = &recs[first as usize];
-                    let row = &k.rows[rec.kind as usize];
-                    (rec.as_lanes().map(V::splat), row.map(V::splat))
-                } else {
-                    // Gather the rows and transpose them to lanes.
-                    let mut rec_rows = [recs[0].as_lanes(); LANES];
-                    let mut mat_rows = [&k.rows[0]; LANES];
-                    for l in 0..LANES {
-                        let wv = buf.win[b + l];
-                        let ri = (if wv == NONE { first } else { wv & !FLAG_INSIDE }) as usize;
-                        debug_assert!(ri < recs.len());
-                        // SAFETY: winner entries other than NONE are indices into this tile's
-                        // `recs` (written by the depth pass), and `first` is one of them.
-                        let rec = unsafe { recs.get_unchecked(ri) };
-                        debug_assert!((rec.kind as usize) < k.rows.len());
-                        rec_rows[l] = rec.as_lanes();
-                        // SAFETY: only valid spheres are projected, and a valid sphere's kind
-                        // indexes `materials`, whose rows these are.
-                        mat_rows[l] = unsafe { k.rows.get_unchecked(rec.kind as usize) };
-                    }
-                    (V::transpose(rec_rows), V::transpose(mat_rows))
+            let idx = win.and_bits(V::splat_bits(!FLAG_INSIDE));
+            let on_first = idx.eq_bits(V::splat_bits(first));
+            let rest = covered & !on_first.bits();
+            let second =
+                buf.win[b + (rest.trailing_zeros() as usize).min(LANES - 1)] & !FLAG_INSIDE;
+            let on_second = idx.eq_bits(V::splat_bits(second));
+            let ([cx, cy, cz, _, inv_r, _, _, _], [br, bg, bb, spec, shin, _, _, _]) = if rest == 0
+            {
+                // One sphere under all covered pixels (most chunks of a scene of large
+                // spheres): its record and material as constants.
+                let rec = &recs[first as usize];
+                let row = &k.rows[rec.kind as usize];
+                (rec.as_lanes().map(V::splat), row.map(V::splat))
+            } else if rest & !on_second.bits() == 0 {
+                // Two spheres (a silhouette crosses the chunk): both as constants, one select
+                // per field.
+                let (r0, r1) = (&recs[first as usize], &recs[second as usize]);
+                let (m0, m1) = (&k.rows[r0.kind as usize], &k.rows[r1.kind as usize]);
+                let pick = |a: &[f32; 8], b: &[f32; 8]| -> [V; 8] {
+                    std::array::from_fn(|f| V::select(on_second, V::splat(b[f]), V::splat(a[f])))
                 };
+                (pick(r0.as_lanes(), r1.as_lanes()), pick(m0, m1))
+            } else {
+                // Gather the rows and transpose them to lanes.
+                let mut rec_rows = [recs[0].as_lanes(); LANES];
+                let mut mat_rows = [&k.rows[0]; LANES];
+                for l in 0..LANES {
+                    let wv = buf.win[b + l];
+                    let ri = (if wv == NONE { first } else { wv & !FLAG_INSIDE }) as usize;
+                    debug_assert!(ri < recs.len());
+                    // SAFETY: winner entries other than NONE are indices into this tile's
+                    // `recs` (written by the depth pass), and `first` is one of them.
+                    let rec = unsafe { recs.get_unchecked(ri) };
+                    debug_assert!((rec.kind as usize) < k.rows.len());
+                    rec_rows[l] = rec.as_lanes();
+                    // SAFETY: only valid spheres are projected, and a valid sphere's kind
+                    // indexes `materials`, whose rows these are.
+                    mat_rows[l] = unsafe { k.rows.get_unchecked(rec.kind as usize) };
+                }
+                (V::transpose(rec_rows), V::transpose(mat_rows))
+            };
             let t = V::load_from(&buf.depth[b..]);
             let dx = V::load_from(&dxs[i..]);
             // Exact normal at the hit point; flipped toward the viewer on the interior (the
