@@ -365,6 +365,9 @@ pub(crate) const LANES: usize = 8;
 /// an infinite depth and never win).
 pub(crate) const TILE_BUF: usize = TILE_PX + LANES;
 
+/// Longest bin a [`Kernel::order`] may reorder (its scratch copy is 8 KB).
+pub(crate) const ORDER_MAX: usize = 256;
+
 /// A tile's depth and winner buffers (row stride [`TILE`]).
 pub(crate) struct TileBuf {
     pub depth: [f32; TILE_BUF],
@@ -378,6 +381,13 @@ pub(crate) trait Kernel: Sync {
     /// is written only together with its winner, so pixels left at [`NONE`] keep an infinite
     /// depth ([`draw_tiles`] copies the depths as they are).
     fn raster(&self, recs: &[Proj], tile: TileRect, buf: &mut TileBuf);
+    /// The order in which both passes take the tile's records: the bin itself (the default),
+    /// or a reordered copy in `scratch` (bins of at most [`ORDER_MAX`] records). Winner
+    /// indices are positions in the returned slice. A kernel that reorders must keep the
+    /// winners those of bin order (see the ray-cast kernel's front-to-back order).
+    fn order<'r>(&self, recs: &'r [Proj], _scratch: &'r mut [Proj; ORDER_MAX]) -> &'r [Proj] {
+        recs
+    }
     /// Colour of pixel `(x, y)` won by `rec` at `depth` (sRGB RGBA8).
     fn resolve(&self, rec: &Proj, x: u32, y: u32, depth: f32, flags: u32) -> [u8; 4];
 
@@ -445,6 +455,7 @@ pub(crate) fn draw_tiles<K: Kernel>(
                 depth: [f32::INFINITY; TILE_BUF],
                 win: [NONE; TILE_BUF],
             };
+            let mut scratch = [Proj::default(); ORDER_MAX];
             let y0 = ty as u32 * TILE;
             let th = (view.height - y0).min(TILE);
             for tx in 0..view.tiles_x {
@@ -469,7 +480,8 @@ pub(crate) fn draw_tiles<K: Kernel>(
                 }
                 buf.depth.fill(f32::INFINITY);
                 buf.win.fill(NONE);
-                // Depth pass over the bin in sphere order.
+                // Depth pass over the bin, in the kernel's order.
+                let recs = kernel.order(recs, &mut scratch);
                 kernel.raster(recs, tile, &mut buf);
                 // Resolve pass: colour each covered pixel once.
                 kernel.resolve_tile(recs, tile, &buf, background, &mut color[x0 as usize..], w);
