@@ -1,9 +1,10 @@
 //! The one pipeline every sprite-like method shares: transform + cull + project → bin into
 //! 32x32 tiles → per-tile pixel kernels in parallel.
 //!
-//! 1. **Project** (parallel over fixed chunks of [`CHUNK`] spheres): each valid sphere is moved to
-//!    eye space, culled against the near/far planes and the screen, and turned into a 32-byte
-//!    [`Proj`] record by the method's projection function. Each chunk appends its records to its
+//! 1. **Project** (parallel over chunks of at most [`CHUNK`] spheres, their size fixed by the
+//!    scene's size alone): each valid sphere is moved to eye space, culled against the near/far
+//!    planes and the screen, and turned into a 32-byte [`Proj`] record by the method's
+//!    projection function. Each chunk appends its records to its
 //!    own buffer and counts, per tile, how many records touch that tile.
 //! 2. **Prefix sum** (serial, over tiles x chunks): the start of every (tile, chunk) run in one
 //!    bin array, so that chunk `c`'s records for tile `t` follow those of chunks `< c`.
@@ -12,13 +13,15 @@
 //!    their bins sequentially (PERFORMANCE-NOTES: the index version spent 55% of its time on cache
 //!    misses).
 //! 4. **Tiles** (parallel over bands of 32 rows): each tile runs the method's depth pass over its
-//!    bin in sphere order, remembering the winning record per pixel, then its resolve pass colours
-//!    each covered pixel once (deferred shading: overdraw costs a depth test, not a shade).
+//!    bin in the kernel's order ([`Kernel::order`]: sphere order, or the ray-cast kernel's front
+//!    to back), remembering the winning record per pixel, then its resolve pass colours each
+//!    covered pixel once (deferred shading: overdraw costs a depth test, not a shade).
 //!
-//! **Determinism:** chunk boundaries are fixed (they do not depend on the thread count), records
-//! keep sphere order within every tile, the depth test is strict (`<`, so of two equal depths the
-//! earlier sphere wins) and every tile writes only its own pixels. The same input therefore gives
-//! the same bytes for any number of threads.
+//! **Determinism:** chunk boundaries depend on the scene's size alone (not on the thread count),
+//! records keep sphere order within every bin, a kernel's order depends on the records alone,
+//! the depth test is strict (`<`, so of two equal depths the record visited first wins) and
+//! every tile writes only its own pixels. The same input therefore gives the same bytes for any
+//! number of threads.
 //!
 //! All per-frame buffers live in [`Bins`], which the [`crate::Renderer`] keeps between frames.
 
@@ -36,8 +39,19 @@ use crate::{RenderStats, SphereScene};
 pub(crate) const TILE: u32 = 32;
 /// Pixels per tile.
 pub(crate) const TILE_PX: usize = (TILE * TILE) as usize;
-/// Spheres per projection chunk: fixed, so results do not depend on the thread count.
+/// Most spheres per projection chunk.
 pub(crate) const CHUNK: usize = 16_384;
+/// Fewest spheres per projection chunk (below this a chunk is not worth a rayon job).
+const MIN_CHUNK: usize = 256;
+
+/// Spheres per projection chunk for a scene of `n` spheres: at most [`CHUNK`], and small
+/// scenes are cut in four (but chunks of at least [`MIN_CHUNK`]) so that both cores project
+/// them (S1: 1,115 spheres, a serial ~5% of the frame in one chunk). It depends on `n` alone,
+/// never on the thread count, and the bins hold the same records in the same order for any
+/// chunking (chunk runs are concatenated in chunk order), so the output does not change.
+fn chunk_len(n: usize) -> usize {
+    n.div_ceil(4).clamp(MIN_CHUNK, CHUNK)
+}
 /// "No winner" in a tile's winner buffer.
 pub(crate) const NONE: u32 = u32::MAX;
 /// Flag bit in a winner entry: the far (inside) intersection was taken.
@@ -184,7 +198,8 @@ impl Bins {
         F: Fn(Vec3, f32, u16) -> Projected + Sync,
     {
         let n = scene.len();
-        let nchunks = n.div_ceil(CHUNK);
+        let chunk = chunk_len(n);
+        let nchunks = n.div_ceil(chunk);
         let ntiles = (view.tiles_x * view.tiles_y) as usize;
         self.chunk_recs.resize_with(nchunks, Vec::new);
         self.chunk_counts.resize_with(nchunks, Vec::new);
@@ -198,8 +213,8 @@ impl Bins {
             .zip(self.chunk_stats[..nchunks].par_iter_mut())
             .enumerate()
             .for_each(|(ci, ((recs, counts), stats))| {
-                let lo = ci * CHUNK;
-                let hi = (lo + CHUNK).min(n);
+                let lo = ci * chunk;
+                let hi = (lo + chunk).min(n);
                 project_chunk(scene, view, &project, lo..hi, recs, counts, stats);
             });
 
