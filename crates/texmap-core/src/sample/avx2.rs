@@ -609,7 +609,7 @@ unsafe fn span_out<A: Addr, const K: usize, const S: usize, const I: i32>(
 #[inline(never)]
 #[target_feature(enable = "avx2")]
 unsafe fn edge_span<A: Addr, const K: usize>(tex: &MipTexture, q: [Vec2; 4]) -> [Vec4; 4] {
-    let p = super::span_plan::<A, K>(tex, q, 0);
+    let p = plan::<A, K>(tex, &q);
     let generic = || super::span_finish::<A, super::Direct, K>(tex, p, &mut super::Direct);
     let Some(a) = edge_level::<A, K>(tex, p.i0, p.sx, p.sy) else {
         return generic();
@@ -937,6 +937,23 @@ unsafe fn quad_pair(base: *const u8, d: &QuadLevel, p: usize) -> __m256 {
     }
 }
 
+/// [`super::span_plan`] with the images read as two 16-byte loads, each inside one half of the
+/// quad: a load straddling the halves (what LLVM made of `Vec4::new(uv[0].x, ..)`, bytes
+/// 4..20) cannot be forwarded from a caller's two 16-byte stores of the quad and waits for them
+/// to retire (`perf` on the one-span calls: ~15 % of the samples there).
+#[inline]
+#[target_feature(enable = "avx2")]
+fn plan<A: Addr, const K: usize>(tex: &MipTexture, uv: &[Vec2; 4]) -> super::SpanPlan {
+    // SAFETY: `uv` is 8 floats.
+    let (h0, h1) = unsafe {
+        let f = uv.as_ptr() as *const f32;
+        (_mm_loadu_ps(f), _mm_loadu_ps(f.add(4)))
+    };
+    let u = _mm_shuffle_ps::<0b10_00_10_00>(h0, h1);
+    let v = _mm_shuffle_ps::<0b11_01_11_01>(h0, h1);
+    super::span_plan_lanes::<A, K>(tex, u.into(), v.into(), 0)
+}
+
 /// The span sampler on one span (Seed 000 Eq. 8–10, Eq. 4 blend): bit-identical to
 /// [`super::span_finish_direct`] after [`super::span_plan`], which it replaces on AVX2 CPUs.
 ///
@@ -947,18 +964,7 @@ pub(super) unsafe fn span_quad<A: Addr, const K: usize>(
     tex: &MipTexture,
     uv: [Vec2; 4],
 ) -> [Vec4; 4] {
-    // The images as two 16-byte loads, each inside one half of the quad: a load straddling
-    // the halves (what LLVM made of `Vec4::new(uv[0].x, ..)`, bytes 4..20) cannot be forwarded
-    // from the caller's two 16-byte stores of the quad and waited for them to retire
-    // (`perf` on the one-span calls: ~15 % of the samples there).
-    // SAFETY: `uv` is 8 floats.
-    let (h0, h1) = unsafe {
-        let f = uv.as_ptr() as *const f32;
-        (_mm_loadu_ps(f), _mm_loadu_ps(f.add(4)))
-    };
-    let u = _mm_shuffle_ps::<0b10_00_10_00>(h0, h1);
-    let v = _mm_shuffle_ps::<0b11_01_11_01>(h0, h1);
-    let p = super::span_plan_lanes::<A, K>(tex, u.into(), v.into(), 0);
+    let p = plan::<A, K>(tex, &uv);
     let Some(a) = quad_level::<A, K>(tex, p.i0, p.sx, p.sy) else {
         return super::span_finish::<A, super::Direct, K>(tex, p, &mut super::Direct);
     };
