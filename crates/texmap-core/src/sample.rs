@@ -96,7 +96,9 @@
 //! Both builds are bit-identical to the scalar kernels and to the bank emulator (no FMA anywhere;
 //! tests below, which fail under mutations of the weights, blend masks and indices).
 //! `sample_quad` runs trilinear's four pixels in one SSE2 lane kernel, and the span through an
-//! AVX2 one-span kernel (same pixel-pair taps) or, without AVX2, a fused scalar path.
+//! AVX2 one-span kernel (same pixel-pair taps) or, without AVX2, a fused scalar path. One call is
+//! one dependency chain, so the power-of-two one-span kernel (`avx2::span_quad_pow2`) is built
+//! for its length and not for lane width (see "One span per call" below).
 //!
 //! The comparison is kept fair: every general technique is in both kernels. The span kernel only
 //! adds what Seed 000's structure gives it: one level pair, one blend weight, one window corner
@@ -109,11 +111,38 @@
 //! tilted plane 1024x768 on a 4096² pyramid, one frame; details in docs/PERFORMANCE.md, "Third
 //! round: the span sampler"):
 //!
-//! | kernel | first lanes (SSE2 / AVX2 build) | now (AVX2 build) |
-//! |---|---|---|
-//! | trilinear, `sample_pixels` | 146 / 134 | 58.6 |
-//! | span K3, `sample_quads` | 134 / 121 | 46.8 |
-//! | span K4, `sample_quads` | 133 / 120 | 46.0 |
+//! | kernel | first lanes (SSE2 / AVX2 build) | third round (AVX2) | fourth round (AVX2) |
+//! |---|---|---|---|
+//! | trilinear, `sample_pixels` | 146 / 134 | 58.6 | 58.6 |
+//! | span K3, `sample_quads` | 134 / 121 | 46.8 | 46.75 |
+//! | span K4, `sample_quads` | 133 / 120 | 46.0 | 46.0 |
+//! | trilinear, one `sample_quad` per quad | – | 161.7 | 155.8 |
+//! | span K3, one `sample_quad` per quad | – | 109.1 | 84.0 |
+//! | span K4, one `sample_quad` per quad | – | 108.0 | 83.5 |
+//!
+//! **One span per call** (fourth round, Intel Xeon; docs/PERFORMANCE.md, "Fourth round"): the
+//! one-span path was SLOWER than trilinear's per quad (23–26 against ~16–17 ns per sample of
+//! thread CPU) with fewer instructions. Measured causes and fixes, all bit-identical: (1) a
+//! store-forwarding stall: LLVM read the quad's images with a 16-byte load at bytes 4..20,
+//! straddling the caller's two 16-byte stores of the quad (`perf`: ~15 % of the kernel's samples
+//! on the two instructions after it); now two loads, one per half. (2) The call is one chain
+//! (images -> repeat shift -> extent -> level -> coordinates -> floors -> indices -> texels -> 3
+//! lerps), and nearly every instruction hangs on it, so the scheduler fills with one call and
+//! the next cannot start: what counts is the chain's length and the instruction count. The
+//! power-of-two kernel keeps x and y of the four pixels in one 256-bit register
+//! (`[x0 y0 x2 y2 | x1 y1 x3 y3]`: extremes, coordinates, floors and fractions of both axes at
+//! once, a pixel pair's weights by in-lane broadcasts), builds the level scales from the level's
+//! bits in lanes (no round trip through integer registers), reduces the shifted extremes instead
+//! of the shifted lanes, takes each texel index straight from the truncated coordinate (equal to
+//! the floor in an interior window; no window corner on the index path) and checks the ±2^30
+//! clamp beside the chain (lanes out of range take the edge path). llvm-mca (icelake-server) on
+//! the kernel's hot path: 206 -> 163 cycles per call alone, 157 -> 119 back to back. (3) The
+//! generic `sample_quad` frame (six saved registers, 0x338 bytes of stack) cost ~35
+//! instructions per call: `sample_quad` is now an inlined dispatch, the span on power-of-two
+//! pyramids with AVX2 tail-calls its kernel and trilinear has its own out-of-line entry (the same
+//! saving for trilinear: 161.7 -> 155.8). Tried and dropped: taking the extent before the repeat
+//! shift (it differs in the last bit on two spans in three on the bench's plane: lanes small next
+//! to the texture width lose bits in the shift).
 //!
 //! Of span K3's 46.8: set-up per eight spans 18.1, per pixel 26.7 (8 texel loads, 10.5 in lerps
 //! and the Eq. 4 blend, 2.9 weight permutes, 5.3 index loads, stores and branches) and 2.0 for
@@ -123,8 +152,9 @@
 //! cache simulation, per sample): 0.30 L1 read misses and 0.04 last-level misses for K3 against
 //! trilinear's 0.93 and 0.27 (K4: 0.56 and 0.26, its level pair is trilinear's), which is worth
 //! more as the instruction counts fall: in thread CPU time (best frame) K3 ran ~1.4x and K4
-//! ~1.3x trilinear on the shared machine, not the 1.5x of issue #2 (figures, commands and load in
-//! the fragment; the quiet re-measurement decides).
+//! ~1.3x trilinear on the shared AMD machine; on the Intel Xeon of the fourth round ~1.4x (best
+//! frame; K4 too) and 1.4–1.8x in criterion's thread CPU (load ~3, ±35 % between runs): the 1.5x
+//! of issue #2 shows up in time only where the memory advantage weighs; in instructions 1.25x.
 //!
 //! Measured and rejected or left: LLVM turns a constant-index `vpermps` into `vshufps` +
 //! `vpermpd` (two instructions per weight): the lane order `[0 2 4 6 | 1 3 5 7]` (trilinear) and
