@@ -398,8 +398,9 @@ pub(crate) trait Kernel: Sync {
     fn raster(&self, recs: &[Proj], tile: TileRect, buf: &mut TileBuf);
     /// The order in which both passes take the tile's records: the bin itself (the default),
     /// or a reordered copy in `scratch` (bins of at most [`ORDER_MAX`] records). Winner
-    /// indices are positions in the returned slice. A kernel that reorders must keep the
-    /// winners those of bin order (see the ray-cast kernel's front-to-back order).
+    /// indices are positions in the returned slice. The order must depend on the records alone
+    /// (determinism); it decides exact depth ties, which the first record visited wins (see the
+    /// ray-cast kernel's front-to-back order).
     fn order<'r>(&self, recs: &'r [Proj], _scratch: &'r mut [Proj; ORDER_MAX]) -> &'r [Proj] {
         recs
     }
