@@ -25,7 +25,7 @@ use std::sync::OnceLock;
 
 use glam::Vec3;
 use texmap_core::color::linear_to_srgb8_fast;
-use texmap_core::shade::{Lighting, Material};
+use texmap_core::shade::{Lighting, MAX_LIGHTS, Material};
 
 /// `log2(x)` for finite `x > 0` (absolute error ≲ 1e-7 on normal numbers).
 #[inline(always)]
@@ -313,48 +313,108 @@ pub(crate) fn shade_lanes<V: Simd8>(
     shin: V,
     pw: SpecPow,
 ) -> [V; 3] {
+    let a = (n, v, base, spec_k, shin, pw);
+    // The build for this light count (the same operations as one generic loop).
+    macro_rules! with {
+        ($n:literal) => {
+            shade_lanes_n(
+                &LanesLighting::<V, $n>::new(l),
+                a.0,
+                a.1,
+                a.2,
+                a.3,
+                a.4,
+                a.5,
+            )
+        };
+    }
+    const { assert!(MAX_LIGHTS == 4) };
+    match l.lights().len() {
+        0 => with!(0),
+        1 => with!(1),
+        2 => with!(2),
+        3 => with!(3),
+        _ => with!(4),
+    }
+}
+
+/// A [`Lighting`] with exactly `N` lights, its constants splat into lanes once (per tile) for
+/// [`shade_lanes_n`].
+#[derive(Clone, Copy)]
+pub(crate) struct LanesLighting<V, const N: usize> {
+    ambient: [V; 3],
+    dir: [[V; 3]; N],
+    color: [[V; 3]; N],
+}
+
+impl<V: Simd8, const N: usize> LanesLighting<V, N> {
+    /// `l`'s constants as lanes (`l` must have `N` lights).
+    #[inline(always)]
+    pub(crate) fn new(l: &Lighting) -> Self {
+        debug_assert_eq!(l.lights().len(), N);
+        let v3 = |a: Vec3| [V::splat(a.x), V::splat(a.y), V::splat(a.z)];
+        LanesLighting {
+            ambient: v3(l.ambient),
+            dir: std::array::from_fn(|i| v3(l.lights()[i].to_light)),
+            color: std::array::from_fn(|i| v3(l.lights()[i].color)),
+        }
+    }
+}
+
+/// The body of [`shade_lanes`] for a lighting of `N` lights known at compile time: the light
+/// loops unroll, and a caller that shades many chunks (the ray-cast resolve) makes `l` once per
+/// tile, so the lights' constants stay in registers instead of being splat per chunk. Lights
+/// are taken two at a time (their specular powers share one squaring loop, see `pow_int8`) and
+/// their terms added in the lights' order.
+#[inline(always)]
+pub(crate) fn shade_lanes_n<V: Simd8, const N: usize>(
+    l: &LanesLighting<V, N>,
+    n: [V; 3],
+    v: [V; 3],
+    base: [V; 3],
+    spec_k: V,
+    shin: V,
+    pw: SpecPow,
+) -> [V; 3] {
     let mut c = [
-        base[0] * V::splat(l.ambient.x),
-        base[1] * V::splat(l.ambient.y),
-        base[2] * V::splat(l.ambient.z),
+        base[0] * l.ambient[0],
+        base[1] * l.ambient[1],
+        base[2] * l.ambient[2],
     ];
     let zero = V::splat(0.0);
     let tiny = V::splat(1e-30);
-    // Lights two at a time: their specular powers share one squaring loop (see `pow_int8`);
-    // the terms are added in the lights' order, so the sums are the same as one at a time.
-    for pair in l.lights().chunks(2) {
+    let mut p = 0;
+    while p < N {
+        let m = (N - p).min(2);
         let mut ndl = [zero; 2];
         let mut ndh = [zero; 2];
         let mut pos = [zero.lt(zero); 2];
-        for (i, light) in pair.iter().enumerate() {
-            let a = light.to_light;
-            let (ax, ay, az) = (V::splat(a.x), V::splat(a.y), V::splat(a.z));
-            // Lambert term n·l.
+        for i in 0..m {
+            let [ax, ay, az] = l.dir[p + i];
             ndl[i] = n[0] * ax + n[1] * ay + n[2] * az;
-            // Blinn half vector h = l + v and n·h/|h|.
             let hx = ax + v[0];
             let hy = ay + v[1];
             let hz = az + v[2];
             let hh = hx * hx + hy * hy + hz * hz;
             let nh = n[0] * hx + n[1] * hy + n[2] * hz;
             let q = nh / hh.sqrt();
-            // Clamp to (0, 1]; lanes at 0 (or NaN from hh = 0) are masked after the pow.
             pos[i] = q.gt(tiny);
             ndh[i] = V::select(pos[i], q.min(V::splat(1.0)), tiny);
         }
         let pw2 = match pw {
-            SpecPow::Same { .. } | SpecPow::Ints { .. } if pair.len() == 2 => pow_int8(ndh, &pw),
+            SpecPow::Same { .. } | SpecPow::Ints { .. } if m == 2 => pow_int8(ndh, &pw),
             SpecPow::Same { .. } | SpecPow::Ints { .. } => [pow_int8([ndh[0]], &pw)[0], zero],
             SpecPow::Poly => ndh.map(|x| pow_poly8(x, shin)),
         };
-        for (i, light) in pair.iter().enumerate() {
+        for i in 0..m {
             let spec = V::select(pos[i], spec_k * pw2[i], zero);
             let lit = ndl[i].gt(zero);
             for k in 0..3 {
                 let term = base[k] * ndl[i] + spec;
-                c[k] = c[k] + V::select(lit, V::splat(light.color[k]) * term, zero);
+                c[k] = c[k] + V::select(lit, l.color[p + i][k] * term, zero);
             }
         }
+        p += 2;
     }
     c
 }

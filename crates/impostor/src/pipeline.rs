@@ -440,6 +440,35 @@ pub(crate) trait Kernel: Sync {
     }
 }
 
+/// `dst.fill(v)` eight elements per store: `<[T]>::fill` on `[u8; 4]` pixels (and on `f32`
+/// depths) compiles to one 4-byte store per element, which made the background of an empty
+/// 500x500 frame cost ~0.9 M instructions; whole `[T; 8]` blocks become 256-bit stores.
+#[inline(always)]
+pub(crate) fn fill8<T: Copy>(dst: &mut [T], v: T) {
+    let mut blocks = dst.chunks_exact_mut(8);
+    for b in &mut blocks {
+        let b: &mut [T; 8] = b.try_into().expect("chunks of 8");
+        *b = [v; 8];
+    }
+    for x in blocks.into_remainder() {
+        *x = v;
+    }
+}
+
+/// `dst.copy_from_slice(src)` for a tile row (at most [`TILE`] elements): whole rows as one
+/// fixed-size copy (inlined vector moves) instead of a `memcpy` call per row.
+#[inline(always)]
+pub(crate) fn copy_row<T: Copy>(dst: &mut [T], src: &[T]) {
+    const T_: usize = TILE as usize;
+    match (
+        <&mut [T; T_]>::try_from(&mut *dst),
+        <&[T; T_]>::try_from(src),
+    ) {
+        (Ok(d), Ok(s)) => *d = *s,
+        _ => dst.copy_from_slice(src),
+    }
+}
+
 /// Clip a record's box to a tile: `(x0, y0, x1, y1)` in tile-local pixels, or `None`.
 #[inline]
 pub(crate) fn clip(p: &Proj, t: TileRect) -> Option<(u32, u32, u32, u32)> {
@@ -489,13 +518,13 @@ pub(crate) fn draw_tiles<K: Kernel>(
                     // Nothing here: background.
                     for j in 0..th as usize {
                         let o = j * w + x0 as usize;
-                        color[o..o + tw as usize].fill(background);
-                        depth[o..o + tw as usize].fill(f32::INFINITY);
+                        fill8(&mut color[o..o + tw as usize], background);
+                        fill8(&mut depth[o..o + tw as usize], f32::INFINITY);
                     }
                     continue;
                 }
-                buf.depth.fill(f32::INFINITY);
-                buf.win.fill(NONE);
+                fill8(&mut buf.depth, f32::INFINITY);
+                fill8(&mut buf.win, NONE);
                 // Depth pass over the bin, in the kernel's order.
                 let recs = kernel.order(recs, &mut scratch);
                 kernel.raster(recs, tile, &mut buf);
@@ -506,7 +535,10 @@ pub(crate) fn draw_tiles<K: Kernel>(
                 for j in 0..th as usize {
                     let o = j * w + x0 as usize;
                     let bw = j * TILE as usize;
-                    depth[o..o + tw as usize].copy_from_slice(&buf.depth[bw..bw + tw as usize]);
+                    copy_row(
+                        &mut depth[o..o + tw as usize],
+                        &buf.depth[bw..bw + tw as usize],
+                    );
                 }
             }
         });

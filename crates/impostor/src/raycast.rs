@@ -465,6 +465,32 @@ fn resolve_persp<V: Simd8>(
     color: &mut [[u8; 4]],
     stride: usize,
 ) {
+    // One build per light count (0 to MAX_LIGHTS): the light loops unroll and the lights'
+    // constants stay in registers across the tile.
+    const { assert!(texmap_core::shade::MAX_LIGHTS == 4) };
+    // Direct calls (not a function pointer): each build inlines into the caller's
+    // `#[target_feature]` function, whose intrinsics it needs inlined.
+    let a = (k, recs, tile, buf, background, color, stride);
+    match k.lighting.lights().len() {
+        0 => resolve_persp_n::<V, 0>(a.0, a.1, a.2, a.3, a.4, a.5, a.6),
+        1 => resolve_persp_n::<V, 1>(a.0, a.1, a.2, a.3, a.4, a.5, a.6),
+        2 => resolve_persp_n::<V, 2>(a.0, a.1, a.2, a.3, a.4, a.5, a.6),
+        3 => resolve_persp_n::<V, 3>(a.0, a.1, a.2, a.3, a.4, a.5, a.6),
+        _ => resolve_persp_n::<V, 4>(a.0, a.1, a.2, a.3, a.4, a.5, a.6),
+    }
+}
+
+/// [`resolve_persp`] for a lighting of `N` lights.
+#[inline(always)]
+fn resolve_persp_n<V: Simd8, const N: usize>(
+    k: &Perspective<V>,
+    recs: &[Proj],
+    tile: TileRect,
+    buf: &TileBuf,
+    background: [u8; 4],
+    color: &mut [[u8; 4]],
+    stride: usize,
+) {
     let v = &k.view;
     // Ray directions of the tile's columns (plus lane slack) and rows (pixel centres).
     let mut dxs = [0f32; TILE as usize + LANES];
@@ -472,6 +498,7 @@ fn resolve_persp<V: Simd8>(
         *dx = ((tile.x0 as usize + i) as f32 + 0.5 - v.cx) * v.inv_k;
     }
     let enc = fastshade::srgb_table32();
+    let lights = fastshade::LanesLighting::<V, N>::new(&k.lighting);
     let bgv = V::splat_bits(u32::from_le_bytes(background));
     let none = V::splat_bits(NONE);
     let sign = V::splat_bits(FLAG_INSIDE);
@@ -487,7 +514,7 @@ fn resolve_persp<V: Simd8>(
             // Covered lanes of this chunk (lanes past the tile hold NONE too).
             let covered = !win.eq_bits(none).bits() & ((1u32 << n) - 1);
             if covered == 0 {
-                out[i..i + n].fill(background);
+                pipeline::fill8(&mut out[i..i + n], background);
                 i += LANES;
                 continue;
             }
@@ -552,7 +579,7 @@ fn resolve_persp<V: Simd8>(
                 Some(p) => p,
                 None => fastshade::spec_pow_of(shin),
             };
-            let c = fastshade::shade_lanes(&k.lighting, nrm, to_eye, [br, bg, bb], spec, shin, pow);
+            let c = fastshade::shade_lanes_n(&lights, nrm, to_eye, [br, bg, bb], spec, shin, pow);
             // Encode to sRGB8 (texmap-core's table), background where nothing won.
             let px = V::select(
                 win.eq_bits(none),
@@ -907,7 +934,7 @@ mod tests {
         let view = View::new(cam);
         let lighting = lighting.to_eye(cam);
         let mut bins = Bins::default();
-        bins.build(&scene, &view, |c, r, k| project(&view, c, r, k));
+        bins.build(scene, &view, |c, r, k| project(&view, c, r, k));
         let mut rows = Vec::new();
         let k = Perspective::<V8>::new(view, lighting, &scene.materials, &mut rows).unwrap();
         let mut worst = 0i32;
