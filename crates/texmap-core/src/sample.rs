@@ -92,6 +92,13 @@
 //!   texel) and stored once, one load per index; two pixels per 256-bit register for the taps,
 //!   lerps and blend, their weights by one in-lane `vpermilps` (lanes ordered so that a pixel
 //!   pair shares a lane of the two halves), one 256-bit store per pair; `roundps` floors.
+//! - `sample/avx512.rs`: where the CPU has AVX-512F/VL/BW/DQ, the span sampler with K = 3 reads
+//!   each span's interior 3x3 window as Seed 000's mspan (three masked 512-bit row loads, one
+//!   zmm = four pixels x RGBA; each pixel's 2x2 picked by four `vpermt2ps` per level; the three
+//!   Eq. 4 lerps and the level blend on the four pixels at once), the AVX2 eight-span set-up
+//!   compiled with the AVX-512 features. Per-pixel trilinear has an AVX-512 build too (four
+//!   pixels per zmm), measured SLOWER than its AVX2 build on the Sapphire Rapids-class Xeon and
+//!   therefore not chosen (`lanes::TRILINEAR_AVX512`); K = 4 keeps the AVX2 kernel.
 //!
 //! Both builds are bit-identical to the scalar kernels and to the bank emulator (no FMA anywhere;
 //! tests below, which fail under mutations of the weights, blend masks and indices).
@@ -186,6 +193,12 @@ use crate::mip::{LevelInfo, MipTexture, Wrap};
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
+// AVX-512 intrinsics are stable since Rust 1.89, past the workspace's rust-version (1.85),
+// which the AVX-512 `target_feature`s already used by impostor (also 1.89) require as well:
+// the rust-version is the workspace's to move.
+#[cfg(target_arch = "x86_64")]
+#[allow(clippy::incompatible_msrv)]
+mod avx512;
 #[cfg(target_arch = "x86_64")]
 mod lanes;
 
@@ -1563,6 +1576,81 @@ mod tests {
         lanes::span_quads4::<RepeatPow2, 3>(&t, &quads, &mut qa);
         lanes::span_quads4_best::<RepeatPow2, 3>(&t, &quads, &mut qb);
         assert_eq!(bits(qa.as_flattened()), bits(qb.as_flattened()));
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn avx512_lane_builds_match_the_sse2_baseline_bit_for_bit() {
+        // The AVX-512 kernels (per-pixel trilinear four pixels per zmm; the span sampler's mspan
+        // read, K = 3) against the SSE2 baseline over every input regime of `random_pixels` /
+        // `random_quads` on square, wide, tall and tiny power-of-two pyramids, both wraps (edge
+        // windows included: they take the AVX2 edge path). Skipped where the CPU lacks AVX-512.
+        if !lanes::has_avx512() {
+            eprintln!("no AVX-512 on this CPU: the AVX-512 builds are not tested here");
+            return;
+        }
+        let bits = |v: &[Vec4]| {
+            v.iter()
+                .map(|c| c.to_array().map(f32::to_bits))
+                .collect::<Vec<_>>()
+        };
+        let (mut interior, mut edge) = (0u64, 0u64);
+        for (w, h) in [
+            (64, 64),
+            (256, 64),
+            (16, 128),
+            (1, 8),
+            (2, 2),
+            (4, 4),
+            (128, 128),
+        ] {
+            for wrap in [Wrap::Repeat, Wrap::Clamp] {
+                let t = ramp(w, h, wrap);
+                let (uv, dx, dy) = random_pixels(4000, w * 7 + h);
+                let quads = random_quads(4000, w * 11 + h);
+                let (mut a, mut b) = (vec![Vec4::ZERO; uv.len()], vec![Vec4::ZERO; uv.len()]);
+                let (mut qa, mut qb) = (
+                    vec![[Vec4::ZERO; 4]; quads.len()],
+                    vec![[Vec4::ZERO; 4]; quads.len()],
+                );
+                macro_rules! run {
+                    ($A:ty) => {{
+                        let na = lanes::trilinear_pixels::<$A>(&t, &uv, &dx, &dy, &mut a);
+                        // SAFETY: AVX-512F/VL/BW/DQ detected above; `t` is a power of two.
+                        let nb =
+                            unsafe { avx512::trilinear_pixels::<$A>(&t, &uv, &dx, &dy, &mut b) };
+                        assert_eq!((na, nb), (4000, 4000));
+                        lanes::span_quads4::<$A, 3>(&t, &quads, &mut qa);
+                        // SAFETY: as above.
+                        let nq = unsafe { avx512::span_quads_k3::<$A>(&t, &quads, &mut qb) };
+                        assert_eq!(nq, 4000);
+                    }};
+                }
+                match wrap {
+                    Wrap::Repeat => run!(RepeatPow2),
+                    Wrap::Clamp => run!(ClampEdge),
+                }
+                assert_eq!(bits(&a), bits(&b), "trilinear {w}x{h} {wrap:?}");
+                for (i, (x, y)) in qa.iter().zip(&qb).enumerate() {
+                    assert_eq!(
+                        bits(x),
+                        bits(y),
+                        "span K3 {w}x{h} {wrap:?} quad {i} {:?}",
+                        quads[i]
+                    );
+                }
+                let bt = BankedTexture::new(&t, Banks::K3);
+                let mut st = BankStats::default();
+                for q in &quads {
+                    bt.sample_quad(&t, *q, &mut st);
+                }
+                assert_eq!(st.conflicts, 0);
+                interior += st.window_reads - st.edge_windows;
+                edge += st.edge_windows;
+            }
+        }
+        assert!(interior > 10_000, "too few interior windows: {interior}");
+        assert!(edge > 1_000, "too few edge windows: {edge}");
     }
 
     #[test]

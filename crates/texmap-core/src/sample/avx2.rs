@@ -36,7 +36,7 @@ use crate::mip::{LevelInfo, MipTexture};
 
 /// The level-offset table of a texture in two registers (levels 0–7 and 8–15).
 #[derive(Clone, Copy)]
-struct Offsets {
+pub(super) struct Offsets {
     lo: __m256i,
     hi: __m256i,
 }
@@ -160,7 +160,7 @@ fn level_offset8(t: Offsets, lvl: __m256i) -> __m256i {
 
 /// Eight `i32` lanes as an array (stored once, read per pixel).
 #[inline(always)]
-fn to_u32x8(v: __m256i) -> [u32; 8] {
+pub(super) fn to_u32x8(v: __m256i) -> [u32; 8] {
     // SAFETY: same size, no invalid bit patterns.
     unsafe { core::mem::transmute::<__m256i, [u32; 8]>(v) }
 }
@@ -214,21 +214,21 @@ fn bc<const I: i32>(v: __m256) -> __m256 {
 
 /// One level of eight pixels (lanes `[0 2 4 6 | 1 3 5 7]`): the doubled texel indices of their
 /// 2x2 taps and their weights.
-struct TriLevel {
+pub(super) struct TriLevel {
     /// `[t00, t10, t01, t11][lane]`.
-    idx: [[u32; 8]; 4],
-    ax: __m256,
-    ay: __m256,
+    pub(super) idx: [[u32; 8]; 4],
+    pub(super) ax: __m256,
+    pub(super) ay: __m256,
     /// Lane mask of pixels whose 2x2 is split by the level edge (`x1 ≠ x0 + 1` or
     /// `y1 ≠ y0 + 1`); where it is 0, `t10 = t00 + 1` and `t11 = t01 + 1`.
-    edge: i32,
+    pub(super) edge: i32,
 }
 
 /// Seed 000 Eq. (3) on `2^L r_m − ½` for eight pixels at levels `lvl`: the SSE2 `level_lanes`
 /// arithmetic lane for lane, then the texel indices in lanes.
 #[inline]
 #[target_feature(enable = "avx2")]
-fn tri_level<A: Addr>(
+pub(super) fn tri_level<A: Addr>(
     u: __m256,
     v: __m256,
     lvl: __m256i,
@@ -296,6 +296,105 @@ unsafe fn tri_pair<const K: usize, const I: i32, const INSIDE: bool>(
     lerp8(lerp8(t00, t10, wx), lerp8(t01, t11, wx), wy)
 }
 
+/// A texture's constants for [`tri_step`].
+#[derive(Clone, Copy)]
+pub(super) struct TriSetup {
+    sw: __m256,
+    sh: __m256,
+    last: i32,
+    pub(super) nw: i32,
+    pub(super) nh: i32,
+    pub(super) offs: Offsets,
+}
+
+impl TriSetup {
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    pub(super) fn new(tex: &MipTexture) -> TriSetup {
+        let l0 = &tex.levels()[0];
+        TriSetup {
+            sw: _mm256_set1_ps(l0.width_f),
+            sh: _mm256_set1_ps(l0.height_f),
+            last: tex.level_count() as i32 - 1,
+            nw: tex.width().trailing_zeros() as i32,
+            nh: tex.height().trailing_zeros() as i32,
+            offs: offsets(tex),
+        }
+    }
+}
+
+/// Eight pixels' map coordinates, two levels, Eq. (4) weight and single-level lanes (`sv` as a
+/// lane mask, `single` as bits), lanes `[0 2 4 6 | 1 3 5 7]`.
+pub(super) struct TriStep {
+    pub(super) u: __m256,
+    pub(super) v: __m256,
+    pub(super) i0: __m256i,
+    pub(super) i1: __m256i,
+    pub(super) frac: __m256,
+    pub(super) sv: __m256,
+    pub(super) single: i32,
+}
+
+/// The set-up of pixels `i..i + 8` (shared by the AVX2 and AVX-512 builds): Seed 000 Eq. (2)'s
+/// footprint and the level split as the SSE2 `trilinear4` (the caller then runs [`tri_level`] on
+/// both levels, where the indices are to stay: moving them costs copies).
+///
+/// # Safety
+/// `i + 8` must not exceed the length of `uv`, `dx` and `dy`.
+#[inline]
+#[target_feature(enable = "avx2")]
+pub(super) unsafe fn tri_step<A: Addr>(
+    c: &TriSetup,
+    i: usize,
+    uv: &[Vec2],
+    dx: &[Vec2],
+    dy: &[Vec2],
+) -> TriStep {
+    let TriSetup { sw, sh, last, .. } = *c;
+    let abs = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fff_ffff));
+    // SAFETY: the caller's contract (8 Vec2 = 16 floats from `i` in each slice).
+    let ((u, v), (dxu, dxv), (dyu, dyv)) = unsafe {
+        (
+            deinterleave8(uv.as_ptr().add(i) as *const f32),
+            deinterleave8(dx.as_ptr().add(i) as *const f32),
+            deinterleave8(dy.as_ptr().add(i) as *const f32),
+        )
+    };
+    // Seed 000 Eq. (2): the footprint, NaN terms as 0 (as `footprint4`).
+    let z = _mm256_setzero_ps();
+    let a = |d: __m256, s: __m256| _mm256_max_ps(_mm256_and_ps(_mm256_mul_ps(d, s), abs), z);
+    let m = _mm256_max_ps(
+        _mm256_max_ps(a(dxu, sw), a(dyu, sw)),
+        _mm256_max_ps(a(dxv, sh), a(dyv, sh)),
+    );
+    // λ = log2 m split into ⌊λ⌋ and frac(λ); level pair as `trilinear4`.
+    let (e, frac) = log2_split8(m);
+    let minified = _mm256_castps_si256(_mm256_cmp_ps::<_CMP_GT_OQ>(m, _mm256_set1_ps(1.0)));
+    let past_top = _mm256_cmpgt_epi32(e, _mm256_set1_epi32(last - 1));
+    let top = _mm256_set1_epi32(last);
+    let all = _mm256_set1_epi32(-1);
+    let i0 = _mm256_and_si256(
+        minified,
+        _mm256_or_si256(
+            _mm256_and_si256(past_top, top),
+            _mm256_andnot_si256(past_top, e),
+        ),
+    );
+    let single_v = _mm256_or_si256(_mm256_andnot_si256(minified, all), past_top);
+    let i1 = _mm256_sub_epi32(i0, _mm256_andnot_si256(single_v, all));
+    let sv = _mm256_castsi256_ps(single_v);
+    let single = _mm256_movemask_ps(sv);
+    TriStep {
+        u,
+        v,
+        i0,
+        i1,
+        frac,
+        sv,
+        single,
+    }
+}
+
 /// Pixels `2k`, `2k + 1` of a step: level `a`, or Eq. (4)'s blend with level `b` by `frac`
 /// where the pixel blends two levels (`single`: lane mask of single-level pixels).
 ///
@@ -347,52 +446,27 @@ pub(super) unsafe fn trilinear_pixels<A: Addr>(
     out: &mut [Vec4],
 ) -> usize {
     debug_assert!(tex.is_pow2());
-    let l0 = &tex.levels()[0];
-    let last = tex.level_count() as i32 - 1;
-    let nw = tex.width().trailing_zeros() as i32;
-    let nh = tex.height().trailing_zeros() as i32;
-    let offs = offsets(tex);
+    let c = TriSetup::new(tex);
     let base = tex.texels().as_ptr() as *const u8;
     let n = uv.len().min(dx.len()).min(dy.len()).min(out.len()) / 8 * 8;
-    let (sw, sh) = (_mm256_set1_ps(l0.width_f), _mm256_set1_ps(l0.height_f));
-    let abs = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fff_ffff));
     for i in (0..n).step_by(8) {
         // SAFETY: i + 8 ≤ n ≤ every slice's length (8 Vec2 = 16 floats, 8 Vec4 = 32 floats);
         // the indices come from `tri_level` on this texture.
         unsafe {
-            let (u, v) = deinterleave8(uv.as_ptr().add(i) as *const f32);
-            let (dxu, dxv) = deinterleave8(dx.as_ptr().add(i) as *const f32);
-            let (dyu, dyv) = deinterleave8(dy.as_ptr().add(i) as *const f32);
-            // Seed 000 Eq. (2): the footprint, NaN terms as 0 (as `footprint4`).
-            let z = _mm256_setzero_ps();
-            let a =
-                |d: __m256, s: __m256| _mm256_max_ps(_mm256_and_ps(_mm256_mul_ps(d, s), abs), z);
-            let m = _mm256_max_ps(
-                _mm256_max_ps(a(dxu, sw), a(dyu, sw)),
-                _mm256_max_ps(a(dxv, sh), a(dyv, sh)),
-            );
-            // λ = log2 m split into ⌊λ⌋ and frac(λ); level pair as `trilinear4`.
-            let (e, frac) = log2_split8(m);
-            let minified = _mm256_castps_si256(_mm256_cmp_ps::<_CMP_GT_OQ>(m, _mm256_set1_ps(1.0)));
-            let past_top = _mm256_cmpgt_epi32(e, _mm256_set1_epi32(last - 1));
-            let top = _mm256_set1_epi32(last);
-            let all = _mm256_set1_epi32(-1);
-            let i0 = _mm256_and_si256(
-                minified,
-                _mm256_or_si256(
-                    _mm256_and_si256(past_top, top),
-                    _mm256_andnot_si256(past_top, e),
-                ),
-            );
-            let single_v = _mm256_or_si256(_mm256_andnot_si256(minified, all), past_top);
-            let i1 = _mm256_sub_epi32(i0, _mm256_andnot_si256(single_v, all));
-            let mut pa = tri_level::<A>(u, v, i0, nw, nh, offs);
-            let mut pb = tri_level::<A>(u, v, i1, nw, nh, offs);
+            let TriStep {
+                u,
+                v,
+                i0,
+                i1,
+                frac,
+                sv,
+                single,
+            } = tri_step::<A>(&c, i, uv, dx, dy);
+            let mut pa = tri_level::<A>(u, v, i0, c.nw, c.nh, c.offs);
+            let mut pb = tri_level::<A>(u, v, i1, c.nw, c.nh, c.offs);
             // Keep the indices in memory: one load per index (else LLVM keeps the vectors and
             // extracts lanes, three instructions per index).
             core::hint::black_box((&mut pa.idx, &mut pb.idx));
-            let sv = _mm256_castsi256_ps(single_v);
-            let single = _mm256_movemask_ps(sv);
             let o = out.as_mut_ptr().add(i) as *mut f32;
             if pa.edge | pb.edge == 0 {
                 tri_out::<0, 0x00, true>(base, &pa, &pb, frac, sv, single, o);
@@ -425,17 +499,32 @@ struct SpanLevel {
     ok: i32,
 }
 
+/// One level's K x K windows of eight spans (Seed 000 Eq. 10, lanes = spans): each pixel's
+/// Eq. (4) weights (`[pixel]`, lanes = spans), the corner's texel index, the level width, and
+/// the lane bits of interior windows (`ok`).
+pub(super) struct SpanWindow {
+    pub(super) ax: [__m256; 4],
+    pub(super) ay: [__m256; 4],
+    pub(super) corner: __m256i,
+    pub(super) wi: __m256i,
+    pub(super) ok: i32,
+}
+
 /// Seed 000 Eq. (10) for eight spans at levels `lvl`: the SSE2 `span_level4` arithmetic lane
-/// for lane, then the indices in lanes and the weights arranged by pixel pair.
+/// for lane (shared by the AVX2 and AVX-512 builds). `offset(j, ox, oy, corner, wf)` receives
+/// pixel `j`'s offset from the window corner (lanes = spans) as soon as it is known, with the
+/// corner's texel index and the level width (inside the loop that makes the offsets: with all
+/// eight live at once the AVX2 build spills registers).
 #[inline]
 #[target_feature(enable = "avx2")]
-fn span_level<A: Addr, const K: usize>(
+pub(super) fn span_window<A: Addr, const K: usize>(
     tex: &MipTexture,
     lvl: __m256i,
     sx: &[__m256; 4],
     sy: &[__m256; 4],
     offs: Offsets,
-) -> SpanLevel {
+    mut offset: impl FnMut(usize, __m256, __m256, __m256i, __m256),
+) -> SpanWindow {
     let l0 = &tex.levels()[0];
     let nw = tex.width().trailing_zeros() as i32;
     let nh = tex.height().trailing_zeros() as i32;
@@ -476,7 +565,6 @@ fn span_level<A: Addr, const K: usize>(
     );
     let lim = _mm256_set1_ps((K - 2) as f32);
     let mut over = z;
-    let mut idx = [[0u32; 8]; 4];
     for j in 0..4 {
         let ox = _mm256_sub_ps(flx[j], mx);
         let oy = _mm256_sub_ps(fly[j], my);
@@ -487,9 +575,7 @@ fn span_level<A: Addr, const K: usize>(
                 _mm256_cmp_ps::<_CMP_GT_OQ>(oy, lim),
             ),
         );
-        // corner + oy·w + ox (oy·w + ox: small non-negative integers, exact in f32), doubled.
-        let o = _mm256_cvttps_epi32(_mm256_add_ps(_mm256_mul_ps(oy, wf), ox));
-        idx[j] = to_u32x8(_mm256_slli_epi32::<1>(_mm256_add_epi32(corner, o)));
+        offset(j, ox, oy, corner, wf);
     }
     // Interior: x0 ≥ 0, y0 ≥ 0, x0 + K ≤ w, y0 + K ≤ h.
     let k = _mm256_set1_epi32(K as i32);
@@ -502,6 +588,32 @@ fn span_level<A: Addr, const K: usize>(
         ),
     );
     let ok = !_mm256_movemask_ps(_mm256_or_ps(over, _mm256_castsi256_ps(outside))) & 0xff;
+    SpanWindow {
+        ax,
+        ay,
+        corner,
+        wi,
+        ok,
+    }
+}
+
+/// [`span_window`], then the indices in lanes and the weights arranged by pixel pair.
+#[inline]
+#[target_feature(enable = "avx2")]
+fn span_level<A: Addr, const K: usize>(
+    tex: &MipTexture,
+    lvl: __m256i,
+    sx: &[__m256; 4],
+    sy: &[__m256; 4],
+    offs: Offsets,
+) -> SpanLevel {
+    let mut idx = [[0u32; 8]; 4];
+    let SpanWindow { ax, ay, wi, ok, .. } =
+        span_window::<A, K>(tex, lvl, sx, sy, offs, |j, ox, oy, corner, wf| {
+            // corner + oy·w + ox (oy·w + ox: small non-negative integers, exact in f32), doubled.
+            let o = _mm256_cvttps_epi32(_mm256_add_ps(_mm256_mul_ps(oy, wf), ox));
+            idx[j] = to_u32x8(_mm256_slli_epi32::<1>(_mm256_add_epi32(corner, o)));
+        });
     // Weights by pixel pair: [w_2p | w_2p+1] of spans 0-3 (h = 0) and 4-7 (h = 1).
     let pp = |w: &[__m256; 4]| {
         [
@@ -608,7 +720,10 @@ unsafe fn span_out<A: Addr, const K: usize, const S: usize, const I: i32>(
 #[cold]
 #[inline(never)]
 #[target_feature(enable = "avx2")]
-unsafe fn edge_span<A: Addr, const K: usize>(tex: &MipTexture, q: [Vec2; 4]) -> [Vec4; 4] {
+pub(super) unsafe fn edge_span<A: Addr, const K: usize>(
+    tex: &MipTexture,
+    q: [Vec2; 4],
+) -> [Vec4; 4] {
     let p = plan::<A, K>(tex, &q);
     let generic = || super::span_finish::<A, super::Direct, K>(tex, p, &mut super::Direct);
     let Some(a) = edge_level::<A, K>(tex, p.i0, p.sx, p.sy) else {
@@ -761,6 +876,126 @@ unsafe fn edge_pair(base: *const u8, d: &EdgeLevel, p: usize) -> __m256 {
     }
 }
 
+/// A texture's constants for [`span_step`].
+#[derive(Clone, Copy)]
+pub(super) struct SpanSetup<'a> {
+    l0: &'a LevelInfo,
+    last: i32,
+    pub(super) offs: Offsets,
+    sw: __m256,
+    sh: __m256,
+}
+
+impl<'a> SpanSetup<'a> {
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    pub(super) fn new(tex: &'a MipTexture) -> SpanSetup<'a> {
+        let l0 = &tex.levels()[0];
+        SpanSetup {
+            l0,
+            last: tex.level_count() as i32 - 1,
+            offs: offsets(tex),
+            sw: _mm256_set1_ps(l0.width_f),
+            sh: _mm256_set1_ps(l0.height_f),
+        }
+    }
+}
+
+/// Eight spans' level-0 texel coordinates (`sx[j]`, `sy[j]`: pixel `j` of each span, shifted
+/// by whole periods for Repeat), their level pair, Eq. (4) weight and single-level spans.
+pub(super) struct SpanStep {
+    pub(super) sx: [__m256; 4],
+    pub(super) sy: [__m256; 4],
+    pub(super) i0: __m256i,
+    pub(super) i1: __m256i,
+    pub(super) frac: __m256,
+    pub(super) single: i32,
+}
+
+/// The set-up of eight spans (shared by the AVX2 and AVX-512 builds): the images transposed
+/// into lanes, clamped as `span_plan` does, the repeat shift, Seed 000 Eq. (9)'s extent and the
+/// level pair of the level policy.
+#[inline]
+#[target_feature(enable = "avx2")]
+pub(super) fn span_step<A: Addr, const K: usize>(c: &SpanSetup, q: &[[Vec2; 4]; 8]) -> SpanStep {
+    let SpanSetup {
+        l0, last, sw, sh, ..
+    } = *c;
+    // Load the 32 images, spans s and s + 4 in the two halves, and transpose: x[j], y[j]
+    // hold pixel j of the eight spans.
+    // SAFETY: each quad is 4 Vec2 = 8 floats, read unaligned.
+    let ld = |s: usize, h: usize| unsafe {
+        _mm256_loadu2_m128(
+            (q[s + 4].as_ptr() as *const f32).add(4 * h),
+            (q[s].as_ptr() as *const f32).add(4 * h),
+        )
+    };
+    let xy01 = transpose8(ld(0, 0), ld(1, 0), ld(2, 0), ld(3, 0)); // x0 y0 x1 y1
+    let xy23 = transpose8(ld(0, 1), ld(1, 1), ld(2, 1), ld(3, 1)); // x2 y2 x3 y3
+    let mut sx = [
+        clamp_nan0_8(_mm256_mul_ps(xy01[0], sw)),
+        clamp_nan0_8(_mm256_mul_ps(xy01[2], sw)),
+        clamp_nan0_8(_mm256_mul_ps(xy23[0], sw)),
+        clamp_nan0_8(_mm256_mul_ps(xy23[2], sw)),
+    ];
+    let mut sy = [
+        clamp_nan0_8(_mm256_mul_ps(xy01[1], sh)),
+        clamp_nan0_8(_mm256_mul_ps(xy01[3], sh)),
+        clamp_nan0_8(_mm256_mul_ps(xy23[1], sh)),
+        clamp_nan0_8(_mm256_mul_ps(xy23[3], sh)),
+    ];
+    let min4 =
+        |v: &[__m256; 4]| _mm256_min_ps(_mm256_min_ps(v[0], v[1]), _mm256_min_ps(v[2], v[3]));
+    let max4 =
+        |v: &[__m256; 4]| _mm256_max_ps(_mm256_max_ps(v[0], v[1]), _mm256_max_ps(v[2], v[3]));
+    if A::REPEAT {
+        // Shift each span by whole periods so its corner lies in the first period.
+        let px = _mm256_mul_ps(
+            _mm256_floor_ps(_mm256_mul_ps(min4(&sx), _mm256_set1_ps(l0.inv_width_f))),
+            sw,
+        );
+        let py = _mm256_mul_ps(
+            _mm256_floor_ps(_mm256_mul_ps(min4(&sy), _mm256_set1_ps(l0.inv_height_f))),
+            sh,
+        );
+        for j in 0..4 {
+            sx[j] = _mm256_sub_ps(sx[j], px);
+            sy[j] = _mm256_sub_ps(sy[j], py);
+        }
+    }
+    // Seed 000 Eq. (9): span level from the extent of the four images.
+    let ext = _mm256_max_ps(
+        _mm256_sub_ps(max4(&sx), min4(&sx)),
+        _mm256_sub_ps(max4(&sy), min4(&sy)),
+    );
+    let (e, frac) = log2_split8(ext);
+    // K = 3 takes the pair one level coarser (see the module doc's level policy).
+    let fine = _mm256_add_epi32(e, _mm256_set1_epi32(if K == 3 { 1 } else { 0 }));
+    let below = _mm256_cmpgt_epi32(_mm256_setzero_si256(), fine);
+    let above = _mm256_cmpgt_epi32(fine, _mm256_set1_epi32(last - 1));
+    let top = _mm256_set1_epi32(last);
+    let i0 = _mm256_andnot_si256(
+        below,
+        _mm256_or_si256(
+            _mm256_and_si256(above, top),
+            _mm256_andnot_si256(above, fine),
+        ),
+    );
+    // Blend two levels unless clamped to the pyramid or frac(λ) = 0.
+    let clamped = _mm256_or_si256(below, above);
+    let zero_t = _mm256_castps_si256(_mm256_cmp_ps::<_CMP_EQ_OQ>(frac, _mm256_setzero_ps()));
+    let single = _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_or_si256(clamped, zero_t)));
+    let i1 = _mm256_sub_epi32(i0, _mm256_andnot_si256(clamped, _mm256_set1_epi32(-1)));
+    SpanStep {
+        sx,
+        sy,
+        i0,
+        i1,
+        frac,
+        single,
+    }
+}
+
 /// [`super::lanes::span_quads4`] for AVX2, eight spans per step: bit-identical, whole groups
 /// of eight spans (the caller does the tail).
 ///
@@ -773,78 +1008,19 @@ pub(super) unsafe fn span_quads<A: Addr, const K: usize>(
     out: &mut [[Vec4; 4]],
 ) -> usize {
     debug_assert!(tex.is_pow2());
-    let l0 = &tex.levels()[0];
-    let last = tex.level_count() as i32 - 1;
-    let offs = offsets(tex);
+    let c = SpanSetup::new(tex);
     let base = tex.texels().as_ptr() as *const u8;
     let n = quads.len().min(out.len()) / 8 * 8;
-    let (sw, sh) = (_mm256_set1_ps(l0.width_f), _mm256_set1_ps(l0.height_f));
     for (o, q) in out[..n].chunks_exact_mut(8).zip(quads[..n].chunks_exact(8)) {
-        // Load the 32 images, spans s and s + 4 in the two halves, and transpose: x[j], y[j]
-        // hold pixel j of the eight spans.
-        // SAFETY: each quad is 4 Vec2 = 8 floats, read unaligned.
-        let ld = |s: usize, h: usize| unsafe {
-            _mm256_loadu2_m128(
-                (q[s + 4].as_ptr() as *const f32).add(4 * h),
-                (q[s].as_ptr() as *const f32).add(4 * h),
-            )
-        };
-        let xy01 = transpose8(ld(0, 0), ld(1, 0), ld(2, 0), ld(3, 0)); // x0 y0 x1 y1
-        let xy23 = transpose8(ld(0, 1), ld(1, 1), ld(2, 1), ld(3, 1)); // x2 y2 x3 y3
-        let mut sx = [
-            clamp_nan0_8(_mm256_mul_ps(xy01[0], sw)),
-            clamp_nan0_8(_mm256_mul_ps(xy01[2], sw)),
-            clamp_nan0_8(_mm256_mul_ps(xy23[0], sw)),
-            clamp_nan0_8(_mm256_mul_ps(xy23[2], sw)),
-        ];
-        let mut sy = [
-            clamp_nan0_8(_mm256_mul_ps(xy01[1], sh)),
-            clamp_nan0_8(_mm256_mul_ps(xy01[3], sh)),
-            clamp_nan0_8(_mm256_mul_ps(xy23[1], sh)),
-            clamp_nan0_8(_mm256_mul_ps(xy23[3], sh)),
-        ];
-        let min4 =
-            |v: &[__m256; 4]| _mm256_min_ps(_mm256_min_ps(v[0], v[1]), _mm256_min_ps(v[2], v[3]));
-        let max4 =
-            |v: &[__m256; 4]| _mm256_max_ps(_mm256_max_ps(v[0], v[1]), _mm256_max_ps(v[2], v[3]));
-        if A::REPEAT {
-            // Shift each span by whole periods so its corner lies in the first period.
-            let px = _mm256_mul_ps(
-                _mm256_floor_ps(_mm256_mul_ps(min4(&sx), _mm256_set1_ps(l0.inv_width_f))),
-                sw,
-            );
-            let py = _mm256_mul_ps(
-                _mm256_floor_ps(_mm256_mul_ps(min4(&sy), _mm256_set1_ps(l0.inv_height_f))),
-                sh,
-            );
-            for j in 0..4 {
-                sx[j] = _mm256_sub_ps(sx[j], px);
-                sy[j] = _mm256_sub_ps(sy[j], py);
-            }
-        }
-        // Seed 000 Eq. (9): span level from the extent of the four images.
-        let ext = _mm256_max_ps(
-            _mm256_sub_ps(max4(&sx), min4(&sx)),
-            _mm256_sub_ps(max4(&sy), min4(&sy)),
-        );
-        let (e, frac) = log2_split8(ext);
-        // K = 3 takes the pair one level coarser (see the module doc's level policy).
-        let fine = _mm256_add_epi32(e, _mm256_set1_epi32(if K == 3 { 1 } else { 0 }));
-        let below = _mm256_cmpgt_epi32(_mm256_setzero_si256(), fine);
-        let above = _mm256_cmpgt_epi32(fine, _mm256_set1_epi32(last - 1));
-        let top = _mm256_set1_epi32(last);
-        let i0 = _mm256_andnot_si256(
-            below,
-            _mm256_or_si256(
-                _mm256_and_si256(above, top),
-                _mm256_andnot_si256(above, fine),
-            ),
-        );
-        // Blend two levels unless clamped to the pyramid or frac(λ) = 0.
-        let clamped = _mm256_or_si256(below, above);
-        let zero_t = _mm256_castps_si256(_mm256_cmp_ps::<_CMP_EQ_OQ>(frac, _mm256_setzero_ps()));
-        let single = _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_or_si256(clamped, zero_t)));
-        let i1 = _mm256_sub_epi32(i0, _mm256_andnot_si256(clamped, _mm256_set1_epi32(-1)));
+        let SpanStep {
+            sx,
+            sy,
+            i0,
+            i1,
+            frac,
+            single,
+        } = span_step::<A, K>(&c, q.try_into().expect("eight spans"));
+        let offs = c.offs;
         let mut a = span_level::<A, K>(tex, i0, &sx, &sy, offs);
         let mut b = span_level::<A, K>(tex, i1, &sx, &sy, offs);
         // Keep the indices in memory: one load per index (else LLVM keeps the vectors and

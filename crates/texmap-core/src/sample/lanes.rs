@@ -580,6 +580,25 @@ pub(super) fn has_avx2() -> bool {
     std::arch::is_x86_feature_detected!("avx2")
 }
 
+/// Whether the AVX-512 build of the kernels can run here (F, VL, BW, DQ; cached by the standard
+/// library).
+#[inline]
+pub(super) fn has_avx512() -> bool {
+    std::arch::is_x86_feature_detected!("avx512f")
+        && std::arch::is_x86_feature_detected!("avx512vl")
+        && std::arch::is_x86_feature_detected!("avx512bw")
+        && std::arch::is_x86_feature_detected!("avx512dq")
+}
+
+/// Whether bulk per-pixel trilinear takes its AVX-512 build where the CPU has AVX-512. Off: on
+/// the Sapphire Rapids-class Xeon it was built and measured on (fifth round, /work notes),
+/// best-frame thread CPU per sample was ~12.5–16 ns against the AVX2 build's ~8–9 (interleaved
+/// runs; a 256-bit EVEX build of the AVX2 code and a set-up kept out of line in pure AVX2 were
+/// as slow), so the run-time choice that is fair to trilinear is its AVX2 build. The kernel is
+/// kept and tested bit for bit (`avx512_lane_builds_match_the_sse2_baseline_bit_for_bit`), to
+/// measure again on other CPUs.
+const TRILINEAR_AVX512: bool = false;
+
 /// [`trilinear_pixels`] compiled for AVX2.
 ///
 /// # Safety
@@ -618,7 +637,10 @@ pub(super) fn trilinear_pixels_best<A: Addr>(
     dy: &[Vec2],
     out: &mut [Vec4],
 ) -> usize {
-    if has_avx2() {
+    if TRILINEAR_AVX512 && has_avx512() {
+        // SAFETY: AVX-512F/VL/BW/DQ were detected just above; the callers check `tex.is_pow2()`.
+        unsafe { super::avx512::trilinear_pixels::<A>(tex, uv, dx, dy, out) }
+    } else if has_avx2() {
         // SAFETY: AVX2 was detected just above.
         unsafe { trilinear_pixels_avx2::<A>(tex, uv, dx, dy, out) }
     } else {
@@ -632,7 +654,10 @@ pub(super) fn span_quads4_best<A: Addr, const K: usize>(
     quads: &[[Vec2; 4]],
     out: &mut [[Vec4; 4]],
 ) -> usize {
-    if has_avx2() {
+    if K == 3 && has_avx512() {
+        // SAFETY: AVX-512F/VL/BW/DQ were detected just above; the callers check `tex.is_pow2()`.
+        unsafe { super::avx512::span_quads_k3::<A>(tex, quads, out) }
+    } else if has_avx2() {
         // SAFETY: AVX2 was detected just above.
         unsafe { span_quads4_avx2::<A, K>(tex, quads, out) }
     } else {

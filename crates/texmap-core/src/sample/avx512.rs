@@ -1,0 +1,402 @@
+//! AVX-512 builds of the bulk lane kernels (chosen at run time by [`super::lanes`]'s `*_best`
+//! entry points where the CPU has AVX-512F/VL/BW/DQ; the AVX2 and SSE2 builds stay the
+//! fallbacks), on power-of-two pyramids: per-pixel trilinear eight pixels per step, and the span
+//! sampler with 3x3 banks eight spans per step, its four pixels read as the paper's mspan.
+//!
+//! The arithmetic is the AVX2 / SSE2 / scalar kernels' operation for operation (`a + (b − a)·t`,
+//! no FMA: Rust never contracts a multiply and an add), so the results are the same bits (tested
+//! in `super::tests` against the SSE2 baseline and the bank emulator). The set-up of each step
+//! (footprint or span extent, level pair, level sizes, texel coordinates, floors, weights,
+//! window corners) is the AVX2 build's eight-lane code, here compiled with the AVX-512 features
+//! (EVEX encoding, 32 vector registers). What changes is the per-pixel part:
+//!
+//! - **span sampler (Seed 000 Eq. 8–10, K = 3), the mspan read:** one span = four pixels x RGBA
+//!   = sixteen floats = one zmm. Its interior 3x3 window is read as three rows of three texels
+//!   (three masked 512-bit loads, `_mm512_maskz_loadu_ps(0x0fff, ..)`: the fourth texel's lanes
+//!   are masked off and never touched, so nothing past the window is read) — the one parallel
+//!   read of the nine banks, per level per span. Each pixel then picks its own 2x2 out of it:
+//!   `t00`/`t10` of all four pixels are two `vpermt2ps` over rows (0, 1), `t01`/`t11` the same
+//!   indices over rows (1, 2); four permutes per level per span instead of sixteen texel loads.
+//!   The lanes are channel-major (`c·4 + p`: channel c of pixel p), so a span's four per-pixel
+//!   weights `[w0 w1 w2 w3]` and the offset part of the permute index are 128-bit broadcasts
+//!   from memory (load ports, no shuffle), and one `vpermps` turns the result back into pixel
+//!   order before the one 512-bit store per span. The three Eq. (4) bilinear lerps and the level
+//!   blend (one weight per span, a broadcast load) run on the four pixels at once.
+//! - **per-pixel trilinear (Seed 000 Eq. 2 + 4), for fairness:** the same four pixels per zmm
+//!   for the taps, lerps and blend: each tap of four pixels is one 128-bit load and three
+//!   `vinsertf32x4` from memory, the weights one `vpermps` each, one 512-bit store per four
+//!   pixels; where no pixel of the eight sits on a level edge it takes two indices per pixel
+//!   and level, as the AVX2 build does.
+//!
+//! Spans whose window is not interior (a level edge, or a level narrower than three texels)
+//! take the AVX2 build's out-of-line edge path; K = 4 keeps the AVX2 kernel (its window's rows
+//! need a row pair per pixel out of four rows: two permutes and a blend per tap).
+
+use core::arch::x86_64::*;
+
+use glam::{Vec2, Vec4};
+
+use super::Addr;
+use super::avx2::{
+    Offsets, SpanSetup, SpanStep, SpanWindow, TriLevel, TriSetup, TriStep, edge_span, span_step,
+    span_window, to_u32x8, tri_level, tri_step,
+};
+use crate::mip::MipTexture;
+
+/// `a + (b − a)·t` lane-wise: the 128-bit `lerp4` on four pixels at once (same operations).
+#[inline]
+#[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq")]
+fn lerp16(a: __m512, b: __m512, t: __m512) -> __m512 {
+    _mm512_add_ps(a, _mm512_mul_ps(_mm512_sub_ps(b, a), t))
+}
+
+/// Sixteen `i32` lanes from an array (a constant vector).
+#[inline]
+#[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq")]
+fn lanes16(v: [i32; 16]) -> __m512i {
+    // SAFETY: same size, no invalid bit patterns.
+    unsafe { core::mem::transmute::<[i32; 16], __m512i>(v) }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Span sampler, K = 3: eight spans per step, each span's four pixels from its mspan.
+
+/// One level of eight spans, span-major for the per-span zmm vectors (span `s` at `[s]`).
+struct MspanLevel {
+    /// Doubled texel index of the window corner (`base + 8·index` addresses it).
+    corner: [u32; 8],
+    /// Doubled row stride (the level width).
+    w2: [u32; 8],
+    /// `[span][pixel]`: `oy·16 + ox·4`, the lane of the pixel's `t00` in two rows of four
+    /// texels (`ox, oy ∈ {0, 1}` from the window corner).
+    o: [[i32; 4]; 8],
+    /// `[span][pixel]`: the Eq. (4) bilinear weights.
+    ax: [[f32; 4]; 8],
+    ay: [[f32; 4]; 8],
+    /// Lane bits of the spans whose window is interior.
+    ok: i32,
+}
+
+/// Four per-pixel vectors (lanes = spans) as span-major rows `[span][pixel]`: spans 0–3 in the
+/// first register, 4–7 in the second.
+#[inline]
+#[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq")]
+fn span_major(v: &[__m256; 4]) -> [[f32; 4]; 8] {
+    let a = _mm512_insertf32x8::<1>(_mm512_castps256_ps512(v[0]), v[1]);
+    let b = _mm512_insertf32x8::<1>(_mm512_castps256_ps512(v[2]), v[3]);
+    // Lane s·4 + p = pixel p of span s = lane 8p + s of [v0 | v1 | v2 | v3].
+    let lo = lanes16([0, 8, 16, 24, 1, 9, 17, 25, 2, 10, 18, 26, 3, 11, 19, 27]);
+    let hi = _mm512_add_epi32(lo, _mm512_set1_epi32(4));
+    let r = [
+        _mm512_permutex2var_ps(a, lo, b),
+        _mm512_permutex2var_ps(a, hi, b),
+    ];
+    // SAFETY: same size, no invalid bit patterns.
+    unsafe { core::mem::transmute::<[__m512; 2], [[f32; 4]; 8]>(r) }
+}
+
+/// Seed 000 Eq. (10) for eight spans at levels `lvl` ([`span_window`], the AVX2 build's
+/// arithmetic), arranged for the mspan read.
+#[inline]
+#[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq")]
+fn mspan_level<A: Addr>(
+    tex: &MipTexture,
+    lvl: __m256i,
+    sx: &[__m256; 4],
+    sy: &[__m256; 4],
+    offs: Offsets,
+) -> MspanLevel {
+    // oy·16 + ox·4: small non-negative integers in interior windows, exact in f32 (other spans
+    // take the edge path and ignore theirs).
+    let (s16, s4) = (_mm256_set1_ps(16.0), _mm256_set1_ps(4.0));
+    let mut o = [_mm256_setzero_ps(); 4];
+    let SpanWindow {
+        ax,
+        ay,
+        corner,
+        wi,
+        ok,
+        ..
+    } = span_window::<A, 3>(tex, lvl, sx, sy, offs, |j, ox, oy, _, _| {
+        let v = _mm256_add_ps(_mm256_mul_ps(oy, s16), _mm256_mul_ps(ox, s4));
+        o[j] = _mm256_castsi256_ps(_mm256_cvttps_epi32(v));
+    });
+    let o = span_major(&o);
+    MspanLevel {
+        corner: to_u32x8(_mm256_slli_epi32::<1>(corner)),
+        w2: to_u32x8(_mm256_slli_epi32::<1>(wi)),
+        // SAFETY: same size, no invalid bit patterns (the i32 bits moved as f32 lanes).
+        o: unsafe { core::mem::transmute::<[[f32; 4]; 8], [[i32; 4]; 8]>(o) },
+        ax: span_major(&ax),
+        ay: span_major(&ay),
+        ok,
+    }
+}
+
+/// The constant vectors of the mspan kernel.
+#[derive(Clone, Copy)]
+struct MspanConsts {
+    /// Lane `c·4 + p` = `c` (the channel), and `c + 4` (the texel to the right).
+    c0: __m512i,
+    c1: __m512i,
+    /// Channel-major `c·4 + p` -> pixel-major `p·4 + c`.
+    to_pixels: __m512i,
+}
+
+/// The bilinear of span `S`'s four pixels (channel-major) from its mspan at one level.
+///
+/// # Safety
+/// `d` must come from [`mspan_level`] on the texture whose texels start at `base`, with span
+/// `S` interior (`d.ok` bit set): its three rows of three texels lie inside the level.
+#[inline]
+#[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq")]
+unsafe fn mspan_bilinear<const S: usize>(
+    base: *const u8,
+    d: &MspanLevel,
+    k: &MspanConsts,
+) -> __m512 {
+    let (c, w) = (d.corner[S] as usize, d.w2[S] as usize);
+    // SAFETY: the caller's contract: rows corner + r·w, r < 3, texels 0..3 inside the level
+    // (the interior window, x0 + 3 ≤ w, y0 + 3 ≤ h); lanes 12–15 (a fourth texel) are masked
+    // off and not read. The 128-bit broadcasts read 4 values of `d`'s arrays.
+    unsafe {
+        // The mspan: one read of the 3x3 banks (Seed 000 Eq. 10).
+        let row = |r: usize| _mm512_maskz_loadu_ps(0x0fff, base.add((c + r * w) * 8) as *const f32);
+        let (r0, r1, r2) = (row(0), row(1), row(2));
+        // Each pixel's 2x2 out of it: lane c·4 + p takes channel c of texel (ox_p, oy_p).
+        let o = _mm512_broadcast_i32x4(_mm_loadu_si128(d.o[S].as_ptr() as *const __m128i));
+        let (i0, i1) = (_mm512_add_epi32(o, k.c0), _mm512_add_epi32(o, k.c1));
+        let t00 = _mm512_permutex2var_ps(r0, i0, r1);
+        let t10 = _mm512_permutex2var_ps(r0, i1, r1);
+        let t01 = _mm512_permutex2var_ps(r1, i0, r2);
+        let t11 = _mm512_permutex2var_ps(r1, i1, r2);
+        let wx = _mm512_broadcast_f32x4(_mm_loadu_ps(d.ax[S].as_ptr()));
+        let wy = _mm512_broadcast_f32x4(_mm_loadu_ps(d.ay[S].as_ptr()));
+        lerp16(lerp16(t00, t10, wx), lerp16(t01, t11, wx), wy)
+    }
+}
+
+/// Span `S` of a step: its four pixels from the levels `a` (and `b`, blended by `frac[S]`, per
+/// Eq. 4), or the AVX2 build's edge path when its window is not interior.
+///
+/// # Safety
+/// As [`mspan_bilinear`] for spans whose `fast` bit is set (`b` too unless `single`).
+#[inline]
+#[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq")]
+#[allow(clippy::too_many_arguments)]
+unsafe fn mspan_out<A: Addr, const S: usize>(
+    tex: &MipTexture,
+    base: *const u8,
+    a: &MspanLevel,
+    b: &MspanLevel,
+    frac: &[f32; 8],
+    fast: i32,
+    single: i32,
+    k: &MspanConsts,
+    q: [Vec2; 4],
+    o: &mut [Vec4; 4],
+) {
+    if fast & (1 << S) == 0 {
+        // A window crossing a level edge (or a conflict).
+        // SAFETY: AVX2 is implied by AVX-512F; the texture is a power of two (our contract).
+        *o = unsafe { edge_span::<A, 3>(tex, q) };
+        return;
+    }
+    // SAFETY: the caller's contract; `o` holds 16 floats.
+    unsafe {
+        let ca = mspan_bilinear::<S>(base, a, k);
+        let r = if single & (1 << S) != 0 {
+            ca
+        } else {
+            // Seed 000 Eq. (4): one blend weight per span.
+            let cb = mspan_bilinear::<S>(base, b, k);
+            lerp16(ca, cb, _mm512_set1_ps(frac[S]))
+        };
+        _mm512_storeu_ps(
+            o.as_mut_ptr() as *mut f32,
+            _mm512_permutexvar_ps(k.to_pixels, r),
+        );
+    }
+}
+
+/// [`super::lanes::span_quads4`] with 3x3 banks for AVX-512, eight spans per step, each span's
+/// pixels from its mspan: bit-identical, whole groups of eight spans (the caller does the tail).
+///
+/// # Safety
+/// The CPU must support AVX-512F/VL/BW/DQ; the texture must be a power of two.
+#[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq")]
+pub(super) unsafe fn span_quads_k3<A: Addr>(
+    tex: &MipTexture,
+    quads: &[[Vec2; 4]],
+    out: &mut [[Vec4; 4]],
+) -> usize {
+    debug_assert!(tex.is_pow2());
+    let c = SpanSetup::new(tex);
+    let base = tex.texels().as_ptr() as *const u8;
+    let n = quads.len().min(out.len()) / 8 * 8;
+    let cpat = lanes16([0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2, 3, 3, 3, 3]);
+    let k = MspanConsts {
+        c0: cpat,
+        c1: _mm512_add_epi32(cpat, _mm512_set1_epi32(4)),
+        to_pixels: lanes16([0, 4, 8, 12, 1, 5, 9, 13, 2, 6, 10, 14, 3, 7, 11, 15]),
+    };
+    for (o, q) in out[..n].chunks_exact_mut(8).zip(quads[..n].chunks_exact(8)) {
+        let SpanStep {
+            sx,
+            sy,
+            i0,
+            i1,
+            frac,
+            single,
+        } = span_step::<A, 3>(&c, q.try_into().expect("eight spans"));
+        let mut a = mspan_level::<A>(tex, i0, &sx, &sy, c.offs);
+        let mut b = mspan_level::<A>(tex, i1, &sx, &sy, c.offs);
+        let mut fr: [f32; 8] = core::array::from_fn(|s| frac_lane(frac, s));
+        // Keep the per-span values in memory: each is then one load or one broadcast load
+        // (else LLVM keeps the vectors and extracts lanes with shuffles).
+        core::hint::black_box((&mut a, &mut b, &mut fr));
+        let fast = a.ok & (b.ok | single);
+        // SAFETY: `mspan_out`'s contract: levels from `mspan_level` on this texture.
+        unsafe {
+            mspan_out::<A, 0>(tex, base, &a, &b, &fr, fast, single, &k, q[0], &mut o[0]);
+            mspan_out::<A, 1>(tex, base, &a, &b, &fr, fast, single, &k, q[1], &mut o[1]);
+            mspan_out::<A, 2>(tex, base, &a, &b, &fr, fast, single, &k, q[2], &mut o[2]);
+            mspan_out::<A, 3>(tex, base, &a, &b, &fr, fast, single, &k, q[3], &mut o[3]);
+            mspan_out::<A, 4>(tex, base, &a, &b, &fr, fast, single, &k, q[4], &mut o[4]);
+            mspan_out::<A, 5>(tex, base, &a, &b, &fr, fast, single, &k, q[5], &mut o[5]);
+            mspan_out::<A, 6>(tex, base, &a, &b, &fr, fast, single, &k, q[6], &mut o[6]);
+            mspan_out::<A, 7>(tex, base, &a, &b, &fr, fast, single, &k, q[7], &mut o[7]);
+        }
+    }
+    n
+}
+
+/// Lane `s` of eight floats.
+#[inline(always)]
+fn frac_lane(v: __m256, s: usize) -> f32 {
+    // SAFETY: same size, no invalid bit patterns.
+    unsafe { core::mem::transmute::<__m256, [f32; 8]>(v)[s] }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Per-pixel trilinear: eight pixels per step, four per zmm.
+
+/// Bilinear of pixels `4G..4G + 4` of a step (lanes `[0 2 4 6 | 1 3 5 7]` of the set-up: pixels
+/// 0–3 are lanes 0 4 1 5, pixels 4–7 lanes 2 6 3 7), pixel-major; `widx` spreads the lanes'
+/// weights over the pixels' four channels.
+///
+/// # Safety
+/// `p` must come from `tri_level` on the texture whose texels start at `base`.
+#[inline]
+#[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq")]
+unsafe fn tri_quad<const G: usize, const INSIDE: bool>(
+    base: *const u8,
+    p: &TriLevel,
+    widx: __m512i,
+) -> __m512 {
+    let l = if G == 0 { [0, 4, 1, 5] } else { [2, 6, 3, 7] };
+    let ld = |c: usize, d: usize| {
+        // SAFETY: the caller's contract (indices inside the texel buffer).
+        let at = |k: usize| unsafe {
+            _mm_loadu_ps(base.add((p.idx[c][l[k]] as usize + d) * 8) as *const f32)
+        };
+        let v = _mm512_castps128_ps512(at(0));
+        let v = _mm512_insertf32x4::<1>(v, at(1));
+        let v = _mm512_insertf32x4::<2>(v, at(2));
+        _mm512_insertf32x4::<3>(v, at(3))
+    };
+    // No pixel's 2x2 split by the level edge: two indices per pixel (t10 = t00 + 1 texel, two
+    // doubled units); else the four wrapped ones.
+    let (t00, t01) = (ld(0, 0), ld(2, 0));
+    let (t10, t11) = if INSIDE {
+        (ld(0, 2), ld(2, 2))
+    } else {
+        (ld(1, 0), ld(3, 0))
+    };
+    let wx = _mm512_permutexvar_ps(widx, _mm512_castps256_ps512(p.ax));
+    let wy = _mm512_permutexvar_ps(widx, _mm512_castps256_ps512(p.ay));
+    lerp16(lerp16(t00, t10, wx), lerp16(t01, t11, wx), wy)
+}
+
+/// Pixels `4G..4G + 4` of a step: level `a`, or Eq. (4)'s blend with level `b` by `frac`
+/// where a pixel blends two levels (`sv`: lane mask of single-level pixels, `single` its bits).
+///
+/// # Safety
+/// As [`tri_quad`]; `o` must hold eight `Vec4`.
+#[inline]
+#[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq")]
+unsafe fn tri_out<const G: usize, const INSIDE: bool>(
+    base: *const u8,
+    pa: &TriLevel,
+    pb: &TriLevel,
+    s: &TriStep,
+    widx: __m512i,
+    o: *mut f32,
+) {
+    let lanes = if G == 0 { 0b0011_0011 } else { 0b1100_1100 };
+    let single = s.single & lanes;
+    // SAFETY: the caller's contract.
+    unsafe {
+        let ca = tri_quad::<G, INSIDE>(base, pa, widx);
+        let r = if single == lanes {
+            ca
+        } else {
+            // Seed 000 Eq. (4): blend the two levels by frac(λ); single pixels keep `ca`.
+            let cb = tri_quad::<G, INSIDE>(base, pb, widx);
+            let t = _mm512_permutexvar_ps(widx, _mm512_castps256_ps512(s.frac));
+            let r = lerp16(ca, cb, t);
+            if single == 0 {
+                r
+            } else {
+                let sv = _mm512_permutexvar_epi32(
+                    widx,
+                    _mm512_castsi256_si512(_mm256_castps_si256(s.sv)),
+                );
+                _mm512_mask_blend_ps(_mm512_movepi32_mask(sv), r, ca)
+            }
+        };
+        _mm512_storeu_ps(o.add(16 * G), r);
+    }
+}
+
+/// [`super::lanes::trilinear_pixels`] for AVX-512, eight pixels per step, four per zmm:
+/// bit-identical, whole chunks of eight (the caller does the tail).
+///
+/// # Safety
+/// The CPU must support AVX-512F/VL/BW/DQ; the texture must be a power of two.
+#[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq")]
+pub(super) unsafe fn trilinear_pixels<A: Addr>(
+    tex: &MipTexture,
+    uv: &[Vec2],
+    dx: &[Vec2],
+    dy: &[Vec2],
+    out: &mut [Vec4],
+) -> usize {
+    debug_assert!(tex.is_pow2());
+    let c = TriSetup::new(tex);
+    let base = tex.texels().as_ptr() as *const u8;
+    let n = uv.len().min(dx.len()).min(dy.len()).min(out.len()) / 8 * 8;
+    // Pixel p of a group of four takes lane l[p]'s weights in its four channels.
+    let w0 = lanes16([0, 0, 0, 0, 4, 4, 4, 4, 1, 1, 1, 1, 5, 5, 5, 5]);
+    let w1 = _mm512_add_epi32(w0, _mm512_set1_epi32(2));
+    for i in (0..n).step_by(8) {
+        // SAFETY: i + 8 ≤ n ≤ every slice's length (8 Vec2 = 16 floats, 8 Vec4 = 32 floats);
+        // the indices come from `tri_level` on this texture.
+        unsafe {
+            let s = tri_step::<A>(&c, i, uv, dx, dy);
+            let mut pa = tri_level::<A>(s.u, s.v, s.i0, c.nw, c.nh, c.offs);
+            let mut pb = tri_level::<A>(s.u, s.v, s.i1, c.nw, c.nh, c.offs);
+            // Keep the indices in memory: one load per index.
+            core::hint::black_box((&mut pa.idx, &mut pb.idx));
+            let o = out.as_mut_ptr().add(i) as *mut f32;
+            if pa.edge | pb.edge == 0 {
+                tri_out::<0, true>(base, &pa, &pb, &s, w0, o);
+                tri_out::<1, true>(base, &pa, &pb, &s, w1, o);
+            } else {
+                tri_out::<0, false>(base, &pa, &pb, &s, w0, o);
+                tri_out::<1, false>(base, &pa, &pb, &s, w1, o);
+            }
+        }
+    }
+    n
+}
