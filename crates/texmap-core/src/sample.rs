@@ -193,11 +193,7 @@ use crate::mip::{LevelInfo, MipTexture, Wrap};
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
-// AVX-512 intrinsics are stable since Rust 1.89, past the workspace's rust-version (1.85),
-// which the AVX-512 `target_feature`s already used by impostor (also 1.89) require as well:
-// the rust-version is the workspace's to move.
 #[cfg(target_arch = "x86_64")]
-#[allow(clippy::incompatible_msrv)]
 mod avx512;
 #[cfg(target_arch = "x86_64")]
 mod lanes;
