@@ -1,7 +1,8 @@
-//! AVX-512 builds of the bulk lane kernels (chosen at run time by [`super::lanes`]'s `*_best`
-//! entry points where the CPU has AVX-512F/VL/BW/DQ; the AVX2 and SSE2 builds stay the
-//! fallbacks), on power-of-two pyramids: per-pixel trilinear eight pixels per step, and the span
-//! sampler with 3x3 banks eight spans per step, its four pixels read as the paper's mspan.
+//! AVX-512 builds of the bulk lane kernels on power-of-two pyramids: the span sampler with 3x3
+//! banks eight spans per step, its four pixels read as the paper's mspan (chosen at run time by
+//! [`super::lanes`]'s `span_quads4_best` where the CPU has AVX-512F/VL/BW/DQ; the AVX2 and SSE2
+//! builds stay the fallbacks), and per-pixel trilinear eight pixels per step (built and tested,
+//! not chosen: see `lanes::TRILINEAR_AVX512`).
 //!
 //! The arithmetic is the AVX2 / SSE2 / scalar kernels' operation for operation (`a + (b − a)·t`,
 //! no FMA: Rust never contracts a multiply and an add), so the results are the same bits (tested

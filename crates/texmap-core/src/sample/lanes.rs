@@ -591,12 +591,12 @@ pub(super) fn has_avx512() -> bool {
 }
 
 /// Whether bulk per-pixel trilinear takes its AVX-512 build where the CPU has AVX-512. Off: on
-/// the Sapphire Rapids-class Xeon it was built and measured on (fifth round, /work notes),
-/// best-frame thread CPU per sample was ~12.5–16 ns against the AVX2 build's ~8–9 (interleaved
-/// runs; a 256-bit EVEX build of the AVX2 code and a set-up kept out of line in pure AVX2 were
-/// as slow), so the run-time choice that is fair to trilinear is its AVX2 build. The kernel is
-/// kept and tested bit for bit (`avx512_lane_builds_match_the_sse2_baseline_bit_for_bit`), to
-/// measure again on other CPUs.
+/// the Sapphire Rapids-class Xeon it was built and measured on (docs/PERFORMANCE.md, "Fifth
+/// round: span sampler"), best-frame thread CPU per sample was ~12.5–16 ns against the AVX2
+/// build's ~8–9 (interleaved runs; a 256-bit EVEX build of the AVX2 code and a set-up kept out
+/// of line in pure AVX2 were as slow), so the run-time choice that is fair to trilinear is its
+/// AVX2 build. The kernel is kept and tested bit for bit
+/// (`avx512_lane_builds_match_the_sse2_baseline_bit_for_bit`), to measure again on other CPUs.
 const TRILINEAR_AVX512: bool = false;
 
 /// [`trilinear_pixels`] compiled for AVX2.
