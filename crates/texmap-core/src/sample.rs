@@ -1620,6 +1620,36 @@ mod tests {
                         // SAFETY: as above.
                         let nq = unsafe { avx512::span_quads_k3::<$A>(&t, &quads, &mut qb) };
                         assert_eq!(nq, 4000);
+                        // Sixteen spans per step on scenes that are not whole groups of 16
+                        // (or of 8): the kernel alone, the chosen build (16, then the
+                        // 8-span kernel on the rest) and the public call (then the scalar
+                        // remainder).
+                        for len in [4000, 3992, 3987, 24, 17, 13, 7, 0] {
+                            // The first `n` spans of `qc` against the SSE2 baseline's.
+                            let same = |what: &str, n: usize, qc: &[[Vec4; 4]]| {
+                                assert_eq!(
+                                    bits(qa[..n].as_flattened()),
+                                    bits(qc[..n].as_flattened()),
+                                    "span K3 {what} {w}x{h} {wrap:?} len {len}"
+                                );
+                            };
+                            let mut qc = vec![[Vec4::ZERO; 4]; len];
+                            // SAFETY: as above.
+                            let n16 = unsafe {
+                                avx512::span_quads_k3_x16::<$A>(&t, &quads[..len], &mut qc)
+                            };
+                            assert_eq!(n16, len / 16 * 16);
+                            same("x16", n16, &qc);
+                            let mut qc = vec![[Vec4::ZERO; 4]; len];
+                            let nb = lanes::span_quads4_best::<$A, 3>(&t, &quads[..len], &mut qc);
+                            assert_eq!(nb, len / 8 * 8);
+                            same("best", nb, &qc);
+                            let mut qc = vec![[Vec4::ZERO; 4]; len];
+                            Sampler::Span(Banks::K3)
+                                .sample_quads(&t, &quads[..len], &mut qc)
+                                .expect("same lengths");
+                            same("sample_quads", len, &qc);
+                        }
                     }};
                 }
                 match wrap {

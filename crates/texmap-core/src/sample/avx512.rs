@@ -1,15 +1,23 @@
 //! AVX-512 builds of the bulk lane kernels on power-of-two pyramids: the span sampler with 3x3
-//! banks eight spans per step, its four pixels read as the paper's mspan (chosen at run time by
-//! [`super::lanes`]'s `span_quads4_best` where the CPU has AVX-512F/VL/BW/DQ; the AVX2 and SSE2
-//! builds stay the fallbacks), and per-pixel trilinear eight pixels per step (built and tested,
-//! not chosen: see `lanes::TRILINEAR_AVX512`).
+//! banks sixteen spans per step (`span_quads_k3_x16`, its set-up in 512-bit lanes) and eight
+//! spans per step (`span_quads_k3`, the AVX2 set-up; it takes the groups of eight left over),
+//! its four pixels read as the paper's mspan (chosen at run time by [`super::lanes`]'s
+//! `span_quads4_best` where the CPU has AVX-512F/VL/BW/DQ; the AVX2 and SSE2 builds stay the
+//! fallbacks), and per-pixel trilinear eight pixels per step (built and tested, not chosen: see
+//! `lanes::TRILINEAR_AVX512`).
 //!
 //! The arithmetic is the AVX2 / SSE2 / scalar kernels' operation for operation (`a + (b − a)·t`,
 //! no FMA: Rust never contracts a multiply and an add), so the results are the same bits (tested
 //! in `super::tests` against the SSE2 baseline and the bank emulator). The set-up of each step
 //! (footprint or span extent, level pair, level sizes, texel coordinates, floors, weights,
 //! window corners) is the AVX2 build's eight-lane code, here compiled with the AVX-512 features
-//! (EVEX encoding, 32 vector registers). What changes is the per-pixel part:
+//! (EVEX encoding, 32 vector registers) — except in `span_quads_k3_x16`, where the same
+//! operations run on sixteen spans per zmm (`span_step16`, `mspan_level16`: the 32 images
+//! transposed by three rounds of `vpermt2ps`, compares into mask registers, the level offset by
+//! one `vpermd` over the 16-entry table), so that the loop issues no 256-bit µops (with 512-bit
+//! µops in flight, Intel cores fuse vector ports 0 and 1, and 256-bit work loses a port); on
+//! the Sapphire Rapids-class Xeon it measured faster than the eight-span kernel (interleaved
+//! best-frame runs and criterion). What changes is the per-pixel part:
 //!
 //! - **span sampler (Seed 000 Eq. 8–10, K = 3), the mspan read:** one span = four pixels x RGBA
 //!   = sixteen floats = one zmm. Its interior 3x3 window is read as three rows of three texels
@@ -62,18 +70,19 @@ fn lanes16(v: [i32; 16]) -> __m512i {
 // ---------------------------------------------------------------------------------------------
 // Span sampler, K = 3: eight spans per step, each span's four pixels from its mspan.
 
-/// One level of eight spans, span-major for the per-span zmm vectors (span `s` at `[s]`).
-struct MspanLevel {
+/// One level of `N` spans (eight or sixteen), span-major for the per-span zmm vectors (span `s`
+/// at `[s]`).
+struct MspanLevel<const N: usize> {
     /// Doubled texel index of the window corner (`base + 8·index` addresses it).
-    corner: [u32; 8],
+    corner: [u32; N],
     /// Doubled row stride (the level width).
-    w2: [u32; 8],
+    w2: [u32; N],
     /// `[span][pixel]`: `oy·16 + ox·4`, the lane of the pixel's `t00` in two rows of four
     /// texels (`ox, oy ∈ {0, 1}` from the window corner).
-    o: [[i32; 4]; 8],
+    o: [[i32; 4]; N],
     /// `[span][pixel]`: the Eq. (4) bilinear weights.
-    ax: [[f32; 4]; 8],
-    ay: [[f32; 4]; 8],
+    ax: [[f32; 4]; N],
+    ay: [[f32; 4]; N],
     /// Lane bits of the spans whose window is interior.
     ok: i32,
 }
@@ -106,7 +115,7 @@ fn mspan_level<A: Addr>(
     sx: &[__m256; 4],
     sy: &[__m256; 4],
     offs: Offsets,
-) -> MspanLevel {
+) -> MspanLevel<8> {
     // oy·16 + ox·4: small non-negative integers in interior windows, exact in f32 (other spans
     // take the edge path and ignore theirs).
     let (s16, s4) = (_mm256_set1_ps(16.0), _mm256_set1_ps(4.0));
@@ -144,6 +153,19 @@ struct MspanConsts {
     to_pixels: __m512i,
 }
 
+impl MspanConsts {
+    #[inline]
+    #[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq")]
+    fn new() -> MspanConsts {
+        let cpat = lanes16([0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2, 3, 3, 3, 3]);
+        MspanConsts {
+            c0: cpat,
+            c1: _mm512_add_epi32(cpat, _mm512_set1_epi32(4)),
+            to_pixels: lanes16([0, 4, 8, 12, 1, 5, 9, 13, 2, 6, 10, 14, 3, 7, 11, 15]),
+        }
+    }
+}
+
 /// The bilinear of span `S`'s four pixels (channel-major) from its mspan at one level.
 ///
 /// # Safety
@@ -151,9 +173,9 @@ struct MspanConsts {
 /// `S` interior (`d.ok` bit set): its three rows of three texels lie inside the level.
 #[inline]
 #[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq")]
-unsafe fn mspan_bilinear<const S: usize>(
+unsafe fn mspan_bilinear<const N: usize, const S: usize>(
     base: *const u8,
-    d: &MspanLevel,
+    d: &MspanLevel<N>,
     k: &MspanConsts,
 ) -> __m512 {
     let (c, w) = (d.corner[S] as usize, d.w2[S] as usize);
@@ -185,12 +207,12 @@ unsafe fn mspan_bilinear<const S: usize>(
 #[inline]
 #[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq")]
 #[allow(clippy::too_many_arguments)]
-unsafe fn mspan_out<A: Addr, const S: usize>(
+unsafe fn mspan_out<A: Addr, const N: usize, const S: usize>(
     tex: &MipTexture,
     base: *const u8,
-    a: &MspanLevel,
-    b: &MspanLevel,
-    frac: &[f32; 8],
+    a: &MspanLevel<N>,
+    b: &MspanLevel<N>,
+    frac: &[f32; N],
     fast: i32,
     single: i32,
     k: &MspanConsts,
@@ -205,12 +227,12 @@ unsafe fn mspan_out<A: Addr, const S: usize>(
     }
     // SAFETY: the caller's contract; `o` holds 16 floats.
     unsafe {
-        let ca = mspan_bilinear::<S>(base, a, k);
+        let ca = mspan_bilinear::<N, S>(base, a, k);
         let r = if single & (1 << S) != 0 {
             ca
         } else {
             // Seed 000 Eq. (4): one blend weight per span.
-            let cb = mspan_bilinear::<S>(base, b, k);
+            let cb = mspan_bilinear::<N, S>(base, b, k);
             lerp16(ca, cb, _mm512_set1_ps(frac[S]))
         };
         _mm512_storeu_ps(
@@ -235,12 +257,7 @@ pub(super) unsafe fn span_quads_k3<A: Addr>(
     let c = SpanSetup::new(tex);
     let base = tex.texels().as_ptr() as *const u8;
     let n = quads.len().min(out.len()) / 8 * 8;
-    let cpat = lanes16([0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2, 3, 3, 3, 3]);
-    let k = MspanConsts {
-        c0: cpat,
-        c1: _mm512_add_epi32(cpat, _mm512_set1_epi32(4)),
-        to_pixels: lanes16([0, 4, 8, 12, 1, 5, 9, 13, 2, 6, 10, 14, 3, 7, 11, 15]),
-    };
+    let k = MspanConsts::new();
     for (o, q) in out[..n].chunks_exact_mut(8).zip(quads[..n].chunks_exact(8)) {
         let SpanStep {
             sx,
@@ -259,14 +276,14 @@ pub(super) unsafe fn span_quads_k3<A: Addr>(
         let fast = a.ok & (b.ok | single);
         // SAFETY: `mspan_out`'s contract: levels from `mspan_level` on this texture.
         unsafe {
-            mspan_out::<A, 0>(tex, base, &a, &b, &fr, fast, single, &k, q[0], &mut o[0]);
-            mspan_out::<A, 1>(tex, base, &a, &b, &fr, fast, single, &k, q[1], &mut o[1]);
-            mspan_out::<A, 2>(tex, base, &a, &b, &fr, fast, single, &k, q[2], &mut o[2]);
-            mspan_out::<A, 3>(tex, base, &a, &b, &fr, fast, single, &k, q[3], &mut o[3]);
-            mspan_out::<A, 4>(tex, base, &a, &b, &fr, fast, single, &k, q[4], &mut o[4]);
-            mspan_out::<A, 5>(tex, base, &a, &b, &fr, fast, single, &k, q[5], &mut o[5]);
-            mspan_out::<A, 6>(tex, base, &a, &b, &fr, fast, single, &k, q[6], &mut o[6]);
-            mspan_out::<A, 7>(tex, base, &a, &b, &fr, fast, single, &k, q[7], &mut o[7]);
+            mspan_out::<A, 8, 0>(tex, base, &a, &b, &fr, fast, single, &k, q[0], &mut o[0]);
+            mspan_out::<A, 8, 1>(tex, base, &a, &b, &fr, fast, single, &k, q[1], &mut o[1]);
+            mspan_out::<A, 8, 2>(tex, base, &a, &b, &fr, fast, single, &k, q[2], &mut o[2]);
+            mspan_out::<A, 8, 3>(tex, base, &a, &b, &fr, fast, single, &k, q[3], &mut o[3]);
+            mspan_out::<A, 8, 4>(tex, base, &a, &b, &fr, fast, single, &k, q[4], &mut o[4]);
+            mspan_out::<A, 8, 5>(tex, base, &a, &b, &fr, fast, single, &k, q[5], &mut o[5]);
+            mspan_out::<A, 8, 6>(tex, base, &a, &b, &fr, fast, single, &k, q[6], &mut o[6]);
+            mspan_out::<A, 8, 7>(tex, base, &a, &b, &fr, fast, single, &k, q[7], &mut o[7]);
         }
     }
     n
@@ -277,6 +294,388 @@ pub(super) unsafe fn span_quads_k3<A: Addr>(
 fn frac_lane(v: __m256, s: usize) -> f32 {
     // SAFETY: same size, no invalid bit patterns.
     unsafe { core::mem::transmute::<__m256, [f32; 8]>(v)[s] }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Span sampler, K = 3: sixteen spans per step, the set-up in 512-bit lanes (lanes = spans).
+
+/// `i32` lanes from a lane -> source function (the index vectors of the transposes, built at
+/// compile time).
+macro_rules! perm16 {
+    (|$l:ident| $e:expr) => {{
+        const P: [i32; 16] = {
+            let mut r = [0i32; 16];
+            let mut $l = 0usize;
+            while $l < 16 {
+                r[$l] = ($e) as i32;
+                $l += 1;
+            }
+            r
+        };
+        lanes16(P)
+    }};
+}
+
+/// `vpermt2ps` over `(a | b)` (source lanes 0–15 of `a`, 16–31 of `b`).
+#[inline]
+#[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq")]
+fn p2(a: __m512, i: __m512i, b: __m512) -> __m512 {
+    _mm512_permutex2var_ps(a, i, b)
+}
+
+/// [`super::lanes::log2_split4`] on sixteen lanes (the AVX2 `log2_split8`'s operations).
+#[inline]
+#[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq")]
+fn log2_split16(x: __m512) -> (__m512i, __m512) {
+    let bits = _mm512_castps_si512(x);
+    let e = _mm512_sub_epi32(
+        _mm512_and_si512(_mm512_srli_epi32::<23>(bits), _mm512_set1_epi32(0xff)),
+        _mm512_set1_epi32(127),
+    );
+    let t = _mm512_sub_ps(
+        _mm512_castsi512_ps(_mm512_or_si512(
+            _mm512_and_si512(bits, _mm512_set1_epi32(0x007f_ffff)),
+            _mm512_set1_epi32(0x3f80_0000),
+        )),
+        _mm512_set1_ps(1.0),
+    );
+    let c = |k: f32| _mm512_set1_ps(k);
+    let poly = _mm512_add_ps(c(super::LOG2_C3), _mm512_mul_ps(t, c(super::LOG2_C4)));
+    let poly = _mm512_add_ps(c(super::LOG2_C2), _mm512_mul_ps(t, poly));
+    let poly = _mm512_add_ps(c(super::LOG2_C1), _mm512_mul_ps(t, poly));
+    (e, _mm512_mul_ps(t, poly))
+}
+
+/// [`super::clamp4`] on sixteen lanes: clamp to ±2^30, then NaN -> +0 (the AVX2
+/// `clamp_nan0_8`'s order; a zero-masked move instead of the `and` with the compare).
+#[inline]
+#[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq")]
+fn clamp_nan0_16(v: __m512) -> __m512 {
+    let c = _mm512_min_ps(
+        _mm512_max_ps(v, _mm512_set1_ps(-super::COORD_LIMIT)),
+        _mm512_set1_ps(super::COORD_LIMIT),
+    );
+    _mm512_maskz_mov_ps(_mm512_cmp_ps_mask::<_CMP_EQ_OQ>(v, v), c)
+}
+
+/// `roundps` floor on sixteen lanes (exact).
+#[inline]
+#[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq")]
+fn floor16(x: __m512) -> __m512 {
+    _mm512_roundscale_ps::<{ _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC }>(x)
+}
+
+/// Level size per lane, `max(2^(b − 127 − lvl), 1)` built from the float exponent (exact).
+#[inline]
+#[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq")]
+fn pow2_16(b: i32, lvl: __m512i) -> __m512 {
+    _mm512_castsi512_ps(_mm512_slli_epi32::<23>(_mm512_sub_epi32(
+        _mm512_set1_epi32(b),
+        lvl,
+    )))
+}
+
+/// `min(min(v0, v1), min(v2, v3))` and the `max` likewise (the AVX2 build's order: `minps`
+/// is not commutative on signed zeros).
+#[inline]
+#[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq")]
+fn min4_16(v: &[__m512; 4]) -> __m512 {
+    _mm512_min_ps(_mm512_min_ps(v[0], v[1]), _mm512_min_ps(v[2], v[3]))
+}
+
+#[inline]
+#[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq")]
+fn max4_16(v: &[__m512; 4]) -> __m512 {
+    _mm512_max_ps(_mm512_max_ps(v[0], v[1]), _mm512_max_ps(v[2], v[3]))
+}
+
+/// A texture's constants for [`span_step16`] and [`mspan_level16`].
+struct Setup16 {
+    /// The 16-entry level-offset table (one `vpermd` per lookup).
+    offs: __m512i,
+    sw: __m512,
+    sh: __m512,
+    inv_w: __m512,
+    inv_h: __m512,
+    last: i32,
+    nw: i32,
+    nh: i32,
+}
+
+impl Setup16 {
+    #[inline]
+    #[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq")]
+    fn new(tex: &MipTexture) -> Setup16 {
+        let l0 = &tex.levels()[0];
+        let t = tex.level_offsets16();
+        Setup16 {
+            // SAFETY: `t` holds 16 i32 (one unaligned 512-bit load).
+            offs: unsafe { _mm512_loadu_si512(t.as_ptr() as *const __m512i) },
+            sw: _mm512_set1_ps(l0.width_f),
+            sh: _mm512_set1_ps(l0.height_f),
+            inv_w: _mm512_set1_ps(l0.inv_width_f),
+            inv_h: _mm512_set1_ps(l0.inv_height_f),
+            last: tex.level_count() as i32 - 1,
+            nw: tex.width().trailing_zeros() as i32,
+            nh: tex.height().trailing_zeros() as i32,
+        }
+    }
+}
+
+/// Sixteen spans' level-0 texel coordinates (`sx[j]`, `sy[j]`: pixel `j`, lane = span), their
+/// level pair, Eq. (4) weight and the bits of single-level spans.
+struct Step16 {
+    sx: [__m512; 4],
+    sy: [__m512; 4],
+    i0: __m512i,
+    i1: __m512i,
+    frac: __m512,
+    single: i32,
+}
+
+/// [`super::avx2::span_step`] (K = 3) on sixteen spans: the images transposed into lanes,
+/// clamped, the repeat shift, Seed 000 Eq. (9)'s extent and the level pair, lane for lane the
+/// same operations.
+#[inline]
+#[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq")]
+fn span_step16<A: Addr>(c: &Setup16, q: &[[Vec2; 4]; 16]) -> Step16 {
+    // Eight loads of two quads each: z[k] lane l = component l mod 8 (x0 y0 x1 y1 x2 y2 x3
+    // y3) of span 2k + l / 8.
+    // (Plain loops here: closures passed to `array::map` / `from_fn` are not inlined into a
+    // `target_feature` function.)
+    let mut z = [_mm512_setzero_ps(); 8];
+    for (k, zk) in z.iter_mut().enumerate() {
+        // SAFETY: sixteen quads = 128 contiguous floats, read unaligned.
+        *zk = unsafe { _mm512_loadu_ps(q[2 * k].as_ptr() as *const f32) };
+    }
+    // Transpose in three rounds of two-source permutes. Round 1: spans 4m..4m+4, components
+    // 4h..4h+4, lane c·4 + s.
+    let r1 = [
+        perm16!(|l| (l % 4 / 2) * 16 + (l % 4 % 2) * 8 + l / 4),
+        perm16!(|l| (l % 4 / 2) * 16 + (l % 4 % 2) * 8 + 4 + l / 4),
+    ];
+    let mut a = [[z[0]; 2]; 4];
+    for m in 0..4 {
+        for h in 0..2 {
+            a[m][h] = p2(z[2 * m], r1[h], z[2 * m + 1]);
+        }
+    }
+    // Round 2: spans 8g..8g+8, components 4h + 2e + (0, 1), lane c·8 + s.
+    let r2 = [
+        perm16!(|l| (l % 8 / 4) * 16 + (l / 8) * 4 + l % 4),
+        perm16!(|l| (l % 8 / 4) * 16 + (2 + l / 8) * 4 + l % 4),
+    ];
+    let mut b = [[[z[0]; 2]; 2]; 2];
+    for g in 0..2 {
+        for h in 0..2 {
+            for e in 0..2 {
+                b[g][h][e] = p2(a[2 * g][h], r2[e], a[2 * g + 1][h]);
+            }
+        }
+    }
+    // Round 3: all sixteen spans, component 4h + 2e + c: x (c = 0) or y (c = 1) of pixel
+    // j = 2h + e.
+    let r3 = [
+        perm16!(|l| (l / 8) * 16 + l % 8),
+        perm16!(|l| (l / 8) * 16 + 8 + l % 8),
+    ];
+    let (mut sx, mut sy) = ([z[0]; 4], [z[0]; 4]);
+    for j in 0..4 {
+        let (lo, hi) = (b[0][j / 2][j % 2], b[1][j / 2][j % 2]);
+        sx[j] = clamp_nan0_16(_mm512_mul_ps(p2(lo, r3[0], hi), c.sw));
+        sy[j] = clamp_nan0_16(_mm512_mul_ps(p2(lo, r3[1], hi), c.sh));
+    }
+    if A::REPEAT {
+        // Shift each span by whole periods so its corner lies in the first period.
+        let px = _mm512_mul_ps(floor16(_mm512_mul_ps(min4_16(&sx), c.inv_w)), c.sw);
+        let py = _mm512_mul_ps(floor16(_mm512_mul_ps(min4_16(&sy), c.inv_h)), c.sh);
+        for j in 0..4 {
+            sx[j] = _mm512_sub_ps(sx[j], px);
+            sy[j] = _mm512_sub_ps(sy[j], py);
+        }
+    }
+    // Seed 000 Eq. (9): span level from the extent of the four images.
+    let ext = _mm512_max_ps(
+        _mm512_sub_ps(max4_16(&sx), min4_16(&sx)),
+        _mm512_sub_ps(max4_16(&sy), min4_16(&sy)),
+    );
+    let (e, frac) = log2_split16(ext);
+    // K = 3 takes the pair one level coarser (see the module doc's level policy).
+    let fine = _mm512_add_epi32(e, _mm512_set1_epi32(1));
+    let below = _mm512_cmpgt_epi32_mask(_mm512_setzero_si512(), fine);
+    let above = _mm512_cmpgt_epi32_mask(fine, _mm512_set1_epi32(c.last - 1));
+    // below ? 0 : above ? last : fine.
+    let i0 = _mm512_maskz_mov_epi32(
+        !below,
+        _mm512_mask_mov_epi32(fine, above, _mm512_set1_epi32(c.last)),
+    );
+    // Blend two levels unless clamped to the pyramid or frac(λ) = 0.
+    let clamped = below | above;
+    let zero_t = _mm512_cmp_ps_mask::<_CMP_EQ_OQ>(frac, _mm512_setzero_ps());
+    let i1 = _mm512_mask_add_epi32(i0, !clamped, i0, _mm512_set1_epi32(1));
+    Step16 {
+        sx,
+        sy,
+        i0,
+        i1,
+        frac,
+        single: (clamped | zero_t) as i32,
+    }
+}
+
+/// Four per-pixel vectors (lanes = spans) as span-major rows `[span][pixel]` (sixteen spans,
+/// four per register).
+#[inline]
+#[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq")]
+fn span_major16(v: &[__m512; 4]) -> [[f32; 4]; 16] {
+    // Pixels (0, 1) and (2, 3) of spans 8g..8g+8: lane s·2 + p.
+    let h = [
+        perm16!(|l| (l % 2) * 16 + l / 2),
+        perm16!(|l| (l % 2) * 16 + 8 + l / 2),
+    ];
+    let p01 = [p2(v[0], h[0], v[1]), p2(v[0], h[1], v[1])];
+    let p23 = [p2(v[2], h[0], v[3]), p2(v[2], h[1], v[3])];
+    // Spans 4k..4k+4: lane s·4 + p, from span 4(k mod 2) + s of the pair vectors.
+    let r = [
+        perm16!(|l| (l % 4 / 2) * 16 + (l / 4) * 2 + l % 2),
+        perm16!(|l| (l % 4 / 2) * 16 + (4 + l / 4) * 2 + l % 2),
+    ];
+    let mut out = [v[0]; 4];
+    for k in 0..4 {
+        out[k] = p2(p01[k / 2], r[k % 2], p23[k / 2]);
+    }
+    // SAFETY: same size, no invalid bit patterns.
+    unsafe { core::mem::transmute::<[__m512; 4], [[f32; 4]; 16]>(out) }
+}
+
+/// [`super::avx2::span_window`] (K = 3) for sixteen spans at levels `lvl`, lane for lane the
+/// same operations (Seed 000 Eq. 10), arranged for the mspan read as [`mspan_level`] does.
+#[inline]
+#[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq")]
+fn mspan_level16<A: Addr>(
+    c: &Setup16,
+    lvl: __m512i,
+    sx: &[__m512; 4],
+    sy: &[__m512; 4],
+) -> MspanLevel<16> {
+    // Level scale (exactly w_i / w_0 = max(2^−i, 1/w_0)) and size per lane.
+    let scx = _mm512_max_ps(pow2_16(127, lvl), c.inv_w);
+    let scy = _mm512_max_ps(pow2_16(127, lvl), c.inv_h);
+    let one = _mm512_set1_ps(1.0);
+    let wf = _mm512_max_ps(pow2_16(127 + c.nw, lvl), one);
+    let hf = _mm512_max_ps(pow2_16(127 + c.nh, lvl), one);
+    let half = _mm512_set1_ps(0.5);
+    let z = _mm512_setzero_ps();
+    let mut flx = [z; 4];
+    let mut fly = [z; 4];
+    let mut ax = [z; 4];
+    let mut ay = [z; 4];
+    for j in 0..4 {
+        // This level's texel coordinates (Eq. 3 on 2^L r_m − ½), floors and weights.
+        let mut x = _mm512_sub_ps(_mm512_mul_ps(sx[j], scx), half);
+        let mut y = _mm512_sub_ps(_mm512_mul_ps(sy[j], scy), half);
+        if !A::REPEAT {
+            // Clamp-to-edge bilinear equals bilinear at the clamped coordinate.
+            x = _mm512_min_ps(_mm512_max_ps(x, z), _mm512_sub_ps(wf, one));
+            y = _mm512_min_ps(_mm512_max_ps(y, z), _mm512_sub_ps(hf, one));
+        }
+        flx[j] = floor16(x);
+        fly[j] = floor16(y);
+        ax[j] = _mm512_sub_ps(x, flx[j]);
+        ay[j] = _mm512_sub_ps(y, fly[j]);
+    }
+    // The window corner: the span's lowest texel.
+    let (mx, my) = (min4_16(&flx), min4_16(&fly));
+    let (x0, y0) = (_mm512_cvttps_epi32(mx), _mm512_cvttps_epi32(my));
+    let (wi, hi) = (_mm512_cvttps_epi32(wf), _mm512_cvttps_epi32(hf));
+    // Level offset (0 ≤ lvl < 16: one table permute), + y0·w + x0.
+    let corner = _mm512_add_epi32(
+        _mm512_add_epi32(
+            _mm512_permutexvar_epi32(lvl, c.offs),
+            _mm512_mullo_epi32(y0, wi),
+        ),
+        x0,
+    );
+    // Each pixel's offset from the corner: oy·16 + ox·4 (small non-negative integers in
+    // interior windows, exact in f32), and the spans with an offset past the window.
+    let lim = _mm512_set1_ps(1.0);
+    let (s16, s4) = (_mm512_set1_ps(16.0), _mm512_set1_ps(4.0));
+    let mut over: __mmask16 = 0;
+    let mut o = [z; 4];
+    for j in 0..4 {
+        let ox = _mm512_sub_ps(flx[j], mx);
+        let oy = _mm512_sub_ps(fly[j], my);
+        over |=
+            _mm512_cmp_ps_mask::<_CMP_GT_OQ>(ox, lim) | _mm512_cmp_ps_mask::<_CMP_GT_OQ>(oy, lim);
+        let v = _mm512_add_ps(_mm512_mul_ps(oy, s16), _mm512_mul_ps(ox, s4));
+        o[j] = _mm512_castsi512_ps(_mm512_cvttps_epi32(v));
+    }
+    // Interior: x0 ≥ 0, y0 ≥ 0, x0 + 3 ≤ w, y0 + 3 ≤ h.
+    let k = _mm512_set1_epi32(3);
+    let zi = _mm512_setzero_si512();
+    let outside = _mm512_cmpgt_epi32_mask(zi, x0)
+        | _mm512_cmpgt_epi32_mask(zi, y0)
+        | _mm512_cmpgt_epi32_mask(_mm512_add_epi32(x0, k), wi)
+        | _mm512_cmpgt_epi32_mask(_mm512_add_epi32(y0, k), hi);
+    let o = span_major16(&o);
+    MspanLevel {
+        corner: to_u32x16(_mm512_slli_epi32::<1>(corner)),
+        w2: to_u32x16(_mm512_slli_epi32::<1>(wi)),
+        // SAFETY: same size, no invalid bit patterns (the i32 bits moved as f32 lanes).
+        o: unsafe { core::mem::transmute::<[[f32; 4]; 16], [[i32; 4]; 16]>(o) },
+        ax: span_major16(&ax),
+        ay: span_major16(&ay),
+        ok: !(over | outside) as i32 & 0xffff,
+    }
+}
+
+/// Sixteen `i32` lanes as an array (stored once, read per span).
+#[inline(always)]
+fn to_u32x16(v: __m512i) -> [u32; 16] {
+    // SAFETY: same size, no invalid bit patterns.
+    unsafe { core::mem::transmute::<__m512i, [u32; 16]>(v) }
+}
+
+/// [`span_quads_k3`] sixteen spans per step, the whole set-up in 512-bit lanes (no 256-bit
+/// µops in the loop but the edge path's): bit-identical, whole groups of sixteen spans (the
+/// caller does the tail, e.g. [`span_quads_k3`] then the scalar remainder).
+///
+/// # Safety
+/// The CPU must support AVX-512F/VL/BW/DQ; the texture must be a power of two.
+#[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq")]
+pub(super) unsafe fn span_quads_k3_x16<A: Addr>(
+    tex: &MipTexture,
+    quads: &[[Vec2; 4]],
+    out: &mut [[Vec4; 4]],
+) -> usize {
+    debug_assert!(tex.is_pow2());
+    let c = Setup16::new(tex);
+    let base = tex.texels().as_ptr() as *const u8;
+    let n = quads.len().min(out.len()) / 16 * 16;
+    let k = MspanConsts::new();
+    for (o, q) in out[..n]
+        .chunks_exact_mut(16)
+        .zip(quads[..n].chunks_exact(16))
+    {
+        let s = span_step16::<A>(&c, q.try_into().expect("sixteen spans"));
+        let mut a = mspan_level16::<A>(&c, s.i0, &s.sx, &s.sy);
+        let mut b = mspan_level16::<A>(&c, s.i1, &s.sx, &s.sy);
+        // SAFETY: same size, no invalid bit patterns.
+        let mut fr = unsafe { core::mem::transmute::<__m512, [f32; 16]>(s.frac) };
+        // Keep the per-span values in memory: each is then one load or one broadcast load.
+        core::hint::black_box((&mut a, &mut b, &mut fr));
+        let (fast, single) = (a.ok & (b.ok | s.single), s.single);
+        macro_rules! spans {
+            ($($i:literal)*) => {$(
+                mspan_out::<A, 16, $i>(tex, base, &a, &b, &fr, fast, single, &k, q[$i], &mut o[$i]);
+            )*};
+        }
+        // SAFETY: `mspan_out`'s contract: levels from `mspan_level16` on this texture.
+        unsafe {
+            spans!(0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15);
+        }
+    }
+    n
 }
 
 // ---------------------------------------------------------------------------------------------

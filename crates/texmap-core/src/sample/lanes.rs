@@ -655,8 +655,13 @@ pub(super) fn span_quads4_best<A: Addr, const K: usize>(
     out: &mut [[Vec4; 4]],
 ) -> usize {
     if K == 3 && has_avx512() {
+        // Sixteen spans per step (the set-up in 512-bit lanes), then the eight-span kernel on
+        // what is left (the caller does the last < 8 spans).
         // SAFETY: AVX-512F/VL/BW/DQ were detected just above; the callers check `tex.is_pow2()`.
-        unsafe { super::avx512::span_quads_k3::<A>(tex, quads, out) }
+        unsafe {
+            let n = super::avx512::span_quads_k3_x16::<A>(tex, quads, out);
+            n + super::avx512::span_quads_k3::<A>(tex, &quads[n..], &mut out[n..])
+        }
     } else if has_avx2() {
         // SAFETY: AVX2 was detected just above.
         unsafe { span_quads4_avx2::<A, K>(tex, quads, out) }
