@@ -95,10 +95,11 @@
 //! - `sample/avx512.rs`: where the CPU has AVX-512F/VL/BW/DQ, the span sampler with K = 3 reads
 //!   each span's interior 3x3 window as Seed 000's mspan (three masked 512-bit row loads, one
 //!   zmm = four pixels x RGBA; each pixel's 2x2 picked by four `vpermt2ps` per level; the three
-//!   Eq. 4 lerps and the level blend on the four pixels at once), the AVX2 eight-span set-up
-//!   compiled with the AVX-512 features. Per-pixel trilinear has an AVX-512 build too (four
-//!   pixels per zmm), measured SLOWER than its AVX2 build on the Sapphire Rapids-class Xeon and
-//!   therefore not chosen (`lanes::TRILINEAR_AVX512`); K = 4 keeps the AVX2 kernel.
+//!   Eq. 4 lerps and the level blend on the four pixels at once), sixteen spans per step with
+//!   the set-up in 512-bit lanes (the AVX2 eight-span set-up on a group of eight left over).
+//!   Per-pixel trilinear likewise, for fairness: sixteen pixels per step, the set-up in 512-bit
+//!   lanes, four pixels per zmm for the taps (`lanes::TRILINEAR_AVX512`: measured faster than
+//!   its AVX2 build on the Sapphire Rapids-class Xeon); K = 4 keeps the AVX2 kernel.
 //!
 //! Both builds are bit-identical to the scalar kernels and to the bank emulator (no FMA anywhere;
 //! tests below, which fail under mutations of the weights, blend masks and indices).
@@ -1549,8 +1550,8 @@ mod tests {
     #[cfg(target_arch = "x86_64")]
     #[test]
     fn sse2_and_runtime_chosen_lane_builds_agree_bit_for_bit() {
-        // The bulk calls above test the build chosen for this CPU (AVX2 here); the SSE2 baseline
-        // build must give the same bits.
+        // The bulk calls above test the build chosen for this CPU (AVX2 or AVX-512); the SSE2
+        // baseline build must give the same bits.
         let t = ramp(128, 64, Wrap::Repeat);
         let (uv, dx, dy) = random_pixels(4000, 99);
         let mut a = vec![Vec4::ZERO; uv.len()];
@@ -1577,8 +1578,8 @@ mod tests {
     #[cfg(target_arch = "x86_64")]
     #[test]
     fn avx512_lane_builds_match_the_sse2_baseline_bit_for_bit() {
-        // The AVX-512 kernels (per-pixel trilinear four pixels per zmm; the span sampler's mspan
-        // read, K = 3) against the SSE2 baseline over every input regime of `random_pixels` /
+        // The AVX-512 kernels (per-pixel trilinear sixteen pixels per step, four per zmm; the
+        // span sampler's mspan read, K = 3) against the SSE2 baseline over every input regime of `random_pixels` /
         // `random_quads` on square, wide, tall and tiny power-of-two pyramids, both wraps (edge
         // windows included: they take the AVX2 edge path). Skipped where the CPU lacks AVX-512.
         if !lanes::has_avx512() {
@@ -1613,13 +1614,42 @@ mod tests {
                     ($A:ty) => {{
                         let na = lanes::trilinear_pixels::<$A>(&t, &uv, &dx, &dy, &mut a);
                         // SAFETY: AVX-512F/VL/BW/DQ detected above; `t` is a power of two.
-                        let nb =
-                            unsafe { avx512::trilinear_pixels::<$A>(&t, &uv, &dx, &dy, &mut b) };
+                        let nb = unsafe {
+                            avx512::trilinear_pixels_x16::<$A>(&t, &uv, &dx, &dy, &mut b)
+                        };
                         assert_eq!((na, nb), (4000, 4000));
                         lanes::span_quads4::<$A, 3>(&t, &quads, &mut qa);
                         // SAFETY: as above.
                         let nq = unsafe { avx512::span_quads_k3::<$A>(&t, &quads, &mut qb) };
                         assert_eq!(nq, 4000);
+                        // Trilinear sixteen pixels per step likewise: the kernel alone, the
+                        // chosen build (16, then the AVX2 build on the rest) and the public call
+                        // (then the scalar remainder).
+                        for len in [4000, 3992, 3987, 24, 17, 13, 7, 0] {
+                            let same = |what: &str, n: usize, c: &[Vec4]| {
+                                assert_eq!(
+                                    bits(&a[..n]),
+                                    bits(&c[..n]),
+                                    "trilinear {what} {w}x{h} {wrap:?} len {len}"
+                                );
+                            };
+                            let (u, x, y) = (&uv[..len], &dx[..len], &dy[..len]);
+                            let mut c = vec![Vec4::ZERO; len];
+                            // SAFETY: as above.
+                            let n16 =
+                                unsafe { avx512::trilinear_pixels_x16::<$A>(&t, u, x, y, &mut c) };
+                            assert_eq!(n16, len / 16 * 16);
+                            same("x16", n16, &c);
+                            let mut c = vec![Vec4::ZERO; len];
+                            let nb = lanes::trilinear_pixels_best::<$A>(&t, u, x, y, &mut c);
+                            assert_eq!(nb, len / 8 * 8);
+                            same("best", nb, &c);
+                            let mut c = vec![Vec4::ZERO; len];
+                            Sampler::Trilinear
+                                .sample_pixels(&t, u, x, y, &mut c)
+                                .expect("same lengths");
+                            same("sample_pixels", len, &c);
+                        }
                         // Sixteen spans per step on scenes that are not whole groups of 16
                         // (or of 8): the kernel alone, the chosen build (16, then the
                         // 8-span kernel on the rest) and the public call (then the scalar

@@ -335,9 +335,9 @@ pub(super) struct TriStep {
     pub(super) single: i32,
 }
 
-/// The set-up of pixels `i..i + 8` (shared by the AVX2 and AVX-512 builds): Seed 000 Eq. (2)'s
-/// footprint and the level split as the SSE2 `trilinear4` (the caller then runs [`tri_level`] on
-/// both levels, where the indices are to stay: moving them costs copies).
+/// The set-up of pixels `i..i + 8`: Seed 000 Eq. (2)'s footprint and the level split as the
+/// SSE2 `trilinear4` (the caller then runs [`tri_level`] on both levels, where the indices are
+/// to stay: moving them costs copies).
 ///
 /// # Safety
 /// `i + 8` must not exceed the length of `uv`, `dx` and `dy`.

@@ -3,21 +3,24 @@
 //! spans per step (`span_quads_k3`, the AVX2 set-up; it takes the groups of eight left over),
 //! its four pixels read as the paper's mspan (chosen at run time by [`super::lanes`]'s
 //! `span_quads4_best` where the CPU has AVX-512F/VL/BW/DQ; the AVX2 and SSE2 builds stay the
-//! fallbacks), and per-pixel trilinear eight pixels per step (built and tested, not chosen: see
-//! `lanes::TRILINEAR_AVX512`).
+//! fallbacks), and per-pixel trilinear sixteen pixels per step, its set-up in 512-bit lanes
+//! (`trilinear_pixels_x16`, chosen by `trilinear_pixels_best`: see `lanes::TRILINEAR_AVX512`;
+//! the AVX2 build takes the group of eight left over).
 //!
 //! The arithmetic is the AVX2 / SSE2 / scalar kernels' operation for operation (`a + (b − a)·t`,
 //! no FMA: Rust never contracts a multiply and an add), so the results are the same bits (tested
 //! in `super::tests` against the SSE2 baseline and the bank emulator). The set-up of each step
 //! (footprint or span extent, level pair, level sizes, texel coordinates, floors, weights,
 //! window corners) is the AVX2 build's eight-lane code, here compiled with the AVX-512 features
-//! (EVEX encoding, 32 vector registers) — except in `span_quads_k3_x16`, where the same
-//! operations run on sixteen spans per zmm (`span_step16`, `mspan_level16`: the 32 images
+//! (EVEX encoding, 32 vector registers) — except in `span_quads_k3_x16` and
+//! `trilinear_pixels_x16`, where the same operations run on sixteen spans or pixels per zmm (`span_step16`, `mspan_level16`: the 32 images
 //! transposed by three rounds of `vpermt2ps`, compares into mask registers, the level offset by
 //! one `vpermd` over the 16-entry table), so that the loop issues no 256-bit µops (with 512-bit
 //! µops in flight, Intel cores fuse vector ports 0 and 1, and 256-bit work loses a port); on
 //! the Sapphire Rapids-class Xeon it measured faster than the eight-span kernel (interleaved
-//! best-frame runs and criterion). What changes is the per-pixel part:
+//! best-frame runs and criterion), and trilinear's sixteen-pixel build faster than its AVX2
+//! build (where its eight-pixel AVX-512 build, the AVX2 set-up, had been slower). What changes
+//! is the per-pixel part:
 //!
 //! - **span sampler (Seed 000 Eq. 8–10, K = 3), the mspan read:** one span = four pixels x RGBA
 //!   = sixteen floats = one zmm. Its interior 3x3 window is read as three rows of three texels
@@ -31,11 +34,14 @@
 //!   from memory (load ports, no shuffle), and one `vpermps` turns the result back into pixel
 //!   order before the one 512-bit store per span. The three Eq. (4) bilinear lerps and the level
 //!   blend (one weight per span, a broadcast load) run on the four pixels at once.
-//! - **per-pixel trilinear (Seed 000 Eq. 2 + 4), for fairness:** the same four pixels per zmm
-//!   for the taps, lerps and blend: each tap of four pixels is one 128-bit load and three
-//!   `vinsertf32x4` from memory, the weights one `vpermps` each, one 512-bit store per four
-//!   pixels; where no pixel of the eight sits on a level edge it takes two indices per pixel
-//!   and level, as the AVX2 build does.
+//! - **per-pixel trilinear (Seed 000 Eq. 2–4), for fairness:** the set-up of sixteen pixels
+//!   (footprint, λ split, level pair, per-level texel coordinates, floors, weights, wrapped
+//!   indices, edge bits) in lanes = pixels (`tri_step16`, `tri_level16`: the inputs
+//!   deinterleaved by two `vpermt2ps` per array, compares into mask registers, the level offset
+//!   by one `vpermd`); then the same four pixels per zmm for the taps, lerps and blend: each tap
+//!   of four pixels is one 128-bit load and three `vinsertf32x4` from memory, the weights one
+//!   `vpermps` each, one 512-bit store per four pixels; where none of the four sits on a level
+//!   edge it takes two indices per pixel and level, as the AVX2 build does per eight.
 //!
 //! Spans whose window is not interior (a level edge, or a level narrower than three texels)
 //! take the AVX2 build's out-of-line edge path; K = 4 keeps the AVX2 kernel (its window's rows
@@ -47,8 +53,7 @@ use glam::{Vec2, Vec4};
 
 use super::Addr;
 use super::avx2::{
-    Offsets, SpanSetup, SpanStep, SpanWindow, TriLevel, TriSetup, TriStep, edge_span, span_step,
-    span_window, to_u32x8, tri_level, tri_step,
+    Offsets, SpanSetup, SpanStep, SpanWindow, edge_span, span_step, span_window, to_u32x8,
 };
 use crate::mip::MipTexture;
 
@@ -389,7 +394,8 @@ fn max4_16(v: &[__m512; 4]) -> __m512 {
     _mm512_max_ps(_mm512_max_ps(v[0], v[1]), _mm512_max_ps(v[2], v[3]))
 }
 
-/// A texture's constants for [`span_step16`] and [`mspan_level16`].
+/// A texture's constants for [`span_step16`] and [`mspan_level16`] (and trilinear's
+/// [`tri_step16`] and [`tri_level16`]).
 struct Setup16 {
     /// The 16-entry level-offset table (one `vpermd` per lookup).
     offs: __m512i,
@@ -422,11 +428,13 @@ impl Setup16 {
     }
 }
 
-/// Sixteen spans' level-0 texel coordinates (`sx[j]`, `sy[j]`: pixel `j`, lane = span), their
-/// level pair, Eq. (4) weight and the bits of single-level spans.
-struct Step16 {
-    sx: [__m512; 4],
-    sy: [__m512; 4],
+/// Sixteen lanes' coordinates, their level pair, Eq. (4) weight and the bits of single-level
+/// lanes: for the span sampler (`C = [__m512; 4]`) the spans' level-0 texel coordinates (`sx[j]`,
+/// `sy[j]`: pixel `j`, lane = span), for trilinear (`C = __m512`) the pixels' map coordinates
+/// (lane = pixel).
+struct Step16<C = [__m512; 4]> {
+    sx: C,
+    sy: C,
     i0: __m512i,
     i1: __m512i,
     frac: __m512,
@@ -679,93 +687,264 @@ pub(super) unsafe fn span_quads_k3_x16<A: Addr>(
 }
 
 // ---------------------------------------------------------------------------------------------
-// Per-pixel trilinear: eight pixels per step, four per zmm.
+// Per-pixel trilinear: sixteen pixels per step, the set-up in 512-bit lanes (lane = pixel).
 
-/// Bilinear of pixels `4G..4G + 4` of a step (lanes `[0 2 4 6 | 1 3 5 7]` of the set-up: pixels
-/// 0–3 are lanes 0 4 1 5, pixels 4–7 lanes 2 6 3 7), pixel-major; `widx` spreads the lanes'
-/// weights over the pixels' four channels.
+/// Sixteen `Vec2` as `(x lanes, y lanes)`, pixel `p` in lane `p`.
 ///
 /// # Safety
-/// `p` must come from `tri_level` on the texture whose texels start at `base`.
+/// `p` must point to at least 32 readable floats.
 #[inline]
 #[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq")]
-unsafe fn tri_quad<const G: usize, const INSIDE: bool>(
+unsafe fn deinterleave16(p: *const f32) -> (__m512, __m512) {
+    // SAFETY: the caller's contract.
+    let (a, b) = unsafe { (_mm512_loadu_ps(p), _mm512_loadu_ps(p.add(16))) };
+    (
+        p2(a, perm16!(|l| 2 * l), b),
+        p2(a, perm16!(|l| 2 * l + 1), b),
+    )
+}
+
+/// [`super::avx2::tri_step`] on sixteen pixels `i..i + 16`: Seed 000 Eq. (2)'s footprint (NaN
+/// terms as 0) and the level split, lane for lane the same operations (compares into mask
+/// registers).
+///
+/// # Safety
+/// `i + 16` must not exceed the length of `uv`, `dx` and `dy`.
+#[inline]
+#[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq")]
+unsafe fn tri_step16(
+    c: &Setup16,
+    i: usize,
+    uv: &[Vec2],
+    dx: &[Vec2],
+    dy: &[Vec2],
+) -> Step16<__m512> {
+    let abs = _mm512_castsi512_ps(_mm512_set1_epi32(0x7fff_ffff));
+    // SAFETY: the caller's contract (16 Vec2 = 32 floats from `i` in each slice).
+    let ((u, v), (dxu, dxv), (dyu, dyv)) = unsafe {
+        (
+            deinterleave16(uv.as_ptr().add(i) as *const f32),
+            deinterleave16(dx.as_ptr().add(i) as *const f32),
+            deinterleave16(dy.as_ptr().add(i) as *const f32),
+        )
+    };
+    // Seed 000 Eq. (2): the footprint, NaN terms as 0 (`maxps` returns its second operand, +0,
+    // when the first is NaN).
+    let z = _mm512_setzero_ps();
+    let (sw, sh) = (c.sw, c.sh);
+    let fu = _mm512_max_ps(
+        _mm512_max_ps(_mm512_and_ps(_mm512_mul_ps(dxu, sw), abs), z),
+        _mm512_max_ps(_mm512_and_ps(_mm512_mul_ps(dyu, sw), abs), z),
+    );
+    let fv = _mm512_max_ps(
+        _mm512_max_ps(_mm512_and_ps(_mm512_mul_ps(dxv, sh), abs), z),
+        _mm512_max_ps(_mm512_and_ps(_mm512_mul_ps(dyv, sh), abs), z),
+    );
+    let m = _mm512_max_ps(fu, fv);
+    // λ = log2 m split into ⌊λ⌋ and frac(λ); level pair as `trilinear4`.
+    let (e, frac) = log2_split16(m);
+    let minified = _mm512_cmp_ps_mask::<_CMP_GT_OQ>(m, _mm512_set1_ps(1.0));
+    let past_top = _mm512_cmpgt_epi32_mask(e, _mm512_set1_epi32(c.last - 1));
+    // minified ? (past_top ? last : e) : 0.
+    let i0 = _mm512_maskz_mov_epi32(
+        minified,
+        _mm512_mask_mov_epi32(e, past_top, _mm512_set1_epi32(c.last)),
+    );
+    let single = !minified | past_top;
+    let i1 = _mm512_mask_add_epi32(i0, !single, i0, _mm512_set1_epi32(1));
+    Step16 {
+        sx: u,
+        sy: v,
+        i0,
+        i1,
+        frac,
+        single: single as i32,
+    }
+}
+
+/// One level of sixteen pixels (lane = pixel): the doubled texel indices of their 2x2 taps and
+/// their weights.
+struct TriLevel16 {
+    /// `[t00, t10, t01, t11][pixel]`.
+    idx: [[u32; 16]; 4],
+    ax: __m512,
+    ay: __m512,
+    /// Bits of the pixels whose 2x2 is split by the level edge (`x1 ≠ x0 + 1` or
+    /// `y1 ≠ y0 + 1`); where clear, `t10 = t00 + 1` and `t11 = t01 + 1`.
+    edge: i32,
+}
+
+/// `Addr::wrap` on sixteen lanes (`n`: the level size per lane; Repeat on power-of-two levels).
+#[inline]
+#[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq")]
+fn wrap16<A: Addr>(i: __m512i, n: __m512i) -> __m512i {
+    let nm1 = _mm512_sub_epi32(n, _mm512_set1_epi32(1));
+    if A::REPEAT {
+        _mm512_and_si512(i, nm1)
+    } else {
+        _mm512_min_epi32(_mm512_max_epi32(i, _mm512_setzero_si512()), nm1)
+    }
+}
+
+/// [`super::avx2::tri_level`] on sixteen pixels at levels `lvl`: Seed 000 Eq. (3) on
+/// `2^L r_m − ½`, lane for lane the same operations, then the texel indices in lanes.
+#[inline]
+#[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq")]
+fn tri_level16<A: Addr>(c: &Setup16, u: __m512, v: __m512, lvl: __m512i) -> TriLevel16 {
+    let one = _mm512_set1_ps(1.0);
+    let wf = _mm512_max_ps(pow2_16(127 + c.nw, lvl), one);
+    let hf = _mm512_max_ps(pow2_16(127 + c.nh, lvl), one);
+    let half = _mm512_set1_ps(0.5);
+    // [`super::clampc`]: NaN -> −2^30 (`maxps` returns its second operand), then ±2^30.
+    let (lo, hi) = (
+        _mm512_set1_ps(-super::COORD_LIMIT),
+        _mm512_set1_ps(super::COORD_LIMIT),
+    );
+    // Texel coordinates with texel centres at integers, floors and Eq. (4) weights.
+    let x = _mm512_min_ps(
+        _mm512_max_ps(_mm512_sub_ps(_mm512_mul_ps(u, wf), half), lo),
+        hi,
+    );
+    let y = _mm512_min_ps(
+        _mm512_max_ps(_mm512_sub_ps(_mm512_mul_ps(v, hf), half), lo),
+        hi,
+    );
+    let (flx, fly) = (floor16(x), floor16(y));
+    let (ax, ay) = (_mm512_sub_ps(x, flx), _mm512_sub_ps(y, fly));
+    let (fx, fy) = (_mm512_cvttps_epi32(flx), _mm512_cvttps_epi32(fly));
+    let (wi, hi) = (_mm512_cvttps_epi32(wf), _mm512_cvttps_epi32(hf));
+    let one_i = _mm512_set1_epi32(1);
+    // Wrapped columns and rows (Addr), then texel indices offset + y·w + x, doubled.
+    let x0 = wrap16::<A>(fx, wi);
+    let x1 = wrap16::<A>(_mm512_add_epi32(fx, one_i), wi);
+    let y0 = wrap16::<A>(fy, hi);
+    let y1 = wrap16::<A>(_mm512_add_epi32(fy, one_i), hi);
+    // Level offset (0 ≤ lvl < 16: one table permute).
+    let off = _mm512_permutexvar_epi32(lvl, c.offs);
+    let r0 = _mm512_add_epi32(off, _mm512_mullo_epi32(y0, wi));
+    let r1 = _mm512_add_epi32(off, _mm512_mullo_epi32(y1, wi));
+    let d = |r: __m512i, c: __m512i| to_u32x16(_mm512_slli_epi32::<1>(_mm512_add_epi32(r, c)));
+    // Pixels whose 2x2 is not split by wrap-around or clamping at the level edge.
+    let inside = _mm512_cmpeq_epi32_mask(x1, _mm512_add_epi32(x0, one_i))
+        & _mm512_cmpeq_epi32_mask(y1, _mm512_add_epi32(y0, one_i));
+    TriLevel16 {
+        idx: [d(r0, x0), d(r0, x1), d(r1, x0), d(r1, x1)],
+        ax,
+        ay,
+        edge: !inside as i32 & 0xffff,
+    }
+}
+
+/// Bilinear of pixels `4G..4G + 4` of a sixteen-pixel step, pixel-major (`widx` spreads lane
+/// `4G + k`'s weights over pixel `k`'s four channels).
+///
+/// # Safety
+/// `p` must come from [`tri_level16`] on the texture whose texels start at `base`.
+#[inline]
+#[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq")]
+unsafe fn tri_quad16<const G: usize, const INSIDE: bool>(
     base: *const u8,
-    p: &TriLevel,
+    p: &TriLevel16,
     widx: __m512i,
 ) -> __m512 {
-    let l = if G == 0 { [0, 4, 1, 5] } else { [2, 6, 3, 7] };
-    let ld = |c: usize, d: usize| {
-        // SAFETY: the caller's contract (indices inside the texel buffer).
-        let at = |k: usize| unsafe {
-            _mm_loadu_ps(base.add((p.idx[c][l[k]] as usize + d) * 8) as *const f32)
-        };
-        let v = _mm512_castps128_ps512(at(0));
-        let v = _mm512_insertf32x4::<1>(v, at(1));
-        let v = _mm512_insertf32x4::<2>(v, at(2));
-        _mm512_insertf32x4::<3>(v, at(3))
-    };
+    // Four pixels' texel `c` (plus `d` doubled units): one 128-bit load and three inserts.
+    macro_rules! ld {
+        ($c:expr, $d:expr) => {{
+            let ix = &p.idx[$c];
+            // SAFETY: the caller's contract (indices inside the texel buffer).
+            unsafe {
+                let at = |k: usize| base.add((ix[4 * G + k] as usize + $d) * 8) as *const f32;
+                let v = _mm512_castps128_ps512(_mm_loadu_ps(at(0)));
+                let v = _mm512_insertf32x4::<1>(v, _mm_loadu_ps(at(1)));
+                let v = _mm512_insertf32x4::<2>(v, _mm_loadu_ps(at(2)));
+                _mm512_insertf32x4::<3>(v, _mm_loadu_ps(at(3)))
+            }
+        }};
+    }
     // No pixel's 2x2 split by the level edge: two indices per pixel (t10 = t00 + 1 texel, two
     // doubled units); else the four wrapped ones.
-    let (t00, t01) = (ld(0, 0), ld(2, 0));
+    let (t00, t01) = (ld!(0, 0), ld!(2, 0));
     let (t10, t11) = if INSIDE {
-        (ld(0, 2), ld(2, 2))
+        (ld!(0, 2), ld!(2, 2))
     } else {
-        (ld(1, 0), ld(3, 0))
+        (ld!(1, 0), ld!(3, 0))
     };
-    let wx = _mm512_permutexvar_ps(widx, _mm512_castps256_ps512(p.ax));
-    let wy = _mm512_permutexvar_ps(widx, _mm512_castps256_ps512(p.ay));
+    let wx = _mm512_permutexvar_ps(widx, p.ax);
+    let wy = _mm512_permutexvar_ps(widx, p.ay);
     lerp16(lerp16(t00, t10, wx), lerp16(t01, t11, wx), wy)
 }
 
-/// Pixels `4G..4G + 4` of a step: level `a`, or Eq. (4)'s blend with level `b` by `frac`
-/// where a pixel blends two levels (`sv`: lane mask of single-level pixels, `single` its bits).
+/// Each of four bits spread over four mask bits (a group's pixels over their channels).
+const SPREAD4: [u16; 16] = {
+    let mut r = [0u16; 16];
+    let mut b = 0;
+    while b < 16 {
+        let mut k = 0;
+        while k < 4 {
+            if b & (1 << k) != 0 {
+                r[b] |= 0xf << (4 * k);
+            }
+            k += 1;
+        }
+        b += 1;
+    }
+    r
+};
+
+/// Pixels `4G..4G + 4` of a sixteen-pixel step: level `a`, or Eq. (4)'s blend with level `b`
+/// by `frac` where a pixel blends two levels; four taps per pixel and level where one of the
+/// four sits on a level edge, else two.
 ///
 /// # Safety
-/// As [`tri_quad`]; `o` must hold eight `Vec4`.
+/// As [`tri_quad16`]; `o` must hold sixteen `Vec4`.
 #[inline]
 #[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq")]
-unsafe fn tri_out<const G: usize, const INSIDE: bool>(
+unsafe fn tri_out16<const G: usize>(
     base: *const u8,
-    pa: &TriLevel,
-    pb: &TriLevel,
-    s: &TriStep,
+    pa: &TriLevel16,
+    pb: &TriLevel16,
+    s: &Step16<__m512>,
     widx: __m512i,
     o: *mut f32,
 ) {
-    let lanes = if G == 0 { 0b0011_0011 } else { 0b1100_1100 };
-    let single = s.single & lanes;
+    let single = (s.single >> (4 * G)) & 0xf;
+    let edge = ((pa.edge | pb.edge) >> (4 * G)) & 0xf;
     // SAFETY: the caller's contract.
     unsafe {
-        let ca = tri_quad::<G, INSIDE>(base, pa, widx);
-        let r = if single == lanes {
+        macro_rules! quad {
+            ($p:expr) => {
+                if edge == 0 {
+                    tri_quad16::<G, true>(base, $p, widx)
+                } else {
+                    tri_quad16::<G, false>(base, $p, widx)
+                }
+            };
+        }
+        let ca = quad!(pa);
+        let r = if single == 0xf {
             ca
         } else {
             // Seed 000 Eq. (4): blend the two levels by frac(λ); single pixels keep `ca`.
-            let cb = tri_quad::<G, INSIDE>(base, pb, widx);
-            let t = _mm512_permutexvar_ps(widx, _mm512_castps256_ps512(s.frac));
-            let r = lerp16(ca, cb, t);
+            let cb = quad!(pb);
+            let r = lerp16(ca, cb, _mm512_permutexvar_ps(widx, s.frac));
             if single == 0 {
                 r
             } else {
-                let sv = _mm512_permutexvar_epi32(
-                    widx,
-                    _mm512_castsi256_si512(_mm256_castps_si256(s.sv)),
-                );
-                _mm512_mask_blend_ps(_mm512_movepi32_mask(sv), r, ca)
+                _mm512_mask_blend_ps(SPREAD4[single as usize], r, ca)
             }
         };
         _mm512_storeu_ps(o.add(16 * G), r);
     }
 }
 
-/// [`super::lanes::trilinear_pixels`] for AVX-512, eight pixels per step, four per zmm:
-/// bit-identical, whole chunks of eight (the caller does the tail).
+/// [`super::lanes::trilinear_pixels`] for AVX-512 sixteen pixels per step, the whole set-up in
+/// 512-bit lanes (no 256-bit µops in the loop), four pixels per zmm for the taps, lerps and
+/// blend: bit-identical, whole chunks of sixteen (the caller does the tail).
 ///
 /// # Safety
 /// The CPU must support AVX-512F/VL/BW/DQ; the texture must be a power of two.
 #[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq")]
-pub(super) unsafe fn trilinear_pixels<A: Addr>(
+pub(super) unsafe fn trilinear_pixels_x16<A: Addr>(
     tex: &MipTexture,
     uv: &[Vec2],
     dx: &[Vec2],
@@ -773,29 +952,29 @@ pub(super) unsafe fn trilinear_pixels<A: Addr>(
     out: &mut [Vec4],
 ) -> usize {
     debug_assert!(tex.is_pow2());
-    let c = TriSetup::new(tex);
+    let c = Setup16::new(tex);
     let base = tex.texels().as_ptr() as *const u8;
-    let n = uv.len().min(dx.len()).min(dy.len()).min(out.len()) / 8 * 8;
-    // Pixel p of a group of four takes lane l[p]'s weights in its four channels.
-    let w0 = lanes16([0, 0, 0, 0, 4, 4, 4, 4, 1, 1, 1, 1, 5, 5, 5, 5]);
-    let w1 = _mm512_add_epi32(w0, _mm512_set1_epi32(2));
-    for i in (0..n).step_by(8) {
-        // SAFETY: i + 8 ≤ n ≤ every slice's length (8 Vec2 = 16 floats, 8 Vec4 = 32 floats);
-        // the indices come from `tri_level` on this texture.
+    let n = uv.len().min(dx.len()).min(dy.len()).min(out.len()) / 16 * 16;
+    // Pixel k of group G takes lane 4G + k's weights in its four channels.
+    let w = perm16!(|l| l / 4);
+    let four = _mm512_set1_epi32(4);
+    let w1 = _mm512_add_epi32(w, four);
+    let w2 = _mm512_add_epi32(w1, four);
+    let w3 = _mm512_add_epi32(w2, four);
+    for i in (0..n).step_by(16) {
+        // SAFETY: i + 16 ≤ n ≤ every slice's length (16 Vec2 = 32 floats, 16 Vec4 = 64
+        // floats); the indices come from `tri_level16` on this texture.
         unsafe {
-            let s = tri_step::<A>(&c, i, uv, dx, dy);
-            let mut pa = tri_level::<A>(s.u, s.v, s.i0, c.nw, c.nh, c.offs);
-            let mut pb = tri_level::<A>(s.u, s.v, s.i1, c.nw, c.nh, c.offs);
+            let s = tri_step16(&c, i, uv, dx, dy);
+            let mut pa = tri_level16::<A>(&c, s.sx, s.sy, s.i0);
+            let mut pb = tri_level16::<A>(&c, s.sx, s.sy, s.i1);
             // Keep the indices in memory: one load per index.
             core::hint::black_box((&mut pa.idx, &mut pb.idx));
             let o = out.as_mut_ptr().add(i) as *mut f32;
-            if pa.edge | pb.edge == 0 {
-                tri_out::<0, true>(base, &pa, &pb, &s, w0, o);
-                tri_out::<1, true>(base, &pa, &pb, &s, w1, o);
-            } else {
-                tri_out::<0, false>(base, &pa, &pb, &s, w0, o);
-                tri_out::<1, false>(base, &pa, &pb, &s, w1, o);
-            }
+            tri_out16::<0>(base, &pa, &pb, &s, w, o);
+            tri_out16::<1>(base, &pa, &pb, &s, w1, o);
+            tri_out16::<2>(base, &pa, &pb, &s, w2, o);
+            tri_out16::<3>(base, &pa, &pb, &s, w3, o);
         }
     }
     n

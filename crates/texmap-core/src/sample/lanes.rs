@@ -590,14 +590,18 @@ pub(super) fn has_avx512() -> bool {
         && std::arch::is_x86_feature_detected!("avx512dq")
 }
 
-/// Whether bulk per-pixel trilinear takes its AVX-512 build where the CPU has AVX-512. Off: on
-/// the Sapphire Rapids-class Xeon it was built and measured on (docs/PERFORMANCE.md, "Fifth
-/// round: span sampler"), best-frame thread CPU per sample was ~12.5–16 ns against the AVX2
-/// build's ~8–9 (interleaved runs; a 256-bit EVEX build of the AVX2 code and a set-up kept out
-/// of line in pure AVX2 were as slow), so the run-time choice that is fair to trilinear is its
-/// AVX2 build. The kernel is kept and tested bit for bit
-/// (`avx512_lane_builds_match_the_sse2_baseline_bit_for_bit`), to measure again on other CPUs.
-const TRILINEAR_AVX512: bool = false;
+/// Whether bulk per-pixel trilinear takes its AVX-512 build where the CPU has AVX-512: sixteen
+/// pixels per step with the set-up in 512-bit lanes (`avx512::trilinear_pixels_x16`), then the
+/// AVX2 build on a last group of eight. On: on the Sapphire Rapids-class Xeon it was built and
+/// measured on (load ~1.5), interleaved best-frame thread CPU per sample (12 rounds each,
+/// alternating) was median 8.35 / min 6.12 ns against the AVX2 build's 10.00 / 7.94, and
+/// criterion `trilinear` (two runs, alternating) 124.6 / 115.7 M/s wall against 95.2 / 94.5
+/// (thread CPU 134.1 / 113.9 against 92.9 / 119.4). The earlier AVX-512 build, eight pixels per
+/// step with the AVX2 set-up compiled for AVX-512 (256-bit set-up beside 512-bit µops), had
+/// been slower than the AVX2 build (~12.5–16 ns against ~8–9; docs/PERFORMANCE.md, "Fifth
+/// round: span sampler") and was dropped. The kernel is tested bit for bit against the SSE2
+/// baseline (`avx512_lane_builds_match_the_sse2_baseline_bit_for_bit`).
+const TRILINEAR_AVX512: bool = true;
 
 /// [`trilinear_pixels`] compiled for AVX2.
 ///
@@ -638,8 +642,15 @@ pub(super) fn trilinear_pixels_best<A: Addr>(
     out: &mut [Vec4],
 ) -> usize {
     if TRILINEAR_AVX512 && has_avx512() {
-        // SAFETY: AVX-512F/VL/BW/DQ were detected just above; the callers check `tex.is_pow2()`.
-        unsafe { super::avx512::trilinear_pixels::<A>(tex, uv, dx, dy, out) }
+        // Sixteen pixels per step (the set-up in 512-bit lanes), then the AVX2 build on what is
+        // left (the caller does the last < 8 pixels).
+        // SAFETY: AVX-512F/VL/BW/DQ (so AVX2) were detected just above; the callers check
+        // `tex.is_pow2()`.
+        unsafe {
+            let n = super::avx512::trilinear_pixels_x16::<A>(tex, uv, dx, dy, out);
+            let rest = (&uv[n..], &dx[n..], &dy[n..], &mut out[n..]);
+            n + trilinear_pixels_avx2::<A>(tex, rest.0, rest.1, rest.2, rest.3)
+        }
     } else if has_avx2() {
         // SAFETY: AVX2 was detected just above.
         unsafe { trilinear_pixels_avx2::<A>(tex, uv, dx, dy, out) }
