@@ -204,7 +204,9 @@ impl Camera {
         let forward = to_target / dist;
         let right = forward.cross(up);
         let rl = right.length();
-        // Reject an up vector within ~0.06° of the view axis: the basis would be noise.
+        // Reject an up vector within ~0.06° of the view axis: the basis would be noise. The
+        // negated comparison is deliberate: it also rejects NaN.
+        #[allow(clippy::neg_cmp_op_on_partial_ord)]
         if !(rl > 1e-6 * up.length()) || rl == 0.0 {
             return Err(CameraError::DegenerateUp);
         }

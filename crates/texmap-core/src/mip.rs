@@ -413,7 +413,7 @@ fn reduce_line(src: &[Vec4], ss: usize, dst: &mut [Vec4], ds: usize) {
     let m = dst.len().div_ceil(ds);
     if n == 1 {
         dst[0] = get(0);
-    } else if n % 2 == 0 {
+    } else if n.is_multiple_of(2) {
         // Even: pairs with weights ½, ½.
         for x in 0..m {
             dst[x * ds] = (get(2 * x) + get(2 * x + 1)) * 0.5;
