@@ -152,9 +152,15 @@ const MAX_INT_EXPONENT: f32 = 65_535.0;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) enum SpecPow {
     /// All 8 exponents are the same integer `k < 2^bits`: squarings, bit tests on a scalar.
-    Same { k: u32, bits: u32 },
-    /// Every exponent is an integer below `2^bits`: squarings, bit tests over lanes.
-    Ints { e: [u32; W], bits: u32 },
+    /// Bases below `floor` ([`pow_floor`] of `bits`) give 0.
+    Same { k: u32, bits: u32, floor: f32 },
+    /// Every exponent is an integer below `2^bits`: squarings, bit tests over lanes. Bases
+    /// below their lane's `floor` ([`pow_floor`] of the lane's bit length) give 0.
+    Ints {
+        e: [u32; W],
+        bits: u32,
+        floor: [f32; W],
+    },
     /// Otherwise: `exp2(e·log2 x)` with the polynomials.
     Poly,
 }
@@ -175,14 +181,43 @@ fn spec_pow(e: &F8) -> SpecPow {
         ei[i] = n;
         any |= n;
     }
-    let bits = u32::BITS - any.leading_zeros();
+    let bit_len = |k: u32| u32::BITS - k.leading_zeros();
+    let bits = bit_len(any);
+    let floors = pow_floors();
     if !ok {
         SpecPow::Poly
     } else if ei.iter().all(|&k| k == ei[0]) {
-        SpecPow::Same { k: ei[0], bits }
+        let floor = floors[bits as usize];
+        SpecPow::Same {
+            k: ei[0],
+            bits,
+            floor,
+        }
     } else {
-        SpecPow::Ints { e: ei, bits }
+        let floor = ei.map(|k| floors[bit_len(k) as usize]);
+        SpecPow::Ints { e: ei, bits, floor }
     }
+}
+
+/// `pow_floors()[b]`: the smallest base [`pow_int8`] raises to an exponent `e` of bit length
+/// `b` (`2^(b−1) ≤ e < 2^b`); smaller bases give 0. It is `2^(−120/2^b)` (0 for `b = 0`), so
+/// every product of the squarings of a base at or above it stays at or above
+/// `floor^(2^b) = 2^−120`: a normal number. Without it, a base below ~0.2 raised to 40
+/// underflows into subnormal numbers, and every multiply producing one takes a microcode
+/// assist of ~100+ cycles (measured: a quarter of an S1 ray-cast frame). What it drops is a
+/// power below `floor^(2^(b−1)) = 2^−60`, invisible in any colour. The values are `2^−120`
+/// square-rooted `b` times in `f32` (correctly rounded everywhere: the same on every backend).
+fn pow_floors() -> &'static [f32; 17] {
+    static T: OnceLock<[f32; 17]> = OnceLock::new();
+    T.get_or_init(|| {
+        let mut t = [0f32; 17];
+        let mut f = f32::from_bits((127 - 120) << 23);
+        for v in t.iter_mut().skip(1) {
+            f = f.sqrt();
+            *v = f;
+        }
+        t
+    })
 }
 
 /// The [`SpecPow`] of the exponents in the lanes of `shin`.
@@ -194,15 +229,27 @@ pub(crate) fn spec_pow_of<V: Simd8>(shin: V) -> SpecPow {
 }
 
 /// `x^e` by repeated squaring over 8 lanes (`x ∈ [0, 1]`, integer exponents below `2^bits`):
-/// at most `2·bits` rounded products, so within ~`2·bits` ulp of the exact power. `Same` and
-/// `Ints` perform the same products, so they give the same bits.
+/// at most `2·bits` rounded products; each squaring doubles the relative error it is given, so
+/// the power is within ~`e·2^−24` of exact (tested). Bases below the floor of [`pow_floors`]
+/// give 0. `Same` and `Ints` perform the same products, so they give the same bits.
 ///
 /// `N` powers (one per light) are taken in one loop: the loop control is shared and the `N`
 /// dependency chains of squarings overlap. Every power sees the same products as alone.
 #[inline(always)]
 fn pow_int8<V: Simd8, const N: usize>(x: [V; N], pw: &SpecPow) -> [V; N] {
     let mut acc = [V::splat(1.0); N];
+    let zero = V::splat(0.0);
+    // Bases below the floor become 0 (no subnormal products; see `pow_floors`).
+    let floor = match pw {
+        SpecPow::Same { floor, .. } => V::splat(*floor),
+        SpecPow::Ints { floor, .. } => V::load_from(floor),
+        SpecPow::Poly => unreachable!("pow_int8 takes integer exponents"),
+    };
+    // (A loop, not `map`: closures do not inherit the caller's `#[target_feature]`s.)
     let mut p = x;
+    for p in &mut p {
+        *p = V::select(p.ge(floor), *p, zero);
+    }
     match *pw {
         SpecPow::Same { mut k, .. } => {
             // The same products as the `Ints` loop (its last squaring is never used).
@@ -220,7 +267,7 @@ fn pow_int8<V: Simd8, const N: usize>(x: [V; N], pw: &SpecPow) -> [V; N] {
                 }
             }
         }
-        SpecPow::Ints { ref e, bits } => {
+        SpecPow::Ints { ref e, bits, .. } => {
             for b in 0..bits {
                 let m = V::bit_set(e, b);
                 for n in 0..N {
@@ -376,42 +423,106 @@ pub(crate) fn shade_lanes_n<V: Simd8, const N: usize>(
     shin: V,
     pw: SpecPow,
 ) -> [V; 3] {
-    let mut c = [
-        base[0] * l.ambient[0],
-        base[1] * l.ambient[1],
-        base[2] * l.ambient[2],
-    ];
+    let s = LaneSurf {
+        n,
+        v,
+        base,
+        spec: spec_k,
+        shin,
+    };
+    shade_chunks(l, [s], pw)[0]
+}
+
+/// The shading inputs of one 8-lane chunk for [`shade_chunks`].
+#[derive(Clone, Copy)]
+pub(crate) struct LaneSurf<V> {
+    /// Unit normal.
+    pub n: [V; 3],
+    /// Unit vector toward the eye.
+    pub v: [V; 3],
+    /// Base colour.
+    pub base: [V; 3],
+    /// Specular coefficient.
+    pub spec: V,
+    /// Shininess (read only when `pw` is [`SpecPow::Poly`]).
+    pub shin: V,
+}
+
+/// [`shade_lanes_n`] for `C` chunks at once (`C` ≤ 2) that share one [`SpecPow`]: every lane
+/// sees exactly the operations it would alone, but the chunks' dependency chains (square
+/// roots, divisions, the squarings of one shared loop) are interleaved in one straight-line
+/// body, so the CPU overlaps them instead of waiting out one chunk's latency at a time.
+#[inline(always)]
+pub(crate) fn shade_chunks<V: Simd8, const N: usize, const C: usize>(
+    l: &LanesLighting<V, N>,
+    s: [LaneSurf<V>; C],
+    pw: SpecPow,
+) -> [[V; 3]; C] {
+    const { assert!(C == 1 || C == 2) };
+    // `Ints` holds exponents per lane: one chunk's.
+    debug_assert!(C == 1 || !matches!(pw, SpecPow::Ints { .. }));
+    let mut c: [[V; 3]; C] = std::array::from_fn(|j| {
+        let b = s[j].base;
+        [
+            b[0] * l.ambient[0],
+            b[1] * l.ambient[1],
+            b[2] * l.ambient[2],
+        ]
+    });
     let zero = V::splat(0.0);
     let tiny = V::splat(1e-30);
     let mut p = 0;
     while p < N {
         let m = (N - p).min(2);
-        let mut ndl = [zero; 2];
-        let mut ndh = [zero; 2];
-        let mut pos = [zero.lt(zero); 2];
+        let mut ndl = [[zero; 2]; C];
+        let mut ndh = [[zero; 2]; C];
+        let mut pos = [[zero.lt(zero); 2]; C];
         for i in 0..m {
             let [ax, ay, az] = l.dir[p + i];
-            ndl[i] = n[0] * ax + n[1] * ay + n[2] * az;
-            let hx = ax + v[0];
-            let hy = ay + v[1];
-            let hz = az + v[2];
-            let hh = hx * hx + hy * hy + hz * hz;
-            let nh = n[0] * hx + n[1] * hy + n[2] * hz;
-            let q = nh / hh.sqrt();
-            pos[i] = q.gt(tiny);
-            ndh[i] = V::select(pos[i], q.min(V::splat(1.0)), tiny);
+            for j in 0..C {
+                let (n, v) = (s[j].n, s[j].v);
+                ndl[j][i] = n[0] * ax + n[1] * ay + n[2] * az;
+                let hx = ax + v[0];
+                let hy = ay + v[1];
+                let hz = az + v[2];
+                let hh = hx * hx + hy * hy + hz * hz;
+                let nh = n[0] * hx + n[1] * hy + n[2] * hz;
+                let q = nh / hh.sqrt();
+                pos[j][i] = q.gt(tiny);
+                ndh[j][i] = V::select(pos[j][i], q.min(V::splat(1.0)), tiny);
+            }
         }
-        let pw2 = match pw {
-            SpecPow::Same { .. } | SpecPow::Ints { .. } if m == 2 => pow_int8(ndh, &pw),
-            SpecPow::Same { .. } | SpecPow::Ints { .. } => [pow_int8([ndh[0]], &pw)[0], zero],
-            SpecPow::Poly => ndh.map(|x| pow_poly8(x, shin)),
-        };
+        // The powers of all chunks and lights in one squaring loop.
+        let mut pw2 = [[zero; 2]; C];
+        match pw {
+            SpecPow::Poly => {
+                for j in 0..C {
+                    for i in 0..m {
+                        pw2[j][i] = pow_poly8(ndh[j][i], s[j].shin);
+                    }
+                }
+            }
+            _ => match (C, m) {
+                (1, 1) => pw2[0][0] = pow_int8([ndh[0][0]], &pw)[0],
+                (1, _) => pw2[0] = pow_int8(ndh[0], &pw),
+                (_, 1) => {
+                    let r = pow_int8([ndh[0][0], ndh[C - 1][0]], &pw);
+                    (pw2[0][0], pw2[C - 1][0]) = (r[0], r[1]);
+                }
+                _ => {
+                    let r = pow_int8([ndh[0][0], ndh[0][1], ndh[C - 1][0], ndh[C - 1][1]], &pw);
+                    (pw2[0], pw2[C - 1]) = ([r[0], r[1]], [r[2], r[3]]);
+                }
+            },
+        }
         for i in 0..m {
-            let spec = V::select(pos[i], spec_k * pw2[i], zero);
-            let lit = ndl[i].gt(zero);
-            for k in 0..3 {
-                let term = base[k] * ndl[i] + spec;
-                c[k] = c[k] + V::select(lit, l.color[p + i][k] * term, zero);
+            for j in 0..C {
+                let spec = V::select(pos[j][i], s[j].spec * pw2[j][i], zero);
+                let lit = ndl[j][i].gt(zero);
+                for k in 0..3 {
+                    let term = s[j].base[k] * ndl[j][i] + spec;
+                    c[j][k] = c[j][k] + V::select(lit, l.color[p + i][k] * term, zero);
+                }
             }
         }
         p += 2;
@@ -1341,6 +1452,58 @@ mod tests {
             }
         }
         assert!(worst < 2e-5, "relative error expected < 2e-5, got {worst}");
+    }
+
+    /// The squaring powers against f64 `powi`: within `e` units of rounding where the base is at or
+    /// above its floor; 0 below it, where the exact power is below 2^−60; never a subnormal
+    /// result; and the per-lane form (`Ints`) gives the same bits as the shared one (`Same`).
+    #[test]
+    fn integer_powers_are_accurate_and_never_subnormal() {
+        let exps = [0u32, 1, 2, 3, 7, 40, 41, 128, 1000, 65_535];
+        let mut xs: Vec<f32> = (0..=2000).map(|i| i as f32 / 2000.0).collect();
+        xs.extend((1..=140).map(|i| 2f32.powi(-i)));
+        xs.extend([f32::MIN_POSITIVE, 1e-30, 0.1, 0.177, 0.2, 0.27, 0.99999]);
+        let mut checked = 0;
+        for (ei, &e) in exps.iter().enumerate() {
+            let same = spec_pow(&[e as f32; W]);
+            // Lane 3 carries `e`; the others other exponents (so `Ints`, with more bits).
+            let mixed: F8 = std::array::from_fn(|l| exps[(ei + l + 7) % exps.len()] as f32);
+            let ints = spec_pow(&mixed);
+            assert!(matches!(same, SpecPow::Same { .. }), "{same:?}");
+            assert!(matches!(ints, SpecPow::Ints { .. }), "{ints:?}");
+            let SpecPow::Same { floor, .. } = same else {
+                unreachable!()
+            };
+            for &x in &xs {
+                let a = pow_int8([V8::splat(x)], &same)[0].store()[0];
+                let b = pow_int8([V8::splat(x)], &ints)[0].store()[3];
+                assert_eq!(
+                    a.to_bits(),
+                    b.to_bits(),
+                    "x = {x}, e = {e}: Same {a}, Ints {b}"
+                );
+                assert!(
+                    a == 0.0 || a.is_normal(),
+                    "x = {x}, e = {e}: {a} is subnormal"
+                );
+                let exact = (x as f64).powi(e as i32);
+                if x >= floor {
+                    // Each squaring doubles the relative error it is given and adds one
+                    // rounding: x^e ends within ~(e − 1)·2^−24 of exact (plus the products).
+                    let tol = 1.1 * e.max(1) as f64 * 2f64.powi(-24);
+                    let rel = (a as f64 - exact).abs() / exact.max(f64::MIN_POSITIVE);
+                    assert!(rel <= tol, "x = {x}, e = {e}: {a} vs {exact} ({rel:e})");
+                } else {
+                    assert_eq!(a, 0.0, "x = {x} below the floor {floor}, e = {e}");
+                    assert!(
+                        exact < 2f64.powi(-60),
+                        "x = {x}, e = {e}: dropped {exact:e}"
+                    );
+                }
+                checked += 1;
+            }
+        }
+        assert_eq!(checked, exps.len() * xs.len());
     }
 
     #[test]

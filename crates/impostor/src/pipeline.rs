@@ -407,6 +407,16 @@ pub(crate) trait Kernel: Sync {
     /// Colour of pixel `(x, y)` won by `rec` at `depth` (sRGB RGBA8).
     fn resolve(&self, rec: &Proj, x: u32, y: u32, depth: f32, flags: u32) -> [u8; 4];
 
+    /// Draw one tile (see [`TileJob`]). The default runs [`draw_tile`]; a kernel built for wider
+    /// vectors runs that same body inside its `#[target_feature]` build, so that the buffer
+    /// clears and the depth copies use those vectors too.
+    fn draw_tile(&self, job: TileJob<'_>)
+    where
+        Self: Sized,
+    {
+        draw_tile(self, job);
+    }
+
     /// Colours of one tile: `color[j * stride + i]` for tile pixel `(i, j)` (background where
     /// nothing won). The default calls [`Kernel::resolve`] per pixel; kernels with costly
     /// shading override it with lanes over the covered pixels.
@@ -437,6 +447,49 @@ pub(crate) trait Kernel: Sync {
                 };
             }
         }
+    }
+}
+
+/// One non-empty tile's work for [`Kernel::draw_tile`]: its records (bin order), rectangle and
+/// buffers, and the frame's colours and depths from the tile's first pixel on (row stride
+/// `stride`).
+pub(crate) struct TileJob<'a> {
+    pub recs: &'a [Proj],
+    pub tile: TileRect,
+    pub buf: &'a mut TileBuf,
+    pub scratch: &'a mut [Proj; ORDER_MAX],
+    pub background: [u8; 4],
+    pub color: &'a mut [[u8; 4]],
+    pub depth: &'a mut [f32],
+    pub stride: usize,
+}
+
+/// One tile: clear the buffers, the depth pass over the bin in the kernel's order, the resolve
+/// (each covered pixel coloured once), the depths out.
+#[inline(always)]
+pub(crate) fn draw_tile<K: Kernel>(kernel: &K, job: TileJob<'_>) {
+    let TileJob {
+        recs,
+        tile,
+        buf,
+        scratch,
+        background,
+        color,
+        depth,
+        stride,
+    } = job;
+    fill8(&mut buf.depth, f32::INFINITY);
+    fill8(&mut buf.win, NONE);
+    let recs = kernel.order(recs, scratch);
+    kernel.raster(recs, tile, buf);
+    kernel.resolve_tile(recs, tile, buf, background, color, stride);
+    // Depths: every kernel writes a depth and its winner together (strict `<` against an
+    // infinite start), so pixels nothing won still hold INFINITY: a plain copy.
+    let tw = tile.w as usize;
+    for j in 0..tile.h as usize {
+        let o = j * stride;
+        let bw = j * TILE as usize;
+        copy_row(&mut depth[o..o + tw], &buf.depth[bw..bw + tw]);
     }
 }
 
@@ -523,23 +576,16 @@ pub(crate) fn draw_tiles<K: Kernel>(
                     }
                     continue;
                 }
-                fill8(&mut buf.depth, f32::INFINITY);
-                fill8(&mut buf.win, NONE);
-                // Depth pass over the bin, in the kernel's order.
-                let recs = kernel.order(recs, &mut scratch);
-                kernel.raster(recs, tile, &mut buf);
-                // Resolve pass: colour each covered pixel once.
-                kernel.resolve_tile(recs, tile, &buf, background, &mut color[x0 as usize..], w);
-                // Depths: every kernel writes a depth and its winner together (strict `<` against
-                // an infinite start), so pixels nothing won still hold INFINITY: a plain copy.
-                for j in 0..th as usize {
-                    let o = j * w + x0 as usize;
-                    let bw = j * TILE as usize;
-                    copy_row(
-                        &mut depth[o..o + tw as usize],
-                        &buf.depth[bw..bw + tw as usize],
-                    );
-                }
+                kernel.draw_tile(TileJob {
+                    recs,
+                    tile,
+                    buf: &mut buf,
+                    scratch: &mut scratch,
+                    background,
+                    color: &mut color[x0 as usize..],
+                    depth: &mut depth[x0 as usize..],
+                    stride: w,
+                });
             }
         });
 }

@@ -67,7 +67,7 @@ use crate::fastshade::V8x;
 use crate::fastshade::{self, Mask8, Simd8, SpecPow, V8};
 use crate::pipeline::{
     self, Bins, FLAG_INSIDE, Kernel, LANES, NONE, ORDER_MAX, Proj, Projected, TILE, TILE_BUF,
-    TileBuf, TileRect, View, clip,
+    TileBuf, TileJob, TileRect, View, clip,
 };
 
 /// Bounds of `x/(−z)` over the circle of radius `r` around `(a, b)` in a plane through the eye
@@ -481,6 +481,12 @@ fn resolve_persp<V: Simd8>(
 }
 
 /// [`resolve_persp`] for a lighting of `N` lights.
+///
+/// When the frame has one specular power (`k.pow`), two neighbouring covered chunks of a row
+/// are shaded together ([`fastshade::shade_chunks`]): a chunk's shading is one long chain of
+/// dependent square roots, divisions and squarings, and two independent chains in one
+/// straight-line body keep the CPU busy where one left it waiting. Every lane sees the same
+/// operations either way, so the bytes do not change.
 #[inline(always)]
 fn resolve_persp_n<V: Simd8, const N: usize>(
     k: &Perspective<V>,
@@ -501,8 +507,7 @@ fn resolve_persp_n<V: Simd8, const N: usize>(
     let lights = fastshade::LanesLighting::<V, N>::new(&k.lighting);
     let bgv = V::splat_bits(u32::from_le_bytes(background));
     let none = V::splat_bits(NONE);
-    let sign = V::splat_bits(FLAG_INSIDE);
-    let (one, tw) = (V::splat(1.0), tile.w as usize);
+    let tw = tile.w as usize;
     for j in 0..tile.h as usize {
         let dy = V::splat((v.cy - ((tile.y0 as usize + j) as f32 + 0.5)) * v.inv_k);
         let out = &mut color[j * stride..j * stride + tw];
@@ -511,90 +516,149 @@ fn resolve_persp_n<V: Simd8, const N: usize>(
             let n = (tw - i).min(LANES);
             let b = j * TILE as usize + i;
             let win = V::load_bits(&buf.win[b..]);
-            // Covered lanes of this chunk (lanes past the tile hold NONE too).
-            let covered = !win.eq_bits(none).bits() & ((1u32 << n) - 1);
+            let covered = covered_lanes(win, none, n);
             if covered == 0 {
                 pipeline::fill8(&mut out[i..i + n], background);
                 i += LANES;
                 continue;
             }
-            // The winners' records and materials as lanes. Uncovered lanes take the first
-            // covered pixel's winner.
-            let first = buf.win[b + covered.trailing_zeros() as usize] & !FLAG_INSIDE;
-            let idx = win.and_bits(V::splat_bits(!FLAG_INSIDE));
-            let on_first = idx.eq_bits(V::splat_bits(first));
-            let rest = covered & !on_first.bits();
-            let second =
-                buf.win[b + (rest.trailing_zeros() as usize).min(LANES - 1)] & !FLAG_INSIDE;
-            let on_second = idx.eq_bits(V::splat_bits(second));
-            let ([cx, cy, cz, _, inv_r, _, _, _], [br, bg, bb, spec, shin, _, _, _]) = if rest == 0
-            {
-                // One sphere under all covered pixels (most chunks of a scene of large
-                // spheres): its record and material as constants.
-                let rec = &recs[first as usize];
-                let row = &k.rows[rec.kind as usize];
-                (rec.as_lanes().map(V::splat), row.map(V::splat))
-            } else if rest & !on_second.bits() == 0 {
-                // Two spheres (a silhouette crosses the chunk): both as constants, one select
-                // per field.
-                let (r0, r1) = (&recs[first as usize], &recs[second as usize]);
-                let (m0, m1) = (&k.rows[r0.kind as usize], &k.rows[r1.kind as usize]);
-                let pick = |a: &[f32; 8], b: &[f32; 8]| -> [V; 8] {
-                    std::array::from_fn(|f| V::select(on_second, V::splat(b[f]), V::splat(a[f])))
-                };
-                (pick(r0.as_lanes(), r1.as_lanes()), pick(m0, m1))
-            } else {
-                // Gather the rows and transpose them to lanes.
-                let mut rec_rows = [recs[0].as_lanes(); LANES];
-                let mut mat_rows = [&k.rows[0]; LANES];
-                for l in 0..LANES {
-                    let wv = buf.win[b + l];
-                    let ri = (if wv == NONE { first } else { wv & !FLAG_INSIDE }) as usize;
-                    debug_assert!(ri < recs.len());
-                    // SAFETY: winner entries other than NONE are indices into this tile's
-                    // `recs` (written by the depth pass), and `first` is one of them.
-                    let rec = unsafe { recs.get_unchecked(ri) };
-                    debug_assert!((rec.kind as usize) < k.rows.len());
-                    rec_rows[l] = rec.as_lanes();
-                    // SAFETY: only valid spheres are projected, and a valid sphere's kind
-                    // indexes `materials`, whose rows these are.
-                    mat_rows[l] = unsafe { k.rows.get_unchecked(rec.kind as usize) };
+            let s = chunk_surface(k, recs, buf, b, covered, win, V::load_from(&dxs[i..]), dy);
+            // With one specular power per frame, the next chunk (if covered) is shaded with
+            // this one.
+            let i2 = i + LANES;
+            if let Some(pw) = k.pow.filter(|_| i2 < tw) {
+                let (n2, b2) = ((tw - i2).min(LANES), b + LANES);
+                let win2 = V::load_bits(&buf.win[b2..]);
+                let covered2 = covered_lanes(win2, none, n2);
+                if covered2 != 0 {
+                    let dx2 = V::load_from(&dxs[i2..]);
+                    let s2 = chunk_surface(k, recs, buf, b2, covered2, win2, dx2, dy);
+                    let [c, c2] = fastshade::shade_chunks(&lights, [s, s2], pw);
+                    store_chunk(c, win, none, bgv, enc, &mut out[i..], n);
+                    store_chunk(c2, win2, none, bgv, enc, &mut out[i2..], n2);
+                    i += 2 * LANES;
+                    continue;
                 }
-                (V::transpose(rec_rows), V::transpose(mat_rows))
-            };
-            let t = V::load_from(&buf.depth[b..]);
-            let dx = V::load_from(&dxs[i..]);
-            // Exact normal at the hit point; flipped toward the viewer on the interior (the
-            // inside flag is the sign bit of the winner entry: it flips the sign of 1/r).
-            let s = inv_r.xor_bits(win.and_bits(sign));
-            let nrm = [
-                (dx * t - cx) * s,
-                (dy * t - cy) * s,
-                (t.xor_bits(sign) - cz) * s,
-            ];
-            // Unit vector toward the eye.
-            let id = one / (dx * dx + dy * dy + one).sqrt();
-            let to_eye = [dx.xor_bits(sign) * id, dy.xor_bits(sign) * id, id];
-            let pow = match k.pow {
-                Some(p) => p,
-                None => fastshade::spec_pow_of(shin),
-            };
-            let c = fastshade::shade_lanes_n(&lights, nrm, to_eye, [br, bg, bb], spec, shin, pow);
-            // Encode to sRGB8 (texmap-core's table), background where nothing won.
-            let px = V::select(
-                win.eq_bits(none),
-                bgv,
-                fastshade::srgb_rgba_lanes(c[0], c[1], c[2], enc),
-            );
-            if n == LANES {
-                px.store_rgba(&mut out[i..]);
-            } else {
-                let mut tmp = [[0u8; 4]; LANES];
-                px.store_rgba(&mut tmp);
-                out[i..i + n].copy_from_slice(&tmp[..n]);
             }
+            let pw = match k.pow {
+                Some(p) => p,
+                None => fastshade::spec_pow_of(s.shin),
+            };
+            let [c] = fastshade::shade_chunks(&lights, [s], pw);
+            store_chunk(c, win, none, bgv, enc, &mut out[i..], n);
             i += LANES;
         }
+    }
+}
+
+/// Covered lanes of a chunk of `n ≤ 8` pixels whose winner entries are `win` (lanes past the
+/// tile hold NONE too).
+#[inline(always)]
+fn covered_lanes<V: Simd8>(win: V, none: V, n: usize) -> u32 {
+    !win.eq_bits(none).bits() & ((1u32 << n) - 1)
+}
+
+/// sRGB8 of a shaded chunk `c`, the background `bgv` where nothing won, into `out[..n]`.
+#[inline(always)]
+fn store_chunk<V: Simd8>(
+    c: [V; 3],
+    win: V,
+    none: V,
+    bgv: V,
+    enc: &[u32; fastshade::SRGB_N],
+    out: &mut [[u8; 4]],
+    n: usize,
+) {
+    let px = V::select(
+        win.eq_bits(none),
+        bgv,
+        fastshade::srgb_rgba_lanes(c[0], c[1], c[2], enc),
+    );
+    if n == LANES {
+        px.store_rgba(out);
+    } else {
+        let mut tmp = [[0u8; 4]; LANES];
+        px.store_rgba(&mut tmp);
+        out[..n].copy_from_slice(&tmp[..n]);
+    }
+}
+
+/// The shading inputs of the covered chunk at `b` of a tile (`covered` its covered lanes, `win`
+/// its winner entries, `dx`/`dy` its rays): the winners' records and materials as lanes
+/// (uncovered lanes take the first covered pixel's winner; the caller replaces them by the
+/// background), the exact normal at the hit point and the unit vector toward the eye.
+#[allow(clippy::too_many_arguments)] // one chunk's inputs, inlined into the resolve loop
+#[inline(always)]
+fn chunk_surface<V: Simd8>(
+    k: &Perspective<V>,
+    recs: &[Proj],
+    buf: &TileBuf,
+    b: usize,
+    covered: u32,
+    win: V,
+    dx: V,
+    dy: V,
+) -> fastshade::LaneSurf<V> {
+    let sign = V::splat_bits(FLAG_INSIDE);
+    let one = V::splat(1.0);
+    let first = buf.win[b + covered.trailing_zeros() as usize] & !FLAG_INSIDE;
+    let idx = win.and_bits(V::splat_bits(!FLAG_INSIDE));
+    let on_first = idx.eq_bits(V::splat_bits(first));
+    let rest = covered & !on_first.bits();
+    let second = buf.win[b + (rest.trailing_zeros() as usize).min(LANES - 1)] & !FLAG_INSIDE;
+    let on_second = idx.eq_bits(V::splat_bits(second));
+    let ([cx, cy, cz, _, inv_r, _, _, _], [br, bg, bb, spec, shin, _, _, _]) = if rest == 0 {
+        // One sphere under all covered pixels (most chunks of a scene of large spheres): its
+        // record and material as constants.
+        let rec = &recs[first as usize];
+        let row = &k.rows[rec.kind as usize];
+        (rec.as_lanes().map(V::splat), row.map(V::splat))
+    } else if rest & !on_second.bits() == 0 {
+        // Two spheres (a silhouette crosses the chunk): both as constants, one select per
+        // field.
+        let (r0, r1) = (&recs[first as usize], &recs[second as usize]);
+        let (m0, m1) = (&k.rows[r0.kind as usize], &k.rows[r1.kind as usize]);
+        let pick = |a: &[f32; 8], b: &[f32; 8]| -> [V; 8] {
+            std::array::from_fn(|f| V::select(on_second, V::splat(b[f]), V::splat(a[f])))
+        };
+        (pick(r0.as_lanes(), r1.as_lanes()), pick(m0, m1))
+    } else {
+        // Gather the rows and transpose them to lanes.
+        let mut rec_rows = [recs[0].as_lanes(); LANES];
+        let mut mat_rows = [&k.rows[0]; LANES];
+        for l in 0..LANES {
+            let wv = buf.win[b + l];
+            let ri = (if wv == NONE { first } else { wv & !FLAG_INSIDE }) as usize;
+            debug_assert!(ri < recs.len());
+            // SAFETY: winner entries other than NONE are indices into this tile's `recs`
+            // (written by the depth pass), and `first` is one of them.
+            let rec = unsafe { recs.get_unchecked(ri) };
+            debug_assert!((rec.kind as usize) < k.rows.len());
+            rec_rows[l] = rec.as_lanes();
+            // SAFETY: only valid spheres are projected, and a valid sphere's kind indexes
+            // `materials`, whose rows these are.
+            mat_rows[l] = unsafe { k.rows.get_unchecked(rec.kind as usize) };
+        }
+        (V::transpose(rec_rows), V::transpose(mat_rows))
+    };
+    let t = V::load_from(&buf.depth[b..]);
+    // Exact normal at the hit point; flipped toward the viewer on the interior (the inside
+    // flag is the sign bit of the winner entry: it flips the sign of 1/r).
+    let s = inv_r.xor_bits(win.and_bits(sign));
+    let n = [
+        (dx * t - cx) * s,
+        (dy * t - cy) * s,
+        (t.xor_bits(sign) - cz) * s,
+    ];
+    // Unit vector toward the eye.
+    let id = one / (dx * dx + dy * dy + one).sqrt();
+    let v = [dx.xor_bits(sign) * id, dy.xor_bits(sign) * id, id];
+    fastshade::LaneSurf {
+        n,
+        v,
+        base: [br, bg, bb],
+        spec,
+        shin,
     }
 }
 
@@ -693,13 +757,35 @@ impl Kernel for Perspective<'_, V8x> {
             }
         }
     }
+
+    fn draw_tile(&self, job: TileJob<'_>) {
+        // SAFETY: as in `raster`.
+        unsafe {
+            if self.evex {
+                draw_tile_evex(self, job)
+            } else {
+                draw_tile_avx2(self, job)
+            }
+        }
+    }
 }
 
-/// The [`V8x`] builds of the perspective kernel: [`raster_persp`] and [`resolve_persp`]
-/// compiled inside `#[target_feature]` functions (the generic bodies and the intrinsics inline
-/// there), one pair per feature set.
+/// The [`V8x`] builds of the perspective kernel: [`raster_persp`], [`resolve_persp`] and the
+/// tile's body ([`pipeline::draw_tile`]: its buffer clears and depth copies) compiled inside
+/// `#[target_feature]` functions (the generic bodies and the intrinsics inline there), one set
+/// per feature set.
 macro_rules! v8x_build {
-    ($features:literal, $raster:ident, $resolve:ident, $doc:literal) => {
+    ($features:literal, $raster:ident, $resolve:ident, $tile:ident, $doc:literal) => {
+        #[doc = concat!("[`pipeline::draw_tile`] of the [`V8x`] kernel, compiled for ", $doc, ".")]
+        ///
+        /// # Safety
+        #[doc = concat!("The CPU must support ", $doc, ".")]
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = $features)]
+        unsafe fn $tile(k: &Perspective<V8x>, job: TileJob<'_>) {
+            pipeline::draw_tile(k, job);
+        }
+
         #[doc = concat!("[`raster_persp`] on the [`V8x`] lanes, compiled for ", $doc, ".")]
         ///
         /// # Safety
@@ -732,7 +818,13 @@ macro_rules! v8x_build {
     };
 }
 
-v8x_build!("avx2", raster_avx2, resolve_tile_avx2, "AVX2");
+v8x_build!(
+    "avx2",
+    raster_avx2,
+    resolve_tile_avx2,
+    draw_tile_avx2,
+    "AVX2"
+);
 // The same 256-bit lanes with AVX-512VL enabled as well: the compiler then has 32 vector
 // registers instead of 16 (fewer spills in the long shading expressions) and mask registers
 // for comparisons and selects (one-µop masked blends instead of `vblendvps`). The IEEE
@@ -742,6 +834,7 @@ v8x_build!(
     "avx2,avx512f,avx512vl",
     raster_evex,
     resolve_tile_evex,
+    draw_tile_evex,
     "AVX2, AVX-512F and AVX-512VL"
 );
 
