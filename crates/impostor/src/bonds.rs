@@ -683,10 +683,10 @@ fn solve8<V: Simd8>(b: &BondV, l: &Rays<V>, lanes: V::M, near: V, far: V) -> (V,
     let regular =
         l.a.gt(V::splat(PARALLEL_A))
             .and((l.du * l.du).gt(V::splat(1e-30)));
-    if regular.bits() == 0xff {
-        if let Some(r) = solve8_regular(b, l, lanes, near, far) {
-            return r;
-        }
+    if regular.bits() == 0xff
+        && let Some(r) = solve8_regular(b, l, lanes, near, far)
+    {
+        return r;
     }
     solve8_general(b, l, lanes, near, far)
 }

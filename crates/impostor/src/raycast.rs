@@ -232,12 +232,12 @@ pub(crate) fn draw_perspective(
     backend: Backend,
 ) {
     #[cfg(target_arch = "x86_64")]
-    if backend != Backend::Baseline {
-        if let Some(mut k) = Perspective::<V8x>::new(*view, lighting, materials, rows) {
-            k.evex = backend == Backend::Best && evex_available();
-            pipeline::draw_tiles(bins, view, &k, background, frame);
-            return;
-        }
+    if backend != Backend::Baseline
+        && let Some(mut k) = Perspective::<V8x>::new(*view, lighting, materials, rows)
+    {
+        k.evex = backend == Backend::Best && evex_available();
+        pipeline::draw_tiles(bins, view, &k, background, frame);
+        return;
     }
     let k = Perspective::<V8>::new(*view, lighting, materials, rows)
         .expect("the baseline lanes are always available");
@@ -274,7 +274,7 @@ impl RayTable {
             // below), so the 8 writes stay inside the table.
             unsafe { std::ptr::copy_nonoverlapping(out.as_ptr(), ptr.add(p * LANES), LANES) };
         }
-        const { assert!(TILE_BUF % LANES == 0) };
+        const { assert!(TILE_BUF.is_multiple_of(LANES)) };
         // SAFETY: the loop above wrote all TILE_BUF values.
         let inv_a = unsafe { inv_a.assume_init() };
         RayTable { dx, dy, inv_a }

@@ -259,14 +259,14 @@ impl<R: Read> HeaderSrc<'_, R> {
     fn record(&mut self, expected: Option<u64>, what: &'static str) -> Result<Vec<u8>, Error> {
         let start = self.off;
         let len = self.marker(what)?;
-        if let Some(want) = expected {
-            if len != want {
-                return Err(Error::Parse {
-                    at: header_at(self.file, start),
-                    expected: what,
-                    found: format!("record marker {len}, expected {want}"),
-                });
-            }
+        if let Some(want) = expected
+            && len != want
+        {
+            return Err(Error::Parse {
+                at: header_at(self.file, start),
+                expected: what,
+                found: format!("record marker {len}, expected {want}"),
+            });
         }
         let payload = self.bytes(len, what)?;
         let end_at = self.off;
@@ -500,10 +500,10 @@ impl<R: Read + Seek> DcdReader<R> {
         positions: &mut Vec<[f32; 3]>,
     ) -> Result<Option<DcdCell>, Error> {
         if index >= self.layout.n_complete {
-            if index == self.layout.n_complete {
-                if let Some(e) = self.truncation() {
-                    return Err(e);
-                }
+            if index == self.layout.n_complete
+                && let Some(e) = self.truncation()
+            {
+                return Err(e);
             }
             return Err(Error::FrameOutOfRange {
                 file: self.file.clone(),
@@ -941,15 +941,16 @@ impl<W: Write + Seek> DcdWriter<W> {
         let mut patch: Vec<(u64, u32)> = Vec::with_capacity(4);
         if frame == 1 {
             // Steps per frame and time step from the first two frames.
-            if let ((Some(s0), t0), Some(s1)) = (self.first, step) {
-                if s1 > s0 && s1 - s0 <= i64::from(i32::MAX) {
-                    self.nsavc = s1 - s0;
-                    patch.push((icntrl_at(2), self.nsavc as u32));
-                    if let (Some(t0), Some(t1)) = (t0, time) {
-                        let delta = ((t1 - t0) / self.nsavc as f64 / AKMA_PS) as f32;
-                        if delta.is_finite() && delta > 0.0 {
-                            patch.push((icntrl_at(9), delta.to_bits()));
-                        }
+            if let ((Some(s0), t0), Some(s1)) = (self.first, step)
+                && s1 > s0
+                && s1 - s0 <= i64::from(i32::MAX)
+            {
+                self.nsavc = s1 - s0;
+                patch.push((icntrl_at(2), self.nsavc as u32));
+                if let (Some(t0), Some(t1)) = (t0, time) {
+                    let delta = ((t1 - t0) / self.nsavc as f64 / AKMA_PS) as f32;
+                    if delta.is_finite() && delta > 0.0 {
+                        patch.push((icntrl_at(9), delta.to_bits()));
                     }
                 }
             }

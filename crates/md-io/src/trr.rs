@@ -273,10 +273,10 @@ impl<R: Read + Seek> TrrReader<R> {
             frames.push((offset, h));
             offset += size;
         }
-        if frames.is_empty() {
-            if let Some(e) = tail {
-                return Err(e);
-            }
+        if frames.is_empty()
+            && let Some(e) = tail
+        {
+            return Err(e);
         }
         let n_atoms = frames.first().map_or(0, |(_, h)| h.natoms);
         Ok(TrrReader {
@@ -312,10 +312,10 @@ impl<R: Read + Seek> TrrReader<R> {
         velocities: &mut Vec<[f32; 3]>,
     ) -> Result<TrrFrameInfo, Error> {
         let Some(&(offset, h)) = self.frames.get(index) else {
-            if index == self.frames.len() {
-                if let Some(e) = &self.tail {
-                    return Err(crate::xtc::clone_error(e));
-                }
+            if index == self.frames.len()
+                && let Some(e) = &self.tail
+            {
+                return Err(crate::xtc::clone_error(e));
             }
             return Err(Error::FrameOutOfRange {
                 file: self.file.clone(),

@@ -271,10 +271,10 @@ impl<R: Read + Seek> XtcReader<R> {
             frames.push(Entry { offset, size });
             offset += size;
         }
-        if frames.is_empty() {
-            if let Some(e) = tail {
-                return Err(e);
-            }
+        if frames.is_empty()
+            && let Some(e) = tail
+        {
+            return Err(e);
         }
         Ok(XtcReader {
             src,
@@ -320,10 +320,10 @@ impl<R: Read + Seek> XtcReader<R> {
         positions: &mut Vec<[f32; 3]>,
     ) -> Result<XtcFrameInfo, Error> {
         let Some(&Entry { offset, size }) = self.frames.get(index) else {
-            if index == self.frames.len() {
-                if let Some(e) = &self.tail {
-                    return Err(clone_error(e));
-                }
+            if index == self.frames.len()
+                && let Some(e) = &self.tail
+            {
+                return Err(clone_error(e));
             }
             return Err(Error::FrameOutOfRange {
                 file: self.file.clone(),
@@ -795,13 +795,13 @@ impl<W: Write> XtcWriter<W> {
         if positions.is_empty() || positions.len() > i32::MAX as usize / 3 {
             return Err(invalid(format!("{} atoms", positions.len())));
         }
-        if let Some(n) = self.n_atoms {
-            if n != positions.len() {
-                return Err(invalid(format!(
-                    "{} atoms, earlier frames had {n}",
-                    positions.len()
-                )));
-            }
+        if let Some(n) = self.n_atoms
+            && n != positions.len()
+        {
+            return Err(invalid(format!(
+                "{} atoms, earlier frames had {n}",
+                positions.len()
+            )));
         }
         // Coordinates must fit i32 after scaling (with margin for molly's differences).
         let max = (i32::MAX / 4) as f32 / self.precision * NM;

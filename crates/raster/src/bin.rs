@@ -138,6 +138,8 @@ impl<T: Copy + Default + Send + Sync> Bins<T> {
     /// each chunk's records in primitive order, all chunks in parallel. Chunk `c`'s records for
     /// tile `t` follow those of chunks `< c`, so every tile lists its primitives in submission
     /// order whatever the thread count.
+    // Tile-major prefix sums over chunk-major counts: both indices address two arrays.
+    #[allow(clippy::needless_range_loop)]
     pub fn fill<F>(&mut self, grid: &Grid, counts: &[&[u32]], emit: F)
     where
         F: Fn(usize, &mut Emitter<'_, T>) + Sync,

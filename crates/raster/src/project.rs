@@ -83,7 +83,7 @@ impl Proj {
     }
 
     #[inline]
-    pub fn to_eye(&self, p: Vec3) -> Vec3 {
+    pub fn to_eye(self, p: Vec3) -> Vec3 {
         let d = p - self.eye;
         Vec3::new(d.dot(self.right), d.dot(self.up), d.dot(self.back))
     }

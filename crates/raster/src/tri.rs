@@ -508,6 +508,8 @@ fn quad_loop<P: FragProgram, E: EdgeInt>(
         while qx <= px1 {
             // Coverage of the four lanes: every edge function >= 0 (sign bits OR-ed).
             let mut mask = 0u8;
+            // `l` is the lane of three offset rows and the mask bit: a range reads best.
+            #[allow(clippy::needless_range_loop)]
             for l in 0..4 {
                 let s = (e[0] + off[0][l]) | (e[1] + off[1][l]) | (e[2] + off[2][l]);
                 mask |= ((s >= E::ZERO) as u8) << l;

@@ -205,15 +205,15 @@ fn read_gltf_mesh(
         let uvs = reader
             .read_tex_coords(0)
             .map(|t| t.into_f32().map(Vec2::from_array).collect::<Vec<_>>());
-        if let Some(uv) = &uvs {
-            if uv.len() != positions.len() {
-                return Err(LoadError::BadAttribute {
-                    source: source.to_string(),
-                    mesh: k,
-                    attribute: "TEXCOORD_0",
-                    len: uv.len(),
-                });
-            }
+        if let Some(uv) = &uvs
+            && uv.len() != positions.len()
+        {
+            return Err(LoadError::BadAttribute {
+                source: source.to_string(),
+                mesh: k,
+                attribute: "TEXCOORD_0",
+                len: uv.len(),
+            });
         }
         // Normals go through the inverse transpose of the node transform (unit length is
         // restored when the mesh is added).
@@ -222,15 +222,15 @@ fn read_gltf_mesh(
             n.map(|v| normal_matrix * Vec3::from_array(v))
                 .collect::<Vec<_>>()
         });
-        if let Some(n) = &normals {
-            if n.len() != positions.len() {
-                return Err(LoadError::BadAttribute {
-                    source: source.to_string(),
-                    mesh: k,
-                    attribute: "NORMAL",
-                    len: n.len(),
-                });
-            }
+        if let Some(n) = &normals
+            && n.len() != positions.len()
+        {
+            return Err(LoadError::BadAttribute {
+                source: source.to_string(),
+                mesh: k,
+                attribute: "NORMAL",
+                len: n.len(),
+            });
         }
         let m = MeshData {
             positions,
@@ -254,7 +254,7 @@ fn check_mesh(m: &MeshData, source: &str, k: usize) -> Result<(), LoadError> {
         mesh: k,
         error,
     };
-    if m.indices.len() % 3 != 0 {
+    if !m.indices.len().is_multiple_of(3) {
         return Err(err(crate::SceneError::IndicesNotTriangles {
             len: m.indices.len(),
         }));

@@ -170,13 +170,13 @@ impl<'a> RenderOptions<'a> {
         if !self.background.is_finite() {
             return Err(RenderError::BadBackground);
         }
-        if let Some(m) = scene.max_material_id() {
-            if m as usize >= self.materials.len() {
-                return Err(RenderError::MissingMaterial {
-                    material_id: m,
-                    materials: self.materials.len(),
-                });
-            }
+        if let Some(m) = scene.max_material_id()
+            && m as usize >= self.materials.len()
+        {
+            return Err(RenderError::MissingMaterial {
+                material_id: m,
+                materials: self.materials.len(),
+            });
         }
         for (i, m) in self.materials.iter().enumerate() {
             let bad = |what| Err(RenderError::BadMaterial { material: i, what });
@@ -197,14 +197,14 @@ impl<'a> RenderOptions<'a> {
                     }
                 }
             }
-            if let Some(t) = m.texture {
-                if t as usize >= self.textures.len() {
-                    return Err(RenderError::MissingTexture {
-                        material: i,
-                        texture: t,
-                        textures: self.textures.len(),
-                    });
-                }
+            if let Some(t) = m.texture
+                && t as usize >= self.textures.len()
+            {
+                return Err(RenderError::MissingTexture {
+                    material: i,
+                    texture: t,
+                    textures: self.textures.len(),
+                });
             }
         }
         Ok(())

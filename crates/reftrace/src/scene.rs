@@ -292,24 +292,24 @@ impl SceneBuilder {
         material_id: u32,
     ) -> Result<u32, SceneError> {
         // Validate the whole mesh before touching the builder.
-        if let Some(n) = normals {
-            if n.len() != positions.len() {
-                return Err(SceneError::NormalCountMismatch {
-                    normals: n.len(),
-                    vertices: positions.len(),
-                });
-            }
+        if let Some(n) = normals
+            && n.len() != positions.len()
+        {
+            return Err(SceneError::NormalCountMismatch {
+                normals: n.len(),
+                vertices: positions.len(),
+            });
         }
-        if indices.len() % 3 != 0 {
+        if !indices.len().is_multiple_of(3) {
             return Err(SceneError::IndicesNotTriangles { len: indices.len() });
         }
-        if let Some(uv) = uvs {
-            if uv.len() != positions.len() {
-                return Err(SceneError::UvCountMismatch {
-                    uvs: uv.len(),
-                    vertices: positions.len(),
-                });
-            }
+        if let Some(uv) = uvs
+            && uv.len() != positions.len()
+        {
+            return Err(SceneError::UvCountMismatch {
+                uvs: uv.len(),
+                vertices: positions.len(),
+            });
         }
         for (k, &i) in indices.iter().enumerate() {
             if i as usize >= positions.len() {
