@@ -1581,7 +1581,9 @@ mod tests {
         // The AVX-512 kernels (per-pixel trilinear sixteen pixels per step, four per zmm; the
         // span sampler's mspan read, K = 3) against the SSE2 baseline over every input regime of `random_pixels` /
         // `random_quads` on square, wide, tall and tiny power-of-two pyramids, both wraps (edge
-        // windows included: they take the AVX2 edge path). Skipped where the CPU lacks AVX-512.
+        // windows included: with Repeat they are read from the level's seam strips, and the
+        // count of such windows must be positive on every pyramid; with Clamp they take the
+        // AVX2 edge path). Skipped where the CPU lacks AVX-512.
         if !lanes::has_avx512() {
             eprintln!("no AVX-512 on this CPU: the AVX-512 builds are not tested here");
             return;
@@ -1602,6 +1604,7 @@ mod tests {
             (128, 128),
         ] {
             for wrap in [Wrap::Repeat, Wrap::Clamp] {
+                avx512::SEAM_WINDOWS.with(|n| n.set(0));
                 let t = ramp(w, h, wrap);
                 let (uv, dx, dy) = random_pixels(4000, w * 7 + h);
                 let quads = random_quads(4000, w * 11 + h);
@@ -1685,6 +1688,13 @@ mod tests {
                 match wrap {
                     Wrap::Repeat => run!(RepeatPow2),
                     Wrap::Clamp => run!(ClampEdge),
+                }
+                // With Repeat the sixteen-span kernel must have read edge windows from the seam
+                // strips (Clamp never does).
+                let seam = avx512::SEAM_WINDOWS.with(|n| n.get());
+                match wrap {
+                    Wrap::Repeat => assert!(seam > 1_000, "{w}x{h}: {seam} seam-strip windows"),
+                    Wrap::Clamp => assert_eq!(seam, 0, "{w}x{h}: Clamp read a seam strip"),
                 }
                 assert_eq!(bits(&a), bits(&b), "trilinear {w}x{h} {wrap:?}");
                 for (i, (x, y)) in qa.iter().zip(&qb).enumerate() {

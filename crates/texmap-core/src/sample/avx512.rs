@@ -44,8 +44,12 @@
 //!   edge it takes two indices per pixel and level, as the AVX2 build does per eight.
 //!
 //! Spans whose window is not interior (a level edge, or a level narrower than three texels)
-//! take the AVX2 build's out-of-line edge path; K = 4 keeps the AVX2 kernel (its window's rows
-//! need a row pair per pixel out of four rows: two permutes and a blend per tap).
+//! take the AVX2 build's out-of-line edge path — except, with Repeat, in `span_quads_k3_x16`,
+//! which reads a window crossing the level's right or bottom edge (wrapped) from the level's
+//! seam strips (see [`MipTexture`]), with the strip's row stride, as an interior window; there
+//! only spans whose pixels lie more than one texel apart take the edge path. K = 4 keeps the
+//! AVX2 kernel (its window's rows need a row pair per pixel out of four rows: two permutes and
+//! a blend per tap).
 
 use core::arch::x86_64::*;
 
@@ -88,8 +92,14 @@ struct MspanLevel<const N: usize> {
     /// `[span][pixel]`: the Eq. (4) bilinear weights.
     ax: [[f32; 4]; N],
     ay: [[f32; 4]; N],
-    /// Lane bits of the spans whose window is interior.
+    /// Lane bits of the spans whose window is interior (in the level, or in one of its Repeat
+    /// seam strips: see `seam`).
     ok: i32,
+    /// Lane bits of the spans whose window is read from one of the level's Repeat seam strips
+    /// ([`MipTexture`]'s seam strips; `corner` and `w2` then address the strip). Always 0 in
+    /// the eight-span build. Read by the tests' count only.
+    #[cfg_attr(not(test), allow(dead_code))]
+    seam: i32,
 }
 
 /// Four per-pixel vectors (lanes = spans) as span-major rows `[span][pixel]`: spans 0–3 in the
@@ -145,6 +155,7 @@ fn mspan_level<A: Addr>(
         ax: span_major(&ax),
         ay: span_major(&ay),
         ok,
+        seam: 0,
     }
 }
 
@@ -174,8 +185,9 @@ impl MspanConsts {
 /// The bilinear of span `S`'s four pixels (channel-major) from its mspan at one level.
 ///
 /// # Safety
-/// `d` must come from [`mspan_level`] on the texture whose texels start at `base`, with span
-/// `S` interior (`d.ok` bit set): its three rows of three texels lie inside the level.
+/// `d` must come from [`mspan_level`] or [`mspan_level16`] on the texture whose texel buffer
+/// ([`MipTexture::texel_buffer`]) starts at `base`, with span `S` interior (`d.ok` bit set): its
+/// three rows of three texels lie inside the level, or inside one of its Repeat seam strips.
 #[inline]
 #[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq")]
 unsafe fn mspan_bilinear<const N: usize, const S: usize>(
@@ -185,8 +197,10 @@ unsafe fn mspan_bilinear<const N: usize, const S: usize>(
 ) -> __m512 {
     let (c, w) = (d.corner[S] as usize, d.w2[S] as usize);
     // SAFETY: the caller's contract: rows corner + r·w, r < 3, texels 0..3 inside the level
-    // (the interior window, x0 + 3 ≤ w, y0 + 3 ≤ h); lanes 12–15 (a fourth texel) are masked
-    // off and not read. The 128-bit broadcasts read 4 values of `d`'s arrays.
+    // (the interior window, x0 + 3 ≤ w, y0 + 3 ≤ h) or in a seam strip (wrapped x0 < w,
+    // y0 < h: columns up to w + 1 of rows up to h + 1 in the column strip, stride 4, or
+    // columns x0 + 3 ≤ w of rows up to h + 1 in the row strip, stride w); lanes 12–15 (a
+    // fourth texel) are masked off and not read. The 128-bit broadcasts read 4 values of `d`'s arrays.
     unsafe {
         // The mspan: one read of the 3x3 banks (Seed 000 Eq. 10).
         let row = |r: usize| _mm512_maskz_loadu_ps(0x0fff, base.add((c + r * w) * 8) as *const f32);
@@ -562,6 +576,7 @@ fn span_major16(v: &[__m512; 4]) -> [[f32; 4]; 16] {
 #[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq")]
 fn mspan_level16<A: Addr>(
     c: &Setup16,
+    r: &Seams16,
     lvl: __m512i,
     sx: &[__m512; 4],
     sy: &[__m512; 4],
@@ -625,16 +640,81 @@ fn mspan_level16<A: Addr>(
         | _mm512_cmpgt_epi32_mask(zi, y0)
         | _mm512_cmpgt_epi32_mask(_mm512_add_epi32(x0, k), wi)
         | _mm512_cmpgt_epi32_mask(_mm512_add_epi32(y0, k), hi);
+    // Repeat: every window, its corner wrapped into the level (power of two: a mask), is
+    // contiguous in the level or in one of its seam strips (origins from the tables, level
+    // coordinates): crossing the right edge in the column strip (stride 4), else crossing the
+    // bottom edge in the row strip (stride w).
+    let (corner, stride, outside, seam) = if A::REPEAT {
+        let one_i = _mm512_set1_epi32(1);
+        let xw = _mm512_and_si512(x0, _mm512_sub_epi32(wi, one_i));
+        let yw = _mm512_and_si512(y0, _mm512_sub_epi32(hi, one_i));
+        let xs = _mm512_cmpgt_epi32_mask(_mm512_add_epi32(xw, k), wi);
+        let ys = _mm512_cmpgt_epi32_mask(_mm512_add_epi32(yw, k), hi) & !xs;
+        // Level or row strip: origin + yw·w + xw.
+        let org = _mm512_mask_mov_epi32(
+            _mm512_permutexvar_epi32(lvl, c.offs),
+            ys,
+            _mm512_permutexvar_epi32(lvl, r.row),
+        );
+        let lr = _mm512_add_epi32(_mm512_add_epi32(org, _mm512_mullo_epi32(yw, wi)), xw);
+        // Column strip: origin + 4·yw + xw.
+        let cs = _mm512_add_epi32(
+            _mm512_add_epi32(
+                _mm512_permutexvar_epi32(lvl, r.col),
+                _mm512_slli_epi32::<2>(yw),
+            ),
+            xw,
+        );
+        (
+            _mm512_mask_mov_epi32(lr, xs, cs),
+            _mm512_mask_mov_epi32(wi, xs, _mm512_set1_epi32(4)),
+            0,
+            xs | ys,
+        )
+    } else {
+        (corner, wi, outside, 0)
+    };
     let o = span_major16(&o);
     MspanLevel {
         corner: to_u32x16(_mm512_slli_epi32::<1>(corner)),
-        w2: to_u32x16(_mm512_slli_epi32::<1>(wi)),
+        w2: to_u32x16(_mm512_slli_epi32::<1>(stride)),
         // SAFETY: same size, no invalid bit patterns (the i32 bits moved as f32 lanes).
         o: unsafe { core::mem::transmute::<[[f32; 4]; 16], [[i32; 4]; 16]>(o) },
         ax: span_major16(&ax),
         ay: span_major16(&ay),
         ok: !(over | outside) as i32 & 0xffff,
+        seam: seam as i32 & !(over as i32) & 0xffff,
     }
+}
+
+/// A texture's Repeat seam strips for [`mspan_level16`] ([`MipTexture::seam_offsets16`]).
+struct Seams16 {
+    /// The column and row strips' origins per level (one `vpermd` per lookup).
+    col: __m512i,
+    row: __m512i,
+}
+
+impl Seams16 {
+    /// `None` without strips (then the kernel must not be run with Repeat).
+    #[inline]
+    #[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq")]
+    fn new(tex: &MipTexture) -> Option<Seams16> {
+        let (col, row) = tex.seam_offsets16()?;
+        // SAFETY: each table holds 16 i32 (one unaligned 512-bit load).
+        unsafe {
+            Some(Seams16 {
+                col: _mm512_loadu_si512(col.as_ptr() as *const __m512i),
+                row: _mm512_loadu_si512(row.as_ptr() as *const __m512i),
+            })
+        }
+    }
+}
+
+#[cfg(test)]
+thread_local! {
+    /// Windows (span-levels) the sixteen-span kernel read from a Repeat seam strip on this
+    /// thread (for the tests: the seam path must be exercised).
+    pub(super) static SEAM_WINDOWS: core::cell::Cell<u64> = const { core::cell::Cell::new(0) };
 }
 
 /// Sixteen `i32` lanes as an array (stored once, read per span).
@@ -646,7 +726,10 @@ fn to_u32x16(v: __m512i) -> [u32; 16] {
 
 /// [`span_quads_k3`] sixteen spans per step, the whole set-up in 512-bit lanes (no 256-bit
 /// µops in the loop but the edge path's): bit-identical, whole groups of sixteen spans (the
-/// caller does the tail, e.g. [`span_quads_k3`] then the scalar remainder).
+/// caller does the tail, e.g. [`span_quads_k3`] then the scalar remainder). With Repeat,
+/// windows crossing a level edge are read from the level's seam strips ([`MipTexture`]'s
+/// seam strips) as interior windows, so only spans whose pixels are more than one texel apart
+/// (Clamp: also windows at a level edge) take the edge path.
 ///
 /// # Safety
 /// The CPU must support AVX-512F/VL/BW/DQ; the texture must be a power of two.
@@ -658,7 +741,9 @@ pub(super) unsafe fn span_quads_k3_x16<A: Addr>(
 ) -> usize {
     debug_assert!(tex.is_pow2());
     let c = Setup16::new(tex);
-    let base = tex.texels().as_ptr() as *const u8;
+    // Power-of-two pyramids always have their strips (Clamp does not read them).
+    let r = Seams16::new(tex).expect("power-of-two pyramid");
+    let base = tex.texel_buffer().as_ptr() as *const u8;
     let n = quads.len().min(out.len()) / 16 * 16;
     let k = MspanConsts::new();
     for (o, q) in out[..n]
@@ -666,13 +751,18 @@ pub(super) unsafe fn span_quads_k3_x16<A: Addr>(
         .zip(quads[..n].chunks_exact(16))
     {
         let s = span_step16::<A>(&c, q.try_into().expect("sixteen spans"));
-        let mut a = mspan_level16::<A>(&c, s.i0, &s.sx, &s.sy);
-        let mut b = mspan_level16::<A>(&c, s.i1, &s.sx, &s.sy);
+        let mut a = mspan_level16::<A>(&c, &r, s.i0, &s.sx, &s.sy);
+        let mut b = mspan_level16::<A>(&c, &r, s.i1, &s.sx, &s.sy);
         // SAFETY: same size, no invalid bit patterns.
         let mut fr = unsafe { core::mem::transmute::<__m512, [f32; 16]>(s.frac) };
         // Keep the per-span values in memory: each is then one load or one broadcast load.
         core::hint::black_box((&mut a, &mut b, &mut fr));
         let (fast, single) = (a.ok & (b.ok | s.single), s.single);
+        #[cfg(test)]
+        SEAM_WINDOWS.with(|n| {
+            let used = (fast & a.seam).count_ones() + (fast & !single & b.seam).count_ones();
+            n.set(n.get() + used as u64);
+        });
         macro_rules! spans {
             ($($i:literal)*) => {$(
                 mspan_out::<A, 16, $i>(tex, base, &a, &b, &fr, fast, single, &k, q[$i], &mut o[$i]);
