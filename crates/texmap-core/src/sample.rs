@@ -93,9 +93,9 @@
 //!   lerps and blend, their weights by one in-lane `vpermilps` (lanes ordered so that a pixel
 //!   pair shares a lane of the two halves), one 256-bit store per pair; `roundps` floors.
 //! - `sample/avx512.rs`: where the CPU has AVX-512F/VL/BW/DQ, the span sampler with K = 3 reads
-//!   each span's interior 3x3 window as Seed 000's mspan (three masked 512-bit row loads, one
-//!   zmm = four pixels x RGBA; each pixel's 2x2 picked by four `vpermt2ps` per level; the three
-//!   Eq. 4 lerps and the level blend on the four pixels at once), sixteen spans per step with
+//!   each span's interior 3x3 window as Seed 000's mspan (each row two overlapping 256-bit
+//!   loads, one zmm = four pixels x RGBA; each pixel's 2x2 picked by four `vpermt2ps` per
+//!   level; the three Eq. 4 lerps and the level blend on the four pixels at once), sixteen spans per step with
 //!   the set-up in 512-bit lanes (the AVX2 eight-span set-up on a group of eight left over).
 //!   Per-pixel trilinear likewise, for fairness: sixteen pixels per step, the set-up in 512-bit
 //!   lanes, four pixels per zmm for the taps (`lanes::TRILINEAR_AVX512`: measured faster than

@@ -23,12 +23,14 @@
 //! is the per-pixel part:
 //!
 //! - **span sampler (Seed 000 Eq. 8–10, K = 3), the mspan read:** one span = four pixels x RGBA
-//!   = sixteen floats = one zmm. Its interior 3x3 window is read as three rows of three texels
-//!   (three masked 512-bit loads, `_mm512_maskz_loadu_ps(0x0fff, ..)`: the fourth texel's lanes
-//!   are masked off and never touched, so nothing past the window is read) — the one parallel
-//!   read of the nine banks, per level per span. Each pixel then picks its own 2x2 out of it:
-//!   `t00`/`t10` of all four pixels are two `vpermt2ps` over rows (0, 1), `t01`/`t11` the same
-//!   indices over rows (1, 2); four permutes per level per span instead of sixteen texel loads.
+//!   = sixteen floats = one zmm. Its interior 3x3 window is read as three rows of three texels,
+//!   each row as two overlapping 256-bit loads (texels 0–1 and 1–2: no mask, nothing past the
+//!   window is read) — the one parallel read of the nine banks, per level per span. Each pixel
+//!   then picks its own 2x2 out of it with one index: `t00` of all four pixels is one
+//!   `vpermt2ps` over rows (0, 1) at texel 0, `t10` the same index over the rows' texel-1 loads,
+//!   `t01`/`t11` likewise over rows (1, 2); four permutes per level per span instead of sixteen
+//!   texel loads. The spans whose window is not interior take the edge path after the step's
+//!   interior spans.
 //!   The lanes are channel-major (`c·4 + p`: channel c of pixel p), so a span's four per-pixel
 //!   weights `[w0 w1 w2 w3]` and the offset part of the permute index are 128-bit broadcasts
 //!   from memory (load ports, no shuffle), and one `vpermps` turns the result back into pixel
@@ -82,10 +84,9 @@ fn lanes16(v: [i32; 16]) -> __m512i {
 /// One level of `N` spans (eight or sixteen), span-major for the per-span zmm vectors (span `s`
 /// at `[s]`).
 struct MspanLevel<const N: usize> {
-    /// Doubled texel index of the window corner (`base + 8·index` addresses it).
-    corner: [u32; N],
-    /// Doubled row stride (the level width).
-    w2: [u32; N],
+    /// `[row][span]`: doubled texel index of the window's rows 0, 1, 2 (the corner, plus one
+    /// and two doubled row strides; `base + 8·index` addresses each).
+    rows: [[u32; N]; 3],
     /// `[span][pixel]`: `oy·16 + ox·4`, the lane of the pixel's `t00` in two rows of four
     /// texels (`ox, oy ∈ {0, 1}` from the window corner).
     o: [[i32; 4]; N],
@@ -147,9 +148,14 @@ fn mspan_level<A: Addr>(
         o[j] = _mm256_castsi256_ps(_mm256_cvttps_epi32(v));
     });
     let o = span_major(&o);
+    let (c2, w2) = (_mm256_slli_epi32::<1>(corner), _mm256_slli_epi32::<1>(wi));
+    let c2w = _mm256_add_epi32(c2, w2);
     MspanLevel {
-        corner: to_u32x8(_mm256_slli_epi32::<1>(corner)),
-        w2: to_u32x8(_mm256_slli_epi32::<1>(wi)),
+        rows: [
+            to_u32x8(c2),
+            to_u32x8(c2w),
+            to_u32x8(_mm256_add_epi32(c2w, w2)),
+        ],
         // SAFETY: same size, no invalid bit patterns (the i32 bits moved as f32 lanes).
         o: unsafe { core::mem::transmute::<[[f32; 4]; 8], [[i32; 4]; 8]>(o) },
         ax: span_major(&ax),
@@ -162,9 +168,8 @@ fn mspan_level<A: Addr>(
 /// The constant vectors of the mspan kernel.
 #[derive(Clone, Copy)]
 struct MspanConsts {
-    /// Lane `c·4 + p` = `c` (the channel), and `c + 4` (the texel to the right).
+    /// Lane `c·4 + p` = `c` (the channel).
     c0: __m512i,
-    c1: __m512i,
     /// Channel-major `c·4 + p` -> pixel-major `p·4 + c`.
     to_pixels: __m512i,
 }
@@ -176,7 +181,6 @@ impl MspanConsts {
         let cpat = lanes16([0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2, 3, 3, 3, 3]);
         MspanConsts {
             c0: cpat,
-            c1: _mm512_add_epi32(cpat, _mm512_set1_epi32(4)),
             to_pixels: lanes16([0, 4, 8, 12, 1, 5, 9, 13, 2, 6, 10, 14, 3, 7, 11, 15]),
         }
     }
@@ -195,23 +199,30 @@ unsafe fn mspan_bilinear<const N: usize, const S: usize>(
     d: &MspanLevel<N>,
     k: &MspanConsts,
 ) -> __m512 {
-    let (c, w) = (d.corner[S] as usize, d.w2[S] as usize);
     // SAFETY: the caller's contract: rows corner + r·w, r < 3, texels 0..3 inside the level
     // (the interior window, x0 + 3 ≤ w, y0 + 3 ≤ h) or in a seam strip (wrapped x0 < w,
     // y0 < h: columns up to w + 1 of rows up to h + 1 in the column strip, stride 4, or
-    // columns x0 + 3 ≤ w of rows up to h + 1 in the row strip, stride w); lanes 12–15 (a
-    // fourth texel) are masked off and not read. The 128-bit broadcasts read 4 values of `d`'s arrays.
+    // columns x0 + 3 ≤ w of rows up to h + 1 in the row strip, stride w); each 256-bit load
+    // reads two of a row's three texels. The 128-bit broadcasts read 4 values of `d`'s arrays.
     unsafe {
-        // The mspan: one read of the 3x3 banks (Seed 000 Eq. 10).
-        let row = |r: usize| _mm512_maskz_loadu_ps(0x0fff, base.add((c + r * w) * 8) as *const f32);
-        let (r0, r1, r2) = (row(0), row(1), row(2));
-        // Each pixel's 2x2 out of it: lane c·4 + p takes channel c of texel (ox_p, oy_p).
+        // The mspan: one read of the 3x3 banks (Seed 000 Eq. 10), each row as its texels
+        // (0, 1) and (1, 2) (the permutes read lanes 0–7 of each: texels 0 and 1 from the
+        // index).
+        let row = |r: usize, t: usize| {
+            let p = base.add((d.rows[r][S] as usize + 2 * t) * 8) as *const f32;
+            _mm512_zextps256_ps512(_mm256_loadu_ps(p))
+        };
+        let (r0, r1, r2) = (row(0, 0), row(1, 0), row(2, 0));
+        let (s0, s1, s2) = (row(0, 1), row(1, 1), row(2, 1));
+        // Each pixel's 2x2 out of it: lane c·4 + p takes channel c of texel (ox_p, oy_p) of
+        // rows (0, 1) or (1, 2); the texel to its right is the same lane of the rows one texel
+        // on.
         let o = _mm512_broadcast_i32x4(_mm_loadu_si128(d.o[S].as_ptr() as *const __m128i));
-        let (i0, i1) = (_mm512_add_epi32(o, k.c0), _mm512_add_epi32(o, k.c1));
-        let t00 = _mm512_permutex2var_ps(r0, i0, r1);
-        let t10 = _mm512_permutex2var_ps(r0, i1, r1);
-        let t01 = _mm512_permutex2var_ps(r1, i0, r2);
-        let t11 = _mm512_permutex2var_ps(r1, i1, r2);
+        let i = _mm512_add_epi32(o, k.c0);
+        let t00 = _mm512_permutex2var_ps(r0, i, r1);
+        let t10 = _mm512_permutex2var_ps(s0, i, s1);
+        let t01 = _mm512_permutex2var_ps(r1, i, r2);
+        let t11 = _mm512_permutex2var_ps(s1, i, s2);
         let wx = _mm512_broadcast_f32x4(_mm_loadu_ps(d.ax[S].as_ptr()));
         let wy = _mm512_broadcast_f32x4(_mm_loadu_ps(d.ay[S].as_ptr()));
         lerp16(lerp16(t00, t10, wx), lerp16(t01, t11, wx), wy)
@@ -219,15 +230,15 @@ unsafe fn mspan_bilinear<const N: usize, const S: usize>(
 }
 
 /// Span `S` of a step: its four pixels from the levels `a` (and `b`, blended by `frac[S]`, per
-/// Eq. 4), or the AVX2 build's edge path when its window is not interior.
+/// Eq. 4) when its window is interior (`fast` bit set); else nothing (the caller runs the edge
+/// path afterwards: [`edge_spans`]).
 ///
 /// # Safety
 /// As [`mspan_bilinear`] for spans whose `fast` bit is set (`b` too unless `single`).
 #[inline]
 #[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq")]
 #[allow(clippy::too_many_arguments)]
-unsafe fn mspan_out<A: Addr, const N: usize, const S: usize>(
-    tex: &MipTexture,
+unsafe fn mspan_out<const N: usize, const S: usize>(
     base: *const u8,
     a: &MspanLevel<N>,
     b: &MspanLevel<N>,
@@ -235,13 +246,9 @@ unsafe fn mspan_out<A: Addr, const N: usize, const S: usize>(
     fast: i32,
     single: i32,
     k: &MspanConsts,
-    q: [Vec2; 4],
     o: &mut [Vec4; 4],
 ) {
     if fast & (1 << S) == 0 {
-        // A window crossing a level edge (or a conflict).
-        // SAFETY: AVX2 is implied by AVX-512F; the texture is a power of two (our contract).
-        *o = unsafe { edge_span::<A, 3>(tex, q) };
         return;
     }
     // SAFETY: the caller's contract; `o` holds 16 floats.
@@ -252,12 +259,40 @@ unsafe fn mspan_out<A: Addr, const N: usize, const S: usize>(
         } else {
             // Seed 000 Eq. (4): one blend weight per span.
             let cb = mspan_bilinear::<N, S>(base, b, k);
-            lerp16(ca, cb, _mm512_set1_ps(frac[S]))
+            let t: __m512;
+            // `_mm512_set1_ps(frac[S])` as one `vbroadcastss` from memory (LLVM otherwise
+            // loads the scalar first and broadcasts the register, a port-5 µop). S < N: the
+            // load is inside `frac`.
+            const { assert!(S < N) };
+            core::arch::asm!(
+                "vbroadcastss {t}, dword ptr [{p} + {o}]",
+                p = in(reg) frac.as_ptr(),
+                o = const 4 * S,
+                t = out(zmm_reg) t,
+                options(pure, readonly, nostack, preserves_flags),
+            );
+            lerp16(ca, cb, t)
         };
         _mm512_storeu_ps(
             o.as_mut_ptr() as *mut f32,
             _mm512_permutexvar_ps(k.to_pixels, r),
         );
+    }
+}
+
+/// The AVX2 build's edge path for the spans of a step whose bit is clear in `fast` (windows
+/// crossing a level edge, or a conflict), after the interior spans (their code then has no
+/// call between them, and no span's images are copied for one).
+#[inline]
+#[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq")]
+fn edge_spans<A: Addr>(tex: &MipTexture, q: &[[Vec2; 4]], o: &mut [[Vec4; 4]], fast: i32) {
+    let mut slow = !fast as u32 & ((1u32 << q.len()) - 1);
+    while slow != 0 {
+        let s = slow.trailing_zeros() as usize;
+        slow &= slow - 1;
+        // SAFETY: AVX2 is implied by AVX-512F; the texture is a power of two (the caller's
+        // contract).
+        o[s] = unsafe { edge_span::<A, 3>(tex, q[s]) };
     }
 }
 
@@ -295,15 +330,16 @@ pub(super) unsafe fn span_quads_k3<A: Addr>(
         let fast = a.ok & (b.ok | single);
         // SAFETY: `mspan_out`'s contract: levels from `mspan_level` on this texture.
         unsafe {
-            mspan_out::<A, 8, 0>(tex, base, &a, &b, &fr, fast, single, &k, q[0], &mut o[0]);
-            mspan_out::<A, 8, 1>(tex, base, &a, &b, &fr, fast, single, &k, q[1], &mut o[1]);
-            mspan_out::<A, 8, 2>(tex, base, &a, &b, &fr, fast, single, &k, q[2], &mut o[2]);
-            mspan_out::<A, 8, 3>(tex, base, &a, &b, &fr, fast, single, &k, q[3], &mut o[3]);
-            mspan_out::<A, 8, 4>(tex, base, &a, &b, &fr, fast, single, &k, q[4], &mut o[4]);
-            mspan_out::<A, 8, 5>(tex, base, &a, &b, &fr, fast, single, &k, q[5], &mut o[5]);
-            mspan_out::<A, 8, 6>(tex, base, &a, &b, &fr, fast, single, &k, q[6], &mut o[6]);
-            mspan_out::<A, 8, 7>(tex, base, &a, &b, &fr, fast, single, &k, q[7], &mut o[7]);
+            mspan_out::<8, 0>(base, &a, &b, &fr, fast, single, &k, &mut o[0]);
+            mspan_out::<8, 1>(base, &a, &b, &fr, fast, single, &k, &mut o[1]);
+            mspan_out::<8, 2>(base, &a, &b, &fr, fast, single, &k, &mut o[2]);
+            mspan_out::<8, 3>(base, &a, &b, &fr, fast, single, &k, &mut o[3]);
+            mspan_out::<8, 4>(base, &a, &b, &fr, fast, single, &k, &mut o[4]);
+            mspan_out::<8, 5>(base, &a, &b, &fr, fast, single, &k, &mut o[5]);
+            mspan_out::<8, 6>(base, &a, &b, &fr, fast, single, &k, &mut o[6]);
+            mspan_out::<8, 7>(base, &a, &b, &fr, fast, single, &k, &mut o[7]);
         }
+        edge_spans::<A>(tex, q, o, fast);
     }
     n
 }
@@ -675,9 +711,17 @@ fn mspan_level16<A: Addr>(
         (corner, wi, outside, 0)
     };
     let o = span_major16(&o);
+    let (c2, w2) = (
+        _mm512_slli_epi32::<1>(corner),
+        _mm512_slli_epi32::<1>(stride),
+    );
+    let c2w = _mm512_add_epi32(c2, w2);
     MspanLevel {
-        corner: to_u32x16(_mm512_slli_epi32::<1>(corner)),
-        w2: to_u32x16(_mm512_slli_epi32::<1>(stride)),
+        rows: [
+            to_u32x16(c2),
+            to_u32x16(c2w),
+            to_u32x16(_mm512_add_epi32(c2w, w2)),
+        ],
         // SAFETY: same size, no invalid bit patterns (the i32 bits moved as f32 lanes).
         o: unsafe { core::mem::transmute::<[[f32; 4]; 16], [[i32; 4]; 16]>(o) },
         ax: span_major16(&ax),
@@ -765,13 +809,14 @@ pub(super) unsafe fn span_quads_k3_x16<A: Addr>(
         });
         macro_rules! spans {
             ($($i:literal)*) => {$(
-                mspan_out::<A, 16, $i>(tex, base, &a, &b, &fr, fast, single, &k, q[$i], &mut o[$i]);
+                mspan_out::<16, $i>(base, &a, &b, &fr, fast, single, &k, &mut o[$i]);
             )*};
         }
         // SAFETY: `mspan_out`'s contract: levels from `mspan_level16` on this texture.
         unsafe {
             spans!(0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15);
         }
+        edge_spans::<A>(tex, q, o, fast);
     }
     n
 }
