@@ -526,7 +526,11 @@ fn resolve_persp_n<V: Simd8, const N: usize>(
             // With one specular power per frame, the next chunk (if covered) is shaded with
             // this one.
             let i2 = i + LANES;
-            if let Some(pw) = k.pow.filter(|_| i2 < tw) {
+            // (A plain condition, not `Option::filter`: closures do not inherit the caller's
+            // `#[target_feature]`s.)
+            if i2 < tw
+                && let Some(pw) = k.pow
+            {
                 let (n2, b2) = ((tw - i2).min(LANES), b + LANES);
                 let win2 = V::load_bits(&buf.win[b2..]);
                 let covered2 = covered_lanes(win2, none, n2);
