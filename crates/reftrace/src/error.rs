@@ -1,7 +1,5 @@
 //! Error types of the reference ray tracer.
 
-use std::path::PathBuf;
-
 /// Why a mesh was refused by [`crate::SceneBuilder::add_mesh`].
 #[derive(Clone, Debug, PartialEq)]
 #[non_exhaustive]
@@ -145,79 +143,3 @@ impl std::fmt::Display for TextureError {
 }
 
 impl std::error::Error for TextureError {}
-
-/// Why a mesh file (or in-memory mesh bytes) could not be loaded. Every variant names the source:
-/// the file path, or the name the caller gave the bytes.
-#[derive(Debug)]
-#[non_exhaustive]
-pub enum LoadError {
-    /// The file could not be read.
-    Io {
-        path: PathBuf,
-        source: std::io::Error,
-    },
-    /// The OBJ parser refused the input.
-    Obj { source: String, message: String },
-    /// The glTF parser refused the input, or a buffer could not be resolved.
-    Gltf { source: String, message: String },
-    /// A primitive of a glTF mesh is not made of triangles.
-    UnsupportedPrimitive {
-        source: String,
-        mesh: usize,
-        mode: String,
-    },
-    /// A mesh in the file is malformed (bad index, coordinate count, ...).
-    BadMesh {
-        source: String,
-        mesh: usize,
-        error: SceneError,
-    },
-    /// A mesh in the file has a vertex attribute of the wrong length.
-    BadAttribute {
-        source: String,
-        mesh: usize,
-        attribute: &'static str,
-        len: usize,
-    },
-    /// The input holds no triangle at all.
-    NoTriangles { source: String },
-}
-
-impl std::fmt::Display for LoadError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            LoadError::Io { path, source } => write!(f, "{}: {source}", path.display()),
-            LoadError::Obj { source, message } => write!(f, "{source}: OBJ: {message}"),
-            LoadError::Gltf { source, message } => write!(f, "{source}: glTF: {message}"),
-            LoadError::UnsupportedPrimitive { source, mesh, mode } => write!(
-                f,
-                "{source}: mesh {mesh}: primitive mode {mode} is not supported (need triangles)"
-            ),
-            LoadError::BadMesh {
-                source,
-                mesh,
-                error,
-            } => write!(f, "{source}: mesh {mesh}: {error}"),
-            LoadError::BadAttribute {
-                source,
-                mesh,
-                attribute,
-                len,
-            } => write!(
-                f,
-                "{source}: mesh {mesh}: attribute {attribute} has {len} values, not a whole number of vectors"
-            ),
-            LoadError::NoTriangles { source } => write!(f, "{source}: no triangles"),
-        }
-    }
-}
-
-impl std::error::Error for LoadError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        match self {
-            LoadError::Io { source, .. } => Some(source),
-            LoadError::BadMesh { error, .. } => Some(error),
-            _ => None,
-        }
-    }
-}

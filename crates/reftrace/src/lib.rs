@@ -6,8 +6,8 @@
 //! `i + 0.5`, depth along the view axis) and shading model ([`texmap_core::shade::Lighting::shade`]),
 //! so a difference between a method and the reference is the method's own error.
 //!
-//! - [`SceneBuilder`] → [`Scene`]: add spheres, cylinders and meshes (from [`load`]ed OBJ or glTF,
-//!   or from slices; flat shaded, or smooth with interpolated vertex normals from the file or
+//! - [`SceneBuilder`] → [`Scene`]: add spheres, cylinders and meshes (a [`TriMesh`] read from OBJ
+//!   or glTF by `texmap_mesh`, or slices; flat shaded, or smooth with interpolated vertex normals from the file or
 //!   averaged from the faces, [`MeshShading`]), build the BVH once; [`Scene::intersect`] answers
 //!   closest-hit queries.
 //! - The BVH is built by obvhs (PLOC); by default ([`BvhKind::Wide4`]) it is collapsed into a
@@ -56,17 +56,17 @@ pub use glam;
 
 pub mod error;
 pub mod geom;
-pub mod load;
 mod render;
 mod scene;
 mod texture;
 mod wide;
 
-pub use error::{LoadError, RenderError, SceneError, TextureError};
+pub use error::{RenderError, SceneError, TextureError};
 pub use geom::CylinderPart;
 pub use render::{
     MAX_RECURSION_DEPTH, MAX_SAMPLES_PER_AXIS, Optics, RenderOptions, SurfaceMaterial,
 };
-pub use scene::{BuildStats, BvhKind, Hit, HitKind, MeshData, MeshShading, Scene, SceneBuilder};
+pub use scene::{BuildStats, BvhKind, Hit, HitKind, MeshShading, Scene, SceneBuilder};
 pub use texmap_core::frame::Frame;
+pub use texmap_mesh::TriMesh;
 pub use texture::Texture;

@@ -50,6 +50,7 @@ use rayon::prelude::*;
 use texmap_core::camera::{Camera, Ray};
 use texmap_core::color::linear_to_srgb8;
 use texmap_core::frame::Frame;
+use texmap_core::optics;
 use texmap_core::shade::{Lighting, Material};
 
 use crate::error::RenderError;
@@ -402,10 +403,7 @@ impl<E: Fn(Vec3) -> Vec3 + Sync> Tracer<'_, E> {
             self.opts.lighting.shade(&s, ns, v)
         };
         let eps = SECONDARY_EPS_REL * (1.0 + hit.point.abs().max_element() + hit.t.abs());
-        let reflect = || {
-            let r = d - ns * (2.0 * d.dot(ns));
-            self.secondary(hit.point + ng * eps, r, depth + 1)
-        };
+        let reflect = || self.secondary(hit.point + ng * eps, optics::reflect(d, ns), depth + 1);
         match mat.optics {
             Optics::Opaque => local(mat),
             Optics::Mirror { reflectance: k } => {
@@ -416,19 +414,15 @@ impl<E: Fn(Vec3) -> Vec3 + Sync> Tracer<'_, E> {
             Optics::Refractive { ior, fresnel } => {
                 // Snell's law with relative index eta = n_from / n_to.
                 let eta = if front { 1.0 / ior } else { ior };
-                let cos_i = (-d.dot(ns)).clamp(0.0, 1.0);
-                let sin2_t = eta * eta * (1.0 - cos_i * cos_i);
-                if sin2_t >= 1.0 {
+                let Some(t) = optics::refract(d, ns, eta) else {
                     // Total internal reflection.
                     return reflect();
-                }
-                let cos_t = (1.0 - sin2_t).sqrt();
-                let t_dir = d * eta + ns * (eta * cos_i - cos_t);
-                let refr = self.secondary(hit.point - ng * eps, t_dir, depth + 1);
+                };
+                let refr = self.secondary(hit.point - ng * eps, t.dir, depth + 1);
                 if !fresnel {
                     return refr;
                 }
-                let f = fresnel_dielectric(cos_i, cos_t, eta);
+                let f = optics::fresnel_dielectric(t.cos_i, t.cos_t, eta);
                 let refl = if f > 0.0 { reflect() } else { Vec3::ZERO };
                 refl * f + refr * (1.0 - f)
             }
@@ -479,19 +473,6 @@ fn primary_depth(scene: &Scene, cam: &Camera, forward: Vec3, x: f32, y: f32) -> 
 #[inline]
 fn finite_depth(d: f32) -> f32 {
     if d.is_finite() { d } else { f32::INFINITY }
-}
-
-/// Exact unpolarised Fresnel reflectance of a dielectric interface (`eta = n_from / n_to`).
-fn fresnel_dielectric(cos_i: f32, cos_t: f32, eta: f32) -> f32 {
-    // r_s and r_p with n_from = eta, n_to = 1 (only the ratio matters).
-    let rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-    let rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-    let f = 0.5 * (rs * rs + rp * rp);
-    if f.is_finite() {
-        f.clamp(0.0, 1.0)
-    } else {
-        1.0
-    }
 }
 
 /// Box integral of the level-0 texels over the screen square of half-size `half` pixels centred
@@ -565,28 +546,4 @@ fn footprint_integral(
         }
     }
     (count > 0).then(|| sum / count as f32)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn fresnel_matches_known_values() {
-        // Normal incidence air -> glass (n = 1.5): ((1 - 1.5)/(1 + 1.5))² = 0.04.
-        let f = fresnel_dielectric(1.0, 1.0, 1.0 / 1.5);
-        assert!((f - 0.04).abs() < 1e-6, "expected 0.04, got {f}, tol 1e-6");
-        // Brewster's angle: r_p = 0, so F = r_s²/2; at tan θ = 1.5.
-        let th = 1.5f32.atan();
-        let (ci, si) = (th.cos(), th.sin());
-        let st = si / 1.5;
-        let ct = (1.0 - st * st).sqrt();
-        let rs = (ci - 1.5 * ct) / (ci + 1.5 * ct);
-        let f = fresnel_dielectric(ci, ct, 1.0 / 1.5);
-        assert!(
-            (f - 0.5 * rs * rs).abs() < 1e-6,
-            "expected {}, got {f}",
-            0.5 * rs * rs
-        );
-    }
 }

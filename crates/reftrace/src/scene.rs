@@ -33,6 +33,7 @@ use obvhs::{
     ray::{Ray as BvhRay, RayHit},
 };
 use texmap_core::camera::Ray;
+use texmap_mesh::TriMesh;
 
 use crate::error::SceneError;
 use crate::geom::{CylinderPart, RayPre, intersect_cylinder, intersect_sphere, intersect_triangle};
@@ -63,18 +64,6 @@ pub enum BvhKind {
     /// the binary traversal ([`Scene::bvh_kind`] then says [`BvhKind::Bvh2`]).
     #[default]
     Wide4,
-}
-
-/// A triangle mesh given as shared vertices and an index list, as loaded from OBJ or glTF.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct MeshData {
-    pub positions: Vec<Vec3>,
-    /// Three indices per triangle.
-    pub indices: Vec<u32>,
-    /// One texture coordinate per vertex, if any.
-    pub uvs: Option<Vec<Vec2>>,
-    /// One vertex normal per vertex, if the file has them (any length; normalised when added).
-    pub normals: Option<Vec<Vec3>>,
 }
 
 /// How a mesh's surface normal is chosen at a hit (for shading and secondary-ray directions;
@@ -374,22 +363,23 @@ impl SceneBuilder {
         Ok(mesh)
     }
 
-    /// [`SceneBuilder::add_mesh`] for a loaded [`MeshData`] (flat shaded).
-    pub fn add_mesh_data(&mut self, mesh: &MeshData, material_id: u32) -> Result<u32, SceneError> {
+    /// [`SceneBuilder::add_mesh`] for a [`TriMesh`] (flat shaded), e.g. one read from OBJ or glTF
+    /// by `texmap_mesh`.
+    pub fn add_mesh_data(&mut self, mesh: &TriMesh, material_id: u32) -> Result<u32, SceneError> {
         self.add_mesh_data_shaded(mesh, MeshShading::Flat, material_id)
     }
 
-    /// [`SceneBuilder::add_mesh_shaded`] for a loaded [`MeshData`]: its normals (if the file had
-    /// them) with the chosen [`MeshShading`].
+    /// [`SceneBuilder::add_mesh_shaded`] for a [`TriMesh`]: its normals (if the file had them)
+    /// with the chosen [`MeshShading`].
     pub fn add_mesh_data_shaded(
         &mut self,
-        mesh: &MeshData,
+        mesh: &TriMesh,
         shading: MeshShading,
         material_id: u32,
     ) -> Result<u32, SceneError> {
         self.add_mesh_shaded(
             &mesh.positions,
-            &mesh.indices,
+            mesh.indices(),
             mesh.uvs.as_deref(),
             mesh.normals.as_deref(),
             shading,

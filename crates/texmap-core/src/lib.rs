@@ -6,7 +6,8 @@
 //! - the shared building blocks every renderer of the workspace agrees on: [`camera`] (perspective
 //!   and orthographic, horizontal field of view), [`shade`] (one Lambert + Blinn-Phong model used by
 //!   the rasteriser and the reference ray tracer alike), [`color`] (sRGB, HSV), [`frame`] (colour +
-//!   depth image) and [`metrics`] (PSNR, SSIM, depth and silhouette error);
+//!   depth image), [`metrics`] (PSNR, SSIM, depth and silhouette error) and [`optics`] (mirror
+//!   reflection, Snell refraction, Fresnel: shared by environment mapping and the ray tracer);
 //! - Seed 000's texture mapping: [`transform`] (Eq. 1–3), [`mip`] pyramids, [`sample`]rs (nearest,
 //!   bilinear, trilinear Eq. 4, span-parallel with K x K banks Eq. 8–10, anisotropic reference) and
 //!   [`coverage`] (Eq. 5–7, the active-area map count).
@@ -32,6 +33,7 @@ pub mod coverage;
 pub mod frame;
 pub mod metrics;
 pub mod mip;
+pub mod optics;
 pub mod sample;
 pub mod shade;
 pub mod transform;

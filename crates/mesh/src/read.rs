@@ -1,9 +1,9 @@
-//! Mesh loading: Wavefront OBJ (tobj) and glTF 2.0 (gltf), from files or from bytes in memory.
+//! Mesh reading: Wavefront OBJ (tobj) and glTF 2.0 (gltf), from files or from bytes in memory.
 //!
-//! Both readers return one [`MeshData`] per mesh (OBJ object/group, glTF primitive) with
+//! Both readers return one [`TriMesh`] per mesh (OBJ object/group, glTF primitive) with
 //! positions, triangle indices and, when present, the first set of texture coordinates and the
 //! vertex normals (glTF normals are carried through the inverse transpose of the node transform;
-//! [`crate::MeshShading`] decides whether they are used). OBJ faces
+//! the consumer decides whether they are used). OBJ faces
 //! are triangulated and re-indexed so that positions and uvs share one index. glTF meshes are
 //! placed by their nodes' world transforms in the default scene (or the first one); meshes not
 //! referenced by any node are not returned. Only triangle-list primitives are read; other modes
@@ -14,21 +14,20 @@ use std::path::Path;
 
 use glam::{Mat4, Vec2, Vec3};
 
-use crate::error::LoadError;
-use crate::scene::MeshData;
+use crate::{MeshError, TriMesh};
 
 /// Read the OBJ file at `path` (materials are not read).
-pub fn load_obj(path: impl AsRef<Path>) -> Result<Vec<MeshData>, LoadError> {
+pub fn read_obj(path: impl AsRef<Path>) -> Result<Vec<TriMesh>, MeshError> {
     let path = path.as_ref();
-    let bytes = std::fs::read(path).map_err(|source| LoadError::Io {
+    let bytes = std::fs::read(path).map_err(|source| MeshError::Io {
         path: path.to_path_buf(),
         source,
     })?;
-    load_obj_bytes(&bytes, &path.display().to_string())
+    read_obj_bytes(&bytes, &path.display().to_string())
 }
 
 /// Parse OBJ text held in memory; `source` names it in errors.
-pub fn load_obj_bytes(bytes: &[u8], source: &str) -> Result<Vec<MeshData>, LoadError> {
+pub fn read_obj_bytes(bytes: &[u8], source: &str) -> Result<Vec<TriMesh>, MeshError> {
     let opts = tobj::LoadOptions {
         single_index: true,
         triangulate: true,
@@ -38,7 +37,7 @@ pub fn load_obj_bytes(bytes: &[u8], source: &str) -> Result<Vec<MeshData>, LoadE
     let mut reader = std::io::BufReader::new(bytes);
     let (models, _materials) =
         tobj::load_obj_buf(&mut reader, &opts, |_| Err(tobj::LoadError::OpenFileFailed)).map_err(
-            |e| LoadError::Obj {
+            |e| MeshError::Obj {
                 source: source.to_string(),
                 message: e.to_string(),
             },
@@ -46,11 +45,12 @@ pub fn load_obj_bytes(bytes: &[u8], source: &str) -> Result<Vec<MeshData>, LoadE
     let mut out = Vec::with_capacity(models.len());
     for (k, model) in models.into_iter().enumerate() {
         let m = model.mesh;
-        let bad = |attribute, len| LoadError::BadAttribute {
+        let bad = |attribute, len| MeshError::AttributeLength {
             source: source.to_string(),
             mesh: k,
             attribute,
             len,
+            expected: 0,
         };
         if m.positions.len() % 3 != 0 {
             return Err(bad("positions", m.positions.len()));
@@ -87,19 +87,19 @@ pub fn load_obj_bytes(bytes: &[u8], source: &str) -> Result<Vec<MeshData>, LoadE
                     .collect(),
             )
         };
-        let mesh = MeshData {
+        let mesh = TriMesh {
             positions,
-            indices: m.indices,
+            triangles: triangles(m.indices, source, k)?,
             uvs,
             normals,
         };
-        check_mesh(&mesh, source, k)?;
-        if !mesh.indices.is_empty() {
+        mesh.validate(source, k)?;
+        if !mesh.triangles.is_empty() {
             out.push(mesh);
         }
     }
     if out.is_empty() {
-        return Err(LoadError::NoTriangles {
+        return Err(MeshError::NoTriangles {
             source: source.to_string(),
         });
     }
@@ -107,27 +107,27 @@ pub fn load_obj_bytes(bytes: &[u8], source: &str) -> Result<Vec<MeshData>, LoadE
 }
 
 /// Read a glTF (`.gltf` with its buffers resolved next to it, or `.glb`) file.
-pub fn load_gltf(path: impl AsRef<Path>) -> Result<Vec<MeshData>, LoadError> {
+pub fn read_gltf(path: impl AsRef<Path>) -> Result<Vec<TriMesh>, MeshError> {
     let path = path.as_ref();
-    let bytes = std::fs::read(path).map_err(|source| LoadError::Io {
+    let bytes = std::fs::read(path).map_err(|source| MeshError::Io {
         path: path.to_path_buf(),
         source,
     })?;
-    load_gltf_impl(&bytes, &path.display().to_string(), path.parent())
+    read_gltf_impl(&bytes, &path.display().to_string(), path.parent())
 }
 
 /// Parse glTF held in memory (a `.glb`, or `.gltf` JSON whose buffers are embedded as data URIs);
 /// `source` names it in errors. External buffer files cannot be resolved from memory.
-pub fn load_gltf_bytes(bytes: &[u8], source: &str) -> Result<Vec<MeshData>, LoadError> {
-    load_gltf_impl(bytes, source, None)
+pub fn read_gltf_bytes(bytes: &[u8], source: &str) -> Result<Vec<TriMesh>, MeshError> {
+    read_gltf_impl(bytes, source, None)
 }
 
-fn load_gltf_impl(
+fn read_gltf_impl(
     bytes: &[u8],
     source: &str,
     base: Option<&Path>,
-) -> Result<Vec<MeshData>, LoadError> {
-    let gerr = |e: gltf::Error| LoadError::Gltf {
+) -> Result<Vec<TriMesh>, MeshError> {
+    let gerr = |e: gltf::Error| MeshError::Gltf {
         source: source.to_string(),
         message: e.to_string(),
     };
@@ -153,7 +153,7 @@ fn load_gltf_impl(
         while let Some((node, parent)) = stack.pop() {
             visited += 1;
             if visited > 1_000_000 {
-                return Err(LoadError::Gltf {
+                return Err(MeshError::Gltf {
                     source: source.to_string(),
                     message: "node hierarchy too large or cyclic".to_string(),
                 });
@@ -168,7 +168,7 @@ fn load_gltf_impl(
         }
     }
     if out.is_empty() {
-        return Err(LoadError::NoTriangles {
+        return Err(MeshError::NoTriangles {
             source: source.to_string(),
         });
     }
@@ -180,12 +180,12 @@ fn read_gltf_mesh(
     buffers: &[gltf::buffer::Data],
     world: Mat4,
     source: &str,
-    out: &mut Vec<MeshData>,
-) -> Result<(), LoadError> {
+    out: &mut Vec<TriMesh>,
+) -> Result<(), MeshError> {
     for prim in mesh.primitives() {
         let k = out.len();
         if prim.mode() != gltf::mesh::Mode::Triangles {
-            return Err(LoadError::UnsupportedPrimitive {
+            return Err(MeshError::UnsupportedPrimitive {
                 source: source.to_string(),
                 mesh: mesh.index(),
                 mode: format!("{:?}", prim.mode()),
@@ -208,11 +208,12 @@ fn read_gltf_mesh(
         if let Some(uv) = &uvs
             && uv.len() != positions.len()
         {
-            return Err(LoadError::BadAttribute {
+            return Err(MeshError::AttributeLength {
                 source: source.to_string(),
                 mesh: k,
                 attribute: "TEXCOORD_0",
                 len: uv.len(),
+                expected: positions.len(),
             });
         }
         // Normals go through the inverse transpose of the node transform (unit length is
@@ -225,52 +226,42 @@ fn read_gltf_mesh(
         if let Some(n) = &normals
             && n.len() != positions.len()
         {
-            return Err(LoadError::BadAttribute {
+            return Err(MeshError::AttributeLength {
                 source: source.to_string(),
                 mesh: k,
                 attribute: "NORMAL",
                 len: n.len(),
+                expected: positions.len(),
             });
         }
-        let m = MeshData {
+        let m = TriMesh {
             positions,
-            indices,
+            triangles: triangles(indices, source, k)?,
             uvs,
             normals,
         };
-        check_mesh(&m, source, k)?;
-        if !m.indices.is_empty() {
+        m.validate(source, k)?;
+        if !m.triangles.is_empty() {
             out.push(m);
         }
     }
     Ok(())
 }
 
-/// Index checks shared with `SceneBuilder::add_mesh`, done at the file boundary so that the error
-/// names the file.
-fn check_mesh(m: &MeshData, source: &str, k: usize) -> Result<(), LoadError> {
-    let err = |error| LoadError::BadMesh {
-        source: source.to_string(),
-        mesh: k,
-        error,
-    };
-    if !m.indices.len().is_multiple_of(3) {
-        return Err(err(crate::SceneError::IndicesNotTriangles {
-            len: m.indices.len(),
-        }));
+/// A flat index list as triangles; its length must be a multiple of three. Index values are
+/// checked by [`TriMesh::validate`] at the file boundary, so that the error names the file.
+fn triangles(indices: Vec<u32>, source: &str, mesh: usize) -> Result<Vec<[u32; 3]>, MeshError> {
+    if !indices.len().is_multiple_of(3) {
+        return Err(MeshError::IndicesNotTriangles {
+            source: source.to_string(),
+            mesh,
+            len: indices.len(),
+        });
     }
-    if let Some(p) = m
-        .indices
-        .iter()
-        .position(|&i| i as usize >= m.positions.len())
-    {
-        return Err(err(crate::SceneError::IndexOutOfRange {
-            triangle: p / 3,
-            index: m.indices[p],
-            vertex_count: m.positions.len(),
-        }));
-    }
-    Ok(())
+    Ok(indices
+        .chunks_exact(3)
+        .map(|t| [t[0], t[1], t[2]])
+        .collect())
 }
 
 #[cfg(test)]
@@ -284,9 +275,9 @@ mod tests {
 
     #[test]
     fn obj_quad_is_two_triangles_with_flipped_v() {
-        let m = load_obj_bytes(QUAD_OBJ.as_bytes(), "quad.obj").unwrap();
+        let m = read_obj_bytes(QUAD_OBJ.as_bytes(), "quad.obj").unwrap();
         assert_eq!(m.len(), 1);
-        assert_eq!(m[0].indices.len(), 6);
+        assert_eq!(m[0].triangles.len(), 2);
         assert_eq!(m[0].positions.len(), 4);
         let uvs = m[0].uvs.as_ref().unwrap();
         // Vertex (1, 1, 0) has vt (1, 1) -> our (1, 0).
@@ -303,7 +294,7 @@ mod tests {
         // OBJ: a triangle whose vertices carry three different normals.
         let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvn 1 0 0\nvn 0 1 0\n\
             f 1//1 2//2 3//3\n";
-        let m = load_obj_bytes(text.as_bytes(), "n.obj").unwrap();
+        let m = read_obj_bytes(text.as_bytes(), "n.obj").unwrap();
         let n = m[0].normals.as_ref().expect("normals read");
         for (p, want) in [
             (Vec3::ZERO, Vec3::Z),
@@ -315,22 +306,22 @@ mod tests {
         }
         // No vn lines: no normals.
         assert!(
-            load_obj_bytes(QUAD_OBJ.as_bytes(), "q.obj").unwrap()[0]
+            read_obj_bytes(QUAD_OBJ.as_bytes(), "q.obj").unwrap()[0]
                 .normals
                 .is_none()
         );
         // glTF without NORMAL: none.
-        let g = load_gltf_bytes(triangle_gltf([0.0; 3]).as_bytes(), "t.gltf").unwrap();
+        let g = read_gltf_bytes(triangle_gltf([0.0; 3]).as_bytes(), "t.gltf").unwrap();
         assert!(g[0].normals.is_none());
     }
 
     #[test]
     fn obj_errors_name_the_source() {
-        let e = load_obj_bytes(b"v 0 0 0\nf 1 2 3\n", "broken.obj").unwrap_err();
+        let e = read_obj_bytes(b"v 0 0 0\nf 1 2 3\n", "broken.obj").unwrap_err();
         assert!(e.to_string().contains("broken.obj"), "{e}");
-        let e = load_obj_bytes(b"# nothing\n", "empty.obj").unwrap_err();
-        assert!(matches!(e, LoadError::NoTriangles { .. }), "{e}");
-        let e = load_obj("/nonexistent/dir/x.obj").unwrap_err();
+        let e = read_obj_bytes(b"# nothing\n", "empty.obj").unwrap_err();
+        assert!(matches!(e, MeshError::NoTriangles { .. }), "{e}");
+        let e = read_obj("/nonexistent/dir/x.obj").unwrap_err();
         assert!(e.to_string().contains("/nonexistent/dir/x.obj"), "{e}");
     }
 
@@ -398,7 +389,7 @@ mod tests {
         // perpendicular to the scaled surface, unlike a normal scaled like a position.
         let s = std::f32::consts::FRAC_1_SQRT_2;
         let text = normal_triangle_gltf([2.0, 1.0, 1.0], [s, s, 0.0]);
-        let m = load_gltf_bytes(text.as_bytes(), "n.gltf").unwrap();
+        let m = read_gltf_bytes(text.as_bytes(), "n.gltf").unwrap();
         let n = m[0].normals.as_ref().expect("normals read")[0].normalize();
         let want = Vec3::new(0.5, 1.0, 0.0).normalize();
         assert!(
@@ -432,38 +423,38 @@ mod tests {
     #[test]
     fn gltf_embedded_triangle_is_placed_by_its_node() {
         let text = triangle_gltf([0.0, 0.0, -3.0]);
-        let m = load_gltf_bytes(text.as_bytes(), "tri.gltf").unwrap();
+        let m = read_gltf_bytes(text.as_bytes(), "tri.gltf").unwrap();
         assert_eq!(m.len(), 1);
-        assert_eq!(m[0].indices, vec![0, 1, 2]);
+        assert_eq!(m[0].triangles, vec![[0, 1, 2]]);
         assert_eq!(m[0].positions[1], Vec3::new(1.0, 0.0, -3.0));
         assert!(m[0].uvs.is_none());
     }
 
     #[test]
     fn gltf_errors_name_the_source() {
-        let e = load_gltf_bytes(b"{not json", "bad.gltf").unwrap_err();
+        let e = read_gltf_bytes(b"{not json", "bad.gltf").unwrap_err();
         assert!(e.to_string().contains("bad.gltf"), "{e}");
         // An index past the vertex count is refused at the file boundary.
         let text = triangle_gltf([0.0; 3]).replace(
             "\"count\":3,\"type\":\"VEC3\"",
             "\"count\":2,\"type\":\"VEC3\"",
         );
-        let e = load_gltf_bytes(text.as_bytes(), "short.gltf").unwrap_err();
+        let e = read_gltf_bytes(text.as_bytes(), "short.gltf").unwrap_err();
         assert!(e.to_string().contains("short.gltf"), "{e}");
     }
 
     #[test]
     fn files_load_like_bytes() {
         // Write the fixtures to a private temporary directory, read them back by path.
-        let dir = std::env::temp_dir().join(format!("texmap-reftrace-load-{}", std::process::id()));
+        let dir = std::env::temp_dir().join(format!("texmap-mesh-read-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let obj = dir.join("quad.obj");
         std::fs::write(&obj, QUAD_OBJ).unwrap();
         let gltf = dir.join("tri.gltf");
         std::fs::write(&gltf, triangle_gltf([1.0, 2.0, 3.0])).unwrap();
-        let a = load_obj(&obj).unwrap();
-        let b = load_obj_bytes(QUAD_OBJ.as_bytes(), "quad.obj").unwrap();
-        let c = load_gltf(&gltf).unwrap();
+        let a = read_obj(&obj).unwrap();
+        let b = read_obj_bytes(QUAD_OBJ.as_bytes(), "quad.obj").unwrap();
+        let c = read_gltf(&gltf).unwrap();
         std::fs::remove_dir_all(&dir).ok();
         assert_eq!(a, b);
         assert_eq!(c[0].positions[0], Vec3::new(1.0, 2.0, 3.0));
