@@ -1,18 +1,18 @@
-//! The few chemical elements the study's scenes use: CPK (Jmol) colours, van der Waals radii for
-//! space-filling molecules, covalent radii for bonds by distance, and Seed 004's particle radii.
-//!
-//! `texmap-md-io` holds the full periodic table; the study must not depend on it
-//! (ARCHITECTURE.md), so this small closed table lives here.
+//! The few chemical elements the study's scenes use, as a closed set: colours and van der Waals
+//! radii come from `texmap-md-io`'s periodic table (Jmol CPK colours, Alvarez 2013 radii), the
+//! one table `texmap render` also draws with, so the study and the command line draw an atom
+//! alike; covalent radii for bonds by distance, masses for the MD integrator, and Seed 004's
+//! particle radii are the study's own.
 //!
 //! # References
-//! - Jmol CPK colours (jmol.sourceforge.net/jscolors), the de-facto molecular-graphics palette.
-//! - A. Bondi, "van der Waals volumes and radii", J. Phys. Chem. 68 (1964) 441 (vdW radii).
+//! - The colour and radius table: `texmap_md_io::elements` (its module docs cite the sources).
 //! - B. Cordero et al., "Covalent radii revisited", Dalton Trans. (2008) 2832 (covalent radii).
 //! - Seed 004 (Kitayama et al.), the particle table of the silicate experiment.
 
 use glam::Vec3;
 use texmap_core::color::srgb8_to_linear;
 use texmap_core::shade::Material;
+use texmap_md_io::elements::Element as TableElement;
 
 /// The elements used by the scenes (a closed set).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -54,18 +54,15 @@ impl Element {
         }
     }
 
+    /// This element's entry in the periodic table of `texmap-md-io`.
+    fn table(self) -> TableElement {
+        // Every symbol of this closed set is in the table (tested below).
+        TableElement::from_symbol(self.symbol()).unwrap_or(TableElement::UNKNOWN)
+    }
+
     /// Jmol CPK colour, sRGB 8-bit.
     pub fn cpk_srgb(self) -> [u8; 3] {
-        match self {
-            Element::H => [255, 255, 255],
-            Element::He => [217, 255, 255],
-            Element::C => [144, 144, 144],
-            Element::N => [48, 80, 248],
-            Element::O => [255, 13, 13],
-            Element::Mg => [138, 255, 0],
-            Element::Al => [191, 166, 166],
-            Element::Si => [240, 200, 160],
-        }
+        self.table().color_srgb8()
     }
 
     /// The CPK colour as linear RGB (what [`Material`] wants).
@@ -80,19 +77,9 @@ impl Element {
         Material::plastic(self.cpk_linear() * 0.8)
     }
 
-    /// Bondi van der Waals radius in Å (Mg, Al, Si from the same compilation's extension by
-    /// Mantina et al. 2009, He from Bondi).
+    /// Van der Waals radius in Å (Alvarez 2013, through `texmap-md-io`'s table).
     pub fn vdw_radius(self) -> f32 {
-        match self {
-            Element::H => 1.20,
-            Element::He => 1.40,
-            Element::C => 1.70,
-            Element::N => 1.55,
-            Element::O => 1.52,
-            Element::Mg => 1.73,
-            Element::Al => 1.84,
-            Element::Si => 2.10,
-        }
+        self.table().vdw_radius()
     }
 
     /// Covalent (single-bond) radius in Å, Cordero et al. 2008.
@@ -160,5 +147,16 @@ mod tests {
         for e in Element::ALL {
             assert!(e.vdw_radius() > e.covalent_radius());
         }
+    }
+
+    #[test]
+    fn every_element_is_in_the_periodic_table() {
+        // The CLI and the study draw from the same table: carbon is Alvarez's 1.77 Å.
+        for e in Element::ALL {
+            assert!(!e.table().is_unknown(), "{} missing", e.symbol());
+            assert_eq!(e.table().symbol(), e.symbol());
+        }
+        assert_eq!(Element::C.vdw_radius(), 1.77);
+        assert_eq!(Element::Mg.vdw_radius(), 2.51);
     }
 }
