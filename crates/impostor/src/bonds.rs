@@ -1,7 +1,7 @@
 //! Bonds drawn as exact ray-cast cylinder impostors, after the sphere pass of every method.
 //!
-//! Issue #4 asks for "a set of spheres … optional bonds as cylinders"; Seed 002 ends with "the
-//! same idea extends to pipes (cylinders, i.e. bonds)". This pass draws every
+//! Molecules are drawn with their bonds; Seed 002 ends with "the same idea extends to pipes
+//! (cylinders, i.e. bonds)". This pass draws every
 //! [`SphereScene::bonds`] pair as a cylinder of radius [`SphereScene::bond_radius`] from one atom
 //! centre to the other, **half-bond coloured** (the half nearer atom `i` in atom `i`'s material,
 //! as VMD and OVITO do), lit with the workspace's one shading model in eye space.

@@ -72,7 +72,7 @@
 //!   path: i32 edge functions for the whole block (eight lanes per row, one bit mask per row),
 //!   then only quads holding a covered pixel are shaded. It gives exactly the pixels of the
 //!   general quad loop (tested); on 1M ~10-px triangles the two together cut the instructions
-//!   of a draw from 2.88 G to 1.46 G (callgrind, see docs/PERFORMANCE.md, "Second round: raster").
+//!   of a draw from 2.88 G to 1.46 G (callgrind; docs/PERFORMANCE.md, "The levers that mattered").
 //! - Vertices are projected four at a time, bit-identical to the scalar projection (tested).
 //! - Attributes use screen-space plane equations of `a/W` and `1/W` (affine in screen space), set
 //!   up in f64 per triangle and evaluated in f32 relative to the triangle's first quad in the

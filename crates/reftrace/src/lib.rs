@@ -24,8 +24,8 @@
 //!   shared edges (obvhs's own triangle test does; it is not used).
 //!
 //! Correctness and robustness come first; speed is measured in `benches/reftrace.rs` and
-//! docs/PERFORMANCE.md, "Second round: reftrace" (on the 100k-sphere S2 scene the 4-wide traversal executes about
-//! 1.5x fewer instructions per primary ray than obvhs's cwbvh traversal).
+//! docs/PERFORMANCE.md (on the 100k-sphere S2 scene the 4-wide traversal executes about 1.5x
+//! fewer instructions per primary ray than obvhs's cwbvh traversal).
 //!
 //! ```
 //! use texmap_core::camera::Camera;

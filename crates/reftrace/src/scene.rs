@@ -60,7 +60,7 @@ pub enum BvhKind {
     CwBvh,
     /// obvhs's binary BVH collapsed into a 4-wide BVH with full-precision boxes in SIMD lanes,
     /// walked by this crate (`wide` module). The default: the fastest here (see
-    /// docs/PERFORMANCE.md, "Second round: reftrace"). A tree too deep for its fixed stack keeps
+    /// docs/PERFORMANCE.md, "Reference ray tracer"). A tree too deep for its fixed stack keeps
     /// the binary traversal ([`Scene::bvh_kind`] then says [`BvhKind::Bvh2`]).
     #[default]
     Wide4,

@@ -8,7 +8,7 @@
 //!
 //! # Why not obvhs's own traversals
 //! Measured with callgrind on the S2-like scene (100k spheres, 480x270 primary rays, one thread;
-//! docs/PERFORMANCE.md, "Second round: reftrace"): obvhs's cwbvh traversal decodes eight quantised child boxes from
+//! docs/PERFORMANCE.md): obvhs's cwbvh traversal decodes eight quantised child boxes from
 //! bytes at every node (48 `u8 → f32` conversions) and its bvh2 traversal tests two boxes per step
 //! with a data-dependent swap. The 4-wide layout keeps full-precision boxes (128 bytes a node, two
 //! cache lines) and halves the depth of the binary tree: 2,469 instructions per primary ray

@@ -116,21 +116,20 @@
 //! where it takes two.
 //!
 //! Measured with callgrind (instructions per sample, `examples/sampling_prof.rs`: the bench's
-//! tilted plane 1024x768 on a 4096² pyramid, one frame; details in docs/PERFORMANCE.md, "Third
-//! round: the span sampler"):
+//! tilted plane 1024x768 on a 4096² pyramid, one frame):
 //!
-//! | kernel | first lanes (SSE2 / AVX2 build) | third round (AVX2) | fourth round (AVX2) |
-//! |---|---|---|---|
-//! | trilinear, `sample_pixels` | 146 / 134 | 58.6 | 58.6 |
-//! | span K3, `sample_quads` | 134 / 121 | 46.8 | 46.75 |
-//! | span K4, `sample_quads` | 133 / 120 | 46.0 | 46.0 |
-//! | trilinear, one `sample_quad` per quad | – | 161.7 | 155.8 |
-//! | span K3, one `sample_quad` per quad | – | 109.1 | 84.0 |
-//! | span K4, one `sample_quad` per quad | – | 108.0 | 83.5 |
+//! | kernel | instructions per sample (AVX2 build) |
+//! |---|---|
+//! | trilinear, `sample_pixels` | 58.6 |
+//! | span K3, `sample_quads` | 46.75 |
+//! | span K4, `sample_quads` | 46.0 |
+//! | trilinear, one `sample_quad` per quad | 155.8 |
+//! | span K3, one `sample_quad` per quad | 84.0 |
+//! | span K4, one `sample_quad` per quad | 83.5 |
 //!
-//! **One span per call** (fourth round, Intel Xeon; docs/PERFORMANCE.md, "Fourth round"): the
-//! one-span path was SLOWER than trilinear's per quad (23–26 against ~16–17 ns per sample of
-//! thread CPU) with fewer instructions. Measured causes and fixes, all bit-identical: (1) a
+//! **One span per call.** A naive one-span path is SLOWER than trilinear's per quad (measured
+//! 23–26 against ~16–17 ns per sample of thread CPU on the Intel Xeon) with fewer instructions.
+//! The causes, and what the code does about them (all bit-identical): (1) a
 //! store-forwarding stall: LLVM read the quad's images with a 16-byte load at bytes 4..20,
 //! straddling the caller's two 16-byte stores of the quad (`perf`: ~15 % of the kernel's samples
 //! on the two instructions after it); now two loads, one per half. (2) The call is one chain
@@ -160,9 +159,9 @@
 //! cache simulation, per sample): 0.30 L1 read misses and 0.04 last-level misses for K3 against
 //! trilinear's 0.93 and 0.27 (K4: 0.56 and 0.26, its level pair is trilinear's), which is worth
 //! more as the instruction counts fall: in thread CPU time (best frame) K3 ran ~1.4x and K4
-//! ~1.3x trilinear on the shared AMD machine; on the Intel Xeon of the fourth round ~1.4x (best
-//! frame; K4 too) and 1.4–1.8x in criterion's thread CPU (load ~3, ±35 % between runs): the 1.5x
-//! of issue #2 shows up in time only where the memory advantage weighs; in instructions 1.25x.
+//! ~1.3x trilinear on the shared AMD machine; on the Intel Xeon ~1.4x (best
+//! frame; K4 too) and 1.4–1.8x in criterion's thread CPU (load ~3, ±35 % between runs): a 1.5x
+//! shows up in time only where the memory advantage weighs; in instructions it is 1.25x.
 //!
 //! Measured and rejected or left: LLVM turns a constant-index `vpermps` into `vshufps` +
 //! `vpermpd` (two instructions per weight): the lane order `[0 2 4 6 | 1 3 5 7]` (trilinear) and

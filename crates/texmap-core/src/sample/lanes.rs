@@ -598,8 +598,8 @@ pub(super) fn has_avx512() -> bool {
 /// criterion `trilinear` (two runs, alternating) 124.6 / 115.7 M/s wall against 95.2 / 94.5
 /// (thread CPU 134.1 / 113.9 against 92.9 / 119.4). The earlier AVX-512 build, eight pixels per
 /// step with the AVX2 set-up compiled for AVX-512 (256-bit set-up beside 512-bit µops), had
-/// been slower than the AVX2 build (~12.5–16 ns against ~8–9; docs/PERFORMANCE.md, "Fifth
-/// round: span sampler") and was dropped. The kernel is tested bit for bit against the SSE2
+/// been slower than the AVX2 build (~12.5–16 ns against ~8–9; docs/PERFORMANCE.md, "Designs
+/// rejected") and was dropped. The kernel is tested bit for bit against the SSE2
 /// baseline (`avx512_lane_builds_match_the_sse2_baseline_bit_for_bit`).
 const TRILINEAR_AVX512: bool = true;
 
