@@ -26,6 +26,7 @@ use crate::program::{
 use crate::project::{ClipTri, FLAG_INVALID, MAX_VAR, PVert, Proj, Var};
 use crate::sprite::{QuadShader, Sprite, raster_sprite};
 use crate::state::{Cull, DrawState};
+use crate::surface::{SurfaceProg, SurfaceShader};
 use crate::tri::{RasterCtx, area2, facing, pixel_bounds, raster_tri};
 
 /// What happened to the primitives of one draw call (integer counts, identical for any thread
@@ -244,6 +245,28 @@ impl Framebuffer {
         }
         let proj = Proj::new(camera);
         Ok(self.draw_program(&proj, mesh, &TexturedProg(sampler), state))
+    }
+
+    /// Draw a mesh with a [`SurfaceShader`] of the caller's own: per covered quad it receives
+    /// the pixels' depths, world-space normals (the mesh's vertex normals interpolated, or the
+    /// face normal when it has none) and triangle, and returns their colours. Coverage, depth
+    /// test, blending and determinism are those of every other draw.
+    ///
+    /// Errors: the camera's image size differs from the framebuffer's.
+    pub fn draw_surface<S: SurfaceShader + ?Sized>(
+        &mut self,
+        camera: &Camera,
+        mesh: &Mesh,
+        shader: &S,
+        state: &DrawState,
+    ) -> Result<DrawStats, RasterError> {
+        self.check_camera(camera)?;
+        let proj = Proj::new(camera);
+        let prog = SurfaceProg {
+            shader,
+            has_normals: mesh.normals().is_some(),
+        };
+        Ok(self.draw_program(&proj, mesh, &prog, state))
     }
 
     fn draw_program<P: FragProgram>(

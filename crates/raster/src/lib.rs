@@ -14,6 +14,10 @@
 //!   [`texmap_core::shade::Lighting`], the same model as the reference ray tracer), or textured
 //!   through any [`QuadSampler`] — [`MipSampler`] wraps every texmap-core sampler, and the Seed 000
 //!   span sampler receives the whole 2x2 quad (Eq. 8–10).
+//! - **Surface shaders of the caller's own** ([`Framebuffer::draw_surface`], [`SurfaceShader`]):
+//!   the open extension point. Per covered quad the shader gets the depth, the interpolated
+//!   world-space normal, the world position and eye ray ([`SurfaceQuad`]) and returns colours —
+//!   environment-mapped reflections and refractions are drawn this way.
 //! - **Sprites** ([`Framebuffer::draw_sprites`]): rectangles shaded by a [`QuadShader`] that
 //!   returns colour, depth and a keep mask per pixel — the impostor path.
 //! - **Quads and tiles**: pixels are processed as 2x2 quads (texture derivatives come for free);
@@ -91,6 +95,7 @@ mod project;
 mod simd;
 pub mod sprite;
 mod state;
+mod surface;
 mod tri;
 
 pub use draw::DrawStats;
@@ -100,3 +105,4 @@ pub use mesh::Mesh;
 pub use program::{MipSampler, QuadSampler, Shading, TexQuad};
 pub use sprite::{QuadOut, QuadShader, Sprite, SpriteQuad};
 pub use state::{Blend, Cull, DepthTest, DrawState};
+pub use surface::{SurfaceQuad, SurfaceShader};

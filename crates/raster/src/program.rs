@@ -49,6 +49,8 @@ pub(crate) struct QuadFrag {
     pub y: [f32; 4],
     /// Perspective-correct varyings, `var[k][lane]`.
     pub var: [[f32; 4]; MAX_VAR],
+    /// Depth along the view axis, as written to the depth buffer.
+    pub depth: [f32; 4],
     /// Lanes that will be written (bit l = lane l).
     pub mask: u8,
 }
@@ -487,6 +489,7 @@ mod tests {
                     x: [0.0; 4],
                     y: [0.0; 4],
                     var: [[0.0; 4]; MAX_VAR],
+                    depth: [1.0; 4],
                     mask: (round % 16) as u8 | 1,
                 };
                 for l in 0..4 {

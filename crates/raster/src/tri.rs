@@ -392,13 +392,14 @@ fn shade_quad<P: FragProgram>(
             qy as f32 + 1.5,
         ],
         var: [[0.0; 4]; MAX_VAR],
+        depth: depth.to_array(),
         mask,
     };
     for k in 0..P::NV {
         frag.var[k] = s.p_var[k].eval4(fx, fy).mul(w).to_array();
     }
     let c = prog.shade(cst, &frag, front);
-    write_quad(tile, qi, mask, &depth.to_array(), &c, st);
+    write_quad(tile, qi, mask, &frag.depth, &c, st);
 }
 
 /// The small-triangle path: coverage of the whole pixel range (at most [`BLOCK`] x [`BLOCK`],
