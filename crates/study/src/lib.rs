@@ -10,9 +10,11 @@
 //!   element colours and radii they need, [`rng`] the seeded generator.
 //! - [`md`]: a small deterministic Lennard-Jones MD (velocity Verlet, cell list, periodic box) that
 //!   moves the Seed 004 system for the animation demo.
-//! - [`harness`]: every method and the reference on one scene: ms/frame (median, tables reused),
-//!   PSNR, SSIM, depth error, silhouette mismatch, as [`harness::Record`]s (JSON and CSV), plus
-//!   error images.
+//! - [`record`]: what every family of methods reports, whatever it draws: a [`record::Record`]
+//!   per method, scene and reference (ms/frame, PSNR, SSIM, depth error, silhouette mismatch),
+//!   the comparison of a frame with its reference, error images, JSON and CSV results.
+//! - [`harness`]: the sphere methods and the reference on one scene (tables reused across
+//!   frames), reported as records.
 //! - [`sweeps`]: stability sweeps over field of view, angle off axis, eye distance and on-screen
 //!   radius on a single sphere; the tests pin each method's breaking point.
 //! - [`chart`]: SVG/PNG charts (speed against accuracy, and the sweep curves) with an embedded
@@ -38,8 +40,8 @@
 //! assert!(m.silhouette_px <= 0.5, "{m:?}");
 //! ```
 //!
-//! **Architecture invariant:** the study depends on `texmap-core`, `texmap-impostor` and
-//! `texmap-reftrace` only among our crates (never on `md-io` or the CLI); the CLI calls these
+//! **Architecture invariant:** the study never depends on the CLI; it takes the periodic table
+//! from `texmap-md-io` (one table for the study and `texmap render`). The CLI calls these
 //! functions and writes the files.
 
 pub mod chart;
@@ -47,6 +49,7 @@ pub mod elements;
 pub mod error;
 pub mod harness;
 pub mod md;
+pub mod record;
 pub mod rng;
 pub mod scenes;
 pub mod sweeps;
