@@ -1,6 +1,6 @@
 //! Profiling driver on texmap-study's canonical scenes (the ones `benches/spheres.rs` measures):
 //!
-//! `cargo run --release -p texmap-impostor --example sphere_prof -- <s1|s2|s3|empty> <method> [iters]`
+//! `cargo run --release -p texmap-study --example sphere_prof -- <s1|s2|s3|empty> <method> [iters]`
 //!
 //! renders the scene `iters` times (after one untimed frame that builds the tables) and prints
 //! the wall and CPU time per frame and the covered fraction. `empty` is S1's camera with no
