@@ -6,7 +6,7 @@
 use std::sync::Arc;
 
 use crate::error::{Error, Location};
-use crate::frame::{Frame, UnitCell};
+use crate::frame::{Frame, MAX_COORDINATE, UnitCell};
 
 /// Point `next` at frame `n` when it exists: `n < complete`, or `n == complete` with a damaged
 /// tail. Returns whether it does.
@@ -38,6 +38,32 @@ pub(crate) fn settle(
         }
     }
 }
+
+/// True if every value is finite and within ±[`MAX_COORDINATE`] Å (branch-free over chunks of 8
+/// values; NaN fails the comparison).
+pub(crate) fn all_in_bounds(p: &[[f32; 3]]) -> bool {
+    const MAX: f32 = MAX_COORDINATE as f32;
+    let flat = p.as_flattened();
+    let mut chunks = flat.chunks_exact(8);
+    let mut ok = true;
+    for c in &mut chunks {
+        let mut lane = true;
+        for v in c {
+            lane &= v.abs() <= MAX;
+        }
+        ok &= lane;
+    }
+    ok && chunks.remainder().iter().all(|v| v.abs() <= MAX)
+}
+
+/// The first atom whose position is not finite or beyond ±[`MAX_COORDINATE`] Å.
+pub(crate) fn first_out_of_bounds(p: &[[f32; 3]]) -> Option<usize> {
+    const MAX: f32 = MAX_COORDINATE as f32;
+    p.iter().position(|a| !a.iter().all(|v| v.abs() <= MAX))
+}
+
+/// What a reader reports for an atom out of bounds.
+pub(crate) const IN_BOUNDS: &str = "finite coordinates within ±1e7 Å";
 
 /// True if every value is finite (branch-free over chunks of 8 values).
 pub(crate) fn all_finite(p: &[[f32; 3]]) -> bool {

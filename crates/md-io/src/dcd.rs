@@ -41,7 +41,7 @@
 use std::io::{self, Read, Seek, SeekFrom, Write};
 use std::sync::Arc;
 
-use crate::cursor::all_finite;
+use crate::cursor::{IN_BOUNDS, all_finite, all_in_bounds, first_out_of_bounds};
 use crate::error::{Error, Location};
 use crate::frame::{Frame, UnitCell};
 
@@ -587,12 +587,9 @@ impl<R: Read + Seek> DcdReader<R> {
             }
         }
 
-        // Check that no NaN or infinity leaves the reader.
-        if !all_finite(positions) {
-            let bad = positions
-                .iter()
-                .position(|p| !p.iter().all(|v| v.is_finite()))
-                .unwrap_or(0);
+        // Check that no NaN, infinity or absurd value leaves the reader.
+        if !all_in_bounds(positions) {
+            let bad = first_out_of_bounds(positions).unwrap_or(0);
             let slot = if full {
                 bad
             } else {
@@ -607,7 +604,7 @@ impl<R: Read + Seek> DcdReader<R> {
                     index,
                     off + (x_at as u64) + self.layout.marker + 4 * slot as u64,
                 ),
-                expected: "finite coordinates",
+                expected: IN_BOUNDS,
                 found: format!("atom {bad}: {:?}", positions[bad]),
             });
         }
@@ -658,9 +655,14 @@ impl<R: Read + Seek> DcdReader<R> {
         ))
     }
 
-    /// Number of complete frames (the `Trajectory` contract; offset arithmetic, no scan).
+    /// Number of frames (the `Trajectory` contract; offset arithmetic, no scan). A partial frame
+    /// at the end, or fewer frames than NSET declares, is that frame's [`Error::Truncated`], not
+    /// a shorter count: nothing is dropped silently.
     pub fn n_frames(&mut self) -> Result<usize, Error> {
-        Ok(self.layout.n_complete)
+        match self.truncation() {
+            Some(e) => Err(e),
+            None => Ok(self.layout.n_complete),
+        }
     }
 }
 

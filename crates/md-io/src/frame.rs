@@ -9,11 +9,19 @@
 //! - every per-atom vector is either empty (the file does not have that column) or exactly
 //!   [`Frame::n_atoms`] long;
 //! - positions (and velocities, radii, colours) are finite: a reader rejects NaN and infinities;
+//! - positions lie within ±[`MAX_COORDINATE`] Å and cell lengths are at most that: a finite but
+//!   absurd value (1e38 from a flipped exponent bit, a cell of 1e300) is a damaged file, reported
+//!   by the reader with the file, frame and atom, not a failure later in a renderer's camera;
 //! - positions are in Å, velocities in Å/ps, time in ps, whatever the file's units.
 
 use crate::elements::Element;
 use crate::error::Error;
 use std::fmt;
+
+/// Largest |coordinate| and cell length (Å) a reader accepts: 10^7 Å = 1 mm, a thousand times
+/// the largest simulation boxes in use, and far below where f32 positions stop resolving atoms
+/// (spacing 1 Å at 1.6·10^7). Anything beyond it in a trajectory is damage.
+pub const MAX_COORDINATE: f64 = 1e7;
 
 /// A short string stored inline (at most [`Label::CAPACITY`] bytes of UTF-8): atom names, types,
 /// residue names. `Copy`, so filling per-atom labels allocates nothing.
@@ -43,6 +51,16 @@ impl Label {
             len: b.len() as u8,
             bytes,
         })
+    }
+
+    /// The label as one 128-bit value (length byte and the zero-padded bytes): equal labels
+    /// give equal keys, so a per-atom comparison is one integer compare.
+    #[inline]
+    pub(crate) fn key(&self) -> u128 {
+        let mut b = [0u8; 16];
+        b[0] = self.len;
+        b[1..].copy_from_slice(&self.bytes);
+        u128::from_le_bytes(b)
     }
 
     /// The label's bytes (UTF-8).
@@ -133,9 +151,12 @@ impl UnitCell {
     /// The cell from lengths (Å) and angles (degrees), in the usual orientation: a along x, b in
     /// the xy plane, c completing a right-handed set (the convention of PDB CRYST1 and LAMMPS).
     pub fn from_lengths_angles(lengths: [f64; 3], angles: [f64; 3]) -> Result<UnitCell, Error> {
-        if lengths.iter().any(|l| !(l.is_finite() && *l > 0.0)) {
+        if lengths
+            .iter()
+            .any(|l| !(l.is_finite() && *l > 0.0 && *l <= MAX_COORDINATE))
+        {
             return Err(Error::InvalidValue {
-                what: format!("cell lengths must be finite and > 0, got {lengths:?}"),
+                what: format!("cell lengths must be > 0 and at most 1e7 Å, got {lengths:?}"),
             });
         }
         if angles
@@ -188,6 +209,11 @@ impl UnitCell {
         }
         let len = |v: [f64; 3]| dot(v, v).sqrt();
         let lengths = [len(matrix[0]), len(matrix[1]), len(matrix[2])];
+        if lengths.iter().any(|l| *l > MAX_COORDINATE) {
+            return Err(Error::InvalidValue {
+                what: format!("cell edges must be at most 1e7 Å long, got {matrix:?}"),
+            });
+        }
         let angle = |u: [f64; 3], v: [f64; 3], lu: f64, lv: f64| {
             (dot(u, v) / (lu * lv)).clamp(-1.0, 1.0).acos().to_degrees()
         };

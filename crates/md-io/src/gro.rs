@@ -19,7 +19,7 @@ use crate::elements::guess_element;
 use crate::error::Error;
 use crate::frame::{Frame, Label, UnitCell};
 use crate::parse::{fields, parse_f64, parse_i64, parse_usize, trim};
-use crate::text::{Ctx, LineReader, MAX_RESERVE, Pos, TextFormat};
+use crate::text::{Ctx, LineReader, Pos, TextFormat};
 use std::io::Read;
 
 /// nm → Å.
@@ -117,7 +117,7 @@ impl TextFormat for Gro {
         };
         let t = trim(line);
         let n = parse_usize(t).ok_or_else(|| ctx.parse(pos, line, t, "the number of atoms"))?;
-        frame.positions.reserve(n.min(MAX_RESERVE));
+        frame.positions.reserve(n.min(ctx.reserve));
         // Atom lines: fixed columns, position width measured on the first line.
         let mut width = 0usize;
         let mut has_vel = false;

@@ -48,7 +48,7 @@ use crate::frame::{Frame, Label, UnitCell};
 use crate::parse::{
     field_f32, field_f64, fields, next_field, parse_f32, parse_f64, parse_i64, parse_usize, trim,
 };
-use crate::text::{Ctx, LineReader, MAX_RESERVE, Pos, TextFormat};
+use crate::text::{Ctx, LineReader, Pos, TextFormat};
 use std::io::Read;
 
 /// What one atom column is read into.
@@ -397,7 +397,7 @@ impl TextFormat for Lammps {
         } else {
             1.0
         };
-        frame.positions.reserve(h.n.min(MAX_RESERVE));
+        frame.positions.reserve(h.n.min(ctx.reserve));
         // Atom lines: one pass over each line's fields with the column actions.
         for i in 0..h.n {
             let p = lines.pos();

@@ -9,6 +9,21 @@
 //!
 //! Positions are in Å whatever the file's units; errors name the file, frame, line and byte.
 //!
+//! # What every reader promises
+//! - **Located errors.** Damage is an [`Error`] naming the file and the place (frame, line, byte
+//!   offset) and what was expected there; never a panic.
+//! - **Bounded memory.** Nothing is sized from a count in a header before the bytes the file
+//!   has left could hold it (an XTC header claiming 2^31 atoms over 1 KB is refused, not
+//!   allocated); text readers reserve at most one atom per 8 bytes of the file.
+//! - **No silent loss.** A last frame cut short is an [`Error::Truncated`] for that frame, from
+//!   [`Trajectory::n_frames`] too, unless `allow_truncated` ([`ReadOptions`]) asks to keep the
+//!   complete frames, and then it is a warning ([`Trajectory::warnings`]). A PDB model with
+//!   another atom count than model 1, or an atom record whose name is damaged, is an error.
+//! - **Sane values.** Coordinates and cell lengths are finite and within ±[`MAX_COORDINATE`]
+//!   (10^7 Å); beyond it a value is damage, reported with the frame and the atom.
+//!
+//! docs/RELIABILITY.md gives the fuzz campaign that checks these promises on every build.
+//!
 //! **Architecture invariant:** md-io depends on no other crate of texmap; it is reusable alone.
 //!
 //! # Example
@@ -36,7 +51,10 @@
 //!      a damaged frame return an error with a [`Location`] and stay at that frame,
 //!    - `fn seek_frame(&mut self, n: usize) -> Result<bool, Error>`: make `read_next` read frame
 //!      `n` next, `Ok(false)` when there is no frame `n` (build the frame index lazily),
-//!    - `fn n_frames(&mut self) -> Result<usize, Error>` that keeps the read position;
+//!    - `fn n_frames(&mut self) -> Result<usize, Error>` that keeps the read position and
+//!      gives a damaged or cut frame's error rather than a shorter count (the `Trajectory`
+//!      turns a cut end into a warning under `allow_truncated`);
+//!    - and sizes nothing from a header before checking that the file can hold it;
 //! 2. add the variant to `Reader`, an arm to `each_reader!` and to `Trajectory::from_reader`;
 //! 3. for a writer, a type with `fn write_frame(&mut self, frame: &Frame) -> std::io::Result<()>`
 //!    and `fn finish(&mut self) -> std::io::Result<()>`, a `WriterKind` variant and arms.
@@ -54,6 +72,7 @@ mod gro;
 mod lammps;
 pub mod parse;
 mod pdb;
+pub mod select;
 mod text;
 mod trajectory;
 mod trr;
@@ -64,8 +83,9 @@ mod xyz;
 pub use elements::{Appearance, AtomStyle, Element, Selector, atom_element};
 pub use error::{Error, Location};
 pub use format::Format;
-pub use frame::{Frame, Label, UnitCell};
-pub use trajectory::Trajectory;
+pub use frame::{Frame, Label, MAX_COORDINATE, UnitCell};
+pub use select::{Selection, SelectionError};
+pub use trajectory::{ReadOptions, Trajectory};
 pub use writer::Writer;
 
 /// molly, the XTC crate our decoder is measured against (benches/md_io.rs); not part of the API.

@@ -10,6 +10,11 @@
 //! - `TITLE`: the frame's comment. Everything else (REMARK, TER, CONECT, MASTER, END, ...) is
 //!   skipped, so trailing CONECT/MASTER/END records do not make a frame.
 //!
+//! Damage is never a silently dropped atom: every model must hold as many ATOM/HETATM records as
+//! model 1 (an error, or a warning under `ReadOptions::allow_truncated`), and a line whose
+//! record name is unknown but whose columns 31-54 hold three numbers (an atom record with a
+//! damaged name) is an error. Unknown lines without coordinates are skipped.
+//!
 //! Elements: columns 77-78 when they hold a symbol, else [`crate::elements::guess_element`] from
 //! the atom and residue names.
 //!
@@ -95,10 +100,36 @@ fn cols(line: &[u8], a: usize, b: usize) -> &[u8] {
     &line[s..e]
 }
 
-/// PDB frame parser state: the cell of the last CRYST1.
+/// Record names of PDB v3.3 that carry no atom position (plus SIGATM, SIGUIJ and USER, which
+/// programs write beside them). A line whose name is none of these nor ATOM/HETATM but whose
+/// columns 31-54 hold three numbers is an atom record with a damaged name: an error, not a
+/// silently skipped atom. Other unknown lines (comments of some programs) are skipped.
+const OTHER_RECORDS: [&[u8]; 53] = [
+    b"HEADER", b"OBSLTE", b"TITLE", b"SPLIT", b"CAVEAT", b"COMPND", b"SOURCE", b"KEYWDS",
+    b"EXPDTA", b"NUMMDL", b"MDLTYP", b"AUTHOR", b"REVDAT", b"SPRSDE", b"JRNL", b"REMARK", b"DBREF",
+    b"DBREF1", b"DBREF2", b"SEQADV", b"SEQRES", b"MODRES", b"HET", b"HETNAM", b"HETSYN", b"FORMUL",
+    b"HELIX", b"SHEET", b"SSBOND", b"LINK", b"CISPEP", b"SITE", b"CRYST1", b"ORIGX1", b"ORIGX2",
+    b"ORIGX3", b"SCALE1", b"SCALE2", b"SCALE3", b"MTRIX1", b"MTRIX2", b"MTRIX3", b"MODEL",
+    b"ANISOU", b"TER", b"ENDMDL", b"CONECT", b"MASTER", b"END", b"SIGATM", b"SIGUIJ", b"USER", b"",
+];
+
+/// True if columns 31-54 of `line` hold three numbers (an atom record's coordinates).
+fn has_coordinates(line: &[u8]) -> bool {
+    line.len() >= 54
+        && (0..3).all(|k| parse_f32(trim(cols(line, 31 + 8 * k, 38 + 8 * k))).is_some())
+}
+
+/// PDB frame parser state: the cell of the last CRYST1, and model 1's atom count, which every
+/// later model must repeat (a model with another count lost or gained atom lines: an error, or
+/// with `lenient` a warning kept in `warnings`).
 #[derive(Default)]
 pub(crate) struct Pdb {
     cell: Option<UnitCell>,
+    first_count: Option<usize>,
+    lenient: bool,
+    warnings: Vec<Error>,
+    /// Frames already warned about (a frame is walked by the scan and again by the read).
+    warned: std::collections::BTreeSet<usize>,
 }
 
 /// Record name of a line: its first 6 bytes, trailing spaces removed.
@@ -107,6 +138,45 @@ fn record(line: &[u8]) -> &[u8] {
 }
 
 impl Pdb {
+    /// A parser; `lenient` turns an atom count that differs from model 1's into a warning.
+    pub(crate) fn new(lenient: bool) -> Pdb {
+        Pdb {
+            lenient,
+            ..Pdb::default()
+        }
+    }
+
+    /// The warnings gathered so far (emptied).
+    pub(crate) fn take_warnings(&mut self) -> Vec<Error> {
+        std::mem::take(&mut self.warnings)
+    }
+
+    /// Checks a finished frame's atom count against model 1's.
+    fn check_count(&mut self, ctx: &Ctx, pos: Pos, n_atoms: usize) -> Result<(), Error> {
+        if ctx.frame == 0 {
+            self.first_count = Some(n_atoms);
+            return Ok(());
+        }
+        let Some(first) = self.first_count else {
+            return Ok(());
+        };
+        if first == n_atoms {
+            return Ok(());
+        }
+        let e = Error::Parse {
+            at: ctx.at(pos),
+            expected: "as many ATOM/HETATM records as model 1 (frame 0)",
+            found: format!("{n_atoms} atoms, model 1 has {first}"),
+        };
+        if !self.lenient {
+            return Err(e);
+        }
+        if self.warned.insert(ctx.frame) {
+            self.warnings.push(e);
+        }
+        Ok(())
+    }
+
     fn cryst1(&mut self, ctx: &Ctx, pos: Pos, line: &[u8]) -> Result<(), Error> {
         let mut v = [0f64; 6];
         let spans = [(7, 15), (16, 24), (25, 33), (34, 40), (41, 47), (48, 54)];
@@ -198,6 +268,7 @@ impl Pdb {
                     in_model = true;
                 }
                 b"ENDMDL" => {
+                    self.check_count(ctx, pos, n_atoms)?;
                     if let Some(f) = frame.as_deref_mut() {
                         f.cell = self.cell;
                     }
@@ -205,6 +276,10 @@ impl Pdb {
                 }
                 b"END" if n_atoms > 0 => break,
                 b"CRYST1" => self.cryst1(ctx, pos, line)?,
+                name if !OTHER_RECORDS.contains(&name) && has_coordinates(line) => {
+                    let name = cols(line, 1, 6);
+                    return Err(ctx.parse(pos, line, name, "ATOM or HETATM in columns 1-6"));
+                }
                 b"TITLE" => {
                     if let Some(f) = frame.as_deref_mut() {
                         let t = String::from_utf8_lossy(trim(cols(line, 11, 80)));
@@ -217,10 +292,14 @@ impl Pdb {
                 _ => {}
             }
         }
+        let found = n_atoms > 0 || in_model;
+        if found {
+            self.check_count(ctx, lines.pos(), n_atoms)?;
+        }
         if let Some(f) = frame {
             f.cell = self.cell;
         }
-        Ok(n_atoms > 0 || in_model)
+        Ok(found)
     }
 }
 

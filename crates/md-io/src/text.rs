@@ -16,10 +16,15 @@ use std::io::{Read, Seek, SeekFrom};
 use std::sync::Arc;
 
 /// Most atoms a reader reserves room for from a count in the file before seeing the atoms: a
-/// corrupt count must not make a huge allocation; larger frames grow as they are read.
+/// corrupt count must not make a huge allocation; larger frames grow as they are read. The
+/// reserve is also capped by the file: an atom line takes at least [`MIN_ATOM_LINE`] bytes.
 pub(crate) const MAX_RESERVE: usize = 1 << 16;
 
-/// Size of the chunk lines are split from.
+/// Fewest bytes of an atom line in any text format ("H 0 0 0\n").
+const MIN_ATOM_LINE: u64 = 8;
+
+/// Size of the chunk lines are split from (smaller for a smaller file: memory stays bounded by
+/// the file's size; a longer line grows the buffer as it is read).
 const CHUNK: usize = 1 << 20;
 
 /// Where a line starts: its 1-based number and the byte offset of its first byte.
@@ -44,10 +49,11 @@ pub(crate) struct LineReader<R> {
 }
 
 impl<R: Read> LineReader<R> {
-    pub fn new(src: R) -> LineReader<R> {
+    /// A line reader whose first chunk is `chunk` bytes (at least 64).
+    pub fn new(src: R, chunk: usize) -> LineReader<R> {
         LineReader {
             src,
-            buf: vec![0; CHUNK],
+            buf: vec![0; chunk.max(64)],
             start: 0,
             end: 0,
             eof: false,
@@ -198,6 +204,8 @@ impl<R: Read + Seek> LineReader<R> {
 pub(crate) struct Ctx {
     pub file: Arc<str>,
     pub frame: usize,
+    /// Most atoms to reserve room for from a count in the file (see [`MAX_RESERVE`]).
+    pub reserve: usize,
 }
 
 impl Ctx {
@@ -282,24 +290,48 @@ pub(crate) struct TextReader<R, F> {
     complete: bool,
     /// Index of the frame the next `read_next` reads.
     next: usize,
+    /// Most atoms to reserve from a count in the file.
+    reserve: usize,
 }
 
 impl<R: Read + Seek, F: TextFormat> TextReader<R, F> {
-    pub fn new(src: R, format: F, file: Arc<str>) -> TextReader<R, F> {
+    /// A reader over `src`, which starts at byte 0. Its length (when it can seek) bounds the
+    /// first line chunk and the atoms reserved from a count, so that memory follows the file.
+    pub fn new(mut src: R, format: F, file: Arc<str>) -> TextReader<R, F> {
+        let len = src
+            .seek(SeekFrom::End(0))
+            .and_then(|n| src.seek(SeekFrom::Start(0)).map(|_| n))
+            .ok();
+        let (chunk, reserve) = match len {
+            Some(n) => (
+                (n as usize).saturating_add(1).min(CHUNK),
+                ((n / MIN_ATOM_LINE) as usize)
+                    .saturating_add(1)
+                    .min(MAX_RESERVE),
+            ),
+            None => (CHUNK, MAX_RESERVE),
+        };
         TextReader {
-            lines: LineReader::new(src),
+            lines: LineReader::new(src, chunk),
             format,
             file,
             starts: Vec::new(),
             complete: false,
             next: 0,
+            reserve,
         }
+    }
+
+    /// The format's parser (for its warnings).
+    pub fn format_mut(&mut self) -> &mut F {
+        &mut self.format
     }
 
     fn ctx(&self) -> Ctx {
         Ctx {
             file: self.file.clone(),
             frame: self.next,
+            reserve: self.reserve,
         }
     }
 
@@ -317,7 +349,20 @@ impl<R: Read + Seek, F: TextFormat> TextReader<R, F> {
         if pushed {
             self.starts.push(start);
         }
-        let ok = self.format.read(&mut self.lines, &ctx, frame);
+        let ok = self
+            .format
+            .read(&mut self.lines, &ctx, frame)
+            .and_then(|ok| {
+                // Finite but absurd coordinates are damage too: name the frame and the atom.
+                match crate::cursor::first_out_of_bounds(&frame.positions) {
+                    Some(bad) if ok => Err(Error::Parse {
+                        at: Location::text(&self.file, self.next, start.line, start.byte),
+                        expected: crate::cursor::IN_BOUNDS,
+                        found: format!("atom {bad}: {:?}", frame.positions[bad]),
+                    }),
+                    _ => Ok(ok),
+                }
+            });
         match ok {
             Ok(true) => {
                 self.next += 1;

@@ -42,6 +42,56 @@ macro_rules! each_reader {
     };
 }
 
+/// How a [`Trajectory`] treats a file whose end is damaged.
+///
+/// By default every frame the file announces or starts must be readable: a last frame cut short
+/// (a crashed or still-running simulation, a partial copy) is an [`Error::Truncated`] naming the
+/// file, the frame, the byte offset where the data ends and what was still expected, from
+/// [`Trajectory::n_frames`] as well as from the read that reaches it. Nothing is dropped
+/// silently.
+///
+/// With `allow_truncated` ([`ReadOptions`]) the complete frames are kept and the cut one is dropped
+/// *with a warning*: the same error, kept in [`Trajectory::warnings`] for the caller to print,
+/// while `n_frames` counts the complete frames and streaming ends after the last of them. A PDB
+/// model whose atom count differs from model 1's is likewise an error by default and a warning
+/// here (the model is passed on as it is). Damage that is not a cut end (a flipped byte, a
+/// corrupt header) stays an error either way.
+///
+/// ```
+/// use texmap_md_io::{Format, Frame, ReadOptions, Trajectory};
+/// // Two XYZ frames, the second cut after its first atom line.
+/// let text = "2\nfirst\nO 0 0 0\nH 1 0 0\n2\nsecond\nO 0 0 0\n";
+/// let src = || std::io::Cursor::new(text);
+/// let mut strict = Trajectory::from_reader(src(), Format::Xyz, "cut.xyz")?;
+/// let e = strict.n_frames().unwrap_err();
+/// assert!(e.to_string().starts_with("cut.xyz: frame 1, line 8"), "{e}");
+///
+/// let opts = ReadOptions::new().allow_truncated(true);
+/// let mut lenient = Trajectory::from_reader_with(src(), Format::Xyz, "cut.xyz", opts)?;
+/// assert_eq!(lenient.n_frames()?, 1);
+/// assert_eq!(lenient.warnings().len(), 1);
+/// # Ok::<(), texmap_md_io::Error>(())
+/// ```
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct ReadOptions {
+    /// Keep the complete frames of a file whose last frame is cut short, with a warning.
+    pub allow_truncated: bool,
+}
+
+impl ReadOptions {
+    /// The defaults: every damage is an error.
+    pub fn new() -> ReadOptions {
+        ReadOptions::default()
+    }
+
+    /// Sets the `allow_truncated` field.
+    pub fn allow_truncated(mut self, yes: bool) -> ReadOptions {
+        self.allow_truncated = yes;
+        self
+    }
+}
+
 /// A trajectory file opened for reading.
 ///
 /// Frames are read one at a time into a caller's [`Frame`] ([`Trajectory::read_next`]), so
@@ -61,11 +111,22 @@ pub struct Trajectory<R: Read + Seek = File> {
     format: Format,
     n_atoms: Option<usize>,
     next: usize,
+    options: ReadOptions,
+    /// What was tolerated under `options` (each once).
+    warnings: Vec<Error>,
 }
 
 impl Trajectory<File> {
     /// Opens `path`, telling the format from the extension or else from the first bytes.
     pub fn open(path: impl AsRef<Path>) -> Result<Trajectory<File>, Error> {
+        Trajectory::open_with(path, ReadOptions::default())
+    }
+
+    /// [`Trajectory::open`] with [`ReadOptions`].
+    pub fn open_with(
+        path: impl AsRef<Path>,
+        options: ReadOptions,
+    ) -> Result<Trajectory<File>, Error> {
         let path = path.as_ref();
         let name: Arc<str> = path.display().to_string().into();
         let io = |source| Error::Io {
@@ -82,31 +143,51 @@ impl Trajectory<File> {
                 Format::from_magic(&head).ok_or(Error::UnknownFormat { file: name.clone() })?
             }
         };
-        Trajectory::from_reader(file, format, &name)
+        Trajectory::from_reader_with(file, format, &name, options)
     }
 
     /// Opens `path` as `format`, whatever its extension.
     pub fn open_as(path: impl AsRef<Path>, format: Format) -> Result<Trajectory<File>, Error> {
+        Trajectory::open_as_with(path, format, ReadOptions::default())
+    }
+
+    /// [`Trajectory::open_as`] with [`ReadOptions`].
+    pub fn open_as_with(
+        path: impl AsRef<Path>,
+        format: Format,
+        options: ReadOptions,
+    ) -> Result<Trajectory<File>, Error> {
         let path = path.as_ref();
         let name: Arc<str> = path.display().to_string().into();
         let file = File::open(path).map_err(|source| Error::Io {
             at: crate::error::Location::file(&name),
             source,
         })?;
-        Trajectory::from_reader(file, format, &name)
+        Trajectory::from_reader_with(file, format, &name, options)
     }
 }
 
 impl<R: Read + Seek> Trajectory<R> {
     /// Reads `src` as `format`; `name` is what errors call the file.
     pub fn from_reader(src: R, format: Format, name: &str) -> Result<Trajectory<R>, Error> {
+        Trajectory::from_reader_with(src, format, name, ReadOptions::default())
+    }
+
+    /// [`Trajectory::from_reader`] with [`ReadOptions`].
+    pub fn from_reader_with(
+        src: R,
+        format: Format,
+        name: &str,
+        options: ReadOptions,
+    ) -> Result<Trajectory<R>, Error> {
         let file: Arc<str> = name.into();
+        let lenient = options.allow_truncated;
         let reader = match format {
             Format::Xyz => Reader::Xyz(TextReader::new(src, Xyz::default(), file.clone())),
             Format::Dcd => Reader::Dcd(DcdReader::new(src, file.clone())?),
             Format::Xtc => Reader::Xtc(XtcReader::new(src, file.clone())?),
             Format::Trr => Reader::Trr(TrrReader::new(src, file.clone())?),
-            Format::Pdb => Reader::Pdb(TextReader::new(src, Pdb::default(), file.clone())),
+            Format::Pdb => Reader::Pdb(TextReader::new(src, Pdb::new(lenient), file.clone())),
             Format::Gro => Reader::Gro(TextReader::new(src, Gro, file.clone())),
             Format::LammpsDump => {
                 Reader::Lammps(TextReader::new(src, Lammps::default(), file.clone()))
@@ -118,7 +199,53 @@ impl<R: Read + Seek> Trajectory<R> {
             format,
             n_atoms: None,
             next: 0,
+            options,
+            warnings: Vec::new(),
         })
+    }
+
+    /// The options the file was opened with.
+    pub fn options(&self) -> ReadOptions {
+        self.options
+    }
+
+    /// What was tolerated under `allow_truncated` ([`ReadOptions`]) so far (a dropped cut frame,
+    /// a PDB model with another atom count), each once, in the order met. Display names the
+    /// file, frame and byte; a caller prints them as warnings.
+    pub fn warnings(&self) -> &[Error] {
+        &self.warnings
+    }
+
+    /// Keeps `w` as a warning unless the same one is kept already.
+    fn warn(&mut self, w: Error) {
+        let same = |k: &Error| k.location() == w.location() && k.to_string() == w.to_string();
+        if !self.warnings.iter().any(same) {
+            self.warnings.push(w);
+        }
+    }
+
+    /// Gathers the PDB parser's warnings.
+    fn gather(&mut self) {
+        if let Reader::Pdb(r) = &mut self.reader {
+            for w in r.format_mut().take_warnings() {
+                self.warn(w);
+            }
+        }
+    }
+
+    /// Under `allow_truncated`, a cut end is a warning and the complete frames before it are
+    /// the whole file: returns that frame count. Any other error is given back.
+    fn tolerate(&mut self, e: Error) -> Result<usize, Error> {
+        match &e {
+            Error::Truncated { at, .. } if self.options.allow_truncated => match at.frame {
+                Some(complete) => {
+                    self.warn(e);
+                    Ok(complete)
+                }
+                None => Err(e),
+            },
+            _ => Err(e),
+        }
     }
 
     /// The file's format.
@@ -134,7 +261,16 @@ impl<R: Read + Seek> Trajectory<R> {
     /// Reads the next frame into `frame` (cleared first); `Ok(false)` after the last frame.
     /// On error `frame` is left empty and the reader stays at the damaged frame.
     pub fn read_next(&mut self, frame: &mut Frame) -> Result<bool, Error> {
-        let ok = each_reader!(&mut self.reader, r => r.read_next(frame))?;
+        let read = each_reader!(&mut self.reader, r => r.read_next(frame));
+        self.gather();
+        let ok = match read {
+            Ok(ok) => ok,
+            Err(e) => {
+                self.tolerate(e)?;
+                frame.clear();
+                false
+            }
+        };
         if ok {
             if self.next == 0 {
                 self.n_atoms = Some(frame.n_atoms());
@@ -146,7 +282,13 @@ impl<R: Read + Seek> Trajectory<R> {
 
     /// Reads frame `n` (0-based) into `frame`; the next `read_next` then reads frame `n + 1`.
     pub fn read_frame(&mut self, n: usize, frame: &mut Frame) -> Result<(), Error> {
-        let found = each_reader!(&mut self.reader, r => r.seek_frame(n))?;
+        let seek = each_reader!(&mut self.reader, r => r.seek_frame(n));
+        self.gather();
+        // A scan that met a cut end under `allow_truncated`: frame `n` is past the kept ones.
+        let found = match seek {
+            Ok(found) => found,
+            Err(e) => self.tolerate(e).map(|_| false)?,
+        };
         if !found {
             let n_frames = self.n_frames()?;
             return Err(Error::FrameOutOfRange {
@@ -169,8 +311,13 @@ impl<R: Read + Seek> Trajectory<R> {
 
     /// Number of frames. The first call may scan the whole file (once); the read position is
     /// kept.
+    ///
+    /// A cut last frame is an error naming it (see [`ReadOptions`]), or under `allow_truncated`
+    /// a warning, and the complete frames are counted.
     pub fn n_frames(&mut self) -> Result<usize, Error> {
-        each_reader!(&mut self.reader, r => r.n_frames())
+        let n = each_reader!(&mut self.reader, r => r.n_frames());
+        self.gather();
+        n.or_else(|e| self.tolerate(e))
     }
 
     /// Number of atoms in the first frame (frames of a LAMMPS dump may differ: use

@@ -22,7 +22,7 @@
 use std::io::{self, Read, Seek, SeekFrom};
 use std::sync::Arc;
 
-use crate::cursor::{all_finite, cell_of};
+use crate::cursor::{IN_BOUNDS, all_finite, all_in_bounds, cell_of, first_out_of_bounds};
 use crate::error::{Error, Location};
 use crate::frame::Frame;
 
@@ -373,7 +373,7 @@ impl<R: Read + Seek> TrrReader<R> {
         p += h.box_size + h.vir_size + h.pres_size;
         // Positions and velocities, nm → Å.
         for (size, out, what) in [
-            (h.x_size, &mut *positions, "finite positions"),
+            (h.x_size, &mut *positions, IN_BOUNDS),
             (h.v_size, &mut *velocities, "finite velocities"),
         ] {
             out.clear();
@@ -386,11 +386,18 @@ impl<R: Read + Seek> TrrReader<R> {
             } else {
                 convert::<4>(bytes, out);
             }
-            if !all_finite(out) {
-                let bad = out
-                    .iter()
-                    .position(|v| !v.iter().all(|c| c.is_finite()))
-                    .unwrap_or(0);
+            let ok = if what == IN_BOUNDS {
+                all_in_bounds(out)
+            } else {
+                all_finite(out)
+            };
+            if !ok {
+                let bad = if what == IN_BOUNDS {
+                    first_out_of_bounds(out)
+                } else {
+                    out.iter().position(|v| !v.iter().all(|c| c.is_finite()))
+                }
+                .unwrap_or(0);
                 return Err(Error::Parse {
                     at: Location::binary(&self.file, index, offset + (p + 3 * r * bad) as u64),
                     expected: what,
@@ -453,9 +460,14 @@ impl<R: Read + Seek> TrrReader<R> {
         ))
     }
 
-    /// Number of complete frames (the `Trajectory` contract; the index is built at open time).
+    /// Number of frames (the `Trajectory` contract; the index is built at open time). A damaged
+    /// or cut frame after the good ones is that frame's error, not a shorter count: nothing is
+    /// dropped silently.
     pub fn n_frames(&mut self) -> Result<usize, Error> {
-        Ok(self.frames.len())
+        match &self.tail {
+            Some(e) => Err(crate::xtc::clone_error(e)),
+            None => Ok(self.frames.len()),
+        }
     }
 }
 

@@ -40,7 +40,7 @@
 use std::io::{self, Read, Seek, SeekFrom, Write};
 use std::sync::Arc;
 
-use crate::cursor::cell_of;
+use crate::cursor::{IN_BOUNDS, all_in_bounds, cell_of, first_out_of_bounds};
 use crate::error::{Error, Location};
 use crate::frame::Frame;
 
@@ -59,6 +59,17 @@ const PAD: usize = 128;
 const FIRSTIDX: usize = 9;
 /// nm → Å.
 const NM: f32 = 10.0;
+/// Fewest bits one atom can take in a compressed stream. Each step of [`Decoder::decode`] reads
+/// a large triple (at least 1 bit: a product of radices ≥ 1) and a run flag (1 bit) and gives one
+/// atom, or reads k ≥ 1 more small triples of `smallidx` ≥ 9 bits and gives k + 1 atoms: never
+/// fewer than 2 bits an atom, and the decoder rejects a stream that ends past its byte count.
+/// So `natoms ≤ 8 · nbytes / 2` holds in every frame that decodes, and the atom count is checked
+/// against it before the position buffer is sized (a header claiming 2^31 atoms over a few
+/// bytes would otherwise ask for 24 GiB).
+const MIN_BITS_PER_ATOM: u64 = 2;
+/// Precisions (1/nm) the reader accepts: GROMACS writes 1000, users 10..=10^6; a value outside
+/// this range is a damaged header, not a choice (1e-30 would turn every integer into ~1e31 Å).
+const PRECISION_RANGE: std::ops::RangeInclusive<f32> = 1e-3..=1e9;
 
 /// Radices of the small differences: MAGICINTS[i] ~ 2^(i/3), so three of them fit in i bits.
 #[rustfmt::skip]
@@ -184,6 +195,15 @@ fn frame_size(
             count_at,
             "a compressed byte count below 64 bytes per atom",
             nbytes.to_string(),
+        ));
+    }
+    // And an atom count the stream cannot hold is corruption too, caught here, before anything
+    // is sized from it: every atom costs the decoder at least `MIN_BITS_PER_ATOM` bits.
+    if natoms as u64 > nbytes.saturating_mul(8) / MIN_BITS_PER_ATOM {
+        return Err(parse(
+            4,
+            "an atom count the compressed stream can hold (at most 4 per byte)",
+            format!("{natoms} atoms in {nbytes} bytes"),
         ));
     }
     let padded = nbytes.div_ceil(4) * 4;
@@ -390,9 +410,14 @@ impl<R: Read + Seek> XtcReader<R> {
         ))
     }
 
-    /// Number of complete frames (the `Trajectory` contract; the index is built at open time).
+    /// Number of frames (the `Trajectory` contract; the index is built at open time). A damaged
+    /// or cut frame after the good ones is that frame's error, not a shorter count: nothing is
+    /// dropped silently.
     pub fn n_frames(&mut self) -> Result<usize, Error> {
-        Ok(self.frames.len())
+        match &self.tail {
+            Some(e) => Err(clone_error(e)),
+            None => Ok(self.frames.len()),
+        }
     }
 }
 
@@ -468,10 +493,10 @@ fn decode_frame(
     } else {
         let precision = be_f32(buf, HEADER);
         let inv = 1.0 / precision;
-        if !(precision > 0.0 && inv.is_finite() && precision.is_finite()) {
+        if !(PRECISION_RANGE.contains(&precision) && inv.is_finite()) {
             return Err(parse(
                 HEADER,
-                "a finite precision > 0",
+                "a precision in 1e-3..=1e9 per nm",
                 precision.to_string(),
             ));
         }
@@ -524,8 +549,13 @@ fn decode_frame(
             })?;
         precision
     };
-    if !positions.as_flattened().iter().all(|v| v.is_finite()) {
-        return Err(parse(HEADER, "finite coordinates", "overflow".into()));
+    if !all_in_bounds(positions) {
+        let bad = first_out_of_bounds(positions).unwrap_or(0);
+        return Err(parse(
+            HEADER,
+            IN_BOUNDS,
+            format!("atom {bad}: {:?}", positions[bad]),
+        ));
     }
     Ok(XtcFrameInfo {
         step,
@@ -957,6 +987,32 @@ mod tests {
                             );
                         }
                     }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn densest_streams_molly_writes_pass_the_atom_count_bound() {
+        // Every atom at one point, or on a 0.001 nm grid: the fewest bits an atom molly's
+        // compressor spends. The reader refuses natoms > 4 per byte before decoding; these
+        // files must still read, and agree with molly.
+        for n in [10, 11, 100, 1000, 4099] {
+            let same = vec![[12.5f32, -3.0, 7.25]; n];
+            let grid: Vec<[f32; 3]> = (0..n).map(|k| [k as f32 * 0.01, 0.0, 0.0]).collect();
+            for frame in [same, grid] {
+                let bytes = write_molly(std::slice::from_ref(&frame), molly::Magic::Xtc1995);
+                let nbytes = be_u32(&bytes, HEADER + PRELUDE) as usize;
+                let want = molly::XTCReader::new(Cursor::new(bytes.clone()))
+                    .read_all_frames()
+                    .unwrap();
+                let mut r = XtcReader::new(Cursor::new(bytes), name())
+                    .unwrap_or_else(|e| panic!("{n} atoms in {nbytes} bytes: {e}"));
+                let mut p = Vec::new();
+                r.read_frame(0, &mut p)
+                    .unwrap_or_else(|e| panic!("{n} atoms in {nbytes} bytes: {e}"));
+                for (a, w) in p.iter().zip(want[0].coords()) {
+                    assert_eq!(*a, w.map(|v| v * NM), "{n} atoms in {nbytes} bytes");
                 }
             }
         }

@@ -20,7 +20,7 @@ use crate::frame::{Frame, Label, UnitCell};
 use crate::parse::{
     field_f32, fields, next_field, parse_f32, parse_f64, parse_i64, parse_usize, trim,
 };
-use crate::text::{Ctx, LineReader, MAX_RESERVE, Pos, TextFormat};
+use crate::text::{Ctx, LineReader, Pos, TextFormat};
 use std::io::Read;
 
 /// What one atom-line column group holds.
@@ -337,7 +337,7 @@ impl TextFormat for Xyz {
         frame.comment.push_str(&String::from_utf8_lossy(line));
         self.parse_comment(ctx, pos, line, frame)?;
         // Atom lines, with the kernel chosen once per frame.
-        frame.positions.reserve(n.min(MAX_RESERVE));
+        frame.positions.reserve(n.min(ctx.reserve));
         let plain = self.cols == [Col::Species, Col::Pos];
         for i in 0..n {
             let p = lines.pos();

@@ -1,12 +1,14 @@
 //! Damaged DCD / XTC / TRR files, built from good ones written by MDAnalysis and by our own
 //! writers: cut at every byte (so at every record boundary and inside every record) and with
 //! bits flipped at every byte. Nothing may panic; every frame before the damage must read back
-//! unchanged; the error for the damaged frame must name the file, the frame and the byte.
+//! unchanged; the error for the damaged frame must name the file, the frame and the byte, and a
+//! cut frame is never dropped silently: `n_frames` reports it, unless `allow_truncated` was
+//! asked for, which keeps the complete frames and gives the same error as a warning.
 
 use std::io::Cursor;
 use std::path::PathBuf;
 
-use texmap_md_io::{Error, Format, Frame, Trajectory};
+use texmap_md_io::{Error, Format, Frame, ReadOptions, Trajectory};
 
 fn data(name: &str) -> Vec<u8> {
     let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -61,7 +63,39 @@ fn cut_at_every_byte_keeps_the_frames_before_the_cut() {
                     continue;
                 }
             };
+            // Strict: a cut inside a frame (or short of the frames DCD's header declares) is
+            // an error for that frame, naming the byte where the data ends.
+            let strict = t.n_frames();
+            let lenient = ReadOptions::new().allow_truncated(true);
+            let mut t = Trajectory::from_reader_with(
+                Cursor::new(bytes[..cut].to_vec()),
+                format,
+                name,
+                lenient,
+            )
+            .unwrap();
             let complete = t.n_frames().unwrap();
+            match strict {
+                Ok(n) => {
+                    assert_eq!(n, complete, "{name} cut {cut}");
+                    assert!(t.warnings().is_empty(), "{name} cut {cut}");
+                }
+                Err(e) => {
+                    assert!(
+                        matches!(e, Error::Truncated { .. }),
+                        "{name} cut {cut}: {e}"
+                    );
+                    let at = e.location().unwrap();
+                    assert_eq!(
+                        (at.frame, at.byte),
+                        (Some(complete), Some(cut as u64)),
+                        "{e}"
+                    );
+                    // Lenient: the same error, as a warning.
+                    assert_eq!(t.warnings().len(), 1, "{name} cut {cut}");
+                    assert_eq!(t.warnings()[0].to_string(), e.to_string());
+                }
+            }
             assert!(
                 complete >= last_complete,
                 "{name} cut {cut}: frames went down"
@@ -71,6 +105,15 @@ fn cut_at_every_byte_keeps_the_frames_before_the_cut() {
             for (k, want) in good.iter().enumerate().take(complete) {
                 t.read_frame(k, &mut f).unwrap();
                 assert_eq!(&f, want, "{name} cut {cut} frame {k}");
+            }
+            assert!(
+                !t.read_next(&mut f).unwrap(),
+                "{name} cut {cut}: past the end"
+            );
+            let mut t =
+                Trajectory::from_reader(Cursor::new(bytes[..cut].to_vec()), format, name).unwrap();
+            for k in 0..complete {
+                t.read_frame(k, &mut f).unwrap();
             }
             match t.read_next(&mut f) {
                 Ok(more) => assert!(!more, "{name} cut {cut}: a frame past the complete ones"),
@@ -108,7 +151,15 @@ fn flipped_bytes_never_panic_and_errors_name_the_place() {
                 let Ok(mut t) = Trajectory::from_reader(Cursor::new(b), format, name) else {
                     continue;
                 };
-                let n = t.n_frames().unwrap();
+                // A damaged frame after the good ones is the count's error, naming that frame.
+                let n = match t.n_frames() {
+                    Ok(n) => n,
+                    Err(e) => {
+                        let loc = e.location().unwrap_or_else(|| panic!("{e}"));
+                        assert!(loc.byte.is_some(), "{e}");
+                        loc.frame.unwrap_or_else(|| panic!("{name} byte {at}: {e}"))
+                    }
+                };
                 let mut f = Frame::new();
                 for k in 0..=n {
                     match t.read_frame(k, &mut f) {

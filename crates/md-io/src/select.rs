@@ -1,0 +1,891 @@
+//! Atom selections in the language VMD and MDAnalysis users type, so that the protein is not
+//! hidden inside its water: `not resname SOL`, `name CA`, `element O and resid 1 to 20`,
+//! `protein and not name H*`, `within 5 of resname LIG`.
+//!
+//! # The language
+//! ```text
+//! expr     := term ("or" term)*
+//! term     := factor ("and" factor)*
+//! factor   := "not" factor | "(" expr ")" | atom
+//! atom     := "all" | "none" | "protein" | "backbone" | "water"
+//!           | ("name" | "type" | "resname" | "element") WORD+      -- any of the words
+//!           | ("index" | "serial" | "bynum" | "id" | "resid") RANGE+
+//!           | "within" NUMBER "of" factor                          -- VMD: includes the factor
+//!           | "around" NUMBER factor                               -- MDAnalysis: excludes it
+//! RANGE    := N | N "to" M | N:M | N-M                              -- inclusive
+//! ```
+//! Keywords are case-insensitive; words are compared exactly (atom names are case-sensitive in
+//! PDB), except `element`, which takes a chemical symbol in any case. A word may hold the glob
+//! characters `*` (any run) and `?` (one character): `name H*`. `index` counts atoms from 0 in
+//! file order; `serial` and `bynum` from 1 (`bynum` is MDAnalysis's name); `id` is the atom id the
+//! file wrote. `protein` is a residue name among the amino acids of [`PROTEIN_RESIDUES`];
+//! `backbone` is `protein and name N CA C O`; `water` a residue name in [`WATER_RESIDUES`].
+//! `within`/`around` use plain distances (no periodic images) through a cell grid, so they cost
+//! time linear in the atoms.
+//!
+//! A selection is parsed once ([`Selection::parse`]) and evaluated per frame
+//! ([`Selection::evaluate`]). A parse error points at the column of the bad token; evaluating a
+//! keyword whose column the frame lacks (`resname` on an XYZ frame) is an error that says so,
+//! never an empty selection.
+
+use std::fmt;
+
+use crate::elements::Element;
+use crate::frame::{Frame, Label};
+
+/// Residue names `protein` matches: the 20 amino acids, their common protonation and
+/// terminal variants (AMBER, CHARMM, GROMACS spellings) and selenomethionine.
+pub const PROTEIN_RESIDUES: &[&str] = &[
+    "ALA", "ARG", "ASN", "ASP", "CYS", "GLN", "GLU", "GLY", "HIS", "ILE", "LEU", "LYS", "MET",
+    "PHE", "PRO", "SER", "THR", "TRP", "TYR", "VAL", "ASH", "GLH", "HID", "HIE", "HIP", "HSD",
+    "HSE", "HSP", "LYN", "CYX", "CYM", "MSE", "NALA", "CALA",
+];
+
+/// Residue names `water` matches.
+pub const WATER_RESIDUES: &[&str] = &[
+    "SOL", "WAT", "HOH", "H2O", "TIP3", "TIP4", "TIP5", "SPC", "T3P", "T4P",
+];
+
+/// Longest selection accepted (characters), and deepest nesting: a selection is typed by a
+/// person, so anything larger is a mistake, and the bound keeps the recursive parser safe.
+const MAX_LEN: usize = 10_000;
+const MAX_DEPTH: usize = 200;
+
+/// A selection that could not be parsed or evaluated: the text, the 1-based column of the token
+/// at fault and what was expected there.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SelectionError {
+    pub selection: String,
+    /// 1-based character column.
+    pub column: usize,
+    pub message: String,
+}
+
+impl fmt::Display for SelectionError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(f, "selection column {}: {}", self.column, self.message)?;
+        writeln!(f, "  {}", self.selection)?;
+        write!(f, "  {}^", " ".repeat(self.column.saturating_sub(1)))
+    }
+}
+
+impl std::error::Error for SelectionError {}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum StrField {
+    Name,
+    Type,
+    ResName,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum NumField {
+    Index,
+    Serial,
+    Id,
+    ResId,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+enum Node {
+    All,
+    None,
+    Not(Box<Node>),
+    And(Box<Node>, Box<Node>),
+    Or(Box<Node>, Box<Node>),
+    Str {
+        field: StrField,
+        words: Vec<String>,
+        column: usize,
+    },
+    Element(Vec<Element>),
+    Num {
+        field: NumField,
+        ranges: Vec<(i64, i64)>,
+        column: usize,
+    },
+    Within {
+        distance: f64,
+        of: Box<Node>,
+        include_reference: bool,
+    },
+}
+
+/// A parsed selection (see the module docs).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Selection {
+    text: String,
+    root: Node,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+struct Token {
+    text: String,
+    /// 1-based column of its first character.
+    column: usize,
+}
+
+fn tokenize(s: &str) -> Vec<Token> {
+    let mut out = Vec::new();
+    let chars: Vec<char> = s.chars().collect();
+    let mut i = 0;
+    while i < chars.len() {
+        let c = chars[i];
+        if c.is_whitespace() {
+            i += 1;
+        } else if c == '(' || c == ')' {
+            out.push(Token {
+                text: c.to_string(),
+                column: i + 1,
+            });
+            i += 1;
+        } else {
+            let start = i;
+            while i < chars.len() && !chars[i].is_whitespace() && chars[i] != '(' && chars[i] != ')'
+            {
+                i += 1;
+            }
+            out.push(Token {
+                text: chars[start..i].iter().collect(),
+                column: start + 1,
+            });
+        }
+    }
+    out
+}
+
+/// Words that end a keyword's list of values: the operators and every keyword, so that a
+/// forgotten `and` (`name CA resid 5`) is an error, not a search for an atom named "resid".
+fn is_reserved(w: &str) -> bool {
+    matches!(
+        w.to_ascii_lowercase().as_str(),
+        "and"
+            | "or"
+            | "not"
+            | "of"
+            | "to"
+            | "("
+            | ")"
+            | "all"
+            | "none"
+            | "protein"
+            | "backbone"
+            | "water"
+            | "name"
+            | "type"
+            | "resname"
+            | "element"
+            | "index"
+            | "serial"
+            | "bynum"
+            | "id"
+            | "resid"
+            | "resnum"
+            | "within"
+            | "around"
+    )
+}
+
+struct Parser<'a> {
+    text: &'a str,
+    tokens: Vec<Token>,
+    pos: usize,
+    depth: usize,
+}
+
+impl Parser<'_> {
+    fn error(&self, column: usize, message: impl Into<String>) -> SelectionError {
+        SelectionError {
+            selection: self.text.to_string(),
+            column,
+            message: message.into(),
+        }
+    }
+
+    fn end_column(&self) -> usize {
+        self.text.chars().count() + 1
+    }
+
+    fn peek(&self) -> Option<&Token> {
+        self.tokens.get(self.pos)
+    }
+
+    fn peek_is(&self, kw: &str) -> bool {
+        self.peek().is_some_and(|t| t.text.eq_ignore_ascii_case(kw))
+    }
+
+    fn next(&mut self, expected: &str) -> Result<Token, SelectionError> {
+        match self.tokens.get(self.pos) {
+            Some(t) => {
+                self.pos += 1;
+                Ok(t.clone())
+            }
+            None => Err(self.error(
+                self.end_column(),
+                format!("expected {expected}, found the end"),
+            )),
+        }
+    }
+
+    fn expr(&mut self) -> Result<Node, SelectionError> {
+        let mut left = self.term()?;
+        while self.peek_is("or") {
+            self.pos += 1;
+            let right = self.term()?;
+            left = Node::Or(Box::new(left), Box::new(right));
+        }
+        Ok(left)
+    }
+
+    fn term(&mut self) -> Result<Node, SelectionError> {
+        let mut left = self.factor()?;
+        while self.peek_is("and") {
+            self.pos += 1;
+            let right = self.factor()?;
+            left = Node::And(Box::new(left), Box::new(right));
+        }
+        Ok(left)
+    }
+
+    fn factor(&mut self) -> Result<Node, SelectionError> {
+        self.depth += 1;
+        if self.depth > MAX_DEPTH {
+            let col = self.peek().map_or(self.end_column(), |t| t.column);
+            return Err(self.error(col, format!("nested deeper than {MAX_DEPTH} levels")));
+        }
+        let node = self.factor_inner();
+        self.depth -= 1;
+        node
+    }
+
+    fn factor_inner(&mut self) -> Result<Node, SelectionError> {
+        let t =
+            self.next("a selection keyword (name, resname, resid, element, index, not, ...)")?;
+        let kw = t.text.to_ascii_lowercase();
+        match kw.as_str() {
+            "not" => Ok(Node::Not(Box::new(self.factor()?))),
+            "(" => {
+                let inner = self.expr()?;
+                match self.tokens.get(self.pos) {
+                    Some(c) if c.text == ")" => {
+                        self.pos += 1;
+                        Ok(inner)
+                    }
+                    Some(c) => Err(self.error(c.column, format!("expected ')' to close the '(' at column {}, found '{}'", t.column, c.text))),
+                    None => Err(self.error(self.end_column(), format!("expected ')' to close the '(' at column {}", t.column))),
+                }
+            }
+            "all" => Ok(Node::All),
+            "none" => Ok(Node::None),
+            "protein" => Ok(protein()),
+            "backbone" => Ok(Node::And(
+                Box::new(protein()),
+                Box::new(Node::Str {
+                    field: StrField::Name,
+                    words: ["N", "CA", "C", "O"].map(String::from).to_vec(),
+                    column: t.column,
+                }),
+            )),
+            "water" => Ok(Node::Str {
+                field: StrField::ResName,
+                words: WATER_RESIDUES.iter().map(|s| s.to_string()).collect(),
+                column: t.column,
+            }),
+            "name" | "type" | "resname" => {
+                let words = self.words(&t)?;
+                let field = match kw.as_str() {
+                    "name" => StrField::Name,
+                    "type" => StrField::Type,
+                    _ => StrField::ResName,
+                };
+                Ok(Node::Str {
+                    field,
+                    words: words.into_iter().map(|w| w.text).collect(),
+                    column: t.column,
+                })
+            }
+            "element" => {
+                let words = self.words(&t)?;
+                let mut els = Vec::new();
+                for w in words {
+                    match Element::from_symbol(&w.text) {
+                        Some(e) => els.push(e),
+                        None => {
+                            return Err(self.error(w.column, format!("'{}' is not a chemical element symbol", w.text)));
+                        }
+                    }
+                }
+                Ok(Node::Element(els))
+            }
+            "index" | "serial" | "bynum" | "id" | "resid" | "resnum" => {
+                let field = match kw.as_str() {
+                    "index" => NumField::Index,
+                    "serial" | "bynum" => NumField::Serial,
+                    "id" => NumField::Id,
+                    _ => NumField::ResId,
+                };
+                let ranges = self.ranges(&t)?;
+                Ok(Node::Num {
+                    field,
+                    ranges,
+                    column: t.column,
+                })
+            }
+            "within" | "around" => {
+                let d = self.next("a distance in Å")?;
+                let distance: f64 = d
+                    .text
+                    .parse()
+                    .ok()
+                    .filter(|v: &f64| v.is_finite() && *v >= 0.0 && *v <= 1e4)
+                    .ok_or_else(|| self.error(d.column, format!("expected a distance in Å (0 to 1e4), found '{}'", d.text)))?;
+                let include_reference = kw == "within";
+                if include_reference {
+                    let of = self.next("'of'")?;
+                    if !of.text.eq_ignore_ascii_case("of") {
+                        return Err(self.error(of.column, format!("expected 'of' after 'within {}', found '{}'", d.text, of.text)));
+                    }
+                }
+                Ok(Node::Within {
+                    distance,
+                    of: Box::new(self.factor()?),
+                    include_reference,
+                })
+            }
+            ")" => Err(self.error(t.column, "unexpected ')'")),
+            _ => Err(self.error(
+                t.column,
+                format!(
+                    "unknown keyword '{}': expected name, type, resname, element, resid, index, serial, id, protein, backbone, water, within, around, all, none, not or '('",
+                    t.text
+                ),
+            )),
+        }
+    }
+
+    /// One or more words after a keyword (up to and/or/')'/the end).
+    fn words(&mut self, kw: &Token) -> Result<Vec<Token>, SelectionError> {
+        let mut out = Vec::new();
+        while let Some(t) = self.peek() {
+            if is_reserved(&t.text) {
+                break;
+            }
+            out.push(t.clone());
+            self.pos += 1;
+        }
+        if out.is_empty() {
+            let col = self.peek().map_or(self.end_column(), |t| t.column);
+            return Err(self.error(
+                col,
+                format!("expected at least one value after '{}'", kw.text),
+            ));
+        }
+        Ok(out)
+    }
+
+    /// One or more ranges: `N`, `N to M`, `N:M`, `N-M` (negative numbers allowed: `-5:-1`).
+    fn ranges(&mut self, kw: &Token) -> Result<Vec<(i64, i64)>, SelectionError> {
+        let mut out = Vec::new();
+        while let Some(t) = self.peek().cloned() {
+            if is_reserved(&t.text) {
+                break;
+            }
+            self.pos += 1;
+            let bad = |p: &Parser| {
+                p.error(t.column, format!("expected an integer or a range (N, N:M, N-M, N to M) after '{}', found '{}'", kw.text, t.text))
+            };
+            let range = if let Ok(n) = t.text.parse::<i64>() {
+                if self.peek_is("to") {
+                    self.pos += 1;
+                    let m = self.next("the end of the range")?;
+                    let hi = m.text.parse::<i64>().map_err(|_| {
+                        self.error(
+                            m.column,
+                            format!("expected an integer after 'to', found '{}'", m.text),
+                        )
+                    })?;
+                    (n, hi)
+                } else {
+                    (n, n)
+                }
+            } else {
+                // N:M or N-M (the '-' after the first character, so "-3" stays a number).
+                let s = t.text.as_str();
+                let split = s.find(':').or_else(|| s[1..].find('-').map(|k| k + 1));
+                let Some(k) = split else {
+                    return Err(bad(self));
+                };
+                match (s[..k].parse::<i64>(), s[k + 1..].parse::<i64>()) {
+                    (Ok(a), Ok(b)) => (a, b),
+                    _ => return Err(bad(self)),
+                }
+            };
+            if range.0 > range.1 {
+                return Err(self.error(
+                    t.column,
+                    format!(
+                        "range {}..{} is empty (its start is past its end)",
+                        range.0, range.1
+                    ),
+                ));
+            }
+            out.push(range);
+        }
+        if out.is_empty() {
+            let col = self.peek().map_or(self.end_column(), |t| t.column);
+            return Err(self.error(
+                col,
+                format!("expected at least one number after '{}'", kw.text),
+            ));
+        }
+        Ok(out)
+    }
+}
+
+fn protein() -> Node {
+    Node::Str {
+        field: StrField::ResName,
+        words: PROTEIN_RESIDUES.iter().map(|s| s.to_string()).collect(),
+        column: 0,
+    }
+}
+
+/// `*` matches any run, `?` one character (on bytes: labels are short and mostly ASCII).
+fn glob(pattern: &[u8], s: &[u8]) -> bool {
+    let (mut p, mut i) = (0, 0);
+    let (mut star, mut mark) = (None, 0);
+    while i < s.len() {
+        if p < pattern.len() && (pattern[p] == b'?' || pattern[p] == s[i]) {
+            p += 1;
+            i += 1;
+        } else if p < pattern.len() && pattern[p] == b'*' {
+            star = Some(p);
+            mark = i;
+            p += 1;
+        } else if let Some(sp) = star {
+            p = sp + 1;
+            mark += 1;
+            i = mark;
+        } else {
+            return false;
+        }
+    }
+    pattern[p..].iter().all(|&c| c == b'*')
+}
+
+impl Selection {
+    /// Parse `text`; the error names the column of the first bad token.
+    pub fn parse(text: &str) -> Result<Selection, SelectionError> {
+        let err = |column, message: &str| SelectionError {
+            selection: text.to_string(),
+            column,
+            message: message.to_string(),
+        };
+        if text.chars().count() > MAX_LEN {
+            return Err(err(
+                MAX_LEN + 1,
+                "a selection longer than 10,000 characters",
+            ));
+        }
+        let mut p = Parser {
+            text,
+            tokens: tokenize(text),
+            pos: 0,
+            depth: 0,
+        };
+        if p.tokens.is_empty() {
+            return Err(err(1, "empty selection (use 'all' to select every atom)"));
+        }
+        let root = p.expr()?;
+        if let Some(t) = p.peek() {
+            let message = if t.text == ")" {
+                "unexpected ')' with no '(' open".to_string()
+            } else {
+                format!(
+                    "expected 'and', 'or' or the end, found '{}'{}",
+                    t.text,
+                    if is_reserved(&t.text) {
+                        " (a missing 'and'?)"
+                    } else {
+                        ""
+                    }
+                )
+            };
+            return Err(p.error(t.column, message));
+        }
+        Ok(Selection {
+            text: text.to_string(),
+            root,
+        })
+    }
+
+    /// The text this selection was parsed from.
+    pub fn text(&self) -> &str {
+        &self.text
+    }
+
+    /// Which atoms of `frame` are selected (one flag per atom). Errors when the selection uses a
+    /// column the frame does not have.
+    pub fn evaluate(&self, frame: &Frame) -> Result<Vec<bool>, SelectionError> {
+        let mut out = vec![false; frame.n_atoms()];
+        self.eval(&self.root, frame, &mut out)?;
+        Ok(out)
+    }
+
+    /// The selected atoms' indices, in file order.
+    pub fn indices(&self, frame: &Frame) -> Result<Vec<usize>, SelectionError> {
+        Ok(self
+            .evaluate(frame)?
+            .iter()
+            .enumerate()
+            .filter_map(|(i, &s)| s.then_some(i))
+            .collect())
+    }
+
+    fn missing(&self, column: usize, what: &str) -> SelectionError {
+        SelectionError {
+            selection: self.text.clone(),
+            column: column.max(1),
+            message: format!(
+                "this frame has no {what} (trajectory-only formats such as XTC, DCD and TRR carry none, nor does plain XYZ: give a topology)"
+            ),
+        }
+    }
+
+    fn eval(&self, node: &Node, frame: &Frame, out: &mut [bool]) -> Result<(), SelectionError> {
+        let n = frame.n_atoms();
+        match node {
+            Node::All => out.fill(true),
+            Node::None => out.fill(false),
+            Node::Not(a) => {
+                self.eval(a, frame, out)?;
+                out.iter_mut().for_each(|v| *v = !*v);
+            }
+            Node::And(a, b) => {
+                self.eval(a, frame, out)?;
+                let mut rhs = vec![false; n];
+                self.eval(b, frame, &mut rhs)?;
+                out.iter_mut().zip(&rhs).for_each(|(v, r)| *v &= r);
+            }
+            Node::Or(a, b) => {
+                self.eval(a, frame, out)?;
+                let mut rhs = vec![false; n];
+                self.eval(b, frame, &mut rhs)?;
+                out.iter_mut().zip(&rhs).for_each(|(v, r)| *v |= r);
+            }
+            Node::Str {
+                field,
+                words,
+                column,
+            } => {
+                let (labels, what): (&[Label], &str) = match field {
+                    StrField::Name => (&frame.names, "atom names"),
+                    StrField::Type => (&frame.types, "atom types"),
+                    StrField::ResName => (&frame.res_names, "residue names"),
+                };
+                if labels.len() != n {
+                    return Err(self.missing(*column, what));
+                }
+                let plain: Vec<&[u8]> = words
+                    .iter()
+                    .filter(|w| !w.contains(['*', '?']))
+                    .map(|w| w.as_bytes())
+                    .collect();
+                let globs: Vec<&[u8]> = words
+                    .iter()
+                    .filter(|w| w.contains(['*', '?']))
+                    .map(|w| w.as_bytes())
+                    .collect();
+                let test = |l: &Label| {
+                    let b = l.as_bytes();
+                    plain.contains(&b) || globs.iter().any(|g| glob(g, b))
+                };
+                // Labels repeat (a residue's names, a run of one residue name): the answer for
+                // each distinct label is computed once and kept in a small direct-mapped cache
+                // keyed by the label's 128-bit value.
+                const WAYS: usize = 256;
+                let mut cache: [(u128, bool); WAYS] = [(u128::MAX, false); WAYS];
+                for (v, l) in out.iter_mut().zip(labels) {
+                    let key = l.key();
+                    let slot =
+                        &mut cache[(key.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 120) as usize];
+                    if slot.0 != key {
+                        *slot = (key, test(l));
+                    }
+                    *v = slot.1;
+                }
+            }
+            Node::Element(els) => {
+                if frame.elements.len() != n {
+                    return Err(self.missing(1, "elements"));
+                }
+                for (v, e) in out.iter_mut().zip(&frame.elements) {
+                    *v = els.contains(e);
+                }
+            }
+            Node::Num {
+                field,
+                ranges,
+                column,
+            } => {
+                let hit = |x: i64| ranges.iter().any(|&(a, b)| a <= x && x <= b);
+                match field {
+                    NumField::Index => out
+                        .iter_mut()
+                        .enumerate()
+                        .for_each(|(i, v)| *v = hit(i as i64)),
+                    NumField::Serial => out
+                        .iter_mut()
+                        .enumerate()
+                        .for_each(|(i, v)| *v = hit(i as i64 + 1)),
+                    NumField::Id | NumField::ResId => {
+                        let (vals, what) = if *field == NumField::Id {
+                            (&frame.ids, "atom ids")
+                        } else {
+                            (&frame.res_ids, "residue numbers")
+                        };
+                        if vals.len() != n {
+                            return Err(self.missing(*column, what));
+                        }
+                        for (v, &x) in out.iter_mut().zip(vals) {
+                            *v = hit(x);
+                        }
+                    }
+                }
+            }
+            Node::Within {
+                distance,
+                of,
+                include_reference,
+            } => {
+                let mut reference = vec![false; n];
+                self.eval(of, frame, &mut reference)?;
+                within(&frame.positions, &reference, *distance, out);
+                if !include_reference {
+                    out.iter_mut().zip(&reference).for_each(|(v, r)| *v &= !r);
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// `out[i]` = some reference atom lies within `d` of atom `i` (plain distances). The reference
+/// atoms are sorted into a dense grid of cells of side ≥ `d` over their bounding box grown by `d`;
+/// an atom outside that box is rejected at once, one inside looks at 27 cells.
+fn within(pos: &[[f32; 3]], reference: &[bool], d: f64, out: &mut [bool]) {
+    out.fill(false);
+    let refs: Vec<usize> = (0..pos.len()).filter(|&i| reference[i]).collect();
+    if refs.is_empty() {
+        return;
+    }
+    let p64 = |i: usize| pos[i].map(f64::from);
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for &r in &refs {
+        let p = p64(r);
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k] - d);
+            hi[k] = hi[k].max(p[k] + d);
+        }
+    }
+    // Cells of side ≥ d, at most 2^21 of them (a sparse reference spread wide gets larger cells;
+    // correctness needs only side ≥ d).
+    let mut cell = d.max(1e-6);
+    let dims = loop {
+        let dims = [0, 1, 2].map(|k| ((hi[k] - lo[k]) / cell).floor() + 1.0);
+        if dims.iter().product::<f64>() <= (1u32 << 21) as f64 {
+            break dims.map(|n| n as usize);
+        }
+        cell *= 2.0;
+    };
+    let cell_of = |p: [f64; 3]| {
+        [0, 1, 2].map(|k| (((p[k] - lo[k]) / cell).floor().max(0.0) as usize).min(dims[k] - 1))
+    };
+    let flat = |c: [usize; 3]| (c[2] * dims[1] + c[1]) * dims[0] + c[0];
+    // Counting sort of the reference atoms by cell.
+    let mut start = vec![0u32; dims.iter().product::<usize>() + 1];
+    for &r in &refs {
+        start[flat(cell_of(p64(r))) + 1] += 1;
+    }
+    for i in 1..start.len() {
+        start[i] += start[i - 1];
+    }
+    let mut fill = start.clone();
+    let mut sorted = vec![0u32; refs.len()];
+    for &r in &refs {
+        let c = flat(cell_of(p64(r)));
+        sorted[fill[c] as usize] = r as u32;
+        fill[c] += 1;
+    }
+    let d2 = d * d;
+    for (v, p) in out.iter_mut().zip(pos) {
+        let p = p.map(f64::from);
+        if (0..3).any(|k| p[k] < lo[k] || p[k] > hi[k]) {
+            continue;
+        }
+        let c = cell_of(p);
+        let range = |k: usize| c[k].saturating_sub(1)..=(c[k] + 1).min(dims[k] - 1);
+        'cells: for z in range(2) {
+            for y in range(1) {
+                for x in range(0) {
+                    let f = flat([x, y, z]);
+                    for &r in &sorted[start[f] as usize..start[f + 1] as usize] {
+                        let q = p64(r as usize);
+                        let s: f64 = (0..3).map(|k| (p[k] - q[k]).powi(2)).sum();
+                        if s <= d2 {
+                            *v = true;
+                            break 'cells;
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn frame() -> Frame {
+        let mut f = Frame::new();
+        // Two alanines and a water, with positions on a line 1 Å apart.
+        let atoms = [
+            ("N", "ALA", 1, "N"),
+            ("CA", "ALA", 1, "C"),
+            ("C", "ALA", 1, "C"),
+            ("O", "ALA", 1, "O"),
+            ("HA", "ALA", 1, "H"),
+            ("N", "ALA", 2, "N"),
+            ("CA", "ALA", 2, "C"),
+            ("OW", "SOL", 3, "O"),
+            ("HW1", "SOL", 3, "H"),
+            ("HW2", "SOL", 3, "H"),
+        ];
+        for (k, (name, res, resid, el)) in atoms.iter().enumerate() {
+            f.positions.push([k as f32, 0.0, 0.0]);
+            f.names.push(Label::new(name).unwrap());
+            f.res_names.push(Label::new(res).unwrap());
+            f.res_ids.push(*resid);
+            f.elements.push(Element::from_symbol(el).unwrap());
+            f.ids.push(100 + k as i64);
+        }
+        f
+    }
+
+    fn sel(s: &str) -> Vec<usize> {
+        Selection::parse(s).unwrap().indices(&frame()).unwrap()
+    }
+
+    #[test]
+    fn keywords_ranges_and_logic() {
+        assert_eq!(sel("name CA"), [1, 6]);
+        assert_eq!(sel("not resname SOL"), [0, 1, 2, 3, 4, 5, 6]);
+        assert_eq!(sel("element O and resid 1 to 20"), [3, 7]);
+        assert_eq!(sel("element O and resid 1 to 2"), [3]);
+        assert_eq!(sel("resid 2:3"), [5, 6, 7, 8, 9]);
+        assert_eq!(sel("resid 2-3 and not water"), [5, 6]);
+        assert_eq!(sel("index 0 9"), [0, 9]);
+        assert_eq!(sel("serial 1 10"), [0, 9]);
+        assert_eq!(sel("id 101:102"), [1, 2]);
+        assert_eq!(sel("name H*"), [4, 8, 9]);
+        assert_eq!(sel("name ?W*"), [7, 8, 9]);
+        assert_eq!(sel("name ?W?"), [8, 9]);
+        assert_eq!(sel("backbone"), [0, 1, 2, 3, 5, 6]);
+        assert_eq!(sel("protein and not (name N or element H)"), [1, 2, 3, 6]);
+        assert_eq!(sel("NOT Protein AND Water"), [7, 8, 9]);
+        assert_eq!(sel("element o"), [3, 7]);
+        assert_eq!(sel("none or all").len(), 10);
+        // Atom 7 (OW) at x = 7: within 1.5 Å are x = 6..9; around excludes OW itself.
+        assert_eq!(sel("within 1.5 of name OW"), [6, 7, 8]);
+        assert_eq!(sel("around 1.5 name OW"), [6, 8]);
+        // `or` binds looser than `and`.
+        assert_eq!(sel("name N or name CA and resid 2"), [0, 5, 6]);
+    }
+
+    #[test]
+    fn errors_point_at_the_bad_token() {
+        let cases = [
+            ("name CA and resnme SOL", 13, "unknown keyword 'resnme'"),
+            ("resid 1 to", 11, "the end of the range"),
+            ("(name CA", 9, "close the '('"),
+            ("name CA)", 8, "unexpected ')'"),
+            ("element Xx", 9, "not a chemical element"),
+            ("resid 5:2", 7, "empty"),
+            ("within x of name CA", 8, "distance"),
+            ("name", 5, "at least one value"),
+            ("name CA CB resid", 12, "expected 'and', 'or' or the end"),
+            ("", 1, "empty selection"),
+        ];
+        for (text, column, want) in cases {
+            let e = Selection::parse(text).unwrap_err();
+            assert_eq!(e.column, column, "{text:?}: {e}");
+            assert!(e.message.contains(want), "{text:?}: {e}");
+            // The caret sits under the column.
+            let caret = e.to_string().lines().last().unwrap().find('^').unwrap();
+            assert_eq!(caret, column + 1, "{e}");
+        }
+        let deep = "not ".repeat(MAX_DEPTH + 5) + "all";
+        assert!(
+            Selection::parse(&deep)
+                .unwrap_err()
+                .message
+                .contains("nested")
+        );
+    }
+
+    #[test]
+    fn a_missing_column_is_an_error_not_an_empty_selection() {
+        let mut f = frame();
+        f.res_names.clear();
+        let e = Selection::parse("name CA or resname SOL")
+            .unwrap()
+            .evaluate(&f)
+            .unwrap_err();
+        assert_eq!(e.column, 12);
+        assert!(e.message.contains("residue names"), "{e}");
+    }
+
+    #[test]
+    fn within_matches_brute_force() {
+        let mut f = Frame::new();
+        let mut state = 7u64;
+        let mut r = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 40) as f32 / (1u64 << 24) as f32 * 20.0
+        };
+        for _ in 0..2000 {
+            f.positions.push([r(), r(), r()]);
+        }
+        let reference: Vec<bool> = (0..2000).map(|i| i % 37 == 0).collect();
+        for d in [0.0, 0.7, 2.5, 6.0] {
+            let mut got = vec![false; 2000];
+            within(&f.positions, &reference, d, &mut got);
+            for (i, (&g, p)) in got.iter().zip(&f.positions).enumerate() {
+                let want = f.positions.iter().zip(&reference).any(|(q, &is_ref)| {
+                    let s: f64 = (0..3).map(|k| (p[k] as f64 - q[k] as f64).powi(2)).sum();
+                    is_ref && s <= d * d
+                });
+                assert_eq!(g, want, "atom {i} at d = {d}");
+            }
+        }
+    }
+
+    #[test]
+    fn glob_patterns() {
+        for (p, s, want) in [
+            ("H*", "HW1", true),
+            ("H*", "OW", false),
+            ("*1", "HW1", true),
+            ("?W?", "HW1", true),
+            ("?W?", "OW", false),
+            ("*", "", true),
+            ("C*A", "CXYA", true),
+            ("C*A", "CXYB", false),
+        ] {
+            assert_eq!(glob(p.as_bytes(), s.as_bytes()), want, "{p} vs {s}");
+        }
+    }
+}

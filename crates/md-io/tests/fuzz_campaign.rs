@@ -1,0 +1,459 @@
+//! The fuzz campaign of every md-io reader (harness: tests/support/campaign.rs): each fixture of
+//! tests/data (written by MDAnalysis, ASE, LAMMPS, OVITO; see the READMEs there) and the DCD and
+//! XTC our writers make, cut at every record boundary and at seeded offsets, with seeded bit
+//! flips and byte replacements, header fields set to extremes, CRLF and NUL for text. Every
+//! mutant is read twice, strict and with `allow_truncated`, through the public API (open,
+//! `n_frames`, streaming, random access), and must end in `Ok` or an error naming the file and
+//! the place, under a heap cap of 64 × its size + 1 MiB, without a panic.
+//!
+//! The record boundaries and header fields are found here by walking each format's structure
+//! (Fortran record markers, XTC byte counts, TRR block sizes, line ends, numeric tokens), not by
+//! the readers under test.
+//!
+//! Run with `cargo test -p texmap-md-io --test fuzz_campaign -- --nocapture` to see the table:
+//! mutants per family and per outcome, the slowest run and the largest heap peak.
+
+mod support {
+    pub mod alloc;
+    // A shared harness: this binary uses most of it, other crates' campaigns the rest.
+    #[allow(dead_code)]
+    pub mod campaign;
+}
+
+use std::io::Cursor;
+use std::path::PathBuf;
+
+use support::alloc::CountingAlloc;
+use support::campaign::{Cuts, Field, Fixture, Settings, Verdict, run_campaign};
+use texmap_md_io::{Error, Format, Frame, MAX_COORDINATE, ReadOptions, Trajectory, Writer};
+
+#[global_allocator]
+static ALLOC: CountingAlloc = CountingAlloc;
+
+fn data(name: &str) -> Vec<u8> {
+    std::fs::read(
+        PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/data")
+            .join(name),
+    )
+    .unwrap()
+}
+
+/// An error is located if it names the file and a byte or line (and the frame, when it came
+/// from reading frame `frame`).
+fn located(e: &Error, name: &str, frame: Option<usize>) -> Verdict {
+    let kind = match e {
+        Error::Parse { .. } => "Parse",
+        Error::Truncated { .. } => "Truncated",
+        Error::Io { .. } => "Io",
+        other => return Verdict::Broken(format!("error without a place: {other}")),
+    };
+    let Some(at) = e.location() else {
+        return Verdict::Broken(format!("no location: {e}"));
+    };
+    if &*at.file != name || !e.to_string().starts_with(name) {
+        return Verdict::Broken(format!("error does not name the file: {e}"));
+    }
+    if at.byte.is_none() && at.line.is_none() {
+        return Verdict::Broken(format!("error names no byte or line: {e}"));
+    }
+    if let Some(k) = frame
+        && at.frame != Some(k)
+    {
+        return Verdict::Broken(format!("reading frame {k} gave an error for another: {e}"));
+    }
+    Verdict::Located(kind)
+}
+
+/// Reads a mutant through the public API: open, count, stream (also when the count failed: a
+/// caller may stream without counting), then random access.
+fn read(format: Format, name: &str, bytes: &[u8], opts: ReadOptions) -> Verdict {
+    let mut t = match Trajectory::from_reader_with(Cursor::new(bytes), format, name, opts) {
+        Ok(t) => t,
+        Err(e) => return located(&e, name, None),
+    };
+    let count = t.n_frames();
+    if let Err(e) = &count {
+        // A count that fails names the frame it could not pass.
+        if let Verdict::Broken(why) = located(e, name, None) {
+            return Verdict::Broken(format!("n_frames: {why}"));
+        }
+        if e.location().is_some_and(|at| at.frame.is_none()) {
+            return Verdict::Broken(format!("n_frames error without a frame: {e}"));
+        }
+    }
+    let mut f = Frame::new();
+    let mut k = 0;
+    loop {
+        match t.read_next(&mut f) {
+            Ok(true) => {
+                if let Err(why) = f.check() {
+                    return Verdict::Broken(format!("frame {k} breaks an invariant: {why}"));
+                }
+                let limit = MAX_COORDINATE as f32;
+                if f.positions
+                    .iter()
+                    .flatten()
+                    .any(|v| v.is_nan() || v.abs() > limit)
+                {
+                    return Verdict::Broken(format!("frame {k} has a coordinate beyond 1e7 Å"));
+                }
+                k += 1;
+                if let Ok(n) = count
+                    && k > n
+                {
+                    return Verdict::Broken(format!("more frames streamed than n_frames {n}"));
+                }
+            }
+            Ok(false) => break,
+            Err(e) => {
+                // The count checks structure, streaming also content: it may stop earlier,
+                // never later than the frame the count could not pass.
+                if let Err(c) = &count
+                    && c.location()
+                        .and_then(|at| at.frame)
+                        .is_some_and(|cf| k > cf)
+                {
+                    return Verdict::Broken(format!(
+                        "n_frames failed with {c}, streaming with {e}"
+                    ));
+                }
+                return located(&e, name, Some(k));
+            }
+        }
+    }
+    let n = match count {
+        Ok(n) => n,
+        Err(e) => return Verdict::Broken(format!("n_frames failed ({e}) but streaming did not")),
+    };
+    if k != n {
+        return Verdict::Broken(format!("{k} frames streamed, n_frames said {n}"));
+    }
+    // Frames that streamed read again by index.
+    for i in [n.saturating_sub(1), 0] {
+        if i < n
+            && let Err(e) = t.read_frame(i, &mut f)
+        {
+            return Verdict::Broken(format!("frame {i} streamed but not by index: {e}"));
+        }
+    }
+    Verdict::Ok { frames: n }
+}
+
+/// Strict, then lenient: the strict verdict is tallied; the lenient one must not break the
+/// contract, and must agree wherever strict reading succeeded.
+fn run(format: Format) -> impl Fn(&Fixture, &[u8]) -> Verdict {
+    move |fx, bytes| {
+        let strict = read(format, &fx.name, bytes, ReadOptions::new());
+        let lenient = read(
+            format,
+            &fx.name,
+            bytes,
+            ReadOptions::new().allow_truncated(true),
+        );
+        // A cut of a file whose frame ends are known keeps exactly the complete frames under
+        // allow_truncated (XTC and TRR cannot open without one complete frame).
+        if let Cuts::FrameEnds(ends) = &fx.cuts
+            && bytes.len() < fx.bytes.len()
+            && fx.bytes.starts_with(bytes)
+        {
+            let complete = ends.iter().filter(|&&e| e > 0 && e <= bytes.len()).count();
+            match &lenient {
+                Verdict::Ok { frames } if *frames == complete => {}
+                Verdict::Located(_) if complete == 0 => {}
+                other => {
+                    return Verdict::Broken(format!(
+                        "allow_truncated kept {other:?}, {complete} frames are complete"
+                    ));
+                }
+            }
+        }
+        match (&strict, lenient) {
+            (_, Verdict::Broken(why)) => Verdict::Broken(format!("allow_truncated: {why}")),
+            (Verdict::Ok { frames: a }, Verdict::Ok { frames: b }) if *a != b => {
+                Verdict::Broken(format!("strict read {a} frames, allow_truncated {b}"))
+            }
+            (Verdict::Ok { .. }, Verdict::Located(kind)) => {
+                Verdict::Broken(format!("strict read it, allow_truncated failed: {kind}"))
+            }
+            _ => strict,
+        }
+    }
+}
+
+fn frames_of(format: Format, bytes: &[u8]) -> usize {
+    Trajectory::from_reader(Cursor::new(bytes), format, "good")
+        .unwrap()
+        .n_frames()
+        .unwrap()
+}
+
+fn le32(b: &[u8], at: usize) -> usize {
+    u32::from_le_bytes(b[at..at + 4].try_into().unwrap()) as usize
+}
+
+fn be32(b: &[u8], at: usize) -> usize {
+    u32::from_be_bytes(b[at..at + 4].try_into().unwrap()) as usize
+}
+
+/// DCD (32-bit little-endian markers): every record's start and end; header control words,
+/// NTITLE, NATOM and frame 0's first cell and coordinate values as fields.
+fn dcd_fixture(name: &str, bytes: Vec<u8>) -> Fixture {
+    let mut boundaries = vec![0];
+    let mut records = Vec::new();
+    let mut at = 0;
+    while at + 4 <= bytes.len() {
+        let len = le32(&bytes, at);
+        records.push(at);
+        at += 8 + len;
+        boundaries.extend([at - 4 - len, at - 4, at]);
+    }
+    assert_eq!(at, bytes.len(), "{name}: records tile the file");
+    // Records: header, title, atoms, then frames (no fixed atoms in these files).
+    let (title, natom, frame0) = (records[1], records[2], records[3]);
+    let mut fields = vec![
+        ("first marker", Field::I32Le(0)),
+        ("NSET", Field::I32Le(8)),
+        ("DELTA", Field::F32Le(8 + 36)),
+        ("NAMNF", Field::I32Le(8 + 32)),
+        ("cell flag", Field::I32Le(8 + 40)),
+        ("4D flag", Field::I32Le(8 + 44)),
+        ("CHARMM version", Field::I32Le(8 + 76)),
+        ("title marker", Field::I32Le(title)),
+        ("NTITLE", Field::I32Le(title + 4)),
+        ("NATOM marker", Field::I32Le(natom)),
+        ("NATOM", Field::I32Le(natom + 4)),
+        ("frame 0 first marker", Field::I32Le(frame0)),
+        ("frame 0 cell A", Field::F64Le(frame0 + 4)),
+        ("frame 0 cell gamma", Field::F64Le(frame0 + 12)),
+    ];
+    if le32(&bytes, frame0) == 48 {
+        fields.push(("frame 0 x[0]", Field::F32Le(frame0 + 56 + 4)));
+    }
+    Fixture {
+        frames: frames_of(Format::Dcd, &bytes),
+        name: name.into(),
+        bytes,
+        boundaries,
+        cuts: Cuts::Declared,
+        fields,
+        text: false,
+    }
+}
+
+/// XTC (magic 1995, compressed frames): each frame's start, header, prelude, byte count and
+/// end; the header values of the first and last frame as fields.
+fn xtc_fixture(name: &str, bytes: Vec<u8>) -> Fixture {
+    let mut starts = Vec::new();
+    let mut at = 0;
+    while at < bytes.len() {
+        assert!(be32(&bytes, at + 4) > 9, "{name}: compressed frames only");
+        starts.push(at);
+        at += 92 + be32(&bytes, at + 88).div_ceil(4) * 4;
+    }
+    assert_eq!(at, bytes.len(), "{name}: frames tile the file");
+    let mut ends: Vec<usize> = starts[1..].to_vec();
+    ends.extend([0, bytes.len()]);
+    let boundaries = starts
+        .iter()
+        .flat_map(|&s| [s, s + 56, s + 88, s + 92])
+        .chain(ends.iter().copied())
+        .collect();
+    let mut fields = Vec::new();
+    for s in [starts[0], *starts.last().unwrap()] {
+        fields.extend([
+            ("magic", Field::I32Be(s)),
+            ("natoms", Field::I32Be(s + 4)),
+            ("step", Field::I32Be(s + 8)),
+            ("time", Field::F32Be(s + 12)),
+            ("box xx", Field::F32Be(s + 16)),
+            ("natoms again", Field::I32Be(s + 52)),
+            ("both atom counts", Field::I32BeTwice(s + 4, s + 52)),
+            ("precision", Field::F32Be(s + 56)),
+            ("minint x", Field::I32Be(s + 60)),
+            ("maxint z", Field::I32Be(s + 80)),
+            ("smallidx", Field::I32Be(s + 84)),
+            ("byte count", Field::I32Be(s + 88)),
+        ]);
+    }
+    Fixture {
+        frames: frames_of(Format::Xtc, &bytes),
+        name: name.into(),
+        bytes,
+        boundaries,
+        cuts: Cuts::FrameEnds(ends),
+        fields,
+        text: false,
+    }
+}
+
+/// TRR (single precision, a box in every frame): each frame's start, header end and block
+/// ends; the sizes, atom count, step, time and box of frame 0 as fields.
+fn trr_fixture(name: &str, bytes: Vec<u8>) -> Fixture {
+    let mut boundaries = vec![0];
+    let mut ends = vec![0];
+    let mut at = 0;
+    while at < bytes.len() {
+        let size = |k: usize| be32(&bytes, at + 24 + 4 * k);
+        let header = 24 + 13 * 4 + 2 * 4;
+        let mut p = at + header;
+        boundaries.extend([at, p]);
+        for k in [2, 3, 4, 7, 8, 9] {
+            p += size(k);
+            boundaries.push(p);
+        }
+        at = p;
+        ends.push(at);
+    }
+    assert_eq!(at, bytes.len(), "{name}: frames tile the file");
+    let fields = vec![
+        ("magic", Field::I32Be(0)),
+        ("version", Field::I32Be(4)),
+        ("box size", Field::I32Be(32)),
+        ("x size", Field::I32Be(52)),
+        ("v size", Field::I32Be(56)),
+        ("f size", Field::I32Be(60)),
+        ("natoms", Field::I32Be(64)),
+        ("step", Field::I32Be(68)),
+        ("time", Field::F32Be(76)),
+        ("box xx", Field::F32Be(84)),
+    ];
+    Fixture {
+        frames: frames_of(Format::Trr, &bytes),
+        name: name.into(),
+        bytes,
+        boundaries,
+        cuts: Cuts::FrameEnds(ends),
+        fields,
+        text: false,
+    }
+}
+
+/// A text file: every line start as a boundary, its first 16 numeric tokens (counts, box,
+/// coordinates) as fields.
+fn text_fixture(name: &str, format: Format) -> Fixture {
+    let bytes = data(name);
+    let mut boundaries = vec![0];
+    boundaries.extend(
+        bytes
+            .iter()
+            .enumerate()
+            .filter(|(_, b)| **b == b'\n')
+            .map(|(i, _)| i + 1),
+    );
+    let mut fields = Vec::new();
+    let mut i = 0;
+    while i < bytes.len() && fields.len() < 16 {
+        let start_of_token = i == 0 || bytes[i - 1].is_ascii_whitespace();
+        if start_of_token && (bytes[i].is_ascii_digit() || bytes[i] == b'-') {
+            let end = (i..bytes.len())
+                .find(|&j| bytes[j].is_ascii_whitespace())
+                .unwrap_or(bytes.len());
+            if std::str::from_utf8(&bytes[i..end])
+                .ok()
+                .and_then(|t| t.parse::<f64>().ok())
+                .is_some()
+            {
+                fields.push(("number", Field::Text(i, end)));
+            }
+            i = end;
+        } else {
+            i += 1;
+        }
+    }
+    Fixture {
+        frames: frames_of(format, &bytes),
+        name: name.into(),
+        bytes,
+        boundaries,
+        cuts: Cuts::Unchecked,
+        fields,
+        text: true,
+    }
+}
+
+/// What our writers make of the MDAnalysis XTC's frames (DCD with cells, XTC compressed).
+fn ours(format: Format) -> Vec<u8> {
+    let good = data("xtc_mda.xtc");
+    let mut t = Trajectory::from_reader(Cursor::new(&good[..]), Format::Xtc, "x").unwrap();
+    let mut w = Writer::new(Cursor::new(Vec::new()), format, "ours").unwrap();
+    let mut f = Frame::new();
+    while t.read_next(&mut f).unwrap() {
+        w.write_frame(&f).unwrap();
+    }
+    w.finish().unwrap().into_inner()
+}
+
+fn campaign(reader: &str, format: Format, fixtures: Vec<Fixture>) {
+    let tally = run_campaign(reader, &fixtures, &Settings::default(), &run(format));
+    println!("{}", tally.report());
+    assert!(tally.mutants > 0);
+    assert!(tally.failures.is_empty(), "{}", tally.report());
+}
+
+#[test]
+fn dcd_campaign() {
+    campaign(
+        "DCD",
+        Format::Dcd,
+        vec![
+            dcd_fixture("dcd_mda.dcd", data("dcd_mda.dcd")),
+            dcd_fixture("ours.dcd", ours(Format::Dcd)),
+        ],
+    );
+}
+
+#[test]
+fn xtc_campaign() {
+    campaign(
+        "XTC",
+        Format::Xtc,
+        vec![
+            xtc_fixture("xtc_mda.xtc", data("xtc_mda.xtc")),
+            xtc_fixture("ours.xtc", ours(Format::Xtc)),
+        ],
+    );
+}
+
+#[test]
+fn trr_campaign() {
+    campaign(
+        "TRR",
+        Format::Trr,
+        vec![trr_fixture("trr_mda.trr", data("trr_mda.trr"))],
+    );
+}
+
+#[test]
+fn xyz_campaign() {
+    let files = ["ase_ext.xyz", "ase_plain.xyz"];
+    let fx = files.map(|f| text_fixture(f, Format::Xyz));
+    campaign("XYZ", Format::Xyz, fx.into());
+}
+
+#[test]
+fn pdb_campaign() {
+    let files = ["mda_multi.pdb", "mda_noelem.pdb"];
+    let fx = files.map(|f| text_fixture(f, Format::Pdb));
+    campaign("PDB", Format::Pdb, fx.into());
+}
+
+#[test]
+fn gro_campaign() {
+    let files = ["mda_vel.gro", "py_prec5.gro"];
+    let fx = files.map(|f| text_fixture(f, Format::Gro));
+    campaign("GRO", Format::Gro, fx.into());
+}
+
+#[test]
+fn lammps_campaign() {
+    let files = [
+        "lmp_tri.lammpstrj",
+        "lmp_scaled.lammpstrj",
+        "lmp_color.lammpstrj",
+        "lmp_color_dot.lammpstrj",
+        "ovito_color.lammpstrj",
+    ];
+    let fx = files.map(|f| text_fixture(f, Format::LammpsDump));
+    campaign("LAMMPS dump", Format::LammpsDump, fx.into());
+}
