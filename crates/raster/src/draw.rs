@@ -16,14 +16,15 @@ use rayon::prelude::*;
 use texmap_core::camera::Camera;
 
 use crate::RasterError;
-use crate::bin::{Bins, CHUNK, ChunkBins, RECT_CLIPPED, RECT_EMPTY, pack_rect};
+use crate::bin::{CHUNK, ChunkBins, RECT_CLIPPED, RECT_EMPTY, pack_rect};
 use crate::framebuffer::{Framebuffer, Grid};
 use crate::mesh::Mesh;
 use crate::program::{
     FlatProg, FragProgram, LitFlatProg, LitSmoothProg, QuadSampler, Shading, TexturedProg,
     VertexColorProg,
 };
-use crate::project::{ClipTri, FLAG_INVALID, MAX_VAR, PVert, Proj, Var};
+use crate::project::{ClipTri, FLAG_INVALID, MAX_VAR, PVert, Proj};
+use crate::record::{FRONT_BIT, Rec, VarStore};
 use crate::sprite::{QuadShader, Sprite, raster_sprite};
 use crate::state::{Cull, DrawState};
 use crate::surface::{SurfaceProg, SurfaceShader};
@@ -58,99 +59,6 @@ impl DrawStats {
         self.no_pixels += o.no_pixels;
         self.skipped_invalid += o.skipped_invalid;
         self.clipped += o.clipped;
-    }
-}
-
-/// A binned triangle: snapped vertices oriented for the edge functions (positive
-/// [`area2`]), varyings in the program's storage `V`, and its source triangle with the facing in
-/// the top bit (triangle indices are below 2^31, see [`Mesh`]).
-#[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct Rec<V> {
-    v: [PVert; 3],
-    var: V,
-    tri_front: u32,
-}
-
-const FRONT_BIT: u32 = 1 << 31;
-
-impl<V: VarStore> Rec<V> {
-    /// The record of a snapped triangle with `area2(v) != 0` whose facing survives culling:
-    /// front faces are re-oriented (vertices 1 and 2 swapped) so that every record is clockwise.
-    #[inline]
-    fn new(mut v: [PVert; 3], mut var: [Var; 3], tri: u32, front: bool) -> Self {
-        if front {
-            v.swap(1, 2);
-            var.swap(1, 2);
-        }
-        Rec {
-            v,
-            var: V::pack(var),
-            tri_front: tri | if front { FRONT_BIT } else { 0 },
-        }
-    }
-}
-
-/// How a record stores its varyings: not at all (52-byte records for programs without
-/// varyings), or all three vertices' (88 bytes).
-pub(crate) trait VarStore: Copy + Default + Send + Sync + 'static {
-    fn pack(var: [Var; 3]) -> Self;
-    fn unpack(&self) -> [Var; 3];
-    fn bins(s: &mut TriBins) -> &mut Bins<Rec<Self>>;
-}
-
-impl VarStore for () {
-    #[inline]
-    fn pack(_: [Var; 3]) {}
-    #[inline]
-    fn unpack(&self) -> [Var; 3] {
-        [[0.0; MAX_VAR]; 3]
-    }
-    fn bins(s: &mut TriBins) -> &mut Bins<Rec<()>> {
-        &mut s.bare
-    }
-}
-
-impl VarStore for [Var; 3] {
-    #[inline]
-    fn pack(var: [Var; 3]) -> Self {
-        var
-    }
-    #[inline]
-    fn unpack(&self) -> [Var; 3] {
-        *self
-    }
-    fn bins(s: &mut TriBins) -> &mut Bins<Rec<[Var; 3]>> {
-        &mut s.with_var
-    }
-}
-
-/// Triangle bins for both record layouts.
-#[derive(Default)]
-pub(crate) struct TriBins {
-    bare: Bins<Rec<()>>,
-    with_var: Bins<Rec<[Var; 3]>>,
-}
-
-/// Buffers reused from draw to draw (no per-draw allocation of the big arrays once warm).
-#[derive(Default)]
-pub(crate) struct Scratch {
-    pverts: Vec<PVert>,
-    rects: Vec<u32>,
-    tris: TriBins,
-    sprites: Bins<Sprite>,
-}
-
-impl std::fmt::Debug for Scratch {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let n = self.tris.bare.items.len() + self.tris.with_var.items.len();
-        write!(f, "Scratch({n} binned triangles)")
-    }
-}
-
-impl Clone for Scratch {
-    /// Scratch holds no state between draws: a clone starts empty.
-    fn clone(&self) -> Self {
-        Scratch::default()
     }
 }
 

@@ -88,7 +88,7 @@ pub struct Framebuffer {
     pub(crate) tiles: Vec<Tile>,
     background: [u8; 4],
     clear_linear: Vec3,
-    pub(crate) scratch: crate::draw::Scratch,
+    pub(crate) scratch: crate::record::Scratch,
     /// Small triangles take the block path (`false` only in tests comparing it with the general
     /// quad loop).
     pub(crate) block_path: bool,

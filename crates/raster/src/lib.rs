@@ -92,6 +92,7 @@ mod framebuffer;
 mod mesh;
 mod program;
 mod project;
+mod record;
 mod simd;
 pub mod sprite;
 mod state;

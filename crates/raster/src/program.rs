@@ -13,9 +13,9 @@ use texmap_core::mip::MipTexture;
 use texmap_core::sample::Sampler;
 use texmap_core::shade::{Lighting, MAX_LIGHTS, Material};
 
-use crate::draw::VarStore;
 use crate::mesh::Mesh;
 use crate::project::{MAX_VAR, Proj, Var};
+use crate::record::VarStore;
 use crate::simd::{F32x4, pow4};
 
 /// How the triangles of [`crate::Framebuffer::draw_mesh`] are coloured. All colours are linear RGB.
