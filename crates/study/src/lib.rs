@@ -46,6 +46,7 @@
 
 pub mod chart;
 pub mod elements;
+pub mod envmap;
 pub mod error;
 pub mod harness;
 pub mod md;
