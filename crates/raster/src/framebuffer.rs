@@ -10,6 +10,7 @@
 //! resolves it to the workspace's sRGB8 + depth [`Frame`].
 
 use glam::Vec3;
+use rayon::prelude::*;
 use texmap_core::camera::MAX_IMAGE_SIDE;
 use texmap_core::color::{linear_to_srgb8, srgb8_to_linear_rgb};
 use texmap_core::frame::Frame;
@@ -177,31 +178,39 @@ impl Framebuffer {
 
     /// Resolve to a [`Frame`]: sRGB8 colour (alpha 255 where drawn) and depth. A pixel whose
     /// depth is infinite and whose colour still equals the clear colour keeps the background bytes.
+    /// Bands of one tile row are resolved in parallel; each output pixel is written once, so the
+    /// bytes do not depend on the thread count.
     pub fn to_frame(&self) -> Frame {
-        let (w, h) = (self.grid.width as usize, self.grid.height as usize);
+        let w = self.grid.width as usize;
         let mut frame = Frame::new(self.grid.width, self.grid.height, self.background);
-        let bg = self.clear_linear;
-        for t in &self.tiles {
-            let xe = (t.x0 + TILE).min(self.grid.width);
-            let ye = (t.y0 + TILE).min(self.grid.height);
-            for y in t.y0..ye {
-                let row = y as usize * w;
-                for x in t.x0..xe {
-                    let i = tile_index(x - t.x0, y - t.y0);
-                    let (q, l) = (i >> 2, i & 3);
-                    let c = Vec3::new(t.r[q][l], t.g[q][l], t.b[q][l]);
-                    let d = t.depth[q][l];
-                    let o = row + x as usize;
-                    frame.depth[o] = d;
-                    if d.is_finite()
-                        || c.to_array().map(f32::to_bits) != bg.to_array().map(f32::to_bits)
-                    {
-                        frame.color[o] = linear_to_srgb8(c, 255);
+        let bg = self.clear_linear.to_array().map(f32::to_bits);
+        let band = w * TILE as usize;
+        let tiles_x = self.grid.tiles_x as usize;
+        let Frame { color, depth, .. } = &mut frame;
+        color
+            .par_chunks_mut(band)
+            .zip(depth.par_chunks_mut(band))
+            .zip(self.tiles.par_chunks(tiles_x))
+            .for_each(|((color, depth), row_tiles)| {
+                for t in row_tiles {
+                    let xe = (t.x0 + TILE).min(self.grid.width);
+                    let ye = (t.y0 + TILE).min(self.grid.height);
+                    for y in t.y0..ye {
+                        let row = (y - t.y0) as usize * w;
+                        for x in t.x0..xe {
+                            let i = tile_index(x - t.x0, y - t.y0);
+                            let (q, l) = (i >> 2, i & 3);
+                            let c = Vec3::new(t.r[q][l], t.g[q][l], t.b[q][l]);
+                            let d = t.depth[q][l];
+                            let o = row + x as usize;
+                            depth[o] = d;
+                            if d.is_finite() || c.to_array().map(f32::to_bits) != bg {
+                                color[o] = linear_to_srgb8(c, 255);
+                            }
+                        }
                     }
                 }
-            }
-        }
-        debug_assert_eq!(frame.len(), w * h);
+            });
         frame
     }
 }
