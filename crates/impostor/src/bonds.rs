@@ -70,11 +70,11 @@ use rayon::prelude::*;
 use texmap_core::frame::Frame;
 use texmap_core::shade::{Lighting, Material};
 
-use crate::SphereScene;
 #[cfg(target_arch = "x86_64")]
 use crate::fastshade::V8x;
 use crate::fastshade::{self, Mask8, Simd8, SpecPow, V8, W};
 use crate::pipeline::{self, FLAG_INSIDE, LANES, NONE, TILE, TILE_BUF, TILE_PX, View};
+use crate::scene::SphereScene;
 
 /// Bonds per projection chunk: fixed, so results do not depend on the thread count.
 pub(crate) const BOND_CHUNK: usize = 8192;

@@ -1,7 +1,7 @@
 //! # texmap-impostor — sphere sets drawn four ways
 //!
 //! Molecules and particle systems are sets of spheres. This crate draws a [`SphereScene`] with a
-//! [`Camera`] and [`Lighting`] by one of four methods behind one face, so that they can be
+//! [`Camera`] and [`Lighting`](texmap_core::shade::Lighting) by one of four methods behind one face, so that they can be
 //! compared pixel for pixel and millisecond for millisecond:
 //!
 //! | [`Method`] | what it is | exact? | bonds? |
@@ -83,207 +83,18 @@
 mod bonds;
 mod fastshade;
 mod lut;
+mod options;
 mod pipeline;
 mod polygon;
 mod raycast;
+mod scene;
 mod template;
 
-use glam::Vec3;
 use texmap_core::camera::Camera;
 use texmap_core::frame::Frame;
-use texmap_core::shade::{Lighting, Material};
 
-/// A set of spheres and optional bonds (drawn as cylinders by every method).
-///
-/// Spheres are stored as structure-of-arrays so that transform and culling can run over lanes.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct SphereScene {
-    pub centers: Vec<Vec3>,
-    pub radii: Vec<f32>,
-    /// Index into `materials` per sphere.
-    pub kinds: Vec<u16>,
-    /// One material per kind (element, type…); linear RGB.
-    pub materials: Vec<Material>,
-    /// Pairs of sphere indices joined by a cylinder of radius `bond_radius`.
-    pub bonds: Vec<[u32; 2]>,
-    pub bond_radius: f32,
-}
-
-impl SphereScene {
-    /// An empty scene with these materials (kinds index into them).
-    pub fn new(materials: Vec<Material>) -> SphereScene {
-        SphereScene {
-            materials,
-            bond_radius: 0.15,
-            ..Default::default()
-        }
-    }
-
-    /// Add one sphere.
-    pub fn push(&mut self, center: Vec3, radius: f32, kind: u16) {
-        self.centers.push(center);
-        self.radii.push(radius);
-        self.kinds.push(kind);
-    }
-
-    /// Number of spheres.
-    pub fn len(&self) -> usize {
-        self.centers.len()
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.centers.is_empty()
-    }
-
-    /// Whether sphere `i` can be drawn: finite centre, finite positive radius, known kind.
-    #[inline]
-    pub fn is_valid(&self, i: usize) -> bool {
-        let r = self.radii[i];
-        self.centers[i].is_finite()
-            && r.is_finite()
-            && r > 0.0
-            && (self.kinds[i] as usize) < self.materials.len()
-    }
-
-    /// Axis-aligned bounds `(min, max)` of the valid spheres including their radii, or `None`
-    /// when there is none.
-    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
-        let mut lo = Vec3::splat(f32::INFINITY);
-        let mut hi = Vec3::splat(f32::NEG_INFINITY);
-        let mut any = false;
-        for i in 0..self.len() {
-            if self.is_valid(i) {
-                let r = Vec3::splat(self.radii[i]);
-                lo = lo.min(self.centers[i] - r);
-                hi = hi.max(self.centers[i] + r);
-                any = true;
-            }
-        }
-        any.then_some((lo, hi))
-    }
-}
-
-/// The drawing methods (a closed set).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Method {
-    Polygon,
-    Lut,
-    Template,
-    Raycast,
-}
-
-impl Method {
-    pub const ALL: [Method; 4] = [
-        Method::Polygon,
-        Method::Lut,
-        Method::Template,
-        Method::Raycast,
-    ];
-
-    /// The lower-case name used on the command line and in results files.
-    pub fn name(self) -> &'static str {
-        match self {
-            Method::Polygon => "polygon",
-            Method::Lut => "lut",
-            Method::Template => "template",
-            Method::Raycast => "raycast",
-        }
-    }
-
-    /// Parse [`Method::name`].
-    pub fn from_name(s: &str) -> Option<Method> {
-        Method::ALL.into_iter().find(|m| m.name() == s)
-    }
-}
-
-/// How the Seed 004 template method writes depth.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum TemplateDepth {
-    /// The billboard plane through the sphere centre, as the paper does.
-    Billboard,
-    /// Seed 002's depth image: `z = z0 + D(s,t)·R/d0`.
-    DepthImage,
-}
-
-/// How the Seed 004 template method colours spheres.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum TemplateColoring {
-    /// One grey template recoloured per sphere by the material's HSV hue and saturation.
-    HueRecolor,
-    /// One template per material.
-    PerKind,
-}
-
-/// How the polygon method lights its triangles.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum PolygonShading {
-    /// Per pixel with the interpolated vertex normal.
-    Phong,
-    /// Per vertex, colours interpolated.
-    Gouraud,
-}
-
-/// Drawing options shared by all methods; fields a method does not use are ignored by it.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Options {
-    pub method: Method,
-    pub lighting: Lighting,
-    /// Background colour, sRGB RGBA.
-    pub background: [u8; 4],
-    /// Side of the Seed 002 colour/depth images (texels).
-    pub lut_size: u32,
-    /// Side of the finest Seed 004 template (texels); coarser levels halve it.
-    pub template_size: u32,
-    pub template_depth: TemplateDepth,
-    pub template_coloring: TemplateColoring,
-    /// Polygon method: largest allowed distance, in pixels, between the true silhouette and the
-    /// tessellated one; the tessellation level per sphere is chosen from it.
-    pub polygon_max_error_px: f32,
-    /// Polygon method: Phong (default) or Gouraud.
-    pub polygon_shading: PolygonShading,
-    /// Draw `SphereScene::bonds` as cylinders after the spheres (every method; see the crate docs).
-    pub draw_bonds: bool,
-}
-
-impl Options {
-    /// Defaults for a method: 256² Seed 002 images, 128² finest template with billboard depth and
-    /// hue recolouring, polygon silhouettes within 0.25 px, bonds drawn.
-    pub fn new(method: Method, lighting: Lighting) -> Options {
-        Options {
-            method,
-            lighting,
-            background: [0, 0, 0, 255],
-            lut_size: 256,
-            template_size: 128,
-            template_depth: TemplateDepth::Billboard,
-            template_coloring: TemplateColoring::HueRecolor,
-            polygon_max_error_px: 0.25,
-            polygon_shading: PolygonShading::Phong,
-            draw_bonds: true,
-        }
-    }
-}
-
-/// What happened to the spheres of a frame.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct RenderStats {
-    /// Spheres that reached the pixel stage.
-    pub drawn: usize,
-    /// Valid spheres outside the view frustum (including behind the camera).
-    pub culled: usize,
-    /// Spheres skipped for a non-finite centre, a non-positive or non-finite radius or an unknown
-    /// kind.
-    pub skipped_invalid: usize,
-    /// Bonds that reached the pixel stage (0 when [`Options::draw_bonds`] is off).
-    pub bonds_drawn: usize,
-    /// Valid bonds outside the view frustum (including behind the camera) or covering no pixel
-    /// centre.
-    pub bonds_culled: usize,
-    /// Bonds skipped: an atom index out of range, an atom that is itself skipped (see
-    /// `skipped_invalid`), two atoms at the same centre, or a non-positive or non-finite
-    /// [`SphereScene::bond_radius`] (then every bond is skipped).
-    pub bonds_skipped: usize,
-}
+pub use options::{Method, Options, PolygonShading, RenderStats, TemplateColoring, TemplateDepth};
+pub use scene::SphereScene;
 
 /// A rendered frame and its statistics.
 #[derive(Clone, Debug, PartialEq)]

@@ -33,7 +33,8 @@ use rayon::prelude::*;
 use texmap_core::camera::Camera;
 use texmap_core::frame::Frame;
 
-use crate::{RenderStats, SphereScene};
+use crate::options::RenderStats;
+use crate::scene::SphereScene;
 
 /// Tile side in pixels.
 pub(crate) const TILE: u32 = 32;

@@ -32,8 +32,10 @@ use texmap_core::frame::Frame;
 use texmap_core::shade::Lighting;
 use texmap_raster::{Cull, DrawState, Framebuffer, Mesh, Shading};
 
+use crate::options::{Options, PolygonShading, RenderStats};
 use crate::pipeline::{Projected, View};
-use crate::{Options, PolygonShading, RenderStats, SphereScene, raycast};
+use crate::raycast;
+use crate::scene::SphereScene;
 
 /// Icosphere levels built (level `L` has `20·4^L` triangles).
 pub const LEVELS: usize = 6;

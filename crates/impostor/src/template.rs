@@ -39,8 +39,8 @@ use texmap_core::color::{hsv_to_rgb, linear_to_srgb8, rgb_to_hsv};
 use texmap_core::shade::{Lighting, Material};
 
 use crate::lut::{depth_image, square};
+use crate::options::{TemplateColoring, TemplateDepth};
 use crate::pipeline::{Kernel, Proj, Projected, TILE, TileBuf, TileRect, View, clip};
-use crate::{TemplateColoring, TemplateDepth};
 
 /// Window radius in template texture units (the window centre moves by up to this much, so the
 /// window always stays inside `[0, 1]²`).
