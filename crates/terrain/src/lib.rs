@@ -1,7 +1,59 @@
-//! # texmap-terrain — terrain databases for Seed 000 (not yet built)
+//! # texmap-terrain — terrain databases for Seed 000
 //!
-//! This crate will turn gridded elevation models into error-bounded level-of-detail meshes, cut
-//! geospecific textures made from aerial photographs into mip-pyramid map tiles, choose the
-//! active-area map set of Seed 000 Eq. (5)–(7), export glTF/OBJ, and render flight views with the
-//! span-parallel sampler of `texmap-core`. It is scheduled by a later issue; today it is an empty
-//! library so that the workspace layout of ARCHITECTURE.md is in place.
+//! Seed 000's visual system drew terrain generated from a real area's elevation grid, draped with
+//! geospecific textures (GST) made from aerial photographs. This crate builds that database:
+//!
+//! - [`dem`]: elevation grids with their georeference and no-data — GeoTIFF (strips or tiles, chunk
+//!   by chunk, BigTIFF, GeoKeys, PixelIsArea/PixelIsPoint, GDAL no-data), ESRI ASCII, SRTM `.hgt`,
+//!   16-bit and Terrain-RGB PNG; geographic grids become local metres with the latitude-dependent
+//!   spacing.
+//! - [`rtin`]: a right-triangulated irregular network with an *exact* per-triangle error bound
+//!   (every grid sample within the maximum error of the mesh), holes where the data has none.
+//! - [`chunks`]: a chunked level-of-detail quadtree cut from one error map, each chunk with its
+//!   geometric error (for selection by screen-space error) and skirts sized 5x that error.
+//! - [`gst`]: the orthophoto placed by georeference (or stretched), cut into a pyramid of 256²
+//!   maps; Seed 000 Eq. (5)–(7) decide which maps are resident in a budgeted cache with counters.
+//! - [`db`]: the database directory (JSON manifest, chunks, tiles, the grid), built atomically, and
+//!   the whole-terrain mesh at any error for glTF/OBJ export (through `texmap-mesh`).
+//!
+//! Coordinates: vertices are in metres, `x` east, `y` up, `z` south (rows), from the centre of
+//! sample (0, 0); texture coordinates span the grid's extent, `v` down the rows as in glTF.
+//! Depends on texmap-core (coverage, Eq. 5–7), texmap-raster (the crack test) and texmap-mesh;
+//! never on the reference ray tracer.
+//!
+//! ```
+//! use texmap_terrain::dem::{Georef, Grid};
+//! use texmap_terrain::{chunks, db};
+//!
+//! // A 65 x 65 paraboloid bowl, 10 m between samples, with one no-data sample.
+//! let n = 65u32;
+//! let mut h: Vec<f32> = (0..n * n)
+//!     .map(|i| {
+//!         let (x, y) = ((i % n) as f32 - 32.0, (i / n) as f32 - 32.0);
+//!         0.05 * (x * x + y * y)
+//!     })
+//!     .collect();
+//! h[10 * 65 + 10] = f32::NAN;
+//! let grid = Grid::new("bowl", n, n, h, Georef::local(10.0))?;
+//!
+//! // One mesh with every sample within 0.5 m; the no-data sample is a hole, not a spike.
+//! let mesh = db::whole_mesh(&grid, 0.5)?;
+//! assert!(mesh.triangles.len() < 2 * 64 * 64);
+//! assert!(mesh.positions.iter().all(|p| p.y.is_finite() && p.y >= 0.0));
+//!
+//! // A quadtree of 33-sample chunks: depth 0 (one chunk) and depth 1 (four), errors doubling upwards.
+//! let tree = chunks::build(&grid, 0.5, 33)?;
+//! assert_eq!(tree.levels[1].len(), 4);
+//! assert!(tree.levels[0][0].geometric_error <= 1.0);
+//! # Ok::<(), texmap_terrain::TerrainError>(())
+//! ```
+
+pub mod chunks;
+pub mod db;
+pub mod dem;
+pub mod error;
+pub mod greedy;
+pub mod gst;
+pub mod rtin;
+
+pub use error::TerrainError;

@@ -1,0 +1,417 @@
+//! The terrain database directory: a JSON manifest, the grid, mesh chunks and GST map tiles.
+//!
+//! ```text
+//! DIR/manifest.json            version, georeference, sizes, levels with chunk errors, texture levels
+//! DIR/grid.f32                 the heights, little-endian f32 row-major (NaN = no-data): exports at any error
+//! DIR/chunks/D/IX_IY.bin       "TMCK", u32 version, u32 vertices, u32 triangles, u32 surface triangles,
+//!                              positions (3 f32), uvs (2 f32), triangles (3 u32), little-endian
+//! DIR/tiles/L/X_Y.png          GST maps, T x T RGBA
+//! ```
+//! A build writes everything into a sibling temporary directory and renames it to `DIR` at the
+//! end, so an interrupted or failed build never leaves a half-written database (the temporary is
+//! removed on failure). `DIR` must not exist.
+
+use crate::chunks;
+use crate::dem::{Georef, Grid};
+use crate::error::{TerrainError, format_err, io};
+use crate::gst::{self, Orthophoto};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// The manifest's format version.
+pub const VERSION: u32 = 1;
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ChunkEntry {
+    pub ix: u32,
+    pub iy: u32,
+    pub x0: u32,
+    pub y0: u32,
+    pub size: u32,
+    pub geometric_error: f32,
+    pub skirt: f32,
+    pub triangles: u32,
+    pub vertices: u32,
+    pub file: String,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LevelEntry {
+    pub depth: u32,
+    pub target_error: f32,
+    pub chunks: Vec<ChunkEntry>,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TextureEntry {
+    pub map_texels: u32,
+    pub levels: u32,
+    pub placed_by: String,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Manifest {
+    pub version: u32,
+    pub source: String,
+    pub width: u32,
+    pub height: u32,
+    pub georef: Georef,
+    pub height_min: f32,
+    pub height_max: f32,
+    pub nodata: u64,
+    pub max_error: f32,
+    pub chunk: u32,
+    pub levels: Vec<LevelEntry>,
+    pub texture: Option<TextureEntry>,
+}
+
+/// Build options.
+#[derive(Clone, Copy, Debug)]
+pub struct BuildOptions {
+    pub max_error: f32,
+    pub chunk: u32,
+    pub map_texels: u32,
+    /// Cap on GST levels (the finest is `map_texels · 2^(levels−1)` a side).
+    pub max_texture_levels: u32,
+}
+
+impl Default for BuildOptions {
+    fn default() -> Self {
+        BuildOptions {
+            max_error: 1.0,
+            chunk: 257,
+            map_texels: 256,
+            max_texture_levels: 5,
+        }
+    }
+}
+
+fn chunk_bytes(c: &chunks::Chunk) -> Vec<u8> {
+    let m = &c.mesh;
+    let mut b = Vec::with_capacity(20 + m.positions.len() * 20 + m.triangles.len() * 12);
+    b.extend_from_slice(b"TMCK");
+    for v in [
+        1u32,
+        m.positions.len() as u32,
+        m.triangles.len() as u32,
+        c.surface_triangles,
+    ] {
+        b.extend_from_slice(&v.to_le_bytes());
+    }
+    for p in &m.positions {
+        for x in p.to_array() {
+            b.extend_from_slice(&x.to_le_bytes());
+        }
+    }
+    for t in m.uvs.as_deref().unwrap_or(&[]) {
+        for x in t.to_array() {
+            b.extend_from_slice(&x.to_le_bytes());
+        }
+    }
+    for t in &m.triangles {
+        for i in t {
+            b.extend_from_slice(&i.to_le_bytes());
+        }
+    }
+    b
+}
+
+/// Build a database at `out` from `grid` (and an orthophoto); `progress(done, total)` is called
+/// after each step.
+pub fn build(
+    grid: &Grid,
+    source: &str,
+    photo: Option<&Orthophoto>,
+    opts: &BuildOptions,
+    out: &Path,
+    mut progress: impl FnMut(u64, u64),
+) -> Result<Manifest, TerrainError> {
+    if out.exists() {
+        return Err(TerrainError::Exists {
+            path: out.to_path_buf(),
+        });
+    }
+    let parent = out
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let name = out
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "terrain".into());
+    let tmp = parent.join(format!(".{name}.tmp-{}", std::process::id()));
+    if tmp.exists() {
+        std::fs::remove_dir_all(&tmp).map_err(io(&tmp))?;
+    }
+    let result = build_into(grid, source, photo, opts, &tmp, &mut progress).and_then(|m| {
+        std::fs::rename(&tmp, out).map_err(io(out))?;
+        Ok(m)
+    });
+    if result.is_err() {
+        let _ = std::fs::remove_dir_all(&tmp);
+    }
+    result
+}
+
+fn write(path: &Path, bytes: &[u8]) -> Result<(), TerrainError> {
+    if let Some(p) = path.parent() {
+        std::fs::create_dir_all(p).map_err(io(p))?;
+    }
+    std::fs::write(path, bytes).map_err(io(path))
+}
+
+fn build_into(
+    grid: &Grid,
+    source: &str,
+    photo: Option<&Orthophoto>,
+    opts: &BuildOptions,
+    dir: &Path,
+    progress: &mut impl FnMut(u64, u64),
+) -> Result<Manifest, TerrainError> {
+    std::fs::create_dir_all(dir).map_err(io(dir))?;
+    let tex_levels = photo
+        .map(|_| gst::level_count(grid, opts.map_texels, opts.max_texture_levels))
+        .unwrap_or(0);
+    let total = 3 + tex_levels as u64;
+    let mut levels = Vec::new();
+    // One depth at a time: its chunks go to disk and are dropped before the next is built.
+    chunks::build_streaming(grid, opts.max_error, opts.chunk, |d, level| {
+        let mut entries = Vec::new();
+        for c in &level {
+            let file = format!("chunks/{d}/{}_{}.bin", c.ix, c.iy);
+            write(&dir.join(&file), &chunk_bytes(c))?;
+            entries.push(ChunkEntry {
+                ix: c.ix,
+                iy: c.iy,
+                x0: c.x0,
+                y0: c.y0,
+                size: c.size,
+                geometric_error: c.geometric_error,
+                skirt: c.skirt,
+                triangles: c.surface_triangles,
+                vertices: c.mesh.positions.len() as u32,
+                file,
+            });
+        }
+        levels.push(LevelEntry {
+            depth: d,
+            target_error: level.first().map_or(0.0, |c| c.target_error),
+            chunks: entries,
+        });
+        Ok(())
+    })?;
+    progress(1, total);
+    progress(2, total);
+    // Streamed: no second copy of a large grid in memory.
+    let gpath = dir.join("grid.f32");
+    {
+        use std::io::Write as _;
+        let f = std::fs::File::create(&gpath).map_err(io(&gpath))?;
+        let mut w = std::io::BufWriter::new(f);
+        for h in grid.heights() {
+            w.write_all(&h.to_le_bytes()).map_err(io(&gpath))?;
+        }
+        w.flush().map_err(io(&gpath))?;
+    }
+    let texture = match photo {
+        Some(p) => {
+            let size = opts.map_texels << (tex_levels - 1);
+            let pyr = gst::pyramid(gst::place(p, grid, size)?, opts.map_texels);
+            for (l, img) in pyr.levels.iter().enumerate() {
+                let n = img.width() / opts.map_texels;
+                for y in 0..n {
+                    for x in 0..n {
+                        let key = gst::MapKey {
+                            level: l as u32,
+                            x,
+                            y,
+                        };
+                        let map = pyr.map(key).expect("inside the level");
+                        let path = dir.join(format!("tiles/{l}/{x}_{y}.png"));
+                        if let Some(par) = path.parent() {
+                            std::fs::create_dir_all(par).map_err(io(par))?;
+                        }
+                        map.save(&path).map_err(|e| {
+                            format_err(
+                                &path.display().to_string(),
+                                "PNG encoding",
+                                format!("a writable file ({e})"),
+                            )
+                        })?;
+                    }
+                }
+                progress(3 + l as u64, total);
+            }
+            Some(TextureEntry {
+                map_texels: opts.map_texels,
+                levels: tex_levels,
+                placed_by: if p.georef.is_some() {
+                    "georeference".into()
+                } else {
+                    "stretched".into()
+                },
+            })
+        }
+        None => None,
+    };
+    let (lo, hi) = grid.height_range();
+    let manifest = Manifest {
+        version: VERSION,
+        source: source.to_string(),
+        width: grid.width(),
+        height: grid.height(),
+        georef: *grid.georef(),
+        height_min: lo,
+        height_max: hi,
+        nodata: grid.nodata_count(),
+        max_error: opts.max_error,
+        chunk: opts.chunk,
+        levels,
+        texture,
+    };
+    let json = serde_json::to_vec_pretty(&manifest)
+        .map_err(|e| format_err(source, "manifest", e.to_string()))?;
+    write(&dir.join("manifest.json"), &json)?;
+    progress(total, total);
+    Ok(manifest)
+}
+
+/// An opened database.
+#[derive(Clone, Debug)]
+pub struct Database {
+    pub dir: PathBuf,
+    pub manifest: Manifest,
+}
+
+impl Database {
+    pub fn open(dir: &Path) -> Result<Database, TerrainError> {
+        let path = dir.join("manifest.json");
+        let text = std::fs::read_to_string(&path).map_err(io(&path))?;
+        let manifest: Manifest = serde_json::from_str(&text).map_err(|e| {
+            format_err(
+                &path.display().to_string(),
+                format!("line {}", e.line()),
+                format!("a terrain manifest ({e})"),
+            )
+        })?;
+        if manifest.version != VERSION {
+            return Err(TerrainError::Unsupported {
+                source: path.display().to_string(),
+                what: format!(
+                    "manifest version {} (this build reads {VERSION})",
+                    manifest.version
+                ),
+            });
+        }
+        Ok(Database {
+            dir: dir.to_path_buf(),
+            manifest,
+        })
+    }
+
+    /// The stored grid.
+    pub fn grid(&self) -> Result<Grid, TerrainError> {
+        let path = self.dir.join("grid.f32");
+        let m = &self.manifest;
+        let bytes = std::fs::read(&path).map_err(io(&path))?;
+        let want = m.width as usize * m.height as usize * 4;
+        if bytes.len() != want {
+            return Err(format_err(
+                &path.display().to_string(),
+                "file size",
+                format!("{want} bytes for {} x {} f32", m.width, m.height),
+            ));
+        }
+        let h = bytes
+            .chunks_exact(4)
+            .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+            .collect();
+        Grid::new(&path.display().to_string(), m.width, m.height, h, m.georef)
+    }
+
+    /// A GST map tile.
+    pub fn map(&self, key: gst::MapKey) -> Result<image::RgbaImage, TerrainError> {
+        let path = self
+            .dir
+            .join(format!("tiles/{}/{}_{}.png", key.level, key.x, key.y));
+        Ok(image::open(&path)
+            .map_err(|e| format_err(&path.display().to_string(), "PNG", e.to_string()))?
+            .to_rgba8())
+    }
+
+    /// The finest texture level whose side is at most `max_side`, assembled from its tiles.
+    pub fn texture(&self, max_side: u32) -> Result<Option<image::RgbaImage>, TerrainError> {
+        let Some(t) = &self.manifest.texture else {
+            return Ok(None);
+        };
+        let mut level = t.levels - 1;
+        while level > 0 && (t.map_texels << level) > max_side {
+            level -= 1;
+        }
+        let n = 1u32 << level;
+        let mut img = image::RgbaImage::new(t.map_texels * n, t.map_texels * n);
+        for y in 0..n {
+            for x in 0..n {
+                let m = self.map(gst::MapKey { level, x, y })?;
+                image::imageops::replace(
+                    &mut img,
+                    &m,
+                    (x * t.map_texels) as i64,
+                    (y * t.map_texels) as i64,
+                );
+            }
+        }
+        Ok(Some(img))
+    }
+}
+
+/// One mesh of the whole grid at `max_error` (RTIN over the padded grid; holes dropped), with
+/// positions in local metres and uvs over the DEM extent.
+pub fn whole_mesh(grid: &Grid, max_error: f32) -> Result<texmap_mesh::TriMesh, TerrainError> {
+    if !(max_error.is_finite() && max_error >= 0.0) {
+        return Err(TerrainError::BadParameter {
+            name: "max-error",
+            value: max_error.to_string(),
+            expected: "a finite error ≥ 0 metres",
+        });
+    }
+    let (padded, n) = crate::rtin::pad_to_rtin(grid.heights(), grid.width(), grid.height());
+    let map = crate::rtin::ErrorMap::new(&padded, n);
+    let gm = crate::rtin::extract(&map, &padded, 0, 0, n - 1, max_error, 1);
+    Ok(chunks::chunk_mesh(
+        grid,
+        &padded,
+        n,
+        &gm,
+        (0, 0, n - 1),
+        0.0,
+    ))
+}
+
+/// As [`whole_mesh`] with the greedy Delaunay refinement (fewer triangles, more time; the grid
+/// must have no no-data).
+pub fn whole_mesh_greedy(
+    grid: &Grid,
+    max_error: f32,
+) -> Result<texmap_mesh::TriMesh, TerrainError> {
+    let gm = crate::greedy::greedy(grid, max_error)?;
+    let w = grid.width();
+    Ok(chunks::chunk_mesh(
+        grid,
+        grid.heights(),
+        w,
+        &gm,
+        (0, 0, 0),
+        0.0,
+    ))
+}
+
+/// The `info` object of a grid: size, georeference, height range, no-data count.
+pub fn grid_info(grid: &Grid, source: &str) -> serde_json::Value {
+    let (lo, hi) = grid.height_range();
+    let (sx, sy) = grid.georef().spacing_metres(grid.height());
+    serde_json::json!({
+        "source": source, "width": grid.width(), "height": grid.height(), "georef": grid.georef(),
+        "spacing_m": [sx, sy], "height_min": lo, "height_max": hi, "nodata": grid.nodata_count(),
+    })
+}

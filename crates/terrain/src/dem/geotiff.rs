@@ -1,0 +1,412 @@
+//! GeoTIFF rasters through the `tiff` crate, with the GeoTIFF tags interpreted here.
+//!
+//! Pixels are decoded one chunk (strip or tile) at a time with [`tiff::decoder::Decoder::read_chunk`]
+//! and copied into the grid, so only one chunk's buffer is alive beside the result: a grid larger
+//! than the crate's default 256 MiB whole-image decode limit loads, and the limit applies per chunk
+//! ([`read_geotiff_limited`] lets a test shrink it). Sample types: 8/16/32/64-bit signed and
+//! unsigned integers, 32- and 64-bit floats; compression (LZW, Deflate, PackBits), predictors 2 and 3
+//! and BigTIFF are the `tiff` crate's. Interleaved (`PlanarConfiguration` 1) and planar (2) layouts.
+//!
+//! Georeference (GeoTIFF 1.1, OGC 19-008):
+//! - `ModelPixelScale` (33550) `(Sx, Sy, Sz)` with `ModelTiepoint` (33922) `(I, J, K, X, Y, Z)`:
+//!   raster point `(I, J)` is model point `(X, Y)`, so raster `(i, j)` is `(X + (i − I)·Sx, Y − (j − J)·Sy)`.
+//! - or `ModelTransformation` (34264), a row-major 4x4 matrix; rotation or shear terms are refused.
+//! - GeoKey directory (34735): `GTModelTypeGeoKey` (1024: 1 projected, 2 geographic),
+//!   `GTRasterTypeGeoKey` (1025: 1 `RasterPixelIsArea`, the default; 2 `RasterPixelIsPoint`),
+//!   `ProjectedCSTypeGeoKey` (3072) / `GeographicTypeGeoKey` (2048) for the EPSG code.
+//! - The raster-space position of the centre of pixel `(c, r)` is `(c + ½, r + ½)` for
+//!   `PixelIsArea` (raster space counts pixel corners) and `(c, r)` for `PixelIsPoint` — the
+//!   half-pixel shift users trip on; [`Georef`] stores centres, so it is applied once here.
+//! - GDAL's no-data tag (42113, ASCII) marks no-data samples.
+
+use super::{CrsKind, Georef, Grid, check_size};
+use crate::error::{TerrainError, format_err, io};
+use std::path::Path;
+use tiff::decoder::{ChunkType, Decoder, DecodingResult, Limits};
+use tiff::tags::{PlanarConfiguration, Tag};
+
+/// A decoded GeoTIFF raster: `bands` planes of `width·height` samples as `f32`.
+#[derive(Clone, Debug)]
+pub struct Raster {
+    pub width: u32,
+    pub height: u32,
+    /// One plane per band requested, row-major.
+    pub bands: Vec<Vec<f32>>,
+    /// Bits per sample as stored (8 for a byte photo, 16 for a 16-bit scene...).
+    pub bits: u8,
+    /// The georeference, if the file has one.
+    pub georef: Option<Georef>,
+    /// GDAL's no-data value, if present.
+    pub nodata: Option<f64>,
+    /// Bands in the file.
+    pub band_count: u16,
+}
+
+/// Read a GeoTIFF elevation grid (band 1).
+pub fn read_geotiff(path: &Path) -> Result<Grid, TerrainError> {
+    read_geotiff_limited(path, Limits::default().decoding_buffer_size)
+}
+
+/// As [`read_geotiff`], with the per-chunk decode buffer limited to `chunk_limit` bytes.
+pub fn read_geotiff_limited(path: &Path, chunk_limit: usize) -> Result<Grid, TerrainError> {
+    let source = path.display().to_string();
+    let r = read_raster(path, Some(&[0]), chunk_limit)?;
+    let georef = r.georef.unwrap_or(Georef::local(1.0));
+    let Raster {
+        width,
+        height,
+        mut bands,
+        nodata,
+        ..
+    } = r;
+    let plane = bands.pop().unwrap_or_default();
+    // Float grids use NaN for no-data themselves (GDAL writes "nan"); an explicit NaN with no
+    // nodata tag is still a hole, not an error, because it is how float rasters store voids.
+    Grid::from_samples(
+        &source,
+        width,
+        height,
+        plane,
+        nodata.filter(|v| !v.is_nan()),
+        true,
+        georef,
+    )
+}
+
+fn tiff_err(source: &str, at: &str) -> impl FnOnce(tiff::TiffError) -> TerrainError {
+    let source = source.to_string();
+    let at = at.to_string();
+    move |e| match e {
+        tiff::TiffError::UnsupportedError(u) => TerrainError::Unsupported {
+            source,
+            what: format!("{at}: {u}"),
+        },
+        other => TerrainError::Format {
+            source,
+            at,
+            expected: format!("valid TIFF data ({other})"),
+        },
+    }
+}
+
+/// The number of bands (SamplesPerPixel) of a TIFF, read from its header only.
+pub fn band_count(path: &Path) -> Result<u16, TerrainError> {
+    let source = path.display().to_string();
+    let file = std::fs::File::open(path).map_err(io(path))?;
+    let mut dec =
+        Decoder::new(std::io::BufReader::new(file)).map_err(tiff_err(&source, "header"))?;
+    Ok(dec
+        .find_tag_unsigned(Tag::SamplesPerPixel)
+        .map_err(tiff_err(&source, "tag 277 SamplesPerPixel"))?
+        .unwrap_or(1))
+}
+
+/// Read the bands `bands` (0-based; `None` = all) of a TIFF, chunk by chunk.
+pub fn read_raster(
+    path: &Path,
+    bands: Option<&[u16]>,
+    chunk_limit: usize,
+) -> Result<Raster, TerrainError> {
+    let source = path.display().to_string();
+    let file = std::fs::File::open(path).map_err(io(path))?;
+    let mut limits = Limits::default();
+    limits.decoding_buffer_size = chunk_limit;
+    let mut dec = Decoder::new(std::io::BufReader::new(file))
+        .map_err(tiff_err(&source, "header"))?
+        .with_limits(limits);
+    let (width, height) = dec
+        .dimensions()
+        .map_err(tiff_err(&source, "ImageWidth/ImageLength"))?;
+    check_size(&source, width as u64, height as u64)?;
+    let spp: u16 = dec
+        .find_tag_unsigned(Tag::SamplesPerPixel)
+        .map_err(tiff_err(&source, "tag 277 SamplesPerPixel"))?
+        .unwrap_or(1);
+    let bits: u16 = dec
+        .find_tag_unsigned_vec::<u16>(Tag::BitsPerSample)
+        .map_err(tiff_err(&source, "tag 258 BitsPerSample"))?
+        .and_then(|v| v.first().copied())
+        .unwrap_or(1);
+    let planar = dec
+        .find_tag_unsigned::<u16>(Tag::PlanarConfiguration)
+        .map_err(tiff_err(&source, "tag 284 PlanarConfiguration"))?
+        .map(PlanarConfiguration::from_u16)
+        .unwrap_or(Some(PlanarConfiguration::Chunky));
+    let planar = match planar {
+        Some(PlanarConfiguration::Chunky) => false,
+        Some(PlanarConfiguration::Planar) => true,
+        _ => {
+            return Err(TerrainError::Unsupported {
+                source,
+                what: "tag 284 PlanarConfiguration other than 1 or 2".into(),
+            });
+        }
+    };
+    let want: Vec<u16> = match bands {
+        Some(b) => b.to_vec(),
+        None => (0..spp).collect(),
+    };
+    if let Some(&b) = want.iter().find(|&&b| b >= spp) {
+        return Err(TerrainError::BadParameter {
+            name: "band",
+            value: (b + 1).to_string(),
+            expected: "a band the file has (1-based, up to SamplesPerPixel)",
+        });
+    }
+    let georef = read_georef(&mut dec, &source)?;
+    let nodata = match dec
+        .find_tag(Tag::GdalNodata)
+        .map_err(tiff_err(&source, "tag 42113 GDAL_NODATA"))?
+    {
+        Some(v) => {
+            let s = v
+                .into_string()
+                .map_err(tiff_err(&source, "tag 42113 GDAL_NODATA"))?;
+            let t = s.trim_matches(|c: char| c == '\0' || c.is_whitespace());
+            Some(t.parse::<f64>().map_err(|_| {
+                format_err(
+                    &source,
+                    "tag 42113 GDAL_NODATA",
+                    format!("a number, got {t:?}"),
+                )
+            })?)
+        }
+        None => None,
+    };
+
+    let (cw, ch) = dec.chunk_dimensions();
+    let chunk_type = dec.get_chunk_type();
+    // Both counts cover every plane of a planar image.
+    let total = match chunk_type {
+        ChunkType::Tile => dec
+            .tile_count()
+            .map_err(tiff_err(&source, "tile offsets"))?,
+        ChunkType::Strip => dec
+            .strip_count()
+            .map_err(tiff_err(&source, "strip offsets"))?,
+    };
+    let per_plane = if planar {
+        total / spp.max(1) as u32
+    } else {
+        total
+    };
+    let across = width.div_ceil(cw.max(1));
+    let n = width as usize * height as usize;
+    let mut out: Vec<Vec<f32>> = want.iter().map(|_| vec![0.0f32; n]).collect();
+    for chunk in 0..per_plane {
+        let (x0, y0) = match chunk_type {
+            ChunkType::Tile => ((chunk % across) * cw, (chunk / across) * ch),
+            ChunkType::Strip => (0, chunk * ch),
+        };
+        if y0 >= height {
+            return Err(format_err(
+                &source,
+                format!("chunk {chunk}"),
+                "a chunk inside the image",
+            ));
+        }
+        // Planar: band b of this chunk is chunk b·per_plane + chunk; interleaved: one chunk holds all.
+        let reads: Vec<(u32, Option<usize>)> = if planar {
+            want.iter()
+                .enumerate()
+                .map(|(k, &b)| (b as u32 * per_plane + chunk, Some(k)))
+                .collect()
+        } else {
+            vec![(chunk, None)]
+        };
+        for (index, only) in reads {
+            let (dw, dh) = dec.chunk_data_dimensions(index);
+            let at = format!("chunk {index}");
+            let data = dec.read_chunk(index).map_err(tiff_err(&source, &at))?;
+            let vals = to_f32(data).ok_or_else(|| TerrainError::Unsupported {
+                source: source.clone(),
+                what: format!("{at}: sample type (need integer or 32/64-bit float samples)"),
+            })?;
+            let stride = if planar { 1 } else { spp as usize };
+            let need = dw as usize * dh as usize * stride;
+            if vals.len() < need {
+                return Err(format_err(
+                    &source,
+                    &at,
+                    format!("{need} samples, decoded {}", vals.len()),
+                ));
+            }
+            let dw_clip = dw.min(width - x0) as usize;
+            let dh_clip = dh.min(height - y0) as usize;
+            for (k, &b) in want.iter().enumerate() {
+                if only.is_some_and(|o| o != k) {
+                    continue;
+                }
+                let sample = if planar { 0 } else { b as usize };
+                let dst = &mut out[k];
+                for row in 0..dh_clip {
+                    let src_row = row * dw as usize * stride;
+                    let dst_row = (y0 as usize + row) * width as usize + x0 as usize;
+                    for col in 0..dw_clip {
+                        dst[dst_row + col] = vals[src_row + col * stride + sample];
+                    }
+                }
+            }
+        }
+    }
+    Ok(Raster {
+        width,
+        height,
+        bands: out,
+        bits: bits.min(255) as u8,
+        georef,
+        nodata,
+        band_count: spp,
+    })
+}
+
+fn to_f32(d: DecodingResult) -> Option<Vec<f32>> {
+    Some(match d {
+        DecodingResult::U8(v) => v.into_iter().map(|x| x as f32).collect(),
+        DecodingResult::U16(v) => v.into_iter().map(|x| x as f32).collect(),
+        DecodingResult::U32(v) => v.into_iter().map(|x| x as f32).collect(),
+        DecodingResult::U64(v) => v.into_iter().map(|x| x as f32).collect(),
+        DecodingResult::I8(v) => v.into_iter().map(|x| x as f32).collect(),
+        DecodingResult::I16(v) => v.into_iter().map(|x| x as f32).collect(),
+        DecodingResult::I32(v) => v.into_iter().map(|x| x as f32).collect(),
+        DecodingResult::I64(v) => v.into_iter().map(|x| x as f32).collect(),
+        DecodingResult::F32(v) => v,
+        DecodingResult::F64(v) => v.into_iter().map(|x| x as f32).collect(),
+        _ => return None,
+    })
+}
+
+fn f64_vec<R: std::io::Read + std::io::Seek>(
+    dec: &mut Decoder<R>,
+    tag: Tag,
+    source: &str,
+    name: &str,
+) -> Result<Option<Vec<f64>>, TerrainError> {
+    match dec.find_tag(tag).map_err(tiff_err(source, name))? {
+        None => Ok(None),
+        Some(v) => Ok(Some(v.into_f64_vec().map_err(tiff_err(source, name))?)),
+    }
+}
+
+/// Interpret the GeoTIFF tags; `None` when the file has no georeference at all.
+fn read_georef<R: std::io::Read + std::io::Seek>(
+    dec: &mut Decoder<R>,
+    source: &str,
+) -> Result<Option<Georef>, TerrainError> {
+    // GeoKeys: model type and raster type.
+    let mut model = None;
+    let mut raster_type = 1u16;
+    let mut epsg = None;
+    if let Some(keys) = dec
+        .find_tag_unsigned_vec::<u16>(Tag::GeoKeyDirectoryTag)
+        .map_err(tiff_err(source, "tag 34735 GeoKeyDirectory"))?
+    {
+        if keys.len() < 4 {
+            return Err(format_err(
+                source,
+                "tag 34735 GeoKeyDirectory",
+                "a 4-value header",
+            ));
+        }
+        let count = keys[3] as usize;
+        if keys.len() < 4 + 4 * count {
+            return Err(format_err(
+                source,
+                "tag 34735 GeoKeyDirectory",
+                format!("{count} keys of 4 values, got {} values", keys.len()),
+            ));
+        }
+        for k in keys[4..4 + 4 * count].chunks_exact(4) {
+            // (KeyID, TIFFTagLocation, Count, Value): location 0 = the value is inline.
+            if k[1] != 0 {
+                continue;
+            }
+            match k[0] {
+                1024 => model = Some(k[3]),
+                1025 => raster_type = k[3],
+                2048 | 3072 if k[3] != 32767 && k[3] != 0 => epsg = Some(k[3]),
+                _ => {}
+            }
+        }
+    }
+    let crs = match model {
+        Some(1) => CrsKind::Projected,
+        Some(2) => CrsKind::Geographic,
+        Some(3) => {
+            return Err(TerrainError::Unsupported {
+                source: source.into(),
+                what: "GTModelTypeGeoKey 3 (geocentric)".into(),
+            });
+        }
+        _ => CrsKind::Local,
+    };
+    // Raster space of pixel centres: PixelIsArea counts corners, PixelIsPoint centres.
+    let half = match raster_type {
+        1 => 0.5,
+        2 => 0.0,
+        other => {
+            return Err(format_err(
+                source,
+                "GeoKey 1025 GTRasterTypeGeoKey",
+                format!("1 (PixelIsArea) or 2 (PixelIsPoint), got {other}"),
+            ));
+        }
+    };
+    let scale = f64_vec(
+        dec,
+        Tag::ModelPixelScaleTag,
+        source,
+        "tag 33550 ModelPixelScale",
+    )?;
+    let tie = f64_vec(
+        dec,
+        Tag::ModelTiepointTag,
+        source,
+        "tag 33922 ModelTiepoint",
+    )?;
+    let trans = f64_vec(
+        dec,
+        Tag::ModelTransformationTag,
+        source,
+        "tag 34264 ModelTransformation",
+    )?;
+    let (x_at, y_at, dx, dy) = match (scale, tie, trans) {
+        (Some(s), Some(t), _) => {
+            if s.len() < 2 || t.len() < 6 {
+                return Err(format_err(
+                    source,
+                    "tags 33550/33922",
+                    "3 pixel scales and 6 tie-point values",
+                ));
+            }
+            // Raster (i, j) -> (X + (i − I)·Sx, Y − (j − J)·Sy).
+            let (i, j, x, y) = (t[0], t[1], t[3], t[4]);
+            (x - i * s[0], y + j * s[1], s[0], -s[1])
+        }
+        (_, _, Some(m)) => {
+            if m.len() < 16 {
+                return Err(format_err(
+                    source,
+                    "tag 34264 ModelTransformation",
+                    "16 values",
+                ));
+            }
+            if m[1] != 0.0 || m[4] != 0.0 {
+                return Err(TerrainError::Unsupported {
+                    source: source.into(),
+                    what: "tag 34264 ModelTransformation with rotation or shear".into(),
+                });
+            }
+            (m[3], m[7], m[0], m[5])
+        }
+        (None, _, None) | (Some(_), None, None) => return Ok(None),
+    };
+    Ok(Some(Georef {
+        crs,
+        epsg,
+        origin_x: x_at + half * dx,
+        origin_y: y_at + half * dy,
+        dx,
+        dy,
+    }))
+}

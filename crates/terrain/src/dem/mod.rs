@@ -1,0 +1,443 @@
+//! Elevation grids: samples, georeference and no-data, and the readers that make them.
+//!
+//! A [`Grid`] is a row-major array of `f32` heights in metres, row 0 at the north (top) edge, with
+//! no-data as `NaN` (never as −32768 or −9999: a reader turns its format's marker into `NaN`, so
+//! no marker can reach a mesh as a spike). Its [`Georef`] places the *centre* of sample
+//! `(col, row)` at `origin + (col·dx, row·dy)` in the grid's coordinate system, whose kind
+//! ([`CrsKind`]) says whether the units are metres (projected) or degrees (geographic). Centres,
+//! not corners, because every mesh vertex is a sample: the GeoTIFF reader resolves
+//! `PixelIsArea` vs `PixelIsPoint` (the half-pixel shift) once, here, and nothing downstream
+//! needs to know which one the file used.
+//!
+//! Geographic grids are turned into local metres with the latitude-dependent spacing
+//! ([`Georef::local_metres`]): east-west metres per degree shrink with `cos φ` row by row, so a
+//! 1° tile at 60° N is half as wide as at the equator. The grid itself keeps its degrees; the
+//! conversion happens when vertices are made, so the georeference survives to the export.
+//!
+//! Readers ([`DemFormat`], [`read_dem`]): GeoTIFF ([`geotiff`]), ESRI ASCII grid ([`asc`]),
+//! SRTM `.hgt` ([`hgt`]), 16-bit PNG with a scale and offset and Mapbox Terrain-RGB PNG
+//! ([`png`]). Each validates at the file boundary ([`Grid::new`]): at least 2 x 2 samples, at most
+//! [`MAX_SAMPLES`], every value finite or no-data, not all no-data.
+
+pub mod asc;
+pub mod geotiff;
+pub mod hgt;
+pub mod png;
+
+use crate::error::TerrainError;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// The largest grid accepted: 2^30 samples (4 GiB of `f32`), far above any DEM tile a terrain
+/// database is built from in one piece, and low enough that a header claiming more is refused
+/// before anything is allocated.
+pub const MAX_SAMPLES: u64 = 1 << 30;
+
+/// What the grid's coordinates measure.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CrsKind {
+    /// A projected system: coordinates in metres (e.g. UTM).
+    Projected,
+    /// Longitude and latitude in degrees.
+    Geographic,
+    /// No georeference: coordinates are in the units the caller gave (metres are assumed).
+    Local,
+}
+
+/// Where the samples are: the centre of sample `(col, row)` is `origin + (col·dx, row·dy)`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Georef {
+    pub crs: CrsKind,
+    /// EPSG code, when the file names one.
+    pub epsg: Option<u16>,
+    /// Centre of sample (0, 0): easting or longitude.
+    pub origin_x: f64,
+    /// Centre of sample (0, 0): northing or latitude.
+    pub origin_y: f64,
+    /// Step between columns (positive: east).
+    pub dx: f64,
+    /// Step between rows (negative for the usual north-up grid).
+    pub dy: f64,
+}
+
+impl Georef {
+    /// A local frame with `cell` metres between samples, north up.
+    pub fn local(cell: f64) -> Georef {
+        Georef {
+            crs: CrsKind::Local,
+            epsg: None,
+            origin_x: 0.0,
+            origin_y: 0.0,
+            dx: cell,
+            dy: -cell,
+        }
+    }
+
+    /// The grid coordinates of the centre of sample `(col, row)`.
+    pub fn sample_xy(&self, col: f64, row: f64) -> (f64, f64) {
+        (self.origin_x + col * self.dx, self.origin_y + row * self.dy)
+    }
+
+    /// The fractional sample position of grid coordinates `(x, y)` (inverse of [`Self::sample_xy`]).
+    pub fn xy_to_sample(&self, x: f64, y: f64) -> (f64, f64) {
+        ((x - self.origin_x) / self.dx, (y - self.origin_y) / self.dy)
+    }
+
+    /// Local metres `(east, south)` of sample `(col, row)` from sample (0, 0).
+    ///
+    /// Projected and local grids: `(col·dx, −row·dy)`. Geographic grids: the WGS 84 meridian arc
+    /// `M(φ) ≈ 111 132.92 − 559.82 cos 2φ + 1.175 cos 4φ` metres per degree of latitude (taken at
+    /// the mean latitude of the two rows) and the parallel `P(φ) ≈ 111 412.84 cos φ − 93.5 cos 3φ`
+    /// metres per degree of longitude at the sample's own latitude (the standard series, good to
+    /// about a centimetre per degree).
+    pub fn local_metres(&self, col: f64, row: f64) -> (f64, f64) {
+        match self.crs {
+            CrsKind::Projected | CrsKind::Local => (col * self.dx, -row * self.dy),
+            CrsKind::Geographic => {
+                let lat0 = self.origin_y;
+                let lat = self.origin_y + row * self.dy;
+                let mid = (0.5 * (lat0 + lat)).to_radians();
+                let m_lat = 111_132.92 - 559.82 * (2.0 * mid).cos() + 1.175 * (4.0 * mid).cos();
+                let phi = lat.to_radians();
+                let m_lon = 111_412.84 * phi.cos() - 93.5 * (3.0 * phi).cos();
+                (col * self.dx * m_lon, -(lat - lat0) * m_lat)
+            }
+        }
+    }
+
+    /// Approximate sample spacing in metres `(east, north)` at the grid's centre row.
+    pub fn spacing_metres(&self, rows: u32) -> (f64, f64) {
+        let r = 0.5 * rows.saturating_sub(1) as f64;
+        let (e0, s0) = self.local_metres(0.0, r);
+        let (e1, s1) = self.local_metres(1.0, r + 1.0);
+        ((e1 - e0).abs(), (s1 - s0).abs())
+    }
+}
+
+/// A validated elevation grid.
+///
+/// # Guarantees
+/// `width, height ≥ 2`, `width·height ≤ MAX_SAMPLES`, every sample finite or `NaN` (no-data), at
+/// least one finite sample.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Grid {
+    width: u32,
+    height: u32,
+    heights: Vec<f32>,
+    georef: Georef,
+}
+
+/// Check a size claimed by a header before allocating for it.
+pub(crate) fn check_size(source: &str, width: u64, height: u64) -> Result<(), TerrainError> {
+    let bad = |reason| {
+        Err(TerrainError::BadSize {
+            source: source.to_string(),
+            width,
+            height,
+            reason,
+        })
+    };
+    if width < 2 || height < 2 {
+        return bad("need at least 2 x 2 samples to make a triangle");
+    }
+    if width > u32::MAX as u64 / 2
+        || height > u32::MAX as u64 / 2
+        || width.saturating_mul(height) > MAX_SAMPLES
+    {
+        return bad("more than 2^30 samples: split the grid into tiles first");
+    }
+    Ok(())
+}
+
+impl Grid {
+    /// Validate `heights` (row-major, `NaN` = no-data). `source` names the data in errors.
+    ///
+    /// Infinite values are refused (a reader maps its no-data marker to `NaN` before this).
+    pub fn new(
+        source: &str,
+        width: u32,
+        height: u32,
+        heights: Vec<f32>,
+        georef: Georef,
+    ) -> Result<Grid, TerrainError> {
+        check_size(source, width as u64, height as u64)?;
+        if heights.len() as u64 != width as u64 * height as u64 {
+            return Err(crate::error::format_err(
+                source,
+                "sample count",
+                format!(
+                    "{} samples for {width} x {height}, got {}",
+                    width as u64 * height as u64,
+                    heights.len()
+                ),
+            ));
+        }
+        if let Some(i) = heights.iter().position(|h| h.is_infinite()) {
+            return Err(TerrainError::NonFinite {
+                source: source.to_string(),
+                col: (i % width as usize) as u32,
+                row: (i / width as usize) as u32,
+            });
+        }
+        if heights.iter().all(|h| h.is_nan()) {
+            return Err(TerrainError::AllNoData {
+                source: source.to_string(),
+            });
+        }
+        let ok = |v: f64| v.is_finite();
+        if !(ok(georef.origin_x) && ok(georef.origin_y) && ok(georef.dx) && ok(georef.dy))
+            || georef.dx == 0.0
+            || georef.dy == 0.0
+        {
+            return Err(crate::error::format_err(
+                source,
+                "georeference",
+                format!("finite origin and non-zero finite spacing, got {georef:?}"),
+            ));
+        }
+        Ok(Grid {
+            width,
+            height,
+            heights,
+            georef,
+        })
+    }
+
+    /// Like [`Grid::new`], but samples equal to `nodata` (when given) become `NaN` first, and a
+    /// NaN is an error (`NonFinite`) rather than no-data unless the format itself uses NaN for it.
+    pub fn from_samples(
+        source: &str,
+        width: u32,
+        height: u32,
+        mut heights: Vec<f32>,
+        nodata: Option<f64>,
+        nan_is_nodata: bool,
+        georef: Georef,
+    ) -> Result<Grid, TerrainError> {
+        if !nan_is_nodata && let Some(i) = heights.iter().position(|h| h.is_nan()) {
+            return Err(TerrainError::NonFinite {
+                source: source.to_string(),
+                col: (i % width.max(1) as usize) as u32,
+                row: (i / width.max(1) as usize) as u32,
+            });
+        }
+        if let Some(nd) = nodata {
+            let nd32 = nd as f32;
+            for h in &mut heights {
+                if *h == nd32 {
+                    *h = f32::NAN;
+                }
+            }
+        }
+        Grid::new(source, width, height, heights, georef)
+    }
+
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+    /// Row-major heights, `NaN` = no-data.
+    pub fn heights(&self) -> &[f32] {
+        &self.heights
+    }
+    pub fn georef(&self) -> &Georef {
+        &self.georef
+    }
+    /// Height of sample `(col, row)` (`NaN` = no-data). Panics if out of range.
+    pub fn at(&self, col: u32, row: u32) -> f32 {
+        self.heights[row as usize * self.width as usize + col as usize]
+    }
+    /// Number of no-data samples.
+    pub fn nodata_count(&self) -> u64 {
+        self.heights.iter().filter(|h| h.is_nan()).count() as u64
+    }
+    /// Lowest and highest valid height.
+    pub fn height_range(&self) -> (f32, f32) {
+        let mut lo = f32::INFINITY;
+        let mut hi = f32::NEG_INFINITY;
+        for &h in &self.heights {
+            if !h.is_nan() {
+                lo = lo.min(h);
+                hi = hi.max(h);
+            }
+        }
+        (lo, hi)
+    }
+
+    /// Fill no-data samples from their neighbours: repeated passes in which every no-data sample
+    /// with at least one valid 8-neighbour takes their mean, until none is left (a flood from the
+    /// hole's rim inwards; deterministic, since each pass reads only the previous pass's values).
+    pub fn fill_nodata(&mut self) {
+        let (w, h) = (self.width as usize, self.height as usize);
+        let mut todo: Vec<usize> = (0..w * h).filter(|&i| self.heights[i].is_nan()).collect();
+        while !todo.is_empty() {
+            let mut updates = Vec::with_capacity(todo.len());
+            for &i in &todo {
+                let (x, y) = ((i % w) as isize, (i / w) as isize);
+                let (mut sum, mut n) = (0.0f64, 0u32);
+                for dy in -1..=1isize {
+                    for dx in -1..=1isize {
+                        let (nx, ny) = (x + dx, y + dy);
+                        if (dx, dy) != (0, 0)
+                            && nx >= 0
+                            && ny >= 0
+                            && (nx as usize) < w
+                            && (ny as usize) < h
+                        {
+                            let v = self.heights[ny as usize * w + nx as usize];
+                            if !v.is_nan() {
+                                sum += v as f64;
+                                n += 1;
+                            }
+                        }
+                    }
+                }
+                if n > 0 {
+                    updates.push((i, (sum / n as f64) as f32));
+                }
+            }
+            // The grid has a valid sample (guaranteed), so every pass fills at least one.
+            for &(i, v) in &updates {
+                self.heights[i] = v;
+            }
+            todo.retain(|&i| self.heights[i].is_nan());
+        }
+    }
+}
+
+/// The elevation file formats read by [`read_dem`] (chosen by extension).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DemFormat {
+    GeoTiff,
+    EsriAscii,
+    Hgt,
+    /// 16-bit greyscale PNG: `height = scale · value + offset`.
+    Png16,
+    /// Mapbox Terrain-RGB: `height = −10000 + 0.1 · (R·65536 + G·256 + B)`.
+    TerrainRgb,
+}
+
+/// Options for the readers that need outside information.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReadOptions {
+    /// Force a format instead of the extension's.
+    pub format: Option<DemFormat>,
+    /// PNG heightmaps: metres per PNG unit (16-bit PNG), default 1.
+    pub scale: f64,
+    /// PNG heightmaps: height of PNG value 0, default 0.
+    pub offset: f64,
+    /// PNG heightmaps (no georeference): metres between samples, default 1.
+    pub cell: f64,
+}
+
+impl Default for ReadOptions {
+    fn default() -> Self {
+        ReadOptions {
+            format: None,
+            scale: 1.0,
+            offset: 0.0,
+            cell: 1.0,
+        }
+    }
+}
+
+impl DemFormat {
+    /// The format a file name's extension says, if known.
+    pub fn from_path(path: &Path) -> Option<DemFormat> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        match ext.as_str() {
+            "tif" | "tiff" => Some(DemFormat::GeoTiff),
+            "asc" => Some(DemFormat::EsriAscii),
+            "hgt" => Some(DemFormat::Hgt),
+            "png" => Some(DemFormat::Png16),
+            _ => None,
+        }
+    }
+}
+
+/// Read an elevation grid, choosing the reader by `opts.format` or the extension.
+pub fn read_dem(path: impl AsRef<Path>, opts: &ReadOptions) -> Result<Grid, TerrainError> {
+    let path = path.as_ref();
+    let format = opts
+        .format
+        .or_else(|| DemFormat::from_path(path))
+        .ok_or_else(|| TerrainError::Unsupported {
+            source: path.display().to_string(),
+            what: "unknown extension (expected .tif, .tiff, .asc, .hgt or .png)".into(),
+        })?;
+    match format {
+        DemFormat::GeoTiff => geotiff::read_geotiff(path),
+        DemFormat::EsriAscii => asc::read_asc(path),
+        DemFormat::Hgt => hgt::read_hgt(path),
+        DemFormat::Png16 => png::read_png16(path, opts.scale, opts.offset, opts.cell),
+        DemFormat::TerrainRgb => png::read_terrain_rgb(path, opts.cell),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn refuses_degenerate_grids() {
+        let g = Georef::local(1.0);
+        assert!(matches!(
+            Grid::new("t", 1, 1, vec![0.0], g),
+            Err(TerrainError::BadSize { .. })
+        ));
+        assert!(matches!(
+            Grid::new("t", 2, 2, vec![f32::NAN; 4], g),
+            Err(TerrainError::AllNoData { .. })
+        ));
+        assert!(matches!(
+            Grid::from_samples("t", 2, 2, vec![0.0, f32::NAN, 1.0, 2.0], None, false, g),
+            Err(TerrainError::NonFinite { col: 1, row: 0, .. })
+        ));
+        assert!(matches!(
+            Grid::new("t", 2, 2, vec![0.0, f32::INFINITY, 1.0, 2.0], g),
+            Err(TerrainError::NonFinite { .. })
+        ));
+        assert!(matches!(
+            check_size("t", 1 << 20, 1 << 20),
+            Err(TerrainError::BadSize { .. })
+        ));
+    }
+
+    #[test]
+    fn fill_takes_neighbour_means() {
+        let mut g = Grid::from_samples(
+            "t",
+            3,
+            3,
+            vec![1.0, 1.0, 1.0, 1.0, -9999.0, 1.0, 1.0, 1.0, 1.0],
+            Some(-9999.0),
+            false,
+            Georef::local(1.0),
+        )
+        .unwrap();
+        assert_eq!(g.nodata_count(), 1);
+        g.fill_nodata();
+        assert_eq!(g.at(1, 1), 1.0);
+    }
+
+    #[test]
+    fn geographic_spacing_shrinks_with_latitude() {
+        // One arc-second: ~30.87 m north-south; east-west 30.92·cos φ.
+        let g = |lat: f64| Georef {
+            crs: CrsKind::Geographic,
+            epsg: Some(4326),
+            origin_x: 138.0,
+            origin_y: lat,
+            dx: 1.0 / 3600.0,
+            dy: -1.0 / 3600.0,
+        };
+        let (e0, n0) = g(0.0).spacing_metres(1);
+        let (e60, _) = g(60.0).spacing_metres(1);
+        assert!((n0 - 30.715).abs() < 0.05, "{n0}");
+        assert!((e0 - 30.92).abs() < 0.05, "{e0}");
+        assert!((e60 / e0 - 0.5).abs() < 0.003, "{}", e60 / e0);
+    }
+}

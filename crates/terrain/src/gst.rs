@@ -1,0 +1,437 @@
+//! Geospecific texture (GST, Seed 000): an orthophoto placed over the elevation grid, cut into a
+//! pyramid of square maps, and the residency of those maps decided by Seed 000 Eq. (5)–(7).
+//!
+//! **Placement.** The texture spans the DEM's extent from the centre of sample (0, 0) (`u, v = 0`)
+//! to that of the last sample (`u, v = 1`), the same `[0, 1]²` the chunk vertices' texture
+//! coordinates use. A photo with a georeference (a GeoTIFF, assumed in the DEM's coordinate system)
+//! is sampled where it lies; texels outside it are transparent (alpha 0) and no overlap at all is an
+//! error. A photo without one (PNG, JPEG, a plain TIFF) is stretched over the extent.
+//! Multispectral GeoTIFFs choose three bands (`--bands 3,2,1`); samples wider than 8 bits are
+//! stretched linearly from each band's minimum to its maximum.
+//!
+//! **Pyramid.** Level `L` is `T·2^L` texels a side (`T` texels per map, 256 by default) and holds
+//! `2^L x 2^L` maps of `T x T`; the finest level is resampled bilinearly from the photo and each
+//! coarser one is the 2x2 box average of the next (in 8-bit sRGB, as the tiles are stored).
+//!
+//! **Residency** ([`needed_maps`], [`GstCache`]). Seed 000 Eq. (7) bounds the level a ground point
+//! at distance `x_a` can need; level `L` is needed within `radius_in_own_maps` of its own maps
+//! around the eye ([`texmap_core::coverage::ActiveArea`]), i.e. a block of `2⌈r⌉ x 2⌈r⌉` maps per
+//! level — 36 per level and 324 for levels 0..=8 in the paper's worked example (ψ = 45°, 1024
+//! pixels, 256² maps). The cache keeps those maps resident under a byte budget, evicting the least
+//! recently used ones first, and counts hits, loads and evictions for the flight view to report.
+
+use crate::dem::{Georef, Grid};
+use crate::error::{TerrainError, format_err, io};
+use image::{Rgba, RgbaImage};
+use std::collections::HashMap;
+use std::path::Path;
+use texmap_core::coverage::ActiveArea;
+
+/// An orthophoto in 8-bit RGBA with its georeference, if it has one.
+#[derive(Clone, Debug)]
+pub struct Orthophoto {
+    pub image: RgbaImage,
+    pub georef: Option<Georef>,
+    pub source: String,
+}
+
+/// Read an orthophoto: PNG or JPEG through `image`, TIFF through the GeoTIFF reader with `bands`
+/// (1-based, default 1,2,3 or band 1 as grey).
+pub fn read_photo(path: &Path, bands: Option<[u16; 3]>) -> Result<Orthophoto, TerrainError> {
+    let source = path.display().to_string();
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(|e| e.to_ascii_lowercase())
+        .unwrap_or_default();
+    if ext == "tif" || ext == "tiff" {
+        let band_count = crate::dem::geotiff::band_count(path)?;
+        let pick: Vec<u16> = match bands {
+            Some(b) => {
+                if b.contains(&0) {
+                    return Err(TerrainError::BadParameter {
+                        name: "bands",
+                        value: format!("{b:?}"),
+                        expected: "1-based band numbers",
+                    });
+                }
+                b.iter().map(|x| x - 1).collect()
+            }
+            None if band_count >= 3 => vec![0, 1, 2],
+            None => vec![0, 0, 0],
+        };
+        let r = crate::dem::geotiff::read_raster(path, Some(&pick), 1 << 28)?;
+        let n = r.width as usize * r.height as usize;
+        let scale: Vec<(f32, f32)> = r
+            .bands
+            .iter()
+            .map(|b| {
+                if r.bits <= 8 {
+                    (0.0, 1.0)
+                } else {
+                    let lo = b.iter().copied().fold(f32::INFINITY, f32::min);
+                    let hi = b.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+                    (lo, if hi > lo { 255.0 / (hi - lo) } else { 0.0 })
+                }
+            })
+            .collect();
+        let mut img = RgbaImage::new(r.width, r.height);
+        for i in 0..n {
+            let c = |k: usize| {
+                ((r.bands[k][i] - scale[k].0) * scale[k].1)
+                    .round()
+                    .clamp(0.0, 255.0) as u8
+            };
+            img.put_pixel(
+                (i % r.width as usize) as u32,
+                (i / r.width as usize) as u32,
+                Rgba([c(0), c(1), c(2), 255]),
+            );
+        }
+        return Ok(Orthophoto {
+            image: img,
+            georef: r.georef,
+            source,
+        });
+    }
+    let img = image::ImageReader::open(path)
+        .map_err(io(path))?
+        .with_guessed_format()
+        .map_err(io(path))?
+        .decode()
+        .map_err(|e| format_err(&source, "image data", format!("a PNG or JPEG ({e})")))?;
+    Ok(Orthophoto {
+        image: img.to_rgba8(),
+        georef: None,
+        source,
+    })
+}
+
+/// A map of the pyramid: level, column, row.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct MapKey {
+    pub level: u32,
+    pub x: u32,
+    pub y: u32,
+}
+
+/// A GST pyramid: `levels[L]` is `T·2^L` texels a side.
+#[derive(Clone, Debug)]
+pub struct Pyramid {
+    pub map_texels: u32,
+    pub levels: Vec<RgbaImage>,
+}
+
+fn bilinear(img: &RgbaImage, x: f64, y: f64) -> [f64; 4] {
+    let (w, h) = (img.width() as i64, img.height() as i64);
+    let (fx, fy) = (x - 0.5, y - 0.5);
+    let (x0, y0) = (fx.floor(), fy.floor());
+    let (ax, ay) = (fx - x0, fy - y0);
+    let px = |i: i64, j: i64| {
+        img.get_pixel(i.clamp(0, w - 1) as u32, j.clamp(0, h - 1) as u32)
+            .0
+            .map(|c| c as f64)
+    };
+    let (x0, y0) = (x0 as i64, y0 as i64);
+    let (a, b, c, d) = (
+        px(x0, y0),
+        px(x0 + 1, y0),
+        px(x0, y0 + 1),
+        px(x0 + 1, y0 + 1),
+    );
+    std::array::from_fn(|k| {
+        (a[k] * (1.0 - ax) + b[k] * ax) * (1.0 - ay) + (c[k] * (1.0 - ax) + d[k] * ax) * ay
+    })
+}
+
+/// Resample `photo` over the grid's extent into a `size x size` texture (see the module docs).
+pub fn place(photo: &Orthophoto, grid: &Grid, size: u32) -> Result<RgbaImage, TerrainError> {
+    let (pw, ph) = (photo.image.width() as f64, photo.image.height() as f64);
+    let g = grid.georef();
+    let (gw, gh) = ((grid.width() - 1) as f64, (grid.height() - 1) as f64);
+    // Photo pixel position (continuous, pixel corners at integers) of texture coordinates (u, v).
+    let to_photo = |u: f64, v: f64| -> (f64, f64) {
+        match &photo.georef {
+            Some(pg) => {
+                let (x, y) = g.sample_xy(u * gw, v * gh);
+                let (c, r) = pg.xy_to_sample(x, y);
+                (c + 0.5, r + 0.5)
+            }
+            None => (u * pw, v * ph),
+        }
+    };
+    if photo.georef.is_some() {
+        // Overlap test on the extents (corners of the grid's sample-centre rectangle).
+        let corners = [to_photo(0.0, 0.0), to_photo(1.0, 1.0)];
+        let (cmin, cmax) = (
+            corners[0].0.min(corners[1].0),
+            corners[0].0.max(corners[1].0),
+        );
+        let (rmin, rmax) = (
+            corners[0].1.min(corners[1].1),
+            corners[0].1.max(corners[1].1),
+        );
+        if cmax <= 0.0 || rmax <= 0.0 || cmin >= pw || rmin >= ph {
+            return Err(TerrainError::NoOverlap {
+                photo: photo.source.clone(),
+                dem: "the elevation grid".into(),
+            });
+        }
+    }
+    let mut out = RgbaImage::new(size, size);
+    let inv = 1.0 / (size - 1).max(1) as f64;
+    for ty in 0..size {
+        for tx in 0..size {
+            let (x, y) = to_photo(tx as f64 * inv, ty as f64 * inv);
+            let inside = x >= 0.0 && y >= 0.0 && x <= pw && y <= ph;
+            let p = if inside {
+                let c = bilinear(&photo.image, x, y);
+                Rgba([
+                    c[0].round() as u8,
+                    c[1].round() as u8,
+                    c[2].round() as u8,
+                    c[3].round() as u8,
+                ])
+            } else {
+                Rgba([0, 0, 0, 0])
+            };
+            out.put_pixel(tx, ty, p);
+        }
+    }
+    Ok(out)
+}
+
+/// Build the pyramid from the finest level's texture (`T·2^L` a side) by 2x2 box averages.
+pub fn pyramid(finest: RgbaImage, map_texels: u32) -> Pyramid {
+    let mut levels = vec![finest];
+    while levels.last().is_some_and(|l| l.width() > map_texels) {
+        let src = levels.last().expect("non-empty");
+        let n = src.width() / 2;
+        let down = RgbaImage::from_fn(n, n, |x, y| {
+            let mut s = [0u32; 4];
+            for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                let p = src.get_pixel(2 * x + dx, 2 * y + dy).0;
+                for k in 0..4 {
+                    s[k] += p[k] as u32;
+                }
+            }
+            Rgba(s.map(|v| ((v + 2) / 4) as u8))
+        });
+        levels.push(down);
+    }
+    levels.reverse();
+    Pyramid { map_texels, levels }
+}
+
+/// The level count for a grid: the finest level has at least one texel per grid sample, capped
+/// at `max_levels`.
+pub fn level_count(grid: &Grid, map_texels: u32, max_levels: u32) -> u32 {
+    let need = grid.width().max(grid.height()) as f64 / map_texels as f64;
+    let l = need.log2().ceil().max(0.0) as u32;
+    (l + 1).min(max_levels.max(1))
+}
+
+impl Pyramid {
+    /// The map `key` (a `T x T` crop), if it exists.
+    pub fn map(&self, key: MapKey) -> Option<RgbaImage> {
+        let img = self.levels.get(key.level as usize)?;
+        let t = self.map_texels;
+        let n = 1u32 << key.level;
+        (key.x < n && key.y < n)
+            .then(|| image::imageops::crop_imm(img, key.x * t, key.y * t, t, t).to_image())
+    }
+}
+
+/// Per-level map counts of Seed 000's active area (Eq. 5–7) for levels `0..levels`.
+pub fn map_budget(
+    hfov_deg: f64,
+    pixels: u32,
+    map_texels: u32,
+    levels: u32,
+) -> Result<Vec<(u32, u64)>, TerrainError> {
+    let area =
+        ActiveArea::new(hfov_deg, pixels, map_texels).map_err(|e| TerrainError::BadParameter {
+            name: "active area",
+            value: e.to_string(),
+            expected: "0° < fov < 180°, pixels > 0, map texels > 0",
+        })?;
+    Ok((0..levels).map(|l| (l, area.maps_per_level())).collect())
+}
+
+/// The maps Seed 000's active area needs around the eye at texture position `(eye_u, eye_v)`
+/// (level-0 map widths, i.e. `[0, 1]²` over the DEM) for levels `0..levels`: per level the
+/// `2⌈r⌉ x 2⌈r⌉` block of maps centred on the map corner nearest the eye, clipped to the pyramid.
+pub fn needed_maps(area: &ActiveArea, eye_u: f64, eye_v: f64, levels: u32) -> Vec<MapKey> {
+    let r = area.radius_in_own_maps().ceil() as i64;
+    let mut out = Vec::new();
+    for level in 0..levels {
+        let n = 1i64 << level;
+        let (cx, cy) = (
+            (eye_u * n as f64).round() as i64,
+            (eye_v * n as f64).round() as i64,
+        );
+        for y in (cy - r).max(0)..(cy + r).min(n) {
+            for x in (cx - r).max(0)..(cx + r).min(n) {
+                out.push(MapKey {
+                    level,
+                    x: x as u32,
+                    y: y as u32,
+                });
+            }
+        }
+    }
+    out
+}
+
+/// Counters of a [`GstCache`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct CacheStats {
+    pub hits: u64,
+    pub loads: u64,
+    pub evictions: u64,
+    pub resident: u64,
+    pub resident_bytes: u64,
+}
+
+/// A residency cache of GST maps under a byte budget, least-recently-used eviction.
+pub struct GstCache {
+    budget: u64,
+    tick: u64,
+    maps: HashMap<MapKey, (RgbaImage, u64)>,
+    stats: CacheStats,
+}
+
+impl GstCache {
+    /// A cache holding at most `budget_bytes` of map texels (4 bytes per texel).
+    pub fn new(budget_bytes: u64) -> GstCache {
+        GstCache {
+            budget: budget_bytes,
+            tick: 0,
+            maps: HashMap::new(),
+            stats: CacheStats::default(),
+        }
+    }
+
+    pub fn stats(&self) -> CacheStats {
+        self.stats
+    }
+
+    pub fn contains(&self, key: MapKey) -> bool {
+        self.maps.contains_key(&key)
+    }
+
+    /// The map `key`, loading it with `load` on a miss and evicting least-recently-used maps to
+    /// stay within the budget. A map larger than the whole budget is returned but not kept.
+    pub fn get(
+        &mut self,
+        key: MapKey,
+        load: impl FnOnce(MapKey) -> Result<RgbaImage, TerrainError>,
+    ) -> Result<&RgbaImage, TerrainError> {
+        self.tick += 1;
+        let tick = self.tick;
+        if self.maps.contains_key(&key) {
+            self.stats.hits += 1;
+            let e = self.maps.get_mut(&key).expect("checked");
+            e.1 = tick;
+            return Ok(&e.0);
+        }
+        let img = load(key)?;
+        self.stats.loads += 1;
+        let bytes = img.as_raw().len() as u64;
+        while self.stats.resident_bytes + bytes > self.budget && !self.maps.is_empty() {
+            // Least recently used; ties broken by key so the order is deterministic.
+            let victim = *self
+                .maps
+                .iter()
+                .min_by_key(|(k, v)| (v.1, **k))
+                .expect("non-empty")
+                .0;
+            let (old, _) = self.maps.remove(&victim).expect("present");
+            self.stats.resident_bytes -= old.as_raw().len() as u64;
+            self.stats.evictions += 1;
+        }
+        self.stats.resident_bytes += bytes;
+        self.maps.insert(key, (img, tick));
+        self.stats.resident = self.maps.len() as u64;
+        Ok(&self.maps[&key].0)
+    }
+
+    /// Make every map of `keys` resident (in order), returning how many had to be loaded.
+    pub fn make_resident(
+        &mut self,
+        keys: &[MapKey],
+        mut load: impl FnMut(MapKey) -> Result<RgbaImage, TerrainError>,
+    ) -> Result<u64, TerrainError> {
+        let before = self.stats.loads;
+        for &k in keys {
+            self.get(k, &mut load)?;
+        }
+        self.stats.resident = self.maps.len() as u64;
+        Ok(self.stats.loads - before)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn seed000_worked_example_324_maps() {
+        let b = map_budget(45.0, 1024, 256, 9).unwrap();
+        assert!(b.iter().all(|&(_, n)| n == 36));
+        assert_eq!(b.iter().map(|x| x.1).sum::<u64>(), 324);
+        // Away from the pyramid's edges the active area is the full 6x6 block per level.
+        let area = ActiveArea::new(45.0, 1024, 256).unwrap();
+        let keys = needed_maps(&area, 0.5, 0.5, 9);
+        let per: Vec<usize> = (0..9)
+            .map(|l| keys.iter().filter(|k| k.level == l).count())
+            .collect();
+        assert_eq!(per[3..], [36; 6]);
+        assert_eq!(per[0], 1); // level 0 has one map
+    }
+
+    #[test]
+    fn cache_budget_and_counters() {
+        let mut c = GstCache::new(3 * 4 * 16); // three 4x4 maps
+        let load = |_k: MapKey| Ok(RgbaImage::new(4, 4));
+        let k = |x| MapKey { level: 2, x, y: 0 };
+        for x in [0, 1, 2, 0, 3, 1] {
+            c.get(k(x), load).unwrap();
+        }
+        // loads 0,1,2 ; hit 0 ; load 3 evicts 1 (LRU) ; load 1 evicts 2.
+        let s = c.stats();
+        assert_eq!((s.hits, s.loads, s.evictions, s.resident), (1, 5, 2, 3));
+        assert!(c.contains(k(0)) && c.contains(k(3)) && c.contains(k(1)) && !c.contains(k(2)));
+    }
+
+    #[test]
+    fn pyramid_levels_are_box_averages() {
+        let fine = RgbaImage::from_fn(8, 8, |x, _| {
+            Rgba([if x % 2 == 0 { 100 } else { 200 }, 0, 0, 255])
+        });
+        let p = pyramid(fine, 2);
+        assert_eq!(
+            p.levels.iter().map(|l| l.width()).collect::<Vec<_>>(),
+            vec![2, 4, 8]
+        );
+        assert_eq!(p.levels[1].get_pixel(0, 0).0, [150, 0, 0, 255]);
+        assert_eq!(
+            p.map(MapKey {
+                level: 2,
+                x: 3,
+                y: 3
+            })
+            .unwrap()
+            .dimensions(),
+            (2, 2)
+        );
+        assert!(
+            p.map(MapKey {
+                level: 1,
+                x: 2,
+                y: 0
+            })
+            .is_none()
+        );
+    }
+}

@@ -1,0 +1,110 @@
+//! The database: build from a GDAL-written GeoTIFF with a georeferenced photo, reopen, export.
+
+use std::path::PathBuf;
+use texmap_terrain::db::{self, BuildOptions, Database};
+use texmap_terrain::dem::{ReadOptions, read_dem};
+use texmap_terrain::gst;
+
+fn data(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(name)
+}
+
+#[test]
+fn build_reopen_export_glb() {
+    let grid = read_dem(data("ramp_i16_lzw.tif"), &ReadOptions::default()).unwrap();
+    let photo = gst::read_photo(&data("photo_rgb.tif"), None).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("db");
+    let opts = BuildOptions {
+        max_error: 0.5,
+        chunk: 17,
+        map_texels: 16,
+        max_texture_levels: 3,
+    };
+    let mut calls = 0;
+    let m = db::build(&grid, "ramp", Some(&photo), &opts, &out, |_, _| calls += 1).unwrap();
+    assert!(calls >= 3);
+    assert_eq!(m.nodata, 1);
+    assert_eq!(m.texture.as_ref().unwrap().placed_by, "georeference");
+    // 37 x 29 pads to 65²: chunks of 16 cells -> depths 0..=2.
+    assert_eq!(m.levels.len(), 3);
+    // A second build to the same place is refused, and leaves no temporary behind.
+    assert!(matches!(
+        db::build(&grid, "ramp", None, &opts, &out, |_, _| {}),
+        Err(texmap_terrain::TerrainError::Exists { .. })
+    ));
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+
+    let d = Database::open(&out).unwrap();
+    let g2 = d.grid().unwrap();
+    assert_eq!(g2.georef(), grid.georef());
+    // The photo covers columns 18..=36 (x from 500540 m): the texture is opaque only there.
+    let tex = d.texture(4096).unwrap().unwrap();
+    let w = tex.width();
+    let u_of_col = |c: f64| c / 36.0;
+    let tx = |c: f64| (u_of_col(c) * (w - 1) as f64).round() as u32;
+    assert_eq!(
+        tex.get_pixel(tx(5.0), w / 2)[3],
+        0,
+        "west of the photo: transparent"
+    );
+    let p = tex.get_pixel(tx(30.0), w / 2);
+    assert_eq!(p[3], 255);
+    assert_eq!(p[2], 77, "band 3 is 77 everywhere");
+
+    // Export: a plane's ramp meshes to few triangles; bounds are the grid's extent in metres.
+    let mesh = db::whole_mesh(&g2, 0.5).unwrap();
+    let glb = dir.path().join("t.glb");
+    texmap_mesh::write_glb(&glb, &mesh, Some(&tex)).unwrap();
+    let back = texmap_mesh::read_gltf(&glb).unwrap();
+    assert_eq!(back[0].positions.len(), mesh.positions.len());
+    let (lo, hi) = back[0].bounds().unwrap();
+    assert_eq!((lo.x, hi.x), (0.0, 36.0 * 30.0));
+    assert_eq!((lo.z, hi.z), (0.0, 28.0 * 30.0));
+    assert_eq!((lo.y, hi.y), (100.0, 100.0 + 72.0 + 84.0));
+    let (_, _, images) = gltf::import(&glb).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(images[0].width, w);
+
+    // The greedy export refuses no-data, and meshes the filled plane with two triangles.
+    assert!(db::whole_mesh_greedy(&g2, 0.5).is_err());
+    let mut filled = g2.clone();
+    filled.fill_nodata();
+    let m = db::whole_mesh_greedy(&filled, 0.5).unwrap();
+    assert!(m.triangles.len() <= 8, "{}", m.triangles.len());
+    let obj = dir.path().join("g.obj");
+    texmap_mesh::write_obj(&obj, &m, None).unwrap();
+    assert_eq!(
+        texmap_mesh::read_obj(&obj).unwrap()[0].triangles.len(),
+        m.triangles.len()
+    );
+}
+
+#[test]
+fn photo_outside_the_grid_is_an_error() {
+    let grid = read_dem(data("ramp_f32_geo.tif"), &ReadOptions::default()).unwrap();
+    // The UTM photo's coordinates are nowhere near 138° E 36° N in degrees.
+    let photo = gst::read_photo(&data("photo_rgb.tif"), None).unwrap();
+    let e = gst::place(&photo, &grid, 16).unwrap_err();
+    assert!(e.to_string().contains("does not overlap"), "{e}");
+}
+
+#[test]
+fn a_failed_build_leaves_nothing_behind() {
+    // The photo does not overlap: the build fails after the chunks are written, and neither the
+    // database nor its temporary directory remains.
+    let grid = read_dem(data("ramp_f32_geo.tif"), &ReadOptions::default()).unwrap();
+    let photo = gst::read_photo(&data("photo_rgb.tif"), None).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("db");
+    let opts = BuildOptions {
+        max_error: 0.5,
+        chunk: 17,
+        map_texels: 16,
+        max_texture_levels: 2,
+    };
+    let e = db::build(&grid, "geo", Some(&photo), &opts, &out, |_, _| {}).unwrap_err();
+    assert!(e.to_string().contains("does not overlap"), "{e}");
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+}

@@ -1,0 +1,136 @@
+//! The readers against files written by GDAL (tests/data/generate.sh), checked against the
+//! analytic heights and against GDAL's own reading of each georeference (gdalinfo -json).
+
+use std::path::PathBuf;
+use texmap_terrain::dem::{CrsKind, ReadOptions, geotiff, read_dem};
+
+fn data(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(name)
+}
+
+/// GDAL's geoTransform: [x of pixel (0,0)'s corner, pixel width, 0, y of the corner, 0, −height].
+fn gdal_transform(name: &str) -> Vec<f64> {
+    let text = std::fs::read_to_string(data(&format!("{name}.gdalinfo.json"))).unwrap();
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    v["geoTransform"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect()
+}
+
+fn expected(col: u32, row: u32) -> f32 {
+    100.0 + 2.0 * col as f32 + 3.0 * row as f32
+}
+
+#[test]
+fn every_geotiff_layout_reads_the_ramp_and_gdals_georeference() {
+    for (name, crs) in [
+        ("ramp_i16_lzw", CrsKind::Projected),
+        ("ramp_u16_tiled_bigtiff", CrsKind::Projected),
+        ("ramp_i32_point", CrsKind::Projected),
+        ("ramp_f32_geo", CrsKind::Geographic),
+        ("ramp_f64", CrsKind::Projected),
+    ] {
+        let g = read_dem(data(&format!("{name}.tif")), &ReadOptions::default()).unwrap();
+        assert_eq!((g.width(), g.height()), (37, 29), "{name}");
+        for row in 0..29 {
+            for col in 0..37 {
+                let h = g.at(col, row);
+                if (col, row) == (5, 3) {
+                    // GDAL records the no-data value of every file (gdalinfo's noDataValue).
+                    assert!(h.is_nan(), "{name}: no-data at (5, 3) read as {h}");
+                } else {
+                    assert_eq!(h, expected(col, row), "{name} at ({col}, {row})");
+                }
+            }
+        }
+        // Sample centres: GDAL's corner plus half a pixel, whatever the raster type.
+        let t = gdal_transform(name);
+        let r = g.georef();
+        assert_eq!(r.crs, crs, "{name}");
+        let tol = 1e-9 * t[0].abs().max(1.0);
+        assert!(
+            (r.origin_x - (t[0] + 0.5 * t[1])).abs() < tol,
+            "{name}: x {} vs GDAL {}",
+            r.origin_x,
+            t[0] + 0.5 * t[1]
+        );
+        assert!(
+            (r.origin_y - (t[3] + 0.5 * t[5])).abs() < tol,
+            "{name}: y {} vs GDAL {}",
+            r.origin_y,
+            t[3] + 0.5 * t[5]
+        );
+        assert!(
+            (r.dx - t[1]).abs() < 1e-12 && (r.dy - t[5]).abs() < 1e-12,
+            "{name}"
+        );
+    }
+}
+
+#[test]
+fn tiles_load_under_a_decode_limit_smaller_than_the_image() {
+    // 37 x 29 x 2 bytes = 2146 bytes whole; each 16x16 tile is 512 bytes. (`tiff` also bounds tag
+    // value lists by this limit, so it cannot be much smaller than the image here.)
+    // The tiff crate's whole-image decode refuses the file under this limit...
+    let f = std::fs::File::open(data("ramp_u16_tiled_bigtiff.tif")).unwrap();
+    let mut limits = tiff::decoder::Limits::default();
+    limits.decoding_buffer_size = 2000;
+    let mut dec = tiff::decoder::Decoder::new(f).unwrap().with_limits(limits);
+    assert!(
+        dec.read_image().is_err(),
+        "the limit must be below the whole image"
+    );
+    // ...while the chunk-by-chunk reader loads it.
+    let g = geotiff::read_geotiff_limited(&data("ramp_u16_tiled_bigtiff.tif"), 2000).unwrap();
+    assert_eq!(g.at(36, 28), expected(36, 28));
+}
+
+#[test]
+fn gdal_ascii_grid_matches_the_geotiff() {
+    let a = read_dem(data("ramp_gdal.asc"), &ReadOptions::default()).unwrap();
+    let t = read_dem(data("ramp_i16_lzw.tif"), &ReadOptions::default()).unwrap();
+    assert_eq!(a.width(), t.width());
+    assert_eq!(a.georef().origin_x, t.georef().origin_x);
+    assert_eq!(a.georef().origin_y, t.georef().origin_y);
+    assert_eq!(a.nodata_count(), 1);
+    for (x, y) in a.heights().iter().zip(t.heights()) {
+        assert!(x == y || (x.is_nan() && y.is_nan()));
+    }
+}
+
+#[test]
+fn multiband_planar_photo_picks_bands() {
+    let r = geotiff::read_raster(&data("photo_4band.tif"), Some(&[1, 3]), 1 << 20).unwrap();
+    assert_eq!(r.band_count, 4);
+    assert_eq!(r.bands.len(), 2);
+    // band 2 (index 1) = (8·row) mod 256, band 4 = band 1 = (12·col) mod 256.
+    let i = |c: u32, row: u32| (row * r.width + c) as usize;
+    assert_eq!(r.bands[0][i(3, 7)], 56.0);
+    assert_eq!(r.bands[1][i(3, 7)], 36.0);
+    let e = geotiff::read_raster(&data("photo_4band.tif"), Some(&[4]), 1 << 20).unwrap_err();
+    assert!(e.to_string().contains("band = 5"), "{e}");
+}
+
+#[test]
+fn missing_and_garbage_files_are_errors_naming_the_file() {
+    let e = read_dem(data("nope.tif"), &ReadOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("nope.tif"), "{e}");
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("junk.tif");
+    std::fs::write(&p, b"II*\0garbage").unwrap();
+    let e = read_dem(&p, &ReadOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("junk.tif"), "{e}");
+    let p = dir.path().join("x.xyz");
+    std::fs::write(&p, b"1").unwrap();
+    assert!(
+        read_dem(&p, &ReadOptions::default())
+            .unwrap_err()
+            .to_string()
+            .contains("unknown extension")
+    );
+}
