@@ -116,6 +116,14 @@ pub enum Error {
     },
     /// A value given to a constructor is out of its domain (e.g. a cell angle of 200°).
     InvalidValue { what: String },
+    /// A topology applied to a trajectory frame with another number of atoms.
+    TopologyMismatch {
+        topology: Arc<str>,
+        topology_atoms: usize,
+        trajectory: Arc<str>,
+        frame: usize,
+        frame_atoms: usize,
+    },
 }
 
 impl Error {
@@ -170,6 +178,16 @@ impl fmt::Display for Error {
                 write!(f, "{file}: frame {frame} cannot be written: {what}")
             }
             Error::InvalidValue { what } => write!(f, "invalid value: {what}"),
+            Error::TopologyMismatch {
+                topology,
+                topology_atoms,
+                trajectory,
+                frame,
+                frame_atoms,
+            } => write!(
+                f,
+                "{trajectory}: frame {frame} has {frame_atoms} atoms but the topology {topology} has {topology_atoms}: they must describe the same atoms in the same order"
+            ),
         }
     }
 }

@@ -20,11 +20,13 @@ pub enum Format {
     Xtc,
     /// GROMACS TRR: `.trr`.
     Trr,
+    /// AMBER NetCDF trajectory (NetCDF-3, classic or 64-bit offset): `.nc`, `.ncdf`.
+    Netcdf,
 }
 
 impl Format {
     /// Every format, in declaration order.
-    pub const ALL: [Format; 7] = [
+    pub const ALL: [Format; 8] = [
         Format::Xyz,
         Format::Pdb,
         Format::Gro,
@@ -32,6 +34,7 @@ impl Format {
         Format::Dcd,
         Format::Xtc,
         Format::Trr,
+        Format::Netcdf,
     ];
 
     /// The format a file extension names (case-insensitive), e.g. "xyz", "lammpstrj".
@@ -45,6 +48,7 @@ impl Format {
             "dcd" => Format::Dcd,
             "xtc" => Format::Xtc,
             "trr" => Format::Trr,
+            "nc" | "ncdf" => Format::Netcdf,
             _ => return None,
         })
     }
@@ -70,6 +74,10 @@ impl Format {
         // DCD: a Fortran record of 84 bytes (either endianness) starting with "CORD".
         if (le(0) == Some(84) || be(0) == Some(84)) && head.get(4..8) == Some(b"CORD") {
             return Some(Format::Dcd);
+        }
+        // NetCDF-3: "CDF" and the version byte 1 (classic) or 2 (64-bit offset).
+        if matches!(head.get(..4), Some(b"CDF\x01" | b"CDF\x02")) {
+            return Some(Format::Netcdf);
         }
         // XTC and TRR: big-endian magic numbers 1995 and 1993.
         match be(0) {
@@ -121,6 +129,7 @@ impl Format {
             Format::Dcd => "dcd",
             Format::Xtc => "xtc",
             Format::Trr => "trr",
+            Format::Netcdf => "ncdf",
         }
     }
 }
@@ -177,6 +186,10 @@ mod tests {
         assert_eq!(
             Format::from_magic(b"Water\n   3\n    1SOL"),
             Some(Format::Gro)
+        );
+        assert_eq!(
+            Format::from_magic(b"CDF\x02\0\0\0\x04"),
+            Some(Format::Netcdf)
         );
         assert_eq!(Format::from_magic(b"hello\nworld\n"), None);
     }

@@ -2,7 +2,11 @@
 //! file formats, streaming frames, and element tables (radius, colour).
 //!
 //! - [`Trajectory`] reads XYZ / extended XYZ, PDB, GRO and LAMMPS text dumps (and the binary
-//!   DCD, XTC, TRR) one frame at a time into a reusable [`Frame`], or any frame by index.
+//!   DCD, XTC, TRR and AMBER NetCDF) one frame at a time into a reusable [`Frame`], or any frame by index.
+//! - [`Topology`] reads atom names, elements, residues and bonds (PDB, GRO, LAMMPS data file)
+//!   and gives them to the frames of a coordinate-only trajectory of the same atoms.
+//! - [`bonds`] finds bonds by distance (covalent radii, a cell grid, minimum image) and [`pbc`]
+//!   wraps atoms into the box or makes bonded molecules whole across it.
 //! - [`Writer`] writes XYZ and PDB.
 //! - [`elements`] maps atom names to elements, gives van der Waals radii and CPK colours, and
 //!   [`AtomStyle`] resolves each atom's radius and colour with user overrides.
@@ -62,6 +66,7 @@
 //! Text formats instead implement the private `TextFormat` trait (src/text.rs) and get
 //! streaming, the line-scan index and error positions from `TextReader`.
 
+pub mod bonds;
 mod cursor;
 mod dcd;
 pub mod elements;
@@ -70,10 +75,13 @@ mod format;
 mod frame;
 mod gro;
 mod lammps;
+mod netcdf;
 pub mod parse;
+pub mod pbc;
 mod pdb;
 pub mod select;
 mod text;
+mod topology;
 mod trajectory;
 mod trr;
 mod writer;
@@ -85,6 +93,7 @@ pub use error::{Error, Location};
 pub use format::Format;
 pub use frame::{Frame, Label, MAX_COORDINATE, UnitCell};
 pub use select::{Selection, SelectionError};
+pub use topology::{Topology, TopologyFormat};
 pub use trajectory::{ReadOptions, Trajectory};
 pub use writer::Writer;
 

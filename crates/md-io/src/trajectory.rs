@@ -6,6 +6,7 @@ use crate::format::Format;
 use crate::frame::Frame;
 use crate::gro::Gro;
 use crate::lammps::Lammps;
+use crate::netcdf::NetcdfReader;
 use crate::pdb::Pdb;
 use crate::text::TextReader;
 use crate::trr::TrrReader;
@@ -22,6 +23,7 @@ enum Reader<R> {
     Dcd(DcdReader<R>),
     Xtc(XtcReader<R>),
     Trr(TrrReader<R>),
+    Netcdf(NetcdfReader<R>),
     Pdb(TextReader<R, Pdb>),
     Gro(TextReader<R, Gro>),
     Lammps(TextReader<R, Lammps>),
@@ -35,6 +37,7 @@ macro_rules! each_reader {
             Reader::Dcd($r) => $body,
             Reader::Xtc($r) => $body,
             Reader::Trr($r) => $body,
+            Reader::Netcdf($r) => $body,
             Reader::Pdb($r) => $body,
             Reader::Gro($r) => $body,
             Reader::Lammps($r) => $body,
@@ -187,6 +190,7 @@ impl<R: Read + Seek> Trajectory<R> {
             Format::Dcd => Reader::Dcd(DcdReader::new(src, file.clone())?),
             Format::Xtc => Reader::Xtc(XtcReader::new(src, file.clone())?),
             Format::Trr => Reader::Trr(TrrReader::new(src, file.clone())?),
+            Format::Netcdf => Reader::Netcdf(NetcdfReader::new(src, file.clone())?),
             Format::Pdb => Reader::Pdb(TextReader::new(src, Pdb::new(lenient), file.clone())),
             Format::Gro => Reader::Gro(TextReader::new(src, Gro, file.clone())),
             Format::LammpsDump => {

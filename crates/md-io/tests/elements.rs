@@ -42,5 +42,12 @@ fn table_matches_ase_alvarez_radii_and_jmol_colours() {
             .map(|c| c.as_u64().unwrap() as u8)
             .collect();
         assert_eq!(e.color_srgb8().to_vec(), rgb, "{}", e.symbol());
+        let cordero = row["cordero"].as_f64().unwrap();
+        let got = e.covalent_radius() as f64;
+        assert!(
+            (cordero - got).abs() <= 1e-6,
+            "{} covalent: expected {cordero}, actual {got}",
+            e.symbol()
+        );
     }
 }

@@ -329,6 +329,111 @@ fn trr_fixture(name: &str, bytes: Vec<u8>) -> Fixture {
     }
 }
 
+/// AMBER NetCDF (CDF-1 or CDF-2): the header walked here (names, attribute values, variable
+/// entries); every list and variable entry start, the header end and each record variable's
+/// slice of every record as boundaries; numrecs, the dimension lengths, every variable's type,
+/// size and begin, and frame 0's first coordinate as fields.
+fn netcdf_fixture(name: &str, bytes: Vec<u8>) -> Fixture {
+    let offset64 = bytes[3] == 2;
+    let mut p = 8;
+    let mut boundaries = vec![0, 4, 8];
+    let mut fields = vec![("magic", Field::I32Be(0)), ("numrecs", Field::I32Be(4))];
+    let padded = |n: usize| n.div_ceil(4) * 4;
+    let name_at = |p: &mut usize| {
+        let n = be32(&bytes, *p);
+        *p += 4 + padded(n);
+    };
+    let type_size = |t: usize| [0, 1, 1, 2, 4, 4, 8][t];
+    // Dimensions.
+    let n_dims = be32(&bytes, p + 4);
+    fields.push(("dimension count", Field::I32Be(p + 4)));
+    p += 8;
+    let mut dim_len = Vec::new();
+    for _ in 0..n_dims {
+        boundaries.push(p);
+        name_at(&mut p);
+        fields.push(("dimension length", Field::I32Be(p)));
+        dim_len.push(be32(&bytes, p));
+        p += 4;
+    }
+    let attrs = |p: &mut usize, fields: &mut Vec<(&'static str, Field)>, b: &mut Vec<usize>| {
+        let n = be32(&bytes, *p + 4);
+        fields.push(("attribute count", Field::I32Be(*p + 4)));
+        *p += 8;
+        for _ in 0..n {
+            b.push(*p);
+            name_at(p);
+            let t = be32(&bytes, *p);
+            fields.push(("attribute value count", Field::I32Be(*p + 4)));
+            let count = be32(&bytes, *p + 4);
+            *p += 8 + padded(count * type_size(t));
+        }
+    };
+    attrs(&mut p, &mut fields, &mut boundaries);
+    let n_vars = be32(&bytes, p + 4);
+    fields.push(("variable count", Field::I32Be(p + 4)));
+    p += 8;
+    // (begin, one record's bytes, is a record variable)
+    let mut vars = Vec::new();
+    for _ in 0..n_vars {
+        boundaries.push(p);
+        name_at(&mut p);
+        let rank = be32(&bytes, p);
+        fields.push(("variable rank", Field::I32Be(p)));
+        let dims: Vec<usize> = (0..rank).map(|k| be32(&bytes, p + 4 + 4 * k)).collect();
+        p += 4 + 4 * rank;
+        attrs(&mut p, &mut fields, &mut boundaries);
+        let t = be32(&bytes, p);
+        fields.push(("variable type", Field::I32Be(p)));
+        fields.push(("variable vsize", Field::I32Be(p + 4)));
+        let begin = if offset64 {
+            fields.push(("variable begin (high)", Field::I32Be(p + 8)));
+            fields.push(("variable begin (low)", Field::I32Be(p + 12)));
+            let b = u64::from_be_bytes(bytes[p + 8..p + 16].try_into().unwrap()) as usize;
+            p += 16;
+            b
+        } else {
+            fields.push(("variable begin", Field::I32Be(p + 8)));
+            let b = be32(&bytes, p + 8);
+            p += 12;
+            b
+        };
+        let record = dims.first().is_some_and(|d| dim_len[*d] == 0);
+        let size = dims
+            .iter()
+            .skip(record as usize)
+            .map(|d| dim_len[*d])
+            .product::<usize>()
+            * type_size(t);
+        vars.push((begin, size, record));
+    }
+    boundaries.push(p);
+    let rec: Vec<_> = vars.iter().filter(|v| v.2).collect();
+    let recsize: usize = rec.iter().map(|v| padded(v.1)).sum();
+    let frames = frames_of(Format::Netcdf, &bytes);
+    for k in 0..frames {
+        for v in &rec {
+            boundaries.extend([v.0 + k * recsize, v.0 + k * recsize + v.1]);
+        }
+    }
+    let first = rec.iter().map(|v| v.0).min().unwrap();
+    fields.push(("frame 0 x of atom 0", Field::F32Be(first)));
+    assert_eq!(
+        first + frames * recsize,
+        bytes.len(),
+        "{name}: records tile the file"
+    );
+    Fixture {
+        frames,
+        name: name.into(),
+        bytes,
+        boundaries,
+        cuts: Cuts::Declared,
+        fields,
+        text: false,
+    }
+}
+
 /// A text file: every line start as a boundary, its first 16 numeric tokens (counts, box,
 /// coordinates) as fields.
 fn text_fixture(name: &str, format: Format) -> Fixture {
@@ -421,6 +526,18 @@ fn trr_campaign() {
         "TRR",
         Format::Trr,
         vec![trr_fixture("trr_mda.trr", data("trr_mda.trr"))],
+    );
+}
+
+#[test]
+fn netcdf_campaign() {
+    campaign(
+        "AMBER NetCDF",
+        Format::Netcdf,
+        vec![
+            netcdf_fixture("amber_mda.ncdf", data("amber_mda.ncdf")),
+            netcdf_fixture("amber_scipy_cdf1.nc", data("amber_scipy_cdf1.nc")),
+        ],
     );
 }
 

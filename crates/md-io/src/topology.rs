@@ -1,0 +1,744 @@
+//! [`Topology`]: who the atoms are (names, elements, types, residues) and how they are bonded,
+//! read from a structure file and given to every frame of a trajectory of the same atoms.
+//!
+//! Trajectory formats such as XTC, DCD, TRR and AMBER NetCDF carry coordinates only. MD users
+//! always have a structure file beside them (the GROMACS `.gro`, the PDB, the LAMMPS data file
+//! the run started from), and VMD, OVITO and MDAnalysis all take "topology + trajectory". This
+//! module reads:
+//!
+//! - **PDB**: the first model's atoms through the PDB reader, plus `CONECT` records (serial
+//!   numbers, hybrid-36 allowed, resolved to atom indices through the model's serials);
+//! - **GRO**: the first frame's atoms (GRO has no bonds);
+//! - **LAMMPS data file** (`.data`, `.lmp`, or a name starting `data.`): the `Atoms` section in
+//!   the styles `full`, `molecular` (and its column-equal `bond`, `angle`), `atomic` and
+//!   `charge`, told by the `Atoms # style` comment or, without one, by the column count (as
+//!   MDAnalysis does, 7 columns is `full`; 6 is ambiguous between `molecular` and `charge` and is
+//!   an error asking for the comment), and the `Bonds` section. Atoms are ordered by id, as the
+//!   LAMMPS dump reader orders them, so index `i` is the same atom in both.
+//!
+//! Applying a topology ([`Topology::apply`]) replaces the frame's per-atom labels with the
+//! topology's; an atom-count mismatch is an [`Error::TopologyMismatch`] naming both files.
+//! Positions are never taken from the topology: the trajectory's frame is what is drawn.
+//!
+//! Rejected: guessing elements of LAMMPS types from the `Masses` section (masses of isotopes and
+//! coarse-grained beads make it a guess that is wrong silently); the types are kept and drawn one
+//! colour per type instead, as OVITO does.
+
+use std::collections::HashMap;
+use std::fs::File;
+use std::io::{BufRead, BufReader, Read};
+use std::path::Path;
+use std::sync::Arc;
+
+use crate::elements::Element;
+use crate::error::{Error, Location};
+use crate::format::Format;
+use crate::frame::{Frame, Label};
+use crate::parse::{fields, parse_f64, parse_i64, trim};
+use crate::trajectory::Trajectory;
+
+/// The kinds of file a topology is read from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum TopologyFormat {
+    /// PDB: atoms of the first model, bonds from `CONECT`.
+    Pdb,
+    /// GROMACS .gro: atoms of the first frame, no bonds.
+    Gro,
+    /// LAMMPS data file: `Atoms` and `Bonds` sections.
+    LammpsData,
+}
+
+impl TopologyFormat {
+    /// The format a path names: `.pdb`/`.ent`, `.gro`, `.data`/`.lmp` or `data.*` (LAMMPS).
+    pub fn from_path(path: &Path) -> Option<TopologyFormat> {
+        let name = path.file_name()?.to_str()?.to_ascii_lowercase();
+        if name.starts_with("data.") {
+            return Some(TopologyFormat::LammpsData);
+        }
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        Some(match ext.as_str() {
+            "pdb" | "ent" => TopologyFormat::Pdb,
+            "gro" => TopologyFormat::Gro,
+            "data" | "lmp" => TopologyFormat::LammpsData,
+            _ => return None,
+        })
+    }
+}
+
+/// Per-atom labels and bonds of a system; see the module doc.
+///
+/// Every per-atom vector is empty (the file has no such column) or [`Topology::n_atoms`] long.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Topology {
+    file: Arc<str>,
+    n_atoms: usize,
+    /// Atom names (PDB/GRO).
+    pub names: Vec<Label>,
+    /// Elements (PDB element column, else guessed from names like the readers do).
+    pub elements: Vec<Element>,
+    /// Atom types (LAMMPS data).
+    pub types: Vec<Label>,
+    /// Atom serials / ids as written in the file.
+    pub ids: Vec<i64>,
+    /// Residue names.
+    pub res_names: Vec<Label>,
+    /// Residue numbers (LAMMPS: molecule ids).
+    pub res_ids: Vec<i64>,
+    /// Bonds as atom index pairs `[i, j]` with `i < j`, sorted, each once.
+    pub bonds: Vec<[u32; 2]>,
+}
+
+/// A text line being parsed: its number and byte offset, for errors.
+struct LineAt {
+    line: u64,
+    byte: u64,
+}
+
+fn at(file: &Arc<str>, l: &LineAt) -> Location {
+    Location {
+        file: file.clone(),
+        frame: None,
+        line: Some(l.line),
+        byte: Some(l.byte),
+    }
+}
+
+fn parse_err(file: &Arc<str>, l: &LineAt, expected: &'static str, found: &[u8]) -> Error {
+    Error::Parse {
+        at: at(file, l),
+        expected,
+        found: Error::found(found),
+    }
+}
+
+/// Streams the lines of a file with their numbers and byte offsets (one line buffered).
+struct Lines<R> {
+    src: BufReader<R>,
+    buf: Vec<u8>,
+    line: u64,
+    byte: u64,
+    next_byte: u64,
+    file: Arc<str>,
+}
+
+impl<R: Read> Lines<R> {
+    fn new(src: R, file: Arc<str>) -> Lines<R> {
+        Lines {
+            src: BufReader::new(src),
+            buf: Vec::new(),
+            line: 0,
+            byte: 0,
+            next_byte: 0,
+            file,
+        }
+    }
+
+    /// The next line (without its end), or `None` at the end of the file.
+    fn next_line(&mut self) -> Result<Option<(&[u8], LineAt)>, Error> {
+        self.buf.clear();
+        let n = self
+            .src
+            .read_until(b'\n', &mut self.buf)
+            .map_err(|source| Error::Io {
+                at: Location {
+                    file: self.file.clone(),
+                    byte: Some(self.next_byte),
+                    ..Location::default()
+                },
+                source,
+            })?;
+        if n == 0 {
+            return Ok(None);
+        }
+        self.byte = self.next_byte;
+        self.next_byte += n as u64;
+        self.line += 1;
+        let mut s: &[u8] = &self.buf;
+        while let [rest @ .., b'\n' | b'\r'] = s {
+            s = rest;
+        }
+        Ok(Some((
+            s,
+            LineAt {
+                line: self.line,
+                byte: self.byte,
+            },
+        )))
+    }
+}
+
+impl Topology {
+    /// Reads the topology of `path`, its format told by the name (see [`TopologyFormat`]).
+    pub fn open(path: impl AsRef<Path>) -> Result<Topology, Error> {
+        let path = path.as_ref();
+        let name: Arc<str> = path.display().to_string().into();
+        let Some(format) = TopologyFormat::from_path(path) else {
+            return Err(Error::Unsupported {
+                file: name,
+                what: "topology format (expected .pdb, .gro, or a LAMMPS data file: .data, .lmp, data.*)",
+            });
+        };
+        Topology::open_as(path, format)
+    }
+
+    /// Reads the topology of `path` as `format`.
+    pub fn open_as(path: impl AsRef<Path>, format: TopologyFormat) -> Result<Topology, Error> {
+        let path = path.as_ref();
+        let name: Arc<str> = path.display().to_string().into();
+        let open = || {
+            File::open(path).map_err(|source| Error::Io {
+                at: Location::file(&name),
+                source,
+            })
+        };
+        match format {
+            TopologyFormat::Pdb => {
+                let mut t = Topology::first_frame(Trajectory::open_as(path, Format::Pdb)?)?;
+                t.bonds = pdb_conect(open()?, &name, &t.ids)?;
+                Ok(t)
+            }
+            TopologyFormat::Gro => Topology::first_frame(Trajectory::open_as(path, Format::Gro)?),
+            TopologyFormat::LammpsData => lammps_data(open()?, &name),
+        }
+    }
+
+    /// Reads `src` (named `name` in errors) as `format`.
+    ///
+    /// ```
+    /// use texmap_md_io::{Topology, TopologyFormat};
+    /// let data = "water\n\n3 atoms\n2 bonds\n\nAtoms # full\n\n\
+    ///             1 1 1 -0.8 0.0 0.0 0.0\n3 1 2 0.4 -0.3 0.9 0.0\n2 1 2 0.4 0.96 0.0 0.0\n\n\
+    ///             Bonds\n\n1 1 1 2\n2 1 1 3\n";
+    /// let t = Topology::from_reader(std::io::Cursor::new(data), TopologyFormat::LammpsData, "w.data")?;
+    /// assert_eq!(t.ids, [1, 2, 3]); // ordered by id, as LAMMPS dumps are read
+    /// assert_eq!(t.types[1].as_str(), "2");
+    /// assert_eq!(t.bonds, [[0, 1], [0, 2]]);
+    /// # Ok::<(), texmap_md_io::Error>(())
+    /// ```
+    pub fn from_reader<R: Read + std::io::Seek>(
+        mut src: R,
+        format: TopologyFormat,
+        name: &str,
+    ) -> Result<Topology, Error> {
+        let file: Arc<str> = name.into();
+        match format {
+            TopologyFormat::Pdb => {
+                let start = src.stream_position().map_err(|source| Error::Io {
+                    at: Location::file(&file),
+                    source,
+                })?;
+                let mut t =
+                    Topology::first_frame(Trajectory::from_reader(&mut src, Format::Pdb, name)?)?;
+                src.seek(std::io::SeekFrom::Start(start))
+                    .map_err(|source| Error::Io {
+                        at: Location::file(&file),
+                        source,
+                    })?;
+                t.bonds = pdb_conect(src, &file, &t.ids)?;
+                Ok(t)
+            }
+            TopologyFormat::Gro => {
+                Topology::first_frame(Trajectory::from_reader(src, Format::Gro, name)?)
+            }
+            TopologyFormat::LammpsData => lammps_data(src, &file),
+        }
+    }
+
+    /// The labels of a trajectory's first frame (no bonds).
+    fn first_frame<R: Read + std::io::Seek>(mut traj: Trajectory<R>) -> Result<Topology, Error> {
+        let mut f = Frame::new();
+        if !traj.read_next(&mut f)? {
+            return Err(Error::Parse {
+                at: Location::file(&traj.name().into()),
+                expected: "at least one atom record",
+                found: "end of file".into(),
+            });
+        }
+        Ok(Topology::from_frame(&f, traj.name()))
+    }
+
+    /// The labels of `frame` as a topology named `name` (no bonds).
+    pub fn from_frame(frame: &Frame, name: &str) -> Topology {
+        let elements = if frame.elements.is_empty() && !frame.names.is_empty() {
+            (0..frame.n_atoms())
+                .map(|i| crate::elements::atom_element(frame, i))
+                .collect()
+        } else {
+            frame.elements.clone()
+        };
+        Topology {
+            file: name.into(),
+            n_atoms: frame.n_atoms(),
+            names: frame.names.clone(),
+            elements,
+            types: frame.types.clone(),
+            ids: frame.ids.clone(),
+            res_names: frame.res_names.clone(),
+            res_ids: frame.res_ids.clone(),
+            bonds: Vec::new(),
+        }
+    }
+
+    /// The file the topology was read from (as errors name it).
+    pub fn name(&self) -> &str {
+        &self.file
+    }
+
+    /// Number of atoms.
+    pub fn n_atoms(&self) -> usize {
+        self.n_atoms
+    }
+
+    /// Number of distinct residues (consecutive atoms with the same residue number and name
+    /// form one residue, as in PDB/GRO files); 0 without residue numbers.
+    pub fn n_residues(&self) -> usize {
+        let mut n = 0;
+        for i in 0..self.res_ids.len() {
+            let same = i > 0
+                && self.res_ids[i] == self.res_ids[i - 1]
+                && self.res_names.get(i) == self.res_names.get(i - 1);
+            if !same {
+                n += 1;
+            }
+        }
+        n
+    }
+
+    /// Gives frame number `frame_index` of the trajectory `trajectory` (a name for errors) the
+    /// topology's per-atom labels, replacing the frame's own. The frame's positions, cell,
+    /// radii and colours stay. An atom-count mismatch is [`Error::TopologyMismatch`].
+    pub fn apply(
+        &self,
+        frame: &mut Frame,
+        trajectory: &str,
+        frame_index: usize,
+    ) -> Result<(), Error> {
+        if frame.n_atoms() != self.n_atoms {
+            return Err(Error::TopologyMismatch {
+                topology: self.file.clone(),
+                topology_atoms: self.n_atoms,
+                trajectory: trajectory.into(),
+                frame: frame_index,
+                frame_atoms: frame.n_atoms(),
+            });
+        }
+        // Labels the topology lacks but the frame has (a dump's types) are kept.
+        let take = |dst: &mut Vec<Label>, src: &Vec<Label>| {
+            if !src.is_empty() {
+                dst.clone_from(src);
+            }
+        };
+        take(&mut frame.names, &self.names);
+        take(&mut frame.types, &self.types);
+        take(&mut frame.res_names, &self.res_names);
+        if !self.elements.is_empty() {
+            frame.elements.clone_from(&self.elements);
+        }
+        if !self.res_ids.is_empty() {
+            frame.res_ids.clone_from(&self.res_ids);
+        }
+        if !self.ids.is_empty() {
+            frame.ids.clone_from(&self.ids);
+        }
+        Ok(())
+    }
+}
+
+/// Sorts, orders (`i < j`) and deduplicates bonds.
+fn tidy(bonds: &mut Vec<[u32; 2]>) {
+    for b in bonds.iter_mut() {
+        if b[0] > b[1] {
+            b.swap(0, 1);
+        }
+    }
+    bonds.sort_unstable();
+    bonds.dedup();
+}
+
+/// The bonds of a PDB file's `CONECT` records: columns 7-11 the atom, 12-16, 17-21, 22-26,
+/// 27-31 the atoms bonded to it (serial numbers, hybrid-36 allowed). `ids` are the serials of
+/// the first model's atoms.
+fn pdb_conect<R: Read>(src: R, file: &Arc<str>, ids: &[i64]) -> Result<Vec<[u32; 2]>, Error> {
+    let index: HashMap<i64, u32> = ids
+        .iter()
+        .enumerate()
+        .map(|(k, id)| (*id, k as u32))
+        .collect();
+    let mut bonds = Vec::new();
+    let mut lines = Lines::new(src, file.clone());
+    while let Some((line, pos)) = lines.next_line()? {
+        if !line.starts_with(b"CONECT") {
+            continue;
+        }
+        let col = |a: usize, b: usize| -> &[u8] {
+            let b = b.min(line.len());
+            if a >= b { &[] } else { &line[a..b] }
+        };
+        let serial = |field: &[u8]| -> Result<Option<u32>, Error> {
+            if trim(field).is_empty() {
+                return Ok(None);
+            }
+            let Some(s) = crate::pdb::hy36_decode(field, 5) else {
+                return Err(parse_err(file, &pos, "a CONECT atom serial number", field));
+            };
+            match index.get(&s) {
+                Some(i) => Ok(Some(*i)),
+                None => Err(parse_err(
+                    file,
+                    &pos,
+                    "a CONECT serial number of an atom of the first model",
+                    field,
+                )),
+            }
+        };
+        let Some(a) = serial(col(6, 11))? else {
+            return Err(parse_err(file, &pos, "a CONECT atom serial number", line));
+        };
+        for k in 0..4 {
+            if let Some(b) = serial(col(11 + 5 * k, 16 + 5 * k))?
+                && a != b
+            {
+                bonds.push([a, b]);
+            }
+        }
+    }
+    tidy(&mut bonds);
+    Ok(bonds)
+}
+
+/// The `Atoms` section layouts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum AtomStyleKind {
+    /// id type x y z
+    Atomic,
+    /// id type q x y z
+    Charge,
+    /// id mol type x y z (also `bond`, `angle`)
+    Molecular,
+    /// id mol type q x y z
+    Full,
+}
+
+impl AtomStyleKind {
+    fn from_name(s: &[u8]) -> Option<AtomStyleKind> {
+        Some(match s {
+            b"atomic" => AtomStyleKind::Atomic,
+            b"charge" => AtomStyleKind::Charge,
+            b"molecular" | b"bond" | b"angle" => AtomStyleKind::Molecular,
+            b"full" => AtomStyleKind::Full,
+            _ => return None,
+        })
+    }
+
+    /// Columns before the image flags, and the indices of mol (if any) and type.
+    fn layout(self) -> (usize, Option<usize>, usize) {
+        match self {
+            AtomStyleKind::Atomic => (5, None, 1),
+            AtomStyleKind::Charge => (6, None, 1),
+            AtomStyleKind::Molecular => (6, Some(1), 2),
+            AtomStyleKind::Full => (7, Some(1), 2),
+        }
+    }
+}
+
+/// The line without a `#` comment.
+fn strip_comment(line: &[u8]) -> &[u8] {
+    match line.iter().position(|b| *b == b'#') {
+        Some(k) => &line[..k],
+        None => line,
+    }
+}
+
+/// A LAMMPS data file's atoms (ordered by id) and bonds.
+fn lammps_data<R: Read>(src: R, file: &Arc<str>) -> Result<Topology, Error> {
+    let mut lines = Lines::new(src, file.clone());
+    // The first line is a title.
+    if lines.next_line()?.is_none() {
+        return Err(Error::Parse {
+            at: Location::file(file),
+            expected: "a LAMMPS data file title line",
+            found: "end of file".into(),
+        });
+    }
+    let mut n_atoms: Option<u64> = None;
+    let mut n_bonds: u64 = 0;
+    // (id, mol, type) per atom; bonds as id pairs with their line.
+    let mut atoms: Vec<(i64, i64, Label)> = Vec::new();
+    let mut bond_ids: Vec<(i64, i64, LineAt)> = Vec::new();
+    let mut section: Option<Vec<u8>> = None;
+    let mut style: Option<AtomStyleKind> = None;
+    let mut atoms_seen = false;
+    while let Some((raw, pos)) = lines.next_line()? {
+        let line = trim(strip_comment(raw));
+        if line.is_empty() {
+            continue;
+        }
+        let first = line[0];
+        if first.is_ascii_alphabetic() {
+            // A section keyword ("Atoms # full", "Bonds", "Pair Coeffs # lj/cut", ...).
+            let name = trim(line).to_vec();
+            if name == b"Atoms" {
+                if atoms_seen {
+                    return Err(parse_err(file, &pos, "one Atoms section", raw));
+                }
+                atoms_seen = true;
+                let hint = raw
+                    .iter()
+                    .position(|b| *b == b'#')
+                    .map(|k| trim(&raw[k + 1..]));
+                style = match hint {
+                    Some(h) if !h.is_empty() => {
+                        let word = fields(h).next().unwrap_or(&[]);
+                        match AtomStyleKind::from_name(word) {
+                            Some(s) => Some(s),
+                            None => {
+                                return Err(parse_err(
+                                    file,
+                                    &pos,
+                                    "an atom style this reader knows (full, molecular, bond, angle, atomic, charge)",
+                                    word,
+                                ));
+                            }
+                        }
+                    }
+                    _ => None,
+                };
+                let n = n_atoms.ok_or_else(|| {
+                    parse_err(
+                        file,
+                        &pos,
+                        "an 'N atoms' header line before the Atoms section",
+                        raw,
+                    )
+                })?;
+                // Bounded: the header's claim reserves at most 64 Ki atoms; past that the
+                // vector grows with the lines actually read.
+                atoms.reserve((n as usize).min(1 << 16));
+            }
+            section = Some(name);
+            continue;
+        }
+        match section.as_deref() {
+            None => {
+                // Header: "N atoms", "N bonds", "N atom types", "xlo xhi", ...
+                let f: Vec<&[u8]> = fields(line).collect();
+                match f.as_slice() {
+                    [n, b"atoms"] => {
+                        n_atoms = Some(
+                            crate::parse::parse_usize(n)
+                                .ok_or_else(|| parse_err(file, &pos, "an atom count", n))?
+                                as u64,
+                        );
+                    }
+                    [n, b"bonds"] => {
+                        n_bonds = crate::parse::parse_usize(n)
+                            .ok_or_else(|| parse_err(file, &pos, "a bond count", n))?
+                            as u64;
+                    }
+                    _ => {}
+                }
+            }
+            Some(b"Atoms") => {
+                let f: Vec<&[u8]> = fields(line).collect();
+                let st = match style {
+                    Some(s) => s,
+                    None => {
+                        let s = match f.len() {
+                            5 | 8 => AtomStyleKind::Atomic,
+                            7 | 10 => AtomStyleKind::Full,
+                            _ => {
+                                return Err(parse_err(
+                                    file,
+                                    &pos,
+                                    "an atom line of 5 (atomic) or 7 (full) columns, or an 'Atoms # style' comment naming the style",
+                                    raw,
+                                ));
+                            }
+                        };
+                        style = Some(s);
+                        s
+                    }
+                };
+                let (cols, mol, ty) = st.layout();
+                if f.len() != cols && f.len() != cols + 3 {
+                    return Err(parse_err(
+                        file,
+                        &pos,
+                        "as many columns as the atom style has (plus 3 optional image flags)",
+                        raw,
+                    ));
+                }
+                let id =
+                    parse_i64(f[0]).ok_or_else(|| parse_err(file, &pos, "an atom id", f[0]))?;
+                let m = match mol {
+                    Some(k) => parse_i64(f[k])
+                        .ok_or_else(|| parse_err(file, &pos, "a molecule id", f[k]))?,
+                    None => 0,
+                };
+                let t = Label::from_utf8(f[ty])
+                    .ok_or_else(|| parse_err(file, &pos, "an atom type", f[ty]))?;
+                for c in &f[cols - 3..cols] {
+                    if !parse_f64(c).is_some_and(f64::is_finite) {
+                        return Err(parse_err(file, &pos, "a finite coordinate", c));
+                    }
+                }
+                if atoms.len() as u64 >= n_atoms.unwrap_or(0) {
+                    return Err(parse_err(
+                        file,
+                        &pos,
+                        "no more atom lines than the header's 'N atoms'",
+                        raw,
+                    ));
+                }
+                atoms.push((id, m, t));
+            }
+            Some(b"Bonds") => {
+                let f: Vec<&[u8]> = fields(line).collect();
+                if f.len() != 4 {
+                    return Err(parse_err(
+                        file,
+                        &pos,
+                        "a bond line 'id type atom1 atom2'",
+                        raw,
+                    ));
+                }
+                let a = parse_i64(f[2]).ok_or_else(|| parse_err(file, &pos, "an atom id", f[2]))?;
+                let b = parse_i64(f[3]).ok_or_else(|| parse_err(file, &pos, "an atom id", f[3]))?;
+                if bond_ids.len() as u64 >= n_bonds {
+                    return Err(parse_err(
+                        file,
+                        &pos,
+                        "no more bond lines than the header's 'N bonds'",
+                        raw,
+                    ));
+                }
+                bond_ids.push((a, b, pos));
+            }
+            Some(_) => {} // Masses, Velocities, coefficients, angles...: not needed here.
+        }
+    }
+    let n = n_atoms.ok_or_else(|| Error::Parse {
+        at: Location::file(file),
+        expected: "an 'N atoms' header line",
+        found: "none".into(),
+    })?;
+    let end = LineAt {
+        line: lines.line,
+        byte: lines.next_byte,
+    };
+    if atoms.len() as u64 != n {
+        return Err(Error::Truncated {
+            at: at(file, &end),
+            expected: format!(
+                "{n} atom lines in the Atoms section (the header's 'N atoms'), found {}",
+                atoms.len()
+            ),
+        });
+    }
+    if bond_ids.len() as u64 != n_bonds {
+        return Err(Error::Truncated {
+            at: at(file, &end),
+            expected: format!(
+                "{n_bonds} bond lines in the Bonds section (the header's 'N bonds'), found {}",
+                bond_ids.len()
+            ),
+        });
+    }
+    atoms.sort_unstable_by_key(|a| a.0);
+    if let Some(w) = atoms.windows(2).find(|w| w[0].0 == w[1].0) {
+        return Err(Error::InvalidValue {
+            what: format!(
+                "{file}: atom id {} appears twice in the Atoms section",
+                w[0].0
+            ),
+        });
+    }
+    let index = |id: i64, pos: &LineAt| -> Result<u32, Error> {
+        atoms
+            .binary_search_by_key(&id, |a| a.0)
+            .map(|k| k as u32)
+            .map_err(|_| Error::Parse {
+                at: at(file, pos),
+                expected: "a bond between atom ids of the Atoms section",
+                found: id.to_string(),
+            })
+    };
+    let mut bonds = Vec::with_capacity(bond_ids.len());
+    for (a, b, pos) in &bond_ids {
+        let (i, j) = (index(*a, pos)?, index(*b, pos)?);
+        if i != j {
+            bonds.push([i, j]);
+        }
+    }
+    tidy(&mut bonds);
+    let has_mol = matches!(style, Some(AtomStyleKind::Full | AtomStyleKind::Molecular));
+    Ok(Topology {
+        file: file.clone(),
+        n_atoms: atoms.len(),
+        names: Vec::new(),
+        elements: Vec::new(),
+        types: atoms.iter().map(|a| a.2).collect(),
+        ids: atoms.iter().map(|a| a.0).collect(),
+        res_names: Vec::new(),
+        res_ids: if has_mol {
+            atoms.iter().map(|a| a.1).collect()
+        } else {
+            Vec::new()
+        },
+        bonds,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::io::Cursor;
+
+    #[test]
+    fn lammps_styles_and_errors() {
+        let data = "title\n\n3 atoms\n1 bonds\n\nAtoms # atomic\n\n3 2 0 0 0\n1 1 1 0 0\n2 1 2 0 0\n\nBonds\n\n1 1 3 1\n";
+        let t = Topology::from_reader(Cursor::new(data), TopologyFormat::LammpsData, "d").unwrap();
+        assert_eq!(t.ids, vec![1, 2, 3]);
+        assert_eq!(
+            t.types.iter().map(|l| l.as_str()).collect::<Vec<_>>(),
+            ["1", "1", "2"]
+        );
+        assert_eq!(t.bonds, vec![[0, 2]]);
+        assert!(t.res_ids.is_empty());
+        // 6 columns without a style: ambiguous, an error on that line.
+        let amb = "t\n2 atoms\nAtoms\n\n1 1 1 0 0 0\n2 1 1 0 0 0\n";
+        let e = Topology::from_reader(Cursor::new(amb), TopologyFormat::LammpsData, "d")
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("d: line 5"), "{e}");
+        // A bond naming a missing atom.
+        let bad = "t\n1 atoms\n1 bonds\nAtoms # full\n\n1 1 1 0.0 0 0 0\nBonds\n\n1 1 1 7\n";
+        let e = Topology::from_reader(Cursor::new(bad), TopologyFormat::LammpsData, "d")
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("d: line 9") && e.contains("'7'"), "{e}");
+        // Fewer atoms than announced.
+        let cut = "t\n3 atoms\nAtoms # full\n\n1 1 1 0.0 0 0 0\n";
+        let e = Topology::from_reader(Cursor::new(cut), TopologyFormat::LammpsData, "d")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("3 atom lines"), "{e}");
+    }
+
+    #[test]
+    fn apply_checks_the_count() {
+        let mut f = Frame::new();
+        f.positions = vec![[0.0; 3]; 2];
+        let mut t = Topology::from_frame(&f, "top.gro");
+        t.names = vec![Label::new("OW").unwrap(); 2];
+        t.apply(&mut f, "run.xtc", 0).unwrap();
+        assert_eq!(f.names.len(), 2);
+        f.positions.push([0.0; 3]);
+        let e = t.apply(&mut f, "run.xtc", 4).unwrap_err().to_string();
+        assert!(
+            e.contains("top.gro") && e.contains("run.xtc") && e.contains("frame 4"),
+            "{e}"
+        );
+    }
+}
