@@ -15,10 +15,14 @@
 //!   maps; Seed 000 Eq. (5)–(7) decide which maps are resident in a budgeted cache with counters.
 //! - [`db`]: the database directory (JSON manifest, chunks, tiles, the grid), built atomically, and
 //!   the whole-terrain mesh at any error for glTF/OBJ export (through `texmap-mesh`).
+//! - [`view`]: the flight view — an aircraft camera (eye, altitude, heading, pitch, roll), chunks
+//!   chosen by screen-space error and frustum culling, drawn through texmap-raster with any
+//!   texmap-core sampler (nearest, bilinear, trilinear, the span sampler with 3x3 or 4x4 banks,
+//!   anisotropic), per-frame statistics and optional haze.
 //!
 //! Coordinates: vertices are in metres, `x` east, `y` up, `z` south (rows), from the centre of
 //! sample (0, 0); texture coordinates span the grid's extent, `v` down the rows as in glTF.
-//! Depends on texmap-core (coverage, Eq. 5–7), texmap-raster (the crack test) and texmap-mesh;
+//! Depends on texmap-core (coverage, Eq. 5–7, samplers), texmap-raster (the flight view, the crack test) and texmap-mesh;
 //! never on the reference ray tracer.
 //!
 //! ```
@@ -55,5 +59,6 @@ pub mod error;
 pub mod greedy;
 pub mod gst;
 pub mod rtin;
+pub mod view;
 
 pub use error::TerrainError;
