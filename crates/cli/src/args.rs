@@ -43,14 +43,24 @@ pub struct Cli {
 }
 
 #[derive(Subcommand, Debug)]
+#[allow(clippy::large_enum_variant)] // parsed once per run: boxing RenderArgs would buy nothing
 pub enum Command {
     /// Print a trajectory's format, atom and frame counts, box and first positions as one JSON object.
     Info {
-        /// Trajectory file (XYZ, extended XYZ, PDB, GRO, LAMMPS dump, DCD, XTC, TRR).
+        /// Trajectory file (XYZ, extended XYZ, PDB, GRO, LAMMPS dump, DCD, XTC, TRR, AMBER
+        /// NetCDF).
         file: PathBuf,
         /// Format, when the extension does not tell it.
         #[arg(long)]
         format: Option<String>,
+        /// Count only the complete frames of a file whose last frame is cut short, with a
+        /// warning (default: a cut frame is an error naming the file, frame and byte).
+        #[arg(long)]
+        allow_truncated: bool,
+        /// Topology (PDB, GRO, LAMMPS data file) of the trajectory's atoms: its atom, residue
+        /// and bond counts are added, and a different atom count is an error.
+        #[arg(long, value_name = "FILE")]
+        topology: Option<PathBuf>,
     },
     /// Render trajectory frames to PNG (and optionally depth to EXR).
     Render(RenderArgs),
@@ -71,6 +81,26 @@ pub enum Command {
         /// Image size for the animation, WxH.
         #[arg(long, default_value = "500x500")]
         size: String,
+    },
+    /// Terrain databases from elevation grids and orthophotos (Seed 000): build, info, export, maps.
+    Terrain {
+        #[command(subcommand)]
+        cmd: crate::terrain::TerrainCmd,
+    },
+    /// Environment mapping (Seed 003): a mirror or glass target drawn with sphere, cube or
+    /// dual-paraboloid maps; `envmap compare` measures every method against the reference.
+    Envmap(crate::envmap::EnvmapArgs),
+    /// Assemble a directory of PNG frames (in numeric order: f2.png before f10.png) into one
+    /// movie: .mp4, .webm, .gif (ffmpeg) or .apng. The last step of a render split into parts.
+    Movie {
+        /// Directory holding the PNG frames (all of one size).
+        dir: PathBuf,
+        /// The movie file; its extension names the format.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Frames per second.
+        #[arg(long, default_value_t = 25.0)]
+        fps: f64,
     },
 }
 
@@ -223,6 +253,10 @@ pub struct RenderArgs {
     /// Format, when the extension does not tell it.
     #[arg(long)]
     pub format: Option<String>,
+    /// Keep the complete frames of a file whose last frame is cut short, with a warning
+    /// (default: a cut frame is an error naming the file, frame and byte).
+    #[arg(long)]
+    pub allow_truncated: bool,
     /// Frames to render, A:B:STEP (B exclusive, each part optional: "::10", "5:", "3").
     #[arg(long, default_value = "0:")]
     pub frames: String,
@@ -259,27 +293,117 @@ pub struct RenderArgs {
     /// Also write depth as a one-channel EXR beside each PNG (same name, .exr).
     #[arg(long)]
     pub depth: bool,
-    /// Output PNG; may hold a %04d frame-number pattern. Without one, several frames get _NNNN.
+    /// Output: PNG image(s) — the name may hold a %04d frame-number pattern; without one, several
+    /// frames get _NNNN — or one movie whose extension names its format: .mp4, .webm, .gif
+    /// (encoded by ffmpeg: apt-get install ffmpeg) or .apng (no external program). Any other
+    /// extension is refused.
     #[arg(short, long)]
     pub output: PathBuf,
+    /// Frames per second of a movie output.
+    #[arg(long, default_value_t = 25.0)]
+    pub fps: f64,
+    /// Topology, selection, bonds and periodic boundaries.
+    #[command(flatten)]
+    pub mol: MolArgs,
     /// How atoms look (last: its help heading applies to the fields after it).
     #[command(flatten)]
     pub style: StyleArgs,
 }
 
+/// Where bonds come from (`--bonds`).
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum BondsArg {
+    /// The topology's bonds when it has some, else by distance (covalent radii + 0.45 Å,
+    /// minimum image in a periodic box).
+    #[default]
+    Auto,
+    /// Only the topology's bonds (PDB CONECT, LAMMPS data Bonds).
+    Topology,
+    /// No bonds.
+    None,
+}
+
+/// How molecules are drawn (`--style`).
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum DrawStyle {
+    /// Atoms at their radii, no bonds.
+    #[default]
+    Spacefill,
+    /// Atoms at 0.3 of their radii, bonds as sticks of 0.2 Å.
+    BallStick,
+    /// Bonds as sticks of 0.3 Å, atoms as 0.3 Å joints.
+    Licorice,
+}
+
+/// Periodic boundaries (`--pbc`).
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum PbcArg {
+    /// Positions as the file has them (bonds across the box are not drawn).
+    #[default]
+    None,
+    /// Every atom moved into the box.
+    Wrap,
+    /// Bonded molecules made whole across the box.
+    Unwrap,
+}
+
+/// `texmap render` options for molecules: topology, selection, per-selection looks, bonds,
+/// periodic boundaries.
+#[derive(Args, Clone, Debug, Default)]
+#[command(next_help_heading = "Molecules")]
+pub struct MolArgs {
+    /// Topology giving names, elements, residues and bonds to a trajectory of the same atoms
+    /// (XTC, DCD, TRR, NetCDF carry coordinates only): PDB (CONECT bonds), GRO, or a LAMMPS
+    /// data file (.data, .lmp, data.*).
+    #[arg(long, value_name = "FILE")]
+    pub topology: Option<PathBuf>,
+    /// Draw only the atoms SEL selects, in the VMD/MDAnalysis language: 'not resname SOL',
+    /// 'name CA', 'element O and resid 1 to 20', 'protein or within 5 of resname LIG'.
+    #[arg(long, value_name = "SEL")]
+    pub select: Option<String>,
+    /// Colour of the atoms SEL selects, #rrggbb or R,G,B: --color 'resname SOL=#4080ff';
+    /// repeatable, applied in order (a later rule wins), over every other colour source.
+    #[arg(long = "color", value_name = "SEL=COLOUR")]
+    pub color_rules: Vec<String>,
+    /// Radius in Å (before --radius-scale) of the atoms SEL selects: --radius 'name CA=2';
+    /// repeatable, applied in order, over every other radius source.
+    #[arg(long = "radius", value_name = "SEL=R")]
+    pub radius_rules: Vec<String>,
+    /// Bonds: auto (the topology's, else by distance), topology, none.
+    #[arg(long, value_enum, default_value_t = BondsArg::Auto)]
+    pub bonds: BondsArg,
+    /// Drawing style: spacefill, ball-stick, licorice (the last two draw bonds).
+    #[arg(long = "style", value_enum, default_value_t = DrawStyle::Spacefill)]
+    pub draw: DrawStyle,
+    /// Periodic boundaries: none, wrap (atoms into the box), unwrap (molecules whole).
+    #[arg(long, value_enum, default_value_t = PbcArg::None)]
+    pub pbc: PbcArg,
+}
+
 /// How an atom's look is chosen and examples, after `texmap render --help`.
 const RENDER_AFTER_HELP: &str = "\
 How each atom's look is chosen (the first that applies):
-  colour: the file's colour column (--color-by property, the default; extended XYZ `color`,
+  colour: --color SEL=COLOUR rules (in order, the last that selects the atom wins) > the
+          file's colour column (--color-by property, the default; extended XYZ `color`,
           LAMMPS dump `ColorR ColorG ColorB` or `Color.R ...` as OVITO names them; values are
           fractions of 1, clamped to [0, 1]) > --type-color > element colour (CPK/Jmol), or one
-          colour per type with --color-by type
-  radius: the file's radius column (`radius`, LAMMPS `diameter` / 2) > --type-radius >
-          van der Waals radius of the element; then times --radius-scale
+          colour per type with --color-by type (the default for atoms that have only types,
+          such as LAMMPS dumps with numeric types)
+  radius: --radius SEL=R rules > the file's radius column (`radius`, LAMMPS `diameter` / 2) >
+          --type-radius > van der Waals radius of the element; then times --radius-scale
   A NAME rule matches the atom's type first, then its name, then its element.
+  SEL is a selection in the VMD/MDAnalysis language (see --select).
+
+Coordinate-only trajectories (XTC, DCD, TRR, AMBER NetCDF) take names, elements, residues and
+bonds from --topology. The automatic camera frames the drawn (selected) atoms.
+
+If a frame cannot be read or drawn, rendering stops there: the images of the frames before it
+stay (each is complete: written to a temporary name, then renamed) and the error lists them.
 
 Examples:
   texmap render traj.pdb --frames 0:100:10 --size 1280x720 -o frames/f%04d.png
+  texmap render run.xtc --topology conf.gro --select 'not resname SOL' --style ball-stick --pbc unwrap -o f.png
+  texmap render md.nc --topology prmtop.pdb --color 'protein=#a0a0ff' --color 'resname LIG=#ff8000' -o f.png
   texmap render dump.lammpstrj --type-color 1=#ff8000 --type-color 2=40,40,255 --type-radius 2=0.6 -o f.png
   texmap render water.gro --color-by element --type-color OW=#ff0000 --radius-scale 0.5 -o w.png
   texmap render md.xyz --eye 0,0,50 --target 0,0,0 --up 0,1,0 --fov 30 --depth -o md.png";

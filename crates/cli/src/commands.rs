@@ -9,17 +9,27 @@ use serde_json::json;
 use texmap_core::camera::Camera;
 use texmap_core::shade::Lighting;
 use texmap_impostor::{Method, Renderer, SphereScene};
-use texmap_md_io::{Format, Frame as MdFrame, Trajectory};
+use texmap_md_io::{Format, Frame as MdFrame, ReadOptions, Trajectory};
 use texmap_study::harness::{self, HarnessOptions, SceneReport};
 use texmap_study::scenes::{self, NamedScene, SceneId};
 
 use crate::args::{Cli, Command, CompareArgs, MethodArg, RenderArgs, SceneArg, usage};
-use crate::output::{frame_path, write_atomic, write_depth_exr, write_png};
+use crate::output::{write_atomic, write_png};
 use crate::scene::{SceneBuilder, camera_for, parse_background, parse_size};
 
 pub fn run(cli: Cli) -> Result<()> {
     match cli.command {
-        Command::Info { file, format } => info(&file, format.as_deref()),
+        Command::Info {
+            file,
+            format,
+            allow_truncated,
+            topology,
+        } => info(
+            &file,
+            format.as_deref(),
+            allow_truncated,
+            topology.as_deref(),
+        ),
         Command::Render(a) => render(&a),
         Command::Compare(a) => compare(&a),
         Command::Demo {
@@ -28,10 +38,13 @@ pub fn run(cli: Cli) -> Result<()> {
             every,
             size,
         } => demo(&out, steps, every, &size),
+        Command::Terrain { cmd } => crate::terrain::run(cmd),
+        Command::Envmap(a) => crate::envmap::run(a),
+        Command::Movie { dir, output, fps } => crate::movie::assemble(&dir, &output, fps),
     }
 }
 
-fn progress(len: u64, what: &str) -> ProgressBar {
+pub(crate) fn progress(len: u64, what: &str) -> ProgressBar {
     let pb = ProgressBar::new(len);
     pb.set_style(
         ProgressStyle::with_template(&format!(
@@ -44,30 +57,69 @@ fn progress(len: u64, what: &str) -> ProgressBar {
 }
 
 fn open_trajectory(file: &Path, format: Option<&str>) -> Result<Trajectory> {
+    open_trajectory_with(file, format, ReadOptions::new())
+}
+
+/// Prints what the reader tolerated under --allow-truncated (once each).
+fn print_warnings(traj: &Trajectory, shown: &mut usize) {
+    for w in &traj.warnings()[*shown..] {
+        eprintln!("texmap: warning: {w} (dropped: --allow-truncated)");
+    }
+    *shown = traj.warnings().len();
+}
+
+fn open_trajectory_with(
+    file: &Path,
+    format: Option<&str>,
+    options: ReadOptions,
+) -> Result<Trajectory> {
     if !file.exists() {
         bail!("{}: no such file", file.display());
+    }
+    if file.is_dir() {
+        bail!("{}: is a directory, not a trajectory file", file.display());
     }
     match format {
         Some(name) => {
             let Some(f) = Format::from_extension(name) else {
                 return usage(format!(
-                    "--format {name:?}: expected one of xyz, extxyz, pdb, gro, lammpstrj, dcd, xtc, trr"
+                    "--format {name:?}: expected one of xyz, extxyz, pdb, gro, lammpstrj, dcd, xtc, trr, nc"
                 ));
             };
-            Ok(Trajectory::open_as(file, f)?)
+            Ok(Trajectory::open_as_with(file, f, options)?)
         }
-        None => Ok(Trajectory::open(file)?),
+        None => Ok(Trajectory::open_with(file, options)?),
     }
 }
 
-fn info(file: &Path, format: Option<&str>) -> Result<()> {
-    let mut traj = open_trajectory(file, format)?;
+fn info(
+    file: &Path,
+    format: Option<&str>,
+    allow_truncated: bool,
+    topology: Option<&Path>,
+) -> Result<()> {
+    let options = ReadOptions::new().allow_truncated(allow_truncated);
+    let mut traj = open_trajectory_with(file, format, options)?;
+    let topo = topology.map(crate::scene::open_topology).transpose()?;
     let mut frame = MdFrame::new();
     let frames = traj.n_frames()?;
+    print_warnings(&traj, &mut 0);
     if frames == 0 {
         bail!("{}: the file holds no frame", file.display());
     }
     traj.read_frame(0, &mut frame)?;
+    let topo_json = match &topo {
+        Some(t) => {
+            t.apply(&mut frame, traj.name(), 0)?;
+            json!({
+                "file": t.name(),
+                "atoms": t.n_atoms(),
+                "residues": t.n_residues(),
+                "bonds": t.bonds.len(),
+            })
+        }
+        None => serde_json::Value::Null,
+    };
     let bx = frame.cell.as_ref().map(|c| {
         let l = c.lengths();
         let a = c.angles();
@@ -79,13 +131,16 @@ fn info(file: &Path, format: Option<&str>) -> Result<()> {
         .take(3)
         .map(|p| json!([p[0], p[1], p[2]]))
         .collect();
-    let obj = json!({
+    let mut obj = json!({
         "format": traj.format().name(),
         "atoms": frame.n_atoms(),
         "frames": frames,
         "box": bx,
         "first_positions": first,
     });
+    if !topo_json.is_null() {
+        obj["topology"] = topo_json;
+    }
     println!("{obj}");
     Ok(())
 }
@@ -130,6 +185,11 @@ pub fn parse_frames(spec: &str, n: usize) -> Result<Vec<usize>> {
             "start frame {a} is past the last frame ({n} frames)"
         ));
     }
+    if b <= a {
+        return bad(&format!(
+            "end {b} is not after start {a}: no frame to render"
+        ));
+    }
     Ok((a..b).step_by(step).collect())
 }
 
@@ -146,23 +206,45 @@ fn method_of(m: MethodArg) -> Option<Method> {
 fn render(a: &RenderArgs) -> Result<()> {
     let background = parse_background(&a.background)?;
     parse_size(&a.size)?;
-    let mut traj = open_trajectory(&a.file, a.format.as_deref())?;
+    let options = ReadOptions::new().allow_truncated(a.allow_truncated);
+    let mut traj = open_trajectory_with(&a.file, a.format.as_deref(), options)?;
     let n = traj.n_frames()?;
+    let mut shown = 0;
+    print_warnings(&traj, &mut shown);
     if n == 0 {
         bail!("{}: the file holds no frame", a.file.display());
     }
     let frames = parse_frames(&a.frames, n)?;
-    let multi = frames.len() > 1;
+    let mut sink = crate::movie::Sink::new(&a.output, frames.len(), a.fps, a.depth)?;
     let mut builder = SceneBuilder::new(&a.style)?;
+    let mut plan = crate::scene::MolPlan::new(&a.mol)?;
     let mut md = MdFrame::new();
     let mut scene = SphereScene::default();
     let mut renderer = Renderer::new();
     let mut camera: Option<Camera> = None;
     let pb = progress(frames.len() as u64, "rendering");
     let mut skipped_total = 0usize;
+    // Frames whose image is on disk, for the error if a later frame fails.
+    let mut written: Vec<PathBuf> = Vec::new();
     for &f in &frames {
-        traj.read_frame(f, &mut md)?;
-        builder.build(&mut md, &mut scene);
+        let fail = |e: anyhow::Error, written: &[PathBuf]| -> anyhow::Error {
+            if written.is_empty() {
+                return e.context(format!("frame {f}: nothing was written"));
+            }
+            let list: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
+            e.context(format!(
+                "frame {f}: stopped after {} complete image(s) of the frames before it: {}",
+                written.len(),
+                list.join(", ")
+            ))
+        };
+        traj.read_frame(f, &mut md)
+            .map_err(|e| fail(e.into(), &written))?;
+        print_warnings(&traj, &mut shown);
+        plan.label(&mut md, traj.name(), f)
+            .map_err(|e| fail(e, &written))?;
+        plan.build(&mut builder, &mut md, &mut scene)
+            .map_err(|e| fail(e, &written))?;
         if a.box_outline {
             add_box_outline(&md, &mut scene);
         }
@@ -173,7 +255,21 @@ fn render(a: &RenderArgs) -> Result<()> {
                 for w in builder.warnings(&md) {
                     pb.suspend(|| eprintln!("texmap: warning: {w}"));
                 }
-                let c = camera_for(a, &md, &scene)?;
+                if let Some(w) = plan.unnamed_warning(&md, traj.name()) {
+                    pb.suspend(|| eprintln!("texmap: warning: {w}"));
+                }
+                if scene.is_empty() {
+                    let e = anyhow::anyhow!(
+                        "no atom to draw{}",
+                        a.mol
+                            .select
+                            .as_deref()
+                            .map(|s| format!(": --select {s:?} selects none of frame {f}'s atoms"))
+                            .unwrap_or_default()
+                    );
+                    return Err(fail(e, &written));
+                }
+                let c = camera_for(a, &md, &scene).map_err(|e| fail(e, &written))?;
                 camera = Some(c.clone());
                 c
             }
@@ -183,27 +279,29 @@ fn render(a: &RenderArgs) -> Result<()> {
             Some(m) => {
                 let mut o = texmap_impostor::Options::new(m, lighting);
                 o.background = background;
+                o.draw_bonds = plan.draws_bonds();
                 let r = renderer.render(&scene, &cam, &o);
                 skipped_total += r.stats.skipped_invalid;
                 r.frame
             }
             None => harness::render_reference(
-                &harness::reference_scene(&scene),
+                &harness::reference_scene_with_bonds(&scene, plan.draws_bonds()),
                 &harness::reference_materials(&scene),
                 &cam,
                 lighting,
                 background,
                 1,
-            )?,
+            )
+            .map_err(|e| fail(e.into(), &written))?,
         };
-        let path = frame_path(&a.output, f, multi)?;
-        write_png(&out, &path)?;
-        if a.depth {
-            write_depth_exr(&out, &path.with_extension("exr"))?;
-        }
+        let files = sink
+            .write(f, &out, a.depth)
+            .map_err(|e| fail(e, &written))?;
+        written.extend(files);
         pb.inc(1);
     }
     pb.finish_and_clear();
+    let movie = sink.finish()?;
     if builder.merged_colors() > 0 {
         eprintln!(
             "texmap: warning: {} more distinct colours than the {} materials a scene holds; each was drawn with the nearest of the first {}",
@@ -218,7 +316,15 @@ fn render(a: &RenderArgs) -> Result<()> {
             frames.len()
         );
     }
-    eprintln!("texmap: wrote {} frame(s)", frames.len());
+    match movie {
+        Some(path) => eprintln!(
+            "texmap: wrote {} ({} frames at {} frames/s)",
+            path.display(),
+            frames.len(),
+            a.fps
+        ),
+        None => eprintln!("texmap: wrote {} frame(s)", frames.len()),
+    }
     Ok(())
 }
 
@@ -275,6 +381,7 @@ fn named_scene(a: &CompareArgs) -> Result<NamedScene> {
             let render_args = RenderArgs {
                 file: file.clone(),
                 format: None,
+                allow_truncated: false,
                 frames: "0".into(),
                 method: MethodArg::Raycast,
                 size: a.size.clone(),
@@ -285,10 +392,12 @@ fn named_scene(a: &CompareArgs) -> Result<NamedScene> {
                 target: None,
                 up: None,
                 style: a.style.clone(),
+                mol: crate::args::MolArgs::default(),
                 background: "0,0,0".into(),
                 box_outline: false,
                 depth: false,
                 output: PathBuf::new(),
+                fps: 25.0,
             };
             let camera = camera_for(&render_args, &md, &spheres)?;
             let stem = file
@@ -536,7 +645,7 @@ mod tests {
         assert_eq!(parse_frames("::2", 5).unwrap(), vec![0, 2, 4]);
         assert_eq!(parse_frames("1:100:2", 6).unwrap(), vec![1, 3, 5]);
         assert_eq!(parse_frames("3", 5).unwrap(), vec![3]);
-        for bad in ["7", "0:5:0", "a:b", "1:2:3:4", "-1:"] {
+        for bad in ["7", "0:5:0", "a:b", "1:2:3:4", "-1:", "4:2", "3:3"] {
             assert!(parse_frames(bad, 5).is_err(), "{bad}");
         }
     }

@@ -6,8 +6,12 @@
 
 mod args;
 mod commands;
+mod envmap;
+mod movie;
 mod output;
 mod scene;
+mod terrain;
+mod terrain_view;
 
 use std::process::ExitCode;
 

@@ -8,9 +8,13 @@ use texmap_core::camera::Camera;
 use texmap_core::color::{hsv_to_rgb, srgb_to_linear};
 use texmap_core::shade::Material;
 use texmap_impostor::SphereScene;
-use texmap_md_io::{Appearance, AtomStyle, Element, Frame, Label, Selector, atom_element};
+use texmap_md_io::{
+    Appearance, AtomStyle, Element, Frame, Label, Selection, Selector, Topology, atom_element,
+};
 
-use crate::args::{ColorBy, RenderArgs, StyleArgs, usage};
+use crate::args::{
+    BondsArg, ColorBy, DrawStyle, MolArgs, PbcArg, RenderArgs, StyleArgs, parse_color, usage,
+};
 
 /// Most materials a scene gets: every method handles this many cheaply (the LUT and template
 /// methods build tables per material). Colours past the first `MAX_MATERIALS` distinct ones
@@ -22,7 +26,7 @@ pub const MAX_MATERIALS: usize = 256;
 pub struct SceneBuilder {
     style: AtomStyle,
     color_by: ColorBy,
-    radius_scale: f32,
+    pub(crate) radius_scale: f32,
     /// The NAMEs of --type-radius / --type-color, for the no-match warning.
     names: Vec<(&'static str, String)>,
     palette: Vec<[u8; 3]>,
@@ -130,7 +134,7 @@ impl SceneBuilder {
     }
 
     /// The material of an sRGB colour in [0, 1] (quantised to 8 bits per channel).
-    fn kind_of(&mut self, srgb: [f32; 3]) -> u16 {
+    pub(crate) fn kind_of(&mut self, srgb: [f32; 3]) -> u16 {
         let key = srgb.map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8);
         if let Some(k) = self.kinds.get(&key) {
             return *k;
@@ -207,10 +211,18 @@ impl SceneBuilder {
         scene.radii.clear();
         scene.kinds.clear();
         scene.bonds.clear();
+        // Atoms with types but no colours, names or elements (a LAMMPS dump with numeric
+        // types) are coloured by type by default, as OVITO does.
+        let by_type = self.color_by == ColorBy::Type
+            || (self.color_by == ColorBy::Property
+                && frame.colors.is_empty()
+                && frame.names.is_empty()
+                && !frame.types.is_empty()
+                && frame.elements.iter().all(|e| e.is_unknown()));
         for i in 0..frame.n_atoms() {
             let p = frame.positions[i];
-            let color = match self.color_by {
-                ColorBy::Type => match self.style.rules_for(frame, i).color {
+            let color = match by_type {
+                true => match self.style.rules_for(frame, i).color {
                     Some(c) => c,
                     None => {
                         // One palette colour per type (or name), in order of appearance.
@@ -230,11 +242,16 @@ impl SceneBuilder {
                         type_color(idx)
                     }
                 },
-                _ => self.colors[i],
+                false => self.colors[i],
             };
             let kind = self.kind_of(color);
             scene.push(Vec3::from(p), self.radii[i] * self.radius_scale, kind);
         }
+        self.refresh_materials(scene);
+    }
+
+    /// One material per palette colour (after [`SceneBuilder::kind_of`] added some).
+    pub(crate) fn refresh_materials(&self, scene: &mut SphereScene) {
         scene.materials = self
             .palette
             .iter()
@@ -248,6 +265,256 @@ impl SceneBuilder {
             .collect();
     }
 }
+
+/// Reads a `--topology` file (its format told by the name).
+pub fn open_topology(path: &std::path::Path) -> Result<Topology> {
+    if path.is_dir() {
+        anyhow::bail!("{}: is a directory, not a topology file", path.display());
+    }
+    if !path.exists() {
+        anyhow::bail!("{}: no such file", path.display());
+    }
+    Ok(Topology::open(path)?)
+}
+
+/// A parsed selection, or a usage error pointing at the bad token's column.
+fn parse_selection(flag: &str, text: &str) -> Result<Selection> {
+    Selection::parse(text).map_err(|e| crate::args::UsageError(format!("{flag}: {e}")).into())
+}
+
+/// Splits `SEL=VALUE` at its last '='.
+fn sel_value<'a>(flag: &str, s: &'a str) -> Result<(&'a str, &'a str)> {
+    match s.rsplit_once('=') {
+        Some((sel, v)) if !sel.trim().is_empty() && !v.trim().is_empty() => {
+            Ok((sel.trim(), v.trim()))
+        }
+        _ => usage(format!(
+            "{flag} {s:?}: expected SELECTION=VALUE, e.g. {flag} 'resname SOL=#4080ff'"
+        )),
+    }
+}
+
+/// What `render` does to a frame between reading and drawing: topology, periodic boundaries,
+/// selection, per-selection looks and bonds (the [`MolArgs`]).
+pub struct MolPlan {
+    pub topology: Option<Topology>,
+    select: Option<Selection>,
+    colors: Vec<(Selection, [f32; 3])>,
+    radii: Vec<(Selection, f32)>,
+    bonds: BondsArg,
+    draw: DrawStyle,
+    pbc: PbcArg,
+    /// Scratch: selected atoms' new indices, bond pairs.
+    map: Vec<u32>,
+    pairs: Vec<[u32; 2]>,
+    /// The bonds of the last frame drawn (before the selection).
+    pub last_bond_count: usize,
+}
+
+impl MolPlan {
+    pub fn new(args: &MolArgs) -> Result<MolPlan> {
+        let topology = args.topology.as_deref().map(open_topology).transpose()?;
+        let select = args
+            .select
+            .as_deref()
+            .map(|t| parse_selection("--select", t))
+            .transpose()?;
+        let mut colors = Vec::new();
+        for c in &args.color_rules {
+            let (sel, v) = sel_value("--color", c)?;
+            let rgb =
+                parse_color(v).map_err(|e| crate::args::UsageError(format!("--color: {e}")))?;
+            colors.push((
+                parse_selection("--color", sel)?,
+                rgb.map(|x| x as f32 / 255.0),
+            ));
+        }
+        let mut radii = Vec::new();
+        for r in &args.radius_rules {
+            let (sel, v) = sel_value("--radius", r)?;
+            let radius = match v.parse::<f32>() {
+                Ok(x) if x.is_finite() && x > 0.0 => x,
+                _ => return usage(format!("--radius {r:?}: {v:?} is not a radius > 0 in Å")),
+            };
+            radii.push((parse_selection("--radius", sel)?, radius));
+        }
+        if args.bonds == BondsArg::Topology
+            && args.draw != DrawStyle::Spacefill
+            && topology.as_ref().is_none_or(|t| t.bonds.is_empty())
+        {
+            return usage(match &topology {
+                None => "--bonds topology needs --topology FILE (PDB with CONECT records, or a LAMMPS data file with a Bonds section)".to_string(),
+                Some(t) => format!("--bonds topology: {} has no bonds (use --bonds auto for bonds by distance)", t.name()),
+            });
+        }
+        Ok(MolPlan {
+            topology,
+            select,
+            colors,
+            radii,
+            bonds: args.bonds,
+            draw: args.draw,
+            pbc: args.pbc,
+            map: Vec::new(),
+            pairs: Vec::new(),
+            last_bond_count: 0,
+        })
+    }
+
+    /// Whether bonds are drawn at all.
+    pub fn draws_bonds(&self) -> bool {
+        self.draw != DrawStyle::Spacefill && self.bonds != BondsArg::None
+    }
+
+    /// The topology's labels on `frame` (number `index` of `trajectory`).
+    pub fn label(&self, frame: &mut Frame, trajectory: &str, index: usize) -> Result<()> {
+        if let Some(t) = &self.topology {
+            t.apply(frame, trajectory, index)?;
+        }
+        Ok(())
+    }
+
+    /// The bonds of `frame` as `--bonds` asks (before periodic handling).
+    fn find_bonds(&mut self, frame: &Frame, need: bool) {
+        self.pairs.clear();
+        if !need {
+            return;
+        }
+        match (self.bonds, &self.topology) {
+            (BondsArg::None, _) => {}
+            (BondsArg::Topology, Some(t)) => self.pairs.extend_from_slice(&t.bonds),
+            (BondsArg::Topology, None) => {}
+            (BondsArg::Auto, Some(t)) if !t.bonds.is_empty() => {
+                self.pairs.extend_from_slice(&t.bonds)
+            }
+            (BondsArg::Auto, _) => {
+                self.pairs = texmap_md_io::bonds::bonds_by_distance(frame, true).pairs;
+            }
+        }
+    }
+
+    /// Periodic boundaries, then the scene: selected atoms only, per-selection colours and
+    /// radii, bonds between drawn atoms (never across the box).
+    pub fn build(
+        &mut self,
+        builder: &mut SceneBuilder,
+        frame: &mut Frame,
+        scene: &mut SphereScene,
+    ) -> Result<()> {
+        let unwrap = self.pbc == PbcArg::Unwrap && frame.cell.is_some();
+        self.find_bonds(frame, self.draws_bonds() || unwrap);
+        match self.pbc {
+            PbcArg::None => {}
+            PbcArg::Wrap => texmap_md_io::pbc::wrap(frame),
+            PbcArg::Unwrap => {
+                if unwrap && self.bonds == BondsArg::None {
+                    // Molecules need bonds to be made whole even when none are drawn.
+                    self.pairs = texmap_md_io::bonds::bonds_by_distance(frame, true).pairs;
+                }
+                texmap_md_io::pbc::unwrap(frame, &self.pairs);
+            }
+        }
+        texmap_md_io::pbc::drop_crossing(&mut self.pairs, &frame.positions, frame.cell.as_ref());
+        self.last_bond_count = self.pairs.len();
+        // Every atom, styled; then the per-selection rules, in order.
+        builder.build(frame, scene);
+        for (sel, rgb) in &self.colors {
+            let mask = sel
+                .evaluate(frame)
+                .map_err(|e| crate::args::UsageError(format!("--color: {e}")))?;
+            let kind = builder.kind_of(*rgb);
+            for (i, m) in mask.iter().enumerate() {
+                if *m {
+                    scene.kinds[i] = kind;
+                }
+            }
+        }
+        builder.refresh_materials(scene);
+        let scale = builder.radius_scale;
+        for (sel, r) in &self.radii {
+            let mask = sel
+                .evaluate(frame)
+                .map_err(|e| crate::args::UsageError(format!("--radius: {e}")))?;
+            for (i, m) in mask.iter().enumerate() {
+                if *m {
+                    scene.radii[i] = r * scale;
+                }
+            }
+        }
+        match self.draw {
+            DrawStyle::Spacefill => {}
+            DrawStyle::BallStick => {
+                for r in &mut scene.radii {
+                    *r *= texmap_study::scenes::BALL_AND_STICK_RADIUS_SCALE;
+                }
+                scene.bond_radius = texmap_study::scenes::BALL_AND_STICK_BOND_RADIUS;
+            }
+            DrawStyle::Licorice => {
+                for r in &mut scene.radii {
+                    *r = LICORICE_RADIUS;
+                }
+                scene.bond_radius = LICORICE_RADIUS;
+            }
+        }
+        // The selection: keep selected atoms, renumber the bonds between them.
+        let mask = match &self.select {
+            Some(sel) => Some(
+                sel.evaluate(frame)
+                    .map_err(|e| crate::args::UsageError(format!("--select: {e}")))?,
+            ),
+            None => None,
+        };
+        self.map.clear();
+        if let Some(mask) = &mask {
+            let mut next = 0u32;
+            for &m in mask {
+                self.map.push(if m { next } else { u32::MAX });
+                next += m as u32;
+            }
+            let mut w = 0;
+            for (i, &m) in mask.iter().enumerate() {
+                if m {
+                    scene.centers[w] = scene.centers[i];
+                    scene.radii[w] = scene.radii[i];
+                    scene.kinds[w] = scene.kinds[i];
+                    w += 1;
+                }
+            }
+            scene.centers.truncate(w);
+            scene.radii.truncate(w);
+            scene.kinds.truncate(w);
+        }
+        scene.bonds.clear();
+        if self.draws_bonds() {
+            for b in &self.pairs {
+                let (i, j) = if self.map.is_empty() {
+                    (b[0], b[1])
+                } else {
+                    (self.map[b[0] as usize], self.map[b[1] as usize])
+                };
+                if i != u32::MAX && j != u32::MAX {
+                    scene.bonds.push([i, j]);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The once-per-run warning for atoms that have nothing to be told apart by.
+    pub fn unnamed_warning(&self, frame: &Frame, file: &str) -> Option<String> {
+        let nothing = frame.names.is_empty()
+            && frame.types.is_empty()
+            && (0..frame.n_atoms()).all(|i| atom_element(frame, i).is_unknown());
+        (self.topology.is_none() && nothing && frame.n_atoms() > 0).then(|| {
+            format!(
+                "{file} has no atom names, types or elements (coordinates only): every atom is drawn in the unknown-element colour; give --topology FILE (PDB, GRO or LAMMPS data file of the same atoms) for names, elements, residues and bonds"
+            )
+        })
+    }
+}
+
+/// Atom and stick radius of `--style licorice` (Å), as VMD's Licorice default (0.3).
+pub const LICORICE_RADIUS: f32 = 0.3;
 
 /// The 8 corners of a periodic cell, corner `c` at fractional coordinates of its bits (x, y, z).
 pub fn cell_corners(cell: &texmap_md_io::UnitCell) -> [Vec3; 8] {
@@ -325,8 +592,8 @@ fn view_direction(view: &str) -> Result<(Vec3, Vec3)> {
     })
 }
 
-/// The camera for a render: exactly `--eye/--target/--up` when given, else fitted to the first
-/// frame's atoms and box.
+/// The camera for a render: exactly `--eye/--target/--up` when given, else fitted to what the
+/// first frame draws (the selected atoms' bounding box's sphere).
 pub fn camera_for(args: &RenderArgs, first: &Frame, scene: &SphereScene) -> Result<Camera> {
     let (w, h) = parse_size(&args.size)?;
     let hfov = if args.ortho { None } else { Some(args.fov) };
@@ -361,14 +628,14 @@ pub fn camera_for(args: &RenderArgs, first: &Frame, scene: &SphereScene) -> Resu
         _ => return usage("--eye, --target and --up go together: give all three or none"),
     }
     let (dir, up) = view_direction(&args.view)?;
-    // Frame the union of the atoms and the periodic box (when the file has one).
+    // Frame what is drawn: the scene's spheres (the selected atoms, and the box outline when
+    // it is drawn); the periodic box only when no atom is drawn.
     let mut lo = Vec3::splat(f32::INFINITY);
     let mut hi = Vec3::splat(f32::NEG_INFINITY);
     if let Some((a, b)) = scene.bounds() {
         lo = a;
         hi = b;
-    }
-    if let Some(cell) = &first.cell {
+    } else if let Some(cell) = &first.cell {
         for p in cell_corners(cell) {
             lo = lo.min(p);
             hi = hi.max(p);

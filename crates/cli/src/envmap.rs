@@ -1,0 +1,292 @@
+//! `texmap envmap`: draw a reflective or refractive target with an environment map (Seed 003 and
+//! its alternatives), one frame or an animation; `texmap envmap compare` writes the study.
+//! Glue only: texmap-envmap renders, texmap-study compares, texmap-mesh reads meshes.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use clap::{Args, Subcommand, ValueEnum};
+use glam::Vec3;
+use texmap_core::camera::Camera;
+use texmap_core::color::srgb8_to_linear;
+use texmap_core::shade::Material;
+use texmap_envmap::scene::{TunnelParams, tunnel_camera, tunnel_lighting, tunnel_scene};
+use texmap_envmap::{
+    EnvScene, Environment, Method, Object, Options, Renderer, Surface, Target, TargetShape,
+};
+
+use crate::args::usage;
+use crate::output::{frame_path, write_png};
+use crate::scene::parse_size;
+
+#[derive(Args, Debug)]
+#[command(args_conflicts_with_subcommands = true)]
+pub struct EnvmapArgs {
+    #[command(subcommand)]
+    pub cmd: Option<EnvmapCmd>,
+    #[command(flatten)]
+    pub render: EnvRenderArgs,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum EnvmapCmd {
+    /// Every method against the reference ray tracer: envmap.csv, envmap.json and SVG charts.
+    Compare {
+        /// Output directory.
+        #[arg(long)]
+        out: PathBuf,
+        /// Image size of the study's frames, WxH.
+        #[arg(long, default_value = "320x240")]
+        size: String,
+        /// Reference samples per pixel axis (n x n per pixel).
+        #[arg(long, default_value_t = 3)]
+        samples: u32,
+    },
+}
+
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EnvMethodArg {
+    SphereStatic,
+    /// The static sphere map with coordinates per vertex (the 1998 way: rim sparkle).
+    SphereStaticVertex,
+    SphereDynamic,
+    Cube,
+    Paraboloid,
+    CubeBox,
+    /// The reference ray tracer (slow, exact).
+    Reference,
+}
+
+#[derive(Args, Debug)]
+pub struct EnvRenderArgs {
+    /// `builtin` (a mirror sphere in a tunnel of moving objects) or an OBJ/glTF file whose first
+    /// mesh is the target and the others the surrounding objects.
+    #[arg(long, default_value = "builtin")]
+    pub scene: String,
+    /// Latitude-longitude environment image (PNG or EXR, width = 2 x height); default: a
+    /// built-in sky.
+    #[arg(long, value_name = "FILE")]
+    pub env: Option<PathBuf>,
+    #[arg(long, value_enum, default_value = "sphere-dynamic")]
+    pub method: EnvMethodArg,
+    /// Make the target refractive with this index of refraction (> 0); default: a mirror.
+    #[arg(long, allow_negative_numbers = true)]
+    pub ior: Option<f32>,
+    /// Image size, WxH.
+    #[arg(long, default_value = "800x600")]
+    pub size: String,
+    /// Map side in texels.
+    #[arg(long, default_value_t = 256)]
+    pub map_size: u32,
+    /// Frames to render (1/24 s apart); use a %04d pattern in -o for more than one.
+    #[arg(long, default_value_t = 1)]
+    pub frames: usize,
+    /// Output PNG (or pattern such as frames/%04d.png).
+    #[arg(short = 'o', long = "out", default_value = "envmap.png")]
+    pub out: PathBuf,
+}
+
+pub fn run(a: EnvmapArgs) -> Result<()> {
+    match a.cmd {
+        Some(EnvmapCmd::Compare { out, size, samples }) => compare(&out, &size, samples),
+        None => render(&a.render),
+    }
+}
+
+fn compare(out: &Path, size: &str, samples: u32) -> Result<()> {
+    let (width, height) = parse_size(size)?;
+    let opts = texmap_study::envmap::EnvStudyOptions {
+        width,
+        height,
+        samples,
+        ..Default::default()
+    };
+    let pb = indicatif::ProgressBar::new_spinner();
+    pb.set_message("envmap study: rendering every method and the reference");
+    pb.enable_steady_tick(std::time::Duration::from_millis(200));
+    let records = texmap_study::envmap::run(&opts)?;
+    pb.finish_and_clear();
+    let files = texmap_study::envmap::write(out, &records)?;
+    for r in records.iter().filter(|r| r.study == "methods") {
+        println!(
+            "{:22} PSNR {:6.2} dB (env only {:6.2})  update {:8.2} ms  draw {:8.2} ms",
+            r.method, r.psnr_db, r.psnr_env_only_db, r.update_ms, r.draw_ms
+        );
+    }
+    for f in files {
+        println!("wrote {}", f.display());
+    }
+    Ok(())
+}
+
+/// A lat-long environment from a PNG (sRGB) or EXR (linear) file.
+fn load_environment(path: &Path) -> Result<Environment> {
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    let (w, h, texels) = if ext == "exr" {
+        let img = exr::prelude::read_first_rgba_layer_from_file(
+            path,
+            |res, _| (res.width(), vec![Vec3::ZERO; res.width() * res.height()]),
+            |(w, px), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+                px[pos.y() * *w + pos.x()] = Vec3::new(r, g, b);
+            },
+        )
+        .with_context(|| format!("{}: cannot read EXR", path.display()))?;
+        let size = img.layer_data.size;
+        (
+            size.width() as u32,
+            size.height() as u32,
+            img.layer_data.channel_data.pixels.1,
+        )
+    } else {
+        let img = image::open(path)
+            .with_context(|| format!("{}: cannot read image", path.display()))?
+            .to_rgb8();
+        let (w, h) = img.dimensions();
+        let texels = img
+            .pixels()
+            .map(|p| {
+                Vec3::new(
+                    srgb8_to_linear(p[0]),
+                    srgb8_to_linear(p[1]),
+                    srgb8_to_linear(p[2]),
+                )
+            })
+            .collect();
+        (w, h, texels)
+    };
+    Environment::lat_long(w, h, texels).with_context(|| format!("{}", path.display()))
+}
+
+/// The scene and a camera for it at time `t`.
+fn build(
+    a: &EnvRenderArgs,
+    env: &Option<Environment>,
+    t: f32,
+    w: u32,
+    h: u32,
+) -> Result<(EnvScene, Camera)> {
+    let surface = match a.ior {
+        Some(ior) => Surface::Refractive { ior },
+        None => Surface::Mirror,
+    };
+    if a.scene == "builtin" {
+        let s = tunnel_scene(TunnelParams {
+            time: t,
+            detail: 1,
+            surface,
+        })?;
+        let s = match env {
+            Some(e) => EnvScene::new(
+                s.objects().to_vec(),
+                s.target().clone(),
+                e.clone(),
+                *s.lighting(),
+            )?,
+            None => s,
+        };
+        return Ok((s, tunnel_camera(w, h)?));
+    }
+    let path = Path::new(&a.scene);
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    let meshes = match ext.as_str() {
+        "obj" => texmap_mesh::read_obj(path)?,
+        "gltf" | "glb" => texmap_mesh::read_gltf(path)?,
+        _ => {
+            return usage(format!(
+                "--scene {:?}: expected builtin, or a .obj, .gltf or .glb file",
+                a.scene
+            ));
+        }
+    };
+    let mut it = meshes.into_iter();
+    let Some(first) = it.next() else {
+        anyhow::bail!("{}: no mesh to use as the target", path.display());
+    };
+    let palette = [
+        Vec3::new(0.8, 0.8, 0.75),
+        Vec3::new(0.2, 0.4, 0.8),
+        Vec3::new(0.85, 0.3, 0.2),
+        Vec3::new(0.3, 0.75, 0.3),
+    ];
+    let objects = it
+        .enumerate()
+        .map(|(i, m)| Object {
+            mesh: m,
+            material: Material::matte(palette[i % palette.len()]),
+        })
+        .collect();
+    let s = EnvScene::new(
+        objects,
+        Target {
+            shape: TargetShape::Mesh(first),
+            surface,
+        },
+        env.clone().unwrap_or(Environment::Sky),
+        tunnel_lighting(),
+    )
+    .with_context(|| format!("{}", path.display()))?;
+    // Orbit the target at three bounding radii.
+    let r = s.radius().max(1e-3);
+    let ang = 0.4 + t * 0.5;
+    let eye = s.centre() + Vec3::new(ang.sin() * 3.0 * r, 0.8 * r, ang.cos() * 3.0 * r);
+    let cam = Camera::perspective_look_at(eye, s.centre(), Vec3::Y, 50.0, w, h)?;
+    Ok((s, cam))
+}
+
+fn render(a: &EnvRenderArgs) -> Result<()> {
+    if let Some(ior) = a.ior
+        && !(ior.is_finite() && ior > 0.0)
+    {
+        return usage(format!(
+            "--ior {ior}: the index of refraction must be a finite number > 0"
+        ));
+    }
+    if !(texmap_envmap::MIN_MAP_SIZE..=texmap_envmap::MAX_MAP_SIZE).contains(&a.map_size) {
+        return usage(format!(
+            "--map-size {}: expected {}..={}",
+            a.map_size,
+            texmap_envmap::MIN_MAP_SIZE,
+            texmap_envmap::MAX_MAP_SIZE
+        ));
+    }
+    if !(1..=100_000).contains(&a.frames) {
+        return usage(format!("--frames {}: expected 1..=100000", a.frames));
+    }
+    let (w, h) = parse_size(&a.size)?;
+    let env = a.env.as_deref().map(load_environment).transpose()?;
+    let multi = a.frames > 1;
+    let pb = crate::commands::progress(a.frames as u64, "envmap");
+    let mut renderer = Renderer::new();
+    for f in 0..a.frames {
+        let t = f as f32 / 24.0;
+        let (scene, cam) = build(a, &env, t, w, h)?;
+        let frame = match a.method {
+            EnvMethodArg::Reference => texmap_study::envmap::reference(&scene, &cam, true, 2)?,
+            m => {
+                let method = match m {
+                    EnvMethodArg::SphereStatic => Method::SphereStatic,
+                    EnvMethodArg::SphereStaticVertex => Method::SphereStaticVertex,
+                    EnvMethodArg::SphereDynamic => Method::SphereDynamic,
+                    EnvMethodArg::Cube => Method::Cube,
+                    EnvMethodArg::Paraboloid => Method::Paraboloid,
+                    EnvMethodArg::CubeBox => Method::CubeBox,
+                    EnvMethodArg::Reference => unreachable!("handled above"),
+                };
+                let mut o = Options::new(method);
+                o.map_size = a.map_size;
+                renderer.render(&scene, &cam, &o)?.frame
+            }
+        };
+        let path = frame_path(&a.out, f, multi)?;
+        write_png(&frame, &path)?;
+        pb.inc(1);
+    }
+    pb.finish_and_clear();
+    Ok(())
+}

@@ -1,0 +1,257 @@
+//! `texmap terrain build | info | export | maps`: glue between files, texmap-terrain and the terminal.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+use clap::Subcommand;
+use indicatif::{ProgressBar, ProgressStyle};
+use serde_json::json;
+use texmap_terrain::db::{self, BuildOptions, Database};
+use texmap_terrain::dem::{self, DemFormat, ReadOptions};
+use texmap_terrain::gst;
+
+use crate::args::usage;
+
+#[derive(Subcommand, Debug)]
+pub enum TerrainCmd {
+    /// Build a terrain database (chunked LoD mesh + GST map pyramid) from an elevation grid.
+    Build {
+        /// Elevation grid: GeoTIFF, ESRI ASCII (.asc), SRTM (.hgt) or 16-bit PNG.
+        #[arg(long)]
+        dem: PathBuf,
+        /// Orthophoto (PNG, JPEG or GeoTIFF), placed by its georeference or stretched.
+        #[arg(long)]
+        photo: Option<PathBuf>,
+        /// GeoTIFF photo bands for red, green, blue (1-based), e.g. 3,2,1.
+        #[arg(long)]
+        bands: Option<String>,
+        /// Maximum vertical error of the finest level, metres.
+        #[arg(long, default_value_t = 1.0)]
+        max_error: f32,
+        /// Samples per chunk side (2^k + 1).
+        #[arg(long, default_value_t = 257)]
+        chunk: u32,
+        /// Read a PNG as Mapbox Terrain-RGB.
+        #[arg(long)]
+        terrain_rgb: bool,
+        /// 16-bit PNG: metres per unit, offset, and metres between samples.
+        #[arg(long, default_value_t = 1.0)]
+        scale: f64,
+        #[arg(long, default_value_t = 0.0)]
+        offset: f64,
+        #[arg(long, default_value_t = 1.0)]
+        cell: f64,
+        /// Fill no-data from neighbours instead of leaving holes.
+        #[arg(long)]
+        fill: bool,
+        /// Output directory (must not exist).
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// Print a grid's or a database's size, georeference, height range, no-data count, levels and
+    /// triangles per level as one JSON object.
+    Info {
+        /// A database directory or an elevation file.
+        path: PathBuf,
+    },
+    /// Export the whole terrain at an error as .glb (texture embedded) or .obj (+ .mtl, .png).
+    Export {
+        /// Database directory.
+        dir: PathBuf,
+        #[arg(long, default_value_t = 1.0)]
+        max_error: f32,
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Greedy Delaunay refinement instead of the RTIN (fewer triangles; no no-data allowed).
+        #[arg(long)]
+        greedy: bool,
+    },
+    /// Seed 000 Eq. (5)-(7): GST maps the active area needs per level, and the total.
+    Maps {
+        #[arg(long, default_value_t = 45.0)]
+        fov: f64,
+        #[arg(long, default_value_t = 1024)]
+        pixels: u32,
+        #[arg(long, default_value_t = 256)]
+        map_texels: u32,
+        #[arg(long, default_value_t = 9)]
+        levels: u32,
+    },
+    /// Draw the database from an aircraft (flight view) with a Seed 000 sampler.
+    Render(crate::terrain_view::RenderArgs),
+}
+
+pub fn run(cmd: TerrainCmd) -> Result<()> {
+    match cmd {
+        TerrainCmd::Build {
+            dem,
+            photo,
+            bands,
+            max_error,
+            chunk,
+            terrain_rgb,
+            scale,
+            offset,
+            cell,
+            fill,
+            out,
+        } => {
+            let bands = match bands {
+                None => None,
+                Some(s) => {
+                    let v: Vec<u16> = s
+                        .split(',')
+                        .map(|t| t.trim().parse::<u16>())
+                        .collect::<Result<_, _>>()
+                        .or_else(|_| {
+                            usage(format!(
+                                "--bands {s}: expected three band numbers like 3,2,1"
+                            ))
+                        })?;
+                    match v[..] {
+                        [r, g, b] if r > 0 && g > 0 && b > 0 => Some([r, g, b]),
+                        _ => {
+                            return usage(format!(
+                                "--bands {s}: expected three 1-based band numbers like 3,2,1"
+                            ));
+                        }
+                    }
+                }
+            };
+            if !(max_error.is_finite() && max_error >= 0.0) {
+                return usage(format!("--max-error {max_error}: expected metres ≥ 0"));
+            }
+            let opts = ReadOptions {
+                format: terrain_rgb.then_some(DemFormat::TerrainRgb),
+                scale,
+                offset,
+                cell,
+            };
+            let mut grid = dem::read_dem(&dem, &opts)?;
+            if fill {
+                grid.fill_nodata();
+            }
+            let photo = photo.map(|p| gst::read_photo(&p, bands)).transpose()?;
+            let pb = ProgressBar::new(1);
+            pb.set_style(
+                ProgressStyle::with_template("{bar:40} {pos}/{len} {msg}")
+                    .unwrap_or_else(|_| ProgressStyle::default_bar()),
+            );
+            pb.set_message("building");
+            let bo = BuildOptions {
+                max_error,
+                chunk,
+                ..BuildOptions::default()
+            };
+            let m = db::build(
+                &grid,
+                &dem.display().to_string(),
+                photo.as_ref(),
+                &bo,
+                &out,
+                |d, t| {
+                    pb.set_length(t);
+                    pb.set_position(d);
+                },
+            )?;
+            pb.finish_and_clear();
+            let tris: u64 = m
+                .levels
+                .last()
+                .map_or(0, |l| l.chunks.iter().map(|c| c.triangles as u64).sum());
+            eprintln!(
+                "texmap: wrote {} ({} levels, {} triangles at the finest)",
+                out.display(),
+                m.levels.len(),
+                tris
+            );
+            Ok(())
+        }
+        TerrainCmd::Info { path } => {
+            let v = if path.is_dir() {
+                let d = Database::open(&path)?;
+                let m = &d.manifest;
+                json!({
+                    "database": path.display().to_string(), "width": m.width, "height": m.height, "georef": m.georef,
+                    "height_min": m.height_min, "height_max": m.height_max, "nodata": m.nodata, "max_error": m.max_error,
+                    "chunk": m.chunk,
+                    "levels": m.levels.iter().map(|l| json!({
+                        "depth": l.depth, "target_error": l.target_error, "chunks": l.chunks.len(),
+                        "triangles": l.chunks.iter().map(|c| c.triangles as u64).sum::<u64>(),
+                        "max_geometric_error": l.chunks.iter().map(|c| c.geometric_error).fold(0.0f32, f32::max),
+                    })).collect::<Vec<_>>(),
+                    "texture": m.texture,
+                })
+            } else {
+                let grid = dem::read_dem(&path, &ReadOptions::default())?;
+                db::grid_info(&grid, &path.display().to_string())
+            };
+            println!("{}", serde_json::to_string(&v)?);
+            Ok(())
+        }
+        TerrainCmd::Export {
+            dir,
+            max_error,
+            output,
+            greedy,
+        } => {
+            if !(max_error.is_finite() && max_error >= 0.0) {
+                return usage(format!("--max-error {max_error}: expected metres ≥ 0"));
+            }
+            let ext = output
+                .extension()
+                .and_then(|e| e.to_str())
+                .map(|e| e.to_ascii_lowercase());
+            let glb = match ext.as_deref() {
+                Some("glb") => true,
+                Some("obj") => false,
+                _ => {
+                    return usage(format!(
+                        "{}: the output must end in .glb or .obj",
+                        output.display()
+                    ));
+                }
+            };
+            let d = Database::open(&dir)?;
+            let grid = d.grid()?;
+            let mesh = if greedy {
+                db::whole_mesh_greedy(&grid, max_error)?
+            } else {
+                db::whole_mesh(&grid, max_error)?
+            };
+            let tex = d.texture(4096)?;
+            if glb {
+                texmap_mesh::write_glb(&output, &mesh, tex.as_ref())
+            } else {
+                texmap_mesh::write_obj(&output, &mesh, tex.as_ref())
+            }
+            .with_context(|| format!("exporting {}", output.display()))?;
+            eprintln!(
+                "texmap: wrote {} ({} vertices, {} triangles)",
+                output.display(),
+                mesh.positions.len(),
+                mesh.triangles.len()
+            );
+            Ok(())
+        }
+        TerrainCmd::Render(a) => crate::terrain_view::run(a),
+        TerrainCmd::Maps {
+            fov,
+            pixels,
+            map_texels,
+            levels,
+        } => {
+            let b = gst::map_budget(fov, pixels, map_texels, levels)
+                .or_else(|e| usage(e.to_string()))?;
+            let total: u64 = b.iter().map(|x| x.1).sum();
+            let v = json!({
+                "fov_deg": fov, "pixels": pixels, "map_texels": map_texels,
+                "levels": b.iter().map(|&(l, n)| json!({"level": l, "maps": n})).collect::<Vec<_>>(),
+                "total": total,
+                "resident_bytes": total * map_texels as u64 * map_texels as u64 * 4,
+            });
+            println!("{}", serde_json::to_string(&v)?);
+            Ok(())
+        }
+    }
+}

@@ -1,0 +1,208 @@
+//! `texmap terrain render`: one flight view of a terrain database to a PNG (and optionally its
+//! depth as OpenEXR), with the frame's statistics as JSON. Glue only: the view is
+//! `texmap_terrain::view`.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use clap::Args;
+use serde_json::json;
+use texmap_raster::Framebuffer;
+use texmap_terrain::db::Database;
+use texmap_terrain::view::{
+    FlightCamera, FlightTerrain, FrameScratch, SAMPLER_NAMES, ViewError, ViewOptions,
+    sampler_by_name,
+};
+
+use crate::args::{UsageError, usage};
+use crate::output::{write_depth_exr, write_png};
+
+/// Draw the terrain database from an aircraft.
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    /// Database directory (from `texmap terrain build`).
+    pub dir: PathBuf,
+    /// Eye position X,Y in the grid's georeference (default: the grid's centre).
+    #[arg(long, allow_hyphen_values = true)]
+    pub eye: Option<String>,
+    /// Eye altitude, metres above sea level (default: the ground at the eye plus a quarter of
+    /// the grid's smaller extent).
+    #[arg(long, allow_hyphen_values = true)]
+    pub altitude: Option<f64>,
+    /// Degrees clockwise from north.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub heading: f64,
+    /// Degrees above the horizon (negative looks down), −90..=90.
+    #[arg(long, default_value_t = -30.0, allow_hyphen_values = true)]
+    pub pitch: f64,
+    /// Degrees, positive right wing down.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub roll: f64,
+    /// Horizontal field of view, degrees.
+    #[arg(long, default_value_t = 45.0)]
+    pub fov: f64,
+    /// Image size WIDTHxHEIGHT.
+    #[arg(long, default_value = "1024x768")]
+    pub size: String,
+    /// nearest, bilinear, trilinear, span3, span4 or aniso.
+    #[arg(long, default_value = "trilinear")]
+    pub sampler: String,
+    /// Refine chunks while their screen-space error exceeds this many pixels.
+    #[arg(long, default_value_t = 1.0)]
+    pub pixel_error: f32,
+    /// Largest side of the whole-terrain texture assembled from the GST pyramid.
+    #[arg(long, default_value_t = 4096)]
+    pub max_texture: u32,
+    /// Sky colour R,G,B (0-255) where no terrain is drawn (default: transparent).
+    #[arg(long)]
+    pub sky: Option<String>,
+    /// Haze toward the horizon: the visibility in metres (contrast falls to 2 % there); the
+    /// haze colour is --sky (default 190,205,220). Off by default.
+    #[arg(long)]
+    pub haze: Option<f32>,
+    /// GST map cache budget, MiB (the maps Seed 000 Eq. 5-7 asks for are made resident and
+    /// counted; the frame samples the whole-terrain texture).
+    #[arg(long, default_value_t = 512)]
+    pub cache_mb: u64,
+    /// Output PNG.
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Also write the eye-space depth as a one-channel OpenEXR.
+    #[arg(long)]
+    pub depth: Option<PathBuf>,
+    /// Print the frame statistics as JSON on stdout (otherwise on stderr).
+    #[arg(long)]
+    pub stats: bool,
+}
+
+fn parse_pair<T: std::str::FromStr>(s: &str, sep: char, what: &str) -> Result<(T, T)> {
+    let mut it = s.split(sep).map(|t| t.trim().parse::<T>());
+    match (it.next(), it.next(), it.next()) {
+        (Some(Ok(a)), Some(Ok(b)), None) => Ok((a, b)),
+        _ => usage(format!(
+            "{what} {s}: expected two numbers separated by '{sep}'"
+        )),
+    }
+}
+
+fn view_error(e: ViewError) -> anyhow::Error {
+    match e {
+        ViewError::NonFinite { .. }
+        | ViewError::EyeOutside { .. }
+        | ViewError::BelowGround { .. }
+        | ViewError::BadParameter { .. }
+        | ViewError::Camera(_) => UsageError(e.to_string()).into(),
+        other => anyhow::Error::new(other),
+    }
+}
+
+pub fn run(a: RenderArgs) -> Result<()> {
+    let Some(sampler) = sampler_by_name(&a.sampler) else {
+        return usage(format!(
+            "--sampler {}: expected one of {}",
+            a.sampler,
+            SAMPLER_NAMES.join(", ")
+        ));
+    };
+    let (width, height) = parse_pair::<u32>(&a.size, 'x', "--size")?;
+    let background = match &a.sky {
+        None => [0, 0, 0, 0],
+        Some(s) => {
+            let v: Vec<u8> = s
+                .split(',')
+                .map(|t| t.trim().parse::<u8>())
+                .collect::<Result<_, _>>()
+                .or_else(|_| usage(format!("--sky {s}: expected R,G,B in 0..=255")))?;
+            match v[..] {
+                [r, g, b] => [r, g, b, 255],
+                _ => return usage(format!("--sky {s}: expected R,G,B in 0..=255")),
+            }
+        }
+    };
+    let db = Database::open(&a.dir)?;
+    let t0 = Instant::now();
+    let terrain = FlightTerrain::from_database(&db, a.max_texture).map_err(view_error)?;
+    let load_ms = t0.elapsed().as_secs_f64() * 1e3;
+
+    let mut view = FlightCamera::over(terrain.grid());
+    if let Some(e) = &a.eye {
+        let (x, y) = parse_pair::<f64>(e, ',', "--eye")?;
+        view.eye_x = x;
+        view.eye_y = y;
+        if a.altitude.is_none() {
+            // Keep the default height above the ground, now at the new eye.
+            let d = FlightCamera::over(terrain.grid());
+            let g = terrain.grid().georef();
+            let (c, r) = g.xy_to_sample(x, y);
+            let (c0, r0) = g.xy_to_sample(d.eye_x, d.eye_y);
+            let above = d.altitude
+                - texmap_terrain::view::ground_height(terrain.grid(), c0, r0).unwrap_or(0.0);
+            if let Some(h) = texmap_terrain::view::ground_height(
+                terrain.grid(),
+                c.clamp(0.0, (terrain.grid().width() - 1) as f64),
+                r.clamp(0.0, (terrain.grid().height() - 1) as f64),
+            ) {
+                view.altitude = h + above;
+            }
+        }
+    }
+    if let Some(h) = a.altitude {
+        view.altitude = h;
+    }
+    view.heading_deg = a.heading;
+    view.pitch_deg = a.pitch;
+    view.roll_deg = a.roll;
+    view.hfov_deg = a.fov;
+    view.width = width;
+    view.height = height;
+    // Validate the view before allocating the image.
+    view.camera(terrain.grid()).map_err(view_error)?;
+
+    let mut fb =
+        Framebuffer::new(width, height).map_err(|e| anyhow::anyhow!("--size {}: {e}", a.size))?;
+    let opts = ViewOptions {
+        pixel_error: a.pixel_error,
+        sampler,
+        background,
+    };
+    let t1 = Instant::now();
+    let stats = terrain
+        .render(&view, &opts, &mut fb, &mut FrameScratch::default())
+        .map_err(view_error)?;
+    let render_ms = t1.elapsed().as_secs_f64() * 1e3;
+    let mut cache = texmap_terrain::gst::GstCache::new(a.cache_mb.saturating_mul(1 << 20));
+    let residency = terrain
+        .make_resident(&view, &db, &mut cache)
+        .map_err(view_error)?;
+    let mut frame = fb.to_frame();
+    let pixels_covered = frame.coverage_count();
+    if let Some(v) = a.haze {
+        let sky = if a.sky.is_some() {
+            [background[0], background[1], background[2]]
+        } else {
+            [190, 205, 220]
+        };
+        let cam = view.camera(terrain.grid()).map_err(view_error)?;
+        texmap_terrain::view::apply_haze(&mut frame, &cam, sky, v).map_err(view_error)?;
+    }
+    write_png(&frame, &a.output)?;
+    if let Some(d) = &a.depth {
+        write_depth_exr(&frame, d)?;
+    }
+    let v = json!({
+        "eye": [view.eye_x, view.eye_y], "altitude": view.altitude,
+        "heading": view.heading_deg, "pitch": view.pitch_deg, "roll": view.roll_deg,
+        "fov": view.hfov_deg, "size": [width, height], "sampler": a.sampler,
+        "pixel_error": a.pixel_error,
+        "frame": stats, "pixels_covered": pixels_covered, "haze_m": a.haze, "residency": residency,
+        "load_ms": load_ms, "render_ms": render_ms,
+    });
+    let text = serde_json::to_string(&v).context("frame statistics")?;
+    if a.stats {
+        println!("{text}");
+    } else {
+        eprintln!("{text}");
+    }
+    Ok(())
+}

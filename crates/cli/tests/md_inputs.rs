@@ -1,0 +1,253 @@
+//! End-to-end tests of `texmap` on MD inputs written by other programs (MDAnalysis 2.11.0, scipy:
+//! md-io's tests/data/gen_topology.py): a topology beside a coordinate-only trajectory, AMBER
+//! NetCDF, bonds, selections, periodic boundaries, and the small defects of the issue.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn texmap(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_texmap"))
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+fn data(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../md-io/tests/data")
+        .join(name)
+        .to_str()
+        .unwrap()
+        .to_string()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn reference() -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(data("topology_reference.json")).unwrap())
+        .unwrap()
+}
+
+#[test]
+fn info_with_a_topology_counts_what_mdanalysis_counts() {
+    let r = reference();
+    for (traj, topo, key) in [
+        ("topo_mda.xtc", "topo_mda.pdb", "pdb"),
+        ("topo_mda.dcd", "topo_mda.gro", "gro"),
+        ("amber_mda.ncdf", "topo_mda.data", "data"),
+    ] {
+        let o = texmap(&["info", &data(traj), "--topology", &data(topo)]);
+        assert!(o.status.success(), "{traj}: {}", stderr(&o));
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        assert_eq!(v["atoms"], r[key]["n_atoms"]);
+        assert_eq!(v["frames"], 4);
+        assert_eq!(v["topology"]["atoms"], r[key]["n_atoms"]);
+        assert_eq!(
+            v["topology"]["bonds"].as_u64().unwrap() as usize,
+            r[key]["bonds"].as_array().unwrap().len()
+        );
+    }
+}
+
+#[test]
+fn a_count_mismatch_names_both_files_and_exits_1() {
+    let o = texmap(&[
+        "info",
+        &data("topo_mda.xtc"),
+        "--topology",
+        &data("select_mda.pdb"),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    let e = stderr(&o);
+    assert!(
+        e.contains("topo_mda.xtc") && e.contains("select_mda.pdb"),
+        "{e}"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("f.png");
+    let o = texmap(&[
+        "render",
+        &data("topo_mda.xtc"),
+        "--topology",
+        &data("select_mda.pdb"),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("select_mda.pdb"));
+    assert!(!out.exists());
+}
+
+#[test]
+fn small_defects_of_the_issue() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("f.png");
+    let o = out.to_str().unwrap();
+    // An empty frame range is an error (exit 2), not "wrote 0 frames".
+    let r = texmap(&["render", &data("topo_mda.xtc"), "--frames", "3:1", "-o", o]);
+    assert_eq!(r.status.code(), Some(2), "{}", stderr(&r));
+    assert!(stderr(&r).contains("not after start"), "{}", stderr(&r));
+    // A directory is said once.
+    let r = texmap(&["info", dir.path().to_str().unwrap()]);
+    assert_eq!(r.status.code(), Some(1));
+    let e = stderr(&r);
+    assert_eq!(e.matches("directory").count(), 1, "{e}");
+    // A trajectory without names says so once; with a topology it does not.
+    let r = texmap(&[
+        "render",
+        &data("topo_mda.xtc"),
+        "--frames",
+        "0:2",
+        "--size",
+        "64x48",
+        "-o",
+        o,
+    ]);
+    assert!(r.status.success(), "{}", stderr(&r));
+    assert_eq!(
+        stderr(&r).matches("--topology").count(),
+        1,
+        "{}",
+        stderr(&r)
+    );
+    let r = texmap(&[
+        "render",
+        &data("topo_mda.xtc"),
+        "--topology",
+        &data("topo_mda.gro"),
+        "--frames",
+        "0",
+        "--size",
+        "64x48",
+        "-o",
+        o,
+    ]);
+    assert!(r.status.success(), "{}", stderr(&r));
+    assert!(!stderr(&r).contains("no atom names"), "{}", stderr(&r));
+    // A bad selection points at the column.
+    let r = texmap(&[
+        "render",
+        &data("topo_mda.xtc"),
+        "--topology",
+        &data("topo_mda.pdb"),
+        "--select",
+        "resname SOL and (",
+        "-o",
+        o,
+    ]);
+    assert_eq!(r.status.code(), Some(2));
+    assert!(stderr(&r).contains("column 18"), "{}", stderr(&r));
+}
+
+fn mean_abs_diff(a: &Path, b: &Path) -> f64 {
+    let a = image::open(a).unwrap().to_rgb8();
+    let b = image::open(b).unwrap().to_rgb8();
+    assert_eq!(a.dimensions(), b.dimensions());
+    let s: u64 = a
+        .as_raw()
+        .iter()
+        .zip(b.as_raw())
+        .map(|(x, y)| (*x as i32 - *y as i32).unsigned_abs() as u64)
+        .sum();
+    s as f64 / a.as_raw().len() as f64
+}
+
+fn lit(p: &Path) -> usize {
+    let a = image::open(p).unwrap().to_rgb8();
+    a.pixels().filter(|p| p.0.iter().any(|c| *c > 0)).count()
+}
+
+#[test]
+fn ball_and_stick_of_a_selection_matches_the_reference_ray_tracer() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |method: &str, extra: &[&str]| -> PathBuf {
+        let out = dir
+            .path()
+            .join(format!("{method}-{}.png", extra.join("_").replace(' ', "")));
+        let mut args = vec![
+            "render",
+            "--frames",
+            "1",
+            "--size",
+            "160x120",
+            "--method",
+            method,
+            "--topology",
+        ];
+        let (traj, topo) = (data("amber_mda.ncdf"), data("topo_mda.pdb"));
+        args.push(&topo);
+        args.push(&traj);
+        args.extend_from_slice(extra);
+        let o = out.to_str().unwrap().to_string();
+        args.extend_from_slice(&["-o", &o]);
+        let r = texmap(&args);
+        assert!(r.status.success(), "{}", stderr(&r));
+        out
+    };
+    let bs = [
+        "--style",
+        "ball-stick",
+        "--select",
+        "not resname SOL",
+        "--pbc",
+        "unwrap",
+    ];
+    let ours = run("raycast", &bs);
+    let reference = run("reference", &bs);
+    let d = mean_abs_diff(&ours, &reference);
+    assert!(d < 2.0, "mean |raycast - reference| = {d} per channel");
+    // Something is drawn (atoms at 0.3 of their radii and thin sticks: a few hundred pixels).
+    assert!(lit(&ours) > 100, "{}", lit(&ours));
+    // The same atoms at the same size without bonds (spacefill) light fewer pixels.
+    let spacefill = run(
+        "raycast",
+        &[
+            "--select",
+            "not resname SOL",
+            "--pbc",
+            "unwrap",
+            "--radius-scale",
+            "0.3",
+        ],
+    );
+    assert!(
+        lit(&ours) > lit(&spacefill) + 20,
+        "sticks add pixels: {} vs {}",
+        lit(&ours),
+        lit(&spacefill)
+    );
+}
+
+#[test]
+fn per_selection_colour_wins() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("c.png");
+    let r = texmap(&[
+        "render",
+        &data("topo_mda.gro"),
+        "--color",
+        "all=#00ff00",
+        "--color",
+        "resname SOL=0,0,255",
+        "--select",
+        "resname SOL",
+        "--size",
+        "96x72",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(r.status.success(), "{}", stderr(&r));
+    let img = image::open(&out).unwrap().to_rgb8();
+    // Only water drawn, all of it blue: no lit pixel is red- or green-dominant.
+    let mut blue = 0;
+    for p in img.pixels() {
+        let [r, g, b] = p.0;
+        if r.max(g).max(b) > 20 {
+            assert!(b >= r && b >= g, "{:?}", p.0);
+            blue += 1;
+        }
+    }
+    assert!(blue > 50);
+}
