@@ -89,9 +89,123 @@ fn tiff_err(source: &str, at: &str) -> impl FnOnce(tiff::TiffError) -> TerrainEr
     }
 }
 
+/// Check the first image directory against the file before the `tiff` decoder reads it: every
+/// entry's values (count x type size) must fit in the file. The decoder sizes a tag's value list
+/// from its count (and keeps each value as a wide enum), so one flipped bit in a count would
+/// otherwise allocate gigabytes for a kilobyte file.
+fn check_directory(path: &Path, source: &str) -> Result<(), TerrainError> {
+    use std::io::{Read, Seek, SeekFrom};
+    let bad = |at: String, expected: String| TerrainError::Format {
+        source: source.to_string(),
+        at,
+        expected,
+    };
+    let mut f = std::fs::File::open(path).map_err(io(path))?;
+    let len = f.metadata().map_err(io(path))?.len();
+    let mut head = [0u8; 16];
+    let got = f.read(&mut head).map_err(io(path))?;
+    if got < 8 {
+        return Err(bad("header".into(), "a TIFF header of 8 bytes".into()));
+    }
+    let le = match &head[..2] {
+        b"II" => true,
+        b"MM" => false,
+        _ => return Err(bad("header".into(), "byte order II or MM".into())),
+    };
+    let u16_at = |b: &[u8]| {
+        if le {
+            u16::from_le_bytes([b[0], b[1]])
+        } else {
+            u16::from_be_bytes([b[0], b[1]])
+        }
+    };
+    let u32_at = |b: &[u8]| {
+        let a = [b[0], b[1], b[2], b[3]];
+        if le {
+            u32::from_le_bytes(a)
+        } else {
+            u32::from_be_bytes(a)
+        }
+    };
+    let u64_at = |b: &[u8]| {
+        let a = [b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7]];
+        if le {
+            u64::from_le_bytes(a)
+        } else {
+            u64::from_be_bytes(a)
+        }
+    };
+    let big = match u16_at(&head[2..4]) {
+        42 => false,
+        43 => true,
+        v => {
+            return Err(bad(
+                "header".into(),
+                format!("version 42 or 43 (BigTIFF), found {v}"),
+            ));
+        }
+    };
+    if big && got < 16 {
+        return Err(bad("header".into(), "a BigTIFF header of 16 bytes".into()));
+    }
+    let ifd = if big {
+        u64_at(&head[8..16])
+    } else {
+        u32_at(&head[4..8]) as u64
+    };
+    let (count_size, entry_size, inline) = if big { (8u64, 20u64, 8u64) } else { (2, 12, 4) };
+    if ifd.saturating_add(count_size) > len {
+        return Err(bad(
+            "first IFD offset".into(),
+            format!("an offset inside the {len}-byte file, found {ifd}"),
+        ));
+    }
+    f.seek(SeekFrom::Start(ifd)).map_err(io(path))?;
+    let mut cbuf = [0u8; 8];
+    f.read_exact(&mut cbuf[..count_size as usize])
+        .map_err(io(path))?;
+    let entries = if big {
+        u64_at(&cbuf)
+    } else {
+        u16_at(&cbuf) as u64
+    };
+    if ifd + count_size + entries.saturating_mul(entry_size) > len {
+        return Err(bad(
+            format!("IFD at byte {ifd}"),
+            format!("{entries} entries inside the {len}-byte file"),
+        ));
+    }
+    let mut table = vec![0u8; (entries * entry_size) as usize];
+    f.read_exact(&mut table).map_err(io(path))?;
+    for e in table.chunks_exact(entry_size as usize) {
+        let tag = u16_at(&e[0..2]);
+        let size: u64 = match u16_at(&e[2..4]) {
+            1 | 2 | 6 | 7 => 1,
+            3 | 8 => 2,
+            4 | 9 | 11 | 13 => 4,
+            5 | 10 | 12 | 16 | 17 | 18 => 8,
+            _ => 1, // an unknown type: the decoder reports it
+        };
+        let count = if big {
+            u64_at(&e[4..12])
+        } else {
+            u32_at(&e[4..8]) as u64
+        };
+        let bytes = count.saturating_mul(size);
+        if bytes > inline && bytes > len {
+            return Err(bad(
+                format!("tag {tag}"),
+                format!("values that fit in the {len}-byte file, found {count} of {size} bytes"),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// The number of bands (SamplesPerPixel) of a TIFF, read from its header only.
 pub fn band_count(path: &Path) -> Result<u16, TerrainError> {
     let source = path.display().to_string();
+    check_directory(path, &source)?;
     let file = std::fs::File::open(path).map_err(io(path))?;
     let mut dec =
         Decoder::new(std::io::BufReader::new(file)).map_err(tiff_err(&source, "header"))?;
@@ -108,6 +222,7 @@ pub fn read_raster(
     chunk_limit: usize,
 ) -> Result<Raster, TerrainError> {
     let source = path.display().to_string();
+    check_directory(path, &source)?;
     let file = std::fs::File::open(path).map_err(io(path))?;
     let mut limits = Limits::default();
     limits.decoding_buffer_size = chunk_limit;
@@ -191,13 +306,56 @@ pub fn read_raster(
         total
     };
     let across = width.div_ceil(cw.max(1));
+    let down = height.div_ceil(ch.max(1));
+    // The offsets table is in the file: an image whose header claims more strips or tiles than
+    // the table lists is refused before anything is sized from the claim.
+    let needed = match chunk_type {
+        ChunkType::Tile => across as u64 * down as u64,
+        ChunkType::Strip => down as u64,
+    };
+    if (per_plane as u64) < needed {
+        return Err(format_err(
+            &source,
+            "tags 273/324 StripOffsets/TileOffsets",
+            format!(
+                "{needed} strips or tiles for a {width}x{height} image, the file lists {per_plane}"
+            ),
+        ));
+    }
+    // What each stored chunk can decode to: its byte count times the largest expansion of its
+    // compression (none 1x; PackBits 64x: two bytes per 128-byte run; Deflate 1032x; LZW at
+    // most 4096 bytes per 12-bit code). A chunk whose claimed size exceeds it is damage, found
+    // before the decoder sizes a buffer for it.
+    let counts = dec
+        .get_tag_u64_vec(match chunk_type {
+            ChunkType::Tile => Tag::TileByteCounts,
+            ChunkType::Strip => Tag::StripByteCounts,
+        })
+        .map_err(tiff_err(
+            &source,
+            "tags 279/325 StripByteCounts/TileByteCounts",
+        ))?;
+    let compression: u16 = dec
+        .find_tag_unsigned(Tag::Compression)
+        .map_err(tiff_err(&source, "tag 259 Compression"))?
+        .unwrap_or(1);
+    let expansion: u64 = match compression {
+        1 => 1,
+        32773 => 64,
+        8 | 32946 => 1032,
+        _ => 2731, // LZW: 4096 bytes from 12 bits
+    };
+    let sample_bytes = (bits as u64).div_ceil(8).max(1);
     let n = width as usize * height as usize;
-    let mut out: Vec<Vec<f32>> = want.iter().map(|_| vec![0.0f32; n]).collect();
+    // The bands grow as their rows are decoded (each chunk's decoded size is bounded by the
+    // decoder's limit), so a header's claim alone never sizes a buffer.
+    let mut out: Vec<Vec<f32>> = want.iter().map(|_| Vec::new()).collect();
     for chunk in 0..per_plane {
         let (x0, y0) = match chunk_type {
             ChunkType::Tile => ((chunk % across) * cw, (chunk / across) * ch),
             ChunkType::Strip => (0, chunk * ch),
         };
+
         if y0 >= height {
             return Err(format_err(
                 &source,
@@ -217,7 +375,26 @@ pub fn read_raster(
         for (index, only) in reads {
             let (dw, dh) = dec.chunk_data_dimensions(index);
             let at = format!("chunk {index}");
+            let stored = counts.get(index as usize).copied().unwrap_or(0);
+            let claimed =
+                dw as u64 * dh as u64 * sample_bytes * if planar { 1 } else { spp as u64 };
+            if claimed > stored.saturating_mul(expansion).saturating_add(64) {
+                return Err(format_err(
+                    &source,
+                    &at,
+                    format!(
+                        "{claimed} decoded bytes cannot come from {stored} stored bytes (compression {compression})"
+                    ),
+                ));
+            }
             let data = dec.read_chunk(index).map_err(tiff_err(&source, &at))?;
+            let rows_end = (y0 + dh).min(height) as usize;
+            for band in &mut out {
+                let len = (rows_end * width as usize).min(n);
+                if band.len() < len {
+                    band.resize(len, 0.0);
+                }
+            }
             let vals = to_f32(data).ok_or_else(|| TerrainError::Unsupported {
                 source: source.clone(),
                 what: format!("{at}: sample type (need integer or 32/64-bit float samples)"),
@@ -248,6 +425,9 @@ pub fn read_raster(
                 }
             }
         }
+    }
+    for band in &mut out {
+        band.resize(n, 0.0); // every chunk was read: already n long
     }
     Ok(Raster {
         width,

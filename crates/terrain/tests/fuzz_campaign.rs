@@ -1,0 +1,191 @@
+//! The terrain readers in the fuzz campaign every reader of the project runs (the harness is
+//! md-io's `tests/support/`, shared by path): GeoTIFF files written by GDAL (five sample types,
+//! strips and tiles, LZW, BigTIFF, PixelIsPoint), the ESRI ASCII grid GDAL wrote, and an SRTM
+//! `.hgt` tile and a 16-bit PNG made here. Each mutant — a cut, bit flips, byte replacements,
+//! header fields set to extremes — must end in a grid or an error naming the file, never a panic,
+//! under a heap cap of 64x the mutant's size + 1 MiB.
+//!
+//! `cargo test -p texmap-terrain --test fuzz_campaign -- --nocapture` prints the table.
+
+#[path = "../../md-io/tests/support/alloc.rs"]
+mod alloc;
+#[allow(dead_code)] // the md-io campaign uses the rest
+#[path = "../../md-io/tests/support/campaign.rs"]
+mod campaign;
+
+use std::path::{Path, PathBuf};
+
+use alloc::CountingAlloc;
+use campaign::{Cuts, Field, Fixture, Settings, Verdict, run_campaign};
+use texmap_terrain::TerrainError;
+use texmap_terrain::dem::{self, Grid};
+
+#[global_allocator]
+static ALLOC: CountingAlloc = CountingAlloc;
+
+fn data(name: &str) -> Vec<u8> {
+    std::fs::read(
+        PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/data")
+            .join(name),
+    )
+    .unwrap()
+}
+
+fn fixture(name: &str, bytes: Vec<u8>, fields: Vec<(&'static str, Field)>, text: bool) -> Fixture {
+    let n = bytes.len();
+    Fixture {
+        name: name.into(),
+        frames: 1,
+        boundaries: (1..16).map(|k| k * n / 16).collect(),
+        cuts: Cuts::Declared,
+        fields,
+        text,
+        bytes,
+    }
+}
+
+/// A grid read, or an error that names the file: the campaign's verdict for one mutant.
+fn verdict(result: Result<Grid, TerrainError>, file: &Path) -> Verdict {
+    match result {
+        Ok(g) => {
+            if g.heights().len() != g.width() as usize * g.height() as usize {
+                return Verdict::Broken("heights and size disagree".into());
+            }
+            if g.heights().iter().any(|h| h.is_infinite()) {
+                return Verdict::Broken("an infinite height in a grid".into());
+            }
+            Verdict::Ok { frames: 1 }
+        }
+        Err(e) => {
+            let msg = e.to_string();
+            let name = file.file_name().unwrap().to_string_lossy();
+            if msg.contains(name.as_ref()) {
+                Verdict::Located(match e {
+                    TerrainError::Io { .. } => "Io",
+                    TerrainError::Format { .. } => "Format",
+                    TerrainError::Unsupported { .. } => "Unsupported",
+                    TerrainError::BadSize { .. } => "BadSize",
+                    TerrainError::NonFinite { .. } => "NonFinite",
+                    TerrainError::AllNoData { .. } => "AllNoData",
+                    _ => "other",
+                })
+            } else {
+                Verdict::Broken(format!("an error that names no file: {msg}"))
+            }
+        }
+    }
+}
+
+/// A cut of a single-grid file is never a complete grid: with `Cuts::Declared` the harness
+/// expects an error for every cut short of the end, but a TIFF cut after its last strip's data
+/// still holds the whole image, so TIFF fixtures use `Cuts::Unchecked`.
+fn unchecked(mut f: Fixture) -> Fixture {
+    f.cuts = Cuts::Unchecked;
+    f
+}
+
+#[test]
+fn terrain_readers_survive_the_campaign() {
+    let dir = tempfile::tempdir().unwrap();
+    let settings = Settings {
+        seeded_cuts: 24,
+        flips: 256,
+        ..Settings::default()
+    };
+    let mut report = String::new();
+
+    // GeoTIFF (bytes 4..8: the first IFD offset, a field every reader trusts first).
+    let tiffs: Vec<Fixture> = [
+        "ramp_i16_lzw.tif",
+        "ramp_u16_tiled_bigtiff.tif",
+        "ramp_i32_point.tif",
+        "ramp_f32_geo.tif",
+        "ramp_f64.tif",
+    ]
+    .iter()
+    .map(|n| {
+        let bytes = data(n);
+        let ifd = if bytes.get(2) == Some(&43) {
+            vec![]
+        } else {
+            vec![("first IFD offset", Field::I32Le(4))]
+        };
+        unchecked(fixture(n, bytes, ifd, false))
+    })
+    .collect();
+    let path = dir.path().join("mutant.tif");
+    let t = run_campaign("GeoTIFF", &tiffs, &settings, &|_, bytes| {
+        std::fs::write(&path, bytes).unwrap();
+        verdict(dem::geotiff::read_geotiff(&path), &path)
+    });
+    report.push_str(&t.report());
+    assert!(t.failures.is_empty(), "{}", t.report());
+
+    // ESRI ASCII (text: the ncols number set to extremes).
+    let asc = data("ramp_gdal.asc");
+    let text = String::from_utf8(asc.clone()).unwrap();
+    let start = text.find(|c: char| c.is_ascii_digit()).unwrap();
+    let end = start + text[start..].find(|c: char| !c.is_ascii_digit()).unwrap();
+    let fx = vec![unchecked(fixture(
+        "ramp_gdal.asc",
+        asc,
+        vec![("ncols", Field::Text(start, end))],
+        true,
+    ))];
+    let t = run_campaign("ESRI ASCII", &fx, &settings, &|_, bytes| {
+        let name = "ramp_gdal.asc";
+        match std::str::from_utf8(bytes) {
+            Ok(s) => verdict(dem::asc::read_asc_str(s, name), Path::new(name)),
+            Err(_) => Verdict::Located("not UTF-8"),
+        }
+    });
+    report.push_str(&t.report());
+    assert!(t.failures.is_empty(), "{}", t.report());
+
+    // SRTM .hgt: 1201² big-endian i16 with voids; the size is the whole header, so every cut is
+    // an error.
+    let mut hgt = Vec::with_capacity(1201 * 1201 * 2);
+    for k in 0..1201 * 1201u32 {
+        let h: i16 = if k % 997 == 0 {
+            -32768
+        } else {
+            (k % 3000) as i16
+        };
+        hgt.extend_from_slice(&h.to_be_bytes());
+    }
+    let fx = vec![fixture("N35E138.hgt", hgt, vec![], false)];
+    let hgt_path = dir.path().join("N35E138.hgt");
+    let small = Settings {
+        flips: 32,
+        seeded_cuts: 8,
+        ..settings.clone()
+    };
+    let t = run_campaign("SRTM hgt", &fx, &small, &|_, bytes| {
+        std::fs::write(&hgt_path, bytes).unwrap();
+        verdict(dem::hgt::read_hgt(&hgt_path), &hgt_path)
+    });
+    report.push_str(&t.report());
+    assert!(t.failures.is_empty(), "{}", t.report());
+
+    // A 16-bit PNG heightmap written by the image crate.
+    let png_path = dir.path().join("height16.png");
+    let img = image::ImageBuffer::<image::Luma<u16>, _>::from_fn(33, 21, |x, y| {
+        image::Luma([(x * 900 + y * 50) as u16])
+    });
+    img.save(&png_path).unwrap();
+    let fx = vec![unchecked(fixture(
+        "height16.png",
+        std::fs::read(&png_path).unwrap(),
+        vec![],
+        false,
+    ))];
+    let mutant = dir.path().join("mutant16.png");
+    let t = run_campaign("16-bit PNG", &fx, &settings, &|_, bytes| {
+        std::fs::write(&mutant, bytes).unwrap();
+        verdict(dem::png::read_png16(&mutant, 0.1, -10.0, 30.0), &mutant)
+    });
+    report.push_str(&t.report());
+    assert!(t.failures.is_empty(), "{}", t.report());
+    eprintln!("{report}");
+}
