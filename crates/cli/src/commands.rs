@@ -516,6 +516,12 @@ fn demo(out: &Path, steps: usize, every: usize, size: &str) -> Result<()> {
     // Animate with every method.
     let pb = progress((frames.len() * Method::ALL.len()) as u64, "animating");
     let mut summaries = Vec::new();
+    // The exact method's animation also goes into one movie file: an animated PNG, which needs
+    // no external program (texmap movie frames/raycast -o md.mp4 makes an MP4 with ffmpeg).
+    let (cam_w, cam_h) = (cam.width(), cam.height());
+    let mut movie_opts = texmap_movie::MovieOptions::new(cam_w, cam_h, frames.len() as u32);
+    movie_opts.fps = 12.0;
+    let mut movie = texmap_movie::MovieWriter::create(&out.join("md.apng"), &movie_opts)?;
     for method in Method::ALL {
         let mut renderer = Renderer::new();
         let opts = harness::study_options(method, lighting);
@@ -532,6 +538,9 @@ fn demo(out: &Path, steps: usize, every: usize, size: &str) -> Result<()> {
                     .join(method.name())
                     .join(format!("{i:04}.png")),
             )?;
+            if method == Method::Raycast {
+                movie.push(&r.frame.color)?;
+            }
             pb.inc(1);
         }
         summaries.push(AnimationSummary {
@@ -541,6 +550,7 @@ fn demo(out: &Path, steps: usize, every: usize, size: &str) -> Result<()> {
         });
     }
     pb.finish_and_clear();
+    movie.finish()?;
 
     // Compare every method with the reference on S1 and run the sweeps.
     eprintln!("texmap: comparing every method with the reference ray tracer (S1)");
@@ -586,7 +596,9 @@ td,th{border:1px solid #bbb;padding:4px 8px;text-align:right}th{background:#eee}
 <p>1,115 particles (409 O, 50 Si, 6 Al, 50 Mg, 500 H, 100 He) moved by a Lennard-Jones MD integrator \
 (velocity Verlet), drawn by four sphere methods on the CPU and compared with a BVH reference ray tracer.</p>\n\
 <h2>Animation</h2>\n<p><button onclick=\"play=!play\">play / pause</button> \
-<input type=\"range\" id=\"slider\" min=\"0\" value=\"0\" oninput=\"show(+this.value)\"> frame <span id=\"fno\">0</span></p>\n",
+<input type=\"range\" id=\"slider\" min=\"0\" value=\"0\" oninput=\"show(+this.value)\"> frame <span id=\"fno\">0</span> \
+&middot; the exact ray-cast animation as one movie file: <a href=\"md.apng\">md.apng</a> \
+(<code>texmap movie frames/raycast -o md.mp4</code> makes an MP4)</p>\n",
     );
     for a in anim {
         s.push_str(&format!(

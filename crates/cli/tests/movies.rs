@@ -172,3 +172,33 @@ fn unknown_extensions_are_refused_before_any_work() {
     ]);
     assert_eq!(out.status.code(), Some(2));
 }
+
+#[test]
+fn the_demo_writes_its_animation_as_a_movie() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("demo");
+    let o = texmap(&[
+        "demo",
+        "--out",
+        out.to_str().unwrap(),
+        "--steps",
+        "40",
+        "--every",
+        "10",
+        "--size",
+        "96x96",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert!(html.contains("md.apng"));
+    let movie = out.join("md.apng");
+    let frames = std::fs::read_dir(out.join("frames/raycast"))
+        .unwrap()
+        .count();
+    assert!(frames >= 4);
+    if ffmpeg_available() {
+        assert_eq!(ffprobe_frames(&movie), frames);
+    } else {
+        assert!(image::open(&movie).is_ok(), "the first frame decodes");
+    }
+}
