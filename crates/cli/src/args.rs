@@ -302,6 +302,13 @@ pub struct RenderArgs {
     /// Frames per second of a movie output.
     #[arg(long, default_value_t = 25.0)]
     pub fps: f64,
+    /// Render only part I of N (0-based) of the frames, as one task of a job array: the frames are
+    /// split into N contiguous blocks, each part writes its PNG frames under the names a single
+    /// render would give (the camera is fitted to the first frame of the whole render, so the
+    /// images are byte-identical), and `texmap movie DIR -o movie.mp4` assembles them. Default:
+    /// SLURM_ARRAY_TASK_ID - SLURM_ARRAY_TASK_MIN of SLURM_ARRAY_TASK_COUNT when Slurm sets them.
+    #[arg(long, value_name = "I/N")]
+    pub shard: Option<String>,
     /// Topology, selection, bonds and periodic boundaries.
     #[command(flatten)]
     pub mol: MolArgs,

@@ -145,6 +145,47 @@ fn info(
     Ok(())
 }
 
+/// `--shard I/N`, or Slurm's job-array variables when the flag is absent: `(I, N)` with
+/// `I < N`, or `None` for an unsharded render.
+fn shard_spec(a: &RenderArgs) -> Result<Option<(usize, usize)>> {
+    let parse = |spec: &str, what: &str| -> Result<(usize, usize)> {
+        let bad = || -> Result<(usize, usize)> {
+            usage(format!(
+                "{what} {spec:?}: expected I/N with 0 <= I < N, e.g. 0/4"
+            ))
+        };
+        let Some((i, n)) = spec.split_once('/') else {
+            return bad();
+        };
+        match (i.trim().parse::<usize>(), n.trim().parse::<usize>()) {
+            (Ok(i), Ok(n)) if i < n && n <= 1_000_000 => Ok((i, n)),
+            _ => bad(),
+        }
+    };
+    if let Some(spec) = &a.shard {
+        return parse(spec, "--shard").map(Some);
+    }
+    let var = |k: &str| std::env::var(k).ok();
+    match (var("SLURM_ARRAY_TASK_ID"), var("SLURM_ARRAY_TASK_COUNT")) {
+        (Some(id), Some(count)) => {
+            let min = var("SLURM_ARRAY_TASK_MIN").unwrap_or_else(|| "0".into());
+            let (Ok(id), Ok(min)) = (id.trim().parse::<usize>(), min.trim().parse::<usize>())
+            else {
+                return usage(format!(
+                    "SLURM_ARRAY_TASK_ID {id:?} / SLURM_ARRAY_TASK_MIN {min:?}: not whole numbers"
+                ));
+            };
+            let spec = format!("{}/{}", id.saturating_sub(min), count.trim());
+            parse(
+                &spec,
+                "Slurm's job array (SLURM_ARRAY_TASK_ID - MIN / COUNT)",
+            )
+            .map(Some)
+        }
+        _ => Ok(None),
+    }
+}
+
 /// Parse `A:B:STEP` against `n` frames (B exclusive, each part optional, a lone `A` is one frame).
 pub fn parse_frames(spec: &str, n: usize) -> Result<Vec<usize>> {
     let bad = |why: &str| -> Result<Vec<usize>> {
@@ -216,17 +257,34 @@ fn render(a: &RenderArgs) -> Result<()> {
     }
     let frames = parse_frames(&a.frames, n)?;
     let mut sink = crate::movie::Sink::new(&a.output, frames.len(), a.fps, a.depth)?;
+    // This part's frames (all of them unless sharded): positions in `frames`.
+    let mine = match shard_spec(a)? {
+        None => 0..frames.len(),
+        Some((i, parts)) => {
+            if !matches!(sink, crate::movie::Sink::Frames { .. }) {
+                return usage(
+                    "--shard writes PNG frames (each part its own); assemble them with texmap movie DIR -o movie.mp4",
+                );
+            }
+            i * frames.len() / parts..(i + 1) * frames.len() / parts
+        }
+    };
     let mut builder = SceneBuilder::new(&a.style)?;
     let mut plan = crate::scene::MolPlan::new(&a.mol)?;
     let mut md = MdFrame::new();
     let mut scene = SphereScene::default();
     let mut renderer = Renderer::new();
     let mut camera: Option<Camera> = None;
-    let pb = progress(frames.len() as u64, "rendering");
+    let pb = progress(mine.len() as u64, "rendering");
     let mut skipped_total = 0usize;
     // Frames whose image is on disk, for the error if a later frame fails.
     let mut written: Vec<PathBuf> = Vec::new();
-    for &f in &frames {
+    for (k, &f) in frames.iter().enumerate() {
+        // A part renders its own frames; the first frame of the whole render is read by every
+        // part, for the camera.
+        if !mine.contains(&k) && camera.is_some() {
+            continue;
+        }
         let fail = |e: anyhow::Error, written: &[PathBuf]| -> anyhow::Error {
             if written.is_empty() {
                 return e.context(format!("frame {f}: nothing was written"));
@@ -274,6 +332,9 @@ fn render(a: &RenderArgs) -> Result<()> {
                 c
             }
         };
+        if !mine.contains(&k) {
+            continue;
+        }
         let lighting = Lighting::default_for(&cam);
         let out = match method_of(a.method) {
             Some(m) => {
@@ -313,6 +374,14 @@ fn render(a: &RenderArgs) -> Result<()> {
     if skipped_total > 0 {
         eprintln!(
             "texmap: warning: {skipped_total} atoms skipped over {} frames (non-finite position or radius)",
+            frames.len()
+        );
+    }
+    if mine.len() != frames.len() {
+        eprintln!(
+            "texmap: this part rendered frames {}..{} of the {} asked for",
+            mine.start,
+            mine.end,
             frames.len()
         );
     }
@@ -398,6 +467,7 @@ fn named_scene(a: &CompareArgs) -> Result<NamedScene> {
                 depth: false,
                 output: PathBuf::new(),
                 fps: 25.0,
+                shard: None,
             };
             let camera = camera_for(&render_args, &md, &spheres)?;
             let stem = file
