@@ -134,3 +134,18 @@ fn missing_and_garbage_files_are_errors_naming_the_file() {
             .contains("unknown extension")
     );
 }
+
+#[test]
+fn inputs_the_coverage_guided_fuzzer_found_are_located_errors() {
+    // libFuzzer (fuzz/fuzz_targets/geotiff.rs) found a BigTIFF whose IFD entry count overflowed
+    // the directory bound check (a panic with overflow checks, a huge allocation without).
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/fuzz");
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        let e = texmap_terrain::dem::geotiff::read_geotiff(&path)
+            .err()
+            .unwrap_or_else(|| panic!("{}: read as a grid", path.display()));
+        let name = path.file_name().unwrap().to_string_lossy();
+        assert!(e.to_string().contains(name.as_ref()), "{e}");
+    }
+}

@@ -169,7 +169,11 @@ fn check_directory(path: &Path, source: &str) -> Result<(), TerrainError> {
     } else {
         u16_at(&cbuf) as u64
     };
-    if ifd + count_size + entries.saturating_mul(entry_size) > len {
+    if ifd
+        .saturating_add(count_size)
+        .saturating_add(entries.saturating_mul(entry_size))
+        > len
+    {
         return Err(bad(
             format!("IFD at byte {ifd}"),
             format!("{entries} entries inside the {len}-byte file"),
@@ -352,8 +356,11 @@ pub fn read_raster(
     let mut out: Vec<Vec<f32>> = want.iter().map(|_| Vec::new()).collect();
     for chunk in 0..per_plane {
         let (x0, y0) = match chunk_type {
-            ChunkType::Tile => ((chunk % across) * cw, (chunk / across) * ch),
-            ChunkType::Strip => (0, chunk * ch),
+            ChunkType::Tile => (
+                (chunk % across).saturating_mul(cw),
+                (chunk / across).saturating_mul(ch),
+            ),
+            ChunkType::Strip => (0, chunk.saturating_mul(ch)),
         };
 
         if y0 >= height {
@@ -367,7 +374,12 @@ pub fn read_raster(
         let reads: Vec<(u32, Option<usize>)> = if planar {
             want.iter()
                 .enumerate()
-                .map(|(k, &b)| (b as u32 * per_plane + chunk, Some(k)))
+                .map(|(k, &b)| {
+                    (
+                        (b as u32).saturating_mul(per_plane).saturating_add(chunk),
+                        Some(k),
+                    )
+                })
                 .collect()
         } else {
             vec![(chunk, None)]
@@ -376,8 +388,9 @@ pub fn read_raster(
             let (dw, dh) = dec.chunk_data_dimensions(index);
             let at = format!("chunk {index}");
             let stored = counts.get(index as usize).copied().unwrap_or(0);
-            let claimed =
-                dw as u64 * dh as u64 * sample_bytes * if planar { 1 } else { spp as u64 };
+            let claimed = (dw as u64 * dh as u64)
+                .saturating_mul(sample_bytes)
+                .saturating_mul(if planar { 1 } else { spp as u64 });
             if claimed > stored.saturating_mul(expansion).saturating_add(64) {
                 return Err(format_err(
                     &source,
@@ -388,7 +401,7 @@ pub fn read_raster(
                 ));
             }
             let data = dec.read_chunk(index).map_err(tiff_err(&source, &at))?;
-            let rows_end = (y0 + dh).min(height) as usize;
+            let rows_end = y0.saturating_add(dh).min(height) as usize;
             for band in &mut out {
                 let len = (rows_end * width as usize).min(n);
                 if band.len() < len {
