@@ -392,7 +392,7 @@ fn render(a: &RenderArgs) -> Result<()> {
             frames.len(),
             a.fps
         ),
-        None => eprintln!("texmap: wrote {} frame(s)", frames.len()),
+        None => eprintln!("texmap: wrote {} frame(s)", mine.len()),
     }
     Ok(())
 }
