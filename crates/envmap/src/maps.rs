@@ -400,6 +400,24 @@ pub struct MapScratch {
 }
 
 impl MapScratch {
+    /// Draw the gathered pieces (`positions`, one colour per vertex, `tris`) into the square
+    /// scratch framebuffer of side `side`, cleared first, with `cam` and `state`.
+    fn draw_pieces(
+        &mut self,
+        side: u32,
+        cam: &Camera,
+        state: &DrawState,
+    ) -> Result<(), EnvMapError> {
+        if self.fb.as_ref().is_none_or(|f| f.width() != side) {
+            self.fb = Some(Framebuffer::new(side, side)?);
+        }
+        let fb = self.fb.as_mut().expect("just set");
+        fb.clear([0, 0, 0, 255]);
+        let mesh = Mesh::new(&self.positions, &self.tris)?.with_colors(&self.colors)?;
+        fb.draw_mesh(cam, &mesh, &Shading::VertexColor, state)?;
+        Ok(())
+    }
+
     fn env_texels(
         &mut self,
         kind: MapKind,
@@ -607,21 +625,7 @@ pub fn update_cube(p: &UpdateParams, scratch: &mut MapScratch) -> Result<EnvMap,
             let b = 3 * k as u32;
             s.tris.push([b, b + 1, b + 2]);
         }
-        let MapScratch {
-            fb,
-            positions,
-            colors,
-            tris,
-            ..
-        } = s;
-        if fb.as_ref().is_none_or(|f| f.width() != side) {
-            *fb = Some(Framebuffer::new(side, side)?);
-        }
-        let fb = fb.as_mut().expect("just set");
-        fb.clear([0, 0, 0, 255]);
-        let mesh = Mesh::new(positions, tris)?.with_colors(colors)?;
-        fb.draw_mesh(&cam, &mesh, &Shading::VertexColor, &state)?;
-        Ok(())
+        s.draw_pieces(side, &cam, &state)
     };
     let result = finish_faces(MapKind::Cube, p, scratch, &mut draw);
     scratch.flat = flat;
@@ -871,21 +875,7 @@ fn update_projected(
         let pieces = (s.positions.len() / 3) as u32;
         s.tris
             .extend((0..pieces).map(|k| [3 * k, 3 * k + 1, 3 * k + 2]));
-        let MapScratch {
-            fb,
-            positions,
-            colors,
-            tris,
-            ..
-        } = s;
-        if fb.as_ref().is_none_or(|f| f.width() != n) {
-            *fb = Some(Framebuffer::new(n, n)?);
-        }
-        let fb = fb.as_mut().expect("just set");
-        fb.clear([0, 0, 0, 255]);
-        let mesh = Mesh::new(positions, tris)?.with_colors(colors)?;
-        fb.draw_mesh(&cam, &mesh, &Shading::VertexColor, &state)?;
-        Ok(())
+        s.draw_pieces(n, &cam, &state)
     };
     finish_faces(kind, p, scratch, &mut draw)
 }
