@@ -127,38 +127,33 @@ pub fn write_glb(
     )?;
     let pa = root.push(pa);
     let mut attributes = serde_json::json!({"POSITION": pa.value()});
-    if let Some(uvs) = &mesh.uvs {
-        let b = f32_bytes(&uvs.iter().flat_map(|p| p.to_array()).collect::<Vec<_>>());
+    // One f32 vertex attribute: its view, its accessor, its entry in the primitive's attributes.
+    let mut attribute = |name: &str, kind: &str, values: Vec<f32>| -> Result<(), MeshError> {
         let v = view(
             &mut root,
             &mut bin,
-            &b,
+            &f32_bytes(&values),
             Some(json::buffer::Target::ArrayBuffer),
         );
         let a: json::Accessor = typed(
-            serde_json::json!({"bufferView": v.value(), "componentType": 5126, "count": n, "type": "VEC2"}),
+            serde_json::json!({"bufferView": v.value(), "componentType": 5126, "count": n, "type": kind}),
             &source,
         )?;
-        attributes["TEXCOORD_0"] = root.push(a).value().into();
+        attributes[name] = root.push(a).value().into();
+        Ok(())
+    };
+    if let Some(uvs) = &mesh.uvs {
+        attribute(
+            "TEXCOORD_0",
+            "VEC2",
+            uvs.iter().flat_map(|p| p.to_array()).collect(),
+        )?;
     }
     if let Some(normals) = &mesh.normals {
-        let b = f32_bytes(
-            &normals
-                .iter()
-                .flat_map(|p| p.normalize_or_zero().to_array())
-                .collect::<Vec<_>>(),
-        );
-        let v = view(
-            &mut root,
-            &mut bin,
-            &b,
-            Some(json::buffer::Target::ArrayBuffer),
-        );
-        let a: json::Accessor = typed(
-            serde_json::json!({"bufferView": v.value(), "componentType": 5126, "count": n, "type": "VEC3"}),
-            &source,
-        )?;
-        attributes["NORMAL"] = root.push(a).value().into();
+        let unit = normals
+            .iter()
+            .flat_map(|p| p.normalize_or_zero().to_array());
+        attribute("NORMAL", "VEC3", unit.collect())?;
     }
     let idx: Vec<u8> = mesh
         .triangles
