@@ -28,6 +28,7 @@
 pub use glam;
 
 pub mod camera;
+pub mod camera_path;
 pub mod color;
 pub mod coverage;
 pub mod frame;
