@@ -38,6 +38,10 @@ pub struct Cli {
     #[arg(long, global = true, value_name = "N")]
     pub threads: Option<usize>,
 
+    /// No progress bars and no "wrote ..." lines; warnings and errors still go to stderr.
+    #[arg(short, long, global = true)]
+    pub quiet: bool,
+
     #[command(subcommand)]
     pub command: Command,
 }
@@ -263,27 +267,12 @@ pub struct RenderArgs {
     /// Drawing method.
     #[arg(long, value_enum, default_value_t = MethodArg::Raycast)]
     pub method: MethodArg,
-    /// Image size WxH in pixels.
-    #[arg(long, default_value = "1280x720")]
-    pub size: String,
-    /// Orthographic projection (parallel rays).
-    #[arg(long)]
-    pub ortho: bool,
-    /// Horizontal field of view in degrees (the project's convention), perspective only.
-    #[arg(long, default_value_t = 40.0)]
-    pub fov: f32,
-    /// View direction for the automatic camera: auto (a three-quarter view), x, y, z, -x, -y, -z.
-    #[arg(long, default_value = "auto", allow_hyphen_values = true)]
-    pub view: String,
-    /// Camera position X,Y,Z in Å (with --target and --up: exactly this camera, no auto-fit).
-    #[arg(long, allow_hyphen_values = true)]
-    pub eye: Option<String>,
-    /// Point looked at, X,Y,Z in Å.
-    #[arg(long, allow_hyphen_values = true)]
-    pub target: Option<String>,
-    /// Up direction X,Y,Z.
-    #[arg(long, allow_hyphen_values = true)]
-    pub up: Option<String>,
+    /// Image size, projection and the camera's pose.
+    #[command(flatten)]
+    pub camera: ViewArgs,
+    /// Camera motion over the frames: orbit, keyframes, following a selection.
+    #[command(flatten)]
+    pub path: PathArgs,
     /// Background colour R,G,B (0-255).
     #[arg(long, default_value = "0,0,0")]
     pub background: String,
@@ -315,6 +304,78 @@ pub struct RenderArgs {
     /// How atoms look (last: its help heading applies to the fields after it).
     #[command(flatten)]
     pub style: StyleArgs,
+}
+
+/// The camera of `texmap render` (and of `texmap compare FILE`): image size, projection and
+/// pose; without --eye/--target/--up it is fitted to what the first frame draws.
+#[derive(Args, Clone, Debug)]
+pub struct ViewArgs {
+    /// Image size WxH in pixels.
+    #[arg(long, default_value = "1280x720")]
+    pub size: String,
+    /// Orthographic projection (parallel rays).
+    #[arg(long)]
+    pub ortho: bool,
+    /// Horizontal field of view in degrees (the project's convention), perspective only.
+    #[arg(long, default_value_t = 40.0)]
+    pub fov: f32,
+    /// View direction for the automatic camera: auto (a three-quarter view), x, y, z, -x, -y, -z.
+    #[arg(long, default_value = "auto", allow_hyphen_values = true)]
+    pub view: String,
+    /// Camera position X,Y,Z in Å (with --target and --up: exactly this camera, no auto-fit).
+    #[arg(long, allow_hyphen_values = true)]
+    pub eye: Option<String>,
+    /// Point looked at, X,Y,Z in Å.
+    #[arg(long, allow_hyphen_values = true)]
+    pub target: Option<String>,
+    /// Up direction X,Y,Z.
+    #[arg(long, allow_hyphen_values = true)]
+    pub up: Option<String>,
+}
+
+impl Default for ViewArgs {
+    fn default() -> ViewArgs {
+        ViewArgs {
+            size: "1280x720".into(),
+            ortho: false,
+            fov: 40.0,
+            view: "auto".into(),
+            eye: None,
+            target: None,
+            up: None,
+        }
+    }
+}
+
+/// How the camera moves over the frames of a render (`--orbit`, `--orbit-turns`,
+/// `--keyframes`, `--follow`).
+#[derive(Args, Clone, Debug, Default)]
+#[command(next_help_heading = "Camera path")]
+pub struct PathArgs {
+    /// Turn the camera about the target by DEG degrees per rendered frame, about the image's up
+    /// axis (positive: counter-clockwise seen from above).
+    #[arg(long, value_name = "DEG", allow_hyphen_values = true, conflicts_with_all = ["orbit_turns", "keyframes"])]
+    pub orbit: Option<f32>,
+    /// Turn the camera T full turns over the rendered frames; a movie of one turn loops without
+    /// a repeated frame (the last frame stops one step short of the first).
+    #[arg(
+        long,
+        value_name = "T",
+        allow_hyphen_values = true,
+        conflicts_with = "keyframes"
+    )]
+    pub orbit_turns: Option<f32>,
+    /// Camera keyframes, one per line: FRAME EX EY EZ TX TY TZ [UX UY UZ [FOV]] (spaces or
+    /// commas; # comments; a CSV header line is skipped). FRAME counts the rendered frames from
+    /// 0; the camera passes through every key smoothly (Catmull-Rom) and holds the first and
+    /// last pose outside them; a key without UP or FOV takes the automatic camera's.
+    #[arg(long, value_name = "FILE")]
+    pub keyframes: Option<PathBuf>,
+    /// Keep the atoms SEL selects at the same place in the image: the camera (and any orbit or
+    /// keyframes) moves with their centre, frame by frame. With a periodic box use --pbc unwrap
+    /// so that the centre does not jump when a molecule crosses the box.
+    #[arg(long, value_name = "SEL")]
+    pub follow: Option<String>,
 }
 
 /// Where bonds come from (`--bonds`).

@@ -1,12 +1,12 @@
 //! The subcommands: glue between files, the libraries and the terminal.
 
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
-use texmap_core::camera::Camera;
 use texmap_core::shade::Lighting;
 use texmap_impostor::{Method, Renderer, SphereScene};
 use texmap_md_io::{Format, Frame as MdFrame, ReadOptions, Trajectory};
@@ -17,7 +17,26 @@ use crate::args::{Cli, Command, CompareArgs, MethodArg, RenderArgs, SceneArg, us
 use crate::output::{write_atomic, write_png};
 use crate::scene::{SceneBuilder, camera_for, parse_background, parse_size};
 
+/// `--quiet`: no progress bars and no notes (warnings and errors still print).
+static QUIET: AtomicBool = AtomicBool::new(false);
+
+/// Whether `--quiet` was given.
+pub(crate) fn quiet() -> bool {
+    QUIET.load(Ordering::Relaxed)
+}
+
+/// A line on stderr about what was done (`texmap: wrote ...`), unless `--quiet`.
+#[macro_export]
+macro_rules! note {
+    ($($arg:tt)*) => {
+        if !$crate::commands::quiet() {
+            eprintln!("texmap: {}", format_args!($($arg)*));
+        }
+    };
+}
+
 pub fn run(cli: Cli) -> Result<()> {
+    QUIET.store(cli.quiet, Ordering::Relaxed);
     match cli.command {
         Command::Info {
             file,
@@ -45,6 +64,9 @@ pub fn run(cli: Cli) -> Result<()> {
 }
 
 pub(crate) fn progress(len: u64, what: &str) -> ProgressBar {
+    if quiet() {
+        return ProgressBar::hidden();
+    }
     let pb = ProgressBar::new(len);
     pb.set_style(
         ProgressStyle::with_template(&format!(
@@ -246,7 +268,7 @@ fn method_of(m: MethodArg) -> Option<Method> {
 
 fn render(a: &RenderArgs) -> Result<()> {
     let background = parse_background(&a.background)?;
-    parse_size(&a.size)?;
+    parse_size(&a.camera.size)?;
     let options = ReadOptions::new().allow_truncated(a.allow_truncated);
     let mut traj = open_trajectory_with(&a.file, a.format.as_deref(), options)?;
     let n = traj.n_frames()?;
@@ -274,7 +296,7 @@ fn render(a: &RenderArgs) -> Result<()> {
     let mut md = MdFrame::new();
     let mut scene = SphereScene::default();
     let mut renderer = Renderer::new();
-    let mut camera: Option<Camera> = None;
+    let mut camera: Option<crate::scene::CameraPlan> = None;
     let pb = progress(mine.len() as u64, "rendering");
     let mut skipped_total = 0usize;
     // Frames whose image is on disk, for the error if a later frame fails.
@@ -306,35 +328,37 @@ fn render(a: &RenderArgs) -> Result<()> {
         if a.box_outline {
             add_box_outline(&md, &mut scene);
         }
-        let cam = match &camera {
-            Some(c) => c.clone(),
-            None => {
-                // First frame: the camera, and warnings about the style flags.
-                for w in builder.warnings(&md) {
-                    pb.suspend(|| eprintln!("texmap: warning: {w}"));
-                }
-                if let Some(w) = plan.unnamed_warning(&md, traj.name()) {
-                    pb.suspend(|| eprintln!("texmap: warning: {w}"));
-                }
-                if scene.is_empty() {
-                    let e = anyhow::anyhow!(
-                        "no atom to draw{}",
-                        a.mol
-                            .select
-                            .as_deref()
-                            .map(|s| format!(": --select {s:?} selects none of frame {f}'s atoms"))
-                            .unwrap_or_default()
-                    );
-                    return Err(fail(e, &written));
-                }
-                let c = camera_for(a, &md, &scene).map_err(|e| fail(e, &written))?;
-                camera = Some(c.clone());
-                c
+        if camera.is_none() {
+            // First frame: the camera, and warnings about the style flags.
+            for w in builder.warnings(&md) {
+                pb.suspend(|| eprintln!("texmap: warning: {w}"));
             }
-        };
+            if let Some(w) = plan.unnamed_warning(&md, traj.name()) {
+                pb.suspend(|| eprintln!("texmap: warning: {w}"));
+            }
+            if scene.is_empty() {
+                let e = anyhow::anyhow!(
+                    "no atom to draw{}",
+                    a.mol
+                        .select
+                        .as_deref()
+                        .map(|s| format!(": --select {s:?} selects none of frame {f}'s atoms"))
+                        .unwrap_or_default()
+                );
+                return Err(fail(e, &written));
+            }
+            let plan = crate::scene::CameraPlan::new(&a.camera, &a.path, &md, &scene, frames.len())
+                .map_err(|e| fail(e, &written))?;
+            camera = Some(plan);
+        }
         if !mine.contains(&k) {
             continue;
         }
+        let cam = camera
+            .as_ref()
+            .expect("planned at the first frame")
+            .camera(k, &md)
+            .map_err(|e| fail(e, &written))?;
         let lighting = Lighting::default_for(&cam);
         let out = match method_of(a.method) {
             Some(m) => {
@@ -378,21 +402,21 @@ fn render(a: &RenderArgs) -> Result<()> {
         );
     }
     if mine.len() != frames.len() {
-        eprintln!(
-            "texmap: this part rendered frames {}..{} of the {} asked for",
+        crate::note!(
+            "this part rendered frames {}..{} of the {} asked for",
             mine.start,
             mine.end,
             frames.len()
         );
     }
     match movie {
-        Some(path) => eprintln!(
-            "texmap: wrote {} ({} frames at {} frames/s)",
+        Some(path) => crate::note!(
+            "wrote {} ({} frames at {} frames/s)",
             path.display(),
             frames.len(),
             a.fps
         ),
-        None => eprintln!("texmap: wrote {} frame(s)", mine.len()),
+        None => crate::note!("wrote {} frame(s)", mine.len()),
     }
     Ok(())
 }
@@ -447,29 +471,11 @@ fn named_scene(a: &CompareArgs) -> Result<NamedScene> {
             for w in builder.warnings(&md) {
                 eprintln!("texmap: warning: {w}");
             }
-            let render_args = RenderArgs {
-                file: file.clone(),
-                format: None,
-                allow_truncated: false,
-                frames: "0".into(),
-                method: MethodArg::Raycast,
+            let view = crate::args::ViewArgs {
                 size: a.size.clone(),
-                ortho: false,
-                fov: 40.0,
-                view: "auto".into(),
-                eye: None,
-                target: None,
-                up: None,
-                style: a.style.clone(),
-                mol: crate::args::MolArgs::default(),
-                background: "0,0,0".into(),
-                box_outline: false,
-                depth: false,
-                output: PathBuf::new(),
-                fps: 25.0,
-                shard: None,
+                ..Default::default()
             };
-            let camera = camera_for(&render_args, &md, &spheres)?;
+            let (camera, _) = camera_for(&view, &md, &spheres)?;
             let stem = file
                 .file_stem()
                 .map(|s| s.to_string_lossy().into_owned())
@@ -513,8 +519,8 @@ fn compare(a: &CompareArgs) -> Result<()> {
         runs: a.runs,
         ..HarnessOptions::default()
     };
-    eprintln!(
-        "texmap: comparing {} methods and the reference on {} ({} spheres, {}x{})",
+    crate::note!(
+        "comparing {} methods and the reference on {} ({} spheres, {}x{})",
         opts.methods.len(),
         scene.name(),
         scene.spheres.len(),
@@ -525,7 +531,7 @@ fn compare(a: &CompareArgs) -> Result<()> {
     write_report(&a.out, &report)?;
     write_results(&a.out, &report.records)?;
     let series = if a.sweeps {
-        eprintln!("texmap: running the stability sweeps");
+        crate::note!("running the stability sweeps");
         let s = texmap_study::sweeps::run_all_sweeps(128)?;
         let csv = texmap_study::sweeps::series_to_csv(&s);
         write_atomic(&a.out.join("sweeps.csv"), |p| {
@@ -573,9 +579,7 @@ fn demo(out: &Path, steps: usize, every: usize, size: &str) -> Result<()> {
         .with_context(|| format!("cannot create output directory {}", out.display()))?;
 
     // Simulate the Seed 004 system.
-    eprintln!(
-        "texmap: simulating the Seed 004 silicate system (1,115 particles, {steps} LJ steps)"
-    );
+    crate::note!("simulating the Seed 004 silicate system (1,115 particles, {steps} LJ steps)");
     let system = Seed004System::generate(SCENE_SEED);
     let mut md = MdSystem::new(&system, MdParams::default())?;
     let frames = md.run(steps, every);
@@ -623,12 +627,12 @@ fn demo(out: &Path, steps: usize, every: usize, size: &str) -> Result<()> {
     movie.finish()?;
 
     // Compare every method with the reference on S1 and run the sweeps.
-    eprintln!("texmap: comparing every method with the reference ray tracer (S1)");
+    crate::note!("comparing every method with the reference ray tracer (S1)");
     let scene = scenes::build_sized(SceneId::S1, w, h)?;
     let report = harness::run_scene(&scene, &HarnessOptions::default())?;
     write_report(out, &report)?;
     write_results(out, &report.records)?;
-    eprintln!("texmap: stability sweeps");
+    crate::note!("stability sweeps");
     let series = texmap_study::sweeps::run_all_sweeps(128)?;
     let csv = texmap_study::sweeps::series_to_csv(&series);
     write_atomic(&out.join("sweeps.csv"), |p| {
@@ -640,7 +644,7 @@ fn demo(out: &Path, steps: usize, every: usize, size: &str) -> Result<()> {
         std::fs::write(p, &html).context("index.html")
     })?;
     print_table(&report.records);
-    eprintln!("texmap: open {}", out.join("index.html").display());
+    crate::note!("open {}", out.join("index.html").display());
     Ok(())
 }
 

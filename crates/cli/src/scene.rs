@@ -5,6 +5,7 @@ use std::collections::HashMap;
 use anyhow::{Context, Result};
 use glam::Vec3;
 use texmap_core::camera::Camera;
+use texmap_core::camera_path::{Keyframes, Pose};
 use texmap_core::color::{hsv_to_rgb, srgb_to_linear};
 use texmap_core::shade::Material;
 use texmap_impostor::SphereScene;
@@ -13,7 +14,8 @@ use texmap_md_io::{
 };
 
 use crate::args::{
-    BondsArg, ColorBy, DrawStyle, MolArgs, PbcArg, RenderArgs, StyleArgs, parse_color, usage,
+    BondsArg, ColorBy, DrawStyle, MolArgs, PathArgs, PbcArg, StyleArgs, ViewArgs, parse_color,
+    usage,
 };
 
 /// Most materials a scene gets: every method handles this many cheaply (the LUT and template
@@ -592,9 +594,9 @@ fn view_direction(view: &str) -> Result<(Vec3, Vec3)> {
     })
 }
 
-/// The camera for a render: exactly `--eye/--target/--up` when given, else fitted to what the
-/// first frame draws (the selected atoms' bounding box's sphere).
-pub fn camera_for(args: &RenderArgs, first: &Frame, scene: &SphereScene) -> Result<Camera> {
+/// The camera for a render and the point it looks at: exactly `--eye/--target/--up` when given,
+/// else fitted to what the first frame draws (the selected atoms' bounding box's sphere).
+pub fn camera_for(args: &ViewArgs, first: &Frame, scene: &SphereScene) -> Result<(Camera, Vec3)> {
     let (w, h) = parse_size(&args.size)?;
     let hfov = if args.ortho { None } else { Some(args.fov) };
     if let Some(f) = hfov
@@ -622,7 +624,9 @@ pub fn camera_for(args: &RenderArgs, first: &Frame, scene: &SphereScene) -> Resu
                     Camera::orthographic_look_at(e, t, u, extent, w, h)
                 }
             };
-            return cam.map_err(|e| crate::args::UsageError(format!("camera: {e}")).into());
+            return cam
+                .map(|c| (c, t))
+                .map_err(|e| crate::args::UsageError(format!("camera: {e}")).into());
         }
         (None, None, None) => {}
         _ => return usage("--eye, --target and --up go together: give all three or none"),
@@ -647,7 +651,137 @@ pub fn camera_for(args: &RenderArgs, first: &Frame, scene: &SphereScene) -> Resu
         (Vec3::ZERO, 1.0)
     };
     Camera::fit_sphere(center, radius.max(1e-3), dir, up, hfov, w, h, 1.05)
+        .map(|c| (c, center))
         .context("automatic camera")
+}
+
+/// How the camera moves over the frames of a render.
+enum Motion {
+    Still,
+    Orbit { degrees_per_frame: f32 },
+    Keys(Keyframes),
+}
+
+/// The camera of every frame of a render: the first frame's camera (fitted or given), moved
+/// along `--orbit`/`--orbit-turns`/`--keyframes` and with the centre of `--follow`'s atoms.
+/// A frame's camera depends only on its position in the render and its own atoms, so the parts
+/// of a sharded render draw exactly what one process would.
+pub struct CameraPlan {
+    template: Camera,
+    pose: Pose,
+    motion: Motion,
+    /// The --follow selection and its atoms' centre in the first frame.
+    follow: Option<(Selection, Vec3)>,
+}
+
+/// The mean position of the atoms `sel` selects, or None when it selects none.
+fn centre_of(sel: &Selection, frame: &Frame) -> Result<Option<Vec3>> {
+    let idx = sel
+        .indices(frame)
+        .map_err(|e| crate::args::UsageError(format!("--follow: {e}")))?;
+    if idx.is_empty() {
+        return Ok(None);
+    }
+    // f64 sum: a million atoms far from the origin keep their centre to well below an atom.
+    let mut sum = [0f64; 3];
+    for &i in &idx {
+        for (s, p) in sum.iter_mut().zip(frame.positions[i]) {
+            *s += p as f64;
+        }
+    }
+    let n = idx.len() as f64;
+    Ok(Some(Vec3::new(
+        (sum[0] / n) as f32,
+        (sum[1] / n) as f32,
+        (sum[2] / n) as f32,
+    )))
+}
+
+impl CameraPlan {
+    /// The plan for a render of `count` frames whose first frame is `first` (drawn as `scene`).
+    pub fn new(
+        view: &ViewArgs,
+        path: &PathArgs,
+        first: &Frame,
+        scene: &SphereScene,
+        count: usize,
+    ) -> Result<CameraPlan> {
+        let (template, target) = camera_for(view, first, scene)?;
+        let pose = Pose::of_camera(&template, target);
+        let motion = match (path.orbit, path.orbit_turns, &path.keyframes) {
+            (Some(d), None, None) => {
+                if !d.is_finite() {
+                    return usage(format!("--orbit {d}: must be a finite number of degrees"));
+                }
+                Motion::Orbit {
+                    degrees_per_frame: d,
+                }
+            }
+            (None, Some(t), None) => {
+                if !t.is_finite() {
+                    return usage(format!("--orbit-turns {t}: must be a finite number"));
+                }
+                Motion::Orbit {
+                    degrees_per_frame: 360.0 * t / count.max(1) as f32,
+                }
+            }
+            (None, None, Some(file)) => {
+                let text = std::fs::read_to_string(file)
+                    .with_context(|| format!("--keyframes {}", file.display()))?;
+                let keys = Keyframes::parse(&text, &pose)
+                    .map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?;
+                Motion::Keys(keys)
+            }
+            (None, None, None) => Motion::Still,
+            _ => return usage("--orbit, --orbit-turns and --keyframes exclude one another"),
+        };
+        let follow = match &path.follow {
+            None => None,
+            Some(text) => {
+                let sel = parse_selection("--follow", text)?;
+                let Some(c) = centre_of(&sel, first)? else {
+                    return usage(format!(
+                        "--follow {text:?} selects none of the first frame's atoms"
+                    ));
+                };
+                Some((sel, c))
+            }
+        };
+        Ok(CameraPlan {
+            template,
+            pose,
+            motion,
+            follow,
+        })
+    }
+
+    /// The camera of the `k`-th rendered frame (0-based), whose atoms are `frame` (after the
+    /// periodic-boundary treatment).
+    pub fn camera(&self, k: usize, frame: &Frame) -> Result<Camera> {
+        let mut pose = match &self.motion {
+            Motion::Still => self.pose,
+            Motion::Orbit { degrees_per_frame } => {
+                // Reduced in f64 so that frame 100,000 turns as exactly as frame 1.
+                let deg = (k as f64 * *degrees_per_frame as f64) % 360.0;
+                self.pose.orbit(deg as f32)
+            }
+            Motion::Keys(keys) => keys.at(k as f32),
+        };
+        if let Some((sel, c0)) = &self.follow {
+            let Some(c) = centre_of(sel, frame)? else {
+                anyhow::bail!(
+                    "--follow {:?} selects none of this frame's atoms",
+                    sel.text()
+                );
+            };
+            pose = pose.translated(c - *c0);
+        }
+        if matches!(self.motion, Motion::Still) && self.follow.is_none() {
+            return Ok(self.template.clone());
+        }
+        pose.camera(&self.template)
+            .map_err(|e| anyhow::anyhow!("camera of rendered frame {k}: {e}"))
+    }
 }
 
 #[cfg(test)]
