@@ -487,12 +487,13 @@ fn named_scene(a: &CompareArgs) -> Result<NamedScene> {
 }
 
 fn write_report(out: &Path, report: &SceneReport) -> Result<()> {
+    use texmap_study::report::ERROR_GAIN;
     let dir = out.join(&report.scene);
     write_png(&report.reference, &dir.join("reference.png"))?;
     for run in &report.runs {
         let name = run.method.name();
         write_png(&run.frame, &dir.join(format!("{name}.png")))?;
-        let err = harness::error_image(&run.frame, &report.reference, 8.0)?;
+        let err = harness::error_image(&run.frame, &report.reference, ERROR_GAIN)?;
         write_png(&err, &dir.join(format!("{name}_error.png")))?;
     }
     Ok(())
@@ -559,14 +560,9 @@ fn print_table(records: &[harness::Record]) {
     }
 }
 
-struct AnimationSummary {
-    method: &'static str,
-    frames: usize,
-    ms_per_frame: f64,
-}
-
 fn demo(out: &Path, steps: usize, every: usize, size: &str) -> Result<()> {
     use texmap_study::md::{MdParams, MdSystem};
+    use texmap_study::report::{AnimationSummary, Section, demo_index_html};
     use texmap_study::scenes::{SCENE_SEED, Seed004System, box_camera};
     let (w, h) = parse_size(size)?;
     if steps == 0 || every == 0 {
@@ -639,86 +635,37 @@ fn demo(out: &Path, steps: usize, every: usize, size: &str) -> Result<()> {
         std::fs::write(p, &csv).context("sweeps.csv")
     })?;
     let charts = texmap_study::chart::write_charts(out, &report.records, &series)?;
-    let html = index_html(&summaries, &report, &charts, out);
+    let mut sections: Vec<Section> = Vec::new();
+
+    // Environment mapping (Seed 003): the study at a small size, and one image per method.
+    crate::note!("environment mapping (Seed 003)");
+    let env_dir = out.join("envmap");
+    let env_opts = texmap_study::envmap::EnvStudyOptions {
+        width: 160,
+        height: 120,
+        samples: 2,
+        timed_frames: 3,
+        map_size: 128,
+    };
+    let env_records = texmap_study::envmap::run(&env_opts)?;
+    texmap_study::envmap::write(&env_dir, &env_records)?;
+    let mut names = Vec::new();
+    for (name, frame) in texmap_study::envmap::demo_frames(240, 180, 256, 2)? {
+        write_png(&frame, &env_dir.join(format!("{name}.png")))?;
+        names.push(name);
+    }
+    sections.push(texmap_study::report::envmap_section(
+        &env_records,
+        &names,
+        "envmap",
+    ));
+    let html = demo_index_html(&summaries, &report, &charts, out, &sections);
     write_atomic(&out.join("index.html"), |p| {
         std::fs::write(p, &html).context("index.html")
     })?;
     print_table(&report.records);
     crate::note!("open {}", out.join("index.html").display());
     Ok(())
-}
-
-fn rel(path: &Path, base: &Path) -> String {
-    path.strip_prefix(base)
-        .unwrap_or(path)
-        .to_string_lossy()
-        .replace('\\', "/")
-}
-
-fn index_html(
-    anim: &[AnimationSummary],
-    report: &SceneReport,
-    charts: &[PathBuf],
-    out: &Path,
-) -> String {
-    let mut s = String::from(
-        "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>texmap demo</title>\n<style>\
-body{font-family:sans-serif;margin:2em;max-width:1200px}table{border-collapse:collapse}\
-td,th{border:1px solid #bbb;padding:4px 8px;text-align:right}th{background:#eee}\
-.anim{display:inline-block;margin:0 1em 1em 0;text-align:center}img{max-width:100%}\
-</style></head><body>\n<h1>texmap demo: the Seed 004 silicate system</h1>\n\
-<p>1,115 particles (409 O, 50 Si, 6 Al, 50 Mg, 500 H, 100 He) moved by a Lennard-Jones MD integrator \
-(velocity Verlet), drawn by four sphere methods on the CPU and compared with a BVH reference ray tracer.</p>\n\
-<h2>Animation</h2>\n<p><button onclick=\"play=!play\">play / pause</button> \
-<input type=\"range\" id=\"slider\" min=\"0\" value=\"0\" oninput=\"show(+this.value)\"> frame <span id=\"fno\">0</span> \
-&middot; the exact ray-cast animation as one movie file: <a href=\"md.apng\">md.apng</a> \
-(<code>texmap movie frames/raycast -o md.mp4</code> makes an MP4)</p>\n",
-    );
-    for a in anim {
-        s.push_str(&format!(
-            "<div class=\"anim\"><img class=\"frame\" data-method=\"{m}\" src=\"frames/{m}/0000.png\" width=\"320\"><br>{m}: {ms:.2} ms/frame</div>\n",
-            m = a.method,
-            ms = a.ms_per_frame
-        ));
-    }
-    let n = anim.first().map(|a| a.frames).unwrap_or(0);
-    s.push_str(&format!(
-        "<script>\nconst N={n};let cur=0,play=true;const sl=document.getElementById('slider');sl.max=N-1;\n\
-function show(i){{cur=i;sl.value=i;document.getElementById('fno').textContent=i;\
-for(const im of document.querySelectorAll('img.frame')){{im.src='frames/'+im.dataset.method+'/'+String(i).padStart(4,'0')+'.png';}}}}\n\
-setInterval(()=>{{if(play&&N>0)show((cur+1)%N);}},100);\n</script>\n"
-    ));
-    s.push_str("<h2>Speed against accuracy (S1, reference: reftrace, 1 sample per pixel)</h2>\n<table><tr><th>method</th><th>ms/frame</th><th>PSNR dB</th><th>SSIM</th><th>depth err mean</th><th>depth err max</th><th>silhouette px</th></tr>\n");
-    for r in &report.records {
-        s.push_str(&format!(
-            "<tr><td style=\"text-align:left\">{}</td><td>{:.3}</td><td>{:.2}</td><td>{:.4}</td><td>{:.3e}</td><td>{:.3e}</td><td>{:.3}</td></tr>\n",
-            r.method, r.ms_per_frame, r.psnr_db, r.ssim, r.depth_err_mean, r.depth_err_max, r.silhouette_px
-        ));
-    }
-    s.push_str("</table>\n<p>Machine-readable: <a href=\"results.json\">results.json</a>, <a href=\"results.csv\">results.csv</a>, <a href=\"sweeps.csv\">sweeps.csv</a>.</p>\n<h2>Images (S1): method and error against the reference (×8)</h2>\n");
-    let scene_dir = report.scene.as_str();
-    s.push_str(&format!(
-        "<div class=\"anim\"><img src=\"{scene_dir}/reference.png\" width=\"300\"><br>reference</div>\n"
-    ));
-    for run in &report.runs {
-        let m = run.method.name();
-        s.push_str(&format!(
-            "<div class=\"anim\"><img src=\"{scene_dir}/{m}.png\" width=\"300\"><br>{m}</div>\
-<div class=\"anim\"><img src=\"{scene_dir}/{m}_error.png\" width=\"300\"><br>{m} error</div>\n"
-        ));
-    }
-    s.push_str("<h2>Charts</h2>\n");
-    for c in charts
-        .iter()
-        .filter(|c| c.extension().is_some_and(|e| e == "svg"))
-    {
-        s.push_str(&format!(
-            "<div><img src=\"{}\" width=\"720\"></div>\n",
-            rel(c, out)
-        ));
-    }
-    s.push_str("</body></html>\n");
-    s
 }
 
 #[cfg(test)]

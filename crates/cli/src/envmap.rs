@@ -114,7 +114,7 @@ fn compare(out: &Path, size: &str, samples: u32) -> Result<()> {
         );
     }
     for f in files {
-        println!("wrote {}", f.display());
+        crate::note!("wrote {}", f.display());
     }
     Ok(())
 }

@@ -191,6 +191,29 @@ fn the_demo_writes_its_animation_as_a_movie() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let html = std::fs::read_to_string(out.join("index.html")).unwrap();
     assert!(html.contains("md.apng"));
+    // The page explains itself: the methods, the metrics, the element and error colours, and
+    // it shows the environment-mapping section with an image per method.
+    for needle in [
+        "Seed 002",
+        "Seed 004",
+        "<dt>PSNR (dB)</dt>",
+        "<dt>SSIM</dt>",
+        "<dt>silhouette px</dt>",
+        "Element colours",
+        "Error images:",
+        "Environment mapping (Seed 003)",
+        "envmap/sphere-dynamic.png",
+    ] {
+        assert!(html.contains(needle), "index.html lacks {needle:?}");
+    }
+    // Every image and chart the page links to exists.
+    for src in html.split("src=\"").skip(1) {
+        let path = src.split('"').next().unwrap();
+        if path.starts_with("frames/") {
+            continue; // the animation's frames are swapped in by the page's script
+        }
+        assert!(out.join(path).is_file(), "index.html links to a missing {path}");
+    }
     let movie = out.join("md.apng");
     let frames = std::fs::read_dir(out.join("frames/raycast"))
         .unwrap()

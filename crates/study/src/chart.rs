@@ -13,6 +13,7 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 use plotters::coord::Shift;
+use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint, Ranged};
 use plotters::prelude::*;
 use plotters::style::FontStyle;
 
@@ -118,19 +119,171 @@ impl Axis {
     fn map(self, v: f64) -> f64 {
         if self.log { v.max(1e-300).log10() } else { v }
     }
+
+    /// Tick positions (mapped values) inside `r` at round values: 1, 2 and 5 times a power of
+    /// ten on a log axis (only the powers when the axis spans many decades), and steps of 1, 2
+    /// or 5 times a power of ten on a linear axis.
+    fn ticks(self, r: &std::ops::Range<f64>) -> Vec<f64> {
+        let (lo, hi) = (r.start, r.end);
+        if !(lo.is_finite() && hi.is_finite() && hi > lo) {
+            return vec![];
+        }
+        if self.log {
+            let decades = hi - lo;
+            let mults: &[f64] = if decades > 6.0 {
+                &[1.0]
+            } else if decades > 2.5 {
+                &[1.0, 3.0]
+            } else {
+                &[1.0, 2.0, 5.0]
+            };
+            let step = if decades > 12.0 {
+                (decades / 8.0).ceil() as i32
+            } else {
+                1
+            };
+            let mut out = Vec::new();
+            let mut d = lo.floor() as i32;
+            while (d as f64) <= hi.ceil() {
+                for m in mults {
+                    let t = m.log10() + d as f64;
+                    if t >= lo && t <= hi {
+                        out.push(t);
+                    }
+                }
+                d += step;
+            }
+            out
+        } else {
+            let raw = (hi - lo) / 8.0;
+            let mag = 10f64.powf(raw.log10().floor());
+            let step = [1.0, 2.0, 5.0, 10.0]
+                .iter()
+                .map(|m| m * mag)
+                .find(|s| *s >= raw)
+                .unwrap_or(10.0 * mag);
+            let mut out = Vec::new();
+            let mut t = (lo / step).ceil() * step;
+            while t <= hi && out.len() < 50 {
+                out.push(t);
+                t += step;
+            }
+            out
+        }
+    }
+
     fn label(self, t: f64) -> String {
         if self.log {
+            // The tick is at a round value: print it without the rounding noise of 10^t.
             let v = 10f64.powf(t);
-            if (1e-3..1e4).contains(&v) {
-                format!("{}", (v * 1000.0).round() / 1000.0)
+            let d = v.log10().floor();
+            let m = (v / 10f64.powf(d)).round();
+            let v = m * 10f64.powf(d);
+            if (1e-3..1e5).contains(&v) {
+                let s = format!("{v:.3}");
+                s.trim_end_matches('0').trim_end_matches('.').to_string()
             } else {
-                format!("{v:.0e}")
+                format!("{m}e{d}")
             }
         } else {
-            format!("{}", (t * 100.0).round() / 100.0)
+            let v = (t * 1000.0).round() / 1000.0;
+            format!("{}", if v == 0.0 { 0.0 } else { v })
         }
     }
 }
+
+/// A linear coordinate (over mapped values) whose ticks are the given round values.
+#[derive(Clone)]
+struct Ticked {
+    range: std::ops::Range<f64>,
+    ticks: Vec<f64>,
+}
+
+impl Ticked {
+    fn new(axis: Axis, range: std::ops::Range<f64>) -> Ticked {
+        let ticks = axis.ticks(&range);
+        Ticked { range, ticks }
+    }
+}
+
+impl Ranged for Ticked {
+    type FormatOption = DefaultFormatting;
+    type ValueType = f64;
+
+    fn map(&self, v: &f64, limit: (i32, i32)) -> i32 {
+        let span = self.range.end - self.range.start;
+        let f = if span > 0.0 {
+            (v - self.range.start) / span
+        } else {
+            0.5
+        };
+        let f = f.clamp(-10.0, 10.0);
+        limit.0 + ((limit.1 - limit.0) as f64 * f).round() as i32
+    }
+
+    fn key_points<Hint: KeyPointHint>(&self, hint: Hint) -> Vec<f64> {
+        if hint.max_num_points() == 0 {
+            return vec![];
+        }
+        self.ticks.clone()
+    }
+
+    fn range(&self) -> std::ops::Range<f64> {
+        self.range.clone()
+    }
+}
+
+/// Draws `pts` (x, y, open) as one method's markers, a shape of its own per method (as well as
+/// its colour, so that overlapping series stay apart); open markers are hollow. With `legend`,
+/// the series gets the method's legend entry.
+fn draw_markers<'a, DB: DrawingBackend + 'a>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<Ticked, Ticked>>,
+    method: &'static str,
+    pts: &[(f64, f64, bool)],
+    size: i32,
+    legend: bool,
+) -> Result<(), String> {
+    let color = method_color(method);
+    let style = move |open: bool| {
+        if open {
+            color.stroke_width(2)
+        } else {
+            color.filled()
+        }
+    };
+    let e = |err: DrawingAreaErrorKind<DB::ErrorType>| err.to_string();
+    macro_rules! shape {
+        ($make:expr) => {{
+            let anno = chart
+                .draw_series(
+                    pts.iter()
+                        .map(|&(x, y, open)| EmptyElement::at((x, y)) + $make((0, 0), style(open))),
+                )
+                .map_err(e)?;
+            if legend {
+                anno.label(method).legend(move |(x, y)| {
+                    EmptyElement::at((x + 9, y)) + $make((0, 0), style(false))
+                });
+            }
+        }};
+    }
+    match method {
+        "polygon" => shape!(|c: (i32, i32), st: ShapeStyle| Rectangle::new(
+            [(c.0 - size, c.1 - size), (c.0 + size, c.1 + size)],
+            st
+        )),
+        "lut" => shape!(|c: (i32, i32), st: ShapeStyle| TriangleMarker::new(c, size + 1, st)),
+        "template" => {
+            shape!(|c: (i32, i32), st: ShapeStyle| Cross::new(c, size, st.stroke_width(2)))
+        }
+        _ => shape!(|c: (i32, i32), st: ShapeStyle| Circle::new(c, size, st)),
+    }
+    Ok(())
+}
+
+/// Chart text for a capped value.
+const CAPPED_NOTE: &str =
+    "open marker: infinite PSNR (identical to the reference), drawn at 100 dB";
 
 /// Padded range of mapped values (never empty).
 fn range(vals: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
@@ -176,7 +329,7 @@ fn draw_speed_accuracy<DB: DrawingBackend>(
         .margin(16)
         .x_label_area_size(44)
         .y_label_area_size(56)
-        .build_cartesian_2d(xr, yr)
+        .build_cartesian_2d(Ticked::new(xa, xr.clone()), Ticked::new(ya, yr.clone()))
         .map_err(|e| e.to_string())?;
     chart
         .configure_mesh()
@@ -188,26 +341,45 @@ fn draw_speed_accuracy<DB: DrawingBackend>(
         .axis_desc_style(("sans-serif", 15))
         .draw()
         .map_err(|e| e.to_string())?;
+    let mut capped = false;
     for method in ["polygon", "lut", "template", "raycast"] {
-        let color = method_color(method);
         let mine: Vec<&&Record> = pts.iter().filter(|r| r.method == method).collect();
         if mine.is_empty() {
             continue;
         }
+        let at: Vec<(f64, f64, bool)> = mine
+            .iter()
+            .map(|r| {
+                (
+                    xa.map(r.ms_per_frame),
+                    r.psnr_db.min(PSNR_CEILING_DB),
+                    r.psnr_db > PSNR_CEILING_DB,
+                )
+            })
+            .collect();
+        capped |= at.iter().any(|p| p.2);
+        draw_markers(&mut chart, method, &at, 6, true)?;
         chart
-            .draw_series(mine.iter().map(|r| {
-                let p = (xa.map(r.ms_per_frame), r.psnr_db.min(PSNR_CEILING_DB));
-                EmptyElement::at(p)
-                    + Circle::new((0, 0), 6, color.filled())
-                    + Text::new(
-                        format!("{} {}", r.method, r.scene),
-                        (8, -14),
-                        ("sans-serif", 13).into_font().color(&BLACK),
-                    )
+            .draw_series(mine.iter().zip(&at).map(|(r, &(x, y, open))| {
+                let text = if open {
+                    format!("{} {} (∞ dB)", r.method, r.scene)
+                } else {
+                    format!("{} {}", r.method, r.scene)
+                };
+                // Labels stay inside the plot: left of points in the right third, below
+                // points near the top.
+                let fx = (x - xr.start) / (xr.end - xr.start);
+                let fy = (y - yr.start) / (yr.end - yr.start);
+                let dx = if fx > 0.62 {
+                    -(text.chars().count() as i32 * 7 + 10)
+                } else {
+                    8
+                };
+                let dy = if fy > 0.9 { 6 } else { -14 };
+                EmptyElement::at((x, y))
+                    + Text::new(text, (dx, dy), ("sans-serif", 13).into_font().color(&BLACK))
             }))
-            .map_err(|e| e.to_string())?
-            .label(method)
-            .legend(move |(x, y)| Circle::new((x + 8, y), 6, color.filled()));
+            .map_err(|e| e.to_string())?;
     }
     chart
         .configure_series_labels()
@@ -217,6 +389,14 @@ fn draw_speed_accuracy<DB: DrawingBackend>(
         .position(SeriesLabelPosition::LowerRight)
         .draw()
         .map_err(|e| e.to_string())?;
+    if capped {
+        root.draw(&Text::new(
+            CAPPED_NOTE,
+            (72, 40),
+            ("sans-serif", 13).into_font().color(&BLACK),
+        ))
+        .map_err(|e| e.to_string())?;
+    }
     root.present().map_err(|e| e.to_string())
 }
 
@@ -248,7 +428,7 @@ fn draw_sweep<DB: DrawingBackend>(
         .margin(16)
         .x_label_area_size(44)
         .y_label_area_size(64)
-        .build_cartesian_2d(xr, yr)
+        .build_cartesian_2d(Ticked::new(xa, xr.clone()), Ticked::new(ya, yr.clone()))
         .map_err(|e| e.to_string())?;
     chart
         .configure_mesh()
@@ -260,23 +440,30 @@ fn draw_sweep<DB: DrawingBackend>(
         .axis_desc_style(("sans-serif", 15))
         .draw()
         .map_err(|e| e.to_string())?;
-    for s in series {
-        let color = method_color(s.method.name());
-        let pts: Vec<(f64, f64)> = s
+    // Series drawn first get wider lines, so a series lying on top of another leaves it visible
+    // as an outline; every method also has its own marker shape.
+    let n = series.len();
+    let mut capped = false;
+    for (i, s) in series.iter().enumerate() {
+        let method = s.method.name();
+        let color = method_color(method);
+        let width = 2 + 2 * (n - 1 - i) as u32;
+        let pts: Vec<(f64, f64, bool)> = s
             .points
             .iter()
-            .map(|p| (xa.map(p.x), ya.map(metric.value(&p.metrics))))
+            .map(|p| {
+                let open = metric == SweepMetric::PsnrDb && p.metrics.psnr_db > PSNR_CEILING_DB;
+                (xa.map(p.x), ya.map(metric.value(&p.metrics)), open)
+            })
             .collect();
+        capped |= pts.iter().any(|p| p.2);
         chart
-            .draw_series(LineSeries::new(pts.iter().copied(), color.stroke_width(2)))
-            .map_err(|e| e.to_string())?
-            .label(s.method.name())
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2))
-            });
-        chart
-            .draw_series(pts.iter().map(|&p| Circle::new(p, 4, color.filled())))
+            .draw_series(LineSeries::new(
+                pts.iter().map(|p| (p.0, p.1)),
+                color.mix(0.85).stroke_width(width),
+            ))
             .map_err(|e| e.to_string())?;
+        draw_markers(&mut chart, method, &pts, 4, true)?;
     }
     chart
         .configure_series_labels()
@@ -286,6 +473,14 @@ fn draw_sweep<DB: DrawingBackend>(
         .position(SeriesLabelPosition::UpperLeft)
         .draw()
         .map_err(|e| e.to_string())?;
+    if capped {
+        root.draw(&Text::new(
+            CAPPED_NOTE,
+            (CHART_SIZE.0 as i32 - 480, 38),
+            ("sans-serif", 13).into_font().color(&BLACK),
+        ))
+        .map_err(|e| e.to_string())?;
+    }
     root.present().map_err(|e| e.to_string())
 }
 
@@ -397,6 +592,28 @@ mod tests {
     use crate::sweeps::SweepPoint;
     use texmap_impostor::Method;
 
+    #[test]
+    fn ticks_sit_at_round_values_on_both_kinds_of_axis() {
+        let log = Axis { log: true };
+        let r = 0.8f64.log10()..30f64.log10();
+        let labels: Vec<String> = log.ticks(&r).iter().map(|t| log.label(*t)).collect();
+        assert_eq!(labels, ["1", "2", "5", "10", "20"]);
+        // Many decades: powers of ten only, written as such.
+        let r = -9.0..2.5;
+        let labels: Vec<String> = log.ticks(&r).iter().map(|t| log.label(*t)).collect();
+        assert_eq!(labels[0], "1e-9");
+        assert!(labels.contains(&"0.001".to_string()) && labels.contains(&"100".to_string()));
+        assert!(
+            labels
+                .iter()
+                .all(|l| !l.contains("1.585") && !l.contains("2.512"))
+        );
+        let lin = Axis { log: false };
+        let ticks = lin.ticks(&(23.7..61.2));
+        assert_eq!(ticks, [25.0, 30.0, 35.0, 40.0, 45.0, 50.0, 55.0, 60.0]);
+        assert_eq!(lin.label(0.1 + 0.2), "0.3");
+    }
+
     fn rec(method: &str, scene: &str, ms: f64, psnr: f64) -> Record {
         Record {
             scene: scene.into(),
@@ -448,7 +665,11 @@ mod tests {
                 && svg.contains("template s1")
                 && svg.contains("raycast molecule")
         );
-        assert!(svg.matches("<circle").count() >= 5);
+        // One shape per method (circles for raycast, squares for polygon), the infinite
+        // PSNR marked as capped on the point and in a note.
+        assert!(svg.matches("<circle").count() >= 2);
+        assert!(svg.contains("<rect") && svg.contains("raycast s1 (∞ dB)"));
+        assert!(svg.contains("infinite PSNR"));
     }
 
     #[test]

@@ -705,6 +705,37 @@ pub fn write(dir: &Path, records: &[EnvRecord]) -> Result<Vec<PathBuf>, EnvStudy
     Ok(written)
 }
 
+/// The images of the demo's environment-mapping section: the tunnel at time `t` drawn by every
+/// method (maps of `map_size`) and by the reference (`samples`² per pixel), named as the
+/// methods are.
+pub fn demo_frames(
+    width: u32,
+    height: u32,
+    map_size: u32,
+    samples: u32,
+) -> Result<Vec<(String, Frame)>, EnvStudyError> {
+    let scene = tunnel_scene(TunnelParams {
+        time: 0.0,
+        detail: 1,
+        surface: Surface::Mirror,
+    })?;
+    let cam = tunnel_camera(width, height)?;
+    let mut out = vec![(
+        "reference".to_string(),
+        reference(&scene, &cam, true, samples)?,
+    )];
+    let mut renderer = Renderer::new();
+    for m in Method::ALL {
+        let mut o = Options::new(m);
+        o.map_size = map_size;
+        out.push((
+            m.name().to_string(),
+            renderer.render(&scene, &cam, &o)?.frame,
+        ));
+    }
+    Ok(out)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -51,6 +51,7 @@ pub mod error;
 pub mod harness;
 pub mod md;
 pub mod record;
+pub mod report;
 pub mod rng;
 pub mod scenes;
 pub mod sweeps;
