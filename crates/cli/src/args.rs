@@ -61,7 +61,7 @@ pub enum Command {
         /// warning (default: a cut frame is an error naming the file, frame and byte).
         #[arg(long)]
         allow_truncated: bool,
-        /// Topology (PDB, GRO, LAMMPS data file) of the trajectory's atoms: its atom, residue
+        /// Topology (PDB, GRO, PSF, LAMMPS data file) of the trajectory's atoms: its atom, residue
         /// and bond counts are added, and a different atom count is an error.
         #[arg(long, value_name = "FILE")]
         topology: Option<PathBuf>,
@@ -385,7 +385,7 @@ pub enum BondsArg {
     /// minimum image in a periodic box).
     #[default]
     Auto,
-    /// Only the topology's bonds (PDB CONECT, LAMMPS data Bonds).
+    /// Only the topology's bonds (PDB CONECT, PSF !NBOND, LAMMPS data Bonds).
     Topology,
     /// No bonds.
     None,
@@ -421,8 +421,8 @@ pub enum PbcArg {
 #[command(next_help_heading = "Molecules")]
 pub struct MolArgs {
     /// Topology giving names, elements, residues and bonds to a trajectory of the same atoms
-    /// (XTC, DCD, TRR, NetCDF carry coordinates only): PDB (CONECT bonds), GRO, or a LAMMPS
-    /// data file (.data, .lmp, data.*).
+    /// (XTC, DCD, TRR, NetCDF carry coordinates only): PDB (CONECT bonds), GRO, a CHARMM/NAMD
+    /// PSF (.psf: !NBOND bonds), or a LAMMPS data file (.data, .lmp, data.*).
     #[arg(long, value_name = "FILE")]
     pub topology: Option<PathBuf>,
     /// Draw only the atoms SEL selects, in the VMD/MDAnalysis language: 'not resname SOL',

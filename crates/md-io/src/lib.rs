@@ -79,6 +79,7 @@ mod netcdf;
 pub mod parse;
 pub mod pbc;
 mod pdb;
+mod psf;
 pub mod select;
 mod text;
 mod topology;

@@ -9,6 +9,8 @@
 //! - **PDB**: the first model's atoms through the PDB reader, plus `CONECT` records (serial
 //!   numbers, hybrid-36 allowed, resolved to atom indices through the model's serials);
 //! - **GRO**: the first frame's atoms (GRO has no bonds);
+//! - **PSF** (CHARMM, NAMD, X-PLOR): atoms with segment-free residues, types and masses, and the
+//!   `!NBOND` section (module `psf`: elements from names, checked against the masses);
 //! - **LAMMPS data file** (`.data`, `.lmp`, or a name starting `data.`): the `Atoms` section in
 //!   the styles `full`, `molecular` (and its column-equal `bond`, `angle`), `atomic` and
 //!   `charge`, told by the `Atoms # style` comment or, without one, by the column count (as
@@ -47,10 +49,12 @@ pub enum TopologyFormat {
     Gro,
     /// LAMMPS data file: `Atoms` and `Bonds` sections.
     LammpsData,
+    /// CHARMM/NAMD/X-PLOR PSF: `!NATOM` and `!NBOND` sections (see the `psf` module).
+    Psf,
 }
 
 impl TopologyFormat {
-    /// The format a path names: `.pdb`/`.ent`, `.gro`, `.data`/`.lmp` or `data.*` (LAMMPS).
+    /// The format a path names: `.pdb`/`.ent`, `.gro`, `.psf`, `.data`/`.lmp` or `data.*` (LAMMPS).
     pub fn from_path(path: &Path) -> Option<TopologyFormat> {
         let name = path.file_name()?.to_str()?.to_ascii_lowercase();
         if name.starts_with("data.") {
@@ -61,6 +65,7 @@ impl TopologyFormat {
             "pdb" | "ent" => TopologyFormat::Pdb,
             "gro" => TopologyFormat::Gro,
             "data" | "lmp" => TopologyFormat::LammpsData,
+            "psf" => TopologyFormat::Psf,
             _ => return None,
         })
     }
@@ -90,12 +95,12 @@ pub struct Topology {
 }
 
 /// A text line being parsed: its number and byte offset, for errors.
-struct LineAt {
-    line: u64,
-    byte: u64,
+pub(crate) struct LineAt {
+    pub(crate) line: u64,
+    pub(crate) byte: u64,
 }
 
-fn at(file: &Arc<str>, l: &LineAt) -> Location {
+pub(crate) fn at(file: &Arc<str>, l: &LineAt) -> Location {
     Location {
         file: file.clone(),
         frame: None,
@@ -104,7 +109,12 @@ fn at(file: &Arc<str>, l: &LineAt) -> Location {
     }
 }
 
-fn parse_err(file: &Arc<str>, l: &LineAt, expected: &'static str, found: &[u8]) -> Error {
+pub(crate) fn parse_err(
+    file: &Arc<str>,
+    l: &LineAt,
+    expected: &'static str,
+    found: &[u8],
+) -> Error {
     Error::Parse {
         at: at(file, l),
         expected,
@@ -113,7 +123,7 @@ fn parse_err(file: &Arc<str>, l: &LineAt, expected: &'static str, found: &[u8]) 
 }
 
 /// Streams the lines of a file with their numbers and byte offsets (one line buffered).
-struct Lines<R> {
+pub(crate) struct Lines<R> {
     src: BufReader<R>,
     buf: Vec<u8>,
     line: u64,
@@ -123,7 +133,7 @@ struct Lines<R> {
 }
 
 impl<R: Read> Lines<R> {
-    fn new(src: R, file: Arc<str>) -> Lines<R> {
+    pub(crate) fn new(src: R, file: Arc<str>) -> Lines<R> {
         Lines {
             src: BufReader::new(src),
             buf: Vec::new(),
@@ -135,7 +145,15 @@ impl<R: Read> Lines<R> {
     }
 
     /// The next line (without its end), or `None` at the end of the file.
-    fn next_line(&mut self) -> Result<Option<(&[u8], LineAt)>, Error> {
+    /// Where the file ends (the line after the last one read), for truncation errors.
+    pub(crate) fn end(&self) -> LineAt {
+        LineAt {
+            line: self.line + 1,
+            byte: self.next_byte,
+        }
+    }
+
+    pub(crate) fn next_line(&mut self) -> Result<Option<(&[u8], LineAt)>, Error> {
         self.buf.clear();
         let n = self
             .src
@@ -176,7 +194,7 @@ impl Topology {
         let Some(format) = TopologyFormat::from_path(path) else {
             return Err(Error::Unsupported {
                 file: name,
-                what: "topology format (expected .pdb, .gro, or a LAMMPS data file: .data, .lmp, data.*)",
+                what: "topology format (expected .pdb, .gro, .psf, or a LAMMPS data file: .data, .lmp, data.*)",
             });
         };
         Topology::open_as(path, format)
@@ -200,6 +218,7 @@ impl Topology {
             }
             TopologyFormat::Gro => Topology::first_frame(Trajectory::open_as(path, Format::Gro)?),
             TopologyFormat::LammpsData => lammps_data(open()?, &name),
+            TopologyFormat::Psf => crate::psf::read_psf(open()?, &name),
         }
     }
 
@@ -242,6 +261,7 @@ impl Topology {
                 Topology::first_frame(Trajectory::from_reader(src, Format::Gro, name)?)
             }
             TopologyFormat::LammpsData => lammps_data(src, &file),
+            TopologyFormat::Psf => crate::psf::read_psf(src, &file),
         }
     }
 
@@ -256,6 +276,31 @@ impl Topology {
             });
         }
         Ok(Topology::from_frame(&f, traj.name()))
+    }
+
+    /// A topology from its columns (empty vectors for what the file lacks).
+    #[allow(clippy::too_many_arguments)] // one argument per column, named at the one call site
+    pub(crate) fn from_parts(
+        file: Arc<str>,
+        names: Vec<Label>,
+        elements: Vec<Element>,
+        types: Vec<Label>,
+        ids: Vec<i64>,
+        res_names: Vec<Label>,
+        res_ids: Vec<i64>,
+        bonds: Vec<[u32; 2]>,
+    ) -> Topology {
+        Topology {
+            file,
+            n_atoms: ids.len(),
+            names,
+            elements,
+            types,
+            ids,
+            res_names,
+            res_ids,
+            bonds,
+        }
     }
 
     /// The labels of `frame` as a topology named `name` (no bonds).
@@ -346,7 +391,7 @@ impl Topology {
 }
 
 /// Sorts, orders (`i < j`) and deduplicates bonds.
-fn tidy(bonds: &mut Vec<[u32; 2]>) {
+pub(crate) fn tidy(bonds: &mut Vec<[u32; 2]>) {
     for b in bonds.iter_mut() {
         if b[0] > b[1] {
             b.swap(0, 1);

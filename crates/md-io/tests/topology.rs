@@ -144,3 +144,33 @@ fn unknown_topology_extension_is_refused_with_the_name() {
         .to_string();
     assert!(e.contains("topo_mda.xtc") && e.contains("topology"), "{e}");
 }
+
+/// A PSF written by ParmEd 4.3 from the same PDB (tests/data/gen_psf.py), against what
+/// MDAnalysis reads from that PSF; the elements (which a PSF does not store) against the PDB's.
+#[test]
+fn psf_written_by_parmed_matches_mdanalysis_and_gives_the_pdb_elements() {
+    let r: Value =
+        serde_json::from_str(&std::fs::read_to_string(path("psf_reference.json")).unwrap())
+            .unwrap();
+    let t = Topology::open(path("psf_parmed.psf")).unwrap();
+    assert_eq!(t.n_atoms() as u64, r["n_atoms"].as_u64().unwrap());
+    assert_eq!(labels(&t.names), strings(&r["names"]));
+    assert_eq!(labels(&t.res_names), strings(&r["resnames"]));
+    assert_eq!(labels(&t.types), strings(&r["types"]));
+    let resids: Vec<i64> = r["resids"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_i64().unwrap())
+        .collect();
+    assert_eq!(t.res_ids, resids);
+    assert_eq!(t.bonds, bonds(&r["bonds"]));
+    let pdb = Topology::open(path("topo_mda.pdb")).unwrap();
+    assert_eq!(t.elements, pdb.elements);
+    // And it labels the XTC of the same atoms.
+    let mut traj = Trajectory::open(path("topo_mda.xtc")).unwrap();
+    let mut f = Frame::new();
+    assert!(traj.read_next(&mut f).unwrap());
+    t.apply(&mut f, "topo_mda.xtc", 0).unwrap();
+    assert_eq!(labels(&f.names), strings(&r["names"]));
+}

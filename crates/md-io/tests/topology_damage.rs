@@ -70,6 +70,7 @@ fn damaged_topologies_give_located_errors_never_panics() {
         ("topo_mda.pdb", TopologyFormat::Pdb),
         ("topo_mda.data", TopologyFormat::LammpsData),
         ("topo_mda.gro", TopologyFormat::Gro),
+        ("psf_parmed.psf", TopologyFormat::Psf),
     ] {
         let good = data(file);
         assert!(check(&good, format, file));
