@@ -26,8 +26,8 @@
 
 use rayon::prelude::*;
 
-use crate::elements::atom_element;
 use crate::frame::{Frame, UnitCell};
+use crate::style::atom_element;
 
 /// The Open Babel / Jmol tolerance added to the sum of covalent radii (Å).
 pub const BOND_TOLERANCE: f32 = 0.45;

@@ -307,7 +307,7 @@ impl Topology {
     pub fn from_frame(frame: &Frame, name: &str) -> Topology {
         let elements = if frame.elements.is_empty() && !frame.names.is_empty() {
             (0..frame.n_atoms())
-                .map(|i| crate::elements::atom_element(frame, i))
+                .map(|i| crate::style::atom_element(frame, i))
                 .collect()
         } else {
             frame.elements.clone()
