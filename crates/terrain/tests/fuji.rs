@@ -57,7 +57,10 @@ fn true_error(g: &[f32], n: u32, verts: &[[u32; 2]], tris: &[[u32; 3]]) -> f32 {
             }
         }
     }
-    assert!(covered.iter().all(|c| *c), "the mesh leaves grid samples uncovered");
+    assert!(
+        covered.iter().all(|c| *c),
+        "the mesh leaves grid samples uncovered"
+    );
     worst
 }
 
@@ -79,7 +82,10 @@ fn fuji_meshes_stay_within_their_error_bound_on_every_sample() {
             "{max_error} m: true error {e} m with {} triangles",
             mesh.triangles.len()
         );
-        assert!(mesh.triangles.len() < last, "coarser bounds give fewer triangles");
+        assert!(
+            mesh.triangles.len() < last,
+            "coarser bounds give fewer triangles"
+        );
         last = mesh.triangles.len();
         eprintln!(
             "fuji 513², max error {max_error} m: {} triangles, {} vertices, true error {e:.2} m{}",
