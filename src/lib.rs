@@ -22,6 +22,7 @@ pub use texmap_impostor as impostor;
 pub use texmap_md_io as md_io;
 pub use texmap_mesh as mesh;
 pub use texmap_movie as movie;
+pub use texmap_quality as quality;
 pub use texmap_raster as raster;
 pub use texmap_reftrace as reftrace;
 pub use texmap_study as study;

@@ -70,6 +70,15 @@ pub enum RenderError {
     BadMaterial { material: usize, what: &'static str },
     /// The background colour is not finite.
     BadBackground,
+    /// Ambient occlusion with 0 or more than [`crate::MAX_AO_SAMPLES_PER_AXIS`] samples per
+    /// axis, or a distance that is not finite and positive.
+    BadAmbientOcclusion {
+        samples_per_axis: u32,
+        distance: f32,
+    },
+    /// Depth cueing with non-finite depths, `start >= end`, a strength outside [0, 1] or a
+    /// non-finite colour.
+    BadFog,
 }
 
 impl std::fmt::Display for RenderError {
@@ -104,6 +113,18 @@ impl std::fmt::Display for RenderError {
                 write!(f, "material {material}: {what}")
             }
             RenderError::BadBackground => write!(f, "background colour must be finite"),
+            RenderError::BadAmbientOcclusion {
+                samples_per_axis,
+                distance,
+            } => write!(
+                f,
+                "ambient occlusion with {samples_per_axis} samples per axis and distance {distance}: need 1..={} samples per axis and a finite positive distance",
+                crate::MAX_AO_SAMPLES_PER_AXIS
+            ),
+            RenderError::BadFog => write!(
+                f,
+                "fog needs finite depths start < end, a strength in [0, 1] and a finite colour"
+            ),
         }
     }
 }

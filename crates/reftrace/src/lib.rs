@@ -19,6 +19,10 @@
 //!   supersampling, a footprint-integrated texture reference. Parallel over rows with rayon and
 //!   byte-identical for any thread count. Writes no files. [`Scene::depth_image`] is the trace
 //!   alone (closest hit and exact depth, no shading).
+//! - Optional ambient occlusion ([`AmbientOcclusion`]: stratified cosine-weighted rays within a
+//!   distance), hard shadows from the key light and depth cueing ([`DepthCue`]) in
+//!   [`RenderOptions`], so that `texmap-quality`'s effects have a converged reference; off by
+//!   default, and then the output is unchanged.
 //! - [`geom`]: the robust leaf tests — pbrt's cancellation-free sphere discriminant and the
 //!   watertight ray/triangle test of Woop, Benthin and Wald (2013), which leaves no pinholes on
 //!   shared edges (obvhs's own triangle test does; it is not used).
@@ -64,7 +68,8 @@ mod wide;
 pub use error::{RenderError, SceneError, TextureError};
 pub use geom::CylinderPart;
 pub use render::{
-    MAX_RECURSION_DEPTH, MAX_SAMPLES_PER_AXIS, Optics, RenderOptions, SurfaceMaterial,
+    AmbientOcclusion, DepthCue, MAX_AO_SAMPLES_PER_AXIS, MAX_RECURSION_DEPTH, MAX_SAMPLES_PER_AXIS,
+    Optics, RenderOptions, SurfaceMaterial,
 };
 pub use scene::{BuildStats, BvhKind, Hit, HitKind, MeshShading, Scene, SceneBuilder};
 pub use texmap_core::frame::Frame;

@@ -36,6 +36,18 @@
 //! Secondary rays start at the hit point offset along the normal by `SECONDARY_EPS_REL` of the
 //! coordinates' magnitude.
 //!
+//! # Ambient occlusion, shadows and depth cueing
+//! Off by default (then nothing changes). With [`RenderOptions::ambient_occlusion`], every
+//! locally shaded hit scales the ambient term of the shading model by the fraction of
+//! `n × n` cosine-weighted hemisphere rays around the viewer-facing geometric normal that meet
+//! nothing within [`AmbientOcclusion::distance`]: one ray per stratum of the unit square
+//! (`u1` gives `cos²θ`, `u2` the azimuth), jittered inside its stratum by a hash of the sample's
+//! screen position and bounce, so the result is deterministic. With [`RenderOptions::shadows`]
+//! the key light (the first light of the lighting) is dropped where a ray toward it meets
+//! anything. Both rays start at the secondary-ray origin (offset along the normal).
+//! [`RenderOptions::fog`] blends each primary sample's colour linearly toward a colour by its
+//! depth ([`DepthCue`]); misses are not fogged.
+//!
 //! # Textures
 //! A material's texture multiplies its base colour on mesh triangles that have uvs (spheres and
 //! cylinders ignore it). On primary hits the texture value is the **box integral of the level-0
@@ -62,6 +74,8 @@ use crate::texture::Texture;
 pub const MAX_SAMPLES_PER_AXIS: u32 = 16;
 /// The largest `max_depth` accepted.
 pub const MAX_RECURSION_DEPTH: u32 = 16;
+/// The largest [`AmbientOcclusion::samples_per_axis`] accepted (4096 rays per shaded point).
+pub const MAX_AO_SAMPLES_PER_AXIS: u32 = 64;
 /// Cap on the footprint-integration grid per axis.
 const MAX_FOOTPRINT_GRID: u32 = 64;
 /// Secondary-ray origin offset, relative to the magnitude of the coordinates involved.
@@ -124,6 +138,25 @@ impl SurfaceMaterial {
     }
 }
 
+/// Ambient occlusion of the reference: `samples_per_axis²` stratified rays per shaded point,
+/// occluders counted within `distance`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AmbientOcclusion {
+    pub samples_per_axis: u32,
+    pub distance: f32,
+}
+
+/// Depth cueing: a primary sample at eye-space depth `z` becomes
+/// `(1 − f)·c + f·color` with `f = strength · clamp((z − start)/(end − start), 0, 1)`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DepthCue {
+    pub start: f32,
+    pub end: f32,
+    /// Linear RGB.
+    pub color: Vec3,
+    pub strength: f32,
+}
+
 /// Everything a render needs besides the scene and the camera.
 #[derive(Clone, Debug)]
 pub struct RenderOptions<'a> {
@@ -140,6 +173,12 @@ pub struct RenderOptions<'a> {
     pub environment_on_primary_miss: bool,
     /// Secondary bounces traced, at most [`MAX_RECURSION_DEPTH`].
     pub max_depth: u32,
+    /// Ambient occlusion (module docs); `None` = off.
+    pub ambient_occlusion: Option<AmbientOcclusion>,
+    /// Hard shadows from the key light (module docs).
+    pub shadows: bool,
+    /// Depth cueing of primary samples; `None` = off.
+    pub fog: Option<DepthCue>,
 }
 
 impl<'a> RenderOptions<'a> {
@@ -153,6 +192,9 @@ impl<'a> RenderOptions<'a> {
             background: Vec3::ZERO,
             environment_on_primary_miss: false,
             max_depth: 8,
+            ambient_occlusion: None,
+            shadows: false,
+            fog: None,
         }
     }
 
@@ -170,6 +212,25 @@ impl<'a> RenderOptions<'a> {
         }
         if !self.background.is_finite() {
             return Err(RenderError::BadBackground);
+        }
+        if let Some(ao) = self.ambient_occlusion
+            && !((1..=MAX_AO_SAMPLES_PER_AXIS).contains(&ao.samples_per_axis)
+                && ao.distance.is_finite()
+                && ao.distance > 0.0)
+        {
+            return Err(RenderError::BadAmbientOcclusion {
+                samples_per_axis: ao.samples_per_axis,
+                distance: ao.distance,
+            });
+        }
+        if let Some(f) = self.fog
+            && !(f.start.is_finite()
+                && f.end.is_finite()
+                && f.end > f.start
+                && (0.0..=1.0).contains(&f.strength)
+                && f.color.is_finite())
+        {
+            return Err(RenderError::BadFog);
         }
         if let Some(m) = scene.max_material_id()
             && m as usize >= self.materials.len()
@@ -347,8 +408,14 @@ impl<E: Fn(Vec3) -> Vec3 + Sync> Tracer<'_, E> {
         let hit = self.scene.finish(&pre, &raw);
         let mat = &self.opts.materials[hit.material_id as usize];
         let tex = self.texture_value(&hit, mat, Some((x, y, half)));
-        let c = self.shade(&hit, ray.dir, mat, tex, 0);
-        (c, finite_depth(raw.t * cos))
+        let seed = ((x.to_bits() as u64) << 32) | y.to_bits() as u64;
+        let mut c = self.shade(&hit, ray.dir, mat, tex, 0, seed);
+        let depth = finite_depth(raw.t * cos);
+        if let Some(f) = &self.opts.fog {
+            let w = ((depth - f.start) / (f.end - f.start)).clamp(0.0, 1.0) * f.strength;
+            c = c * (1.0 - w) + f.color * w;
+        }
+        (c, depth)
     }
 
     /// The environment in direction `d`, never non-finite.
@@ -385,7 +452,15 @@ impl<E: Fn(Vec3) -> Vec3 + Sync> Tracer<'_, E> {
     }
 
     /// Outgoing radiance at a hit seen along `dir`, at bounce `depth`.
-    fn shade(&self, hit: &Hit, dir: Vec3, mat: &SurfaceMaterial, tex: Vec3, depth: u32) -> Vec3 {
+    fn shade(
+        &self,
+        hit: &Hit,
+        dir: Vec3,
+        mat: &SurfaceMaterial,
+        tex: Vec3,
+        depth: u32,
+        seed: u64,
+    ) -> Vec3 {
         let d = dir.normalize();
         // The geometric normal decides the side (and offsets secondary origins); the shading
         // normal (interpolated on smooth meshes, else the same) shades and bends rays.
@@ -397,13 +472,39 @@ impl<E: Fn(Vec3) -> Vec3 + Sync> Tracer<'_, E> {
             -hit.shading_normal
         };
         let v = -d;
+        let eps = SECONDARY_EPS_REL * (1.0 + hit.point.abs().max_element() + hit.t.abs());
         let local = |m: &SurfaceMaterial| {
             let mut s = m.shading;
             s.base_color *= tex;
-            self.opts.lighting.shade(&s, ns, v)
+            if self.opts.ambient_occlusion.is_none() && !self.opts.shadows {
+                return self.opts.lighting.shade(&s, ns, v);
+            }
+            let origin = hit.point + ng * eps;
+            let ao = match self.opts.ambient_occlusion {
+                Some(ao) => self.ambient_visibility(origin, ng, ao, mix64(seed ^ depth as u64)),
+                None => 1.0,
+            };
+            let mut mask = u32::MAX;
+            if self.opts.shadows
+                && let Some(key) = self.opts.lighting.lights().first()
+                && ng.dot(key.to_light) > 0.0
+            {
+                let pre = RayPre::new(origin, key.to_light);
+                if self.scene.closest(&pre, 0.0, f32::INFINITY).is_some() {
+                    mask &= !1;
+                }
+            }
+            self.opts.lighting.shade_with(&s, ns, v, ao, mask)
         };
-        let eps = SECONDARY_EPS_REL * (1.0 + hit.point.abs().max_element() + hit.t.abs());
-        let reflect = || self.secondary(hit.point + ng * eps, optics::reflect(d, ns), depth + 1);
+        let seed2 = mix64(seed.wrapping_add(0x9e37_79b9_7f4a_7c15));
+        let reflect = || {
+            self.secondary(
+                hit.point + ng * eps,
+                optics::reflect(d, ns),
+                depth + 1,
+                seed2,
+            )
+        };
         match mat.optics {
             Optics::Opaque => local(mat),
             Optics::Mirror { reflectance: k } => {
@@ -418,7 +519,7 @@ impl<E: Fn(Vec3) -> Vec3 + Sync> Tracer<'_, E> {
                     // Total internal reflection.
                     return reflect();
                 };
-                let refr = self.secondary(hit.point - ng * eps, t.dir, depth + 1);
+                let refr = self.secondary(hit.point - ng * eps, t.dir, depth + 1, seed2 ^ 1);
                 if !fresnel {
                     return refr;
                 }
@@ -430,7 +531,7 @@ impl<E: Fn(Vec3) -> Vec3 + Sync> Tracer<'_, E> {
     }
 
     /// Radiance arriving along a secondary ray (environment beyond the depth limit).
-    fn secondary(&self, origin: Vec3, dir: Vec3, depth: u32) -> Vec3 {
+    fn secondary(&self, origin: Vec3, dir: Vec3, depth: u32, seed: u64) -> Vec3 {
         let dir = dir.normalize_or_zero();
         if depth > self.opts.max_depth || !origin.is_finite() || dir == Vec3::ZERO {
             return self.env_lookup(dir);
@@ -442,8 +543,48 @@ impl<E: Fn(Vec3) -> Vec3 + Sync> Tracer<'_, E> {
         let hit = self.scene.finish(&pre, &raw);
         let mat = &self.opts.materials[hit.material_id as usize];
         let tex = self.texture_value(&hit, mat, None);
-        self.shade(&hit, dir, mat, tex, depth)
+        self.shade(&hit, dir, mat, tex, depth, seed)
     }
+
+    /// The unoccluded fraction of `ao.samples_per_axis²` stratified cosine-weighted rays
+    /// around unit normal `n` from `origin` (module docs).
+    fn ambient_visibility(&self, origin: Vec3, n: Vec3, ao: AmbientOcclusion, seed: u64) -> f32 {
+        // Any unit vector not parallel to n gives the tangent frame.
+        let helper = if n.x.abs() < 0.6 { Vec3::X } else { Vec3::Y };
+        let t1 = n.cross(helper).normalize();
+        let t2 = n.cross(t1);
+        let m = ao.samples_per_axis;
+        let inv = 1.0 / m as f32;
+        let mut state = seed;
+        let mut open = 0u32;
+        for b in 0..m {
+            for a in 0..m {
+                state = mix64(state.wrapping_add(0x9e37_79b9_7f4a_7c15));
+                let j1 = (state >> 40) as f32 / 16_777_216.0;
+                let j2 = ((state >> 16) & 0xff_ffff) as f32 / 16_777_216.0;
+                let u1 = (a as f32 + j1) * inv;
+                let u2 = (b as f32 + j2) * inv;
+                let r = u1.sqrt();
+                let phi = 2.0 * std::f32::consts::PI * u2;
+                let dir =
+                    (t1 * (r * phi.cos()) + t2 * (r * phi.sin()) + n * (1.0 - u1).max(0.0).sqrt())
+                        .normalize_or(n);
+                let pre = RayPre::new(origin, dir);
+                if self.scene.closest(&pre, 0.0, ao.distance).is_none() {
+                    open += 1;
+                }
+            }
+        }
+        open as f32 / (m * m) as f32
+    }
+}
+
+/// splitmix64's output function: a 64-bit mix of `z`.
+#[inline]
+fn mix64(mut z: u64) -> u64 {
+    z = (z ^ (z >> 33)).wrapping_mul(0xff51_afd7_ed55_8ccd);
+    z = (z ^ (z >> 33)).wrapping_mul(0xc4ce_b9fe_1a85_ec53);
+    z ^ (z >> 33)
 }
 
 /// The primary ray through (x, y), the cosine of its angle to the view axis and its parameter

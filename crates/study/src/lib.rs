@@ -17,6 +17,8 @@
 //!   frames), reported as records.
 //! - [`sweeps`]: stability sweeps over field of view, angle off axis, eye distance and on-screen
 //!   radius on a single sphere; the tests pin each method's breaking point.
+//! - [`quality`]: the quality axis — `texmap-quality`'s anti-aliasing, ambient occlusion and
+//!   shadow settings timed and measured against a converged reference with the same effects.
 //! - [`chart`]: SVG/PNG charts (speed against accuracy, and the sweep curves) with an embedded
 //!   font.
 //!
@@ -50,6 +52,7 @@ pub mod envmap;
 pub mod error;
 pub mod harness;
 pub mod md;
+pub mod quality;
 pub mod record;
 pub mod report;
 pub mod rng;

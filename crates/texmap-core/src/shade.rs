@@ -173,8 +173,28 @@ impl Lighting {
     /// All vectors in the same frame as the lights.
     #[inline]
     pub fn shade(&self, m: &Material, n: Vec3, v: Vec3) -> Vec3 {
-        let mut c = self.ambient * m.base_color;
-        for light in &self.lights[..self.count] {
+        // Scaling by exactly 1 and keeping every light changes no bit.
+        self.shade_with(m, n, v, 1.0, u32::MAX)
+    }
+
+    /// [`Lighting::shade`] with the ambient term scaled by `ambient_scale` (ambient occlusion:
+    /// the unoccluded fraction in [0, 1]) and light `i` present only where bit `i` of
+    /// `lights_visible` is set (hard shadows). `shade(m, n, v)` is
+    /// `shade_with(m, n, v, 1.0, u32::MAX)`.
+    #[inline]
+    pub fn shade_with(
+        &self,
+        m: &Material,
+        n: Vec3,
+        v: Vec3,
+        ambient_scale: f32,
+        lights_visible: u32,
+    ) -> Vec3 {
+        let mut c = self.ambient * m.base_color * ambient_scale;
+        for (i, light) in self.lights[..self.count].iter().enumerate() {
+            if lights_visible & (1 << i) == 0 {
+                continue;
+            }
             let ndl = n.dot(light.to_light);
             if ndl > 0.0 {
                 let mut term = m.base_color * ndl;
@@ -211,6 +231,27 @@ mod tests {
         assert!((c.x - 0.5).abs() < 1e-5, "{c}");
         // Facing away: nothing.
         assert_eq!(l.shade(&m, -Vec3::Z, Vec3::Z), Vec3::ZERO);
+    }
+
+    #[test]
+    fn shade_with_all_on_is_shade_and_masks_lights() {
+        let l = Lighting::new(
+            Vec3::splat(0.2),
+            &[(Vec3::Z, Vec3::splat(0.7)), (Vec3::X, Vec3::splat(0.3))],
+        )
+        .unwrap();
+        let m = Material::plastic(Vec3::new(0.3, 0.5, 0.9));
+        let n = Vec3::new(0.4, 0.1, 0.9).normalize();
+        let v = Vec3::new(0.0, 0.2, 1.0).normalize();
+        assert_eq!(l.shade_with(&m, n, v, 1.0, u32::MAX), l.shade(&m, n, v));
+        // No light and no ambient: black. Ambient alone: ambient * base * scale.
+        assert_eq!(l.shade_with(&m, n, v, 0.0, 0), Vec3::ZERO);
+        let a = l.shade_with(&m, n, v, 0.5, 0);
+        assert!((a - Vec3::splat(0.1) * m.base_color).length() < 1e-7);
+        // The two lights add up to the whole.
+        let k = l.shade_with(&m, n, v, 0.0, 1);
+        let f = l.shade_with(&m, n, v, 0.0, 2);
+        assert!((a * 2.0 + k + f - l.shade(&m, n, v)).length() < 1e-6);
     }
 
     #[test]

@@ -1,0 +1,50 @@
+//! Speed of the quality pass (`texmap-quality`) at the setting — 4 anti-aliasing
+//! samples on edges, 8 ambient-occlusion rays, hard shadows from the key light — on the named
+//! scenes of `texmap-study`: S1 (1,115 particles) at 500x500 (target ≤ 100 ms) and S2
+//! (100,000 spheres) at 1920x1080 (target ≤ 1.5 s). Each iteration draws a whole frame: the
+//! ray-cast impostor, the grid build, recovery, shading and the edge samples. With `--bench`
+//! the `publication` preset is timed on S1 too.
+//!
+//! `CARGO_TARGET_DIR=/work/target-a cargo bench --bench quality -- --warm-up-time 1 --measurement-time 3`
+//! (test mode, `cargo test --bench quality`, draws each scene once at 160x120.)
+
+use criterion::{Criterion, criterion_group};
+use texmap::quality::{QualityOptions, QualityRenderer};
+use texmap::study::scenes::{SceneId, build};
+
+fn bench(c: &mut Criterion) {
+    let test_mode = std::env::args().any(|a| a == "--test");
+    let full = std::env::args().any(|a| a == "--bench");
+    let opts = QualityOptions {
+        aa: 4,
+        ao_samples: 8,
+        shadows: true,
+        ..QualityOptions::draft()
+    };
+    for id in [SceneId::S1, SceneId::S2] {
+        let mut s = build(id);
+        if test_mode {
+            s = s.with_size(160, 120).unwrap();
+        }
+        let mut g = c.benchmark_group(format!("quality/{}", s.name()));
+        g.sample_size(10);
+        let mut r = QualityRenderer::new();
+        g.bench_function("aa4_ao8_shadows", |b| {
+            b.iter(|| r.render(&s.spheres, &s.camera, &s.lighting, &opts).unwrap())
+        });
+        if full && id == SceneId::S1 {
+            let p = QualityOptions::publication();
+            g.bench_function("publication", |b| {
+                b.iter(|| r.render(&s.spheres, &s.camera, &s.lighting, &p).unwrap())
+            });
+        }
+        g.finish();
+    }
+}
+
+criterion_group!(benches, bench);
+
+fn main() {
+    benches();
+    Criterion::default().configure_from_args().final_summary();
+}
