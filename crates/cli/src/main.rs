@@ -11,6 +11,7 @@ mod movie;
 mod output;
 mod scene;
 mod terrain;
+mod terrain_fly;
 mod terrain_view;
 
 use std::process::ExitCode;

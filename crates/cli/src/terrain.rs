@@ -1,4 +1,4 @@
-//! `texmap terrain build | info | export | maps`: glue between files, texmap-terrain and the terminal.
+//! `texmap terrain build | info | export | maps | render | fly | compare`: glue between files, texmap-terrain and the terminal.
 
 use std::path::PathBuf;
 
@@ -79,6 +79,11 @@ pub enum TerrainCmd {
     },
     /// Draw the database from an aircraft (flight view) with a Seed 000 sampler.
     Render(crate::terrain_view::RenderArgs),
+    /// Fly a path file (or an orbit) over the database: PNG frames or a movie, with a progress bar.
+    Fly(crate::terrain_fly::FlyArgs),
+    /// Every sampler against the supersampled ray-traced reference along a flight path: CSV,
+    /// JSON, Markdown summary and SVG charts, and Seed 000's bank claims counted.
+    Compare(crate::terrain_fly::CompareArgs),
 }
 
 pub fn run(cmd: TerrainCmd) -> Result<()> {
@@ -235,6 +240,8 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
             Ok(())
         }
         TerrainCmd::Render(a) => crate::terrain_view::run(a),
+        TerrainCmd::Fly(a) => crate::terrain_fly::run_fly(a),
+        TerrainCmd::Compare(a) => crate::terrain_fly::run_compare(a),
         TerrainCmd::Maps {
             fov,
             pixels,

@@ -45,9 +45,13 @@ pub struct RenderArgs {
     /// Image size WIDTHxHEIGHT.
     #[arg(long, default_value = "1024x768")]
     pub size: String,
-    /// nearest, bilinear, trilinear, span3, span4 or aniso.
+    /// nearest, bilinear, trilinear, span3, span4, aniso, or reference: the full-resolution mesh
+    /// ray-traced with the texture integrated over each sample's footprint, --samples² per pixel.
     #[arg(long, default_value = "trilinear")]
     pub sampler: String,
+    /// Reference samples per pixel axis (--sampler reference).
+    #[arg(long, default_value_t = 4)]
+    pub samples: u32,
     /// Refine chunks while their screen-space error exceeds this many pixels.
     #[arg(long, default_value_t = 1.0)]
     pub pixel_error: f32,
@@ -98,13 +102,22 @@ fn view_error(e: ViewError) -> anyhow::Error {
 }
 
 pub fn run(a: RenderArgs) -> Result<()> {
-    let Some(sampler) = sampler_by_name(&a.sampler) else {
+    let reference = a.sampler == "reference";
+    // The reference draws no rasterised frame; the trilinear entry only fills the options.
+    let Some(sampler) = sampler_by_name(if reference { "trilinear" } else { &a.sampler }) else {
         return usage(format!(
-            "--sampler {}: expected one of {}",
+            "--sampler {}: expected one of {}, reference",
             a.sampler,
             SAMPLER_NAMES.join(", ")
         ));
     };
+    if reference && !(1..=texmap_reftrace::MAX_SAMPLES_PER_AXIS).contains(&a.samples) {
+        return usage(format!(
+            "--samples {}: expected 1..={}",
+            a.samples,
+            texmap_reftrace::MAX_SAMPLES_PER_AXIS
+        ));
+    }
     let (width, height) = parse_pair::<u32>(&a.size, 'x', "--size")?;
     let background = match &a.sky {
         None => [0, 0, 0, 0],
@@ -170,12 +183,32 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let stats = terrain
         .render(&view, &opts, &mut fb, &mut FrameScratch::default())
         .map_err(view_error)?;
+    let mut frame = if reference {
+        // The chunk statistics above are the flight view's; the image is the reference's.
+        let r = texmap_study::terrain::TerrainReference::new(&terrain)?;
+        let cam = view.camera(terrain.grid()).map_err(view_error)?;
+        let mut f = r.render(
+            &cam,
+            a.samples,
+            [background[0], background[1], background[2]],
+        )?;
+        if background[3] == 0 {
+            // Transparent where no terrain is, as the flight view draws it.
+            for i in 0..f.len() {
+                if !f.covered(i) {
+                    f.color[i] = background;
+                }
+            }
+        }
+        f
+    } else {
+        fb.to_frame()
+    };
     let render_ms = t1.elapsed().as_secs_f64() * 1e3;
     let mut cache = texmap_terrain::gst::GstCache::new(a.cache_mb.saturating_mul(1 << 20));
     let residency = terrain
         .make_resident(&view, &db, &mut cache)
         .map_err(view_error)?;
-    let mut frame = fb.to_frame();
     let pixels_covered = frame.coverage_count();
     if let Some(v) = a.haze {
         let sky = if a.sky.is_some() {
@@ -193,7 +226,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let v = json!({
         "eye": [view.eye_x, view.eye_y], "altitude": view.altitude,
         "heading": view.heading_deg, "pitch": view.pitch_deg, "roll": view.roll_deg,
-        "fov": view.hfov_deg, "size": [width, height], "sampler": a.sampler,
+        "fov": view.hfov_deg, "size": [width, height], "sampler": a.sampler, "reference_samples": reference.then_some(a.samples),
         "pixel_error": a.pixel_error,
         "frame": stats, "pixels_covered": pixels_covered, "haze_m": a.haze, "residency": residency,
         "load_ms": load_ms, "render_ms": render_ms,

@@ -165,3 +165,139 @@ fn bad_input_gets_exit_codes_scripts_can_trust() {
     }
     assert!(!out.exists());
 }
+
+/// A small database from the GDAL test grid and photo.
+fn small_db(dir: &Path) -> PathBuf {
+    let db = dir.join("area.db");
+    ok(&texmap(&[
+        "terrain",
+        "build",
+        "--dem",
+        &data("ramp_i16_lzw.tif"),
+        "--photo",
+        &data("photo_rgb.tif"),
+        "--max-error",
+        "0.5",
+        "--out",
+        db.to_str().unwrap(),
+    ]));
+    db
+}
+
+#[test]
+fn fly_writes_frames_and_names_a_bad_path_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let db = small_db(dir.path());
+    let db_s = db.to_str().unwrap();
+    // An orbit to numbered PNG frames, one per view.
+    let pattern = dir.path().join("frames/%04d.png");
+    std::fs::create_dir_all(dir.path().join("frames")).unwrap();
+    ok(&texmap(&[
+        "terrain",
+        "fly",
+        db_s,
+        "--orbit",
+        "3,0.3,0.2,-30",
+        "--size",
+        "64x48",
+        "--sampler",
+        "span3",
+        "-o",
+        pattern.to_str().unwrap(),
+    ]));
+    for f in 0..3 {
+        let p = dir.path().join(format!("frames/{f:04}.png"));
+        let img = image::open(&p).expect("a frame").to_rgba8();
+        assert_eq!(img.dimensions(), (64, 48));
+    }
+    // Per-frame statistics along the flight: one JSON line per frame with the GST residency.
+    let stats = dir.path().join("fly.jsonl");
+    ok(&texmap(&[
+        "terrain",
+        "fly",
+        db_s,
+        "--orbit",
+        "3",
+        "--size",
+        "32x24",
+        "--stats",
+        stats.to_str().unwrap(),
+        "-o",
+        dir.path().join("s.apng").to_str().unwrap(),
+    ]));
+    let text = std::fs::read_to_string(&stats).unwrap();
+    assert_eq!(text.lines().count(), 3);
+    for l in text.lines() {
+        let v: serde_json::Value = serde_json::from_str(l).unwrap();
+        assert!(v["stats"]["chunks_drawn"].as_u64().unwrap() >= 1, "{v}");
+        assert!(v["residency"]["needed"].as_u64().is_some(), "{v}");
+    }
+    // The same orbit as an animated PNG, and with the ray-traced reference.
+    let apng = dir.path().join("orbit.apng");
+    ok(&texmap(&[
+        "terrain",
+        "fly",
+        db_s,
+        "--orbit",
+        "2",
+        "--size",
+        "48x36",
+        "--sampler",
+        "reference",
+        "--samples",
+        "2",
+        "-o",
+        apng.to_str().unwrap(),
+    ]));
+    assert!(std::fs::metadata(&apng).unwrap().len() > 100);
+    // A path file whose second data line has four fields: the error names file and line.
+    let path = dir.path().join("path.csv");
+    std::fs::write(&path, "x,y,altitude,heading,pitch\n1,2,3,4,5\n1,2,3,4\n").unwrap();
+    let o = texmap(&[
+        "terrain",
+        "fly",
+        db_s,
+        "--path",
+        path.to_str().unwrap(),
+        "-o",
+        dir.path().join("p.apng").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("path.csv:3:"), "{err}");
+    assert!(!dir.path().join("p.apng").exists(), "no partial movie");
+    // Neither --path nor --orbit: a usage error.
+    let o = texmap(&["terrain", "fly", db_s, "-o", "x.png"]);
+    assert_eq!(o.status.code(), Some(2));
+}
+
+#[test]
+fn compare_writes_the_study_with_no_bank_conflicts() {
+    let dir = tempfile::tempdir().unwrap();
+    let db = small_db(dir.path());
+    let out = dir.path().join("study");
+    let o = texmap(&[
+        "terrain",
+        "compare",
+        db.to_str().unwrap(),
+        "--size",
+        "48x36",
+        "--samples",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    ok(&o);
+    let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
+    // The built-in path (26 views) times the seven samplers, plus the header.
+    assert_eq!(csv.lines().count(), 1 + 26 * 7);
+    let v: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("results.json")).unwrap()).unwrap();
+    assert_eq!(v["claims"]["conflicts_span3"], 0);
+    assert!(v["claims"]["spans_span3"].as_u64().unwrap() > 0);
+    for chart in ["error_vs_pitch.svg", "error_vs_altitude.svg"] {
+        let svg = std::fs::read_to_string(out.join(chart)).unwrap();
+        assert!(svg.starts_with("<svg") && svg.contains("trilinear"));
+    }
+    assert!(String::from_utf8_lossy(&o.stdout).contains("| span3 |"));
+}

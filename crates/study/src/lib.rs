@@ -17,6 +17,8 @@
 //!   frames), reported as records.
 //! - [`sweeps`]: stability sweeps over field of view, angle off axis, eye distance and on-screen
 //!   radius on a single sphere; the tests pin each method's breaking point.
+//! - [`terrain`]: the flight-view study (Seed 000): every terrain sampler against a supersampled,
+//!   footprint-integrated ray-traced reference, and the paper's bank claims counted.
 //! - [`quality`]: the quality axis — `texmap-quality`'s anti-aliasing, ambient occlusion and
 //!   shadow settings timed and measured against a converged reference with the same effects.
 //! - [`chart`]: SVG/PNG charts (speed against accuracy, and the sweep curves) with an embedded
@@ -58,5 +60,6 @@ pub mod report;
 pub mod rng;
 pub mod scenes;
 pub mod sweeps;
+pub mod terrain;
 
 pub use error::StudyError;

@@ -19,6 +19,8 @@
 //!   chosen by screen-space error and frustum culling, drawn through texmap-raster with any
 //!   texmap-core sampler (nearest, bilinear, trilinear, the span sampler with 3x3 or 4x4 banks,
 //!   anisotropic), per-frame statistics and optional haze.
+//! - [`flight`]: flight paths — CSV/JSON path files (a bad line is named), orbits, and the
+//!   built-in study path (look-down, low, grazing, turn, slow pass).
 //!
 //! Coordinates: vertices are in metres, `x` east, `y` up, `z` south (rows), from the centre of
 //! sample (0, 0); texture coordinates span the grid's extent, `v` down the rows as in glTF.
@@ -56,6 +58,7 @@ pub mod chunks;
 pub mod db;
 pub mod dem;
 pub mod error;
+pub mod flight;
 pub mod greedy;
 pub mod gst;
 pub mod rtin;

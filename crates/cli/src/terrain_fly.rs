@@ -1,0 +1,346 @@
+//! `texmap terrain fly` (a flight path or an orbit to PNG frames or a movie, with a progress bar)
+//! and `texmap terrain compare` (the sampler study against the ray-traced reference). Glue only:
+//! paths are `texmap_terrain::flight`, the study is `texmap_study::terrain`.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
+use serde_json::json;
+use texmap_core::frame::Frame;
+use texmap_study::terrain::{self as study, StudyOptions, TerrainReference};
+use texmap_terrain::db::Database;
+use texmap_terrain::flight::{self, PathView};
+use texmap_terrain::view::{
+    FlightCamera, FlightTerrain, FrameScratch, SAMPLER_NAMES, ViewOptions, sampler_by_name,
+};
+
+use crate::args::usage;
+use crate::movie::Sink;
+
+/// Fly a path over the terrain database and write every frame.
+#[derive(Args, Debug)]
+pub struct FlyArgs {
+    /// Database directory (from `texmap terrain build`).
+    pub dir: PathBuf,
+    /// Path file: CSV (x,y,altitude,heading,pitch[,roll[,fov]] per line, optional header) or a
+    /// JSON array of {x, y, altitude, heading, pitch, roll?, fov?}.
+    #[arg(long, conflicts_with = "orbit")]
+    pub path: Option<PathBuf>,
+    /// Orbit instead of a path: FRAMES[,RADIUS[,HEIGHT[,PITCH]]] — FRAMES views on a circle around
+    /// the grid's centre looking at it; radius and height above the ground as fractions of the
+    /// grid's smaller extent (defaults 0.3 and 0.1), pitch in degrees (default −25).
+    #[arg(long, allow_hyphen_values = true)]
+    pub orbit: Option<String>,
+    /// Horizontal field of view, degrees (a path file's fov column overrides it).
+    #[arg(long, default_value_t = 45.0)]
+    pub fov: f64,
+    /// Image size WIDTHxHEIGHT.
+    #[arg(long, default_value = "1024x768")]
+    pub size: String,
+    /// nearest, bilinear, trilinear, span3, span4, aniso or reference (the ray-traced reference).
+    #[arg(long, default_value = "trilinear")]
+    pub sampler: String,
+    /// Reference samples per pixel axis (--sampler reference).
+    #[arg(long, default_value_t = 4)]
+    pub samples: u32,
+    /// Refine chunks while their screen-space error exceeds this many pixels.
+    #[arg(long, default_value_t = 1.0)]
+    pub pixel_error: f32,
+    /// Largest side of the whole-terrain texture assembled from the GST pyramid.
+    #[arg(long, default_value_t = 4096)]
+    pub max_texture: u32,
+    /// Frames per second of a movie output.
+    #[arg(long, default_value_t = 25.0)]
+    pub fps: f64,
+    /// Write one JSON line per frame: the view, the frame's statistics (chunks per level,
+    /// triangles) and the GST maps Seed 000 Eq. 5-7 made resident along the flight (needed,
+    /// loaded, cache hits, evictions, resident bytes).
+    #[arg(long)]
+    pub stats: Option<PathBuf>,
+    /// GST map cache budget along the flight, MiB.
+    #[arg(long, default_value_t = 512)]
+    pub cache_mb: u64,
+    /// Output: PNG frames (frames/%04d.png) or a movie (.apng, .mp4, .webm, .gif).
+    #[arg(short, long)]
+    pub output: PathBuf,
+}
+
+/// Compare every sampler with the ray-traced reference along a flight path.
+#[derive(Args, Debug)]
+pub struct CompareArgs {
+    /// Database directory (from `texmap terrain build`).
+    #[arg(required_unless_present = "builtin")]
+    pub dir: Option<PathBuf>,
+    /// Use the built-in deterministic terrain instead of a database: a SIDE² grid of hills with a
+    /// synthetic 4·(SIDE−1)² photo (e.g. 257).
+    #[arg(long, conflicts_with = "dir")]
+    pub builtin: Option<u32>,
+    /// Path file (as for `fly`); default: the built-in study path (look-down, low, grazing, turn,
+    /// slow pass; 26 views).
+    #[arg(long)]
+    pub path: Option<PathBuf>,
+    /// Image size WIDTHxHEIGHT.
+    #[arg(long, default_value = "320x240")]
+    pub size: String,
+    /// Horizontal field of view, degrees.
+    #[arg(long, default_value_t = 45.0)]
+    pub fov: f64,
+    /// Reference samples per pixel axis (n x n per pixel).
+    #[arg(long, default_value_t = 4)]
+    pub samples: u32,
+    /// Samplers to compare, comma-separated: nearest, bilinear, trilinear, span3, span4, aniso,
+    /// quadratic3 (quadratic interpolation on each level's 3x3 neighbourhood); default: all.
+    #[arg(long)]
+    pub samplers: Option<String>,
+    /// Refine chunks while their screen-space error exceeds this many pixels.
+    #[arg(long, default_value_t = 1.0)]
+    pub pixel_error: f32,
+    /// Largest side of the whole-terrain texture assembled from the GST pyramid.
+    #[arg(long, default_value_t = 4096)]
+    pub max_texture: u32,
+    /// Output directory: results.csv, results.json, summary.md, error_vs_pitch.svg,
+    /// error_vs_altitude.svg.
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+fn size(s: &str) -> Result<(u32, u32)> {
+    let mut it = s.split('x').map(|t| t.trim().parse::<u32>());
+    match (it.next(), it.next(), it.next()) {
+        (Some(Ok(w)), Some(Ok(h)), None) if w > 0 && h > 0 && w <= 16384 && h <= 16384 => {
+            Ok((w, h))
+        }
+        _ => usage(format!("--size {s}: expected WIDTHxHEIGHT, each 1..=16384")),
+    }
+}
+
+fn progress_bar(len: usize, msg: &'static str) -> ProgressBar {
+    let pb = ProgressBar::new(len as u64);
+    pb.set_style(
+        ProgressStyle::with_template("{bar:40} {pos}/{len} {msg} {elapsed}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    pb.set_message(msg);
+    pb
+}
+
+/// The orbit of `--orbit FRAMES[,RADIUS[,HEIGHT[,PITCH]]]`.
+fn parse_orbit(
+    s: &str,
+    terrain: &FlightTerrain,
+    template: &FlightCamera,
+) -> Result<Vec<FlightCamera>> {
+    let bad = || {
+        usage(format!(
+            "--orbit {s}: expected FRAMES[,RADIUS[,HEIGHT[,PITCH]]]"
+        ))
+    };
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    if parts.is_empty() || parts.len() > 4 {
+        return bad();
+    }
+    let Ok(frames) = parts[0].parse::<u32>() else {
+        return bad();
+    };
+    if frames == 0 || frames > 100_000 {
+        return usage(format!("--orbit {s}: frames must be 1..=100000"));
+    }
+    let mut v = [0.3, 0.1, -25.0];
+    for (k, p) in parts[1..].iter().enumerate() {
+        match p.parse::<f64>() {
+            Ok(x) if x.is_finite() => v[k] = x,
+            _ => return bad(),
+        }
+    }
+    if !(v[0] >= 0.0 && v[1] > 0.0 && v[2].abs() <= 90.0) {
+        return usage(format!(
+            "--orbit {s}: expected radius ≥ 0, height > 0 and |pitch| ≤ 90"
+        ));
+    }
+    Ok(flight::orbit(
+        terrain.grid(),
+        template,
+        frames,
+        v[0],
+        v[1],
+        v[2],
+    ))
+}
+
+/// Open a database as a flight terrain.
+fn open(dir: &std::path::Path, max_texture: u32) -> Result<(Database, FlightTerrain)> {
+    let db = Database::open(dir)?;
+    let terrain = FlightTerrain::from_database(&db, max_texture)
+        .with_context(|| format!("{}: cannot open the terrain", dir.display()))?;
+    Ok((db, terrain))
+}
+
+pub fn run_fly(a: FlyArgs) -> Result<()> {
+    let reference = a.sampler == "reference";
+    let sampler = match sampler_by_name(&a.sampler) {
+        Some(s) => Some(s),
+        None if reference => None,
+        None => {
+            return usage(format!(
+                "--sampler {}: expected one of {}, reference",
+                a.sampler,
+                SAMPLER_NAMES.join(", ")
+            ));
+        }
+    };
+    if reference && !(1..=texmap_reftrace::MAX_SAMPLES_PER_AXIS).contains(&a.samples) {
+        return usage(format!(
+            "--samples {}: expected 1..={}",
+            a.samples,
+            texmap_reftrace::MAX_SAMPLES_PER_AXIS
+        ));
+    }
+    let (width, height) = size(&a.size)?;
+    if a.path.is_none() && a.orbit.is_none() {
+        return usage("terrain fly: give --path FILE or --orbit FRAMES[,RADIUS[,HEIGHT[,PITCH]]]");
+    }
+    let (db, terrain) = open(&a.dir, a.max_texture)?;
+    let template = FlightCamera {
+        hfov_deg: a.fov,
+        width,
+        height,
+        ..FlightCamera::over(terrain.grid())
+    };
+    let views = match (&a.path, &a.orbit) {
+        (Some(p), _) => flight::read_path_for(p, &template, terrain.grid())?,
+        (None, Some(o)) => parse_orbit(o, &terrain, &template)?,
+        (None, None) => unreachable!("checked above"),
+    };
+    for (i, v) in views.iter().enumerate() {
+        v.camera(terrain.grid())
+            .with_context(|| format!("view {i} of the orbit"))?;
+    }
+    let mut sink = Sink::new(&a.output, views.len(), a.fps, false)?;
+    let refr = if reference {
+        Some(TerrainReference::new(&terrain)?)
+    } else {
+        None
+    };
+    let pb = progress_bar(views.len(), "frames");
+    let t0 = Instant::now();
+    let mut scratch = FrameScratch::default();
+    let mut triangles = 0u64;
+    let mut cache = texmap_terrain::gst::GstCache::new(a.cache_mb.saturating_mul(1 << 20));
+    let mut lines = String::new();
+    for (i, v) in views.iter().enumerate() {
+        let mut frame_stats = None;
+        let frame: Frame = match (&refr, sampler) {
+            (Some(r), _) => r.render_view(&terrain, v, a.samples)?,
+            (None, Some(s)) => {
+                let mut fb = texmap_raster::Framebuffer::new(width, height)?;
+                let opts = ViewOptions {
+                    pixel_error: a.pixel_error,
+                    sampler: s,
+                    ..ViewOptions::default()
+                };
+                let st = terrain
+                    .render(v, &opts, &mut fb, &mut scratch)
+                    .with_context(|| format!("view {i}"))?;
+                triangles += st.triangles;
+                frame_stats = Some(st);
+                fb.to_frame()
+            }
+            (None, None) => unreachable!("sampler checked above"),
+        };
+        sink.write(i, &frame, false)?;
+        if a.stats.is_some() {
+            let residency = terrain
+                .make_resident(v, &db, &mut cache)
+                .with_context(|| format!("view {i}: GST maps"))?;
+            let line = json!({
+                "frame": i, "eye": [v.eye_x, v.eye_y], "altitude": v.altitude,
+                "heading": v.heading_deg, "pitch": v.pitch_deg, "roll": v.roll_deg,
+                "stats": frame_stats, "residency": residency,
+                "pixels_covered": frame.coverage_count(),
+            });
+            lines.push_str(&line.to_string());
+            lines.push('\n');
+        }
+        pb.inc(1);
+    }
+    if let Some(p) = &a.stats {
+        std::fs::write(p, lines).with_context(|| format!("cannot write {}", p.display()))?;
+    }
+    let movie = sink.finish()?;
+    pb.finish_and_clear();
+    let secs = t0.elapsed().as_secs_f64();
+    let v = json!({
+        "frames": views.len(), "size": [width, height], "sampler": a.sampler,
+        "seconds": secs, "ms_per_frame": 1e3 * secs / views.len() as f64,
+        "triangles": triangles, "movie": movie.map(|p| p.display().to_string()),
+    });
+    eprintln!("{v}");
+    Ok(())
+}
+
+pub fn run_compare(a: CompareArgs) -> Result<()> {
+    let (width, height) = size(&a.size)?;
+    if !(1..=texmap_reftrace::MAX_SAMPLES_PER_AXIS).contains(&a.samples) {
+        return usage(format!(
+            "--samples {}: expected 1..={}",
+            a.samples,
+            texmap_reftrace::MAX_SAMPLES_PER_AXIS
+        ));
+    }
+    let known = study::study_sampler_names();
+    let samplers: Vec<String> = match &a.samplers {
+        None => known.clone(),
+        Some(s) => s.split(',').map(|t| t.trim().to_string()).collect(),
+    };
+    if let Some(bad) = samplers.iter().find(|s| !known.contains(s)) {
+        return usage(format!(
+            "--samplers: {bad} is not one of {}",
+            known.join(", ")
+        ));
+    }
+    if !(a.pixel_error.is_finite() && a.pixel_error > 0.0) {
+        return usage(format!("--pixel-error {}: expected > 0", a.pixel_error));
+    }
+    let terrain = match (&a.dir, a.builtin) {
+        (_, Some(side)) => study::builtin_terrain(side, 4 * side.saturating_sub(1))?,
+        (Some(dir), None) => open(dir, a.max_texture)?.1,
+        (None, None) => return usage("terrain compare: give a database DIR or --builtin SIDE"),
+    };
+    let template = FlightCamera {
+        hfov_deg: a.fov,
+        width,
+        height,
+        ..FlightCamera::over(terrain.grid())
+    };
+    let path: Vec<PathView> = match &a.path {
+        Some(p) => flight::read_path_for(p, &template, terrain.grid())?
+            .into_iter()
+            .map(|view| PathView {
+                segment: "path",
+                view,
+            })
+            .collect(),
+        None => flight::study_path(terrain.grid(), &template),
+    };
+    let reference = TerrainReference::new(&terrain)?;
+    let opts = StudyOptions {
+        samples_per_axis: a.samples,
+        pixel_error: a.pixel_error,
+        samplers,
+    };
+    let pb = progress_bar(path.len(), "views");
+    let result = study::run_study(&terrain, &reference, &path, &opts, &mut |done, _| {
+        pb.set_position(done as u64)
+    });
+    pb.finish_and_clear();
+    let s = result?;
+    let written = study::write_study(&a.out, &s)?;
+    print!("{}", study::summary_markdown(&s));
+    for p in written {
+        eprintln!("wrote {}", p.display());
+    }
+    Ok(())
+}
