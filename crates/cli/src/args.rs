@@ -273,7 +273,8 @@ pub struct RenderArgs {
     /// Camera motion over the frames: orbit, keyframes, following a selection.
     #[command(flatten)]
     pub path: PathArgs,
-    /// Background colour R,G,B (0-255).
+    /// Background: a colour R,G,B (0-255), or `transparent` (PNG alpha 0 where no atom is;
+    /// with --aa, edges carry their covered fraction as alpha).
     #[arg(long, default_value = "0,0,0")]
     pub background: String,
     /// Draw the periodic box outline when the file has a box.
@@ -298,6 +299,9 @@ pub struct RenderArgs {
     /// SLURM_ARRAY_TASK_ID - SLURM_ARRAY_TASK_MIN of SLURM_ARRAY_TASK_COUNT when Slurm sets them.
     #[arg(long, value_name = "I/N")]
     pub shard: Option<String>,
+    /// Anti-aliasing, ambient occlusion, shadows, depth cueing, outlines.
+    #[command(flatten)]
+    pub quality: QualityArgs,
     /// Topology, selection, bonds and periodic boundaries.
     #[command(flatten)]
     pub mol: MolArgs,
@@ -376,6 +380,46 @@ pub struct PathArgs {
     /// so that the centre does not jump when a molecule crosses the box.
     #[arg(long, value_name = "SEL")]
     pub follow: Option<String>,
+}
+
+/// `--quality` presets.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum QualityPreset {
+    /// The exact ray-cast image, nothing added (the default look).
+    Draft,
+    /// 4 samples on edges, ambient occlusion with 8 rays, shadows.
+    Good,
+    /// 16 samples on edges, ambient occlusion with 32 rays, shadows, a 1-pixel black outline.
+    Publication,
+}
+
+/// Image quality of `texmap render` (ray-cast method): each flag overrides its preset's value.
+#[derive(Args, Clone, Debug, Default)]
+#[command(next_help_heading = "Quality (raycast method)")]
+pub struct QualityArgs {
+    /// A preset to start from: draft, good, publication (see --help for what each turns on).
+    #[arg(long, value_enum)]
+    pub quality: Option<QualityPreset>,
+    /// Anti-aliasing: samples per pixel on silhouettes and shadow edges (1-256; 1 = off). Only
+    /// edge pixels are traced again, so the cost grows with the outline, not the image.
+    #[arg(long, value_name = "N")]
+    pub aa: Option<u32>,
+    /// Ambient occlusion: hemisphere rays per pixel (0-4096; 0 = off), deterministic noise.
+    #[arg(long, value_name = "SAMPLES")]
+    pub ao: Option<u32>,
+    /// How far (Å) an occluder darkens a surface (default: 4 mean atom radii).
+    #[arg(long, value_name = "D", allow_hyphen_values = true)]
+    pub ao_distance: Option<f32>,
+    /// Hard shadows from the key light.
+    #[arg(long)]
+    pub shadows: bool,
+    /// Depth cueing: atoms fade toward the background colour from the front to the back of
+    /// the scene.
+    #[arg(long)]
+    pub fog: bool,
+    /// A black silhouette line of PX pixels (1-16) where depth jumps, as QuteMol draws.
+    #[arg(long, value_name = "PX")]
+    pub outline: Option<u32>,
 }
 
 /// Where bonds come from (`--bonds`).

@@ -70,7 +70,7 @@ pub(crate) fn progress(len: u64, what: &str) -> ProgressBar {
     let pb = ProgressBar::new(len);
     pb.set_style(
         ProgressStyle::with_template(&format!(
-            "{{spinner}} {what} [{{bar:30}}] {{pos}}/{{len}} {{per_sec}} ETA {{eta}}"
+            "{{spinner}} {what} [{{bar:30}}] {{pos}}/{{len}} {{per_sec}} ETA {{eta}} {{msg}}"
         ))
         .expect("static template")
         .progress_chars("=> "),
@@ -291,6 +291,13 @@ fn render(a: &RenderArgs) -> Result<()> {
             i * frames.len() / parts..(i + 1) * frames.len() / parts
         }
     };
+    let quality = crate::scene::quality_options(&a.quality, background)?;
+    if quality.is_some() && a.method != MethodArg::Raycast {
+        return usage(
+            "--quality, --aa, --ao, --ao-distance, --shadows, --fog and --outline apply to --method raycast (the default)",
+        );
+    }
+    let mut quality_renderer = texmap_quality::QualityRenderer::new();
     let mut builder = SceneBuilder::new(&a.style)?;
     let mut plan = crate::scene::MolPlan::new(&a.mol)?;
     let mut md = MdFrame::new();
@@ -360,8 +367,22 @@ fn render(a: &RenderArgs) -> Result<()> {
             .camera(k, &md)
             .map_err(|e| fail(e, &written))?;
         let lighting = Lighting::default_for(&cam);
-        let out = match method_of(a.method) {
-            Some(m) => {
+        let out = match (method_of(a.method), quality) {
+            (Some(_), Some(mut q)) => {
+                q.draw_bonds = plan.draws_bonds();
+                if a.quality.fog {
+                    q.fog = texmap_quality::Fog::for_scene(
+                        &scene,
+                        &cam,
+                        [background[0], background[1], background[2]],
+                    );
+                }
+                quality_renderer
+                    .render(&scene, &cam, &lighting, &q)
+                    .map_err(|e| fail(anyhow::anyhow!("{e}"), &written))?
+                    .frame
+            }
+            (Some(m), None) => {
                 let mut o = texmap_impostor::Options::new(m, lighting);
                 o.background = background;
                 o.draw_bonds = plan.draws_bonds();
@@ -369,7 +390,7 @@ fn render(a: &RenderArgs) -> Result<()> {
                 skipped_total += r.stats.skipped_invalid;
                 r.frame
             }
-            None => harness::render_reference(
+            (None, _) => harness::render_reference(
                 &harness::reference_scene_with_bonds(&scene, plan.draws_bonds()),
                 &harness::reference_materials(&scene),
                 &cam,
@@ -528,7 +549,15 @@ fn compare(a: &CompareArgs) -> Result<()> {
         scene.camera.width(),
         scene.camera.height()
     );
-    let report = harness::run_scene(&scene, &opts)?;
+    let pb = progress(1 + opts.methods.len() as u64, "comparing");
+    let mut first = true;
+    let report = harness::run_scene_with_progress(&scene, &opts, &mut |stage| {
+        if !std::mem::take(&mut first) {
+            pb.inc(1);
+        }
+        pb.set_message(stage.to_string());
+    })?;
+    pb.finish_and_clear();
     write_report(&a.out, &report)?;
     write_results(&a.out, &report.records)?;
     let series = if a.sweeps {
@@ -659,6 +688,13 @@ fn demo(out: &Path, steps: usize, every: usize, size: &str) -> Result<()> {
         &names,
         "envmap",
     ));
+
+    // Terrain (Seed 000): a built-in DEM and photo, a fly-through and the sampler comparison.
+    crate::note!("terrain flight view (Seed 000)");
+    sections.push(Section {
+        title: "Terrain flight view (Seed 000)".into(),
+        html: texmap_study::terrain::demo_section(out)?,
+    });
     let html = demo_index_html(&summaries, &report, &charts, out, &sections);
     write_atomic(&out.join("index.html"), |p| {
         std::fs::write(p, &html).context("index.html")

@@ -566,12 +566,15 @@ pub fn parse_size(s: &str) -> Result<(u32, u32)> {
 
 /// Parse `R,G,B` (0–255) into an opaque sRGB colour.
 pub fn parse_background(s: &str) -> Result<[u8; 4]> {
+    if s.trim().eq_ignore_ascii_case("transparent") {
+        return Ok([0, 0, 0, 0]);
+    }
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();
     let parsed: Vec<Option<u8>> = parts.iter().map(|p| p.parse::<u8>().ok()).collect();
     match parsed.as_slice() {
         [Some(r), Some(g), Some(b)] => Ok([*r, *g, *b, 255]),
         _ => usage(format!(
-            "--background {s:?}: expected R,G,B with each 0-255"
+            "--background {s:?}: expected R,G,B with each 0-255, or transparent"
         )),
     }
 }
@@ -782,6 +785,56 @@ impl CameraPlan {
         pose.camera(&self.template)
             .map_err(|e| anyhow::anyhow!("camera of rendered frame {k}: {e}"))
     }
+}
+
+/// The quality pass a render asked for (`--quality`, `--aa`, `--ao`, ...), or `None` when no
+/// quality flag was given (the plain impostor image). Fog is filled in per frame
+/// ([`texmap_quality::Fog::for_scene`]), as the camera may move.
+pub fn quality_options(
+    q: &crate::args::QualityArgs,
+    background: [u8; 4],
+) -> Result<Option<texmap_quality::QualityOptions>> {
+    use crate::args::QualityPreset;
+    use texmap_quality::{Background, Outline, QualityOptions};
+    let any = q.quality.is_some()
+        || q.aa.is_some()
+        || q.ao.is_some()
+        || q.ao_distance.is_some()
+        || q.shadows
+        || q.fog
+        || q.outline.is_some();
+    if !any {
+        return Ok(None);
+    }
+    let mut o = match q.quality.unwrap_or(QualityPreset::Draft) {
+        QualityPreset::Draft => QualityOptions::draft(),
+        QualityPreset::Good => QualityOptions::good(),
+        QualityPreset::Publication => QualityOptions::publication(),
+    };
+    if let Some(n) = q.aa {
+        o.aa = n;
+    }
+    if let Some(n) = q.ao {
+        o.ao_samples = n;
+    }
+    if q.ao_distance.is_some() {
+        o.ao_distance = q.ao_distance;
+    }
+    o.shadows |= q.shadows;
+    if let Some(px) = q.outline {
+        o.outline = Some(Outline {
+            width_px: px,
+            color: [0, 0, 0],
+        });
+    }
+    o.background = if background[3] == 0 {
+        Background::Transparent
+    } else {
+        Background::Color([background[0], background[1], background[2]])
+    };
+    o.validate()
+        .map_err(|e| crate::args::UsageError(format!("quality options: {e}")))?;
+    Ok(Some(o))
 }
 
 #[cfg(test)]

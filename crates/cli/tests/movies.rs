@@ -203,6 +203,8 @@ fn the_demo_writes_its_animation_as_a_movie() {
         "Error images:",
         "Environment mapping (Seed 003)",
         "envmap/sphere-dynamic.png",
+        "Terrain flight view (Seed 000)",
+        "terrain/flight.apng",
     ] {
         assert!(html.contains(needle), "index.html lacks {needle:?}");
     }
@@ -212,7 +214,10 @@ fn the_demo_writes_its_animation_as_a_movie() {
         if path.starts_with("frames/") {
             continue; // the animation's frames are swapped in by the page's script
         }
-        assert!(out.join(path).is_file(), "index.html links to a missing {path}");
+        assert!(
+            out.join(path).is_file(),
+            "index.html links to a missing {path}"
+        );
     }
     let movie = out.join("md.apng");
     let frames = std::fs::read_dir(out.join("frames/raycast"))

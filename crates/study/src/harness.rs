@@ -164,6 +164,16 @@ pub struct SceneReport {
 
 /// Run every asked-for method and the reference on `scene`.
 pub fn run_scene(scene: &NamedScene, opts: &HarnessOptions) -> Result<SceneReport, StudyError> {
+    run_scene_with_progress(scene, opts, &mut |_| {})
+}
+
+/// [`run_scene`], calling `step` with the name of each stage (`"reference"`, then each
+/// method's name) before it starts: `1 + opts.methods.len()` calls.
+pub fn run_scene_with_progress(
+    scene: &NamedScene,
+    opts: &HarnessOptions,
+    step: &mut dyn FnMut(&str),
+) -> Result<SceneReport, StudyError> {
     if let Some(n) = opts.supersample
         && !(1..=texmap_reftrace::MAX_SAMPLES_PER_AXIS).contains(&n)
     {
@@ -185,6 +195,7 @@ pub fn run_scene(scene: &NamedScene, opts: &HarnessOptions) -> Result<SceneRepor
             spp,
         )
     };
+    step("reference");
     let (reference_ms, reference) = if opts.time_reference {
         let (ms, f) = time_ms(0, opts.runs.min(3), || trace(1));
         (Some(ms), f?)
@@ -209,6 +220,7 @@ pub fn run_scene(scene: &NamedScene, opts: &HarnessOptions) -> Result<SceneRepor
     }
     let mut runs = Vec::new();
     for &method in &opts.methods {
+        step(method.name());
         let mut o = study_options(method, scene.lighting);
         o.draw_bonds = scene.draw_bonds;
         let mut renderer = Renderer::new();

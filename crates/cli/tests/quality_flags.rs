@@ -1,0 +1,92 @@
+//! `texmap render` quality flags: presets, transparent background with anti-aliased alpha, and
+//! bad values refused as usage errors. (The quality pass's accuracy against the reference ray
+//! tracer is tested in crates/quality.)
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn texmap(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_texmap"))
+        .args(args)
+        .output()
+        .expect("texmap runs")
+}
+
+fn data(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../md-io/tests/data")
+        .join(name)
+}
+
+fn rgba(path: &Path) -> image::RgbaImage {
+    image::open(path).unwrap().to_rgba8()
+}
+
+#[test]
+fn presets_change_the_image_and_transparency_gives_partial_alpha_on_edges() {
+    let dir = tempfile::tempdir().unwrap();
+    let gro = data("topo_mda.gro");
+    let gro = gro.to_str().unwrap();
+    let run = |name: &str, extra: &[&str]| -> image::RgbaImage {
+        let out = dir.path().join(name);
+        let mut args = vec![
+            "render",
+            gro,
+            "--size",
+            "160x120",
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        let o = texmap(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        rgba(&out)
+    };
+    let plain = run("plain.png", &[]);
+    let draft = run("draft.png", &["--quality", "draft"]);
+    // The draft preset adds nothing: the exact ray-cast image, byte for byte.
+    assert_eq!(plain, draft);
+    let good = run("good.png", &["--quality", "good"]);
+    let differing = plain
+        .pixels()
+        .zip(good.pixels())
+        .filter(|(a, b)| a != b)
+        .count();
+    assert!(
+        differing > 100,
+        "AO and shadows changed only {differing} pixels"
+    );
+    let clear = run("clear.png", &["--aa", "16", "--background", "transparent"]);
+    assert_eq!(clear.get_pixel(0, 0)[3], 0, "background is transparent");
+    let partial = clear.pixels().filter(|p| p[3] > 0 && p[3] < 255).count();
+    let opaque = clear.pixels().filter(|p| p[3] == 255).count();
+    assert!(
+        partial > 20 && opaque > partial,
+        "{partial} partial, {opaque} opaque"
+    );
+}
+
+#[test]
+fn bad_quality_values_are_usage_errors() {
+    let gro = data("topo_mda.gro");
+    let gro = gro.to_str().unwrap();
+    for bad in [
+        vec!["--aa", "0"],
+        vec!["--aa", "100000"],
+        vec!["--ao", "999999"],
+        vec!["--ao-distance", "-1"],
+        vec!["--outline", "0"],
+        vec!["--method", "lut", "--shadows"],
+        vec!["--background", "transparentish"],
+    ] {
+        let mut args = vec!["render", gro, "-o", "/nonexistent/x.png"];
+        args.extend(&bad);
+        let o = texmap(&args);
+        assert_eq!(
+            o.status.code(),
+            Some(2),
+            "{bad:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    }
+}
