@@ -554,6 +554,12 @@ pub struct CompareArgs {
     /// Also run the stability sweeps (FOV, angle, distance, size) and chart them.
     #[arg(long)]
     pub sweeps: bool,
+    /// Also run the quality axis: the ray-cast image with anti-aliasing, ambient occlusion and
+    /// shadows (texmap render --aa/--ao/--shadows) timed and measured against an 8x8
+    /// supersampled reference traced with the same effects (256 AO rays per pixel): quality.csv,
+    /// quality.json, quality.svg. Minutes on S2/S3 (the reference is the cost).
+    #[arg(long)]
+    pub quality_axis: bool,
     /// Image size WxH for a trajectory file.
     #[arg(long, default_value = "800x600")]
     pub size: String,

@@ -573,17 +573,37 @@ fn compare(a: &CompareArgs) -> Result<()> {
     };
     texmap_study::chart::write_charts(&a.out, &report.records, &series)?;
     print_table(&report.records);
+    if a.quality_axis {
+        crate::note!(
+            "quality axis: anti-aliasing, ambient occlusion and shadow settings against an 8x8 reference with 256 AO rays per pixel"
+        );
+        let q = texmap_study::quality::run_quality(
+            &scene,
+            &texmap_study::quality::QualityStudyOptions::default(),
+        )?;
+        let records: Vec<harness::Record> = q.runs.iter().map(|r| r.record.clone()).collect();
+        texmap_study::quality::write_quality(&a.out, &records)?;
+        for r in &q.runs {
+            write_png(
+                &r.frame,
+                &a.out
+                    .join(&report.scene)
+                    .join(format!("quality_{}.png", r.record.method)),
+            )?;
+        }
+        print_table(&records);
+    }
     Ok(())
 }
 
 fn print_table(records: &[harness::Record]) {
     println!(
-        "{:<10} {:<10} {:>12} {:>9} {:>7} {:>12} {:>12}",
+        "{:<10} {:<18} {:>12} {:>9} {:>7} {:>12} {:>12}",
         "scene", "method", "ms/frame", "PSNR dB", "SSIM", "depth mean", "silhouette px"
     );
     for r in records {
         println!(
-            "{:<10} {:<10} {:>12.3} {:>9.2} {:>7.4} {:>12.3e} {:>12.3}",
+            "{:<10} {:<18} {:>12.3} {:>9.2} {:>7.4} {:>12.3e} {:>12.3}",
             r.scene, r.method, r.ms_per_frame, r.psnr_db, r.ssim, r.depth_err_mean, r.silhouette_px
         );
     }

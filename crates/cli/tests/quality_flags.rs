@@ -90,3 +90,34 @@ fn bad_quality_values_are_usage_errors() {
         );
     }
 }
+
+/// `compare --quality-axis`: every setting against the converged reference with the same
+/// effects; more edge samples must come closer to it (a reference traced independently).
+#[test]
+fn compare_quality_axis_orders_the_settings_by_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = texmap(&[
+        "compare",
+        "--scene",
+        "S1",
+        "--runs",
+        "1",
+        "--quality-axis",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let csv = std::fs::read_to_string(dir.path().join("quality.csv")).unwrap();
+    let psnr = |method: &str| -> f64 {
+        let line = csv
+            .lines()
+            .find(|l| l.split(',').nth(1) == Some(method))
+            .unwrap_or_else(|| panic!("{method} missing from quality.csv"));
+        line.split(',').nth(6).unwrap().parse().unwrap()
+    };
+    assert!(psnr("aa4") > psnr("aa1") + 3.0);
+    assert!(psnr("aa16") > psnr("aa4") + 3.0);
+    assert!(psnr("aa16-ao32-shadows") > psnr("aa1-ao8-shadows") + 3.0);
+    assert!(dir.path().join("quality.svg").is_file());
+    assert!(dir.path().join("s1/quality_aa4-ao8-shadows.png").is_file());
+}

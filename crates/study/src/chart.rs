@@ -238,12 +238,12 @@ impl Ranged for Ticked {
 /// the series gets the method's legend entry.
 fn draw_markers<'a, DB: DrawingBackend + 'a>(
     chart: &mut ChartContext<'a, DB, Cartesian2d<Ticked, Ticked>>,
-    method: &'static str,
+    method: &str,
+    color: RGBColor,
     pts: &[(f64, f64, bool)],
     size: i32,
     legend: bool,
 ) -> Result<(), String> {
-    let color = method_color(method);
     let style = move |open: bool| {
         if open {
             color.stroke_width(2)
@@ -306,26 +306,33 @@ fn chart_err(chart: &str) -> impl Fn(String) -> StudyError + '_ {
     }
 }
 
-/// Draw the speed-versus-accuracy chart of the records measured against the 1-spp reference.
+/// Draw the speed-versus-accuracy chart: one point per record (the reference's own record
+/// left out), against the 1-spp reference when the records hold it (a sphere comparison), else
+/// against whatever reference each was measured with (e.g. the quality axis's converged ones).
 fn draw_speed_accuracy<DB: DrawingBackend>(
     root: DrawingArea<DB, Shift>,
     records: &[Record],
 ) -> Result<(), String> {
+    let one_spp = records.iter().any(|r| r.reference == "reftrace-1spp");
     let pts: Vec<&Record> = records
         .iter()
-        .filter(|r| r.reference == "reftrace-1spp" && r.method != "reftrace")
+        .filter(|r| (!one_spp || r.reference == "reftrace-1spp") && r.method != "reftrace")
         .filter(|r| r.ms_per_frame.is_finite() && r.ms_per_frame > 0.0)
         .collect();
+    // Series in first-seen order; the sphere methods keep their fixed colours.
+    let mut methods: Vec<&str> = Vec::new();
+    for r in &pts {
+        if !methods.contains(&r.method.as_str()) {
+            methods.push(&r.method);
+        }
+    }
     let xa = Axis { log: true };
     let ya = Axis { log: false };
     let xr = range(pts.iter().map(|r| xa.map(r.ms_per_frame)));
     let yr = range(pts.iter().map(|r| r.psnr_db.min(PSNR_CEILING_DB)));
     root.fill(&WHITE).map_err(|e| e.to_string())?;
     let mut chart = ChartBuilder::on(&root)
-        .caption(
-            "Speed versus accuracy of the sphere methods",
-            ("sans-serif", 22),
-        )
+        .caption("Speed versus accuracy", ("sans-serif", 22))
         .margin(16)
         .x_label_area_size(44)
         .y_label_area_size(56)
@@ -342,7 +349,14 @@ fn draw_speed_accuracy<DB: DrawingBackend>(
         .draw()
         .map_err(|e| e.to_string())?;
     let mut capped = false;
-    for method in ["polygon", "lut", "template", "raycast"] {
+    for (k, &method) in methods.iter().enumerate() {
+        let color = match method {
+            "polygon" | "lut" | "template" | "raycast" => method_color(method),
+            _ => {
+                let (r, g, b) = Palette99::pick(k).to_rgba().rgb();
+                RGBColor(r, g, b)
+            }
+        };
         let mine: Vec<&&Record> = pts.iter().filter(|r| r.method == method).collect();
         if mine.is_empty() {
             continue;
@@ -358,7 +372,7 @@ fn draw_speed_accuracy<DB: DrawingBackend>(
             })
             .collect();
         capped |= at.iter().any(|p| p.2);
-        draw_markers(&mut chart, method, &at, 6, true)?;
+        draw_markers(&mut chart, method, color, &at, 6, true)?;
         chart
             .draw_series(mine.iter().zip(&at).map(|(r, &(x, y, open))| {
                 let text = if open {
@@ -463,7 +477,7 @@ fn draw_sweep<DB: DrawingBackend>(
                 color.mix(0.85).stroke_width(width),
             ))
             .map_err(|e| e.to_string())?;
-        draw_markers(&mut chart, method, &pts, 4, true)?;
+        draw_markers(&mut chart, method, color, &pts, 4, true)?;
     }
     chart
         .configure_series_labels()
