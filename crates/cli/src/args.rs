@@ -393,9 +393,11 @@ pub enum QualityPreset {
     Publication,
 }
 
-/// Image quality of `texmap render` (ray-cast method): each flag overrides its preset's value.
+/// Image quality of `texmap render` (ray-cast method, and the reference with the same effects
+/// traced: ⌈√aa⌉² samples per pixel, at least as many AO rays; outlines are not traced): each
+/// flag overrides its preset's value.
 #[derive(Args, Clone, Debug, Default)]
-#[command(next_help_heading = "Quality (raycast method)")]
+#[command(next_help_heading = "Quality (raycast and reference methods)")]
 pub struct QualityArgs {
     /// A preset to start from: draft, good, publication (see --help for what each turns on).
     #[arg(long, value_enum)]

@@ -292,9 +292,9 @@ fn render(a: &RenderArgs) -> Result<()> {
         }
     };
     let quality = crate::scene::quality_options(&a.quality, background)?;
-    if quality.is_some() && a.method != MethodArg::Raycast {
+    if quality.is_some() && !matches!(a.method, MethodArg::Raycast | MethodArg::Reference) {
         return usage(
-            "--quality, --aa, --ao, --ao-distance, --shadows, --fog and --outline apply to --method raycast (the default)",
+            "--quality, --aa, --ao, --ao-distance, --shadows, --fog and --outline apply to --method raycast (the default) and reference",
         );
     }
     let mut quality_renderer = texmap_quality::QualityRenderer::new();
@@ -367,21 +367,33 @@ fn render(a: &RenderArgs) -> Result<()> {
             .camera(k, &md)
             .map_err(|e| fail(e, &written))?;
         let lighting = Lighting::default_for(&cam);
+        // This frame's quality options: bonds as drawn, fog over this frame's depth.
+        let quality = quality.map(|mut q| {
+            q.draw_bonds = plan.draws_bonds();
+            if a.quality.fog {
+                q.fog = texmap_quality::Fog::for_scene(
+                    &scene,
+                    &cam,
+                    [background[0], background[1], background[2]],
+                );
+            }
+            q
+        });
         let out = match (method_of(a.method), quality) {
-            (Some(_), Some(mut q)) => {
-                q.draw_bonds = plan.draws_bonds();
-                if a.quality.fog {
-                    q.fog = texmap_quality::Fog::for_scene(
-                        &scene,
-                        &cam,
-                        [background[0], background[1], background[2]],
-                    );
-                }
+            (Some(_), Some(q)) => {
                 quality_renderer
                     .render(&scene, &cam, &lighting, &q)
                     .map_err(|e| fail(anyhow::anyhow!("{e}"), &written))?
                     .frame
             }
+            (None, Some(q)) => texmap_study::quality::reference_with(
+                &scene,
+                plan.draws_bonds(),
+                &cam,
+                lighting,
+                &q,
+            )
+            .map_err(|e| fail(e.into(), &written))?,
             (Some(m), None) => {
                 let mut o = texmap_impostor::Options::new(m, lighting);
                 o.background = background;
@@ -390,7 +402,7 @@ fn render(a: &RenderArgs) -> Result<()> {
                 skipped_total += r.stats.skipped_invalid;
                 r.frame
             }
-            (None, _) => harness::render_reference(
+            (None, None) => harness::render_reference(
                 &harness::reference_scene_with_bonds(&scene, plan.draws_bonds()),
                 &harness::reference_materials(&scene),
                 &cam,

@@ -121,3 +121,50 @@ fn compare_quality_axis_orders_the_settings_by_error() {
     assert!(dir.path().join("quality.svg").is_file());
     assert!(dir.path().join("s1/quality_aa4-ao8-shadows.png").is_file());
 }
+
+/// `--method reference` takes the same quality flags: the ray-cast `good` image lies close to
+/// the reference traced with the same AO, shadows and samples (and far from the plain one).
+#[test]
+fn the_reference_draws_the_same_quality_settings() {
+    let dir = tempfile::tempdir().unwrap();
+    let gro = data("topo_mda.gro");
+    let gro = gro.to_str().unwrap();
+    let run = |name: &str, extra: &[&str]| -> image::RgbaImage {
+        let out = dir.path().join(name);
+        let mut args = vec![
+            "render",
+            gro,
+            "--size",
+            "200x150",
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        let o = texmap(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        rgba(&out)
+    };
+    let psnr = |a: &image::RgbaImage, b: &image::RgbaImage| -> f64 {
+        let mut se = 0f64;
+        for (p, q) in a.pixels().zip(b.pixels()) {
+            for c in 0..3 {
+                se += (p[c] as f64 - q[c] as f64).powi(2);
+            }
+        }
+        let mse = se / (3 * a.width() * a.height()) as f64;
+        10.0 * (255.0f64 * 255.0 / mse.max(1e-12)).log10()
+    };
+    let ours = run("good.png", &["--quality", "good", "--ao", "64"]);
+    let reference = run(
+        "ref.png",
+        &["--quality", "good", "--ao", "64", "--method", "reference"],
+    );
+    let plain_reference = run("plain_ref.png", &["--method", "reference"]);
+    let close = psnr(&ours, &reference);
+    let far = psnr(&plain_reference, &reference);
+    assert!(close > 35.0, "quality pass vs its reference: {close} dB");
+    assert!(
+        close > far + 3.0,
+        "{close} dB vs {far} dB without the effects"
+    );
+}

@@ -16,8 +16,11 @@
 
 use std::path::{Path, PathBuf};
 
+use texmap_core::camera::Camera;
 use texmap_core::color::srgb8_to_linear_rgb;
 use texmap_core::frame::Frame;
+use texmap_core::shade::Lighting;
+use texmap_impostor::SphereScene;
 use texmap_quality::{QualityOptions, QualityRenderer, ao_distance_for};
 use texmap_reftrace::{AmbientOcclusion, RenderOptions};
 
@@ -32,6 +35,53 @@ use crate::scenes::NamedScene;
 pub struct QualitySetting {
     pub name: String,
     pub options: QualityOptions,
+}
+
+/// The reference ray tracer's image of `spheres` with the effects `q` asks for, so that a
+/// quality setting of `texmap render --method reference` has its converged counterpart:
+/// `⌈√aa⌉²` samples per pixel, ambient occlusion with at least `ao_samples` rays per pixel
+/// (`m²` per sample, the same distance: `q.ao_distance` or [`ao_distance_for`]), hard shadows
+/// and the same depth cueing. Outlines and a transparent background are not drawn by the
+/// reference (the background colour is used, black for a transparent one).
+pub fn reference_with(
+    spheres: &SphereScene,
+    draw_bonds: bool,
+    camera: &Camera,
+    lighting: Lighting,
+    q: &QualityOptions,
+) -> Result<Frame, StudyError> {
+    q.validate().map_err(|e| StudyError::BadOption {
+        what: "quality options",
+        value: e.to_string(),
+    })?;
+    let rscene = reference_scene_with_bonds(spheres, draw_bonds);
+    let mats = reference_materials(spheres);
+    let n = (q.aa as f64).sqrt().ceil().max(1.0) as u32;
+    let mut o = RenderOptions::new(lighting, &mats);
+    o.samples_per_axis = n.min(texmap_reftrace::MAX_SAMPLES_PER_AXIS);
+    let bg = match q.background {
+        texmap_quality::Background::Color(c) => [c[0], c[1], c[2], 255],
+        texmap_quality::Background::Transparent => [0, 0, 0, 255],
+    };
+    o.background = srgb8_to_linear_rgb(bg);
+    if q.ao_samples > 0 {
+        let per_sample = (q.ao_samples as f64 / (n * n) as f64)
+            .sqrt()
+            .ceil()
+            .max(1.0) as u32;
+        o.ambient_occlusion = Some(AmbientOcclusion {
+            samples_per_axis: per_sample.min(texmap_reftrace::MAX_AO_SAMPLES_PER_AXIS),
+            distance: q.ao_distance.unwrap_or_else(|| ao_distance_for(spheres)),
+        });
+    }
+    o.shadows = q.shadows;
+    o.fog = q.fog.map(|f| texmap_reftrace::DepthCue {
+        start: f.start,
+        end: f.end,
+        color: srgb8_to_linear_rgb([f.color[0], f.color[1], f.color[2], 255]),
+        strength: f.strength,
+    });
+    Ok(rscene.render(camera, &o)?)
 }
 
 /// The settings of the study: the plain ray-cast image, edge anti-aliasing at 4 and 16
