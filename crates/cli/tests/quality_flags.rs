@@ -22,26 +22,28 @@ fn rgba(path: &Path) -> image::RgbaImage {
     image::open(path).unwrap().to_rgba8()
 }
 
+/// `texmap render topo_mda.gro` at `size` into `dir/name` with `extra` flags; the image.
+fn render(dir: &Path, size: &str, name: &str, extra: &[&str]) -> image::RgbaImage {
+    let gro = data("topo_mda.gro");
+    let out = dir.join(name);
+    let mut args = vec![
+        "render",
+        gro.to_str().unwrap(),
+        "--size",
+        size,
+        "-o",
+        out.to_str().unwrap(),
+    ];
+    args.extend(extra);
+    let o = texmap(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    rgba(&out)
+}
+
 #[test]
 fn presets_change_the_image_and_transparency_gives_partial_alpha_on_edges() {
     let dir = tempfile::tempdir().unwrap();
-    let gro = data("topo_mda.gro");
-    let gro = gro.to_str().unwrap();
-    let run = |name: &str, extra: &[&str]| -> image::RgbaImage {
-        let out = dir.path().join(name);
-        let mut args = vec![
-            "render",
-            gro,
-            "--size",
-            "160x120",
-            "-o",
-            out.to_str().unwrap(),
-        ];
-        args.extend(extra);
-        let o = texmap(&args);
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        rgba(&out)
-    };
+    let run = |name: &str, extra: &[&str]| render(dir.path(), "160x120", name, extra);
     let plain = run("plain.png", &[]);
     let draft = run("draft.png", &["--quality", "draft"]);
     // The draft preset adds nothing: the exact ray-cast image, byte for byte.
@@ -127,23 +129,7 @@ fn compare_quality_axis_orders_the_settings_by_error() {
 #[test]
 fn the_reference_draws_the_same_quality_settings() {
     let dir = tempfile::tempdir().unwrap();
-    let gro = data("topo_mda.gro");
-    let gro = gro.to_str().unwrap();
-    let run = |name: &str, extra: &[&str]| -> image::RgbaImage {
-        let out = dir.path().join(name);
-        let mut args = vec![
-            "render",
-            gro,
-            "--size",
-            "200x150",
-            "-o",
-            out.to_str().unwrap(),
-        ];
-        args.extend(extra);
-        let o = texmap(&args);
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        rgba(&out)
-    };
+    let run = |name: &str, extra: &[&str]| render(dir.path(), "200x150", name, extra);
     let psnr = |a: &image::RgbaImage, b: &image::RgbaImage| -> f64 {
         let mut se = 0f64;
         for (p, q) in a.pixels().zip(b.pixels()) {

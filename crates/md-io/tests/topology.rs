@@ -37,6 +37,14 @@ fn bonds(v: &Value) -> Vec<[u32; 2]> {
         .collect()
 }
 
+fn ints(v: &Value) -> Vec<i64> {
+    v.as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_i64().unwrap())
+        .collect()
+}
+
 fn labels(l: &[texmap_md_io::Label]) -> Vec<String> {
     l.iter().map(|x| x.to_string()).collect()
 }
@@ -48,13 +56,7 @@ fn pdb_topology_matches_mdanalysis_names_residues_and_conect_bonds() {
     assert_eq!(t.n_atoms() as u64, r["n_atoms"].as_u64().unwrap());
     assert_eq!(labels(&t.names), strings(&r["names"]));
     assert_eq!(labels(&t.res_names), strings(&r["resnames"]));
-    let resids: Vec<i64> = r["resids"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|v| v.as_i64().unwrap())
-        .collect();
-    assert_eq!(t.res_ids, resids);
+    assert_eq!(t.res_ids, ints(&r["resids"]));
     let elements: Vec<String> = t
         .elements
         .iter()
@@ -157,13 +159,7 @@ fn psf_written_by_parmed_matches_mdanalysis_and_gives_the_pdb_elements() {
     assert_eq!(labels(&t.names), strings(&r["names"]));
     assert_eq!(labels(&t.res_names), strings(&r["resnames"]));
     assert_eq!(labels(&t.types), strings(&r["types"]));
-    let resids: Vec<i64> = r["resids"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|v| v.as_i64().unwrap())
-        .collect();
-    assert_eq!(t.res_ids, resids);
+    assert_eq!(t.res_ids, ints(&r["resids"]));
     assert_eq!(t.bonds, bonds(&r["bonds"]));
     let pdb = Topology::open(path("topo_mda.pdb")).unwrap();
     assert_eq!(t.elements, pdb.elements);
