@@ -78,6 +78,17 @@ pub(crate) fn progress(len: u64, what: &str) -> ProgressBar {
     pb
 }
 
+/// A spinner with `what` for work whose length is not known in steps (hidden with --quiet).
+pub(crate) fn spinner(what: &str) -> ProgressBar {
+    if quiet() {
+        return ProgressBar::hidden();
+    }
+    let pb = ProgressBar::new_spinner();
+    pb.set_message(what.to_string());
+    pb.enable_steady_tick(std::time::Duration::from_millis(200));
+    pb
+}
+
 fn open_trajectory(file: &Path, format: Option<&str>) -> Result<Trajectory> {
     open_trajectory_with(file, format, ReadOptions::new())
 }
@@ -589,10 +600,12 @@ fn compare(a: &CompareArgs) -> Result<()> {
         crate::note!(
             "quality axis: anti-aliasing, ambient occlusion and shadow settings against an 8x8 reference with 256 AO rays per pixel"
         );
+        let sp = spinner("quality axis");
         let q = texmap_study::quality::run_quality(
             &scene,
             &texmap_study::quality::QualityStudyOptions::default(),
         )?;
+        sp.finish_and_clear();
         let records: Vec<harness::Record> = q.runs.iter().map(|r| r.record.clone()).collect();
         texmap_study::quality::write_quality(&a.out, &records)?;
         for r in &q.runs {
@@ -685,12 +698,16 @@ fn demo(out: &Path, steps: usize, every: usize, size: &str) -> Result<()> {
 
     // Compare every method with the reference on S1 and run the sweeps.
     crate::note!("comparing every method with the reference ray tracer (S1)");
+    let sp = spinner("comparing every method with the reference (S1)");
     let scene = scenes::build_sized(SceneId::S1, w, h)?;
     let report = harness::run_scene(&scene, &HarnessOptions::default())?;
+    sp.finish_and_clear();
     write_report(out, &report)?;
     write_results(out, &report.records)?;
     crate::note!("stability sweeps");
+    let sp = spinner("stability sweeps");
     let series = texmap_study::sweeps::run_all_sweeps(128)?;
+    sp.finish_and_clear();
     let csv = texmap_study::sweeps::series_to_csv(&series);
     write_atomic(&out.join("sweeps.csv"), |p| {
         std::fs::write(p, &csv).context("sweeps.csv")
@@ -708,7 +725,9 @@ fn demo(out: &Path, steps: usize, every: usize, size: &str) -> Result<()> {
         timed_frames: 3,
         map_size: 128,
     };
+    let sp = spinner("environment-mapping study");
     let env_records = texmap_study::envmap::run(&env_opts)?;
+    sp.finish_and_clear();
     texmap_study::envmap::write(&env_dir, &env_records)?;
     let mut names = Vec::new();
     for (name, frame) in texmap_study::envmap::demo_frames(240, 180, 256, 2)? {
@@ -723,10 +742,12 @@ fn demo(out: &Path, steps: usize, every: usize, size: &str) -> Result<()> {
 
     // Terrain (Seed 000): a built-in DEM and photo, a fly-through and the sampler comparison.
     crate::note!("terrain flight view (Seed 000)");
+    let sp = spinner("terrain flight view and sampler study");
     sections.push(Section {
         title: "Terrain flight view (Seed 000)".into(),
         html: texmap_study::terrain::demo_section(out)?,
     });
+    sp.finish_and_clear();
     let html = demo_index_html(&summaries, &report, &charts, out, &sections);
     write_atomic(&out.join("index.html"), |p| {
         std::fs::write(p, &html).context("index.html")

@@ -101,9 +101,7 @@ fn compare(out: &Path, size: &str, samples: u32) -> Result<()> {
         samples,
         ..Default::default()
     };
-    let pb = indicatif::ProgressBar::new_spinner();
-    pb.set_message("envmap study: rendering every method and the reference");
-    pb.enable_steady_tick(std::time::Duration::from_millis(200));
+    let pb = crate::commands::spinner("envmap study: rendering every method and the reference");
     let records = texmap_study::envmap::run(&opts)?;
     pb.finish_and_clear();
     let files = texmap_study::envmap::write(out, &records)?;

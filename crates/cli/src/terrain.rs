@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use clap::Subcommand;
-use indicatif::{ProgressBar, ProgressStyle};
+
 use serde_json::json;
 use texmap_terrain::db::{self, BuildOptions, Database};
 use texmap_terrain::dem::{self, DemFormat, ReadOptions};
@@ -137,12 +137,7 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
                 grid.fill_nodata();
             }
             let photo = photo.map(|p| gst::read_photo(&p, bands)).transpose()?;
-            let pb = ProgressBar::new(1);
-            pb.set_style(
-                ProgressStyle::with_template("{bar:40} {pos}/{len} {msg}")
-                    .unwrap_or_else(|_| ProgressStyle::default_bar()),
-            );
-            pb.set_message("building");
+            let pb = crate::commands::progress(1, "building");
             let bo = BuildOptions {
                 max_error,
                 chunk,

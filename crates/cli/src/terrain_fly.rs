@@ -7,7 +7,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use clap::Args;
-use indicatif::{ProgressBar, ProgressStyle};
+use indicatif::ProgressBar;
 use serde_json::json;
 use texmap_core::frame::Frame;
 use texmap_study::terrain::{self as study, StudyOptions, TerrainReference};
@@ -118,13 +118,7 @@ fn size(s: &str) -> Result<(u32, u32)> {
 }
 
 fn progress_bar(len: usize, msg: &'static str) -> ProgressBar {
-    let pb = ProgressBar::new(len as u64);
-    pb.set_style(
-        ProgressStyle::with_template("{bar:40} {pos}/{len} {msg} {elapsed}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
-    pb.set_message(msg);
-    pb
+    crate::commands::progress(len as u64, msg)
 }
 
 /// The orbit of `--orbit FRAMES[,RADIUS[,HEIGHT[,PITCH]]]`.
