@@ -13,9 +13,7 @@ use texmap_core::frame::Frame;
 use texmap_study::terrain::{self as study, StudyOptions, TerrainReference};
 use texmap_terrain::db::Database;
 use texmap_terrain::flight::{self, PathView};
-use texmap_terrain::view::{
-    FlightCamera, FlightTerrain, FrameScratch, SAMPLER_NAMES, ViewOptions, sampler_by_name,
-};
+use texmap_terrain::view::{FlightCamera, FlightTerrain, FrameScratch, ViewOptions};
 
 use crate::args::usage;
 use crate::movie::Sink;
@@ -34,24 +32,9 @@ pub struct FlyArgs {
     /// grid's smaller extent (defaults 0.3 and 0.1), pitch in degrees (default −25).
     #[arg(long, allow_hyphen_values = true)]
     pub orbit: Option<String>,
-    /// Horizontal field of view, degrees (a path file's fov column overrides it).
-    #[arg(long, default_value_t = 45.0)]
-    pub fov: f64,
-    /// Image size WIDTHxHEIGHT.
-    #[arg(long, default_value = "1024x768")]
-    pub size: String,
-    /// nearest, bilinear, trilinear, span3, span4, aniso or reference (the ray-traced reference).
-    #[arg(long, default_value = "trilinear")]
-    pub sampler: String,
-    /// Reference samples per pixel axis (--sampler reference).
-    #[arg(long, default_value_t = 4)]
-    pub samples: u32,
-    /// Refine chunks while their screen-space error exceeds this many pixels.
-    #[arg(long, default_value_t = 1.0)]
-    pub pixel_error: f32,
-    /// Largest side of the whole-terrain texture assembled from the GST pyramid.
-    #[arg(long, default_value_t = 4096)]
-    pub max_texture: u32,
+    /// Field of view, size, sampler and level of detail.
+    #[command(flatten)]
+    pub view: crate::terrain_view::FlightViewArgs,
     /// Frames per second of a movie output.
     #[arg(long, default_value_t = 25.0)]
     pub fps: f64,
@@ -105,16 +88,6 @@ pub struct CompareArgs {
     /// error_vs_altitude.svg.
     #[arg(long)]
     pub out: PathBuf,
-}
-
-fn size(s: &str) -> Result<(u32, u32)> {
-    let mut it = s.split('x').map(|t| t.trim().parse::<u32>());
-    match (it.next(), it.next(), it.next()) {
-        (Some(Ok(w)), Some(Ok(h)), None) if w > 0 && h > 0 && w <= 16384 && h <= 16384 => {
-            Ok((w, h))
-        }
-        _ => usage(format!("--size {s}: expected WIDTHxHEIGHT, each 1..=16384")),
-    }
 }
 
 fn progress_bar(len: usize, msg: &'static str) -> ProgressBar {
@@ -173,32 +146,13 @@ fn open(dir: &std::path::Path, max_texture: u32) -> Result<(Database, FlightTerr
 }
 
 pub fn run_fly(a: FlyArgs) -> Result<()> {
-    let reference = a.sampler == "reference";
-    let sampler = match sampler_by_name(&a.sampler) {
-        Some(s) => Some(s),
-        None if reference => None,
-        None => {
-            return usage(format!(
-                "--sampler {}: expected one of {}, reference",
-                a.sampler,
-                SAMPLER_NAMES.join(", ")
-            ));
-        }
-    };
-    if reference && !(1..=texmap_reftrace::MAX_SAMPLES_PER_AXIS).contains(&a.samples) {
-        return usage(format!(
-            "--samples {}: expected 1..={}",
-            a.samples,
-            texmap_reftrace::MAX_SAMPLES_PER_AXIS
-        ));
-    }
-    let (width, height) = size(&a.size)?;
+    let (sampler, (width, height)) = a.view.checked()?;
     if a.path.is_none() && a.orbit.is_none() {
         return usage("terrain fly: give --path FILE or --orbit FRAMES[,RADIUS[,HEIGHT[,PITCH]]]");
     }
-    let (db, terrain) = open(&a.dir, a.max_texture)?;
+    let (db, terrain) = open(&a.dir, a.view.max_texture)?;
     let template = FlightCamera {
-        hfov_deg: a.fov,
+        hfov_deg: a.view.fov,
         width,
         height,
         ..FlightCamera::over(terrain.grid())
@@ -213,7 +167,7 @@ pub fn run_fly(a: FlyArgs) -> Result<()> {
             .with_context(|| format!("view {i} of the orbit"))?;
     }
     let mut sink = Sink::new(&a.output, views.len(), a.fps, false)?;
-    let refr = if reference {
+    let refr = if sampler.is_none() {
         Some(TerrainReference::new(&terrain)?)
     } else {
         None
@@ -227,11 +181,11 @@ pub fn run_fly(a: FlyArgs) -> Result<()> {
     for (i, v) in views.iter().enumerate() {
         let mut frame_stats = None;
         let frame: Frame = match (&refr, sampler) {
-            (Some(r), _) => r.render_view(&terrain, v, a.samples)?,
+            (Some(r), _) => r.render_view(&terrain, v, a.view.samples)?,
             (None, Some(s)) => {
                 let mut fb = texmap_raster::Framebuffer::new(width, height)?;
                 let opts = ViewOptions {
-                    pixel_error: a.pixel_error,
+                    pixel_error: a.view.pixel_error,
                     sampler: s,
                     ..ViewOptions::default()
                 };
@@ -267,7 +221,7 @@ pub fn run_fly(a: FlyArgs) -> Result<()> {
     pb.finish_and_clear();
     let secs = t0.elapsed().as_secs_f64();
     let v = json!({
-        "frames": views.len(), "size": [width, height], "sampler": a.sampler,
+        "frames": views.len(), "size": [width, height], "sampler": a.view.sampler,
         "seconds": secs, "ms_per_frame": 1e3 * secs / views.len() as f64,
         "triangles": triangles, "movie": movie.map(|p| p.display().to_string()),
     });
@@ -276,7 +230,7 @@ pub fn run_fly(a: FlyArgs) -> Result<()> {
 }
 
 pub fn run_compare(a: CompareArgs) -> Result<()> {
-    let (width, height) = size(&a.size)?;
+    let (width, height) = crate::scene::parse_size(&a.size)?;
     if !(1..=texmap_reftrace::MAX_SAMPLES_PER_AXIS).contains(&a.samples) {
         return usage(format!(
             "--samples {}: expected 1..={}",

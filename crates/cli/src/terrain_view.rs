@@ -8,6 +8,7 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use clap::Args;
 use serde_json::json;
+use texmap_core::sample::Sampler;
 use texmap_raster::Framebuffer;
 use texmap_terrain::db::Database;
 use texmap_terrain::view::{
@@ -17,6 +18,53 @@ use texmap_terrain::view::{
 
 use crate::args::{UsageError, usage};
 use crate::output::{write_depth_exr, write_png};
+
+/// The image options `terrain render` and `terrain fly` share.
+#[derive(Args, Debug)]
+pub struct FlightViewArgs {
+    /// Horizontal field of view, degrees (in `fly`, a path file's fov column overrides it).
+    #[arg(long, default_value_t = 45.0)]
+    pub fov: f64,
+    /// Image size WIDTHxHEIGHT.
+    #[arg(long, default_value = "1024x768")]
+    pub size: String,
+    /// nearest, bilinear, trilinear, span3, span4, aniso, or reference: the full-resolution mesh
+    /// ray-traced with the texture integrated over each sample's footprint, --samples² per pixel.
+    #[arg(long, default_value = "trilinear")]
+    pub sampler: String,
+    /// Reference samples per pixel axis (--sampler reference).
+    #[arg(long, default_value_t = 4)]
+    pub samples: u32,
+    /// Refine chunks while their screen-space error exceeds this many pixels.
+    #[arg(long, default_value_t = 1.0)]
+    pub pixel_error: f32,
+    /// Largest side of the whole-terrain texture assembled from the GST pyramid.
+    #[arg(long, default_value_t = 4096)]
+    pub max_texture: u32,
+}
+
+impl FlightViewArgs {
+    /// The rasterising sampler (`None` for `reference`) and the image size, checked.
+    pub fn checked(&self) -> Result<(Option<Sampler>, (u32, u32))> {
+        let reference = self.sampler == "reference";
+        let sampler = sampler_by_name(&self.sampler);
+        if sampler.is_none() && !reference {
+            return usage(format!(
+                "--sampler {}: expected one of {}, reference",
+                self.sampler,
+                SAMPLER_NAMES.join(", ")
+            ));
+        }
+        if reference && !(1..=texmap_reftrace::MAX_SAMPLES_PER_AXIS).contains(&self.samples) {
+            return usage(format!(
+                "--samples {}: expected 1..={}",
+                self.samples,
+                texmap_reftrace::MAX_SAMPLES_PER_AXIS
+            ));
+        }
+        Ok((sampler, crate::scene::parse_size(&self.size)?))
+    }
+}
 
 /// Draw the terrain database from an aircraft.
 #[derive(Args, Debug)]
@@ -39,25 +87,9 @@ pub struct RenderArgs {
     /// Degrees, positive right wing down.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub roll: f64,
-    /// Horizontal field of view, degrees.
-    #[arg(long, default_value_t = 45.0)]
-    pub fov: f64,
-    /// Image size WIDTHxHEIGHT.
-    #[arg(long, default_value = "1024x768")]
-    pub size: String,
-    /// nearest, bilinear, trilinear, span3, span4, aniso, or reference: the full-resolution mesh
-    /// ray-traced with the texture integrated over each sample's footprint, --samples² per pixel.
-    #[arg(long, default_value = "trilinear")]
-    pub sampler: String,
-    /// Reference samples per pixel axis (--sampler reference).
-    #[arg(long, default_value_t = 4)]
-    pub samples: u32,
-    /// Refine chunks while their screen-space error exceeds this many pixels.
-    #[arg(long, default_value_t = 1.0)]
-    pub pixel_error: f32,
-    /// Largest side of the whole-terrain texture assembled from the GST pyramid.
-    #[arg(long, default_value_t = 4096)]
-    pub max_texture: u32,
+    /// Field of view, size, sampler and level of detail.
+    #[command(flatten)]
+    pub view: FlightViewArgs,
     /// Sky colour R,G,B (0-255) where no terrain is drawn (default: transparent).
     #[arg(long)]
     pub sky: Option<String>,
@@ -102,23 +134,10 @@ fn view_error(e: ViewError) -> anyhow::Error {
 }
 
 pub fn run(a: RenderArgs) -> Result<()> {
-    let reference = a.sampler == "reference";
+    let (sampler, (width, height)) = a.view.checked()?;
+    let reference = sampler.is_none();
     // The reference draws no rasterised frame; the trilinear entry only fills the options.
-    let Some(sampler) = sampler_by_name(if reference { "trilinear" } else { &a.sampler }) else {
-        return usage(format!(
-            "--sampler {}: expected one of {}, reference",
-            a.sampler,
-            SAMPLER_NAMES.join(", ")
-        ));
-    };
-    if reference && !(1..=texmap_reftrace::MAX_SAMPLES_PER_AXIS).contains(&a.samples) {
-        return usage(format!(
-            "--samples {}: expected 1..={}",
-            a.samples,
-            texmap_reftrace::MAX_SAMPLES_PER_AXIS
-        ));
-    }
-    let (width, height) = parse_pair::<u32>(&a.size, 'x', "--size")?;
+    let sampler = sampler.unwrap_or(Sampler::Trilinear);
     let background = match &a.sky {
         None => [0, 0, 0, 0],
         Some(s) => {
@@ -135,7 +154,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
     };
     let db = Database::open(&a.dir)?;
     let t0 = Instant::now();
-    let terrain = FlightTerrain::from_database(&db, a.max_texture).map_err(view_error)?;
+    let terrain = FlightTerrain::from_database(&db, a.view.max_texture).map_err(view_error)?;
     let load_ms = t0.elapsed().as_secs_f64() * 1e3;
 
     let mut view = FlightCamera::over(terrain.grid());
@@ -166,16 +185,16 @@ pub fn run(a: RenderArgs) -> Result<()> {
     view.heading_deg = a.heading;
     view.pitch_deg = a.pitch;
     view.roll_deg = a.roll;
-    view.hfov_deg = a.fov;
+    view.hfov_deg = a.view.fov;
     view.width = width;
     view.height = height;
     // Validate the view before allocating the image.
     view.camera(terrain.grid()).map_err(view_error)?;
 
-    let mut fb =
-        Framebuffer::new(width, height).map_err(|e| anyhow::anyhow!("--size {}: {e}", a.size))?;
+    let mut fb = Framebuffer::new(width, height)
+        .map_err(|e| anyhow::anyhow!("--size {}: {e}", a.view.size))?;
     let opts = ViewOptions {
-        pixel_error: a.pixel_error,
+        pixel_error: a.view.pixel_error,
         sampler,
         background,
     };
@@ -189,7 +208,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
         let cam = view.camera(terrain.grid()).map_err(view_error)?;
         let mut f = r.render(
             &cam,
-            a.samples,
+            a.view.samples,
             [background[0], background[1], background[2]],
         )?;
         if background[3] == 0 {
@@ -226,8 +245,8 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let v = json!({
         "eye": [view.eye_x, view.eye_y], "altitude": view.altitude,
         "heading": view.heading_deg, "pitch": view.pitch_deg, "roll": view.roll_deg,
-        "fov": view.hfov_deg, "size": [width, height], "sampler": a.sampler, "reference_samples": reference.then_some(a.samples),
-        "pixel_error": a.pixel_error,
+        "fov": view.hfov_deg, "size": [width, height], "sampler": a.view.sampler, "reference_samples": reference.then_some(a.view.samples),
+        "pixel_error": a.view.pixel_error,
         "frame": stats, "pixels_covered": pixels_covered, "haze_m": a.haze, "residency": residency,
         "load_ms": load_ms, "render_ms": render_ms,
     });
