@@ -350,6 +350,24 @@ pub fn tunnel_camera(width: u32, height: u32) -> Result<Camera, EnvMapError> {
     )?)
 }
 
+/// A smooth latitude-longitude environment (64x32: a sine in longitude, a ramp in latitude), for
+/// studies where the environment's own detail must not matter and only the objects' parallax is
+/// left to see.
+pub fn smooth_environment() -> Environment {
+    let (w, h) = (64u32, 32u32);
+    let texels = (0..w * h)
+        .map(|i| {
+            let (x, y) = ((i % w) as f32 / w as f32, (i / w) as f32 / h as f32);
+            Vec3::new(
+                0.3 + 0.3 * (x * std::f32::consts::TAU).sin(),
+                0.2 + 0.6 * (1.0 - y),
+                0.5,
+            )
+        })
+        .collect();
+    Environment::lat_long(w, h, texels).expect("2:1 and finite by construction")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

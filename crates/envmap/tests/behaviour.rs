@@ -328,7 +328,7 @@ fn parallax_error_is_bounded_for_distant_objects() {
                 },
                 surface: Surface::Mirror,
             },
-            smooth_env(),
+            texmap_envmap::scene::smooth_environment(),
             tunnel_lighting(),
         )
         .unwrap();
@@ -432,20 +432,4 @@ fn a_mesh_target_matches_the_reference() {
         p > 23.0 && (p - ps).abs() < 1.0,
         "mesh {p} dB, sphere {ps} dB"
     );
-}
-
-/// A smooth lat-long environment (so that the error measured is the objects' parallax).
-fn smooth_env() -> Environment {
-    let (w, h) = (64u32, 32u32);
-    let texels = (0..w * h)
-        .map(|i| {
-            let (x, y) = ((i % w) as f32 / w as f32, (i / w) as f32 / h as f32);
-            Vec3::new(
-                0.3 + 0.3 * (x * std::f32::consts::TAU).sin(),
-                0.2 + 0.6 * (1.0 - y),
-                0.5,
-            )
-        })
-        .collect();
-    Environment::lat_long(w, h, texels).unwrap()
 }

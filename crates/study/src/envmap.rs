@@ -33,11 +33,12 @@ use serde::Serialize;
 use texmap_core::camera::Camera;
 use texmap_core::frame::Frame;
 use texmap_core::shade::Material;
-use texmap_envmap::scene::{TunnelParams, tunnel_camera, tunnel_lighting, tunnel_scene};
+use texmap_envmap::scene::{
+    TunnelParams, smooth_environment, tunnel_camera, tunnel_lighting, tunnel_scene,
+};
 use texmap_envmap::shapes;
 use texmap_envmap::{
-    EnvMapError, EnvScene, Environment, Method, Object, Options, Renderer, Surface, Target,
-    TargetShape,
+    EnvMapError, EnvScene, Method, Object, Options, Renderer, Surface, Target, TargetShape,
 };
 use texmap_reftrace::{
     MeshShading, Optics, RenderError, RenderOptions, SceneBuilder, SceneError, SurfaceMaterial,
@@ -258,22 +259,6 @@ pub fn masked_error(a: &Frame, b: &Frame, mask: &[bool]) -> (f64, f64, usize) {
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
-}
-
-/// A smooth lat-long environment (the distance study: only parallax is left to see).
-pub fn smooth_environment() -> Environment {
-    let (w, h) = (64u32, 32u32);
-    let texels = (0..w * h)
-        .map(|i| {
-            let (x, y) = ((i % w) as f32 / w as f32, (i / w) as f32 / h as f32);
-            Vec3::new(
-                0.3 + 0.3 * (x * std::f32::consts::TAU).sin(),
-                0.2 + 0.6 * (1.0 - y),
-                0.5,
-            )
-        })
-        .collect();
-    Environment::lat_long(w, h, texels).expect("2:1 and finite by construction")
 }
 
 /// The distance study's scene: a unit mirror sphere and one box of half-size `0.18 k` at
