@@ -495,9 +495,9 @@ impl Default for StudyOptions {
     }
 }
 
-/// One sampler on one view.
+/// Where a view of the path is: its index, segment, eye and attitude.
 #[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct ViewResult {
+pub struct ViewPlace {
     pub view: usize,
     pub segment: String,
     pub eye_x: f64,
@@ -507,6 +507,13 @@ pub struct ViewResult {
     pub clearance_m: f64,
     pub heading_deg: f64,
     pub pitch_deg: f64,
+}
+
+/// One sampler on one view.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ViewResult {
+    #[serde(flatten)]
+    pub place: ViewPlace,
     pub sampler: String,
     pub psnr_db: f64,
     pub ssim: f64,
@@ -572,14 +579,8 @@ pub struct Claims {
 /// A view of the path as studied.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct StudiedView {
-    pub view: usize,
-    pub segment: String,
-    pub eye_x: f64,
-    pub eye_y: f64,
-    pub altitude_m: f64,
-    pub clearance_m: f64,
-    pub heading_deg: f64,
-    pub pitch_deg: f64,
+    #[serde(flatten)]
+    pub place: ViewPlace,
     pub reference_ms: f64,
     pub pixels_covered: usize,
 }
@@ -709,7 +710,7 @@ pub fn run_study(
         let reference_ms = t0.elapsed().as_secs_f64() * 1e3;
         let (col, row) = grid.georef().xy_to_sample(v.eye_x, v.eye_y);
         let clearance = v.altitude - ground_height(grid, col, row).unwrap_or(0.0);
-        views.push(StudiedView {
+        let place = ViewPlace {
             view: i,
             segment: p.segment.to_string(),
             eye_x: v.eye_x,
@@ -718,6 +719,9 @@ pub fn run_study(
             clearance_m: clearance,
             heading_deg: v.heading_deg,
             pitch_deg: v.pitch_deg,
+        };
+        views.push(StudiedView {
+            place: place.clone(),
             reference_ms,
             pixels_covered: rf.coverage_count(),
         });
@@ -742,14 +746,7 @@ pub fn run_study(
             let ms = t0.elapsed().as_secs_f64() * 1e3;
             let br = blur_ratio(&f, &rf);
             results.push(ViewResult {
-                view: i,
-                segment: p.segment.to_string(),
-                eye_x: v.eye_x,
-                eye_y: v.eye_y,
-                altitude_m: v.altitude,
-                clearance_m: clearance,
-                heading_deg: v.heading_deg,
-                pitch_deg: v.pitch_deg,
+                place: place.clone(),
                 sampler: name.clone(),
                 psnr_db: psnr(&f, &rf).map_err(StudyError::from)?,
                 ssim: ssim(&f, &rf).map_err(StudyError::from)?,
@@ -797,8 +794,8 @@ pub fn run_study(
                 sampler: name.clone(),
                 psnr_mean_db: mean(mine.iter().map(|r| r.psnr_db)),
                 psnr_min_db: worst.psnr_db,
-                worst_view: worst.view,
-                worst_segment: worst.segment.clone(),
+                worst_view: worst.place.view,
+                worst_segment: worst.place.segment.clone(),
                 ssim_mean: mean(mine.iter().map(|r| r.ssim)),
                 blur_mean_db: 10.0
                     * mean(mine.iter().map(|r| r.blur_ratio).filter(|x| x.is_finite())).log10(),
@@ -871,14 +868,14 @@ pub fn results_csv(study: &TerrainStudy) -> String {
     for r in &study.results {
         s.push_str(&format!(
             "{},{},{},{},{:.3},{:.3},{},{},{},{:.4},{:.5},{:.5},{:.4},{:.3}\n",
-            r.view,
-            r.segment,
-            r.eye_x,
-            r.eye_y,
-            r.altitude_m,
-            r.clearance_m,
-            r.heading_deg,
-            r.pitch_deg,
+            r.place.view,
+            r.place.segment,
+            r.place.eye_x,
+            r.place.eye_y,
+            r.place.altitude_m,
+            r.place.clearance_m,
+            r.place.heading_deg,
+            r.place.pitch_deg,
             r.sampler,
             r.psnr_db,
             r.ssim,
@@ -1112,7 +1109,7 @@ pub fn charts(study: &TerrainStudy) -> [(String, String); 2] {
                 "PSNR against the reference by pitch",
                 "pitch (degrees)",
                 "PSNR (dB)",
-                &chart_series(study, |r| r.pitch_deg),
+                &chart_series(study, |r| r.place.pitch_deg),
             ),
         ),
         (
@@ -1121,7 +1118,7 @@ pub fn charts(study: &TerrainStudy) -> [(String, String); 2] {
                 "PSNR against the reference by height above ground",
                 "log10 height above ground (m)",
                 "PSNR (dB)",
-                &chart_series(study, |r| r.clearance_m.max(1e-3).log10()),
+                &chart_series(study, |r| r.place.clearance_m.max(1e-3).log10()),
             ),
         ),
     ]
