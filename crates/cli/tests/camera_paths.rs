@@ -12,6 +12,14 @@ fn texmap(args: &[&str]) -> Output {
         .expect("texmap runs")
 }
 
+/// `texmap render TRAJ FLAGS -o OUT`, which must succeed.
+fn render_ok(traj: &str, out: &str, flags: &[&str]) {
+    let mut args = vec!["render", traj];
+    args.extend(flags);
+    args.extend(["-o", out]);
+    ok(&texmap(&args));
+}
+
 fn ok(out: &Output) {
     assert!(
         out.status.success(),
@@ -73,22 +81,14 @@ fn an_orbit_reaches_the_pose_of_the_turned_camera() {
     for (frame, eye) in [(1, "40,0,0"), (2, "0,0,-40")] {
         let out = dir.path().join(format!("ref{frame}.png"));
         let frames = format!("{frame}");
-        ok(&texmap(&[
-            "render",
+        render_ok(
             traj,
-            "--frames",
-            &frames,
-            "--eye",
-            eye,
-            "--target",
-            "0,0,0",
-            "--up",
-            "0,1,0",
-            "--size",
-            "120x90",
-            "-o",
             out.to_str().unwrap(),
-        ]));
+            &[
+                "--frames", &frames, "--eye", eye, "--target", "0, 0, 0", "--up", "0, 1, 0",
+                "--size", "120x90",
+            ],
+        );
         let a = pixels(&dir.path().join(format!("o{frame:02}.png")));
         let b = pixels(&out);
         let d = differing(&a, &b);
@@ -104,16 +104,11 @@ fn one_orbit_turn_over_the_movie_loops_without_repeating_a_frame() {
     let traj = dir.path().join("c.xyz");
     write_cluster(&traj, 4, 0.0);
     let pat = dir.path().join("t%02d.png");
-    ok(&texmap(&[
-        "render",
+    render_ok(
         traj.to_str().unwrap(),
-        "--orbit-turns",
-        "1",
-        "--size",
-        "96x72",
-        "-o",
         pat.to_str().unwrap(),
-    ]));
+        &["--orbit-turns", "1", "--size", "96x72"],
+    );
     let imgs: Vec<Vec<u8>> = (0..4)
         .map(|k| pixels(&dir.path().join(format!("t{k:02}.png"))))
         .collect();
@@ -127,18 +122,11 @@ fn one_orbit_turn_over_the_movie_loops_without_repeating_a_frame() {
     // rendered frame (files are named by trajectory frame; the still cluster gives every run the
     // same automatic camera).
     let pair = dir.path().join("p%02d.png");
-    ok(&texmap(&[
-        "render",
+    render_ok(
         traj.to_str().unwrap(),
-        "--frames",
-        "1:3",
-        "--orbit",
-        "180",
-        "--size",
-        "96x72",
-        "-o",
         pair.to_str().unwrap(),
-    ]));
+        &["--frames", "1:3", "--orbit", "180", "--size", "96x72"],
+    );
     let d = differing(&imgs[2], &pixels(&dir.path().join("p02.png")));
     assert!(d < 0.002, "{d}");
 }
@@ -156,38 +144,23 @@ fn keyframes_pass_through_their_keys_and_errors_name_the_line() {
     )
     .unwrap();
     let pat = dir.path().join("k%02d.png");
-    ok(&texmap(&[
-        "render",
+    render_ok(
         traj,
-        "--keyframes",
-        keys.to_str().unwrap(),
-        "--size",
-        "120x90",
-        "-o",
         pat.to_str().unwrap(),
-    ]));
+        &["--keyframes", keys.to_str().unwrap(), "--size", "120x90"],
+    );
     for (frame, eye, target, fov) in [(0, "0,0,40", "0,0,0", "40"), (3, "30,10,20", "1,0,0", "25")]
     {
         let out = dir.path().join(format!("ref{frame}.png"));
         let frames = format!("{frame}");
-        ok(&texmap(&[
-            "render",
+        render_ok(
             traj,
-            "--frames",
-            &frames,
-            "--eye",
-            eye,
-            "--target",
-            target,
-            "--up",
-            "0,1,0",
-            "--fov",
-            fov,
-            "--size",
-            "120x90",
-            "-o",
             out.to_str().unwrap(),
-        ]));
+            &[
+                "--frames", &frames, "--eye", eye, "--target", target, "--up", "0, 1, 0", "--fov",
+                fov, "--size", "120x90",
+            ],
+        );
         assert_eq!(
             pixels(&dir.path().join(format!("k{frame:02}.png"))),
             pixels(&out),
@@ -236,25 +209,13 @@ fn follow_keeps_a_moving_molecule_still_in_the_image() {
     write_cluster(&traj, 4, 2.5);
     let traj = traj.to_str().unwrap();
     let still = dir.path().join("s%02d.png");
-    ok(&texmap(&[
-        "render",
+    render_ok(
         traj,
-        "--follow",
-        "all",
-        "--size",
-        "120x90",
-        "-o",
         still.to_str().unwrap(),
-    ]));
+        &["--follow", "all", "--size", "120x90"],
+    );
     let drift = dir.path().join("d%02d.png");
-    ok(&texmap(&[
-        "render",
-        traj,
-        "--size",
-        "120x90",
-        "-o",
-        drift.to_str().unwrap(),
-    ]));
+    render_ok(traj, drift.to_str().unwrap(), &["--size", "120x90"]);
     let s0 = pixels(&dir.path().join("s00.png"));
     let s3 = pixels(&dir.path().join("s03.png"));
     let d3 = pixels(&dir.path().join("d03.png"));
