@@ -9,6 +9,9 @@ use std::path::PathBuf;
 use texmap_terrain::dem::png::terrain_rgb_height;
 use texmap_terrain::rtin::{ErrorMap, extract};
 
+mod common;
+use common::true_error;
+
 fn fuji() -> (Vec<f32>, u32) {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/fuji.png");
     let img = image::open(&path).unwrap().to_rgba8();
@@ -25,45 +28,6 @@ fn fuji() -> (Vec<f32>, u32) {
     (g, n)
 }
 
-/// The largest |surface − sample| over every grid sample, the surface being the mesh's
-/// triangles (each sample measured in the triangles that contain it).
-fn true_error(g: &[f32], n: u32, verts: &[[u32; 2]], tris: &[[u32; 3]]) -> f32 {
-    let mut worst = 0f32;
-    let mut covered = vec![false; (n * n) as usize];
-    for t in tris {
-        let p = t.map(|i| verts[i as usize]);
-        let h = p.map(|q| g[(q[1] * n + q[0]) as usize] as f64);
-        let (x0, y0) = (p[0][0] as f64, p[0][1] as f64);
-        let (e1, e2) = (
-            [p[1][0] as f64 - x0, p[1][1] as f64 - y0],
-            [p[2][0] as f64 - x0, p[2][1] as f64 - y0],
-        );
-        let det = e1[0] * e2[1] - e1[1] * e2[0];
-        assert!(det != 0.0, "degenerate triangle {t:?}");
-        let xs = p.map(|q| q[0]);
-        let ys = p.map(|q| q[1]);
-        for y in *ys.iter().min().unwrap()..=*ys.iter().max().unwrap() {
-            for x in *xs.iter().min().unwrap()..=*xs.iter().max().unwrap() {
-                let (dx, dy) = (x as f64 - x0, y as f64 - y0);
-                let u = (dx * e2[1] - dy * e2[0]) / det;
-                let v = (e1[0] * dy - e1[1] * dx) / det;
-                if u < -1e-9 || v < -1e-9 || u + v > 1.0 + 1e-9 {
-                    continue;
-                }
-                let z = h[0] + u * (h[1] - h[0]) + v * (h[2] - h[0]);
-                let k = (y * n + x) as usize;
-                worst = worst.max((z - g[k] as f64).abs() as f32);
-                covered[k] = true;
-            }
-        }
-    }
-    assert!(
-        covered.iter().all(|c| *c),
-        "the mesh leaves grid samples uncovered"
-    );
-    worst
-}
-
 #[test]
 fn fuji_meshes_stay_within_their_error_bound_on_every_sample() {
     let (g, n) = fuji();
@@ -76,7 +40,7 @@ fn fuji_meshes_stay_within_their_error_bound_on_every_sample() {
     let mut last = usize::MAX;
     for max_error in [1.0f32, 5.0, 10.0, 30.0, 100.0, 500.0] {
         let mesh = extract(&map, &g, 0, 0, n - 1, max_error, 1);
-        let e = true_error(&g, n, &mesh.vertices, &mesh.triangles);
+        let e = true_error(&g, n, (n, n), &mesh.vertices, &mesh.triangles);
         assert!(
             e <= max_error + 1e-3,
             "{max_error} m: true error {e} m with {} triangles",

@@ -11,9 +11,12 @@ use std::path::Path;
 /// Read an SRTM `.hgt` tile; its position comes from the file name.
 pub fn read_hgt(path: &Path) -> Result<Grid, TerrainError> {
     let source = path.display().to_string();
+    // NASA's downloads add a product name (`N35E138.SRTMGL1.hgt`): the position is what comes
+    // before the first dot.
     let name = path
-        .file_stem()
+        .file_name()
         .and_then(|s| s.to_str())
+        .and_then(|s| s.split('.').next())
         .ok_or_else(|| format_err(&source, "file name", "a name like N35E138.hgt"))?;
     let (lat, lon) = parse_name(name).ok_or_else(|| {
         format_err(&source, "file name", format!("a name like N35E138.hgt (hemisphere letter, latitude, hemisphere letter, longitude), got {name:?}"))
@@ -100,6 +103,17 @@ mod tests {
         assert_eq!(parse_name("s01w072"), Some((-1, -72)));
         assert_eq!(parse_name("X35E138"), None);
         assert_eq!(parse_name("N35E13"), None);
+    }
+
+    #[test]
+    fn product_suffixes_keep_the_position() {
+        let dir = std::env::temp_dir().join(format!("texmap-hgt-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("S01W072.SRTMGL3.hgt");
+        std::fs::write(&path, vec![0u8; 2 * 1201 * 1201]).unwrap();
+        let g = read_hgt(&path).unwrap();
+        std::fs::remove_dir_all(&dir).unwrap();
+        assert_eq!((g.georef().origin_x, g.georef().origin_y), (-72.0, 0.0));
     }
 
     #[test]
