@@ -154,9 +154,12 @@ pub fn build_from_map(
     }
 }
 
-/// Build the quadtree one depth at a time, handing each depth's chunks to `sink` and dropping
-/// them before the next: a database build never holds every chunk mesh at once. Returns the
-/// finest depth.
+/// Build the quadtree one depth at a time and, within a depth, one band of chunk rows at a time
+/// (a band holds at least as many chunks as there are worker threads, so each band is still built
+/// in parallel), handing each band's chunks to `sink` in row-major order and dropping them before
+/// the next: a database build holds the grid, its error map and one band of chunk meshes, never a
+/// whole depth. `sink` sees every depth in order, possibly in several calls. Returns the finest
+/// depth.
 pub fn build_streaming(
     grid: &Grid,
     max_error: f32,
@@ -173,8 +176,19 @@ pub fn build_streaming(
     let (n, max_depth) = layout(grid.width(), grid.height(), chunk)?;
     let (padded, _) = pad_to_rtin(grid.heights(), grid.width(), grid.height());
     let map = ErrorMap::new(&padded, n);
+    let threads = rayon::current_num_threads().max(1) as u32;
     for d in 0..=max_depth {
-        sink(d, build_level(grid, &padded, &map, max_error, max_depth, d))?;
+        let cells = 1u32 << d;
+        let rows_per_band = threads.div_ceil(cells).max(1);
+        let mut row = 0;
+        while row < cells {
+            let rows = row..(row + rows_per_band).min(cells);
+            row = rows.end;
+            sink(
+                d,
+                build_rows(grid, &padded, &map, max_error, max_depth, d, rows),
+            )?;
+        }
     }
     Ok(max_depth)
 }
@@ -188,12 +202,25 @@ pub fn build_level(
     max_depth: u32,
     d: u32,
 ) -> Vec<Chunk> {
+    build_rows(grid, padded, map, max_error, max_depth, d, 0..1u32 << d)
+}
+
+/// The chunks of depth `d` in the cell rows `rows` holding terrain, in row-major cell order.
+fn build_rows(
+    grid: &Grid,
+    padded: &[f32],
+    map: &ErrorMap,
+    max_error: f32,
+    max_depth: u32,
+    d: u32,
+    rows: std::ops::Range<u32>,
+) -> Vec<Chunk> {
     let size = map.n() - 1;
     let cells = 1u32 << d;
     let s = size / cells;
     let step = 1u32 << (max_depth - d);
     let target = max_error * step as f32;
-    (0..cells * cells)
+    (rows.start * cells..rows.end * cells)
         .into_par_iter()
         .filter_map(|i| {
             let (ix, iy) = (i % cells, i / cells);

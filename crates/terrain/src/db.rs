@@ -173,8 +173,8 @@ fn build_into(
         .map(|_| gst::level_count(grid, opts.map_texels, opts.max_texture_levels))
         .unwrap_or(0);
     let total = 3 + tex_levels as u64;
-    let mut levels = Vec::new();
-    // One depth at a time: its chunks go to disk and are dropped before the next is built.
+    let mut levels: Vec<LevelEntry> = Vec::new();
+    // One band of chunks at a time: they go to disk and are dropped before the next is built.
     chunks::build_streaming(grid, opts.max_error, opts.chunk, |d, level| {
         let mut entries = Vec::new();
         for c in &level {
@@ -193,11 +193,21 @@ fn build_into(
                 file,
             });
         }
-        levels.push(LevelEntry {
-            depth: d,
-            target_error: level.first().map_or(0.0, |c| c.target_error),
-            chunks: entries,
-        });
+        // A depth may come in several bands: extend its entry.
+        let target = level.first().map(|c| c.target_error);
+        match levels.last_mut() {
+            Some(l) if l.depth == d => {
+                if l.chunks.is_empty() {
+                    l.target_error = target.unwrap_or(0.0);
+                }
+                l.chunks.extend(entries);
+            }
+            _ => levels.push(LevelEntry {
+                depth: d,
+                target_error: target.unwrap_or(0.0),
+                chunks: entries,
+            }),
+        }
         Ok(())
     })?;
     progress(1, total);

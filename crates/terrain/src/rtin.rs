@@ -464,8 +464,16 @@ pub fn extract(
     min_step: u32,
 ) -> GridMesh {
     let n = map.n;
-    // Dense remap over the cell: vertex numbers in first-use order (deterministic).
-    let side = s as usize + 1;
+    // Dense remap over the cell's lattice of `min_step` samples (every emitted vertex lies on
+    // it: the walk stops only at triangles whose legs are axis-aligned and at least `min_step`
+    // long), with vertex numbers in first-use order (deterministic). A coarse chunk of a large
+    // grid thus needs `(s / min_step + 1)²` slots, not one per grid sample.
+    let g = if min_step > 1 && x0 % min_step == 0 && y0 % min_step == 0 && s % min_step == 0 {
+        min_step
+    } else {
+        1
+    };
+    let side = (s / g) as usize + 1;
     let mut index = vec![u32::MAX; side * side];
     let mut vertices: Vec<[u32; 2]> = Vec::new();
     let mut tris: Vec<[u32; 3]> = Vec::new();
@@ -485,7 +493,9 @@ pub fn extract(
             bridging += 1;
         }
         tris.push(pts.map(|p| {
-            let slot = &mut index[(p[1] - y0) as usize * side + (p[0] - x0) as usize];
+            let (dx, dy) = (p[0] - x0, p[1] - y0);
+            debug_assert!(dx % g == 0 && dy % g == 0, "vertex off the lattice");
+            let slot = &mut index[(dy / g) as usize * side + (dx / g) as usize];
             if *slot == u32::MAX {
                 *slot = vertices.len() as u32;
                 vertices.push(p);
