@@ -12,11 +12,12 @@ use texmap_core::color::srgb8_to_linear;
 use texmap_core::shade::Material;
 use texmap_envmap::scene::{TunnelParams, tunnel_camera, tunnel_lighting, tunnel_scene};
 use texmap_envmap::{
-    EnvScene, Environment, Method, Object, Options, Renderer, Surface, Target, TargetShape,
+    EnvScene, Environment, Filter, Method, Object, Options, Renderer, RimPolicy, Surface, Target,
+    TargetShape,
 };
 
 use crate::args::usage;
-use crate::output::{frame_path, write_png};
+use crate::movie::Sink;
 use crate::scene::parse_size;
 
 #[derive(Args, Debug)]
@@ -78,12 +79,56 @@ pub struct EnvRenderArgs {
     /// Map side in texels.
     #[arg(long, default_value_t = 256)]
     pub map_size: u32,
-    /// Frames to render (1/24 s apart); use a %04d pattern in -o for more than one.
+    /// Map filtering: trilinear over the map's pyramid, or bilinear on its finest level (aliases
+    /// where the reflection shrinks the map, e.g. near the target's rim).
+    #[arg(long, value_enum, default_value = "trilinear")]
+    pub filter: EnvFilterArg,
+    /// Dynamic sphere and paraboloid maps: triangles whose directions straddle the map's rim are
+    /// split (`split`), or drawn with straight edges as in 1998 (`naive`: they smear across the
+    /// map, the artefact Seed 003 shows).
+    #[arg(long, value_enum, default_value = "split")]
+    pub rim: EnvRimArg,
+    /// Seed 003's option: draw into the dynamic maps only objects whose triangles lie at least
+    /// this far from the target's centre (scene units; 0 draws every object). Nearby objects
+    /// carry the largest parallax error, so leaving them out trades missing reflections for
+    /// wrong ones.
+    #[arg(
+        long,
+        value_name = "D",
+        default_value_t = 0.0,
+        allow_negative_numbers = true
+    )]
+    pub min_distance: f32,
+    /// Background where nothing is drawn: `environment` (the environment image or sky), or
+    /// R,G,B (0-255). The target still reflects the environment.
+    #[arg(long, default_value = "environment")]
+    pub background: String,
+    /// Samples per pixel axis of `--method reference` (n x n per pixel).
+    #[arg(long, default_value_t = 2)]
+    pub reference_samples: u32,
+    /// Frames to render (1/24 s apart); use a %04d pattern in -o for more than one PNG, or a
+    /// movie extension.
     #[arg(long, default_value_t = 1)]
     pub frames: usize,
-    /// Output PNG (or pattern such as frames/%04d.png).
+    /// Frames per second of a movie output.
+    #[arg(long, default_value_t = 24.0)]
+    pub fps: f64,
+    /// Output: a PNG (or a pattern such as frames/%04d.png), or a movie: .mp4, .webm, .gif
+    /// (through ffmpeg) or .apng.
     #[arg(short = 'o', long = "out", default_value = "envmap.png")]
     pub out: PathBuf,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum EnvFilterArg {
+    Bilinear,
+    Trilinear,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum EnvRimArg {
+    Split,
+    Naive,
 }
 
 pub fn run(a: EnvmapArgs) -> Result<()> {
@@ -256,16 +301,46 @@ fn render(a: &EnvRenderArgs) -> Result<()> {
     if !(1..=100_000).contains(&a.frames) {
         return usage(format!("--frames {}: expected 1..=100000", a.frames));
     }
+    if !(a.min_distance.is_finite() && a.min_distance >= 0.0) {
+        return usage(format!(
+            "--min-distance {}: expected a finite distance ≥ 0",
+            a.min_distance
+        ));
+    }
+    if !(1..=16).contains(&a.reference_samples) {
+        return usage(format!(
+            "--reference-samples {}: expected 1..=16",
+            a.reference_samples
+        ));
+    }
+    let background = match a.background.trim() {
+        "environment" => None,
+        other => match crate::scene::parse_background(other)? {
+            [_, _, _, 0] => {
+                return usage(format!(
+                    "--background {other}: expected environment or R,G,B (a transparent background is not supported here)"
+                ));
+            }
+            c => Some(c),
+        },
+    };
     let (w, h) = parse_size(&a.size)?;
     let env = a.env.as_deref().map(load_environment).transpose()?;
-    let multi = a.frames > 1;
+    let mut sink = Sink::new(&a.out, a.frames, a.fps, false)?;
     let pb = crate::commands::progress(a.frames as u64, "envmap");
     let mut renderer = Renderer::new();
     for f in 0..a.frames {
         let t = f as f32 / 24.0;
         let (scene, cam) = build(a, &env, t, w, h)?;
         let frame = match a.method {
-            EnvMethodArg::Reference => texmap_study::envmap::reference(&scene, &cam, true, 2)?,
+            EnvMethodArg::Reference => {
+                if background.is_some() {
+                    return usage(
+                        "--background R,G,B applies to the mapping methods; the reference shows the environment",
+                    );
+                }
+                texmap_study::envmap::reference(&scene, &cam, true, a.reference_samples)?
+            }
             m => {
                 let method = match m {
                     EnvMethodArg::SphereStatic => Method::SphereStatic,
@@ -278,13 +353,32 @@ fn render(a: &EnvRenderArgs) -> Result<()> {
                 };
                 let mut o = Options::new(method);
                 o.map_size = a.map_size;
+                o.filter = match a.filter {
+                    EnvFilterArg::Bilinear => Filter::Bilinear,
+                    EnvFilterArg::Trilinear => Filter::Trilinear,
+                };
+                o.rim = match a.rim {
+                    EnvRimArg::Split => RimPolicy::Split,
+                    EnvRimArg::Naive => RimPolicy::Naive,
+                };
+                o.min_object_distance = a.min_distance;
+                if let Some(c) = background {
+                    o.show_environment = false;
+                    o.background = c;
+                }
                 renderer.render(&scene, &cam, &o)?.frame
             }
         };
-        let path = frame_path(&a.out, f, multi)?;
-        write_png(&frame, &path)?;
+        for path in sink.write(f, &frame, false)? {
+            if a.frames == 1 {
+                crate::note!("wrote {}", path.display());
+            }
+        }
         pb.inc(1);
     }
     pb.finish_and_clear();
+    if let Some(movie) = sink.finish()? {
+        crate::note!("wrote {}", movie.display());
+    }
     Ok(())
 }
