@@ -394,8 +394,8 @@ pub enum QualityPreset {
 }
 
 /// Image quality of `texmap render` (ray-cast method, and the reference with the same effects
-/// traced: ⌈√aa⌉² samples per pixel, at least as many AO rays; outlines are not traced): each
-/// flag overrides its preset's value.
+/// traced: ⌈√aa⌉² samples per pixel, at least as many AO and soft-shadow rays, outlines by the
+/// same rule on every sample): each flag overrides its preset's value.
 #[derive(Args, Clone, Debug, Default)]
 #[command(next_help_heading = "Quality (raycast and reference methods)")]
 pub struct QualityArgs {
@@ -415,6 +415,19 @@ pub struct QualityArgs {
     /// Hard shadows from the key light.
     #[arg(long)]
     pub shadows: bool,
+    /// Soft shadows: the key light is a disc (see --light-size) sampled with SAMPLES shadow rays
+    /// per point (1-1024); turns shadows on.
+    #[arg(long, value_name = "SAMPLES")]
+    pub soft_shadows: Option<u32>,
+    /// Apparent diameter of the key light for --soft-shadows, in degrees (0-30, default 4;
+    /// 0 = hard shadows).
+    #[arg(
+        long,
+        value_name = "DEG",
+        allow_hyphen_values = true,
+        requires = "soft_shadows"
+    )]
+    pub light_size: Option<f32>,
     /// Depth cueing: atoms fade toward the background colour from the front to the back of
     /// the scene.
     #[arg(long)]

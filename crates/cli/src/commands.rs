@@ -305,7 +305,7 @@ fn render(a: &RenderArgs) -> Result<()> {
     let quality = crate::scene::quality_options(&a.quality, background)?;
     if quality.is_some() && !matches!(a.method, MethodArg::Raycast | MethodArg::Reference) {
         return usage(
-            "--quality, --aa, --ao, --ao-distance, --shadows, --fog and --outline apply to --method raycast (the default) and reference",
+            "--quality, --aa, --ao, --ao-distance, --shadows, --soft-shadows, --light-size, --fog and --outline apply to --method raycast (the default) and reference",
         );
     }
     let mut quality_renderer = texmap_quality::QualityRenderer::new();

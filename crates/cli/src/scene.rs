@@ -801,6 +801,7 @@ pub fn quality_options(
         || q.ao.is_some()
         || q.ao_distance.is_some()
         || q.shadows
+        || q.soft_shadows.is_some()
         || q.fog
         || q.outline.is_some();
     if !any {
@@ -821,6 +822,14 @@ pub fn quality_options(
         o.ao_distance = q.ao_distance;
     }
     o.shadows |= q.shadows;
+    if let Some(samples) = q.soft_shadows {
+        o.soft_shadows = Some(texmap_quality::SoftShadows {
+            samples,
+            light_size_deg: q
+                .light_size
+                .unwrap_or(texmap_quality::DEFAULT_LIGHT_SIZE_DEG),
+        });
+    }
     if let Some(px) = q.outline {
         o.outline = Some(Outline {
             width_px: px,

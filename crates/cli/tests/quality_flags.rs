@@ -1,6 +1,6 @@
-//! `texmap render` quality flags: presets, transparent background with anti-aliased alpha, and
-//! bad values refused as usage errors. (The quality pass's accuracy against the reference ray
-//! tracer is tested in crates/quality.)
+//! `texmap render` quality flags: presets, transparent background with anti-aliased alpha, soft
+//! shadows, reference outlines, and bad values refused as usage errors. (The quality pass's
+//! accuracy against the reference ray tracer is tested in crates/quality.)
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -69,6 +69,33 @@ fn presets_change_the_image_and_transparency_gives_partial_alpha_on_edges() {
 }
 
 #[test]
+fn soft_shadows_and_reference_outlines_render() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |name: &str, extra: &[&str]| render(dir.path(), "160x120", name, extra);
+    let hard = run("hard.png", &["--shadows"]);
+    // A 0° light is the hard shadow; a 10° one softens it.
+    let point = run("point.png", &["--soft-shadows", "4", "--light-size", "0"]);
+    assert_eq!(hard, point);
+    let soft = run("soft.png", &["--soft-shadows", "16", "--light-size", "10"]);
+    assert_ne!(hard, soft);
+    // The reference draws the same outline as the ray-cast method.
+    let args = ["--aa", "16", "--outline", "1"];
+    let ours = run("ours.png", &args);
+    let mut r = args.to_vec();
+    r.extend(["--method", "reference"]);
+    let reference = run("reference.png", &r);
+    let far = ours
+        .pixels()
+        .zip(reference.pixels())
+        .filter(|(a, b)| (0..3).any(|c| a[c].abs_diff(b[c]) > 16))
+        .count();
+    assert!(
+        far * 100 <= (160 * 120),
+        "{far} pixels differ by more than 16 levels"
+    );
+}
+
+#[test]
 fn bad_quality_values_are_usage_errors() {
     let gro = data("topo_mda.gro");
     let gro = gro.to_str().unwrap();
@@ -80,6 +107,11 @@ fn bad_quality_values_are_usage_errors() {
         vec!["--outline", "0"],
         vec!["--method", "lut", "--shadows"],
         vec!["--background", "transparentish"],
+        vec!["--soft-shadows", "0"],
+        vec!["--soft-shadows", "1000000"],
+        vec!["--soft-shadows", "16", "--light-size", "-1"],
+        vec!["--soft-shadows", "16", "--light-size", "45"],
+        vec!["--light-size", "4"],
     ] {
         let mut args = vec!["render", gro, "-o", "/nonexistent/x.png"];
         args.extend(&bad);
@@ -90,6 +122,12 @@ fn bad_quality_values_are_usage_errors() {
             "{bad:?}: {}",
             String::from_utf8_lossy(&o.stderr)
         );
+        // A range problem names the allowed range.
+        let err = String::from_utf8_lossy(&o.stderr);
+        if bad[0] == "--soft-shadows" {
+            let range = if bad.len() == 2 { "1..=1024" } else { "0..=30" };
+            assert!(err.contains(range), "{bad:?}: {err}");
+        }
     }
 }
 

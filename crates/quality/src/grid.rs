@@ -524,9 +524,17 @@ pub(crate) struct LightGrid {
 
 impl LightGrid {
     /// The primitives of `grid` seen along unit `dir`; `basis` completes `dir` to an
-    /// orthonormal frame.
-    pub fn build(grid: &Grid, dir: Vec3, basis: (Vec3, Vec3)) -> LightGrid {
+    /// orthonormal frame. `spread` is the tangent of the widest angle a shadow ray may make
+    /// with `dir` (0 for hard shadows; a disc light's angular radius for soft ones): each
+    /// primitive's square is widened by how far such a ray drifts sideways between the lowest
+    /// point of the scene along `dir` and the primitive's far side, so the cell of a ray's origin
+    /// still lists every primitive the ray can meet.
+    pub fn build(grid: &Grid, dir: Vec3, basis: (Vec3, Vec3), spread: f32) -> LightGrid {
         let (e1, e2) = basis;
+        let lowest = grid.prims.iter().fold(f32::INFINITY, |m, p| {
+            let (c, r) = p.bounding_sphere();
+            m.min(c.dot(dir) - r)
+        });
         // Per primitive: its projected square and its reach along the light.
         let boxes: Vec<([f32; 4], f32)> = grid
             .prims
@@ -534,7 +542,14 @@ impl LightGrid {
             .map(|p| {
                 let (c, r) = p.bounding_sphere();
                 let (x, y) = (c.dot(e1), c.dot(e2));
-                ([x - r, y - r, x + r, y + r], c.dot(dir) + r)
+                let reach = c.dot(dir) + r;
+                // Hard shadows keep the exact square (no arithmetic on `r`).
+                let r = if spread > 0.0 {
+                    r + spread * (reach - lowest)
+                } else {
+                    r
+                };
+                ([x - r, y - r, x + r, y + r], reach)
             })
             .collect();
         let (mut lo, mut hi) = ([f32::INFINITY; 2], [f32::NEG_INFINITY; 2]);
@@ -606,29 +621,63 @@ impl LightGrid {
         }
     }
 
-    /// Whether the ray from `p` toward the light meets any primitive of `grid`.
+    /// The primitives listed in the cell of `p`'s projection (`(id, reach along the light)`),
+    /// and `p`'s own coordinate along the light; a primitive whose reach is not beyond it cannot
+    /// meet a ray leaving `p` toward the light.
     #[inline]
-    pub fn occluded(&self, grid: &Grid, p: Vec3) -> bool {
+    fn cell_of(&self, p: Vec3) -> (&[(u32, f32)], f32) {
         let (x, y) = (p.dot(self.e1), p.dot(self.e2));
         let cx = (x - self.lo[0]) * self.inv_cell;
         let cy = (y - self.lo[1]) * self.inv_cell;
         if !(cx >= 0.0 && cy >= 0.0) {
-            return false;
+            return (&[], 0.0);
         }
         let (cx, cy) = (cx as i32, cy as i32);
         if cx >= self.dims[0] || cy >= self.dims[1] {
-            return false;
+            return (&[], 0.0);
         }
         let k = (cy * self.dims[0] + cx) as usize;
-        let s = p.dot(self.dir);
-        self.items[self.start[k] as usize..self.start[k + 1] as usize]
-            .iter()
-            .any(|&(id, reach)| {
+        (
+            &self.items[self.start[k] as usize..self.start[k + 1] as usize],
+            p.dot(self.dir),
+        )
+    }
+
+    /// Whether the ray from `p` toward the light meets any primitive of `grid`.
+    #[inline]
+    pub fn occluded(&self, grid: &Grid, p: Vec3) -> bool {
+        let (items, s) = self.cell_of(p);
+        items.iter().any(|&(id, reach)| {
+            reach > s
+                && grid.prims[id as usize]
+                    .intersect(p, self.dir, 0.0, f32::INFINITY)
+                    .is_some()
+        })
+    }
+
+    /// How many of the unit directions `dirs(k)`, `k < count` (each within the `spread` the
+    /// grid was built with), leave `p` without meeting a primitive of `grid`.
+    #[inline]
+    pub fn open_count(
+        &self,
+        grid: &Grid,
+        p: Vec3,
+        count: u32,
+        mut dirs: impl FnMut(u32) -> Vec3,
+    ) -> u32 {
+        let (items, s) = self.cell_of(p);
+        let mut open = 0;
+        for k in 0..count {
+            let d = dirs(k);
+            let blocked = items.iter().any(|&(id, reach)| {
                 reach > s
                     && grid.prims[id as usize]
-                        .intersect(p, self.dir, 0.0, f32::INFINITY)
+                        .intersect(p, d, 0.0, f32::INFINITY)
                         .is_some()
-            })
+            });
+            open += (!blocked) as u32;
+        }
+        open
     }
 }
 

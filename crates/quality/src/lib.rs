@@ -1,8 +1,8 @@
 //! # texmap-quality — publication-quality sphere images at interactive cost
 //!
-//! Molecular-dynamics papers show their atoms anti-aliased, with ambient occlusion, shadows and
-//! often an outline. This crate adds those to the exact ray-cast impostor of `texmap-impostor`
-//! ([`Method::Raycast`]) while keeping most pixels at one sample:
+//! Molecular-dynamics papers show their atoms anti-aliased, with ambient occlusion, shadows
+//! (often soft) and an outline. This crate adds those to the exact ray-cast impostor of
+//! `texmap-impostor` ([`Method::Raycast`]) while keeping most pixels at one sample:
 //!
 //! 1. **Primary visibility** is the impostor frame: exact depth and coverage at every pixel
 //!    centre, in about a millisecond for a thousand atoms.
@@ -21,24 +21,40 @@
 //!    primitive's neighbour list (built once per frame for the primitives seen), cut per pixel
 //!    to the spheres and bonds that reach the ball of radius `ao_distance` above the surface;
 //!    a shadow ray only against the one cell holding its origin in a 2D grid perpendicular to
-//!    the key light. **Depth cueing** ([`Fog`]) then blends linearly toward a colour between
-//!    two eye-space depths.
+//!    the key light. With [`SoftShadows`] the key light is a disc of a given apparent size:
+//!    `samples` shadow rays per point, uniform in solid angle over the disc (stratified in
+//!    `sin²(θ/2)`, golden-ratio azimuths, offsets hashed from the pixel), the key term scaled by
+//!    the fraction that meets nothing; the 2D grid's cells are widened by the sideways drift of
+//!    the widest ray across the scene, so one cell still lists every possible occluder. A 0°
+//!    disc traces exactly the hard shadow ray, and gives the hard-shadow image byte for byte.
+//!    **Depth cueing** ([`Fog`]) then blends linearly toward a colour between two eye-space
+//!    depths.
 //! 4. **Anti-aliasing** on edges only: a pixel whose 8 neighbours do not all show the same
 //!    primitive (a silhouette against the background or against another atom, an
-//!    intersection curve) or the same shadow state is traced again with `aa` samples
+//!    intersection curve) or a key-light visibility within 0.25 of its own (any hard-shadow
+//!    edge; a penumbra narrower than about four pixels) is traced again with `aa` samples
 //!    (an `n × n` grid of strata centres when `aa` is a square, else a Hammersley set) through
 //!    the grid, each shaded as above with its own shadow ray, and averaged in linear light. A
 //!    sample's AO is the one found at the centre of this pixel or of a neighbour when that
 //!    centre lies on the same primitive (AO changes little within a pixel); only a primitive
 //!    seen at no centre nearby gets its own `ao_samples` rays. With a
 //!    [`Background::Transparent`] background the edge pixel's alpha is its covered fraction.
-//! 5. **Outlines** ([`Outline`]): a covered pixel within `width_px` pixels of a pixel that is
-//!    background or lies deeper by more than the pixel's primitive radius is painted in the
-//!    outline colour (QuteMol's depth-discontinuity silhouettes).
+//! 5. **Outlines** ([`Outline`]): a covered point is outlined when a point `width_px` pixels or
+//!    less away along rows and columns is background or lies deeper by more than the radius of
+//!    the point's primitive (QuteMol's depth-discontinuity silhouettes). With `aa` 1 the rule
+//!    is applied at pixel centres, on the impostor's depths, and marked pixels are painted. With
+//!    anti-aliasing it is applied to each sample offset (the offset's sub-image: sample `k` of
+//!    every pixel) within `width_px + 1` pixels of a primitive change, the depths traced through
+//!    the grid there (on the pixel's own primitive where its 3x3 block shows one primitive):
+//!    edge pixels composite outlined and shaded samples, other pixels blend toward the outline
+//!    colour by their outlined fraction in linear light, and farther pixels keep the
+//!    pixel-centre rule. The reference ray tracer applies the same rule to its samples, so the
+//!    outline has an error figure.
 //!
 //! Depth in the output is the impostor's (pixel-centre) depth. Colours are clamped to [0, 1]
-//! per sample and encoded as sRGB, as the reference ray tracer does, whose AO, shadow and
-//! fog options follow the same definitions so that each setting has an error figure.
+//! per sample and encoded as sRGB, as the reference ray tracer does, whose AO, shadow (hard and
+//! disc), fog and outline options follow the same definitions so that each setting has an
+//! error figure.
 //!
 //! # Presets
 //! | preset | aa | AO samples | shadows | outline |
@@ -94,6 +110,12 @@ pub const MAX_AA: u32 = 256;
 pub const MAX_AO_SAMPLES: u32 = 4096;
 /// The widest accepted outline, in pixels.
 pub const MAX_OUTLINE_PX: u32 = 16;
+/// The most shadow rays per shaded point with [`SoftShadows`].
+pub const MAX_SOFT_SHADOW_SAMPLES: u32 = 1024;
+/// The largest accepted [`SoftShadows::light_size_deg`].
+pub const MAX_LIGHT_SIZE_DEG: f32 = 30.0;
+/// The default apparent diameter of the key light for soft shadows, in degrees.
+pub const DEFAULT_LIGHT_SIZE_DEG: f32 = 4.0;
 
 /// What is drawn where no surface is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -148,6 +170,18 @@ pub struct Outline {
     pub color: [u8; 3],
 }
 
+/// Soft shadows: the key light is a disc of apparent diameter `light_size_deg` centred on its
+/// direction, and a surface point receives the key light times the fraction of `samples`
+/// shadow rays toward the disc that meet nothing.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SoftShadows {
+    /// Shadow rays per shaded point, 1..=[`MAX_SOFT_SHADOW_SAMPLES`].
+    pub samples: u32,
+    /// Apparent (angular) diameter of the light in degrees, 0..=[`MAX_LIGHT_SIZE_DEG`]; 0 is
+    /// the point light of hard shadows.
+    pub light_size_deg: f32,
+}
+
 /// What the quality pass adds to the ray-cast impostor image (see the crate docs).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct QualityOptions {
@@ -160,6 +194,9 @@ pub struct QualityOptions {
     pub ao_distance: Option<f32>,
     /// Hard shadows from the key light (the first light of the [`Lighting`]).
     pub shadows: bool,
+    /// Soft shadows from the key light as a disc; `Some` turns shadows on whatever `shadows`
+    /// says.
+    pub soft_shadows: Option<SoftShadows>,
     pub fog: Option<Fog>,
     pub background: Background,
     pub outline: Option<Outline>,
@@ -175,6 +212,7 @@ impl QualityOptions {
             ao_samples: 0,
             ao_distance: None,
             shadows: false,
+            soft_shadows: None,
             fog: None,
             background: Background::Color([0, 0, 0]),
             outline: None,
@@ -250,6 +288,18 @@ impl QualityOptions {
                 width_px: o.width_px,
             });
         }
+        if let Some(ss) = self.soft_shadows {
+            if !(1..=MAX_SOFT_SHADOW_SAMPLES).contains(&ss.samples) {
+                return Err(QualityError::BadSoftShadowSamples {
+                    samples: ss.samples,
+                });
+            }
+            if !(0.0..=MAX_LIGHT_SIZE_DEG).contains(&ss.light_size_deg) {
+                return Err(QualityError::BadLightSize {
+                    degrees: ss.light_size_deg,
+                });
+            }
+        }
         Ok(())
     }
 }
@@ -268,6 +318,10 @@ pub enum QualityError {
     BadFog { start: f32, end: f32, strength: f32 },
     /// Outline width 0 or above [`MAX_OUTLINE_PX`].
     BadOutline { width_px: u32 },
+    /// Soft-shadow rays 0 or above [`MAX_SOFT_SHADOW_SAMPLES`].
+    BadSoftShadowSamples { samples: u32 },
+    /// Light size negative, above [`MAX_LIGHT_SIZE_DEG`] or not a number.
+    BadLightSize { degrees: f32 },
 }
 
 impl std::fmt::Display for QualityError {
@@ -296,6 +350,14 @@ impl std::fmt::Display for QualityError {
             QualityError::BadOutline { width_px } => write!(
                 f,
                 "outline width {width_px} px is not allowed (1..={MAX_OUTLINE_PX})"
+            ),
+            QualityError::BadSoftShadowSamples { samples } => write!(
+                f,
+                "soft shadows: {samples} rays per point is not allowed (1..={MAX_SOFT_SHADOW_SAMPLES})"
+            ),
+            QualityError::BadLightSize { degrees } => write!(
+                f,
+                "light size {degrees} degrees is not allowed (0..={MAX_LIGHT_SIZE_DEG}; 0 = hard shadows)"
             ),
         }
     }
@@ -334,7 +396,7 @@ pub struct QualityStats {
     /// Covered impostor pixels the grid ray found no primitive for (kept as the impostor drew
     /// them; nonzero only for rays grazing a silhouette).
     pub recovery_misses: usize,
-    /// Pixels painted by the outline.
+    /// Pixels painted, wholly or in part, by the outline.
     pub outline_pixels: usize,
 }
 
@@ -361,6 +423,9 @@ struct Ctx<'a> {
     grid: &'a Grid,
     /// The key light's 2D grid (with shadows on).
     light: Option<LightGrid>,
+    /// Soft shadows: rays per point, `sin(ρ/2)` of the disc's angular radius `ρ`, and the key
+    /// light's direction completed to an orthonormal frame.
+    soft: Option<SoftLight>,
     /// AO occluder lists of the primitives seen at pixel centres (with AO on).
     neighbours: Option<Neighbours>,
     /// `(cos, sin)` of `2π k / AZIMUTHS`.
@@ -373,6 +438,21 @@ struct Ctx<'a> {
     ao_distance: f32,
     fog: Option<(Fog, Vec3)>,
 }
+
+/// The key light as a disc (see [`Ctx::key_visibility`]).
+#[derive(Clone, Copy)]
+struct SoftLight {
+    samples: u32,
+    sin_half: f32,
+    dir: Vec3,
+    t1: Vec3,
+    t2: Vec3,
+}
+
+/// Two neighbouring pixels whose key-light visibilities differ by more than this are an edge
+/// (hard shadows: visibility 0 or 1, so any change; soft shadows: a penumbra narrower than
+/// about four pixels).
+const LIGHT_EDGE: f32 = 0.25;
 
 /// Azimuth steps of the AO directions.
 const AZIMUTHS: usize = 4096;
@@ -570,8 +650,52 @@ impl Ctx<'_> {
         open as f32 * inv
     }
 
-    /// Linear colour (clamped to [0, 1]) of a hit seen along unit `d`, and whether the key light
-    /// is shadowed there.
+    /// The fraction of the key light reaching `origin` (normal `n`): 0 or 1 with hard shadows,
+    /// the open fraction of the soft light's rays with soft ones, 1 where the surface faces away
+    /// from the light's centre (the key term is zero there anyway) or without shadows.
+    ///
+    /// Soft-shadow rays sample the disc uniformly in solid angle: ray `k` of `m` makes the angle
+    /// `θ` with the light's direction where `sin²(θ/2) = u·sin²(ρ/2)` (`ρ` the disc's angular
+    /// radius), `u = (k + r₁)/m` stratified, and its azimuth is the golden-ratio sequence offset
+    /// by `r₂`, both offsets from a hash of the pixel and sample.
+    fn key_visibility(&self, origin: Vec3, n: Vec3, seed: u64) -> f32 {
+        let (Some(light), Some(key)) = (&self.light, self.lighting.lights().first()) else {
+            return 1.0;
+        };
+        let faces_light = n.dot(key.to_light) > 0.0;
+        if !faces_light {
+            return 1.0;
+        }
+        let Some(soft) = &self.soft else {
+            return if light.occluded(self.grid, origin) {
+                0.0
+            } else {
+                1.0
+            };
+        };
+        let h = mix(seed ^ 0x50f7_5ad0_0000_0001);
+        let (r1, r2) = (unit(h), unit(h << 24));
+        let inv = 1.0 / soft.samples as f32;
+        let open = light.open_count(self.grid, origin, soft.samples, |k| {
+            let u1 = (k as f32 + r1) * inv;
+            let u2 = r2 + k as f32 * 0.618_034;
+            let u2 = u2 - (u2 as u32) as f32;
+            let (cos, sin) = self.azimuths[((u2 * AZIMUTHS as f32) as usize).min(AZIMUTHS - 1)];
+            // Half-angle form: exact for small discs, and θ = 0 (a 0° light) gives `dir` itself.
+            let sh = u1.sqrt() * soft.sin_half;
+            let cos_t = 1.0 - 2.0 * sh * sh;
+            let sin_t = 2.0 * sh * (1.0 - sh * sh).max(0.0).sqrt();
+            soft.dir * cos_t + (soft.t1 * cos + soft.t2 * sin) * sin_t
+        });
+        if open == soft.samples {
+            1.0
+        } else {
+            open as f32 * inv
+        }
+    }
+
+    /// Linear colour (clamped to [0, 1]) of a hit seen along unit `d`, and the fraction of the
+    /// key light that reaches it ([`Ctx::key_visibility`]).
     fn shade(
         &self,
         hit: &Hit,
@@ -579,7 +703,7 @@ impl Ctx<'_> {
         ao: Ao,
         seed: u64,
         cand: &mut Candidates,
-    ) -> (Vec3, bool, f32) {
+    ) -> (Vec3, f32, f32) {
         let n = if hit.normal.dot(d) > 0.0 {
             -hit.normal
         } else {
@@ -593,23 +717,26 @@ impl Ctx<'_> {
             Ao::Trace(count) => self.ambient_visibility(origin, n, hit.prim, count, seed, cand),
             Ao::Known(v) => v,
         };
-        let mut mask = u32::MAX;
-        let mut shadowed = false;
-        if let Some(light) = &self.light
-            && let Some(key) = self.lighting.lights().first()
-            && n.dot(key.to_light) > 0.0
-            && light.occluded(self.grid, origin)
-        {
-            mask &= !1;
-            shadowed = true;
-        }
+        let vis = self.key_visibility(origin, n, seed);
         let m = &self.materials[hit.material as usize];
-        let mut c = self.lighting.shade_with(m, n, -d, ao, mask);
+        // The key term scaled by its visibility: the shading is a sum over lights, so a
+        // partly visible key light is a blend of the images with and without it.
+        let mut c = if vis == 1.0 {
+            self.lighting.shade_with(m, n, -d, ao, u32::MAX)
+        } else {
+            let dark = self.lighting.shade_with(m, n, -d, ao, !1);
+            if vis == 0.0 {
+                dark
+            } else {
+                let lit = self.lighting.shade_with(m, n, -d, ao, u32::MAX);
+                dark + (lit - dark) * vis
+            }
+        };
         if let Some((fog, color)) = &self.fog {
             let depth = hit.t * d.dot(self.forward);
             c = fog.apply(c, depth, *color);
         }
-        (c.clamp(Vec3::ZERO, Vec3::ONE), shadowed, ao)
+        (c.clamp(Vec3::ZERO, Vec3::ONE), vis, ao)
     }
 
     /// The camera ray through (x, y) and its parameter range from the clip planes; `None` when
@@ -669,7 +796,8 @@ struct Centre {
     /// Ambient visibility at the centre (1 without AO).
     ao: f32,
     id: u32,
-    shadowed: bool,
+    /// Fraction of the key light reaching the centre (1 without shadows).
+    lit: f32,
     /// Recovery needed a full grid walk.
     walked: bool,
 }
@@ -702,23 +830,41 @@ impl QualityRenderer {
             ..QualityStats::default()
         };
         let mut frame = base.frame;
-        let effects = options.ao_samples > 0 || options.shadows || options.fog.is_some();
+        let shadows = options.shadows || options.soft_shadows.is_some();
+        let effects = options.ao_samples > 0 || shadows || options.fog.is_some();
         if !effects && options.aa == 1 && options.outline.is_none() {
             return Ok(QualityRender { frame, stats });
         }
 
         let grid = Grid::build(scene, options.draw_bonds);
-        let light = match lighting.lights().first() {
-            Some(key) if options.shadows => {
-                Some(LightGrid::build(&grid, key.to_light, basis(key.to_light)))
+        let key = lighting.lights().first().filter(|_| shadows);
+        // The disc's angular radius ρ is half its apparent size.
+        let rho = options
+            .soft_shadows
+            .map_or(0.0, |ss| (0.5 * ss.light_size_deg).to_radians());
+        let light = key.map(|key| {
+            let spread = if rho > 0.0 { rho.tan() } else { 0.0 };
+            LightGrid::build(&grid, key.to_light, basis(key.to_light), spread)
+        });
+        let soft = match (key, options.soft_shadows) {
+            (Some(key), Some(ss)) => {
+                let (t1, t2) = basis(key.to_light);
+                Some(SoftLight {
+                    samples: ss.samples,
+                    sin_half: (0.5 * rho).sin(),
+                    dir: key.to_light,
+                    t1,
+                    t2,
+                })
             }
             _ => None,
         };
         let mut ctx = Ctx {
             grid: &grid,
             light,
+            soft,
             neighbours: None,
-            azimuths: if options.ao_samples > 0 {
+            azimuths: if options.ao_samples > 0 || soft.is_some() {
                 azimuth_table()
             } else {
                 Vec::new()
@@ -746,7 +892,7 @@ impl QualityRenderer {
                 color: Vec3::ZERO,
                 ao: 1.0,
                 id: NONE,
-                shadowed: false,
+                lit: 1.0,
                 walked: false,
             };
             w * h
@@ -789,29 +935,49 @@ impl QualityRenderer {
             for jj in j0..=j1 {
                 for ii in i0..=i1 {
                     let q = &centre[jj * w + ii];
-                    if q.id != c.id || q.shadowed != c.shadowed {
+                    if q.id != c.id || (q.lit - c.lit).abs() > LIGHT_EDGE {
                         return true;
                     }
                 }
             }
             false
         };
+        let aa = options.aa;
+        let edges: Vec<bool> = (0..w * h)
+            .into_par_iter()
+            .with_min_len(w)
+            .map(|k| aa > 1 && edge(k % w, k / w))
+            .collect();
+
+        // Outline: the pixel-centre marks, and with anti-aliasing the per-sample marks near
+        // silhouettes.
+        let hard_marks = options
+            .outline
+            .map(|o| outline_centre_marks(&grid, &centre, &frame.depth, w, h, o.width_px));
+        let sample_marks = match options.outline {
+            Some(o) if aa > 1 => Some(outline_sample_marks(
+                &ctx, &centre, &edges, w, h, aa, o.width_px,
+            )),
+            _ => None,
+        };
+        let oc_lin = options
+            .outline
+            .map(|o| srgb8_to_linear_rgb([o.color[0], o.color[1], o.color[2], 255]));
 
         // 3. Colour: the centre sample, or `aa` samples on edges.
         let bg_lin = srgb8_to_linear_rgb(bg4);
-        let aa = options.aa;
         let ao_sub = options.ao_samples;
         let edge_counts: Vec<usize> = frame
             .color
             .par_chunks_mut(w)
             .enumerate()
             .map(|(j, row)| {
-                let mut edges = 0;
+                let mut edges_here = 0;
                 let mut cand = Candidates::new();
                 for (i, px) in row.iter_mut().enumerate() {
                     let c = &centre[j * w + i];
-                    if aa > 1 && edge(i, j) {
-                        edges += 1;
+                    if edges[j * w + i] {
+                        edges_here += 1;
                         let mut sum = Vec3::ZERO;
                         let mut covered = 0u32;
                         // AO of the primitive at this pixel's centre, else at a neighbour's
@@ -830,7 +996,15 @@ impl QualityRenderer {
                             }
                             None
                         };
+                        let marked = sample_marks.as_ref().and_then(|m| m.bits_of(j * w + i));
                         for k in 0..aa {
+                            if let (Some(bits), Some(oc)) = (marked, oc_lin)
+                                && bits[(k / 64) as usize] & (1 << (k % 64)) != 0
+                            {
+                                sum += oc;
+                                covered += 1;
+                                continue;
+                            }
                             let (dx, dy) = aa_offset(k, aa);
                             let x = i as f32 + dx;
                             let y = j as f32 + dy;
@@ -868,49 +1042,246 @@ impl QualityRenderer {
                         px[3] = 255;
                     }
                 }
-                edges
+                edges_here
             })
             .collect();
         stats.edge_pixels = edge_counts.iter().sum();
 
-        // 4. Outline.
-        if let Some(o) = options.outline {
-            let r = o.width_px as usize;
-            let radius = |c: &Centre| match c.id {
-                NONE | UNKNOWN => 0.0,
-                id => grid.prims[id as usize].radius(),
-            };
-            let depth = &frame.depth;
-            let marks: Vec<bool> = (0..w * h)
-                .into_par_iter()
-                .with_min_len(w)
-                .map(|k| {
-                    let (i, j) = (k % w, k / w);
-                    let dp = depth[k];
-                    if !dp.is_finite() {
-                        return false;
+        // 4. Outline on the pixels not composited sample by sample above: the outline colour
+        // where the centre rule marks them, or, near silhouettes with anti-aliasing, blended by
+        // the fraction of their samples the rule marks (in linear light).
+        if let (Some(o), Some(hard), Some(oc)) = (options.outline, &hard_marks, oc_lin) {
+            let o4 = [o.color[0], o.color[1], o.color[2], 255];
+            let mut painted = 0usize;
+            for (k, px) in frame.color.iter_mut().enumerate() {
+                match &sample_marks {
+                    Some(m) if m.zone[k] => {
+                        let n = m.count[k] as u32;
+                        painted += (n > 0) as usize;
+                        if edges[k] || n == 0 {
+                            continue;
+                        }
+                        *px = if n == aa {
+                            o4
+                        } else {
+                            let f = n as f32 / aa as f32;
+                            let c = srgb8_to_linear_rgb(*px);
+                            linear_to_srgb8(c * (1.0 - f) + oc * f, px[3])
+                        };
                     }
-                    let gap = radius(&centre[k]);
-                    for jj in j.saturating_sub(r)..=(j + r).min(h - 1) {
-                        for ii in i.saturating_sub(r)..=(i + r).min(w - 1) {
-                            let dq = depth[jj * w + ii];
-                            if !dq.is_finite() || dq - dp > gap {
-                                return true;
-                            }
+                    _ => {
+                        if hard[k] {
+                            *px = o4;
+                            painted += 1;
                         }
                     }
-                    false
-                })
-                .collect();
-            let oc = [o.color[0], o.color[1], o.color[2], 255];
-            for (px, &m) in frame.color.iter_mut().zip(&marks) {
-                if m {
-                    *px = oc;
                 }
             }
-            stats.outline_pixels = marks.iter().filter(|&&m| m).count();
+            stats.outline_pixels = painted;
         }
         Ok(QualityRender { frame, stats })
+    }
+}
+
+/// The outline rule at pixel centres: a covered pixel is marked when a pixel within `r` rows
+/// and columns is background or deeper (impostor depth) by more than the pixel's primitive
+/// radius.
+fn outline_centre_marks(
+    grid: &Grid,
+    centre: &[Centre],
+    depth: &[f32],
+    w: usize,
+    h: usize,
+    r: u32,
+) -> Vec<bool> {
+    let r = r as usize;
+    let radius = |c: &Centre| match c.id {
+        NONE | UNKNOWN => 0.0,
+        id => grid.prims[id as usize].radius(),
+    };
+    (0..w * h)
+        .into_par_iter()
+        .with_min_len(w)
+        .map(|k| {
+            let (i, j) = (k % w, k / w);
+            let dp = depth[k];
+            if !dp.is_finite() {
+                return false;
+            }
+            let gap = radius(&centre[k]);
+            for jj in j.saturating_sub(r)..=(j + r).min(h - 1) {
+                for ii in i.saturating_sub(r)..=(i + r).min(w - 1) {
+                    let dq = depth[jj * w + ii];
+                    if !dq.is_finite() || dq - dp > gap {
+                        return true;
+                    }
+                }
+            }
+            false
+        })
+        .collect()
+}
+
+/// The outline rule applied to every anti-aliasing sample near a silhouette (see
+/// [`outline_sample_marks`]).
+struct SampleMarks {
+    /// Pixels within `r + 1` of a primitive change, whose marks are counted per sample.
+    zone: Vec<bool>,
+    /// Marked samples per pixel of the zone.
+    count: Vec<u16>,
+    /// Per pixel, `u32::MAX` or its row in `bits` (edge pixels of the zone).
+    slot: Vec<u32>,
+    /// Bit `k` set: sample `k` of the pixel is marked.
+    bits: Vec<[u64; 4]>,
+}
+
+impl SampleMarks {
+    #[inline]
+    fn bits_of(&self, k: usize) -> Option<&[u64; 4]> {
+        let s = self.slot[k];
+        (s != u32::MAX).then(|| &self.bits[s as usize])
+    }
+}
+
+/// `flags` dilated by `r` pixels (Chebyshev distance), as two separable passes.
+fn dilate(flags: &[bool], w: usize, h: usize, r: usize) -> Vec<bool> {
+    let mut rows = vec![false; w * h];
+    rows.par_chunks_mut(w).enumerate().for_each(|(j, row)| {
+        let src = &flags[j * w..(j + 1) * w];
+        let mut last: Option<usize> = None;
+        for (i, &f) in src.iter().enumerate() {
+            if f {
+                last = Some(i);
+            }
+            row[i] = last.is_some_and(|l| i - l <= r);
+        }
+        let mut next: Option<usize> = None;
+        for i in (0..w).rev() {
+            if src[i] {
+                next = Some(i);
+            }
+            row[i] |= next.is_some_and(|n| n - i <= r);
+        }
+    });
+    let mut out = vec![false; w * h];
+    out.par_chunks_mut(w).enumerate().for_each(|(j, row)| {
+        for jj in j.saturating_sub(r)..=(j + r).min(h - 1) {
+            for (o, &f) in row.iter_mut().zip(&rows[jj * w..(jj + 1) * w]) {
+                *o |= f;
+            }
+        }
+    });
+    out
+}
+
+/// The outline rule of the reference applied to each anti-aliasing offset: sample `k` of a
+/// pixel (at `aa_offset(k)`) is marked when it is covered and the sample at the same offset
+/// of a pixel within `r` rows and columns misses or lies deeper by more than the radius of the
+/// sample's primitive. Evaluated only in the zone within `r + 1` pixels of a primitive change
+/// (farther away every probe shows the pixel's own primitive and the centre rule stands); a
+/// sample's depth is traced through the grid in pixels next to a primitive change and taken on
+/// the pixel's own primitive elsewhere.
+#[allow(clippy::too_many_arguments)]
+fn outline_sample_marks(
+    ctx: &Ctx,
+    centre: &[Centre],
+    edges: &[bool],
+    w: usize,
+    h: usize,
+    aa: u32,
+    r: u32,
+) -> SampleMarks {
+    let r = r as usize;
+    let changes: Vec<bool> = (0..w * h)
+        .into_par_iter()
+        .with_min_len(w)
+        .map(|k| {
+            let (i, j) = (k % w, k / w);
+            let id = centre[k].id;
+            (j.saturating_sub(1)..=(j + 1).min(h - 1)).any(|jj| {
+                (i.saturating_sub(1)..=(i + 1).min(w - 1)).any(|ii| centre[jj * w + ii].id != id)
+            })
+        })
+        .collect();
+    let zone = dilate(&changes, w, h, r + 1);
+    let region = dilate(&zone, w, h, r);
+    let mut slot = vec![u32::MAX; w * h];
+    let mut rows = 0u32;
+    for k in 0..w * h {
+        if zone[k] && edges[k] {
+            slot[k] = rows;
+            rows += 1;
+        }
+    }
+    let mut bits = vec![[0u64; 4]; rows as usize];
+    let mut count = vec![0u16; w * h];
+    // (depth, gap) of the current offset's sample in every pixel of the region.
+    let mut sub = vec![(f32::INFINITY, 0f32); w * h];
+    for k in 0..aa {
+        let (dx, dy) = aa_offset(k, aa);
+        sub.par_chunks_mut(w).enumerate().for_each(|(j, row)| {
+            for (i, out) in row.iter_mut().enumerate() {
+                let p = j * w + i;
+                if !region[p] {
+                    continue;
+                }
+                *out = (f32::INFINITY, 0.0);
+                let id = centre[p].id;
+                if id == NONE && !changes[p] {
+                    continue;
+                }
+                let Some((o, d, cos, tmin, tmax)) = ctx.ray(i as f32 + dx, j as f32 + dy) else {
+                    continue;
+                };
+                let own = if changes[p] || id == UNKNOWN {
+                    None
+                } else {
+                    ctx.grid
+                        .hit_on(id, &ctx.grid.prims[id as usize], o, d, tmin, tmax)
+                };
+                if let Some(hit) = own.or_else(|| ctx.grid.closest(o, d, tmin, tmax)) {
+                    *out = (hit.t * cos, ctx.grid.prims[hit.prim as usize].radius());
+                }
+            }
+        });
+        let sub = &sub;
+        let marks: Vec<bool> = (0..w * h)
+            .into_par_iter()
+            .with_min_len(w)
+            .map(|p| {
+                if !zone[p] {
+                    return false;
+                }
+                let (i, j) = (p % w, p / w);
+                let (dp, gap) = sub[p];
+                if !dp.is_finite() {
+                    return false;
+                }
+                for jj in j.saturating_sub(r)..=(j + r).min(h - 1) {
+                    for ii in i.saturating_sub(r)..=(i + r).min(w - 1) {
+                        let dq = sub[jj * w + ii].0;
+                        if !dq.is_finite() || dq - dp > gap {
+                            return true;
+                        }
+                    }
+                }
+                false
+            })
+            .collect();
+        for (p, &m) in marks.iter().enumerate() {
+            if m {
+                count[p] += 1;
+                if slot[p] != u32::MAX {
+                    bits[slot[p] as usize][(k / 64) as usize] |= 1 << (k % 64);
+                }
+            }
+        }
+    }
+    SampleMarks {
+        zone,
+        count,
+        slot,
+        bits,
     }
 }
 
@@ -920,7 +1291,7 @@ fn recover(ctx: &Ctx, i: u32, j: u32, depth: f32) -> Centre {
         color: Vec3::ZERO,
         ao: 1.0,
         id: UNKNOWN,
-        shadowed: false,
+        lit: 1.0,
         walked: false,
     };
     let Some((o, d, cos, tmin, tmax)) = ctx.ray(i as f32 + 0.5, j as f32 + 0.5) else {
@@ -955,7 +1326,7 @@ fn shade_centre(ctx: &Ctx, i: u32, j: u32, out: &mut Centre, cand: &mut Candidat
     if let Some(hit) = ctx.grid.hit_on(out.id, prim, o, d, tmin, tmax) {
         let (c, s, ao) = ctx.shade(&hit, d, Ao::Trace(ctx.ao_samples), seed(i, j, 0), cand);
         out.color = c;
-        out.shadowed = s;
+        out.lit = s;
         out.ao = ao;
     }
 }
@@ -1019,6 +1390,7 @@ mod tests {
         let mut ctx = Ctx {
             grid: &grid,
             light: None,
+            soft: None,
             neighbours: None,
             azimuths: azimuth_table(),
             cam: &cam,

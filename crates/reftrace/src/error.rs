@@ -79,6 +79,14 @@ pub enum RenderError {
     /// Depth cueing with non-finite depths, `start >= end`, a strength outside [0, 1] or a
     /// non-finite colour.
     BadFog,
+    /// Soft shadows with 0 or more than [`crate::MAX_SHADOW_SAMPLES_PER_AXIS`] samples per
+    /// axis, or a light size outside `0..=`[`crate::MAX_LIGHT_SIZE_DEG`] degrees.
+    BadSoftShadows {
+        samples_per_axis: u32,
+        size_deg: f32,
+    },
+    /// An outline width of 0 or more than [`crate::MAX_OUTLINE_PX`] pixels.
+    BadOutline { width_px: u32 },
 }
 
 impl std::fmt::Display for RenderError {
@@ -124,6 +132,20 @@ impl std::fmt::Display for RenderError {
             RenderError::BadFog => write!(
                 f,
                 "fog needs finite depths start < end, a strength in [0, 1] and a finite colour"
+            ),
+            RenderError::BadSoftShadows {
+                samples_per_axis,
+                size_deg,
+            } => write!(
+                f,
+                "soft shadows with {samples_per_axis} samples per axis and a {size_deg}° light: need 1..={} samples per axis and a light size in 0..={} degrees",
+                crate::MAX_SHADOW_SAMPLES_PER_AXIS,
+                crate::MAX_LIGHT_SIZE_DEG
+            ),
+            RenderError::BadOutline { width_px } => write!(
+                f,
+                "outline width {width_px} px is not allowed (1..={})",
+                crate::MAX_OUTLINE_PX
             ),
         }
     }

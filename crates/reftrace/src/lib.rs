@@ -20,7 +20,8 @@
 //!   byte-identical for any thread count. Writes no files. [`Scene::depth_image`] is the trace
 //!   alone (closest hit and exact depth, no shading).
 //! - Optional ambient occlusion ([`AmbientOcclusion`]: stratified cosine-weighted rays within a
-//!   distance), hard shadows from the key light and depth cueing ([`DepthCue`]) in
+//!   distance), hard shadows from the key light or soft ones from it as a disc ([`DiscLight`]),
+//!   depth cueing ([`DepthCue`]) and supersampled silhouette outlines ([`Outline`]) in
 //!   [`RenderOptions`], so that `texmap-quality`'s effects have a converged reference; off by
 //!   default, and then the output is unchanged.
 //! - [`geom`]: the robust leaf tests — pbrt's cancellation-free sphere discriminant and the
@@ -68,8 +69,9 @@ mod wide;
 pub use error::{RenderError, SceneError, TextureError};
 pub use geom::CylinderPart;
 pub use render::{
-    AmbientOcclusion, DepthCue, MAX_AO_SAMPLES_PER_AXIS, MAX_RECURSION_DEPTH, MAX_SAMPLES_PER_AXIS,
-    Optics, RenderOptions, SurfaceMaterial,
+    AmbientOcclusion, DepthCue, DiscLight, MAX_AO_SAMPLES_PER_AXIS, MAX_LIGHT_SIZE_DEG,
+    MAX_OUTLINE_PX, MAX_RECURSION_DEPTH, MAX_SAMPLES_PER_AXIS, MAX_SHADOW_SAMPLES_PER_AXIS, Optics,
+    Outline, RenderOptions, SurfaceMaterial,
 };
 pub use scene::{BuildStats, BvhKind, Hit, HitKind, MeshShading, Scene, SceneBuilder};
 pub use texmap_core::frame::Frame;

@@ -44,9 +44,25 @@
 //! (`u1` gives `cos²θ`, `u2` the azimuth), jittered inside its stratum by a hash of the sample's
 //! screen position and bounce, so the result is deterministic. With [`RenderOptions::shadows`]
 //! the key light (the first light of the lighting) is dropped where a ray toward it meets
-//! anything. Both rays start at the secondary-ray origin (offset along the normal).
-//! [`RenderOptions::fog`] blends each primary sample's colour linearly toward a colour by its
-//! depth ([`DepthCue`]); misses are not fogged.
+//! anything. With [`RenderOptions::soft_shadows`] the key light is a disc of apparent diameter
+//! [`DiscLight::size_deg`] around its direction: `n × n` shadow rays, one per stratum of the unit
+//! square jittered by a hash, `u1` giving the angle `θ` to the light's direction by
+//! `sin²(θ/2) = u1·sin²(ρ/2)` (uniform in solid angle over the cap of angular radius `ρ`, half
+//! the size) and `u2` the azimuth; the key light's term is scaled by the fraction that meets
+//! nothing (the shading is a sum over lights, so this is the blend of the shading with and
+//! without it). A 0° disc is the hard shadow. All these rays start at the secondary-ray origin
+//! (offset along the normal) and are traced only where the geometric normal faces the light's
+//! centre. [`RenderOptions::fog`] blends each primary sample's colour linearly toward a colour
+//! by its depth ([`DepthCue`]); misses are not fogged.
+//!
+//! # Outlines
+//! [`RenderOptions::outline`] draws silhouette lines by the rule of `texmap-quality`, applied to
+//! every sample rather than every pixel centre: the image is traced one sample offset at a time
+//! (the `n × n` offsets above), and a covered sample becomes the outline colour when a sample at
+//! the same offset in a pixel within `width_px` rows and columns misses or lies deeper by more
+//! than the radius of the sample's own sphere or cylinder (only misses count on triangles).
+//! The pixel is the mean of its outlined and shaded samples, so the line is anti-aliased as the
+//! rest of the image; with one sample per pixel it is exactly the pixel-centre rule.
 //!
 //! # Textures
 //! A material's texture multiplies its base colour on mesh triangles that have uvs (spheres and
@@ -76,6 +92,12 @@ pub const MAX_SAMPLES_PER_AXIS: u32 = 16;
 pub const MAX_RECURSION_DEPTH: u32 = 16;
 /// The largest [`AmbientOcclusion::samples_per_axis`] accepted (4096 rays per shaded point).
 pub const MAX_AO_SAMPLES_PER_AXIS: u32 = 64;
+/// The largest [`DiscLight::samples_per_axis`] accepted (4096 shadow rays per shaded point).
+pub const MAX_SHADOW_SAMPLES_PER_AXIS: u32 = 64;
+/// The largest [`DiscLight::size_deg`] accepted.
+pub const MAX_LIGHT_SIZE_DEG: f32 = 30.0;
+/// The widest accepted [`Outline::width_px`].
+pub const MAX_OUTLINE_PX: u32 = 16;
 /// Cap on the footprint-integration grid per axis.
 const MAX_FOOTPRINT_GRID: u32 = 64;
 /// Secondary-ray origin offset, relative to the magnitude of the coordinates involved.
@@ -146,6 +168,27 @@ pub struct AmbientOcclusion {
     pub distance: f32,
 }
 
+/// The key light as a disc of apparent (angular) diameter `size_deg` around its direction, for
+/// soft shadows: `samples_per_axis²` stratified shadow rays per shaded point, uniform in solid
+/// angle over the disc (module docs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DiscLight {
+    pub samples_per_axis: u32,
+    /// 0..=[`MAX_LIGHT_SIZE_DEG`]; 0 is the point light of hard shadows.
+    pub size_deg: f32,
+}
+
+/// Silhouette outlines (module docs): a sample is painted `color` when a sample at the same
+/// offset in a pixel at most `width_px` away (rows and columns) misses or lies deeper by more
+/// than the radius of the sample's own sphere or cylinder.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Outline {
+    /// 1..=[`MAX_OUTLINE_PX`].
+    pub width_px: u32,
+    /// Linear RGB.
+    pub color: Vec3,
+}
+
 /// Depth cueing: a primary sample at eye-space depth `z` becomes
 /// `(1 − f)·c + f·color` with `f = strength · clamp((z − start)/(end − start), 0, 1)`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -177,8 +220,13 @@ pub struct RenderOptions<'a> {
     pub ambient_occlusion: Option<AmbientOcclusion>,
     /// Hard shadows from the key light (module docs).
     pub shadows: bool,
+    /// Soft shadows from the key light as a disc (module docs); `Some` turns shadows on
+    /// whatever `shadows` says.
+    pub soft_shadows: Option<DiscLight>,
     /// Depth cueing of primary samples; `None` = off.
     pub fog: Option<DepthCue>,
+    /// Silhouette outlines; `None` = off.
+    pub outline: Option<Outline>,
 }
 
 impl<'a> RenderOptions<'a> {
@@ -194,7 +242,9 @@ impl<'a> RenderOptions<'a> {
             max_depth: 8,
             ambient_occlusion: None,
             shadows: false,
+            soft_shadows: None,
             fog: None,
+            outline: None,
         }
     }
 
@@ -221,6 +271,22 @@ impl<'a> RenderOptions<'a> {
             return Err(RenderError::BadAmbientOcclusion {
                 samples_per_axis: ao.samples_per_axis,
                 distance: ao.distance,
+            });
+        }
+        if let Some(l) = self.soft_shadows
+            && !((1..=MAX_SHADOW_SAMPLES_PER_AXIS).contains(&l.samples_per_axis)
+                && (0.0..=MAX_LIGHT_SIZE_DEG).contains(&l.size_deg))
+        {
+            return Err(RenderError::BadSoftShadows {
+                samples_per_axis: l.samples_per_axis,
+                size_deg: l.size_deg,
+            });
+        }
+        if let Some(o) = self.outline
+            && !((1..=MAX_OUTLINE_PX).contains(&o.width_px) && o.color.is_finite())
+        {
+            return Err(RenderError::BadOutline {
+                width_px: o.width_px,
             });
         }
         if let Some(f) = self.fog
@@ -328,6 +394,9 @@ impl Scene {
             env,
             forward: camera.forward(),
         };
+        if let Some(outline) = opts.outline {
+            return Ok(tracer.render_outlined(outline));
+        }
         let (w, h) = (camera.width() as usize, camera.height() as usize);
         let mut color = vec![[0u8; 4]; w * h];
         let mut depth = vec![f32::INFINITY; w * h];
@@ -351,6 +420,64 @@ impl Scene {
 }
 
 impl<E: Fn(Vec3) -> Vec3 + Sync> Tracer<'_, E> {
+    /// The frame with outlines: one sub-image per sample offset (colour, depth and outline gap of
+    /// that sample in every pixel), the outline rule applied within each sub-image, and the
+    /// outlined or shaded samples averaged per pixel; depth from the centre ray.
+    fn render_outlined(&self, outline: Outline) -> Frame {
+        let (w, h) = (self.cam.width() as usize, self.cam.height() as usize);
+        let n = self.opts.samples_per_axis;
+        let nf = n as f32;
+        let half = 0.5 / nf;
+        let r = outline.width_px as usize;
+        let mut sum = vec![Vec3::ZERO; w * h];
+        let mut sub = vec![(Vec3::ZERO, f32::INFINITY, 0f32); w * h];
+        for b in 0..n {
+            for a in 0..n {
+                let (dx, dy) = ((a as f32 + 0.5) / nf, (b as f32 + 0.5) / nf);
+                sub.par_chunks_mut(w).enumerate().for_each(|(j, row)| {
+                    for (i, out) in row.iter_mut().enumerate() {
+                        *out = self.primary_sample(i as f32 + dx, j as f32 + dy, half);
+                        out.0 = out.0.clamp(Vec3::ZERO, Vec3::ONE);
+                    }
+                });
+                let sub = &sub;
+                sum.par_chunks_mut(w).enumerate().for_each(|(j, row)| {
+                    for (i, acc) in row.iter_mut().enumerate() {
+                        let (c, dp, gap) = sub[j * w + i];
+                        let mut marked = false;
+                        if dp.is_finite() {
+                            'probe: for jj in j.saturating_sub(r)..=(j + r).min(h - 1) {
+                                for ii in i.saturating_sub(r)..=(i + r).min(w - 1) {
+                                    let dq = sub[jj * w + ii].1;
+                                    if !dq.is_finite() || dq - dp > gap {
+                                        marked = true;
+                                        break 'probe;
+                                    }
+                                }
+                            }
+                        }
+                        *acc += if marked { outline.color } else { c };
+                    }
+                });
+            }
+        }
+        let inv = 1.0 / (n * n) as f32;
+        let mut color = vec![[0u8; 4]; w * h];
+        let mut depth = vec![f32::INFINITY; w * h];
+        color
+            .par_chunks_mut(w)
+            .zip(depth.par_chunks_mut(w))
+            .enumerate()
+            .for_each(|(j, (crow, drow))| {
+                for i in 0..w {
+                    crow[i] = linear_to_srgb8(sum[j * w + i] * inv, 255);
+                    drow[i] = self.primary_depth(i as f32 + 0.5, j as f32 + 0.5);
+                }
+            });
+        Frame::from_parts(self.cam.width(), self.cam.height(), color, depth)
+            .expect("buffers sized width * height")
+    }
+
     /// Linear colour (mean of the samples) and depth (centre ray) of pixel (i, j).
     fn pixel(&self, i: u32, j: u32) -> (Vec3, f32) {
         let n = self.opts.samples_per_axis;
@@ -362,7 +489,7 @@ impl<E: Fn(Vec3) -> Vec3 + Sync> Tracer<'_, E> {
             for a in 0..n {
                 let x = i as f32 + (a as f32 + 0.5) / nf;
                 let y = j as f32 + (b as f32 + 0.5) / nf;
-                let (c, d) = self.primary_sample(x, y, half);
+                let (c, d, _) = self.primary_sample(x, y, half);
                 acc += c.clamp(Vec3::ZERO, Vec3::ONE);
                 if n % 2 == 1 && a == n / 2 && b == n / 2 {
                     centre_depth = Some(d);
@@ -387,8 +514,10 @@ impl<E: Fn(Vec3) -> Vec3 + Sync> Tracer<'_, E> {
         primary_depth(self.scene, self.cam, self.forward, x, y)
     }
 
-    /// One primary sample: linear colour and depth.
-    fn primary_sample(&self, x: f32, y: f32, half: f32) -> (Vec3, f32) {
+    /// One primary sample: linear colour, depth, and the depth gap beyond which a neighbour
+    /// makes it an outline sample (the radius of its sphere or cylinder; infinite on a
+    /// triangle, so that only misses outline meshes).
+    fn primary_sample(&self, x: f32, y: f32, half: f32) -> (Vec3, f32, f32) {
         let (ray, cos, tmin, tmax) = self.primary_ray(x, y);
         let miss = || {
             let c = if self.opts.environment_on_primary_miss {
@@ -396,7 +525,7 @@ impl<E: Fn(Vec3) -> Vec3 + Sync> Tracer<'_, E> {
             } else {
                 self.opts.background
             };
-            (c, f32::INFINITY)
+            (c, f32::INFINITY, 0.0)
         };
         if !(valid_ray(&ray) && cos > 0.0) {
             return miss();
@@ -415,7 +544,8 @@ impl<E: Fn(Vec3) -> Vec3 + Sync> Tracer<'_, E> {
             let w = ((depth - f.start) / (f.end - f.start)).clamp(0.0, 1.0) * f.strength;
             c = c * (1.0 - w) + f.color * w;
         }
-        (c, depth)
+        let gap = self.scene.hit_radius(&hit).unwrap_or(f32::INFINITY);
+        (c, depth, gap)
     }
 
     /// The environment in direction `d`, never non-finite.
@@ -476,7 +606,8 @@ impl<E: Fn(Vec3) -> Vec3 + Sync> Tracer<'_, E> {
         let local = |m: &SurfaceMaterial| {
             let mut s = m.shading;
             s.base_color *= tex;
-            if self.opts.ambient_occlusion.is_none() && !self.opts.shadows {
+            let shadows = self.opts.shadows || self.opts.soft_shadows.is_some();
+            if self.opts.ambient_occlusion.is_none() && !shadows {
                 return self.opts.lighting.shade(&s, ns, v);
             }
             let origin = hit.point + ng * eps;
@@ -485,14 +616,33 @@ impl<E: Fn(Vec3) -> Vec3 + Sync> Tracer<'_, E> {
                 None => 1.0,
             };
             let mut mask = u32::MAX;
-            if self.opts.shadows
+            let mut key_fraction = 1.0;
+            if shadows
                 && let Some(key) = self.opts.lighting.lights().first()
                 && ng.dot(key.to_light) > 0.0
             {
-                let pre = RayPre::new(origin, key.to_light);
-                if self.scene.closest(&pre, 0.0, f32::INFINITY).is_some() {
-                    mask &= !1;
+                match self.opts.soft_shadows {
+                    None => {
+                        let pre = RayPre::new(origin, key.to_light);
+                        if self.scene.closest(&pre, 0.0, f32::INFINITY).is_some() {
+                            mask &= !1;
+                        }
+                    }
+                    Some(disc) => {
+                        key_fraction = self.disc_visibility(
+                            origin,
+                            key.to_light,
+                            disc,
+                            mix64(seed ^ depth as u64 ^ 0x5_0f75_4ad0),
+                        );
+                    }
                 }
+            }
+            if key_fraction < 1.0 {
+                // Lights add up: the key term scaled by the visible fraction of the disc.
+                let without = self.opts.lighting.shade_with(&s, ns, v, ao, !1);
+                let with = self.opts.lighting.shade_with(&s, ns, v, ao, u32::MAX);
+                return without + (with - without) * key_fraction;
             }
             self.opts.lighting.shade_with(&s, ns, v, ao, mask)
         };
@@ -571,6 +721,46 @@ impl<E: Fn(Vec3) -> Vec3 + Sync> Tracer<'_, E> {
                         .normalize_or(n);
                 let pre = RayPre::new(origin, dir);
                 if self.scene.closest(&pre, 0.0, ao.distance).is_none() {
+                    open += 1;
+                }
+            }
+        }
+        open as f32 / (m * m) as f32
+    }
+}
+
+impl<E: Fn(Vec3) -> Vec3 + Sync> Tracer<'_, E> {
+    /// The unoccluded fraction of `disc.samples_per_axis²` shadow rays from `origin` toward a
+    /// disc light of apparent diameter `disc.size_deg` centred on unit direction `to_light`: one
+    /// ray per stratum of the unit square, jittered inside it by a hash, `u1` giving
+    /// `sin²(θ/2) = u1·sin²(ρ/2)` (uniform in solid angle over the cap of angular radius `ρ`),
+    /// `u2` the azimuth.
+    fn disc_visibility(&self, origin: Vec3, to_light: Vec3, disc: DiscLight, seed: u64) -> f32 {
+        let helper = if to_light.x.abs() < 0.6 {
+            Vec3::X
+        } else {
+            Vec3::Y
+        };
+        let t1 = to_light.cross(helper).normalize();
+        let t2 = to_light.cross(t1);
+        let sin_half = (0.25 * disc.size_deg.to_radians()).sin();
+        let m = disc.samples_per_axis;
+        let inv = 1.0 / m as f32;
+        let mut state = seed;
+        let mut open = 0u32;
+        for b in 0..m {
+            for a in 0..m {
+                state = mix64(state.wrapping_add(0x9e37_79b9_7f4a_7c15));
+                let j1 = (state >> 40) as f32 / 16_777_216.0;
+                let j2 = ((state >> 16) & 0xff_ffff) as f32 / 16_777_216.0;
+                let sh = ((a as f32 + j1) * inv).sqrt() * sin_half;
+                let phi = 2.0 * std::f32::consts::PI * (b as f32 + j2) * inv;
+                let sin_t = 2.0 * sh * (1.0 - sh * sh).max(0.0).sqrt();
+                // Unit to rounding; not renormalised, so a 0° disc traces `to_light` itself.
+                let dir =
+                    to_light * (1.0 - 2.0 * sh * sh) + (t1 * phi.cos() + t2 * phi.sin()) * sin_t;
+                let pre = RayPre::new(origin, dir);
+                if self.scene.closest(&pre, 0.0, f32::INFINITY).is_none() {
                     open += 1;
                 }
             }

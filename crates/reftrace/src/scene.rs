@@ -601,6 +601,15 @@ impl Scene {
         self.stats
     }
 
+    /// The radius of the sphere or cylinder `hit` lies on; `None` for a triangle.
+    pub(crate) fn hit_radius(&self, hit: &Hit) -> Option<f32> {
+        match hit.kind {
+            HitKind::Sphere => Some(self.spheres[hit.prim_id as usize][3]),
+            HitKind::Cylinder { .. } => Some(self.cylinders[hit.prim_id as usize].radius),
+            HitKind::Triangle { .. } => None,
+        }
+    }
+
     /// The largest material id a primitive of the scene uses (`None` for an empty scene).
     pub fn max_material_id(&self) -> Option<u32> {
         self.max_material

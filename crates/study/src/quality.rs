@@ -7,8 +7,8 @@
 //! has ambient occlusion, `ref_ao_samples_per_axis²` AO rays per sample at the same AO distance,
 //! and shadows from the same key light. So a setting without AO is measured against the
 //! supersampled plain image and a setting with AO and shadows against the supersampled AO and
-//! shadow image; the error left is aliasing plus AO noise. Outlines are a stylisation the
-//! reference does not draw and are not measured.
+//! shadow image; the error left is aliasing plus AO noise. Outlines and soft shadows are not
+//! among the settings measured here ([`reference_with`] traces them for `--method reference`).
 //!
 //! The results are [`Record`]s (method = the setting's name, reference = e.g.
 //! `reftrace-8x8-ao256-shadows`), written as `quality.json` / `quality.csv`, and the
@@ -40,9 +40,11 @@ pub struct QualitySetting {
 /// The reference ray tracer's image of `spheres` with the effects `q` asks for, so that a
 /// quality setting of `texmap render --method reference` has its converged counterpart:
 /// `⌈√aa⌉²` samples per pixel, ambient occlusion with at least `ao_samples` rays per pixel
-/// (`m²` per sample, the same distance: `q.ao_distance` or [`ao_distance_for`]), hard shadows
-/// and the same depth cueing. Outlines and a transparent background are not drawn by the
-/// reference (the background colour is used, black for a transparent one).
+/// (`m²` per sample, the same distance: `q.ao_distance` or [`ao_distance_for`]), hard shadows,
+/// soft shadows from the same disc with at least `samples` rays per pixel (`m²` per sample),
+/// the same depth cueing and the same outline rule applied to every sample. A transparent
+/// background is not drawn by the reference (the background colour is used, black for a
+/// transparent one).
 pub fn reference_with(
     spheres: &SphereScene,
     draw_bonds: bool,
@@ -75,6 +77,17 @@ pub fn reference_with(
         });
     }
     o.shadows = q.shadows;
+    o.soft_shadows = q.soft_shadows.map(|ss| {
+        let per_sample = (ss.samples as f64 / (n * n) as f64).sqrt().ceil().max(1.0) as u32;
+        texmap_reftrace::DiscLight {
+            samples_per_axis: per_sample.min(texmap_reftrace::MAX_SHADOW_SAMPLES_PER_AXIS),
+            size_deg: ss.light_size_deg,
+        }
+    });
+    o.outline = q.outline.map(|ol| texmap_reftrace::Outline {
+        width_px: ol.width_px,
+        color: srgb8_to_linear_rgb([ol.color[0], ol.color[1], ol.color[2], 255]),
+    });
     o.fog = q.fog.map(|f| texmap_reftrace::DepthCue {
         start: f.start,
         end: f.end,
