@@ -468,7 +468,11 @@ pub fn extract(
     // it: the walk stops only at triangles whose legs are axis-aligned and at least `min_step`
     // long), with vertex numbers in first-use order (deterministic). A coarse chunk of a large
     // grid thus needs `(s / min_step + 1)²` slots, not one per grid sample.
-    let g = if min_step > 1 && x0 % min_step == 0 && y0 % min_step == 0 && s % min_step == 0 {
+    let g = if min_step > 1
+        && x0.is_multiple_of(min_step)
+        && y0.is_multiple_of(min_step)
+        && s.is_multiple_of(min_step)
+    {
         min_step
     } else {
         1
@@ -494,7 +498,10 @@ pub fn extract(
         }
         tris.push(pts.map(|p| {
             let (dx, dy) = (p[0] - x0, p[1] - y0);
-            debug_assert!(dx % g == 0 && dy % g == 0, "vertex off the lattice");
+            debug_assert!(
+                dx.is_multiple_of(g) && dy.is_multiple_of(g),
+                "vertex off the lattice"
+            );
             let slot = &mut index[(dy / g) as usize * side + (dx / g) as usize];
             if *slot == u32::MAX {
                 *slot = vertices.len() as u32;
