@@ -4,6 +4,7 @@
 //! - [`speed_accuracy`]: speed on the x axis (ms per frame, log scale) against accuracy on the y
 //!   axis (PSNR against the 1-spp reference), one labelled point per method per scene.
 //! - [`sweep`]: one chart per sweep, one line per method, for a chosen [`SweepMetric`].
+//! - [`scatter`]: points per series with a line through the mean at each x (the terrain study).
 //!
 //! Log axes are drawn as linear axes over `log10(x)` with tick labels written back as `x`: one
 //! code path for both kinds of axis. Infinite PSNR (identical images) is drawn at
@@ -600,6 +601,106 @@ pub fn write_charts(
     Ok(written)
 }
 
+/// Colours of [`scatter`]'s series, in order (the terrain study's sampler palette).
+const SCATTER_COLOURS: [RGBColor; 8] = [
+    RGBColor(0x1f, 0x77, 0xb4),
+    RGBColor(0xff, 0x7f, 0x0e),
+    RGBColor(0x2c, 0xa0, 0x2c),
+    RGBColor(0xd6, 0x27, 0x28),
+    RGBColor(0x94, 0x67, 0xbd),
+    RGBColor(0x8c, 0x56, 0x4b),
+    RGBColor(0xe3, 0x77, 0xc2),
+    RGBColor(0x7f, 0x7f, 0x7f),
+];
+
+/// A scatter chart at [`CHART_SIZE`]: one colour per series, a marker at every finite point and a
+/// line through the mean `y` at each distinct `x` (the terrain study's PSNR against pitch and
+/// height). Non-finite points are left out.
+pub fn scatter(
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    series: &[(String, Vec<(f64, f64)>)],
+    target: Target,
+) -> Result<(), StudyError> {
+    let finite: Vec<Vec<(f64, f64)>> = series
+        .iter()
+        .map(|(_, pts)| {
+            let mut v: Vec<(f64, f64)> = pts
+                .iter()
+                .copied()
+                .filter(|p| p.0.is_finite() && p.1.is_finite())
+                .collect();
+            v.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+            v
+        })
+        .collect();
+    let xr = range(finite.iter().flatten().map(|p| p.0));
+    let yr = range(finite.iter().flatten().map(|p| p.1));
+    fn draw<DB: DrawingBackend>(
+        root: DrawingArea<DB, Shift>,
+        [title, x_label, y_label]: [&str; 3],
+        names: &[&str],
+        finite: &[Vec<(f64, f64)>],
+        xr: std::ops::Range<f64>,
+        yr: std::ops::Range<f64>,
+    ) -> Result<(), String> {
+        let e = |err: DrawingAreaErrorKind<DB::ErrorType>| err.to_string();
+        root.fill(&WHITE).map_err(e)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 22))
+            .margin(16)
+            .x_label_area_size(44)
+            .y_label_area_size(60)
+            .build_cartesian_2d(xr, yr)
+            .map_err(e)?;
+        chart
+            .configure_mesh()
+            .x_desc(x_label)
+            .y_desc(y_label)
+            .label_style(("sans-serif", 14))
+            .draw()
+            .map_err(e)?;
+        for (k, (name, pts)) in names.iter().zip(finite).enumerate() {
+            let c = SCATTER_COLOURS[k % SCATTER_COLOURS.len()];
+            let mut means: Vec<(f64, f64)> = Vec::new();
+            let mut i = 0;
+            while i < pts.len() {
+                let j = pts[i..].iter().take_while(|p| p.0 == pts[i].0).count();
+                let m = pts[i..i + j].iter().map(|p| p.1).sum::<f64>() / j as f64;
+                means.push((pts[i].0, m));
+                i += j;
+            }
+            chart
+                .draw_series(LineSeries::new(means, c.stroke_width(2)))
+                .map_err(e)?
+                .label(*name)
+                .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], c.stroke_width(3)));
+            chart
+                .draw_series(pts.iter().map(|&p| Circle::new(p, 3, c.filled())))
+                .map_err(e)?;
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::LowerRight)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 14))
+            .draw()
+            .map_err(e)?;
+        root.present().map_err(e)
+    }
+    let names: Vec<&str> = series.iter().map(|s| s.0.as_str()).collect();
+    let labels = [title, x_label, y_label];
+    draw_on(
+        "scatter",
+        target,
+        CHART_SIZE,
+        |r| draw(r, labels, &names, &finite, xr.clone(), yr.clone()),
+        |r| draw(r, labels, &names, &finite, xr.clone(), yr.clone()),
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -735,5 +836,38 @@ mod tests {
             speed_accuracy(&records(), Target::Rgb(&mut buf)),
             Err(StudyError::BadOption { .. })
         ));
+    }
+
+    #[test]
+    fn scatter_draws_every_series_in_its_colour() {
+        let series = vec![
+            (
+                "trilinear".to_string(),
+                vec![(-10.0, 30.0), (-10.0, 32.0), (-50.0, 35.0)],
+            ),
+            (
+                "span3".to_string(),
+                vec![(-10.0, 28.0), (-50.0, f64::INFINITY)],
+            ),
+        ];
+        let mut svg = String::new();
+        scatter("t", "pitch", "PSNR", &series, Target::Svg(&mut svg)).unwrap();
+        assert!(svg.contains("trilinear") && svg.contains("span3"));
+        let (w, h) = CHART_SIZE;
+        let mut rgb = vec![0u8; 3 * (w * h) as usize];
+        scatter("t", "pitch", "PSNR", &series, Target::Rgb(&mut rgb)).unwrap();
+        let count = |c: RGBColor| rgb.chunks(3).filter(|p| *p == [c.0, c.1, c.2]).count();
+        // Markers, mean lines and legend swatches of both series are drawn.
+        assert!(
+            count(SCATTER_COLOURS[0]) > 100,
+            "{}",
+            count(SCATTER_COLOURS[0])
+        );
+        assert!(
+            count(SCATTER_COLOURS[1]) > 50,
+            "{}",
+            count(SCATTER_COLOURS[1])
+        );
+        assert_eq!(count(SCATTER_COLOURS[2]), 0);
     }
 }
