@@ -35,9 +35,9 @@
 //! `quadratic3`), which the paper suggests but did not test, runs beside the texmap-core samplers
 //! and is compared with trilinear in [`Claims`].
 //!
-//! [`write_study`] writes `results.csv`, `results.json`, `summary.md` and the SVG charts
-//! `error_vs_pitch.svg` and `error_vs_altitude.svg` (PSNR of every sampler against the view's
-//! pitch and height above the ground). [`demo_section`] builds a deterministic terrain
+//! [`write_study`] writes `results.csv`, `results.json`, `summary.md` and two charts, each as
+//! SVG and PNG: `error_vs_pitch` and `error_vs_altitude` (PSNR of every sampler against the
+//! view's pitch and height above the ground). [`demo_section`] builds a deterministic terrain
 //! ([`builtin_terrain`]), flies it into an APNG and compares the samplers on a small study path.
 //!
 //! ```
@@ -1102,29 +1102,15 @@ fn chart_series(
 /// The two charts: PSNR against pitch and against the eye's height above the ground
 /// (`log10` metres).
 pub fn charts(study: &TerrainStudy) -> [(String, String); 2] {
-    [
+    chart_data(study).map(|(stem, title, x_label, series)| {
         (
-            "error_vs_pitch.svg".to_string(),
-            scatter_svg(
-                "PSNR against the reference by pitch",
-                "pitch (degrees)",
-                "PSNR (dB)",
-                &chart_series(study, |r| r.place.pitch_deg),
-            ),
-        ),
-        (
-            "error_vs_altitude.svg".to_string(),
-            scatter_svg(
-                "PSNR against the reference by height above ground",
-                "log10 height above ground (m)",
-                "PSNR (dB)",
-                &chart_series(study, |r| r.place.clearance_m.max(1e-3).log10()),
-            ),
-        ),
-    ]
+            format!("{stem}.svg"),
+            scatter_svg(title, x_label, "PSNR (dB)", &series),
+        )
+    })
 }
 
-/// Write `results.csv`, `results.json`, `summary.md` and the two SVG charts into `dir`
+/// Write `results.csv`, `results.json`, `summary.md` and the two charts (SVG and PNG) into `dir`
 /// (created if missing); returns the paths written.
 pub fn write_study(dir: &Path, study: &TerrainStudy) -> Result<Vec<PathBuf>, TerrainStudyError> {
     std::fs::create_dir_all(dir).map_err(io(dir))?;
@@ -1141,7 +1127,45 @@ pub fn write_study(dir: &Path, study: &TerrainStudy) -> Result<Vec<PathBuf>, Ter
         std::fs::write(&p, text).map_err(io(&p))?;
         written.push(p);
     }
+    // The same two charts as PNG, drawn with plotters.
+    for (stem, title, x_label, series) in chart_data(study) {
+        let p = dir.join(format!("{stem}.png"));
+        crate::chart::scatter(
+            title,
+            x_label,
+            "PSNR (dB)",
+            &series,
+            crate::chart::Target::Png(&p),
+        )?;
+        written.push(p);
+    }
     Ok(written)
+}
+
+/// Stem, title, x label and series of the two charts.
+#[allow(clippy::type_complexity)] // one row per chart, read once by its two writers
+fn chart_data(
+    study: &TerrainStudy,
+) -> [(
+    &'static str,
+    &'static str,
+    &'static str,
+    Vec<(String, Vec<(f64, f64)>)>,
+); 2] {
+    [
+        (
+            "error_vs_pitch",
+            "PSNR against the reference by pitch",
+            "pitch (degrees)",
+            chart_series(study, |r| r.place.pitch_deg),
+        ),
+        (
+            "error_vs_altitude",
+            "PSNR against the reference by height above ground",
+            "log10 height above ground (m)",
+            chart_series(study, |r| r.place.clearance_m.max(1e-3).log10()),
+        ),
+    ]
 }
 
 /// A deterministic integer hash (for the built-in photo).
