@@ -635,7 +635,9 @@ pub fn scatter(
             v
         })
         .collect();
+    // Room on the right for the legend, so that it covers no point.
     let xr = range(finite.iter().flatten().map(|p| p.0));
+    let xr = xr.start..xr.end + 0.3 * (xr.end - xr.start);
     let yr = range(finite.iter().flatten().map(|p| p.1));
     fn draw<DB: DrawingBackend>(
         root: DrawingArea<DB, Shift>,
@@ -659,6 +661,7 @@ pub fn scatter(
             .x_desc(x_label)
             .y_desc(y_label)
             .label_style(("sans-serif", 14))
+            .light_line_style(RGBColor(238, 238, 238))
             .draw()
             .map_err(e)?;
         for (k, (name, pts)) in names.iter().zip(finite).enumerate() {
@@ -682,7 +685,7 @@ pub fn scatter(
         }
         chart
             .configure_series_labels()
-            .position(SeriesLabelPosition::LowerRight)
+            .position(SeriesLabelPosition::UpperRight)
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
             .label_font(("sans-serif", 14))
