@@ -558,26 +558,6 @@ fn bad_options_are_errors() {
     assert_eq!(QualityOptions::preset("best"), None);
 }
 
-/// Area of the intersection of two caps of the unit sphere with angular radii `a` and `b` whose
-/// centres are `g` apart (Tovchigrechko and Vakser 2001, Eq. 3), in f64.
-fn cap_intersection(a: f64, b: f64, g: f64) -> f64 {
-    use std::f64::consts::PI;
-    let cap = |t: f64| 2.0 * PI * (1.0 - t.cos());
-    if g >= a + b {
-        return 0.0;
-    }
-    if g <= (a - b).abs() {
-        return cap(a.min(b));
-    }
-    let (ca, cb, cg) = (a.cos(), b.cos(), g.cos());
-    let (sa, sb, sg) = (a.sin(), b.sin(), g.sin());
-    let clamp = |x: f64| x.clamp(-1.0, 1.0);
-    2.0 * (PI
-        - clamp((cg - ca * cb) / (sa * sb)).acos()
-        - clamp((cb - cg * ca) / (sg * sa)).acos() * ca
-        - clamp((ca - cg * cb) / (sg * sb)).acos() * cb)
-}
-
 /// A white matte ground (a sphere of radius 50 touching y = 0; small enough for f32 shadow rays
 /// leaving it) with a unit sphere 3 above it, lit from straight above by the key light alone,
 /// seen from above and to the side.
@@ -631,7 +611,7 @@ fn analytic_penumbra(cam: &Camera, size_deg: f64) -> Vec<(usize, f64, f64)> {
             let beta = (ball_r / dist).asin();
             let gamma = (u.dot(DVec3::Y) / dist).clamp(-1.0, 1.0).acos();
             let cap = 2.0 * std::f64::consts::PI * (1.0 - rho.cos());
-            let vis = 1.0 - cap_intersection(rho, beta, gamma) / cap;
+            let vis = 1.0 - texmap_core::solid_angle::cap_intersection(rho, beta, gamma) / cap;
             out.push((
                 (j * cam.width() + i) as usize,
                 (ndl * vis).clamp(0.0, 1.0),
@@ -757,12 +737,15 @@ fn soft_shadows_match_the_reference_disc_light() {
     o.shadows = false;
     let unshadowed = scene.render(&cam, &o).unwrap();
     let shaded = (0..n)
-        .filter(|&k| reference.covered(k) && reference.color[k][0] + 3 < unshadowed.color[k][0])
+        .filter(|&k| {
+            let sum = |c: [u8; 4]| c[..3].iter().map(|&v| u32::from(v)).sum::<u32>();
+            reference.covered(k) && sum(reference.color[k]) + 9 < sum(unshadowed.color[k])
+        })
         .count();
     eprintln!(
         "soft shadows vs reference over {n} pixels ({shaded} shaded): mean {mean:.4}, max {max:.4}; hard shadows mean {hard_mean:.4}, max {hard_max:.4}"
     );
-    assert!(n > 3000 && shaded > 300, "{n} pixels, {shaded} shaded");
+    assert!(n > 3000 && shaded > 80, "{n} pixels, {shaded} shaded");
     // 64 rays against 1024: noise of a few 1/64 steps of the key term.
     assert!(mean < 0.002 && max < 0.1, "mean {mean}, max {max}");
     assert!(hard_max > 0.2, "the hard shadow should differ: {hard_max}");

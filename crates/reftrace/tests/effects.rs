@@ -112,26 +112,6 @@ fn bad_effect_options_are_errors() {
     assert_eq!(scene.render(&cam, &o).unwrap_err(), RenderError::BadFog);
 }
 
-/// Area of the intersection of two caps of the unit sphere with angular radii `a` and `b` whose
-/// centres are `g` apart (Tovchigrechko and Vakser 2001, Eq. 3), in f64.
-fn cap_intersection(a: f64, b: f64, g: f64) -> f64 {
-    use std::f64::consts::PI;
-    let cap = |t: f64| 2.0 * PI * (1.0 - t.cos());
-    if g >= a + b {
-        return 0.0;
-    }
-    if g <= (a - b).abs() {
-        return cap(a.min(b));
-    }
-    let (ca, cb, cg) = (a.cos(), b.cos(), g.cos());
-    let (sa, sb, sg) = (a.sin(), b.sin(), g.sin());
-    let clamp = |x: f64| x.clamp(-1.0, 1.0);
-    2.0 * (PI
-        - clamp((cg - ca * cb) / (sa * sb)).acos()
-        - clamp((cb - cg * ca) / (sg * sa)).acos() * ca
-        - clamp((ca - cg * cb) / (sg * sb)).acos() * cb)
-}
-
 #[test]
 fn disc_light_penumbra_is_the_visible_fraction_of_the_disc() {
     // A white matte ground (a sphere of radius 50 touching y = 0) and a unit sphere 3 above it,
@@ -186,7 +166,7 @@ fn disc_light_penumbra_is_the_visible_fraction_of_the_disc() {
             let u = ball - p;
             let dist = u.length();
             let vis = 1.0
-                - cap_intersection(
+                - texmap_core::solid_angle::cap_intersection(
                     rho,
                     (1.0 / dist).asin(),
                     (u.y / dist).clamp(-1.0, 1.0).acos(),

@@ -37,4 +37,5 @@ pub mod mip;
 pub mod optics;
 pub mod sample;
 pub mod shade;
+pub mod solid_angle;
 pub mod transform;
