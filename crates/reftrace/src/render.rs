@@ -699,33 +699,19 @@ impl<E: Fn(Vec3) -> Vec3 + Sync> Tracer<'_, E> {
     /// The unoccluded fraction of `ao.samples_per_axis²` stratified cosine-weighted rays
     /// around unit normal `n` from `origin` (module docs).
     fn ambient_visibility(&self, origin: Vec3, n: Vec3, ao: AmbientOcclusion, seed: u64) -> f32 {
-        // Any unit vector not parallel to n gives the tangent frame.
-        let helper = if n.x.abs() < 0.6 { Vec3::X } else { Vec3::Y };
-        let t1 = n.cross(helper).normalize();
-        let t2 = n.cross(t1);
+        let (t1, t2) = tangents(n);
         let m = ao.samples_per_axis;
         let inv = 1.0 / m as f32;
-        let mut state = seed;
-        let mut open = 0u32;
-        for b in 0..m {
-            for a in 0..m {
-                state = mix64(state.wrapping_add(0x9e37_79b9_7f4a_7c15));
-                let j1 = (state >> 40) as f32 / 16_777_216.0;
-                let j2 = ((state >> 16) & 0xff_ffff) as f32 / 16_777_216.0;
-                let u1 = (a as f32 + j1) * inv;
-                let u2 = (b as f32 + j2) * inv;
-                let r = u1.sqrt();
-                let phi = 2.0 * std::f32::consts::PI * u2;
-                let dir =
-                    (t1 * (r * phi.cos()) + t2 * (r * phi.sin()) + n * (1.0 - u1).max(0.0).sqrt())
-                        .normalize_or(n);
-                let pre = RayPre::new(origin, dir);
-                if self.scene.closest(&pre, 0.0, ao.distance).is_none() {
-                    open += 1;
-                }
-            }
-        }
-        open as f32 / (m * m) as f32
+        stratified_fraction(m, seed, |sa, sb| {
+            let (u1, u2) = (sa * inv, sb * inv);
+            let r = u1.sqrt();
+            let phi = 2.0 * std::f32::consts::PI * u2;
+            let dir =
+                (t1 * (r * phi.cos()) + t2 * (r * phi.sin()) + n * (1.0 - u1).max(0.0).sqrt())
+                    .normalize_or(n);
+            let pre = RayPre::new(origin, dir);
+            self.scene.closest(&pre, 0.0, ao.distance).is_none()
+        })
     }
 }
 
@@ -736,37 +722,49 @@ impl<E: Fn(Vec3) -> Vec3 + Sync> Tracer<'_, E> {
     /// `sin²(θ/2) = u1·sin²(ρ/2)` (uniform in solid angle over the cap of angular radius `ρ`),
     /// `u2` the azimuth.
     fn disc_visibility(&self, origin: Vec3, to_light: Vec3, disc: DiscLight, seed: u64) -> f32 {
-        let helper = if to_light.x.abs() < 0.6 {
-            Vec3::X
-        } else {
-            Vec3::Y
-        };
-        let t1 = to_light.cross(helper).normalize();
-        let t2 = to_light.cross(t1);
+        let (t1, t2) = tangents(to_light);
         let sin_half = (0.25 * disc.size_deg.to_radians()).sin();
         let m = disc.samples_per_axis;
         let inv = 1.0 / m as f32;
-        let mut state = seed;
-        let mut open = 0u32;
-        for b in 0..m {
-            for a in 0..m {
-                state = mix64(state.wrapping_add(0x9e37_79b9_7f4a_7c15));
-                let j1 = (state >> 40) as f32 / 16_777_216.0;
-                let j2 = ((state >> 16) & 0xff_ffff) as f32 / 16_777_216.0;
-                let sh = ((a as f32 + j1) * inv).sqrt() * sin_half;
-                let phi = 2.0 * std::f32::consts::PI * (b as f32 + j2) * inv;
-                let sin_t = 2.0 * sh * (1.0 - sh * sh).max(0.0).sqrt();
-                // Unit to rounding; not renormalised, so a 0° disc traces `to_light` itself.
-                let dir =
-                    to_light * (1.0 - 2.0 * sh * sh) + (t1 * phi.cos() + t2 * phi.sin()) * sin_t;
-                let pre = RayPre::new(origin, dir);
-                if self.scene.closest(&pre, 0.0, f32::INFINITY).is_none() {
-                    open += 1;
-                }
+        stratified_fraction(m, seed, |sa, sb| {
+            let sh = (sa * inv).sqrt() * sin_half;
+            let phi = 2.0 * std::f32::consts::PI * sb * inv;
+            let sin_t = 2.0 * sh * (1.0 - sh * sh).max(0.0).sqrt();
+            // Unit to rounding; not renormalised, so a 0° disc traces `to_light` itself.
+            let dir = to_light * (1.0 - 2.0 * sh * sh) + (t1 * phi.cos() + t2 * phi.sin()) * sin_t;
+            let pre = RayPre::new(origin, dir);
+            self.scene.closest(&pre, 0.0, f32::INFINITY).is_none()
+        })
+    }
+}
+
+/// Two unit vectors completing unit `n` to an orthonormal frame (any vector not parallel to `n`
+/// gives one).
+#[inline]
+fn tangents(n: Vec3) -> (Vec3, Vec3) {
+    let helper = if n.x.abs() < 0.6 { Vec3::X } else { Vec3::Y };
+    let t1 = n.cross(helper).normalize();
+    (t1, n.cross(t1))
+}
+
+/// The fraction of `m x m` stratified samples for which `open(a + j1, b + j2)` holds: stratum
+/// `(a, b)` of the `[0, m)²` square, jittered inside it by `j1, j2 ∈ [0, 1)` from a splitmix64
+/// stream seeded with `seed` (so the same bytes for any thread count).
+#[inline]
+fn stratified_fraction(m: u32, seed: u64, mut open: impl FnMut(f32, f32) -> bool) -> f32 {
+    let mut state = seed;
+    let mut count = 0u32;
+    for b in 0..m {
+        for a in 0..m {
+            state = mix64(state.wrapping_add(0x9e37_79b9_7f4a_7c15));
+            let j1 = (state >> 40) as f32 / 16_777_216.0;
+            let j2 = ((state >> 16) & 0xff_ffff) as f32 / 16_777_216.0;
+            if open(a as f32 + j1, b as f32 + j2) {
+                count += 1;
             }
         }
-        open as f32 / (m * m) as f32
     }
+    count as f32 / (m * m) as f32
 }
 
 /// splitmix64's output function: a 64-bit mix of `z`.
