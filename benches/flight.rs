@@ -9,6 +9,11 @@
 //! - `trilinear`, `span3`, `span4`, `aniso`: whole frames (camera, selection, clear, draw) with
 //!   each sampler; sampling costs the difference to `raster_only`.
 //!
+//! - `streamed/whole_db`, `streamed/streamed`: the same terrain and texture built into a database
+//!   (a temporary directory), drawn with trilinear from the whole finest level and from the
+//!   streamed per-chunk textures (`texmap_terrain::stream`, 512 MiB, cache warm: the steady
+//!   state of a slow flight; the first frame's loads are printed).
+//!
 //! Targets (issue): trilinear ≤ 16 ms on 2 cores, span3 ≤ 0.8x trilinear, aniso ≤ 3x trilinear.
 //!
 //!     cargo bench --bench flight
@@ -22,7 +27,7 @@ use texmap_terrain::chunks;
 use texmap_terrain::dem::{Georef, Grid};
 use texmap_terrain::view::{FlightCamera, FlightTerrain, FrameScratch, ViewOptions};
 
-fn terrain() -> FlightTerrain {
+fn grid_and_photo() -> (Grid, image::RgbaImage) {
     let n = 1025u32;
     let h = (0..n * n)
         .map(|i| {
@@ -34,7 +39,6 @@ fn terrain() -> FlightTerrain {
         })
         .collect();
     let grid = Grid::new("bench hills", n, n, h, Georef::local(10.0)).unwrap();
-    let tree = chunks::build(&grid, 0.5, 65).unwrap();
     let img = image::RgbaImage::from_fn(2048, 2048, |x, y| {
         let c = if ((x / 32) + (y / 32)) % 2 == 0 {
             200
@@ -43,6 +47,12 @@ fn terrain() -> FlightTerrain {
         };
         image::Rgba([(x / 8) as u8, c, (y / 8) as u8, 255])
     });
+    (grid, img)
+}
+
+fn terrain() -> FlightTerrain {
+    let (grid, img) = grid_and_photo();
+    let tree = chunks::build(&grid, 0.5, 65).unwrap();
     let tex = texmap_terrain::view::texture_from_rgba(&img).unwrap();
     FlightTerrain::new(grid, tree, tex)
 }
@@ -112,5 +122,69 @@ fn bench(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench);
+fn bench_streamed(c: &mut Criterion) {
+    use texmap_terrain::db::{self, BuildOptions, Database};
+    let (grid, img) = grid_and_photo();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("db");
+    let photo = texmap_terrain::gst::Orthophoto {
+        image: img,
+        georef: None,
+        source: "bench".into(),
+    };
+    let opts = BuildOptions {
+        max_error: 0.5,
+        chunk: 65,
+        map_texels: 256,
+        max_texture_levels: 4,
+    };
+    db::build(&grid, "bench", Some(&photo), &opts, &out, |_, _| {}).unwrap();
+    let db = Database::open(&out).unwrap();
+    let whole = FlightTerrain::from_database(&db, 2048).unwrap();
+    let streamed = FlightTerrain::from_database(&db, 1).unwrap();
+    let mut stream = texmap_terrain::stream::TextureStream::new(&db, 512 << 20).unwrap();
+    let view = FlightCamera {
+        eye_x: 5120.0,
+        eye_y: -9800.0,
+        altitude: 300.0 + texmap_terrain::view::ground_height(&grid, 512.0, 980.0).unwrap(),
+        heading_deg: 0.0,
+        pitch_deg: -15.0,
+        roll_deg: 0.0,
+        hfov_deg: 45.0,
+        width: 1024,
+        height: 768,
+    };
+    let opts = ViewOptions::default();
+    let mut fb = Framebuffer::new(1024, 768).unwrap();
+    let mut scratch = FrameScratch::default();
+    let t0 = std::time::Instant::now();
+    let s = streamed
+        .render_streamed(&view, &opts, &mut stream, &mut fb, &mut scratch)
+        .unwrap();
+    eprintln!(
+        "streamed first frame: {:.1} ms, {} chunks, {:?} maps loaded, {:?} bytes resident, {:?}",
+        t0.elapsed().as_secs_f64() * 1e3,
+        s.chunks_drawn,
+        s.maps_loaded,
+        s.cache_bytes,
+        stream.stats()
+    );
+    let mut g = c.benchmark_group("flight_1024x768_streamed");
+    g.sample_size(20);
+    g.bench_function("whole_db", |b| {
+        b.iter(|| black_box(whole.render(&view, &opts, &mut fb, &mut scratch).unwrap()))
+    });
+    g.bench_function("streamed", |b| {
+        b.iter(|| {
+            black_box(
+                streamed
+                    .render_streamed(&view, &opts, &mut stream, &mut fb, &mut scratch)
+                    .unwrap(),
+            )
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench, bench_streamed);
 criterion_main!(benches);

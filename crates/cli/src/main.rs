@@ -12,6 +12,7 @@ mod output;
 mod scene;
 mod terrain;
 mod terrain_fly;
+mod terrain_models;
 mod terrain_view;
 
 use std::process::ExitCode;

@@ -43,7 +43,8 @@ pub struct FlyArgs {
     /// loaded, cache hits, evictions, resident bytes).
     #[arg(long)]
     pub stats: Option<PathBuf>,
-    /// GST map cache budget along the flight, MiB.
+    /// GST map cache budget along the flight, MiB; with --texture streamed, the budget of the
+    /// maps and chunk textures the frames are drawn from.
     #[arg(long, default_value_t = 512)]
     pub cache_mb: u64,
     /// Output: PNG frames (frames/%04d.png) or a movie (.apng, .mp4, .webm, .gif).
@@ -84,8 +85,8 @@ pub struct CompareArgs {
     /// Largest side of the whole-terrain texture assembled from the GST pyramid.
     #[arg(long, default_value_t = 4096)]
     pub max_texture: u32,
-    /// Output directory: results.csv, results.json, summary.md, error_vs_pitch.svg,
-    /// error_vs_altitude.svg.
+    /// Output directory: results.csv, results.json, summary.md, and the charts
+    /// error_vs_pitch and error_vs_altitude as .svg and .png.
     #[arg(long)]
     pub out: PathBuf,
 }
@@ -150,7 +151,7 @@ pub fn run_fly(a: FlyArgs) -> Result<()> {
     if a.path.is_none() && a.orbit.is_none() {
         return usage("terrain fly: give --path FILE or --orbit FRAMES[,RADIUS[,HEIGHT[,PITCH]]]");
     }
-    let (db, terrain) = open(&a.dir, a.view.max_texture)?;
+    let (db, terrain) = open(&a.dir, a.view.whole_texture_side())?;
     let template = FlightCamera {
         hfov_deg: a.view.fov,
         width,
@@ -166,9 +167,10 @@ pub fn run_fly(a: FlyArgs) -> Result<()> {
         v.camera(terrain.grid())
             .with_context(|| format!("view {i} of the orbit"))?;
     }
+    let objects = a.view.objects.load(terrain.grid())?;
     let mut sink = Sink::new(&a.output, views.len(), a.fps, false)?;
     let refr = if sampler.is_none() {
-        Some(TerrainReference::new(&terrain)?)
+        Some(TerrainReference::with_models(&terrain, objects.placed())?)
     } else {
         None
     };
@@ -177,9 +179,18 @@ pub fn run_fly(a: FlyArgs) -> Result<()> {
     let mut scratch = FrameScratch::default();
     let mut triangles = 0u64;
     let mut cache = texmap_terrain::gst::GstCache::new(a.cache_mb.saturating_mul(1 << 20));
+    let mut stream = if a.view.streamed() {
+        Some(
+            texmap_terrain::stream::TextureStream::new(&db, a.cache_mb.saturating_mul(1 << 20))
+                .context("--texture streamed")?,
+        )
+    } else {
+        None
+    };
     let mut lines = String::new();
     for (i, v) in views.iter().enumerate() {
         let mut frame_stats = None;
+        let mut model_stats = None;
         let frame: Frame = match (&refr, sampler) {
             (Some(r), _) => r.render_view(&terrain, v, a.view.samples)?,
             (None, Some(s)) => {
@@ -189,11 +200,15 @@ pub fn run_fly(a: FlyArgs) -> Result<()> {
                     sampler: s,
                     ..ViewOptions::default()
                 };
-                let st = terrain
-                    .render(v, &opts, &mut fb, &mut scratch)
-                    .with_context(|| format!("view {i}"))?;
+                let st = match &mut stream {
+                    Some(s) => terrain.render_streamed(v, &opts, s, &mut fb, &mut scratch),
+                    None => terrain.render(v, &opts, &mut fb, &mut scratch),
+                }
+                .with_context(|| format!("view {i}"))?;
                 triangles += st.triangles;
                 frame_stats = Some(st);
+                let cam = v.camera(terrain.grid())?;
+                model_stats = Some(objects.draw(&cam, s, &mut fb)?);
                 fb.to_frame()
             }
             (None, None) => unreachable!("sampler checked above"),
@@ -206,7 +221,7 @@ pub fn run_fly(a: FlyArgs) -> Result<()> {
             let line = json!({
                 "frame": i, "eye": [v.eye_x, v.eye_y], "altitude": v.altitude,
                 "heading": v.heading_deg, "pitch": v.pitch_deg, "roll": v.roll_deg,
-                "stats": frame_stats, "residency": residency,
+                "stats": frame_stats, "models": model_stats, "residency": residency,
                 "pixels_covered": frame.coverage_count(),
             });
             lines.push_str(&line.to_string());

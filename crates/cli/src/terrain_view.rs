@@ -41,6 +41,14 @@ pub struct FlightViewArgs {
     /// Largest side of the whole-terrain texture assembled from the GST pyramid.
     #[arg(long, default_value_t = 4096)]
     pub max_texture: u32,
+    /// Texture source: `whole` (one texture, the finest GST level whose side is at most
+    /// --max-texture) or `streamed` (each chunk textured from the GST maps at the level it
+    /// needs, maps and chunk textures held under --cache-mb).
+    #[arg(long, default_value = "whole")]
+    pub texture: String,
+    /// Models and trees drawn on the terrain.
+    #[command(flatten)]
+    pub objects: crate::terrain_models::ModelArgs,
 }
 
 impl FlightViewArgs {
@@ -62,7 +70,29 @@ impl FlightViewArgs {
                 texmap_reftrace::MAX_SAMPLES_PER_AXIS
             ));
         }
+        match self.texture.as_str() {
+            "whole" => {}
+            "streamed" if reference => {
+                return usage("--texture streamed: the reference sampler reads the whole texture");
+            }
+            "streamed" => {}
+            t => return usage(format!("--texture {t}: expected whole or streamed")),
+        }
+        if reference && self.objects.any_trees() {
+            return usage("--tree/--trees: the reference sampler traces models, not billboards");
+        }
         Ok((sampler, crate::scene::parse_size(&self.size)?))
+    }
+
+    /// Whether frames are textured from the streamed GST maps.
+    pub fn streamed(&self) -> bool {
+        self.texture == "streamed"
+    }
+
+    /// The side limit of the whole texture to open the terrain with (the coarsest level when
+    /// streamed: the stream holds the photo).
+    pub fn whole_texture_side(&self) -> u32 {
+        if self.streamed() { 1 } else { self.max_texture }
     }
 }
 
@@ -98,7 +128,7 @@ pub struct RenderArgs {
     #[arg(long)]
     pub haze: Option<f32>,
     /// GST map cache budget, MiB (the maps Seed 000 Eq. 5-7 asks for are made resident and
-    /// counted; the frame samples the whole-terrain texture).
+    /// counted); with --texture streamed, the budget of the maps and chunk textures drawn.
     #[arg(long, default_value_t = 512)]
     pub cache_mb: u64,
     /// Output PNG.
@@ -128,6 +158,7 @@ fn view_error(e: ViewError) -> anyhow::Error {
         | ViewError::EyeOutside { .. }
         | ViewError::BelowGround { .. }
         | ViewError::BadParameter { .. }
+        | ViewError::TextureBudget { .. }
         | ViewError::Camera(_) => UsageError(e.to_string()).into(),
         other => anyhow::Error::new(other),
     }
@@ -154,7 +185,8 @@ pub fn run(a: RenderArgs) -> Result<()> {
     };
     let db = Database::open(&a.dir)?;
     let t0 = Instant::now();
-    let terrain = FlightTerrain::from_database(&db, a.view.max_texture).map_err(view_error)?;
+    let terrain =
+        FlightTerrain::from_database(&db, a.view.whole_texture_side()).map_err(view_error)?;
     let load_ms = t0.elapsed().as_secs_f64() * 1e3;
 
     let mut view = FlightCamera::over(terrain.grid());
@@ -189,7 +221,8 @@ pub fn run(a: RenderArgs) -> Result<()> {
     view.width = width;
     view.height = height;
     // Validate the view before allocating the image.
-    view.camera(terrain.grid()).map_err(view_error)?;
+    let camera = view.camera(terrain.grid()).map_err(view_error)?;
+    let objects = a.view.objects.load(terrain.grid())?;
 
     let mut fb = Framebuffer::new(width, height)
         .map_err(|e| anyhow::anyhow!("--size {}: {e}", a.view.size))?;
@@ -199,12 +232,28 @@ pub fn run(a: RenderArgs) -> Result<()> {
         background,
     };
     let t1 = Instant::now();
-    let stats = terrain
-        .render(&view, &opts, &mut fb, &mut FrameScratch::default())
-        .map_err(view_error)?;
+    let stats = if a.view.streamed() {
+        let mut stream =
+            texmap_terrain::stream::TextureStream::new(&db, a.cache_mb.saturating_mul(1 << 20))
+                .map_err(view_error)?;
+        terrain
+            .render_streamed(
+                &view,
+                &opts,
+                &mut stream,
+                &mut fb,
+                &mut FrameScratch::default(),
+            )
+            .map_err(view_error)?
+    } else {
+        terrain
+            .render(&view, &opts, &mut fb, &mut FrameScratch::default())
+            .map_err(view_error)?
+    };
+    let model_stats = objects.draw(&camera, sampler, &mut fb)?;
     let mut frame = if reference {
         // The chunk statistics above are the flight view's; the image is the reference's.
-        let r = texmap_study::terrain::TerrainReference::new(&terrain)?;
+        let r = texmap_study::terrain::TerrainReference::with_models(&terrain, objects.placed())?;
         let cam = view.camera(terrain.grid()).map_err(view_error)?;
         let mut f = r.render(
             &cam,
@@ -247,7 +296,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
         "heading": view.heading_deg, "pitch": view.pitch_deg, "roll": view.roll_deg,
         "fov": view.hfov_deg, "size": [width, height], "sampler": a.view.sampler, "reference_samples": reference.then_some(a.view.samples),
         "pixel_error": a.view.pixel_error,
-        "frame": stats, "pixels_covered": pixels_covered, "haze_m": a.haze, "residency": residency,
+        "frame": stats, "models": model_stats, "pixels_covered": pixels_covered, "haze_m": a.haze, "residency": residency,
         "load_ms": load_ms, "render_ms": render_ms,
     });
     let text = serde_json::to_string(&v).context("frame statistics")?;

@@ -301,3 +301,59 @@ fn compare_writes_the_study_with_no_bank_conflicts() {
     }
     assert!(String::from_utf8_lossy(&o.stdout).contains("| span3 |"));
 }
+
+#[test]
+fn render_draws_models_and_trees_and_names_bad_ones() {
+    let dir = tempfile::tempdir().unwrap();
+    let db = small_db(dir.path());
+    let db_s = db.to_str().unwrap();
+    let model = data("models/box.obj");
+    let out = dir.path().join("m.png");
+    let out_s = out.to_str().unwrap();
+    // The grid: 37 x 29 samples 30 m apart from (500015, 3900855); the default eye looks north
+    // from the centre (500555, 3900435).
+    let render = |extra: &[&str]| {
+        let mut args = vec![
+            "terrain", "render", db_s, "--size", "160x120", "--stats", "-o", out_s,
+        ];
+        args.extend_from_slice(extra);
+        texmap(&args)
+    };
+    let spec = format!("{model}@500555,3900735,30,40");
+    let o = render(&[
+        "--model",
+        &spec,
+        "--tree",
+        "500455,3900655,25",
+        "--trees",
+        "20",
+    ]);
+    ok(&o);
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["models"]["models_drawn"], 1, "{v}");
+    assert_eq!(v["models"]["model_triangles"], 12, "{v}");
+    let trees = v["models"]["trees_drawn"].as_u64().unwrap()
+        + v["models"]["trees_culled"].as_u64().unwrap();
+    assert_eq!(trees, 21, "{v}");
+    assert!(v["models"]["trees_drawn"].as_u64().unwrap() >= 1, "{v}");
+    assert!(out.exists());
+    std::fs::remove_file(&out).unwrap();
+    // A missing model file names it (runtime error); a placement off the grid, a zero scale and
+    // a malformed spec are usage errors; no image is written.
+    let missing = format!("{}@500555,3900735", dir.path().join("nope.obj").display());
+    let o = render(&["--model", &missing]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("nope.obj"));
+    for (flag, bad, word) in [
+        ("--model", format!("{model}@1,2"), "outside"),
+        ("--model", format!("{model}@500555,3900735,0,0"), "scale"),
+        ("--model", model.clone(), "FILE@X,Y"),
+        ("--tree", "500555,3900735,-3".to_string(), "height"),
+    ] {
+        let o = render(&[flag, &bad]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{flag} {bad}: {err}");
+        assert!(err.contains(word), "{flag} {bad}: {err}");
+    }
+    assert!(!out.exists());
+}

@@ -72,6 +72,7 @@ use texmap_raster::{Framebuffer, MipSampler, QuadSampler, TexQuad};
 use texmap_reftrace::{RenderOptions, Scene, SceneBuilder, SurfaceMaterial, Texture};
 use texmap_terrain::dem::{Georef, Grid};
 use texmap_terrain::flight::{PathView, study_path};
+use texmap_terrain::models::Placed;
 use texmap_terrain::view::{
     self, FlightCamera, FlightTerrain, FrameScratch, ViewError, ViewOptions, ground_height,
     sampler_by_name,
@@ -172,7 +173,7 @@ pub const DEFAULT_REFERENCE_SAMPLES: u32 = 4;
 pub struct TerrainReference {
     scene: Scene,
     textures: Vec<Texture>,
-    materials: [SurfaceMaterial; 1],
+    materials: Vec<SurfaceMaterial>,
     triangles: usize,
 }
 
@@ -191,21 +192,57 @@ impl std::fmt::Debug for TerrainReference {
 impl TerrainReference {
     /// The reference of `terrain`: its grid's full-resolution mesh and level 0 of its texture.
     pub fn new(terrain: &FlightTerrain) -> Result<TerrainReference, TerrainStudyError> {
+        TerrainReference::with_models(terrain, &[])
+    }
+
+    /// The reference of `terrain` with placed models ([`texmap_terrain::models`]): each model's
+    /// mesh traced with level 0 of its texture (repeating, as the model's pyramid), or its flat
+    /// colour when it is drawn untextured. Tree billboards are not part of the reference.
+    pub fn with_models(
+        terrain: &FlightTerrain,
+        models: &[Placed],
+    ) -> Result<TerrainReference, TerrainStudyError> {
+        let reference = |e: &dyn std::fmt::Display| TerrainStudyError::Reference(e.to_string());
+        let level0 = |tex: &MipTexture| {
+            let n = tex.width() as usize * tex.height() as usize;
+            let texels = tex.texels()[..n].iter().map(|t| t.to_array()).collect();
+            Texture::new(tex.width(), tex.height(), texels).map_err(|e| reference(&e))
+        };
         let mesh = texmap_terrain::db::whole_mesh(terrain.grid(), 0.0)?;
         let indices: Vec<u32> = mesh.triangles.iter().flatten().copied().collect();
         let mut b = SceneBuilder::new();
         b.add_mesh(&mesh.positions, &indices, mesh.uvs.as_deref(), 0)
-            .map_err(|e| TerrainStudyError::Reference(e.to_string()))?;
-        let tex = terrain.texture();
-        let n = tex.width() as usize * tex.height() as usize;
-        let texels = tex.texels()[..n].iter().map(|t| t.to_array()).collect();
-        let texture = Texture::new(tex.width(), tex.height(), texels)
-            .map_err(|e| TerrainStudyError::Reference(e.to_string()))?;
+            .map_err(|e| reference(&e))?;
+        let mut textures = vec![level0(terrain.texture())?];
+        let mut materials =
+            vec![SurfaceMaterial::opaque(Material::matte(Vec3::ONE)).with_texture(0)];
+        let mut triangles = mesh.triangles.len();
+        for m in models {
+            let id = materials.len() as u32;
+            let idx: Vec<u32> = m.triangles.iter().flatten().copied().collect();
+            match (&m.uvs, &m.texture) {
+                (Some(uvs), Some(tex)) => {
+                    b.add_mesh(&m.positions, &idx, Some(uvs), id)
+                        .map_err(|e| reference(&e))?;
+                    materials.push(
+                        SurfaceMaterial::opaque(Material::matte(Vec3::ONE))
+                            .with_texture(textures.len() as u32),
+                    );
+                    textures.push(level0(tex)?);
+                }
+                _ => {
+                    b.add_mesh(&m.positions, &idx, None, id)
+                        .map_err(|e| reference(&e))?;
+                    materials.push(SurfaceMaterial::opaque(Material::matte(m.color)));
+                }
+            }
+            triangles += m.triangles.len();
+        }
         Ok(TerrainReference {
             scene: b.build(),
-            textures: vec![texture],
-            materials: [SurfaceMaterial::opaque(Material::matte(Vec3::ONE)).with_texture(0)],
-            triangles: mesh.triangles.len(),
+            textures,
+            materials,
+            triangles,
         })
     }
 

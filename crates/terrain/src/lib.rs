@@ -19,6 +19,8 @@
 //!   chosen by screen-space error and frustum culling, drawn through texmap-raster with any
 //!   texmap-core sampler (nearest, bilinear, trilinear, the span sampler with 3x3 or 4x4 banks,
 //!   anisotropic), per-frame statistics and optional haze.
+//! - [`models`]: textured OBJ models placed on the terrain by georeference and a built-in tree
+//!   billboard, drawn after the terrain with the same samplers and depth-tested against it.
 //! - [`flight`]: flight paths — CSV/JSON path files (a bad line is named), orbits, and the
 //!   built-in study path (look-down, low, grazing, turn, slow pass).
 //!
@@ -61,7 +63,9 @@ pub mod error;
 pub mod flight;
 pub mod greedy;
 pub mod gst;
+pub mod models;
 pub mod rtin;
+pub mod stream;
 pub mod view;
 
 pub use error::TerrainError;

@@ -18,7 +18,7 @@
 //! 3. **Draw** ([`FlightTerrain::render`]): the selected chunk meshes (surface and skirts) are
 //!    concatenated into one mesh and drawn with one [`Framebuffer::draw_textured`] call, so the
 //!    rasteriser bins and shades the whole frame in one parallel pass (one call per chunk would
-//!    pay the tile pass per chunk). The texture is one whole-terrain [`MipTexture`] (clamped at
+//!    pay the tile pass per chunk; the streamed source does that, see below). The texture is one whole-terrain [`MipTexture`] (clamped at
 //!    the edges) sampled by any texmap-core [`Sampler`]: nearest, bilinear, trilinear (Eq. 4),
 //!    span 3x3 / 4x4 (Eq. 8–10, the rasteriser's 2x2 quad is the span) or anisotropic.
 //!
@@ -26,14 +26,18 @@
 //! each pixel toward a sky colour by Koschmieder's transmittance over its eye distance; a sky
 //! alone is just the frame's background colour ([`ViewOptions::background`]).
 //!
-//! **Texture residency.** The database's GST maps are 256² tiles of a pyramid; this module
-//! assembles one level of it (the finest whose side fits a caller's limit, [`Database::texture`])
-//! into one [`MipTexture`] rather than sampling through the map cache: the samplers' kernels
-//! address one pyramid, and a per-map indirection in the per-pixel loop was out of scope for a
-//! first renderer. The maps Seed 000's active area (Eq. 5–7) asks for at the eye are still
-//! counted ([`FrameStats::maps_needed`]) and can be made resident through the database's
-//! [`gst::GstCache`] ([`FlightTerrain::make_resident`]: needed, loaded, resident bytes), which
-//! measures what a cache-fed renderer would hold along a flight.
+//! **Texture residency.** Two texture sources. [`FlightTerrain::render`] samples one whole-
+//! terrain [`MipTexture`]: one level of the database's GST pyramid (the finest whose side fits a
+//! caller's limit, [`Database::texture`]) assembled once, so its memory grows with the square of
+//! that side (16 bytes a texel plus mips: 1.4 GB for 8192², and more than [`MipTexture`]'s
+//! 16384 side cannot be held at all). [`FlightTerrain::render_streamed`] ([`crate::stream`])
+//! instead textures each chunk from the GST maps at the level its on-screen size needs (Seed 000
+//! Eq. 7's rule), through the map cache ([`gst::GstCache`], loads counted) and a
+//! least-recently-used set of per-chunk textures, both under one byte budget, with one draw
+//! call per chunk; the photo's size then bounds only the disk. For the whole-texture frame the
+//! maps Seed 000's active area (Eq. 5–7) asks for at the eye are counted
+//! ([`FrameStats::maps_needed`]) and can be made resident in a separate cache
+//! ([`FlightTerrain::make_resident`]) to measure what a cache-fed renderer would hold.
 //!
 //! **Chunks.** [`FlightTerrain::from_database`] rebuilds the chunk quadtree from the stored grid
 //! with the manifest's error and chunk size (the same function the build wrote the chunk files
@@ -120,6 +124,12 @@ pub enum ViewError {
     Raster(RasterError),
     Texture(MipError),
     Terrain(TerrainError),
+    /// A streamed texture budget below what the frame needs at the coarsest level.
+    TextureBudget {
+        budget: u64,
+        needed: u64,
+        what: &'static str,
+    },
 }
 
 impl std::fmt::Display for ViewError {
@@ -164,6 +174,15 @@ impl std::fmt::Display for ViewError {
             ViewError::Raster(e) => write!(f, "flight view: {e}"),
             ViewError::Texture(e) => write!(f, "flight view texture: {e}"),
             ViewError::Terrain(e) => write!(f, "{e}"),
+            ViewError::TextureBudget {
+                budget,
+                needed,
+                what,
+            } => write!(
+                f,
+                "flight view: texture budget of {budget} bytes is too small for {what} \
+                 (about {needed} bytes needed; raise the budget)"
+            ),
         }
     }
 }
@@ -409,13 +428,13 @@ impl Aabb {
 }
 
 /// The view frustum's five planes (four sides and the eye plane), `n · (p − eye) ≤ 0` inside.
-struct Frustum {
+pub(crate) struct Frustum {
     eye: Vec3,
     normals: [Vec3; 5],
 }
 
 impl Frustum {
-    fn new(cam: &Camera) -> Frustum {
+    pub(crate) fn new(cam: &Camera) -> Frustum {
         let k = cam.scale();
         let tx = 0.5 * cam.width() as f32 / k;
         let ty = 0.5 * cam.height() as f32 / k;
@@ -428,7 +447,7 @@ impl Frustum {
 
     /// True when the box lies entirely outside one plane (conservative: may keep a box that is
     /// outside the frustum near its edges, never drops one that is inside).
-    fn culls(&self, b: &Aabb) -> bool {
+    pub(crate) fn culls(&self, b: &Aabb) -> bool {
         let c = b.corners();
         self.normals
             .iter()
@@ -477,6 +496,14 @@ pub struct FrameStats {
     pub texture_bytes: u64,
     /// GST maps Seed 000's active area (Eq. 5–7) needs at the eye, when the database has maps.
     pub maps_needed: Option<u64>,
+    /// Streamed frames only ([`crate::stream`]): GST maps resident in the cache after the frame,
+    /// maps loaded during it, bytes the stream holds (maps and chunk textures) and the chunk
+    /// textures' share of them. (`texture_side` is then the finest level drawn and
+    /// `texture_bytes` the bytes of the frame's chunk textures.)
+    pub maps_resident: Option<u64>,
+    pub maps_loaded: Option<u64>,
+    pub cache_bytes: Option<u64>,
+    pub chunk_texture_bytes: Option<u64>,
 }
 
 /// Options of a frame.
@@ -506,6 +533,13 @@ pub struct FrameScratch {
     positions: Vec<Vec3>,
     uvs: Vec<Vec2>,
     triangles: Vec<[u32; 3]>,
+}
+
+impl FrameScratch {
+    /// The texture-coordinate buffer (the streamed draw's remapped per-chunk uvs).
+    pub(crate) fn uvs_mut(&mut self) -> &mut Vec<Vec2> {
+        &mut self.uvs
+    }
 }
 
 /// A terrain ready to be flown over: grid (for the ground under the eye), chunk quadtree with
