@@ -397,26 +397,29 @@ impl Scene {
         if let Some(outline) = opts.outline {
             return Ok(tracer.render_outlined(outline));
         }
-        let (w, h) = (camera.width() as usize, camera.height() as usize);
-        let mut color = vec![[0u8; 4]; w * h];
-        let mut depth = vec![f32::INFINITY; w * h];
-        // Parallel over rows; each pixel depends only on its coordinates.
-        color
-            .par_chunks_mut(w)
-            .zip(depth.par_chunks_mut(w))
-            .enumerate()
-            .for_each(|(j, (crow, drow))| {
-                for i in 0..w {
-                    let (c, d) = tracer.pixel(i as u32, j as u32);
-                    crow[i] = linear_to_srgb8(c, 255);
-                    drow[i] = d;
-                }
-            });
-        Ok(
-            Frame::from_parts(camera.width(), camera.height(), color, depth)
-                .expect("buffers sized width * height"),
-        )
+        Ok(frame_of(camera, |i, j| tracer.pixel(i as u32, j as u32)))
     }
+}
+
+/// The frame whose pixel `(i, j)` has linear colour and depth `pixel(i, j)`, encoded to sRGB8;
+/// parallel over rows (each pixel depends only on its coordinates).
+fn frame_of(camera: &Camera, pixel: impl Fn(usize, usize) -> (Vec3, f32) + Sync) -> Frame {
+    let (w, h) = (camera.width() as usize, camera.height() as usize);
+    let mut color = vec![[0u8; 4]; w * h];
+    let mut depth = vec![f32::INFINITY; w * h];
+    color
+        .par_chunks_mut(w)
+        .zip(depth.par_chunks_mut(w))
+        .enumerate()
+        .for_each(|(j, (crow, drow))| {
+            for i in 0..w {
+                let (c, d) = pixel(i, j);
+                crow[i] = linear_to_srgb8(c, 255);
+                drow[i] = d;
+            }
+        });
+    Frame::from_parts(camera.width(), camera.height(), color, depth)
+        .expect("buffers sized width * height")
 }
 
 impl<E: Fn(Vec3) -> Vec3 + Sync> Tracer<'_, E> {
@@ -462,20 +465,12 @@ impl<E: Fn(Vec3) -> Vec3 + Sync> Tracer<'_, E> {
             }
         }
         let inv = 1.0 / (n * n) as f32;
-        let mut color = vec![[0u8; 4]; w * h];
-        let mut depth = vec![f32::INFINITY; w * h];
-        color
-            .par_chunks_mut(w)
-            .zip(depth.par_chunks_mut(w))
-            .enumerate()
-            .for_each(|(j, (crow, drow))| {
-                for i in 0..w {
-                    crow[i] = linear_to_srgb8(sum[j * w + i] * inv, 255);
-                    drow[i] = self.primary_depth(i as f32 + 0.5, j as f32 + 0.5);
-                }
-            });
-        Frame::from_parts(self.cam.width(), self.cam.height(), color, depth)
-            .expect("buffers sized width * height")
+        frame_of(self.cam, |i, j| {
+            (
+                sum[j * w + i] * inv,
+                self.primary_depth(i as f32 + 0.5, j as f32 + 0.5),
+            )
+        })
     }
 
     /// Linear colour (mean of the samples) and depth (centre ray) of pixel (i, j).

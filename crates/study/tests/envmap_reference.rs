@@ -7,12 +7,11 @@
 
 use texmap_core::camera::Camera;
 use texmap_core::frame::Frame;
-use texmap_core::shade::Material;
 use texmap_envmap::glam::{Quat, Vec3};
-use texmap_envmap::scene::{TunnelParams, tunnel_camera, tunnel_lighting, tunnel_scene};
+use texmap_envmap::scene::{TunnelParams, tunnel_camera, tunnel_scene};
 use texmap_envmap::shapes;
 use texmap_envmap::{
-    EnvScene, Environment, Method, Object, Options, Renderer, Surface, Target, TargetShape,
+    EnvScene, Environment, Method, Options, Renderer, Surface, Target, TargetShape,
 };
 
 fn reference(scene: &EnvScene, cam: &Camera, with_objects: bool) -> Frame {
@@ -155,7 +154,7 @@ fn reflections_turn_when_the_camera_rolls() {
 }
 
 /// Seed 003's parallax error: exact only at the target's centre. One object of constant angular
-/// size at k target radii: the dynamic maps' error falls as k grows, and beyond 12 radii it is
+/// size at k target radii (`texmap_study::envmap::distance_scene`): the dynamic maps' error falls as k grows, and beyond 12 radii it is
 /// small.
 #[test]
 fn parallax_error_is_bounded_for_distant_objects() {
@@ -170,30 +169,8 @@ fn parallax_error_is_bounded_for_distant_objects() {
     .unwrap();
     let mut by_k = Vec::new();
     for k in [2.0f32, 4.0, 12.0, 30.0] {
-        let dir = Vec3::new(0.45, 0.35, 0.82).normalize();
-        let c = dir * k;
-        let h = 0.18 * k;
-        let obj = Object {
-            mesh: shapes::cuboid(
-                c - Vec3::splat(h),
-                c + Vec3::splat(h),
-                Quat::from_rotation_y(0.5),
-            ),
-            material: Material::matte(Vec3::new(0.9, 0.3, 0.1)),
-        };
-        let scene = EnvScene::new(
-            vec![obj],
-            Target {
-                shape: TargetShape::Sphere {
-                    centre: Vec3::ZERO,
-                    radius: 1.0,
-                },
-                surface: Surface::Mirror,
-            },
-            texmap_envmap::scene::smooth_environment(),
-            tunnel_lighting(),
-        )
-        .unwrap();
+        // The distance study's scene: a unit mirror sphere and one box at k radii.
+        let scene = texmap_study::envmap::distance_scene(k).unwrap();
         let reference = reference(&scene, &cam, true);
         let mask = target_mask(&scene, &cam);
         let mut row = Vec::new();
