@@ -3,14 +3,10 @@
 //! must reach (the camera a user would have given by hand), not against stored images.
 
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Output;
 
-fn texmap(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_texmap"))
-        .args(args)
-        .output()
-        .expect("texmap runs")
-}
+mod common;
+use common::texmap;
 
 /// `texmap render TRAJ FLAGS -o OUT`, which must succeed.
 fn render_ok(traj: &str, out: &str, flags: &[&str]) {

@@ -1,14 +1,10 @@
 //! End-to-end tests of the `texmap` binary: what a script sees (stdout JSON, files, exit codes).
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
-fn texmap(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_texmap"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
+mod common;
+use common::texmap;
 
 fn data(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))

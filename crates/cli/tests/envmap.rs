@@ -3,14 +3,9 @@
 //! (The methods' accuracy against the reference ray tracer is tested in crates/study.)
 
 use std::path::Path;
-use std::process::{Command, Output};
 
-fn texmap(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_texmap"))
-        .args(args)
-        .output()
-        .expect("texmap runs")
-}
+mod common;
+use common::texmap;
 
 /// `texmap envmap --size 160x120 -o dir/name extra...`; the image's RGB bytes.
 fn envmap(dir: &Path, name: &str, extra: &[&str]) -> Vec<u8> {

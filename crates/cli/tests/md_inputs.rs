@@ -3,14 +3,10 @@
 //! NetCDF, bonds, selections, periodic boundaries, and the small defects of the issue.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
-fn texmap(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_texmap"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
+mod common;
+use common::texmap;
 
 fn data(name: &str) -> String {
     Path::new(env!("CARGO_MANIFEST_DIR"))

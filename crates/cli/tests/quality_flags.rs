@@ -3,14 +3,9 @@
 //! accuracy against the reference ray tracer is tested in crates/quality.)
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-fn texmap(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_texmap"))
-        .args(args)
-        .output()
-        .expect("texmap runs")
-}
+mod common;
+use common::texmap;
 
 fn data(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))

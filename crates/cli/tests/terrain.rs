@@ -2,14 +2,10 @@
 //! sees — files, JSON, exit codes.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
-fn texmap(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_texmap"))
-        .args(args)
-        .output()
-        .expect("texmap runs")
-}
+mod common;
+use common::texmap;
 
 fn data(name: &str) -> String {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -26,20 +22,8 @@ fn ok(o: &Output) {
 #[test]
 fn build_info_maps_export_and_render() {
     let dir = tempfile::tempdir().unwrap();
-    let db: PathBuf = dir.path().join("area.db");
+    let db = small_db(dir.path());
     let db_s = db.to_str().unwrap();
-    ok(&texmap(&[
-        "terrain",
-        "build",
-        "--dem",
-        &data("ramp_i16_lzw.tif"),
-        "--photo",
-        &data("photo_rgb.tif"),
-        "--max-error",
-        "0.5",
-        "--out",
-        db_s,
-    ]));
     // The database reports the grid GDAL wrote (37 x 29 samples, one no-data sample).
     let o = texmap(&["terrain", "info", db_s]);
     ok(&o);
