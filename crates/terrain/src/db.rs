@@ -33,6 +33,11 @@ pub struct ChunkEntry {
     pub triangles: u32,
     pub vertices: u32,
     pub file: String,
+    /// The mesh's bounding box in local metres, `[min x, min y, min z, max x, max y, max z]`
+    /// (surface and skirts): what a renderer selects by without reading the file. Absent in
+    /// databases written before it was recorded.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bounds: Option<[f32; 6]>,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -116,6 +121,74 @@ fn chunk_bytes(c: &chunks::Chunk) -> Vec<u8> {
     b
 }
 
+/// `[min x, min y, min z, max x, max y, max z]` of `points`.
+fn bounds_of(points: &[glam::Vec3]) -> [f32; 6] {
+    let b = crate::view::Aabb::of(points);
+    [b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z]
+}
+
+/// Parse a chunk file written by [`chunk_bytes`], checking every count against the file's length
+/// and every index against the vertex count.
+fn parse_chunk(path: &Path, b: &[u8]) -> Result<texmap_mesh::TriMesh, TerrainError> {
+    let src = path.display().to_string();
+    let bad = |at: usize, what: String| format_err(&src, format!("byte {at}"), what);
+    if b.len() < 20 || &b[..4] != b"TMCK" {
+        return Err(bad(
+            0,
+            "a chunk file starting \"TMCK\" with a 20-byte header".into(),
+        ));
+    }
+    let word = |i: usize| u32::from_le_bytes([b[i], b[i + 1], b[i + 2], b[i + 3]]);
+    if word(4) != 1 {
+        return Err(bad(4, format!("chunk format version 1, got {}", word(4))));
+    }
+    let (nv, nt) = (word(8) as u64, word(12) as u64);
+    let want = 20 + nv * 20 + nt * 12;
+    if b.len() as u64 != want {
+        return Err(bad(
+            8,
+            format!(
+                "{want} bytes for {nv} vertices and {nt} triangles, the file has {}",
+                b.len()
+            ),
+        ));
+    }
+    let f = |i: usize| f32::from_le_bytes([b[i], b[i + 1], b[i + 2], b[i + 3]]);
+    let (nv, nt) = (nv as usize, nt as usize);
+    let mut positions = Vec::with_capacity(nv);
+    for v in 0..nv {
+        let o = 20 + 12 * v;
+        let p = glam::Vec3::new(f(o), f(o + 4), f(o + 8));
+        if !p.is_finite() {
+            return Err(bad(o, format!("a finite position for vertex {v}")));
+        }
+        positions.push(p);
+    }
+    let uo = 20 + 12 * nv;
+    let uvs = (0..nv)
+        .map(|v| glam::Vec2::new(f(uo + 8 * v), f(uo + 8 * v + 4)))
+        .collect();
+    let to = uo + 8 * nv;
+    let mut triangles = Vec::with_capacity(nt);
+    for t in 0..nt {
+        let o = to + 12 * t;
+        let tri = [word(o), word(o + 4), word(o + 8)];
+        if tri.iter().any(|&i| i as usize >= nv) {
+            return Err(bad(
+                o,
+                format!("triangle {t}: vertex indices below {nv}, got {tri:?}"),
+            ));
+        }
+        triangles.push(tri);
+    }
+    Ok(texmap_mesh::TriMesh {
+        positions,
+        triangles,
+        uvs: Some(uvs),
+        normals: None,
+    })
+}
+
 /// Build a database at `out` from `grid` (and an orthophoto); `progress(done, total)` is called
 /// after each step.
 pub fn build(
@@ -191,6 +264,7 @@ fn build_into(
                 triangles: c.surface_triangles,
                 vertices: c.mesh.positions.len() as u32,
                 file,
+                bounds: Some(bounds_of(&c.mesh.positions)),
             });
         }
         // A depth may come in several bands: extend its entry.
@@ -337,6 +411,37 @@ impl Database {
             .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
             .collect();
         Grid::new(&path.display().to_string(), m.width, m.height, h, m.georef)
+    }
+
+    /// The stored grid mapped into memory rather than read ([`Grid::map_file`]): pages are read
+    /// only when their heights are used.
+    pub fn grid_mapped(&self) -> Result<Grid, TerrainError> {
+        let m = &self.manifest;
+        Grid::map_file(
+            &self.dir.join("grid.f32"),
+            m.width,
+            m.height,
+            m.georef,
+            (m.height_min, m.height_max),
+        )
+    }
+
+    /// The mesh of one chunk (surface and skirts) from its file.
+    pub fn read_chunk(&self, entry: &ChunkEntry) -> Result<texmap_mesh::TriMesh, TerrainError> {
+        let rel = Path::new(&entry.file);
+        if !rel
+            .components()
+            .all(|c| matches!(c, std::path::Component::Normal(_)))
+        {
+            return Err(format_err(
+                &self.dir.join("manifest.json").display().to_string(),
+                format!("chunk file \"{}\"", entry.file),
+                "a path inside the database directory",
+            ));
+        }
+        let path = self.dir.join(rel);
+        let bytes = std::fs::read(&path).map_err(io(&path))?;
+        parse_chunk(&path, &bytes)
     }
 
     /// A GST map tile.

@@ -315,7 +315,7 @@ fn align(map_texels: u32) -> u32 {
 
 /// The uv rectangle `[u0, u1, v0, v1]` of a chunk's cell (its vertices' texture coordinates,
 /// [`crate::chunks::vertex`], lie within it; the padding beyond the grid is clipped).
-fn uv_rect(grid: &crate::dem::Grid, c: &crate::chunks::Chunk) -> [f32; 4] {
+fn uv_rect(grid: &crate::dem::Grid, c: &crate::view::ChunkInfo) -> [f32; 4] {
     let (w1, h1) = ((grid.width() - 1) as f32, (grid.height() - 1) as f32);
     let last = (c.size - 1) as f32;
     [
@@ -372,6 +372,7 @@ impl FlightTerrain {
         }
         // Step 2: levels.
         let plan = self.plan_levels(&camera, &sel.chunks, stream)?;
+        self.prepare(&sel.chunks)?;
         // Step 3: textures.
         let frame_start = stream.tick + 1;
         for (c, level, uv) in &plan {
@@ -413,8 +414,7 @@ impl FlightTerrain {
             stats.triangles_binned += ds.binned as u64;
             stats.triangles_backface += ds.culled as u64;
             stats.triangles_clipped += ds.clipped as u64;
-            stats.surface_triangles +=
-                self.tree().levels[c.depth as usize][c.index].surface_triangles as u64;
+            stats.surface_triangles += self.chunk(*c).surface_triangles as u64;
         }
         let ms = stream.maps.stats();
         stats.texture_bytes = frame_bytes;
@@ -423,6 +423,7 @@ impl FlightTerrain {
         stats.maps_loaded = Some(ms.loads - loads_before);
         stats.cache_bytes = Some(ms.resident_bytes + stream.stats.chunk_texture_bytes);
         stats.chunk_texture_bytes = Some(stream.stats.chunk_texture_bytes);
+        stats.chunk_cache = self.chunk_cache();
         Ok(stats)
     }
 
@@ -442,23 +443,22 @@ impl FlightTerrain {
     fn split_for_texture(&self, camera: &Camera, sel: &mut Selection, stream: &mut TextureStream) {
         let frustum = Frustum::new(camera);
         let (extent, k, eye) = (self.extent_m(), camera.scale() as f64, camera.eye());
-        let tree = self.tree();
         let mut out = Vec::with_capacity(sel.chunks.len());
         let mut stack: Vec<ChunkRef> = sel.chunks.iter().rev().copied().collect();
         let mut split = 0;
         while let Some(c) = stack.pop() {
-            let chunk = &tree.levels[c.depth as usize][c.index];
+            let chunk = self.chunk(c);
             let uv = uv_rect(self.grid(), chunk);
             let d = self.bounds(c).distance(eye) as f64;
             let l = wanted_level(extent, k, stream.map_texels, d, stream.levels);
             let n = ((stream.map_texels as u64) << l) as f64;
             let span = ((uv[1] - uv[0]).max(uv[3] - uv[2])) as f64 * n;
-            if span <= MAX_CHUNK_TEXELS as f64 || c.depth >= tree.max_depth {
+            if span <= MAX_CHUNK_TEXELS as f64 || c.depth >= self.max_depth() {
                 out.push(c);
                 continue;
             }
             split += 1;
-            let next = &tree.levels[c.depth as usize + 1];
+            let next = &self.levels()[c.depth as usize + 1];
             for (cx, cy) in [(1, 1), (0, 1), (1, 0), (0, 0)] {
                 let key = (2 * chunk.iy + cy, 2 * chunk.ix + cx);
                 if let Ok(i) = next.binary_search_by_key(&key, |ch| (ch.iy, ch.ix)) {
@@ -499,7 +499,7 @@ impl FlightTerrain {
         let mut plan: Vec<(ChunkRef, u32, [f32; 4])> = chunks
             .iter()
             .map(|&c| {
-                let uv = uv_rect(self.grid(), &self.tree().levels[c.depth as usize][c.index]);
+                let uv = uv_rect(self.grid(), self.chunk(c));
                 let d = self.bounds(c).distance(eye) as f64;
                 let l = wanted_level(extent, k, stream.map_texels, d, stream.levels);
                 (c, l, uv)
@@ -548,7 +548,7 @@ impl FlightTerrain {
         scratch: &mut FrameScratch,
         state: &DrawState,
     ) -> Result<texmap_raster::DrawStats, ViewError> {
-        let m = &self.tree().levels[c.depth as usize][c.index].mesh;
+        let m = self.mesh(c)?;
         let n = tex.level_side as f64;
         let (sx, sy) = (n / tex.width as f64, n / tex.height as f64);
         let (ox, oy) = (

@@ -39,9 +39,15 @@
 //! ([`FrameStats::maps_needed`]) and can be made resident in a separate cache
 //! ([`FlightTerrain::make_resident`]) to measure what a cache-fed renderer would hold.
 //!
-//! **Chunks.** [`FlightTerrain::from_database`] rebuilds the chunk quadtree from the stored grid
-//! with the manifest's error and chunk size (the same function the build wrote the chunk files
-//! with), rather than reading the chunk files.
+//! **Chunks.** [`FlightTerrain::open`] (and [`FlightTerrain::from_database`], with a default
+//! budget) does not read the grid or rebuild the quadtree: selection runs on the boxes and errors
+//! the manifest records per chunk, the grid is mapped ([`Grid::map_file`]) so the ground under the
+//! eye touches a few pages, and a frame's chunk meshes are read from their files when it selects
+//! them ([`FlightTerrain::prepare`], misses read in parallel), kept in a least-recently-used set
+//! under a byte budget ([`ChunkCacheStats`] in [`FrameStats::chunk_cache`]). The files hold the
+//! meshes the in-memory build makes, so a paged frame is the resident frame byte for byte. A
+//! terrain made with [`FlightTerrain::new`] holds every mesh; so does a database whose manifest
+//! predates the per-chunk boxes (its quadtree is rebuilt from the grid).
 //!
 //! Frames are deterministic: selection is a sequential walk, and the rasteriser's output does not
 //! depend on the thread count.
@@ -81,10 +87,14 @@ use crate::dem::Grid;
 use crate::error::TerrainError;
 use crate::gst;
 use glam::{DVec3, Vec2, Vec3};
+use rayon::prelude::*;
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex};
 use texmap_core::camera::{Camera, CameraError};
 use texmap_core::coverage::ActiveArea;
 use texmap_core::mip::{MipError, MipTexture, Reduction, Wrap};
 use texmap_core::sample::{Banks, Sampler};
+use texmap_mesh::TriMesh;
 use texmap_raster::{
     Cull, DrawState, DrawStats, Framebuffer, Mesh, MipSampler, QuadSampler, RasterError,
 };
@@ -387,14 +397,14 @@ pub fn ground_height(grid: &Grid, col: f64, row: f64) -> Option<f64> {
 }
 
 /// An axis-aligned box in local metres.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Aabb {
     pub min: Vec3,
     pub max: Vec3,
 }
 
 impl Aabb {
-    fn of(points: &[Vec3]) -> Aabb {
+    pub(crate) fn of(points: &[Vec3]) -> Aabb {
         let mut b = Aabb {
             min: Vec3::splat(f32::INFINITY),
             max: Vec3::splat(f32::NEG_INFINITY),
@@ -456,7 +466,7 @@ impl Frustum {
 }
 
 /// A chunk chosen for a frame: its depth and its index in `tree.levels[depth]`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct ChunkRef {
     pub depth: u32,
     pub index: usize,
@@ -504,6 +514,9 @@ pub struct FrameStats {
     pub maps_loaded: Option<u64>,
     pub cache_bytes: Option<u64>,
     pub chunk_texture_bytes: Option<u64>,
+    /// Paged terrains only ([`FlightTerrain::open`]): the chunk-mesh cache after the frame
+    /// (its counters accumulate over the terrain's frames).
+    pub chunk_cache: Option<ChunkCacheStats>,
 }
 
 /// Options of a frame.
@@ -542,49 +555,289 @@ impl FrameScratch {
     }
 }
 
-/// A terrain ready to be flown over: grid (for the ground under the eye), chunk quadtree with
-/// bounding boxes, and the whole-terrain texture.
+/// What a renderer needs of a chunk to choose it, without its mesh: cell, error, triangle count
+/// and bounding box (surface and skirts).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ChunkInfo {
+    /// Cell index at its depth (column, row).
+    pub ix: u32,
+    pub iy: u32,
+    /// Sample coordinates of the cell's north-west corner and its side in samples.
+    pub x0: u32,
+    pub y0: u32,
+    pub size: u32,
+    /// Metres (see [`crate::chunks::Chunk::geometric_error`]).
+    pub geometric_error: f32,
+    pub surface_triangles: u32,
+    pub bounds: Aabb,
+}
+
+/// Where the chunk meshes live.
+#[derive(Debug)]
+enum Meshes {
+    /// All of them in memory (`[depth][index]`).
+    Resident(Vec<Vec<TriMesh>>),
+    /// Read from the database's chunk files when a frame selects them.
+    Paged(ChunkPager),
+}
+
+/// A chunk mesh borrowed from a resident tree or shared from the pager's cache.
+#[derive(Debug)]
+pub enum ChunkMesh<'a> {
+    Borrowed(&'a TriMesh),
+    Shared(Arc<TriMesh>),
+}
+
+impl std::ops::Deref for ChunkMesh<'_> {
+    type Target = TriMesh;
+    fn deref(&self) -> &TriMesh {
+        match self {
+            ChunkMesh::Borrowed(m) => m,
+            ChunkMesh::Shared(m) => m,
+        }
+    }
+}
+
+/// The chunk-mesh cache's counters ([`FlightTerrain::chunk_cache`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct ChunkCacheStats {
+    /// Selected chunks found resident, and read from their files.
+    pub hits: u64,
+    pub loads: u64,
+    /// Chunks dropped to keep the cache under its budget.
+    pub evictions: u64,
+    /// Chunks and mesh bytes resident now, and the budget.
+    pub resident: u64,
+    pub resident_bytes: u64,
+    pub budget_bytes: u64,
+}
+
+/// Chunk meshes read from a database on demand and kept in a least-recently-used set under a
+/// byte budget (the chunks of the current frame are never evicted, so one frame may exceed it).
+#[derive(Debug)]
+struct ChunkPager {
+    db: Database,
+    state: Mutex<PagerState>,
+}
+
+#[derive(Debug, Default)]
+struct PagerState {
+    /// `(depth, index)` -> (mesh, bytes, frame it was last used in).
+    resident: HashMap<(u32, usize), (Arc<TriMesh>, u64, u64)>,
+    frame: u64,
+    stats: ChunkCacheStats,
+}
+
+/// Bytes a chunk mesh holds (positions, uvs, triangles).
+fn mesh_bytes(m: &TriMesh) -> u64 {
+    (m.positions.len() * 20 + m.triangles.len() * 12) as u64
+}
+
+impl ChunkPager {
+    /// Make the meshes of `chunks` resident (misses read in parallel), then evict the least
+    /// recently used others while over budget.
+    fn prepare(&self, chunks: &[ChunkRef]) -> Result<(), ViewError> {
+        let mut st = self.state.lock().unwrap_or_else(|e| e.into_inner());
+        st.frame += 1;
+        let frame = st.frame;
+        let mut misses = Vec::new();
+        for c in chunks {
+            match st.resident.get_mut(&(c.depth, c.index)) {
+                Some(e) => {
+                    e.2 = frame;
+                    st.stats.hits += 1;
+                }
+                None => misses.push(*c),
+            }
+        }
+        let entries = &self.db.manifest.levels;
+        let loaded: Vec<Result<TriMesh, TerrainError>> = misses
+            .par_iter()
+            .map(|c| {
+                self.db
+                    .read_chunk(&entries[c.depth as usize].chunks[c.index])
+            })
+            .collect();
+        for (c, m) in misses.iter().zip(loaded) {
+            let m = m?;
+            let bytes = mesh_bytes(&m);
+            st.stats.resident_bytes += bytes;
+            st.stats.loads += 1;
+            st.resident
+                .insert((c.depth, c.index), (Arc::new(m), bytes, frame));
+        }
+        if st.stats.resident_bytes > st.stats.budget_bytes {
+            // Oldest first, ties by key: deterministic.
+            let mut old: Vec<(u64, (u32, usize), u64)> = st
+                .resident
+                .iter()
+                .filter(|(_, e)| e.2 < frame)
+                .map(|(k, e)| (e.2, *k, e.1))
+                .collect();
+            old.sort_unstable();
+            for (_, key, bytes) in old {
+                if st.stats.resident_bytes <= st.stats.budget_bytes {
+                    break;
+                }
+                st.resident.remove(&key);
+                st.stats.resident_bytes -= bytes;
+                st.stats.evictions += 1;
+            }
+        }
+        st.stats.resident = st.resident.len() as u64;
+        Ok(())
+    }
+
+    fn get(&self, c: ChunkRef) -> Result<Arc<TriMesh>, ViewError> {
+        if let Some(e) = self
+            .state
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .resident
+            .get(&(c.depth, c.index))
+        {
+            return Ok(e.0.clone());
+        }
+        // Not prepared (a caller drawing chunks it did not select): read it, do not cache it.
+        let entry = &self.db.manifest.levels[c.depth as usize].chunks[c.index];
+        Ok(Arc::new(self.db.read_chunk(entry)?))
+    }
+}
+
+/// The default byte budget of the chunk-mesh cache of a paged terrain
+/// ([`FlightTerrain::from_database`]).
+pub const DEFAULT_CHUNK_BUDGET: u64 = 128 << 20;
+
+/// A terrain ready to be flown over: the grid (for the ground under the eye), the chunk
+/// quadtree's boxes and errors, the chunk meshes (resident, or paged from a database) and the
+/// whole-terrain texture.
 #[derive(Debug)]
 pub struct FlightTerrain {
     grid: Grid,
-    tree: ChunkTree,
-    /// `bounds[d][i]` = the box of `tree.levels[d][i]` (surface and skirts).
-    bounds: Vec<Vec<Aabb>>,
+    max_depth: u32,
+    /// `chunks[d]` = the chunks at depth `d`, in row-major cell order.
+    chunks: Vec<Vec<ChunkInfo>>,
+    meshes: Meshes,
     texture: MipTexture,
     /// GST map side and level count, when the terrain comes from a database with maps.
     maps: Option<(u32, u32)>,
 }
 
 impl FlightTerrain {
-    /// A terrain from its parts. `texture` spans the grid's extent (uv `[0, 1]²`, the chunks'
-    /// texture coordinates).
+    /// A terrain from its parts, every chunk mesh in memory. `texture` spans the grid's extent
+    /// (uv `[0, 1]²`, the chunks' texture coordinates).
     pub fn new(grid: Grid, tree: ChunkTree, texture: MipTexture) -> FlightTerrain {
-        let bounds = tree
-            .levels
-            .iter()
-            .map(|l| l.iter().map(|c| Aabb::of(&c.mesh.positions)).collect())
-            .collect();
+        let mut chunks = Vec::with_capacity(tree.levels.len());
+        let mut meshes = Vec::with_capacity(tree.levels.len());
+        for level in tree.levels {
+            let mut infos = Vec::with_capacity(level.len());
+            let mut ms = Vec::with_capacity(level.len());
+            for c in level {
+                infos.push(ChunkInfo {
+                    ix: c.ix,
+                    iy: c.iy,
+                    x0: c.x0,
+                    y0: c.y0,
+                    size: c.size,
+                    geometric_error: c.geometric_error,
+                    surface_triangles: c.surface_triangles,
+                    bounds: Aabb::of(&c.mesh.positions),
+                });
+                ms.push(c.mesh);
+            }
+            chunks.push(infos);
+            meshes.push(ms);
+        }
         FlightTerrain {
             grid,
-            tree,
-            bounds,
+            max_depth: tree.max_depth,
+            chunks,
+            meshes: Meshes::Resident(meshes),
             texture,
             maps: None,
         }
     }
 
-    /// Open a database: its grid, the chunk quadtree rebuilt at the manifest's error and chunk
-    /// size, and the finest texture level whose side is at most `max_texture_side` (a height-
-    /// coloured texture when the database has no photo).
+    /// Open a database with the default chunk budget ([`DEFAULT_CHUNK_BUDGET`]); see
+    /// [`FlightTerrain::open`].
     pub fn from_database(db: &Database, max_texture_side: u32) -> Result<FlightTerrain, ViewError> {
-        let grid = db.grid()?;
+        FlightTerrain::open(db, max_texture_side, DEFAULT_CHUNK_BUDGET)
+    }
+
+    /// Open a database for flight: the grid mapped, not read ([`Grid::map_file`]), the chunk
+    /// boxes and errors from the manifest, the chunk meshes read from their files when a frame
+    /// selects them and kept under `chunk_budget` bytes, and the finest texture level whose side
+    /// is at most `max_texture_side` (a height-coloured texture when the database has no photo).
+    /// A database whose manifest predates chunk boxes is opened the old way: its grid read and
+    /// the quadtree rebuilt in memory (the same meshes).
+    pub fn open(
+        db: &Database,
+        max_texture_side: u32,
+        chunk_budget: u64,
+    ) -> Result<FlightTerrain, ViewError> {
         let m = &db.manifest;
-        let tree = crate::chunks::build(&grid, m.max_error, m.chunk)?;
-        let texture = match db.texture(max_texture_side)? {
-            Some(img) => texture_from_rgba(&img)?,
-            None => height_texture(&grid, max_texture_side.clamp(1, 2048))?,
+        let paged = m
+            .levels
+            .iter()
+            .all(|l| l.chunks.iter().all(|c| c.bounds.is_some()));
+        let mut t = if paged {
+            let grid = db.grid_mapped()?;
+            let texture = match db.texture(max_texture_side)? {
+                Some(img) => texture_from_rgba(&img)?,
+                None => height_texture(&grid, max_texture_side.clamp(1, 2048))?,
+            };
+            let chunks = m
+                .levels
+                .iter()
+                .map(|l| {
+                    l.chunks
+                        .iter()
+                        .map(|c| {
+                            let b = c.bounds.unwrap_or_default();
+                            ChunkInfo {
+                                ix: c.ix,
+                                iy: c.iy,
+                                x0: c.x0,
+                                y0: c.y0,
+                                size: c.size,
+                                geometric_error: c.geometric_error,
+                                surface_triangles: c.triangles,
+                                bounds: Aabb {
+                                    min: Vec3::new(b[0], b[1], b[2]),
+                                    max: Vec3::new(b[3], b[4], b[5]),
+                                },
+                            }
+                        })
+                        .collect()
+                })
+                .collect();
+            let pager = ChunkPager {
+                db: db.clone(),
+                state: Mutex::new(PagerState {
+                    stats: ChunkCacheStats {
+                        budget_bytes: chunk_budget,
+                        ..ChunkCacheStats::default()
+                    },
+                    ..PagerState::default()
+                }),
+            };
+            FlightTerrain {
+                grid,
+                max_depth: m.levels.len().saturating_sub(1) as u32,
+                chunks,
+                meshes: Meshes::Paged(pager),
+                texture,
+                maps: None,
+            }
+        } else {
+            let grid = db.grid()?;
+            let tree = crate::chunks::build(&grid, m.max_error, m.chunk)?;
+            let texture = match db.texture(max_texture_side)? {
+                Some(img) => texture_from_rgba(&img)?,
+                None => height_texture(&grid, max_texture_side.clamp(1, 2048))?,
+            };
+            FlightTerrain::new(grid, tree, texture)
         };
-        let mut t = FlightTerrain::new(grid, tree, texture);
         t.maps = m.texture.as_ref().map(|t| (t.map_texels, t.levels));
         Ok(t)
     }
@@ -592,20 +845,54 @@ impl FlightTerrain {
     pub fn grid(&self) -> &Grid {
         &self.grid
     }
-    pub fn tree(&self) -> &ChunkTree {
-        &self.tree
+    /// The finest depth of the quadtree.
+    pub fn max_depth(&self) -> u32 {
+        self.max_depth
+    }
+    /// `levels()[d]` = the chunks at depth `d`, in row-major cell order.
+    pub fn levels(&self) -> &[Vec<ChunkInfo>] {
+        &self.chunks
+    }
+    /// The chunk `c` refers to.
+    pub fn chunk(&self, c: ChunkRef) -> &ChunkInfo {
+        &self.chunks[c.depth as usize][c.index]
+    }
+    /// True when chunk meshes are read from the database on demand.
+    pub fn is_paged(&self) -> bool {
+        matches!(self.meshes, Meshes::Paged(_))
+    }
+    /// The chunk-mesh cache's counters (`None` when every mesh is resident).
+    pub fn chunk_cache(&self) -> Option<ChunkCacheStats> {
+        match &self.meshes {
+            Meshes::Resident(_) => None,
+            Meshes::Paged(p) => Some(p.state.lock().unwrap_or_else(|e| e.into_inner()).stats),
+        }
+    }
+    /// Make the meshes of `chunks` resident (a paged terrain reads its misses; a resident one
+    /// has nothing to do). [`FlightTerrain::render`] calls it for its selection.
+    pub fn prepare(&self, chunks: &[ChunkRef]) -> Result<(), ViewError> {
+        match &self.meshes {
+            Meshes::Resident(_) => Ok(()),
+            Meshes::Paged(p) => p.prepare(chunks),
+        }
+    }
+    /// The mesh of chunk `c` (read from its file if a paged terrain did not prepare it).
+    pub fn mesh(&self, c: ChunkRef) -> Result<ChunkMesh<'_>, ViewError> {
+        match &self.meshes {
+            Meshes::Resident(m) => Ok(ChunkMesh::Borrowed(&m[c.depth as usize][c.index])),
+            Meshes::Paged(p) => Ok(ChunkMesh::Shared(p.get(c)?)),
+        }
     }
     pub fn texture(&self) -> &MipTexture {
         &self.texture
     }
-    /// The bounding box of `tree().levels[depth][index]`.
+    /// The bounding box of chunk `c`.
     pub fn bounds(&self, c: ChunkRef) -> Aabb {
-        self.bounds[c.depth as usize][c.index]
+        self.chunk(c).bounds
     }
 
     fn index_of(&self, depth: u32, ix: u32, iy: u32) -> Option<usize> {
-        self.tree
-            .levels
+        self.chunks
             .get(depth as usize)?
             .binary_search_by_key(&(iy, ix), |c| (c.iy, c.ix))
             .ok()
@@ -618,7 +905,7 @@ impl FlightTerrain {
         let k = camera.scale();
         let eye = camera.eye();
         let mut sel = Selection {
-            chunks_per_level: vec![0; self.tree.levels.len()],
+            chunks_per_level: vec![0; self.chunks.len()],
             ..Selection::default()
         };
         let mut stack: Vec<(u32, u32, u32)> = vec![(0, 0, 0)];
@@ -628,14 +915,13 @@ impl FlightTerrain {
                 continue;
             };
             sel.visited += 1;
-            let b = self.bounds[d as usize][i];
-            if frustum.culls(&b) {
+            let c = &self.chunks[d as usize][i];
+            if frustum.culls(&c.bounds) {
                 sel.culled += 1;
                 continue;
             }
-            let c = &self.tree.levels[d as usize][i];
-            let sse = screen_space_error(c.geometric_error, b.distance(eye), k);
-            if sse > pixel_error && d < self.tree.max_depth {
+            let sse = screen_space_error(c.geometric_error, c.bounds.distance(eye), k);
+            if sse > pixel_error && d < self.max_depth {
                 for (cx, cy) in [(1, 1), (0, 1), (1, 0), (0, 0)] {
                     stack.push((d + 1, 2 * ix + cx, 2 * iy + cy));
                 }
@@ -655,7 +941,12 @@ impl FlightTerrain {
 
     /// Concatenate the selected chunks' meshes (positions, uvs, triangles with offset indices)
     /// into `scratch`, in the selection's order; returns the triangle count.
-    pub fn gather(&self, selection: &Selection, scratch: &mut FrameScratch) -> usize {
+    pub fn gather(
+        &self,
+        selection: &Selection,
+        scratch: &mut FrameScratch,
+    ) -> Result<usize, ViewError> {
+        self.prepare(&selection.chunks)?;
         let FrameScratch {
             positions,
             uvs,
@@ -665,7 +956,7 @@ impl FlightTerrain {
         uvs.clear();
         triangles.clear();
         for c in &selection.chunks {
-            let m = &self.tree.levels[c.depth as usize][c.index].mesh;
+            let m = self.mesh(*c)?;
             let base = positions.len() as u32;
             positions.extend_from_slice(&m.positions);
             match &m.uvs {
@@ -674,7 +965,7 @@ impl FlightTerrain {
             }
             triangles.extend(m.triangles.iter().map(|t| t.map(|v| v + base)));
         }
-        triangles.len()
+        Ok(triangles.len())
     }
 
     /// Concatenate the selected chunks' meshes into `scratch` and draw them with `sampler` into
@@ -687,7 +978,7 @@ impl FlightTerrain {
         fb: &mut Framebuffer,
         scratch: &mut FrameScratch,
     ) -> Result<DrawStats, ViewError> {
-        self.gather(selection, scratch);
+        self.gather(selection, scratch)?;
         let FrameScratch {
             positions,
             uvs,
@@ -743,8 +1034,9 @@ impl FlightTerrain {
         stats.surface_triangles = sel
             .chunks
             .iter()
-            .map(|c| self.tree.levels[c.depth as usize][c.index].surface_triangles as u64)
+            .map(|c| self.chunk(*c).surface_triangles as u64)
             .sum();
+        stats.chunk_cache = self.chunk_cache();
         stats.maps_needed = self.needed_maps(view).map(|k| k.len() as u64);
         Ok(stats)
     }

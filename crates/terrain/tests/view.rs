@@ -196,8 +196,8 @@ fn hills_terrain() -> FlightTerrain {
 }
 
 fn is_ancestor(t: &FlightTerrain, a: ChunkRef, b: ChunkRef) -> bool {
-    let ca = &t.tree().levels[a.depth as usize][a.index];
-    let cb = &t.tree().levels[b.depth as usize][b.index];
+    let ca = t.chunk(a);
+    let cb = t.chunk(b);
     a.depth < b.depth
         && cb.ix >> (b.depth - a.depth) == ca.ix
         && cb.iy >> (b.depth - a.depth) == ca.iy
@@ -220,17 +220,17 @@ fn selection_refines_near_the_eye_and_coarsens_far_away() {
     let cam = v.camera(t.grid()).unwrap();
     let tol = 1.0;
     let sel = t.select(&cam, tol);
-    let max_depth = t.tree().max_depth;
+    let max_depth = t.max_depth();
     assert!(sel.chunks.len() > 4);
     // The rule, checked on every drawn chunk: its error is within tolerance unless it is a
     // finest chunk, and its parent's was not.
     let k = cam.scale();
     for &c in &sel.chunks {
-        let ch = &t.tree().levels[c.depth as usize][c.index];
+        let ch = t.chunk(c);
         let sse = screen_space_error(ch.geometric_error, t.bounds(c).distance(cam.eye()), k);
         assert!(sse <= tol || c.depth == max_depth, "{c:?} sse {sse}");
         if c.depth > 0 {
-            let l = &t.tree().levels[c.depth as usize - 1];
+            let l = &t.levels()[c.depth as usize - 1];
             let pi = l
                 .iter()
                 .position(|p| p.ix == ch.ix / 2 && p.iy == ch.iy / 2)
@@ -280,12 +280,7 @@ fn selection_refines_near_the_eye_and_coarsens_far_away() {
     let tris = |s: &texmap_terrain::view::Selection| -> usize {
         s.chunks
             .iter()
-            .map(|c| {
-                t.tree().levels[c.depth as usize][c.index]
-                    .mesh
-                    .triangles
-                    .len()
-            })
+            .map(|c| t.mesh(*c).unwrap().triangles.len())
             .sum()
     };
     assert!(tris(&fine) > tris(&sel));

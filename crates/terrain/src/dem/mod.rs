@@ -120,12 +120,71 @@ impl Georef {
 /// # Guarantees
 /// `width, height ≥ 2`, `width·height ≤ MAX_SAMPLES`, every sample finite or `NaN` (no-data), at
 /// least one finite sample.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 pub struct Grid {
     width: u32,
     height: u32,
-    heights: Vec<f32>,
+    heights: Heights,
     georef: Georef,
+    /// Lowest and highest valid height (`height_range`), found once.
+    range: (f32, f32),
+}
+
+impl PartialEq for Grid {
+    fn eq(&self, o: &Grid) -> bool {
+        self.width == o.width
+            && self.height == o.height
+            && self.georef == o.georef
+            && self.heights() == o.heights()
+    }
+}
+
+/// Where a grid's samples live: in memory, or in a database's `grid.f32` mapped into the address
+/// space ([`Grid::map_file`]), so that a flight over a grid larger than memory touches only the
+/// pages under the eye, the models and the path.
+#[derive(Clone, Debug)]
+enum Heights {
+    Owned(Vec<f32>),
+    Mapped(std::sync::Arc<memmap2::Mmap>),
+}
+
+impl Heights {
+    fn as_slice(&self) -> &[f32] {
+        match self {
+            Heights::Owned(v) => v,
+            Heights::Mapped(m) => {
+                let bytes: &[u8] = m;
+                // SAFETY: `map_file` maps only on little-endian targets, checked the length is a
+                // multiple of 4 and the start 4-aligned (a mapping starts on a page), and every
+                // bit pattern is a valid f32.
+                unsafe { std::slice::from_raw_parts(bytes.as_ptr().cast::<f32>(), bytes.len() / 4) }
+            }
+        }
+    }
+
+    fn to_mut(&mut self) -> &mut Vec<f32> {
+        if let Heights::Mapped(m) = self {
+            let owned = Heights::Mapped(m.clone()).as_slice().to_vec();
+            *self = Heights::Owned(owned);
+        }
+        match self {
+            Heights::Owned(v) => v,
+            Heights::Mapped(_) => unreachable!("converted to owned above"),
+        }
+    }
+}
+
+/// Lowest and highest non-NaN value (`(inf, -inf)` when there is none).
+fn range_of(heights: &[f32]) -> (f32, f32) {
+    let mut lo = f32::INFINITY;
+    let mut hi = f32::NEG_INFINITY;
+    for &h in heights {
+        if !h.is_nan() {
+            lo = lo.min(h);
+            hi = hi.max(h);
+        }
+    }
+    (lo, hi)
 }
 
 /// Check a size claimed by a header before allocating for it.
@@ -196,11 +255,76 @@ impl Grid {
                 format!("finite origin and non-zero finite spacing, got {georef:?}"),
             ));
         }
+        let range = range_of(&heights);
+        Ok(Grid {
+            width,
+            height,
+            heights: Heights::Owned(heights),
+            georef,
+            range,
+        })
+    }
+
+    /// A grid over the little-endian `f32` samples of `path` (a database's `grid.f32`), mapped
+    /// rather than read: only the pages a caller touches are loaded, so opening a 16k² grid costs
+    /// no memory until heights are asked for. `range` is the file's lowest and highest valid
+    /// height, as recorded when it was written; the samples are not scanned again (a database
+    /// build validated them). On big-endian targets the file is read into memory instead.
+    ///
+    /// The file must not be changed while the grid is alive (a truncated mapping faults).
+    pub fn map_file(
+        path: &Path,
+        width: u32,
+        height: u32,
+        georef: Georef,
+        range: (f32, f32),
+    ) -> Result<Grid, TerrainError> {
+        let source = path.display().to_string();
+        check_size(&source, width as u64, height as u64)?;
+        if !(range.0.is_finite() && range.1.is_finite() && range.0 <= range.1) {
+            return Err(crate::error::format_err(
+                &source,
+                "height range",
+                format!("finite lowest ≤ highest height, got {range:?}"),
+            ));
+        }
+        let want = width as u64 * height as u64 * 4;
+        let file = std::fs::File::open(path).map_err(crate::error::io(path))?;
+        let len = file.metadata().map_err(crate::error::io(path))?.len();
+        if len != want {
+            return Err(crate::error::format_err(
+                &source,
+                "file size",
+                format!("{want} bytes for {width} x {height} f32, got {len}"),
+            ));
+        }
+        let heights = if cfg!(target_endian = "little") {
+            // SAFETY: the mapping is read-only and the database directory is not written while a
+            // terrain is open (documented above).
+            let map = unsafe { memmap2::Mmap::map(&file) }.map_err(crate::error::io(path))?;
+            if map.as_ptr().align_offset(4) != 0 {
+                return Err(crate::error::format_err(
+                    &source,
+                    "mapping",
+                    "a 4-byte aligned mapping",
+                ));
+            }
+            Heights::Mapped(std::sync::Arc::new(map))
+        } else {
+            let bytes = std::fs::read(path).map_err(crate::error::io(path))?;
+            Heights::Owned(
+                bytes
+                    .chunks_exact(4)
+                    .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+                    .collect(),
+            )
+        };
         Ok(Grid {
             width,
             height,
             heights,
             georef,
+            range,
         })
     }
 
@@ -241,30 +365,22 @@ impl Grid {
     }
     /// Row-major heights, `NaN` = no-data.
     pub fn heights(&self) -> &[f32] {
-        &self.heights
+        self.heights.as_slice()
     }
     pub fn georef(&self) -> &Georef {
         &self.georef
     }
     /// Height of sample `(col, row)` (`NaN` = no-data). Panics if out of range.
     pub fn at(&self, col: u32, row: u32) -> f32 {
-        self.heights[row as usize * self.width as usize + col as usize]
+        self.heights()[row as usize * self.width as usize + col as usize]
     }
     /// Number of no-data samples.
     pub fn nodata_count(&self) -> u64 {
-        self.heights.iter().filter(|h| h.is_nan()).count() as u64
+        self.heights().iter().filter(|h| h.is_nan()).count() as u64
     }
     /// Lowest and highest valid height.
     pub fn height_range(&self) -> (f32, f32) {
-        let mut lo = f32::INFINITY;
-        let mut hi = f32::NEG_INFINITY;
-        for &h in &self.heights {
-            if !h.is_nan() {
-                lo = lo.min(h);
-                hi = hi.max(h);
-            }
-        }
-        (lo, hi)
+        self.range
     }
 
     /// Fill no-data samples from their neighbours: repeated passes in which every no-data sample
@@ -272,7 +388,8 @@ impl Grid {
     /// hole's rim inwards; deterministic, since each pass reads only the previous pass's values).
     pub fn fill_nodata(&mut self) {
         let (w, h) = (self.width as usize, self.height as usize);
-        let mut todo: Vec<usize> = (0..w * h).filter(|&i| self.heights[i].is_nan()).collect();
+        let heights = self.heights.to_mut();
+        let mut todo: Vec<usize> = (0..w * h).filter(|&i| heights[i].is_nan()).collect();
         while !todo.is_empty() {
             let mut updates = Vec::with_capacity(todo.len());
             for &i in &todo {
@@ -287,7 +404,7 @@ impl Grid {
                             && (nx as usize) < w
                             && (ny as usize) < h
                         {
-                            let v = self.heights[ny as usize * w + nx as usize];
+                            let v = heights[ny as usize * w + nx as usize];
                             if !v.is_nan() {
                                 sum += v as f64;
                                 n += 1;
@@ -301,9 +418,9 @@ impl Grid {
             }
             // The grid has a valid sample (guaranteed), so every pass fills at least one.
             for &(i, v) in &updates {
-                self.heights[i] = v;
+                heights[i] = v;
             }
-            todo.retain(|&i| self.heights[i].is_nan());
+            todo.retain(|&i| heights[i].is_nan());
         }
     }
 }
