@@ -139,9 +139,13 @@ fn parse_orbit(
 }
 
 /// Open a database as a flight terrain.
-fn open(dir: &std::path::Path, max_texture: u32) -> Result<(Database, FlightTerrain)> {
+fn open(
+    dir: &std::path::Path,
+    max_texture: u32,
+    chunk_budget: u64,
+) -> Result<(Database, FlightTerrain)> {
     let db = Database::open(dir)?;
-    let terrain = FlightTerrain::from_database(&db, max_texture)
+    let terrain = FlightTerrain::open(&db, max_texture, chunk_budget)
         .with_context(|| format!("{}: cannot open the terrain", dir.display()))?;
     Ok((db, terrain))
 }
@@ -151,7 +155,7 @@ pub fn run_fly(a: FlyArgs) -> Result<()> {
     if a.path.is_none() && a.orbit.is_none() {
         return usage("terrain fly: give --path FILE or --orbit FRAMES[,RADIUS[,HEIGHT[,PITCH]]]");
     }
-    let (db, terrain) = open(&a.dir, a.view.whole_texture_side())?;
+    let (db, terrain) = open(&a.dir, a.view.whole_texture_side(), a.view.chunk_budget())?;
     let template = FlightCamera {
         hfov_deg: a.view.fov,
         width,
@@ -269,7 +273,14 @@ pub fn run_compare(a: CompareArgs) -> Result<()> {
     }
     let terrain = match (&a.dir, a.builtin) {
         (_, Some(side)) => study::builtin_terrain(side, 4 * side.saturating_sub(1))?,
-        (Some(dir), None) => open(dir, a.max_texture)?.1,
+        (Some(dir), None) => {
+            open(
+                dir,
+                a.max_texture,
+                texmap_terrain::view::DEFAULT_CHUNK_BUDGET,
+            )?
+            .1
+        }
         (None, None) => return usage("terrain compare: give a database DIR or --builtin SIDE"),
     };
     let template = FlightCamera {

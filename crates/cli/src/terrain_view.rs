@@ -46,6 +46,11 @@ pub struct FlightViewArgs {
     /// needs, maps and chunk textures held under --cache-mb).
     #[arg(long, default_value = "whole")]
     pub texture: String,
+    /// Chunk-mesh cache budget, MiB: a database's chunk meshes are read from its files when a
+    /// view selects them and the least recently used are dropped above this (the frame's own
+    /// chunks always stay).
+    #[arg(long, default_value_t = 128)]
+    pub chunk_cache_mb: u64,
     /// Models and trees drawn on the terrain.
     #[command(flatten)]
     pub objects: crate::terrain_models::ModelArgs,
@@ -87,6 +92,11 @@ impl FlightViewArgs {
     /// Whether frames are textured from the streamed GST maps.
     pub fn streamed(&self) -> bool {
         self.texture == "streamed"
+    }
+
+    /// The chunk-mesh cache budget in bytes.
+    pub fn chunk_budget(&self) -> u64 {
+        self.chunk_cache_mb.saturating_mul(1 << 20)
     }
 
     /// The side limit of the whole texture to open the terrain with (the coarsest level when
@@ -185,8 +195,8 @@ pub fn run(a: RenderArgs) -> Result<()> {
     };
     let db = Database::open(&a.dir)?;
     let t0 = Instant::now();
-    let terrain =
-        FlightTerrain::from_database(&db, a.view.whole_texture_side()).map_err(view_error)?;
+    let terrain = FlightTerrain::open(&db, a.view.whole_texture_side(), a.view.chunk_budget())
+        .map_err(view_error)?;
     let load_ms = t0.elapsed().as_secs_f64() * 1e3;
 
     let mut view = FlightCamera::over(terrain.grid());
