@@ -31,6 +31,12 @@ pub enum TerrainCmd {
         /// Samples per chunk side (2^k + 1).
         #[arg(long, default_value_t = 257)]
         chunk: u32,
+        /// Most GST texture levels (level L is 256·2^L texels a side): the finest level has a
+        /// texel per DEM sample and per photo pixel over the DEM, up to this many levels (8:
+        /// 32768² texels). A GeoTIFF photo is read a band of rows at a time, so its size
+        /// bounds only the build's time and the disk.
+        #[arg(long, default_value_t = 8)]
+        texture_levels: u32,
         /// Read a PNG as Mapbox Terrain-RGB.
         #[arg(long)]
         terrain_rgb: bool,
@@ -95,6 +101,7 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
             max_error,
             chunk,
             terrain_rgb,
+            texture_levels,
             scale,
             offset,
             cell,
@@ -136,17 +143,25 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
             if fill {
                 grid.fill_nodata();
             }
-            let photo = photo.map(|p| gst::read_photo(&p, bands)).transpose()?;
+            if !(1..=12).contains(&texture_levels) {
+                return usage(format!(
+                    "--texture-levels {texture_levels}: expected 1..=12"
+                ));
+            }
+            let photo = photo
+                .map(|p| texmap_terrain::photo::open_photo(&p, bands))
+                .transpose()?;
             let pb = crate::commands::progress(1, "building");
             let bo = BuildOptions {
                 max_error,
                 chunk,
+                max_texture_levels: texture_levels,
                 ..BuildOptions::default()
             };
-            let m = db::build(
+            let m = db::build_with(
                 &grid,
                 &dem.display().to_string(),
-                photo.as_ref(),
+                photo.as_deref(),
                 &bo,
                 &out,
                 |d, t| {

@@ -14,7 +14,7 @@
 use crate::chunks;
 use crate::dem::{Georef, Grid};
 use crate::error::{TerrainError, format_err, io};
-use crate::gst::{self, Orthophoto};
+use crate::gst::{self, Orthophoto, PhotoSource};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -197,6 +197,26 @@ pub fn build(
     photo: Option<&Orthophoto>,
     opts: &BuildOptions,
     out: &Path,
+    progress: impl FnMut(u64, u64),
+) -> Result<Manifest, TerrainError> {
+    build_with(
+        grid,
+        source,
+        photo.map(|p| p as &dyn PhotoSource),
+        opts,
+        out,
+        progress,
+    )
+}
+
+/// As [`build`], with the photo from any [`PhotoSource`] (a GeoTIFF read by rows:
+/// [`crate::photo::open_photo`]).
+pub fn build_with(
+    grid: &Grid,
+    source: &str,
+    photo: Option<&dyn PhotoSource>,
+    opts: &BuildOptions,
+    out: &Path,
     mut progress: impl FnMut(u64, u64),
 ) -> Result<Manifest, TerrainError> {
     if out.exists() {
@@ -236,15 +256,16 @@ fn write(path: &Path, bytes: &[u8]) -> Result<(), TerrainError> {
 fn build_into(
     grid: &Grid,
     source: &str,
-    photo: Option<&Orthophoto>,
+    photo: Option<&dyn PhotoSource>,
     opts: &BuildOptions,
     dir: &Path,
     progress: &mut impl FnMut(u64, u64),
 ) -> Result<Manifest, TerrainError> {
     std::fs::create_dir_all(dir).map_err(io(dir))?;
-    let tex_levels = photo
-        .map(|_| gst::level_count(grid, opts.map_texels, opts.max_texture_levels))
-        .unwrap_or(0);
+    let tex_levels = match photo {
+        Some(p) => gst::photo_level_count(p, grid, opts.map_texels, opts.max_texture_levels)?,
+        None => 0,
+    };
     let total = 3 + tex_levels as u64;
     let mut levels: Vec<LevelEntry> = Vec::new();
     // One band of chunks at a time: they go to disk and are dropped before the next is built.
@@ -299,37 +320,44 @@ fn build_into(
     }
     let texture = match photo {
         Some(p) => {
-            let size = opts.map_texels << (tex_levels - 1);
-            let pyr = gst::pyramid(gst::place(p, grid, size)?, opts.map_texels);
-            for (l, img) in pyr.levels.iter().enumerate() {
-                let n = img.width() / opts.map_texels;
-                for y in 0..n {
-                    for x in 0..n {
-                        let key = gst::MapKey {
-                            level: l as u32,
-                            x,
-                            y,
-                        };
-                        let map = pyr.map(key).expect("inside the level");
-                        let path = dir.join(format!("tiles/{l}/{x}_{y}.png"));
-                        if let Some(par) = path.parent() {
-                            std::fs::create_dir_all(par).map_err(io(par))?;
-                        }
-                        map.save(&path).map_err(|e| {
-                            format_err(
-                                &path.display().to_string(),
-                                "PNG encoding",
-                                format!("a writable file ({e})"),
-                            )
-                        })?;
-                    }
-                }
-                progress(3 + l as u64, total);
+            for l in 0..tex_levels {
+                let d = dir.join(format!("tiles/{l}"));
+                std::fs::create_dir_all(&d).map_err(io(&d))?;
             }
+            let tile = |k: gst::MapKey| dir.join(format!("tiles/{}/{}_{}.png", k.level, k.x, k.y));
+            let write = |k: gst::MapKey, map: &image::RgbaImage| {
+                let path = tile(k);
+                map.save(&path).map_err(|e| {
+                    format_err(
+                        &path.display().to_string(),
+                        "PNG encoding",
+                        format!("a writable file ({e})"),
+                    )
+                })
+            };
+            let read = |k: gst::MapKey| {
+                let path = tile(k);
+                Ok(image::open(&path)
+                    .map_err(|e| format_err(&path.display().to_string(), "PNG", e.to_string()))?
+                    .to_rgba8())
+            };
+            let mut done = 0;
+            gst::write_pyramid(
+                p,
+                grid,
+                opts.map_texels,
+                tex_levels,
+                &write,
+                &read,
+                &mut |_| {
+                    done += 1;
+                    progress(2 + done, total);
+                },
+            )?;
             Some(TextureEntry {
                 map_texels: opts.map_texels,
                 levels: tex_levels,
-                placed_by: if p.georef.is_some() {
+                placed_by: if p.georef().is_some() {
                     "georeference".into()
                 } else {
                     "stretched".into()

@@ -122,16 +122,14 @@ pub struct Pyramid {
     pub levels: Vec<RgbaImage>,
 }
 
-fn bilinear(img: &RgbaImage, x: f64, y: f64) -> [f64; 4] {
-    let (w, h) = (img.width() as i64, img.height() as i64);
+/// Bilinear sample at continuous pixel position `(x, y)` (pixel corners at integers) of a
+/// `w x h` image whose pixel `(i, j)` is `px(i, j)`, clamped at the image's edges.
+fn bilinear(w: i64, h: i64, px: impl Fn(u32, u32) -> [u8; 4], x: f64, y: f64) -> [f64; 4] {
     let (fx, fy) = (x - 0.5, y - 0.5);
     let (x0, y0) = (fx.floor(), fy.floor());
     let (ax, ay) = (fx - x0, fy - y0);
-    let px = |i: i64, j: i64| {
-        img.get_pixel(i.clamp(0, w - 1) as u32, j.clamp(0, h - 1) as u32)
-            .0
-            .map(|c| c as f64)
-    };
+    let px =
+        |i: i64, j: i64| px(i.clamp(0, w - 1) as u32, j.clamp(0, h - 1) as u32).map(|c| c as f64);
     let (x0, y0) = (x0 as i64, y0 as i64);
     let (a, b, c, d) = (
         px(x0, y0),
@@ -144,61 +142,232 @@ fn bilinear(img: &RgbaImage, x: f64, y: f64) -> [f64; 4] {
     })
 }
 
-/// Resample `photo` over the grid's extent into a `size x size` texture (see the module docs).
-pub fn place(photo: &Orthophoto, grid: &Grid, size: u32) -> Result<RgbaImage, TerrainError> {
-    let (pw, ph) = (photo.image.width() as f64, photo.image.height() as f64);
-    let g = grid.georef();
-    let (gw, gh) = ((grid.width() - 1) as f64, (grid.height() - 1) as f64);
-    // Photo pixel position (continuous, pixel corners at integers) of texture coordinates (u, v).
-    let to_photo = |u: f64, v: f64| -> (f64, f64) {
-        match &photo.georef {
+/// Where a photo lies over a grid: texture coordinates `(u, v)` over the DEM extent to photo
+/// pixel positions (see the module docs).
+struct Placement {
+    grid: Georef,
+    gw: f64,
+    gh: f64,
+    photo: Option<Georef>,
+    pw: f64,
+    ph: f64,
+}
+
+impl Placement {
+    fn new(
+        grid: &Grid,
+        size: (u32, u32),
+        georef: Option<Georef>,
+        source: &str,
+    ) -> Result<Placement, TerrainError> {
+        let p = Placement {
+            grid: *grid.georef(),
+            gw: (grid.width() - 1) as f64,
+            gh: (grid.height() - 1) as f64,
+            photo: georef,
+            pw: size.0 as f64,
+            ph: size.1 as f64,
+        };
+        if p.photo.is_some() {
+            // Overlap test on the extents (corners of the grid's sample-centre rectangle).
+            let corners = [p.to_photo(0.0, 0.0), p.to_photo(1.0, 1.0)];
+            let (cmin, cmax) = (
+                corners[0].0.min(corners[1].0),
+                corners[0].0.max(corners[1].0),
+            );
+            let (rmin, rmax) = (
+                corners[0].1.min(corners[1].1),
+                corners[0].1.max(corners[1].1),
+            );
+            if cmax <= 0.0 || rmax <= 0.0 || cmin >= p.pw || rmin >= p.ph {
+                return Err(TerrainError::NoOverlap {
+                    photo: source.to_string(),
+                    dem: "the elevation grid".into(),
+                });
+            }
+        }
+        Ok(p)
+    }
+
+    /// Photo pixel position (continuous, pixel corners at integers) of texture coordinates.
+    fn to_photo(&self, u: f64, v: f64) -> (f64, f64) {
+        match &self.photo {
             Some(pg) => {
-                let (x, y) = g.sample_xy(u * gw, v * gh);
+                let (x, y) = self.grid.sample_xy(u * self.gw, v * self.gh);
                 let (c, r) = pg.xy_to_sample(x, y);
                 (c + 0.5, r + 0.5)
             }
-            None => (u * pw, v * ph),
+            None => (u * self.pw, v * self.ph),
         }
-    };
-    if photo.georef.is_some() {
-        // Overlap test on the extents (corners of the grid's sample-centre rectangle).
-        let corners = [to_photo(0.0, 0.0), to_photo(1.0, 1.0)];
-        let (cmin, cmax) = (
-            corners[0].0.min(corners[1].0),
-            corners[0].0.max(corners[1].0),
-        );
-        let (rmin, rmax) = (
-            corners[0].1.min(corners[1].1),
-            corners[0].1.max(corners[1].1),
-        );
-        if cmax <= 0.0 || rmax <= 0.0 || cmin >= pw || rmin >= ph {
-            return Err(TerrainError::NoOverlap {
-                photo: photo.source.clone(),
-                dem: "the elevation grid".into(),
+    }
+
+    /// The texel of a `size`-sided texture at `(tx, ty)`: the photo sampled bilinearly through
+    /// `px`, transparent outside the photo.
+    fn texel(&self, size: u32, tx: u32, ty: u32, px: impl Fn(u32, u32) -> [u8; 4]) -> Rgba<u8> {
+        let inv = 1.0 / (size - 1).max(1) as f64;
+        let (x, y) = self.to_photo(tx as f64 * inv, ty as f64 * inv);
+        let inside = x >= 0.0 && y >= 0.0 && x <= self.pw && y <= self.ph;
+        if !inside {
+            return Rgba([0, 0, 0, 0]);
+        }
+        let c = bilinear(self.pw as i64, self.ph as i64, px, x, y);
+        Rgba([
+            c[0].round() as u8,
+            c[1].round() as u8,
+            c[2].round() as u8,
+            c[3].round() as u8,
+        ])
+    }
+
+    /// The photo rows bilinear reads for texture rows `ty0..ty1` of a `size`-sided texture
+    /// (`None` when none of them lies on the photo).
+    fn rows_for(&self, size: u32, ty0: u32, ty1: u32) -> Option<(u32, u32)> {
+        let inv = 1.0 / (size - 1).max(1) as f64;
+        let ys = [
+            self.to_photo(0.0, ty0 as f64 * inv).1,
+            self.to_photo(1.0, ty0 as f64 * inv).1,
+            self.to_photo(0.0, (ty1 - 1) as f64 * inv).1,
+            self.to_photo(1.0, (ty1 - 1) as f64 * inv).1,
+        ];
+        let lo = ys.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = ys.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        if hi < 0.0 || lo > self.ph {
+            return None;
+        }
+        let last = self.ph as i64 - 1;
+        let r0 = ((lo - 0.5).floor() as i64).clamp(0, last);
+        let r1 = ((hi - 0.5).floor() as i64 + 1).clamp(0, last);
+        Some((r0 as u32, r1 as u32 + 1))
+    }
+}
+
+/// Resample `photo` over the grid's extent into a `size x size` texture (see the module docs).
+pub fn place(photo: &Orthophoto, grid: &Grid, size: u32) -> Result<RgbaImage, TerrainError> {
+    let img = &photo.image;
+    let p = Placement::new(grid, img.dimensions(), photo.georef, &photo.source)?;
+    Ok(RgbaImage::from_fn(size, size, |tx, ty| {
+        p.texel(size, tx, ty, |i, j| img.get_pixel(i, j).0)
+    }))
+}
+
+/// Box-average four `T x T` child maps (north-west, north-east, south-west, south-east) into
+/// their parent map, in 8-bit sRGB as the tiles are stored (the same rule as [`pyramid`]).
+fn parent_map(children: &[RgbaImage; 4], t: u32) -> RgbaImage {
+    let h = t / 2;
+    RgbaImage::from_fn(t, t, |x, y| {
+        let child = &children[(y / h * 2 + x / h) as usize];
+        let (cx, cy) = (2 * (x % h), 2 * (y % h));
+        let mut s = [0u32; 4];
+        for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+            let p = child.get_pixel(cx + dx, cy + dy).0;
+            for k in 0..4 {
+                s[k] += p[k] as u32;
+            }
+        }
+        Rgba(s.map(|v| ((v + 2) / 4) as u8))
+    })
+}
+
+/// Make the GST pyramid of `photo` over `grid` map by map, never holding a level: the finest
+/// level (`levels − 1`) one row of maps at a time from the photo rows it needs
+/// ([`PhotoSource::rows`], read once per row of maps), each coarser map from its four children
+/// read back through `read`. Every map goes to `write` as it is made (maps of one row, or of one
+/// level, in parallel); `progress(level)` after each level, finest first. The maps equal those of
+/// `pyramid(place(photo, grid, T·2^(levels−1)), T)` byte for byte.
+pub fn write_pyramid(
+    photo: &dyn PhotoSource,
+    grid: &Grid,
+    map_texels: u32,
+    levels: u32,
+    write: &(dyn Fn(MapKey, &RgbaImage) -> Result<(), TerrainError> + Sync),
+    read: &(dyn Fn(MapKey) -> Result<RgbaImage, TerrainError> + Sync),
+    progress: &mut dyn FnMut(u32),
+) -> Result<(), TerrainError> {
+    use rayon::prelude::*;
+    let t = map_texels;
+    if levels == 0 || t < 2 || !t.is_power_of_two() {
+        return Err(TerrainError::BadParameter {
+            name: "map texels",
+            value: format!("{t} texels, {levels} levels"),
+            expected: "a power of two ≥ 2 and at least one level",
+        });
+    }
+    let finest = levels - 1;
+    let n = 1u32 << finest;
+    let size = t << finest;
+    let (pw, ph) = photo.size();
+    let p = Placement::new(grid, (pw, ph), photo.georef(), photo.source())?;
+    for y in 0..n {
+        let rows = p.rows_for(size, y * t, (y + 1) * t);
+        let band = match rows {
+            Some((r0, r1)) => photo.rows(r0, r1)?,
+            None => RgbaImage::new(pw, 0),
+        };
+        let r0 = rows.map_or(0, |r| r.0);
+        (0..n).into_par_iter().try_for_each(|x| {
+            let map = RgbaImage::from_fn(t, t, |i, j| {
+                // `rows_for` covers every row a texel on the photo reads.
+                p.texel(size, x * t + i, y * t + j, |a, b| {
+                    band.get_pixel_checked(a, b.wrapping_sub(r0))
+                        .map_or([0; 4], |px| px.0)
+                })
             });
-        }
+            write(
+                MapKey {
+                    level: finest,
+                    x,
+                    y,
+                },
+                &map,
+            )
+        })?;
     }
-    let mut out = RgbaImage::new(size, size);
-    let inv = 1.0 / (size - 1).max(1) as f64;
-    for ty in 0..size {
-        for tx in 0..size {
-            let (x, y) = to_photo(tx as f64 * inv, ty as f64 * inv);
-            let inside = x >= 0.0 && y >= 0.0 && x <= pw && y <= ph;
-            let p = if inside {
-                let c = bilinear(&photo.image, x, y);
-                Rgba([
-                    c[0].round() as u8,
-                    c[1].round() as u8,
-                    c[2].round() as u8,
-                    c[3].round() as u8,
-                ])
-            } else {
-                Rgba([0, 0, 0, 0])
+    progress(finest);
+    for level in (0..finest).rev() {
+        let m = 1u32 << level;
+        (0..m * m).into_par_iter().try_for_each(|i| {
+            let (x, y) = (i % m, i / m);
+            let child = |dx: u32, dy: u32| {
+                read(MapKey {
+                    level: level + 1,
+                    x: 2 * x + dx,
+                    y: 2 * y + dy,
+                })
             };
-            out.put_pixel(tx, ty, p);
-        }
+            let children = [child(0, 0)?, child(1, 0)?, child(0, 1)?, child(1, 1)?];
+            write(MapKey { level, x, y }, &parent_map(&children, t))
+        })?;
+        progress(level);
     }
-    Ok(out)
+    Ok(())
+}
+
+/// An orthophoto read by rows: its size, georeference and any band of full-width rows. The
+/// pyramid writer ([`write_pyramid`]) asks for the rows one row of maps needs, top to bottom, so
+/// a source may read them on demand ([`crate::photo::TiffPhoto`]) instead of holding the image.
+pub trait PhotoSource: Sync {
+    /// Width and height in pixels.
+    fn size(&self) -> (u32, u32);
+    fn georef(&self) -> Option<Georef>;
+    /// The file or name, for errors.
+    fn source(&self) -> &str;
+    /// Rows `y0..y1` (`y0 < y1 ≤ height`) at full width, 8-bit RGBA.
+    fn rows(&self, y0: u32, y1: u32) -> Result<RgbaImage, TerrainError>;
+}
+
+impl PhotoSource for Orthophoto {
+    fn size(&self) -> (u32, u32) {
+        self.image.dimensions()
+    }
+    fn georef(&self) -> Option<Georef> {
+        self.georef
+    }
+    fn source(&self) -> &str {
+        &self.source
+    }
+    fn rows(&self, y0: u32, y1: u32) -> Result<RgbaImage, TerrainError> {
+        Ok(image::imageops::crop_imm(&self.image, 0, y0, self.image.width(), y1 - y0).to_image())
+    }
 }
 
 /// Build the pyramid from the finest level's texture (`T·2^L` a side) by 2x2 box averages.
@@ -226,7 +395,26 @@ pub fn pyramid(finest: RgbaImage, map_texels: u32) -> Pyramid {
 /// The level count for a grid: the finest level has at least one texel per grid sample, capped
 /// at `max_levels`.
 pub fn level_count(grid: &Grid, map_texels: u32, max_levels: u32) -> u32 {
-    let need = grid.width().max(grid.height()) as f64 / map_texels as f64;
+    texture_levels(grid.width().max(grid.height()), map_texels, max_levels)
+}
+
+/// The level count for a photo over a grid: the finest level has at least one texel per grid
+/// sample and per photo pixel over the grid's extent, capped at `max_levels`.
+pub fn photo_level_count(
+    photo: &dyn PhotoSource,
+    grid: &Grid,
+    map_texels: u32,
+    max_levels: u32,
+) -> Result<u32, TerrainError> {
+    let p = Placement::new(grid, photo.size(), photo.georef(), photo.source())?;
+    let (a, b) = (p.to_photo(0.0, 0.0), p.to_photo(1.0, 1.0));
+    let across = (b.0 - a.0).abs().max((b.1 - a.1).abs()).min(1e9) as u32;
+    let side = grid.width().max(grid.height()).max(across);
+    Ok(texture_levels(side, map_texels, max_levels))
+}
+
+fn texture_levels(side: u32, map_texels: u32, max_levels: u32) -> u32 {
+    let need = side as f64 / map_texels as f64;
     let l = need.log2().ceil().max(0.0) as u32;
     (l + 1).min(max_levels.max(1))
 }

@@ -64,6 +64,7 @@ pub mod flight;
 pub mod greedy;
 pub mod gst;
 pub mod models;
+pub mod photo;
 pub mod rtin;
 pub mod stream;
 pub mod view;

@@ -219,164 +219,251 @@ pub fn band_count(path: &Path) -> Result<u16, TerrainError> {
         .unwrap_or(1))
 }
 
-/// Read the bands `bands` (0-based; `None` = all) of a TIFF, chunk by chunk.
-pub fn read_raster(
-    path: &Path,
-    bands: Option<&[u16]>,
-    chunk_limit: usize,
-) -> Result<Raster, TerrainError> {
-    let source = path.display().to_string();
-    check_directory(path, &source)?;
-    let file = std::fs::File::open(path).map_err(io(path))?;
-    let mut limits = Limits::default();
-    limits.decoding_buffer_size = chunk_limit;
-    let mut dec = Decoder::new(std::io::BufReader::new(file))
-        .map_err(tiff_err(&source, "header"))?
-        .with_limits(limits);
-    let (width, height) = dec
-        .dimensions()
-        .map_err(tiff_err(&source, "ImageWidth/ImageLength"))?;
-    check_size(&source, width as u64, height as u64)?;
-    let spp: u16 = dec
-        .find_tag_unsigned(Tag::SamplesPerPixel)
-        .map_err(tiff_err(&source, "tag 277 SamplesPerPixel"))?
-        .unwrap_or(1);
-    let bits: u16 = dec
-        .find_tag_unsigned_vec::<u16>(Tag::BitsPerSample)
-        .map_err(tiff_err(&source, "tag 258 BitsPerSample"))?
-        .and_then(|v| v.first().copied())
-        .unwrap_or(1);
-    let planar = dec
-        .find_tag_unsigned::<u16>(Tag::PlanarConfiguration)
-        .map_err(tiff_err(&source, "tag 284 PlanarConfiguration"))?
-        .map(PlanarConfiguration::from_u16)
-        .unwrap_or(Some(PlanarConfiguration::Chunky));
-    let planar = match planar {
-        Some(PlanarConfiguration::Chunky) => false,
-        Some(PlanarConfiguration::Planar) => true,
-        _ => {
-            return Err(TerrainError::Unsupported {
-                source,
-                what: "tag 284 PlanarConfiguration other than 1 or 2".into(),
+/// An open TIFF read one stored chunk (strip or tile) at a time: the header, georeference and
+/// chunk layout checked once ([`RasterReader::open`]), then [`RasterReader::read_chunk`] decodes
+/// one chunk's wanted bands. [`read_raster`] reads them all; an orthophoto larger than memory is
+/// read a band of rows at a time ([`crate::gst::TiffPhoto`]).
+pub struct RasterReader {
+    source: String,
+    dec: Decoder<std::io::BufReader<std::fs::File>>,
+    pub width: u32,
+    pub height: u32,
+    /// Bands in the file, and bits per sample as stored.
+    pub band_count: u16,
+    pub bits: u8,
+    planar: bool,
+    want: Vec<u16>,
+    pub georef: Option<Georef>,
+    pub nodata: Option<f64>,
+    chunk_type: ChunkType,
+    cw: u32,
+    ch: u32,
+    across: u32,
+    per_plane: u32,
+    counts: Vec<u64>,
+    compression: u16,
+    expansion: u64,
+    sample_bytes: u64,
+}
+
+/// One decoded chunk: its rectangle in the image (clipped to it) and one plane per wanted band.
+pub struct ChunkPlanes {
+    pub x0: u32,
+    pub y0: u32,
+    pub width: u32,
+    pub height: u32,
+    pub planes: Vec<Vec<f32>>,
+}
+
+impl RasterReader {
+    /// Open `path` for the bands `bands` (0-based; `None` = all), with the per-chunk decode
+    /// buffer limited to `chunk_limit` bytes.
+    pub fn open(
+        path: &Path,
+        bands: Option<&[u16]>,
+        chunk_limit: usize,
+    ) -> Result<RasterReader, TerrainError> {
+        let source = path.display().to_string();
+        check_directory(path, &source)?;
+        let file = std::fs::File::open(path).map_err(io(path))?;
+        let mut limits = Limits::default();
+        limits.decoding_buffer_size = chunk_limit;
+        let mut dec = Decoder::new(std::io::BufReader::new(file))
+            .map_err(tiff_err(&source, "header"))?
+            .with_limits(limits);
+        let (width, height) = dec
+            .dimensions()
+            .map_err(tiff_err(&source, "ImageWidth/ImageLength"))?;
+        check_size(&source, width as u64, height as u64)?;
+        let spp: u16 = dec
+            .find_tag_unsigned(Tag::SamplesPerPixel)
+            .map_err(tiff_err(&source, "tag 277 SamplesPerPixel"))?
+            .unwrap_or(1);
+        let bits: u16 = dec
+            .find_tag_unsigned_vec::<u16>(Tag::BitsPerSample)
+            .map_err(tiff_err(&source, "tag 258 BitsPerSample"))?
+            .and_then(|v| v.first().copied())
+            .unwrap_or(1);
+        let planar = dec
+            .find_tag_unsigned::<u16>(Tag::PlanarConfiguration)
+            .map_err(tiff_err(&source, "tag 284 PlanarConfiguration"))?
+            .map(PlanarConfiguration::from_u16)
+            .unwrap_or(Some(PlanarConfiguration::Chunky));
+        let planar = match planar {
+            Some(PlanarConfiguration::Chunky) => false,
+            Some(PlanarConfiguration::Planar) => true,
+            _ => {
+                return Err(TerrainError::Unsupported {
+                    source,
+                    what: "tag 284 PlanarConfiguration other than 1 or 2".into(),
+                });
+            }
+        };
+        let want: Vec<u16> = match bands {
+            Some(b) => b.to_vec(),
+            None => (0..spp).collect(),
+        };
+        if let Some(&b) = want.iter().find(|&&b| b >= spp) {
+            return Err(TerrainError::BadParameter {
+                name: "band",
+                value: (b + 1).to_string(),
+                expected: "a band the file has (1-based, up to SamplesPerPixel)",
             });
         }
-    };
-    let want: Vec<u16> = match bands {
-        Some(b) => b.to_vec(),
-        None => (0..spp).collect(),
-    };
-    if let Some(&b) = want.iter().find(|&&b| b >= spp) {
-        return Err(TerrainError::BadParameter {
-            name: "band",
-            value: (b + 1).to_string(),
-            expected: "a band the file has (1-based, up to SamplesPerPixel)",
-        });
-    }
-    let georef = read_georef(&mut dec, &source)?;
-    let nodata = match dec
-        .find_tag(Tag::GdalNodata)
-        .map_err(tiff_err(&source, "tag 42113 GDAL_NODATA"))?
-    {
-        Some(v) => {
-            let s = v
-                .into_string()
-                .map_err(tiff_err(&source, "tag 42113 GDAL_NODATA"))?;
-            let t = s.trim_matches(|c: char| c == '\0' || c.is_whitespace());
-            Some(t.parse::<f64>().map_err(|_| {
-                format_err(
-                    &source,
-                    "tag 42113 GDAL_NODATA",
-                    format!("a number, got {t:?}"),
-                )
-            })?)
-        }
-        None => None,
-    };
-
-    let (cw, ch) = dec.chunk_dimensions();
-    let chunk_type = dec.get_chunk_type();
-    // Both counts cover every plane of a planar image.
-    let total = match chunk_type {
-        ChunkType::Tile => dec
-            .tile_count()
-            .map_err(tiff_err(&source, "tile offsets"))?,
-        ChunkType::Strip => dec
-            .strip_count()
-            .map_err(tiff_err(&source, "strip offsets"))?,
-    };
-    let per_plane = if planar {
-        total / spp.max(1) as u32
-    } else {
-        total
-    };
-    let across = width.div_ceil(cw.max(1));
-    let down = height.div_ceil(ch.max(1));
-    // The offsets table is in the file: an image whose header claims more strips or tiles than
-    // the table lists is refused before anything is sized from the claim.
-    let needed = match chunk_type {
-        ChunkType::Tile => across as u64 * down as u64,
-        ChunkType::Strip => down as u64,
-    };
-    if (per_plane as u64) < needed {
-        return Err(format_err(
-            &source,
-            "tags 273/324 StripOffsets/TileOffsets",
-            format!(
-                "{needed} strips or tiles for a {width}x{height} image, the file lists {per_plane}"
-            ),
-        ));
-    }
-    // What each stored chunk can decode to: its byte count times the largest expansion of its
-    // compression (none 1x; PackBits 64x: two bytes per 128-byte run; Deflate 1032x; LZW at
-    // most 4096 bytes per 12-bit code). A chunk whose claimed size exceeds it is damage, found
-    // before the decoder sizes a buffer for it.
-    let counts = dec
-        .get_tag_u64_vec(match chunk_type {
-            ChunkType::Tile => Tag::TileByteCounts,
-            ChunkType::Strip => Tag::StripByteCounts,
-        })
-        .map_err(tiff_err(
-            &source,
-            "tags 279/325 StripByteCounts/TileByteCounts",
-        ))?;
-    let compression: u16 = dec
-        .find_tag_unsigned(Tag::Compression)
-        .map_err(tiff_err(&source, "tag 259 Compression"))?
-        .unwrap_or(1);
-    let expansion: u64 = match compression {
-        1 => 1,
-        32773 => 64,
-        8 | 32946 => 1032,
-        _ => 2731, // LZW: 4096 bytes from 12 bits
-    };
-    let sample_bytes = (bits as u64).div_ceil(8).max(1);
-    let n = width as usize * height as usize;
-    // The bands grow as their rows are decoded (each chunk's decoded size is bounded by the
-    // decoder's limit), so a header's claim alone never sizes a buffer.
-    let mut out: Vec<Vec<f32>> = want.iter().map(|_| Vec::new()).collect();
-    for chunk in 0..per_plane {
-        let (x0, y0) = match chunk_type {
-            ChunkType::Tile => (
-                (chunk % across).saturating_mul(cw),
-                (chunk / across).saturating_mul(ch),
-            ),
-            ChunkType::Strip => (0, chunk.saturating_mul(ch)),
+        let georef = read_georef(&mut dec, &source)?;
+        let nodata = match dec
+            .find_tag(Tag::GdalNodata)
+            .map_err(tiff_err(&source, "tag 42113 GDAL_NODATA"))?
+        {
+            Some(v) => {
+                let s = v
+                    .into_string()
+                    .map_err(tiff_err(&source, "tag 42113 GDAL_NODATA"))?;
+                let t = s.trim_matches(|c: char| c == '\0' || c.is_whitespace());
+                Some(t.parse::<f64>().map_err(|_| {
+                    format_err(
+                        &source,
+                        "tag 42113 GDAL_NODATA",
+                        format!("a number, got {t:?}"),
+                    )
+                })?)
+            }
+            None => None,
         };
 
-        if y0 >= height {
+        let (cw, ch) = dec.chunk_dimensions();
+        let chunk_type = dec.get_chunk_type();
+        // Both counts cover every plane of a planar image.
+        let total = match chunk_type {
+            ChunkType::Tile => dec
+                .tile_count()
+                .map_err(tiff_err(&source, "tile offsets"))?,
+            ChunkType::Strip => dec
+                .strip_count()
+                .map_err(tiff_err(&source, "strip offsets"))?,
+        };
+        let per_plane = if planar {
+            total / spp.max(1) as u32
+        } else {
+            total
+        };
+        let across = width.div_ceil(cw.max(1));
+        let down = height.div_ceil(ch.max(1));
+        // The offsets table is in the file: an image whose header claims more strips or tiles than
+        // the table lists is refused before anything is sized from the claim.
+        let needed = match chunk_type {
+            ChunkType::Tile => across as u64 * down as u64,
+            ChunkType::Strip => down as u64,
+        };
+        if (per_plane as u64) < needed {
+            return Err(format_err(
+                &source,
+                "tags 273/324 StripOffsets/TileOffsets",
+                format!(
+                    "{needed} strips or tiles for a {width}x{height} image, the file lists {per_plane}"
+                ),
+            ));
+        }
+        // What each stored chunk can decode to: its byte count times the largest expansion of its
+        // compression (none 1x; PackBits 64x: two bytes per 128-byte run; Deflate 1032x; LZW at
+        // most 4096 bytes per 12-bit code). A chunk whose claimed size exceeds it is damage, found
+        // before the decoder sizes a buffer for it.
+        let counts = dec
+            .get_tag_u64_vec(match chunk_type {
+                ChunkType::Tile => Tag::TileByteCounts,
+                ChunkType::Strip => Tag::StripByteCounts,
+            })
+            .map_err(tiff_err(
+                &source,
+                "tags 279/325 StripByteCounts/TileByteCounts",
+            ))?;
+        let compression: u16 = dec
+            .find_tag_unsigned(Tag::Compression)
+            .map_err(tiff_err(&source, "tag 259 Compression"))?
+            .unwrap_or(1);
+        let expansion: u64 = match compression {
+            1 => 1,
+            32773 => 64,
+            8 | 32946 => 1032,
+            _ => 2731, // LZW: 4096 bytes from 12 bits
+        };
+        let sample_bytes = (bits as u64).div_ceil(8).max(1);
+        Ok(RasterReader {
+            source,
+            dec,
+            width,
+            height,
+            band_count: spp,
+            bits: bits.min(255) as u8,
+            planar,
+            want,
+            georef,
+            nodata,
+            chunk_type,
+            cw,
+            ch,
+            across,
+            per_plane,
+            counts,
+            compression,
+            expansion,
+            sample_bytes,
+        })
+    }
+
+    /// Stored chunks per band, in file order (row-major tiles, or strips top to bottom).
+    pub fn chunk_count(&self) -> u32 {
+        self.per_plane
+    }
+
+    /// Height of a chunk row (strip or tile height) in image rows.
+    pub fn chunk_rows(&self) -> u32 {
+        self.ch.max(1)
+    }
+
+    /// The chunks holding image rows `y0..y1`, in file order.
+    pub fn chunks_in_rows(&self, y0: u32, y1: u32) -> Vec<u32> {
+        if y1 <= y0 {
+            return Vec::new();
+        }
+        let (r0, r1) = (y0 / self.chunk_rows(), (y1 - 1) / self.chunk_rows());
+        match self.chunk_type {
+            ChunkType::Strip => (r0..=r1).collect(),
+            ChunkType::Tile => (r0..=r1)
+                .flat_map(|r| (0..self.across).map(move |c| r * self.across + c))
+                .collect(),
+        }
+    }
+
+    /// Decode stored chunk `chunk` (`0..chunk_count()`): its wanted bands, clipped to the image.
+    pub fn read_chunk(&mut self, chunk: u32) -> Result<ChunkPlanes, TerrainError> {
+        let source = self.source.clone();
+        let (width, height) = (self.width, self.height);
+        let (x0, y0) = match self.chunk_type {
+            ChunkType::Tile => (
+                (chunk % self.across).saturating_mul(self.cw),
+                (chunk / self.across).saturating_mul(self.ch),
+            ),
+            ChunkType::Strip => (0, chunk.saturating_mul(self.ch)),
+        };
+        if y0 >= height || x0 >= width {
             return Err(format_err(
                 &source,
                 format!("chunk {chunk}"),
                 "a chunk inside the image",
             ));
         }
+        let spp = self.band_count;
         // Planar: band b of this chunk is chunk b·per_plane + chunk; interleaved: one chunk holds all.
-        let reads: Vec<(u32, Option<usize>)> = if planar {
-            want.iter()
+        let reads: Vec<(u32, Option<usize>)> = if self.planar {
+            self.want
+                .iter()
                 .enumerate()
                 .map(|(k, &b)| {
                     (
-                        (b as u32).saturating_mul(per_plane).saturating_add(chunk),
+                        (b as u32)
+                            .saturating_mul(self.per_plane)
+                            .saturating_add(chunk),
                         Some(k),
                     )
                 })
@@ -384,35 +471,31 @@ pub fn read_raster(
         } else {
             vec![(chunk, None)]
         };
+        let (mut out_w, mut out_h) = (0, 0);
+        let mut planes: Vec<Vec<f32>> = self.want.iter().map(|_| Vec::new()).collect();
         for (index, only) in reads {
-            let (dw, dh) = dec.chunk_data_dimensions(index);
+            let (dw, dh) = self.dec.chunk_data_dimensions(index);
             let at = format!("chunk {index}");
-            let stored = counts.get(index as usize).copied().unwrap_or(0);
+            let stored = self.counts.get(index as usize).copied().unwrap_or(0);
             let claimed = (dw as u64 * dh as u64)
-                .saturating_mul(sample_bytes)
-                .saturating_mul(if planar { 1 } else { spp as u64 });
-            if claimed > stored.saturating_mul(expansion).saturating_add(64) {
+                .saturating_mul(self.sample_bytes)
+                .saturating_mul(if self.planar { 1 } else { spp as u64 });
+            if claimed > stored.saturating_mul(self.expansion).saturating_add(64) {
                 return Err(format_err(
                     &source,
                     &at,
                     format!(
-                        "{claimed} decoded bytes cannot come from {stored} stored bytes (compression {compression})"
+                        "{claimed} decoded bytes cannot come from {stored} stored bytes (compression {})",
+                        self.compression
                     ),
                 ));
             }
-            let data = dec.read_chunk(index).map_err(tiff_err(&source, &at))?;
-            let rows_end = y0.saturating_add(dh).min(height) as usize;
-            for band in &mut out {
-                let len = (rows_end * width as usize).min(n);
-                if band.len() < len {
-                    band.resize(len, 0.0);
-                }
-            }
+            let data = self.dec.read_chunk(index).map_err(tiff_err(&source, &at))?;
             let vals = to_f32(data).ok_or_else(|| TerrainError::Unsupported {
                 source: source.clone(),
                 what: format!("{at}: sample type (need integer or 32/64-bit float samples)"),
             })?;
-            let stride = if planar { 1 } else { spp as usize };
+            let stride = if self.planar { 1 } else { spp as usize };
             let need = dw as usize * dh as usize * stride;
             if vals.len() < need {
                 return Err(format_err(
@@ -423,19 +506,58 @@ pub fn read_raster(
             }
             let dw_clip = dw.min(width - x0) as usize;
             let dh_clip = dh.min(height - y0) as usize;
-            for (k, &b) in want.iter().enumerate() {
+            (out_w, out_h) = (dw_clip as u32, dh_clip as u32);
+            for (k, &b) in self.want.iter().enumerate() {
                 if only.is_some_and(|o| o != k) {
                     continue;
                 }
-                let sample = if planar { 0 } else { b as usize };
-                let dst = &mut out[k];
+                let sample = if self.planar { 0 } else { b as usize };
+                let dst = &mut planes[k];
+                dst.clear();
+                dst.reserve(dw_clip * dh_clip);
                 for row in 0..dh_clip {
                     let src_row = row * dw as usize * stride;
-                    let dst_row = (y0 as usize + row) * width as usize + x0 as usize;
                     for col in 0..dw_clip {
-                        dst[dst_row + col] = vals[src_row + col * stride + sample];
+                        dst.push(vals[src_row + col * stride + sample]);
                     }
                 }
+            }
+        }
+        Ok(ChunkPlanes {
+            x0,
+            y0,
+            width: out_w,
+            height: out_h,
+            planes,
+        })
+    }
+}
+
+/// Read the bands `bands` (0-based; `None` = all) of a TIFF, chunk by chunk.
+pub fn read_raster(
+    path: &Path,
+    bands: Option<&[u16]>,
+    chunk_limit: usize,
+) -> Result<Raster, TerrainError> {
+    let mut r = RasterReader::open(path, bands, chunk_limit)?;
+    let (width, height) = (r.width, r.height);
+    let n = width as usize * height as usize;
+    // The bands grow as their rows are decoded (each chunk's decoded size is bounded by the
+    // decoder's limit), so a header's claim alone never sizes a buffer.
+    let mut out: Vec<Vec<f32>> = r.want.iter().map(|_| Vec::new()).collect();
+    for chunk in 0..r.chunk_count() {
+        let c = r.read_chunk(chunk)?;
+        let rows_end = (c.y0 + c.height) as usize;
+        for (band, plane) in out.iter_mut().zip(&c.planes) {
+            let len = (rows_end * width as usize).min(n);
+            if band.len() < len {
+                band.resize(len, 0.0);
+            }
+            for row in 0..c.height as usize {
+                let dst = (c.y0 as usize + row) * width as usize + c.x0 as usize;
+                let src = row * c.width as usize;
+                band[dst..dst + c.width as usize]
+                    .copy_from_slice(&plane[src..src + c.width as usize]);
             }
         }
     }
@@ -446,10 +568,10 @@ pub fn read_raster(
         width,
         height,
         bands: out,
-        bits: bits.min(255) as u8,
-        georef,
-        nodata,
-        band_count: spp,
+        bits: r.bits,
+        georef: r.georef,
+        nodata: r.nodata,
+        band_count: r.band_count,
     })
 }
 
