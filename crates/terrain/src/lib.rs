@@ -11,12 +11,16 @@
 //!   (every grid sample within the maximum error of the mesh), holes where the data has none.
 //! - [`chunks`]: a chunked level-of-detail quadtree cut from one error map, each chunk with its
 //!   geometric error (for selection by screen-space error) and skirts sized 5x that error.
+//! - [`photo`]: orthophotos as row sources — a GeoTIFF of any size read a band of rows at a time
+//!   (any band count, 16-bit bands stretched), PNG and JPEG whole.
 //! - [`gst`]: the orthophoto placed by georeference (or stretched), cut into a pyramid of 256²
-//!   maps; Seed 000 Eq. (5)–(7) decide which maps are resident in a budgeted cache with counters.
+//!   maps written map by map; Seed 000 Eq. (5)–(7) decide which maps are resident in a budgeted
+//!   cache with counters.
 //! - [`db`]: the database directory (JSON manifest, chunks, tiles, the grid), built atomically, and
 //!   the whole-terrain mesh at any error for glTF/OBJ export (through `texmap-mesh`).
 //! - [`view`]: the flight view — an aircraft camera (eye, altitude, heading, pitch, roll), chunks
-//!   chosen by screen-space error and frustum culling, drawn through texmap-raster with any
+//!   chosen by screen-space error and frustum culling and read from the database under a byte
+//!   budget (the grid mapped, not read), drawn through texmap-raster with any
 //!   texmap-core sampler (nearest, bilinear, trilinear, the span sampler with 3x3 or 4x4 banks,
 //!   anisotropic), per-frame statistics and optional haze.
 //! - [`models`]: textured OBJ models placed on the terrain by georeference and a built-in tree
