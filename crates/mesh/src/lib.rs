@@ -29,7 +29,9 @@ mod read;
 pub mod write;
 
 pub use error::MeshError;
-pub use read::{read_gltf, read_gltf_bytes, read_obj, read_obj_bytes};
+pub use read::{
+    BaseColor, read_gltf, read_gltf_base_color, read_gltf_bytes, read_obj, read_obj_bytes,
+};
 pub use write::{write_glb, write_obj};
 
 use glam::{Vec2, Vec3};

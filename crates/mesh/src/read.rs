@@ -460,3 +460,102 @@ mod tests {
         assert_eq!(c[0].positions[0], Vec3::new(1.0, 2.0, 3.0));
     }
 }
+
+/// The base colour of a glTF material (`pbrMetallicRoughness`): the linear RGBA factor and the
+/// base-colour texture as 8-bit sRGB RGBA (when the material has one), with the index of the
+/// texture-coordinate set it reads.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BaseColor {
+    pub factor: [f32; 4],
+    pub texture: Option<image::RgbaImage>,
+    pub tex_coord: u32,
+}
+
+/// The base colour of the first material a triangle primitive of `path` uses (meshes in file
+/// order), `None` when no primitive has a material. Images embedded in a `.glb`, in data URIs
+/// or in files beside a `.gltf` are decoded (PNG or JPEG); 16-bit and float images are refused.
+pub fn read_gltf_base_color(path: impl AsRef<Path>) -> Result<Option<BaseColor>, MeshError> {
+    let path = path.as_ref();
+    let source = path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|e| MeshError::Io {
+        path: path.to_path_buf(),
+        source: e,
+    })?;
+    let gerr = |message: String| MeshError::Gltf {
+        source: source.clone(),
+        message,
+    };
+    let gltf::Gltf { document, blob } =
+        gltf::Gltf::from_slice(&bytes).map_err(|e| gerr(e.to_string()))?;
+    let base = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let buffers =
+        gltf::import_buffers(&document, Some(base), blob).map_err(|e| gerr(e.to_string()))?;
+    let material = document
+        .meshes()
+        .flat_map(|m| m.primitives().collect::<Vec<_>>())
+        .filter(|p| p.mode() == gltf::mesh::Mode::Triangles)
+        .find_map(|p| p.material().index().map(|_| p.material()));
+    let Some(material) = material else {
+        return Ok(None);
+    };
+    let pbr = material.pbr_metallic_roughness();
+    let factor = pbr.base_color_factor();
+    let Some(info) = pbr.base_color_texture() else {
+        return Ok(Some(BaseColor {
+            factor,
+            texture: None,
+            tex_coord: 0,
+        }));
+    };
+    let image = info.texture().source();
+    let what = format!("image {}", image.index());
+    if let gltf::image::Source::View { view, .. } = image.source() {
+        // The decoder slices the buffer by the view without checking it.
+        let len = buffers.get(view.buffer().index()).map_or(0, |b| b.0.len());
+        if view
+            .offset()
+            .checked_add(view.length())
+            .is_none_or(|end| end > len)
+        {
+            return Err(gerr(format!(
+                "{what}: buffer view {} ends past its buffer ({len} bytes)",
+                view.index()
+            )));
+        }
+    }
+    let data = gltf::image::Data::from_source(image.source(), Some(base), &buffers)
+        .map_err(|e| gerr(format!("{what}: {e}")))?;
+    let (w, h) = (data.width, data.height);
+    let px = &data.pixels;
+    use gltf::image::Format;
+    let channels = match data.format {
+        Format::R8 => 1,
+        Format::R8G8 => 2,
+        Format::R8G8B8 => 3,
+        Format::R8G8B8A8 => 4,
+        other => return Err(gerr(format!("{what}: pixel format {other:?} (need 8-bit)"))),
+    };
+    if px.len() != w as usize * h as usize * channels {
+        return Err(gerr(format!(
+            "{what}: {} bytes for {w} x {h} x {channels}",
+            px.len()
+        )));
+    }
+    let texture = image::RgbaImage::from_fn(w, h, |x, y| {
+        let i = (y as usize * w as usize + x as usize) * channels;
+        image::Rgba(match channels {
+            1 => [px[i], px[i], px[i], 255],
+            2 => [px[i], px[i], px[i], px[i + 1]],
+            3 => [px[i], px[i + 1], px[i + 2], 255],
+            _ => [px[i], px[i + 1], px[i + 2], px[i + 3]],
+        })
+    });
+    Ok(Some(BaseColor {
+        factor,
+        texture: Some(texture),
+        tex_coord: info.tex_coord(),
+    }))
+}

@@ -4,10 +4,12 @@
 //! **Models** ([`Model`], [`Placed`]). A model is one mesh (every mesh of the file merged) read
 //! by texmap-mesh ([`texmap_mesh::read_obj`], [`texmap_mesh::read_gltf`]) in the model's own
 //! units, `y` up, `−z` its front (north at heading 0). Its texture is the OBJ material's
-//! base-colour map (`map_Kd` of the first material library named by `mtllib` that has one),
-//! read as sRGB into a gamma-correct, repeating [`MipTexture`]. A glTF model, an OBJ without a
-//! textured material and a mesh without texture coordinates are drawn with one flat colour
-//! ([`Model::color`]). A [`Placement`] puts the model at a map position `(x, y)` of the grid's
+//! base-colour map (`map_Kd` of the first material library named by `mtllib` that has one) or the
+//! glTF material's base-colour texture (of the first primitive with a material, times its base
+//! colour factor; [`texmap_mesh::read_gltf_base_color`]), read as sRGB into a gamma-correct,
+//! repeating [`MipTexture`]. A model without a textured material and a mesh without texture
+//! coordinates are drawn with one flat colour ([`Model::color`]: a glTF material's base colour
+//! factor, otherwise grey). A [`Placement`] puts the model at a map position `(x, y)` of the grid's
 //! georeference ([`crate::dem::Georef::sample_xy`]) with its lowest vertex
 //! `height_above_ground` metres above the ground under `(x, y)` ([`crate::view::ground_height`]),
 //! turned `heading` degrees clockwise seen from above (the model's `−z` then points along the
@@ -223,15 +225,29 @@ impl Model {
             .and_then(|e| e.to_str())
             .map(str::to_ascii_lowercase);
         let name = path.display().to_string();
+        let mut color = DEFAULT_MODEL_COLOR;
         let (meshes, texture) = match ext.as_deref() {
             Some("obj") => {
                 let meshes = texmap_mesh::read_obj(path).map_err(ModelError::Mesh)?;
                 (meshes, obj_texture(path)?)
             }
-            Some("gltf") | Some("glb") => (
-                texmap_mesh::read_gltf(path).map_err(ModelError::Mesh)?,
-                None,
-            ),
+            Some("gltf") | Some("glb") => {
+                let meshes = texmap_mesh::read_gltf(path).map_err(ModelError::Mesh)?;
+                let bc = texmap_mesh::read_gltf_base_color(path).map_err(ModelError::Mesh)?;
+                let texture = match bc {
+                    // The meshes carry TEXCOORD_0 only: a texture on another set is not drawn.
+                    Some(b) if b.tex_coord == 0 && b.texture.is_some() => {
+                        let img = b.texture.expect("checked above");
+                        Some(gltf_texture(&img, b.factor).map_err(ModelError::Mip)?)
+                    }
+                    Some(b) => {
+                        color = Vec3::new(b.factor[0], b.factor[1], b.factor[2]);
+                        None
+                    }
+                    None => None,
+                };
+                (meshes, texture)
+            }
             _ => {
                 return Err(ModelError::UnknownFormat {
                     path: path.to_path_buf(),
@@ -254,7 +270,9 @@ impl Model {
         if all_uvs {
             merged.uvs = Some(uvs);
         }
-        Model::from_mesh(&name, merged, texture)
+        let mut model = Model::from_mesh(&name, merged, texture)?;
+        model.color = color;
+        Ok(model)
     }
 
     /// A model from a mesh in memory and an optional texture. Errors: a non-finite vertex, or a
@@ -294,6 +312,21 @@ pub fn model_texture(img: &image::RgbaImage) -> Result<MipTexture, MipError> {
         Reduction::GammaCorrect,
         Wrap::Repeat,
     )
+}
+
+/// A glTF base-colour texture times its (linear) factor, as a model texture.
+fn gltf_texture(img: &image::RgbaImage, factor: [f32; 4]) -> Result<MipTexture, MipError> {
+    if factor == [1.0; 4] {
+        return model_texture(img);
+    }
+    let mut scaled = img.clone();
+    for p in scaled.pixels_mut() {
+        let c = texmap_core::color::srgb8_to_linear_rgb(p.0)
+            * Vec3::new(factor[0], factor[1], factor[2]);
+        let a = (p.0[3] as f32 * factor[3]).round().clamp(0.0, 255.0) as u8;
+        p.0 = texmap_core::color::linear_to_srgb8(c, a);
+    }
+    model_texture(&scaled)
 }
 
 /// The `map_Kd` texture of an OBJ's material libraries, `None` when no library names one.

@@ -500,3 +500,43 @@ fn bad_input_gives_errors_naming_the_file_or_value() {
     let e = Model::from_mesh("nan", nan, None).unwrap_err();
     assert!(e.to_string().contains("vertex 0"), "{e}");
 }
+
+#[test]
+fn gltf_models_carry_their_base_colour_texture_and_factor() {
+    let boxed =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../mesh/tests/data/BoxTextured.gltf");
+    let m = Model::load(&boxed).unwrap();
+    assert!(m.is_textured());
+    let tex = m.texture.as_ref().unwrap();
+    assert_eq!((tex.width(), tex.height()), (211, 211));
+    // The base colour factor multiplies the texture in linear light: halve the red channel.
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(&boxed).unwrap().replace(
+        "\"baseColorTexture\": {",
+        "\"baseColorFactor\": [0.5, 1.0, 1.0, 1.0],\n                \"baseColorTexture\": {",
+    );
+    let p = dir.path().join("red_half.gltf");
+    std::fs::write(&p, text).unwrap();
+    let half = Model::load(&p).unwrap();
+    let (a, b) = (tex.texels()[0], half.texture.as_ref().unwrap().texels()[0]);
+    assert!(
+        (b.x - 0.5 * a.x).abs() < 0.01 && (b.y - a.y).abs() < 0.01,
+        "{a:?} {b:?}"
+    );
+    // A material without a texture gives the flat colour its factor names.
+    let text = std::fs::read_to_string(fixture("notex.gltf"))
+        .unwrap()
+        .replace(
+            "\"primitives\":[{\"attributes\":{\"POSITION\":0}}]",
+            "\"primitives\":[{\"attributes\":{\"POSITION\":0},\"material\":0}]",
+        )
+        .replace(
+            "\"buffers\"",
+            "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.2,0.4,0.6,1]}}],\"buffers\"",
+        );
+    let p = dir.path().join("blue.gltf");
+    std::fs::write(&p, text).unwrap();
+    let flat = Model::load(&p).unwrap();
+    assert!(!flat.is_textured());
+    assert_eq!(flat.color, glam::Vec3::new(0.2, 0.4, 0.6));
+}
