@@ -578,7 +578,7 @@ enum Meshes {
     /// All of them in memory (`[depth][index]`).
     Resident(Vec<Vec<TriMesh>>),
     /// Read from the database's chunk files when a frame selects them.
-    Paged(ChunkPager),
+    Paged(Box<ChunkPager>),
 }
 
 /// A chunk mesh borrowed from a resident tree or shared from the pager's cache.
@@ -825,7 +825,7 @@ impl FlightTerrain {
                 grid,
                 max_depth: m.levels.len().saturating_sub(1) as u32,
                 chunks,
-                meshes: Meshes::Paged(pager),
+                meshes: Meshes::Paged(Box::new(pager)),
                 texture,
                 maps: None,
             }

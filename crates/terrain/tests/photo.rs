@@ -19,7 +19,7 @@ fn data(name: &str) -> PathBuf {
 }
 
 fn srtm() -> Grid {
-    dem::read_dem(&data("N44W072.hgt"), &dem::ReadOptions::default()).unwrap()
+    dem::read_dem(data("N44W072.hgt"), &dem::ReadOptions::default()).unwrap()
 }
 
 #[test]
