@@ -121,6 +121,25 @@ fn chunk_bytes(c: &chunks::Chunk) -> Vec<u8> {
     b
 }
 
+impl ChunkEntry {
+    /// The manifest entry of chunk `c` stored at `file` (relative to the database directory).
+    pub fn of(c: &chunks::Chunk, file: String) -> ChunkEntry {
+        ChunkEntry {
+            ix: c.ix,
+            iy: c.iy,
+            x0: c.x0,
+            y0: c.y0,
+            size: c.size,
+            geometric_error: c.geometric_error,
+            skirt: c.skirt,
+            triangles: c.surface_triangles,
+            vertices: c.mesh.positions.len() as u32,
+            file,
+            bounds: Some(bounds_of(&c.mesh.positions)),
+        }
+    }
+}
+
 /// `[min x, min y, min z, max x, max y, max z]` of `points`.
 fn bounds_of(points: &[glam::Vec3]) -> [f32; 6] {
     let b = crate::view::Aabb::of(points);
@@ -274,19 +293,7 @@ fn build_into(
         for c in &level {
             let file = format!("chunks/{d}/{}_{}.bin", c.ix, c.iy);
             write(&dir.join(&file), &chunk_bytes(c))?;
-            entries.push(ChunkEntry {
-                ix: c.ix,
-                iy: c.iy,
-                x0: c.x0,
-                y0: c.y0,
-                size: c.size,
-                geometric_error: c.geometric_error,
-                skirt: c.skirt,
-                triangles: c.surface_triangles,
-                vertices: c.mesh.positions.len() as u32,
-                file,
-                bounds: Some(bounds_of(&c.mesh.positions)),
-            });
+            entries.push(ChunkEntry::of(c, file));
         }
         // A depth may come in several bands: extend its entry.
         let target = level.first().map(|c| c.target_error);

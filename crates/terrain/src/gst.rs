@@ -46,20 +46,7 @@ pub fn read_photo(path: &Path, bands: Option<[u16; 3]>) -> Result<Orthophoto, Te
         .unwrap_or_default();
     if ext == "tif" || ext == "tiff" {
         let band_count = crate::dem::geotiff::band_count(path)?;
-        let pick: Vec<u16> = match bands {
-            Some(b) => {
-                if b.contains(&0) {
-                    return Err(TerrainError::BadParameter {
-                        name: "bands",
-                        value: format!("{b:?}"),
-                        expected: "1-based band numbers",
-                    });
-                }
-                b.iter().map(|x| x - 1).collect()
-            }
-            None if band_count >= 3 => vec![0, 1, 2],
-            None => vec![0, 0, 0],
-        };
+        let pick = crate::photo::pick_bands(bands, band_count)?;
         let r = crate::dem::geotiff::read_raster(path, Some(&pick), 1 << 28)?;
         let n = r.width as usize * r.height as usize;
         let scale: Vec<(f32, f32)> = r

@@ -40,7 +40,10 @@ struct State {
 }
 
 /// The bands to read for red, green and blue (0-based) from a 1-based choice.
-fn pick_bands(bands: Option<[u16; 3]>, band_count: u16) -> Result<[u16; 3], TerrainError> {
+pub(crate) fn pick_bands(
+    bands: Option<[u16; 3]>,
+    band_count: u16,
+) -> Result<[u16; 3], TerrainError> {
     match bands {
         Some(b) => {
             if b.contains(&0) {

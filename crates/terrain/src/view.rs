@@ -82,7 +82,7 @@
 //! ```
 
 use crate::chunks::{ChunkTree, screen_space_error};
-use crate::db::Database;
+use crate::db::{ChunkEntry, Database};
 use crate::dem::Grid;
 use crate::error::TerrainError;
 use crate::gst;
@@ -572,6 +572,27 @@ pub struct ChunkInfo {
     pub bounds: Aabb,
 }
 
+impl From<&ChunkEntry> for ChunkInfo {
+    /// A manifest entry's cell, error, triangles and box (an entry without a box gets an empty
+    /// one at the origin; [`FlightTerrain::open`] pages only manifests whose entries all have one).
+    fn from(c: &ChunkEntry) -> ChunkInfo {
+        let b = c.bounds.unwrap_or_default();
+        ChunkInfo {
+            ix: c.ix,
+            iy: c.iy,
+            x0: c.x0,
+            y0: c.y0,
+            size: c.size,
+            geometric_error: c.geometric_error,
+            surface_triangles: c.triangles,
+            bounds: Aabb {
+                min: Vec3::new(b[0], b[1], b[2]),
+                max: Vec3::new(b[3], b[4], b[5]),
+            },
+        }
+    }
+}
+
 /// Where the chunk meshes live.
 #[derive(Debug)]
 enum Meshes {
@@ -733,16 +754,7 @@ impl FlightTerrain {
             let mut infos = Vec::with_capacity(level.len());
             let mut ms = Vec::with_capacity(level.len());
             for c in level {
-                infos.push(ChunkInfo {
-                    ix: c.ix,
-                    iy: c.iy,
-                    x0: c.x0,
-                    y0: c.y0,
-                    size: c.size,
-                    geometric_error: c.geometric_error,
-                    surface_triangles: c.surface_triangles,
-                    bounds: Aabb::of(&c.mesh.positions),
-                });
+                infos.push(ChunkInfo::from(&ChunkEntry::of(&c, String::new())));
                 ms.push(c.mesh);
             }
             chunks.push(infos);
@@ -789,27 +801,7 @@ impl FlightTerrain {
             let chunks = m
                 .levels
                 .iter()
-                .map(|l| {
-                    l.chunks
-                        .iter()
-                        .map(|c| {
-                            let b = c.bounds.unwrap_or_default();
-                            ChunkInfo {
-                                ix: c.ix,
-                                iy: c.iy,
-                                x0: c.x0,
-                                y0: c.y0,
-                                size: c.size,
-                                geometric_error: c.geometric_error,
-                                surface_triangles: c.triangles,
-                                bounds: Aabb {
-                                    min: Vec3::new(b[0], b[1], b[2]),
-                                    max: Vec3::new(b[3], b[4], b[5]),
-                                },
-                            }
-                        })
-                        .collect()
-                })
+                .map(|l| l.chunks.iter().map(ChunkInfo::from).collect())
                 .collect();
             let pager = ChunkPager {
                 db: db.clone(),
