@@ -39,12 +39,7 @@ pub struct Orthophoto {
 /// (1-based, default 1,2,3 or band 1 as grey).
 pub fn read_photo(path: &Path, bands: Option<[u16; 3]>) -> Result<Orthophoto, TerrainError> {
     let source = path.display().to_string();
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(|e| e.to_ascii_lowercase())
-        .unwrap_or_default();
-    if ext == "tif" || ext == "tiff" {
+    if crate::photo::is_tiff(path) {
         let band_count = crate::dem::geotiff::band_count(path)?;
         let pick = crate::photo::pick_bands(bands, band_count)?;
         let r = crate::dem::geotiff::read_raster(path, Some(&pick), 1 << 28)?;

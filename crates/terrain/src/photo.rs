@@ -167,17 +167,19 @@ impl PhotoSource for TiffPhoto {
     }
 }
 
+/// Whether `path` names a TIFF (by its extension, `.tif` or `.tiff`, any case).
+pub(crate) fn is_tiff(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("tif") || e.eq_ignore_ascii_case("tiff"))
+}
+
 /// Open an orthophoto for a pyramid build: a TIFF by rows ([`TiffPhoto`]), a PNG or JPEG whole.
 pub fn open_photo(
     path: &Path,
     bands: Option<[u16; 3]>,
 ) -> Result<Box<dyn PhotoSource>, TerrainError> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(|e| e.to_ascii_lowercase())
-        .unwrap_or_default();
-    if ext == "tif" || ext == "tiff" {
+    if is_tiff(path) {
         Ok(Box::new(TiffPhoto::open(path, bands)?))
     } else {
         let p: Orthophoto = read_photo(path, bands)?;

@@ -315,7 +315,7 @@ fn align(map_texels: u32) -> u32 {
 
 /// The uv rectangle `[u0, u1, v0, v1]` of a chunk's cell (its vertices' texture coordinates,
 /// [`crate::chunks::vertex`], lie within it; the padding beyond the grid is clipped).
-fn uv_rect(grid: &crate::dem::Grid, c: &crate::view::ChunkInfo) -> [f32; 4] {
+fn uv_rect(grid: &crate::dem::Grid, c: &crate::db::ChunkEntry) -> [f32; 4] {
     let (w1, h1) = ((grid.width() - 1) as f32, (grid.height() - 1) as f32);
     let last = (c.size - 1) as f32;
     [
@@ -414,7 +414,7 @@ impl FlightTerrain {
             stats.triangles_binned += ds.binned as u64;
             stats.triangles_backface += ds.culled as u64;
             stats.triangles_clipped += ds.clipped as u64;
-            stats.surface_triangles += self.chunk(*c).surface_triangles as u64;
+            stats.surface_triangles += self.chunk(*c).triangles as u64;
         }
         let ms = stream.maps.stats();
         stats.texture_bytes = frame_bytes;

@@ -555,42 +555,23 @@ impl FrameScratch {
     }
 }
 
-/// What a renderer needs of a chunk to choose it, without its mesh: cell, error, triangle count
-/// and bounding box (surface and skirts).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ChunkInfo {
-    /// Cell index at its depth (column, row).
-    pub ix: u32,
-    pub iy: u32,
-    /// Sample coordinates of the cell's north-west corner and its side in samples.
-    pub x0: u32,
-    pub y0: u32,
-    pub size: u32,
-    /// Metres (see [`crate::chunks::Chunk::geometric_error`]).
-    pub geometric_error: f32,
-    pub surface_triangles: u32,
-    pub bounds: Aabb,
-}
-
-impl From<&ChunkEntry> for ChunkInfo {
-    /// A manifest entry's cell, error, triangles and box (an entry without a box gets an empty
-    /// one at the origin; [`FlightTerrain::open`] pages only manifests whose entries all have one).
-    fn from(c: &ChunkEntry) -> ChunkInfo {
-        let b = c.bounds.unwrap_or_default();
-        ChunkInfo {
-            ix: c.ix,
-            iy: c.iy,
-            x0: c.x0,
-            y0: c.y0,
-            size: c.size,
-            geometric_error: c.geometric_error,
-            surface_triangles: c.triangles,
-            bounds: Aabb {
-                min: Vec3::new(b[0], b[1], b[2]),
-                max: Vec3::new(b[3], b[4], b[5]),
-            },
-        }
-    }
+/// The boxes of manifest entries (an entry without one gets an empty box at the origin;
+/// [`FlightTerrain::open`] pages only manifests whose entries all have one).
+fn boxes(chunks: &[Vec<ChunkEntry>]) -> Vec<Vec<Aabb>> {
+    chunks
+        .iter()
+        .map(|l| {
+            l.iter()
+                .map(|c| {
+                    let b = c.bounds.unwrap_or_default();
+                    Aabb {
+                        min: Vec3::new(b[0], b[1], b[2]),
+                        max: Vec3::new(b[3], b[4], b[5]),
+                    }
+                })
+                .collect()
+        })
+        .collect()
 }
 
 /// Where the chunk meshes live.
@@ -736,8 +717,10 @@ pub const DEFAULT_CHUNK_BUDGET: u64 = 128 << 20;
 pub struct FlightTerrain {
     grid: Grid,
     max_depth: u32,
-    /// `chunks[d]` = the chunks at depth `d`, in row-major cell order.
-    chunks: Vec<Vec<ChunkInfo>>,
+    /// `chunks[d]` = the chunks at depth `d`, in row-major cell order (their manifest entries;
+    /// the file names are empty for a terrain made in memory), and `bounds[d]` their boxes.
+    chunks: Vec<Vec<ChunkEntry>>,
+    bounds: Vec<Vec<Aabb>>,
     meshes: Meshes,
     texture: MipTexture,
     /// GST map side and level count, when the terrain comes from a database with maps.
@@ -751,19 +734,21 @@ impl FlightTerrain {
         let mut chunks = Vec::with_capacity(tree.levels.len());
         let mut meshes = Vec::with_capacity(tree.levels.len());
         for level in tree.levels {
-            let mut infos = Vec::with_capacity(level.len());
+            let mut entries = Vec::with_capacity(level.len());
             let mut ms = Vec::with_capacity(level.len());
             for c in level {
-                infos.push(ChunkInfo::from(&ChunkEntry::of(&c, String::new())));
+                entries.push(ChunkEntry::of(&c, String::new()));
                 ms.push(c.mesh);
             }
-            chunks.push(infos);
+            chunks.push(entries);
             meshes.push(ms);
         }
+        let bounds = boxes(&chunks);
         FlightTerrain {
             grid,
             max_depth: tree.max_depth,
             chunks,
+            bounds,
             meshes: Meshes::Resident(meshes),
             texture,
             maps: None,
@@ -798,11 +783,8 @@ impl FlightTerrain {
                 Some(img) => texture_from_rgba(&img)?,
                 None => height_texture(&grid, max_texture_side.clamp(1, 2048))?,
             };
-            let chunks = m
-                .levels
-                .iter()
-                .map(|l| l.chunks.iter().map(ChunkInfo::from).collect())
-                .collect();
+            let chunks: Vec<Vec<ChunkEntry>> = m.levels.iter().map(|l| l.chunks.clone()).collect();
+            let bounds = boxes(&chunks);
             let pager = ChunkPager {
                 db: db.clone(),
                 state: Mutex::new(PagerState {
@@ -817,6 +799,7 @@ impl FlightTerrain {
                 grid,
                 max_depth: m.levels.len().saturating_sub(1) as u32,
                 chunks,
+                bounds,
                 meshes: Meshes::Paged(Box::new(pager)),
                 texture,
                 maps: None,
@@ -841,12 +824,12 @@ impl FlightTerrain {
     pub fn max_depth(&self) -> u32 {
         self.max_depth
     }
-    /// `levels()[d]` = the chunks at depth `d`, in row-major cell order.
-    pub fn levels(&self) -> &[Vec<ChunkInfo>] {
+    /// `levels()[d]` = the chunks at depth `d`, in row-major cell order (as manifest entries).
+    pub fn levels(&self) -> &[Vec<ChunkEntry>] {
         &self.chunks
     }
     /// The chunk `c` refers to.
-    pub fn chunk(&self, c: ChunkRef) -> &ChunkInfo {
+    pub fn chunk(&self, c: ChunkRef) -> &ChunkEntry {
         &self.chunks[c.depth as usize][c.index]
     }
     /// True when chunk meshes are read from the database on demand.
@@ -878,9 +861,9 @@ impl FlightTerrain {
     pub fn texture(&self) -> &MipTexture {
         &self.texture
     }
-    /// The bounding box of chunk `c`.
+    /// The bounding box of chunk `c` (surface and skirts).
     pub fn bounds(&self, c: ChunkRef) -> Aabb {
-        self.chunk(c).bounds
+        self.bounds[c.depth as usize][c.index]
     }
 
     fn index_of(&self, depth: u32, ix: u32, iy: u32) -> Option<usize> {
@@ -908,11 +891,12 @@ impl FlightTerrain {
             };
             sel.visited += 1;
             let c = &self.chunks[d as usize][i];
-            if frustum.culls(&c.bounds) {
+            let b = self.bounds[d as usize][i];
+            if frustum.culls(&b) {
                 sel.culled += 1;
                 continue;
             }
-            let sse = screen_space_error(c.geometric_error, c.bounds.distance(eye), k);
+            let sse = screen_space_error(c.geometric_error, b.distance(eye), k);
             if sse > pixel_error && d < self.max_depth {
                 for (cx, cy) in [(1, 1), (0, 1), (1, 0), (0, 0)] {
                     stack.push((d + 1, 2 * ix + cx, 2 * iy + cy));
@@ -1026,7 +1010,7 @@ impl FlightTerrain {
         stats.surface_triangles = sel
             .chunks
             .iter()
-            .map(|c| self.chunk(*c).surface_triangles as u64)
+            .map(|c| self.chunk(*c).triangles as u64)
             .sum();
         stats.chunk_cache = self.chunk_cache();
         stats.maps_needed = self.needed_maps(view).map(|k| k.len() as u64);
