@@ -20,6 +20,7 @@ pub use texmap_core as core;
 pub use texmap_envmap as envmap;
 pub use texmap_impostor as impostor;
 pub use texmap_md_io as md_io;
+pub use texmap_md_scene as md_scene;
 pub use texmap_mesh as mesh;
 pub use texmap_movie as movie;
 pub use texmap_quality as quality;

@@ -310,6 +310,9 @@ pub struct RenderArgs {
     pub style: StyleArgs,
 }
 
+/// Horizontal field of view (degrees) of `texmap render`'s camera and of `texmap compare FILE`.
+pub const DEFAULT_FOV: f32 = 40.0;
+
 /// The camera of `texmap render` (and of `texmap compare FILE`): image size, projection and
 /// pose; without --eye/--target/--up it is fitted to what the first frame draws.
 #[derive(Args, Clone, Debug)]
@@ -321,7 +324,7 @@ pub struct ViewArgs {
     #[arg(long)]
     pub ortho: bool,
     /// Horizontal field of view in degrees (the project's convention), perspective only.
-    #[arg(long, default_value_t = 40.0)]
+    #[arg(long, default_value_t = DEFAULT_FOV)]
     pub fov: f32,
     /// View direction for the automatic camera: auto (a three-quarter view), x, y, z, -x, -y, -z.
     #[arg(long, default_value = "auto", allow_hyphen_values = true)]
@@ -342,7 +345,7 @@ impl Default for ViewArgs {
         ViewArgs {
             size: "1280x720".into(),
             ortho: false,
-            fov: 40.0,
+            fov: DEFAULT_FOV,
             view: "auto".into(),
             eye: None,
             target: None,

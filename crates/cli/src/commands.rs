@@ -15,7 +15,7 @@ use texmap_study::scenes::{self, NamedScene, SceneId};
 
 use crate::args::{Cli, Command, CompareArgs, MethodArg, RenderArgs, SceneArg, usage};
 use crate::output::{write_atomic, write_png};
-use crate::scene::{SceneBuilder, camera_for, parse_background, parse_size};
+use crate::scene::{parse_background, parse_size, warning_text};
 
 /// `--quiet`: no progress bars and no notes (warnings and errors still print).
 static QUIET: AtomicBool = AtomicBool::new(false);
@@ -279,7 +279,7 @@ fn method_of(m: MethodArg) -> Option<Method> {
 
 fn render(a: &RenderArgs) -> Result<()> {
     let background = parse_background(&a.background)?;
-    parse_size(&a.camera.size)?;
+    let size = parse_size(&a.camera.size)?;
     let options = ReadOptions::new().allow_truncated(a.allow_truncated);
     let mut traj = open_trajectory_with(&a.file, a.format.as_deref(), options)?;
     let n = traj.n_frames()?;
@@ -309,7 +309,7 @@ fn render(a: &RenderArgs) -> Result<()> {
         );
     }
     let mut quality_renderer = texmap_quality::QualityRenderer::new();
-    let mut builder = SceneBuilder::new(&a.style)?;
+    let mut builder = crate::scene::scene_builder(&a.style)?;
     let mut plan = crate::scene::MolPlan::new(&a.mol)?;
     let mut md = MdFrame::new();
     let mut scene = SphereScene::default();
@@ -343,13 +343,15 @@ fn render(a: &RenderArgs) -> Result<()> {
             .map_err(|e| fail(e, &written))?;
         plan.build(&mut builder, &mut md, &mut scene)
             .map_err(|e| fail(e, &written))?;
-        if a.box_outline {
-            add_box_outline(&md, &mut scene);
+        if a.box_outline
+            && let Some(cell) = &md.cell
+        {
+            texmap_md_scene::add_box_outline(cell, &mut scene);
         }
         if camera.is_none() {
             // First frame: the camera, and warnings about the style flags.
             for w in builder.warnings(&md) {
-                pb.suspend(|| eprintln!("texmap: warning: {w}"));
+                pb.suspend(|| eprintln!("texmap: warning: {}", warning_text(&w)));
             }
             if let Some(w) = plan.unnamed_warning(&md, traj.name()) {
                 pb.suspend(|| eprintln!("texmap: warning: {w}"));
@@ -365,8 +367,9 @@ fn render(a: &RenderArgs) -> Result<()> {
                 );
                 return Err(fail(e, &written));
             }
-            let plan = crate::scene::CameraPlan::new(&a.camera, &a.path, &md, &scene, frames.len())
-                .map_err(|e| fail(e, &written))?;
+            let plan =
+                crate::scene::CameraPlan::new(&a.camera, size, &a.path, &md, &scene, frames.len())
+                    .map_err(|e| fail(e, &written))?;
             camera = Some(plan);
         }
         if !mine.contains(&k) {
@@ -465,31 +468,6 @@ fn render(a: &RenderArgs) -> Result<()> {
     Ok(())
 }
 
-/// The periodic box outline as rows of small grey spheres along its 12 edges (every method draws
-/// spheres; none draws lines), spaced at one radius so they read as a line.
-fn add_box_outline(md: &MdFrame, scene: &mut SphereScene) {
-    let Some(cell) = &md.cell else { return };
-    let grey = scene.materials.len() as u16;
-    scene
-        .materials
-        .push(texmap_core::shade::Material::matte(glam::Vec3::splat(0.6)));
-    let l = cell.lengths();
-    let r = (l[0].min(l[1]).min(l[2]) as f32 * 0.004).max(1e-3);
-    let corners = crate::scene::cell_corners(cell);
-    for a in 0..8u32 {
-        for bit in [1u32, 2, 4] {
-            if a & bit == 0 {
-                let (p, q) = (corners[a as usize], corners[(a | bit) as usize]);
-                // At most 2,000 spheres an edge, whatever the box.
-                let n = ((p.distance(q) / r).ceil() as usize).clamp(1, 2000);
-                for k in 0..=n {
-                    scene.push(p.lerp(q, k as f32 / n as f32), r, grey);
-                }
-            }
-        }
-    }
-}
-
 fn named_scene(a: &CompareArgs) -> Result<NamedScene> {
     match (&a.scene, &a.file) {
         (Some(s), None) => {
@@ -504,7 +482,7 @@ fn named_scene(a: &CompareArgs) -> Result<NamedScene> {
         }
         (None, Some(file)) => {
             // The first frame of the file, styled as `render` would, with the automatic camera.
-            let mut builder = SceneBuilder::new(&a.style)?;
+            let mut builder = crate::scene::scene_builder(&a.style)?;
             let mut traj = open_trajectory(file, None)?;
             let mut md = MdFrame::new();
             if !traj.read_next(&mut md)? {
@@ -513,13 +491,18 @@ fn named_scene(a: &CompareArgs) -> Result<NamedScene> {
             let mut spheres = SphereScene::default();
             builder.build(&mut md, &mut spheres);
             for w in builder.warnings(&md) {
-                eprintln!("texmap: warning: {w}");
+                eprintln!("texmap: warning: {}", warning_text(&w));
             }
-            let view = crate::args::ViewArgs {
-                size: a.size.clone(),
-                ..Default::default()
-            };
-            let (camera, _) = camera_for(&view, &md, &spheres)?;
+            let (w, h) = parse_size(&a.size)?;
+            let (camera, _) = texmap_md_scene::fit_camera(
+                &md,
+                &spheres,
+                texmap_md_scene::ViewAxis::Auto,
+                Some(crate::args::DEFAULT_FOV),
+                w,
+                h,
+            )
+            .context("automatic camera")?;
             let stem = file
                 .file_stem()
                 .map(|s| s.to_string_lossy().into_owned())
@@ -543,15 +526,11 @@ fn write_report(out: &Path, report: &SceneReport) -> Result<()> {
     Ok(())
 }
 
+/// `results.csv` and `results.json` of `records` in `out` (created if missing).
 fn write_results(out: &Path, records: &[harness::Record]) -> Result<()> {
-    let csv = harness::records_to_csv(records);
-    let json = harness::records_to_json(records)?;
-    write_atomic(&out.join("results.csv"), |p| {
-        std::fs::write(p, &csv).context("results.csv")
-    })?;
-    write_atomic(&out.join("results.json"), |p| {
-        std::fs::write(p, &json).context("results.json")
-    })?;
+    std::fs::create_dir_all(out)
+        .with_context(|| format!("cannot create directory {}", out.display()))?;
+    texmap_study::record::write_results(out, records)?;
     Ok(())
 }
 

@@ -1,270 +1,68 @@
-//! Glue: an md-io frame (atoms in Å) becomes an impostor `SphereScene`, and a camera is chosen.
-
-use std::collections::HashMap;
+//! The `render` flags turned into the `texmap-md-scene` library's calls: an md-io frame (atoms
+//! in Å) becomes an impostor `SphereScene` styled as the flags ask, and a camera is chosen.
 
 use anyhow::{Context, Result};
 use glam::Vec3;
 use texmap_core::camera::Camera;
 use texmap_core::camera_path::{Keyframes, Pose};
-use texmap_core::color::{hsv_to_rgb, srgb_to_linear};
-use texmap_core::shade::Material;
 use texmap_impostor::SphereScene;
-use texmap_md_io::{
-    Appearance, AtomStyle, Element, Frame, Label, Selection, Selector, Topology, atom_element,
-};
+use texmap_md_io::{Frame, Selection, Topology, atom_element};
+use texmap_md_scene::{RuleKind, StyleError, StyleOptions, StyleWarning, ViewAxis, centre_of};
 
 use crate::args::{
     BondsArg, ColorBy, DrawStyle, MolArgs, PathArgs, PbcArg, StyleArgs, ViewArgs, parse_color,
     usage,
 };
 
-/// Most materials a scene gets: every method handles this many cheaply (the LUT and template
-/// methods build tables per material). Colours past the first `MAX_MATERIALS` distinct ones
-/// (after 8-bit quantisation) are drawn with the nearest of those.
-pub const MAX_MATERIALS: usize = 256;
+pub use texmap_md_scene::{MAX_MATERIALS, SceneBuilder};
 
-/// Reusable conversion from md-io frames to sphere scenes: one material per distinct colour,
-/// kept stable across frames so per-material tables survive from frame to frame.
-pub struct SceneBuilder {
-    style: AtomStyle,
-    color_by: ColorBy,
-    pub(crate) radius_scale: f32,
-    /// The NAMEs of --type-radius / --type-color, for the no-match warning.
-    names: Vec<(&'static str, String)>,
-    palette: Vec<[u8; 3]>,
-    /// 8-bit colour -> material (exact, or the nearest palette entry once the palette is full).
-    kinds: HashMap<[u8; 3], u16>,
-    /// Distinct colours drawn with a nearest palette entry.
-    merged: usize,
-    types: Vec<Label>,
-    radii: Vec<f32>,
-    colors: Vec<[f32; 3]>,
-}
-
-/// A distinct, evenly spaced hue per type index (golden-angle hues).
-fn type_color(i: usize) -> [f32; 3] {
-    let c = hsv_to_rgb(Vec3::new((i as f32 * 137.507_77) % 360.0, 0.65, 0.95));
-    [c.x, c.y, c.z]
-}
-
-/// The selectors a NAME of --type-radius / --type-color stands for: the type and the atom name
-/// NAME, and the element whose symbol NAME is (any case), if any.
-fn selectors(name: &str) -> Result<Vec<Selector>> {
-    let Some(label) = Label::new(name) else {
-        return usage(format!(
-            "NAME {name:?} is longer than {} bytes",
-            Label::CAPACITY
-        ));
-    };
-    let mut v = vec![Selector::Type(label), Selector::Name(label)];
-    if let Some(e) = Element::from_symbol(name) {
-        v.push(Selector::Element(e));
-    }
-    Ok(v)
-}
-
-/// The md-io style for the CLI flags: one rule per selector, later flags replacing earlier
-/// ones field by field (so `--type-radius O=1 --type-color O=#f00` sets both).
-pub fn style_from(args: &StyleArgs) -> Result<AtomStyle> {
-    let mut rules: Vec<(Selector, Appearance)> = Vec::new();
-    let mut merge = |sel: Selector, look: Appearance| match rules.iter_mut().find(|r| r.0 == sel) {
-        Some(r) => {
-            r.1.radius = look.radius.or(r.1.radius);
-            r.1.color = look.color.or(r.1.color);
-        }
-        None => rules.push((sel, look)),
-    };
-    for t in &args.type_radius {
-        for sel in selectors(&t.name)? {
-            merge(
-                sel,
-                Appearance {
-                    radius: Some(t.radius),
-                    color: None,
-                },
-            );
-        }
-    }
-    for t in &args.type_color {
-        for sel in selectors(&t.name)? {
-            merge(
-                sel,
-                Appearance {
-                    radius: None,
-                    color: Some(t.rgb.map(|c| c as f32 / 255.0)),
-                },
-            );
-        }
-    }
-    let mut style = AtomStyle::new();
-    for (sel, look) in rules {
-        style
-            .set(sel, look)
-            .map_err(|e| crate::args::UsageError(format!("--type-radius/--type-color: {e}")))?;
-    }
-    Ok(style)
-}
-
-impl SceneBuilder {
-    pub fn new(args: &StyleArgs) -> Result<SceneBuilder> {
-        let s = args.radius_scale;
-        if !(s.is_finite() && s > 0.0) {
-            return usage(format!("--radius-scale {s}: must be a finite number > 0"));
-        }
-        let names = args
+/// The library's style options for the `--color-by`, `--radius-scale`, `--type-radius` and
+/// `--type-color` flags.
+pub fn style_options(args: &StyleArgs) -> StyleOptions {
+    StyleOptions {
+        color_by: match args.color_by {
+            ColorBy::Property => texmap_md_scene::ColorBy::Property,
+            ColorBy::Element => texmap_md_scene::ColorBy::Element,
+            ColorBy::Type => texmap_md_scene::ColorBy::Type,
+        },
+        radius_scale: args.radius_scale,
+        type_radius: args
             .type_radius
             .iter()
-            .map(|t| ("--type-radius", t.name.clone()))
-            .chain(
-                args.type_color
-                    .iter()
-                    .map(|t| ("--type-color", t.name.clone())),
-            )
-            .collect();
-        Ok(SceneBuilder {
-            style: style_from(args)?,
-            color_by: args.color_by,
-            radius_scale: s,
-            names,
-            palette: Vec::new(),
-            kinds: HashMap::new(),
-            merged: 0,
-            types: Vec::new(),
-            radii: Vec::new(),
-            colors: Vec::new(),
-        })
-    }
-
-    /// The material of an sRGB colour in [0, 1] (quantised to 8 bits per channel).
-    pub(crate) fn kind_of(&mut self, srgb: [f32; 3]) -> u16 {
-        let key = srgb.map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8);
-        if let Some(k) = self.kinds.get(&key) {
-            return *k;
-        }
-        let k = if self.palette.len() < MAX_MATERIALS {
-            // A new material for a new colour.
-            self.palette.push(key);
-            (self.palette.len() - 1) as u16
-        } else {
-            // Palette full: the nearest entry (squared 8-bit distance, lowest index on ties).
-            self.merged += 1;
-            let d2 =
-                |p: &[u8; 3]| -> i32 { (0..3).map(|c| (p[c] as i32 - key[c] as i32).pow(2)).sum() };
-            let mut best = 0;
-            for (i, p) in self.palette.iter().enumerate() {
-                if d2(p) < d2(&self.palette[best]) {
-                    best = i;
-                }
-            }
-            best as u16
-        };
-        self.kinds.insert(key, k);
-        k
-    }
-
-    /// Distinct colours so far drawn with the nearest of the first [`MAX_MATERIALS`].
-    pub fn merged_colors(&self) -> usize {
-        self.merged
-    }
-
-    /// Warnings worth one line each about `frame` (the first one rendered): a --type-radius or
-    /// --type-color NAME that selects no atom; colour-column values outside [0, 1].
-    pub fn warnings(&self, frame: &Frame) -> Vec<String> {
-        let mut out = Vec::new();
-        for (flag, name) in &self.names {
-            let element = Element::from_symbol(name);
-            let hit = frame.types.iter().any(|t| t.as_str() == name)
-                || frame.names.iter().any(|n| n.as_str() == name)
-                || element
-                    .is_some_and(|e| (0..frame.n_atoms()).any(|i| atom_element(frame, i) == e));
-            if !hit {
-                out.push(format!(
-                    "{flag} {name}: no atom of the first frame has this type, name or element"
-                ));
-            }
-        }
-        if self.color_by == ColorBy::Property {
-            let outside = frame
-                .colors
-                .iter()
-                .flatten()
-                .filter(|v| !(0.0..=1.0).contains(*v))
-                .count();
-            if outside > 0 {
-                out.push(format!(
-                    "{outside} colour-column values of the first frame are outside [0, 1] and were clamped (colours are fractions of 1, not 0-255)"
-                ));
-            }
-        }
-        out
-    }
-
-    /// Fill `scene` (cleared first) from `frame` (whose colour column is dropped unless colouring
-    /// by property). Atoms with non-finite coordinates are kept as they are: the renderers skip
-    /// and count them.
-    pub fn build(&mut self, frame: &mut Frame, scene: &mut SphereScene) {
-        if self.color_by != ColorBy::Property {
-            // Element and type colouring ignore colour columns in the file.
-            frame.colors.clear();
-        }
-        // Radius and colour per atom: file column > --type-* rule > element table.
-        self.style.apply(frame, &mut self.radii, &mut self.colors);
-        scene.centers.clear();
-        scene.radii.clear();
-        scene.kinds.clear();
-        scene.bonds.clear();
-        // Atoms with types but no colours, names or elements (a LAMMPS dump with numeric
-        // types) are coloured by type by default, as OVITO does.
-        let by_type = self.color_by == ColorBy::Type
-            || (self.color_by == ColorBy::Property
-                && frame.colors.is_empty()
-                && frame.names.is_empty()
-                && !frame.types.is_empty()
-                && frame.elements.iter().all(|e| e.is_unknown()));
-        for i in 0..frame.n_atoms() {
-            let p = frame.positions[i];
-            let color = match by_type {
-                true => match self.style.rules_for(frame, i).color {
-                    Some(c) => c,
-                    None => {
-                        // One palette colour per type (or name), in order of appearance.
-                        let label = frame
-                            .types
-                            .get(i)
-                            .or(frame.names.get(i))
-                            .copied()
-                            .unwrap_or_default();
-                        let idx = match self.types.iter().position(|t| *t == label) {
-                            Some(j) => j,
-                            None => {
-                                self.types.push(label);
-                                self.types.len() - 1
-                            }
-                        };
-                        type_color(idx)
-                    }
-                },
-                false => self.colors[i],
-            };
-            let kind = self.kind_of(color);
-            scene.push(Vec3::from(p), self.radii[i] * self.radius_scale, kind);
-        }
-        self.refresh_materials(scene);
-    }
-
-    /// One material per palette colour (after [`SceneBuilder::kind_of`] added some).
-    pub(crate) fn refresh_materials(&self, scene: &mut SphereScene) {
-        scene.materials = self
-            .palette
+            .map(|t| (t.name.clone(), t.radius))
+            .collect(),
+        type_color: args
+            .type_color
             .iter()
-            .map(|c| {
-                Material::plastic(Vec3::new(
-                    srgb_to_linear(c[0] as f32 / 255.0),
-                    srgb_to_linear(c[1] as f32 / 255.0),
-                    srgb_to_linear(c[2] as f32 / 255.0),
-                ))
-            })
-            .collect();
+            .map(|t| (t.name.clone(), t.rgb))
+            .collect(),
+    }
+}
+
+/// The scene builder for the style flags; a refused style is a usage error naming the flag.
+pub fn scene_builder(args: &StyleArgs) -> Result<SceneBuilder> {
+    SceneBuilder::new(&style_options(args)).or_else(|e| match e {
+        StyleError::BadRadiusScale { scale } => usage(format!(
+            "--radius-scale {scale}: must be a finite number > 0"
+        )),
+        StyleError::NameTooLong { .. } => usage(e.to_string()),
+        StyleError::Rule(e) => usage(format!("--type-radius/--type-color: {e}")),
+    })
+}
+
+/// One line of warning about the style flags.
+pub fn warning_text(w: &StyleWarning) -> String {
+    match w {
+        StyleWarning::NoMatch { kind, name } => {
+            let flag = match kind {
+                RuleKind::Radius => "--type-radius",
+                RuleKind::Color => "--type-color",
+            };
+            format!("{flag} {name}: no atom of the first frame has this type, name or element")
+        }
+        StyleWarning::ColorsOutOfRange { count } => format!(
+            "{count} colour-column values of the first frame are outside [0, 1] and were clamped (colours are fractions of 1, not 0-255)"
+        ),
     }
 }
 
@@ -432,7 +230,7 @@ impl MolPlan {
             }
         }
         builder.refresh_materials(scene);
-        let scale = builder.radius_scale;
+        let scale = builder.radius_scale();
         for (sel, r) in &self.radii {
             let mask = sel
                 .evaluate(frame)
@@ -518,14 +316,6 @@ impl MolPlan {
 /// Atom and stick radius of `--style licorice` (Å), as VMD's Licorice default (0.3).
 pub const LICORICE_RADIUS: f32 = 0.3;
 
-/// The 8 corners of a periodic cell, corner `c` at fractional coordinates of its bits (x, y, z).
-pub fn cell_corners(cell: &texmap_md_io::UnitCell) -> [Vec3; 8] {
-    std::array::from_fn(|c| {
-        let p = cell.to_cartesian([(c & 1) as f64, ((c >> 1) & 1) as f64, ((c >> 2) & 1) as f64]);
-        Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32)
-    })
-}
-
 fn parse_vec3(s: &str, what: &str) -> Result<Vec3> {
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();
     if parts.len() != 3 {
@@ -579,28 +369,25 @@ pub fn parse_background(s: &str) -> Result<[u8; 4]> {
     }
 }
 
-/// The view direction (from the camera toward the target) for `--view`.
-fn view_direction(view: &str) -> Result<(Vec3, Vec3)> {
-    Ok(match view {
-        "auto" => (-texmap_study::scenes::VIEW_DIRECTION.normalize(), Vec3::Y),
-        "x" => (-Vec3::X, Vec3::Z),
-        "-x" => (Vec3::X, Vec3::Z),
-        "y" => (-Vec3::Y, Vec3::Z),
-        "-y" => (Vec3::Y, Vec3::Z),
-        "z" => (-Vec3::Z, Vec3::Y),
-        "-z" => (Vec3::Z, Vec3::Y),
-        other => {
-            return usage(format!(
-                "--view {other:?}: expected auto, x, y, z, -x, -y or -z (the axis the camera sits on)"
-            ));
-        }
-    })
+/// The automatic camera's position for `--view`.
+fn view_axis(view: &str) -> Result<ViewAxis> {
+    match ViewAxis::parse(view) {
+        Some(axis) => Ok(axis),
+        None => usage(format!(
+            "--view {view:?}: expected auto, x, y, z, -x, -y or -z (the axis the camera sits on)"
+        )),
+    }
 }
 
-/// The camera for a render and the point it looks at: exactly `--eye/--target/--up` when given,
-/// else fitted to what the first frame draws (the selected atoms' bounding box's sphere).
-pub fn camera_for(args: &ViewArgs, first: &Frame, scene: &SphereScene) -> Result<(Camera, Vec3)> {
-    let (w, h) = parse_size(&args.size)?;
+/// The camera for a render of `size` pixels and the point it looks at: exactly
+/// `--eye/--target/--up` when given, else fitted to what the first frame draws
+/// ([`texmap_md_scene::fit_camera`]).
+pub fn camera_for(
+    args: &ViewArgs,
+    (w, h): (u32, u32),
+    first: &Frame,
+    scene: &SphereScene,
+) -> Result<(Camera, Vec3)> {
     let hfov = if args.ortho { None } else { Some(args.fov) };
     if let Some(f) = hfov
         && !(f.is_finite() && f > 0.0 && f < 180.0)
@@ -618,14 +405,15 @@ pub fn camera_for(args: &ViewArgs, first: &Frame, scene: &SphereScene) -> Result
             );
             let cam = match hfov {
                 Some(f) => Camera::perspective_look_at(e, t, u, f, w, h),
-                None => {
-                    // Orthographic with an explicit camera: frame the scene's extent.
-                    let extent = scene
-                        .bounds()
-                        .map(|(lo, hi)| (hi - lo).length())
-                        .unwrap_or(1.0);
-                    Camera::orthographic_look_at(e, t, u, extent, w, h)
-                }
+                // Orthographic with an explicit camera: frame the scene's extent.
+                None => Camera::orthographic_look_at(
+                    e,
+                    t,
+                    u,
+                    texmap_md_scene::camera::ortho_extent(scene),
+                    w,
+                    h,
+                ),
             };
             return cam
                 .map(|c| (c, t))
@@ -634,28 +422,8 @@ pub fn camera_for(args: &ViewArgs, first: &Frame, scene: &SphereScene) -> Result
         (None, None, None) => {}
         _ => return usage("--eye, --target and --up go together: give all three or none"),
     }
-    let (dir, up) = view_direction(&args.view)?;
-    // Frame what is drawn: the scene's spheres (the selected atoms, and the box outline when
-    // it is drawn); the periodic box only when no atom is drawn.
-    let mut lo = Vec3::splat(f32::INFINITY);
-    let mut hi = Vec3::splat(f32::NEG_INFINITY);
-    if let Some((a, b)) = scene.bounds() {
-        lo = a;
-        hi = b;
-    } else if let Some(cell) = &first.cell {
-        for p in cell_corners(cell) {
-            lo = lo.min(p);
-            hi = hi.max(p);
-        }
-    }
-    let (center, radius) = if lo.x <= hi.x {
-        ((lo + hi) * 0.5, (hi - lo).length() * 0.5)
-    } else {
-        (Vec3::ZERO, 1.0)
-    };
-    Camera::fit_sphere(center, radius.max(1e-3), dir, up, hfov, w, h, 1.05)
-        .map(|c| (c, center))
-        .context("automatic camera")
+    let axis = view_axis(&args.view)?;
+    texmap_md_scene::fit_camera(first, scene, axis, hfov, w, h).context("automatic camera")
 }
 
 /// How the camera moves over the frames of a render.
@@ -678,38 +446,22 @@ pub struct CameraPlan {
 }
 
 /// The mean position of the atoms `sel` selects, or None when it selects none.
-fn centre_of(sel: &Selection, frame: &Frame) -> Result<Option<Vec3>> {
-    let idx = sel
-        .indices(frame)
-        .map_err(|e| crate::args::UsageError(format!("--follow: {e}")))?;
-    if idx.is_empty() {
-        return Ok(None);
-    }
-    // f64 sum: a million atoms far from the origin keep their centre to well below an atom.
-    let mut sum = [0f64; 3];
-    for &i in &idx {
-        for (s, p) in sum.iter_mut().zip(frame.positions[i]) {
-            *s += p as f64;
-        }
-    }
-    let n = idx.len() as f64;
-    Ok(Some(Vec3::new(
-        (sum[0] / n) as f32,
-        (sum[1] / n) as f32,
-        (sum[2] / n) as f32,
-    )))
+fn follow_centre(sel: &Selection, frame: &Frame) -> Result<Option<Vec3>> {
+    centre_of(sel, frame).map_err(|e| crate::args::UsageError(format!("--follow: {e}")).into())
 }
 
 impl CameraPlan {
-    /// The plan for a render of `count` frames whose first frame is `first` (drawn as `scene`).
+    /// The plan for a render of `count` frames of `size` pixels whose first frame is `first`
+    /// (drawn as `scene`).
     pub fn new(
         view: &ViewArgs,
+        size: (u32, u32),
         path: &PathArgs,
         first: &Frame,
         scene: &SphereScene,
         count: usize,
     ) -> Result<CameraPlan> {
-        let (template, target) = camera_for(view, first, scene)?;
+        let (template, target) = camera_for(view, size, first, scene)?;
         let pose = Pose::of_camera(&template, target);
         let motion = match (path.orbit, path.orbit_turns, &path.keyframes) {
             (Some(d), None, None) => {
@@ -742,7 +494,7 @@ impl CameraPlan {
             None => None,
             Some(text) => {
                 let sel = parse_selection("--follow", text)?;
-                let Some(c) = centre_of(&sel, first)? else {
+                let Some(c) = follow_centre(&sel, first)? else {
                     return usage(format!(
                         "--follow {text:?} selects none of the first frame's atoms"
                     ));
@@ -771,7 +523,7 @@ impl CameraPlan {
             Motion::Keys(keys) => keys.at(k as f32),
         };
         if let Some((sel, c0)) = &self.follow {
-            let Some(c) = centre_of(sel, frame)? else {
+            let Some(c) = follow_centre(sel, frame)? else {
                 anyhow::bail!(
                     "--follow {:?} selects none of this frame's atoms",
                     sel.text()
@@ -870,71 +622,11 @@ mod tests {
         assert!(parse_vec3("1,nan,3", "x").is_err());
     }
 
-    fn style_args(radius: &[(&str, f32)], color: &[(&str, [u8; 3])]) -> StyleArgs {
-        StyleArgs {
-            color_by: ColorBy::Property,
-            radius_scale: 1.0,
-            type_radius: radius
-                .iter()
-                .map(|(n, r)| crate::args::TypeRadius {
-                    name: n.to_string(),
-                    radius: *r,
-                })
-                .collect(),
-            type_color: color
-                .iter()
-                .map(|(n, c)| crate::args::TypeColor {
-                    name: n.to_string(),
-                    rgb: *c,
-                })
-                .collect(),
-        }
-    }
-
     #[test]
-    fn type_flags_merge_per_selector_and_match_type_name_or_element() {
-        // "O" as radius and "o" as colour: both reach the oxygen element rule.
-        let st = style_from(&style_args(&[("O", 1.0)], &[("o", [255, 0, 0])])).unwrap();
-        let mut f = Frame::new();
-        f.positions = vec![[0.0; 3]; 2];
-        f.names = ["OW", "O"].map(|s| Label::new(s).unwrap()).to_vec();
-        let look = st.rules_for(&f, 0);
-        assert_eq!(look.radius, Some(1.0), "element rule radius for OW");
+    fn the_automatic_view_is_the_study_scenes_view() {
         assert_eq!(
-            look.color,
-            Some([1.0, 0.0, 0.0]),
-            "element rule colour for OW"
+            texmap_md_scene::AUTO_VIEW_DIRECTION,
+            texmap_study::scenes::VIEW_DIRECTION
         );
-        // Atom named exactly "O": the name rule (radius only) then the element rule (colour).
-        assert_eq!(st.rules_for(&f, 1).radius, Some(1.0));
-        assert_eq!(st.rules_for(&f, 1).color, Some([1.0, 0.0, 0.0]));
-    }
-
-    #[test]
-    fn palette_is_capped_and_overflow_colours_take_the_nearest() {
-        let mut b = SceneBuilder::new(&style_args(&[], &[])).unwrap();
-        // MAX_MATERIALS distinct greys 0..=255 fill the palette exactly.
-        for g in 0..MAX_MATERIALS {
-            let v = g as f32 / 255.0;
-            assert_eq!(b.kind_of([v, v, v]) as usize, g);
-        }
-        assert_eq!(b.merged_colors(), 0);
-        // Pure red is nearest (squared 8-bit distance, computed here by brute force) to the grey
-        // g minimising (255 − g)² + 2g²: g = 85.
-        let best = (0..256i32)
-            .min_by_key(|g| (255 - g).pow(2) + 2 * g * g)
-            .unwrap();
-        assert_eq!(best, 85);
-        assert_eq!(b.kind_of([1.0, 0.0, 0.0]) as usize, best as usize);
-        assert_eq!(b.merged_colors(), 1);
-        // Asked again: same material, counted once.
-        assert_eq!(b.kind_of([1.0, 0.0, 0.0]) as usize, best as usize);
-        assert_eq!(b.merged_colors(), 1);
-        // The palette never grows past the cap, so u16 kinds cannot wrap.
-        for i in 0..5000u32 {
-            let c = [(i % 97) as f32 / 96.0, (i % 89) as f32 / 88.0, 0.5];
-            assert!((b.kind_of(c) as usize) < MAX_MATERIALS);
-        }
-        assert_eq!(b.palette.len(), MAX_MATERIALS);
     }
 }

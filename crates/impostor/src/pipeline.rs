@@ -1,18 +1,15 @@
 //! The one pipeline every sprite-like method shares: transform + cull + project → bin into
 //! 32x32 tiles → per-tile pixel kernels in parallel.
 //!
-//! 1. **Project** (parallel over chunks of at most [`CHUNK`] spheres, their size fixed by the
-//!    scene's size alone): each valid sphere is moved to eye space, culled against the near/far
-//!    planes and the screen, and turned into a 32-byte [`Proj`] record by the method's
-//!    projection function. Each chunk appends its records to its
-//!    own buffer and counts, per tile, how many records touch that tile.
-//! 2. **Prefix sum** (serial, over tiles x chunks): the start of every (tile, chunk) run in one
-//!    bin array, so that chunk `c`'s records for tile `t` follow those of chunks `< c`.
-//! 3. **Fill** (parallel over chunks): each chunk copies its records into its own disjoint runs.
-//!    A copy of the projected record (not an index) lives in the bin: the tile kernels then read
-//!    their bins sequentially (PERFORMANCE-NOTES: the index version spent 55% of its time on cache
-//!    misses).
-//! 4. **Tiles** (parallel over bands of 32 rows): each tile runs the method's depth pass over its
+//! 1. **Project and bin** (the raster crate's tile binner, [`texmap_raster::bin`], parallel
+//!    over chunks of at most [`CHUNK`] spheres, their size fixed by the scene's size alone):
+//!    each valid sphere is moved to eye space, culled against the near/far planes and the
+//!    screen, and turned into a 32-byte [`Proj`] record by the method's projection function;
+//!    the binner then copies each record into every tile its box touches, sphere order kept
+//!    within every tile. A copy of the projected record (not an index) lives in the bin: the
+//!    tile kernels then read their bins sequentially (PERFORMANCE-NOTES: the index version
+//!    spent 55% of its time on cache misses).
+//! 2. **Tiles** (parallel over bands of 32 rows): each tile runs the method's depth pass over its
 //!    bin in the kernel's order ([`Kernel::order`]: sphere order, or the ray-cast kernel's front
 //!    to back), remembering the winning record per pixel, then its resolve pass colours each
 //!    covered pixel once (deferred shading: overdraw costs a depth test, not a shade).
@@ -32,6 +29,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 use texmap_core::camera::Camera;
 use texmap_core::frame::Frame;
+use texmap_raster::bin::{ChunkSink, TileBins, TileGrid};
 
 use crate::options::RenderStats;
 use crate::scene::SphereScene;
@@ -104,7 +102,11 @@ pub(crate) struct View {
     pub up: Vec3,
     pub back: Vec3,
     pub tiles_x: u32,
+    /// Tile rows (the tile passes walk the frame in bands instead; the tests walk tiles).
+    #[cfg_attr(not(test), allow(dead_code))]
     pub tiles_y: u32,
+    /// The tiles for the binner (`tiles_x` by `tiles_y` tiles of [`TILE`] pixels).
+    pub grid: TileGrid,
 }
 
 impl View {
@@ -126,6 +128,10 @@ impl View {
             back: -cam.forward(),
             tiles_x: w.div_ceil(TILE),
             tiles_y: h.div_ceil(TILE),
+            grid: match TileGrid::new(w, h, TILE) {
+                Ok(g) => g,
+                Err(_) => unreachable!("a camera's sides are in 1..=MAX_IMAGE_SIDE"),
+            },
         }
     }
 
@@ -174,23 +180,11 @@ pub(crate) enum Projected {
     Culled,
 }
 
-/// The reusable per-frame buffers.
+/// The reusable per-frame buffers: the binned records of the frame.
 #[derive(Debug, Default)]
 pub(crate) struct Bins {
-    chunk_recs: Vec<Vec<Proj>>,
-    chunk_counts: Vec<Vec<u32>>,
-    chunk_stats: Vec<RenderStats>,
-    pub recs: Vec<Proj>,
-    /// `tile_start[t]..tile_start[t + 1]` is tile `t`'s run in `recs`.
-    pub tile_start: Vec<usize>,
+    bins: TileBins<Proj>,
 }
-
-/// A raw pointer that chunks write through at disjoint offsets.
-#[derive(Clone, Copy)]
-struct SendPtr(*mut Proj);
-// SAFETY: every writer writes a disjoint set of slots (see `Bins::build`).
-unsafe impl Send for SendPtr {}
-unsafe impl Sync for SendPtr {}
 
 impl Bins {
     /// Project every sphere with `project` and bin the records into tiles. Returns the stats.
@@ -199,108 +193,39 @@ impl Bins {
         F: Fn(Vec3, f32, u16) -> Projected + Sync,
     {
         let n = scene.len();
-        let chunk = chunk_len(n);
-        let nchunks = n.div_ceil(chunk);
-        let ntiles = (view.tiles_x * view.tiles_y) as usize;
-        self.chunk_recs.resize_with(nchunks, Vec::new);
-        self.chunk_counts.resize_with(nchunks, Vec::new);
-        self.chunk_stats.resize(nchunks, RenderStats::default());
-        let tiles_x = view.tiles_x as usize;
-
-        // Pass 1: transform, cull, project, count per tile (parallel over fixed chunks).
-        self.chunk_recs[..nchunks]
-            .par_iter_mut()
-            .zip(self.chunk_counts[..nchunks].par_iter_mut())
-            .zip(self.chunk_stats[..nchunks].par_iter_mut())
-            .enumerate()
-            .for_each(|(ci, ((recs, counts), stats))| {
-                let lo = ci * chunk;
-                let hi = (lo + chunk).min(n);
-                project_chunk(scene, view, &project, lo..hi, recs, counts, stats);
-            });
-
-        // Pass 2: prefix sum over (tile, chunk); counts become write offsets.
-        let total = prefix_tile_offsets(
-            &mut self.tile_start,
-            &mut self.chunk_counts[..nchunks],
-            ntiles,
-        );
-
-        // Pass 3: fill (parallel over chunks, each writing its own disjoint runs).
-        self.recs.clear();
-        self.recs.reserve(total);
-        let base = SendPtr(self.recs.as_mut_ptr());
-        let tile_start = &self.tile_start;
-        self.chunk_recs[..nchunks]
-            .par_iter()
-            .zip(self.chunk_counts[..nchunks].par_iter_mut())
-            .for_each(|(recs, offs)| {
-                // Capture the whole `SendPtr` (edition 2024 closures would capture the raw
-                // pointer field alone, which is not `Send`).
-                #[allow(clippy::redundant_locals)]
-                let base = base;
-                // SAFETY: as `fill_chunk` requires, `offs` are this chunk's write offsets from
-                // the prefix sum and `base` has capacity `total`.
-                unsafe { fill_chunk(recs, offs, tile_start, tiles_x, base) };
-            });
-        // SAFETY: the runs of all (tile, chunk) pairs partition 0..total and each slot was
-        // written exactly once above.
-        unsafe { self.recs.set_len(total) };
-
+        let chunk_stats = self.bins.build(view.grid, n, chunk_len(n), |range, sink| {
+            project_chunk(scene, view, &project, range, sink)
+        });
         let mut stats = RenderStats::default();
-        for s in &self.chunk_stats[..nchunks] {
+        for s in &chunk_stats {
             stats.drawn += s.drawn;
             stats.culled += s.culled;
             stats.skipped_invalid += s.skipped_invalid;
         }
         stats
     }
-}
 
-/// Pass 2 of the two-pass binning (shared by the sphere pipeline and the bond pass): a prefix sum
-/// over (tile, chunk). `tile_start` becomes the start of every tile's run (plus the total at the
-/// end) and each chunk's per-tile count becomes its write offset *relative to the tile start*
-/// (so offsets fit u32 whenever one tile's run does). Returns the total number of records.
-pub(crate) fn prefix_tile_offsets(
-    tile_start: &mut Vec<usize>,
-    chunk_counts: &mut [Vec<u32>],
-    ntiles: usize,
-) -> usize {
-    tile_start.clear();
-    tile_start.reserve(ntiles + 1);
-    let mut run = 0usize;
-    for t in 0..ntiles {
-        tile_start.push(run);
-        for counts in chunk_counts.iter_mut() {
-            let c = counts[t] as usize;
-            counts[t] = (run - tile_start[t]) as u32;
-            run += c;
-        }
+    /// The records of tile `t`, in sphere order.
+    #[inline]
+    pub fn tile(&self, t: usize) -> &[Proj] {
+        self.bins.tile(t)
     }
-    tile_start.push(run);
-    run
 }
 
-/// Pass 1 of [`Bins::build`] for one chunk of spheres: transform, cull, project, count per
-/// tile. Not inlined, so that profiles show the stage.
+/// The project pass of [`Bins::build`] for one chunk of spheres: transform, cull, project,
+/// push into the tiles of the record's box. Not inlined, so that profiles show the stage.
 #[inline(never)]
 fn project_chunk<F>(
     scene: &SphereScene,
     view: &View,
     project: &F,
     range: std::ops::Range<usize>,
-    recs: &mut Vec<Proj>,
-    counts: &mut Vec<u32>,
-    stats: &mut RenderStats,
-) where
+    sink: &mut ChunkSink<'_, Proj>,
+) -> RenderStats
+where
     F: Fn(Vec3, f32, u16) -> Projected + Sync,
 {
-    let ntiles = (view.tiles_x * view.tiles_y) as usize;
-    let tiles_x = view.tiles_x as usize;
-    recs.clear();
-    counts.clear();
-    counts.resize(ntiles, 0);
-    *stats = RenderStats::default();
+    let mut stats = RenderStats::default();
     for i in range {
         if !scene.is_valid(i) {
             stats.skipped_invalid += 1;
@@ -309,60 +234,20 @@ fn project_chunk<F>(
         let c = view.eye_space(scene.centers[i]);
         match project(c, scene.radii[i], scene.kinds[i]) {
             Projected::Draw(p) => {
-                stats.drawn += 1;
-                let (tx0, ty0, tx1, ty1) = tile_range(&p);
-                for ty in ty0..=ty1 {
-                    let row = &mut counts[ty * tiles_x..];
-                    for c in &mut row[tx0..=tx1] {
-                        *c += 1;
+                // A drawn record's box holds at least one pixel of the image.
+                let [x0, y0, x1, y1] = p.bbox.map(u32::from);
+                match view.grid.span(x0, y0, x1, y1) {
+                    Some(span) => {
+                        stats.drawn += 1;
+                        sink.push(span, p);
                     }
+                    None => stats.culled += 1,
                 }
-                recs.push(p);
             }
             Projected::Culled => stats.culled += 1,
         }
     }
-}
-
-/// Pass 3 of [`Bins::build`] for one chunk: copy every record into the bins it touches.
-///
-/// # Safety
-/// `offs[t]` must be this chunk's write offset in tile `t`'s run (from the prefix sum), so that
-/// the slots written are disjoint from every other chunk's and below the capacity behind `base`.
-#[inline(never)]
-unsafe fn fill_chunk(
-    recs: &[Proj],
-    offs: &mut [u32],
-    tile_start: &[usize],
-    tiles_x: usize,
-    base: SendPtr,
-) {
-    for p in recs {
-        let (tx0, ty0, tx1, ty1) = tile_range(p);
-        for ty in ty0..=ty1 {
-            for tx in tx0..=tx1 {
-                let t = ty * tiles_x + tx;
-                let slot = tile_start[t] + offs[t] as usize;
-                offs[t] += 1;
-                debug_assert!(slot < tile_start[t + 1]);
-                // SAFETY: `slot` lies in this chunk's own run of tile `t` (prefix sum), which no
-                // other chunk writes, and below `total`, the reserved capacity.
-                unsafe { base.0.add(slot).write(*p) };
-            }
-        }
-    }
-}
-
-#[inline]
-fn tile_range(p: &Proj) -> (usize, usize, usize, usize) {
-    let [x0, y0, x1, y1] = p.bbox;
-    debug_assert!(x0 < x1 && y0 < y1);
-    (
-        (x0 as u32 / TILE) as usize,
-        (y0 as u32 / TILE) as usize,
-        ((x1 as u32 - 1) / TILE) as usize,
-        ((y1 as u32 - 1) / TILE) as usize,
-    )
+    stats
 }
 
 /// The pixel rectangle of one tile.
@@ -567,7 +452,7 @@ pub(crate) fn draw_tiles<K: Kernel>(
                     h: th,
                 };
                 let t = ty * view.tiles_x as usize + tx as usize;
-                let recs = &bins.recs[bins.tile_start[t]..bins.tile_start[t + 1]];
+                let recs = bins.tile(t);
                 if recs.is_empty() {
                     // Nothing here: background.
                     for j in 0..th as usize {

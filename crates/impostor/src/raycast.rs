@@ -1039,7 +1039,7 @@ mod tests {
         for ty in 0..view.tiles_y {
             for tx in 0..view.tiles_x {
                 let t = (ty * view.tiles_x + tx) as usize;
-                let recs = &bins.recs[bins.tile_start[t]..bins.tile_start[t + 1]];
+                let recs = bins.tile(t);
                 if recs.is_empty() {
                     continue;
                 }

@@ -2,10 +2,10 @@
 //!
 //! Every draw runs the same three stages:
 //! 1. **vertices** (parallel): world -> eye -> fixed-point screen ([`crate::project`]);
-//! 2. **primitives** (parallel over fixed chunks of [`CHUNK`] primitives): facing, bounding box,
-//!    clipping of the few triangles that need it, one packed tile rectangle per primitive, and
-//!    per-chunk tile counts; then a prefix sum and a parallel fill that copies each primitive's
-//!    record into its tiles in primitive order (`bin`);
+//! 2. **primitives** (the [`crate::bin`] binner, parallel over fixed chunks of [`CHUNK`]
+//!    primitives): facing, bounding box, clipping of the few triangles that need it, and the
+//!    set-up record (snapped vertices oriented clockwise, varyings) pushed with its tile span;
+//!    the binner then copies each record into its tiles in primitive order;
 //! 3. **tiles** (parallel): each tile walks its records in submission order and rasterises them
 //!    into its own pixels.
 //!
@@ -16,19 +16,22 @@ use rayon::prelude::*;
 use texmap_core::camera::Camera;
 
 use crate::RasterError;
-use crate::bin::{CHUNK, ChunkBins, RECT_CLIPPED, RECT_EMPTY, pack_rect};
+use crate::bin::TileSpan;
 use crate::framebuffer::{Framebuffer, Grid};
 use crate::mesh::Mesh;
 use crate::program::{
     FlatProg, FragProgram, LitFlatProg, LitSmoothProg, QuadSampler, Shading, TexturedProg,
     VertexColorProg,
 };
-use crate::project::{ClipTri, FLAG_INVALID, MAX_VAR, PVert, Proj};
+use crate::project::{FLAG_INVALID, MAX_VAR, PVert, Proj};
 use crate::record::{FRONT_BIT, Rec, VarStore};
 use crate::sprite::{QuadShader, Sprite, raster_sprite};
 use crate::state::{Cull, DrawState};
 use crate::surface::{SurfaceProg, SurfaceShader};
 use crate::tri::{RasterCtx, area2, facing, pixel_bounds, raster_tri};
+
+/// Fixed chunk length of the primitive pass (independent of the thread count).
+const CHUNK: usize = 8192;
 
 /// What happened to the primitives of one draw call (integer counts, identical for any thread
 /// count).
@@ -62,25 +65,41 @@ impl DrawStats {
     }
 }
 
-/// Classify a snapped triangle: its packed tile rectangle or why it draws nothing.
+/// Classify a snapped triangle: its tile span and facing (`true`: front), or why it draws
+/// nothing (counted in `stats`).
 #[inline]
-fn tri_rect(v: &[PVert; 3], cull: Cull, grid: &Grid, stats: &mut DrawStats) -> u32 {
+fn tri_span(
+    v: &[PVert; 3],
+    cull: Cull,
+    grid: &Grid,
+    stats: &mut DrawStats,
+) -> Option<(TileSpan, bool)> {
     let a = area2(v);
     if a == 0 {
         stats.degenerate += 1;
-        return RECT_EMPTY;
+        return None;
     }
-    if facing(a, cull).is_none() {
+    let Some(front) = facing(a, cull) else {
         stats.culled += 1;
-        return RECT_EMPTY;
-    }
-    match pixel_bounds(v, grid.width, grid.height) {
-        Some([x0, y0, x1, y1]) => pack_rect(x0, y0, x1, y1),
+        return None;
+    };
+    match pixel_bounds(v, grid.width, grid.height).and_then(|b| inclusive_span(grid, b)) {
+        Some(span) => Some((span, front)),
         None => {
             stats.no_pixels += 1;
-            RECT_EMPTY
+            None
         }
     }
+}
+
+/// The tile span of the inclusive pixel bounds `[x0, y0, x1, y1]` (inside the image).
+#[inline]
+fn inclusive_span(grid: &Grid, [x0, y0, x1, y1]: [i32; 4]) -> Option<TileSpan> {
+    if x0 < 0 || y0 < 0 || x1 < x0 || y1 < y0 {
+        return None;
+    }
+    grid.bins
+        .span(x0 as u32, y0 as u32, x1 as u32 + 1, y1 as u32 + 1)
 }
 
 impl Framebuffer {
@@ -204,108 +223,57 @@ impl Framebuffer {
             .for_each(|(out, p)| proj.project_slice(p, out));
         let pverts = &scratch.pverts;
 
-        // Stage 2: primitives, in fixed chunks.
-        scratch.rects.resize(indices.len(), RECT_EMPTY);
+        // Stage 2: primitives, in fixed chunks: set up and bin each record.
         let cull = state.cull;
-        let chunks: Vec<(ChunkBins<ClipTri>, DrawStats)> = scratch
-            .rects
-            .par_chunks_mut(CHUNK)
-            .zip(indices.par_chunks(CHUNK))
-            .enumerate()
-            .map(|(ci, (rects, tris))| {
-                let mut bins = ChunkBins::new(&grid);
-                let mut stats = DrawStats {
-                    submitted: tris.len(),
-                    ..DrawStats::default()
-                };
-                for (j, (rect, tri)) in rects.iter_mut().zip(tris).enumerate() {
-                    let t = ci * CHUNK + j;
-                    let v = tri.map(|i| pverts[i as usize]);
-                    let r = if v.iter().any(PVert::flagged) {
-                        if v.iter().any(|p| p.flagged() && p.y == FLAG_INVALID) {
-                            stats.skipped_invalid += 1;
-                            RECT_EMPTY
-                        } else {
-                            // Slow path: clip against the near plane and the guard band.
-                            stats.clipped += 1;
-                            let start = bins.pieces.len();
-                            let p = tri.map(|i| positions[i as usize]);
-                            let var = tri.map(|i| prog.vertex_var(mesh, i as usize));
-                            proj.clip_triangle(p, var, t as u32, &mut bins.pieces);
-                            let mut any = false;
-                            for k in start..bins.pieces.len() {
-                                let mut s = DrawStats::default();
-                                let pr = tri_rect(&bins.pieces[k].v, cull, &grid, &mut s);
-                                bins.pieces[k].rect = pr;
-                                if pr != RECT_EMPTY {
-                                    bins.count(&grid, pr);
-                                    any = true;
-                                }
-                            }
-                            if any {
-                                stats.binned += 1;
-                            }
-                            RECT_CLIPPED
-                        }
-                    } else {
-                        let r = tri_rect(&v, cull, &grid, &mut stats);
-                        if r != RECT_EMPTY {
-                            bins.count(&grid, r);
-                            stats.binned += 1;
-                        }
-                        r
-                    };
-                    *rect = r;
-                }
-                (bins, stats)
-            })
-            .collect();
-        let mut stats = DrawStats::default();
-        let mut chunk_bins = Vec::with_capacity(chunks.len());
-        for (b, s) in chunks {
-            stats.add(&s);
-            chunk_bins.push(b);
-        }
-
-        // Fill: copy each triangle's record into its tiles, chunks in parallel.
-        let counts: Vec<&[u32]> = chunk_bins.iter().map(|c| c.counts.as_slice()).collect();
-        let rects = &scratch.rects;
         let bins = P::Vars::bins(&mut scratch.tris);
-        bins.fill(&grid, &counts, |ci, em| {
-            let lo = ci * CHUNK;
-            let hi = (lo + CHUNK).min(rects.len());
-            let pieces = &chunk_bins[ci].pieces;
-            let mut pc = 0usize;
-            for t in lo..hi {
-                let r = rects[t];
-                if r == RECT_EMPTY {
-                    continue;
-                }
-                if r == RECT_CLIPPED {
-                    while pc < pieces.len() && pieces[pc].tri == t as u32 {
-                        let p = &pieces[pc];
-                        if p.rect != RECT_EMPTY {
-                            // A binned piece has a non-zero area and survives culling.
-                            if let Some(front) = facing(area2(&p.v), cull) {
-                                em.put(p.rect, Rec::new(p.v, p.var, p.tri, front));
-                            }
-                        }
-                        pc += 1;
-                    }
-                    continue;
-                }
+        let chunk_stats = bins.build(grid.bins, indices.len(), CHUNK, |range, sink| {
+            let mut stats = DrawStats {
+                submitted: range.len(),
+                ..DrawStats::default()
+            };
+            let mut pieces = Vec::new();
+            for t in range {
                 let tri = indices[t];
                 let v = tri.map(|i| pverts[i as usize]);
-                let Some(front) = facing(area2(&v), cull) else {
-                    continue;
-                };
-                let mut var = [[0.0; MAX_VAR]; 3];
-                if P::NV > 0 {
-                    var = tri.map(|i| prog.vertex_var(mesh, i as usize));
+                if v.iter().any(PVert::flagged) {
+                    if v.iter().any(|p| p.flagged() && p.y == FLAG_INVALID) {
+                        stats.skipped_invalid += 1;
+                        continue;
+                    }
+                    // Slow path: clip against the near plane and the guard band.
+                    stats.clipped += 1;
+                    pieces.clear();
+                    let p = tri.map(|i| positions[i as usize]);
+                    let var = tri.map(|i| prog.vertex_var(mesh, i as usize));
+                    proj.clip_triangle(p, var, t as u32, &mut pieces);
+                    let mut any = false;
+                    for piece in &pieces {
+                        // The pieces' own degenerate, culled and empty cases are not counted:
+                        // the source triangle counts once, as clipped.
+                        let mut s = DrawStats::default();
+                        if let Some((span, front)) = tri_span(&piece.v, cull, &grid, &mut s) {
+                            sink.push(span, Rec::new(piece.v, piece.var, piece.tri, front));
+                            any = true;
+                        }
+                    }
+                    if any {
+                        stats.binned += 1;
+                    }
+                } else if let Some((span, front)) = tri_span(&v, cull, &grid, &mut stats) {
+                    let mut var = [[0.0; MAX_VAR]; 3];
+                    if P::NV > 0 {
+                        var = tri.map(|i| prog.vertex_var(mesh, i as usize));
+                    }
+                    sink.push(span, Rec::new(v, var, t as u32, front));
+                    stats.binned += 1;
                 }
-                em.put(r, Rec::new(v, var, t as u32, front));
             }
+            stats
         });
+        let mut stats = DrawStats::default();
+        for s in &chunk_stats {
+            stats.add(s);
+        }
 
         // Stage 3: tiles.
         let ctx = RasterCtx::new(*state, proj.far, grid.width, grid.height, *block_path);
@@ -337,52 +305,32 @@ impl Framebuffer {
         }
         let grid = self.grid;
         let Framebuffer { tiles, scratch, .. } = self;
-        scratch.rects.resize(sprites.len(), RECT_EMPTY);
-        let chunks: Vec<(ChunkBins<()>, DrawStats)> = scratch
-            .rects
-            .par_chunks_mut(CHUNK)
-            .zip(sprites.par_chunks(CHUNK))
-            .map(|(rects, sps)| {
-                let mut bins = ChunkBins::new(&grid);
+        let chunk_stats = scratch
+            .sprites
+            .build(grid.bins, sprites.len(), CHUNK, |range, sink| {
                 let mut stats = DrawStats {
-                    submitted: sps.len(),
+                    submitted: range.len(),
                     ..DrawStats::default()
                 };
-                for (rect, sp) in rects.iter_mut().zip(sps) {
-                    *rect = if !sp.is_valid() {
+                for sp in &sprites[range] {
+                    if !sp.is_valid() {
                         stats.skipped_invalid += 1;
-                        RECT_EMPTY
-                    } else if let Some([x0, y0, x1, y1]) = sp.pixel_bounds(grid.width, grid.height)
+                    } else if let Some(span) = sp
+                        .pixel_bounds(grid.width, grid.height)
+                        .and_then(|b| inclusive_span(&grid, b))
                     {
-                        let r = pack_rect(x0, y0, x1, y1);
-                        bins.count(&grid, r);
+                        sink.push(span, *sp);
                         stats.binned += 1;
-                        r
                     } else {
                         stats.no_pixels += 1;
-                        RECT_EMPTY
-                    };
+                    }
                 }
-                (bins, stats)
-            })
-            .collect();
+                stats
+            });
         let mut stats = DrawStats::default();
-        let mut chunk_bins = Vec::with_capacity(chunks.len());
-        for (b, s) in chunks {
-            stats.add(&s);
-            chunk_bins.push(b);
+        for s in &chunk_stats {
+            stats.add(s);
         }
-        let counts: Vec<&[u32]> = chunk_bins.iter().map(|c| c.counts.as_slice()).collect();
-        let rects = &scratch.rects;
-        scratch.sprites.fill(&grid, &counts, |ci, em| {
-            let lo = ci * CHUNK;
-            let hi = (lo + CHUNK).min(rects.len());
-            for i in lo..hi {
-                if rects[i] != RECT_EMPTY {
-                    em.put(rects[i], sprites[i]);
-                }
-            }
-        });
         let ctx = RasterCtx::new(*state, f32::INFINITY, grid.width, grid.height, true);
         let bins = &scratch.sprites;
         tiles.par_iter_mut().enumerate().for_each(|(ti, tile)| {

@@ -31,6 +31,8 @@ pub enum RasterError {
     MissingAttribute { attribute: &'static str },
     /// More primitives in one draw than the bin format can address (2^31 − 1).
     TooManyPrimitives { count: usize },
+    /// A tile side that is not a power of two in `1..=MAX_IMAGE_SIDE` ([`crate::bin::TileGrid`]).
+    BadTileSize { tile: u32 },
 }
 
 impl std::fmt::Display for RasterError {
@@ -69,6 +71,11 @@ impl std::fmt::Display for RasterError {
                 f,
                 "{count} primitives in one draw; at most {} are supported",
                 i32::MAX
+            ),
+            RasterError::BadTileSize { tile } => write!(
+                f,
+                "tile side {tile} is not allowed (a power of two up to {})",
+                texmap_core::camera::MAX_IMAGE_SIDE
             ),
         }
     }

@@ -16,6 +16,7 @@ use texmap_core::color::{linear_to_srgb8, srgb8_to_linear_rgb};
 use texmap_core::frame::Frame;
 
 use crate::RasterError;
+use crate::bin::TileGrid;
 
 /// Side of a screen tile in pixels (a multiple of 2).
 pub const TILE: u32 = 64;
@@ -68,6 +69,8 @@ pub(crate) struct Grid {
     pub height: u32,
     pub tiles_x: u32,
     pub tiles_y: u32,
+    /// The same grid for the binner.
+    pub bins: TileGrid,
 }
 
 impl Grid {
@@ -108,6 +111,7 @@ impl Framebuffer {
             height,
             tiles_x,
             tiles_y,
+            bins: TileGrid::new(width, height, TILE)?,
         };
         let mut tiles = Vec::with_capacity(grid.tile_count());
         for ty in 0..tiles_y {

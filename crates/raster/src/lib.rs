@@ -68,7 +68,8 @@
 //!   with indices, the tile pass of 1M scattered triangles spent about 80% of its time in two
 //!   cache-missing loads (perf, this machine). Programs without varyings bin 52-byte records
 //!   (vertices + triangle index with the facing bit), the others 88 bytes; records are oriented
-//!   at fill time, so the tile pass does no area or cull test.
+//!   when they are set up, before binning, so the tile pass does no area or cull test. The binner
+//!   itself ([`bin`]) is public: the sphere and bond passes of `texmap-impostor` bin through it.
 //! - Programs are monomorphised: the per-quad loop holds no `dyn` and no per-pixel match on the
 //!   shading mode. The depth test, depth write and blend run on four-lane masks and selects
 //!   (`simd`: SSE2 on x86-64, the baseline, with a scalar fallback of identical semantics).
@@ -85,7 +86,7 @@
 //!   [`texmap_core::shade::Lighting::shade`]; only the Blinn-Phong power differs (a four-lane
 //!   `exp2(p·log2 x)`, relative error < 1e-5 against `powf`, tested).
 
-mod bin;
+pub mod bin;
 mod draw;
 mod error;
 mod framebuffer;

@@ -249,8 +249,6 @@ pub(crate) struct ClipTri {
     pub v: [PVert; 3],
     pub var: [Var; 3],
     pub tri: u32,
-    /// Packed tile rectangle (see `bin`).
-    pub rect: u32,
 }
 
 const MAX_POLY: usize = 3 + 5;
@@ -287,7 +285,7 @@ impl Proj {
     }
 
     /// Clip triangle `tri` (world positions `p`, varyings `var`) and append the fan pieces to
-    /// `out` (each with `rect` left 0 for the caller to fill). Returns the number of pieces.
+    /// `out`. Returns the number of pieces.
     pub fn clip_triangle(
         &self,
         p: [Vec3; 3],
@@ -361,7 +359,6 @@ impl Proj {
                 v: [pv[0], pv[i], pv[i + 1]],
                 var: [poly[0].var, poly[i].var, poly[i + 1].var],
                 tri,
-                rect: 0,
             });
         }
         n - 2

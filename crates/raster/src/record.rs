@@ -3,7 +3,7 @@
 //! from draw to draw. The draw stages (`draw`), the fragment programs (`program`) and the
 //! framebuffer all take these from here, so none of them reaches into another's module.
 
-use crate::bin::Bins;
+use crate::bin::TileBins;
 use crate::project::{MAX_VAR, PVert, Var};
 use crate::sprite::Sprite;
 
@@ -41,7 +41,7 @@ impl<V: VarStore> Rec<V> {
 pub(crate) trait VarStore: Copy + Default + Send + Sync + 'static {
     fn pack(var: [Var; 3]) -> Self;
     fn unpack(&self) -> [Var; 3];
-    fn bins(s: &mut TriBins) -> &mut Bins<Rec<Self>>;
+    fn bins(s: &mut TriBins) -> &mut TileBins<Rec<Self>>;
 }
 
 impl VarStore for () {
@@ -51,7 +51,7 @@ impl VarStore for () {
     fn unpack(&self) -> [Var; 3] {
         [[0.0; MAX_VAR]; 3]
     }
-    fn bins(s: &mut TriBins) -> &mut Bins<Rec<()>> {
+    fn bins(s: &mut TriBins) -> &mut TileBins<Rec<()>> {
         &mut s.bare
     }
 }
@@ -65,7 +65,7 @@ impl VarStore for [Var; 3] {
     fn unpack(&self) -> [Var; 3] {
         *self
     }
-    fn bins(s: &mut TriBins) -> &mut Bins<Rec<[Var; 3]>> {
+    fn bins(s: &mut TriBins) -> &mut TileBins<Rec<[Var; 3]>> {
         &mut s.with_var
     }
 }
@@ -73,22 +73,21 @@ impl VarStore for [Var; 3] {
 /// Triangle bins for both record layouts.
 #[derive(Default)]
 pub(crate) struct TriBins {
-    pub bare: Bins<Rec<()>>,
-    pub with_var: Bins<Rec<[Var; 3]>>,
+    pub bare: TileBins<Rec<()>>,
+    pub with_var: TileBins<Rec<[Var; 3]>>,
 }
 
 /// Buffers reused from draw to draw (no per-draw allocation of the big arrays once warm).
 #[derive(Default)]
 pub(crate) struct Scratch {
     pub pverts: Vec<PVert>,
-    pub rects: Vec<u32>,
     pub tris: TriBins,
-    pub sprites: Bins<Sprite>,
+    pub sprites: TileBins<Sprite>,
 }
 
 impl std::fmt::Debug for Scratch {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let n = self.tris.bare.items.len() + self.tris.with_var.items.len();
+        let n = self.tris.bare.len() + self.tris.with_var.len();
         write!(f, "Scratch({n} binned triangles)")
     }
 }

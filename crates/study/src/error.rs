@@ -76,7 +76,16 @@ impl From<RenderError> for StudyError {
     }
 }
 
-/// Write `bytes` to `path`, mapping the error to [`StudyError::Io`].
+/// Write `bytes` to `path` atomically (a temporary file beside it, then a rename, so a failed
+/// write never leaves a partial file), mapping the error to [`StudyError::Io`].
 pub(crate) fn write_file(path: PathBuf, bytes: &[u8]) -> Result<(), StudyError> {
-    std::fs::write(&path, bytes).map_err(|source| StudyError::Io { path, source })
+    let mut name = std::ffi::OsString::from(".");
+    name.push(path.file_name().unwrap_or_default());
+    name.push(".tmp");
+    let tmp = path.with_file_name(name);
+    let result = std::fs::write(&tmp, bytes).and_then(|()| std::fs::rename(&tmp, &path));
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result.map_err(|source| StudyError::Io { path, source })
 }

@@ -15,8 +15,8 @@
 //!    spheres, and a perspective projection maps that hull onto the hull of their images (the
 //!    eight tangent slopes of both spheres on one set of 8 lanes). A 96-byte [`BondRec`] holds
 //!    the per-bond constants of the intersection below, formed in f64 and rounded once.
-//! 2. **Bin** into the sphere pipeline's 32x32 tiles: count, prefix sum, fill (a copy of the
-//!    record per tile, bond order kept within every tile).
+//! 2. **Bin** into the sphere pipeline's 32x32 tiles with the raster crate's binner
+//!    ([`texmap_raster::bin`]): a copy of the record per tile, bond order kept within every tile.
 //! 3. **Tiles** (parallel over bands of 32 rows): the tile's depth buffer starts as the depth the
 //!    sphere pass wrote, so bonds and atoms interpenetrate correctly; every bond of the bin is
 //!    intersected with the tile's eye rays 8 pixels at a time (one row, or two rows of 4 for
@@ -73,8 +73,9 @@ use texmap_core::shade::{Lighting, Material};
 #[cfg(target_arch = "x86_64")]
 use crate::fastshade::V8x;
 use crate::fastshade::{self, Mask8, Simd8, SpecPow, V8, W};
-use crate::pipeline::{self, FLAG_INSIDE, LANES, NONE, TILE, TILE_BUF, TILE_PX, View};
+use crate::pipeline::{FLAG_INSIDE, LANES, NONE, TILE, TILE_BUF, TILE_PX, View};
 use crate::scene::SphereScene;
+use texmap_raster::bin::{ChunkSink, TileBins};
 
 mod kernel;
 mod project;
@@ -156,7 +157,7 @@ pub(crate) fn draw(
             let th = (view.height - y0).min(TILE);
             for tx in 0..view.tiles_x {
                 let t = ty * view.tiles_x as usize + tx as usize;
-                let recs = &bins.recs[bins.tile_start[t]..bins.tile_start[t + 1]];
+                let recs = bins.tile(t);
                 if recs.is_empty() {
                     continue;
                 }

@@ -1,5 +1,6 @@
 //! Stages 1 and 2 of the bond pass: project each bond to a record of per-bond constants and
-//! bin the records into the sphere pipeline's tiles (see the parent module).
+//! bin the records into the sphere pipeline's tiles with the raster crate's binner (see the
+//! parent module).
 
 use super::*;
 
@@ -97,15 +98,10 @@ pub(crate) struct BondStats {
     pub skipped: usize,
 }
 
-/// The reusable per-frame buffers of the bond pass.
+/// The reusable per-frame buffers of the bond pass: the binned records of the frame.
 #[derive(Debug, Default)]
 pub(crate) struct BondBins {
-    pub(super) chunk_recs: Vec<Vec<BondRec>>,
-    pub(super) chunk_counts: Vec<Vec<u32>>,
-    pub(super) chunk_stats: Vec<BondStats>,
-    pub(super) recs: Vec<BondRec>,
-    /// `tile_start[t]..tile_start[t + 1]` is tile `t`'s run in `recs`.
-    pub(super) tile_start: Vec<usize>,
+    bins: TileBins<BondRec>,
 }
 
 /// Bounds of `x/(−z)` over the circle of radius `r` around `(x, z)` (a plane through the eye):
@@ -275,50 +271,20 @@ pub(super) fn project(view: &View, a: DVec3, b: DVec3, r: f32, kind: [u16; 2]) -
     })
 }
 
-#[inline]
-pub(super) fn tile_range(p: &BondRec) -> (usize, usize, usize, usize) {
-    let [x0, y0, x1, y1] = p.bbox;
-    debug_assert!(x0 < x1 && y0 < y1);
-    (
-        (x0 as u32 / TILE) as usize,
-        (y0 as u32 / TILE) as usize,
-        ((x1 as u32 - 1) / TILE) as usize,
-        ((y1 as u32 - 1) / TILE) as usize,
-    )
-}
-
-/// A raw pointer that chunks write through at disjoint offsets.
-#[derive(Clone, Copy)]
-pub(super) struct SendPtr(*mut BondRec);
-// SAFETY: every writer writes a disjoint set of slots (see `BondBins::build`).
-unsafe impl Send for SendPtr {}
-unsafe impl Sync for SendPtr {}
-
-/// Pass 1 of [`BondBins::build`] for one chunk of bonds: validate, transform, cull, project and
-/// count per tile.
+/// The binning pass of [`BondBins::build`] for one chunk of bonds: validate, transform, cull,
+/// project and push into the tiles of the record's box.
 #[inline(never)]
-#[allow(clippy::too_many_arguments)]
 pub(super) fn project_chunk(
     scene: &SphereScene,
     view: &View,
-    ci: usize,
-    n: usize,
-    ntiles: usize,
-    recs: &mut Vec<BondRec>,
-    counts: &mut Vec<u32>,
-    stats: &mut BondStats,
-) {
-    let tiles_x = view.tiles_x as usize;
+    range: std::ops::Range<usize>,
+    sink: &mut ChunkSink<'_, BondRec>,
+) -> BondStats {
     let r = scene.bond_radius;
     let radius_ok = r.is_finite() && r > 0.0;
     let natoms = scene.len();
-    recs.clear();
-    counts.clear();
-    counts.resize(ntiles, 0);
-    *stats = BondStats::default();
-    let lo = ci * BOND_CHUNK;
-    let hi = (lo + BOND_CHUNK).min(n);
-    for &[i, j] in &scene.bonds[lo..hi] {
+    let mut stats = BondStats::default();
+    for &[i, j] in &scene.bonds[range] {
         let (i, j) = (i as usize, j as usize);
         // Validate: radius, indices, both atoms drawable, distinct centres.
         if !(radius_ok
@@ -333,88 +299,42 @@ pub(super) fn project_chunk(
         }
         let a = eye_space_f64(view, scene.centers[i]);
         let b = eye_space_f64(view, scene.centers[j]);
-        match project(view, a, b, r, [scene.kinds[i], scene.kinds[j]]) {
-            Some(p) => {
+        let rec = project(view, a, b, r, [scene.kinds[i], scene.kinds[j]]);
+        // A projected record's box holds at least one pixel of the image.
+        let span = rec.and_then(|p| {
+            let [x0, y0, x1, y1] = p.bbox.map(u32::from);
+            view.grid.span(x0, y0, x1, y1).map(|s| (s, p))
+        });
+        match span {
+            Some((span, p)) => {
                 stats.drawn += 1;
-                let (tx0, ty0, tx1, ty1) = tile_range(&p);
-                for ty in ty0..=ty1 {
-                    for c in &mut counts[ty * tiles_x + tx0..=ty * tiles_x + tx1] {
-                        *c += 1;
-                    }
-                }
-                recs.push(p);
+                sink.push(span, p);
             }
             None => stats.culled += 1,
         }
     }
+    stats
 }
 
 impl BondBins {
     /// Validate, project and bin every bond of `scene`. Returns the counts.
     pub(super) fn build(&mut self, scene: &SphereScene, view: &View) -> BondStats {
         let n = scene.bonds.len();
-        let nchunks = n.div_ceil(BOND_CHUNK);
-        let ntiles = (view.tiles_x * view.tiles_y) as usize;
-        let tiles_x = view.tiles_x as usize;
-        self.chunk_recs.resize_with(nchunks, Vec::new);
-        self.chunk_counts.resize_with(nchunks, Vec::new);
-        self.chunk_stats.resize(nchunks, BondStats::default());
-
-        // Pass 1: validate, transform, cull, project, count per tile (parallel over chunks).
-        self.chunk_recs[..nchunks]
-            .par_iter_mut()
-            .zip(self.chunk_counts[..nchunks].par_iter_mut())
-            .zip(self.chunk_stats[..nchunks].par_iter_mut())
-            .enumerate()
-            .for_each(|(ci, ((recs, counts), stats))| {
-                project_chunk(scene, view, ci, n, ntiles, recs, counts, stats);
-            });
-
-        // Pass 2: prefix sum over (tile, chunk); counts become offsets within the tile's run.
-        let total = pipeline::prefix_tile_offsets(
-            &mut self.tile_start,
-            &mut self.chunk_counts[..nchunks],
-            ntiles,
-        );
-
-        // Pass 3: fill (parallel over chunks, each writing its own disjoint runs).
-        self.recs.clear();
-        self.recs.reserve(total);
-        let base = SendPtr(self.recs.as_mut_ptr());
-        let tile_start = &self.tile_start;
-        self.chunk_recs[..nchunks]
-            .par_iter()
-            .zip(self.chunk_counts[..nchunks].par_iter_mut())
-            .for_each(|(recs, offs)| {
-                // Capture the whole `SendPtr` (edition 2024 closures capture fields).
-                #[allow(clippy::redundant_locals)]
-                let base = base;
-                for p in recs {
-                    let (tx0, ty0, tx1, ty1) = tile_range(p);
-                    for ty in ty0..=ty1 {
-                        for tx in tx0..=tx1 {
-                            let t = ty * tiles_x + tx;
-                            let slot = tile_start[t] + offs[t] as usize;
-                            offs[t] += 1;
-                            debug_assert!(slot < tile_start[t + 1]);
-                            // SAFETY: `slot` lies in this chunk's own run of tile `t` (prefix
-                            // sum above), which no other chunk writes, and below `total`, the
-                            // reserved capacity.
-                            unsafe { base.0.add(slot).write(*p) };
-                        }
-                    }
-                }
-            });
-        // SAFETY: the runs of all (tile, chunk) pairs partition 0..total and each slot was
-        // written exactly once above.
-        unsafe { self.recs.set_len(total) };
-
+        let chunk_stats = self.bins.build(view.grid, n, BOND_CHUNK, |range, sink| {
+            project_chunk(scene, view, range, sink)
+        });
         let mut stats = BondStats::default();
-        for s in &self.chunk_stats[..nchunks] {
+        for s in &chunk_stats {
             stats.drawn += s.drawn;
             stats.culled += s.culled;
             stats.skipped += s.skipped;
         }
         stats
+    }
+
+    /// The records of tile `t`, in bond order.
+    #[inline]
+    pub(super) fn tile(&self, t: usize) -> &[BondRec] {
+        self.bins.tile(t)
     }
 }

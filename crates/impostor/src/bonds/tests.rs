@@ -343,7 +343,7 @@ fn avx2_and_sse_depth_passes_are_bit_identical() {
         for ty in 0..view.tiles_y {
             for tx in 0..view.tiles_x {
                 let t = (ty * view.tiles_x + tx) as usize;
-                let recs = &bins.recs[bins.tile_start[t]..bins.tile_start[t + 1]];
+                let recs = bins.tile(t);
                 let (x0, y0) = (tx * TILE, ty * TILE);
                 let (w, h) = ((view.width - x0).min(TILE), (view.height - y0).min(TILE));
                 // A sphere-pass depth to test against: a slanted plane through the scene.

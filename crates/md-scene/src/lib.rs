@@ -1,0 +1,56 @@
+//! Molecular-dynamics frames as impostor sphere scenes: the join of `texmap-md-io` (atoms,
+//! periodic cells, selections) and `texmap-impostor` ([`SphereScene`]), which depend on no
+//! crate of each other.
+//!
+//! - [`style`]: per-name radius and colour rules and the [`SceneBuilder`] that turns each frame
+//!   into a scene with them, colouring by the file's colour column, the element or the type.
+//! - [`palette`]: one material per distinct 8-bit sRGB colour, at most [`MAX_MATERIALS`] of
+//!   them (further colours take the nearest), and the evenly spaced colour of each atom type.
+//! - [`camera`]: the automatic camera, fitted so that the sphere around everything a frame draws
+//!   fills the image, seen along an axis or the three-quarter [`AUTO_VIEW_DIRECTION`]; the centre
+//!   of a selection, which a camera may follow.
+//! - [`outline`]: the periodic box drawn as rows of small spheres along its twelve edges (every
+//!   sphere method draws spheres; none draws lines).
+//!
+//! ```
+//! use glam::Vec3;
+//! use texmap_impostor::SphereScene;
+//! use texmap_md_io::{Frame, UnitCell};
+//! use texmap_md_scene::{Palette, ViewAxis, add_box_outline, fit_camera};
+//!
+//! // Two atoms in a 10 Å cubic box.
+//! let mut frame = Frame::new();
+//! frame.positions = vec![[2.0, 2.0, 2.0], [8.0, 8.0, 8.0]];
+//! frame.cell = Some(UnitCell::orthorhombic(10.0, 10.0, 10.0).unwrap());
+//!
+//! // One material per colour: both atoms red.
+//! let mut palette = Palette::new();
+//! let red = palette.kind_of([1.0, 0.0, 0.0]);
+//! let mut scene = SphereScene::default();
+//! for p in &frame.positions {
+//!     scene.push(Vec3::from(*p), 1.5, red);
+//! }
+//! scene.materials = palette.materials();
+//! add_box_outline(frame.cell.as_ref().unwrap(), &mut scene);
+//! assert_eq!(scene.materials.len(), 2); // red, and the outline's grey
+//!
+//! // The automatic camera looks at the centre of what is drawn (here, the box).
+//! let (camera, target) = fit_camera(&frame, &scene, ViewAxis::Auto, Some(40.0), 640, 480).unwrap();
+//! assert!((target - Vec3::splat(5.0)).length() < 0.1);
+//! assert_eq!((camera.width(), camera.height()), (640, 480));
+//! ```
+
+pub mod camera;
+pub mod outline;
+pub mod palette;
+pub mod style;
+
+pub use camera::{AUTO_VIEW_DIRECTION, FIT_MARGIN, ViewAxis, centre_of, drawn_bounds, fit_camera};
+pub use outline::{add_box_outline, cell_corners};
+pub use palette::{MAX_MATERIALS, Palette, type_color};
+pub use style::{
+    ColorBy, RuleKind, SceneBuilder, StyleError, StyleOptions, StyleWarning, style_from,
+};
+
+#[doc(no_inline)]
+pub use texmap_impostor::SphereScene;

@@ -1,0 +1,399 @@
+//! Frames styled into sphere scenes: [`style_from`] turns per-name radius and colour rules into
+//! an md-io [`AtomStyle`], and a [`SceneBuilder`] fills a [`SphereScene`] from each frame with
+//! it, one material per distinct colour ([`Palette`]).
+//!
+//! Per atom, the radius and colour come from the frame's own columns, then the rules, then the
+//! element tables ([`AtomStyle`]); colouring by type gives every type (or atom name) without a
+//! rule its own colour ([`type_color`]), in order of first appearance. Atoms with types but no
+//! colours, names or elements (a LAMMPS dump with numeric types) are coloured by type by
+//! default, as OVITO does.
+
+use glam::Vec3;
+use texmap_impostor::SphereScene;
+use texmap_md_io::{Appearance, AtomStyle, Element, Frame, Label, Selector, atom_element};
+
+use crate::palette::{Palette, type_color};
+
+/// Where an atom's colour comes from (before the rules of [`style_from`], which always win
+/// over the element table).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ColorBy {
+    /// The frame's per-atom colour column where it has one, else the rules, else the element.
+    Property,
+    /// The rules, else the element; colour columns are ignored.
+    Element,
+    /// The rules, else one distinct colour per atom type (or name).
+    Type,
+}
+
+/// Which kind of rule a [`StyleWarning`] or [`StyleError`] is about.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RuleKind {
+    Radius,
+    Color,
+}
+
+/// How a [`SceneBuilder`] styles atoms.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StyleOptions {
+    pub color_by: ColorBy,
+    /// Factor on every radius (finite, > 0).
+    pub radius_scale: f32,
+    /// `(NAME, radius in Å)`: the atoms whose type, atom name or element symbol is NAME.
+    pub type_radius: Vec<(String, f32)>,
+    /// `(NAME, 8-bit sRGB colour)`, NAME as for `type_radius`.
+    pub type_color: Vec<(String, [u8; 3])>,
+}
+
+impl Default for StyleOptions {
+    fn default() -> Self {
+        StyleOptions {
+            color_by: ColorBy::Property,
+            radius_scale: 1.0,
+            type_radius: Vec::new(),
+            type_color: Vec::new(),
+        }
+    }
+}
+
+/// Why a style was refused.
+#[derive(Debug)]
+pub enum StyleError {
+    /// A rule's NAME is longer than an md-io [`Label`] holds.
+    NameTooLong { name: String },
+    /// md-io refused a rule (a radius that is not finite and > 0, or a colour outside [0, 1]).
+    Rule(texmap_md_io::Error),
+    /// The radius scale is not a finite number > 0.
+    BadRadiusScale { scale: f32 },
+}
+
+impl std::fmt::Display for StyleError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            StyleError::NameTooLong { name } => {
+                write!(f, "NAME {name:?} is longer than {} bytes", Label::CAPACITY)
+            }
+            StyleError::Rule(e) => write!(f, "{e}"),
+            StyleError::BadRadiusScale { scale } => {
+                write!(f, "radius scale {scale}: must be a finite number > 0")
+            }
+        }
+    }
+}
+
+impl std::error::Error for StyleError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            StyleError::Rule(e) => Some(e),
+            _ => None,
+        }
+    }
+}
+
+/// Something worth telling the user about a style and the first frame it meets.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum StyleWarning {
+    /// A rule's NAME matches no atom's type, name or element.
+    NoMatch { kind: RuleKind, name: String },
+    /// Colour-column values outside [0, 1] (clamped).
+    ColorsOutOfRange { count: usize },
+}
+
+/// The selectors a rule NAME stands for: the type and the atom name NAME, and the element whose
+/// symbol NAME is (any case), if any.
+fn selectors(name: &str) -> Result<Vec<Selector>, StyleError> {
+    let Some(label) = Label::new(name) else {
+        return Err(StyleError::NameTooLong {
+            name: name.to_string(),
+        });
+    };
+    let mut v = vec![Selector::Type(label), Selector::Name(label)];
+    if let Some(e) = Element::from_symbol(name) {
+        v.push(Selector::Element(e));
+    }
+    Ok(v)
+}
+
+/// The md-io style for per-name rules: one rule per selector, later rules replacing earlier
+/// ones field by field (so a radius rule and a colour rule for `O` set both), the radius rules
+/// taken before the colour rules.
+pub fn style_from(
+    type_radius: &[(String, f32)],
+    type_color: &[(String, [u8; 3])],
+) -> Result<AtomStyle, StyleError> {
+    let mut rules: Vec<(Selector, Appearance)> = Vec::new();
+    let mut merge = |sel: Selector, look: Appearance| match rules.iter_mut().find(|r| r.0 == sel) {
+        Some(r) => {
+            r.1.radius = look.radius.or(r.1.radius);
+            r.1.color = look.color.or(r.1.color);
+        }
+        None => rules.push((sel, look)),
+    };
+    for (name, radius) in type_radius {
+        for sel in selectors(name)? {
+            let look = Appearance {
+                radius: Some(*radius),
+                color: None,
+            };
+            merge(sel, look);
+        }
+    }
+    for (name, rgb) in type_color {
+        for sel in selectors(name)? {
+            let look = Appearance {
+                radius: None,
+                color: Some(rgb.map(|c| c as f32 / 255.0)),
+            };
+            merge(sel, look);
+        }
+    }
+    let mut style = AtomStyle::new();
+    for (sel, look) in rules {
+        style.set(sel, look).map_err(StyleError::Rule)?;
+    }
+    Ok(style)
+}
+
+/// Reusable conversion from md-io frames to sphere scenes: one material per distinct colour,
+/// kept stable across frames so per-material tables survive from frame to frame.
+#[derive(Clone, Debug)]
+pub struct SceneBuilder {
+    style: AtomStyle,
+    color_by: ColorBy,
+    radius_scale: f32,
+    /// The rule NAMEs, for [`SceneBuilder::warnings`].
+    names: Vec<(RuleKind, String)>,
+    palette: Palette,
+    types: Vec<Label>,
+    radii: Vec<f32>,
+    colors: Vec<[f32; 3]>,
+}
+
+impl SceneBuilder {
+    /// A builder styling atoms as `options` say.
+    pub fn new(options: &StyleOptions) -> Result<SceneBuilder, StyleError> {
+        let s = options.radius_scale;
+        if !(s.is_finite() && s > 0.0) {
+            return Err(StyleError::BadRadiusScale { scale: s });
+        }
+        let names = options
+            .type_radius
+            .iter()
+            .map(|(n, _)| (RuleKind::Radius, n.clone()))
+            .chain(
+                options
+                    .type_color
+                    .iter()
+                    .map(|(n, _)| (RuleKind::Color, n.clone())),
+            )
+            .collect();
+        Ok(SceneBuilder {
+            style: style_from(&options.type_radius, &options.type_color)?,
+            color_by: options.color_by,
+            radius_scale: s,
+            names,
+            palette: Palette::new(),
+            types: Vec::new(),
+            radii: Vec::new(),
+            colors: Vec::new(),
+        })
+    }
+
+    /// The factor on every radius.
+    pub fn radius_scale(&self) -> f32 {
+        self.radius_scale
+    }
+
+    /// The material of an sRGB colour in [0, 1] (see [`Palette::kind_of`]); call
+    /// [`SceneBuilder::refresh_materials`] before drawing a scene that uses it.
+    pub fn kind_of(&mut self, srgb: [f32; 3]) -> u16 {
+        self.palette.kind_of(srgb)
+    }
+
+    /// Distinct colours so far drawn with the nearest of the first
+    /// [`MAX_MATERIALS`](crate::MAX_MATERIALS).
+    pub fn merged_colors(&self) -> usize {
+        self.palette.merged_colors()
+    }
+
+    /// What is worth telling about `frame` (the first one drawn): rules whose NAME selects no
+    /// atom, in rule order (radius rules first), then colour-column values outside [0, 1] when
+    /// colouring by property.
+    pub fn warnings(&self, frame: &Frame) -> Vec<StyleWarning> {
+        let mut out = Vec::new();
+        for (kind, name) in &self.names {
+            let element = Element::from_symbol(name);
+            let hit = frame.types.iter().any(|t| t.as_str() == name)
+                || frame.names.iter().any(|n| n.as_str() == name)
+                || element
+                    .is_some_and(|e| (0..frame.n_atoms()).any(|i| atom_element(frame, i) == e));
+            if !hit {
+                out.push(StyleWarning::NoMatch {
+                    kind: *kind,
+                    name: name.clone(),
+                });
+            }
+        }
+        if self.color_by == ColorBy::Property {
+            let count = frame
+                .colors
+                .iter()
+                .flatten()
+                .filter(|v| !(0.0..=1.0).contains(*v))
+                .count();
+            if count > 0 {
+                out.push(StyleWarning::ColorsOutOfRange { count });
+            }
+        }
+        out
+    }
+
+    /// Fill `scene` (cleared first, bonds included) from `frame`, whose colour column is
+    /// dropped unless colouring by property. Atoms with non-finite coordinates are kept as they
+    /// are: the renderers skip and count them.
+    pub fn build(&mut self, frame: &mut Frame, scene: &mut SphereScene) {
+        if self.color_by != ColorBy::Property {
+            // Element and type colouring ignore colour columns in the file.
+            frame.colors.clear();
+        }
+        // Radius and colour per atom: file column > rule > element table.
+        self.style.apply(frame, &mut self.radii, &mut self.colors);
+        scene.centers.clear();
+        scene.radii.clear();
+        scene.kinds.clear();
+        scene.bonds.clear();
+        let by_type = self.color_by == ColorBy::Type
+            || (self.color_by == ColorBy::Property
+                && frame.colors.is_empty()
+                && frame.names.is_empty()
+                && !frame.types.is_empty()
+                && frame.elements.iter().all(|e| e.is_unknown()));
+        for i in 0..frame.n_atoms() {
+            let p = frame.positions[i];
+            let color = match by_type {
+                true => match self.style.rules_for(frame, i).color {
+                    Some(c) => c,
+                    None => {
+                        // One palette colour per type (or name), in order of appearance.
+                        let label = frame
+                            .types
+                            .get(i)
+                            .or(frame.names.get(i))
+                            .copied()
+                            .unwrap_or_default();
+                        let idx = match self.types.iter().position(|t| *t == label) {
+                            Some(j) => j,
+                            None => {
+                                self.types.push(label);
+                                self.types.len() - 1
+                            }
+                        };
+                        type_color(idx)
+                    }
+                },
+                false => self.colors[i],
+            };
+            let kind = self.palette.kind_of(color);
+            scene.push(Vec3::from(p), self.radii[i] * self.radius_scale, kind);
+        }
+        self.refresh_materials(scene);
+    }
+
+    /// One material per palette colour, in material order (after [`SceneBuilder::kind_of`]
+    /// added some).
+    pub fn refresh_materials(&self, scene: &mut SphereScene) {
+        scene.materials = self.palette.materials();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn labels(v: &[&str]) -> Vec<Label> {
+        v.iter().map(|s| Label::new(s).unwrap()).collect()
+    }
+
+    #[test]
+    fn rules_merge_per_selector_and_match_type_name_or_element() {
+        // "O" as radius and "o" as colour: both reach the oxygen element rule.
+        let st = style_from(&[("O".into(), 1.0)], &[("o".into(), [255, 0, 0])]).unwrap();
+        let mut f = Frame::new();
+        f.positions = vec![[0.0; 3]; 2];
+        f.names = labels(&["OW", "O"]);
+        let look = st.rules_for(&f, 0);
+        assert_eq!(look.radius, Some(1.0), "element rule radius for OW");
+        assert_eq!(
+            look.color,
+            Some([1.0, 0.0, 0.0]),
+            "element rule colour for OW"
+        );
+        // Atom named exactly "O": the name rule (radius only) then the element rule (colour).
+        assert_eq!(st.rules_for(&f, 1).radius, Some(1.0));
+        assert_eq!(st.rules_for(&f, 1).color, Some([1.0, 0.0, 0.0]));
+        let long = "X".repeat(Label::CAPACITY + 1);
+        assert!(matches!(
+            style_from(&[(long, 1.0)], &[]),
+            Err(StyleError::NameTooLong { .. })
+        ));
+        assert!(matches!(
+            style_from(&[("C".into(), -1.0)], &[]),
+            Err(StyleError::Rule(_))
+        ));
+    }
+
+    #[test]
+    fn numeric_types_get_one_colour_each_and_scaled_radii() {
+        // A LAMMPS-like frame: types only.
+        let mut f = Frame::new();
+        f.positions = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [2.0, 0.0, 0.0],
+            [3.0, 0.0, 0.0],
+        ];
+        f.types = labels(&["2", "1", "2", "7"]);
+        let opts = StyleOptions {
+            radius_scale: 0.5,
+            type_radius: vec![("7".into(), 3.0)],
+            ..StyleOptions::default()
+        };
+        let mut b = SceneBuilder::new(&opts).unwrap();
+        let mut scene = SphereScene::default();
+        b.build(&mut f, &mut scene);
+        // Colours by type in order of appearance: "2", "1", "7".
+        assert_eq!(scene.kinds, [0, 1, 0, 2]);
+        let want: Vec<[u8; 3]> = (0..3)
+            .map(|i| type_color(i).map(|c| (c * 255.0).round() as u8))
+            .collect();
+        assert_eq!(b.palette.colors(), want.as_slice());
+        assert_eq!(scene.materials.len(), 3);
+        // The rule's radius, scaled; the others the unknown element's, scaled.
+        assert_eq!(scene.radii[3], 1.5);
+        assert_eq!(scene.radii[0], Element::UNKNOWN_RADIUS * 0.5);
+        assert_eq!(
+            b.warnings(&f),
+            [] as [StyleWarning; 0],
+            "rule 7 matches a type"
+        );
+        let other = StyleOptions {
+            type_color: vec![("Zz".into(), [1, 2, 3])],
+            ..StyleOptions::default()
+        };
+        assert_eq!(
+            SceneBuilder::new(&other).unwrap().warnings(&f),
+            [StyleWarning::NoMatch {
+                kind: RuleKind::Color,
+                name: "Zz".into()
+            }]
+        );
+        let bad = StyleOptions {
+            radius_scale: f32::NAN,
+            ..StyleOptions::default()
+        };
+        assert!(matches!(
+            SceneBuilder::new(&bad),
+            Err(StyleError::BadRadiusScale { .. })
+        ));
+    }
+}
