@@ -81,7 +81,6 @@
 //! reference ray tracer appears in its tests alone (the comparison harness lives in `texmap-study`).
 
 mod bonds;
-mod fastshade;
 mod lut;
 mod options;
 mod pipeline;

@@ -28,10 +28,10 @@
 //!   `ρ² = (x − c.x)² + (y − c.y)²`, depth `−c.z − sqrt(r² − ρ²)`.
 //!
 //! - **Lanes.** The perspective kernel (depth pass and resolve) is generic over
-//!   [`Simd8`] and compiled three times: on the SSE2 baseline; when the CPU has AVX2 (checked
-//!   once per frame), inside `#[target_feature(enable = "avx2")]` wrappers with one `__m256`
-//!   per 8 lanes; and when it also has AVX-512VL, the same `__m256` code compiled with that
-//!   enabled (32 registers: the shading's spills go; mask-register selects). No FMA, so all
+//!   [`Lanes8`] and compiled three times: on the SSE2 baseline; where [`lanes::isa`] allows
+//!   AVX2 (checked once per frame), inside `#[target_feature(enable = "avx2")]` wrappers with
+//!   one `__m256` per 8 lanes ([`F32x8Avx2`]); and where it allows AVX-512, the same `__m256`
+//!   code compiled with AVX-512VL enabled (32 registers: the shading's spills go; mask-register selects). No FMA, so all
 //!   three give the same bytes (tested). S1, one thread, interleaved A/B on an Intel Xeon
 //!   (AVX-512): the AVX-512VL build ran ~10% faster than the AVX2 build of the same code.
 //! - **Resolve.** Deferred shading over 8-pixel row chunks of the tile (S1 averages 7.5
@@ -60,11 +60,11 @@ use std::marker::PhantomData;
 use glam::Vec3;
 use texmap_core::color::linear_to_srgb8;
 use texmap_core::frame::Frame;
+#[cfg(target_arch = "x86_64")]
+use texmap_core::lanes::F32x8Avx2;
+use texmap_core::lanes::{self, F32x8, LaneMask, Lanes8, SpecPow};
 use texmap_core::shade::{Lighting, Material};
 
-#[cfg(target_arch = "x86_64")]
-use crate::fastshade::V8x;
-use crate::fastshade::{self, Mask8, Simd8, SpecPow, V8};
 use crate::pipeline::{
     self, Bins, FLAG_INSIDE, Kernel, LANES, NONE, ORDER_MAX, Proj, Projected, TILE, TILE_BUF,
     TileBuf, TileJob, TileRect, View, clip,
@@ -159,7 +159,7 @@ pub(crate) enum Backend {
     /// The AVX2 lanes compiled for AVX2 alone (used by tests to compare the two builds).
     #[cfg_attr(not(test), allow(dead_code))]
     Avx2,
-    /// The SSE2 / portable [`V8`] lanes (used by tests to check that both give the same bytes).
+    /// The SSE2 / portable [`F32x8`] lanes (used by tests to check that both give the same bytes).
     #[cfg_attr(not(test), allow(dead_code))]
     Baseline,
 }
@@ -178,12 +178,12 @@ pub(crate) struct Perspective<'a, V> {
     /// The specular power when every material has the same shininess (the common case): then
     /// no chunk needs to check its lanes.
     pow: Option<SpecPow>,
-    /// Run the [`V8x`] kernels' build compiled with AVX-512VL (see [`raster_evex`]).
+    /// Run the [`F32x8Avx2`] kernels' build compiled with AVX-512VL (see [`raster_evex`]).
     evex: bool,
     _lanes: PhantomData<V>,
 }
 
-impl<'a, V: Simd8> Perspective<'a, V> {
+impl<'a, V: Lanes8> Perspective<'a, V> {
     /// The kernel, or `None` when this CPU cannot run backend `V`. `rows` is filled from
     /// `materials` (a buffer kept between frames).
     fn new(
@@ -202,7 +202,7 @@ impl<'a, V: Simd8> Perspective<'a, V> {
         }));
         let pow = match materials.first() {
             Some(m0) if materials.iter().all(|m| m.shininess == m0.shininess) => {
-                Some(fastshade::spec_pow_of(V::splat(m0.shininess)))
+                Some(lanes::spec_pow_of(V::splat(m0.shininess)))
             }
             _ => None,
         };
@@ -233,13 +233,13 @@ pub(crate) fn draw_perspective(
 ) {
     #[cfg(target_arch = "x86_64")]
     if backend != Backend::Baseline
-        && let Some(mut k) = Perspective::<V8x>::new(*view, lighting, materials, rows)
+        && let Some(mut k) = Perspective::<F32x8Avx2>::new(*view, lighting, materials, rows)
     {
         k.evex = backend == Backend::Best && evex_available();
         pipeline::draw_tiles(bins, view, &k, background, frame);
         return;
     }
-    let k = Perspective::<V8>::new(*view, lighting, materials, rows)
+    let k = Perspective::<F32x8>::new(*view, lighting, materials, rows)
         .expect("the baseline lanes are always available");
     pipeline::draw_tiles(bins, view, &k, background, frame);
 }
@@ -253,7 +253,7 @@ struct RayTable {
 
 impl RayTable {
     #[inline(always)]
-    fn new<V: Simd8>(v: &View, tile: TileRect) -> RayTable {
+    fn new<V: Lanes8>(v: &View, tile: TileRect) -> RayTable {
         let dx: [f32; TILE as usize + LANES] =
             std::array::from_fn(|i| ((tile.x0 + i as u32) as f32 + 0.5 - v.cx) * v.inv_k);
         let dy: [f32; TILE as usize] =
@@ -289,7 +289,7 @@ impl RayTable {
 /// per pixel (`1/|d|²` comes from the tile table) and no cancellation for distant spheres.
 /// Returns the depths (`INFINITY` for a miss or a clipped hit) and the inside flags.
 #[inline(always)]
-fn hit8<V: Simd8>(f: &[f32; 5], dx: V, dy: V, ia: V, near: V, far: V) -> (V, V::M) {
+fn hit8<V: Lanes8>(f: &[f32; 5], dx: V, dy: V, ia: V, near: V, far: V) -> (V, V::Mask) {
     let (cx, cy, cz, r2) = (
         V::splat(f[0]),
         V::splat(f[1]),
@@ -316,7 +316,7 @@ fn hit8<V: Simd8>(f: &[f32; 5], dx: V, dy: V, ia: V, near: V, far: V) -> (V, V::
 /// Strict depth test of 8 lanes against `depth`/`win`: of records at exactly the same depth
 /// the one visited first wins (see [`front_to_back`]).
 #[inline(always)]
-fn depth_test8<V: Simd8>(t: V, inside: V::M, idx: u32, depth: &mut [f32], win: &mut [u32]) {
+fn depth_test8<V: Lanes8>(t: V, inside: V::Mask, idx: u32, depth: &mut [f32], win: &mut [u32]) {
     let d = V::load_from(depth);
     let closer = t.lt(d);
     if closer.bits() == 0 {
@@ -365,7 +365,7 @@ fn front(p: &Proj, near: f32) -> f32 {
 
 /// Depth pass of the perspective kernel (see [`Kernel::raster`]).
 #[inline(always)]
-fn raster_persp<V: Simd8>(v: &View, recs: &[Proj], tile: TileRect, buf: &mut TileBuf) {
+fn raster_persp<V: Lanes8>(v: &View, recs: &[Proj], tile: TileRect, buf: &mut TileBuf) {
     let rt = RayTable::new::<V>(v, tile);
     let (near, far) = (V::splat(v.near), V::splat(v.far));
     let inf = V::splat(f32::INFINITY);
@@ -381,7 +381,7 @@ fn raster_persp<V: Simd8>(v: &View, recs: &[Proj], tile: TileRect, buf: &mut Til
         let zmin = V::splat(front(p, v.near));
         if x1 - x0 <= 4 {
             // Narrow boxes (small spheres): two rows of up to 4 pixels per 8-lane test.
-            let cols = V::M::first_of_halves(x1 - x0);
+            let cols = V::Mask::first_of_halves(x1 - x0);
             let dx4 = &rt.dx[x0..];
             let mut j = y0;
             while j < y1 {
@@ -389,7 +389,11 @@ fn raster_persp<V: Simd8>(v: &View, recs: &[Proj], tile: TileRect, buf: &mut Til
                 let j1 = if two { j + 1 } else { j };
                 let (b0, b1) = (j * T + x0, j1 * T + x0);
                 let d = V::load_halves(&buf.depth[b0..], &buf.depth[b1..]);
-                let lanes = if two { cols } else { cols.and(V::M::first(4)) };
+                let lanes = if two {
+                    cols
+                } else {
+                    cols.and(V::Mask::first(4))
+                };
                 if zmin.lt(d).and(lanes).bits() != 0 {
                     let dx = V::load_halves(dx4, dx4);
                     let dy = V::load_halves(&[rt.dy[j]; 4], &[rt.dy[j1]; 4]);
@@ -425,7 +429,7 @@ fn raster_persp<V: Simd8>(v: &View, recs: &[Proj], tile: TileRect, buf: &mut Til
             while i < x1 {
                 let b = row + i;
                 // Lanes past the box must not write.
-                let lanes = V::M::first(x1 - i);
+                let lanes = V::Mask::first(x1 - i);
                 let d = V::load_from(&buf.depth[b..]);
                 if zmin.lt(d).and(lanes).bits() != 0 {
                     let (t, inside) = hit8(
@@ -456,7 +460,7 @@ fn raster_persp<V: Simd8>(v: &View, recs: &[Proj], tile: TileRect, buf: &mut Til
 /// are loaded as whole rows and transposed to lanes (uncovered lanes repeat the first covered
 /// pixel's winner and are replaced by the background at the end), shaded and encoded.
 #[inline(always)]
-fn resolve_persp<V: Simd8>(
+fn resolve_persp<V: Lanes8>(
     k: &Perspective<V>,
     recs: &[Proj],
     tile: TileRect,
@@ -483,12 +487,12 @@ fn resolve_persp<V: Simd8>(
 /// [`resolve_persp`] for a lighting of `N` lights.
 ///
 /// When the frame has one specular power (`k.pow`), two neighbouring covered chunks of a row
-/// are shaded together ([`fastshade::shade_chunks`]): a chunk's shading is one long chain of
+/// are shaded together ([`lanes::shade::shade_chunks`]): a chunk's shading is one long chain of
 /// dependent square roots, divisions and squarings, and two independent chains in one
 /// straight-line body keep the CPU busy where one left it waiting. Every lane sees the same
 /// operations either way, so the bytes do not change.
 #[inline(always)]
-fn resolve_persp_n<V: Simd8, const N: usize>(
+fn resolve_persp_n<V: Lanes8, const N: usize>(
     k: &Perspective<V>,
     recs: &[Proj],
     tile: TileRect,
@@ -503,8 +507,8 @@ fn resolve_persp_n<V: Simd8, const N: usize>(
     for (i, dx) in dxs.iter_mut().enumerate() {
         *dx = ((tile.x0 as usize + i) as f32 + 0.5 - v.cx) * v.inv_k;
     }
-    let enc = fastshade::srgb_table32();
-    let lights = fastshade::LanesLighting::<V, N>::new(&k.lighting);
+    let enc = lanes::srgb_table32();
+    let lights = lanes::shade::LanesLighting::<V, N>::new(&k.lighting);
     let bgv = V::splat_bits(u32::from_le_bytes(background));
     let none = V::splat_bits(NONE);
     let tw = tile.w as usize;
@@ -537,7 +541,7 @@ fn resolve_persp_n<V: Simd8, const N: usize>(
                 if covered2 != 0 {
                     let dx2 = V::load_from(&dxs[i2..]);
                     let s2 = chunk_surface(k, recs, buf, b2, covered2, win2, dx2, dy);
-                    let [c, c2] = fastshade::shade_chunks(&lights, [s, s2], pw);
+                    let [c, c2] = lanes::shade::shade_chunks(&lights, [s, s2], pw);
                     store_chunk(c, win, none, bgv, enc, &mut out[i..], n);
                     store_chunk(c2, win2, none, bgv, enc, &mut out[i2..], n2);
                     i += 2 * LANES;
@@ -546,9 +550,9 @@ fn resolve_persp_n<V: Simd8, const N: usize>(
             }
             let pw = match k.pow {
                 Some(p) => p,
-                None => fastshade::spec_pow_of(s.shin),
+                None => lanes::spec_pow_of(s.shin),
             };
-            let [c] = fastshade::shade_chunks(&lights, [s], pw);
+            let [c] = lanes::shade::shade_chunks(&lights, [s], pw);
             store_chunk(c, win, none, bgv, enc, &mut out[i..], n);
             i += LANES;
         }
@@ -558,25 +562,25 @@ fn resolve_persp_n<V: Simd8, const N: usize>(
 /// Covered lanes of a chunk of `n ≤ 8` pixels whose winner entries are `win` (lanes past the
 /// tile hold NONE too).
 #[inline(always)]
-fn covered_lanes<V: Simd8>(win: V, none: V, n: usize) -> u32 {
+fn covered_lanes<V: Lanes8>(win: V, none: V, n: usize) -> u32 {
     !win.eq_bits(none).bits() & ((1u32 << n) - 1)
 }
 
 /// sRGB8 of a shaded chunk `c`, the background `bgv` where nothing won, into `out[..n]`.
 #[inline(always)]
-fn store_chunk<V: Simd8>(
+fn store_chunk<V: Lanes8>(
     c: [V; 3],
     win: V,
     none: V,
     bgv: V,
-    enc: &[u32; fastshade::SRGB_N],
+    enc: &[u32; lanes::SRGB_N],
     out: &mut [[u8; 4]],
     n: usize,
 ) {
     let px = V::select(
         win.eq_bits(none),
         bgv,
-        fastshade::srgb_rgba_lanes(c[0], c[1], c[2], enc),
+        lanes::srgb_rgba_lanes(c[0], c[1], c[2], enc),
     );
     if n == LANES {
         px.store_rgba(out);
@@ -593,7 +597,7 @@ fn store_chunk<V: Simd8>(
 /// background), the exact normal at the hit point and the unit vector toward the eye.
 #[allow(clippy::too_many_arguments)] // one chunk's inputs, inlined into the resolve loop
 #[inline(always)]
-fn chunk_surface<V: Simd8>(
+fn chunk_surface<V: Lanes8>(
     k: &Perspective<V>,
     recs: &[Proj],
     buf: &TileBuf,
@@ -602,7 +606,7 @@ fn chunk_surface<V: Simd8>(
     win: V,
     dx: V,
     dy: V,
-) -> fastshade::LaneSurf<V> {
+) -> lanes::shade::LaneSurf<V> {
     let sign = V::splat_bits(FLAG_INSIDE);
     let one = V::splat(1.0);
     let first = buf.win[b + covered.trailing_zeros() as usize] & !FLAG_INSIDE;
@@ -657,7 +661,7 @@ fn chunk_surface<V: Simd8>(
     // Unit vector toward the eye.
     let id = one / (dx * dx + dy * dy + one).sqrt();
     let v = [dx.xor_bits(sign) * id, dy.xor_bits(sign) * id, id];
-    fastshade::LaneSurf {
+    lanes::shade::LaneSurf {
         n,
         v,
         base: [br, bg, bb],
@@ -690,13 +694,13 @@ fn resolve_px<V>(
     }
     let to_eye = d * -(1.0 / d.length());
     let m = &materials[rec.kind as usize];
-    linear_to_srgb8(fastshade::shade(lighting, m, n, to_eye), 255)
+    linear_to_srgb8(lanes::shade::shade(lighting, m, n, to_eye), 255)
 }
 
-impl Kernel for Perspective<'_, V8> {
+impl Kernel for Perspective<'_, F32x8> {
     #[inline(never)]
     fn raster(&self, recs: &[Proj], tile: TileRect, buf: &mut TileBuf) {
-        raster_persp::<V8>(&self.view, recs, tile, buf);
+        raster_persp::<F32x8>(&self.view, recs, tile, buf);
     }
 
     fn order<'r>(&self, recs: &'r [Proj], scratch: &'r mut [Proj; ORDER_MAX]) -> &'r [Proj] {
@@ -722,14 +726,14 @@ impl Kernel for Perspective<'_, V8> {
 }
 
 #[cfg(target_arch = "x86_64")]
-impl Kernel for Perspective<'_, V8x> {
+impl Kernel for Perspective<'_, F32x8Avx2> {
     fn order<'r>(&self, recs: &'r [Proj], scratch: &'r mut [Proj; ORDER_MAX]) -> &'r [Proj] {
         front_to_back(&self.view, recs, scratch)
     }
 
     fn raster(&self, recs: &[Proj], tile: TileRect, buf: &mut TileBuf) {
-        // SAFETY: a `Perspective<V8x>` exists only when `V8x::available()` (AVX2) held, and
-        // `evex` is set only when `evex_available()` held.
+        // SAFETY: a `Perspective<F32x8Avx2>` exists only when `F32x8Avx2::available()` (AVX2)
+        // held, and `evex` is set only when `evex_available()` held.
         unsafe {
             if self.evex {
                 raster_evex(&self.view, recs, tile, buf)
@@ -774,23 +778,23 @@ impl Kernel for Perspective<'_, V8x> {
     }
 }
 
-/// The [`V8x`] builds of the perspective kernel: [`raster_persp`], [`resolve_persp`] and the
+/// The [`F32x8Avx2`] builds of the perspective kernel: [`raster_persp`], [`resolve_persp`] and the
 /// tile's body ([`pipeline::draw_tile`]: its buffer clears and depth copies) compiled inside
 /// `#[target_feature]` functions (the generic bodies and the intrinsics inline there), one set
 /// per feature set.
-macro_rules! v8x_build {
+macro_rules! avx2_lanes_build {
     ($features:literal, $raster:ident, $resolve:ident, $tile:ident, $doc:literal) => {
-        #[doc = concat!("[`pipeline::draw_tile`] of the [`V8x`] kernel, compiled for ", $doc, ".")]
+        #[doc = concat!("[`pipeline::draw_tile`] of the [`F32x8Avx2`] kernel, compiled for ", $doc, ".")]
         ///
         /// # Safety
         #[doc = concat!("The CPU must support ", $doc, ".")]
         #[cfg(target_arch = "x86_64")]
         #[target_feature(enable = $features)]
-        unsafe fn $tile(k: &Perspective<V8x>, job: TileJob<'_>) {
+        unsafe fn $tile(k: &Perspective<F32x8Avx2>, job: TileJob<'_>) {
             pipeline::draw_tile(k, job);
         }
 
-        #[doc = concat!("[`raster_persp`] on the [`V8x`] lanes, compiled for ", $doc, ".")]
+        #[doc = concat!("[`raster_persp`] on the [`F32x8Avx2`] lanes, compiled for ", $doc, ".")]
         ///
         /// # Safety
         #[doc = concat!("The CPU must support ", $doc, ".")]
@@ -798,10 +802,10 @@ macro_rules! v8x_build {
         #[target_feature(enable = $features)]
         #[inline(never)]
         unsafe fn $raster(v: &View, recs: &[Proj], tile: TileRect, buf: &mut TileBuf) {
-            raster_persp::<V8x>(v, recs, tile, buf);
+            raster_persp::<F32x8Avx2>(v, recs, tile, buf);
         }
 
-        #[doc = concat!("[`resolve_persp`] on the [`V8x`] lanes, compiled for ", $doc, ".")]
+        #[doc = concat!("[`resolve_persp`] on the [`F32x8Avx2`] lanes, compiled for ", $doc, ".")]
         ///
         /// # Safety
         #[doc = concat!("The CPU must support ", $doc, ".")]
@@ -809,7 +813,7 @@ macro_rules! v8x_build {
         #[target_feature(enable = $features)]
         #[inline(never)]
         unsafe fn $resolve(
-            k: &Perspective<V8x>,
+            k: &Perspective<F32x8Avx2>,
             recs: &[Proj],
             tile: TileRect,
             buf: &TileBuf,
@@ -822,7 +826,7 @@ macro_rules! v8x_build {
     };
 }
 
-v8x_build!(
+avx2_lanes_build!(
     "avx2",
     raster_avx2,
     resolve_tile_avx2,
@@ -834,7 +838,7 @@ v8x_build!(
 // for comparisons and selects (one-µop masked blends instead of `vblendvps`). The IEEE
 // operations are the same (no fused multiply-add: Rust never contracts), so are the bytes
 // (tested against the AVX2 build and the baseline).
-v8x_build!(
+avx2_lanes_build!(
     "avx2,avx512f,avx512vl",
     raster_evex,
     resolve_tile_evex,
@@ -845,8 +849,7 @@ v8x_build!(
 /// Whether this CPU can run the AVX-512VL builds ([`raster_evex`], [`resolve_tile_evex`]).
 #[cfg(target_arch = "x86_64")]
 fn evex_available() -> bool {
-    std::arch::is_x86_feature_detected!("avx512f")
-        && std::arch::is_x86_feature_detected!("avx512vl")
+    lanes::Isa::Avx512.enabled()
 }
 
 /// Ray-cast kernel, orthographic camera (parallel rays along −z).
@@ -908,7 +911,7 @@ impl Kernel for Orthographic<'_> {
             n = -n;
         }
         let m = &self.materials[rec.kind as usize];
-        linear_to_srgb8(fastshade::shade(&self.lighting, m, n, Vec3::Z), 255)
+        linear_to_srgb8(lanes::shade::shade(&self.lighting, m, n, Vec3::Z), 255)
     }
 }
 
@@ -1033,7 +1036,7 @@ mod tests {
         let mut bins = Bins::default();
         bins.build(scene, &view, |c, r, k| project(&view, c, r, k));
         let mut rows = Vec::new();
-        let k = Perspective::<V8>::new(view, lighting, &scene.materials, &mut rows).unwrap();
+        let k = Perspective::<F32x8>::new(view, lighting, &scene.materials, &mut rows).unwrap();
         let mut worst = 0i32;
         let mut checked = 0;
         for ty in 0..view.tiles_y {

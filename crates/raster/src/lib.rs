@@ -72,7 +72,8 @@
 //!   itself ([`bin`]) is public: the sphere and bond passes of `texmap-impostor` bin through it.
 //! - Programs are monomorphised: the per-quad loop holds no `dyn` and no per-pixel match on the
 //!   shading mode. The depth test, depth write and blend run on four-lane masks and selects
-//!   (`simd`: SSE2 on x86-64, the baseline, with a scalar fallback of identical semantics).
+//!   ([`texmap_core::lanes::F32x4`]: SSE2 on x86-64, the baseline, with a portable twin of
+//!   identical semantics).
 //! - Small triangles (at most 16 px across, pixel range within an 8 x 8 block) take the block
 //!   path: i32 edge functions for the whole block (eight lanes per row, one bit mask per row),
 //!   then only quads holding a covered pixel are shaded. It gives exactly the pixels of the
@@ -94,7 +95,6 @@ mod mesh;
 mod program;
 mod project;
 mod record;
-mod simd;
 pub mod sprite;
 mod state;
 mod surface;

@@ -9,6 +9,7 @@
 //! 000's spans) come from.
 
 use glam::{Vec2, Vec3};
+use texmap_core::lanes::{F32x4, pow01_x4};
 use texmap_core::mip::MipTexture;
 use texmap_core::sample::Sampler;
 use texmap_core::shade::{Lighting, MAX_LIGHTS, Material};
@@ -16,7 +17,6 @@ use texmap_core::shade::{Lighting, MAX_LIGHTS, Material};
 use crate::mesh::Mesh;
 use crate::project::{MAX_VAR, Proj, Var};
 use crate::record::VarStore;
-use crate::simd::{F32x4, pow4};
 
 /// How the triangles of [`crate::Framebuffer::draw_mesh`] are coloured. All colours are linear RGB.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -273,7 +273,7 @@ fn normalize_or_zero4(v: [F32x4; 3]) -> [F32x4; 3] {
 }
 
 /// [`Lighting::shade`] for the four lanes of a quad, the same operations in the same order,
-/// except the Blinn-Phong power: [`pow4`] (relative error < 1e-5) for exponents in
+/// except the Blinn-Phong power: [`pow01_x4`] (relative error < 1e-5) for exponents in
 /// `(0, 65536]`, `powf` per lit lane otherwise. Without a specular term the result is
 /// bit-identical to four scalar calls; with it, within 1e-5 of them (tested).
 #[inline(always)]
@@ -294,9 +294,9 @@ fn shade4(ll: &LightLanes, n: [F32x4; 3], v: [F32x4; 3], mask: u8) -> [[f32; 4];
             let h = normalize_or_zero4([l[0].add(v[0]), l[1].add(v[1]), l[2].add(v[2])]);
             let ndh = dot4(&n, &h).max(s(0.0));
             let spec = if ll.shininess > 0.0 && ll.shininess <= 65536.0 {
-                ll.specular.mul(pow4(ndh, ll.shininess))
+                ll.specular.mul(pow01_x4(ndh, ll.shininess))
             } else {
-                // Exponents outside pow4's range: powf per lit lane.
+                // Exponents outside pow01_x4's range: powf per lit lane.
                 let ndh = ndh.to_array();
                 let mut spec = [0.0f32; 4];
                 for (lane, sp) in spec.iter_mut().enumerate() {
@@ -526,7 +526,7 @@ mod tests {
                                 got[k][l]
                             );
                         } else {
-                            // pow4's relative error (< 1e-5) on a specular term <= Σ colour.
+                            // pow01_x4's relative error (< 1e-5) on a specular term <= Σ colour.
                             let tol = 1e-5 * (1.0 + want[k].abs());
                             let err = (got[k][l] - want[k]).abs();
                             assert!(

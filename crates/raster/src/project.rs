@@ -14,8 +14,7 @@
 
 use glam::Vec3;
 use texmap_core::camera::Camera;
-
-use crate::simd::F32x4;
+use texmap_core::lanes::F32x4;
 
 /// Fractional bits of the fixed-point screen coordinates.
 pub(crate) const SUB_BITS: u32 = 8;

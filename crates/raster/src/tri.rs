@@ -10,10 +10,11 @@
 //! affine in (x, y); per pixel, `W = 1 / (1/W)` recovers depth and the perspective-correct
 //! varyings (the perspective-correct form of Seed 000 Eq. 1: `z⁻¹` is affine on the screen).
 
+use texmap_core::lanes::{F32x4, I32x4};
+
 use crate::framebuffer::{TILE, Tile, quad_index};
 use crate::program::{FragProgram, QuadFrag};
 use crate::project::{MAX_VAR, PVert, SUB_BITS, Var};
-use crate::simd::{F32x4, I32x4};
 use crate::state::{Blend, Cull, DepthTest, DrawState};
 
 /// What the quad loop needs besides the triangle.

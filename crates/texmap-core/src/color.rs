@@ -37,6 +37,16 @@ pub fn linear_to_srgb8_exact(c: f32) -> u8 {
 const ENC_BITS: usize = 12;
 const ENC_N: usize = 1 << ENC_BITS;
 
+/// Bins of the table behind [`linear_to_srgb8_fast`] ([`srgb_encode_table`]).
+pub const SRGB_ENCODE_BINS: usize = ENC_N;
+
+/// The table behind [`linear_to_srgb8_fast`]: entry `i` is the code of the linear values in
+/// `[i/4096, (i+1)/4096)` (the exact code at the bin centre; 0 and 255 at the ends). The lane
+/// encoder ([`crate::lanes::srgb_rgba_lanes`]) reads it widened to `u32`.
+pub fn srgb_encode_table() -> &'static [u8; SRGB_ENCODE_BINS] {
+    enc_table()
+}
+
 fn enc_table() -> &'static [u8; ENC_N] {
     static T: OnceLock<[u8; ENC_N]> = OnceLock::new();
     T.get_or_init(|| {

@@ -8,6 +8,9 @@
 //!   the rasteriser and the reference ray tracer alike), [`color`] (sRGB, HSV), [`frame`] (colour +
 //!   depth image), [`metrics`] (PSNR, SSIM, depth and silhouette error) and [`optics`] (mirror
 //!   reflection, Snell refraction, Fresnel: shared by environment mapping and the ray tracer);
+//! - [`lanes`]: the workspace's one CPU-feature detection, the 4- and 8-lane types (SSE2, AVX2,
+//!   with portable twins) and the maths written over them (pow, exp2/log2, sRGB, shading), used
+//!   by the rasteriser, the sphere ray caster and the samplers;
 //! - Seed 000's texture mapping: [`transform`] (Eq. 1–3), [`mip`] pyramids, [`sample`]rs (nearest,
 //!   bilinear, trilinear Eq. 4, span-parallel with K x K banks Eq. 8–10, anisotropic reference) and
 //!   [`coverage`] (Eq. 5–7, the active-area map count).
@@ -32,6 +35,7 @@ pub mod camera_path;
 pub mod color;
 pub mod coverage;
 pub mod frame;
+pub mod lanes;
 pub mod metrics;
 pub mod mip;
 pub mod optics;

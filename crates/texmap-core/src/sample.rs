@@ -8,7 +8,7 @@
 //! - `sample/scalar.rs`: the scalar kernels and wrap modes, the reference every build matches;
 //! - `sample/span.rs`: the span sampler's planning and per-pixel work (Eq. 8–10);
 //! - `sample/bank.rs`: the bank emulator ([`BankedTexture`], [`BankStats`]);
-//! - `sample/lanes.rs` (SSE2, the x86-64 baseline, and run-time feature detection),
+//! - `sample/lanes.rs` (SSE2, the x86-64 baseline, and the run-time choice of build),
 //!   `sample/avx2.rs`, `sample/avx512.rs`: one file per instruction set;
 //! - `sample/tests.rs`: every build bit for bit against the scalar kernels and the emulator.
 //!
@@ -87,18 +87,19 @@
 //! # Performance notes (what was measured and rejected)
 //! Texels are linear RGBA `f32` (`Vec4`, one SSE register): filtering is gamma-correct for free
 //! and a lerp is three SIMD instructions. The level's `log2` uses the float exponent plus a
-//! degree-4 mantissa polynomial (`log2_split`, |error| ≤ 1.2e-4 in λ) instead of libm's `log2f`;
-//! Repeat on power-of-two levels is a mask; texel reads skip bounds checks (indices are folded by
+//! degree-4 mantissa polynomial ([`crate::lanes::log2_split`], |error| ≤ 1.2e-4 in λ) instead
+//! of libm's `log2f`; Repeat on power-of-two levels is a mask; texel reads skip bounds checks (indices are folded by
 //! construction).
 //!
 //! **Lane kernels** (x86_64, power-of-two pyramids; the tail of a call, NPOT pyramids and other
 //! targets take the scalar path): the bulk calls run per-pixel trilinear several PIXELS per step
 //! and the span sampler several SPANS per step, the footprint, level split, level sizes (from the
 //! float exponent), texel coordinates, floors and fractions computed once per group of lanes.
-//! - `sample/lanes.rs`: the SSE2 baseline, four lanes per step.
-//! - `sample/avx2.rs`: the build chosen at run time (`is_x86_feature_detected!("avx2")`), eight
-//!   lanes per step; each pixel's texel indices computed in lanes (level base from a 16-entry
-//!   table with two `vpermd`, rows by `vpmulld`, doubled so that `base + 8·index` addresses a
+//! - `sample/lanes.rs`: the SSE2 baseline, four lanes per step, and the choice of build
+//!   ([`crate::lanes::isa`], the workspace's one CPU-feature detection).
+//! - `sample/avx2.rs`: the build chosen at run time where [`crate::lanes::Isa::Avx2`] is
+//!   enabled, eight lanes per step; each pixel's texel indices computed in lanes (level base
+//!   from a 16-entry table with two `vpermd`, rows by `vpmulld`, doubled so that `base + 8·index` addresses a
 //!   texel) and stored once, one load per index; two pixels per 256-bit register for the taps,
 //!   lerps and blend, their weights by one in-lane `vpermilps` (lanes ordered so that a pixel
 //!   pair shares a lane of the two halves), one 256-bit store per pair; `roundps` floors.

@@ -79,7 +79,7 @@ pub(super) struct Rays<V> {
 /// A camera's rays over lanes, in two steps: what depends on the row (`y`) once per row, then
 /// what depends on the column (`x`) per 8 pixels. Both implementations keep the operations and
 /// their order of the one-step form (so the results are bit-identical to it).
-pub(super) trait RayGen<V: Simd8> {
+pub(super) trait RayGen<V: Lanes8> {
     type Row;
     fn row(b: &BondV, y: V) -> Self::Row;
     fn rays(b: &BondV, r: &Self::Row, x: V) -> Rays<V>;
@@ -97,7 +97,7 @@ pub(super) struct PerspRow<V> {
     pub(super) yqy: V,
 }
 
-impl<V: Simd8> RayGen<V> for Persp {
+impl<V: Lanes8> RayGen<V> for Persp {
     type Row = PerspRow<V>;
     #[inline(always)]
     fn row(b: &BondV, y: V) -> PerspRow<V> {
@@ -138,7 +138,7 @@ pub(super) struct OrthoRow<V> {
     pub(super) gy2: V,
 }
 
-impl<V: Simd8> RayGen<V> for Ortho {
+impl<V: Lanes8> RayGen<V> for Ortho {
     type Row = OrthoRow<V>;
     #[inline(always)]
     fn row(b: &BondV, y: V) -> OrthoRow<V> {
@@ -183,7 +183,7 @@ impl<V: Simd8> RayGen<V> for Ortho {
 /// group), [`solve8_regular`] computes the same operations on the same values without the
 /// selects those cases need; otherwise [`solve8_general`].
 #[inline(always)]
-pub(super) fn solve8<V: Simd8>(b: &BondV, l: &Rays<V>, lanes: V::M, near: V, far: V) -> (V, V) {
+pub(super) fn solve8<V: Lanes8>(b: &BondV, l: &Rays<V>, lanes: V::Mask, near: V, far: V) -> (V, V) {
     let regular =
         l.a.gt(V::splat(PARALLEL_A))
             .and((l.du * l.du).gt(V::splat(1e-30)));
@@ -197,10 +197,10 @@ pub(super) fn solve8<V: Simd8>(b: &BondV, l: &Rays<V>, lanes: V::M, near: V, far
 
 /// [`solve8`] for 8 regular lanes, or `None` when a hit lane took the exit (near plane).
 #[inline(always)]
-pub(super) fn solve8_regular<V: Simd8>(
+pub(super) fn solve8_regular<V: Lanes8>(
     b: &BondV,
     l: &Rays<V>,
-    lanes: V::M,
+    lanes: V::Mask,
     near: V,
     far: V,
 ) -> Option<(V, V)> {
@@ -248,10 +248,10 @@ pub(super) fn solve8_regular<V: Simd8>(
 
 /// [`solve8`] for any lanes: rays parallel to the axis or the cap planes, and exits.
 #[inline(always)]
-pub(super) fn solve8_general<V: Simd8>(
+pub(super) fn solve8_general<V: Lanes8>(
     b: &BondV,
     l: &Rays<V>,
-    lanes: V::M,
+    lanes: V::Mask,
     near: V,
     far: V,
 ) -> (V, V) {
@@ -309,7 +309,7 @@ pub(super) fn solve8_general<V: Simd8>(
 
 /// Strict depth test of 8 lanes against `depth`/`win` (the atom, then the earlier bond, wins ties).
 #[inline(always)]
-pub(super) fn depth_test8<V: Simd8>(t: V, word: V, depth: &mut [f32], win: &mut [u32]) {
+pub(super) fn depth_test8<V: Lanes8>(t: V, word: V, depth: &mut [f32], win: &mut [u32]) {
     let d = V::load_from(depth);
     let closer = t.lt(d);
     if closer.bits() == 0 {
@@ -348,9 +348,9 @@ pub(super) fn raster_sse(
     buf: &mut TileBuf,
 ) {
     if k.view.ortho {
-        k.raster_with::<Ortho, V8>(recs, x0t, y0t, w, h, buf);
+        k.raster_with::<Ortho, F32x8>(recs, x0t, y0t, w, h, buf);
     } else {
-        k.raster_with::<Persp, V8>(recs, x0t, y0t, w, h, buf);
+        k.raster_with::<Persp, F32x8>(recs, x0t, y0t, w, h, buf);
     }
 }
 
@@ -372,9 +372,9 @@ pub(super) unsafe fn raster_avx2(
     buf: &mut TileBuf,
 ) {
     if k.view.ortho {
-        k.raster_with::<Ortho, V8x>(recs, x0t, y0t, w, h, buf);
+        k.raster_with::<Ortho, F32x8Avx2>(recs, x0t, y0t, w, h, buf);
     } else {
-        k.raster_with::<Persp, V8x>(recs, x0t, y0t, w, h, buf);
+        k.raster_with::<Persp, F32x8Avx2>(recs, x0t, y0t, w, h, buf);
     }
 }
 
@@ -393,7 +393,7 @@ pub(super) fn resolve_sse(
     depth: &mut [f32],
     stride: usize,
 ) {
-    k.resolve_with::<V8>(recs, x0t, y0t, w, h, buf, color, depth, stride);
+    k.resolve_with::<F32x8>(recs, x0t, y0t, w, h, buf, color, depth, stride);
 }
 
 /// [`Kernel::resolve_with`] on AVX2 lanes (same IEEE operations, so the same bytes).
@@ -416,7 +416,7 @@ pub(super) unsafe fn resolve_avx2(
     depth: &mut [f32],
     stride: usize,
 ) {
-    k.resolve_with::<V8x>(recs, x0t, y0t, w, h, buf, color, depth, stride);
+    k.resolve_with::<F32x8Avx2>(recs, x0t, y0t, w, h, buf, color, depth, stride);
 }
 
 impl Kernel<'_> {
@@ -432,7 +432,7 @@ impl Kernel<'_> {
     ) {
         #[cfg(target_arch = "x86_64")]
         if self.avx2 {
-            // SAFETY: `avx2` is set only where `V8x::available()` returned true.
+            // SAFETY: `avx2` is set only where `F32x8Avx2::available()` returned true.
             unsafe { raster_avx2(self, recs, x0t, y0t, w, h, buf) };
             return;
         }
@@ -442,7 +442,7 @@ impl Kernel<'_> {
     /// [`Kernel::raster`] with the camera's ray generator chosen outside the loops.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    pub(super) fn raster_with<G: RayGen<V>, V: Simd8>(
+    pub(super) fn raster_with<G: RayGen<V>, V: Lanes8>(
         &self,
         recs: &[BondRec],
         x0t: u32,
@@ -485,7 +485,7 @@ impl Kernel<'_> {
             let zmin = V::splat(rec.zmin());
             if i1 - i0 <= 4 {
                 // Narrow boxes (thin or short bonds): two rows of up to 4 pixels per 8 lanes.
-                let cols = <V::M as Mask8>::first_of_halves(i1 - i0);
+                let cols = <V::Mask as LaneMask>::first_of_halves(i1 - i0);
                 let x = V::load_halves(&xs[i0..], &xs[i0..]);
                 let mut j = j0;
                 while j < j1 {
@@ -496,7 +496,7 @@ impl Kernel<'_> {
                     let lanes = if two {
                         cols
                     } else {
-                        cols.and(<V::M as Mask8>::first(4))
+                        cols.and(<V::Mask as LaneMask>::first(4))
                     };
                     if zmin.lt(d).and(lanes).bits() != 0 {
                         let y = V::load_halves(&[ys[j]; 4], &[ys[jb]; 4]);
@@ -543,7 +543,7 @@ impl Kernel<'_> {
                 let mut i = a;
                 while i < e {
                     let o = j * T + i;
-                    let lanes = <V::M as Mask8>::first(e - i);
+                    let lanes = <V::Mask as LaneMask>::first(e - i);
                     let d = V::load_from(&buf.depth[o..]);
                     if zmin.lt(d).and(lanes).bits() != 0 {
                         let x = V::load_from(&xs[i..]);
@@ -579,7 +579,7 @@ impl Kernel<'_> {
     ) {
         #[cfg(target_arch = "x86_64")]
         if self.avx2 {
-            // SAFETY: `avx2` is set only where `V8x::available()` returned true.
+            // SAFETY: `avx2` is set only where `F32x8Avx2::available()` returned true.
             unsafe { resolve_avx2(self, recs, x0t, y0t, w, h, buf, color, depth, stride) };
             return;
         }
@@ -589,7 +589,7 @@ impl Kernel<'_> {
     /// [`Kernel::resolve`] on the lanes `V`.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    pub(super) fn resolve_with<V: Simd8>(
+    pub(super) fn resolve_with<V: Lanes8>(
         &self,
         recs: &[BondRec],
         x0t: u32,
@@ -624,14 +624,14 @@ impl Kernel<'_> {
             *y = (v.cy - ((y0t + j as u32) as f32 + 0.5)) * v.inv_k;
         }
         let zero = V::splat(0.0);
-        let enc = fastshade::srgb_table32();
-        for chunk in list[..n].chunks(W) {
+        let enc = lanes::srgb_table32();
+        for chunk in list[..n].chunks(LANES8) {
             // Gather the lanes' ray, depth, bond and materials (short chunks repeat their first
             // pixel).
-            let mut g = [[0f32; W]; 12];
-            let mut flags = [0u32; W];
-            let mut kinds = [[0u16; 2]; W];
-            for l in 0..W {
+            let mut g = [[0f32; LANES8]; 12];
+            let mut flags = [0u32; LANES8];
+            let mut kinds = [[0u16; 2]; LANES8];
+            for l in 0..LANES8 {
                 let b = chunk[if l < chunk.len() { l } else { 0 }] as usize;
                 let wv = buf.win[b];
                 let rec = &recs[(wv & INDEX_MASK) as usize];
@@ -677,8 +677,8 @@ impl Kernel<'_> {
                 nrm[k] = V::select(inside, zero - nk, nk);
             }
             let first = first.bits();
-            let mut m = [[0f32; W]; 5];
-            for l in 0..W {
+            let mut m = [[0f32; LANES8]; 5];
+            for l in 0..LANES8 {
                 let mat =
                     &self.materials[kinds[l][if first >> l & 1 != 0 { 0 } else { 1 }] as usize];
                 for k in 0..3 {
@@ -690,13 +690,20 @@ impl Kernel<'_> {
             let [br, bg, bb, spec, shin] = m.map(|c| V::load_from(&c));
             let pow = match self.spec_pow {
                 Some(pw) => pw,
-                None => fastshade::spec_pow_of(shin),
+                None => lanes::spec_pow_of(shin),
             };
-            let c =
-                fastshade::shade_lanes(&self.lighting, nrm, to_eye, [br, bg, bb], spec, shin, pow);
+            let c = lanes::shade::shade_lanes(
+                &self.lighting,
+                nrm,
+                to_eye,
+                [br, bg, bb],
+                spec,
+                shin,
+                pow,
+            );
             // sRGB encode over lanes: the 4096-bin table of `linear_to_srgb8` (same bytes).
-            let mut px = [0u32; W];
-            fastshade::srgb_rgba_lanes(c[0], c[1], c[2], enc).store_bits(&mut px);
+            let mut px = [0u32; LANES8];
+            lanes::srgb_rgba_lanes(c[0], c[1], c[2], enc).store_bits(&mut px);
             for (l, &b) in chunk.iter().enumerate() {
                 let (i, j) = (b as usize % TILE as usize, b as usize / TILE as usize);
                 let o = j * stride + i;

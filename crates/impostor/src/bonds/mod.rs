@@ -68,11 +68,11 @@
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 use texmap_core::frame::Frame;
+#[cfg(target_arch = "x86_64")]
+use texmap_core::lanes::F32x8Avx2;
+use texmap_core::lanes::{self, F32x8, LANES8, LaneMask, Lanes8, SpecPow};
 use texmap_core::shade::{Lighting, Material};
 
-#[cfg(target_arch = "x86_64")]
-use crate::fastshade::V8x;
-use crate::fastshade::{self, Mask8, Simd8, SpecPow, V8, W};
 use crate::pipeline::{FLAG_INSIDE, LANES, NONE, TILE, TILE_BUF, TILE_PX, View};
 use crate::scene::SphereScene;
 use texmap_raster::bin::{ChunkSink, TileBins};
@@ -102,14 +102,14 @@ fn shared_spec_pow(materials: &[Material]) -> Option<SpecPow> {
     materials
         .iter()
         .all(|m| m.shininess.to_bits() == m0.shininess.to_bits())
-        .then(|| fastshade::spec_pow_of(V8::splat(m0.shininess)))
+        .then(|| lanes::spec_pow_of(F32x8::splat(m0.shininess)))
 }
 
 /// Whether the depth pass may use AVX2 lanes (checked once per frame).
 fn avx2_available() -> bool {
     #[cfg(target_arch = "x86_64")]
     {
-        V8x::available()
+        F32x8Avx2::available()
     }
     #[cfg(not(target_arch = "x86_64"))]
     {

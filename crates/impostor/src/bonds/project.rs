@@ -157,23 +157,26 @@ pub(super) fn sphere_rects_persp(
     r: f32,
 ) -> [[Option<(f32, f32)>; 2]; 2] {
     // Lane k: sphere k / 4, axis (k / 2) % 2 (x, then y), tangent k % 2 (turned by ±asin(r/l)).
-    let x = V8::load(&[a.x, a.x, a.y, a.y, b.x, b.x, b.y, b.y]);
-    let z = V8::load(&[a.z, a.z, a.z, a.z, b.z, b.z, b.z, b.z]);
-    let rs = V8::load(&[r, -r, r, -r, r, -r, r, -r]);
-    let zero = V8::splat(0.0);
+    let x = F32x8::load(&[a.x, a.x, a.y, a.y, b.x, b.x, b.y, b.y]);
+    let z = F32x8::load(&[a.z, a.z, a.z, a.z, b.z, b.z, b.z, b.z]);
+    let rs = F32x8::load(&[r, -r, r, -r, r, -r, r, -r]);
+    let zero = F32x8::splat(0.0);
     let l2 = x * x + z * z;
-    let t2 = l2 - V8::splat(r * r);
+    let t2 = l2 - F32x8::splat(r * r);
     let t = t2.max(zero).sqrt();
     // Tangent directions (scaled by the centre distance): cos = t/l, sin = ±r/l.
     let xt = t * x - rs * z;
     let zt = rs * x + t * z;
     // Both tangents of a pair must point in front of the eye plane, with a margin against
     // rounding; then the slopes x/(−z) map to pixels (x: cx + s·k, y: cy − s·k).
-    let ok = t2.gt(zero).and(zt.lt(zero - V8::splat(1e-6) * l2)).bits();
+    let ok = t2
+        .gt(zero)
+        .and(zt.lt(zero - F32x8::splat(1e-6) * l2))
+        .bits();
     let s = xt / (zero - zt);
     let (k, cx, cy) = (view.k, view.cx, view.cy);
-    let px = (V8::load(&[cx, cx, cy, cy, cx, cx, cy, cy])
-        + s * V8::load(&[k, k, -k, -k, k, k, -k, -k]))
+    let px = (F32x8::load(&[cx, cx, cy, cy, cx, cx, cy, cy])
+        + s * F32x8::load(&[k, k, -k, -k, k, k, -k, -k]))
     .store();
     let pair = |i: usize| -> Option<(f32, f32)> {
         if ok >> i & 3 != 3 {

@@ -209,7 +209,7 @@ fn lane_kernel_matches_the_scalar_reference() {
         };
         let bv = BondV::new(&rec, 5);
         let qq = Vec3::from(rec.q).length_squared();
-        let (near, far) = (V8::splat(view.near), V8::splat(view.far));
+        let (near, far) = (F32x8::splat(view.near), F32x8::splat(view.far));
         let [x0, y0, x1, y1] = rec.bbox.map(|v| v as u32);
         for y in y0.saturating_sub(2)..(y1 + 2).min(view.height) {
             let ys = (view.cy - (y as f32 + 0.5)) * view.inv_k;
@@ -225,13 +225,13 @@ fn lane_kernel_matches_the_scalar_reference() {
                     lanes_persp(&rec, &xs, ys, qq)
                 };
                 let (t_ref, f_ref) = solve8_scalar(&rec, &lanes_ref, LANES, view.near, view.far);
-                let (x, yv) = (V8::load(&xs), V8::splat(ys));
+                let (x, yv) = (F32x8::load(&xs), F32x8::splat(ys));
                 let rays = if view.ortho {
                     Ortho::rays(&bv, &Ortho::row(&bv, yv), x)
                 } else {
                     Persp::rays(&bv, &Persp::row(&bv, yv), x)
                 };
-                let (t, word) = solve8(&bv, &rays, fastshade::M8::first(LANES), near, far);
+                let (t, word) = solve8(&bv, &rays, lanes::Mask8::first(LANES), near, far);
                 let (t, word) = (t.store(), word.store());
                 for k in 0..LANES {
                     par_lanes += !(lanes_ref.a[k] > PARALLEL_A) as usize;
@@ -306,7 +306,7 @@ fn lane_sphere_rects_match_the_scalar_ones() {
 fn avx2_and_sse_depth_passes_are_bit_identical() {
     use texmap_core::camera::Camera;
     use texmap_core::shade::Material;
-    if !V8x::available() {
+    if !F32x8Avx2::available() {
         eprintln!("no AVX2 on this CPU: nothing to compare");
         return;
     }

@@ -17,6 +17,7 @@ use core::arch::x86_64::*;
 use glam::{Vec2, Vec4};
 
 use super::{Addr, COORD_LIMIT, lerp4, texel};
+use crate::lanes::Isa;
 use crate::mip::MipTexture;
 
 /// Four `i32` lanes as an array (for the per-pixel scalar part).
@@ -574,20 +575,17 @@ pub(super) fn span_quads4<A: Addr, const K: usize>(
 // for AVX2, whose three-operand encoding drops the register copies SSE2's two-operand form needs
 // (same instructions otherwise: no FMA, so the results are the same bits).
 
-/// Whether the AVX2 build of the kernels can run here (cached by the standard library).
+/// Whether the AVX2 build of the kernels can run here ([`crate::lanes::isa`]).
 #[inline]
 pub(super) fn has_avx2() -> bool {
-    std::arch::is_x86_feature_detected!("avx2")
+    Isa::Avx2.enabled()
 }
 
-/// Whether the AVX-512 build of the kernels can run here (F, VL, BW, DQ; cached by the standard
-/// library).
+/// Whether the AVX-512 build of the kernels (F, VL, BW, DQ) can run here
+/// ([`crate::lanes::isa`]).
 #[inline]
 pub(super) fn has_avx512() -> bool {
-    std::arch::is_x86_feature_detected!("avx512f")
-        && std::arch::is_x86_feature_detected!("avx512vl")
-        && std::arch::is_x86_feature_detected!("avx512bw")
-        && std::arch::is_x86_feature_detected!("avx512dq")
+    Isa::Avx512.enabled()
 }
 
 /// Whether bulk per-pixel trilinear takes its AVX-512 build where the CPU has AVX-512: sixteen

@@ -3,6 +3,8 @@
 //! the reference the lane kernels are tested against bit for bit.
 
 use super::*;
+// The level-of-detail logarithm and its coefficients (used by the lane kernels too).
+pub(super) use crate::lanes::math::{LOG2_C1, LOG2_C2, LOG2_C3, LOG2_C4, log2_split};
 
 pub(super) trait Addr {
     const REPEAT: bool;
@@ -46,27 +48,6 @@ pub(super) fn clampc(x: f32) -> f32 {
     let x = if x >= -COORD_LIMIT { x } else { -COORD_LIMIT };
     if x <= COORD_LIMIT { x } else { COORD_LIMIT }
 }
-
-/// `log2 x` split into its integer part `⌊log2 x⌋` (exact, from the exponent) and an approximate
-/// fraction in `[0, 1]`: a degree-4 polynomial in the mantissa `t = x/2^e − 1` with `p(0) = 0`,
-/// `p(1) = 1` (continuous across octaves), fitted to `log2(1 + t)` with max error 1.2e-4 (tested).
-/// For positive normal `x` only; the callers route 0, NaN and subnormals elsewhere.
-#[inline(always)]
-pub(super) fn log2_split(x: f32) -> (i32, f32) {
-    let bits = x.to_bits();
-    let e = ((bits >> 23) & 0xff) as i32 - 127;
-    let t = f32::from_bits((bits & 0x007f_ffff) | 0x3f80_0000) - 1.0;
-    (
-        e,
-        t * (LOG2_C1 + t * (LOG2_C2 + t * (LOG2_C3 + t * LOG2_C4))),
-    )
-}
-
-/// [`log2_split`]'s mantissa polynomial (shared with the lane kernels).
-pub(super) const LOG2_C1: f32 = 1.438_725_7;
-pub(super) const LOG2_C2: f32 = -0.677_783_9;
-pub(super) const LOG2_C3: f32 = 0.321_188_76;
-pub(super) const LOG2_C4: f32 = 1.0 - LOG2_C1 - LOG2_C2 - LOG2_C3;
 
 /// ⌊x⌋ for |x| ≤ 2^30 (finite): truncate, then step down for negative fractions.
 #[inline(always)]

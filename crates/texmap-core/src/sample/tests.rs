@@ -12,24 +12,6 @@ fn ramp(w: u32, h: u32, wrap: Wrap) -> MipTexture {
 }
 
 #[test]
-fn log2_split_is_exact_in_its_integer_part_and_close_in_its_fraction() {
-    let mut worst = 0f64;
-    let mut prev = f64::NEG_INFINITY;
-    for i in 0..200_000 {
-        let x = 2f32.powf(-20.0 + 40.0 * i as f32 / 200_000.0);
-        let (e, f) = log2_split(x);
-        let exact = (x as f64).log2();
-        assert_eq!(e, exact.floor() as i32, "x = {x}");
-        assert!((0.0..=1.0).contains(&f), "x = {x}: fraction {f}");
-        let got = e as f64 + f as f64;
-        worst = worst.max((got - exact).abs());
-        assert!(got >= prev, "not monotone at {x}");
-        prev = got;
-    }
-    assert!(worst < 1.3e-4, "expected |error| < 1.3e-4, worst {worst}");
-}
-
-#[test]
 fn bilinear_at_texel_centres_and_midpoints_is_exact() {
     let t = ramp(8, 8, Wrap::Clamp);
     // Centre of texel (3, 5) is ((3.5)/8, (5.5)/8).

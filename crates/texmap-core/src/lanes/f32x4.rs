@@ -1,26 +1,31 @@
-//! Four-lane vectors for the quad loop: `I32x4` (edge functions) and `F32x4` (planes, depth,
-//! colour), with comparison masks and selects.
+//! Four lanes: [`I32x4`] (wrapping integer arithmetic, shifts) and [`F32x4`] (IEEE single
+//! arithmetic, comparisons that return all-ones / all-zero lane masks as `F32x4`, selects).
 //!
-//! On x86-64 they are SSE2 registers (SSE2 is part of the x86-64 baseline, so no runtime
-//! detection is needed); elsewhere plain arrays with the same semantics. Every operation is
-//! IEEE-exact lane by lane (no FMA, no approximate reciprocal), so both implementations and the
-//! scalar formulas they replace give bit-identical results.
+//! On x86-64 they are SSE2 registers (SSE2 is part of the x86-64 baseline, so no run-time
+//! detection is needed); elsewhere they are the [`portable`] arrays, which are compiled on every
+//! target as the scalar twin the SSE2 form is tested against bit for bit. Every operation is
+//! IEEE-exact lane by lane (no FMA, no approximate reciprocal), so both forms, and the scalar
+//! formulas they replace, give bit-identical results.
 //!
-//! Why not leave it to the auto-vectoriser: the lane loops of the quad path (`(d < s) as u8 << l`,
-//! `if on { a } else { b }`) stayed scalar; on the 1M-small-triangle scene the depth test alone
-//! took ~300 instructions per triangle (callgrind), written this way it takes about 10 per quad.
+//! The rasteriser's quad loop is written with them: lane loops such as `(d < s) as u8 << l` or
+//! `if on { a } else { b }` stay scalar under the auto-vectoriser, and written with these types
+//! the depth test of a quad is about ten instructions.
+
+// The arithmetic is written as method chains (`a.mul(b).add(c)`), in the evaluation order the
+// bit-for-bit tests fix; the methods are named after the operations they perform.
+#![allow(clippy::should_implement_trait)]
 
 #[cfg(target_arch = "x86_64")]
-mod imp {
+mod sse2 {
     use core::arch::x86_64::*;
 
     /// Four i32 lanes (wrapping arithmetic).
-    #[derive(Clone, Copy)]
-    pub(crate) struct I32x4(__m128i);
+    #[derive(Clone, Copy, Debug)]
+    pub struct I32x4(__m128i);
 
     /// Four f32 lanes; comparisons return all-ones / all-zero lane masks as `F32x4`.
-    #[derive(Clone, Copy)]
-    pub(crate) struct F32x4(__m128);
+    #[derive(Clone, Copy, Debug)]
+    pub struct F32x4(__m128);
 
     impl I32x4 {
         #[inline(always)]
@@ -231,17 +236,16 @@ mod imp {
     }
 }
 
-/// The portable lanes: the implementation off x86-64, and the reference the SSE2 lanes are
+/// The portable lanes: the implementation off x86-64, and the scalar twin the SSE2 lanes are
 /// tested against on x86-64.
-#[cfg(any(not(target_arch = "x86_64"), test))]
-mod scalar {
+pub mod portable {
     /// Four i32 lanes (wrapping arithmetic).
-    #[derive(Clone, Copy)]
-    pub(crate) struct I32x4([i32; 4]);
+    #[derive(Clone, Copy, Debug)]
+    pub struct I32x4([i32; 4]);
 
     /// Four f32 lanes; comparisons return all-ones / all-zero lane masks as `F32x4`.
-    #[derive(Clone, Copy)]
-    pub(crate) struct F32x4([f32; 4]);
+    #[derive(Clone, Copy, Debug)]
+    pub struct F32x4([f32; 4]);
 
     #[inline(always)]
     fn mask(b: bool) -> f32 {
@@ -413,55 +417,9 @@ mod scalar {
 }
 
 #[cfg(not(target_arch = "x86_64"))]
-use scalar as imp;
-
-pub(crate) use imp::{F32x4, I32x4};
-
-/// `x^p` for four lanes with `x` in `[0, 1]` and `0 < p <= 65536`, as `exp2(p · log2 x)`:
-/// relative error below 1e-5 against `f32::powf` (tested); lanes with `x` below the smallest
-/// normal f32 give 0, as `powf` does up to its own rounding.
-///
-/// `log2 x = e + log2 m` with `m ∈ [√½, √2)`, `log2 m = 2/ln2 · atanh(t)`, `t = (m − 1)/(m + 1)`,
-/// odd series to `t⁹` (|t| < 0.172: truncation < 1e-9); `2^y = 2^n · 2^f` with
-/// `n = trunc(y − ½)`, `f ∈ (−½, ½]`, Taylor series of `e^(f·ln2)` to degree 7 (< 1e-8).
-#[inline(always)]
-pub(crate) fn pow4(x: F32x4, p: f32) -> F32x4 {
-    let s = F32x4::splat;
-    let i = I32x4::splat;
-    // Split x = 2^e · m, m in [1, 2), then fold m into [√½, √2).
-    let bits = x.cast_i32();
-    let e = bits.shr::<23>().sub(i(127));
-    let m = bits.and(i(0x007f_ffff)).or(i(0x3f80_0000)).cast_f32();
-    let big = s(std::f32::consts::SQRT_2).lt(m);
-    let m = F32x4::select(big, m.mul(s(0.5)), m);
-    let e = F32x4::select(big, e.to_f32().add(s(1.0)), e.to_f32());
-    // log2 m by the atanh series.
-    let t = m.sub(s(1.0)).div(m.add(s(1.0)));
-    let t2 = t.mul(t);
-    let c = |k: f32| s((2.0 / std::f64::consts::LN_2 / k as f64) as f32);
-    let poly = c(9.0)
-        .mul(t2)
-        .add(c(7.0))
-        .mul(t2)
-        .add(c(5.0))
-        .mul(t2)
-        .add(c(3.0))
-        .mul(t2)
-        .add(c(1.0));
-    let log2x = e.add(t.mul(poly));
-    // y = p · log2 x <= 0, clamped where 2^y is below the normal range anyway.
-    let y = s(p).mul(log2x).max(s(-126.0));
-    // 2^y = 2^n · 2^f.
-    let n = y.sub(s(0.5)).trunc_i32();
-    let f = y.sub(n.to_f32()).mul(s(std::f32::consts::LN_2));
-    let mut ef = s(1.0 / 5040.0);
-    for k in [720.0f32, 120.0, 24.0, 6.0, 2.0, 1.0, 1.0] {
-        ef = ef.mul(f).add(s(1.0 / k));
-    }
-    let two_n = n.add(i(127)).shl::<23>().cast_f32();
-    let r = ef.mul(two_n);
-    F32x4::select(s(f32::MIN_POSITIVE).le(x), r, s(0.0))
-}
+pub use portable::{F32x4, I32x4};
+#[cfg(target_arch = "x86_64")]
+pub use sse2::{F32x4, I32x4};
 
 #[cfg(test)]
 mod tests {
@@ -589,7 +547,7 @@ mod tests {
             let ib = [bits() as i32, 7, i32::MIN, i32::MAX];
             let m = (round % 16) as u8;
             let fast = op_trace!(F32x4, I32x4, a, b, ia, ib, m);
-            let portable = op_trace!(scalar::F32x4, scalar::I32x4, a, b, ia, ib, m);
+            let portable = op_trace!(portable::F32x4, portable::I32x4, a, b, ia, ib, m);
             // NaN payloads may differ between implementations; NaN-ness may not.
             for (k, (x, y)) in fast.iter().zip(&portable).enumerate() {
                 let nan = |v: u32| f32::from_bits(v).is_nan();
@@ -599,32 +557,5 @@ mod tests {
                 );
             }
         }
-    }
-
-    #[test]
-    fn pow4_matches_powf_within_1e_5() {
-        let mut worst = 0.0f64;
-        for p in [1.0f32, 2.5, 5.0, 40.0, 128.0, 1000.0, 65536.0] {
-            for k in 0..=4096u32 {
-                // Uniform in [0, 1] plus a dense set just below 1 and a few tiny values.
-                let xs = [
-                    k as f32 / 4096.0,
-                    1.0 - k as f32 * 1e-7,
-                    f32::MIN_POSITIVE * k as f32,
-                    1e-20 * k as f32,
-                ];
-                let got = pow4(F32x4::new(xs), p).to_array();
-                for (x, g) in xs.into_iter().zip(got) {
-                    let want = (x as f64).powf(p as f64);
-                    let err = (g as f64 - want).abs();
-                    let tol = 1e-5 * want + 1e-37;
-                    assert!(err <= tol, "{x}^{p}: expected {want} got {g} tol {tol}");
-                    if want > 1e-30 {
-                        worst = worst.max(err / want);
-                    }
-                }
-            }
-        }
-        assert!(worst > 0.0 && worst < 1e-5, "worst relative error {worst}");
     }
 }
