@@ -310,11 +310,11 @@ fn render(a: &RenderArgs) -> Result<()> {
     }
     let mut quality_renderer = texmap_quality::QualityRenderer::new();
     let mut builder = crate::scene::scene_builder(&a.style)?;
-    let mut plan = crate::scene::MolPlan::new(&a.mol)?;
+    let mut plan = crate::scene::mol_plan(&a.mol)?;
     let mut md = MdFrame::new();
     let mut scene = SphereScene::default();
     let mut renderer = Renderer::new();
-    let mut camera: Option<crate::scene::CameraPlan> = None;
+    let mut camera: Option<texmap_md_scene::CameraPlan> = None;
     let pb = progress(mine.len() as u64, "rendering");
     let mut skipped_total = 0usize;
     // Frames whose image is on disk, for the error if a later frame fails.
@@ -340,9 +340,9 @@ fn render(a: &RenderArgs) -> Result<()> {
             .map_err(|e| fail(e.into(), &written))?;
         print_warnings(&traj, &mut shown);
         plan.label(&mut md, traj.name(), f)
-            .map_err(|e| fail(e, &written))?;
+            .map_err(|e| fail(e.into(), &written))?;
         plan.build(&mut builder, &mut md, &mut scene)
-            .map_err(|e| fail(e, &written))?;
+            .map_err(|e| fail(crate::scene::mol_error(e), &written))?;
         if a.box_outline
             && let Some(cell) = &md.cell
         {
@@ -353,7 +353,7 @@ fn render(a: &RenderArgs) -> Result<()> {
             for w in builder.warnings(&md) {
                 pb.suspend(|| eprintln!("texmap: warning: {}", warning_text(&w)));
             }
-            if let Some(w) = plan.unnamed_warning(&md, traj.name()) {
+            if let Some(w) = crate::scene::unnamed_warning(&plan, &md, traj.name()) {
                 pb.suspend(|| eprintln!("texmap: warning: {w}"));
             }
             if scene.is_empty() {
@@ -368,7 +368,7 @@ fn render(a: &RenderArgs) -> Result<()> {
                 return Err(fail(e, &written));
             }
             let plan =
-                crate::scene::CameraPlan::new(&a.camera, size, &a.path, &md, &scene, frames.len())
+                crate::scene::camera_plan(&a.camera, size, &a.path, &md, &scene, frames.len())
                     .map_err(|e| fail(e, &written))?;
             camera = Some(plan);
         }
@@ -379,7 +379,7 @@ fn render(a: &RenderArgs) -> Result<()> {
             .as_ref()
             .expect("planned at the first frame")
             .camera(k, &md)
-            .map_err(|e| fail(e, &written))?;
+            .map_err(|e| fail(crate::scene::camera_error(e, &a.path), &written))?;
         let lighting = Lighting::default_for(&cam);
         // This frame's quality options: bonds as drawn, fog over this frame's depth.
         let quality = quality.map(|mut q| {

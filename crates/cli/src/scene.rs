@@ -1,13 +1,18 @@
 //! The `render` flags turned into the `texmap-md-scene` library's calls: an md-io frame (atoms
 //! in Å) becomes an impostor `SphereScene` styled as the flags ask, and a camera is chosen.
+//! Files and flag texts (topology, selections, colours, vectors, keyframes) are read and parsed
+//! here; the library's [`MolPlan`] and [`CameraPlan`] do the work, and their errors are
+//! reworded to name the flags.
 
 use anyhow::{Context, Result};
 use glam::Vec3;
 use texmap_core::camera::Camera;
-use texmap_core::camera_path::{Keyframes, Pose};
 use texmap_impostor::SphereScene;
-use texmap_md_io::{Frame, Selection, Topology, atom_element};
-use texmap_md_scene::{RuleKind, StyleError, StyleOptions, StyleWarning, ViewAxis, centre_of};
+use texmap_md_io::{Frame, Selection, Topology};
+use texmap_md_scene::{
+    BondSource, CameraPlan, CameraPlanError, MolError, MolOptions, MolPlan, MotionSpec, Pbc,
+    RuleKind, SelectionRole, StyleError, StyleOptions, StyleWarning, ViewAxis,
+};
 
 use crate::args::{
     BondsArg, ColorBy, DrawStyle, MolArgs, PathArgs, PbcArg, StyleArgs, ViewArgs, parse_color,
@@ -94,227 +99,106 @@ fn sel_value<'a>(flag: &str, s: &'a str) -> Result<(&'a str, &'a str)> {
     }
 }
 
-/// What `render` does to a frame between reading and drawing: topology, periodic boundaries,
-/// selection, per-selection looks and bonds (the [`MolArgs`]).
-pub struct MolPlan {
-    pub topology: Option<Topology>,
-    select: Option<Selection>,
-    colors: Vec<(Selection, [f32; 3])>,
-    radii: Vec<(Selection, f32)>,
-    bonds: BondsArg,
-    draw: DrawStyle,
-    pbc: PbcArg,
-    /// Scratch: selected atoms' new indices, bond pairs.
-    map: Vec<u32>,
-    pairs: Vec<[u32; 2]>,
-    /// The bonds of the last frame drawn (before the selection).
-    pub last_bond_count: usize,
+/// The library's bond source for `--bonds`.
+impl From<BondsArg> for BondSource {
+    fn from(b: BondsArg) -> BondSource {
+        match b {
+            BondsArg::Auto => BondSource::Auto,
+            BondsArg::Topology => BondSource::Topology,
+            BondsArg::None => BondSource::None,
+        }
+    }
 }
 
-impl MolPlan {
-    pub fn new(args: &MolArgs) -> Result<MolPlan> {
-        let topology = args.topology.as_deref().map(open_topology).transpose()?;
-        let select = args
-            .select
-            .as_deref()
-            .map(|t| parse_selection("--select", t))
-            .transpose()?;
-        let mut colors = Vec::new();
-        for c in &args.color_rules {
-            let (sel, v) = sel_value("--color", c)?;
-            let rgb =
-                parse_color(v).map_err(|e| crate::args::UsageError(format!("--color: {e}")))?;
-            colors.push((
-                parse_selection("--color", sel)?,
-                rgb.map(|x| x as f32 / 255.0),
-            ));
-        }
-        let mut radii = Vec::new();
-        for r in &args.radius_rules {
-            let (sel, v) = sel_value("--radius", r)?;
-            let radius = match v.parse::<f32>() {
-                Ok(x) if x.is_finite() && x > 0.0 => x,
-                _ => return usage(format!("--radius {r:?}: {v:?} is not a radius > 0 in Å")),
-            };
-            radii.push((parse_selection("--radius", sel)?, radius));
-        }
-        if args.bonds == BondsArg::Topology
-            && args.draw != DrawStyle::Spacefill
-            && topology.as_ref().is_none_or(|t| t.bonds.is_empty())
-        {
-            return usage(match &topology {
-                None => "--bonds topology needs --topology FILE (PDB with CONECT records, or a LAMMPS data file with a Bonds section)".to_string(),
-                Some(t) => format!("--bonds topology: {} has no bonds (use --bonds auto for bonds by distance)", t.name()),
-            });
-        }
-        Ok(MolPlan {
-            topology,
-            select,
-            colors,
-            radii,
-            bonds: args.bonds,
-            draw: args.draw,
-            pbc: args.pbc,
-            map: Vec::new(),
-            pairs: Vec::new(),
-            last_bond_count: 0,
-        })
-    }
-
-    /// Whether bonds are drawn at all.
-    pub fn draws_bonds(&self) -> bool {
-        self.draw != DrawStyle::Spacefill && self.bonds != BondsArg::None
-    }
-
-    /// The topology's labels on `frame` (number `index` of `trajectory`).
-    pub fn label(&self, frame: &mut Frame, trajectory: &str, index: usize) -> Result<()> {
-        if let Some(t) = &self.topology {
-            t.apply(frame, trajectory, index)?;
-        }
-        Ok(())
-    }
-
-    /// The bonds of `frame` as `--bonds` asks (before periodic handling).
-    fn find_bonds(&mut self, frame: &Frame, need: bool) {
-        self.pairs.clear();
-        if !need {
-            return;
-        }
-        match (self.bonds, &self.topology) {
-            (BondsArg::None, _) => {}
-            (BondsArg::Topology, Some(t)) => self.pairs.extend_from_slice(&t.bonds),
-            (BondsArg::Topology, None) => {}
-            (BondsArg::Auto, Some(t)) if !t.bonds.is_empty() => {
-                self.pairs.extend_from_slice(&t.bonds)
-            }
-            (BondsArg::Auto, _) => {
-                self.pairs = texmap_md_io::bonds::bonds_by_distance(frame, true).pairs;
-            }
+/// The library's draw style for `--style`.
+impl From<DrawStyle> for texmap_md_scene::DrawStyle {
+    fn from(d: DrawStyle) -> texmap_md_scene::DrawStyle {
+        match d {
+            DrawStyle::Spacefill => texmap_md_scene::DrawStyle::Spacefill,
+            DrawStyle::BallStick => texmap_md_scene::DrawStyle::BallStick,
+            DrawStyle::Licorice => texmap_md_scene::DrawStyle::Licorice,
         }
     }
+}
 
-    /// Periodic boundaries, then the scene: selected atoms only, per-selection colours and
-    /// radii, bonds between drawn atoms (never across the box).
-    pub fn build(
-        &mut self,
-        builder: &mut SceneBuilder,
-        frame: &mut Frame,
-        scene: &mut SphereScene,
-    ) -> Result<()> {
-        let unwrap = self.pbc == PbcArg::Unwrap && frame.cell.is_some();
-        self.find_bonds(frame, self.draws_bonds() || unwrap);
-        match self.pbc {
-            PbcArg::None => {}
-            PbcArg::Wrap => texmap_md_io::pbc::wrap(frame),
-            PbcArg::Unwrap => {
-                if unwrap && self.bonds == BondsArg::None {
-                    // Molecules need bonds to be made whole even when none are drawn.
-                    self.pairs = texmap_md_io::bonds::bonds_by_distance(frame, true).pairs;
-                }
-                texmap_md_io::pbc::unwrap(frame, &self.pairs);
-            }
+/// The library's periodic treatment for `--pbc`.
+impl From<PbcArg> for Pbc {
+    fn from(p: PbcArg) -> Pbc {
+        match p {
+            PbcArg::None => Pbc::None,
+            PbcArg::Wrap => Pbc::Wrap,
+            PbcArg::Unwrap => Pbc::Unwrap,
         }
-        texmap_md_io::pbc::drop_crossing(&mut self.pairs, &frame.positions, frame.cell.as_ref());
-        self.last_bond_count = self.pairs.len();
-        // Every atom, styled; then the per-selection rules, in order.
-        builder.build(frame, scene);
-        for (sel, rgb) in &self.colors {
-            let mask = sel
-                .evaluate(frame)
-                .map_err(|e| crate::args::UsageError(format!("--color: {e}")))?;
-            let kind = builder.kind_of(*rgb);
-            for (i, m) in mask.iter().enumerate() {
-                if *m {
-                    scene.kinds[i] = kind;
-                }
-            }
-        }
-        builder.refresh_materials(scene);
-        let scale = builder.radius_scale();
-        for (sel, r) in &self.radii {
-            let mask = sel
-                .evaluate(frame)
-                .map_err(|e| crate::args::UsageError(format!("--radius: {e}")))?;
-            for (i, m) in mask.iter().enumerate() {
-                if *m {
-                    scene.radii[i] = r * scale;
-                }
-            }
-        }
-        match self.draw {
-            DrawStyle::Spacefill => {}
-            DrawStyle::BallStick => {
-                for r in &mut scene.radii {
-                    *r *= texmap_study::scenes::BALL_AND_STICK_RADIUS_SCALE;
-                }
-                scene.bond_radius = texmap_study::scenes::BALL_AND_STICK_BOND_RADIUS;
-            }
-            DrawStyle::Licorice => {
-                for r in &mut scene.radii {
-                    *r = LICORICE_RADIUS;
-                }
-                scene.bond_radius = LICORICE_RADIUS;
-            }
-        }
-        // The selection: keep selected atoms, renumber the bonds between them.
-        let mask = match &self.select {
-            Some(sel) => Some(
-                sel.evaluate(frame)
-                    .map_err(|e| crate::args::UsageError(format!("--select: {e}")))?,
-            ),
-            None => None,
+    }
+}
+
+/// What `render` does to a frame between reading and drawing ([`MolPlan`]) for the
+/// [`MolArgs`]: the topology file read, the selections and colours parsed.
+pub fn mol_plan(args: &MolArgs) -> Result<MolPlan> {
+    let topology = args.topology.as_deref().map(open_topology).transpose()?;
+    let select = args
+        .select
+        .as_deref()
+        .map(|t| parse_selection("--select", t))
+        .transpose()?;
+    let mut colors = Vec::new();
+    for c in &args.color_rules {
+        let (sel, v) = sel_value("--color", c)?;
+        let rgb = parse_color(v).map_err(|e| crate::args::UsageError(format!("--color: {e}")))?;
+        colors.push((
+            parse_selection("--color", sel)?,
+            rgb.map(|x| x as f32 / 255.0),
+        ));
+    }
+    let mut radii = Vec::new();
+    for r in &args.radius_rules {
+        let (sel, v) = sel_value("--radius", r)?;
+        let radius = match v.parse::<f32>() {
+            Ok(x) if x.is_finite() && x > 0.0 => x,
+            _ => return usage(format!("--radius {r:?}: {v:?} is not a radius > 0 in Å")),
         };
-        self.map.clear();
-        if let Some(mask) = &mask {
-            let mut next = 0u32;
-            for &m in mask {
-                self.map.push(if m { next } else { u32::MAX });
-                next += m as u32;
-            }
-            let mut w = 0;
-            for (i, &m) in mask.iter().enumerate() {
-                if m {
-                    scene.centers[w] = scene.centers[i];
-                    scene.radii[w] = scene.radii[i];
-                    scene.kinds[w] = scene.kinds[i];
-                    w += 1;
-                }
-            }
-            scene.centers.truncate(w);
-            scene.radii.truncate(w);
-            scene.kinds.truncate(w);
-        }
-        scene.bonds.clear();
-        if self.draws_bonds() {
-            for b in &self.pairs {
-                let (i, j) = if self.map.is_empty() {
-                    (b[0], b[1])
-                } else {
-                    (self.map[b[0] as usize], self.map[b[1] as usize])
-                };
-                if i != u32::MAX && j != u32::MAX {
-                    scene.bonds.push([i, j]);
-                }
-            }
-        }
-        Ok(())
+        radii.push((parse_selection("--radius", sel)?, radius));
     }
-
-    /// The once-per-run warning for atoms that have nothing to be told apart by.
-    pub fn unnamed_warning(&self, frame: &Frame, file: &str) -> Option<String> {
-        let nothing = frame.names.is_empty()
-            && frame.types.is_empty()
-            && (0..frame.n_atoms()).all(|i| atom_element(frame, i).is_unknown());
-        (self.topology.is_none() && nothing && frame.n_atoms() > 0).then(|| {
-            format!(
-                "{file} has no atom names, types or elements (coordinates only): every atom is drawn in the unknown-element colour; give --topology FILE (PDB, GRO or LAMMPS data file of the same atoms) for names, elements, residues and bonds"
-            )
-        })
-    }
+    MolPlan::new(MolOptions {
+        topology,
+        select,
+        colors,
+        radii,
+        bonds: args.bonds.into(),
+        draw: args.draw.into(),
+        pbc: args.pbc.into(),
+    })
+    .map_err(mol_error)
 }
 
-/// Atom and stick radius of `--style licorice` (Å), as VMD's Licorice default (0.3).
-pub const LICORICE_RADIUS: f32 = 0.3;
+/// A [`MolError`] as the usage error naming the flag.
+pub fn mol_error(e: MolError) -> anyhow::Error {
+    let text = match e {
+        MolError::NoTopology => "--bonds topology needs --topology FILE (PDB with CONECT records, or a LAMMPS data file with a Bonds section)".to_string(),
+        MolError::TopologyWithoutBonds { topology } => format!(
+            "--bonds topology: {topology} has no bonds (use --bonds auto for bonds by distance)"
+        ),
+        MolError::BadRadius { radius, .. } => format!("--radius: {radius} is not a radius > 0 in Å"),
+        MolError::Selection { role, error } => {
+            let flag = match role {
+                SelectionRole::Select => "--select",
+                SelectionRole::Color => "--color",
+                SelectionRole::Radius => "--radius",
+            };
+            format!("{flag}: {error}")
+        }
+    };
+    crate::args::UsageError(text).into()
+}
+
+/// The once-per-run warning for atoms that have nothing to be told apart by.
+pub fn unnamed_warning(plan: &MolPlan, frame: &Frame, file: &str) -> Option<String> {
+    plan.atoms_unnamed(frame).then(|| {
+        format!(
+            "{file} has no atom names, types or elements (coordinates only): every atom is drawn in the unknown-element colour; give --topology FILE (PDB, GRO or LAMMPS data file of the same atoms) for names, elements, residues and bonds"
+        )
+    })
+}
 
 fn parse_vec3(s: &str, what: &str) -> Result<Vec3> {
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();
@@ -426,116 +310,64 @@ pub fn camera_for(
     texmap_md_scene::fit_camera(first, scene, axis, hfov, w, h).context("automatic camera")
 }
 
-/// How the camera moves over the frames of a render.
-enum Motion {
-    Still,
-    Orbit { degrees_per_frame: f32 },
-    Keys(Keyframes),
+/// The camera of every frame of a render ([`CameraPlan`]) of `count` frames of `size` pixels
+/// whose first frame is `first` (drawn as `scene`): the first camera from the view flags,
+/// moved along `--orbit`/`--orbit-turns`/`--keyframes` and with the centre of `--follow`'s atoms.
+pub fn camera_plan(
+    view: &ViewArgs,
+    size: (u32, u32),
+    path: &PathArgs,
+    first: &Frame,
+    scene: &SphereScene,
+    count: usize,
+) -> Result<CameraPlan> {
+    let (template, target) = camera_for(view, size, first, scene)?;
+    let motion = match (path.orbit, path.orbit_turns, &path.keyframes) {
+        (Some(d), None, None) => MotionSpec::Orbit {
+            degrees_per_frame: d,
+        },
+        (None, Some(t), None) => MotionSpec::OrbitTurns { turns: t },
+        (None, None, Some(file)) => MotionSpec::Keyframes(
+            std::fs::read_to_string(file)
+                .with_context(|| format!("--keyframes {}", file.display()))?,
+        ),
+        (None, None, None) => MotionSpec::Still,
+        _ => return usage("--orbit, --orbit-turns and --keyframes exclude one another"),
+    };
+    let follow = path
+        .follow
+        .as_deref()
+        .map(|t| parse_selection("--follow", t))
+        .transpose()?;
+    CameraPlan::new(template, target, motion, follow, first, count)
+        .map_err(|e| camera_error(e, path))
 }
 
-/// The camera of every frame of a render: the first frame's camera (fitted or given), moved
-/// along `--orbit`/`--orbit-turns`/`--keyframes` and with the centre of `--follow`'s atoms.
-/// A frame's camera depends only on its position in the render and its own atoms, so the parts
-/// of a sharded render draw exactly what one process would.
-pub struct CameraPlan {
-    template: Camera,
-    pose: Pose,
-    motion: Motion,
-    /// The --follow selection and its atoms' centre in the first frame.
-    follow: Option<(Selection, Vec3)>,
-}
-
-/// The mean position of the atoms `sel` selects, or None when it selects none.
-fn follow_centre(sel: &Selection, frame: &Frame) -> Result<Option<Vec3>> {
-    centre_of(sel, frame).map_err(|e| crate::args::UsageError(format!("--follow: {e}")).into())
-}
-
-impl CameraPlan {
-    /// The plan for a render of `count` frames of `size` pixels whose first frame is `first`
-    /// (drawn as `scene`).
-    pub fn new(
-        view: &ViewArgs,
-        size: (u32, u32),
-        path: &PathArgs,
-        first: &Frame,
-        scene: &SphereScene,
-        count: usize,
-    ) -> Result<CameraPlan> {
-        let (template, target) = camera_for(view, size, first, scene)?;
-        let pose = Pose::of_camera(&template, target);
-        let motion = match (path.orbit, path.orbit_turns, &path.keyframes) {
-            (Some(d), None, None) => {
-                if !d.is_finite() {
-                    return usage(format!("--orbit {d}: must be a finite number of degrees"));
-                }
-                Motion::Orbit {
-                    degrees_per_frame: d,
-                }
-            }
-            (None, Some(t), None) => {
-                if !t.is_finite() {
-                    return usage(format!("--orbit-turns {t}: must be a finite number"));
-                }
-                Motion::Orbit {
-                    degrees_per_frame: 360.0 * t / count.max(1) as f32,
-                }
-            }
-            (None, None, Some(file)) => {
-                let text = std::fs::read_to_string(file)
-                    .with_context(|| format!("--keyframes {}", file.display()))?;
-                let keys = Keyframes::parse(&text, &pose)
-                    .map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?;
-                Motion::Keys(keys)
-            }
-            (None, None, None) => Motion::Still,
-            _ => return usage("--orbit, --orbit-turns and --keyframes exclude one another"),
-        };
-        let follow = match &path.follow {
-            None => None,
-            Some(text) => {
-                let sel = parse_selection("--follow", text)?;
-                let Some(c) = follow_centre(&sel, first)? else {
-                    return usage(format!(
-                        "--follow {text:?} selects none of the first frame's atoms"
-                    ));
-                };
-                Some((sel, c))
-            }
-        };
-        Ok(CameraPlan {
-            template,
-            pose,
-            motion,
-            follow,
-        })
-    }
-
-    /// The camera of the `k`-th rendered frame (0-based), whose atoms are `frame` (after the
-    /// periodic-boundary treatment).
-    pub fn camera(&self, k: usize, frame: &Frame) -> Result<Camera> {
-        let mut pose = match &self.motion {
-            Motion::Still => self.pose,
-            Motion::Orbit { degrees_per_frame } => {
-                // Reduced in f64 so that frame 100,000 turns as exactly as frame 1.
-                let deg = (k as f64 * *degrees_per_frame as f64) % 360.0;
-                self.pose.orbit(deg as f32)
-            }
-            Motion::Keys(keys) => keys.at(k as f32),
-        };
-        if let Some((sel, c0)) = &self.follow {
-            let Some(c) = follow_centre(sel, frame)? else {
-                anyhow::bail!(
-                    "--follow {:?} selects none of this frame's atoms",
-                    sel.text()
-                );
-            };
-            pose = pose.translated(c - *c0);
+/// A [`CameraPlanError`] as the error naming the flag (usage errors for the flags' values).
+pub fn camera_error(e: CameraPlanError, path: &PathArgs) -> anyhow::Error {
+    let usage = |text: String| crate::args::UsageError(text).into();
+    match e {
+        CameraPlanError::OrbitNotFinite { degrees } => usage(format!(
+            "--orbit {degrees}: must be a finite number of degrees"
+        )),
+        CameraPlanError::OrbitTurnsNotFinite { turns } => {
+            usage(format!("--orbit-turns {turns}: must be a finite number"))
         }
-        if matches!(self.motion, Motion::Still) && self.follow.is_none() {
-            return Ok(self.template.clone());
+        CameraPlanError::Keyframes(e) => {
+            let file = path
+                .keyframes
+                .as_deref()
+                .unwrap_or(std::path::Path::new(""));
+            anyhow::anyhow!("{}: {e}", file.display())
         }
-        pose.camera(&self.template)
-            .map_err(|e| anyhow::anyhow!("camera of rendered frame {k}: {e}"))
+        CameraPlanError::Follow(e) => usage(format!("--follow: {e}")),
+        CameraPlanError::FollowNoneFirst { selection } => usage(format!(
+            "--follow {selection:?} selects none of the first frame's atoms"
+        )),
+        CameraPlanError::FollowNone { selection } => {
+            anyhow::anyhow!("--follow {selection:?} selects none of this frame's atoms")
+        }
+        e @ CameraPlanError::Camera { .. } => anyhow::anyhow!("{e}"),
     }
 }
 

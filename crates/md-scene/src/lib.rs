@@ -9,6 +9,11 @@
 //! - [`camera`]: the automatic camera, fitted so that the sphere around everything a frame draws
 //!   fills the image, seen along an axis or the three-quarter [`AUTO_VIEW_DIRECTION`]; the centre
 //!   of a selection, which a camera may follow.
+//! - [`plan`]: a frame's way from reading to drawing ([`MolPlan`]): the topology's labels, bonds
+//!   ([`BondSource`]), periodic boundaries ([`Pbc`]), per-selection colours and radii applied in
+//!   order, the [`DrawStyle`] and the selection of drawn atoms with its bonds renumbered.
+//! - [`camera_plan`]: the camera of every frame of a render ([`CameraPlan`]): still, orbiting or
+//!   along keyframes ([`MotionSpec`]), and following a selection's centre.
 //! - [`outline`]: the periodic box drawn as rows of small spheres along its twelve edges (every
 //!   sphere method draws spheres; none draws lines).
 //!
@@ -41,13 +46,20 @@
 //! ```
 
 pub mod camera;
+pub mod camera_plan;
 pub mod outline;
 pub mod palette;
+pub mod plan;
 pub mod style;
 
 pub use camera::{AUTO_VIEW_DIRECTION, FIT_MARGIN, ViewAxis, centre_of, drawn_bounds, fit_camera};
+pub use camera_plan::{CameraPlan, CameraPlanError, MotionSpec};
 pub use outline::{add_box_outline, cell_corners};
 pub use palette::{MAX_MATERIALS, Palette, type_color};
+pub use plan::{
+    BALL_AND_STICK_BOND_RADIUS, BALL_AND_STICK_RADIUS_SCALE, BondSource, DrawStyle,
+    LICORICE_RADIUS, MolError, MolOptions, MolPlan, Pbc, SelectionRole,
+};
 pub use style::{
     ColorBy, RuleKind, SceneBuilder, StyleError, StyleOptions, StyleWarning, style_from,
 };

@@ -25,11 +25,7 @@ use texmap_impostor::SphereScene;
 use crate::elements::{Element, SEED004_SPECIES};
 use crate::rng::SplitMix64;
 
-/// Ball-and-stick atoms are this fraction of their Bondi (van der Waals) radii.
-pub const BALL_AND_STICK_RADIUS_SCALE: f32 = 0.3;
-/// Ball-and-stick bond radius in Å: thinner than the smallest scaled atom (H, 0.36 Å), so the
-/// bond ends are hidden inside the atoms.
-pub const BALL_AND_STICK_BOND_RADIUS: f32 = 0.2;
+pub use texmap_md_scene::{BALL_AND_STICK_BOND_RADIUS, BALL_AND_STICK_RADIUS_SCALE};
 
 /// The eye sits this many box lengths from the box centre.
 pub const EYE_DISTANCE_IN_BOX_LENGTHS: f32 = 2.4;

@@ -1,0 +1,472 @@
+//! What happens to a frame between reading and drawing: the topology's labels, the bonds, the
+//! periodic boundaries, the per-selection colours and radii, the draw style and the selection
+//! of the atoms that are drawn.
+//!
+//! [`MolPlan::build`] runs, in this order:
+//! 1. the bonds as [`BondSource`] asks (the topology's, or found by distance), found only when
+//!    they are drawn or needed to unwrap;
+//! 2. the periodic boundaries ([`Pbc`]): atoms wrapped into the box, or molecules made whole
+//!    across it (with bonds by distance when none are drawn); bonds that still cross the box
+//!    are dropped, so no stick spans it;
+//! 3. every atom styled by the [`SceneBuilder`], then the colour rules and the radius rules, each
+//!    list in order, so that a later rule wins over an earlier one for the atoms both select;
+//! 4. the [`DrawStyle`]: radii scaled for ball-and-stick, or all set to [`LICORICE_RADIUS`];
+//! 5. the selection: the selected atoms are kept in their order and the bonds between two kept
+//!    atoms are renumbered to the kept atoms' indices; bonds to a dropped atom are dropped.
+
+use std::fmt;
+
+use texmap_impostor::SphereScene;
+use texmap_md_io::{Frame, Selection, SelectionError, Topology, atom_element};
+
+use crate::SceneBuilder;
+
+/// Ball-and-stick atoms are this fraction of their Bondi (van der Waals) radii.
+pub const BALL_AND_STICK_RADIUS_SCALE: f32 = 0.3;
+/// Ball-and-stick bond radius in Å: thinner than the smallest scaled atom (H, 0.36 Å), so the
+/// bond ends are hidden inside the atoms.
+pub const BALL_AND_STICK_BOND_RADIUS: f32 = 0.2;
+/// Atom and stick radius of [`DrawStyle::Licorice`] (Å), as VMD's Licorice default (0.3).
+pub const LICORICE_RADIUS: f32 = 0.3;
+
+/// Where the bonds come from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BondSource {
+    /// No bonds.
+    None,
+    /// The topology's bonds only.
+    Topology,
+    /// The topology's bonds when it has any, else bonds by distance.
+    Auto,
+}
+
+/// How atoms and bonds are drawn.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DrawStyle {
+    /// Atoms at their full radii, no bonds.
+    Spacefill,
+    /// Atoms at [`BALL_AND_STICK_RADIUS_SCALE`] of their radii, bonds of
+    /// [`BALL_AND_STICK_BOND_RADIUS`].
+    BallStick,
+    /// Atoms and bonds all of [`LICORICE_RADIUS`].
+    Licorice,
+}
+
+/// The periodic-boundary treatment (frames without a cell are left as they are).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pbc {
+    /// Positions as read.
+    None,
+    /// Every atom moved into the box.
+    Wrap,
+    /// Molecules split across the box joined along their bonds.
+    Unwrap,
+}
+
+/// The options of a [`MolPlan`]; selections are parsed by the caller.
+#[derive(Clone, Debug)]
+pub struct MolOptions {
+    /// Per-atom labels (names, residues, elements) and bonds given to every frame.
+    pub topology: Option<Topology>,
+    /// The atoms drawn (all when `None`).
+    pub select: Option<Selection>,
+    /// Colour rules (sRGB fractions of 1), applied in order.
+    pub colors: Vec<(Selection, [f32; 3])>,
+    /// Radius rules (Å, before the style's radius scale), applied in order.
+    pub radii: Vec<(Selection, f32)>,
+    /// Where bonds come from.
+    pub bonds: BondSource,
+    /// How atoms and bonds are drawn.
+    pub draw: DrawStyle,
+    /// The periodic-boundary treatment.
+    pub pbc: Pbc,
+}
+
+impl Default for MolOptions {
+    fn default() -> MolOptions {
+        MolOptions {
+            topology: None,
+            select: None,
+            colors: Vec::new(),
+            radii: Vec::new(),
+            bonds: BondSource::Auto,
+            draw: DrawStyle::Spacefill,
+            pbc: Pbc::None,
+        }
+    }
+}
+
+/// Which selection of a [`MolPlan`] failed to evaluate.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SelectionRole {
+    /// [`MolOptions::select`].
+    Select,
+    /// A colour rule's selection.
+    Color,
+    /// A radius rule's selection.
+    Radius,
+}
+
+/// Why a [`MolPlan`] was refused or a frame could not be built.
+#[derive(Clone, Debug, PartialEq)]
+pub enum MolError {
+    /// Bonds from the topology are drawn, but there is no topology.
+    NoTopology,
+    /// Bonds from the topology are drawn, but the topology (named) has none.
+    TopologyWithoutBonds {
+        /// The topology's name.
+        topology: String,
+    },
+    /// A radius rule's radius is not a finite number > 0 (index of the rule, radius).
+    BadRadius {
+        /// Index in [`MolOptions::radii`].
+        rule: usize,
+        /// The refused radius.
+        radius: f32,
+    },
+    /// A selection could not be evaluated on a frame.
+    Selection {
+        /// Which selection.
+        role: SelectionRole,
+        /// Why.
+        error: SelectionError,
+    },
+}
+
+impl fmt::Display for MolError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            MolError::NoTopology => write!(f, "bonds from the topology need a topology"),
+            MolError::TopologyWithoutBonds { topology } => {
+                write!(f, "bonds from the topology: {topology} has no bonds")
+            }
+            MolError::BadRadius { rule, radius } => {
+                write!(f, "radius rule {rule}: {radius} is not a radius > 0 in Å")
+            }
+            MolError::Selection { role, error } => {
+                let what = match role {
+                    SelectionRole::Select => "the selection of drawn atoms",
+                    SelectionRole::Color => "a colour rule's selection",
+                    SelectionRole::Radius => "a radius rule's selection",
+                };
+                write!(f, "{what}: {error}")
+            }
+        }
+    }
+}
+
+impl std::error::Error for MolError {}
+
+/// A frame's way from reading to drawing (see the module docs for the order of the steps).
+#[derive(Clone, Debug)]
+pub struct MolPlan {
+    options: MolOptions,
+    /// Scratch: selected atoms' new indices (`u32::MAX` for dropped atoms), bond pairs.
+    map: Vec<u32>,
+    pairs: Vec<[u32; 2]>,
+    last_bond_count: usize,
+}
+
+impl MolPlan {
+    /// The plan for `options`; refused when topology bonds are drawn without a topology that
+    /// has bonds, or a radius rule's radius is not finite and > 0.
+    pub fn new(options: MolOptions) -> Result<MolPlan, MolError> {
+        for (rule, (_, radius)) in options.radii.iter().enumerate() {
+            if !(radius.is_finite() && *radius > 0.0) {
+                return Err(MolError::BadRadius {
+                    rule,
+                    radius: *radius,
+                });
+            }
+        }
+        if options.bonds == BondSource::Topology && options.draw != DrawStyle::Spacefill {
+            match &options.topology {
+                None => return Err(MolError::NoTopology),
+                Some(t) if t.bonds.is_empty() => {
+                    return Err(MolError::TopologyWithoutBonds {
+                        topology: t.name().to_string(),
+                    });
+                }
+                Some(_) => {}
+            }
+        }
+        Ok(MolPlan {
+            options,
+            map: Vec::new(),
+            pairs: Vec::new(),
+            last_bond_count: 0,
+        })
+    }
+
+    /// The topology, if any.
+    pub fn topology(&self) -> Option<&Topology> {
+        self.options.topology.as_ref()
+    }
+
+    /// Whether bonds are drawn at all.
+    pub fn draws_bonds(&self) -> bool {
+        self.options.draw != DrawStyle::Spacefill && self.options.bonds != BondSource::None
+    }
+
+    /// The bonds of the last frame built, after the periodic treatment and before the
+    /// selection.
+    pub fn last_bond_count(&self) -> usize {
+        self.last_bond_count
+    }
+
+    /// Gives `frame` (number `index` of the trajectory named `trajectory`) the topology's
+    /// labels; nothing without a topology.
+    pub fn label(
+        &self,
+        frame: &mut Frame,
+        trajectory: &str,
+        index: usize,
+    ) -> Result<(), texmap_md_io::Error> {
+        match &self.options.topology {
+            Some(t) => t.apply(frame, trajectory, index),
+            None => Ok(()),
+        }
+    }
+
+    /// The bonds of `frame` as [`MolOptions::bonds`] asks (before periodic handling).
+    fn find_bonds(&mut self, frame: &Frame, need: bool) {
+        self.pairs.clear();
+        if !need {
+            return;
+        }
+        match (self.options.bonds, &self.options.topology) {
+            (BondSource::None, _) => {}
+            (BondSource::Topology, Some(t)) => self.pairs.extend_from_slice(&t.bonds),
+            (BondSource::Topology, None) => {}
+            (BondSource::Auto, Some(t)) if !t.bonds.is_empty() => {
+                self.pairs.extend_from_slice(&t.bonds)
+            }
+            (BondSource::Auto, _) => {
+                self.pairs = texmap_md_io::bonds::bonds_by_distance(frame, true).pairs;
+            }
+        }
+    }
+
+    /// Periodic boundaries applied to `frame`, then `scene` built from it: selected atoms
+    /// only, per-selection colours and radii, bonds between drawn atoms (never across the box).
+    pub fn build(
+        &mut self,
+        builder: &mut SceneBuilder,
+        frame: &mut Frame,
+        scene: &mut SphereScene,
+    ) -> Result<(), MolError> {
+        let unwrap = self.options.pbc == Pbc::Unwrap && frame.cell.is_some();
+        self.find_bonds(frame, self.draws_bonds() || unwrap);
+        match self.options.pbc {
+            Pbc::None => {}
+            Pbc::Wrap => texmap_md_io::pbc::wrap(frame),
+            Pbc::Unwrap => {
+                if unwrap && self.options.bonds == BondSource::None {
+                    // Molecules need bonds to be made whole even when none are drawn.
+                    self.pairs = texmap_md_io::bonds::bonds_by_distance(frame, true).pairs;
+                }
+                texmap_md_io::pbc::unwrap(frame, &self.pairs);
+            }
+        }
+        texmap_md_io::pbc::drop_crossing(&mut self.pairs, &frame.positions, frame.cell.as_ref());
+        self.last_bond_count = self.pairs.len();
+        // Every atom, styled; then the per-selection rules, in order.
+        builder.build(frame, scene);
+        let failed = |role| move |error| MolError::Selection { role, error };
+        for (sel, rgb) in &self.options.colors {
+            let mask = sel.evaluate(frame).map_err(failed(SelectionRole::Color))?;
+            let kind = builder.kind_of(*rgb);
+            for (i, m) in mask.iter().enumerate() {
+                if *m {
+                    scene.kinds[i] = kind;
+                }
+            }
+        }
+        builder.refresh_materials(scene);
+        let scale = builder.radius_scale();
+        for (sel, r) in &self.options.radii {
+            let mask = sel.evaluate(frame).map_err(failed(SelectionRole::Radius))?;
+            for (i, m) in mask.iter().enumerate() {
+                if *m {
+                    scene.radii[i] = r * scale;
+                }
+            }
+        }
+        match self.options.draw {
+            DrawStyle::Spacefill => {}
+            DrawStyle::BallStick => {
+                for r in &mut scene.radii {
+                    *r *= BALL_AND_STICK_RADIUS_SCALE;
+                }
+                scene.bond_radius = BALL_AND_STICK_BOND_RADIUS;
+            }
+            DrawStyle::Licorice => {
+                for r in &mut scene.radii {
+                    *r = LICORICE_RADIUS;
+                }
+                scene.bond_radius = LICORICE_RADIUS;
+            }
+        }
+        // The selection: keep selected atoms, renumber the bonds between them.
+        let mask = match &self.options.select {
+            Some(sel) => Some(sel.evaluate(frame).map_err(failed(SelectionRole::Select))?),
+            None => None,
+        };
+        self.map.clear();
+        if let Some(mask) = &mask {
+            let mut next = 0u32;
+            for &m in mask {
+                self.map.push(if m { next } else { u32::MAX });
+                next += m as u32;
+            }
+            let mut w = 0;
+            for (i, &m) in mask.iter().enumerate() {
+                if m {
+                    scene.centers[w] = scene.centers[i];
+                    scene.radii[w] = scene.radii[i];
+                    scene.kinds[w] = scene.kinds[i];
+                    w += 1;
+                }
+            }
+            scene.centers.truncate(w);
+            scene.radii.truncate(w);
+            scene.kinds.truncate(w);
+        }
+        scene.bonds.clear();
+        if self.draws_bonds() {
+            for b in &self.pairs {
+                let (i, j) = if self.map.is_empty() {
+                    (b[0], b[1])
+                } else {
+                    (self.map[b[0] as usize], self.map[b[1] as usize])
+                };
+                if i != u32::MAX && j != u32::MAX {
+                    scene.bonds.push([i, j]);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Whether `frame`'s atoms have nothing to be told apart by (no names, types or known
+    /// elements) and no topology gives them any: every atom is drawn in one colour.
+    pub fn atoms_unnamed(&self, frame: &Frame) -> bool {
+        let nothing = frame.names.is_empty()
+            && frame.types.is_empty()
+            && (0..frame.n_atoms()).all(|i| atom_element(frame, i).is_unknown());
+        self.options.topology.is_none() && nothing && frame.n_atoms() > 0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::StyleOptions;
+    use texmap_md_io::{Element, UnitCell};
+
+    /// Carbon atoms at `xs` on the x axis.
+    fn carbons(xs: &[f32]) -> Frame {
+        let mut frame = Frame::new();
+        frame.positions = xs.iter().map(|&x| [x, 0.0, 0.0]).collect();
+        frame.elements = vec![Element::from_symbol("C").unwrap(); xs.len()];
+        frame
+    }
+
+    fn sel(text: &str) -> Selection {
+        Selection::parse(text).unwrap()
+    }
+
+    fn built(options: MolOptions, frame: &mut Frame) -> (SphereScene, SceneBuilder) {
+        let mut builder = SceneBuilder::new(&StyleOptions::default()).unwrap();
+        let mut plan = MolPlan::new(options).unwrap();
+        let mut scene = SphereScene::default();
+        plan.build(&mut builder, frame, &mut scene).unwrap();
+        (scene, builder)
+    }
+
+    #[test]
+    fn the_selection_keeps_its_atoms_in_order_and_renumbers_their_bonds() {
+        // A chain of five carbons 1.5 Å apart: bonds 0-1, 1-2, 2-3, 3-4 (C-C cutoff 1.97 Å).
+        let xs = [0.0, 1.5, 3.0, 4.5, 6.0];
+        let mut frame = carbons(&xs);
+        let options = MolOptions {
+            select: Some(sel("index 0 1 3 4")),
+            draw: DrawStyle::BallStick,
+            ..MolOptions::default()
+        };
+        let (scene, _) = built(options, &mut frame);
+        let kept: Vec<f32> = scene.centers.iter().map(|c| c.x).collect();
+        assert_eq!(kept, [0.0, 1.5, 4.5, 6.0]);
+        // Atom 2 is dropped with its two bonds; 3-4 becomes 2-3.
+        let mut bonds: Vec<[u32; 2]> = scene
+            .bonds
+            .iter()
+            .map(|b| [b[0].min(b[1]), b[0].max(b[1])])
+            .collect();
+        bonds.sort();
+        assert_eq!(bonds, [[0, 1], [2, 3]]);
+        assert_eq!(scene.bond_radius, BALL_AND_STICK_BOND_RADIUS);
+    }
+
+    #[test]
+    fn later_colour_and_radius_rules_win() {
+        let mut frame = carbons(&[0.0, 5.0, 10.0, 15.0]);
+        let (red, blue) = ([1.0, 0.0, 0.0], [0.0, 0.0, 1.0]);
+        let options = MolOptions {
+            colors: vec![(sel("index 0 1"), red), (sel("index 1 2"), blue)],
+            radii: vec![(sel("index 0 1"), 2.0), (sel("index 1"), 3.0)],
+            ..MolOptions::default()
+        };
+        let (scene, mut builder) = built(options, &mut frame);
+        let (red, blue) = (builder.kind_of(red), builder.kind_of(blue));
+        assert_eq!(scene.kinds[..3], [red, blue, blue]);
+        assert_ne!(scene.kinds[3], red);
+        assert_ne!(scene.kinds[3], blue);
+        let carbon = Element::from_symbol("C").unwrap().vdw_radius();
+        assert_eq!(scene.radii, [2.0, 3.0, carbon, carbon]);
+    }
+
+    #[test]
+    fn unwrapping_joins_a_molecule_split_across_the_box() {
+        // Two carbons 1.2 Å apart through the x face of a 10 Å box.
+        let split = || {
+            let mut f = carbons(&[0.2, 9.0]);
+            f.cell = Some(UnitCell::orthorhombic(10.0, 10.0, 10.0).unwrap());
+            f
+        };
+        let gap = |f: &Frame| {
+            let (a, b) = (f.positions[0], f.positions[1]);
+            ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+        };
+        let mut frame = split();
+        built(
+            MolOptions {
+                pbc: Pbc::Unwrap,
+                bonds: BondSource::None,
+                ..MolOptions::default()
+            },
+            &mut frame,
+        );
+        assert!((gap(&frame) - 1.2).abs() < 1e-4, "{}", gap(&frame));
+        let mut kept = split();
+        built(MolOptions::default(), &mut kept);
+        assert!((gap(&kept) - 8.8).abs() < 1e-4);
+    }
+
+    #[test]
+    fn topology_bonds_without_a_topology_are_refused() {
+        let e = MolPlan::new(MolOptions {
+            bonds: BondSource::Topology,
+            draw: DrawStyle::Licorice,
+            ..MolOptions::default()
+        })
+        .unwrap_err();
+        assert_eq!(e, MolError::NoTopology);
+        let e = MolPlan::new(MolOptions {
+            radii: vec![(sel("all"), f32::NAN)],
+            ..MolOptions::default()
+        })
+        .unwrap_err();
+        assert!(matches!(e, MolError::BadRadius { rule: 0, .. }));
+    }
+}
