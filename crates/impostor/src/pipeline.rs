@@ -419,12 +419,16 @@ pub(crate) fn clip(p: &Proj, t: TileRect) -> Option<(u32, u32, u32, u32)> {
 }
 
 /// Run `kernel` over every tile, writing the whole frame (background where nothing won).
-pub(crate) fn draw_tiles<K: Kernel>(
-    bins: &Bins,
+/// Walk every tile of the frame, in parallel by rows of tiles (one job per row: the rows' costs
+/// differ a lot, and rayon's default splitting would leave one thread with the dense half).
+/// `init` makes each row's scratch state; `f(state, t, tile, color, depth)` gets the tile's index
+/// in the bins, its rectangle and the row's colour and depth slices from the tile's first
+/// column (row stride `view.width`).
+pub(crate) fn for_each_tile<S>(
     view: &View,
-    kernel: &K,
-    background: [u8; 4],
     frame: &mut Frame,
+    init: impl Fn() -> S + Sync,
+    f: impl Fn(&mut S, usize, TileRect, &mut [[u8; 4]], &mut [f32]) + Sync,
 ) {
     let w = view.width as usize;
     let band = w * TILE as usize;
@@ -435,43 +439,71 @@ pub(crate) fn draw_tiles<K: Kernel>(
         .enumerate()
         .with_max_len(1)
         .for_each(|(ty, (color, depth))| {
-            let mut buf = TileBuf {
-                depth: [f32::INFINITY; TILE_BUF],
-                win: [NONE; TILE_BUF],
-            };
-            let mut scratch = [Proj::default(); ORDER_MAX];
+            let mut state = init();
             let y0 = ty as u32 * TILE;
-            let th = (view.height - y0).min(TILE);
+            let h = (view.height - y0).min(TILE);
             for tx in 0..view.tiles_x {
                 let x0 = tx * TILE;
-                let tw = (view.width - x0).min(TILE);
                 let tile = TileRect {
                     x0,
                     y0,
-                    w: tw,
-                    h: th,
+                    w: (view.width - x0).min(TILE),
+                    h,
                 };
                 let t = ty * view.tiles_x as usize + tx as usize;
-                let recs = bins.tile(t);
-                if recs.is_empty() {
-                    // Nothing here: background.
-                    for j in 0..th as usize {
-                        let o = j * w + x0 as usize;
-                        fill8(&mut color[o..o + tw as usize], background);
-                        fill8(&mut depth[o..o + tw as usize], f32::INFINITY);
-                    }
-                    continue;
-                }
-                kernel.draw_tile(TileJob {
-                    recs,
+                f(
+                    &mut state,
+                    t,
                     tile,
-                    buf: &mut buf,
-                    scratch: &mut scratch,
-                    background,
-                    color: &mut color[x0 as usize..],
-                    depth: &mut depth[x0 as usize..],
-                    stride: w,
-                });
+                    &mut color[x0 as usize..],
+                    &mut depth[x0 as usize..],
+                );
             }
         });
+}
+
+pub(crate) fn draw_tiles<K: Kernel>(
+    bins: &Bins,
+    view: &View,
+    kernel: &K,
+    background: [u8; 4],
+    frame: &mut Frame,
+) {
+    let w = view.width as usize;
+    let init = || {
+        (
+            TileBuf {
+                depth: [f32::INFINITY; TILE_BUF],
+                win: [NONE; TILE_BUF],
+            },
+            [Proj::default(); ORDER_MAX],
+        )
+    };
+    for_each_tile(
+        view,
+        frame,
+        init,
+        |(buf, scratch), t, tile, color, depth| {
+            let recs = bins.tile(t);
+            if recs.is_empty() {
+                // Nothing here: background.
+                for j in 0..tile.h as usize {
+                    let o = j * w;
+                    fill8(&mut color[o..o + tile.w as usize], background);
+                    fill8(&mut depth[o..o + tile.w as usize], f32::INFINITY);
+                }
+                return;
+            }
+            kernel.draw_tile(TileJob {
+                recs,
+                tile,
+                buf,
+                scratch,
+                background,
+                color,
+                depth,
+                stride: w,
+            });
+        },
+    );
 }

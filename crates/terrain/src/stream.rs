@@ -350,13 +350,7 @@ impl FlightTerrain {
         fb: &mut Framebuffer,
         scratch: &mut FrameScratch,
     ) -> Result<FrameStats, ViewError> {
-        if !(options.pixel_error.is_finite() && options.pixel_error > 0.0) {
-            return Err(ViewError::BadParameter {
-                name: "pixel error",
-                value: options.pixel_error.to_string(),
-                expected: "a finite tolerance > 0 pixels",
-            });
-        }
+        options.check()?;
         let camera = view.camera(self.grid())?;
         let mut sel = self.select(&camera, options.pixel_error);
         self.split_for_texture(&camera, &mut sel, stream);

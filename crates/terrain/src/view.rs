@@ -530,6 +530,20 @@ pub struct ViewOptions {
     pub background: [u8; 4],
 }
 
+impl ViewOptions {
+    /// Errors: a pixel tolerance that is not a finite number > 0.
+    pub fn check(&self) -> Result<(), ViewError> {
+        if !(self.pixel_error.is_finite() && self.pixel_error > 0.0) {
+            return Err(ViewError::BadParameter {
+                name: "pixel error",
+                value: self.pixel_error.to_string(),
+                expected: "a finite tolerance > 0 pixels",
+            });
+        }
+        Ok(())
+    }
+}
+
 impl Default for ViewOptions {
     fn default() -> Self {
         ViewOptions {
@@ -979,13 +993,7 @@ impl FlightTerrain {
         fb: &mut Framebuffer,
         scratch: &mut FrameScratch,
     ) -> Result<FrameStats, ViewError> {
-        if !(options.pixel_error.is_finite() && options.pixel_error > 0.0) {
-            return Err(ViewError::BadParameter {
-                name: "pixel error",
-                value: options.pixel_error.to_string(),
-                expected: "a finite tolerance > 0 pixels",
-            });
-        }
+        options.check()?;
         let camera = view.camera(&self.grid)?;
         let sel = self.select(&camera, options.pixel_error);
         fb.clear(options.background);

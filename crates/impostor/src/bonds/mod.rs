@@ -66,14 +66,13 @@
 #![allow(clippy::needless_range_loop)]
 
 use glam::{DVec3, Vec3};
-use rayon::prelude::*;
 use texmap_core::frame::Frame;
 #[cfg(target_arch = "x86_64")]
 use texmap_core::lanes::F32x8Avx2;
 use texmap_core::lanes::{self, F32x8, LANES8, LaneMask, Lanes8, SpecPow};
 use texmap_core::shade::{Lighting, Material};
 
-use crate::pipeline::{FLAG_INSIDE, LANES, NONE, TILE, TILE_BUF, TILE_PX, View};
+use crate::pipeline::{FLAG_INSIDE, LANES, NONE, TILE, TILE_BUF, TILE_PX, TileRect, View};
 use crate::scene::SphereScene;
 use texmap_raster::bin::{ChunkSink, TileBins};
 
@@ -139,52 +138,31 @@ pub(crate) fn draw(
     };
     let bins = &*bins;
     let w = view.width as usize;
-    let band = w * TILE as usize;
-    frame
-        .color
-        .par_chunks_mut(band)
-        .zip(frame.depth.par_chunks_mut(band))
-        .enumerate()
-        // One job per band: the bands' costs differ a lot (bonds crowd the image centre), and
-        // rayon's default splitting would leave one thread with the dense half.
-        .with_max_len(1)
-        .for_each(|(ty, (color, depth))| {
-            let mut buf = TileBuf {
-                depth: [f32::INFINITY; TILE_BUF],
-                win: [NONE; TILE_BUF],
-            };
-            let y0 = ty as u32 * TILE;
-            let th = (view.height - y0).min(TILE);
-            for tx in 0..view.tiles_x {
-                let t = ty * view.tiles_x as usize + tx as usize;
-                let recs = bins.tile(t);
-                if recs.is_empty() {
-                    continue;
-                }
-                let x0 = tx * TILE;
-                let tw = (view.width - x0).min(TILE);
-                // Start from the sphere pass's depth (lanes past the tile stay infinite).
-                buf.depth.fill(f32::INFINITY);
-                buf.win.fill(NONE);
-                for j in 0..th as usize {
-                    let o = j * w + x0 as usize;
-                    buf.depth[j * TILE as usize..j * TILE as usize + tw as usize]
-                        .copy_from_slice(&depth[o..o + tw as usize]);
-                }
-                kernel.raster(recs, x0, y0, tw, th, &mut buf);
-                kernel.resolve(
-                    recs,
-                    x0,
-                    y0,
-                    tw,
-                    th,
-                    &buf,
-                    &mut color[x0 as usize..],
-                    &mut depth[x0 as usize..],
-                    w,
-                );
-            }
-        });
+    let init = || TileBuf {
+        depth: [f32::INFINITY; TILE_BUF],
+        win: [NONE; TILE_BUF],
+    };
+    crate::pipeline::for_each_tile(view, frame, init, |buf, t, tile, color, depth| {
+        let recs = bins.tile(t);
+        if recs.is_empty() {
+            return;
+        }
+        let TileRect {
+            x0,
+            y0,
+            w: tw,
+            h: th,
+        } = tile;
+        // Start from the sphere pass's depth (lanes past the tile stay infinite).
+        buf.depth.fill(f32::INFINITY);
+        buf.win.fill(NONE);
+        for j in 0..th as usize {
+            buf.depth[j * TILE as usize..j * TILE as usize + tw as usize]
+                .copy_from_slice(&depth[j * w..j * w + tw as usize]);
+        }
+        kernel.raster(recs, x0, y0, tw, th, &mut *buf);
+        kernel.resolve(recs, x0, y0, tw, th, &*buf, color, depth, w);
+    });
     stats
 }
 
