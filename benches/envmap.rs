@@ -31,7 +31,12 @@ fn bench(c: &mut Criterion) {
         let mut r = Renderer::new();
         let opts = Options::new(method);
         g.bench_function(format!("frame_1024x768_100k/{}", method.name()), |b| {
-            b.iter(|| black_box(r.render(&scene, &cam, &opts).unwrap().frame.len()))
+            b.iter(|| {
+                let out = r.render(&scene, &cam, &opts).unwrap();
+                let n = black_box(out.frame.len());
+                r.recycle(out.frame);
+                n
+            })
         });
     }
     let p = |frame| UpdateParams {

@@ -374,6 +374,7 @@ fn render(a: &EnvRenderArgs) -> Result<()> {
                 crate::note!("wrote {}", path.display());
             }
         }
+        renderer.recycle(frame);
         pb.inc(1);
     }
     pb.finish_and_clear();

@@ -391,7 +391,8 @@ pub struct MapScratch {
     positions: Vec<Vec3>,
     colors: Vec<Vec3>,
     tris: Vec<[u32; 3]>,
-    texels: Vec<Vec4>,
+    /// One merged face per map face, reused across updates.
+    texels: Vec<Vec<Vec4>>,
     filtered: Vec<[u32; 3]>,
     /// The cube update's flattened triangles: vertices, colour, faces touched.
     flat: Vec<([Vec3; 3], Vec3, u8)>,
@@ -469,7 +470,8 @@ fn select<'s>(o: &'s Object, p: &UpdateParams, filtered: &'s mut Vec<[u32; 3]>) 
     filtered
 }
 
-/// Merge the rasterised faces with the environment fill and build the pyramids.
+/// Merge the rasterised faces with the environment fill and build the pyramids (the faces are
+/// drawn one after another into the scratch framebuffer; their pyramids are built in parallel).
 fn finish_faces(
     kind: MapKind,
     p: &UpdateParams,
@@ -477,13 +479,14 @@ fn finish_faces(
     draw: &mut dyn FnMut(usize, &mut MapScratch) -> Result<(), EnvMapError>,
 ) -> Result<EnvMap, EnvMapError> {
     let side = tex_side(kind, p.size);
-    let mut faces = Vec::with_capacity(face_count(kind));
+    let count = face_count(kind);
     scratch.env_texels(kind, p.frame, p.size, p.environment);
-    for face in 0..face_count(kind) {
+    let mut texels = std::mem::take(&mut scratch.texels);
+    texels.resize_with(count, Vec::new);
+    for (face, texels) in texels.iter_mut().enumerate() {
         draw(face, scratch)?;
         let fb = scratch.fb.as_ref().expect("drawn");
         let env = &scratch.env_cache.as_ref().expect("filled").3[face];
-        let texels = &mut scratch.texels;
         texels.clear();
         texels.resize((side * side) as usize, Vec4::ZERO);
         texels
@@ -504,14 +507,18 @@ fn finish_faces(
         if kind == MapKind::Sphere {
             fill_outside_disc(side, texels);
         }
-        faces.push(pyramid(side, texels)?);
     }
+    let faces = texels
+        .par_iter()
+        .map(|t| pyramid(side, t))
+        .collect::<Result<Vec<_>, _>>();
+    scratch.texels = texels;
     Ok(EnvMap {
         kind,
         frame: p.frame,
         centre: p.centre,
         size: p.size,
-        faces,
+        faces: faces?,
     })
 }
 

@@ -196,6 +196,8 @@ pub struct Renderer {
     scratch: MapScratch,
     static_map: Option<(MapKind, u32, MapFrame, Vec3, EnvMap)>,
     map: Option<EnvMap>,
+    /// A frame handed back by [`Renderer::recycle`], resolved into by the next render.
+    spare: Option<Frame>,
 }
 
 fn framebuffer(
@@ -354,6 +356,12 @@ impl Renderer {
         Renderer::default()
     }
 
+    /// Hand back a frame of an earlier [`Output`] once it has been used: the next render resolves
+    /// into its buffers instead of allocating new ones (a loop of frames then allocates none).
+    pub fn recycle(&mut self, frame: Frame) {
+        self.spare = Some(frame);
+    }
+
     /// The map of the last frame (for display and tests).
     pub fn map(&self) -> Option<&EnvMap> {
         self.map.as_ref()
@@ -494,7 +502,7 @@ impl Renderer {
             };
             fb.draw_textured(cam, &m, &sampler, &state)?;
             self.draw_background(scene, cam, opts)?;
-            return Ok(self.fb.as_ref().expect("drawn").to_frame());
+            return Ok(self.resolve());
         }
         match &target.shape {
             TargetShape::Sphere { centre, radius } => {
@@ -603,7 +611,19 @@ impl Renderer {
             }
         }
         self.draw_background(scene, cam, opts)?;
-        Ok(self.fb.as_ref().expect("drawn").to_frame())
+        Ok(self.resolve())
+    }
+
+    /// The drawn framebuffer as a frame (into the recycled one when there is one).
+    fn resolve(&mut self) -> Frame {
+        let fb = self.fb.as_ref().expect("drawn");
+        match self.spare.take() {
+            Some(mut f) => {
+                fb.resolve_into(&mut f);
+                f
+            }
+            None => fb.to_frame(),
+        }
     }
 
     /// The environment where nothing was drawn: a full-screen sprite drawn last, depth-tested

@@ -185,12 +185,23 @@ impl Framebuffer {
     /// Bands of one tile row are resolved in parallel; each output pixel is written once, so the
     /// bytes do not depend on the thread count.
     pub fn to_frame(&self) -> Frame {
-        let w = self.grid.width as usize;
         let mut frame = Frame::new(self.grid.width, self.grid.height, self.background);
+        self.resolve_into(&mut frame);
+        frame
+    }
+
+    /// [`to_frame`](Self::to_frame) into an existing frame, reusing its buffers when it already
+    /// has this framebuffer's size (a renderer drawing many frames then allocates none).
+    pub fn resolve_into(&self, frame: &mut Frame) {
+        if frame.width() != self.grid.width || frame.height() != self.grid.height {
+            *frame = Frame::new(self.grid.width, self.grid.height, self.background);
+        }
+        let w = self.grid.width as usize;
         let bg = self.clear_linear.to_array().map(f32::to_bits);
+        let bg_bytes = self.background;
         let band = w * TILE as usize;
         let tiles_x = self.grid.tiles_x as usize;
-        let Frame { color, depth, .. } = &mut frame;
+        let Frame { color, depth, .. } = frame;
         color
             .par_chunks_mut(band)
             .zip(depth.par_chunks_mut(band))
@@ -208,14 +219,15 @@ impl Framebuffer {
                             let d = t.depth[q][l];
                             let o = row + x as usize;
                             depth[o] = d;
-                            if d.is_finite() || c.to_array().map(f32::to_bits) != bg {
-                                color[o] = linear_to_srgb8(c, 255);
-                            }
+                            color[o] = if d.is_finite() || c.to_array().map(f32::to_bits) != bg {
+                                linear_to_srgb8(c, 255)
+                            } else {
+                                bg_bytes
+                            };
                         }
                     }
                 }
             });
-        frame
     }
 }
 
@@ -247,5 +259,13 @@ mod tests {
         assert_eq!(f.coverage_count(), 0);
         assert!(Framebuffer::new(0, 5).is_err());
         assert_eq!(fb.depth_at(70, 0), None);
+        // Resolving into a frame of another size or content gives the same bytes.
+        let mut g = Frame::new(5, 5, [1, 2, 3, 4]);
+        fb.resolve_into(&mut g);
+        assert_eq!(g.color, f.color);
+        g.color.fill([9; 4]);
+        g.depth.fill(0.0);
+        fb.resolve_into(&mut g);
+        assert_eq!((g.color, g.depth), (f.color, f.depth));
     }
 }

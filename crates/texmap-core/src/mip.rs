@@ -278,9 +278,20 @@ impl MipTexture {
                 t
             }
         };
+        // Storage of every level and seam strip, reserved once (no regrowth copies).
+        let pow2 = width.is_power_of_two() && height.is_power_of_two();
+        let mut total = 0usize;
+        let (mut w, mut h) = (width as usize, height as usize);
+        loop {
+            total += w * h + if pow2 { 4 * (h + 2) + 4 * w } else { 0 };
+            if w == 1 && h == 1 {
+                break;
+            }
+            (w, h) = ((w / 2).max(1), (h / 2).max(1));
+        }
         let (mut w, mut h) = (width, height);
         let mut levels = Vec::new();
-        let mut texels: Vec<Vec4> = Vec::new();
+        let mut texels: Vec<Vec4> = Vec::with_capacity(total);
         loop {
             levels.push(LevelInfo {
                 offset: texels.len(),
@@ -315,7 +326,6 @@ impl MipTexture {
         }
         // Linear-light storage of sRGB Box levels can only drift by float rounding: keep it finite.
         debug_assert!(texels.iter().all(|t| t.is_finite()));
-        let pow2 = width.is_power_of_two() && height.is_power_of_two();
         let last = levels.len() - 1;
         let offsets16 = std::array::from_fn(|i| levels[i.min(last)].offset as i32);
         // Repeat seam strips of every level (power-of-two pyramids only: the kernel that reads
@@ -347,6 +357,7 @@ impl MipTexture {
                 (*c, *r) = top;
             }
         }
+        debug_assert_eq!(texels.len(), total, "pyramid storage reserved exactly");
         MipTexture {
             texels,
             level_texels,
