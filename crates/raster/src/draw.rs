@@ -209,8 +209,10 @@ impl Framebuffer {
             tiles,
             scratch,
             block_path,
+            clear_linear,
             ..
         } = self;
+        let clear_linear = *clear_linear;
         let positions = mesh.positions();
         let indices = mesh.indices();
 
@@ -279,7 +281,11 @@ impl Framebuffer {
         let ctx = RasterCtx::new(*state, proj.far, grid.width, grid.height, *block_path);
         let bins = &*bins;
         tiles.par_iter_mut().enumerate().for_each(|(ti, tile)| {
-            for rec in bins.tile(ti) {
+            let recs = bins.tile(ti);
+            if !recs.is_empty() {
+                tile.prepare(clear_linear);
+            }
+            for rec in recs {
                 let front = rec.tri_front & FRONT_BIT != 0;
                 let tri = rec.tri_front & !FRONT_BIT;
                 let cst = prog.tri_const(mesh, tri, front);
@@ -304,7 +310,13 @@ impl Framebuffer {
             });
         }
         let grid = self.grid;
-        let Framebuffer { tiles, scratch, .. } = self;
+        let Framebuffer {
+            tiles,
+            scratch,
+            clear_linear,
+            ..
+        } = self;
+        let clear_linear = *clear_linear;
         let chunk_stats = scratch
             .sprites
             .build(grid.bins, sprites.len(), CHUNK, |range, sink| {
@@ -334,7 +346,11 @@ impl Framebuffer {
         let ctx = RasterCtx::new(*state, f32::INFINITY, grid.width, grid.height, true);
         let bins = &scratch.sprites;
         tiles.par_iter_mut().enumerate().for_each(|(ti, tile)| {
-            for sp in bins.tile(ti) {
+            let sps = bins.tile(ti);
+            if !sps.is_empty() {
+                tile.prepare(clear_linear);
+            }
+            for sp in sps {
                 raster_sprite(tile, &ctx, shader, sp);
             }
         });

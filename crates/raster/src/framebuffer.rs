@@ -47,6 +47,24 @@ pub(crate) struct Tile {
     /// Pixel origin of the tile.
     pub x0: u32,
     pub y0: u32,
+    /// The tile holds the clear values but its planes were not written yet: the last
+    /// [`Framebuffer::clear`] is applied by the first draw that reaches the tile (on that
+    /// draw's thread, in cache) or stands in for the planes when they are read.
+    pub pending: bool,
+}
+
+impl Tile {
+    /// Apply a pending clear to linear colour `lin` and infinite depth.
+    #[inline]
+    pub(crate) fn prepare(&mut self, lin: Vec3) {
+        if self.pending {
+            self.depth.fill([f32::INFINITY; 4]);
+            self.r.fill([lin.x; 4]);
+            self.g.fill([lin.y; 4]);
+            self.b.fill([lin.z; 4]);
+            self.pending = false;
+        }
+    }
 }
 
 /// Index of the quad holding pixel (lx, ly) of a tile (masked: always in range).
@@ -91,7 +109,7 @@ pub struct Framebuffer {
     pub(crate) grid: Grid,
     pub(crate) tiles: Vec<Tile>,
     background: [u8; 4],
-    clear_linear: Vec3,
+    pub(crate) clear_linear: Vec3,
     pub(crate) scratch: crate::record::Scratch,
     /// Small triangles take the block path (`false` only in tests comparing it with the general
     /// quad loop).
@@ -123,6 +141,7 @@ impl Framebuffer {
                     b: quad_plane(0.0),
                     x0: tx * TILE,
                     y0: ty * TILE,
+                    pending: false,
                 });
             }
         }
@@ -146,16 +165,13 @@ impl Framebuffer {
     }
 
     /// Clear depth to `INFINITY` and colour to `background` (sRGB8 RGBA). Uncovered pixels keep
-    /// exactly these bytes in [`to_frame`](Self::to_frame).
+    /// exactly these bytes in [`to_frame`](Self::to_frame). Constant time: each tile is cleared
+    /// by the first draw that reaches it, and tiles no draw reaches are never written.
     pub fn clear(&mut self, background: [u8; 4]) {
-        let lin = srgb8_to_linear_rgb(background);
         self.background = background;
-        self.clear_linear = lin;
+        self.clear_linear = srgb8_to_linear_rgb(background);
         for t in &mut self.tiles {
-            t.depth.fill([f32::INFINITY; 4]);
-            t.r.fill([lin.x; 4]);
-            t.g.fill([lin.y; 4]);
-            t.b.fill([lin.z; 4]);
+            t.pending = true;
         }
     }
 
@@ -170,14 +186,25 @@ impl Framebuffer {
 
     /// Stored depth of pixel (x, y) (`None` outside the image).
     pub fn depth_at(&self, x: u32, y: u32) -> Option<f32> {
-        self.locate(x, y).map(|(t, i)| t.depth[i >> 2][i & 3])
+        self.locate(x, y).map(|(t, i)| {
+            if t.pending {
+                f32::INFINITY
+            } else {
+                t.depth[i >> 2][i & 3]
+            }
+        })
     }
 
     /// Stored linear colour of pixel (x, y) (`None` outside the image). With [`crate::Blend::Add`]
     /// and a flat colour of 1 this is the number of fragments written there.
     pub fn color_at(&self, x: u32, y: u32) -> Option<Vec3> {
-        self.locate(x, y)
-            .map(|(t, i)| Vec3::new(t.r[i >> 2][i & 3], t.g[i >> 2][i & 3], t.b[i >> 2][i & 3]))
+        self.locate(x, y).map(|(t, i)| {
+            if t.pending {
+                self.clear_linear
+            } else {
+                Vec3::new(t.r[i >> 2][i & 3], t.g[i >> 2][i & 3], t.b[i >> 2][i & 3])
+            }
+        })
     }
 
     /// Resolve to a [`Frame`]: sRGB8 colour (alpha 255 where drawn) and depth. A pixel whose
@@ -210,6 +237,15 @@ impl Framebuffer {
                 for t in row_tiles {
                     let xe = (t.x0 + TILE).min(self.grid.width);
                     let ye = (t.y0 + TILE).min(self.grid.height);
+                    if t.pending {
+                        for y in t.y0..ye {
+                            let row = (y - t.y0) as usize * w;
+                            let span = row + t.x0 as usize..row + xe as usize;
+                            depth[span.clone()].fill(f32::INFINITY);
+                            color[span].fill(bg_bytes);
+                        }
+                        continue;
+                    }
                     for y in t.y0..ye {
                         let row = (y - t.y0) as usize * w;
                         for x in t.x0..xe {

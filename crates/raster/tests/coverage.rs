@@ -315,3 +315,47 @@ fn back_face_culling_follows_counter_clockwise_front() {
     assert_eq!(draw(&mut fb, Cull::Front), 0);
     let _ = Vec2::ZERO;
 }
+
+/// Clearing is deferred per tile: after a second clear to another colour, every pixel no later
+/// draw reaches reads (and resolves to) the new colour with infinite depth, and a draw into one
+/// tile sees the new clear values there, whatever the first frame left in that tile.
+#[test]
+fn a_second_clear_holds_for_drawn_and_untouched_tiles() {
+    let (w, h) = (200u32, 150u32);
+    let cam = ortho(w, h);
+    let big = [[0.0, 0.0], [400.0, 0.0], [0.0, 300.0]];
+    let pos: Vec<Vec3> = big.iter().map(|p| world(&cam, p[0], p[1])).collect();
+    let mut fb = Framebuffer::new(w, h).unwrap();
+    fb.clear([0, 0, 0, 255]);
+    let state = DrawState {
+        cull: Cull::None,
+        ..DrawState::default()
+    };
+    let mesh = Mesh::new(&pos, &[[0, 1, 2]]).unwrap();
+    fb.draw_mesh(&cam, &mesh, &Shading::Flat(Vec3::ONE), &state)
+        .unwrap();
+    assert_eq!(fb.color_at(150, 100), Some(Vec3::ONE));
+    // Second frame: another background, one small triangle inside the first tile only.
+    fb.clear([0, 255, 0, 255]);
+    let small = [[4.0, 4.0], [20.0, 4.0], [4.0, 20.0]];
+    let pos: Vec<Vec3> = small.iter().map(|p| world(&cam, p[0], p[1])).collect();
+    let mesh = Mesh::new(&pos, &[[0, 1, 2]]).unwrap();
+    fb.draw_mesh(&cam, &mesh, &Shading::Flat(Vec3::X), &state)
+        .unwrap();
+    let f = fb.to_frame();
+    for y in 0..h {
+        for x in 0..w {
+            let inside = x >= 4 && y >= 4 && x + y < 23;
+            let (c, d) = (f.color[f.index(x, y)], f.depth[f.index(x, y)]);
+            if inside {
+                assert_eq!(c, [255, 0, 0, 255], "({x},{y})");
+                assert!(d.is_finite());
+            } else if x + y > 25 || x < 3 || y < 3 {
+                assert_eq!(c, [0, 255, 0, 255], "({x},{y})");
+                assert_eq!(d, f32::INFINITY);
+                assert_eq!(fb.depth_at(x, y), Some(f32::INFINITY));
+                assert_eq!(fb.color_at(x, y), Some(Vec3::Y));
+            }
+        }
+    }
+}
