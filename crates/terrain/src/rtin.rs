@@ -21,8 +21,10 @@
 //! Mapbox martini stores only the midpoint's distance to its hypotenuse's linear interpolation
 //! (maxed over descendants), which is cheaper but not a bound on the triangle's error; the cost
 //! of the exact bound is visiting every sample once per level (`2 log2 S` passes over the grid),
-//! done in parallel over vertex rows with rayon (the max is exact, so the map is the same for any
-//! thread count).
+//! done in parallel over map rows with rayon — first every midpoint's own error (they are
+//! independent), then the max with the children, level by level — and vectorised over the
+//! samples of each row segment. Every entry is computed by one fixed sequence of operations and
+//! the max is exact, so the map is the same for any thread count.
 //!
 //! # No-data
 //! A diamond holding both valid and no-data (`NaN`) samples gets an infinite error, so it is split
@@ -31,6 +33,7 @@
 //! cell-exact rims, and padding a grid with `NaN` to `2^k + 1` costs only its border.
 
 use rayon::prelude::*;
+use texmap_core::lanes::F32x4;
 
 /// A triangle of grid sample coordinates `(x, y)`: hypotenuse `a–b`, right angle at `c`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -47,47 +50,154 @@ pub struct ErrorMap {
     errors: Vec<f32>,
 }
 
-/// Fold of a diamond's samples: the max error, samples visited and no-data samples seen.
+/// Lanes of the sample fold: 8 independent running maxima, so the per-sample loop is a vector
+/// loop instead of one chain of dependent comparisons.
+const LANES: usize = 8;
+
+/// Fold of a diamond's or cell's samples: the max error (per lane), samples visited and no-data
+/// samples seen (per lane; counted only when the grid has no-data, `NODATA`).
 ///
 /// Branch-free per sample: a NaN difference never wins the `>` comparison, and no-data is counted
-/// separately, so the inner loops vectorise.
+/// separately. The max does not depend on the order samples are folded in (every error is
+/// `≥ +0`), so the lanes change nothing in the result.
 #[derive(Clone, Copy)]
-struct Acc {
-    err: f32,
+struct Acc<const NODATA: bool> {
+    err: [f32; LANES],
+    nodata: [u32; LANES],
     seen: u32,
-    nodata: u32,
 }
 
-impl Acc {
-    fn new() -> Acc {
+impl<const NODATA: bool> Acc<NODATA> {
+    #[inline(always)]
+    fn new() -> Self {
         Acc {
-            err: 0.0,
+            err: [0.0; LANES],
+            nodata: [0; LANES],
             seen: 0,
-            nodata: 0,
         }
     }
-    /// Samples `row[i]` against the plane values `base + slope·i`.
-    #[inline]
-    fn scan(&mut self, row: &[f32], base: f32, slope: f32) {
-        let mut err = self.err;
-        let mut nodata = 0u32;
-        for (i, &h) in row.iter().enumerate() {
-            let e = (h - (base + slope * i as f32)).abs();
-            err = if e > err { e } else { err };
-            nodata += h.is_nan() as u32;
+
+    /// Samples `heights[start + i]`, `i < len`, against the plane values `base + slope·i`.
+    #[inline(always)]
+    fn scan(&mut self, heights: &[f32], start: usize, len: usize, base: f32, slope: f32) {
+        self.seen += len as u32;
+        let mut i = 0;
+        while i + LANES <= len {
+            let chunk = heights[start + i..start + i + LANES].try_into().unwrap();
+            self.fold::<LANES>(chunk, base, slope, i, LANES);
+            i += LANES;
         }
-        self.err = err;
-        self.nodata += nodata;
-        self.seen += row.len() as u32;
+        // The partial chunk at the end, on 8 or (short segments of the fine levels) 4 lanes.
+        let rest = len - i;
+        if rest > 4 {
+            self.fold_part::<LANES>(heights, start + i, base, slope, i, rest);
+        } else if rest > 0 {
+            self.fold_part::<4>(heights, start + i, base, slope, i, rest);
+        }
     }
-    fn value(self) -> f32 {
-        if self.nodata == 0 {
-            self.err
-        } else if self.nodata == self.seen {
-            0.0
+
+    /// Folds the `valid < W` samples from `heights[at]` (segment index `i0` on): reads a whole
+    /// chunk when the grid has the samples past them, and masks the lanes beyond the segment
+    /// (their samples belong to other triangles).
+    #[inline(always)]
+    fn fold_part<const W: usize>(
+        &mut self,
+        heights: &[f32],
+        at: usize,
+        base: f32,
+        slope: f32,
+        i0: usize,
+        valid: usize,
+    ) {
+        if at + W <= heights.len() {
+            self.fold::<W>(
+                heights[at..at + W].try_into().unwrap(),
+                base,
+                slope,
+                i0,
+                valid,
+            );
         } else {
-            f32::INFINITY
+            let mut chunk = [0.0f32; W];
+            chunk[..valid].copy_from_slice(&heights[at..at + valid]);
+            self.fold::<W>(&chunk, base, slope, i0, valid);
         }
+    }
+
+    /// Folds `chunk[j]` (segment index `i0 + j`) for the lanes `j < valid` into the first `W`
+    /// lanes (`W` = 4 or 8).
+    #[inline(always)]
+    fn fold<const W: usize>(
+        &mut self,
+        chunk: &[f32; W],
+        base: f32,
+        slope: f32,
+        i0: usize,
+        valid: usize,
+    ) {
+        // `i0 + j` as f32 is exact (grid sides are far below 2^24). The lane mask comes from a
+        // table (all ones for the live lanes), so the loop is all vector operations.
+        const J: [f32; LANES] = [0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0];
+        const MASKS: [[u32; LANES]; LANES + 1] = {
+            let mut m = [[0u32; LANES]; LANES + 1];
+            let mut v = 0;
+            while v <= LANES {
+                let mut j = 0;
+                while j < v {
+                    m[v][j] = u32::MAX;
+                    j += 1;
+                }
+                v += 1;
+            }
+            m
+        };
+        let mask = &MASKS[valid];
+        let f0 = i0 as f32;
+        let mut e = [0.0f32; W];
+        for j in 0..W {
+            let h = chunk[j];
+            let d = (h - (base + slope * (f0 + J[j]))).abs();
+            e[j] = f32::from_bits(d.to_bits() & mask[j]);
+            if NODATA {
+                self.nodata[j] += h.is_nan() as u32 & mask[j];
+            }
+        }
+        for q in 0..W / 4 {
+            let (acc, new) = (&mut self.err[4 * q..4 * q + 4], &e[4 * q..4 * q + 4]);
+            let m = max4(new.try_into().unwrap(), acc[..].try_into().unwrap());
+            acc.copy_from_slice(&m);
+        }
+    }
+
+    #[inline(always)]
+    fn value(self) -> f32 {
+        let mut err = 0.0f32;
+        let mut nodata = 0;
+        for j in 0..LANES {
+            err = if self.err[j] > err { self.err[j] } else { err };
+            nodata += self.nodata[j];
+        }
+        fold_value(err, self.seen, nodata)
+    }
+}
+
+/// `if e > acc { e } else { acc }` lane by lane (a NaN `e` never wins): one `maxps` through the
+/// workspace's lane type, which the plain comparison does not compile to (signed zeros).
+#[inline(always)]
+fn max4(e: [f32; 4], acc: [f32; 4]) -> [f32; 4] {
+    F32x4::new(e).max(F32x4::new(acc)).to_array()
+}
+
+/// The value of a fold of `seen` samples of which `nodata` are no-data, `err` being the max error
+/// over the valid ones.
+#[inline(always)]
+fn fold_value(err: f32, seen: u32, nodata: u32) -> f32 {
+    if nodata == 0 {
+        err
+    } else if nodata == seen {
+        0.0
+    } else {
+        f32::INFINITY
     }
 }
 
@@ -98,6 +208,10 @@ impl ErrorMap {
     }
 
     /// Build the error map of `heights` (`n x n`, row-major, `NaN` = no-data).
+    ///
+    /// Two passes, both parallel over map rows and writing in place: every midpoint's own error
+    /// (its diamond or cell against the triangles' planes; independent of the other entries),
+    /// then, level by level from the finest, the max with the four children.
     ///
     /// # Panics
     /// If `n` is not `2^k + 1` with `k ≥ 1` or `heights.len() != n²` (callers pad first).
@@ -110,85 +224,63 @@ impl ErrorMap {
         let size = n - 1;
         let nu = n as usize;
         let mut errors = vec![0.0f32; nu * nu];
+        // Without no-data anywhere (the common case) no sample needs counting.
+        let nodata = heights.iter().any(|h| h.is_nan());
+        errors.par_chunks_mut(nu).enumerate().for_each(|(y, row)| {
+            if nodata {
+                own_row::<true>(heights, nu, size, y as u32, row)
+            } else {
+                own_row::<false>(heights, nu, size, y as u32, row)
+            }
+        });
         let mut s = 2;
         while s <= size {
             let h = s / 2;
-            let cells = size / s;
-            // Diamond vertices of step s: horizontal edges (x0 + s/2, y), vertical edges (x, y0 + s/2).
-            for horizontal in [true, false] {
-                let (rows, cols) = if horizontal {
-                    (cells + 1, cells)
-                } else {
-                    (cells, cells + 1)
-                };
-                let errs = &errors;
-                // One Vec per row through an indexed collect: no intermediate copy of the phase.
-                let vals: Vec<Vec<f32>> = (0..rows)
-                    .into_par_iter()
-                    .map(|r| {
-                        (0..cols)
-                            .map(move |q| {
-                                let (mx, my) = if horizontal {
-                                    (q * s + h, r * s)
-                                } else {
-                                    (q * s, r * s + h)
-                                };
-                                let own = diamond_error(heights, nu, mx, my, h, horizontal, size);
-                                let mut e = own;
-                                if h >= 2 {
-                                    let k = h / 2;
-                                    for (dx, dy) in [(-1i64, -1i64), (1, -1), (-1, 1), (1, 1)] {
-                                        let cx = mx as i64 + dx * k as i64;
-                                        let cy = my as i64 + dy * k as i64;
-                                        if cx >= 0
-                                            && cy >= 0
-                                            && cx <= size as i64
-                                            && cy <= size as i64
-                                        {
-                                            e = e.max(errs[cy as usize * nu + cx as usize]);
-                                        }
-                                    }
+            if h >= 2 {
+                // Diamond vertices of step s (rows at multiples of h) take their children, the
+                // square vertices of step h (rows at odd multiples of h / 2).
+                let k = h / 2;
+                for_rows(
+                    &mut errors,
+                    nu,
+                    |y| y % h == 0,
+                    |y, row, rows| {
+                        let (first, step) = if y % s == 0 { (h, s) } else { (0, s) };
+                        let mut x = first;
+                        while x <= size {
+                            let mut e = row[x as usize];
+                            for (dx, dy) in [(-1i64, -1i64), (1, -1), (-1, 1), (1, 1)] {
+                                let cx = x as i64 + dx * k as i64;
+                                let cy = y as i64 + dy * k as i64;
+                                if cx >= 0 && cy >= 0 && cx <= size as i64 && cy <= size as i64 {
+                                    e = e.max(rows[cy as usize][cx as usize]);
                                 }
-                                e
-                            })
-                            .collect()
-                    })
-                    .collect();
-                for r in 0..rows {
-                    for q in 0..cols {
-                        let (mx, my) = if horizontal {
-                            (q * s + h, r * s)
-                        } else {
-                            (q * s, r * s + h)
-                        };
-                        errors[my as usize * nu + mx as usize] = vals[r as usize][q as usize];
-                    }
-                }
-            }
-            // Square vertices of step s: cell centres.
-            let errs = &errors;
-            let vals: Vec<Vec<f32>> = (0..cells)
-                .into_par_iter()
-                .map(|j| {
-                    (0..cells)
-                        .map(move |i| {
-                            let (x0, y0) = (i * s, j * s);
-                            let main = is_main_diagonal(i, j, s, size);
-                            let mut e = cell_error(heights, nu, x0, y0, s, main);
-                            for (ex, ey) in [(h, 0), (h, s), (0, h), (s, h)] {
-                                e = e.max(errs[(y0 + ey) as usize * nu + (x0 + ex) as usize]);
                             }
-                            e
-                        })
-                        .collect()
-                })
-                .collect();
-            for j in 0..cells {
-                for i in 0..cells {
-                    errors[(j * s + h) as usize * nu + (i * s + h) as usize] =
-                        vals[j as usize][i as usize];
-                }
+                            row[x as usize] = e;
+                            x += step;
+                        }
+                    },
+                );
             }
+            // Square vertices of step s (rows at odd multiples of h) take the four diamond
+            // vertices of step s on their cell's edges: two on their own row, two on the rows of
+            // the cell's top and bottom (multiples of s).
+            for_rows(
+                &mut errors,
+                nu,
+                |y| y % s == h,
+                |y, row, rows| {
+                    let y0 = y - h;
+                    for x0 in (0..size).step_by(s as usize) {
+                        let mut e = row[(x0 + h) as usize];
+                        e = e.max(rows[y0 as usize][(x0 + h) as usize]);
+                        e = e.max(rows[(y0 + s) as usize][(x0 + h) as usize]);
+                        e = e.max(row[x0 as usize]);
+                        e = e.max(row[(x0 + s) as usize]);
+                        row[(x0 + h) as usize] = e;
+                    }
+                },
+            );
             s *= 2;
         }
         ErrorMap { n, errors }
@@ -288,70 +380,110 @@ fn is_main_diagonal(i: u32, j: u32, s: u32, size: u32) -> bool {
     s == size || (i & 1) == (j & 1)
 }
 
-/// Exact error of the two triangles of an `s`-cell against their planes, row by row.
-fn cell_error(heights: &[f32], nu: usize, x0: u32, y0: u32, s: u32, main: bool) -> f32 {
+/// [`cell_error_in`] with the small steps compiled apart (constant segment lengths: the scans
+/// unroll to straight-line vector code).
+fn cell_error<const NODATA: bool>(
+    heights: &[f32],
+    nu: usize,
+    x0: u32,
+    y0: u32,
+    s: u32,
+    main: bool,
+) -> f32 {
+    match s {
+        4 => cell_error_in::<NODATA>(heights, nu, x0, y0, 4, main),
+        8 => cell_error_in::<NODATA>(heights, nu, x0, y0, 8, main),
+        16 => cell_error_in::<NODATA>(heights, nu, x0, y0, 16, main),
+        _ => cell_error_in::<NODATA>(heights, nu, x0, y0, s, main),
+    }
+}
+
+/// Exact error of the two triangles of an `s`-cell (`s ≥ 4`) against their planes, row by row.
+#[inline(always)]
+fn cell_error_in<const NODATA: bool>(
+    heights: &[f32],
+    nu: usize,
+    x0: u32,
+    y0: u32,
+    s: u32,
+    main: bool,
+) -> f32 {
     let at = |x: u32, y: u32| heights[y as usize * nu + x as usize];
     let h00 = at(x0, y0);
     let h10 = at(x0 + s, y0);
     let h01 = at(x0, y0 + s);
     let h11 = at(x0 + s, y0 + s);
-    if s == 2 {
-        // The finest cells: besides the corners, the centre (on the diagonal) and the four edge
-        // midpoints (on the legs), each measured against the line it lies on.
-        let (hc, ht, hb, hl, hr) = (
-            at(x0 + 1, y0 + 1),
-            at(x0 + 1, y0),
-            at(x0 + 1, y0 + 2),
-            at(x0, y0 + 1),
-            at(x0 + 2, y0 + 1),
-        );
-        let diag = if main {
-            0.5 * (h00 + h11)
-        } else {
-            0.5 * (h10 + h01)
-        };
-        let all = [h00, h10, h01, h11, hc, ht, hb, hl, hr];
-        let nodata = all.iter().filter(|v| v.is_nan()).count();
-        if nodata == 9 {
-            return 0.0;
-        } else if nodata > 0 {
-            return f32::INFINITY;
-        }
-        return (hc - diag)
-            .abs()
-            .max((ht - 0.5 * (h00 + h10)).abs())
-            .max((hb - 0.5 * (h01 + h11)).abs())
-            .max((hl - 0.5 * (h00 + h01)).abs())
-            .max((hr - 0.5 * (h10 + h11)).abs());
-    }
     let inv = 1.0 / s as f32;
-    let mut acc = Acc::new();
+    let mut acc = Acc::<NODATA>::new();
     for v in 0..=s {
         let fv = v as f32 * inv;
         let start = (y0 + v) as usize * nu + x0 as usize;
-        let row = &heights[start..=start + s as usize];
+        let len = s as usize + 1;
         if main {
             // u < v: the lower-left triangle (h00, h01, h11); u ≥ v: the upper-right (h00, h10, h11).
             let split = v as usize;
-            acc.scan(&row[..split], h00 + (h01 - h00) * fv, (h11 - h01) * inv);
+            acc.scan(
+                heights,
+                start,
+                split,
+                h00 + (h01 - h00) * fv,
+                (h11 - h01) * inv,
+            );
             let (b1, d1) = (h00 + (h11 - h10) * fv, (h10 - h00) * inv);
-            acc.scan(&row[split..], b1 + d1 * split as f32, d1);
+            acc.scan(
+                heights,
+                start + split,
+                len - split,
+                b1 + d1 * split as f32,
+                d1,
+            );
         } else {
             // u + v ≤ s: the upper-left triangle (h00, h10, h01); beyond: the lower-right (h10, h01, h11).
             let split = (s - v) as usize + 1;
-            acc.scan(&row[..split], h00 + (h01 - h00) * fv, (h10 - h00) * inv);
+            acc.scan(
+                heights,
+                start,
+                split,
+                h00 + (h01 - h00) * fv,
+                (h10 - h00) * inv,
+            );
             let d2 = -(h01 - h11) * inv;
             let b2 = h11 + (h01 - h11) + (h10 - h11) * (1.0 - fv);
-            acc.scan(&row[split..], b2 + d2 * split as f32, d2);
+            acc.scan(
+                heights,
+                start + split,
+                len - split,
+                b2 + d2 * split as f32,
+                d2,
+            );
         }
     }
     acc.value()
 }
 
+/// [`diamond_error_in`] with the small steps compiled apart (constant segment lengths).
+fn diamond_error<const NODATA: bool>(
+    heights: &[f32],
+    nu: usize,
+    mx: u32,
+    my: u32,
+    h: u32,
+    horizontal: bool,
+    size: u32,
+) -> f32 {
+    match h {
+        2 => diamond_error_in::<NODATA>(heights, nu, mx, my, 2, horizontal, size),
+        4 => diamond_error_in::<NODATA>(heights, nu, mx, my, 4, horizontal, size),
+        8 => diamond_error_in::<NODATA>(heights, nu, mx, my, 8, horizontal, size),
+        _ => diamond_error_in::<NODATA>(heights, nu, mx, my, h, horizontal, size),
+    }
+}
+
 /// Exact error of the (one or two) triangles whose hypotenuse is the lattice edge of length `2h`
-/// centred at `(mx, my)`: horizontal edge -> apexes above and below, vertical -> left and right.
-/// Samples on the edge are visited once per side (harmless for a max).
-fn diamond_error(
+/// (`h ≥ 2`) centred at `(mx, my)`: horizontal edge -> apexes above and below, vertical -> left
+/// and right. Samples on the edge are visited once per side (harmless for a max).
+#[inline(always)]
+fn diamond_error_in<const NODATA: bool>(
     heights: &[f32],
     nu: usize,
     mx: u32,
@@ -361,37 +493,7 @@ fn diamond_error(
     size: u32,
 ) -> f32 {
     let at = |x: u32, y: u32| heights[y as usize * nu + x as usize];
-    if h == 1 {
-        // The finest diamonds: the only sample not a vertex of its triangle is the midpoint.
-        let (a, b) = if horizontal {
-            (at(mx - 1, my), at(mx + 1, my))
-        } else {
-            (at(mx, my - 1), at(mx, my + 1))
-        };
-        let m = at(mx, my);
-        let (p, q) = if horizontal {
-            (
-                (my >= 1).then(|| at(mx, my - 1)),
-                (my < size).then(|| at(mx, my + 1)),
-            )
-        } else {
-            (
-                (mx >= 1).then(|| at(mx - 1, my)),
-                (mx < size).then(|| at(mx + 1, my)),
-            )
-        };
-        let samples = [Some(a), Some(b), Some(m), p, q];
-        let seen = samples.iter().flatten().count();
-        let nodata = samples.iter().flatten().filter(|v| v.is_nan()).count();
-        return if nodata == 0 {
-            (m - 0.5 * (a + b)).abs()
-        } else if nodata == seen {
-            0.0
-        } else {
-            f32::INFINITY
-        };
-    }
-    let mut acc = Acc::new();
+    let mut acc = Acc::<NODATA>::new();
     let inv = 1.0 / h as f32;
     let half = 0.5 * inv;
     if horizontal {
@@ -410,7 +512,7 @@ fn diamond_error(
                 let x_start = mx - r;
                 let start = y * nu + x_start as usize;
                 let base = ha + slope * (x_start - (mx - h)) as f32 + lift * wa as f32 * inv;
-                acc.scan(&heights[start..=start + 2 * r as usize], base, slope);
+                acc.scan(heights, start, 2 * r as usize + 1, base, slope);
             }
         }
     } else {
@@ -425,18 +527,192 @@ fn diamond_error(
             if let Some(l) = left {
                 let start = y * nu + (mx - r) as usize;
                 acc.scan(
-                    &heights[start..=start + r as usize],
+                    heights,
+                    start,
+                    r as usize + 1,
                     along + l * r as f32 * inv,
                     -l * inv,
                 );
             }
             if let Some(rl) = right {
                 let start = y * nu + mx as usize;
-                acc.scan(&heights[start..=start + r as usize], along, rl * inv);
+                acc.scan(heights, start, r as usize + 1, along, rl * inv);
             }
         }
     }
     acc.value()
+}
+
+/// Runs `f(y, row, rows)` in parallel over the map rows `y` with `dest(y)`, `row` writable and
+/// `rows[y']` the other rows, readable (empty for the rows being written).
+fn for_rows(
+    errors: &mut [f32],
+    nu: usize,
+    dest: impl Fn(u32) -> bool,
+    f: impl Fn(u32, &mut [f32], &[&[f32]]) + Sync,
+) {
+    let mut written = Vec::new();
+    let mut rows: Vec<&[f32]> = Vec::with_capacity(nu);
+    for (y, row) in errors.chunks_mut(nu).enumerate() {
+        if dest(y as u32) {
+            written.push((y as u32, row));
+            rows.push(&[]);
+        } else {
+            rows.push(row);
+        }
+    }
+    written
+        .into_par_iter()
+        .for_each(|(y, row)| f(y, row, &rows));
+}
+
+/// The own error of every midpoint on map row `y` (before the max with its children).
+///
+/// With `2^t` the largest power of two dividing `y` (`y = 0` and `y = size` count as the top
+/// level), the row holds the horizontal-edge diamond vertices of every step `2h ≤ 2^t` at odd
+/// multiples of `h`, and, for `y` an odd multiple of `h = 2^t`, the square vertices of step
+/// `2h` (odd multiples of `h`) and vertical-edge diamond vertices of step `2h` (multiples of
+/// `2h`). The corners of the grid are no midpoint and stay 0.
+fn own_row<const NODATA: bool>(heights: &[f32], nu: usize, size: u32, y: u32, row: &mut [f32]) {
+    let top = size.trailing_zeros();
+    let ty = if y == 0 { top } else { y.trailing_zeros() };
+    let line = |y: u32| &heights[y as usize * nu..(y as usize + 1) * nu];
+    let cur = line(y);
+    let up = (y > 0).then(|| line(y - 1));
+    let down = (y < size).then(|| line(y + 1));
+    if ty > 0 {
+        if NODATA {
+            fine_horizontal(cur, up, down, row);
+        } else {
+            // Every interior x; the even ones are other midpoints, overwritten below.
+            fine_horizontal_all(cur, row);
+        }
+    }
+    for t in 1..ty.min(top) {
+        let h = 1u32 << t;
+        for x in (h..size).step_by(2 * h as usize) {
+            row[x as usize] = diamond_error::<NODATA>(heights, nu, x, y, h, true, size);
+        }
+    }
+    if ty < top {
+        let h = 1u32 << ty;
+        let s = 2 * h;
+        let (up, down) = (up.unwrap(), down.unwrap());
+        if h == 1 {
+            if NODATA {
+                fine_vertical(cur, up, down, row, size);
+            } else {
+                // Every x; the odd ones are cell centres, overwritten next.
+                fine_vertical_all(cur, up, down, row);
+            }
+            fine_cells::<NODATA>(cur, up, down, row, y, size);
+        } else {
+            let y0 = y - h;
+            for x0 in (0..size).step_by(s as usize) {
+                let main = is_main_diagonal(x0 / s, y0 / s, s, size);
+                row[(x0 + h) as usize] = cell_error::<NODATA>(heights, nu, x0, y0, s, main);
+            }
+            for x in (0..=size).step_by(s as usize) {
+                row[x as usize] = diamond_error::<NODATA>(heights, nu, x, y, h, false, size);
+            }
+        }
+    }
+}
+
+/// [`fine_horizontal`] on a grid without no-data, written at every interior `x` (one vector
+/// loop): `|h[x] − (h[x − 1] + h[x + 1]) / 2|`.
+fn fine_horizontal_all(cur: &[f32], row: &mut [f32]) {
+    let n = cur.len();
+    for (((o, &a), &m), &b) in row[1..n - 1]
+        .iter_mut()
+        .zip(&cur[..n - 2])
+        .zip(&cur[1..n - 1])
+        .zip(&cur[2..])
+    {
+        *o = (m - 0.5 * (a + b)).abs();
+    }
+}
+
+/// [`fine_vertical`] on a grid without no-data, written at every `x` (one vector loop).
+fn fine_vertical_all(cur: &[f32], up: &[f32], down: &[f32], row: &mut [f32]) {
+    for (((o, &m), &a), &b) in row.iter_mut().zip(cur).zip(up).zip(down) {
+        *o = (m - 0.5 * (a + b)).abs();
+    }
+}
+
+/// Diamonds of one sample step on an edge along an even row (odd `x`): the only sample of their
+/// triangles not a vertex is the midpoint, measured against the edge; the apexes above and below
+/// (where the grid has them) only count for no-data.
+fn fine_horizontal(cur: &[f32], up: Option<&[f32]>, down: Option<&[f32]>, row: &mut [f32]) {
+    let size = cur.len() - 1;
+    for x in (1..size).step_by(2) {
+        let (a, b, m) = (cur[x - 1], cur[x + 1], cur[x]);
+        let mut seen = 3;
+        let mut nodata = a.is_nan() as u32 + b.is_nan() as u32 + m.is_nan() as u32;
+        for apex in [up, down].into_iter().flatten() {
+            seen += 1;
+            nodata += apex[x].is_nan() as u32;
+        }
+        row[x] = fold_value((m - 0.5 * (a + b)).abs(), seen, nodata);
+    }
+}
+
+/// Diamonds of one sample step on an edge across an odd row (even `x`): the midpoint against
+/// the samples above and below; the apexes left and right only count for no-data.
+fn fine_vertical(cur: &[f32], up: &[f32], down: &[f32], row: &mut [f32], size: u32) {
+    let size = size as usize;
+    for x in (0..=size).step_by(2) {
+        let (a, b, m) = (up[x], down[x], cur[x]);
+        let mut seen = 3;
+        let mut nodata = a.is_nan() as u32 + b.is_nan() as u32 + m.is_nan() as u32;
+        if x >= 1 {
+            seen += 1;
+            nodata += cur[x - 1].is_nan() as u32;
+        }
+        if x < size {
+            seen += 1;
+            nodata += cur[x + 1].is_nan() as u32;
+        }
+        row[x] = fold_value((m - 0.5 * (a + b)).abs(), seen, nodata);
+    }
+}
+
+/// Cells of two sample steps centred on an odd row (odd `x`): besides the corners, the centre
+/// (on the diagonal) and the four edge midpoints (on the legs), each measured against the line
+/// it lies on.
+fn fine_cells<const NODATA: bool>(
+    cur: &[f32],
+    up: &[f32],
+    down: &[f32],
+    row: &mut [f32],
+    y: u32,
+    size: u32,
+) {
+    let j = (y - 1) / 2;
+    for x in (1..size as usize).step_by(2) {
+        let (h00, h10, h01, h11) = (up[x - 1], up[x + 1], down[x - 1], down[x + 1]);
+        let (hc, ht, hb, hl, hr) = (cur[x], up[x], down[x], cur[x - 1], cur[x + 1]);
+        let diag = if is_main_diagonal((x as u32 - 1) / 2, j, 2, size) {
+            0.5 * (h00 + h11)
+        } else {
+            0.5 * (h10 + h01)
+        };
+        let err = (hc - diag)
+            .abs()
+            .max((ht - 0.5 * (h00 + h10)).abs())
+            .max((hb - 0.5 * (h01 + h11)).abs())
+            .max((hl - 0.5 * (h00 + h01)).abs())
+            .max((hr - 0.5 * (h10 + h11)).abs());
+        row[x] = if NODATA {
+            let nodata = [h00, h10, h01, h11, hc, ht, hb, hl, hr]
+                .iter()
+                .map(|v| v.is_nan() as u32)
+                .sum();
+            fold_value(err, 9, nodata)
+        } else {
+            err
+        };
+    }
 }
 
 /// A mesh extracted from an error map: grid sample indices per vertex, triangles over them.
@@ -454,6 +730,8 @@ pub struct GridMesh {
 
 /// Extract the mesh under the `s`-cell at `(x0, y0)` (the whole grid: `(0, 0, n − 1)`); triangles
 /// with a no-data vertex are dropped.
+///
+/// The same walk as [`ErrorMap::walk`], recursive on plain coordinates.
 pub fn extract(
     map: &ErrorMap,
     heights: &[f32],
@@ -463,12 +741,12 @@ pub fn extract(
     max_error: f32,
     min_step: u32,
 ) -> GridMesh {
-    let n = map.n;
     // Dense remap over the cell's lattice of `min_step` samples (every emitted vertex lies on
     // it: the walk stops only at triangles whose legs are axis-aligned and at least `min_step`
     // long), with vertex numbers in first-use order (deterministic). A coarse chunk of a large
     // grid thus needs `(s / min_step + 1)²` slots, not one per grid sample.
     let g = if min_step > 1
+        && min_step.is_power_of_two()
         && x0.is_multiple_of(min_step)
         && y0.is_multiple_of(min_step)
         && s.is_multiple_of(min_step)
@@ -478,43 +756,123 @@ pub fn extract(
         1
     };
     let side = (s / g) as usize + 1;
-    let mut index = vec![u32::MAX; side * side];
-    let mut vertices: Vec<[u32; 2]> = Vec::new();
-    let mut tris: Vec<[u32; 3]> = Vec::new();
-    let mut max_bound = 0.0f32;
-    let mut bridging = 0;
-    map.walk(x0, y0, s, max_error, min_step, |t, bound| {
-        let pts = [t.a, t.b, t.c];
-        if pts
-            .iter()
-            .any(|p| heights[(p[1] * n + p[0]) as usize].is_nan())
-        {
-            return;
-        }
-        if bound.is_finite() {
-            max_bound = max_bound.max(bound);
+    let mut ex = Extractor {
+        errors: &map.errors,
+        heights,
+        n: map.n as usize,
+        max_error,
+        min_step,
+        x0,
+        y0,
+        shift: g.trailing_zeros(),
+        side,
+        index: vec![UNSEEN; side * side],
+        mesh: GridMesh::default(),
+    };
+    for t in map.cell_triangles(x0, y0, s) {
+        let stored = ex.stored(t.a, t.b);
+        ex.visit::<true>(t.a, t.b, t.c, s, stored);
+    }
+    ex.mesh
+}
+
+/// Index slot of a vertex not met yet.
+const UNSEEN: u32 = u32::MAX;
+
+/// The state of one [`extract`].
+struct Extractor<'a> {
+    errors: &'a [f32],
+    heights: &'a [f32],
+    n: usize,
+    max_error: f32,
+    min_step: u32,
+    x0: u32,
+    y0: u32,
+    /// log2 of the remap lattice step.
+    shift: u32,
+    side: usize,
+    /// Vertex number per lattice slot, or [`UNSEEN`].
+    index: Vec<u32>,
+    mesh: GridMesh,
+}
+
+impl Extractor<'_> {
+    /// The error map entry at the hypotenuse midpoint of `(a, b)`.
+    #[inline(always)]
+    fn stored(&self, a: [u32; 2], b: [u32; 2]) -> f32 {
+        self.errors[((a[1] + b[1]) / 2) as usize * self.n + ((a[0] + b[0]) / 2) as usize]
+    }
+
+    /// The triangle `(a, b, c)` (hypotenuse `a–b`, right angle at `c`; `stored`: the map at its
+    /// hypotenuse midpoint), split as [`ErrorMap::walk`] does (children first-child-first) or
+    /// kept. The kind of triangle alternates with depth, so it is a type parameter: `SQUARE` when
+    /// its legs lie along the axes (`d` their length), else its legs are diagonal (`d` their
+    /// length in steps `|dx| + |dy|`).
+    #[inline(always)]
+    fn visit<const SQUARE: bool>(
+        &mut self,
+        a: [u32; 2],
+        b: [u32; 2],
+        c: [u32; 2],
+        d: u32,
+        stored: f32,
+    ) {
+        let bound = if d > 1 { stored } else { 0.0 };
+        let splittable = if SQUARE { d > self.min_step } else { true } && d > 1;
+        if splittable && bound > self.max_error {
+            self.split::<SQUARE>(a, b, c, d);
         } else {
-            bridging += 1;
+            self.keep([a, b, c], bound);
         }
-        tris.push(pts.map(|p| {
-            let (dx, dy) = (p[0] - x0, p[1] - y0);
+    }
+
+    /// Visits the children of a split triangle, both their map entries read up front (the
+    /// second one's load overlaps the walk under the first).
+    fn split<const SQUARE: bool>(&mut self, a: [u32; 2], b: [u32; 2], c: [u32; 2], d: u32) {
+        let m = [(a[0] + b[0]) / 2, (a[1] + b[1]) / 2];
+        let (first, second) = (self.stored(c, a), self.stored(b, c));
+        if SQUARE {
+            self.visit::<false>(c, a, m, d, first);
+            self.visit::<false>(b, c, m, d, second);
+        } else {
+            self.visit::<true>(c, a, m, d / 2, first);
+            self.visit::<true>(b, c, m, d / 2, second);
+        }
+    }
+
+    /// Adds a kept triangle unless one of its vertices is no-data (checked when a vertex is new).
+    #[inline(always)]
+    fn keep(&mut self, pts: [[u32; 2]; 3], bound: f32) {
+        let mut slots = [0usize; 3];
+        for (slot, p) in slots.iter_mut().zip(pts) {
+            let (dx, dy) = (p[0] - self.x0, p[1] - self.y0);
             debug_assert!(
-                dx.is_multiple_of(g) && dy.is_multiple_of(g),
+                (dx | dy).trailing_zeros() >= self.shift,
                 "vertex off the lattice"
             );
-            let slot = &mut index[(dy / g) as usize * side + (dx / g) as usize];
-            if *slot == u32::MAX {
-                *slot = vertices.len() as u32;
-                vertices.push(p);
+            *slot = (dy >> self.shift) as usize * self.side + (dx >> self.shift) as usize;
+            if self.index[*slot] == UNSEEN
+                && self.heights[p[1] as usize * self.n + p[0] as usize].is_nan()
+            {
+                return;
             }
-            *slot
-        }));
-    });
-    GridMesh {
-        vertices,
-        triangles: tris,
-        max_bound,
-        bridging,
+        }
+        let mesh = &mut self.mesh;
+        if bound.is_finite() {
+            mesh.max_bound = mesh.max_bound.max(bound);
+        } else {
+            mesh.bridging += 1;
+        }
+        let mut tri = [0u32; 3];
+        for ((id, slot), p) in tri.iter_mut().zip(slots).zip(pts) {
+            let slot = &mut self.index[slot];
+            if *slot == UNSEEN {
+                *slot = mesh.vertices.len() as u32;
+                mesh.vertices.push(p);
+            }
+            *id = *slot;
+        }
+        mesh.triangles.push(tri);
     }
 }
 
@@ -563,6 +921,45 @@ mod tests {
         let mesh = extract(&m, &h, 0, 0, n - 1, 0.0, 1);
         assert_eq!(mesh.triangles.len(), 2 * 16 * 16);
         assert_eq!(mesh.vertices.len(), 17 * 17);
+    }
+
+    #[test]
+    fn no_data_free_paths_match_the_counting_ones() {
+        // On a grid without no-data the map skips all counting (vector loops over whole rows at
+        // the finest level): every own error must equal the counting path's, bit for bit.
+        let n = 65;
+        let h = grid(n, |x, y| {
+            (x * 0.37).sin() * 40.0 + (y * 0.23).cos() * 25.0 + ((x * y) % 7.0)
+        });
+        let nu = n as usize;
+        for y in 0..n {
+            let mut plain = vec![0.0f32; nu];
+            let mut counted = vec![0.0f32; nu];
+            own_row::<false>(&h, nu, n - 1, y, &mut plain);
+            own_row::<true>(&h, nu, n - 1, y, &mut counted);
+            let bits = |r: &[f32]| r.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&plain), bits(&counted), "row {y}");
+        }
+    }
+
+    #[test]
+    fn map_is_the_same_for_any_thread_count() {
+        let n = 129;
+        let mut h = grid(n, |x, y| (x * 0.11).sin() * 90.0 + (y * 0.07).cos() * 60.0);
+        for i in (0..h.len()).step_by(97) {
+            h[i] = f32::NAN;
+        }
+        let bits = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let m = pool.install(|| ErrorMap::new(&h, n));
+            m.errors.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
+        };
+        let one = bits(1);
+        assert_eq!(one, bits(2));
+        assert_eq!(one, bits(5));
     }
 
     #[test]
