@@ -361,11 +361,24 @@ impl EnvMap {
         let mut out = [Vec3::ZERO; 4];
         let dm = dirs.map(|d| self.frame.to_map(d));
         let sampler = filter.sampler();
+        // The usual case: the whole quad on one face. Its coarse derivatives are then those of
+        // the quad itself, which is what the samplers' quad path (SIMD where it has one) uses.
+        let homes = dm.map(|d| home(self.kind, self.size, d));
+        let f = homes[0].0;
+        if homes.iter().all(|h| h.0 == f) {
+            let q = sampler.sample_quad(&self.faces[f], homes.map(|h| h.1));
+            for l in 0..4 {
+                if mask & (1 << l) != 0 {
+                    out[l] = q[l].truncate();
+                }
+            }
+            return out;
+        }
         for l in 0..4 {
             if mask & (1 << l) == 0 {
                 continue;
             }
-            let (f, t) = home(self.kind, self.size, dm[l]);
+            let (f, t) = homes[l];
             let (dx, dy) = match filter {
                 Filter::Bilinear => (Vec2::ZERO, Vec2::ZERO),
                 Filter::Trilinear => {
