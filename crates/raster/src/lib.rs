@@ -23,7 +23,9 @@
 //! - **Quads and tiles**: pixels are processed as 2x2 quads (texture derivatives come for free);
 //!   primitives are binned into [`TILE`]-pixel tiles and tiles are rasterised in parallel with
 //!   rayon. Each tile owns its pixels and sees its primitives in submission order, so the output is
-//!   byte-identical for any thread count.
+//!   byte-identical for any thread count. [`Framebuffer::clear`] is deferred: the first draw that
+//!   reaches a tile clears it on that tile's thread, and tiles no draw reaches resolve straight to
+//!   the background.
 //!
 //! Degenerate input is never an error and never a panic: triangles with a non-finite vertex, zero
 //! area after snapping, or no pixel centre inside are skipped and counted in [`DrawStats`]; no NaN
