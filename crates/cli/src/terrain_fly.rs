@@ -314,7 +314,7 @@ pub fn run_compare(a: CompareArgs) -> Result<()> {
     let written = study::write_study(&a.out, &s)?;
     print!("{}", study::summary_markdown(&s));
     for p in written {
-        eprintln!("wrote {}", p.display());
+        crate::note!("wrote {}", p.display());
     }
     Ok(())
 }

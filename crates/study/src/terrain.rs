@@ -746,7 +746,9 @@ pub fn run_study(
         let rf = reference.render(&cam, opts.samples_per_axis, [0, 0, 0])?;
         let reference_ms = t0.elapsed().as_secs_f64() * 1e3;
         let (col, row) = grid.georef().xy_to_sample(v.eye_x, v.eye_y);
-        let clearance = v.altitude - ground_height(grid, col, row).unwrap_or(0.0);
+        // Over no-data, the clearance is taken above the highest ground (as the path places it).
+        let ground = ground_height(grid, col, row).unwrap_or_else(|| grid.height_range().1 as f64);
+        let clearance = v.altitude - ground;
         let place = ViewPlace {
             view: i,
             segment: p.segment.to_string(),
