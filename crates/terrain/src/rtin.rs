@@ -341,34 +341,71 @@ impl ErrorMap {
         s: u32,
         max_error: f32,
         min_step: u32,
-        mut emit: impl FnMut(Tri, f32),
+        emit: impl FnMut(Tri, f32),
     ) {
-        let mut stack: Vec<Tri> = self.cell_triangles(x0, y0, s).into_iter().rev().collect();
-        while let Some(t) = stack.pop() {
-            let [ax, ay] = t.a;
-            let [bx, by] = t.b;
-            let [cx, cy] = t.c;
-            let d = ax.abs_diff(cx) + ay.abs_diff(cy);
-            let square = ax == cx || ay == cy;
-            let splittable = if square { d > min_step } else { true } && d > 1;
-            let (mx, my) = ((ax + bx) / 2, (ay + by) / 2);
-            let bound = if d > 1 { self.error_at(mx, my) } else { 0.0 };
-            if splittable && bound > max_error {
-                let m = [mx, my];
-                // Push the second child first so the first is walked first.
-                stack.push(Tri {
-                    a: t.b,
-                    b: t.c,
-                    c: m,
-                });
-                stack.push(Tri {
-                    a: t.c,
-                    b: t.a,
-                    c: m,
-                });
-            } else {
-                emit(t, bound);
-            }
+        let mut w = Walker {
+            errors: &self.errors,
+            n: self.n as usize,
+            max_error,
+            min_step,
+            emit,
+        };
+        for t in self.cell_triangles(x0, y0, s) {
+            let stored = w.stored(t.a, t.b);
+            w.visit::<true>(t.a, t.b, t.c, s, stored);
+        }
+    }
+}
+
+/// The walk of [`ErrorMap::walk`], depth first, first child first.
+struct Walker<'a, F> {
+    errors: &'a [f32],
+    n: usize,
+    max_error: f32,
+    min_step: u32,
+    emit: F,
+}
+
+impl<F: FnMut(Tri, f32)> Walker<'_, F> {
+    /// The error map entry at the hypotenuse midpoint of `(a, b)`.
+    #[inline(always)]
+    fn stored(&self, a: [u32; 2], b: [u32; 2]) -> f32 {
+        self.errors[((a[1] + b[1]) / 2) as usize * self.n + ((a[0] + b[0]) / 2) as usize]
+    }
+
+    /// The triangle `(a, b, c)` (hypotenuse `a–b`, right angle at `c`; `stored`: the map at its
+    /// hypotenuse midpoint), split or kept. The kind of triangle alternates with depth, so it is
+    /// a type parameter: `SQUARE` when its legs lie along the axes (`d` their length), else its
+    /// legs are diagonal (`d` their length in steps `|dx| + |dy|`).
+    #[inline(always)]
+    fn visit<const SQUARE: bool>(
+        &mut self,
+        a: [u32; 2],
+        b: [u32; 2],
+        c: [u32; 2],
+        d: u32,
+        stored: f32,
+    ) {
+        let bound = if d > 1 { stored } else { 0.0 };
+        let splittable = if SQUARE { d > self.min_step } else { true } && d > 1;
+        if splittable && bound > self.max_error {
+            self.split::<SQUARE>(a, b, c, d);
+        } else {
+            (self.emit)(Tri { a, b, c }, bound);
+        }
+    }
+
+    /// Visits the children of a split triangle, both their map entries read up front (the
+    /// second one's load overlaps the walk under the first).
+    fn split<const SQUARE: bool>(&mut self, a: [u32; 2], b: [u32; 2], c: [u32; 2], d: u32) {
+        let m = [(a[0] + b[0]) / 2, (a[1] + b[1]) / 2];
+        let (first, second) = (self.stored(c, a), self.stored(b, c));
+        if SQUARE {
+            self.visit::<false>(c, a, m, d, first);
+            self.visit::<false>(b, c, m, d, second);
+        } else {
+            self.visit::<true>(c, a, m, d / 2, first);
+            self.visit::<true>(b, c, m, d / 2, second);
         }
     }
 }
@@ -756,12 +793,9 @@ pub fn extract(
         1
     };
     let side = (s / g) as usize + 1;
-    let mut ex = Extractor {
-        errors: &map.errors,
+    let mut m = Mesher {
         heights,
         n: map.n as usize,
-        max_error,
-        min_step,
         x0,
         y0,
         shift: g.trailing_zeros(),
@@ -769,23 +803,17 @@ pub fn extract(
         index: vec![UNSEEN; side * side],
         mesh: GridMesh::default(),
     };
-    for t in map.cell_triangles(x0, y0, s) {
-        let stored = ex.stored(t.a, t.b);
-        ex.visit::<true>(t.a, t.b, t.c, s, stored);
-    }
-    ex.mesh
+    map.walk(x0, y0, s, max_error, min_step, |t, bound| m.keep(t, bound));
+    m.mesh
 }
 
 /// Index slot of a vertex not met yet.
 const UNSEEN: u32 = u32::MAX;
 
-/// The state of one [`extract`].
-struct Extractor<'a> {
-    errors: &'a [f32],
+/// The mesh an [`extract`] builds from the walk's kept triangles.
+struct Mesher<'a> {
     heights: &'a [f32],
     n: usize,
-    max_error: f32,
-    min_step: u32,
     x0: u32,
     y0: u32,
     /// log2 of the remap lattice step.
@@ -796,53 +824,11 @@ struct Extractor<'a> {
     mesh: GridMesh,
 }
 
-impl Extractor<'_> {
-    /// The error map entry at the hypotenuse midpoint of `(a, b)`.
-    #[inline(always)]
-    fn stored(&self, a: [u32; 2], b: [u32; 2]) -> f32 {
-        self.errors[((a[1] + b[1]) / 2) as usize * self.n + ((a[0] + b[0]) / 2) as usize]
-    }
-
-    /// The triangle `(a, b, c)` (hypotenuse `a–b`, right angle at `c`; `stored`: the map at its
-    /// hypotenuse midpoint), split as [`ErrorMap::walk`] does (children first-child-first) or
-    /// kept. The kind of triangle alternates with depth, so it is a type parameter: `SQUARE` when
-    /// its legs lie along the axes (`d` their length), else its legs are diagonal (`d` their
-    /// length in steps `|dx| + |dy|`).
-    #[inline(always)]
-    fn visit<const SQUARE: bool>(
-        &mut self,
-        a: [u32; 2],
-        b: [u32; 2],
-        c: [u32; 2],
-        d: u32,
-        stored: f32,
-    ) {
-        let bound = if d > 1 { stored } else { 0.0 };
-        let splittable = if SQUARE { d > self.min_step } else { true } && d > 1;
-        if splittable && bound > self.max_error {
-            self.split::<SQUARE>(a, b, c, d);
-        } else {
-            self.keep([a, b, c], bound);
-        }
-    }
-
-    /// Visits the children of a split triangle, both their map entries read up front (the
-    /// second one's load overlaps the walk under the first).
-    fn split<const SQUARE: bool>(&mut self, a: [u32; 2], b: [u32; 2], c: [u32; 2], d: u32) {
-        let m = [(a[0] + b[0]) / 2, (a[1] + b[1]) / 2];
-        let (first, second) = (self.stored(c, a), self.stored(b, c));
-        if SQUARE {
-            self.visit::<false>(c, a, m, d, first);
-            self.visit::<false>(b, c, m, d, second);
-        } else {
-            self.visit::<true>(c, a, m, d / 2, first);
-            self.visit::<true>(b, c, m, d / 2, second);
-        }
-    }
-
+impl Mesher<'_> {
     /// Adds a kept triangle unless one of its vertices is no-data (checked when a vertex is new).
     #[inline(always)]
-    fn keep(&mut self, pts: [[u32; 2]; 3], bound: f32) {
+    fn keep(&mut self, t: Tri, bound: f32) {
+        let pts = [t.a, t.b, t.c];
         let mut slots = [0usize; 3];
         for (slot, p) in slots.iter_mut().zip(pts) {
             let (dx, dy) = (p[0] - self.x0, p[1] - self.y0);
