@@ -3,6 +3,12 @@
 //! peer harness (same generator, seed and 3 km relief), so triangle counts compare at equal error;
 //! they are printed once before timing.
 //!
+//! `fuji_*` times the same two steps on mapbox's Fuji tile (martini's own fixture, made 513² as
+//! martini's test does), the terrain the martini figures were measured on (89.5k
+//! triangles at 10 m). The bench writes that grid as little-endian f32 to
+//! `target/fuji-513.f32` so the peer harness can time martini on the very same samples:
+//! `node bench.mjs <that file> 513 10`.
+//!
 //!     cargo bench --bench terrain
 
 use criterion::{Criterion, criterion_group, criterion_main};
@@ -69,6 +75,25 @@ fn diamond_square(n: usize, amp: f64, rough: f64, seed: u32) -> Vec<f32> {
     t
 }
 
+/// Mapbox's Fuji Terrain-RGB tile as a 513² grid (last row and column repeated, as martini's test).
+fn fuji() -> Vec<f32> {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/crates/terrain/tests/data/fuji.png"
+    );
+    let img = image::open(path).unwrap().to_rgba8();
+    let w = img.width();
+    let n = w + 1;
+    let mut g = Vec::with_capacity((n * n) as usize);
+    for y in 0..n {
+        for x in 0..n {
+            let p = img.get_pixel(x.min(w - 1), y.min(w - 1));
+            g.push(texmap_terrain::dem::png::terrain_rgb_height(p[0], p[1], p[2]) as f32);
+        }
+    }
+    g
+}
+
 fn bench(c: &mut Criterion) {
     let n = 513u32;
     let h = diamond_square(n as usize, 3000.0, 0.9, 42);
@@ -101,6 +126,25 @@ fn bench(c: &mut Criterion) {
     });
     g.bench_function("rtin_mesh_10m_513", |b| {
         b.iter(|| extract(&map, black_box(&h), 0, 0, n - 1, 10.0, 1))
+    });
+    let fj = fuji();
+    let peer_input = concat!(env!("CARGO_MANIFEST_DIR"), "/target/fuji-513.f32");
+    let bytes: Vec<u8> = fj.iter().flat_map(|v| v.to_le_bytes()).collect();
+    if std::fs::write(peer_input, bytes).is_ok() {
+        eprintln!(
+            "fuji grid for the peer harness: {peer_input} (node bench.mjs {peer_input} 513 10)"
+        );
+    }
+    let fmap = ErrorMap::new(&fj, n);
+    eprintln!(
+        "texmap RTIN fuji 513²: 10 m -> {} triangles",
+        extract(&fmap, &fj, 0, 0, n - 1, 10.0, 1).triangles.len()
+    );
+    g.bench_function("fuji_error_map_513_1core", |b| {
+        b.iter(|| one.install(|| ErrorMap::new(black_box(&fj), n)))
+    });
+    g.bench_function("fuji_mesh_10m_513", |b| {
+        b.iter(|| extract(&fmap, black_box(&fj), 0, 0, n - 1, 10.0, 1))
     });
     g.sample_size(10);
     g.bench_function("greedy_10m_513", |b| {

@@ -48,6 +48,8 @@ pub struct Tri {
 pub struct ErrorMap {
     n: u32,
     errors: Vec<f32>,
+    /// Whether the grid it was built from has no-data samples.
+    nodata: bool,
 }
 
 /// Lanes of the sample fold: 8 independent running maxima, so the per-sample loop is a vector
@@ -283,7 +285,7 @@ impl ErrorMap {
             );
             s *= 2;
         }
-        ErrorMap { n, errors }
+        ErrorMap { n, errors, nodata }
     }
 
     /// Side length in samples.
@@ -803,7 +805,16 @@ pub fn extract(
         index: vec![UNSEEN; side * side],
         mesh: GridMesh::default(),
     };
-    map.walk(x0, y0, s, max_error, min_step, |t, bound| m.keep(t, bound));
+    // Without no-data in the grid no vertex needs its height checked.
+    if map.nodata {
+        map.walk(x0, y0, s, max_error, min_step, |t, bound| {
+            m.keep::<true>(t, bound)
+        });
+    } else {
+        map.walk(x0, y0, s, max_error, min_step, |t, bound| {
+            m.keep::<false>(t, bound)
+        });
+    }
     m.mesh
 }
 
@@ -825,9 +836,10 @@ struct Mesher<'a> {
 }
 
 impl Mesher<'_> {
-    /// Adds a kept triangle unless one of its vertices is no-data (checked when a vertex is new).
+    /// Adds a kept triangle unless one of its vertices is no-data (checked when a vertex is new,
+    /// if the grid has any: `NODATA`).
     #[inline(always)]
-    fn keep(&mut self, t: Tri, bound: f32) {
+    fn keep<const NODATA: bool>(&mut self, t: Tri, bound: f32) {
         let pts = [t.a, t.b, t.c];
         let mut slots = [0usize; 3];
         for (slot, p) in slots.iter_mut().zip(pts) {
@@ -837,7 +849,8 @@ impl Mesher<'_> {
                 "vertex off the lattice"
             );
             *slot = (dy >> self.shift) as usize * self.side + (dx >> self.shift) as usize;
-            if self.index[*slot] == UNSEEN
+            if NODATA
+                && self.index[*slot] == UNSEEN
                 && self.heights[p[1] as usize * self.n + p[0] as usize].is_nan()
             {
                 return;
