@@ -329,6 +329,9 @@ pub struct TexQuad {
     pub origin: Vec2,
     /// Lanes whose colour will be used (bit l = lane l).
     pub mask: u8,
+    /// Index of the drawn mesh's triangle the quad belongs to: one draw call can texture parts
+    /// of a mesh from different textures (e.g. terrain chunks, each with its own map).
+    pub triangle: u32,
 }
 
 impl TexQuad {
@@ -384,16 +387,18 @@ pub(crate) struct TexturedProg<'s, S: QuadSampler + ?Sized>(pub &'s S);
 impl<S: QuadSampler + ?Sized> FragProgram for TexturedProg<'_, S> {
     const NV: usize = 2;
     type Vars = [Var; 3];
-    type TriConst = ();
+    type TriConst = u32;
     #[inline]
     fn vertex_var(&self, mesh: &Mesh, vi: usize) -> Var {
         let uv = mesh.uvs().map_or(Vec2::ZERO, |u| u[vi]);
         [uv.x, uv.y, 0.0]
     }
     #[inline]
-    fn tri_const(&self, _: &Mesh, _: u32, _: bool) {}
+    fn tri_const(&self, _: &Mesh, tri: u32, _: bool) -> u32 {
+        tri
+    }
     #[inline]
-    fn shade(&self, _: &(), f: &QuadFrag, _: bool) -> [[f32; 4]; 3] {
+    fn shade(&self, tri: &u32, f: &QuadFrag, _: bool) -> [[f32; 4]; 3] {
         let mut uv = [Vec2::ZERO; 4];
         for (l, v) in uv.iter_mut().enumerate() {
             *v = Vec2::new(f.var[0][l], f.var[1][l]);
@@ -415,6 +420,7 @@ impl<S: QuadSampler + ?Sized> FragProgram for TexturedProg<'_, S> {
             uv,
             origin: Vec2::new(f.x[0], f.y[0]),
             mask: f.mask,
+            triangle: *tri,
         });
         [
             [c[0].x, c[1].x, c[2].x, c[3].x],

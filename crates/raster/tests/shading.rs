@@ -698,3 +698,53 @@ fn degenerate_input_is_skipped_without_panic_or_nan() {
     assert!(fb.draw_textured(&cam, &mesh, &uv_probe, &st).is_err());
     let _ = Vec4::ZERO;
 }
+
+#[test]
+fn textured_quads_name_their_source_triangle() {
+    // One world unit per pixel; a 20 x 10 rectangle cut by its diagonal from (−10, −5) to
+    // (10, 5): triangle 0 below it, triangle 1 above. The sampler colours by `quad.triangle`.
+    let cam =
+        Camera::orthographic_look_at(Vec3::new(0.0, 0.0, 10.0), Vec3::ZERO, Vec3::Y, 64.0, 64, 48)
+            .unwrap();
+    let pos = [
+        Vec3::new(-10.0, -5.0, 0.0),
+        Vec3::new(10.0, -5.0, 0.0),
+        Vec3::new(10.0, 5.0, 0.0),
+        Vec3::new(-10.0, 5.0, 0.0),
+    ];
+    let uv = [Vec2::ZERO; 4];
+    let mesh = Mesh::new(&pos, &[[0, 1, 2], [0, 2, 3]])
+        .unwrap()
+        .with_uvs(&uv)
+        .unwrap();
+    let by_triangle = |q: &TexQuad| {
+        [match q.triangle {
+            0 => Vec3::X,
+            1 => Vec3::Y,
+            _ => Vec3::Z,
+        }; 4]
+    };
+    let mut fb = Framebuffer::new(64, 48).unwrap();
+    fb.clear([0, 0, 0, 255]);
+    fb.draw_textured(&cam, &mesh, &by_triangle, &DrawState::default())
+        .unwrap();
+    let frame = fb.to_frame();
+    let (mut below, mut above) = (0, 0);
+    for j in 0..48 {
+        for i in 0..64 {
+            let c = frame.color[frame.index(i, j)];
+            let (x, y) = (i as f64 + 0.5 - 32.0, 24.0 - (j as f64 + 0.5));
+            if x.abs() > 10.0 || y.abs() > 5.0 {
+                assert_eq!(c, [0, 0, 0, 255], "({i}, {j}) outside");
+            } else if y < x / 2.0 {
+                assert_eq!(c, [255, 0, 0, 255], "({i}, {j}) in triangle 0");
+                below += 1;
+            } else {
+                assert_eq!(c, [0, 255, 0, 255], "({i}, {j}) in triangle 1");
+                above += 1;
+            }
+        }
+    }
+    assert_eq!(below + above, 200);
+    assert_eq!(below, above);
+}

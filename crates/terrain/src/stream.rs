@@ -46,13 +46,12 @@
 //! sample the same colours along their shared edge unless their levels differ and one of them
 //! magnifies there; the level rule keeps magnification to a chunk's nearest point.
 //!
-//! **Drawing.** The rasteriser's textured program takes one [`QuadSampler`] per draw call and
-//! hands it no triangle id, so each chunk is one [`Framebuffer::draw_textured`] call with its
-//! own texture, nearest chunk first (the depth test then skips hidden texels as in the whole
-//! frame). A per-triangle texture id would need the rasteriser to pass the triangle to the
-//! sampler (it does for [`texmap_raster::SurfaceShader`], without uvs); the calls' cost against
-//! the one-call whole frame is measured by the `flight_1024x768_streamed` group of
-//! `benches/flight.rs`.
+//! **Drawing.** The frame is one [`Framebuffer::draw_textured`] call: the chunk meshes are
+//! concatenated nearest first (the depth test then skips hidden texels as in the whole frame),
+//! each chunk's texture coordinates remapped into its own texture, and the sampler picks the
+//! chunk's texture by the triangle each quad belongs to ([`texmap_raster::TexQuad::triangle`]).
+//! Its cost against the whole-texture frame is measured by the `flight_1024x768_streamed` group
+//! of `benches/flight.rs`.
 //!
 //! Frames are deterministic: planning, loading and eviction are sequential with ties broken by
 //! keys, and the rasteriser's output does not depend on the thread count.
@@ -68,7 +67,7 @@ use glam::Vec2;
 use std::collections::HashMap;
 use texmap_core::camera::Camera;
 use texmap_core::mip::{MipTexture, Reduction, Wrap};
-use texmap_raster::{Cull, DrawState, Framebuffer, Mesh, MipSampler, QuadSampler};
+use texmap_raster::{Cull, DrawState, Framebuffer, Mesh, MipSampler, QuadSampler, TexQuad};
 
 /// Border (and alignment) of a chunk texture, in texels of its level.
 pub const BORDER: u32 = 16;
@@ -327,6 +326,21 @@ fn uv_rect(grid: &crate::dem::Grid, c: &crate::db::ChunkEntry) -> [f32; 4] {
     .map(|x| x.clamp(0.0, 1.0))
 }
 
+/// The textures of a frame's chunks in one draw call: chunk `i` owns the triangles from
+/// `starts[i]` up to the next start and is sampled from `samplers[i]`.
+struct PerChunk<'a> {
+    starts: Vec<u32>,
+    samplers: Vec<MipSampler<'a>>,
+}
+
+impl QuadSampler for PerChunk<'_> {
+    #[inline]
+    fn sample_quad(&self, quad: &TexQuad) -> [glam::Vec3; 4] {
+        let i = self.starts.partition_point(|&s| s <= quad.triangle);
+        self.samplers[i.saturating_sub(1)].sample_quad(quad)
+    }
+}
+
 /// The level Eq. (7)'s rule asks for at distance `d` (see the module docs).
 fn wanted_level(extent_m: f64, k: f64, map_texels: u32, d: f64, levels: u32) -> u32 {
     let need = extent_m * k / (map_texels as f64 * d.max(1e-6));
@@ -389,7 +403,22 @@ impl FlightTerrain {
             chunks_per_level: sel.chunks_per_level.clone(),
             ..FrameStats::default()
         };
+        // Step 4: one draw call. The chunk meshes are concatenated nearest first, each chunk's
+        // uvs remapped to its own texture; the sampler picks the chunk's texture by the
+        // triangle each quad belongs to.
         let mut frame_bytes = 0u64;
+        let mut per_chunk = PerChunk {
+            starts: Vec::with_capacity(plan.len()),
+            samplers: Vec::with_capacity(plan.len()),
+        };
+        let FrameScratch {
+            positions,
+            uvs,
+            triangles,
+        } = scratch;
+        positions.clear();
+        uvs.clear();
+        triangles.clear();
         for (c, level, _) in &plan {
             let key = ChunkTexKey {
                 depth: c.depth,
@@ -399,17 +428,35 @@ impl FlightTerrain {
             let tex = &stream.textures[&key].0;
             frame_bytes += tex.bytes();
             stats.texture_side = stats.texture_side.max(stream.map_texels << tex.level);
-            let sampler = MipSampler {
+            per_chunk.starts.push(triangles.len() as u32);
+            per_chunk.samplers.push(MipSampler {
                 texture: &tex.texture,
                 sampler: options.sampler,
-            };
-            let ds = self.draw_chunk(&camera, *c, tex, &sampler, fb, scratch, &state)?;
-            stats.triangles += ds.submitted as u64;
-            stats.triangles_binned += ds.binned as u64;
-            stats.triangles_backface += ds.culled as u64;
-            stats.triangles_clipped += ds.clipped as u64;
+            });
+            let m = self.mesh(*c)?;
+            let base = positions.len() as u32;
+            positions.extend_from_slice(&m.positions);
+            let n = tex.level_side as f64;
+            let (sx, sy) = (n / tex.width as f64, n / tex.height as f64);
+            let (ox, oy) = (
+                tex.tx0 as f64 / tex.width as f64,
+                tex.ty0 as f64 / tex.height as f64,
+            );
+            match &m.uvs {
+                Some(u) => uvs.extend(u.iter().map(|p| {
+                    Vec2::new((p.x as f64 * sx - ox) as f32, (p.y as f64 * sy - oy) as f32)
+                })),
+                None => uvs.extend(std::iter::repeat_n(Vec2::ZERO, m.positions.len())),
+            }
+            triangles.extend(m.triangles.iter().map(|t| t.map(|v| v + base)));
             stats.surface_triangles += self.chunk(*c).triangles as u64;
         }
+        let mesh = Mesh::new(positions, triangles)?.with_uvs(uvs)?;
+        let ds = fb.draw_textured(&camera, &mesh, &per_chunk, &state)?;
+        stats.triangles = ds.submitted as u64;
+        stats.triangles_binned = ds.binned as u64;
+        stats.triangles_backface = ds.culled as u64;
+        stats.triangles_clipped = ds.clipped as u64;
         let ms = stream.maps.stats();
         stats.texture_bytes = frame_bytes;
         stats.maps_needed = needed.map(|k| k.len() as u64);
@@ -528,38 +575,5 @@ impl FlightTerrain {
         stream.stats.coarsest_level = plan.iter().map(|p| p.1).min().unwrap_or(0);
         stream.stats.finest_level = plan.iter().map(|p| p.1).max().unwrap_or(0);
         Ok(plan)
-    }
-
-    /// Draw one chunk with its texture: uvs remapped into the texture's rectangle.
-    #[allow(clippy::too_many_arguments)]
-    fn draw_chunk<S: QuadSampler + ?Sized>(
-        &self,
-        camera: &Camera,
-        c: ChunkRef,
-        tex: &ChunkTexture,
-        sampler: &S,
-        fb: &mut Framebuffer,
-        scratch: &mut FrameScratch,
-        state: &DrawState,
-    ) -> Result<texmap_raster::DrawStats, ViewError> {
-        let m = self.mesh(c)?;
-        let n = tex.level_side as f64;
-        let (sx, sy) = (n / tex.width as f64, n / tex.height as f64);
-        let (ox, oy) = (
-            tex.tx0 as f64 / tex.width as f64,
-            tex.ty0 as f64 / tex.height as f64,
-        );
-        let uvs = scratch.uvs_mut();
-        uvs.clear();
-        match &m.uvs {
-            Some(u) => {
-                uvs.extend(u.iter().map(|p| {
-                    Vec2::new((p.x as f64 * sx - ox) as f32, (p.y as f64 * sy - oy) as f32)
-                }))
-            }
-            None => uvs.extend(std::iter::repeat_n(Vec2::ZERO, m.positions.len())),
-        }
-        let mesh = Mesh::new(&m.positions, &m.triangles)?.with_uvs(uvs)?;
-        Ok(fb.draw_textured(camera, &mesh, sampler, state)?)
     }
 }

@@ -557,16 +557,9 @@ impl Default for ViewOptions {
 /// Reusable buffers for the concatenated frame mesh.
 #[derive(Clone, Debug, Default)]
 pub struct FrameScratch {
-    positions: Vec<Vec3>,
-    uvs: Vec<Vec2>,
-    triangles: Vec<[u32; 3]>,
-}
-
-impl FrameScratch {
-    /// The texture-coordinate buffer (the streamed draw's remapped per-chunk uvs).
-    pub(crate) fn uvs_mut(&mut self) -> &mut Vec<Vec2> {
-        &mut self.uvs
-    }
+    pub(crate) positions: Vec<Vec3>,
+    pub(crate) uvs: Vec<Vec2>,
+    pub(crate) triangles: Vec<[u32; 3]>,
 }
 
 /// The boxes of manifest entries (an entry without one gets an empty box at the origin;
