@@ -67,7 +67,7 @@ use glam::Vec2;
 use std::collections::HashMap;
 use texmap_core::camera::Camera;
 use texmap_core::mip::{MipTexture, Reduction, Wrap};
-use texmap_raster::{Cull, DrawState, Framebuffer, Mesh, MipSampler, QuadSampler, TexQuad};
+use texmap_raster::{Cull, DrawState, Framebuffer, MipSampler, QuadSampler, TexQuad};
 
 /// Border (and alignment) of a chunk texture, in texels of its level.
 pub const BORDER: u32 = 16;
@@ -411,14 +411,7 @@ impl FlightTerrain {
             starts: Vec::with_capacity(plan.len()),
             samplers: Vec::with_capacity(plan.len()),
         };
-        let FrameScratch {
-            positions,
-            uvs,
-            triangles,
-        } = scratch;
-        positions.clear();
-        uvs.clear();
-        triangles.clear();
+        scratch.clear();
         for (c, level, _) in &plan {
             let key = ChunkTexKey {
                 depth: c.depth,
@@ -428,30 +421,23 @@ impl FlightTerrain {
             let tex = &stream.textures[&key].0;
             frame_bytes += tex.bytes();
             stats.texture_side = stats.texture_side.max(stream.map_texels << tex.level);
-            per_chunk.starts.push(triangles.len() as u32);
             per_chunk.samplers.push(MipSampler {
                 texture: &tex.texture,
                 sampler: options.sampler,
             });
-            let m = self.mesh(*c)?;
-            let base = positions.len() as u32;
-            positions.extend_from_slice(&m.positions);
             let n = tex.level_side as f64;
             let (sx, sy) = (n / tex.width as f64, n / tex.height as f64);
             let (ox, oy) = (
                 tex.tx0 as f64 / tex.width as f64,
                 tex.ty0 as f64 / tex.height as f64,
             );
-            match &m.uvs {
-                Some(u) => uvs.extend(u.iter().map(|p| {
-                    Vec2::new((p.x as f64 * sx - ox) as f32, (p.y as f64 * sy - oy) as f32)
-                })),
-                None => uvs.extend(std::iter::repeat_n(Vec2::ZERO, m.positions.len())),
-            }
-            triangles.extend(m.triangles.iter().map(|t| t.map(|v| v + base)));
+            let first = scratch.append(&*self.mesh(*c)?, |p| {
+                Vec2::new((p.x as f64 * sx - ox) as f32, (p.y as f64 * sy - oy) as f32)
+            });
+            per_chunk.starts.push(first);
             stats.surface_triangles += self.chunk(*c).triangles as u64;
         }
-        let mesh = Mesh::new(positions, triangles)?.with_uvs(uvs)?;
+        let mesh = scratch.mesh()?;
         let ds = fb.draw_textured(&camera, &mesh, &per_chunk, &state)?;
         stats.triangles = ds.submitted as u64;
         stats.triangles_binned = ds.binned as u64;

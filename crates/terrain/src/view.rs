@@ -557,9 +557,40 @@ impl Default for ViewOptions {
 /// Reusable buffers for the concatenated frame mesh.
 #[derive(Clone, Debug, Default)]
 pub struct FrameScratch {
-    pub(crate) positions: Vec<Vec3>,
-    pub(crate) uvs: Vec<Vec2>,
-    pub(crate) triangles: Vec<[u32; 3]>,
+    positions: Vec<Vec3>,
+    uvs: Vec<Vec2>,
+    triangles: Vec<[u32; 3]>,
+}
+
+impl FrameScratch {
+    /// Empty the buffers (keeping their capacity).
+    pub(crate) fn clear(&mut self) {
+        self.positions.clear();
+        self.uvs.clear();
+        self.triangles.clear();
+    }
+
+    /// Append `m` with its uvs mapped by `uv` (zero uvs when it has none); returns the index of
+    /// its first triangle in the concatenation.
+    pub(crate) fn append(&mut self, m: &TriMesh, uv: impl Fn(Vec2) -> Vec2) -> u32 {
+        let first = self.triangles.len() as u32;
+        let base = self.positions.len() as u32;
+        self.positions.extend_from_slice(&m.positions);
+        match &m.uvs {
+            Some(u) => self.uvs.extend(u.iter().map(|&p| uv(p))),
+            None => self
+                .uvs
+                .extend(std::iter::repeat_n(Vec2::ZERO, m.positions.len())),
+        }
+        self.triangles
+            .extend(m.triangles.iter().map(|t| t.map(|v| v + base)));
+        first
+    }
+
+    /// The concatenation as a raster mesh.
+    pub(crate) fn mesh(&self) -> Result<Mesh<'_>, ViewError> {
+        Ok(Mesh::new(&self.positions, &self.triangles)?.with_uvs(&self.uvs)?)
+    }
 }
 
 /// The boxes of manifest entries (an entry without one gets an empty box at the origin;
@@ -930,25 +961,11 @@ impl FlightTerrain {
         scratch: &mut FrameScratch,
     ) -> Result<usize, ViewError> {
         self.prepare(&selection.chunks)?;
-        let FrameScratch {
-            positions,
-            uvs,
-            triangles,
-        } = scratch;
-        positions.clear();
-        uvs.clear();
-        triangles.clear();
+        scratch.clear();
         for c in &selection.chunks {
-            let m = self.mesh(*c)?;
-            let base = positions.len() as u32;
-            positions.extend_from_slice(&m.positions);
-            match &m.uvs {
-                Some(u) => uvs.extend_from_slice(u),
-                None => uvs.extend(std::iter::repeat_n(Vec2::ZERO, m.positions.len())),
-            }
-            triangles.extend(m.triangles.iter().map(|t| t.map(|v| v + base)));
+            scratch.append(&*self.mesh(*c)?, |p| p);
         }
-        Ok(triangles.len())
+        Ok(scratch.triangles.len())
     }
 
     /// Concatenate the selected chunks' meshes into `scratch` and draw them with `sampler` into
@@ -962,12 +979,7 @@ impl FlightTerrain {
         scratch: &mut FrameScratch,
     ) -> Result<DrawStats, ViewError> {
         self.gather(selection, scratch)?;
-        let FrameScratch {
-            positions,
-            uvs,
-            triangles,
-        } = scratch;
-        let mesh = Mesh::new(positions, triangles)?.with_uvs(uvs)?;
+        let mesh = scratch.mesh()?;
         // Surfaces face up and skirts outward (counter-clockwise from outside): back faces are
         // never the visible side of a closed chunk.
         let state = DrawState {
