@@ -803,6 +803,7 @@ pub fn extract(
         shift: g.trailing_zeros(),
         side,
         index: vec![UNSEEN; side * side],
+        count: 0,
         mesh: GridMesh::default(),
     };
     // Without no-data in the grid no vertex needs its height checked.
@@ -811,9 +812,12 @@ pub fn extract(
             m.keep::<true>(t, bound)
         });
     } else {
+        let mut verts = Vec::new();
         map.walk(x0, y0, s, max_error, min_step, |t, bound| {
-            m.keep::<false>(t, bound)
+            m.keep_dense(t, bound, &mut verts)
         });
+        verts.truncate(m.count);
+        m.mesh.vertices = verts;
     }
     m.mesh
 }
@@ -832,10 +836,44 @@ struct Mesher<'a> {
     side: usize,
     /// Vertex number per lattice slot, or [`UNSEEN`].
     index: Vec<u32>,
+    /// Vertices numbered so far ([`Mesher::keep_dense`]).
+    count: usize,
     mesh: GridMesh,
 }
 
 impl Mesher<'_> {
+    /// [`Mesher::keep`] for a grid without no-data, branch-free per vertex (whether a vertex is
+    /// new depends on the terrain: a branch on it is mispredicted about once a triangle). The
+    /// vertices go to `verts`, whose length runs ahead of their count (`self.count`; the mesh's
+    /// own vertex list stays empty until the end): every corner is written at the count,
+    /// which advances only for a new one. Vertex numbers are smaller than the count and
+    /// [`UNSEEN`] is the largest `u32`, so `min(slot, count)` is the vertex's number either way.
+    #[inline(always)]
+    fn keep_dense(&mut self, t: Tri, bound: f32, verts: &mut Vec<[u32; 2]>) {
+        debug_assert!(
+            bound.is_finite(),
+            "a grid without no-data has finite bounds"
+        );
+        let mesh = &mut self.mesh;
+        mesh.max_bound = mesh.max_bound.max(bound);
+        let mut count = self.count;
+        if verts.len() < count + 3 {
+            verts.resize((count + 3).max(2 * verts.len()), [0, 0]);
+        }
+        let mut tri = [0u32; 3];
+        for (id, p) in tri.iter_mut().zip([t.a, t.b, t.c]) {
+            let (dx, dy) = (p[0] - self.x0, p[1] - self.y0);
+            let slot = (dy >> self.shift) as usize * self.side + (dx >> self.shift) as usize;
+            let v = self.index[slot].min(count as u32);
+            self.index[slot] = v;
+            verts[count] = p;
+            count += (v == count as u32) as usize;
+            *id = v;
+        }
+        self.count = count;
+        mesh.triangles.push(tri);
+    }
+
     /// Adds a kept triangle unless one of its vertices is no-data (checked when a vertex is new,
     /// if the grid has any: `NODATA`).
     #[inline(always)]
@@ -920,6 +958,34 @@ mod tests {
         let mesh = extract(&m, &h, 0, 0, n - 1, 0.0, 1);
         assert_eq!(mesh.triangles.len(), 2 * 16 * 16);
         assert_eq!(mesh.vertices.len(), 17 * 17);
+    }
+
+    #[test]
+    fn branch_free_mesher_matches_the_checking_one() {
+        // Without no-data, extraction numbers vertices branch-free; forcing the no-data path
+        // (a height check per new vertex, which never fires here) must give the same mesh, in
+        // the same order, for whole grids and for chunks on a coarser lattice.
+        let n = 129;
+        let h = grid(n, |x, y| {
+            (x * 0.21).sin() * 30.0 + (y * 0.17).cos() * 20.0 + ((x * 3.0 + y) % 5.0)
+        });
+        let dense = ErrorMap::new(&h, n);
+        assert!(!dense.nodata);
+        let mut checking = dense.clone();
+        checking.nodata = true;
+        for (x0, y0, s, step) in [
+            (0, 0, 128, 1),
+            (64, 0, 64, 1),
+            (0, 64, 64, 4),
+            (32, 32, 32, 2),
+        ] {
+            for e in [0.0f32, 0.5, 3.0, 20.0] {
+                let a = extract(&dense, &h, x0, y0, s, e, step);
+                let b = extract(&checking, &h, x0, y0, s, e, step);
+                assert!(!a.triangles.is_empty());
+                assert_eq!(a, b, "cell ({x0}, {y0}) side {s} step {step}, {e} m");
+            }
+        }
     }
 
     #[test]
