@@ -6,8 +6,10 @@
 //! - `select_and_gather`: plus the concatenation of the chosen chunk meshes into one mesh;
 //! - `raster_only`: selection, mesh concatenation and rasterisation with a constant-colour
 //!   sampler (no texture reads): the frame's cost without sampling;
-//! - `trilinear`, `span3`, `span4`, `aniso`: whole frames (camera, selection, clear, draw) with
-//!   each sampler; sampling costs the difference to `raster_only`.
+//! - `trilinear`, `span3`, `span4`, `aniso`, `quadratic3`: whole frames (camera, selection,
+//!   clear, draw) with each sampler; sampling costs the difference to `raster_only`.
+//!   `quadratic3` (3x3 Lagrange per level on trilinear's levels, the higher-order interpolation
+//!   the paper suggests) measures what it costs against trilinear.
 //!
 //! - `streamed/whole_db`, `streamed/streamed`: the same terrain and texture built into a database
 //!   (a temporary directory), drawn with trilinear from the whole finest level and from the
@@ -110,6 +112,7 @@ fn bench(c: &mut Criterion) {
         ("span3", Sampler::Span(Banks::K3)),
         ("span4", Sampler::Span(Banks::K4)),
         ("aniso", Sampler::Anisotropic { max_taps: 16 }),
+        ("quadratic3", Sampler::Quadratic3),
     ] {
         let opts = ViewOptions {
             sampler,

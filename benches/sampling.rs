@@ -9,7 +9,8 @@
 //! Cases: `nearest`, `bilinear`, `trilinear` through `sample_pixels` (trilinear runs eight pixels
 //! per step in AVX2 lanes, four in the SSE2 baseline); `trilinear_quads`, `span_k3`, `span_k4`
 //! through `sample_quads` (the span sampler runs eight spans per step in AVX2 lanes, four in
-//! SSE2); `*_quad_api` one `sample_quad` call per quad, as the rasteriser calls it.
+//! SSE2); `*_quad_api` one `sample_quad` call per quad, as the rasteriser calls it
+//! (`quadratic3_quad_api`: the quadratic 3x3 sampler on trilinear's levels).
 //! The target of issue #2 compares `span_k3` / `span_k4` with `trilinear` (the best of each).
 //! Instruction counts of the same scene: `crates/texmap-core/examples/sampling_prof.rs`.
 //!
@@ -206,6 +207,7 @@ fn run<M: Measurement>(c: &mut Criterion<M>, group: &str) {
         ("trilinear_quad_api", Sampler::Trilinear),
         ("span_k3_quad_api", Sampler::Span(Banks::K3)),
         ("span_k4_quad_api", Sampler::Span(Banks::K4)),
+        ("quadratic3_quad_api", Sampler::Quadratic3),
     ] {
         g.bench_function(name, |b| {
             b.iter(|| {

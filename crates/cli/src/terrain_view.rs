@@ -28,8 +28,9 @@ pub struct FlightViewArgs {
     /// Image size WIDTHxHEIGHT.
     #[arg(long, default_value = "1024x768")]
     pub size: String,
-    /// nearest, bilinear, trilinear, span3, span4, aniso, or reference: the full-resolution mesh
-    /// ray-traced with the texture integrated over each sample's footprint, --samples² per pixel.
+    /// nearest, bilinear, trilinear, span3, span4, aniso, quadratic3 (quadratic interpolation
+    /// on each level's 3x3 neighbourhood), or reference: the full-resolution mesh ray-traced
+    /// with the texture integrated over each sample's footprint, --samples² per pixel.
     #[arg(long, default_value = "trilinear")]
     pub sampler: String,
     /// Reference samples per pixel axis (--sampler reference).

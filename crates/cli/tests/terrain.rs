@@ -72,7 +72,7 @@ fn build_info_maps_export_and_render() {
     ]));
     assert!(obj.exists() && dir.path().join("area.mtl").exists());
     // A flight view with each sampler family, and its statistics as JSON.
-    for sampler in ["trilinear", "span3"] {
+    for sampler in ["trilinear", "span3", "quadratic3"] {
         let png = dir.path().join(format!("{sampler}.png"));
         let o = texmap(&[
             "terrain",

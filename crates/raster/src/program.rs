@@ -365,7 +365,7 @@ where
 
 /// A texmap-core [`Sampler`] bound to its [`MipTexture`]: the way to texture triangles with
 /// nearest, bilinear, trilinear (Seed 000 Eq. 4), span-parallel (Eq. 8–10, the whole quad is the
-/// span) or anisotropic sampling. Colour is the texture's linear RGB (alpha is dropped).
+/// span), quadratic 3x3 or anisotropic sampling. Colour is the texture's linear RGB (alpha is dropped).
 #[derive(Clone, Copy, Debug)]
 pub struct MipSampler<'a> {
     pub texture: &'a MipTexture,

@@ -31,9 +31,11 @@
 //! trilinear: one per pixel), and the blur that 3x3 banks cost against 4x4 (PSNR difference in
 //! dB, blur measure).
 //!
-//! **Higher-order interpolation from the 3x3 neighbourhood** ([`Quadratic3x3`], study name
-//! `quadratic3`), which the paper suggests but did not test, runs beside the texmap-core samplers
-//! and is compared with trilinear in [`Claims`].
+//! **Higher-order interpolation from the 3x3 neighbourhood** ([`Sampler::Quadratic3`], study
+//! name `quadratic3`: per level, 3-point Lagrange interpolation on the 3x3 texels around the
+//! pixel's nearest texel, on trilinear's levels), which the paper suggests but did not test,
+//! is drawn like every other texmap-core sampler (its quad kernel, so its frame time compares
+//! with trilinear's) and compared with trilinear in [`Claims`].
 //!
 //! [`write_study`] writes `results.csv`, `results.json`, `summary.md` and two charts, each as
 //! SVG and PNG: `error_vs_pitch` and `error_vs_altitude` (PSNR of every sampler against the
@@ -375,75 +377,9 @@ impl QuadSampler for QuadCounter<'_> {
     }
 }
 
-/// Higher-order interpolation from the 3x3 neighbourhood (the paper's suggestion): per level,
-/// separable 3-point Lagrange (quadratic) interpolation on the 3x3 texels around the pixel's
-/// nearest texel, clamped to [0, 1]; levels and their blend as trilinear (Eq. 2's footprint from
-/// the quad's coarse derivatives, Eq. 4's blend of ⌊λ⌋ and ⌊λ⌋ + 1). It reads 9 texels per level
-/// where trilinear reads 4 — one window of 3x3 banks per level and pixel, so it is conflict-free
-/// on the same banks. Scalar code: its frame time is not comparable with the SIMD kernels.
-#[derive(Clone, Copy, Debug)]
-pub struct Quadratic3x3<'a> {
-    pub texture: &'a MipTexture,
-}
-
-/// The name of [`Quadratic3x3`] in the study's sampler lists.
+/// The study name of [`Sampler::Quadratic3`], the higher-order interpolation from the 3x3
+/// neighbourhood that the paper suggests (compared with trilinear in [`Claims`]).
 pub const QUADRATIC_NAME: &str = "quadratic3";
-
-impl Quadratic3x3<'_> {
-    fn level(&self, level: usize, uv: glam::Vec2) -> glam::Vec4 {
-        let tex = self.texture;
-        let l = &tex.levels()[level];
-        let t = glam::Vec2::new(uv.x * l.width_f - 0.5, uv.y * l.height_f - 0.5);
-        let c = t
-            .round()
-            .clamp(glam::Vec2::splat(-1e9), glam::Vec2::splat(1e9));
-        let d = t - c;
-        let w = |d: f32| [0.5 * d * (d - 1.0), 1.0 - d * d, 0.5 * d * (d + 1.0)];
-        let (wx, wy) = (w(d.x), w(d.y));
-        let (cx, cy) = (c.x as i64, c.y as i64);
-        let mut sum = glam::Vec4::ZERO;
-        for (j, wyj) in wy.iter().enumerate() {
-            let mut row = glam::Vec4::ZERO;
-            for (i, wxi) in wx.iter().enumerate() {
-                let texel = tex
-                    .texel(level, cx + i as i64 - 1, cy + j as i64 - 1)
-                    .unwrap_or(glam::Vec4::ZERO);
-                row += texel * *wxi;
-            }
-            sum += row * *wyj;
-        }
-        sum.clamp(glam::Vec4::ZERO, glam::Vec4::ONE)
-    }
-
-    /// One pixel with screen derivatives `dx`, `dy` of its uv.
-    pub fn sample(&self, uv: glam::Vec2, dx: glam::Vec2, dy: glam::Vec2) -> glam::Vec4 {
-        let tex = self.texture;
-        let l0 = &tex.levels()[0];
-        let size = glam::Vec2::new(l0.width_f, l0.height_f);
-        let m = (dx * size).abs().max((dy * size).abs()).max_element();
-        let last = tex.level_count() - 1;
-        // Magnification, a zero or a NaN footprint: level 0 alone.
-        if m.is_nan() || m <= 1.0 {
-            return self.level(0, uv);
-        }
-        let lam = m.log2();
-        let i = lam.floor() as usize;
-        if i >= last {
-            return self.level(last, uv);
-        }
-        let f = lam - i as f32;
-        let a = self.level(i, uv);
-        let b = self.level(i + 1, uv);
-        a + (b - a) * f
-    }
-}
-
-impl QuadSampler for Quadratic3x3<'_> {
-    fn sample_quad(&self, quad: &TexQuad) -> [Vec3; 4] {
-        let (dx, dy) = quad.derivatives();
-        quad.uv.map(|uv| self.sample(uv, dx, dy).truncate())
-    }
-}
 
 /// Rec. 601 luma of an sRGB8 pixel.
 fn luma(c: [u8; 4]) -> f64 {
@@ -502,13 +438,9 @@ fn frame_difference(a: &Frame, b: &Frame) -> f64 {
     if n == 0 { 0.0 } else { s / n as f64 }
 }
 
-/// Every sampler name the study knows: [`view::SAMPLER_NAMES`] and [`QUADRATIC_NAME`].
+/// Every sampler name the study knows: [`view::SAMPLER_NAMES`] (with [`QUADRATIC_NAME`]).
 pub fn study_sampler_names() -> Vec<String> {
-    view::SAMPLER_NAMES
-        .iter()
-        .map(|s| s.to_string())
-        .chain([QUADRATIC_NAME.to_string()])
-        .collect()
+    view::SAMPLER_NAMES.iter().map(|s| s.to_string()).collect()
 }
 
 /// What the study draws and how.
@@ -608,7 +540,7 @@ pub struct Claims {
     pub blur_span3_db: Option<f64>,
     pub blur_span4_db: Option<f64>,
     /// Higher-order interpolation from the 3x3 neighbourhood against trilinear: mean PSNR of
-    /// [`Quadratic3x3`] minus trilinear's (dB), and the views where it is better.
+    /// [`Sampler::Quadratic3`] minus trilinear's (dB), and the views where it is better.
     pub psnr_quadratic_minus_trilinear_db: Option<f64>,
     pub quadratic_better_views: Option<usize>,
 }
@@ -693,8 +625,7 @@ pub fn run_study(
     let mut samplers = Vec::new();
     for name in &opts.samplers {
         let s = match sampler_by_name(name) {
-            Some(s) => Some(s),
-            None if name == QUADRATIC_NAME => None,
+            Some(s) => s,
             None => {
                 return Err(TerrainStudyError::BadOption {
                     what: "sampler",
@@ -767,18 +698,7 @@ pub fn run_study(
         let mut frames = Vec::with_capacity(samplers.len());
         for (name, s) in &samplers {
             let t0 = Instant::now();
-            let f = match s {
-                Some(s) => render_method(terrain, v, *s, opts.pixel_error),
-                None => render_with(
-                    terrain,
-                    v,
-                    &Quadratic3x3 {
-                        texture: terrain.texture(),
-                    },
-                    opts.pixel_error,
-                ),
-            }
-            .map_err(|e| match e {
+            let f = render_method(terrain, v, *s, opts.pixel_error).map_err(|e| match e {
                 TerrainStudyError::View { source, .. } => at(source),
                 e => e,
             })?;
@@ -1474,42 +1394,6 @@ mod tests {
             assert!(html.contains(f) || f.ends_with(".csv") || f.ends_with(".md"));
         }
         assert!(html.contains("<td>span3</td>") && html.contains("Bank conflicts"));
-    }
-
-    /// Quadratic Lagrange interpolation reproduces a quadratic texture exactly under
-    /// magnification (level 0 alone), where bilinear interpolation cannot.
-    #[test]
-    fn quadratic_sampler_is_exact_on_a_quadratic_texture() {
-        let w = 16u32;
-        let f = |x: f32| 0.002 * x * x + 0.01 * x + 0.1;
-        let texels: Vec<glam::Vec4> = (0..w * w)
-            .map(|i| {
-                let v = f((i % w) as f32);
-                glam::Vec4::new(v, v, v, 1.0)
-            })
-            .collect();
-        let tex = MipTexture::from_linear(
-            w,
-            w,
-            &texels,
-            texmap_core::mip::Reduction::Box,
-            texmap_core::mip::Wrap::Clamp,
-        )
-        .unwrap();
-        let q = Quadratic3x3 { texture: &tex };
-        let tiny = glam::Vec2::splat(1e-3);
-        let (mut worst_q, mut worst_bilinear) = (0.0f32, 0.0f32);
-        for k in 0..100 {
-            // Texel-centre coordinate x in [2, 13): away from the clamped edges.
-            let x = 2.0 + 0.11 * k as f32;
-            let uv = glam::Vec2::new((x + 0.5) / w as f32, 0.5);
-            let got = q.sample(uv, tiny, tiny).x;
-            worst_q = worst_q.max((got - f(x)).abs());
-            let b = Sampler::Bilinear.sample(&tex, uv, tiny, tiny).x;
-            worst_bilinear = worst_bilinear.max((b - f(x)).abs());
-        }
-        assert!(worst_q < 1e-5, "quadratic {worst_q}");
-        assert!(worst_bilinear > 1e-4, "bilinear {worst_bilinear}");
     }
 
     #[test]

@@ -22,7 +22,7 @@
 //!   chosen by screen-space error and frustum culling and read from the database under a byte
 //!   budget (the grid mapped, not read), drawn through texmap-raster with any
 //!   texmap-core sampler (nearest, bilinear, trilinear, the span sampler with 3x3 or 4x4 banks,
-//!   anisotropic), per-frame statistics and optional haze.
+//!   quadratic 3x3, anisotropic), per-frame statistics and optional haze.
 //! - [`models`]: textured OBJ models placed on the terrain by georeference and a built-in tree
 //!   billboard, drawn after the terrain with the same samplers and depth-tested against it.
 //! - [`flight`]: flight paths — CSV/JSON path files (a bad line is named), orbits, and the

@@ -20,7 +20,8 @@
 //!    rasteriser bins and shades the whole frame in one parallel pass (one call per chunk would
 //!    pay the tile pass per chunk; the streamed source does that, see below). The texture is one whole-terrain [`MipTexture`] (clamped at
 //!    the edges) sampled by any texmap-core [`Sampler`]: nearest, bilinear, trilinear (Eq. 4),
-//!    span 3x3 / 4x4 (Eq. 8–10, the rasteriser's 2x2 quad is the span) or anisotropic.
+//!    span 3x3 / 4x4 (Eq. 8–10, the rasteriser's 2x2 quad is the span), quadratic 3x3 or
+//!    anisotropic.
 //!
 //! **Haze** ([`apply_haze`], off unless called): a post-pass on the finished frame that blends
 //! each pixel toward a sky colour by Koschmieder's transmittance over its eye distance; a sky
@@ -222,7 +223,8 @@ impl From<RasterError> for ViewError {
 }
 
 /// The sampler names of the command line: `nearest`, `bilinear`, `trilinear`, `span3`, `span4`,
-/// `aniso` (anisotropic, at most 16 taps per side).
+/// `aniso` (anisotropic, at most 16 taps per side), `quadratic3` (quadratic interpolation on
+/// each level's 3x3 neighbourhood, trilinear's levels).
 pub fn sampler_by_name(name: &str) -> Option<Sampler> {
     Some(match name {
         "nearest" => Sampler::Nearest,
@@ -231,18 +233,20 @@ pub fn sampler_by_name(name: &str) -> Option<Sampler> {
         "span3" => Sampler::Span(Banks::K3),
         "span4" => Sampler::Span(Banks::K4),
         "aniso" => Sampler::Anisotropic { max_taps: 16 },
+        "quadratic3" => Sampler::Quadratic3,
         _ => return None,
     })
 }
 
 /// The names [`sampler_by_name`] accepts.
-pub const SAMPLER_NAMES: [&str; 6] = [
+pub const SAMPLER_NAMES: [&str; 7] = [
     "nearest",
     "bilinear",
     "trilinear",
     "span3",
     "span4",
     "aniso",
+    "quadratic3",
 ];
 
 /// An aircraft's view.

@@ -393,6 +393,7 @@ fn every_sampler_draws_the_same_scene() {
         assert!((m - means[2]).abs() < 3.0, "{means:?}");
     }
     assert_eq!(sampler_by_name("span3"), Some(Sampler::Span(Banks::K3)));
+    assert_eq!(sampler_by_name("quadratic3"), Some(Sampler::Quadratic3));
     assert_eq!(sampler_by_name("cubic"), None);
 }
 

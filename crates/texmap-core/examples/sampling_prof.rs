@@ -9,8 +9,8 @@
 //! ```
 //!
 //! Cases: `trilinear` (`sample_pixels`), `trilinear_quads`, `span_k3`, `span_k4`
-//! (`sample_quads`), `trilinear_quad_api`, `span_k3_quad_api`, `span_k4_quad_api` (one
-//! `sample_quad` call per quad). An optional third argument sets the texture side (default 4096).
+//! (`sample_quads`), `trilinear_quad_api`, `span_k3_quad_api`, `span_k4_quad_api`,
+//! `quadratic3_quad_api` (one `sample_quad` call per quad). An optional third argument sets the texture side (default 4096).
 //! Prints the thread CPU time per sample of the best frame to stderr (for quick A/B runs on a
 //! shared machine: time spent waiting for a core is not counted, cache contention is).
 
@@ -126,6 +126,7 @@ fn run_case(
         "trilinear_quad_api" => api(Sampler::Trilinear, qout),
         "span_k3_quad_api" => api(Sampler::Span(Banks::K3), qout),
         "span_k4_quad_api" => api(Sampler::Span(Banks::K4), qout),
+        "quadratic3_quad_api" => api(Sampler::Quadratic3, qout),
         _ => false,
     }
 }

@@ -58,6 +58,94 @@ fn trilinear_f64(t: &MipTexture, uv: Vec2, dx: Vec2, dy: Vec2) -> DVec4 {
     bilinear_f64(t, i, uv) * (1.0 - f) + bilinear_f64(t, i + 1, uv) * f
 }
 
+/// The quadratic 3x3 of one level in f64 from `texel()`: the texel coordinate `u·w − ½` as the
+/// sampler forms it in f32 (the nearest texel is a discontinuity, so it must round the same
+/// value), its nearest texel by `round`, Lagrange weights and sums in f64, clamped to [0, 1].
+fn quadratic_level_f64(t: &MipTexture, level: usize, uv: Vec2) -> DVec4 {
+    let l = t.level(level).unwrap();
+    let x = (uv.x * l.width as f32 - 0.5) as f64;
+    let y = (uv.y * l.height as f32 - 0.5) as f64;
+    let (cx, cy) = (x.round(), y.round());
+    let w = |d: f64| [0.5 * d * (d - 1.0), 1.0 - d * d, 0.5 * d * (d + 1.0)];
+    let (wx, wy) = (w(x - cx), w(y - cy));
+    let mut s = DVec4::ZERO;
+    for (j, wyj) in wy.iter().enumerate() {
+        for (i, wxi) in wx.iter().enumerate() {
+            let texel = t
+                .texel(level, cx as i64 + i as i64 - 1, cy as i64 + j as i64 - 1)
+                .unwrap();
+            s += texel.as_dvec4() * wxi * wyj;
+        }
+    }
+    s.clamp(DVec4::ZERO, DVec4::ONE)
+}
+
+/// [`Sampler::Quadratic3`] in f64: trilinear's levels and blend (Eq. 2, exact log2) over
+/// [`quadratic_level_f64`].
+fn quadratic_f64(t: &MipTexture, uv: Vec2, dx: Vec2, dy: Vec2) -> DVec4 {
+    let (w, h) = (t.width() as f64, t.height() as f64);
+    let m = (dx.x as f64 * w)
+        .abs()
+        .max((dx.y as f64 * h).abs())
+        .max((dy.x as f64 * w).abs())
+        .max((dy.y as f64 * h).abs());
+    let last = t.level_count() - 1;
+    let lam = m.log2();
+    if lam.is_nan() || lam <= 0.0 {
+        return quadratic_level_f64(t, 0, uv);
+    }
+    if lam >= last as f64 {
+        return quadratic_level_f64(t, last, uv);
+    }
+    let i = lam.floor() as usize;
+    let f = lam - i as f64;
+    quadratic_level_f64(t, i, uv) * (1.0 - f) + quadratic_level_f64(t, i + 1, uv) * f
+}
+
+#[test]
+fn quadratic3_matches_an_f64_recomputation() {
+    // Random uv and derivatives, both wrap modes, power-of-two and NPOT pyramids, single pixels
+    // and quads (the quad kernel in lanes).
+    let mut r = Rng(0xF00D);
+    for (w, h, wrap) in [
+        (64, 64, Wrap::Repeat),
+        (64, 64, Wrap::Clamp),
+        (40, 24, Wrap::Repeat),
+        (17, 9, Wrap::Clamp),
+    ] {
+        let t = tex(w, h, wrap, &mut r);
+        let mut worst = 0f64;
+        for _ in 0..20_000 {
+            let uv = Vec2::new(r.f() * 3.0 - 1.0, r.f() * 3.0 - 1.0);
+            let s = 10f32.powf(r.f() * 4.0 - 3.5);
+            let dx = Vec2::new(r.f() - 0.5, r.f() - 0.5) * s;
+            let dy = Vec2::new(r.f() - 0.5, r.f() - 0.5) * s;
+            let got = Sampler::Quadratic3.sample(&t, uv, dx, dy).as_dvec4();
+            let e = quadratic_f64(&t, uv, dx, dy);
+            // As trilinear: the log2's error (≤ 1.2e-4) moves the blend weight, times the
+            // difference of two clamped level values (≤ 1).
+            let d = (got - e).abs().max_element();
+            assert!(
+                d < 2e-4,
+                "quadratic3 {uv} {dx} {dy}: expected {e}, got {got}, tol 2e-4"
+            );
+            worst = worst.max(d);
+            let quad = [uv, uv + dx, uv + dy, uv + dx + dy];
+            let got = Sampler::Quadratic3.sample_quad(&t, quad);
+            for j in 0..4 {
+                let e = quadratic_f64(&t, quad[j], quad[1] - quad[0], quad[2] - quad[0]);
+                let d = (got[j].as_dvec4() - e).abs().max_element();
+                assert!(
+                    d < 2e-4,
+                    "quadratic3 quad {quad:?} pixel {j}: expected {e}, got {}",
+                    got[j]
+                );
+            }
+        }
+        eprintln!("{w}x{h} {wrap:?}: worst quadratic3 difference {worst:e}");
+    }
+}
+
 #[test]
 fn bilinear_and_trilinear_match_an_f64_recomputation() {
     let mut r = Rng(0xBEEF);
@@ -107,6 +195,7 @@ fn a_constant_texture_samples_to_the_constant_everywhere() {
         Sampler::Trilinear,
         Sampler::Span(Banks::K3),
         Sampler::Span(Banks::K4),
+        Sampler::Quadratic3,
         Sampler::Anisotropic { max_taps: 16 },
     ] {
         for _ in 0..2000 {

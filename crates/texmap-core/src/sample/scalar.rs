@@ -1,6 +1,6 @@
-//! The scalar kernels: wrap modes (addressing kernels chosen once per call), the log2 split,
-//! nearest, bilinear, trilinear (Seed 000 Eq. 4) and the anisotropic reference. They are also
-//! the reference the lane kernels are tested against bit for bit.
+//! The scalar kernels: wrap modes (addressing kernels chosen once per call, also on four lanes),
+//! the log2 split, nearest, bilinear, trilinear (Seed 000 Eq. 4) and the anisotropic reference.
+//! They are also the reference the lane kernels are tested against bit for bit.
 
 use super::*;
 // The level-of-detail logarithm and its coefficients (used by the lane kernels too).
@@ -10,6 +10,9 @@ pub(super) trait Addr {
     const REPEAT: bool;
     /// Fold an integer texel address into `0..n`.
     fn wrap(i: i32, n: i32) -> i32;
+    /// [`Addr::wrap`] on four integer-valued lanes (`|i| ≤ 2^30 + 1`) of a level `n` texels
+    /// wide (`inv_n = 1/n`), as floats: the same values.
+    fn wrap_lanes(i: Vec4, n: f32, inv_n: f32) -> Vec4;
 }
 
 /// Repeat on a power-of-two level: a mask.
@@ -25,6 +28,17 @@ impl Addr for RepeatPow2 {
     fn wrap(i: i32, n: i32) -> i32 {
         i & (n - 1)
     }
+    #[inline(always)]
+    fn wrap_lanes(i: Vec4, n: f32, _: f32) -> Vec4 {
+        // The mask on each lane (LLVM keeps the four in one register).
+        let (m, i) = (n as i32 - 1, lanes_i32(i));
+        Vec4::new(
+            (i[0] & m) as f32,
+            (i[1] & m) as f32,
+            (i[2] & m) as f32,
+            (i[3] & m) as f32,
+        )
+    }
 }
 impl Addr for RepeatAny {
     const REPEAT: bool = true;
@@ -32,12 +46,23 @@ impl Addr for RepeatAny {
     fn wrap(i: i32, n: i32) -> i32 {
         i.rem_euclid(n)
     }
+    #[inline(always)]
+    fn wrap_lanes(i: Vec4, n: f32, _: f32) -> Vec4 {
+        // A float quotient is not exact for any n: one lane at a time in integers.
+        let (n, i) = (n as i32, lanes_i32(i));
+        let r = |j: usize| i[j].rem_euclid(n) as f32;
+        Vec4::new(r(0), r(1), r(2), r(3))
+    }
 }
 impl Addr for ClampEdge {
     const REPEAT: bool = false;
     #[inline(always)]
     fn wrap(i: i32, n: i32) -> i32 {
         i.max(0).min(n - 1)
+    }
+    #[inline(always)]
+    fn wrap_lanes(i: Vec4, n: f32, _: f32) -> Vec4 {
+        i.max(Vec4::ZERO).min(Vec4::splat(n - 1.0))
     }
 }
 

@@ -38,6 +38,7 @@ fn nan_and_huge_inputs_give_finite_output() {
             Sampler::Trilinear,
             Sampler::Span(Banks::K3),
             Sampler::Span(Banks::K4),
+            Sampler::Quadratic3,
             Sampler::Anisotropic { max_taps: 8 },
         ] {
             for uv in [
@@ -456,4 +457,177 @@ fn span_fast_path_case(t: &MipTexture) -> u64 {
         interior += st.window_reads - st.edge_windows;
     }
     interior
+}
+
+/// A pyramid of random texels in [0, 1] (the quadratic sampler's clamp then rarely bites).
+fn noise(w: u32, h: u32, wrap: Wrap, seed: u32) -> MipTexture {
+    let mut rng = seed | 1;
+    let mut r = move || {
+        rng ^= rng << 13;
+        rng ^= rng >> 17;
+        rng ^= rng << 5;
+        (rng >> 8) as f32 / (1u32 << 24) as f32
+    };
+    let data: Vec<Vec4> = (0..w * h).map(|_| Vec4::new(r(), r(), r(), 1.0)).collect();
+    MipTexture::from_linear(w, h, &data, Reduction::GammaCorrect, wrap).unwrap()
+}
+
+/// The quadratic 3x3 sampler as the flight study first wrote it (scalar, texels through
+/// [`MipTexture::texel`], which wraps by the texture's mode, `f32::round` for the nearest
+/// texel), with the level pair and blend weight taken from trilinear's `log2_split`.
+fn quadratic_study(tex: &MipTexture, uv: Vec2, dx: Vec2, dy: Vec2) -> Vec4 {
+    let level = |level: usize| {
+        let l = &tex.levels()[level];
+        let t = Vec2::new(uv.x * l.width_f - 0.5, uv.y * l.height_f - 0.5);
+        let c = t.round().clamp(Vec2::splat(-1e9), Vec2::splat(1e9));
+        let d = t - c;
+        let w = |d: f32| [0.5 * d * (d - 1.0), 1.0 - d * d, 0.5 * d * (d + 1.0)];
+        let (wx, wy) = (w(d.x), w(d.y));
+        let (cx, cy) = (c.x as i64, c.y as i64);
+        let mut sum = Vec4::ZERO;
+        for (j, wyj) in wy.iter().enumerate() {
+            let mut row = Vec4::ZERO;
+            for (i, wxi) in wx.iter().enumerate() {
+                let texel = tex
+                    .texel(level, cx + i as i64 - 1, cy + j as i64 - 1)
+                    .unwrap();
+                row += texel * *wxi;
+            }
+            sum += row * *wyj;
+        }
+        sum.clamp(Vec4::ZERO, Vec4::ONE)
+    };
+    let l0 = &tex.levels()[0];
+    let size = Vec2::new(l0.width_f, l0.height_f);
+    let m = (dx * size).abs().max((dy * size).abs()).max_element();
+    let last = tex.level_count() - 1;
+    if m.is_nan() || m <= 1.0 {
+        return level(0);
+    }
+    let (i, f) = log2_split(m);
+    let i = i as usize;
+    if i >= last {
+        return level(last);
+    }
+    let (a, b) = (level(i), level(i + 1));
+    a + (b - a) * f
+}
+
+#[test]
+fn quadratic3_matches_the_study_formulation() {
+    // Random uv and derivatives (finite), both wrap modes, power-of-two and NPOT pyramids: the
+    // sampler against the study's scalar formulation with trilinear's log2; every regime
+    // (magnified, blended pair, past the top) reached.
+    let (mut blended, mut magnified, mut top) = (0, 0, 0);
+    let mut same_bits = 0usize;
+    let mut total = 0usize;
+    for (w, h) in [(64, 64), (64, 16), (48, 20), (17, 9), (1, 8)] {
+        for wrap in [Wrap::Repeat, Wrap::Clamp] {
+            let t = noise(w, h, wrap, w * 7 + h);
+            let (uv, dx, dy) = random_pixels(4000, w * 3 + h);
+            for i in 0..uv.len() {
+                // The study clamped its texel coordinate at ±1e9, the sampler at ±2^30: compare
+                // where neither clamps (NaN and huge inputs are tested elsewhere).
+                if !(uv[i].abs().max_element() < 1e4 && dx[i].is_finite() && dy[i].is_finite()) {
+                    continue;
+                }
+                let got = Sampler::Quadratic3.sample(&t, uv[i], dx[i], dy[i]);
+                let e = quadratic_study(&t, uv[i], dx[i], dy[i]);
+                assert!(
+                    (got - e).abs().max_element() <= 1e-6,
+                    "{w}x{h} {wrap:?} pixel {i}: uv {} dx {} dy {}: expected {e}, got {got}",
+                    uv[i],
+                    dx[i],
+                    dy[i],
+                );
+                same_bits +=
+                    (got.to_array().map(f32::to_bits) == e.to_array().map(f32::to_bits)) as usize;
+                total += 1;
+                let m = footprint(&t.levels()[0], dx[i], dy[i]);
+                if m <= 1.0 {
+                    magnified += 1;
+                } else if log2_split(m).0 as usize >= t.level_count() - 1 {
+                    top += 1;
+                } else {
+                    blended += 1;
+                }
+            }
+        }
+    }
+    assert!(
+        blended > 1000 && magnified > 1000 && top > 1000,
+        "{blended} {magnified} {top}"
+    );
+    assert_eq!(same_bits, total, "bit-identical on {same_bits} of {total}");
+}
+
+#[test]
+fn quadratic3_reproduces_a_quadratic_and_clamps() {
+    // Magnified (level 0 alone): a texture quadratic in x is reproduced exactly between its
+    // edges, where bilinear is not; a texture with a spike overshoots and is clamped to [0, 1].
+    let w = 16u32;
+    let f = |x: f32| 0.002 * x * x + 0.01 * x + 0.1;
+    let data: Vec<Vec4> = (0..w * w).map(|i| Vec4::splat(f((i % w) as f32))).collect();
+    let t = MipTexture::from_linear(w, w, &data, Reduction::Box, Wrap::Clamp).unwrap();
+    let tiny = Vec2::splat(1e-3);
+    let (mut worst_q, mut worst_b) = (0f32, 0f32);
+    for k in 0..100 {
+        let x = 2.0 + 0.11 * k as f32;
+        let uv = Vec2::new((x + 0.5) / w as f32, 0.5);
+        let q = Sampler::Quadratic3.sample(&t, uv, tiny, tiny).x;
+        worst_q = worst_q.max((q - f(x)).abs());
+        let b = Sampler::Bilinear.sample(&t, uv, tiny, tiny).x;
+        worst_b = worst_b.max((b - f(x)).abs());
+    }
+    assert!(worst_q < 1e-5, "quadratic {worst_q}");
+    assert!(worst_b > 1e-4, "bilinear {worst_b}");
+    // A single bright texel among zeros: the negative lobes next to it would go below 0.
+    let mut data = vec![Vec4::ZERO; 64];
+    data[3 * 8 + 3] = Vec4::ONE;
+    let t = MipTexture::from_linear(8, 8, &data, Reduction::Box, Wrap::Repeat).unwrap();
+    // Nearest texel (4, 3), 0.3 texels right of it: the x weight of texel 3 is ½d(d − 1) < 0.
+    let uv = Vec2::new((4.3 + 0.5) / 8.0, 3.5 / 8.0);
+    let got = Sampler::Quadratic3.sample(&t, uv, Vec2::ZERO, Vec2::ZERO);
+    assert_eq!(got, Vec4::ZERO, "clamped at 0");
+    // 0.3 texels left of the bright texel's centre: its weights are 1 − d² along x, 1 along y.
+    let uv = Vec2::new((2.7 + 0.5) / 8.0, 3.5 / 8.0);
+    let got = Sampler::Quadratic3.sample(&t, uv, Vec2::ZERO, Vec2::ZERO).x;
+    let d: f32 = 2.7 - 3.0;
+    assert!((got - (1.0 - d * d)).abs() < 1e-6, "{got}");
+}
+
+#[test]
+fn quadratic3_quad_lanes_match_per_pixel_sampling_bit_for_bit() {
+    // `sample_quad` and `sample_quads` (the quad kernel in lanes) against four `sample` calls
+    // with the quad's coarse derivatives: every regime of `random_quads`, interior and wrapped
+    // neighbourhoods, power-of-two and NPOT pyramids, both wrap modes.
+    let mut blended = 0;
+    for (w, h) in [(64, 64), (64, 16), (16, 128), (48, 20), (1, 8), (2, 2)] {
+        for wrap in [Wrap::Repeat, Wrap::Clamp] {
+            let t = noise(w, h, wrap, w + 5 * h);
+            let quads = random_quads(3001, w * 11 + h);
+            let mut bulk = vec![[Vec4::ZERO; 4]; quads.len()];
+            Sampler::Quadratic3
+                .sample_quads(&t, &quads, &mut bulk)
+                .unwrap();
+            for (i, q) in quads.iter().enumerate() {
+                let got = Sampler::Quadratic3.sample_quad(&t, *q);
+                let (dx, dy) = (q[1] - q[0], q[2] - q[0]);
+                for j in 0..4 {
+                    let e = Sampler::Quadratic3.sample(&t, q[j], dx, dy);
+                    assert!(e.is_finite(), "{w}x{h} {wrap:?} quad {i}: {e}");
+                    for (what, g) in [("sample_quad", got[j]), ("sample_quads", bulk[i][j])] {
+                        assert_eq!(
+                            g.to_array().map(f32::to_bits),
+                            e.to_array().map(f32::to_bits),
+                            "{what} {w}x{h} {wrap:?} quad {i} {q:?} pixel {j}: expected {e}, got {g}",
+                        );
+                    }
+                }
+                let m = footprint(&t.levels()[0], dx, dy);
+                blended += (m > 1.0 && m.log2() < (t.level_count() - 1) as f32) as usize;
+            }
+        }
+    }
+    assert!(blended > 1000, "{blended} quads blended two levels");
 }
