@@ -703,6 +703,7 @@ fn demo(out: &Path, steps: usize, every: usize, size: &str) -> Result<()> {
         samples: 2,
         timed_frames: 3,
         map_size: 128,
+        ..Default::default()
     };
     let sp = spinner("environment-mapping study");
     let env_records = texmap_study::envmap::run(&env_opts)?;

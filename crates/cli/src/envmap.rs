@@ -31,7 +31,8 @@ pub struct EnvmapArgs {
 
 #[derive(Subcommand, Debug)]
 pub enum EnvmapCmd {
-    /// Every method against the reference ray tracer: envmap.csv, envmap.json and SVG charts.
+    /// Every method against the reference ray tracer, and time-sliced cube maps on the moving
+    /// scene (error against update cost): envmap.csv, envmap.json and SVG/PNG charts.
     Compare {
         /// Output directory.
         #[arg(long)]
@@ -42,6 +43,14 @@ pub enum EnvmapCmd {
         /// Reference samples per pixel axis (n x n per pixel).
         #[arg(long, default_value_t = 3)]
         samples: u32,
+        /// Frames of the time-sliced cube study (0 leaves it out): the moving tunnel rendered
+        /// with 1, 2, 3 and 6 cube faces redrawn per frame, each frame against the reference.
+        #[arg(long, default_value_t = texmap_study::envmap::STALENESS_FRAMES)]
+        staleness_frames: u32,
+        /// Scene seconds between the time-sliced study's frames: the faster the objects move
+        /// per frame, the larger the error of faces drawn a few frames earlier.
+        #[arg(long, value_name = "SECONDS", default_value_t = texmap_study::envmap::STALENESS_DT)]
+        staleness_dt: f32,
     },
 }
 
@@ -99,6 +108,15 @@ pub struct EnvRenderArgs {
         allow_negative_numbers = true
     )]
     pub min_distance: f32,
+    /// Cube and cube-box: cube faces redrawn per frame, 1-6. A dynamic cube map is six renders
+    /// of the scene every frame; with N < 6 the map is kept between frames and only N faces are
+    /// redrawn, round robin (all six on the first frame), so the map update costs about N/6 of
+    /// a full one. The price: a face shows moving objects where they were up to ⌈6/N⌉ − 1
+    /// frames ago (reflections lag and tear at face edges). Engines spread a probe over 6-16
+    /// frames. 6 redraws every face every frame; only animations (--frames > 1) see a
+    /// difference, and the other methods ignore it.
+    #[arg(long, value_name = "N", default_value_t = 6)]
+    pub faces_per_frame: u32,
     /// Background where nothing is drawn: `environment` (the environment image or sky), or
     /// R,G,B (0-255). The target still reflects the environment.
     #[arg(long, default_value = "environment")]
@@ -133,17 +151,31 @@ pub enum EnvRimArg {
 
 pub fn run(a: EnvmapArgs) -> Result<()> {
     match a.cmd {
-        Some(EnvmapCmd::Compare { out, size, samples }) => compare(&out, &size, samples),
+        Some(EnvmapCmd::Compare {
+            out,
+            size,
+            samples,
+            staleness_frames,
+            staleness_dt,
+        }) => compare(&out, &size, samples, staleness_frames, staleness_dt),
         None => render(&a.render),
     }
 }
 
-fn compare(out: &Path, size: &str, samples: u32) -> Result<()> {
+fn compare(
+    out: &Path,
+    size: &str,
+    samples: u32,
+    staleness_frames: u32,
+    staleness_dt: f32,
+) -> Result<()> {
     let (width, height) = parse_size(size)?;
     let opts = texmap_study::envmap::EnvStudyOptions {
         width,
         height,
         samples,
+        staleness_frames,
+        staleness_dt,
         ..Default::default()
     };
     let pb = crate::commands::spinner("envmap study: rendering every method and the reference");
@@ -154,6 +186,12 @@ fn compare(out: &Path, size: &str, samples: u32) -> Result<()> {
         println!(
             "{:22} PSNR {:6.2} dB (env only {:6.2})  update {:8.2} ms  draw {:8.2} ms",
             r.method, r.psnr_db, r.psnr_env_only_db, r.update_ms, r.draw_ms
+        );
+    }
+    for r in records.iter().filter(|r| r.study == "staleness") {
+        println!(
+            "{:10} {} face(s)/frame  PSNR {:6.2} dB (vs every face redrawn {:6.2})  update {:6.2} ms/frame",
+            r.method, r.faces_per_frame, r.psnr_db, r.psnr_vs_full_update_db, r.update_ms
         );
     }
     for f in files {
@@ -298,6 +336,12 @@ fn render(a: &EnvRenderArgs) -> Result<()> {
             texmap_envmap::MAX_MAP_SIZE
         ));
     }
+    if !(1..=6).contains(&a.faces_per_frame) {
+        return usage(format!(
+            "--faces-per-frame {}: expected 1..=6 cube faces redrawn per frame",
+            a.faces_per_frame
+        ));
+    }
     if !(1..=100_000).contains(&a.frames) {
         return usage(format!("--frames {}: expected 1..=100000", a.frames));
     }
@@ -328,6 +372,8 @@ fn render(a: &EnvRenderArgs) -> Result<()> {
     let env = a.env.as_deref().map(load_environment).transpose()?;
     let mut sink = Sink::new(&a.out, a.frames, a.fps, false)?;
     let pb = crate::commands::progress(a.frames as u64, "envmap");
+    // One renderer for every frame: it keeps the maps (a time-sliced cube map redraws only
+    // --faces-per-frame faces of the kept one) and recycles the frame buffers.
     let mut renderer = Renderer::new();
     for f in 0..a.frames {
         let t = f as f32 / 24.0;
@@ -362,6 +408,7 @@ fn render(a: &EnvRenderArgs) -> Result<()> {
                     EnvRimArg::Naive => RimPolicy::Naive,
                 };
                 o.min_object_distance = a.min_distance;
+                o.cube_faces_per_frame = a.faces_per_frame;
                 if let Some(c) = background {
                     o.show_environment = false;
                     o.background = c;

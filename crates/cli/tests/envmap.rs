@@ -101,6 +101,44 @@ fn an_animation_goes_into_a_movie() {
 }
 
 #[test]
+fn faces_per_frame_slices_the_cube_map_of_one_renderer_across_frames() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // Three frames of the animation, PNG bytes per frame, for a given --faces-per-frame.
+    let run = |name: &str, extra: &[&str]| -> Vec<Vec<u8>> {
+        let pat = d.join(format!("{name}_%04d.png"));
+        let mut args = vec![
+            "envmap",
+            "--method",
+            "cube",
+            "--size",
+            "96x72",
+            "--map-size",
+            "64",
+            "--frames",
+            "3",
+            "-q",
+            "-o",
+            pat.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        let o = texmap(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        (0..3)
+            .map(|i| std::fs::read(d.join(format!("{name}_{i:04}.png"))).unwrap())
+            .collect()
+    };
+    let every = run("six", &[]);
+    assert_eq!(run("six_explicit", &["--faces-per-frame", "6"]), every);
+    let one = run("one", &["--faces-per-frame", "1"]);
+    // The first frame draws the whole map; the next ones keep the renderer's map and redraw one
+    // face, so the moving objects' reflections differ from the full update's.
+    assert_eq!(one[0], every[0]);
+    assert_ne!(one[1], every[1]);
+    assert_ne!(one[2], every[2]);
+}
+
+#[test]
 fn bad_values_are_usage_errors() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("x.png");
@@ -111,6 +149,8 @@ fn bad_values_are_usage_errors() {
         ("--background", "1,2"),
         ("--background", "transparent"),
         ("--reference-samples", "0"),
+        ("--faces-per-frame", "0"),
+        ("--faces-per-frame", "7"),
         ("--fps", "0"),
     ] {
         let mut args = vec!["envmap", "--size", "32x32", "-o", out, flag, value];

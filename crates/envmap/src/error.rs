@@ -36,6 +36,8 @@ pub enum EnvMapError {
     },
     /// A map side outside `MIN_MAP_SIZE..=MAX_MAP_SIZE`.
     MapSize { size: u32 },
+    /// `Options::cube_faces_per_frame` outside 1..=6.
+    FacesPerFrame { faces: u32 },
     /// A render option is out of range.
     BadOption { what: &'static str },
     /// The camera could not be built (e.g. a face camera for a degenerate probe).
@@ -95,6 +97,11 @@ impl std::fmt::Display for EnvMapError {
                 "map size {size} is out of range: expected {}..={}",
                 crate::MIN_MAP_SIZE,
                 crate::MAX_MAP_SIZE
+            ),
+            EnvMapError::FacesPerFrame { faces } => write!(
+                f,
+                "cube faces per frame {faces} is out of range: expected 1..=6 (6 redraws the \
+                 whole cube map every frame, fewer spread it over several frames)"
             ),
             EnvMapError::BadOption { what } => write!(f, "bad render option: {what}"),
             EnvMapError::Camera(e) => write!(f, "camera: {e}"),

@@ -8,8 +8,8 @@
 //! | `SphereStatic` | sphere map of the environment alone, in the camera's frame | rebuilt only when the camera turns |
 //! | `SphereStaticVertex` | the same, coordinates per vertex and interpolated (the 1998 way) | idem |
 //! | `SphereDynamic` | Seed 003: objects mapped straight into sphere-map space | every frame |
-//! | `Cube` | six faces drawn by six cameras | every frame |
-//! | `CubeBox` | the same cube map, looked up box-projected (parallax-corrected) | every frame |
+//! | `Cube` | six faces drawn by six cameras | every frame, or N faces per frame (time-sliced) |
+//! | `CubeBox` | the same cube map, looked up box-projected (parallax-corrected) | idem |
 //! | `Paraboloid` | two paraboloids, objects mapped like the sphere map | every frame |
 //!
 //! - [`address`]: direction ⇄ map coordinates for the three layouts, both ways;

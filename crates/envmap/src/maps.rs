@@ -34,7 +34,10 @@
 //!   vertex-coloured soup, each triangle tagged with the faces whose frustum pyramid it may
 //!   touch (4-bit outcodes per face), and each face draws only its own triangles, with their own
 //!   vertices, in one call. Submitting every object to every face instead left the rasteriser
-//!   projecting and clipping six times the geometry.
+//!   projecting and clipping six times the geometry. [`update_cube_faces`] draws a subset of the
+//!   faces (a time-sliced update): triangles on none of them are not flattened (their outcodes
+//!   are still computed), and the other faces are moved from the previous map with their
+//!   pyramids, untouched.
 //! - **Sphere map** (Seed 003) and **dual paraboloid**: no camera can produce them, so the
 //!   objects' triangles are *mapped*: every vertex goes to its map point
 //!   (`d = normalize(v − centre)` through [`sphere_uv`] or [`paraboloid_point`]) and the
@@ -483,20 +486,33 @@ fn select<'s>(o: &'s Object, p: &UpdateParams, filtered: &'s mut Vec<[u32; 3]>) 
     filtered
 }
 
+/// Every face of a map of `kind` as a face mask (bit `i` is `faces()[i]`).
+pub fn all_faces(kind: MapKind) -> u8 {
+    ((1u16 << face_count(kind)) - 1) as u8
+}
+
 /// Merge the rasterised faces with the environment fill and build the pyramids (the faces are
 /// drawn one after another into the scratch framebuffer; their pyramids are built in parallel).
+/// Only the faces in `faces` are drawn; the others are moved, texels and pyramid, from
+/// `previous` (which the caller has checked is a map of the same layout, size, frame and centre).
 fn finish_faces(
     kind: MapKind,
     p: &UpdateParams,
     scratch: &mut MapScratch,
+    faces: u8,
+    previous: Option<EnvMap>,
     draw: &mut dyn FnMut(usize, &mut MapScratch) -> Result<(), EnvMapError>,
 ) -> Result<EnvMap, EnvMapError> {
     let side = tex_side(kind, p.size);
     let count = face_count(kind);
+    let drawn = |face: usize| faces & (1 << face) != 0;
     scratch.env_texels(kind, p.frame, p.size, p.environment);
     let mut texels = std::mem::take(&mut scratch.texels);
     texels.resize_with(count, Vec::new);
     for (face, texels) in texels.iter_mut().enumerate() {
+        if !drawn(face) {
+            continue;
+        }
         draw(face, scratch)?;
         let fb = scratch.fb.as_ref().expect("drawn");
         let env = &scratch.env_cache.as_ref().expect("filled").3[face];
@@ -521,17 +537,28 @@ fn finish_faces(
             fill_outside_disc(side, texels);
         }
     }
-    let faces = texels
+    let built = texels
         .par_iter()
-        .map(|t| pyramid(side, t))
+        .enumerate()
+        .map(|(face, t)| drawn(face).then(|| pyramid(side, t)).transpose())
         .collect::<Result<Vec<_>, _>>();
     scratch.texels = texels;
+    let mut kept = previous.map(|m| m.faces).unwrap_or_default().into_iter();
+    let faces = built?
+        .into_iter()
+        .map(|b| {
+            let old = kept.next();
+            b.or(old).ok_or(EnvMapError::BadOption {
+                what: "a partial map update needs the previous map",
+            })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
     Ok(EnvMap {
         kind,
         frame: p.frame,
         centre: p.centre,
         size: p.size,
-        faces: faces?,
+        faces,
     })
 }
 
@@ -574,7 +601,46 @@ fn flat_colour(p: &UpdateParams, o: &Object, w: [Vec3; 3]) -> Option<Vec3> {
 /// outcodes per vertex). Submitting every object to every face instead (the rasteriser clips
 /// what lies outside) spent most of the update in clipping and per-draw set-up.
 pub fn update_cube(p: &UpdateParams, scratch: &mut MapScratch) -> Result<EnvMap, EnvMapError> {
+    update_cube_faces(p, scratch, all_faces(MapKind::Cube), None)
+}
+
+/// A time-sliced cube update: only the faces in the mask `faces` (bit `i` is
+/// [`Face::ALL`]`[i]`) are drawn, as [`update_cube`] draws them; the others are moved from
+/// `previous`, level-0 texels and pyramid alike, untouched. Triangles that fall on no drawn face
+/// are not flattened. With every face in the mask, `previous` is ignored and the result is
+/// [`update_cube`]'s.
+///
+/// Errors: bits beyond the six faces; a partial mask without a `previous` cube map of the same
+/// size, frame and centre (its faces would be of another map).
+pub fn update_cube_faces(
+    p: &UpdateParams,
+    scratch: &mut MapScratch,
+    faces: u8,
+    previous: Option<EnvMap>,
+) -> Result<EnvMap, EnvMapError> {
     check_size(p.size)?;
+    let all = all_faces(MapKind::Cube);
+    if faces & !all != 0 {
+        return Err(EnvMapError::BadOption {
+            what: "a cube face mask has six bits",
+        });
+    }
+    let previous = if faces == all {
+        None
+    } else {
+        let same = previous.as_ref().is_some_and(|m| {
+            m.kind == MapKind::Cube
+                && m.size == p.size
+                && m.frame == p.frame
+                && m.centre == p.centre
+        });
+        if !same {
+            return Err(EnvMapError::BadOption {
+                what: "a partial cube update needs the previous cube map of the same size, frame and centre",
+            });
+        }
+        previous
+    };
     let side = tex_side(MapKind::Cube, p.size);
     let fov = 2.0 * (side as f32 / p.size as f32).atan().to_degrees();
     let tan_half = side as f32 / p.size as f32;
@@ -609,9 +675,10 @@ pub fn update_cube(p: &UpdateParams, scratch: &mut MapScratch) -> Result<EnvMap,
         }
         code
     };
+    // Faces not drawn are masked out: their triangles are neither flattened nor drawn.
     let face_mask = |w: &[Vec3; 3]| {
         let out = vertex_code(w[0]) & vertex_code(w[1]) & vertex_code(w[2]);
-        (0..6).fold(0u8, |m, k| m | ((((out >> (4 * k)) & 0xf) == 0) as u8) << k)
+        (0..6).fold(0u8, |m, k| m | ((((out >> (4 * k)) & 0xf) == 0) as u8) << k) & faces
     };
     let mut flat = std::mem::take(&mut scratch.flat);
     flat.clear();
@@ -647,7 +714,7 @@ pub fn update_cube(p: &UpdateParams, scratch: &mut MapScratch) -> Result<EnvMap,
         }
         s.draw_pieces(side, &cam, &state)
     };
-    let result = finish_faces(MapKind::Cube, p, scratch, &mut draw);
+    let result = finish_faces(MapKind::Cube, p, scratch, faces, previous, &mut draw);
     scratch.flat = flat;
     result
 }
@@ -897,7 +964,7 @@ fn update_projected(
             .extend((0..pieces).map(|k| [3 * k, 3 * k + 1, 3 * k + 2]));
         s.draw_pieces(n, &cam, &state)
     };
-    finish_faces(kind, p, scratch, &mut draw)
+    finish_faces(kind, p, scratch, all_faces(kind), None, &mut draw)
 }
 
 /// Dynamic sphere map (Seed 003): the objects' triangles mapped straight into sphere-map space.

@@ -4,7 +4,9 @@
 //! # A frame
 //! 1. **Map update** ([`Output::update_ms`]): per [`Method`], a static map rebuilt only when its
 //!    inputs change, or a dynamic map drawn from the objects ([`crate::maps`]). Maps are made at
-//!    the target's centre.
+//!    the target's centre. A cube map may be time-sliced ([`Options::cube_faces_per_frame`]):
+//!    N of its six faces redrawn per frame, round robin, the others kept from earlier frames
+//!    ([`Output::faces_updated`] says which were redrawn).
 //! 2. **Drawing** ([`Output::draw_ms`]): the objects flat-lit by texmap-raster, then the target,
 //!    then (optionally) the environment where nothing was drawn — last, so that early depth
 //!    rejection skips every covered pixel (drawn first, the per-pixel sky cost about a third of a
@@ -139,6 +141,13 @@ pub struct Options {
     /// Segments of the tessellated sphere for `SphereStaticVertex` on a sphere target (rings are
     /// half as many).
     pub vertex_segments: u32,
+    /// `Cube` and `CubeBox`: cube faces redrawn per frame, 1..=6 (6, the default: the whole map
+    /// every frame). With fewer, the [`Renderer`] keeps its cube map and redraws N faces per
+    /// frame, round robin in [`Face::ALL`](crate::address::Face::ALL) order, the others kept as
+    /// they are (texels and pyramids): the update costs about N/6 of a full one, and a face may
+    /// show the objects as they were up to ⌈6/N⌉ − 1 frames earlier (see [`Renderer::render`]).
+    /// The other methods ignore it.
+    pub cube_faces_per_frame: u32,
 }
 
 impl Options {
@@ -153,6 +162,7 @@ impl Options {
             show_environment: true,
             background: [0, 0, 0, 255],
             vertex_segments: 32,
+            cube_faces_per_frame: 6,
         }
     }
 
@@ -165,6 +175,11 @@ impl Options {
         if !(self.min_object_distance.is_finite() && self.min_object_distance >= 0.0) {
             return Err(EnvMapError::BadOption {
                 what: "min_object_distance must be finite and ≥ 0",
+            });
+        }
+        if !(1..=6).contains(&self.cube_faces_per_frame) {
+            return Err(EnvMapError::FacesPerFrame {
+                faces: self.cube_faces_per_frame,
             });
         }
         if !(3..=4096).contains(&self.vertex_segments) {
@@ -186,6 +201,10 @@ pub struct Output {
     pub draw_ms: f64,
     /// Pieces of mapped triangles dropped at the singular direction (projected maps).
     pub dropped_pieces: usize,
+    /// The map's faces redrawn this frame: bit `i` is [`EnvMap::faces`]`()[i]` (on a cube map,
+    /// [`Face::ALL`](crate::address::Face::ALL)`[i]`). Every face of a dynamic map, N of the six
+    /// on a time-sliced cube frame, 0 when a cached static map was reused.
+    pub faces_updated: u8,
 }
 
 /// Holds framebuffers, the map and cached static maps across frames (create once, render many).
@@ -196,6 +215,10 @@ pub struct Renderer {
     scratch: MapScratch,
     static_map: Option<(MapKind, u32, MapFrame, Vec3, EnvMap)>,
     map: Option<EnvMap>,
+    /// The `min_object_distance` the kept map was drawn with.
+    map_min_distance: f32,
+    /// Time-sliced cube maps: the face the next partial update starts at.
+    next_face: usize,
     /// A frame handed back by [`Renderer::recycle`], resolved into by the next render.
     spare: Option<Frame>,
 }
@@ -369,6 +392,14 @@ impl Renderer {
 
     /// Render one frame (see the module docs). Errors: options out of range, or the rasteriser
     /// refusing a draw (never for scene data, which [`EnvScene::new`] validated).
+    ///
+    /// With [`Options::cube_faces_per_frame`] N < 6, the cube map of the last frame is kept and
+    /// N of its faces are redrawn, continuing round robin from the last frame's. It is redrawn
+    /// whole (and the round robin starts again at face 0) on the first frame, and whenever the
+    /// kept map is not a cube map of this frame's map size, probe centre and
+    /// `min_object_distance` (another method in between, a resized map, a moved target). Other
+    /// changes of the scene — moving objects, another environment — reach a face when it is next
+    /// redrawn: that is the trade.
     pub fn render(
         &mut self,
         scene: &EnvScene,
@@ -377,7 +408,7 @@ impl Renderer {
     ) -> Result<Output, EnvMapError> {
         opts.validate()?;
         let t0 = Instant::now();
-        let map = self.update_map(scene, cam, opts)?;
+        let (map, faces_updated) = self.update_map(scene, cam, opts)?;
         let update_ms = t0.elapsed().as_secs_f64() * 1e3;
         let t1 = Instant::now();
         let frame = self.draw(scene, cam, opts, &map)?;
@@ -388,15 +419,17 @@ impl Renderer {
             update_ms,
             draw_ms,
             dropped_pieces: self.scratch.dropped_pieces,
+            faces_updated,
         })
     }
 
+    /// The frame's map and the mask of its faces redrawn.
     fn update_map(
         &mut self,
         scene: &EnvScene,
         cam: &Camera,
         opts: &Options,
-    ) -> Result<EnvMap, EnvMapError> {
+    ) -> Result<(EnvMap, u8), EnvMapError> {
         let kind = opts.method.map_kind();
         let frame = match kind {
             MapKind::Sphere => MapFrame::of_camera(cam),
@@ -411,12 +444,12 @@ impl Renderer {
                 && *f == frame
                 && *c == centre
             {
-                return Ok(m.clone());
+                return Ok((m.clone(), 0));
             }
             let m =
                 EnvMap::from_environment(kind, scene.environment(), frame, centre, opts.map_size)?;
             self.static_map = Some((kind, opts.map_size, frame, centre, m.clone()));
-            return Ok(m);
+            return Ok((m, maps::all_faces(kind)));
         }
         let p = UpdateParams {
             objects: scene.objects(),
@@ -428,11 +461,36 @@ impl Renderer {
             min_distance: opts.min_object_distance,
             rim: opts.rim,
         };
-        match kind {
-            MapKind::Sphere => maps::update_sphere(&p, &mut self.scratch),
-            MapKind::Cube => maps::update_cube(&p, &mut self.scratch),
-            MapKind::Paraboloid => maps::update_paraboloid(&p, &mut self.scratch),
-        }
+        let all = maps::all_faces(kind);
+        let map = match kind {
+            MapKind::Sphere => (maps::update_sphere(&p, &mut self.scratch)?, all),
+            MapKind::Cube => {
+                let n = opts.cube_faces_per_frame as usize;
+                let kept = self.map.take().filter(|m| {
+                    m.kind() == MapKind::Cube
+                        && m.size() == opts.map_size
+                        && m.frame() == frame
+                        && m.centre() == centre
+                        && self.map_min_distance == opts.min_object_distance
+                });
+                let faces = match kept {
+                    Some(_) if n < 6 => {
+                        (0..n).fold(0u8, |m, k| m | 1 << ((self.next_face + k) % 6))
+                    }
+                    _ => all,
+                };
+                let map = maps::update_cube_faces(&p, &mut self.scratch, faces, kept)?;
+                self.next_face = if faces == all {
+                    0
+                } else {
+                    (self.next_face + n) % 6
+                };
+                (map, faces)
+            }
+            MapKind::Paraboloid => (maps::update_paraboloid(&p, &mut self.scratch)?, all),
+        };
+        self.map_min_distance = opts.min_object_distance;
+        Ok(map)
     }
 
     fn draw(

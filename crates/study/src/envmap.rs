@@ -13,12 +13,19 @@
 //!   "exact only at the centre".
 //! - **resolution**: the tunnel at map sides 32–512.
 //! - **refraction**: a glass sphere (ior 1.5 and 1.05) in the tunnel.
+//! - **staleness**: time-sliced cube maps ([`Options::cube_faces_per_frame`] N of 1, 2, 3, 6) on
+//!   the moving tunnel: [`EnvStudyOptions::staleness_frames`] frames
+//!   [`EnvStudyOptions::staleness_dt`] apart in scene time, one [`Renderer`] across them, each
+//!   frame against the reference at its own time. PSNR pooled over the frames after the first
+//!   (which draws the whole map for every N), against the reference and against the same method
+//!   redrawing every face (the stale faces' error alone), and the mean update time per frame:
+//!   the update cost traded for the error. `staleness_frames` holds the per-frame figures.
 //!
 //! The reference traces the target analytically (mirror, or refraction without Fresnel: what the
 //! maps compute), objects flat-shaded with the same materials and lighting, escaped rays and
-//! primary misses looking up the same [`Environment`], `n × n` samples per pixel. Target pixels
-//! are those where the traced depth with the target alone equals the depth with everything.
-//! PSNR is over sRGB8 RGB of those pixels.
+//! primary misses looking up the same [`Environment`](texmap_envmap::Environment), `n × n`
+//! samples per pixel. Target pixels are those where the traced depth with the target alone
+//! equals the depth with everything. PSNR is over sRGB8 RGB of those pixels.
 //!
 //! Timings come from this harness (wall clock, median of a few frames, shared machine): the
 //! criterion bench `benches/envmap.rs` is the figure to quote.
@@ -100,11 +107,13 @@ impl From<SceneError> for EnvStudyError {
 /// One measurement: a method at one point of one study.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct EnvRecord {
-    /// `methods`, `angle`, `distance`, `resolution` or `refraction`.
+    /// `methods`, `angle`, `distance`, `resolution`, `refraction`, `staleness` or
+    /// `staleness_frames`.
     pub study: String,
     pub method: String,
     /// The swept value: incidence angle (degrees, bin centre), distance (target radii), map
-    /// side (texels), ior; 0 for `methods`.
+    /// side (texels), ior, cube faces redrawn per frame (`staleness`), frame index
+    /// scene time of the frame (`staleness_frames`, seconds); 0 for `methods`.
     pub x: f64,
     /// PSNR (dB) over the target's pixels (or the bin's) against the full reference.
     pub psnr_db: f64,
@@ -112,11 +121,18 @@ pub struct EnvRecord {
     pub psnr_env_only_db: f64,
     /// Mean absolute error, sRGB8 codes averaged over RGB.
     pub mean_abs_err: f64,
-    /// Median wall time of the map update and of drawing (ms; 0 outside `methods`).
+    /// Median wall time of the map update and of drawing (ms; 0 outside `methods`); for
+    /// `staleness` the mean per frame, for `staleness_frames` the frame's.
     pub update_ms: f64,
     pub draw_ms: f64,
     /// Pixels measured.
     pub pixels: usize,
+    /// Cube faces redrawn per frame ([`Options::cube_faces_per_frame`]): the default 6 outside
+    /// the staleness studies.
+    pub faces_per_frame: u32,
+    /// Staleness studies only: PSNR against the same method redrawing every face every frame,
+    /// the stale faces' own error (infinite for N = 6; NaN elsewhere).
+    pub psnr_vs_full_update_db: f64,
 }
 
 /// Study size.
@@ -128,8 +144,12 @@ pub struct EnvStudyOptions {
     pub samples: u32,
     /// Frames timed per method (median).
     pub timed_frames: u32,
-    /// Map side of the `methods`, `angle`, `distance` and `refraction` studies.
+    /// Map side of the `methods`, `angle`, `distance`, `refraction` and `staleness` studies.
     pub map_size: u32,
+    /// Frames of the staleness study (0 leaves it out).
+    pub staleness_frames: u32,
+    /// Scene time between two frames of the staleness study (seconds).
+    pub staleness_dt: f32,
 }
 
 impl Default for EnvStudyOptions {
@@ -140,9 +160,18 @@ impl Default for EnvStudyOptions {
             samples: 3,
             timed_frames: 5,
             map_size: 256,
+            staleness_frames: STALENESS_FRAMES,
+            staleness_dt: STALENESS_DT,
         }
     }
 }
+
+/// Default frames of the staleness study: two rounds of one face per frame after the first.
+pub const STALENESS_FRAMES: u32 = 13;
+/// Default scene time between the staleness study's frames (s): a 30 Hz animation.
+pub const STALENESS_DT: f32 = 1.0 / 30.0;
+/// Faces per frame of the staleness study.
+pub const STALENESS_FACES: [u32; 4] = [1, 2, 3, 6];
 
 /// The reference frame (see the module docs); `with_objects = false` traces the target alone.
 pub fn reference(
@@ -321,6 +350,12 @@ pub fn run(opts: &EnvStudyOptions) -> Result<Vec<EnvRecord>, EnvStudyError> {
             what: "samples must be in 1..=8 and timed_frames in 1..=100",
         });
     }
+    if opts.staleness_frames > 1000 || !(opts.staleness_dt.is_finite() && opts.staleness_dt >= 0.0)
+    {
+        return Err(EnvStudyError::BadOption {
+            what: "staleness_frames must be in 0..=1000 and staleness_dt finite and ≥ 0",
+        });
+    }
     let mut out = Vec::new();
     let rec = |study: &str, method: Method, x: f64| EnvRecord {
         study: study.into(),
@@ -332,6 +367,8 @@ pub fn run(opts: &EnvStudyOptions) -> Result<Vec<EnvRecord>, EnvStudyError> {
         update_ms: 0.0,
         draw_ms: 0.0,
         pixels: 0,
+        faces_per_frame: 6,
+        psnr_vs_full_update_db: f64::NAN,
     };
     let scene = tunnel_scene(TunnelParams::default())?;
     let cam = tunnel_camera(opts.width, opts.height)?;
@@ -466,17 +503,104 @@ pub fn run(opts: &EnvStudyOptions) -> Result<Vec<EnvRecord>, EnvStudyError> {
             });
         }
     }
+    out.extend(staleness(opts, &cam)?);
+    Ok(out)
+}
+
+/// The staleness study (see the module docs): records `staleness` (x = faces per frame) and
+/// `staleness_frames` (x = frame index), for the cube and box-projected cube methods.
+fn staleness(opts: &EnvStudyOptions, cam: &Camera) -> Result<Vec<EnvRecord>, EnvStudyError> {
+    let frames = opts.staleness_frames as usize;
+    if frames == 0 {
+        return Ok(Vec::new());
+    }
+    // The scene, its reference and its target's pixels at each frame's time, shared by every N.
+    let shots = (0..frames)
+        .map(|k| {
+            let time = k as f32 * opts.staleness_dt;
+            let scene = tunnel_scene(TunnelParams {
+                time,
+                ..Default::default()
+            })?;
+            let full = reference(&scene, cam, true, opts.samples)?;
+            let mask = target_mask(&scene, cam)?;
+            Ok((time, scene, full, mask))
+        })
+        .collect::<Result<Vec<_>, EnvStudyError>>()?;
+    let mut out = Vec::new();
+    for method in [Method::Cube, Method::CubeBox] {
+        // N = 6 first: its frames are the full-update frames the others are compared with.
+        let mut every_face: Vec<Frame> = Vec::new();
+        let mut summary = Vec::new();
+        for &n in STALENESS_FACES.iter().rev() {
+            let mut o = Options::new(method);
+            o.map_size = opts.map_size;
+            o.cube_faces_per_frame = n;
+            let mut r = Renderer::new();
+            let (mut se, mut ae, mut px, mut se_full) = (0.0, 0.0, 0, 0.0);
+            let (mut up, mut dr) = (0.0, 0.0);
+            for (k, (time, scene, full, mask)) in shots.iter().enumerate() {
+                let res = r.render(scene, cam, &o)?;
+                let (fse, fae, fpx) = sq_err(&res.frame, full, |i| mask[i]);
+                if n == 6 {
+                    every_face.push(res.frame.clone());
+                }
+                let (fse_full, _, _) = sq_err(&res.frame, &every_face[k], |i| mask[i]);
+                out.push(EnvRecord {
+                    study: "staleness_frames".into(),
+                    method: method.name().into(),
+                    // The scene time, rounded to µs for the CSV.
+                    x: (*time as f64 * 1e6).round() / 1e6,
+                    psnr_db: psnr_of(fse, fpx),
+                    psnr_env_only_db: f64::NAN,
+                    mean_abs_err: fae / (3 * fpx.max(1)) as f64,
+                    update_ms: res.update_ms,
+                    draw_ms: res.draw_ms,
+                    pixels: fpx,
+                    faces_per_frame: n,
+                    psnr_vs_full_update_db: psnr_of(fse_full, fpx),
+                });
+                // The first frame draws the whole map for every N (and fills the caches).
+                if k > 0 {
+                    se += fse;
+                    ae += fae;
+                    px += fpx;
+                    se_full += fse_full;
+                    up += res.update_ms;
+                    dr += res.draw_ms;
+                }
+                r.recycle(res.frame);
+            }
+            let timed = (frames - 1).max(1) as f64;
+            summary.push(EnvRecord {
+                study: "staleness".into(),
+                method: method.name().into(),
+                x: n as f64,
+                psnr_db: psnr_of(se, px),
+                psnr_env_only_db: f64::NAN,
+                mean_abs_err: ae / (3 * px.max(1)) as f64,
+                update_ms: up / timed,
+                draw_ms: dr / timed,
+                pixels: px,
+                faces_per_frame: n,
+                psnr_vs_full_update_db: psnr_of(se_full, px),
+            });
+        }
+        summary.reverse();
+        out.extend(summary);
+    }
     Ok(out)
 }
 
 /// CSV of the records (one header line).
 pub fn to_csv(records: &[EnvRecord]) -> String {
     let mut s = String::from(
-        "study,method,x,psnr_db,psnr_env_only_db,mean_abs_err,update_ms,draw_ms,pixels\n",
+        "study,method,x,psnr_db,psnr_env_only_db,mean_abs_err,update_ms,draw_ms,pixels,\
+         faces_per_frame,psnr_vs_full_update_db\n",
     );
     for r in records {
         s.push_str(&format!(
-            "{},{},{},{:.3},{:.3},{:.3},{:.3},{:.3},{}\n",
+            "{},{},{},{:.3},{:.3},{:.3},{:.3},{:.3},{},{},{:.3}\n",
             r.study,
             r.method,
             r.x,
@@ -485,7 +609,9 @@ pub fn to_csv(records: &[EnvRecord]) -> String {
             r.mean_abs_err,
             r.update_ms,
             r.draw_ms,
-            r.pixels
+            r.pixels,
+            r.faces_per_frame,
+            r.psnr_vs_full_update_db
         ));
     }
     s
@@ -508,6 +634,8 @@ fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), EnvStudyError> {
 
 /// Chart size in pixels.
 const CHART_SIZE: (u32, u32) = (900, 560);
+/// The staleness chart's size (two panels side by side).
+const STALENESS_CHART_SIZE: (u32, u32) = (1300, 560);
 
 static FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
 
@@ -522,67 +650,76 @@ fn ensure_font() -> Result<(), EnvStudyError> {
     })
 }
 
-/// One line per method of the records of `study`, y = PSNR (or mean abs error), on `root`.
-/// Returns `false` (nothing drawn) when the study has no finite point.
-fn line_chart<DB: DrawingBackend>(
-    root: DrawingArea<DB, plotters::coord::Shift>,
-    records: &[EnvRecord],
-    study: &str,
-    x_label: &str,
+/// One line of a chart: its legend, colour and points.
+struct Line {
+    name: String,
+    colour: RGBAColor,
+    pts: Vec<(f64, f64)>,
+}
+
+/// The colour of a method's lines.
+fn method_colour(method: Method) -> RGBAColor {
+    let i = Method::ALL.iter().position(|&m| m == method).unwrap_or(0);
+    Palette99::pick(i).to_rgba()
+}
+
+/// Axis labels and title of a panel.
+struct Panel<'a> {
+    chart: &'a str,
+    title: &'a str,
+    x_label: &'a str,
+    y_label: &'a str,
+    /// Points' x are log2 of the values (tick labels show the values).
     log_x: bool,
-    y_err: bool,
+}
+
+/// Draw `lines` (non-finite points left out) on `area`, filled white first; the caller presents
+/// the drawing. Returns `false` (nothing drawn) when no point is finite.
+fn draw_lines<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    panel: &Panel,
+    lines: &[Line],
 ) -> Result<bool, EnvStudyError> {
     ensure_font()?;
     let err = |e: String| EnvStudyError::Chart {
-        chart: study.into(),
+        chart: panel.chart.into(),
         message: e,
     };
-    let mine: Vec<&EnvRecord> = records.iter().filter(|r| r.study == study).collect();
-    let y_of = |r: &EnvRecord| {
-        if y_err {
-            r.mean_abs_err
-        } else {
-            r.psnr_db.min(100.0)
-        }
-    };
-    let x_of = |r: &EnvRecord| if log_x { r.x.log2() } else { r.x };
+    let lines: Vec<(&Line, Vec<(f64, f64)>)> = lines
+        .iter()
+        .map(|l| {
+            let pts = l.pts.iter().copied();
+            (
+                l,
+                pts.filter(|(x, y)| x.is_finite() && y.is_finite())
+                    .collect(),
+            )
+        })
+        .collect();
     let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-    for r in &mine {
-        let (x, y) = (x_of(r), y_of(r));
-        if x.is_finite() && y.is_finite() {
-            x0 = x0.min(x);
-            x1 = x1.max(x);
-            y0 = y0.min(y);
-            y1 = y1.max(y);
-        }
+    for &(x, y) in lines.iter().flat_map(|(_, p)| p) {
+        x0 = x0.min(x);
+        x1 = x1.max(x);
+        y0 = y0.min(y);
+        y1 = y1.max(y);
     }
     if x0 > x1 {
         return Ok(false);
     }
     let pad = ((y1 - y0) * 0.08).max(0.5);
-    root.fill(&WHITE).map_err(|e| err(e.to_string()))?;
-    let title = match study {
-        "angle" => "Error against angle of incidence (tunnel scene)",
-        "distance" => "PSNR against object distance (target radii)",
-        "resolution" => "PSNR against map resolution (tunnel scene)",
-        "refraction" => "Refraction: PSNR against index of refraction",
-        _ => study,
-    };
-    let mut chart = ChartBuilder::on(&root)
-        .caption(title, ("sans-serif", 22))
+    area.fill(&WHITE).map_err(|e| err(e.to_string()))?;
+    let mut chart = ChartBuilder::on(area)
+        .caption(panel.title, ("sans-serif", 22))
         .margin(12)
         .x_label_area_size(40)
         .y_label_area_size(60)
         .build_cartesian_2d(x0..x1 + 1e-9, (y0 - pad)..(y1 + pad))
         .map_err(|e| err(e.to_string()))?;
+    let log_x = panel.log_x;
     chart
         .configure_mesh()
-        .x_desc(x_label)
-        .y_desc(if y_err {
-            "mean |error| (sRGB codes)"
-        } else {
-            "PSNR over target pixels (dB)"
-        })
+        .x_desc(panel.x_label)
+        .y_desc(panel.y_label)
         .x_label_formatter(&|v| {
             if log_x {
                 format!("{:.0}", 2f64.powf(*v))
@@ -593,21 +730,15 @@ fn line_chart<DB: DrawingBackend>(
         .label_style(("sans-serif", 14))
         .draw()
         .map_err(|e| err(e.to_string()))?;
-    for (mi, method) in Method::ALL.iter().enumerate() {
-        let pts: Vec<(f64, f64)> = mine
-            .iter()
-            .filter(|r| r.method == method.name())
-            .map(|r| (x_of(r), y_of(r)))
-            .filter(|(x, y)| x.is_finite() && y.is_finite())
-            .collect();
+    for (line, pts) in &lines {
         if pts.is_empty() {
             continue;
         }
-        let colour = Palette99::pick(mi).to_rgba();
+        let colour = line.colour;
         chart
             .draw_series(LineSeries::new(pts.clone(), colour.stroke_width(2)))
             .map_err(|e| err(e.to_string()))?
-            .label(method.name())
+            .label(line.name.as_str())
             .legend(move |(x, y)| PathElement::new([(x, y), (x + 18, y)], colour.stroke_width(2)));
         chart
             .draw_series(pts.iter().map(|&p| Circle::new(p, 3, colour.filled())))
@@ -620,8 +751,177 @@ fn line_chart<DB: DrawingBackend>(
         .label_font(("sans-serif", 14))
         .draw()
         .map_err(|e| err(e.to_string()))?;
-    root.present().map_err(|e| err(e.to_string()))?;
     Ok(true)
+}
+
+/// One line per method of the records of `study`, y = PSNR (or mean abs error), on `area`.
+/// Returns `false` (nothing drawn) when the study has no finite point.
+fn line_chart<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    records: &[EnvRecord],
+    study: &str,
+    x_label: &str,
+    log_x: bool,
+    y_err: bool,
+) -> Result<bool, EnvStudyError> {
+    let y_of = |r: &EnvRecord| {
+        if y_err {
+            r.mean_abs_err
+        } else {
+            r.psnr_db.min(100.0)
+        }
+    };
+    let x_of = |r: &EnvRecord| if log_x { r.x.log2() } else { r.x };
+    let lines: Vec<Line> = Method::ALL
+        .iter()
+        .map(|&method| Line {
+            name: method.name().into(),
+            colour: method_colour(method),
+            pts: records
+                .iter()
+                .filter(|r| r.study == study && r.method == method.name())
+                .map(|r| (x_of(r), y_of(r)))
+                .collect(),
+        })
+        .collect();
+    let title = match study {
+        "angle" => "Error against angle of incidence (tunnel scene)",
+        "distance" => "PSNR against object distance (target radii)",
+        "resolution" => "PSNR against map resolution (tunnel scene)",
+        "refraction" => "Refraction: PSNR against index of refraction",
+        _ => study,
+    };
+    let panel = Panel {
+        chart: study,
+        title,
+        x_label,
+        y_label: if y_err {
+            "mean |error| (sRGB codes)"
+        } else {
+            "PSNR over target pixels (dB)"
+        },
+        log_x,
+    };
+    draw_lines(area, &panel, &lines)
+}
+
+/// The staleness study on two panels: PSNR against faces redrawn per frame (against the
+/// reference, and against the full update), and the mean update time per frame.
+fn staleness_chart<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    records: &[EnvRecord],
+) -> Result<bool, EnvStudyError> {
+    let mine: Vec<&EnvRecord> = records.iter().filter(|r| r.study == "staleness").collect();
+    let (left, right) = area.split_horizontally(STALENESS_CHART_SIZE.0 / 2);
+    let (mut psnr, mut time) = (Vec::new(), Vec::new());
+    for method in [Method::Cube, Method::CubeBox] {
+        let of = |y: &dyn Fn(&EnvRecord) -> f64| -> Vec<(f64, f64)> {
+            mine.iter()
+                .filter(|r| r.method == method.name())
+                .map(|r| (r.x, y(r)))
+                .collect()
+        };
+        let colour = method_colour(method);
+        psnr.push(Line {
+            name: format!("{} vs reference", method.name()),
+            colour,
+            pts: of(&|r| r.psnr_db),
+        });
+        psnr.push(Line {
+            name: format!("{} vs every face redrawn", method.name()),
+            colour: colour.mix(0.45),
+            pts: of(&|r| r.psnr_vs_full_update_db),
+        });
+        time.push(Line {
+            name: method.name().into(),
+            colour,
+            pts: of(&|r| r.update_ms),
+        });
+    }
+    // The frame interval and count, from the per-frame records' times.
+    let times: Vec<f64> = records
+        .iter()
+        .filter(|r| r.study == "staleness_frames" && r.method == Method::Cube.name())
+        .map(|r| r.x)
+        .collect();
+    let runs = times.iter().filter(|&&t| t == 0.0).count().max(1);
+    let dt = times
+        .iter()
+        .copied()
+        .filter(|&t| t > 0.0)
+        .fold(f64::NAN, f64::min);
+    let title = format!(
+        "Time-sliced cube map: PSNR ({} frames {:.3} s apart)",
+        times.len() / runs,
+        dt
+    );
+    let x_label = "cube faces redrawn per frame";
+    let drawn = draw_lines(
+        &left,
+        &Panel {
+            chart: "staleness",
+            title: &title,
+            x_label,
+            y_label: "PSNR over target pixels, frames 2+ (dB)",
+            log_x: false,
+        },
+        &psnr,
+    )?;
+    Ok(drawn
+        && draw_lines(
+            &right,
+            &Panel {
+                chart: "staleness",
+                title: "Map update per frame (mean, harness clock)",
+                x_label,
+                y_label: "update (ms)",
+                log_x: false,
+            },
+            &time,
+        )?)
+}
+
+/// Draw one chart as `<name>.svg` and `<name>.png` in `dir` (both through temporary names, then
+/// renamed) and add their paths to `written`; nothing is written when `draw` draws nothing.
+fn write_chart(
+    dir: &Path,
+    name: &str,
+    size: (u32, u32),
+    draw_svg: impl Fn(&DrawingArea<SVGBackend, plotters::coord::Shift>) -> Result<bool, EnvStudyError>,
+    draw_png: impl Fn(
+        &DrawingArea<BitMapBackend, plotters::coord::Shift>,
+    ) -> Result<bool, EnvStudyError>,
+    written: &mut Vec<PathBuf>,
+) -> Result<(), EnvStudyError> {
+    let err = |e: String| EnvStudyError::Chart {
+        chart: name.into(),
+        message: e,
+    };
+    let mut svg = String::new();
+    {
+        let area = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+        if !draw_svg(&area)? {
+            return Ok(());
+        }
+        area.present().map_err(|e| err(e.to_string()))?;
+    }
+    let path = dir.join(format!("{name}.svg"));
+    write_atomic(&path, svg.as_bytes())?;
+    written.push(path);
+    // PNG: drawn to a temporary name (plotters picks the encoder by extension), renamed.
+    let png = dir.join(format!("{name}.png"));
+    let tmp = dir.join(format!("{name}.partial.png"));
+    {
+        let area = BitMapBackend::new(&tmp, size).into_drawing_area();
+        draw_png(&area)?;
+        area.present().map_err(|e| err(e.to_string()))?;
+    }
+    std::fs::rename(&tmp, &png).map_err(|source| EnvStudyError::Io {
+        path: png.clone(),
+        source,
+    })?;
+    written.push(png);
+    Ok(())
 }
 
 /// Write `envmap.csv`, `envmap.json` and the charts (SVG and PNG) into `dir` (created if missing); returns
@@ -655,38 +955,23 @@ pub fn write(dir: &Path, records: &[EnvRecord]) -> Result<Vec<PathBuf>, EnvStudy
         ("resolution", "map side (texels, log2 axis)", true, false),
         ("refraction", "index of refraction", false, false),
     ] {
-        let mut svg = String::new();
-        let drawn = line_chart(
-            SVGBackend::with_string(&mut svg, CHART_SIZE).into_drawing_area(),
-            records,
-            study,
-            x_label,
-            log_x,
-            y_err,
+        write_chart(
+            dir,
+            &format!("envmap_{study}"),
+            CHART_SIZE,
+            |a| line_chart(a, records, study, x_label, log_x, y_err),
+            |a| line_chart(a, records, study, x_label, log_x, y_err),
+            &mut written,
         )?;
-        if !drawn {
-            continue;
-        }
-        let path = dir.join(format!("envmap_{study}.svg"));
-        write_atomic(&path, svg.as_bytes())?;
-        written.push(path);
-        // PNG: drawn to a temporary name (plotters picks the encoder by extension), renamed.
-        let png = dir.join(format!("envmap_{study}.png"));
-        let tmp = dir.join(format!("envmap_{study}.partial.png"));
-        line_chart(
-            BitMapBackend::new(&tmp, CHART_SIZE).into_drawing_area(),
-            records,
-            study,
-            x_label,
-            log_x,
-            y_err,
-        )?;
-        std::fs::rename(&tmp, &png).map_err(|source| EnvStudyError::Io {
-            path: png.clone(),
-            source,
-        })?;
-        written.push(png);
     }
+    write_chart(
+        dir,
+        "envmap_staleness",
+        STALENESS_CHART_SIZE,
+        |a| staleness_chart(a, records),
+        |a| staleness_chart(a, records),
+        &mut written,
+    )?;
     Ok(written)
 }
 
@@ -733,6 +1018,8 @@ mod tests {
             samples: 2,
             timed_frames: 1,
             map_size: 64,
+            staleness_frames: 7,
+            staleness_dt: STALENESS_DT,
         };
         let recs = run(&opts).unwrap();
         let get = |study: &str, m: Method, x: f64| {
@@ -748,8 +1035,36 @@ mod tests {
                 "{m:?}"
             );
         }
+        // Time slicing: the first frame is the full update's for every N; after it, fewer faces
+        // per frame leave stale faces (an error against the full update), six leave none.
+        for m in [Method::Cube, Method::CubeBox] {
+            let stale = |n: u32| {
+                recs.iter()
+                    .find(|r| r.study == "staleness" && r.method == m.name() && r.x == n as f64)
+                    .unwrap()
+            };
+            assert_eq!(stale(6).psnr_vs_full_update_db, f64::INFINITY);
+            for n in [1, 2, 3] {
+                let p = stale(n).psnr_vs_full_update_db;
+                assert!(p.is_finite() && p > 10.0, "{m:?} N {n}: {p}");
+                assert_eq!(stale(n).pixels, stale(6).pixels);
+            }
+            let frames: Vec<&EnvRecord> = recs
+                .iter()
+                .filter(|r| r.study == "staleness_frames" && r.method == m.name())
+                .collect();
+            assert_eq!(frames.len(), 7 * STALENESS_FACES.len());
+            assert!(
+                frames
+                    .iter()
+                    .filter(|r| r.x == 0.0)
+                    .all(|r| r.psnr_vs_full_update_db == f64::INFINITY)
+            );
+        }
         let dir = tempfile::tempdir().unwrap();
         let files = write(dir.path(), &recs).unwrap();
+        assert!(files.iter().any(|p| p.ends_with("envmap_staleness.svg")));
+        assert!(files.iter().any(|p| p.ends_with("envmap_staleness.png")));
         assert!(files.iter().any(|p| p.ends_with("envmap_distance.svg")));
         assert!(files.iter().any(|p| p.ends_with("envmap_angle.png")));
         let csv = std::fs::read_to_string(dir.path().join("envmap.csv")).unwrap();

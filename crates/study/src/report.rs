@@ -259,9 +259,11 @@ envmap</code>) gives the figures to quote.</p>\n",
     s.push_str(
         "<p>Charts: the error against the angle of incidence (the sphere map's sampling collapses \
 toward the silhouette), against the distance of a reflected object (a map has one centre: \
-Seed 003 is exact only there), against the map's resolution, and for refraction.</p>\n",
+Seed 003 is exact only there), against the map's resolution, for refraction, and for time-sliced \
+cube maps (N of the six faces redrawn per frame on the moving scene: the update cost against the \
+error of faces drawn up to a few frames earlier).</p>\n",
     );
-    for study in ["angle", "distance", "resolution", "refraction"] {
+    for study in ["angle", "distance", "resolution", "refraction", "staleness"] {
         s.push_str(&format!(
             "<div><img src=\"{dir}/envmap_{study}.svg\" width=\"720\"></div>\n"
         ));
