@@ -37,8 +37,15 @@ fn bilinear_f64(t: &MipTexture, level: usize, uv: Vec2) -> DVec4 {
     (g(0, 0) * (1.0 - ax) + g(1, 0) * ax) * (1.0 - ay) + (g(0, 1) * (1.0 - ax) + g(1, 1) * ax) * ay
 }
 
-/// Seed 000 Eq. (4) in f64 with λ from Eq. (2)'s max component and an exact log2.
-fn trilinear_f64(t: &MipTexture, uv: Vec2, dx: Vec2, dy: Vec2) -> DVec4 {
+/// Eq. (2)'s level in f64 (max component, exact log2) and Eq. (4)'s blend of the two levels
+/// around it, each level filtered by `level_f64`; level 0 under magnification, the last beyond it.
+fn blend_levels_f64(
+    t: &MipTexture,
+    uv: Vec2,
+    dx: Vec2,
+    dy: Vec2,
+    level_f64: fn(&MipTexture, usize, Vec2) -> DVec4,
+) -> DVec4 {
     let (w, h) = (t.width() as f64, t.height() as f64);
     let m = (dx.x as f64 * w)
         .abs()
@@ -48,14 +55,19 @@ fn trilinear_f64(t: &MipTexture, uv: Vec2, dx: Vec2, dy: Vec2) -> DVec4 {
     let last = t.level_count() - 1;
     let lam = m.log2();
     if lam.is_nan() || lam <= 0.0 {
-        return bilinear_f64(t, 0, uv);
+        return level_f64(t, 0, uv);
     }
     if lam >= last as f64 {
-        return bilinear_f64(t, last, uv);
+        return level_f64(t, last, uv);
     }
     let i = lam.floor() as usize;
     let f = lam - i as f64;
-    bilinear_f64(t, i, uv) * (1.0 - f) + bilinear_f64(t, i + 1, uv) * f
+    level_f64(t, i, uv) * (1.0 - f) + level_f64(t, i + 1, uv) * f
+}
+
+/// Seed 000 Eq. (4) in f64: bilinear levels blended.
+fn trilinear_f64(t: &MipTexture, uv: Vec2, dx: Vec2, dy: Vec2) -> DVec4 {
+    blend_levels_f64(t, uv, dx, dy, bilinear_f64)
 }
 
 /// The quadratic 3x3 of one level in f64 from `texel()`: the texel coordinate `u·w − ½` as the
@@ -83,104 +95,87 @@ fn quadratic_level_f64(t: &MipTexture, level: usize, uv: Vec2) -> DVec4 {
 /// [`Sampler::Quadratic3`] in f64: trilinear's levels and blend (Eq. 2, exact log2) over
 /// [`quadratic_level_f64`].
 fn quadratic_f64(t: &MipTexture, uv: Vec2, dx: Vec2, dy: Vec2) -> DVec4 {
-    let (w, h) = (t.width() as f64, t.height() as f64);
-    let m = (dx.x as f64 * w)
-        .abs()
-        .max((dx.y as f64 * h).abs())
-        .max((dy.x as f64 * w).abs())
-        .max((dy.y as f64 * h).abs());
-    let last = t.level_count() - 1;
-    let lam = m.log2();
-    if lam.is_nan() || lam <= 0.0 {
-        return quadratic_level_f64(t, 0, uv);
+    blend_levels_f64(t, uv, dx, dy, quadratic_level_f64)
+}
+
+/// Four textures of random texels (both wraps, power-of-two and not), each looked up at 20,000
+/// random points (uv over three periods, footprints from 10^−3.5 to 10^0.5 of the map):
+/// `check` asserts on one lookup and returns its difference to the reference; the worst per
+/// texture is printed under `name`.
+fn random_lookups(
+    seed: u32,
+    name: &str,
+    mut check: impl FnMut(&MipTexture, Vec2, Vec2, Vec2) -> f64,
+) {
+    let mut r = Rng(seed);
+    for (w, h, wrap) in [
+        (64, 64, Wrap::Repeat),
+        (64, 64, Wrap::Clamp),
+        (40, 24, Wrap::Repeat),
+        (17, 9, Wrap::Clamp),
+    ] {
+        let t = tex(w, h, wrap, &mut r);
+        let mut worst = 0f64;
+        for _ in 0..20_000 {
+            let uv = Vec2::new(r.f() * 3.0 - 1.0, r.f() * 3.0 - 1.0);
+            let s = 10f32.powf(r.f() * 4.0 - 3.5);
+            let dx = Vec2::new(r.f() - 0.5, r.f() - 0.5) * s;
+            let dy = Vec2::new(r.f() - 0.5, r.f() - 0.5) * s;
+            worst = worst.max(check(&t, uv, dx, dy));
+        }
+        eprintln!("{w}x{h} {wrap:?}: worst {name} difference {worst:e}");
     }
-    if lam >= last as f64 {
-        return quadratic_level_f64(t, last, uv);
-    }
-    let i = lam.floor() as usize;
-    let f = lam - i as f64;
-    quadratic_level_f64(t, i, uv) * (1.0 - f) + quadratic_level_f64(t, i + 1, uv) * f
 }
 
 #[test]
 fn quadratic3_matches_an_f64_recomputation() {
     // Random uv and derivatives, both wrap modes, power-of-two and NPOT pyramids, single pixels
     // and quads (the quad kernel in lanes).
-    let mut r = Rng(0xF00D);
-    for (w, h, wrap) in [
-        (64, 64, Wrap::Repeat),
-        (64, 64, Wrap::Clamp),
-        (40, 24, Wrap::Repeat),
-        (17, 9, Wrap::Clamp),
-    ] {
-        let t = tex(w, h, wrap, &mut r);
-        let mut worst = 0f64;
-        for _ in 0..20_000 {
-            let uv = Vec2::new(r.f() * 3.0 - 1.0, r.f() * 3.0 - 1.0);
-            let s = 10f32.powf(r.f() * 4.0 - 3.5);
-            let dx = Vec2::new(r.f() - 0.5, r.f() - 0.5) * s;
-            let dy = Vec2::new(r.f() - 0.5, r.f() - 0.5) * s;
-            let got = Sampler::Quadratic3.sample(&t, uv, dx, dy).as_dvec4();
-            let e = quadratic_f64(&t, uv, dx, dy);
-            // As trilinear: the log2's error (≤ 1.2e-4) moves the blend weight, times the
-            // difference of two clamped level values (≤ 1).
-            let d = (got - e).abs().max_element();
+    random_lookups(0xF00D, "quadratic3", |t, uv, dx, dy| {
+        let got = Sampler::Quadratic3.sample(t, uv, dx, dy).as_dvec4();
+        let e = quadratic_f64(t, uv, dx, dy);
+        // As trilinear: the log2's error (≤ 1.2e-4) moves the blend weight, times the
+        // difference of two clamped level values (≤ 1).
+        let d = (got - e).abs().max_element();
+        assert!(
+            d < 2e-4,
+            "quadratic3 {uv} {dx} {dy}: expected {e}, got {got}, tol 2e-4"
+        );
+        let quad = [uv, uv + dx, uv + dy, uv + dx + dy];
+        let got = Sampler::Quadratic3.sample_quad(t, quad);
+        for j in 0..4 {
+            let e = quadratic_f64(t, quad[j], quad[1] - quad[0], quad[2] - quad[0]);
+            let d = (got[j].as_dvec4() - e).abs().max_element();
             assert!(
                 d < 2e-4,
-                "quadratic3 {uv} {dx} {dy}: expected {e}, got {got}, tol 2e-4"
+                "quadratic3 quad {quad:?} pixel {j}: expected {e}, got {}",
+                got[j]
             );
-            worst = worst.max(d);
-            let quad = [uv, uv + dx, uv + dy, uv + dx + dy];
-            let got = Sampler::Quadratic3.sample_quad(&t, quad);
-            for j in 0..4 {
-                let e = quadratic_f64(&t, quad[j], quad[1] - quad[0], quad[2] - quad[0]);
-                let d = (got[j].as_dvec4() - e).abs().max_element();
-                assert!(
-                    d < 2e-4,
-                    "quadratic3 quad {quad:?} pixel {j}: expected {e}, got {}",
-                    got[j]
-                );
-            }
         }
-        eprintln!("{w}x{h} {wrap:?}: worst quadratic3 difference {worst:e}");
-    }
+        d
+    });
 }
 
 #[test]
 fn bilinear_and_trilinear_match_an_f64_recomputation() {
-    let mut r = Rng(0xBEEF);
-    for (w, h, wrap) in [
-        (64, 64, Wrap::Repeat),
-        (64, 64, Wrap::Clamp),
-        (40, 24, Wrap::Repeat),
-        (17, 9, Wrap::Clamp),
-    ] {
-        let t = tex(w, h, wrap, &mut r);
-        let mut worst = 0f64;
-        for _ in 0..20_000 {
-            let uv = Vec2::new(r.f() * 3.0 - 1.0, r.f() * 3.0 - 1.0);
-            let s = 10f32.powf(r.f() * 4.0 - 3.5);
-            let dx = Vec2::new(r.f() - 0.5, r.f() - 0.5) * s;
-            let dy = Vec2::new(r.f() - 0.5, r.f() - 0.5) * s;
-            let b = Sampler::Bilinear.sample(&t, uv, dx, dy).as_dvec4();
-            let e = bilinear_f64(&t, 0, uv);
-            assert!(
-                (b - e).abs().max_element() < 1e-5,
-                "bilinear {uv}: expected {e}, got {b}, tol 1e-5"
-            );
-            let got = Sampler::Trilinear.sample(&t, uv, dx, dy).as_dvec4();
-            let e = trilinear_f64(&t, uv, dx, dy);
-            // The sampler's log2 has |error| ≤ 1.2e-4 (tested in the crate): the blend weight
-            // moves at most that much times the difference of two texel values (≤ 1).
-            let d = (got - e).abs().max_element();
-            assert!(
-                d < 2e-4,
-                "trilinear {uv} {dx} {dy}: expected {e}, got {got}, tol 2e-4"
-            );
-            worst = worst.max(d);
-        }
-        eprintln!("{w}x{h} {wrap:?}: worst trilinear difference {worst:e}");
-    }
+    random_lookups(0xBEEF, "trilinear", |t, uv, dx, dy| {
+        let b = Sampler::Bilinear.sample(t, uv, dx, dy).as_dvec4();
+        let e = bilinear_f64(t, 0, uv);
+        assert!(
+            (b - e).abs().max_element() < 1e-5,
+            "bilinear {uv}: expected {e}, got {b}, tol 1e-5"
+        );
+        let got = Sampler::Trilinear.sample(t, uv, dx, dy).as_dvec4();
+        let e = trilinear_f64(t, uv, dx, dy);
+        // The sampler's log2 has |error| ≤ 1.2e-4 (tested in the crate): the blend weight
+        // moves at most that much times the difference of two texel values (≤ 1).
+        let d = (got - e).abs().max_element();
+        assert!(
+            d < 2e-4,
+            "trilinear {uv} {dx} {dy}: expected {e}, got {got}, tol 2e-4"
+        );
+        d
+    });
 }
 
 #[test]
