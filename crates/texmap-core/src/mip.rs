@@ -171,6 +171,13 @@ enum Encoding {
     Linear,
 }
 
+/// Buffers a pyramid is built into (empty, or taken from a pyramid no longer needed).
+#[derive(Default)]
+struct Storage {
+    texels: Vec<Vec4>,
+    levels: Vec<LevelInfo>,
+}
+
 fn check_size(width: u32, height: u32) -> Result<(), MipError> {
     if width == 0 || height == 0 || width > MAX_TEXTURE_SIDE || height > MAX_TEXTURE_SIDE {
         return Err(MipError::BadSize { width, height });
@@ -217,10 +224,11 @@ impl MipTexture {
         Ok(Self::build(
             width,
             height,
-            work,
+            &work,
             Encoding::Srgb,
             reduction,
             wrap,
+            Storage::default(),
         ))
     }
 
@@ -231,6 +239,35 @@ impl MipTexture {
         data: &[Vec4],
         reduction: Reduction,
         wrap: Wrap,
+    ) -> Result<MipTexture, MipError> {
+        Self::linear(width, height, data, reduction, wrap, Storage::default())
+    }
+
+    /// [`MipTexture::from_linear`] built into the buffers of `old`, a pyramid no longer needed:
+    /// when they are large enough (a pyramid of the same size rebuilt every frame), nothing is
+    /// allocated. The result equals [`MipTexture::from_linear`]'s; on an error `old` is dropped.
+    pub fn from_linear_reusing(
+        old: MipTexture,
+        width: u32,
+        height: u32,
+        data: &[Vec4],
+        reduction: Reduction,
+        wrap: Wrap,
+    ) -> Result<MipTexture, MipError> {
+        let storage = Storage {
+            texels: old.texels,
+            levels: old.levels,
+        };
+        Self::linear(width, height, data, reduction, wrap, storage)
+    }
+
+    fn linear(
+        width: u32,
+        height: u32,
+        data: &[Vec4],
+        reduction: Reduction,
+        wrap: Wrap,
+        storage: Storage,
     ) -> Result<MipTexture, MipError> {
         check_size(width, height)?;
         let n = width as usize * height as usize;
@@ -249,52 +286,38 @@ impl MipTexture {
         Ok(Self::build(
             width,
             height,
-            data.to_vec(),
+            data,
             Encoding::Linear,
             reduction,
             wrap,
+            storage,
         ))
     }
 
-    /// Reduce level by level in the averaging space; store every level as linear light.
+    /// Reduce level by level in the averaging space (`level0` is level 0 in it); store every
+    /// level as linear light, in `storage`'s buffers.
     fn build(
         width: u32,
         height: u32,
-        mut work: Vec<Vec4>,
+        level0: &[Vec4],
         encoding: Encoding,
         reduction: Reduction,
         wrap: Wrap,
+        storage: Storage,
     ) -> MipTexture {
         let encoded = encoding == Encoding::Srgb && reduction == Reduction::Box;
-        let to_linear = |t: Vec4| {
-            if encoded {
-                Vec4::new(
-                    srgb_to_linear(t.x),
-                    srgb_to_linear(t.y),
-                    srgb_to_linear(t.z),
-                    t.w,
-                )
-            } else {
-                t
-            }
-        };
-        // Storage of every level and seam strip, reserved once (no regrowth copies).
         let pow2 = width.is_power_of_two() && height.is_power_of_two();
-        let mut total = 0usize;
-        let (mut w, mut h) = (width as usize, height as usize);
-        loop {
-            total += w * h + if pow2 { 4 * (h + 2) + 4 * w } else { 0 };
-            if w == 1 && h == 1 {
-                break;
-            }
-            (w, h) = ((w / 2).max(1), (h / 2).max(1));
-        }
+        let Storage {
+            mut texels,
+            mut levels,
+        } = storage;
+        levels.clear();
         let (mut w, mut h) = (width, height);
-        let mut levels = Vec::new();
-        let mut texels: Vec<Vec4> = Vec::with_capacity(total);
+        let mut level_texels = 0usize;
+        let mut strip_texels = 0usize;
         loop {
             levels.push(LevelInfo {
-                offset: texels.len(),
+                offset: level_texels,
                 width: w,
                 height: h,
                 width_f: w as f32,
@@ -304,25 +327,42 @@ impl MipTexture {
                 inv_width_f: 1.0 / w as f32,
                 inv_height_f: 1.0 / h as f32,
             });
-            texels.extend(work.iter().map(|&t| to_linear(t)));
+            level_texels += w as usize * h as usize;
+            if pow2 {
+                strip_texels += 4 * (h as usize + 2) + 4 * w as usize;
+            }
             if w == 1 && h == 1 {
                 break;
             }
-            let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
-            // Reduce along x, then along y (separable exact box).
-            let mut tmp = vec![Vec4::ZERO; nw as usize * h as usize];
-            for y in 0..h as usize {
-                let src = &work[y * w as usize..(y + 1) * w as usize];
-                let dst = &mut tmp[y * nw as usize..(y + 1) * nw as usize];
-                reduce_line(src, 1, dst, 1);
+            (w, h) = ((w / 2).max(1), (h / 2).max(1));
+        }
+        // Every level and seam strip in one buffer, sized once (a reused buffer keeps its pages).
+        texels.clear();
+        texels.resize(level_texels + strip_texels, Vec4::ZERO);
+        // The levels are reduced in place in the averaging space: the texel buffer itself, or a
+        // separate one for Box-filtered sRGB input (reduced encoded, stored linear).
+        let mut encoded_levels = Vec::new();
+        let avg: &mut [Vec4] = if encoded {
+            encoded_levels.resize(level_texels, Vec4::ZERO);
+            &mut encoded_levels
+        } else {
+            &mut texels[..level_texels]
+        };
+        avg[..level0.len()].copy_from_slice(level0);
+        let mut rows = vec![Vec4::ZERO; 3 * (width as usize / 2).max(1)];
+        for pair in levels.windows(2) {
+            let (src, dst) = avg.split_at_mut(pair[1].offset);
+            reduce_level(&src[pair[0].offset..], &pair[0], dst, &pair[1], &mut rows);
+        }
+        if encoded {
+            for (t, e) in texels.iter_mut().zip(&encoded_levels) {
+                *t = Vec4::new(
+                    srgb_to_linear(e.x),
+                    srgb_to_linear(e.y),
+                    srgb_to_linear(e.z),
+                    e.w,
+                );
             }
-            let mut next = vec![Vec4::ZERO; nw as usize * nh as usize];
-            for x in 0..nw as usize {
-                reduce_strided(&tmp, x, nw as usize, h as usize, &mut next, nh as usize);
-            }
-            work = next;
-            w = nw;
-            h = nh;
         }
         // Linear-light storage of sRGB Box levels can only drift by float rounding: keep it finite.
         debug_assert!(texels.iter().all(|t| t.is_finite()));
@@ -332,32 +372,34 @@ impl MipTexture {
         // them is the power-of-two one). Origins are stored shifted so that strip texel (x, y)
         // sits at origin + y·stride + x in level coordinates (x = w − 2.. in the column strip,
         // y = h − 2.. in the row strip); they stay positive (each strip follows all levels).
-        let level_texels = texels.len();
         let (mut col_strip16, mut row_strip16) = ([0i32; 16], [0i32; 16]);
         if pow2 {
+            let mut end = level_texels;
             for (i, l) in levels.iter().enumerate() {
                 let (w, h) = (l.width as usize, l.height as usize);
                 let at = |x: usize, y: usize| l.offset + (y % h) * w + x % w;
-                col_strip16[i] = (texels.len() + 2) as i32 - w as i32;
+                col_strip16[i] = (end + 2) as i32 - w as i32;
                 for y in 0..h + 2 {
                     for x in w + w - 2..w + w + 2 {
-                        texels.push(texels[at(x, y)]);
+                        texels[end] = texels[at(x, y)];
+                        end += 1;
                     }
                 }
-                row_strip16[i] = texels.len() as i32 - (h as i32 - 2) * w as i32;
+                row_strip16[i] = end as i32 - (h as i32 - 2) * w as i32;
                 for y in h + h - 2..h + h + 2 {
                     for x in 0..w {
-                        texels.push(texels[at(x, y)]);
+                        texels[end] = texels[at(x, y)];
+                        end += 1;
                     }
                 }
             }
+            debug_assert_eq!(end, texels.len(), "strip storage sized exactly");
             let top = (col_strip16[last], row_strip16[last]);
             let strips = col_strip16.iter_mut().zip(row_strip16.iter_mut());
             for (c, r) in strips.skip(levels.len()) {
                 (*c, *r) = top;
             }
         }
-        debug_assert_eq!(texels.len(), total, "pyramid storage reserved exactly");
         MipTexture {
             texels,
             level_texels,
@@ -512,14 +554,39 @@ fn reduce_line(src: &[Vec4], ss: usize, dst: &mut [Vec4], ds: usize) {
     }
 }
 
-/// Reduce column `x` of a `width`-wide image of `h` rows into column `x` of `dst` (`nh` rows).
-fn reduce_strided(src: &[Vec4], x: usize, width: usize, h: usize, dst: &mut [Vec4], nh: usize) {
-    // Gather the column, reduce it, scatter it: columns are short and this keeps one code path.
-    let col: Vec<Vec4> = (0..h).map(|y| src[y * width + x]).collect();
-    let mut out = vec![Vec4::ZERO; nh];
-    reduce_line(&col, 1, &mut out, 1);
-    for (y, v) in out.into_iter().enumerate() {
-        dst[y * width + x] = v;
+/// Reduce level `src` (`a`) into level `dst` (`b`, the next one) with the module's exact box
+/// weights, separably: each destination row combines the x-reduced source rows under it (into
+/// `rows`, three rows of `b.width` at least), with [`reduce_line`]'s weights and arithmetic along
+/// y, so every texel is the same expression as reducing all rows first and then each column.
+fn reduce_level(src: &[Vec4], a: &LevelInfo, dst: &mut [Vec4], b: &LevelInfo, rows: &mut [Vec4]) {
+    let (w, h) = (a.width as usize, a.height as usize);
+    let nw = b.width as usize;
+    let row = |y: usize, out: &mut [Vec4]| reduce_line(&src[y * w..(y + 1) * w], 1, out, 1);
+    let (r0, rest) = rows.split_at_mut(nw);
+    let (r1, rest) = rest.split_at_mut(nw);
+    let r2 = &mut rest[..nw];
+    let m = b.height as usize;
+    let inv = 1.0 / h as f32;
+    let mf = m as f32;
+    for (y, out) in dst.chunks_exact_mut(nw).take(m).enumerate() {
+        if h == 1 {
+            row(0, out);
+        } else if h.is_multiple_of(2) {
+            row(2 * y, r0);
+            row(2 * y + 1, r1);
+            for ((o, &p), &q) in out.iter_mut().zip(&*r0).zip(&*r1) {
+                *o = (p + q) * 0.5;
+            }
+        } else {
+            row(2 * y, r0);
+            row(2 * y + 1, r1);
+            row(2 * y + 2, r2);
+            let yf = y as f32;
+            let (w0, w1, w2) = ((mf - yf) * inv, mf * inv, (yf + 1.0) * inv);
+            for (((o, &p), &q), &r) in out.iter_mut().zip(&*r0).zip(&*r1).zip(&*r2) {
+                *o = p * w0 + q * w1 + r * w2;
+            }
+        }
     }
 }
 
@@ -603,5 +670,90 @@ mod tests {
         let ms: f64 = src.iter().map(|v| v.x as f64).sum::<f64>() / 7.0;
         let md: f64 = dst.iter().map(|v| v.x as f64).sum::<f64>() / 3.0;
         assert!((ms - md).abs() < 1e-5, "expected {ms}, got {md}, tol 1e-5");
+    }
+
+    /// Texels from a small deterministic hash (values in 0..1).
+    fn noise(w: u32, h: u32, seed: u32) -> Vec<Vec4> {
+        (0..w * h)
+            .map(|i| {
+                let v = |k: u32| {
+                    let x = (i ^ seed.wrapping_mul(0x9e37_79b9)).wrapping_add(k) as u64;
+                    ((x.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 40) & 0xffff) as f32 / 65535.0
+                };
+                Vec4::new(v(1), v(2), v(3), v(4))
+            })
+            .collect()
+    }
+
+    #[test]
+    fn levels_are_the_separable_box_of_the_level_below() {
+        // Each level against an f64 evaluation of the module's weights (the tap lists written
+        // out again here), for odd, even and unit sides.
+        let taps = |n: usize, m: usize, x: usize| -> Vec<(usize, f64)> {
+            if n == 1 {
+                vec![(0, 1.0)]
+            } else if n.is_multiple_of(2) {
+                vec![(2 * x, 0.5), (2 * x + 1, 0.5)]
+            } else {
+                let (nf, mf, xf) = (n as f64, m as f64, x as f64);
+                vec![
+                    (2 * x, (mf - xf) / nf),
+                    (2 * x + 1, mf / nf),
+                    (2 * x + 2, (xf + 1.0) / nf),
+                ]
+            }
+        };
+        for (w, h) in [(7, 5), (6, 9), (1, 7), (10, 1), (258, 258), (33, 64)] {
+            let t = MipTexture::from_linear(w, h, &noise(w, h, w * h), Reduction::Box, Wrap::Clamp)
+                .unwrap();
+            for i in 1..t.level_count() {
+                let (a, b) = (t.levels()[i - 1], t.levels()[i]);
+                let (aw, ah) = (a.width as usize, a.height as usize);
+                let (bw, bh) = (b.width as usize, b.height as usize);
+                for y in 0..bh {
+                    for x in 0..bw {
+                        let mut want = [0f64; 4];
+                        for (sy, wy) in taps(ah, bh, y) {
+                            for (sx, wx) in taps(aw, bw, x) {
+                                let v = t.texels()[a.offset + sy * aw + sx].to_array();
+                                for c in 0..4 {
+                                    want[c] += wx * wy * v[c] as f64;
+                                }
+                            }
+                        }
+                        let got = t.texels()[b.offset + y * bw + x].to_array();
+                        for c in 0..4 {
+                            assert!(
+                                (got[c] as f64 - want[c]).abs() < 1e-5,
+                                "{w}x{h} level {i} ({x}, {y}) channel {c}: {} vs {}",
+                                got[c],
+                                want[c]
+                            );
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn rebuilding_into_old_storage_gives_the_same_pyramid() {
+        // Power-of-two (seam strips) and NPOT pyramids, rebuilt into a smaller, a larger and an
+        // equal old buffer: the same texture as a fresh build, strips included.
+        let sizes = [(64, 64), (48, 20), (258, 258), (258, 258), (16, 128)];
+        let mut old =
+            MipTexture::from_linear(1, 1, &[Vec4::ONE], Reduction::Box, Wrap::Repeat).unwrap();
+        for (k, (w, h)) in sizes.into_iter().enumerate() {
+            let data = noise(w, h, k as u32);
+            let fresh = MipTexture::from_linear(w, h, &data, Reduction::Box, Wrap::Repeat).unwrap();
+            let rebuilt =
+                MipTexture::from_linear_reusing(old, w, h, &data, Reduction::Box, Wrap::Repeat)
+                    .unwrap();
+            assert_eq!(rebuilt, fresh, "{w}x{h}");
+            old = rebuilt;
+        }
+        let bad = vec![Vec4::NAN; 4];
+        let err = MipTexture::from_linear_reusing(old, 2, 2, &bad, Reduction::Box, Wrap::Clamp);
+        assert!(matches!(err, Err(MipError::NonFinite { x: 0, y: 0 })));
     }
 }
