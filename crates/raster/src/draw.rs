@@ -20,8 +20,8 @@ use crate::bin::TileSpan;
 use crate::framebuffer::{Framebuffer, Grid};
 use crate::mesh::Mesh;
 use crate::program::{
-    FlatProg, FragProgram, LitFlatProg, LitSmoothProg, QuadSampler, Shading, TexturedProg,
-    VertexColorProg,
+    FirstVertexColorProg, FlatProg, FragProgram, LitFlatProg, LitSmoothProg, QuadSampler, Shading,
+    TexturedProg, VertexColorProg,
 };
 use crate::project::{FLAG_INVALID, MAX_VAR, PVert, Proj};
 use crate::record::{FRONT_BIT, Rec, VarStore};
@@ -129,13 +129,17 @@ impl Framebuffer {
         let proj = Proj::new(camera);
         Ok(match *shading {
             Shading::Flat(c) => self.draw_program(&proj, mesh, &FlatProg(c), state),
-            Shading::VertexColor => {
+            Shading::VertexColor | Shading::FirstVertexColor => {
                 if mesh.colors().is_none() {
                     return Err(RasterError::MissingAttribute {
                         attribute: "colors",
                     });
                 }
-                self.draw_program(&proj, mesh, &VertexColorProg, state)
+                if matches!(shading, Shading::VertexColor) {
+                    self.draw_program(&proj, mesh, &VertexColorProg, state)
+                } else {
+                    self.draw_program(&proj, mesh, &FirstVertexColorProg, state)
+                }
             }
             Shading::LitFlat { lighting, material } => {
                 let prog = LitFlatProg {
@@ -453,6 +457,7 @@ mod tests {
         for shading in [
             Shading::Flat(Vec3::new(0.2, 0.7, 1.0)),
             Shading::VertexColor,
+            Shading::FirstVertexColor,
             lit,
         ] {
             for st in &states {

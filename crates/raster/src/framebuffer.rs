@@ -9,7 +9,7 @@
 //! Colour is linear f32 (so additive blending and counting are exact); [`Framebuffer::to_frame`]
 //! resolves it to the workspace's sRGB8 + depth [`Frame`].
 
-use glam::Vec3;
+use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 use texmap_core::camera::MAX_IMAGE_SIDE;
 use texmap_core::color::{linear_to_srgb8, srgb8_to_linear_rgb};
@@ -260,6 +260,57 @@ impl Framebuffer {
                             } else {
                                 bg_bytes
                             };
+                        }
+                    }
+                }
+            });
+    }
+
+    /// The drawn image in linear light over `under`: `out[y·w + x]` is pixel `(x, y)`'s colour
+    /// with alpha 1 where something was drawn (finite depth), else `under`'s texel (both
+    /// `width × height`, row-major). For an image drawn over a background that is not one colour
+    /// (a map face over its environment). Bands of one tile row are written in parallel, each
+    /// texel once. Panics if a slice is not `width × height` long.
+    pub fn composite_linear_into(&self, under: &[Vec4], out: &mut [Vec4]) {
+        let w = self.grid.width as usize;
+        let n = w * self.grid.height as usize;
+        assert!(
+            under.len() == n && out.len() == n,
+            "composite_linear_into: {} and {} texels for a {}x{} image",
+            under.len(),
+            out.len(),
+            self.grid.width,
+            self.grid.height
+        );
+        let band = w * TILE as usize;
+        let tiles_x = self.grid.tiles_x as usize;
+        out.par_chunks_mut(band)
+            .zip(under.par_chunks(band))
+            .zip(self.tiles.par_chunks(tiles_x))
+            .for_each(|((out, under), row_tiles)| {
+                for t in row_tiles {
+                    let xe = (t.x0 + TILE).min(self.grid.width);
+                    let ye = (t.y0 + TILE).min(self.grid.height);
+                    for y in t.y0..ye {
+                        let row = (y - t.y0) as usize * w;
+                        let span = row + t.x0 as usize..row + xe as usize;
+                        if t.pending {
+                            out[span.clone()].copy_from_slice(&under[span]);
+                            continue;
+                        }
+                        // Two pixels of a quad row at a time: lanes l and l + 1 of quad q.
+                        let ly = y - t.y0;
+                        for x in (t.x0..xe).step_by(2) {
+                            let i = tile_index(x - t.x0, ly);
+                            let (q, l) = (i >> 2, i & 3);
+                            let o = row + x as usize;
+                            for k in 0..((xe - x) as usize).min(2) {
+                                out[o + k] = if t.depth[q][l + k].is_finite() {
+                                    Vec4::new(t.r[q][l + k], t.g[q][l + k], t.b[q][l + k], 1.0)
+                                } else {
+                                    under[o + k]
+                                };
+                            }
                         }
                     }
                 }

@@ -27,6 +27,9 @@ pub enum Shading {
     /// Gouraud: per-vertex colours (the mesh must carry colours), interpolated
     /// perspective-correctly.
     VertexColor,
+    /// Flat: each triangle in the colour of its first vertex (OpenGL's flat shading, first
+    /// vertex provoking; the mesh must carry colours). Nothing is interpolated per pixel.
+    FirstVertexColor,
     /// [`Lighting::shade`] with one face normal per triangle (from the winding), evaluated once
     /// per triangle at its centroid.
     LitFlat {
@@ -109,6 +112,28 @@ impl FragProgram for VertexColorProg {
     #[inline]
     fn shade(&self, _: &(), f: &QuadFrag, _: bool) -> [[f32; 4]; 3] {
         [f.var[0], f.var[1], f.var[2]]
+    }
+}
+
+/// `Shading::FirstVertexColor`.
+pub(crate) struct FirstVertexColorProg;
+
+impl FragProgram for FirstVertexColorProg {
+    const NV: usize = 0;
+    type Vars = ();
+    type TriConst = Vec3;
+    #[inline]
+    fn vertex_var(&self, _: &Mesh, _: usize) -> Var {
+        NO_VAR
+    }
+    #[inline]
+    fn tri_const(&self, mesh: &Mesh, tri: u32, _: bool) -> Vec3 {
+        let first = mesh.indices()[tri as usize][0] as usize;
+        mesh.colors().map_or(Vec3::ONE, |c| c[first])
+    }
+    #[inline]
+    fn shade(&self, c: &Vec3, _: &QuadFrag, _: bool) -> [[f32; 4]; 3] {
+        [[c.x; 4], [c.y; 4], [c.z; 4]]
     }
 }
 

@@ -359,3 +359,48 @@ fn a_second_clear_holds_for_drawn_and_untouched_tiles() {
         }
     }
 }
+
+#[test]
+fn composite_takes_drawn_pixels_and_the_underlay_elsewhere() {
+    // A 131x70 image (odd width, partial tiles) with a triangle across tile borders and one
+    // tile row never drawn: every texel is checked against the per-pixel accessors, with a
+    // distinct underlay value per texel.
+    let (w, h) = (131u32, 70u32);
+    let cam = ortho(w, h);
+    let screen = [[3.5, 2.0], [120.25, 30.0], [40.0, 60.5]];
+    let pos: Vec<Vec3> = screen.iter().map(|p| world(&cam, p[0], p[1])).collect();
+    let mesh = Mesh::new(&pos, &[[0, 1, 2]]).unwrap();
+    let mut fb = Framebuffer::new(w, h).unwrap();
+    fb.clear([0, 0, 0, 255]);
+    let state = DrawState {
+        cull: Cull::None,
+        ..DrawState::default()
+    };
+    fb.draw_mesh(
+        &cam,
+        &mesh,
+        &Shading::Flat(Vec3::new(0.25, 0.5, 0.75)),
+        &state,
+    )
+    .unwrap();
+    let under: Vec<glam::Vec4> = (0..w * h)
+        .map(|i| glam::Vec4::new(i as f32, -(i as f32), 2.0, 0.5))
+        .collect();
+    let mut out = vec![glam::Vec4::NAN; (w * h) as usize];
+    fb.composite_linear_into(&under, &mut out);
+    let mut drawn = 0;
+    for y in 0..h {
+        for x in 0..w {
+            let i = (y * w + x) as usize;
+            let want = if fb.depth_at(x, y).unwrap().is_finite() {
+                drawn += 1;
+                fb.color_at(x, y).unwrap().extend(1.0)
+            } else {
+                under[i]
+            };
+            assert_eq!(out[i], want, "texel ({x}, {y})");
+        }
+    }
+    // About half the triangle's bounding box: the triangle was drawn, not skipped.
+    assert!(drawn > 2000, "{drawn} pixels drawn");
+}

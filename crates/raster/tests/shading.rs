@@ -748,3 +748,69 @@ fn textured_quads_name_their_source_triangle() {
     assert_eq!(below + above, 200);
     assert_eq!(below, above);
 }
+
+#[test]
+fn first_vertex_colour_fills_each_triangle_with_its_first_vertex() {
+    // The same rectangle and diagonal; vertex colours differ everywhere, and the two triangles
+    // start at different vertices: every covered pixel holds exactly its triangle's first
+    // vertex colour (linear, read back unencoded), nothing interpolated.
+    let cam =
+        Camera::orthographic_look_at(Vec3::new(0.0, 0.0, 10.0), Vec3::ZERO, Vec3::Y, 64.0, 64, 48)
+            .unwrap();
+    let pos = [
+        Vec3::new(-10.0, -5.0, 0.0),
+        Vec3::new(10.0, -5.0, 0.0),
+        Vec3::new(10.0, 5.0, 0.0),
+        Vec3::new(-10.0, 5.0, 0.0),
+    ];
+    let colors = [
+        Vec3::new(0.9, 0.1, 0.2),
+        Vec3::new(0.1, 0.8, 0.3),
+        Vec3::new(0.3, 0.2, 0.7),
+        Vec3::new(0.5, 0.5, 0.05),
+    ];
+    let mesh = Mesh::new(&pos, &[[1, 2, 0], [3, 0, 2]])
+        .unwrap()
+        .with_colors(&colors)
+        .unwrap();
+    let mut fb = Framebuffer::new(64, 48).unwrap();
+    fb.clear([0, 0, 0, 255]);
+    fb.draw_mesh(
+        &cam,
+        &mesh,
+        &Shading::FirstVertexColor,
+        &DrawState::default(),
+    )
+    .unwrap();
+    let (mut below, mut above) = (0, 0);
+    for j in 0..48 {
+        for i in 0..64 {
+            let (x, y) = (i as f64 + 0.5 - 32.0, 24.0 - (j as f64 + 0.5));
+            let got = fb.color_at(i, j).unwrap();
+            if x.abs() > 10.0 || y.abs() > 5.0 {
+                assert!(
+                    fb.depth_at(i, j).unwrap().is_infinite(),
+                    "({i}, {j}) outside"
+                );
+            } else if y < x / 2.0 {
+                assert_eq!(got, colors[1], "({i}, {j}) in triangle 0");
+                below += 1;
+            } else {
+                assert_eq!(got, colors[3], "({i}, {j}) in triangle 1");
+                above += 1;
+            }
+        }
+    }
+    assert_eq!((below, above), (100, 100));
+    // Without colours the draw is refused, as for Gouraud colours.
+    let bare = Mesh::new(&pos, &[[0, 1, 2]]).unwrap();
+    assert!(
+        fb.draw_mesh(
+            &cam,
+            &bare,
+            &Shading::FirstVertexColor,
+            &DrawState::default()
+        )
+        .is_err()
+    );
+}
