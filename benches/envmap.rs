@@ -3,7 +3,9 @@
 //! time-sliced (`cube_faces_per_frame` 1 and 2: one Renderer across iterations, so each
 //! iteration redraws the next faces of the kept map, round robin — the steady state of an
 //! animation; the scene is static, which changes nothing in the cost), and each map update alone
-//! (the cube's also time-sliced, through `maps::update_cube_faces` with the kept map).
+//! (the cube's also time-sliced, through `maps::update_cube_faces` with the kept map). Each
+//! full update hands its map back to the scratch (`MapScratch::recycle`), as the Renderer does
+//! with the last frame's map, so the pyramids are rebuilt into the same buffers.
 //!
 //! `cargo bench --bench envmap`
 
@@ -12,10 +14,11 @@ use std::hint::black_box;
 use criterion::{Criterion, criterion_group, criterion_main};
 use texmap_envmap::address::MapFrame;
 use texmap_envmap::maps::{
-    MapScratch, UpdateParams, update_cube, update_cube_faces, update_paraboloid, update_sphere,
+    EnvMap, MapScratch, UpdateParams, update_cube, update_cube_faces, update_paraboloid,
+    update_sphere,
 };
 use texmap_envmap::scene::{TunnelParams, tunnel_camera, tunnel_scene};
-use texmap_envmap::{Method, Options, Renderer, RimPolicy};
+use texmap_envmap::{EnvMapError, Method, Options, Renderer, RimPolicy};
 
 fn bench(c: &mut Criterion) {
     let scene = tunnel_scene(TunnelParams {
@@ -67,9 +70,17 @@ fn bench(c: &mut Criterion) {
         min_distance: 0.0,
         rim: RimPolicy::Split,
     };
+    // A full update, its map recycled into the scratch for the next one.
+    let update = |s: &mut MapScratch,
+                  f: &dyn Fn(&mut MapScratch) -> Result<EnvMap, EnvMapError>| {
+        let m = f(s).unwrap();
+        let n = black_box(m.size());
+        s.recycle(m);
+        n
+    };
     let mut s = MapScratch::default();
     g.bench_function("update_256/cube", |b| {
-        b.iter(|| black_box(update_cube(&p(MapFrame::WORLD), &mut s).unwrap().size()))
+        b.iter(|| update(&mut s, &|s| update_cube(&p(MapFrame::WORLD), s)))
     });
     // Time-sliced: N faces of the kept map per iteration, round robin, as the Renderer does.
     for n in [1usize, 2] {
@@ -90,17 +101,11 @@ fn bench(c: &mut Criterion) {
     let mut s = MapScratch::default();
     let eye = MapFrame::of_camera(&cam);
     g.bench_function("update_256/sphere", |b| {
-        b.iter(|| black_box(update_sphere(&p(eye), &mut s).unwrap().size()))
+        b.iter(|| update(&mut s, &|s| update_sphere(&p(eye), s)))
     });
     let mut s = MapScratch::default();
     g.bench_function("update_256/paraboloid", |b| {
-        b.iter(|| {
-            black_box(
-                update_paraboloid(&p(MapFrame::WORLD), &mut s)
-                    .unwrap()
-                    .size(),
-            )
-        })
+        b.iter(|| update(&mut s, &|s| update_paraboloid(&p(MapFrame::WORLD), s)))
     });
     g.finish();
 }

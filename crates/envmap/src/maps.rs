@@ -290,14 +290,14 @@ fn environment_texels(
         .collect()
 }
 
-fn pyramid(side: u32, texels: &[Vec4]) -> Result<MipTexture, EnvMapError> {
-    Ok(MipTexture::from_linear(
-        side,
-        side,
-        texels,
-        Reduction::Box,
-        Wrap::Clamp,
-    )?)
+/// The face pyramid of `texels`, built into `old`'s buffers when given (see [`MapScratch::recycle`]).
+fn pyramid(side: u32, texels: &[Vec4], old: Option<MipTexture>) -> Result<MipTexture, EnvMapError> {
+    Ok(match old {
+        Some(old) => {
+            MipTexture::from_linear_reusing(old, side, side, texels, Reduction::Box, Wrap::Clamp)
+        }
+        None => MipTexture::from_linear(side, side, texels, Reduction::Box, Wrap::Clamp),
+    }?)
 }
 
 impl EnvMap {
@@ -313,7 +313,7 @@ impl EnvMap {
         let side = tex_side(kind, size);
         let faces = environment_texels(kind, frame, size, env, 2)
             .iter()
-            .map(|t| pyramid(side, t))
+            .map(|t| pyramid(side, t, None))
             .collect::<Result<Vec<_>, _>>()?;
         Ok(EnvMap {
             kind,
@@ -410,15 +410,32 @@ pub struct MapScratch {
     /// One merged face per map face, reused across updates.
     texels: Vec<Vec<Vec4>>,
     filtered: Vec<[u32; 3]>,
-    /// The cube update's flattened triangles: vertices, colour, faces touched.
-    flat: Vec<([Vec3; 3], Vec3, u8)>,
+    /// The cube update's frustum outcodes per vertex of the object being flattened.
+    codes: Vec<u32>,
+    /// The cube update's flattened triangles (vertices, colour, faces touched), in runs of
+    /// [`FLAT_RUN`] object triangles.
+    flat: Vec<Vec<([Vec3; 3], Vec3, u8)>>,
     /// Pieces of mapped triangles dropped at the rim in the last projected update.
     pub dropped_pieces: usize,
+    /// Pyramids of recycled maps, rebuilt into by the next updates.
+    spare: Vec<MipTexture>,
 }
 
 impl MapScratch {
-    /// Draw the gathered pieces (`positions`, one colour per vertex, `tris`) into the square
-    /// scratch framebuffer of side `side`, cleared first, with `cam` and `state`.
+    /// Hand back a map no longer needed: the next updates build their face pyramids into its
+    /// buffers instead of allocating (an animation's steady state then allocates no pyramid).
+    /// At most six pyramids are kept.
+    pub fn recycle(&mut self, map: EnvMap) {
+        for face in map.faces {
+            if self.spare.len() < 6 {
+                self.spare.push(face);
+            }
+        }
+    }
+
+    /// Draw the gathered pieces (`positions`, one colour per vertex, `tris`; every piece is
+    /// flat, drawn in its first vertex's colour) into the square scratch framebuffer of side
+    /// `side`, cleared first, with `cam` and `state`.
     fn draw_pieces(
         &mut self,
         side: u32,
@@ -431,7 +448,7 @@ impl MapScratch {
         let fb = self.fb.as_mut().expect("just set");
         fb.clear([0, 0, 0, 255]);
         let mesh = Mesh::new(&self.positions, &self.tris)?.with_colors(&self.colors)?;
-        fb.draw_mesh(cam, &mesh, &Shading::VertexColor, state)?;
+        fb.draw_mesh(cam, &mesh, &Shading::FirstVertexColor, state)?;
         Ok(())
     }
 
@@ -468,21 +485,31 @@ pub struct UpdateParams<'a> {
     pub rim: RimPolicy,
 }
 
+/// Object triangles flattened per parallel job by the cube update.
+const FLAT_RUN: usize = 4096;
+
+/// Whether the update draws the triangle `w`: its centroid is at least `min_distance` from the
+/// centre (every triangle when it is 0).
+#[inline]
+fn far_enough(p: &UpdateParams, w: &[Vec3; 3]) -> bool {
+    p.min_distance <= 0.0
+        || ((w[0] + w[1] + w[2]) / 3.0 - p.centre).length_squared()
+            >= p.min_distance * p.min_distance
+}
+
 /// The triangles of `o` that the update draws (all, or those far enough from the centre).
 fn select<'s>(o: &'s Object, p: &UpdateParams, filtered: &'s mut Vec<[u32; 3]>) -> &'s [[u32; 3]] {
     if p.min_distance <= 0.0 {
         return &o.mesh.triangles;
     }
     filtered.clear();
-    let m2 = p.min_distance * p.min_distance;
-    filtered.extend(o.mesh.triangles.iter().copied().filter(|t| {
-        let c = t
+    filtered.extend(
+        o.mesh
+            .triangles
             .iter()
-            .map(|&i| o.mesh.positions[i as usize])
-            .sum::<Vec3>()
-            / 3.0;
-        (c - p.centre).length_squared() >= m2
-    }));
+            .copied()
+            .filter(|t| far_enough(p, &t.map(|i| o.mesh.positions[i as usize]))),
+    );
     filtered
 }
 
@@ -516,31 +543,24 @@ fn finish_faces(
         draw(face, scratch)?;
         let fb = scratch.fb.as_ref().expect("drawn");
         let env = &scratch.env_cache.as_ref().expect("filled").3[face];
-        texels.clear();
         texels.resize((side * side) as usize, Vec4::ZERO);
-        texels
-            .par_chunks_mut(side as usize)
-            .zip(env.par_chunks(side as usize))
-            .enumerate()
-            .for_each(|(y, (row, env_row))| {
-                for (x, (t, e)) in row.iter_mut().zip(env_row).enumerate() {
-                    let (x, y) = (x as u32, y as u32);
-                    let covered = fb.depth_at(x, y).is_some_and(f32::is_finite);
-                    *t = if covered {
-                        fb.color_at(x, y).unwrap_or(Vec3::ZERO).extend(1.0)
-                    } else {
-                        *e
-                    };
-                }
-            });
+        fb.composite_linear_into(env, texels);
         if kind == MapKind::Sphere {
             fill_outside_disc(side, texels);
         }
     }
+    let mut spare: Vec<Option<MipTexture>> = (0..count)
+        .map(|face| drawn(face).then(|| scratch.spare.pop()).flatten())
+        .collect();
     let built = texels
         .par_iter()
+        .zip(spare.par_iter_mut())
         .enumerate()
-        .map(|(face, t)| drawn(face).then(|| pyramid(side, t)).transpose())
+        .map(|(face, (t, old))| {
+            drawn(face)
+                .then(|| pyramid(side, t, old.take()))
+                .transpose()
+        })
         .collect::<Result<Vec<_>, _>>();
     scratch.texels = texels;
     let mut kept = previous.map(|m| m.faces).unwrap_or_default().into_iter();
@@ -676,33 +696,68 @@ pub fn update_cube_faces(
         code
     };
     // Faces not drawn are masked out: their triangles are neither flattened nor drawn.
-    let face_mask = |w: &[Vec3; 3]| {
-        let out = vertex_code(w[0]) & vertex_code(w[1]) & vertex_code(w[2]);
+    let face_mask = |out: u32| {
         (0..6).fold(0u8, |m, k| m | ((((out >> (4 * k)) & 0xf) == 0) as u8) << k) & faces
     };
-    let mut flat = std::mem::take(&mut scratch.flat);
-    flat.clear();
-    let mut filtered = std::mem::take(&mut scratch.filtered);
+    // Outcodes once per vertex (a vertex is shared by about six triangles), all objects'
+    // vertices in one buffer.
+    let mut codes = std::mem::take(&mut scratch.codes);
+    let mut first_vertex = Vec::with_capacity(p.objects.len());
+    codes.clear();
     for o in p.objects {
-        // `par_extend` keeps the order of the triangles.
-        flat.par_extend(select(o, p, &mut filtered).par_iter().filter_map(|t| {
-            let pos = &o.mesh.positions;
-            let w = [pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]];
-            let m = face_mask(&w);
-            if m == 0 {
-                return None;
-            }
-            flat_colour(p, o, w).map(|c| (w, c, m))
-        }));
+        first_vertex.push(codes.len());
+        codes.resize(codes.len() + o.mesh.positions.len(), 0);
     }
-    scratch.filtered = filtered;
+    for (o, &v0) in p.objects.iter().zip(&first_vertex) {
+        codes[v0..v0 + o.mesh.positions.len()]
+            .par_iter_mut()
+            .zip(o.mesh.positions.par_iter())
+            .for_each(|(c, &v)| *c = vertex_code(v));
+    }
+    // Flattened in fixed runs of triangles, each into its own buffer kept across updates (so a
+    // steady state allocates nothing), read back in order: the same soup for any thread count.
+    let runs: Vec<(usize, std::ops::Range<usize>)> = p
+        .objects
+        .iter()
+        .enumerate()
+        .flat_map(|(k, o)| {
+            let n = o.mesh.triangles.len();
+            (0..n)
+                .step_by(FLAT_RUN)
+                .map(move |a| (k, a..(a + FLAT_RUN).min(n)))
+        })
+        .collect();
+    let mut flat = std::mem::take(&mut scratch.flat);
+    flat.resize_with(runs.len(), Vec::new);
+    flat.par_iter_mut()
+        .zip(&runs)
+        .for_each(|(out, (k, range))| {
+            out.clear();
+            let o = &p.objects[*k];
+            let (pos, codes) = (&o.mesh.positions, &codes[first_vertex[*k]..]);
+            for t in &o.mesh.triangles[range.clone()] {
+                let [a, b, c] = t.map(|i| i as usize);
+                let m = face_mask(codes[a] & codes[b] & codes[c]);
+                let w = [pos[a], pos[b], pos[c]];
+                if m == 0 || !far_enough(p, &w) {
+                    continue;
+                }
+                if let Some(c) = flat_colour(p, o, w) {
+                    out.push((w, c, m));
+                }
+            }
+        });
+    scratch.codes = codes;
     let mut draw = |face: usize, s: &mut MapScratch| -> Result<(), EnvMapError> {
         let (f, _, up) = Face::ALL[face].basis();
         let (fw, uw) = (p.frame.to_world(f), p.frame.to_world(up));
         let cam = Camera::perspective_look_at(p.centre, p.centre + fw, uw, fov, side, side)?;
         // Only this face's triangles, with their own vertices: the rasteriser projects every
         // vertex of the mesh it is given.
-        let mine = flat.iter().filter(|(_, _, m)| m & (1 << face) != 0);
+        let mine = flat
+            .iter()
+            .flatten()
+            .filter(|(_, _, m)| m & (1 << face) != 0);
         s.positions.clear();
         s.colors.clear();
         s.tris.clear();

@@ -462,22 +462,39 @@ impl Renderer {
             rim: opts.rim,
         };
         let all = maps::all_faces(kind);
+        // The last frame's map: kept by a time-sliced cube update, else its pyramids' buffers
+        // are rebuilt into.
+        let last = self.map.take();
         let map = match kind {
-            MapKind::Sphere => (maps::update_sphere(&p, &mut self.scratch)?, all),
+            MapKind::Sphere | MapKind::Paraboloid => {
+                if let Some(m) = last {
+                    self.scratch.recycle(m);
+                }
+                let map = if kind == MapKind::Sphere {
+                    maps::update_sphere(&p, &mut self.scratch)?
+                } else {
+                    maps::update_paraboloid(&p, &mut self.scratch)?
+                };
+                (map, all)
+            }
             MapKind::Cube => {
                 let n = opts.cube_faces_per_frame as usize;
-                let kept = self.map.take().filter(|m| {
-                    m.kind() == MapKind::Cube
+                let keep = last.as_ref().is_some_and(|m| {
+                    n < 6
+                        && m.kind() == MapKind::Cube
                         && m.size() == opts.map_size
                         && m.frame() == frame
                         && m.centre() == centre
                         && self.map_min_distance == opts.min_object_distance
                 });
-                let faces = match kept {
-                    Some(_) if n < 6 => {
-                        (0..n).fold(0u8, |m, k| m | 1 << ((self.next_face + k) % 6))
+                let (kept, faces) = if keep {
+                    let faces = (0..n).fold(0u8, |m, k| m | 1 << ((self.next_face + k) % 6));
+                    (last, faces)
+                } else {
+                    if let Some(m) = last {
+                        self.scratch.recycle(m);
                     }
-                    _ => all,
+                    (None, all)
                 };
                 let map = maps::update_cube_faces(&p, &mut self.scratch, faces, kept)?;
                 self.next_face = if faces == all {
@@ -487,7 +504,6 @@ impl Renderer {
                 };
                 (map, faces)
             }
-            MapKind::Paraboloid => (maps::update_paraboloid(&p, &mut self.scratch)?, all),
         };
         self.map_min_distance = opts.min_object_distance;
         Ok(map)
