@@ -412,9 +412,9 @@ pub struct MapScratch {
     filtered: Vec<[u32; 3]>,
     /// The cube update's frustum outcodes per vertex of the object being flattened.
     codes: Vec<u32>,
-    /// The cube update's flattened triangles (vertices, colour, faces touched), in runs of
-    /// [`FLAT_RUN`] object triangles.
-    flat: Vec<Vec<([Vec3; 3], Vec3, u8)>>,
+    /// The cube update's flattened triangles (vertices, colour) per run of [`FLAT_RUN`] object
+    /// triangles, listed under each face they may touch.
+    flat: Vec<[Vec<([Vec3; 3], Vec3)>; 6]>,
     /// Pieces of mapped triangles dropped at the rim in the last projected update.
     pub dropped_pieces: usize,
     /// Pyramids of recycled maps, rebuilt into by the next updates.
@@ -433,7 +433,7 @@ impl MapScratch {
         }
     }
 
-    /// Draw the gathered pieces (`positions`, one colour per vertex, `tris`; every piece is
+    /// Draw the gathered pieces (`positions` and `colors`, three vertices per piece; every piece is
     /// flat, drawn in its first vertex's colour) into the square scratch framebuffer of side
     /// `side`, cleared first, with `cam` and `state`.
     fn draw_pieces(
@@ -447,7 +447,12 @@ impl MapScratch {
         }
         let fb = self.fb.as_mut().expect("just set");
         fb.clear([0, 0, 0, 255]);
-        let mesh = Mesh::new(&self.positions, &self.tris)?.with_colors(&self.colors)?;
+        // Piece k is vertices 3k..3k + 3: the index list only grows, and is a prefix's.
+        let pieces = self.positions.len() / 3;
+        let have = self.tris.len() as u32;
+        self.tris
+            .extend((have..pieces as u32).map(|k| [3 * k, 3 * k + 1, 3 * k + 2]));
+        let mesh = Mesh::new(&self.positions, &self.tris[..pieces])?.with_colors(&self.colors)?;
         fb.draw_mesh(cam, &mesh, &Shading::FirstVertexColor, state)?;
         Ok(())
     }
@@ -728,11 +733,11 @@ pub fn update_cube_faces(
         })
         .collect();
     let mut flat = std::mem::take(&mut scratch.flat);
-    flat.resize_with(runs.len(), Vec::new);
+    flat.resize_with(runs.len(), Default::default);
     flat.par_iter_mut()
         .zip(&runs)
         .for_each(|(out, (k, range))| {
-            out.clear();
+            out.iter_mut().for_each(Vec::clear);
             let o = &p.objects[*k];
             let (pos, codes) = (&o.mesh.positions, &codes[first_vertex[*k]..]);
             for t in &o.mesh.triangles[range.clone()] {
@@ -743,7 +748,11 @@ pub fn update_cube_faces(
                     continue;
                 }
                 if let Some(c) = flat_colour(p, o, w) {
-                    out.push((w, c, m));
+                    for (face, out) in out.iter_mut().enumerate() {
+                        if m & (1 << face) != 0 {
+                            out.push((w, c));
+                        }
+                    }
                 }
             }
         });
@@ -754,18 +763,11 @@ pub fn update_cube_faces(
         let cam = Camera::perspective_look_at(p.centre, p.centre + fw, uw, fov, side, side)?;
         // Only this face's triangles, with their own vertices: the rasteriser projects every
         // vertex of the mesh it is given.
-        let mine = flat
-            .iter()
-            .flatten()
-            .filter(|(_, _, m)| m & (1 << face) != 0);
         s.positions.clear();
         s.colors.clear();
-        s.tris.clear();
-        for (k, (w, c, _)) in mine.enumerate() {
+        for (w, c) in flat.iter().flat_map(|run| &run[face]) {
             s.positions.extend_from_slice(w);
             s.colors.extend([*c; 3]);
-            let b = 3 * k as u32;
-            s.tris.push([b, b + 1, b + 2]);
         }
         s.draw_pieces(side, &cam, &state)
     };
@@ -972,7 +974,6 @@ fn update_projected(
         };
         s.positions.clear();
         s.colors.clear();
-        s.tris.clear();
         let mapper = || Mapper {
             kind: proj,
             n: n as f32,
@@ -1014,9 +1015,6 @@ fn update_projected(
         }
         s.filtered = filtered;
         s.dropped_pieces += dropped;
-        let pieces = (s.positions.len() / 3) as u32;
-        s.tris
-            .extend((0..pieces).map(|k| [3 * k, 3 * k + 1, 3 * k + 2]));
         s.draw_pieces(n, &cam, &state)
     };
     finish_faces(kind, p, scratch, all_faces(kind), None, &mut draw)
