@@ -414,7 +414,7 @@ pub struct MapScratch {
     codes: Vec<u32>,
     /// The cube update's flattened triangles (vertices, colour) per run of [`FLAT_RUN`] object
     /// triangles, listed under each face they may touch.
-    flat: Vec<[Vec<([Vec3; 3], Vec3)>; 6]>,
+    flat: Vec<[Vec<FlatTri>; 6]>,
     /// Pieces of mapped triangles dropped at the rim in the last projected update.
     pub dropped_pieces: usize,
     /// Pyramids of recycled maps, rebuilt into by the next updates.
@@ -489,6 +489,9 @@ pub struct UpdateParams<'a> {
     pub min_distance: f32,
     pub rim: RimPolicy,
 }
+
+/// A flattened triangle: its world vertices and flat-lit colour.
+type FlatTri = ([Vec3; 3], Vec3);
 
 /// Object triangles flattened per parallel job by the cube update.
 const FLAT_RUN: usize = 4096;
