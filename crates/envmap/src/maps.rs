@@ -31,9 +31,9 @@
 //! probe, [`Lighting::shade`] seen from the probe); texels no object covers take the
 //! environment (a cached static map of it, 2x2 supersampled per texel).
 //! - **Cube map**: six perspective cameras at the probe. The objects are flattened once into a
-//!   vertex-coloured soup, each triangle tagged with the faces whose frustum pyramid it may
-//!   touch (4-bit outcodes per face), and each face draws only its own triangles, with their own
-//!   vertices, in one call. Submitting every object to every face instead left the rasteriser
+//!   flat-coloured soup, each triangle listed under the faces whose frustum pyramid it may
+//!   touch (4-bit outcodes per vertex and face), and each face draws only its own triangles,
+//!   with their own vertices, in one call. Submitting every object to every face instead left the rasteriser
 //!   projecting and clipping six times the geometry. [`update_cube_faces`] draws a subset of the
 //!   faces (a time-sliced update): triangles on none of them are not flattened (their outcodes
 //!   are still computed), and the other faces are moved from the previous map with their
@@ -60,6 +60,13 @@
 //!   instead of the chord test cut the tunnel's far rings, stretched around the singular
 //!   direction, into thousands of pieces: about 3x the update time of the cube map on the
 //!   built-in scene (harness timing, shared machine).
+//!
+//! Faces are independent: each is drawn, composited over the environment and built into its
+//! pyramid in a parallel job with its own buffers (drawn one after another, each draw's tile
+//! pass had a few busy tiles per face to split between the cores). Every buffer, the soup's and
+//! the pyramids' included, is kept in [`MapScratch`] and reused, so an animation's updates
+//! allocate nothing once warm (the soup's `par_extend` alone caused most of an update's page
+//! faults).
 //!
 //! Rejected: clipping against the map's rim circle in the plane of the map (the rim is one
 //! direction, so there is no line in direction space to clip against), and per-texel ray casting
@@ -402,14 +409,9 @@ impl EnvMap {
 /// Reusable buffers of the dynamic updates.
 #[derive(Debug, Default)]
 pub struct MapScratch {
-    fb: Option<Framebuffer>,
     env_cache: Option<(MapKind, u32, MapFrame, Vec<Vec<Vec4>>)>,
-    positions: Vec<Vec3>,
-    colors: Vec<Vec3>,
-    tris: Vec<[u32; 3]>,
-    /// One merged face per map face, reused across updates.
-    texels: Vec<Vec<Vec4>>,
-    filtered: Vec<[u32; 3]>,
+    /// One per map face: the faces are drawn in parallel.
+    faces: Vec<FaceScratch>,
     /// The cube update's frustum outcodes per vertex of the object being flattened.
     codes: Vec<u32>,
     /// The cube update's flattened triangles (vertices, colour) per run of [`FLAT_RUN`] object
@@ -419,6 +421,20 @@ pub struct MapScratch {
     pub dropped_pieces: usize,
     /// Pyramids of recycled maps, rebuilt into by the next updates.
     spare: Vec<MipTexture>,
+}
+
+/// The buffers of one face's draw, kept across updates.
+#[derive(Debug, Default)]
+struct FaceScratch {
+    fb: Option<Framebuffer>,
+    positions: Vec<Vec3>,
+    colors: Vec<Vec3>,
+    tris: Vec<[u32; 3]>,
+    filtered: Vec<[u32; 3]>,
+    /// The face composited over the environment (level 0 of its pyramid).
+    texels: Vec<Vec4>,
+    /// A recycled pyramid to build this face's into.
+    spare: Option<MipTexture>,
 }
 
 impl MapScratch {
@@ -433,9 +449,29 @@ impl MapScratch {
         }
     }
 
+    fn env_texels(
+        &mut self,
+        kind: MapKind,
+        frame: MapFrame,
+        size: u32,
+        env: &Environment,
+    ) -> &[Vec<Vec4>] {
+        let hit = self
+            .env_cache
+            .as_ref()
+            .is_some_and(|(k, s, f, _)| *k == kind && *s == size && *f == frame);
+        if !hit {
+            let t = environment_texels(kind, frame, size, env, 2);
+            self.env_cache = Some((kind, size, frame, t));
+        }
+        &self.env_cache.as_ref().expect("just set").3
+    }
+}
+
+impl FaceScratch {
     /// Draw the gathered pieces (`positions` and `colors`, three vertices per piece; every piece is
-    /// flat, drawn in its first vertex's colour) into the square scratch framebuffer of side
-    /// `side`, cleared first, with `cam` and `state`.
+    /// flat, drawn in its first vertex's colour) into the square framebuffer of side `side`,
+    /// cleared first, with `cam` and `state`.
     fn draw_pieces(
         &mut self,
         side: u32,
@@ -455,24 +491,6 @@ impl MapScratch {
         let mesh = Mesh::new(&self.positions, &self.tris[..pieces])?.with_colors(&self.colors)?;
         fb.draw_mesh(cam, &mesh, &Shading::FirstVertexColor, state)?;
         Ok(())
-    }
-
-    fn env_texels(
-        &mut self,
-        kind: MapKind,
-        frame: MapFrame,
-        size: u32,
-        env: &Environment,
-    ) -> &[Vec<Vec4>] {
-        let hit = self
-            .env_cache
-            .as_ref()
-            .is_some_and(|(k, s, f, _)| *k == kind && *s == size && *f == frame);
-        if !hit {
-            let t = environment_texels(kind, frame, size, env, 2);
-            self.env_cache = Some((kind, size, frame, t));
-        }
-        &self.env_cache.as_ref().expect("just set").3
     }
 }
 
@@ -526,55 +544,59 @@ pub fn all_faces(kind: MapKind) -> u8 {
     ((1u16 << face_count(kind)) - 1) as u8
 }
 
-/// Merge the rasterised faces with the environment fill and build the pyramids (the faces are
-/// drawn one after another into the scratch framebuffer; their pyramids are built in parallel).
-/// Only the faces in `faces` are drawn; the others are moved, texels and pyramid, from
-/// `previous` (which the caller has checked is a map of the same layout, size, frame and centre).
+/// Draw the faces in `faces`, each composited over the environment fill and built into its
+/// pyramid; faces are independent, so they run in parallel (each draw is parallel inside too),
+/// each in its own [`FaceScratch`]. `draw` fills a face's framebuffer and returns the pieces it
+/// dropped ([`MapScratch::dropped_pieces`] gets their sum). The faces not in `faces` are moved,
+/// texels and pyramid, from `previous` (which the caller has checked is a map of the same
+/// layout, size, frame and centre).
 fn finish_faces(
     kind: MapKind,
     p: &UpdateParams,
     scratch: &mut MapScratch,
     faces: u8,
     previous: Option<EnvMap>,
-    draw: &mut dyn FnMut(usize, &mut MapScratch) -> Result<(), EnvMapError>,
+    draw: &(dyn Fn(usize, &mut FaceScratch) -> Result<usize, EnvMapError> + Sync),
 ) -> Result<EnvMap, EnvMapError> {
     let side = tex_side(kind, p.size);
     let count = face_count(kind);
     let drawn = |face: usize| faces & (1 << face) != 0;
     scratch.env_texels(kind, p.frame, p.size, p.environment);
-    let mut texels = std::mem::take(&mut scratch.texels);
-    texels.resize_with(count, Vec::new);
-    for (face, texels) in texels.iter_mut().enumerate() {
-        if !drawn(face) {
-            continue;
-        }
-        draw(face, scratch)?;
-        let fb = scratch.fb.as_ref().expect("drawn");
-        let env = &scratch.env_cache.as_ref().expect("filled").3[face];
-        texels.resize((side * side) as usize, Vec4::ZERO);
-        fb.composite_linear_into(env, texels);
-        if kind == MapKind::Sphere {
-            fill_outside_disc(side, texels);
+    let MapScratch {
+        env_cache,
+        faces: face_scratch,
+        spare,
+        ..
+    } = scratch;
+    let env = &env_cache.as_ref().expect("filled").3;
+    face_scratch.resize_with(count, FaceScratch::default);
+    for (face, f) in face_scratch.iter_mut().enumerate() {
+        if drawn(face) && f.spare.is_none() {
+            f.spare = spare.pop();
         }
     }
-    let mut spare: Vec<Option<MipTexture>> = (0..count)
-        .map(|face| drawn(face).then(|| scratch.spare.pop()).flatten())
-        .collect();
-    let built = texels
-        .par_iter()
-        .zip(spare.par_iter_mut())
+    let built = face_scratch
+        .par_iter_mut()
         .enumerate()
-        .map(|(face, (t, old))| {
-            drawn(face)
-                .then(|| pyramid(side, t, old.take()))
-                .transpose()
+        .map(|(face, f)| {
+            if !drawn(face) {
+                return Ok((None, 0));
+            }
+            let dropped = draw(face, f)?;
+            let fb = f.fb.as_ref().expect("drawn");
+            f.texels.resize((side * side) as usize, Vec4::ZERO);
+            fb.composite_linear_into(&env[face], &mut f.texels);
+            if kind == MapKind::Sphere {
+                fill_outside_disc(side, &mut f.texels);
+            }
+            Ok((Some(pyramid(side, &f.texels, f.spare.take())?), dropped))
         })
-        .collect::<Result<Vec<_>, _>>();
-    scratch.texels = texels;
+        .collect::<Result<Vec<_>, EnvMapError>>()?;
+    scratch.dropped_pieces += built.iter().map(|b| b.1).sum::<usize>();
     let mut kept = previous.map(|m| m.faces).unwrap_or_default().into_iter();
-    let faces = built?
+    let faces = built
         .into_iter()
-        .map(|b| {
+        .map(|(b, _)| {
             let old = kept.next();
             b.or(old).ok_or(EnvMapError::BadOption {
                 what: "a partial map update needs the previous map",
@@ -760,7 +782,7 @@ pub fn update_cube_faces(
             }
         });
     scratch.codes = codes;
-    let mut draw = |face: usize, s: &mut MapScratch| -> Result<(), EnvMapError> {
+    let draw = |face: usize, s: &mut FaceScratch| -> Result<usize, EnvMapError> {
         let (f, _, up) = Face::ALL[face].basis();
         let (fw, uw) = (p.frame.to_world(f), p.frame.to_world(up));
         let cam = Camera::perspective_look_at(p.centre, p.centre + fw, uw, fov, side, side)?;
@@ -772,9 +794,10 @@ pub fn update_cube_faces(
             s.positions.extend_from_slice(w);
             s.colors.extend([*c; 3]);
         }
-        s.draw_pieces(side, &cam, &state)
+        s.draw_pieces(side, &cam, &state)?;
+        Ok(0)
     };
-    let result = finish_faces(MapKind::Cube, p, scratch, faces, previous, &mut draw);
+    let result = finish_faces(MapKind::Cube, p, scratch, faces, previous, &draw);
     scratch.flat = flat;
     result
 }
@@ -969,7 +992,7 @@ fn update_projected(
         .min(n as f32 / 4.0)
         .max(MIN_SPLIT_EDGE_TEXELS);
     scratch.dropped_pieces = 0;
-    let mut draw = |face: usize, s: &mut MapScratch| -> Result<(), EnvMapError> {
+    let draw = |face: usize, s: &mut FaceScratch| -> Result<usize, EnvMapError> {
         let proj = match (kind, face) {
             (MapKind::Sphere, _) => Projected::Sphere,
             (_, 0) => Projected::Paraboloid(Hemisphere::Front),
@@ -1017,10 +1040,10 @@ fn update_projected(
             }
         }
         s.filtered = filtered;
-        s.dropped_pieces += dropped;
-        s.draw_pieces(n, &cam, &state)
+        s.draw_pieces(n, &cam, &state)?;
+        Ok(dropped)
     };
-    finish_faces(kind, p, scratch, all_faces(kind), None, &mut draw)
+    finish_faces(kind, p, scratch, all_faces(kind), None, &draw)
 }
 
 /// Dynamic sphere map (Seed 003): the objects' triangles mapped straight into sphere-map space.
