@@ -72,6 +72,8 @@
 //! direction, so there is no line in direction space to clip against), and per-texel ray casting
 //! of the objects into the map (exact, but it needs a BVH: a second renderer).
 
+use std::ops::Range;
+
 use glam::{Vec2, Vec3, Vec4};
 use rayon::prelude::*;
 use texmap_core::camera::Camera;
@@ -108,7 +110,7 @@ pub const CHORD_TOLERANCE_TEXELS: f32 = 0.5;
 /// ...unless every edge is at most this long.
 pub const MIN_SPLIT_EDGE_TEXELS: f32 = 2.0;
 /// Object triangles per parallel task of a mapped update.
-const MAP_CHUNK: usize = 2048;
+const MAP_RUN: usize = 2048;
 /// The deepest split of a mapped triangle (`4^10` pieces at most, only near the singular
 /// direction in practice).
 pub const MAX_SPLIT_DEPTH: u32 = 10;
@@ -430,7 +432,8 @@ struct FaceScratch {
     positions: Vec<Vec3>,
     colors: Vec<Vec3>,
     tris: Vec<[u32; 3]>,
-    filtered: Vec<[u32; 3]>,
+    /// Projected updates: the pieces mapped from each run of object triangles.
+    pieces: Vec<Pieces>,
     /// The face composited over the environment (level 0 of its pyramid).
     texels: Vec<Vec4>,
     /// A recycled pyramid to build this face's into.
@@ -523,20 +526,17 @@ fn far_enough(p: &UpdateParams, w: &[Vec3; 3]) -> bool {
             >= p.min_distance * p.min_distance
 }
 
-/// The triangles of `o` that the update draws (all, or those far enough from the centre).
-fn select<'s>(o: &'s Object, p: &UpdateParams, filtered: &'s mut Vec<[u32; 3]>) -> &'s [[u32; 3]] {
-    if p.min_distance <= 0.0 {
-        return &o.mesh.triangles;
-    }
-    filtered.clear();
-    filtered.extend(
-        o.mesh
-            .triangles
-            .iter()
-            .copied()
-            .filter(|t| far_enough(p, &t.map(|i| o.mesh.positions[i as usize]))),
-    );
-    filtered
+/// The objects' triangles in runs `(object, range)` of at most `len`, in order: the parallel
+/// jobs of an update, each writing into buffers of its own.
+fn triangle_runs(objects: &[Object], len: usize) -> Vec<(usize, Range<usize>)> {
+    objects
+        .iter()
+        .enumerate()
+        .flat_map(|(k, o)| {
+            let n = o.mesh.triangles.len();
+            (0..n).step_by(len).map(move |a| (k, a..(a + len).min(n)))
+        })
+        .collect()
 }
 
 /// Every face of a map of `kind` as a face mask (bit `i` is `faces()[i]`).
@@ -746,17 +746,7 @@ pub fn update_cube_faces(
     }
     // Flattened in fixed runs of triangles, each into its own buffer kept across updates (so a
     // steady state allocates nothing), read back in order: the same soup for any thread count.
-    let runs: Vec<(usize, std::ops::Range<usize>)> = p
-        .objects
-        .iter()
-        .enumerate()
-        .flat_map(|(k, o)| {
-            let n = o.mesh.triangles.len();
-            (0..n)
-                .step_by(FLAT_RUN)
-                .map(move |a| (k, a..(a + FLAT_RUN).min(n)))
-        })
-        .collect();
+    let runs = triangle_runs(p.objects, FLAT_RUN);
     let mut flat = std::mem::take(&mut scratch.flat);
     flat.resize_with(runs.len(), Default::default);
     flat.par_iter_mut()
@@ -840,28 +830,35 @@ fn contains_dir(a: Vec3, b: Vec3, c: Vec3, q: Vec3) -> bool {
 }
 
 /// Emit the pieces of one mapped triangle (positions relative to the centre, map frame).
-struct Mapper {
+struct Mapper<'a> {
     kind: Projected,
     n: f32,
     max_edge2: f32,
     /// `1 − cos` of the angle below which a piece at a paraboloid band's edge is dropped.
     band_edge_cos: f32,
     rim: RimPolicy,
-    /// Three vertices per emitted piece (map-space positions) and their colours.
-    out_pos: Vec<Vec3>,
-    out_col: Vec<Vec3>,
+    out: &'a mut Pieces,
+}
+
+/// Mapped pieces: three vertices per piece (map-space positions) and their colours, and the
+/// pieces dropped at the rim.
+#[derive(Debug, Default)]
+struct Pieces {
+    pos: Vec<Vec3>,
+    col: Vec<Vec3>,
     dropped: usize,
 }
 
-impl Mapper {
+impl Mapper<'_> {
     fn emit(&mut self, q: [Vec2; 3], dist: [f32; 3], colour: Vec3) {
         let h = self.n * 0.5;
         for k in 0..3 {
             // Orthographic camera at the origin looking down −z, one unit per pixel:
             // pixel (x, y) is world (x − n/2, n/2 − y); depth is the distance to the centre.
-            self.out_pos
+            self.out
+                .pos
                 .push(Vec3::new(q[k].x - h, h - q[k].y, -dist[k]));
-            self.out_col.push(colour);
+            self.out.col.push(colour);
         }
     }
 
@@ -892,7 +889,7 @@ impl Mapper {
     fn triangle(&mut self, v: [Vec3; 3], colour: Vec3, depth: u32) {
         let dist = v.map(Vec3::length);
         if dist.iter().any(|&d| !(d > 1e-12 && d.is_finite())) {
-            self.dropped += 1;
+            self.out.dropped += 1;
             return;
         }
         let d = [v[0] / dist[0], v[1] / dist[1], v[2] / dist[2]];
@@ -905,7 +902,7 @@ impl Mapper {
             if let [Some(a), Some(b), Some(c)] = q {
                 self.emit([a, b, c], dist, colour);
             } else {
-                self.dropped += 1;
+                self.out.dropped += 1;
             }
             return;
         }
@@ -941,7 +938,7 @@ impl Mapper {
             return;
         }
         if depth >= MAX_SPLIT_DEPTH {
-            self.dropped += 1;
+            self.out.dropped += 1;
             return;
         }
         let mid = |i: usize| (v[i] + v[(i + 1) % 3]) * 0.5;
@@ -992,15 +989,14 @@ fn update_projected(
         .min(n as f32 / 4.0)
         .max(MIN_SPLIT_EDGE_TEXELS);
     scratch.dropped_pieces = 0;
+    let runs = triangle_runs(p.objects, MAP_RUN);
     let draw = |face: usize, s: &mut FaceScratch| -> Result<usize, EnvMapError> {
         let proj = match (kind, face) {
             (MapKind::Sphere, _) => Projected::Sphere,
             (_, 0) => Projected::Paraboloid(Hemisphere::Front),
             _ => Projected::Paraboloid(Hemisphere::Back),
         };
-        s.positions.clear();
-        s.colors.clear();
-        let mapper = || Mapper {
+        let config = |out| Mapper {
             kind: proj,
             n: n as f32,
             max_edge2: max_edge * max_edge,
@@ -1010,36 +1006,39 @@ fn update_projected(
                 0.5 * a * a
             },
             rim: p.rim,
-            out_pos: Vec::new(),
-            out_col: Vec::new(),
-            dropped: 0,
+            out,
         };
-        let mut filtered = std::mem::take(&mut s.filtered);
-        let mut dropped = 0;
-        for o in p.objects {
-            // Chunks mapped in parallel, concatenated in order: the same pieces in the same
-            // order for any thread count.
-            let parts: Vec<Mapper> = select(o, p, &mut filtered)
-                .par_chunks(MAP_CHUNK)
-                .map(|chunk| {
-                    let mut m = mapper();
-                    for t in chunk {
-                        let w = t.map(|i| o.mesh.positions[i as usize]);
-                        let v = w.map(|x| p.frame.to_map(x - p.centre));
-                        if let Some(colour) = flat_colour(p, o, w) {
-                            m.triangle(v, colour, 0);
-                        }
+        // Runs mapped in parallel into buffers kept across updates, concatenated in order: the
+        // same pieces in the same order for any thread count.
+        s.pieces.resize_with(runs.len(), Pieces::default);
+        s.pieces
+            .par_iter_mut()
+            .zip(&runs)
+            .for_each(|(out, (k, range))| {
+                out.pos.clear();
+                out.col.clear();
+                out.dropped = 0;
+                let o = &p.objects[*k];
+                let mut m = config(out);
+                for t in &o.mesh.triangles[range.clone()] {
+                    let w = t.map(|i| o.mesh.positions[i as usize]);
+                    if !far_enough(p, &w) {
+                        continue;
                     }
-                    m
-                })
-                .collect();
-            for m in parts {
-                s.positions.extend_from_slice(&m.out_pos);
-                s.colors.extend_from_slice(&m.out_col);
-                dropped += m.dropped;
-            }
+                    let v = w.map(|x| p.frame.to_map(x - p.centre));
+                    if let Some(colour) = flat_colour(p, o, w) {
+                        m.triangle(v, colour, 0);
+                    }
+                }
+            });
+        s.positions.clear();
+        s.colors.clear();
+        let mut dropped = 0;
+        for run in &s.pieces {
+            s.positions.extend_from_slice(&run.pos);
+            s.colors.extend_from_slice(&run.col);
+            dropped += run.dropped;
         }
-        s.filtered = filtered;
         s.draw_pieces(n, &cam, &state)?;
         Ok(dropped)
     };

@@ -20,8 +20,8 @@ use crate::bin::TileSpan;
 use crate::framebuffer::{Framebuffer, Grid};
 use crate::mesh::Mesh;
 use crate::program::{
-    FirstVertexColorProg, FlatProg, FragProgram, LitFlatProg, LitSmoothProg, QuadSampler, Shading,
-    TexturedProg, VertexColorProg,
+    FirstVertexColour, FlatProg, FragProgram, LitFlat, LitSmoothProg, PerTriangle, QuadSampler,
+    Shading, TexturedProg, VertexColorProg,
 };
 use crate::project::{FLAG_INVALID, MAX_VAR, PVert, Proj};
 use crate::record::{FRONT_BIT, Rec, VarStore};
@@ -138,15 +138,15 @@ impl Framebuffer {
                 if matches!(shading, Shading::VertexColor) {
                     self.draw_program(&proj, mesh, &VertexColorProg, state)
                 } else {
-                    self.draw_program(&proj, mesh, &FirstVertexColorProg, state)
+                    self.draw_program(&proj, mesh, &PerTriangle(FirstVertexColour), state)
                 }
             }
             Shading::LitFlat { lighting, material } => {
-                let prog = LitFlatProg {
+                let prog = PerTriangle(LitFlat {
                     lighting: lighting.to_eye(camera),
                     material,
                     proj,
-                };
+                });
                 self.draw_program(&proj, mesh, &prog, state)
             }
             Shading::LitSmooth { lighting, material } => {

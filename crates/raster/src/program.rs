@@ -115,10 +115,16 @@ impl FragProgram for VertexColorProg {
     }
 }
 
-/// `Shading::FirstVertexColor`.
-pub(crate) struct FirstVertexColorProg;
+/// A colour computed once per triangle, for [`PerTriangle`].
+pub(crate) trait TriangleColour: Sync {
+    /// The colour of triangle `tri` of `mesh` (`front`: seen from its front side).
+    fn colour(&self, mesh: &Mesh, tri: u32, front: bool) -> Vec3;
+}
 
-impl FragProgram for FirstVertexColorProg {
+/// A program that fills each triangle with one [`TriangleColour`]: nothing is interpolated.
+pub(crate) struct PerTriangle<C>(pub C);
+
+impl<C: TriangleColour> FragProgram for PerTriangle<C> {
     const NV: usize = 0;
     type Vars = ();
     type TriConst = Vec3;
@@ -127,9 +133,8 @@ impl FragProgram for FirstVertexColorProg {
         NO_VAR
     }
     #[inline]
-    fn tri_const(&self, mesh: &Mesh, tri: u32, _: bool) -> Vec3 {
-        let first = mesh.indices()[tri as usize][0] as usize;
-        mesh.colors().map_or(Vec3::ONE, |c| c[first])
+    fn tri_const(&self, mesh: &Mesh, tri: u32, front: bool) -> Vec3 {
+        self.0.colour(mesh, tri, front)
     }
     #[inline]
     fn shade(&self, c: &Vec3, _: &QuadFrag, _: bool) -> [[f32; 4]; 3] {
@@ -137,22 +142,26 @@ impl FragProgram for FirstVertexColorProg {
     }
 }
 
+/// `Shading::FirstVertexColor`.
+pub(crate) struct FirstVertexColour;
+
+impl TriangleColour for FirstVertexColour {
+    #[inline]
+    fn colour(&self, mesh: &Mesh, tri: u32, _: bool) -> Vec3 {
+        let first = mesh.indices()[tri as usize][0] as usize;
+        mesh.colors().map_or(Vec3::ONE, |c| c[first])
+    }
+}
+
 /// `Shading::LitFlat`: lighting in eye space, one colour per triangle.
-pub(crate) struct LitFlatProg {
+pub(crate) struct LitFlat {
     pub lighting: Lighting,
     pub material: Material,
     pub proj: Proj,
 }
 
-impl FragProgram for LitFlatProg {
-    const NV: usize = 0;
-    type Vars = ();
-    type TriConst = Vec3;
-    #[inline]
-    fn vertex_var(&self, _: &Mesh, _: usize) -> Var {
-        NO_VAR
-    }
-    fn tri_const(&self, mesh: &Mesh, tri: u32, front: bool) -> Vec3 {
+impl TriangleColour for LitFlat {
+    fn colour(&self, mesh: &Mesh, tri: u32, front: bool) -> Vec3 {
         let p = mesh.positions();
         let e = mesh.indices()[tri as usize].map(|i| self.proj.to_eye(p[i as usize]));
         // Face normal from the counter-clockwise winding, toward the viewer when front-facing.
@@ -167,10 +176,6 @@ impl FragProgram for LitFlatProg {
             Vec3::Z
         };
         self.lighting.shade(&self.material, n, v)
-    }
-    #[inline]
-    fn shade(&self, c: &Vec3, _: &QuadFrag, _: bool) -> [[f32; 4]; 3] {
-        [[c.x; 4], [c.y; 4], [c.z; 4]]
     }
 }
 

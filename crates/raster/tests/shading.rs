@@ -699,10 +699,9 @@ fn degenerate_input_is_skipped_without_panic_or_nan() {
     let _ = Vec4::ZERO;
 }
 
-#[test]
-fn textured_quads_name_their_source_triangle() {
-    // One world unit per pixel; a 20 x 10 rectangle cut by its diagonal from (−10, −5) to
-    // (10, 5): triangle 0 below it, triangle 1 above. The sampler colours by `quad.triangle`.
+/// One world unit per pixel on a 64x48 image, and the corners of a 20 x 10 rectangle centred on
+/// it, counter-clockwise from (−10, −5).
+fn rectangle_64x48() -> (Camera, [Vec3; 4]) {
     let cam =
         Camera::orthographic_look_at(Vec3::new(0.0, 0.0, 10.0), Vec3::ZERO, Vec3::Y, 64.0, 64, 48)
             .unwrap();
@@ -712,6 +711,14 @@ fn textured_quads_name_their_source_triangle() {
         Vec3::new(10.0, 5.0, 0.0),
         Vec3::new(-10.0, 5.0, 0.0),
     ];
+    (cam, pos)
+}
+
+#[test]
+fn textured_quads_name_their_source_triangle() {
+    // One world unit per pixel; a 20 x 10 rectangle cut by its diagonal from (−10, −5) to
+    // (10, 5): triangle 0 below it, triangle 1 above. The sampler colours by `quad.triangle`.
+    let (cam, pos) = rectangle_64x48();
     let uv = [Vec2::ZERO; 4];
     let mesh = Mesh::new(&pos, &[[0, 1, 2], [0, 2, 3]])
         .unwrap()
@@ -754,15 +761,7 @@ fn first_vertex_colour_fills_each_triangle_with_its_first_vertex() {
     // The same rectangle and diagonal; vertex colours differ everywhere, and the two triangles
     // start at different vertices: every covered pixel holds exactly its triangle's first
     // vertex colour (linear, read back unencoded), nothing interpolated.
-    let cam =
-        Camera::orthographic_look_at(Vec3::new(0.0, 0.0, 10.0), Vec3::ZERO, Vec3::Y, 64.0, 64, 48)
-            .unwrap();
-    let pos = [
-        Vec3::new(-10.0, -5.0, 0.0),
-        Vec3::new(10.0, -5.0, 0.0),
-        Vec3::new(10.0, 5.0, 0.0),
-        Vec3::new(-10.0, 5.0, 0.0),
-    ];
+    let (cam, pos) = rectangle_64x48();
     let colors = [
         Vec3::new(0.9, 0.1, 0.2),
         Vec3::new(0.1, 0.8, 0.3),
