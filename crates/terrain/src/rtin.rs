@@ -331,84 +331,200 @@ impl ErrorMap {
             ]
         }
     }
-
-    /// Walk the tree under the `s`-cell at `(x0, y0)`: split a triangle while its hypotenuse
-    /// midpoint's bound exceeds `max_error`, never below cells of `min_step` (a power of two ≥ 1).
-    /// Calls `emit(tri, bound)` for each kept triangle, `bound` being its error bound (0 for a cell
-    /// of one sample step; `INFINITY` if it spans no-data it could not split away).
-    pub fn walk(
-        &self,
-        x0: u32,
-        y0: u32,
-        s: u32,
-        max_error: f32,
-        min_step: u32,
-        emit: impl FnMut(Tri, f32),
-    ) {
-        let mut w = Walker {
-            errors: &self.errors,
-            n: self.n as usize,
-            max_error,
-            min_step,
-            emit,
-        };
-        for t in self.cell_triangles(x0, y0, s) {
-            let stored = w.stored(t.a, t.b);
-            w.visit::<true>(t.a, t.b, t.c, s, stored);
-        }
-    }
 }
 
-/// The walk of [`ErrorMap::walk`], depth first, first child first.
-struct Walker<'a, F> {
+/// A vertex of the walk: its grid sample index `y·n + x` (low 32 bits) and its slot `j·side + i`
+/// on the extracted cell's lattice (high 32 bits). Both are linear in the coordinates and the two
+/// ends of a hypotenuse have coordinates of the same parity, so `(p + q) >> 1` is the midpoint in
+/// both halves at once when it lies on the lattice (neither half's sum reaches 2^32 for
+/// `n ≤ 2^15 + 1`).
+type Vert = u64;
+
+/// The midpoint of the hypotenuse `p–q`, a lattice point.
+#[inline(always)]
+fn mid(p: Vert, q: Vert) -> Vert {
+    (p + q) >> 1
+}
+
+/// The lattice slot of a vertex.
+#[inline(always)]
+fn slot(p: Vert) -> u32 {
+    (p >> 32) as u32
+}
+
+/// A level of the walk: triangles with legs `D = 2^K` long, as a type so that every level
+/// compiles apart (no branch on the level in the walk).
+struct Legs<const K: u32>;
+
+trait Level {
+    /// The legs' length.
+    const D: u32;
+    /// The level of half the legs (itself for `D = 1`, which is not split).
+    type Half: Level;
+}
+
+macro_rules! levels {
+    ($($k:literal => $half:literal),*) => {
+        $(impl Level for Legs<$k> {
+            const D: u32 = 1 << $k;
+            type Half = Legs<$half>;
+        })*
+    };
+}
+
+levels!(0 => 0, 1 => 0, 2 => 1, 3 => 2, 4 => 3, 5 => 4, 6 => 5, 7 => 6, 8 => 7, 9 => 8,
+    10 => 9, 11 => 10, 12 => 11, 13 => 12, 14 => 13, 15 => 14);
+
+/// The walk of [`extract`], depth first, first child first: split a triangle while its
+/// hypotenuse midpoint's bound exceeds `max_error`, never below cells of `min_step`. Kept
+/// triangles go to `tris` as lattice slots, in walk order; with `NODATA` (the grid has no-data),
+/// those with a no-data vertex are dropped.
+struct Walker<'a, const NODATA: bool> {
     errors: &'a [f32],
-    n: usize,
+    heights: &'a [f32],
     max_error: f32,
     min_step: u32,
-    emit: F,
+    /// Kept triangles in `tris[..len]`; the rest is room written ahead of `len`.
+    tris: Vec<[u32; 3]>,
+    len: usize,
+    /// Largest finite bound among the kept triangles.
+    max_bound: f32,
+    /// Kept triangles with an infinite bound.
+    bridging: u32,
 }
 
-impl<F: FnMut(Tri, f32)> Walker<'_, F> {
-    /// The error map entry at the hypotenuse midpoint of `(a, b)`.
+impl<const NODATA: bool> Walker<'_, NODATA> {
+    /// The error map entry at the hypotenuse midpoint of `p–q` (a grid sample, on the lattice
+    /// or not: only the sample halves are added).
     #[inline(always)]
-    fn stored(&self, a: [u32; 2], b: [u32; 2]) -> f32 {
-        self.errors[((a[1] + b[1]) / 2) as usize * self.n + ((a[0] + b[0]) / 2) as usize]
+    fn stored(&self, p: Vert, q: Vert) -> f32 {
+        self.errors[((p + q) as u32 >> 1) as usize]
     }
 
-    /// The triangle `(a, b, c)` (hypotenuse `a–b`, right angle at `c`; `stored`: the map at its
-    /// hypotenuse midpoint), split or kept. The kind of triangle alternates with depth, so it is
-    /// a type parameter: `SQUARE` when its legs lie along the axes (`d` their length), else its
-    /// legs are diagonal (`d` their length in steps `|dx| + |dy|`).
+    /// Makes room for `k` more triangles past `len`.
     #[inline(always)]
-    fn visit<const SQUARE: bool>(
-        &mut self,
-        a: [u32; 2],
-        b: [u32; 2],
-        c: [u32; 2],
-        d: u32,
-        stored: f32,
-    ) {
-        let bound = if d > 1 { stored } else { 0.0 };
-        let splittable = if SQUARE { d > self.min_step } else { true } && d > 1;
-        if splittable && bound > self.max_error {
-            self.split::<SQUARE>(a, b, c, d);
-        } else {
-            (self.emit)(Tri { a, b, c }, bound);
+    fn room(&mut self, k: usize) {
+        if self.len + k > self.tris.len() {
+            let grown = (self.len + k).max(2 * self.tris.len()).max(1024);
+            self.tris.resize(grown, [0; 3]);
         }
     }
 
-    /// Visits the children of a split triangle, both their map entries read up front (the
-    /// second one's load overlaps the walk under the first).
-    fn split<const SQUARE: bool>(&mut self, a: [u32; 2], b: [u32; 2], c: [u32; 2], d: u32) {
-        let m = [(a[0] + b[0]) / 2, (a[1] + b[1]) / 2];
-        let (first, second) = (self.stored(c, a), self.stored(b, c));
-        if SQUARE {
-            self.visit::<false>(c, a, m, d, first);
-            self.visit::<false>(b, c, m, d, second);
+    /// Keeps the triangle `(a, b, c)` of error bound `bound`.
+    #[inline(always)]
+    fn emit(&mut self, a: Vert, b: Vert, c: Vert, bound: f32) {
+        if NODATA {
+            if [a, b, c]
+                .iter()
+                .any(|&p| self.heights[p as u32 as usize].is_nan())
+            {
+                return;
+            }
+            if bound.is_finite() {
+                self.max_bound = self.max_bound.max(bound);
+            } else {
+                self.bridging += 1;
+            }
         } else {
-            self.visit::<true>(c, a, m, d / 2, first);
-            self.visit::<true>(b, c, m, d / 2, second);
+            self.max_bound = self.max_bound.max(bound);
         }
+        self.room(1);
+        self.tris[self.len] = [slot(a), slot(b), slot(c)];
+        self.len += 1;
+    }
+
+    /// [`Walker::square`], as a call of its own for the coarse levels and inlined into the
+    /// caller for the last two (legs of 4 and 2).
+    #[inline(always)]
+    fn child<L: Level>(&mut self, a: Vert, b: Vert, c: Vert, e: f32) {
+        if L::D > 4 {
+            self.square_call::<L>(a, b, c, e)
+        } else {
+            self.square::<L>(a, b, c, e)
+        }
+    }
+
+    /// [`Walker::square`] as a function of its own (the recursion).
+    #[inline(never)]
+    fn square_call<L: Level>(&mut self, a: Vert, b: Vert, c: Vert, e: f32) {
+        self.square::<L>(a, b, c, e)
+    }
+
+    /// The triangle `(a, b, c)` (hypotenuse `a–b`, right angle at `c`) with legs along the axes,
+    /// `L::D` long, and `e` the map at its hypotenuse midpoint (unused for `L::D = 1`).
+    #[inline(always)]
+    fn square<L: Level>(&mut self, a: Vert, b: Vert, c: Vert, e: f32) {
+        if L::D == 1 {
+            return self.emit(a, b, c, 0.0);
+        }
+        if !NODATA && L::D == 2 && self.min_step == 1 {
+            return self.fine(a, b, c, e);
+        }
+        if L::D > self.min_step && e > self.max_error {
+            let m = mid(a, b);
+            let (first, second) = (self.stored(c, a), self.stored(b, c));
+            self.diagonal::<L>(c, a, m, first);
+            self.diagonal::<L>(b, c, m, second);
+        } else {
+            self.emit(a, b, c, e);
+        }
+    }
+
+    /// The triangle `(a, b, c)` with diagonal legs, `L::D ≥ 2` steps `|dx| + |dy|` long.
+    #[inline(always)]
+    fn diagonal<L: Level>(&mut self, a: Vert, b: Vert, c: Vert, e: f32) {
+        if e > self.max_error {
+            let m = mid(a, b);
+            let (first, second) = if L::D > 2 {
+                (self.stored(c, a), self.stored(b, c))
+            } else {
+                (0.0, 0.0)
+            };
+            self.child::<L::Half>(c, a, m, first);
+            self.child::<L::Half>(b, c, m, second);
+        } else {
+            self.emit(a, b, c, e);
+        }
+    }
+
+    /// [`Walker::square`] for legs of 2 (and `min_step = 1`) on a grid without no-data, without a
+    /// branch on the terrain: the subtree's candidates (the triangle, its two children, their
+    /// four children) are all written in walk order, `len` advancing past the kept ones only.
+    #[inline(always)]
+    fn fine(&mut self, a: Vert, b: Vert, c: Vert, e: f32) {
+        let (m, ca, bc) = (mid(a, b), mid(c, a), mid(b, c));
+        let (e1, e2) = (self.stored(c, a), self.stored(b, c));
+        let max = self.max_error;
+        let (s0, s1, s2) = (e > max, e1 > max, e2 > max);
+        let keep0 = !s0;
+        let (keep1, keep1s) = (s0 & !s1, s0 & s1);
+        let (keep2, keep2s) = (s0 & !s2, s0 & s2);
+        let at = |p: Vert| slot(p);
+        let cands = [
+            ([at(a), at(b), at(c)], keep0),
+            ([at(c), at(a), at(m)], keep1),
+            ([at(m), at(c), at(ca)], keep1s),
+            ([at(a), at(m), at(ca)], keep1s),
+            ([at(b), at(c), at(m)], keep2),
+            ([at(m), at(b), at(bc)], keep2s),
+            ([at(c), at(m), at(bc)], keep2s),
+        ];
+        self.room(cands.len());
+        let out = &mut self.tris[self.len..self.len + cands.len()];
+        let mut k = 0;
+        for (t, keep) in cands {
+            out[k] = t;
+            k += keep as usize;
+        }
+        self.len += k;
+        // The kept triangles' bounds, the others' times 0 (finite without no-data): a product,
+        // which does not compile to a branch as a select would.
+        let pick = |keep: bool, e: f32| e * keep as u8 as f32;
+        self.max_bound = self
+            .max_bound
+            .max(pick(keep0, e))
+            .max(pick(keep1, e1))
+            .max(pick(keep2, e2));
     }
 }
 
@@ -767,10 +883,19 @@ pub struct GridMesh {
     pub bridging: u32,
 }
 
-/// Extract the mesh under the `s`-cell at `(x0, y0)` (the whole grid: `(0, 0, n − 1)`); triangles
-/// with a no-data vertex are dropped.
+/// Extract the mesh under the `s`-cell at `(x0, y0)` (the whole grid: `(0, 0, n − 1)`): the
+/// tree walked from the cell's two triangles, splitting a triangle while its hypotenuse
+/// midpoint's bound exceeds `max_error`, never below cells of `min_step` (a power of two ≥ 1).
+/// Triangles with a no-data vertex are dropped.
 ///
-/// The same walk as [`ErrorMap::walk`], recursive on plain coordinates.
+/// Vertices are numbered in first-use order over the kept triangles (deterministic) through a
+/// dense slot table over the cell's lattice of `min_step` samples (every kept vertex lies on it:
+/// the walk stops only at triangles whose legs are axis-aligned and at least `min_step` long),
+/// so a coarse chunk of a large grid needs `(s / min_step + 1)²` slots, not one per grid sample.
+///
+/// # Panics
+/// If `s` is not a power of two or the map is larger than `(2^15 + 1)²` (the walk's packed
+/// vertex indices).
 pub fn extract(
     map: &ErrorMap,
     heights: &[f32],
@@ -780,10 +905,8 @@ pub fn extract(
     max_error: f32,
     min_step: u32,
 ) -> GridMesh {
-    // Dense remap over the cell's lattice of `min_step` samples (every emitted vertex lies on
-    // it: the walk stops only at triangles whose legs are axis-aligned and at least `min_step`
-    // long), with vertex numbers in first-use order (deterministic). A coarse chunk of a large
-    // grid thus needs `(s / min_step + 1)²` slots, not one per grid sample.
+    assert!(s.is_power_of_two(), "cells are 2^k samples a side, got {s}");
+    assert!(map.n <= (1 << 15) + 1, "extract needs n ≤ 2^15 + 1");
     let g = if min_step > 1
         && min_step.is_power_of_two()
         && x0.is_multiple_of(min_step)
@@ -794,123 +917,95 @@ pub fn extract(
     } else {
         1
     };
-    let side = (s / g) as usize + 1;
-    let mut m = Mesher {
-        heights,
-        n: map.n as usize,
-        x0,
-        y0,
-        shift: g.trailing_zeros(),
-        side,
-        index: vec![UNSEEN; side * side],
-        count: 0,
-        mesh: GridMesh::default(),
+    let shift = g.trailing_zeros();
+    let side = s / g + 1;
+    let n = map.n;
+    let vert = |[x, y]: [u32; 2]| -> Vert {
+        let sample = y as u64 * n as u64 + x as u64;
+        let lattice = ((y - y0) >> shift) as u64 * side as u64 + ((x - x0) >> shift) as u64;
+        sample | lattice << 32
     };
-    // Without no-data in the grid no vertex needs its height checked.
-    if map.nodata {
-        map.walk(x0, y0, s, max_error, min_step, |t, bound| {
-            m.keep::<true>(t, bound)
-        });
+    let roots = map
+        .cell_triangles(x0, y0, s)
+        .map(|t| [t.a, t.b, t.c].map(vert));
+    let (mut tris, max_bound, bridging) = if map.nodata {
+        walk::<true>(map, heights, roots, s, max_error, min_step)
     } else {
-        let mut verts = Vec::new();
-        map.walk(x0, y0, s, max_error, min_step, |t, bound| {
-            m.keep_dense(t, bound, &mut verts)
-        });
-        verts.truncate(m.count);
-        m.mesh.vertices = verts;
+        walk::<false>(map, heights, roots, s, max_error, min_step)
+    };
+    // Vertex numbers in first-use order, branch-free per vertex (whether a vertex is new depends
+    // on the terrain: a branch on it is mispredicted about once a triangle). `index[slot]` is the
+    // vertex number + 1, 0 (a zeroed table, no fill) for a slot not met yet, so
+    // `index[slot] − 1` wrapped and capped at the count is the vertex's number either way;
+    // every corner's slot is written at the count, which advances only for a new one.
+    let slots = side as usize * side as usize;
+    let mut index = vec![0u32; slots];
+    let mut order = vec![0u32; slots.min(3 * tris.len()) + 1];
+    let mut count = 0u32;
+    for t in tris.iter_mut() {
+        for v in t.iter_mut() {
+            let at = *v as usize;
+            let id = index[at].wrapping_sub(1).min(count);
+            index[at] = id + 1;
+            order[count as usize] = *v;
+            count += (id == count) as u32;
+            *v = id;
+        }
     }
-    m.mesh
+    order.truncate(count as usize);
+    // Slot -> lattice row by a multiply: `⌊(M·v) / 2^64⌋` with `M = ⌊(2^64 − 1) / side⌋ + 1` is
+    // `⌊v / side⌋` for every 32-bit `v` (Lemire, Kaser & Kurz 2019), without a division a vertex.
+    let m = (u64::MAX / side as u64 + 1) as u128;
+    let vertices = order
+        .iter()
+        .map(|&v| {
+            let row = ((m * v as u128) >> 64) as u32;
+            let col = v - row * side;
+            [x0 + (col << shift), y0 + (row << shift)]
+        })
+        .collect();
+    GridMesh {
+        vertices,
+        triangles: tris,
+        max_bound,
+        bridging,
+    }
 }
 
-/// Index slot of a vertex not met yet.
-const UNSEEN: u32 = u32::MAX;
-
-/// The mesh an [`extract`] builds from the walk's kept triangles.
-struct Mesher<'a> {
-    heights: &'a [f32],
-    n: usize,
-    x0: u32,
-    y0: u32,
-    /// log2 of the remap lattice step.
-    shift: u32,
-    side: usize,
-    /// Vertex number per lattice slot, or [`UNSEEN`].
-    index: Vec<u32>,
-    /// Vertices numbered so far ([`Mesher::keep_dense`]).
-    count: usize,
-    mesh: GridMesh,
-}
-
-impl Mesher<'_> {
-    /// [`Mesher::keep`] for a grid without no-data, branch-free per vertex (whether a vertex is
-    /// new depends on the terrain: a branch on it is mispredicted about once a triangle). The
-    /// vertices go to `verts`, whose length runs ahead of their count (`self.count`; the mesh's
-    /// own vertex list stays empty until the end): every corner is written at the count,
-    /// which advances only for a new one. Vertex numbers are smaller than the count and
-    /// [`UNSEEN`] is the largest `u32`, so `min(slot, count)` is the vertex's number either way.
-    #[inline(always)]
-    fn keep_dense(&mut self, t: Tri, bound: f32, verts: &mut Vec<[u32; 2]>) {
-        debug_assert!(
-            bound.is_finite(),
-            "a grid without no-data has finite bounds"
-        );
-        let mesh = &mut self.mesh;
-        mesh.max_bound = mesh.max_bound.max(bound);
-        let mut count = self.count;
-        if verts.len() < count + 3 {
-            verts.resize((count + 3).max(2 * verts.len()), [0, 0]);
+/// The kept triangles (lattice slots, walk order) of the tree under the two `roots` (`s` their
+/// legs), their largest finite bound and how many have an infinite one.
+fn walk<const NODATA: bool>(
+    map: &ErrorMap,
+    heights: &[f32],
+    roots: [[Vert; 3]; 2],
+    s: u32,
+    max_error: f32,
+    min_step: u32,
+) -> (Vec<[u32; 3]>, f32, u32) {
+    let mut w = Walker::<NODATA> {
+        errors: &map.errors,
+        heights,
+        max_error,
+        min_step,
+        tris: Vec::new(),
+        len: 0,
+        max_bound: 0.0,
+        bridging: 0,
+    };
+    for [a, b, c] in roots {
+        let e = if s > 1 { w.stored(a, b) } else { 0.0 };
+        macro_rules! root {
+            ($($k:literal)*) => {
+                match s.trailing_zeros() {
+                    $($k => w.square_call::<Legs<$k>>(a, b, c, e),)*
+                    _ => unreachable!("cells are at most 2^15 samples"),
+                }
+            };
         }
-        let mut tri = [0u32; 3];
-        for (id, p) in tri.iter_mut().zip([t.a, t.b, t.c]) {
-            let (dx, dy) = (p[0] - self.x0, p[1] - self.y0);
-            let slot = (dy >> self.shift) as usize * self.side + (dx >> self.shift) as usize;
-            let v = self.index[slot].min(count as u32);
-            self.index[slot] = v;
-            verts[count] = p;
-            count += (v == count as u32) as usize;
-            *id = v;
-        }
-        self.count = count;
-        mesh.triangles.push(tri);
+        root!(0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15);
     }
-
-    /// Adds a kept triangle unless one of its vertices is no-data (checked when a vertex is new,
-    /// if the grid has any: `NODATA`).
-    #[inline(always)]
-    fn keep<const NODATA: bool>(&mut self, t: Tri, bound: f32) {
-        let pts = [t.a, t.b, t.c];
-        let mut slots = [0usize; 3];
-        for (slot, p) in slots.iter_mut().zip(pts) {
-            let (dx, dy) = (p[0] - self.x0, p[1] - self.y0);
-            debug_assert!(
-                (dx | dy).trailing_zeros() >= self.shift,
-                "vertex off the lattice"
-            );
-            *slot = (dy >> self.shift) as usize * self.side + (dx >> self.shift) as usize;
-            if NODATA
-                && self.index[*slot] == UNSEEN
-                && self.heights[p[1] as usize * self.n + p[0] as usize].is_nan()
-            {
-                return;
-            }
-        }
-        let mesh = &mut self.mesh;
-        if bound.is_finite() {
-            mesh.max_bound = mesh.max_bound.max(bound);
-        } else {
-            mesh.bridging += 1;
-        }
-        let mut tri = [0u32; 3];
-        for ((id, slot), p) in tri.iter_mut().zip(slots).zip(pts) {
-            let slot = &mut self.index[slot];
-            if *slot == UNSEEN {
-                *slot = mesh.vertices.len() as u32;
-                mesh.vertices.push(p);
-            }
-            *id = *slot;
-        }
-        mesh.triangles.push(tri);
-    }
+    w.tris.truncate(w.len);
+    (w.tris, w.max_bound, w.bridging)
 }
 
 /// Pad a `w x h` grid with no-data to the smallest `(2^k + 1)²` square holding it (borrowed
@@ -962,9 +1057,10 @@ mod tests {
 
     #[test]
     fn branch_free_mesher_matches_the_checking_one() {
-        // Without no-data, extraction numbers vertices branch-free; forcing the no-data path
-        // (a height check per new vertex, which never fires here) must give the same mesh, in
-        // the same order, for whole grids and for chunks on a coarser lattice.
+        // Without no-data, the walk keeps the cells of two sample steps branch-free; forcing the
+        // no-data path (the plain recursion down to single cells, a height check per kept
+        // triangle, which never fires here) must give the same mesh, in the same order, for
+        // whole grids and for chunks on a coarser lattice.
         let n = 129;
         let h = grid(n, |x, y| {
             (x * 0.21).sin() * 30.0 + (y * 0.17).cos() * 20.0 + ((x * 3.0 + y) % 5.0)

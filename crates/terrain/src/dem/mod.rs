@@ -33,6 +33,11 @@ use std::path::Path;
 /// before anything is allocated.
 pub const MAX_SAMPLES: u64 = 1 << 30;
 
+/// The longest side accepted, 2^15 samples: the mesher pads a grid to the smallest
+/// `(2^k + 1)²` square holding it, and walks squares of at most `(2^15 + 1)²` (a longer strip would
+/// also pad to a square far beyond [`MAX_SAMPLES`]).
+pub const MAX_SIDE: u32 = 1 << 15;
+
 /// What the grid's coordinates measure.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -118,8 +123,8 @@ impl Georef {
 /// A validated elevation grid.
 ///
 /// # Guarantees
-/// `width, height ≥ 2`, `width·height ≤ MAX_SAMPLES`, every sample finite or `NaN` (no-data), at
-/// least one finite sample.
+/// `2 ≤ width, height ≤ MAX_SIDE`, `width·height ≤ MAX_SAMPLES`, every sample finite or `NaN`
+/// (no-data), at least one finite sample.
 #[derive(Clone, Debug)]
 pub struct Grid {
     width: u32,
@@ -205,6 +210,12 @@ pub(crate) fn check_size(source: &str, width: u64, height: u64) -> Result<(), Te
         || width.saturating_mul(height) > MAX_SAMPLES
     {
         return bad("more than 2^30 samples: split the grid into tiles first");
+    }
+    if width.max(height) > MAX_SIDE as u64 {
+        return bad(
+            "a side longer than 32768 samples (meshes are cut from the grid padded to a \
+             (2^k + 1)² square): split the grid into tiles first",
+        );
     }
     Ok(())
 }
@@ -521,6 +532,10 @@ mod tests {
             check_size("t", 1 << 20, 1 << 20),
             Err(TerrainError::BadSize { .. })
         ));
+        // Few samples, but a strip too long to pad to a meshable square.
+        assert!(check_size("t", MAX_SIDE as u64, 2).is_ok());
+        let e = check_size("t", MAX_SIDE as u64 + 1, 2).unwrap_err();
+        assert!(e.to_string().contains("32768"), "{e}");
     }
 
     #[test]
