@@ -109,6 +109,8 @@ pub const MAX_MAPPED_EDGE_TEXELS: f32 = 64.0;
 pub const CHORD_TOLERANCE_TEXELS: f32 = 0.5;
 /// ...unless every edge is at most this long.
 pub const MIN_SPLIT_EDGE_TEXELS: f32 = 2.0;
+/// Recycled pyramids a [`MapScratch`] keeps (a cube map's faces).
+const MAX_SPARE: usize = 6;
 /// Object triangles per parallel task of a mapped update.
 const MAP_RUN: usize = 2048;
 /// The deepest split of a mapped triangle (`4^10` pieces at most, only near the singular
@@ -445,11 +447,8 @@ impl MapScratch {
     /// buffers instead of allocating (an animation's steady state then allocates no pyramid).
     /// At most six pyramids are kept.
     pub fn recycle(&mut self, map: EnvMap) {
-        for face in map.faces {
-            if self.spare.len() < 6 {
-                self.spare.push(face);
-            }
-        }
+        self.spare.extend(map.faces);
+        self.spare.truncate(MAX_SPARE);
     }
 
     fn env_texels(
@@ -593,16 +592,23 @@ fn finish_faces(
         })
         .collect::<Result<Vec<_>, EnvMapError>>()?;
     scratch.dropped_pieces += built.iter().map(|b| b.1).sum::<usize>();
+    // Faces not drawn come from the previous map; the previous map's redrawn faces are
+    // rebuilt into by the next update.
     let mut kept = previous.map(|m| m.faces).unwrap_or_default().into_iter();
     let faces = built
         .into_iter()
-        .map(|(b, _)| {
-            let old = kept.next();
-            b.or(old).ok_or(EnvMapError::BadOption {
+        .map(|(b, _)| match (b, kept.next()) {
+            (Some(b), old) => {
+                scratch.spare.extend(old);
+                Ok(b)
+            }
+            (None, Some(old)) => Ok(old),
+            (None, None) => Err(EnvMapError::BadOption {
                 what: "a partial map update needs the previous map",
-            })
+            }),
         })
         .collect::<Result<Vec<_>, _>>()?;
+    scratch.spare.truncate(MAX_SPARE);
     Ok(EnvMap {
         kind,
         frame: p.frame,
