@@ -464,37 +464,31 @@ impl Renderer {
         let all = maps::all_faces(kind);
         // The last frame's map: kept by a time-sliced cube update, else its pyramids' buffers
         // are rebuilt into.
+        let n = opts.cube_faces_per_frame as usize;
         let last = self.map.take();
-        let map = match kind {
-            MapKind::Sphere | MapKind::Paraboloid => {
-                if let Some(m) = last {
-                    self.scratch.recycle(m);
-                }
-                let map = if kind == MapKind::Sphere {
-                    maps::update_sphere(&p, &mut self.scratch)?
-                } else {
-                    maps::update_paraboloid(&p, &mut self.scratch)?
-                };
-                (map, all)
+        let keep = last.as_ref().is_some_and(|m| {
+            n < 6
+                && m.kind() == MapKind::Cube
+                && kind == MapKind::Cube
+                && m.size() == opts.map_size
+                && m.frame() == frame
+                && m.centre() == centre
+                && self.map_min_distance == opts.min_object_distance
+        });
+        let kept = match last {
+            Some(m) if !keep => {
+                self.scratch.recycle(m);
+                None
             }
+            last => last,
+        };
+        let map = match kind {
+            MapKind::Sphere => (maps::update_sphere(&p, &mut self.scratch)?, all),
+            MapKind::Paraboloid => (maps::update_paraboloid(&p, &mut self.scratch)?, all),
             MapKind::Cube => {
-                let n = opts.cube_faces_per_frame as usize;
-                let keep = last.as_ref().is_some_and(|m| {
-                    n < 6
-                        && m.kind() == MapKind::Cube
-                        && m.size() == opts.map_size
-                        && m.frame() == frame
-                        && m.centre() == centre
-                        && self.map_min_distance == opts.min_object_distance
-                });
-                let (kept, faces) = if keep {
-                    let faces = (0..n).fold(0u8, |m, k| m | 1 << ((self.next_face + k) % 6));
-                    (last, faces)
-                } else {
-                    if let Some(m) = last {
-                        self.scratch.recycle(m);
-                    }
-                    (None, all)
+                let faces = match kept {
+                    Some(_) => (0..n).fold(0u8, |m, k| m | 1 << ((self.next_face + k) % 6)),
+                    None => all,
                 };
                 let map = maps::update_cube_faces(&p, &mut self.scratch, faces, kept)?;
                 self.next_face = if faces == all {
