@@ -19,7 +19,8 @@ pub enum TerrainCmd {
         /// Elevation grid: GeoTIFF, ESRI ASCII (.asc), SRTM (.hgt) or 16-bit PNG.
         #[arg(long)]
         dem: PathBuf,
-        /// Orthophoto (PNG, JPEG or GeoTIFF), placed by its georeference or stretched.
+        /// Orthophoto (PNG, JPEG or GeoTIFF), placed by its georeference or stretched. Without one the
+        /// views are textured with shaded relief (height colours lit like `gdaldem hillshade`).
         #[arg(long)]
         photo: Option<PathBuf>,
         /// GeoTIFF photo bands for red, green, blue (1-based), e.g. 3,2,1.

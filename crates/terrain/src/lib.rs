@@ -23,6 +23,8 @@
 //!   budget (the grid mapped, not read), drawn through texmap-raster with any
 //!   texmap-core sampler (nearest, bilinear, trilinear, the span sampler with 3x3 or 4x4 banks,
 //!   quadratic 3x3, anisotropic), per-frame statistics and optional haze.
+//! - [`relief`]: shaded relief (height colours lit by a `gdaldem`-compatible hillshade), the
+//!   texture of a database built without a photo.
 //! - [`models`]: textured OBJ models placed on the terrain by georeference and a built-in tree
 //!   billboard, drawn after the terrain with the same samplers and depth-tested against it.
 //! - [`flight`]: flight paths — CSV/JSON path files (a bad line is named), orbits, and the
@@ -69,6 +71,7 @@ pub mod greedy;
 pub mod gst;
 pub mod models;
 pub mod photo;
+pub mod relief;
 pub mod rtin;
 pub mod stream;
 pub mod view;

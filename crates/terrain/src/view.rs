@@ -1090,36 +1090,18 @@ pub fn texture_from_rgba(img: &image::RgbaImage) -> Result<MipTexture, ViewError
     .map_err(ViewError::Texture)
 }
 
-/// A texture for a database without a photo: heights coloured green (low) to brown to white
-/// (high), nearest grid sample per texel, no-data grey; the side is at most `max_side` and at
-/// most the grid's larger side.
+/// A texture for a database without a photo: shaded relief ([`crate::relief`]: heights coloured
+/// green (low) to brown to white (high), lit by `gdaldem`'s default hillshade), nearest grid
+/// sample per texel, no-data grey; the side is at most `max_side` and at most the grid's larger
+/// side.
 pub fn height_texture(grid: &Grid, max_side: u32) -> Result<MipTexture, ViewError> {
     let side = max_side.min(grid.width().max(grid.height())).max(1);
-    let (lo, hi) = grid.height_range();
-    let span = (hi - lo).max(f32::MIN_POSITIVE);
-    let ramp = |t: f32| -> [u8; 4] {
-        let stops = [
-            (0.0, [60.0, 110.0, 50.0]),
-            (0.5, [140.0, 110.0, 70.0]),
-            (1.0, [240.0, 240.0, 240.0]),
-        ];
-        let (a, b, f) = if t < 0.5 {
-            (stops[0].1, stops[1].1, t / 0.5)
-        } else {
-            (stops[1].1, stops[2].1, (t - 0.5) / 0.5)
-        };
-        let c = |i: usize| (a[i] + (b[i] - a[i]) * f).round().clamp(0.0, 255.0) as u8;
-        [c(0), c(1), c(2), 255]
-    };
+    let shade = crate::relief::Hillshade::new(grid, crate::relief::Light::default());
     let img = image::RgbaImage::from_fn(side, side, |x, y| {
         let col = ((x as f64 + 0.5) / side as f64 * (grid.width() - 1) as f64).round() as u32;
         let row = ((y as f64 + 0.5) / side as f64 * (grid.height() - 1) as f64).round() as u32;
-        let h = grid.at(col.min(grid.width() - 1), row.min(grid.height() - 1));
-        image::Rgba(if h.is_finite() {
-            ramp(((h - lo) / span).clamp(0.0, 1.0))
-        } else {
-            [128, 128, 128, 255]
-        })
+        let (col, row) = (col.min(grid.width() - 1), row.min(grid.height() - 1));
+        image::Rgba(crate::relief::relief_colour(grid, &shade, col, row))
     });
     texture_from_rgba(&img)
 }
