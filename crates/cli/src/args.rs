@@ -25,13 +25,18 @@ pub fn usage<T>(msg: impl Into<String>) -> anyhow::Result<T> {
 #[command(
     name = "texmap",
     version,
-    about = "Render molecular-dynamics trajectories as spheres on the CPU and compare sphere-drawing methods for speed and accuracy",
-    long_about = "Render molecular-dynamics trajectories as spheres on the CPU (no GPU needed) with four \
-methods from classic texture-mapping papers — tessellated polygons, Seed 002 colour+depth look-up \
-images, Seed 004 template billboards and exact ray-cast impostors — and measure each against a BVH \
-reference ray tracer.\n\nExit codes: 0 success, 1 runtime failure (unreadable or damaged input, \
-unwritable output), 2 bad usage.",
-    after_help = "Examples:\n  texmap demo --out demo\n  texmap info traj.xtc\n  texmap render traj.pdb --frames 0:100:10 --size 1280x720 -o frames/f%04d.png\n  texmap compare --scene S1 --out study"
+    about = "Texture mapping on the CPU, every method measured against a reference ray tracer: molecular-dynamics spheres, flight-simulator terrain and environment-mapped reflections",
+    long_about = "Texture mapping on the CPU (no GPU, no X server), every method measured for speed and \
+against a BVH reference ray tracer for accuracy:\n\
+  - molecular dynamics: trajectories drawn as spheres with four methods from classic papers — \
+tessellated polygons, Seed 002 colour+depth look-up images, Seed 004 template billboards and exact \
+ray-cast impostors (info, render, compare, movie);\n\
+  - terrain (Seed 000): databases from elevation grids and orthophotos, flown over with mipmapped \
+and span-parallel samplers (terrain build, render, fly, compare);\n\
+  - environment mapping (Seed 003): mirror and glass objects with sphere, cube and dual-paraboloid \
+maps re-rendered every frame (envmap, envmap compare).\n\n\
+Exit codes: 0 success, 1 runtime failure (unreadable or damaged input, unwritable output), 2 bad usage.",
+    after_help = "Examples:\n  texmap demo --out demo\n  texmap info traj.xtc\n  texmap render traj.pdb --frames 0:100:10 --size 1280x720 -o frames/f%04d.png\n  texmap compare --scene S1 --out study\n  texmap terrain build --dem N44W072.hgt --out db && texmap terrain render db -o view.png\n  texmap envmap --method cube -o mirror.png"
 )]
 pub struct Cli {
     /// Worker threads (default: all cores). Output is byte-identical for any count.
@@ -70,8 +75,9 @@ pub enum Command {
     Render(RenderArgs),
     /// Run every method and the reference ray tracer on a scene; write results, images and charts.
     Compare(CompareArgs),
-    /// No input needed: simulate a small built-in MD system, render it with every method, compare,
-    /// and write an index.html that shows it all.
+    /// No input needed: simulate a small built-in MD system and render it with every method, build
+    /// and fly a built-in terrain with every sampler, draw the environment-mapping scene with every
+    /// method, compare each against the reference, and write an index.html that shows it all.
     Demo {
         /// Output directory.
         #[arg(long, default_value = "texmap-demo")]
@@ -86,7 +92,8 @@ pub enum Command {
         #[arg(long, default_value = "500x500")]
         size: String,
     },
-    /// Terrain databases from elevation grids and orthophotos (Seed 000): build, info, export, maps.
+    /// Terrain databases from elevation grids and orthophotos (Seed 000): build, info, export, maps,
+    /// and the flight view: render, fly, compare.
     Terrain {
         #[command(subcommand)]
         cmd: crate::terrain::TerrainCmd,

@@ -148,7 +148,7 @@ pub struct RenderArgs {
     /// Also write the eye-space depth as a one-channel OpenEXR.
     #[arg(long)]
     pub depth: Option<PathBuf>,
-    /// Print the frame statistics as JSON on stdout (otherwise on stderr).
+    /// Print the frame statistics as JSON on stdout (otherwise on stderr, unless --quiet).
     #[arg(long)]
     pub stats: bool,
 }
@@ -313,7 +313,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let text = serde_json::to_string(&v).context("frame statistics")?;
     if a.stats {
         println!("{text}");
-    } else {
+    } else if !crate::commands::quiet() {
         eprintln!("{text}");
     }
     Ok(())
