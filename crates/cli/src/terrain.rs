@@ -61,7 +61,8 @@ pub enum TerrainCmd {
         /// A database directory or an elevation file.
         path: PathBuf,
     },
-    /// Export the whole terrain at an error as .glb (texture embedded) or .obj (+ .mtl, .png).
+    /// Export the whole terrain at an error as .glb (texture embedded) or .obj (+ .mtl, .png); the
+    /// texture is the photo's or, without one, shaded relief.
     Export {
         /// Database directory.
         dir: PathBuf,
@@ -175,8 +176,8 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
                 .levels
                 .last()
                 .map_or(0, |l| l.chunks.iter().map(|c| c.triangles as u64).sum());
-            eprintln!(
-                "texmap: wrote {} ({} levels, {} triangles at the finest)",
+            crate::note!(
+                "wrote {} ({} levels, {} triangles at the finest)",
                 out.display(),
                 m.levels.len(),
                 tris
@@ -235,15 +236,21 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
             } else {
                 db::whole_mesh(&grid, max_error)?
             };
-            let tex = d.texture(4096)?;
+            // The photo's finest level up to 4096² or, without a photo, the shaded relief the
+            // views draw.
+            let tex = match d.texture(4096)? {
+                Some(t) => t,
+                None => texmap_terrain::relief::relief_image(&grid, 4096),
+            };
+            let tex = Some(tex);
             if glb {
                 texmap_mesh::write_glb(&output, &mesh, tex.as_ref())
             } else {
                 texmap_mesh::write_obj(&output, &mesh, tex.as_ref())
             }
             .with_context(|| format!("exporting {}", output.display()))?;
-            eprintln!(
-                "texmap: wrote {} ({} vertices, {} triangles)",
+            crate::note!(
+                "wrote {} ({} vertices, {} triangles)",
                 output.display(),
                 mesh.positions.len(),
                 mesh.triangles.len()

@@ -244,7 +244,9 @@ pub fn run_fly(a: FlyArgs) -> Result<()> {
         "seconds": secs, "ms_per_frame": 1e3 * secs / views.len() as f64,
         "triangles": triangles, "movie": movie.map(|p| p.display().to_string()),
     });
-    eprintln!("{v}");
+    if !crate::commands::quiet() {
+        eprintln!("{v}");
+    }
     Ok(())
 }
 

@@ -341,3 +341,46 @@ fn render_draws_models_and_trees_and_names_bad_ones() {
     }
     assert!(!out.exists());
 }
+
+/// A database built without a photo exports the shaded relief the views draw: the .glb embeds
+/// exactly `relief_image` of the grid, and `--quiet` leaves stderr empty.
+#[test]
+fn export_without_a_photo_embeds_the_shaded_relief() {
+    let dir = tempfile::tempdir().unwrap();
+    let db = dir.path().join("relief.db");
+    let dem = data("hillshade_dem_utm.tif");
+    ok(&texmap(&[
+        "terrain",
+        "build",
+        "--dem",
+        &dem,
+        "--out",
+        db.to_str().unwrap(),
+        "-q",
+    ]));
+    let glb = dir.path().join("relief.glb");
+    let o = texmap(&[
+        "terrain",
+        "export",
+        db.to_str().unwrap(),
+        "--max-error",
+        "2",
+        "-o",
+        glb.to_str().unwrap(),
+        "-q",
+    ]);
+    ok(&o);
+    assert!(
+        o.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let (_, _, images) = gltf::import(&glb).expect("a valid glTF");
+    assert_eq!(images.len(), 1);
+    let grid = texmap_terrain::dem::read_dem(&dem, &Default::default()).unwrap();
+    let want = texmap_terrain::relief::relief_image(&grid, 4096);
+    let img = &images[0];
+    assert_eq!((img.width, img.height), want.dimensions());
+    assert_eq!(img.format, gltf::image::Format::R8G8B8A8);
+    assert!(img.pixels == want.as_raw()[..], "embedded texture differs");
+}

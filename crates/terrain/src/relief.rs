@@ -45,7 +45,10 @@ pub struct Hillshade<'a> {
 
 impl<'a> Hillshade<'a> {
     pub fn new(grid: &'a Grid, light: Light) -> Hillshade<'a> {
-        let (az, alt) = (light.azimuth_deg.to_radians(), light.altitude_deg.to_radians());
+        let (az, alt) = (
+            light.azimuth_deg.to_radians(),
+            light.altitude_deg.to_radians(),
+        );
         let g = grid.georef();
         let east = (0..grid.height())
             .map(|r| {
@@ -88,9 +91,8 @@ impl<'a> Hillshade<'a> {
                 .unwrap_or(centre)
         };
         let (b, d, f, hh) = (edge(0, -1), edge(-1, 0), edge(1, 0), edge(0, 1));
-        let corner = |dc: i64, dr: i64, side: f64, vert: f64| {
-            raw(dc, dr).unwrap_or(side + vert - centre)
-        };
+        let corner =
+            |dc: i64, dr: i64, side: f64, vert: f64| raw(dc, dr).unwrap_or(side + vert - centre);
         // a b c / d e f / g h i, row − 1 on top.
         let (a, c) = (corner(-1, -1, d, b), corner(1, -1, f, b));
         let (g, i) = (corner(-1, 1, d, hh), corner(1, 1, f, hh));
@@ -106,7 +108,11 @@ impl<'a> Hillshade<'a> {
 
 /// The height colour of `t` in `[0, 1]` (lowest to highest valid height): green, brown, white.
 pub fn height_colour(t: f32) -> [f32; 3] {
-    const STOPS: [[f32; 3]; 3] = [[60.0, 110.0, 50.0], [140.0, 110.0, 70.0], [240.0, 240.0, 240.0]];
+    const STOPS: [[f32; 3]; 3] = [
+        [60.0, 110.0, 50.0],
+        [140.0, 110.0, 70.0],
+        [240.0, 240.0, 240.0],
+    ];
     let t = t.clamp(0.0, 1.0);
     let (a, b, f) = if t < 0.5 {
         (STOPS[0], STOPS[1], t / 0.5)
@@ -128,6 +134,19 @@ pub fn relief_colour(grid: &Grid, shade: &Hillshade, col: u32, row: u32) -> [u8;
     let k = (0.35 + 0.9 * s) as f32;
     let c = |v: f32| (v * k).round().clamp(0.0, 255.0) as u8;
     [c(base[0]), c(base[1]), c(base[2]), 255]
+}
+
+/// The shaded relief of the whole grid as an sRGB image, nearest sample per texel: the side is at
+/// most `max_side` and at most the grid's larger side (at least 1).
+pub fn relief_image(grid: &Grid, max_side: u32) -> image::RgbaImage {
+    let side = max_side.min(grid.width().max(grid.height())).max(1);
+    let shade = Hillshade::new(grid, Light::default());
+    image::RgbaImage::from_fn(side, side, |x, y| {
+        let col = ((x as f64 + 0.5) / side as f64 * (grid.width() - 1) as f64).round() as u32;
+        let row = ((y as f64 + 0.5) / side as f64 * (grid.height() - 1) as f64).round() as u32;
+        let (col, row) = (col.min(grid.width() - 1), row.min(grid.height() - 1));
+        image::Rgba(relief_colour(grid, &shade, col, row))
+    })
 }
 
 #[cfg(test)]
@@ -170,11 +189,19 @@ mod tests {
     #[test]
     fn slopes_toward_and_away_from_the_light() {
         let light = Light::default();
-        let flat = Hillshade::new(&plane(0.0, 0.0, 10.0), light).at(4, 4).unwrap();
+        let flat = Hillshade::new(&plane(0.0, 0.0, 10.0), light)
+            .at(4, 4)
+            .unwrap();
         // Rising to the south-east: faces north-west, toward the light.
-        let toward = Hillshade::new(&plane(5.0, 5.0, 10.0), light).at(4, 4).unwrap();
-        let away = Hillshade::new(&plane(-5.0, -5.0, 10.0), light).at(4, 4).unwrap();
-        let cliff = Hillshade::new(&plane(-80.0, -80.0, 10.0), light).at(4, 4).unwrap();
+        let toward = Hillshade::new(&plane(5.0, 5.0, 10.0), light)
+            .at(4, 4)
+            .unwrap();
+        let away = Hillshade::new(&plane(-5.0, -5.0, 10.0), light)
+            .at(4, 4)
+            .unwrap();
+        let cliff = Hillshade::new(&plane(-80.0, -80.0, 10.0), light)
+            .at(4, 4)
+            .unwrap();
         assert!(toward > flat && flat > away, "{toward} {flat} {away}");
         assert_eq!(cliff, 0.0);
     }

@@ -1095,15 +1095,7 @@ pub fn texture_from_rgba(img: &image::RgbaImage) -> Result<MipTexture, ViewError
 /// sample per texel, no-data grey; the side is at most `max_side` and at most the grid's larger
 /// side.
 pub fn height_texture(grid: &Grid, max_side: u32) -> Result<MipTexture, ViewError> {
-    let side = max_side.min(grid.width().max(grid.height())).max(1);
-    let shade = crate::relief::Hillshade::new(grid, crate::relief::Light::default());
-    let img = image::RgbaImage::from_fn(side, side, |x, y| {
-        let col = ((x as f64 + 0.5) / side as f64 * (grid.width() - 1) as f64).round() as u32;
-        let row = ((y as f64 + 0.5) / side as f64 * (grid.height() - 1) as f64).round() as u32;
-        let (col, row) = (col.min(grid.width() - 1), row.min(grid.height() - 1));
-        image::Rgba(crate::relief::relief_colour(grid, &shade, col, row))
-    });
-    texture_from_rgba(&img)
+    texture_from_rgba(&crate::relief::relief_image(grid, max_side))
 }
 
 /// Haze toward the horizon, applied to a finished frame (off unless called): each covered
