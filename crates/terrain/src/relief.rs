@@ -137,16 +137,27 @@ pub fn relief_colour(grid: &Grid, shade: &Hillshade, col: u32, row: u32) -> [u8;
 }
 
 /// The shaded relief of the whole grid as an sRGB image, nearest sample per texel: the side is at
-/// most `max_side` and at most the grid's larger side (at least 1).
+/// most `max_side` and at most the grid's larger side (at least 1). Rows are coloured in parallel
+/// (each texel on its own: the same bytes for any thread count).
 pub fn relief_image(grid: &Grid, max_side: u32) -> image::RgbaImage {
+    use rayon::prelude::*;
     let side = max_side.min(grid.width().max(grid.height())).max(1);
     let shade = Hillshade::new(grid, Light::default());
-    image::RgbaImage::from_fn(side, side, |x, y| {
-        let col = ((x as f64 + 0.5) / side as f64 * (grid.width() - 1) as f64).round() as u32;
-        let row = ((y as f64 + 0.5) / side as f64 * (grid.height() - 1) as f64).round() as u32;
-        let (col, row) = (col.min(grid.width() - 1), row.min(grid.height() - 1));
-        image::Rgba(relief_colour(grid, &shade, col, row))
-    })
+    let nearest = |t: u32, n: u32| {
+        let i = ((t as f64 + 0.5) / side as f64 * (n - 1) as f64).round() as u32;
+        i.min(n - 1)
+    };
+    let mut raw = vec![0u8; side as usize * side as usize * 4];
+    raw.par_chunks_mut(side as usize * 4)
+        .enumerate()
+        .for_each(|(y, line)| {
+            let row = nearest(y as u32, grid.height());
+            for (x, px) in line.chunks_exact_mut(4).enumerate() {
+                let col = nearest(x as u32, grid.width());
+                px.copy_from_slice(&relief_colour(grid, &shade, col, row));
+            }
+        });
+    image::RgbaImage::from_raw(side, side, raw).expect("side² RGBA texels")
 }
 
 #[cfg(test)]
