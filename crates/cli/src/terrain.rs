@@ -61,18 +61,28 @@ pub enum TerrainCmd {
         /// A database directory or an elevation file.
         path: PathBuf,
     },
-    /// Export the whole terrain at an error as .glb (texture embedded) or .obj (+ .mtl, .png); the
-    /// texture is the photo's or, without one, shaded relief.
+    /// Export the whole terrain at an error as .glb (texture embedded) or .obj (+ .mtl, .png), or
+    /// the whole level-of-detail tree as 3D Tiles for Cesium (--3d-tiles); the texture is the
+    /// photo's or, without one, shaded relief.
     Export {
         /// Database directory.
         dir: PathBuf,
+        /// Maximum vertical error of the exported mesh, metres (not with --3d-tiles: the tileset
+        /// holds every level).
         #[arg(long, default_value_t = 1.0)]
         max_error: f32,
+        /// Output: a .glb or .obj file, or with --3d-tiles a new directory.
         #[arg(short, long)]
         output: PathBuf,
         /// Greedy Delaunay refinement instead of the RTIN (fewer triangles; no no-data allowed).
         #[arg(long)]
         greedy: bool,
+        /// Write an OGC 3D Tiles 1.1 tileset into the new directory -o: tileset.json and one .glb
+        /// per chunk, each tile's geometricError the chunk's measured error, placed on the WGS 84
+        /// ellipsoid (the grid must be geographic or WGS 84 UTM; heights are taken as ellipsoidal).
+        /// Open it in CesiumJS with `Cesium3DTileset.fromUrl(".../tileset.json")`.
+        #[arg(long = "3d-tiles")]
+        tiles3d: bool,
     },
     /// Seed 000 Eq. (5)-(7): GST maps the active area needs per level, and the total.
     Maps {
@@ -211,7 +221,26 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
             max_error,
             output,
             greedy,
+            tiles3d,
         } => {
+            if tiles3d {
+                if greedy {
+                    return usage("--greedy applies to a single mesh, not to --3d-tiles");
+                }
+                let d = Database::open(&dir)?;
+                let sp = crate::commands::spinner("writing 3D Tiles");
+                let s = texmap_terrain::tiles3d::write_tileset(&d, &output, 4096)?;
+                sp.finish_and_clear();
+                crate::note!(
+                    "wrote {} ({} tiles, {} with content, {} triangles, {:.1} MB)",
+                    output.join("tileset.json").display(),
+                    s.tiles,
+                    s.with_content,
+                    s.triangles,
+                    s.bytes as f64 / 1e6
+                );
+                return Ok(());
+            }
             if !(max_error.is_finite() && max_error >= 0.0) {
                 return usage(format!("--max-error {max_error}: expected metres ≥ 0"));
             }

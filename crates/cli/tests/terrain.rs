@@ -387,8 +387,8 @@ fn export_without_a_photo_embeds_the_shaded_relief() {
 
 /// The exports open in any glTF viewer: the Khronos glTF-Validator (the reference checker every
 /// viewer is tested with; `.ci/run` installs it under target/gltf-validator) reports no error and
-/// no warning for a textured export (photo placed by georeference, with a no-data hole) and for a
-/// shaded-relief one. Without node or the validator the test says SKIPPED.
+/// no warning for a textured export (photo placed by georeference, with a no-data hole), a
+/// shaded-relief one and a 3D Tiles tile. Without node or the validator the test says SKIPPED.
 #[test]
 fn glb_exports_pass_the_khronos_gltf_validator() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
@@ -435,6 +435,18 @@ fn glb_exports_pass_the_khronos_gltf_validator() {
         ]));
         files.push(out);
     }
+    // And the finest tile of a 3D Tiles export (UTM grid: placed through the inverse projection).
+    let tiles = dir.path().join("tiles");
+    ok(&texmap(&[
+        "terrain",
+        "export",
+        relief_db.to_str().unwrap(),
+        "--3d-tiles",
+        "-o",
+        tiles.to_str().unwrap(),
+        "-q",
+    ]));
+    files.push(tiles.join("tiles/0/0_0.glb"));
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/gltf_validate.cjs");
     let o = std::process::Command::new("node")
         .arg(&script)
@@ -447,10 +459,78 @@ fn glb_exports_pass_the_khronos_gltf_validator() {
         .lines()
         .map(|l| serde_json::from_str(l).unwrap())
         .collect();
-    assert_eq!(lines.len(), 2);
+    assert_eq!(lines.len(), 3);
     for r in &lines {
         assert_eq!(r["errors"], 0, "{r}");
         assert_eq!(r["warnings"], 0, "{r}");
         eprintln!("glTF-Validator: {r}");
     }
+}
+
+/// `terrain export --3d-tiles`: a tileset from a UTM grid, refused over an existing directory
+/// and for a grid with no place on the ellipsoid (exit 1, the reason named, nothing written).
+#[test]
+fn export_3d_tiles_and_its_refusals() {
+    let dir = tempfile::tempdir().unwrap();
+    let utm = dir.path().join("utm.db");
+    let dem = data("hillshade_dem_utm.tif");
+    ok(&texmap(&[
+        "terrain",
+        "build",
+        "--dem",
+        &dem,
+        "--out",
+        utm.to_str().unwrap(),
+        "-q",
+    ]));
+    let tiles = dir.path().join("tiles");
+    let t = tiles.to_str().unwrap();
+    ok(&texmap(&[
+        "terrain",
+        "export",
+        utm.to_str().unwrap(),
+        "--3d-tiles",
+        "-o",
+        t,
+        "-q",
+    ]));
+    let ts: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(tiles.join("tileset.json")).unwrap())
+            .unwrap();
+    assert_eq!(ts["asset"]["version"], "1.1");
+    assert_eq!(ts["root"]["content"]["uri"], "tiles/0/0_0.glb");
+    assert!(tiles.join("tiles/0/0_0.glb").exists());
+    let o = texmap(&[
+        "terrain",
+        "export",
+        utm.to_str().unwrap(),
+        "--3d-tiles",
+        "-o",
+        t,
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    // An ESRI grid without a .prj has a local georeference: no place on the globe.
+    let local = dir.path().join("local.db");
+    ok(&texmap(&[
+        "terrain",
+        "build",
+        "--dem",
+        &data("ramp_gdal.asc"),
+        "--out",
+        local.to_str().unwrap(),
+        "-q",
+    ]));
+    let out = dir.path().join("local_tiles");
+    let o = texmap(&[
+        "terrain",
+        "export",
+        local.to_str().unwrap(),
+        "--3d-tiles",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("3D Tiles need"), "{err}");
+    assert!(!out.exists());
 }

@@ -238,6 +238,18 @@ pub fn build_with(
     out: &Path,
     mut progress: impl FnMut(u64, u64),
 ) -> Result<Manifest, TerrainError> {
+    write_dir_atomically(out, |tmp| {
+        build_into(grid, source, photo, opts, tmp, &mut progress)
+    })
+}
+
+/// Runs `fill` on a sibling temporary directory of `out` (`.NAME.tmp-PID`) and renames it to `out`
+/// when `fill` succeeds; on failure the temporary directory is removed, so `out` either holds a
+/// complete result or does not exist. Errors: `out` exists already.
+pub(crate) fn write_dir_atomically<T>(
+    out: &Path,
+    fill: impl FnOnce(&Path) -> Result<T, TerrainError>,
+) -> Result<T, TerrainError> {
     if out.exists() {
         return Err(TerrainError::Exists {
             path: out.to_path_buf(),
@@ -255,7 +267,7 @@ pub fn build_with(
     if tmp.exists() {
         std::fs::remove_dir_all(&tmp).map_err(io(&tmp))?;
     }
-    let result = build_into(grid, source, photo, opts, &tmp, &mut progress).and_then(|m| {
+    let result = fill(&tmp).and_then(|m| {
         std::fs::rename(&tmp, out).map_err(io(out))?;
         Ok(m)
     });

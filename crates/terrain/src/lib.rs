@@ -23,6 +23,8 @@
 //!   budget (the grid mapped, not read), drawn through texmap-raster with any
 //!   texmap-core sampler (nearest, bilinear, trilinear, the span sampler with 3x3 or 4x4 banks,
 //!   quadratic 3x3, anisotropic), per-frame statistics and optional haze.
+//! - [`tiles3d`]: the database as OGC 3D Tiles 1.1 (`tileset.json` and a glTF per chunk, placed
+//!   on the WGS 84 ellipsoid through [`geodesy`]) for Cesium and the engines that stream it.
 //! - [`relief`]: shaded relief (height colours lit by a `gdaldem`-compatible hillshade), the
 //!   texture of a database built without a photo.
 //! - [`models`]: textured OBJ models placed on the terrain by georeference and a built-in tree
@@ -67,6 +69,7 @@ pub mod db;
 pub mod dem;
 pub mod error;
 pub mod flight;
+pub mod geodesy;
 pub mod greedy;
 pub mod gst;
 pub mod models;
@@ -74,6 +77,7 @@ pub mod photo;
 pub mod relief;
 pub mod rtin;
 pub mod stream;
+pub mod tiles3d;
 pub mod view;
 
 pub use error::TerrainError;

@@ -222,7 +222,7 @@ pub fn band_count(path: &Path) -> Result<u16, TerrainError> {
 /// An open TIFF read one stored chunk (strip or tile) at a time: the header, georeference and
 /// chunk layout checked once ([`RasterReader::open`]), then [`RasterReader::read_chunk`] decodes
 /// one chunk's wanted bands. [`read_raster`] reads them all; an orthophoto larger than memory is
-/// read a band of rows at a time ([`crate::gst::TiffPhoto`]).
+/// read a band of rows at a time ([`crate::photo::TiffPhoto`]).
 pub struct RasterReader {
     source: String,
     dec: Decoder<std::io::BufReader<std::fs::File>>,

@@ -1,0 +1,367 @@
+//! Export of a database as OGC 3D Tiles 1.1 — the chunked level-of-detail tree as Cesium (and the
+//! engines with Cesium's plug-ins) stream it: `tileset.json` plus one binary glTF per chunk.
+//!
+//! The database's quadtree maps one to one onto the tileset: every chunk is a tile whose
+//! `geometricError` is the chunk's measured geometric error in metres (a parent's is at least its
+//! children's), refined by replacement, with the chunk's mesh (surface and skirts) and its part of
+//! the texture (the photo's or, without one, the shaded relief) as content. A viewer refines a
+//! tile when that error, projected to the screen, exceeds its pixel tolerance — the same rule the
+//! flight view uses.
+//!
+//! Placement on the globe: every vertex goes from its grid sample (recovered from its texture
+//! coordinate) through the grid's georeference to WGS 84 longitude/latitude ([`crate::geodesy`]:
+//! geographic grids directly, WGS 84 UTM grids by the inverse projection) and, with its height as
+//! ellipsoidal height, to earth-centred, earth-fixed (ECEF) metres. Each glTF holds its vertices
+//! relative to the centre of its tile's box (single precision keeps millimetres there), the tile's
+//! `transform` translating by that centre (relative to the parent's, as transforms compose), and
+//! the y-up glTF axes are written so that the viewer's y-up to z-up rotation yields ECEF. Bounding
+//! volumes are boxes aligned with the ECEF axes around each chunk's vertices. Grids without a
+//! georeference on the ellipsoid (local grids, projections other than UTM) are refused by name.
+//!
+//! The output directory is written atomically (a temporary sibling renamed at the end).
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use glam::{DVec3, Vec2, Vec3};
+use rayon::prelude::*;
+use serde_json::{Value, json};
+use texmap_mesh::TriMesh;
+
+use crate::db::{ChunkEntry, Database, write_dir_atomically};
+use crate::error::{TerrainError, io};
+use crate::geodesy::{Placement, ecef};
+
+/// Largest texture side per tile.
+pub const MAX_TILE_TEXTURE: u32 = 1024;
+
+/// What [`write_tileset`] wrote.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TilesetSummary {
+    /// Tiles in the tree (chunks).
+    pub tiles: usize,
+    /// Tiles with content (chunks holding at least one triangle).
+    pub with_content: usize,
+    /// Triangles over all tiles.
+    pub triangles: u64,
+    /// Bytes of all files written.
+    pub bytes: u64,
+}
+
+/// One chunk's tile, before the tree is assembled.
+struct Tile {
+    depth: u32,
+    ix: u32,
+    iy: u32,
+    geometric_error: f64,
+    /// ECEF box of the chunk's vertices.
+    lo: DVec3,
+    hi: DVec3,
+    content: Option<String>,
+    triangles: u64,
+    bytes: u64,
+}
+
+/// Write `db` as a 3D Tiles 1.1 tileset into the new directory `out` (which must not exist), the
+/// texture taken at up to `max_texture` texels a side from the database (its photo's pyramid, or
+/// shaded relief), each tile's part at most [`MAX_TILE_TEXTURE`].
+///
+/// Errors: `out` exists; the grid has no placement on the ellipsoid; a chunk file or the texture
+/// cannot be read; a file cannot be written.
+pub fn write_tileset(
+    db: &Database,
+    out: &Path,
+    max_texture: u32,
+) -> Result<TilesetSummary, TerrainError> {
+    let m = &db.manifest;
+    let placement = Placement::of(&m.georef).ok_or_else(|| TerrainError::Unsupported {
+        source: db.dir.display().to_string(),
+        what: format!(
+            "3D Tiles need the grid placed on the WGS 84 ellipsoid: a geographic or a WGS 84 UTM \
+             (EPSG:326zz/327zz) georeference; this grid's is {:?}{}",
+            m.georef.crs,
+            m.georef
+                .epsg
+                .map(|e| format!(" (EPSG:{e})"))
+                .unwrap_or_default()
+        ),
+    })?;
+    let texture = match db.texture(max_texture)? {
+        Some(t) => t,
+        None => crate::relief::relief_image(&db.grid()?, max_texture),
+    };
+    write_dir_atomically(out, |tmp| {
+        let mut tiles = Vec::new();
+        for level in &m.levels {
+            let dir = tmp.join(format!("tiles/{}", level.depth));
+            std::fs::create_dir_all(&dir).map_err(io(&dir))?;
+            let made: Vec<Result<Tile, TerrainError>> = level
+                .chunks
+                .par_iter()
+                .map(|c| chunk_tile(db, level.depth, c, placement, &texture, tmp))
+                .collect();
+            for t in made {
+                tiles.push(t?);
+            }
+        }
+        let summary = TilesetSummary {
+            tiles: tiles.len(),
+            with_content: tiles.iter().filter(|t| t.content.is_some()).count(),
+            triangles: tiles.iter().map(|t| t.triangles).sum(),
+            bytes: tiles.iter().map(|t| t.bytes).sum(),
+        };
+        let json = tileset_json(&tiles, m.max_error as f64);
+        let text = serde_json::to_string_pretty(&json).expect("JSON values serialise");
+        let path = tmp.join("tileset.json");
+        std::fs::write(&path, &text).map_err(io(&path))?;
+        Ok(TilesetSummary {
+            bytes: summary.bytes + text.len() as u64,
+            ..summary
+        })
+    })
+}
+
+/// ECEF position of a chunk vertex: its grid sample from its texture coordinate (the databases'
+/// `uv = (col, row) / (side − 1)`), its height from `y`.
+fn vertex_ecef(db: &Database, placement: Placement, p: Vec3, uv: Vec2) -> DVec3 {
+    let m = &db.manifest;
+    let col = uv.x as f64 * (m.width - 1) as f64;
+    let row = uv.y as f64 * (m.height - 1) as f64;
+    let (x, y) = m.georef.sample_xy(col, row);
+    let (lon, lat) = placement.lonlat(x, y);
+    DVec3::from(ecef(lon, lat, p.y as f64))
+}
+
+fn chunk_tile(
+    db: &Database,
+    depth: u32,
+    c: &ChunkEntry,
+    placement: Placement,
+    texture: &image::RgbaImage,
+    tmp: &Path,
+) -> Result<Tile, TerrainError> {
+    let mesh = db.read_chunk(c)?;
+    let mut tile = Tile {
+        depth,
+        ix: c.ix,
+        iy: c.iy,
+        geometric_error: c.geometric_error as f64,
+        lo: DVec3::ZERO,
+        hi: DVec3::ZERO,
+        content: None,
+        triangles: 0,
+        bytes: 0,
+    };
+    let Some(uvs) = mesh.uvs.as_ref().filter(|_| !mesh.triangles.is_empty()) else {
+        return Ok(tile);
+    };
+    let world: Vec<DVec3> = mesh
+        .positions
+        .iter()
+        .zip(uvs)
+        .map(|(&p, &uv)| vertex_ecef(db, placement, p, uv))
+        .collect();
+    let (lo, hi) = world.iter().fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(lo, hi), &p| (lo.min(p), hi.max(p)),
+    );
+    let centre = 0.5 * (lo + hi);
+    // glTF y-up: (x, y, z) is read as (x, −z, y), so ECEF offset (X, Y, Z) is written (X, Z, −Y).
+    let positions = world
+        .iter()
+        .map(|&p| {
+            let d = p - centre;
+            Vec3::new(d.x as f32, d.z as f32, -d.y as f32)
+        })
+        .collect();
+    let (crop, tile_uvs) = tile_texture(texture, uvs);
+    let out = TriMesh {
+        positions,
+        triangles: mesh.triangles.clone(),
+        uvs: Some(tile_uvs),
+        normals: None,
+    };
+    let rel = format!("tiles/{}/{}_{}.glb", depth, c.ix, c.iy);
+    let path = tmp.join(&rel);
+    texmap_mesh::write_glb(&path, &out, Some(&crop)).map_err(TerrainError::Mesh)?;
+    tile.bytes = std::fs::metadata(&path).map_err(io(&path))?.len();
+    tile.lo = lo;
+    tile.hi = hi;
+    tile.content = Some(rel);
+    tile.triangles = out.triangles.len() as u64;
+    Ok(tile)
+}
+
+/// The part of `texture` that `uvs` cover (whole texels, at most [`MAX_TILE_TEXTURE`] a side after
+/// a box-filtered reduction) and the uvs remapped onto it.
+fn tile_texture(texture: &image::RgbaImage, uvs: &[Vec2]) -> (image::RgbaImage, Vec<Vec2>) {
+    let (w, h) = (texture.width() as f32, texture.height() as f32);
+    let (lo, hi) = uvs.iter().fold(
+        (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY)),
+        |(lo, hi), &uv| (lo.min(uv), hi.max(uv)),
+    );
+    let x0 = ((lo.x * w).floor().max(0.0) as u32).min(texture.width() - 1);
+    let y0 = ((lo.y * h).floor().max(0.0) as u32).min(texture.height() - 1);
+    let x1 = ((hi.x * w).ceil() as u32).clamp(x0 + 1, texture.width());
+    let y1 = ((hi.y * h).ceil() as u32).clamp(y0 + 1, texture.height());
+    let (cw, ch) = (x1 - x0, y1 - y0);
+    let mut crop = image::imageops::crop_imm(texture, x0, y0, cw, ch).to_image();
+    let scale = (MAX_TILE_TEXTURE as f32 / cw.max(ch) as f32).min(1.0);
+    if scale < 1.0 {
+        let (nw, nh) = (
+            ((cw as f32 * scale).round() as u32).max(1),
+            ((ch as f32 * scale).round() as u32).max(1),
+        );
+        crop = image::imageops::resize(&crop, nw, nh, image::imageops::FilterType::Triangle);
+    }
+    let remapped = uvs
+        .iter()
+        .map(|uv| {
+            Vec2::new(
+                (uv.x * w - x0 as f32) / cw as f32,
+                (uv.y * h - y0 as f32) / ch as f32,
+            )
+        })
+        .collect();
+    (crop, remapped)
+}
+
+/// An ECEF-aligned box (3D Tiles `box`: centre, then three half-axis vectors) around `lo..hi`,
+/// relative to `origin`.
+fn box_volume(lo: DVec3, hi: DVec3, origin: DVec3) -> Value {
+    let c = 0.5 * (lo + hi) - origin;
+    let h = (0.5 * (hi - lo)).max(DVec3::splat(0.01));
+    json!({ "box": [c.x, c.y, c.z, h.x, 0.0, 0.0, 0.0, h.y, 0.0, 0.0, 0.0, h.z] })
+}
+
+fn translation(d: DVec3) -> Value {
+    json!([
+        1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, d.x, d.y, d.z, 1.0
+    ])
+}
+
+/// The tileset: tiles by `(depth, ix, iy)`, children `(2ix + i, 2iy + j)` at the next depth;
+/// geometric errors made monotone upwards; a root without content over several depth-0 tiles.
+fn tileset_json(tiles: &[Tile], max_error: f64) -> Value {
+    let index: HashMap<(u32, u32, u32), usize> = tiles
+        .iter()
+        .enumerate()
+        .map(|(i, t)| ((t.depth, t.ix, t.iy), i))
+        .collect();
+    let children = |t: &Tile| -> Vec<usize> {
+        let (x, y) = (2 * t.ix, 2 * t.iy);
+        [(x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1)]
+            .iter()
+            .filter_map(|&(cx, cy)| index.get(&(t.depth + 1, cx, cy)).copied())
+            .collect()
+    };
+    // Boxes and errors of whole subtrees (a tile without content still bounds its children).
+    struct Sub {
+        lo: DVec3,
+        hi: DVec3,
+        error: f64,
+    }
+    fn subtree(
+        i: usize,
+        tiles: &[Tile],
+        children: &dyn Fn(&Tile) -> Vec<usize>,
+        memo: &mut HashMap<usize, (DVec3, DVec3, f64)>,
+    ) -> (DVec3, DVec3, f64) {
+        if let Some(&v) = memo.get(&i) {
+            return v;
+        }
+        let t = &tiles[i];
+        let (mut lo, mut hi) = if t.content.is_some() {
+            (t.lo, t.hi)
+        } else {
+            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY))
+        };
+        let mut error = t.geometric_error;
+        for c in children(t) {
+            let (clo, chi, ce) = subtree(c, tiles, children, memo);
+            lo = lo.min(clo);
+            hi = hi.max(chi);
+            error = error.max(ce);
+        }
+        memo.insert(i, (lo, hi, error));
+        (lo, hi, error)
+    }
+    let mut memo = HashMap::new();
+    fn node(
+        i: usize,
+        parent_origin: DVec3,
+        tiles: &[Tile],
+        children: &dyn Fn(&Tile) -> Vec<usize>,
+        memo: &mut HashMap<usize, (DVec3, DVec3, f64)>,
+    ) -> Option<Value> {
+        let (lo, hi, error) = subtree(i, tiles, children, memo);
+        if lo.x > hi.x {
+            return None; // no terrain anywhere below
+        }
+        let t = &tiles[i];
+        // The content's vertices are relative to its own box's centre; a tile without content
+        // takes its subtree's.
+        let origin = if t.content.is_some() {
+            0.5 * (t.lo + t.hi)
+        } else {
+            0.5 * (lo + hi)
+        };
+        let kids: Vec<Value> = children(t)
+            .into_iter()
+            .filter_map(|c| node(c, origin, tiles, children, memo))
+            .collect();
+        let mut v = json!({
+            "transform": translation(origin - parent_origin),
+            "boundingVolume": box_volume(lo, hi, origin),
+            "geometricError": if kids.is_empty() { t.geometric_error } else { error },
+            "refine": "REPLACE",
+        });
+        if let Some(uri) = &t.content {
+            v["content"] = json!({ "uri": uri });
+        }
+        if !kids.is_empty() {
+            v["children"] = Value::Array(kids);
+        }
+        Some(v)
+    }
+    let roots: Vec<usize> = (0..tiles.len()).filter(|&i| tiles[i].depth == 0).collect();
+    let mut subs: Vec<Sub> = Vec::new();
+    for &r in &roots {
+        let (lo, hi, error) = subtree(r, tiles, &children, &mut memo);
+        if lo.x <= hi.x {
+            subs.push(Sub { lo, hi, error });
+        }
+    }
+    let (lo, hi, error) = subs.iter().fold(
+        (
+            DVec3::splat(f64::INFINITY),
+            DVec3::splat(f64::NEG_INFINITY),
+            max_error,
+        ),
+        |(lo, hi, e), s| (lo.min(s.lo), hi.max(s.hi), e.max(s.error)),
+    );
+    let root = if roots.len() == 1 {
+        node(roots[0], DVec3::ZERO, tiles, &children, &mut memo)
+    } else {
+        let origin = 0.5 * (lo + hi);
+        let kids: Vec<Value> = roots
+            .iter()
+            .filter_map(|&r| node(r, origin, tiles, &children, &mut memo))
+            .collect();
+        Some(json!({
+            "transform": translation(origin),
+            "boundingVolume": box_volume(lo, hi, origin),
+            "geometricError": error,
+            "refine": "REPLACE",
+            "children": kids,
+        }))
+    };
+    json!({
+        "asset": { "version": "1.1", "generator": "texmap terrain export --3d-tiles" },
+        "geometricError": 2.0 * error.max(max_error).max(1.0),
+        "root": root.unwrap_or_else(|| json!({
+            "boundingVolume": { "box": [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0] },
+            "geometricError": 0.0,
+        })),
+    })
+}

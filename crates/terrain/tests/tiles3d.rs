@@ -1,0 +1,200 @@
+//! The 3D Tiles export and the geodesy under it, against other programs' numbers: PROJ's UTM and
+//! ECEF coordinates (`gdaltransform`, tests/data/geodesy.sh) and GDAL's reading of the real SRTM
+//! tile N44W072.hgt (its georeference and corner heights, tests/data/srtm_facts.sh).
+
+use std::collections::HashMap;
+use std::path::PathBuf;
+
+use glam::DVec3;
+use texmap_terrain::db::{self, BuildOptions, Database};
+use texmap_terrain::dem::{ReadOptions, read_dem};
+use texmap_terrain::geodesy::{ecef, utm_to_lonlat, utm_zone};
+use texmap_terrain::tiles3d::write_tileset;
+
+fn data(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(name)
+}
+
+fn gdal_lines(kind: &str) -> Vec<Vec<f64>> {
+    std::fs::read_to_string(data("geodesy_gdal.txt"))
+        .unwrap()
+        .lines()
+        .filter(|l| l.starts_with(kind))
+        .map(|l| {
+            l.split_whitespace()
+                .skip(1)
+                .map(|x| x.parse().unwrap())
+                .collect()
+        })
+        .collect()
+}
+
+#[test]
+fn inverse_utm_matches_proj() {
+    let pts = gdal_lines("utm ");
+    assert_eq!(pts.len(), 10);
+    for p in pts {
+        let (zone, north) = utm_zone(p[0] as u16).unwrap();
+        let (lon, lat) = utm_to_lonlat(zone, north, p[3], p[4]);
+        // 1e-7 degrees is about a centimetre.
+        assert!(
+            (lon - p[1]).abs() < 1e-7 && (lat - p[2]).abs() < 1e-7,
+            "EPSG:{} ({}, {}) -> ({lon}, {lat}), PROJ ({}, {})",
+            p[0],
+            p[3],
+            p[4],
+            p[1],
+            p[2]
+        );
+    }
+}
+
+#[test]
+fn ecef_matches_proj() {
+    let pts = gdal_lines("ecef ");
+    assert_eq!(pts.len(), 5);
+    for p in pts {
+        let got = ecef(p[0], p[1], p[2]);
+        for k in 0..3 {
+            assert!((got[k] - p[3 + k]).abs() < 1e-3, "{p:?}: {got:?}");
+        }
+    }
+}
+
+/// A tile of the tree with its absolute transform (translations compose from the root).
+struct Seen {
+    origin: DVec3,
+    centre: DVec3,
+    half: DVec3,
+    depth: u32,
+    uri: Option<String>,
+}
+
+fn walk(v: &serde_json::Value, parent: DVec3, depth: u32, parent_error: f64, out: &mut Vec<Seen>) {
+    let t: Vec<f64> = v["transform"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    assert_eq!(t.len(), 16);
+    let origin = parent + DVec3::new(t[12], t[13], t[14]);
+    let b: Vec<f64> = v["boundingVolume"]["box"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    let error = v["geometricError"].as_f64().unwrap();
+    assert!(
+        error <= parent_error,
+        "a child's geometricError {error} above its parent's {parent_error}"
+    );
+    out.push(Seen {
+        origin,
+        centre: origin + DVec3::new(b[0], b[1], b[2]),
+        half: DVec3::new(b[3], b[7], b[11]),
+        depth,
+        uri: v["content"]["uri"].as_str().map(String::from),
+    });
+    for c in v["children"].as_array().into_iter().flatten() {
+        walk(c, origin, depth + 1, error, out);
+    }
+}
+
+/// The SRTM tile as a tileset: the quadtree (1 + 4 + 9 + 25 chunks) with monotone errors, every
+/// glTF vertex inside its tile's box, the texture in each tile, and the grid's four corners —
+/// always mesh vertices — exactly where GDAL's georeference and heights put them on the ellipsoid.
+#[test]
+fn srtm_tileset_is_placed_where_gdal_puts_the_tile() {
+    let dir = tempfile::tempdir().unwrap();
+    let grid = read_dem(data("N44W072.hgt"), &ReadOptions::default()).unwrap();
+    let dbp = dir.path().join("srtm.db");
+    db::build(
+        &grid,
+        "N44W072.hgt",
+        None,
+        &BuildOptions::default(),
+        &dbp,
+        |_, _| {},
+    )
+    .unwrap();
+    let d = Database::open(&dbp).unwrap();
+    let out = dir.path().join("tiles");
+    let s = write_tileset(&d, &out, 4096).unwrap();
+    let chunks: usize = d.manifest.levels.iter().map(|l| l.chunks.len()).sum();
+    assert_eq!((s.tiles, s.with_content), (chunks, chunks));
+    // Writing again over it is refused, the tileset untouched.
+    assert!(write_tileset(&d, &out, 4096).is_err());
+
+    let ts: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("tileset.json")).unwrap()).unwrap();
+    assert_eq!(ts["asset"]["version"], "1.1");
+    let mut seen = Vec::new();
+    walk(
+        &ts["root"],
+        DVec3::ZERO,
+        0,
+        ts["geometricError"].as_f64().unwrap(),
+        &mut seen,
+    );
+    assert_eq!(seen.len(), chunks);
+
+    // GDAL's corners: geoTransform (pixel corners) + half a pixel, and its heights.
+    let info: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(data("N44W072.gdalinfo.json")).unwrap())
+            .unwrap();
+    let gt: Vec<f64> = info["geoTransform"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    let samples = std::fs::read_to_string(data("N44W072.gdal_samples.txt")).unwrap();
+    let corners: Vec<DVec3> = samples
+        .lines()
+        .take(4)
+        .map(|l| {
+            let v: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
+            let lon = gt[0] + (v[0] + 0.5) * gt[1];
+            let lat = gt[3] + (v[1] + 0.5) * gt[5];
+            DVec3::from(ecef(lon, lat, v[2]))
+        })
+        .collect();
+    let mut nearest = [f64::INFINITY; 4];
+    let mut per_depth: HashMap<u32, usize> = HashMap::new();
+    let finest = seen.iter().map(|t| t.depth).max().unwrap();
+    for t in &seen {
+        *per_depth.entry(t.depth).or_default() += 1;
+        let uri = t.uri.as_ref().unwrap();
+        let (doc, buffers, images) = gltf::import(out.join(uri)).unwrap();
+        assert_eq!(images.len(), 1, "{uri}: one texture");
+        for mesh in doc.meshes() {
+            for prim in mesh.primitives() {
+                let r = prim.reader(|b| Some(&buffers[b.index()]));
+                for p in r.read_positions().unwrap() {
+                    // glTF y-up read as z-up: (x, y, z) -> (x, -z, y), then the tile's transform.
+                    let w = t.origin + DVec3::new(p[0] as f64, -p[2] as f64, p[1] as f64);
+                    let off = (w - t.centre).abs() - t.half;
+                    assert!(
+                        off.max_element() < 0.05,
+                        "{uri}: vertex {w} outside its box by {off}"
+                    );
+                    if t.depth == finest {
+                        for (k, c) in corners.iter().enumerate() {
+                            nearest[k] = nearest[k].min(w.distance(*c));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    assert_eq!(per_depth.len(), d.manifest.levels.len());
+    // Single-precision offsets from tile centres some 10 km away: within a few centimetres.
+    eprintln!("corners: nearest finest-tile vertices {nearest:?} m away");
+    for (k, n) in nearest.iter().enumerate() {
+        assert!(*n < 0.03, "corner {k}: nearest vertex {n} m away");
+    }
+}
