@@ -3,7 +3,8 @@
 //!
 //! The database's quadtree maps one to one onto the tileset: every chunk is a tile whose
 //! `geometricError` is the chunk's measured geometric error in metres (a parent's is at least its
-//! children's), refined by replacement, with the chunk's mesh (surface and skirts) and its part of
+//! children's; the tileset's, the error of leaving the terrain out, is the radius of its box),
+//! refined by replacement, with the chunk's mesh (surface and skirts) and its part of
 //! the texture (the photo's or, without one, the shaded relief) as content. A viewer refines a
 //! tile when that error, projected to the screen, exceeds its pixel tolerance — the same rule the
 //! flight view uses.
@@ -340,6 +341,11 @@ fn tileset_json(tiles: &[Tile], max_error: f64) -> Value {
         ),
         |(lo, hi, e), s| (lo.min(s.lo), hi.max(s.hi), e.max(s.error)),
     );
+    let radius = if lo.x <= hi.x {
+        0.5 * (hi - lo).length()
+    } else {
+        0.0
+    };
     let root = if roots.len() == 1 {
         node(roots[0], DVec3::ZERO, tiles, &children, &mut memo)
     } else {
@@ -358,7 +364,9 @@ fn tileset_json(tiles: &[Tile], max_error: f64) -> Value {
     };
     json!({
         "asset": { "version": "1.1", "generator": "texmap terrain export --3d-tiles" },
-        "geometricError": 2.0 * error.max(max_error).max(1.0),
+        // Not drawing the tileset at all leaves out the whole terrain: its error is the extent
+        // (the radius of the root's box), so a viewer draws it from as far as it covers pixels.
+        "geometricError": (2.0 * error.max(max_error)).max(radius).max(1.0),
         "root": root.unwrap_or_else(|| json!({
             "boundingVolume": { "box": [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0] },
             "geometricError": 0.0,

@@ -141,6 +141,15 @@ fn srtm_tileset_is_placed_where_gdal_puts_the_tile() {
         &mut seen,
     );
     assert_eq!(seen.len(), chunks);
+    // Leaving the whole terrain out is at least as wrong as its extent (CesiumJS draws nothing
+    // while the tileset's error projects under its pixel tolerance: an error of only twice the
+    // root's hid this tile from 70 km).
+    let root_radius = seen[0].half.length();
+    assert!(
+        ts["geometricError"].as_f64().unwrap() >= root_radius,
+        "{}",
+        ts["geometricError"]
+    );
 
     // GDAL's corners: geoTransform (pixel corners) + half a pixel, and its heights.
     let info: serde_json::Value =
