@@ -241,65 +241,56 @@ fn translation(d: DVec3) -> Value {
     ])
 }
 
-/// The tileset: tiles by `(depth, ix, iy)`, children `(2ix + i, 2iy + j)` at the next depth;
-/// geometric errors made monotone upwards; a root without content over several depth-0 tiles.
-fn tileset_json(tiles: &[Tile], max_error: f64) -> Value {
-    let index: HashMap<(u32, u32, u32), usize> = tiles
-        .iter()
-        .enumerate()
-        .map(|(i, t)| ((t.depth, t.ix, t.iy), i))
-        .collect();
-    let children = |t: &Tile| -> Vec<usize> {
+/// The tree of tiles: `(depth, ix, iy)` has the children `(2ix + i, 2iy + j)` at the next depth
+/// that exist; each subtree's box and largest error computed once.
+struct Tree<'a> {
+    tiles: &'a [Tile],
+    index: HashMap<(u32, u32, u32), usize>,
+    /// Per tile: its subtree's ECEF box and largest geometric error.
+    subtrees: HashMap<usize, (DVec3, DVec3, f64)>,
+}
+
+impl Tree<'_> {
+    fn children(&self, i: usize) -> Vec<usize> {
+        let t = &self.tiles[i];
         let (x, y) = (2 * t.ix, 2 * t.iy);
         [(x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1)]
             .iter()
-            .filter_map(|&(cx, cy)| index.get(&(t.depth + 1, cx, cy)).copied())
+            .filter_map(|&(cx, cy)| self.index.get(&(t.depth + 1, cx, cy)).copied())
             .collect()
-    };
-    // Boxes and errors of whole subtrees (a tile without content still bounds its children).
-    struct Sub {
-        lo: DVec3,
-        hi: DVec3,
-        error: f64,
     }
-    fn subtree(
-        i: usize,
-        tiles: &[Tile],
-        children: &dyn Fn(&Tile) -> Vec<usize>,
-        memo: &mut HashMap<usize, (DVec3, DVec3, f64)>,
-    ) -> (DVec3, DVec3, f64) {
-        if let Some(&v) = memo.get(&i) {
+
+    /// The box (empty: `lo > hi`) and largest error of tile `i` and everything below it (a tile
+    /// without content still bounds its children).
+    fn subtree(&mut self, i: usize) -> (DVec3, DVec3, f64) {
+        if let Some(&v) = self.subtrees.get(&i) {
             return v;
         }
-        let t = &tiles[i];
+        let t = &self.tiles[i];
         let (mut lo, mut hi) = if t.content.is_some() {
             (t.lo, t.hi)
         } else {
             (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY))
         };
         let mut error = t.geometric_error;
-        for c in children(t) {
-            let (clo, chi, ce) = subtree(c, tiles, children, memo);
+        for c in self.children(i) {
+            let (clo, chi, ce) = self.subtree(c);
             lo = lo.min(clo);
             hi = hi.max(chi);
             error = error.max(ce);
         }
-        memo.insert(i, (lo, hi, error));
+        self.subtrees.insert(i, (lo, hi, error));
         (lo, hi, error)
     }
-    let mut memo = HashMap::new();
-    fn node(
-        i: usize,
-        parent_origin: DVec3,
-        tiles: &[Tile],
-        children: &dyn Fn(&Tile) -> Vec<usize>,
-        memo: &mut HashMap<usize, (DVec3, DVec3, f64)>,
-    ) -> Option<Value> {
-        let (lo, hi, error) = subtree(i, tiles, children, memo);
+
+    /// Tile `i` as JSON, its transform relative to `parent_origin`; `None` when no terrain lies
+    /// anywhere below it.
+    fn node(&mut self, i: usize, parent_origin: DVec3) -> Option<Value> {
+        let (lo, hi, error) = self.subtree(i);
         if lo.x > hi.x {
-            return None; // no terrain anywhere below
+            return None;
         }
-        let t = &tiles[i];
+        let t = &self.tiles[i];
         // The content's vertices are relative to its own box's centre; a tile without content
         // takes its subtree's.
         let origin = if t.content.is_some() {
@@ -307,17 +298,19 @@ fn tileset_json(tiles: &[Tile], max_error: f64) -> Value {
         } else {
             0.5 * (lo + hi)
         };
-        let kids: Vec<Value> = children(t)
+        let (leaf_error, content) = (t.geometric_error, t.content.clone());
+        let kids: Vec<Value> = self
+            .children(i)
             .into_iter()
-            .filter_map(|c| node(c, origin, tiles, children, memo))
+            .filter_map(|c| self.node(c, origin))
             .collect();
         let mut v = json!({
             "transform": translation(origin - parent_origin),
             "boundingVolume": box_volume(lo, hi, origin),
-            "geometricError": if kids.is_empty() { t.geometric_error } else { error },
+            "geometricError": if kids.is_empty() { leaf_error } else { error },
             "refine": "REPLACE",
         });
-        if let Some(uri) = &t.content {
+        if let Some(uri) = content {
             v["content"] = json!({ "uri": uri });
         }
         if !kids.is_empty() {
@@ -325,48 +318,55 @@ fn tileset_json(tiles: &[Tile], max_error: f64) -> Value {
         }
         Some(v)
     }
+}
+
+/// The tileset: geometric errors made monotone upwards; a root without content over several
+/// depth-0 tiles.
+fn tileset_json(tiles: &[Tile], max_error: f64) -> Value {
+    let mut tree = Tree {
+        tiles,
+        index: tiles
+            .iter()
+            .enumerate()
+            .map(|(i, t)| ((t.depth, t.ix, t.iy), i))
+            .collect(),
+        subtrees: HashMap::new(),
+    };
     let roots: Vec<usize> = (0..tiles.len()).filter(|&i| tiles[i].depth == 0).collect();
-    let mut subs: Vec<Sub> = Vec::new();
-    for &r in &roots {
-        let (lo, hi, error) = subtree(r, tiles, &children, &mut memo);
-        if lo.x <= hi.x {
-            subs.push(Sub { lo, hi, error });
-        }
-    }
-    let (lo, hi, error) = subs.iter().fold(
-        (
-            DVec3::splat(f64::INFINITY),
-            DVec3::splat(f64::NEG_INFINITY),
-            max_error,
-        ),
-        |(lo, hi, e), s| (lo.min(s.lo), hi.max(s.hi), e.max(s.error)),
+    let (mut lo, mut hi, mut error) = (
+        DVec3::splat(f64::INFINITY),
+        DVec3::splat(f64::NEG_INFINITY),
+        max_error,
     );
+    for &r in &roots {
+        let (rlo, rhi, re) = tree.subtree(r);
+        (lo, hi, error) = (lo.min(rlo), hi.max(rhi), error.max(re));
+    }
     let radius = if lo.x <= hi.x {
         0.5 * (hi - lo).length()
     } else {
         0.0
     };
     let root = if roots.len() == 1 {
-        node(roots[0], DVec3::ZERO, tiles, &children, &mut memo)
+        tree.node(roots[0], DVec3::ZERO)
     } else {
         let origin = 0.5 * (lo + hi);
-        let kids: Vec<Value> = roots
-            .iter()
-            .filter_map(|&r| node(r, origin, tiles, &children, &mut memo))
-            .collect();
-        Some(json!({
-            "transform": translation(origin),
-            "boundingVolume": box_volume(lo, hi, origin),
-            "geometricError": error,
-            "refine": "REPLACE",
-            "children": kids,
-        }))
+        let kids: Vec<Value> = roots.iter().filter_map(|&r| tree.node(r, origin)).collect();
+        (!kids.is_empty()).then(|| {
+            json!({
+                "transform": translation(origin),
+                "boundingVolume": box_volume(lo, hi, origin),
+                "geometricError": error,
+                "refine": "REPLACE",
+                "children": kids,
+            })
+        })
     };
     json!({
         "asset": { "version": "1.1", "generator": "texmap terrain export --3d-tiles" },
         // Not drawing the tileset at all leaves out the whole terrain: its error is the extent
         // (the radius of the root's box), so a viewer draws it from as far as it covers pixels.
-        "geometricError": (2.0 * error.max(max_error)).max(radius).max(1.0),
+        "geometricError": (2.0 * error).max(radius).max(1.0),
         "root": root.unwrap_or_else(|| json!({
             "boundingVolume": { "box": [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0] },
             "geometricError": 0.0,
