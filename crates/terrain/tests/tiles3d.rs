@@ -207,3 +207,38 @@ fn srtm_tileset_is_placed_where_gdal_puts_the_tile() {
         assert!(*n < 0.03, "corner {k}: nearest vertex {n} m away");
     }
 }
+
+/// The same files, byte for byte, for any thread count (tiles are written in parallel).
+#[test]
+fn tileset_bytes_do_not_depend_on_threads() {
+    let dir = tempfile::tempdir().unwrap();
+    let grid = read_dem(data("hillshade_dem_utm.tif"), &ReadOptions::default()).unwrap();
+    let dbp = dir.path().join("utm.db");
+    let opts = BuildOptions {
+        chunk: 17,
+        ..BuildOptions::default()
+    };
+    db::build(&grid, "utm", None, &opts, &dbp, |_, _| {}).unwrap();
+    let d = Database::open(&dbp).unwrap();
+    let files = |threads: usize| {
+        let out = dir.path().join(format!("t{threads}"));
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let s = pool.install(|| write_tileset(&d, &out, 4096)).unwrap();
+        assert!(s.tiles > 5, "{s:?}");
+        let mut all = vec![(
+            "tileset.json".to_string(),
+            std::fs::read(out.join("tileset.json")).unwrap(),
+        )];
+        for level in &d.manifest.levels {
+            for c in &level.chunks {
+                let rel = format!("tiles/{}/{}_{}.glb", level.depth, c.ix, c.iy);
+                all.push((rel.clone(), std::fs::read(out.join(&rel)).unwrap()));
+            }
+        }
+        all
+    };
+    assert!(files(1) == files(2));
+}
