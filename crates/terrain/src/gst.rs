@@ -162,9 +162,28 @@ impl Placement {
                 corners[0].1.max(corners[1].1),
             );
             if cmax <= 0.0 || rmax <= 0.0 || cmin >= p.pw || rmin >= p.ph {
+                let crs = |g: &Georef| match g.epsg {
+                    Some(e) => format!("EPSG:{e}"),
+                    None => format!("{:?}", g.crs).to_lowercase(),
+                };
                 return Err(TerrainError::NoOverlap {
                     photo: source.to_string(),
-                    dem: "the elevation grid".into(),
+                    dem: format!(
+                        "({}): the grid falls at photo pixels {cmin:.0}..{cmax:.0} x \
+                         {rmin:.0}..{rmax:.0}, outside its {} x {} pixels{}",
+                        crs(&p.grid),
+                        p.pw,
+                        p.ph,
+                        p.photo
+                            .as_ref()
+                            .filter(|g| g.epsg != p.grid.epsg || g.crs != p.grid.crs)
+                            .map(|g| format!(
+                                " (the photo is in {}: reproject one to the other, e.g. with \
+                                 gdalwarp -t_srs)",
+                                crs(g)
+                            ))
+                            .unwrap_or_default()
+                    ),
                 });
             }
         }
