@@ -229,7 +229,11 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
                 }
                 let d = Database::open(&dir)?;
                 let sp = crate::commands::spinner("writing 3D Tiles");
-                let s = texmap_terrain::tiles3d::write_tileset(&d, &output, 4096)?;
+                let s = texmap_terrain::tiles3d::write_tileset(
+                    &d,
+                    &output,
+                    texmap_terrain::tiles3d::MAX_TILE_TEXTURE,
+                )?;
                 sp.finish_and_clear();
                 crate::note!(
                     "wrote {} ({} tiles, {} with content, {} triangles, {:.1} MB)",

@@ -136,6 +136,21 @@ pub fn relief_colour(grid: &Grid, shade: &Hillshade, col: u32, row: u32) -> [u8;
     [c(base[0]), c(base[1]), c(base[2]), 255]
 }
 
+/// The texel `(x, y)` of the grid's shaded relief at `side` texels a side: the colour of the
+/// nearest sample ([`relief_image`] and the tiles of a 3D Tiles export share it).
+pub fn relief_texel(grid: &Grid, shade: &Hillshade, side: u32, x: u32, y: u32) -> [u8; 4] {
+    let nearest = |t: u32, n: u32| {
+        let i = ((t as f64 + 0.5) / side as f64 * (n - 1) as f64).round() as u32;
+        i.min(n - 1)
+    };
+    relief_colour(
+        grid,
+        shade,
+        nearest(x, grid.width()),
+        nearest(y, grid.height()),
+    )
+}
+
 /// The shaded relief of the whole grid as an sRGB image, nearest sample per texel: the side is at
 /// most `max_side` and at most the grid's larger side (at least 1). Rows are coloured in parallel
 /// (each texel on its own: the same bytes for any thread count).
@@ -143,18 +158,12 @@ pub fn relief_image(grid: &Grid, max_side: u32) -> image::RgbaImage {
     use rayon::prelude::*;
     let side = max_side.min(grid.width().max(grid.height())).max(1);
     let shade = Hillshade::new(grid, Light::default());
-    let nearest = |t: u32, n: u32| {
-        let i = ((t as f64 + 0.5) / side as f64 * (n - 1) as f64).round() as u32;
-        i.min(n - 1)
-    };
     let mut raw = vec![0u8; side as usize * side as usize * 4];
     raw.par_chunks_mut(side as usize * 4)
         .enumerate()
         .for_each(|(y, line)| {
-            let row = nearest(y as u32, grid.height());
             for (x, px) in line.chunks_exact_mut(4).enumerate() {
-                let col = nearest(x as u32, grid.width());
-                px.copy_from_slice(&relief_colour(grid, &shade, col, row));
+                px.copy_from_slice(&relief_texel(grid, &shade, side, x as u32, y as u32));
             }
         });
     image::RgbaImage::from_raw(side, side, raw).expect("side² RGBA texels")

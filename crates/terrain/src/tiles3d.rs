@@ -30,10 +30,12 @@ use serde_json::{Value, json};
 use texmap_mesh::TriMesh;
 
 use crate::db::{ChunkEntry, Database, write_dir_atomically};
+use crate::dem::Grid;
 use crate::error::{TerrainError, io};
 use crate::geodesy::{Placement, ecef};
+use crate::relief::{Hillshade, Light, relief_texel};
 
-/// Largest texture side per tile.
+/// The default largest texture side per tile.
 pub const MAX_TILE_TEXTURE: u32 = 1024;
 
 /// What [`write_tileset`] wrote.
@@ -63,9 +65,10 @@ struct Tile {
     bytes: u64,
 }
 
-/// Write `db` as a 3D Tiles 1.1 tileset into the new directory `out` (which must not exist), the
-/// texture taken at up to `max_texture` texels a side from the database (its photo's pyramid, or
-/// shaded relief), each tile's part at most [`MAX_TILE_TEXTURE`].
+/// Write `db` as a 3D Tiles 1.1 tileset into the new directory `out` (which must not exist). Each
+/// tile's texture is at most `max_texture` texels a side ([`MAX_TILE_TEXTURE`] is the usual
+/// choice): the finest level of the photo's GST pyramid whose part under the tile fits, or, without
+/// a photo, shaded relief at one texel per grid sample (reduced if it does not fit).
 ///
 /// Errors: `out` exists; the grid has no placement on the ellipsoid; a chunk file or the texture
 /// cannot be read; a file cannot be written.
@@ -87,10 +90,20 @@ pub fn write_tileset(
                 .unwrap_or_default()
         ),
     })?;
-    let texture = match db.texture(max_texture)? {
-        Some(t) => t,
-        None => crate::relief::relief_image(&db.grid()?, max_texture),
+    let grid = db.grid_mapped()?;
+    let shade = Hillshade::new(&grid, Light::default());
+    let source = match &m.texture {
+        Some(t) => Source::Photo {
+            db,
+            map_texels: t.map_texels,
+            levels: t.levels,
+        },
+        None => Source::Relief {
+            grid: &grid,
+            shade: &shade,
+        },
     };
+    let max_texture = max_texture.max(1);
     write_dir_atomically(out, |tmp| {
         let mut tiles = Vec::new();
         for level in &m.levels {
@@ -99,7 +112,7 @@ pub fn write_tileset(
             let made: Vec<Result<Tile, TerrainError>> = level
                 .chunks
                 .par_iter()
-                .map(|c| chunk_tile(db, level.depth, c, placement, &texture, tmp))
+                .map(|c| chunk_tile(db, level.depth, c, placement, &source, max_texture, tmp))
                 .collect();
             for t in made {
                 tiles.push(t?);
@@ -138,7 +151,8 @@ fn chunk_tile(
     depth: u32,
     c: &ChunkEntry,
     placement: Placement,
-    texture: &image::RgbaImage,
+    source: &Source,
+    max_texture: u32,
     tmp: &Path,
 ) -> Result<Tile, TerrainError> {
     let mesh = db.read_chunk(c)?;
@@ -175,7 +189,7 @@ fn chunk_tile(
             Vec3::new(d.x as f32, d.z as f32, -d.y as f32)
         })
         .collect();
-    let (crop, tile_uvs) = tile_texture(texture, uvs);
+    let (crop, tile_uvs) = tile_texture(source, uvs, max_texture)?;
     let out = TriMesh {
         positions,
         triangles: mesh.triangles.clone(),
@@ -193,21 +207,87 @@ fn chunk_tile(
     Ok(tile)
 }
 
-/// The part of `texture` that `uvs` cover (whole texels, at most [`MAX_TILE_TEXTURE`] a side after
-/// a box-filtered reduction) and the uvs remapped onto it.
-fn tile_texture(texture: &image::RgbaImage, uvs: &[Vec2]) -> (image::RgbaImage, Vec<Vec2>) {
-    let (w, h) = (texture.width() as f32, texture.height() as f32);
+/// Where the tiles' textures come from.
+enum Source<'a> {
+    /// The database's GST pyramid: level `L` is `map_texels · 2^L` texels a side.
+    Photo {
+        db: &'a Database,
+        map_texels: u32,
+        levels: u32,
+    },
+    /// Shaded relief at one texel per grid sample.
+    Relief {
+        grid: &'a Grid,
+        shade: &'a Hillshade<'a>,
+    },
+}
+
+/// The texels a tile's `uvs` cover, at the finest resolution whose crop is at most `max_side`
+/// texels a side (a GST level of the photo, or the relief at one texel per sample, reduced by a
+/// box filter if still larger), and the uvs remapped onto that crop.
+fn tile_texture(
+    source: &Source,
+    uvs: &[Vec2],
+    max_side: u32,
+) -> Result<(image::RgbaImage, Vec<Vec2>), TerrainError> {
     let (lo, hi) = uvs.iter().fold(
         (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY)),
         |(lo, hi), &uv| (lo.min(uv), hi.max(uv)),
     );
-    let x0 = ((lo.x * w).floor().max(0.0) as u32).min(texture.width() - 1);
-    let y0 = ((lo.y * h).floor().max(0.0) as u32).min(texture.height() - 1);
-    let x1 = ((hi.x * w).ceil() as u32).clamp(x0 + 1, texture.width());
-    let y1 = ((hi.y * h).ceil() as u32).clamp(y0 + 1, texture.height());
-    let (cw, ch) = (x1 - x0, y1 - y0);
-    let mut crop = image::imageops::crop_imm(texture, x0, y0, cw, ch).to_image();
-    let scale = (MAX_TILE_TEXTURE as f32 / cw.max(ch) as f32).min(1.0);
+    // The crop `[x0, x1) x [y0, y1)` of a texture `side` texels a side.
+    let rect = |side: u32| {
+        let s = side as f32;
+        let x0 = ((lo.x * s).floor().max(0.0) as u32).min(side - 1);
+        let y0 = ((lo.y * s).floor().max(0.0) as u32).min(side - 1);
+        let x1 = ((hi.x * s).ceil() as u32).clamp(x0 + 1, side);
+        let y1 = ((hi.y * s).ceil() as u32).clamp(y0 + 1, side);
+        (x0, y0, x1 - x0, y1 - y0)
+    };
+    let (side, (x0, y0, cw, ch), mut crop) = match *source {
+        Source::Photo {
+            db,
+            map_texels,
+            levels,
+        } => {
+            // The finest level whose crop fits (level 0 at worst).
+            let level = (0..levels)
+                .rev()
+                .find(|&l| {
+                    let (_, _, w, h) = rect(map_texels << l);
+                    w.max(h) <= max_side
+                })
+                .unwrap_or(0);
+            let side = map_texels << level;
+            let r @ (x0, y0, cw, ch) = rect(side);
+            let mut img = image::RgbaImage::new(cw, ch);
+            for my in y0 / map_texels..=(y0 + ch - 1) / map_texels {
+                for mx in x0 / map_texels..=(x0 + cw - 1) / map_texels {
+                    let map = db.map(crate::gst::MapKey {
+                        level,
+                        x: mx,
+                        y: my,
+                    })?;
+                    let (ox, oy) = (mx * map_texels, my * map_texels);
+                    image::imageops::replace(
+                        &mut img,
+                        &map,
+                        ox as i64 - x0 as i64,
+                        oy as i64 - y0 as i64,
+                    );
+                }
+            }
+            (side, r, img)
+        }
+        Source::Relief { grid, shade } => {
+            let side = grid.width().max(grid.height());
+            let r @ (x0, y0, cw, ch) = rect(side);
+            let img = image::RgbaImage::from_fn(cw, ch, |x, y| {
+                image::Rgba(relief_texel(grid, shade, side, x0 + x, y0 + y))
+            });
+            (side, r, img)
+        }
+    };
+    let scale = (max_side as f32 / cw.max(ch) as f32).min(1.0);
     if scale < 1.0 {
         let (nw, nh) = (
             ((cw as f32 * scale).round() as u32).max(1),
@@ -215,16 +295,17 @@ fn tile_texture(texture: &image::RgbaImage, uvs: &[Vec2]) -> (image::RgbaImage, 
         );
         crop = image::imageops::resize(&crop, nw, nh, image::imageops::FilterType::Triangle);
     }
+    let s = side as f32;
     let remapped = uvs
         .iter()
         .map(|uv| {
             Vec2::new(
-                (uv.x * w - x0 as f32) / cw as f32,
-                (uv.y * h - y0 as f32) / ch as f32,
+                (uv.x * s - x0 as f32) / cw as f32,
+                (uv.y * s - y0 as f32) / ch as f32,
             )
         })
         .collect();
-    (crop, remapped)
+    Ok((crop, remapped))
 }
 
 /// An ECEF-aligned box (3D Tiles `box`: centre, then three half-axis vectors) around `lo..hi`,

@@ -123,11 +123,11 @@ fn srtm_tileset_is_placed_where_gdal_puts_the_tile() {
     .unwrap();
     let d = Database::open(&dbp).unwrap();
     let out = dir.path().join("tiles");
-    let s = write_tileset(&d, &out, 4096).unwrap();
+    let s = write_tileset(&d, &out, 1024).unwrap();
     let chunks: usize = d.manifest.levels.iter().map(|l| l.chunks.len()).sum();
     assert_eq!((s.tiles, s.with_content), (chunks, chunks));
     // Writing again over it is refused, the tileset untouched.
-    assert!(write_tileset(&d, &out, 4096).is_err());
+    assert!(write_tileset(&d, &out, 1024).is_err());
 
     let ts: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("tileset.json")).unwrap()).unwrap();
@@ -226,7 +226,7 @@ fn tileset_bytes_do_not_depend_on_threads() {
             .num_threads(threads)
             .build()
             .unwrap();
-        let s = pool.install(|| write_tileset(&d, &out, 4096)).unwrap();
+        let s = pool.install(|| write_tileset(&d, &out, 1024)).unwrap();
         assert!(s.tiles > 5, "{s:?}");
         let mut all = vec![(
             "tileset.json".to_string(),
@@ -241,4 +241,57 @@ fn tileset_bytes_do_not_depend_on_threads() {
         all
     };
     assert!(files(1) == files(2));
+}
+
+/// Tile textures come from the database at the finest resolution that fits: a root tile over the
+/// whole grid carries exactly the photo's GST level that `Database::texture` assembles (a GDAL-
+/// written UTM photo), or exactly the relief image at one texel per sample.
+#[test]
+fn tile_textures_are_the_databases_texels() {
+    use texmap_terrain::gst;
+    let dir = tempfile::tempdir().unwrap();
+    let root_image = |tiles: &std::path::Path| {
+        let (_, _, images) = gltf::import(tiles.join("tiles/0/0_0.glb")).unwrap();
+        let img = &images[0];
+        assert_eq!(img.format, gltf::image::Format::R8G8B8A8);
+        (img.width, img.height, img.pixels.clone())
+    };
+    // A photo placed by its georeference (UTM 54N, as the grid).
+    let grid = read_dem(data("ramp_i16_lzw.tif"), &ReadOptions::default()).unwrap();
+    let photo = gst::read_photo(&data("photo_rgb.tif"), None).unwrap();
+    let with_photo = dir.path().join("photo.db");
+    db::build(
+        &grid,
+        "ramp",
+        Some(&photo),
+        &BuildOptions::default(),
+        &with_photo,
+        |_, _| {},
+    )
+    .unwrap();
+    let d = Database::open(&with_photo).unwrap();
+    assert_eq!(d.manifest.levels[0].chunks.len(), 1);
+    let out = dir.path().join("photo_tiles");
+    write_tileset(&d, &out, 1024).unwrap();
+    let want = d.texture(1024).unwrap().unwrap();
+    assert_eq!(
+        root_image(&out),
+        (want.width(), want.height(), want.into_raw())
+    );
+    // Shaded relief.
+    let grid = read_dem(data("hillshade_dem_utm.tif"), &ReadOptions::default()).unwrap();
+    let relief = dir.path().join("relief.db");
+    db::build(
+        &grid,
+        "utm",
+        None,
+        &BuildOptions::default(),
+        &relief,
+        |_, _| {},
+    )
+    .unwrap();
+    let out = dir.path().join("relief_tiles");
+    write_tileset(&Database::open(&relief).unwrap(), &out, 1024).unwrap();
+    let want = texmap_terrain::relief::relief_image(&grid, 4096);
+    assert_eq!(root_image(&out), (64, 64, want.into_raw()));
 }
