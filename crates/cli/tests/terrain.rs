@@ -151,6 +151,21 @@ fn bad_input_gets_exit_codes_scripts_can_trust() {
 }
 
 /// A small database from the GDAL test grid and photo.
+/// A database without a photo (shaded relief) from the GDAL-warped UTM crop of the SRTM tile.
+fn relief_db(dir: &Path, name: &str) -> PathBuf {
+    let db = dir.join(name);
+    ok(&texmap(&[
+        "terrain",
+        "build",
+        "--dem",
+        &data("hillshade_dem_utm.tif"),
+        "--out",
+        db.to_str().unwrap(),
+        "-q",
+    ]));
+    db
+}
+
 fn small_db(dir: &Path) -> PathBuf {
     let db = dir.join("area.db");
     ok(&texmap(&[
@@ -347,17 +362,7 @@ fn render_draws_models_and_trees_and_names_bad_ones() {
 #[test]
 fn export_without_a_photo_embeds_the_shaded_relief() {
     let dir = tempfile::tempdir().unwrap();
-    let db = dir.path().join("relief.db");
-    let dem = data("hillshade_dem_utm.tif");
-    ok(&texmap(&[
-        "terrain",
-        "build",
-        "--dem",
-        &dem,
-        "--out",
-        db.to_str().unwrap(),
-        "-q",
-    ]));
+    let db = relief_db(dir.path(), "relief.db");
     let glb = dir.path().join("relief.glb");
     let o = texmap(&[
         "terrain",
@@ -377,7 +382,8 @@ fn export_without_a_photo_embeds_the_shaded_relief() {
     );
     let (_, _, images) = gltf::import(&glb).expect("a valid glTF");
     assert_eq!(images.len(), 1);
-    let grid = texmap_terrain::dem::read_dem(&dem, &Default::default()).unwrap();
+    let grid =
+        texmap_terrain::dem::read_dem(data("hillshade_dem_utm.tif"), &Default::default()).unwrap();
     let want = texmap_terrain::relief::relief_image(&grid, 4096);
     let img = &images[0];
     assert_eq!((img.width, img.height), want.dimensions());
@@ -409,17 +415,7 @@ fn glb_exports_pass_the_khronos_gltf_validator() {
     }
     let dir = tempfile::tempdir().unwrap();
     let photo_db = small_db(dir.path());
-    let relief_db = dir.path().join("relief.db");
-    let dem = data("hillshade_dem_utm.tif");
-    ok(&texmap(&[
-        "terrain",
-        "build",
-        "--dem",
-        &dem,
-        "--out",
-        relief_db.to_str().unwrap(),
-        "-q",
-    ]));
+    let relief_db = relief_db(dir.path(), "relief.db");
     let mut files = Vec::new();
     for (db, name) in [(&photo_db, "photo.glb"), (&relief_db, "relief.glb")] {
         let out = dir.path().join(name);
@@ -472,17 +468,7 @@ fn glb_exports_pass_the_khronos_gltf_validator() {
 #[test]
 fn export_3d_tiles_and_its_refusals() {
     let dir = tempfile::tempdir().unwrap();
-    let utm = dir.path().join("utm.db");
-    let dem = data("hillshade_dem_utm.tif");
-    ok(&texmap(&[
-        "terrain",
-        "build",
-        "--dem",
-        &dem,
-        "--out",
-        utm.to_str().unwrap(),
-        "-q",
-    ]));
+    let utm = relief_db(dir.path(), "utm.db");
     let tiles = dir.path().join("tiles");
     let t = tiles.to_str().unwrap();
     ok(&texmap(&[

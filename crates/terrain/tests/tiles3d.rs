@@ -31,6 +31,19 @@ fn gdal_lines(kind: &str) -> Vec<Vec<f64>> {
         .collect()
 }
 
+/// The database built from `grid` (and `photo`) in `dir/name`, opened.
+fn built(
+    dir: &std::path::Path,
+    name: &str,
+    grid: &texmap_terrain::dem::Grid,
+    photo: Option<&texmap_terrain::gst::Orthophoto>,
+    opts: BuildOptions,
+) -> Database {
+    let path = dir.join(name);
+    db::build(grid, name, photo, &opts, &path, |_, _| {}).unwrap();
+    Database::open(&path).unwrap()
+}
+
 #[test]
 fn inverse_utm_matches_proj() {
     let pts = gdal_lines("utm ");
@@ -111,17 +124,7 @@ fn walk(v: &serde_json::Value, parent: DVec3, depth: u32, parent_error: f64, out
 fn srtm_tileset_is_placed_where_gdal_puts_the_tile() {
     let dir = tempfile::tempdir().unwrap();
     let grid = read_dem(data("N44W072.hgt"), &ReadOptions::default()).unwrap();
-    let dbp = dir.path().join("srtm.db");
-    db::build(
-        &grid,
-        "N44W072.hgt",
-        None,
-        &BuildOptions::default(),
-        &dbp,
-        |_, _| {},
-    )
-    .unwrap();
-    let d = Database::open(&dbp).unwrap();
+    let d = built(dir.path(), "srtm.db", &grid, None, BuildOptions::default());
     let out = dir.path().join("tiles");
     let s = write_tileset(&d, &out, 1024).unwrap();
     let chunks: usize = d.manifest.levels.iter().map(|l| l.chunks.len()).sum();
@@ -213,13 +216,11 @@ fn srtm_tileset_is_placed_where_gdal_puts_the_tile() {
 fn tileset_bytes_do_not_depend_on_threads() {
     let dir = tempfile::tempdir().unwrap();
     let grid = read_dem(data("hillshade_dem_utm.tif"), &ReadOptions::default()).unwrap();
-    let dbp = dir.path().join("utm.db");
     let opts = BuildOptions {
         chunk: 17,
         ..BuildOptions::default()
     };
-    db::build(&grid, "utm", None, &opts, &dbp, |_, _| {}).unwrap();
-    let d = Database::open(&dbp).unwrap();
+    let d = built(dir.path(), "utm.db", &grid, None, opts);
     let files = |threads: usize| {
         let out = dir.path().join(format!("t{threads}"));
         let pool = rayon::ThreadPoolBuilder::new()
@@ -259,17 +260,13 @@ fn tile_textures_are_the_databases_texels() {
     // A photo placed by its georeference (UTM 54N, as the grid).
     let grid = read_dem(data("ramp_i16_lzw.tif"), &ReadOptions::default()).unwrap();
     let photo = gst::read_photo(&data("photo_rgb.tif"), None).unwrap();
-    let with_photo = dir.path().join("photo.db");
-    db::build(
+    let d = built(
+        dir.path(),
+        "photo.db",
         &grid,
-        "ramp",
         Some(&photo),
-        &BuildOptions::default(),
-        &with_photo,
-        |_, _| {},
-    )
-    .unwrap();
-    let d = Database::open(&with_photo).unwrap();
+        BuildOptions::default(),
+    );
     assert_eq!(d.manifest.levels[0].chunks.len(), 1);
     let out = dir.path().join("photo_tiles");
     write_tileset(&d, &out, 1024).unwrap();
@@ -280,18 +277,15 @@ fn tile_textures_are_the_databases_texels() {
     );
     // Shaded relief.
     let grid = read_dem(data("hillshade_dem_utm.tif"), &ReadOptions::default()).unwrap();
-    let relief = dir.path().join("relief.db");
-    db::build(
+    let relief = built(
+        dir.path(),
+        "relief.db",
         &grid,
-        "utm",
         None,
-        &BuildOptions::default(),
-        &relief,
-        |_, _| {},
-    )
-    .unwrap();
+        BuildOptions::default(),
+    );
     let out = dir.path().join("relief_tiles");
-    write_tileset(&Database::open(&relief).unwrap(), &out, 1024).unwrap();
+    write_tileset(&relief, &out, 1024).unwrap();
     let want = texmap_terrain::relief::relief_image(&grid, 4096);
     assert_eq!(root_image(&out), (64, 64, want.into_raw()));
 }
