@@ -19,8 +19,10 @@ pub enum TerrainCmd {
         /// Elevation grid: GeoTIFF, ESRI ASCII (.asc), SRTM (.hgt) or 16-bit PNG.
         #[arg(long)]
         dem: PathBuf,
-        /// Orthophoto (PNG, JPEG or GeoTIFF), placed by its georeference or stretched. Without one the
-        /// views are textured with shaded relief (height colours lit like `gdaldem hillshade`).
+        /// Orthophoto (PNG, JPEG or GeoTIFF), placed by its georeference or stretched. A GeoTIFF in
+        /// another system than the DEM's is reprojected (WGS 84 degrees, UTM of WGS 84/ETRS89/
+        /// NAD83, Web Mercator EPSG:3857). Without a photo the views are textured with shaded
+        /// relief (height colours lit like `gdaldem hillshade`).
         #[arg(long)]
         photo: Option<PathBuf>,
         /// GeoTIFF photo bands for red, green, blue (1-based), e.g. 3,2,1.
@@ -79,7 +81,8 @@ pub enum TerrainCmd {
         greedy: bool,
         /// Write an OGC 3D Tiles 1.1 tileset into the new directory -o: tileset.json and one .glb
         /// per chunk, each tile's geometricError the chunk's measured error, placed on the WGS 84
-        /// ellipsoid (the grid must be geographic or WGS 84 UTM; heights are taken as ellipsoidal).
+        /// ellipsoid (the grid must be geographic, UTM or Web Mercator; heights are taken as
+        /// ellipsoidal).
         /// Open it in CesiumJS with `Cesium3DTileset.fromUrl(".../tileset.json")`.
         #[arg(long = "3d-tiles")]
         tiles3d: bool,

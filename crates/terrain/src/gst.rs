@@ -3,9 +3,20 @@
 //!
 //! **Placement.** The texture spans the DEM's extent from the centre of sample (0, 0) (`u, v = 0`)
 //! to that of the last sample (`u, v = 1`), the same `[0, 1]²` the chunk vertices' texture
-//! coordinates use. A photo with a georeference (a GeoTIFF, assumed in the DEM's coordinate system)
-//! is sampled where it lies; texels outside it are transparent (alpha 0) and no overlap at all is an
-//! error. A photo without one (PNG, JPEG, a plain TIFF) is stretched over the extent.
+//! coordinates use. A photo with a georeference (a GeoTIFF) is sampled where it lies; texels
+//! outside it are transparent (alpha 0) and no overlap at all is an error. A photo without one
+//! (PNG, JPEG, a plain TIFF) is stretched over the extent.
+//!
+//! **Reprojection.** A photo in another coordinate system than the grid's is reprojected on the
+//! fly: each texel's grid coordinates go through longitude and latitude into the photo's system
+//! ([`crate::geodesy::Placement`]: WGS 84 longitude/latitude, UTM of WGS 84, ETRS89 or NAD83, Web
+//! Mercator), so a Sentinel-2 scene in UTM drapes an SRTM tile in degrees, and a photo in a
+//! neighbouring UTM zone lands where it belongs instead of where its numbers would put it in the
+//! grid's zone. As in GDAL's warper, the exact transform is evaluated on a lattice over the grid
+//! (64 cells a side, doubled until the bilinear interpolation between nodes is within 0.02 photo
+//! pixels of it at every cell's centre and edge midpoints) and interpolated between nodes. Two codes with no
+//! conversion here are an error that names both and the `gdalwarp` command to use; a side with no
+//! code is taken to be in the other's system.
 //! Multispectral GeoTIFFs choose three bands (`--bands 3,2,1`); samples wider than 8 bits are
 //! stretched linearly from each band's minimum to its maximum.
 //!
@@ -133,6 +144,23 @@ struct Placement {
     photo: Option<Georef>,
     pw: f64,
     ph: f64,
+    /// Photo positions on a `(k + 1)²` lattice over `[0, 1]²`, row-major, when the photo is in
+    /// another coordinate system than the grid: positions between the nodes are bilinear.
+    lattice: Option<(usize, Vec<(f64, f64)>)>,
+}
+
+/// The largest distance in photo pixels between a reprojected position and the lattice's
+/// bilinear interpolation of it, at the lattice cells' centres and edge midpoints (GDAL's
+/// approximate transformer allows 0.125 by default).
+const LATTICE_TOLERANCE_PX: f64 = 0.02;
+/// The finest lattice: 1024 x 1024 cells.
+const LATTICE_MAX_CELLS: usize = 1024;
+
+fn crs_name(g: &Georef) -> String {
+    match g.epsg {
+        Some(e) => format!("EPSG:{e}"),
+        None => format!("{:?}", g.crs).to_lowercase(),
+    }
 }
 
 impl Placement {
@@ -142,63 +170,198 @@ impl Placement {
         georef: Option<Georef>,
         source: &str,
     ) -> Result<Placement, TerrainError> {
-        let p = Placement {
+        let mut p = Placement {
             grid: *grid.georef(),
             gw: (grid.width() - 1) as f64,
             gh: (grid.height() - 1) as f64,
             photo: georef,
             pw: size.0 as f64,
             ph: size.1 as f64,
+            lattice: None,
         };
-        if p.photo.is_some() {
-            // Overlap test on the extents (corners of the grid's sample-centre rectangle).
-            let corners = [p.to_photo(0.0, 0.0), p.to_photo(1.0, 1.0)];
-            let (cmin, cmax) = (
-                corners[0].0.min(corners[1].0),
-                corners[0].0.max(corners[1].0),
-            );
-            let (rmin, rmax) = (
-                corners[0].1.min(corners[1].1),
-                corners[0].1.max(corners[1].1),
-            );
-            if cmax <= 0.0 || rmax <= 0.0 || cmin >= p.pw || rmin >= p.ph {
-                let crs = |g: &Georef| match g.epsg {
-                    Some(e) => format!("EPSG:{e}"),
-                    None => format!("{:?}", g.crs).to_lowercase(),
-                };
-                return Err(TerrainError::NoOverlap {
-                    photo: source.to_string(),
-                    dem: format!(
-                        "({}): the grid falls at photo pixels {cmin:.0}..{cmax:.0} x \
-                         {rmin:.0}..{rmax:.0}, outside its {} x {} pixels{}",
-                        crs(&p.grid),
-                        p.pw,
-                        p.ph,
-                        p.photo
-                            .as_ref()
-                            .filter(|g| g.epsg != p.grid.epsg || g.crs != p.grid.crs)
-                            .map(|g| format!(
-                                " (the photo is in {}: reproject one to the other, e.g. with \
-                                 gdalwarp -t_srs)",
-                                crs(g)
-                            ))
-                            .unwrap_or_default()
+        let Some(pg) = p.photo else {
+            return Ok(p);
+        };
+        let (from, to) = (
+            crate::geodesy::Placement::of(&p.grid),
+            crate::geodesy::Placement::of(&pg),
+        );
+        match (from, to) {
+            (Some(from), Some(to)) if from != to => p.lattice = Some(p.reprojection(from, to)),
+            (Some(_), Some(_)) => {}
+            _ if p.grid.epsg.is_some() && pg.epsg.is_some() && p.grid.epsg != pg.epsg => {
+                return Err(TerrainError::Unsupported {
+                    source: source.to_string(),
+                    what: format!(
+                        "placing a photo in {} on an elevation grid in {}: texmap reprojects \
+                         between WGS 84 longitude/latitude, UTM (WGS 84, ETRS89, NAD83) and Web \
+                         Mercator only; reproject the photo first, e.g. gdalwarp -t_srs {} \
+                         -r bilinear",
+                        crs_name(&pg),
+                        crs_name(&p.grid),
+                        crs_name(&p.grid),
                     ),
                 });
             }
+            // A side without a code: the photo is taken to be in the grid's system.
+            _ => {}
+        }
+        if !p.overlaps(from, to) {
+            let (cmin, cmax, rmin, rmax) = p.grid_in_photo();
+            return Err(TerrainError::NoOverlap {
+                photo: source.to_string(),
+                dem: format!(
+                    "({}): the grid falls at photo pixels {cmin:.0}..{cmax:.0} x \
+                     {rmin:.0}..{rmax:.0}, outside its {} x {} pixels{}",
+                    crs_name(&p.grid),
+                    p.pw,
+                    p.ph,
+                    if p.lattice.is_some() {
+                        format!(" (the photo in {}, reprojected)", crs_name(&pg))
+                    } else {
+                        String::new()
+                    }
+                ),
+            });
         }
         Ok(p)
     }
 
+    /// Whether any of the photo lies over the grid's extent: the extents' rectangles in photo
+    /// pixels, or, reprojected, a lattice node on the photo or a photo corner on the grid.
+    fn overlaps(
+        &self,
+        from: Option<crate::geodesy::Placement>,
+        to: Option<crate::geodesy::Placement>,
+    ) -> bool {
+        let on_photo = |(c, r): (f64, f64)| c >= 0.0 && r >= 0.0 && c <= self.pw && r <= self.ph;
+        match (&self.lattice, from, to, &self.photo) {
+            (Some((_, nodes)), Some(from), Some(to), Some(pg)) => {
+                nodes.iter().any(|&q| on_photo(q))
+                    || [
+                        (0.0, 0.0),
+                        (self.pw, 0.0),
+                        (0.0, self.ph),
+                        (self.pw, self.ph),
+                    ]
+                    .into_iter()
+                    .any(|(c, r)| {
+                        let (x, y) = pg.sample_xy(c - 0.5, r - 0.5);
+                        let (lon, lat) = to.lonlat(x, y);
+                        let (gx, gy) = from.xy(lon, lat);
+                        let (col, row) = self.grid.xy_to_sample(gx, gy);
+                        (0.0..=self.gw).contains(&col) && (0.0..=self.gh).contains(&row)
+                    })
+            }
+            _ => {
+                let (cmin, cmax, rmin, rmax) = self.grid_in_photo();
+                !(cmax <= 0.0 || rmax <= 0.0 || cmin >= self.pw || rmin >= self.ph)
+            }
+        }
+    }
+
+    /// The photo pixel ranges (columns, then rows) between the grid's first and last sample.
+    fn grid_in_photo(&self) -> (f64, f64, f64, f64) {
+        let (a, b) = (self.to_photo(0.0, 0.0), self.to_photo(1.0, 1.0));
+        (a.0.min(b.0), a.0.max(b.0), a.1.min(b.1), a.1.max(b.1))
+    }
+
+    /// The exact photo position of `(u, v)` through longitude and latitude.
+    fn reprojected(
+        &self,
+        from: crate::geodesy::Placement,
+        to: crate::geodesy::Placement,
+        pg: &Georef,
+        u: f64,
+        v: f64,
+    ) -> (f64, f64) {
+        let (x, y) = self.grid.sample_xy(u * self.gw, v * self.gh);
+        let (lon, lat) = from.lonlat(x, y);
+        let (px, py) = to.xy(lon, lat);
+        let (c, r) = pg.xy_to_sample(px, py);
+        (c + 0.5, r + 0.5)
+    }
+
+    /// The coarsest lattice (from 64 cells a side, doubling) whose bilinear interpolation is
+    /// within [`LATTICE_TOLERANCE_PX`] of the exact reprojection at every cell's centre and the
+    /// midpoints of its top and left edges.
+    fn reprojection(
+        &self,
+        from: crate::geodesy::Placement,
+        to: crate::geodesy::Placement,
+    ) -> (usize, Vec<(f64, f64)>) {
+        let pg = self.photo.expect("a photo georeference");
+        let mut k = 64;
+        loop {
+            let inv = 1.0 / k as f64;
+            let nodes: Vec<(f64, f64)> = (0..(k + 1) * (k + 1))
+                .map(|i| {
+                    let (a, b) = (i % (k + 1), i / (k + 1));
+                    self.reprojected(from, to, &pg, a as f64 * inv, b as f64 * inv)
+                })
+                .collect();
+            if k >= LATTICE_MAX_CELLS {
+                return (k, nodes);
+            }
+            // At the centre a conformal map's two curvatures cancel (its components are
+            // harmonic), so the edges' midpoints are checked too.
+            let mut worst = 0.0f64;
+            for b in 0..k {
+                for a in 0..k {
+                    let q = |da: usize, db: usize| nodes[(b + db) * (k + 1) + a + da];
+                    let (n00, n10, n01, n11) = (q(0, 0), q(1, 0), q(0, 1), q(1, 1));
+                    let mid = |p: (f64, f64), q: (f64, f64)| ((p.0 + q.0) / 2.0, (p.1 + q.1) / 2.0);
+                    for (s, t, est) in [
+                        (0.5, 0.5, mid(mid(n00, n10), mid(n01, n11))),
+                        (0.5, 0.0, mid(n00, n10)),
+                        (0.0, 0.5, mid(n00, n01)),
+                    ] {
+                        let exact = self.reprojected(
+                            from,
+                            to,
+                            &pg,
+                            (a as f64 + s) * inv,
+                            (b as f64 + t) * inv,
+                        );
+                        let e = (est.0 - exact.0).hypot(est.1 - exact.1);
+                        // NaN (a position off the projection's domain) counts as a miss.
+                        worst = if e.is_nan() {
+                            f64::INFINITY
+                        } else {
+                            worst.max(e)
+                        };
+                    }
+                }
+            }
+            if worst <= LATTICE_TOLERANCE_PX {
+                return (k, nodes);
+            }
+            k *= 2;
+        }
+    }
+
     /// Photo pixel position (continuous, pixel corners at integers) of texture coordinates.
     fn to_photo(&self, u: f64, v: f64) -> (f64, f64) {
-        match &self.photo {
-            Some(pg) => {
+        match (&self.photo, &self.lattice) {
+            (Some(_), Some((k, nodes))) => {
+                let k = *k;
+                let (fu, fv) = (u.clamp(0.0, 1.0) * k as f64, v.clamp(0.0, 1.0) * k as f64);
+                let (a, b) = ((fu as usize).min(k - 1), (fv as usize).min(k - 1));
+                let (s, t) = (fu - a as f64, fv - b as f64);
+                let q = |da: usize, db: usize| nodes[(b + db) * (k + 1) + a + da];
+                let (n00, n10, n01, n11) = (q(0, 0), q(1, 0), q(0, 1), q(1, 1));
+                let lerp = |p: f64, q: f64, w: f64| p + (q - p) * w;
+                (
+                    lerp(lerp(n00.0, n10.0, s), lerp(n01.0, n11.0, s), t),
+                    lerp(lerp(n00.1, n10.1, s), lerp(n01.1, n11.1, s), t),
+                )
+            }
+            (Some(pg), None) => {
                 let (x, y) = self.grid.sample_xy(u * self.gw, v * self.gh);
                 let (c, r) = pg.xy_to_sample(x, y);
                 (c + 0.5, r + 0.5)
             }
-            None => (u * self.pw, v * self.ph),
+            (None, _) => (u * self.pw, v * self.ph),
         }
     }
 
@@ -224,14 +387,31 @@ impl Placement {
     /// (`None` when none of them lies on the photo).
     fn rows_for(&self, size: u32, ty0: u32, ty1: u32) -> Option<(u32, u32)> {
         let inv = 1.0 / (size - 1).max(1) as f64;
-        let ys = [
-            self.to_photo(0.0, ty0 as f64 * inv).1,
-            self.to_photo(1.0, ty0 as f64 * inv).1,
-            self.to_photo(0.0, (ty1 - 1) as f64 * inv).1,
-            self.to_photo(1.0, (ty1 - 1) as f64 * inv).1,
-        ];
-        let lo = ys.iter().copied().fold(f64::INFINITY, f64::min);
-        let hi = ys.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let (v0, v1) = (ty0 as f64 * inv, (ty1 - 1) as f64 * inv);
+        let (lo, hi) = match &self.lattice {
+            // Bilinear positions lie between their cell's nodes: bound by the nodes of the
+            // lattice rows the texture rows fall in.
+            Some((k, nodes)) => {
+                let row = |v: f64| ((v.clamp(0.0, 1.0) * *k as f64) as usize).min(k - 1);
+                nodes[row(v0) * (k + 1)..(row(v1) + 2) * (k + 1)]
+                    .iter()
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), q| {
+                        (lo.min(q.1), hi.max(q.1))
+                    })
+            }
+            None => {
+                let ys = [
+                    self.to_photo(0.0, v0).1,
+                    self.to_photo(1.0, v0).1,
+                    self.to_photo(0.0, v1).1,
+                    self.to_photo(1.0, v1).1,
+                ];
+                (
+                    ys.iter().copied().fold(f64::INFINITY, f64::min),
+                    ys.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+                )
+            }
+        };
         if hi < 0.0 || lo > self.ph {
             return None;
         }
@@ -563,6 +743,62 @@ impl GstCache {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn reprojection_lattice_holds_its_tolerance_over_large_grids() {
+        use crate::dem::CrsKind;
+        // A 6° x 6° geographic grid under a UTM photo of 100 m pixels, and a 300 km UTM grid under a Web Mercator photo of 10 m pixels: between the nodes the interpolated position stays
+        // within the tolerance of the exact one (checked off the cell centres too).
+        let geo = Georef {
+            crs: CrsKind::Geographic,
+            epsg: Some(4326),
+            origin_x: -75.0,
+            origin_y: 48.0,
+            dx: 6.0 / 600.0,
+            dy: -6.0 / 600.0,
+        };
+        let utm = Georef {
+            crs: CrsKind::Projected,
+            epsg: Some(32618),
+            origin_x: 200_000.0,
+            origin_y: 5_400_000.0,
+            dx: 100.0,
+            dy: -100.0,
+        };
+        let merc = Georef {
+            crs: CrsKind::Projected,
+            epsg: Some(3857),
+            origin_x: -8_230_000.0,
+            origin_y: 5_660_000.0,
+            dx: 10.0,
+            dy: -10.0,
+        };
+        let utm_grid = Georef {
+            origin_x: 600_000.0,
+            origin_y: 5_000_000.0,
+            dx: 300.0,
+            dy: -300.0,
+            ..utm
+        };
+        for (g, photo, size) in [(geo, utm, (6000, 8000)), (utm_grid, merc, (40_000, 40_000))] {
+            let grid = Grid::new("g", 1001, 1001, vec![0.0; 1001 * 1001], g).unwrap();
+            let p = Placement::new(&grid, size, Some(photo), "photo").unwrap();
+            let (k, _) = p.lattice.as_ref().expect("reprojected");
+            let from = crate::geodesy::Placement::of(&g).unwrap();
+            let to = crate::geodesy::Placement::of(&photo).unwrap();
+            let mut worst = 0.0f64;
+            for i in 0..=97 {
+                for j in 0..=89 {
+                    let (u, v) = (i as f64 / 97.0, j as f64 / 89.0);
+                    let a = p.to_photo(u, v);
+                    let b = p.reprojected(from, to, &photo, u, v);
+                    worst = worst.max((a.0 - b.0).hypot(a.1 - b.1));
+                }
+            }
+            assert!(worst <= 1.5 * LATTICE_TOLERANCE_PX, "{k} cells: {worst} px");
+            assert!(*k > 64, "the lattice refined ({k} cells)");
+        }
+    }
 
     #[test]
     fn seed000_worked_example_324_maps() {

@@ -11,13 +11,14 @@
 //!
 //! Placement on the globe: every vertex goes from its grid sample (recovered from its texture
 //! coordinate) through the grid's georeference to WGS 84 longitude/latitude ([`crate::geodesy`]:
-//! geographic grids directly, WGS 84 UTM grids by the inverse projection) and, with its height as
+//! geographic grids directly, UTM and Web Mercator grids by the inverse projection) and, with its height as
 //! ellipsoidal height, to earth-centred, earth-fixed (ECEF) metres. Each glTF holds its vertices
 //! relative to the centre of its tile's box (single precision keeps millimetres there), the tile's
 //! `transform` translating by that centre (relative to the parent's, as transforms compose), and
 //! the y-up glTF axes are written so that the viewer's y-up to z-up rotation yields ECEF. Bounding
 //! volumes are boxes aligned with the ECEF axes around each chunk's vertices. Grids without a
-//! georeference on the ellipsoid (local grids, projections other than UTM) are refused by name.
+//! georeference on the ellipsoid (local grids, projections other than UTM and Web Mercator) are
+//! refused by name.
 //!
 //! The output directory is written atomically (a temporary sibling renamed at the end).
 
@@ -81,8 +82,9 @@ pub fn write_tileset(
     let placement = Placement::of(&m.georef).ok_or_else(|| TerrainError::Unsupported {
         source: db.dir.display().to_string(),
         what: format!(
-            "3D Tiles need the grid placed on the WGS 84 ellipsoid: a geographic or a WGS 84 UTM \
-             (EPSG:326zz/327zz) georeference; this grid's is {:?}{}",
+            "3D Tiles need the grid placed on the WGS 84 ellipsoid: a geographic, UTM (EPSG:326zz/\
+             327zz, ETRS89 258zz, NAD83 269zz) or Web Mercator (EPSG:3857) georeference; this \
+             grid's is {:?}{}",
             m.georef.crs,
             m.georef
                 .epsg

@@ -1,6 +1,6 @@
-//! The 3D Tiles export and the geodesy under it, against other programs' numbers: PROJ's UTM and
-//! ECEF coordinates (`gdaltransform`, tests/data/geodesy.sh) and GDAL's reading of the real SRTM
-//! tile N44W072.hgt (its georeference and corner heights, tests/data/srtm_facts.sh).
+//! The 3D Tiles export against other programs' numbers: GDAL's reading of the real SRTM tile
+//! N44W072.hgt (its georeference and corner heights, tests/data/srtm_facts.sh); the geodesy under
+//! it is checked against PROJ in tests/geodesy.rs.
 
 use std::collections::HashMap;
 use std::path::PathBuf;
@@ -8,27 +8,13 @@ use std::path::PathBuf;
 use glam::DVec3;
 use texmap_terrain::db::{self, BuildOptions, Database};
 use texmap_terrain::dem::{ReadOptions, read_dem};
-use texmap_terrain::geodesy::{ecef, utm_to_lonlat, utm_zone};
+use texmap_terrain::geodesy::ecef;
 use texmap_terrain::tiles3d::write_tileset;
 
 fn data(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("tests/data")
         .join(name)
-}
-
-fn gdal_lines(kind: &str) -> Vec<Vec<f64>> {
-    std::fs::read_to_string(data("geodesy_gdal.txt"))
-        .unwrap()
-        .lines()
-        .filter(|l| l.starts_with(kind))
-        .map(|l| {
-            l.split_whitespace()
-                .skip(1)
-                .map(|x| x.parse().unwrap())
-                .collect()
-        })
-        .collect()
 }
 
 /// The database built from `grid` (and `photo`) in `dir/name`, opened.
@@ -42,38 +28,6 @@ fn built(
     let path = dir.join(name);
     db::build(grid, name, photo, &opts, &path, |_, _| {}).unwrap();
     Database::open(&path).unwrap()
-}
-
-#[test]
-fn inverse_utm_matches_proj() {
-    let pts = gdal_lines("utm ");
-    assert_eq!(pts.len(), 10);
-    for p in pts {
-        let (zone, north) = utm_zone(p[0] as u16).unwrap();
-        let (lon, lat) = utm_to_lonlat(zone, north, p[3], p[4]);
-        // 1e-7 degrees is about a centimetre.
-        assert!(
-            (lon - p[1]).abs() < 1e-7 && (lat - p[2]).abs() < 1e-7,
-            "EPSG:{} ({}, {}) -> ({lon}, {lat}), PROJ ({}, {})",
-            p[0],
-            p[3],
-            p[4],
-            p[1],
-            p[2]
-        );
-    }
-}
-
-#[test]
-fn ecef_matches_proj() {
-    let pts = gdal_lines("ecef ");
-    assert_eq!(pts.len(), 5);
-    for p in pts {
-        let got = ecef(p[0], p[1], p[2]);
-        for k in 0..3 {
-            assert!((got[k] - p[3 + k]).abs() < 1e-3, "{p:?}: {got:?}");
-        }
-    }
 }
 
 /// A tile of the tree with its absolute transform (translations compose from the root).
