@@ -154,10 +154,11 @@ impl Placement {
     pub fn of(georef: &Georef) -> Option<Placement> {
         match georef.crs {
             CrsKind::Geographic => Some(Placement::Geographic),
-            CrsKind::Projected => match georef.epsg? {
-                3857 | 3785 => Some(Placement::WebMercator),
-                code => utm_zone(code).map(|(zone, north)| Placement::Utm { zone, north }),
-            },
+            CrsKind::Projected if georef.is_web_mercator() => Some(Placement::WebMercator),
+            CrsKind::Projected => georef
+                .epsg
+                .and_then(utm_zone)
+                .map(|(zone, north)| Placement::Utm { zone, north }),
             CrsKind::Local => None,
         }
     }

@@ -62,6 +62,8 @@ fn photos_in_other_systems_drape_where_gdal_warps_them() {
         ),
         ("dem_geo.tif", "photo_merc.tif", "ref_geo_merc.png"),
         ("dem_geo.tif", "photo_utm18.tif", "ref_geo_utm18.png"),
+        ("dem_merc.tif", "photo_geo.tif", "ref_merc_geo.png"),
+        ("dem_merc.tif", "photo_utm18.tif", "ref_merc_utm18.png"),
     ] {
         let (n, mean, max, one) = against_gdal(dem, photo, reference);
         eprintln!("{dem} <- {photo}: {n} texels, mean |diff| {mean:.3}, max {max}, {one} edge");
@@ -125,4 +127,47 @@ fn unknown_pairs_of_systems_are_refused_by_name() {
             north: true
         })
     );
+}
+
+#[test]
+fn web_mercator_grids_are_measured_in_ground_metres() {
+    use texmap_terrain::geodesy::{ecef, web_mercator_to_lonlat};
+    // dem_merc.tif: the SRTM cut warped by GDAL to EPSG:3857 at 100 "metres", about 72 m on the
+    // ground at 44.3° N. Distances between samples in local metres against the straight line
+    // between the same points on the ellipsoid (earth-centred; the chord is shorter than the
+    // surface by under a millimetre at these 10 km).
+    let grid = read_dem(&data("dem_merc.tif"), &ReadOptions::default()).unwrap();
+    let g = *grid.georef();
+    assert!(g.is_web_mercator());
+    let (w, h) = ((grid.width() - 1) as f64, (grid.height() - 1) as f64);
+    let (east, north) = g.spacing_metres(grid.height());
+    let lat_mid = web_mercator_to_lonlat(0.0, g.sample_xy(0.0, h / 2.0).1).1;
+    let k = lat_mid.to_radians().cos();
+    assert!(
+        (east / (100.0 * k) - 1.0).abs() < 0.01 && (north / (100.0 * k) - 1.0).abs() < 0.01,
+        "{east} x {north} m, cos φ = {k}"
+    );
+    let on_ellipsoid = |c: f64, r: f64| {
+        let (x, y) = g.sample_xy(c, r);
+        let (lon, lat) = web_mercator_to_lonlat(x, y);
+        glam::DVec3::from(ecef(lon, lat, 0.0))
+    };
+    // Along a row or a column: within a centimetre. Across (the diagonals): the local frame
+    // takes each row's own metres per degree of longitude, which shears it by ±2 m over 8.7 km
+    // here (the same as for a grid in degrees). Read as plain metres, as before, the
+    // distances were 1.4x too long.
+    for (a, b, tol) in [
+        ((0.0, 0.0), (w, 0.0), 1e-6),
+        ((0.0, h), (0.0, 0.0), 1e-6),
+        ((0.0, 0.0), (w, h), 3e-4),
+        ((w, 0.0), (0.0, h), 3e-4),
+    ] {
+        let (pa, pb) = (g.local_metres(a.0, a.1), g.local_metres(b.0, b.1));
+        let local = (pb.0 - pa.0).hypot(pb.1 - pa.1);
+        let truth = on_ellipsoid(a.0, a.1).distance(on_ellipsoid(b.0, b.1));
+        assert!(
+            (local - truth).abs() < tol * truth,
+            "{a:?} -> {b:?}: {local} m, on the ellipsoid {truth} m"
+        );
+    }
 }

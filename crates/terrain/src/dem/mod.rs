@@ -11,7 +11,8 @@
 //!
 //! Geographic grids are turned into local metres with the latitude-dependent spacing
 //! ([`Georef::local_metres`]): east-west metres per degree shrink with `cos φ` row by row, so a
-//! 1° tile at 60° N is half as wide as at the equator. The grid itself keeps its degrees; the
+//! 1° tile at 60° N is half as wide as at the equator. Web Mercator grids (EPSG:3857) too: their
+//! metres are ground metres only at the equator. The grid itself keeps its own coordinates; the
 //! conversion happens when vertices are made, so the georeference survives to the export.
 //!
 //! Readers ([`DemFormat`], [`read_dem`]): GeoTIFF ([`geotiff`]), ESRI ASCII grid ([`asc`]),
@@ -95,20 +96,36 @@ impl Georef {
     /// `M(φ) ≈ 111 132.92 − 559.82 cos 2φ + 1.175 cos 4φ` metres per degree of latitude (taken at
     /// the mean latitude of the two rows) and the parallel `P(φ) ≈ 111 412.84 cos φ − 93.5 cos 3φ`
     /// metres per degree of longitude at the sample's own latitude (the standard series, good to
-    /// about a centimetre per degree).
+    /// about a centimetre per degree). Web Mercator grids (EPSG:3857), whose metres are ground
+    /// metres only at the equator (√2 of them at 45°), the same way after turning rows into
+    /// latitudes and columns into degrees of longitude.
     pub fn local_metres(&self, col: f64, row: f64) -> (f64, f64) {
+        let arcs = |lat0: f64, lat: f64, dlon: f64| {
+            let mid = (0.5 * (lat0 + lat)).to_radians();
+            let m_lat = 111_132.92 - 559.82 * (2.0 * mid).cos() + 1.175 * (4.0 * mid).cos();
+            let phi = lat.to_radians();
+            let m_lon = 111_412.84 * phi.cos() - 93.5 * (3.0 * phi).cos();
+            (dlon * m_lon, -(lat - lat0) * m_lat)
+        };
         match self.crs {
+            CrsKind::Projected if self.is_web_mercator() => {
+                let (_, lat0) = crate::geodesy::web_mercator_to_lonlat(0.0, self.origin_y);
+                let (dlon, lat) = crate::geodesy::web_mercator_to_lonlat(
+                    col * self.dx,
+                    self.origin_y + row * self.dy,
+                );
+                arcs(lat0, lat, dlon)
+            }
             CrsKind::Projected | CrsKind::Local => (col * self.dx, -row * self.dy),
             CrsKind::Geographic => {
-                let lat0 = self.origin_y;
-                let lat = self.origin_y + row * self.dy;
-                let mid = (0.5 * (lat0 + lat)).to_radians();
-                let m_lat = 111_132.92 - 559.82 * (2.0 * mid).cos() + 1.175 * (4.0 * mid).cos();
-                let phi = lat.to_radians();
-                let m_lon = 111_412.84 * phi.cos() - 93.5 * (3.0 * phi).cos();
-                (col * self.dx * m_lon, -(lat - lat0) * m_lat)
+                arcs(self.origin_y, self.origin_y + row * self.dy, col * self.dx)
             }
         }
+    }
+
+    /// Whether the grid coordinates are Web Mercator metres (EPSG:3857, or its old code 3785).
+    pub fn is_web_mercator(&self) -> bool {
+        self.crs == CrsKind::Projected && matches!(self.epsg, Some(3857 | 3785))
     }
 
     /// Approximate sample spacing in metres `(east, north)` at the grid's centre row.

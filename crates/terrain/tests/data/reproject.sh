@@ -7,7 +7,7 @@
 #   photo_merc.tif   EPSG:3857 (Web Mercator, as web map imagery comes)
 #   photo_utm18.tif  EPSG:32618 (UTM 18N: the zone west of the grids' 19N)
 # The grids: hillshade_dem_utm.tif (UTM 19N, 64², from hillshade.sh) and dem_geo.tif (90 x 70
-# samples of N44W072.hgt, EPSG:4326). ref_<grid>_<photo>.png is `gdalwarp -r bilinear -et 0`
+# samples of N44W072.hgt, EPSG:4326); dem_merc.tif is dem_geo.tif warped to EPSG:3857. ref_<grid>_<photo>.png is `gdalwarp -r bilinear -et 0`
 # (exact PROJ transforms) of the photo onto the texel lattice of a 129² texture over the grid's
 # sample-centre extent (texel (i, j) at u = i/128, v = j/128), RGBA with alpha 0 off the photo.
 set -eu
@@ -32,6 +32,10 @@ for p in "geo 4326" "merc 3857" "utm18 32618"; do
     -co COMPRESS=DEFLATE p.vrt "$here/photo_$1.tif"
 done
 gdal_translate -q -srcwin 790 842 90 70 -co COMPRESS=DEFLATE "$here/N44W072.hgt" "$here/dem_geo.tif"
+# The same area's heights in Web Mercator at 100 m (about 72 m on the ground at 44.3° N)
+rm -f "$here/dem_merc.tif"
+gdalwarp -q -t_srs EPSG:3857 -tr 100 100 -r bilinear -ot Float32 -co COMPRESS=DEFLATE \
+  "$here/dem_geo.tif" "$here/dem_merc.tif"
 # texel-centred extents: sample-centre extent grown by half a texel (128 texel steps) each side
 extent() { # $1 = grid file: prints "xmin ymin xmax ymax" for -te
   gdalinfo -json "$1" | python3 -c '
@@ -42,10 +46,10 @@ x1, y1 = x0 + (w - 1) * g[1], y0 + (h - 1) * g[5]  # centre of the last sample
 sx, sy = (x1 - x0) / 256, (y0 - y1) / 256            # half a texel
 print(repr(x0 - sx), repr(y1 - sy), repr(x1 + sx), repr(y0 + sy))'
 }
-for g in "utm19 hillshade_dem_utm.tif 32619" "geo dem_geo.tif 4326"; do
+for g in "utm19 hillshade_dem_utm.tif 32619" "geo dem_geo.tif 4326" "merc dem_merc.tif 3857"; do
   set -- $g
   for p in geo merc utm18; do
-    [ "$1" = geo ] && [ "$p" = geo ] && continue
+    [ "$1" = "$p" ] && continue
     rm -f w.tif
     gdalwarp -q -t_srs "EPSG:$3" -te $(extent "$here/$2") -ts 129 129 -r bilinear -et 0 -dstalpha \
       "$here/photo_$p.tif" w.tif
