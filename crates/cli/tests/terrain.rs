@@ -150,6 +150,51 @@ fn bad_input_gets_exit_codes_scripts_can_trust() {
     assert!(!out.exists());
 }
 
+#[test]
+fn photos_in_another_system_are_reprojected_or_refused_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    // A UTM 18N photo over a grid in degrees: reprojected, the build succeeds.
+    let db = dir.path().join("geo.db");
+    ok(&texmap(&[
+        "terrain",
+        "build",
+        "--dem",
+        &data("dem_geo.tif"),
+        "--photo",
+        &data("photo_utm18.tif"),
+        "--out",
+        db.to_str().unwrap(),
+        "-q",
+    ]));
+    let info = texmap(&["terrain", "info", db.to_str().unwrap()]);
+    ok(&info);
+    let j: serde_json::Value = serde_json::from_slice(&info.stdout).unwrap();
+    assert_eq!(j["texture"]["placed_by"], "georeference", "{j}");
+    // A photo in UTM 54N (Japan) over the UTM 19N grid (New Hampshire): no overlap once both are
+    // on the globe; a runtime failure naming the photo, and no database left behind.
+    let bad = dir.path().join("far.db");
+    let o = texmap(&[
+        "terrain",
+        "build",
+        "--dem",
+        &data("hillshade_dem_utm.tif"),
+        "--photo",
+        &data("photo_rgb.tif"),
+        "--out",
+        bad.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    for part in [
+        "photo_rgb.tif",
+        "does not overlap",
+        "EPSG:32654, reprojected",
+    ] {
+        assert!(err.contains(part), "{part}: {err}");
+    }
+    assert!(!bad.exists(), "no partial database");
+}
+
 /// A small database from the GDAL test grid and photo.
 /// A database without a photo (shaded relief) from the GDAL-warped UTM crop of the SRTM tile.
 fn relief_db(dir: &Path, name: &str) -> PathBuf {
