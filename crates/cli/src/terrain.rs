@@ -16,9 +16,11 @@ use crate::args::usage;
 pub enum TerrainCmd {
     /// Build a terrain database (chunked LoD mesh + GST map pyramid) from an elevation grid.
     Build {
-        /// Elevation grid: GeoTIFF, ESRI ASCII (.asc), SRTM (.hgt) or 16-bit PNG.
-        #[arg(long)]
-        dem: PathBuf,
+        /// Elevation grid: GeoTIFF, ESRI ASCII (.asc), SRTM (.hgt) or 16-bit PNG. Several grids
+        /// that tile an area (e.g. `--dem N44W072.hgt N44W071.hgt`) are joined as gdalbuildvrt
+        /// joins them: one system, cell size and lattice; the later file wins where they overlap.
+        #[arg(long, num_args = 1.., required = true)]
+        dem: Vec<PathBuf>,
         /// Orthophoto (PNG, JPEG or GeoTIFF), placed by its georeference or stretched. A GeoTIFF in
         /// another system than the DEM's is reprojected (WGS 84 degrees, UTM of WGS 84/ETRS89/
         /// NAD83, Web Mercator EPSG:3857). Without a photo the views are textured with shaded
@@ -154,7 +156,22 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
                 offset,
                 cell,
             };
-            let mut grid = dem::read_dem(&dem, &opts)?;
+            let names: Vec<String> = dem.iter().map(|p| p.display().to_string()).collect();
+            let parts = dem
+                .iter()
+                .zip(&names)
+                .map(|(p, n)| Ok((n.clone(), dem::read_dem(p, &opts)?)))
+                .collect::<Result<Vec<_>, texmap_terrain::TerrainError>>()?;
+            let (mut grid, overlaps) = dem::mosaic::mosaic(parts)?;
+            for o in &overlaps {
+                crate::note!(
+                    "{} overlaps the grids before it on {} samples (largest difference {} m): its \
+                     heights are kept there",
+                    o.later,
+                    o.samples,
+                    o.max_difference
+                );
+            }
             if fill {
                 grid.fill_nodata();
             }
@@ -175,7 +192,7 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
             };
             let m = db::build_with(
                 &grid,
-                &dem.display().to_string(),
+                &names.join(" + "),
                 photo.as_deref(),
                 &bo,
                 &out,

@@ -195,6 +195,47 @@ fn photos_in_another_system_are_reprojected_or_refused_by_name() {
     assert!(!bad.exists(), "no partial database");
 }
 
+#[test]
+fn several_dems_join_into_one_database_or_are_refused_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let db = dir.path().join("m.db");
+    let pieces = ["mosaic_nw.tif", "mosaic_ne.tif", "mosaic_s.tif"].map(data);
+    let mut args = vec!["terrain", "build", "--dem"];
+    args.extend(pieces.iter().map(String::as_str));
+    args.extend(["--out", db.to_str().unwrap()]);
+    let o = texmap(&args);
+    ok(&o);
+    // The overlaps are reported, not replaced silently.
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("mosaic_s.tif overlaps the grids before it on 70 samples"),
+        "{err}"
+    );
+    let info = texmap(&["terrain", "info", db.to_str().unwrap()]);
+    ok(&info);
+    let j: serde_json::Value = serde_json::from_slice(&info.stdout).unwrap();
+    // GDAL's mosaic of the same pieces is 109 x 69 (tests/data/mosaic.sh).
+    assert_eq!(
+        (j["width"].as_u64(), j["height"].as_u64()),
+        (Some(109), Some(69))
+    );
+    // A grid in another system: exit 1, named, no database.
+    let bad = dir.path().join("bad.db");
+    let o = texmap(&[
+        "terrain",
+        "build",
+        "--dem",
+        &pieces[0],
+        &data("hillshade_dem_utm.tif"),
+        "--out",
+        bad.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("hillshade_dem_utm.tif") && err.contains("gdalwarp -t_srs EPSG:4326"));
+    assert!(!bad.exists());
+}
+
 /// A small database from the GDAL test grid and photo.
 /// A database without a photo (shaded relief) from the GDAL-warped UTM crop of the SRTM tile.
 fn relief_db(dir: &Path, name: &str) -> PathBuf {

@@ -17,12 +17,13 @@
 //!
 //! Readers ([`DemFormat`], [`read_dem`]): GeoTIFF ([`geotiff`]), ESRI ASCII grid ([`asc`]),
 //! SRTM `.hgt` ([`hgt`]), 16-bit PNG with a scale and offset and Mapbox Terrain-RGB PNG
-//! ([`png`]). Each validates at the file boundary ([`Grid::new`]): at least 2 x 2 samples, at most
+//! ([`png`]); grids that tile an area join into one ([`mosaic`]). Each validates at the file boundary ([`Grid::new`]): at least 2 x 2 samples, at most
 //! [`MAX_SAMPLES`], every value finite or no-data, not all no-data.
 
 pub mod asc;
 pub mod geotiff;
 pub mod hgt;
+pub mod mosaic;
 pub mod png;
 
 use crate::error::TerrainError;
