@@ -22,8 +22,8 @@ pub enum TerrainCmd {
         #[arg(long, num_args = 1.., required = true)]
         dem: Vec<PathBuf>,
         /// Orthophoto (PNG, JPEG or GeoTIFF), placed by its georeference or stretched. A GeoTIFF in
-        /// another system than the DEM's is reprojected (WGS 84 degrees, UTM of WGS 84/ETRS89/
-        /// NAD83, Web Mercator EPSG:3857). Without a photo the views are textured with shaded
+        /// another system than the DEM's is reprojected (WGS 84 degrees, UTM of WGS 84, ETRS89
+        /// or NAD83, Web Mercator EPSG:3857). Without a photo the views are textured with shaded
         /// relief (height colours lit like `gdaldem hillshade`).
         #[arg(long)]
         photo: Option<PathBuf>,
