@@ -115,6 +115,10 @@ pub struct RenderArgs {
     /// Eye position X,Y in the grid's georeference (default: the grid's centre).
     #[arg(long, allow_hyphen_values = true)]
     pub eye: Option<String>,
+    /// Eye position as WGS 84 longitude,latitude in degrees, whatever the grid's system
+    /// (geographic, UTM or Web Mercator), e.g. --eye-lonlat=-71.3033,44.2706.
+    #[arg(long, allow_hyphen_values = true, conflicts_with = "eye")]
+    pub eye_lonlat: Option<String>,
     /// Eye altitude, metres above sea level (default: the ground at the eye plus a quarter of
     /// the grid's smaller extent).
     #[arg(long, allow_hyphen_values = true)]
@@ -201,8 +205,31 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let load_ms = t0.elapsed().as_secs_f64() * 1e3;
 
     let mut view = FlightCamera::over(terrain.grid());
-    if let Some(e) = &a.eye {
-        let (x, y) = parse_pair::<f64>(e, ',', "--eye")?;
+    let eye = match (&a.eye, &a.eye_lonlat) {
+        (Some(e), _) => Some(parse_pair::<f64>(e, ',', "--eye")?),
+        (None, Some(e)) => {
+            let (lon, lat) = parse_pair::<f64>(e, ',', "--eye-lonlat")?;
+            if !(lon.abs() <= 180.0 && lat.abs() <= 90.0) {
+                return usage(format!(
+                    "--eye-lonlat {e}: expected longitude in −180..180 and latitude in −90..90"
+                ));
+            }
+            let g = terrain.grid().georef();
+            match texmap_terrain::geodesy::Placement::of(g) {
+                Some(p) => Some(p.xy(lon, lat)),
+                None => {
+                    return usage(format!(
+                        "--eye-lonlat {e}: the grid has no place on the globe ({:?}{}): give \
+                         --eye X,Y in its own coordinates",
+                        g.crs,
+                        g.epsg.map(|c| format!(", EPSG:{c}")).unwrap_or_default()
+                    ));
+                }
+            }
+        }
+        (None, None) => None,
+    };
+    if let Some((x, y)) = eye {
         view.eye_x = x;
         view.eye_y = y;
         if a.altitude.is_none() {

@@ -236,6 +236,38 @@ fn several_dems_join_into_one_database_or_are_refused_by_name() {
     assert!(!bad.exists());
 }
 
+#[test]
+fn the_eye_can_be_given_in_longitude_and_latitude() {
+    let dir = tempfile::tempdir().unwrap();
+    let db = relief_db(dir.path(), "utm.db");
+    let out = dir.path().join("v.png");
+    let render = |eye: &str| {
+        texmap(&[
+            "terrain",
+            "render",
+            db.to_str().unwrap(),
+            eye,
+            "--stats",
+            "-o",
+            out.to_str().unwrap(),
+        ])
+    };
+    // Mount Washington's summit on the UTM 19N grid: where PROJ puts it (gdaltransform,
+    // terrain/tests/data/geodesy.sh: 316174.999893 E, 4904508.425352 N).
+    let o = render("--eye-lonlat=-71.3033,44.2706");
+    ok(&o);
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let e = [j["eye"][0].as_f64().unwrap(), j["eye"][1].as_f64().unwrap()];
+    assert!(
+        (e[0] - 316174.999893).abs() < 1e-3 && (e[1] - 4904508.425352).abs() < 1e-3,
+        "{e:?}"
+    );
+    // Off the grid, or not a longitude and latitude: usage errors.
+    for bad in ["--eye-lonlat=-171.3,44.27", "--eye-lonlat=-71.3,94"] {
+        assert_eq!(render(bad).status.code(), Some(2), "{bad}");
+    }
+}
+
 /// A small database from the GDAL test grid and photo.
 /// A database without a photo (shaded relief) from the GDAL-warped UTM crop of the SRTM tile.
 fn relief_db(dir: &Path, name: &str) -> PathBuf {
