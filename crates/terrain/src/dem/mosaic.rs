@@ -84,7 +84,7 @@ pub fn mosaic(parts: Vec<(String, Grid)>) -> Result<(Grid, Vec<Overlap>), Terrai
             (q.origin_y - r.origin_y) / r.dy,
         );
         let off = (c - c.round()).abs().max((w - w.round()).abs());
-        if !(off <= 1e-3) || c.abs() > 1e9 || w.abs() > 1e9 {
+        if off.is_nan() || off > 1e-3 || c.abs() > 1e9 || w.abs() > 1e9 {
             return Err(unsupported(
                 name,
                 format!(
