@@ -19,7 +19,7 @@ fn data(name: &str) -> PathBuf {
 /// Our 129² texture of `photo` over `dem` against GDAL's warp: (texels compared, mean and largest
 /// absolute difference over the RGB of texels both give, texels where exactly one gives).
 fn against_gdal(dem: &str, photo: &str, reference: &str) -> (usize, f64, u8, usize) {
-    let grid = read_dem(&data(dem), &ReadOptions::default()).unwrap();
+    let grid = read_dem(data(dem), &ReadOptions::default()).unwrap();
     let photo = read_photo(&data(photo), None).unwrap();
     let ours = gst::place(&photo, &grid, 129).unwrap();
     let gdal = image::open(data(reference)).unwrap().to_rgba8();
@@ -80,7 +80,7 @@ fn photos_in_other_systems_drape_where_gdal_warps_them() {
 fn taking_the_photo_in_the_grids_system_would_misplace_it() {
     // What placement without reprojection did: the UTM 18N photo's numbers read as UTM 19N
     // put it ~470 km west of the grid, so there is no overlap and the error says so.
-    let grid = read_dem(&data("hillshade_dem_utm.tif"), &ReadOptions::default()).unwrap();
+    let grid = read_dem(data("hillshade_dem_utm.tif"), &ReadOptions::default()).unwrap();
     let mut photo = read_photo(&data("photo_utm18.tif"), None).unwrap();
     let g = photo.georef.unwrap();
     assert_eq!(g.epsg, Some(32618));
@@ -94,7 +94,7 @@ fn taking_the_photo_in_the_grids_system_would_misplace_it() {
 
 #[test]
 fn unknown_pairs_of_systems_are_refused_by_name() {
-    let grid = read_dem(&data("hillshade_dem_utm.tif"), &ReadOptions::default()).unwrap();
+    let grid = read_dem(data("hillshade_dem_utm.tif"), &ReadOptions::default()).unwrap();
     let photo = read_photo(&data("photo_utm18.tif"), None).unwrap();
     // Swiss LV95: no conversion here.
     let swiss = Orthophoto {
@@ -118,7 +118,7 @@ fn unknown_pairs_of_systems_are_refused_by_name() {
         assert!(msg.contains(part), "{msg}");
     }
     // A grid's own system is recognised: the Placement of each fixture's georeference.
-    let geo = read_dem(&data("dem_geo.tif"), &ReadOptions::default()).unwrap();
+    let geo = read_dem(data("dem_geo.tif"), &ReadOptions::default()).unwrap();
     assert_eq!(Placement::of(geo.georef()), Some(Placement::Geographic));
     assert_eq!(
         Placement::of(grid.georef()),
@@ -136,7 +136,7 @@ fn web_mercator_grids_are_measured_in_ground_metres() {
     // ground at 44.3° N. Distances between samples in local metres against the straight line
     // between the same points on the ellipsoid (earth-centred; the chord is shorter than the
     // surface by under a millimetre at these 10 km).
-    let grid = read_dem(&data("dem_merc.tif"), &ReadOptions::default()).unwrap();
+    let grid = read_dem(data("dem_merc.tif"), &ReadOptions::default()).unwrap();
     let g = *grid.georef();
     assert!(g.is_web_mercator());
     let (w, h) = ((grid.width() - 1) as f64, (grid.height() - 1) as f64);
