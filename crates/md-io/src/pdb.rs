@@ -29,7 +29,7 @@ use crate::elements::guess_element;
 use crate::error::Error;
 use crate::frame::{Frame, Label, UnitCell};
 use crate::parse::{parse_f32, parse_f64, trim};
-use crate::text::{Ctx, LineReader, Pos, TextFormat};
+use crate::text::{Ctx, FrameWalk, LineReader, ModelCheck, Pos};
 use std::io::Read;
 
 /// Value of a base-36 digit in the given alphabet half (upper or lower case), else `None`.
@@ -120,16 +120,11 @@ fn has_coordinates(line: &[u8]) -> bool {
 }
 
 /// PDB frame parser state: the cell of the last CRYST1, and model 1's atom count, which every
-/// later model must repeat (a model with another count lost or gained atom lines: an error, or
-/// with `lenient` a warning kept in `warnings`).
+/// later model must repeat ([`ModelCheck`]).
 #[derive(Default)]
 pub(crate) struct Pdb {
     cell: Option<UnitCell>,
-    first_count: Option<usize>,
-    lenient: bool,
-    warnings: Vec<Error>,
-    /// Frames already warned about (a frame is walked by the scan and again by the read).
-    warned: std::collections::BTreeSet<usize>,
+    models: ModelCheck,
 }
 
 /// Record name of a line: its first 6 bytes, trailing spaces removed.
@@ -141,40 +136,20 @@ impl Pdb {
     /// A parser; `lenient` turns an atom count that differs from model 1's into a warning.
     pub(crate) fn new(lenient: bool) -> Pdb {
         Pdb {
-            lenient,
-            ..Pdb::default()
+            cell: None,
+            models: ModelCheck::new(lenient),
         }
     }
 
     /// The warnings gathered so far (emptied).
     pub(crate) fn take_warnings(&mut self) -> Vec<Error> {
-        std::mem::take(&mut self.warnings)
+        self.models.take_warnings()
     }
 
     /// Checks a finished frame's atom count against model 1's.
     fn check_count(&mut self, ctx: &Ctx, pos: Pos, n_atoms: usize) -> Result<(), Error> {
-        if ctx.frame == 0 {
-            self.first_count = Some(n_atoms);
-            return Ok(());
-        }
-        let Some(first) = self.first_count else {
-            return Ok(());
-        };
-        if first == n_atoms {
-            return Ok(());
-        }
-        let e = Error::Parse {
-            at: ctx.at(pos),
-            expected: "as many ATOM/HETATM records as model 1 (frame 0)",
-            found: format!("{n_atoms} atoms, model 1 has {first}"),
-        };
-        if !self.lenient {
-            return Err(e);
-        }
-        if self.warned.insert(ctx.frame) {
-            self.warnings.push(e);
-        }
-        Ok(())
+        let expected = "as many ATOM/HETATM records as model 1 (frame 0)";
+        self.models.check(ctx, pos, n_atoms, expected)
     }
 
     fn cryst1(&mut self, ctx: &Ctx, pos: Pos, line: &[u8]) -> Result<(), Error> {
@@ -234,8 +209,10 @@ impl Pdb {
         frame.elements.push(element);
         Ok(())
     }
+}
 
-    /// Walks the records of one frame; `atoms` parses ATOM/HETATM lines when given a frame.
+impl FrameWalk for Pdb {
+    /// Walks the records of one frame; parses ATOM/HETATM lines when given a frame.
     fn walk<R: Read>(
         &mut self,
         lines: &mut LineReader<R>,
@@ -300,21 +277,6 @@ impl Pdb {
             f.cell = self.cell;
         }
         Ok(found)
-    }
-}
-
-impl TextFormat for Pdb {
-    fn read<R: Read>(
-        &mut self,
-        lines: &mut LineReader<R>,
-        ctx: &Ctx,
-        frame: &mut Frame,
-    ) -> Result<bool, Error> {
-        self.walk(lines, ctx, Some(frame))
-    }
-
-    fn skip<R: Read>(&mut self, lines: &mut LineReader<R>, ctx: &Ctx) -> Result<bool, Error> {
-        self.walk(lines, ctx, None)
     }
 }
 

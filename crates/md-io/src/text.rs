@@ -260,6 +260,98 @@ pub(crate) trait TextFormat {
     fn skip<R: Read>(&mut self, lines: &mut LineReader<R>, ctx: &Ctx) -> Result<bool, Error>;
 }
 
+/// A text format whose `read` and `skip` are one walk over a frame's records, parsing them into
+/// a frame when given one and checking their structure when not (PDB, PDBx/mmCIF).
+pub(crate) trait FrameWalk {
+    fn walk<R: Read>(
+        &mut self,
+        lines: &mut LineReader<R>,
+        ctx: &Ctx,
+        frame: Option<&mut Frame>,
+    ) -> Result<bool, Error>;
+}
+
+impl<T: FrameWalk> TextFormat for T {
+    fn read<R: Read>(
+        &mut self,
+        lines: &mut LineReader<R>,
+        ctx: &Ctx,
+        frame: &mut Frame,
+    ) -> Result<bool, Error> {
+        self.walk(lines, ctx, Some(frame))
+    }
+
+    fn skip<R: Read>(&mut self, lines: &mut LineReader<R>, ctx: &Ctx) -> Result<bool, Error> {
+        self.walk(lines, ctx, None)
+    }
+}
+
+/// What the multi-model text formats (PDB, PDBx/mmCIF) check across frames: every model must
+/// hold as many atoms as model 1 (frame 0). A model with another count lost or gained atom
+/// records: an error, or with `lenient` (`ReadOptions::allow_truncated`) a warning and the model
+/// passed on as it is. Also keeps the parser's warnings until the `Trajectory` gathers them,
+/// each once per frame and kind (a frame is walked by the scan and again by the read).
+#[derive(Default)]
+pub(crate) struct ModelCheck {
+    first: Option<usize>,
+    lenient: bool,
+    warnings: Vec<Error>,
+    warned: std::collections::BTreeSet<(usize, &'static str)>,
+}
+
+impl ModelCheck {
+    /// A check; `lenient` turns an atom count that differs from model 1's into a warning.
+    pub fn new(lenient: bool) -> ModelCheck {
+        ModelCheck {
+            lenient,
+            ..ModelCheck::default()
+        }
+    }
+
+    /// The warnings kept so far (emptied).
+    pub fn take_warnings(&mut self) -> Vec<Error> {
+        std::mem::take(&mut self.warnings)
+    }
+
+    /// Keeps `w` as a warning about frame `frame`, unless one of the same `kind` is kept already.
+    pub fn warn(&mut self, frame: usize, kind: &'static str, w: Error) {
+        if self.warned.insert((frame, kind)) {
+            self.warnings.push(w);
+        }
+    }
+
+    /// Checks a finished frame's atom count against model 1's (frame 0 sets it); `expected`
+    /// names the records counted, e.g. "as many ATOM/HETATM records as model 1 (frame 0)".
+    pub fn check(
+        &mut self,
+        ctx: &Ctx,
+        pos: Pos,
+        n_atoms: usize,
+        expected: &'static str,
+    ) -> Result<(), Error> {
+        if ctx.frame == 0 {
+            self.first = Some(n_atoms);
+            return Ok(());
+        }
+        let Some(first) = self.first else {
+            return Ok(());
+        };
+        if first == n_atoms {
+            return Ok(());
+        }
+        let e = Error::Parse {
+            at: ctx.at(pos),
+            expected,
+            found: format!("{n_atoms} atoms, model 1 has {first}"),
+        };
+        if !self.lenient {
+            return Err(e);
+        }
+        self.warn(ctx.frame, expected, e);
+        Ok(())
+    }
+}
+
 /// Skips blank lines; returns the first non-blank line's position, or `None` at the end.
 pub(crate) fn skip_blank<R: Read>(
     lines: &mut LineReader<R>,
