@@ -1,10 +1,12 @@
 //! Molecular-dynamics trajectories for the sphere renderers: readers and writers of the usual
 //! file formats, streaming frames, and element tables (radius, colour).
 //!
-//! - [`Trajectory`] reads XYZ / extended XYZ, PDB, GRO and LAMMPS text dumps (and the binary
-//!   DCD, XTC, TRR and AMBER NetCDF) one frame at a time into a reusable [`Frame`], or any frame by index.
-//! - [`Topology`] reads atom names, elements, residues and bonds (PDB, GRO, LAMMPS data file)
-//!   and gives them to the frames of a coordinate-only trajectory of the same atoms.
+//! - [`Trajectory`] reads XYZ / extended XYZ, PDB, PDBx/mmCIF (the first data block's
+//!   `_atom_site`, models as frames), GRO and LAMMPS text dumps (and the binary DCD, XTC, TRR
+//!   and AMBER NetCDF) one frame at a time into a reusable [`Frame`], or any frame by index.
+//! - [`Topology`] reads atom names, elements, residues and bonds (PDB, PDBx/mmCIF, GRO, PSF,
+//!   LAMMPS data file) and gives them to the frames of a coordinate-only trajectory of the same
+//!   atoms.
 //! - [`bonds`] finds bonds by distance (covalent radii, a cell grid, minimum image) and [`pbc`]
 //!   wraps atoms into the box or makes bonded molecules whole across it.
 //! - [`Writer`] writes XYZ and PDB.
@@ -21,8 +23,10 @@
 //!   allocated); text readers reserve at most one atom per 8 bytes of the file.
 //! - **No silent loss.** A last frame cut short is an [`Error::Truncated`] for that frame, from
 //!   [`Trajectory::n_frames`] too, unless `allow_truncated` ([`ReadOptions`]) asks to keep the
-//!   complete frames, and then it is a warning ([`Trajectory::warnings`]). A PDB model with
-//!   another atom count than model 1, or an atom record whose name is damaged, is an error.
+//!   complete frames, and then it is a warning ([`Trajectory::warnings`]). A PDB or mmCIF model
+//!   with another atom count than model 1, or a PDB atom record whose name is damaged, is an
+//!   error. The one deliberate drop: of an mmCIF atom's alternate locations only the first is
+//!   kept (as gemmi does), and each frame that lost rows says how many in a warning.
 //! - **Sane values.** Coordinates and cell lengths are finite and within ±[`MAX_COORDINATE`]
 //!   (10^7 Å); beyond it a value is damage, reported with the frame and the atom.
 //!
@@ -75,6 +79,7 @@ mod format;
 mod frame;
 mod gro;
 mod lammps;
+mod mmcif;
 mod netcdf;
 pub mod parse;
 pub mod pbc;

@@ -9,6 +9,10 @@
 //! - **PDB**: the first model's atoms through the PDB reader, plus `CONECT` records (serial
 //!   numbers, hybrid-36 allowed, resolved to atom indices through the model's serials);
 //! - **GRO**: the first frame's atoms (GRO has no bonds);
+//! - **PDBx/mmCIF**: the first model's atoms through the mmCIF reader (the first alternate
+//!   location of each atom, as there: the dropped rows are not reported here, read the file as a
+//!   trajectory to see the warning). No bonds are taken from `_struct_conn`: as for GRO, bonds
+//!   come from the distance-based finder ([`crate::bonds`]);
 //! - **PSF** (CHARMM, NAMD, X-PLOR): atoms with segment-free residues, types and masses, and the
 //!   `!NBOND` section (module `psf`: elements from names, checked against the masses);
 //! - **LAMMPS data file** (`.data`, `.lmp`, or a name starting `data.`): the `Atoms` section in
@@ -47,6 +51,8 @@ pub enum TopologyFormat {
     Pdb,
     /// GROMACS .gro: atoms of the first frame, no bonds.
     Gro,
+    /// PDBx/mmCIF: atoms of the first model, no bonds.
+    Mmcif,
     /// LAMMPS data file: `Atoms` and `Bonds` sections.
     LammpsData,
     /// CHARMM/NAMD/X-PLOR PSF: `!NATOM` and `!NBOND` sections (see the `psf` module).
@@ -54,7 +60,8 @@ pub enum TopologyFormat {
 }
 
 impl TopologyFormat {
-    /// The format a path names: `.pdb`/`.ent`, `.gro`, `.psf`, `.data`/`.lmp` or `data.*` (LAMMPS).
+    /// The format a path names: `.pdb`/`.ent`, `.gro`, `.cif`/`.mmcif`, `.psf`, `.data`/`.lmp` or
+    /// `data.*` (LAMMPS).
     pub fn from_path(path: &Path) -> Option<TopologyFormat> {
         let name = path.file_name()?.to_str()?.to_ascii_lowercase();
         if name.starts_with("data.") {
@@ -64,6 +71,7 @@ impl TopologyFormat {
         Some(match ext.as_str() {
             "pdb" | "ent" => TopologyFormat::Pdb,
             "gro" => TopologyFormat::Gro,
+            "cif" | "mmcif" => TopologyFormat::Mmcif,
             "data" | "lmp" => TopologyFormat::LammpsData,
             "psf" => TopologyFormat::Psf,
             _ => return None,
@@ -194,7 +202,7 @@ impl Topology {
         let Some(format) = TopologyFormat::from_path(path) else {
             return Err(Error::Unsupported {
                 file: name,
-                what: "topology format (expected .pdb, .gro, .psf, or a LAMMPS data file: .data, .lmp, data.*)",
+                what: "topology format (expected .pdb, .gro, .cif/.mmcif, .psf, or a LAMMPS data file: .data, .lmp, data.*)",
             });
         };
         Topology::open_as(path, format)
@@ -217,6 +225,9 @@ impl Topology {
                 Ok(t)
             }
             TopologyFormat::Gro => Topology::first_frame(Trajectory::open_as(path, Format::Gro)?),
+            TopologyFormat::Mmcif => {
+                Topology::first_frame(Trajectory::open_as(path, Format::Mmcif)?)
+            }
             TopologyFormat::LammpsData => lammps_data(open()?, &name),
             TopologyFormat::Psf => crate::psf::read_psf(open()?, &name),
         }
@@ -259,6 +270,9 @@ impl Topology {
             }
             TopologyFormat::Gro => {
                 Topology::first_frame(Trajectory::from_reader(src, Format::Gro, name)?)
+            }
+            TopologyFormat::Mmcif => {
+                Topology::first_frame(Trajectory::from_reader(src, Format::Mmcif, name)?)
             }
             TopologyFormat::LammpsData => lammps_data(src, &file),
             TopologyFormat::Psf => crate::psf::read_psf(src, &file),

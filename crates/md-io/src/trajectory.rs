@@ -6,6 +6,7 @@ use crate::format::Format;
 use crate::frame::Frame;
 use crate::gro::Gro;
 use crate::lammps::Lammps;
+use crate::mmcif::Mmcif;
 use crate::netcdf::NetcdfReader;
 use crate::pdb::Pdb;
 use crate::text::TextReader;
@@ -27,6 +28,7 @@ enum Reader<R> {
     Pdb(TextReader<R, Pdb>),
     Gro(TextReader<R, Gro>),
     Lammps(TextReader<R, Lammps>),
+    Mmcif(TextReader<R, Mmcif>),
 }
 
 /// Runs `$body` with `$r` bound to the format's reader, whatever the format.
@@ -41,6 +43,7 @@ macro_rules! each_reader {
             Reader::Pdb($r) => $body,
             Reader::Gro($r) => $body,
             Reader::Lammps($r) => $body,
+            Reader::Mmcif($r) => $body,
         }
     };
 }
@@ -56,8 +59,8 @@ macro_rules! each_reader {
 /// With `allow_truncated` ([`ReadOptions`]) the complete frames are kept and the cut one is dropped
 /// *with a warning*: the same error, kept in [`Trajectory::warnings`] for the caller to print,
 /// while `n_frames` counts the complete frames and streaming ends after the last of them. A PDB
-/// model whose atom count differs from model 1's is likewise an error by default and a warning
-/// here (the model is passed on as it is). Damage that is not a cut end (a flipped byte, a
+/// or mmCIF model whose atom count differs from model 1's is likewise an error by default and a
+/// warning here (the model is passed on as it is). Damage that is not a cut end (a flipped byte, a
 /// corrupt header) stays an error either way.
 ///
 /// ```
@@ -115,7 +118,8 @@ pub struct Trajectory<R: Read + Seek = File> {
     n_atoms: Option<usize>,
     next: usize,
     options: ReadOptions,
-    /// What was tolerated under `options` (each once).
+    /// What was tolerated under `options`, and the alternate locations an mmCIF read dropped
+    /// (each once).
     warnings: Vec<Error>,
 }
 
@@ -196,6 +200,7 @@ impl<R: Read + Seek> Trajectory<R> {
             Format::LammpsDump => {
                 Reader::Lammps(TextReader::new(src, Lammps::default(), file.clone()))
             }
+            Format::Mmcif => Reader::Mmcif(TextReader::new(src, Mmcif::new(lenient), file.clone())),
         };
         Ok(Trajectory {
             reader,
@@ -214,8 +219,10 @@ impl<R: Read + Seek> Trajectory<R> {
     }
 
     /// What was tolerated under `allow_truncated` ([`ReadOptions`]) so far (a dropped cut frame,
-    /// a PDB model with another atom count), each once, in the order met. Display names the
-    /// file, frame and byte; a caller prints them as warnings.
+    /// a PDB or mmCIF model with another atom count), and whatever the options, the alternate
+    /// locations of PDBx/mmCIF atoms dropped after the first (one warning per frame, with the
+    /// count), each once, in the order met. Display names the file, frame and byte; a caller
+    /// prints them as warnings.
     pub fn warnings(&self) -> &[Error] {
         &self.warnings
     }
@@ -228,12 +235,15 @@ impl<R: Read + Seek> Trajectory<R> {
         }
     }
 
-    /// Gathers the PDB parser's warnings.
+    /// Gathers the PDB and mmCIF parsers' warnings.
     fn gather(&mut self) {
-        if let Reader::Pdb(r) = &mut self.reader {
-            for w in r.format_mut().take_warnings() {
-                self.warn(w);
-            }
+        let taken = match &mut self.reader {
+            Reader::Pdb(r) => r.format_mut().take_warnings(),
+            Reader::Mmcif(r) => r.format_mut().take_warnings(),
+            _ => return,
+        };
+        for w in taken {
+            self.warn(w);
         }
     }
 

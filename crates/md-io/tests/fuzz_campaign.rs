@@ -1,5 +1,5 @@
 //! The fuzz campaign of every md-io reader (harness: tests/support/campaign.rs): each fixture of
-//! tests/data (written by MDAnalysis, ASE, LAMMPS, OVITO; see the READMEs there) and the DCD and
+//! tests/data (written by MDAnalysis, ASE, LAMMPS, OVITO, gemmi and the wwPDB; see the READMEs there) and the DCD and
 //! XTC our writers make, cut at every record boundary and at seeded offsets, with seeded bit
 //! flips and byte replacements, header fields set to extremes, CRLF and NUL for text. Every
 //! mutant is read twice, strict and with `allow_truncated`, through the public API (open,
@@ -553,6 +553,13 @@ fn pdb_campaign() {
     let files = ["mda_multi.pdb", "mda_noelem.pdb"];
     let fx = files.map(|f| text_fixture(f, Format::Pdb));
     campaign("PDB", Format::Pdb, fx.into());
+}
+
+#[test]
+fn mmcif_campaign() {
+    let files = ["gemmi_multi.cif", "gemmi_topo.cif", "1uqc.cif"];
+    let fx = files.map(|f| text_fixture(f, Format::Mmcif));
+    campaign("PDBx/mmCIF", Format::Mmcif, fx.into());
 }
 
 #[test]

@@ -38,6 +38,7 @@ fn random_access_equals_streaming_in_any_order() {
     for name in [
         "ase_ext.xyz",
         "mda_multi.pdb",
+        "gemmi_multi.cif",
         "mda_vel.gro",
         "lmp_tri.lammpstrj",
         "lmp_scaled.lammpstrj",
@@ -90,6 +91,7 @@ fn open_tells_the_format_from_the_content_without_extension() {
     for (name, format) in [
         ("ase_ext.xyz", Format::Xyz),
         ("mda_multi.pdb", Format::Pdb),
+        ("gemmi_multi.cif", Format::Mmcif),
         ("mda_vel.gro", Format::Gro),
         ("lmp_tri.lammpstrj", Format::LammpsDump),
     ] {

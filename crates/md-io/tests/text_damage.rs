@@ -9,10 +9,11 @@ use std::io::Cursor;
 use std::path::PathBuf;
 use texmap_md_io::{Error, Format, Frame, Trajectory};
 
-const FILES: [(&str, Format); 7] = [
+const FILES: [(&str, Format); 8] = [
     ("ase_ext.xyz", Format::Xyz),
     ("ase_plain.xyz", Format::Xyz),
     ("mda_multi.pdb", Format::Pdb),
+    ("gemmi_multi.cif", Format::Mmcif),
     ("mda_vel.gro", Format::Gro),
     ("py_prec5.gro", Format::Gro),
     ("lmp_tri.lammpstrj", Format::LammpsDump),
@@ -60,6 +61,22 @@ fn frame_ends(bytes: &[u8], format: Format) -> Vec<usize> {
                     ends.push(line_starts[k + 1]);
                 }
             }
+        }
+        Format::Mmcif => {
+            // A model ends where the next one's first _atom_site row shows (the row's line is
+            // part of what ends it: a damaged model number there is the earlier model's
+            // damage); the last ends with the loop, here at the end of the file. The rows are
+            // gemmi's one-line ATOM records, the model number their last field.
+            let model = |l: &str| l.split_whitespace().last().unwrap().to_string();
+            let rows: Vec<usize> = (0..lines.len())
+                .filter(|&k| lines[k].starts_with("ATOM") || lines[k].starts_with("HETATM"))
+                .collect();
+            for w in rows.windows(2) {
+                if model(lines[w[0]]) != model(lines[w[1]]) {
+                    ends.push(line_starts[w[1] + 1]);
+                }
+            }
+            ends.push(bytes.len());
         }
         Format::LammpsDump => {
             let mut starts: Vec<usize> = lines
