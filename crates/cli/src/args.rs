@@ -56,8 +56,8 @@ pub struct Cli {
 pub enum Command {
     /// Print a trajectory's format, atom and frame counts, box and first positions as one JSON object.
     Info {
-        /// Trajectory file (XYZ, extended XYZ, PDB, GRO, LAMMPS dump, DCD, XTC, TRR, AMBER
-        /// NetCDF).
+        /// Trajectory file (XYZ, extended XYZ, PDB, PDBx/mmCIF, GRO, LAMMPS dump, DCD, XTC, TRR,
+        /// AMBER NetCDF).
         file: PathBuf,
         /// Format, when the extension does not tell it.
         #[arg(long)]
@@ -66,8 +66,8 @@ pub enum Command {
         /// warning (default: a cut frame is an error naming the file, frame and byte).
         #[arg(long)]
         allow_truncated: bool,
-        /// Topology (PDB, GRO, PSF, LAMMPS data file) of the trajectory's atoms: its atom, residue
-        /// and bond counts are added, and a different atom count is an error.
+        /// Topology (PDB, PDBx/mmCIF, GRO, PSF, LAMMPS data file) of the trajectory's atoms: its
+        /// atom, residue and bond counts are added, and a different atom count is an error.
         #[arg(long, value_name = "FILE")]
         topology: Option<PathBuf>,
     },
@@ -490,8 +490,8 @@ pub enum PbcArg {
 #[command(next_help_heading = "Molecules")]
 pub struct MolArgs {
     /// Topology giving names, elements, residues and bonds to a trajectory of the same atoms
-    /// (XTC, DCD, TRR, NetCDF carry coordinates only): PDB (CONECT bonds), GRO, a CHARMM/NAMD
-    /// PSF (.psf: !NBOND bonds), or a LAMMPS data file (.data, .lmp, data.*).
+    /// (XTC, DCD, TRR, NetCDF carry coordinates only): PDB (CONECT bonds), PDBx/mmCIF (.cif),
+    /// GRO, a CHARMM/NAMD PSF (.psf: !NBOND bonds), or a LAMMPS data file (.data, .lmp, data.*).
     #[arg(long, value_name = "FILE")]
     pub topology: Option<PathBuf>,
     /// Draw only the atoms SEL selects, in the VMD/MDAnalysis language: 'not resname SOL',

@@ -116,7 +116,7 @@ fn open_trajectory_with(
         Some(name) => {
             let Some(f) = Format::from_extension(name) else {
                 return usage(format!(
-                    "--format {name:?}: expected one of xyz, extxyz, pdb, gro, lammpstrj, dcd, xtc, trr, nc"
+                    "--format {name:?}: expected one of xyz, extxyz, pdb, cif, gro, lammpstrj, dcd, xtc, trr, nc"
                 ));
             };
             Ok(Trajectory::open_as_with(file, f, options)?)

@@ -195,7 +195,7 @@ pub fn mol_error(e: MolError) -> anyhow::Error {
 pub fn unnamed_warning(plan: &MolPlan, frame: &Frame, file: &str) -> Option<String> {
     plan.atoms_unnamed(frame).then(|| {
         format!(
-            "{file} has no atom names, types or elements (coordinates only): every atom is drawn in the unknown-element colour; give --topology FILE (PDB, GRO or LAMMPS data file of the same atoms) for names, elements, residues and bonds"
+            "{file} has no atom names, types or elements (coordinates only): every atom is drawn in the unknown-element colour; give --topology FILE (PDB, PDBx/mmCIF, GRO or LAMMPS data file of the same atoms) for names, elements, residues and bonds"
         )
     })
 }
