@@ -93,10 +93,15 @@ fn open_trajectory(file: &Path, format: Option<&str>) -> Result<Trajectory> {
     open_trajectory_with(file, format, ReadOptions::new())
 }
 
-/// Prints what the reader tolerated under --allow-truncated (once each).
+/// Prints the reader's warnings (once each): what it tolerated under --allow-truncated, and the
+/// alternate locations of PDBx/mmCIF atoms it dropped after the first.
 fn print_warnings(traj: &Trajectory, shown: &mut usize) {
     for w in &traj.warnings()[*shown..] {
-        eprintln!("texmap: warning: {w} (dropped: --allow-truncated)");
+        if texmap_md_io::is_altloc_warning(w) {
+            eprintln!("texmap: warning: {w}");
+        } else {
+            eprintln!("texmap: warning: {w} (dropped: --allow-truncated)");
+        }
     }
     *shown = traj.warnings().len();
 }

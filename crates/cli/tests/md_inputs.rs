@@ -247,3 +247,18 @@ fn per_selection_colour_wins() {
     }
     assert!(blue > 50);
 }
+
+#[test]
+fn mmcif_alternate_locations_are_a_plain_warning() {
+    // 3JQH (wwPDB, from Biopython's tests): gemmi keeps 206 of its 238 atom rows, dropping the
+    // second conformations (md-io's tests/data/mmcif_reference.json).
+    let o = texmap(&["info", &data("3jqh.cif")]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(j["atoms"], 206);
+    let err = stderr(&o);
+    assert!(
+        err.contains("32 rows of other alternate locations") && !err.contains("--allow-truncated"),
+        "{err}"
+    );
+}

@@ -99,6 +99,7 @@ pub use elements::Element;
 pub use error::{Error, Location};
 pub use format::Format;
 pub use frame::{Frame, Label, MAX_COORDINATE, UnitCell};
+pub use mmcif::is_altloc_warning;
 pub use select::{Selection, SelectionError};
 pub use style::{Appearance, AtomStyle, Selector, atom_element};
 pub use topology::{Topology, TopologyFormat};

@@ -361,6 +361,16 @@ fn strip_esd(t: &[u8]) -> &[u8] {
     }
 }
 
+/// What the warning for dropped alternate locations expected (see [`is_altloc_warning`]).
+const ALTLOC_EXPECTED: &str = "one conformation per atom (label_alt_id: the first is kept)";
+
+/// Whether a [`crate::Trajectory::warnings`] entry is the PDBx/mmCIF reader's note of dropped
+/// alternate locations (given whatever the options), rather than something tolerated under
+/// `allow_truncated`.
+pub fn is_altloc_warning(w: &Error) -> bool {
+    matches!(w, Error::Parse { expected, .. } if *expected == ALTLOC_EXPECTED)
+}
+
 /// FNV-1a: the keys of the alternate-location filter (names, residue ids), in the read and in
 /// the scan alike.
 fn fnv(b: &[u8]) -> u64 {
@@ -546,7 +556,7 @@ impl Mmcif {
         let expected = "as many _atom_site rows as model 1 (frame 0)";
         self.models.check(ctx, at, p.n_atoms, expected)?;
         if let Some(first) = p.filter.first_dropped {
-            let expected = "one conformation per atom (label_alt_id: the first is kept)";
+            let expected = ALTLOC_EXPECTED;
             let w = Error::Parse {
                 at: ctx.at(first),
                 expected,
