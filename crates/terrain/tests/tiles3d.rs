@@ -243,3 +243,62 @@ fn tile_textures_are_the_databases_texels() {
     let want = texmap_terrain::relief::relief_image(&grid, 4096);
     assert_eq!(root_image(&out), (64, 64, want.into_raw()));
 }
+
+/// A Web Mercator grid (GDAL's EPSG:3857 warp of an SRTM cut) goes on the globe through its
+/// inverse projection: the finest tiles' vertices reach the earth-centred position of each valid
+/// corner sample (longitude and latitude by `web_mercator_to_lonlat`, checked against PROJ in
+/// tests/geodesy.rs; its height as ellipsoidal).
+#[test]
+fn web_mercator_tileset_is_placed_through_its_projection() {
+    use texmap_terrain::geodesy::web_mercator_to_lonlat;
+    let dir = tempfile::tempdir().unwrap();
+    let grid = read_dem(data("dem_merc.tif"), &ReadOptions::default()).unwrap();
+    let opts = BuildOptions {
+        chunk: 33,
+        ..BuildOptions::default()
+    };
+    let d = built(dir.path(), "merc.db", &grid, None, opts);
+    let out = dir.path().join("tiles");
+    write_tileset(&d, &out, 1024).unwrap();
+    let ts: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("tileset.json")).unwrap()).unwrap();
+    let mut seen = Vec::new();
+    walk(
+        &ts["root"],
+        DVec3::ZERO,
+        0,
+        ts["geometricError"].as_f64().unwrap(),
+        &mut seen,
+    );
+    let (w, h) = (grid.width() - 1, grid.height() - 1);
+    let g = grid.georef();
+    let corners: Vec<DVec3> = [(0, 0), (w, 0), (0, h), (w, h)]
+        .into_iter()
+        .filter_map(|(c, r)| {
+            let z = grid.heights()[(r * grid.width() + c) as usize];
+            let (x, y) = g.sample_xy(c as f64, r as f64);
+            let (lon, lat) = web_mercator_to_lonlat(x, y);
+            (!z.is_nan()).then(|| DVec3::from(ecef(lon, lat, z as f64)))
+        })
+        .collect();
+    assert!(corners.len() >= 2, "valid corners: {}", corners.len());
+    let finest = seen.iter().map(|t| t.depth).max().unwrap();
+    let mut nearest = vec![f64::INFINITY; corners.len()];
+    for t in seen.iter().filter(|t| t.depth == finest) {
+        let (doc, buffers, _) = gltf::import(out.join(t.uri.as_ref().unwrap())).unwrap();
+        for mesh in doc.meshes() {
+            for prim in mesh.primitives() {
+                let r = prim.reader(|b| Some(&buffers[b.index()]));
+                for p in r.read_positions().unwrap() {
+                    let v = t.origin + DVec3::new(p[0] as f64, -p[2] as f64, p[1] as f64);
+                    for (k, c) in corners.iter().enumerate() {
+                        nearest[k] = nearest[k].min(v.distance(*c));
+                    }
+                }
+            }
+        }
+    }
+    for (k, n) in nearest.iter().enumerate() {
+        assert!(*n < 0.03, "corner {k}: nearest vertex {n} m away");
+    }
+}
