@@ -135,24 +135,17 @@ fn srtm_tileset_is_placed_where_gdal_puts_the_tile() {
     for t in &seen {
         *per_depth.entry(t.depth).or_default() += 1;
         let uri = t.uri.as_ref().unwrap();
-        let (doc, buffers, images) = gltf::import(out.join(uri)).unwrap();
-        assert_eq!(images.len(), 1, "{uri}: one texture");
-        for mesh in doc.meshes() {
-            for prim in mesh.primitives() {
-                let r = prim.reader(|b| Some(&buffers[b.index()]));
-                for p in r.read_positions().unwrap() {
-                    // glTF y-up read as z-up: (x, y, z) -> (x, -z, y), then the tile's transform.
-                    let w = t.origin + DVec3::new(p[0] as f64, -p[2] as f64, p[1] as f64);
-                    let off = (w - t.centre).abs() - t.half;
-                    assert!(
-                        off.max_element() < 0.05,
-                        "{uri}: vertex {w} outside its box by {off}"
-                    );
-                    if t.depth == finest {
-                        for (k, c) in corners.iter().enumerate() {
-                            nearest[k] = nearest[k].min(w.distance(*c));
-                        }
-                    }
+        let (vertices, images) = tile_vertices(&out, t);
+        assert_eq!(images, 1, "{uri}: one texture");
+        for w in vertices {
+            let off = (w - t.centre).abs() - t.half;
+            assert!(
+                off.max_element() < 0.05,
+                "{uri}: vertex {w} outside its box by {off}"
+            );
+            if t.depth == finest {
+                for (k, c) in corners.iter().enumerate() {
+                    nearest[k] = nearest[k].min(w.distance(*c));
                 }
             }
         }
@@ -163,6 +156,24 @@ fn srtm_tileset_is_placed_where_gdal_puts_the_tile() {
     for (k, n) in nearest.iter().enumerate() {
         assert!(*n < 0.03, "corner {k}: nearest vertex {n} m away");
     }
+}
+
+/// A tile's vertices in earth-centred metres (glTF y-up read as z-up, `(x, y, z) -> (x, −z, y)`,
+/// then the tile's transform), and how many images its glTF holds.
+fn tile_vertices(out: &std::path::Path, t: &Seen) -> (Vec<DVec3>, usize) {
+    let (doc, buffers, images) = gltf::import(out.join(t.uri.as_ref().unwrap())).unwrap();
+    let mut v = Vec::new();
+    for mesh in doc.meshes() {
+        for prim in mesh.primitives() {
+            let r = prim.reader(|b| Some(&buffers[b.index()]));
+            v.extend(
+                r.read_positions()
+                    .unwrap()
+                    .map(|p| t.origin + DVec3::new(p[0] as f64, -p[2] as f64, p[1] as f64)),
+            );
+        }
+    }
+    (v, images.len())
 }
 
 /// The same files, byte for byte, for any thread count (tiles are written in parallel).
@@ -285,16 +296,9 @@ fn web_mercator_tileset_is_placed_through_its_projection() {
     let finest = seen.iter().map(|t| t.depth).max().unwrap();
     let mut nearest = vec![f64::INFINITY; corners.len()];
     for t in seen.iter().filter(|t| t.depth == finest) {
-        let (doc, buffers, _) = gltf::import(out.join(t.uri.as_ref().unwrap())).unwrap();
-        for mesh in doc.meshes() {
-            for prim in mesh.primitives() {
-                let r = prim.reader(|b| Some(&buffers[b.index()]));
-                for p in r.read_positions().unwrap() {
-                    let v = t.origin + DVec3::new(p[0] as f64, -p[2] as f64, p[1] as f64);
-                    for (k, c) in corners.iter().enumerate() {
-                        nearest[k] = nearest[k].min(v.distance(*c));
-                    }
-                }
+        for v in tile_vertices(&out, t).0 {
+            for (k, c) in corners.iter().enumerate() {
+                nearest[k] = nearest[k].min(v.distance(*c));
             }
         }
     }
