@@ -86,17 +86,8 @@ fn srtm_tileset_is_placed_where_gdal_puts_the_tile() {
     // Writing again over it is refused, the tileset untouched.
     assert!(write_tileset(&d, &out, 1024).is_err());
 
-    let ts: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("tileset.json")).unwrap()).unwrap();
+    let (ts, seen) = read_tileset(&out);
     assert_eq!(ts["asset"]["version"], "1.1");
-    let mut seen = Vec::new();
-    walk(
-        &ts["root"],
-        DVec3::ZERO,
-        0,
-        ts["geometricError"].as_f64().unwrap(),
-        &mut seen,
-    );
     assert_eq!(seen.len(), chunks);
     // Leaving the whole terrain out is at least as wrong as its extent (CesiumJS draws nothing
     // while the tileset's error projects under its pixel tolerance: an error of only twice the
@@ -156,6 +147,21 @@ fn srtm_tileset_is_placed_where_gdal_puts_the_tile() {
     for (k, n) in nearest.iter().enumerate() {
         assert!(*n < 0.03, "corner {k}: nearest vertex {n} m away");
     }
+}
+
+/// The tileset.json written into `out`, and its tiles in walk order (checked by `walk`).
+fn read_tileset(out: &std::path::Path) -> (serde_json::Value, Vec<Seen>) {
+    let ts: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("tileset.json")).unwrap()).unwrap();
+    let mut seen = Vec::new();
+    walk(
+        &ts["root"],
+        DVec3::ZERO,
+        0,
+        ts["geometricError"].as_f64().unwrap(),
+        &mut seen,
+    );
+    (ts, seen)
 }
 
 /// A tile's vertices in earth-centred metres (glTF y-up read as z-up, `(x, y, z) -> (x, −z, y)`,
@@ -271,16 +277,7 @@ fn web_mercator_tileset_is_placed_through_its_projection() {
     let d = built(dir.path(), "merc.db", &grid, None, opts);
     let out = dir.path().join("tiles");
     write_tileset(&d, &out, 1024).unwrap();
-    let ts: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("tileset.json")).unwrap()).unwrap();
-    let mut seen = Vec::new();
-    walk(
-        &ts["root"],
-        DVec3::ZERO,
-        0,
-        ts["geometricError"].as_f64().unwrap(),
-        &mut seen,
-    );
+    let (_, seen) = read_tileset(&out);
     let (w, h) = (grid.width() - 1, grid.height() - 1);
     let g = grid.georef();
     let corners: Vec<DVec3> = [(0, 0), (w, 0), (0, h), (w, h)]
