@@ -134,6 +134,9 @@ pub enum ColorBy {
     Element,
     /// --type-color, else one distinct colour per atom type (or name).
     Type,
+    /// --type-color, else one distinct colour per chain (PDB column 22, mmCIF auth_asym_id),
+    /// or per segment (PSF, PDB columns 73-76) when the file has no chains.
+    Chain,
 }
 
 /// `--type-radius NAME=R`: the radius in Å of the atoms NAME selects.
@@ -495,7 +498,8 @@ pub struct MolArgs {
     #[arg(long, value_name = "FILE")]
     pub topology: Option<PathBuf>,
     /// Draw only the atoms SEL selects, in the VMD/MDAnalysis language: 'not resname SOL',
-    /// 'name CA', 'element O and resid 1 to 20', 'protein or within 5 of resname LIG'.
+    /// 'name CA', 'element O and resid 1 to 20', 'chain A', 'segid PROA',
+    /// 'protein or within 5 of resname LIG'.
     #[arg(long, value_name = "SEL")]
     pub select: Option<String>,
     /// Colour of the atoms SEL selects, #rrggbb or R,G,B: --color 'resname SOL=#4080ff';
@@ -525,11 +529,12 @@ How each atom's look is chosen (the first that applies):
           LAMMPS dump `ColorR ColorG ColorB` or `Color.R ...` as OVITO names them; values are
           fractions of 1, clamped to [0, 1]) > --type-color > element colour (CPK/Jmol), or one
           colour per type with --color-by type (the default for atoms that have only types,
-          such as LAMMPS dumps with numeric types)
+          such as LAMMPS dumps with numeric types), or per chain with --color-by chain
   radius: --radius SEL=R rules > the file's radius column (`radius`, LAMMPS `diameter` / 2) >
           --type-radius > van der Waals radius of the element; then times --radius-scale
   A NAME rule matches the atom's type first, then its name, then its element.
-  SEL is a selection in the VMD/MDAnalysis language (see --select).
+  SEL is a selection in the VMD/MDAnalysis language (see --select), e.g. 'chain A' or
+  'segid PROA'.
 
 Coordinate-only trajectories (XTC, DCD, TRR, AMBER NetCDF) take names, elements, residues and
 bonds from --topology. The automatic camera frames the drawn (selected) atoms.
@@ -542,6 +547,7 @@ Examples:
   texmap render run.xtc --topology conf.gro --select 'not resname SOL' --style ball-stick --pbc unwrap -o f.png
   texmap render md.nc --topology prmtop.pdb --color 'protein=#a0a0ff' --color 'resname LIG=#ff8000' -o f.png
   texmap render dump.lammpstrj --type-color 1=#ff8000 --type-color 2=40,40,255 --type-radius 2=0.6 -o f.png
+  texmap render 1abc.cif --select 'protein and chain A B' --color-by chain -o chains.png
   texmap render water.gro --color-by element --type-color OW=#ff0000 --radius-scale 0.5 -o w.png
   texmap render md.xyz --eye 0,0,50 --target 0,0,0 --up 0,1,0 --fov 30 --depth -o md.png";
 

@@ -176,11 +176,30 @@ fn info(
         "box": bx,
         "first_positions": first,
     });
+    // Chains and segments with their atom counts, in order of first appearance: what a user
+    // needs to write `chain A` or `segid PROA` selections.
+    for (key, labels) in [("chains", &frame.chains), ("segments", &frame.segments)] {
+        if !labels.is_empty() {
+            obj[key] = json!(label_counts(labels));
+        }
+    }
     if !topo_json.is_null() {
         obj["topology"] = topo_json;
     }
     println!("{obj}");
     Ok(())
+}
+
+/// Each distinct label with its count, `[label, count]`, in order of first appearance.
+fn label_counts(labels: &[texmap_md_io::Label]) -> Vec<(String, usize)> {
+    let mut out: Vec<(texmap_md_io::Label, usize)> = Vec::new();
+    for l in labels {
+        match out.iter_mut().find(|(k, _)| k == l) {
+            Some((_, n)) => *n += 1,
+            None => out.push((*l, 1)),
+        }
+    }
+    out.into_iter().map(|(k, n)| (k.to_string(), n)).collect()
 }
 
 /// `--shard I/N`, or Slurm's job-array variables when the flag is absent: `(I, N)` with

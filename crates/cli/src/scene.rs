@@ -29,6 +29,7 @@ pub fn style_options(args: &StyleArgs) -> StyleOptions {
             ColorBy::Property => texmap_md_scene::ColorBy::Property,
             ColorBy::Element => texmap_md_scene::ColorBy::Element,
             ColorBy::Type => texmap_md_scene::ColorBy::Type,
+            ColorBy::Chain => texmap_md_scene::ColorBy::Chain,
         },
         radius_scale: args.radius_scale,
         type_radius: args
@@ -68,6 +69,7 @@ pub fn warning_text(w: &StyleWarning) -> String {
         StyleWarning::ColorsOutOfRange { count } => format!(
             "{count} colour-column values of the first frame are outside [0, 1] and were clamped (colours are fractions of 1, not 0-255)"
         ),
+        StyleWarning::NoChains => "--color-by chain: the first frame has no chain or segment identifiers (PDB, mmCIF and PSF files carry them); element colours are used".to_string(),
     }
 }
 

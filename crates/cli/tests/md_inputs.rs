@@ -262,3 +262,70 @@ fn mmcif_alternate_locations_are_a_plain_warning() {
         "{err}"
     );
 }
+
+#[test]
+fn info_lists_chains_and_colour_by_chain_draws_the_palette_colour() {
+    // chains_mda.pdb: MDAnalysis wrote chain and segment identifiers (gen_chains.py).
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(data("chains_reference.json")).unwrap())
+            .unwrap();
+    let o = texmap(&["info", &data("chains_mda.pdb")]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    for (key, column) in [("chains", "chains"), ("segments", "segments")] {
+        let labels: Vec<&str> = r[column]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_str().unwrap())
+            .collect();
+        let listed = j[key].as_array().unwrap();
+        let total: u64 = listed.iter().map(|e| e[1].as_u64().unwrap()).sum();
+        assert_eq!(total as usize, labels.len(), "{key}");
+        for e in listed {
+            let (name, n) = (e[0].as_str().unwrap(), e[1].as_u64().unwrap() as usize);
+            assert_eq!(
+                labels.iter().filter(|l| **l == name).count(),
+                n,
+                "{key} {name}"
+            );
+        }
+    }
+    assert_eq!(j["chains"][0][0], "A");
+    // Chain A drawn by chain takes the palette's first colour: the same image as colouring it
+    // with that colour by a rule.
+    let dir = tempfile::tempdir().unwrap();
+    let c = texmap_md_scene::type_color(0).map(|v| (v * 255.0).round() as u8);
+    let rule = format!("all={},{},{}", c[0], c[1], c[2]);
+    let draw = |name: &str, extra: &[&str]| -> PathBuf {
+        let out = dir.path().join(name);
+        let file = data("chains_mda.pdb");
+        let mut args = vec!["render", &file, "--select", "chain A", "--size", "96x72"];
+        args.extend_from_slice(extra);
+        let o = out.to_str().unwrap().to_string();
+        args.extend_from_slice(&["-o", &o]);
+        let run = texmap(&args);
+        assert!(run.status.success(), "{}", stderr(&run));
+        out
+    };
+    let by_chain = draw("chain.png", &["--color-by", "chain"]);
+    let by_rule = draw("rule.png", &["--color", &rule]);
+    let by_element = draw("element.png", &["--color-by", "element"]);
+    assert!(lit(&by_chain) > 50);
+    assert_eq!(mean_abs_diff(&by_chain, &by_rule), 0.0);
+    assert!(mean_abs_diff(&by_chain, &by_element) > 1.0);
+    // A file without chains or segments: element colours and a warning naming the flag.
+    let out = dir.path().join("none.png");
+    let o = texmap(&[
+        "render",
+        &data("topo_mda.gro"),
+        "--color-by",
+        "chain",
+        "--size",
+        "64x48",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--color-by chain"), "{}", stderr(&o));
+}

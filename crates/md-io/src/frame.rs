@@ -302,6 +302,11 @@ pub struct Frame {
     pub res_names: Vec<Label>,
     /// Residue numbers (PDB, GRO).
     pub res_ids: Vec<i64>,
+    /// Chain identifiers (PDB column 22, mmCIF `auth_asym_id` else `label_asym_id`); an atom
+    /// whose field is blank has an empty label.
+    pub chains: Vec<Label>,
+    /// Segment identifiers (PDB columns 73-76, PSF `segid`); blank is an empty label.
+    pub segments: Vec<Label>,
     /// Per-atom radii in Å from a `radius` column (OVITO convention).
     pub radii: Vec<f32>,
     /// Per-atom colours from colour columns (extended XYZ `color`, LAMMPS dump `ColorR ColorG
@@ -336,6 +341,8 @@ impl Frame {
         self.ids.clear();
         self.res_names.clear();
         self.res_ids.clear();
+        self.chains.clear();
+        self.segments.clear();
         self.radii.clear();
         self.colors.clear();
         self.comment.clear();
@@ -353,6 +360,8 @@ impl Frame {
             ("ids", self.ids.len()),
             ("res_names", self.res_names.len()),
             ("res_ids", self.res_ids.len()),
+            ("chains", self.chains.len()),
+            ("segments", self.segments.len()),
             ("radii", self.radii.len()),
             ("colors", self.colors.len()),
         ];

@@ -11,8 +11,9 @@
 //!   are missing, as for a blank PDB field); the element from `type_symbol`, else
 //!   [`crate::elements::guess_element`] from the names. These are the fields the PDB reader fills
 //!   from the same structure's ATOM/HETATM records, so selections read a `.pdb` and its `.cif`
-//!   alike. `group_PDB`, chains (`*_asym_id`), insertion codes, occupancies and B-factors have no
-//!   place in a [`Frame`] and are not kept (nor by the PDB reader).
+//!   alike; and the chain from `auth_asym_id`, else `label_asym_id` (gemmi's chain name).
+//!   `group_PDB`, insertion codes, occupancies and B-factors have no place in a [`Frame`] and are
+//!   not kept (nor by the PDB reader).
 //! - `pdbx_PDB_model_num` splits the rows into frames (NMR ensembles): each change of model
 //!   number starts a frame; numbers must increase, and every model must hold as many atoms as
 //!   model 1 (an error, or a warning under `ReadOptions::allow_truncated`, as for PDB). Without
@@ -455,6 +456,7 @@ struct Row {
     atom: [Option<Label>; 2],
     comp: [Option<Label>; 2],
     seq: [Option<i64>; 2],
+    asym: [Option<Label>; 2],
     /// Keys for the alternate-location filter (`[label, auth]`, 0 when missing).
     atom_key: [u64; 2],
     comp_key: [u64; 2],
@@ -505,8 +507,8 @@ struct Parser {
     phase: Phase,
     /// The `_atom_site` columns (empty until the loop's header is read).
     cols: Vec<Role>,
-    /// Which optional columns exist: id, atom name, residue name, residue number.
-    has: [bool; 4],
+    /// Which optional columns exist: id, atom name, residue name, residue number, chain.
+    has: [bool; 5],
     /// `_cell` values and where the first one is; the cell built from them.
     cell_values: [Option<f64>; 6],
     cell_at: Option<Pos>,
@@ -818,6 +820,7 @@ impl Parser {
             any(Role::Atom),
             any(Role::Comp),
             any(Role::Seq),
+            any(Role::Asym),
         ];
         self.cell = self.unit_cell(ctx)?;
         Ok(())
@@ -949,7 +952,10 @@ impl Parser {
             Role::Symbol => row.symbol = label(&tok, "an element symbol in type_symbol")?,
             Role::AltId => row.alt = !tok.missing(),
             Role::InsCode => row.ins_key = key(&tok),
-            Role::Asym(k) => row.asym_key[k] = key(&tok),
+            Role::Asym(k) => {
+                row.asym_key[k] = key(&tok);
+                row.asym[k] = label(&tok, "a chain name of at most 15 bytes")?;
+            }
             Role::Atom(k) => {
                 row.atom_key[k] = key(&tok);
                 row.atom[k] = label(&tok, "an atom name of at most 15 bytes")?;
@@ -1024,7 +1030,7 @@ impl Parser {
         let name = row.atom[1].or(row.atom[0]).unwrap_or_default();
         let res = row.comp[1].or(row.comp[0]);
         let symbol = row.symbol.as_ref().map(|s| s.as_str());
-        let [has_id, has_name, has_res, has_seq] = self.has;
+        let [has_id, has_name, has_res, has_seq, has_chain] = self.has;
         if has_id {
             f.ids.push(row.id.unwrap_or(f.n_atoms() as i64 + 1));
         }
@@ -1039,6 +1045,10 @@ impl Parser {
         }
         if has_seq {
             f.res_ids.push(row.seq[1].or(row.seq[0]).unwrap_or(0));
+        }
+        if has_chain {
+            f.chains
+                .push(row.asym[1].or(row.asym[0]).unwrap_or_default());
         }
     }
 }

@@ -2,7 +2,9 @@
 //!
 //! Records used (1-based columns, PDB format v3.3):
 //! - `ATOM`/`HETATM`: serial 7-11 (hybrid-36 past 99,999), name 13-16, residue name 18-21,
-//!   residue number 23-26 (hybrid-36 past 9,999), x y z 31-38, 39-46, 47-54, element 77-78;
+//!   chain 22, residue number 23-26 (hybrid-36 past 9,999), x y z 31-38, 39-46, 47-54, segment
+//!   73-76, element 77-78. A frame whose chain (or segment) fields are all blank has no chain
+//!   (segment) column, so `chain A` on it is an error rather than an empty selection;
 //! - `CRYST1`: a b c 7-15, 16-24, 25-33, α β γ 34-40, 41-47, 48-54. A cell of 1 Å x 1 Å x 1 Å
 //!   with right angles is the conventional "no cell" placeholder and is dropped (as MDAnalysis
 //!   does). A CRYST1 holds for the frames after it until the next CRYST1;
@@ -199,6 +201,12 @@ impl Pdb {
                 ctx.parse(pos, line, resid_field, "a residue number in columns 23-26")
             })?
         };
+        let chain_f = trim(cols(line, 22, 22));
+        let chain = Label::from_utf8(chain_f)
+            .ok_or_else(|| ctx.parse(pos, line, chain_f, "a chain identifier in column 22"))?;
+        let seg_f = trim(cols(line, 73, 76));
+        let segment = Label::from_utf8(seg_f)
+            .ok_or_else(|| ctx.parse(pos, line, seg_f, "a segment identifier in columns 73-76"))?;
         let elem = std::str::from_utf8(trim(cols(line, 77, 78))).ok();
         let element = guess_element(&name, Some(&res), elem.filter(|e| !e.is_empty()));
         frame.positions.push(p);
@@ -206,8 +214,19 @@ impl Pdb {
         frame.names.push(name);
         frame.res_names.push(res);
         frame.res_ids.push(resid);
+        frame.chains.push(chain);
+        frame.segments.push(segment);
         frame.elements.push(element);
         Ok(())
+    }
+
+    /// Drops the chain and segment columns of a finished frame when every field was blank.
+    fn finish(frame: &mut Frame) {
+        for column in [&mut frame.chains, &mut frame.segments] {
+            if column.iter().all(|l| l.is_empty()) {
+                column.clear();
+            }
+        }
     }
 }
 
@@ -248,6 +267,7 @@ impl FrameWalk for Pdb {
                     self.check_count(ctx, pos, n_atoms)?;
                     if let Some(f) = frame.as_deref_mut() {
                         f.cell = self.cell;
+                        Pdb::finish(f);
                     }
                     return Ok(true);
                 }
@@ -275,6 +295,7 @@ impl FrameWalk for Pdb {
         }
         if let Some(f) = frame {
             f.cell = self.cell;
+            Pdb::finish(f);
         }
         Ok(found)
     }
@@ -322,6 +343,16 @@ impl<W: std::io::Write> PdbWriter<W> {
             return Err(format!(
                 "atom {i}'s residue name is longer than 4 characters"
             ));
+        }
+        if let Some(i) = frame.chains.iter().position(|l| l.len() > 1) {
+            return Err(format!(
+                "atom {i}'s chain {:?} is longer than PDB's one column (write mmCIF-sized \
+                 structures as XYZ, or rename the chains)",
+                frame.chains[i].as_str()
+            ));
+        }
+        if let Some(i) = frame.segments.iter().position(|l| l.len() > 4) {
+            return Err(format!("atom {i}'s segment is longer than 4 characters"));
         }
         if frame.n_atoms() > 87_440_031 {
             return Err("more atoms than hybrid-36 serial numbers".into());
@@ -373,9 +404,12 @@ impl<W: std::io::Write> PdbWriter<W> {
             let res = frame.res_names.get(i).map_or("UNK", |l| l.as_str());
             let resid = frame.res_ids.get(i).copied().unwrap_or(1);
             let resid = hy36_encode(resid, 4).unwrap_or_else(|| "****".into());
+            let chain = frame.chains.get(i).map_or(" ", |l| l.as_str());
+            let chain = if chain.is_empty() { " " } else { chain };
+            let seg = frame.segments.get(i).map_or("", |l| l.as_str());
             writeln!(
                 w,
-                "ATOM  {serial}{name:>5} {res:<4} {resid}    {:8.3}{:8.3}{:8.3}{:6.2}{:6.2}          {sym:>2}",
+                "ATOM  {serial}{name:>5} {res:<4}{chain}{resid}    {:8.3}{:8.3}{:8.3}{:6.2}{:6.2}      {seg:<4}{sym:>2}",
                 p[0], p[1], p[2], 1.0, 0.0
             )?;
         }

@@ -2,7 +2,7 @@
 //!
 //! A PSF starts with a `PSF` line (flags such as `EXT`, `CHEQ`, `XPLOR`, `CMAP` follow it on the
 //! same line), a title block (`N !NTITLE` and N remark lines), then `N !NATOM` and one line per
-//! atom: `id segment resid resname name type charge mass [imove ...]`, then `N !NBOND` and the
+//! atom: `id segment resid resname name type charge mass [imove ...]` (all but charge kept), then `N !NBOND` and the
 //! bonded pairs of atom ids, four pairs (eight ids) a line. Later sections (angles, dihedrals,
 //! ...) are not needed to draw molecules and are not read.
 //!
@@ -143,6 +143,7 @@ pub(crate) fn read_psf<R: Read>(src: R, file: &Arc<str>) -> Result<Topology, Err
     let mut types: Vec<Label> = Vec::new();
     let mut res_names: Vec<Label> = Vec::new();
     let mut res_ids: Vec<i64> = Vec::new();
+    let mut segments: Vec<Label> = Vec::new();
     let mut elements: Vec<Element> = Vec::new();
     while (ids.len() as u64) < n_atoms {
         let Some((l, pos)) = lines.next_line()? else {
@@ -172,6 +173,7 @@ pub(crate) fn read_psf<R: Read>(src: R, file: &Arc<str>) -> Result<Topology, Err
         let label = |s: &[u8], what: &'static str| {
             Label::from_utf8(s).ok_or_else(|| parse_err(file, &pos, what, s))
         };
+        let segment = label(f[1], "a segment name of at most 15 bytes")?;
         let res = label(f[3], "a residue name of at most 15 bytes")?;
         let name = label(f[4], "an atom name of at most 15 bytes")?;
         let ty = label(f[5], "an atom type of at most 15 bytes")?;
@@ -184,6 +186,7 @@ pub(crate) fn read_psf<R: Read>(src: R, file: &Arc<str>) -> Result<Topology, Err
         types.push(ty);
         res_names.push(res);
         res_ids.push(resid);
+        segments.push(segment);
     }
     // Atom ids to indices (PSF ids are 1..N in order, but do not rely on it).
     let mut order: Vec<(i64, u32)> = ids
@@ -244,7 +247,7 @@ pub(crate) fn read_psf<R: Read>(src: R, file: &Arc<str>) -> Result<Topology, Err
         }
     }
     tidy(&mut bonds);
-    Ok(Topology::from_parts(
+    let mut topology = Topology::from_parts(
         file.clone(),
         names,
         elements,
@@ -253,7 +256,9 @@ pub(crate) fn read_psf<R: Read>(src: R, file: &Arc<str>) -> Result<Topology, Err
         res_names,
         res_ids,
         bonds,
-    ))
+    );
+    topology.segments = segments;
+    Ok(topology)
 }
 
 fn end_of<R: Read>(lines: &Lines<R>) -> LineAt {

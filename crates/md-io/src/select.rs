@@ -9,6 +9,7 @@
 //! factor   := "not" factor | "(" expr ")" | atom
 //! atom     := "all" | "none" | "protein" | "backbone" | "water"
 //!           | ("name" | "type" | "resname" | "element") WORD+      -- any of the words
+//!           | ("chain" | "chainID" | "segid" | "segname") WORD+
 //!           | ("index" | "serial" | "bynum" | "id" | "resid") RANGE+
 //!           | "within" NUMBER "of" factor                          -- VMD: includes the factor
 //!           | "around" NUMBER factor                               -- MDAnalysis: excludes it
@@ -20,6 +21,9 @@
 //! file order; `serial` and `bynum` from 1 (`bynum` is MDAnalysis's name); `id` is the atom id the
 //! file wrote. `protein` is a residue name among the amino acids of [`PROTEIN_RESIDUES`];
 //! `backbone` is `protein and name N CA C O`; `water` a residue name in [`WATER_RESIDUES`].
+//! `chain` (VMD) and `chainID` (MDAnalysis) match the chain identifier (PDB column 22, mmCIF
+//! `auth_asym_id`); `segid` (MDAnalysis) and `segname` (VMD) the segment (PDB columns 73-76,
+//! PSF). A blank chain or segment is matched by no word.
 //! `within`/`around` use plain distances (no periodic images) through a cell grid, so they cost
 //! time linear in the atoms.
 //!
@@ -76,6 +80,8 @@ enum StrField {
     Name,
     Type,
     ResName,
+    Chain,
+    Segment,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -174,6 +180,10 @@ fn is_reserved(w: &str) -> bool {
             | "name"
             | "type"
             | "resname"
+            | "chain"
+            | "chainid"
+            | "segid"
+            | "segname"
             | "element"
             | "index"
             | "serial"
@@ -291,12 +301,14 @@ impl Parser<'_> {
                 words: WATER_RESIDUES.iter().map(|s| s.to_string()).collect(),
                 column: t.column,
             }),
-            "name" | "type" | "resname" => {
+            "name" | "type" | "resname" | "chain" | "chainid" | "segid" | "segname" => {
                 let words = self.words(&t)?;
                 let field = match kw.as_str() {
                     "name" => StrField::Name,
                     "type" => StrField::Type,
-                    _ => StrField::ResName,
+                    "resname" => StrField::ResName,
+                    "chain" | "chainid" => StrField::Chain,
+                    _ => StrField::Segment,
                 };
                 Ok(Node::Str {
                     field,
@@ -546,9 +558,15 @@ impl Selection {
         SelectionError {
             selection: self.text.clone(),
             column: column.max(1),
-            message: format!(
-                "this frame has no {what} (trajectory-only formats such as XTC, DCD and TRR carry none, nor does plain XYZ: give a topology)"
-            ),
+            message: if what.starts_with("chain") || what.starts_with("segment") {
+                format!(
+                    "this frame has no {what}: its file leaves them blank or has no such field (PDB, mmCIF and PSF files carry them)"
+                )
+            } else {
+                format!(
+                    "this frame has no {what} (trajectory-only formats such as XTC, DCD and TRR carry none, nor does plain XYZ: give a topology)"
+                )
+            },
         }
     }
 
@@ -582,6 +600,8 @@ impl Selection {
                     StrField::Name => (&frame.names, "atom names"),
                     StrField::Type => (&frame.types, "atom types"),
                     StrField::ResName => (&frame.res_names, "residue names"),
+                    StrField::Chain => (&frame.chains, "chain identifiers"),
+                    StrField::Segment => (&frame.segments, "segment identifiers"),
                 };
                 if labels.len() != n {
                     return Err(self.missing(*column, what));

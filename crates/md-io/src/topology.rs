@@ -98,6 +98,10 @@ pub struct Topology {
     pub res_names: Vec<Label>,
     /// Residue numbers (LAMMPS: molecule ids).
     pub res_ids: Vec<i64>,
+    /// Chain identifiers (PDB, mmCIF).
+    pub chains: Vec<Label>,
+    /// Segment identifiers (PSF `segid`, PDB columns 73-76).
+    pub segments: Vec<Label>,
     /// Bonds as atom index pairs `[i, j]` with `i < j`, sorted, each once.
     pub bonds: Vec<[u32; 2]>,
 }
@@ -313,6 +317,8 @@ impl Topology {
             ids,
             res_names,
             res_ids,
+            chains: Vec::new(),
+            segments: Vec::new(),
             bonds,
         }
     }
@@ -335,6 +341,8 @@ impl Topology {
             ids: frame.ids.clone(),
             res_names: frame.res_names.clone(),
             res_ids: frame.res_ids.clone(),
+            chains: frame.chains.clone(),
+            segments: frame.segments.clone(),
             bonds: Vec::new(),
         }
     }
@@ -391,6 +399,8 @@ impl Topology {
         take(&mut frame.names, &self.names);
         take(&mut frame.types, &self.types);
         take(&mut frame.res_names, &self.res_names);
+        take(&mut frame.chains, &self.chains);
+        take(&mut frame.segments, &self.segments);
         if !self.elements.is_empty() {
             frame.elements.clone_from(&self.elements);
         }
@@ -745,6 +755,8 @@ fn lammps_data<R: Read>(src: R, file: &Arc<str>) -> Result<Topology, Error> {
         } else {
             Vec::new()
         },
+        chains: Vec::new(),
+        segments: Vec::new(),
         bonds,
     })
 }

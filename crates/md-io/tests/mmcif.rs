@@ -74,6 +74,7 @@ fn reads_what_gemmi_reads() {
                 let what = format!("{name} model {k} atom {i}");
                 assert_eq!(f.names[i], a[0].as_str().unwrap(), "{what}: name");
                 assert_eq!(f.res_names[i], a[1].as_str().unwrap(), "{what}: residue");
+                assert_eq!(f.chains[i], a[3].as_str().unwrap(), "{what}: chain");
                 assert_eq!(
                     f.res_ids[i],
                     a[2].as_i64().unwrap(),

@@ -371,3 +371,27 @@ fn python_reads_our_xyz_and_pdb_as_we_wrote_them() {
         }
     }
 }
+
+/// Chains and segments survive a PDB write and read: MDAnalysis's PDB with both columns.
+#[test]
+fn pdb_writer_keeps_chains_and_segments() {
+    let mut frame = Frame::new();
+    Trajectory::open(data("chains_mda.pdb"))
+        .unwrap()
+        .read_frame(0, &mut frame)
+        .unwrap();
+    assert!(!frame.chains.is_empty() && !frame.segments.is_empty());
+    let mut w = Writer::new(Cursor::new(Vec::new()), Format::Pdb, "c.pdb").unwrap();
+    w.write_frame(&frame).unwrap();
+    let bytes = w.finish().unwrap().into_inner();
+    let back =
+        stream(&mut Trajectory::from_reader(Cursor::new(bytes), Format::Pdb, "c.pdb").unwrap());
+    assert_eq!(back[0].chains, frame.chains);
+    assert_eq!(back[0].segments, frame.segments);
+    assert_eq!(back[0].res_ids, frame.res_ids);
+    // A two-letter chain (mmCIF allows them) does not fit column 22: refused, not cut.
+    frame.chains[0] = Label::new("AA").unwrap();
+    let mut w = Writer::new(Cursor::new(Vec::new()), Format::Pdb, "c.pdb").unwrap();
+    let e = w.write_frame(&frame).unwrap_err().to_string();
+    assert!(e.contains("chain \"AA\""), "{e}");
+}

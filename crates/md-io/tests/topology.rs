@@ -161,6 +161,11 @@ fn psf_written_by_parmed_matches_mdanalysis_and_gives_the_pdb_elements() {
     assert_eq!(labels(&t.types), strings(&r["types"]));
     assert_eq!(t.res_ids, ints(&r["resids"]));
     assert_eq!(t.bonds, bonds(&r["bonds"]));
+    // Segments as MDAnalysis reads them (tests/data/gen_chains.py).
+    let chains: Value =
+        serde_json::from_str(&std::fs::read_to_string(path("chains_reference.json")).unwrap())
+            .unwrap();
+    assert_eq!(labels(&t.segments), strings(&chains["psf_segments"]));
     let pdb = Topology::open(path("topo_mda.pdb")).unwrap();
     assert_eq!(t.elements, pdb.elements);
     // And it labels the XTC of the same atoms.
@@ -169,4 +174,5 @@ fn psf_written_by_parmed_matches_mdanalysis_and_gives_the_pdb_elements() {
     assert!(traj.read_next(&mut f).unwrap());
     t.apply(&mut f, "topo_mda.xtc", 0).unwrap();
     assert_eq!(labels(&f.names), strings(&r["names"]));
+    assert_eq!(f.segments, t.segments);
 }

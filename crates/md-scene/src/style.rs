@@ -24,6 +24,9 @@ pub enum ColorBy {
     Element,
     /// The rules, else one distinct colour per atom type (or name).
     Type,
+    /// The rules, else one distinct colour per chain (or, without chains, per segment), in
+    /// order of appearance; atoms of a frame with neither take the element colours.
+    Chain,
 }
 
 /// Which kind of rule a [`StyleWarning`] or [`StyleError`] is about.
@@ -97,6 +100,9 @@ pub enum StyleWarning {
     NoMatch { kind: RuleKind, name: String },
     /// Colour-column values outside [0, 1] (clamped).
     ColorsOutOfRange { count: usize },
+    /// Colouring by chain, but the frame has neither chain nor segment identifiers: the
+    /// element colours are used.
+    NoChains,
 }
 
 /// The selectors a rule NAME stands for: the type and the atom name NAME, and the element whose
@@ -164,7 +170,8 @@ pub struct SceneBuilder {
     /// The rule NAMEs, for [`SceneBuilder::warnings`].
     names: Vec<(RuleKind, String)>,
     palette: Palette,
-    types: Vec<Label>,
+    /// The type, name or chain labels met so far: label k has palette colour k.
+    categories: Vec<Label>,
     radii: Vec<f32>,
     colors: Vec<[f32; 3]>,
 }
@@ -193,7 +200,7 @@ impl SceneBuilder {
             radius_scale: s,
             names,
             palette: Palette::new(),
-            types: Vec::new(),
+            categories: Vec::new(),
             radii: Vec::new(),
             colors: Vec::new(),
         })
@@ -218,7 +225,7 @@ impl SceneBuilder {
 
     /// What is worth telling about `frame` (the first one drawn): rules whose NAME selects no
     /// atom, in rule order (radius rules first), then colour-column values outside [0, 1] when
-    /// colouring by property.
+    /// colouring by property, or no chains when colouring by chain.
     pub fn warnings(&self, frame: &Frame) -> Vec<StyleWarning> {
         let mut out = Vec::new();
         for (kind, name) in &self.names {
@@ -245,6 +252,9 @@ impl SceneBuilder {
                 out.push(StyleWarning::ColorsOutOfRange { count });
             }
         }
+        if self.color_by == ColorBy::Chain && frame.chains.is_empty() && frame.segments.is_empty() {
+            out.push(StyleWarning::NoChains);
+        }
         out
     }
 
@@ -268,30 +278,32 @@ impl SceneBuilder {
                 && frame.names.is_empty()
                 && !frame.types.is_empty()
                 && frame.elements.iter().all(|e| e.is_unknown()));
+        // The per-atom labels that pick a palette colour, if colouring by category.
+        let categories: Option<(&[Label], &[Label])> = match self.color_by {
+            ColorBy::Chain if !frame.chains.is_empty() => Some((&frame.chains, &[])),
+            ColorBy::Chain if !frame.segments.is_empty() => Some((&frame.segments, &[])),
+            _ if by_type => Some((&frame.types, &frame.names)),
+            _ => None,
+        };
         for i in 0..frame.n_atoms() {
             let p = frame.positions[i];
-            let color = match by_type {
-                true => match self.style.rules_for(frame, i).color {
+            let color = match categories {
+                Some((first, second)) => match self.style.rules_for(frame, i).color {
                     Some(c) => c,
                     None => {
-                        // One palette colour per type (or name), in order of appearance.
-                        let label = frame
-                            .types
-                            .get(i)
-                            .or(frame.names.get(i))
-                            .copied()
-                            .unwrap_or_default();
-                        let idx = match self.types.iter().position(|t| *t == label) {
+                        // One palette colour per label, in order of appearance.
+                        let label = first.get(i).or(second.get(i)).copied().unwrap_or_default();
+                        let idx = match self.categories.iter().position(|t| *t == label) {
                             Some(j) => j,
                             None => {
-                                self.types.push(label);
-                                self.types.len() - 1
+                                self.categories.push(label);
+                                self.categories.len() - 1
                             }
                         };
                         type_color(idx)
                     }
                 },
-                false => self.colors[i],
+                None => self.colors[i],
             };
             let kind = self.palette.kind_of(color);
             scene.push(Vec3::from(p), self.radii[i] * self.radius_scale, kind);
@@ -395,5 +407,43 @@ mod tests {
             SceneBuilder::new(&bad),
             Err(StyleError::BadRadiusScale { .. })
         ));
+    }
+
+    #[test]
+    fn chains_get_one_colour_each_then_segments_then_elements() {
+        let mut f = Frame::new();
+        f.positions = vec![[0.0; 3]; 5];
+        f.names = labels(&["CA", "CA", "OW", "CA", "NA"]);
+        f.chains = labels(&["B", "A", "W", "B", ""]);
+        f.res_names = labels(&["ALA", "ALA", "SOL", "ALA", "NA"]);
+        let opts = StyleOptions {
+            color_by: ColorBy::Chain,
+            type_color: vec![("NA".into(), [0, 0, 255])],
+            ..StyleOptions::default()
+        };
+        let mut b = SceneBuilder::new(&opts).unwrap();
+        let mut scene = SphereScene::default();
+        b.build(&mut f, &mut scene);
+        // Chains in order of appearance B, A, W; the rule wins over the blank chain.
+        let want: Vec<[u8; 3]> = (0..3)
+            .map(|i| type_color(i).map(|c| (c * 255.0).round() as u8))
+            .chain([[0, 0, 255]])
+            .collect();
+        assert_eq!(scene.kinds, [0, 1, 2, 0, 3]);
+        assert_eq!(b.palette.colors(), want.as_slice());
+        assert!(b.warnings(&f).is_empty());
+        // Segments stand in for chains; neither gives element colours and a warning.
+        f.chains.clear();
+        f.segments = labels(&["PROA", "PROA", "SOLV", "PROA", "IONS"]);
+        let mut b = SceneBuilder::new(&opts).unwrap();
+        b.build(&mut f, &mut scene);
+        assert_eq!(scene.kinds, [0, 0, 1, 0, 2]);
+        f.segments.clear();
+        let mut b = SceneBuilder::new(&opts).unwrap();
+        b.build(&mut f, &mut scene);
+        assert_eq!(b.warnings(&f), [StyleWarning::NoChains]);
+        let carbon = Element::from_symbol("C").unwrap().color();
+        let carbon = carbon.map(|c| (c * 255.0).round() as u8);
+        assert_eq!(b.palette.colors()[scene.kinds[0] as usize], carbon);
     }
 }

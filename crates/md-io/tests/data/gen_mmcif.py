@@ -2,7 +2,7 @@
 reads from each mmCIF file (mmcif_reference.json), for crates/md-io/tests/mmcif.rs.
 
 - gemmi_multi.cif, gemmi_topo.cif, gemmi_select.cif: gemmi's conversion of mda_multi.pdb (3
-  models, triclinic CRYST1, ions), topo_mda.pdb (66 atoms, 18 A cube) and select_mda.pdb (1,215
+  models, triclinic CRYST1, ions), topo_mda.pdb (66 atoms, 18 A cube) and select_mda.pdb (905
   atoms, the 1 A placeholder cell): `gemmi.read_structure` + `setup_entities` +
   `make_mmcif_document`, as `gemmi convert x.pdb x.cif` does.
 - 3jqh.cif (X-ray, alternate locations and two microheterogeneities) and 1uqc.cif (NMR, quoted

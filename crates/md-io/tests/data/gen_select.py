@@ -2,7 +2,7 @@
 of selection strings (select_reference.json), for crates/md-io/tests/select.rs.
 
 30 alanines (N H CA HA CB HB1 HB2 HB3 C O), 200 waters (OW HW1 HW2, resname SOL) and 5 sodium
-ions (NA), 1,215 atoms at seeded random positions in a 40 Å cube, no periodic box (so `around`
+ions (NA), 905 atoms at seeded random positions in a 40 Å cube, no periodic box (so `around`
 uses plain distances in both programs).
 """
 import json
