@@ -54,10 +54,11 @@ pub struct Cli {
 #[derive(Subcommand, Debug)]
 #[allow(clippy::large_enum_variant)] // parsed once per run: boxing RenderArgs would buy nothing
 pub enum Command {
-    /// Print a trajectory's format, atom and frame counts, box and first positions as one JSON object.
+    /// Print a trajectory's format, atom and frame counts, box, chains and segments (with their
+    /// atom counts) and first positions as one JSON object.
     Info {
         /// Trajectory file (XYZ, extended XYZ, PDB, PDBx/mmCIF, GRO, LAMMPS dump, DCD, XTC, TRR,
-        /// AMBER NetCDF).
+        /// AMBER NetCDF), gzip-compressed or not (1abc.cif.gz).
         file: PathBuf,
         /// Format, when the extension does not tell it.
         #[arg(long)]
@@ -262,7 +263,7 @@ Examples: --type-color 1=#ff8000 --type-color 2=40,40,255 (LAMMPS types 1 and 2)
 #[derive(Args, Debug)]
 #[command(after_help = RENDER_AFTER_HELP)]
 pub struct RenderArgs {
-    /// Trajectory file.
+    /// Trajectory file (any format `texmap info` reads; gzip-compressed files too).
     pub file: PathBuf,
     /// Format, when the extension does not tell it.
     #[arg(long)]

@@ -264,6 +264,32 @@ fn mmcif_alternate_locations_are_a_plain_warning() {
 }
 
 #[test]
+fn gzip_inputs_read_like_the_plain_files() {
+    // GNU gzip copies (md-io's tests/data/gzip.sh): a PDB as trajectory, a PSF as topology.
+    let o = texmap(&[
+        "info",
+        &data("topo_mda.pdb.gz"),
+        "--topology",
+        &data("psf_parmed.psf.gz"),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let r = reference();
+    assert_eq!(j["format"], "pdb");
+    assert_eq!(j["atoms"], r["pdb"]["n_atoms"]);
+    assert_eq!(j["topology"]["atoms"], r["pdb"]["n_atoms"]);
+    // A cut copy is an error naming the file and gzip, exit status 1.
+    let dir = tempfile::tempdir().unwrap();
+    let gz = std::fs::read(data("topo_mda.pdb.gz")).unwrap();
+    let cut = dir.path().join("cut.pdb.gz");
+    std::fs::write(&cut, &gz[..gz.len() - 8]).unwrap();
+    let o = texmap(&["info", cut.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1));
+    let e = stderr(&o);
+    assert!(e.contains("cut.pdb.gz") && e.contains("gzip"), "{e}");
+}
+
+#[test]
 fn info_lists_chains_and_colour_by_chain_draws_the_palette_colour() {
     // chains_mda.pdb: MDAnalysis wrote chain and segment identifiers (gen_chains.py).
     let r: serde_json::Value =

@@ -21,7 +21,8 @@ pub struct Location {
     pub frame: Option<usize>,
     /// 1-based line number (text formats).
     pub line: Option<u64>,
-    /// 0-based byte offset from the start of the file.
+    /// 0-based byte offset from the start of the file; of a gzip file, from the start of its
+    /// decompressed bytes, except in an error of the gzip stream itself (the compressed offset).
     pub byte: Option<u64>,
 }
 

@@ -57,9 +57,10 @@ impl Format {
         })
     }
 
-    /// The format a path's extension names.
+    /// The format a path's extension names; a final `.gz` is looked through (`run.xyz.gz` is
+    /// XYZ, read decompressed by [`crate::Trajectory::open`]).
     pub fn from_path(path: &Path) -> Option<Format> {
-        Format::from_extension(path.extension()?.to_str()?)
+        Format::from_extension(crate::gz::inner_path(path).extension()?.to_str()?)
     }
 
     /// The format the first bytes of a file show (give at least 256 bytes when the file has
@@ -166,6 +167,11 @@ mod tests {
         );
         assert_eq!(Format::from_path(Path::new("x.trr")), Some(Format::Trr));
         assert_eq!(Format::from_path(Path::new("noext")), None);
+        assert_eq!(
+            Format::from_path(Path::new("1abc.pdb.GZ")),
+            Some(Format::Pdb)
+        );
+        assert_eq!(Format::from_path(Path::new("run.gz")), None);
         for f in Format::ALL {
             assert_eq!(
                 Format::from_extension(f.name().split('-').next().unwrap()).is_some(),

@@ -4,6 +4,9 @@
 //! - [`Trajectory`] reads XYZ / extended XYZ, PDB, PDBx/mmCIF (the first data block's
 //!   `_atom_site`, models as frames), GRO and LAMMPS text dumps (and the binary DCD, XTC, TRR
 //!   and AMBER NetCDF) one frame at a time into a reusable [`Frame`], or any frame by index.
+//!   Any of them may be gzip-compressed (`1abc.cif.gz`, `run.xyz.gz`; topologies too): it is
+//!   inflated once into a temporary file, so the byte offsets of a `.gz` file's errors count
+//!   decompressed bytes, except for damage to the gzip stream itself (compressed offset).
 //! - [`Topology`] reads atom names, elements, residues and bonds (PDB, PDBx/mmCIF, GRO, PSF,
 //!   LAMMPS data file) and gives them to the frames of a coordinate-only trajectory of the same
 //!   atoms.
@@ -78,6 +81,7 @@ mod error;
 mod format;
 mod frame;
 mod gro;
+mod gz;
 mod lammps;
 mod mmcif;
 mod netcdf;

@@ -31,7 +31,6 @@
 //! colour per type instead, as OVITO does.
 
 use std::collections::HashMap;
-use std::fs::File;
 use std::io::{BufRead, BufReader, Read};
 use std::path::Path;
 use std::sync::Arc;
@@ -61,8 +60,10 @@ pub enum TopologyFormat {
 
 impl TopologyFormat {
     /// The format a path names: `.pdb`/`.ent`, `.gro`, `.cif`/`.mmcif`, `.psf`, `.data`/`.lmp` or
-    /// `data.*` (LAMMPS).
+    /// `data.*` (LAMMPS). A final `.gz` is looked through (`top.psf.gz` is PSF, read
+    /// decompressed by [`Topology::open`]).
     pub fn from_path(path: &Path) -> Option<TopologyFormat> {
+        let path = crate::gz::inner_path(path);
         let name = path.file_name()?.to_str()?.to_ascii_lowercase();
         if name.starts_with("data.") {
             return Some(TopologyFormat::LammpsData);
@@ -200,6 +201,9 @@ impl<R: Read> Lines<R> {
 
 impl Topology {
     /// Reads the topology of `path`, its format told by the name (see [`TopologyFormat`]).
+    ///
+    /// A gzip file (`top.psf.gz`, `1abc.cif.gz`) is read decompressed, as by
+    /// [`Trajectory::open`]: byte offsets in its errors count decompressed bytes.
     pub fn open(path: impl AsRef<Path>) -> Result<Topology, Error> {
         let path = path.as_ref();
         let name: Arc<str> = path.display().to_string().into();
@@ -212,29 +216,13 @@ impl Topology {
         Topology::open_as(path, format)
     }
 
-    /// Reads the topology of `path` as `format`.
+    /// Reads the topology of `path` as `format`; a gzip file is read decompressed, as by
+    /// [`Topology::open`].
     pub fn open_as(path: impl AsRef<Path>, format: TopologyFormat) -> Result<Topology, Error> {
         let path = path.as_ref();
         let name: Arc<str> = path.display().to_string().into();
-        let open = || {
-            File::open(path).map_err(|source| Error::Io {
-                at: Location::file(&name),
-                source,
-            })
-        };
-        match format {
-            TopologyFormat::Pdb => {
-                let mut t = Topology::first_frame(Trajectory::open_as(path, Format::Pdb)?)?;
-                t.bonds = pdb_conect(open()?, &name, &t.ids)?;
-                Ok(t)
-            }
-            TopologyFormat::Gro => Topology::first_frame(Trajectory::open_as(path, Format::Gro)?),
-            TopologyFormat::Mmcif => {
-                Topology::first_frame(Trajectory::open_as(path, Format::Mmcif)?)
-            }
-            TopologyFormat::LammpsData => lammps_data(open()?, &name),
-            TopologyFormat::Psf => crate::psf::read_psf(open()?, &name),
-        }
+        let file = crate::gz::open(path, &name)?;
+        Topology::from_reader(file, format, &name)
     }
 
     /// Reads `src` (named `name` in errors) as `format`.

@@ -110,7 +110,8 @@ impl ReadOptions {
 /// every frame before it stays readable.
 ///
 /// Memory: the current frame's buffers, a 1 MiB read chunk for text formats, and the frame
-/// index (16 bytes per frame seen: byte offset and line number of its start).
+/// index (16 bytes per frame seen: byte offset and line number of its start). A gzip file opened
+/// by path is read from its decompressed copy in a temporary file (disk, not memory).
 pub struct Trajectory<R: Read + Seek = File> {
     reader: Reader<R>,
     file: Arc<str>,
@@ -125,6 +126,13 @@ pub struct Trajectory<R: Read + Seek = File> {
 
 impl Trajectory<File> {
     /// Opens `path`, telling the format from the extension or else from the first bytes.
+    ///
+    /// A gzip file (first bytes `1f 8b`, e.g. `1abc.cif.gz`, `run.xyz.gz`) is read decompressed:
+    /// its format comes from the name without `.gz`, else from the decompressed first bytes. It
+    /// is inflated once into an anonymous temporary file (disk, not memory: the decompressed
+    /// size), so byte offsets in later errors count decompressed bytes; damage to the gzip
+    /// stream itself is an error here naming the file, "gzip" and the compressed offset. A name
+    /// ending in `.gz` over bytes that are not gzip is an error.
     pub fn open(path: impl AsRef<Path>) -> Result<Trajectory<File>, Error> {
         Trajectory::open_with(path, ReadOptions::default())
     }
@@ -140,7 +148,7 @@ impl Trajectory<File> {
             at: crate::error::Location::file(&name),
             source,
         };
-        let mut file = File::open(path).map_err(io)?;
+        let mut file = crate::gz::open(path, &name)?;
         let format = match Format::from_path(path) {
             Some(f) => f,
             None => {
@@ -153,7 +161,8 @@ impl Trajectory<File> {
         Trajectory::from_reader_with(file, format, &name, options)
     }
 
-    /// Opens `path` as `format`, whatever its extension.
+    /// Opens `path` as `format`, whatever its extension; a gzip file is read decompressed, as
+    /// by [`Trajectory::open`].
     pub fn open_as(path: impl AsRef<Path>, format: Format) -> Result<Trajectory<File>, Error> {
         Trajectory::open_as_with(path, format, ReadOptions::default())
     }
@@ -166,10 +175,7 @@ impl Trajectory<File> {
     ) -> Result<Trajectory<File>, Error> {
         let path = path.as_ref();
         let name: Arc<str> = path.display().to_string().into();
-        let file = File::open(path).map_err(|source| Error::Io {
-            at: crate::error::Location::file(&name),
-            source,
-        })?;
+        let file = crate::gz::open(path, &name)?;
         Trajectory::from_reader_with(file, format, &name, options)
     }
 }
