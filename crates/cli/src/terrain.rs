@@ -84,10 +84,16 @@ pub enum TerrainCmd {
         /// Write an OGC 3D Tiles 1.1 tileset into the new directory -o: tileset.json and one .glb
         /// per chunk, each tile's geometricError the chunk's measured error, placed on the WGS 84
         /// ellipsoid (the grid must be geographic, UTM or Web Mercator; heights are taken as
-        /// ellipsoidal).
+        /// ellipsoidal unless --geoid is given).
         /// Open it in CesiumJS with `Cesium3DTileset.fromUrl(".../tileset.json")`.
         #[arg(long = "3d-tiles")]
         tiles3d: bool,
+        /// With --3d-tiles: the geoid the DEM's heights are above (SRTM and most national DEMs:
+        /// EGM96 or EGM2008), so that the tiles get ellipsoidal heights and sit on Cesium World
+        /// Terrain instead of 20-100 m above or below it. A PROJ .gtx grid (proj-data's
+        /// /usr/share/proj/egm96_15.gtx) or a GeoTIFF in degrees (us_nga_egm96_15.tif).
+        #[arg(long, value_name = "GRID", requires = "tiles3d")]
+        geoid: Option<PathBuf>,
     },
     /// Seed 000 Eq. (5)-(7): GST maps the active area needs per level, and the total.
     Maps {
@@ -242,18 +248,20 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
             output,
             greedy,
             tiles3d,
+            geoid,
         } => {
             if tiles3d {
                 if greedy {
                     return usage("--greedy applies to a single mesh, not to --3d-tiles");
                 }
                 let d = Database::open(&dir)?;
+                let geoid = geoid.map(texmap_terrain::geoid::Geoid::open).transpose()?;
                 let sp = crate::commands::spinner("writing 3D Tiles");
-                let s = texmap_terrain::tiles3d::write_tileset(
-                    &d,
-                    &output,
-                    texmap_terrain::tiles3d::MAX_TILE_TEXTURE,
-                )?;
+                let options = texmap_terrain::tiles3d::TilesetOptions {
+                    geoid: geoid.as_ref(),
+                    ..Default::default()
+                };
+                let s = texmap_terrain::tiles3d::write_tileset_with(&d, &output, &options)?;
                 sp.finish_and_clear();
                 crate::note!(
                     "wrote {} ({} tiles, {} with content, {} triangles, {:.1} MB)",

@@ -604,6 +604,50 @@ fn export_3d_tiles_and_its_refusals() {
     assert_eq!(ts["asset"]["version"], "1.1");
     assert_eq!(ts["root"]["content"]["uri"], "tiles/0/0_0.glb");
     assert!(tiles.join("tiles/0/0_0.glb").exists());
+    let heights = ts["asset"]["extras"]["heights"].as_str().unwrap();
+    assert!(heights.contains("taken as ellipsoidal"), "{heights}");
+    // With PROJ's EGM96 (a GDAL cut of it): the root tile's box sits lower by the undulation
+    // there (about 27.5 m, tests/data/geoid_proj.txt), along the local vertical.
+    let geoid_tiles = dir.path().join("geoid_tiles");
+    ok(&texmap(&[
+        "terrain",
+        "export",
+        utm.to_str().unwrap(),
+        "--3d-tiles",
+        "--geoid",
+        &data("egm96_cut.gtx"),
+        "-o",
+        geoid_tiles.to_str().unwrap(),
+        "-q",
+    ]));
+    let gs: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(geoid_tiles.join("tileset.json")).unwrap())
+            .unwrap();
+    let heights = gs["asset"]["extras"]["heights"].as_str().unwrap();
+    assert!(heights.contains("egm96_cut.gtx"), "{heights}");
+    let centre = |v: &serde_json::Value| -> [f64; 3] {
+        let t = &v["root"]["transform"];
+        let b = &v["root"]["boundingVolume"]["box"];
+        [0, 1, 2].map(|k| t[12 + k].as_f64().unwrap() + b[k].as_f64().unwrap())
+    };
+    let (a, g) = (centre(&ts), centre(&gs));
+    let r = |p: [f64; 3]| (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+    let drop = r(a) - r(g);
+    assert!(
+        (26.0..29.0).contains(&drop),
+        "the box centre moved {drop} m inwards"
+    );
+    // --geoid without --3d-tiles is a usage error.
+    let o = texmap(&[
+        "terrain",
+        "export",
+        utm.to_str().unwrap(),
+        "--geoid",
+        &data("egm96_cut.gtx"),
+        "-o",
+        dir.path().join("x.glb").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
     let o = texmap(&[
         "terrain",
         "export",

@@ -24,7 +24,9 @@
 //!   texmap-core sampler (nearest, bilinear, trilinear, the span sampler with 3x3 or 4x4 banks,
 //!   quadratic 3x3, anisotropic), per-frame statistics and optional haze.
 //! - [`tiles3d`]: the database as OGC 3D Tiles 1.1 (`tileset.json` and a glTF per chunk, placed
-//!   on the WGS 84 ellipsoid through [`geodesy`]) for Cesium and the engines that stream it.
+//!   on the WGS 84 ellipsoid through [`geodesy`]) for Cesium and the engines that stream it;
+//!   [`geoid`] turns heights above sea level into ellipsoidal heights there (EGM96 and other
+//!   geoid grids from PROJ's `.gtx` or GeoTIFF files).
 //! - [`relief`]: shaded relief (height colours lit by a `gdaldem`-compatible hillshade), the
 //!   texture of a database built without a photo.
 //! - [`models`]: textured OBJ models placed on the terrain by georeference and a built-in tree
@@ -70,6 +72,7 @@ pub mod dem;
 pub mod error;
 pub mod flight;
 pub mod geodesy;
+pub mod geoid;
 pub mod greedy;
 pub mod gst;
 pub mod models;

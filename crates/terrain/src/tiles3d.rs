@@ -11,8 +11,11 @@
 //!
 //! Placement on the globe: every vertex goes from its grid sample (recovered from its texture
 //! coordinate) through the grid's georeference to WGS 84 longitude/latitude ([`crate::geodesy`]:
-//! geographic grids directly, UTM and Web Mercator grids by the inverse projection) and, with its height as
-//! ellipsoidal height, to earth-centred, earth-fixed (ECEF) metres. Each glTF holds its vertices
+//! geographic grids directly, UTM and Web Mercator grids by the inverse projection) and, with its
+//! height as ellipsoidal height, to earth-centred, earth-fixed (ECEF) metres. A DEM's heights are
+//! usually above sea level (orthometric): with a geoid grid ([`TilesetOptions::geoid`]) each
+//! vertex's height becomes `H + N(lon, lat)`, the ellipsoidal height Cesium World Terrain and
+//! photogrammetry use, and `asset.extras.heights` says which the tileset holds. Each glTF holds its vertices
 //! relative to the centre of its tile's box (single precision keeps millimetres there), the tile's
 //! `transform` translating by that centre (relative to the parent's, as transforms compose), and
 //! the y-up glTF axes are written so that the viewer's y-up to z-up rotation yields ECEF. Bounding
@@ -34,10 +37,30 @@ use crate::db::{ChunkEntry, Database, write_dir_atomically};
 use crate::dem::Grid;
 use crate::error::{TerrainError, io};
 use crate::geodesy::{Placement, ecef};
+use crate::geoid::Geoid;
 use crate::relief::{Hillshade, Light, relief_texel};
 
 /// The default largest texture side per tile.
 pub const MAX_TILE_TEXTURE: u32 = 1024;
+
+/// How [`write_tileset_with`] writes a tileset.
+#[derive(Clone, Copy, Debug)]
+pub struct TilesetOptions<'a> {
+    /// Largest texture side per tile ([`MAX_TILE_TEXTURE`] by default).
+    pub max_texture: u32,
+    /// The geoid the grid's heights are above: each vertex is raised by the undulation there.
+    /// `None` takes the heights as ellipsoidal.
+    pub geoid: Option<&'a Geoid>,
+}
+
+impl Default for TilesetOptions<'_> {
+    fn default() -> Self {
+        TilesetOptions {
+            max_texture: MAX_TILE_TEXTURE,
+            geoid: None,
+        }
+    }
+}
 
 /// What [`write_tileset`] wrote.
 #[derive(Clone, Debug, PartialEq)]
@@ -78,7 +101,22 @@ pub fn write_tileset(
     out: &Path,
     max_texture: u32,
 ) -> Result<TilesetSummary, TerrainError> {
+    let options = TilesetOptions {
+        max_texture,
+        geoid: None,
+    };
+    write_tileset_with(db, out, &options)
+}
+
+/// [`write_tileset`] with a geoid: heights are above it and become ellipsoidal. A vertex the
+/// geoid grid does not cover is an error naming the grid and the point.
+pub fn write_tileset_with(
+    db: &Database,
+    out: &Path,
+    options: &TilesetOptions,
+) -> Result<TilesetSummary, TerrainError> {
     let m = &db.manifest;
+    let max_texture = options.max_texture;
     let placement = Placement::of(&m.georef).ok_or_else(|| TerrainError::Unsupported {
         source: db.dir.display().to_string(),
         what: format!(
@@ -114,7 +152,13 @@ pub fn write_tileset(
             let made: Vec<Result<Tile, TerrainError>> = level
                 .chunks
                 .par_iter()
-                .map(|c| chunk_tile(db, level.depth, c, placement, &source, max_texture, tmp))
+                .map(|c| {
+                    let place = Place {
+                        placement,
+                        geoid: options.geoid,
+                    };
+                    chunk_tile(db, level.depth, c, place, &source, max_texture, tmp)
+                })
                 .collect();
             for t in made {
                 tiles.push(t?);
@@ -126,7 +170,16 @@ pub fn write_tileset(
             triangles: tiles.iter().map(|t| t.triangles).sum(),
             bytes: tiles.iter().map(|t| t.bytes).sum(),
         };
-        let json = tileset_json(&tiles, m.max_error as f64);
+        let mut json = tileset_json(&tiles, m.max_error as f64);
+        json["asset"]["extras"] = json!({
+            "heights": match options.geoid {
+                Some(g) => format!(
+                    "ellipsoidal (WGS 84): the grid's heights plus the undulation of {}",
+                    file_name(g.name())
+                ),
+                None => "the grid's heights, taken as ellipsoidal (WGS 84)".to_string(),
+            }
+        });
         let text = serde_json::to_string_pretty(&json).expect("JSON values serialise");
         let path = tmp.join("tileset.json");
         std::fs::write(&path, &text).map_err(io(&path))?;
@@ -137,22 +190,47 @@ pub fn write_tileset(
     })
 }
 
+/// How grid samples go onto the ellipsoid: the horizontal placement and the geoid, if any.
+#[derive(Clone, Copy)]
+struct Place<'a> {
+    placement: Placement,
+    geoid: Option<&'a Geoid>,
+}
+
+/// The last component of a path, for the tileset's description of its heights.
+fn file_name(path: &str) -> &str {
+    path.rsplit(['/', '\\']).next().unwrap_or(path)
+}
+
 /// ECEF position of a chunk vertex: its grid sample from its texture coordinate (the databases'
-/// `uv = (col, row) / (side − 1)`), its height from `y`.
-fn vertex_ecef(db: &Database, placement: Placement, p: Vec3, uv: Vec2) -> DVec3 {
+/// `uv = (col, row) / (side − 1)`), its height from `y` plus the geoid's undulation there.
+fn vertex_ecef(db: &Database, place: Place, p: Vec3, uv: Vec2) -> Result<DVec3, TerrainError> {
     let m = &db.manifest;
     let col = uv.x as f64 * (m.width - 1) as f64;
     let row = uv.y as f64 * (m.height - 1) as f64;
     let (x, y) = m.georef.sample_xy(col, row);
-    let (lon, lat) = placement.lonlat(x, y);
-    DVec3::from(ecef(lon, lat, p.y as f64))
+    let (lon, lat) = place.placement.lonlat(x, y);
+    let n = match place.geoid {
+        None => 0.0,
+        Some(g) => g
+            .undulation(lon, lat)
+            .ok_or_else(|| TerrainError::Unsupported {
+                source: g.name().to_string(),
+                what: format!(
+                    "the geoid grid has no undulation at longitude {lon:.6}, latitude {lat:.6} \
+                 (outside the grid or no data), a point of the terrain {}",
+                    db.dir.display()
+                ),
+            })?,
+    };
+    Ok(DVec3::from(ecef(lon, lat, p.y as f64 + n)))
 }
 
 fn chunk_tile(
     db: &Database,
     depth: u32,
     c: &ChunkEntry,
-    placement: Placement,
+    place: Place,
     source: &Source,
     max_texture: u32,
     tmp: &Path,
@@ -176,8 +254,8 @@ fn chunk_tile(
         .positions
         .iter()
         .zip(uvs)
-        .map(|(&p, &uv)| vertex_ecef(db, placement, p, uv))
-        .collect();
+        .map(|(&p, &uv)| vertex_ecef(db, place, p, uv))
+        .collect::<Result<_, _>>()?;
     let (lo, hi) = world.iter().fold(
         (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
         |(lo, hi), &p| (lo.min(p), hi.max(p)),

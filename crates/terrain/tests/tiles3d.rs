@@ -9,7 +9,8 @@ use glam::DVec3;
 use texmap_terrain::db::{self, BuildOptions, Database};
 use texmap_terrain::dem::{ReadOptions, read_dem};
 use texmap_terrain::geodesy::ecef;
-use texmap_terrain::tiles3d::write_tileset;
+use texmap_terrain::geoid::Geoid;
+use texmap_terrain::tiles3d::{TilesetOptions, write_tileset, write_tileset_with};
 
 fn data(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -302,4 +303,67 @@ fn web_mercator_tileset_is_placed_through_its_projection() {
     for (k, n) in nearest.iter().enumerate() {
         assert!(*n < 0.03, "corner {k}: nearest vertex {n} m away");
     }
+}
+
+/// Heights above EGM96 (SRTM's) become ellipsoidal through the geoid grid: the tile's corners
+/// land where PROJ puts them (`gdaltransform -s_srs EPSG:4326+5773 -t_srs EPSG:4979` with
+/// proj-data's egm96_15.gtx, tests/data/geoid.sh), 26.5-28 m below the heights taken as
+/// ellipsoidal; a grid that does not cover the terrain is refused by name.
+#[test]
+fn geoid_heights_land_where_proj_puts_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let grid = read_dem(data("N44W072.hgt"), &ReadOptions::default()).unwrap();
+    let d = built(dir.path(), "srtm.db", &grid, None, BuildOptions::default());
+    let geoid = Geoid::open(data("egm96_cut.gtx")).unwrap();
+    let out = dir.path().join("tiles");
+    let options = TilesetOptions {
+        geoid: Some(&geoid),
+        ..TilesetOptions::default()
+    };
+    write_tileset_with(&d, &out, &options).unwrap();
+    let (ts, seen) = read_tileset(&out);
+    let heights = ts["asset"]["extras"]["heights"].as_str().unwrap();
+    assert!(heights.contains("egm96_cut.gtx"), "{heights}");
+    // PROJ's ellipsoidal heights of the four corner samples: "corner lon lat H h".
+    let proj = std::fs::read_to_string(data("geoid_proj.txt")).unwrap();
+    let corners: Vec<(DVec3, f64)> = proj
+        .lines()
+        .filter_map(|l| l.strip_prefix("corner "))
+        .map(|l| {
+            let v: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
+            (DVec3::from(ecef(v[0], v[1], v[3])), v[2] - v[3])
+        })
+        .collect();
+    assert_eq!(corners.len(), 4);
+    let finest = seen.iter().map(|t| t.depth).max().unwrap();
+    let mut nearest = [f64::INFINITY; 4];
+    for t in seen.iter().filter(|t| t.depth == finest) {
+        for w in tile_vertices(&out, t).0 {
+            for (k, (c, _)) in corners.iter().enumerate() {
+                nearest[k] = nearest[k].min(w.distance(*c));
+            }
+        }
+    }
+    eprintln!("geoid corners: nearest finest-tile vertices {nearest:?} m away");
+    for (k, n) in nearest.iter().enumerate() {
+        assert!(*n < 0.03, "corner {k}: nearest vertex {n} m away");
+        let lift = corners[k].1;
+        assert!((26.0..29.0).contains(&lift), "corner {k}: H - h = {lift}");
+    }
+    // A geoid grid away from the terrain: refused, naming the grid and the point.
+    let mut far = std::fs::read(data("egm96_cut.gtx")).unwrap();
+    far[8..16].copy_from_slice(&10.0f64.to_be_bytes()); // west edge at 10°E
+    let far = Geoid::from_gtx(&far, "far.gtx").unwrap();
+    let options = TilesetOptions {
+        geoid: Some(&far),
+        ..TilesetOptions::default()
+    };
+    let e = write_tileset_with(&d, &dir.path().join("far"), &options)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("far.gtx: ") && e.contains("no undulation at longitude -7"),
+        "{e}"
+    );
+    assert!(!dir.path().join("far").exists());
 }
