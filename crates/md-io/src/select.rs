@@ -7,7 +7,7 @@
 //! expr     := term ("or" term)*
 //! term     := factor ("and" factor)*
 //! factor   := "not" factor | "(" expr ")" | atom
-//! atom     := "all" | "none" | "protein" | "backbone" | "water"
+//! atom     := "all" | "none" | "protein" | "nucleic" | "backbone" | "water"
 //!           | ("name" | "type" | "resname" | "element") WORD+      -- any of the words
 //!           | ("chain" | "chainID" | "segid" | "segname") WORD+
 //!           | ("index" | "serial" | "bynum" | "id" | "resid") RANGE+
@@ -20,7 +20,8 @@
 //! characters `*` (any run) and `?` (one character): `name H*`. `index` counts atoms from 0 in
 //! file order; `serial` and `bynum` from 1 (`bynum` is MDAnalysis's name); `id` is the atom id the
 //! file wrote. `protein` is a residue name among the amino acids of [`PROTEIN_RESIDUES`];
-//! `backbone` is `protein and name N CA C O`; `water` a residue name in [`WATER_RESIDUES`].
+//! `backbone` is `protein and name N CA C O`; `nucleic` a residue name in [`NUCLEIC_RESIDUES`];
+//! `water` a residue name in [`WATER_RESIDUES`].
 //! `chain` (VMD) and `chainID` (MDAnalysis) match the chain identifier (PDB column 22, mmCIF
 //! `auth_asym_id`); `segid` (MDAnalysis) and `segname` (VMD) the segment (PDB columns 73-76,
 //! PSF). A blank chain or segment is matched by no word.
@@ -43,6 +44,14 @@ pub const PROTEIN_RESIDUES: &[&str] = &[
     "ALA", "ARG", "ASN", "ASP", "CYS", "GLN", "GLU", "GLY", "HIS", "ILE", "LEU", "LYS", "MET",
     "PHE", "PRO", "SER", "THR", "TRP", "TYR", "VAL", "ASH", "GLH", "HID", "HIE", "HIP", "HSD",
     "HSE", "HSP", "LYN", "CYX", "CYM", "MSE", "NALA", "CALA",
+];
+
+/// Residue names `nucleic` matches: DNA and RNA nucleotides in the PDB, AMBER and CHARMM
+/// spellings, with AMBER's 5'/3' terminal variants (MDAnalysis's list).
+pub const NUCLEIC_RESIDUES: &[&str] = &[
+    "ADE", "URA", "CYT", "GUA", "THY", "DA", "DC", "DG", "DT", "RA", "RU", "RG", "RC", "A", "T",
+    "U", "C", "G", "DA5", "DC5", "DG5", "DT5", "DA3", "DC3", "DG3", "DT3", "RA5", "RU5", "RG5",
+    "RC5", "RA3", "RU3", "RG3", "RC3",
 ];
 
 /// Residue names `water` matches.
@@ -175,6 +184,7 @@ fn is_reserved(w: &str) -> bool {
             | "all"
             | "none"
             | "protein"
+            | "nucleic"
             | "backbone"
             | "water"
             | "name"
@@ -288,6 +298,11 @@ impl Parser<'_> {
             "all" => Ok(Node::All),
             "none" => Ok(Node::None),
             "protein" => Ok(protein()),
+            "nucleic" => Ok(Node::Str {
+                field: StrField::ResName,
+                words: NUCLEIC_RESIDUES.iter().map(|s| s.to_string()).collect(),
+                column: t.column,
+            }),
             "backbone" => Ok(Node::And(
                 Box::new(protein()),
                 Box::new(Node::Str {

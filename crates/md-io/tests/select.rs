@@ -77,7 +77,7 @@ fn chain_and_segment_selections_match_mdanalysis() {
             .unwrap_or_else(|e| panic!("{e}"))
     };
     let sels = reference["selections"].as_object().unwrap();
-    assert_eq!(sels.len(), 10);
+    assert_eq!(sels.len(), 12);
     for (text, want) in sels {
         let want = indices(want);
         assert!(!want.is_empty(), "{text}");

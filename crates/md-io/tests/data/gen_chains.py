@@ -4,8 +4,9 @@ columns 73-76) and what MDAnalysis selects on it for chain and segment selection
 atom of psf_parmed.psf (ParmEd's PSF, see gen_psf.py) as MDAnalysis reads it.
 
 The system: two alanine chains A and B (segments PROA, PROB, 8 residues of N H CA HA CB HB1 HB2
-HB3 C O each), 60 waters in chain W (segment SOLV) and 4 sodium ions with a blank chain, which
-MDAnalysis's writer turns into its default chain X (segment IONS): 344 atoms at seeded random
+HB3 C O each), 60 waters in chain W (segment SOLV), 4 sodium ions with a blank chain, which
+MDAnalysis's writer turns into its default chain X (segment IONS), and a 6-nucleotide DNA strand
+(P C4' N1 per residue, DA5 ... DC3) in chain D (segment DNA1): 362 atoms at seeded random
 positions in a 30 A cube. ParmEd names its PSF's one segment SYS.
 
 Run with MDAnalysis 2.11 (`pip install MDAnalysis`): `python3 gen_chains.py`.
@@ -21,7 +22,7 @@ warnings.filterwarnings("ignore")
 ala = ["N", "H", "CA", "HA", "CB", "HB1", "HB2", "HB3", "C", "O"]
 names, elements, resindex = [], [], []
 resnames, resids, segindex = [], [], []
-chain_of_segment = {"PROA": "A", "PROB": "B", "SOLV": "W", "IONS": ""}
+chain_of_segment = {"PROA": "A", "PROB": "B", "SOLV": "W", "IONS": "", "DNA1": "D"}
 segments = list(chain_of_segment)
 r = 0
 for seg in (0, 1):
@@ -36,6 +37,10 @@ for k in range(60):
 for k in range(4):
     names.append("NA"); elements.append("Na"); resindex.append(r)
     resnames.append("NA"); resids.append(k + 1); segindex.append(3); r += 1
+for k, base in enumerate(["DA5", "DC", "DG", "DT", "DA", "DC3"]):
+    for a, e in (("P", "P"), ("C4'", "C"), ("N1", "N")):
+        names.append(a); elements.append(e); resindex.append(r)
+    resnames.append(base); resids.append(k + 1); segindex.append(4); r += 1
 
 n = len(names)
 u = mda.Universe.empty(n, n_residues=r, n_segments=len(segments), atom_resindex=resindex,
@@ -64,6 +69,8 @@ selections = [
     "chainID B and resid 3:5 and name CA",
     "protein and not chainID A",
     "segid PROA and around 3.0 segid PROB",
+    "nucleic",
+    "nucleic and name P and not resname DA5",
 ]
 psf = mda.Universe("psf_parmed.psf")
 out = {
