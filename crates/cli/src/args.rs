@@ -474,6 +474,9 @@ pub enum DrawStyle {
     BallStick,
     /// Bonds as sticks of 0.3 Å, atoms as 0.3 Å joints.
     Licorice,
+    /// Protein and nucleic-acid backbones as a smooth 0.3 Å tube through the CA (P) atoms of
+    /// each chain (VMD's Tube); ligands, ions and water as licorice.
+    Tube,
 }
 
 /// Periodic boundaries (`--pbc`).
@@ -514,7 +517,8 @@ pub struct MolArgs {
     /// Bonds: auto (the topology's, else by distance), topology, none.
     #[arg(long, value_enum, default_value_t = BondsArg::Auto)]
     pub bonds: BondsArg,
-    /// Drawing style: spacefill, ball-stick, licorice (the last two draw bonds).
+    /// Drawing style: spacefill, ball-stick, licorice (the last two draw bonds), tube (backbones
+    /// as a tube, other atoms as licorice).
     #[arg(long = "style", value_enum, default_value_t = DrawStyle::Spacefill)]
     pub draw: DrawStyle,
     /// Periodic boundaries: none, wrap (atoms into the box), unwrap (molecules whole).
@@ -548,7 +552,7 @@ Examples:
   texmap render run.xtc --topology conf.gro --select 'not resname SOL' --style ball-stick --pbc unwrap -o f.png
   texmap render md.nc --topology prmtop.pdb --color 'protein=#a0a0ff' --color 'resname LIG=#ff8000' -o f.png
   texmap render dump.lammpstrj --type-color 1=#ff8000 --type-color 2=40,40,255 --type-radius 2=0.6 -o f.png
-  texmap render 1abc.cif --select 'protein and chain A B' --color-by chain -o chains.png
+  texmap render 1abc.cif.gz --style tube --color-by chain --select 'not water' -o chains.png
   texmap render water.gro --color-by element --type-color OW=#ff0000 --radius-scale 0.5 -o w.png
   texmap render md.xyz --eye 0,0,50 --target 0,0,0 --up 0,1,0 --fov 30 --depth -o md.png";
 

@@ -119,6 +119,7 @@ impl From<DrawStyle> for texmap_md_scene::DrawStyle {
             DrawStyle::Spacefill => texmap_md_scene::DrawStyle::Spacefill,
             DrawStyle::BallStick => texmap_md_scene::DrawStyle::BallStick,
             DrawStyle::Licorice => texmap_md_scene::DrawStyle::Licorice,
+            DrawStyle::Tube => texmap_md_scene::DrawStyle::Tube,
         }
     }
 }

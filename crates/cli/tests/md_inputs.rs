@@ -355,3 +355,34 @@ fn info_lists_chains_and_colour_by_chain_draws_the_palette_colour() {
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stderr(&o).contains("--color-by chain"), "{}", stderr(&o));
 }
+
+#[test]
+fn tube_of_a_real_helix_matches_the_reference_ray_tracer() {
+    // 3JQH (wwPDB): one helical chain; its CA trace as a tube, its waters as licorice.
+    let dir = tempfile::tempdir().unwrap();
+    let draw = |method: &str, style: &str| -> PathBuf {
+        let out = dir.path().join(format!("{method}-{style}.png"));
+        let file = data("3jqh.cif");
+        let o = out.to_str().unwrap().to_string();
+        let args = [
+            "render", &file, "--style", style, "--select", "protein", "--size", "200x150",
+            "--method", method, "-o", &o,
+        ];
+        let r = texmap(&args);
+        assert!(r.status.success(), "{}", stderr(&r));
+        out
+    };
+    let ours = draw("raycast", "tube");
+    let reference = draw("reference", "tube");
+    let d = mean_abs_diff(&ours, &reference);
+    assert!(d < 2.0, "mean |raycast - reference| = {d} per channel");
+    // A thin tube is drawn, lighting fewer pixels than the same atoms as licorice.
+    let licorice = draw("raycast", "licorice");
+    assert!(lit(&ours) > 300, "{}", lit(&ours));
+    assert!(
+        lit(&ours) < lit(&licorice),
+        "{} vs {}",
+        lit(&ours),
+        lit(&licorice)
+    );
+}

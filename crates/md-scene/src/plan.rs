@@ -12,7 +12,19 @@
 //!    list in order, so that a later rule wins over an earlier one for the atoms both select;
 //! 4. the [`DrawStyle`]: radii scaled for ball-and-stick, or all set to [`LICORICE_RADIUS`];
 //! 5. the selection: the selected atoms are kept in their order and the bonds between two kept
-//!    atoms are renumbered to the kept atoms' indices; bonds to a dropped atom are dropped.
+//!    atoms are renumbered to the kept atoms' indices; bonds to a dropped atom are dropped;
+//! 6. for [`DrawStyle::Tube`], the selected atoms of protein and nucleic residues give way to
+//!    the backbone tube through their CA (P) atoms, appended as spheres joined by bonds.
+//!
+//! # The tube
+//! VMD's Tube representation: per chain, a uniform Catmull-Rom spline through the consecutive
+//! CA atoms of protein residues (P atoms of nucleic residues), which it passes through exactly,
+//! sampled [`TUBE_SUBDIVISIONS`] times per interval and drawn as spheres of [`TUBE_RADIUS`]
+//! joined by cylinders of the same radius. A trace breaks where the chain or segment changes or
+//! two neighbours are further apart than a bonded pair can be ([`MAX_CA_GAP`], [`MAX_P_GAP`]).
+//! Each half interval takes the colour of its nearer CA (P) atom, so colour rules and
+//! `ColorBy::Chain` colour the tube. A lone CA (P) is one sphere. Ends are extended by mirroring
+//! the neighbour, so the tube ends at the first and last atom.
 
 use std::fmt;
 
@@ -28,6 +40,16 @@ pub const BALL_AND_STICK_RADIUS_SCALE: f32 = 0.3;
 pub const BALL_AND_STICK_BOND_RADIUS: f32 = 0.2;
 /// Atom and stick radius of [`DrawStyle::Licorice`] (Å), as VMD's Licorice default (0.3).
 pub const LICORICE_RADIUS: f32 = 0.3;
+/// Radius of [`DrawStyle::Tube`]'s backbone tube (Å), as VMD's Tube default (0.3); equal to
+/// [`LICORICE_RADIUS`], since a scene has one bond radius and ligands are drawn as licorice.
+pub const TUBE_RADIUS: f32 = LICORICE_RADIUS;
+/// Spline points per CA-CA (P-P) interval of the tube.
+pub const TUBE_SUBDIVISIONS: usize = 8;
+/// Largest CA-CA distance (Å) joined by the tube: 3.8 Å in a chain (2.9 Å for a cis peptide),
+/// so a longer gap is a chain break (a missing loop).
+pub const MAX_CA_GAP: f32 = 4.3;
+/// Largest P-P distance (Å) joined by the tube: 5.5-7.5 Å between nucleotides.
+pub const MAX_P_GAP: f32 = 8.0;
 
 /// Where the bonds come from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -50,6 +72,9 @@ pub enum DrawStyle {
     BallStick,
     /// Atoms and bonds all of [`LICORICE_RADIUS`].
     Licorice,
+    /// Protein and nucleic-acid backbones as a smooth tube (see the module docs); other atoms
+    /// (ligands, ions, water) as [`DrawStyle::Licorice`].
+    Tube,
 }
 
 /// The periodic-boundary treatment (frames without a cell are left as they are).
@@ -300,7 +325,7 @@ impl MolPlan {
                 }
                 scene.bond_radius = BALL_AND_STICK_BOND_RADIUS;
             }
-            DrawStyle::Licorice => {
+            DrawStyle::Licorice | DrawStyle::Tube => {
                 for r in &mut scene.radii {
                     *r = LICORICE_RADIUS;
                 }
@@ -308,9 +333,16 @@ impl MolPlan {
             }
         }
         // The selection: keep selected atoms, renumber the bonds between them.
-        let mask = match &self.options.select {
+        let mut mask = match &self.options.select {
             Some(sel) => Some(sel.evaluate(frame).map_err(failed(SelectionRole::Select))?),
             None => None,
+        };
+        let traces = match self.options.draw {
+            DrawStyle::Tube => {
+                let selected = mask.get_or_insert_with(|| vec![true; frame.n_atoms()]);
+                backbone_traces(frame, scene, selected)
+            }
+            _ => Vec::new(),
         };
         self.map.clear();
         if let Some(mask) = &mask {
@@ -345,6 +377,9 @@ impl MolPlan {
                 }
             }
         }
+        for trace in &traces {
+            push_tube(scene, trace);
+        }
         Ok(())
     }
 
@@ -356,6 +391,106 @@ impl MolPlan {
             && (0..frame.n_atoms()).all(|i| atom_element(frame, i).is_unknown());
         self.options.topology.is_none() && nothing && frame.n_atoms() > 0
     }
+}
+
+/// One backbone atom of a tube: where it is and its material.
+#[derive(Clone, Copy, Debug)]
+struct TracePoint {
+    at: glam::Vec3,
+    kind: u16,
+}
+
+/// The tube traces through the selected CA (protein) and P (nucleic) atoms of `frame`, in file
+/// order, split at chain and segment changes and at gaps; clears `selected` for every atom of a
+/// protein or nucleic residue (the tube stands for them). `scene` holds every atom of the frame,
+/// styled, in frame order.
+fn backbone_traces(
+    frame: &Frame,
+    scene: &SphereScene,
+    selected: &mut [bool],
+) -> Vec<Vec<TracePoint>> {
+    use texmap_md_io::select::{NUCLEIC_RESIDUES, PROTEIN_RESIDUES};
+    let mut traces: Vec<Vec<TracePoint>> = Vec::new();
+    if frame.res_names.is_empty() || frame.names.is_empty() {
+        return traces;
+    }
+    let label = |v: &[texmap_md_io::Label], i: usize| v.get(i).copied();
+    // The previous trace atom: its index and its gap limit.
+    let mut last: Option<(usize, f32)> = None;
+    for (i, keep) in selected.iter_mut().enumerate() {
+        let res = frame.res_names[i].as_str();
+        let (atom, gap) = if PROTEIN_RESIDUES.contains(&res) {
+            ("CA", MAX_CA_GAP)
+        } else if NUCLEIC_RESIDUES.contains(&res) {
+            ("P", MAX_P_GAP)
+        } else {
+            continue;
+        };
+        if !std::mem::replace(keep, false) || frame.names[i] != atom {
+            continue;
+        }
+        let point = TracePoint {
+            at: scene.centers[i],
+            kind: scene.kinds[i],
+        };
+        let joined = last.is_some_and(|(j, last_gap)| {
+            last_gap == gap
+                && label(&frame.chains, i) == label(&frame.chains, j)
+                && label(&frame.segments, i) == label(&frame.segments, j)
+                && point.at.distance(scene.centers[j]) <= gap
+        });
+        match traces.last_mut() {
+            Some(t) if joined => t.push(point),
+            _ => traces.push(vec![point]),
+        }
+        last = Some((i, gap));
+    }
+    traces
+}
+
+/// Appends the tube of one trace to `scene`: spline points as spheres, consecutive ones bonded.
+fn push_tube(scene: &mut SphereScene, trace: &[TracePoint]) {
+    let first = scene.centers.len() as u32;
+    let n = trace.len();
+    if n == 1 {
+        scene.push(trace[0].at, TUBE_RADIUS, trace[0].kind);
+        return;
+    }
+    // Mirrored neighbours past the ends: the spline's end tangents follow the first and last
+    // intervals.
+    let p = |k: isize| -> glam::Vec3 {
+        match k {
+            -1 => 2.0 * trace[0].at - trace[1].at,
+            k if k as usize >= n => 2.0 * trace[n - 1].at - trace[n - 2].at,
+            k => trace[k as usize].at,
+        }
+    };
+    for i in 0..n - 1 {
+        let (p0, p1, p2, p3) = (
+            p(i as isize - 1),
+            p(i as isize),
+            p(i as isize + 1),
+            p(i as isize + 2),
+        );
+        for s in 0..TUBE_SUBDIVISIONS {
+            let t = s as f32 / TUBE_SUBDIVISIONS as f32;
+            let (t2, t3) = (t * t, t * t * t);
+            let at = 0.5
+                * (2.0 * p1
+                    + (p2 - p0) * t
+                    + (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3) * t2
+                    + (3.0 * p1 - p0 - 3.0 * p2 + p3) * t3);
+            let kind = if t < 0.5 {
+                trace[i].kind
+            } else {
+                trace[i + 1].kind
+            };
+            scene.push(at, TUBE_RADIUS, kind);
+        }
+    }
+    scene.push(trace[n - 1].at, TUBE_RADIUS, trace[n - 1].kind);
+    let last = scene.centers.len() as u32;
+    scene.bonds.extend((first..last - 1).map(|k| [k, k + 1]));
 }
 
 #[cfg(test)]
@@ -468,5 +603,75 @@ mod tests {
         })
         .unwrap_err();
         assert!(matches!(e, MolError::BadRadius { rule: 0, .. }));
+    }
+
+    /// Residue-labelled atoms: `(name, residue, chain, x)` on the x axis (y = z = 0).
+    fn residues(atoms: &[(&str, &str, &str, f32)]) -> Frame {
+        let l = |s: &str| texmap_md_io::Label::new(s).unwrap();
+        let mut f = Frame::new();
+        for (k, (name, res, chain, x)) in atoms.iter().enumerate() {
+            f.positions.push([*x, 0.0, 0.0]);
+            f.names.push(l(name));
+            f.res_names.push(l(res));
+            f.res_ids.push(k as i64);
+            f.chains.push(l(chain));
+        }
+        f
+    }
+
+    #[test]
+    fn the_tube_passes_through_each_chains_ca_atoms_and_breaks_at_gaps_and_chains() {
+        let mut atoms = Vec::new();
+        for k in 0..5 {
+            atoms.push(("CA", "ALA", "A", 3.8 * k as f32));
+            atoms.push(("CB", "ALA", "A", 3.8 * k as f32 + 1.0));
+        }
+        atoms.push(("CA", "GLY", "A", 3.8 * 4.0 + 10.0)); // a gap: a lone CA
+        atoms.push(("O", "HOH", "W", 50.0)); // a water: licorice
+        atoms.push(("CA", "ALA", "B", 60.0)); // chain B, two residues 3.8 Å apart
+        atoms.push(("CA", "ALA", "B", 63.8));
+        let mut frame = residues(&atoms);
+        let options = MolOptions {
+            draw: DrawStyle::Tube,
+            ..MolOptions::default()
+        };
+        let (scene, _) = built(options.clone(), &mut frame);
+        let s = TUBE_SUBDIVISIONS;
+        // The water first (kept atoms come before the appended tube), then the traces.
+        assert_eq!(scene.len(), 1 + (4 * s + 1) + 1 + (s + 1));
+        assert_eq!(scene.centers[0].x, 50.0);
+        assert!(scene.radii.iter().all(|r| *r == TUBE_RADIUS));
+        // Chain A's tube goes through every CA (every s-th point) along the axis, monotonically.
+        let tube_a = &scene.centers[1..2 + 4 * s];
+        for k in 0..5 {
+            assert!((tube_a[k * s].x - 3.8 * k as f32).abs() < 1e-5);
+        }
+        assert!(tube_a.iter().all(|c| c.y == 0.0 && c.z == 0.0));
+        assert!(tube_a.windows(2).all(|w| w[1].x > w[0].x));
+        // Points of a straight, evenly spaced trace are evenly spaced (Catmull-Rom is linear
+        // there): the cylinders join without gaps.
+        let step = 3.8 / s as f32;
+        assert!(
+            tube_a
+                .windows(2)
+                .all(|w| (w[1].x - w[0].x - step).abs() < 1e-4)
+        );
+        // Bonds: the consecutive points of each trace, none across a break.
+        assert_eq!(scene.bonds.len(), 4 * s + s);
+        assert!(scene.bonds.iter().all(|b| b[1] == b[0] + 1));
+        assert!(
+            !scene
+                .bonds
+                .contains(&[(1 + 4 * s) as u32, (2 + 4 * s) as u32])
+        );
+        // A selection picks which backbones are drawn.
+        let mut frame = residues(&atoms);
+        let chain_b = MolOptions {
+            select: Some(sel("chain B")),
+            ..options
+        };
+        let (scene, _) = built(chain_b, &mut frame);
+        assert_eq!(scene.len(), s + 1);
+        assert_eq!(scene.centers[0].x, 60.0);
     }
 }
