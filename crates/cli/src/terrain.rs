@@ -92,8 +92,16 @@ pub enum TerrainCmd {
         /// EGM96 or EGM2008), so that the tiles get ellipsoidal heights and sit on Cesium World
         /// Terrain instead of 20-100 m above or below it. A PROJ .gtx grid (proj-data's
         /// /usr/share/proj/egm96_15.gtx) or a GeoTIFF in degrees (us_nga_egm96_15.tif).
-        #[arg(long, value_name = "GRID", requires = "tiles3d")]
+        #[arg(long, value_name = "GRID")]
         geoid: Option<PathBuf>,
+        /// Write Cesium quantized-mesh-1.0 terrain into the new directory -o: layer.json and a
+        /// TMS geographic pyramid of .terrain tiles, down to the level as fine as the grid, for
+        /// `CesiumTerrainProvider.fromUrl(".../")` (the globe's terrain under any imagery).
+        #[arg(long = "quantized-mesh", conflicts_with_all = ["tiles3d", "greedy"])]
+        quantized_mesh: bool,
+        /// With --quantized-mesh: the finest level (0-19; default: as fine as the grid).
+        #[arg(long, value_name = "LEVEL", requires = "quantized_mesh")]
+        max_level: Option<u32>,
     },
     /// Seed 000 Eq. (5)-(7): GST maps the active area needs per level, and the total.
     Maps {
@@ -249,7 +257,32 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
             greedy,
             tiles3d,
             geoid,
+            quantized_mesh,
+            max_level,
         } => {
+            if geoid.is_some() && !(tiles3d || quantized_mesh) {
+                return usage("--geoid applies to --3d-tiles and --quantized-mesh");
+            }
+            if quantized_mesh {
+                let d = Database::open(&dir)?;
+                let geoid = geoid.map(texmap_terrain::geoid::Geoid::open).transpose()?;
+                let sp = crate::commands::spinner("writing quantized-mesh terrain");
+                let options = texmap_terrain::qmesh::QuantizedMeshOptions {
+                    geoid: geoid.as_ref(),
+                    max_level,
+                };
+                let s = texmap_terrain::qmesh::write_quantized_mesh(&d, &output, &options)?;
+                sp.finish_and_clear();
+                crate::note!(
+                    "wrote {} (levels 0-{}, {} tiles, {} triangles, {:.1} MB)",
+                    output.join("layer.json").display(),
+                    s.levels - 1,
+                    s.tiles,
+                    s.triangles,
+                    s.bytes as f64 / 1e6
+                );
+                return Ok(());
+            }
             if tiles3d {
                 if greedy {
                     return usage("--greedy applies to a single mesh, not to --3d-tiles");

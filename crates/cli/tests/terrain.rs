@@ -682,3 +682,45 @@ fn export_3d_tiles_and_its_refusals() {
     assert!(err.contains("3D Tiles need"), "{err}");
     assert!(!out.exists());
 }
+
+/// `terrain export --quantized-mesh`: layer.json and the tile pyramid from a UTM grid; the
+/// finest level by --max-level; --geoid without a globe export and --quantized-mesh with
+/// --3d-tiles are usage errors (exit 2).
+#[test]
+fn export_quantized_mesh_and_its_usage_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let utm = relief_db(dir.path(), "utm.db");
+    let out = dir.path().join("qm");
+    ok(&texmap(&[
+        "terrain",
+        "export",
+        utm.to_str().unwrap(),
+        "--quantized-mesh",
+        "--max-level",
+        "9",
+        "--geoid",
+        &data("egm96_cut.gtx"),
+        "-o",
+        out.to_str().unwrap(),
+        "-q",
+    ]));
+    let layer: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("layer.json")).unwrap()).unwrap();
+    assert_eq!(layer["maxzoom"], 9);
+    assert_eq!(layer["available"].as_array().unwrap().len(), 10);
+    assert!(out.join("0/0/0.terrain").exists() && out.join("0/1/0.terrain").exists());
+    let last = &layer["available"][9][0];
+    let x = last["startX"].as_u64().unwrap();
+    let y = last["startY"].as_u64().unwrap();
+    assert!(out.join(format!("9/{x}/{y}.terrain")).exists());
+    for bad in [
+        vec!["--quantized-mesh", "--3d-tiles"],
+        vec!["--max-level", "9"],
+    ] {
+        let mut args = vec!["terrain", "export", utm.to_str().unwrap()];
+        args.extend(bad.iter().copied());
+        let o = dir.path().join("x");
+        args.extend(["-o", o.to_str().unwrap()]);
+        assert_eq!(texmap(&args).status.code(), Some(2), "{bad:?}");
+    }
+}

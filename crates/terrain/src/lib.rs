@@ -26,7 +26,8 @@
 //! - [`tiles3d`]: the database as OGC 3D Tiles 1.1 (`tileset.json` and a glTF per chunk, placed
 //!   on the WGS 84 ellipsoid through [`geodesy`]) for Cesium and the engines that stream it;
 //!   [`geoid`] turns heights above sea level into ellipsoidal heights there (EGM96 and other
-//!   geoid grids from PROJ's `.gtx` or GeoTIFF files).
+//!   geoid grids from PROJ's `.gtx` or GeoTIFF files); [`qmesh`] writes Cesium's
+//!   quantized-mesh-1.0 terrain (`layer.json` and a tile pyramid) for `CesiumTerrainProvider`.
 //! - [`relief`]: shaded relief (height colours lit by a `gdaldem`-compatible hillshade), the
 //!   texture of a database built without a photo.
 //! - [`models`]: textured OBJ models placed on the terrain by georeference and a built-in tree
@@ -77,6 +78,7 @@ pub mod greedy;
 pub mod gst;
 pub mod models;
 pub mod photo;
+pub mod qmesh;
 pub mod relief;
 pub mod rtin;
 pub mod stream;
