@@ -67,7 +67,7 @@ pub enum Command {
         /// warning (default: a cut frame is an error naming the file, frame and byte).
         #[arg(long)]
         allow_truncated: bool,
-        /// Topology (PDB, PDBx/mmCIF, GRO, PSF, LAMMPS data file) of the trajectory's atoms: its
+        /// Topology (PDB, PDBx/mmCIF, GRO, PSF, AMBER prmtop, LAMMPS data file) of the trajectory's atoms: its
         /// atom, residue and bond counts are added, and a different atom count is an error.
         #[arg(long, value_name = "FILE")]
         topology: Option<PathBuf>,
@@ -458,7 +458,7 @@ pub enum BondsArg {
     /// minimum image in a periodic box).
     #[default]
     Auto,
-    /// Only the topology's bonds (PDB CONECT, PSF !NBOND, LAMMPS data Bonds).
+    /// Only the topology's bonds (PDB CONECT, PSF !NBOND, prmtop BONDS_*, LAMMPS data Bonds).
     Topology,
     /// No bonds.
     None,
@@ -498,7 +498,8 @@ pub enum PbcArg {
 pub struct MolArgs {
     /// Topology giving names, elements, residues and bonds to a trajectory of the same atoms
     /// (XTC, DCD, TRR, NetCDF carry coordinates only): PDB (CONECT bonds), PDBx/mmCIF (.cif),
-    /// GRO, a CHARMM/NAMD PSF (.psf: !NBOND bonds), or a LAMMPS data file (.data, .lmp, data.*).
+    /// GRO, a CHARMM/NAMD PSF (.psf: !NBOND bonds), an AMBER prmtop (.prmtop, .parm7: bonds,
+    /// chains), or a LAMMPS data file (.data, .lmp, data.*).
     #[arg(long, value_name = "FILE")]
     pub topology: Option<PathBuf>,
     /// Draw only the atoms SEL selects, in the VMD/MDAnalysis language: 'not resname SOL',
@@ -550,7 +551,7 @@ stay (each is complete: written to a temporary name, then renamed) and the error
 Examples:
   texmap render traj.pdb --frames 0:100:10 --size 1280x720 -o frames/f%04d.png
   texmap render run.xtc --topology conf.gro --select 'not resname SOL' --style ball-stick --pbc unwrap -o f.png
-  texmap render md.nc --topology prmtop.pdb --color 'protein=#a0a0ff' --color 'resname LIG=#ff8000' -o f.png
+  texmap render md.nc --topology system.prmtop --color 'protein=#a0a0ff' --color 'resname LIG=#ff8000' -o f.png
   texmap render dump.lammpstrj --type-color 1=#ff8000 --type-color 2=40,40,255 --type-radius 2=0.6 -o f.png
   texmap render 1abc.cif.gz --style tube --color-by chain --select 'not water' -o chains.png
   texmap render water.gro --color-by element --type-color OW=#ff0000 --radius-scale 0.5 -o w.png

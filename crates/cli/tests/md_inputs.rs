@@ -386,3 +386,66 @@ fn tube_of_a_real_helix_matches_the_reference_ray_tracer() {
         lit(&licorice)
     );
 }
+
+/// The AMBER pair: a ParmEd prmtop labels the NetCDF trajectory of the same atoms; bonds and
+/// chains as MDAnalysis reads them from the prmtop (tests/data/gen_prmtop.py).
+#[test]
+fn amber_prmtop_and_netcdf_render_together() {
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(data("prmtop_reference.json")).unwrap())
+            .unwrap();
+    let o = texmap(&[
+        "info",
+        &data("amber_mda.ncdf"),
+        "--topology",
+        &data("prmtop_parmed.prmtop"),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let want = &r["prmtop_parmed.prmtop"];
+    assert_eq!(v["topology"]["atoms"], want["n_atoms"]);
+    assert_eq!(
+        v["topology"]["bonds"].as_u64().unwrap() as usize,
+        want["bonds"].as_array().unwrap().len()
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("f.png");
+    let o = texmap(&[
+        "render",
+        &data("amber_mda.ncdf"),
+        "--topology",
+        &data("prmtop_parmed.prmtop"),
+        "--select",
+        "resname ALA",
+        "--frames",
+        "3",
+        "--style",
+        "licorice",
+        "--bonds",
+        "topology",
+        "--size",
+        "96x72",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(out.exists());
+    // RESIDUE_CHAINID's chains reach the frames: info counts them as MDAnalysis does.
+    let o = texmap(&[
+        "info",
+        &data("chains_mda.pdb"),
+        "--topology",
+        &data("prmtop_chains.parm7"),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let mut counts: Vec<(String, u64)> = Vec::new();
+    for c in r["prmtop_chains.parm7"]["chains"].as_array().unwrap() {
+        let c = c.as_str().unwrap();
+        match counts.iter_mut().find(|(k, _)| k == c) {
+            Some((_, n)) => *n += 1,
+            None => counts.push((c.to_string(), 1)),
+        }
+    }
+    assert_eq!(v["chains"], serde_json::json!(counts));
+}

@@ -8,7 +8,7 @@
 //!   inflated once into a temporary file, so the byte offsets of a `.gz` file's errors count
 //!   decompressed bytes, except for damage to the gzip stream itself (compressed offset).
 //! - [`Topology`] reads atom names, elements, residues and bonds (PDB, PDBx/mmCIF, GRO, PSF,
-//!   LAMMPS data file) and gives them to the frames of a coordinate-only trajectory of the same
+//!   AMBER prmtop, LAMMPS data file) and gives them to the frames of a coordinate-only trajectory of the same
 //!   atoms.
 //! - [`bonds`] finds bonds by distance (covalent radii, a cell grid, minimum image) and [`pbc`]
 //!   wraps atoms into the box or makes bonded molecules whole across it.
@@ -88,6 +88,7 @@ mod netcdf;
 pub mod parse;
 pub mod pbc;
 mod pdb;
+mod prmtop;
 mod psf;
 pub mod select;
 pub mod style;

@@ -73,7 +73,7 @@ fn weight(e: Element) -> Option<f64> {
 }
 
 /// The element of an atom named `name` in residue `res` with mass `mass` (see the module docs).
-fn element_of(name: &str, res: &str, mass: f64) -> Element {
+pub(crate) fn element_of(name: &str, res: &str, mass: f64) -> Element {
     let guess = guess_element(name, Some(res), None);
     let fits = weight(guess).is_some_and(|w| (w - mass).abs() <= 1.5);
     if fits || !(mass.is_finite() && mass > 0.5) {

@@ -15,6 +15,8 @@
 //!   come from the distance-based finder ([`crate::bonds`]);
 //! - **PSF** (CHARMM, NAMD, X-PLOR): atoms with segment-free residues, types and masses, and the
 //!   `!NBOND` section (module `psf`: elements from names, checked against the masses);
+//! - **AMBER prmtop** (`.prmtop`, `.parm7`): atoms, types, elements from `ATOMIC_NUMBER`,
+//!   residues, chains (`RESIDUE_CHAINID`) and both bond sections (module `prmtop`);
 //! - **LAMMPS data file** (`.data`, `.lmp`, or a name starting `data.`): the `Atoms` section in
 //!   the styles `full`, `molecular` (and its column-equal `bond`, `angle`), `atomic` and
 //!   `charge`, told by the `Atoms # style` comment or, without one, by the column count (as
@@ -56,11 +58,13 @@ pub enum TopologyFormat {
     LammpsData,
     /// CHARMM/NAMD/X-PLOR PSF: `!NATOM` and `!NBOND` sections (see the `psf` module).
     Psf,
+    /// AMBER prmtop/parm7: atoms, residues, bonds and chains (see the `prmtop` module).
+    Prmtop,
 }
 
 impl TopologyFormat {
-    /// The format a path names: `.pdb`/`.ent`, `.gro`, `.cif`/`.mmcif`, `.psf`, `.data`/`.lmp` or
-    /// `data.*` (LAMMPS). A final `.gz` is looked through (`top.psf.gz` is PSF, read
+    /// The format a path names: `.pdb`/`.ent`, `.gro`, `.cif`/`.mmcif`, `.psf`,
+    /// `.prmtop`/`.parm7` (AMBER), `.data`/`.lmp` or `data.*` (LAMMPS). A final `.gz` is looked through (`top.psf.gz` is PSF, read
     /// decompressed by [`Topology::open`]).
     pub fn from_path(path: &Path) -> Option<TopologyFormat> {
         let path = crate::gz::inner_path(path);
@@ -75,6 +79,7 @@ impl TopologyFormat {
             "cif" | "mmcif" => TopologyFormat::Mmcif,
             "data" | "lmp" => TopologyFormat::LammpsData,
             "psf" => TopologyFormat::Psf,
+            "prmtop" | "parm7" => TopologyFormat::Prmtop,
             _ => return None,
         })
     }
@@ -99,7 +104,7 @@ pub struct Topology {
     pub res_names: Vec<Label>,
     /// Residue numbers (LAMMPS: molecule ids).
     pub res_ids: Vec<i64>,
-    /// Chain identifiers (PDB, mmCIF).
+    /// Chain identifiers (PDB, mmCIF, AMBER `RESIDUE_CHAINID`).
     pub chains: Vec<Label>,
     /// Segment identifiers (PSF `segid`, PDB columns 73-76).
     pub segments: Vec<Label>,
@@ -210,7 +215,7 @@ impl Topology {
         let Some(format) = TopologyFormat::from_path(path) else {
             return Err(Error::Unsupported {
                 file: name,
-                what: "topology format (expected .pdb, .gro, .cif/.mmcif, .psf, or a LAMMPS data file: .data, .lmp, data.*)",
+                what: "topology format (expected .pdb, .gro, .cif/.mmcif, .psf, .prmtop/.parm7, or a LAMMPS data file: .data, .lmp, data.*)",
             });
         };
         Topology::open_as(path, format)
@@ -268,6 +273,7 @@ impl Topology {
             }
             TopologyFormat::LammpsData => lammps_data(src, &file),
             TopologyFormat::Psf => crate::psf::read_psf(src, &file),
+            TopologyFormat::Prmtop => crate::prmtop::read_prmtop(src, &file),
         }
     }
 

@@ -1,6 +1,6 @@
 //! Damaged topology files (the MDAnalysis-written PDB with CONECT, LAMMPS data file and GRO,
-//! ParmEd's PSF and gemmi's mmCIF of tests/data, cut at every line end and at seeded offsets,
-//! with seeded bit flips and byte replacements): never a panic, and every error names the file
+//! ParmEd's PSF and prmtop and gemmi's mmCIF of tests/data, cut at every line end and at seeded
+//! offsets, with seeded bit flips and byte replacements): never a panic, and every error names the file
 //! and, for damage inside the file, the line or byte.
 
 use std::io::Cursor;
@@ -72,6 +72,7 @@ fn damaged_topologies_give_located_errors_never_panics() {
         ("topo_mda.gro", TopologyFormat::Gro),
         ("psf_parmed.psf", TopologyFormat::Psf),
         ("gemmi_topo.cif", TopologyFormat::Mmcif),
+        ("prmtop_parmed.prmtop", TopologyFormat::Prmtop),
     ] {
         let good = data(file);
         assert!(check(&good, format, file));
