@@ -7,8 +7,9 @@
 //!
 //! # Guarantees of a frame filled by a reader
 //! - every per-atom vector is either empty (the file does not have that column) or exactly
-//!   [`Frame::n_atoms`] long;
-//! - positions (and velocities, radii, colours) are finite: a reader rejects NaN and infinities;
+//!   [`Frame::n_atoms`] long, and so is every property's;
+//! - positions (and velocities, radii, colours) are finite: a reader rejects NaN and infinities
+//!   (property values are NaN only where a LAMMPS dump writes `nan` or `inf`);
 //! - positions lie within ±[`MAX_COORDINATE`] Å and cell lengths are at most that: a finite but
 //!   absurd value (1e38 from a flipped exponent bit, a cell of 1e300) is a damaged file, reported
 //!   by the reader with the file, frame and atom, not a failure later in a renderer's camera;
@@ -313,8 +314,22 @@ pub struct Frame {
     /// ColorB` / `Color.R …`), sRGB-encoded RGB stored as written: normally in [0, 1], but a file
     /// may hold values outside it ([`crate::AtomStyle`] clamps them for drawing).
     pub colors: Vec<[f32; 3]>,
+    /// Named per-atom numbers, in the file's column order: PDB and mmCIF `occupancy` and
+    /// `bfactor`, every LAMMPS dump column not read into another field (`q`, `mass`, `c_pe`,
+    /// `v_stress`, `fx`, ...), extended-XYZ real or integer columns of one component. What
+    /// OVITO calls particle properties and colours by; see [`Frame::property`].
+    pub properties: Vec<Property>,
     /// The frame's title / comment line (XYZ comment, GRO title, PDB TITLE), if any.
     pub comment: String,
+}
+
+/// One named per-atom number column of a [`Frame`].
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Property {
+    /// The column's name as the file writes it (`bfactor`, `c_pe`, `v_stress[1]`).
+    pub name: String,
+    /// One value per atom: finite, except where a LAMMPS dump writes `nan` or `inf` (NaN).
+    pub values: Vec<f32>,
 }
 
 impl Frame {
@@ -345,7 +360,31 @@ impl Frame {
         self.segments.clear();
         self.radii.clear();
         self.colors.clear();
+        self.properties.clear();
         self.comment.clear();
+    }
+
+    /// The values of the property named `name` (exact match), if the frame has it.
+    pub fn property(&self, name: &str) -> Option<&[f32]> {
+        self.properties
+            .iter()
+            .find(|p| p.name == name)
+            .map(|p| p.values.as_slice())
+    }
+
+    /// The values of the property `name`, a new empty one added if the frame has none yet.
+    pub(crate) fn property_mut(&mut self, name: &str) -> &mut Vec<f32> {
+        let k = match self.properties.iter().position(|p| p.name == name) {
+            Some(k) => k,
+            None => {
+                self.properties.push(Property {
+                    name: name.to_string(),
+                    values: Vec::new(),
+                });
+                self.properties.len() - 1
+            }
+        };
+        &mut self.properties[k].values
     }
 
     /// Checks the guarantees of a frame (see the module doc); the message names the first broken
@@ -386,6 +425,15 @@ impl Frame {
         }
         if let Some(i) = finite3(&self.colors) {
             return Err(format!("colour of atom {i} is not finite"));
+        }
+        for p in &self.properties {
+            if p.values.len() != n {
+                return Err(format!(
+                    "property {} has {} entries but there are {n} atoms",
+                    p.name,
+                    p.values.len()
+                ));
+            }
         }
         Ok(())
     }

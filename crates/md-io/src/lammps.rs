@@ -16,7 +16,10 @@
 //! `xs ys zs` (scaled), `xu yu zu` (unwrapped), `xsu ysu zsu` (scaled unwrapped); scaled ones
 //! become Cartesian as origin + s·M with the frame's box (f64). Also read: `id`, `type`,
 //! `element` (→ elements; else elements are guessed from non-numeric types), `vx vy vz`,
-//! `radius`, `diameter` (halved), the colour columns below, `mass`/`q`/others skipped.
+//! `radius`, `diameter` (halved), the colour columns below. Every other column (`q`, `mass`,
+//! `c_pe`, `v_stress[1]`, `fx`, `ix`, a partial velocity or colour, ...) is a property named by
+//! its header ([`Frame::property`]), as OVITO imports it: a number per atom, NaN where LAMMPS
+//! writes `nan` or `inf` (drawn grey when coloured by), an error for anything else.
 //!
 //! # Colour columns
 //! Per-atom colours (sRGB in [0, 1], into [`Frame::colors`]) come from the column names OVITO's
@@ -62,6 +65,8 @@ enum Act {
     Color(usize),
     Radius,
     Diameter,
+    /// A named number column: `Frame::properties[k]`.
+    Property(usize),
     Skip,
 }
 
@@ -82,6 +87,8 @@ enum Units {
 /// LAMMPS dump parser state: column actions and the scratch buffers of the sort by id.
 pub(crate) struct Lammps {
     acts: Vec<Act>,
+    /// The names of the `Act::Property` columns, in column order.
+    properties: Vec<String>,
     units: Units,
     perm: Vec<(i64, u32)>,
     s3: Vec<[f32; 3]>,
@@ -109,6 +116,7 @@ impl Default for Lammps {
     fn default() -> Self {
         Lammps {
             acts: Vec::new(),
+            properties: Vec::new(),
             units: Units::Unknown,
             perm: Vec::new(),
             s3: Vec::new(),
@@ -117,6 +125,18 @@ impl Default for Lammps {
             si: Vec::new(),
             sf: Vec::new(),
         }
+    }
+}
+
+/// The value of a field LAMMPS writes for a non-finite number (`nan`, `-nan`, `inf`, `-inf`).
+fn non_finite(f: &[u8]) -> Option<f32> {
+    let f = f.strip_prefix(b"-").or(f.strip_prefix(b"+")).unwrap_or(f);
+    if f.eq_ignore_ascii_case(b"nan") {
+        Some(f32::NAN)
+    } else if f.eq_ignore_ascii_case(b"inf") || f.eq_ignore_ascii_case(b"infinity") {
+        Some(f32::INFINITY)
+    } else {
+        None
     }
 }
 
@@ -314,6 +334,7 @@ impl Lammps {
     /// Maps the ATOMS column names to actions.
     fn columns(&mut self, ctx: &Ctx, pos: Pos, line: &[u8], spec: &[u8]) -> Result<PosKind, Error> {
         self.acts.clear();
+        self.properties.clear();
         const SETS: [(&[&[u8]; 3], PosKind); 4] = [
             (&[b"x", b"y", b"z"], PosKind::Cartesian),
             (&[b"xs", b"ys", b"zs"], PosKind::Scaled),
@@ -355,23 +376,30 @@ impl Lammps {
             };
             self.acts.push(act);
         }
-        // A partial velocity or colour is not one: skip those columns.
+        // A partial velocity or colour is not one: those columns are properties.
         let vel = (0..3).filter(|k| self.acts.contains(&Act::Vel(*k))).count();
-        if vel != 0 && vel != 3 {
-            for a in &mut self.acts {
-                if matches!(a, Act::Vel(_)) {
-                    *a = Act::Skip;
-                }
-            }
-        }
         let rgb = (0..3)
             .filter(|k| self.acts.contains(&Act::Color(*k)))
             .count();
-        if rgb != 0 && rgb != 3 {
-            for a in &mut self.acts {
-                if matches!(a, Act::Color(_)) {
-                    *a = Act::Skip;
-                }
+        for a in &mut self.acts {
+            let partial = match a {
+                Act::Vel(_) => vel != 3,
+                Act::Color(_) => rgb != 3,
+                _ => false,
+            };
+            if partial {
+                *a = Act::Skip;
+            }
+        }
+        // Every other column, named once, is a property.
+        for (a, name) in self.acts.iter_mut().zip(fields(spec)) {
+            if *a != Act::Skip {
+                continue;
+            }
+            let name = String::from_utf8_lossy(name).into_owned();
+            if !self.properties.contains(&name) {
+                *a = Act::Property(self.properties.len());
+                self.properties.push(name);
             }
         }
         Ok(kind)
@@ -398,6 +426,12 @@ impl TextFormat for Lammps {
             1.0
         };
         frame.positions.reserve(h.n.min(ctx.reserve));
+        for name in &self.properties {
+            frame.properties.push(crate::frame::Property {
+                name: name.clone(),
+                values: Vec::with_capacity(h.n.min(ctx.reserve)),
+            });
+        }
         // Atom lines: one pass over each line's fields with the column actions.
         for i in 0..h.n {
             let p = lines.pos();
@@ -465,6 +499,12 @@ impl TextFormat for Lammps {
                             .radii
                             .push(if act == Act::Diameter { r * 0.5 } else { r });
                     }
+                    Act::Property(k) => {
+                        let v = parse_f32(f)
+                            .or_else(|| non_finite(f))
+                            .ok_or_else(|| ctx.parse(pos, line, f, "a number"))?;
+                        frame.properties[k].values.push(v);
+                    }
                     Act::Skip => {}
                 }
             }
@@ -511,6 +551,9 @@ impl TextFormat for Lammps {
             permute(&mut frame.elements, perm, &mut self.se);
             permute(&mut frame.radii, perm, &mut self.sf);
             permute(&mut frame.ids, perm, &mut self.si);
+            for p in &mut frame.properties {
+                permute(&mut p.values, perm, &mut self.sf);
+            }
         }
         Ok(true)
     }

@@ -12,8 +12,9 @@
 //!   [`crate::elements::guess_element`] from the names. These are the fields the PDB reader fills
 //!   from the same structure's ATOM/HETATM records, so selections read a `.pdb` and its `.cif`
 //!   alike; and the chain from `auth_asym_id`, else `label_asym_id` (gemmi's chain name).
-//!   `group_PDB`, insertion codes, occupancies and B-factors have no place in a [`Frame`] and are
-//!   not kept (nor by the PDB reader).
+//!   `occupancy` and `B_iso_or_equiv` become the `occupancy` and `bfactor` properties
+//!   ([`Frame::property`]; a missing value is 1 and 0, as in the PDB reader). `group_PDB` and
+//!   insertion codes have no place in a [`Frame`] and are not kept.
 //! - `pdbx_PDB_model_num` splits the rows into frames (NMR ensembles): each change of model
 //!   number starts a frame; numbers must increase, and every model must hold as many atoms as
 //!   model 1 (an error, or a warning under `ReadOptions::allow_truncated`, as for PDB). Without
@@ -286,6 +287,8 @@ enum Role {
     Comp(usize),
     Seq(usize),
     Asym(usize),
+    /// `occupancy` and `B_iso_or_equiv`: the frame's `occupancy` and `bfactor` properties.
+    Scalar(usize),
     Other,
 }
 
@@ -308,6 +311,8 @@ fn role(item: &[u8]) -> Role {
         b"auth_seq_id" => Role::Seq(1),
         b"label_asym_id" => Role::Asym(0),
         b"auth_asym_id" => Role::Asym(1),
+        b"occupancy" => Role::Scalar(0),
+        b"b_iso_or_equiv" => Role::Scalar(1),
         _ => Role::Other,
     }
 }
@@ -457,6 +462,8 @@ struct Row {
     comp: [Option<Label>; 2],
     seq: [Option<i64>; 2],
     asym: [Option<Label>; 2],
+    /// Occupancy and B-factor (`None` when missing).
+    scalar: [Option<f32>; 2],
     /// Keys for the alternate-location filter (`[label, auth]`, 0 when missing).
     atom_key: [u64; 2],
     comp_key: [u64; 2],
@@ -486,6 +493,13 @@ enum Phase {
     Rows,
 }
 
+/// The properties of the `Role::Scalar` columns: name, what a bad value should have been, the
+/// value of a missing one (`?` or `.`), as MDAnalysis and the PDB reader fill blanks.
+const SCALAR_NAMES: [(&str, &str, f32); 2] = [
+    ("occupancy", "a number for _atom_site.occupancy", 1.0),
+    ("bfactor", "a number for _atom_site.B_iso_or_equiv", 0.0),
+];
+
 /// `Cartn_x/y/z` errors, by axis.
 const NOT_A_COORDINATE: [&str; 3] = [
     "a number for _atom_site.Cartn_x",
@@ -509,6 +523,8 @@ struct Parser {
     cols: Vec<Role>,
     /// Which optional columns exist: id, atom name, residue name, residue number, chain.
     has: [bool; 5],
+    /// Whether the loop has the occupancy and B-factor columns.
+    has_scalar: [bool; 2],
     /// `_cell` values and where the first one is; the cell built from them.
     cell_values: [Option<f64>; 6],
     cell_at: Option<Pos>,
@@ -822,6 +838,7 @@ impl Parser {
             any(Role::Seq),
             any(Role::Asym),
         ];
+        self.has_scalar = [has(Role::Scalar(0)), has(Role::Scalar(1))];
         self.cell = self.unit_cell(ctx)?;
         Ok(())
     }
@@ -972,6 +989,12 @@ impl Parser {
                     row.seq[k] = Some(s);
                 }
             }
+            Role::Scalar(k) if read && !tok.missing() => {
+                let v = parse_f32(strip_esd(tok.text))
+                    .filter(|v| v.is_finite())
+                    .ok_or_else(|| tok.error(ctx, SCALAR_NAMES[k].1))?;
+                row.scalar[k] = Some(v);
+            }
             Role::Model => {
                 let m = (!tok.missing())
                     .then(|| parse_i64(tok.text))
@@ -1049,6 +1072,11 @@ impl Parser {
         if has_chain {
             f.chains
                 .push(row.asym[1].or(row.asym[0]).unwrap_or_default());
+        }
+        for (k, (name, _, missing)) in SCALAR_NAMES.iter().enumerate() {
+            if self.has_scalar[k] {
+                f.property_mut(name).push(row.scalar[k].unwrap_or(*missing));
+            }
         }
     }
 }

@@ -2,8 +2,10 @@
 //!
 //! Records used (1-based columns, PDB format v3.3):
 //! - `ATOM`/`HETATM`: serial 7-11 (hybrid-36 past 99,999), name 13-16, residue name 18-21,
-//!   chain 22, residue number 23-26 (hybrid-36 past 9,999), x y z 31-38, 39-46, 47-54, segment
-//!   73-76, element 77-78. A frame whose chain (or segment) fields are all blank has no chain
+//!   chain 22, residue number 23-26 (hybrid-36 past 9,999), x y z 31-38, 39-46, 47-54,
+//!   occupancy 55-60 and B-factor 61-66 (the `occupancy` and `bfactor` properties; a frame
+//!   whose fields are all blank has neither, a blank among numbers is 1 and 0), segment 73-76,
+//!   element 77-78. A frame whose chain (or segment) fields are all blank has no chain
 //!   (segment) column, so `chain A` on it is an error rather than an empty selection;
 //! - `CRYST1`: a b c 7-15, 16-24, 25-33, α β γ 34-40, 41-47, 48-54. A cell of 1 Å x 1 Å x 1 Å
 //!   with right angles is the conventional "no cell" placeholder and is dropped (as MDAnalysis
@@ -33,6 +35,10 @@ use crate::frame::{Frame, Label, UnitCell};
 use crate::parse::{parse_f32, parse_f64, trim};
 use crate::text::{Ctx, FrameWalk, LineReader, ModelCheck, Pos};
 use std::io::Read;
+
+/// The properties of columns 55-60 and 61-66, and the value of a blank field in a frame whose
+/// other atoms have one (MDAnalysis's defaults: occupancy 1, B-factor 0).
+const SCALARS: [(&str, f32); 2] = [("occupancy", 1.0), ("bfactor", 0.0)];
 
 /// Value of a base-36 digit in the given alphabet half (upper or lower case), else `None`.
 fn digit36(b: u8, upper: bool) -> Option<u64> {
@@ -207,6 +213,22 @@ impl Pdb {
         let seg_f = trim(cols(line, 73, 76));
         let segment = Label::from_utf8(seg_f)
             .ok_or_else(|| ctx.parse(pos, line, seg_f, "a segment identifier in columns 73-76"))?;
+        // Occupancy 55-60 and B-factor 61-66; a blank field is NaN until the frame ends.
+        let mut scalars = [f32::NAN; 2];
+        for (k, (a, b, what)) in [
+            (55, 60, "an occupancy in columns 55-60"),
+            (61, 66, "a B-factor in columns 61-66"),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let f = trim(cols(line, a, b));
+            if !f.is_empty() {
+                scalars[k] = parse_f32(f)
+                    .filter(|v| v.is_finite())
+                    .ok_or_else(|| ctx.parse(pos, line, f, what))?;
+            }
+        }
         let elem = std::str::from_utf8(trim(cols(line, 77, 78))).ok();
         let element = guess_element(&name, Some(&res), elem.filter(|e| !e.is_empty()));
         frame.positions.push(p);
@@ -217,14 +239,31 @@ impl Pdb {
         frame.chains.push(chain);
         frame.segments.push(segment);
         frame.elements.push(element);
+        for (k, (name, _)) in SCALARS.iter().enumerate() {
+            frame.property_mut(name).push(scalars[k]);
+        }
         Ok(())
     }
 
-    /// Drops the chain and segment columns of a finished frame when every field was blank.
+    /// Drops the chain and segment columns of a finished frame when every field was blank, and
+    /// the occupancy and B-factor properties when every field was; fills the blanks of the
+    /// others with [`SCALARS`]' defaults.
     fn finish(frame: &mut Frame) {
         for column in [&mut frame.chains, &mut frame.segments] {
             if column.iter().all(|l| l.is_empty()) {
                 column.clear();
+            }
+        }
+        for (name, missing) in SCALARS {
+            if let Some(k) = frame.properties.iter().position(|p| p.name == name) {
+                let values = &mut frame.properties[k].values;
+                if values.iter().all(|v| v.is_nan()) {
+                    frame.properties.remove(k);
+                } else {
+                    for v in values.iter_mut().filter(|v| v.is_nan()) {
+                        *v = missing;
+                    }
+                }
             }
         }
     }
@@ -354,6 +393,17 @@ impl<W: std::io::Write> PdbWriter<W> {
         if let Some(i) = frame.segments.iter().position(|l| l.len() > 4) {
             return Err(format!("atom {i}'s segment is longer than 4 characters"));
         }
+        for (name, _) in SCALARS {
+            let fits = |v: &f32| (-99.995..999.995).contains(v);
+            if let Some(i) = frame
+                .property(name)
+                .and_then(|v| v.iter().position(|v| !fits(v)))
+            {
+                return Err(format!(
+                    "atom {i}'s {name} does not fit PDB's 6 columns (-99.99 to 999.99)"
+                ));
+            }
+        }
         if frame.n_atoms() > 87_440_031 {
             return Err("more atoms than hybrid-36 serial numbers".into());
         }
@@ -372,6 +422,8 @@ impl<W: std::io::Write> PdbWriter<W> {
             )?;
         }
         writeln!(w, "MODEL     {:>4}", self.models)?;
+        let occupancy = frame.property("occupancy");
+        let bfactor = frame.property("bfactor");
         for (i, p) in frame.positions.iter().enumerate() {
             let serial = frame.ids.get(i).copied().unwrap_or(i as i64 + 1);
             // Serials past hybrid-36's range were rejected by `check`; wrap defensively.
@@ -410,7 +462,11 @@ impl<W: std::io::Write> PdbWriter<W> {
             writeln!(
                 w,
                 "ATOM  {serial}{name:>5} {res:<4}{chain}{resid}    {:8.3}{:8.3}{:8.3}{:6.2}{:6.2}      {seg:<4}{sym:>2}",
-                p[0], p[1], p[2], 1.0, 0.0
+                p[0],
+                p[1],
+                p[2],
+                occupancy.map_or(1.0, |v| v[i]),
+                bfactor.map_or(0.0, |v| v[i])
             )?;
         }
         writeln!(w, "ENDMDL")

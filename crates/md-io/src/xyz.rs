@@ -7,8 +7,10 @@
 //! - `Properties=name:type:count:...` with type S (string), R (real), I (integer), L (logical):
 //!   the columns of the atom lines. Known names: `species` (→ names and elements), `pos`,
 //!   `velo`/`vel`/`velocities` (Å/ps, stored as given), `radius`/`radii`, `color`/`colors`
-//!   (R:3, sRGB in [0, 1]), `type` (→ types), `id` (→ ids), `Z` (→ elements); other columns are
-//!   skipped. Without `Properties` the columns are `species:S:1:pos:R:3`.
+//!   (R:3, sRGB in [0, 1]), `type` (→ types), `id` (→ ids), `Z` (→ elements); every other real
+//!   or integer column of one component (ASE's `masses`, `initial_charges`, `energies`, ...) is
+//!   a property of that name ([`Frame::property`]); the rest are skipped. Without `Properties`
+//!   the columns are `species:S:1:pos:R:3`.
 //! - `Time=` (ps) and `step=`/`Step=`/`timestep=` when present.
 //!
 //! Elements come from the species by [`crate::elements::guess_element`] (species are normally
@@ -34,6 +36,8 @@ enum Col {
     Type,
     Id,
     Z,
+    /// A real or integer column of one component: property `k` of `Xyz::properties`.
+    Property(usize),
     Skip(usize),
 }
 
@@ -41,6 +45,8 @@ enum Col {
 #[derive(Default)]
 pub(crate) struct Xyz {
     cols: Vec<Col>,
+    /// The names of the `Col::Property` columns, in column order.
+    properties: Vec<String>,
     species: Vec<(Label, Element)>,
 }
 
@@ -124,6 +130,7 @@ impl Xyz {
         frame: &mut Frame,
     ) -> Result<(), Error> {
         self.cols.clear();
+        self.properties.clear();
         for (key, value) in key_values(line) {
             if key.eq_ignore_ascii_case(b"Lattice") {
                 let mut m = [0.0f64; 9];
@@ -186,6 +193,15 @@ impl Xyz {
                 b"type" if count == 1 => Col::Type,
                 b"id" if ty == b"I" && count == 1 => Col::Id,
                 b"Z" if ty == b"I" && count == 1 => Col::Z,
+                _ if (ty == b"R" || ty == b"I") && count == 1 => {
+                    let name = String::from_utf8_lossy(name).into_owned();
+                    if self.properties.contains(&name) {
+                        Col::Skip(1)
+                    } else {
+                        self.properties.push(name);
+                        Col::Property(self.properties.len() - 1)
+                    }
+                }
                 _ => Col::Skip(count),
             };
             has_pos |= col == Col::Pos;
@@ -251,6 +267,17 @@ impl Xyz {
                             .ok_or_else(|| ctx.parse(pos, line, f, "an atomic number 1..=103"))?;
                         frame.elements.push(e);
                     }
+                }
+                Col::Property(k) => {
+                    let f = it.next().unwrap_or(end);
+                    let v = parse_f32(f).ok_or_else(|| ctx.parse(pos, line, f, "a number"))?;
+                    if frame.properties.len() == k {
+                        frame.properties.push(crate::frame::Property {
+                            name: self.properties[k].clone(),
+                            values: Vec::new(),
+                        });
+                    }
+                    frame.properties[k].values.push(v);
                 }
                 Col::Skip(n) => {
                     for _ in 0..n {
