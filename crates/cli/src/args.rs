@@ -126,7 +126,8 @@ pub enum MethodArg {
     Reference,
 }
 
-#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+/// `--color-by`: a colour source, or a number per atom coloured through `--colormap`.
+#[derive(Clone, Debug, PartialEq)]
 pub enum ColorBy {
     /// The file's per-atom colour columns (extended XYZ `color`, LAMMPS dump `ColorR ColorG
     /// ColorB`) where it has them, else --type-color, else element colours.
@@ -138,6 +139,59 @@ pub enum ColorBy {
     /// --type-color, else one distinct colour per chain (PDB column 22, mmCIF auth_asym_id),
     /// or per segment (PSF, PDB columns 73-76) when the file has no chains.
     Chain,
+    /// A number per atom through --colormap.
+    Scalar(texmap_md_scene::ScalarSource),
+}
+
+/// Parses `--color-by`: a keyword, or the name of a per-atom property of the file.
+pub fn parse_color_by(s: &str) -> Result<ColorBy, String> {
+    use texmap_md_scene::ScalarSource;
+    Ok(match s {
+        "property" => ColorBy::Property,
+        "element" => ColorBy::Element,
+        "type" => ColorBy::Type,
+        "chain" => ColorBy::Chain,
+        "speed" | "velocity" => ColorBy::Scalar(ScalarSource::Speed),
+        "residue" | "resid" => ColorBy::Scalar(ScalarSource::Residue),
+        "index" => ColorBy::Scalar(ScalarSource::Index),
+        "beta" | "b" => ColorBy::Scalar(ScalarSource::Property("bfactor".into())),
+        "" => return Err("expected a colour source or a property name".into()),
+        name => ColorBy::Scalar(ScalarSource::Property(name.to_string())),
+    })
+}
+
+/// The colour maps of `--colormap`.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ColormapArg {
+    /// Perceptually uniform, dark blue to yellow (matplotlib's default).
+    Viridis,
+    /// Perceptually uniform, dark blue through magenta to yellow.
+    Plasma,
+    /// Diverging blue-white-red, for signed values such as charges.
+    Coolwarm,
+    /// Rainbow (Google's Turbo), as VMD's default colour scale looks.
+    Turbo,
+    /// Black to white.
+    Gray,
+}
+
+/// Parses `--color-range LO:HI` (finite, LO < HI).
+pub fn parse_color_range(s: &str) -> Result<(f32, f32), String> {
+    let (lo, hi) = s
+        .split_once(':')
+        .ok_or_else(|| format!("{s:?}: expected LO:HI, e.g. 0:80"))?;
+    let num = |t: &str| {
+        t.trim()
+            .parse::<f32>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| format!("{t:?} is not a finite number"))
+    };
+    let (lo, hi) = (num(lo)?, num(hi)?);
+    if lo >= hi {
+        return Err(format!("{s}: LO must be below HI"));
+    }
+    Ok((lo, hi))
 }
 
 /// `--type-radius NAME=R`: the radius in Å of the atoms NAME selects.
@@ -222,9 +276,43 @@ pub fn parse_type_color(s: &str) -> Result<TypeColor, String> {
 #[derive(Args, Clone, Debug)]
 #[command(next_help_heading = "Atom style")]
 pub struct StyleArgs {
-    /// How atoms are coloured.
-    #[arg(long, value_enum, default_value_t = ColorBy::Property)]
+    /// How atoms are coloured: property (the file's colour columns, the default), element,
+    /// type, chain, or a number per atom through --colormap: bfactor, occupancy, speed, residue,
+    /// index or any per-atom column of the file (a LAMMPS dump's c_pe or q, an extended-XYZ
+    /// array).
+    #[arg(
+        long,
+        value_name = "SOURCE",
+        default_value = "property",
+        value_parser = parse_color_by,
+        long_help = "How atoms are coloured.\n\
+  property   the file's per-atom colour columns (extended XYZ `color`, LAMMPS `ColorR ColorG\n\
+             ColorB`) where it has them, else --type-color, else element colours (default)\n\
+  element    --type-color, else element colours (CPK/Jmol)\n\
+  type       --type-color, else one distinct colour per atom type (or name)\n\
+  chain      --type-color, else one colour per chain (or per segment without chains)\n\
+A number per atom, mapped through --colormap over --color-range (default: the range of the\n\
+first frame's drawn atoms, then fixed, so a colour means one value in every frame) with a\n\
+colour bar (--no-color-bar to leave it out):\n\
+  bfactor, occupancy   PDB columns 61-66 / 55-60, mmCIF B_iso_or_equiv / occupancy\n\
+  speed                |v| in Å/ps (GRO, TRR, NetCDF, LAMMPS vx vy vz, extended XYZ velo)\n\
+  residue              the residue's position in the file, 0, 1, 2, ... (a rainbow along chains)\n\
+  index                the atom index\n\
+  NAME                 any other per-atom column: a LAMMPS dump's c_pe, v_stress, q, mass, an\n\
+                       extended-XYZ array (`texmap info FILE` lists them as `properties`)\n\
+Examples: --color-by bfactor --colormap coolwarm   --color-by c_pe --color-range=-4:-2"
+    )]
     pub color_by: ColorBy,
+    /// The colour map of a numeric --color-by.
+    #[arg(long, value_enum, default_value_t = ColormapArg::Viridis)]
+    pub colormap: ColormapArg,
+    /// The values mapped to the colour map's ends, LO:HI (a numeric --color-by); values beyond
+    /// take the end colours. Default: the first frame's range over the drawn atoms.
+    #[arg(long, value_name = "LO:HI", value_parser = parse_color_range, allow_hyphen_values = true)]
+    pub color_range: Option<(f32, f32)>,
+    /// Leave out the colour bar a numeric --color-by draws at the right edge.
+    #[arg(long)]
+    pub no_color_bar: bool,
     /// Multiply every atom radius (file column, --type-radius or table) by S.
     #[arg(long, default_value_t = 1.0, value_name = "S")]
     pub radius_scale: f32,

@@ -183,6 +183,11 @@ fn info(
             obj[key] = json!(label_counts(labels));
         }
     }
+    // Per-atom numbers a --color-by can name.
+    if !frame.properties.is_empty() {
+        let names: Vec<&str> = frame.properties.iter().map(|p| p.name.as_str()).collect();
+        obj["properties"] = json!(names);
+    }
     if !topo_json.is_null() {
         obj["topology"] = topo_json;
     }
@@ -375,6 +380,9 @@ fn render(a: &RenderArgs) -> Result<()> {
         if camera.is_none() {
             // First frame: the camera, and warnings about the style flags.
             for w in builder.warnings(&md) {
+                if matches!(w, texmap_md_scene::StyleWarning::NoScalar { .. }) {
+                    return Err(fail(anyhow::anyhow!(warning_text(&w)), &written));
+                }
                 pb.suspend(|| eprintln!("texmap: warning: {}", warning_text(&w)));
             }
             if let Some(w) = crate::scene::unnamed_warning(&plan, &md, traj.name()) {
@@ -450,6 +458,8 @@ fn render(a: &RenderArgs) -> Result<()> {
             )
             .map_err(|e| fail(e.into(), &written))?,
         };
+        let mut out = out;
+        crate::scene::draw_color_bar(&builder, &a.style, &mut out);
         let files = sink
             .write(f, &out, a.depth)
             .map_err(|e| fail(e, &written))?;

@@ -14,9 +14,11 @@ use texmap_md_scene::{
     RuleKind, SelectionRole, StyleError, StyleOptions, StyleWarning, ViewAxis,
 };
 
+use texmap_md_scene::Colormap;
+
 use crate::args::{
-    BondsArg, ColorBy, DrawStyle, MolArgs, PathArgs, PbcArg, StyleArgs, ViewArgs, parse_color,
-    usage,
+    BondsArg, ColorBy, ColormapArg, DrawStyle, MolArgs, PathArgs, PbcArg, StyleArgs, ViewArgs,
+    parse_color, usage,
 };
 
 pub use texmap_md_scene::{MAX_MATERIALS, SceneBuilder};
@@ -30,6 +32,21 @@ pub fn style_options(args: &StyleArgs) -> StyleOptions {
             ColorBy::Element => texmap_md_scene::ColorBy::Element,
             ColorBy::Type => texmap_md_scene::ColorBy::Type,
             ColorBy::Chain => texmap_md_scene::ColorBy::Chain,
+            ColorBy::Scalar(_) => texmap_md_scene::ColorBy::Scalar,
+        },
+        scalar: texmap_md_scene::ScalarColor {
+            source: match &args.color_by {
+                ColorBy::Scalar(s) => s.clone(),
+                _ => texmap_md_scene::ScalarSource::Index,
+            },
+            map: match args.colormap {
+                ColormapArg::Viridis => Colormap::Viridis,
+                ColormapArg::Plasma => Colormap::Plasma,
+                ColormapArg::Coolwarm => Colormap::Coolwarm,
+                ColormapArg::Turbo => Colormap::Turbo,
+                ColormapArg::Gray => Colormap::Gray,
+            },
+            range: args.color_range,
         },
         radius_scale: args.radius_scale,
         type_radius: args
@@ -56,6 +73,34 @@ pub fn scene_builder(args: &StyleArgs) -> Result<SceneBuilder> {
     })
 }
 
+/// The colour bar of a numeric `--color-by`, unless `--no-color-bar`: drawn onto `image`.
+pub fn draw_color_bar(
+    builder: &SceneBuilder,
+    args: &StyleArgs,
+    image: &mut texmap_core::frame::Frame,
+) {
+    if args.no_color_bar || builder.color_by() != texmap_md_scene::ColorBy::Scalar {
+        return;
+    }
+    let scalar = builder.scalar();
+    let Some((min, max)) = scalar.range else {
+        return;
+    };
+    let title = scalar.source.title();
+    let (w, h) = (image.width() as usize, image.height() as usize);
+    texmap_md_scene::draw_color_bar(
+        image.color.as_flattened_mut(),
+        w,
+        h,
+        &texmap_md_scene::ColorBar {
+            map: scalar.map,
+            min,
+            max,
+            title: &title,
+        },
+    );
+}
+
 /// One line of warning about the style flags.
 pub fn warning_text(w: &StyleWarning) -> String {
     match w {
@@ -70,6 +115,16 @@ pub fn warning_text(w: &StyleWarning) -> String {
             "{count} colour-column values of the first frame are outside [0, 1] and were clamped (colours are fractions of 1, not 0-255)"
         ),
         StyleWarning::NoChains => "--color-by chain: the first frame has no chain or segment identifiers (PDB, mmCIF and PSF files carry them); element colours are used".to_string(),
+        StyleWarning::NoScalar { what, available } => {
+            let has = if available.is_empty() {
+                "it has no per-atom property".to_string()
+            } else {
+                format!("its properties: {}", available.join(", "))
+            };
+            format!(
+                "--color-by {what}: the first frame has no such number ({has}; speed needs velocities); --color-by takes property, element, type, chain, bfactor, occupancy, speed, residue, index or a property name"
+            )
+        }
     }
 }
 

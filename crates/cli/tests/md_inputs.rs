@@ -449,3 +449,103 @@ fn amber_prmtop_and_netcdf_render_together() {
     }
     assert_eq!(v["chains"], serde_json::json!(counts));
 }
+
+/// `--color-by bfactor` on the wwPDB's 3JQH: the gray map's colour bar runs from black at the
+/// bottom (the smallest B-factor) to white at the top, beside an image otherwise equal to the
+/// one without the bar; a property the file lacks is an error naming those it has; a reversed
+/// range is a usage error.
+#[test]
+fn color_by_a_number_draws_its_colour_bar() {
+    let dir = tempfile::tempdir().unwrap();
+    let with = dir.path().join("with.png");
+    let without = dir.path().join("without.png");
+    let input = data_3jqh();
+    for (out, extra) in [(&with, None), (&without, Some("--no-color-bar"))] {
+        let mut args = vec![
+            "render",
+            "--quiet",
+            &input,
+            "--color-by",
+            "bfactor",
+            "--colormap",
+            "gray",
+            "--size",
+            "320x240",
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        let o = texmap(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    let a = image::open(&with).unwrap().to_rgba8();
+    let b = image::open(&without).unwrap().to_rgba8();
+    let (w, h) = a.dimensions();
+    let mut differ_left = 0;
+    let mut bar: Vec<(u32, u8)> = Vec::new();
+    for y in 0..h {
+        for x in 0..w {
+            let (p, q) = (a.get_pixel(x, y), b.get_pixel(x, y));
+            if p != q && x < w * 2 / 3 {
+                differ_left += 1;
+            }
+        }
+    }
+    assert_eq!(differ_left, 0, "the bar stays at the right edge");
+    // The bar's gray ramp: find the column with the most distinct grays, read it top to bottom.
+    let col = (w * 2 / 3..w)
+        .max_by_key(|&x| {
+            let mut g: Vec<u8> = (0..h)
+                .map(|y| a.get_pixel(x, y).0)
+                .filter(|p| p[0] == p[1] && p[1] == p[2])
+                .map(|p| p[0])
+                .collect();
+            g.sort_unstable();
+            g.dedup();
+            g.len()
+        })
+        .unwrap();
+    for y in 0..h {
+        let p = a.get_pixel(col, y).0;
+        if p[0] == p[1] && p[1] == p[2] {
+            bar.push((y, p[0]));
+        }
+    }
+    let top = bar.iter().filter(|(_, g)| *g > 240).map(|(y, _)| *y).min();
+    let bottom = bar.iter().filter(|(_, g)| *g < 15).map(|(y, _)| *y).max();
+    assert!(
+        matches!((top, bottom), (Some(t), Some(b)) if t < b),
+        "white above black in column {col}: {top:?} {bottom:?}"
+    );
+    // A property the file does not have.
+    let o = texmap(&[
+        "render",
+        &data_3jqh(),
+        "--color-by",
+        "c_pe",
+        "-o",
+        with.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("occupancy, bfactor"), "{}", stderr(&o));
+    // A reversed range.
+    let o = texmap(&[
+        "render",
+        &data_3jqh(),
+        "--color-by",
+        "bfactor",
+        "--color-range",
+        "80:20",
+        "-o",
+        with.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    // info lists what --color-by can name.
+    let o = texmap(&["info", &data("lmp_tri.lammpstrj")]);
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["properties"][6], "ix", "{v}");
+}
+
+fn data_3jqh() -> String {
+    data("3jqh.cif")
+}

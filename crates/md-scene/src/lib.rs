@@ -16,6 +16,13 @@
 //!   along keyframes ([`MotionSpec`]), and following a selection's centre.
 //! - [`outline`]: the periodic box drawn as rows of small spheres along its twelve edges (every
 //!   sphere method draws spheres; none draws lines).
+//! - [`colormap`]: colour coding, a scalar in [0, 1] to an sRGB colour ([`Colormap`]: viridis,
+//!   plasma, coolwarm, turbo, gray, within one 8-bit code of matplotlib's).
+//! - [`scalar`]: colour coding by a number per atom ([`ScalarSource`]: a property such as the
+//!   B-factor or a LAMMPS compute, the speed, the residue, the index) over a range fixed at the
+//!   first frame.
+//! - [`legend`]: a colour bar with its tick labels and title drawn onto a rendered RGBA image
+//!   ([`draw_color_bar`]).
 //!
 //! ```
 //! use glam::Vec3;
@@ -47,19 +54,25 @@
 
 pub mod camera;
 pub mod camera_plan;
+pub mod colormap;
+pub mod legend;
 pub mod outline;
 pub mod palette;
 pub mod plan;
+pub mod scalar;
 pub mod style;
 
 pub use camera::{AUTO_VIEW_DIRECTION, FIT_MARGIN, ViewAxis, centre_of, drawn_bounds, fit_camera};
 pub use camera_plan::{CameraPlan, CameraPlanError, MotionSpec};
+pub use colormap::Colormap;
+pub use legend::{ColorBar, draw_color_bar};
 pub use outline::{add_box_outline, cell_corners};
 pub use palette::{MAX_MATERIALS, Palette, type_color};
 pub use plan::{
     BALL_AND_STICK_BOND_RADIUS, BALL_AND_STICK_RADIUS_SCALE, BondSource, DrawStyle,
     LICORICE_RADIUS, MolError, MolOptions, MolPlan, Pbc, SelectionRole,
 };
+pub use scalar::{NAN_COLOR, SCALAR_LEVELS, ScalarColor, ScalarSource};
 pub use style::{
     ColorBy, RuleKind, SceneBuilder, StyleError, StyleOptions, StyleWarning, style_from,
 };

@@ -8,8 +8,10 @@
 //! 2. the periodic boundaries ([`Pbc`]): atoms wrapped into the box, or molecules made whole
 //!    across it (with bonds by distance when none are drawn); bonds that still cross the box
 //!    are dropped, so no stick spans it;
-//! 3. every atom styled by the [`SceneBuilder`], then the colour rules and the radius rules, each
-//!    list in order, so that a later rule wins over an earlier one for the atoms both select;
+//! 3. every atom styled by the [`SceneBuilder`] (a scalar colouring's range, unless given,
+//!    fitted at the first frame to the atoms the selection draws), then the colour rules and the
+//!    radius rules, each list in order, so that a later rule wins over an earlier one for the
+//!    atoms both select;
 //! 4. the [`DrawStyle`]: radii scaled for ball-and-stick, or all set to [`LICORICE_RADIUS`];
 //! 5. the selection: the selected atoms are kept in their order and the bonds between two kept
 //!    atoms are renumbered to the kept atoms' indices; bonds to a dropped atom are dropped;
@@ -295,9 +297,17 @@ impl MolPlan {
         }
         texmap_md_io::pbc::drop_crossing(&mut self.pairs, &frame.positions, frame.cell.as_ref());
         self.last_bond_count = self.pairs.len();
+        let failed = |role| move |error| MolError::Selection { role, error };
+        // A scalar colouring's range, once: over the atoms drawn.
+        if builder.color_by() == crate::ColorBy::Scalar && builder.scalar().range.is_none() {
+            let mask = match &self.options.select {
+                Some(sel) => Some(sel.evaluate(frame).map_err(failed(SelectionRole::Select))?),
+                None => None,
+            };
+            builder.fit_scalar_range(frame, mask.as_deref());
+        }
         // Every atom, styled; then the per-selection rules, in order.
         builder.build(frame, scene);
-        let failed = |role| move |error| MolError::Selection { role, error };
         for (sel, rgb) in &self.options.colors {
             let mask = sel.evaluate(frame).map_err(failed(SelectionRole::Color))?;
             let kind = builder.kind_of(*rgb);

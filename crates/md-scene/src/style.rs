@@ -13,6 +13,7 @@ use texmap_impostor::SphereScene;
 use texmap_md_io::{Appearance, AtomStyle, Element, Frame, Label, Selector, atom_element};
 
 use crate::palette::{Palette, type_color};
+use crate::scalar::{ScalarColor, fit_range, scalar_color};
 
 /// Where an atom's colour comes from (before the rules of [`style_from`], which always win
 /// over the element table).
@@ -27,6 +28,9 @@ pub enum ColorBy {
     /// The rules, else one distinct colour per chain (or, without chains, per segment), in
     /// order of appearance; atoms of a frame with neither take the element colours.
     Chain,
+    /// The rules, else [`StyleOptions::scalar`]'s number per atom through its colour map
+    /// (module [`crate::scalar`]); atoms of a frame without the number take the element colours.
+    Scalar,
 }
 
 /// Which kind of rule a [`StyleWarning`] or [`StyleError`] is about.
@@ -46,6 +50,8 @@ pub struct StyleOptions {
     pub type_radius: Vec<(String, f32)>,
     /// `(NAME, 8-bit sRGB colour)`, NAME as for `type_radius`.
     pub type_color: Vec<(String, [u8; 3])>,
+    /// What [`ColorBy::Scalar`] colours by.
+    pub scalar: ScalarColor,
 }
 
 impl Default for StyleOptions {
@@ -55,6 +61,7 @@ impl Default for StyleOptions {
             radius_scale: 1.0,
             type_radius: Vec::new(),
             type_color: Vec::new(),
+            scalar: ScalarColor::default(),
         }
     }
 }
@@ -103,6 +110,12 @@ pub enum StyleWarning {
     /// Colouring by chain, but the frame has neither chain nor segment identifiers: the
     /// element colours are used.
     NoChains,
+    /// Colouring by a number the frame does not have (a property by another name, speed
+    /// without velocities); `available` lists the frame's properties.
+    NoScalar {
+        what: String,
+        available: Vec<String>,
+    },
 }
 
 /// The selectors a rule NAME stands for: the type and the atom name NAME, and the element whose
@@ -174,6 +187,9 @@ pub struct SceneBuilder {
     categories: Vec<Label>,
     radii: Vec<f32>,
     colors: Vec<[f32; 3]>,
+    /// The scalar colouring and the per-atom values of the last frame.
+    scalar: ScalarColor,
+    values: Vec<f32>,
 }
 
 impl SceneBuilder {
@@ -203,7 +219,31 @@ impl SceneBuilder {
             categories: Vec::new(),
             radii: Vec::new(),
             colors: Vec::new(),
+            scalar: options.scalar.clone(),
+            values: Vec::new(),
         })
+    }
+
+    /// How atoms are coloured.
+    pub fn color_by(&self) -> ColorBy {
+        self.color_by
+    }
+
+    /// The scalar colouring (its range once fixed).
+    pub fn scalar(&self) -> &ScalarColor {
+        &self.scalar
+    }
+
+    /// Fixes the scalar range, when colouring by a scalar without one, to the finite values of
+    /// `frame`'s atoms that `mask` selects (all atoms without a mask). Nothing when the frame
+    /// lacks the values or none is finite: [`SceneBuilder::build`] then fits all atoms.
+    pub fn fit_scalar_range(&mut self, frame: &Frame, mask: Option<&[bool]>) {
+        if self.color_by != ColorBy::Scalar || self.scalar.range.is_some() {
+            return;
+        }
+        if self.scalar.source.values(frame, &mut self.values) {
+            self.scalar.range = fit_range(&self.values, mask);
+        }
     }
 
     /// The factor on every radius.
@@ -255,6 +295,12 @@ impl SceneBuilder {
         if self.color_by == ColorBy::Chain && frame.chains.is_empty() && frame.segments.is_empty() {
             out.push(StyleWarning::NoChains);
         }
+        if self.color_by == ColorBy::Scalar && !self.scalar.source.values(frame, &mut Vec::new()) {
+            out.push(StyleWarning::NoScalar {
+                what: self.scalar.source.title(),
+                available: frame.properties.iter().map(|p| p.name.clone()).collect(),
+            });
+        }
         out
     }
 
@@ -279,6 +325,13 @@ impl SceneBuilder {
                 && !frame.types.is_empty()
                 && frame.elements.iter().all(|e| e.is_unknown()));
         // The per-atom labels that pick a palette colour, if colouring by category.
+        // The numbers that pick a map colour, if colouring by a scalar the frame has.
+        let scalar =
+            self.color_by == ColorBy::Scalar && self.scalar.source.values(frame, &mut self.values);
+        if scalar && self.scalar.range.is_none() {
+            self.scalar.range = fit_range(&self.values, None);
+        }
+        let range = self.scalar.range.unwrap_or((0.0, 1.0));
         let categories: Option<(&[Label], &[Label])> = match self.color_by {
             ColorBy::Chain if !frame.chains.is_empty() => Some((&frame.chains, &[])),
             ColorBy::Chain if !frame.segments.is_empty() => Some((&frame.segments, &[])),
@@ -302,6 +355,10 @@ impl SceneBuilder {
                         };
                         type_color(idx)
                     }
+                },
+                None if scalar => match self.style.rules_for(frame, i).color {
+                    Some(c) => c,
+                    None => scalar_color(self.scalar.map, range, self.values[i]),
                 },
                 None => self.colors[i],
             };
