@@ -285,22 +285,24 @@ pub struct StyleArgs {
         value_name = "SOURCE",
         default_value = "property",
         value_parser = parse_color_by,
-        long_help = "How atoms are coloured.\n\
-  property   the file's per-atom colour columns (extended XYZ `color`, LAMMPS `ColorR ColorG\n\
-             ColorB`) where it has them, else --type-color, else element colours (default)\n\
-  element    --type-color, else element colours (CPK/Jmol)\n\
-  type       --type-color, else one distinct colour per atom type (or name)\n\
-  chain      --type-color, else one colour per chain (or per segment without chains)\n\
-A number per atom, mapped through --colormap over --color-range (default: the range of the\n\
-first frame's drawn atoms, then fixed, so a colour means one value in every frame) with a\n\
-colour bar (--no-color-bar to leave it out):\n\
-  bfactor, occupancy   PDB columns 61-66 / 55-60, mmCIF B_iso_or_equiv / occupancy\n\
-  speed                |v| in Å/ps (GRO, TRR, NetCDF, LAMMPS vx vy vz, extended XYZ velo)\n\
-  residue              the residue's position in the file, 0, 1, 2, ... (a rainbow along chains)\n\
-  index                the atom index\n\
-  NAME                 any other per-atom column: a LAMMPS dump's c_pe, v_stress, q, mass, an\n\
-                       extended-XYZ array (`texmap info FILE` lists them as `properties`)\n\
-Examples: --color-by bfactor --colormap coolwarm   --color-by c_pe --color-range=-4:-2"
+        long_help = concat!(
+            "How atoms are coloured.\n",
+            "  property   the file's per-atom colour columns (extended XYZ `color`, LAMMPS `ColorR ColorG\n",
+            "             ColorB`) where it has them, else --type-color, else element colours (default)\n",
+            "  element    --type-color, else element colours (CPK/Jmol)\n",
+            "  type       --type-color, else one distinct colour per atom type (or name)\n",
+            "  chain      --type-color, else one colour per chain (or per segment without chains)\n",
+            "A number per atom, mapped through --colormap over --color-range (default: the range of the\n",
+            "first frame's drawn atoms, then fixed, so a colour means one value in every frame) with a\n",
+            "colour bar (--no-color-bar to leave it out):\n",
+            "  bfactor, occupancy   PDB columns 61-66 / 55-60, mmCIF B_iso_or_equiv / occupancy\n",
+            "  speed                |v| in Å/ps (GRO, TRR, NetCDF, LAMMPS vx vy vz, extended XYZ velo)\n",
+            "  residue              the residue's position in the file, 0, 1, 2, ... (a rainbow along chains)\n",
+            "  index                the atom index\n",
+            "  NAME                 any other per-atom column: a LAMMPS dump's c_pe, v_stress, q, mass, an\n",
+            "                       extended-XYZ array (`texmap info FILE` lists them as `properties`)\n",
+            "Examples: --color-by bfactor --colormap coolwarm   --color-by c_pe --color-range=-4:-2",
+        )
     )]
     pub color_by: ColorBy,
     /// The colour map of a numeric --color-by.
@@ -642,6 +644,7 @@ Examples:
   texmap render md.nc --topology system.prmtop --color 'protein=#a0a0ff' --color 'resname LIG=#ff8000' -o f.png
   texmap render dump.lammpstrj --type-color 1=#ff8000 --type-color 2=40,40,255 --type-radius 2=0.6 -o f.png
   texmap render 1abc.cif.gz --style tube --color-by chain --select 'not water' -o chains.png
+  texmap render 1abc.cif --color-by bfactor --colormap coolwarm -o b.png
   texmap render water.gro --color-by element --type-color OW=#ff0000 --radius-scale 0.5 -o w.png
   texmap render md.xyz --eye 0,0,50 --target 0,0,0 --up 0,1,0 --fov 30 --depth -o md.png";
 
