@@ -122,7 +122,7 @@ pub fn warning_text(w: &StyleWarning) -> String {
                 format!("its properties: {}", available.join(", "))
             };
             format!(
-                "--color-by {what}: the first frame has no such number ({has}; speed needs velocities); --color-by takes property, element, type, chain, bfactor, occupancy, speed, residue, index or a property name"
+                "--color-by {what}: the first frame has no such number ({has}; speed needs velocities); --color-by takes property, element, type, chain, bfactor, occupancy, charge (from a topology), speed, residue, index or a property name"
             )
         }
     }

@@ -572,7 +572,9 @@ fn bad_style_values_exit_2_naming_the_flag_and_value() {
         ("--type-color", "O=red"),
         ("--type-color", "ABCDEFGHIJKLMNOP=#ffffff"),
         ("--radius-scale", "0"),
-        ("--color-by", "charge"),
+        ("--colormap", "jet"),
+        ("--color-range", "5:1"),
+        ("--color-range", "0:inf"),
     ] {
         let o = render_axis(&xyz, &out, &[flag, value]);
         assert_eq!(o.status.code(), Some(2), "{flag} {value}: {}", stderr(&o));

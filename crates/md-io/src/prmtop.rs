@@ -10,7 +10,8 @@
 //! - `POINTERS`: `NATOM` (1st), `NBONH` (3rd), `MBONA` (4th) and `NRES` (12th), against which
 //!   the sections below are counted: a section holding fewer or more entries is an error naming
 //!   its `%FLAG` line, never a silently shifted column;
-//! - `ATOM_NAME`, `AMBER_ATOM_TYPE` (the types), `ATOMIC_NUMBER` and `MASS`;
+//! - `ATOM_NAME`, `AMBER_ATOM_TYPE` (the types), `ATOMIC_NUMBER`, `MASS` and `CHARGE` (stored
+//!   times 18.2223, divided back to e);
 //! - `RESIDUE_LABEL` and `RESIDUE_POINTER` (the first atom of each residue, 1-based);
 //! - `BONDS_INC_HYDROGEN` and `BONDS_WITHOUT_HYDROGEN`: triples `3*(i-1) 3*(j-1) type`;
 //! - `RESIDUE_CHAINID` (cpptraj and ParmEd write it when the system has chains): the chains.
@@ -35,6 +36,10 @@ use crate::error::Error;
 use crate::frame::Label;
 use crate::parse::{parse_f64, parse_i64};
 use crate::topology::{LineAt, Lines, Topology, at, parse_err, tidy};
+
+/// AMBER stores charges multiplied by 18.2223 (the square root of Coulomb's constant in
+/// kcal·Å/(mol·e²)), so that products of two are energies.
+const AMBER_CHARGE: f64 = 18.2223;
 
 /// A `%FORMAT(...)` descriptor: `count` fields of `width` bytes a line.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -111,8 +116,9 @@ struct Section {
 }
 
 /// The sections this reader uses; the others are skipped without parsing their fields.
-const WANTED: [&str; 10] = [
+const WANTED: [&str; 11] = [
     "POINTERS",
+    "CHARGE",
     "ATOM_NAME",
     "AMBER_ATOM_TYPE",
     "ATOMIC_NUMBER",
@@ -381,6 +387,16 @@ fn assemble(
         }
     }
 
+    let charges = match sections.remove("CHARGE") {
+        Some(s) => {
+            counted(&s, "CHARGE", "charges", n_atoms)?;
+            match s.values {
+                Values::Real(v) => v.iter().map(|q| (q / AMBER_CHARGE) as f32).collect(),
+                _ => return Err(wrong_kind(file, &s, "CHARGE", "numbers")),
+            }
+        }
+        None => Vec::new(),
+    };
     let masses = match sections.remove("MASS") {
         Some(s) => {
             counted(&s, "MASS", "masses", n_atoms)?;
@@ -470,6 +486,7 @@ fn assemble(
         bonds,
     );
     topology.chains = chains;
+    topology.charges = charges;
     Ok(topology)
 }
 
@@ -492,7 +509,7 @@ mod tests {
     }
 
     /// A TIP4P-style water (oxygen, two hydrogens, an extra point that tleap writes with atomic
-    /// number -1 and mass 0) and a calcium ion with no atomic number section value (0), in the
+    /// number -1 and mass 0) and a calcium ion with atomic number 0, in the
     /// chamber layout (%COMMENT lines between %FLAG and %FORMAT). Bonds: O-H1 and O-H2 with
     /// hydrogen, none without.
     const WATER: &str = "%VERSION  VERSION_STAMP = V0001.000  DATE = 01/01/26  00:00:00\n\
@@ -503,7 +520,7 @@ mod tests {
        0       0       0       0       0       0       0       0       4       0\n\
        0\n\
 %FLAG ATOM_NAME\n%FORMAT(20a4)\nO   H1  H2  EPW CAL \n\
-%FLAG CHARGE\n%FORMAT(5E16.8)\n  0.0 this section is skipped, so its damage does not matter\n\
+%FLAG CHARGE\n%FORMAT(5E16.8)\n -1.51973982E+01  7.59869910E+00  7.59869910E+00  0.00000000E+00\n  3.64446000E+01\n\
 %FLAG ATOMIC_NUMBER\n%FORMAT(10I8)\n       8       1       1      -1       0\n\
 %FLAG MASS\n%FORMAT(5E16.8)\n  1.60000000E+01  1.00800000E+00  1.00800000E+00  0.00000000E+00\n  4.00800000E+01\n\
 %FLAG RESIDUE_LABEL\n%FORMAT(20a4)\nWAT CAL \n\
@@ -526,6 +543,16 @@ mod tests {
         assert_eq!(t.ids, [1, 2, 3, 4, 5]);
         assert_eq!(t.bonds, [[0, 1], [0, 2]]);
         assert!(t.chains.is_empty());
+        // TIP3P's charges, stored times 18.2223.
+        let want = [-0.834, 0.417, 0.417, 0.0, 2.0];
+        assert!(
+            t.charges
+                .iter()
+                .zip(want)
+                .all(|(q, w)| (q - w).abs() < 1e-6),
+            "{:?}",
+            t.charges
+        );
         // The extra point (mass 0) is no element; CAL's 40.08 u makes it calcium, not carbon.
         let e: Vec<&str> = t.elements.iter().map(|e| e.symbol()).collect();
         assert_eq!(e, ["O", "H", "H", "X", "Ca"]);

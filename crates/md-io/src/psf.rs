@@ -2,7 +2,7 @@
 //!
 //! A PSF starts with a `PSF` line (flags such as `EXT`, `CHEQ`, `XPLOR`, `CMAP` follow it on the
 //! same line), a title block (`N !NTITLE` and N remark lines), then `N !NATOM` and one line per
-//! atom: `id segment resid resname name type charge mass [imove ...]` (all but charge kept), then `N !NBOND` and the
+//! atom: `id segment resid resname name type charge mass [imove ...]` (all kept but the mass, which decides elements), then `N !NBOND` and the
 //! bonded pairs of atom ids, four pairs (eight ids) a line. Later sections (angles, dihedrals,
 //! ...) are not needed to draw molecules and are not read.
 //!
@@ -144,6 +144,7 @@ pub(crate) fn read_psf<R: Read>(src: R, file: &Arc<str>) -> Result<Topology, Err
     let mut res_names: Vec<Label> = Vec::new();
     let mut res_ids: Vec<i64> = Vec::new();
     let mut segments: Vec<Label> = Vec::new();
+    let mut charges: Vec<f32> = Vec::new();
     let mut elements: Vec<Element> = Vec::new();
     while (ids.len() as u64) < n_atoms {
         let Some((l, pos)) = lines.next_line()? else {
@@ -177,6 +178,9 @@ pub(crate) fn read_psf<R: Read>(src: R, file: &Arc<str>) -> Result<Topology, Err
         let res = label(f[3], "a residue name of at most 15 bytes")?;
         let name = label(f[4], "an atom name of at most 15 bytes")?;
         let ty = label(f[5], "an atom type of at most 15 bytes")?;
+        let charge = parse_f64(f[6])
+            .filter(|q| q.is_finite())
+            .ok_or_else(|| parse_err(file, &pos, "a finite charge", f[6]))?;
         let mass = parse_f64(f[7])
             .filter(|m| m.is_finite())
             .ok_or_else(|| parse_err(file, &pos, "a finite mass", f[7]))?;
@@ -187,6 +191,7 @@ pub(crate) fn read_psf<R: Read>(src: R, file: &Arc<str>) -> Result<Topology, Err
         res_names.push(res);
         res_ids.push(resid);
         segments.push(segment);
+        charges.push(charge as f32);
     }
     // Atom ids to indices (PSF ids are 1..N in order, but do not rely on it).
     let mut order: Vec<(i64, u32)> = ids
@@ -258,6 +263,7 @@ pub(crate) fn read_psf<R: Read>(src: R, file: &Arc<str>) -> Result<Topology, Err
         bonds,
     );
     topology.segments = segments;
+    topology.charges = charges;
     Ok(topology)
 }
 

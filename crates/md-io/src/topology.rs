@@ -108,6 +108,9 @@ pub struct Topology {
     pub chains: Vec<Label>,
     /// Segment identifiers (PSF `segid`, PDB columns 73-76).
     pub segments: Vec<Label>,
+    /// Partial charges in e (PSF, AMBER prmtop, LAMMPS data styles `full` and `charge`); given
+    /// to frames as their `charge` property.
+    pub charges: Vec<f32>,
     /// Bonds as atom index pairs `[i, j]` with `i < j`, sorted, each once.
     pub bonds: Vec<[u32; 2]>,
 }
@@ -313,6 +316,7 @@ impl Topology {
             res_ids,
             chains: Vec::new(),
             segments: Vec::new(),
+            charges: Vec::new(),
             bonds,
         }
     }
@@ -337,6 +341,7 @@ impl Topology {
             res_ids: frame.res_ids.clone(),
             chains: frame.chains.clone(),
             segments: frame.segments.clone(),
+            charges: Vec::new(),
             bonds: Vec::new(),
         }
     }
@@ -403,6 +408,9 @@ impl Topology {
         }
         if !self.ids.is_empty() {
             frame.ids.clone_from(&self.ids);
+        }
+        if !self.charges.is_empty() {
+            frame.property_mut("charge").clone_from(&self.charges);
         }
         Ok(())
     }
@@ -494,6 +502,15 @@ impl AtomStyleKind {
         })
     }
 
+    /// The index of the charge column `q`, if the style has one.
+    fn charge_column(self) -> Option<usize> {
+        match self {
+            AtomStyleKind::Full => Some(3),
+            AtomStyleKind::Charge => Some(2),
+            AtomStyleKind::Atomic | AtomStyleKind::Molecular => None,
+        }
+    }
+
     /// Columns before the image flags, and the indices of mol (if any) and type.
     fn layout(self) -> (usize, Option<usize>, usize) {
         match self {
@@ -527,7 +544,7 @@ fn lammps_data<R: Read>(src: R, file: &Arc<str>) -> Result<Topology, Error> {
     let mut n_atoms: Option<u64> = None;
     let mut n_bonds: u64 = 0;
     // (id, mol, type) per atom; bonds as id pairs with their line.
-    let mut atoms: Vec<(i64, i64, Label)> = Vec::new();
+    let mut atoms: Vec<(i64, i64, Label, f32)> = Vec::new();
     let mut bond_ids: Vec<(i64, i64, LineAt)> = Vec::new();
     let mut section: Option<Vec<u8>> = None;
     let mut style: Option<AtomStyleKind> = None;
@@ -646,6 +663,13 @@ fn lammps_data<R: Read>(src: R, file: &Arc<str>) -> Result<Topology, Error> {
                         return Err(parse_err(file, &pos, "a finite coordinate", c));
                     }
                 }
+                let q = match st.charge_column() {
+                    Some(k) => parse_f64(f[k])
+                        .filter(|q| q.is_finite())
+                        .ok_or_else(|| parse_err(file, &pos, "a finite charge", f[k]))?
+                        as f32,
+                    None => f32::NAN,
+                };
                 if atoms.len() as u64 >= n_atoms.unwrap_or(0) {
                     return Err(parse_err(
                         file,
@@ -654,7 +678,7 @@ fn lammps_data<R: Read>(src: R, file: &Arc<str>) -> Result<Topology, Error> {
                         raw,
                     ));
                 }
-                atoms.push((id, m, t));
+                atoms.push((id, m, t, q));
             }
             Some(b"Bonds") => {
                 let f: Vec<&[u8]> = fields(line).collect();
@@ -751,6 +775,11 @@ fn lammps_data<R: Read>(src: R, file: &Arc<str>) -> Result<Topology, Error> {
         },
         chains: Vec::new(),
         segments: Vec::new(),
+        charges: if style.and_then(AtomStyleKind::charge_column).is_some() {
+            atoms.iter().map(|a| a.3).collect()
+        } else {
+            Vec::new()
+        },
         bonds,
     })
 }

@@ -62,6 +62,16 @@ fn prmtops_written_by_parmed_read_as_mdanalysis_reads_them() {
             .collect();
         assert!(!bonds.is_empty());
         assert_eq!(t.bonds, bonds, "{name}");
+        let charges: Vec<f64> = r["charges"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect();
+        assert_eq!(t.charges.len(), charges.len(), "{name}");
+        for (q, w) in t.charges.iter().zip(&charges) {
+            assert!((*q as f64 - w).abs() < 1e-6, "{name}: charge {q} vs {w}");
+        }
         match r.get("chains") {
             Some(c) => assert_eq!(labels(&t.chains), strings(c), "{name}"),
             None => assert!(t.chains.is_empty(), "{name}"),

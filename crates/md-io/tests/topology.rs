@@ -97,6 +97,24 @@ fn lammps_data_topology_matches_mdanalysis() {
     assert_eq!(t.bonds, bonds(&r["bonds"]));
     // The same bonds as the PDB's CONECT records, through another file format and program path.
     assert_eq!(t.bonds, bonds(&reference()["pdb"]["bonds"]));
+    // The charges gen_topology.py gave MDAnalysis (atom i: 0.1 * ((i % 5) - 2) e), which the
+    // frames it labels carry as their `charge` property.
+    let want: Vec<f32> = (0..t.n_atoms())
+        .map(|i| (0.1 * ((i % 5) as f64 - 2.0)) as f32)
+        .collect();
+    assert!(
+        t.charges
+            .iter()
+            .zip(&want)
+            .all(|(q, w)| (q - w).abs() < 1e-6),
+        "{:?}",
+        t.charges
+    );
+    let mut traj = Trajectory::open(path("amber_mda.ncdf")).unwrap();
+    let mut f = Frame::new();
+    assert!(traj.read_next(&mut f).unwrap());
+    t.apply(&mut f, "amber_mda.ncdf", 0).unwrap();
+    assert_eq!(f.property("charge"), Some(&t.charges[..]));
 }
 
 #[test]

@@ -10,8 +10,8 @@ and numbers, elements, chains, bonds), for crates/md-io/tests/prmtop.rs.
   RESIDUE_CHAINID section (ParmEd's add_flag, formatted by ParmEd) holding each residue's chain.
 
 A PDB has no force field: ParmEd needs parameters to write a prmtop, so every atom's type is
-its name with one Lennard-Jones pair, every bond one bond type and every charge 0.1 e; the
-drawing needs none of them.
+its name with one Lennard-Jones pair and every bond one bond type, and atom i's charge is
+0.1 * ((i % 5) - 2) e, as gen_topology.py gives topo_mda.data's.
 
 Run with ParmEd 4.3.1 and MDAnalysis 2.11: `python3 gen_prmtop.py`.
 """
@@ -31,13 +31,13 @@ def parametrised(pdb):
     s.bond_types.append(bt)
     for b in s.bonds:
         b.type = bt
-    for a in s.atoms:
+    for i, a in enumerate(s.atoms):
         if not a.type:
             a.type = a.name
         t = AtomType(a.type, None, a.mass, a.atomic_number)
         t.set_lj_params(0.1, 1.5)
         a.atom_type = t
-        a.charge = 0.1
+        a.charge = 0.1 * ((i % 5) - 2)
     return s
 
 
@@ -62,6 +62,7 @@ for name in ("prmtop_parmed.prmtop", "prmtop_chains.parm7"):
         "resnames": [str(x) for x in u.atoms.resnames],
         "resids": [int(x) for x in u.atoms.resids],
         "elements": [str(x) for x in u.atoms.elements],
+        "charges": [float(x) for x in u.atoms.charges],
         "bonds": sorted(sorted([int(b[0]), int(b[1])]) for b in u.bonds.indices),
     }
     if hasattr(u.atoms, "segids") and name.endswith(".parm7"):
