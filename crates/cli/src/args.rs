@@ -277,8 +277,8 @@ pub fn parse_type_color(s: &str) -> Result<TypeColor, String> {
 #[command(next_help_heading = "Atom style")]
 pub struct StyleArgs {
     /// How atoms are coloured: property (the file's colour columns, the default), element,
-    /// type, chain, or a number per atom through --colormap: bfactor, occupancy, speed, residue,
-    /// index or any per-atom column of the file (a LAMMPS dump's c_pe or q, an extended-XYZ
+    /// type, chain, or a number per atom through --colormap: bfactor, occupancy, charge, speed,
+    /// residue, index or any per-atom column of the file (a LAMMPS dump's c_pe or q, an extended-XYZ
     /// array).
     #[arg(
         long,
@@ -296,6 +296,7 @@ pub struct StyleArgs {
             "first frame's drawn atoms, then fixed, so a colour means one value in every frame) with a\n",
             "colour bar (--no-color-bar to leave it out):\n",
             "  bfactor, occupancy   PDB columns 61-66 / 55-60, mmCIF B_iso_or_equiv / occupancy\n",
+            "  charge               partial charges of the --topology (PSF, AMBER prmtop, LAMMPS data)\n",
             "  speed                |v| in Å/ps (GRO, TRR, NetCDF, LAMMPS vx vy vz, extended XYZ velo)\n",
             "  residue              the residue's position in the file, 0, 1, 2, ... (a rainbow along chains)\n",
             "  index                the atom index\n",
@@ -594,7 +595,7 @@ pub struct MolArgs {
     pub topology: Option<PathBuf>,
     /// Draw only the atoms SEL selects, in the VMD/MDAnalysis language: 'not resname SOL',
     /// 'name CA', 'element O and resid 1 to 20', 'chain A', 'segid PROA',
-    /// 'protein or within 5 of resname LIG'.
+    /// 'protein or within 5 of resname LIG', 'prop bfactor > 50', 'prop abs charge > 0.5'.
     #[arg(long, value_name = "SEL")]
     pub select: Option<String>,
     /// Colour of the atoms SEL selects, #rrggbb or R,G,B: --color 'resname SOL=#4080ff';

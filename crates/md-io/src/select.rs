@@ -13,7 +13,9 @@
 //!           | ("index" | "serial" | "bynum" | "id" | "resid") RANGE+
 //!           | "within" NUMBER "of" factor                          -- VMD: includes the factor
 //!           | "around" NUMBER factor                               -- MDAnalysis: excludes it
+//!           | "prop" ["abs"] NAME OP NUMBER                        -- MDAnalysis: prop z > 10
 //! RANGE    := N | N "to" M | N:M | N-M                              -- inclusive
+//! OP       := "<" | "<=" | ">" | ">=" | "==" | "!="                  -- spaces optional
 //! ```
 //! Keywords are case-insensitive; words are compared exactly (atom names are case-sensitive in
 //! PDB), except `element`, which takes a chemical symbol in any case. A word may hold the glob
@@ -25,6 +27,13 @@
 //! `chain` (VMD) and `chainID` (MDAnalysis) match the chain identifier (PDB column 22, mmCIF
 //! `auth_asym_id`); `segid` (MDAnalysis) and `segname` (VMD) the segment (PDB columns 73-76,
 //! PSF). A blank chain or segment is matched by no word.
+//! `prop` compares a coordinate (`x`, `y`, `z`) or a per-atom property ([`Frame::property`]:
+//! `bfactor`, also spelt `tempfactor` (MDAnalysis) or `beta` (VMD), `occupancy`, a topology's
+//! `charge`, a LAMMPS column such as `c_pe`) with a number, its absolute value with `abs`; the
+//! number may come first (`prop 10 < z`); `==` is `|a - b| <= 1e-8 + 1e-5 |b|` (numpy's
+//! `isclose`, as MDAnalysis). Comparisons are made in f32, the values' precision, as numpy makes
+//! MDAnalysis's (`prop x == 3.278` holds for the x read as 3.278). An atom whose value is NaN
+//! matches only `!=`.
 //! `within`/`around` use plain distances (no periodic images) through a cell grid, so they cost
 //! time linear in the atoms.
 //!
@@ -124,6 +133,72 @@ enum Node {
         of: Box<Node>,
         include_reference: bool,
     },
+    /// `prop [abs] NAME OP VALUE`: a coordinate or a property compared with a number.
+    Prop {
+        name: String,
+        abs: bool,
+        op: CmpOp,
+        value: f64,
+        column: usize,
+    },
+}
+
+/// The comparisons of `prop`, as MDAnalysis has them (`==` is numpy's `isclose`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum CmpOp {
+    Lt,
+    Le,
+    Gt,
+    Ge,
+    Eq,
+    Ne,
+}
+
+impl CmpOp {
+    /// Longest symbols first, so `<=` is not read as `<`.
+    const SYMBOLS: [(&'static str, CmpOp); 6] = [
+        ("<=", CmpOp::Le),
+        (">=", CmpOp::Ge),
+        ("==", CmpOp::Eq),
+        ("!=", CmpOp::Ne),
+        ("<", CmpOp::Lt),
+        (">", CmpOp::Gt),
+    ];
+
+    /// `a OP b` becomes `b OP' a`.
+    fn flipped(self) -> CmpOp {
+        match self {
+            CmpOp::Lt => CmpOp::Gt,
+            CmpOp::Le => CmpOp::Ge,
+            CmpOp::Gt => CmpOp::Lt,
+            CmpOp::Ge => CmpOp::Le,
+            op => op,
+        }
+    }
+
+    /// In f32, the precision of the values, as numpy compares a float32 column with a number.
+    fn test(self, a: f32, b: f32) -> bool {
+        match self {
+            CmpOp::Lt => a < b,
+            CmpOp::Le => a <= b,
+            CmpOp::Gt => a > b,
+            CmpOp::Ge => a >= b,
+            // numpy.isclose's defaults, as MDAnalysis uses them.
+            CmpOp::Eq => (a - b).abs() <= 1e-8 + 1e-5 * b.abs(),
+            CmpOp::Ne => a != b,
+        }
+    }
+}
+
+/// The property a `prop` NAME reads: MDAnalysis's `tempfactor` (and VMD's `beta`) is the
+/// `bfactor` property; `x`, `y`, `z` are coordinates; any other NAME is a property by that name.
+fn prop_name(name: &str) -> String {
+    match name {
+        "tempfactor" | "tempfactors" | "beta" | "bfactor" => "bfactor".into(),
+        "charges" => "charge".into(),
+        "occupancies" => "occupancy".into(),
+        other => other.into(),
+    }
 }
 
 /// A parsed selection (see the module docs).
@@ -203,6 +278,7 @@ fn is_reserved(w: &str) -> bool {
             | "resnum"
             | "within"
             | "around"
+            | "prop"
     )
 }
 
@@ -379,15 +455,66 @@ impl Parser<'_> {
                     include_reference,
                 })
             }
+            "prop" => self.prop(&t),
             ")" => Err(self.error(t.column, "unexpected ')'")),
             _ => Err(self.error(
                 t.column,
                 format!(
-                    "unknown keyword '{}': expected name, type, resname, element, resid, index, serial, id, protein, backbone, water, within, around, all, none, not or '('",
+                    "unknown keyword '{}': expected name, type, resname, element, resid, index, serial, id, prop, protein, backbone, water, within, around, all, none, not or '('",
                     t.text
                 ),
             )),
         }
+    }
+
+    /// `prop [abs] NAME OP VALUE` after `prop`: MDAnalysis's forms, spaced or not (`z > 10`,
+    /// `z>10`, `z >10`), or with the value first (`10 < z`).
+    fn prop(&mut self, kw: &Token) -> Result<Node, SelectionError> {
+        let abs = self.peek().is_some_and(|t| t.text == "abs");
+        if abs {
+            self.pos += 1;
+        }
+        let expected =
+            "'prop [abs] NAME OP VALUE' with OP one of < <= > >= == != (e.g. prop bfactor > 50)";
+        let mut joined = String::new();
+        let mut parsed = None;
+        for _ in 0..3 {
+            let Some(t) = self.peek() else { break };
+            if t.text == "(" || t.text == ")" {
+                break;
+            }
+            joined.push_str(&t.text);
+            self.pos += 1;
+            parsed = split_comparison(&joined);
+            if parsed.is_some() {
+                break;
+            }
+        }
+        let Some((left, op, right)) = parsed else {
+            return Err(self.error(
+                kw.column,
+                format!("expected {expected}, found 'prop {joined}'"),
+            ));
+        };
+        let number = |s: &str| s.parse::<f64>().ok().filter(|v| v.is_finite());
+        let name_like = |s: &str| !s.contains(['<', '>', '=', '!']);
+        let (name, op, value) = match (number(&left), number(&right)) {
+            (None, Some(v)) if name_like(&left) => (left, op, v),
+            (Some(v), None) if name_like(&right) => (right, op.flipped(), v),
+            _ => {
+                return Err(self.error(
+                    kw.column,
+                    format!("expected {expected}, found 'prop {joined}'"),
+                ));
+            }
+        };
+        Ok(Node::Prop {
+            name: prop_name(&name),
+            abs,
+            op,
+            value,
+            column: kw.column,
+        })
     }
 
     /// One or more words after a keyword (up to and/or/')'/the end).
@@ -688,6 +815,36 @@ impl Selection {
                     }
                 }
             }
+            Node::Prop {
+                name,
+                abs,
+                op,
+                value,
+                column,
+            } => {
+                let axis = ["x", "y", "z"].iter().position(|a| a == name);
+                let values: Vec<f32> = match (axis, frame.property(name)) {
+                    (Some(k), _) => frame.positions.iter().map(|p| p[k]).collect(),
+                    (None, Some(v)) if v.len() == n => v.to_vec(),
+                    _ => {
+                        let have: Vec<&str> =
+                            frame.properties.iter().map(|p| p.name.as_str()).collect();
+                        return Err(SelectionError {
+                            selection: self.text.clone(),
+                            column: *column,
+                            message: format!(
+                                "this frame has no property '{name}' (it has x, y, z{}{}; charges come from a PSF, prmtop or LAMMPS data topology)",
+                                if have.is_empty() { "" } else { ", " },
+                                have.join(", ")
+                            ),
+                        });
+                    }
+                };
+                for (v, x) in out.iter_mut().zip(values) {
+                    let x = if *abs { x.abs() } else { x };
+                    *v = op.test(x, *value as f32);
+                }
+            }
             Node::Within {
                 distance,
                 of,
@@ -703,6 +860,20 @@ impl Selection {
         }
         Ok(())
     }
+}
+
+/// `text` as `LEFT OP RIGHT` at its first comparison symbol, both sides non-empty.
+fn split_comparison(text: &str) -> Option<(String, CmpOp, String)> {
+    let (at, sym, op) = (0..text.len())
+        .filter(|&i| text.is_char_boundary(i))
+        .find_map(|i| {
+            CmpOp::SYMBOLS
+                .iter()
+                .find(|(sym, _)| text[i..].starts_with(sym))
+                .map(|(sym, op)| (i, *sym, *op))
+        })?;
+    let (left, right) = (&text[..at], &text[at + sym.len()..]);
+    (!left.is_empty() && !right.is_empty()).then(|| (left.to_string(), op, right.to_string()))
 }
 
 /// `out[i]` = some reference atom lies within `d` of atom `i` (plain distances). The reference

@@ -150,3 +150,44 @@ fn pdb_writer_keeps_b_factors_and_refuses_what_does_not_fit() {
     let e = w.write_frame(&big).unwrap_err().to_string();
     assert!(e.contains("atom 3") && e.contains("bfactor"), "{e}");
 }
+
+/// MDAnalysis's `prop` selections on gemmi's PDB of 3JQH select the atoms ours select.
+#[test]
+fn prop_selections_select_what_mdanalysis_selects() {
+    let r: Value =
+        serde_json::from_str(&std::fs::read_to_string(path("properties_reference.json")).unwrap())
+            .unwrap();
+    let f = first_frame("3jqh_gemmi.pdb");
+    let cases = r["prop_selections"].as_object().unwrap();
+    assert!(cases.len() >= 9);
+    for (text, want) in cases {
+        let want: Vec<usize> = want
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_u64().unwrap() as usize)
+            .collect();
+        let got = texmap_md_io::Selection::parse(text)
+            .unwrap()
+            .indices(&f)
+            .unwrap();
+        assert_eq!(got, want, "{text}");
+    }
+    // A property the frame lacks is an error listing those it has.
+    let e = texmap_md_io::Selection::parse("prop c_pe > 1")
+        .unwrap()
+        .indices(&f)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("c_pe") && e.contains("bfactor"), "{e}");
+    // Malformed comparisons point at `prop`.
+    for bad in [
+        "prop bfactor",
+        "prop bfactor > ",
+        "prop 5 > 6",
+        "prop x => 5",
+    ] {
+        let e = texmap_md_io::Selection::parse(bad).unwrap_err().to_string();
+        assert!(e.contains("prop [abs] NAME OP VALUE"), "{bad}: {e}");
+    }
+}

@@ -5,7 +5,8 @@
   every atom after `remove_alternative_conformations()` (the first conformation, as our reader
   keeps), model 1.
 - 3jqh_gemmi.pdb: gemmi's PDB of 3jqh.cif (`write_pdb` after the same removal); the reference
-  for it is what MDAnalysis reads back (`occupancies`, `tempfactors`).
+  for it is what MDAnalysis reads back (`occupancies`, `tempfactors`) and the atoms its `prop`
+  selections select.
 - ase_props.xyz: ASE's extended XYZ of 40 seeded atoms with `masses`, `initial_charges` and a
   user array `von_mises` (real, one component) and `tags` (integer); the reference is ASE's
   reading back of the file.
@@ -43,6 +44,21 @@ u = mda.Universe("3jqh_gemmi.pdb")
 ref["3jqh_gemmi.pdb"] = {
     "occupancy": [round(float(x), 4) for x in u.atoms.occupancies],
     "bfactor": [round(float(x), 4) for x in u.atoms.tempfactors],
+}
+# MDAnalysis's `prop` selections on the same file: the indices it selects.
+ref["prop_selections"] = {
+    sel: [int(i) for i in u.select_atoms(sel).indices]
+    for sel in [
+        "prop tempfactor > 60",
+        "prop tempfactor>=57.5 and name CA",
+        "prop abs x < 5",
+        "prop z <= 20.5 or prop y > 30",
+        "prop 50 > tempfactor",
+        "prop occupancy < 1",
+        "prop occupancy == 1",
+        "not prop x != 3.278",
+        "prop x> 10 and prop x <12",
+    ]
 }
 
 rng = np.random.default_rng(7)
