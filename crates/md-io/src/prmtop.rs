@@ -109,10 +109,34 @@ impl Values {
     }
 }
 
-/// A section kept for the topology: its data and where its `%FLAG` line is.
+/// A section kept for the topology: its name, its data and where its `%FLAG` line is.
 struct Section {
+    name: &'static str,
     flag: LineAt,
     values: Values,
+}
+
+impl Section {
+    fn text(self, file: &Arc<str>) -> Result<Vec<Label>, Error> {
+        match self.values {
+            Values::Text(v) => Ok(v),
+            _ => Err(wrong_kind(file, &self, "text (a4)")),
+        }
+    }
+
+    fn ints(self, file: &Arc<str>) -> Result<Vec<i64>, Error> {
+        match self.values {
+            Values::Int(v) => Ok(v),
+            _ => Err(wrong_kind(file, &self, "integers")),
+        }
+    }
+
+    fn reals(self, file: &Arc<str>) -> Result<Vec<f64>, Error> {
+        match self.values {
+            Values::Real(v) => Ok(v),
+            _ => Err(wrong_kind(file, &self, "numbers")),
+        }
+    }
 }
 
 /// The sections this reader uses; the others are skipped without parsing their fields.
@@ -214,6 +238,7 @@ pub(crate) fn read_prmtop<R: Read>(src: R, file: &Arc<str>) -> Result<Topology, 
                 sections.insert(
                     w,
                     Section {
+                        name: w,
                         flag: pos,
                         values: Values::Text(Vec::new()),
                     },
@@ -275,36 +300,22 @@ fn assemble(
         at: at(file, end),
         expected: format!("a %FLAG {what} section"),
     };
-    let counted = |s: &Section, name: &str, what: &str, want: usize| -> Result<(), Error> {
-        if s.values.len() == want {
-            return Ok(());
-        }
-        Err(Error::InvalidValue {
-            what: format!(
-                "{}: %FLAG {name} holds {} {what}, POINTERS says {want}",
-                at(file, &s.flag),
-                s.values.len()
-            ),
-        })
-    };
     let pointers = sections
         .remove("POINTERS")
         .ok_or_else(|| missing("POINTERS"))?;
-    let Values::Int(p) = &pointers.values else {
-        return Err(wrong_kind(file, &pointers, "POINTERS", "integers"));
-    };
+    let pointers_at = at(file, &pointers.flag);
+    let p = pointers.ints(file)?;
     if p.len() < 12 {
         return Err(Error::InvalidValue {
             what: format!(
-                "{}: %FLAG POINTERS holds {} values, at least 12 expected",
-                at(file, &pointers.flag),
+                "{pointers_at}: %FLAG POINTERS holds {} values, at least 12 expected",
                 p.len()
             ),
         });
     }
     let count = |k: usize, what: &str| {
         usize::try_from(p[k]).map_err(|_| Error::InvalidValue {
-            what: format!("{}: POINTERS {what} is {}", at(file, &pointers.flag), p[k]),
+            what: format!("{pointers_at}: POINTERS {what} is {}", p[k]),
         })
     };
     let n_atoms = count(0, "NATOM")?;
@@ -313,51 +324,44 @@ fn assemble(
     let n_res = count(11, "NRES")?;
     if n_atoms == 0 || n_atoms > u32::MAX as usize {
         return Err(Error::InvalidValue {
-            what: format!(
-                "{}: POINTERS NATOM is {n_atoms}, expected 1 to 2^32-1 atoms",
-                at(file, &pointers.flag)
-            ),
+            what: format!("{pointers_at}: POINTERS NATOM is {n_atoms}, expected 1 to 2^32-1 atoms"),
         });
     }
 
-    let text = |sections: &mut HashMap<&'static str, Section>,
-                name: &'static str,
-                want: usize,
-                what: &str|
-     -> Result<Option<Vec<Label>>, Error> {
-        let Some(s) = sections.remove(name) else {
-            return Ok(None);
+    // A section, checked to hold `want` entries; `None` when the file lacks it.
+    let mut take =
+        |name: &'static str, want: usize, what: &str| -> Result<Option<Section>, Error> {
+            let Some(s) = sections.remove(name) else {
+                return Ok(None);
+            };
+            if s.values.len() != want {
+                return Err(Error::InvalidValue {
+                    what: format!(
+                        "{}: %FLAG {name} holds {} {what}, POINTERS says {want}",
+                        at(file, &s.flag),
+                        s.values.len()
+                    ),
+                });
+            }
+            Ok(Some(s))
         };
-        counted(&s, name, what, want)?;
-        match s.values {
-            Values::Text(v) => Ok(Some(v)),
-            _ => Err(wrong_kind(file, &s, name, "text (a4)")),
-        }
+    let names = take("ATOM_NAME", n_atoms, "names")?
+        .ok_or_else(|| missing("ATOM_NAME"))?
+        .text(file)?;
+    let types = match take("AMBER_ATOM_TYPE", n_atoms, "types")? {
+        Some(s) => s.text(file)?,
+        None => Vec::new(),
     };
-    let names =
-        text(&mut sections, "ATOM_NAME", n_atoms, "names")?.ok_or_else(|| missing("ATOM_NAME"))?;
-    let types = text(&mut sections, "AMBER_ATOM_TYPE", n_atoms, "types")?.unwrap_or_default();
-    let res_labels = text(&mut sections, "RESIDUE_LABEL", n_res, "residue names")?
-        .ok_or_else(|| missing("RESIDUE_LABEL"))?;
-    let chain_ids = text(&mut sections, "RESIDUE_CHAINID", n_res, "chain ids")?;
-
-    let pointer_section = sections
-        .remove("RESIDUE_POINTER")
+    let res_labels = take("RESIDUE_LABEL", n_res, "residue names")?
+        .ok_or_else(|| missing("RESIDUE_LABEL"))?
+        .text(file)?;
+    let chain_ids = take("RESIDUE_CHAINID", n_res, "chain ids")?
+        .map(|s| s.text(file))
+        .transpose()?;
+    let pointer_section = take("RESIDUE_POINTER", n_res, "residue pointers")?
         .ok_or_else(|| missing("RESIDUE_POINTER"))?;
-    counted(
-        &pointer_section,
-        "RESIDUE_POINTER",
-        "residue pointers",
-        n_res,
-    )?;
-    let Values::Int(starts) = &pointer_section.values else {
-        return Err(wrong_kind(
-            file,
-            &pointer_section,
-            "RESIDUE_POINTER",
-            "integers",
-        ));
-    };
+    let pointer_at = at(file, &pointer_section.flag);
+    let starts = pointer_section.ints(file)?;
     // Residue r covers atoms starts[r]-1 .. starts[r+1]-1: 1 first, strictly increasing.
     let bad_start = starts.first() != Some(&1)
         || starts.windows(2).any(|w| w[1] <= w[0])
@@ -367,8 +371,7 @@ fn assemble(
     if bad_start {
         return Err(Error::InvalidValue {
             what: format!(
-                "{}: RESIDUE_POINTER must start at 1 and increase strictly up to NATOM = {n_atoms}",
-                at(file, &pointer_section.flag)
+                "{pointer_at}: RESIDUE_POINTER must start at 1 and increase strictly up to NATOM = {n_atoms}"
             ),
         });
     }
@@ -386,37 +389,20 @@ fn assemble(
             }
         }
     }
-
-    let charges = match sections.remove("CHARGE") {
-        Some(s) => {
-            counted(&s, "CHARGE", "charges", n_atoms)?;
-            match s.values {
-                Values::Real(v) => v.iter().map(|q| (q / AMBER_CHARGE) as f32).collect(),
-                _ => return Err(wrong_kind(file, &s, "CHARGE", "numbers")),
-            }
-        }
+    let charges = match take("CHARGE", n_atoms, "charges")? {
+        Some(s) => s
+            .reals(file)?
+            .iter()
+            .map(|q| (q / AMBER_CHARGE) as f32)
+            .collect(),
         None => Vec::new(),
     };
-    let masses = match sections.remove("MASS") {
-        Some(s) => {
-            counted(&s, "MASS", "masses", n_atoms)?;
-            match s.values {
-                Values::Real(v) => Some(v),
-                _ => return Err(wrong_kind(file, &s, "MASS", "numbers")),
-            }
-        }
-        None => None,
-    };
-    let numbers = match sections.remove("ATOMIC_NUMBER") {
-        Some(s) => {
-            counted(&s, "ATOMIC_NUMBER", "atomic numbers", n_atoms)?;
-            match s.values {
-                Values::Int(v) => Some(v),
-                _ => return Err(wrong_kind(file, &s, "ATOMIC_NUMBER", "integers")),
-            }
-        }
-        None => None,
-    };
+    let masses = take("MASS", n_atoms, "masses")?
+        .map(|s| s.reals(file))
+        .transpose()?;
+    let numbers = take("ATOMIC_NUMBER", n_atoms, "atomic numbers")?
+        .map(|s| s.ints(file))
+        .transpose()?;
     let elements = (0..n_atoms)
         .map(|i| {
             let mass = masses.as_ref().map_or(f64::NAN, |m| m[i]);
@@ -440,14 +426,12 @@ fn assemble(
             }
             continue;
         };
-        let Values::Int(v) = &s.values else {
-            return Err(wrong_kind(file, &s, name, "integers"));
-        };
+        let flag_at = at(file, &s.flag);
+        let v = s.ints(file)?;
         if v.len() != 3 * want {
             return Err(Error::InvalidValue {
                 what: format!(
-                    "{}: %FLAG {name} holds {} values, POINTERS {pointer} = {want} bonds needs {}",
-                    at(file, &s.flag),
+                    "{flag_at}: %FLAG {name} holds {} values, POINTERS {pointer} = {want} bonds needs {}",
                     v.len(),
                     3 * want
                 ),
@@ -462,10 +446,8 @@ fn assemble(
                 _ => {
                     return Err(Error::InvalidValue {
                         what: format!(
-                            "{}: %FLAG {name} has the bond {} {}: atom entries are 3*(atom-1), atoms 1..{n_atoms}",
-                            at(file, &s.flag),
-                            t[0],
-                            t[1]
+                            "{flag_at}: %FLAG {name} has the bond {} {}: atom entries are 3*(atom-1), atoms 1..{n_atoms}",
+                            t[0], t[1]
                         ),
                     });
                 }
@@ -490,11 +472,12 @@ fn assemble(
     Ok(topology)
 }
 
-fn wrong_kind(file: &Arc<str>, s: &Section, name: &str, expected: &str) -> Error {
+fn wrong_kind(file: &Arc<str>, s: &Section, expected: &str) -> Error {
     Error::InvalidValue {
         what: format!(
-            "{}: %FLAG {name} has a %FORMAT of another kind, expected {expected}",
-            at(file, &s.flag)
+            "{}: %FLAG {} has a %FORMAT of another kind, expected {expected}",
+            at(file, &s.flag),
+            s.name
         ),
     }
 }
