@@ -55,7 +55,8 @@ pub struct Cli {
 #[allow(clippy::large_enum_variant)] // parsed once per run: boxing RenderArgs would buy nothing
 pub enum Command {
     /// Print a trajectory's format, atom and frame counts, box, chains and segments (with their
-    /// atom counts) and first positions as one JSON object.
+    /// atom counts), per-atom properties and first positions as one JSON object; for a topology
+    /// file (PSF, AMBER prmtop, LAMMPS data) its atoms, residues, bonds, chains and segments.
     Info {
         /// Trajectory file (XYZ, extended XYZ, PDB, PDBx/mmCIF, GRO, LAMMPS dump, DCD, XTC, TRR,
         /// AMBER NetCDF), gzip-compressed or not (1abc.cif.gz).

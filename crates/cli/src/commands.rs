@@ -136,6 +136,15 @@ fn info(
     allow_truncated: bool,
     topology: Option<&Path>,
 ) -> Result<()> {
+    use texmap_md_io::TopologyFormat;
+    if format.is_none()
+        && matches!(
+            TopologyFormat::from_path(file),
+            Some(TopologyFormat::Psf | TopologyFormat::Prmtop | TopologyFormat::LammpsData)
+        )
+    {
+        return topology_info(file);
+    }
     let options = ReadOptions::new().allow_truncated(allow_truncated);
     let mut traj = open_trajectory_with(file, format, options)?;
     let topo = topology.map(crate::scene::open_topology).transpose()?;
@@ -190,6 +199,34 @@ fn info(
     }
     if !topo_json.is_null() {
         obj["topology"] = topo_json;
+    }
+    println!("{obj}");
+    Ok(())
+}
+
+/// `texmap info` of a file that holds a topology and no coordinates (PSF, AMBER prmtop, LAMMPS
+/// data): atoms, residues, bonds, chains and segments, and the properties it gives frames.
+fn topology_info(file: &Path) -> Result<()> {
+    let t = crate::scene::open_topology(file)?;
+    let format = match texmap_md_io::TopologyFormat::from_path(file) {
+        Some(texmap_md_io::TopologyFormat::Psf) => "psf",
+        Some(texmap_md_io::TopologyFormat::Prmtop) => "prmtop",
+        _ => "lammps-data",
+    };
+    let mut obj = json!({
+        "format": format,
+        "topology_only": true,
+        "atoms": t.n_atoms(),
+        "residues": t.n_residues(),
+        "bonds": t.bonds.len(),
+    });
+    for (key, labels) in [("chains", &t.chains), ("segments", &t.segments)] {
+        if !labels.is_empty() {
+            obj[key] = json!(label_counts(labels));
+        }
+    }
+    if !t.charges.is_empty() {
+        obj["properties"] = json!(["charge"]);
     }
     println!("{obj}");
     Ok(())

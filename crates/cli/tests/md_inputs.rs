@@ -434,6 +434,18 @@ fn amber_prmtop_and_netcdf_render_together() {
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(out.exists());
+    // A topology alone: info gives its counts (atoms, bonds and chains as MDAnalysis reads them).
+    let o = texmap(&["info", &data("prmtop_chains.parm7")]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let t: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let want = &r["prmtop_chains.parm7"];
+    assert_eq!(t["format"], "prmtop");
+    assert_eq!(t["atoms"], want["n_atoms"]);
+    assert_eq!(
+        t["bonds"].as_u64().unwrap() as usize,
+        want["bonds"].as_array().unwrap().len()
+    );
+    assert_eq!(t["properties"], serde_json::json!(["charge"]));
     // RESIDUE_CHAINID's chains reach the frames: info counts them as MDAnalysis does.
     let o = texmap(&[
         "info",
@@ -452,6 +464,7 @@ fn amber_prmtop_and_netcdf_render_together() {
         }
     }
     assert_eq!(v["chains"], serde_json::json!(counts));
+    assert_eq!(t["chains"], v["chains"]);
 }
 
 /// `--color-by bfactor` on the wwPDB's 3JQH: the gray map's colour bar runs from black at the
