@@ -14,6 +14,7 @@
 //!           | "within" NUMBER "of" factor                          -- VMD: includes the factor
 //!           | "around" NUMBER factor                               -- MDAnalysis: excludes it
 //!           | "prop" ["abs"] NAME OP NUMBER                        -- MDAnalysis: prop z > 10
+//!           | ("beta" | "occupancy" | "charge") OP NUMBER          -- VMD: beta > 50
 //! RANGE    := N | N "to" M | N:M | N-M                              -- inclusive
 //! OP       := "<" | "<=" | ">" | ">=" | "==" | "!="                  -- spaces optional
 //! ```
@@ -279,6 +280,9 @@ fn is_reserved(w: &str) -> bool {
             | "within"
             | "around"
             | "prop"
+            | "beta"
+            | "occupancy"
+            | "charge"
     )
 }
 
@@ -358,6 +362,13 @@ impl Parser<'_> {
         let t =
             self.next("a selection keyword (name, resname, resid, element, index, not, ...)")?;
         let kw = t.text.to_ascii_lowercase();
+        // `beta>=50` written as one word: the comparison is read from the word itself.
+        if let Some((left, _, _)) = split_comparison(&kw)
+            && matches!(left.as_str(), "beta" | "occupancy" | "charge")
+        {
+            self.pos -= 1;
+            return self.prop(&t, Some(""));
+        }
         match kw.as_str() {
             "not" => Ok(Node::Not(Box::new(self.factor()?))),
             "(" => {
@@ -455,7 +466,9 @@ impl Parser<'_> {
                     include_reference,
                 })
             }
-            "prop" => self.prop(&t),
+            "prop" => self.prop(&t, None),
+            // VMD's spelling without `prop`: `beta > 50`, `occupancy < 1`, `charge < 0`.
+            "beta" | "occupancy" | "charge" => self.prop(&t, Some(kw.as_str())),
             ")" => Err(self.error(t.column, "unexpected ')'")),
             _ => Err(self.error(
                 t.column,
@@ -469,14 +482,15 @@ impl Parser<'_> {
 
     /// `prop [abs] NAME OP VALUE` after `prop`: MDAnalysis's forms, spaced or not (`z > 10`,
     /// `z>10`, `z >10`), or with the value first (`10 < z`).
-    fn prop(&mut self, kw: &Token) -> Result<Node, SelectionError> {
-        let abs = self.peek().is_some_and(|t| t.text == "abs");
+    /// With `name`, the comparison after VMD's `beta`, `occupancy` or `charge` keyword.
+    fn prop(&mut self, kw: &Token, name: Option<&str>) -> Result<Node, SelectionError> {
+        let abs = name.is_none() && self.peek().is_some_and(|t| t.text == "abs");
         if abs {
             self.pos += 1;
         }
         let expected =
             "'prop [abs] NAME OP VALUE' with OP one of < <= > >= == != (e.g. prop bfactor > 50)";
-        let mut joined = String::new();
+        let mut joined = name.unwrap_or_default().to_string();
         let mut parsed = None;
         for _ in 0..3 {
             let Some(t) = self.peek() else { break };

@@ -173,6 +173,27 @@ fn prop_selections_select_what_mdanalysis_selects() {
             .unwrap();
         assert_eq!(got, want, "{text}");
     }
+    // VMD's spelling selects what MDAnalysis's does.
+    for (vmd, mda) in [
+        ("beta > 60", "prop tempfactor > 60"),
+        ("occupancy < 1", "prop occupancy < 1"),
+        (
+            "beta>=57.5 and name CA",
+            "prop tempfactor>=57.5 and name CA",
+        ),
+    ] {
+        let want: Vec<usize> = cases[mda]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_u64().unwrap() as usize)
+            .collect();
+        let got = texmap_md_io::Selection::parse(vmd)
+            .unwrap()
+            .indices(&f)
+            .unwrap();
+        assert_eq!(got, want, "{vmd}");
+    }
     // A property the frame lacks is an error listing those it has.
     let e = texmap_md_io::Selection::parse("prop c_pe > 1")
         .unwrap()
