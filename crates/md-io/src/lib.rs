@@ -90,6 +90,7 @@ pub mod pbc;
 mod pdb;
 mod prmtop;
 mod psf;
+pub mod secondary;
 pub mod select;
 pub mod style;
 mod text;
