@@ -8,6 +8,7 @@
 //! term     := factor ("and" factor)*
 //! factor   := "not" factor | "(" expr ")" | atom
 //! atom     := "all" | "none" | "protein" | "nucleic" | "backbone" | "water"
+//!           | "helix" | "sheet" | "betasheet" | "beta_sheet" | "coil"  -- VMD: structure
 //!           | ("name" | "type" | "resname" | "element") WORD+      -- any of the words
 //!           | ("chain" | "chainID" | "segid" | "segname") WORD+
 //!           | ("index" | "serial" | "bynum" | "id" | "resid") RANGE+
@@ -25,6 +26,10 @@
 //! file wrote. `protein` is a residue name among the amino acids of [`PROTEIN_RESIDUES`];
 //! `backbone` is `protein and name N CA C O`; `nucleic` a residue name in [`NUCLEIC_RESIDUES`];
 //! `water` a residue name in [`WATER_RESIDUES`].
+//! `helix`, `sheet` (also `betasheet`, `beta_sheet`) and `coil` are VMD's secondary-structure
+//! keywords: the atoms of residues that [`crate::secondary::assign`] finds helical, in a strand or
+//! bridge, or neither (coil is only residues with a protein backbone: water is not coil). The
+//! structure is assigned from the frame being selected, so it follows a trajectory.
 //! `chain` (VMD) and `chainID` (MDAnalysis) match the chain identifier (PDB column 22, mmCIF
 //! `auth_asym_id`); `segid` (MDAnalysis) and `segname` (VMD) the segment (PDB columns 73-76,
 //! PSF). A blank chain or segment is matched by no word.
@@ -47,6 +52,7 @@ use std::fmt;
 
 use crate::elements::Element;
 use crate::frame::{Frame, Label};
+use crate::secondary::Structure;
 
 /// Residue names `protein` matches: the 20 amino acids, their common protonation and
 /// terminal variants (AMBER, CHARMM, GROMACS spellings) and selenomethionine.
@@ -133,6 +139,11 @@ enum Node {
         distance: f64,
         of: Box<Node>,
         include_reference: bool,
+    },
+    /// `helix`, `sheet`, `coil`: the atoms of residues of that secondary structure.
+    Structure {
+        class: Structure,
+        column: usize,
     },
     /// `prop [abs] NAME OP VALUE`: a coordinate or a property compared with a number.
     Prop {
@@ -263,6 +274,11 @@ fn is_reserved(w: &str) -> bool {
             | "nucleic"
             | "backbone"
             | "water"
+            | "helix"
+            | "sheet"
+            | "betasheet"
+            | "beta_sheet"
+            | "coil"
             | "name"
             | "type"
             | "resname"
@@ -401,6 +417,18 @@ impl Parser<'_> {
             "water" => Ok(Node::Str {
                 field: StrField::ResName,
                 words: WATER_RESIDUES.iter().map(|s| s.to_string()).collect(),
+                column: t.column,
+            }),
+            "helix" => Ok(Node::Structure {
+                class: Structure::Helix,
+                column: t.column,
+            }),
+            "sheet" | "betasheet" | "beta_sheet" => Ok(Node::Structure {
+                class: Structure::Strand,
+                column: t.column,
+            }),
+            "coil" => Ok(Node::Structure {
+                class: Structure::Coil,
                 column: t.column,
             }),
             "name" | "type" | "resname" | "chain" | "chainid" | "segid" | "segname" => {
@@ -746,6 +774,21 @@ impl Selection {
                 let mut rhs = vec![false; n];
                 self.eval(b, frame, &mut rhs)?;
                 out.iter_mut().zip(&rhs).for_each(|(v, r)| *v |= r);
+            }
+            Node::Structure { class, column } => {
+                for (v, what) in [
+                    (frame.names.len(), "atom names"),
+                    (frame.res_names.len(), "residue names"),
+                    (frame.res_ids.len(), "residue numbers"),
+                ] {
+                    if v != n {
+                        return Err(self.missing(*column, what));
+                    }
+                }
+                let ss = crate::secondary::assign(frame).per_atom(n);
+                out.iter_mut()
+                    .zip(ss)
+                    .for_each(|(o, c)| *o = c == Some(*class));
             }
             Node::Str {
                 field,

@@ -159,3 +159,64 @@ fn frames_without_residues_or_backbones_have_no_structure() {
     assert!(ss.residues().is_empty());
     assert_eq!(ss.per_atom(4), vec![None::<Structure>; 4]);
 }
+
+#[test]
+fn vmd_structure_keywords_select_the_residues_mdanalysis_assigns() {
+    let r = reference();
+    for name in ["3gwiA.pdb.gz", "3e8mA.pdb.gz"] {
+        let f = first_frame(&dir().join(name));
+        let codes: Vec<char> = r[name]["dssp"].as_str().unwrap().chars().collect();
+        let ca = texmap_md_io::Selection::parse("name CA")
+            .unwrap()
+            .indices(&f)
+            .unwrap();
+        let ca_sel = |text: &str| -> Vec<usize> {
+            let on = texmap_md_io::Selection::parse(text)
+                .unwrap()
+                .evaluate(&f)
+                .unwrap();
+            ca.iter().filter(|&&i| on[i]).copied().collect()
+        };
+        for (text, code) in [
+            ("helix", 'H'),
+            ("sheet", 'E'),
+            ("betasheet", 'E'),
+            ("beta_sheet", 'E'),
+            ("coil", '-'),
+        ] {
+            // The CA atoms of protein residues, in order, are the reference's residues.
+            let want: Vec<usize> = ca
+                .iter()
+                .zip(&codes)
+                .filter(|(_, c)| **c == code)
+                .map(|(i, _)| *i)
+                .collect();
+            assert!(!want.is_empty(), "{name} {text}");
+            assert_eq!(
+                ca_sel(&format!("protein and {text}")),
+                want,
+                "{name} {text}"
+            );
+        }
+        // Every protein atom is in exactly one class; waters and ligands in none.
+        let any = texmap_md_io::Selection::parse("helix or sheet or coil")
+            .unwrap()
+            .evaluate(&f)
+            .unwrap();
+        let protein = texmap_md_io::Selection::parse("protein")
+            .unwrap()
+            .evaluate(&f)
+            .unwrap();
+        assert_eq!(any, protein, "{name}");
+    }
+    // A frame without residue names cannot answer.
+    let mut f = Frame::new();
+    f.positions = vec![[0.0; 3]; 2];
+    f.names = vec![texmap_md_io::Label::new("CA").unwrap(); 2];
+    let e = texmap_md_io::Selection::parse("name CA or helix")
+        .unwrap()
+        .evaluate(&f)
+        .unwrap_err();
+    assert_eq!(e.column, 12, "{e}");
+    assert!(e.to_string().contains("residue names"), "{e}");
+}
