@@ -55,7 +55,8 @@ pub struct Cli {
 #[allow(clippy::large_enum_variant)] // parsed once per run: boxing RenderArgs would buy nothing
 pub enum Command {
     /// Print a trajectory's format, atom and frame counts, box, chains and segments (with their
-    /// atom counts), per-atom properties and first positions as one JSON object; for a topology
+    /// atom counts), per-atom properties, the first frame's secondary structure (DSSP: helix,
+    /// strand, coil) and first positions as one JSON object; for a topology
     /// file (PSF, AMBER prmtop, LAMMPS data) its atoms, residues, bonds, chains and segments.
     Info {
         /// Trajectory file (XYZ, extended XYZ, PDB, PDBx/mmCIF, GRO, LAMMPS dump, DCD, XTC, TRR,
@@ -140,6 +141,8 @@ pub enum ColorBy {
     /// --type-color, else one distinct colour per chain (PDB column 22, mmCIF auth_asym_id),
     /// or per segment (PSF, PDB columns 73-76) when the file has no chains.
     Chain,
+    /// --type-color, else the residue's secondary structure (helix, strand, coil), per frame.
+    Structure,
     /// A number per atom through --colormap.
     Scalar(texmap_md_scene::ScalarSource),
 }
@@ -152,6 +155,7 @@ pub fn parse_color_by(s: &str) -> Result<ColorBy, String> {
         "element" => ColorBy::Element,
         "type" => ColorBy::Type,
         "chain" => ColorBy::Chain,
+        "structure" | "secondary" | "ss" => ColorBy::Structure,
         "speed" | "velocity" => ColorBy::Scalar(ScalarSource::Speed),
         "residue" | "resid" => ColorBy::Scalar(ScalarSource::Residue),
         "index" => ColorBy::Scalar(ScalarSource::Index),
@@ -278,7 +282,7 @@ pub fn parse_type_color(s: &str) -> Result<TypeColor, String> {
 #[command(next_help_heading = "Atom style")]
 pub struct StyleArgs {
     /// How atoms are coloured: property (the file's colour columns, the default), element,
-    /// type, chain, or a number per atom through --colormap: bfactor, occupancy, charge, speed,
+    /// type, chain, structure (helix, strand, coil), or a number per atom through --colormap: bfactor, occupancy, charge, speed,
     /// residue, index or any per-atom column of the file (a LAMMPS dump's c_pe or q, an extended-XYZ
     /// array).
     #[arg(
@@ -293,6 +297,9 @@ pub struct StyleArgs {
             "  element    --type-color, else element colours (CPK/Jmol)\n",
             "  type       --type-color, else one distinct colour per atom type (or name)\n",
             "  chain      --type-color, else one colour per chain (or per segment without chains)\n",
+            "  structure  --type-color, else the residue's secondary structure in VMD's colours: helix\n",
+            "             purple, strand yellow, coil white (DSSP's hydrogen bonds, as MDAnalysis assigns\n",
+            "             them, recomputed every frame); water and ligands keep element colours\n",
             "A number per atom, mapped through --colormap over --color-range (default: the range of the\n",
             "first frame's drawn atoms, then fixed, so a colour means one value in every frame) with a\n",
             "colour bar (--no-color-bar to leave it out):\n",

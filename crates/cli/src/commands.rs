@@ -197,6 +197,19 @@ fn info(
         let names: Vec<&str> = frame.properties.iter().map(|p| p.name.as_str()).collect();
         obj["properties"] = json!(names);
     }
+    // The first frame's secondary structure (what `helix`, `sheet`, `coil` and
+    // --color-by structure will see), when it has protein backbones.
+    let ss = texmap_md_io::secondary::assign(&frame);
+    if !ss.residues().is_empty() {
+        let [coil, helix, strand] = ss.counts();
+        obj["secondary_structure"] = json!({
+            "residues": ss.residues().len(),
+            "helix": helix,
+            "strand": strand,
+            "coil": coil,
+            "dssp": ss.codes(),
+        });
+    }
     if !topo_json.is_null() {
         obj["topology"] = topo_json;
     }

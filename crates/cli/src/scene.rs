@@ -32,6 +32,7 @@ pub fn style_options(args: &StyleArgs) -> StyleOptions {
             ColorBy::Element => texmap_md_scene::ColorBy::Element,
             ColorBy::Type => texmap_md_scene::ColorBy::Type,
             ColorBy::Chain => texmap_md_scene::ColorBy::Chain,
+            ColorBy::Structure => texmap_md_scene::ColorBy::Structure,
             ColorBy::Scalar(_) => texmap_md_scene::ColorBy::Scalar,
         },
         scalar: texmap_md_scene::ScalarColor {
@@ -115,6 +116,7 @@ pub fn warning_text(w: &StyleWarning) -> String {
             "{count} colour-column values of the first frame are outside [0, 1] and were clamped (colours are fractions of 1, not 0-255)"
         ),
         StyleWarning::NoChains => "--color-by chain: the first frame has no chain or segment identifiers (PDB, mmCIF and PSF files carry them); element colours are used".to_string(),
+        StyleWarning::NoStructure => "--color-by structure: no residue of the first frame has a protein backbone (atoms N, CA, C and O with residue names and numbers: PDB, mmCIF, GRO, PSF, prmtop); element colours are used".to_string(),
         StyleWarning::NoScalar { what, available } => {
             let has = if available.is_empty() {
                 "it has no per-atom property".to_string()
@@ -122,7 +124,7 @@ pub fn warning_text(w: &StyleWarning) -> String {
                 format!("its properties: {}", available.join(", "))
             };
             format!(
-                "--color-by {what}: the first frame has no such number ({has}; speed needs velocities); --color-by takes property, element, type, chain, bfactor, occupancy, charge (from a topology), speed, residue, index or a property name"
+                "--color-by {what}: the first frame has no such number ({has}; speed needs velocities); --color-by takes property, element, type, chain, structure, bfactor, occupancy, charge (from a topology), speed, residue, index or a property name"
             )
         }
     }

@@ -566,3 +566,67 @@ fn color_by_a_number_draws_its_colour_bar() {
 fn data_3jqh() -> String {
     data("3jqh.cif")
 }
+
+/// `helix`/`sheet` selections and `--color-by structure` end to end: each selection drawn alone
+/// is VMD's colour for its class (helix purple, strand yellow) wherever an atom is lit, and
+/// `info` reports MDAnalysis's assignment of the chain (md-io/tests/data/dssp/reference.json).
+#[test]
+fn secondary_structure_selects_and_colours() {
+    let input = data("dssp/3gwiA.pdb.gz");
+    let o = texmap(&["info", &input]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let info: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(data("dssp/reference.json")).unwrap())
+            .unwrap();
+    let codes = r["3gwiA.pdb.gz"]["dssp"].as_str().unwrap();
+    let ss = &info["secondary_structure"];
+    assert_eq!(ss["dssp"], codes);
+    assert_eq!(ss["helix"], codes.matches('H').count());
+    assert_eq!(ss["strand"], codes.matches('E').count());
+    let dir = tempfile::tempdir().unwrap();
+    // (selection, is this pixel of the class's hue? purple r = b > g, yellow r = g > b; the
+    // white light's highlights desaturate but keep the hue)
+    type Hue = fn([u8; 3]) -> bool;
+    let cases: [(&str, Hue); 2] = [
+        ("helix", |p| {
+            p[0].abs_diff(p[2]) <= 10 && p[1] as u32 + 30 < p[0].min(p[2]) as u32
+        }),
+        ("sheet", |p| {
+            p[0].abs_diff(p[1]) <= 10 && p[2] as u32 + 30 < p[0].min(p[1]) as u32
+        }),
+    ];
+    for (sel, hue) in cases {
+        let out = dir.path().join(format!("{sel}.png"));
+        let o = texmap(&[
+            "render",
+            "--quiet",
+            &input,
+            "--select",
+            sel,
+            "--color-by",
+            "structure",
+            "--size",
+            "320x240",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let img = image::open(&out).unwrap().to_rgb8();
+        // Lit pixels: not background, not in deep shade, not a white highlight.
+        let lit: Vec<[u8; 3]> = img
+            .pixels()
+            .map(|p| p.0)
+            .filter(|p| {
+                p.iter().copied().max().unwrap() > 100 && p.iter().copied().min().unwrap() < 200
+            })
+            .collect();
+        assert!(lit.len() > 500, "{sel}: {} lit pixels", lit.len());
+        let of_hue = lit.iter().filter(|p| hue(**p)).count();
+        assert!(
+            of_hue * 100 >= lit.len() * 95,
+            "{sel}: {of_hue} of {} pixels",
+            lit.len()
+        );
+    }
+}

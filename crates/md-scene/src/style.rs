@@ -31,7 +31,16 @@ pub enum ColorBy {
     /// The rules, else [`StyleOptions::scalar`]'s number per atom through its colour map
     /// (module [`crate::scalar`]); atoms of a frame without the number take the element colours.
     Scalar,
+    /// The rules, else the secondary structure of the atom's residue, assigned per frame
+    /// ([`texmap_md_io::secondary`]), in VMD's Structure colours ([`STRUCTURE_COLORS`]); atoms
+    /// outside protein residues (water, ligands, ions) take the element colours.
+    Structure,
 }
+
+/// The colours of [`ColorBy::Structure`], VMD's: coil white, helix purple (VMD's alpha-helix
+/// colour), strand yellow (VMD's extended-beta colour); sRGB in [0, 1], indexed by
+/// [`texmap_md_io::secondary::Structure`] as `usize`.
+pub const STRUCTURE_COLORS: [[f32; 3]; 3] = [[1.0, 1.0, 1.0], [0.65, 0.0, 0.65], [1.0, 1.0, 0.0]];
 
 /// Which kind of rule a [`StyleWarning`] or [`StyleError`] is about.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -116,6 +125,9 @@ pub enum StyleWarning {
         what: String,
         available: Vec<String>,
     },
+    /// Colouring by secondary structure, but no residue of the frame has a protein backbone
+    /// (N, CA, C, O with residue names and numbers): the element colours are used.
+    NoStructure,
 }
 
 /// The selectors a rule NAME stands for: the type and the atom name NAME, and the element whose
@@ -295,6 +307,11 @@ impl SceneBuilder {
         if self.color_by == ColorBy::Chain && frame.chains.is_empty() && frame.segments.is_empty() {
             out.push(StyleWarning::NoChains);
         }
+        if self.color_by == ColorBy::Structure
+            && texmap_md_io::secondary::assign(frame).residues().is_empty()
+        {
+            out.push(StyleWarning::NoStructure);
+        }
         if self.color_by == ColorBy::Scalar && !self.scalar.source.values(frame, &mut Vec::new()) {
             out.push(StyleWarning::NoScalar {
                 what: self.scalar.source.title(),
@@ -338,6 +355,11 @@ impl SceneBuilder {
             _ if by_type => Some((&frame.types, &frame.names)),
             _ => None,
         };
+        let structure = if self.color_by == ColorBy::Structure {
+            texmap_md_io::secondary::assign(frame).per_atom(frame.n_atoms())
+        } else {
+            Vec::new()
+        };
         for i in 0..frame.n_atoms() {
             let p = frame.positions[i];
             let color = match categories {
@@ -360,6 +382,13 @@ impl SceneBuilder {
                     Some(c) => c,
                     None => scalar_color(self.scalar.map, range, self.values[i]),
                 },
+                None if !structure.is_empty() => {
+                    match (structure[i], self.style.rules_for(frame, i).color) {
+                        (_, Some(c)) => c,
+                        (Some(ss), None) => STRUCTURE_COLORS[ss as usize],
+                        (None, None) => self.colors[i],
+                    }
+                }
                 None => self.colors[i],
             };
             let kind = self.palette.kind_of(color);
