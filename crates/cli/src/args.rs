@@ -625,6 +625,13 @@ pub struct MolArgs {
     /// Periodic boundaries: none, wrap (atoms into the box), unwrap (molecules whole).
     #[arg(long, value_enum, default_value_t = PbcArg::None)]
     pub pbc: PbcArg,
+    /// Superpose every frame on the first rendered frame by the least-squares fit of the atoms
+    /// SEL picks ('backbone', 'name CA', 'protein and not name H*'), so the molecule holds still
+    /// while it tumbles and diffuses, as MDAnalysis's AlignTraj and VMD's 'measure fit' do
+    /// before a movie. SEL is evaluated once, at the first frame; the fit is unweighted and
+    /// after --pbc (use --pbc unwrap so the fitted molecule is whole).
+    #[arg(long, value_name = "SEL")]
+    pub align: Option<String>,
 }
 
 /// How an atom's look is chosen and examples, after `texmap render --help`.
@@ -655,6 +662,7 @@ Examples:
   texmap render dump.lammpstrj --type-color 1=#ff8000 --type-color 2=40,40,255 --type-radius 2=0.6 -o f.png
   texmap render 1abc.cif.gz --style tube --color-by chain --select 'not water' -o chains.png
   texmap render 1abc.cif --color-by bfactor --colormap coolwarm -o b.png
+  texmap render md.xtc --topology protein.pdb --align backbone --style tube --color-by structure -o f%04d.png
   texmap render water.gro --color-by element --type-color OW=#ff0000 --radius-scale 0.5 -o w.png
   texmap render md.xyz --eye 0,0,50 --target 0,0,0 --up 0,1,0 --fov 30 --depth -o md.png";
 

@@ -219,9 +219,15 @@ pub fn mol_plan(args: &MolArgs) -> Result<MolPlan> {
         };
         radii.push((parse_selection("--radius", sel)?, radius));
     }
+    let align = args
+        .align
+        .as_deref()
+        .map(|t| parse_selection("--align", t))
+        .transpose()?;
     MolPlan::new(MolOptions {
         topology,
         select,
+        align,
         colors,
         radii,
         bonds: args.bonds.into(),
@@ -244,8 +250,16 @@ pub fn mol_error(e: MolError) -> anyhow::Error {
                 SelectionRole::Select => "--select",
                 SelectionRole::Color => "--color",
                 SelectionRole::Radius => "--radius",
+                SelectionRole::Align => "--align",
             };
             format!("{flag}: {error}")
+        }
+        MolError::Align { atoms, why } if atoms >= 3 => {
+            // Bad coordinates in a frame: a runtime failure, not a usage error.
+            return anyhow::anyhow!("--align: the selection's {atoms} atoms: {why}");
+        }
+        MolError::Align { atoms, why } => {
+            format!("--align: the selection picks {atoms} atom(s) of the first frame: {why}")
         }
     };
     crate::args::UsageError(text).into()

@@ -52,6 +52,7 @@
 //! assert_eq!((camera.width(), camera.height()), (640, 480));
 //! ```
 
+pub mod align;
 pub mod camera;
 pub mod camera_plan;
 pub mod colormap;

@@ -8,14 +8,19 @@
 //! 2. the periodic boundaries ([`Pbc`]): atoms wrapped into the box, or molecules made whole
 //!    across it (with bonds by distance when none are drawn); bonds that still cross the box
 //!    are dropped, so no stick spans it;
-//! 3. every atom styled by the [`SceneBuilder`] (a scalar colouring's range, unless given,
+//! 3. with [`MolOptions::align`], the frame superposed on the first frame built: the
+//!    alignment selection is evaluated once, at the first frame, and every frame's positions,
+//!    velocities and cell are moved by the rotation and translation that fit those atoms onto
+//!    their first-frame positions in least squares ([`crate::align`]; MDAnalysis's
+//!    `AlignTraj`), so the picked molecule holds still while the rest moves relative to it;
+//! 4. every atom styled by the [`SceneBuilder`] (a scalar colouring's range, unless given,
 //!    fitted at the first frame to the atoms the selection draws), then the colour rules and the
 //!    radius rules, each list in order, so that a later rule wins over an earlier one for the
 //!    atoms both select;
-//! 4. the [`DrawStyle`]: radii scaled for ball-and-stick, or all set to [`LICORICE_RADIUS`];
-//! 5. the selection: the selected atoms are kept in their order and the bonds between two kept
+//! 5. the [`DrawStyle`]: radii scaled for ball-and-stick, or all set to [`LICORICE_RADIUS`];
+//! 6. the selection: the selected atoms are kept in their order and the bonds between two kept
 //!    atoms are renumbered to the kept atoms' indices; bonds to a dropped atom are dropped;
-//! 6. for [`DrawStyle::Tube`], the selected atoms of protein and nucleic residues give way to
+//! 7. for [`DrawStyle::Tube`], the selected atoms of protein and nucleic residues give way to
 //!    the backbone tube through their CA (P) atoms, appended as spheres joined by bonds.
 //!
 //! # The tube
@@ -107,6 +112,9 @@ pub struct MolOptions {
     pub draw: DrawStyle,
     /// The periodic-boundary treatment.
     pub pbc: Pbc,
+    /// Superpose every frame on the first frame built, fitted on these atoms (see the module
+    /// docs); `None` leaves positions as read.
+    pub align: Option<Selection>,
 }
 
 impl Default for MolOptions {
@@ -119,6 +127,7 @@ impl Default for MolOptions {
             bonds: BondSource::Auto,
             draw: DrawStyle::Spacefill,
             pbc: Pbc::None,
+            align: None,
         }
     }
 }
@@ -132,6 +141,8 @@ pub enum SelectionRole {
     Color,
     /// A radius rule's selection.
     Radius,
+    /// [`MolOptions::align`].
+    Align,
 }
 
 /// Why a [`MolPlan`] was refused or a frame could not be built.
@@ -150,6 +161,14 @@ pub enum MolError {
         rule: usize,
         /// The refused radius.
         radius: f32,
+    },
+    /// The alignment selection picks fewer than three atoms at the first frame (a fit needs
+    /// three), or a frame's picked atoms have non-finite coordinates.
+    Align {
+        /// Atoms picked at the first frame.
+        atoms: usize,
+        /// Why.
+        why: &'static str,
     },
     /// A selection could not be evaluated on a frame.
     Selection {
@@ -170,8 +189,15 @@ impl fmt::Display for MolError {
             MolError::BadRadius { rule, radius } => {
                 write!(f, "radius rule {rule}: {radius} is not a radius > 0 in Å")
             }
+            MolError::Align { atoms, why } => {
+                write!(
+                    f,
+                    "alignment: the selection picks {atoms} atom(s) of the first frame: {why}"
+                )
+            }
             MolError::Selection { role, error } => {
                 let what = match role {
+                    SelectionRole::Align => "the alignment selection",
                     SelectionRole::Select => "the selection of drawn atoms",
                     SelectionRole::Color => "a colour rule's selection",
                     SelectionRole::Radius => "a radius rule's selection",
@@ -192,6 +218,9 @@ pub struct MolPlan {
     map: Vec<u32>,
     pairs: Vec<[u32; 2]>,
     last_bond_count: usize,
+    /// The alignment's atoms and their positions in the first frame built.
+    align_reference: Option<(Vec<usize>, Vec<[f64; 3]>)>,
+    last_fit_rmsd: Option<f64>,
 }
 
 impl MolPlan {
@@ -222,12 +251,77 @@ impl MolPlan {
             map: Vec::new(),
             pairs: Vec::new(),
             last_bond_count: 0,
+            align_reference: None,
+            last_fit_rmsd: None,
         })
     }
 
     /// The topology, if any.
     pub fn topology(&self) -> Option<&Topology> {
         self.options.topology.as_ref()
+    }
+
+    /// The RMSD (Å) of the last frame's alignment atoms after the fit onto the first frame's;
+    /// `None` without [`MolOptions::align`].
+    pub fn last_fit_rmsd(&self) -> Option<f64> {
+        self.last_fit_rmsd
+    }
+
+    /// Step 3 of the module docs: `frame` superposed on the first frame built (which sets the reference: its
+    /// alignment atoms, picked once, and their positions).
+    fn align(&mut self, frame: &mut Frame) -> Result<(), MolError> {
+        let Some(sel) = &self.options.align else {
+            return Ok(());
+        };
+        let pos = |frame: &Frame, atoms: &[usize]| -> Vec<[f64; 3]> {
+            atoms
+                .iter()
+                .map(|&i| {
+                    frame
+                        .positions
+                        .get(i)
+                        .copied()
+                        .unwrap_or([f32::NAN; 3])
+                        .map(f64::from)
+                })
+                .collect()
+        };
+        let (atoms, reference) = match &self.align_reference {
+            Some(r) => r,
+            None => {
+                let atoms = sel.indices(frame).map_err(|error| MolError::Selection {
+                    role: SelectionRole::Align,
+                    error,
+                })?;
+                if atoms.len() < 3 {
+                    return Err(MolError::Align {
+                        atoms: atoms.len(),
+                        why: "a fit needs at least three",
+                    });
+                }
+                let reference = pos(frame, &atoms);
+                self.align_reference.insert((atoms, reference))
+            }
+        };
+        let mobile = pos(frame, atoms);
+        let fit = crate::align::superpose(&mobile, reference).ok_or(MolError::Align {
+            atoms: atoms.len(),
+            why: "some have no finite coordinates in this frame",
+        })?;
+        self.last_fit_rmsd = Some(fit.rmsd);
+        for p in &mut frame.positions {
+            *p = fit.apply(p.map(f64::from)).map(|v| v as f32);
+        }
+        for v in &mut frame.velocities {
+            *v = fit.rotate(v.map(f64::from)).map(|v| v as f32);
+        }
+        if let Some(cell) = &frame.cell {
+            let m = cell.matrix().map(|row| fit.rotate(row));
+            frame.cell = texmap_md_io::UnitCell::from_matrix(m)
+                .ok()
+                .map(|c| c.with_origin(fit.apply(cell.origin())));
+        }
+        Ok(())
     }
 
     /// Whether bonds are drawn at all.
@@ -298,6 +392,7 @@ impl MolPlan {
         texmap_md_io::pbc::drop_crossing(&mut self.pairs, &frame.positions, frame.cell.as_ref());
         self.last_bond_count = self.pairs.len();
         let failed = |role| move |error| MolError::Selection { role, error };
+        self.align(frame)?;
         // A scalar colouring's range, once: over the atoms drawn.
         if builder.color_by() == crate::ColorBy::Scalar && builder.scalar().range.is_none() {
             let mask = match &self.options.select {
