@@ -102,6 +102,10 @@ pub enum TerrainCmd {
         /// With --quantized-mesh: the finest level (0-19; default: as fine as the grid).
         #[arg(long, value_name = "LEVEL", requires = "quantized_mesh")]
         max_level: Option<u32>,
+        /// With --quantized-mesh: gzip every tile (names unchanged), as cesium-terrain-builder
+        /// writes them; serve them with `Content-Encoding: gzip`.
+        #[arg(long, requires = "quantized_mesh")]
+        gzip: bool,
     },
     /// Seed 000 Eq. (5)-(7): GST maps the active area needs per level, and the total.
     Maps {
@@ -259,6 +263,7 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
             geoid,
             quantized_mesh,
             max_level,
+            gzip,
         } => {
             if geoid.is_some() && !(tiles3d || quantized_mesh) {
                 return usage("--geoid applies to --3d-tiles and --quantized-mesh");
@@ -270,6 +275,7 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
                 let options = texmap_terrain::qmesh::QuantizedMeshOptions {
                     geoid: geoid.as_ref(),
                     max_level,
+                    gzip,
                 };
                 let s = texmap_terrain::qmesh::write_quantized_mesh(&d, &output, &options)?;
                 sp.finish_and_clear();

@@ -684,8 +684,8 @@ fn export_3d_tiles_and_its_refusals() {
 }
 
 /// `terrain export --quantized-mesh`: layer.json and the tile pyramid from a UTM grid; the
-/// finest level by --max-level; --geoid without a globe export and --quantized-mesh with
-/// --3d-tiles are usage errors (exit 2).
+/// finest level by --max-level; --gzip tiles; --geoid without a globe export, --quantized-mesh
+/// with --3d-tiles and --max-level or --gzip without --quantized-mesh are usage errors (exit 2).
 #[test]
 fn export_quantized_mesh_and_its_usage_errors() {
     let dir = tempfile::tempdir().unwrap();
@@ -713,9 +713,26 @@ fn export_quantized_mesh_and_its_usage_errors() {
     let x = last["startX"].as_u64().unwrap();
     let y = last["startY"].as_u64().unwrap();
     assert!(out.join(format!("9/{x}/{y}.terrain")).exists());
+    // --gzip: the same tile names, each a gzip member (the library test inflates them).
+    let gz = dir.path().join("qmgz");
+    ok(&texmap(&[
+        "terrain",
+        "export",
+        utm.to_str().unwrap(),
+        "--quantized-mesh",
+        "--max-level",
+        "9",
+        "--gzip",
+        "-o",
+        gz.to_str().unwrap(),
+        "-q",
+    ]));
+    let tile = std::fs::read(gz.join(format!("9/{x}/{y}.terrain"))).unwrap();
+    assert_eq!(tile[..2], [0x1f, 0x8b]);
     for bad in [
         vec!["--quantized-mesh", "--3d-tiles"],
         vec!["--max-level", "9"],
+        vec!["--gzip"],
     ] {
         let mut args = vec!["terrain", "export", utm.to_str().unwrap()];
         args.extend(bad.iter().copied());

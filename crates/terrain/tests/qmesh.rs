@@ -4,7 +4,7 @@
 //! it, every lattice sample of the finest tiles within the stated error of the decoded mesh,
 //! triangles counter-clockwise, the edge lists exactly the vertices on each edge, and every
 //! vertex inside the header's bounding sphere. Also: the tile ranges of layer.json, and the same
-//! bytes for any thread count.
+//! bytes for any thread count, and gzipped tiles that inflate to the same bytes.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -46,11 +46,12 @@ fn srtm_height(grid: &Grid, lon: f64, lat: f64) -> Option<f64> {
     Some(top * (1.0 - fr) + bottom * fr)
 }
 
-fn export(dir: &Path, db: &Database, geoid: &Geoid, name: &str) -> PathBuf {
+fn export(dir: &Path, db: &Database, geoid: &Geoid, name: &str, gzip: bool) -> PathBuf {
     let out = dir.join(name);
     let options = QuantizedMeshOptions {
         geoid: Some(geoid),
         max_level: Some(LEVEL),
+        gzip,
     };
     let s = write_quantized_mesh(db, &out, &options).unwrap();
     assert_eq!(s.levels, LEVEL + 1);
@@ -129,7 +130,7 @@ fn srtm_terrain_decodes_where_the_grid_and_the_geoid_put_it() {
     .unwrap();
     let db = Database::open(&path).unwrap();
     let geoid = Geoid::open(data("egm96_cut.gtx")).unwrap();
-    let out = export(dir.path(), &db, &geoid, "qm");
+    let out = export(dir.path(), &db, &geoid, "qm", false);
 
     // layer.json: both level-0 tiles, then the tiles over the SRTM tile's degree square.
     let layer: serde_json::Value =
@@ -164,7 +165,7 @@ fn srtm_terrain_decodes_where_the_grid_and_the_geoid_put_it() {
         .num_threads(1)
         .build()
         .unwrap();
-    let one = pool.install(|| export(dir.path(), &db, &geoid, "qm1"));
+    let one = pool.install(|| export(dir.path(), &db, &geoid, "qm1", false));
     for z in 0..=LEVEL {
         for entry in walk(&out.join(z.to_string())) {
             let rel = entry.strip_prefix(&out).unwrap();
@@ -177,7 +178,36 @@ fn srtm_terrain_decodes_where_the_grid_and_the_geoid_put_it() {
         }
     }
 
-    // The independent decoder.
+    // Gzipped tiles: each a gzip member whose content is the plain tile, byte for byte;
+    // layer.json as it was.
+    let gz = export(dir.path(), &db, &geoid, "qmgz", true);
+    let (mut plain_bytes, mut gz_bytes) = (0, 0);
+    for entry in walk_all(&out) {
+        let rel = entry.strip_prefix(&out).unwrap();
+        let packed = std::fs::read(gz.join(rel)).unwrap();
+        assert_eq!(packed[..3], [0x1f, 0x8b, 8], "{}", rel.display());
+        let mut inflated = Vec::new();
+        std::io::Read::read_to_end(
+            &mut flate2::read::GzDecoder::new(&packed[..]),
+            &mut inflated,
+        )
+        .unwrap();
+        let plain = std::fs::read(&entry).unwrap();
+        assert_eq!(inflated, plain, "{}", rel.display());
+        plain_bytes += plain.len();
+        gz_bytes += packed.len();
+    }
+    assert_eq!(
+        std::fs::read(out.join("layer.json")).unwrap(),
+        std::fs::read(gz.join("layer.json")).unwrap()
+    );
+    eprintln!("gzip: {gz_bytes} of {plain_bytes} bytes");
+    assert!(
+        gz_bytes * 10 < plain_bytes * 7,
+        "{gz_bytes} of {plain_bytes}"
+    );
+
+    // The independent decoder, on the plain and the gzipped tiles (which it inflates itself).
     let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/tools/qmesh_decode.py");
     let decoded = Command::new("python3").arg(&script).arg(&out).output();
     let decoded = match decoded {
@@ -197,6 +227,20 @@ fn srtm_terrain_decodes_where_the_grid_and_the_geoid_put_it() {
             return;
         }
     };
+    let from_gz = Command::new("python3")
+        .arg(&script)
+        .arg(&gz)
+        .output()
+        .unwrap();
+    assert!(
+        from_gz.status.success(),
+        "{}",
+        String::from_utf8_lossy(&from_gz.stderr)
+    );
+    assert!(
+        from_gz.stdout == decoded.as_bytes(),
+        "the gzipped tiles decode differently"
+    );
     let tiles = parse(&decoded);
     let expected_tiles: usize = walk_all(&out).len();
     assert_eq!(tiles.len(), expected_tiles);

@@ -4,7 +4,8 @@ crates/terrain/tests/qmesh.rs.
 
 Usage: python3 qmesh_decode.py DIR > decoded.txt
 
-For every tile that DIR/layer.json lists as available, in level, x, y order:
+Tiles may be gzip-compressed (told by their first two bytes). For every tile that
+DIR/layer.json lists as available, in level, x, y order:
   tile Z X Y WEST SOUTH EAST NORTH N_VERTICES N_TRIANGLES MIN_H MAX_H
   v LON LAT H                       (one line per vertex, in file order)
   t A B C                           (one line per triangle, decoded indices)
@@ -30,8 +31,10 @@ for z, ranges in enumerate(layer["available"]):
             for y in range(r["startY"], r["endY"] + 1):
                 w, s, e, n = geodetic.TileBounds(x, y, z)
                 t = TerrainTile(west=w, south=s, east=e, north=n)
-                t.fromFile(os.path.join(root, str(z), str(x), "%d.terrain" % y), hasLighting=True,
-                           gzipped=False)
+                path = os.path.join(root, str(z), str(x), "%d.terrain" % y)
+                with open(path, "rb") as f:
+                    gzipped = f.read(2) == b"\x1f\x8b"
+                t.fromFile(path, hasLighting=True, gzipped=gzipped)
                 verts = t.getVerticesCoordinates()
                 h = t.header
                 out.write("tile %d %d %d %.12f %.12f %.12f %.12f %d %d %.9g %.9g\n" % (
