@@ -393,6 +393,12 @@ pub struct RenderArgs {
     /// Also write depth as a one-channel EXR beside each PNG (same name, .exr).
     #[arg(long)]
     pub depth: bool,
+    /// A caption at the top left of every image, on a light backdrop, for movies:
+    /// 't = {ns} ns'. {time} is the frame's time in ps, {ns} in ns, {step} its MD step,
+    /// {frame} its index in the file; a file whose frames carry no time (XYZ, PDB) takes
+    /// {frame}. ASCII only; the text is cut at half the image width.
+    #[arg(long, value_name = "TEXT")]
+    pub label: Option<String>,
     /// Output: PNG image(s) — the name may hold a %04d frame-number pattern; without one, several
     /// frames get _NNNN — or one movie whose extension names its format: .mp4, .webm, .gif
     /// (encoded by ffmpeg: apt-get install ffmpeg) or .apng (no external program). Any other
@@ -662,7 +668,7 @@ Examples:
   texmap render dump.lammpstrj --type-color 1=#ff8000 --type-color 2=40,40,255 --type-radius 2=0.6 -o f.png
   texmap render 1abc.cif.gz --style tube --color-by chain --select 'not water' -o chains.png
   texmap render 1abc.cif --color-by bfactor --colormap coolwarm -o b.png
-  texmap render md.xtc --topology protein.pdb --align backbone --style tube --color-by structure -o f%04d.png
+  texmap render md.xtc --topology protein.pdb --align backbone --style tube --color-by structure --label 't = {ns} ns' -o md.mp4
   texmap render water.gro --color-by element --type-color OW=#ff0000 --radius-scale 0.5 -o w.png
   texmap render md.xyz --eye 0,0,50 --target 0,0,0 --up 0,1,0 --fov 30 --depth -o md.png";
 

@@ -102,6 +102,75 @@ pub fn draw_color_bar(
     );
 }
 
+/// The placeholders `--label` takes.
+const LABEL_FIELDS: [&str; 4] = ["time", "ns", "step", "frame"];
+
+/// `--label`'s template checked before any frame is read: braces balanced, every placeholder
+/// one of [`LABEL_FIELDS`].
+pub fn check_label(template: &str) -> Result<()> {
+    let mut rest = template;
+    while let Some(open) = rest.find(['{', '}']) {
+        if rest[open..].starts_with('}') {
+            return usage(format!("--label {template:?}: '}}' without a '{{'"));
+        }
+        let Some(close) = rest[open..].find('}') else {
+            return usage(format!("--label {template:?}: '{{' without a '}}'"));
+        };
+        let name = &rest[open + 1..open + close];
+        if !LABEL_FIELDS.contains(&name) {
+            return usage(format!(
+                "--label {template:?}: {{{name}}} is not a placeholder; use {{time}} (ps), {{ns}}, {{step}} or {{frame}}"
+            ));
+        }
+        rest = &rest[open + close + 1..];
+    }
+    Ok(())
+}
+
+/// A number with up to `decimals` decimals, trailing zeros dropped: 2.5, 1250, 0.125.
+fn compact(v: f64, decimals: usize) -> String {
+    let s = format!("{v:.decimals$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
+/// `--label`'s text for frame `index` of `file` (a template [`check_label`] accepted). Errors
+/// when it asks for a time or step the frame does not carry.
+pub fn label_text(template: &str, index: usize, frame: &Frame, file: &str) -> Result<String> {
+    let mut out = String::new();
+    let mut rest = template;
+    while let Some(open) = rest.find('{') {
+        out.push_str(&rest[..open]);
+        let close = open + rest[open..].find('}').unwrap_or(rest.len() - open);
+        let name = &rest[open + 1..close.min(rest.len())];
+        let missing = |what: &str| {
+            anyhow::anyhow!(
+                "--label {{{name}}}: frame {index} of {file} has no {what} (XTC, TRR, DCD, AMBER NetCDF, GRO with t= or step=, extended XYZ with Time= and LAMMPS dumps carry them; PDB and plain XYZ do not: use {{frame}})"
+            )
+        };
+        match name {
+            "time" => out.push_str(&compact(frame.time.ok_or_else(|| missing("time"))?, 3)),
+            "ns" => out.push_str(&compact(
+                frame.time.ok_or_else(|| missing("time"))? / 1000.0,
+                3,
+            )),
+            "step" => out.push_str(
+                &frame
+                    .step
+                    .ok_or_else(|| missing("step number"))?
+                    .to_string(),
+            ),
+            _ => out.push_str(&index.to_string()),
+        }
+        rest = &rest[(close + 1).min(rest.len())..];
+    }
+    out.push_str(rest);
+    Ok(out)
+}
+
 /// One line of warning about the style flags.
 pub fn warning_text(w: &StyleWarning) -> String {
     match w {

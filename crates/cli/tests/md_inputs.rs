@@ -692,3 +692,72 @@ fn align_holds_a_tumbling_protein_still() {
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("--align"), "{}", stderr(&o));
 }
+
+/// `--label`: each frame's caption is the template with the time MDAnalysis reads from the
+/// AMBER NetCDF (topology_reference.json), drawn by `draw_caption` over the image `render` makes
+/// without it; nothing else changes. A bad placeholder is a usage error (exit 2); a time the file
+/// lacks (PDB) a runtime error (exit 1).
+#[test]
+fn label_captions_each_frame_with_its_time() {
+    let nc = data("amber_mda.ncdf");
+    let top = data("topo_mda.pdb");
+    let times: Vec<f64> = reference()["ncdf"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f["time"].as_f64().unwrap())
+        .collect();
+    let dir = tempfile::tempdir().unwrap();
+    for label in [None, Some("t = {time} ps, frame {frame}")] {
+        let out = dir.path().join(format!("{}-%d.png", label.is_some()));
+        let mut args = vec![
+            "render",
+            "--quiet",
+            &nc,
+            "--topology",
+            &top,
+            "--frames",
+            "0:4",
+            "--size",
+            "320x240",
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        if let Some(l) = label {
+            args.extend(["--label", l]);
+        }
+        let o = texmap(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    for (f, t) in times.iter().enumerate() {
+        let read = |labelled: bool| {
+            image::open(dir.path().join(format!("{labelled}-{f}.png")))
+                .unwrap()
+                .to_rgba8()
+        };
+        let mut want = read(false);
+        let text = format!("t = {t} ps, frame {f}");
+        let (w, h) = want.dimensions();
+        assert_eq!(
+            texmap_md_scene::draw_caption(&mut want, w as usize, h as usize, &text),
+            text.len()
+        );
+        assert!(read(true) == want, "frame {f}: {text}");
+    }
+    for (template, file, code) in [
+        ("{bogus}", &nc, 2),
+        ("t = {time", &nc, 2),
+        ("t = {time} ps", &top, 1),
+    ] {
+        let out = dir.path().join("bad.png");
+        let mut args = vec!["render", "--quiet", file.as_str()];
+        if file == &nc {
+            args.extend(["--topology", &top]);
+        }
+        args.extend(["--label", template, "-o", out.to_str().unwrap()]);
+        let o = texmap(&args);
+        assert_eq!(o.status.code(), Some(code), "{template}: {}", stderr(&o));
+        assert!(stderr(&o).contains("--label"), "{}", stderr(&o));
+        assert!(!out.exists());
+    }
+}

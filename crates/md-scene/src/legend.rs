@@ -1,4 +1,5 @@
-//! A colour bar legend drawn onto a rendered image: the colour map from the range's maximum (top)
+//! A colour bar legend drawn onto a rendered image (and, with the same font, a one-line caption
+//! at the top left: [`draw_caption`]): the colour map from the range's maximum (top)
 //! to its minimum (bottom) in a thin dark frame, tick labels for the minimum, the middle and the
 //! maximum beside it and a title above, on a light backdrop at the right edge of the image.
 //!
@@ -163,6 +164,53 @@ pub fn draw_color_bar(rgba: &mut [u8], width: usize, height: usize, bar: &ColorB
         image.text(layout.title_x, layout.title_y, s, title, layout.panel);
     }
     true
+}
+
+/// Draws `text` as a caption at the top left of `rgba` (8-bit sRGB RGBA, `width` x `height`,
+/// row 0 at the top): the colour bar's font at its scale, on the same backdrop, one line, the
+/// characters that do not fit within half the image width dropped (non-ASCII ones drawn as `?`).
+/// Returns the number of characters drawn (0, and nothing drawn, for an empty text or an image
+/// too small for one character). Movies use it for the frame's time (`texmap render --label`).
+///
+/// ```
+/// use texmap_md_scene::draw_caption;
+/// let (width, height) = (360, 240);
+/// let mut rgba = vec![0u8; width * height * 4];
+/// assert_eq!(draw_caption(&mut rgba, width, height, "t = 2.5 ns"), 10);
+/// // Top left is covered, the rest of the image untouched.
+/// assert_eq!(rgba[(6 * width + 6) * 4 + 3], 255);
+/// assert!(rgba[(height / 2 * width) * 4..].iter().all(|&b| b == 0));
+/// ```
+pub fn draw_caption(rgba: &mut [u8], width: usize, height: usize, text: &str) -> usize {
+    let expected = width.checked_mul(height).and_then(|n| n.checked_mul(4));
+    assert!(
+        expected == Some(rgba.len()),
+        "draw_caption: {width} x {height} RGBA needs {expected:?} bytes, got {}",
+        rgba.len()
+    );
+    let s = scale_of(height);
+    let (margin, pad) = (4 * s, 4 * s);
+    let room = (width / 2).saturating_sub(margin + 2 * pad);
+    let chars = text.chars().count().min((room + s) / (ADVANCE * s));
+    let panel = Rect {
+        x0: margin,
+        y0: margin,
+        x1: margin + 2 * pad + (chars * ADVANCE * s).saturating_sub(s),
+        y1: margin + 2 * pad + CELL_HEIGHT * s,
+    };
+    if chars == 0 || panel.y1 + margin > height {
+        return 0;
+    }
+    let mut image = Image { rgba, width };
+    image.blend_backdrop(panel);
+    image.text(
+        margin + pad,
+        margin + pad,
+        s,
+        text.chars().take(chars),
+        panel,
+    );
+    chars
 }
 
 /// Text, frame and tick colour: opaque dark grey (sRGB).
@@ -904,5 +952,42 @@ mod tests {
         }
         assert_eq!(glyph('é'), glyph('?'));
         assert_eq!(glyph('\n'), glyph('?'));
+    }
+
+    #[test]
+    fn captions_draw_the_fonts_glyphs_at_the_top_left_and_clip_to_half_the_width() {
+        for (width, height) in [(360usize, 240usize), (1280, 720)] {
+            let s = scale_of(height);
+            let text = "t=1.5 ns";
+            let mut rgba = vec![0u8; width * height * 4];
+            assert_eq!(draw_caption(&mut rgba, width, height, text), text.len());
+            let (x0, y0) = (8 * s, 8 * s);
+            let px = |x: usize, y: usize| &rgba[(y * width + x) * 4..(y * width + x) * 4 + 4];
+            for (i, ch) in text.chars().enumerate() {
+                let g = glyph(ch);
+                for row in 0..CELL_HEIGHT {
+                    for col in 0..GLYPH_WIDTH {
+                        let ink = (g >> (8 * (CELL_HEIGHT - 1 - row))) as u8 & (0x10 >> col) != 0;
+                        // Every pixel of the s-by-s block.
+                        for dy in 0..s {
+                            for dx in 0..s {
+                                let p = px(x0 + (i * ADVANCE + col) * s + dx, y0 + row * s + dy);
+                                assert_eq!(p == INK, ink, "{ch:?} row {row} col {col}");
+                            }
+                        }
+                    }
+                }
+            }
+            // Below the backdrop nothing changed.
+            let below = 8 * s + CELL_HEIGHT * s + 4 * s;
+            assert!(rgba[below * width * 4..].iter().all(|&b| b == 0));
+        }
+        // A long text keeps to half the width; a tiny image gets nothing.
+        let mut rgba = vec![0u8; 200 * 100 * 4];
+        let n = draw_caption(&mut rgba, 200, 100, &"x".repeat(100));
+        assert_eq!(n, (100 - 4 - 8 + 1) / ADVANCE);
+        let mut tiny = vec![0u8; 10 * 10 * 4];
+        assert_eq!(draw_caption(&mut tiny, 10, 10, "t"), 0);
+        assert!(tiny.iter().all(|&b| b == 0));
     }
 }
