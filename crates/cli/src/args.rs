@@ -631,6 +631,13 @@ pub struct MolArgs {
     /// Periodic boundaries: none, wrap (atoms into the box), unwrap (molecules whole).
     #[arg(long, value_enum, default_value_t = PbcArg::None)]
     pub pbc: PbcArg,
+    /// A representation, as VMD's: 'SEL=STYLE' draws the atoms SEL selects in STYLE (spacefill,
+    /// ball-stick, licorice, tube), each with its own radii and bond radius; repeat it to
+    /// draw several in one image: --rep 'protein=tube' --rep 'resname LIG=ball-stick'
+    /// --rep 'water and within 5 of resname LIG=licorice'. Replaces --select and --style; an
+    /// atom two representations select is drawn by both.
+    #[arg(long = "rep", value_name = "SEL=STYLE", conflicts_with_all = ["select", "draw"])]
+    pub reps: Vec<String>,
     /// Superpose every frame on the first rendered frame by the least-squares fit of the atoms
     /// SEL picks ('backbone', 'name CA', 'protein and not name H*'), so the molecule holds still
     /// while it tumbles and diffuses, as MDAnalysis's AlignTraj and VMD's 'measure fit' do

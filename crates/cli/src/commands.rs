@@ -442,14 +442,16 @@ fn render(a: &RenderArgs) -> Result<()> {
                 pb.suspend(|| eprintln!("texmap: warning: {w}"));
             }
             if scene.is_empty() {
-                let e = anyhow::anyhow!(
-                    "no atom to draw{}",
+                let why = if a.mol.reps.is_empty() {
                     a.mol
                         .select
                         .as_deref()
                         .map(|s| format!(": --select {s:?} selects none of frame {f}'s atoms"))
                         .unwrap_or_default()
-                );
+                } else {
+                    format!(": no --rep selects any of frame {f}'s atoms")
+                };
+                let e = anyhow::anyhow!("no atom to draw{why}");
                 return Err(fail(e, &written));
             }
             let plan =

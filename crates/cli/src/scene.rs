@@ -221,9 +221,16 @@ fn sel_value<'a>(flag: &str, s: &'a str) -> Result<(&'a str, &'a str)> {
         Some((sel, v)) if !sel.trim().is_empty() && !v.trim().is_empty() => {
             Ok((sel.trim(), v.trim()))
         }
-        _ => usage(format!(
-            "{flag} {s:?}: expected SELECTION=VALUE, e.g. {flag} 'resname SOL=#4080ff'"
-        )),
+        _ => {
+            let example = match flag {
+                "--rep" => "protein=tube",
+                "--radius" => "name CA=2",
+                _ => "resname SOL=#4080ff",
+            };
+            usage(format!(
+                "{flag} {s:?}: expected SELECTION=VALUE, e.g. {flag} '{example}'"
+            ))
+        }
     }
 }
 
@@ -293,10 +300,24 @@ pub fn mol_plan(args: &MolArgs) -> Result<MolPlan> {
         .as_deref()
         .map(|t| parse_selection("--align", t))
         .transpose()?;
+    let mut reps = Vec::new();
+    for r in &args.reps {
+        let (sel, style) = sel_value("--rep", r)?;
+        let draw = <DrawStyle as clap::ValueEnum>::from_str(style.trim(), true).map_err(|_| {
+            crate::args::UsageError(format!(
+                "--rep {r:?}: {style:?} is not a style; use spacefill, ball-stick, licorice or tube"
+            ))
+        })?;
+        reps.push(texmap_md_scene::Representation {
+            select: Some(parse_selection("--rep", sel)?),
+            draw: draw.into(),
+        });
+    }
     MolPlan::new(MolOptions {
         topology,
         select,
         align,
+        reps,
         colors,
         radii,
         bonds: args.bonds.into(),

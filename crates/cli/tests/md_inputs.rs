@@ -761,3 +761,48 @@ fn label_captions_each_frame_with_its_time() {
         assert!(!out.exists());
     }
 }
+
+/// `--rep SEL=STYLE`: one representation is `--select SEL --style STYLE` byte for byte; a second
+/// adds its atoms (here residues 420-432 as balls and sticks over the tube); a style that does not exist, a missing '=', or --rep with --select are usage errors.
+#[test]
+fn representations_combine_styles_in_one_image() {
+    let input = data("dssp/3gwiA.pdb.gz");
+    let dir = tempfile::tempdir().unwrap();
+    let render = |name: &str, extra: &[&str]| {
+        let out = dir.path().join(name);
+        let mut args = vec![
+            "render", "--quiet", &input, "--size", "320x240", "--view", "z",
+        ];
+        args.extend(extra);
+        args.extend(["-o", out.to_str().unwrap()]);
+        let o = texmap(&args);
+        assert!(o.status.success(), "{extra:?}: {}", stderr(&o));
+        std::fs::read(out).unwrap()
+    };
+    let plain = render("plain.png", &["--select", "protein", "--style", "tube"]);
+    let one = render("one.png", &["--rep", "protein=tube"]);
+    assert!(plain == one, "one --rep differs from --select/--style");
+    let two = render(
+        "two.png",
+        &[
+            "--rep",
+            "protein=tube",
+            "--rep",
+            "resid 420 to 432 and not name H*=ball-stick",
+        ],
+    );
+    assert!(two != one);
+    for bad in [
+        vec!["--rep", "protein=cartoon"],
+        vec!["--rep", "protein"],
+        vec!["--rep", "protein=tube", "--select", "protein"],
+        vec!["--rep", "protein=tube", "--style", "licorice"],
+    ] {
+        let mut args = vec!["render", "--quiet", input.as_str()];
+        args.extend(bad.iter().copied());
+        let out = dir.path().join("bad.png");
+        args.extend(["-o", out.to_str().unwrap()]);
+        let o = texmap(&args);
+        assert_eq!(o.status.code(), Some(2), "{bad:?}: {}", stderr(&o));
+    }
+}

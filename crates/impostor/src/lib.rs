@@ -13,7 +13,7 @@
 //!
 //! **Bonds.** Every method draws [`SphereScene::bonds`] (when [`Options::draw_bonds`] is on, the
 //! default) in one pass after its spheres: exact ray-cast cylinders of radius
-//! [`SphereScene::bond_radius`] between the atom centres, half-bond coloured (each half in its
+//! [`SphereScene::bond_radius`] (or each bond's own, [`SphereScene::bond_radii`]) between the atom centres, half-bond coloured (each half in its
 //! atom's material), flat-capped where a bond is thicker than its atom, depth-tested against the
 //! spheres so that atoms and bonds interpenetrate correctly (module `bonds`). A bond's accuracy
 //! is the ray caster's whatever method drew the atoms; invalid bonds are skipped and counted in

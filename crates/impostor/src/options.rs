@@ -120,6 +120,6 @@ pub struct RenderStats {
     pub bonds_culled: usize,
     /// Bonds skipped: an atom index out of range, an atom that is itself skipped (see
     /// `skipped_invalid`), two atoms at the same centre, or a non-positive or non-finite
-    /// [`crate::SphereScene::bond_radius`] (then every bond is skipped).
+    /// radius ([`crate::SphereScene::bond_radius_of`]).
     pub bonds_skipped: usize,
 }

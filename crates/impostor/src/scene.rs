@@ -18,6 +18,10 @@ pub struct SphereScene {
     /// Pairs of sphere indices joined by a cylinder of radius `bond_radius`.
     pub bonds: Vec<[u32; 2]>,
     pub bond_radius: f32,
+    /// Per-bond radii, one per entry of `bonds`, when bonds differ (several draw styles in one
+    /// scene); empty: every bond has `bond_radius`. A length other than `bonds.len()` makes
+    /// every bond use `bond_radius`.
+    pub bond_radii: Vec<f32>,
 }
 
 impl SphereScene {
@@ -27,6 +31,17 @@ impl SphereScene {
             materials,
             bond_radius: 0.15,
             ..Default::default()
+        }
+    }
+
+    /// The radius of bond `k`: `bond_radii[k]` when per-bond radii are given, else
+    /// `bond_radius`.
+    #[inline]
+    pub fn bond_radius_of(&self, k: usize) -> f32 {
+        if self.bond_radii.len() == self.bonds.len() {
+            self.bond_radii[k]
+        } else {
+            self.bond_radius
         }
     }
 

@@ -56,10 +56,10 @@ fn oracle(scene: &SphereScene, cam: &Camera, lighting: &Lighting, halves: bool) 
     for i in 0..scene.len() {
         b.add_sphere(scene.centers[i], scene.radii[i], scene.kinds[i] as u32);
     }
-    for &[i, j] in &scene.bonds {
+    for (k, &[i, j]) in scene.bonds.iter().enumerate() {
         let (i, j) = (i as usize, j as usize);
         let (pa, pb) = (scene.centers[i], scene.centers[j]);
-        let r = scene.bond_radius;
+        let r = scene.bond_radius_of(k);
         if halves {
             let mid = (pa + pb) * 0.5;
             b.add_cylinder(pa, mid, r, scene.kinds[i] as u32);
@@ -422,4 +422,30 @@ fn same_bytes_for_one_and_two_threads() {
             m.name()
         );
     }
+}
+
+#[test]
+fn per_bond_radii_match_reftrace() {
+    // Three radii along the chain (thin, medium, thicker than the atoms: flat caps), the
+    // reference built with each bond's own radius.
+    let mut scene = molecule(24, 0.2);
+    scene.bond_radii = (0..scene.bonds.len())
+        .map(|k| [0.1, 0.25, 0.45][k % 3])
+        .collect();
+    let dir = Vec3::new(0.5, 0.3, 1.0).normalize();
+    let cam = persp(dir * 16.0, 40.0, 240, 240);
+    check(&scene, &cam, true, "per-bond radii");
+    // A wrong-length list falls back to bond_radius for every bond.
+    let mut fallback = scene.clone();
+    fallback.bond_radii.pop();
+    let uniform = molecule(24, 0.2);
+    let lighting = Lighting::default_for(&cam);
+    let mut r = Renderer::new();
+    let a = r
+        .render(&fallback, &cam, &Options::new(Method::Raycast, lighting))
+        .frame;
+    let b = r
+        .render(&uniform, &cam, &Options::new(Method::Raycast, lighting))
+        .frame;
+    assert!(a == b);
 }

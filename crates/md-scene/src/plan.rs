@@ -17,7 +17,10 @@
 //!    fitted at the first frame to the atoms the selection draws), then the colour rules and the
 //!    radius rules, each list in order, so that a later rule wins over an earlier one for the
 //!    atoms both select;
-//! 5. the [`DrawStyle`]: radii scaled for ball-and-stick, or all set to [`LICORICE_RADIUS`];
+//! 5. per [`Representation`] (one, of [`MolOptions::select`] and [`MolOptions::draw`], unless
+//!    [`MolOptions::reps`] lists several, each then drawn on its own and the scenes
+//!    concatenated, every bond with its style's radius in [`SphereScene::bond_radii`]):
+//!    the [`DrawStyle`]: radii scaled for ball-and-stick, or all set to [`LICORICE_RADIUS`];
 //! 6. the selection: the selected atoms are kept in their order and the bonds between two kept
 //!    atoms are renumbered to the kept atoms' indices; bonds to a dropped atom are dropped;
 //! 7. for [`DrawStyle::Tube`], the selected atoms of protein and nucleic residues give way to
@@ -115,6 +118,20 @@ pub struct MolOptions {
     /// Superpose every frame on the first frame built, fitted on these atoms (see the module
     /// docs); `None` leaves positions as read.
     pub align: Option<Selection>,
+    /// Several representations in one scene (see [`Representation`]); when not empty, they
+    /// replace `select` and `draw`.
+    pub reps: Vec<Representation>,
+}
+
+/// One representation, as VMD's: the atoms a selection picks (all when `None`), drawn in one
+/// style. Each representation's atoms and bonds are drawn on their own, with that style's radii
+/// and bond radius, so one scene can hold a protein's tube, a ligand's balls and sticks and
+/// nearby waters as licorice; an atom two selections pick is drawn twice. Colours are the plan's
+/// for every representation (colour-by and the colour rules).
+#[derive(Clone, Debug)]
+pub struct Representation {
+    pub select: Option<Selection>,
+    pub draw: DrawStyle,
 }
 
 impl Default for MolOptions {
@@ -128,6 +145,7 @@ impl Default for MolOptions {
             draw: DrawStyle::Spacefill,
             pbc: Pbc::None,
             align: None,
+            reps: Vec::new(),
         }
     }
 }
@@ -221,6 +239,8 @@ pub struct MolPlan {
     /// The alignment's atoms and their positions in the first frame built.
     align_reference: Option<(Vec<usize>, Vec<[f64; 3]>)>,
     last_fit_rmsd: Option<f64>,
+    /// The representations: `options.reps`, or the one of `options.select` and `options.draw`.
+    reps: Vec<Representation>,
 }
 
 impl MolPlan {
@@ -235,7 +255,16 @@ impl MolPlan {
                 });
             }
         }
-        if options.bonds == BondSource::Topology && options.draw != DrawStyle::Spacefill {
+        let reps = if options.reps.is_empty() {
+            vec![Representation {
+                select: options.select.clone(),
+                draw: options.draw,
+            }]
+        } else {
+            options.reps.clone()
+        };
+        let sticks = reps.iter().any(|r| r.draw != DrawStyle::Spacefill);
+        if options.bonds == BondSource::Topology && sticks {
             match &options.topology {
                 None => return Err(MolError::NoTopology),
                 Some(t) if t.bonds.is_empty() => {
@@ -253,6 +282,7 @@ impl MolPlan {
             last_bond_count: 0,
             align_reference: None,
             last_fit_rmsd: None,
+            reps,
         })
     }
 
@@ -326,7 +356,8 @@ impl MolPlan {
 
     /// Whether bonds are drawn at all.
     pub fn draws_bonds(&self) -> bool {
-        self.options.draw != DrawStyle::Spacefill && self.options.bonds != BondSource::None
+        self.reps.iter().any(|r| r.draw != DrawStyle::Spacefill)
+            && self.options.bonds != BondSource::None
     }
 
     /// The bonds of the last frame built, after the periodic treatment and before the
@@ -395,10 +426,19 @@ impl MolPlan {
         self.align(frame)?;
         // A scalar colouring's range, once: over the atoms drawn.
         if builder.color_by() == crate::ColorBy::Scalar && builder.scalar().range.is_none() {
-            let mask = match &self.options.select {
-                Some(sel) => Some(sel.evaluate(frame).map_err(failed(SelectionRole::Select))?),
-                None => None,
-            };
+            // The atoms of every representation.
+            let mut mask: Option<Vec<bool>> = Some(vec![false; frame.n_atoms()]);
+            for rep in &self.reps {
+                match &rep.select {
+                    Some(sel) => {
+                        let m = sel.evaluate(frame).map_err(failed(SelectionRole::Select))?;
+                        if let Some(all) = &mut mask {
+                            all.iter_mut().zip(m).for_each(|(a, b)| *a |= b);
+                        }
+                    }
+                    None => mask = None,
+                }
+            }
             builder.fit_scalar_range(frame, mask.as_deref());
         }
         // Every atom, styled; then the per-selection rules, in order.
@@ -422,7 +462,44 @@ impl MolPlan {
                 }
             }
         }
-        match self.options.draw {
+        if let [rep] = &self.reps[..] {
+            let rep = rep.clone();
+            return self.draw_rep(frame, &rep, scene);
+        }
+        // Several: each drawn from the styled atoms on its own, then concatenated, every bond
+        // with its representation's radius.
+        let styled = std::mem::take(scene);
+        scene.materials = styled.materials.clone();
+        let reps = self.reps.clone();
+        for (k, rep) in reps.iter().enumerate() {
+            let mut part = styled.clone();
+            self.draw_rep(frame, rep, &mut part)?;
+            if k == 0 {
+                scene.bond_radius = part.bond_radius;
+            }
+            let offset = scene.centers.len() as u32;
+            scene.centers.extend_from_slice(&part.centers);
+            scene.radii.extend_from_slice(&part.radii);
+            scene.kinds.extend_from_slice(&part.kinds);
+            for (b, pair) in part.bonds.iter().enumerate() {
+                scene.bonds.push(pair.map(|i| i + offset));
+                scene.bond_radii.push(part.bond_radius_of(b));
+            }
+        }
+        Ok(())
+    }
+
+    /// Steps 5-7 of the module docs for one representation, in place: `scene` holds every atom
+    /// of `frame`, styled, in frame order, and the plan's bond pairs index them.
+    fn draw_rep(
+        &mut self,
+        frame: &Frame,
+        rep: &Representation,
+        scene: &mut SphereScene,
+    ) -> Result<(), MolError> {
+        let failed = |role| move |error| MolError::Selection { role, error };
+        scene.bond_radii.clear();
+        match rep.draw {
             DrawStyle::Spacefill => {}
             DrawStyle::BallStick => {
                 for r in &mut scene.radii {
@@ -438,11 +515,11 @@ impl MolPlan {
             }
         }
         // The selection: keep selected atoms, renumber the bonds between them.
-        let mut mask = match &self.options.select {
+        let mut mask = match &rep.select {
             Some(sel) => Some(sel.evaluate(frame).map_err(failed(SelectionRole::Select))?),
             None => None,
         };
-        let traces = match self.options.draw {
+        let traces = match rep.draw {
             DrawStyle::Tube => {
                 let selected = mask.get_or_insert_with(|| vec![true; frame.n_atoms()]);
                 backbone_traces(frame, scene, selected)
@@ -470,7 +547,7 @@ impl MolPlan {
             scene.kinds.truncate(w);
         }
         scene.bonds.clear();
-        if self.draws_bonds() {
+        if rep.draw != DrawStyle::Spacefill && self.options.bonds != BondSource::None {
             for b in &self.pairs {
                 let (i, j) = if self.map.is_empty() {
                     (b[0], b[1])

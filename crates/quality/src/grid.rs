@@ -197,9 +197,8 @@ pub(crate) struct Grid {
     items: Vec<u32>,
 }
 
-/// Whether bond `[i, j]` of `scene` is drawn (the impostor crate's rules).
-fn bond_ok(scene: &SphereScene, i: usize, j: usize) -> bool {
-    let r = scene.bond_radius;
+/// Whether bond `[i, j]` of `scene`, of radius `r`, is drawn (the impostor crate's rules).
+fn bond_ok(scene: &SphereScene, i: usize, j: usize, r: f32) -> bool {
     r.is_finite()
         && r > 0.0
         && i < scene.len()
@@ -223,9 +222,10 @@ impl Grid {
             }
         }
         if bonds {
-            for &[i, j] in &scene.bonds {
+            for (k, &[i, j]) in scene.bonds.iter().enumerate() {
                 let (i, j) = (i as usize, j as usize);
-                if bond_ok(scene, i, j) {
+                let r = scene.bond_radius_of(k);
+                if bond_ok(scene, i, j, r) {
                     let (a, b) = (scene.centers[i], scene.centers[j]);
                     let len = (b - a).length();
                     if !(len.is_finite() && len > 0.0) {
@@ -235,7 +235,7 @@ impl Grid {
                         a,
                         u: (b - a) / len,
                         len,
-                        r: scene.bond_radius,
+                        r,
                         mat_a: scene.kinds[i],
                         mat_b: scene.kinds[j],
                     });

@@ -44,7 +44,7 @@ pub fn reference_scene(spheres: &SphereScene) -> texmap_reftrace::Scene {
 }
 
 /// [`reference_scene`] plus, when `bonds` is set, every drawable bond of `spheres` as two capped
-/// cylinders of radius `bond_radius`, from each atom's centre to the bond's midpoint in that
+/// cylinders of its radius (`bond_radius_of`), from each atom's centre to the bond's midpoint in that
 /// atom's material (half-bond colouring, as the methods draw it). Bonds the methods skip (an
 /// index out of range, an invalid atom, coincident centres, a bad radius) are left out.
 pub fn reference_scene_with_bonds(spheres: &SphereScene, bonds: bool) -> texmap_reftrace::Scene {
@@ -58,11 +58,13 @@ pub fn reference_scene_with_bonds(spheres: &SphereScene, bonds: bool) -> texmap_
             );
         }
     }
-    let r = spheres.bond_radius;
-    if bonds && r.is_finite() && r > 0.0 {
-        for &[i, j] in &spheres.bonds {
+    if bonds {
+        for (k, &[i, j]) in spheres.bonds.iter().enumerate() {
             let (i, j) = (i as usize, j as usize);
-            if i < spheres.len()
+            let r = spheres.bond_radius_of(k);
+            if r.is_finite()
+                && r > 0.0
+                && i < spheres.len()
                 && j < spheres.len()
                 && spheres.is_valid(i)
                 && spheres.is_valid(j)

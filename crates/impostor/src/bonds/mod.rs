@@ -2,7 +2,7 @@
 //!
 //! Molecules are drawn with their bonds; Seed 002 ends with "the same idea extends to pipes
 //! (cylinders, i.e. bonds)". This pass draws every
-//! [`SphereScene::bonds`] pair as a cylinder of radius [`SphereScene::bond_radius`] from one atom
+//! [`SphereScene::bonds`] pair as a cylinder of its radius ([`SphereScene::bond_radius_of`]: per bond, or `bond_radius` for all) from one atom
 //! centre to the other, **half-bond coloured** (the half nearer atom `i` in atom `i`'s material,
 //! as VMD and OVITO do), lit with the workspace's one shading model in eye space.
 //!

@@ -283,12 +283,12 @@ pub(super) fn project_chunk(
     range: std::ops::Range<usize>,
     sink: &mut ChunkSink<'_, BondRec>,
 ) -> BondStats {
-    let r = scene.bond_radius;
-    let radius_ok = r.is_finite() && r > 0.0;
     let natoms = scene.len();
     let mut stats = BondStats::default();
-    for &[i, j] in &scene.bonds[range] {
+    for (k, &[i, j]) in scene.bonds[range.clone()].iter().enumerate() {
         let (i, j) = (i as usize, j as usize);
+        let r = scene.bond_radius_of(range.start + k);
+        let radius_ok = r.is_finite() && r > 0.0;
         // Validate: radius, indices, both atoms drawable, distinct centres.
         if !(radius_ok
             && i < natoms
