@@ -111,12 +111,7 @@ pub struct ColorBar<'a> {
 /// assert!(tiny.iter().all(|&b| b == 0));
 /// ```
 pub fn draw_color_bar(rgba: &mut [u8], width: usize, height: usize, bar: &ColorBar) -> bool {
-    let expected = width.checked_mul(height).and_then(|n| n.checked_mul(4));
-    assert!(
-        expected == Some(rgba.len()),
-        "draw_color_bar: {width} x {height} RGBA needs {expected:?} bytes, got {}",
-        rgba.len()
-    );
+    check_buffer("draw_color_bar", rgba, width, height);
     let Some(layout) = Layout::new(width, height, bar) else {
         return false;
     };
@@ -182,12 +177,7 @@ pub fn draw_color_bar(rgba: &mut [u8], width: usize, height: usize, bar: &ColorB
 /// assert!(rgba[(height / 2 * width) * 4..].iter().all(|&b| b == 0));
 /// ```
 pub fn draw_caption(rgba: &mut [u8], width: usize, height: usize, text: &str) -> usize {
-    let expected = width.checked_mul(height).and_then(|n| n.checked_mul(4));
-    assert!(
-        expected == Some(rgba.len()),
-        "draw_caption: {width} x {height} RGBA needs {expected:?} bytes, got {}",
-        rgba.len()
-    );
+    check_buffer("draw_caption", rgba, width, height);
     let s = scale_of(height);
     let (margin, pad) = (4 * s, 4 * s);
     let room = (width / 2).saturating_sub(margin + 2 * pad);
@@ -211,6 +201,17 @@ pub fn draw_caption(rgba: &mut [u8], width: usize, height: usize, text: &str) ->
         panel,
     );
     chars
+}
+
+/// Panics unless `rgba` holds `width` x `height` RGBA pixels (a caller's bug, named after
+/// `what`).
+fn check_buffer(what: &str, rgba: &[u8], width: usize, height: usize) {
+    let expected = width.checked_mul(height).and_then(|n| n.checked_mul(4));
+    assert!(
+        expected == Some(rgba.len()),
+        "{what}: {width} x {height} RGBA needs {expected:?} bytes, got {}",
+        rgba.len()
+    );
 }
 
 /// Text, frame and tick colour: opaque dark grey (sRGB).
