@@ -655,7 +655,8 @@ How each atom's look is chosen (the first that applies):
           LAMMPS dump `ColorR ColorG ColorB` or `Color.R ...` as OVITO names them; values are
           fractions of 1, clamped to [0, 1]) > --type-color > element colour (CPK/Jmol), or one
           colour per type with --color-by type (the default for atoms that have only types,
-          such as LAMMPS dumps with numeric types), or per chain with --color-by chain
+          such as LAMMPS dumps with numeric types), per chain with --color-by chain, or by
+          secondary structure with --color-by structure (helix purple, strand yellow, coil white)
   radius: --radius SEL=R rules > the file's radius column (`radius`, LAMMPS `diameter` / 2) >
           --type-radius > van der Waals radius of the element; then times --radius-scale
   A NAME rule matches the atom's type first, then its name, then its element.

@@ -26,7 +26,9 @@
 //! Where a piece breaks, no turn or bridge spans the break (DSSP's rule); MDAnalysis ignores
 //! breaks, so the two differ only next to a missing loop. Distances are plain, without periodic
 //! images: a protein split across a periodic box should be made whole first (`--pbc unwrap`).
-//! The hydrogen-bond search uses a cell grid, so the cost is linear in the residues.
+//! The hydrogen-bond search uses a cell grid, so the cost is linear in the residues; a frame
+//! whose residues are stacked denser than any protein's ([`MAX_CANDIDATES_PER_RESIDUE`]) is
+//! all coil rather than a quadratic search.
 //!
 //! ```
 //! use texmap_md_io::{Frame, Label, secondary::{self, Structure}};
@@ -54,6 +56,11 @@ pub const MAX_PEPTIDE_BOND: f32 = 2.5;
 pub const HBOND_SEARCH: f32 = 5.0;
 /// Energy (kcal/mol) below which a C=O ... H-N pair is a hydrogen bond.
 pub const HBOND_ENERGY: f64 = -0.5;
+/// Average oxygens per amide in the cells searched above which a frame is taken as degenerate
+/// (residues stacked on each other, e.g. every atom at the origin) and every residue is coil:
+/// proteins give a few dozen, and the search would otherwise cost time quadratic in the
+/// residues.
+pub const MAX_CANDIDATES_PER_RESIDUE: usize = 400;
 
 /// The three-class secondary structure of a residue.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -269,8 +276,9 @@ impl HBonds {
     }
 }
 
-/// The backbone hydrogen bonds of `res` (see the module docs, steps 1-2).
-fn hbonds(frame: &Frame, res: &[BackboneResidue]) -> HBonds {
+/// The backbone hydrogen bonds of `res` (see the module docs, steps 1-2); `None` when the
+/// residues are packed denser than any protein ([`MAX_CANDIDATES_PER_RESIDUE`]).
+fn hbonds(frame: &Frame, res: &[BackboneResidue]) -> Option<HBonds> {
     let n = res.len();
     let pos = |r: usize, k: usize| v3(frame.positions[res[r].backbone[k]]);
     // Amide hydrogens: none for the first residue of a piece or a proline.
@@ -306,6 +314,28 @@ fn hbonds(frame: &Frame, res: &[BackboneResidue]) -> HBonds {
     let mut grid: std::collections::HashMap<[i64; 3], Vec<u32>> = std::collections::HashMap::new();
     for r in 0..n {
         grid.entry(ckey(pos(r, 3))).or_default().push(r as u32);
+    }
+    // Real proteins put a few dozen oxygens in the 27 cells around an amide; a frame that puts
+    // hundreds (every atom at the origin, a placeholder) would cost quadratic time: refused.
+    let candidates: usize = (0..n)
+        .filter(|&j| h[j].is_some())
+        .map(|j| {
+            let c = ckey(pos(j, 0));
+            let mut k = 0;
+            for dx in -1..=1 {
+                for dy in -1..=1 {
+                    for dz in -1..=1 {
+                        k += grid
+                            .get(&[c[0] + dx, c[1] + dy, c[2] + dz])
+                            .map_or(0, Vec::len);
+                    }
+                }
+            }
+            k
+        })
+        .sum();
+    if candidates > MAX_CANDIDATES_PER_RESIDUE * n {
+        return None;
     }
     let mut donors = vec![Vec::new(); n];
     let cut2 = cell * cell;
@@ -345,7 +375,7 @@ fn hbonds(frame: &Frame, res: &[BackboneResidue]) -> HBonds {
             }
         }
     }
-    HBonds { donors }
+    Some(HBonds { donors })
 }
 
 /// The secondary structure of `frame`'s residues (see the module docs). A frame without
@@ -356,7 +386,13 @@ pub fn assign(frame: &Frame) -> SecondaryStructure {
     if n == 0 {
         return SecondaryStructure::default();
     }
-    let hb = hbonds(frame, &res);
+    let Some(hb) = hbonds(frame, &res) else {
+        return SecondaryStructure {
+            classes: vec![Structure::Coil; n],
+            residues: res,
+            hbonds: 0,
+        };
+    };
     // piece[r]: index of the piece residue r belongs to, so "no break in a..=b" is
     // piece[a] == piece[b].
     let mut piece = vec![0usize; n];

@@ -220,3 +220,30 @@ fn vmd_structure_keywords_select_the_residues_mdanalysis_assigns() {
     assert_eq!(e.column, 12, "{e}");
     assert!(e.to_string().contains("residue names"), "{e}");
 }
+
+#[test]
+fn residues_stacked_on_one_point_are_coil_at_once() {
+    // 20,000 alanines with every atom within 1 Å of the origin (a placeholder file): the search
+    // would evaluate 4e8 pairs and find hydrogen bonds among most of them; the density guard
+    // makes it all coil, with no bond searched.
+    let mut f = Frame::new();
+    let mut seed = 12345u64;
+    let mut jitter = || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((seed >> 40) as f32 / (1u64 << 24) as f32 - 0.5) * 1.0
+    };
+    for r in 0..20_000 {
+        for name in ["N", "CA", "C", "O"] {
+            f.names.push(texmap_md_io::Label::new(name).unwrap());
+            f.res_names.push(texmap_md_io::Label::new("ALA").unwrap());
+            f.res_ids.push(r);
+            f.positions.push([jitter(), jitter(), jitter()]);
+        }
+    }
+    let ss = secondary::assign(&f);
+    assert_eq!(ss.residues().len(), 20_000);
+    assert_eq!(ss.hbonds(), 0);
+    assert!(ss.classes().iter().all(|c| *c == Structure::Coil));
+}
