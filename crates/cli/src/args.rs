@@ -609,8 +609,10 @@ pub struct MolArgs {
     pub topology: Option<PathBuf>,
     /// Draw only the atoms SEL selects, in the VMD/MDAnalysis language: 'not resname SOL',
     /// 'name CA', 'element O and resid 1 to 20', 'chain A', 'segid PROA',
-    /// 'protein or within 5 of resname LIG', 'prop bfactor > 50' (VMD: 'beta > 50'),
-    /// 'prop abs charge > 0.5'.
+    /// 'protein or within 5 of resname LIG', 'byres around 5 resname LIG' (whole residues),
+    /// 'same resname as within 3 of name NA', 'helix', 'prop bfactor > 50' (VMD: 'beta > 50'),
+    /// 'prop abs charge > 0.5'. within/around/byres/same...as take the rest of the expression,
+    /// as MDAnalysis reads it: parenthesise to end them sooner.
     #[arg(long, value_name = "SEL")]
     pub select: Option<String>,
     /// Colour of the atoms SEL selects, #rrggbb or R,G,B: --color 'resname SOL=#4080ff';

@@ -12,8 +12,10 @@
 //!           | ("name" | "type" | "resname" | "element") WORD+      -- any of the words
 //!           | ("chain" | "chainID" | "segid" | "segname") WORD+
 //!           | ("index" | "serial" | "bynum" | "id" | "resid") RANGE+
-//!           | "within" NUMBER "of" factor                          -- VMD: includes the factor
-//!           | "around" NUMBER factor                               -- MDAnalysis: excludes it
+//!           | "within" NUMBER "of" expr                            -- VMD: includes the expr
+//!           | "around" NUMBER expr                                 -- MDAnalysis: excludes it
+//!           | "byres" expr                                         -- whole residues
+//!           | "same" FIELD "as" expr  -- FIELD: residue resname resid name type element chain segid
 //!           | "prop" ["abs"] NAME OP NUMBER                        -- MDAnalysis: prop z > 10
 //!           | ("beta" | "occupancy" | "charge") OP NUMBER          -- VMD: beta > 50
 //! RANGE    := N | N "to" M | N:M | N-M                              -- inclusive
@@ -40,6 +42,12 @@
 //! `isclose`, as MDAnalysis). Comparisons are made in f32, the values' precision, as numpy makes
 //! MDAnalysis's (`prop x == 3.278` holds for the x read as 3.278). An atom whose value is NaN
 //! matches only `!=`.
+//! `within`, `around`, `byres` and `same ... as` take the rest of the expression (up to a
+//! closing parenthesis) as MDAnalysis does: `around 4 resname NA and resid 1:15` is
+//! `around 4 (resname NA and resid 1:15)`; parenthesise to end them sooner. `byres` and
+//! `same residue as` select whole residues (consecutive atoms of one residue number, name,
+//! chain and segment); `same resname as around 3 resname NA` every atom whose residue name one
+//! of the picked atoms has.
 //! `within`/`around` use plain distances (no periodic images) through a cell grid, so they cost
 //! time linear in the atoms.
 //!
@@ -117,6 +125,16 @@ enum NumField {
     ResId,
 }
 
+/// What `same ... as` compares.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum SameField {
+    /// The residue itself (consecutive atoms of one residue number, name, chain and segment).
+    Residue,
+    Str(StrField),
+    ResId,
+    Element,
+}
+
 #[derive(Clone, Debug, PartialEq)]
 enum Node {
     All,
@@ -139,6 +157,12 @@ enum Node {
         distance: f64,
         of: Box<Node>,
         include_reference: bool,
+    },
+    /// `byres SEL`, `same FIELD as SEL`: every atom sharing FIELD with an atom SEL selects.
+    Same {
+        field: SameField,
+        of: Box<Node>,
+        column: usize,
     },
     /// `helix`, `sheet`, `coil`: the atoms of residues of that secondary structure.
     Structure {
@@ -295,6 +319,8 @@ fn is_reserved(w: &str) -> bool {
             | "resnum"
             | "within"
             | "around"
+            | "byres"
+            | "same"
             | "prop"
             | "beta"
             | "occupancy"
@@ -490,8 +516,41 @@ impl Parser<'_> {
                 }
                 Ok(Node::Within {
                     distance,
-                    of: Box::new(self.factor()?),
+                    of: Box::new(self.rest(&t)?),
                     include_reference,
+                })
+            }
+            "byres" => Ok(Node::Same {
+                field: SameField::Residue,
+                of: Box::new(self.rest(&t)?),
+                column: t.column,
+            }),
+            "same" => {
+                let f = self.next("what to compare: residue, resname, resid, name, type, element, chain or segid")?;
+                let field = match f.text.to_ascii_lowercase().as_str() {
+                    "residue" => SameField::Residue,
+                    "resname" => SameField::Str(StrField::ResName),
+                    "resid" | "resnum" => SameField::ResId,
+                    "name" => SameField::Str(StrField::Name),
+                    "type" => SameField::Str(StrField::Type),
+                    "element" => SameField::Element,
+                    "chain" | "chainid" => SameField::Str(StrField::Chain),
+                    "segid" | "segname" => SameField::Str(StrField::Segment),
+                    _ => {
+                        return Err(self.error(
+                            f.column,
+                            format!("'same {}': expected residue, resname, resid, name, type, element, chain or segid", f.text),
+                        ));
+                    }
+                };
+                let as_ = self.next("'as'")?;
+                if !as_.text.eq_ignore_ascii_case("as") {
+                    return Err(self.error(as_.column, format!("expected 'as' after 'same {}', found '{}'", f.text, as_.text)));
+                }
+                Ok(Node::Same {
+                    field,
+                    of: Box::new(self.rest(&t)?),
+                    column: t.column,
                 })
             }
             "prop" => self.prop(&t, None),
@@ -506,6 +565,21 @@ impl Parser<'_> {
                 ),
             )),
         }
+    }
+
+    /// The selection after `within ... of`, `around ...`, `byres` and `same ... as`: the rest of
+    /// the expression (up to a closing parenthesis), as MDAnalysis and VMD read it, so
+    /// `around 4 resname NA and resid 1:15` is `around 4 (resname NA and resid 1:15)`.
+    fn rest(&mut self, kw: &Token) -> Result<Node, SelectionError> {
+        let column = match self.peek() {
+            None => Some(self.end_column()),
+            Some(t) if t.text == ")" => Some(t.column),
+            Some(_) => None,
+        };
+        if let Some(column) = column {
+            return Err(self.error(column, format!("expected a selection after '{}'", kw.text)));
+        }
+        self.expr()
     }
 
     /// `prop [abs] NAME OP VALUE` after `prop`: MDAnalysis's forms, spaced or not (`z > 10`,
@@ -902,6 +976,59 @@ impl Selection {
                     *v = op.test(x, *value as f32);
                 }
             }
+            Node::Same { field, of, column } => {
+                let mut picked = vec![false; n];
+                self.eval(of, frame, &mut picked)?;
+                match field {
+                    SameField::Residue => {
+                        if frame.res_ids.len() != n || frame.res_names.len() != n {
+                            return Err(self.missing(*column, "residue numbers and names"));
+                        }
+                        for r in crate::secondary::residue_ranges(frame) {
+                            let any = picked[r.clone()].iter().any(|&p| p);
+                            out[r].fill(any);
+                        }
+                    }
+                    SameField::ResId => {
+                        if frame.res_ids.len() != n {
+                            return Err(self.missing(*column, "residue numbers"));
+                        }
+                        let set: std::collections::HashSet<i64> = (0..n)
+                            .filter(|&i| picked[i])
+                            .map(|i| frame.res_ids[i])
+                            .collect();
+                        for (o, id) in out.iter_mut().zip(&frame.res_ids) {
+                            *o = set.contains(id);
+                        }
+                    }
+                    SameField::Element => {
+                        let set: std::collections::HashSet<Element> = (0..n)
+                            .filter(|&i| picked[i])
+                            .map(|i| crate::style::atom_element(frame, i))
+                            .collect();
+                        for (i, o) in out.iter_mut().enumerate() {
+                            *o = set.contains(&crate::style::atom_element(frame, i));
+                        }
+                    }
+                    SameField::Str(f) => {
+                        let (labels, what): (&[Label], &str) = match f {
+                            StrField::Name => (&frame.names, "atom names"),
+                            StrField::Type => (&frame.types, "atom types"),
+                            StrField::ResName => (&frame.res_names, "residue names"),
+                            StrField::Chain => (&frame.chains, "chain identifiers"),
+                            StrField::Segment => (&frame.segments, "segment identifiers"),
+                        };
+                        if labels.len() != n {
+                            return Err(self.missing(*column, what));
+                        }
+                        let set: std::collections::HashSet<&Label> =
+                            (0..n).filter(|&i| picked[i]).map(|i| &labels[i]).collect();
+                        for (o, l) in out.iter_mut().zip(labels) {
+                            *o = set.contains(l);
+                        }
+                    }
+                }
+            }
             Node::Within {
                 distance,
                 of,
@@ -1079,6 +1206,10 @@ mod tests {
             ("name", 5, "at least one value"),
             ("name CA CB resid", 12, "expected 'and', 'or' or the end"),
             ("", 1, "empty selection"),
+            ("same colour as name CA", 6, "expected residue, resname"),
+            ("same residue of name CA", 14, "expected 'as'"),
+            ("byres", 6, "a selection after 'byres'"),
+            ("name CA or (around 3 )", 22, "a selection after 'around'"),
         ];
         for (text, column, want) in cases {
             let e = Selection::parse(text).unwrap_err();

@@ -51,6 +51,12 @@ selections = [
     "resname NA or (resid 3 and name O)",
     "name HW? and resid 40:45",
     "not protein and not resname SOL",
+    "byres around 4.0 resname NA",
+    "byres name CA and resid 3:5",
+    "same resname as around 3.0 resname NA",
+    "same residue as (name OW and around 3.0 resname NA)",
+    "name O and around 4.0 resname NA and resid 1:15",
+    "same resid as bynum 1 2 3",
 ]
 out = {
     "program": f"MDAnalysis {mda.__version__}",
