@@ -368,9 +368,11 @@ fn render(a: &RenderArgs) -> Result<()> {
         bail!("{}: the file holds no frame", a.file.display());
     }
     let frames = parse_frames(&a.frames, n)?;
-    if let Some(template) = &a.label {
-        crate::scene::check_label(template)?;
-    }
+    let label = a
+        .label
+        .as_deref()
+        .map(crate::scene::parse_label)
+        .transpose()?;
     let mut sink = crate::movie::Sink::new(&a.output, frames.len(), a.fps, a.depth)?;
     // This part's frames (all of them unless sharded): positions in `frames`.
     let mine = match shard_spec(a)? {
@@ -515,8 +517,8 @@ fn render(a: &RenderArgs) -> Result<()> {
         };
         let mut out = out;
         crate::scene::draw_color_bar(&builder, &a.style, &mut out);
-        if let Some(template) = &a.label {
-            let text = crate::scene::label_text(template, f, &md, traj.name())
+        if let Some(parts) = &label {
+            let text = crate::scene::label_text(parts, f, &md, traj.name())
                 .map_err(|e| fail(e, &written))?;
             let (w, h) = (out.width() as usize, out.height() as usize);
             texmap_md_scene::draw_caption(out.color.as_flattened_mut(), w, h, &text);

@@ -102,12 +102,24 @@ pub fn draw_color_bar(
     );
 }
 
-/// The placeholders `--label` takes.
-const LABEL_FIELDS: [&str; 4] = ["time", "ns", "step", "frame"];
+/// One piece of a `--label` template.
+#[derive(Clone, Debug, PartialEq)]
+pub enum LabelPart {
+    Text(String),
+    /// `{time}`: the frame's time in ps.
+    Time,
+    /// `{ns}`: the frame's time in ns.
+    Ns,
+    /// `{step}`: the frame's MD step.
+    Step,
+    /// `{frame}`: the frame's index in the file.
+    Frame,
+}
 
-/// `--label`'s template checked before any frame is read: braces balanced, every placeholder
-/// one of [`LABEL_FIELDS`].
-pub fn check_label(template: &str) -> Result<()> {
+/// `--label`'s template, parsed before any frame is read: braces balanced, every placeholder
+/// `{time}`, `{ns}`, `{step}` or `{frame}`.
+pub fn parse_label(template: &str) -> Result<Vec<LabelPart>> {
+    let mut parts = Vec::new();
     let mut rest = template;
     while let Some(open) = rest.find(['{', '}']) {
         if rest[open..].starts_with('}') {
@@ -116,15 +128,26 @@ pub fn check_label(template: &str) -> Result<()> {
         let Some(close) = rest[open..].find('}') else {
             return usage(format!("--label {template:?}: '{{' without a '}}'"));
         };
-        let name = &rest[open + 1..open + close];
-        if !LABEL_FIELDS.contains(&name) {
-            return usage(format!(
-                "--label {template:?}: {{{name}}} is not a placeholder; use {{time}} (ps), {{ns}}, {{step}} or {{frame}}"
-            ));
+        if open > 0 {
+            parts.push(LabelPart::Text(rest[..open].to_string()));
         }
+        parts.push(match &rest[open + 1..open + close] {
+            "time" => LabelPart::Time,
+            "ns" => LabelPart::Ns,
+            "step" => LabelPart::Step,
+            "frame" => LabelPart::Frame,
+            name => {
+                return usage(format!(
+                    "--label {template:?}: {{{name}}} is not a placeholder; use {{time}} (ps), {{ns}}, {{step}} or {{frame}}"
+                ));
+            }
+        });
         rest = &rest[open + close + 1..];
     }
-    Ok(())
+    if !rest.is_empty() {
+        parts.push(LabelPart::Text(rest.to_string()));
+    }
+    Ok(parts)
 }
 
 /// A number with up to `decimals` decimals, trailing zeros dropped: 2.5, 1250, 0.125.
@@ -137,37 +160,33 @@ fn compact(v: f64, decimals: usize) -> String {
     }
 }
 
-/// `--label`'s text for frame `index` of `file` (a template [`check_label`] accepted). Errors
-/// when it asks for a time or step the frame does not carry.
-pub fn label_text(template: &str, index: usize, frame: &Frame, file: &str) -> Result<String> {
+/// The `--label` text of frame `index` of `file`. Errors when it asks for a time or step the
+/// frame does not carry.
+pub fn label_text(parts: &[LabelPart], index: usize, frame: &Frame, file: &str) -> Result<String> {
+    let missing = |what: &str, placeholder: &str| {
+        anyhow::anyhow!(
+            "--label {{{placeholder}}}: frame {index} of {file} has no {what} (XTC, TRR, DCD, AMBER NetCDF, GRO with t= or step=, extended XYZ with Time= and LAMMPS dumps carry them; PDB and plain XYZ do not: use {{frame}})"
+        )
+    };
     let mut out = String::new();
-    let mut rest = template;
-    while let Some(open) = rest.find('{') {
-        out.push_str(&rest[..open]);
-        let close = open + rest[open..].find('}').unwrap_or(rest.len() - open);
-        let name = &rest[open + 1..close.min(rest.len())];
-        let missing = |what: &str| {
-            anyhow::anyhow!(
-                "--label {{{name}}}: frame {index} of {file} has no {what} (XTC, TRR, DCD, AMBER NetCDF, GRO with t= or step=, extended XYZ with Time= and LAMMPS dumps carry them; PDB and plain XYZ do not: use {{frame}})"
-            )
-        };
-        match name {
-            "time" => out.push_str(&compact(frame.time.ok_or_else(|| missing("time"))?, 3)),
-            "ns" => out.push_str(&compact(
-                frame.time.ok_or_else(|| missing("time"))? / 1000.0,
+    for p in parts {
+        match p {
+            LabelPart::Text(t) => out.push_str(t),
+            LabelPart::Time => out.push_str(&compact(
+                frame.time.ok_or_else(|| missing("time", "time"))?,
                 3,
             )),
-            "step" => out.push_str(
-                &frame
-                    .step
-                    .ok_or_else(|| missing("step number"))?
-                    .to_string(),
-            ),
-            _ => out.push_str(&index.to_string()),
+            LabelPart::Ns => out.push_str(&compact(
+                frame.time.ok_or_else(|| missing("time", "ns"))? / 1000.0,
+                3,
+            )),
+            LabelPart::Step => {
+                let step = frame.step.ok_or_else(|| missing("step number", "step"))?;
+                out.push_str(&step.to_string())
+            }
+            LabelPart::Frame => out.push_str(&index.to_string()),
         }
-        rest = &rest[(close + 1).min(rest.len())..];
     }
-    out.push_str(rest);
     Ok(out)
 }
 
