@@ -798,7 +798,7 @@ impl Selection {
     /// column the frame does not have.
     pub fn evaluate(&self, frame: &Frame) -> Result<Vec<bool>, SelectionError> {
         let mut out = vec![false; frame.n_atoms()];
-        self.eval(&self.root, frame, &mut out)?;
+        self.eval(&self.root, frame, &std::cell::OnceCell::new(), &mut out)?;
         Ok(out)
     }
 
@@ -828,25 +828,31 @@ impl Selection {
         }
     }
 
-    fn eval(&self, node: &Node, frame: &Frame, out: &mut [bool]) -> Result<(), SelectionError> {
+    fn eval(
+        &self,
+        node: &Node,
+        frame: &Frame,
+        structure: &std::cell::OnceCell<Vec<Option<Structure>>>,
+        out: &mut [bool],
+    ) -> Result<(), SelectionError> {
         let n = frame.n_atoms();
         match node {
             Node::All => out.fill(true),
             Node::None => out.fill(false),
             Node::Not(a) => {
-                self.eval(a, frame, out)?;
+                self.eval(a, frame, structure, out)?;
                 out.iter_mut().for_each(|v| *v = !*v);
             }
             Node::And(a, b) => {
-                self.eval(a, frame, out)?;
+                self.eval(a, frame, structure, out)?;
                 let mut rhs = vec![false; n];
-                self.eval(b, frame, &mut rhs)?;
+                self.eval(b, frame, structure, &mut rhs)?;
                 out.iter_mut().zip(&rhs).for_each(|(v, r)| *v &= r);
             }
             Node::Or(a, b) => {
-                self.eval(a, frame, out)?;
+                self.eval(a, frame, structure, out)?;
                 let mut rhs = vec![false; n];
-                self.eval(b, frame, &mut rhs)?;
+                self.eval(b, frame, structure, &mut rhs)?;
                 out.iter_mut().zip(&rhs).for_each(|(v, r)| *v |= r);
             }
             Node::Structure { class, column } => {
@@ -859,10 +865,11 @@ impl Selection {
                         return Err(self.missing(*column, what));
                     }
                 }
-                let ss = crate::secondary::assign(frame).per_atom(n);
+                // Assigned once per evaluation, however many structure keywords it has.
+                let ss = structure.get_or_init(|| crate::secondary::assign(frame).per_atom(n));
                 out.iter_mut()
                     .zip(ss)
-                    .for_each(|(o, c)| *o = c == Some(*class));
+                    .for_each(|(o, c)| *o = *c == Some(*class));
             }
             Node::Str {
                 field,
@@ -978,7 +985,7 @@ impl Selection {
             }
             Node::Same { field, of, column } => {
                 let mut picked = vec![false; n];
-                self.eval(of, frame, &mut picked)?;
+                self.eval(of, frame, structure, &mut picked)?;
                 match field {
                     SameField::Residue => {
                         if frame.res_ids.len() != n || frame.res_names.len() != n {
@@ -1035,7 +1042,7 @@ impl Selection {
                 include_reference,
             } => {
                 let mut reference = vec![false; n];
-                self.eval(of, frame, &mut reference)?;
+                self.eval(of, frame, structure, &mut reference)?;
                 within(&frame.positions, &reference, *distance, out);
                 if !include_reference {
                     out.iter_mut().zip(&reference).for_each(|(v, r)| *v &= !r);
