@@ -117,6 +117,19 @@ enum StrField {
     Segment,
 }
 
+impl StrField {
+    /// The frame's column of this field, and its name for an error.
+    fn column(self, frame: &Frame) -> (&[Label], &'static str) {
+        match self {
+            StrField::Name => (&frame.names, "atom names"),
+            StrField::Type => (&frame.types, "atom types"),
+            StrField::ResName => (&frame.res_names, "residue names"),
+            StrField::Chain => (&frame.chains, "chain identifiers"),
+            StrField::Segment => (&frame.segments, "segment identifiers"),
+        }
+    }
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum NumField {
     Index,
@@ -876,13 +889,7 @@ impl Selection {
                 words,
                 column,
             } => {
-                let (labels, what): (&[Label], &str) = match field {
-                    StrField::Name => (&frame.names, "atom names"),
-                    StrField::Type => (&frame.types, "atom types"),
-                    StrField::ResName => (&frame.res_names, "residue names"),
-                    StrField::Chain => (&frame.chains, "chain identifiers"),
-                    StrField::Segment => (&frame.segments, "segment identifiers"),
-                };
+                let (labels, what) = field.column(frame);
                 if labels.len() != n {
                     return Err(self.missing(*column, what));
                 }
@@ -1018,13 +1025,7 @@ impl Selection {
                         }
                     }
                     SameField::Str(f) => {
-                        let (labels, what): (&[Label], &str) = match f {
-                            StrField::Name => (&frame.names, "atom names"),
-                            StrField::Type => (&frame.types, "atom types"),
-                            StrField::ResName => (&frame.res_names, "residue names"),
-                            StrField::Chain => (&frame.chains, "chain identifiers"),
-                            StrField::Segment => (&frame.segments, "segment identifiers"),
-                        };
+                        let (labels, what) = f.column(frame);
                         if labels.len() != n {
                             return Err(self.missing(*column, what));
                         }
