@@ -291,11 +291,12 @@ impl From<PbcArg> for Pbc {
 /// [`MolArgs`]: the topology file read, the selections and colours parsed.
 pub fn mol_plan(args: &MolArgs) -> Result<MolPlan> {
     let topology = args.topology.as_deref().map(open_topology).transpose()?;
-    let select = args
-        .select
-        .as_deref()
-        .map(|t| parse_selection("--select", t))
-        .transpose()?;
+    let optional = |flag, text: &Option<String>| {
+        text.as_deref()
+            .map(|t| parse_selection(flag, t))
+            .transpose()
+    };
+    let select = optional("--select", &args.select)?;
     let mut colors = Vec::new();
     for c in &args.color_rules {
         let (sel, v) = sel_value("--color", c)?;
@@ -314,11 +315,7 @@ pub fn mol_plan(args: &MolArgs) -> Result<MolPlan> {
         };
         radii.push((parse_selection("--radius", sel)?, radius));
     }
-    let align = args
-        .align
-        .as_deref()
-        .map(|t| parse_selection("--align", t))
-        .transpose()?;
+    let align = optional("--align", &args.align)?;
     let mut reps = Vec::new();
     for r in &args.reps {
         let (sel, style) = sel_value("--rep", r)?;

@@ -462,15 +462,28 @@ impl MolPlan {
                 }
             }
         }
-        if let [rep] = &self.reps[..] {
-            let rep = rep.clone();
-            return self.draw_rep(frame, &rep, scene);
+        // The representations are taken out for the call (draw_rep borrows the plan mutably)
+        // and put back, whatever the outcome.
+        let reps = std::mem::take(&mut self.reps);
+        let drawn = self.draw_reps(frame, &reps, scene);
+        self.reps = reps;
+        drawn
+    }
+
+    /// Steps 5-7 for every representation: one is drawn in place; several are each drawn from
+    /// the styled atoms on their own and concatenated, every bond with its representation's
+    /// radius.
+    fn draw_reps(
+        &mut self,
+        frame: &Frame,
+        reps: &[Representation],
+        scene: &mut SphereScene,
+    ) -> Result<(), MolError> {
+        if let [rep] = reps {
+            return self.draw_rep(frame, rep, scene);
         }
-        // Several: each drawn from the styled atoms on its own, then concatenated, every bond
-        // with its representation's radius.
         let styled = std::mem::take(scene);
         scene.materials = styled.materials.clone();
-        let reps = self.reps.clone();
         for (k, rep) in reps.iter().enumerate() {
             let mut part = styled.clone();
             self.draw_rep(frame, rep, &mut part)?;
