@@ -636,9 +636,16 @@ pub struct MolArgs {
     /// A representation, as VMD's: 'SEL=STYLE' draws the atoms SEL selects in STYLE (spacefill,
     /// ball-stick, licorice, tube), each with its own radii and bond radius; repeat it to
     /// draw several in one image: --rep 'protein=tube' --rep 'resname LIG=ball-stick'
-    /// --rep 'water and within 5 of resname LIG=licorice'. Replaces --select and --style; an
+    /// --rep 'water and within 5 of resname LIG=licorice'. 'SEL=STYLE:COLOUR' gives it its own
+    /// colouring: element, type, chain, structure, property, or one colour #rrggbb or R,G,B
+    /// (--rep 'protein=tube:structure' --rep 'resname LIG=ball-stick:element'); without one it
+    /// takes --color-by, and --color rules win over both. Replaces --select and --style; an
     /// atom two representations select is drawn by both.
-    #[arg(long = "rep", value_name = "SEL=STYLE", conflicts_with_all = ["select", "draw"])]
+    #[arg(
+        long = "rep",
+        value_name = "SEL=STYLE[:COLOUR]",
+        conflicts_with_all = ["select", "draw"]
+    )]
     pub reps: Vec<String>,
     /// Superpose every frame on the first rendered frame by the least-squares fit of the atoms
     /// SEL picks ('backbone', 'name CA', 'protein and not name H*'), so the molecule holds still

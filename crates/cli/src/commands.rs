@@ -434,7 +434,11 @@ fn render(a: &RenderArgs) -> Result<()> {
         }
         if camera.is_none() {
             // First frame: the camera, and warnings about the style flags.
-            for w in builder.warnings(&md) {
+            let rep_warnings: Vec<_> = plan
+                .rep_colorings()
+                .flat_map(|c| builder.color_warnings(&md, c))
+                .collect();
+            for w in builder.warnings(&md).into_iter().chain(rep_warnings) {
                 if matches!(w, texmap_md_scene::StyleWarning::NoScalar { .. }) {
                     return Err(fail(anyhow::anyhow!(warning_text(&w)), &written));
                 }
@@ -516,7 +520,9 @@ fn render(a: &RenderArgs) -> Result<()> {
             .map_err(|e| fail(e.into(), &written))?,
         };
         let mut out = out;
-        crate::scene::draw_color_bar(&builder, &a.style, &mut out);
+        if plan.uses_builder_coloring() {
+            crate::scene::draw_color_bar(&builder, &a.style, &mut out);
+        }
         if let Some(parts) = &label {
             let text = crate::scene::label_text(parts, f, &md, traj.name())
                 .map_err(|e| fail(e, &written))?;

@@ -318,8 +318,12 @@ pub fn mol_plan(args: &MolArgs) -> Result<MolPlan> {
     let align = optional("--align", &args.align)?;
     let mut reps = Vec::new();
     for r in &args.reps {
-        let (sel, style) = sel_value("--rep", r)?;
-        let draw = <DrawStyle as clap::ValueEnum>::from_str(style.trim(), true).map_err(|_| {
+        let (sel, spec) = sel_value("--rep", r)?;
+        let (style, color) = match spec.split_once(':') {
+            Some((style, color)) => (style.trim(), Some(rep_color(r, color.trim())?)),
+            None => (spec, None),
+        };
+        let draw = <DrawStyle as clap::ValueEnum>::from_str(style, true).map_err(|_| {
             crate::args::UsageError(format!(
                 "--rep {r:?}: {style:?} is not a style; use spacefill, ball-stick, licorice or tube"
             ))
@@ -327,6 +331,7 @@ pub fn mol_plan(args: &MolArgs) -> Result<MolPlan> {
         reps.push(texmap_md_scene::Representation {
             select: Some(parse_selection("--rep", sel)?),
             draw: draw.into(),
+            color,
         });
     }
     MolPlan::new(MolOptions {
@@ -341,6 +346,32 @@ pub fn mol_plan(args: &MolArgs) -> Result<MolPlan> {
         pbc: args.pbc.into(),
     })
     .map_err(mol_error)
+}
+
+/// The `:COLOUR` of `--rep SEL=STYLE:COLOUR`: a colouring method without a number, or one
+/// colour.
+fn rep_color(rep: &str, text: &str) -> Result<texmap_md_scene::RepColor> {
+    use texmap_md_scene::RepColor;
+    if text.starts_with('#') || text.contains(',') {
+        let rgb = parse_color(text)
+            .map_err(|e| crate::args::UsageError(format!("--rep {rep:?}: {e}")))?;
+        return Ok(RepColor::Fixed(rgb.map(|x| x as f32 / 255.0)));
+    }
+    let by = match crate::args::parse_color_by(text) {
+        Ok(ColorBy::Property) => texmap_md_scene::ColorBy::Property,
+        Ok(ColorBy::Element) => texmap_md_scene::ColorBy::Element,
+        Ok(ColorBy::Type) => texmap_md_scene::ColorBy::Type,
+        Ok(ColorBy::Chain) => texmap_md_scene::ColorBy::Chain,
+        Ok(ColorBy::Structure) => texmap_md_scene::ColorBy::Structure,
+        _ => {
+            return usage(format!(
+                "--rep {rep:?}: {text:?} is not a representation's colouring; use element, type, \
+                 chain, structure, property, #rrggbb or R,G,B (a colouring by a number is the \
+                 scene's: --color-by {text}, and the representations without :COLOUR take it)"
+            ));
+        }
+    };
+    Ok(RepColor::By(by))
 }
 
 /// A [`MolError`] as the usage error naming the flag.

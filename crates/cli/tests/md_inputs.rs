@@ -764,21 +764,26 @@ fn label_captions_each_frame_with_its_time() {
 
 /// `--rep SEL=STYLE`: one representation is `--select SEL --style STYLE` byte for byte; a second
 /// adds its atoms (here residues 420-432 as balls and sticks over the tube); a style that does not exist, a missing '=', or --rep with --select are usage errors.
+/// 3GWI chain A rendered at 320x240 down z with `extra` flags into `dir/name`.
+fn render_3gwi(dir: &Path, name: &str, extra: &[&str]) -> PathBuf {
+    let input = data("dssp/3gwiA.pdb.gz");
+    let out = dir.join(name);
+    let mut args = vec![
+        "render", "--quiet", &input, "--size", "320x240", "--view", "z",
+    ];
+    args.extend(extra);
+    args.extend(["-o", out.to_str().unwrap()]);
+    let o = texmap(&args);
+    assert!(o.status.success(), "{extra:?}: {}", stderr(&o));
+    out
+}
+
 #[test]
 fn representations_combine_styles_in_one_image() {
     let input = data("dssp/3gwiA.pdb.gz");
     let dir = tempfile::tempdir().unwrap();
-    let render = |name: &str, extra: &[&str]| {
-        let out = dir.path().join(name);
-        let mut args = vec![
-            "render", "--quiet", &input, "--size", "320x240", "--view", "z",
-        ];
-        args.extend(extra);
-        args.extend(["-o", out.to_str().unwrap()]);
-        let o = texmap(&args);
-        assert!(o.status.success(), "{extra:?}: {}", stderr(&o));
-        std::fs::read(out).unwrap()
-    };
+    let render =
+        |name: &str, extra: &[&str]| std::fs::read(render_3gwi(dir.path(), name, extra)).unwrap();
     let plain = render("plain.png", &["--select", "protein", "--style", "tube"]);
     let one = render("one.png", &["--rep", "protein=tube"]);
     assert!(plain == one, "one --rep differs from --select/--style");
@@ -804,5 +809,84 @@ fn representations_combine_styles_in_one_image() {
         args.extend(["-o", out.to_str().unwrap()]);
         let o = texmap(&args);
         assert_eq!(o.status.code(), Some(2), "{bad:?}: {}", stderr(&o));
+    }
+}
+
+#[test]
+fn a_representation_takes_its_own_colouring() {
+    let input = data("dssp/3gwiA.pdb.gz");
+    let dir = tempfile::tempdir().unwrap();
+    let render = |name: &str, extra: &[&str]| render_3gwi(dir.path(), name, extra);
+    let read = |p: &Path| std::fs::read(p).unwrap();
+    // A representation's colouring is the same image as that --color-by for the whole scene.
+    let own = render("own.png", &["--rep", "protein=tube:structure"]);
+    let scene = render(
+        "scene.png",
+        &[
+            "--select",
+            "protein",
+            "--style",
+            "tube",
+            "--color-by",
+            "structure",
+        ],
+    );
+    assert!(read(&own) == read(&scene));
+    // A numeric --color-by that no representation uses draws no colour bar.
+    let unused = render(
+        "unused.png",
+        &["--color-by", "bfactor", "--rep", "protein=tube:element"],
+    );
+    let element = render(
+        "element.png",
+        &[
+            "--color-by",
+            "element",
+            "--select",
+            "protein",
+            "--style",
+            "tube",
+        ],
+    );
+    assert!(read(&unused) == read(&element));
+    let used = render(
+        "used.png",
+        &[
+            "--color-by",
+            "bfactor",
+            "--rep",
+            "protein=tube:element",
+            "--rep",
+            "resid 420 to 432=spacefill",
+        ],
+    );
+    assert!(read(&used) != read(&unused));
+    // One colour: every lit pixel of the tube is a shade of it.
+    let red = render("red.png", &["--rep", "protein=tube:#ff0000"]);
+    let img = image::open(&red).unwrap().to_rgb8();
+    let lit: Vec<_> = img.pixels().filter(|p| p.0 != [0, 0, 0]).collect();
+    assert!(lit.len() > 1000);
+    let reddish = lit
+        .iter()
+        .filter(|p| p.0[0] as u32 > 2 * p.0[1] as u32 + 10 && p.0[1].abs_diff(p.0[2]) < 8)
+        .count();
+    assert!(
+        reddish * 100 >= lit.len() * 95,
+        "{reddish} of {}",
+        lit.len()
+    );
+    for bad in ["protein=tube:bfactor", "protein=tube:#12", "protein=tube:"] {
+        let out = dir.path().join("bad.png");
+        let o = texmap(&[
+            "render",
+            "--quiet",
+            &input,
+            "--rep",
+            bad,
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert_eq!(o.status.code(), Some(2), "{bad}: {}", stderr(&o));
+        assert!(!out.exists());
     }
 }

@@ -20,7 +20,8 @@
 //! 5. per [`Representation`] (one, of [`MolOptions::select`] and [`MolOptions::draw`], unless
 //!    [`MolOptions::reps`] lists several, each then drawn on its own and the scenes
 //!    concatenated, every bond with its style's radius in [`SphereScene::bond_radii`]):
-//!    the [`DrawStyle`]: radii scaled for ball-and-stick, or all set to [`LICORICE_RADIUS`];
+//!    its own colouring ([`RepColor`]) if it has one, under the colour rules again; then the
+//!    [`DrawStyle`]: radii scaled for ball-and-stick, or all set to [`LICORICE_RADIUS`];
 //! 6. the selection: the selected atoms are kept in their order and the bonds between two kept
 //!    atoms are renumbered to the kept atoms' indices; bonds to a dropped atom are dropped;
 //! 7. for [`DrawStyle::Tube`], the selected atoms of protein and nucleic residues give way to
@@ -41,7 +42,7 @@ use std::fmt;
 use texmap_impostor::SphereScene;
 use texmap_md_io::{Frame, Selection, SelectionError, Topology, atom_element};
 
-use crate::SceneBuilder;
+use crate::{ColorBy, SceneBuilder};
 
 /// Ball-and-stick atoms are this fraction of their Bondi (van der Waals) radii.
 pub const BALL_AND_STICK_RADIUS_SCALE: f32 = 0.3;
@@ -126,12 +127,26 @@ pub struct MolOptions {
 /// One representation, as VMD's: the atoms a selection picks (all when `None`), drawn in one
 /// style. Each representation's atoms and bonds are drawn on their own, with that style's radii
 /// and bond radius, so one scene can hold a protein's tube, a ligand's balls and sticks and
-/// nearby waters as licorice; an atom two selections pick is drawn twice. Colours are the plan's
-/// for every representation (colour-by and the colour rules).
+/// nearby waters as licorice; an atom two selections pick is drawn twice. A representation
+/// is coloured by the [`SceneBuilder`]'s colouring unless it has one of its own
+/// ([`RepColor`]); the plan's colour rules ([`MolOptions::colors`]) win over both.
 #[derive(Clone, Debug)]
 pub struct Representation {
     pub select: Option<Selection>,
     pub draw: DrawStyle,
+    /// The representation's own colouring (VMD's per-representation colouring method);
+    /// `None`: the builder's.
+    pub color: Option<RepColor>,
+}
+
+/// A [`Representation`]'s own colouring.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum RepColor {
+    /// Another colouring method, with the builder's palette and per-name rules (see
+    /// [`SceneBuilder::kinds_by`]); [`ColorBy::Scalar`] is the builder's number and colour map.
+    By(ColorBy),
+    /// One colour (sRGB in [0, 1]) for all its atoms (VMD's ColorID).
+    Fixed([f32; 3]),
 }
 
 impl Default for MolOptions {
@@ -239,6 +254,8 @@ pub struct MolPlan {
     /// The alignment's atoms and their positions in the first frame built.
     align_reference: Option<(Vec<usize>, Vec<[f64; 3]>)>,
     last_fit_rmsd: Option<f64>,
+    /// Scratch: per atom, the material the colour rules give it (`u16::MAX`: none).
+    rule_kinds: Vec<u16>,
     /// The representations: `options.reps`, or the one of `options.select` and `options.draw`.
     reps: Vec<Representation>,
 }
@@ -259,6 +276,7 @@ impl MolPlan {
             vec![Representation {
                 select: options.select.clone(),
                 draw: options.draw,
+                color: None,
             }]
         } else {
             options.reps.clone()
@@ -282,6 +300,7 @@ impl MolPlan {
             last_bond_count: 0,
             align_reference: None,
             last_fit_rmsd: None,
+            rule_kinds: Vec::new(),
             reps,
         })
     }
@@ -424,11 +443,19 @@ impl MolPlan {
         self.last_bond_count = self.pairs.len();
         let failed = |role| move |error| MolError::Selection { role, error };
         self.align(frame)?;
-        // A scalar colouring's range, once: over the atoms drawn.
-        if builder.color_by() == crate::ColorBy::Scalar && builder.scalar().range.is_none() {
-            // The atoms of every representation.
+        // The frame's colour column, for a representation coloured by it when the builder
+        // (which drops it otherwise) colours by something else.
+        let file_colors = (builder.color_by() != ColorBy::Property
+            && self.rep_colorings().any(|c| c == ColorBy::Property))
+        .then(|| frame.colors.clone());
+        // A scalar colouring's range, once: over the atoms drawn in that colouring.
+        if builder.color_by() == ColorBy::Scalar && builder.scalar().range.is_none() {
             let mut mask: Option<Vec<bool>> = Some(vec![false; frame.n_atoms()]);
-            for rep in &self.reps {
+            let scalar = |rep: &Representation| match rep.color {
+                None => true,
+                Some(c) => c == RepColor::By(ColorBy::Scalar),
+            };
+            for rep in self.reps.iter().filter(|r| scalar(r)) {
                 match &rep.select {
                     Some(sel) => {
                         let m = sel.evaluate(frame).map_err(failed(SelectionRole::Select))?;
@@ -443,16 +470,23 @@ impl MolPlan {
         }
         // Every atom, styled; then the per-selection rules, in order.
         builder.build(frame, scene);
-        for (sel, rgb) in &self.options.colors {
-            let mask = sel.evaluate(frame).map_err(failed(SelectionRole::Color))?;
-            let kind = builder.kind_of(*rgb);
-            for (i, m) in mask.iter().enumerate() {
-                if *m {
-                    scene.kinds[i] = kind;
+        if let Some(colors) = file_colors {
+            frame.colors = colors;
+        }
+        self.rule_kinds.clear();
+        if !self.options.colors.is_empty() {
+            self.rule_kinds.resize(frame.n_atoms(), u16::MAX);
+            for (sel, rgb) in &self.options.colors {
+                let mask = sel.evaluate(frame).map_err(failed(SelectionRole::Color))?;
+                let kind = builder.kind_of(*rgb);
+                for (k, m) in self.rule_kinds.iter_mut().zip(mask) {
+                    if m {
+                        *k = kind;
+                    }
                 }
             }
+            overlay(&mut scene.kinds, &self.rule_kinds);
         }
-        builder.refresh_materials(scene);
         let scale = builder.radius_scale();
         for (sel, r) in &self.options.radii {
             let mask = sel.evaluate(frame).map_err(failed(SelectionRole::Radius))?;
@@ -465,9 +499,46 @@ impl MolPlan {
         // The representations are taken out for the call (draw_rep borrows the plan mutably)
         // and put back, whatever the outcome.
         let reps = std::mem::take(&mut self.reps);
-        let drawn = self.draw_reps(frame, &reps, scene);
+        let drawn = self.draw_reps(builder, frame, &reps, scene);
         self.reps = reps;
+        builder.refresh_materials(scene);
         drawn
+    }
+
+    /// The colourings the representations have of their own, in order.
+    pub fn rep_colorings(&self) -> impl Iterator<Item = ColorBy> + '_ {
+        self.reps.iter().filter_map(|r| match r.color {
+            Some(RepColor::By(c)) => Some(c),
+            _ => None,
+        })
+    }
+
+    /// Whether some representation is coloured by the builder's colouring (so a colour bar for
+    /// it belongs in the image).
+    pub fn uses_builder_coloring(&self) -> bool {
+        self.reps
+            .iter()
+            .any(|r| matches!(r.color, None | Some(RepColor::By(ColorBy::Scalar))))
+    }
+
+    /// `scene`'s materials recoloured by `rep`'s own colouring, if it has one, the colour
+    /// rules still winning.
+    fn recolor(
+        &mut self,
+        builder: &mut SceneBuilder,
+        frame: &Frame,
+        rep: &Representation,
+        scene: &mut SphereScene,
+    ) {
+        match rep.color {
+            None => return,
+            Some(RepColor::By(by)) => builder.kinds_by(frame, by, &mut scene.kinds),
+            Some(RepColor::Fixed(rgb)) => {
+                let kind = builder.kind_of(rgb);
+                scene.kinds.iter_mut().for_each(|k| *k = kind);
+            }
+        }
+        overlay(&mut scene.kinds, &self.rule_kinds);
     }
 
     /// Steps 5-7 for every representation: one is drawn in place; several are each drawn from
@@ -475,17 +546,19 @@ impl MolPlan {
     /// radius.
     fn draw_reps(
         &mut self,
+        builder: &mut SceneBuilder,
         frame: &Frame,
         reps: &[Representation],
         scene: &mut SphereScene,
     ) -> Result<(), MolError> {
         if let [rep] = reps {
+            self.recolor(builder, frame, rep, scene);
             return self.draw_rep(frame, rep, scene);
         }
         let styled = std::mem::take(scene);
-        scene.materials = styled.materials.clone();
         for (k, rep) in reps.iter().enumerate() {
             let mut part = styled.clone();
+            self.recolor(builder, frame, rep, &mut part);
             self.draw_rep(frame, rep, &mut part)?;
             if k == 0 {
                 scene.bond_radius = part.bond_radius;
@@ -585,6 +658,16 @@ impl MolPlan {
             && frame.types.is_empty()
             && (0..frame.n_atoms()).all(|i| atom_element(frame, i).is_unknown());
         self.options.topology.is_none() && nothing && frame.n_atoms() > 0
+    }
+}
+
+/// `kinds` with each atom's colour-rule material where it has one (`u16::MAX`: none; an empty
+/// `rules` changes nothing).
+fn overlay(kinds: &mut [u16], rules: &[u16]) {
+    for (k, &r) in kinds.iter_mut().zip(rules) {
+        if r != u16::MAX {
+            *k = r;
+        }
     }
 }
 

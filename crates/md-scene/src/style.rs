@@ -195,8 +195,9 @@ pub struct SceneBuilder {
     /// The rule NAMEs, for [`SceneBuilder::warnings`].
     names: Vec<(RuleKind, String)>,
     palette: Palette,
-    /// The type, name or chain labels met so far: label k has palette colour k.
-    categories: Vec<Label>,
+    /// The type or name labels met so far, and the chain (or segment) labels: label k of a
+    /// list has palette colour k, so a chain keeps its colour whatever else is coloured.
+    categories: [Vec<Label>; 2],
     radii: Vec<f32>,
     colors: Vec<[f32; 3]>,
     /// The scalar colouring and the per-atom values of the last frame.
@@ -228,7 +229,7 @@ impl SceneBuilder {
             radius_scale: s,
             names,
             palette: Palette::new(),
-            categories: Vec::new(),
+            categories: [Vec::new(), Vec::new()],
             radii: Vec::new(),
             colors: Vec::new(),
             scalar: options.scalar.clone(),
@@ -293,7 +294,17 @@ impl SceneBuilder {
                 });
             }
         }
-        if self.color_by == ColorBy::Property {
+        out.extend(self.color_warnings(frame, self.color_by));
+        out
+    }
+
+    /// What is worth telling about colouring `frame` by `color_by` (the builder's own colouring
+    /// or a representation's): colour-column values outside [0, 1] when colouring by property,
+    /// no chains when colouring by chain, no protein backbone when colouring by structure, no
+    /// such number when colouring by a scalar.
+    pub fn color_warnings(&self, frame: &Frame, color_by: ColorBy) -> Vec<StyleWarning> {
+        let mut out = Vec::new();
+        if color_by == ColorBy::Property {
             let count = frame
                 .colors
                 .iter()
@@ -304,15 +315,15 @@ impl SceneBuilder {
                 out.push(StyleWarning::ColorsOutOfRange { count });
             }
         }
-        if self.color_by == ColorBy::Chain && frame.chains.is_empty() && frame.segments.is_empty() {
+        if color_by == ColorBy::Chain && frame.chains.is_empty() && frame.segments.is_empty() {
             out.push(StyleWarning::NoChains);
         }
-        if self.color_by == ColorBy::Structure
+        if color_by == ColorBy::Structure
             && texmap_md_io::secondary::assign(frame).residues().is_empty()
         {
             out.push(StyleWarning::NoStructure);
         }
-        if self.color_by == ColorBy::Scalar && !self.scalar.source.values(frame, &mut Vec::new()) {
+        if color_by == ColorBy::Scalar && !self.scalar.source.values(frame, &mut Vec::new()) {
             out.push(StyleWarning::NoScalar {
                 what: self.scalar.source.title(),
                 available: frame.properties.iter().map(|p| p.name.clone()).collect(),
@@ -333,10 +344,53 @@ impl SceneBuilder {
         self.style.apply(frame, &mut self.radii, &mut self.colors);
         scene.centers.clear();
         scene.radii.clear();
-        scene.kinds.clear();
         scene.bonds.clear();
-        let by_type = self.color_by == ColorBy::Type
-            || (self.color_by == ColorBy::Property
+        let base = std::mem::take(&mut self.colors);
+        self.kinds_into(frame, self.color_by, &base, &mut scene.kinds);
+        self.colors = base;
+        scene
+            .centers
+            .extend(frame.positions.iter().map(|&p| Vec3::from(p)));
+        scene
+            .radii
+            .extend(self.radii.iter().map(|r| r * self.radius_scale));
+        self.refresh_materials(scene);
+    }
+
+    /// The materials of `frame`'s atoms coloured by `color_by` rather than the builder's own
+    /// colouring (a representation with its own colouring), in `kinds` (cleared first). The
+    /// palette, the per-name rules and the category colours are the builder's, so one colour
+    /// means one thing in every representation; [`ColorBy::Scalar`] is the builder's scalar.
+    /// [`ColorBy::Property`] reads the frame's colour column, which [`SceneBuilder::build`]
+    /// drops under any other colouring: keep a copy for it. Call
+    /// [`SceneBuilder::refresh_materials`] before drawing.
+    pub fn kinds_by(&mut self, frame: &Frame, color_by: ColorBy, kinds: &mut Vec<u16>) {
+        let base: Vec<[f32; 3]> = (0..frame.n_atoms())
+            .map(|i| match color_by {
+                ColorBy::Property => self.style.resolve(frame, i).1,
+                _ => self
+                    .style
+                    .rules_for(frame, i)
+                    .color
+                    .unwrap_or_else(|| atom_element(frame, i).color()),
+            })
+            .collect();
+        self.kinds_into(frame, color_by, &base, kinds);
+    }
+
+    /// Every atom's material under `color_by`, into `kinds` (cleared first); `base` is each
+    /// atom's colour without a colouring of its own (file column where it counts, rule,
+    /// element).
+    fn kinds_into(
+        &mut self,
+        frame: &Frame,
+        color_by: ColorBy,
+        base: &[[f32; 3]],
+        kinds: &mut Vec<u16>,
+    ) {
+        kinds.clear();
+        let by_type = color_by == ColorBy::Type
+            || (color_by == ColorBy::Property
                 && frame.colors.is_empty()
                 && frame.names.is_empty()
                 && !frame.types.is_empty()
@@ -344,35 +398,36 @@ impl SceneBuilder {
         // The per-atom labels that pick a palette colour, if colouring by category.
         // The numbers that pick a map colour, if colouring by a scalar the frame has.
         let scalar =
-            self.color_by == ColorBy::Scalar && self.scalar.source.values(frame, &mut self.values);
+            color_by == ColorBy::Scalar && self.scalar.source.values(frame, &mut self.values);
         if scalar && self.scalar.range.is_none() {
             self.scalar.range = fit_range(&self.values, None);
         }
         let range = self.scalar.range.unwrap_or((0.0, 1.0));
-        let categories: Option<(&[Label], &[Label])> = match self.color_by {
+        let list = usize::from(color_by == ColorBy::Chain);
+        let categories: Option<(&[Label], &[Label])> = match color_by {
             ColorBy::Chain if !frame.chains.is_empty() => Some((&frame.chains, &[])),
             ColorBy::Chain if !frame.segments.is_empty() => Some((&frame.segments, &[])),
             _ if by_type => Some((&frame.types, &frame.names)),
             _ => None,
         };
-        let structure = if self.color_by == ColorBy::Structure {
+        let structure = if color_by == ColorBy::Structure {
             texmap_md_io::secondary::assign(frame).per_atom(frame.n_atoms())
         } else {
             Vec::new()
         };
-        for i in 0..frame.n_atoms() {
-            let p = frame.positions[i];
+        for (i, &base_color) in base.iter().enumerate().take(frame.n_atoms()) {
             let color = match categories {
                 Some((first, second)) => match self.style.rules_for(frame, i).color {
                     Some(c) => c,
                     None => {
                         // One palette colour per label, in order of appearance.
                         let label = first.get(i).or(second.get(i)).copied().unwrap_or_default();
-                        let idx = match self.categories.iter().position(|t| *t == label) {
+                        let seen = &mut self.categories[list];
+                        let idx = match seen.iter().position(|t| *t == label) {
                             Some(j) => j,
                             None => {
-                                self.categories.push(label);
-                                self.categories.len() - 1
+                                seen.push(label);
+                                seen.len() - 1
                             }
                         };
                         type_color(idx)
@@ -386,15 +441,13 @@ impl SceneBuilder {
                     match (structure[i], self.style.rules_for(frame, i).color) {
                         (_, Some(c)) => c,
                         (Some(ss), None) => STRUCTURE_COLORS[ss as usize],
-                        (None, None) => self.colors[i],
+                        (None, None) => base_color,
                     }
                 }
-                None => self.colors[i],
+                None => base_color,
             };
-            let kind = self.palette.kind_of(color);
-            scene.push(Vec3::from(p), self.radii[i] * self.radius_scale, kind);
+            kinds.push(self.palette.kind_of(color));
         }
-        self.refresh_materials(scene);
     }
 
     /// One material per palette colour, in material order (after [`SceneBuilder::kind_of`]
