@@ -647,13 +647,25 @@ pub struct MolArgs {
         conflicts_with_all = ["select", "draw"]
     )]
     pub reps: Vec<String>,
-    /// Superpose every frame on the first rendered frame by the least-squares fit of the atoms
-    /// SEL picks ('backbone', 'name CA', 'protein and not name H*'), so the molecule holds still
-    /// while it tumbles and diffuses, as MDAnalysis's AlignTraj and VMD's 'measure fit' do
-    /// before a movie. SEL is evaluated once, at the first frame; the fit is unweighted and
-    /// after --pbc (use --pbc unwrap so the fitted molecule is whole).
+    /// Superpose every frame on the first rendered frame (or on --align-to's structure) by the
+    /// least-squares fit of the atoms SEL picks ('backbone', 'name CA', 'protein and not name
+    /// H*'), so the molecule holds still while it tumbles and diffuses, as MDAnalysis's
+    /// AlignTraj and VMD's 'measure fit' do before a movie. SEL is evaluated once, at the first
+    /// frame; the fit is unweighted (see --align-mass) and after --pbc (use --pbc unwrap so the
+    /// fitted molecule is whole).
     #[arg(long, value_name = "SEL")]
     pub align: Option<String>,
+    /// The structure --align fits onto, instead of the first frame: a crystal structure or an
+    /// equilibrated frame (the first frame of any file texmap reads: PDB, PDBx/mmCIF, GRO,
+    /// XYZ, ...), in its own coordinates, so every frame is drawn where that structure sits.
+    /// SEL must pick as many atoms in it as in the trajectory, with the same names where both
+    /// have names (MDAnalysis's AlignTraj with a reference universe).
+    #[arg(long, value_name = "FILE", requires = "align")]
+    pub align_to: Option<PathBuf>,
+    /// Weight --align's fit by the atoms' masses (their elements' standard atomic weights), as
+    /// MDAnalysis's AlignTraj(weights="mass").
+    #[arg(long, requires = "align")]
+    pub align_mass: bool,
 }
 
 /// How an atom's look is chosen and examples, after `texmap render --help`.

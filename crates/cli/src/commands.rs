@@ -89,7 +89,7 @@ pub(crate) fn spinner(what: &str) -> ProgressBar {
     pb
 }
 
-fn open_trajectory(file: &Path, format: Option<&str>) -> Result<Trajectory> {
+pub(crate) fn open_trajectory(file: &Path, format: Option<&str>) -> Result<Trajectory> {
     open_trajectory_with(file, format, ReadOptions::new())
 }
 

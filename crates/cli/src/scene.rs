@@ -315,7 +315,14 @@ pub fn mol_plan(args: &MolArgs) -> Result<MolPlan> {
         };
         radii.push((parse_selection("--radius", sel)?, radius));
     }
-    let align = optional("--align", &args.align)?;
+    let align = match optional("--align", &args.align)? {
+        Some(select) => Some(texmap_md_scene::Alignment {
+            select,
+            reference: args.align_to.as_deref().map(read_reference).transpose()?,
+            mass_weighted: args.align_mass,
+        }),
+        None => None,
+    };
     let mut reps = Vec::new();
     for r in &args.reps {
         let (sel, spec) = sel_value("--rep", r)?;
@@ -374,6 +381,17 @@ fn rep_color(rep: &str, text: &str) -> Result<texmap_md_scene::RepColor> {
     Ok(RepColor::By(by))
 }
 
+/// The first frame of `--align-to FILE`, any format a trajectory may have.
+fn read_reference(path: &std::path::Path) -> Result<Frame> {
+    let mut traj = crate::commands::open_trajectory(path, None)
+        .with_context(|| format!("--align-to {}", path.display()))?;
+    let mut frame = Frame::new();
+    if !traj.read_next(&mut frame)? {
+        anyhow::bail!("--align-to {}: the file holds no frame", path.display());
+    }
+    Ok(frame)
+}
+
 /// A [`MolError`] as the usage error naming the flag.
 pub fn mol_error(e: MolError) -> anyhow::Error {
     let text = match e {
@@ -397,6 +415,10 @@ pub fn mol_error(e: MolError) -> anyhow::Error {
         }
         MolError::Align { atoms, why } => {
             format!("--align: the selection picks {atoms} atom(s) of the first frame: {why}")
+        }
+        MolError::AlignMismatch { .. } => {
+            // The trajectory and the --align-to structure disagree: bad input, not usage.
+            return anyhow::anyhow!("--align-to: {e}");
         }
     };
     crate::args::UsageError(text).into()

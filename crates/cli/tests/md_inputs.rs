@@ -890,3 +890,75 @@ fn a_representation_takes_its_own_colouring() {
         assert!(!out.exists());
     }
 }
+
+/// `--align-to`: frame 5 of the tumbling trajectory fitted (by mass) onto a moved copy of the
+/// structure is drawn where and as that structure is; a structure of other atoms is an input
+/// error (exit 1) naming the flag; `--align-to` without `--align` a usage error (exit 2).
+#[test]
+fn align_to_a_reference_structure_draws_the_frames_as_it_sits() {
+    let here = Path::new(env!("CARGO_MANIFEST_DIR")).join("../md-scene/tests/data");
+    let xtc = here.join("align_3gwi.xtc");
+    let target = here.join("align_target.pdb.gz");
+    let top = data("dssp/3gwiA.pdb.gz");
+    let dir = tempfile::tempdir().unwrap();
+    let render = |name: &str, input: &Path, extra: &[&str]| {
+        let out = dir.path().join(name);
+        let mut args = vec![
+            "render",
+            "--quiet",
+            input.to_str().unwrap(),
+            "--size",
+            "200x150",
+            "--view",
+            "z",
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        let o = texmap(&args);
+        (o, out)
+    };
+    let (o, reference) = render("target.png", &target, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let flipped = |p: &Path| {
+        let (a, b) = (
+            image::open(&reference).unwrap().to_rgb8(),
+            image::open(p).unwrap().to_rgb8(),
+        );
+        let bg = |p: &image::Rgb<u8>| p.0 == [0, 0, 0];
+        let covered = a.pixels().filter(|p| !bg(p)).count();
+        let n = a
+            .pixels()
+            .zip(b.pixels())
+            .filter(|(p, q)| bg(p) != bg(q))
+            .count();
+        n as f64 / covered as f64
+    };
+    let frame5 = ["--topology", &top, "--frames", "5:6"];
+    let (o, as_read) = render("as_read.png", &xtc, &frame5);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let mut args = frame5.to_vec();
+    let target_arg = target.to_str().unwrap();
+    args.extend([
+        "--align",
+        "backbone",
+        "--align-to",
+        target_arg,
+        "--align-mass",
+    ]);
+    let (o, fitted) = render("fitted.png", &xtc, &args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (before, after) = (flipped(&as_read), flipped(&fitted));
+    assert!(before > 0.2, "as read: {before} (fitted: {after})");
+    assert!(after < 0.1, "fitted: {after}");
+    // Another chain's structure: the picked atoms differ in number.
+    let other = data("dssp/1eteA.pdb.gz");
+    let mut args = frame5.to_vec();
+    args.extend(["--align", "backbone", "--align-to", &other]);
+    let (o, out) = render("other.png", &xtc, &args);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--align-to"), "{}", stderr(&o));
+    assert!(!out.exists());
+    let (o, _) = render("usage.png", &xtc, &["--align-to", target_arg]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+}

@@ -9,12 +9,14 @@
 //!   for Pm and Fm..Lr. Note Alvarez's radii are larger than Bondi's (1964) for metals (Na 2.50
 //!   vs 2.27 Å) and for C (1.77 vs 1.70 Å).
 //! - Colours: the Jmol CPK colours (8-bit sRGB), H..Lr.
+//! - Masses: IUPAC 2016 standard atomic weights (conventional values: C 12.011, H 1.008), as
+//!   ASE and MDAnalysis's mass guesser give them; for mass-weighted fits.
 //! - Covalent radii: B. Cordero et al., "Covalent radii revisited", Dalton Trans. (2008) 2832,
 //!   H..Cm (sp³ carbon 0.76 Å; the low-spin values for Mn, Fe, Co); Bk..Lr, which Cordero does
 //!   not cover, 2.00 Å as ASE gives them. Used for bonds by distance ([`crate::bonds`]).
 //!
 //! All were generated from ASE 3.29 (`ase.data.vdw_alvarez`, `ase.data.colors.jmol_colors`,
-//! `ase.data.covalent_radii`) by
+//! `ase.data.covalent_radii`, `ase.data.atomic_masses`) by
 //! `tests/data/gen_elements.py --rust`; `tests/elements.rs` checks every entry against the JSON
 //! that script writes.
 //!
@@ -36,6 +38,114 @@
 //!
 //! Integer LAMMPS types ("1", "2") have no element: give them one with an `element` column or
 //! style them by type with [`crate::AtomStyle`].
+
+/// Standard atomic weights (IUPAC 2016, as ASE gives them) for Z = 1..=103, in u; for elements
+/// without a stable isotope, the mass number of the longest-lived one.
+const MASSES: [f64; 103] = [
+    1.008,        // H
+    4.002602,     // He
+    6.94,         // Li
+    9.0121831,    // Be
+    10.81,        // B
+    12.011,       // C
+    14.007,       // N
+    15.999,       // O
+    18.998403163, // F
+    20.1797,      // Ne
+    22.98976928,  // Na
+    24.305,       // Mg
+    26.9815385,   // Al
+    28.085,       // Si
+    30.973761998, // P
+    32.06,        // S
+    35.45,        // Cl
+    39.948,       // Ar
+    39.0983,      // K
+    40.078,       // Ca
+    44.955908,    // Sc
+    47.867,       // Ti
+    50.9415,      // V
+    51.9961,      // Cr
+    54.938044,    // Mn
+    55.845,       // Fe
+    58.933194,    // Co
+    58.6934,      // Ni
+    63.546,       // Cu
+    65.38,        // Zn
+    69.723,       // Ga
+    72.63,        // Ge
+    74.921595,    // As
+    78.971,       // Se
+    79.904,       // Br
+    83.798,       // Kr
+    85.4678,      // Rb
+    87.62,        // Sr
+    88.90584,     // Y
+    91.224,       // Zr
+    92.90637,     // Nb
+    95.95,        // Mo
+    97.90721,     // Tc
+    101.07,       // Ru
+    102.9055,     // Rh
+    106.42,       // Pd
+    107.8682,     // Ag
+    112.414,      // Cd
+    114.818,      // In
+    118.71,       // Sn
+    121.76,       // Sb
+    127.6,        // Te
+    126.90447,    // I
+    131.293,      // Xe
+    132.90545196, // Cs
+    137.327,      // Ba
+    138.90547,    // La
+    140.116,      // Ce
+    140.90766,    // Pr
+    144.242,      // Nd
+    144.91276,    // Pm
+    150.36,       // Sm
+    151.964,      // Eu
+    157.25,       // Gd
+    158.92535,    // Tb
+    162.5,        // Dy
+    164.93033,    // Ho
+    167.259,      // Er
+    168.93422,    // Tm
+    173.054,      // Yb
+    174.9668,     // Lu
+    178.49,       // Hf
+    180.94788,    // Ta
+    183.84,       // W
+    186.207,      // Re
+    190.23,       // Os
+    192.217,      // Ir
+    195.084,      // Pt
+    196.966569,   // Au
+    200.592,      // Hg
+    204.38,       // Tl
+    207.2,        // Pb
+    208.9804,     // Bi
+    208.98243,    // Po
+    209.98715,    // At
+    222.01758,    // Rn
+    223.01974,    // Fr
+    226.02541,    // Ra
+    227.02775,    // Ac
+    232.0377,     // Th
+    231.03588,    // Pa
+    238.02891,    // U
+    237.04817,    // Np
+    244.06421,    // Pu
+    243.06138,    // Am
+    247.07035,    // Cm
+    247.07031,    // Bk
+    251.07959,    // Cf
+    252.083,      // Es
+    257.09511,    // Fm
+    258.09843,    // Md
+    259.101,      // No
+    262.11,       // Lr
+];
 
 /// (symbol, van der Waals radius in Å, Jmol colour as 8-bit sRGB, covalent radius in Å) for
 /// Z = 1..=103.
@@ -244,6 +354,14 @@ impl Element {
         match self.0 {
             0 => 0.0,
             z => TABLE[z as usize - 1].3,
+        }
+    }
+
+    /// Standard atomic weight in u (see the module doc); 0 for the unknown element.
+    pub fn mass(self) -> f64 {
+        match self.0 {
+            0 => 0.0,
+            z => MASSES[z as usize - 1],
         }
     }
 

@@ -49,5 +49,8 @@ fn table_matches_ase_alvarez_radii_and_jmol_colours() {
             "{} covalent: expected {cordero}, actual {got}",
             e.symbol()
         );
+        let mass = row["mass"].as_f64().unwrap();
+        assert_eq!(e.mass(), mass, "{} mass", e.symbol());
     }
+    assert_eq!(Element::UNKNOWN.mass(), 0.0);
 }

@@ -5,8 +5,9 @@
 //!
 //! The rotation is Horn's (1987) closed form: the unit quaternion that is the eigenvector of the
 //! largest eigenvalue of a symmetric 4x4 matrix built from the two sets' cross-covariance, found
-//! by Jacobi rotations in f64. It is always a proper rotation (never a reflection), and the
-//! fit is unweighted, as MDAnalysis's and VMD's defaults are.
+//! by Jacobi rotations in f64. It is always a proper rotation (never a reflection). The fit is
+//! unweighted, as MDAnalysis's and VMD's defaults are, or weighted ([`superpose_weighted`],
+//! e.g. by mass).
 //!
 //! ```
 //! use texmap_md_scene::align::superpose;
@@ -48,14 +49,15 @@ impl Superposition {
     }
 }
 
-fn centroid(p: &[[f64; 3]]) -> [f64; 3] {
+/// The weighted centroid (`w(i)` the weight of point `i`; `total` their sum).
+fn centroid(p: &[[f64; 3]], w: impl Fn(usize) -> f64, total: f64) -> [f64; 3] {
     let mut c = [0.0; 3];
-    for q in p {
+    for (i, q) in p.iter().enumerate() {
         for k in 0..3 {
-            c[k] += q[k];
+            c[k] += w(i) * q[k];
         }
     }
-    c.map(|v| v / p.len() as f64)
+    c.map(|v| v / total)
 }
 
 /// Eigenvalues and eigenvectors (columns of the returned matrix) of a symmetric 4x4 matrix by
@@ -115,7 +117,32 @@ fn jacobi4(mut a: [[f64; 4]; 4]) -> ([f64; 4], [[f64; 4]; 4]) {
 /// coordinate is not finite. With fewer than three non-collinear points the rotation about
 /// their line is arbitrary (but still a proper rotation).
 pub fn superpose(mobile: &[[f64; 3]], reference: &[[f64; 3]]) -> Option<Superposition> {
+    superpose_weighted(mobile, reference, None)
+}
+
+/// [`superpose`] with a weight per point (MDAnalysis's `weights="mass"` gives the masses):
+/// weighted centroids, the rotation minimising the weighted sum of squared distances, and the
+/// weighted RMSD `sqrt(sum w d² / sum w)`. `None` also when `weights` has another length, a
+/// weight is negative or not finite, or they sum to 0.
+pub fn superpose_weighted(
+    mobile: &[[f64; 3]],
+    reference: &[[f64; 3]],
+    weights: Option<&[f64]>,
+) -> Option<Superposition> {
     if mobile.len() != reference.len() || mobile.len() < 3 {
+        return None;
+    }
+    let w = |i: usize| weights.map_or(1.0, |w| w[i]);
+    let total = match weights {
+        None => mobile.len() as f64,
+        Some(ws) => {
+            if ws.len() != mobile.len() || ws.iter().any(|w| !(w.is_finite() && *w >= 0.0)) {
+                return None;
+            }
+            ws.iter().sum()
+        }
+    };
+    if total <= 0.0 {
         return None;
     }
     if mobile
@@ -126,11 +153,11 @@ pub fn superpose(mobile: &[[f64; 3]], reference: &[[f64; 3]]) -> Option<Superpos
     {
         return None;
     }
-    let (cm, cr) = (centroid(mobile), centroid(reference));
-    // s[a][b] = sum over points of x_a y_b (x mobile, y reference, both centred).
+    let (cm, cr) = (centroid(mobile, w, total), centroid(reference, w, total));
+    // s[a][b] = sum over points of w x_a y_b (x mobile, y reference, both centred).
     let mut s = [[0.0f64; 3]; 3];
-    for (m, r) in mobile.iter().zip(reference) {
-        let x = [0, 1, 2].map(|k| m[k] - cm[k]);
+    for (i, (m, r)) in mobile.iter().zip(reference).enumerate() {
+        let x = [0, 1, 2].map(|k| w(i) * (m[k] - cm[k]));
         let y = [0, 1, 2].map(|k| r[k] - cr[k]);
         for a in 0..3 {
             for b in 0..3 {
@@ -180,12 +207,13 @@ pub fn superpose(mobile: &[[f64; 3]], reference: &[[f64; 3]]) -> Option<Superpos
     let sum: f64 = mobile
         .iter()
         .zip(reference)
-        .map(|(m, r)| {
+        .enumerate()
+        .map(|(i, (m, r))| {
             let q = fit.apply(*m);
-            (0..3).map(|k| (q[k] - r[k]).powi(2)).sum::<f64>()
+            w(i) * (0..3).map(|k| (q[k] - r[k]).powi(2)).sum::<f64>()
         })
         .sum();
-    fit.rmsd = (sum / mobile.len() as f64).sqrt();
+    fit.rmsd = (sum / total).sqrt();
     Some(fit)
 }
 

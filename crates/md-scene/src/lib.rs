@@ -70,7 +70,7 @@ pub use legend::{ColorBar, draw_caption, draw_color_bar};
 pub use outline::{add_box_outline, cell_corners};
 pub use palette::{MAX_MATERIALS, Palette, type_color};
 pub use plan::{
-    BALL_AND_STICK_BOND_RADIUS, BALL_AND_STICK_RADIUS_SCALE, BondSource, DrawStyle,
+    Alignment, BALL_AND_STICK_BOND_RADIUS, BALL_AND_STICK_RADIUS_SCALE, BondSource, DrawStyle,
     LICORICE_RADIUS, MolError, MolOptions, MolPlan, Pbc, RepColor, Representation, SelectionRole,
 };
 pub use scalar::{NAN_COLOR, SCALAR_LEVELS, ScalarColor, ScalarSource};

@@ -8,10 +8,11 @@
 //! 2. the periodic boundaries ([`Pbc`]): atoms wrapped into the box, or molecules made whole
 //!    across it (with bonds by distance when none are drawn); bonds that still cross the box
 //!    are dropped, so no stick spans it;
-//! 3. with [`MolOptions::align`], the frame superposed on the first frame built: the
-//!    alignment selection is evaluated once, at the first frame, and every frame's positions,
+//! 3. with [`MolOptions::align`], the frame superposed on a reference: the first frame built,
+//!    or a structure given ([`Alignment::reference`]). The alignment selection is evaluated
+//!    once, at the first frame (and in the reference), and every frame's positions,
 //!    velocities and cell are moved by the rotation and translation that fit those atoms onto
-//!    their first-frame positions in least squares ([`crate::align`]; MDAnalysis's
+//!    the reference's in least squares, unweighted or by mass ([`crate::align`]; MDAnalysis's
 //!    `AlignTraj`), so the picked molecule holds still while the rest moves relative to it;
 //! 4. every atom styled by the [`SceneBuilder`] (a scalar colouring's range, unless given,
 //!    fitted at the first frame to the atoms the selection draws), then the colour rules and the
@@ -116,12 +117,37 @@ pub struct MolOptions {
     pub draw: DrawStyle,
     /// The periodic-boundary treatment.
     pub pbc: Pbc,
-    /// Superpose every frame on the first frame built, fitted on these atoms (see the module
-    /// docs); `None` leaves positions as read.
-    pub align: Option<Selection>,
+    /// Superpose every frame on a reference (the first frame built, or a structure), fitted
+    /// on the atoms a selection picks (see the module docs); `None` leaves positions as read.
+    pub align: Option<Alignment>,
     /// Several representations in one scene (see [`Representation`]); when not empty, they
     /// replace `select` and `draw`.
     pub reps: Vec<Representation>,
+}
+
+/// What [`MolOptions::align`] fits every frame onto, and how.
+#[derive(Clone, Debug)]
+pub struct Alignment {
+    /// The fitted atoms, picked once: in the first frame built, and in `reference`.
+    pub select: Selection,
+    /// The structure to fit onto (a crystal structure, an equilibrated frame), in its own
+    /// coordinates; its picked atoms must be as many as the first frame's, with the same
+    /// names where both have names. `None`: the first frame built.
+    pub reference: Option<Frame>,
+    /// Weight each atom by its element's mass (MDAnalysis's `weights="mass"`); else all
+    /// atoms weigh the same (the default of MDAnalysis and VMD).
+    pub mass_weighted: bool,
+}
+
+impl Alignment {
+    /// An unweighted fit of `select` onto the first frame built.
+    pub fn on_first_frame(select: Selection) -> Alignment {
+        Alignment {
+            select,
+            reference: None,
+            mass_weighted: false,
+        }
+    }
 }
 
 /// One representation, as VMD's: the atoms a selection picks (all when `None`), drawn in one
@@ -195,8 +221,19 @@ pub enum MolError {
         /// The refused radius.
         radius: f32,
     },
+    /// The alignment selection picks another number of atoms in the reference structure than
+    /// in the first frame, or the `index`-th picked atoms differ by name.
+    AlignMismatch {
+        /// Atoms picked in the first frame.
+        frame: usize,
+        /// Atoms picked in the reference.
+        reference: usize,
+        /// The first pair of picked atoms with different names: (position among the picked,
+        /// the frame's name, the reference's name).
+        names: Option<(usize, String, String)>,
+    },
     /// The alignment selection picks fewer than three atoms at the first frame (a fit needs
-    /// three), or a frame's picked atoms have non-finite coordinates.
+    /// three), or a frame's picked atoms have non-finite coordinates, or no mass.
     Align {
         /// Atoms picked at the first frame.
         atoms: usize,
@@ -228,6 +265,21 @@ impl fmt::Display for MolError {
                     "alignment: the selection picks {atoms} atom(s) of the first frame: {why}"
                 )
             }
+            MolError::AlignMismatch {
+                frame,
+                reference,
+                names,
+            } => match names {
+                Some((k, a, b)) => write!(
+                    f,
+                    "alignment: picked atom {k} is {a} in the frame but {b} in the reference"
+                ),
+                None => write!(
+                    f,
+                    "alignment: the selection picks {frame} atom(s) of the first frame but \
+                     {reference} of the reference"
+                ),
+            },
             MolError::Selection { role, error } => {
                 let what = match role {
                     SelectionRole::Align => "the alignment selection",
@@ -243,6 +295,16 @@ impl fmt::Display for MolError {
 
 impl std::error::Error for MolError {}
 
+/// What every frame is fitted onto, fixed at the first frame: the picked atoms (indices in the
+/// frames), the positions they are fitted onto (the first frame's or the reference
+/// structure's) and the weights of a mass-weighted fit.
+#[derive(Clone, Debug)]
+struct AlignTarget {
+    atoms: Vec<usize>,
+    positions: Vec<[f64; 3]>,
+    weights: Option<Vec<f64>>,
+}
+
 /// A frame's way from reading to drawing (see the module docs for the order of the steps).
 #[derive(Clone, Debug)]
 pub struct MolPlan {
@@ -251,8 +313,9 @@ pub struct MolPlan {
     map: Vec<u32>,
     pairs: Vec<[u32; 2]>,
     last_bond_count: usize,
-    /// The alignment's atoms and their positions in the first frame built.
-    align_reference: Option<(Vec<usize>, Vec<[f64; 3]>)>,
+    /// The alignment's atoms (in the frames), the positions fitted onto (the first frame's or
+    /// the reference structure's) and the weights of a mass-weighted fit.
+    align_reference: Option<AlignTarget>,
     last_fit_rmsd: Option<f64>,
     /// Scratch: per atom, the material the colour rules give it (`u16::MAX`: none).
     rule_kinds: Vec<u16>,
@@ -319,7 +382,7 @@ impl MolPlan {
     /// Step 3 of the module docs: `frame` superposed on the first frame built (which sets the reference: its
     /// alignment atoms, picked once, and their positions).
     fn align(&mut self, frame: &mut Frame) -> Result<(), MolError> {
-        let Some(sel) = &self.options.align else {
+        let Some(alignment) = &self.options.align else {
             return Ok(());
         };
         let pos = |frame: &Frame, atoms: &[usize]| -> Vec<[f64; 3]> {
@@ -335,28 +398,85 @@ impl MolPlan {
                 })
                 .collect()
         };
-        let (atoms, reference) = match &self.align_reference {
-            Some(r) => r,
-            None => {
-                let atoms = sel.indices(frame).map_err(|error| MolError::Selection {
+        let picked = |frame: &Frame| {
+            alignment
+                .select
+                .indices(frame)
+                .map_err(|error| MolError::Selection {
                     role: SelectionRole::Align,
                     error,
-                })?;
-                if atoms.len() < 3 {
-                    return Err(MolError::Align {
-                        atoms: atoms.len(),
-                        why: "a fit needs at least three",
-                    });
-                }
-                let reference = pos(frame, &atoms);
-                self.align_reference.insert((atoms, reference))
-            }
+                })
         };
+        let AlignTarget {
+            atoms,
+            positions: reference,
+            weights,
+        } =
+            match &self.align_reference {
+                Some(r) => r,
+                None => {
+                    let atoms = picked(frame)?;
+                    if atoms.len() < 3 {
+                        return Err(MolError::Align {
+                            atoms: atoms.len(),
+                            why: "a fit needs at least three",
+                        });
+                    }
+                    let (target, target_atoms) = match &alignment.reference {
+                        Some(r) => (r, picked(r)?),
+                        None => (&*frame, atoms.clone()),
+                    };
+                    if target_atoms.len() != atoms.len() {
+                        return Err(MolError::AlignMismatch {
+                            frame: atoms.len(),
+                            reference: target_atoms.len(),
+                            names: None,
+                        });
+                    }
+                    let name = |f: &Frame, i: usize| f.names.get(i).map(|n| n.as_str().to_string());
+                    let differ = atoms.iter().zip(&target_atoms).enumerate().find_map(
+                        |(k, (&i, &j))| match (name(frame, i), name(target, j)) {
+                            (Some(a), Some(b)) if a != b => Some((k, a, b)),
+                            _ => None,
+                        },
+                    );
+                    if let Some(names) = differ {
+                        return Err(MolError::AlignMismatch {
+                            frame: atoms.len(),
+                            reference: target_atoms.len(),
+                            names: Some(names),
+                        });
+                    }
+                    let weights = alignment.mass_weighted.then(|| {
+                        target_atoms
+                            .iter()
+                            .map(|&j| atom_element(target, j).mass())
+                            .collect::<Vec<f64>>()
+                    });
+                    if weights
+                        .as_ref()
+                        .is_some_and(|w| w.iter().all(|m| *m == 0.0))
+                    {
+                        return Err(MolError::Align {
+                            atoms: atoms.len(),
+                            why: "none has an element, so none has a mass",
+                        });
+                    }
+                    let reference = pos(target, &target_atoms);
+                    self.align_reference.insert(AlignTarget {
+                        atoms,
+                        positions: reference,
+                        weights,
+                    })
+                }
+            };
         let mobile = pos(frame, atoms);
-        let fit = crate::align::superpose(&mobile, reference).ok_or(MolError::Align {
-            atoms: atoms.len(),
-            why: "some have no finite coordinates in this frame",
-        })?;
+        let fit = crate::align::superpose_weighted(&mobile, reference, weights.as_deref()).ok_or(
+            MolError::Align {
+                atoms: atoms.len(),
+                why: "some have no finite coordinates in this frame",
+            },
+        )?;
         self.last_fit_rmsd = Some(fit.rmsd);
         for p in &mut frame.positions {
             *p = fit.apply(p.map(f64::from)).map(|v| v as f32);

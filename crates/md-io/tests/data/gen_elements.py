@@ -2,14 +2,16 @@
 
 Writes elements.json: for Z = 1..103 the symbol, the Alvarez (2013) van der Waals radius
 (ase.data.vdw_alvarez, null where Alvarez gives none), the Jmol colour (ase.data.colors,
-as 8-bit sRGB) and the covalent radius of Cordero et al. 2008 (ase.data.covalent_radii). With --rust it also prints the Rust table body used in src/elements.rs.
+as 8-bit sRGB), the covalent radius of Cordero et al. 2008 (ase.data.covalent_radii) and the
+standard atomic weight (IUPAC 2016, ase.data.atomic_masses). With --rust it prints the Rust
+table bodies used in src/elements.rs instead (TABLE, then MASSES).
 """
 import json
 import math
 import sys
 
 import ase
-from ase.data import chemical_symbols, covalent_radii
+from ase.data import atomic_masses, chemical_symbols, covalent_radii
 from ase.data.colors import jmol_colors
 from ase.data.vdw_alvarez import vdw_radii
 
@@ -24,13 +26,16 @@ for z in range(1, 104):
     rgb = [int(round(float(c) * 255)) for c in jmol_colors[z]]
     rows.append({"z": z, "symbol": chemical_symbols[z],
                  "alvarez": None if math.isnan(r) else r, "jmol": rgb,
-                 "cordero": float(covalent_radii[z])})
+                 "cordero": float(covalent_radii[z]), "mass": float(atomic_masses[z])})
 
 if "--rust" in sys.argv:
     for row in rows:
         r = row["alvarez"] if row["alvarez"] is not None else FALLBACK[row["z"]]
         print('    ("%s", %.2f, [%d, %d, %d], %.2f),'
               % (row["symbol"], r, *row["jmol"], row["cordero"]))
+    print()
+    for row in rows:
+        print("    %r, // %s" % (row["mass"], row["symbol"]))
 else:
     with open("elements.json", "w") as f:
         json.dump({"program": "ase", "version": ase.__version__, "elements": rows}, f, indent=0)
