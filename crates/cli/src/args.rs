@@ -374,6 +374,16 @@ pub struct RenderArgs {
     /// Frames to render, A:B:STEP (B exclusive, each part optional: "::10", "5:", "3").
     #[arg(long, default_value = "0:")]
     pub frames: String,
+    /// Smooth the motion, as VMD's trajectory smoothing: each drawn frame's positions are the
+    /// mean over the 2N+1 consecutive frames of the file centred on it (fewer near the ends,
+    /// where the window shrinks on both sides so that steady motion is not pulled back; the
+    /// first and last frames are drawn as read). Takes the thermal jitter out of a movie.
+    /// Positions only, as read, before --pbc and --align; in a periodic box each neighbour
+    /// counts at its nearest image, so wrapped atoms do not jump (while no atom moves half a
+    /// box within a window).
+    #[arg(long, value_name = "N", default_value_t = 0,
+          value_parser = clap::value_parser!(u32).range(0..=1000))]
+    pub smooth: u32,
     /// Drawing method.
     #[arg(long, value_enum, default_value_t = MethodArg::Raycast)]
     pub method: MethodArg,

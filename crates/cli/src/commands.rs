@@ -395,6 +395,7 @@ fn render(a: &RenderArgs) -> Result<()> {
     let mut quality_renderer = texmap_quality::QualityRenderer::new();
     let mut builder = crate::scene::scene_builder(&a.style)?;
     let mut plan = crate::scene::mol_plan(&a.mol)?;
+    let mut smoother = texmap_md_io::smooth::Smoother::new(a.smooth as usize);
     let mut md = MdFrame::new();
     let mut scene = SphereScene::default();
     let mut renderer = Renderer::new();
@@ -421,6 +422,9 @@ fn render(a: &RenderArgs) -> Result<()> {
             ))
         };
         traj.read_frame(f, &mut md)
+            .map_err(|e| fail(e.into(), &written))?;
+        smoother
+            .smooth(&mut traj, n, f, &mut md)
             .map_err(|e| fail(e.into(), &written))?;
         print_warnings(&traj, &mut shown);
         plan.label(&mut md, traj.name(), f)

@@ -962,3 +962,73 @@ fn align_to_a_reference_structure_draws_the_frames_as_it_sits() {
     let (o, _) = render("usage.png", &xtc, &["--align-to", target_arg]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
 }
+
+/// `--smooth`: a structure jiggled by seeded noise in every frame (an XYZ trajectory written by
+/// md-io) flickers less from frame to frame when smoothed; the first frame, an end of the
+/// window, is drawn as read, byte for byte.
+#[test]
+fn smoothing_takes_the_jitter_out_of_a_movie() {
+    use texmap_md_io::{Format, Frame, Trajectory, Writer};
+    let dir = tempfile::tempdir().unwrap();
+    let mut t = Trajectory::open(data("dssp/3gwiA.pdb.gz")).unwrap();
+    let mut base = Frame::new();
+    assert!(t.read_next(&mut base).unwrap());
+    let xyz = dir.path().join("jiggle.xyz");
+    let mut w = Writer::create(&xyz, Format::Xyz).unwrap();
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut noise = || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f32 / (1u64 << 53) as f32 - 0.5
+    };
+    let n = 12;
+    for _ in 0..n {
+        let mut f = base.clone();
+        for p in &mut f.positions {
+            *p = p.map(|x| x + 1.2 * noise());
+        }
+        w.write_frame(&f).unwrap();
+    }
+    w.finish().unwrap();
+    let render = |tag: &str, smooth: &str| {
+        let out = dir.path().join(format!("{tag}-%02d.png"));
+        let o = texmap(&[
+            "render",
+            "--quiet",
+            xyz.to_str().unwrap(),
+            "--size",
+            "200x150",
+            "--smooth",
+            smooth,
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        (0..n)
+            .map(|f| dir.path().join(format!("{tag}-{f:02}.png")))
+            .collect::<Vec<_>>()
+    };
+    let raw = render("raw", "0");
+    let smooth = render("smooth", "3");
+    assert!(std::fs::read(&raw[0]).unwrap() == std::fs::read(&smooth[0]).unwrap());
+    // Mean absolute change between consecutive interior frames.
+    let flicker = |frames: &[PathBuf]| {
+        (3..n - 4)
+            .map(|f| mean_abs_diff(&frames[f], &frames[f + 1]))
+            .sum::<f64>()
+            / (n - 7) as f64
+    };
+    let (before, after) = (flicker(&raw), flicker(&smooth));
+    assert!(after < 0.5 * before, "flicker {before} -> {after}");
+    let o = texmap(&[
+        "render",
+        "--quiet",
+        xyz.to_str().unwrap(),
+        "--smooth",
+        "-1",
+        "-o",
+        dir.path().join("bad.png").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+}

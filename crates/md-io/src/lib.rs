@@ -92,6 +92,7 @@ mod prmtop;
 mod psf;
 pub mod secondary;
 pub mod select;
+pub mod smooth;
 pub mod style;
 mod text;
 mod topology;
