@@ -65,8 +65,9 @@ pub enum Command {
         /// Format, when the extension does not tell it.
         #[arg(long)]
         format: Option<String>,
-        /// Count only the complete frames of a file whose last frame is cut short, with a
-        /// warning (default: a cut frame is an error naming the file, frame and byte).
+        /// Count only the complete frames of a file whose last frame is cut short (a .gz whose
+        /// stream ends early too), with a warning (default: a cut frame is an error naming the
+        /// file, frame and byte).
         #[arg(long)]
         allow_truncated: bool,
         /// Topology (PDB, PDBx/mmCIF, GRO, PSF, AMBER prmtop, LAMMPS data file) of the trajectory's atoms: its
@@ -367,7 +368,8 @@ pub struct RenderArgs {
     /// Format, when the extension does not tell it.
     #[arg(long)]
     pub format: Option<String>,
-    /// Keep the complete frames of a file whose last frame is cut short, with a warning
+    /// Keep the complete frames of a file whose last frame is cut short (a crashed or running
+    /// simulation, a partial copy; a .gz whose stream ends early too), with a warning
     /// (default: a cut frame is an error naming the file, frame and byte).
     #[arg(long)]
     pub allow_truncated: bool,

@@ -114,3 +114,44 @@ fn render_failing_at_frame_1_names_the_images_already_written() {
     let img = image::open(&first).unwrap();
     assert_eq!((img.width(), img.height()), (32, 24));
 }
+
+/// A gzip trajectory whose stream ends early (GNU gzip's copy of a LAMMPS dump, cut in the
+/// second frame's compressed data): an error naming the file, "gzip" and the compressed
+/// offset; with --allow-truncated, two warnings (the gzip cut, the cut frame) and the complete
+/// frames rendered.
+#[test]
+fn a_cut_gz_renders_its_complete_frames_with_allow_truncated() {
+    let dir = tempfile::tempdir().unwrap();
+    let gz = data("lmp_tri.lammpstrj.gz");
+    let p = write(dir.path(), "cut.lammpstrj.gz", &gz[..gz.len() * 2 / 3]);
+    let path = p.to_str().unwrap();
+    let o = texmap(&["info", path]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains(path) && stderr(&o).contains("gzip"),
+        "{}",
+        stderr(&o)
+    );
+    let out = dir.path().join("f-%d.png");
+    let o = texmap(&[
+        "render",
+        path,
+        "--quiet",
+        "--allow-truncated",
+        "--size",
+        "64x48",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let warnings = stderr(&o);
+    assert!(warnings.contains("gzip stream"), "{warnings}");
+    assert!(
+        warnings.contains("file ends inside the frame"),
+        "{warnings}"
+    );
+    let written = (0..3)
+        .filter(|f| dir.path().join(format!("f-{f}.png")).exists())
+        .count();
+    assert!((1..3).contains(&written), "{written} frames written");
+}

@@ -18,7 +18,11 @@
 //! Every member of the file is read (`MultiGzDecoder`), so `cat a.gz b.gz` and bgzip files read
 //! whole. A damaged or cut stream is an [`Error::Parse`] naming the file, saying "gzip" and giving
 //! the compressed byte offset where decoding stopped; a stream cut before its 8-byte trailer is
-//! such an error too, never a shorter file.
+//! such an error too, never a shorter file. The one exception is a trajectory opened with
+//! `allow_truncated` ([`crate::ReadOptions`]): a stream that simply ends early (a simulation
+//! killed while writing `run.xyz.gz`, a partial download) gives what inflated up to the cut,
+//! with the cut as a warning (the [`Error::Parse`] it would have been), and the reader then keeps
+//! the complete frames as it does for a cut plain file. Corrupt data stays an error either way.
 //!
 //! Rejected: inflating into memory (`Cursor<Vec<u8>>`), since memory would then grow with the
 //! file, which no reader of the crate does; and random access inside the compressed stream
@@ -59,8 +63,14 @@ pub(crate) fn inner_path(path: &Path) -> Cow<'_, Path> {
 }
 
 /// Opens `path` (called `name` in errors) for reading: the file itself, or when it is gzip, an
-/// anonymous temporary file holding its decompressed bytes, positioned at the start.
-pub(crate) fn open(path: &Path, name: &Arc<str>) -> Result<File, Error> {
+/// anonymous temporary file holding its decompressed bytes, positioned at the start. With
+/// `keep_cut`, a gzip stream that ends early gives the bytes inflated up to there and the cut as
+/// a warning (the second value); otherwise the cut is the error.
+pub(crate) fn open(
+    path: &Path,
+    name: &Arc<str>,
+    keep_cut: bool,
+) -> Result<(File, Option<Error>), Error> {
     let io_at = |byte: Option<u64>| {
         move |source| Error::Io {
             at: Location {
@@ -75,7 +85,7 @@ pub(crate) fn open(path: &Path, name: &Arc<str>) -> Result<File, Error> {
     if !regular && !has_gz_extension(path) {
         // A pipe or device cannot give back the bytes a look at its magic would take: it is read
         // as it is, as before gzip input existed (the text readers stream without seeking).
-        return Ok(file);
+        return Ok((file, None));
     }
     // Read the magic (and a few bytes more, to show what a misnamed file holds).
     let mut head = Vec::with_capacity(16);
@@ -95,22 +105,29 @@ pub(crate) fn open(path: &Path, name: &Arc<str>) -> Result<File, Error> {
             });
         }
         file.rewind().map_err(io_at(Some(0)))?;
-        return Ok(file);
+        return Ok((file, None));
     }
     // The bytes already read go first, so that a pipe named `.gz` needs no seek either.
-    decompress(io::Cursor::new(head).chain(file), name)
+    decompress(io::Cursor::new(head).chain(file), name, keep_cut)
 }
 
-/// Inflates every member of `src` into a new anonymous temporary file, rewound.
-fn decompress(src: impl Read, name: &Arc<str>) -> Result<File, Error> {
+/// Inflates every member of `src` into a new anonymous temporary file, rewound; with
+/// `keep_cut`, a stream that ends early stops there with the cut as a warning.
+fn decompress(
+    src: impl Read,
+    name: &Arc<str>,
+    keep_cut: bool,
+) -> Result<(File, Option<Error>), Error> {
     let mut out = tempfile::tempfile().map_err(|e| temp_error(name, e))?;
     let mut input = Counting {
         inner: BufReader::with_capacity(64 * 1024, src),
         consumed: 0,
         failed: false,
+        ended: false,
     };
     let mut decoder = MultiGzDecoder::new(&mut input);
     let mut buf = vec![0u8; 64 * 1024];
+    let mut cut = None;
     loop {
         let n = match decoder.read(&mut buf) {
             Ok(0) => break,
@@ -118,13 +135,31 @@ fn decompress(src: impl Read, name: &Arc<str>) -> Result<File, Error> {
             Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
             Err(e) => {
                 drop(decoder);
-                return Err(stream_error(name, &input, e));
+                let ended_early = e.kind() == io::ErrorKind::UnexpectedEof;
+                let e = stream_error(name, &input, e);
+                match e {
+                    Error::Parse { at, found, .. } if keep_cut && ended_early && is_cut(&input) => {
+                        cut = Some(Error::Parse {
+                            at,
+                            expected: "the rest of the gzip stream (the data before the cut is read)",
+                            found,
+                        });
+                        break;
+                    }
+                    e => return Err(e),
+                }
             }
         };
         out.write_all(&buf[..n]).map_err(|e| temp_error(name, e))?;
     }
     out.rewind().map_err(|e| temp_error(name, e))?;
-    Ok(out)
+    Ok((out, cut))
+}
+
+/// Whether the decoder stopped because the compressed input ended (rather than at corrupt
+/// data): every byte of the file was consumed without a read failure.
+fn is_cut<R: BufRead>(input: &Counting<R>) -> bool {
+    !input.failed && input.ended
 }
 
 /// An error of the gzip stream at the compressed offset `input` has reached: the operating
@@ -168,12 +203,15 @@ struct Counting<R> {
     inner: R,
     consumed: u64,
     failed: bool,
+    /// The file gave its last byte (a read or fill returned nothing).
+    ended: bool,
 }
 
 impl<R: BufRead> Read for Counting<R> {
     fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
         let n = self.inner.read(buf).inspect_err(|_| self.failed = true)?;
         self.consumed += n as u64;
+        self.ended |= n == 0 && !buf.is_empty();
         Ok(n)
     }
 }
@@ -181,7 +219,10 @@ impl<R: BufRead> Read for Counting<R> {
 impl<R: BufRead> BufRead for Counting<R> {
     fn fill_buf(&mut self) -> io::Result<&[u8]> {
         match self.inner.fill_buf() {
-            Ok(b) => Ok(b),
+            Ok(b) => {
+                self.ended |= b.is_empty();
+                Ok(b)
+            }
             Err(e) => {
                 self.failed = true;
                 Err(e)
@@ -212,7 +253,8 @@ mod tests {
         f.write_all(gz).unwrap();
         f.rewind().unwrap();
         let mut out = Vec::new();
-        decompress(f, &"t.gz".into())?
+        decompress(f, &"t.gz".into(), false)?
+            .0
             .read_to_end(&mut out)
             .unwrap();
         Ok(out)

@@ -46,6 +46,9 @@ pub(crate) struct LineReader<R> {
     offset: u64,
     /// Number of the next line.
     line: u64,
+    /// The number of the data's last line when it has no '\n' (once met): where a file cut
+    /// mid-line ends.
+    pub unterminated: Option<u64>,
 }
 
 impl<R: Read> LineReader<R> {
@@ -59,6 +62,7 @@ impl<R: Read> LineReader<R> {
             eof: false,
             offset: 0,
             line: 1,
+            unterminated: None,
         }
     }
 
@@ -123,6 +127,7 @@ impl<R: Read> LineReader<R> {
                 }
                 let (s, e) = (self.start, self.end);
                 let pos = self.pos();
+                self.unterminated = Some(pos.line);
                 self.start = e;
                 self.offset += (e - s) as u64;
                 self.line += 1;
@@ -173,6 +178,7 @@ impl<R: Read> LineReader<R> {
             if self.eof {
                 // A last line without '\n' counts as a line.
                 if self.start < self.end {
+                    self.unterminated = Some(self.line);
                     self.offset += (self.end - self.start) as u64;
                     self.start = self.end;
                     self.line += 1;
@@ -384,6 +390,9 @@ pub(crate) struct TextReader<R, F> {
     next: usize,
     /// Most atoms to reserve from a count in the file.
     reserve: usize,
+    /// Once checked: whether the last frame is cut inside its last line (see
+    /// `last_frame_cut`), as the location and what was expected.
+    last_cut: Option<Option<(Location, String)>>,
 }
 
 impl<R: Read + Seek, F: TextFormat> TextReader<R, F> {
@@ -411,6 +420,7 @@ impl<R: Read + Seek, F: TextFormat> TextReader<R, F> {
             complete: false,
             next: 0,
             reserve,
+            last_cut: None,
         }
     }
 
@@ -472,9 +482,44 @@ impl<R: Read + Seek, F: TextFormat> TextReader<R, F> {
             Err(e) => {
                 // Leave the cursor at the damaged frame so a retry gives the same error.
                 frame.clear();
-                let _ = self.lines.seek(self.starts[self.next]);
+                let start = self.starts[self.next];
+                let e = self.explain_cut(e, start);
+                let _ = self.lines.seek(start);
                 Err(e)
             }
+        }
+    }
+
+    /// The error to give for the frame starting at `start` that failed to parse with `e`: when
+    /// the data ends inside the frame, the parser meets a partial last line first, but the cut
+    /// is what happened (and what `allow_truncated` forgives). The cut is found as `n_frames`
+    /// finds it, by the format's scan of the frame from its start, or it is the failing line
+    /// itself when that is the data's last line and has no end of line.
+    fn explain_cut(&mut self, e: Error, start: Pos) -> Error {
+        let Error::Parse { .. } = &e else {
+            return e;
+        };
+        if self.lines.seek(start).is_err() {
+            return e;
+        }
+        let ctx = self.ctx();
+        if let Err(cut @ Error::Truncated { .. }) = self.format.skip(&mut self.lines, &ctx) {
+            return cut;
+        }
+        self.cut_line(e)
+    }
+
+    /// `e` as the cut it is when it is a parse error on the data's last line and that line has
+    /// no end of line (a file cut mid-line); else `e`.
+    fn cut_line(&self, e: Error) -> Error {
+        match (&e, self.lines.unterminated) {
+            (Error::Parse { at, .. }, Some(last)) if at.line == Some(last) => Error::Truncated {
+                at: at.clone(),
+                expected: format!(
+                    "the rest of line {last}: the file ends inside it, without an end of line"
+                ),
+            },
+            _ => e,
         }
     }
 
@@ -488,7 +533,8 @@ impl<R: Read + Seek, F: TextFormat> TextReader<R, F> {
             self.next = self.starts.len() - 1;
             self.lines.seek(last).map_err(|e| self.ctx().io(last, e))?;
             let ctx = self.ctx();
-            if !self.format.skip(&mut self.lines, &ctx)? {
+            let skipped = self.format.skip(&mut self.lines, &ctx);
+            if !skipped.map_err(|e| self.cut_line(e))? {
                 self.complete = true;
                 return Ok(());
             }
@@ -505,7 +551,8 @@ impl<R: Read + Seek, F: TextFormat> TextReader<R, F> {
                 return Ok(());
             };
             self.starts.push(start);
-            if !self.format.skip(&mut self.lines, &ctx)? {
+            let skipped = self.format.skip(&mut self.lines, &ctx);
+            if !skipped.map_err(|e| self.cut_line(e))? {
                 self.starts.pop();
                 self.complete = true;
                 return Ok(());
@@ -549,6 +596,41 @@ impl<R: Read + Seek, F: TextFormat> TextReader<R, F> {
             self.next = keep;
             scanned?;
         }
+        if let Some((at, expected)) = self.last_frame_cut()? {
+            return Err(Error::Truncated { at, expected });
+        }
         Ok(self.starts.len())
+    }
+
+    /// A scan counts lines, so it takes a last frame that the data ends inside its last line
+    /// (no end of line) for whole; parsing that frame tells (once, after a complete scan).
+    fn last_frame_cut(&mut self) -> Result<Option<(Location, String)>, Error> {
+        if self.lines.unterminated.is_none() || self.starts.is_empty() {
+            return Ok(None);
+        }
+        if self.last_cut.is_none() {
+            let (keep, resume) = (self.next, self.lines.pos());
+            self.next = self.starts.len() - 1;
+            let start = self.starts[self.next];
+            self.lines
+                .seek(start)
+                .map_err(|e| self.ctx().io(start, e))?;
+            let ctx = self.ctx();
+            let mut scratch = Frame::new();
+            let read = self.format.read(&mut self.lines, &ctx, &mut scratch);
+            let cut = match read {
+                Err(e) => match self.explain_cut(e, start) {
+                    Error::Truncated { at, expected } => Some((at, expected)),
+                    _ => None,
+                },
+                Ok(_) => None,
+            };
+            self.lines
+                .seek(resume)
+                .map_err(|e| self.ctx().io(resume, e))?;
+            self.next = keep;
+            self.last_cut = Some(cut);
+        }
+        Ok(self.last_cut.clone().flatten())
     }
 }

@@ -229,7 +229,8 @@ impl Topology {
     pub fn open_as(path: impl AsRef<Path>, format: TopologyFormat) -> Result<Topology, Error> {
         let path = path.as_ref();
         let name: Arc<str> = path.display().to_string().into();
-        let file = crate::gz::open(path, &name)?;
+        // A topology must be whole: a cut gzip stream is an error.
+        let (file, _) = crate::gz::open(path, &name, false)?;
         Topology::from_reader(file, format, &name)
     }
 

@@ -58,7 +58,12 @@ macro_rules! each_reader {
 ///
 /// With `allow_truncated` ([`ReadOptions`]) the complete frames are kept and the cut one is dropped
 /// *with a warning*: the same error, kept in [`Trajectory::warnings`] for the caller to print,
-/// while `n_frames` counts the complete frames and streaming ends after the last of them. A PDB
+/// while `n_frames` counts the complete frames and streaming ends after the last of them. A cut
+/// mid-line is a cut, not damage: the partial last line a frame fails to parse is reported as
+/// the data ending inside the frame, by streaming and by `n_frames` alike. (A partial last line
+/// that still parses, such as a number cut to a shorter number with no end of line after it,
+/// cannot be told from a file written without a final newline, and is read as it is.) A gzip
+/// stream that ends early is read up to the cut, with a warning naming the compressed offset. A PDB
 /// or mmCIF model whose atom count differs from model 1's is likewise an error by default and a
 /// warning here (the model is passed on as it is). Damage that is not a cut end (a flipped byte, a
 /// corrupt header) stays an error either way.
@@ -122,6 +127,9 @@ pub struct Trajectory<R: Read + Seek = File> {
     /// What was tolerated under `options`, and the alternate locations an mmCIF read dropped
     /// (each once).
     warnings: Vec<Error>,
+    /// The first frame a read found cut (tolerated under `allow_truncated`): frames from it on
+    /// do not exist, whatever a scan counted.
+    cut_at: Option<usize>,
 }
 
 impl Trajectory<File> {
@@ -131,8 +139,10 @@ impl Trajectory<File> {
     /// its format comes from the name without `.gz`, else from the decompressed first bytes. It
     /// is inflated once into an anonymous temporary file (disk, not memory: the decompressed
     /// size), so byte offsets in later errors count decompressed bytes; damage to the gzip
-    /// stream itself is an error here naming the file, "gzip" and the compressed offset. A name
-    /// ending in `.gz` over bytes that are not gzip is an error.
+    /// stream itself is an error here naming the file, "gzip" and the compressed offset (a
+    /// stream that just ends early, under `allow_truncated`, a warning: what inflated is read,
+    /// and a frame it cuts is dropped as in a cut plain file). A name ending in `.gz` over bytes
+    /// that are not gzip is an error.
     pub fn open(path: impl AsRef<Path>) -> Result<Trajectory<File>, Error> {
         Trajectory::open_with(path, ReadOptions::default())
     }
@@ -148,7 +158,7 @@ impl Trajectory<File> {
             at: crate::error::Location::file(&name),
             source,
         };
-        let mut file = crate::gz::open(path, &name)?;
+        let (mut file, cut) = crate::gz::open(path, &name, options.allow_truncated)?;
         let format = match Format::from_path(path) {
             Some(f) => f,
             None => {
@@ -158,7 +168,7 @@ impl Trajectory<File> {
                 Format::from_magic(&head).ok_or(Error::UnknownFormat { file: name.clone() })?
             }
         };
-        Trajectory::from_reader_with(file, format, &name, options)
+        Trajectory::from_reader_with(file, format, &name, options).map(|t| t.with_warning(cut))
     }
 
     /// Opens `path` as `format`, whatever its extension; a gzip file is read decompressed, as
@@ -175,8 +185,8 @@ impl Trajectory<File> {
     ) -> Result<Trajectory<File>, Error> {
         let path = path.as_ref();
         let name: Arc<str> = path.display().to_string().into();
-        let file = crate::gz::open(path, &name)?;
-        Trajectory::from_reader_with(file, format, &name, options)
+        let (file, cut) = crate::gz::open(path, &name, options.allow_truncated)?;
+        Trajectory::from_reader_with(file, format, &name, options).map(|t| t.with_warning(cut))
     }
 }
 
@@ -216,6 +226,7 @@ impl<R: Read + Seek> Trajectory<R> {
             next: 0,
             options,
             warnings: Vec::new(),
+            cut_at: None,
         })
     }
 
@@ -231,6 +242,15 @@ impl<R: Read + Seek> Trajectory<R> {
     /// prints them as warnings.
     pub fn warnings(&self) -> &[Error] {
         &self.warnings
+    }
+
+    /// `self` with `w` (a cut gzip stream read under `allow_truncated`), if any, as its first
+    /// warning.
+    fn with_warning(mut self, w: Option<Error>) -> Self {
+        if let Some(w) = w {
+            self.warnings.insert(0, w);
+        }
+        self
     }
 
     /// Keeps `w` as a warning unless the same one is kept already.
@@ -286,7 +306,8 @@ impl<R: Read + Seek> Trajectory<R> {
         let ok = match read {
             Ok(ok) => ok,
             Err(e) => {
-                self.tolerate(e)?;
+                let complete = self.tolerate(e)?;
+                self.cut_at = Some(self.cut_at.map_or(complete, |c| c.min(complete)));
                 frame.clear();
                 false
             }
@@ -337,7 +358,8 @@ impl<R: Read + Seek> Trajectory<R> {
     pub fn n_frames(&mut self) -> Result<usize, Error> {
         let n = each_reader!(&mut self.reader, r => r.n_frames());
         self.gather();
-        n.or_else(|e| self.tolerate(e))
+        let n = n.or_else(|e| self.tolerate(e))?;
+        Ok(self.cut_at.map_or(n, |c| n.min(c)))
     }
 
     /// Number of atoms in the first frame (frames of a LAMMPS dump may differ: use

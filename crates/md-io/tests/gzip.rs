@@ -201,15 +201,64 @@ fn a_cut_gz_is_an_error_not_a_shorter_trajectory() {
             };
             assert_gzip_error(&e, &p, cut);
             assert!(e.to_string().contains("found 'end of file'"), "{e}");
-            // allow_truncated keeps complete frames of a cut *trajectory*; a cut gzip stream is
-            // damage to the container and stays an error.
-            let lenient = ReadOptions::new().allow_truncated(true);
-            assert!(
-                Trajectory::open_with(&p, lenient).is_err(),
-                "{fixture} cut at {cut}"
-            );
         }
     }
+}
+
+/// Under `allow_truncated`, a gzip stream that ends early is read up to the cut, with a
+/// warning naming the compressed offset, and the frame the cut falls in is dropped as in a
+/// cut plain file: at every cut, the frames read are the plain file's first frames, bit for
+/// bit, and as many as the inflated prefix holds whole. Topologies stay strict.
+#[test]
+fn allow_truncated_keeps_the_complete_frames_of_a_cut_gz() {
+    let dir = scratch();
+    let lenient = ReadOptions::new().allow_truncated(true);
+    // GNU gzip's two-member copy, and MDAnalysis's multi-model PDB gzipped here.
+    let multi = gzip(&std::fs::read(path("mda_multi.pdb")).unwrap());
+    for (fixture, plain) in [
+        ("lmp_tri.lammpstrj.gz", "lmp_tri.lammpstrj"),
+        ("mda_multi.pdb.gz", "mda_multi.pdb"),
+    ] {
+        let gz = match fixture {
+            "mda_multi.pdb.gz" => multi.clone(),
+            _ => std::fs::read(path(fixture)).unwrap(),
+        };
+        let plain = path(plain);
+        let (want, n) = frames(&mut Trajectory::open(&plain).unwrap());
+        assert!(n >= 2, "{fixture}");
+        let mut seen = std::collections::BTreeSet::new();
+        for cut in (20..gz.len()).step_by(gz.len() / 40) {
+            let p = put(&dir, fixture, &gz[..cut]);
+            let mut t = Trajectory::open_with(&p, lenient).unwrap();
+            let (got, k) = frames(&mut t);
+            assert!(k <= n, "{fixture} cut at {cut}");
+            assert!(
+                got[..] == want[..k],
+                "{fixture} cut at {cut}: frames differ"
+            );
+            // A cut exactly at a member boundary leaves a whole gzip file: no gzip warning.
+            let whole = gz[cut..].starts_with(&[0x1f, 0x8b, 8]);
+            let w = warnings(&t);
+            assert!(
+                whole || (w[0].starts_with(&name_of(&p)) && w[0].contains("gzip")),
+                "{fixture} cut at {cut}: {w:?}"
+            );
+            seen.insert(k);
+        }
+        // Cuts early and late: some keep no frame or a few, some all but the last.
+        assert!(
+            seen.len() >= 2 && seen.contains(&(n - 1)),
+            "{fixture}: {seen:?}"
+        );
+        // Only the trailer missing: every frame inflated, the cut still reported.
+        let p = put(&dir, fixture, &gz[..gz.len() - 4]);
+        let mut t = Trajectory::open_with(&p, lenient).unwrap();
+        assert_eq!(frames(&mut t).1, n);
+        assert!(warnings(&t)[0].contains("gzip"));
+    }
+    let gz = std::fs::read(path("psf_parmed.psf.gz")).unwrap();
+    let p = put(&dir, "psf_parmed.psf.gz", &gz[..gz.len() / 2]);
+    assert_gzip_error(&Topology::open(&p).unwrap_err(), &p, gz.len() / 2);
 }
 
 #[test]

@@ -200,3 +200,67 @@ fn error_after_good_frames_then_random_access_still_reaches_them() {
     assert_eq!(f, all[0]);
     assert!(t.read_frame(2, &mut f).is_err());
 }
+
+/// Under `allow_truncated`, a file cut at any byte streams its complete frames and stops at
+/// the cut with a warning: a partial last line is the cut, not damage. Frames complete before
+/// the cut read back unchanged, and the frame count agrees with what streaming gave. (A cut
+/// before the first atom's data leaves no frame to keep, and may be an error.) One more
+/// frame than the complete ones may be read where nothing in the file tells that it is cut: a
+/// model of a format without atom counts (mmCIF) cut between rows, or a partial last line that
+/// still parses (a number cut to a shorter number, no end of line after it), which the readers
+/// cannot tell from a file written without a final newline.
+#[test]
+fn allow_truncated_streams_every_cut_to_its_complete_frames() {
+    use texmap_md_io::ReadOptions;
+    let lenient = ReadOptions::new().allow_truncated(true);
+    for (name, format) in FILES {
+        let good = data(name);
+        let (all, _) = read_all(&good, format);
+        let ends = frame_ends(&good, format);
+        let mut errors = Vec::new();
+        for cut in 1..good.len() {
+            let src = Cursor::new(good[..cut].to_vec());
+            let mut t = Trajectory::from_reader_with(src, format, "cut", lenient).unwrap();
+            let complete = ends.iter().filter(|e| **e <= cut).count();
+            let mut f = Frame::new();
+            let mut got = 0;
+            let streamed = loop {
+                match t.read_next(&mut f) {
+                    Ok(true) => {
+                        if got < complete {
+                            assert_eq!(f, all[got], "{name} cut at {cut}: frame {got}");
+                        }
+                        got += 1;
+                    }
+                    Ok(false) => break Ok(got),
+                    Err(e) => break Err(e),
+                }
+            };
+            match streamed {
+                Ok(k) => {
+                    // (mmCIF: `frame_ends` counts a model complete only after the next
+                    // model's first row line, where the reader already has it.)
+                    assert!(
+                        k >= complete && (format == Format::Mmcif || k <= complete + 1),
+                        "{name} cut at {cut}: {k} frames, {complete} complete"
+                    );
+                    assert_eq!(t.n_frames().unwrap(), k, "{name} cut at {cut}");
+                }
+                Err(e) => errors.push((cut, e.to_string())),
+            }
+        }
+        // Only a cut before the first atom's data may fail: an mmCIF header without its
+        // complete _atom_site loop is a file that holds no frame, not a cut frame.
+        let first_row = match format {
+            Format::Mmcif => std::str::from_utf8(&good).unwrap().find("\nATOM").unwrap(),
+            _ => 0,
+        };
+        let late: Vec<_> = errors.iter().filter(|(cut, _)| *cut > first_row).collect();
+        assert!(
+            late.is_empty(),
+            "{name}: {} cuts failed: {:?}",
+            late.len(),
+            &late[..late.len().min(5)]
+        );
+    }
+}
