@@ -74,6 +74,7 @@
 //! streaming, the line-scan index and error positions from `TextReader`.
 
 pub mod bonds;
+pub mod cna;
 mod cursor;
 mod dcd;
 pub mod elements;

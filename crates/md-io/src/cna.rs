@@ -1,0 +1,435 @@
+//! Crystal structure per atom by adaptive common neighbour analysis (a-CNA; A. Stukowski,
+//! "Structure identification methods for atomistic simulations of crystalline materials",
+//! Modelling Simul. Mater. Sci. Eng. 20 (2012) 045021), as OVITO's Common Neighbor Analysis
+//! modifier assigns it in its default adaptive mode: FCC, HCP, BCC, icosahedral or other.
+//! Materials simulations colour by it and hide the perfect crystal to show dislocations,
+//! stacking faults, grain boundaries and surfaces.
+//!
+//! Per atom:
+//! 1. The 12 nearest neighbours (FCC, HCP, icosahedral test): the local cutoff is
+//!    `(1 + √2) / 2` times their mean distance, and two neighbours are bonded when they are at
+//!    most that far apart. For each neighbour, its CNA signature is (common neighbours: the
+//!    other neighbours bonded to it; bonds among those; bonds in the largest connected set of
+//!    those bonds). Twelve (4,2,1) is FCC; six (4,2,1) and six (4,2,2) HCP; twelve (5,5,5)
+//!    icosahedral.
+//! 2. Otherwise the 14 nearest (BCC test): the cutoff is `(1 + √2) / 2` times
+//!    `(2/√3 · Σ₁⁸ rⱼ + Σ₉¹⁴ rⱼ) / 14`; eight (6,6,6) and six (4,4,4) is BCC.
+//! 3. Otherwise other (surfaces, cores of defects, liquids, too few atoms).
+//!
+//! Neighbours are found in a cell grid; in a periodic cell by the nearest image
+//! ([`crate::pbc::minimum_image`]), so the box must be wider than twice the 14th neighbour
+//! distance (any box of a few unit cells). Frames without a cell are open.
+//!
+//! ```
+//! use texmap_md_io::cna::{StructureType, classify};
+//! use texmap_md_io::{Frame, UnitCell};
+//! // A 3x3x3 block of FCC unit cells (a = 3.6 Å), periodic.
+//! let a = 3.6f32;
+//! let mut frame = Frame::new();
+//! for (i, j, k) in (0..27).map(|n| (n % 3, n / 3 % 3, n / 9)) {
+//!     for b in [[0.0, 0.0, 0.0], [0.5, 0.5, 0.0], [0.5, 0.0, 0.5], [0.0, 0.5, 0.5]] {
+//!         frame.positions.push([(i as f32 + b[0]) * a, (j as f32 + b[1]) * a, (k as f32 + b[2]) * a]);
+//!     }
+//! }
+//! frame.cell = Some(UnitCell::orthorhombic(3.0 * a as f64, 3.0 * a as f64, 3.0 * a as f64).unwrap());
+//! assert!(classify(&frame).iter().all(|t| *t == StructureType::Fcc));
+//! ```
+
+use crate::frame::{Frame, UnitCell};
+use crate::pbc::minimum_image;
+
+/// A crystal structure type; the numbers are OVITO's structure type codes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[repr(u8)]
+pub enum StructureType {
+    Other = 0,
+    Fcc = 1,
+    Hcp = 2,
+    Bcc = 3,
+    Ico = 4,
+}
+
+impl StructureType {
+    /// All types, in code order.
+    pub const ALL: [StructureType; 5] = [
+        StructureType::Other,
+        StructureType::Fcc,
+        StructureType::Hcp,
+        StructureType::Bcc,
+        StructureType::Ico,
+    ];
+
+    /// The lower-case name (`other`, `fcc`, `hcp`, `bcc`, `ico`).
+    pub fn name(self) -> &'static str {
+        match self {
+            StructureType::Other => "other",
+            StructureType::Fcc => "fcc",
+            StructureType::Hcp => "hcp",
+            StructureType::Bcc => "bcc",
+            StructureType::Ico => "ico",
+        }
+    }
+
+    /// The type named `name` (any case).
+    pub fn from_name(name: &str) -> Option<StructureType> {
+        StructureType::ALL
+            .into_iter()
+            .find(|t| t.name().eq_ignore_ascii_case(name))
+    }
+}
+
+/// Neighbours examined per atom: the BCC test's 14.
+const MAX_NEIGHBOURS: usize = 14;
+
+/// The structure type of every atom of `frame` (see the module docs). Atoms with non-finite
+/// coordinates are other, and are nobody's neighbour.
+pub fn classify(frame: &Frame) -> Vec<StructureType> {
+    let grid = Grid::new(&frame.positions, frame.cell.as_ref());
+    let mut near = Vec::with_capacity(64);
+    (0..frame.positions.len())
+        .map(|i| {
+            grid.nearest(i, &mut near);
+            signature_type(&near)
+        })
+        .collect()
+}
+
+/// The count of each type in `types`, indexed by the type's code.
+pub fn counts(types: &[StructureType]) -> [usize; 5] {
+    let mut c = [0; 5];
+    for t in types {
+        c[*t as usize] += 1;
+    }
+    c
+}
+
+/// The type from the neighbour vectors sorted by length (at most [`MAX_NEIGHBOURS`] used).
+fn signature_type(near: &[([f64; 3], f64)]) -> StructureType {
+    if near.len() >= 12 {
+        let mean = near[..12].iter().map(|n| n.1).sum::<f64>() / 12.0;
+        let cutoff = 0.5 * (1.0 + std::f64::consts::SQRT_2) * mean;
+        let sigs = signatures(&near[..12], cutoff);
+        let count = |s: [u8; 3]| sigs.iter().filter(|x| **x == s).count();
+        let (s421, s422, s555) = (count([4, 2, 1]), count([4, 2, 2]), count([5, 5, 5]));
+        if s421 == 12 {
+            return StructureType::Fcc;
+        }
+        if s421 == 6 && s422 == 6 {
+            return StructureType::Hcp;
+        }
+        if s555 == 12 {
+            return StructureType::Ico;
+        }
+    }
+    if near.len() >= 14 {
+        let first: f64 = near[..8].iter().map(|n| n.1).sum();
+        let second: f64 = near[8..14].iter().map(|n| n.1).sum();
+        let mean = (2.0 / 3f64.sqrt() * first + second) / 14.0;
+        let cutoff = 0.5 * (1.0 + std::f64::consts::SQRT_2) * mean;
+        let sigs = signatures(&near[..14], cutoff);
+        let count = |s: [u8; 3]| sigs.iter().filter(|x| **x == s).count();
+        if count([6, 6, 6]) == 8 && count([4, 4, 4]) == 6 {
+            return StructureType::Bcc;
+        }
+    }
+    StructureType::Other
+}
+
+/// Each neighbour's CNA signature among `near` (vectors from the central atom) with bonds
+/// shorter than `cutoff`.
+fn signatures(near: &[([f64; 3], f64)], cutoff: f64) -> Vec<[u8; 3]> {
+    let n = near.len();
+    let c2 = cutoff * cutoff;
+    // bonded[j] has bit k when neighbours j and k are bonded.
+    let mut bonded = [0u16; MAX_NEIGHBOURS];
+    for j in 0..n {
+        for k in j + 1..n {
+            let d: f64 = (0..3).map(|a| (near[j].0[a] - near[k].0[a]).powi(2)).sum();
+            if d <= c2 {
+                bonded[j] |= 1 << k;
+                bonded[k] |= 1 << j;
+            }
+        }
+    }
+    (0..n)
+        .map(|j| {
+            let common = bonded[j];
+            let members: Vec<usize> = (0..n).filter(|&k| common >> k & 1 == 1).collect();
+            // The bonds among the common neighbours.
+            let mut bonds: Vec<(usize, usize)> = Vec::new();
+            for (x, &a) in members.iter().enumerate() {
+                for &b in &members[x + 1..] {
+                    if bonded[a] >> b & 1 == 1 {
+                        bonds.push((a, b));
+                    }
+                }
+            }
+            [
+                members.len().min(255) as u8,
+                bonds.len().min(255) as u8,
+                largest_cluster(&bonds).min(255) as u8,
+            ]
+        })
+        .collect()
+}
+
+/// The number of bonds in the largest set of bonds connected through shared atoms.
+fn largest_cluster(bonds: &[(usize, usize)]) -> usize {
+    let mut done = vec![false; bonds.len()];
+    let mut best = 0;
+    for start in 0..bonds.len() {
+        if done[start] {
+            continue;
+        }
+        done[start] = true;
+        let mut stack = vec![start];
+        let mut size = 0;
+        while let Some(b) = stack.pop() {
+            size += 1;
+            let (p, q) = bonds[b];
+            for (c, &(r, s)) in bonds.iter().enumerate() {
+                if !done[c] && (r == p || r == q || s == p || s == q) {
+                    done[c] = true;
+                    stack.push(c);
+                }
+            }
+        }
+        best = best.max(size);
+    }
+    best
+}
+
+/// A cell grid over the atoms (fractional cells in a periodic cell, the bounding box
+/// otherwise) for nearest-neighbour queries.
+struct Grid<'a> {
+    positions: &'a [[f32; 3]],
+    cell: Option<&'a UnitCell>,
+    /// Grid size per axis, and each atom's cell (`usize::MAX`: non-finite atom).
+    dims: [usize; 3],
+    /// Atoms sorted by cell, and where each cell's atoms start (`starts[c]..starts[c + 1]`).
+    order: Vec<u32>,
+    starts: Vec<u32>,
+    /// Cell index per atom.
+    of: Vec<usize>,
+    /// The smallest width of a grid cell (Å): a ring of k cells around an atom holds every
+    /// atom within k times this.
+    width: f64,
+    /// Bounding-box origin and inverse cell size per axis (open frames).
+    lo: [f64; 3],
+    inv: [f64; 3],
+    /// Inverse of the cell matrix (periodic frames).
+    inverse: [[f64; 3]; 3],
+}
+
+impl<'a> Grid<'a> {
+    fn new(positions: &'a [[f32; 3]], cell: Option<&'a UnitCell>) -> Grid<'a> {
+        let finite: Vec<usize> = (0..positions.len())
+            .filter(|&i| positions[i].iter().all(|v| v.is_finite()))
+            .collect();
+        let n = finite.len().max(1) as f64;
+        let mut grid = Grid {
+            positions,
+            cell,
+            dims: [1; 3],
+            order: Vec::new(),
+            starts: Vec::new(),
+            of: vec![usize::MAX; positions.len()],
+            width: f64::INFINITY,
+            lo: [0.0; 3],
+            inv: [0.0; 3],
+            inverse: [[0.0; 3]; 3],
+        };
+        match cell {
+            Some(c) => {
+                let m = c.matrix();
+                grid.inverse = invert(&m);
+                let volume = det(&m).abs();
+                // Perpendicular widths of the cell; about 3 atoms per grid cell.
+                let target = (3.0 * volume / n).cbrt();
+                for a in 0..3 {
+                    let (b, d) = ((a + 1) % 3, (a + 2) % 3);
+                    let area = norm(cross(m[b], m[d]));
+                    let w = volume / area.max(f64::MIN_POSITIVE);
+                    grid.dims[a] = ((w / target).floor() as usize).clamp(1, 1024);
+                    grid.width = grid.width.min(w / grid.dims[a] as f64);
+                }
+            }
+            None => {
+                let mut lo = [f64::INFINITY; 3];
+                let mut hi = [f64::NEG_INFINITY; 3];
+                for &i in &finite {
+                    for a in 0..3 {
+                        lo[a] = lo[a].min(positions[i][a] as f64);
+                        hi[a] = hi[a].max(positions[i][a] as f64);
+                    }
+                }
+                let extent = [0, 1, 2].map(|a| (hi[a] - lo[a]).max(1e-3));
+                let target = (3.0 * extent.iter().product::<f64>() / n).cbrt().max(1e-3);
+                for (a, e) in extent.into_iter().enumerate() {
+                    grid.dims[a] = ((e / target).ceil() as usize).clamp(1, 1024);
+                    let size = e / grid.dims[a] as f64;
+                    grid.inv[a] = 1.0 / size;
+                    grid.width = grid.width.min(size);
+                }
+                grid.lo = lo;
+            }
+        }
+        let total = grid.dims.iter().product::<usize>();
+        let mut count = vec![0u32; total + 1];
+        for &i in &finite {
+            let c = grid.cell_of(i);
+            grid.of[i] = c;
+            count[c + 1] += 1;
+        }
+        for c in 0..total {
+            count[c + 1] += count[c];
+        }
+        let mut next = count.clone();
+        grid.order = vec![0; finite.len()];
+        for &i in &finite {
+            let c = grid.of[i];
+            grid.order[next[c] as usize] = i as u32;
+            next[c] += 1;
+        }
+        grid.starts = count;
+        grid
+    }
+
+    /// The grid coordinates of atom `i`.
+    fn coords(&self, i: usize) -> [usize; 3] {
+        let p = self.positions[i].map(f64::from);
+        match self.cell {
+            Some(_) => {
+                let f = [0, 1, 2].map(|a| (0..3).map(|k| p[k] * self.inverse[k][a]).sum::<f64>());
+                [0, 1, 2].map(|a| {
+                    let s = f[a] - f[a].floor();
+                    ((s * self.dims[a] as f64) as usize).min(self.dims[a] - 1)
+                })
+            }
+            None => [0, 1, 2].map(|a| {
+                (((p[a] - self.lo[a]) * self.inv[a]).max(0.0) as usize).min(self.dims[a] - 1)
+            }),
+        }
+    }
+
+    fn cell_of(&self, i: usize) -> usize {
+        let [x, y, z] = self.coords(i);
+        (z * self.dims[1] + y) * self.dims[0] + x
+    }
+
+    /// The vector from atom `i` to atom `j` (nearest image in a periodic cell).
+    fn vector(&self, i: usize, j: usize) -> [f64; 3] {
+        let d = [0, 1, 2].map(|a| self.positions[j][a] as f64 - self.positions[i][a] as f64);
+        match self.cell {
+            Some(c) => minimum_image(c, d),
+            None => d,
+        }
+    }
+
+    /// Atom `i`'s nearest neighbours (vector, distance), closest first, at most
+    /// [`MAX_NEIGHBOURS`], into `out`.
+    fn nearest(&self, i: usize, out: &mut Vec<([f64; 3], f64)>) {
+        out.clear();
+        if self.of[i] == usize::MAX {
+            return;
+        }
+        let centre = self.coords(i);
+        let max_ring = self.dims.iter().max().copied().unwrap_or(1);
+        let mut seen_cells: Vec<usize> = Vec::new();
+        let mut found: Vec<([f64; 3], f64)> = Vec::new();
+        for ring in 1..=max_ring {
+            // Every cell within `ring` of the centre (wrapped in a periodic cell), once.
+            seen_cells.clear();
+            let r = ring as isize;
+            for dz in -r..=r {
+                for dy in -r..=r {
+                    for dx in -r..=r {
+                        if let Some(c) = self.offset_cell(centre, [dx, dy, dz]) {
+                            seen_cells.push(c);
+                        }
+                    }
+                }
+            }
+            seen_cells.sort_unstable();
+            seen_cells.dedup();
+            found.clear();
+            for &c in &seen_cells {
+                for &j in &self.order[self.starts[c] as usize..self.starts[c + 1] as usize] {
+                    let j = j as usize;
+                    if j == i {
+                        continue;
+                    }
+                    let v = self.vector(i, j);
+                    found.push((v, norm(v)));
+                }
+            }
+            found.sort_by(|a, b| a.1.total_cmp(&b.1));
+            // The ring holds every atom within `ring` cell widths: enough when the
+            // neighbours needed are that close, or when the ring covers the whole grid.
+            let whole = (0..3).all(|a| 2 * ring + 1 >= self.dims[a]);
+            let enough = found.len() >= MAX_NEIGHBOURS
+                && found[MAX_NEIGHBOURS - 1].1 <= ring as f64 * self.width;
+            if enough || whole {
+                break;
+            }
+        }
+        // In a periodic cell, a small grid's wrapped rings meet the same atom from several
+        // sides: the nearest image is one atom, so keep each atom once.
+        if self.cell.is_some() {
+            found.dedup_by(|a, b| a.1 == b.1 && a.0 == b.0);
+        }
+        out.extend(found.into_iter().take(MAX_NEIGHBOURS));
+    }
+
+    /// The cell at `offset` from `centre`: wrapped in a periodic cell, `None` outside an open
+    /// grid.
+    fn offset_cell(&self, centre: [usize; 3], offset: [isize; 3]) -> Option<usize> {
+        let mut c = [0usize; 3];
+        for a in 0..3 {
+            let n = self.dims[a] as isize;
+            let v = centre[a] as isize + offset[a];
+            c[a] = match self.cell {
+                Some(_) => v.rem_euclid(n) as usize,
+                None if (0..n).contains(&v) => v as usize,
+                None => return None,
+            };
+        }
+        Some((c[2] * self.dims[1] + c[1]) * self.dims[0] + c[0])
+    }
+}
+
+fn det(m: &[[f64; 3]; 3]) -> f64 {
+    m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
+}
+
+/// The inverse of `m` (rows are the cell edges): `f = p · inverse` gives fractional coordinates.
+fn invert(m: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
+    let d = det(m);
+    let c = |r: usize, s: usize| {
+        let (r1, r2) = ((r + 1) % 3, (r + 2) % 3);
+        let (s1, s2) = ((s + 1) % 3, (s + 2) % 3);
+        m[r1][s1] * m[r2][s2] - m[r1][s2] * m[r2][s1]
+    };
+    // inverse[s][r] = cofactor(r, s) / det.
+    let mut out = [[0.0; 3]; 3];
+    for (s, row) in out.iter_mut().enumerate() {
+        for (r, v) in row.iter_mut().enumerate() {
+            *v = c(r, s) / d;
+        }
+    }
+    out
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn norm(v: [f64; 3]) -> f64 {
+    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
+}

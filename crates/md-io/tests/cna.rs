@@ -1,0 +1,71 @@
+//! Adaptive common neighbour analysis (`texmap_md_io::cna`) against OVITO 3.17's Common
+//! Neighbor Analysis modifier (adaptive mode) on five systems written by ASE
+//! (tests/data/cna/, by gen_cna.py): jiggled FCC with a vacancy cluster, BCC, HCP in a
+//! triclinic cell, FCC with a stacking fault and free surfaces, an icosahedral cluster
+//! without a cell. Every atom's type must be OVITO's.
+
+use std::path::Path;
+
+use texmap_md_io::cna::{StructureType, classify, counts};
+use texmap_md_io::{Frame, Trajectory};
+
+fn data(name: &str) -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/cna")
+        .join(name)
+}
+
+#[test]
+fn every_atom_has_ovitos_structure_type() {
+    let text = std::fs::read_to_string(data("cna_reference.json")).unwrap();
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let frames = v["frames"].as_array().unwrap();
+    assert_eq!(frames.len(), 5);
+    let mut t = Trajectory::open(data("crystals.xyz.gz")).unwrap();
+    let mut frame = Frame::new();
+    let mut seen = [0usize; 5];
+    for (k, want) in frames.iter().enumerate() {
+        assert!(t.read_next(&mut frame).unwrap(), "frame {k}");
+        assert_eq!(frame.n_atoms() as u64, want["atoms"].as_u64().unwrap());
+        assert_eq!(
+            frame.cell.is_some(),
+            want["pbc"].as_bool().unwrap(),
+            "frame {k}"
+        );
+        let got = classify(&frame);
+        let codes: Vec<u8> = want["types"]
+            .as_str()
+            .unwrap()
+            .bytes()
+            .map(|b| b - b'0')
+            .collect();
+        let wrong: Vec<(usize, u8, u8)> = got
+            .iter()
+            .zip(&codes)
+            .enumerate()
+            .filter(|(_, (g, w))| **g as u8 != **w)
+            .map(|(i, (g, w))| (i, *g as u8, *w))
+            .take(10)
+            .collect();
+        assert!(
+            wrong.is_empty(),
+            "frame {k}: (atom, ours, OVITO's) {wrong:?}"
+        );
+        let c = counts(&got);
+        for (s, n) in seen.iter_mut().zip(c) {
+            *s += n;
+        }
+    }
+    // Every type occurs, and the defects (vacancy, fault, surfaces) give plenty of "other".
+    assert!(seen.iter().all(|&n| n > 0), "{seen:?}");
+    assert!(seen[StructureType::Other as usize] > 100, "{seen:?}");
+}
+
+#[test]
+fn names_round_trip_and_codes_are_ovitos() {
+    for (code, t) in StructureType::ALL.into_iter().enumerate() {
+        assert_eq!(t as usize, code);
+        assert_eq!(StructureType::from_name(&t.name().to_uppercase()), Some(t));
+    }
+    assert_eq!(StructureType::from_name("diamond"), None);
+}
