@@ -144,6 +144,9 @@ pub enum ColorBy {
     Chain,
     /// --type-color, else the residue's secondary structure (helix, strand, coil), per frame.
     Structure,
+    /// --type-color, else the crystal structure type (adaptive CNA: FCC, HCP, BCC, ICO,
+    /// other), per frame, in OVITO's colours.
+    Cna,
     /// A number per atom through --colormap.
     Scalar(texmap_md_scene::ScalarSource),
 }
@@ -157,6 +160,7 @@ pub fn parse_color_by(s: &str) -> Result<ColorBy, String> {
         "type" => ColorBy::Type,
         "chain" => ColorBy::Chain,
         "structure" | "secondary" | "ss" => ColorBy::Structure,
+        "cna" | "structure-type" => ColorBy::Cna,
         "speed" | "velocity" => ColorBy::Scalar(ScalarSource::Speed),
         "residue" | "resid" => ColorBy::Scalar(ScalarSource::Residue),
         "index" => ColorBy::Scalar(ScalarSource::Index),
@@ -301,6 +305,10 @@ pub struct StyleArgs {
             "  structure  --type-color, else the residue's secondary structure in VMD's colours: helix\n",
             "             purple, strand yellow, coil white (DSSP's hydrogen bonds, as MDAnalysis assigns\n",
             "             them, recomputed every frame); water and ligands keep element colours\n",
+            "  cna        --type-color, else the crystal structure type by adaptive common neighbour\n",
+            "             analysis in OVITO's colours: FCC green, HCP red, BCC blue, icosahedral yellow,\n",
+            "             other white (as OVITO assigns them, recomputed every frame); with --select\n",
+            "             'not cna fcc' only the defects, stacking faults and surfaces are drawn\n",
             "A number per atom, mapped through --colormap over --color-range (default: the range of the\n",
             "first frame's drawn atoms, then fixed, so a colour means one value in every frame) with a\n",
             "colour bar (--no-color-bar to leave it out):\n",
@@ -622,7 +630,7 @@ pub struct MolArgs {
     /// Draw only the atoms SEL selects, in the VMD/MDAnalysis language: 'not resname SOL',
     /// 'name CA', 'element O and resid 1 to 20', 'chain A', 'segid PROA',
     /// 'protein or within 5 of resname LIG', 'byres around 5 resname LIG' (whole residues),
-    /// 'same resname as within 3 of name NA', 'helix', 'prop bfactor > 50' (VMD: 'beta > 50'),
+    /// 'same resname as within 3 of name NA', 'helix', 'not cna fcc' (crystal defects), 'prop bfactor > 50' (VMD: 'beta > 50'),
     /// 'prop abs charge > 0.5'. within/around/byres/same...as take the rest of the expression,
     /// as MDAnalysis reads it: parenthesise to end them sooner.
     #[arg(long, value_name = "SEL")]

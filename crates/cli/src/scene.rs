@@ -33,6 +33,7 @@ pub fn style_options(args: &StyleArgs) -> StyleOptions {
             ColorBy::Type => texmap_md_scene::ColorBy::Type,
             ColorBy::Chain => texmap_md_scene::ColorBy::Chain,
             ColorBy::Structure => texmap_md_scene::ColorBy::Structure,
+            ColorBy::Cna => texmap_md_scene::ColorBy::Cna,
             ColorBy::Scalar(_) => texmap_md_scene::ColorBy::Scalar,
         },
         scalar: texmap_md_scene::ScalarColor {
@@ -370,10 +371,11 @@ fn rep_color(rep: &str, text: &str) -> Result<texmap_md_scene::RepColor> {
         Ok(ColorBy::Type) => texmap_md_scene::ColorBy::Type,
         Ok(ColorBy::Chain) => texmap_md_scene::ColorBy::Chain,
         Ok(ColorBy::Structure) => texmap_md_scene::ColorBy::Structure,
+        Ok(ColorBy::Cna) => texmap_md_scene::ColorBy::Cna,
         _ => {
             return usage(format!(
                 "--rep {rep:?}: {text:?} is not a representation's colouring; use element, type, \
-                 chain, structure, property, #rrggbb or R,G,B (a colouring by a number is the \
+                 chain, structure, cna, property, #rrggbb or R,G,B (a colouring by a number is the \
                  scene's: --color-by {text}, and the representations without :COLOUR take it)"
             ));
         }

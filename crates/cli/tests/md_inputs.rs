@@ -1032,3 +1032,59 @@ fn smoothing_takes_the_jitter_out_of_a_movie() {
     ]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
 }
+
+/// `--color-by cna` and the `cna` keyword on an FCC crystal with a stacking fault and free
+/// surfaces (md-io's cna fixture, types checked against OVITO there): the whole crystal is
+/// mostly OVITO's FCC green; with `--select 'not cna fcc'` no green is left, and both the
+/// fault's HCP red and the surfaces' white are drawn.
+#[test]
+fn cna_colours_and_hides_the_perfect_crystal() {
+    let input = data("cna/crystals.xyz.gz");
+    let dir = tempfile::tempdir().unwrap();
+    let render = |name: &str, extra: &[&str]| {
+        let out = dir.path().join(name);
+        let mut args = vec![
+            "render",
+            "--quiet",
+            &input,
+            "--frames",
+            "3:4",
+            "--size",
+            "240x180",
+            "--view",
+            "x",
+            "--color-by",
+            "cna",
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        let o = texmap(&args);
+        assert!(o.status.success(), "{extra:?}: {}", stderr(&o));
+        image::open(&out).unwrap().to_rgb8()
+    };
+    // (green, red, white) shares of the lit pixels.
+    let hues = |img: &image::RgbImage| {
+        let lit: Vec<[i32; 3]> = img
+            .pixels()
+            .filter(|p| p.0 != [0, 0, 0])
+            .map(|p| p.0.map(i32::from))
+            .collect();
+        let share = |f: &dyn Fn(&[i32; 3]) -> bool| {
+            lit.iter().filter(|p| f(p)).count() as f64 / lit.len() as f64
+        };
+        (
+            share(&|p| p[1] > p[0] + 30 && p[1] > p[2] + 30),
+            share(&|p| p[0] > p[1] + 30 && p[0] > p[2] + 30),
+            share(&|p| p[0].abs_diff(p[1]) < 12 && p[1].abs_diff(p[2]) < 12 && p[0] > 60),
+        )
+    };
+    let all = hues(&render("all.png", &[]));
+    assert!(all.0 > 0.4, "whole crystal (green, red, white): {all:?}");
+    let defects = hues(&render("defects.png", &["--select", "not cna fcc"]));
+    assert!(
+        defects.0 < 0.01,
+        "defects only (green, red, white): {defects:?}"
+    );
+    assert!(defects.1 > 0.1 && defects.2 > 0.1, "{defects:?}");
+}

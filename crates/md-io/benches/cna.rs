@@ -17,7 +17,12 @@ fn crystal(n: usize) -> Frame {
     };
     let mut f = Frame::new();
     for (i, j, k) in (0..n * n * n).map(|m| (m % n, m / n % n, m / (n * n))) {
-        for b in [[0.0, 0.0, 0.0], [0.5, 0.5, 0.0], [0.5, 0.0, 0.5], [0.0, 0.5, 0.5]] {
+        for b in [
+            [0.0, 0.0, 0.0],
+            [0.5, 0.5, 0.0],
+            [0.5, 0.0, 0.5],
+            [0.0, 0.5, 0.5],
+        ] {
             f.positions.push([
                 (i as f32 + b[0]) * a + noise(),
                 (j as f32 + b[1]) * a + noise(),

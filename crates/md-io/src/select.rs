@@ -9,6 +9,7 @@
 //! factor   := "not" factor | "(" expr ")" | atom
 //! atom     := "all" | "none" | "protein" | "nucleic" | "backbone" | "water"
 //!           | "helix" | "sheet" | "betasheet" | "beta_sheet" | "coil"  -- VMD: structure
+//!           | "cna" TYPE+          -- crystal structure: fcc hcp bcc ico other (OVITO's a-CNA)
 //!           | ("name" | "type" | "resname" | "element") WORD+      -- any of the words
 //!           | ("chain" | "chainID" | "segid" | "segname") WORD+
 //!           | ("index" | "serial" | "bynum" | "id" | "resid") RANGE+
@@ -32,6 +33,9 @@
 //! keywords: the atoms of residues that [`crate::secondary::assign`] finds helical, in a strand or
 //! bridge, or neither (coil is only residues with a protein backbone: water is not coil). The
 //! structure is assigned from the frame being selected, so it follows a trajectory.
+//! `cna` selects by the crystal structure type [`crate::cna::classify`] gives each atom, as
+//! OVITO's adaptive common neighbour analysis: `not cna fcc` hides the perfect FCC crystal and
+//! leaves dislocations, stacking faults (`cna hcp`), grain boundaries and surfaces.
 //! `chain` (VMD) and `chainID` (MDAnalysis) match the chain identifier (PDB column 22, mmCIF
 //! `auth_asym_id`); `segid` (MDAnalysis) and `segname` (VMD) the segment (PDB columns 73-76,
 //! PSF). A blank chain or segment is matched by no word.
@@ -61,6 +65,15 @@ use std::fmt;
 use crate::elements::Element;
 use crate::frame::{Frame, Label};
 use crate::secondary::Structure;
+
+/// What one evaluation computes at most once, however many keywords need it.
+#[derive(Default)]
+struct Cache {
+    /// Secondary structure per atom (`helix`, `sheet`, `coil`).
+    structure: std::cell::OnceCell<Vec<Option<Structure>>>,
+    /// Crystal structure type per atom (`cna`).
+    cna: std::cell::OnceCell<Vec<crate::cna::StructureType>>,
+}
 
 /// Residue names `protein` matches: the 20 amino acids, their common protonation and
 /// terminal variants (AMBER, CHARMM, GROMACS spellings) and selenomethionine.
@@ -181,6 +194,10 @@ enum Node {
     Structure {
         class: Structure,
         column: usize,
+    },
+    /// `cna fcc hcp ...`: the atoms of those crystal structure types (bit `t` for type code t).
+    Cna {
+        types: u8,
     },
     /// `prop [abs] NAME OP VALUE`: a coordinate or a property compared with a number.
     Prop {
@@ -316,6 +333,7 @@ fn is_reserved(w: &str) -> bool {
             | "betasheet"
             | "beta_sheet"
             | "coil"
+            | "cna"
             | "name"
             | "type"
             | "resname"
@@ -470,6 +488,25 @@ impl Parser<'_> {
                 class: Structure::Coil,
                 column: t.column,
             }),
+            "cna" => {
+                let words = self.words(&t)?;
+                let mut types = 0u8;
+                for w in &words {
+                    match crate::cna::StructureType::from_name(&w.text) {
+                        Some(s) => types |= 1 << s as u8,
+                        None => {
+                            return Err(self.error(
+                                w.column,
+                                format!(
+                                    "cna: '{}' is not a structure type; use fcc, hcp, bcc, ico or other",
+                                    w.text
+                                ),
+                            ));
+                        }
+                    }
+                }
+                Ok(Node::Cna { types })
+            }
             "name" | "type" | "resname" | "chain" | "chainid" | "segid" | "segname" => {
                 let words = self.words(&t)?;
                 let field = match kw.as_str() {
@@ -811,7 +848,7 @@ impl Selection {
     /// column the frame does not have.
     pub fn evaluate(&self, frame: &Frame) -> Result<Vec<bool>, SelectionError> {
         let mut out = vec![false; frame.n_atoms()];
-        self.eval(&self.root, frame, &std::cell::OnceCell::new(), &mut out)?;
+        self.eval(&self.root, frame, &Cache::default(), &mut out)?;
         Ok(out)
     }
 
@@ -845,7 +882,7 @@ impl Selection {
         &self,
         node: &Node,
         frame: &Frame,
-        structure: &std::cell::OnceCell<Vec<Option<Structure>>>,
+        cache: &Cache,
         out: &mut [bool],
     ) -> Result<(), SelectionError> {
         let n = frame.n_atoms();
@@ -853,19 +890,19 @@ impl Selection {
             Node::All => out.fill(true),
             Node::None => out.fill(false),
             Node::Not(a) => {
-                self.eval(a, frame, structure, out)?;
+                self.eval(a, frame, cache, out)?;
                 out.iter_mut().for_each(|v| *v = !*v);
             }
             Node::And(a, b) => {
-                self.eval(a, frame, structure, out)?;
+                self.eval(a, frame, cache, out)?;
                 let mut rhs = vec![false; n];
-                self.eval(b, frame, structure, &mut rhs)?;
+                self.eval(b, frame, cache, &mut rhs)?;
                 out.iter_mut().zip(&rhs).for_each(|(v, r)| *v &= r);
             }
             Node::Or(a, b) => {
-                self.eval(a, frame, structure, out)?;
+                self.eval(a, frame, cache, out)?;
                 let mut rhs = vec![false; n];
-                self.eval(b, frame, structure, &mut rhs)?;
+                self.eval(b, frame, cache, &mut rhs)?;
                 out.iter_mut().zip(&rhs).for_each(|(v, r)| *v |= r);
             }
             Node::Structure { class, column } => {
@@ -879,10 +916,19 @@ impl Selection {
                     }
                 }
                 // Assigned once per evaluation, however many structure keywords it has.
-                let ss = structure.get_or_init(|| crate::secondary::assign(frame).per_atom(n));
+                let ss = cache
+                    .structure
+                    .get_or_init(|| crate::secondary::assign(frame).per_atom(n));
                 out.iter_mut()
                     .zip(ss)
                     .for_each(|(o, c)| *o = *c == Some(*class));
+            }
+            Node::Cna { types } => {
+                // Classified once per evaluation, however many cna keywords it has.
+                let cna = cache.cna.get_or_init(|| crate::cna::classify(frame));
+                out.iter_mut()
+                    .zip(cna)
+                    .for_each(|(o, t)| *o = types >> *t as u8 & 1 == 1);
             }
             Node::Str {
                 field,
@@ -992,7 +1038,7 @@ impl Selection {
             }
             Node::Same { field, of, column } => {
                 let mut picked = vec![false; n];
-                self.eval(of, frame, structure, &mut picked)?;
+                self.eval(of, frame, cache, &mut picked)?;
                 match field {
                     SameField::Residue => {
                         if frame.res_ids.len() != n || frame.res_names.len() != n {
@@ -1043,7 +1089,7 @@ impl Selection {
                 include_reference,
             } => {
                 let mut reference = vec![false; n];
-                self.eval(of, frame, structure, &mut reference)?;
+                self.eval(of, frame, cache, &mut reference)?;
                 within(&frame.positions, &reference, *distance, out);
                 if !include_reference {
                     out.iter_mut().zip(&reference).for_each(|(v, r)| *v &= !r);

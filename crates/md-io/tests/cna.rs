@@ -69,3 +69,35 @@ fn names_round_trip_and_codes_are_ovitos() {
     }
     assert_eq!(StructureType::from_name("diamond"), None);
 }
+
+#[test]
+fn the_cna_keyword_selects_ovitos_types() {
+    use texmap_md_io::Selection;
+    let text = std::fs::read_to_string(data("cna_reference.json")).unwrap();
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let mut t = Trajectory::open(data("crystals.xyz.gz")).unwrap();
+    let mut frame = Frame::new();
+    // Frame 3: FCC with a stacking fault (HCP layers) and free surfaces (other).
+    for _ in 0..4 {
+        assert!(t.read_next(&mut frame).unwrap());
+    }
+    let codes: Vec<u8> = v["frames"][3]["types"]
+        .as_str()
+        .unwrap()
+        .bytes()
+        .map(|b| b - b'0')
+        .collect();
+    for (sel, want) in [
+        ("cna fcc", vec![1u8]),
+        ("not cna fcc", vec![0, 2, 3, 4]),
+        ("cna HCP other", vec![0, 2]),
+        ("cna bcc", vec![3]),
+    ] {
+        let got = Selection::parse(sel).unwrap().evaluate(&frame).unwrap();
+        for (i, (g, c)) in got.iter().zip(&codes).enumerate() {
+            assert_eq!(*g, want.contains(c), "{sel}: atom {i} of type {c}");
+        }
+    }
+    let e = Selection::parse("cna diamond").unwrap_err();
+    assert!(e.to_string().contains("diamond"), "{e}");
+}

@@ -75,8 +75,8 @@ pub use plan::{
 };
 pub use scalar::{NAN_COLOR, SCALAR_LEVELS, ScalarColor, ScalarSource};
 pub use style::{
-    ColorBy, RuleKind, STRUCTURE_COLORS, SceneBuilder, StyleError, StyleOptions, StyleWarning,
-    style_from,
+    CNA_COLORS, ColorBy, RuleKind, STRUCTURE_COLORS, SceneBuilder, StyleError, StyleOptions,
+    StyleWarning, style_from,
 };
 
 #[doc(no_inline)]

@@ -35,7 +35,21 @@ pub enum ColorBy {
     /// ([`texmap_md_io::secondary`]), in VMD's Structure colours ([`STRUCTURE_COLORS`]); atoms
     /// outside protein residues (water, ligands, ions) take the element colours.
     Structure,
+    /// The rules, else the crystal structure type adaptive common neighbour analysis gives the
+    /// atom ([`texmap_md_io::cna`]), assigned per frame, in OVITO's colours ([`CNA_COLORS`]).
+    Cna,
 }
+
+/// The colours of [`ColorBy::Cna`], OVITO's: other near-white, FCC green, HCP red, BCC blue,
+/// icosahedral yellow; sRGB in [0, 1], indexed by [`texmap_md_io::cna::StructureType`] as
+/// `usize` (OVITO's type codes).
+pub const CNA_COLORS: [[f32; 3]; 5] = [
+    [0.95, 0.95, 0.95],
+    [0.4, 1.0, 0.4],
+    [1.0, 0.4, 0.4],
+    [0.4, 0.4, 1.0],
+    [0.95, 0.8, 0.2],
+];
 
 /// The colours of [`ColorBy::Structure`], VMD's: coil white, helix purple (VMD's alpha-helix
 /// colour), strand yellow (VMD's extended-beta colour); sRGB in [0, 1], indexed by
@@ -415,6 +429,11 @@ impl SceneBuilder {
         } else {
             Vec::new()
         };
+        let crystal = if color_by == ColorBy::Cna {
+            texmap_md_io::cna::classify(frame)
+        } else {
+            Vec::new()
+        };
         for (i, &base_color) in base.iter().enumerate().take(frame.n_atoms()) {
             let color = match categories {
                 Some((first, second)) => match self.style.rules_for(frame, i).color {
@@ -436,6 +455,10 @@ impl SceneBuilder {
                 None if scalar => match self.style.rules_for(frame, i).color {
                     Some(c) => c,
                     None => scalar_color(self.scalar.map, range, self.values[i]),
+                },
+                None if !crystal.is_empty() => match self.style.rules_for(frame, i).color {
+                    Some(c) => c,
+                    None => CNA_COLORS[crystal[i] as usize],
                 },
                 None if !structure.is_empty() => {
                     match (structure[i], self.style.rules_for(frame, i).color) {
