@@ -657,7 +657,7 @@ pub struct MolArgs {
     /// ball-stick, licorice, tube), each with its own radii and bond radius; repeat it to
     /// draw several in one image: --rep 'protein=tube' --rep 'resname LIG=ball-stick'
     /// --rep 'water and within 5 of resname LIG=licorice'. 'SEL=STYLE:COLOUR' gives it its own
-    /// colouring: element, type, chain, structure, property, or one colour #rrggbb or R,G,B
+    /// colouring: element, type, chain, structure, cna, property, or one colour #rrggbb or R,G,B
     /// (--rep 'protein=tube:structure' --rep 'resname LIG=ball-stick:element'); without one it
     /// takes --color-by, and --color rules win over both. Replaces --select and --style; an
     /// atom two representations select is drawn by both.

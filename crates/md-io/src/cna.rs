@@ -211,8 +211,9 @@ struct Grid<'a> {
     starts: Vec<u32>,
     /// Cell index per atom.
     of: Vec<usize>,
-    /// The smallest width of a grid cell (Å): a ring of k cells around an atom holds every
-    /// atom within k times this.
+    /// The smallest width of a grid cell (Å) along an axis of more than one cell: a ring of k
+    /// cells around an atom holds every atom within k times this (an axis of one cell is
+    /// covered whole by every ring).
     width: f64,
     /// Bounding-box origin and inverse cell size per axis (open frames).
     lo: [f64; 3],
@@ -251,25 +252,46 @@ impl<'a> Grid<'a> {
                     let area = norm(cross(m[b], m[d]));
                     let w = volume / area.max(f64::MIN_POSITIVE);
                     grid.dims[a] = ((w / target).floor() as usize).clamp(1, 1024);
-                    grid.width = grid.width.min(w / grid.dims[a] as f64);
+                    if grid.dims[a] > 1 {
+                        grid.width = grid.width.min(w / grid.dims[a] as f64);
+                    }
                 }
             }
             None => {
-                let mut lo = [f64::INFINITY; 3];
-                let mut hi = [f64::NEG_INFINITY; 3];
-                for &i in &finite {
-                    for a in 0..3 {
-                        lo[a] = lo[a].min(positions[i][a] as f64);
-                        hi[a] = hi[a].max(positions[i][a] as f64);
+                // The box of the 0.5th to 99.5th percentile per axis: a few atoms far away (an
+                // evaporated atom) do not stretch the grid; they are kept in the edge cells,
+                // which leaves every ring's guarantee intact (they are at least as far as
+                // those cells).
+                let mut lo = [0.0; 3];
+                let mut hi = [0.0; 3];
+                let mut values: Vec<f64> = Vec::with_capacity(finite.len());
+                for a in 0..3 {
+                    values.clear();
+                    values.extend(finite.iter().map(|&i| positions[i][a] as f64));
+                    if values.is_empty() {
+                        continue;
                     }
+                    let last = values.len() - 1;
+                    let (k_lo, k_hi) = (last / 200, last - last / 200);
+                    lo[a] = *values.select_nth_unstable_by(k_lo, f64::total_cmp).1;
+                    hi[a] = *values.select_nth_unstable_by(k_hi, f64::total_cmp).1;
                 }
                 let extent = [0, 1, 2].map(|a| (hi[a] - lo[a]).max(1e-3));
-                let target = (3.0 * extent.iter().product::<f64>() / n).cbrt().max(1e-3);
+                // About 3 atoms per cell: the cell size s solves s³ = 3 Π max(extent, s) / n,
+                // so that a flat or thin system gets few cells across its thin side rather
+                // than cells far smaller than its atoms' spacing.
+                let mut target = (3.0 * extent.iter().product::<f64>() / n).cbrt().max(1e-3);
+                for _ in 0..60 {
+                    let v: f64 = extent.iter().map(|e| e.max(target)).product();
+                    target = (3.0 * v / n).cbrt().max(1e-3);
+                }
                 for (a, e) in extent.into_iter().enumerate() {
                     grid.dims[a] = ((e / target).ceil() as usize).clamp(1, 1024);
                     let size = e / grid.dims[a] as f64;
                     grid.inv[a] = 1.0 / size;
-                    grid.width = grid.width.min(size);
+                    if grid.dims[a] > 1 {
+                        grid.width = grid.width.min(size);
+                    }
                 }
                 grid.lo = lo;
             }
@@ -337,13 +359,13 @@ impl<'a> Grid<'a> {
         let max_ring = self.dims.iter().max().copied().unwrap_or(1);
         let mut seen_cells: Vec<usize> = Vec::new();
         let mut found: Vec<([f64; 3], f64)> = Vec::new();
-        for ring in 1..=max_ring {
+        for ring in 1..=max_ring.max(1) {
             // Every cell within `ring` of the centre (wrapped in a periodic cell), once.
             seen_cells.clear();
-            let r = ring as isize;
-            for dz in -r..=r {
-                for dy in -r..=r {
-                    for dx in -r..=r {
+            let span = [0, 1, 2].map(|a| self.offsets(centre[a], a, ring));
+            for dz in span[2].clone() {
+                for dy in span[1].clone() {
+                    for dx in span[0].clone() {
                         if let Some(c) = self.offset_cell(centre, [dx, dy, dz]) {
                             seen_cells.push(c);
                         }
@@ -379,6 +401,17 @@ impl<'a> Grid<'a> {
             found.dedup_by(|a, b| a.1 == b.1 && a.0 == b.0);
         }
         out.extend(found.into_iter().take(MAX_NEIGHBOURS));
+    }
+
+    /// The offsets along axis `a` from grid coordinate `at` within `ring` cells: inside an open
+    /// grid, and at most once around a periodic one.
+    fn offsets(&self, at: usize, a: usize, ring: usize) -> std::ops::RangeInclusive<isize> {
+        let (n, at, r) = (self.dims[a] as isize, at as isize, ring as isize);
+        match self.cell {
+            Some(_) if 2 * r + 1 >= n => 0..=n - 1,
+            Some(_) => -r..=r,
+            None => (-r).max(-at)..=r.min(n - 1 - at),
+        }
     }
 
     /// The cell at `offset` from `centre`: wrapped in a periodic cell, `None` outside an open

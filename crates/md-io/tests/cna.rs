@@ -101,3 +101,22 @@ fn the_cna_keyword_selects_ovitos_types() {
     let e = Selection::parse("cna diamond").unwrap_err();
     assert!(e.to_string().contains("diamond"), "{e}");
 }
+
+#[test]
+fn a_flat_sheet_and_a_far_atom_without_a_cell_are_other() {
+    // A hexagonal monolayer (6 neighbours each: no 3D crystal) 300 Å wide, and one atom
+    // 10 km away: the grid sizes itself to the sheet, not to the empty bounding box.
+    let mut frame = Frame::new();
+    let a = 2.5f32;
+    for j in 0..120 {
+        for i in 0..120 {
+            let x = (i as f32 + 0.5 * (j % 2) as f32) * a;
+            frame.positions.push([x, j as f32 * a * 0.866, 0.0]);
+        }
+    }
+    frame.positions.push([1.0e4, 1.0e4, 1.0e4]);
+    frame.positions.push([f32::NAN, 0.0, 0.0]);
+    let types = classify(&frame);
+    assert_eq!(types.len(), frame.n_atoms());
+    assert!(types.iter().all(|t| *t == StructureType::Other));
+}
