@@ -16,9 +16,11 @@
 //!    `(2/√3 · Σ₁⁸ rⱼ + Σ₉¹⁴ rⱼ) / 14`; eight (6,6,6) and six (4,4,4) is BCC.
 //! 3. Otherwise other (surfaces, cores of defects, liquids, too few atoms).
 //!
-//! Neighbours are found in a cell grid; in a periodic cell by the nearest image
-//! ([`crate::pbc::minimum_image`]), so the box must be wider than twice the 14th neighbour
-//! distance (any box of a few unit cells). Frames without a cell are open.
+//! Neighbours are found in a cell grid; in a periodic cell by the nearest image (rounded
+//! fractional differences, as [`crate::pbc::minimum_image`]), so the box must be wider than
+//! twice the 14th neighbour distance (any box of a few unit cells). Frames without a cell are
+//! open. Atoms are classified in parallel (rayon); the result does not depend on the thread
+//! count.
 //!
 //! ```
 //! use texmap_md_io::cna::{StructureType, classify};
@@ -36,7 +38,6 @@
 //! ```
 
 use crate::frame::{Frame, UnitCell};
-use crate::pbc::minimum_image;
 
 /// A crystal structure type; the numbers are OVITO's structure type codes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -81,17 +82,32 @@ impl StructureType {
 /// Neighbours examined per atom: the BCC test's 14.
 const MAX_NEIGHBOURS: usize = 14;
 
+/// Atoms per grid cell on average: cells about as wide as the 14th neighbour distance of FCC
+/// (1.04 a) and BCC (1.31 a), so one ring of cells usually holds the neighbours.
+const ATOMS_PER_CELL: f64 = 4.5;
+
 /// The structure type of every atom of `frame` (see the module docs). Atoms with non-finite
 /// coordinates are other, and are nobody's neighbour.
 pub fn classify(frame: &Frame) -> Vec<StructureType> {
+    use rayon::prelude::*;
     let grid = Grid::new(&frame.positions, frame.cell.as_ref());
-    let mut near = Vec::with_capacity(64);
+    // Atoms are independent: in parallel, each with its own scratch, in atom order.
     (0..frame.positions.len())
-        .map(|i| {
-            grid.nearest(i, &mut near);
-            signature_type(&near)
+        .into_par_iter()
+        .map_init(Scratch::default, |scratch, i| {
+            grid.nearest(i, scratch);
+            signature_type(&scratch.near)
         })
         .collect()
+}
+
+/// One worker's buffers for [`Grid::nearest`].
+#[derive(Default)]
+struct Scratch {
+    cells: Vec<usize>,
+    found: Vec<([f64; 3], f64)>,
+    /// The nearest neighbours found: vector from the atom, distance.
+    near: Vec<([f64; 3], f64)>,
 }
 
 /// The count of each type in `types`, indexed by the type's code.
@@ -151,52 +167,49 @@ fn signatures(near: &[([f64; 3], f64)], cutoff: f64) -> Vec<[u8; 3]> {
             }
         }
     }
+    // Bonds among the atoms of `set`.
+    let bonds_in = |set: u16| -> u32 {
+        let mut twice = 0;
+        let mut rest = set;
+        while rest != 0 {
+            let k = rest.trailing_zeros() as usize;
+            rest &= rest - 1;
+            twice += (bonded[k] & set).count_ones();
+        }
+        twice / 2
+    };
     (0..n)
         .map(|j| {
             let common = bonded[j];
-            let members: Vec<usize> = (0..n).filter(|&k| common >> k & 1 == 1).collect();
-            // The bonds among the common neighbours.
-            let mut bonds: Vec<(usize, usize)> = Vec::new();
-            for (x, &a) in members.iter().enumerate() {
-                for &b in &members[x + 1..] {
-                    if bonded[a] >> b & 1 == 1 {
-                        bonds.push((a, b));
+            // The largest set of bonds connected through shared atoms: the connected
+            // components of the common neighbours' bond graph, each grown from an atom.
+            let mut left = common;
+            let mut largest = 0;
+            while left != 0 {
+                let mut component = 1u16 << left.trailing_zeros();
+                loop {
+                    let mut grown = component;
+                    let mut rest = component;
+                    while rest != 0 {
+                        let k = rest.trailing_zeros() as usize;
+                        rest &= rest - 1;
+                        grown |= bonded[k] & common;
                     }
+                    if grown == component {
+                        break;
+                    }
+                    component = grown;
                 }
+                largest = largest.max(bonds_in(component));
+                left &= !component;
             }
             [
-                members.len().min(255) as u8,
-                bonds.len().min(255) as u8,
-                largest_cluster(&bonds).min(255) as u8,
+                common.count_ones() as u8,
+                bonds_in(common).min(255) as u8,
+                largest.min(255) as u8,
             ]
         })
         .collect()
-}
-
-/// The number of bonds in the largest set of bonds connected through shared atoms.
-fn largest_cluster(bonds: &[(usize, usize)]) -> usize {
-    let mut done = vec![false; bonds.len()];
-    let mut best = 0;
-    for start in 0..bonds.len() {
-        if done[start] {
-            continue;
-        }
-        done[start] = true;
-        let mut stack = vec![start];
-        let mut size = 0;
-        while let Some(b) = stack.pop() {
-            size += 1;
-            let (p, q) = bonds[b];
-            for (c, &(r, s)) in bonds.iter().enumerate() {
-                if !done[c] && (r == p || r == q || s == p || s == q) {
-                    done[c] = true;
-                    stack.push(c);
-                }
-            }
-        }
-        best = best.max(size);
-    }
-    best
 }
 
 /// A cell grid over the atoms (fractional cells in a periodic cell, the bounding box
@@ -218,8 +231,11 @@ struct Grid<'a> {
     /// Bounding-box origin and inverse cell size per axis (open frames).
     lo: [f64; 3],
     inv: [f64; 3],
-    /// Inverse of the cell matrix (periodic frames).
+    /// Inverse of the cell matrix and the matrix (periodic frames), and each atom's wrapped
+    /// fractional coordinates.
     inverse: [[f64; 3]; 3],
+    matrix: [[f64; 3]; 3],
+    frac: Vec<[f64; 3]>,
 }
 
 impl<'a> Grid<'a> {
@@ -239,14 +255,28 @@ impl<'a> Grid<'a> {
             lo: [0.0; 3],
             inv: [0.0; 3],
             inverse: [[0.0; 3]; 3],
+            matrix: [[0.0; 3]; 3],
+            frac: Vec::new(),
         };
         match cell {
             Some(c) => {
                 let m = c.matrix();
                 grid.inverse = invert(&m);
+                grid.matrix = m;
+                grid.frac = positions
+                    .iter()
+                    .map(|p| {
+                        let p = p.map(f64::from);
+                        [0, 1, 2].map(|a| {
+                            let f: f64 = (0..3).map(|k| p[k] * grid.inverse[k][a]).sum();
+                            f - f.floor()
+                        })
+                    })
+                    .collect();
                 let volume = det(&m).abs();
-                // Perpendicular widths of the cell; about 3 atoms per grid cell.
-                let target = (3.0 * volume / n).cbrt();
+                // Perpendicular widths of the cell; about 4.5 atoms per grid cell, so that the
+                // first ring of cells holds the 14 nearest neighbours of a crystal atom.
+                let target = (ATOMS_PER_CELL * volume / n).cbrt();
                 for a in 0..3 {
                     let (b, d) = ((a + 1) % 3, (a + 2) % 3);
                     let area = norm(cross(m[b], m[d]));
@@ -277,13 +307,15 @@ impl<'a> Grid<'a> {
                     hi[a] = *values.select_nth_unstable_by(k_hi, f64::total_cmp).1;
                 }
                 let extent = [0, 1, 2].map(|a| (hi[a] - lo[a]).max(1e-3));
-                // About 3 atoms per cell: the cell size s solves s³ = 3 Π max(extent, s) / n,
+                // ATOMS_PER_CELL per cell: the cell size s solves s³ = A Π max(extent, s) / n,
                 // so that a flat or thin system gets few cells across its thin side rather
                 // than cells far smaller than its atoms' spacing.
-                let mut target = (3.0 * extent.iter().product::<f64>() / n).cbrt().max(1e-3);
+                let mut target = (ATOMS_PER_CELL * extent.iter().product::<f64>() / n)
+                    .cbrt()
+                    .max(1e-3);
                 for _ in 0..60 {
                     let v: f64 = extent.iter().map(|e| e.max(target)).product();
-                    target = (3.0 * v / n).cbrt().max(1e-3);
+                    target = (ATOMS_PER_CELL * v / n).cbrt().max(1e-3);
                 }
                 for (a, e) in extent.into_iter().enumerate() {
                     grid.dims[a] = ((e / target).ceil() as usize).clamp(1, 1024);
@@ -322,11 +354,8 @@ impl<'a> Grid<'a> {
         let p = self.positions[i].map(f64::from);
         match self.cell {
             Some(_) => {
-                let f = [0, 1, 2].map(|a| (0..3).map(|k| p[k] * self.inverse[k][a]).sum::<f64>());
-                [0, 1, 2].map(|a| {
-                    let s = f[a] - f[a].floor();
-                    ((s * self.dims[a] as f64) as usize).min(self.dims[a] - 1)
-                })
+                let f = self.frac[i];
+                [0, 1, 2].map(|a| ((f[a] * self.dims[a] as f64) as usize).min(self.dims[a] - 1))
             }
             None => [0, 1, 2].map(|a| {
                 (((p[a] - self.lo[a]) * self.inv[a]).max(0.0) as usize).min(self.dims[a] - 1)
@@ -341,41 +370,49 @@ impl<'a> Grid<'a> {
 
     /// The vector from atom `i` to atom `j` (nearest image in a periodic cell).
     fn vector(&self, i: usize, j: usize) -> [f64; 3] {
-        let d = [0, 1, 2].map(|a| self.positions[j][a] as f64 - self.positions[i][a] as f64);
         match self.cell {
-            Some(c) => minimum_image(c, d),
-            None => d,
+            Some(_) => {
+                // The fractional difference rounded to the nearest image, as
+                // `pbc::minimum_image` does, from the fractional coordinates kept.
+                let (a, b) = (self.frac[i], self.frac[j]);
+                let f = [0, 1, 2].map(|k| {
+                    let d = b[k] - a[k];
+                    d - d.round()
+                });
+                let m = &self.matrix;
+                [0, 1, 2].map(|k| f[0] * m[0][k] + f[1] * m[1][k] + f[2] * m[2][k])
+            }
+            None => [0, 1, 2].map(|a| self.positions[j][a] as f64 - self.positions[i][a] as f64),
         }
     }
 
     /// Atom `i`'s nearest neighbours (vector, distance), closest first, at most
-    /// [`MAX_NEIGHBOURS`], into `out`.
-    fn nearest(&self, i: usize, out: &mut Vec<([f64; 3], f64)>) {
-        out.clear();
+    /// [`MAX_NEIGHBOURS`], into `scratch.near`.
+    fn nearest(&self, i: usize, scratch: &mut Scratch) {
+        let Scratch { cells, found, near } = scratch;
+        near.clear();
         if self.of[i] == usize::MAX {
             return;
         }
         let centre = self.coords(i);
         let max_ring = self.dims.iter().max().copied().unwrap_or(1);
-        let mut seen_cells: Vec<usize> = Vec::new();
-        let mut found: Vec<([f64; 3], f64)> = Vec::new();
         for ring in 1..=max_ring.max(1) {
             // Every cell within `ring` of the centre (wrapped in a periodic cell), once.
-            seen_cells.clear();
+            cells.clear();
             let span = [0, 1, 2].map(|a| self.offsets(centre[a], a, ring));
             for dz in span[2].clone() {
                 for dy in span[1].clone() {
                     for dx in span[0].clone() {
                         if let Some(c) = self.offset_cell(centre, [dx, dy, dz]) {
-                            seen_cells.push(c);
+                            cells.push(c);
                         }
                     }
                 }
             }
-            seen_cells.sort_unstable();
-            seen_cells.dedup();
+            cells.sort_unstable();
+            cells.dedup();
             found.clear();
-            for &c in &seen_cells {
+            for &c in cells.iter() {
                 for &j in &self.order[self.starts[c] as usize..self.starts[c + 1] as usize] {
                     let j = j as usize;
                     if j == i {
@@ -384,6 +421,11 @@ impl<'a> Grid<'a> {
                     let v = self.vector(i, j);
                     found.push((v, norm(v)));
                 }
+            }
+            // The nearest MAX_NEIGHBOURS, in order (ties by atom order of the scan).
+            if found.len() > MAX_NEIGHBOURS {
+                found.select_nth_unstable_by(MAX_NEIGHBOURS - 1, |a, b| a.1.total_cmp(&b.1));
+                found.truncate(MAX_NEIGHBOURS);
             }
             found.sort_by(|a, b| a.1.total_cmp(&b.1));
             // The ring holds every atom within `ring` cell widths: enough when the
@@ -395,12 +437,7 @@ impl<'a> Grid<'a> {
                 break;
             }
         }
-        // In a periodic cell, a small grid's wrapped rings meet the same atom from several
-        // sides: the nearest image is one atom, so keep each atom once.
-        if self.cell.is_some() {
-            found.dedup_by(|a, b| a.1 == b.1 && a.0 == b.0);
-        }
-        out.extend(found.into_iter().take(MAX_NEIGHBOURS));
+        near.extend_from_slice(found);
     }
 
     /// The offsets along axis `a` from grid coordinate `at` within `ring` cells: inside an open
