@@ -37,6 +37,8 @@
 //! assert!(classify(&frame).iter().all(|t| *t == StructureType::Fcc));
 //! ```
 
+use glam::{DMat3, DVec3};
+
 use crate::frame::{Frame, UnitCell};
 
 /// A crystal structure type; the numbers are OVITO's structure type codes.
@@ -231,11 +233,10 @@ struct Grid<'a> {
     /// Bounding-box origin and inverse cell size per axis (open frames).
     lo: [f64; 3],
     inv: [f64; 3],
-    /// Inverse of the cell matrix and the matrix (periodic frames), and each atom's wrapped
-    /// fractional coordinates.
-    inverse: [[f64; 3]; 3],
-    matrix: [[f64; 3]; 3],
-    frac: Vec<[f64; 3]>,
+    /// The cell's edges as columns (periodic frames: Cartesian = edges · fractional), and each
+    /// atom's wrapped fractional coordinates.
+    edges: DMat3,
+    frac: Vec<DVec3>,
 }
 
 impl<'a> Grid<'a> {
@@ -254,32 +255,29 @@ impl<'a> Grid<'a> {
             width: f64::INFINITY,
             lo: [0.0; 3],
             inv: [0.0; 3],
-            inverse: [[0.0; 3]; 3],
-            matrix: [[0.0; 3]; 3],
+            edges: DMat3::IDENTITY,
             frac: Vec::new(),
         };
         match cell {
             Some(c) => {
-                let m = c.matrix();
-                grid.inverse = invert(&m);
-                grid.matrix = m;
+                // UnitCell::matrix has the edges as rows.
+                let edges = DMat3::from_cols_array_2d(&c.matrix());
+                let inverse = edges.inverse();
+                grid.edges = edges;
                 grid.frac = positions
                     .iter()
                     .map(|p| {
-                        let p = p.map(f64::from);
-                        [0, 1, 2].map(|a| {
-                            let f: f64 = (0..3).map(|k| p[k] * grid.inverse[k][a]).sum();
-                            f - f.floor()
-                        })
+                        let f = inverse * DVec3::from(p.map(f64::from));
+                        f - f.floor()
                     })
                     .collect();
-                let volume = det(&m).abs();
+                let volume = edges.determinant().abs();
                 // Perpendicular widths of the cell; about 4.5 atoms per grid cell, so that the
                 // first ring of cells holds the 14 nearest neighbours of a crystal atom.
                 let target = (ATOMS_PER_CELL * volume / n).cbrt();
                 for a in 0..3 {
                     let (b, d) = ((a + 1) % 3, (a + 2) % 3);
-                    let area = norm(cross(m[b], m[d]));
+                    let area = edges.col(b).cross(edges.col(d)).length();
                     let w = volume / area.max(f64::MIN_POSITIVE);
                     grid.dims[a] = ((w / target).floor() as usize).clamp(1, 1024);
                     if grid.dims[a] > 1 {
@@ -354,7 +352,7 @@ impl<'a> Grid<'a> {
         let p = self.positions[i].map(f64::from);
         match self.cell {
             Some(_) => {
-                let f = self.frac[i];
+                let f = self.frac[i].to_array();
                 [0, 1, 2].map(|a| ((f[a] * self.dims[a] as f64) as usize).min(self.dims[a] - 1))
             }
             None => [0, 1, 2].map(|a| {
@@ -374,13 +372,8 @@ impl<'a> Grid<'a> {
             Some(_) => {
                 // The fractional difference rounded to the nearest image, as
                 // `pbc::minimum_image` does, from the fractional coordinates kept.
-                let (a, b) = (self.frac[i], self.frac[j]);
-                let f = [0, 1, 2].map(|k| {
-                    let d = b[k] - a[k];
-                    d - d.round()
-                });
-                let m = &self.matrix;
-                [0, 1, 2].map(|k| f[0] * m[0][k] + f[1] * m[1][k] + f[2] * m[2][k])
+                let d = self.frac[j] - self.frac[i];
+                (self.edges * (d - d.round())).to_array()
             }
             None => [0, 1, 2].map(|a| self.positions[j][a] as f64 - self.positions[i][a] as f64),
         }
@@ -466,38 +459,6 @@ impl<'a> Grid<'a> {
         }
         Some((c[2] * self.dims[1] + c[1]) * self.dims[0] + c[0])
     }
-}
-
-fn det(m: &[[f64; 3]; 3]) -> f64 {
-    m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
-        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
-}
-
-/// The inverse of `m` (rows are the cell edges): `f = p · inverse` gives fractional coordinates.
-fn invert(m: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
-    let d = det(m);
-    let c = |r: usize, s: usize| {
-        let (r1, r2) = ((r + 1) % 3, (r + 2) % 3);
-        let (s1, s2) = ((s + 1) % 3, (s + 2) % 3);
-        m[r1][s1] * m[r2][s2] - m[r1][s2] * m[r2][s1]
-    };
-    // inverse[s][r] = cofactor(r, s) / det.
-    let mut out = [[0.0; 3]; 3];
-    for (s, row) in out.iter_mut().enumerate() {
-        for (r, v) in row.iter_mut().enumerate() {
-            *v = c(r, s) / d;
-        }
-    }
-    out
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }
 
 fn norm(v: [f64; 3]) -> f64 {

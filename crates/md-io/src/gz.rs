@@ -123,7 +123,6 @@ fn decompress(
         inner: BufReader::with_capacity(64 * 1024, src),
         consumed: 0,
         failed: false,
-        ended: false,
     };
     let mut decoder = MultiGzDecoder::new(&mut input);
     let mut buf = vec![0u8; 64 * 1024];
@@ -138,7 +137,8 @@ fn decompress(
                 let ended_early = e.kind() == io::ErrorKind::UnexpectedEof;
                 let e = stream_error(name, &input, e);
                 match e {
-                    Error::Parse { at, found, .. } if keep_cut && ended_early && is_cut(&input) => {
+                    // The decoder ran out of input (not a read failure): a cut, not corruption.
+                    Error::Parse { at, found, .. } if keep_cut && ended_early && !input.failed => {
                         cut = Some(Error::Parse {
                             at,
                             expected: "the rest of the gzip stream (the data before the cut is read)",
@@ -154,12 +154,6 @@ fn decompress(
     }
     out.rewind().map_err(|e| temp_error(name, e))?;
     Ok((out, cut))
-}
-
-/// Whether the decoder stopped because the compressed input ended (rather than at corrupt
-/// data): every byte of the file was consumed without a read failure.
-fn is_cut<R: BufRead>(input: &Counting<R>) -> bool {
-    !input.failed && input.ended
 }
 
 /// An error of the gzip stream at the compressed offset `input` has reached: the operating
@@ -203,15 +197,12 @@ struct Counting<R> {
     inner: R,
     consumed: u64,
     failed: bool,
-    /// The file gave its last byte (a read or fill returned nothing).
-    ended: bool,
 }
 
 impl<R: BufRead> Read for Counting<R> {
     fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
         let n = self.inner.read(buf).inspect_err(|_| self.failed = true)?;
         self.consumed += n as u64;
-        self.ended |= n == 0 && !buf.is_empty();
         Ok(n)
     }
 }
@@ -219,10 +210,7 @@ impl<R: BufRead> Read for Counting<R> {
 impl<R: BufRead> BufRead for Counting<R> {
     fn fill_buf(&mut self) -> io::Result<&[u8]> {
         match self.inner.fill_buf() {
-            Ok(b) => {
-                self.ended |= b.is_empty();
-                Ok(b)
-            }
+            Ok(b) => Ok(b),
             Err(e) => {
                 self.failed = true;
                 Err(e)

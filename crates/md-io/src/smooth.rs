@@ -127,20 +127,6 @@ impl Smoother {
                 continue;
             }
             traj.read_frame(g, &mut self.scratch)?;
-            if self.scratch.n_atoms() != frame.n_atoms() {
-                return Err(Error::Parse {
-                    at: Location {
-                        frame: Some(g),
-                        ..Location::file(&traj.name().into())
-                    },
-                    expected: "the same atoms in every frame of the smoothing window",
-                    found: format!(
-                        "{} atoms, but frame {f} has {}",
-                        self.scratch.n_atoms(),
-                        frame.n_atoms()
-                    ),
-                });
-            }
             let at = self.cache.partition_point(|(h, _)| *h < g);
             self.cache
                 .insert(at, (g, std::mem::take(&mut self.scratch.positions)));
@@ -150,23 +136,22 @@ impl Smoother {
             let at = self.cache.partition_point(|(h, _)| *h < f);
             self.cache.insert(at, (f, frame.positions.clone()));
         }
-        let others: Vec<&[[f32; 3]]> = self
+        let window: Vec<&(usize, Vec<[f32; 3]>)> = self
             .cache
             .iter()
             .filter(|(g, _)| *g != f && range.contains(g))
-            .map(|(_, p)| p.as_slice())
             .collect();
-        if others.iter().any(|o| o.len() != frame.positions.len()) {
-            // A cached neighbour read for another centre frame of another size.
+        if let Some((g, p)) = window.iter().find(|(_, p)| p.len() != frame.n_atoms()) {
             return Err(Error::Parse {
                 at: Location {
-                    frame: Some(f),
+                    frame: Some(*g),
                     ..Location::file(&traj.name().into())
                 },
                 expected: "the same atoms in every frame of the smoothing window",
-                found: format!("{} atoms", frame.n_atoms()),
+                found: format!("{} atoms, but frame {f} has {}", p.len(), frame.n_atoms()),
             });
         }
+        let others: Vec<&[[f32; 3]]> = window.iter().map(|(_, p)| p.as_slice()).collect();
         mean_positions(frame, &others);
         Ok(())
     }
