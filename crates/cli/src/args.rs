@@ -170,6 +170,23 @@ pub fn parse_color_by(s: &str) -> Result<ColorBy, String> {
     })
 }
 
+/// Parses `--replicate`: `NX,NY,NZ` (or one `N` for all three), each 1 to 100.
+pub fn parse_replicate(s: &str) -> Result<[usize; 3], String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    let counts: Vec<usize> = parts
+        .iter()
+        .map(|p| match p.parse::<usize>() {
+            Ok(n) if (1..=100).contains(&n) => Ok(n),
+            _ => Err(format!("{p:?} is not an image count from 1 to 100")),
+        })
+        .collect::<Result<_, _>>()?;
+    match counts[..] {
+        [n] => Ok([n; 3]),
+        [x, y, z] => Ok([x, y, z]),
+        _ => Err("expected NX,NY,NZ (images along the cell's a, b, c) or one N".into()),
+    }
+}
+
 /// The colour maps of `--colormap`.
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ColormapArg {
@@ -653,6 +670,15 @@ pub struct MolArgs {
     /// Periodic boundaries: none, wrap (atoms into the box), unwrap (molecules whole).
     #[arg(long, value_enum, default_value_t = PbcArg::None)]
     pub pbc: PbcArg,
+    /// Draw NX x NY x NZ periodic images of the cell, as OVITO's Replicate modifier: '3,3,1'
+    /// shows a slab as the surface it models, '2' a 2x2x2 block. Images run from -(N-1)/2 to
+    /// N/2 along each cell vector (2 is the cell and the next one, 3 is centred on it); bonds
+    /// across the faces join the neighbouring copy, so a crystal's bonds are whole inside the
+    /// block. After --pbc (wrap first for a tidy block); every selection, colour rule and
+    /// --align sees the copies (atom ids are offset per copy so they stay unique, as in OVITO).
+    /// Needs a periodic cell.
+    #[arg(long, value_name = "NX,NY,NZ", value_parser = parse_replicate)]
+    pub replicate: Option<[usize; 3]>,
     /// A representation, as VMD's: 'SEL=STYLE' draws the atoms SEL selects in STYLE (spacefill,
     /// ball-stick, licorice, tube), each with its own radii and bond radius; repeat it to
     /// draw several in one image: --rep 'protein=tube' --rep 'resname LIG=ball-stick'

@@ -352,6 +352,7 @@ pub fn mol_plan(args: &MolArgs) -> Result<MolPlan> {
         bonds: args.bonds.into(),
         draw: args.draw.into(),
         pbc: args.pbc.into(),
+        replicate: args.replicate,
     })
     .map_err(mol_error)
 }
@@ -417,6 +418,10 @@ pub fn mol_error(e: MolError) -> anyhow::Error {
         }
         MolError::Align { atoms, why } => {
             format!("--align: the selection picks {atoms} atom(s) of the first frame: {why}")
+        }
+        MolError::Replicate(e) => {
+            // A frame without a cell, or too many atoms for the copies: the input's limit.
+            return anyhow::anyhow!("--replicate: {e}");
         }
         MolError::AlignMismatch { .. } => {
             // The trajectory and the --align-to structure disagree: bad input, not usage.

@@ -1088,3 +1088,96 @@ fn cna_colours_and_hides_the_perfect_crystal() {
     );
     assert!(defects.1 > 0.1 && defects.2 > 0.1, "{defects:?}");
 }
+
+/// `--replicate` against OVITO's Replicate modifier end to end: 60 waters in a triclinic cell
+/// with bonds across its faces (md-io's replicate fixture, written by OVITO 3.17.2), drawn
+/// with `--replicate 2,2,1`, look like OVITO's own 2 x 2 x 1 copy of them drawn as read
+/// (positions differ only in their last digit: no channel moves by more than 2); drawn alone
+/// they do not. A frame without a cell is an error naming the flag and the frame, and a count
+/// of 0 a usage error.
+#[test]
+fn replicate_draws_what_ovitos_replicate_modifier_makes() {
+    let dir = tempfile::tempdir().unwrap();
+    let render = |name: &str, input: &str, topology: &str, extra: &[&str]| {
+        let out = dir.path().join(name);
+        let (input, topology) = (data(input), data(topology));
+        let mut args = vec![
+            "render",
+            "--quiet",
+            &input,
+            "--topology",
+            &topology,
+            "--style",
+            "ball-stick",
+            "--size",
+            "320x240",
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        let o = texmap(&args);
+        assert!(o.status.success(), "{extra:?}: {}", stderr(&o));
+        image::open(&out).unwrap().to_rgb8()
+    };
+    let ours = render(
+        "ours.png",
+        "replicate/water.lammpstrj",
+        "replicate/water.data",
+        &["--replicate", "2,2,1"],
+    );
+    let ovito = render(
+        "ovito.png",
+        "replicate/water_2x2x1.lammpstrj.gz",
+        "replicate/water_2x2x1.data.gz",
+        &[],
+    );
+    let alone = render(
+        "alone.png",
+        "replicate/water.lammpstrj",
+        "replicate/water.data",
+        &[],
+    );
+    let worst = |a: &image::RgbImage, b: &image::RgbImage| {
+        let (mut max, mut differ) = (0u8, 0usize);
+        for (p, q) in a.pixels().zip(b.pixels()) {
+            let d = (0..3).map(|k| p.0[k].abs_diff(q.0[k])).max().unwrap();
+            max = max.max(d);
+            differ += usize::from(d > 0);
+        }
+        (max, differ)
+    };
+    let (max, differ) = worst(&ours, &ovito);
+    assert!(max <= 2 && differ < 320 * 240 / 100, "{max} {differ}");
+    let (max, differ) = worst(&alone, &ovito);
+    assert!(max > 100 && differ > 320 * 240 / 20, "{max} {differ}");
+
+    let input = data("cna/crystals.xyz.gz");
+    let out = dir.path().join("x.png");
+    let o = texmap(&[
+        "render",
+        "--quiet",
+        &input,
+        "--frames",
+        "4:5",
+        "--replicate",
+        "2",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    let e = stderr(&o);
+    assert!(
+        e.contains("--replicate") && e.contains("frame 4") && e.contains("no periodic cell"),
+        "{e}"
+    );
+    assert!(!out.exists());
+    let o = texmap(&[
+        "render",
+        &input,
+        "--replicate",
+        "2,0,1",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+}

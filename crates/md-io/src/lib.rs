@@ -11,7 +11,8 @@
 //!   AMBER prmtop, LAMMPS data file) and gives them to the frames of a coordinate-only trajectory of the same
 //!   atoms.
 //! - [`bonds`] finds bonds by distance (covalent radii, a cell grid, minimum image) and [`pbc`]
-//!   wraps atoms into the box or makes bonded molecules whole across it.
+//!   wraps atoms into the box or makes bonded molecules whole across it; [`replicate`] copies a
+//!   frame and its bonds along the cell vectors (periodic images, as OVITO's Replicate).
 //! - [`Writer`] writes XYZ and PDB.
 //! - [`elements`] maps atom names to elements, gives van der Waals radii and CPK colours, and
 //!   [`AtomStyle`] resolves each atom's radius and colour with user overrides.
@@ -91,6 +92,7 @@ pub mod pbc;
 mod pdb;
 mod prmtop;
 mod psf;
+pub mod replicate;
 pub mod secondary;
 pub mod select;
 pub mod smooth;

@@ -6,8 +6,11 @@
 //! 1. the bonds as [`BondSource`] asks (the topology's, or found by distance), found only when
 //!    they are drawn or needed to unwrap;
 //! 2. the periodic boundaries ([`Pbc`]): atoms wrapped into the box, or molecules made whole
-//!    across it (with bonds by distance when none are drawn); bonds that still cross the box
-//!    are dropped, so no stick spans it;
+//!    across it (with bonds by distance when none are drawn); with
+//!    [`MolOptions::replicate`], the frame and its bonds then copied along the cell vectors
+//!    ([`texmap_md_io::replicate`]: bonds across inner faces become whole, and every later
+//!    step sees the copies, so `index` counts their atoms too); bonds that still cross the
+//!    (enlarged) box are dropped, so no stick spans it;
 //! 3. with [`MolOptions::align`], the frame superposed on a reference: the first frame built,
 //!    or a structure given ([`Alignment::reference`]). The alignment selection is evaluated
 //!    once, at the first frame (and in the reference), and every frame's positions,
@@ -41,6 +44,7 @@
 use std::fmt;
 
 use texmap_impostor::SphereScene;
+use texmap_md_io::replicate::ReplicateError;
 use texmap_md_io::{Frame, Selection, SelectionError, Topology, atom_element};
 
 use crate::{ColorBy, SceneBuilder};
@@ -117,6 +121,9 @@ pub struct MolOptions {
     pub draw: DrawStyle,
     /// The periodic-boundary treatment.
     pub pbc: Pbc,
+    /// Periodic images `[nx, ny, nz]` drawn with the frame (OVITO's Replicate modifier:
+    /// [`texmap_md_io::replicate`]), after the periodic treatment; `None` draws the frame alone.
+    pub replicate: Option<[usize; 3]>,
     /// Superpose every frame on a reference (the first frame built, or a structure), fitted
     /// on the atoms a selection picks (see the module docs); `None` leaves positions as read.
     pub align: Option<Alignment>,
@@ -185,6 +192,7 @@ impl Default for MolOptions {
             bonds: BondSource::Auto,
             draw: DrawStyle::Spacefill,
             pbc: Pbc::None,
+            replicate: None,
             align: None,
             reps: Vec::new(),
         }
@@ -240,6 +248,8 @@ pub enum MolError {
         /// Why.
         why: &'static str,
     },
+    /// [`MolOptions::replicate`] cannot copy the frame (no cell, too many atoms).
+    Replicate(ReplicateError),
     /// A selection could not be evaluated on a frame.
     Selection {
         /// Which selection.
@@ -253,6 +263,7 @@ impl fmt::Display for MolError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             MolError::NoTopology => write!(f, "bonds from the topology need a topology"),
+            MolError::Replicate(e) => write!(f, "periodic images: {e}"),
             MolError::TopologyWithoutBonds { topology } => {
                 write!(f, "bonds from the topology: {topology} has no bonds")
             }
@@ -558,6 +569,10 @@ impl MolPlan {
                 }
                 texmap_md_io::pbc::unwrap(frame, &self.pairs);
             }
+        }
+        if let Some(n) = self.options.replicate {
+            texmap_md_io::replicate::replicate(frame, &mut self.pairs, n)
+                .map_err(MolError::Replicate)?;
         }
         texmap_md_io::pbc::drop_crossing(&mut self.pairs, &frame.positions, frame.cell.as_ref());
         self.last_bond_count = self.pairs.len();
