@@ -436,6 +436,13 @@ pub struct RenderArgs {
     /// {frame}. ASCII only; the text is cut at half the image width.
     #[arg(long, value_name = "TEXT")]
     pub label: Option<String>,
+    /// Label the atoms SEL picks, as PyMOL's and VMD's labels: each gets TEXT just above it,
+    /// drawn over the scene on a light backdrop. TEXT may hold {name}, {resname}, {resid},
+    /// {chain}, {segid}, {element}, {type}, {index} (from 0), {serial} (from 1) and {id}:
+    /// --atom-label 'name CA and resid 10 20 30={resname}{resid}'. Repeatable; the selection
+    /// is evaluated every frame, so labels follow their atoms. ASCII, at most 40 characters.
+    #[arg(long = "atom-label", value_name = "SEL=TEXT")]
+    pub atom_labels: Vec<String>,
     /// Output: PNG image(s) — the name may hold a %04d frame-number pattern; without one, several
     /// frames get _NNNN — or one movie whose extension names its format: .mp4, .webm, .gif
     /// (encoded by ffmpeg: apt-get install ffmpeg) or .apng (no external program). Any other

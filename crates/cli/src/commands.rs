@@ -373,6 +373,11 @@ fn render(a: &RenderArgs) -> Result<()> {
         .as_deref()
         .map(crate::scene::parse_label)
         .transpose()?;
+    let atom_labels = a
+        .atom_labels
+        .iter()
+        .map(|s| crate::scene::parse_atom_label(s))
+        .collect::<Result<Vec<_>>>()?;
     let mut sink = crate::movie::Sink::new(&a.output, frames.len(), a.fps, a.depth)?;
     // This part's frames (all of them unless sharded): positions in `frames`.
     let mine = match shard_spec(a)? {
@@ -526,6 +531,18 @@ fn render(a: &RenderArgs) -> Result<()> {
         let mut out = out;
         if plan.uses_builder_coloring() {
             crate::scene::draw_color_bar(&builder, &a.style, &mut out);
+        }
+        if !atom_labels.is_empty() {
+            let at = format!("frame {f} of {}", traj.name());
+            let empty = crate::scene::draw_atom_labels(&atom_labels, &md, &cam, &mut out, &at)
+                .map_err(|e| fail(e, &written))?;
+            if k == mine.start {
+                for spec in empty {
+                    pb.suspend(|| {
+                        eprintln!("texmap: warning: --atom-label {spec:?} selects no atom of {at}")
+                    });
+                }
+            }
         }
         if let Some(parts) = &label {
             let text = crate::scene::label_text(parts, f, &md, traj.name())

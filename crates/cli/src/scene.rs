@@ -117,38 +117,163 @@ pub enum LabelPart {
     Frame,
 }
 
-/// `--label`'s template, parsed before any frame is read: braces balanced, every placeholder
-/// `{time}`, `{ns}`, `{step}` or `{frame}`.
-pub fn parse_label(template: &str) -> Result<Vec<LabelPart>> {
+/// A `{placeholder}` template split into text and placeholders, each placeholder one of
+/// `names` (given as its index there); `flag` and `hint` name the option and its placeholders
+/// in the usage errors for unbalanced braces or an unknown placeholder.
+fn template<'a>(
+    flag: &str,
+    text: &'a str,
+    names: &[&str],
+    hint: &str,
+) -> Result<Vec<Result<&'a str, usize>>> {
     let mut parts = Vec::new();
-    let mut rest = template;
+    let mut rest = text;
     while let Some(open) = rest.find(['{', '}']) {
         if rest[open..].starts_with('}') {
-            return usage(format!("--label {template:?}: '}}' without a '{{'"));
+            return usage(format!("{flag} {text:?}: '}}' without a '{{'"));
         }
         let Some(close) = rest[open..].find('}') else {
-            return usage(format!("--label {template:?}: '{{' without a '}}'"));
+            return usage(format!("{flag} {text:?}: '{{' without a '}}'"));
         };
         if open > 0 {
-            parts.push(LabelPart::Text(rest[..open].to_string()));
+            parts.push(Ok(&rest[..open]));
         }
-        parts.push(match &rest[open + 1..open + close] {
-            "time" => LabelPart::Time,
-            "ns" => LabelPart::Ns,
-            "step" => LabelPart::Step,
-            "frame" => LabelPart::Frame,
-            name => {
+        let name = &rest[open + 1..open + close];
+        match names.iter().position(|n| *n == name) {
+            Some(k) => parts.push(Err(k)),
+            None => {
                 return usage(format!(
-                    "--label {template:?}: {{{name}}} is not a placeholder; use {{time}} (ps), {{ns}}, {{step}} or {{frame}}"
+                    "{flag} {text:?}: {{{name}}} is not a placeholder; use {hint}"
                 ));
             }
-        });
+        }
         rest = &rest[open + close + 1..];
     }
     if !rest.is_empty() {
-        parts.push(LabelPart::Text(rest.to_string()));
+        parts.push(Ok(rest));
     }
     Ok(parts)
+}
+
+/// `--label`'s template, parsed before any frame is read: braces balanced, every placeholder
+/// `{time}`, `{ns}`, `{step}` or `{frame}`.
+pub fn parse_label(text: &str) -> Result<Vec<LabelPart>> {
+    const NAMES: [&str; 4] = ["time", "ns", "step", "frame"];
+    let hint = "{time} (ps), {ns}, {step} or {frame}";
+    Ok(template("--label", text, &NAMES, hint)?
+        .into_iter()
+        .map(|p| match p {
+            Ok(t) => LabelPart::Text(t.to_string()),
+            Err(0) => LabelPart::Time,
+            Err(1) => LabelPart::Ns,
+            Err(2) => LabelPart::Step,
+            Err(_) => LabelPart::Frame,
+        })
+        .collect())
+}
+
+/// The per-atom fields an `--atom-label` template may name, in the order of [`AtomLabel`]'s
+/// placeholders.
+const ATOM_FIELDS: [&str; 10] = [
+    "name", "resname", "resid", "chain", "segid", "element", "type", "index", "serial", "id",
+];
+
+/// One `--atom-label SEL=TEXT`: the atoms it labels and the template of each one's text.
+#[derive(Clone, Debug)]
+pub struct AtomLabel {
+    spec: String,
+    select: Selection,
+    /// Text, or a placeholder as its index in [`ATOM_FIELDS`].
+    parts: Vec<Result<String, usize>>,
+}
+
+/// Parses `--atom-label 'SEL=TEXT'` before any frame is read.
+pub fn parse_atom_label(spec: &str) -> Result<AtomLabel> {
+    let (sel, text) = sel_value("--atom-label", spec)?;
+    let hint = "{name} {resname} {resid} {chain} {segid} {element} {type} {index} (from 0) \
+                {serial} (from 1) or {id} (as the file numbers atoms)";
+    let parts = template("--atom-label", text, &ATOM_FIELDS, hint)?
+        .into_iter()
+        .map(|p| p.map(str::to_string))
+        .collect();
+    Ok(AtomLabel {
+        spec: spec.to_string(),
+        select: parse_selection("--atom-label", sel)?,
+        parts,
+    })
+}
+
+/// Atom `i`'s label text; an error names the field the frame lacks.
+fn atom_label_text(label: &AtomLabel, frame: &Frame, i: usize, at: &str) -> Result<String> {
+    let mut out = String::new();
+    for part in &label.parts {
+        let field = match part {
+            Ok(text) => {
+                out.push_str(text);
+                continue;
+            }
+            Err(k) => *k,
+        };
+        let text = |v: &[texmap_md_io::Label]| v.get(i).map(|l| l.as_str().to_string());
+        let value = match field {
+            0 => text(&frame.names),
+            1 => text(&frame.res_names),
+            2 => frame.res_ids.get(i).map(i64::to_string),
+            3 => text(&frame.chains),
+            4 => text(&frame.segments),
+            5 => frame.elements.get(i).map(|e| e.symbol().to_string()),
+            6 => text(&frame.types),
+            7 => Some(i.to_string()),
+            8 => Some((i + 1).to_string()),
+            _ => frame.ids.get(i).map(i64::to_string),
+        };
+        let Some(value) = value else {
+            anyhow::bail!(
+                "--atom-label {:?}: {at} has no {} column for {{{}}} (give --topology FILE for names, residues and chains)",
+                label.spec,
+                ATOM_FIELDS[field],
+                ATOM_FIELDS[field]
+            );
+        };
+        out.push_str(&value);
+    }
+    Ok(out)
+}
+
+/// Draws every `--atom-label` onto `image` (the frame drawn with `camera`): each selected atom's
+/// text just above its projected centre, the farthest first so nearer labels stay on top.
+/// `at` names the frame for errors. Returns the `--atom-label` options that select no atom.
+pub fn draw_atom_labels<'a>(
+    labels: &'a [AtomLabel],
+    frame: &Frame,
+    camera: &Camera,
+    image: &mut texmap_core::frame::Frame,
+    at: &str,
+) -> Result<Vec<&'a str>> {
+    let mut placed: Vec<(f32, [f32; 2], String)> = Vec::new();
+    let mut empty = Vec::new();
+    for label in labels {
+        let mask = label
+            .select
+            .evaluate(frame)
+            .map_err(|e| crate::args::UsageError(format!("--atom-label {:?}: {e}", label.spec)))?;
+        if !mask.contains(&true) {
+            empty.push(label.spec.as_str());
+        }
+        for (i, _) in mask.iter().enumerate().filter(|(_, m)| **m) {
+            let p = Vec3::from_array(frame.positions[i]);
+            if let Some((xy, depth)) = camera.project(p) {
+                placed.push((depth, xy.to_array(), atom_label_text(label, frame, i, at)?));
+            }
+        }
+    }
+    // Far to near; ties in the order given (a stable sort), so the result is deterministic.
+    placed.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let (w, h) = (image.width() as usize, image.height() as usize);
+    for (_, xy, text) in &placed {
+        texmap_md_scene::draw_atom_label(image.color.as_flattened_mut(), w, h, *xy, text);
+    }
+    Ok(empty)
 }
 
 /// A number with up to `decimals` decimals, trailing zeros dropped: 2.5, 1250, 0.125.

@@ -778,6 +778,17 @@ fn render_3gwi(dir: &Path, name: &str, extra: &[&str]) -> PathBuf {
     out
 }
 
+/// `texmap render --quiet ARGS -o dir/name`, which must succeed, and the image it wrote.
+fn render_rgb(dir: &Path, name: &str, args: &[&str]) -> image::RgbImage {
+    let out = dir.join(name);
+    let mut all = vec!["render", "--quiet"];
+    all.extend(args);
+    all.extend(["-o", out.to_str().unwrap()]);
+    let o = texmap(&all);
+    assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+    image::open(&out).unwrap().to_rgb8()
+}
+
 #[test]
 fn representations_combine_styles_in_one_image() {
     let input = data("dssp/3gwiA.pdb.gz");
@@ -1042,11 +1053,8 @@ fn cna_colours_and_hides_the_perfect_crystal() {
     let input = data("cna/crystals.xyz.gz");
     let dir = tempfile::tempdir().unwrap();
     let render = |name: &str, extra: &[&str]| {
-        let out = dir.path().join(name);
         let mut args = vec![
-            "render",
-            "--quiet",
-            &input,
+            &input[..],
             "--frames",
             "3:4",
             "--size",
@@ -1055,13 +1063,9 @@ fn cna_colours_and_hides_the_perfect_crystal() {
             "x",
             "--color-by",
             "cna",
-            "-o",
-            out.to_str().unwrap(),
         ];
         args.extend(extra);
-        let o = texmap(&args);
-        assert!(o.status.success(), "{extra:?}: {}", stderr(&o));
-        image::open(&out).unwrap().to_rgb8()
+        render_rgb(dir.path(), name, &args)
     };
     // (green, red, white) shares of the lit pixels.
     let hues = |img: &image::RgbImage| {
@@ -1099,25 +1103,18 @@ fn cna_colours_and_hides_the_perfect_crystal() {
 fn replicate_draws_what_ovitos_replicate_modifier_makes() {
     let dir = tempfile::tempdir().unwrap();
     let render = |name: &str, input: &str, topology: &str, extra: &[&str]| {
-        let out = dir.path().join(name);
         let (input, topology) = (data(input), data(topology));
         let mut args = vec![
-            "render",
-            "--quiet",
-            &input,
+            &input[..],
             "--topology",
             &topology,
             "--style",
             "ball-stick",
             "--size",
             "320x240",
-            "-o",
-            out.to_str().unwrap(),
         ];
         args.extend(extra);
-        let o = texmap(&args);
-        assert!(o.status.success(), "{extra:?}: {}", stderr(&o));
-        image::open(&out).unwrap().to_rgb8()
+        render_rgb(dir.path(), name, &args)
     };
     let ours = render(
         "ours.png",
@@ -1180,4 +1177,94 @@ fn replicate_draws_what_ovitos_replicate_modifier_makes() {
         out.to_str().unwrap(),
     ]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+}
+
+/// `--atom-label` puts each label where its atom projects: with the camera aimed at CA 420 of
+/// 3GWI, the only pixels the label changes are its backdrop, centred on the image's centre
+/// column and ending 2 px above its centre row, exactly as wide as six 6-px glyph cells (less
+/// the last spacing column) plus a pixel of padding per side. The placeholders give the
+/// residue's own name and number (byte-identical to the text typed out), a label needing a
+/// column the file lacks is an error naming it, and a bad placeholder a usage error.
+#[test]
+fn atom_labels_sit_over_their_atoms() {
+    use texmap_md_io::{Frame, Trajectory};
+    let input = data("dssp/3gwiA.pdb.gz");
+    let mut t = Trajectory::open(&input).unwrap();
+    let mut frame = Frame::new();
+    assert!(t.read_next(&mut frame).unwrap());
+    let ca = (0..frame.n_atoms())
+        .find(|&i| frame.res_ids[i] == 420 && frame.names[i].as_str() == "CA")
+        .unwrap();
+    assert_eq!(frame.res_names[ca].as_str(), "ALA");
+    let p = frame.positions[ca];
+    let target = format!("{},{},{}", p[0], p[1], p[2]);
+    let eye = format!("{},{},{}", p[0], p[1], p[2] + 90.0);
+    let dir = tempfile::tempdir().unwrap();
+    let render = |name: &str, extra: &[&str]| {
+        let mut args = vec![
+            &input[..],
+            "--style",
+            "tube",
+            "--size",
+            "400x300",
+            "--eye",
+            &eye,
+            "--target",
+            &target,
+            "--up",
+            "0,1,0",
+        ];
+        args.extend(extra);
+        render_rgb(dir.path(), name, &args)
+    };
+    let plain = render("plain.png", &[]);
+    let labelled = render(
+        "labelled.png",
+        &["--atom-label", "name CA and resid 420={resname}{resid}"],
+    );
+    let typed = render(
+        "typed.png",
+        &["--atom-label", "name CA and resid 420=ALA420"],
+    );
+    assert_eq!(labelled.as_raw(), typed.as_raw());
+    let (mut x0, mut y0, mut x1, mut y1) = (u32::MAX, u32::MAX, 0, 0);
+    for (x, y, px) in labelled.enumerate_pixels() {
+        if px != plain.get_pixel(x, y) {
+            (x0, y0, x1, y1) = (x0.min(x), y0.min(y), x1.max(x + 1), y1.max(y + 1));
+        }
+    }
+    // 6 * 6 - 1 + 2 = 37 wide, 8 + 2 = 10 tall, centred on x = 200, ending at y = 150 - 2.
+    assert_eq!((x1 - x0, y1 - y0), (37, 10), "{x0}..{x1} x {y0}..{y1}");
+    assert!((181..=183).contains(&x0), "{x0}");
+    assert!((147..=149).contains(&y1), "{y1}");
+
+    let out = dir.path().join("x.png");
+    let xyz = data("ase_plain.xyz");
+    let o = texmap(&[
+        "render",
+        "-q",
+        &xyz,
+        "--atom-label",
+        "index 0={resname}",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("no resname column"), "{}", stderr(&o));
+    assert!(!out.exists());
+    let o = texmap(&[
+        "render",
+        "-q",
+        &xyz,
+        "--atom-label",
+        "index 0={resnam}",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("{resnam} is not a placeholder"),
+        "{}",
+        stderr(&o)
+    );
 }

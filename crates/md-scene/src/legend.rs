@@ -1,7 +1,8 @@
 //! A colour bar legend drawn onto a rendered image (and, with the same font, a one-line caption
-//! at the top left: [`draw_caption`]): the colour map from the range's maximum (top)
-//! to its minimum (bottom) in a thin dark frame, tick labels for the minimum, the middle and the
-//! maximum beside it and a title above, on a light backdrop at the right edge of the image.
+//! at the top left, [`draw_caption`], and atom labels, [`draw_atom_label`]): the colour map from
+//! the range's maximum (top) to its minimum (bottom) in a thin dark frame, tick labels for the
+//! minimum, the middle and the maximum beside it and a title above, on a light backdrop at the
+//! right edge of the image.
 //!
 //! The image is 8-bit sRGB RGBA with straight (not premultiplied) alpha, row-major, row 0 at
 //! the top, as a [`Frame`](texmap_core::frame::Frame) and a PNG hold it.
@@ -202,6 +203,71 @@ pub fn draw_caption(rgba: &mut [u8], width: usize, height: usize, text: &str) ->
     );
     chars
 }
+
+/// Draws `text` as an atom's label (`texmap render --atom-label`): the colour bar's font at its
+/// scale `s`, on the same backdrop with `s` of padding, centred horizontally on `anchor` (pixel
+/// coordinates, x right, y down: the atom's projected centre) with the backdrop's bottom edge `2s`
+/// above it, so the label sits just over the atom. A label that would cross an image edge is
+/// moved inside it; nothing is drawn for an anchor outside the image, a non-finite anchor, an
+/// empty text or an image too small for the label. At most [`MAX_LABEL_CHARS`] characters are
+/// drawn. Returns whether the label was drawn.
+///
+/// ```
+/// use texmap_md_scene::draw_atom_label;
+/// let (width, height) = (360, 240);
+/// let mut rgba = vec![0u8; width * height * 4];
+/// assert!(draw_atom_label(&mut rgba, width, height, [180.0, 120.0], "ALA 10"));
+/// // The backdrop, 37 x 10 px (6 glyph cells of 6 px less the last spacing column, 8 px rows,
+/// // 1 px padding per side), spans x = 162..=198 around 180 and ends 2 px above row 120.
+/// let opaque = |x: usize, y: usize| rgba[(y * width + x) * 4 + 3] == 255;
+/// assert!(opaque(162, 117) && opaque(198, 117) && opaque(180, 108));
+/// assert!(!opaque(161, 117) && !opaque(199, 117) && !opaque(180, 118) && !opaque(180, 107));
+/// assert!(!draw_atom_label(&mut rgba, width, height, [-5.0, 120.0], "off screen"));
+/// ```
+pub fn draw_atom_label(
+    rgba: &mut [u8],
+    width: usize,
+    height: usize,
+    anchor: [f32; 2],
+    text: &str,
+) -> bool {
+    check_buffer("draw_atom_label", rgba, width, height);
+    let [ax, ay] = anchor;
+    let inside = ax.is_finite() && ay.is_finite() && ax >= 0.0 && ay >= 0.0;
+    if !inside || ax >= width as f32 || ay >= height as f32 {
+        return false;
+    }
+    let s = scale_of(height);
+    let chars = text.chars().count().min(MAX_LABEL_CHARS);
+    let panel_w = (chars * ADVANCE * s).saturating_sub(s) + 2 * s;
+    let panel_h = CELL_HEIGHT * s + 2 * s;
+    if chars == 0 || panel_w > width || panel_h > height {
+        return false;
+    }
+    // Centred on the anchor, ending 2s above it, then moved inside the image.
+    let x0 = (ax.floor() as i64 - (panel_w / 2) as i64).clamp(0, (width - panel_w) as i64);
+    let y1 = ay.floor() as i64 - 2 * s as i64;
+    let y0 = (y1 - panel_h as i64).clamp(0, (height - panel_h) as i64);
+    let panel = Rect {
+        x0: x0 as usize,
+        y0: y0 as usize,
+        x1: x0 as usize + panel_w,
+        y1: y0 as usize + panel_h,
+    };
+    let mut image = Image { rgba, width };
+    image.blend_backdrop(panel);
+    image.text(
+        panel.x0 + s,
+        panel.y0 + s,
+        s,
+        text.chars().take(chars),
+        panel,
+    );
+    true
+}
+
+/// The longest atom label [`draw_atom_label`] draws, in characters.
+pub const MAX_LABEL_CHARS: usize = 40;
 
 /// Panics unless `rgba` holds `width` x `height` RGBA pixels (a caller's bug, named after
 /// `what`).

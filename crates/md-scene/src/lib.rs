@@ -66,7 +66,7 @@ pub mod style;
 pub use camera::{AUTO_VIEW_DIRECTION, FIT_MARGIN, ViewAxis, centre_of, drawn_bounds, fit_camera};
 pub use camera_plan::{CameraPlan, CameraPlanError, MotionSpec};
 pub use colormap::Colormap;
-pub use legend::{ColorBar, draw_caption, draw_color_bar};
+pub use legend::{ColorBar, MAX_LABEL_CHARS, draw_atom_label, draw_caption, draw_color_bar};
 pub use outline::{add_box_outline, cell_corners};
 pub use palette::{MAX_MATERIALS, Palette, type_color};
 pub use plan::{
