@@ -187,6 +187,14 @@ pub fn parse_replicate(s: &str) -> Result<[usize; 3], String> {
     }
 }
 
+/// Parses `--coordination`: a cutoff in Å from 0.45 (exclusive) to 20.
+pub fn parse_cutoff(s: &str) -> Result<f32, String> {
+    match s.trim().parse::<f32>() {
+        Ok(r) if r > 0.45 && r <= texmap_md_io::coordination::MAX_CUTOFF => Ok(r),
+        _ => Err(format!("{s:?} is not a cutoff from 0.45 to 20 Å")),
+    }
+}
+
 /// The colour maps of `--colormap`.
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ColormapArg {
@@ -686,6 +694,14 @@ pub struct MolArgs {
     /// Needs a periodic cell.
     #[arg(long, value_name = "NX,NY,NZ", value_parser = parse_replicate)]
     pub replicate: Option<[usize; 3]>,
+    /// Count each atom's neighbours within R Å every frame, as OVITO's Coordination analysis,
+    /// into the per-atom number 'coordination': colour by it (--color-by coordination) or
+    /// select by it (--select 'prop coordination < 12' leaves the surface and the atoms next to
+    /// vacancies of an FCC crystal; pick R between the first and second neighbour shells).
+    /// Counted after --pbc and --replicate, under the minimum image; a periodic cell narrower
+    /// than 3 R is refused (replicate it). R from 0.45 to 20 Å.
+    #[arg(long, value_name = "R", value_parser = parse_cutoff)]
+    pub coordination: Option<f32>,
     /// A representation, as VMD's: 'SEL=STYLE' draws the atoms SEL selects in STYLE (spacefill,
     /// ball-stick, licorice, tube), each with its own radii and bond radius; repeat it to
     /// draw several in one image: --rep 'protein=tube' --rep 'resname LIG=ball-stick'

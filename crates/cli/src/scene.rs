@@ -338,7 +338,7 @@ pub fn warning_text(w: &StyleWarning) -> String {
                 format!("its properties: {}", available.join(", "))
             };
             format!(
-                "--color-by {what}: the first frame has no such number ({has}; speed needs velocities); --color-by takes property, element, type, chain, structure, bfactor, occupancy, charge (from a topology), speed, residue, index or a property name"
+                "--color-by {what}: the first frame has no such number ({has}; speed needs velocities, coordination --coordination R); --color-by takes property, element, type, chain, structure, bfactor, occupancy, charge (from a topology), speed, residue, index, coordination or a property name"
             )
         }
     }
@@ -478,6 +478,7 @@ pub fn mol_plan(args: &MolArgs) -> Result<MolPlan> {
         draw: args.draw.into(),
         pbc: args.pbc.into(),
         replicate: args.replicate,
+        coordination: args.coordination,
     })
     .map_err(mol_error)
 }
@@ -544,6 +545,7 @@ pub fn mol_error(e: MolError) -> anyhow::Error {
         MolError::Align { atoms, why } => {
             format!("--align: the selection picks {atoms} atom(s) of the first frame: {why}")
         }
+        MolError::Coordination(e) => return anyhow::anyhow!("--coordination: {e}"),
         MolError::Replicate(e) => {
             // A frame without a cell, or too many atoms for the copies: the input's limit.
             return anyhow::anyhow!("--replicate: {e}");

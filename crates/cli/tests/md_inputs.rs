@@ -1268,3 +1268,47 @@ fn atom_labels_sit_over_their_atoms() {
         stderr(&o)
     );
 }
+
+/// `--coordination R` (counts checked against OVITO in md-io and md-scene): a cell narrower than
+/// three cutoffs is refused with a hint, and replicating it first makes it wide enough; a
+/// cutoff out of range is a usage error; colouring by coordination without counting it names
+/// the flag that would.
+#[test]
+fn coordination_needs_a_wide_enough_cell_and_says_how() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("c.png");
+    let (input, topology) = (
+        data("replicate/water.lammpstrj"),
+        data("replicate/water.data"),
+    );
+    let run = |extra: &[&str]| {
+        let mut args = vec!["render", "-q", &input, "--topology", &topology];
+        args.extend(extra);
+        args.extend(["-o", out.to_str().unwrap()]);
+        texmap(&args)
+    };
+    let o = run(&["--coordination", "6", "--color-by", "coordination"]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(
+        e.contains("--coordination") && e.contains("--replicate"),
+        "{e}"
+    );
+    assert!(!out.exists());
+    let o = run(&[
+        "--coordination",
+        "6",
+        "--replicate",
+        "2",
+        "--color-by",
+        "coordination",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(out.exists());
+    std::fs::remove_file(&out).unwrap();
+    let o = run(&["--coordination", "0.3"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    let o = run(&["--color-by", "coordination"]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--coordination R"), "{}", stderr(&o));
+}

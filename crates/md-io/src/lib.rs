@@ -12,7 +12,9 @@
 //!   atoms.
 //! - [`bonds`] finds bonds by distance (covalent radii, a cell grid, minimum image) and [`pbc`]
 //!   wraps atoms into the box or makes bonded molecules whole across it; [`replicate`] copies a
-//!   frame and its bonds along the cell vectors (periodic images, as OVITO's Replicate).
+//!   frame and its bonds along the cell vectors (periodic images, as OVITO's Replicate);
+//!   [`coordination`] counts each atom's neighbours within a cutoff, and [`cna`] classifies
+//!   its crystal structure, as OVITO's analyses do.
 //! - [`Writer`] writes XYZ and PDB.
 //! - [`elements`] maps atom names to elements, gives van der Waals radii and CPK colours, and
 //!   [`AtomStyle`] resolves each atom's radius and colour with user overrides.
@@ -76,6 +78,7 @@
 
 pub mod bonds;
 pub mod cna;
+pub mod coordination;
 mod cursor;
 mod dcd;
 pub mod elements;

@@ -70,8 +70,9 @@ pub use legend::{ColorBar, MAX_LABEL_CHARS, draw_atom_label, draw_caption, draw_
 pub use outline::{add_box_outline, cell_corners};
 pub use palette::{MAX_MATERIALS, Palette, type_color};
 pub use plan::{
-    Alignment, BALL_AND_STICK_BOND_RADIUS, BALL_AND_STICK_RADIUS_SCALE, BondSource, DrawStyle,
-    LICORICE_RADIUS, MolError, MolOptions, MolPlan, Pbc, RepColor, Representation, SelectionRole,
+    Alignment, BALL_AND_STICK_BOND_RADIUS, BALL_AND_STICK_RADIUS_SCALE, BondSource, COORDINATION,
+    DrawStyle, LICORICE_RADIUS, MolError, MolOptions, MolPlan, Pbc, RepColor, Representation,
+    SelectionRole,
 };
 pub use scalar::{NAN_COLOR, SCALAR_LEVELS, ScalarColor, ScalarSource};
 pub use style::{

@@ -9,8 +9,10 @@
 //!    across it (with bonds by distance when none are drawn); with
 //!    [`MolOptions::replicate`], the frame and its bonds then copied along the cell vectors
 //!    ([`texmap_md_io::replicate`]: bonds across inner faces become whole, and every later
-//!    step sees the copies, so `index` counts their atoms too); bonds that still cross the
-//!    (enlarged) box are dropped, so no stick spans it;
+//!    step sees the copies, so `index` counts their atoms too); with
+//!    [`MolOptions::coordination`], each atom's neighbour count as the property
+//!    [`COORDINATION`]; bonds that still cross the (enlarged) box are dropped, so no stick
+//!    spans it;
 //! 3. with [`MolOptions::align`], the frame superposed on a reference: the first frame built,
 //!    or a structure given ([`Alignment::reference`]). The alignment selection is evaluated
 //!    once, at the first frame (and in the reference), and every frame's positions,
@@ -44,8 +46,9 @@
 use std::fmt;
 
 use texmap_impostor::SphereScene;
+use texmap_md_io::coordination::CoordinationError;
 use texmap_md_io::replicate::ReplicateError;
-use texmap_md_io::{Frame, Selection, SelectionError, Topology, atom_element};
+use texmap_md_io::{Frame, Property, Selection, SelectionError, Topology, atom_element};
 
 use crate::{ColorBy, SceneBuilder};
 
@@ -104,6 +107,9 @@ pub enum Pbc {
     Unwrap,
 }
 
+/// The per-atom property [`MolOptions::coordination`] adds to each frame.
+pub const COORDINATION: &str = "coordination";
+
 /// The options of a [`MolPlan`]; selections are parsed by the caller.
 #[derive(Clone, Debug)]
 pub struct MolOptions {
@@ -124,6 +130,10 @@ pub struct MolOptions {
     /// Periodic images `[nx, ny, nz]` drawn with the frame (OVITO's Replicate modifier:
     /// [`texmap_md_io::replicate`]), after the periodic treatment; `None` draws the frame alone.
     pub replicate: Option<[usize; 3]>,
+    /// Count each atom's neighbours within this cutoff (Å) every frame, after the periodic
+    /// images, as the per-atom property `coordination` (OVITO's Coordination analysis:
+    /// [`texmap_md_io::coordination`]), for colouring and selections (`prop coordination < 12`).
+    pub coordination: Option<f32>,
     /// Superpose every frame on a reference (the first frame built, or a structure), fitted
     /// on the atoms a selection picks (see the module docs); `None` leaves positions as read.
     pub align: Option<Alignment>,
@@ -193,6 +203,7 @@ impl Default for MolOptions {
             draw: DrawStyle::Spacefill,
             pbc: Pbc::None,
             replicate: None,
+            coordination: None,
             align: None,
             reps: Vec::new(),
         }
@@ -250,6 +261,8 @@ pub enum MolError {
     },
     /// [`MolOptions::replicate`] cannot copy the frame (no cell, too many atoms).
     Replicate(ReplicateError),
+    /// [`MolOptions::coordination`] cannot be counted (the cell is too small for the cutoff).
+    Coordination(CoordinationError),
     /// A selection could not be evaluated on a frame.
     Selection {
         /// Which selection.
@@ -264,6 +277,7 @@ impl fmt::Display for MolError {
         match self {
             MolError::NoTopology => write!(f, "bonds from the topology need a topology"),
             MolError::Replicate(e) => write!(f, "periodic images: {e}"),
+            MolError::Coordination(e) => write!(f, "coordination: {e}"),
             MolError::TopologyWithoutBonds { topology } => {
                 write!(f, "bonds from the topology: {topology} has no bonds")
             }
@@ -573,6 +587,16 @@ impl MolPlan {
         if let Some(n) = self.options.replicate {
             texmap_md_io::replicate::replicate(frame, &mut self.pairs, n)
                 .map_err(MolError::Replicate)?;
+        }
+        if let Some(cutoff) = self.options.coordination {
+            let counts = texmap_md_io::coordination::coordination(frame, cutoff)
+                .map_err(MolError::Coordination)?;
+            let values = counts.into_iter().map(|c| c as f32).collect();
+            frame.properties.retain(|p| p.name != COORDINATION);
+            frame.properties.push(Property {
+                name: COORDINATION.to_string(),
+                values,
+            });
         }
         texmap_md_io::pbc::drop_crossing(&mut self.pairs, &frame.positions, frame.cell.as_ref());
         self.last_bond_count = self.pairs.len();
