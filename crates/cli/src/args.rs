@@ -60,7 +60,8 @@ pub enum Command {
     /// file (PSF, AMBER prmtop, LAMMPS data) its atoms, residues, bonds, chains and segments.
     Info {
         /// Trajectory file (XYZ, extended XYZ, PDB, PDBx/mmCIF, GRO, LAMMPS dump, DCD, XTC, TRR,
-        /// AMBER NetCDF), gzip-compressed or not (1abc.cif.gz).
+        /// AMBER NetCDF, SDF/MOL and MOL2 with their bonds, one frame per record),
+        /// gzip-compressed or not (1abc.cif.gz).
         file: PathBuf,
         /// Format, when the extension does not tell it.
         #[arg(long)]
@@ -611,11 +612,12 @@ pub struct QualityArgs {
 /// Where bonds come from (`--bonds`).
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum BondsArg {
-    /// The topology's bonds when it has some, else by distance (covalent radii + 0.45 Å,
-    /// minimum image in a periodic box).
+    /// The bonds the files list when they list some (the topology's, else an SDF or MOL2
+    /// file's own), else by distance (covalent radii + 0.45 Å, minimum image in a periodic box).
     #[default]
     Auto,
-    /// Only the topology's bonds (PDB CONECT, PSF !NBOND, prmtop BONDS_*, LAMMPS data Bonds).
+    /// Only the bonds the files list (PDB CONECT, PSF !NBOND, prmtop BONDS_*, LAMMPS data
+    /// Bonds, SDF/MOL and MOL2 bond blocks).
     Topology,
     /// No bonds.
     None,
@@ -675,7 +677,7 @@ pub struct MolArgs {
     /// repeatable, applied in order, over every other radius source.
     #[arg(long = "radius", value_name = "SEL=R")]
     pub radius_rules: Vec<String>,
-    /// Bonds: auto (the topology's, else by distance), topology, none.
+    /// Bonds: auto (the files' bonds, else by distance), topology (the files' only), none.
     #[arg(long, value_enum, default_value_t = BondsArg::Auto)]
     pub bonds: BondsArg,
     /// Drawing style: spacefill, ball-stick, licorice (the last two draw bonds), tube (backbones

@@ -121,7 +121,7 @@ fn open_trajectory_with(
         Some(name) => {
             let Some(f) = Format::from_extension(name) else {
                 return usage(format!(
-                    "--format {name:?}: expected one of xyz, extxyz, pdb, cif, gro, lammpstrj, dcd, xtc, trr, nc"
+                    "--format {name:?}: expected one of xyz, extxyz, pdb, cif, gro, lammpstrj, dcd, xtc, trr, nc, sdf, mol, mol2"
                 ));
             };
             Ok(Trajectory::open_as_with(file, f, options)?)
@@ -191,6 +191,10 @@ fn info(
         if !labels.is_empty() {
             obj[key] = json!(label_counts(labels));
         }
+    }
+    // Bonds the file lists with its atoms (SDF, MOL2).
+    if !frame.bonds.is_empty() {
+        obj["bonds"] = json!(frame.bonds.len());
     }
     // Per-atom numbers a --color-by can name.
     if !frame.properties.is_empty() {

@@ -524,7 +524,7 @@ fn read_reference(path: &std::path::Path) -> Result<Frame> {
 /// A [`MolError`] as the usage error naming the flag.
 pub fn mol_error(e: MolError) -> anyhow::Error {
     let text = match e {
-        MolError::NoTopology => "--bonds topology needs --topology FILE (PDB with CONECT records, or a LAMMPS data file with a Bonds section)".to_string(),
+        MolError::NoTopology => "--bonds topology needs bonds listed in a file: --topology FILE (PDB with CONECT records, PSF, prmtop, or a LAMMPS data file with a Bonds section), or an SDF/MOL2 input".to_string(),
         MolError::TopologyWithoutBonds { topology } => format!(
             "--bonds topology: {topology} has no bonds (use --bonds auto for bonds by distance)"
         ),

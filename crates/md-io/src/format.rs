@@ -24,11 +24,16 @@ pub enum Format {
     Netcdf,
     /// PDBx/mmCIF, the Protein Data Bank's archive format; models are frames: `.cif`, `.mmcif`.
     Mmcif,
+    /// MDL molfile / SD file (V2000 and V3000), records are frames, with bonds: `.sdf`,
+    /// `.sd`, `.mol`.
+    Sdf,
+    /// Tripos MOL2, molecules are frames, with bonds and partial charges: `.mol2`.
+    Mol2,
 }
 
 impl Format {
     /// Every format, in declaration order.
-    pub const ALL: [Format; 9] = [
+    pub const ALL: [Format; 11] = [
         Format::Xyz,
         Format::Pdb,
         Format::Gro,
@@ -38,6 +43,8 @@ impl Format {
         Format::Trr,
         Format::Netcdf,
         Format::Mmcif,
+        Format::Sdf,
+        Format::Mol2,
     ];
 
     /// The format a file extension names (case-insensitive), e.g. "xyz", "lammpstrj".
@@ -53,6 +60,8 @@ impl Format {
             "trr" => Format::Trr,
             "nc" | "ncdf" => Format::Netcdf,
             "cif" | "mmcif" => Format::Mmcif,
+            "sdf" | "sd" | "mol" => Format::Sdf,
+            "mol2" => Format::Mol2,
             _ => return None,
         })
     }
@@ -65,8 +74,9 @@ impl Format {
 
     /// The format the first bytes of a file show (give at least 256 bytes when the file has
     /// them). Binary formats are told by their magic numbers, text formats by their first
-    /// lines: `data_` on the first line that is not a `#` comment (PDBx/mmCIF), `ITEM: TIMESTEP`
-    /// (LAMMPS), a PDB record name, an integer first line (XYZ), an integer second line (GRO).
+    /// lines: `data_` (PDBx/mmCIF) or `@<TRIPOS>` (MOL2) on the first line that is not a `#`
+    /// comment, `ITEM: TIMESTEP` (LAMMPS), a PDB record name, a fourth line ending in `V2000` or
+    /// `V3000` (molfile, SD file), an integer first line (XYZ), an integer second line (GRO).
     pub fn from_magic(head: &[u8]) -> Option<Format> {
         let be = |k: usize| {
             head.get(k..k + 4)
@@ -98,11 +108,21 @@ impl Format {
         if cif.is_some_and(|l| l.len() >= 5 && l[..5].eq_ignore_ascii_case(b"data_")) {
             return Some(Format::Mmcif);
         }
+        // MOL2: a Tripos record header, after comments and blank lines.
+        if cif.is_some_and(|l| l.starts_with(b"@<TRIPOS>")) {
+            return Some(Format::Mol2);
+        }
         let mut lines = head.split(|b| *b == b'\n');
         let first = lines.next().unwrap_or(&[]);
         let t = crate::parse::trim(first);
         if t.starts_with(b"ITEM:") {
             return Some(Format::LammpsDump);
+        }
+        // Molfile: the fourth line is a counts line ending in its version.
+        let counts = head.split(|b| *b == b'\n').nth(3).unwrap_or(&[]);
+        let counts = crate::parse::trim(counts);
+        if counts.ends_with(b"V2000") || counts.ends_with(b"V3000") {
+            return Some(Format::Sdf);
         }
         const PDB_RECORDS: [&[u8]; 12] = [
             b"HEADER", b"TITLE ", b"CRYST1", b"ATOM  ", b"HETATM", b"MODEL ", b"REMARK", b"COMPND",
@@ -128,7 +148,13 @@ impl Format {
     pub fn is_text(self) -> bool {
         matches!(
             self,
-            Format::Xyz | Format::Pdb | Format::Gro | Format::LammpsDump | Format::Mmcif
+            Format::Xyz
+                | Format::Pdb
+                | Format::Gro
+                | Format::LammpsDump
+                | Format::Mmcif
+                | Format::Sdf
+                | Format::Mol2
         )
     }
 
@@ -144,6 +170,8 @@ impl Format {
             Format::Trr => "trr",
             Format::Netcdf => "ncdf",
             Format::Mmcif => "mmcif",
+            Format::Sdf => "sdf",
+            Format::Mol2 => "mol2",
         }
     }
 }

@@ -319,6 +319,10 @@ pub struct Frame {
     /// `v_stress`, `fx`, ...), extended-XYZ real or integer columns of one component. What
     /// OVITO calls particle properties and colours by; see [`Frame::property`].
     pub properties: Vec<Property>,
+    /// The bonds the file lists with the atoms (MDL SDF/MOL, Tripos MOL2): atom index pairs
+    /// `[i, j]` with `i < j`, sorted, each once; empty for formats without bonds (whose bonds
+    /// come from a topology or from distances).
+    pub bonds: Vec<[u32; 2]>,
     /// The frame's title / comment line (XYZ comment, GRO title, PDB TITLE), if any.
     pub comment: String,
 }
@@ -361,6 +365,7 @@ impl Frame {
         self.radii.clear();
         self.colors.clear();
         self.properties.clear();
+        self.bonds.clear();
         self.comment.clear();
     }
 
@@ -434,6 +439,18 @@ impl Frame {
                     p.values.len()
                 ));
             }
+        }
+        if let Some(b) = self
+            .bonds
+            .iter()
+            .find(|b| b[0] >= b[1] || b[1] as usize >= n)
+        {
+            return Err(format!(
+                "bond {b:?} is not two atom indices i < j below {n}"
+            ));
+        }
+        if self.bonds.windows(2).any(|w| w[0] >= w[1]) {
+            return Err("bonds are not sorted, each once".into());
         }
         Ok(())
     }

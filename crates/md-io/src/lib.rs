@@ -2,8 +2,9 @@
 //! file formats, streaming frames, and element tables (radius, colour).
 //!
 //! - [`Trajectory`] reads XYZ / extended XYZ, PDB, PDBx/mmCIF (the first data block's
-//!   `_atom_site`, models as frames), GRO and LAMMPS text dumps (and the binary DCD, XTC, TRR
-//!   and AMBER NetCDF) one frame at a time into a reusable [`Frame`], or any frame by index.
+//!   `_atom_site`, models as frames), GRO and LAMMPS text dumps, MDL SDF/MOL and Tripos MOL2
+//!   (records as frames, with the bonds they list: [`Frame::bonds`]) (and the binary DCD, XTC,
+//!   TRR and AMBER NetCDF) one frame at a time into a reusable [`Frame`], or any frame by index.
 //!   Any of them may be gzip-compressed (`1abc.cif.gz`, `run.xyz.gz`; topologies too): it is
 //!   inflated once into a temporary file, so the byte offsets of a `.gz` file's errors count
 //!   decompressed bytes, except for damage to the gzip stream itself (compressed offset).
@@ -89,6 +90,7 @@ mod gro;
 mod gz;
 mod lammps;
 mod mmcif;
+mod mol2;
 mod netcdf;
 pub mod parse;
 pub mod pbc;
@@ -96,6 +98,7 @@ mod pdb;
 mod prmtop;
 mod psf;
 pub mod replicate;
+mod sdf;
 pub mod secondary;
 pub mod select;
 pub mod smooth;

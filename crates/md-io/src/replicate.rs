@@ -86,8 +86,8 @@ fn images(n: usize) -> std::ops::RangeInclusive<i64> {
 }
 
 /// Copies `frame` `n[0]·n[1]·n[2]` times along its cell vectors and `bonds` with it (see the
-/// module docs). `bonds` are index pairs into the frame; they come back sorted, each `[i, j]`
-/// with `i < j`. Nothing changes on error.
+/// module docs), and [`Frame::bonds`] likewise. `bonds` are index pairs into the frame; they
+/// come back sorted, each `[i, j]` with `i < j`. Nothing changes on error.
 pub fn replicate(
     frame: &mut Frame,
     bonds: &mut Vec<[u32; 2]>,
@@ -132,21 +132,27 @@ pub fn replicate(
         };
         (wrap(o[0], 0) * n[1] + wrap(o[1], 1)) * n[2] + wrap(o[2], 2)
     };
-    let mut new_bonds = Vec::with_capacity(bonds.len() * copies);
-    for &[a, b] in bonds.iter() {
-        // b's nearest image to a lies `back` cells from b.
-        let back = -(inverse * (pos(b) - pos(a))).round();
-        let back = [back.x as i64, back.y as i64, back.z as i64];
-        for (m_a, o) in offsets.iter().enumerate() {
-            let m_b = image_index([o[0] + back[0], o[1] + back[1], o[2] + back[2]]);
-            let i = (m_a * atoms) as u32 + a;
-            let j = (m_b * atoms) as u32 + b;
-            new_bonds.push([i.min(j), i.max(j)]);
+    let images_of = |bonds: &[[u32; 2]]| {
+        let mut out = Vec::with_capacity(bonds.len() * copies);
+        for &[a, b] in bonds {
+            // b's nearest image to a lies `back` cells from b.
+            let back = -(inverse * (pos(b) - pos(a))).round();
+            let back = [back.x as i64, back.y as i64, back.z as i64];
+            for (m_a, o) in offsets.iter().enumerate() {
+                let m_b = image_index([o[0] + back[0], o[1] + back[1], o[2] + back[2]]);
+                let i = (m_a * atoms) as u32 + a;
+                let j = (m_b * atoms) as u32 + b;
+                out.push([i.min(j), i.max(j)]);
+            }
         }
-    }
-    new_bonds.sort_unstable();
-    new_bonds.dedup();
-    *bonds = new_bonds;
+        out.sort_unstable();
+        out.dedup();
+        out
+    };
+    *bonds = images_of(bonds);
+    // The frame's own bonds (SDF, MOL2) follow the copies the same way.
+    let frame_bonds = images_of(&frame.bonds);
+    frame.bonds = frame_bonds;
 
     // Positions by image; every other per-atom column copied.
     let positions = std::mem::take(&mut frame.positions);

@@ -7,8 +7,10 @@ use crate::frame::Frame;
 use crate::gro::Gro;
 use crate::lammps::Lammps;
 use crate::mmcif::Mmcif;
+use crate::mol2::Mol2;
 use crate::netcdf::NetcdfReader;
 use crate::pdb::Pdb;
+use crate::sdf::Sdf;
 use crate::text::TextReader;
 use crate::trr::TrrReader;
 use crate::xtc::XtcReader;
@@ -29,6 +31,8 @@ enum Reader<R> {
     Gro(TextReader<R, Gro>),
     Lammps(TextReader<R, Lammps>),
     Mmcif(TextReader<R, Mmcif>),
+    Sdf(TextReader<R, Sdf>),
+    Mol2(TextReader<R, Mol2>),
 }
 
 /// Runs `$body` with `$r` bound to the format's reader, whatever the format.
@@ -44,6 +48,8 @@ macro_rules! each_reader {
             Reader::Gro($r) => $body,
             Reader::Lammps($r) => $body,
             Reader::Mmcif($r) => $body,
+            Reader::Sdf($r) => $body,
+            Reader::Mol2($r) => $body,
         }
     };
 }
@@ -217,6 +223,8 @@ impl<R: Read + Seek> Trajectory<R> {
                 Reader::Lammps(TextReader::new(src, Lammps::default(), file.clone()))
             }
             Format::Mmcif => Reader::Mmcif(TextReader::new(src, Mmcif::new(lenient), file.clone())),
+            Format::Sdf => Reader::Sdf(TextReader::new(src, Sdf, file.clone())),
+            Format::Mol2 => Reader::Mol2(TextReader::new(src, Mol2::default(), file.clone())),
         };
         Ok(Trajectory {
             reader,

@@ -9,7 +9,7 @@ use std::io::Cursor;
 use std::path::PathBuf;
 use texmap_md_io::{Error, Format, Frame, Trajectory};
 
-const FILES: [(&str, Format); 8] = [
+const FILES: [(&str, Format); 11] = [
     ("ase_ext.xyz", Format::Xyz),
     ("ase_plain.xyz", Format::Xyz),
     ("mda_multi.pdb", Format::Pdb),
@@ -18,6 +18,9 @@ const FILES: [(&str, Format); 8] = [
     ("py_prec5.gro", Format::Gro),
     ("lmp_tri.lammpstrj", Format::LammpsDump),
     ("lmp_scaled.lammpstrj", Format::LammpsDump),
+    ("molecules/library.sdf", Format::Sdf),
+    ("molecules/caffeine_v3000.mol", Format::Sdf),
+    ("molecules/library.mol2", Format::Mol2),
 ];
 
 fn data(name: &str) -> Vec<u8> {
@@ -88,6 +91,27 @@ fn frame_ends(bytes: &[u8], format: Format) -> Vec<usize> {
             starts.remove(0);
             starts.push(bytes.len());
             ends = starts;
+        }
+        Format::Sdf => {
+            // A record ends with its '$$$$' line; a molfile (no '$$$$') with the file.
+            for (k, l) in lines.iter().enumerate() {
+                if l.trim_end() == "$$$$" {
+                    ends.push(line_starts[k + 1]);
+                }
+            }
+            if ends.last() != Some(&bytes.len()) {
+                ends.push(bytes.len());
+            }
+        }
+        Format::Mol2 => {
+            // A molecule ends where the next one's header line shows (that line is part of
+            // what ends it: its damage is the earlier molecule's), the last with the file.
+            for (k, l) in lines.iter().enumerate().skip(1) {
+                if l.starts_with("@<TRIPOS>MOLECULE") {
+                    ends.push(line_starts[k + 1]);
+                }
+            }
+            ends.push(bytes.len());
         }
         _ => unreachable!(),
     }

@@ -75,9 +75,11 @@ pub const MAX_P_GAP: f32 = 8.0;
 pub enum BondSource {
     /// No bonds.
     None,
-    /// The topology's bonds only.
+    /// Only the bonds the files list: the topology's, else the frame's own
+    /// ([`Frame::bonds`]: SDF, MOL2).
     Topology,
-    /// The topology's bonds when it has any, else bonds by distance.
+    /// The bonds the files list when they list any (the topology's, else the frame's), else
+    /// bonds by distance.
     Auto,
 }
 
@@ -372,7 +374,8 @@ impl MolPlan {
         let sticks = reps.iter().any(|r| r.draw != DrawStyle::Spacefill);
         if options.bonds == BondSource::Topology && sticks {
             match &options.topology {
-                None => return Err(MolError::NoTopology),
+                // The frames may list bonds (SDF, MOL2): checked at the first frame.
+                None => {}
                 Some(t) if t.bonds.is_empty() => {
                     return Err(MolError::TopologyWithoutBonds {
                         topology: t.name().to_string(),
@@ -544,23 +547,36 @@ impl MolPlan {
         }
     }
 
-    /// The bonds of `frame` as [`MolOptions::bonds`] asks (before periodic handling).
-    fn find_bonds(&mut self, frame: &Frame, need: bool) {
+    /// The bonds of `frame` as [`MolOptions::bonds`] asks (before periodic handling). Bonds
+    /// from the files drawn with neither a topology nor bonds in the frame are an error.
+    fn find_bonds(&mut self, frame: &Frame, need: bool) -> Result<(), MolError> {
         self.pairs.clear();
         if !need {
-            return;
+            return Ok(());
         }
-        match (self.options.bonds, &self.options.topology) {
+        let topology = self
+            .options
+            .topology
+            .as_ref()
+            .filter(|t| !t.bonds.is_empty());
+        match (self.options.bonds, topology) {
             (BondSource::None, _) => {}
-            (BondSource::Topology, Some(t)) => self.pairs.extend_from_slice(&t.bonds),
-            (BondSource::Topology, None) => {}
-            (BondSource::Auto, Some(t)) if !t.bonds.is_empty() => {
+            (BondSource::Topology | BondSource::Auto, Some(t)) => {
                 self.pairs.extend_from_slice(&t.bonds)
             }
-            (BondSource::Auto, _) => {
+            (BondSource::Topology | BondSource::Auto, None) if !frame.bonds.is_empty() => {
+                self.pairs.extend_from_slice(&frame.bonds)
+            }
+            (BondSource::Topology, None) => {
+                if self.draws_bonds() && self.options.topology.is_none() {
+                    return Err(MolError::NoTopology);
+                }
+            }
+            (BondSource::Auto, None) => {
                 self.pairs = texmap_md_io::bonds::bonds_by_distance(frame, true).pairs;
             }
         }
+        Ok(())
     }
 
     /// Periodic boundaries applied to `frame`, then `scene` built from it: selected atoms
@@ -572,7 +588,7 @@ impl MolPlan {
         scene: &mut SphereScene,
     ) -> Result<(), MolError> {
         let unwrap = self.options.pbc == Pbc::Unwrap && frame.cell.is_some();
-        self.find_bonds(frame, self.draws_bonds() || unwrap);
+        self.find_bonds(frame, self.draws_bonds() || unwrap)?;
         match self.options.pbc {
             Pbc::None => {}
             Pbc::Wrap => texmap_md_io::pbc::wrap(frame),
@@ -1026,14 +1042,24 @@ mod tests {
     }
 
     #[test]
-    fn topology_bonds_without_a_topology_are_refused() {
-        let e = MolPlan::new(MolOptions {
+    fn listed_bonds_without_a_topology_come_from_the_frame_or_are_refused() {
+        let mut plan = MolPlan::new(MolOptions {
             bonds: BondSource::Topology,
             draw: DrawStyle::Licorice,
             ..MolOptions::default()
         })
-        .unwrap_err();
-        assert_eq!(e, MolError::NoTopology);
+        .unwrap();
+        let mut frame = Frame::new();
+        frame.positions = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [5.0, 0.0, 0.0]];
+        frame.elements = vec![Element::from_symbol("C").unwrap(); 3];
+        let mut builder = SceneBuilder::new(&StyleOptions::default()).unwrap();
+        let mut scene = SphereScene::default();
+        let e = plan.build(&mut builder, &mut frame.clone(), &mut scene);
+        assert_eq!(e, Err(MolError::NoTopology));
+        // The frame's own bonds (an SDF or MOL2 file's) are the listed bonds, however long.
+        frame.bonds = vec![[1, 2]];
+        plan.build(&mut builder, &mut frame, &mut scene).unwrap();
+        assert_eq!(scene.bonds, [[1, 2]]);
         let e = MolPlan::new(MolOptions {
             radii: vec![(sel("all"), f32::NAN)],
             ..MolOptions::default()
