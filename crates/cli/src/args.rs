@@ -402,6 +402,15 @@ pub struct RenderArgs {
     /// Format, when the extension does not tell it.
     #[arg(long)]
     pub format: Option<String>,
+    /// Another file drawn in the same scene, its atoms after FILE's (a ligand beside its
+    /// receptor, docking poses around it): 'texmap render poses.sdf --add receptor.pdb' draws
+    /// each pose in its pocket, one pose per frame. A file of one frame is drawn with every
+    /// frame; one of several frames gives its frame N to frame N, and needs at least as many
+    /// as FILE. Each file keeps its own bonds (listed in it, or by distance with --bonds
+    /// auto); --topology labels FILE's atoms only; selections see all atoms (an SDF's have no
+    /// residue names: select them as 'not protein' or by index). Repeatable.
+    #[arg(long = "add", value_name = "FILE")]
+    pub add: Vec<PathBuf>,
     /// Keep the complete frames of a file whose last frame is cut short (a crashed or running
     /// simulation, a partial copy; a .gz whose stream ends early too), with a warning
     /// (default: a cut frame is an error naming the file, frame and byte).

@@ -372,6 +372,21 @@ fn render(a: &RenderArgs) -> Result<()> {
         bail!("{}: the file holds no frame", a.file.display());
     }
     let frames = parse_frames(&a.frames, n)?;
+    // The other files of the scene: each with one frame, or at least as many as the file.
+    let mut adds = Vec::with_capacity(a.add.len());
+    for file in &a.add {
+        let mut t = open_trajectory_with(file, None, options)?;
+        let k = t.n_frames()?;
+        print_warnings(&t, &mut shown);
+        if k != 1 && k < n {
+            bail!(
+                "--add {}: {k} frames; an added file has one frame (drawn with every frame) or at least as many as {} ({n})",
+                file.display(),
+                a.file.display()
+            );
+        }
+        adds.push((t, k, MdFrame::new()));
+    }
     let label = a
         .label
         .as_deref()
@@ -438,6 +453,16 @@ fn render(a: &RenderArgs) -> Result<()> {
         print_warnings(&traj, &mut shown);
         plan.label(&mut md, traj.name(), f)
             .map_err(|e| fail(e.into(), &written))?;
+        if !adds.is_empty() {
+            plan.part_bonds(&mut md, true);
+            for (t, k, part) in &mut adds {
+                let at = if *k == 1 { 0 } else { f };
+                t.read_frame(at, part)
+                    .map_err(|e| fail(e.into(), &written))?;
+                plan.part_bonds(part, false);
+                md.append(part);
+            }
+        }
         plan.build(&mut builder, &mut md, &mut scene)
             .map_err(|e| fail(crate::scene::mol_error(e), &written))?;
         if a.box_outline

@@ -1365,3 +1365,57 @@ fn sdf_and_mol2_draw_the_bonds_they_list() {
     );
     assert!(img.pixels().any(|p| p.0 != [0, 0, 0]));
 }
+
+/// `--add`: a receptor written by MDAnalysis with an RDKit SD file's ligand added draws, bonds
+/// and all, byte for byte what ASE's single file of both molecules draws (md-io's
+/// molecules/gen_scene.py): the receptor's bonds by distance and the ligand's as listed, each
+/// part keeping its own. Poses as the frames, the receptor with every frame; an added file
+/// with too few frames is an error naming it.
+#[test]
+fn added_files_share_the_scene_with_their_own_bonds() {
+    let dir = tempfile::tempdir().unwrap();
+    let (receptor, ligands) = (data("select_mda.pdb"), data("molecules/library.sdf"));
+    let both = data("molecules/receptor_aspirin.xyz.gz");
+    let size = ["--style", "ball-stick", "--size", "320x240"];
+    let mut args = vec![&receptor[..], "--add", &ligands];
+    args.extend(size);
+    let added = render_rgb(dir.path(), "added.png", &args);
+    let mut args = vec![&both[..]];
+    args.extend(size);
+    let single = render_rgb(dir.path(), "single.png", &args);
+    assert_eq!(added.as_raw(), single.as_raw());
+
+    let poses = data("molecules/imatinib_confs.sdf");
+    let out = dir.path().join("pose_%02d.png");
+    let o = texmap(&[
+        "render",
+        "-q",
+        &poses,
+        "--add",
+        &receptor,
+        "--size",
+        "160x120",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for k in 0..5 {
+        assert!(dir.path().join(format!("pose_{k:02}.png")).exists());
+    }
+    let three = data("mda_multi.pdb");
+    let o = texmap(&[
+        "render",
+        "-q",
+        &poses,
+        "--add",
+        &three,
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("mda_multi.pdb: 3 frames"),
+        "{}",
+        stderr(&o)
+    );
+}

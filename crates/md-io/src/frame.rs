@@ -369,6 +369,86 @@ impl Frame {
         self.comment.clear();
     }
 
+    /// Adds `other`'s atoms after this frame's, as one scene of several files (a receptor and a
+    /// ligand's poses): positions and every per-atom column, [`Frame::bonds`] renumbered. The
+    /// cell, time, step and comment stay this frame's. A column only one of the two frames has
+    /// is filled for the other's atoms: empty labels (names, types, residues, chains,
+    /// segments), [`Element::UNKNOWN`], ids and residue numbers 0, zero velocities, NaN
+    /// property values; except radii and colours, which are dropped unless both frames have
+    /// them (the atoms are then drawn at their elements' radii and colours, as without the
+    /// column, rather than at a made-up one).
+    ///
+    /// ```
+    /// use texmap_md_io::{Element, Frame};
+    /// let mut receptor = Frame::new();
+    /// receptor.positions = vec![[0.0; 3]; 2];
+    /// receptor.elements = vec![Element::from_symbol("N").unwrap(); 2];
+    /// let mut ligand = Frame::new();
+    /// ligand.positions = vec![[5.0, 0.0, 0.0], [6.2, 0.0, 0.0]];
+    /// ligand.bonds = vec![[0, 1]];
+    /// receptor.append(&ligand);
+    /// assert_eq!(receptor.n_atoms(), 4);
+    /// assert_eq!(receptor.bonds, [[2, 3]]);
+    /// assert_eq!(receptor.elements[3], Element::UNKNOWN);
+    /// assert_eq!(receptor.check(), Ok(()));
+    /// ```
+    pub fn append(&mut self, other: &Frame) {
+        let (n, m) = (self.n_atoms(), other.n_atoms());
+        fn join<T: Clone>(a: &mut Vec<T>, b: &[T], n: usize, m: usize, fill: T) {
+            if a.is_empty() && b.is_empty() {
+                return;
+            }
+            if a.is_empty() {
+                a.resize(n, fill.clone());
+            }
+            if b.is_empty() {
+                a.resize(n + m, fill);
+            } else {
+                a.extend_from_slice(b);
+            }
+        }
+        let blank = Label::default();
+        join(&mut self.velocities, &other.velocities, n, m, [0.0; 3]);
+        join(&mut self.names, &other.names, n, m, blank);
+        join(&mut self.elements, &other.elements, n, m, Element::UNKNOWN);
+        join(&mut self.types, &other.types, n, m, blank);
+        join(&mut self.ids, &other.ids, n, m, 0);
+        join(&mut self.res_names, &other.res_names, n, m, blank);
+        join(&mut self.res_ids, &other.res_ids, n, m, 0);
+        join(&mut self.chains, &other.chains, n, m, blank);
+        join(&mut self.segments, &other.segments, n, m, blank);
+        if self.radii.is_empty() || other.radii.is_empty() {
+            self.radii.clear();
+        } else {
+            self.radii.extend_from_slice(&other.radii);
+        }
+        if self.colors.is_empty() || other.colors.is_empty() {
+            self.colors.clear();
+        } else {
+            self.colors.extend_from_slice(&other.colors);
+        }
+        for p in &mut self.properties {
+            match other.property(&p.name) {
+                Some(v) => p.values.extend_from_slice(v),
+                None => p.values.resize(n + m, f32::NAN),
+            }
+        }
+        for p in &other.properties {
+            if self.property(&p.name).is_none() {
+                let mut values = vec![f32::NAN; n];
+                values.extend_from_slice(&p.values);
+                self.properties.push(Property {
+                    name: p.name.clone(),
+                    values,
+                });
+            }
+        }
+        let shift = n as u32;
+        self.bonds
+            .extend(other.bonds.iter().map(|[i, j]| [i + shift, j + shift]));
+        self.positions.extend_from_slice(&other.positions);
+    }
+
     /// The values of the property named `name` (exact match), if the frame has it.
     pub fn property(&self, name: &str) -> Option<&[f32]> {
         self.properties

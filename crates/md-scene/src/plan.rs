@@ -554,29 +554,52 @@ impl MolPlan {
         if !need {
             return Ok(());
         }
-        let topology = self
-            .options
-            .topology
-            .as_ref()
-            .filter(|t| !t.bonds.is_empty());
-        match (self.options.bonds, topology) {
-            (BondSource::None, _) => {}
-            (BondSource::Topology | BondSource::Auto, Some(t)) => {
-                self.pairs.extend_from_slice(&t.bonds)
-            }
-            (BondSource::Topology | BondSource::Auto, None) if !frame.bonds.is_empty() => {
-                self.pairs.extend_from_slice(&frame.bonds)
-            }
-            (BondSource::Topology, None) => {
-                if self.draws_bonds() && self.options.topology.is_none() {
+        if self.options.bonds == BondSource::None {
+            return Ok(());
+        }
+        // The listed bonds: the topology's and the frame's own (SDF, MOL2, appended parts).
+        if let Some(t) = &self.options.topology {
+            self.pairs.extend_from_slice(&t.bonds);
+        }
+        if !frame.bonds.is_empty() {
+            self.pairs.extend_from_slice(&frame.bonds);
+            self.pairs.sort_unstable();
+            self.pairs.dedup();
+        }
+        if self.pairs.is_empty() {
+            match self.options.bonds {
+                BondSource::Auto => {
+                    self.pairs = texmap_md_io::bonds::bonds_by_distance(frame, true).pairs;
+                }
+                _ if self.draws_bonds() && self.options.topology.is_none() => {
                     return Err(MolError::NoTopology);
                 }
-            }
-            (BondSource::Auto, None) => {
-                self.pairs = texmap_md_io::bonds::bonds_by_distance(frame, true).pairs;
+                _ => {}
             }
         }
         Ok(())
+    }
+
+    /// For a scene of several files, before one file's frame (`part`) is appended to the
+    /// others ([`Frame::append`]): gives it the bonds [`BondSource::Auto`] finds for it alone,
+    /// by distance, when it lists none itself (nor, for the `first` part, the topology), so
+    /// that each part keeps its bonds once the parts' listed bonds are merged. Nothing for
+    /// other bond sources, or when no bonds are needed.
+    pub fn part_bonds(&self, part: &mut Frame, first: bool) {
+        let topology_lists = first
+            && self
+                .options
+                .topology
+                .as_ref()
+                .is_some_and(|t| !t.bonds.is_empty());
+        let needed = self.draws_bonds() || self.options.pbc == Pbc::Unwrap;
+        if self.options.bonds == BondSource::Auto
+            && needed
+            && part.bonds.is_empty()
+            && !topology_lists
+        {
+            part.bonds = texmap_md_io::bonds::bonds_by_distance(part, true).pairs;
+        }
     }
 
     /// Periodic boundaries applied to `frame`, then `scene` built from it: selected atoms
