@@ -188,6 +188,29 @@ pub fn parse_replicate(s: &str) -> Result<[usize; 3], String> {
     }
 }
 
+/// Parses `--slice NX,NY,NZ:D[:W]` into `[nx, ny, nz, d, w]` (w = 0 without one).
+pub fn parse_slice(s: &str) -> Result<[f64; 5], String> {
+    let parts: Vec<&str> = s.split(':').map(str::trim).collect();
+    let number = |t: &str| t.parse::<f64>().ok().filter(|v| v.is_finite());
+    let normal: Vec<Option<f64>> = parts[0].split(',').map(|t| number(t.trim())).collect();
+    let (normal, d, w) = match (&normal[..], &parts[1..]) {
+        ([Some(x), Some(y), Some(z)], [d]) => ([*x, *y, *z], number(d), Some(0.0)),
+        ([Some(x), Some(y), Some(z)], [d, w]) => ([*x, *y, *z], number(d), number(w)),
+        _ => {
+            return Err(
+                "expected NX,NY,NZ:D or NX,NY,NZ:D:W (normal, distance, slab width)".into(),
+            );
+        }
+    };
+    if normal.iter().all(|v| *v == 0.0) {
+        return Err("the normal must not be zero".into());
+    }
+    match (d, w) {
+        (Some(d), Some(w)) if w >= 0.0 => Ok([normal[0], normal[1], normal[2], d, w]),
+        _ => Err("the distance must be a number and the width a number >= 0 (Å)".into()),
+    }
+}
+
 /// Parses `--coordination`: a cutoff in Å from 0.45 (exclusive) to 20.
 pub fn parse_cutoff(s: &str) -> Result<f32, String> {
     match s.trim().parse::<f32>() {
@@ -713,6 +736,18 @@ pub struct MolArgs {
     /// than 3 R is refused (replicate it). R from 0.45 to 20 Å.
     #[arg(long, value_name = "R", value_parser = parse_cutoff)]
     pub coordination: Option<f32>,
+    /// Cut the system open, as OVITO's Slice modifier: 'NX,NY,NZ:D' keeps the atoms behind the
+    /// plane n·x = D (n the unit normal: the side n points away from), 'NX,NY,NZ:D:W' the
+    /// slab of width W Å centred on it: --slice 1,1,1:20:6 shows one (111) slab of an FCC
+    /// crystal, --slice 0,0,1:0 the lower half of a membrane. Only the drawing is cut, as by a
+    /// Slice at the end of an OVITO pipeline: colourings (cna, coordination, structure) and
+    /// selections see the whole system, so atoms at the cut keep their crystal structure. The
+    /// plane is placed after --align, so it stays put relative to an aligned molecule.
+    #[arg(long, value_name = "NX,NY,NZ:D[:W]", value_parser = parse_slice, allow_hyphen_values = true)]
+    pub slice: Option<[f64; 5]>,
+    /// Keep the atoms --slice would remove instead (the other side, or all but the slab).
+    #[arg(long, requires = "slice")]
+    pub slice_invert: bool,
     /// A representation, as VMD's: 'SEL=STYLE' draws the atoms SEL selects in STYLE (spacefill,
     /// ball-stick, licorice, tube), each with its own radii and bond radius; repeat it to
     /// draw several in one image: --rep 'protein=tube' --rep 'resname LIG=ball-stick'

@@ -479,6 +479,12 @@ pub fn mol_plan(args: &MolArgs) -> Result<MolPlan> {
         pbc: args.pbc.into(),
         replicate: args.replicate,
         coordination: args.coordination,
+        slice: args.slice.map(|[x, y, z, d, w]| texmap_md_scene::Slice {
+            normal: [x, y, z],
+            distance: d,
+            width: w,
+            invert: args.slice_invert,
+        }),
     })
     .map_err(mol_error)
 }
@@ -546,6 +552,7 @@ pub fn mol_error(e: MolError) -> anyhow::Error {
             format!("--align: the selection picks {atoms} atom(s) of the first frame: {why}")
         }
         MolError::Coordination(e) => return anyhow::anyhow!("--coordination: {e}"),
+        MolError::BadSlice => format!("--slice: {e}"),
         MolError::Replicate(e) => {
             // A frame without a cell, or too many atoms for the copies: the input's limit.
             return anyhow::anyhow!("--replicate: {e}");

@@ -1419,3 +1419,57 @@ fn added_files_share_the_scene_with_their_own_bonds() {
         stderr(&o)
     );
 }
+
+/// `--slice` (atoms checked against OVITO's Slice in md-scene's tests/analysis.rs): a (111)
+/// slab through the FCC crystal's vacancy cluster, coloured by CNA, is mostly FCC green, with
+/// the white of the cluster's atoms (their structure from the whole crystal, not the slab);
+/// a zero normal is a usage error, and --slice-invert needs --slice.
+#[test]
+fn a_slab_keeps_the_whole_crystals_structure() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = data("cna/crystals.xyz.gz");
+    let img = render_rgb(
+        dir.path(),
+        "slab.png",
+        &[
+            &input,
+            "--frames",
+            "0:1",
+            "--size",
+            "240x180",
+            "--slice",
+            "1,1,1:20:6",
+            "--color-by",
+            "cna",
+        ],
+    );
+    let lit: Vec<[i32; 3]> = img
+        .pixels()
+        .filter(|p| p.0 != [0, 0, 0])
+        .map(|p| p.0.map(i32::from))
+        .collect();
+    let green = lit
+        .iter()
+        .filter(|p| p[1] > p[0] + 30 && p[1] > p[2] + 30)
+        .count();
+    let white = lit
+        .iter()
+        .filter(|p| p[0] > 150 && p[0].abs_diff(p[2]) < 12)
+        .count();
+    assert!(
+        green * 10 > lit.len() * 7 && white > 0,
+        "{green} {white} of {}",
+        lit.len()
+    );
+    let out = dir.path().join("x.png");
+    for bad in [
+        &["--slice", "0,0,0:1"][..],
+        &["--slice", "1,0,0:1:-2"],
+        &["--slice-invert"],
+    ] {
+        let mut args = vec!["render", "-q", &input, "-o", out.to_str().unwrap()];
+        args.extend(bad);
+        let o = texmap(&args);
+        assert_eq!(o.status.code(), Some(2), "{bad:?}: {}", stderr(&o));
+    }
+}

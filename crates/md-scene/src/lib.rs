@@ -72,7 +72,7 @@ pub use palette::{MAX_MATERIALS, Palette, type_color};
 pub use plan::{
     Alignment, BALL_AND_STICK_BOND_RADIUS, BALL_AND_STICK_RADIUS_SCALE, BondSource, COORDINATION,
     DrawStyle, LICORICE_RADIUS, MolError, MolOptions, MolPlan, Pbc, RepColor, Representation,
-    SelectionRole,
+    SelectionRole, Slice,
 };
 pub use scalar::{NAN_COLOR, SCALAR_LEVELS, ScalarColor, ScalarSource};
 pub use style::{

@@ -19,6 +19,10 @@
 //!    velocities and cell are moved by the rotation and translation that fit those atoms onto
 //!    the reference's in least squares, unweighted or by mass ([`crate::align`]; MDAnalysis's
 //!    `AlignTraj`), so the picked molecule holds still while the rest moves relative to it;
+//!    then, with [`MolOptions::slice`], which atoms lie on the kept side of a plane or in a
+//!    slab ([`Slice`]): only those are drawn (step 6), while colourings, analyses and
+//!    selections still see the whole system, as with OVITO's Slice at the end of a pipeline
+//!    (atoms at the cut keep their crystal structure and coordination);
 //! 4. every atom styled by the [`SceneBuilder`] (a scalar colouring's range, unless given,
 //!    fitted at the first frame to the atoms the selection draws), then the colour rules and the
 //!    radius rules, each list in order, so that a later rule wins over an earlier one for the
@@ -28,7 +32,7 @@
 //!    concatenated, every bond with its style's radius in [`SphereScene::bond_radii`]):
 //!    its own colouring ([`RepColor`]) if it has one, under the colour rules again; then the
 //!    [`DrawStyle`]: radii scaled for ball-and-stick, or all set to [`LICORICE_RADIUS`];
-//! 6. the selection: the selected atoms are kept in their order and the bonds between two kept
+//! 6. the selection (and the slice): the selected atoms are kept in their order and the bonds between two kept
 //!    atoms are renumbered to the kept atoms' indices; bonds to a dropped atom are dropped;
 //! 7. for [`DrawStyle::Tube`], the selected atoms of protein and nucleic residues give way to
 //!    the backbone tube through their CA (P) atoms, appended as spheres joined by bonds.
@@ -136,12 +140,46 @@ pub struct MolOptions {
     /// images, as the per-atom property `coordination` (OVITO's Coordination analysis:
     /// [`texmap_md_io::coordination`]), for colouring and selections (`prop coordination < 12`).
     pub coordination: Option<f32>,
+    /// Draw only the atoms on one side of a plane or inside a slab (OVITO's Slice modifier as
+    /// the last step of a pipeline), placed after the alignment; `None` draws every atom.
+    pub slice: Option<Slice>,
     /// Superpose every frame on a reference (the first frame built, or a structure), fitted
     /// on the atoms a selection picks (see the module docs); `None` leaves positions as read.
     pub align: Option<Alignment>,
     /// Several representations in one scene (see [`Representation`]); when not empty, they
     /// replace `select` and `draw`.
     pub reps: Vec<Representation>,
+}
+
+/// A cut through the frame, as OVITO's Slice modifier makes it: the plane `n̂·x = distance`
+/// (`n̂` the unit normal, `x` in Å in the frame's coordinates). With `width` 0 the atoms with
+/// `n̂·x <= distance` are kept (the side the normal points away from); with a `width` > 0 the
+/// atoms of the slab `|n̂·x − distance| <= width / 2`. `invert` keeps the others instead.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Slice {
+    /// The plane's normal (any length but zero).
+    pub normal: [f64; 3],
+    /// The plane's distance from the origin along the unit normal, Å.
+    pub distance: f64,
+    /// The slab's width, Å; 0 for a half-space.
+    pub width: f64,
+    /// Keep the atoms the cut would drop, and drop the others.
+    pub invert: bool,
+}
+
+impl Slice {
+    /// Whether the atom at `p` is kept (see the type's docs).
+    pub fn keeps(&self, p: [f32; 3]) -> bool {
+        let [a, b, c] = self.normal;
+        let len = (a * a + b * b + c * c).sqrt();
+        let d = (a * p[0] as f64 + b * p[1] as f64 + c * p[2] as f64) / len - self.distance;
+        let inside = if self.width > 0.0 {
+            d.abs() <= self.width / 2.0
+        } else {
+            d <= 0.0
+        };
+        inside != self.invert
+    }
 }
 
 /// What [`MolOptions::align`] fits every frame onto, and how.
@@ -206,6 +244,7 @@ impl Default for MolOptions {
             pbc: Pbc::None,
             replicate: None,
             coordination: None,
+            slice: None,
             align: None,
             reps: Vec::new(),
         }
@@ -265,6 +304,9 @@ pub enum MolError {
     Replicate(ReplicateError),
     /// [`MolOptions::coordination`] cannot be counted (the cell is too small for the cutoff).
     Coordination(CoordinationError),
+    /// [`MolOptions::slice`] has a zero or non-finite normal, a non-finite distance or a
+    /// negative or non-finite width.
+    BadSlice,
     /// A selection could not be evaluated on a frame.
     Selection {
         /// Which selection.
@@ -280,6 +322,10 @@ impl fmt::Display for MolError {
             MolError::NoTopology => write!(f, "bonds from the topology need a topology"),
             MolError::Replicate(e) => write!(f, "periodic images: {e}"),
             MolError::Coordination(e) => write!(f, "coordination: {e}"),
+            MolError::BadSlice => write!(
+                f,
+                "slice: the normal must be finite and not zero, the distance finite, the width finite and >= 0"
+            ),
             MolError::TopologyWithoutBonds { topology } => {
                 write!(f, "bonds from the topology: {topology} has no bonds")
             }
@@ -344,6 +390,8 @@ pub struct MolPlan {
     /// the reference structure's) and the weights of a mass-weighted fit.
     align_reference: Option<AlignTarget>,
     last_fit_rmsd: Option<f64>,
+    /// This frame's atoms inside [`MolOptions::slice`] (drawn); `None` without a slice.
+    slice_keep: Option<Vec<bool>>,
     /// Scratch: per atom, the material the colour rules give it (`u16::MAX`: none).
     rule_kinds: Vec<u16>,
     /// The representations: `options.reps`, or the one of `options.select` and `options.draw`.
@@ -371,6 +419,13 @@ impl MolPlan {
         } else {
             options.reps.clone()
         };
+        if let Some(s) = &options.slice {
+            let n2: f64 = s.normal.iter().map(|x| x * x).sum();
+            let finite = n2.is_finite() && s.distance.is_finite() && s.width.is_finite();
+            if !(finite && n2 > 0.0 && s.width >= 0.0) {
+                return Err(MolError::BadSlice);
+            }
+        }
         let sticks = reps.iter().any(|r| r.draw != DrawStyle::Spacefill);
         if options.bonds == BondSource::Topology && sticks {
             match &options.topology {
@@ -391,6 +446,7 @@ impl MolPlan {
             last_bond_count: 0,
             align_reference: None,
             last_fit_rmsd: None,
+            slice_keep: None,
             rule_kinds: Vec::new(),
             reps,
         })
@@ -641,6 +697,10 @@ impl MolPlan {
         self.last_bond_count = self.pairs.len();
         let failed = |role| move |error| MolError::Selection { role, error };
         self.align(frame)?;
+        self.slice_keep = self
+            .options
+            .slice
+            .map(|s| frame.positions.iter().map(|p| s.keeps(*p)).collect());
         // The frame's colour column, for a representation coloured by it when the builder
         // (which drops it otherwise) colours by something else.
         let file_colors = (builder.color_by() != ColorBy::Property
@@ -803,6 +863,10 @@ impl MolPlan {
             Some(sel) => Some(sel.evaluate(frame).map_err(failed(SelectionRole::Select))?),
             None => None,
         };
+        if let Some(keep) = &self.slice_keep {
+            let m = mask.get_or_insert_with(|| vec![true; frame.n_atoms()]);
+            m.iter_mut().zip(keep).for_each(|(m, k)| *m &= *k);
+        }
         let traces = match rep.draw {
             DrawStyle::Tube => {
                 let selected = mask.get_or_insert_with(|| vec![true; frame.n_atoms()]);
