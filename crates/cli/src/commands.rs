@@ -456,10 +456,13 @@ fn render(a: &RenderArgs) -> Result<()> {
         if !adds.is_empty() {
             plan.part_bonds(&mut md, true);
             for (t, k, part) in &mut adds {
-                let at = if *k == 1 { 0 } else { f };
-                t.read_frame(at, part)
-                    .map_err(|e| fail(e.into(), &written))?;
-                plan.part_bonds(part, false);
+                // A file of one frame is read (and bonded) once, for every frame.
+                if *k != 1 || part.n_atoms() == 0 {
+                    let at = if *k == 1 { 0 } else { f };
+                    t.read_frame(at, part)
+                        .map_err(|e| fail(e.into(), &written))?;
+                    plan.part_bonds(part, false);
+                }
                 md.append(part);
             }
         }

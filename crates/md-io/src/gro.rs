@@ -18,7 +18,7 @@
 use crate::elements::guess_element;
 use crate::error::Error;
 use crate::frame::{Frame, Label, UnitCell};
-use crate::parse::{fields, parse_f64, parse_i64, parse_usize, trim};
+use crate::parse::{fields, parse_f64, parse_i64, parse_usize, span, trim};
 use crate::text::{Ctx, LineReader, Pos, TextFormat};
 use std::io::Read;
 
@@ -27,11 +27,6 @@ const NM: f64 = 10.0;
 
 #[derive(Default)]
 pub(crate) struct Gro;
-
-/// Bytes `[a, b)` (0-based) of a line, cut to its length.
-fn span(line: &[u8], a: usize, b: usize) -> &[u8] {
-    &line[a.min(line.len())..b.min(line.len())]
-}
 
 /// Reads `t=` and `step=` from a GROMACS title.
 fn title_time_step(title: &[u8], frame: &mut Frame) {

@@ -82,10 +82,6 @@ fn need<'a, R: Read>(
     next_content(lines, ctx)?.ok_or_else(|| ctx.truncated(p, expected()))
 }
 
-/// Optional atom columns seen on the first atom line: subst_id, subst_name, charge.
-#[derive(Clone, Copy, PartialEq)]
-struct Columns(usize);
-
 impl FrameWalk for Mol2 {
     fn walk<R: Read>(
         &mut self,
@@ -208,10 +204,10 @@ impl Mol2 {
             }
             let ty = Label::from_utf8(w[5])
                 .ok_or_else(|| ctx.parse(pos, line, w[5], "an atom type of at most 15 bytes"))?;
-            // subst_id, subst_name, charge: as many as the first atom line has.
-            let extra = Columns((w.len() - 6).min(3));
+            // The optional subst_id, subst_name, charge: as many as the first atom line has.
+            let extra = (w.len() - 6).min(3);
             let want = *columns.get_or_insert(extra);
-            if extra.0 < want.0 {
+            if extra < want {
                 return Err(ctx.parse(
                     pos,
                     line,
@@ -219,17 +215,17 @@ impl Mol2 {
                     "subst_id, subst_name and charge as on the first atom line",
                 ));
             }
-            let res_id = match want.0 {
+            let res_id = match want {
                 0 => None,
                 _ => Some(parse_i64(w[6]).ok_or_else(|| ctx.parse(pos, line, w[6], "a subst_id"))?),
             };
-            let res_name = match want.0 {
+            let res_name = match want {
                 0 | 1 => None,
                 _ => Some(Label::from_utf8(w[7]).ok_or_else(|| {
                     ctx.parse(pos, line, w[7], "a subst_name of at most 15 bytes")
                 })?),
             };
-            let charge = match want.0 {
+            let charge = match want {
                 3 => Some(
                     parse_f64(w[8])
                         .map(|v| v as f32)

@@ -325,6 +325,12 @@ pub fn fields(line: &[u8]) -> impl Iterator<Item = &[u8]> {
         .filter(|f| !f.is_empty())
 }
 
+/// Bytes `[a, b)` (0-based) of a fixed-column line, cut to its length (empty past its end).
+#[inline]
+pub fn span(line: &[u8], a: usize, b: usize) -> &[u8] {
+    &line[a.min(line.len())..b.min(line.len())]
+}
+
 /// The line with leading and trailing spaces and tabs removed.
 #[inline]
 pub fn trim(line: &[u8]) -> &[u8] {

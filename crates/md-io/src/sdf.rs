@@ -35,17 +35,12 @@ use std::io::Read;
 use crate::elements::Element;
 use crate::error::Error;
 use crate::frame::{Frame, Label};
-use crate::parse::{fields, parse_f64, parse_usize, trim};
+use crate::parse::{fields, parse_f64, parse_usize, span, trim};
 use crate::text::{Ctx, FrameWalk, LineReader, Pos};
 
 /// The SD file / molfile parser.
 #[derive(Default)]
 pub(crate) struct Sdf;
-
-/// Bytes `[a, b)` of a line, cut to its length.
-fn span(line: &[u8], a: usize, b: usize) -> &[u8] {
-    &line[a.min(line.len())..b.min(line.len())]
-}
 
 /// The next line, or a truncation error saying what was expected.
 fn need<'a, R: Read>(
