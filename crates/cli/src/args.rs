@@ -430,8 +430,10 @@ pub struct RenderArgs {
     /// each pose in its pocket, one pose per frame. A file of one frame is drawn with every
     /// frame; one of several frames gives its frame N to frame N, and needs at least as many
     /// as FILE. Each file keeps its own bonds (listed in it, or by distance with --bonds
-    /// auto); --topology labels FILE's atoms only; selections see all atoms (an SDF's have no
-    /// residue names: select them as 'not protein' or by index). Repeatable.
+    /// auto); --topology labels FILE's atoms only. Every atom has the number 'file': 0 for FILE,
+    /// 1, 2, ... for the added files in order, so --rep 'prop file == 0=tube' --rep 'prop file
+    /// == 1=ball-stick' draws a receptor as a tube and its ligand in balls and sticks.
+    /// Repeatable.
     #[arg(long = "add", value_name = "FILE")]
     pub add: Vec<PathBuf>,
     /// Keep the complete frames of a file whose last frame is cut short (a crashed or running

@@ -360,6 +360,16 @@ fn method_of(m: MethodArg) -> Option<Method> {
     }
 }
 
+/// Gives every atom of `frame` the property `file`: which file of a several-file scene it
+/// came from (0 for FILE, then the --add files in order), for `prop file == 1` selections.
+fn set_file_number(frame: &mut MdFrame, number: usize) {
+    frame.properties.retain(|p| p.name != "file");
+    frame.properties.push(texmap_md_io::Property {
+        name: "file".into(),
+        values: vec![number as f32; frame.n_atoms()],
+    });
+}
+
 fn render(a: &RenderArgs) -> Result<()> {
     let background = parse_background(&a.background)?;
     let size = parse_size(&a.camera.size)?;
@@ -455,13 +465,15 @@ fn render(a: &RenderArgs) -> Result<()> {
             .map_err(|e| fail(e.into(), &written))?;
         if !adds.is_empty() {
             plan.part_bonds(&mut md, true);
-            for (t, k, part) in &mut adds {
+            set_file_number(&mut md, 0);
+            for (number, (t, k, part)) in adds.iter_mut().enumerate() {
                 // A file of one frame is read (and bonded) once, for every frame.
                 if *k != 1 || part.n_atoms() == 0 {
                     let at = if *k == 1 { 0 } else { f };
                     t.read_frame(at, part)
                         .map_err(|e| fail(e.into(), &written))?;
                     plan.part_bonds(part, false);
+                    set_file_number(part, number + 1);
                 }
                 md.append(part);
             }

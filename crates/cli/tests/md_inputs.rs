@@ -1384,6 +1384,20 @@ fn added_files_share_the_scene_with_their_own_bonds() {
     args.extend(size);
     let single = render_rgb(dir.path(), "single.png", &args);
     assert_eq!(added.as_raw(), single.as_raw());
+    // `prop file == 1` picks the added file's atoms: drawn alone, they are the ligand's image.
+    let mut args = vec![
+        &receptor[..],
+        "--add",
+        &ligands,
+        "--select",
+        "prop file == 1",
+    ];
+    args.extend(size);
+    let picked = render_rgb(dir.path(), "picked.png", &args);
+    let mut args = vec![&ligands[..], "--frames", "0:1"];
+    args.extend(size);
+    let alone = render_rgb(dir.path(), "alone.png", &args);
+    assert_eq!(picked.as_raw(), alone.as_raw());
 
     let poses = data("molecules/imatinib_confs.sdf");
     let out = dir.path().join("pose_%02d.png");
