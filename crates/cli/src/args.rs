@@ -670,6 +670,9 @@ pub enum DrawStyle {
     /// Protein and nucleic-acid backbones as a smooth 0.3 Å tube through the CA (P) atoms of
     /// each chain (VMD's Tube); ligands, ions and water as licorice.
     Tube,
+    /// A molecular surface around the atoms (VMD's QuickSurf: the isosurface of one Gaussian per
+    /// atom, an isolated atom's at its radius), coloured by the atom nearest under it.
+    Surface,
 }
 
 /// Periodic boundaries (`--pbc`).
@@ -715,9 +718,18 @@ pub struct MolArgs {
     #[arg(long, value_enum, default_value_t = BondsArg::Auto)]
     pub bonds: BondsArg,
     /// Drawing style: spacefill, ball-stick, licorice (the last two draw bonds), tube (backbones
-    /// as a tube, other atoms as licorice).
+    /// as a tube, other atoms as licorice), surface (a molecular surface, see --surface-spacing).
     #[arg(long = "style", value_enum, default_value_t = DrawStyle::Spacefill)]
     pub draw: DrawStyle,
+    /// The surface style's grid spacing in Å: finer cuts the surface into more, smaller
+    /// triangles (every vertex lies on the exact surface whatever the spacing). A system whose
+    /// grid would pass 2^25 samples is sampled coarser, with a warning.
+    #[arg(long, value_name = "Å", default_value_t = 0.5)]
+    pub surface_spacing: f32,
+    /// The surface style's radius scale: an isolated atom's surface lies at this multiple of its
+    /// radius (1: the van der Waals surface, smoothed where atoms overlap; 1.4 is fuller).
+    #[arg(long, value_name = "S", default_value_t = 1.0)]
+    pub surface_scale: f32,
     /// Periodic boundaries: none, wrap (atoms into the box), unwrap (molecules whole).
     #[arg(long, value_enum, default_value_t = PbcArg::None)]
     pub pbc: PbcArg,
@@ -751,9 +763,11 @@ pub struct MolArgs {
     #[arg(long, requires = "slice")]
     pub slice_invert: bool,
     /// A representation, as VMD's: 'SEL=STYLE' draws the atoms SEL selects in STYLE (spacefill,
-    /// ball-stick, licorice, tube), each with its own radii and bond radius; repeat it to
-    /// draw several in one image: --rep 'protein=tube' --rep 'resname LIG=ball-stick'
-    /// --rep 'water and within 5 of resname LIG=licorice'. 'SEL=STYLE:COLOUR' gives it its own
+    /// ball-stick, licorice, tube, surface), each with its own radii and bond radius; repeat it
+    /// to draw several in one image: --rep 'protein=tube' --rep 'resname LIG=ball-stick'
+    /// --rep 'water and within 5 of resname LIG=licorice'; --rep 'protein=surface' --rep
+    /// 'resname LIG=ball-stick' shows a ligand in its pocket (surface representations share
+    /// one surface). 'SEL=STYLE:COLOUR' gives it its own
     /// colouring: element, type, chain, structure, cna, property, or one colour #rrggbb or R,G,B
     /// (--rep 'protein=tube:structure' --rep 'resname LIG=ball-stick:element'); without one it
     /// takes --color-by, and --color rules win over both. Replaces --select and --style; an

@@ -429,6 +429,14 @@ fn render(a: &RenderArgs) -> Result<()> {
     let mut quality_renderer = texmap_quality::QualityRenderer::new();
     let mut builder = crate::scene::scene_builder(&a.style)?;
     let mut plan = crate::scene::mol_plan(&a.mol)?;
+    let surface_options = crate::scene::surface_options(&a.mol)?;
+    if plan.draws_surface() && quality.is_some() {
+        return usage(
+            "the surface style is drawn without --quality's anti-aliasing, ambient occlusion and shadows; drop --quality and its options, or draw the surface's atoms in another style",
+        );
+    }
+    let mut surface = texmap_md_scene::surface::MolSurface::default();
+    let mut coarser_warned = false;
     let mut smoother = texmap_md_io::smooth::Smoother::new(a.smooth as usize);
     let mut md = MdFrame::new();
     let mut scene = SphereScene::default();
@@ -485,6 +493,20 @@ fn render(a: &RenderArgs) -> Result<()> {
         {
             texmap_md_scene::add_box_outline(cell, &mut scene);
         }
+        if plan.draws_surface() && mine.contains(&k) {
+            surface =
+                texmap_md_scene::surface::MolSurface::build(plan.surface_atoms(), &surface_options)
+                    .map_err(|e| fail(e.into(), &written))?;
+            if surface.spacing > surface_options.spacing && !coarser_warned {
+                coarser_warned = true;
+                pb.suspend(|| {
+                    eprintln!(
+                        "texmap: warning: frame {f}: the surface is sampled every {:.3} Å instead of --surface-spacing {} (its grid would have held more than 2^25 samples)",
+                        surface.spacing, surface_options.spacing
+                    )
+                });
+            }
+        }
         if camera.is_none() {
             // First frame: the camera, and warnings about the style flags.
             let rep_warnings: Vec<_> = plan
@@ -500,7 +522,7 @@ fn render(a: &RenderArgs) -> Result<()> {
             if let Some(w) = crate::scene::unnamed_warning(&plan, &md, traj.name()) {
                 pb.suspend(|| eprintln!("texmap: warning: {w}"));
             }
-            if scene.is_empty() {
+            if scene.is_empty() && plan.surface_atoms().is_empty() {
                 let why = if a.mol.reps.is_empty() {
                     a.mol
                         .select
@@ -513,8 +535,14 @@ fn render(a: &RenderArgs) -> Result<()> {
                 let e = anyhow::anyhow!("no atom to draw{why}");
                 return Err(fail(e, &written));
             }
+            // The camera frames the surface's atoms too, at the surface's radii.
+            let mut framed = scene.clone();
+            let atoms = plan.surface_atoms();
+            for ((c, r), kind) in atoms.centers.iter().zip(&atoms.radii).zip(&atoms.kinds) {
+                framed.push(*c, r * surface_options.radius_scale, *kind);
+            }
             let plan =
-                crate::scene::camera_plan(&a.camera, size, &a.path, &md, &scene, frames.len())
+                crate::scene::camera_plan(&a.camera, size, &a.path, &md, &framed, frames.len())
                     .map_err(|e| fail(e, &written))?;
             camera = Some(plan);
         }
@@ -558,12 +586,20 @@ fn render(a: &RenderArgs) -> Result<()> {
                 let mut o = texmap_impostor::Options::new(m, lighting);
                 o.background = background;
                 o.draw_bonds = plan.draws_bonds();
-                let r = renderer.render(&scene, &cam, &o);
+                let mut r = renderer.render(&scene, &cam, &o);
                 skipped_total += r.stats.skipped_invalid;
+                texmap_md_scene::surface::draw_surface(
+                    &surface,
+                    &scene.materials,
+                    &cam,
+                    &lighting,
+                    &mut r.frame,
+                )
+                .map_err(|e| fail(e.into(), &written))?;
                 r.frame
             }
             (None, None) => harness::render_reference(
-                &harness::reference_scene_with_bonds(&scene, plan.draws_bonds()),
+                &harness::reference_scene_with_surface(&scene, plan.draws_bonds(), &surface),
                 &harness::reference_materials(&scene),
                 &cam,
                 lighting,

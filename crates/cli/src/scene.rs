@@ -398,6 +398,7 @@ impl From<DrawStyle> for texmap_md_scene::DrawStyle {
             DrawStyle::BallStick => texmap_md_scene::DrawStyle::BallStick,
             DrawStyle::Licorice => texmap_md_scene::DrawStyle::Licorice,
             DrawStyle::Tube => texmap_md_scene::DrawStyle::Tube,
+            DrawStyle::Surface => texmap_md_scene::DrawStyle::Surface,
         }
     }
 }
@@ -411,6 +412,29 @@ impl From<PbcArg> for Pbc {
             PbcArg::Unwrap => Pbc::Unwrap,
         }
     }
+}
+
+/// The surface style's options from `--surface-spacing` and `--surface-scale` (usage errors
+/// out of range).
+pub fn surface_options(args: &MolArgs) -> Result<texmap_md_scene::surface::SurfaceOptions> {
+    let o = texmap_md_scene::surface::SurfaceOptions {
+        spacing: args.surface_spacing,
+        radius_scale: args.surface_scale,
+        ..Default::default()
+    };
+    if !(o.spacing.is_finite() && o.spacing >= 0.05 && o.spacing <= 10.0) {
+        return usage(format!(
+            "--surface-spacing {}: expected a grid spacing from 0.05 to 10 Å",
+            o.spacing
+        ));
+    }
+    if !(o.radius_scale.is_finite() && o.radius_scale >= 0.1 && o.radius_scale <= 10.0) {
+        return usage(format!(
+            "--surface-scale {}: expected a radius scale from 0.1 to 10",
+            o.radius_scale
+        ));
+    }
+    Ok(o)
 }
 
 /// What `render` does to a frame between reading and drawing ([`MolPlan`]) for the
@@ -458,7 +482,7 @@ pub fn mol_plan(args: &MolArgs) -> Result<MolPlan> {
         };
         let draw = <DrawStyle as clap::ValueEnum>::from_str(style, true).map_err(|_| {
             crate::args::UsageError(format!(
-                "--rep {r:?}: {style:?} is not a style; use spacefill, ball-stick, licorice or tube"
+                "--rep {r:?}: {style:?} is not a style; use spacefill, ball-stick, licorice, tube or surface"
             ))
         })?;
         reps.push(texmap_md_scene::Representation {

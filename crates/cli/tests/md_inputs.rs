@@ -1487,3 +1487,86 @@ fn a_slab_keeps_the_whole_crystals_structure() {
         assert_eq!(o.status.code(), Some(2), "{bad:?}: {}", stderr(&o));
     }
 }
+
+/// `--style surface` (md_scene::surface) on 3GWI chain A: drawn by every sphere method over the
+/// same image the reference ray tracer makes of the same mesh; a ligand-in-pocket view mixes it
+/// with balls and sticks; bad surface options and --quality are usage errors.
+#[test]
+fn a_molecular_surface_is_drawn_as_the_reference_traces_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let surface = ["--style", "surface"];
+    let reference = render_3gwi(
+        dir.path(),
+        "ref.png",
+        &[&surface[..], &["--method", "reference"]].concat(),
+    );
+    for method in ["raycast", "template", "polygon"] {
+        let name = format!("{method}.png");
+        let ours = render_3gwi(
+            dir.path(),
+            &name,
+            &[&surface[..], &["--method", method]].concat(),
+        );
+        let d = mean_abs_diff(&ours, &reference);
+        eprintln!("{method}: mean |surface - reference| = {d:.3} per channel");
+        assert!(
+            d < 1.0,
+            "{method}: mean |surface - reference| = {d} per channel"
+        );
+    }
+    // The surface covers more of the image than the atoms' spheres (it fills the crevices) and
+    // hides them: the density sum is at least each atom's own Gaussian, so a surface of scale
+    // 1.1 encloses every atom's sphere and spacefill drawn with it adds nothing.
+    let spheres = render_3gwi(dir.path(), "spheres.png", &[]);
+    let wrapped = dir.path().join("raycast.png");
+    assert!(
+        lit(&wrapped) > lit(&spheres),
+        "{} vs {}",
+        lit(&wrapped),
+        lit(&spheres)
+    );
+    let fuller = ["--surface-scale", "1.1"];
+    let alone = render_3gwi(dir.path(), "alone.png", &[&surface[..], &fuller].concat());
+    let both = render_3gwi(
+        dir.path(),
+        "both.png",
+        &[
+            &["--rep", "protein=surface", "--rep", "protein=spacefill"][..],
+            &fuller,
+        ]
+        .concat(),
+    );
+    assert!(std::fs::read(&both).unwrap() == std::fs::read(&alone).unwrap());
+    // A pocket view: the surface of all but residues 420-432, which show as balls and sticks.
+    let pocket = render_3gwi(
+        dir.path(),
+        "pocket.png",
+        &[
+            "--rep",
+            "not resid 420 to 432=surface",
+            "--rep",
+            "resid 420 to 432=ball-stick:#ff8000",
+        ],
+    );
+    let img = image::open(&pocket).unwrap().to_rgb8();
+    let orange = img
+        .pixels()
+        .filter(|p| p[0] > 180 && p[1] > 70 && p[1] < 150 && p[2] < 60)
+        .count();
+    assert!(orange > 200, "{orange} orange pixels");
+    // Usage errors: exit 2, nothing written.
+    let input = data("dssp/3gwiA.pdb.gz");
+    for bad in [
+        &["--style", "surface", "--surface-spacing", "0"][..],
+        &["--style", "surface", "--surface-scale", "nan"],
+        &["--style", "surface", "--quality", "good"],
+        &["--rep", "protein=surfaces"],
+    ] {
+        let out = dir.path().join("bad.png");
+        let mut args = vec!["render", input.as_str(), "-o", out.to_str().unwrap()];
+        args.extend(bad);
+        let o = texmap(&args);
+        assert_eq!(o.status.code(), Some(2), "{bad:?}: {}", stderr(&o));
+        assert!(!out.exists());
+    }
+}

@@ -62,6 +62,7 @@ pub mod palette;
 pub mod plan;
 pub mod scalar;
 pub mod style;
+pub mod surface;
 
 pub use camera::{AUTO_VIEW_DIRECTION, FIT_MARGIN, ViewAxis, centre_of, drawn_bounds, fit_camera};
 pub use camera_plan::{CameraPlan, CameraPlanError, MotionSpec};

@@ -54,6 +54,7 @@ use texmap_md_io::coordination::CoordinationError;
 use texmap_md_io::replicate::ReplicateError;
 use texmap_md_io::{Frame, Property, Selection, SelectionError, Topology, atom_element};
 
+use crate::surface::SurfaceAtoms;
 use crate::{ColorBy, SceneBuilder};
 
 /// Ball-and-stick atoms are this fraction of their Bondi (van der Waals) radii.
@@ -100,6 +101,9 @@ pub enum DrawStyle {
     /// Protein and nucleic-acid backbones as a smooth tube (see the module docs); other atoms
     /// (ligands, ions, water) as [`DrawStyle::Licorice`].
     Tube,
+    /// The selected atoms wrapped in a molecular surface (VMD's QuickSurf: a Gaussian density
+    /// surface, [`crate::surface`]); they are not drawn as spheres, and nothing is bonded.
+    Surface,
 }
 
 /// The periodic-boundary treatment (frames without a cell are left as they are).
@@ -396,6 +400,8 @@ pub struct MolPlan {
     rule_kinds: Vec<u16>,
     /// The representations: `options.reps`, or the one of `options.select` and `options.draw`.
     reps: Vec<Representation>,
+    /// The last frame's atoms drawn as a surface ([`DrawStyle::Surface`]).
+    surface: SurfaceAtoms,
 }
 
 impl MolPlan {
@@ -449,6 +455,7 @@ impl MolPlan {
             slice_keep: None,
             rule_kinds: Vec::new(),
             reps,
+            surface: SurfaceAtoms::default(),
         })
     }
 
@@ -579,7 +586,9 @@ impl MolPlan {
 
     /// Whether bonds are drawn at all.
     pub fn draws_bonds(&self) -> bool {
-        self.reps.iter().any(|r| r.draw != DrawStyle::Spacefill)
+        self.reps
+            .iter()
+            .any(|r| !matches!(r.draw, DrawStyle::Spacefill | DrawStyle::Surface))
             && self.options.bonds != BondSource::None
     }
 
@@ -757,10 +766,22 @@ impl MolPlan {
         // The representations are taken out for the call (draw_rep borrows the plan mutably)
         // and put back, whatever the outcome.
         let reps = std::mem::take(&mut self.reps);
+        self.surface.clear();
         let drawn = self.draw_reps(builder, frame, &reps, scene);
         self.reps = reps;
         builder.refresh_materials(scene);
         drawn
+    }
+
+    /// Whether some representation draws a molecular surface ([`DrawStyle::Surface`]).
+    pub fn draws_surface(&self) -> bool {
+        self.reps.iter().any(|r| r.draw == DrawStyle::Surface)
+    }
+
+    /// The atoms the last frame built draws as a molecular surface ([`DrawStyle::Surface`]),
+    /// at their radii, with their materials (indices into the scene's).
+    pub fn surface_atoms(&self) -> &SurfaceAtoms {
+        &self.surface
     }
 
     /// The colourings the representations have of their own, in order.
@@ -844,7 +865,7 @@ impl MolPlan {
         let failed = |role| move |error| MolError::Selection { role, error };
         scene.bond_radii.clear();
         match rep.draw {
-            DrawStyle::Spacefill => {}
+            DrawStyle::Spacefill | DrawStyle::Surface => {}
             DrawStyle::BallStick => {
                 for r in &mut scene.radii {
                     *r *= BALL_AND_STICK_RADIUS_SCALE;
@@ -895,6 +916,16 @@ impl MolPlan {
             scene.kinds.truncate(w);
         }
         scene.bonds.clear();
+        if rep.draw == DrawStyle::Surface {
+            // The atoms go to the surface instead of the spheres.
+            for ((c, r), k) in scene.centers.iter().zip(&scene.radii).zip(&scene.kinds) {
+                self.surface.push(*c, *r, *k);
+            }
+            scene.centers.clear();
+            scene.radii.clear();
+            scene.kinds.clear();
+            return Ok(());
+        }
         if rep.draw != DrawStyle::Spacefill && self.options.bonds != BondSource::None {
             for b in &self.pairs {
                 let (i, j) = if self.map.is_empty() {

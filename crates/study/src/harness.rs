@@ -48,6 +48,44 @@ pub fn reference_scene(spheres: &SphereScene) -> texmap_reftrace::Scene {
 /// atom's material (half-bond colouring, as the methods draw it). Bonds the methods skip (an
 /// index out of range, an invalid atom, coincident centres, a bad radius) are left out.
 pub fn reference_scene_with_bonds(spheres: &SphereScene, bonds: bool) -> texmap_reftrace::Scene {
+    reference_builder(spheres, bonds).build()
+}
+
+/// [`reference_scene_with_bonds`] plus a molecular surface: each material's triangles as one
+/// mesh shaded by its vertex normals (the surface's exact normals), material id = kind, as
+/// `md_scene::surface::draw_surface` draws it; triangles of an unknown kind are left out.
+pub fn reference_scene_with_surface(
+    spheres: &SphereScene,
+    bonds: bool,
+    surface: &texmap_md_scene::surface::MolSurface,
+) -> texmap_reftrace::Scene {
+    let mut b = reference_builder(spheres, bonds);
+    for kind in 0..spheres.materials.len() {
+        let indices: Vec<u32> = surface
+            .triangles
+            .iter()
+            .zip(&surface.kinds)
+            .filter(|(_, k)| **k as usize == kind)
+            .flat_map(|(t, _)| *t)
+            .collect();
+        if indices.is_empty() {
+            continue;
+        }
+        b.add_mesh_shaded(
+            &surface.positions,
+            &indices,
+            None,
+            Some(&surface.normals),
+            texmap_reftrace::MeshShading::VertexNormals,
+            kind as u32,
+        )
+        .expect("a surface's indices and normals match its vertices");
+    }
+    b.build()
+}
+
+/// The reference builder of [`reference_scene_with_bonds`].
+fn reference_builder(spheres: &SphereScene, bonds: bool) -> SceneBuilder {
     let mut b = SceneBuilder::with_sphere_capacity(spheres.len());
     for i in 0..spheres.len() {
         if (spheres.kinds[i] as usize) < spheres.materials.len() {
@@ -77,7 +115,7 @@ pub fn reference_scene_with_bonds(spheres: &SphereScene, bonds: bool) -> texmap_
             }
         }
     }
-    b.build()
+    b
 }
 
 /// The reference materials: every kind's shading material, opaque.

@@ -1,0 +1,647 @@
+//! Molecular surfaces as VMD's QuickSurf draws them: one Gaussian per atom summed on a grid,
+//! the isosurface extracted by surface nets, every vertex then moved onto the exact isosurface
+//! and given its exact normal and the colour of the atom that dominates it; drawn by the
+//! rasteriser and composited by depth over the frame the sphere methods made ([`draw_surface`]).
+//!
+//! # The density
+//! `ρ(p) = Σ_i exp(−|p − c_i|² / (2 σ_i²))` with `σ_i = s · r_i / √(2 ln(1/ρ₀))`, so that the
+//! surface `ρ = ρ₀` of an isolated atom is the sphere of radius `s · r_i` (`s` the radius scale:
+//! 1, the default, gives the van der Waals surface, smoothed where atoms overlap; `ρ₀` the
+//! isovalue, 0.5 as in VMD). Each Gaussian is cut off where it falls below [`CUTOFF`] of its
+//! peak ([`CUT_SIGMAS`] σ), and the sampled density, which only decides where the vertices
+//! start, where it falls below 1e-3: an atom touches a bounded block of the grid.
+//!
+//! # Extraction
+//! The density is sampled on a grid of spacing `h` (at most [`MAX_VOXELS`] samples: a larger
+//! system is sampled coarser and [`MolSurface::spacing`] says how coarse), summed per atom over
+//! slabs of planes in parallel, each sample's sum in atom order, so the result is the same for
+//! any thread count. Surface nets (Gibson 1998): one vertex per grid cell whose corners straddle
+//! `ρ₀`, at the mean of its edges' linear crossings; one quad per grid edge that crosses, joining
+//! the four cells around it, wound counter-clockwise seen from outside. The mesh is closed: a
+//! crossing edge is shared by exactly four cells, each of which therefore has a vertex, and the
+//! grid is padded so that no crossing lies on its border.
+//!
+//! Each vertex then takes [`NEWTON_STEPS`] Newton steps `p ← p − (ρ(p) − ρ₀) ∇ρ / |∇ρ|²` (each
+//! at most half a cell) on the exact, not the sampled, density: vertices lie on the true
+//! isosurface to within float rounding, and the normal `−∇ρ / |∇ρ|` there is exact too, so the
+//! grid only decides how finely the surface is cut into triangles. A triangle takes the material
+//! of the atom contributing most to the density at two or three of its vertices (else the
+//! first's), as PyMOL colours a surface by its nearest atom.
+
+use glam::Vec3;
+use rayon::prelude::*;
+use texmap_core::camera::Camera;
+use texmap_core::frame::Frame;
+use texmap_core::shade::{Lighting, Material};
+use texmap_raster::{DrawState, Framebuffer, Mesh, RasterError, Shading};
+
+/// A Gaussian is cut off where it falls below this fraction of its peak.
+pub const CUTOFF: f32 = 1e-6;
+/// The cut-off radius in units of σ: `√(2 ln(1/CUTOFF))`.
+pub const CUT_SIGMAS: f32 = 5.256_521;
+/// The sampled density's cut-off radius in units of σ, `√(2 ln 1000)`: it only decides which
+/// cells hold a vertex, so it stops at 1e-3 of each peak (a third of the samples per atom).
+const GRID_CUT_SIGMAS: f32 = 3.716_922;
+/// Most density samples one surface allocates (128 MiB of f32, plus as many vertex slots).
+pub const MAX_VOXELS: usize = 1 << 25;
+/// Newton steps that move each vertex onto the exact isosurface.
+pub const NEWTON_STEPS: usize = 6;
+/// Grid planes per parallel slab of the density sum.
+const SLAB: usize = 4;
+
+/// How a surface is made.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfaceOptions {
+    /// Grid spacing (Å): finer cuts the surface into more, smaller triangles.
+    pub spacing: f32,
+    /// An isolated atom's surface radius as a multiple of its radius.
+    pub radius_scale: f32,
+    /// The density level of the surface, in (0, 1).
+    pub isovalue: f32,
+}
+
+impl Default for SurfaceOptions {
+    /// Spacing 0.5 Å, radius scale 1, isovalue 0.5.
+    fn default() -> SurfaceOptions {
+        SurfaceOptions {
+            spacing: 0.5,
+            radius_scale: 1.0,
+            isovalue: 0.5,
+        }
+    }
+}
+
+/// A surface option out of its range.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SurfaceError {
+    /// The option's name, its value and the range it must lie in.
+    BadOption {
+        name: &'static str,
+        value: f32,
+        expected: &'static str,
+    },
+}
+
+impl std::fmt::Display for SurfaceError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            SurfaceError::BadOption {
+                name,
+                value,
+                expected,
+            } => write!(f, "surface {name} {value}: expected {expected}"),
+        }
+    }
+}
+
+impl std::error::Error for SurfaceError {}
+
+/// The atoms a surface wraps: centres (Å), radii and material indices.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SurfaceAtoms {
+    pub centers: Vec<Vec3>,
+    pub radii: Vec<f32>,
+    pub kinds: Vec<u16>,
+}
+
+impl SurfaceAtoms {
+    pub fn push(&mut self, center: Vec3, radius: f32, kind: u16) {
+        self.centers.push(center);
+        self.radii.push(radius);
+        self.kinds.push(kind);
+    }
+
+    pub fn len(&self) -> usize {
+        self.centers.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.centers.is_empty()
+    }
+
+    pub fn clear(&mut self) {
+        self.centers.clear();
+        self.radii.clear();
+        self.kinds.clear();
+    }
+}
+
+/// A closed triangle mesh around a set of atoms.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct MolSurface {
+    pub positions: Vec<Vec3>,
+    /// Unit outward normals, one per vertex.
+    pub normals: Vec<Vec3>,
+    /// Counter-clockwise seen from outside.
+    pub triangles: Vec<[u32; 3]>,
+    /// The material index of each triangle.
+    pub kinds: Vec<u16>,
+    /// The grid spacing used (Å): the one asked for, or coarser when the grid would have held
+    /// more than [`MAX_VOXELS`] samples.
+    pub spacing: f32,
+}
+
+/// One valid atom's Gaussian.
+#[derive(Clone, Copy)]
+struct Blob {
+    center: Vec3,
+    /// `1 / (2 σ²)`.
+    inv2s2: f32,
+    cut: f32,
+    /// The cut-off radius of the sampled density.
+    grid_cut: f32,
+    /// The atom's position in the input (for the dominant atom's kind).
+    atom: u32,
+}
+
+/// The atoms binned in cubes of the largest cut-off, for exact evaluation at a point.
+struct Lookup {
+    blobs: Vec<Blob>,
+    origin: Vec3,
+    cell: f32,
+    dims: [usize; 3],
+    /// `start[c]..start[c + 1]` are cell `c`'s blobs in `order`.
+    start: Vec<u32>,
+    order: Vec<u32>,
+}
+
+impl Lookup {
+    fn new(blobs: Vec<Blob>, lo: Vec3, hi: Vec3) -> Lookup {
+        let cell = blobs.iter().map(|b| b.cut).fold(0.0f32, f32::max).max(1e-3);
+        // At most ~2M cells: a sparse system's cells grow instead.
+        let extent = (hi - lo).max(Vec3::splat(cell));
+        let mut cell = cell;
+        let dims = loop {
+            let d = (extent / cell).ceil().as_uvec3().max(glam::UVec3::ONE);
+            let d = [d.x as usize, d.y as usize, d.z as usize];
+            if d[0].saturating_mul(d[1]).saturating_mul(d[2]) <= 1 << 21 {
+                break d;
+            }
+            cell *= 2.0;
+        };
+        let n = dims[0] * dims[1] * dims[2];
+        let cell_of = |p: Vec3| -> usize {
+            let q = ((p - lo) / cell).floor();
+            let c = |v: f32, d: usize| (v.max(0.0) as usize).min(d - 1);
+            (c(q.z, dims[2]) * dims[1] + c(q.y, dims[1])) * dims[0] + c(q.x, dims[0])
+        };
+        let mut start = vec![0u32; n + 1];
+        for b in &blobs {
+            start[cell_of(b.center) + 1] += 1;
+        }
+        for c in 0..n {
+            start[c + 1] += start[c];
+        }
+        let mut fill = start.clone();
+        let mut order = vec![0u32; blobs.len()];
+        for (i, b) in blobs.iter().enumerate() {
+            let c = cell_of(b.center);
+            order[fill[c] as usize] = i as u32;
+            fill[c] += 1;
+        }
+        Lookup {
+            blobs,
+            origin: lo,
+            cell,
+            dims,
+            start,
+            order,
+        }
+    }
+
+    /// `ρ(p)`, `∇ρ(p)` and the blob contributing most (its input index; `u32::MAX` if none).
+    fn eval(&self, p: Vec3) -> (f32, Vec3, u32) {
+        let q = ((p - self.origin) / self.cell).floor();
+        let (mut rho, mut grad, mut best, mut best_w) = (0.0f32, Vec3::ZERO, u32::MAX, 0.0f32);
+        let range = |v: f32, d: usize| {
+            let v = v.clamp(-1.0, d as f32) as i64;
+            (v - 1).max(0) as usize..=((v + 1).min(d as i64 - 1)).max(0) as usize
+        };
+        for z in range(q.z, self.dims[2]) {
+            for y in range(q.y, self.dims[1]) {
+                for x in range(q.x, self.dims[0]) {
+                    let c = (z * self.dims[1] + y) * self.dims[0] + x;
+                    for &k in &self.order[self.start[c] as usize..self.start[c + 1] as usize] {
+                        let b = &self.blobs[k as usize];
+                        let d = p - b.center;
+                        let d2 = d.length_squared();
+                        if d2 >= b.cut * b.cut {
+                            continue;
+                        }
+                        let w = (-d2 * b.inv2s2).exp();
+                        rho += w;
+                        grad += d * (-2.0 * b.inv2s2 * w);
+                        if w > best_w {
+                            (best, best_w) = (b.atom, w);
+                        }
+                    }
+                }
+            }
+        }
+        (rho, grad, best)
+    }
+}
+
+impl MolSurface {
+    /// The surface of `atoms` (atoms with a non-finite centre or a radius that is not positive
+    /// and finite are left out; none left gives an empty mesh).
+    pub fn build(
+        atoms: &SurfaceAtoms,
+        options: &SurfaceOptions,
+    ) -> Result<MolSurface, SurfaceError> {
+        let bad = |name, value, expected| {
+            Err(SurfaceError::BadOption {
+                name,
+                value,
+                expected,
+            })
+        };
+        let o = *options;
+        if !(o.spacing.is_finite() && o.spacing > 0.0) {
+            return bad("spacing", o.spacing, "a positive length in Å");
+        }
+        if !(o.radius_scale.is_finite() && o.radius_scale > 0.0) {
+            return bad("radius scale", o.radius_scale, "a positive number");
+        }
+        if !(o.isovalue > 0.0 && o.isovalue < 1.0) {
+            return bad("isovalue", o.isovalue, "a number between 0 and 1");
+        }
+        let k = (2.0 * (1.0 / o.isovalue).ln()).sqrt();
+        let n = atoms
+            .centers
+            .len()
+            .min(atoms.radii.len())
+            .min(atoms.kinds.len());
+        let blobs: Vec<Blob> = (0..n)
+            .filter(|&i| {
+                let r = atoms.radii[i] * o.radius_scale;
+                atoms.centers[i].is_finite() && r.is_finite() && r > 0.0
+            })
+            .map(|i| {
+                let sigma = atoms.radii[i] * o.radius_scale / k;
+                Blob {
+                    center: atoms.centers[i],
+                    inv2s2: 1.0 / (2.0 * sigma * sigma),
+                    cut: CUT_SIGMAS * sigma,
+                    grid_cut: GRID_CUT_SIGMAS * sigma,
+                    atom: i as u32,
+                }
+            })
+            .collect();
+        let mut surface = MolSurface {
+            spacing: o.spacing,
+            ..Default::default()
+        };
+        if blobs.is_empty() {
+            return Ok(surface);
+        }
+        let (lo, hi) = blobs.iter().fold(
+            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+            |(lo, hi), b| (lo.min(b.center - b.grid_cut), hi.max(b.center + b.grid_cut)),
+        );
+        // The grid: one spacing of padding beyond every cut-off, so no crossing on its border.
+        let mut h = o.spacing as f64;
+        let extent = (hi - lo).as_dvec3();
+        let dims = loop {
+            let d = (extent / h).ceil() + 3.0;
+            let count = d.x * d.y * d.z;
+            if count <= MAX_VOXELS as f64 {
+                break [d.x as usize, d.y as usize, d.z as usize];
+            }
+            h *= (count / MAX_VOXELS as f64).cbrt() * 1.001;
+        };
+        let h = h as f32;
+        surface.spacing = h;
+        let origin = lo - Vec3::splat(h);
+        let rho = density(&blobs, origin, h, dims);
+        let lookup = Lookup::new(blobs, lo, hi);
+        surface.extract(&rho, &lookup, origin, dims, o.isovalue, atoms);
+        Ok(surface)
+    }
+
+    /// Surface nets over the sampled density, then the vertices projected onto the exact one.
+    fn extract(
+        &mut self,
+        rho: &[f32],
+        lookup: &Lookup,
+        origin: Vec3,
+        [nx, ny, nz]: [usize; 3],
+        iso: f32,
+        atoms: &SurfaceAtoms,
+    ) {
+        let h = self.spacing;
+        let at = |x: usize, y: usize, z: usize| rho[(z * ny + y) * nx + x];
+        let (cx, cy, cz) = (nx - 1, ny - 1, nz - 1);
+        // Vertices: per plane of cells in parallel, concatenated in plane order.
+        let planes: Vec<Vec<(u32, Vec3)>> = (0..cz)
+            .into_par_iter()
+            .map(|z| {
+                let mut out = Vec::new();
+                for y in 0..cy {
+                    for x in 0..cx {
+                        let mut c = [0.0f32; 8];
+                        let mut inside = 0u32;
+                        for (i, v) in c.iter_mut().enumerate() {
+                            *v = at(x + (i & 1), y + ((i >> 1) & 1), z + (i >> 2));
+                            inside += (*v > iso) as u32;
+                        }
+                        if inside == 0 || inside == 8 {
+                            continue;
+                        }
+                        let (mut sum, mut count) = (Vec3::ZERO, 0.0f32);
+                        for (a, b) in CUBE_EDGES {
+                            let (va, vb) = (c[a], c[b]);
+                            if (va > iso) != (vb > iso) {
+                                let t = (iso - va) / (vb - va);
+                                sum += corner(a).lerp(corner(b), t);
+                                count += 1.0;
+                            }
+                        }
+                        let local = sum / count;
+                        let p = origin + (Vec3::new(x as f32, y as f32, z as f32) + local) * h;
+                        out.push((((z * cy + y) * cx + x) as u32, p));
+                    }
+                }
+                out
+            })
+            .collect();
+        let mut slot = vec![u32::MAX; cx * cy * cz];
+        let mut positions = Vec::with_capacity(planes.iter().map(Vec::len).sum());
+        for plane in &planes {
+            for &(cell, p) in plane {
+                slot[cell as usize] = positions.len() as u32;
+                positions.push(p);
+            }
+        }
+        drop(planes);
+        // Onto the exact isosurface; the exact normal and the dominant atom there.
+        let max_step = 0.5 * h;
+        let projected: Vec<(Vec3, Vec3, u16)> = positions
+            .par_iter()
+            .map(|&p0| {
+                let mut p = p0;
+                for _ in 0..NEWTON_STEPS {
+                    let (r, g, _) = lookup.eval(p);
+                    let g2 = g.length_squared();
+                    if g2 <= 0.0 || !g2.is_finite() {
+                        break;
+                    }
+                    let step = g * ((r - iso) / g2);
+                    let len = step.length();
+                    p -= if len > max_step {
+                        step * (max_step / len)
+                    } else {
+                        step
+                    };
+                }
+                let (_, g, best) = lookup.eval(p);
+                let n = (-g).normalize_or_zero();
+                let kind = atoms.kinds.get(best as usize).copied().unwrap_or(0);
+                (p, n, kind)
+            })
+            .collect();
+        let vertex_kind: Vec<u16> = projected.iter().map(|v| v.2).collect();
+        self.positions = projected.iter().map(|v| v.0).collect();
+        self.normals = projected.iter().map(|v| v.1).collect();
+        // Quads: per plane of grid edges (edges whose lower sample is in plane z), in parallel.
+        let positions = &self.positions;
+        let cell = |x: usize, y: usize, z: usize| slot[(z * cy + y) * cx + x];
+        let quads: Vec<Vec<[u32; 3]>> = (1..nz - 1)
+            .into_par_iter()
+            .map(|z| {
+                let mut out = Vec::new();
+                let mut quad = |q: [u32; 4], outward_positive: bool| {
+                    let q = if outward_positive {
+                        q
+                    } else {
+                        [q[3], q[2], q[1], q[0]]
+                    };
+                    if q.contains(&u32::MAX) {
+                        return; // not reached: the four cells of a crossing edge have vertices
+                    }
+                    let p = q.map(|i| positions[i as usize]);
+                    if (p[0] - p[2]).length_squared() <= (p[1] - p[3]).length_squared() {
+                        out.push([q[0], q[1], q[2]]);
+                        out.push([q[0], q[2], q[3]]);
+                    } else {
+                        out.push([q[0], q[1], q[3]]);
+                        out.push([q[1], q[2], q[3]]);
+                    }
+                };
+                for y in 1..ny - 1 {
+                    for x in 1..nx - 1 {
+                        let v = at(x, y, z) > iso;
+                        // Edge along x from (x, y, z): cells (x, y-1..y, z-1..z).
+                        if x < nx - 1 && v != (at(x + 1, y, z) > iso) {
+                            let q = [
+                                cell(x, y - 1, z - 1),
+                                cell(x, y, z - 1),
+                                cell(x, y, z),
+                                cell(x, y - 1, z),
+                            ];
+                            quad(q, v);
+                        }
+                        if v != (at(x, y + 1, z) > iso) {
+                            let q = [
+                                cell(x - 1, y, z - 1),
+                                cell(x - 1, y, z),
+                                cell(x, y, z),
+                                cell(x, y, z - 1),
+                            ];
+                            quad(q, v);
+                        }
+                        if v != (at(x, y, z + 1) > iso) {
+                            let q = [
+                                cell(x - 1, y - 1, z),
+                                cell(x, y - 1, z),
+                                cell(x, y, z),
+                                cell(x - 1, y, z),
+                            ];
+                            quad(q, v);
+                        }
+                    }
+                }
+                out
+            })
+            .collect();
+        self.triangles = quads.concat();
+        self.kinds = self
+            .triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| vertex_kind[i as usize]);
+                if a == b || a == c {
+                    a
+                } else if b == c {
+                    b
+                } else {
+                    a
+                }
+            })
+            .collect();
+    }
+
+    /// The enclosed volume (Å³), by the divergence theorem over the triangles: positive when
+    /// they are wound counter-clockwise seen from outside.
+    pub fn volume(&self) -> f64 {
+        self.triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| self.positions[i as usize].as_dvec3());
+                a.dot(b.cross(c)) / 6.0
+            })
+            .sum()
+    }
+
+    /// The surface area (Å²).
+    pub fn area(&self) -> f64 {
+        self.triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| self.positions[i as usize].as_dvec3());
+                0.5 * (b - a).cross(c - a).length()
+            })
+            .sum()
+    }
+}
+
+/// The unit cube's corner `i` (bit 0 x, bit 1 y, bit 2 z).
+fn corner(i: usize) -> Vec3 {
+    Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, (i >> 2) as f32)
+}
+
+/// The unit cube's twelve edges as corner pairs.
+const CUBE_EDGES: [(usize, usize); 12] = [
+    (0, 1),
+    (2, 3),
+    (4, 5),
+    (6, 7),
+    (0, 2),
+    (1, 3),
+    (4, 6),
+    (5, 7),
+    (0, 4),
+    (1, 5),
+    (2, 6),
+    (3, 7),
+];
+
+/// The density sampled at `origin + h · (x, y, z)`: each Gaussian added over its cut-off block
+/// as a product of three one-dimensional factors, slab by slab in parallel, atoms in order.
+fn density(blobs: &[Blob], origin: Vec3, h: f32, [nx, ny, nz]: [usize; 3]) -> Vec<f32> {
+    let slabs = nz.div_ceil(SLAB);
+    let range = |c: f32, o: f32, cut: f32, n: usize| {
+        let a = ((c - cut - o) / h).ceil().max(0.0) as usize;
+        let b = (((c + cut - o) / h).floor().max(0.0) as usize).min(n - 1);
+        a..b + 1
+    };
+    let mut lists: Vec<Vec<u32>> = vec![Vec::new(); slabs];
+    for (i, b) in blobs.iter().enumerate() {
+        let zr = range(b.center.z, origin.z, b.grid_cut, nz);
+        if zr.is_empty() {
+            continue;
+        }
+        for list in &mut lists[zr.start / SLAB..=(zr.end - 1) / SLAB] {
+            list.push(i as u32);
+        }
+    }
+    let mut rho = vec![0.0f32; nx * ny * nz];
+    rho.par_chunks_mut(nx * ny * SLAB)
+        .zip(lists.par_iter())
+        .enumerate()
+        .for_each(|(s, (slab, list))| {
+            let z0 = s * SLAB;
+            let planes = slab.len() / (nx * ny);
+            let (mut ex, mut ey) = (Vec::new(), Vec::new());
+            for &i in list {
+                let b = &blobs[i as usize];
+                let factors = |r: std::ops::Range<usize>, c: f32, o: f32, out: &mut Vec<f32>| {
+                    out.clear();
+                    out.extend(r.map(|k| {
+                        let d = o + k as f32 * h - c;
+                        (-d * d * b.inv2s2).exp()
+                    }));
+                };
+                let xr = range(b.center.x, origin.x, b.grid_cut, nx);
+                let yr = range(b.center.y, origin.y, b.grid_cut, ny);
+                let zr = range(b.center.z, origin.z, b.grid_cut, nz);
+                factors(xr.clone(), b.center.x, origin.x, &mut ex);
+                factors(yr.clone(), b.center.y, origin.y, &mut ey);
+                for z in zr.start.max(z0)..zr.end.min(z0 + planes) {
+                    let d = origin.z + z as f32 * h - b.center.z;
+                    let fz = (-d * d * b.inv2s2).exp();
+                    for (y, &fy) in yr.clone().zip(&ey) {
+                        let fyz = fy * fz;
+                        let row = ((z - z0) * ny + y) * nx;
+                        for (v, &fx) in slab[row + xr.start..row + xr.end].iter_mut().zip(&ex) {
+                            *v += fx * fyz;
+                        }
+                    }
+                }
+            }
+        });
+    rho
+}
+
+/// Draw `surface` as `camera` sees it, lit per pixel as the sphere methods light their atoms
+/// (`materials` indexed by the triangles' kinds; a kind past them is drawn grey), over `frame`:
+/// a surface pixel replaces the frame's where it is nearer. Returns the triangles drawn.
+pub fn draw_surface(
+    surface: &MolSurface,
+    materials: &[Material],
+    camera: &Camera,
+    lighting: &Lighting,
+    frame: &mut Frame,
+) -> Result<usize, RasterError> {
+    if surface.triangles.is_empty() {
+        return Ok(0);
+    }
+    let mut fb = Framebuffer::new(camera.width(), camera.height())?;
+    fb.clear([0, 0, 0, 0]);
+    // The triangles grouped by kind (a counting sort: groups in kind order, each in mesh order).
+    let kinds = materials.len() + 1;
+    let kind = |k: u16| (k as usize).min(materials.len());
+    let mut start = vec![0usize; kinds + 1];
+    for &k in &surface.kinds {
+        start[kind(k) + 1] += 1;
+    }
+    for k in 0..kinds {
+        start[k + 1] += start[k];
+    }
+    let mut sorted = vec![[0u32; 3]; surface.triangles.len()];
+    let mut fill = start.clone();
+    for (t, &k) in surface.triangles.iter().zip(&surface.kinds) {
+        sorted[fill[kind(k)]] = *t;
+        fill[kind(k)] += 1;
+    }
+    let mut drawn = 0;
+    for k in 0..kinds {
+        let group = &sorted[start[k]..start[k + 1]];
+        if group.is_empty() {
+            continue;
+        }
+        let material = materials
+            .get(k)
+            .copied()
+            .unwrap_or(Material::plastic(Vec3::splat(0.6)));
+        let mesh = Mesh::new(&surface.positions, group)?.with_normals(&surface.normals)?;
+        let shading = Shading::LitSmooth {
+            lighting: *lighting,
+            material,
+        };
+        drawn += fb
+            .draw_mesh(camera, &mesh, &shading, &DrawState::default())?
+            .binned;
+    }
+    let drawn_frame = fb.to_frame();
+    if frame.width() != drawn_frame.width() || frame.height() != drawn_frame.height() {
+        *frame = Frame::new(camera.width(), camera.height(), [0, 0, 0, 255]);
+    }
+    for (i, &d) in drawn_frame.depth.iter().enumerate() {
+        if d < frame.depth[i] {
+            frame.depth[i] = d;
+            frame.color[i] = drawn_frame.color[i];
+        }
+    }
+    Ok(drawn)
+}
