@@ -21,7 +21,7 @@
 //! crossing edge is shared by exactly four cells, each of which therefore has a vertex, and the
 //! grid is padded so that no crossing lies on its border.
 //!
-//! Each vertex then takes [`NEWTON_STEPS`] Newton steps `p ← p − (ρ(p) − ρ₀) ∇ρ / |∇ρ|²` (each
+//! Each vertex then takes up to [`NEWTON_STEPS`] Newton steps `p ← p − (ρ(p) − ρ₀) ∇ρ / |∇ρ|²` (each
 //! at most half a cell) on the exact, not the sampled, density: vertices lie on the true
 //! isosurface to within float rounding, and the normal `−∇ρ / |∇ρ|` there is exact too, so the
 //! grid only decides how finely the surface is cut into triangles. A triangle takes the material
@@ -44,8 +44,10 @@ pub const CUT_SIGMAS: f32 = 5.256_521;
 const GRID_CUT_SIGMAS: f32 = 3.716_922;
 /// Most density samples one surface allocates (128 MiB of f32, plus as many vertex slots).
 pub const MAX_VOXELS: usize = 1 << 25;
-/// Newton steps that move each vertex onto the exact isosurface.
+/// Most Newton steps that move a vertex onto the exact isosurface.
 pub const NEWTON_STEPS: usize = 6;
+/// A vertex whose density is this close to the isovalue takes no further step.
+const CONVERGED: f32 = 2e-6;
 /// Grid planes per parallel slab of the density sum.
 const SLAB: usize = 4;
 
@@ -154,23 +156,28 @@ struct Blob {
     atom: u32,
 }
 
-/// The atoms binned in cubes of the largest cut-off, for exact evaluation at a point.
+/// The atoms binned in cubes of half the largest cut-off, stored cell by cell (each cell's in
+/// input order), for exact evaluation at a point: the 5x5x5 cells around a point hold every atom
+/// within reach with 42 % fewer to test than 3x3x3 cells of the whole cut-off.
 struct Lookup {
+    /// The blobs in cell order.
     blobs: Vec<Blob>,
     origin: Vec3,
     cell: f32,
     dims: [usize; 3],
-    /// `start[c]..start[c + 1]` are cell `c`'s blobs in `order`.
+    /// `blobs[start[c]..start[c + 1]]` are cell `c`'s.
     start: Vec<u32>,
-    order: Vec<u32>,
 }
+
+/// Cells each side of a point's own that [`Lookup::eval`] visits.
+const REACH: i64 = 2;
 
 impl Lookup {
     fn new(blobs: Vec<Blob>, lo: Vec3, hi: Vec3) -> Lookup {
-        let cell = blobs.iter().map(|b| b.cut).fold(0.0f32, f32::max).max(1e-3);
+        let cut = blobs.iter().map(|b| b.cut).fold(0.0f32, f32::max).max(1e-3);
+        let mut cell = cut / REACH as f32;
         // At most ~2M cells: a sparse system's cells grow instead.
         let extent = (hi - lo).max(Vec3::splat(cell));
-        let mut cell = cell;
         let dims = loop {
             let d = (extent / cell).ceil().as_uvec3().max(glam::UVec3::ONE);
             let d = [d.x as usize, d.y as usize, d.z as usize];
@@ -193,19 +200,18 @@ impl Lookup {
             start[c + 1] += start[c];
         }
         let mut fill = start.clone();
-        let mut order = vec![0u32; blobs.len()];
-        for (i, b) in blobs.iter().enumerate() {
+        let mut sorted = blobs.clone();
+        for b in &blobs {
             let c = cell_of(b.center);
-            order[fill[c] as usize] = i as u32;
+            sorted[fill[c] as usize] = *b;
             fill[c] += 1;
         }
         Lookup {
-            blobs,
+            blobs: sorted,
             origin: lo,
             cell,
             dims,
             start,
-            order,
         }
     }
 
@@ -215,25 +221,26 @@ impl Lookup {
         let (mut rho, mut grad, mut best, mut best_w) = (0.0f32, Vec3::ZERO, u32::MAX, 0.0f32);
         let range = |v: f32, d: usize| {
             let v = v.clamp(-1.0, d as f32) as i64;
-            (v - 1).max(0) as usize..=((v + 1).min(d as i64 - 1)).max(0) as usize
+            (v - REACH).max(0) as usize..=((v + REACH).min(d as i64 - 1)).max(0) as usize
         };
+        let xs = range(q.x, self.dims[0]);
         for z in range(q.z, self.dims[2]) {
             for y in range(q.y, self.dims[1]) {
-                for x in range(q.x, self.dims[0]) {
-                    let c = (z * self.dims[1] + y) * self.dims[0] + x;
-                    for &k in &self.order[self.start[c] as usize..self.start[c + 1] as usize] {
-                        let b = &self.blobs[k as usize];
-                        let d = p - b.center;
-                        let d2 = d.length_squared();
-                        if d2 >= b.cut * b.cut {
-                            continue;
-                        }
-                        let w = (-d2 * b.inv2s2).exp();
-                        rho += w;
-                        grad += d * (-2.0 * b.inv2s2 * w);
-                        if w > best_w {
-                            (best, best_w) = (b.atom, w);
-                        }
+                // The row's cells are contiguous: one run of blobs.
+                let row = (z * self.dims[1] + y) * self.dims[0];
+                let from = self.start[row + xs.start()] as usize;
+                let to = self.start[row + xs.end() + 1] as usize;
+                for b in &self.blobs[from..to] {
+                    let d = p - b.center;
+                    let d2 = d.length_squared();
+                    if d2 >= b.cut * b.cut {
+                        continue;
+                    }
+                    let w = (-d2 * b.inv2s2).exp();
+                    rho += w;
+                    grad += d * (-2.0 * b.inv2s2 * w);
+                    if w > best_w {
+                        (best, best_w) = (b.atom, w);
                     }
                 }
             }
@@ -380,10 +387,11 @@ impl MolSurface {
             .par_iter()
             .map(|&p0| {
                 let mut p = p0;
+                let mut at = lookup.eval(p);
                 for _ in 0..NEWTON_STEPS {
-                    let (r, g, _) = lookup.eval(p);
+                    let (r, g, _) = at;
                     let g2 = g.length_squared();
-                    if g2 <= 0.0 || !g2.is_finite() {
+                    if (r - iso).abs() <= CONVERGED || g2 <= 0.0 || !g2.is_finite() {
                         break;
                     }
                     let step = g * ((r - iso) / g2);
@@ -393,8 +401,9 @@ impl MolSurface {
                     } else {
                         step
                     };
+                    at = lookup.eval(p);
                 }
-                let (_, g, best) = lookup.eval(p);
+                let (_, g, best) = at;
                 let n = (-g).normalize_or_zero();
                 let kind = atoms.kinds.get(best as usize).copied().unwrap_or(0);
                 (p, n, kind)
