@@ -1,4 +1,4 @@
-//! Molecular-dynamics frames as impostor sphere scenes: the join of `texmap-md-io` (atoms,
+//! Molecular-dynamics frames as impostor sphere scenes (and molecular surfaces): the join of `texmap-md-io` (atoms,
 //! periodic cells, selections) and `texmap-impostor` ([`SphereScene`]), which depend on no
 //! crate of each other.
 //!
@@ -21,6 +21,9 @@
 //! - [`scalar`]: colour coding by a number per atom ([`ScalarSource`]: a property such as the
 //!   B-factor or a LAMMPS compute, the speed, the residue, the index) over a range fixed at the
 //!   first frame.
+//! - [`surface`]: molecular surfaces as VMD's QuickSurf draws them (one Gaussian per atom, the
+//!   isosurface by surface nets with every vertex on the exact surface), drawn by the rasteriser
+//!   over a sphere method's frame ([`surface::draw_surface`]).
 //! - [`legend`]: a colour bar with its tick labels and title drawn onto a rendered RGBA image
 //!   ([`draw_color_bar`]).
 //!

@@ -27,6 +27,22 @@
 //! grid only decides how finely the surface is cut into triangles. A triangle takes the material
 //! of the atom contributing most to the density at two or three of its vertices (else the
 //! first's), as PyMOL colours a surface by its nearest atom.
+//!
+//! ```
+//! use glam::Vec3;
+//! use texmap_md_scene::surface::{MolSurface, SurfaceAtoms, SurfaceOptions};
+//!
+//! // One carbon-sized atom: its surface is its sphere of radius 1.7 Å.
+//! let mut atoms = SurfaceAtoms::default();
+//! atoms.push(Vec3::new(1.0, 2.0, 3.0), 1.7, 0);
+//! let s = MolSurface::build(&atoms, &SurfaceOptions::default()).unwrap();
+//! for p in &s.positions {
+//!     assert!(((*p - Vec3::new(1.0, 2.0, 3.0)).length() - 1.7).abs() < 1e-4);
+//! }
+//! // Closed and wound outward: the enclosed volume is the sphere's, less the chords' sag.
+//! let sphere = 4.0 / 3.0 * std::f64::consts::PI * 1.7f64.powi(3);
+//! assert!(s.volume() > 0.95 * sphere && s.volume() < sphere);
+//! ```
 
 use glam::Vec3;
 use rayon::prelude::*;
