@@ -12,7 +12,7 @@ use texmap::core::camera::Camera;
 use texmap::core::frame::Frame as Image;
 use texmap::core::shade::{Lighting, Material};
 use texmap::md_io::{AtomStyle, Frame, Trajectory};
-use texmap::md_scene::surface::{MolSurface, SurfaceAtoms, SurfaceOptions, draw_surface};
+use texmap::md_scene::surface::{MolMesh, SurfaceAtoms, SurfaceOptions, draw_mesh};
 
 fn bench(c: &mut Criterion) {
     let test_mode = std::env::args().any(|a| a == "--test");
@@ -53,9 +53,9 @@ fn bench(c: &mut Criterion) {
     }
     for (name, atoms) in cases {
         g.bench_function(format!("build_{name}_{}atoms", atoms.len()), |b| {
-            b.iter(|| MolSurface::build(atoms, &options).unwrap())
+            b.iter(|| MolMesh::surface(atoms, &options).unwrap())
         });
-        let surface = MolSurface::build(atoms, &options).unwrap();
+        let surface = MolMesh::surface(atoms, &options).unwrap();
         let (lo, hi) = atoms
             .centers
             .iter()
@@ -81,7 +81,7 @@ fn bench(c: &mut Criterion) {
             |b| {
                 b.iter(|| {
                     image.depth.fill(f32::INFINITY);
-                    draw_surface(&surface, &materials, &camera, &lighting, &mut image).unwrap()
+                    draw_mesh(&surface, &materials, &camera, &lighting, &mut image).unwrap()
                 })
             },
         );

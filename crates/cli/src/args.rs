@@ -670,6 +670,10 @@ pub enum DrawStyle {
     /// Protein and nucleic-acid backbones as a smooth 0.3 Å tube through the CA (P) atoms of
     /// each chain (VMD's Tube); ligands, ions and water as licorice.
     Tube,
+    /// Protein backbones as a cartoon (VMD's NewCartoon): helices as ribbons, strands as arrows,
+    /// coil as a thin tube, from the secondary structure of each frame; nucleic acids as a tube,
+    /// ligands, ions and water as licorice.
+    Cartoon,
     /// A molecular surface around the atoms (VMD's QuickSurf: the isosurface of one Gaussian per
     /// atom, an isolated atom's at its radius), coloured by the atom nearest under it.
     Surface,
@@ -718,7 +722,8 @@ pub struct MolArgs {
     #[arg(long, value_enum, default_value_t = BondsArg::Auto)]
     pub bonds: BondsArg,
     /// Drawing style: spacefill, ball-stick, licorice (the last two draw bonds), tube (backbones
-    /// as a tube, other atoms as licorice), surface (a molecular surface, see --surface-spacing).
+    /// as a tube, other atoms as licorice), cartoon (helix ribbons, strand arrows, coil tubes; other
+    /// atoms as licorice), surface (a molecular surface, see --surface-spacing).
     #[arg(long = "style", value_enum, default_value_t = DrawStyle::Spacefill)]
     pub draw: DrawStyle,
     /// The surface style's grid spacing in Å: finer cuts the surface into more, smaller
@@ -763,7 +768,7 @@ pub struct MolArgs {
     #[arg(long, requires = "slice")]
     pub slice_invert: bool,
     /// A representation, as VMD's: 'SEL=STYLE' draws the atoms SEL selects in STYLE (spacefill,
-    /// ball-stick, licorice, tube, surface), each with its own radii and bond radius; repeat it
+    /// ball-stick, licorice, tube, cartoon, surface), each with its own radii and bond radius; repeat it
     /// to draw several in one image: --rep 'protein=tube' --rep 'resname LIG=ball-stick'
     /// --rep 'water and within 5 of resname LIG=licorice'; --rep 'protein=surface' --rep
     /// 'resname LIG=ball-stick' shows a ligand in its pocket (surface representations share

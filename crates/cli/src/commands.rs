@@ -435,7 +435,7 @@ fn render(a: &RenderArgs) -> Result<()> {
             "the surface style is drawn without --quality's anti-aliasing, ambient occlusion and shadows; drop --quality and its options, or draw the surface's atoms in another style",
         );
     }
-    let mut surface = texmap_md_scene::surface::MolSurface::default();
+    let mut surface = texmap_md_scene::surface::MolMesh::default();
     let mut coarser_warned = false;
     let mut smoother = texmap_md_io::smooth::Smoother::new(a.smooth as usize);
     let mut md = MdFrame::new();
@@ -495,7 +495,7 @@ fn render(a: &RenderArgs) -> Result<()> {
         }
         if plan.draws_surface() && mine.contains(&k) {
             surface =
-                texmap_md_scene::surface::MolSurface::build(plan.surface_atoms(), &surface_options)
+                texmap_md_scene::surface::MolMesh::surface(plan.surface_atoms(), &surface_options)
                     .map_err(|e| fail(e.into(), &written))?;
             if surface.spacing > surface_options.spacing && !coarser_warned {
                 coarser_warned = true;
@@ -522,7 +522,10 @@ fn render(a: &RenderArgs) -> Result<()> {
             if let Some(w) = crate::scene::unnamed_warning(&plan, &md, traj.name()) {
                 pb.suspend(|| eprintln!("texmap: warning: {w}"));
             }
-            if scene.is_empty() && plan.surface_atoms().is_empty() {
+            if scene.is_empty()
+                && plan.surface_atoms().is_empty()
+                && plan.cartoon_mesh().triangles.is_empty()
+            {
                 let why = if a.mol.reps.is_empty() {
                     a.mol
                         .select
@@ -540,6 +543,9 @@ fn render(a: &RenderArgs) -> Result<()> {
             let atoms = plan.surface_atoms();
             for ((c, r), kind) in atoms.centers.iter().zip(&atoms.radii).zip(&atoms.kinds) {
                 framed.push(*c, r * surface_options.radius_scale, *kind);
+            }
+            for p in &plan.cartoon_mesh().positions {
+                framed.push(*p, texmap_md_scene::cartoon::COIL_RADIUS, 0);
             }
             let plan =
                 crate::scene::camera_plan(&a.camera, size, &a.path, &md, &framed, frames.len())
@@ -588,18 +594,24 @@ fn render(a: &RenderArgs) -> Result<()> {
                 o.draw_bonds = plan.draws_bonds();
                 let mut r = renderer.render(&scene, &cam, &o);
                 skipped_total += r.stats.skipped_invalid;
-                texmap_md_scene::surface::draw_surface(
-                    &surface,
-                    &scene.materials,
-                    &cam,
-                    &lighting,
-                    &mut r.frame,
-                )
-                .map_err(|e| fail(e.into(), &written))?;
+                for mesh in [&surface, plan.cartoon_mesh()] {
+                    texmap_md_scene::surface::draw_mesh(
+                        mesh,
+                        &scene.materials,
+                        &cam,
+                        &lighting,
+                        &mut r.frame,
+                    )
+                    .map_err(|e| fail(e.into(), &written))?;
+                }
                 r.frame
             }
             (None, None) => harness::render_reference(
-                &harness::reference_scene_with_surface(&scene, plan.draws_bonds(), &surface),
+                &harness::reference_scene_with_meshes(
+                    &scene,
+                    plan.draws_bonds(),
+                    &[&surface, plan.cartoon_mesh()],
+                ),
                 &harness::reference_materials(&scene),
                 &cam,
                 lighting,

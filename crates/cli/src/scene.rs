@@ -398,6 +398,7 @@ impl From<DrawStyle> for texmap_md_scene::DrawStyle {
             DrawStyle::BallStick => texmap_md_scene::DrawStyle::BallStick,
             DrawStyle::Licorice => texmap_md_scene::DrawStyle::Licorice,
             DrawStyle::Tube => texmap_md_scene::DrawStyle::Tube,
+            DrawStyle::Cartoon => texmap_md_scene::DrawStyle::Cartoon,
             DrawStyle::Surface => texmap_md_scene::DrawStyle::Surface,
         }
     }
@@ -482,7 +483,7 @@ pub fn mol_plan(args: &MolArgs) -> Result<MolPlan> {
         };
         let draw = <DrawStyle as clap::ValueEnum>::from_str(style, true).map_err(|_| {
             crate::args::UsageError(format!(
-                "--rep {r:?}: {style:?} is not a style; use spacefill, ball-stick, licorice, tube or surface"
+                "--rep {r:?}: {style:?} is not a style; use spacefill, ball-stick, licorice, tube, cartoon or surface"
             ))
         })?;
         reps.push(texmap_md_scene::Representation {

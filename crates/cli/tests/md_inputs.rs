@@ -1570,3 +1570,51 @@ fn a_molecular_surface_is_drawn_as_the_reference_traces_it() {
         assert!(!out.exists());
     }
 }
+
+/// `--style cartoon` (md_scene::cartoon) on 3GWI chain A: helix ribbons, strand arrows and coil
+/// in VMD's structure colours, drawn as the reference ray tracer traces the same mesh; with a
+/// representation of balls and sticks beside it.
+#[test]
+fn a_cartoon_shows_dssps_structure_as_the_reference_traces_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let cartoon = ["--style", "cartoon", "--color-by", "structure"];
+    let reference = render_3gwi(
+        dir.path(),
+        "ref.png",
+        &[&cartoon[..], &["--method", "reference"]].concat(),
+    );
+    let ours = render_3gwi(dir.path(), "ours.png", &cartoon);
+    let d = mean_abs_diff(&ours, &reference);
+    eprintln!("mean |cartoon - reference| = {d:.3} per channel");
+    assert!(d < 1.0, "mean |cartoon - reference| = {d} per channel");
+    let img = image::open(&ours).unwrap().to_rgb8();
+    let count = |f: &dyn Fn(&image::Rgb<u8>) -> bool| img.pixels().filter(|p| f(p)).count();
+    let purple = count(&|p| p[0] > 60 && p[1] < 30 && p[2] > 60 && p[0].abs_diff(p[2]) < 20);
+    let yellow = count(&|p| p[0] > 90 && p[1] > 90 && p[2] < 30);
+    let white = count(&|p| p[0] > 90 && p[0] == p[1] && p[1] == p[2]);
+    eprintln!("purple {purple}, yellow {yellow}, white {white}");
+    assert!(
+        purple > 500 && yellow > 500 && white > 100,
+        "{purple} {yellow} {white}"
+    );
+    // A cartoon drawn thinner than the atoms' spheres: fewer pixels than spacefill.
+    let spheres = render_3gwi(dir.path(), "spheres.png", &[]);
+    assert!(lit(&ours) < lit(&spheres));
+    // Beside balls and sticks of residues 420-432 in orange.
+    let both = render_3gwi(
+        dir.path(),
+        "both.png",
+        &[
+            "--rep",
+            "protein=cartoon:structure",
+            "--rep",
+            "resid 420 to 432 and not name H*=ball-stick:#ff8000",
+        ],
+    );
+    let img = image::open(&both).unwrap().to_rgb8();
+    let orange = img
+        .pixels()
+        .filter(|p| p[0] > 180 && p[1] > 70 && p[1] < 150 && p[2] < 60)
+        .count();
+    assert!(orange > 100, "{orange} orange pixels");
+}

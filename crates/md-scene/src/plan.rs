@@ -54,7 +54,7 @@ use texmap_md_io::coordination::CoordinationError;
 use texmap_md_io::replicate::ReplicateError;
 use texmap_md_io::{Frame, Property, Selection, SelectionError, Topology, atom_element};
 
-use crate::surface::SurfaceAtoms;
+use crate::surface::{MolMesh, SurfaceAtoms};
 use crate::{ColorBy, SceneBuilder};
 
 /// Ball-and-stick atoms are this fraction of their Bondi (van der Waals) radii.
@@ -101,6 +101,10 @@ pub enum DrawStyle {
     /// Protein and nucleic-acid backbones as a smooth tube (see the module docs); other atoms
     /// (ligands, ions, water) as [`DrawStyle::Licorice`].
     Tube,
+    /// Protein backbones as a cartoon (VMD's NewCartoon: helices as ribbons, strands as arrows,
+    /// coil as a tube, [`crate::cartoon`]); nucleic acids as [`DrawStyle::Tube`] draws them,
+    /// other atoms (ligands, ions, water) as [`DrawStyle::Licorice`].
+    Cartoon,
     /// The selected atoms wrapped in a molecular surface (VMD's QuickSurf: a Gaussian density
     /// surface, [`crate::surface`]); they are not drawn as spheres, and nothing is bonded.
     Surface,
@@ -402,6 +406,8 @@ pub struct MolPlan {
     reps: Vec<Representation>,
     /// The last frame's atoms drawn as a surface ([`DrawStyle::Surface`]).
     surface: SurfaceAtoms,
+    /// The last frame's cartoon ([`DrawStyle::Cartoon`]).
+    cartoon: MolMesh,
 }
 
 impl MolPlan {
@@ -456,6 +462,7 @@ impl MolPlan {
             rule_kinds: Vec::new(),
             reps,
             surface: SurfaceAtoms::default(),
+            cartoon: MolMesh::default(),
         })
     }
 
@@ -767,10 +774,16 @@ impl MolPlan {
         // and put back, whatever the outcome.
         let reps = std::mem::take(&mut self.reps);
         self.surface.clear();
+        self.cartoon = MolMesh::default();
         let drawn = self.draw_reps(builder, frame, &reps, scene);
         self.reps = reps;
         builder.refresh_materials(scene);
         drawn
+    }
+
+    /// The last frame's cartoon ([`DrawStyle::Cartoon`]; empty without one).
+    pub fn cartoon_mesh(&self) -> &MolMesh {
+        &self.cartoon
     }
 
     /// Whether some representation draws a molecular surface ([`DrawStyle::Surface`]).
@@ -872,7 +885,7 @@ impl MolPlan {
                 }
                 scene.bond_radius = BALL_AND_STICK_BOND_RADIUS;
             }
-            DrawStyle::Licorice | DrawStyle::Tube => {
+            DrawStyle::Licorice | DrawStyle::Tube | DrawStyle::Cartoon => {
                 for r in &mut scene.radii {
                     *r = LICORICE_RADIUS;
                 }
@@ -891,6 +904,24 @@ impl MolPlan {
         let traces = match rep.draw {
             DrawStyle::Tube => {
                 let selected = mask.get_or_insert_with(|| vec![true; frame.n_atoms()]);
+                backbone_traces(frame, scene, selected)
+            }
+            DrawStyle::Cartoon => {
+                let selected = mask.get_or_insert_with(|| vec![true; frame.n_atoms()]);
+                crate::cartoon::append_cartoon(
+                    frame,
+                    &scene.centers,
+                    &scene.kinds,
+                    selected,
+                    &mut self.cartoon,
+                );
+                // Protein residues give way to the cartoon; nucleic acids are traced as tubes.
+                use texmap_md_io::select::PROTEIN_RESIDUES;
+                for (keep, res) in selected.iter_mut().zip(&frame.res_names) {
+                    if PROTEIN_RESIDUES.contains(&res.as_str()) {
+                        *keep = false;
+                    }
+                }
                 backbone_traces(frame, scene, selected)
             }
             _ => Vec::new(),
@@ -1045,12 +1076,7 @@ fn push_tube(scene: &mut SphereScene, trace: &[TracePoint]) {
         );
         for s in 0..TUBE_SUBDIVISIONS {
             let t = s as f32 / TUBE_SUBDIVISIONS as f32;
-            let (t2, t3) = (t * t, t * t * t);
-            let at = 0.5
-                * (2.0 * p1
-                    + (p2 - p0) * t
-                    + (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3) * t2
-                    + (3.0 * p1 - p0 - 3.0 * p2 + p3) * t3);
+            let (at, _) = crate::cartoon::catmull_rom(p0, p1, p2, p3, t);
             let kind = if t < 0.5 {
                 trace[i].kind
             } else {

@@ -1,7 +1,7 @@
 //! Molecular surfaces as VMD's QuickSurf draws them: one Gaussian per atom summed on a grid,
 //! the isosurface extracted by surface nets, every vertex then moved onto the exact isosurface
 //! and given its exact normal and the colour of the atom that dominates it; drawn by the
-//! rasteriser and composited by depth over the frame the sphere methods made ([`draw_surface`]).
+//! rasteriser and composited by depth over the frame the sphere methods made ([`draw_mesh`]).
 //!
 //! # The density
 //! `ρ(p) = Σ_i exp(−|p − c_i|² / (2 σ_i²))` with `σ_i = s · r_i / √(2 ln(1/ρ₀))`, so that the
@@ -13,7 +13,7 @@
 //!
 //! # Extraction
 //! The density is sampled on a grid of spacing `h` (at most [`MAX_VOXELS`] samples: a larger
-//! system is sampled coarser and [`MolSurface::spacing`] says how coarse), summed per atom over
+//! system is sampled coarser and [`MolMesh::spacing`] says how coarse), summed per atom over
 //! slabs of planes in parallel, each sample's sum in atom order, so the result is the same for
 //! any thread count. Surface nets (Gibson 1998): one vertex per grid cell whose corners straddle
 //! `ρ₀`, at the mean of its edges' linear crossings; one quad per grid edge that crosses, joining
@@ -30,12 +30,12 @@
 //!
 //! ```
 //! use glam::Vec3;
-//! use texmap_md_scene::surface::{MolSurface, SurfaceAtoms, SurfaceOptions};
+//! use texmap_md_scene::surface::{MolMesh, SurfaceAtoms, SurfaceOptions};
 //!
 //! // One carbon-sized atom: its surface is its sphere of radius 1.7 Å.
 //! let mut atoms = SurfaceAtoms::default();
 //! atoms.push(Vec3::new(1.0, 2.0, 3.0), 1.7, 0);
-//! let s = MolSurface::build(&atoms, &SurfaceOptions::default()).unwrap();
+//! let s = MolMesh::surface(&atoms, &SurfaceOptions::default()).unwrap();
 //! for p in &s.positions {
 //!     assert!(((*p - Vec3::new(1.0, 2.0, 3.0)).length() - 1.7).abs() < 1e-4);
 //! }
@@ -144,9 +144,10 @@ impl SurfaceAtoms {
     }
 }
 
-/// A closed triangle mesh around a set of atoms.
+/// A closed triangle mesh drawn over a frame by [`draw_mesh`]: a molecular surface
+/// ([`MolMesh::surface`]) or a protein cartoon ([`crate::cartoon`]).
 #[derive(Clone, Debug, Default, PartialEq)]
-pub struct MolSurface {
+pub struct MolMesh {
     pub positions: Vec<Vec3>,
     /// Unit outward normals, one per vertex.
     pub normals: Vec<Vec3>,
@@ -154,8 +155,8 @@ pub struct MolSurface {
     pub triangles: Vec<[u32; 3]>,
     /// The material index of each triangle.
     pub kinds: Vec<u16>,
-    /// The grid spacing used (Å): the one asked for, or coarser when the grid would have held
-    /// more than [`MAX_VOXELS`] samples.
+    /// A surface's grid spacing (Å): the one asked for, or coarser when the grid would have
+    /// held more than [`MAX_VOXELS`] samples (0 for a cartoon).
     pub spacing: f32,
 }
 
@@ -265,13 +266,13 @@ impl Lookup {
     }
 }
 
-impl MolSurface {
+impl MolMesh {
     /// The surface of `atoms` (atoms with a non-finite centre or a radius that is not positive
     /// and finite are left out; none left gives an empty mesh).
-    pub fn build(
+    pub fn surface(
         atoms: &SurfaceAtoms,
         options: &SurfaceOptions,
-    ) -> Result<MolSurface, SurfaceError> {
+    ) -> Result<MolMesh, SurfaceError> {
         let bad = |name, value, expected| {
             Err(SurfaceError::BadOption {
                 name,
@@ -311,7 +312,7 @@ impl MolSurface {
                 }
             })
             .collect();
-        let mut surface = MolSurface {
+        let mut surface = MolMesh {
             spacing: o.spacing,
             ..Default::default()
         };
@@ -611,8 +612,8 @@ fn density(blobs: &[Blob], origin: Vec3, h: f32, [nx, ny, nz]: [usize; 3]) -> Ve
 /// Draw `surface` as `camera` sees it, lit per pixel as the sphere methods light their atoms
 /// (`materials` indexed by the triangles' kinds; a kind past them is drawn grey), over `frame`:
 /// a surface pixel replaces the frame's where it is nearer. Returns the triangles drawn.
-pub fn draw_surface(
-    surface: &MolSurface,
+pub fn draw_mesh(
+    surface: &MolMesh,
     materials: &[Material],
     camera: &Camera,
     lighting: &Lighting,

@@ -8,7 +8,7 @@ use texmap_core::frame::Frame;
 use texmap_core::metrics::psnr;
 use texmap_core::shade::{Lighting, Material};
 use texmap_md_scene::surface::{
-    MAX_VOXELS, MolSurface, SurfaceAtoms, SurfaceError, SurfaceOptions, draw_surface,
+    MAX_VOXELS, MolMesh, SurfaceAtoms, SurfaceError, SurfaceOptions, draw_mesh,
 };
 use texmap_reftrace::{MeshShading, RenderOptions, SceneBuilder, SurfaceMaterial};
 
@@ -44,18 +44,18 @@ fn protein() -> (SurfaceAtoms, serde_json::Value) {
     (atoms, v)
 }
 
-fn build(atoms: &SurfaceAtoms, spacing: f32) -> MolSurface {
+fn build(atoms: &SurfaceAtoms, spacing: f32) -> MolMesh {
     let o = SurfaceOptions {
         spacing,
         ..Default::default()
     };
-    MolSurface::build(atoms, &o).unwrap()
+    MolMesh::surface(atoms, &o).unwrap()
 }
 
 /// Every directed edge as often as its reverse: closed (no border), and wound one way
 /// throughout. Returns how many edges are used more than once each way (surface nets join two
 /// sheets that pass through one cell at its vertex: the mesh is closed, not always a manifold).
-fn assert_closed_and_consistent(s: &MolSurface) -> usize {
+fn assert_closed_and_consistent(s: &MolMesh) -> usize {
     let mut edges: HashMap<(u32, u32), u32> = HashMap::new();
     for t in &s.triangles {
         for k in 0..3 {
@@ -194,7 +194,7 @@ fn bad_options_are_errors_and_a_huge_box_is_sampled_coarser() {
             radius_scale,
             isovalue,
         };
-        let e = MolSurface::build(&atoms, &o).unwrap_err();
+        let e = MolMesh::surface(&atoms, &o).unwrap_err();
         assert!(matches!(e, SurfaceError::BadOption { .. }), "{e}");
     }
     // Two atoms 2 km apart at 0.1 Å would need 10^21 samples: the spacing grows instead.
@@ -231,7 +231,7 @@ fn the_drawn_surface_matches_the_ray_traced_mesh() {
         .collect();
     let bg = [10, 20, 30, 255];
     let mut drawn = Frame::new(400, 300, bg);
-    let n = draw_surface(&s, &materials, &cam, &lighting, &mut drawn).unwrap();
+    let n = draw_mesh(&s, &materials, &cam, &lighting, &mut drawn).unwrap();
     assert!(n > 10_000);
     // The reference: each material's triangles as one mesh with vertex normals.
     let mut b = SceneBuilder::new();
@@ -271,6 +271,6 @@ fn the_drawn_surface_matches_the_ray_traced_mesh() {
     // Drawn over a nearer frame, the surface hides nothing in front of it.
     let mut front = Frame::new(400, 300, bg);
     front.depth.iter_mut().for_each(|d| *d = 1.0);
-    draw_surface(&s, &materials, &cam, &lighting, &mut front).unwrap();
+    draw_mesh(&s, &materials, &cam, &lighting, &mut front).unwrap();
     assert!(front.color.iter().all(|&c| c == bg));
 }

@@ -51,16 +51,19 @@ pub fn reference_scene_with_bonds(spheres: &SphereScene, bonds: bool) -> texmap_
     reference_builder(spheres, bonds).build()
 }
 
-/// [`reference_scene_with_bonds`] plus a molecular surface: each material's triangles as one
-/// mesh shaded by its vertex normals (the surface's exact normals), material id = kind, as
-/// `md_scene::surface::draw_surface` draws it; triangles of an unknown kind are left out.
-pub fn reference_scene_with_surface(
+/// [`reference_scene_with_bonds`] plus meshes (molecular surfaces, cartoons): each material's
+/// triangles of each mesh as one mesh shaded by its vertex normals, material id = kind, as
+/// `md_scene::surface::draw_mesh` draws them; triangles of an unknown kind are left out.
+pub fn reference_scene_with_meshes(
     spheres: &SphereScene,
     bonds: bool,
-    surface: &texmap_md_scene::surface::MolSurface,
+    meshes: &[&texmap_md_scene::surface::MolMesh],
 ) -> texmap_reftrace::Scene {
     let mut b = reference_builder(spheres, bonds);
-    for kind in 0..spheres.materials.len() {
+    for (surface, kind) in meshes
+        .iter()
+        .flat_map(|m| (0..spheres.materials.len()).map(move |k| (*m, k)))
+    {
         let indices: Vec<u32> = surface
             .triangles
             .iter()
