@@ -809,7 +809,7 @@ fn representations_combine_styles_in_one_image() {
     );
     assert!(two != one);
     for bad in [
-        vec!["--rep", "protein=cartoon"],
+        vec!["--rep", "protein=ribbons"],
         vec!["--rep", "protein"],
         vec!["--rep", "protein=tube", "--select", "protein"],
         vec!["--rep", "protein=tube", "--style", "licorice"],

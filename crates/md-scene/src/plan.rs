@@ -35,7 +35,10 @@
 //! 6. the selection (and the slice): the selected atoms are kept in their order and the bonds between two kept
 //!    atoms are renumbered to the kept atoms' indices; bonds to a dropped atom are dropped;
 //! 7. for [`DrawStyle::Tube`], the selected atoms of protein and nucleic residues give way to
-//!    the backbone tube through their CA (P) atoms, appended as spheres joined by bonds.
+//!    the backbone tube through their CA (P) atoms, appended as spheres joined by bonds; for
+//!    [`DrawStyle::Cartoon`], protein residues give way to the cartoon mesh
+//!    ([`MolPlan::cartoon_mesh`]) and nucleic ones to the tube; for [`DrawStyle::Surface`], the
+//!    selected atoms leave the scene for [`MolPlan::surface_atoms`].
 //!
 //! # The tube
 //! VMD's Tube representation: per chain, a uniform Catmull-Rom spline through the consecutive
