@@ -430,9 +430,9 @@ fn render(a: &RenderArgs) -> Result<()> {
     let mut builder = crate::scene::scene_builder(&a.style)?;
     let mut plan = crate::scene::mol_plan(&a.mol)?;
     let surface_options = crate::scene::surface_options(&a.mol)?;
-    if plan.draws_surface() && quality.is_some() {
+    if plan.draws_meshes() && quality.is_some() {
         return usage(
-            "the surface style is drawn without --quality's anti-aliasing, ambient occlusion and shadows; drop --quality and its options, or draw the surface's atoms in another style",
+            "the cartoon and surface styles are drawn without --quality's anti-aliasing, ambient occlusion and shadows; drop --quality and its options, or draw those atoms in another style",
         );
     }
     let mut surface = texmap_md_scene::surface::MolMesh::default();

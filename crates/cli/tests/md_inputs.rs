@@ -1560,6 +1560,7 @@ fn a_molecular_surface_is_drawn_as_the_reference_traces_it() {
         &["--style", "surface", "--surface-spacing", "0"][..],
         &["--style", "surface", "--surface-scale", "nan"],
         &["--style", "surface", "--quality", "good"],
+        &["--style", "cartoon", "--ao", "8"],
         &["--rep", "protein=surfaces"],
     ] {
         let out = dir.path().join("bad.png");

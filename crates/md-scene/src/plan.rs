@@ -794,6 +794,13 @@ impl MolPlan {
         self.reps.iter().any(|r| r.draw == DrawStyle::Surface)
     }
 
+    /// Whether some representation draws a mesh (a surface or a cartoon) rather than spheres.
+    pub fn draws_meshes(&self) -> bool {
+        self.reps
+            .iter()
+            .any(|r| matches!(r.draw, DrawStyle::Surface | DrawStyle::Cartoon))
+    }
+
     /// The atoms the last frame built draws as a molecular surface ([`DrawStyle::Surface`]),
     /// at their radii, with their materials (indices into the scene's).
     pub fn surface_atoms(&self) -> &SurfaceAtoms {
