@@ -81,7 +81,7 @@ fn bench(c: &mut Criterion) {
             |b| {
                 b.iter(|| {
                     image.depth.fill(f32::INFINITY);
-                    draw_mesh(&surface, &materials, &camera, &lighting, &mut image).unwrap()
+                    draw_mesh(&surface, &materials, &camera, &lighting, 1.0, &mut image).unwrap()
                 })
             },
         );

@@ -735,6 +735,11 @@ pub struct MolArgs {
     /// radius (1: the van der Waals surface, smoothed where atoms overlap; 1.4 is fuller).
     #[arg(long, value_name = "S", default_value_t = 1.0)]
     pub surface_scale: f32,
+    /// The surface style's opacity, 0.05 to 1: below 1 the surface's front is laid over what
+    /// lies behind it (mixed in linear light), so a cartoon or ligand inside shows through, as
+    /// VMD's Transparent material (one layer: the surface's back is not seen through its front).
+    #[arg(long, value_name = "A", default_value_t = 1.0)]
+    pub surface_opacity: f32,
     /// Periodic boundaries: none, wrap (atoms into the box), unwrap (molecules whole).
     #[arg(long, value_enum, default_value_t = PbcArg::None)]
     pub pbc: PbcArg,

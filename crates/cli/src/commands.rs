@@ -430,6 +430,12 @@ fn render(a: &RenderArgs) -> Result<()> {
     let mut builder = crate::scene::scene_builder(&a.style)?;
     let mut plan = crate::scene::mol_plan(&a.mol)?;
     let surface_options = crate::scene::surface_options(&a.mol)?;
+    let surface_opacity = a.mol.surface_opacity;
+    if !(surface_opacity.is_finite() && (0.05..=1.0).contains(&surface_opacity)) {
+        return usage(format!(
+            "--surface-opacity {surface_opacity}: expected an opacity from 0.05 to 1"
+        ));
+    }
     if plan.draws_meshes() && quality.is_some() {
         return usage(
             "the cartoon and surface styles are drawn without --quality's anti-aliasing, ambient occlusion and shadows; drop --quality and its options, or draw those atoms in another style",
@@ -594,31 +600,48 @@ fn render(a: &RenderArgs) -> Result<()> {
                 o.draw_bonds = plan.draws_bonds();
                 let mut r = renderer.render(&scene, &cam, &o);
                 skipped_total += r.stats.skipped_invalid;
-                for mesh in [&surface, plan.cartoon_mesh()] {
+                // The surface last: a transparent one shows what is under it.
+                for (mesh, opacity) in [(plan.cartoon_mesh(), 1.0), (&surface, surface_opacity)] {
                     texmap_md_scene::surface::draw_mesh(
                         mesh,
                         &scene.materials,
                         &cam,
                         &lighting,
+                        opacity,
                         &mut r.frame,
                     )
                     .map_err(|e| fail(e.into(), &written))?;
                 }
                 r.frame
             }
-            (None, None) => harness::render_reference(
-                &harness::reference_scene_with_meshes(
-                    &scene,
-                    plan.draws_bonds(),
-                    &[&surface, plan.cartoon_mesh()],
-                ),
-                &harness::reference_materials(&scene),
-                &cam,
-                lighting,
-                background,
-                1,
-            )
-            .map_err(|e| fail(e.into(), &written))?,
+            (None, None) => {
+                // A transparent surface is traced on its own and laid over the rest as the
+                // methods lay it ([`texmap_md_scene::surface::composite`]).
+                let opaque: &[&texmap_md_scene::surface::MolMesh] = if surface_opacity < 1.0 {
+                    &[plan.cartoon_mesh()]
+                } else {
+                    &[&surface, plan.cartoon_mesh()]
+                };
+                let trace = |spheres: &SphereScene, bonds, meshes| {
+                    harness::render_reference(
+                        &harness::reference_scene_with_meshes(spheres, bonds, meshes),
+                        &harness::reference_materials(&scene),
+                        &cam,
+                        lighting,
+                        background,
+                        1,
+                    )
+                };
+                let mut base = trace(&scene, plan.draws_bonds(), opaque)
+                    .map_err(|e| fail(e.into(), &written))?;
+                if surface_opacity < 1.0 {
+                    let alone = SphereScene::new(scene.materials.clone());
+                    let layer =
+                        trace(&alone, false, &[&surface]).map_err(|e| fail(e.into(), &written))?;
+                    texmap_md_scene::surface::composite(&mut base, &layer, surface_opacity);
+                }
+                base
+            }
         };
         let mut out = out;
         if plan.uses_builder_coloring() {

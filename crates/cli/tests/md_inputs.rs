@@ -1619,3 +1619,80 @@ fn a_cartoon_shows_dssps_structure_as_the_reference_traces_it() {
         .count();
     assert!(orange > 100, "{orange} orange pixels");
 }
+
+/// `--surface-opacity`: a transparent surface (scale 1.3, so it encloses every atom's sphere)
+/// over spacefill is, pixel by pixel, the opaque surface's colour mixed in linear light with
+/// the spheres' at that opacity, and the spheres alone where it does not reach; the reference
+/// lays its traced surface the same way. One camera for all (a keyframe on the molecule).
+#[test]
+fn a_transparent_surface_mixes_with_what_is_behind_it() {
+    use texmap_core::color::{linear_to_srgb8, srgb8_to_linear_rgb};
+    let dir = tempfile::tempdir().unwrap();
+    let input = data("dssp/3gwiA.pdb.gz");
+    let mut frame = texmap_md_io::Frame::new();
+    texmap_md_io::Trajectory::open(&input)
+        .unwrap()
+        .read_frame(0, &mut frame)
+        .unwrap();
+    let n = frame.n_atoms() as f32;
+    let c = frame.positions.iter().fold([0.0f32; 3], |s, p| {
+        [s[0] + p[0] / n, s[1] + p[1] / n, s[2] + p[2] / n]
+    });
+    let keys = dir.path().join("camera.csv");
+    std::fs::write(
+        &keys,
+        format!(
+            "0 {} {} {} {} {} {}\n",
+            c[0],
+            c[1],
+            c[2] + 90.0,
+            c[0],
+            c[1],
+            c[2]
+        ),
+    )
+    .unwrap();
+    let keys = keys.to_str().unwrap().to_string();
+    for method in ["raycast", "reference"] {
+        let render = |name: &str, extra: &[&str]| {
+            let mut args = vec![
+                input.as_str(),
+                "--size",
+                "160x120",
+                "--method",
+                method,
+                "--keyframes",
+                &keys,
+            ];
+            args.extend(["--surface-scale", "1.3"]);
+            args.extend(extra);
+            render_rgb(dir.path(), &format!("{method}-{name}"), &args)
+        };
+        let both = ["--rep", "protein=surface", "--rep", "protein=spacefill"];
+        let opaque = render("opaque.png", &both);
+        let spheres = render("spheres.png", &["--style", "spacefill"]);
+        let mixed = render(
+            "mixed.png",
+            &[&both[..], &["--surface-opacity", "0.4"]].concat(),
+        );
+        let (mut worst, mut covered) = (0u8, 0);
+        for ((o, s), m) in opaque.pixels().zip(spheres.pixels()).zip(mixed.pixels()) {
+            let expected = if o.0 == [0, 0, 0] {
+                s.0
+            } else {
+                covered += 1;
+                let lin = |p: &image::Rgb<u8>| srgb8_to_linear_rgb([p[0], p[1], p[2], 255]);
+                let e = linear_to_srgb8(lin(o) * 0.4 + lin(s) * 0.6, 255);
+                [e[0], e[1], e[2]]
+            };
+            for k in 0..3 {
+                worst = worst.max(expected[k].abs_diff(m[k]));
+            }
+        }
+        eprintln!("{method}: {covered} surface pixels, worst {worst} codes");
+        assert!(
+            covered > 2000 && worst <= 1,
+            "{method}: {covered} pixels, worst {worst}"
+        );
+    }
+}

@@ -47,6 +47,7 @@
 use glam::Vec3;
 use rayon::prelude::*;
 use texmap_core::camera::Camera;
+use texmap_core::color::{linear_to_srgb8, srgb8_to_linear_rgb};
 use texmap_core::frame::Frame;
 use texmap_core::shade::{Lighting, Material};
 use texmap_raster::{DrawState, Framebuffer, Mesh, RasterError, Shading};
@@ -609,14 +610,15 @@ fn density(blobs: &[Blob], origin: Vec3, h: f32, [nx, ny, nz]: [usize; 3]) -> Ve
     rho
 }
 
-/// Draw `surface` as `camera` sees it, lit per pixel as the sphere methods light their atoms
-/// (`materials` indexed by the triangles' kinds; a kind past them is drawn grey), over `frame`:
-/// a surface pixel replaces the frame's where it is nearer. Returns the triangles drawn.
+/// Draw `mesh` as `camera` sees it, lit per pixel as the sphere methods light their atoms
+/// (`materials` indexed by the triangles' kinds; a kind past them is drawn grey), over `frame`
+/// where it is nearer, at `opacity` ([`composite`]). Returns the triangles drawn.
 pub fn draw_mesh(
     surface: &MolMesh,
     materials: &[Material],
     camera: &Camera,
     lighting: &Lighting,
+    opacity: f32,
     frame: &mut Frame,
 ) -> Result<usize, RasterError> {
     if surface.triangles.is_empty() {
@@ -659,15 +661,33 @@ pub fn draw_mesh(
             .draw_mesh(camera, &mesh, &shading, &DrawState::default())?
             .binned;
     }
-    let drawn_frame = fb.to_frame();
-    if frame.width() != drawn_frame.width() || frame.height() != drawn_frame.height() {
+    if frame.width() != camera.width() || frame.height() != camera.height() {
         *frame = Frame::new(camera.width(), camera.height(), [0, 0, 0, 255]);
     }
-    for (i, &d) in drawn_frame.depth.iter().enumerate() {
+    composite(frame, &fb.to_frame(), opacity);
+    Ok(drawn)
+}
+
+/// `layer` over `frame` where it is nearer: replacing colour and depth at `opacity` ≥ 1, else
+/// mixing the colours in linear light, `opacity · layer + (1 − opacity) · frame`, and keeping the
+/// frame's depth (what shows through stays the depth of record). One layer: a transparent
+/// closed surface shows its front, not its back. Frames of other sizes are left as they are.
+pub fn composite(frame: &mut Frame, layer: &Frame, opacity: f32) {
+    if frame.width() != layer.width() || frame.height() != layer.height() {
+        return;
+    }
+    let a = opacity.clamp(0.0, 1.0);
+    for (i, &d) in layer.depth.iter().enumerate() {
         if d < frame.depth[i] {
-            frame.depth[i] = d;
-            frame.color[i] = drawn_frame.color[i];
+            if a >= 1.0 {
+                frame.depth[i] = d;
+                frame.color[i] = layer.color[i];
+            } else {
+                let over = srgb8_to_linear_rgb(layer.color[i]);
+                let under = srgb8_to_linear_rgb(frame.color[i]);
+                let alpha = frame.color[i][3];
+                frame.color[i] = linear_to_srgb8(over * a + under * (1.0 - a), alpha);
+            }
         }
     }
-    Ok(drawn)
 }

@@ -231,7 +231,7 @@ fn the_drawn_surface_matches_the_ray_traced_mesh() {
         .collect();
     let bg = [10, 20, 30, 255];
     let mut drawn = Frame::new(400, 300, bg);
-    let n = draw_mesh(&s, &materials, &cam, &lighting, &mut drawn).unwrap();
+    let n = draw_mesh(&s, &materials, &cam, &lighting, 1.0, &mut drawn).unwrap();
     assert!(n > 10_000);
     // The reference: each material's triangles as one mesh with vertex normals.
     let mut b = SceneBuilder::new();
@@ -271,6 +271,6 @@ fn the_drawn_surface_matches_the_ray_traced_mesh() {
     // Drawn over a nearer frame, the surface hides nothing in front of it.
     let mut front = Frame::new(400, 300, bg);
     front.depth.iter_mut().for_each(|d| *d = 1.0);
-    draw_mesh(&s, &materials, &cam, &lighting, &mut front).unwrap();
+    draw_mesh(&s, &materials, &cam, &lighting, 1.0, &mut front).unwrap();
     assert!(front.color.iter().all(|&c| c == bg));
 }
