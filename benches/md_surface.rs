@@ -1,7 +1,8 @@
 //! Molecular surfaces (`md_scene::surface`, `texmap render --style surface`): wwPDB 3E8M chain A
 //! (2,646 atoms, md-io's test data) with van der Waals radii, and 27 copies of it on a 3x3x3
 //! lattice 70 Å apart (71,442 atoms): the surface built at 0.5 Å (density, surface nets, Newton
-//! projection) and drawn over a cleared 1920x1080 frame. A movie pays both per frame.
+//! projection) and drawn over a cleared 1920x1080 frame; the chain's cartoon (DSSP, spline,
+//! sweep). A movie pays them per frame.
 //!
 //! `cargo bench --bench md_surface -- --warm-up-time 2 --measurement-time 10`
 //! (test mode, `cargo test --bench md_surface`, builds the one chain at 1.0 Å and 320x180.)
@@ -12,6 +13,7 @@ use texmap::core::camera::Camera;
 use texmap::core::frame::Frame as Image;
 use texmap::core::shade::{Lighting, Material};
 use texmap::md_io::{AtomStyle, Frame, Trajectory};
+use texmap::md_scene::cartoon::append_cartoon;
 use texmap::md_scene::surface::{MolMesh, SurfaceAtoms, SurfaceOptions, draw_mesh};
 
 fn bench(c: &mut Criterion) {
@@ -47,6 +49,16 @@ fn bench(c: &mut Criterion) {
     };
     let mut g = c.benchmark_group("md_surface");
     g.sample_size(10);
+    // The chain's cartoon (DSSP included, as every frame pays it).
+    let centers: Vec<Vec3> = md.positions.iter().map(|p| Vec3::from(*p)).collect();
+    let (kinds, selected) = (vec![0u16; md.n_atoms()], vec![true; md.n_atoms()]);
+    g.bench_function("cartoon_3e8m", |b| {
+        b.iter(|| {
+            let mut mesh = MolMesh::default();
+            append_cartoon(&md, &centers, &kinds, &selected, &mut mesh);
+            mesh
+        })
+    });
     let mut cases = vec![("3e8m", &chain)];
     if !test_mode {
         cases.push(("3e8m_x27", &lattice));
