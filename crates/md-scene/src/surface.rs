@@ -508,6 +508,16 @@ impl MolMesh {
             .collect();
     }
 
+    /// The triangles grouped by kind, `kinds + 1` groups in kind order (the last holds every
+    /// kind from `kinds` up), each in mesh order.
+    pub fn by_kind(&self, kinds: usize) -> Vec<Vec<[u32; 3]>> {
+        let mut groups = vec![Vec::new(); kinds + 1];
+        for (t, &k) in self.triangles.iter().zip(&self.kinds) {
+            groups[(k as usize).min(kinds)].push(*t);
+        }
+        groups
+    }
+
     /// The enclosed volume (Å³), by the divergence theorem over the triangles: positive when
     /// they are wound counter-clockwise seen from outside.
     pub fn volume(&self) -> f64 {
@@ -626,25 +636,9 @@ pub fn draw_mesh(
     }
     let mut fb = Framebuffer::new(camera.width(), camera.height())?;
     fb.clear([0, 0, 0, 0]);
-    // The triangles grouped by kind (a counting sort: groups in kind order, each in mesh order).
-    let kinds = materials.len() + 1;
-    let kind = |k: u16| (k as usize).min(materials.len());
-    let mut start = vec![0usize; kinds + 1];
-    for &k in &surface.kinds {
-        start[kind(k) + 1] += 1;
-    }
-    for k in 0..kinds {
-        start[k + 1] += start[k];
-    }
-    let mut sorted = vec![[0u32; 3]; surface.triangles.len()];
-    let mut fill = start.clone();
-    for (t, &k) in surface.triangles.iter().zip(&surface.kinds) {
-        sorted[fill[kind(k)]] = *t;
-        fill[kind(k)] += 1;
-    }
+    let groups = surface.by_kind(materials.len());
     let mut drawn = 0;
-    for k in 0..kinds {
-        let group = &sorted[start[k]..start[k + 1]];
+    for (k, group) in groups.iter().enumerate() {
         if group.is_empty() {
             continue;
         }

@@ -60,29 +60,22 @@ pub fn reference_scene_with_meshes(
     meshes: &[&texmap_md_scene::surface::MolMesh],
 ) -> texmap_reftrace::Scene {
     let mut b = reference_builder(spheres, bonds);
-    for (surface, kind) in meshes
-        .iter()
-        .flat_map(|m| (0..spheres.materials.len()).map(move |k| (*m, k)))
-    {
-        let indices: Vec<u32> = surface
-            .triangles
-            .iter()
-            .zip(&surface.kinds)
-            .filter(|(_, k)| **k as usize == kind)
-            .flat_map(|(t, _)| *t)
-            .collect();
-        if indices.is_empty() {
-            continue;
+    for mesh in meshes {
+        let groups = mesh.by_kind(spheres.materials.len());
+        for (kind, group) in groups.iter().enumerate().take(spheres.materials.len()) {
+            if group.is_empty() {
+                continue;
+            }
+            b.add_mesh_shaded(
+                &mesh.positions,
+                group.as_flattened(),
+                None,
+                Some(&mesh.normals),
+                texmap_reftrace::MeshShading::VertexNormals,
+                kind as u32,
+            )
+            .expect("a mesh's indices and normals match its vertices");
         }
-        b.add_mesh_shaded(
-            &surface.positions,
-            &indices,
-            None,
-            Some(&surface.normals),
-            texmap_reftrace::MeshShading::VertexNormals,
-            kind as u32,
-        )
-        .expect("a surface's indices and normals match its vertices");
     }
     b.build()
 }
