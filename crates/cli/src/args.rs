@@ -473,6 +473,11 @@ pub struct RenderArgs {
     /// Also write depth as a one-channel EXR beside each PNG (same name, .exr).
     #[arg(long)]
     pub depth: bool,
+    /// Also write the cartoon and surface of the first rendered frame as a mesh file, for
+    /// Blender, ChimeraX or a 3D printer's slicer: .glb (binary glTF 2.0) or .obj (with its
+    /// .mtl and .png beside it); coloured as drawn (a palette texture), 1 unit = 1 Å.
+    #[arg(long, value_name = "FILE.glb|FILE.obj")]
+    pub export_mesh: Option<PathBuf>,
     /// A caption at the top left of every image, on a light backdrop, for movies:
     /// 't = {ns} ns'. {time} is the frame's time in ps, {ns} in ns, {step} its MD step,
     /// {frame} its index in the file; a file whose frames carry no time (XYZ, PDB) takes

@@ -452,6 +452,28 @@ fn render(a: &RenderArgs) -> Result<()> {
     let mut skipped_total = 0usize;
     // Frames whose image is on disk, for the error if a later frame fails.
     let mut written: Vec<PathBuf> = Vec::new();
+    let export_glb = match &a.export_mesh {
+        None => false,
+        Some(p) => match p
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase)
+        {
+            Some(e) if e == "glb" => true,
+            Some(e) if e == "obj" => false,
+            _ => {
+                return usage(format!(
+                    "--export-mesh {}: expected a .glb or .obj file name",
+                    p.display()
+                ));
+            }
+        },
+    };
+    if a.export_mesh.is_some() && !plan.draws_meshes() {
+        return usage(
+            "--export-mesh writes the cartoon and surface styles' meshes: draw some atoms with --style cartoon or surface (or a --rep of them)",
+        );
+    }
     for (k, &f) in frames.iter().enumerate() {
         // A part renders its own frames; the first frame of the whole render is read by every
         // part, for the camera.
@@ -644,6 +666,25 @@ fn render(a: &RenderArgs) -> Result<()> {
             }
         };
         let mut out = out;
+        // The first frame of the render (with --shard, the part that draws it writes it).
+        if let Some(path) = &a.export_mesh
+            && k == 0
+        {
+            let mut all = plan.cartoon_mesh().clone();
+            all.append(&surface);
+            if all.triangles.is_empty() {
+                let e =
+                    anyhow::anyhow!("--export-mesh: frame {f} has no cartoon or surface to write");
+                return Err(fail(e, &written));
+            }
+            let (mesh, palette) = all.to_textured(&scene.materials);
+            let result = if export_glb {
+                texmap_mesh::write_glb(path, &mesh, Some(&palette))
+            } else {
+                texmap_mesh::write_obj(path, &mesh, Some(&palette))
+            };
+            result.map_err(|e| fail(e.into(), &written))?;
+        }
         if plan.uses_builder_coloring() {
             crate::scene::draw_color_bar(&builder, &a.style, &mut out);
         }

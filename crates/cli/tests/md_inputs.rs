@@ -1696,3 +1696,92 @@ fn a_transparent_surface_mixes_with_what_is_behind_it() {
         );
     }
 }
+
+/// `--export-mesh`: 3GWI's cartoon and a surface as binary glTF, read back by the gltf crate
+/// (triangles, positions inside the molecule's reach, each vertex's uv on a palette texel of a
+/// colour drawn) and checked by the Khronos glTF-Validator when installed; as OBJ with its MTL
+/// and PNG; refused without a mesh style or with another extension.
+#[test]
+fn cartoon_and_surface_export_as_gltf_and_obj() {
+    let dir = tempfile::tempdir().unwrap();
+    let reps = [
+        "--rep",
+        "protein=cartoon:structure",
+        "--rep",
+        "resid 420 to 432=surface",
+    ];
+    let glb = dir.path().join("mol.glb");
+    let args = [&reps[..], &["--export-mesh", glb.to_str().unwrap()]].concat();
+    render_3gwi(dir.path(), "m.png", &args);
+    let (doc, buffers, images) = gltf::import(&glb).unwrap();
+    let prim = doc.meshes().next().unwrap().primitives().next().unwrap();
+    let reader = prim.reader(|b| Some(&buffers[b.index()]));
+    let positions: Vec<[f32; 3]> = reader.read_positions().unwrap().collect();
+    let uvs: Vec<[f32; 2]> = reader.read_tex_coords(0).unwrap().into_f32().collect();
+    let triangles = reader.read_indices().unwrap().into_u32().count() / 3;
+    assert!(triangles > 10_000, "{triangles} triangles");
+    // In the molecule's own coordinates (Å): every vertex within 4 Å of some atom (an
+    // arrowhead's corner is 1.5 Å from the CA spline, itself up to ~1.9 Å from the nearest
+    // atom midway between CAs; the surface lies at the atoms' radii), where the molecule spans
+    // some 50 Å.
+    let mut frame = texmap_md_io::Frame::new();
+    texmap_md_io::Trajectory::open(data("dssp/3gwiA.pdb.gz"))
+        .unwrap()
+        .read_frame(0, &mut frame)
+        .unwrap();
+    for p in positions.iter().step_by(97) {
+        let near = frame
+            .positions
+            .iter()
+            .map(|a| (0..3).map(|k| (a[k] - p[k]).powi(2)).sum::<f32>().sqrt());
+        let d = near.fold(f32::MAX, f32::min);
+        assert!(d < 4.0, "vertex {p:?} is {d} Å from every atom");
+    }
+    // The palette: each uv at a texel centre of one row; helix purple and strand yellow in it.
+    let img = &images[0];
+    assert_eq!(img.height, 1);
+    for uv in &uvs {
+        let x = uv[0] * img.width as f32 - 0.5;
+        assert!(
+            (x - x.round()).abs() < 1e-3 && (uv[1] - 0.5).abs() < 1e-6,
+            "{uv:?}"
+        );
+    }
+    let texels: Vec<&[u8]> = img.pixels.chunks(4).collect();
+    assert!(
+        texels.iter().any(|t| t[0] > 150 && t[1] < 30 && t[2] > 150),
+        "no purple"
+    );
+    assert!(
+        texels.iter().any(|t| t[0] > 240 && t[1] > 240 && t[2] < 30),
+        "no yellow"
+    );
+    if let Some(reports) = common::gltf_validator_reports(std::slice::from_ref(&glb)) {
+        assert_eq!(reports[0]["errors"], 0, "{}", reports[0]);
+        assert_eq!(reports[0]["warnings"], 0, "{}", reports[0]);
+        eprintln!("glTF-Validator: {}", reports[0]);
+    }
+    // OBJ: the same triangles, with the MTL and the palette PNG beside it.
+    let obj = dir.path().join("mol.obj");
+    let args = [&reps[..], &["--export-mesh", obj.to_str().unwrap()]].concat();
+    render_3gwi(dir.path(), "o.png", &args);
+    let meshes = texmap_mesh::read_obj(&obj).unwrap();
+    assert_eq!(
+        meshes.iter().map(|m| m.triangles.len()).sum::<usize>(),
+        triangles
+    );
+    assert!(dir.path().join("mol.mtl").is_file() && dir.path().join("mol.png").is_file());
+    // Refusals: exit 2, nothing written.
+    let input = data("dssp/3gwiA.pdb.gz");
+    let stl = dir.path().join("mol.stl");
+    let spheres = dir.path().join("spheres.glb");
+    for (bad, file) in [(&reps[..], &stl), (&["--style", "spacefill"][..], &spheres)] {
+        let out = dir.path().join("bad.png");
+        let mut args = vec!["render", input.as_str(), "-o", out.to_str().unwrap()];
+        args.extend(bad);
+        args.extend(["--export-mesh", file.to_str().unwrap()]);
+        let o = texmap(&args);
+        assert_eq!(o.status.code(), Some(2), "{bad:?}: {}", stderr(&o));
+        assert!(!out.exists() && !file.exists());
+    }
+}

@@ -515,22 +515,6 @@ fn export_without_a_photo_embeds_the_shaded_relief() {
 /// shaded-relief one and a 3D Tiles tile. Without node or the validator the test says SKIPPED.
 #[test]
 fn glb_exports_pass_the_khronos_gltf_validator() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-    let validator = std::env::var_os("TEXMAP_GLTF_VALIDATOR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| root.join("target/gltf-validator"));
-    let node_ok = std::process::Command::new("node")
-        .arg("--version")
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if !node_ok || !validator.join("node_modules/gltf-validator").is_dir() {
-        eprintln!(
-            "SKIPPED the glTF-Validator check: node or {} is missing (npm install --prefix {} gltf-validator)",
-            validator.join("node_modules/gltf-validator").display(),
-            validator.display()
-        );
-        return;
-    }
     let dir = tempfile::tempdir().unwrap();
     let photo_db = small_db(dir.path());
     let relief_db = relief_db(dir.path(), "relief.db");
@@ -561,18 +545,9 @@ fn glb_exports_pass_the_khronos_gltf_validator() {
         "-q",
     ]));
     files.push(tiles.join("tiles/0/0_0.glb"));
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/gltf_validate.cjs");
-    let o = std::process::Command::new("node")
-        .arg(&script)
-        .arg(&validator)
-        .args(&files)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let lines: Vec<serde_json::Value> = String::from_utf8_lossy(&o.stdout)
-        .lines()
-        .map(|l| serde_json::from_str(l).unwrap())
-        .collect();
+    let Some(lines) = common::gltf_validator_reports(&files) else {
+        return;
+    };
     assert_eq!(lines.len(), 3);
     for r in &lines {
         assert_eq!(r["errors"], 0, "{r}");

@@ -50,6 +50,7 @@ use texmap_core::camera::Camera;
 use texmap_core::color::{linear_to_srgb8, srgb8_to_linear_rgb};
 use texmap_core::frame::Frame;
 use texmap_core::shade::{Lighting, Material};
+use texmap_mesh::TriMesh;
 use texmap_raster::{DrawState, Framebuffer, Mesh, RasterError, Shading};
 
 /// A Gaussian is cut off where it falls below this fraction of its peak.
@@ -193,17 +194,18 @@ const REACH: i64 = 2;
 impl Lookup {
     fn new(blobs: Vec<Blob>, lo: Vec3, hi: Vec3) -> Lookup {
         let cut = blobs.iter().map(|b| b.cut).fold(0.0f32, f32::max).max(1e-3);
-        let mut cell = cut / REACH as f32;
-        // At most ~2M cells: a sparse system's cells grow instead.
-        let extent = (hi - lo).max(Vec3::splat(cell));
+        let mut cell = (cut / REACH as f32) as f64;
+        // At most ~2M cells: a sparse system's cells grow instead (in f64: the extent of atoms
+        // near ±f32::MAX does not fit an f32).
+        let extent = (hi.as_dvec3() - lo.as_dvec3()).max(glam::DVec3::splat(cell));
         let dims = loop {
-            let d = (extent / cell).ceil().as_uvec3().max(glam::UVec3::ONE);
-            let d = [d.x as usize, d.y as usize, d.z as usize];
-            if d[0].saturating_mul(d[1]).saturating_mul(d[2]) <= 1 << 21 {
-                break d;
+            let d = (extent / cell).ceil().max(glam::DVec3::ONE);
+            if d.x * d.y * d.z <= (1 << 21) as f64 {
+                break [d.x as usize, d.y as usize, d.z as usize];
             }
             cell *= 2.0;
         };
+        let cell = cell as f32;
         let n = dims[0] * dims[1] * dims[2];
         let cell_of = |p: Vec3| -> usize {
             let q = ((p - lo) / cell).floor();
@@ -300,7 +302,9 @@ impl MolMesh {
         let blobs: Vec<Blob> = (0..n)
             .filter(|&i| {
                 let r = atoms.radii[i] * o.radius_scale;
-                atoms.centers[i].is_finite() && r.is_finite() && r > 0.0
+                // The cut-off box must be finite too (no radius or position near f32::MAX).
+                let reach = atoms.centers[i].abs().max_element() + CUT_SIGMAS * r;
+                r.is_finite() && r > 0.0 && reach.is_finite()
             })
             .map(|i| {
                 let sigma = atoms.radii[i] * o.radius_scale / k;
@@ -326,7 +330,7 @@ impl MolMesh {
         );
         // The grid: one spacing of padding beyond every cut-off, so no crossing on its border.
         let mut h = o.spacing as f64;
-        let extent = (hi - lo).as_dvec3();
+        let extent = hi.as_dvec3() - lo.as_dvec3();
         let dims = loop {
             let d = (extent / h).ceil() + 3.0;
             let count = d.x * d.y * d.z;
@@ -516,6 +520,53 @@ impl MolMesh {
             groups[(k as usize).min(kinds)].push(*t);
         }
         groups
+    }
+
+    /// Appends `other`'s vertices and triangles (its indices shifted past ours).
+    pub fn append(&mut self, other: &MolMesh) {
+        let base = self.positions.len() as u32;
+        self.positions.extend_from_slice(&other.positions);
+        self.normals.extend_from_slice(&other.normals);
+        self.triangles
+            .extend(other.triangles.iter().map(|t| t.map(|i| i + base)));
+        self.kinds.extend_from_slice(&other.kinds);
+    }
+
+    /// The mesh for a file (glTF, OBJ: `texmap_mesh::write_glb`, `write_obj`), coloured through
+    /// a texture: a one-row palette of the materials' base colours in sRGB (`materials.len() + 1`
+    /// texels, the last grey for kinds past them), each triangle's vertices copied per kind with
+    /// the uv of their kind's texel centre, which any filtering samples exactly. Positions in Å.
+    pub fn to_textured(&self, materials: &[Material]) -> (TriMesh, image::RgbaImage) {
+        let n = materials.len() + 1;
+        let mut palette = image::RgbaImage::new(n as u32, 1);
+        for (k, px) in palette.pixels_mut().enumerate() {
+            let c = materials.get(k).map_or(Vec3::splat(0.6), |m| m.base_color);
+            *px = image::Rgba(linear_to_srgb8(c, 255));
+        }
+        let (mut positions, mut normals, mut uvs, mut triangles) =
+            (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        for (k, group) in self.by_kind(materials.len()).iter().enumerate() {
+            // This kind's vertices, numbered in first use.
+            let mut index = std::collections::HashMap::new();
+            let uv = glam::Vec2::new((k as f32 + 0.5) / n as f32, 0.5);
+            for t in group {
+                triangles.push(t.map(|v| {
+                    *index.entry(v).or_insert_with(|| {
+                        positions.push(self.positions[v as usize]);
+                        normals.push(self.normals[v as usize]);
+                        uvs.push(uv);
+                        positions.len() as u32 - 1
+                    })
+                }));
+            }
+        }
+        let mesh = TriMesh {
+            positions,
+            triangles,
+            uvs: Some(uvs),
+            normals: Some(normals),
+        };
+        (mesh, palette)
     }
 
     /// The enclosed volume (Å³), by the divergence theorem over the triangles: positive when

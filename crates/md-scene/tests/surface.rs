@@ -204,6 +204,12 @@ fn bad_options_are_errors_and_a_huge_box_is_sampled_coarser() {
     let side = 2e4 / s.spacing as f64;
     assert!(side.powi(3) <= MAX_VOXELS as f64, "spacing {}", s.spacing);
     assert!(s.spacing > 60.0);
+    // Atoms at the ends of the f32 range: still bounded, still one surface per drawable atom.
+    let mut extreme = one_atom(Vec3::splat(-3e38), 1.5);
+    extreme.push(Vec3::splat(3e38), 1.5, 0);
+    extreme.push(Vec3::ZERO, 1e38, 0);
+    let s = build(&extreme, 0.5);
+    assert!(s.spacing.is_finite() && s.positions.iter().all(|p| p.is_finite()));
     // Atoms it cannot draw are left out, and none at all is an empty surface.
     let mut bad = SurfaceAtoms::default();
     bad.push(Vec3::NAN, 1.0, 0);

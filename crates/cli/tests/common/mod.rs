@@ -9,3 +9,42 @@ pub fn texmap(args: &[&str]) -> Output {
         .output()
         .expect("the texmap binary runs")
 }
+
+/// The Khronos glTF-Validator's report on each of `files` (`tests/gltf_validate.cjs`: one JSON
+/// object per file with its error and warning counts), or `None` (and a SKIPPED line) without
+/// node or the validator (`.ci/run` installs it under target/gltf-validator;
+/// `TEXMAP_GLTF_VALIDATOR` names another directory).
+#[allow(dead_code)] // not every test binary validates glTF
+pub fn gltf_validator_reports(files: &[std::path::PathBuf]) -> Option<Vec<serde_json::Value>> {
+    use std::path::{Path, PathBuf};
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let validator = std::env::var_os("TEXMAP_GLTF_VALIDATOR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| root.join("target/gltf-validator"));
+    let node_ok = Command::new("node")
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !node_ok || !validator.join("node_modules/gltf-validator").is_dir() {
+        eprintln!(
+            "SKIPPED the glTF-Validator check: node or {} is missing (npm install --prefix {} gltf-validator)",
+            validator.join("node_modules/gltf-validator").display(),
+            validator.display()
+        );
+        return None;
+    }
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/gltf_validate.cjs");
+    let o = Command::new("node")
+        .arg(&script)
+        .arg(&validator)
+        .args(files)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    Some(
+        String::from_utf8_lossy(&o.stdout)
+            .lines()
+            .map(|l| serde_json::from_str(l).unwrap())
+            .collect(),
+    )
+}
