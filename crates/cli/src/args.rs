@@ -478,6 +478,12 @@ pub struct RenderArgs {
     /// .mtl and .png beside it); coloured as drawn (a palette texture), 1 unit = 1 Å.
     #[arg(long, value_name = "FILE.glb|FILE.obj")]
     pub export_mesh: Option<PathBuf>,
+    /// Anti-alias by supersampling: draw each image at N times its size in each direction and
+    /// average each N x N block in linear light (depth: the nearest), with any method, style
+    /// and --quality; N² times the drawing time. 3 smooths the edges of cartoons and surfaces,
+    /// which --quality does not draw.
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    pub supersample: u32,
     /// A caption at the top left of every image, on a light backdrop, for movies:
     /// 't = {ns} ns'. {time} is the frame's time in ps, {ns} in ns, {step} its MD step,
     /// {frame} its index in the file; a file whose frames carry no time (XYZ, PDB) takes

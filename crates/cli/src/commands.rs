@@ -431,6 +431,10 @@ fn render(a: &RenderArgs) -> Result<()> {
     let mut plan = crate::scene::mol_plan(&a.mol)?;
     let surface_options = crate::scene::surface_options(&a.mol)?;
     let surface_opacity = a.mol.surface_opacity;
+    let ss = a.supersample;
+    if !(1..=8).contains(&ss) {
+        return usage(format!("--supersample {ss}: expected 1 to 8"));
+    }
     if !(surface_opacity.is_finite() && (0.05..=1.0).contains(&surface_opacity)) {
         return usage(format!(
             "--surface-opacity {surface_opacity}: expected an opacity from 0.05 to 1"
@@ -588,6 +592,15 @@ fn render(a: &RenderArgs) -> Result<()> {
             .expect("planned at the first frame")
             .camera(k, &md)
             .map_err(|e| fail(crate::scene::camera_error(e, &a.path), &written))?;
+        // Supersampled: drawn at ss times the size and box-filtered down (labels, captions and
+        // the colour bar are drawn after, on the output size, through `shown`).
+        let shown = cam.clone();
+        let cam = if ss > 1 {
+            cam.with_size(cam.width() * ss, cam.height() * ss)
+                .map_err(|e| fail(anyhow::anyhow!("--supersample {ss}: {e}"), &written))?
+        } else {
+            cam
+        };
         let lighting = Lighting::default_for(&cam);
         // This frame's quality options: bonds as drawn, fog over this frame's depth.
         let quality = quality.map(|mut q| {
@@ -666,6 +679,11 @@ fn render(a: &RenderArgs) -> Result<()> {
             }
         };
         let mut out = out;
+        if ss > 1 {
+            out = out
+                .downsample(ss)
+                .expect("the image is ss times the output size");
+        }
         // The first frame of the render (with --shard, the part that draws it writes it).
         if let Some(path) = &a.export_mesh
             && k == 0
@@ -690,7 +708,7 @@ fn render(a: &RenderArgs) -> Result<()> {
         }
         if !atom_labels.is_empty() {
             let at = format!("frame {f} of {}", traj.name());
-            let empty = crate::scene::draw_atom_labels(&atom_labels, &md, &cam, &mut out, &at)
+            let empty = crate::scene::draw_atom_labels(&atom_labels, &md, &shown, &mut out, &at)
                 .map_err(|e| fail(e, &written))?;
             if k == mine.start {
                 for spec in empty {

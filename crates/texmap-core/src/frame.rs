@@ -78,11 +78,75 @@ impl Frame {
     pub fn color_bytes(&self) -> &[u8] {
         self.color.as_flattened()
     }
+
+    /// The frame shrunk by `factor` in each direction (a supersampled image box-filtered to its
+    /// output size; `None` unless `factor ≥ 1` divides both sides): each output pixel is the
+    /// mean of its `factor²` pixels in linear light, weighted by their alpha (so a transparent
+    /// background adds no colour), its alpha their mean alpha, its depth the nearest of theirs.
+    /// A factor of 1 is the frame itself.
+    pub fn downsample(&self, factor: u32) -> Option<Frame> {
+        if factor == 0 || !self.width.is_multiple_of(factor) || !self.height.is_multiple_of(factor)
+        {
+            return None;
+        }
+        if factor == 1 {
+            return Some(self.clone());
+        }
+        let (w, h) = (self.width / factor, self.height / factor);
+        let mut out = Frame::new(w, h, [0, 0, 0, 0]);
+        let n = (factor * factor) as f32;
+        for y in 0..h {
+            for x in 0..w {
+                let (mut sum, mut alpha, mut depth) = (glam::Vec3::ZERO, 0.0f32, f32::INFINITY);
+                for sy in 0..factor {
+                    let row = (y * factor + sy) as usize * self.width as usize;
+                    for sx in 0..factor {
+                        let i = row + (x * factor + sx) as usize;
+                        let a = self.color[i][3] as f32 / 255.0;
+                        sum += crate::color::srgb8_to_linear_rgb(self.color[i]) * a;
+                        alpha += a;
+                        depth = depth.min(self.depth[i]);
+                    }
+                }
+                let o = out.index(x, y);
+                let c = if alpha > 0.0 {
+                    sum / alpha
+                } else {
+                    glam::Vec3::ZERO
+                };
+                out.color[o] = crate::color::linear_to_srgb8(c, (alpha / n * 255.0).round() as u8);
+                out.depth[o] = depth;
+            }
+        }
+        Some(out)
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn downsampling_averages_light_and_keeps_the_nearest_depth() {
+        // A 2x2 block of black and white: half the light, sRGB code 188 (0.5 linear); the
+        // background of a transparent image adds no colour, only transparency.
+        let mut f = Frame::new(4, 2, [0, 0, 0, 255]);
+        f.color[1] = [255, 255, 255, 255];
+        f.color[4] = [255, 255, 255, 255];
+        f.depth[4] = 3.0;
+        f.depth[5] = 2.0;
+        f.color[2] = [255, 0, 0, 255];
+        f.color[3] = [9, 9, 9, 0];
+        f.color[6] = [9, 9, 9, 0];
+        f.color[7] = [9, 9, 9, 0];
+        let d = f.downsample(2).unwrap();
+        assert_eq!(d.color[0], [188, 188, 188, 255]);
+        assert_eq!(d.depth[0], 2.0);
+        assert_eq!(d.color[1], [255, 0, 0, 64]);
+        assert_eq!(d.depth[1], f32::INFINITY);
+        assert!(f.downsample(3).is_none() && f.downsample(0).is_none());
+        assert_eq!(f.downsample(1).unwrap(), f);
+    }
 
     #[test]
     fn parts_must_match_size() {
