@@ -8,6 +8,8 @@ use texmap_md_io::{Frame, Trajectory};
 use texmap_md_scene::cartoon::{ARROW, COIL_RADIUS, HELIX, STRAND, append_cartoon};
 use texmap_md_scene::surface::MolMesh;
 
+mod common;
+
 fn read(name: &str) -> Frame {
     let path = format!(
         "{}/../md-io/tests/data/dssp/{name}",
@@ -181,7 +183,6 @@ fn a_supersampled_cartoon_meets_the_supersampled_reference() {
     use texmap_core::metrics::psnr;
     use texmap_core::shade::{Lighting, Material};
     use texmap_md_scene::surface::draw_mesh;
-    use texmap_reftrace::{MeshShading, RenderOptions, SceneBuilder, SurfaceMaterial};
     let f = read("3gwiA.pdb.gz");
     let (_, m, _) = cartoon(&vec![true; f.n_atoms()]);
     let centre = m.positions.iter().copied().sum::<Vec3>() / m.positions.len() as f32;
@@ -206,32 +207,7 @@ fn a_supersampled_cartoon_meets_the_supersampled_reference() {
         draw_mesh(&m, &materials, &big, &lighting, 1.0, &mut img).unwrap();
         img.downsample(ss).unwrap()
     };
-    let mut b = SceneBuilder::new();
-    for (k, group) in m
-        .by_kind(materials.len())
-        .iter()
-        .enumerate()
-        .take(materials.len())
-    {
-        if !group.is_empty() {
-            b.add_mesh_shaded(
-                &m.positions,
-                group.as_flattened(),
-                None,
-                Some(&m.normals),
-                MeshShading::VertexNormals,
-                k as u32,
-            )
-            .unwrap();
-        }
-    }
-    let mats: Vec<SurfaceMaterial> = materials
-        .iter()
-        .map(|&m| SurfaceMaterial::opaque(m))
-        .collect();
-    let mut o = RenderOptions::new(lighting, &mats);
-    o.samples_per_axis = 4;
-    let reference = b.build().render(&cam, &o).unwrap();
+    let reference = common::traced(&m, &materials, &cam, lighting, 4, bg);
     let (one, four) = (
         psnr(&draw(1), &reference).unwrap(),
         psnr(&draw(4), &reference).unwrap(),

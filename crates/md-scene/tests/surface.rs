@@ -10,7 +10,8 @@ use texmap_core::shade::{Lighting, Material};
 use texmap_md_scene::surface::{
     MAX_VOXELS, MolMesh, SurfaceAtoms, SurfaceError, SurfaceOptions, draw_mesh,
 };
-use texmap_reftrace::{MeshShading, RenderOptions, SceneBuilder, SurfaceMaterial};
+
+mod common;
 
 fn one_atom(c: Vec3, r: f32) -> SurfaceAtoms {
     let mut a = SurfaceAtoms::default();
@@ -239,33 +240,8 @@ fn the_drawn_surface_matches_the_ray_traced_mesh() {
     let mut drawn = Frame::new(400, 300, bg);
     let n = draw_mesh(&s, &materials, &cam, &lighting, 1.0, &mut drawn).unwrap();
     assert!(n > 10_000);
-    // The reference: each material's triangles as one mesh with vertex normals.
-    let mut b = SceneBuilder::new();
-    for k in 0..5u16 {
-        let idx: Vec<u32> = s
-            .triangles
-            .iter()
-            .zip(&s.kinds)
-            .filter(|(_, kind)| **kind == k)
-            .flat_map(|(t, _)| *t)
-            .collect();
-        b.add_mesh_shaded(
-            &s.positions,
-            &idx,
-            None,
-            Some(&s.normals),
-            MeshShading::VertexNormals,
-            k as u32,
-        )
-        .unwrap();
-    }
-    let mats: Vec<SurfaceMaterial> = materials
-        .iter()
-        .map(|&m| SurfaceMaterial::opaque(m))
-        .collect();
-    let mut o = RenderOptions::new(lighting, &mats);
-    o.background = texmap_core::color::srgb8_to_linear_rgb(bg);
-    let reference = b.build().render(&cam, &o).unwrap();
+    // The reference: the same mesh traced.
+    let reference = common::traced(&s, &materials, &cam, lighting, 1, bg);
     let db = psnr(&drawn, &reference).unwrap();
     let covered = (0..drawn.len()).filter(|&i| drawn.covered(i)).count();
     let agree = (0..drawn.len())
