@@ -682,8 +682,8 @@ pub enum DrawStyle {
     /// each chain (VMD's Tube); ligands, ions and water as licorice.
     Tube,
     /// Protein backbones as a cartoon (VMD's NewCartoon): helices as ribbons, strands as arrows,
-    /// coil as a thin tube, from the secondary structure of each frame; nucleic acids as a tube,
-    /// ligands, ions and water as licorice.
+    /// coil as a thin tube, from the secondary structure of each frame; nucleic acids as a tube
+    /// through the P atoms with a rung to each base; ligands, ions and water as licorice.
     Cartoon,
     /// A molecular surface around the atoms (VMD's QuickSurf: the isosurface of one Gaussian per
     /// atom, an isolated atom's at its radius), coloured by the atom nearest under it.

@@ -14,10 +14,17 @@
 //! A trace breaks where the chain or segment changes, at a peptide bond DSSP finds broken, or
 //! where a residue is not selected; a lone residue draws nothing. Each half interval takes the
 //! material of its nearer CA atom, so colour rules and every colouring reach the cartoon.
+//!
+//! Nucleic acids, as VMD's NewCartoon draws them: a coil tube along the spline through each
+//! strand's P atoms (broken where the chain changes or two are more than
+//! [`crate::plan::MAX_P_GAP`] apart) and a rung per nucleotide from its P to the base atom at
+//! the pairing edge (N1 of a purine, N3 of a pyrimidine; N1 when the residue has neither), so
+//! the rungs of paired bases meet across the double helix.
 
 use glam::Vec3;
 use texmap_md_io::Frame;
 use texmap_md_io::secondary::{self, Structure};
+use texmap_md_io::select::NUCLEIC_RESIDUES;
 
 use crate::surface::MolMesh;
 
@@ -56,7 +63,8 @@ struct Section {
     kind: u16,
 }
 
-/// The cartoon of `frame`'s protein residues whose CA `selected` keeps, positions from
+/// The cartoon of `frame`'s protein residues whose CA `selected` keeps (and nucleotides whose P
+/// it keeps), positions from
 /// `centers` (the frame's, after the plan's alignment) and materials from `kinds` (per atom),
 /// appended to `mesh`. Returns the residues drawn (in traces of two or more).
 pub fn append_cartoon(
@@ -97,7 +105,72 @@ pub fn append_cartoon(
         sweep(&sections(trace), mesh);
         drawn += trace.len();
     }
-    drawn
+    drawn + append_nucleic(frame, centers, kinds, selected, mesh)
+}
+
+/// The nucleic-acid part of [`append_cartoon`]: P traces and base rungs. Returns the
+/// nucleotides drawn.
+fn append_nucleic(
+    frame: &Frame,
+    centers: &[Vec3],
+    kinds: &[u16],
+    selected: &[bool],
+    mesh: &mut MolMesh,
+) -> usize {
+    if frame.names.len() != frame.n_atoms() || centers.len() != frame.n_atoms() {
+        return 0;
+    }
+    let label = |v: &[texmap_md_io::Label], i: usize| v.get(i).copied();
+    let mut traces: Vec<Vec<Residue>> = Vec::new();
+    let mut rungs: Vec<(Vec3, Vec3, u16)> = Vec::new();
+    let mut last_p: Option<usize> = None;
+    for range in secondary::residue_ranges(frame) {
+        if !NUCLEIC_RESIDUES.contains(&frame.res_names[range.start].as_str()) {
+            continue;
+        }
+        let find = |name: &str| range.clone().find(|&i| frame.names[i] == name);
+        let Some(p) = find("P").filter(|&p| selected.get(p).copied().unwrap_or(false)) else {
+            continue;
+        };
+        let res = Residue {
+            ca: centers[p],
+            o: centers[p],
+            class: Structure::Coil,
+            kind: kinds.get(p).copied().unwrap_or(0),
+        };
+        let joined = last_p.is_some_and(|q| {
+            label(&frame.chains, p) == label(&frame.chains, q)
+                && label(&frame.segments, p) == label(&frame.segments, q)
+                && centers[p].distance(centers[q]) <= crate::plan::MAX_P_GAP
+        });
+        match traces.last_mut() {
+            Some(t) if joined => t.push(res),
+            _ => traces.push(vec![res]),
+        }
+        last_p = Some(p);
+        let edge = if find("N9").is_some() { "N1" } else { "N3" };
+        if let Some(b) = find(edge).or_else(|| find("N1")) {
+            rungs.push((centers[p], centers[b], res.kind));
+        }
+    }
+    for trace in traces.iter().filter(|t| t.len() >= 2) {
+        sweep(&sections(trace), mesh);
+    }
+    for &(from, to, kind) in &rungs {
+        let Some(t) = (to - from).try_normalize() else {
+            continue;
+        };
+        let end = |at| Section {
+            at,
+            t,
+            side: t.any_orthonormal_vector(),
+            a: COIL_RADIUS,
+            b: COIL_RADIUS,
+            kind,
+        };
+        sweep(&[end(from), end(to)], mesh);
+    }
+    traces.iter().filter(|t| t.len() >= 2).map(Vec::len).sum()
 }
 
 /// Point and derivative of the uniform Catmull-Rom spline through `p1` and `p2` at `t`.

@@ -36,8 +36,8 @@
 //!    atoms are renumbered to the kept atoms' indices; bonds to a dropped atom are dropped;
 //! 7. for [`DrawStyle::Tube`], the selected atoms of protein and nucleic residues give way to
 //!    the backbone tube through their CA (P) atoms, appended as spheres joined by bonds; for
-//!    [`DrawStyle::Cartoon`], protein residues give way to the cartoon mesh
-//!    ([`MolPlan::cartoon_mesh`]) and nucleic ones to the tube; for [`DrawStyle::Surface`], the
+//!    [`DrawStyle::Cartoon`], protein and nucleic residues give way to the cartoon mesh
+//!    ([`MolPlan::cartoon_mesh`]); for [`DrawStyle::Surface`], the
 //!    selected atoms leave the scene for [`MolPlan::surface_atoms`].
 //!
 //! # The tube
@@ -105,8 +105,8 @@ pub enum DrawStyle {
     /// (ligands, ions, water) as [`DrawStyle::Licorice`].
     Tube,
     /// Protein backbones as a cartoon (VMD's NewCartoon: helices as ribbons, strands as arrows,
-    /// coil as a tube, [`crate::cartoon`]); nucleic acids as [`DrawStyle::Tube`] draws them,
-    /// other atoms (ligands, ions, water) as [`DrawStyle::Licorice`].
+    /// coil as a tube, [`crate::cartoon`]), nucleic acids as a tube through the P atoms with a
+    /// rung to each base, other atoms (ligands, ions, water) as [`DrawStyle::Licorice`].
     Cartoon,
     /// The selected atoms wrapped in a molecular surface (VMD's QuickSurf: a Gaussian density
     /// surface, [`crate::surface`]); they are not drawn as spheres, and nothing is bonded.
@@ -925,14 +925,16 @@ impl MolPlan {
                     selected,
                     &mut self.cartoon,
                 );
-                // Protein residues give way to the cartoon; nucleic acids are traced as tubes.
-                use texmap_md_io::select::PROTEIN_RESIDUES;
+                // Protein and nucleic residues give way to the cartoon.
+                use texmap_md_io::select::{NUCLEIC_RESIDUES, PROTEIN_RESIDUES};
                 for (keep, res) in selected.iter_mut().zip(&frame.res_names) {
-                    if PROTEIN_RESIDUES.contains(&res.as_str()) {
+                    if PROTEIN_RESIDUES.contains(&res.as_str())
+                        || NUCLEIC_RESIDUES.contains(&res.as_str())
+                    {
                         *keep = false;
                     }
                 }
-                backbone_traces(frame, scene, selected)
+                Vec::new()
             }
             _ => Vec::new(),
         };

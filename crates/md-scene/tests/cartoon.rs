@@ -218,3 +218,51 @@ fn a_supersampled_cartoon_meets_the_supersampled_reference() {
         "1 sample {one} dB, supersampled {four} dB"
     );
 }
+
+/// Nucleic acids: the DNA "strand" of md-io's chains fixture (MDAnalysis-written for the
+/// selection tests: P, C4' and N1 of six nucleotides at scattered places): a rung from every P
+/// to its N1 (neither N9 nor N3 in this file: the N1 fallback), and a tube only between
+/// phosphates close enough to be bonded neighbours (DA 5 and DC3 6, 6.9 Å apart; the others are
+/// 11 to 27 Å from their neighbours).
+#[test]
+fn a_dna_strand_is_a_tube_through_its_phosphates_with_a_rung_to_each_base() {
+    let path = format!(
+        "{}/../md-io/tests/data/chains_mda.pdb",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let mut f = Frame::new();
+    Trajectory::open(&path)
+        .unwrap()
+        .read_frame(0, &mut f)
+        .unwrap();
+    let centers: Vec<Vec3> = f.positions.iter().map(|p| Vec3::from(*p)).collect();
+    let dna: Vec<bool> = f
+        .res_names
+        .iter()
+        .map(|r| r.as_str().starts_with('D'))
+        .collect();
+    let mut m = MolMesh::default();
+    let n = append_cartoon(&f, &centers, &vec![0; f.n_atoms()], &dna, &mut m);
+    assert_eq!(n, 2);
+    // A rung's cap centres are its ends: a vertex on every P and every N1.
+    for (i, name) in f.names.iter().enumerate() {
+        if dna[i] && (name.as_str() == "P" || name.as_str() == "N1") {
+            let d = m
+                .positions
+                .iter()
+                .map(|p| p.distance(centers[i]))
+                .fold(f32::MAX, f32::min);
+            assert!(d < 1e-5, "atom {i} ({name}): nearest vertex {d}");
+        }
+    }
+    let volume = m.volume();
+    assert!(volume > 0.0, "volume {volume}");
+    // Nothing for the protein's atoms: a DNA-only selection draws no ribbon.
+    assert!(m.positions.iter().all(|p| {
+        centers
+            .iter()
+            .zip(&dna)
+            .filter(|(_, d)| **d)
+            .any(|(c, _)| c.distance(*p) < 6.0)
+    }));
+}
