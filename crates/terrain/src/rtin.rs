@@ -940,7 +940,10 @@ pub fn extract(
     // every corner's slot is written at the count, which advances only for a new one.
     let slots = side as usize * side as usize;
     let mut index = vec![0u32; slots];
-    let mut order = vec![0u32; slots.min(3 * tris.len()) + 1];
+    // At most T + 2 vertices for T triangles tiling a disk (Euler: T = 2V − B − 2 with B ≤ V
+    // boundary vertices); no-data can leave separate islands, up to 3 vertices a triangle.
+    let most = if map.nodata { 3 * tris.len() } else { tris.len() + 2 };
+    let mut order = vec![0u32; slots.min(most) + 1];
     let mut count = 0u32;
     for t in tris.iter_mut() {
         for v in t.iter_mut() {
