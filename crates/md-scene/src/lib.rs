@@ -21,8 +21,9 @@
 //! - [`scalar`]: colour coding by a number per atom ([`ScalarSource`]: a property such as the
 //!   B-factor or a LAMMPS compute, the speed, the residue, the index) over a range fixed at the
 //!   first frame.
-//! - [`cartoon`]: protein cartoons as VMD's NewCartoon draws them (helix ribbons, strand
-//!   arrows, coil tubes along a spline through the CA atoms), a mesh like the surface's.
+//! - [`cartoon`]: cartoons as VMD's NewCartoon draws them (helix ribbons, strand arrows, coil
+//!   tubes along a spline through the CA atoms; nucleic acids as a P tube with base rungs), a
+//!   mesh like the surface's.
 //! - [`surface`]: molecular surfaces as VMD's QuickSurf draws them (one Gaussian per atom, the
 //!   isosurface by surface nets with every vertex on the exact surface), drawn by the rasteriser
 //!   over a sphere method's frame ([`surface::draw_mesh`]).
