@@ -942,7 +942,11 @@ pub fn extract(
     let mut index = vec![0u32; slots];
     // At most T + 2 vertices for T triangles tiling a disk (Euler: T = 2V − B − 2 with B ≤ V
     // boundary vertices); no-data can leave separate islands, up to 3 vertices a triangle.
-    let most = if map.nodata { 3 * tris.len() } else { tris.len() + 2 };
+    let most = if map.nodata {
+        3 * tris.len()
+    } else {
+        tris.len() + 2
+    };
     let mut order = vec![0u32; slots.min(most) + 1];
     let mut count = 0u32;
     for t in tris.iter_mut() {
