@@ -849,6 +849,9 @@ Examples:
   texmap render dump.lammpstrj --type-color 1=#ff8000 --type-color 2=40,40,255 --type-radius 2=0.6 -o f.png
   texmap render 1abc.cif.gz --style tube --color-by chain --select 'not water' -o chains.png
   texmap render 1abc.cif --color-by bfactor --colormap coolwarm -o b.png
+  texmap render 1abc.cif --style cartoon --color-by structure --supersample 3 -o fold.png
+  texmap render 1abc.cif --rep 'protein=cartoon' --rep 'protein=surface:#8080ff' --surface-opacity 0.35 -o see.png
+  texmap render 1abc.cif --rep 'not resname LIG=surface' --rep 'resname LIG=ball-stick' --export-mesh pocket.glb -o pocket.png
   texmap render md.xtc --topology protein.pdb --align backbone --style tube --color-by structure --label 't = {ns} ns' -o md.mp4
   texmap render water.gro --color-by element --type-color OW=#ff0000 --radius-scale 0.5 -o w.png
   texmap render md.xyz --eye 0,0,50 --target 0,0,0 --up 0,1,0 --fov 30 --depth -o md.png";

@@ -463,7 +463,7 @@ impl MolMesh {
                     for x in 1..nx - 1 {
                         let v = at(x, y, z) > iso;
                         // Edge along x from (x, y, z): cells (x, y-1..y, z-1..z).
-                        if x < nx - 1 && v != (at(x + 1, y, z) > iso) {
+                        if v != (at(x + 1, y, z) > iso) {
                             let q = [
                                 cell(x, y - 1, z - 1),
                                 cell(x, y, z - 1),
