@@ -64,9 +64,9 @@ struct Section {
 }
 
 /// The cartoon of `frame`'s protein residues whose CA `selected` keeps (and nucleotides whose P
-/// it keeps), positions from
-/// `centers` (the frame's, after the plan's alignment) and materials from `kinds` (per atom),
-/// appended to `mesh`. Returns the residues drawn (in traces of two or more).
+/// it keeps), positions from `centers` (the frame's, after the plan's alignment) and materials
+/// from `kinds` (per atom), appended to `mesh`. Returns the residues drawn (in traces of two or
+/// more).
 pub fn append_cartoon(
     frame: &Frame,
     centers: &[Vec3],
@@ -100,12 +100,17 @@ pub fn append_cartoon(
         }
         joined = true;
     }
+    sweep_traces(&traces, mesh) + append_nucleic(frame, centers, kinds, selected, mesh)
+}
+
+/// Sweeps every trace of two or more residues into `mesh`; returns the residues they hold.
+fn sweep_traces(traces: &[Vec<Residue>], mesh: &mut MolMesh) -> usize {
     let mut drawn = 0;
     for trace in traces.iter().filter(|t| t.len() >= 2) {
         sweep(&sections(trace), mesh);
         drawn += trace.len();
     }
-    drawn + append_nucleic(frame, centers, kinds, selected, mesh)
+    drawn
 }
 
 /// The nucleic-acid part of [`append_cartoon`]: P traces and base rungs. Returns the
@@ -153,9 +158,7 @@ fn append_nucleic(
             rungs.push((centers[p], centers[b], res.kind));
         }
     }
-    for trace in traces.iter().filter(|t| t.len() >= 2) {
-        sweep(&sections(trace), mesh);
-    }
+    let drawn = sweep_traces(&traces, mesh);
     for &(from, to, kind) in &rungs {
         let Some(t) = (to - from).try_normalize() else {
             continue;
@@ -170,7 +173,7 @@ fn append_nucleic(
         };
         sweep(&[end(from), end(to)], mesh);
     }
-    traces.iter().filter(|t| t.len() >= 2).map(Vec::len).sum()
+    drawn
 }
 
 /// Point and derivative of the uniform Catmull-Rom spline through `p1` and `p2` at `t`.
