@@ -77,12 +77,7 @@ pub fn coordination(frame: &Frame, cutoff: f32) -> Result<Vec<u32>, Coordination
         && !bonds.periodic
         && n >= 2
     {
-        let m = cell.matrix().map(glam::DVec3::from_array);
-        let volume = cell.volume();
-        let width = [(1, 2), (2, 0), (0, 1)]
-            .map(|(a, b)| volume / m[a].cross(m[b]).length())
-            .into_iter()
-            .fold(f64::INFINITY, f64::min);
+        let width = cell.min_width();
         return Err(CoordinationError::CellTooSmall { width, cutoff });
     }
     let mut counts = vec![0u32; n];

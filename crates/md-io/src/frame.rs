@@ -262,6 +262,17 @@ impl UnitCell {
         det3(&self.matrix)
     }
 
+    /// The narrowest perpendicular width of the cell (Å): the distance between its closest pair
+    /// of opposite faces, volume over the area of a face.
+    pub fn min_width(&self) -> f64 {
+        let m = self.matrix.map(glam::DVec3::from_array);
+        let volume = self.volume();
+        [(1, 2), (2, 0), (0, 1)]
+            .map(|(a, b)| volume / m[a].cross(m[b]).length())
+            .into_iter()
+            .fold(f64::INFINITY, f64::min)
+    }
+
     /// True when all three angles are 90°.
     pub fn is_orthorhombic(&self) -> bool {
         self.angles.iter().all(|a| (a - 90.0).abs() < 1e-9)

@@ -15,7 +15,8 @@
 //!   wraps atoms into the box or makes bonded molecules whole across it; [`replicate`] copies a
 //!   frame and its bonds along the cell vectors (periodic images, as OVITO's Replicate);
 //!   [`coordination`] counts each atom's neighbours within a cutoff, and [`cna`] classifies
-//!   its crystal structure, as OVITO's analyses do.
+//!   its crystal structure, as OVITO's analyses do; [`hbonds`] finds hydrogen bonds by
+//!   MDAnalysis's geometric criterion.
 //! - [`Writer`] writes XYZ and PDB.
 //! - [`elements`] maps atom names to elements, gives van der Waals radii and CPK colours, and
 //!   [`AtomStyle`] resolves each atom's radius and colour with user overrides.
@@ -88,6 +89,7 @@ mod format;
 mod frame;
 mod gro;
 mod gz;
+pub mod hbonds;
 mod lammps;
 mod mmcif;
 mod mol2;

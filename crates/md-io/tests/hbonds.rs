@@ -1,0 +1,248 @@
+//! Hydrogen bonds against MDAnalysis 2.11's HydrogenBondAnalysis on a solvated protein in a
+//! triclinic box (adk_oplsaa: 47,681 atoms, rhombic dodecahedron), two frames; the reference,
+//! topology and trajectory are written by `tests/data/gen_hbonds.py`. MDAnalysis takes its
+//! donor–hydrogen bonds from the GROMACS TPR, which texmap does not read: here they come from
+//! bonds by distance, so the comparison also checks that those find every polar hydrogen.
+
+use std::collections::BTreeSet;
+use std::io::Read;
+
+use texmap_md_io::bonds::bonds_by_distance;
+use texmap_md_io::hbonds::{Criteria, HBondError, donor_hydrogens, hydrogen_bonds};
+use texmap_md_io::{Frame, Label, Topology, Trajectory, UnitCell};
+
+fn data(name: &str) -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/hbonds")
+        .join(name)
+}
+
+type Triple = (u32, u32, u32);
+
+fn reference() -> (usize, Vec<BTreeSet<Triple>>) {
+    let mut text = String::new();
+    flate2::read::GzDecoder::new(std::fs::File::open(data("reference.json.gz")).unwrap())
+        .read_to_string(&mut text)
+        .unwrap();
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let frames = v["frames"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| {
+            let flat: Vec<u32> = f["dha"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|x| x.as_u64().unwrap() as u32)
+                .collect();
+            flat.chunks(3).map(|c| (c[0], c[1], c[2])).collect()
+        })
+        .collect();
+    (v["n_atoms"].as_u64().unwrap() as usize, frames)
+}
+
+/// The D–A distance and D–H···A angle of a triple, for the report of a disagreement.
+fn geometry(frame: &Frame, (d, h, a): Triple) -> (f64, f64) {
+    let cell = frame.cell.unwrap();
+    let p = |i: u32| frame.positions[i as usize].map(f64::from);
+    let disp = |from: u32, to: u32| {
+        let (f, t) = (p(from), p(to));
+        texmap_md_io::pbc::minimum_image(&cell, std::array::from_fn(|k| t[k] - f[k]))
+    };
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let da = disp(d, a);
+    let (hd, ha) = (disp(h, d), disp(h, a));
+    let angle = (dot(hd, ha) / (dot(hd, hd) * dot(ha, ha)).sqrt())
+        .acos()
+        .to_degrees();
+    (dot(da, da).sqrt(), angle)
+}
+
+#[test]
+fn matches_mdanalysis_on_a_solvated_protein_in_a_triclinic_box() {
+    let (n_atoms, want) = reference();
+    let top = Topology::open(data("adk_top.gro.gz")).unwrap();
+    let mut traj = Trajectory::open(data("adk_0_9.xtc")).unwrap();
+    let mut frame = Frame::new();
+    let mut k = 0;
+    while traj.read_next(&mut frame).unwrap() {
+        top.apply(&mut frame, "adk_0_9.xtc", k).unwrap();
+        assert_eq!(frame.n_atoms(), n_atoms);
+        let cell = frame.cell.expect("the XTC has a box");
+        assert!(!cell.is_orthorhombic());
+        let bonds = bonds_by_distance(&frame, true);
+        let dh = donor_hydrogens(&frame, &bonds.pairs);
+        let got: BTreeSet<Triple> = hydrogen_bonds(&frame, &dh, None, Criteria::default())
+            .unwrap()
+            .iter()
+            .map(|b| (b.donor, b.hydrogen, b.acceptor))
+            .collect();
+        // A triple one side finds and the other does not must lie on a cutoff (rounding of the
+        // f32 positions decides it); none does in these frames.
+        let mut report = Vec::new();
+        for t in got.symmetric_difference(&want[k]) {
+            let (dist, angle) = geometry(&frame, *t);
+            let on_edge = (dist - 3.0).abs() < 1e-5 || (angle - 150.0).abs() < 1e-4;
+            if !on_edge {
+                report.push((*t, want[k].contains(t), dist, angle));
+            }
+        }
+        assert!(
+            report.is_empty(),
+            "frame {k}: {} bonds, {} in MDAnalysis; disagreements (triple, in MDAnalysis, \
+             distance, angle): {:?}",
+            got.len(),
+            want[k].len(),
+            &report[..report.len().min(20)]
+        );
+        assert!(got.len() > 13_000, "frame {k}: {}", got.len());
+        k += 1;
+    }
+    assert_eq!(k, want.len());
+}
+
+fn water_dimer(shift: f32) -> Frame {
+    let mut frame = Frame::new();
+    frame.names = ["OW", "HW1", "HW2", "OW", "HW1", "HW2"]
+        .map(|n| Label::new(n).unwrap())
+        .to_vec();
+    // Donor O at the origin, its first H along +x toward the acceptor 2.9 Å away.
+    frame.positions = vec![
+        [0.0, 0.0, 0.0],
+        [0.96, 0.0, 0.0],
+        [-0.24, 0.93, 0.0],
+        [2.9, 0.0, 0.0],
+        [3.15, 0.93, 0.0],
+        [3.15, -0.47, 0.81],
+    ];
+    for p in &mut frame.positions {
+        p[0] += shift;
+    }
+    frame
+}
+
+#[test]
+fn criteria_are_the_distance_and_angle_stated() {
+    let frame = water_dimer(5.0);
+    let dh = [[0, 1], [0, 2], [3, 4], [3, 5]];
+    let at = |c: Criteria| hydrogen_bonds(&frame, &dh, None, c).unwrap().len();
+    assert_eq!(at(Criteria::default()), 1);
+    // 2.9 Å: out at a 2.85 Å cutoff, in at 2.95.
+    assert_eq!(
+        at(Criteria {
+            distance: 2.85,
+            ..Criteria::default()
+        }),
+        0
+    );
+    assert_eq!(
+        at(Criteria {
+            distance: 2.95,
+            ..Criteria::default()
+        }),
+        1
+    );
+    // Bend the hydrogen 40° off the O···O line: the angle at H drops to about 124°.
+    let mut bent = frame.clone();
+    let t = 40f32.to_radians();
+    bent.positions[1] = [5.0 + 0.96 * t.cos(), 0.96 * t.sin(), 0.0];
+    let b = hydrogen_bonds(&bent, &dh, None, Criteria::default()).unwrap();
+    assert!(b.is_empty());
+    let b = hydrogen_bonds(
+        &bent,
+        &dh,
+        None,
+        Criteria {
+            angle: 120.0,
+            ..Criteria::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(b.len(), 1);
+    // The angle at H of the triangle O(0,0), H(0.96 cos t, 0.96 sin t), O(2.9, 0).
+    let h = [0.96 * t.cos() as f64, 0.96 * t.sin() as f64];
+    let (u, v) = ([-h[0], -h[1]], [2.9 - h[0], -h[1]]);
+    let want = ((u[0] * v[0] + u[1] * v[1])
+        / ((u[0] * u[0] + u[1] * u[1]) * (v[0] * v[0] + v[1] * v[1])).sqrt())
+    .acos()
+    .to_degrees();
+    assert!(
+        (b[0].angle as f64 - want).abs() < 1e-3,
+        "{} {want}",
+        b[0].angle
+    );
+}
+
+#[test]
+fn a_bond_across_the_box_is_found_by_its_nearest_image() {
+    // The dimer straddling the face x = 0 of a 20 Å box: the acceptor at x = 1.4, the donor
+    // at x = −1.5 written wrapped as 18.5.
+    let mut frame = water_dimer(-1.5);
+    for p in &mut frame.positions {
+        if p[0] < 0.0 {
+            p[0] += 20.0;
+        }
+    }
+    let dh = [[0, 1], [0, 2], [3, 4], [3, 5]];
+    let open = hydrogen_bonds(&frame, &dh, None, Criteria::default()).unwrap();
+    assert!(open.is_empty(), "no bond without the box: {open:?}");
+    frame.cell = Some(UnitCell::orthorhombic(20.0, 20.0, 20.0).unwrap());
+    let b = hydrogen_bonds(&frame, &dh, None, Criteria::default()).unwrap();
+    assert_eq!(b.len(), 1);
+    assert_eq!((b[0].donor, b[0].hydrogen, b[0].acceptor), (0, 1, 3));
+    assert!((b[0].distance - 2.9).abs() < 1e-4, "{}", b[0].distance);
+}
+
+#[test]
+fn a_mask_keeps_only_bonds_within_it_and_bad_criteria_are_refused() {
+    let frame = water_dimer(0.0);
+    let dh = [[0, 1], [0, 2], [3, 4], [3, 5]];
+    let c = Criteria::default();
+    let without_acceptor = [true, true, true, false, true, true];
+    assert!(
+        hydrogen_bonds(&frame, &dh, Some(&without_acceptor), c)
+            .unwrap()
+            .is_empty()
+    );
+    let without_hydrogen = [true, false, true, true, true, true];
+    assert!(
+        hydrogen_bonds(&frame, &dh, Some(&without_hydrogen), c)
+            .unwrap()
+            .is_empty()
+    );
+    assert_eq!(
+        hydrogen_bonds(&frame, &dh, Some(&[true; 6]), c)
+            .unwrap()
+            .len(),
+        1
+    );
+    for d in [0.0, 0.45, -3.0, 6.5, f32::NAN, f32::INFINITY] {
+        let e = hydrogen_bonds(
+            &frame,
+            &dh,
+            None,
+            Criteria {
+                distance: d,
+                angle: 150.0,
+            },
+        );
+        assert!(matches!(e, Err(HBondError::BadDistance(_))), "{d}");
+    }
+    for a in [-1.0, 180.5, f32::NAN] {
+        let e = hydrogen_bonds(
+            &frame,
+            &dh,
+            None,
+            Criteria {
+                distance: 3.0,
+                angle: a,
+            },
+        );
+        assert!(matches!(e, Err(HBondError::BadAngle(_))), "{a}");
+    }
+    let mut small = frame.clone();
+    small.cell = Some(UnitCell::orthorhombic(8.0, 8.0, 8.0).unwrap());
+    let e = hydrogen_bonds(&small, &dh, None, c).unwrap_err();
+    assert!(e.to_string().contains("--replicate"), "{e}");
+}
