@@ -688,6 +688,12 @@ pub enum DrawStyle {
     /// A molecular surface around the atoms (VMD's QuickSurf: the isosurface of one Gaussian per
     /// atom, an isolated atom's at its radius), coloured by the atom nearest under it.
     Surface,
+    /// The hydrogen bonds among the atoms as dashed lines from hydrogen to acceptor (VMD's
+    /// HBonds), found every frame by MDAnalysis's criterion (see --hbond-distance); needs
+    /// explicit hydrogens. Usually one --rep among others: --rep 'protein=cartoon'
+    /// --rep 'all=hbonds'.
+    #[value(name = "hbonds")]
+    HBonds,
 }
 
 /// Periodic boundaries (`--pbc`).
@@ -734,7 +740,8 @@ pub struct MolArgs {
     pub bonds: BondsArg,
     /// Drawing style: spacefill, ball-stick, licorice (the last two draw bonds), tube (backbones
     /// as a tube, other atoms as licorice), cartoon (helix ribbons, strand arrows, coil tubes; other
-    /// atoms as licorice), surface (a molecular surface, see --surface-spacing).
+    /// atoms as licorice), surface (a molecular surface, see --surface-spacing), hbonds (hydrogen
+    /// bonds as dashed lines, see --hbond-distance).
     #[arg(long = "style", value_enum, default_value_t = DrawStyle::Spacefill)]
     pub draw: DrawStyle,
     /// The surface style's grid spacing in Å: finer cuts the surface into more, smaller
@@ -751,6 +758,16 @@ pub struct MolArgs {
     /// VMD's Transparent material (one layer: the surface's back is not seen through its front).
     #[arg(long, value_name = "A", default_value_t = 1.0)]
     pub surface_opacity: f32,
+    /// The hbonds style's largest donor-acceptor distance, Å (MDAnalysis's default 3.0; up to
+    /// 6). A hydrogen bonded to an N or O donates to an N or O acceptor within it when the
+    /// donor-hydrogen-acceptor angle is at least --hbond-angle; distances use the nearest
+    /// periodic image.
+    #[arg(long, value_name = "Å", default_value_t = texmap_md_io::hbonds::DEFAULT_DISTANCE)]
+    pub hbond_distance: f32,
+    /// The hbonds style's smallest donor-hydrogen-acceptor angle, degrees (MDAnalysis's
+    /// default 150; VMD's angle cutoff of 20 is 160 here).
+    #[arg(long, value_name = "DEG", default_value_t = texmap_md_io::hbonds::DEFAULT_ANGLE)]
+    pub hbond_angle: f32,
     /// Periodic boundaries: none, wrap (atoms into the box), unwrap (molecules whole).
     #[arg(long, value_enum, default_value_t = PbcArg::None)]
     pub pbc: PbcArg,
@@ -784,7 +801,7 @@ pub struct MolArgs {
     #[arg(long, requires = "slice")]
     pub slice_invert: bool,
     /// A representation, as VMD's: 'SEL=STYLE' draws the atoms SEL selects in STYLE (spacefill,
-    /// ball-stick, licorice, tube, cartoon, surface), each with its own radii and bond radius; repeat it
+    /// ball-stick, licorice, tube, cartoon, surface, hbonds), each with its own radii and bond radius; repeat it
     /// to draw several in one image: --rep 'protein=tube' --rep 'resname LIG=ball-stick'
     /// --rep 'water and within 5 of resname LIG=licorice'; --rep 'protein=surface' --rep
     /// 'resname LIG=ball-stick' shows a ligand in its pocket (surface representations share
@@ -851,6 +868,7 @@ Examples:
   texmap render 1abc.cif --color-by bfactor --colormap coolwarm -o b.png
   texmap render 1abc.cif --style cartoon --color-by structure --supersample 3 -o fold.png
   texmap render 1abc.cif --rep 'protein=cartoon' --rep 'protein=surface:#8080ff' --surface-opacity 0.35 -o see.png
+  texmap render md.xtc --topology md.gro --rep 'protein=cartoon' --rep 'resname LIG=licorice' --rep 'protein or resname LIG=hbonds' -o hb.png
   texmap render 1abc.cif --rep 'not resname LIG=surface' --rep 'resname LIG=ball-stick' --export-mesh pocket.glb -o pocket.png
   texmap render md.xtc --topology protein.pdb --align backbone --style tube --color-by structure --label 't = {ns} ns' -o md.mp4
   texmap render water.gro --color-by element --type-color OW=#ff0000 --radius-scale 0.5 -o w.png

@@ -400,6 +400,7 @@ impl From<DrawStyle> for texmap_md_scene::DrawStyle {
             DrawStyle::Tube => texmap_md_scene::DrawStyle::Tube,
             DrawStyle::Cartoon => texmap_md_scene::DrawStyle::Cartoon,
             DrawStyle::Surface => texmap_md_scene::DrawStyle::Surface,
+            DrawStyle::HBonds => texmap_md_scene::DrawStyle::HBonds,
         }
     }
 }
@@ -483,7 +484,7 @@ pub fn mol_plan(args: &MolArgs) -> Result<MolPlan> {
         };
         let draw = <DrawStyle as clap::ValueEnum>::from_str(style, true).map_err(|_| {
             crate::args::UsageError(format!(
-                "--rep {r:?}: {style:?} is not a style; use spacefill, ball-stick, licorice, tube, cartoon or surface"
+                "--rep {r:?}: {style:?} is not a style; use spacefill, ball-stick, licorice, tube, cartoon, surface or hbonds"
             ))
         })?;
         reps.push(texmap_md_scene::Representation {
@@ -510,6 +511,10 @@ pub fn mol_plan(args: &MolArgs) -> Result<MolPlan> {
             width: w,
             invert: args.slice_invert,
         }),
+        hbonds: texmap_md_io::hbonds::Criteria {
+            distance: args.hbond_distance,
+            angle: args.hbond_angle,
+        },
     })
     .map_err(mol_error)
 }
@@ -585,6 +590,16 @@ pub fn mol_error(e: MolError) -> anyhow::Error {
         MolError::AlignMismatch { .. } => {
             // The trajectory and the --align-to structure disagree: bad input, not usage.
             return anyhow::anyhow!("--align-to: {e}");
+        }
+        MolError::HBonds(texmap_md_io::hbonds::HBondError::CellTooSmall { .. }) => {
+            // The frame's cell, not the options: bad input.
+            return anyhow::anyhow!("--rep ...=hbonds: {e}");
+        }
+        MolError::HBonds(texmap_md_io::hbonds::HBondError::BadDistance(d)) => {
+            format!("--hbond-distance {d}: expected a donor-acceptor distance above 0.45 and at most 6 Å")
+        }
+        MolError::HBonds(texmap_md_io::hbonds::HBondError::BadAngle(a)) => {
+            format!("--hbond-angle {a}: expected an angle from 0 to 180 degrees")
         }
     };
     crate::args::UsageError(text).into()

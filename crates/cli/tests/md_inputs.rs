@@ -1785,3 +1785,86 @@ fn cartoon_and_surface_export_as_gltf_and_obj() {
         assert!(!out.exists() && !file.exists());
     }
 }
+
+/// `--rep SEL=hbonds` on MDAnalysis's solvated adenylate kinase (GRO topology + XTC, triclinic
+/// box): the dashes are drawn as the reference ray tracer traces them, in ChimeraX's blue
+/// unless the representation names a colour; bad cutoffs are usage errors (exit 2).
+#[test]
+fn hydrogen_bonds_are_drawn_as_dashes_as_the_reference_traces_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let (xtc, gro) = (data("hbonds/adk_0_9.xtc"), data("hbonds/adk_top.gro.gz"));
+    let near = "resid 1:25 or (resname SOL and same residue as within 3.5 of resid 1:25)";
+    let hb = format!("{near}=hbonds");
+    let sticks = format!("{near}=licorice");
+    // `render --quiet` of the first frame at 320x240 down z, molecules whole, with `extra`.
+    let args = |extra: &[&str]| -> Vec<String> {
+        let base = [
+            "render",
+            "--quiet",
+            &xtc,
+            "--topology",
+            &gro,
+            "--frames",
+            "0",
+            "--size",
+            "320x240",
+            "--view",
+            "z",
+            "--pbc",
+            "unwrap",
+        ];
+        base.iter().chain(extra).map(|s| s.to_string()).collect()
+    };
+    let run = |extra: &[&str]| {
+        let v = args(extra);
+        texmap(&v.iter().map(String::as_str).collect::<Vec<_>>())
+    };
+    let ours = dir.path().join("ours.png");
+    let reference = dir.path().join("ref.png");
+    for (out, method) in [(&ours, "raycast"), (&reference, "reference")] {
+        let out = out.to_str().unwrap();
+        let o = run(&[
+            "--rep", &sticks, "--rep", &hb, "--method", method, "-o", out,
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    let d = mean_abs_diff(&ours, &reference);
+    eprintln!("mean |hbonds + licorice - reference| = {d:.3} per channel");
+    assert!(d < 1.0, "mean |hbonds - reference| = {d} per channel");
+    // The dashes alone: blue by default, red when the representation says so.
+    let image = |name: &str, rep: &str| {
+        let out = dir.path().join(name);
+        let o = run(&["--rep", rep, "-o", out.to_str().unwrap()]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        image::open(&out).unwrap().to_rgb8()
+    };
+    let blue = image("blue.png", &hb);
+    let red = image("red.png", &format!("{hb}:#ff0000"));
+    let count = |img: &image::RgbImage, f: &dyn Fn(&image::Rgb<u8>) -> bool| {
+        img.pixels().filter(|p| f(p)).count()
+    };
+    let bluish = |p: &image::Rgb<u8>| p[2] > 80 && p[2] as u16 > p[0] as u16 + 40;
+    let reddish = |p: &image::Rgb<u8>| p[0] > 80 && p[0] as u16 > p[2] as u16 + 40;
+    let lit = |p: &image::Rgb<u8>| p.0 != [0, 0, 0];
+    eprintln!(
+        "dash pixels: {} blue, {} red",
+        count(&blue, &bluish),
+        count(&red, &reddish)
+    );
+    assert!(count(&blue, &bluish) > 150 && count(&blue, &reddish) == 0);
+    assert!(count(&red, &reddish) > 150 && count(&red, &bluish) == 0);
+    let sticks_drawn = image::open(&ours).unwrap().to_rgb8();
+    assert!(count(&sticks_drawn, &lit) > 3000, "{}", count(&sticks_drawn, &lit));
+    assert_eq!(count(&blue, &lit), count(&red, &lit));
+    for bad in [
+        ["--hbond-distance", "0.3"],
+        ["--hbond-distance", "7"],
+        ["--hbond-angle", "190"],
+    ] {
+        let out = dir.path().join("bad.png");
+        let o = run(&["--rep", &hb, bad[0], bad[1], "-o", out.to_str().unwrap()]);
+        assert_eq!(o.status.code(), Some(2), "{bad:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains(bad[0]), "{}", stderr(&o));
+        assert!(!out.exists());
+    }
+}

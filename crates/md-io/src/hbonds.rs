@@ -68,6 +68,19 @@ pub struct Criteria {
     pub angle: f32,
 }
 
+impl Criteria {
+    /// Whether the cutoffs are in range (see the fields).
+    pub fn check(&self) -> Result<(), HBondError> {
+        if !(self.distance > BOND_TOLERANCE && self.distance <= MAX_DISTANCE) {
+            return Err(HBondError::BadDistance(self.distance));
+        }
+        if !(0.0..=180.0).contains(&self.angle) {
+            return Err(HBondError::BadAngle(self.angle));
+        }
+        Ok(())
+    }
+}
+
 impl Default for Criteria {
     fn default() -> Criteria {
         Criteria {
@@ -186,13 +199,8 @@ pub fn hydrogen_bonds(
     mask: Option<&[bool]>,
     criteria: Criteria,
 ) -> Result<Vec<HBond>, HBondError> {
+    criteria.check()?;
     let Criteria { distance, angle } = criteria;
-    if !(distance > BOND_TOLERANCE && distance <= MAX_DISTANCE) {
-        return Err(HBondError::BadDistance(distance));
-    }
-    if !(0.0..=180.0).contains(&angle) {
-        return Err(HBondError::BadAngle(angle));
-    }
     let n = frame.n_atoms();
     let keep = |i: usize| i < n && mask.is_none_or(|m| m.get(i).copied().unwrap_or(false));
     // Hydrogens per donor (CSR over the sorted pairs kept).

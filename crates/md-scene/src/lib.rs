@@ -21,6 +21,8 @@
 //! - [`scalar`]: colour coding by a number per atom ([`ScalarSource`]: a property such as the
 //!   B-factor or a LAMMPS compute, the speed, the residue, the index) over a range fixed at the
 //!   first frame.
+//! - hydrogen bonds ([`DrawStyle::HBonds`]): dashed lines from hydrogen to acceptor, found by
+//!   [`texmap_md_io::hbonds`] every frame (see [`plan`]).
 //! - [`cartoon`]: cartoons as VMD's NewCartoon draws them (helix ribbons, strand arrows, coil
 //!   tubes along a spline through the CA atoms; nucleic acids as a P tube with base rungs), a
 //!   mesh like the surface's.
@@ -79,8 +81,8 @@ pub use outline::{add_box_outline, cell_corners};
 pub use palette::{MAX_MATERIALS, Palette, type_color};
 pub use plan::{
     Alignment, BALL_AND_STICK_BOND_RADIUS, BALL_AND_STICK_RADIUS_SCALE, BondSource, COORDINATION,
-    DrawStyle, LICORICE_RADIUS, MolError, MolOptions, MolPlan, Pbc, RepColor, Representation,
-    SelectionRole, Slice,
+    DrawStyle, HBOND_COLOR, HBOND_DASHES, HBOND_RADIUS, LICORICE_RADIUS, MolError, MolOptions,
+    MolPlan, Pbc, RepColor, Representation, SelectionRole, Slice,
 };
 pub use scalar::{NAN_COLOR, SCALAR_LEVELS, ScalarColor, ScalarSource};
 pub use style::{

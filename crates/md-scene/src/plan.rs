@@ -38,7 +38,19 @@
 //!    the backbone tube through their CA (P) atoms, appended as spheres joined by bonds; for
 //!    [`DrawStyle::Cartoon`], protein and nucleic residues give way to the cartoon mesh
 //!    ([`MolPlan::cartoon_mesh`]); for [`DrawStyle::Surface`], the
-//!    selected atoms leave the scene for [`MolPlan::surface_atoms`].
+//!    selected atoms leave the scene for [`MolPlan::surface_atoms`]; for [`DrawStyle::HBonds`],
+//!    the atoms give way to the hydrogen bonds among them (below).
+//!
+//! # Hydrogen bonds
+//! [`DrawStyle::HBonds`] draws the hydrogen bonds among a representation's atoms
+//! ([`texmap_md_io::hbonds`]: MDAnalysis's criterion, [`MolOptions::hbonds`] its cutoffs; the
+//! donor–hydrogen pairs are taken from the frame's bonds in step 2, before bonds across the
+//! box are dropped, or by distance when no bonds are drawn) as VMD's HBonds and ChimeraX's
+//! `hbonds` show them: a dashed line from each hydrogen to its acceptor (to the acceptor's
+//! nearest image, so a bond across the box leaves the box), [`HBOND_DASHES`] dashes of radius
+//! [`HBOND_RADIUS`] with round ends, as long as the gaps between them, in the
+//! representation's colour, else [`HBOND_COLOR`]. Explicit hydrogens are needed (a crystal
+//! structure without them has none to find); [`MolPlan::last_hbonds`] lists the last frame's.
 //!
 //! # The tube
 //! VMD's Tube representation: per chain, a uniform Catmull-Rom spline through the consecutive
@@ -54,6 +66,7 @@ use std::fmt;
 
 use texmap_impostor::SphereScene;
 use texmap_md_io::coordination::CoordinationError;
+use texmap_md_io::hbonds::{self, Criteria, HBond, HBondError};
 use texmap_md_io::replicate::ReplicateError;
 use texmap_md_io::{Frame, Property, Selection, SelectionError, Topology, atom_element};
 
@@ -62,6 +75,14 @@ use crate::{ColorBy, SceneBuilder};
 
 /// Ball-and-stick atoms are this fraction of their Bondi (van der Waals) radii.
 pub const BALL_AND_STICK_RADIUS_SCALE: f32 = 0.3;
+/// Radius (Å) of the dashes of [`DrawStyle::HBonds`] (ChimeraX draws its hydrogen bonds at
+/// 0.075 Å).
+pub const HBOND_RADIUS: f32 = 0.075;
+/// Dashes per hydrogen bond of [`DrawStyle::HBonds`].
+pub const HBOND_DASHES: usize = 4;
+/// The colour (sRGB) of [`DrawStyle::HBonds`] without a colour of its own: ChimeraX's deep sky
+/// blue.
+pub const HBOND_COLOR: [f32; 3] = [0.0, 0.75, 1.0];
 /// Ball-and-stick bond radius in Å: thinner than the smallest scaled atom (H, 0.36 Å), so the
 /// bond ends are hidden inside the atoms.
 pub const BALL_AND_STICK_BOND_RADIUS: f32 = 0.2;
@@ -111,6 +132,9 @@ pub enum DrawStyle {
     /// The selected atoms wrapped in a molecular surface (VMD's QuickSurf: a Gaussian density
     /// surface, [`crate::surface`]); they are not drawn as spheres, and nothing is bonded.
     Surface,
+    /// The hydrogen bonds among the selected atoms as dashed lines from hydrogen to acceptor
+    /// (VMD's HBonds; see the module docs); the atoms themselves are not drawn.
+    HBonds,
 }
 
 /// The periodic-boundary treatment (frames without a cell are left as they are).
@@ -160,6 +184,8 @@ pub struct MolOptions {
     /// Several representations in one scene (see [`Representation`]); when not empty, they
     /// replace `select` and `draw`.
     pub reps: Vec<Representation>,
+    /// The cutoffs of [`DrawStyle::HBonds`] (MDAnalysis's 3.0 Å and 150° by default).
+    pub hbonds: Criteria,
 }
 
 /// A cut through the frame, as OVITO's Slice modifier makes it: the plane `n̂·x = distance`
@@ -258,6 +284,7 @@ impl Default for MolOptions {
             slice: None,
             align: None,
             reps: Vec::new(),
+            hbonds: Criteria::default(),
         }
     }
 }
@@ -318,6 +345,8 @@ pub enum MolError {
     /// [`MolOptions::slice`] has a zero or non-finite normal, a non-finite distance or a
     /// negative or non-finite width.
     BadSlice,
+    /// [`MolOptions::hbonds`] is out of range, or the cell is too small for its cutoff.
+    HBonds(HBondError),
     /// A selection could not be evaluated on a frame.
     Selection {
         /// Which selection.
@@ -333,6 +362,7 @@ impl fmt::Display for MolError {
             MolError::NoTopology => write!(f, "bonds from the topology need a topology"),
             MolError::Replicate(e) => write!(f, "periodic images: {e}"),
             MolError::Coordination(e) => write!(f, "coordination: {e}"),
+            MolError::HBonds(e) => write!(f, "hydrogen bonds: {e}"),
             MolError::BadSlice => write!(
                 f,
                 "slice: the normal must be finite and not zero, the distance finite, the width finite and >= 0"
@@ -411,6 +441,10 @@ pub struct MolPlan {
     surface: SurfaceAtoms,
     /// The last frame's cartoon ([`DrawStyle::Cartoon`]).
     cartoon: MolMesh,
+    /// This frame's donor–hydrogen pairs ([`DrawStyle::HBonds`]), and the hydrogen bonds the
+    /// last frame drew.
+    donor_h: Vec<[u32; 2]>,
+    hbonds: Vec<HBond>,
 }
 
 impl MolPlan {
@@ -441,6 +475,7 @@ impl MolPlan {
                 return Err(MolError::BadSlice);
             }
         }
+        options.hbonds.check().map_err(MolError::HBonds)?;
         let sticks = reps.iter().any(|r| r.draw != DrawStyle::Spacefill);
         if options.bonds == BondSource::Topology && sticks {
             match &options.topology {
@@ -466,6 +501,8 @@ impl MolPlan {
             reps,
             surface: SurfaceAtoms::default(),
             cartoon: MolMesh::default(),
+            donor_h: Vec::new(),
+            hbonds: Vec::new(),
         })
     }
 
@@ -712,6 +749,16 @@ impl MolPlan {
                 values,
             });
         }
+        self.donor_h.clear();
+        if self.draws_hbonds() {
+            // Before bonds across the box are dropped: a water split by a face still donates.
+            self.donor_h = if self.options.bonds == BondSource::None {
+                let by_distance = texmap_md_io::bonds::bonds_by_distance(frame, true).pairs;
+                hbonds::donor_hydrogens(frame, &by_distance)
+            } else {
+                hbonds::donor_hydrogens(frame, &self.pairs)
+            };
+        }
         texmap_md_io::pbc::drop_crossing(&mut self.pairs, &frame.positions, frame.cell.as_ref());
         self.last_bond_count = self.pairs.len();
         let failed = |role| move |error| MolError::Selection { role, error };
@@ -777,6 +824,7 @@ impl MolPlan {
         // and put back, whatever the outcome.
         let reps = std::mem::take(&mut self.reps);
         self.surface.clear();
+        self.hbonds.clear();
         self.cartoon = MolMesh::default();
         let drawn = self.draw_reps(builder, frame, &reps, scene);
         self.reps = reps;
@@ -787,6 +835,18 @@ impl MolPlan {
     /// The last frame's cartoon ([`DrawStyle::Cartoon`]; empty without one).
     pub fn cartoon_mesh(&self) -> &MolMesh {
         &self.cartoon
+    }
+
+    /// Whether some representation draws hydrogen bonds ([`DrawStyle::HBonds`]).
+    pub fn draws_hbonds(&self) -> bool {
+        self.reps.iter().any(|r| r.draw == DrawStyle::HBonds)
+    }
+
+    /// The hydrogen bonds the last frame built draws ([`DrawStyle::HBonds`]), per
+    /// representation in order, each sorted by donor, hydrogen, acceptor (atom indices of the
+    /// frame, after periodic images).
+    pub fn last_hbonds(&self) -> &[HBond] {
+        &self.hbonds
     }
 
     /// Whether some representation draws a molecular surface ([`DrawStyle::Surface`]).
@@ -832,7 +892,11 @@ impl MolPlan {
         rep: &Representation,
         scene: &mut SphereScene,
     ) {
-        match rep.color {
+        let color = match (rep.color, rep.draw) {
+            (None, DrawStyle::HBonds) => Some(RepColor::Fixed(HBOND_COLOR)),
+            (c, _) => c,
+        };
+        match color {
             None => return,
             Some(RepColor::By(by)) => builder.kinds_by(frame, by, &mut scene.kinds),
             Some(RepColor::Fixed(rgb)) => {
@@ -888,7 +952,7 @@ impl MolPlan {
         let failed = |role| move |error| MolError::Selection { role, error };
         scene.bond_radii.clear();
         match rep.draw {
-            DrawStyle::Spacefill | DrawStyle::Surface => {}
+            DrawStyle::Spacefill | DrawStyle::Surface | DrawStyle::HBonds => {}
             DrawStyle::BallStick => {
                 for r in &mut scene.radii {
                     *r *= BALL_AND_STICK_RADIUS_SCALE;
@@ -938,6 +1002,29 @@ impl MolPlan {
             }
             _ => Vec::new(),
         };
+        if rep.draw == DrawStyle::HBonds {
+            let found =
+                hbonds::hydrogen_bonds(frame, &self.donor_h, mask.as_deref(), self.options.hbonds)
+                    .map_err(MolError::HBonds)?;
+            let kinds = std::mem::take(&mut scene.kinds);
+            scene.centers.clear();
+            scene.radii.clear();
+            scene.bonds.clear();
+            scene.bond_radius = HBOND_RADIUS;
+            for b in &found {
+                let h = frame.positions[b.hydrogen as usize];
+                let a = frame.positions[b.acceptor as usize];
+                let mut v: [f64; 3] = std::array::from_fn(|k| a[k] as f64 - h[k] as f64);
+                if let Some(cell) = &frame.cell {
+                    v = texmap_md_io::pbc::minimum_image(cell, v);
+                }
+                let from = glam::Vec3::from(h);
+                let to = from + glam::DVec3::from(v).as_vec3();
+                push_dashes(scene, from, to, kinds[b.hydrogen as usize]);
+            }
+            self.hbonds.extend_from_slice(&found);
+            return Ok(());
+        }
         self.map.clear();
         if let Some(mask) = &mask {
             let mut next = 0u32;
@@ -1063,6 +1150,26 @@ fn backbone_traces(
 }
 
 /// Appends the tube of one trace to `scene`: spline points as spheres, consecutive ones bonded.
+/// A dashed line from `from` to `to` into `scene`: [`HBOND_DASHES`] cylinders of
+/// [`HBOND_RADIUS`] with round ends, each (ends included) as long as the gaps between them.
+fn push_dashes(scene: &mut SphereScene, from: glam::Vec3, to: glam::Vec3, kind: u16) {
+    let r = HBOND_RADIUS;
+    let n = HBOND_DASHES;
+    let axis = (to - from).normalize_or_zero();
+    // n dashes and n − 1 gaps of one length; a dash's sphere centres lie r inside its ends.
+    let step = (to - from).length() / (2 * n - 1) as f32;
+    let inset = r.min(step / 2.0);
+    for k in 0..n {
+        let start = from + axis * (2 * k) as f32 * step;
+        let a = start + axis * inset;
+        let b = start + axis * (step - inset);
+        let first = scene.centers.len() as u32;
+        scene.push(a, r, kind);
+        scene.push(b, r, kind);
+        scene.bonds.push([first, first + 1]);
+    }
+}
+
 fn push_tube(scene: &mut SphereScene, trace: &[TracePoint]) {
     let first = scene.centers.len() as u32;
     let n = trace.len();
