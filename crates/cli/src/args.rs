@@ -768,6 +768,12 @@ pub struct MolArgs {
     /// default 150; VMD's angle cutoff of 20 is 160 here).
     #[arg(long, value_name = "DEG", default_value_t = texmap_md_io::hbonds::DEFAULT_ANGLE)]
     pub hbond_angle: f32,
+    /// Also write the hydrogen bonds the hbonds style draws as a CSV table, one row per bond and
+    /// frame: frame, donor, hydrogen, acceptor (0-based atom indices, as MDAnalysis's
+    /// results.hbonds), the three atoms as RESNAME RESID:NAME, the donor-acceptor distance (Å)
+    /// and the donor-hydrogen-acceptor angle (degrees). Written whole or not at all.
+    #[arg(long, value_name = "FILE.csv")]
+    pub hbond_table: Option<PathBuf>,
     /// Periodic boundaries: none, wrap (atoms into the box), unwrap (molecules whole).
     #[arg(long, value_enum, default_value_t = PbcArg::None)]
     pub pbc: PbcArg,

@@ -473,6 +473,24 @@ fn render(a: &RenderArgs) -> Result<()> {
             }
         },
     };
+    let mut hbond_table = match &a.mol.hbond_table {
+        None => None,
+        Some(_) if !plan.draws_hbonds() => {
+            return usage(
+                "--hbond-table lists the hydrogen bonds the hbonds style draws: add a representation of them, as --rep 'protein or water=hbonds'",
+            );
+        }
+        Some(_) if mine.len() != frames.len() => {
+            return usage(
+                "--hbond-table with --shard (or a Slurm array): every part would write the same table; write it in a run of its own",
+            );
+        }
+        Some(p) => {
+            let mut t = crate::output::AtomicFile::create(p)?;
+            t.write("frame,donor,hydrogen,acceptor,donor_atom,hydrogen_atom,acceptor_atom,distance,angle\n")?;
+            Some(t)
+        }
+    };
     if a.export_mesh.is_some() && !plan.draws_meshes() {
         return usage(
             "--export-mesh writes the cartoon and surface styles' meshes: draw some atoms with --style cartoon or surface (or a --rep of them)",
@@ -520,6 +538,12 @@ fn render(a: &RenderArgs) -> Result<()> {
         }
         plan.build(&mut builder, &mut md, &mut scene)
             .map_err(|e| fail(crate::scene::mol_error(e), &written))?;
+        if let Some(t) = &mut hbond_table
+            && mine.contains(&k)
+        {
+            t.write(&hbond_rows(f, plan.last_hbonds(), &md))
+                .map_err(|e| fail(e, &written))?;
+        }
         if a.box_outline
             && let Some(cell) = &md.cell
         {
@@ -732,6 +756,9 @@ fn render(a: &RenderArgs) -> Result<()> {
     }
     pb.finish_and_clear();
     let movie = sink.finish()?;
+    if let Some(t) = hbond_table {
+        t.commit()?;
+    }
     if builder.merged_colors() > 0 {
         eprintln!(
             "texmap: warning: {} more distinct colours than the {} materials a scene holds; each was drawn with the nearest of the first {}",
@@ -764,6 +791,41 @@ fn render(a: &RenderArgs) -> Result<()> {
         None => crate::note!("wrote {} frame(s)", mine.len()),
     }
     Ok(())
+}
+
+/// The `--hbond-table` rows of frame `f` (see the flag).
+fn hbond_rows(f: usize, bonds: &[texmap_md_io::hbonds::HBond], md: &MdFrame) -> String {
+    use std::fmt::Write;
+    let atom = |i: u32| {
+        let i = i as usize;
+        let label = |v: &[texmap_md_io::Label]| v.get(i).map(|l| l.as_str().to_string());
+        let res = label(&md.res_names).unwrap_or_default();
+        let id = md.res_ids.get(i).map(|r| r.to_string()).unwrap_or_default();
+        let name = label(&md.names).unwrap_or_else(|| format!("#{i}"));
+        let text = format!("{res}{id}:{name}");
+        // CSV quoting (RFC 4180) for names that hold a comma or a quote.
+        if text.contains([',', '"', '\n', '\r']) {
+            format!("\"{}\"", text.replace('"', "\"\""))
+        } else {
+            text
+        }
+    };
+    let mut out = String::new();
+    for b in bonds {
+        let _ = writeln!(
+            out,
+            "{f},{},{},{},{},{},{},{:.4},{:.3}",
+            b.donor,
+            b.hydrogen,
+            b.acceptor,
+            atom(b.donor),
+            atom(b.hydrogen),
+            atom(b.acceptor),
+            b.distance,
+            b.angle
+        );
+    }
+    out
 }
 
 fn named_scene(a: &CompareArgs) -> Result<NamedScene> {

@@ -73,6 +73,67 @@ pub fn write_atomic(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Res
     result
 }
 
+/// A file written piece by piece (a table growing frame by frame) under a temporary name beside
+/// its destination, moved into place by [`AtomicFile::commit`]; dropped without it (an error on
+/// the way), it removes the temporary file, so no partial file is left under either name.
+pub struct AtomicFile {
+    path: PathBuf,
+    tmp: PathBuf,
+    out: Option<std::io::BufWriter<std::fs::File>>,
+}
+
+impl AtomicFile {
+    /// Start writing `path` (its directory created if needed).
+    pub fn create(path: &Path) -> Result<AtomicFile> {
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir)
+                .with_context(|| format!("cannot create directory {}", dir.display()))?;
+        }
+        let tmp = temp_beside(path);
+        let file = std::fs::File::create(&tmp)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+        Ok(AtomicFile {
+            path: path.to_path_buf(),
+            tmp,
+            out: Some(std::io::BufWriter::new(file)),
+        })
+    }
+
+    /// Append `text`.
+    pub fn write(&mut self, text: &str) -> Result<()> {
+        use std::io::Write;
+        let out = self.out.as_mut().expect("open until committed");
+        out.write_all(text.as_bytes())
+            .with_context(|| format!("cannot write {}", self.path.display()))
+    }
+
+    /// Flush and move the file into place.
+    pub fn commit(mut self) -> Result<()> {
+        let out = self.out.take().expect("open until committed");
+        let done = out
+            .into_inner()
+            .map_err(|e| e.into_error())
+            .and_then(|f| f.sync_all())
+            .with_context(|| format!("cannot write {}", self.path.display()))
+            .and_then(|()| {
+                std::fs::rename(&self.tmp, &self.path)
+                    .with_context(|| format!("cannot move {} into place", self.path.display()))
+            });
+        if done.is_err() {
+            let _ = std::fs::remove_file(&self.tmp);
+        }
+        done
+    }
+}
+
+impl Drop for AtomicFile {
+    fn drop(&mut self) {
+        if self.out.take().is_some() {
+            let _ = std::fs::remove_file(&self.tmp);
+        }
+    }
+}
+
 /// Write the colour of a frame as an 8-bit sRGB RGBA PNG.
 pub fn write_png(frame: &Frame, path: &Path) -> Result<()> {
     write_atomic(path, |tmp| {

@@ -18,9 +18,11 @@
 //! - a mask restricts all three to the atoms it keeps (a selection: the bonds within it).
 //!
 //! Candidate D–A pairs come from the cell grid of [`crate::bonds`] (linear in the atoms,
-//! parallel, the same pairs for any thread count), each then tested exactly in f64 (pairs
-//! closer than the grid's 0.4 Å floor, overlapping atoms of a damaged frame, are never bonds). As for
-//! [`crate::coordination`], a periodic cell narrower than three cutoffs along some axis would
+//! parallel, the same pairs for any thread count), each then tested in f64 on the f32 positions
+//! (so a pair written exactly at the cutoff, as a trajectory's 0.01 Å grid makes some, is in or
+//! out as its f32 rounding falls; MDAnalysis's f32 arithmetic may decide such a tie the other
+//! way); pairs closer than the grid's 0.4 Å floor (overlapping atoms of a damaged frame) are
+//! never bonds. As for [`crate::coordination`], a periodic cell narrower than three cutoffs along some axis would
 //! need several images of one partner and is an error ([`HBondError::CellTooSmall`]).
 //!
 //! ```
