@@ -3,12 +3,20 @@
 //! in seeded directions) in a periodic cubic box (minimum image) and the same atoms open.
 //! Target: ≤ 100 ms on 2 cores.
 //!
+//! Hydrogen bonds (`md_io::hbonds`, MDAnalysis's 3.0 Å / 150° criterion) on a real system:
+//! frame 0 of MDAnalysis's adenylate kinase in water (md-io's tests/data/hbonds: 47,681 atoms,
+//! triclinic box, 13.5k hydrogen bonds), the search alone (donor-hydrogen pairs given) and a
+//! frame's whole cost when the bonds come by distance (bonds, pairs, search), as the hbonds
+//! representation pays it.
+//!
 //! `cargo bench --bench md_bonds -- --warm-up-time 1 --measurement-time 5`
 //! (test mode, `cargo test --bench md_bonds`, uses 30,000 atoms.)
 
 use criterion::{Criterion, criterion_group};
 use texmap::md_io::UnitCell;
-use texmap::md_io::bonds::bonds_with_radii;
+use texmap::md_io::bonds::{bonds_by_distance, bonds_with_radii};
+use texmap::md_io::hbonds::{Criteria, donor_hydrogens, hydrogen_bonds};
+use texmap::md_io::{Frame, Topology, Trajectory};
 
 struct Lcg(u64);
 impl Lcg {
@@ -78,7 +86,40 @@ fn bench(c: &mut Criterion) {
     assert!(found >= 2 * (n / 3), "{found} bonds");
 }
 
-criterion_group!(benches, bench);
+fn bench_hbonds(c: &mut Criterion) {
+    let dir = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/crates/md-io/tests/data/hbonds"
+    );
+    let top = Topology::open(format!("{dir}/adk_top.gro.gz")).unwrap();
+    let mut traj = Trajectory::open(format!("{dir}/adk_0_9.xtc")).unwrap();
+    let mut frame = Frame::new();
+    assert!(traj.read_next(&mut frame).unwrap());
+    top.apply(&mut frame, "adk_0_9.xtc", 0).unwrap();
+    let dh = donor_hydrogens(&frame, &bonds_by_distance(&frame, true).pairs);
+    let found = hydrogen_bonds(&frame, &dh, None, Criteria::default()).unwrap();
+    assert!(found.len() > 13_000, "{}", found.len());
+    let mut g = c.benchmark_group("md_hbonds");
+    g.sample_size(20);
+    g.bench_function("adk_47681_search", |b| {
+        b.iter(|| {
+            hydrogen_bonds(&frame, &dh, None, Criteria::default())
+                .unwrap()
+                .len()
+        })
+    });
+    g.bench_function("adk_47681_bonds_and_search", |b| {
+        b.iter(|| {
+            let dh = donor_hydrogens(&frame, &bonds_by_distance(&frame, true).pairs);
+            hydrogen_bonds(&frame, &dh, None, Criteria::default())
+                .unwrap()
+                .len()
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench, bench_hbonds);
 
 fn main() {
     benches();
