@@ -578,6 +578,16 @@ fn render(a: &RenderArgs) -> Result<()> {
             if let Some(w) = crate::scene::unnamed_warning(&plan, &md, traj.name()) {
                 pb.suspend(|| eprintln!("texmap: warning: {w}"));
             }
+            let hydrogens =
+                (0..md.n_atoms()).any(|i| texmap_md_io::atom_element(&md, i).symbol() == "H");
+            if plan.draws_hbonds() && !hydrogens {
+                pb.suspend(|| {
+                    eprintln!(
+                        "texmap: warning: frame {f} of {} has no hydrogen atoms, so the hbonds style finds no hydrogen bonds: they need explicit hydrogens (add them with pdbfixer, reduce or gmx pdb2gmx)",
+                        traj.name()
+                    )
+                });
+            }
             if scene.is_empty()
                 && plan.surface_atoms().is_empty()
                 && plan.cartoon_mesh().triangles.is_empty()
@@ -588,6 +598,10 @@ fn render(a: &RenderArgs) -> Result<()> {
                         .as_deref()
                         .map(|s| format!(": --select {s:?} selects none of frame {f}'s atoms"))
                         .unwrap_or_default()
+                } else if plan.draws_hbonds() {
+                    format!(
+                        ": no --rep selects any of frame {f}'s atoms, and the hbonds representations find no hydrogen bond among theirs"
+                    )
                 } else {
                     format!(": no --rep selects any of frame {f}'s atoms")
                 };

@@ -1871,6 +1871,26 @@ fn hydrogen_bonds_are_drawn_as_dashes_as_the_reference_traces_them() {
         assert!(stderr(&o).contains(bad[0]), "{}", stderr(&o));
         assert!(!out.exists());
     }
+    // A crystal structure without hydrogens: a warning that says why there are no dashes; with
+    // nothing else to draw, an error that says so.
+    let pdb = data("dssp/3gwiA.pdb.gz");
+    let out = dir.path().join("noh.png");
+    let noh = |reps: &[&str]| {
+        let mut v = vec!["render", "--quiet", &pdb, "--size", "64x48"];
+        for r in reps {
+            v.extend(["--rep", r]);
+        }
+        v.extend(["-o", out.to_str().unwrap()]);
+        texmap(&v)
+    };
+    let o = noh(&["protein=cartoon", "all=hbonds"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("no hydrogen atoms"), "{}", stderr(&o));
+    std::fs::remove_file(&out).unwrap();
+    let o = noh(&["all=hbonds"]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("no hydrogen bond"), "{}", stderr(&o));
+    assert!(!out.exists());
 }
 
 /// `--hbond-table` lists, frame by frame, the hydrogen bonds the hbonds style draws: over the
