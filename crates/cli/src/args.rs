@@ -486,8 +486,9 @@ pub struct RenderArgs {
     pub supersample: u32,
     /// A caption at the top left of every image, on a light backdrop, for movies:
     /// 't = {ns} ns'. {time} is the frame's time in ps, {ns} in ns, {step} its MD step,
-    /// {frame} its index in the file; a file whose frames carry no time (XYZ, PDB) takes
-    /// {frame}. ASCII only; the text is cut at half the image width.
+    /// {frame} its index in the file, {hbonds} the hydrogen bonds an hbonds representation
+    /// draws in it; a file whose frames carry no time (XYZ, PDB) takes {frame}. ASCII only;
+    /// the text is cut at half the image width.
     #[arg(long, value_name = "TEXT")]
     pub label: Option<String>,
     /// Label the atoms SEL picks, as PyMOL's and VMD's labels: each gets TEXT just above it,

@@ -473,6 +473,16 @@ fn render(a: &RenderArgs) -> Result<()> {
             }
         },
     };
+    if label.as_ref().is_some_and(|parts| {
+        parts
+            .iter()
+            .any(|p| matches!(p, crate::scene::LabelPart::HBonds))
+    }) && !plan.draws_hbonds()
+    {
+        return usage(
+            "--label {hbonds} counts the hydrogen bonds the hbonds style draws: add a representation of them, as --rep 'protein or water=hbonds'",
+        );
+    }
     let mut hbond_table = match &a.mol.hbond_table {
         None => None,
         Some(_) if !plan.draws_hbonds() => {
@@ -757,7 +767,8 @@ fn render(a: &RenderArgs) -> Result<()> {
             }
         }
         if let Some(parts) = &label {
-            let text = crate::scene::label_text(parts, f, &md, traj.name())
+            let hbonds = plan.last_hbonds().len();
+            let text = crate::scene::label_text(parts, f, &md, traj.name(), hbonds)
                 .map_err(|e| fail(e, &written))?;
             let (w, h) = (out.width() as usize, out.height() as usize);
             texmap_md_scene::draw_caption(out.color.as_flattened_mut(), w, h, &text);

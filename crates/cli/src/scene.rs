@@ -115,6 +115,8 @@ pub enum LabelPart {
     Step,
     /// `{frame}`: the frame's index in the file.
     Frame,
+    /// `{hbonds}`: the hydrogen bonds the hbonds style draws in the frame.
+    HBonds,
 }
 
 /// A `{placeholder}` template split into text and placeholders, each placeholder one of
@@ -158,8 +160,8 @@ fn template<'a>(
 /// `--label`'s template, parsed before any frame is read: braces balanced, every placeholder
 /// `{time}`, `{ns}`, `{step}` or `{frame}`.
 pub fn parse_label(text: &str) -> Result<Vec<LabelPart>> {
-    const NAMES: [&str; 4] = ["time", "ns", "step", "frame"];
-    let hint = "{time} (ps), {ns}, {step} or {frame}";
+    const NAMES: [&str; 5] = ["time", "ns", "step", "frame", "hbonds"];
+    let hint = "{time} (ps), {ns}, {step}, {frame} or {hbonds}";
     Ok(template("--label", text, &NAMES, hint)?
         .into_iter()
         .map(|p| match p {
@@ -167,7 +169,8 @@ pub fn parse_label(text: &str) -> Result<Vec<LabelPart>> {
             Err(0) => LabelPart::Time,
             Err(1) => LabelPart::Ns,
             Err(2) => LabelPart::Step,
-            Err(_) => LabelPart::Frame,
+            Err(3) => LabelPart::Frame,
+            Err(_) => LabelPart::HBonds,
         })
         .collect())
 }
@@ -288,7 +291,15 @@ fn compact(v: f64, decimals: usize) -> String {
 
 /// The `--label` text of frame `index` of `file`. Errors when it asks for a time or step the
 /// frame does not carry.
-pub fn label_text(parts: &[LabelPart], index: usize, frame: &Frame, file: &str) -> Result<String> {
+/// The caption of frame `index` of `file`; `hbonds` is the count of hydrogen bonds drawn (the
+/// caller refuses `{hbonds}` without an hbonds representation).
+pub fn label_text(
+    parts: &[LabelPart],
+    index: usize,
+    frame: &Frame,
+    file: &str,
+    hbonds: usize,
+) -> Result<String> {
     let missing = |what: &str, placeholder: &str| {
         anyhow::anyhow!(
             "--label {{{placeholder}}}: frame {index} of {file} has no {what} (XTC, TRR, DCD, AMBER NetCDF, GRO with t= or step=, extended XYZ with Time= and LAMMPS dumps carry them; PDB and plain XYZ do not: use {{frame}})"
@@ -311,6 +322,7 @@ pub fn label_text(parts: &[LabelPart], index: usize, frame: &Frame, file: &str) 
                 out.push_str(&step.to_string())
             }
             LabelPart::Frame => out.push_str(&index.to_string()),
+            LabelPart::HBonds => out.push_str(&hbonds.to_string()),
         }
     }
     Ok(out)

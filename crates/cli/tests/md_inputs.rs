@@ -1986,4 +1986,40 @@ fn the_hydrogen_bond_table_is_mdanalysis_s_list() {
         }
         assert!(got[k].len() > 13_000);
     }
+    // `--label {hbonds}` writes the count the table lists (the caption drawn byte for byte as
+    // the literal number); without an hbonds representation it is a usage error.
+    let caption = |label: &str, rep: &str, out: &str| {
+        texmap(&[
+            "render",
+            "--quiet",
+            &xtc,
+            "--topology",
+            &gro,
+            "--frames",
+            "0",
+            "--size",
+            "160x120",
+            "--rep",
+            rep,
+            "--label",
+            label,
+            "-o",
+            out,
+        ])
+    };
+    let (a, b) = (dir.path().join("a.png"), dir.path().join("b.png"));
+    let o = caption("{hbonds} H-bonds", "all=hbonds", a.to_str().unwrap());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let literal = format!("{} H-bonds", got[0].len());
+    let o = caption(&literal, "all=hbonds", b.to_str().unwrap());
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(std::fs::read(&a).unwrap() == std::fs::read(&b).unwrap());
+    let c = dir.path().join("c.png");
+    let o = caption("{hbonds} H-bonds", "all=licorice", c.to_str().unwrap());
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("{hbonds}") && !c.exists(),
+        "{}",
+        stderr(&o)
+    );
 }
