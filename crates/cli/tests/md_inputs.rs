@@ -1786,38 +1786,40 @@ fn cartoon_and_surface_export_as_gltf_and_obj() {
     }
 }
 
+/// `texmap render --quiet` of frame 0 of MDAnalysis's solvated adenylate kinase (md-io's
+/// tests/data/hbonds: GRO topology + XTC) at `size`, with `extra`.
+fn render_adk_frame0(size: &str, extra: &[&str]) -> Output {
+    let (xtc, gro) = (data("hbonds/adk_0_9.xtc"), data("hbonds/adk_top.gro.gz"));
+    let mut args = vec![
+        "render",
+        "--quiet",
+        &xtc,
+        "--topology",
+        &gro,
+        "--frames",
+        "0",
+        "--size",
+        size,
+    ];
+    args.extend(extra);
+    texmap(&args)
+}
+
 /// `--rep SEL=hbonds` on MDAnalysis's solvated adenylate kinase (GRO topology + XTC, triclinic
 /// box): the dashes are drawn as the reference ray tracer traces them, in ChimeraX's blue
 /// unless the representation names a colour; bad cutoffs are usage errors (exit 2).
 #[test]
 fn hydrogen_bonds_are_drawn_as_dashes_as_the_reference_traces_them() {
     let dir = tempfile::tempdir().unwrap();
-    let (xtc, gro) = (data("hbonds/adk_0_9.xtc"), data("hbonds/adk_top.gro.gz"));
     let near = "resid 1:25 or (resname SOL and same residue as within 3.5 of resid 1:25)";
     let hb = format!("{near}=hbonds");
     let sticks = format!("{near}=licorice");
-    // `render --quiet` of the first frame at 320x240 down z, molecules whole, with `extra`.
-    let args = |extra: &[&str]| -> Vec<String> {
-        let base = [
-            "render",
-            "--quiet",
-            &xtc,
-            "--topology",
-            &gro,
-            "--frames",
-            "0",
-            "--size",
-            "320x240",
-            "--view",
-            "z",
-            "--pbc",
-            "unwrap",
-        ];
-        base.iter().chain(extra).map(|s| s.to_string()).collect()
-    };
+    // The first frame at 320x240 down z, molecules whole, with `extra`.
     let run = |extra: &[&str]| {
-        let v = args(extra);
-        texmap(&v.iter().map(String::as_str).collect::<Vec<_>>())
+        render_adk_frame0(
+            "320x240",
+            &[&["--view", "z", "--pbc", "unwrap"][..], extra].concat(),
+        )
     };
     let ours = dir.path().join("ours.png");
     let reference = dir.path().join("ref.png");
@@ -1989,23 +1991,7 @@ fn the_hydrogen_bond_table_is_mdanalysis_s_list() {
     // `--label {hbonds}` writes the count the table lists (the caption drawn byte for byte as
     // the literal number); without an hbonds representation it is a usage error.
     let caption = |label: &str, rep: &str, out: &str| {
-        texmap(&[
-            "render",
-            "--quiet",
-            &xtc,
-            "--topology",
-            &gro,
-            "--frames",
-            "0",
-            "--size",
-            "160x120",
-            "--rep",
-            rep,
-            "--label",
-            label,
-            "-o",
-            out,
-        ])
+        render_adk_frame0("160x120", &["--rep", rep, "--label", label, "-o", out])
     };
     let (a, b) = (dir.path().join("a.png"), dir.path().join("b.png"));
     let o = caption("{hbonds} H-bonds", "all=hbonds", a.to_str().unwrap());
