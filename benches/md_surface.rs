@@ -1,8 +1,9 @@
 //! Molecular surfaces (`md_scene::surface`, `texmap render --style surface`): wwPDB 3E8M chain A
 //! (2,646 atoms, md-io's test data) with van der Waals radii, and 27 copies of it on a 3x3x3
 //! lattice 70 Å apart (71,442 atoms): the surface built at 0.5 Å (density, surface nets, Newton
-//! projection) and drawn over a cleared 1920x1080 frame; the chain's cartoon (DSSP, spline,
-//! sweep). A movie pays them per frame.
+//! projection) and drawn over a cleared 1920x1080 frame; the chain alone also coloured by
+//! element (`3e8m_by_element`: the colour boundaries cut into the triangles they cross); the
+//! chain's cartoon (DSSP, spline, sweep). A movie pays them per frame.
 //!
 //! `cargo bench --bench md_surface -- --warm-up-time 2 --measurement-time 10`
 //! (test mode, `cargo test --bench md_surface`, builds the one chain at 1.0 Å and 320x180.)
@@ -30,6 +31,12 @@ fn bench(c: &mut Criterion) {
     let mut chain = SurfaceAtoms::default();
     for (p, r) in md.positions.iter().zip(&radii) {
         chain.push(Vec3::from(*p), *r, 0);
+    }
+    // The same chain with one material per element (C, N, O, S, ...).
+    let mut by_element = SurfaceAtoms::default();
+    for (i, (p, r)) in md.positions.iter().zip(&radii).enumerate() {
+        let z = texmap::md_io::atom_element(&md, i).z();
+        by_element.push(Vec3::from(*p), *r, z as u16);
     }
     let mut lattice = SurfaceAtoms::default();
     for k in 0..27 {
@@ -59,7 +66,7 @@ fn bench(c: &mut Criterion) {
             mesh
         })
     });
-    let mut cases = vec![("3e8m", &chain)];
+    let mut cases = vec![("3e8m", &chain), ("3e8m_by_element", &by_element)];
     if !test_mode {
         cases.push(("3e8m_x27", &lattice));
     }
@@ -68,6 +75,11 @@ fn bench(c: &mut Criterion) {
             b.iter(|| MolMesh::surface(atoms, &options).unwrap())
         });
         let surface = MolMesh::surface(atoms, &options).unwrap();
+        eprintln!(
+            "{name}: {} vertices, {} triangles",
+            surface.positions.len(),
+            surface.triangles.len()
+        );
         let (lo, hi) = atoms
             .centers
             .iter()

@@ -24,9 +24,12 @@
 //! Each vertex then takes up to [`NEWTON_STEPS`] Newton steps `p ← p − (ρ(p) − ρ₀) ∇ρ / |∇ρ|²` (each
 //! at most half a cell) on the exact, not the sampled, density: vertices lie on the true
 //! isosurface to within float rounding, and the normal `−∇ρ / |∇ρ|` there is exact too, so the
-//! grid only decides how finely the surface is cut into triangles. A triangle takes the material
-//! of the atom contributing most to the density at two or three of its vertices (else the
-//! first's), as PyMOL colours a surface by its nearest atom.
+//! grid only decides how finely the surface is cut into triangles. Each vertex takes the
+//! material of the atom contributing most to the density there, as PyMOL colours a surface by
+//! its nearest atom; a triangle whose vertices differ is cut between its edges' midpoints (and
+//! its centroid, for three materials), the new vertices projected onto the surface too, and each
+//! piece takes its vertex's material, so colour boundaries cross triangles rather than follow
+//! their edges in steps.
 //!
 //! ```
 //! use glam::Vec3;
@@ -235,6 +238,30 @@ impl Lookup {
         }
     }
 
+    /// `p0` moved onto the isosurface `ρ = iso` by up to [`NEWTON_STEPS`] Newton steps of at most
+    /// `max_step` each; with the unit normal `−∇ρ / |∇ρ|` there and the atom contributing most.
+    fn project(&self, p0: Vec3, iso: f32, max_step: f32) -> (Vec3, Vec3, u32) {
+        let mut p = p0;
+        let mut at = self.eval(p);
+        for _ in 0..NEWTON_STEPS {
+            let (r, g, _) = at;
+            let g2 = g.length_squared();
+            if (r - iso).abs() <= CONVERGED || g2 <= 0.0 || !g2.is_finite() {
+                break;
+            }
+            let step = g * ((r - iso) / g2);
+            let len = step.length();
+            p -= if len > max_step {
+                step * (max_step / len)
+            } else {
+                step
+            };
+            at = self.eval(p);
+        }
+        let (_, g, best) = at;
+        (p, (-g).normalize_or_zero(), best)
+    }
+
     /// `ρ(p)`, `∇ρ(p)` and the blob contributing most (its input index; `u32::MAX` if none).
     fn eval(&self, p: Vec3) -> (f32, Vec3, u32) {
         let q = ((p - self.origin) / self.cell).floor();
@@ -404,34 +431,11 @@ impl MolMesh {
         }
         drop(planes);
         // Onto the exact isosurface; the exact normal and the dominant atom there.
-        let max_step = 0.5 * h;
-        let projected: Vec<(Vec3, Vec3, u16)> = positions
+        let projected: Vec<(Vec3, Vec3, u32)> = positions
             .par_iter()
-            .map(|&p0| {
-                let mut p = p0;
-                let mut at = lookup.eval(p);
-                for _ in 0..NEWTON_STEPS {
-                    let (r, g, _) = at;
-                    let g2 = g.length_squared();
-                    if (r - iso).abs() <= CONVERGED || g2 <= 0.0 || !g2.is_finite() {
-                        break;
-                    }
-                    let step = g * ((r - iso) / g2);
-                    let len = step.length();
-                    p -= if len > max_step {
-                        step * (max_step / len)
-                    } else {
-                        step
-                    };
-                    at = lookup.eval(p);
-                }
-                let (_, g, best) = at;
-                let n = (-g).normalize_or_zero();
-                let kind = atoms.kinds.get(best as usize).copied().unwrap_or(0);
-                (p, n, kind)
-            })
+            .map(|&p0| lookup.project(p0, iso, 0.5 * h))
             .collect();
-        let vertex_kind: Vec<u16> = projected.iter().map(|v| v.2).collect();
+        let vertex_atom: Vec<u32> = projected.iter().map(|v| v.2).collect();
         self.positions = projected.iter().map(|v| v.0).collect();
         self.normals = projected.iter().map(|v| v.1).collect();
         // Quads: per plane of grid edges (edges whose lower sample is in plane z), in parallel.
@@ -496,20 +500,102 @@ impl MolMesh {
             })
             .collect();
         self.triangles = quads.concat();
-        self.kinds = self
-            .triangles
-            .iter()
-            .map(|t| {
-                let [a, b, c] = t.map(|i| vertex_kind[i as usize]);
-                if a == b || a == c {
-                    a
-                } else if b == c {
-                    b
+        self.split_colour_boundaries(&vertex_atom, atoms, lookup, iso);
+    }
+
+    /// Where a triangle's vertices have different materials, cut it where each such edge crosses
+    /// the boundary between its ends' dominant atoms (and at its centroid, for three materials)
+    /// and give each piece the material of the vertex it holds, so that a colour boundary runs
+    /// through the triangles instead of stepping along their edges. An edge's cut vertex is
+    /// shared by both its triangles (the mesh stays closed); the new vertices are projected onto
+    /// the exact surface as the others.
+    fn split_colour_boundaries(
+        &mut self,
+        vertex_atom: &[u32],
+        atoms: &SurfaceAtoms,
+        lookup: &Lookup,
+        iso: f32,
+    ) {
+        let kind_of = |atom: u32| atoms.kinds.get(atom as usize).copied().unwrap_or(0);
+        let vertex_kind: Vec<u16> = vertex_atom.iter().map(|&a| kind_of(a)).collect();
+        // Each atom's Gaussian (centre, 1 / 2σ²), by input index.
+        let mut gauss = vec![(Vec3::ZERO, 0.0f32); atoms.kinds.len()];
+        for b in &lookup.blobs {
+            gauss[b.atom as usize] = (b.center, b.inv2s2);
+        }
+        let base = self.positions.len() as u32;
+        let mut start: Vec<Vec3> = Vec::new();
+        let mut mids: std::collections::HashMap<u64, u32> = std::collections::HashMap::new();
+        let positions = &self.positions;
+        let mut mid = |a: u32, b: u32, start: &mut Vec<Vec3>| -> u32 {
+            let key = (a.min(b) as u64) << 32 | a.max(b) as u64;
+            *mids.entry(key).or_insert_with(|| {
+                // Where ln w_A − ln w_B (A, B the ends' dominant atoms) changes sign along the
+                // edge: linear in the position for equal σ, interpolated linearly otherwise.
+                let (p, q) = (positions[a as usize], positions[b as usize]);
+                let [ga, gb] = [a, b].map(|v| {
+                    gauss
+                        .get(vertex_atom[v as usize] as usize)
+                        .copied()
+                        .unwrap_or_default()
+                });
+                let f = |x: Vec3| {
+                    -(x - ga.0).length_squared() * ga.1 + (x - gb.0).length_squared() * gb.1
+                };
+                let (f0, f1) = (f(p), f(q));
+                let t = f0 / (f0 - f1);
+                let t = if t.is_finite() {
+                    t.clamp(0.0, 1.0)
                 } else {
-                    a
-                }
+                    0.5
+                };
+                start.push(p.lerp(q, t));
+                base + start.len() as u32 - 1
             })
+        };
+        let mut triangles = Vec::with_capacity(self.triangles.len());
+        let mut kinds = Vec::with_capacity(self.triangles.len());
+        for &[a, b, c] in &self.triangles {
+            let k = [a, b, c].map(|i| vertex_kind[i as usize]);
+            if k[0] == k[1] && k[1] == k[2] {
+                triangles.push([a, b, c]);
+                kinds.push(k[0]);
+            } else if k[0] != k[1] && k[1] != k[2] && k[0] != k[2] {
+                let ab = mid(a, b, &mut start);
+                let bc = mid(b, c, &mut start);
+                let ca = mid(c, a, &mut start);
+                let g = base + start.len() as u32;
+                let p = |i: u32| positions[i as usize];
+                start.push((p(a) + p(b) + p(c)) / 3.0);
+                for (v, out, back, kind) in
+                    [(a, ab, ca, k[0]), (b, bc, ab, k[1]), (c, ca, bc, k[2])]
+                {
+                    triangles.extend([[v, out, g], [v, g, back]]);
+                    kinds.extend([kind, kind]);
+                }
+            } else {
+                // Rotated (winding kept) so that `c` is the odd one out.
+                let [a, b, c] = if k[0] == k[1] {
+                    [a, b, c]
+                } else if k[1] == k[2] {
+                    [b, c, a]
+                } else {
+                    [c, a, b]
+                };
+                let (bc, ca) = (mid(b, c, &mut start), mid(c, a, &mut start));
+                let (kab, kc) = (vertex_kind[a as usize], vertex_kind[c as usize]);
+                triangles.extend([[a, b, bc], [a, bc, ca], [ca, bc, c]]);
+                kinds.extend([kab, kab, kc]);
+            }
+        }
+        let placed: Vec<(Vec3, Vec3, u32)> = start
+            .par_iter()
+            .map(|&p| lookup.project(p, iso, 0.5 * self.spacing))
             .collect();
+        self.positions.extend(placed.iter().map(|v| v.0));
+        self.normals.extend(placed.iter().map(|v| v.1));
+        self.triangles = triangles;
+        self.kinds = kinds;
     }
 
     /// The triangles grouped by kind, `kinds + 1` groups in kind order (the last holds every
