@@ -1,10 +1,12 @@
 //! The automatic camera of a frame, the view axes, and the centre of a selection.
 //!
-//! [`fit_camera`] frames what a frame draws: the bounding box of the scene's spheres (the
-//! selected atoms, and the box outline when it is drawn), or the periodic cell's corners when no
-//! sphere is drawn, or the unit sphere at the origin when there is neither. The sphere around
-//! that box is fitted into the image with [`Camera::fit_sphere`] and a margin of
-//! [`FIT_MARGIN`], so every drawn atom lies inside the picture whatever the view direction.
+//! [`fit_camera`] frames what a frame draws: the scene's spheres (the selected atoms, and the
+//! box outline when it is drawn), or the periodic cell's corners when no sphere is drawn, or
+//! the unit sphere at the origin when there is neither. The smallest sphere about the centre
+//! of their bounding box that holds them all is fitted into the image with
+//! [`Camera::fit_sphere`] and a margin of [`FIT_MARGIN`], so every drawn atom lies inside the
+//! picture whatever the view direction (the sphere around the box itself would be up to √3
+//! times larger: a compact molecule would fill a third of the picture less than it can).
 
 use glam::Vec3;
 use texmap_core::camera::{Camera, CameraError};
@@ -94,7 +96,22 @@ pub fn fit_camera(
 ) -> Result<(Camera, Vec3), CameraError> {
     let (dir, up) = axis.direction();
     let (center, radius) = match drawn_bounds(frame, scene) {
-        Some((lo, hi)) => ((lo + hi) * 0.5, (hi - lo).length() * 0.5),
+        Some((lo, hi)) => {
+            let c = (lo + hi) * 0.5;
+            // Within the box's circumsphere by construction; the tighter of the two.
+            let spheres = (0..scene.len())
+                .filter(|&i| scene.is_valid(i))
+                .map(|i| (scene.centers[i] - c).length() + scene.radii[i]);
+            let corners = frame
+                .cell
+                .as_ref()
+                .filter(|_| scene.bounds().is_none())
+                .map(|cell| cell_corners(cell).map(|p| (p - c).length()))
+                .into_iter()
+                .flatten();
+            let r = spheres.chain(corners).fold(0.0f32, f32::max);
+            (c, r.min((hi - lo).length() * 0.5))
+        }
         None => (Vec3::ZERO, 1.0),
     };
     Camera::fit_sphere(
@@ -167,6 +184,18 @@ mod tests {
         true
     }
 
+    /// One sphere of radius `r` per point, one material.
+    fn scene_of(points: &[[f32; 3]], r: f32) -> SphereScene {
+        let mut scene = SphereScene::default();
+        scene
+            .materials
+            .push(texmap_core::shade::Material::plastic(Vec3::ONE));
+        for p in points {
+            scene.push(Vec3::from(*p), r, 0);
+        }
+        scene
+    }
+
     fn frame_of(points: &[[f32; 3]]) -> Frame {
         let mut f = Frame::new();
         f.positions = points.to_vec();
@@ -181,14 +210,7 @@ mod tests {
             [0.5, 7.0, 38.0],
             [1.0, 1.0, 52.0],
         ];
-        let frame = frame_of(&pts);
-        let mut scene = SphereScene::default();
-        scene
-            .materials
-            .push(texmap_core::shade::Material::plastic(Vec3::ONE));
-        for p in &pts {
-            scene.push(Vec3::from(*p), 1.2, 0);
-        }
+        let (frame, scene) = (frame_of(&pts), scene_of(&pts, 1.2));
         for axis in ["auto", "x", "-x", "y", "-y", "z", "-z"] {
             let axis = ViewAxis::parse(axis).unwrap();
             for hfov in [Some(20.0), Some(40.0), Some(100.0), None] {
@@ -203,9 +225,13 @@ mod tests {
                             "{axis:?} {hfov:?}"
                         );
                     }
-                    // ... and the picture is not much larger than the bounding sphere: grown
-                    // by a quarter, the sphere no longer fits.
-                    let big = (hi - lo).length() * 0.5 * 1.25;
+                    // ... and the picture is not much larger than the bounding sphere about the
+                    // target: grown by a quarter, that sphere no longer fits.
+                    let tight = pts
+                        .iter()
+                        .map(|p| (Vec3::from(*p) - target).length() + 1.2)
+                        .fold(0.0f32, f32::max);
+                    let big = tight * 1.25;
                     assert!(
                         !sphere_inside(&cam, target, big),
                         "{axis:?} {hfov:?} too loose"
@@ -215,6 +241,30 @@ mod tests {
                     assert!(cam.forward().dot(dir.normalize()) > 0.9999);
                 }
             }
+        }
+    }
+
+    #[test]
+    fn a_round_molecule_fills_the_picture_not_its_boxs_circumsphere() {
+        // Atoms on a sphere of radius 20 Å: the box around them is 42 Å a side, and the sphere
+        // around that box is √3 times too large to frame them.
+        let n = 400;
+        let golden = std::f32::consts::PI * (3.0 - 5f32.sqrt());
+        let pts: Vec<[f32; 3]> = (0..n)
+            .map(|i| {
+                let z = 1.0 - 2.0 * (i as f32 + 0.5) / n as f32;
+                let r = (1.0 - z * z).sqrt();
+                let a = golden * i as f32;
+                [20.0 * r * a.cos(), 20.0 * r * a.sin(), 20.0 * z]
+            })
+            .collect();
+        let (frame, scene) = (frame_of(&pts), scene_of(&pts, 1.0));
+        for axis in ["auto", "x", "z"] {
+            let axis = ViewAxis::parse(axis).unwrap();
+            let (cam, target) = fit_camera(&frame, &scene, axis, Some(40.0), 640, 480).unwrap();
+            assert!(pts.iter().all(|p| sphere_inside(&cam, Vec3::from(*p), 1.0)));
+            // The 21 Å sphere holding every atom fills the picture within the 5 % margin.
+            assert!(!sphere_inside(&cam, target, 21.0 * 1.08), "{axis:?}");
         }
     }
 
