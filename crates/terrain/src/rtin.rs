@@ -933,33 +933,21 @@ pub fn extract(
     } else {
         walk::<false>(map, heights, roots, s, max_error, min_step)
     };
-    // Vertex numbers in first-use order, branch-free per vertex (whether a vertex is new depends
-    // on the terrain: a branch on it is mispredicted about once a triangle). `index[slot]` is the
-    // vertex number + 1, 0 (a zeroed table, no fill) for a slot not met yet, so
-    // `index[slot] − 1` wrapped and capped at the count is the vertex's number either way;
-    // every corner's slot is written at the count, which advances only for a new one.
+    // At most 1 + (T + B) / 2 vertices for T triangles tiling the cell (Euler for a disk:
+    // V − E + T = 1 with 3T = 2E − B), B ≤ 4 (side − 1) of them on its border; no-data can leave
+    // separate islands, up to 3 vertices a triangle. The numbering table takes 16-bit entries
+    // when the numbers fit (half the memory: the 513² cell's table then stays in L2).
     let slots = side as usize * side as usize;
-    let mut index = vec![0u32; slots];
-    // At most T + 2 vertices for T triangles tiling a disk (Euler: T = 2V − B − 2 with B ≤ V
-    // boundary vertices); no-data can leave separate islands, up to 3 vertices a triangle.
     let most = if map.nodata {
         3 * tris.len()
     } else {
-        tris.len() + 2
+        1 + (tris.len() + 4 * (side as usize - 1)) / 2
     };
-    let mut order = vec![0u32; slots.min(most) + 1];
-    let mut count = 0u32;
-    for t in tris.iter_mut() {
-        for v in t.iter_mut() {
-            let at = *v as usize;
-            let id = index[at].wrapping_sub(1).min(count);
-            index[at] = id + 1;
-            order[count as usize] = *v;
-            count += (id == count) as u32;
-            *v = id;
-        }
-    }
-    order.truncate(count as usize);
+    let order = if most < u16::MAX as usize {
+        number::<u16>(&mut tris, slots, most)
+    } else {
+        number::<u32>(&mut tris, slots, most)
+    };
     // Slot -> lattice row by a multiply: `⌊(M·v) / 2^64⌋` with `M = ⌊(2^64 − 1) / side⌋ + 1` is
     // `⌊v / side⌋` for every 32-bit `v` (Lemire, Kaser & Kurz 2019), without a division a vertex.
     let m = (u64::MAX / side as u64 + 1) as u128;
@@ -977,6 +965,59 @@ pub fn extract(
         max_bound,
         bridging,
     }
+}
+
+/// An entry of the numbering table: a vertex number + 1, 0 for a slot not met yet.
+trait Entry: Copy + Default {
+    fn get(self) -> u32;
+    /// `v` fits (the caller sized the type to the most vertices).
+    fn of(v: u32) -> Self;
+}
+
+impl Entry for u16 {
+    #[inline(always)]
+    fn get(self) -> u32 {
+        self as u32
+    }
+    #[inline(always)]
+    fn of(v: u32) -> u16 {
+        v as u16
+    }
+}
+
+impl Entry for u32 {
+    #[inline(always)]
+    fn get(self) -> u32 {
+        self
+    }
+    #[inline(always)]
+    fn of(v: u32) -> u32 {
+        v
+    }
+}
+
+/// Vertex numbers in first-use order for `tris` (lattice slots in, numbers out) over `slots`
+/// lattice slots and at most `most` vertices; returns each number's slot. Branch-free per
+/// vertex (whether a vertex is new depends on the terrain: a branch on it is mispredicted about
+/// once a triangle): `index[slot]` is the vertex number + 1, 0 (a zeroed table, no fill) for a
+/// slot not met yet, so `index[slot] − 1` wrapped and capped at the count is the vertex's number
+/// either way; every corner's slot is written at the count, which advances only for a new one.
+fn number<E: Entry>(tris: &mut [[u32; 3]], slots: usize, most: usize) -> Vec<u32> {
+    let mut index = vec![E::default(); slots];
+    let mut order = vec![0u32; slots.min(most) + 1];
+    let mut count = 0u32;
+    for t in tris.iter_mut() {
+        for v in t.iter_mut() {
+            let at = *v as usize;
+            let id = index[at].get().wrapping_sub(1).min(count);
+            index[at] = E::of(id + 1);
+            order[count as usize] = *v;
+            count += (id == count) as u32;
+            *v = id;
+        }
+    }
+    order.truncate(count as usize);
+    order
 }
 
 /// The kept triangles (lattice slots, walk order) of the tree under the two `roots` (`s` their
