@@ -90,6 +90,15 @@ fn bench(c: &mut Criterion) {
             f.len()
         );
     }
+    {
+        let sel = t.select(&cam, 1.0);
+        let flat = |_: &TexQuad| [Vec3::new(0.5, 0.6, 0.4); 4];
+        let d = t.draw(&cam, &sel, &flat, &mut fb, &mut scratch).unwrap();
+        eprintln!(
+            "raster: {} submitted, {} binned, {} back-facing, {} degenerate, {} on no pixel centre, {} clipped",
+            d.submitted, d.binned, d.culled, d.degenerate, d.no_pixels, d.clipped
+        );
+    }
     let mut g = c.benchmark_group("flight_1024x768");
     g.sample_size(20);
     g.bench_function("select", |b| b.iter(|| black_box(t.select(&cam, 1.0))));
