@@ -1841,6 +1841,14 @@ fn hydrogen_bonds_are_drawn_as_dashes_as_the_reference_traces_them() {
         image::open(&out).unwrap().to_rgb8()
     };
     let blue = image("blue.png", &hb);
+    // With --bonds none the dashes are the same (donors found by distance, dashes drawn).
+    let out = dir.path().join("nobonds.png");
+    let o = run(&["--rep", &hb, "--bonds", "none", "-o", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        image::open(&out).unwrap().to_rgb8() == blue,
+        "--bonds none changed the dashes"
+    );
     let red = image("red.png", &format!("{hb}:#ff0000"));
     let count = |img: &image::RgbImage, f: &dyn Fn(&image::Rgb<u8>) -> bool| {
         img.pixels().filter(|p| f(p)).count()

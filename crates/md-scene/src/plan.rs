@@ -631,12 +631,17 @@ impl MolPlan {
         Ok(())
     }
 
-    /// Whether bonds are drawn at all.
+    /// Whether the scene's bonds (cylinders) are drawn at all: some style draws sticks and
+    /// bonds are asked for, or some representation draws hydrogen bonds (whose dashes are
+    /// cylinders whatever the bond source).
     pub fn draws_bonds(&self) -> bool {
-        self.reps
-            .iter()
-            .any(|r| !matches!(r.draw, DrawStyle::Spacefill | DrawStyle::Surface))
-            && self.options.bonds != BondSource::None
+        let sticks = self.reps.iter().any(|r| {
+            !matches!(
+                r.draw,
+                DrawStyle::Spacefill | DrawStyle::Surface | DrawStyle::HBonds
+            )
+        });
+        (sticks && self.options.bonds != BondSource::None) || self.draws_hbonds()
     }
 
     /// The bonds of the last frame built, after the periodic treatment and before the

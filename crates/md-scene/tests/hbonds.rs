@@ -138,6 +138,8 @@ fn no_bonds_drawn_still_finds_donors_and_bad_cutoffs_are_refused() {
     let (_, none) = build(with(BondSource::None), &mut frame).unwrap();
     assert!(!auto.last_hbonds().is_empty());
     assert_eq!(auto.last_hbonds(), none.last_hbonds());
+    // The dashes are cylinders: drawn whatever the bond source.
+    assert!(auto.draws_bonds() && none.draws_bonds());
     for hbonds in [
         Criteria {
             distance: 0.2,
