@@ -193,7 +193,8 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
 }
 
 /// The hydrogen bonds of `frame` (see the module docs) made by the `[donor, hydrogen]` pairs
-/// `dh` ([`donor_hydrogens`]) with the frame's N and O acceptors; with a `mask`, only
+/// `dh` ([`donor_hydrogens`], or any list of such pairs, in any order) with the frame's N and
+/// O acceptors; with a `mask`, only
 /// donors, hydrogens and acceptors it keeps take part. Sorted by donor, hydrogen, acceptor.
 pub fn hydrogen_bonds(
     frame: &Frame,
@@ -205,12 +206,15 @@ pub fn hydrogen_bonds(
     let Criteria { distance, angle } = criteria;
     let n = frame.n_atoms();
     let keep = |i: usize| i < n && mask.is_none_or(|m| m.get(i).copied().unwrap_or(false));
-    // Hydrogens per donor (CSR over the sorted pairs kept).
-    let dh: Vec<[u32; 2]> = dh
+    // Hydrogens per donor: the pairs kept, sorted, looked up by donor.
+    let mut dh: Vec<[u32; 2]> = dh
         .iter()
         .copied()
         .filter(|[d, h]| keep(*d as usize) && keep(*h as usize))
         .collect();
+    // Sorted by donor for the look-up below, whatever order the caller's pairs are in.
+    dh.sort_unstable();
+    dh.dedup();
     // The candidates: every donor and acceptor, once, in atom order.
     let mut role = vec![0u8; n];
     const DONOR: u8 = 1;

@@ -219,6 +219,12 @@ fn a_mask_keeps_only_bonds_within_it_and_bad_criteria_are_refused() {
             .len(),
         1
     );
+    // The pairs in any order (and repeated) give the same bonds.
+    let shuffled = [[3, 5], [0, 2], [3, 4], [0, 1], [0, 1]];
+    assert_eq!(
+        hydrogen_bonds(&frame, &shuffled, None, c).unwrap(),
+        hydrogen_bonds(&frame, &dh, None, c).unwrap()
+    );
     for d in [0.0, 0.45, -3.0, 6.5, f32::NAN, f32::INFINITY] {
         let e = hydrogen_bonds(
             &frame,
