@@ -2017,3 +2017,49 @@ fn the_hydrogen_bond_table_is_mdanalysis_s_list() {
         stderr(&o)
     );
 }
+
+/// VASP: pymatgen's fixed-cell XDATCAR (md-io's tests/data/gen_vasp.py) renders as the same
+/// frames written by ASE as extended XYZ draw (elements, positions, cell, bonds by distance),
+/// and `info` counts its frames and atoms.
+#[test]
+fn a_vasp_xdatcar_renders_as_its_frames_in_extended_xyz() {
+    let xdatcar = data("vasp/XDATCAR_pmg");
+    let o = texmap(&["info", &xdatcar]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["format"], "vasp");
+    assert_eq!(v["frames"], 6);
+    assert_eq!(v["atoms"], 9);
+    let dir = tempfile::tempdir().unwrap();
+    for frame in ["0", "5"] {
+        let args = |f: &str| {
+            vec![
+                f.to_string(),
+                "--frames".into(),
+                frame.into(),
+                "--style".into(),
+                "ball-stick".into(),
+                "--size".into(),
+                "320x240".into(),
+            ]
+        };
+        let a = args(&xdatcar);
+        let extxyz = data("vasp/pmg_frames.extxyz");
+        let b = args(&extxyz);
+        let render = |name: &str, a: &[String]| {
+            render_rgb(
+                dir.path(),
+                name,
+                &a.iter().map(String::as_str).collect::<Vec<_>>(),
+            )
+        };
+        let (a, b) = (render("a.png", &a), render("b.png", &b));
+        let differ = a
+            .pixels()
+            .zip(b.pixels())
+            .filter(|(p, q)| p.0.iter().zip(q.0).any(|(x, y)| x.abs_diff(y) > 2))
+            .count();
+        assert!(differ < 20, "frame {frame}: {differ} pixels differ");
+        assert!(a.pixels().filter(|p| p.0 != [0, 0, 0]).count() > 2000);
+    }
+}

@@ -29,11 +29,14 @@ pub enum Format {
     Sdf,
     /// Tripos MOL2, molecules are frames, with bonds and partial charges: `.mol2`.
     Mol2,
+    /// VASP POSCAR / CONTCAR (one structure) and XDATCAR (MD trajectory): files named
+    /// `POSCAR*`, `CONTCAR*`, `XDATCAR*`, or `.vasp`, `.poscar`.
+    Vasp,
 }
 
 impl Format {
     /// Every format, in declaration order.
-    pub const ALL: [Format; 11] = [
+    pub const ALL: [Format; 12] = [
         Format::Xyz,
         Format::Pdb,
         Format::Gro,
@@ -45,6 +48,7 @@ impl Format {
         Format::Mmcif,
         Format::Sdf,
         Format::Mol2,
+        Format::Vasp,
     ];
 
     /// The format a file extension names (case-insensitive), e.g. "xyz", "lammpstrj".
@@ -62,14 +66,29 @@ impl Format {
             "cif" | "mmcif" => Format::Mmcif,
             "sdf" | "sd" | "mol" => Format::Sdf,
             "mol2" => Format::Mol2,
+            "vasp" | "poscar" | "contcar" | "xdatcar" => Format::Vasp,
             _ => return None,
         })
     }
 
-    /// The format a path's extension names; a final `.gz` is looked through (`run.xyz.gz` is
-    /// XYZ, read decompressed by [`crate::Trajectory::open`]).
+    /// The format a path's extension names, else VASP for the names VASP gives its files
+    /// (`POSCAR`, `CONTCAR`, `XDATCAR` and any suffix: `CONTCAR.2`); a final `.gz` is looked
+    /// through (`run.xyz.gz` is XYZ, read decompressed by [`crate::Trajectory::open`]).
     pub fn from_path(path: &Path) -> Option<Format> {
-        Format::from_extension(crate::gz::inner_path(path).extension()?.to_str()?)
+        let inner = crate::gz::inner_path(path);
+        let by_extension = inner
+            .extension()
+            .and_then(|e| e.to_str())
+            .and_then(Format::from_extension);
+        if by_extension.is_some() {
+            return by_extension;
+        }
+        // VASP's fixed file names, with any suffix (`POSCAR_relaxed`, `CONTCAR.2`).
+        let name = inner.file_name()?.to_str()?.as_bytes();
+        let vasp = [&b"POSCAR"[..], b"CONTCAR", b"XDATCAR"]
+            .iter()
+            .any(|v| name.len() >= v.len() && name[..v.len()].eq_ignore_ascii_case(v));
+        vasp.then_some(Format::Vasp)
     }
 
     /// The format the first bytes of a file show (give at least 256 bytes when the file has
@@ -135,6 +154,9 @@ impl Format {
             let t = crate::parse::trim(l);
             !t.is_empty() && crate::parse::parse_usize(t).is_some()
         };
+        if looks_like_vasp(head) {
+            return Some(Format::Vasp);
+        }
         if is_count(first) {
             return Some(Format::Xyz);
         }
@@ -155,6 +177,7 @@ impl Format {
                 | Format::Mmcif
                 | Format::Sdf
                 | Format::Mol2
+                | Format::Vasp
         )
     }
 
@@ -172,8 +195,36 @@ impl Format {
             Format::Mmcif => "mmcif",
             Format::Sdf => "sdf",
             Format::Mol2 => "mol2",
+            Format::Vasp => "vasp",
         }
     }
+}
+
+/// True when the first lines have a VASP header's shape: a comment, one or three scaling
+/// numbers, three lattice lines of three numbers, then species names (words starting with a
+/// letter) or atom counts (integers).
+fn looks_like_vasp(head: &[u8]) -> bool {
+    use crate::parse::{fields, parse_f64, parse_usize};
+    let lines: Vec<&[u8]> = head
+        .split(|b| *b == b'\n')
+        .map(crate::parse::trim)
+        .take(7)
+        .collect();
+    if lines.len() < 7 {
+        return false;
+    }
+    let numbers = |l: &[u8]| fields(l).take_while(|f| parse_f64(f).is_some()).count();
+    let scale = numbers(lines[1]);
+    if !(scale == 1 || scale == 3) || fields(lines[1]).count() != scale {
+        return false;
+    }
+    if lines[2..5].iter().any(|l| numbers(l) < 3) {
+        return false;
+    }
+    let words: Vec<&[u8]> = fields(lines[5]).collect();
+    !words.is_empty()
+        && (words.iter().all(|w| parse_usize(w).is_some())
+            || words.iter().all(|w| w[0].is_ascii_alphabetic()))
 }
 
 impl std::fmt::Display for Format {

@@ -51,7 +51,7 @@ use crate::frame::{Frame, Label, UnitCell};
 use crate::parse::{
     field_f32, field_f64, fields, next_field, parse_f32, parse_f64, parse_i64, parse_usize, trim,
 };
-use crate::text::{Ctx, LineReader, Pos, TextFormat};
+use crate::text::{Ctx, LineReader, Pos, TextFormat, need_line};
 use std::io::Read;
 
 /// What one atom column is read into.
@@ -158,19 +158,6 @@ struct Header {
 }
 
 impl Lammps {
-    /// The next line, or a truncation error saying what was expected.
-    fn line<'a, R: Read>(
-        lines: &'a mut LineReader<R>,
-        ctx: &Ctx,
-        expected: &str,
-    ) -> Result<(Pos, &'a [u8]), Error> {
-        let p = lines.pos();
-        match lines.next_line().map_err(|e| ctx.io(p, e))? {
-            Some(x) => Ok(x),
-            None => Err(ctx.truncated(p, expected.to_string())),
-        }
-    }
-
     fn bounds(ctx: &Ctx, pos: Pos, line: &[u8], n: usize) -> Result<[f64; 4], Error> {
         let mut v = [0f64; 4];
         let mut k = 0;
@@ -201,7 +188,7 @@ impl Lammps {
             4
         };
         for row in &mut rows {
-            let (pos, line) = Lammps::line(lines, ctx, "3 box bound lines")?;
+            let (pos, line) = need_line(lines, ctx, "3 box bound lines")?;
             *row = Lammps::bounds(ctx, pos, line, width)?;
         }
         let cell = match kind {
@@ -265,7 +252,7 @@ impl Lammps {
             };
             let item = trim(item);
             if item == b"TIMESTEP" {
-                let (pos, line) = Lammps::line(lines, ctx, "the timestep")?;
+                let (pos, line) = need_line(lines, ctx, "the timestep")?;
                 let t = trim(line);
                 let step =
                     parse_i64(t).ok_or_else(|| ctx.parse(pos, line, t, "an integer timestep"))?;
@@ -273,18 +260,18 @@ impl Lammps {
                     f.step = Some(step);
                 }
             } else if item == b"TIME" {
-                let (pos, line) = Lammps::line(lines, ctx, "the time")?;
+                let (pos, line) = need_line(lines, ctx, "the time")?;
                 let t = trim(line);
                 time = Some(parse_f64(t).ok_or_else(|| ctx.parse(pos, line, t, "a time"))?);
             } else if item == b"UNITS" {
-                let (_, line) = Lammps::line(lines, ctx, "the units")?;
+                let (_, line) = need_line(lines, ctx, "the units")?;
                 self.units = match trim(line) {
                     b"real" => Units::Real,
                     b"metal" => Units::Metal,
                     _ => Units::Unknown,
                 };
             } else if item == b"NUMBER OF ATOMS" {
-                let (pos, line) = Lammps::line(lines, ctx, "the number of atoms")?;
+                let (pos, line) = need_line(lines, ctx, "the number of atoms")?;
                 let t = trim(line);
                 n = Some(
                     parse_usize(t).ok_or_else(|| ctx.parse(pos, line, t, "the number of atoms"))?,

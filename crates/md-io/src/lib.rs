@@ -3,7 +3,8 @@
 //!
 //! - [`Trajectory`] reads XYZ / extended XYZ, PDB, PDBx/mmCIF (the first data block's
 //!   `_atom_site`, models as frames), GRO and LAMMPS text dumps, MDL SDF/MOL and Tripos MOL2
-//!   (records as frames, with the bonds they list: [`Frame::bonds`]) (and the binary DCD, XTC,
+//!   (records as frames, with the bonds they list: [`Frame::bonds`]), VASP POSCAR/CONTCAR
+//!   and XDATCAR (the ionic steps as frames, a changing cell too) (and the binary DCD, XTC,
 //!   TRR and AMBER NetCDF) one frame at a time into a reusable [`Frame`], or any frame by index.
 //!   Any of them may be gzip-compressed (`1abc.cif.gz`, `run.xyz.gz`; topologies too): it is
 //!   inflated once into a temporary file, so the byte offsets of a `.gz` file's errors count
@@ -109,6 +110,7 @@ mod text;
 mod topology;
 mod trajectory;
 mod trr;
+mod vasp;
 mod writer;
 mod xtc;
 mod xyz;

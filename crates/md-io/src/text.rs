@@ -358,6 +358,19 @@ impl ModelCheck {
     }
 }
 
+/// The next line, or the cut-file error naming what was expected there.
+pub(crate) fn need_line<'a, R: Read>(
+    lines: &'a mut LineReader<R>,
+    ctx: &Ctx,
+    expected: &str,
+) -> Result<(Pos, &'a [u8]), Error> {
+    let p = lines.pos();
+    match lines.next_line().map_err(|e| ctx.io(p, e))? {
+        Some(l) => Ok(l),
+        None => Err(ctx.truncated(p, expected.to_string())),
+    }
+}
+
 /// Skips blank lines; returns the first non-blank line's position, or `None` at the end.
 pub(crate) fn skip_blank<R: Read>(
     lines: &mut LineReader<R>,

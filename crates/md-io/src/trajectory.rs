@@ -13,6 +13,7 @@ use crate::pdb::Pdb;
 use crate::sdf::Sdf;
 use crate::text::TextReader;
 use crate::trr::TrrReader;
+use crate::vasp::Vasp;
 use crate::xtc::XtcReader;
 use crate::xyz::Xyz;
 use std::fs::File;
@@ -33,6 +34,7 @@ enum Reader<R> {
     Mmcif(TextReader<R, Mmcif>),
     Sdf(TextReader<R, Sdf>),
     Mol2(TextReader<R, Mol2>),
+    Vasp(TextReader<R, Vasp>),
 }
 
 /// Runs `$body` with `$r` bound to the format's reader, whatever the format.
@@ -50,6 +52,7 @@ macro_rules! each_reader {
             Reader::Mmcif($r) => $body,
             Reader::Sdf($r) => $body,
             Reader::Mol2($r) => $body,
+            Reader::Vasp($r) => $body,
         }
     };
 }
@@ -225,6 +228,7 @@ impl<R: Read + Seek> Trajectory<R> {
             Format::Mmcif => Reader::Mmcif(TextReader::new(src, Mmcif::new(lenient), file.clone())),
             Format::Sdf => Reader::Sdf(TextReader::new(src, Sdf, file.clone())),
             Format::Mol2 => Reader::Mol2(TextReader::new(src, Mol2::default(), file.clone())),
+            Format::Vasp => Reader::Vasp(TextReader::new(src, Vasp::default(), file.clone())),
         };
         Ok(Trajectory {
             reader,

@@ -9,7 +9,7 @@ use std::io::Cursor;
 use std::path::PathBuf;
 use texmap_md_io::{Error, Format, Frame, Trajectory};
 
-const FILES: [(&str, Format); 11] = [
+const FILES: &[(&str, Format)] = &[
     ("ase_ext.xyz", Format::Xyz),
     ("ase_plain.xyz", Format::Xyz),
     ("mda_multi.pdb", Format::Pdb),
@@ -21,6 +21,9 @@ const FILES: [(&str, Format); 11] = [
     ("molecules/library.sdf", Format::Sdf),
     ("molecules/caffeine_v3000.mol", Format::Sdf),
     ("molecules/library.mol2", Format::Mol2),
+    ("vasp/XDATCAR_pmg", Format::Vasp),
+    ("vasp/XDATCAR_ase", Format::Vasp),
+    ("vasp/POSCAR_pmg_vel", Format::Vasp),
 ];
 
 fn data(name: &str) -> Vec<u8> {
@@ -113,6 +116,22 @@ fn frame_ends(bytes: &[u8], format: Format) -> Vec<usize> {
             }
             ends.push(bytes.len());
         }
+        Format::Vasp => {
+            // An XDATCAR frame ends after the atom lines of its configuration line; the atom
+            // count is the sum on the header's counts line (the 7th). A POSCAR is one frame.
+            let n: usize = lines[6]
+                .split_whitespace()
+                .map(|c| c.parse::<usize>().unwrap())
+                .sum();
+            for (k, l) in lines.iter().enumerate() {
+                if l.contains("configuration=") {
+                    ends.push(line_starts[k + 1 + n]);
+                }
+            }
+            if ends.is_empty() {
+                ends.push(bytes.len());
+            }
+        }
         _ => unreachable!(),
     }
     ends
@@ -146,7 +165,7 @@ fn check_error_names_the_place(e: &Error, frames_before: usize) {
 
 #[test]
 fn cut_at_every_byte_keeps_the_frames_before_the_cut() {
-    for (name, format) in FILES {
+    for &(name, format) in FILES {
         let good = data(name);
         let (all, err) = read_all(&good, format);
         assert!(err.is_none(), "{name}: {err:?}");
@@ -173,7 +192,7 @@ fn cut_at_every_byte_keeps_the_frames_before_the_cut() {
 
 #[test]
 fn replaced_bytes_never_panic_and_keep_earlier_frames() {
-    for (name, format) in FILES {
+    for &(name, format) in FILES {
         let good = data(name);
         let (all, _) = read_all(&good, format);
         let ends = frame_ends(&good, format);
@@ -237,7 +256,7 @@ fn error_after_good_frames_then_random_access_still_reaches_them() {
 fn allow_truncated_streams_every_cut_to_its_complete_frames() {
     use texmap_md_io::ReadOptions;
     let lenient = ReadOptions::new().allow_truncated(true);
-    for (name, format) in FILES {
+    for &(name, format) in FILES {
         let good = data(name);
         let (all, _) = read_all(&good, format);
         let ends = frame_ends(&good, format);
