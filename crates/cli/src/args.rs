@@ -696,6 +696,10 @@ pub enum DrawStyle {
     /// --rep 'all=hbonds'.
     #[value(name = "hbonds")]
     HBonds,
+    /// Coordination polyhedra (VESTA's): around each atom, the convex hull of the atoms of other
+    /// elements bonded to it (at their nearest periodic images), in the atom's colour, lit flat. Usually one
+    /// --rep among others: --rep 'all=ball-stick' --rep 'element Ti=polyhedra'.
+    Polyhedra,
 }
 
 /// Periodic boundaries (`--pbc`).
@@ -760,6 +764,10 @@ pub struct MolArgs {
     /// VMD's Transparent material (one layer: the surface's back is not seen through its front).
     #[arg(long, value_name = "A", default_value_t = 1.0)]
     pub surface_opacity: f32,
+    /// The polyhedra style's opacity, 0.05 to 1: below 1 the polyhedra's fronts are laid over
+    /// what lies behind them (the centre atoms, when another --rep draws them), as the surface's.
+    #[arg(long, value_name = "A", default_value_t = 1.0)]
+    pub polyhedra_opacity: f32,
     /// The hbonds style's largest donor-acceptor distance, Å (MDAnalysis's default 3.0; up to
     /// 6). A hydrogen bonded to an N or O donates to an N or O acceptor within it when the
     /// donor-hydrogen-acceptor angle is at least --hbond-angle; distances use the nearest
@@ -879,6 +887,7 @@ Examples:
   texmap render md.xtc --topology md.gro --rep 'protein=cartoon' --rep 'resname LIG=licorice' --rep 'protein or resname LIG=hbonds' -o hb.png
   texmap render 1abc.cif --rep 'not resname LIG=surface' --rep 'resname LIG=ball-stick' --export-mesh pocket.glb -o pocket.png
   texmap render md.xtc --topology protein.pdb --align backbone --style tube --color-by structure --label 't = {ns} ns' -o md.mp4
+  texmap render XDATCAR --rep 'element Ti=polyhedra' --rep 'element O=ball-stick' --replicate 2,2,2 -o tio2.mp4
   texmap render water.gro --color-by element --type-color OW=#ff0000 --radius-scale 0.5 -o w.png
   texmap render md.xyz --eye 0,0,50 --target 0,0,0 --up 0,1,0 --fov 30 --depth -o md.png";
 

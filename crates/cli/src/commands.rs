@@ -431,6 +431,7 @@ fn render(a: &RenderArgs) -> Result<()> {
     let mut plan = crate::scene::mol_plan(&a.mol)?;
     let surface_options = crate::scene::surface_options(&a.mol)?;
     let surface_opacity = a.mol.surface_opacity;
+    let polyhedra_opacity = a.mol.polyhedra_opacity;
     let ss = a.supersample;
     if !(1..=8).contains(&ss) {
         return usage(format!("--supersample {ss}: expected 1 to 8"));
@@ -440,9 +441,14 @@ fn render(a: &RenderArgs) -> Result<()> {
             "--surface-opacity {surface_opacity}: expected an opacity from 0.05 to 1"
         ));
     }
+    if !(polyhedra_opacity.is_finite() && (0.05..=1.0).contains(&polyhedra_opacity)) {
+        return usage(format!(
+            "--polyhedra-opacity {polyhedra_opacity}: expected an opacity from 0.05 to 1"
+        ));
+    }
     if plan.draws_meshes() && quality.is_some() {
         return usage(
-            "the cartoon and surface styles are drawn without --quality's anti-aliasing, ambient occlusion and shadows; drop --quality and its options, or draw those atoms in another style",
+            "the cartoon, surface and polyhedra styles are drawn without --quality's anti-aliasing, ambient occlusion and shadows; drop --quality and its options, or draw those atoms in another style",
         );
     }
     let mut surface = texmap_md_scene::surface::MolMesh::default();
@@ -503,7 +509,7 @@ fn render(a: &RenderArgs) -> Result<()> {
     };
     if a.export_mesh.is_some() && !plan.draws_meshes() {
         return usage(
-            "--export-mesh writes the cartoon and surface styles' meshes: draw some atoms with --style cartoon or surface (or a --rep of them)",
+            "--export-mesh writes the cartoon, surface and polyhedra styles' meshes: draw some atoms with --style cartoon, surface or polyhedra (or a --rep of them)",
         );
     }
     for (k, &f) in frames.iter().enumerate() {
@@ -601,6 +607,7 @@ fn render(a: &RenderArgs) -> Result<()> {
             if scene.is_empty()
                 && plan.surface_atoms().is_empty()
                 && plan.cartoon_mesh().triangles.is_empty()
+                && plan.polyhedra_mesh().triangles.is_empty()
             {
                 let why = if a.mol.reps.is_empty() {
                     a.mol
@@ -626,6 +633,9 @@ fn render(a: &RenderArgs) -> Result<()> {
             }
             for p in &plan.cartoon_mesh().positions {
                 framed.push(*p, texmap_md_scene::cartoon::COIL_RADIUS, 0);
+            }
+            for p in &plan.polyhedra_mesh().positions {
+                framed.push(*p, 0.0, 0);
             }
             let plan =
                 crate::scene::camera_plan(&a.camera, size, &a.path, &md, &framed, frames.len())
@@ -662,6 +672,12 @@ fn render(a: &RenderArgs) -> Result<()> {
             }
             q
         });
+        // The meshes drawn over the spheres, each with its opacity.
+        let layers = [
+            (plan.cartoon_mesh(), 1.0),
+            (&surface, surface_opacity),
+            (plan.polyhedra_mesh(), polyhedra_opacity),
+        ];
         let out = match (method_of(a.method), quality) {
             (Some(_), Some(q)) => {
                 quality_renderer
@@ -683,8 +699,9 @@ fn render(a: &RenderArgs) -> Result<()> {
                 o.draw_bonds = plan.draws_bonds();
                 let mut r = renderer.render(&scene, &cam, &o);
                 skipped_total += r.stats.skipped_invalid;
-                // The surface last: a transparent one shows what is under it.
-                for (mesh, opacity) in [(plan.cartoon_mesh(), 1.0), (&surface, surface_opacity)] {
+                // The opaque meshes first: a transparent one shows what is under it.
+                let opaque = layers.iter().filter(|l| l.1 >= 1.0);
+                for &(mesh, opacity) in opaque.chain(layers.iter().filter(|l| l.1 < 1.0)) {
                     texmap_md_scene::surface::draw_mesh(
                         mesh,
                         &scene.materials,
@@ -698,30 +715,33 @@ fn render(a: &RenderArgs) -> Result<()> {
                 r.frame
             }
             (None, None) => {
-                // A transparent surface is traced on its own and laid over the rest as the
+                // A transparent mesh is traced on its own and laid over the rest as the
                 // methods lay it ([`texmap_md_scene::surface::composite`]).
-                let opaque: &[&texmap_md_scene::surface::MolMesh] = if surface_opacity < 1.0 {
-                    &[plan.cartoon_mesh()]
-                } else {
-                    &[&surface, plan.cartoon_mesh()]
-                };
-                let trace = |spheres: &SphereScene, bonds, meshes| {
-                    harness::render_reference(
-                        &harness::reference_scene_with_meshes(spheres, bonds, meshes),
-                        &harness::reference_materials(&scene),
-                        &cam,
-                        lighting,
-                        background,
-                        1,
-                    )
-                };
-                let mut base = trace(&scene, plan.draws_bonds(), opaque)
+                let opaque: Vec<&texmap_md_scene::surface::MolMesh> =
+                    layers.iter().filter(|l| l.1 >= 1.0).map(|l| l.0).collect();
+                let trace =
+                    |spheres: &SphereScene,
+                     bonds,
+                     meshes: &[&texmap_md_scene::surface::MolMesh]| {
+                        harness::render_reference(
+                            &harness::reference_scene_with_meshes(spheres, bonds, meshes),
+                            &harness::reference_materials(&scene),
+                            &cam,
+                            lighting,
+                            background,
+                            1,
+                        )
+                    };
+                let mut base = trace(&scene, plan.draws_bonds(), &opaque)
                     .map_err(|e| fail(e.into(), &written))?;
-                if surface_opacity < 1.0 {
+                for &(mesh, opacity) in layers.iter().filter(|l| l.1 < 1.0) {
+                    if mesh.triangles.is_empty() {
+                        continue;
+                    }
                     let alone = SphereScene::new(scene.materials.clone());
                     let layer =
-                        trace(&alone, false, &[&surface]).map_err(|e| fail(e.into(), &written))?;
-                    texmap_md_scene::surface::composite(&mut base, &layer, surface_opacity);
+                        trace(&alone, false, &[mesh]).map_err(|e| fail(e.into(), &written))?;
+                    texmap_md_scene::surface::composite(&mut base, &layer, opacity);
                 }
                 base
             }
@@ -738,9 +758,11 @@ fn render(a: &RenderArgs) -> Result<()> {
         {
             let mut all = plan.cartoon_mesh().clone();
             all.append(&surface);
+            all.append(plan.polyhedra_mesh());
             if all.triangles.is_empty() {
-                let e =
-                    anyhow::anyhow!("--export-mesh: frame {f} has no cartoon or surface to write");
+                let e = anyhow::anyhow!(
+                    "--export-mesh: frame {f} has no cartoon, surface or polyhedra to write"
+                );
                 return Err(fail(e, &written));
             }
             let (mesh, palette) = all.to_textured(&scene.materials);

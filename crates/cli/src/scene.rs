@@ -413,6 +413,7 @@ impl From<DrawStyle> for texmap_md_scene::DrawStyle {
             DrawStyle::Cartoon => texmap_md_scene::DrawStyle::Cartoon,
             DrawStyle::Surface => texmap_md_scene::DrawStyle::Surface,
             DrawStyle::HBonds => texmap_md_scene::DrawStyle::HBonds,
+            DrawStyle::Polyhedra => texmap_md_scene::DrawStyle::Polyhedra,
         }
     }
 }

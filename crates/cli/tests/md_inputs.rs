@@ -2063,3 +2063,88 @@ fn a_vasp_xdatcar_renders_as_its_frames_in_extended_xyz() {
         assert!(a.pixels().filter(|p| p.0 != [0, 0, 0]).count() > 2000);
     }
 }
+
+/// Coordination polyhedra: ASE's rutile (md-io's tests/data/gen_vasp.py) replicated 2x2x3 gives
+/// one TiO6 octahedron per Ti, each of 8 faces and of the volume scipy's ConvexHull gives the
+/// six O around a Ti (nearest images), Ti-Ti bonds by distance left out; the picture matches
+/// the reference ray tracer's, opaque and translucent.
+#[test]
+fn rutile_polyhedra_are_its_tio6_octahedra() {
+    let poscar = data("vasp/POSCAR_rutile");
+    let want: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(data("vasp/rutile_polyhedra.json")).unwrap(),
+    )
+    .unwrap();
+    let volume = want["octahedron_volumes"][0].as_f64().unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let obj = dir.path().join("poly.obj");
+    let base = [
+        poscar.as_str(),
+        "--rep",
+        "element Ti=polyhedra",
+        "--rep",
+        "element O=ball-stick",
+        "--replicate",
+        "2,2,3",
+        "--size",
+        "320x240",
+    ];
+    let mut args = base.to_vec();
+    args.extend(["--export-mesh", obj.to_str().unwrap()]);
+    let img = render_rgb(dir.path(), "poly.png", &args);
+    assert!(img.pixels().filter(|p| p.0 != [0, 0, 0]).count() > 5000);
+    // The exported mesh: vertices and triangles (1-based, `v/vt/vn` or plain).
+    let text = std::fs::read_to_string(&obj).unwrap();
+    let mut v: Vec<[f64; 3]> = Vec::new();
+    let mut faces: Vec<[usize; 3]> = Vec::new();
+    for line in text.lines() {
+        let mut it = line.split_whitespace();
+        match it.next() {
+            Some("v") => v.push(std::array::from_fn(|_| {
+                it.next().unwrap().parse().unwrap()
+            })),
+            Some("f") => faces.push(std::array::from_fn(|_| {
+                let t = it.next().unwrap();
+                t.split('/').next().unwrap().parse::<usize>().unwrap() - 1
+            })),
+            _ => {}
+        }
+    }
+    let n_ti = 2 * 2 * 2 * 3;
+    assert_eq!(faces.len(), n_ti * 8, "faces");
+    let enclosed: f64 = faces
+        .iter()
+        .map(|f| {
+            let [a, b, c] = f.map(|i| v[i]);
+            (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+                + a[2] * (b[0] * c[1] - b[1] * c[0]))
+                / 6.0
+        })
+        .sum();
+    let expected = n_ti as f64 * volume;
+    assert!(
+        (enclosed - expected).abs() < 1e-3 * expected,
+        "{enclosed} Å³ enclosed, {expected} expected"
+    );
+    // Against the reference ray tracer, opaque and translucent.
+    for opacity in ["1", "0.5"] {
+        let mut args = base.to_vec();
+        args.extend(["--polyhedra-opacity", opacity]);
+        let raycast = dir.path().join(format!("r{opacity}.png"));
+        let reference = dir.path().join(format!("t{opacity}.png"));
+        for (method, out) in [("raycast", &raycast), ("reference", &reference)] {
+            let mut all = vec!["render", "--quiet", "--method", method];
+            all.extend(&args);
+            all.extend(["-o", out.to_str().unwrap()]);
+            let o = texmap(&all);
+            assert!(o.status.success(), "{}", stderr(&o));
+        }
+        let d = mean_abs_diff(&raycast, &reference);
+        assert!(d < 1.5, "opacity {opacity}: mean |raycast - reference| = {d}");
+    }
+    let (opaque, clear) = (
+        image::open(dir.path().join("r1.png")).unwrap().to_rgb8(),
+        image::open(dir.path().join("r0.5.png")).unwrap().to_rgb8(),
+    );
+    assert_ne!(opaque.as_raw(), clear.as_raw());
+}

@@ -26,6 +26,8 @@
 //! - [`cartoon`]: cartoons as VMD's NewCartoon draws them (helix ribbons, strand arrows, coil
 //!   tubes along a spline through the CA atoms; nucleic acids as a P tube with base rungs), a
 //!   mesh like the surface's.
+//! - [`polyhedra`]: coordination polyhedra as VESTA draws them (the convex hull of each centre
+//!   atom's bonded neighbours at their nearest periodic images), a mesh like the surface's.
 //! - [`surface`]: molecular surfaces as VMD's QuickSurf draws them (one Gaussian per atom, the
 //!   isosurface by surface nets with every vertex on the exact surface), drawn by the rasteriser
 //!   over a sphere method's frame ([`surface::draw_mesh`]).
@@ -69,6 +71,7 @@ pub mod legend;
 pub mod outline;
 pub mod palette;
 pub mod plan;
+pub mod polyhedra;
 pub mod scalar;
 pub mod style;
 pub mod surface;

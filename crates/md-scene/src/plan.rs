@@ -39,7 +39,11 @@
 //!    [`DrawStyle::Cartoon`], protein and nucleic residues give way to the cartoon mesh
 //!    ([`MolPlan::cartoon_mesh`]); for [`DrawStyle::Surface`], the
 //!    selected atoms leave the scene for [`MolPlan::surface_atoms`]; for [`DrawStyle::HBonds`],
-//!    the atoms give way to the hydrogen bonds among them (below).
+//!    the atoms give way to the hydrogen bonds among them (below); for
+//!    [`DrawStyle::Polyhedra`], the selected atoms give way to their coordination polyhedra
+//!    ([`MolPlan::polyhedra_mesh`], [`crate::polyhedra`]), whose ligands are the atoms of
+//!    another element bonded to them in step 2, before bonds across the box are dropped (by
+//!    distance when no bonds are drawn).
 //!
 //! # Hydrogen bonds
 //! [`DrawStyle::HBonds`] draws the hydrogen bonds among a representation's atoms
@@ -135,6 +139,11 @@ pub enum DrawStyle {
     /// The hydrogen bonds among the selected atoms as dashed lines from hydrogen to acceptor
     /// (VMD's HBonds; see the module docs); the atoms themselves are not drawn.
     HBonds,
+    /// Coordination polyhedra (VESTA's): around each selected atom, the convex hull of the
+    /// atoms of other elements bonded to it, at their nearest periodic images, in the centre
+    /// atom's colour
+    /// ([`crate::polyhedra`]); the atoms themselves are not drawn.
+    Polyhedra,
 }
 
 /// The periodic-boundary treatment (frames without a cell are left as they are).
@@ -445,6 +454,12 @@ pub struct MolPlan {
     /// last frame drew.
     donor_h: Vec<[u32; 2]>,
     hbonds: Vec<HBond>,
+    /// This frame's bonds before those across the box are dropped (the ligands of
+    /// [`DrawStyle::Polyhedra`]), and the last frame's polyhedra.
+    ligand_pairs: Vec<[u32; 2]>,
+    polyhedra: MolMesh,
+    /// Whether this frame's bonds are the files' (else found by distance, or none).
+    pairs_listed: bool,
 }
 
 impl MolPlan {
@@ -502,6 +517,9 @@ impl MolPlan {
             surface: SurfaceAtoms::default(),
             cartoon: MolMesh::default(),
             donor_h: Vec::new(),
+            ligand_pairs: Vec::new(),
+            polyhedra: MolMesh::default(),
+            pairs_listed: false,
             hbonds: Vec::new(),
         })
     }
@@ -638,7 +656,10 @@ impl MolPlan {
         let sticks = self.reps.iter().any(|r| {
             !matches!(
                 r.draw,
-                DrawStyle::Spacefill | DrawStyle::Surface | DrawStyle::HBonds
+                DrawStyle::Spacefill
+                    | DrawStyle::Surface
+                    | DrawStyle::HBonds
+                    | DrawStyle::Polyhedra
             )
         });
         (sticks && self.options.bonds != BondSource::None) || self.draws_hbonds()
@@ -668,6 +689,7 @@ impl MolPlan {
     /// from the files drawn with neither a topology nor bonds in the frame are an error.
     fn find_bonds(&mut self, frame: &Frame, need: bool) -> Result<(), MolError> {
         self.pairs.clear();
+        self.pairs_listed = false;
         if !need {
             return Ok(());
         }
@@ -683,6 +705,7 @@ impl MolPlan {
             self.pairs.sort_unstable();
             self.pairs.dedup();
         }
+        self.pairs_listed = !self.pairs.is_empty();
         if self.pairs.is_empty() {
             match self.options.bonds {
                 BondSource::Auto => {
@@ -728,7 +751,10 @@ impl MolPlan {
         scene: &mut SphereScene,
     ) -> Result<(), MolError> {
         let unwrap = self.options.pbc == Pbc::Unwrap && frame.cell.is_some();
-        self.find_bonds(frame, self.draws_bonds() || unwrap)?;
+        self.find_bonds(
+            frame,
+            self.draws_bonds() || unwrap || self.draws_polyhedra(),
+        )?;
         match self.options.pbc {
             Pbc::None => {}
             Pbc::Wrap => texmap_md_io::pbc::wrap(frame),
@@ -763,6 +789,35 @@ impl MolPlan {
             } else {
                 hbonds::donor_hydrogens(frame, &self.pairs)
             };
+        }
+        self.ligand_pairs.clear();
+        if self.draws_polyhedra() {
+            // Before bonds across the box are dropped: a centre by a face keeps its ligands.
+            // Bonds between atoms of one element are no ligands (rutile's Ti-Ti at 2.96 Å is
+            // a bond by distance, not a corner of the TiO6 octahedron).
+            // Bonds by distance are found again in the frame as it now is: a bond list made
+            // before `replicate` holds one bond per pair of atoms of the unit cell, which loses
+            // the second image of a ligand bonded through both faces of a short cell.
+            let by_distance;
+            let pairs = if self.pairs_listed {
+                &self.pairs
+            } else {
+                let found = texmap_md_io::bonds::bonds_by_distance(frame, true);
+                by_distance = match &frame.cell {
+                    // A unit cell too narrow for the periodic grid: every pair, nearest images.
+                    Some(cell) if !found.periodic => {
+                        crate::polyhedra::pairs_in_narrow_cell(frame, cell)
+                    }
+                    _ => found.pairs,
+                };
+                &by_distance
+            };
+            let element = |i: u32| atom_element(frame, i as usize);
+            self.ligand_pairs.extend(
+                pairs
+                    .iter()
+                    .filter(|[i, j]| element(*i).is_unknown() || element(*i) != element(*j)),
+            );
         }
         texmap_md_io::pbc::drop_crossing(&mut self.pairs, &frame.positions, frame.cell.as_ref());
         self.last_bond_count = self.pairs.len();
@@ -831,6 +886,7 @@ impl MolPlan {
         self.surface.clear();
         self.hbonds.clear();
         self.cartoon = MolMesh::default();
+        self.polyhedra = MolMesh::default();
         let drawn = self.draw_reps(builder, frame, &reps, scene);
         self.reps = reps;
         builder.refresh_materials(scene);
@@ -854,16 +910,30 @@ impl MolPlan {
         &self.hbonds
     }
 
+    /// Whether some representation draws coordination polyhedra ([`DrawStyle::Polyhedra`]).
+    pub fn draws_polyhedra(&self) -> bool {
+        self.reps.iter().any(|r| r.draw == DrawStyle::Polyhedra)
+    }
+
+    /// The last frame's coordination polyhedra ([`DrawStyle::Polyhedra`]; empty without them).
+    pub fn polyhedra_mesh(&self) -> &MolMesh {
+        &self.polyhedra
+    }
+
     /// Whether some representation draws a molecular surface ([`DrawStyle::Surface`]).
     pub fn draws_surface(&self) -> bool {
         self.reps.iter().any(|r| r.draw == DrawStyle::Surface)
     }
 
-    /// Whether some representation draws a mesh (a surface or a cartoon) rather than spheres.
+    /// Whether some representation draws a mesh (a surface, a cartoon or polyhedra) rather
+    /// than spheres.
     pub fn draws_meshes(&self) -> bool {
-        self.reps
-            .iter()
-            .any(|r| matches!(r.draw, DrawStyle::Surface | DrawStyle::Cartoon))
+        self.reps.iter().any(|r| {
+            matches!(
+                r.draw,
+                DrawStyle::Surface | DrawStyle::Cartoon | DrawStyle::Polyhedra
+            )
+        })
     }
 
     /// The atoms the last frame built draws as a molecular surface ([`DrawStyle::Surface`]),
@@ -957,7 +1027,10 @@ impl MolPlan {
         let failed = |role| move |error| MolError::Selection { role, error };
         scene.bond_radii.clear();
         match rep.draw {
-            DrawStyle::Spacefill | DrawStyle::Surface | DrawStyle::HBonds => {}
+            DrawStyle::Spacefill
+            | DrawStyle::Surface
+            | DrawStyle::HBonds
+            | DrawStyle::Polyhedra => {}
             DrawStyle::BallStick => {
                 for r in &mut scene.radii {
                     *r *= BALL_AND_STICK_RADIUS_SCALE;
@@ -1007,6 +1080,33 @@ impl MolPlan {
             }
             _ => Vec::new(),
         };
+        if rep.draw == DrawStyle::Polyhedra {
+            let all;
+            let centre = match &mask {
+                Some(m) => m.as_slice(),
+                None => {
+                    all = vec![true; frame.n_atoms()];
+                    &all
+                }
+            };
+            let radii: Vec<f32> = (0..frame.n_atoms())
+                .map(|i| atom_element(frame, i).covalent_radius())
+                .collect();
+            crate::polyhedra::append_polyhedra(
+                &scene.centers,
+                &radii,
+                &scene.kinds,
+                centre,
+                &self.ligand_pairs,
+                frame.cell.as_ref(),
+                &mut self.polyhedra,
+            );
+            scene.centers.clear();
+            scene.radii.clear();
+            scene.kinds.clear();
+            scene.bonds.clear();
+            return Ok(());
+        }
         if rep.draw == DrawStyle::HBonds {
             let found =
                 hbonds::hydrogen_bonds(frame, &self.donor_h, mask.as_deref(), self.options.hbonds)

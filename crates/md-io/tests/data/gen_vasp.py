@@ -71,6 +71,29 @@ Poscar(s, comment="pymatgen POSCAR", selective_dynamics=sd, velocities=vel).writ
     f"{out}/POSCAR_pmg_vel"
 )
 
+# ASE: rutile TiO2 from its space group (P4_2/mnm, Baur's 1956 parameters), for the polyhedra
+# style; with the volume of each Ti's O6 octahedron by scipy's ConvexHull (the six O within
+# 2.3 Å, nearest images by ase.neighborlist) in vasp/rutile_polyhedra.json.
+from ase.neighborlist import neighbor_list
+from ase.spacegroup import crystal
+from scipy.spatial import ConvexHull
+
+rutile = crystal(
+    ["Ti", "O"],
+    basis=[(0, 0, 0), (0.3048, 0.3048, 0)],
+    spacegroup=136,
+    cellpar=[4.594, 4.594, 2.959, 90, 90, 90],
+)
+write(f"{out}/POSCAR_rutile", rutile, format="vasp", direct=True)
+i, j, d = neighbor_list("ijD", rutile, 2.3)
+volumes = []
+for ti in [k for k, s in enumerate(rutile.get_chemical_symbols()) if s == "Ti"]:
+    shell = d[(i == ti) & (np.array(rutile.get_chemical_symbols())[j] == "O")]
+    assert len(shell) == 6
+    volumes.append(ConvexHull(shell).volume)
+with open(f"{out}/rutile_polyhedra.json", "w") as fh:
+    json.dump({"octahedron_volumes": volumes, "faces": 8}, fh)
+
 reference = {}
 for name in sorted(os.listdir(out)):
     if name.endswith((".json", ".extxyz")):
