@@ -32,11 +32,16 @@ pub enum Format {
     /// VASP POSCAR / CONTCAR (one structure) and XDATCAR (MD trajectory): files named
     /// `POSCAR*`, `CONTCAR*`, `XDATCAR*`, or `.vasp`, `.poscar`.
     Vasp,
+    /// Crystallographic CIF (COD, ICSD, Materials Project: DDL1 `_atom_site_fract_x`), the
+    /// asymmetric unit expanded by the file's symmetry operations; data blocks are frames. A
+    /// `.cif` file is this or PDBx/mmCIF by its tags ([`Format::cif_kind`]); by name:
+    /// `cif-crystal`.
+    CrystalCif,
 }
 
 impl Format {
     /// Every format, in declaration order.
-    pub const ALL: [Format; 12] = [
+    pub const ALL: [Format; 13] = [
         Format::Xyz,
         Format::Pdb,
         Format::Gro,
@@ -49,6 +54,7 @@ impl Format {
         Format::Sdf,
         Format::Mol2,
         Format::Vasp,
+        Format::CrystalCif,
     ];
 
     /// The format a file extension names (case-insensitive), e.g. "xyz", "lammpstrj".
@@ -67,6 +73,7 @@ impl Format {
             "sdf" | "sd" | "mol" => Format::Sdf,
             "mol2" => Format::Mol2,
             "vasp" | "poscar" | "contcar" | "xdatcar" => Format::Vasp,
+            "cif-crystal" => Format::CrystalCif,
             _ => return None,
         })
     }
@@ -93,7 +100,8 @@ impl Format {
 
     /// The format the first bytes of a file show (give at least 256 bytes when the file has
     /// them). Binary formats are told by their magic numbers, text formats by their first
-    /// lines: `data_` (PDBx/mmCIF) or `@<TRIPOS>` (MOL2) on the first line that is not a `#`
+    /// lines: `data_` (CIF: PDBx/mmCIF or crystallographic, by [`Format::cif_kind`]) or
+    /// `@<TRIPOS>` (MOL2) on the first line that is not a `#`
     /// comment, `ITEM: TIMESTEP` (LAMMPS), a PDB record name, a fourth line ending in `V2000` or
     /// `V3000` (molfile, SD file), an integer first line (XYZ), an integer second line (GRO).
     pub fn from_magic(head: &[u8]) -> Option<Format> {
@@ -119,13 +127,14 @@ impl Format {
             Some(1993) => return Some(Format::Trr),
             _ => {}
         }
-        // PDBx/mmCIF: a data block header, after comments and blank lines.
+        // CIF (PDBx/mmCIF or crystallographic): a data block header, after comments and blank
+        // lines.
         let cif = head
             .split(|b| *b == b'\n')
             .map(crate::parse::trim)
             .find(|l| !l.is_empty() && l[0] != b'#');
         if cif.is_some_and(|l| l.len() >= 5 && l[..5].eq_ignore_ascii_case(b"data_")) {
-            return Some(Format::Mmcif);
+            return Some(Format::cif_kind(head));
         }
         // MOL2: a Tripos record header, after comments and blank lines.
         if cif.is_some_and(|l| l.starts_with(b"@<TRIPOS>")) {
@@ -166,6 +175,54 @@ impl Format {
         None
     }
 
+    /// Which CIF a file is, from its first bytes (`head`; [`crate::Trajectory::open`] gives up
+    /// to [`Format::CIF_HEAD`] of a `.cif` file): [`Format::CrystalCif`] or [`Format::Mmcif`].
+    ///
+    /// The tags decide, outside text fields: an `_atom_site_…` tag without a dot (DDL1:
+    /// `_atom_site_label`, `_atom_site_fract_x`, `_atom_site_aniso_U_11`) is a crystallographic
+    /// CIF; `_atom_site.…` tags (DDL2) are PDBx/mmCIF, unless they hold `fract_x` and no
+    /// `Cartn_x` (a DDLm core CIF). Without an atom-site tag in `head` the first tag decides:
+    /// dotted (`_entry.id`) is mmCIF, undotted (`_publ_author_name`, `_cell_length_a`) is a
+    /// crystallographic CIF. Without any tag, mmCIF.
+    pub fn cif_kind(head: &[u8]) -> Format {
+        let (mut first, mut dotted, mut fract, mut cartn) = (None, false, false, false);
+        let mut text_field = false;
+        for line in head.split(|b| *b == b'\n') {
+            if line.first() == Some(&b';') {
+                text_field = !text_field;
+                continue;
+            }
+            let t = crate::parse::trim(line);
+            if text_field || t.first() != Some(&b'_') {
+                continue;
+            }
+            let end = t
+                .iter()
+                .position(|b| matches!(b, b' ' | b'\t'))
+                .unwrap_or(t.len());
+            let tag = t[..end].to_ascii_lowercase();
+            let dot = tag.contains(&b'.');
+            first.get_or_insert(dot);
+            if tag.starts_with(b"_atom_site_") && !dot {
+                return Format::CrystalCif;
+            }
+            if let Some(item) = tag.strip_prefix(b"_atom_site.") {
+                dotted = true;
+                fract |= item == b"fract_x";
+                cartn |= item == b"cartn_x";
+            }
+        }
+        match (dotted, first) {
+            (true, _) if fract && !cartn => Format::CrystalCif,
+            (true, _) | (false, Some(true) | None) => Format::Mmcif,
+            (false, Some(false)) => Format::CrystalCif,
+        }
+    }
+
+    /// How much of a `.cif` file [`crate::Trajectory::open`] reads to tell its kind
+    /// ([`Format::cif_kind`]): a COD file's atom sites come after kilobytes of bibliography.
+    pub const CIF_HEAD: u64 = 64 * 1024;
+
     /// True for the text formats (line numbers in errors, line-scan frame index).
     pub fn is_text(self) -> bool {
         matches!(
@@ -178,6 +235,7 @@ impl Format {
                 | Format::Sdf
                 | Format::Mol2
                 | Format::Vasp
+                | Format::CrystalCif
         )
     }
 
@@ -196,6 +254,7 @@ impl Format {
             Format::Sdf => "sdf",
             Format::Mol2 => "mol2",
             Format::Vasp => "vasp",
+            Format::CrystalCif => "cif-crystal",
         }
     }
 }

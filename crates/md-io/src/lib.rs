@@ -4,7 +4,9 @@
 //! - [`Trajectory`] reads XYZ / extended XYZ, PDB, PDBx/mmCIF (the first data block's
 //!   `_atom_site`, models as frames), GRO and LAMMPS text dumps, MDL SDF/MOL and Tripos MOL2
 //!   (records as frames, with the bonds they list: [`Frame::bonds`]), VASP POSCAR/CONTCAR
-//!   and XDATCAR (the ionic steps as frames, a changing cell too) (and the binary DCD, XTC,
+//!   and XDATCAR (the ionic steps as frames, a changing cell too), crystallographic CIF (COD,
+//!   ICSD, Materials Project: each data block a frame, the asymmetric unit expanded by the
+//!   file's symmetry operations; a `.cif` is told from PDBx/mmCIF by its tags) (and the binary DCD, XTC,
 //!   TRR and AMBER NetCDF) one frame at a time into a reusable [`Frame`], or any frame by index.
 //!   Any of them may be gzip-compressed (`1abc.cif.gz`, `run.xyz.gz`; topologies too): it is
 //!   inflated once into a temporary file, so the byte offsets of a `.gz` file's errors count
@@ -80,8 +82,10 @@
 //! streaming, the line-scan index and error positions from `TextReader`.
 
 pub mod bonds;
+mod cif;
 pub mod cna;
 pub mod coordination;
+mod crystal_cif;
 mod cursor;
 mod dcd;
 pub mod elements;

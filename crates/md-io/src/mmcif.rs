@@ -74,78 +74,14 @@ use std::collections::HashSet;
 use std::hash::{BuildHasherDefault, Hasher};
 use std::io::Read;
 
+#[cfg(test)]
+use crate::cif::classify;
+use crate::cif::{Kind, Lexer, Tok, number, strip_esd};
 use crate::elements::guess_element;
 use crate::error::Error;
 use crate::frame::{Frame, Label, UnitCell};
-use crate::parse::{parse_f32, parse_f64, parse_i64};
+use crate::parse::{parse_f32, parse_i64};
 use crate::text::{Ctx, FrameWalk, LineReader, ModelCheck, Pos};
-
-/// What a token is, by the CIF grammar.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Kind {
-    /// An unquoted value (bare `.` and `?` are the missing values).
-    Bare,
-    /// A quoted value or a text field: always a value, never a keyword.
-    Quoted,
-    /// `_category.item`.
-    Tag,
-    /// `loop_`.
-    Loop,
-    /// `data_name`.
-    Data,
-    /// `save_…`, `global_`, `stop_`: not used by PDBx data files.
-    Reserved,
-}
-
-/// One token: its bytes (quotes removed) and where it starts.
-#[derive(Clone, Copy)]
-struct Tok<'a> {
-    kind: Kind,
-    text: &'a [u8],
-    /// The token's line and the byte offset of its first byte (a text field: its opening `;`).
-    at: Pos,
-    /// True when only blanks precede it on its line.
-    starts_line: bool,
-}
-
-impl Tok<'_> {
-    fn is_value(&self) -> bool {
-        matches!(self.kind, Kind::Bare | Kind::Quoted)
-    }
-
-    /// A bare `.` (inapplicable) or `?` (unknown).
-    fn missing(&self) -> bool {
-        self.kind == Kind::Bare && matches!(self.text, b"." | b"?")
-    }
-
-    /// A parse error at this token.
-    fn error(&self, ctx: &Ctx, expected: &'static str) -> Error {
-        Error::Parse {
-            at: ctx.at(self.at),
-            expected,
-            found: Error::found(self.text),
-        }
-    }
-}
-
-/// The kind of a bare token (reserved words are case-insensitive).
-fn classify(t: &[u8]) -> Kind {
-    let starts = |p: &[u8]| t.len() >= p.len() && t[..p.len()].eq_ignore_ascii_case(p);
-    if t.first() == Some(&b'_') {
-        Kind::Tag
-    } else if t.eq_ignore_ascii_case(b"loop_") {
-        Kind::Loop
-    } else if starts(b"data_") {
-        Kind::Data
-    } else if starts(b"save_")
-        || t.eq_ignore_ascii_case(b"global_")
-        || t.eq_ignore_ascii_case(b"stop_")
-    {
-        Kind::Reserved
-    } else {
-        Kind::Bare
-    }
-}
 
 /// What the parser asks of the line loop after a token.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -156,119 +92,6 @@ enum Flow {
     NextModel,
     /// The `_atom_site` loop ended: the frame ends, and the rest of the file is not read.
     LoopEnd,
-}
-
-/// Splits lines into tokens and carries an open text field from line to line.
-#[derive(Default)]
-struct Lexer {
-    /// Where the open text field started (its `;`), if one is open.
-    open: Option<Pos>,
-    /// The open text field's lines, joined by spaces.
-    text: Vec<u8>,
-}
-
-impl Lexer {
-    /// Feeds the tokens of `line` (which starts at `pos`) to `f` until it asks for something
-    /// else than more.
-    fn line(
-        &mut self,
-        line: &[u8],
-        pos: Pos,
-        ctx: &Ctx,
-        mut f: impl FnMut(Tok<'_>) -> Result<Flow, Error>,
-    ) -> Result<Flow, Error> {
-        let mut i = 0;
-        let mut first = true;
-        if let Some(open) = self.open {
-            if line.first() != Some(&b';') {
-                // Another line of the text field.
-                if !self.text.is_empty() {
-                    self.text.push(b' ');
-                }
-                self.text.extend_from_slice(line);
-                return Ok(Flow::More);
-            }
-            // The field closes; the rest of this line holds ordinary tokens.
-            self.open = None;
-            let tok = Tok {
-                kind: Kind::Quoted,
-                text: &self.text,
-                at: open,
-                starts_line: true,
-            };
-            match f(tok)? {
-                Flow::More => {}
-                other => return Ok(other),
-            }
-            i = 1;
-            first = false;
-        }
-        loop {
-            while i < line.len() && matches!(line[i], b' ' | b'\t') {
-                i += 1;
-            }
-            if i >= line.len() {
-                return Ok(Flow::More);
-            }
-            let at = Pos {
-                line: pos.line,
-                byte: pos.byte + i as u64,
-            };
-            let starts_line = std::mem::replace(&mut first, false);
-            let tok = match line[i] {
-                b'#' => return Ok(Flow::More),
-                b';' if i == 0 => {
-                    self.open = Some(at);
-                    self.text.clear();
-                    self.text.extend_from_slice(&line[1..]);
-                    return Ok(Flow::More);
-                }
-                q @ (b'\'' | b'"') => {
-                    // A quote closes only before a blank or the end of the line.
-                    let close = (i + 1..line.len()).find(|&j| {
-                        line[j] == q && line.get(j + 1).is_none_or(|&b| matches!(b, b' ' | b'\t'))
-                    });
-                    let Some(j) = close else {
-                        return Err(Error::Parse {
-                            at: ctx.at(at),
-                            expected: if q == b'\'' {
-                                "a closing ' (followed by a blank or the line end) on the same line"
-                            } else {
-                                "a closing \" (followed by a blank or the line end) on the same line"
-                            },
-                            found: Error::found(&line[i..]),
-                        });
-                    };
-                    let tok = Tok {
-                        kind: Kind::Quoted,
-                        text: &line[i + 1..j],
-                        at,
-                        starts_line,
-                    };
-                    i = j + 1;
-                    tok
-                }
-                _ => {
-                    let j = line[i..]
-                        .iter()
-                        .position(|b| matches!(b, b' ' | b'\t'))
-                        .map_or(line.len(), |k| i + k);
-                    let text = &line[i..j];
-                    i = j;
-                    Tok {
-                        kind: classify(text),
-                        text,
-                        at,
-                        starts_line,
-                    }
-                }
-            };
-            match f(tok)? {
-                Flow::More => {}
-                other => return Ok(other),
-            }
-        }
-    }
 }
 
 /// An `_atom_site` column the reader uses.
@@ -345,24 +168,6 @@ fn interest(tag: &[u8]) -> Interest {
         Interest::Atom(role(item))
     } else {
         Interest::None
-    }
-}
-
-/// A CIF number (a standard uncertainty in parentheses, `1.234(5)`, is dropped).
-fn number(tok: &Tok) -> Option<f64> {
-    if tok.missing() {
-        return None;
-    }
-    parse_f64(strip_esd(tok.text))
-}
-
-fn strip_esd(t: &[u8]) -> &[u8] {
-    match t {
-        [head @ .., b')'] => match head.iter().rposition(|b| *b == b'(') {
-            Some(k) if head[k + 1..].iter().all(u8::is_ascii_digit) => &head[..k],
-            _ => t,
-        },
-        _ => t,
     }
 }
 
@@ -641,9 +446,12 @@ impl FrameWalk for Mmcif {
                 return self.finish(ctx, p, frame);
             };
             let Mmcif { lex, p: parser, .. } = self;
-            let flow = lex.line(line, pos, ctx, |tok| {
-                parser.token(tok, ctx, frame.as_deref_mut())
-            })?;
+            let flow = lex
+                .line(line, pos, ctx, |tok| {
+                    let flow = parser.token(tok, ctx, frame.as_deref_mut())?;
+                    Ok((flow != Flow::More).then_some(flow))
+                })?
+                .unwrap_or(Flow::More);
             match flow {
                 Flow::More => {}
                 Flow::NextModel => {

@@ -1,5 +1,6 @@
 //! [`Trajectory`]: one reader for every format, streaming or random access.
 
+use crate::crystal_cif::CrystalCif;
 use crate::dcd::DcdReader;
 use crate::error::Error;
 use crate::format::Format;
@@ -35,6 +36,7 @@ enum Reader<R> {
     Sdf(TextReader<R, Sdf>),
     Mol2(TextReader<R, Mol2>),
     Vasp(TextReader<R, Vasp>),
+    CrystalCif(TextReader<R, CrystalCif>),
 }
 
 /// Runs `$body` with `$r` bound to the format's reader, whatever the format.
@@ -53,6 +55,7 @@ macro_rules! each_reader {
             Reader::Sdf($r) => $body,
             Reader::Mol2($r) => $body,
             Reader::Vasp($r) => $body,
+            Reader::CrystalCif($r) => $body,
         }
     };
 }
@@ -143,6 +146,8 @@ pub struct Trajectory<R: Read + Seek = File> {
 
 impl Trajectory<File> {
     /// Opens `path`, telling the format from the extension or else from the first bytes.
+    /// A CIF (`.cif`, or first bytes `data_`) is PDBx/mmCIF or crystallographic by its tags
+    /// in its first [`Format::CIF_HEAD`] bytes ([`Format::cif_kind`]); `.mmcif` is mmCIF.
     ///
     /// A gzip file (first bytes `1f 8b`, e.g. `1abc.cif.gz`, `run.xyz.gz`) is read decompressed:
     /// its format comes from the name without `.gz`, else from the decompressed first bytes. It
@@ -176,6 +181,22 @@ impl Trajectory<File> {
                 file.rewind().map_err(io)?;
                 Format::from_magic(&head).ok_or(Error::UnknownFormat { file: name.clone() })?
             }
+        };
+        // A CIF not named `.mmcif` is PDBx/mmCIF or crystallographic: its tags tell, from a
+        // larger head than the magic's (a COD file's atom sites follow its bibliography).
+        let mmcif_named = crate::gz::inner_path(path)
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("mmcif"));
+        let format = if format == Format::Mmcif && !mmcif_named {
+            let mut head = Vec::new();
+            (&mut file)
+                .take(Format::CIF_HEAD)
+                .read_to_end(&mut head)
+                .map_err(io)?;
+            file.rewind().map_err(io)?;
+            Format::cif_kind(&head)
+        } else {
+            format
         };
         Trajectory::from_reader_with(file, format, &name, options).map(|t| t.with_warning(cut))
     }
@@ -229,6 +250,9 @@ impl<R: Read + Seek> Trajectory<R> {
             Format::Sdf => Reader::Sdf(TextReader::new(src, Sdf, file.clone())),
             Format::Mol2 => Reader::Mol2(TextReader::new(src, Mol2::default(), file.clone())),
             Format::Vasp => Reader::Vasp(TextReader::new(src, Vasp::default(), file.clone())),
+            Format::CrystalCif => {
+                Reader::CrystalCif(TextReader::new(src, CrystalCif::default(), file.clone()))
+            }
         };
         Ok(Trajectory {
             reader,

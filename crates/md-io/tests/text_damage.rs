@@ -24,6 +24,8 @@ const FILES: &[(&str, Format)] = &[
     ("vasp/XDATCAR_pmg", Format::Vasp),
     ("vasp/XDATCAR_ase", Format::Vasp),
     ("vasp/POSCAR_pmg_vel", Format::Vasp),
+    ("crystal/two_blocks.cif", Format::CrystalCif),
+    ("crystal/cod_9001665.cif", Format::CrystalCif),
 ];
 
 fn data(name: &str) -> Vec<u8> {
@@ -131,6 +133,16 @@ fn frame_ends(bytes: &[u8], format: Format) -> Vec<usize> {
             if ends.is_empty() {
                 ends.push(bytes.len());
             }
+        }
+        Format::CrystalCif => {
+            // A data block ends where the next one's `data_` line shows (that line is part of
+            // what ends it: its damage is the earlier block's), the last with the file. (Every
+            // block of these files holds atom sites.)
+            let blocks = (0..lines.len()).filter(|&k| lines[k].starts_with("data_"));
+            for k in blocks.skip(1) {
+                ends.push(line_starts[k + 1]);
+            }
+            ends.push(bytes.len());
         }
         _ => unreachable!(),
     }
@@ -296,6 +308,10 @@ fn allow_truncated_streams_every_cut_to_its_complete_frames() {
         // complete _atom_site loop is a file that holds no frame, not a cut frame.
         let first_row = match format {
             Format::Mmcif => std::str::from_utf8(&good).unwrap().find("\nATOM").unwrap(),
+            // A crystallographic CIF's first block without its atom-site loop holds no frame.
+            Format::CrystalCif => (std::str::from_utf8(&good).unwrap())
+                .find("\n_atom_site_label")
+                .unwrap(),
             _ => 0,
         };
         let late: Vec<_> = errors.iter().filter(|(cut, _)| *cut > first_row).collect();
