@@ -380,12 +380,14 @@ impl Vasp {
         }
     }
 
-    /// A CONTCAR's velocities, if it has them (see the module docs), into `frame`.
+    /// A CONTCAR's velocities, if it has them (see the module docs), into `frame`; without a
+    /// frame (a scan), the same lines are walked and only the first is parsed (it tells
+    /// whether velocities follow), so that a cut inside them is found by a scan too.
     fn velocities<R: Read>(
         lines: &mut LineReader<R>,
         ctx: &Ctx,
         h: &Header,
-        frame: &mut Frame,
+        mut frame: Option<&mut Frame>,
     ) -> Result<(), Error> {
         // The line after the coordinates: its first letter, or None when it is blank.
         let kind = |l: &[u8]| trim(l).first().map(u8::to_ascii_lowercase);
@@ -411,33 +413,35 @@ impl Vasp {
         }
         let direct = sep == Some(b'd');
         let known = matches!(sep, None | Some(b'd' | b'c' | b'k'));
-        // The first velocity line: three numbers, else no velocities are written.
-        let p = lines.pos();
-        let Some((pos, line)) = lines.next_line().map_err(|e| ctx.io(p, e))? else {
-            return Ok(());
-        };
-        if !known || three(line).is_err() {
-            return Ok(());
+        if let Some(f) = frame.as_deref_mut() {
+            f.velocities.reserve(h.n.min(ctx.reserve));
         }
-        let mut first = Some((pos, line.to_vec()));
-        frame.velocities.reserve(h.n.min(ctx.reserve));
         for i in 0..h.n {
-            let (pos, line) = match first.take() {
-                Some((p, l)) => (p, l),
-                None => {
-                    let (p, l) =
-                        need_line(lines, ctx, &format!("{} more velocity lines", h.n - i))?;
-                    (p, l.to_vec())
+            let (pos, line) = if i == 0 {
+                // The first velocity line: three numbers, else no velocities are written.
+                let p = lines.pos();
+                match lines.next_line().map_err(|e| ctx.io(p, e))? {
+                    Some((pos, line)) if known && three(line).is_ok() => (pos, line),
+                    _ => return Ok(()),
                 }
+            } else {
+                need_line(lines, ctx, &format!("{} more velocity lines", h.n - i))?
+            };
+            let Some(f) = frame.as_deref_mut() else {
+                continue;
             };
             let v =
-                three(&line).map_err(|f| ctx.parse(pos, &line, f, "3 velocity numbers (Å/fs)"))?;
+                three(line).map_err(|t| ctx.parse(pos, line, t, "3 velocity numbers (Å/fs)"))?;
             let v = if direct {
                 frac_to_cartesian(&h.lattice, v)
             } else {
                 v
             };
-            frame.velocities.push(v.map(|x| (x * PS_PER_FS) as f32));
+            let v = v.map(|x| (x * PS_PER_FS) as f32);
+            if v.iter().any(|x| !x.is_finite()) {
+                return Err(ctx.parse(pos, line, trim(line), "a velocity within f32 range"));
+            }
+            f.velocities.push(v);
         }
         Ok(())
     }
@@ -498,7 +502,7 @@ impl TextFormat for Vasp {
             }
         }
         if !mode.configuration {
-            Vasp::velocities(lines, ctx, &h, frame)?;
+            Vasp::velocities(lines, ctx, &h, Some(frame))?;
             Vasp::rest(lines, ctx)?;
         }
         Ok(true)
@@ -514,6 +518,7 @@ impl TextFormat for Vasp {
             return Err(ctx.truncated(lines.pos(), format!("{missing} more coordinate lines")));
         }
         if !mode.configuration {
+            Vasp::velocities(lines, ctx, &h, None)?;
             Vasp::rest(lines, ctx)?;
         }
         Ok(true)

@@ -581,3 +581,22 @@ fn lammps_campaign() {
     let fx = files.map(|f| text_fixture(f, Format::LammpsDump));
     campaign("LAMMPS dump", Format::LammpsDump, fx.into());
 }
+
+#[test]
+fn vasp_campaign() {
+    let files = [
+        "vasp/XDATCAR_pmg",
+        "vasp/XDATCAR_ase",
+        "vasp/CONTCAR_ase_vel.vasp",
+        "vasp/POSCAR_pmg_vel",
+    ];
+    let fx = files.map(|f| text_fixture(f, Format::Vasp));
+    campaign("VASP", Format::Vasp, fx.into());
+}
+
+#[test]
+fn crystal_cif_campaign() {
+    let files = ["crystal/cod_9001665.cif", "crystal/two_blocks.cif"];
+    let fx = files.map(|f| text_fixture(f, Format::CrystalCif));
+    campaign("crystallographic CIF", Format::CrystalCif, fx.into());
+}
