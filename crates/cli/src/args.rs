@@ -697,9 +697,14 @@ pub enum DrawStyle {
     #[value(name = "hbonds")]
     HBonds,
     /// Coordination polyhedra (VESTA's): around each atom, the convex hull of the atoms of other
-    /// elements bonded to it (at their nearest periodic images), in the atom's colour, lit flat. Usually one
-    /// --rep among others: --rep 'all=ball-stick' --rep 'element Ti=polyhedra'.
+    /// elements bonded to it (at their nearest periodic images), in the atom's colour, lit
+    /// flat. Usually one --rep among others: --rep 'all=ball-stick' --rep 'element Ti=polyhedra'.
     Polyhedra,
+    /// An arrow from each atom along its vector (OVITO's vector display): --arrows velocity
+    /// (the default), displacement (from the first frame drawn) or a property stem (f for a
+    /// LAMMPS dump's fx fy fz), times --arrow-scale. Usually one --rep among others:
+    /// --rep 'all=ball-stick' --rep 'all=arrows'.
+    Arrows,
 }
 
 /// Periodic boundaries (`--pbc`).
@@ -778,6 +783,20 @@ pub struct MolArgs {
     /// default 150; VMD's angle cutoff of 20 is 160 here).
     #[arg(long, value_name = "DEG", default_value_t = texmap_md_io::hbonds::DEFAULT_ANGLE)]
     pub hbond_angle: f32,
+    /// The arrows style's vectors: `velocity` (the file's, Å/ps), `displacement` (from the
+    /// first frame drawn, to the nearest periodic image: OVITO's Displacements with that frame
+    /// as the reference; --frames 0:100 measures from frame 0) or the stem of
+    /// three per-atom properties (`f` for a LAMMPS dump's fx fy fz, `c_disp` for
+    /// c_disp[1] c_disp[2] c_disp[3]).
+    #[arg(long, value_name = "SOURCE", default_value = "velocity")]
+    pub arrows: String,
+    /// The arrows style's length per unit of the vector (Å per Å/ps for velocities; 1 draws a
+    /// displacement at its true length).
+    #[arg(long, value_name = "S", default_value_t = 1.0)]
+    pub arrow_scale: f32,
+    /// The arrows style's shaft radius, Å (the head is 2.5 times as wide).
+    #[arg(long, value_name = "Å", default_value_t = 0.1)]
+    pub arrow_radius: f32,
     /// Also write the hydrogen bonds the hbonds style draws as a CSV table, one row per bond and
     /// frame: frame, donor, hydrogen, acceptor (0-based atom indices, as MDAnalysis's
     /// results.hbonds), the three atoms as RESNAME RESID:NAME, the donor-acceptor distance (Å)

@@ -507,6 +507,15 @@ fn render(a: &RenderArgs) -> Result<()> {
             Some(t)
         }
     };
+    if plan.draws_arrows()
+        && a.mol.arrows.starts_with("displacement")
+        && frames.first().is_some_and(|f| *f != 0)
+    {
+        crate::note!(
+            "--arrows displacement measures from frame {} (the first frame drawn); start --frames at 0 to measure from the trajectory's first frame",
+            frames[0]
+        );
+    }
     if a.export_mesh.is_some() && !plan.draws_meshes() {
         return usage(
             "--export-mesh writes the cartoon, surface and polyhedra styles' meshes: draw some atoms with --style cartoon, surface or polyhedra (or a --rep of them)",
@@ -608,6 +617,7 @@ fn render(a: &RenderArgs) -> Result<()> {
                 && plan.surface_atoms().is_empty()
                 && plan.cartoon_mesh().triangles.is_empty()
                 && plan.polyhedra_mesh().triangles.is_empty()
+                && plan.arrow_atoms().is_empty()
             {
                 let why = if a.mol.reps.is_empty() {
                     a.mol
@@ -634,7 +644,13 @@ fn render(a: &RenderArgs) -> Result<()> {
             for p in &plan.cartoon_mesh().positions {
                 framed.push(*p, texmap_md_scene::cartoon::COIL_RADIUS, 0);
             }
-            for p in &plan.polyhedra_mesh().positions {
+            for p in plan
+                .polyhedra_mesh()
+                .positions
+                .iter()
+                .chain(&plan.arrows_mesh().positions)
+                .chain(plan.arrow_atoms())
+            {
                 framed.push(*p, 0.0, 0);
             }
             let plan =
@@ -675,6 +691,7 @@ fn render(a: &RenderArgs) -> Result<()> {
         // The meshes drawn over the spheres, each with its opacity.
         let layers = [
             (plan.cartoon_mesh(), 1.0),
+            (plan.arrows_mesh(), 1.0),
             (&surface, surface_opacity),
             (plan.polyhedra_mesh(), polyhedra_opacity),
         ];
@@ -759,6 +776,7 @@ fn render(a: &RenderArgs) -> Result<()> {
             let mut all = plan.cartoon_mesh().clone();
             all.append(&surface);
             all.append(plan.polyhedra_mesh());
+            all.append(plan.arrows_mesh());
             if all.triangles.is_empty() {
                 let e = anyhow::anyhow!(
                     "--export-mesh: frame {f} has no cartoon, surface or polyhedra to write"

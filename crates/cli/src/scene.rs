@@ -414,6 +414,7 @@ impl From<DrawStyle> for texmap_md_scene::DrawStyle {
             DrawStyle::Surface => texmap_md_scene::DrawStyle::Surface,
             DrawStyle::HBonds => texmap_md_scene::DrawStyle::HBonds,
             DrawStyle::Polyhedra => texmap_md_scene::DrawStyle::Polyhedra,
+            DrawStyle::Arrows => texmap_md_scene::DrawStyle::Arrows,
         }
     }
 }
@@ -528,6 +529,17 @@ pub fn mol_plan(args: &MolArgs) -> Result<MolPlan> {
             distance: args.hbond_distance,
             angle: args.hbond_angle,
         },
+        arrows: texmap_md_scene::arrows::ArrowOptions {
+            source: match args.arrows.as_str() {
+                "velocity" | "velocities" => texmap_md_scene::arrows::ArrowSource::Velocity,
+                "displacement" | "displacements" => {
+                    texmap_md_scene::arrows::ArrowSource::Displacement
+                }
+                stem => texmap_md_scene::arrows::ArrowSource::Property(stem.to_string()),
+            },
+            scale: args.arrow_scale,
+            radius: args.arrow_radius,
+        },
     })
     .map_err(mol_error)
 }
@@ -610,6 +622,13 @@ pub fn mol_error(e: MolError) -> anyhow::Error {
         }
         MolError::HBonds(texmap_md_io::hbonds::HBondError::BadDistance(d)) => {
             format!("--hbond-distance {d}: expected a donor-acceptor distance above 0.45 and at most 6 Å")
+        }
+        MolError::Arrows(texmap_md_scene::arrows::ArrowError::BadOption { what, value }) => {
+            format!("--arrow-{what} {value}: expected a finite number > 0")
+        }
+        MolError::Arrows(e) => {
+            // The frame lacks the vectors asked for: the input's limit.
+            return anyhow::anyhow!("--rep ...=arrows: {e}");
         }
         MolError::HBonds(texmap_md_io::hbonds::HBondError::BadAngle(a)) => {
             format!("--hbond-angle {a}: expected an angle from 0 to 180 degrees")

@@ -2148,3 +2148,120 @@ fn rutile_polyhedra_are_its_tio6_octahedra() {
     );
     assert_ne!(opaque.as_raw(), clear.as_raw());
 }
+
+/// Arrows: the velocities of ASE's CONTCAR (md-io's tests/data/gen_vasp.py) drawn at 0.3 Å per
+/// Å/ps end, atom for atom, where ASE's positions plus 0.3 times ASE's velocities put them (the
+/// exported mesh's farthest point along each arrow); displacements of ASE's XDATCAR drawn by
+/// the rasteriser as the reference ray tracer draws them; a file without the vectors asked for
+/// is an error naming what it lacks.
+#[test]
+fn arrows_end_where_the_vectors_point() {
+    let dir = tempfile::tempdir().unwrap();
+    let contcar = data("vasp/CONTCAR_ase_vel.vasp");
+    let reference: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(data("vasp/reference.json")).unwrap(),
+    )
+    .unwrap();
+    let want = &reference["CONTCAR_ase_vel.vasp"][0];
+    let obj = dir.path().join("arrows.obj");
+    let args = [
+        contcar.as_str(),
+        "--rep",
+        "all=arrows",
+        "--arrow-scale",
+        "0.3",
+        "--size",
+        "320x240",
+        "--export-mesh",
+        obj.to_str().unwrap(),
+    ];
+    render_rgb(dir.path(), "v.png", &args);
+    let v: Vec<[f64; 3]> = std::fs::read_to_string(&obj)
+        .unwrap()
+        .lines()
+        .filter_map(|l| l.strip_prefix("v "))
+        .map(|l| {
+            let mut it = l.split_whitespace().map(|x| x.parse::<f64>().unwrap());
+            std::array::from_fn(|_| it.next().unwrap())
+        })
+        .collect();
+    let positions = want["positions"].as_array().unwrap();
+    let velocities = want["velocities"].as_array().unwrap();
+    assert_eq!(positions.len(), 9);
+    for (p, u) in positions.iter().zip(velocities) {
+        let p: [f64; 3] = std::array::from_fn(|k| p[k].as_f64().unwrap());
+        let u: [f64; 3] = std::array::from_fn(|k| u[k].as_f64().unwrap() * 0.3);
+        let len = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
+        let tip: [f64; 3] = std::array::from_fn(|k| p[k] + u[k]);
+        // Some vertex of the mesh is the tip, and no vertex of this arrow lies beyond it.
+        let nearest = v
+            .iter()
+            .map(|q| (0..3).map(|k| (q[k] - tip[k]).powi(2)).sum::<f64>().sqrt())
+            .fold(f64::MAX, f64::min);
+        assert!(nearest < 1e-4 * len.max(1.0), "tip {tip:?}: nearest vertex {nearest} Å");
+    }
+    // Displacements: rasteriser against the reference ray tracer, frame 0 (no arrows) and 4.
+    let xdatcar = data("vasp/XDATCAR_ase");
+    for method in ["raycast", "reference"] {
+        let out = dir.path().join(format!("{method}%d.png"));
+        let o = texmap(&[
+            "render",
+            "--quiet",
+            &xdatcar,
+            "--frames",
+            "0:5:4",
+            "--rep",
+            "all=ball-stick",
+            "--rep",
+            "all=arrows",
+            "--arrows",
+            "displacement",
+            "--arrow-scale",
+            "5",
+            "--size",
+            "320x240",
+            "--method",
+            method,
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    let d = mean_abs_diff(&dir.path().join("raycast4.png"), &dir.path().join("reference4.png"));
+    assert!(d < 1.0, "mean |raycast - reference| = {d}");
+    // Without the arrows (the same frames, so the same camera): frame 4 differs, and frame 0,
+    // whose displacements are all zero, is the same picture.
+    let o = texmap(&[
+        "render",
+        "--quiet",
+        &xdatcar,
+        "--frames",
+        "0:5:4",
+        "--rep",
+        "all=ball-stick",
+        "--size",
+        "320x240",
+        "-o",
+        dir.path().join("plain%d.png").to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (f0, f4) = (dir.path().join("raycast0.png"), dir.path().join("raycast4.png"));
+    assert!(mean_abs_diff(&dir.path().join("plain4.png"), &f4) > 0.2, "frame 4's arrows");
+    assert_eq!(mean_abs_diff(&dir.path().join("plain0.png"), &f0), 0.0, "frame 0");
+    // What a file lacks.
+    for (arrows, lacks) in [("velocity", "no velocities"), ("f", "no per-atom properties fx")] {
+        let o = texmap(&[
+            "render",
+            "--quiet",
+            &xdatcar,
+            "--rep",
+            "all=arrows",
+            "--arrows",
+            arrows,
+            "-o",
+            dir.path().join("e.png").to_str().unwrap(),
+        ]);
+        assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+        assert!(stderr(&o).contains(lacks), "{}", stderr(&o));
+    }
+}

@@ -26,6 +26,8 @@
 //! - [`cartoon`]: cartoons as VMD's NewCartoon draws them (helix ribbons, strand arrows, coil
 //!   tubes along a spline through the CA atoms; nucleic acids as a P tube with base rungs), a
 //!   mesh like the surface's.
+//! - [`arrows`]: an arrow per atom for its velocity, displacement or a vector property (OVITO's
+//!   vector display), a mesh like the surface's.
 //! - [`polyhedra`]: coordination polyhedra as VESTA draws them (the convex hull of each centre
 //!   atom's bonded neighbours at their nearest periodic images), a mesh like the surface's.
 //! - [`surface`]: molecular surfaces as VMD's QuickSurf draws them (one Gaussian per atom, the
@@ -63,6 +65,7 @@
 //! ```
 
 pub mod align;
+pub mod arrows;
 pub mod camera;
 pub mod camera_plan;
 pub mod cartoon;

@@ -43,7 +43,9 @@
 //!    [`DrawStyle::Polyhedra`], the selected atoms give way to their coordination polyhedra
 //!    ([`MolPlan::polyhedra_mesh`], [`crate::polyhedra`]), whose ligands are the atoms of
 //!    another element bonded to them in step 2, before bonds across the box are dropped (by
-//!    distance when no bonds are drawn).
+//!    distance when no bonds are drawn); for [`DrawStyle::Arrows`], the selected atoms give
+//!    way to their arrows ([`MolPlan::arrows_mesh`], [`crate::arrows`]), the vectors taken
+//!    after the alignment (displacements from the first frame built, as it was then).
 //!
 //! # Hydrogen bonds
 //! [`DrawStyle::HBonds`] draws the hydrogen bonds among a representation's atoms
@@ -74,6 +76,7 @@ use texmap_md_io::hbonds::{self, Criteria, HBond, HBondError};
 use texmap_md_io::replicate::ReplicateError;
 use texmap_md_io::{Frame, Property, Selection, SelectionError, Topology, atom_element};
 
+use crate::arrows::{ArrowError, ArrowOptions, ArrowSource};
 use crate::surface::{MolMesh, SurfaceAtoms};
 use crate::{ColorBy, SceneBuilder};
 
@@ -144,6 +147,10 @@ pub enum DrawStyle {
     /// atom's colour
     /// ([`crate::polyhedra`]); the atoms themselves are not drawn.
     Polyhedra,
+    /// An arrow from each selected atom along its vector ([`MolOptions::arrows`]: velocity,
+    /// displacement from the first frame, or a vector property; [`crate::arrows`]); the atoms
+    /// themselves are not drawn.
+    Arrows,
 }
 
 /// The periodic-boundary treatment (frames without a cell are left as they are).
@@ -195,6 +202,8 @@ pub struct MolOptions {
     pub reps: Vec<Representation>,
     /// The cutoffs of [`DrawStyle::HBonds`] (MDAnalysis's 3.0 Å and 150° by default).
     pub hbonds: Criteria,
+    /// The vectors, scale and radius of [`DrawStyle::Arrows`].
+    pub arrows: ArrowOptions,
 }
 
 /// A cut through the frame, as OVITO's Slice modifier makes it: the plane `n̂·x = distance`
@@ -294,6 +303,7 @@ impl Default for MolOptions {
             align: None,
             reps: Vec::new(),
             hbonds: Criteria::default(),
+            arrows: ArrowOptions::default(),
         }
     }
 }
@@ -356,6 +366,8 @@ pub enum MolError {
     BadSlice,
     /// [`MolOptions::hbonds`] is out of range, or the cell is too small for its cutoff.
     HBonds(HBondError),
+    /// The arrows' options are bad, or a frame lacks their vectors.
+    Arrows(ArrowError),
     /// A selection could not be evaluated on a frame.
     Selection {
         /// Which selection.
@@ -372,6 +384,7 @@ impl fmt::Display for MolError {
             MolError::Replicate(e) => write!(f, "periodic images: {e}"),
             MolError::Coordination(e) => write!(f, "coordination: {e}"),
             MolError::HBonds(e) => write!(f, "hydrogen bonds: {e}"),
+            MolError::Arrows(e) => write!(f, "arrows: {e}"),
             MolError::BadSlice => write!(
                 f,
                 "slice: the normal must be finite and not zero, the distance finite, the width finite and >= 0"
@@ -460,6 +473,12 @@ pub struct MolPlan {
     polyhedra: MolMesh,
     /// Whether this frame's bonds are the files' (else found by distance, or none).
     pairs_listed: bool,
+    /// [`DrawStyle::Arrows`]: the first frame's positions (for displacements), this frame's
+    /// vectors and the last frame's arrows.
+    arrow_reference: Option<Vec<[f32; 3]>>,
+    arrow_vectors: Vec<glam::Vec3>,
+    arrows: MolMesh,
+    arrow_atoms: Vec<glam::Vec3>,
 }
 
 impl MolPlan {
@@ -491,6 +510,9 @@ impl MolPlan {
             }
         }
         options.hbonds.check().map_err(MolError::HBonds)?;
+        if reps.iter().any(|r| r.draw == DrawStyle::Arrows) {
+            options.arrows.check().map_err(MolError::Arrows)?;
+        }
         let sticks = reps.iter().any(|r| r.draw != DrawStyle::Spacefill);
         if options.bonds == BondSource::Topology && sticks {
             match &options.topology {
@@ -520,6 +542,10 @@ impl MolPlan {
             ligand_pairs: Vec::new(),
             polyhedra: MolMesh::default(),
             pairs_listed: false,
+            arrow_reference: None,
+            arrow_vectors: Vec::new(),
+            arrows: MolMesh::default(),
+            arrow_atoms: Vec::new(),
             hbonds: Vec::new(),
         })
     }
@@ -660,6 +686,7 @@ impl MolPlan {
                     | DrawStyle::Surface
                     | DrawStyle::HBonds
                     | DrawStyle::Polyhedra
+                    | DrawStyle::Arrows
             )
         });
         (sticks && self.options.bonds != BondSource::None) || self.draws_hbonds()
@@ -827,6 +854,16 @@ impl MolPlan {
             .options
             .slice
             .map(|s| frame.positions.iter().map(|p| s.keeps(*p)).collect());
+        self.arrow_vectors.clear();
+        if self.draws_arrows() {
+            let source = &self.options.arrows.source;
+            if *source == ArrowSource::Displacement && self.arrow_reference.is_none() {
+                self.arrow_reference = Some(frame.positions.clone());
+            }
+            self.arrow_vectors =
+                crate::arrows::vectors(frame, source, self.arrow_reference.as_deref())
+                    .map_err(MolError::Arrows)?;
+        }
         // The frame's colour column, for a representation coloured by it when the builder
         // (which drops it otherwise) colours by something else.
         let file_colors = (builder.color_by() != ColorBy::Property
@@ -887,6 +924,8 @@ impl MolPlan {
         self.hbonds.clear();
         self.cartoon = MolMesh::default();
         self.polyhedra = MolMesh::default();
+        self.arrows = MolMesh::default();
+        self.arrow_atoms.clear();
         let drawn = self.draw_reps(builder, frame, &reps, scene);
         self.reps = reps;
         builder.refresh_materials(scene);
@@ -910,6 +949,23 @@ impl MolPlan {
         &self.hbonds
     }
 
+    /// Whether some representation draws arrows ([`DrawStyle::Arrows`]).
+    pub fn draws_arrows(&self) -> bool {
+        self.reps.iter().any(|r| r.draw == DrawStyle::Arrows)
+    }
+
+    /// The last frame's arrows ([`DrawStyle::Arrows`]; empty without them).
+    pub fn arrows_mesh(&self) -> &MolMesh {
+        &self.arrows
+    }
+
+    /// The centres of the atoms the last frame's arrows start from, one per selected atom
+    /// whether its vector is zero or not (an empty picture of zero displacements is still a
+    /// picture of those atoms).
+    pub fn arrow_atoms(&self) -> &[glam::Vec3] {
+        &self.arrow_atoms
+    }
+
     /// Whether some representation draws coordination polyhedra ([`DrawStyle::Polyhedra`]).
     pub fn draws_polyhedra(&self) -> bool {
         self.reps.iter().any(|r| r.draw == DrawStyle::Polyhedra)
@@ -925,13 +981,13 @@ impl MolPlan {
         self.reps.iter().any(|r| r.draw == DrawStyle::Surface)
     }
 
-    /// Whether some representation draws a mesh (a surface, a cartoon or polyhedra) rather
-    /// than spheres.
+    /// Whether some representation draws a mesh (a surface, a cartoon, polyhedra or arrows)
+    /// rather than spheres.
     pub fn draws_meshes(&self) -> bool {
         self.reps.iter().any(|r| {
             matches!(
                 r.draw,
-                DrawStyle::Surface | DrawStyle::Cartoon | DrawStyle::Polyhedra
+                DrawStyle::Surface | DrawStyle::Cartoon | DrawStyle::Polyhedra | DrawStyle::Arrows
             )
         })
     }
@@ -1030,7 +1086,8 @@ impl MolPlan {
             DrawStyle::Spacefill
             | DrawStyle::Surface
             | DrawStyle::HBonds
-            | DrawStyle::Polyhedra => {}
+            | DrawStyle::Polyhedra
+            | DrawStyle::Arrows => {}
             DrawStyle::BallStick => {
                 for r in &mut scene.radii {
                     *r *= BALL_AND_STICK_RADIUS_SCALE;
@@ -1080,6 +1137,27 @@ impl MolPlan {
             }
             _ => Vec::new(),
         };
+        if rep.draw == DrawStyle::Arrows {
+            let o = &self.options.arrows;
+            for (i, v) in self.arrow_vectors.iter().enumerate() {
+                if mask.as_ref().is_none_or(|m| m[i]) {
+                    let from = scene.centers[i];
+                    self.arrow_atoms.push(from);
+                    crate::arrows::append_arrow(
+                        &mut self.arrows,
+                        from,
+                        *v * o.scale,
+                        o.radius,
+                        scene.kinds[i],
+                    );
+                }
+            }
+            scene.centers.clear();
+            scene.radii.clear();
+            scene.kinds.clear();
+            scene.bonds.clear();
+            return Ok(());
+        }
         if rep.draw == DrawStyle::Polyhedra {
             let all;
             let centre = match &mask {
