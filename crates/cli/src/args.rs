@@ -705,6 +705,11 @@ pub enum DrawStyle {
     /// LAMMPS dump's fx fy fz), times --arrow-scale. Usually one --rep among others:
     /// --rep 'all=ball-stick' --rep 'all=arrows'.
     Arrows,
+    /// The paths the atoms (picked at the first frame) took over the frames drawn so far, as
+    /// thin tubes unwrapped across the box (OVITO's trajectory lines); --trail-length N keeps
+    /// the last N frames. Usually one --rep among others: --rep 'all=ball-stick'
+    /// --rep 'resname LI=trails'.
+    Trails,
 }
 
 /// Periodic boundaries (`--pbc`).
@@ -797,6 +802,10 @@ pub struct MolArgs {
     /// The arrows style's shaft radius, Å (the head is 2.5 times as wide).
     #[arg(long, value_name = "Å", default_value_t = 0.1)]
     pub arrow_radius: f32,
+    /// The trails style's length in frames drawn (the current one included); default: every
+    /// frame drawn so far.
+    #[arg(long, value_name = "N")]
+    pub trail_length: Option<usize>,
     /// Also write the hydrogen bonds the hbonds style draws as a CSV table, one row per bond and
     /// frame: frame, donor, hydrogen, acceptor (0-based atom indices, as MDAnalysis's
     /// results.hbonds), the three atoms as RESNAME RESID:NAME, the donor-acceptor distance (Å)

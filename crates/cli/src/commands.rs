@@ -523,8 +523,9 @@ fn render(a: &RenderArgs) -> Result<()> {
     }
     for (k, &f) in frames.iter().enumerate() {
         // A part renders its own frames; the first frame of the whole render is read by every
-        // part, for the camera.
-        if !mine.contains(&k) && camera.is_some() {
+        // part, for the camera, and with trails every frame before its own, for their paths.
+        let trail = plan.draws_trails() && k < mine.start;
+        if !mine.contains(&k) && camera.is_some() && !trail {
             continue;
         }
         let fail = |e: anyhow::Error, written: &[PathBuf]| -> anyhow::Error {

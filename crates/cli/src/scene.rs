@@ -415,6 +415,7 @@ impl From<DrawStyle> for texmap_md_scene::DrawStyle {
             DrawStyle::HBonds => texmap_md_scene::DrawStyle::HBonds,
             DrawStyle::Polyhedra => texmap_md_scene::DrawStyle::Polyhedra,
             DrawStyle::Arrows => texmap_md_scene::DrawStyle::Arrows,
+            DrawStyle::Trails => texmap_md_scene::DrawStyle::Trails,
         }
     }
 }
@@ -540,6 +541,7 @@ pub fn mol_plan(args: &MolArgs) -> Result<MolPlan> {
             scale: args.arrow_scale,
             radius: args.arrow_radius,
         },
+        trail_length: args.trail_length,
     })
     .map_err(mol_error)
 }
@@ -626,6 +628,7 @@ pub fn mol_error(e: MolError) -> anyhow::Error {
         MolError::Arrows(texmap_md_scene::arrows::ArrowError::BadOption { what, value }) => {
             format!("--arrow-{what} {value}: expected a finite number > 0")
         }
+        MolError::TrailAtoms { .. } => return anyhow::anyhow!("--rep ...=trails: {e}"),
         MolError::Arrows(e) => {
             // The frame lacks the vectors asked for: the input's limit.
             return anyhow::anyhow!("--rep ...=arrows: {e}");

@@ -2265,3 +2265,71 @@ fn arrows_end_where_the_vectors_point() {
         assert!(stderr(&o).contains(lacks), "{}", stderr(&o));
     }
 }
+
+/// Trails: two argon atoms in a 10 Å box, one walking 1.5 Å a frame through a face of the box
+/// (an extended XYZ file written here): the rasteriser's picture matches the reference ray
+/// tracer's, the trail grows frame by frame, and a render split into parts (`--shard`) draws
+/// every frame byte for byte as the whole render does (each part builds the frames before its
+/// own for their paths).
+#[test]
+fn trails_grow_over_the_frames_and_survive_sharding() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("walk.extxyz");
+    let mut text = String::new();
+    for k in 0..6 {
+        let x = (7.0 + 1.5 * k as f64) % 10.0;
+        text += &format!(
+            "2\nLattice=\"10 0 0 0 10 0 0 0 10\" Properties=species:S:1:pos:R:3\nAr {x} 2 3\nAr 5 5 5\n"
+        );
+    }
+    std::fs::write(&input, text).unwrap();
+    let render = |sub: &str, extra: &[&str]| {
+        let out = dir.path().join(sub);
+        std::fs::create_dir_all(&out).unwrap();
+        let pattern = out.join("f%d.png");
+        let mut args = vec![
+            "render",
+            "--quiet",
+            input.to_str().unwrap(),
+            "--frames",
+            "0:6",
+            "--rep",
+            "all=ball-stick",
+            "--rep",
+            "index 0=trails:#ffcc00",
+            "--size",
+            "320x240",
+            "-o",
+            pattern.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        let o = texmap(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        out
+    };
+    let whole = render("whole", &[]);
+    let reference = render("reference", &["--method", "reference"]);
+    for k in 0..6 {
+        let f = format!("f{k}.png");
+        let d = mean_abs_diff(&whole.join(&f), &reference.join(&f));
+        assert!(d < 1.0, "frame {k}: mean |raycast - reference| = {d}");
+    }
+    // The trail's colour covers more pixels as it grows.
+    let yellow = |k: usize| {
+        let img = image::open(whole.join(format!("f{k}.png"))).unwrap().to_rgb8();
+        img.pixels()
+            .filter(|p| p.0[0] > 150 && p.0[1] > 120 && p.0[2] < 60)
+            .count()
+    };
+    assert!(yellow(5) > yellow(2) + 50, "{} vs {}", yellow(5), yellow(2));
+    for part in 0..2 {
+        let shard = format!("{part}/2");
+        let out = render(&format!("part{part}"), &["--shard", &shard]);
+        for entry in std::fs::read_dir(&out).unwrap() {
+            let name = entry.unwrap().file_name();
+            let a = std::fs::read(out.join(&name)).unwrap();
+            let b = std::fs::read(whole.join(&name)).unwrap();
+            assert!(a == b, "part {part}: {name:?} differs from the whole render's");
+        }
+    }
+}

@@ -26,6 +26,8 @@
 //! - [`cartoon`]: cartoons as VMD's NewCartoon draws them (helix ribbons, strand arrows, coil
 //!   tubes along a spline through the CA atoms; nucleic acids as a P tube with base rungs), a
 //!   mesh like the surface's.
+//! - trails ([`DrawStyle::Trails`]): the unwrapped paths of atoms over the frames drawn (see
+//!   [`plan`]).
 //! - [`arrows`]: an arrow per atom for its velocity, displacement or a vector property (OVITO's
 //!   vector display), a mesh like the surface's.
 //! - [`polyhedra`]: coordination polyhedra as VESTA draws them (the convex hull of each centre
@@ -88,7 +90,7 @@ pub use palette::{MAX_MATERIALS, Palette, type_color};
 pub use plan::{
     Alignment, BALL_AND_STICK_BOND_RADIUS, BALL_AND_STICK_RADIUS_SCALE, BondSource, COORDINATION,
     DrawStyle, HBOND_COLOR, HBOND_DASHES, HBOND_RADIUS, LICORICE_RADIUS, MolError, MolOptions,
-    MolPlan, Pbc, RepColor, Representation, SelectionRole, Slice,
+    MolPlan, Pbc, RepColor, Representation, SelectionRole, Slice, TRAIL_RADIUS,
 };
 pub use scalar::{NAN_COLOR, SCALAR_LEVELS, ScalarColor, ScalarSource};
 pub use style::{

@@ -47,6 +47,18 @@
 //!    way to their arrows ([`MolPlan::arrows_mesh`], [`crate::arrows`]), the vectors taken
 //!    after the alignment (displacements from the first frame built, as it was then).
 //!
+//! # Trails
+//! [`DrawStyle::Trails`] draws where atoms went, as OVITO's Generate trajectory lines: the
+//! atoms its representation selects at the first frame built are followed from then on, each
+//! frame built adding a point to each one's path. The path is unwrapped: a step is taken to
+//! the nearest periodic image, so an atom that crossed a face of the box has a trail that
+//! leaves the box through the face it came in by, instead of a line back across the box (the
+//! frames drawn must then be close enough that no atom moves half a box between two of them).
+//! The path is drawn moved as a whole to end at the atom as it is drawn. The last [`MolOptions::trail_length`] points
+//! are drawn, as spheres of [`TRAIL_RADIUS`] joined by sticks, in each atom's current colour.
+//! Points are added by [`MolPlan::build`], so a trail holds the frames built before, in the
+//! order they were built.
+//!
 //! # Hydrogen bonds
 //! [`DrawStyle::HBonds`] draws the hydrogen bonds among a representation's atoms
 //! ([`texmap_md_io::hbonds`]: MDAnalysis's criterion, [`MolOptions::hbonds`] its cutoffs; the
@@ -82,6 +94,8 @@ use crate::{ColorBy, SceneBuilder};
 
 /// Ball-and-stick atoms are this fraction of their Bondi (van der Waals) radii.
 pub const BALL_AND_STICK_RADIUS_SCALE: f32 = 0.3;
+/// Radius (Å) of the spheres and sticks of [`DrawStyle::Trails`].
+pub const TRAIL_RADIUS: f32 = 0.1;
 /// Radius (Å) of the dashes of [`DrawStyle::HBonds`] (ChimeraX draws its hydrogen bonds at
 /// 0.075 Å).
 pub const HBOND_RADIUS: f32 = 0.075;
@@ -151,6 +165,11 @@ pub enum DrawStyle {
     /// displacement from the first frame, or a vector property; [`crate::arrows`]); the atoms
     /// themselves are not drawn.
     Arrows,
+    /// The path each selected atom took over the frames drawn so far (OVITO's trajectory
+    /// lines; see the module docs): the atoms picked at the first frame, the path unwrapped
+    /// across the box, [`MolOptions::trail_length`] frames long; the atoms themselves are not
+    /// drawn.
+    Trails,
 }
 
 /// The periodic-boundary treatment (frames without a cell are left as they are).
@@ -204,6 +223,9 @@ pub struct MolOptions {
     pub hbonds: Criteria,
     /// The vectors, scale and radius of [`DrawStyle::Arrows`].
     pub arrows: ArrowOptions,
+    /// How many frames of path [`DrawStyle::Trails`] draws (the current one included); `None`:
+    /// every frame drawn so far.
+    pub trail_length: Option<usize>,
 }
 
 /// A cut through the frame, as OVITO's Slice modifier makes it: the plane `n̂·x = distance`
@@ -304,6 +326,7 @@ impl Default for MolOptions {
             reps: Vec::new(),
             hbonds: Criteria::default(),
             arrows: ArrowOptions::default(),
+            trail_length: None,
         }
     }
 }
@@ -368,6 +391,13 @@ pub enum MolError {
     HBonds(HBondError),
     /// The arrows' options are bad, or a frame lacks their vectors.
     Arrows(ArrowError),
+    /// An atom the trails follow (picked at the first frame) is past a later frame's atoms.
+    TrailAtoms {
+        /// The atom's index.
+        atom: usize,
+        /// The frame's atom count.
+        frame: usize,
+    },
     /// A selection could not be evaluated on a frame.
     Selection {
         /// Which selection.
@@ -385,6 +415,10 @@ impl fmt::Display for MolError {
             MolError::Coordination(e) => write!(f, "coordination: {e}"),
             MolError::HBonds(e) => write!(f, "hydrogen bonds: {e}"),
             MolError::Arrows(e) => write!(f, "arrows: {e}"),
+            MolError::TrailAtoms { atom, frame } => write!(
+                f,
+                "trails follow the atoms picked at the first frame, and atom {atom} is past this frame's {frame} atoms"
+            ),
             MolError::BadSlice => write!(
                 f,
                 "slice: the normal must be finite and not zero, the distance finite, the width finite and >= 0"
@@ -479,6 +513,11 @@ pub struct MolPlan {
     arrow_vectors: Vec<glam::Vec3>,
     arrows: MolMesh,
     arrow_atoms: Vec<glam::Vec3>,
+    /// [`DrawStyle::Trails`]: the atoms followed (picked at the first frame), each one's path
+    /// (unwrapped, the last `trail_length` points) and its last position as read.
+    trail_atoms: Option<Vec<u32>>,
+    trail_paths: Vec<std::collections::VecDeque<glam::Vec3>>,
+    trail_last: Vec<[f32; 3]>,
 }
 
 impl MolPlan {
@@ -546,6 +585,9 @@ impl MolPlan {
             arrow_vectors: Vec::new(),
             arrows: MolMesh::default(),
             arrow_atoms: Vec::new(),
+            trail_atoms: None,
+            trail_paths: Vec::new(),
+            trail_last: Vec::new(),
             hbonds: Vec::new(),
         })
     }
@@ -676,8 +718,8 @@ impl MolPlan {
     }
 
     /// Whether the scene's bonds (cylinders) are drawn at all: some style draws sticks and
-    /// bonds are asked for, or some representation draws hydrogen bonds (whose dashes are
-    /// cylinders whatever the bond source).
+    /// bonds are asked for, or some representation draws hydrogen bonds or trails (whose
+    /// dashes and paths are cylinders whatever the bond source).
     pub fn draws_bonds(&self) -> bool {
         let sticks = self.reps.iter().any(|r| {
             !matches!(
@@ -689,7 +731,9 @@ impl MolPlan {
                     | DrawStyle::Arrows
             )
         });
-        (sticks && self.options.bonds != BondSource::None) || self.draws_hbonds()
+        (sticks && self.options.bonds != BondSource::None)
+            || self.draws_hbonds()
+            || self.draws_trails()
     }
 
     /// The bonds of the last frame built, after the periodic treatment and before the
@@ -854,6 +898,9 @@ impl MolPlan {
             .options
             .slice
             .map(|s| frame.positions.iter().map(|p| s.keeps(*p)).collect());
+        if self.draws_trails() {
+            self.extend_trails(frame)?;
+        }
         self.arrow_vectors.clear();
         if self.draws_arrows() {
             let source = &self.options.arrows.source;
@@ -947,6 +994,82 @@ impl MolPlan {
     /// frame, after periodic images).
     pub fn last_hbonds(&self) -> &[HBond] {
         &self.hbonds
+    }
+
+    /// Whether some representation draws trails ([`DrawStyle::Trails`]).
+    pub fn draws_trails(&self) -> bool {
+        self.reps.iter().any(|r| r.draw == DrawStyle::Trails)
+    }
+
+    /// Appends `frame`'s positions of the followed atoms to their trails (see
+    /// [`DrawStyle::Trails`]); the atoms are picked at the first frame, by the first trails
+    /// representation's selection.
+    fn extend_trails(&mut self, frame: &Frame) -> Result<(), MolError> {
+        if self.trail_atoms.is_none() {
+            let rep = self.reps.iter().find(|r| r.draw == DrawStyle::Trails);
+            let picked: Vec<u32> = match rep.and_then(|r| r.select.as_ref()) {
+                Some(sel) => {
+                    let mask = sel.evaluate(frame).map_err(|error| MolError::Selection {
+                        role: SelectionRole::Select,
+                        error,
+                    })?;
+                    (0..frame.n_atoms() as u32)
+                        .filter(|i| mask[*i as usize])
+                        .collect()
+                }
+                None => (0..frame.n_atoms() as u32).collect(),
+            };
+            self.trail_paths = vec![Default::default(); picked.len()];
+            self.trail_last = picked
+                .iter()
+                .map(|i| frame.positions[*i as usize])
+                .collect();
+            self.trail_atoms = Some(picked);
+        }
+        let atoms = self.trail_atoms.as_deref().unwrap_or(&[]);
+        if let Some(&i) = atoms.iter().find(|i| **i as usize >= frame.n_atoms()) {
+            return Err(MolError::TrailAtoms {
+                atom: i as usize,
+                frame: frame.n_atoms(),
+            });
+        }
+        let keep = self.options.trail_length.unwrap_or(usize::MAX).max(1);
+        for ((&i, path), last) in atoms
+            .iter()
+            .zip(&mut self.trail_paths)
+            .zip(&mut self.trail_last)
+        {
+            let now = frame.positions[i as usize];
+            let point = match path.back() {
+                None => glam::Vec3::from(now),
+                Some(prev) => {
+                    // The step from the last frame, through the nearest image: the path goes
+                    // on across a face of the box instead of jumping back through it.
+                    let mut d: [f64; 3] = std::array::from_fn(|k| now[k] as f64 - last[k] as f64);
+                    if let Some(cell) = &frame.cell {
+                        d = texmap_md_io::pbc::minimum_image(cell, d);
+                    }
+                    *prev + glam::DVec3::from_array(d).as_vec3()
+                }
+            };
+            *last = now;
+            path.push_back(point);
+            while path.len() > keep {
+                path.pop_front();
+            }
+        }
+        Ok(())
+    }
+
+    /// The followed atoms' trails as they are after the last frame built ([`DrawStyle::Trails`]):
+    /// per atom, its index in the frames and its path, oldest point first.
+    pub fn trails(&self) -> impl Iterator<Item = (u32, &std::collections::VecDeque<glam::Vec3>)> {
+        self.trail_atoms
+            .as_deref()
+            .unwrap_or(&[])
+            .iter()
+            .copied()
+            .zip(&self.trail_paths)
     }
 
     /// Whether some representation draws arrows ([`DrawStyle::Arrows`]).
@@ -1087,7 +1210,8 @@ impl MolPlan {
             | DrawStyle::Surface
             | DrawStyle::HBonds
             | DrawStyle::Polyhedra
-            | DrawStyle::Arrows => {}
+            | DrawStyle::Arrows
+            | DrawStyle::Trails => {}
             DrawStyle::BallStick => {
                 for r in &mut scene.radii {
                     *r *= BALL_AND_STICK_RADIUS_SCALE;
@@ -1137,6 +1261,36 @@ impl MolPlan {
             }
             _ => Vec::new(),
         };
+        if rep.draw == DrawStyle::Trails {
+            // Spheres at the path's points joined by sticks, in each atom's colour now.
+            let kinds = std::mem::take(&mut scene.kinds);
+            scene.centers.clear();
+            scene.radii.clear();
+            scene.bonds.clear();
+            scene.bond_radius = TRAIL_RADIUS;
+            for (&i, path) in self
+                .trail_atoms
+                .as_deref()
+                .unwrap_or(&[])
+                .iter()
+                .zip(&self.trail_paths)
+            {
+                let kind = kinds[i as usize];
+                let first = scene.centers.len() as u32;
+                // The path moved as a whole to end at the atom as drawn (wrapped or not).
+                let shift = match path.back() {
+                    Some(last) => glam::Vec3::from(frame.positions[i as usize]) - *last,
+                    None => glam::Vec3::ZERO,
+                };
+                for (k, p) in path.iter().enumerate() {
+                    scene.push(*p + shift, TRAIL_RADIUS, kind);
+                    if k > 0 {
+                        scene.bonds.push([first + k as u32 - 1, first + k as u32]);
+                    }
+                }
+            }
+            return Ok(());
+        }
         if rep.draw == DrawStyle::Arrows {
             let o = &self.options.arrows;
             for (i, v) in self.arrow_vectors.iter().enumerate() {
