@@ -806,6 +806,19 @@ pub struct MolArgs {
     /// frame drawn so far.
     #[arg(long, value_name = "N")]
     pub trail_length: Option<usize>,
+    /// Measure and draw, as PyMOL's distance, angle and dihedral: 'SEL; SEL' (a distance, Å),
+    /// 'SEL; SEL; SEL' (the angle at the middle atom) or four (the dihedral about the middle
+    /// bond, IUPAC's sign), each SEL picking exactly one atom in every frame: yellow dashes
+    /// through the atoms (nearest periodic images) and the value as a label. Repeatable:
+    /// --measure 'resid 10 and name OG; resname LIG and name O1'.
+    #[arg(long = "measure", value_name = "SEL; SEL[; SEL[; SEL]]")]
+    pub measures: Vec<String>,
+    /// Also write the --measure values as a CSV table, one row per measurement and frame:
+    /// frame, measure (0-based, in the order given), kind (distance, angle, dihedral), value
+    /// (Å or degrees), the atoms' 0-based indices joined by spaces, and the spec as given.
+    /// Written whole or not at all.
+    #[arg(long, value_name = "FILE.csv")]
+    pub measure_table: Option<PathBuf>,
     /// Also write the hydrogen bonds the hbonds style draws as a CSV table, one row per bond and
     /// frame: frame, donor, hydrogen, acceptor (0-based atom indices, as MDAnalysis's
     /// results.hbonds), the three atoms as RESNAME RESID:NAME, the donor-acceptor distance (Å)

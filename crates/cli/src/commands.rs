@@ -140,7 +140,7 @@ fn info(
     if format.is_none()
         && matches!(
             TopologyFormat::from_path(file),
-            Some(TopologyFormat::Psf | TopologyFormat::Prmtop | TopologyFormat::LammpsData)
+            Some(TopologyFormat::Psf | TopologyFormat::Prmtop)
         )
     {
         return topology_info(file);
@@ -192,9 +192,14 @@ fn info(
             obj[key] = json!(label_counts(labels));
         }
     }
-    // Bonds the file lists with its atoms (SDF, MOL2).
+    // Bonds the file lists with its atoms (SDF, MOL2, LAMMPS data).
     if !frame.bonds.is_empty() {
         obj["bonds"] = json!(frame.bonds.len());
+    }
+    // A LAMMPS data file is a topology too: its molecules, as `--topology` counts them.
+    if traj.format() == Format::LammpsData {
+        let t = texmap_md_io::Topology::from_frame(&frame, traj.name());
+        obj["residues"] = json!(t.n_residues());
     }
     // Per-atom numbers a --color-by can name.
     if !frame.properties.is_empty() {
@@ -507,6 +512,24 @@ fn render(a: &RenderArgs) -> Result<()> {
             Some(t)
         }
     };
+    let mut measure_table = match &a.mol.measure_table {
+        None => None,
+        Some(_) if a.mol.measures.is_empty() => {
+            return usage(
+                "--measure-table lists the --measure values: add a measurement, as --measure 'index 0; index 5'",
+            );
+        }
+        Some(_) if mine.len() != frames.len() => {
+            return usage(
+                "--measure-table with --shard (or a Slurm array): every part would write the same table; write it in a run of its own",
+            );
+        }
+        Some(p) => {
+            let mut t = crate::output::AtomicFile::create(p)?;
+            t.write("frame,measure,kind,value,atoms,spec\n")?;
+            Some(t)
+        }
+    };
     if plan.draws_arrows()
         && a.mol.arrows.starts_with("displacement")
         && frames.first().is_some_and(|f| *f != 0)
@@ -569,6 +592,27 @@ fn render(a: &RenderArgs) -> Result<()> {
         {
             t.write(&hbond_rows(f, plan.last_hbonds(), &md))
                 .map_err(|e| fail(e, &written))?;
+        }
+        if let Some(t) = &mut measure_table
+            && mine.contains(&k)
+        {
+            let mut rows = String::new();
+            for (m, (got, spec)) in plan
+                .last_measurements()
+                .iter()
+                .zip(&a.mol.measures)
+                .enumerate()
+            {
+                let kind = ["distance", "angle", "dihedral"][got.atoms.len() - 2];
+                let atoms: Vec<String> = got.atoms.iter().map(|i| i.to_string()).collect();
+                let spec = spec.replace('"', "\"\"");
+                rows += &format!(
+                    "{f},{m},{kind},{:.6},{},\"{spec}\"\n",
+                    got.value,
+                    atoms.join(" ")
+                );
+            }
+            t.write(&rows).map_err(|e| fail(e, &written))?;
         }
         if a.box_outline
             && let Some(cell) = &md.cell
@@ -807,6 +851,13 @@ fn render(a: &RenderArgs) -> Result<()> {
                 }
             }
         }
+        for m in plan.last_measurements() {
+            if let Some((xy, _)) = shown.project(m.label_at) {
+                let (w, h) = (out.width() as usize, out.height() as usize);
+                let rgba = out.color.as_flattened_mut();
+                texmap_md_scene::draw_atom_label(rgba, w, h, xy.to_array(), &m.text());
+            }
+        }
         if let Some(parts) = &label {
             let hbonds = plan.last_hbonds().len();
             let text = crate::scene::label_text(parts, f, &md, traj.name(), hbonds)
@@ -823,6 +874,9 @@ fn render(a: &RenderArgs) -> Result<()> {
     pb.finish_and_clear();
     let movie = sink.finish()?;
     if let Some(t) = hbond_table {
+        t.commit()?;
+    }
+    if let Some(t) = measure_table {
         t.commit()?;
     }
     if builder.merged_colors() > 0 {

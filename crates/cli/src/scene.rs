@@ -542,6 +542,14 @@ pub fn mol_plan(args: &MolArgs) -> Result<MolPlan> {
             radius: args.arrow_radius,
         },
         trail_length: args.trail_length,
+        measures: args
+            .measures
+            .iter()
+            .map(|m| {
+                texmap_md_scene::measure::Measure::parse(m)
+                    .map_err(|e| crate::args::UsageError(format!("--measure {e}")))
+            })
+            .collect::<Result<Vec<_>, _>>()?,
     })
     .map_err(mol_error)
 }
@@ -629,6 +637,7 @@ pub fn mol_error(e: MolError) -> anyhow::Error {
             format!("--arrow-{what} {value}: expected a finite number > 0")
         }
         MolError::TrailAtoms { .. } => return anyhow::anyhow!("--rep ...=trails: {e}"),
+        MolError::Measure(e) => return anyhow::anyhow!("--measure {e}"),
         MolError::Arrows(e) => {
             // The frame lacks the vectors asked for: the input's limit.
             return anyhow::anyhow!("--rep ...=arrows: {e}");

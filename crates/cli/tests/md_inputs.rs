@@ -2333,3 +2333,94 @@ fn trails_grow_over_the_frames_and_survive_sharding() {
         }
     }
 }
+
+/// `--measure`: distances (one to a water far across the box: the nearest image), an angle and
+/// a backbone dihedral on MDAnalysis's solvated adenylate kinase, frame by frame, written by
+/// `--measure-table` as MDAnalysis's calc_bonds / calc_angles / calc_dihedrals give them with
+/// the box (md-io's tests/data/gen_measure.py); the dashes are drawn as the reference ray
+/// tracer traces them; a selection that picks two atoms is an error naming it.
+#[test]
+fn measurements_are_mdanalysis_values_and_drawn_as_traced() {
+    let dir = tempfile::tempdir().unwrap();
+    let reference: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(data("hbonds/measure_reference.json")).unwrap(),
+    )
+    .unwrap();
+    let specs: Vec<&str> = reference
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| m["spec"].as_str().unwrap())
+        .collect();
+    let (xtc, gro) = (data("hbonds/adk_0_9.xtc"), data("hbonds/adk_top.gro.gz"));
+    let table = dir.path().join("m.csv");
+    let run = |method: &str, out: &str, table: Option<&Path>| {
+        let mut args = vec![
+            "render",
+            "--quiet",
+            xtc.as_str(),
+            "--topology",
+            gro.as_str(),
+            "--frames",
+            "0:2",
+            "--select",
+            "protein and resid 5:25",
+            "--style",
+            "licorice",
+            "--size",
+            "320x240",
+            "--method",
+            method,
+        ];
+        for s in &specs {
+            args.extend(["--measure", s]);
+        }
+        let t = table.map(|t| t.to_str().unwrap().to_string());
+        if let Some(t) = &t {
+            args.extend(["--measure-table", t.as_str()]);
+        }
+        let out = dir.path().join(out);
+        args.extend(["-o", out.to_str().unwrap()]);
+        let o = texmap(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+    };
+    run("raycast", "r%d.png", Some(&table));
+    let text = std::fs::read_to_string(&table).unwrap();
+    let rows: Vec<&str> = text.lines().collect();
+    assert_eq!(rows[0], "frame,measure,kind,value,atoms,spec");
+    assert_eq!(rows.len(), 1 + 2 * specs.len());
+    for row in &rows[1..] {
+        let f: Vec<&str> = row.splitn(6, ',').collect();
+        let (frame, m) = (f[0].parse::<usize>().unwrap(), f[1].parse::<usize>().unwrap());
+        let want = reference[m]["values"][frame].as_f64().unwrap();
+        let got: f64 = f[3].parse().unwrap();
+        assert!((got - want).abs() < 2e-3, "{row}: MDAnalysis {want}");
+        let kind = ["distance", "angle", "dihedral"][specs[m].split(';').count() - 2];
+        assert_eq!(f[2], kind);
+        assert_eq!(f[5], format!("\"{}\"", specs[m]));
+    }
+    // The picture: dashes and labels against the reference ray tracer's dashes (the labels
+    // are drawn on both alike).
+    run("reference", "t%d.png", None);
+    for k in 0..2 {
+        let d = mean_abs_diff(
+            &dir.path().join(format!("r{k}.png")),
+            &dir.path().join(format!("t{k}.png")),
+        );
+        assert!(d < 1.5, "frame {k}: mean |raycast - reference| = {d}");
+    }
+    // A selection that does not pick one atom.
+    let o = render_adk_frame0(
+        "160x120",
+        &[
+            "--select",
+            "resid 10",
+            "--measure",
+            "resid 10 and name CA; resid 11",
+            "-o",
+            dir.path().join("e.png").to_str().unwrap(),
+        ],
+    );
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("selection 2 picks"), "{}", stderr(&o));
+}

@@ -164,7 +164,7 @@ pub fn draw_color_bar(rgba: &mut [u8], width: usize, height: usize, bar: &ColorB
 
 /// Draws `text` as a caption at the top left of `rgba` (8-bit sRGB RGBA, `width` x `height`,
 /// row 0 at the top): the colour bar's font at its scale, on the same backdrop, one line, the
-/// characters that do not fit within half the image width dropped (non-ASCII ones drawn as `?`).
+/// characters that do not fit within half the image width dropped (non-ASCII ones but `Å` and `°` drawn as `?`).
 /// Returns the number of characters drawn (0, and nothing drawn, for an empty text or an image
 /// too small for one character). Movies use it for the frame's time (`texmap render --label`).
 ///
@@ -573,14 +573,15 @@ fn trim_fraction(s: &str) -> &str {
     }
 }
 
-/// The glyph of `c` ([`FONT`]), `?` for characters outside printable ASCII.
+/// The glyph of `c` ([`FONT`], and `Å` and `°` for the measurements' units), `?` for other
+/// characters outside printable ASCII.
 fn glyph(c: char) -> u64 {
-    let i = if (' '..='~').contains(&c) {
-        c as usize - 32
-    } else {
-        '?' as usize - 32
-    };
-    FONT[i]
+    match c {
+        'Å' => 0x04_0a_04_0a_11_1f_11_00,
+        '°' => 0x0c_12_12_0c_00_00_00_00,
+        ' '..='~' => FONT[c as usize - 32],
+        _ => FONT['?' as usize - 32],
+    }
 }
 
 /// The 5x7 font, printable ASCII 32..=126 in order. One glyph per `u64`: the most significant

@@ -28,6 +28,8 @@
 //!   mesh like the surface's.
 //! - trails ([`DrawStyle::Trails`]): the unwrapped paths of atoms over the frames drawn (see
 //!   [`plan`]).
+//! - [`measure`]: distances, angles and dihedrals between picked atoms, drawn as dashes with
+//!   their values (PyMOL's `distance`, `angle`, `dihedral`).
 //! - [`arrows`]: an arrow per atom for its velocity, displacement or a vector property (OVITO's
 //!   vector display), a mesh like the surface's.
 //! - [`polyhedra`]: coordination polyhedra as VESTA draws them (the convex hull of each centre
@@ -73,6 +75,7 @@ pub mod camera_plan;
 pub mod cartoon;
 pub mod colormap;
 pub mod legend;
+pub mod measure;
 pub mod outline;
 pub mod palette;
 pub mod plan;

@@ -47,6 +47,13 @@
 //!    way to their arrows ([`MolPlan::arrows_mesh`], [`crate::arrows`]), the vectors taken
 //!    after the alignment (displacements from the first frame built, as it was then).
 //!
+//! # Measurements
+//! [`MolOptions::measures`] are measured in every frame as it is drawn (after the periodic
+//! treatment, the images and the alignment; [`crate::measure`]) and drawn as
+//! [`crate::measure::MEASURE_DASHES`] yellow dashes per segment of radius
+//! [`crate::measure::MEASURE_RADIUS`], appended after every representation with their own
+//! bond radius; [`MolPlan::last_measurements`] gives their values and label places.
+//!
 //! # Trails
 //! [`DrawStyle::Trails`] draws where atoms went, as OVITO's Generate trajectory lines: the
 //! atoms its representation selects at the first frame built are followed from then on, each
@@ -89,6 +96,9 @@ use texmap_md_io::replicate::ReplicateError;
 use texmap_md_io::{Frame, Property, Selection, SelectionError, Topology, atom_element};
 
 use crate::arrows::{ArrowError, ArrowOptions, ArrowSource};
+use crate::measure::{
+    MEASURE_COLOR, MEASURE_DASHES, MEASURE_RADIUS, Measure, MeasureError, Measured,
+};
 use crate::surface::{MolMesh, SurfaceAtoms};
 use crate::{ColorBy, SceneBuilder};
 
@@ -226,6 +236,9 @@ pub struct MolOptions {
     /// How many frames of path [`DrawStyle::Trails`] draws (the current one included); `None`:
     /// every frame drawn so far.
     pub trail_length: Option<usize>,
+    /// Distances, angles and dihedrals drawn as dashes in every frame ([`crate::measure`]);
+    /// their values are [`MolPlan::last_measurements`].
+    pub measures: Vec<Measure>,
 }
 
 /// A cut through the frame, as OVITO's Slice modifier makes it: the plane `n̂·x = distance`
@@ -327,6 +340,7 @@ impl Default for MolOptions {
             hbonds: Criteria::default(),
             arrows: ArrowOptions::default(),
             trail_length: None,
+            measures: Vec::new(),
         }
     }
 }
@@ -391,6 +405,8 @@ pub enum MolError {
     HBonds(HBondError),
     /// The arrows' options are bad, or a frame lacks their vectors.
     Arrows(ArrowError),
+    /// A measurement's atoms are not one per selection in a frame, or make no angle.
+    Measure(MeasureError),
     /// An atom the trails follow (picked at the first frame) is past a later frame's atoms.
     TrailAtoms {
         /// The atom's index.
@@ -415,6 +431,7 @@ impl fmt::Display for MolError {
             MolError::Coordination(e) => write!(f, "coordination: {e}"),
             MolError::HBonds(e) => write!(f, "hydrogen bonds: {e}"),
             MolError::Arrows(e) => write!(f, "arrows: {e}"),
+            MolError::Measure(e) => write!(f, "measure: {e}"),
             MolError::TrailAtoms { atom, frame } => write!(
                 f,
                 "trails follow the atoms picked at the first frame, and atom {atom} is past this frame's {frame} atoms"
@@ -518,6 +535,8 @@ pub struct MolPlan {
     trail_atoms: Option<Vec<u32>>,
     trail_paths: Vec<std::collections::VecDeque<glam::Vec3>>,
     trail_last: Vec<[f32; 3]>,
+    /// The last frame's measurements, one per [`MolOptions::measures`].
+    measured: Vec<Measured>,
 }
 
 impl MolPlan {
@@ -588,6 +607,7 @@ impl MolPlan {
             trail_atoms: None,
             trail_paths: Vec::new(),
             trail_last: Vec::new(),
+            measured: Vec::new(),
             hbonds: Vec::new(),
         })
     }
@@ -734,6 +754,7 @@ impl MolPlan {
         (sticks && self.options.bonds != BondSource::None)
             || self.draws_hbonds()
             || self.draws_trails()
+            || !self.options.measures.is_empty()
     }
 
     /// The bonds of the last frame built, after the periodic treatment and before the
@@ -973,10 +994,40 @@ impl MolPlan {
         self.polyhedra = MolMesh::default();
         self.arrows = MolMesh::default();
         self.arrow_atoms.clear();
-        let drawn = self.draw_reps(builder, frame, &reps, scene);
+        let mut drawn = self.draw_reps(builder, frame, &reps, scene);
         self.reps = reps;
+        self.measured.clear();
+        if drawn.is_ok() && !self.options.measures.is_empty() {
+            drawn = self.draw_measures(builder, frame, scene);
+        }
         builder.refresh_materials(scene);
         drawn
+    }
+
+    /// The measurements' dashes appended to `scene`, each bond then with its radius listed.
+    fn draw_measures(
+        &mut self,
+        builder: &mut SceneBuilder,
+        frame: &Frame,
+        scene: &mut SphereScene,
+    ) -> Result<(), MolError> {
+        if scene.bond_radii.len() != scene.bonds.len() {
+            scene.bond_radii = vec![scene.bond_radius; scene.bonds.len()];
+        }
+        let kind = builder.kind_of(MEASURE_COLOR);
+        for m in &self.options.measures {
+            let got = m.measure(frame).map_err(MolError::Measure)?;
+            for w in got.points.windows(2) {
+                let before = scene.bonds.len();
+                push_dash_line(scene, w[0], w[1], kind, MEASURE_RADIUS, MEASURE_DASHES);
+                let added = scene.bonds.len() - before;
+                scene
+                    .bond_radii
+                    .extend(std::iter::repeat_n(MEASURE_RADIUS, added));
+            }
+            self.measured.push(got);
+        }
+        Ok(())
     }
 
     /// The last frame's cartoon ([`DrawStyle::Cartoon`]; empty without one).
@@ -994,6 +1045,12 @@ impl MolPlan {
     /// frame, after periodic images).
     pub fn last_hbonds(&self) -> &[HBond] {
         &self.hbonds
+    }
+
+    /// The last frame's measurements ([`MolOptions::measures`], in order): points, values and
+    /// where their labels go.
+    pub fn last_measurements(&self) -> &[Measured] {
+        &self.measured
     }
 
     /// Whether some representation draws trails ([`DrawStyle::Trails`]).
@@ -1490,8 +1547,18 @@ fn backbone_traces(
 /// A dashed line from `from` to `to` into `scene`: [`HBOND_DASHES`] cylinders of
 /// [`HBOND_RADIUS`] with round ends, each (ends included) as long as the gaps between them.
 fn push_dashes(scene: &mut SphereScene, from: glam::Vec3, to: glam::Vec3, kind: u16) {
-    let r = HBOND_RADIUS;
-    let n = HBOND_DASHES;
+    push_dash_line(scene, from, to, kind, HBOND_RADIUS, HBOND_DASHES);
+}
+
+/// `n` dashes of radius `r` from `from` to `to` as spheres joined by sticks (round ends).
+fn push_dash_line(
+    scene: &mut SphereScene,
+    from: glam::Vec3,
+    to: glam::Vec3,
+    kind: u16,
+    r: f32,
+    n: usize,
+) {
     let axis = (to - from).normalize_or_zero();
     // n dashes and n − 1 gaps of one length; a dash's sphere centres lie r inside its ends.
     let step = (to - from).length() / (2 * n - 1) as f32;
