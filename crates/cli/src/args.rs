@@ -57,11 +57,11 @@ pub enum Command {
     /// Print a trajectory's format, atom and frame counts, box, chains and segments (with their
     /// atom counts), per-atom properties, the first frame's secondary structure (DSSP: helix,
     /// strand, coil) and first positions as one JSON object; for a topology
-    /// file (PSF, AMBER prmtop, LAMMPS data) its atoms, residues, bonds, chains and segments.
+    /// file (PSF, AMBER prmtop) its atoms, residues, bonds, chains and segments.
     Info {
         /// Trajectory file (XYZ, extended XYZ, PDB, PDBx/mmCIF, GRO, LAMMPS dump, DCD, XTC, TRR,
         /// AMBER NetCDF, SDF/MOL and MOL2 with their bonds, one frame per record, VASP
-        /// POSCAR/CONTCAR/XDATCAR),
+        /// POSCAR/CONTCAR/XDATCAR, crystallographic CIF, a LAMMPS data file),
         /// gzip-compressed or not (1abc.cif.gz).
         file: PathBuf,
         /// Format, when the extension does not tell it.

@@ -121,7 +121,7 @@ fn open_trajectory_with(
         Some(name) => {
             let Some(f) = Format::from_extension(name) else {
                 return usage(format!(
-                    "--format {name:?}: expected one of xyz, extxyz, pdb, cif, gro, lammpstrj, dcd, xtc, trr, nc, sdf, mol, mol2, vasp, cif-crystal"
+                    "--format {name:?}: expected one of xyz, extxyz, pdb, cif, gro, lammpstrj, dcd, xtc, trr, nc, sdf, mol, mol2, vasp, cif-crystal, lammps-data"
                 ));
             };
             Ok(Trajectory::open_as_with(file, f, options)?)
@@ -226,14 +226,13 @@ fn info(
     Ok(())
 }
 
-/// `texmap info` of a file that holds a topology and no coordinates (PSF, AMBER prmtop, LAMMPS
-/// data): atoms, residues, bonds, chains and segments, and the properties it gives frames.
+/// `texmap info` of a file that holds a topology and no coordinates (PSF, AMBER prmtop): atoms,
+/// residues, bonds, chains and segments, and the properties it gives frames.
 fn topology_info(file: &Path) -> Result<()> {
     let t = crate::scene::open_topology(file)?;
     let format = match texmap_md_io::TopologyFormat::from_path(file) {
         Some(texmap_md_io::TopologyFormat::Psf) => "psf",
-        Some(texmap_md_io::TopologyFormat::Prmtop) => "prmtop",
-        _ => "lammps-data",
+        _ => "prmtop",
     };
     let mut obj = json!({
         "format": format,

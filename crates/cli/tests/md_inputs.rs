@@ -2071,10 +2071,9 @@ fn a_vasp_xdatcar_renders_as_its_frames_in_extended_xyz() {
 #[test]
 fn rutile_polyhedra_are_its_tio6_octahedra() {
     let poscar = data("vasp/POSCAR_rutile");
-    let want: serde_json::Value = serde_json::from_str(
-        &std::fs::read_to_string(data("vasp/rutile_polyhedra.json")).unwrap(),
-    )
-    .unwrap();
+    let want: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(data("vasp/rutile_polyhedra.json")).unwrap())
+            .unwrap();
     let volume = want["octahedron_volumes"][0].as_f64().unwrap();
     let dir = tempfile::tempdir().unwrap();
     let obj = dir.path().join("poly.obj");
@@ -2100,9 +2099,7 @@ fn rutile_polyhedra_are_its_tio6_octahedra() {
     for line in text.lines() {
         let mut it = line.split_whitespace();
         match it.next() {
-            Some("v") => v.push(std::array::from_fn(|_| {
-                it.next().unwrap().parse().unwrap()
-            })),
+            Some("v") => v.push(std::array::from_fn(|_| it.next().unwrap().parse().unwrap())),
             Some("f") => faces.push(std::array::from_fn(|_| {
                 let t = it.next().unwrap();
                 t.split('/').next().unwrap().parse::<usize>().unwrap() - 1
@@ -2140,7 +2137,10 @@ fn rutile_polyhedra_are_its_tio6_octahedra() {
             assert!(o.status.success(), "{}", stderr(&o));
         }
         let d = mean_abs_diff(&raycast, &reference);
-        assert!(d < 1.5, "opacity {opacity}: mean |raycast - reference| = {d}");
+        assert!(
+            d < 1.5,
+            "opacity {opacity}: mean |raycast - reference| = {d}"
+        );
     }
     let (opaque, clear) = (
         image::open(dir.path().join("r1.png")).unwrap().to_rgb8(),
@@ -2158,10 +2158,9 @@ fn rutile_polyhedra_are_its_tio6_octahedra() {
 fn arrows_end_where_the_vectors_point() {
     let dir = tempfile::tempdir().unwrap();
     let contcar = data("vasp/CONTCAR_ase_vel.vasp");
-    let reference: serde_json::Value = serde_json::from_str(
-        &std::fs::read_to_string(data("vasp/reference.json")).unwrap(),
-    )
-    .unwrap();
+    let reference: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(data("vasp/reference.json")).unwrap())
+            .unwrap();
     let want = &reference["CONTCAR_ase_vel.vasp"][0];
     let obj = dir.path().join("arrows.obj");
     let args = [
@@ -2198,7 +2197,10 @@ fn arrows_end_where_the_vectors_point() {
             .iter()
             .map(|q| (0..3).map(|k| (q[k] - tip[k]).powi(2)).sum::<f64>().sqrt())
             .fold(f64::MAX, f64::min);
-        assert!(nearest < 1e-4 * len.max(1.0), "tip {tip:?}: nearest vertex {nearest} Å");
+        assert!(
+            nearest < 1e-4 * len.max(1.0),
+            "tip {tip:?}: nearest vertex {nearest} Å"
+        );
     }
     // Displacements: rasteriser against the reference ray tracer, frame 0 (no arrows) and 4.
     let xdatcar = data("vasp/XDATCAR_ase");
@@ -2227,7 +2229,10 @@ fn arrows_end_where_the_vectors_point() {
         ]);
         assert!(o.status.success(), "{}", stderr(&o));
     }
-    let d = mean_abs_diff(&dir.path().join("raycast4.png"), &dir.path().join("reference4.png"));
+    let d = mean_abs_diff(
+        &dir.path().join("raycast4.png"),
+        &dir.path().join("reference4.png"),
+    );
     assert!(d < 1.0, "mean |raycast - reference| = {d}");
     // Without the arrows (the same frames, so the same camera): frame 4 differs, and frame 0,
     // whose displacements are all zero, is the same picture.
@@ -2245,11 +2250,24 @@ fn arrows_end_where_the_vectors_point() {
         dir.path().join("plain%d.png").to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let (f0, f4) = (dir.path().join("raycast0.png"), dir.path().join("raycast4.png"));
-    assert!(mean_abs_diff(&dir.path().join("plain4.png"), &f4) > 0.2, "frame 4's arrows");
-    assert_eq!(mean_abs_diff(&dir.path().join("plain0.png"), &f0), 0.0, "frame 0");
+    let (f0, f4) = (
+        dir.path().join("raycast0.png"),
+        dir.path().join("raycast4.png"),
+    );
+    assert!(
+        mean_abs_diff(&dir.path().join("plain4.png"), &f4) > 0.2,
+        "frame 4's arrows"
+    );
+    assert_eq!(
+        mean_abs_diff(&dir.path().join("plain0.png"), &f0),
+        0.0,
+        "frame 0"
+    );
     // What a file lacks.
-    for (arrows, lacks) in [("velocity", "no velocities"), ("f", "no per-atom properties fx")] {
+    for (arrows, lacks) in [
+        ("velocity", "no velocities"),
+        ("f", "no per-atom properties fx"),
+    ] {
         let o = texmap(&[
             "render",
             "--quiet",
@@ -2316,7 +2334,9 @@ fn trails_grow_over_the_frames_and_survive_sharding() {
     }
     // The trail's colour covers more pixels as it grows.
     let yellow = |k: usize| {
-        let img = image::open(whole.join(format!("f{k}.png"))).unwrap().to_rgb8();
+        let img = image::open(whole.join(format!("f{k}.png")))
+            .unwrap()
+            .to_rgb8();
         img.pixels()
             .filter(|p| p.0[0] > 150 && p.0[1] > 120 && p.0[2] < 60)
             .count()
@@ -2329,7 +2349,10 @@ fn trails_grow_over_the_frames_and_survive_sharding() {
             let name = entry.unwrap().file_name();
             let a = std::fs::read(out.join(&name)).unwrap();
             let b = std::fs::read(whole.join(&name)).unwrap();
-            assert!(a == b, "part {part}: {name:?} differs from the whole render's");
+            assert!(
+                a == b,
+                "part {part}: {name:?} differs from the whole render's"
+            );
         }
     }
 }
@@ -2391,7 +2414,10 @@ fn measurements_are_mdanalysis_values_and_drawn_as_traced() {
     assert_eq!(rows.len(), 1 + 2 * specs.len());
     for row in &rows[1..] {
         let f: Vec<&str> = row.splitn(6, ',').collect();
-        let (frame, m) = (f[0].parse::<usize>().unwrap(), f[1].parse::<usize>().unwrap());
+        let (frame, m) = (
+            f[0].parse::<usize>().unwrap(),
+            f[1].parse::<usize>().unwrap(),
+        );
         let want = reference[m]["values"][frame].as_f64().unwrap();
         let got: f64 = f[3].parse().unwrap();
         assert!((got - want).abs() < 2e-3, "{row}: MDAnalysis {want}");
@@ -2423,4 +2449,33 @@ fn measurements_are_mdanalysis_values_and_drawn_as_traced() {
     );
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     assert!(stderr(&o).contains("selection 2 picks"), "{}", stderr(&o));
+}
+
+/// A LAMMPS data file (MDAnalysis's topo_mda.data) is a structure to render and describe, not
+/// only a topology: one frame, its listed bonds, elements from its masses.
+#[test]
+fn a_lammps_data_file_renders_and_is_described() {
+    let file = data("topo_mda.data");
+    let o = texmap(&["info", &file]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["format"], "lammps-data");
+    assert_eq!(v["frames"], 1);
+    assert_eq!(v["atoms"], 66);
+    assert_eq!(v["bonds"], 53);
+    let dir = tempfile::tempdir().unwrap();
+    let img = render_rgb(dir.path(), "d.png", &[&file, "--style", "ball-stick"]);
+    // The listed bonds drawn: more pixels lit than the same atoms without bonds.
+    let none = render_rgb(
+        dir.path(),
+        "n.png",
+        &[&file, "--style", "ball-stick", "--bonds", "none"],
+    );
+    let lit = |i: &image::RgbImage| i.pixels().filter(|p| p.0 != [0, 0, 0]).count();
+    assert!(
+        lit(&img) > lit(&none) + 100,
+        "{} vs {}",
+        lit(&img),
+        lit(&none)
+    );
 }

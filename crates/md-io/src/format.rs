@@ -37,11 +37,15 @@ pub enum Format {
     /// `.cif` file is this or PDBx/mmCIF by its tags ([`Format::cif_kind`]); by name:
     /// `cif-crystal`.
     CrystalCif,
+    /// LAMMPS data file (`read_data` / `write_data`), one frame with its bonds: `.data`, `.lmp`,
+    /// files named `data.*` (`data.peptide`, as in the LAMMPS examples), or by its header (an
+    /// `N atoms` line after the title: `system.lammps`); by name: `lammps-data`.
+    LammpsData,
 }
 
 impl Format {
     /// Every format, in declaration order.
-    pub const ALL: [Format; 13] = [
+    pub const ALL: [Format; 14] = [
         Format::Xyz,
         Format::Pdb,
         Format::Gro,
@@ -55,6 +59,7 @@ impl Format {
         Format::Mol2,
         Format::Vasp,
         Format::CrystalCif,
+        Format::LammpsData,
     ];
 
     /// The format a file extension names (case-insensitive), e.g. "xyz", "lammpstrj".
@@ -74,12 +79,14 @@ impl Format {
             "mol2" => Format::Mol2,
             "vasp" | "poscar" | "contcar" | "xdatcar" => Format::Vasp,
             "cif-crystal" => Format::CrystalCif,
+            "data" | "lmp" | "lammps-data" => Format::LammpsData,
             _ => return None,
         })
     }
 
     /// The format a path's extension names, else VASP for the names VASP gives its files
-    /// (`POSCAR`, `CONTCAR`, `XDATCAR` and any suffix: `CONTCAR.2`); a final `.gz` is looked
+    /// (`POSCAR`, `CONTCAR`, `XDATCAR` and any suffix: `CONTCAR.2`), else a LAMMPS data file for
+    /// a name starting `data.` (`data.peptide`); a final `.gz` is looked
     /// through (`run.xyz.gz` is XYZ, read decompressed by [`crate::Trajectory::open`]).
     pub fn from_path(path: &Path) -> Option<Format> {
         let inner = crate::gz::inner_path(path);
@@ -95,7 +102,11 @@ impl Format {
         let vasp = [&b"POSCAR"[..], b"CONTCAR", b"XDATCAR"]
             .iter()
             .any(|v| name.len() >= v.len() && name[..v.len()].eq_ignore_ascii_case(v));
-        vasp.then_some(Format::Vasp)
+        if vasp {
+            return Some(Format::Vasp);
+        }
+        // The LAMMPS examples' names: `data.peptide`, `data.lj`.
+        (name.len() > 5 && name[..5].eq_ignore_ascii_case(b"data.")).then_some(Format::LammpsData)
     }
 
     /// The format the first bytes of a file show (give at least 256 bytes when the file has
@@ -103,7 +114,8 @@ impl Format {
     /// lines: `data_` (CIF: PDBx/mmCIF or crystallographic, by [`Format::cif_kind`]) or
     /// `@<TRIPOS>` (MOL2) on the first line that is not a `#`
     /// comment, `ITEM: TIMESTEP` (LAMMPS), a PDB record name, a fourth line ending in `V2000` or
-    /// `V3000` (molfile, SD file), an integer first line (XYZ), an integer second line (GRO).
+    /// `V3000` (molfile, SD file), an integer first line (XYZ), an `N atoms` line after the title
+    /// (LAMMPS data file), an integer second line (GRO).
     pub fn from_magic(head: &[u8]) -> Option<Format> {
         let be = |k: usize| {
             head.get(k..k + 4)
@@ -168,6 +180,9 @@ impl Format {
         }
         if is_count(first) {
             return Some(Format::Xyz);
+        }
+        if looks_like_lammps_data(head) {
+            return Some(Format::LammpsData);
         }
         if lines.next().is_some_and(is_count) {
             return Some(Format::Gro);
@@ -236,6 +251,7 @@ impl Format {
                 | Format::Mol2
                 | Format::Vasp
                 | Format::CrystalCif
+                | Format::LammpsData
         )
     }
 
@@ -255,6 +271,7 @@ impl Format {
             Format::Mol2 => "mol2",
             Format::Vasp => "vasp",
             Format::CrystalCif => "cif-crystal",
+            Format::LammpsData => "lammps-data",
         }
     }
 }
@@ -286,6 +303,22 @@ fn looks_like_vasp(head: &[u8]) -> bool {
             || words.iter().all(|w| w[0].is_ascii_alphabetic()))
 }
 
+/// True when a LAMMPS data file's header shows: after the title line, one of the first three
+/// lines that are not blank or `#` comments is `N atoms` (what LAMMPS `write_data`, MDAnalysis,
+/// ASE, OVITO and moltemplate write first).
+fn looks_like_lammps_data(head: &[u8]) -> bool {
+    use crate::parse::{fields, parse_usize};
+    head.split(|b| *b == b'\n')
+        .skip(1)
+        .map(|l| crate::parse::trim(l.split(|b| *b == b'#').next().unwrap_or(&[])))
+        .filter(|l| !l.is_empty())
+        .take(3)
+        .any(|l| {
+            let f: Vec<&[u8]> = fields(l).collect();
+            matches!(f[..], [n, b"atoms"] if parse_usize(n).is_some())
+        })
+}
+
 impl std::fmt::Display for Format {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(self.name())
@@ -313,7 +346,7 @@ mod tests {
         for f in Format::ALL {
             assert_eq!(
                 Format::from_extension(f.name().split('-').next().unwrap()).is_some(),
-                f != Format::LammpsDump
+                !matches!(f, Format::LammpsDump | Format::LammpsData)
             );
         }
     }

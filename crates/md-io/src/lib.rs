@@ -6,7 +6,9 @@
 //!   (records as frames, with the bonds they list: [`Frame::bonds`]), VASP POSCAR/CONTCAR
 //!   and XDATCAR (the ionic steps as frames, a changing cell too), crystallographic CIF (COD,
 //!   ICSD, Materials Project: each data block a frame, the asymmetric unit expanded by the
-//!   file's symmetry operations; a `.cif` is told from PDBx/mmCIF by its tags) (and the binary DCD, XTC,
+//!   file's symmetry operations; a `.cif` is told from PDBx/mmCIF by its tags), LAMMPS data files
+//!   (one frame: the atom style's columns, the box, masses and their elements, velocities and
+//!   image flags as properties, the `Bonds` as [`Frame::bonds`]) (and the binary DCD, XTC,
 //!   TRR and AMBER NetCDF) one frame at a time into a reusable [`Frame`], or any frame by index.
 //!   Any of them may be gzip-compressed (`1abc.cif.gz`, `run.xyz.gz`; topologies too): it is
 //!   inflated once into a temporary file, so the byte offsets of a `.gz` file's errors count
@@ -96,6 +98,7 @@ mod gro;
 mod gz;
 pub mod hbonds;
 mod lammps;
+mod lammps_data;
 mod mmcif;
 mod mol2;
 mod netcdf;

@@ -17,20 +17,24 @@
 //!   `!NBOND` section (module `psf`: elements from names, checked against the masses);
 //! - **AMBER prmtop** (`.prmtop`, `.parm7`): atoms, types, elements from `ATOMIC_NUMBER`,
 //!   residues, chains (`RESIDUE_CHAINID`) and both bond sections (module `prmtop`);
-//! - **LAMMPS data file** (`.data`, `.lmp`, or a name starting `data.`): the `Atoms` section in
-//!   the styles `full`, `molecular` (and its column-equal `bond`, `angle`), `atomic` and
-//!   `charge`, told by the `Atoms # style` comment or, without one, by the column count (as
-//!   MDAnalysis does, 7 columns is `full`; 6 is ambiguous between `molecular` and `charge` and is
-//!   an error asking for the comment), and the `Bonds` section. Atoms are ordered by id, as the
-//!   LAMMPS dump reader orders them, so index `i` is the same atom in both.
+//! - **LAMMPS data file** (`.data`, `.lmp`, or a name starting `data.`): read by the trajectory
+//!   reader of [`Format::LammpsData`] (module `lammps_data`: the atom styles, told by the
+//!   `Atoms # style` comment or, without one, by the column count: 7 columns is `full`, 5
+//!   `atomic`, 6 is ambiguous between `molecular` and `charge` and an error asking for the
+//!   comment), and its frame's types, ids, molecule ids, elements, charges and `Bonds` kept.
+//!   Atoms are ordered by id, as the LAMMPS dump reader orders them, so index `i` is the same
+//!   atom in both. Errors name frame 0, as those of the other topologies read through a
+//!   trajectory reader (PDB, GRO, mmCIF) do.
 //!
 //! Applying a topology ([`Topology::apply`]) replaces the frame's per-atom labels with the
 //! topology's; an atom-count mismatch is an [`Error::TopologyMismatch`] naming both files.
 //! Positions are never taken from the topology: the trajectory's frame is what is drawn.
 //!
-//! Rejected: guessing elements of LAMMPS types from the `Masses` section (masses of isotopes and
-//! coarse-grained beads make it a guess that is wrong silently); the types are kept and drawn one
-//! colour per type instead, as OVITO does.
+//! LAMMPS elements come from a `Masses` line's comment (`1 12.011 # C`) or a type label when it
+//! is an element symbol, else from a mass within 0.1 % of exactly one element's standard weight.
+//! Rejected: the nearest element whatever the distance (ASE's rule): masses of isotopes,
+//! united atoms and coarse-grained beads would be wrong silently; those types stay of unknown
+//! element and are drawn one colour per type, as OVITO does.
 
 use std::collections::HashMap;
 use std::io::{BufRead, BufReader, Read};
@@ -41,7 +45,7 @@ use crate::elements::Element;
 use crate::error::{Error, Location};
 use crate::format::Format;
 use crate::frame::{Frame, Label};
-use crate::parse::{fields, parse_f64, parse_i64, trim};
+use crate::parse::trim;
 use crate::trajectory::Trajectory;
 
 /// The kinds of file a topology is read from.
@@ -275,7 +279,20 @@ impl Topology {
             TopologyFormat::Mmcif => {
                 Topology::first_frame(Trajectory::from_reader(src, Format::Mmcif, name)?)
             }
-            TopologyFormat::LammpsData => lammps_data(src, &file),
+            TopologyFormat::LammpsData => {
+                // The trajectory reader's parse (module `lammps_data`), its frame's labels kept.
+                let mut traj = Trajectory::from_reader(src, Format::LammpsData, name)?;
+                let mut f = Frame::new();
+                if !traj.read_next(&mut f)? {
+                    return Err(Error::Truncated {
+                        at: Location::file(&file),
+                        expected:
+                            "a LAMMPS data file: a title, an 'N atoms' line, the Atoms section"
+                                .into(),
+                    });
+                }
+                Ok(Topology::from_lammps_data(&f, &file))
+            }
             TopologyFormat::Psf => crate::psf::read_psf(src, &file),
             TopologyFormat::Prmtop => crate::prmtop::read_prmtop(src, &file),
         }
@@ -319,6 +336,28 @@ impl Topology {
             segments: Vec::new(),
             charges: Vec::new(),
             bonds,
+        }
+    }
+
+    /// The topology of a LAMMPS data file's frame: types, ids, molecule ids, elements (from
+    /// the masses or their comments), charges and bonds.
+    fn from_lammps_data(f: &Frame, file: &Arc<str>) -> Topology {
+        Topology {
+            file: file.clone(),
+            n_atoms: f.n_atoms(),
+            names: Vec::new(),
+            elements: f.elements.clone(),
+            types: f.types.clone(),
+            ids: f.ids.clone(),
+            res_names: Vec::new(),
+            res_ids: f.res_ids.clone(),
+            chains: Vec::new(),
+            segments: Vec::new(),
+            charges: f
+                .property("charge")
+                .map(<[f32]>::to_vec)
+                .unwrap_or_default(),
+            bonds: f.bonds.clone(),
         }
     }
 
@@ -401,7 +440,15 @@ impl Topology {
         take(&mut frame.res_names, &self.res_names);
         take(&mut frame.chains, &self.chains);
         take(&mut frame.segments, &self.segments);
-        if !self.elements.is_empty() {
+        // An element the topology does not know (a LAMMPS type of no element) keeps the frame's
+        // (a dump's `element` column).
+        if self.elements.len() == frame.elements.len() {
+            for (d, s) in frame.elements.iter_mut().zip(&self.elements) {
+                if !s.is_unknown() {
+                    *d = *s;
+                }
+            }
+        } else if !self.elements.is_empty() {
             frame.elements.clone_from(&self.elements);
         }
         if !self.res_ids.is_empty() {
@@ -479,312 +526,6 @@ fn pdb_conect<R: Read>(src: R, file: &Arc<str>, ids: &[i64]) -> Result<Vec<[u32;
     Ok(bonds)
 }
 
-/// The `Atoms` section layouts.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum AtomStyleKind {
-    /// id type x y z
-    Atomic,
-    /// id type q x y z
-    Charge,
-    /// id mol type x y z (also `bond`, `angle`)
-    Molecular,
-    /// id mol type q x y z
-    Full,
-}
-
-impl AtomStyleKind {
-    fn from_name(s: &[u8]) -> Option<AtomStyleKind> {
-        Some(match s {
-            b"atomic" => AtomStyleKind::Atomic,
-            b"charge" => AtomStyleKind::Charge,
-            b"molecular" | b"bond" | b"angle" => AtomStyleKind::Molecular,
-            b"full" => AtomStyleKind::Full,
-            _ => return None,
-        })
-    }
-
-    /// The index of the charge column `q`, if the style has one.
-    fn charge_column(self) -> Option<usize> {
-        match self {
-            AtomStyleKind::Full => Some(3),
-            AtomStyleKind::Charge => Some(2),
-            AtomStyleKind::Atomic | AtomStyleKind::Molecular => None,
-        }
-    }
-
-    /// Columns before the image flags, and the indices of mol (if any) and type.
-    fn layout(self) -> (usize, Option<usize>, usize) {
-        match self {
-            AtomStyleKind::Atomic => (5, None, 1),
-            AtomStyleKind::Charge => (6, None, 1),
-            AtomStyleKind::Molecular => (6, Some(1), 2),
-            AtomStyleKind::Full => (7, Some(1), 2),
-        }
-    }
-}
-
-/// The line without a `#` comment.
-fn strip_comment(line: &[u8]) -> &[u8] {
-    match line.iter().position(|b| *b == b'#') {
-        Some(k) => &line[..k],
-        None => line,
-    }
-}
-
-/// A LAMMPS data file's atoms (ordered by id) and bonds.
-fn lammps_data<R: Read>(src: R, file: &Arc<str>) -> Result<Topology, Error> {
-    let mut lines = Lines::new(src, file.clone());
-    // The first line is a title.
-    if lines.next_line()?.is_none() {
-        return Err(Error::Parse {
-            at: Location::file(file),
-            expected: "a LAMMPS data file title line",
-            found: "end of file".into(),
-        });
-    }
-    let mut n_atoms: Option<u64> = None;
-    let mut n_bonds: u64 = 0;
-    // (id, mol, type) per atom; bonds as id pairs with their line.
-    let mut atoms: Vec<(i64, i64, Label, f32)> = Vec::new();
-    let mut bond_ids: Vec<(i64, i64, LineAt)> = Vec::new();
-    let mut section: Option<Vec<u8>> = None;
-    let mut style: Option<AtomStyleKind> = None;
-    let mut atoms_seen = false;
-    while let Some((raw, pos)) = lines.next_line()? {
-        let line = trim(strip_comment(raw));
-        if line.is_empty() {
-            continue;
-        }
-        let first = line[0];
-        if first.is_ascii_alphabetic() {
-            // A section keyword ("Atoms # full", "Bonds", "Pair Coeffs # lj/cut", ...).
-            let name = trim(line).to_vec();
-            if name == b"Atoms" {
-                if atoms_seen {
-                    return Err(parse_err(file, &pos, "one Atoms section", raw));
-                }
-                atoms_seen = true;
-                let hint = raw
-                    .iter()
-                    .position(|b| *b == b'#')
-                    .map(|k| trim(&raw[k + 1..]));
-                style = match hint {
-                    Some(h) if !h.is_empty() => {
-                        let word = fields(h).next().unwrap_or(&[]);
-                        match AtomStyleKind::from_name(word) {
-                            Some(s) => Some(s),
-                            None => {
-                                return Err(parse_err(
-                                    file,
-                                    &pos,
-                                    "an atom style this reader knows (full, molecular, bond, angle, atomic, charge)",
-                                    word,
-                                ));
-                            }
-                        }
-                    }
-                    _ => None,
-                };
-                let n = n_atoms.ok_or_else(|| {
-                    parse_err(
-                        file,
-                        &pos,
-                        "an 'N atoms' header line before the Atoms section",
-                        raw,
-                    )
-                })?;
-                // Bounded: the header's claim reserves at most 64 Ki atoms; past that the
-                // vector grows with the lines actually read.
-                atoms.reserve((n as usize).min(1 << 16));
-            }
-            section = Some(name);
-            continue;
-        }
-        match section.as_deref() {
-            None => {
-                // Header: "N atoms", "N bonds", "N atom types", "xlo xhi", ...
-                let f: Vec<&[u8]> = fields(line).collect();
-                match f.as_slice() {
-                    [n, b"atoms"] => {
-                        n_atoms = Some(
-                            crate::parse::parse_usize(n)
-                                .ok_or_else(|| parse_err(file, &pos, "an atom count", n))?
-                                as u64,
-                        );
-                    }
-                    [n, b"bonds"] => {
-                        n_bonds = crate::parse::parse_usize(n)
-                            .ok_or_else(|| parse_err(file, &pos, "a bond count", n))?
-                            as u64;
-                    }
-                    _ => {}
-                }
-            }
-            Some(b"Atoms") => {
-                let f: Vec<&[u8]> = fields(line).collect();
-                let st = match style {
-                    Some(s) => s,
-                    None => {
-                        let s = match f.len() {
-                            5 | 8 => AtomStyleKind::Atomic,
-                            7 | 10 => AtomStyleKind::Full,
-                            _ => {
-                                return Err(parse_err(
-                                    file,
-                                    &pos,
-                                    "an atom line of 5 (atomic) or 7 (full) columns, or an 'Atoms # style' comment naming the style",
-                                    raw,
-                                ));
-                            }
-                        };
-                        style = Some(s);
-                        s
-                    }
-                };
-                let (cols, mol, ty) = st.layout();
-                if f.len() != cols && f.len() != cols + 3 {
-                    return Err(parse_err(
-                        file,
-                        &pos,
-                        "as many columns as the atom style has (plus 3 optional image flags)",
-                        raw,
-                    ));
-                }
-                let id =
-                    parse_i64(f[0]).ok_or_else(|| parse_err(file, &pos, "an atom id", f[0]))?;
-                let m = match mol {
-                    Some(k) => parse_i64(f[k])
-                        .ok_or_else(|| parse_err(file, &pos, "a molecule id", f[k]))?,
-                    None => 0,
-                };
-                let t = Label::from_utf8(f[ty])
-                    .ok_or_else(|| parse_err(file, &pos, "an atom type", f[ty]))?;
-                for c in &f[cols - 3..cols] {
-                    if !parse_f64(c).is_some_and(f64::is_finite) {
-                        return Err(parse_err(file, &pos, "a finite coordinate", c));
-                    }
-                }
-                let q = match st.charge_column() {
-                    Some(k) => parse_f64(f[k])
-                        .filter(|q| q.is_finite())
-                        .ok_or_else(|| parse_err(file, &pos, "a finite charge", f[k]))?
-                        as f32,
-                    None => f32::NAN,
-                };
-                if atoms.len() as u64 >= n_atoms.unwrap_or(0) {
-                    return Err(parse_err(
-                        file,
-                        &pos,
-                        "no more atom lines than the header's 'N atoms'",
-                        raw,
-                    ));
-                }
-                atoms.push((id, m, t, q));
-            }
-            Some(b"Bonds") => {
-                let f: Vec<&[u8]> = fields(line).collect();
-                if f.len() != 4 {
-                    return Err(parse_err(
-                        file,
-                        &pos,
-                        "a bond line 'id type atom1 atom2'",
-                        raw,
-                    ));
-                }
-                let a = parse_i64(f[2]).ok_or_else(|| parse_err(file, &pos, "an atom id", f[2]))?;
-                let b = parse_i64(f[3]).ok_or_else(|| parse_err(file, &pos, "an atom id", f[3]))?;
-                if bond_ids.len() as u64 >= n_bonds {
-                    return Err(parse_err(
-                        file,
-                        &pos,
-                        "no more bond lines than the header's 'N bonds'",
-                        raw,
-                    ));
-                }
-                bond_ids.push((a, b, pos));
-            }
-            Some(_) => {} // Masses, Velocities, coefficients, angles...: not needed here.
-        }
-    }
-    let n = n_atoms.ok_or_else(|| Error::Parse {
-        at: Location::file(file),
-        expected: "an 'N atoms' header line",
-        found: "none".into(),
-    })?;
-    let end = LineAt {
-        line: lines.line,
-        byte: lines.next_byte,
-    };
-    if atoms.len() as u64 != n {
-        return Err(Error::Truncated {
-            at: at(file, &end),
-            expected: format!(
-                "{n} atom lines in the Atoms section (the header's 'N atoms'), found {}",
-                atoms.len()
-            ),
-        });
-    }
-    if bond_ids.len() as u64 != n_bonds {
-        return Err(Error::Truncated {
-            at: at(file, &end),
-            expected: format!(
-                "{n_bonds} bond lines in the Bonds section (the header's 'N bonds'), found {}",
-                bond_ids.len()
-            ),
-        });
-    }
-    atoms.sort_unstable_by_key(|a| a.0);
-    if let Some(w) = atoms.windows(2).find(|w| w[0].0 == w[1].0) {
-        return Err(Error::InvalidValue {
-            what: format!(
-                "{file}: atom id {} appears twice in the Atoms section",
-                w[0].0
-            ),
-        });
-    }
-    let index = |id: i64, pos: &LineAt| -> Result<u32, Error> {
-        atoms
-            .binary_search_by_key(&id, |a| a.0)
-            .map(|k| k as u32)
-            .map_err(|_| Error::Parse {
-                at: at(file, pos),
-                expected: "a bond between atom ids of the Atoms section",
-                found: id.to_string(),
-            })
-    };
-    let mut bonds = Vec::with_capacity(bond_ids.len());
-    for (a, b, pos) in &bond_ids {
-        let (i, j) = (index(*a, pos)?, index(*b, pos)?);
-        if i != j {
-            bonds.push([i, j]);
-        }
-    }
-    tidy(&mut bonds);
-    let has_mol = matches!(style, Some(AtomStyleKind::Full | AtomStyleKind::Molecular));
-    Ok(Topology {
-        file: file.clone(),
-        n_atoms: atoms.len(),
-        names: Vec::new(),
-        elements: Vec::new(),
-        types: atoms.iter().map(|a| a.2).collect(),
-        ids: atoms.iter().map(|a| a.0).collect(),
-        res_names: Vec::new(),
-        res_ids: if has_mol {
-            atoms.iter().map(|a| a.1).collect()
-        } else {
-            Vec::new()
-        },
-        chains: Vec::new(),
-        segments: Vec::new(),
-        charges: if style.and_then(AtomStyleKind::charge_column).is_some() {
-            atoms.iter().map(|a| a.3).collect()
-        } else {
-            Vec::new()
-        },
-        bonds,
-    })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -806,19 +547,22 @@ mod tests {
         let e = Topology::from_reader(Cursor::new(amb), TopologyFormat::LammpsData, "d")
             .unwrap_err()
             .to_string();
-        assert!(e.starts_with("d: line 5"), "{e}");
+        assert!(e.starts_with("d: frame 0, line 5"), "{e}");
         // A bond naming a missing atom.
         let bad = "t\n1 atoms\n1 bonds\nAtoms # full\n\n1 1 1 0.0 0 0 0\nBonds\n\n1 1 1 7\n";
         let e = Topology::from_reader(Cursor::new(bad), TopologyFormat::LammpsData, "d")
             .unwrap_err()
             .to_string();
-        assert!(e.starts_with("d: line 9") && e.contains("'7'"), "{e}");
+        assert!(
+            e.starts_with("d: frame 0, line 9") && e.contains("'7'"),
+            "{e}"
+        );
         // Fewer atoms than announced.
         let cut = "t\n3 atoms\nAtoms # full\n\n1 1 1 0.0 0 0 0\n";
         let e = Topology::from_reader(Cursor::new(cut), TopologyFormat::LammpsData, "d")
             .unwrap_err()
             .to_string();
-        assert!(e.contains("3 atom lines"), "{e}");
+        assert!(e.contains("2 more lines of the Atoms section"), "{e}");
     }
 
     #[test]

@@ -7,6 +7,7 @@ use crate::format::Format;
 use crate::frame::Frame;
 use crate::gro::Gro;
 use crate::lammps::Lammps;
+use crate::lammps_data::LammpsData;
 use crate::mmcif::Mmcif;
 use crate::mol2::Mol2;
 use crate::netcdf::NetcdfReader;
@@ -37,6 +38,7 @@ enum Reader<R> {
     Mol2(TextReader<R, Mol2>),
     Vasp(TextReader<R, Vasp>),
     CrystalCif(TextReader<R, CrystalCif>),
+    LammpsData(TextReader<R, LammpsData>),
 }
 
 /// Runs `$body` with `$r` bound to the format's reader, whatever the format.
@@ -56,6 +58,7 @@ macro_rules! each_reader {
             Reader::Mol2($r) => $body,
             Reader::Vasp($r) => $body,
             Reader::CrystalCif($r) => $body,
+            Reader::LammpsData($r) => $body,
         }
     };
 }
@@ -252,6 +255,9 @@ impl<R: Read + Seek> Trajectory<R> {
             Format::Vasp => Reader::Vasp(TextReader::new(src, Vasp::default(), file.clone())),
             Format::CrystalCif => {
                 Reader::CrystalCif(TextReader::new(src, CrystalCif::default(), file.clone()))
+            }
+            Format::LammpsData => {
+                Reader::LammpsData(TextReader::new(src, LammpsData::default(), file.clone()))
             }
         };
         Ok(Trajectory {

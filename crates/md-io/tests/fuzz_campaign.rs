@@ -595,6 +595,18 @@ fn vasp_campaign() {
 }
 
 #[test]
+fn lammps_data_campaign() {
+    let files = [
+        "lammps_data/ase_atomic_tri.data",
+        "lammps_data/ase_full.data",
+        "lammps_data/mda_full_tri.data",
+        "replicate/water.data",
+    ];
+    let fx = files.map(|f| text_fixture(f, Format::LammpsData));
+    campaign("LAMMPS data", Format::LammpsData, fx.into());
+}
+
+#[test]
 fn crystal_cif_campaign() {
     let files = ["crystal/cod_9001665.cif", "crystal/two_blocks.cif"];
     let fx = files.map(|f| text_fixture(f, Format::CrystalCif));

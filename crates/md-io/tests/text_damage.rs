@@ -26,6 +26,8 @@ const FILES: &[(&str, Format)] = &[
     ("vasp/POSCAR_pmg_vel", Format::Vasp),
     ("crystal/two_blocks.cif", Format::CrystalCif),
     ("crystal/cod_9001665.cif", Format::CrystalCif),
+    ("lammps_data/ase_full.data", Format::LammpsData),
+    ("lammps_data/mda_full_tri.data", Format::LammpsData),
 ];
 
 fn data(name: &str) -> Vec<u8> {
@@ -142,6 +144,10 @@ fn frame_ends(bytes: &[u8], format: Format) -> Vec<usize> {
             for k in blocks.skip(1) {
                 ends.push(line_starts[k + 1]);
             }
+            ends.push(bytes.len());
+        }
+        Format::LammpsData => {
+            // One frame: the whole file (its sections may come in any order).
             ends.push(bytes.len());
         }
         _ => unreachable!(),
