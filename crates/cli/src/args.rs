@@ -813,6 +813,11 @@ pub struct MolArgs {
     /// --measure 'resid 10 and name OG; resname LIG and name O1'.
     #[arg(long = "measure", value_name = "SEL; SEL[; SEL[; SEL]]")]
     pub measures: Vec<String>,
+    /// Draw the bond orders an SDF/MOL or MOL2 file gives (PyMOL's valence mode) in the
+    /// ball-stick and licorice styles: double bonds as two sticks, triple as three, aromatic
+    /// as a stick with a dashed line inside the ring.
+    #[arg(long)]
+    pub bond_orders: bool,
     /// Also write the --measure values as a CSV table, one row per measurement and frame:
     /// frame, measure (0-based, in the order given), kind (distance, angle, dihedral), value
     /// (Å or degrees), the atoms' 0-based indices joined by spaces, and the spec as given.

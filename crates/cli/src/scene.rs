@@ -542,6 +542,7 @@ pub fn mol_plan(args: &MolArgs) -> Result<MolPlan> {
             radius: args.arrow_radius,
         },
         trail_length: args.trail_length,
+        bond_orders: args.bond_orders,
         measures: args
             .measures
             .iter()

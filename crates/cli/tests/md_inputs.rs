@@ -2479,3 +2479,36 @@ fn a_lammps_data_file_renders_and_is_described() {
         lit(&none)
     );
 }
+
+/// `--bond-orders`: Open Babel's MOL2 of imatinib (aromatic rings, double bonds) drawn in
+/// valence mode as the reference ray tracer traces it, and differently from single sticks.
+#[test]
+fn bond_orders_are_drawn_as_the_reference_traces_them() {
+    let mol2 = data("molecules/imatinib_poses.mol2");
+    let dir = tempfile::tempdir().unwrap();
+    let run = |name: &str, extra: &[&str]| {
+        let out = dir.path().join(name);
+        let mut args = vec![
+            "render",
+            "--quiet",
+            mol2.as_str(),
+            "--frames",
+            "0",
+            "--style",
+            "licorice",
+            "--size",
+            "400x300",
+        ];
+        args.extend(extra);
+        args.extend(["-o", out.to_str().unwrap()]);
+        let o = texmap(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        out
+    };
+    let valence = run("v.png", &["--bond-orders"]);
+    let traced = run("t.png", &["--bond-orders", "--method", "reference"]);
+    let single = run("s.png", &[]);
+    let d = mean_abs_diff(&valence, &traced);
+    assert!(d < 1.5, "mean |raycast - reference| = {d}");
+    assert!(mean_abs_diff(&valence, &single) > 1.0);
+}

@@ -334,8 +334,24 @@ pub struct Frame {
     /// `[i, j]` with `i < j`, sorted, each once; empty for formats without bonds (whose bonds
     /// come from a topology or from distances).
     pub bonds: Vec<[u32; 2]>,
+    /// The order of each of [`Frame::bonds`] as the file gives it (SDF/MOL bond types, MOL2
+    /// bond orders), or empty: 1 single, 2 double, 3 triple, [`BOND_AROMATIC`] aromatic, 0 any
+    /// other (an SDF query type, a MOL2 `du`, `un` or `nc`; a MOL2 amide `am` is 1).
+    pub bond_orders: Vec<u8>,
     /// The frame's title / comment line (XYZ comment, GRO title, PDB TITLE), if any.
     pub comment: String,
+}
+
+/// The [`Frame::bond_orders`] value of an aromatic bond.
+pub const BOND_AROMATIC: u8 = 4;
+
+/// Sorts `bonds` (pairs `i < j`) with their `orders` alongside, each pair once (the lowest
+/// order of a repeated pair kept), into a frame's [`Frame::bonds`] and [`Frame::bond_orders`].
+pub(crate) fn set_ordered_bonds(frame: &mut Frame, mut bonds: Vec<([u32; 2], u8)>) {
+    bonds.sort_unstable();
+    bonds.dedup_by_key(|b| b.0);
+    frame.bonds = bonds.iter().map(|b| b.0).collect();
+    frame.bond_orders = bonds.iter().map(|b| b.1).collect();
 }
 
 /// One named per-atom number column of a [`Frame`].
@@ -377,6 +393,7 @@ impl Frame {
         self.colors.clear();
         self.properties.clear();
         self.bonds.clear();
+        self.bond_orders.clear();
         self.comment.clear();
     }
 
@@ -455,6 +472,16 @@ impl Frame {
             }
         }
         let shift = n as u32;
+        // Orders for every bond once either frame has some (0: not given).
+        let ordered = |f: &Frame| !f.bond_orders.is_empty() && f.bond_orders.len() == f.bonds.len();
+        if ordered(self) || ordered(other) {
+            self.bond_orders.resize(self.bonds.len(), 0);
+            if ordered(other) {
+                self.bond_orders.extend_from_slice(&other.bond_orders);
+            } else {
+                self.bond_orders.resize(self.bonds.len() + other.bonds.len(), 0);
+            }
+        }
         self.bonds
             .extend(other.bonds.iter().map(|[i, j]| [i + shift, j + shift]));
         self.positions.extend_from_slice(&other.positions);
@@ -542,6 +569,13 @@ impl Frame {
         }
         if self.bonds.windows(2).any(|w| w[0] >= w[1]) {
             return Err("bonds are not sorted, each once".into());
+        }
+        if !self.bond_orders.is_empty() && self.bond_orders.len() != self.bonds.len() {
+            return Err(format!(
+                "{} bond orders for {} bonds",
+                self.bond_orders.len(),
+                self.bonds.len()
+            ));
         }
         Ok(())
     }

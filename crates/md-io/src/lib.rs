@@ -125,7 +125,7 @@ mod xyz;
 pub use elements::Element;
 pub use error::{Error, Location};
 pub use format::Format;
-pub use frame::{Frame, Label, MAX_COORDINATE, Property, UnitCell};
+pub use frame::{BOND_AROMATIC, Frame, Label, MAX_COORDINATE, Property, UnitCell};
 pub use mmcif::is_altloc_warning;
 pub use select::{Selection, SelectionError};
 pub use style::{Appearance, AtomStyle, Selector, atom_element};

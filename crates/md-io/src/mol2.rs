@@ -14,7 +14,8 @@
 //!   property (partial charges in e). An optional column present on the first atom line must be
 //!   on every one.
 //! - `@<TRIPOS>BOND`: `bond_id origin target type`, the two atoms named by their `atom_id`,
-//!   into [`Frame::bonds`] whatever the bond type.
+//!   into [`Frame::bonds`], the SYBYL type into [`Frame::bond_orders`] (`1`, `2`, `3`, `ar`
+//!   aromatic; an amide `am` single; `du`, `un`, `nc` 0).
 //! - Other sections (`SUBSTRUCTURE`, `CRYSIN`, `COMMENT`, ...) are skipped, as are `#` comment
 //!   and blank lines between records and sections.
 //!
@@ -164,9 +165,7 @@ impl FrameWalk for Mol2 {
             // Any other line belongs to a section not read.
         }
         if let Some(f) = frame {
-            bonds.sort_unstable();
-            bonds.dedup();
-            f.bonds = bonds;
+            crate::frame::set_ordered_bonds(f, bonds);
         }
         Ok(true)
     }
@@ -277,7 +276,7 @@ impl Mol2 {
         lines: &mut LineReader<R>,
         ctx: &Ctx,
         n: usize,
-    ) -> Result<Vec<[u32; 2]>, Error> {
+    ) -> Result<Vec<([u32; 2], u8)>, Error> {
         let mut bonds = Vec::with_capacity(n.min(ctx.reserve));
         let atom = |f: &[u8]| {
             let id = parse_i64(f)?;
@@ -286,7 +285,7 @@ impl Mol2 {
         };
         for i in 0..n {
             let (pos, line) = need(lines, ctx, || format!("{} more bond lines", n - i))?;
-            let w: Vec<&[u8]> = fields(line).take(3).collect();
+            let w: Vec<&[u8]> = fields(line).take(4).collect();
             let what = "bond_id and two atom ids of this molecule";
             let (Some(a), Some(b)) = (
                 w.get(1).and_then(|f| atom(f)),
@@ -297,7 +296,15 @@ impl Mol2 {
             if a == b {
                 return Err(ctx.parse(pos, line, line, what));
             }
-            bonds.push([a.min(b), a.max(b)]);
+            // The SYBYL bond type: 1, 2, 3, ar(omatic), am(ide: drawn single), du, un, nc.
+            let order = match w.get(3).map(|t| t.to_ascii_lowercase()) {
+                Some(t) if t == b"1" || t == b"am" => 1,
+                Some(t) if t == b"2" => 2,
+                Some(t) if t == b"3" => 3,
+                Some(t) if t == b"ar" => crate::frame::BOND_AROMATIC,
+                _ => 0,
+            };
+            bonds.push(([a.min(b), a.max(b)], order));
         }
         Ok(bonds)
     }

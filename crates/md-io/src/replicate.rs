@@ -150,8 +150,23 @@ pub fn replicate(
         out
     };
     *bonds = images_of(bonds);
-    // The frame's own bonds (SDF, MOL2) follow the copies the same way.
+    // The frame's own bonds (SDF, MOL2) follow the copies the same way, each copy with its
+    // original's order.
     let frame_bonds = images_of(&frame.bonds);
+    if !frame.bond_orders.is_empty() && frame.bond_orders.len() == frame.bonds.len() {
+        let original = |i: u32| i % atoms as u32;
+        frame.bond_orders = frame_bonds
+            .iter()
+            .map(|&[i, j]| {
+                let (a, b) = (original(i), original(j));
+                let pair = [a.min(b), a.max(b)];
+                frame
+                    .bonds
+                    .binary_search(&pair)
+                    .map_or(0, |k| frame.bond_orders[k])
+            })
+            .collect();
+    }
     frame.bonds = frame_bonds;
 
     // Positions by image; every other per-atom column copied.

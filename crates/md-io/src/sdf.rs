@@ -9,16 +9,17 @@
 //! to a `$$$$` line. Both connection-table versions are read:
 //! - **V2000** (the counts line's `V2000`, or no version): atom and bond counts in columns 1-3
 //!   and 4-6; atom lines with x, y, z in columns 1-10, 11-20, 21-30 (Å) and the element symbol
-//!   in columns 32-34; bond lines with the two atom numbers in columns 1-3 and 4-6.
+//!   in columns 32-34; bond lines with the two atom numbers in columns 1-3 and 4-6 and the bond
+//!   type in columns 7-9.
 //! - **V3000** (`V3000` in the counts line; RDKit writes it past 999 atoms): `M  V30` lines,
 //!   a `-` at a line's end continuing it on the next; `COUNTS na nb`, the `ATOM` block
 //!   (`index type x y z ...`) and the `BOND` block (`index order atom atom ...`), bonds naming
 //!   atoms by their index; other blocks (`SGROUP`, `COLLECTION`) are skipped.
 //!
 //! Each atom's name is its element symbol (molfiles have no atom names; PyMOL names them so
-//! too), its id its number in the file. Bonds go to [`Frame::bonds`] (sorted, each once),
-//! whatever their order: bond orders, charges (`M  CHG`), isotopes and the data items are not
-//! kept. A symbol that is no element (`R#`, `*`, `A`, a list) is an unknown element.
+//! too), its id its number in the file. Bonds go to [`Frame::bonds`] (sorted, each once) with
+//! their types in [`Frame::bond_orders`] (1-3, 4 aromatic, a query type 0); charges
+//! (`M  CHG`), isotopes and the data items are not kept. A symbol that is no element (`R#`, `*`, `A`, a list) is an unknown element.
 //!
 //! # Damage
 //! Errors name the file, frame, line and byte: a counts line without two counts, an atom line
@@ -160,23 +161,29 @@ impl FrameWalk for Sdf {
             }
         }
         if let Some(f) = frame {
-            let mut bonds = bonds;
-            bonds.sort_unstable();
-            bonds.dedup();
-            f.bonds = bonds;
+            crate::frame::set_ordered_bonds(f, bonds);
         }
         Ok(true)
     }
 }
 
-/// The V2000 atom and bond blocks; the bonds (0-based pairs).
+/// An MDL bond type as a [`Frame::bond_orders`] value: 1-3 as they are, 4 aromatic, query
+/// types (5-8) and anything else 0.
+fn mdl_order(t: &[u8]) -> u8 {
+    match parse_usize(trim(t)) {
+        Some(o @ 1..=4) => o as u8,
+        _ => 0,
+    }
+}
+
+/// The V2000 atom and bond blocks; the bonds (0-based pairs) with their orders.
 fn v2000_table<R: Read>(
     lines: &mut LineReader<R>,
     ctx: &Ctx,
     mut frame: Option<&mut Frame>,
     n_atoms: usize,
     n_bonds: usize,
-) -> Result<Vec<[u32; 2]>, Error> {
+) -> Result<Vec<([u32; 2], u8)>, Error> {
     if let Some(f) = frame.as_deref_mut() {
         f.positions.reserve(n_atoms.min(ctx.reserve));
     }
@@ -206,9 +213,8 @@ fn v2000_table<R: Read>(
             (Some(a), Some(b)) if a >= 1 && b >= 1 => (a - 1, b - 1),
             _ => return Err(ctx.parse(pos, line, span(line, 0, 6), what)),
         };
-        bonds.push(bond(a, b, n_atoms, || {
-            ctx.parse(pos, line, span(line, 0, 6), what)
-        })?);
+        let pair = bond(a, b, n_atoms, || ctx.parse(pos, line, span(line, 0, 6), what))?;
+        bonds.push((pair, mdl_order(span(line, 6, 9))));
     }
     Ok(bonds)
 }
@@ -237,12 +243,13 @@ fn v30_line<R: Read>(
     Ok(first)
 }
 
-/// The V3000 connection table up to `M  V30 END CTAB`; the bonds (0-based pairs).
+/// The V3000 connection table up to `M  V30 END CTAB`; the bonds (0-based pairs) with their
+/// orders.
 fn v3000_table<R: Read>(
     lines: &mut LineReader<R>,
     ctx: &Ctx,
     mut frame: Option<&mut Frame>,
-) -> Result<Vec<[u32; 2]>, Error> {
+) -> Result<Vec<([u32; 2], u8)>, Error> {
     let mut text = Vec::new();
     // Errors point at the logical line's start: a joined line is no slice of the file.
     let at = |pos: Pos, text: &[u8], expected: &'static str| ctx.parse(pos, text, text, expected);
@@ -326,7 +333,8 @@ fn v3000_table<R: Read>(
                     ) else {
                         return Err(at(pos, &text, what));
                     };
-                    bonds.push(bond(a, b, n, || at(pos, &text, what))?);
+                    let pair = bond(a, b, n, || at(pos, &text, what))?;
+                    bonds.push((pair, w.get(1).map_or(0, |t| mdl_order(t))));
                 }
                 v30_end(lines, ctx, &mut text, b"BOND")?;
             }

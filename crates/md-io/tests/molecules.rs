@@ -7,7 +7,7 @@
 use std::path::{Path, PathBuf};
 
 use serde_json::Value;
-use texmap_md_io::{Error, Format, Frame, Trajectory};
+use texmap_md_io::{BOND_AROMATIC, Error, Format, Frame, Trajectory};
 
 fn data(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -217,4 +217,37 @@ fn damaged_records_are_errors_naming_the_line() {
             .to_string()
             .contains("two atom ids of this molecule")
     );
+}
+
+/// Bond orders: every record's bonds with their orders as RDKit reads the SD files and the
+/// V3000 molfile (the file's Kekulé single and double bonds) and as MDAnalysis reads the MOL2
+/// files (aromatic `ar` bonds as [`BOND_AROMATIC`]) (molecules/gen_bond_orders.py).
+#[test]
+fn bond_orders_read_as_rdkit_and_mdanalysis_read_them() {
+    let text = std::fs::read_to_string(data("bond_orders_reference.json")).unwrap();
+    let reference: Value = serde_json::from_str(&text).unwrap();
+    let mut aromatic = 0;
+    for (name, records) in reference.as_object().unwrap() {
+        let got = frames(name);
+        let records = records.as_array().unwrap();
+        assert_eq!(got.len(), records.len(), "{name}");
+        for (k, (f, want)) in got.iter().zip(records).enumerate() {
+            assert_eq!(f.bond_orders.len(), f.bonds.len(), "{name} record {k}");
+            let ours: Vec<[u64; 3]> = f
+                .bonds
+                .iter()
+                .zip(&f.bond_orders)
+                .map(|(b, o)| [b[0] as u64, b[1] as u64, *o as u64])
+                .collect();
+            let theirs: Vec<[u64; 3]> = want
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|b| [0, 1, 2].map(|c| b[c].as_u64().unwrap()))
+                .collect();
+            assert_eq!(ours, theirs, "{name} record {k}");
+            aromatic += f.bond_orders.iter().filter(|o| **o == BOND_AROMATIC).count();
+        }
+    }
+    assert!(aromatic > 100, "{aromatic} aromatic bonds");
 }

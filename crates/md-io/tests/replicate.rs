@@ -148,3 +148,20 @@ fn a_three_by_three_block_is_centred_on_the_original() {
     assert_eq!(frame.cell.unwrap().origin(), [-10.0, 0.0, -10.0]);
     assert_eq!(frame.cell.unwrap().lengths(), [30.0, 10.0, 30.0]);
 }
+
+/// A frame's own bonds keep their orders in every copy: the water file's bonds given orders
+/// by their first atom's parity, replicated 2x3x2, each copy's order is its original's.
+#[test]
+fn bond_orders_follow_the_copies() {
+    let (mut frame, mut bonds) = water();
+    frame.bonds = bonds.clone();
+    frame.bond_orders = frame.bonds.iter().map(|b| 1 + (b[0] % 2) as u8).collect();
+    let atoms = frame.n_atoms() as u32;
+    replicate(&mut frame, &mut bonds, [2, 3, 2]).unwrap();
+    assert_eq!(frame.check(), Ok(()));
+    assert_eq!(frame.bonds.len(), 12 * 120);
+    for (b, o) in frame.bonds.iter().zip(&frame.bond_orders) {
+        let (i, j) = (b[0] % atoms, b[1] % atoms);
+        assert_eq!(*o, 1 + (i.min(j) % 2) as u8, "{b:?}");
+    }
+}

@@ -47,6 +47,15 @@
 //!    way to their arrows ([`MolPlan::arrows_mesh`], [`crate::arrows`]), the vectors taken
 //!    after the alignment (displacements from the first frame built, as it was then).
 //!
+//! # Bond orders
+//! With [`MolOptions::bond_orders`], the ball-and-stick and licorice styles draw the orders a
+//! file gives its bonds ([`Frame::bond_orders`]) as PyMOL's valence mode does: a double bond
+//! as two sticks of [`VALENCE_RADIUS`] times the style's bond radius, [`VALENCE_OFFSET`] bond
+//! radii either side of the bond, a triple as three thinner ones, an aromatic bond as a thin
+//! stick with a dashed line beside it; the second line lies toward a third atom bonded to one
+//! end (an aromatic neighbour first, so a ring's dashes lie inside it). Each stick ends in
+//! spheres of its radius at the atoms' centres, hidden inside the atoms.
+//!
 //! # Measurements
 //! [`MolOptions::measures`] are measured in every frame as it is drawn (after the periodic
 //! treatment, the images and the alignment; [`crate::measure`]) and drawn as
@@ -93,7 +102,9 @@ use texmap_impostor::SphereScene;
 use texmap_md_io::coordination::CoordinationError;
 use texmap_md_io::hbonds::{self, Criteria, HBond, HBondError};
 use texmap_md_io::replicate::ReplicateError;
-use texmap_md_io::{Frame, Property, Selection, SelectionError, Topology, atom_element};
+use texmap_md_io::{
+    BOND_AROMATIC, Frame, Property, Selection, SelectionError, Topology, atom_element,
+};
 
 use crate::arrows::{ArrowError, ArrowOptions, ArrowSource};
 use crate::measure::{
@@ -104,6 +115,10 @@ use crate::{ColorBy, SceneBuilder};
 
 /// Ball-and-stick atoms are this fraction of their Bondi (van der Waals) radii.
 pub const BALL_AND_STICK_RADIUS_SCALE: f32 = 0.3;
+/// The sticks of a double bond ([`MolOptions::bond_orders`]): each of this fraction of the
+/// style's bond radius, their axes this many bond radii from the bond's.
+pub const VALENCE_RADIUS: f32 = 0.5;
+pub const VALENCE_OFFSET: f32 = 1.2;
 /// Radius (Å) of the spheres and sticks of [`DrawStyle::Trails`].
 pub const TRAIL_RADIUS: f32 = 0.1;
 /// Radius (Å) of the dashes of [`DrawStyle::HBonds`] (ChimeraX draws its hydrogen bonds at
@@ -239,6 +254,9 @@ pub struct MolOptions {
     /// Distances, angles and dihedrals drawn as dashes in every frame ([`crate::measure`]);
     /// their values are [`MolPlan::last_measurements`].
     pub measures: Vec<Measure>,
+    /// Draw the bond orders the files give ([`Frame::bond_orders`]: SDF/MOL, MOL2) in the
+    /// ball-and-stick and licorice styles, as PyMOL's valence mode (see the module docs).
+    pub bond_orders: bool,
 }
 
 /// A cut through the frame, as OVITO's Slice modifier makes it: the plane `n̂·x = distance`
@@ -341,6 +359,7 @@ impl Default for MolOptions {
             arrows: ArrowOptions::default(),
             trail_length: None,
             measures: Vec::new(),
+            bond_orders: false,
         }
     }
 }
@@ -1451,6 +1470,11 @@ impl MolPlan {
             return Ok(());
         }
         if rep.draw != DrawStyle::Spacefill && self.options.bonds != BondSource::None {
+            let valence = self.options.bond_orders
+                && matches!(rep.draw, DrawStyle::BallStick | DrawStyle::Licorice)
+                && !frame.bond_orders.is_empty()
+                && frame.bond_orders.len() == frame.bonds.len();
+            let mut multiple = Vec::new();
             for b in &self.pairs {
                 let (i, j) = if self.map.is_empty() {
                     (b[0], b[1])
@@ -1458,14 +1482,96 @@ impl MolPlan {
                     (self.map[b[0] as usize], self.map[b[1] as usize])
                 };
                 if i != u32::MAX && j != u32::MAX {
-                    scene.bonds.push([i, j]);
+                    let order = match valence {
+                        true => frame
+                            .bonds
+                            .binary_search(b)
+                            .map_or(1, |k| frame.bond_orders[k]),
+                        false => 1,
+                    };
+                    if matches!(order, 2 | 3 | BOND_AROMATIC) {
+                        multiple.push((*b, [i, j], order));
+                    } else {
+                        scene.bonds.push([i, j]);
+                    }
                 }
+            }
+            if !multiple.is_empty() {
+                self.push_multiple_bonds(frame, scene, &multiple);
             }
         }
         for trace in &traces {
             push_tube(scene, trace);
         }
         Ok(())
+    }
+
+    /// Double, triple and aromatic bonds (`(frame pair, scene pair, order)`) drawn as PyMOL's
+    /// valence mode draws them (see the module docs), every bond of `scene` then with its
+    /// radius listed.
+    fn push_multiple_bonds(
+        &self,
+        frame: &Frame,
+        scene: &mut SphereScene,
+        bonds: &[([u32; 2], [u32; 2], u8)],
+    ) {
+        let r = scene.bond_radius;
+        if scene.bond_radii.len() != scene.bonds.len() {
+            scene.bond_radii = vec![r; scene.bonds.len()];
+        }
+        let mut neighbours: Vec<Vec<(u32, u8)>> = vec![Vec::new(); frame.n_atoms()];
+        for (k, &[i, j]) in frame.bonds.iter().enumerate() {
+            let o = frame.bond_orders[k];
+            neighbours[i as usize].push((j, o));
+            neighbours[j as usize].push((i, o));
+        }
+        for &(pair, [i, j], order) in bonds {
+            let side = valence_side(frame, &neighbours, pair);
+            let (pi, pj) = (scene.centers[i as usize], scene.centers[j as usize]);
+            let (ki, kj) = (scene.kinds[i as usize], scene.kinds[j as usize]);
+            let mut stick = |offset: glam::Vec3, radius: f32| {
+                let first = scene.centers.len() as u32;
+                scene.push(pi + offset, radius, ki);
+                scene.push(pj + offset, radius, kj);
+                scene.bonds.push([first, first + 1]);
+                scene.bond_radii.push(radius);
+            };
+            match order {
+                2 => {
+                    for s in [-1.0, 1.0] {
+                        stick(side * (s * VALENCE_OFFSET * r), VALENCE_RADIUS * r);
+                    }
+                }
+                3 => {
+                    for s in [-1.0, 0.0, 1.0] {
+                        stick(
+                            side * (s * 1.6 * VALENCE_OFFSET * r),
+                            0.75 * VALENCE_RADIUS * r,
+                        );
+                    }
+                }
+                _ => {
+                    // Aromatic: the bond itself, thinner, and a dashed line on the ring's side.
+                    stick(glam::Vec3::ZERO, VALENCE_RADIUS * r);
+                    let off = side * (2.0 * VALENCE_OFFSET * r);
+                    let (a, b) = (pi + off, pj + off);
+                    let shorten = (b - a) * 0.15;
+                    let before = scene.bonds.len();
+                    push_dash_line(
+                        scene,
+                        a + shorten,
+                        b - shorten,
+                        ki,
+                        0.5 * VALENCE_RADIUS * r,
+                        3,
+                    );
+                    let added = scene.bonds.len() - before;
+                    scene
+                        .bond_radii
+                        .extend(std::iter::repeat_n(0.5 * VALENCE_RADIUS * r, added));
+                }
+            }
+        }
     }
 
     /// Whether `frame`'s atoms have nothing to be told apart by (no names, types or known
@@ -1572,6 +1678,32 @@ fn push_dash_line(
         scene.push(b, r, kind);
         scene.bonds.push([first, first + 1]);
     }
+}
+
+/// Where the second line of a double or aromatic bond `a`–`b` lies: across the bond, toward a
+/// third atom bonded to `a` (else to `b`), preferring one bonded aromatically (so an aromatic
+/// ring's dashes lie inside it); any direction across the bond without one.
+fn valence_side(frame: &Frame, neighbours: &[Vec<(u32, u8)>], [a, b]: [u32; 2]) -> glam::Vec3 {
+    let p = |i: u32| glam::Vec3::from(frame.positions[i as usize]);
+    let axis = (p(b) - p(a)).normalize_or_zero();
+    let across = |from: u32, to: u32| {
+        let d = p(to) - p(from);
+        (d - axis * d.dot(axis)).normalize_or_zero()
+    };
+    for (from, other) in [(a, b), (b, a)] {
+        let list = &neighbours[from as usize];
+        let pick = list
+            .iter()
+            .filter(|(n, _)| *n != other)
+            .max_by_key(|(n, o)| (*o == BOND_AROMATIC, std::cmp::Reverse(*n)));
+        if let Some(&(n, _)) = pick {
+            let v = across(from, n);
+            if v != glam::Vec3::ZERO {
+                return v;
+            }
+        }
+    }
+    axis.any_orthonormal_vector()
 }
 
 fn push_tube(scene: &mut SphereScene, trace: &[TracePoint]) {
