@@ -149,6 +149,7 @@ fn bench_streamed(c: &mut Criterion) {
         chunk: 65,
         map_texels: 256,
         max_texture_levels: 4,
+        ..Default::default()
     };
     db::build(&grid, "bench", Some(&photo), &opts, &out, |_, _| {}).unwrap();
     let db = Database::open(&out).unwrap();

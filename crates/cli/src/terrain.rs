@@ -42,6 +42,14 @@ pub enum TerrainCmd {
         /// bounds only the build's time and the disk.
         #[arg(long, default_value_t = 8)]
         texture_levels: u32,
+        /// Draw contour lines every M metres of height into the texture, as topographic maps
+        /// (every fifth an index line twice as wide); without --photo the texture is then the
+        /// shaded relief with the lines.
+        #[arg(long, value_name = "M")]
+        contours: Option<f64>,
+        /// The contour lines' width in texels of the finest texture level.
+        #[arg(long, value_name = "TEXELS", default_value_t = 1.5)]
+        contour_width: f32,
         /// Read a PNG as Mapbox Terrain-RGB.
         #[arg(long)]
         terrain_rgb: bool,
@@ -137,6 +145,8 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
             chunk,
             terrain_rgb,
             texture_levels,
+            contours,
+            contour_width,
             scale,
             offset,
             cell,
@@ -198,6 +208,21 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
                     "--texture-levels {texture_levels}: expected 1..=12"
                 ));
             }
+            let contours = match contours {
+                None => None,
+                Some(m) if m.is_finite() && m > 0.0 => {
+                    if !(contour_width.is_finite() && (0.25..=16.0).contains(&contour_width)) {
+                        return usage(format!(
+                            "--contour-width {contour_width}: expected 0.25 to 16 texels"
+                        ));
+                    }
+                    Some(texmap_terrain::relief::Contours {
+                        width: contour_width,
+                        ..texmap_terrain::relief::Contours::every(m)
+                    })
+                }
+                Some(m) => return usage(format!("--contours {m}: expected metres > 0")),
+            };
             let photo = photo
                 .map(|p| texmap_terrain::photo::open_photo(&p, bands))
                 .transpose()?;
@@ -206,6 +231,7 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
                 max_error,
                 chunk,
                 max_texture_levels: texture_levels,
+                contours,
                 ..BuildOptions::default()
             };
             let m = db::build_with(

@@ -716,3 +716,71 @@ fn export_quantized_mesh_and_its_usage_errors() {
         assert_eq!(texmap(&args).status.code(), Some(2), "{bad:?}");
     }
 }
+
+/// `--contours`: a database built without a photo gets the shaded relief with contour lines as
+/// its texture (brown texels where the heights cross the 50 m levels, as the library's rule
+/// gives them), the flight view draws it, and a bad interval or width is a usage error.
+#[test]
+fn contours_drape_the_relief_and_bad_intervals_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let db = dir.path().join("lined.db");
+    let build = |extra: &[&str], out: &Path| {
+        let mut args = vec![
+            "terrain",
+            "build",
+            "--dem",
+            data_hillshade(),
+            "--max-error",
+            "2",
+            "--chunk",
+            "33",
+            "--texture-levels",
+            "2",
+            "--out",
+            out.to_str().unwrap(),
+            "-q",
+        ];
+        args.extend(extra);
+        texmap(&args)
+    };
+    ok(&build(&["--contours", "50"], &db));
+    let manifest: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(db.join("manifest.json")).unwrap()).unwrap();
+    assert_eq!(manifest["texture"]["placed_by"], "stretched");
+    let finest = manifest["texture"]["levels"].as_u64().unwrap() - 1;
+    let tile = image::open(db.join(format!("tiles/{finest}/0_0.png")))
+        .unwrap()
+        .to_rgba8();
+    let brown = tile
+        .pixels()
+        .filter(|p| p.0[..3] == texmap_terrain::relief::CONTOUR_COLOUR)
+        .count();
+    assert!(brown > 50, "{brown} texels on a line");
+    let png = dir.path().join("view.png");
+    ok(&texmap(&[
+        "terrain",
+        "render",
+        db.to_str().unwrap(),
+        "--size",
+        "320x240",
+        "-o",
+        png.to_str().unwrap(),
+        "-q",
+    ]));
+    assert!(png.exists());
+    for bad in [["--contours", "0"], ["--contours", "-5"]] {
+        let o = build(&bad, &dir.path().join("bad.db"));
+        assert_eq!(o.status.code(), Some(2), "{bad:?}");
+    }
+    let o = build(
+        &["--contours", "50", "--contour-width", "100"],
+        &dir.path().join("bad.db"),
+    );
+    assert_eq!(o.status.code(), Some(2));
+    assert!(!dir.path().join("bad.db").exists());
+}
+
+fn data_hillshade() -> &'static str {
+    static PATH: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    PATH.get_or_init(|| data("hillshade_dem_utm.tif"))
+}

@@ -78,6 +78,9 @@ pub struct BuildOptions {
     pub map_texels: u32,
     /// Cap on GST levels (the finest is `map_texels · 2^(levels−1)` a side).
     pub max_texture_levels: u32,
+    /// Contour lines drawn into the texture ([`crate::relief::Contours`]); without a photo the
+    /// texture is then the shaded relief (up to 4096² texels), with the lines.
+    pub contours: Option<crate::relief::Contours>,
 }
 
 impl Default for BuildOptions {
@@ -87,6 +90,7 @@ impl Default for BuildOptions {
             chunk: 257,
             map_texels: 256,
             max_texture_levels: 5,
+            contours: None,
         }
     }
 }
@@ -293,6 +297,16 @@ fn build_into(
     progress: &mut impl FnMut(u64, u64),
 ) -> Result<Manifest, TerrainError> {
     std::fs::create_dir_all(dir).map_err(io(dir))?;
+    // Contours without a photo: drawn over the shaded relief, which becomes the texture.
+    let relief = match (photo, &opts.contours) {
+        (None, Some(_)) => Some(gst::Orthophoto {
+            image: crate::relief::relief_image(grid, 4096),
+            georef: None,
+            source: "shaded relief".into(),
+        }),
+        _ => None,
+    };
+    let photo = photo.or(relief.as_ref().map(|r| r as &dyn PhotoSource));
     let tex_levels = match photo {
         Some(p) => gst::photo_level_count(p, grid, opts.map_texels, opts.max_texture_levels)?,
         None => 0,
@@ -361,11 +375,12 @@ fn build_into(
                     .to_rgba8())
             };
             let mut done = 0;
-            gst::write_pyramid(
+            gst::write_pyramid_with(
                 p,
                 grid,
                 opts.map_texels,
                 tex_levels,
+                opts.contours.as_ref(),
                 &write,
                 &read,
                 &mut |_| {

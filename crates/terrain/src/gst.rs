@@ -464,6 +464,22 @@ pub fn write_pyramid(
     read: &(dyn Fn(MapKey) -> Result<RgbaImage, TerrainError> + Sync),
     progress: &mut dyn FnMut(u32),
 ) -> Result<(), TerrainError> {
+    write_pyramid_with(photo, grid, map_texels, levels, None, write, read, progress)
+}
+
+/// [`write_pyramid`] with contour lines drawn into the finest level's texels
+/// ([`crate::relief::Contours`]); the coarser levels average them down like the photo.
+#[allow(clippy::too_many_arguments)]
+pub fn write_pyramid_with(
+    photo: &dyn PhotoSource,
+    grid: &Grid,
+    map_texels: u32,
+    levels: u32,
+    contours: Option<&crate::relief::Contours>,
+    write: &(dyn Fn(MapKey, &RgbaImage) -> Result<(), TerrainError> + Sync),
+    read: &(dyn Fn(MapKey) -> Result<RgbaImage, TerrainError> + Sync),
+    progress: &mut dyn FnMut(u32),
+) -> Result<(), TerrainError> {
     use rayon::prelude::*;
     let t = map_texels;
     if levels == 0 || t < 2 || !t.is_power_of_two() {
@@ -486,12 +502,26 @@ pub fn write_pyramid(
         };
         let r0 = rows.map_or(0, |r| r.0);
         (0..n).into_par_iter().try_for_each(|x| {
+            // Grid samples per texel (the texture spans sample 0 to the last).
+            let per_texel = [
+                (grid.width() - 1) as f64 / (size - 1).max(1) as f64,
+                (grid.height() - 1) as f64 / (size - 1).max(1) as f64,
+            ];
             let map = RgbaImage::from_fn(t, t, |i, j| {
+                let (gx, gy) = (x * t + i, y * t + j);
                 // `rows_for` covers every row a texel on the photo reads.
-                p.texel(size, x * t + i, y * t + j, |a, b| {
+                let px = p.texel(size, gx, gy, |a, b| {
                     band.get_pixel_checked(a, b.wrapping_sub(r0))
                         .map_or([0; 4], |px| px.0)
-                })
+                });
+                match contours {
+                    None => px,
+                    Some(c) => {
+                        let (col, row) = (gx as f64 * per_texel[0], gy as f64 * per_texel[1]);
+                        let cover = c.coverage(grid, col, row, per_texel);
+                        Rgba(crate::relief::Contours::blend(px.0, cover))
+                    }
+                }
             });
             write(
                 MapKey {

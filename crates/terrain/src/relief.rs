@@ -15,6 +15,91 @@
 
 use crate::dem::Grid;
 
+/// Contour lines drawn into a terrain's texture, as topographic maps draw them: a line at every
+/// multiple of `interval` metres of height, every `index_every`-th (an index contour) twice as
+/// wide, in [`CONTOUR_COLOUR`].
+///
+/// Each texel is covered by how near its centre lies to a contour level: the height and its
+/// gradient come from the grid bilinearly at the texel's place, the distance to the nearest
+/// level is the height difference over the gradient per texel (the first-order distance in
+/// texels, as for an isoline drawn by its signed distance), and the coverage falls linearly from
+/// 1 to 0 across the line's edge, one texel wide, so lines are anti-aliased at any zoom. A texel
+/// by no-data draws no line; flat ground (gradient under 10⁻⁹ m a texel) draws none unless it
+/// lies exactly on a level.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Contours {
+    /// Height between two lines, metres (> 0).
+    pub interval: f64,
+    /// Line width in texels of the finest texture level.
+    pub width: f32,
+    /// Every how many lines an index contour (0: none).
+    pub index_every: u32,
+}
+
+/// The contour lines' colour (sRGB): the brown of topographic maps.
+pub const CONTOUR_COLOUR: [u8; 3] = [130, 75, 35];
+
+impl Contours {
+    /// Lines every `interval` metres, 1.5 texels wide, every fifth an index contour.
+    pub fn every(interval: f64) -> Contours {
+        Contours {
+            interval,
+            width: 1.5,
+            index_every: 5,
+        }
+    }
+
+    /// The coverage (0..=1) of the texel centred at grid coordinates `(col, row)` (fractional
+    /// sample indices), the texture holding `per_texel` samples per texel along x and y.
+    pub fn coverage(&self, grid: &Grid, col: f64, row: f64, per_texel: [f64; 2]) -> f32 {
+        let (w, h) = (grid.width(), grid.height());
+        if w < 2 || h < 2 || self.interval.is_nan() || self.interval <= 0.0 {
+            return 0.0;
+        }
+        let c0 = (col.floor().max(0.0) as u32).min(w - 2);
+        let r0 = (row.floor().max(0.0) as u32).min(h - 2);
+        let (fx, fy) = (col - c0 as f64, row - r0 as f64);
+        let z = |c: u32, r: u32| grid.at(c, r) as f64;
+        let (z00, z10, z01, z11) = (z(c0, r0), z(c0 + 1, r0), z(c0, r0 + 1), z(c0 + 1, r0 + 1));
+        if [z00, z10, z01, z11].iter().any(|v| v.is_nan()) {
+            return 0.0;
+        }
+        let height = z00 * (1.0 - fx) * (1.0 - fy)
+            + z10 * fx * (1.0 - fy)
+            + z01 * (1.0 - fx) * fy
+            + z11 * fx * fy;
+        let dcol = (z10 - z00) * (1.0 - fy) + (z11 - z01) * fy;
+        let drow = (z01 - z00) * (1.0 - fx) + (z11 - z10) * fx;
+        let (gx, gy) = (dcol * per_texel[0], drow * per_texel[1]);
+        let level = (height / self.interval).round();
+        let off = (height - level * self.interval).abs();
+        let slope = (gx * gx + gy * gy).sqrt();
+        let distance = if slope < 1e-9 {
+            if off == 0.0 { 0.0 } else { f64::INFINITY }
+        } else {
+            off / slope
+        };
+        let index = self.index_every > 0 && (level as i64).rem_euclid(self.index_every as i64) == 0;
+        let width = self.width as f64 * if index { 2.0 } else { 1.0 };
+        (width / 2.0 + 0.5 - distance).clamp(0.0, 1.0) as f32
+    }
+
+    /// `px` with the line laid over it at `coverage` (in sRGB, as maps are drawn); a transparent
+    /// texel becomes as opaque as the line covers it.
+    pub fn blend(px: [u8; 4], coverage: f32) -> [u8; 4] {
+        if coverage <= 0.0 {
+            return px;
+        }
+        let mix = |a: u8, b: u8| (a as f32 + (b as f32 - a as f32) * coverage).round() as u8;
+        [
+            mix(px[0], CONTOUR_COLOUR[0]),
+            mix(px[1], CONTOUR_COLOUR[1]),
+            mix(px[2], CONTOUR_COLOUR[2]),
+            px[3].max((coverage * 255.0).round() as u8),
+        ]
+    }
+}
+
 /// A distant light: `azimuth_deg` clockwise from north, `altitude_deg` above the horizon.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Light {
@@ -184,6 +269,48 @@ mod tests {
 
     /// On a plane the shade is the analytic cosine, at every sample (edges included: the
     /// one-sided gradient of a plane is its gradient).
+    /// A plane rising 1 m per sample east: the lines every 10 m lie on the columns of height
+    /// 10k, fully covered there, half covered 0.75 texels off (1.5 texels wide), twice as wide
+    /// every fifth line; none through no-data.
+    #[test]
+    fn contour_coverage_on_a_plane_is_its_distance_to_the_level() {
+        let grid = plane(1.0, 0.0, 10.0); // 500 + col
+        let c = Contours::every(10.0);
+        let at = |col: f64| c.coverage(&grid, col, 4.0, [1.0, 1.0]);
+        // 500 is level 50, an index line 3 texels wide: covered 1 texel off, not 2 off.
+        assert_eq!(at(0.0), 1.0);
+        assert_eq!(at(1.0), 1.0);
+        assert_eq!(at(2.0), 0.0);
+        let c = Contours {
+            interval: 7.0,
+            width: 1.5,
+            index_every: 0,
+        };
+        // 504 is 7 · 72: column 4; 0.75 texels off, half covered; 2 off, none.
+        let at = |col: f64, per: f64| c.coverage(&grid, col, 4.0, [per, per]);
+        assert_eq!(at(4.0, 1.0), 1.0);
+        assert!((at(4.75, 1.0) - 0.5).abs() < 1e-6, "{}", at(4.75, 1.0));
+        assert_eq!(at(6.0, 1.0), 0.0);
+        // Four texels a sample: 0.75 samples off is 3 texels off.
+        assert_eq!(at(4.75, 0.25), 0.0);
+        assert!((at(4.1875, 0.25) - 0.5).abs() < 1e-6);
+        // Index lines are twice as wide: 1.5 texels off, half covered.
+        let c = Contours {
+            interval: 7.0,
+            width: 1.5,
+            index_every: 72,
+        };
+        assert!((c.coverage(&grid, 5.5, 4.0, [1.0, 1.0]) - 0.5).abs() < 1e-6);
+        // No line through a no-data sample; blending keeps a texel the line misses.
+        let mut h: Vec<f32> = grid.heights().to_vec();
+        h[4 * 9 + 4] = f32::NAN;
+        let holed = Grid::new("holed", 9, 9, h, Georef::local(10.0)).unwrap();
+        assert_eq!(c.coverage(&holed, 4.0, 4.0, [1.0, 1.0]), 0.0);
+        assert_eq!(Contours::blend([9, 8, 7, 255], 0.0), [9, 8, 7, 255]);
+        let full = Contours::blend([9, 8, 7, 0], 1.0);
+        assert_eq!(full, [CONTOUR_COLOUR[0], CONTOUR_COLOUR[1], CONTOUR_COLOUR[2], 255]);
+    }
+
     #[test]
     fn plane_shade_is_the_analytic_cosine() {
         // Heights rise 3 m per column east and 4 m per row south, 10 m cells: slope

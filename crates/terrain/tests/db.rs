@@ -22,6 +22,7 @@ fn build_reopen_export_glb() {
         chunk: 17,
         map_texels: 16,
         max_texture_levels: 3,
+        ..Default::default()
     };
     let mut calls = 0;
     let m = db::build(&grid, "ramp", Some(&photo), &opts, &out, |_, _| calls += 1).unwrap();
@@ -103,8 +104,65 @@ fn a_failed_build_leaves_nothing_behind() {
         chunk: 17,
         map_texels: 16,
         max_texture_levels: 2,
+        ..Default::default()
     };
     let e = db::build(&grid, "geo", Some(&photo), &opts, &out, |_, _| {}).unwrap_err();
     assert!(e.to_string().contains("does not overlap"), "{e}");
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+}
+
+/// Contour lines without a photo: the database's texture is the shaded relief with brown lines
+/// where the heights cross the levels, and nowhere else. The ramp GeoTIFF rises along its
+/// rows; a line every 25 m crosses it, so the finest level's texels near a level are brown.
+#[test]
+fn contours_are_drawn_into_the_relief_texture() {
+    use texmap_terrain::relief::{CONTOUR_COLOUR, Contours};
+    let grid = read_dem(data("ramp_i16_lzw.tif"), &ReadOptions::default()).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let build = |name: &str, contours: Option<Contours>| {
+        let out = dir.path().join(name);
+        let opts = BuildOptions {
+            max_error: 0.5,
+            chunk: 17,
+            map_texels: 64,
+            max_texture_levels: 2,
+            contours,
+        };
+        let m = db::build(&grid, "ramp", None, &opts, &out, |_, _| {}).unwrap();
+        (out, m)
+    };
+    let (plain, m0) = build("plain", None);
+    assert!(m0.texture.is_none());
+    let c = Contours::every(25.0);
+    let (lined, m) = build("lined", Some(c));
+    let tex = m.texture.unwrap();
+    assert_eq!(tex.placed_by, "stretched");
+    assert!(!plain.join("tiles").exists());
+    // Every texel of the finest level: brown exactly where the coverage says so.
+    let finest = tex.levels - 1;
+    let n = 1u32 << finest;
+    let size = tex.map_texels * n;
+    let per = [
+        (grid.width() - 1) as f64 / (size - 1) as f64,
+        (grid.height() - 1) as f64 / (size - 1) as f64,
+    ];
+    let (mut lit, mut checked) = (0, 0);
+    for (x, y) in (0..n).flat_map(|x| (0..n).map(move |y| (x, y))) {
+        let map = image::open(lined.join(format!("tiles/{finest}/{x}_{y}.png")))
+            .unwrap()
+            .to_rgba8();
+        for (i, j, px) in map.enumerate_pixels() {
+            let (gx, gy) = (x * tex.map_texels + i, y * tex.map_texels + j);
+            let cover = c.coverage(&grid, gx as f64 * per[0], gy as f64 * per[1], per);
+            let brown = px.0[..3] == CONTOUR_COLOUR;
+            if cover == 1.0 {
+                assert!(brown, "texel ({gx}, {gy}) on a line: {:?}", px.0);
+                lit += 1;
+            } else if cover == 0.0 {
+                assert!(!brown, "texel ({gx}, {gy}) off the lines is brown");
+            }
+            checked += 1;
+        }
+    }
+    assert!(lit > 100 && lit < checked / 4, "{lit} of {checked} texels on a line");
 }

@@ -120,6 +120,7 @@ fn a_database_built_from_rows_equals_one_built_from_the_whole_photo() {
         chunk: 129,
         map_texels: 64,
         max_texture_levels: 8,
+        ..Default::default()
     };
     let whole = gst::read_photo(&data("relief_planar_u16.tif"), Some([1, 2, 3])).unwrap();
     let rows = open_photo(&data("relief_planar_u16.tif"), Some([1, 2, 3])).unwrap();

@@ -97,6 +97,7 @@ fn streamed_matches_whole_texture_without_seams() {
         chunk: 33,
         map_texels: 64,
         max_texture_levels: 4,
+        ..Default::default()
     };
     let (_dir, db) = build(&grid, photo, &opts);
     assert_eq!(db.manifest.texture.as_ref().unwrap().levels, 4); // finest 512²
@@ -209,6 +210,7 @@ fn streamed_stays_within_a_budget_the_whole_texture_exceeds() {
         chunk: 65,
         map_texels: 256,
         max_texture_levels: 4,
+        ..Default::default()
     };
     let (_dir, db) = build(&grid, photo, &opts);
     let whole = FlightTerrain::from_database(&db, 2048).unwrap();
@@ -271,6 +273,7 @@ fn budgets_too_small_are_errors() {
         chunk: 17,
         map_texels: 64,
         max_texture_levels: 2,
+        ..Default::default()
     };
     let (_dir, db) = build(&grid, photo, &opts);
     // Not even one map and one level-0 texture.
@@ -368,6 +371,7 @@ fn big_database() {
         chunk: 257,
         map_texels: 256,
         max_texture_levels: 8,
+        ..Default::default()
     };
     let m = db::build(
         &grid,

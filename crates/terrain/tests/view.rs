@@ -500,6 +500,7 @@ fn database_view_puts_the_photo_where_it_belongs() {
         chunk: 33,
         map_texels: 64,
         max_texture_levels: 4,
+        ..Default::default()
     };
     texmap_terrain::db::build(&grid, "flat", Some(&photo), &opts, &out, |_, _| {}).unwrap();
     let db = texmap_terrain::db::Database::open(&out).unwrap();
