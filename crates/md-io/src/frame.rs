@@ -479,7 +479,8 @@ impl Frame {
             if ordered(other) {
                 self.bond_orders.extend_from_slice(&other.bond_orders);
             } else {
-                self.bond_orders.resize(self.bonds.len() + other.bonds.len(), 0);
+                self.bond_orders
+                    .resize(self.bonds.len() + other.bonds.len(), 0);
             }
         }
         self.bonds

@@ -213,7 +213,9 @@ fn v2000_table<R: Read>(
             (Some(a), Some(b)) if a >= 1 && b >= 1 => (a - 1, b - 1),
             _ => return Err(ctx.parse(pos, line, span(line, 0, 6), what)),
         };
-        let pair = bond(a, b, n_atoms, || ctx.parse(pos, line, span(line, 0, 6), what))?;
+        let pair = bond(a, b, n_atoms, || {
+            ctx.parse(pos, line, span(line, 0, 6), what)
+        })?;
         bonds.push((pair, mdl_order(span(line, 6, 9))));
     }
     Ok(bonds)

@@ -246,7 +246,11 @@ fn bond_orders_read_as_rdkit_and_mdanalysis_read_them() {
                 .map(|b| [0, 1, 2].map(|c| b[c].as_u64().unwrap()))
                 .collect();
             assert_eq!(ours, theirs, "{name} record {k}");
-            aromatic += f.bond_orders.iter().filter(|o| **o == BOND_AROMATIC).count();
+            aromatic += f
+                .bond_orders
+                .iter()
+                .filter(|o| **o == BOND_AROMATIC)
+                .count();
         }
     }
     assert!(aromatic > 100, "{aromatic} aromatic bonds");

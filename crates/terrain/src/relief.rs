@@ -308,7 +308,10 @@ mod tests {
         assert_eq!(c.coverage(&holed, 4.0, 4.0, [1.0, 1.0]), 0.0);
         assert_eq!(Contours::blend([9, 8, 7, 255], 0.0), [9, 8, 7, 255]);
         let full = Contours::blend([9, 8, 7, 0], 1.0);
-        assert_eq!(full, [CONTOUR_COLOUR[0], CONTOUR_COLOUR[1], CONTOUR_COLOUR[2], 255]);
+        assert_eq!(
+            full,
+            [CONTOUR_COLOUR[0], CONTOUR_COLOUR[1], CONTOUR_COLOUR[2], 255]
+        );
     }
 
     #[test]

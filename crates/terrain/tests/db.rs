@@ -164,5 +164,8 @@ fn contours_are_drawn_into_the_relief_texture() {
             checked += 1;
         }
     }
-    assert!(lit > 100 && lit < checked / 4, "{lit} of {checked} texels on a line");
+    assert!(
+        lit > 100 && lit < checked / 4,
+        "{lit} of {checked} texels on a line"
+    );
 }
