@@ -818,6 +818,12 @@ pub struct MolArgs {
     /// as a stick with a dashed line inside the ring.
     #[arg(long)]
     pub bond_orders: bool,
+    /// Give every atom the property `displacement`: its distance (Å) from where it was in the
+    /// first frame drawn, to the nearest periodic image (OVITO's Displacements modifier), for
+    /// selections (--select 'prop displacement > 2') and colours (--color-by displacement
+    /// turns it on by itself).
+    #[arg(long)]
+    pub displacements: bool,
     /// Also write the --measure values as a CSV table, one row per measurement and frame:
     /// frame, measure (0-based, in the order given), kind (distance, angle, dihedral), value
     /// (Å or degrees), the atoms' 0-based indices joined by spaces, and the spec as given.

@@ -432,7 +432,7 @@ fn render(a: &RenderArgs) -> Result<()> {
     }
     let mut quality_renderer = texmap_quality::QualityRenderer::new();
     let mut builder = crate::scene::scene_builder(&a.style)?;
-    let mut plan = crate::scene::mol_plan(&a.mol)?;
+    let mut plan = crate::scene::mol_plan(&a.mol, &a.style)?;
     let surface_options = crate::scene::surface_options(&a.mol)?;
     let surface_opacity = a.mol.surface_opacity;
     let polyhedra_opacity = a.mol.polyhedra_opacity;

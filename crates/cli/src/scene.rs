@@ -456,7 +456,7 @@ pub fn surface_options(args: &MolArgs) -> Result<texmap_md_scene::surface::Surfa
 
 /// What `render` does to a frame between reading and drawing ([`MolPlan`]) for the
 /// [`MolArgs`]: the topology file read, the selections and colours parsed.
-pub fn mol_plan(args: &MolArgs) -> Result<MolPlan> {
+pub fn mol_plan(args: &MolArgs, style: &StyleArgs) -> Result<MolPlan> {
     let topology = args.topology.as_deref().map(open_topology).transpose()?;
     let optional = |flag, text: &Option<String>| {
         text.as_deref()
@@ -543,6 +543,8 @@ pub fn mol_plan(args: &MolArgs) -> Result<MolPlan> {
         },
         trail_length: args.trail_length,
         bond_orders: args.bond_orders,
+        displacement: args.displacements
+            || matches!(&style.color_by, ColorBy::Scalar(texmap_md_scene::ScalarSource::Property(p)) if p == "displacement"),
         measures: args
             .measures
             .iter()

@@ -2512,3 +2512,65 @@ fn bond_orders_are_drawn_as_the_reference_traces_them() {
     assert!(d < 1.5, "mean |raycast - reference| = {d}");
     assert!(mean_abs_diff(&valence, &single) > 1.0);
 }
+
+/// `--displacements` / `--color-by displacement`: the property is there for colours (turned on
+/// by the colouring itself) and for selections (with the flag), measured from the first frame
+/// drawn: an atom walking 1.5 Å a frame through a box face is selected from frame 2 on.
+#[test]
+fn displacements_colour_and_select() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("walk.extxyz");
+    let mut text = String::new();
+    for k in 0..4 {
+        let x = (7.0 + 1.5 * k as f64) % 10.0;
+        text += &format!(
+            "2\nLattice=\"10 0 0 0 10 0 0 0 10\" Properties=species:S:1:pos:R:3\nAr {x} 2 3\nAr 5 5 5\n"
+        );
+    }
+    std::fs::write(&input, text).unwrap();
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "render",
+            "--quiet",
+            input.to_str().unwrap(),
+            "--size",
+            "160x120",
+        ];
+        args.extend(extra);
+        let out = dir.path().join("f%d.png");
+        args.extend(["-o", out.to_str().unwrap()]);
+        texmap(&args)
+    };
+    let o = run(&["--frames", "0:4", "--color-by", "displacement", "--color-range", "0:5"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let sel = ["--frames", "2:4", "--select", "prop displacement > 2"];
+    let o = run(&sel);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("displacement"), "{}", stderr(&o));
+    // Measured from frame 0 (the first drawn), a fixed camera over the whole box.
+    let o = run(&[
+        "--frames",
+        "0:4",
+        "--displacements",
+        "--rep",
+        "prop displacement > 2=ball-stick",
+        "--rep",
+        "index 1=ball-stick",
+        "--eye",
+        "5,5,40",
+        "--target",
+        "5,5,5",
+        "--up",
+        "0,1,0",
+        "--fov",
+        "20",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let lit = |k: usize| {
+        let img = image::open(dir.path().join(format!("f{k}.png"))).unwrap().to_rgb8();
+        img.pixels().filter(|p| p.0 != [0, 0, 0]).count()
+    };
+    // Frames 0 and 1 draw atom 1 only; frames 2 and 3 both atoms.
+    assert!(lit(2) > lit(1) + 50, "{} vs {}", lit(2), lit(1));
+    assert!(lit(3) > lit(0) + 50);
+}

@@ -92,9 +92,9 @@ pub use outline::{add_box_outline, cell_corners};
 pub use palette::{MAX_MATERIALS, Palette, type_color};
 pub use plan::{
     Alignment, BALL_AND_STICK_BOND_RADIUS, BALL_AND_STICK_RADIUS_SCALE, BondSource, COORDINATION,
-    DrawStyle, HBOND_COLOR, HBOND_DASHES, HBOND_RADIUS, LICORICE_RADIUS, MolError, MolOptions,
-    MolPlan, Pbc, RepColor, Representation, SelectionRole, Slice, TRAIL_RADIUS, VALENCE_OFFSET,
-    VALENCE_RADIUS,
+    DISPLACEMENT, DrawStyle, HBOND_COLOR, HBOND_DASHES, HBOND_RADIUS, LICORICE_RADIUS, MolError,
+    MolOptions, MolPlan, Pbc, RepColor, Representation, SelectionRole, Slice, TRAIL_RADIUS,
+    VALENCE_OFFSET, VALENCE_RADIUS,
 };
 pub use scalar::{NAN_COLOR, SCALAR_LEVELS, ScalarColor, ScalarSource};
 pub use style::{

@@ -210,6 +210,8 @@ pub enum Pbc {
 
 /// The per-atom property [`MolOptions::coordination`] adds to each frame.
 pub const COORDINATION: &str = "coordination";
+/// The per-atom property [`MolOptions::displacement`] adds to each frame.
+pub const DISPLACEMENT: &str = "displacement";
 
 /// The options of a [`MolPlan`]; selections are parsed by the caller.
 #[derive(Clone, Debug)]
@@ -254,6 +256,10 @@ pub struct MolOptions {
     /// Distances, angles and dihedrals drawn as dashes in every frame ([`crate::measure`]);
     /// their values are [`MolPlan::last_measurements`].
     pub measures: Vec<Measure>,
+    /// Give every frame the per-atom property [`DISPLACEMENT`]: each atom's distance (Å) from
+    /// where it was in the first frame built, to the nearest periodic image (OVITO's
+    /// Displacements modifier with frame 0 as the reference), for colouring and selections.
+    pub displacement: bool,
     /// Draw the bond orders the files give ([`Frame::bond_orders`]: SDF/MOL, MOL2) in the
     /// ball-and-stick and licorice styles, as PyMOL's valence mode (see the module docs).
     pub bond_orders: bool,
@@ -360,6 +366,7 @@ impl Default for MolOptions {
             trail_length: None,
             measures: Vec::new(),
             bond_orders: false,
+            displacement: false,
         }
     }
 }
@@ -543,8 +550,8 @@ pub struct MolPlan {
     polyhedra: MolMesh,
     /// Whether this frame's bonds are the files' (else found by distance, or none).
     pairs_listed: bool,
-    /// [`DrawStyle::Arrows`]: the first frame's positions (for displacements), this frame's
-    /// vectors and the last frame's arrows.
+    /// The first frame's positions (for displacements: [`DrawStyle::Arrows`],
+    /// [`MolOptions::displacement`]), this frame's arrow vectors and the last frame's arrows.
     arrow_reference: Option<Vec<[f32; 3]>>,
     arrow_vectors: Vec<glam::Vec3>,
     arrows: MolMesh,
@@ -941,12 +948,27 @@ impl MolPlan {
         if self.draws_trails() {
             self.extend_trails(frame)?;
         }
+        let displaced =
+            self.draws_arrows() && self.options.arrows.source == ArrowSource::Displacement;
+        if (displaced || self.options.displacement) && self.arrow_reference.is_none() {
+            self.arrow_reference = Some(frame.positions.clone());
+        }
+        if self.options.displacement {
+            let d = crate::arrows::vectors(
+                frame,
+                &ArrowSource::Displacement,
+                self.arrow_reference.as_deref(),
+            )
+            .map_err(MolError::Arrows)?;
+            frame.properties.retain(|p| p.name != DISPLACEMENT);
+            frame.properties.push(Property {
+                name: DISPLACEMENT.to_string(),
+                values: d.iter().map(|v| v.length()).collect(),
+            });
+        }
         self.arrow_vectors.clear();
         if self.draws_arrows() {
             let source = &self.options.arrows.source;
-            if *source == ArrowSource::Displacement && self.arrow_reference.is_none() {
-                self.arrow_reference = Some(frame.positions.clone());
-            }
             self.arrow_vectors =
                 crate::arrows::vectors(frame, source, self.arrow_reference.as_deref())
                     .map_err(MolError::Arrows)?;

@@ -101,3 +101,26 @@ fn a_frame_without_the_followed_atom_is_an_error() {
         "{e}"
     );
 }
+
+/// `MolOptions::displacement`: each frame's `displacement` property is every atom's distance
+/// from the first frame built, the short way through the box, and selections can use it.
+#[test]
+fn displacements_are_a_property_selections_see() {
+    let mut p = MolPlan::new(MolOptions {
+        displacement: true,
+        select: Some(Selection::parse("prop displacement > 2").unwrap()),
+        ..MolOptions::default()
+    })
+    .unwrap();
+    let mut builder = SceneBuilder::new(&StyleOptions::default()).unwrap();
+    for k in 0..4 {
+        let mut f = frame(k, true);
+        let mut scene = SphereScene::default();
+        p.build(&mut builder, &mut f, &mut scene).unwrap();
+        let d = f.property(texmap_md_scene::DISPLACEMENT).unwrap();
+        // Atom 0 has walked 1.5 Å a frame (through the face at k = 2); atom 1 stays.
+        assert!((d[0] - 1.5 * k as f32).abs() < 1e-5, "frame {k}: {d:?}");
+        assert_eq!(d[1], 0.0);
+        assert_eq!(scene.centers.len(), usize::from(k >= 2), "frame {k}");
+    }
+}
