@@ -2541,7 +2541,14 @@ fn displacements_colour_and_select() {
         args.extend(["-o", out.to_str().unwrap()]);
         texmap(&args)
     };
-    let o = run(&["--frames", "0:4", "--color-by", "displacement", "--color-range", "0:5"]);
+    let o = run(&[
+        "--frames",
+        "0:4",
+        "--color-by",
+        "displacement",
+        "--color-range",
+        "0:5",
+    ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let sel = ["--frames", "2:4", "--select", "prop displacement > 2"];
     let o = run(&sel);
@@ -2567,7 +2574,9 @@ fn displacements_colour_and_select() {
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let lit = |k: usize| {
-        let img = image::open(dir.path().join(format!("f{k}.png"))).unwrap().to_rgb8();
+        let img = image::open(dir.path().join(format!("f{k}.png")))
+            .unwrap()
+            .to_rgb8();
         img.pixels().filter(|p| p.0 != [0, 0, 0]).count()
     };
     // Frames 0 and 1 draw atom 1 only; frames 2 and 3 both atoms.

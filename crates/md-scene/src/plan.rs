@@ -12,7 +12,8 @@
 //!    step sees the copies, so `index` counts their atoms too); with
 //!    [`MolOptions::coordination`], each atom's neighbour count as the property
 //!    [`COORDINATION`]; bonds that still cross the (enlarged) box are dropped, so no stick
-//!    spans it;
+//!    spans it; with [`MolOptions::displacement`] (after the alignment of step 3), each atom's
+//!    distance from the first frame built as the property [`DISPLACEMENT`];
 //! 3. with [`MolOptions::align`], the frame superposed on a reference: the first frame built,
 //!    or a structure given ([`Alignment::reference`]). The alignment selection is evaluated
 //!    once, at the first frame (and in the reference), and every frame's positions,
