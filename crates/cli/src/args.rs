@@ -940,6 +940,10 @@ Examples:
   texmap render 1abc.cif --rep 'not resname LIG=surface' --rep 'resname LIG=ball-stick' --export-mesh pocket.glb -o pocket.png
   texmap render md.xtc --topology protein.pdb --align backbone --style tube --color-by structure --label 't = {ns} ns' -o md.mp4
   texmap render XDATCAR --rep 'element Ti=polyhedra' --rep 'element O=ball-stick' --replicate 2,2,2 -o tio2.mp4
+  texmap render dump.lammpstrj --rep 'all=ball-stick' --rep 'type 2=trails' --trail-length 50 --color-by displacement -o diffusion.mp4
+  texmap render run.xtc --topology conf.gro --style licorice --select protein --measure 'resid 10 and name CA; resid 20 and name CA' --measure-table d.csv -o d.png
+  texmap render CONTCAR --rep 'all=ball-stick' --rep 'all=arrows' --arrow-scale 0.3 -o v.png
+  texmap render poses.sdf --style licorice --bond-orders -o poses.png
   texmap render water.gro --color-by element --type-color OW=#ff0000 --radius-scale 0.5 -o w.png
   texmap render md.xyz --eye 0,0,50 --target 0,0,0 --up 0,1,0 --fov 30 --depth -o md.png";
 
