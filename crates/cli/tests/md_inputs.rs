@@ -2342,6 +2342,17 @@ fn trails_grow_over_the_frames_and_survive_sharding() {
             .count()
     };
     assert!(yellow(5) > yellow(2) + 50, "{} vs {}", yellow(5), yellow(2));
+    let zero = texmap(&[
+        "render",
+        input.to_str().unwrap(),
+        "--rep",
+        "index 0=trails",
+        "--trail-length",
+        "0",
+        "-o",
+        dir.path().join("z.png").to_str().unwrap(),
+    ]);
+    assert_eq!(zero.status.code(), Some(2), "{}", stderr(&zero));
     for part in 0..2 {
         let shard = format!("{part}/2");
         let out = render(&format!("part{part}"), &["--shard", &shard]);
