@@ -1207,6 +1207,12 @@ fn demo(out: &Path, steps: usize, every: usize, size: &str) -> Result<()> {
         html: texmap_study::terrain::demo_section(out)?,
     });
     sp.finish_and_clear();
+    // Materials: a built-in crystal as VESTA draws it.
+    crate::note!("materials (coordination polyhedra)");
+    sections.push(Section {
+        title: "Materials: a crystal's coordination polyhedra".into(),
+        html: texmap_study::materials::demo_section(out)?,
+    });
     let html = demo_index_html(&summaries, &report, &charts, out, &sections);
     write_atomic(&out.join("index.html"), |p| {
         std::fs::write(p, &html).context("index.html")

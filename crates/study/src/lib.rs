@@ -53,6 +53,7 @@ pub mod elements;
 pub mod envmap;
 pub mod error;
 pub mod harness;
+pub mod materials;
 pub mod md;
 pub mod quality;
 pub mod record;
