@@ -73,8 +73,8 @@ pub struct EnvRenderArgs {
     /// mesh is the target and the others the surrounding objects.
     #[arg(long, default_value = "builtin")]
     pub scene: String,
-    /// Latitude-longitude environment image (PNG or EXR, width = 2 x height); default: a
-    /// built-in sky.
+    /// Latitude-longitude environment image (PNG, EXR or Radiance .hdr as HDRI libraries serve
+    /// them, width = 2 x height); default: a built-in sky.
     #[arg(long, value_name = "FILE")]
     pub env: Option<PathBuf>,
     #[arg(long, value_enum, default_value = "sphere-dynamic")]
@@ -200,7 +200,7 @@ fn compare(
     Ok(())
 }
 
-/// A lat-long environment from a PNG (sRGB) or EXR (linear) file.
+/// A lat-long environment from a PNG (sRGB), EXR or Radiance HDR (linear) file.
 fn load_environment(path: &Path) -> Result<Environment> {
     let ext = path
         .extension()
@@ -221,6 +221,14 @@ fn load_environment(path: &Path) -> Result<Environment> {
             size.height() as u32,
             img.layer_data.channel_data.pixels.1,
         )
+    } else if ext == "hdr" {
+        // Radiance RGBE (.hdr, as Poly Haven and most HDRI libraries serve them): linear.
+        let img = image::open(path)
+            .with_context(|| format!("{}: cannot read Radiance HDR", path.display()))?
+            .to_rgb32f();
+        let (w, h) = img.dimensions();
+        let texels = img.pixels().map(|p| Vec3::new(p[0], p[1], p[2])).collect();
+        (w, h, texels)
     } else {
         let img = image::open(path)
             .with_context(|| format!("{}: cannot read image", path.display()))?

@@ -164,3 +164,34 @@ fn bad_values_are_usage_errors() {
         assert!(err.contains(flag), "{flag} {value}: {err}");
     }
 }
+
+/// A Radiance `.hdr` environment (RGBE, written by OpenCV: tests/data/env/gen_env.py) reads as
+/// OpenCV decodes it, sun brighter than white included: the image drawn with it equals the one
+/// drawn with OpenCV's decoded floats written as an EXR.
+#[test]
+fn a_radiance_hdr_environment_reads_as_opencv_decodes_it() {
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/env");
+    let raw = std::fs::read(data.join("sky_opencv.f32")).unwrap();
+    let v: Vec<f32> = raw
+        .chunks_exact(4)
+        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        .collect();
+    let (w, h) = (128usize, 64usize);
+    assert_eq!(v.len(), w * h * 3);
+    assert!(v.iter().copied().fold(0.0f32, f32::max) > 4.0, "an HDR sun");
+    let dir = tempfile::tempdir().unwrap();
+    let exr_path = dir.path().join("sky.exr");
+    exr::prelude::write_rgb_file(&exr_path, w, h, |x, y| {
+        let k = (y * w + x) * 3;
+        (v[k], v[k + 1], v[k + 2])
+    })
+    .unwrap();
+    let hdr = data.join("sky.hdr");
+    let with = |env: &Path, name: &str| envmap(dir.path(), name, &["--env", env.to_str().unwrap()]);
+    let a = with(&hdr, "hdr.png");
+    let b = with(&exr_path, "exr.png");
+    assert_eq!(a, b, "PSNR {}", psnr(&a, &b));
+    // And it is not the built-in sky.
+    let builtin = envmap(dir.path(), "sky.png", &[]);
+    assert!(psnr(&a, &builtin) < 30.0);
+}

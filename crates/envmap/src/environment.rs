@@ -1,7 +1,7 @@
 //! The background environment: radiance arriving from infinity along each direction.
 //!
 //! Either a latitude-longitude image (linear RGB, `width = 2 · height`, the layout of HDR
-//! panoramas; the caller decodes PNG or EXR and hands the texels over, so this crate opens no
+//! panoramas; the caller decodes PNG, EXR or Radiance HDR and hands the texels over, so this crate opens no
 //! file) or a built-in analytic sky. The same [`Environment::radiance`] function feeds the static
 //! maps and the reference ray tracer's escaped rays, so a difference between a method and the
 //! reference is the method's sampling, never a different background.
