@@ -56,9 +56,51 @@ fn images_within(cell: &UnitCell, nearest: DVec3, cutoff: f64, mut found: impl F
 
 /// The pairs of atoms of `frame` bonded by distance through its cell's nearest images, for a
 /// cell too narrow for [`texmap_md_io::bonds::bonds_by_distance`]'s periodic grid (under three
-/// cutoffs wide: a crystal's unit cell), which then gives plain distances; every pair is
-/// tested (the atoms of a unit cell are few). The same rule: `0.4 Å < d < r_i + r_j + 0.45 Å`.
+/// cutoffs wide: a crystal's unit cell, a film one cell thick), which then gives plain
+/// distances. The same rule, `0.4 Å < d < r_i + r_j + 0.45 Å` to the nearest image: the frame
+/// is replicated ([`texmap_md_io::replicate`]) until the grid takes it, its bonds found there and
+/// folded back onto the original atoms, so the cost stays linear in the atoms; only if that
+/// copy would be too large is every pair tested.
 pub fn pairs_in_narrow_cell(frame: &texmap_md_io::Frame, cell: &UnitCell) -> Vec<[u32; 2]> {
+    let n = frame.n_atoms();
+    let elements: Vec<texmap_md_io::Element> = (0..n)
+        .map(|i| texmap_md_io::atom_element(frame, i))
+        .collect();
+    let widest = elements
+        .iter()
+        .map(|e| e.covalent_radius() as f64)
+        .fold(0.0, f64::max);
+    let cutoff = 2.0 * widest + BOND_TOLERANCE;
+    let m = cell.matrix().map(DVec3::from_array);
+    let volume = cell.volume();
+    let widths = [(1, 2), (2, 0), (0, 1)].map(|(a, b)| volume / m[a].cross(m[b]).length());
+    let copies = widths.map(|w| ((3.0 * cutoff / w).ceil() as usize + 1).max(1));
+    let mut copy = texmap_md_io::Frame::new();
+    copy.positions = frame.positions.clone();
+    copy.elements = elements;
+    copy.cell = Some(*cell);
+    if texmap_md_io::replicate::replicate(&mut copy, &mut Vec::new(), copies).is_ok() {
+        let found = texmap_md_io::bonds::bonds_by_distance(&copy, true);
+        if found.periodic {
+            // Atom `a` of image `m` is copy atom `m·n + a`.
+            let n = n as u32;
+            let mut pairs: Vec<[u32; 2]> = found
+                .pairs
+                .iter()
+                .map(|&[i, j]| (i % n, j % n))
+                .filter(|(a, b)| a != b)
+                .map(|(a, b)| [a.min(b), a.max(b)])
+                .collect();
+            pairs.sort_unstable();
+            pairs.dedup();
+            return pairs;
+        }
+    }
+    every_pair(frame, cell)
+}
+
+/// [`pairs_in_narrow_cell`] by testing every pair of atoms at its nearest image.
+fn every_pair(frame: &texmap_md_io::Frame, cell: &UnitCell) -> Vec<[u32; 2]> {
     let n = frame.n_atoms();
     let radii: Vec<f64> = (0..n)
         .map(|i| texmap_md_io::atom_element(frame, i).covalent_radius() as f64)
@@ -403,5 +445,43 @@ mod tests {
             "{}",
             mesh.area()
         );
+    }
+
+    #[test]
+    fn a_narrow_cells_pairs_by_the_grid_equal_every_pair_tested() {
+        // Rutile's unit cell (c = 2.959 Å, under three cutoffs) and a film of 6 x 5 x 1 cells.
+        let (a, c, u) = (4.594f64, 2.959f64, 0.3048f64);
+        let sites = [
+            ("Ti", [0.0, 0.0, 0.0]),
+            ("Ti", [0.5, 0.5, 0.5]),
+            ("O", [u, u, 0.0]),
+            ("O", [1.0 - u, 1.0 - u, 0.0]),
+            ("O", [0.5 + u, 0.5 - u, 0.5]),
+            ("O", [0.5 - u, 0.5 + u, 0.5]),
+        ];
+        for (nx, ny) in [(1usize, 1usize), (6, 5)] {
+            let cell = UnitCell::orthorhombic(a * nx as f64, a * ny as f64, c).unwrap();
+            let mut f = texmap_md_io::Frame::new();
+            for x in 0..nx {
+                for y in 0..ny {
+                    for (el, p) in sites {
+                        let frac = [
+                            (p[0] + x as f64) / nx as f64,
+                            (p[1] + y as f64) / ny as f64,
+                            p[2],
+                        ];
+                        f.positions.push(cell.to_cartesian(frac).map(|v| v as f32));
+                        f.elements
+                            .push(texmap_md_io::Element::from_symbol(el).unwrap());
+                    }
+                }
+            }
+            f.cell = Some(cell);
+            let mut want = every_pair(&f, &cell);
+            want.sort_unstable();
+            let got = pairs_in_narrow_cell(&f, &cell);
+            assert!(!got.is_empty());
+            assert_eq!(got, want, "{nx} x {ny} cells");
+        }
     }
 }
