@@ -202,6 +202,15 @@ pub(crate) fn number(tok: &Tok) -> Option<f64> {
     parse_f64(strip_esd(tok.text))
 }
 
+/// A `_cell` length or angle: its number, `None` when missing (`.`, `?`); anything else is an
+/// error at the token.
+pub(crate) fn cell_number(tok: &Tok, ctx: &Ctx) -> Result<Option<f64>, Error> {
+    if !tok.missing() && number(tok).is_none() {
+        return Err(tok.error(ctx, "a number for a _cell length or angle"));
+    }
+    Ok(number(tok))
+}
+
 /// `t` without a trailing standard uncertainty in parentheses (`12.345(6)` -> `12.345`).
 pub(crate) fn strip_esd(t: &[u8]) -> &[u8] {
     match t {

@@ -97,7 +97,7 @@
 
 use std::io::Read;
 
-use crate::cif::{Kind, Lexer, Tok, number, strip_esd};
+use crate::cif::{Kind, Lexer, Tok, cell_number, number, strip_esd};
 use crate::elements::{Element, guess_element};
 use crate::error::Error;
 use crate::frame::{Frame, Label, MAX_COORDINATE, UnitCell};
@@ -551,10 +551,7 @@ impl Block {
     fn item(&mut self, role: Role, tok: &Tok, ctx: &Ctx) -> Result<(), Error> {
         match role {
             Role::Cell(k) => {
-                if !tok.missing() && number(tok).is_none() {
-                    return Err(tok.error(ctx, "a number for a _cell length or angle"));
-                }
-                self.cell[k] = number(tok);
+                self.cell[k] = cell_number(tok, ctx)?;
                 self.cell_at.get_or_insert(tok.at);
             }
             Role::Group(k) if !tok.missing() => {

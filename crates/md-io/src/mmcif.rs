@@ -76,7 +76,7 @@ use std::io::Read;
 
 #[cfg(test)]
 use crate::cif::classify;
-use crate::cif::{Kind, Lexer, Tok, number, strip_esd};
+use crate::cif::{Kind, Lexer, Tok, cell_number, strip_esd};
 use crate::elements::guess_element;
 use crate::error::Error;
 use crate::frame::{Frame, Label, UnitCell};
@@ -597,10 +597,7 @@ impl Parser {
     fn keep(&mut self, what: Interest, tok: &Tok, ctx: &Ctx) -> Result<(), Error> {
         match what {
             Interest::Cell(k) => {
-                if !tok.missing() && number(tok).is_none() {
-                    return Err(tok.error(ctx, "a number for a _cell length or angle"));
-                }
-                self.cell_values[k] = number(tok);
+                self.cell_values[k] = cell_number(tok, ctx)?;
                 self.cell_at.get_or_insert(tok.at);
             }
             Interest::Title if !tok.missing() => {
