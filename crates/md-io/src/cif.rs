@@ -211,6 +211,31 @@ pub(crate) fn cell_number(tok: &Tok, ctx: &Ctx) -> Result<Option<f64>, Error> {
     Ok(number(tok))
 }
 
+/// The lengths and angles of the six `_cell` values (angles 90° when absent); `None` without
+/// all three lengths.
+pub(crate) fn cell_parameters(v: [Option<f64>; 6]) -> Option<([f64; 3], [f64; 3])> {
+    let (Some(a), Some(b), Some(c)) = (v[0], v[1], v[2]) else {
+        return None;
+    };
+    Some(([a, b, c], [v[3], v[4], v[5]].map(|x| x.unwrap_or(90.0))))
+}
+
+/// The cell of `lengths` and `angles`, or a parse error at `at` (the first `_cell` value)
+/// saying what was `expected`.
+pub(crate) fn cell_of(
+    lengths: [f64; 3],
+    angles: [f64; 3],
+    ctx: &Ctx,
+    at: Pos,
+    expected: &'static str,
+) -> Result<crate::frame::UnitCell, Error> {
+    crate::frame::UnitCell::from_lengths_angles(lengths, angles).map_err(|e| Error::Parse {
+        at: ctx.at(at),
+        expected,
+        found: e.to_string(),
+    })
+}
+
 /// `t` without a trailing standard uncertainty in parentheses (`12.345(6)` -> `12.345`).
 pub(crate) fn strip_esd(t: &[u8]) -> &[u8] {
     match t {

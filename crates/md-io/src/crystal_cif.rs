@@ -97,7 +97,7 @@
 
 use std::io::Read;
 
-use crate::cif::{Kind, Lexer, Tok, cell_number, number, strip_esd};
+use crate::cif::{Kind, Lexer, Tok, cell_number, cell_of, cell_parameters, number, strip_esd};
 use crate::elements::{Element, guess_element};
 use crate::error::Error;
 use crate::frame::{Frame, Label, MAX_COORDINATE, UnitCell};
@@ -824,18 +824,12 @@ impl Block {
 
     /// The cell of the `_cell` values, `None` without all three lengths.
     fn unit_cell(&self, ctx: &Ctx) -> Result<Option<UnitCell>, Error> {
-        let v = self.cell;
-        let (Some(a), Some(b), Some(c)) = (v[0], v[1], v[2]) else {
+        let Some((lengths, angles)) = cell_parameters(self.cell) else {
             return Ok(None);
         };
-        let angles = [v[3], v[4], v[5]].map(|x| x.unwrap_or(90.0));
-        UnitCell::from_lengths_angles([a, b, c], angles)
-            .map(Some)
-            .map_err(|e| Error::Parse {
-                at: ctx.at(self.cell_at.unwrap_or_default()),
-                expected: "a _cell with lengths > 0 (at most 1e7 Å) and angles that make a volume > 0",
-                found: e.to_string(),
-            })
+        let expected = "a _cell with lengths > 0 (at most 1e7 Å) and angles that make a volume > 0";
+        let at = self.cell_at.unwrap_or_default();
+        cell_of(lengths, angles, ctx, at, expected).map(Some)
     }
 
     /// The operations to expand by: the file's list, else the identity when the space group is

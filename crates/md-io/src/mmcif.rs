@@ -76,7 +76,7 @@ use std::io::Read;
 
 #[cfg(test)]
 use crate::cif::classify;
-use crate::cif::{Kind, Lexer, Tok, cell_number, strip_esd};
+use crate::cif::{Kind, Lexer, Tok, cell_number, cell_of, cell_parameters, strip_esd};
 use crate::elements::guess_element;
 use crate::error::Error;
 use crate::frame::{Frame, Label, UnitCell};
@@ -650,21 +650,21 @@ impl Parser {
 
     /// The cell of the `_cell` values, `None` without lengths or for the 1 Å placeholder.
     fn unit_cell(&self, ctx: &Ctx) -> Result<Option<UnitCell>, Error> {
-        let v = self.cell_values;
-        let (Some(a), Some(b), Some(c)) = (v[0], v[1], v[2]) else {
+        let Some((lengths, angles)) = cell_parameters(self.cell_values) else {
             return Ok(None);
         };
-        let angles = [v[3], v[4], v[5]].map(|x| x.unwrap_or(90.0));
-        if ([a, b, c] == [1.0; 3] && angles == [90.0; 3]) || [a, b, c] == [0.0; 3] {
+        if (lengths == [1.0; 3] && angles == [90.0; 3]) || lengths == [0.0; 3] {
             return Ok(None);
         }
-        UnitCell::from_lengths_angles([a, b, c], angles)
-            .map(Some)
-            .map_err(|e| Error::Parse {
-                at: ctx.at(self.cell_at.unwrap_or_default()),
-                expected: "a _cell with lengths > 0 and a volume > 0",
-                found: e.to_string(),
-            })
+        let at = self.cell_at.unwrap_or_default();
+        cell_of(
+            lengths,
+            angles,
+            ctx,
+            at,
+            "a _cell with lengths > 0 and a volume > 0",
+        )
+        .map(Some)
     }
 
     /// A token of the `_atom_site` rows.
