@@ -118,6 +118,7 @@ mod topology;
 mod trajectory;
 mod trr;
 mod vasp;
+pub mod volume;
 mod writer;
 mod xtc;
 mod xyz;
