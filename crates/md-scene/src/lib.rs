@@ -37,6 +37,9 @@
 //! - [`surface`]: molecular surfaces as VMD's QuickSurf draws them (one Gaussian per atom, the
 //!   isosurface by surface nets with every vertex on the exact surface), drawn by the rasteriser
 //!   over a sphere method's frame ([`surface::draw_mesh`]).
+//! - [`isosurface`]: isosurfaces of volumetric data (a cube file's orbital, a CHGCAR's density;
+//!   md-io's `Volume`) by surface nets on the data's own skewed grid, capped at a bounded grid's
+//!   border, continued across a periodic one's; a mesh like the surface's.
 //! - [`legend`]: a colour bar with its tick labels and title drawn onto a rendered RGBA image
 //!   ([`draw_color_bar`]).
 //!
@@ -74,6 +77,7 @@ pub mod camera;
 pub mod camera_plan;
 pub mod cartoon;
 pub mod colormap;
+pub mod isosurface;
 pub mod legend;
 pub mod measure;
 pub mod outline;

@@ -684,8 +684,8 @@ fn corner(i: usize) -> Vec3 {
     Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, (i >> 2) as f32)
 }
 
-/// The unit cube's twelve edges as corner pairs.
-const CUBE_EDGES: [(usize, usize); 12] = [
+/// The unit cube's twelve edges as corner pairs (corners numbered as by [`corner`]).
+pub(crate) const CUBE_EDGES: [(usize, usize); 12] = [
     (0, 1),
     (2, 3),
     (4, 5),

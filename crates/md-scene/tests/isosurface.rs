@@ -1,0 +1,245 @@
+//! Isosurfaces of volumetric data against analytic surfaces: a Gaussian's sphere on a skewed
+//! grid, a p orbital's two lobes, a periodic slab's planes, a region cut by the grid's border.
+
+use std::collections::HashMap;
+use std::f64::consts::PI;
+
+use glam::{DVec3, Vec3};
+use texmap_md_io::volume::Volume;
+use texmap_md_scene::isosurface::{IsoError, isosurface};
+use texmap_md_scene::surface::MolMesh;
+
+/// A volume sampling `f` (Å in, value out) at `origin + i·s0 + j·s1 + k·s2`.
+fn sample(
+    origin: DVec3,
+    steps: [DVec3; 3],
+    dims: [usize; 3],
+    periodic: bool,
+    f: impl Fn(DVec3) -> f64,
+) -> Volume {
+    let mut data = Vec::with_capacity(dims[0] * dims[1] * dims[2]);
+    for k in 0..dims[2] {
+        for j in 0..dims[1] {
+            for i in 0..dims[0] {
+                let p = origin + steps[0] * i as f64 + steps[1] * j as f64 + steps[2] * k as f64;
+                data.push(f(p) as f32);
+            }
+        }
+    }
+    Volume::new(
+        origin.to_array(),
+        steps.map(|s| s.to_array()),
+        dims,
+        data,
+        periodic,
+        "test",
+    )
+    .unwrap()
+}
+
+/// Every edge of the mesh is shared by exactly two triangles, running opposite ways.
+fn assert_closed(m: &MolMesh) {
+    let mut edges: HashMap<(u32, u32), i32> = HashMap::new();
+    for t in &m.triangles {
+        for e in 0..3 {
+            let (a, b) = (t[e], t[(e + 1) % 3]);
+            *edges.entry((a, b)).or_default() += 1;
+        }
+    }
+    for (&(a, b), &n) in &edges {
+        assert_eq!(n, 1, "edge {a}-{b} used {n} times the same way");
+        assert_eq!(edges.get(&(b, a)), Some(&1), "edge {a}-{b} has no twin");
+    }
+}
+
+#[test]
+fn a_gaussian_on_a_skewed_grid_gives_its_sphere() {
+    // exp(−|p − c|² / 2σ²) at level exp(−R²/2σ²): the sphere of radius R around c.
+    let (c, sigma, r) = (DVec3::new(0.3, -0.2, 0.1), 0.8f64, 1.2f64);
+    let level = (-(r * r) / (2.0 * sigma * sigma)).exp() as f32;
+    // Skewed steps (monoclinic-like), 0.12 Å: the grid covers the sphere with margin.
+    let steps = [
+        DVec3::new(0.12, 0.0, 0.0),
+        DVec3::new(0.04, 0.11, 0.0),
+        DVec3::new(-0.03, 0.02, 0.12),
+    ];
+    let origin = DVec3::new(-2.0, -2.4, -2.2);
+    let vol = sample(origin, steps, [42, 42, 40], false, |p| {
+        (-(p - c).length_squared() / (2.0 * sigma * sigma)).exp()
+    });
+    let m = isosurface(&vol, level, 3).unwrap();
+    assert!(m.triangles.len() > 2000, "{} triangles", m.triangles.len());
+    assert!(m.kinds.iter().all(|&k| k == 3));
+    assert_closed(&m);
+    let cf = c.as_vec3();
+    let mut worst = 0.0f32;
+    for (p, n) in m.positions.iter().zip(&m.normals) {
+        let d = *p - cf;
+        worst = worst.max((d.length() - r as f32).abs());
+        // Outward and radial: within 2° of the exact normal.
+        assert!(n.dot(d.normalize()) > 2f32.to_radians().cos(), "{n} at {d}");
+    }
+    // Linear crossings on a Gaussian's flank and their mean within a cell: O(h²) inside.
+    assert!(worst < 0.02, "worst radius error {worst} Å");
+    let sphere = 4.0 / 3.0 * PI * r.powi(3);
+    let rel = m.volume() / sphere - 1.0;
+    assert!(rel.abs() < 0.02, "volume {} vs {sphere}", m.volume());
+    let area = 4.0 * PI * r * r;
+    assert!((m.area() / area - 1.0).abs() < 0.03, "area {}", m.area());
+}
+
+#[test]
+fn a_p_orbital_has_two_mirror_lobes_each_lit_outside() {
+    // x·exp(−r²/2): positive for x > 0, negative for x < 0, antisymmetric in x.
+    let h = 0.15;
+    let n = 61;
+    let o = -4.5;
+    let steps = [DVec3::X * h, DVec3::Y * h, DVec3::Z * h];
+    let vol = sample(DVec3::splat(o), steps, [n, n, n], false, |p| {
+        p.x * (-p.length_squared() / 2.0).exp()
+    });
+    let pos = isosurface(&vol, 0.1, 0).unwrap();
+    let neg = isosurface(&vol, -0.1, 1).unwrap();
+    assert_closed(&pos);
+    assert_closed(&neg);
+    assert!(pos.triangles.len() > 1000);
+    // Mirror images: the same volume and area; centroids at ±x.
+    assert!((pos.volume() / neg.volume() - 1.0).abs() < 1e-3);
+    assert!((pos.area() / neg.area() - 1.0).abs() < 1e-3);
+    let centroid =
+        |m: &MolMesh| m.positions.iter().copied().sum::<Vec3>() / m.positions.len() as f32;
+    let (cp, cn) = (centroid(&pos), centroid(&neg));
+    assert!(cp.x > 0.8 && cn.x < -0.8, "{cp} {cn}");
+    assert!((cp.x + cn.x).abs() < 1e-3);
+    // Every vertex lies on its level within the grid's interpolation error, on its side.
+    let f = |p: Vec3| p.x as f64 * (-(p.length_squared() as f64) / 2.0).exp();
+    for p in &pos.positions {
+        assert!((f(*p) - 0.1).abs() < 4e-3 && p.x > 0.0, "{p}: {}", f(*p));
+    }
+    for p in &neg.positions {
+        assert!((f(*p) + 0.1).abs() < 4e-3 && p.x < 0.0, "{p}: {}", f(*p));
+    }
+    // Both lit on their outside: the normal points where the value moves away from the
+    // enclosed side (down for the positive lobe, up for the negative one).
+    let grad = |p: Vec3| {
+        let e = 1e-3;
+        Vec3::new(
+            (f(p + Vec3::X * e) - f(p - Vec3::X * e)) as f32,
+            (f(p + Vec3::Y * e) - f(p - Vec3::Y * e)) as f32,
+            (f(p + Vec3::Z * e) - f(p - Vec3::Z * e)) as f32,
+        )
+    };
+    for (p, n) in pos.positions.iter().zip(&pos.normals) {
+        assert!(n.dot(grad(*p)) < 0.0);
+    }
+    for (p, n) in neg.positions.iter().zip(&neg.normals) {
+        assert!(n.dot(grad(*p)) > 0.0);
+    }
+    // Exactly the enclosed volume of the positive lobe: x·exp(−r²/2) > 0.1, by quadrature.
+    let mut inside = 0usize;
+    let q = 0.03;
+    let m = (4.0 / q) as i64;
+    for i in 0..m {
+        for j in -m..m {
+            for k in -m..m {
+                let p = DVec3::new(
+                    (i as f64 + 0.5) * q,
+                    (j as f64 + 0.5) * q,
+                    (k as f64 + 0.5) * q,
+                );
+                if p.x * (-p.length_squared() / 2.0).exp() > 0.1 {
+                    inside += 1;
+                }
+            }
+        }
+    }
+    let exact = inside as f64 * q * q * q;
+    assert!(
+        (pos.volume() / exact - 1.0).abs() < 0.02,
+        "{} vs {exact}",
+        pos.volume()
+    );
+}
+
+#[test]
+fn a_periodic_grid_runs_on_across_the_cell_and_a_bounded_one_is_capped() {
+    // cos(2π u) over a skewed cell (u the first fractional coordinate) at level 1/2: the
+    // region |u| < 1/6 (mod 1), bounded by the planes u = 1/6 and u = 5/6 (≡ −1/6).
+    let cell = [
+        DVec3::new(6.0, 0.0, 0.0),
+        DVec3::new(2.0, 5.0, 0.0),
+        DVec3::new(0.5, 1.0, 4.0),
+    ];
+    let dims = [30, 25, 20];
+    let steps = std::array::from_fn(|a| cell[a] / dims[a] as f64);
+    let inv = glam::DMat3::from_cols(cell[0], cell[1], cell[2]).inverse();
+    let frac = move |p: DVec3| inv * p;
+    let field = move |p: DVec3| (2.0 * PI * frac(p).x).cos();
+    let periodic = sample(DVec3::ZERO, steps, dims, true, field);
+    let m = isosurface(&periodic, 0.5, 0).unwrap();
+    // Every vertex lies on one of the two planes (or its image one period over): no cap.
+    for p in &m.positions {
+        let u = frac(p.as_dvec3()).x;
+        let near = [-1.0 / 6.0, 1.0 / 6.0, 5.0 / 6.0, 7.0 / 6.0]
+            .iter()
+            .any(|&w| (u - w).abs() < 0.01);
+        assert!(near, "vertex at u = {u}");
+    }
+    // Two planes, each spanning the cell's b x c face: area 2·|b x c|, within the half-cell
+    // margins the surface runs past the faces.
+    let face = cell[1].cross(cell[2]).length();
+    let a = m.area();
+    assert!(
+        a > 2.0 * face && a < 2.0 * face * 1.25,
+        "area {a} vs 2 x {face}"
+    );
+
+    // The same grid not periodic: the region at u ∈ [0, 1/6) and (5/6, 1) is cut by the
+    // grid's border, so caps close it (vertices at u ≈ 0 and at the last grid plane).
+    let bounded = Volume {
+        periodic: false,
+        ..periodic.clone()
+    };
+    let m = isosurface(&bounded, 0.5, 0).unwrap();
+    assert_closed(&m);
+    let last = (dims[0] - 1) as f64 / dims[0] as f64;
+    let us: Vec<f64> = m.positions.iter().map(|p| frac(p.as_dvec3()).x).collect();
+    assert!(us.iter().any(|u| u.abs() < 1e-4));
+    assert!(us.iter().any(|u| (u - last).abs() < 1e-4));
+    assert!(us.iter().all(|u| *u > -1e-4 && *u < last + 1e-4));
+    // The enclosed volume: the slabs u ∈ [0, 1/6] and [5/6, last] of the cell.
+    let vcell = cell[0].dot(cell[1].cross(cell[2]));
+    let exact = vcell * (1.0 / 6.0 + (last - 5.0 / 6.0));
+    // The grid's cross-section is one cell short along b and c (points 0..n−1).
+    let exact =
+        exact * ((dims[1] - 1) as f64 / dims[1] as f64) * ((dims[2] - 1) as f64 / dims[2] as f64);
+    assert!(
+        (m.volume() / exact - 1.0).abs() < 0.01,
+        "{} vs {exact}",
+        m.volume()
+    );
+}
+
+#[test]
+fn a_mirrored_grid_is_still_wound_outward_and_nothing_crosses_is_empty() {
+    // Steps of negative determinant (the third axis reversed).
+    let steps = [DVec3::X * 0.1, DVec3::Y * 0.1, DVec3::NEG_Z * 0.1];
+    let vol = sample(
+        DVec3::new(-2.0, -2.0, 2.0),
+        steps,
+        [41, 41, 41],
+        false,
+        |p| (-p.length_squared()).exp(),
+    );
+    let m = isosurface(&vol, 0.5, 0).unwrap();
+    assert_closed(&m);
+    assert!(m.volume() > 0.0);
+    let r = (2f64.ln()).sqrt();
+    let rel = m.volume() / (4.0 / 3.0 * PI * r.powi(3)) - 1.0;
+    assert!(rel.abs() < 0.02, "{rel}");
+    assert!(isosurface(&vol, 2.0, 0).unwrap().triangles.is_empty());
+    assert!(matches!(
+        isosurface(&vol, f32::NAN, 0),
+        Err(IsoError::BadLevel(l)) if l.is_nan()
+    ));
+}
