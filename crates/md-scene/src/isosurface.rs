@@ -3,10 +3,10 @@
 //! where the values cross a level, the two signs of an orbital as two surfaces.
 //!
 //! # Which side is inside
-//! A level `L ≥ 0` encloses the points whose value is above it; a level `L < 0` encloses the
-//! points below it (an orbital's negative lobe at `−L`). The mesh is wound counter-clockwise seen
-//! from outside, its normals point out of the enclosed region, so a positive and a negative lobe
-//! are both lit on their outside.
+//! The caller says which side of the level the surface encloses ([`Side`]): the values above
+//! it (a density, an orbital's positive lobe) or below it (the negative lobe at `−L`). The mesh
+//! is wound counter-clockwise seen from outside, its normals point out of the enclosed region,
+//! so a positive and a negative lobe are both lit on their outside.
 //!
 //! # Extraction
 //! Surface nets (Gibson 1998) on the grid itself, in index space, mapped to Å through the
@@ -30,7 +30,7 @@
 //! ```
 //! use glam::Vec3;
 //! use texmap_md_io::volume::Volume;
-//! use texmap_md_scene::isosurface::isosurface;
+//! use texmap_md_scene::isosurface::{Side, isosurface};
 //!
 //! // exp(−r²/2) on a 61³ grid 0.1 Å apart centred on the origin: the level exp(−1/2)
 //! // is the sphere of radius 1 Å.
@@ -46,7 +46,7 @@
 //!     .collect();
 //! let steps = [[h, 0.0, 0.0], [0.0, h, 0.0], [0.0, 0.0, h]];
 //! let v = Volume::new([o; 3], steps, [n, n, n], data, false, "gaussian").unwrap();
-//! let mesh = isosurface(&v, (-0.5f32).exp(), 0).unwrap();
+//! let mesh = isosurface(&v, (-0.5f32).exp(), Side::Above, 0).unwrap();
 //! for p in &mesh.positions {
 //!     assert!((p.length() - 1.0).abs() < 0.02);
 //! }
@@ -63,6 +63,15 @@ use crate::surface::{CUBE_EDGES, MolMesh};
 
 /// Most grid cells one isosurface walks (the data's points, padded).
 pub const MAX_CELLS: usize = 1 << 30;
+
+/// Which values an isosurface encloses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Side {
+    /// The values above the level.
+    Above,
+    /// The values below the level.
+    Below,
+}
 
 /// Why no isosurface was made.
 #[derive(Clone, Debug, PartialEq)]
@@ -92,7 +101,7 @@ impl std::error::Error for IsoError {}
 struct Field<'a> {
     vol: &'a Volume,
     level: f32,
-    /// +1 for a level ≥ 0 (inside above it), −1 below.
+    /// +1 when the values above the level are inside, −1 below.
     sign: f32,
     n: [i64; 3],
 }
@@ -165,11 +174,12 @@ struct CellVertex {
     normal: Option<Vec3>,
 }
 
-/// The isosurface of `vol` at `level` (see the module docs for the sides, caps and periodic
-/// grids), every triangle of material `kind`. Empty when no value crosses the level.
+/// The isosurface of `vol` at `level` enclosing the values on `side` of it (see the module
+/// docs for the caps and periodic grids), every triangle of material `kind`. Empty when no
+/// value crosses the level.
 ///
 /// Errors: a level that is not finite, or more than [`MAX_CELLS`] cells.
-pub fn isosurface(vol: &Volume, level: f32, kind: u16) -> Result<MolMesh, IsoError> {
+pub fn isosurface(vol: &Volume, level: f32, side: Side, kind: u16) -> Result<MolMesh, IsoError> {
     if !level.is_finite() {
         return Err(IsoError::BadLevel(level));
     }
@@ -186,7 +196,10 @@ pub fn isosurface(vol: &Volume, level: f32, kind: u16) -> Result<MolMesh, IsoErr
     let field = Field {
         vol,
         level,
-        sign: if level >= 0.0 { 1.0 } else { -1.0 },
+        sign: match side {
+            Side::Above => 1.0,
+            Side::Below => -1.0,
+        },
         n,
     };
     let key =

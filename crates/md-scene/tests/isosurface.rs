@@ -6,7 +6,7 @@ use std::f64::consts::PI;
 
 use glam::{DVec3, Vec3};
 use texmap_md_io::volume::Volume;
-use texmap_md_scene::isosurface::{IsoError, isosurface};
+use texmap_md_scene::isosurface::{IsoError, Side, isosurface};
 use texmap_md_scene::surface::MolMesh;
 
 /// A volume sampling `f` (Å in, value out) at `origin + i·s0 + j·s1 + k·s2`.
@@ -67,7 +67,7 @@ fn a_gaussian_on_a_skewed_grid_gives_its_sphere() {
     let vol = sample(origin, steps, [42, 42, 40], false, |p| {
         (-(p - c).length_squared() / (2.0 * sigma * sigma)).exp()
     });
-    let m = isosurface(&vol, level, 3).unwrap();
+    let m = isosurface(&vol, level, Side::Above, 3).unwrap();
     assert!(m.triangles.len() > 2000, "{} triangles", m.triangles.len());
     assert!(m.kinds.iter().all(|&k| k == 3));
     assert_closed(&m);
@@ -98,8 +98,8 @@ fn a_p_orbital_has_two_mirror_lobes_each_lit_outside() {
     let vol = sample(DVec3::splat(o), steps, [n, n, n], false, |p| {
         p.x * (-p.length_squared() / 2.0).exp()
     });
-    let pos = isosurface(&vol, 0.1, 0).unwrap();
-    let neg = isosurface(&vol, -0.1, 1).unwrap();
+    let pos = isosurface(&vol, 0.1, Side::Above, 0).unwrap();
+    let neg = isosurface(&vol, -0.1, Side::Below, 1).unwrap();
     assert_closed(&pos);
     assert_closed(&neg);
     assert!(pos.triangles.len() > 1000);
@@ -176,7 +176,7 @@ fn a_periodic_grid_runs_on_across_the_cell_and_a_bounded_one_is_capped() {
     let frac = move |p: DVec3| inv * p;
     let field = move |p: DVec3| (2.0 * PI * frac(p).x).cos();
     let periodic = sample(DVec3::ZERO, steps, dims, true, field);
-    let m = isosurface(&periodic, 0.5, 0).unwrap();
+    let m = isosurface(&periodic, 0.5, Side::Above, 0).unwrap();
     // Every vertex lies on one of the two planes (or its image one period over): no cap.
     for p in &m.positions {
         let u = frac(p.as_dvec3()).x;
@@ -200,7 +200,7 @@ fn a_periodic_grid_runs_on_across_the_cell_and_a_bounded_one_is_capped() {
         periodic: false,
         ..periodic.clone()
     };
-    let m = isosurface(&bounded, 0.5, 0).unwrap();
+    let m = isosurface(&bounded, 0.5, Side::Above, 0).unwrap();
     assert_closed(&m);
     let last = (dims[0] - 1) as f64 / dims[0] as f64;
     let us: Vec<f64> = m.positions.iter().map(|p| frac(p.as_dvec3()).x).collect();
@@ -231,15 +231,20 @@ fn a_mirrored_grid_is_still_wound_outward_and_nothing_crosses_is_empty() {
         false,
         |p| (-p.length_squared()).exp(),
     );
-    let m = isosurface(&vol, 0.5, 0).unwrap();
+    let m = isosurface(&vol, 0.5, Side::Above, 0).unwrap();
     assert_closed(&m);
     assert!(m.volume() > 0.0);
     let r = (2f64.ln()).sqrt();
     let rel = m.volume() / (4.0 / 3.0 * PI * r.powi(3)) - 1.0;
     assert!(rel.abs() < 0.02, "{rel}");
-    assert!(isosurface(&vol, 2.0, 0).unwrap().triangles.is_empty());
+    assert!(
+        isosurface(&vol, 2.0, Side::Above, 0)
+            .unwrap()
+            .triangles
+            .is_empty()
+    );
     assert!(matches!(
-        isosurface(&vol, f32::NAN, 0),
+        isosurface(&vol, f32::NAN, Side::Above, 0),
         Err(IsoError::BadLevel(l)) if l.is_nan()
     ));
 }
