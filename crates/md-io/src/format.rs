@@ -41,11 +41,14 @@ pub enum Format {
     /// files named `data.*` (`data.peptide`, as in the LAMMPS examples), or by its header (an
     /// `N atoms` line after the title: `system.lammps`); by name: `lammps-data`.
     LammpsData,
+    /// Gaussian cube file, one frame (the molecule; its grid values are checked, not kept: see
+    /// [`crate::volume::read_volumes`]): `.cube`, `.cub`.
+    Cube,
 }
 
 impl Format {
     /// Every format, in declaration order.
-    pub const ALL: [Format; 14] = [
+    pub const ALL: [Format; 15] = [
         Format::Xyz,
         Format::Pdb,
         Format::Gro,
@@ -60,6 +63,7 @@ impl Format {
         Format::Vasp,
         Format::CrystalCif,
         Format::LammpsData,
+        Format::Cube,
     ];
 
     /// The format a file extension names (case-insensitive), e.g. "xyz", "lammpstrj".
@@ -80,12 +84,16 @@ impl Format {
             "vasp" | "poscar" | "contcar" | "xdatcar" => Format::Vasp,
             "cif-crystal" => Format::CrystalCif,
             "data" | "lmp" | "lammps-data" => Format::LammpsData,
+            "cube" | "cub" => Format::Cube,
             _ => return None,
         })
     }
 
     /// The format a path's extension names, else VASP for the names VASP gives its files
-    /// (`POSCAR`, `CONTCAR`, `XDATCAR` and any suffix: `CONTCAR.2`), else a LAMMPS data file for
+    /// (`POSCAR`, `CONTCAR`, `XDATCAR` and any suffix: `CONTCAR.2`; the volumetric `CHGCAR`,
+    /// `CHG`, `PARCHG`, `LOCPOT`, `ELFCAR`, `AECCAR0/1/2` as
+    /// [`crate::volume::VaspQuantity::from_file_name`] tells them: `run1.CHGCAR`,
+    /// `PARCHG.0012.ALLK`, read as one frame, the structure), else a LAMMPS data file for
     /// a name starting `data.` (`data.peptide`); a final `.gz` is looked
     /// through (`run.xyz.gz` is XYZ, read decompressed by [`crate::Trajectory::open`]).
     pub fn from_path(path: &Path) -> Option<Format> {
@@ -102,7 +110,11 @@ impl Format {
         let vasp = [&b"POSCAR"[..], b"CONTCAR", b"XDATCAR"]
             .iter()
             .any(|v| name.len() >= v.len() && name[..v.len()].eq_ignore_ascii_case(v));
-        if vasp {
+        let volumetric = std::str::from_utf8(name)
+            .ok()
+            .and_then(crate::volume::VaspQuantity::from_file_name)
+            .is_some();
+        if vasp || volumetric {
             return Some(Format::Vasp);
         }
         // The LAMMPS examples' names: `data.peptide`, `data.lj`.
@@ -252,6 +264,7 @@ impl Format {
                 | Format::Vasp
                 | Format::CrystalCif
                 | Format::LammpsData
+                | Format::Cube
         )
     }
 
@@ -272,6 +285,7 @@ impl Format {
             Format::Vasp => "vasp",
             Format::CrystalCif => "cif-crystal",
             Format::LammpsData => "lammps-data",
+            Format::Cube => "cube",
         }
     }
 }

@@ -84,10 +84,12 @@
 //! streaming, the line-scan index and error positions from `TextReader`.
 
 pub mod bonds;
+mod chgcar;
 mod cif;
 pub mod cna;
 pub mod coordination;
 mod crystal_cif;
+mod cube;
 mod cursor;
 mod dcd;
 pub mod elements;

@@ -1,6 +1,7 @@
 //! [`Trajectory`]: one reader for every format, streaming or random access.
 
 use crate::crystal_cif::CrystalCif;
+use crate::cube::Cube;
 use crate::dcd::DcdReader;
 use crate::error::Error;
 use crate::format::Format;
@@ -39,6 +40,7 @@ enum Reader<R> {
     Vasp(TextReader<R, Vasp>),
     CrystalCif(TextReader<R, CrystalCif>),
     LammpsData(TextReader<R, LammpsData>),
+    Cube(TextReader<R, Cube>),
 }
 
 /// Runs `$body` with `$r` bound to the format's reader, whatever the format.
@@ -59,6 +61,7 @@ macro_rules! each_reader {
             Reader::Vasp($r) => $body,
             Reader::CrystalCif($r) => $body,
             Reader::LammpsData($r) => $body,
+            Reader::Cube($r) => $body,
         }
     };
 }
@@ -259,6 +262,7 @@ impl<R: Read + Seek> Trajectory<R> {
             Format::LammpsData => {
                 Reader::LammpsData(TextReader::new(src, LammpsData::default(), file.clone()))
             }
+            Format::Cube => Reader::Cube(TextReader::new(src, Cube, file.clone())),
         };
         Ok(Trajectory {
             reader,

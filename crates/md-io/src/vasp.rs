@@ -411,6 +411,25 @@ impl Vasp {
                 None => return Ok(()),
             }
         }
+        if sep.is_none() {
+            // A volumetric file (CHGCAR, LOCPOT, …): a blank line, then a grid line. Its grids
+            // are walked, values parsed when reading (counted by a scan).
+            let p = lines.pos();
+            if let Some((pos, line)) = lines.next_line().map_err(|e| ctx.io(p, e))? {
+                if let Some(dims) = crate::chgcar::grid_dims(line) {
+                    let budget = crate::volume::Budget::unknown();
+                    crate::chgcar::check_dims(ctx, pos, line, dims, &budget)?;
+                    let walk = crate::chgcar::Walk {
+                        dims,
+                        n_atoms: h.n,
+                        scale: 1.0,
+                        parse: frame.is_some(),
+                    };
+                    return walk.grids(lines, ctx, &budget, None);
+                }
+                lines.unread(pos);
+            }
+        }
         let direct = sep == Some(b'd');
         let known = matches!(sep, None | Some(b'd' | b'c' | b'k'));
         if let Some(f) = frame.as_deref_mut() {
@@ -455,15 +474,17 @@ fn frac_to_cartesian(m: &[[f64; 3]; 3], f: [f64; 3]) -> [f64; 3] {
     out
 }
 
-impl TextFormat for Vasp {
-    fn read<R: Read>(
+impl Vasp {
+    /// Reads a frame's header (or the kept one) and its coordinates into `frame`, nothing after
+    /// them; `None` at the end of the data.
+    fn structure<R: Read>(
         &mut self,
         lines: &mut LineReader<R>,
         ctx: &Ctx,
         frame: &mut Frame,
-    ) -> Result<bool, Error> {
+    ) -> Result<Option<(Arc<Header>, Mode)>, Error> {
         let Some((h, mode)) = self.start(lines, ctx)? else {
-            return Ok(false);
+            return Ok(None);
         };
         frame.comment.push_str(&h.comment);
         frame.cell = Some(h.cell);
@@ -501,6 +522,30 @@ impl TextFormat for Vasp {
                 frame.ids.push(i as i64);
             }
         }
+        Ok(Some((h, mode)))
+    }
+}
+
+/// Reads one POSCAR block (header and coordinates, nothing after them) into `frame`, cleared
+/// by the caller: the structure of a VASP volumetric file. False at the end of the data.
+pub(crate) fn read_structure<R: Read>(
+    lines: &mut LineReader<R>,
+    ctx: &Ctx,
+    frame: &mut Frame,
+) -> Result<bool, Error> {
+    Ok(Vasp::default().structure(lines, ctx, frame)?.is_some())
+}
+
+impl TextFormat for Vasp {
+    fn read<R: Read>(
+        &mut self,
+        lines: &mut LineReader<R>,
+        ctx: &Ctx,
+        frame: &mut Frame,
+    ) -> Result<bool, Error> {
+        let Some((h, mode)) = self.structure(lines, ctx, frame)? else {
+            return Ok(false);
+        };
         if !mode.configuration {
             Vasp::velocities(lines, ctx, &h, Some(frame))?;
             Vasp::rest(lines, ctx)?;

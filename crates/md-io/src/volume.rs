@@ -19,6 +19,14 @@
 //! assert_eq!(v.range(), Some((0.0, 112.0)));
 //! ```
 
+use crate::error::Error;
+use crate::frame::Frame;
+use crate::parse::{fields, parse_f64};
+use crate::text::{Ctx, LineReader};
+use std::io::Read;
+use std::path::Path;
+use std::sync::Arc;
+
 /// Values on a grid of points (see the module docs).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Volume {
@@ -136,7 +144,257 @@ impl Volume {
     }
 }
 
-fn det3(m: [[f64; 3]; 3]) -> f64 {
+/// Most points (and values) one grid may have: 2^30, 4 GiB of `f32`.
+pub const MAX_POINTS: usize = 1 << 30;
+
+/// A volumetric file format, told by [`VolumeFormat::from_path`] or given to
+/// [`read_volumes_from`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum VolumeFormat {
+    /// Gaussian cube: `.cube`, `.cub`.
+    Cube,
+    /// VASP volumetric data (a POSCAR block, then grids) holding this quantity.
+    Vasp(VaspQuantity),
+}
+
+/// What a VASP volumetric file's values are; the file's name tells (see the module docs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum VaspQuantity {
+    /// `CHGCAR`, `CHG`, `PARCHG`, `AECCAR0/1/2`: charge densities, stored by VASP as ρ·V_cell
+    /// and read as ρ in e/Å³.
+    Density,
+    /// `LOCPOT`: the local potential in eV, as written.
+    Potential,
+    /// `ELFCAR`: the electron localisation function (0 to 1), as written.
+    Elf,
+}
+
+impl VaspQuantity {
+    /// The quantity a VASP file name holds: one of its parts (split at `.`, `_`, `-`) is
+    /// `CHGCAR`, `CHG`, `PARCHG`, `LOCPOT`, `ELFCAR` or `AECCAR`, in any case, optionally
+    /// followed by digits (`AECCAR2`, `CHGCAR_spin`, `PARCHG.0012.ALLK`, `run1.CHGCAR`).
+    pub fn from_file_name(name: &str) -> Option<VaspQuantity> {
+        const NAMES: [(&str, VaspQuantity); 6] = [
+            ("CHGCAR", VaspQuantity::Density),
+            ("PARCHG", VaspQuantity::Density),
+            ("AECCAR", VaspQuantity::Density),
+            ("CHG", VaspQuantity::Density),
+            ("LOCPOT", VaspQuantity::Potential),
+            ("ELFCAR", VaspQuantity::Elf),
+        ];
+        name.split(['.', '_', '-']).find_map(|part| {
+            NAMES.iter().find_map(|(n, q)| {
+                let head = part.get(..n.len())?;
+                let tail = &part[n.len()..];
+                (head.eq_ignore_ascii_case(n) && tail.bytes().all(|b| b.is_ascii_digit()))
+                    .then_some(*q)
+            })
+        })
+    }
+
+    /// The name of data set `k` (0-based) of `count` in a file of this quantity.
+    fn set_name(self, k: usize, count: usize) -> String {
+        const XYZ: [&str; 3] = ["x", "y", "z"];
+        match (self, count, k) {
+            (VaspQuantity::Density, _, 0) => "total density (e/Å³)".into(),
+            (VaspQuantity::Density, 2, 1) => "magnetisation density (e/Å³)".into(),
+            (VaspQuantity::Density, 4, _) => {
+                format!("magnetisation {} density (e/Å³)", XYZ[k - 1])
+            }
+            (VaspQuantity::Density, _, _) => format!("data set {} (e/Å³)", k + 1),
+            (VaspQuantity::Potential, 1, _) => "local potential (eV)".into(),
+            (VaspQuantity::Potential, 2, _) => {
+                format!("local potential, spin {} (eV)", ["up", "down"][k])
+            }
+            (VaspQuantity::Potential, 4, 0) => "local potential (eV)".into(),
+            (VaspQuantity::Potential, 4, _) => format!("local potential B{} (eV)", k),
+            (VaspQuantity::Potential, _, _) => format!("local potential, data set {} (eV)", k + 1),
+            (VaspQuantity::Elf, 1, _) => "ELF".into(),
+            (VaspQuantity::Elf, 2, _) => format!("ELF, spin {}", ["up", "down"][k]),
+            (VaspQuantity::Elf, _, _) => format!("ELF, data set {}", k + 1),
+        }
+    }
+}
+
+impl VolumeFormat {
+    /// The format a path names: `.cube` / `.cub` (any case) is a cube file, a VASP name
+    /// ([`VaspQuantity::from_file_name`]) VASP volumetric data; a final `.gz` is looked through.
+    pub fn from_path(path: &Path) -> Option<VolumeFormat> {
+        let inner = crate::gz::inner_path(path);
+        let ext = inner.extension().and_then(|e| e.to_str()).unwrap_or("");
+        if ext.eq_ignore_ascii_case("cube") || ext.eq_ignore_ascii_case("cub") {
+            return Some(VolumeFormat::Cube);
+        }
+        let name = inner.file_name()?.to_str()?;
+        VaspQuantity::from_file_name(name).map(VolumeFormat::Vasp)
+    }
+}
+
+/// Reads a volumetric file: its atoms (elements and positions in Å; a VASP file's cell) as a
+/// [`Frame`], and every data set in file order. The format comes from the name
+/// ([`VolumeFormat::from_path`]); a gzip file is read decompressed, as
+/// [`crate::Trajectory::open`] reads one.
+pub fn read_volumes(path: impl AsRef<Path>) -> Result<(Frame, Vec<Volume>), Error> {
+    let path = path.as_ref();
+    let name: Arc<str> = path.display().to_string().into();
+    let kind = VolumeFormat::from_path(path).ok_or_else(|| Error::Unsupported {
+        file: name.clone(),
+        what: "volumetric data from a file not named .cube / .cub or as VASP names its \
+               volumetric files (CHGCAR, CHG, PARCHG, LOCPOT, ELFCAR, AECCAR0/1/2)",
+    })?;
+    let (file, _) = crate::gz::open(path, &name, false)?;
+    let len = file.metadata().ok().map(|m| m.len());
+    read_sized(file, kind, name, Budget { len })
+}
+
+/// Reads volumetric data of format `kind` from `src`; `name` is what errors call the file.
+/// Without the file's length, nothing is reserved beyond 2^16 values ahead of reading them.
+///
+/// ```
+/// use texmap_md_io::volume::{read_volumes_from, VolumeFormat};
+/// // Two atoms and a 2 x 2 x 3 grid, axes in Å (negative counts), x outermost, z fastest.
+/// let cube = "title\ncomment\n 2 0.0 0.0 0.0\n-2 0.5 0 0\n-2 0 0.5 0\n-3 0 0 0.25\n\
+///             8 8.0 0 0 0\n1 1.0 0.96 0 0\n\
+///             0 1 2\n10 11 12\n100 101 102\n110 111 112\n";
+/// let (atoms, sets) = read_volumes_from(cube.as_bytes(), VolumeFormat::Cube, "w.cube")?;
+/// assert_eq!(atoms.elements[1].symbol(), "H");
+/// assert_eq!(atoms.positions[1], [0.96, 0.0, 0.0]);
+/// let v = &sets[0];
+/// assert_eq!((v.dims, v.name.as_str()), ([2, 2, 3], "title"));
+/// assert_eq!(v.at(1, 0, 2), 102.0); // x = 1, y = 0, z = 2
+/// assert_eq!(v.point(1, 1, 2), [0.5, 0.5, 0.5]);
+/// # Ok::<(), texmap_md_io::Error>(())
+/// ```
+pub fn read_volumes_from<R: Read>(
+    src: R,
+    kind: VolumeFormat,
+    name: &str,
+) -> Result<(Frame, Vec<Volume>), Error> {
+    read_sized(src, kind, name.into(), Budget { len: None })
+}
+
+fn read_sized<R: Read>(
+    src: R,
+    kind: VolumeFormat,
+    file: Arc<str>,
+    budget: Budget,
+) -> Result<(Frame, Vec<Volume>), Error> {
+    let ctx = Ctx {
+        file,
+        frame: 0,
+        reserve: budget.max_atoms().min(1 << 10),
+    };
+    let mut lines = LineReader::new(src, 1 << 16);
+    let mut frame = Frame::new();
+    let sets = match kind {
+        VolumeFormat::Cube => crate::cube::read(&mut lines, &ctx, &mut frame, &budget)?,
+        VolumeFormat::Vasp(q) => {
+            let grids = crate::chgcar::read(&mut lines, &ctx, &mut frame, q, &budget)?;
+            let count = grids.len();
+            grids
+                .into_iter()
+                .enumerate()
+                .map(|(k, g)| {
+                    Volume::new(
+                        [0.0; 3],
+                        g.steps,
+                        g.dims,
+                        g.data,
+                        true,
+                        &q.set_name(k, count),
+                    )
+                    .map_err(|e| Error::InvalidValue { what: e.0 })
+                })
+                .collect::<Result<_, _>>()?
+        }
+    };
+    Ok((frame, sets))
+}
+
+/// What the file's size allows: a reader sizes nothing from a count beyond it.
+pub(crate) struct Budget {
+    /// The file's length in bytes, when known.
+    len: Option<u64>,
+}
+
+impl Budget {
+    /// No length known: counts are bounded by [`MAX_POINTS`] only, and reserves are small.
+    pub fn unknown() -> Budget {
+        Budget { len: None }
+    }
+
+    /// Most atoms the file can hold: an atom line takes at least 8 bytes.
+    pub fn max_atoms(&self) -> usize {
+        self.len.map_or(usize::MAX, |l| (l / 8) as usize)
+    }
+
+    /// Most values the file can hold: a value and its separator take at least 2 bytes.
+    pub fn max_values(&self) -> usize {
+        self.len
+            .map_or(MAX_POINTS, |l| ((l / 2) as usize).min(MAX_POINTS))
+    }
+
+    /// Values to reserve room for before reading them.
+    pub fn reserve_values(&self) -> usize {
+        self.len.map_or(1 << 16, |_| self.max_values())
+    }
+}
+
+/// What a walk over grid values does with them.
+pub(crate) enum Values<'a> {
+    /// Counts their fields (a scan: the structure only).
+    Count,
+    /// Parses each (a finite number, within f32 once scaled) and drops it.
+    Check,
+    /// Parses each and keeps it, scaled.
+    Keep(&'a mut Vec<f32>),
+}
+
+/// Walks `n` whitespace-separated values over as many lines as they take (the last of them
+/// must hold nothing after the last value), multiplied by `scale`; `what` names the data set
+/// in the error of a file that ends before them.
+pub(crate) fn walk_values<R: Read>(
+    lines: &mut LineReader<R>,
+    ctx: &Ctx,
+    n: usize,
+    scale: f64,
+    mode: &mut Values,
+    what: &str,
+) -> Result<(), Error> {
+    const VALUE: &str = "a number (a grid value: finite, within f32 range; Fortran's 1.0-100 \
+                         for 1.0E-100 is not one)";
+    let mut got = 0usize;
+    while got < n {
+        let p = lines.pos();
+        let Some((pos, line)) = lines.next_line().map_err(|e| ctx.io(p, e))? else {
+            return Err(ctx.truncated(p, format!("{n} values of {what}, found {got}")));
+        };
+        for t in fields(line) {
+            if got == n {
+                return Err(ctx.parse(pos, line, t, "nothing after the data set's last value"));
+            }
+            got += 1;
+            let keep = match mode {
+                Values::Count => continue,
+                Values::Check => None,
+                Values::Keep(v) => Some(v),
+            };
+            let v = parse_f64(t)
+                .map(|v| (v * scale) as f32)
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| ctx.parse(pos, line, t, VALUE))?;
+            if let Some(k) = keep {
+                k.push(v);
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The determinant of the rows `m`.
+pub(crate) fn det3(m: [[f64; 3]; 3]) -> f64 {
     m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
         - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
         + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])

@@ -589,9 +589,17 @@ fn vasp_campaign() {
         "vasp/XDATCAR_ase",
         "vasp/CONTCAR_ase_vel.vasp",
         "vasp/POSCAR_pmg_vel",
+        "volume/CHGCAR_small",
     ];
     let fx = files.map(|f| text_fixture(f, Format::Vasp));
     campaign("VASP", Format::Vasp, fx.into());
+}
+
+#[test]
+fn cube_campaign() {
+    let files = ["volume/ase_small.cube"];
+    let fx = files.map(|f| text_fixture(f, Format::Cube));
+    campaign("Gaussian cube", Format::Cube, fx.into());
 }
 
 #[test]

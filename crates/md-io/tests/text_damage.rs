@@ -24,6 +24,8 @@ const FILES: &[(&str, Format)] = &[
     ("vasp/XDATCAR_pmg", Format::Vasp),
     ("vasp/XDATCAR_ase", Format::Vasp),
     ("vasp/POSCAR_pmg_vel", Format::Vasp),
+    ("volume/CHGCAR_small", Format::Vasp),
+    ("volume/ase_small.cube", Format::Cube),
     ("crystal/two_blocks.cif", Format::CrystalCif),
     ("crystal/cod_9001665.cif", Format::CrystalCif),
     ("lammps_data/ase_full.data", Format::LammpsData),
@@ -146,8 +148,9 @@ fn frame_ends(bytes: &[u8], format: Format) -> Vec<usize> {
             }
             ends.push(bytes.len());
         }
-        Format::LammpsData => {
-            // One frame: the whole file (its sections may come in any order).
+        Format::LammpsData | Format::Cube => {
+            // One frame: the whole file (a LAMMPS data file's sections may come in any order;
+            // a cube's frame is its molecule, its grid values walked to the end).
             ends.push(bytes.len());
         }
         _ => unreachable!(),

@@ -1,0 +1,648 @@
+//! Volumetric readers (`volume::read_volumes`): Gaussian cube and VASP CHGCAR-family files.
+//!
+//! - Files written by ASE and pymatgen (tests/data/volume, `gen_volume.py`) against what those
+//!   programs' own readers give back (`expected.json`): atoms, grid origin and steps, dims, and
+//!   per data set the sum, min, max and values at listed points.
+//! - Synthetic files for each rule (Bohr and Å axes, DSET_IDS over two lines, NVAL, Fortran
+//!   exponents, augmentation occupancies and per-atom moments between grids, gzip, file names),
+//!   checked against the values the test wrote.
+//! - Damage: every cut and replaced bytes of a small cube and CHGCAR, under a heap cap; hostile
+//!   headers; error messages that name the file and the line.
+
+mod support {
+    pub mod alloc;
+}
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use serde_json::Value;
+use support::alloc::{CountingAlloc, measure};
+use texmap_md_io::volume::{VaspQuantity, Volume, VolumeFormat, read_volumes, read_volumes_from};
+use texmap_md_io::{Error, Format, Frame, Trajectory};
+
+#[global_allocator]
+static ALLOC: CountingAlloc = CountingAlloc;
+
+const BOHR: f64 = 0.529177210903;
+
+fn dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/volume")
+}
+
+fn f64s(v: &Value) -> Vec<f64> {
+    v.as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect()
+}
+
+fn close(a: f64, b: f64, tol: f64, what: &str) {
+    assert!((a - b).abs() <= tol, "{what}: {a} vs {b} (tolerance {tol})");
+}
+
+/// Relative 1e-5 of the value (values are f32 here, f64 in the reference).
+fn close_rel(a: f64, b: f64, what: &str) {
+    close(a, b, 1e-5 * b.abs().max(1e-30), what);
+}
+
+#[test]
+fn files_of_ase_and_pymatgen_read_as_their_readers_read_them() {
+    let expected: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir().join("expected.json")).unwrap())
+            .unwrap();
+    let files = expected.as_object().unwrap();
+    assert_eq!(files.len(), 5);
+    for (name, want) in files {
+        let path = dir().join(name);
+        let (frame, sets) = read_volumes(&path).unwrap_or_else(|e| panic!("{e}"));
+        // Atoms.
+        let symbols: Vec<&str> = want["symbols"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|s| s.as_str().unwrap())
+            .collect();
+        let got: Vec<&str> = frame.elements.iter().map(|e| e.symbol()).collect();
+        assert_eq!(got, symbols, "{name}");
+        for (i, p) in want["positions"].as_array().unwrap().iter().enumerate() {
+            for (a, x) in f64s(p).into_iter().enumerate() {
+                close(
+                    frame.positions[i][a] as f64,
+                    x,
+                    1e-4,
+                    &format!("{name} atom {i}"),
+                );
+            }
+        }
+        let periodic = want["periodic"].as_bool().unwrap();
+        assert_eq!(
+            frame.cell.is_some(),
+            periodic,
+            "{name}: a cell for VASP only"
+        );
+        // Grid.
+        let dims: Vec<usize> = f64s(&want["dims"]).iter().map(|d| *d as usize).collect();
+        let origin = f64s(&want["origin"]);
+        let sets_want = want["sets"].as_array().unwrap();
+        assert_eq!(sets.len(), sets_want.len(), "{name}");
+        for (s, (v, w)) in sets.iter().zip(sets_want).enumerate() {
+            let what = format!("{name} set {s}");
+            assert_eq!(v.dims.to_vec(), dims, "{what}");
+            assert_eq!(v.periodic, periodic, "{what}");
+            for a in 0..3 {
+                close(v.origin[a], origin[a], 1e-6, &what);
+                let step = f64s(&want["steps"][a]);
+                for (got, want) in v.steps[a].iter().zip(step) {
+                    close(*got, want, 1e-6, &format!("{what} step {a}"));
+                }
+            }
+            if let Some(names) = want.get("names") {
+                assert_eq!(v.name, names[s].as_str().unwrap(), "{what}");
+            } else {
+                assert_eq!(v.name, "analytic field, written by ASE", "{what}");
+            }
+            let sum: f64 = v.data.iter().map(|x| *x as f64).sum();
+            let abs_sum = w["abs_sum"].as_f64().unwrap();
+            close(
+                sum,
+                w["sum"].as_f64().unwrap(),
+                1e-5 * abs_sum,
+                &format!("{what} sum"),
+            );
+            let (lo, hi) = v.range().unwrap();
+            close_rel(
+                lo as f64,
+                w["min"].as_f64().unwrap(),
+                &format!("{what} min"),
+            );
+            close_rel(
+                hi as f64,
+                w["max"].as_f64().unwrap(),
+                &format!("{what} max"),
+            );
+            for p in w["samples"].as_array().unwrap() {
+                let p = f64s(p);
+                let (i, j, k) = (p[0] as usize, p[1] as usize, p[2] as usize);
+                close_rel(
+                    v.at(i, j, k) as f64,
+                    p[3],
+                    &format!("{what} at {i} {j} {k}"),
+                );
+            }
+        }
+        // The same file as a trajectory: one frame, the same atoms.
+        let mut t = Trajectory::open(&path).unwrap();
+        let want_format = if name.ends_with(".cube") {
+            Format::Cube
+        } else {
+            Format::Vasp
+        };
+        assert_eq!(t.format(), want_format, "{name}");
+        assert_eq!(t.n_frames().unwrap(), 1, "{name}");
+        let mut f = Frame::new();
+        assert!(t.read_next(&mut f).unwrap());
+        assert_eq!(f.positions, frame.positions, "{name}");
+        assert_eq!(f.elements, frame.elements, "{name}");
+        assert!(!t.read_next(&mut f).unwrap());
+    }
+}
+
+/// A density CHGCAR integrates to ρ·V summed over the points / N: the electron count VASP
+/// writes is the plain mean of the stored values.
+#[test]
+fn a_chgcar_density_integrates_to_the_mean_of_the_stored_values() {
+    let (frame, sets) = read_volumes(dir().join("CHGCAR_small")).unwrap();
+    let v = &sets[0];
+    let volume = frame.cell.unwrap().volume();
+    let n = v.data.len() as f64;
+    let stored_mean = v.data.iter().map(|x| *x as f64 * volume).sum::<f64>() / n;
+    close(
+        v.integral(),
+        stored_mean,
+        1e-6 * stored_mean.abs().max(1.0),
+        "integral",
+    );
+    close(
+        v.cell_volume() * n,
+        volume,
+        1e-9,
+        "grid cells tile the cell",
+    );
+}
+
+fn read(text: &str, kind: VolumeFormat, name: &str) -> Result<(Frame, Vec<Volume>), Error> {
+    read_volumes_from(text.as_bytes(), kind, name)
+}
+
+/// A cube file: two atoms, a 3 x 2 x 2 grid of `per_point` values per point, each `f(i, j, k,
+/// s)`; `count` is the signed point count written on each axis line.
+fn cube_text(natoms: &str, ids: &str, nval: &str, counts: [i64; 3], steps: [f64; 3]) -> String {
+    let per_point = if ids.is_empty() {
+        nval.trim().parse::<usize>().unwrap_or(1)
+    } else {
+        2
+    };
+    let mut s = format!("first title\nsecond\n{natoms} 0.1 0.2 0.3 {nval}\n");
+    for a in 0..3 {
+        let mut v = [0.0; 3];
+        v[a] = steps[a];
+        s += &format!("{} {} {} {}\n", counts[a], v[0], v[1], v[2]);
+    }
+    s += "8 8.0 1.0 2.0 3.0\n1 0.9 1.5 2.0 3.0\n";
+    s += ids;
+    let mut k = 0;
+    for i in 0..3 {
+        for j in 0..2 {
+            for z in 0..2 {
+                for p in 0..per_point {
+                    s += &format!("{:.5E}", f(i, j, z, p));
+                    k += 1;
+                    s += if k % 6 == 0 { "\n" } else { " " };
+                }
+            }
+        }
+    }
+    s + "\n"
+}
+
+fn f(i: usize, j: usize, k: usize, s: usize) -> f64 {
+    (1 + i + 10 * j + 100 * k) as f64 * 1.5e-5 * if s == 0 { 1.0 } else { -2.0 }
+}
+
+fn check_values(v: &Volume, s: usize) {
+    for k in 0..2 {
+        for j in 0..2 {
+            for i in 0..3 {
+                close_rel(v.at(i, j, k) as f64, f(i, j, k, s), &format!("{i} {j} {k}"));
+            }
+        }
+    }
+}
+
+#[test]
+fn cube_axes_in_bohr_and_in_angstrom() {
+    let bohr = cube_text("2", "", "", [3, 2, 2], [0.5, 0.6, 0.7]);
+    let (fb, vb) = read(&bohr, VolumeFormat::Cube, "b.cube").unwrap();
+    let ang = cube_text("2", "", "", [-3, -2, -2], [0.5, 0.6, 0.7]);
+    let (fa, va) = read(&ang, VolumeFormat::Cube, "a.cube").unwrap();
+    for (f, v, unit) in [(&fb, &vb[0], BOHR), (&fa, &va[0], 1.0)] {
+        assert_eq!(v.dims, [3, 2, 2]);
+        assert!(!v.periodic && f.cell.is_none());
+        assert_eq!(v.name, "first title");
+        for a in 0..3 {
+            close(v.origin[a], [0.1, 0.2, 0.3][a] * unit, 1e-12, "origin");
+            close(v.steps[a][a], [0.5, 0.6, 0.7][a] * unit, 1e-12, "step");
+        }
+        close(f.positions[1][0] as f64, 1.5 * unit, 1e-6, "atom x");
+        assert_eq!(f.elements[0].symbol(), "O");
+        assert_eq!(f.elements[1].symbol(), "H");
+        check_values(v, 0);
+    }
+    assert_eq!(fb.comment, "first title");
+}
+
+#[test]
+fn cube_dset_ids_wrapping_onto_a_second_line_give_one_volume_per_orbital() {
+    let text = cube_text("-2", "    2   11\n  12\n", "", [3, 2, 2], [0.5, 0.5, 0.5]);
+    let (frame, sets) = read(&text, VolumeFormat::Cube, "mo.cube").unwrap();
+    assert_eq!(frame.n_atoms(), 2);
+    assert_eq!(sets.len(), 2);
+    assert_eq!(sets[0].name, "orbital 11");
+    assert_eq!(sets[1].name, "orbital 12");
+    check_values(&sets[0], 0);
+    check_values(&sets[1], 1);
+    // NVAL 1 on line 3 is allowed beside DSET_IDS; NVAL 3 is not.
+    let one = cube_text("-2", "2 11 12\n", "1", [3, 2, 2], [0.5, 0.5, 0.5]);
+    assert_eq!(
+        read(&one, VolumeFormat::Cube, "mo.cube").unwrap().1.len(),
+        2
+    );
+    let three = one.replacen(" 1\n", " 3\n", 1);
+    let e = read(&three, VolumeFormat::Cube, "mo.cube").unwrap_err();
+    assert!(e.to_string().starts_with("mo.cube: frame 0, line 3"), "{e}");
+}
+
+#[test]
+fn cube_nval_2_gives_two_volumes() {
+    let text = cube_text("2", "", "2", [3, 2, 2], [0.5, 0.5, 0.5]);
+    let (_, sets) = read(&text, VolumeFormat::Cube, "two.cube").unwrap();
+    assert_eq!(sets.len(), 2);
+    assert_eq!(
+        (sets[0].name.as_str(), sets[1].name.as_str()),
+        ("value 1", "value 2")
+    );
+    check_values(&sets[0], 0);
+    check_values(&sets[1], 1);
+}
+
+#[test]
+fn fortran_exponents_parse_and_a_dropped_e_is_an_error_naming_the_line() {
+    let text = cube_text("2", "", "", [3, 2, 2], [0.5, 0.5, 0.5]);
+    assert!(
+        text.contains("1.50000E-5"),
+        "the values are written with E exponents"
+    );
+    let (_, sets) = read(&text, VolumeFormat::Cube, "e.cube").unwrap();
+    close_rel(sets[0].at(0, 0, 0) as f64, 1.5e-5, "E exponent");
+    // Fortran drops the E of a three-digit exponent: 1.0-100. Line 9 holds the first values.
+    let bad = text.replacen("1.50000E-5", "1.0-100", 1);
+    let e = read(&bad, VolumeFormat::Cube, "e.cube").unwrap_err();
+    let msg = e.to_string();
+    assert!(msg.starts_with("e.cube: frame 0, line 9, byte "), "{msg}");
+    assert!(
+        msg.contains("Fortran") && msg.ends_with("found '1.0-100'"),
+        "{msg}"
+    );
+    // A value beyond f32 is not finite there: an error too.
+    let big = text.replacen("1.50000E-5", "1e39", 1);
+    assert!(read(&big, VolumeFormat::Cube, "e.cube").is_err());
+}
+
+/// A CHGCAR of 2 atoms on a 2 x 3 x 2 grid: `total` then augmentation occupancies, a line of
+/// per-atom moments, the magnetisation and its occupancies; values `g(n, s)` in file order.
+fn chgcar_text() -> String {
+    let mut s = String::from(
+        "test cell\n1.0\n 3.0 0.0 0.0\n 1.0 4.0 0.0\n 0.0 0.5 5.0\nSi C\n1 1\nDirect\n\
+         0.0 0.0 0.0\n0.5 0.5 0.5\n\n   2   3   2\n",
+    );
+    let grid = |s: &mut String, set: usize| {
+        for n in 0..12 {
+            *s += &format!(" {:.11E}", g(n, set));
+            if n % 5 == 4 || n == 11 {
+                *s += "\n";
+            }
+        }
+    };
+    grid(&mut s, 0);
+    s += "augmentation occupancies   1   3\n 0.1 0.2 0.3\naugmentation occupancies   2   3\n\
+          0.1 0.2 -0.3E-01\n";
+    s += " 0.5000E+00 -0.2500E+00\n   2   3   2\n";
+    grid(&mut s, 1);
+    s += "augmentation occupancies   1   2\n 0.1 0.2\naugmentation occupancies   2   2\n 0.3 0.4\n";
+    s
+}
+
+fn g(n: usize, set: usize) -> f64 {
+    (n as f64 + 1.0) * if set == 0 { 10.0 } else { -1.0 }
+}
+
+#[test]
+fn chgcar_grids_around_augmentation_occupancies_and_moments() {
+    let text = chgcar_text();
+    let (frame, sets) = read(&text, VolumeFormat::Vasp(VaspQuantity::Density), "CHGCAR").unwrap();
+    let cell = frame.cell.unwrap();
+    close(cell.volume(), 60.0, 1e-12, "cell volume");
+    assert_eq!(frame.elements[1].symbol(), "C");
+    assert_eq!(frame.positions[1], [2.0, 2.25, 2.5]);
+    assert_eq!(sets.len(), 2);
+    assert_eq!(sets[0].name, "total density (e/Å³)");
+    assert_eq!(sets[1].name, "magnetisation density (e/Å³)");
+    for (s, v) in sets.iter().enumerate() {
+        assert!(v.periodic);
+        assert_eq!(v.dims, [2, 3, 2]);
+        assert_eq!(v.origin, [0.0; 3]);
+        assert_eq!(v.steps[1], [1.0 / 3.0, 4.0 / 3.0, 0.0]);
+        // x fastest, as VASP writes: data index n is the file's n-th value.
+        for (n, x) in v.data.iter().enumerate() {
+            close_rel(*x as f64, g(n, s) / 60.0, &format!("set {s} value {n}"));
+        }
+    }
+    // The same layout as a LOCPOT and an ELFCAR: values as written.
+    let (_, pot) = read(&text, VolumeFormat::Vasp(VaspQuantity::Potential), "LOCPOT").unwrap();
+    assert_eq!(pot[1].name, "local potential, spin down (eV)");
+    close_rel(pot[0].at(1, 2, 1) as f64, g(11, 0), "potential as written");
+    let (_, elf) = read(&text, VolumeFormat::Vasp(VaspQuantity::Elf), "ELFCAR").unwrap();
+    assert_eq!(
+        (elf[0].name.as_str(), elf[1].name.as_str()),
+        ("ELF, spin up", "ELF, spin down")
+    );
+    // Non-collinear: four grids, x y z magnetisations.
+    let mut ncl = text.clone();
+    let second = &text[text.rfind("   2   3   2\n").unwrap()..];
+    ncl += second;
+    ncl += second;
+    let (_, four) = read(&ncl, VolumeFormat::Vasp(VaspQuantity::Density), "CHGCAR").unwrap();
+    let names: Vec<&str> = four.iter().map(|v| v.name.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "total density (e/Å³)",
+            "magnetisation x density (e/Å³)",
+            "magnetisation y density (e/Å³)",
+            "magnetisation z density (e/Å³)"
+        ]
+    );
+}
+
+#[test]
+fn vasp_volumetric_names_and_cube_extensions() {
+    use VaspQuantity::*;
+    for (name, q) in [
+        ("CHGCAR", Some(Density)),
+        ("CHGCAR_spin", Some(Density)),
+        ("PARCHG.0012.ALLK", Some(Density)),
+        ("run1.CHGCAR", Some(Density)),
+        ("CHGCAR.vasp", Some(Density)),
+        ("CHG", Some(Density)),
+        ("AECCAR0", Some(Density)),
+        ("AECCAR2.gz", Some(Density)),
+        ("LOCPOT", Some(Potential)),
+        ("ELFCAR", Some(Elf)),
+        ("POSCAR", None),
+        ("CHGCARX", None),
+        ("notes.txt", None),
+    ] {
+        let format = VolumeFormat::from_path(Path::new(name));
+        assert_eq!(format, q.map(VolumeFormat::Vasp), "{name}");
+        if q.is_some() {
+            assert_eq!(
+                Format::from_path(Path::new(name)),
+                Some(Format::Vasp),
+                "{name}"
+            );
+        }
+    }
+    for name in ["a.cube", "a.CUB", "b.cube.gz"] {
+        assert_eq!(
+            VolumeFormat::from_path(Path::new(name)),
+            Some(VolumeFormat::Cube)
+        );
+        assert_eq!(
+            Format::from_path(Path::new(name)),
+            Some(Format::Cube),
+            "{name}"
+        );
+    }
+    let e = read_volumes("frame.xyz").unwrap_err();
+    assert!(e.to_string().starts_with("frame.xyz: unsupported"), "{e}");
+}
+
+#[test]
+fn gzip_files_are_read_through() {
+    let tmp = std::env::temp_dir().join(format!("texmap-volume-{}", std::process::id()));
+    std::fs::create_dir_all(&tmp).unwrap();
+    for (name, text, n) in [
+        (
+            "x.cube.gz",
+            cube_text("2", "", "", [3, 2, 2], [0.5, 0.5, 0.5]),
+            1,
+        ),
+        ("CHGCAR.gz", chgcar_text(), 2),
+    ] {
+        let path = tmp.join(name);
+        let mut z = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
+        z.write_all(text.as_bytes()).unwrap();
+        std::fs::write(&path, z.finish().unwrap()).unwrap();
+        let (frame, sets) = read_volumes(&path).unwrap();
+        assert_eq!((frame.n_atoms(), sets.len()), (2, n), "{name}");
+        let plain = tmp.join(name.trim_end_matches(".gz"));
+        std::fs::write(&plain, &text).unwrap();
+        assert_eq!(read_volumes(&plain).unwrap().1, sets, "{name}");
+    }
+    std::fs::remove_dir_all(&tmp).unwrap();
+}
+
+/// Reads `text` as a file named as `place` starts, and checks the error message: it starts
+/// with `place` and holds each of `parts`.
+fn error_names(text: &str, kind: VolumeFormat, place: &str, parts: &[&str]) {
+    let name = place.split(':').next().unwrap();
+    let msg = read(text, kind, name).unwrap_err().to_string();
+    assert!(msg.starts_with(place), "{msg}");
+    for p in parts {
+        assert!(msg.contains(p), "{msg}");
+    }
+}
+
+#[test]
+fn errors_name_the_file_the_line_and_what_was_expected() {
+    let cube = cube_text("2", "", "", [3, 2, 2], [0.5, 0.5, 0.5]);
+    // Cut after 10 of the 12 values: the data set, the count expected and found, the end.
+    let lines: Vec<&str> = cube.lines().collect();
+    let cut = format!("{}\n{}\n", lines[..8].join("\n"), "1.5E-5 ".repeat(10));
+    let e = read(&cut, VolumeFormat::Cube, "cut.cube").unwrap_err();
+    assert!(matches!(e, Error::Truncated { .. }), "{e}");
+    assert_eq!(
+        e.to_string(),
+        format!(
+            "cut.cube: frame 0, line 10, byte {}: file ends inside the frame: expected 12 \
+             values of the grid (3x2x2 points, 1 per point), found 10",
+            cut.len()
+        )
+    );
+    // An axis line with a zero count.
+    let bad = cube.replacen("2 0 0.5 0", "0 0 0.5 0", 1);
+    let expected = ["expected a point count, > 0 (Bohr) or < 0 (Å)"];
+    error_names(
+        &bad,
+        VolumeFormat::Cube,
+        "axis.cube: frame 0, line 5, byte ",
+        &expected,
+    );
+    // A CHGCAR whose second grid line differs from the first (line 21, after the moments).
+    let text = chgcar_text();
+    let k = text.rfind("   2   3   2\n").unwrap();
+    let text = format!("{}   2   3   3\n{}", &text[..k], &text[k + 13..]);
+    let expected = [
+        "the grid dimensions of the next data set",
+        "found '2   3   3'",
+    ];
+    let density = VolumeFormat::Vasp(VaspQuantity::Density);
+    error_names(
+        &text,
+        density,
+        "CHGCAR_x: frame 0, line 21, byte ",
+        &expected,
+    );
+    // Junk between grids.
+    let junk = chgcar_text().replacen(" 0.5000E+00 -0.2500E+00\n", "hello\n", 1);
+    let e = read(&junk, VolumeFormat::Vasp(VaspQuantity::Density), "CHGCAR").unwrap_err();
+    assert!(e.to_string().starts_with("CHGCAR: frame 0, line 20"), "{e}");
+    // A truncated CHGCAR names the data set.
+    let text = chgcar_text();
+    let aug = text.rfind("augmentation occupancies   1   2").unwrap();
+    let cut = &text[..text[..aug - 1].rfind('\n').unwrap() + 1];
+    let e = read(cut, VolumeFormat::Vasp(VaspQuantity::Density), "CHGCAR").unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("12 values of data set 2 (2x3x2 points), found 10"),
+        "{e}"
+    );
+}
+
+#[test]
+fn hostile_headers_are_refused_before_any_allocation() {
+    let cube = cube_text("2", "", "", [3, 2, 2], [0.5, 0.5, 0.5]);
+    let vasp = VolumeFormat::Vasp(VaspQuantity::Density);
+    let cases = [
+        (
+            cube.replacen("2 0.1 0.2 0.3", "2000000000 0.1 0.2 0.3", 1),
+            VolumeFormat::Cube,
+        ),
+        (
+            cube.replacen("3 0.5 0 0", "1073741824 0.5 0 0", 1),
+            VolumeFormat::Cube,
+        ),
+        (
+            cube.replacen("3 0.5 0 0", "-9223372036854775808 0.5 0 0", 1),
+            VolumeFormat::Cube,
+        ),
+        (
+            cube.replacen("0.1 0.2 0.3 ", "0.1 0.2 0.3 1000000000", 1),
+            VolumeFormat::Cube,
+        ),
+        (
+            chgcar_text().replacen("   2   3   2\n", "   2000   3000   2000\n", 1),
+            vasp,
+        ),
+        (
+            chgcar_text().replacen("   2   3   2\n", "   20   30   20\n", 1),
+            vasp,
+        ),
+        (chgcar_text().replacen("1 1\n", "1 1000000000\n", 1), vasp),
+        (
+            chgcar_text().replacen("occupancies   1   3", "occupancies   1 999999999", 1),
+            vasp,
+        ),
+    ];
+    for (text, kind) in cases {
+        let (r, peak) = measure(|| read(&text, kind, "hostile"));
+        assert!(r.is_err(), "{text:.200}");
+        assert!(
+            peak < 2 << 20,
+            "{peak} bytes for a {} byte file",
+            text.len()
+        );
+    }
+    // With the file's size known, a grid it cannot hold is refused at its header line.
+    let tmp = std::env::temp_dir().join(format!("texmap-hostile-{}", std::process::id()));
+    std::fs::create_dir_all(&tmp).unwrap();
+    let path = tmp.join("CHGCAR");
+    std::fs::write(
+        &path,
+        chgcar_text().replacen("   2   3   2\n", "   200 300 200\n", 1),
+    )
+    .unwrap();
+    let e = read_volumes(&path).unwrap_err();
+    assert!(
+        e.to_string().contains("line 12") && e.to_string().contains("2^30"),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&tmp).unwrap();
+}
+
+/// Start of the file's last number: a cut inside it that leaves a number cannot be told from
+/// a file without a final newline.
+fn last_token_start(b: &[u8]) -> usize {
+    let end = b.iter().rposition(|c| !c.is_ascii_whitespace()).unwrap();
+    b[..end]
+        .iter()
+        .rposition(|c| c.is_ascii_whitespace())
+        .unwrap()
+        + 1
+}
+
+/// Every cut is an error, or reads complete data sets of the whole file: all of a cube's
+/// (only a cut inside its last number, which still parses, reads), the first grids of a
+/// CHGCAR (a cut after a grid or its occupancies: the rest is optional), the last of them
+/// differing only in its last value when the cut leaves that number partial. Replaced bytes
+/// give a located error or a read. Neither holds more heap than 64 x the bytes + 1 MiB.
+#[test]
+fn every_cut_and_replaced_byte_of_a_small_cube_and_chgcar_is_an_error_or_complete_sets() {
+    for (name, kind) in [
+        ("ase_small.cube", VolumeFormat::Cube),
+        ("CHGCAR_small", VolumeFormat::Vasp(VaspQuantity::Density)),
+    ] {
+        let good = std::fs::read(dir().join(name)).unwrap();
+        let (_, all) = read_volumes_from(&good[..], kind, name).unwrap();
+        let cap = 64 * good.len() + (1 << 20);
+        let last = last_token_start(&good);
+        let located = |e: &Error| {
+            let at = e.location().unwrap_or_else(|| panic!("{e}"));
+            assert!(e.to_string().starts_with(name), "{e}");
+            assert!(at.line.is_some() && at.byte.is_some(), "{e}");
+        };
+        let mut reads = 0;
+        for cut in 0..good.len() {
+            let (r, peak) = measure(|| read_volumes_from(&good[..cut], kind, name));
+            assert!(peak <= cap, "{name} cut at {cut}: {peak} bytes");
+            let sets = match r {
+                Err(e) => {
+                    located(&e);
+                    continue;
+                }
+                Ok((_, sets)) => sets,
+            };
+            reads += 1;
+            let partial = cut > 0 && !good[cut - 1].is_ascii_whitespace();
+            let n = sets.len();
+            assert!(
+                (1..=all.len()).contains(&n),
+                "{name} cut at {cut}: {n} sets"
+            );
+            assert_eq!(sets[..n - 1], all[..n - 1], "{name} cut at {cut}");
+            let (a, b) = (&sets[n - 1], &all[n - 1]);
+            if a != b {
+                let k = b.data.len() - 1;
+                assert!(partial, "{name} cut at {cut}: set {n} differs");
+                assert_eq!(a.data[..k], b.data[..k], "{name} cut at {cut}");
+            }
+            if kind == VolumeFormat::Cube {
+                assert!(cut > last, "{name} cut at {cut} read");
+            }
+        }
+        assert!(reads > 0, "{name}: the cut inside the last number reads");
+        for at in 0..good.len() {
+            for junk in [b'x', b'\n', b' ', 0xff] {
+                let mut bad = good.clone();
+                bad[at] = junk;
+                let (r, peak) = measure(|| read_volumes_from(&bad[..], kind, name));
+                assert!(peak <= cap, "{name} byte {at}: {peak} bytes");
+                if let Err(e) = r {
+                    located(&e);
+                }
+            }
+        }
+    }
+}
