@@ -22,6 +22,9 @@
 //!   [`coordination`] counts each atom's neighbours within a cutoff, and [`cna`] classifies
 //!   its crystal structure, as OVITO's analyses do; [`hbonds`] finds hydrogen bonds by
 //!   MDAnalysis's geometric criterion.
+//! - [`volume`] reads volumetric data (Gaussian cube; VASP CHGCAR, CHG, PARCHG, LOCPOT, ELFCAR,
+//!   AECCAR) into grids with their atoms ([`volume::read_volumes`]); as trajectories these
+//!   files are one frame, the atoms (`Format::Cube`, `Format::Vasp`).
 //! - [`Writer`] writes XYZ and PDB.
 //! - [`elements`] maps atom names to elements, gives van der Waals radii and CPK colours, and
 //!   [`AtomStyle`] resolves each atom's radius and colour with user overrides.

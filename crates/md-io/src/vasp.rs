@@ -34,8 +34,14 @@
 //! kept as [`Frame::velocities`] in Å/ps. Whatever follows (the predictor-corrector block VASP
 //! writes for a restart) is not read.
 //!
+//! **Volumetric files** (CHGCAR, CHG, PARCHG, LOCPOT, ELFCAR, AECCAR*: a blank line and a
+//! grid line `NGX NGY NGZ` after the coordinates) are one frame, the structure: their grids are
+//! walked (values parsed when the frame is read, counted by a scan) so that a damaged or cut
+//! grid is an error for that frame. [`crate::volume::read_volumes`] reads their values.
+//!
 //! Files are recognised by name (`POSCAR`, `CONTCAR`, `XDATCAR`, with any suffix such as
-//! `POSCAR_relaxed` or `CONTCAR.2`; extensions `.vasp`, `.poscar`) or by the header's shape.
+//! `POSCAR_relaxed` or `CONTCAR.2`; extensions `.vasp`, `.poscar`; the volumetric names) or by
+//! the header's shape.
 //!
 //! # Damage
 //! Errors name the file, frame, line and byte: a scaling factor that is zero or not one or three

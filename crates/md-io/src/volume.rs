@@ -7,6 +7,63 @@
 //! A periodic volume (VASP's, on the unit cell) wraps: point `nx` along the first axis is
 //! point 0 again, so the cells between the last points and the first are part of it too.
 //!
+//! # Reading files
+//! [`read_volumes`] gives a file's atoms as a [`Frame`] (elements, positions in Å, a VASP
+//! file's cell) and every data set in it, in file order; the name tells the format
+//! ([`VolumeFormat::from_path`]; a `.gz` is read decompressed). [`read_volumes_from`] reads
+//! from memory or a pipe. The same files open as one-frame trajectories (the atoms):
+//! `Format::Cube`, and `Format::Vasp` for the VASP names.
+//!
+//! **Gaussian cube** (`.cube`, `.cub`; Gaussian's cubegen, Paul Bourke's description):
+//! 1. two comment lines (the first non-blank one names a single data set, else `values`);
+//! 2. `natoms x0 y0 z0 [NVAL]`: the atom count, the origin, and optionally the values per point;
+//! 3. three axis lines `n_i sx sy sz`: the point count and the step along axis i. A positive
+//!    count means Bohr (0.529177210903 Å, CODATA 2018) for the steps, the origin and the atom
+//!    positions, a negative one Å (|n_i| points; the three signs must agree);
+//! 4. |natoms| atom lines `Z charge x y z` (element by atomic number; 0 or beyond the table is
+//!    [`crate::Element::UNKNOWN`]);
+//! 5. when natoms < 0, a DSET_IDS record `m id1 … idm` over as many lines as it takes: each
+//!    point holds m values, one volume per id named `orbital <id>` (NVAL must be absent, 1 or
+//!    m); otherwise NVAL values per point, named `value 1`, `value 2`, … when NVAL > 1;
+//! 6. the values: whitespace-separated numbers in any line layout (`1.23456E-05`; Fortran's
+//!    `1.0-100`, an exponent that lost its `E`, is an error naming the line), x outermost, then
+//!    y, z fastest, the values of one point together. They are stored transposed into the
+//!    volume's i-fastest layout. Nothing but blank lines may follow them.
+//!
+//! A cube grid is not periodic and its frame has no cell.
+//!
+//! **VASP volumetric files** (named as [`VaspQuantity::from_file_name`] tells: `CHGCAR`,
+//! `CHG`, `PARCHG`, `LOCPOT`, `ELFCAR`, `AECCAR0/1/2`, also `CHGCAR_spin`,
+//! `PARCHG.0012.ALLK`, `run1.CHGCAR`, `CHGCAR.vasp`): a POSCAR block (comment, scaling
+//! factor, lattice, species, counts, coordinates: the structure, read as a POSCAR is), a
+//! blank line, `NGX NGY NGZ`, then NGX·NGY·NGZ values with x fastest (Fortran's order, the
+//! volume's own), 5 per line in a CHGCAR, 10 in a CHG. After a grid may come augmentation
+//! occupancies (`augmentation occupancies <atom> <count>` and that many numbers: checked,
+//! not kept) and a line of per-atom magnetic moments (one number per atom, as some VASP
+//! versions write), then the next grid: its dimension line (the first's again) and its
+//! values. The grids are periodic over the cell: origin 0, steps the lattice vectors / N.
+//!
+//! | file | holds | read as | data sets |
+//! |---|---|---|---|
+//! | `CHGCAR`, `CHG` | the charge density times the cell volume, ρ·V_cell (CHG: fewer digits, no occupancies) | ρ in e/Å³: divided by the cell volume (pymatgen's `data["total"] / structure.volume`) | `total density (e/Å³)`; spin-polarised (ISPIN=2) also `magnetisation density (e/Å³)` (ρ↑ − ρ↓); non-collinear `magnetisation x/y/z density (e/Å³)` |
+//! | `PARCHG` | the partial (band- or energy-resolved) density, ρ·V_cell | as CHGCAR | as CHGCAR |
+//! | `AECCAR0`, `AECCAR1`, `AECCAR2` | the core, proto-atomic valence and self-consistent valence all-electron densities (LAECHG), ρ·V_cell | as CHGCAR | `total density (e/Å³)` |
+//! | `LOCPOT` | the local potential, eV | as written | `local potential (eV)`; ISPIN=2 `local potential, spin up (eV)` and `… spin down (eV)`; non-collinear also `local potential B1 (eV)` to `B3` |
+//! | `ELFCAR` | the electron localisation function, 0 to 1 | as written | `ELF`; ISPIN=2 `ELF, spin up` and `ELF, spin down` |
+//!
+//! # Damage and memory
+//! Errors are the crate's [`Error`]: the file, line and byte offset and what was expected
+//! there, as the trajectory readers give them. A file that ends inside a data set is an
+//! [`Error::Truncated`] naming the set, the values expected and found, at the end of the file;
+//! a value that is not a number, or not finite within f32 once scaled, an [`Error::Parse`] at
+//! its line. (A cut between two data sets of a VASP file, where the rest is optional, or inside
+//! the last number, where what is left still parses, cannot be told from a whole file.)
+//! Nothing is sized from a count in a header: values are pushed as they are parsed; a grid
+//! of more than [`MAX_POINTS`] points, or, the file's length known ([`read_volumes`]), more
+//! values or atoms than its bytes could hold (2 bytes a value, 8 an atom line), is refused at
+//! its header line.
+//!
+//! # Example
 //! ```
 //! use texmap_md_io::volume::Volume;
 //!

@@ -646,3 +646,39 @@ fn every_cut_and_replaced_byte_of_a_small_cube_and_chgcar_is_an_error_or_complet
         }
     }
 }
+
+/// As a trajectory a cube is one frame, the molecule, even with blank comment lines (which the
+/// frame scan passes over); its values are walked, so a damaged one is an error for frame 0.
+#[test]
+fn a_cube_trajectory_is_one_frame_and_its_damaged_values_an_error() {
+    use std::io::Cursor;
+    let text = cube_text("2", "", "", [3, 2, 2], [0.5, 0.5, 0.5]);
+    let blank = text.replacen("first title\nsecond\n", "\n\n", 1);
+    for t in [&text, &blank] {
+        let mut traj =
+            Trajectory::from_reader(Cursor::new(t.clone()), Format::Cube, "m.cube").unwrap();
+        assert_eq!(traj.n_frames().unwrap(), 1);
+        let mut f = Frame::new();
+        assert!(traj.read_next(&mut f).unwrap());
+        assert_eq!(f.n_atoms(), 2);
+        assert_eq!(f.positions[1], [1.5, 2.0, 3.0].map(|x| (x * BOHR) as f32));
+        assert!(!traj.read_next(&mut f).unwrap());
+    }
+    let (_, sets) = read(&blank, VolumeFormat::Cube, "m.cube").unwrap();
+    assert_eq!(sets[0].name, "values");
+    let bad = text.replacen("1.50000E-5", "1.5x", 1);
+    let mut traj = Trajectory::from_reader(Cursor::new(bad), Format::Cube, "m.cube").unwrap();
+    let e = traj.read_next(&mut Frame::new()).unwrap_err();
+    assert!(
+        e.to_string().starts_with("m.cube: frame 0, line 9, byte "),
+        "{e}"
+    );
+    // A CHGCAR's damaged grid too, through the VASP reader.
+    let bad = chgcar_text().replacen("0.1 0.2 0.3", "0.1 0.x 0.3", 1);
+    let mut traj = Trajectory::from_reader(Cursor::new(bad), Format::Vasp, "CHGCAR").unwrap();
+    let e = traj.read_next(&mut Frame::new()).unwrap_err();
+    assert!(
+        e.to_string().starts_with("CHGCAR: frame 0, line 17, byte "),
+        "{e}"
+    );
+}
