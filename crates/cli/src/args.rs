@@ -671,6 +671,15 @@ pub enum BondsArg {
 }
 
 /// How molecules are drawn (`--style`).
+/// Which sides of the data `--isosurface` draws.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum IsoSignArg {
+    #[default]
+    Both,
+    Positive,
+    Negative,
+}
+
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum DrawStyle {
     /// Atoms at their radii, no bonds.
@@ -778,6 +787,38 @@ pub struct MolArgs {
     /// what lies behind them (the centre atoms, when another --rep draws them), as the surface's.
     #[arg(long, value_name = "A", default_value_t = 1.0)]
     pub polyhedra_opacity: f32,
+    /// Draw the isosurface of volumetric data at this level, as VMD, VESTA and Avogadro do: the
+    /// volume of a Gaussian cube file or a VASP CHGCAR / PARCHG / LOCPOT / ELFCAR given as the
+    /// input (or by --volume). Where the data also runs below −LEVEL (an orbital's negative
+    /// lobe) that surface is drawn too, in --isosurface-negative-color (see --isosurface-sign).
+    /// A CHGCAR's density is in e/Å³, a cube file's values as written (often e/bohr³);
+    /// `texmap info FILE` prints each data set's range.
+    #[arg(long, value_name = "LEVEL", allow_negative_numbers = true)]
+    pub isosurface: Option<f32>,
+    /// The volumetric data for --isosurface when the input is not itself a cube or CHGCAR file
+    /// (render a POSCAR or PDB with the density of another file; its grid must be in the same
+    /// coordinates).
+    #[arg(long, value_name = "FILE")]
+    pub volume: Option<PathBuf>,
+    /// Which data set of the volumetric file --isosurface draws, from 1: a CHGCAR's 1 is the
+    /// total density and 2 the magnetisation (spin-polarised runs); a cube file's the orbitals
+    /// in the order it lists them.
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    pub volume_set: usize,
+    /// Which sides --isosurface draws: both (+LEVEL and −LEVEL where the data reaches it),
+    /// positive (+LEVEL only) or negative (−LEVEL only).
+    #[arg(long, value_enum, default_value_t = IsoSignArg::Both)]
+    pub isosurface_sign: IsoSignArg,
+    /// Colour of the +LEVEL surface, #rrggbb or R,G,B.
+    #[arg(long, value_name = "COLOUR", default_value = "#3b6fd8")]
+    pub isosurface_color: String,
+    /// Colour of the −LEVEL surface, #rrggbb or R,G,B.
+    #[arg(long, value_name = "COLOUR", default_value = "#d84a3b")]
+    pub isosurface_negative_color: String,
+    /// The isosurfaces' opacity, 0.05 to 1 (below 1 the atoms inside show through, as the
+    /// surface style's --surface-opacity).
+    #[arg(long, value_name = "A", default_value_t = 1.0)]
+    pub isosurface_opacity: f32,
     /// The hbonds style's largest donor-acceptor distance, Å (MDAnalysis's default 3.0; up to
     /// 6). A hydrogen bonded to an N or O donates to an N or O acceptor within it when the
     /// donor-hydrogen-acceptor angle is at least --hbond-angle; distances use the nearest
@@ -944,6 +985,8 @@ Examples:
   texmap render run.xtc --topology conf.gro --style licorice --select protein --measure 'resid 10 and name CA; resid 20 and name CA' --measure-table d.csv -o d.png
   texmap render CONTCAR --rep 'all=ball-stick' --rep 'all=arrows' --arrow-scale 0.3 -o v.png
   texmap render poses.sdf --style licorice --bond-orders -o poses.png
+  texmap render homo.cube --style ball-stick --isosurface 0.02 --isosurface-opacity 0.7 -o homo.png
+  texmap render CHGCAR --style ball-stick --isosurface 0.05 --replicate 2,2,1 -o rho.png
   texmap render water.gro --color-by element --type-color OW=#ff0000 --radius-scale 0.5 -o w.png
   texmap render md.xyz --eye 0,0,50 --target 0,0,0 --up 0,1,0 --fov 30 --depth -o md.png";
 

@@ -201,6 +201,30 @@ fn info(
         let t = texmap_md_io::Topology::from_frame(&frame, traj.name());
         obj["residues"] = json!(t.n_residues());
     }
+    // Volumetric data (a cube file, a CHGCAR): each data set's grid and range, what
+    // --isosurface and --volume-set choose from.
+    if format.is_none() && texmap_md_io::volume::VolumeFormat::from_path(file).is_some() {
+        let (_, sets) = texmap_md_io::volume::read_volumes(file)?;
+        let sets: Vec<_> = sets
+            .iter()
+            .enumerate()
+            .map(|(i, v)| {
+                let (lo, hi) = v.range().unwrap_or((0.0, 0.0));
+                json!({
+                    "set": i + 1,
+                    "name": v.name,
+                    "points": v.dims,
+                    "origin": v.origin,
+                    "steps": v.steps,
+                    "periodic": v.periodic,
+                    "min": lo,
+                    "max": hi,
+                    "integral": v.integral(),
+                })
+            })
+            .collect();
+        obj["volumes"] = json!(sets);
+    }
     // Per-atom numbers a --color-by can name.
     if !frame.properties.is_empty() {
         let names: Vec<&str> = frame.properties.iter().map(|p| p.name.as_str()).collect();
@@ -450,6 +474,14 @@ fn render(a: &RenderArgs) -> Result<()> {
             "--polyhedra-opacity {polyhedra_opacity}: expected an opacity from 0.05 to 1"
         ));
     }
+    let isosurfaces = crate::scene::isosurfaces(&a.file, &a.mol)?;
+    if isosurfaces.is_some() && quality.is_some() {
+        return usage(
+            "--isosurface is drawn without --quality's anti-aliasing, ambient occlusion and shadows; drop --quality and its options",
+        );
+    }
+    let mut iso_mesh = texmap_md_scene::surface::MolMesh::default();
+    let iso_opacity = isosurfaces.as_ref().map_or(1.0, |i| i.opacity);
     if plan.draws_meshes() && quality.is_some() {
         return usage(
             "the cartoon, surface and polyhedra styles are drawn without --quality's anti-aliasing, ambient occlusion and shadows; drop --quality and its options, or draw those atoms in another style",
@@ -538,9 +570,9 @@ fn render(a: &RenderArgs) -> Result<()> {
             frames[0]
         );
     }
-    if a.export_mesh.is_some() && !plan.draws_meshes() {
+    if a.export_mesh.is_some() && !plan.draws_meshes() && isosurfaces.is_none() {
         return usage(
-            "--export-mesh writes the cartoon, surface and polyhedra styles' meshes: draw some atoms with --style cartoon, surface or polyhedra (or a --rep of them)",
+            "--export-mesh writes the cartoon, surface and polyhedra styles' meshes and --isosurface's: draw some atoms with --style cartoon, surface or polyhedra (or a --rep of them), or give --isosurface",
         );
     }
     for (k, &f) in frames.iter().enumerate() {
@@ -586,6 +618,11 @@ fn render(a: &RenderArgs) -> Result<()> {
         }
         plan.build(&mut builder, &mut md, &mut scene)
             .map_err(|e| fail(crate::scene::mol_error(e), &written))?;
+        if let Some(iso) = &isosurfaces {
+            let (mesh, materials) = iso.for_scene(scene.materials.len());
+            scene.materials.extend(materials);
+            iso_mesh = mesh;
+        }
         if let Some(t) = &mut hbond_table
             && mine.contains(&k)
         {
@@ -662,6 +699,7 @@ fn render(a: &RenderArgs) -> Result<()> {
                 && plan.cartoon_mesh().triangles.is_empty()
                 && plan.polyhedra_mesh().triangles.is_empty()
                 && plan.arrow_atoms().is_empty()
+                && iso_mesh.triangles.is_empty()
             {
                 let why = if a.mol.reps.is_empty() {
                     a.mol
@@ -694,6 +732,7 @@ fn render(a: &RenderArgs) -> Result<()> {
                 .iter()
                 .chain(&plan.arrows_mesh().positions)
                 .chain(plan.arrow_atoms())
+                .chain(&iso_mesh.positions)
             {
                 framed.push(*p, 0.0, 0);
             }
@@ -738,6 +777,7 @@ fn render(a: &RenderArgs) -> Result<()> {
             (plan.arrows_mesh(), 1.0),
             (&surface, surface_opacity),
             (plan.polyhedra_mesh(), polyhedra_opacity),
+            (&iso_mesh, iso_opacity),
         ];
         let out = match (method_of(a.method), quality) {
             (Some(_), Some(q)) => {
@@ -821,9 +861,10 @@ fn render(a: &RenderArgs) -> Result<()> {
             all.append(&surface);
             all.append(plan.polyhedra_mesh());
             all.append(plan.arrows_mesh());
+            all.append(&iso_mesh);
             if all.triangles.is_empty() {
                 let e = anyhow::anyhow!(
-                    "--export-mesh: frame {f} has no cartoon, surface or polyhedra to write"
+                    "--export-mesh: frame {f} has no cartoon, surface, polyhedra, arrows or isosurface to write"
                 );
                 return Err(fail(e, &written));
             }

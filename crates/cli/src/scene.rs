@@ -897,6 +897,138 @@ pub fn quality_options(
     Ok(Some(o))
 }
 
+/// What `--isosurface` draws: one mesh whose kind 0 is the +LEVEL side and kind 1 the −LEVEL
+/// side, their colours and opacity.
+pub struct Isosurfaces {
+    pub mesh: texmap_md_scene::surface::MolMesh,
+    pub colors: [[u8; 3]; 2],
+    pub opacity: f32,
+}
+
+impl Isosurfaces {
+    /// The mesh with its kinds moved past a scene's `base` materials, and the two materials
+    /// to append to them.
+    pub fn for_scene(
+        &self,
+        base: usize,
+    ) -> (
+        texmap_md_scene::surface::MolMesh,
+        [texmap_core::shade::Material; 2],
+    ) {
+        let mut mesh = self.mesh.clone();
+        for k in &mut mesh.kinds {
+            *k += base as u16;
+        }
+        let lin = |c: [u8; 3]| {
+            let v = texmap_core::color::srgb8_to_linear_rgb([c[0], c[1], c[2], 255]);
+            texmap_core::shade::Material::plastic(v)
+        };
+        (mesh, self.colors.map(lin))
+    }
+}
+
+/// The isosurfaces of `--isosurface` (with `--volume`, `--volume-set`, `--isosurface-sign`,
+/// the colours, `--isosurface-opacity` and a periodic volume's `--replicate`); `None` without
+/// `--isosurface`. Usage errors for options out of range and for a level the data never reaches.
+pub fn isosurfaces(file: &std::path::Path, m: &MolArgs) -> Result<Option<Isosurfaces>> {
+    use crate::args::IsoSignArg;
+    use texmap_md_scene::isosurface::{Side, isosurface};
+    let Some(level) = m.isosurface else {
+        if let Some(v) = &m.volume {
+            return usage(format!(
+                "--volume {}: give --isosurface LEVEL to draw its data",
+                v.display()
+            ));
+        }
+        return Ok(None);
+    };
+    if !level.is_finite() {
+        return usage(format!("--isosurface {level}: expected a finite number"));
+    }
+    let opacity = m.isosurface_opacity;
+    if !(opacity.is_finite() && (0.05..=1.0).contains(&opacity)) {
+        return usage(format!(
+            "--isosurface-opacity {opacity}: expected an opacity from 0.05 to 1"
+        ));
+    }
+    let color = |flag: &str, v: &str| parse_color(v).or_else(|e| usage(format!("{flag}: {e}")));
+    let colors = [
+        color("--isosurface-color", &m.isosurface_color)?,
+        color("--isosurface-negative-color", &m.isosurface_negative_color)?,
+    ];
+    let path = m.volume.as_deref().unwrap_or(file);
+    let (_, sets) = texmap_md_io::volume::read_volumes(path).with_context(|| {
+        format!(
+            "--isosurface reads volumetric data from {} (a Gaussian cube file, or a VASP CHGCAR, PARCHG, LOCPOT or ELFCAR; another file's with --volume)",
+            path.display()
+        )
+    })?;
+    let names: Vec<String> = sets
+        .iter()
+        .enumerate()
+        .map(|(i, v)| format!("{} {}", i + 1, v.name))
+        .collect();
+    let Some(vol) = m.volume_set.checked_sub(1).and_then(|i| sets.get(i)) else {
+        return usage(format!(
+            "--volume-set {}: {} holds {} data set(s): {}",
+            m.volume_set,
+            path.display(),
+            sets.len(),
+            names.join(", ")
+        ));
+    };
+    let (lo, hi) = vol.range().unwrap_or((0.0, 0.0));
+    let mut sides = Vec::new();
+    match m.isosurface_sign {
+        IsoSignArg::Both => {
+            sides.push((level, Side::Above, 0));
+            if level > 0.0 && lo < -level {
+                sides.push((-level, Side::Below, 1));
+            }
+        }
+        IsoSignArg::Positive => sides.push((level, Side::Above, 0)),
+        IsoSignArg::Negative => sides.push((-level, Side::Below, 1)),
+    }
+    let mut mesh = texmap_md_scene::surface::MolMesh::default();
+    for (l, side, kind) in sides {
+        mesh.append(&isosurface(vol, l, side, kind)?);
+    }
+    if mesh.triangles.is_empty() {
+        return usage(format!(
+            "--isosurface {level}: {} of {} runs from {lo} to {hi}, so no surface lies at that level",
+            vol.name,
+            path.display()
+        ));
+    }
+    // A periodic volume follows the atoms' periodic images (md-io's replicate: images from
+    // −(n − 1)/2 to n/2 along each cell vector).
+    if let (true, Some(n)) = (vol.periodic, m.replicate) {
+        let cell: [Vec3; 3] = std::array::from_fn(|a| {
+            Vec3::from(vol.steps[a].map(|v| v as f32)) * vol.dims[a] as f32
+        });
+        let one = mesh.clone();
+        mesh = texmap_md_scene::surface::MolMesh::default();
+        let range = |k: usize| -((n[k] as i32 - 1) / 2)..=(n[k] as i32 / 2);
+        for i in range(0) {
+            for j in range(1) {
+                for k in range(2) {
+                    let mut copy = one.clone();
+                    let shift = cell[0] * i as f32 + cell[1] * j as f32 + cell[2] * k as f32;
+                    for p in &mut copy.positions {
+                        *p += shift;
+                    }
+                    mesh.append(&copy);
+                }
+            }
+        }
+    }
+    Ok(Some(Isosurfaces {
+        mesh,
+        colors,
+        opacity,
+    }))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,0 +1,264 @@
+//! End-to-end tests of `texmap render --isosurface` on volumetric data written by another
+//! program: formaldehyde's HOMO as PySCF 2.14 writes a Gaussian cube file
+//! (tests/data/orbital/gen_orbital.py), against scikit-image's marching cubes of the same data
+//! and the reference ray tracer.
+
+use std::path::Path;
+use std::process::Output;
+
+mod common;
+use common::texmap;
+
+fn cube() -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/orbital/h2co_homo.cube.gz")
+        .to_str()
+        .unwrap()
+        .to_string()
+}
+
+fn reference() -> serde_json::Value {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/orbital/reference.json");
+    serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// Enclosed volume and area of the triangles of an OBJ file (1-based `v/vt/vn` faces).
+fn obj_volume_area(path: &Path) -> (f64, f64, usize) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut v: Vec<[f64; 3]> = Vec::new();
+    let (mut vol, mut area, mut n) = (0.0, 0.0, 0);
+    for line in text.lines() {
+        let mut it = line.split_whitespace();
+        match it.next() {
+            Some("v") => v.push(std::array::from_fn(|_| it.next().unwrap().parse().unwrap())),
+            Some("f") => {
+                let [a, b, c]: [[f64; 3]; 3] = std::array::from_fn(|_| {
+                    let t = it.next().unwrap();
+                    v[t.split('/').next().unwrap().parse::<usize>().unwrap() - 1]
+                });
+                let cross = |p: [f64; 3], q: [f64; 3]| {
+                    [
+                        p[1] * q[2] - p[2] * q[1],
+                        p[2] * q[0] - p[0] * q[2],
+                        p[0] * q[1] - p[1] * q[0],
+                    ]
+                };
+                let bc = cross(b, c);
+                vol += (a[0] * bc[0] + a[1] * bc[1] + a[2] * bc[2]) / 6.0;
+                let (ab, ac) = (
+                    [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
+                    [c[0] - a[0], c[1] - a[1], c[2] - a[2]],
+                );
+                let x = cross(ab, ac);
+                area += (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt() / 2.0;
+                n += 1;
+            }
+            _ => {}
+        }
+    }
+    (vol, area, n)
+}
+
+fn mean_abs_diff(a: &Path, b: &Path) -> f64 {
+    let (a, b) = (
+        image::open(a).unwrap().to_rgb8(),
+        image::open(b).unwrap().to_rgb8(),
+    );
+    let sum: u64 = a
+        .as_raw()
+        .iter()
+        .zip(b.as_raw())
+        .map(|(x, y)| (*x as i64 - *y as i64).unsigned_abs())
+        .sum();
+    sum as f64 / a.as_raw().len() as f64
+}
+
+/// The two lobes of PySCF's orbital at ±0.05: the exported meshes enclose the volumes and
+/// have the areas scikit-image's marching cubes gives the same grid (both close the lobes at
+/// the grid's border; the two extractions differ by their O(h²) cut corners), one lobe alone
+/// with --isosurface-sign; the rasterised picture matches the reference ray tracer's, opaque
+/// and translucent.
+#[test]
+fn an_orbitals_lobes_match_marching_cubes_and_the_ray_tracer() {
+    let want = reference();
+    let level = want["level"].as_f64().unwrap().to_string();
+    let dir = tempfile::tempdir().unwrap();
+    let cube = cube();
+    let base = [
+        cube.as_str(),
+        "--style",
+        "ball-stick",
+        "--isosurface",
+        level.as_str(),
+        "--size",
+        "320x240",
+    ];
+    let export = |name: &str, extra: &[&str]| {
+        let obj = dir.path().join(name);
+        let png = dir.path().join(format!("{name}.png"));
+        let mut args = vec!["render", "--quiet"];
+        args.extend(base);
+        args.extend(extra);
+        args.extend(["--export-mesh", obj.to_str().unwrap()]);
+        args.extend(["-o", png.to_str().unwrap()]);
+        let o = texmap(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        obj_volume_area(&obj)
+    };
+    let (pos, neg) = (&want["positive"], &want["negative"]);
+    let (mc_vol, mc_area) = (
+        pos["volume"].as_f64().unwrap() + neg["volume"].as_f64().unwrap(),
+        pos["area"].as_f64().unwrap() + neg["area"].as_f64().unwrap(),
+    );
+    let (vol, area, tris) = export("both.obj", &[]);
+    assert!(tris > 2000, "{tris} triangles");
+    assert!((vol / mc_vol - 1.0).abs() < 0.03, "{vol} Å³ vs {mc_vol}");
+    assert!(
+        (area / mc_area - 1.0).abs() < 0.03,
+        "{area} Å² vs {mc_area}"
+    );
+    let (one, _, one_tris) = export("pos.obj", &["--isosurface-sign", "positive"]);
+    let mc_one = pos["volume"].as_f64().unwrap();
+    assert!((one / mc_one - 1.0).abs() < 0.03, "{one} Å³ vs {mc_one}");
+    assert!(one_tris * 2 > tris - 50 && one_tris * 2 < tris + 50);
+
+    // Drawn by the rasteriser over the ray-cast atoms, and traced by the reference.
+    for opacity in ["1", "0.6"] {
+        let raycast = dir.path().join(format!("r{opacity}.png"));
+        let traced = dir.path().join(format!("t{opacity}.png"));
+        for (method, out) in [("raycast", &raycast), ("reference", &traced)] {
+            let mut args = vec!["render", "--quiet", "--method", method];
+            args.extend(base);
+            args.extend(["--isosurface-opacity", opacity, "-o", out.to_str().unwrap()]);
+            let o = texmap(&args);
+            assert!(o.status.success(), "{}", stderr(&o));
+        }
+        let d = mean_abs_diff(&raycast, &traced);
+        assert!(
+            d < 1.5,
+            "opacity {opacity}: mean |raycast - reference| = {d}"
+        );
+    }
+    // Both lobes in their colours: blue-ish and red-ish pixels.
+    let img = image::open(dir.path().join("r1.png")).unwrap().to_rgb8();
+    let blue = img
+        .pixels()
+        .filter(|p| p.0[2] as i32 > p.0[0] as i32 + 40)
+        .count();
+    let red = img
+        .pixels()
+        .filter(|p| p.0[0] as i32 > p.0[2] as i32 + 40)
+        .count();
+    assert!(blue > 2000 && red > 2000, "{blue} blue, {red} red pixels");
+}
+
+/// What the data cannot give is a usage error (exit 2) saying what it holds; a file with no
+/// volumetric data is an error naming it (exit 1).
+#[test]
+fn isosurface_errors_say_what_the_data_holds() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("x.png");
+    let out = out.to_str().unwrap();
+    let cube = cube();
+    let run = |extra: &[&str]| {
+        let mut args = vec!["render", "--quiet", cube.as_str(), "-o", out];
+        args.extend(extra);
+        texmap(&args)
+    };
+    let o = run(&["--isosurface", "5"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("runs from -0.558"), "{}", stderr(&o));
+    let o = run(&["--isosurface", "0.05", "--volume-set", "2"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("holds 1 data set"), "{}", stderr(&o));
+    let o = run(&["--isosurface", "0.05", "--isosurface-opacity", "0"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    let o = run(&["--volume", cube.as_str()]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--isosurface"), "{}", stderr(&o));
+    // A structure without a grid.
+    let xyz = dir.path().join("w.xyz");
+    std::fs::write(&xyz, "3\nwater\nO 0 0 0\nH 0.96 0 0\nH -0.24 0.93 0\n").unwrap();
+    let o = texmap(&[
+        "render",
+        "--quiet",
+        xyz.to_str().unwrap(),
+        "--isosurface",
+        "0.05",
+        "-o",
+        out,
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("w.xyz"), "{}", stderr(&o));
+    assert!(!Path::new(out).exists());
+}
+
+/// `texmap info` on a cube file: its atoms, and each data set's grid and range.
+#[test]
+fn info_gives_the_grid_and_the_range() {
+    let o = texmap(&["info", cube().as_str()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["atoms"], 4);
+    let want = reference();
+    let set = &v["volumes"][0];
+    assert_eq!(set["points"], want["shape"]);
+    let (lo, hi) = (want["min"].as_f64().unwrap(), want["max"].as_f64().unwrap());
+    assert!((set["min"].as_f64().unwrap() - lo).abs() < 1e-6);
+    assert!((set["max"].as_f64().unwrap() - hi).abs() < 1e-6);
+}
+
+/// A CHGCAR (pymatgen's, md-io's tests/data/volume/gen_volume.py) is periodic: its
+/// isosurface follows the atoms' periodic images, each image the same surface moved by a cell
+/// vector; `--volume-set 2` draws the magnetisation, both signs.
+#[test]
+fn a_chgcar_surface_follows_the_periodic_images() {
+    let chgcar = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../md-io/tests/data/volume/CHGCAR_pmg_spin")
+        .to_str()
+        .unwrap()
+        .to_string();
+    let dir = tempfile::tempdir().unwrap();
+    let export = |name: &str, extra: &[&str]| {
+        let obj = dir.path().join(name);
+        let png = dir.path().join(format!("{name}.png"));
+        let mut args = vec![
+            "render",
+            "--quiet",
+            chgcar.as_str(),
+            "--size",
+            "160x120",
+            "--export-mesh",
+            obj.to_str().unwrap(),
+            "-o",
+            png.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        let o = texmap(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        obj_volume_area(&obj)
+    };
+    let (v1, a1, n1) = export("one.obj", &["--isosurface", "0.2"]);
+    let (v4, a4, n4) = export("four.obj", &["--isosurface", "0.2", "--replicate", "2,2,1"]);
+    assert!(n1 > 100, "{n1} triangles");
+    assert_eq!(n4, 4 * n1);
+    assert!((v4 / v1 - 4.0).abs() < 1e-3, "{v4} vs 4 x {v1}");
+    assert!((a4 / a1 - 4.0).abs() < 1e-3, "{a4} vs 4 x {a1}");
+    let (_, _, both) = export("m.obj", &["--isosurface", "0.03", "--volume-set", "2"]);
+    let (_, _, pos) = export(
+        "mp.obj",
+        &[
+            "--isosurface",
+            "0.03",
+            "--volume-set",
+            "2",
+            "--isosurface-sign",
+            "positive",
+        ],
+    );
+    assert!(pos > 0 && both > pos, "{both} and {pos} triangles");
+}
