@@ -792,8 +792,14 @@ pub struct MolArgs {
     /// input (or by --volume). Where the data also runs below −LEVEL (an orbital's negative
     /// lobe) that surface is drawn too, in --isosurface-negative-color (see --isosurface-sign).
     /// A CHGCAR's density is in e/Å³, a cube file's values as written (often e/bohr³);
-    /// `texmap info FILE` prints each data set's range.
-    #[arg(long, value_name = "LEVEL", allow_negative_numbers = true)]
+    /// `texmap info FILE` prints each data set's range. Not with --align-to, which would move
+    /// the atoms away from the grid.
+    #[arg(
+        long,
+        value_name = "LEVEL",
+        allow_negative_numbers = true,
+        conflicts_with = "align_to"
+    )]
     pub isosurface: Option<f32>,
     /// The volumetric data for --isosurface when the input is not itself a cube or CHGCAR file
     /// (render a POSCAR or PDB with the density of another file; its grid must be in the same
