@@ -734,7 +734,9 @@ fn render(a: &RenderArgs) -> Result<()> {
                 .chain(plan.arrow_atoms())
                 .chain(&iso_mesh.positions)
             {
-                framed.push(*p, 0.0, 0);
+                // A point the camera must see: the smallest valid sphere (a radius of 0 is
+                // not a sphere, and the fit would leave the point out).
+                framed.push(*p, 1e-3, 0);
             }
             let plan =
                 crate::scene::camera_plan(&a.camera, size, &a.path, &md, &framed, frames.len())
