@@ -682,3 +682,50 @@ fn a_cube_trajectory_is_one_frame_and_its_damaged_values_an_error() {
         "{e}"
     );
 }
+
+/// PySCF's electrostatic potential cube of formaldehyde (`gen_esp.py`), interpolated between
+/// its grid points, against the potential PySCF evaluates exactly at those points; its density
+/// cube lies on the same grid.
+#[test]
+fn a_pyscf_potential_interpolates_to_pyscfs_exact_values() {
+    let want: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir().join("esp_points.json")).unwrap())
+            .unwrap();
+    let (atoms, esp) = read_volumes(dir().join("h2co_esp.cube.gz")).unwrap();
+    let (_, rho) = read_volumes(dir().join("h2co_density.cube.gz")).unwrap();
+    assert_eq!(atoms.n_atoms(), 4);
+    let (esp, rho) = (&esp[0], &rho[0]);
+    assert_eq!(
+        (esp.dims, esp.origin, esp.steps),
+        (rho.dims, rho.origin, rho.steps)
+    );
+    let points = want["points_angstrom"].as_array().unwrap();
+    let exact = want["esp_hartree_per_e"].as_array().unwrap();
+    let (mut worst, mut far) = (0.0f64, 0);
+    for (p, e) in points.iter().zip(exact) {
+        let p: [f64; 3] = std::array::from_fn(|a| p[a].as_f64().unwrap());
+        let e = e.as_f64().unwrap();
+        let got = esp.interpolate(p).expect("inside the grid");
+        let near = atoms
+            .positions
+            .iter()
+            .map(|a| {
+                (0..3)
+                    .map(|k| (a[k] as f64 - p[k]).powi(2))
+                    .sum::<f64>()
+                    .sqrt()
+            })
+            .fold(f64::INFINITY, f64::min);
+        // Where potential maps are drawn (a van der Waals surface, ≥ 1.2 Å from the nuclei)
+        // the field is smooth; next to a nucleus its 1/r peak falls between grid points.
+        if near >= 1.2 {
+            worst = worst.max((got - e).abs());
+            far += 1;
+        }
+    }
+    assert!(far >= 15, "{far} points");
+    assert!(
+        worst < 1e-3,
+        "largest interpolation error {worst} hartree/e"
+    );
+}
