@@ -221,9 +221,10 @@ pub fn parse_cutoff(s: &str) -> Result<f32, String> {
 }
 
 /// The colour maps of `--colormap`.
-#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum ColormapArg {
     /// Perceptually uniform, dark blue to yellow (matplotlib's default).
+    #[default]
     Viridis,
     /// Perceptually uniform, dark blue through magenta to yellow.
     Plasma,
@@ -821,6 +822,21 @@ pub struct MolArgs {
     /// Colour of the −LEVEL surface, #rrggbb or R,G,B.
     #[arg(long, value_name = "COLOUR", default_value = "#d84a3b")]
     pub isosurface_negative_color: String,
+    /// Colour the isosurface by the values of another volumetric file at its vertices, as an
+    /// electrostatic potential is mapped onto an electron density surface (GaussView's and
+    /// VMD's ESP maps): a cube file or CHGCAR-family file in the same coordinates, through
+    /// --isosurface-colormap over --isosurface-range, with a colour bar.
+    #[arg(long, value_name = "FILE", requires = "isosurface")]
+    pub isosurface_color_by: Option<PathBuf>,
+    /// The colour map of --isosurface-color-by.
+    #[arg(long, value_enum, default_value_t = ColormapArg::Coolwarm)]
+    pub isosurface_colormap: ColormapArg,
+    /// The values at the two ends of --isosurface-colormap, LO:HI (default: ±the largest
+    /// magnitude on the surface for values of both signs, else their range). HI:LO reverses
+    /// the map: --isosurface-range 0.05:-0.05 with coolwarm draws negative potentials red and
+    /// positive ones blue, GaussView's convention.
+    #[arg(long, value_name = "LO:HI", allow_hyphen_values = true)]
+    pub isosurface_range: Option<String>,
     /// The isosurfaces' opacity, 0.05 to 1 (below 1 the atoms inside show through, as the
     /// surface style's --surface-opacity).
     #[arg(long, value_name = "A", default_value_t = 1.0)]

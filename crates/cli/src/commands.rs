@@ -506,7 +506,22 @@ fn render(a: &RenderArgs) -> Result<()> {
             .map(str::to_ascii_lowercase)
         {
             Some(e) if e == "glb" => true,
-            Some(e) if e == "obj" => false,
+            Some(e) if e == "obj" => {
+                // An OBJ's texture and material library go beside it, named after it.
+                if ["png", "mtl"]
+                    .map(|e| p.with_extension(e))
+                    .contains(&a.output)
+                {
+                    return usage(format!(
+                        "--export-mesh {} writes its texture and materials to {} and {}, and -o {} is one of them: give the mesh or the image another name",
+                        p.display(),
+                        p.with_extension("png").display(),
+                        p.with_extension("mtl").display(),
+                        a.output.display()
+                    ));
+                }
+                false
+            }
             _ => {
                 return usage(format!(
                     "--export-mesh {}: expected a .glb or .obj file name",
@@ -878,8 +893,14 @@ fn render(a: &RenderArgs) -> Result<()> {
             };
             result.map_err(|e| fail(e.into(), &written))?;
         }
+        let atom_bar =
+            plan.uses_builder_coloring() && builder.color_by() == texmap_md_scene::ColorBy::Scalar;
         if plan.uses_builder_coloring() {
             crate::scene::draw_color_bar(&builder, &a.style, &mut out);
+        }
+        // A mapped isosurface's bar, unless the atoms' own takes the place.
+        if let Some(iso) = &isosurfaces {
+            iso.draw_color_bar(a.style.no_color_bar || atom_bar, &mut out);
         }
         if !atom_labels.is_empty() {
             let at = format!("frame {f} of {}", traj.name());

@@ -41,13 +41,7 @@ pub fn style_options(args: &StyleArgs) -> StyleOptions {
                 ColorBy::Scalar(s) => s.clone(),
                 _ => texmap_md_scene::ScalarSource::Index,
             },
-            map: match args.colormap {
-                ColormapArg::Viridis => Colormap::Viridis,
-                ColormapArg::Plasma => Colormap::Plasma,
-                ColormapArg::Coolwarm => Colormap::Coolwarm,
-                ColormapArg::Turbo => Colormap::Turbo,
-                ColormapArg::Gray => Colormap::Gray,
-            },
+            map: colormap(args.colormap),
             range: args.color_range,
         },
         radius_scale: args.radius_scale,
@@ -61,6 +55,17 @@ pub fn style_options(args: &StyleArgs) -> StyleOptions {
             .iter()
             .map(|t| (t.name.clone(), t.rgb))
             .collect(),
+    }
+}
+
+/// The library's colour map for a `--colormap` choice.
+pub fn colormap(c: ColormapArg) -> Colormap {
+    match c {
+        ColormapArg::Viridis => Colormap::Viridis,
+        ColormapArg::Plasma => Colormap::Plasma,
+        ColormapArg::Coolwarm => Colormap::Coolwarm,
+        ColormapArg::Turbo => Colormap::Turbo,
+        ColormapArg::Gray => Colormap::Gray,
     }
 }
 
@@ -897,34 +902,145 @@ pub fn quality_options(
     Ok(Some(o))
 }
 
-/// What `--isosurface` draws: one mesh whose kind 0 is the +LEVEL side and kind 1 the −LEVEL
-/// side, their colours and opacity.
+/// What `--isosurface` draws: one mesh whose kinds index `colors` (the +LEVEL and −LEVEL
+/// sides, or with `--isosurface-color-by` the colour map's bins and a grey for vertices off the
+/// other grid), their opacity, and the colour bar of a mapped surface.
 pub struct Isosurfaces {
     pub mesh: texmap_md_scene::surface::MolMesh,
-    pub colors: [[u8; 3]; 2],
+    pub colors: Vec<[u8; 3]>,
     pub opacity: f32,
+    pub bar: Option<IsoBar>,
 }
 
+/// A mapped isosurface's colour bar: the map, the values at its two ends, the title.
+pub type IsoBar = (Colormap, f32, f32, String);
+
+/// Colour-map bands of an `--isosurface-color-by` surface (`isosurface::bands`: the triangles
+/// cut where the value crosses from one band to the next).
+pub const ISO_BINS: usize = 64;
+
 impl Isosurfaces {
-    /// The mesh with its kinds moved past a scene's `base` materials, and the two materials
-    /// to append to them.
+    /// The mesh with its kinds moved past a scene's `base` materials, and the materials to
+    /// append to them.
     pub fn for_scene(
         &self,
         base: usize,
     ) -> (
         texmap_md_scene::surface::MolMesh,
-        [texmap_core::shade::Material; 2],
+        Vec<texmap_core::shade::Material>,
     ) {
         let mut mesh = self.mesh.clone();
         for k in &mut mesh.kinds {
             *k += base as u16;
         }
-        let lin = |c: [u8; 3]| {
+        let lin = |c: &[u8; 3]| {
             let v = texmap_core::color::srgb8_to_linear_rgb([c[0], c[1], c[2], 255]);
             texmap_core::shade::Material::plastic(v)
         };
-        (mesh, self.colors.map(lin))
+        (mesh, self.colors.iter().map(lin).collect())
     }
+
+    /// Draws the colour bar of a mapped surface onto `image` (unless `off`).
+    pub fn draw_color_bar(&self, off: bool, image: &mut texmap_core::frame::Frame) {
+        let Some((map, min, max, title)) = &self.bar else {
+            return;
+        };
+        if off {
+            return;
+        }
+        let (w, h) = (image.width() as usize, image.height() as usize);
+        texmap_md_scene::draw_color_bar(
+            image.color.as_flattened_mut(),
+            w,
+            h,
+            &texmap_md_scene::ColorBar {
+                map: *map,
+                min: *min,
+                max: *max,
+                title,
+            },
+        );
+    }
+}
+
+/// Parses `--isosurface-range LO:HI` (finite, LO ≠ HI; HI < LO reverses the map).
+fn parse_iso_range(s: &str) -> Result<(f32, f32)> {
+    let bad = || {
+        usage(format!(
+            "--isosurface-range {s:?}: expected LO:HI, two different numbers (e.g. -0.05:0.05, or 0.05:-0.05 to reverse the map)"
+        ))
+    };
+    let Some((a, b)) = s.split_once(':') else {
+        return bad();
+    };
+    match (a.trim().parse::<f32>(), b.trim().parse::<f32>()) {
+        (Ok(lo), Ok(hi)) if lo.is_finite() && hi.is_finite() && lo != hi => Ok((lo, hi)),
+        _ => bad(),
+    }
+}
+
+/// Cuts `mesh` into colour bands of `by`'s values at its vertices (see [`ISO_BINS`]): the
+/// colours and the colour bar.
+fn map_isosurface(
+    mesh: &mut texmap_md_scene::surface::MolMesh,
+    by: &texmap_md_io::volume::Volume,
+    path: &std::path::Path,
+    m: &MolArgs,
+) -> Result<(Vec<[u8; 3]>, IsoBar)> {
+    let values: Vec<Option<f64>> = mesh
+        .positions
+        .iter()
+        .map(|p| by.interpolate(p.as_dvec3().to_array()))
+        .collect();
+    let off = values.iter().filter(|v| v.is_none()).count();
+    if off > 0 {
+        crate::note!(
+            "{off} of the isosurface's {} vertices lie outside {}'s grid: their triangles are drawn grey",
+            values.len(),
+            path.display()
+        );
+    }
+    let (lo, hi) = match &m.isosurface_range {
+        Some(r) => parse_iso_range(r)?,
+        None => {
+            let on = values.iter().flatten();
+            let (min, max) = on.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                (a.min(v), b.max(v))
+            });
+            if min > max {
+                return usage(format!(
+                    "--isosurface-color-by {}: no vertex of the isosurface lies inside its grid",
+                    path.display()
+                ));
+            }
+            if min < 0.0 && max > 0.0 {
+                let r = min.abs().max(max) as f32;
+                (-r, r)
+            } else if min == max {
+                (min as f32 - 1.0, max as f32 + 1.0)
+            } else {
+                (min as f32, max as f32)
+            }
+        }
+    };
+    let map = colormap(m.isosurface_colormap);
+    let mut colors: Vec<[u8; 3]> = (0..ISO_BINS)
+        .map(|b| {
+            let c = map.srgb((b as f32 + 0.5) / ISO_BINS as f32);
+            c.map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8)
+        })
+        .collect();
+    colors.push([128, 128, 128]);
+    let values: Vec<f64> = values.into_iter().map(|v| v.unwrap_or(f64::NAN)).collect();
+    *mesh = texmap_md_scene::isosurface::bands(
+        mesh,
+        &values,
+        (lo as f64, hi as f64),
+        ISO_BINS as u16,
+        0,
+        ISO_BINS as u16,
+    );
+    Ok((colors, (map, lo, hi, by.name.clone())))
 }
 
 /// The isosurfaces of `--isosurface` (with `--volume`, `--volume-set`, `--isosurface-sign`,
@@ -952,7 +1068,7 @@ pub fn isosurfaces(file: &std::path::Path, m: &MolArgs) -> Result<Option<Isosurf
         ));
     }
     let color = |flag: &str, v: &str| parse_color(v).or_else(|e| usage(format!("{flag}: {e}")));
-    let colors = [
+    let mut colors = vec![
         color("--isosurface-color", &m.isosurface_color)?,
         color("--isosurface-negative-color", &m.isosurface_negative_color)?,
     ];
@@ -1000,6 +1116,18 @@ pub fn isosurfaces(file: &std::path::Path, m: &MolArgs) -> Result<Option<Isosurf
             path.display()
         ));
     }
+    let mut bar = None;
+    if let Some(by_path) = &m.isosurface_color_by {
+        let (_, by) = texmap_md_io::volume::read_volumes(by_path).with_context(|| {
+            format!(
+                "--isosurface-color-by reads volumetric data from {} (a Gaussian cube file, or a VASP CHGCAR, PARCHG, LOCPOT or ELFCAR)",
+                by_path.display()
+            )
+        })?;
+        let (c, b) = map_isosurface(&mut mesh, &by[0], by_path, m)?;
+        colors = c;
+        bar = Some(b);
+    }
     // A periodic volume follows the atoms' periodic images (md-io's replicate: images from
     // −(n − 1)/2 to n/2 along each cell vector).
     if let (true, Some(n)) = (vol.periodic, m.replicate) {
@@ -1026,6 +1154,7 @@ pub fn isosurfaces(file: &std::path::Path, m: &MolArgs) -> Result<Option<Isosurf
         mesh,
         colors,
         opacity,
+        bar,
     }))
 }
 

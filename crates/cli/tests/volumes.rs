@@ -262,3 +262,164 @@ fn a_chgcar_surface_follows_the_periodic_images() {
     );
     assert!(pos > 0 && both > pos, "{both} and {pos} triangles");
 }
+
+/// A cube file's text: atoms (Z, position in Å) and `f` on `n`³ points `step` Å apart from
+/// `origin` (axes in Å: negative counts; x outermost, z fastest).
+fn cube_text(
+    atoms: &[(u32, [f64; 3])],
+    origin: f64,
+    step: f64,
+    n: usize,
+    f: impl Fn([f64; 3]) -> f64,
+) -> String {
+    let mut s = format!(
+        "synthetic\nfield\n{} {origin} {origin} {origin}\n",
+        atoms.len()
+    );
+    for a in 0..3 {
+        let mut v = [0.0; 3];
+        v[a] = step;
+        s += &format!("-{n} {} {} {}\n", v[0], v[1], v[2]);
+    }
+    for (z, p) in atoms {
+        s += &format!("{z} 0.0 {} {} {}\n", p[0], p[1], p[2]);
+    }
+    for i in 0..n {
+        for j in 0..n {
+            for k in 0..n {
+                let p = [i, j, k].map(|c| origin + step * c as f64);
+                s += &format!("{:.8e}\n", f(p));
+            }
+        }
+    }
+    s
+}
+
+/// --isosurface-color-by: a Gaussian density's sphere coloured by a linear field z (on a
+/// coarser grid of its own, where interpolation is exact): every exported piece lies in the
+/// colour band of its z, in 64 bands over --isosurface-range (reversed too); the picture
+/// matches the reference ray tracer's; a range that is not two numbers is a usage error.
+#[test]
+fn a_surface_coloured_by_another_volume_is_banded_by_its_values() {
+    let dir = tempfile::tempdir().unwrap();
+    let atoms = [(8u32, [0.0, 0.0, 0.0])];
+    let rho = dir.path().join("rho.cube");
+    let pot = dir.path().join("pot.cube");
+    std::fs::write(
+        &rho,
+        cube_text(&atoms, -2.0, 0.1, 41, |p| {
+            (-(p[0] * p[0] + p[1] * p[1] + p[2] * p[2])).exp()
+        }),
+    )
+    .unwrap();
+    std::fs::write(&pot, cube_text(&atoms, -2.5, 0.5, 11, |p| p[2])).unwrap();
+    let (rho, pot) = (rho.to_str().unwrap(), pot.to_str().unwrap());
+    for (range, lo, hi) in [("-1:1", -1.0, 1.0), ("1:-1", 1.0, -1.0)] {
+        let obj = dir.path().join("m.obj");
+        let png = dir.path().join("picture.png");
+        let o = texmap(&[
+            "render",
+            "--quiet",
+            rho,
+            "--isosurface",
+            "0.3",
+            "--isosurface-color-by",
+            pot,
+            "--isosurface-range",
+            range,
+            "--size",
+            "240x180",
+            "--export-mesh",
+            obj.to_str().unwrap(),
+            "-o",
+            png.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        // Faces and the palette texel (kind) their uvs pick.
+        let text = std::fs::read_to_string(&obj).unwrap();
+        let (mut v, mut vt) = (Vec::<[f64; 3]>::new(), Vec::<f64>::new());
+        let mut bases = std::collections::BTreeSet::new();
+        let mut faces = 0;
+        let kinds_in_palette = {
+            // The palette is one row of materials + 1 texels (the scene's atom materials, the
+            // 64 bands, the grey): kinds from the uv's texel.
+            let png = obj.with_extension("png");
+            image::open(&png).map(|i| i.width()).unwrap_or(0)
+        };
+        for line in text.lines() {
+            let mut it = line.split_whitespace();
+            match it.next() {
+                Some("v") => v.push(std::array::from_fn(|_| it.next().unwrap().parse().unwrap())),
+                Some("vt") => vt.push(it.next().unwrap().parse().unwrap()),
+                Some("f") => {
+                    let corners: Vec<(usize, usize)> = it
+                        .map(|t| {
+                            let mut p = t.split('/');
+                            let vi = p.next().unwrap().parse::<usize>().unwrap() - 1;
+                            let ti = p.next().unwrap().parse::<usize>().unwrap() - 1;
+                            (vi, ti)
+                        })
+                        .collect();
+                    let kind = (vt[corners[0].1] * kinds_in_palette as f64).floor() as i64;
+                    // The band every corner's z lies in (closed: corners on a boundary are in
+                    // both); the piece's band is the one all its corners share.
+                    let us: Vec<f64> = corners
+                        .iter()
+                        .map(|&(vi, _)| ((v[vi][2] - lo) / (hi - lo) * 64.0).clamp(0.0, 64.0))
+                        .collect();
+                    let top = us.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+                    let bottom = us.iter().cloned().fold(f64::INFINITY, f64::min);
+                    assert!(top - bottom <= 1.0 + 1e-3, "a piece spans {bottom}..{top}");
+                    let band = ((bottom + top) / 2.0).floor().min(63.0) as i64;
+                    bases.insert(kind - band);
+                    faces += 1;
+                }
+                _ => {}
+            }
+        }
+        assert!(faces > 1000, "{faces} faces");
+        assert!(
+            kinds_in_palette > 64,
+            "palette of {kinds_in_palette} texels"
+        );
+        assert_eq!(bases.len(), 1, "kind - band: {bases:?}");
+    }
+    // Against the reference ray tracer.
+    let mut images = Vec::new();
+    for method in ["raycast", "reference"] {
+        let png = dir.path().join(format!("{method}.png"));
+        let o = texmap(&[
+            "render",
+            "--quiet",
+            "--method",
+            method,
+            rho,
+            "--isosurface",
+            "0.3",
+            "--isosurface-color-by",
+            pot,
+            "--size",
+            "240x180",
+            "-o",
+            png.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        images.push(png);
+    }
+    let d = mean_abs_diff(&images[0], &images[1]);
+    assert!(d < 1.5, "mean |raycast - reference| = {d}");
+    let o = texmap(&[
+        "render",
+        "--quiet",
+        rho,
+        "--isosurface",
+        "0.3",
+        "--isosurface-color-by",
+        pot,
+        "--isosurface-range",
+        "1:1",
+        "-o",
+        dir.path().join("x.png").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+}

@@ -22,6 +22,10 @@
 //!   from half a grid cell before the cell's origin faces to half a cell past its far faces,
 //!   and fits the same surface of the neighbouring cells.
 //!
+//! [`bands`] cuts a surface into colour bands of another quantity given at its vertices (an
+//! electrostatic potential on a density surface), along the lines where it crosses each band's
+//! boundary, so the colours change on smooth contours instead of in triangle steps.
+//!
 //! Vertex normals are the value's gradient (central differences at the grid points, one-sided
 //! at a border, interpolated trilinearly to the vertex and taken to Å through the inverse
 //! transpose of the steps); a vertex of a cell on a cap, where the region is cut rather than
@@ -361,4 +365,126 @@ pub fn isosurface(vol: &Volume, level: f32, side: Side, kind: u16) -> Result<Mol
         }
     }
     Ok(mesh)
+}
+
+/// `mesh` cut into colour bands of a value given at its vertices, as a map is coloured between
+/// contour lines: `values` (one per vertex, NaN where there is none) run from band 0 at `lo`
+/// to band `bins − 1` at `hi` (`hi < lo` reverses them; values beyond either end take the end
+/// band), each band `1 / bins` of the range. Every triangle is cut along the straight lines
+/// where the linearly interpolated value crosses a band boundary, each piece taking kind
+/// `first_kind + band`; a triangle with a NaN vertex keeps its shape and takes `off_kind`.
+/// The cut points are shared by the triangles on both sides of an edge, so a closed mesh stays
+/// closed, and its area and enclosed volume do not change.
+pub fn bands(
+    mesh: &MolMesh,
+    values: &[f64],
+    (lo, hi): (f64, f64),
+    bins: u16,
+    first_kind: u16,
+    off_kind: u16,
+) -> MolMesh {
+    let n = bins.max(1) as i64;
+    let scale = n as f64 / (hi - lo);
+    let u: Vec<f64> = values.iter().map(|v| (v - lo) * scale).collect();
+    let band = |u: f64| (u.floor() as i64).clamp(0, n - 1);
+    let mut out = MolMesh {
+        positions: mesh.positions.clone(),
+        normals: mesh.normals.clone(),
+        spacing: mesh.spacing,
+        ..MolMesh::default()
+    };
+    // The cut point of edge (i, j) at band boundary `level`, shared by both triangles.
+    let mut cuts: std::collections::HashMap<(u32, u32, i64), u32> = Default::default();
+    let mut cut = |out: &mut MolMesh, a: u32, b: u32, level: i64| -> u32 {
+        let (i, j) = (a.min(b), a.max(b));
+        *cuts.entry((i, j, level)).or_insert_with(|| {
+            let (ui, uj) = (u[i as usize], u[j as usize]);
+            let t = ((level as f64 - ui) / (uj - ui)) as f32;
+            let (pi, pj) = (mesh.positions[i as usize], mesh.positions[j as usize]);
+            let (ni, nj) = (mesh.normals[i as usize], mesh.normals[j as usize]);
+            out.positions.push(pi + (pj - pi) * t);
+            out.normals.push(ni.lerp(nj, t).normalize_or(ni));
+            (out.positions.len() - 1) as u32
+        })
+    };
+    let mut poly: Vec<u32> = Vec::with_capacity(8);
+    for (t, _) in mesh.triangles.iter().zip(&mesh.kinds) {
+        let ut = t.map(|i| u.get(i as usize).copied().unwrap_or(f64::NAN));
+        if ut.iter().any(|v| v.is_nan()) {
+            // Kept whole, but with the cut points its neighbours put on its edges whose ends
+            // both have values (fanned from a corner: pieces along an edge have no area, so
+            // that every edge still has its twin).
+            poly.clear();
+            for e in 0..3 {
+                let (a, b) = (t[e], t[(e + 1) % 3]);
+                let (ua, ub) = (ut[e], ut[(e + 1) % 3]);
+                poly.push(a);
+                if ua.is_nan() || ub.is_nan() {
+                    continue;
+                }
+                let (l0, l1) = (ua.min(ub).floor() as i64 + 1, ua.max(ub).ceil() as i64 - 1);
+                let levels = l0.max(1)..=l1.min(n - 1);
+                if ua < ub {
+                    for l in levels {
+                        poly.push(cut(&mut out, a, b, l));
+                    }
+                } else {
+                    for l in levels.rev() {
+                        poly.push(cut(&mut out, a, b, l));
+                    }
+                }
+            }
+            for w in 1..poly.len() - 1 {
+                out.triangles.push([poly[0], poly[w], poly[w + 1]]);
+                out.kinds.push(off_kind);
+            }
+            continue;
+        }
+        let bt = ut.map(band);
+        let (kmin, kmax) = (
+            bt.iter().min().copied().unwrap(),
+            bt.iter().max().copied().unwrap(),
+        );
+        if kmin == kmax {
+            out.triangles.push(*t);
+            out.kinds.push(first_kind + kmin as u16);
+            continue;
+        }
+        for k in kmin..=kmax {
+            // Band k's polygon: the triangle's corners in it (boundaries included) and the cut
+            // points of its two boundaries (levels k and k + 1, interior ones only), in order
+            // around the triangle.
+            poly.clear();
+            for e in 0..3 {
+                let (a, b) = (t[e], t[(e + 1) % 3]);
+                let (ua, ub) = (ut[e], ut[(e + 1) % 3]);
+                // Corners on a boundary belong to the bands on both sides of it.
+                let uc = ua.clamp(0.0, n as f64);
+                if k as f64 <= uc && uc <= (k + 1) as f64 {
+                    poly.push(a);
+                }
+                let levels = [k, k + 1]
+                    .into_iter()
+                    .filter(|&l| l >= 1 && l < n)
+                    .filter(|&l| ua.min(ub) < l as f64 && (l as f64) < ua.max(ub));
+                let mut ls: [i64; 2] = [0; 2];
+                let mut m = 0;
+                for l in levels {
+                    ls[m] = l;
+                    m += 1;
+                }
+                if m == 2 && ua > ub {
+                    ls.swap(0, 1);
+                }
+                for &l in &ls[..m] {
+                    poly.push(cut(&mut out, a, b, l));
+                }
+            }
+            for w in 1..poly.len().saturating_sub(1) {
+                out.triangles.push([poly[0], poly[w], poly[w + 1]]);
+                out.kinds.push(first_kind + k as u16);
+            }
+        }
+    }
+    out
 }

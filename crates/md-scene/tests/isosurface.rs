@@ -248,3 +248,67 @@ fn a_mirrored_grid_is_still_wound_outward_and_nothing_crosses_is_empty() {
         Err(IsoError::BadLevel(l)) if l.is_nan()
     ));
 }
+
+#[test]
+fn colour_bands_cut_the_surface_along_the_values_and_keep_it_closed() {
+    use texmap_md_scene::isosurface::bands;
+    let steps = [DVec3::X * 0.1, DVec3::Y * 0.1, DVec3::Z * 0.1];
+    let vol = sample(DVec3::splat(-2.0), steps, [41, 41, 41], false, |p| {
+        (-p.length_squared()).exp()
+    });
+    let m = isosurface(&vol, 0.3, Side::Above, 0).unwrap();
+    // Colour by x over [-1, 1] in 16 bands, reversed too; one vertex with no value.
+    let mut values: Vec<f64> = m.positions.iter().map(|p| p.x as f64).collect();
+    values[7] = f64::NAN;
+    for range in [(-1.0, 1.0), (1.0, -1.0)] {
+        let b = bands(&m, &values, range, 16, 5, 99);
+        assert_closed(&b);
+        assert!(
+            (b.area() / m.area() - 1.0).abs() < 1e-4,
+            "{} vs {}",
+            b.area(),
+            m.area()
+        );
+        assert!((b.volume() / m.volume() - 1.0).abs() < 1e-4);
+        assert!(b.triangles.len() > m.triangles.len());
+        let (lo, hi) = range;
+        // The triangles around the vertex with no value keep their area, in kind 99.
+        let tri_area = |m: &MolMesh, t: &[u32; 3]| {
+            let [a, c, d] = t.map(|i| m.positions[i as usize]);
+            (c - a).cross(d - a).length() as f64 / 2.0
+        };
+        let around: f64 = m
+            .triangles
+            .iter()
+            .filter(|t| t.contains(&7))
+            .map(|t| tri_area(&m, t))
+            .sum();
+        let off: f64 = b
+            .triangles
+            .iter()
+            .zip(&b.kinds)
+            .filter(|(_, k)| **k == 99)
+            .map(|(t, _)| tri_area(&b, t))
+            .sum();
+        assert!(
+            around > 0.0 && (off / around - 1.0).abs() < 1e-4,
+            "{off} vs {around}"
+        );
+        for (t, &k) in b.triangles.iter().zip(&b.kinds) {
+            if k == 99 {
+                continue;
+            }
+            assert!((5..21).contains(&k), "kind {k}");
+            // Every corner of a piece lies in its band (ends open to the clamped values).
+            let band = (k - 5) as f64;
+            for &i in t {
+                let u = (b.positions[i as usize].x as f64 - lo) / (hi - lo) * 16.0;
+                let u = u.clamp(0.0, 16.0);
+                assert!(
+                    u >= band - 1e-3 && u <= band + 1.0 + 1e-3,
+                    "u {u} in band {band}"
+                );
+            }
+        }
+    }
+}
