@@ -1060,6 +1060,17 @@ pub struct CompareArgs {
     pub style: StyleArgs,
 }
 
+/// A file's name without its directory, a final `.gz` and then its extension:
+/// `data/esp.cube.gz` is `esp`.
+pub fn strip_gz_stem(path: &std::path::Path) -> String {
+    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
+    let name = name.strip_suffix(".gz").unwrap_or(name);
+    match name.rsplit_once('.') {
+        Some((stem, _)) if !stem.is_empty() => stem.to_string(),
+        _ => name.to_string(),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1040,7 +1040,10 @@ fn map_isosurface(
         0,
         ISO_BINS as u16,
     );
-    Ok((colors, (map, lo, hi, by.name.clone())))
+    // The bar's title: the file's name (a cube's comment line, where its name would come from,
+    // is often a long title card).
+    let title = crate::args::strip_gz_stem(path);
+    Ok((colors, (map, lo, hi, title)))
 }
 
 /// The isosurfaces of `--isosurface` (with `--volume`, `--volume-set`, `--isosurface-sign`,
