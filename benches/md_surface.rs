@@ -3,7 +3,9 @@
 //! lattice 70 Å apart (71,442 atoms): the surface built at 0.5 Å (density, surface nets, Newton
 //! projection) and drawn over a cleared 1920x1080 frame; the chain alone also coloured by
 //! element (`3e8m_by_element`: the colour boundaries cut into the triangles they cross); the
-//! chain's cartoon (DSSP, spline, sweep). A movie pays them per frame.
+//! chain's cartoon (DSSP, spline, sweep). A movie pays them per frame. Volumetric data: the
+//! chain's Gaussian density on a 0.5 Å grid (as a cube file would hold it), its isosurface and
+//! that surface cut into 64 colour bands (`texmap render --isosurface`, `--isosurface-color-by`).
 //!
 //! `cargo bench --bench md_surface -- --warm-up-time 2 --measurement-time 10`
 //! (test mode, `cargo test --bench md_surface`, builds the one chain at 1.0 Å and 320x180.)
@@ -13,8 +15,10 @@ use glam::Vec3;
 use texmap::core::camera::Camera;
 use texmap::core::frame::Frame as Image;
 use texmap::core::shade::{Lighting, Material};
+use texmap::md_io::volume::Volume;
 use texmap::md_io::{AtomStyle, Frame, Trajectory};
 use texmap::md_scene::cartoon::append_cartoon;
+use texmap::md_scene::isosurface::{Side, bands, isosurface};
 use texmap::md_scene::surface::{MolMesh, SurfaceAtoms, SurfaceOptions, draw_mesh};
 
 fn bench(c: &mut Criterion) {
@@ -110,7 +114,70 @@ fn bench(c: &mut Criterion) {
             },
         );
     }
+    // Volumetric data: the chain's density, a Gaussian per atom (σ = 0.6 r) summed on a grid
+    // as a cube file holds it, then its isosurface (surface nets on the grid, normals from
+    // the gradient) and that surface cut into 64 colour bands by x (an ESP map's step).
+    let h = if test_mode { 1.0 } else { 0.5 };
+    let vol = density_volume(&chain, h);
+    let n_points = vol.data.len();
+    g.bench_function(format!("isosurface_3e8m_{n_points}points"), |b| {
+        b.iter(|| isosurface(&vol, 0.3, Side::Above, 0).unwrap())
+    });
+    let iso = isosurface(&vol, 0.3, Side::Above, 0).unwrap();
+    eprintln!(
+        "isosurface of {n_points} points: {} vertices, {} triangles",
+        iso.positions.len(),
+        iso.triangles.len()
+    );
+    let values: Vec<f64> = iso.positions.iter().map(|p| p.x as f64).collect();
+    let (lo, hi) = values
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(a, b), &v| (a.min(v), b.max(v)));
+    g.bench_function(
+        format!("bands64_3e8m_{}triangles", iso.triangles.len()),
+        |b| b.iter(|| bands(&iso, &values, (lo, hi), 64, 0, 64)),
+    );
     g.finish();
+}
+
+/// The Gaussian density of `atoms` (σ = 0.6 r, cut at 3σ) on a grid `h` Å apart.
+fn density_volume(atoms: &SurfaceAtoms, h: f32) -> Volume {
+    let (lo, hi) = atoms
+        .centers
+        .iter()
+        .fold((Vec3::MAX, Vec3::MIN), |(lo, hi), c| {
+            (lo.min(*c), hi.max(*c))
+        });
+    let (lo, hi) = (lo - Vec3::splat(5.0), hi + Vec3::splat(5.0));
+    let dims = ((hi - lo) / h)
+        .ceil()
+        .as_uvec3()
+        .to_array()
+        .map(|d| d as usize + 1);
+    let mut data = vec![0f32; dims[0] * dims[1] * dims[2]];
+    for (c, r) in atoms.centers.iter().zip(&atoms.radii) {
+        let sigma = 0.6 * r;
+        let cut = 3.0 * sigma;
+        let a = ((*c - lo - cut) / h).floor().max(Vec3::ZERO).as_uvec3();
+        let b = ((*c - lo + cut) / h).ceil().as_uvec3();
+        for k in a.z..=b.z.min(dims[2] as u32 - 1) {
+            for j in a.y..=b.y.min(dims[1] as u32 - 1) {
+                for i in a.x..=b.x.min(dims[0] as u32 - 1) {
+                    let p = lo + Vec3::new(i as f32, j as f32, k as f32) * h;
+                    let d2 = (p - *c).length_squared();
+                    data[(k as usize * dims[1] + j as usize) * dims[0] + i as usize] +=
+                        (-d2 / (2.0 * sigma * sigma)).exp();
+                }
+            }
+        }
+    }
+    let steps = [
+        [h as f64, 0.0, 0.0],
+        [0.0, h as f64, 0.0],
+        [0.0, 0.0, h as f64],
+    ];
+    let origin = lo.as_dvec3().to_array();
+    Volume::new(origin, steps, dims, data, false, "density").unwrap()
 }
 
 criterion_group!(benches, bench);
