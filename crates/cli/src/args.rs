@@ -852,8 +852,8 @@ pub struct MolArgs {
     #[arg(long, value_name = "DEG", default_value_t = texmap_md_io::hbonds::DEFAULT_ANGLE)]
     pub hbond_angle: f32,
     /// The arrows style's vectors: `velocity` (the file's, Å/ps), `displacement` (from the
-    /// first frame drawn, to the nearest periodic image: OVITO's Displacements with that frame
-    /// as the reference; --frames 0:100 measures from frame 0) or the stem of
+    /// first frame drawn or --displacement-reference, to the nearest periodic image: OVITO's
+    /// Displacements) or the stem of
     /// three per-atom properties (`f` for a LAMMPS dump's fx fy fz, `c_disp` for
     /// c_disp[1] c_disp[2] c_disp[3]).
     #[arg(long, value_name = "SOURCE", default_value = "velocity")]
@@ -882,11 +882,19 @@ pub struct MolArgs {
     #[arg(long)]
     pub bond_orders: bool,
     /// Give every atom the property `displacement`: its distance (Å) from where it was in the
-    /// first frame drawn, to the nearest periodic image (OVITO's Displacements modifier), for
+    /// first frame drawn (or --displacement-reference), to the nearest periodic image (OVITO's
+    /// Displacements modifier), for
     /// selections (--select 'prop displacement > 2') and colours (--color-by displacement
     /// turns it on by itself).
     #[arg(long)]
     pub displacements: bool,
+    /// Measure displacements (--displacements, --color-by displacement, --arrows
+    /// displacement) from this reference instead of the first frame drawn: a frame number of
+    /// the trajectory (0 for its first) or a structure file of the same atoms (its first
+    /// frame), OVITO's reference configuration. It is wrapped, unwrapped, replicated and
+    /// aligned as the frames are; with --align, the frames are superposed on it.
+    #[arg(long, value_name = "FRAME|FILE")]
+    pub displacement_reference: Option<String>,
     /// Also write the --measure values as a CSV table, one row per measurement and frame:
     /// frame, measure (0-based, in the order given), kind (distance, angle, dihedral), value
     /// (Å or degrees), the atoms' 0-based indices joined by spaces, and the spec as given.

@@ -576,7 +576,35 @@ fn render(a: &RenderArgs) -> Result<()> {
             Some(t)
         }
     };
-    if plan.draws_arrows()
+    if let Some(r) = &a.mol.displacement_reference {
+        if !plan.measures_displacements() {
+            return usage(format!(
+                "--displacement-reference {r}: nothing measures displacements; add --displacements, --color-by displacement or --arrows displacement"
+            ));
+        }
+        let mut reference = MdFrame::new();
+        match r.parse::<usize>() {
+            Ok(k) if k < n => {
+                traj.read_frame(k, &mut reference)?;
+                plan.label(&mut reference, traj.name(), k)?;
+            }
+            Ok(k) => {
+                return usage(format!(
+                    "--displacement-reference {k}: {} has {n} frames (0 to {})",
+                    a.file.display(),
+                    n - 1
+                ));
+            }
+            Err(_) => {
+                let mut t = open_trajectory_with(Path::new(r), None, options)?;
+                t.read_frame(0, &mut reference)?;
+                plan.label(&mut reference, t.name(), 0)?;
+            }
+        }
+        plan.set_displacement_reference(&mut reference)
+            .map_err(crate::scene::mol_error)
+            .with_context(|| format!("--displacement-reference {r}"))?;
+    } else if plan.draws_arrows()
         && a.mol.arrows.starts_with("displacement")
         && frames.first().is_some_and(|f| *f != 0)
     {

@@ -2594,3 +2594,64 @@ fn displacements_colour_and_select() {
     assert!(lit(2) > lit(1) + 50, "{} vs {}", lit(2), lit(1));
     assert!(lit(3) > lit(0) + 50);
 }
+
+/// --displacement-reference: displacements of ASE's XDATCAR measured from a chosen frame (so
+/// that frame itself has none: no atom is selected by `prop displacement > 0.001`) or from
+/// a structure file (the same file's first frame draws the same image as frame 0); a reference
+/// nothing uses, or past the last frame, is a usage error.
+#[test]
+fn displacements_measure_from_the_reference_given() {
+    let xdatcar = data("vasp/XDATCAR_ase");
+    let dir = tempfile::tempdir().unwrap();
+    let run = |name: &str, extra: &[&str]| {
+        let out = dir.path().join(name);
+        let mut args = vec!["render", "--quiet", xdatcar.as_str(), "--size", "160x120"];
+        args.extend(extra);
+        args.extend(["-o", out.to_str().unwrap()]);
+        (texmap(&args), out)
+    };
+    let moved = [
+        "--frames",
+        "2",
+        "--displacements",
+        "--select",
+        "prop displacement > 0.001",
+    ];
+    let (o, _) = run(
+        "self.png",
+        &[&moved[..], &["--displacement-reference", "2"]].concat(),
+    );
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("no atom to draw"), "{}", stderr(&o));
+    let (o, _) = run(
+        "first.png",
+        &[&moved[..], &["--displacement-reference", "0"]].concat(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let colour = ["--frames", "2", "--color-by", "displacement"];
+    let (o, a) = run(
+        "a.png",
+        &[&colour[..], &["--displacement-reference", "0"]].concat(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (o, b) = run(
+        "b.png",
+        &[&colour[..], &["--displacement-reference", &xdatcar]].concat(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+    let (o, c) = run(
+        "c.png",
+        &[&colour[..], &["--displacement-reference", "2"]].concat(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_ne!(std::fs::read(&a).unwrap(), std::fs::read(&c).unwrap());
+    let (o, _) = run("x.png", &["--displacement-reference", "0"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    let (o, _) = run(
+        "y.png",
+        &[&colour[..], &["--displacement-reference", "999"]].concat(),
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("frames (0 to"), "{}", stderr(&o));
+}

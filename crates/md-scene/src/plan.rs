@@ -861,6 +861,36 @@ impl MolPlan {
         }
     }
 
+    /// Measure displacements (the [`DISPLACEMENT`] property, displacement arrows) from `frame`
+    /// instead of from the first frame built: OVITO's reference configuration. Call it before
+    /// the first [`build`](Self::build). The frame takes the steps that move atoms before a
+    /// build measures them: the periodic treatment ([`MolOptions::pbc`]; unwrapping by bonds
+    /// found by distance), the periodic images and the alignment, which then superposes every
+    /// frame built on this one (unless it fits onto its own reference structure).
+    ///
+    /// Errors: those of the images and the alignment; a frame whose atom count differs from a
+    /// built frame's is an error of that build.
+    pub fn set_displacement_reference(&mut self, frame: &mut Frame) -> Result<(), MolError> {
+        let mut pairs = Vec::new();
+        match self.options.pbc {
+            Pbc::None => {}
+            Pbc::Wrap => texmap_md_io::pbc::wrap(frame),
+            Pbc::Unwrap => {
+                if frame.cell.is_some() {
+                    pairs = texmap_md_io::bonds::bonds_by_distance(frame, true).pairs;
+                    texmap_md_io::pbc::unwrap(frame, &pairs);
+                }
+            }
+        }
+        if let Some(n) = self.options.replicate {
+            texmap_md_io::replicate::replicate(frame, &mut pairs, n)
+                .map_err(MolError::Replicate)?;
+        }
+        self.align(frame)?;
+        self.arrow_reference = Some(frame.positions.clone());
+        Ok(())
+    }
+
     /// Periodic boundaries applied to `frame`, then `scene` built from it: selected atoms
     /// only, per-selection colours and radii, bonds between drawn atoms (never across the box).
     pub fn build(
@@ -1174,6 +1204,14 @@ impl MolPlan {
     /// Whether some representation draws arrows ([`DrawStyle::Arrows`]).
     pub fn draws_arrows(&self) -> bool {
         self.reps.iter().any(|r| r.draw == DrawStyle::Arrows)
+    }
+
+    /// Whether the frames built measure displacements (the [`DISPLACEMENT`] property, or
+    /// displacement arrows): what [`set_displacement_reference`](Self::set_displacement_reference)
+    /// changes.
+    pub fn measures_displacements(&self) -> bool {
+        self.options.displacement
+            || (self.draws_arrows() && self.options.arrows.source == ArrowSource::Displacement)
     }
 
     /// The last frame's arrows ([`DrawStyle::Arrows`]; empty without them).

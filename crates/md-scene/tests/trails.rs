@@ -124,3 +124,66 @@ fn displacements_are_a_property_selections_see() {
         assert_eq!(scene.centers.len(), usize::from(k >= 2), "frame {k}");
     }
 }
+
+/// `MolPlan::set_displacement_reference`: displacements from a frame given beforehand (here
+/// frame 3, walked through the box face), not from the first frame built; the reference is
+/// replicated with the frames, and one of another atom count is an error of the build.
+#[test]
+fn displacements_measure_from_a_given_reference() {
+    let mut p = MolPlan::new(MolOptions {
+        displacement: true,
+        ..MolOptions::default()
+    })
+    .unwrap();
+    let mut reference = frame(3, true);
+    p.set_displacement_reference(&mut reference).unwrap();
+    let mut builder = SceneBuilder::new(&StyleOptions::default()).unwrap();
+    for k in [0usize, 3, 5] {
+        let mut f = frame(k, true);
+        let mut scene = SphereScene::default();
+        p.build(&mut builder, &mut f, &mut scene).unwrap();
+        let d = f.property(texmap_md_scene::DISPLACEMENT).unwrap();
+        let want = 1.5 * (k as f32 - 3.0).abs();
+        assert!((d[0] - want).abs() < 1e-5, "frame {k}: {d:?}");
+        assert_eq!(d[1], 0.0);
+    }
+    // Replicated 2x1x1: the reference is too, image by image.
+    let mut p = MolPlan::new(MolOptions {
+        displacement: true,
+        replicate: Some([2, 1, 1]),
+        ..MolOptions::default()
+    })
+    .unwrap();
+    p.set_displacement_reference(&mut frame(3, true)).unwrap();
+    let mut f = frame(4, true);
+    p.build(&mut builder, &mut f, &mut SphereScene::default())
+        .unwrap();
+    let d = f.property(texmap_md_scene::DISPLACEMENT).unwrap();
+    assert_eq!(d.len(), 4);
+    for (i, v) in d.iter().enumerate() {
+        let want = if i % 2 == 0 { 1.5 } else { 0.0 };
+        assert!((v - want).abs() < 1e-5, "atom {i}: {d:?}");
+    }
+    // A reference of another atom count.
+    let mut p = MolPlan::new(MolOptions {
+        displacement: true,
+        ..MolOptions::default()
+    })
+    .unwrap();
+    let mut one = frame(0, true);
+    one.positions.truncate(1);
+    one.elements.truncate(1);
+    one.names.truncate(1);
+    p.set_displacement_reference(&mut one).unwrap();
+    let e = p
+        .build(
+            &mut builder,
+            &mut frame(1, true),
+            &mut SphereScene::default(),
+        )
+        .unwrap_err();
+    assert!(
+        e.to_string().contains('1') && e.to_string().contains('2'),
+        "{e}"
+    );
+}
