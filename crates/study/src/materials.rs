@@ -92,29 +92,14 @@ pub fn demo_section(out_dir: &Path) -> Result<String, MaterialsError> {
     // The camera frames the polyhedra too.
     let mut framed = scene.clone();
     for p in &mesh.positions {
-        framed.push(*p, 0.0, 0);
+        // The smallest valid sphere: a radius of 0 is left out of the fit.
+        framed.push(*p, 1e-3, 0);
     }
     let (cam, _) = fit_camera(&frame, &framed, ViewAxis::Auto, None, 480, 360).map_err(fail)?;
     let lighting = Lighting::default_for(&cam);
     let mut options = Options::new(Method::Raycast, lighting);
     options.draw_bonds = plan.draws_bonds();
-    let mut render = texmap_impostor::render(&scene, &cam, &options);
-    texmap_md_scene::surface::draw_mesh(
-        &mesh,
-        &scene.materials,
-        &cam,
-        &lighting,
-        0.85,
-        &mut render.frame,
-    )
-    .map_err(fail)?;
-    let (w, h) = (render.frame.width(), render.frame.height());
-    let raw: Vec<u8> = render.frame.color.iter().flatten().copied().collect();
-    let png = dir.join("rutile.png");
-    image::RgbaImage::from_raw(w, h, raw)
-        .ok_or_else(|| fail("a frame of its own size"))?
-        .save(&png)
-        .map_err(fail)?;
+    draw_and_save(&scene, &mesh, &cam, &options, 0.85, &dir.join("rutile.png"))?;
     // What the picture holds: 3 x 3 x 4 cells of two Ti, each an octahedron of 8 faces.
     let titanium = 2 * 3 * 3 * 4;
     let faces = mesh.triangles.len();
@@ -124,6 +109,7 @@ pub fn demo_section(out_dir: &Path) -> Result<String, MaterialsError> {
             "expected {titanium} octahedra of 8 faces and 9.908 Å³, drew {faces} faces of {volume:.3} Å³ each"
         )));
     }
+    let orbital = orbital_section(&dir)?;
     Ok(format!(
         "<p>Rutile TiO<sub>2</sub> (built in: its six atoms of the unit cell), 3 x 3 x 4 cells, \
          drawn as VESTA draws a crystal: the TiO<sub>6</sub> coordination polyhedra \
@@ -133,7 +119,117 @@ pub fn demo_section(out_dir: &Path) -> Result<String, MaterialsError> {
          atoms: 9.908 Å<sup>3</sup>). The same pipeline reads VASP POSCAR/XDATCAR, \
          crystallographic CIF (expanded by its symmetry operations) and LAMMPS data files, and \
          draws arrows (<code>--rep 'all=arrows'</code>), trails and measurements.</p>\n\
-         <img src=\"materials/rutile.png\" alt=\"rutile's TiO6 octahedra\" width=\"480\">\n"
+         <img src=\"materials/rutile.png\" alt=\"rutile's TiO6 octahedra\" width=\"480\">\n\
+         {orbital}"
+    ))
+}
+
+/// The spheres of `scene` ray-cast, `mesh` drawn over them at `opacity`, saved as a PNG.
+fn draw_and_save(
+    scene: &SphereScene,
+    mesh: &texmap_md_scene::surface::MolMesh,
+    cam: &texmap_core::camera::Camera,
+    options: &Options,
+    opacity: f32,
+    png: &Path,
+) -> Result<(), MaterialsError> {
+    let mut render = texmap_impostor::render(scene, cam, options);
+    let lighting = options.lighting;
+    texmap_md_scene::surface::draw_mesh(
+        mesh,
+        &scene.materials,
+        cam,
+        &lighting,
+        opacity,
+        &mut render.frame,
+    )
+    .map_err(fail)?;
+    let (w, h) = (render.frame.width(), render.frame.height());
+    let raw: Vec<u8> = render.frame.color.iter().flatten().copied().collect();
+    image::RgbaImage::from_raw(w, h, raw)
+        .ok_or_else(|| fail("a frame of its own size"))?
+        .save(png)
+        .map_err(fail)
+}
+
+/// The bohr radius in Å.
+const BOHR: f64 = 0.529177210903;
+
+/// The hydrogen atom's 3d_z² orbital (atomic units): `(3z² − r²) e^(−r/3) / (81 √(6π))`.
+fn d_z2(p: [f64; 3]) -> f64 {
+    let r2 = p[0] * p[0] + p[1] * p[1] + p[2] * p[2];
+    (3.0 * p[2] * p[2] - r2) * (-r2.sqrt() / 3.0).exp()
+        / (81.0 * (6.0 * std::f64::consts::PI).sqrt())
+}
+
+/// Volumetric data drawn as `texmap render --isosurface` draws a cube file's orbital: the
+/// hydrogen atom's 3d_z² orbital sampled on an 81³ grid (as a cube file would hold it), its
+/// two lobes at +0.004 and the torus at −0.004 bohr^−3/2. The section checks the enclosed
+/// volumes against a count of the exact function's points on a grid three times finer.
+fn orbital_section(dir: &Path) -> Result<String, MaterialsError> {
+    use texmap_md_io::volume::Volume;
+    use texmap_md_scene::isosurface::{Side, isosurface};
+    let (n, half) = (81usize, 22.0f64);
+    let h = 2.0 * half / (n - 1) as f64;
+    let mut data = Vec::with_capacity(n * n * n);
+    for k in 0..n {
+        for j in 0..n {
+            for i in 0..n {
+                let p = [i, j, k].map(|c| -half + h * c as f64);
+                data.push(d_z2(p) as f32);
+            }
+        }
+    }
+    let step = h * BOHR;
+    let steps = [[step, 0.0, 0.0], [0.0, step, 0.0], [0.0, 0.0, step]];
+    let vol = Volume::new([-half * BOHR; 3], steps, [n; 3], data, false, "3d_z2").map_err(fail)?;
+    let level = 0.004f32;
+    let mut mesh = isosurface(&vol, level, Side::Above, 1).map_err(fail)?;
+    let torus = isosurface(&vol, -level, Side::Below, 2).map_err(fail)?;
+    let (v_pos, v_neg) = (mesh.volume(), torus.volume());
+    mesh.append(&torus);
+    // The exact volumes: points of a grid three times finer inside each region (bohr³ to Å³).
+    let (m, (mut pos, mut neg)) = (3 * (n - 1), (0usize, 0usize));
+    let f = h / 3.0;
+    for k in 0..m {
+        for j in 0..m {
+            for i in 0..m {
+                let v = d_z2([i, j, k].map(|c| -half + f * (c as f64 + 0.5)));
+                pos += (v > level as f64) as usize;
+                neg += (v < -level as f64) as usize;
+            }
+        }
+    }
+    let cell = (f * BOHR).powi(3);
+    let (q_pos, q_neg) = (pos as f64 * cell, neg as f64 * cell);
+    if (v_pos / q_pos - 1.0).abs() > 0.03 || (v_neg / q_neg - 1.0).abs() > 0.03 {
+        return Err(fail(format!(
+            "3d_z2 at ±{level}: the isosurfaces enclose {v_pos:.1} and {v_neg:.1} Å³, the exact function {q_pos:.1} and {q_neg:.1}"
+        )));
+    }
+    // The atom at the centre, the lobes blue and the torus red, three-quarter view.
+    let mut scene = SphereScene::new(vec![
+        texmap_core::shade::Material::plastic(texmap_core::glam::Vec3::splat(0.9)),
+        texmap_core::shade::Material::plastic(texmap_core::glam::Vec3::new(0.05, 0.17, 0.69)),
+        texmap_core::shade::Material::plastic(texmap_core::glam::Vec3::new(0.69, 0.07, 0.05)),
+    ]);
+    scene.push(texmap_core::glam::Vec3::ZERO, 0.5, 0);
+    let mut framed = scene.clone();
+    for p in &mesh.positions {
+        framed.push(*p, 1e-3, 0);
+    }
+    let (cam, _) = fit_camera(&Frame::new(), &framed, ViewAxis::X, None, 480, 360).map_err(fail)?;
+    let options = Options::new(Method::Raycast, Lighting::default_for(&cam));
+    draw_and_save(&scene, &mesh, &cam, &options, 0.8, &dir.join("orbital.png"))?;
+    Ok(format!(
+        "<p>Volumetric data, as <code>texmap render orbital.cube --isosurface 0.004</code> \
+         draws a Gaussian cube file (or a VASP CHGCAR): the hydrogen atom's 3d<sub>z²</sub> \
+         orbital (built in, sampled on an {n}³ grid), its two lobes at +{level} and its torus at \
+         −{level} bohr<sup>−3/2</sup> by surface nets on the grid, {} triangles. They enclose \
+         {v_pos:.1} and {v_neg:.1} Å<sup>3</sup>; the exact function, counted on a grid three \
+         times finer: {q_pos:.1} and {q_neg:.1} Å<sup>3</sup>.</p>\n\
+         <img src=\"materials/orbital.png\" alt=\"the 3d_z2 orbital's lobes and torus\" width=\"480\">\n",
+        mesh.triangles.len()
     ))
 }
 
@@ -152,5 +248,18 @@ mod tests {
         assert_eq!(img.dimensions(), (480, 360));
         let lit = img.pixels().filter(|p| p.0[..3] != [0, 0, 0]).count();
         assert!(lit > 20_000, "{lit}");
+        assert!(html.contains("3d<sub>z²</sub>"), "{html}");
+        let img = image::open(dir.path().join("materials/orbital.png"))
+            .unwrap()
+            .to_rgba8();
+        let blue = img
+            .pixels()
+            .filter(|p| p.0[2] as i32 > p.0[0] as i32 + 40)
+            .count();
+        let red = img
+            .pixels()
+            .filter(|p| p.0[0] as i32 > p.0[2] as i32 + 40)
+            .count();
+        assert!(blue > 5_000 && red > 5_000, "{blue} blue, {red} red");
     }
 }
