@@ -825,18 +825,30 @@ pub struct MolArgs {
     /// Colour the isosurface by the values of another volumetric file at its vertices, as an
     /// electrostatic potential is mapped onto an electron density surface (GaussView's and
     /// VMD's ESP maps): a cube file or CHGCAR-family file in the same coordinates, through
-    /// --isosurface-colormap over --isosurface-range, with a colour bar.
+    /// --volume-colormap over --volume-range, with a colour bar.
     #[arg(long, value_name = "FILE", requires = "isosurface")]
     pub isosurface_color_by: Option<PathBuf>,
-    /// The colour map of --isosurface-color-by.
+    /// Draw a plane through the volumetric data coloured by its values, as VESTA draws a
+    /// section and VMD a VolumeSlice: AXIS (a, b or c: the grid's first, second or third axis,
+    /// a VASP file's lattice vectors) and the position along it as a fraction of the grid
+    /// (0 to 1), through --volume-colormap over --volume-range, with a colour bar. The data are
+    /// the input's (or --volume's, --volume-set). Repeatable: --volume-slice c:0.5
+    /// --volume-slice a:0.
+    #[arg(
+        long = "volume-slice",
+        value_name = "AXIS:F",
+        conflicts_with = "align_to"
+    )]
+    pub volume_slices: Vec<String>,
+    /// The colour map of --isosurface-color-by and --volume-slice.
     #[arg(long, value_enum, default_value_t = ColormapArg::Coolwarm)]
-    pub isosurface_colormap: ColormapArg,
-    /// The values at the two ends of --isosurface-colormap, LO:HI (default: ±the largest
-    /// magnitude on the surface for values of both signs, else their range). HI:LO reverses
-    /// the map: --isosurface-range 0.05:-0.05 with coolwarm draws negative potentials red and
-    /// positive ones blue, GaussView's convention.
+    pub volume_colormap: ColormapArg,
+    /// The values at the two ends of --volume-colormap, LO:HI (default: ±the largest
+    /// magnitude drawn for values of both signs, else their range). HI:LO reverses the map:
+    /// --volume-range 0.05:-0.05 with coolwarm draws negative potentials red and positive
+    /// ones blue, GaussView's convention.
     #[arg(long, value_name = "LO:HI", allow_hyphen_values = true)]
-    pub isosurface_range: Option<String>,
+    pub volume_range: Option<String>,
     /// The isosurfaces' opacity, 0.05 to 1 (below 1 the atoms inside show through, as the
     /// surface style's --surface-opacity).
     #[arg(long, value_name = "A", default_value_t = 1.0)]

@@ -963,11 +963,11 @@ impl Isosurfaces {
     }
 }
 
-/// Parses `--isosurface-range LO:HI` (finite, LO ≠ HI; HI < LO reverses the map).
+/// Parses `--volume-range LO:HI` (finite, LO ≠ HI; HI < LO reverses the map).
 fn parse_iso_range(s: &str) -> Result<(f32, f32)> {
     let bad = || {
         usage(format!(
-            "--isosurface-range {s:?}: expected LO:HI, two different numbers (e.g. -0.05:0.05, or 0.05:-0.05 to reverse the map)"
+            "--volume-range {s:?}: expected LO:HI, two different numbers (e.g. -0.05:0.05, or 0.05:-0.05 to reverse the map)"
         ))
     };
     let Some((a, b)) = s.split_once(':') else {
@@ -979,91 +979,109 @@ fn parse_iso_range(s: &str) -> Result<(f32, f32)> {
     }
 }
 
-/// Cuts `mesh` into colour bands of `by`'s values at its vertices (see [`ISO_BINS`]): the
-/// colours and the colour bar.
-fn map_isosurface(
-    mesh: &mut texmap_md_scene::surface::MolMesh,
-    by: &texmap_md_io::volume::Volume,
-    path: &std::path::Path,
-    m: &MolArgs,
-) -> Result<(Vec<[u8; 3]>, IsoBar)> {
-    let values: Vec<Option<f64>> = mesh
-        .positions
-        .iter()
-        .map(|p| by.interpolate(p.as_dvec3().to_array()))
-        .collect();
-    let off = values.iter().filter(|v| v.is_none()).count();
-    if off > 0 {
-        crate::note!(
-            "{off} of the isosurface's {} vertices lie outside {}'s grid: their triangles are drawn grey",
-            values.len(),
-            path.display()
-        );
+/// The range `--volume-range` gives, or the values' own: ±the largest magnitude for values of
+/// both signs, else their span (NaN values, off the grid, left out). `what` names the layer in
+/// the error for no values at all.
+fn volume_range(values: &[f64], m: &MolArgs, what: &str) -> Result<(f32, f32)> {
+    if let Some(r) = &m.volume_range {
+        return parse_iso_range(r);
     }
-    let (lo, hi) = match &m.isosurface_range {
-        Some(r) => parse_iso_range(r)?,
-        None => {
-            let on = values.iter().flatten();
-            let (min, max) = on.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-                (a.min(v), b.max(v))
-            });
-            if min > max {
-                return usage(format!(
-                    "--isosurface-color-by {}: no vertex of the isosurface lies inside its grid",
-                    path.display()
-                ));
-            }
-            if min < 0.0 && max > 0.0 {
-                let r = min.abs().max(max) as f32;
-                (-r, r)
-            } else if min == max {
-                (min as f32 - 1.0, max as f32 + 1.0)
-            } else {
-                (min as f32, max as f32)
-            }
-        }
-    };
-    let map = colormap(m.isosurface_colormap);
-    let mut colors: Vec<[u8; 3]> = (0..ISO_BINS)
-        .map(|b| {
-            let c = map.srgb((b as f32 + 0.5) / ISO_BINS as f32);
-            c.map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8)
-        })
-        .collect();
-    colors.push([128, 128, 128]);
-    let values: Vec<f64> = values.into_iter().map(|v| v.unwrap_or(f64::NAN)).collect();
-    *mesh = texmap_md_scene::isosurface::bands(
-        mesh,
-        &values,
-        (lo as f64, hi as f64),
-        ISO_BINS as u16,
-        0,
-        ISO_BINS as u16,
-    );
-    // The bar's title: the file's name (a cube's comment line, where its name would come from,
-    // is often a long title card).
-    let title = crate::args::strip_gz_stem(path);
-    Ok((colors, (map, lo, hi, title)))
+    let (min, max) = values
+        .iter()
+        .filter(|v| !v.is_nan())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
+    if min > max {
+        return usage(format!(
+            "{what}: no point of it lies inside the data's grid"
+        ));
+    }
+    Ok(if min < 0.0 && max > 0.0 {
+        let r = min.abs().max(max) as f32;
+        (-r, r)
+    } else if min == max {
+        (min as f32 - 1.0, max as f32 + 1.0)
+    } else {
+        (min as f32, max as f32)
+    })
 }
 
-/// The isosurfaces of `--isosurface` (with `--volume`, `--volume-set`, `--isosurface-sign`,
-/// the colours, `--isosurface-opacity` and a periodic volume's `--replicate`); `None` without
-/// `--isosurface`. Usage errors for options out of range and for a level the data never reaches.
+/// `mesh` (kinds ignored) cut into the [`ISO_BINS`] colour bands of `values` over `range`,
+/// its kinds from `base` (the grey of values off the grid: `base + ISO_BINS`); the bands'
+/// colours and grey appended to `colors`.
+fn banded(
+    mesh: &texmap_md_scene::surface::MolMesh,
+    values: &[f64],
+    range: (f32, f32),
+    map: Colormap,
+    colors: &mut Vec<[u8; 3]>,
+) -> texmap_md_scene::surface::MolMesh {
+    let base = colors.len() as u16;
+    colors.extend((0..ISO_BINS).map(|b| {
+        let c = map.srgb((b as f32 + 0.5) / ISO_BINS as f32);
+        c.map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8)
+    }));
+    colors.push([128, 128, 128]);
+    texmap_md_scene::isosurface::bands(
+        mesh,
+        values,
+        (range.0 as f64, range.1 as f64),
+        ISO_BINS as u16,
+        base,
+        base + ISO_BINS as u16,
+    )
+}
+
+/// Parses `--volume-slice AXIS:F` (a, b or c; F from 0 to 1) into (axis, F).
+fn parse_volume_slice(s: &str) -> Result<(usize, f64)> {
+    let bad = || {
+        usage(format!(
+            "--volume-slice {s:?}: expected AXIS:F, the grid axis a, b or c and the position along it from 0 to 1 (e.g. c:0.5)"
+        ))
+    };
+    let Some((axis, f)) = s.split_once(':') else {
+        return bad();
+    };
+    let axis = match axis.trim() {
+        "a" | "A" => 0,
+        "b" | "B" => 1,
+        "c" | "C" => 2,
+        _ => return bad(),
+    };
+    match f.trim().parse::<f64>() {
+        Ok(f) if (0.0..=1.0).contains(&f) => Ok((axis, f)),
+        _ => bad(),
+    }
+}
+
+/// What `--isosurface` and `--volume-slice` draw of volumetric data (with `--volume`,
+/// `--volume-set`, `--isosurface-sign`, the colours, `--isosurface-color-by`,
+/// `--volume-colormap`, `--volume-range`, `--isosurface-opacity` and a periodic volume's
+/// `--replicate`); `None` without either. Usage errors for options out of range and for a
+/// level the data never reaches.
 pub fn isosurfaces(file: &std::path::Path, m: &MolArgs) -> Result<Option<Isosurfaces>> {
     use crate::args::IsoSignArg;
-    use texmap_md_scene::isosurface::{Side, isosurface};
-    let Some(level) = m.isosurface else {
+    use texmap_md_scene::isosurface::{Side, isosurface, slice};
+    if m.isosurface.is_none() && m.volume_slices.is_empty() {
         if let Some(v) = &m.volume {
             return usage(format!(
-                "--volume {}: give --isosurface LEVEL to draw its data",
+                "--volume {}: give --isosurface LEVEL or --volume-slice AXIS:F to draw its data",
                 v.display()
             ));
         }
         return Ok(None);
-    };
-    if !level.is_finite() {
-        return usage(format!("--isosurface {level}: expected a finite number"));
     }
+    if m.isosurface_color_by.is_some() && !m.volume_slices.is_empty() {
+        return usage(
+            "--isosurface-color-by and --volume-slice would share one colour bar (--volume-colormap, --volume-range): draw them in two renders",
+        );
+    }
+    let slices = m
+        .volume_slices
+        .iter()
+        .map(|s| parse_volume_slice(s))
+        .collect::<Result<Vec<_>>>()?;
     let opacity = m.isosurface_opacity;
     if !(opacity.is_finite() && (0.05..=1.0).contains(&opacity)) {
         return usage(format!(
@@ -1071,14 +1089,14 @@ pub fn isosurfaces(file: &std::path::Path, m: &MolArgs) -> Result<Option<Isosurf
         ));
     }
     let color = |flag: &str, v: &str| parse_color(v).or_else(|e| usage(format!("{flag}: {e}")));
-    let mut colors = vec![
+    let sign_colors = [
         color("--isosurface-color", &m.isosurface_color)?,
         color("--isosurface-negative-color", &m.isosurface_negative_color)?,
     ];
     let path = m.volume.as_deref().unwrap_or(file);
     let (_, sets) = texmap_md_io::volume::read_volumes(path).with_context(|| {
         format!(
-            "--isosurface reads volumetric data from {} (a Gaussian cube file, or a VASP CHGCAR, PARCHG, LOCPOT or ELFCAR; another file's with --volume)",
+            "--isosurface and --volume-slice read volumetric data from {} (a Gaussian cube file, or a VASP CHGCAR, PARCHG, LOCPOT or ELFCAR; another file's with --volume)",
             path.display()
         )
     })?;
@@ -1096,40 +1114,85 @@ pub fn isosurfaces(file: &std::path::Path, m: &MolArgs) -> Result<Option<Isosurf
             names.join(", ")
         ));
     };
-    let (lo, hi) = vol.range().unwrap_or((0.0, 0.0));
-    let mut sides = Vec::new();
-    match m.isosurface_sign {
-        IsoSignArg::Both => {
-            sides.push((level, Side::Above, 0));
-            if level > 0.0 && lo < -level {
-                sides.push((-level, Side::Below, 1));
+    let map = colormap(m.volume_colormap);
+    let mut mesh = texmap_md_scene::surface::MolMesh::default();
+    let mut colors = Vec::new();
+    let mut bar = None;
+    if let Some(level) = m.isosurface {
+        if !level.is_finite() {
+            return usage(format!("--isosurface {level}: expected a finite number"));
+        }
+        let (lo, hi) = vol.range().unwrap_or((0.0, 0.0));
+        let mut sides = Vec::new();
+        match m.isosurface_sign {
+            IsoSignArg::Both => {
+                sides.push((level, Side::Above, 0));
+                if level > 0.0 && lo < -level {
+                    sides.push((-level, Side::Below, 1));
+                }
+            }
+            IsoSignArg::Positive => sides.push((level, Side::Above, 0)),
+            IsoSignArg::Negative => sides.push((-level, Side::Below, 1)),
+        }
+        let mut iso = texmap_md_scene::surface::MolMesh::default();
+        for (l, side, kind) in sides {
+            iso.append(&isosurface(vol, l, side, kind)?);
+        }
+        if iso.triangles.is_empty() {
+            return usage(format!(
+                "--isosurface {level}: {} of {} runs from {lo} to {hi}, so no surface lies at that level",
+                vol.name,
+                path.display()
+            ));
+        }
+        match &m.isosurface_color_by {
+            None => {
+                colors.extend(sign_colors);
+                mesh.append(&iso);
+            }
+            Some(by_path) => {
+                let (_, by) = texmap_md_io::volume::read_volumes(by_path).with_context(|| {
+                    format!(
+                        "--isosurface-color-by reads volumetric data from {} (a Gaussian cube file, or a VASP CHGCAR, PARCHG, LOCPOT or ELFCAR)",
+                        by_path.display()
+                    )
+                })?;
+                let values: Vec<f64> = iso
+                    .positions
+                    .iter()
+                    .map(|p| {
+                        by[0]
+                            .interpolate(p.as_dvec3().to_array())
+                            .unwrap_or(f64::NAN)
+                    })
+                    .collect();
+                let off = values.iter().filter(|v| v.is_nan()).count();
+                if off > 0 {
+                    crate::note!(
+                        "{off} of the isosurface's {} vertices lie outside {}'s grid: their triangles are drawn grey",
+                        values.len(),
+                        by_path.display()
+                    );
+                }
+                let what = format!("--isosurface-color-by {}", by_path.display());
+                let range = volume_range(&values, m, &what)?;
+                mesh.append(&banded(&iso, &values, range, map, &mut colors));
+                // The bar's title: the file's name (a cube's comment line is often a long
+                // title card).
+                bar = Some((map, range.0, range.1, crate::args::strip_gz_stem(by_path)));
             }
         }
-        IsoSignArg::Positive => sides.push((level, Side::Above, 0)),
-        IsoSignArg::Negative => sides.push((-level, Side::Below, 1)),
     }
-    let mut mesh = texmap_md_scene::surface::MolMesh::default();
-    for (l, side, kind) in sides {
-        mesh.append(&isosurface(vol, l, side, kind)?);
-    }
-    if mesh.triangles.is_empty() {
-        return usage(format!(
-            "--isosurface {level}: {} of {} runs from {lo} to {hi}, so no surface lies at that level",
-            vol.name,
-            path.display()
-        ));
-    }
-    let mut bar = None;
-    if let Some(by_path) = &m.isosurface_color_by {
-        let (_, by) = texmap_md_io::volume::read_volumes(by_path).with_context(|| {
-            format!(
-                "--isosurface-color-by reads volumetric data from {} (a Gaussian cube file, or a VASP CHGCAR, PARCHG, LOCPOT or ELFCAR)",
-                by_path.display()
-            )
-        })?;
-        let (c, b) = map_isosurface(&mut mesh, &by[0], by_path, m)?;
-        colors = c;
-        bar = Some(b);
+    if !slices.is_empty() {
+        let (mut planes, mut values) = (texmap_md_scene::surface::MolMesh::default(), Vec::new());
+        for (axis, f) in slices {
+            let (plane, v) = slice(vol, axis, f, 0)?;
+            planes.append(&plane);
+            values.extend(v);
+        }
+        let range = volume_range(&values, m, "--volume-slice")?;
+        mesh.append(&banded(&planes, &values, range, map, &mut colors));
+        bar = Some((map, range.0, range.1, crate::args::strip_gz_stem(path)));
     }
     // A periodic volume follows the atoms' periodic images (md-io's replicate: images from
     // −(n − 1)/2 to n/2 along each cell vector).

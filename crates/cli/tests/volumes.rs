@@ -63,6 +63,57 @@ fn obj_volume_area(path: &Path) -> (f64, f64, usize) {
     (vol, area, n)
 }
 
+/// Checks that every face of an exported OBJ mesh lies in one colour band of `value` (64
+/// bands over `range`, corners on a boundary in both) and that its palette texel is that band's
+/// (one offset for all: the scene's atom materials come first); returns the face count.
+fn assert_banded(
+    text: &str,
+    obj: &Path,
+    value: impl Fn([f64; 3]) -> f64,
+    (lo, hi): (f64, f64),
+) -> usize {
+    let (mut v, mut vt) = (Vec::<[f64; 3]>::new(), Vec::<f64>::new());
+    let mut bases = std::collections::BTreeSet::new();
+    let mut faces = 0;
+    // The palette is one row of materials + 1 texels (the scene's atom materials, the 64
+    // bands, the grey): kinds from the uv's texel.
+    let texels = image::open(obj.with_extension("png"))
+        .map(|i| i.width())
+        .unwrap_or(0);
+    assert!(texels > 64, "palette of {texels} texels");
+    for line in text.lines() {
+        let mut it = line.split_whitespace();
+        match it.next() {
+            Some("v") => v.push(std::array::from_fn(|_| it.next().unwrap().parse().unwrap())),
+            Some("vt") => vt.push(it.next().unwrap().parse().unwrap()),
+            Some("f") => {
+                let corners: Vec<(usize, usize)> = it
+                    .map(|t| {
+                        let mut p = t.split('/');
+                        let vi = p.next().unwrap().parse::<usize>().unwrap() - 1;
+                        let ti = p.next().unwrap().parse::<usize>().unwrap() - 1;
+                        (vi, ti)
+                    })
+                    .collect();
+                let kind = (vt[corners[0].1] * texels as f64).floor() as i64;
+                let us: Vec<f64> = corners
+                    .iter()
+                    .map(|&(vi, _)| ((value(v[vi]) - lo) / (hi - lo) * 64.0).clamp(0.0, 64.0))
+                    .collect();
+                let top = us.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+                let bottom = us.iter().cloned().fold(f64::INFINITY, f64::min);
+                assert!(top - bottom <= 1.0 + 1e-3, "a piece spans {bottom}..{top}");
+                let band = ((bottom + top) / 2.0).floor().min(63.0) as i64;
+                bases.insert(kind - band);
+                faces += 1;
+            }
+            _ => {}
+        }
+    }
+    assert_eq!(bases.len(), 1, "kind - band: {bases:?}");
+    faces
+}
+
 fn mean_abs_diff(a: &Path, b: &Path) -> f64 {
     let (a, b) = (
         image::open(a).unwrap().to_rgb8(),
@@ -297,7 +348,7 @@ fn cube_text(
 
 /// --isosurface-color-by: a Gaussian density's sphere coloured by a linear field z (on a
 /// coarser grid of its own, where interpolation is exact): every exported piece lies in the
-/// colour band of its z, in 64 bands over --isosurface-range (reversed too); the picture
+/// colour band of its z, in 64 bands over --volume-range (reversed too); the picture
 /// matches the reference ray tracer's; a range that is not two numbers is a usage error.
 #[test]
 fn a_surface_coloured_by_another_volume_is_banded_by_its_values() {
@@ -325,7 +376,7 @@ fn a_surface_coloured_by_another_volume_is_banded_by_its_values() {
             "0.3",
             "--isosurface-color-by",
             pot,
-            "--isosurface-range",
+            "--volume-range",
             range,
             "--size",
             "240x180",
@@ -337,52 +388,8 @@ fn a_surface_coloured_by_another_volume_is_banded_by_its_values() {
         assert!(o.status.success(), "{}", stderr(&o));
         // Faces and the palette texel (kind) their uvs pick.
         let text = std::fs::read_to_string(&obj).unwrap();
-        let (mut v, mut vt) = (Vec::<[f64; 3]>::new(), Vec::<f64>::new());
-        let mut bases = std::collections::BTreeSet::new();
-        let mut faces = 0;
-        let kinds_in_palette = {
-            // The palette is one row of materials + 1 texels (the scene's atom materials, the
-            // 64 bands, the grey): kinds from the uv's texel.
-            let png = obj.with_extension("png");
-            image::open(&png).map(|i| i.width()).unwrap_or(0)
-        };
-        for line in text.lines() {
-            let mut it = line.split_whitespace();
-            match it.next() {
-                Some("v") => v.push(std::array::from_fn(|_| it.next().unwrap().parse().unwrap())),
-                Some("vt") => vt.push(it.next().unwrap().parse().unwrap()),
-                Some("f") => {
-                    let corners: Vec<(usize, usize)> = it
-                        .map(|t| {
-                            let mut p = t.split('/');
-                            let vi = p.next().unwrap().parse::<usize>().unwrap() - 1;
-                            let ti = p.next().unwrap().parse::<usize>().unwrap() - 1;
-                            (vi, ti)
-                        })
-                        .collect();
-                    let kind = (vt[corners[0].1] * kinds_in_palette as f64).floor() as i64;
-                    // The band every corner's z lies in (closed: corners on a boundary are in
-                    // both); the piece's band is the one all its corners share.
-                    let us: Vec<f64> = corners
-                        .iter()
-                        .map(|&(vi, _)| ((v[vi][2] - lo) / (hi - lo) * 64.0).clamp(0.0, 64.0))
-                        .collect();
-                    let top = us.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
-                    let bottom = us.iter().cloned().fold(f64::INFINITY, f64::min);
-                    assert!(top - bottom <= 1.0 + 1e-3, "a piece spans {bottom}..{top}");
-                    let band = ((bottom + top) / 2.0).floor().min(63.0) as i64;
-                    bases.insert(kind - band);
-                    faces += 1;
-                }
-                _ => {}
-            }
-        }
+        let faces = assert_banded(&text, &obj, |p| p[2], (lo, hi));
         assert!(faces > 1000, "{faces} faces");
-        assert!(
-            kinds_in_palette > 64,
-            "palette of {kinds_in_palette} texels"
-        );
-        assert_eq!(bases.len(), 1, "kind - band: {bases:?}");
     }
     // Against the reference ray tracer.
     let mut images = Vec::new();
@@ -416,10 +423,88 @@ fn a_surface_coloured_by_another_volume_is_banded_by_its_values() {
         "0.3",
         "--isosurface-color-by",
         pot,
-        "--isosurface-range",
+        "--volume-range",
         "1:1",
         "-o",
         dir.path().join("x.png").to_str().unwrap(),
     ]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+}
+
+/// --volume-slice: a plane through a cube file's grid at the fraction asked, both sides, cut
+/// into the colour bands of its values (a linear field: every piece in its band, in its colour);
+/// what it cannot draw is a usage error.
+#[test]
+fn a_volume_slice_is_the_grids_plane_in_its_values_colours() {
+    let dir = tempfile::tempdir().unwrap();
+    let field = dir.path().join("field.cube");
+    let atoms = [(6u32, [0.0, 0.0, 0.0])];
+    std::fs::write(
+        &field,
+        cube_text(&atoms, -2.5, 0.5, 11, |p| p[0] + 2.0 * p[1]),
+    )
+    .unwrap();
+    let field = field.to_str().unwrap();
+    let obj = dir.path().join("slice.obj");
+    let png = dir.path().join("picture.png");
+    let o = texmap(&[
+        "render",
+        "--quiet",
+        field,
+        "--volume-slice",
+        "c:0.5",
+        "--volume-range",
+        "-7.5:7.5",
+        "--size",
+        "240x180",
+        "--export-mesh",
+        obj.to_str().unwrap(),
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(&obj).unwrap();
+    let v: Vec<[f64; 3]> = text
+        .lines()
+        .filter_map(|l| l.strip_prefix("v "))
+        .map(|l| {
+            let mut it = l.split_whitespace().map(|x| x.parse::<f64>().unwrap());
+            std::array::from_fn(|_| it.next().unwrap())
+        })
+        .collect();
+    // The plane z = 0 (the grid's middle along c), spanning the grid's 5 x 5 Å.
+    assert!(v.iter().all(|p| p[2].abs() < 1e-5), "off the plane");
+    let span = |k: usize| {
+        let (lo, hi) = v
+            .iter()
+            .fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p[k]), b.max(p[k])));
+        hi - lo
+    };
+    assert!((span(0) - 5.0).abs() < 1e-4 && (span(1) - 5.0).abs() < 1e-4);
+    assert_banded(&text, &obj, |p| p[0] + 2.0 * p[1], (-7.5, 7.5));
+    let (vol, area, faces) = obj_volume_area(&obj);
+    // Two sides of 25 Å²; a plane seen both ways encloses nothing.
+    assert!((area - 50.0).abs() < 1e-3, "{area}");
+    assert!(vol.abs() < 1e-6, "{vol}");
+    assert!(
+        faces > 400,
+        "{faces} faces: the bands cut the 400 triangles"
+    );
+    let bad = |extra: &[&str]| {
+        let mut args = vec!["render", "--quiet", field, "-o", png.to_str().unwrap()];
+        args.extend(extra);
+        let o = texmap(&args);
+        assert_eq!(o.status.code(), Some(2), "{extra:?}: {}", stderr(&o));
+        stderr(&o)
+    };
+    assert!(bad(&["--volume-slice", "d:0.5"]).contains("a, b or c"));
+    assert!(bad(&["--volume-slice", "a:1.5"]).contains("from 0 to 1"));
+    bad(&[
+        "--volume-slice",
+        "a:0.5",
+        "--isosurface",
+        "1",
+        "--isosurface-color-by",
+        field,
+    ]);
 }

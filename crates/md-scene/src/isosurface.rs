@@ -488,3 +488,100 @@ pub fn bands(
     }
     out
 }
+
+/// Why no slice was made.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SliceError {
+    /// The axis is not 0, 1 or 2.
+    BadAxis(usize),
+    /// The position along the axis is not a fraction in [0, 1].
+    BadFraction(f64),
+}
+
+impl std::fmt::Display for SliceError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            SliceError::BadAxis(a) => write!(f, "slice axis {a}: expected 0, 1 or 2 (a, b, c)"),
+            SliceError::BadFraction(x) => {
+                write!(f, "slice position {x}: expected a fraction from 0 to 1")
+            }
+        }
+    }
+}
+
+impl std::error::Error for SliceError {}
+
+/// A plane through the grid, as VESTA draws a section and VMD a VolumeSlice: the points whose
+/// index along `axis` is `fraction` of the way across the grid (`fraction · (n − 1)`; on a
+/// periodic grid `fraction · n`, the whole cell), spanned by the other two axes' grid points (a
+/// periodic grid's plane covers the whole cell: one more row and column, the first ones
+/// again). Each triangle is there twice, facing both ways, so that the plane is seen from
+/// either side; with it, the data's value at each vertex (interpolated along `axis` only), for
+/// [`bands`]. Every triangle has material `kind`.
+pub fn slice(
+    vol: &Volume,
+    axis: usize,
+    fraction: f64,
+    kind: u16,
+) -> Result<(MolMesh, Vec<f64>), SliceError> {
+    if axis > 2 {
+        return Err(SliceError::BadAxis(axis));
+    }
+    if !(0.0..=1.0).contains(&fraction) {
+        return Err(SliceError::BadFraction(fraction));
+    }
+    let (b, c) = ((axis + 1) % 3, (axis + 2) % 3);
+    let extra = usize::from(vol.periodic);
+    let (nb, nc) = (vol.dims[b] + extra, vol.dims[c] + extra);
+    let along = if vol.periodic {
+        fraction * vol.dims[axis] as f64
+    } else {
+        fraction * (vol.dims[axis] - 1) as f64
+    };
+    let steps = vol.steps.map(DVec3::from);
+    let normal = steps[b].cross(steps[c]).normalize_or_zero().as_vec3();
+    let mut mesh = MolMesh {
+        spacing: (steps[b].length() + steps[c].length()) as f32 / 2.0,
+        ..MolMesh::default()
+    };
+    let mut values = Vec::with_capacity(2 * nb * nc);
+    for side in [1.0f32, -1.0] {
+        for jc in 0..nc {
+            for jb in 0..nb {
+                let mut q = [0.0f64; 3];
+                q[axis] = along;
+                q[b] = jb as f64;
+                q[c] = jc as f64;
+                let p = vol.point(q[0], q[1], q[2]);
+                mesh.positions.push(DVec3::from(p).as_vec3());
+                mesh.normals.push(normal * side);
+                // On the plane itself, so inside the grid (or its periodic images).
+                values.push(vol.interpolate(p).unwrap_or(f64::NAN));
+            }
+        }
+    }
+    let at = |s: usize, jb: usize, jc: usize| (s * nb * nc + jc * nb + jb) as u32;
+    for jc in 0..nc - 1 {
+        for jb in 0..nb - 1 {
+            let q = [
+                at(0, jb, jc),
+                at(0, jb + 1, jc),
+                at(0, jb + 1, jc + 1),
+                at(0, jb, jc + 1),
+            ];
+            // Counter-clockwise seen along +normal (b then c) on the front copy.
+            mesh.triangles.push([q[0], q[1], q[2]]);
+            mesh.triangles.push([q[0], q[2], q[3]]);
+            let r = [
+                at(1, jb, jc),
+                at(1, jb + 1, jc),
+                at(1, jb + 1, jc + 1),
+                at(1, jb, jc + 1),
+            ];
+            mesh.triangles.push([r[0], r[2], r[1]]);
+            mesh.triangles.push([r[0], r[3], r[2]]);
+        }
+    }
+    mesh.kinds = vec![kind; mesh.triangles.len()];
+    Ok((mesh, values))
+}

@@ -39,7 +39,8 @@
 //!   over a sphere method's frame ([`surface::draw_mesh`]).
 //! - [`isosurface`]: isosurfaces of volumetric data (a cube file's orbital, a CHGCAR's density;
 //!   md-io's `Volume`) by surface nets on the data's own skewed grid, capped at a bounded grid's
-//!   border, continued across a periodic one's; a mesh like the surface's.
+//!   border, continued across a periodic one's, cut into colour bands of another quantity, or
+//!   a plane through the data (`isosurface::slice`); a mesh like the surface's.
 //! - [`legend`]: a colour bar with its tick labels and title drawn onto a rendered RGBA image
 //!   ([`draw_color_bar`]).
 //!

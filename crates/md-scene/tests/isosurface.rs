@@ -312,3 +312,57 @@ fn colour_bands_cut_the_surface_along_the_values_and_keep_it_closed() {
         }
     }
 }
+
+/// A slice through a skewed grid: a plane at the fraction asked along its axis, the value at
+/// every vertex (a linear field's, exactly), both sides wound towards their normals; a periodic
+/// grid's plane covers the whole cell.
+#[test]
+fn a_slice_is_a_plane_of_the_grids_values_seen_from_both_sides() {
+    use texmap_md_scene::isosurface::{SliceError, slice};
+    let steps = [
+        DVec3::new(0.5, 0.0, 0.0),
+        DVec3::new(0.1, 0.4, 0.0),
+        DVec3::new(0.0, -0.1, 0.3),
+    ];
+    let f = |p: DVec3| 1.0 + p.x - 2.0 * p.y + 3.0 * p.z;
+    let vol = sample(DVec3::new(1.0, 2.0, 3.0), steps, [6, 5, 7], false, f);
+    let (m, values) = slice(&vol, 2, 0.25, 4).unwrap();
+    // 6 x 5 points per side, 5 x 4 quads, two triangles each, two sides.
+    assert_eq!(m.positions.len(), 60);
+    assert_eq!(m.triangles.len(), 80);
+    assert!(m.kinds.iter().all(|&k| k == 4));
+    let inv = glam::DMat3::from_cols(steps[0], steps[1], steps[2]).inverse();
+    for (p, v) in m.positions.iter().zip(&values) {
+        let q = inv * (p.as_dvec3() - DVec3::new(1.0, 2.0, 3.0));
+        assert!((q.z - 1.5).abs() < 1e-5, "{q}");
+        assert!(
+            (v - f(p.as_dvec3())).abs() < 1e-4,
+            "{v} vs {}",
+            f(p.as_dvec3())
+        );
+    }
+    for t in &m.triangles {
+        let [a, b, c] = t.map(|i| m.positions[i as usize]);
+        let n = m.normals[t[0] as usize];
+        assert!((b - a).cross(c - a).normalize().dot(n) > 0.999);
+    }
+    // Periodic: the plane spans the cell, one more row and column.
+    let periodic = Volume {
+        periodic: true,
+        ..vol.clone()
+    };
+    let (m, values) = slice(&periodic, 0, 1.0, 0).unwrap();
+    assert_eq!(m.positions.len(), 2 * 6 * 8);
+    assert!(values.iter().all(|v| v.is_finite()));
+    let far = m
+        .positions
+        .iter()
+        .map(|p| (inv * (p.as_dvec3() - DVec3::new(1.0, 2.0, 3.0))).z)
+        .fold(0.0f64, f64::max);
+    assert!((far - 7.0).abs() < 1e-4, "{far}");
+    assert_eq!(slice(&vol, 3, 0.5, 0).unwrap_err(), SliceError::BadAxis(3));
+    assert_eq!(
+        slice(&vol, 0, 1.5, 0).unwrap_err(),
+        SliceError::BadFraction(1.5)
+    );
+}
