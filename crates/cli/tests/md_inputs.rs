@@ -2090,7 +2090,8 @@ fn rutile_polyhedra_are_its_tio6_octahedra() {
     ];
     let mut args = base.to_vec();
     args.extend(["--export-mesh", obj.to_str().unwrap()]);
-    let img = render_rgb(dir.path(), "poly.png", &args);
+    // Not poly.png: that is the OBJ's palette texture.
+    let img = render_rgb(dir.path(), "picture.png", &args);
     assert!(img.pixels().filter(|p| p.0 != [0, 0, 0]).count() > 5000);
     // The exported mesh: vertices and triangles (1-based, `v/vt/vn` or plain).
     let text = std::fs::read_to_string(&obj).unwrap();
