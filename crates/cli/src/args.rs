@@ -802,12 +802,14 @@ pub struct MolArgs {
         conflicts_with = "align_to"
     )]
     pub isosurface: Option<f32>,
-    /// The volumetric data for --isosurface when the input is not itself a cube or CHGCAR file
+    /// The volumetric data for --isosurface and --volume-slice when the input is not itself a
+    /// cube or CHGCAR file
     /// (render a POSCAR or PDB with the density of another file; its grid must be in the same
     /// coordinates).
     #[arg(long, value_name = "FILE")]
     pub volume: Option<PathBuf>,
-    /// Which data set of the volumetric file --isosurface draws, from 1: a CHGCAR's 1 is the
+    /// Which data set of the volumetric file --isosurface and --volume-slice draw, from 1: a
+    /// CHGCAR's 1 is the
     /// total density and 2 the magnetisation (spin-polarised runs); a cube file's the orbitals
     /// in the order it lists them.
     #[arg(long, value_name = "N", default_value_t = 1)]
@@ -849,8 +851,8 @@ pub struct MolArgs {
     /// ones blue, GaussView's convention.
     #[arg(long, value_name = "LO:HI", allow_hyphen_values = true)]
     pub volume_range: Option<String>,
-    /// The isosurfaces' opacity, 0.05 to 1 (below 1 the atoms inside show through, as the
-    /// surface style's --surface-opacity).
+    /// The opacity of --isosurface's surfaces and --volume-slice's planes, 0.05 to 1 (below 1
+    /// the atoms inside show through, as the surface style's --surface-opacity).
     #[arg(long, value_name = "A", default_value_t = 1.0)]
     pub isosurface_opacity: f32,
     /// The hbonds style's largest donor-acceptor distance, Å (MDAnalysis's default 3.0; up to
