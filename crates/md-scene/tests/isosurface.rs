@@ -366,3 +366,28 @@ fn a_slice_is_a_plane_of_the_grids_values_seen_from_both_sides() {
         SliceError::BadFraction(1.5)
     );
 }
+
+/// The same surface, vertex for vertex, whatever the number of threads.
+#[test]
+fn an_isosurface_is_the_same_on_any_thread_count() {
+    let steps = [
+        DVec3::X * 0.13,
+        DVec3::new(0.02, 0.12, 0.0),
+        DVec3::Z * 0.11,
+    ];
+    let vol = sample(DVec3::splat(-2.5), steps, [40, 41, 45], false, |p| {
+        (p.x * 1.3).sin() * (p.y * 0.9).cos() + 0.3 * p.z
+    });
+    let run = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| isosurface(&vol, 0.2, Side::Above, 0).unwrap())
+    };
+    let one = run(1);
+    assert!(one.triangles.len() > 1000);
+    for threads in [2, 3] {
+        assert_eq!(run(threads), one, "{threads} threads");
+    }
+}
