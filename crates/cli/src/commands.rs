@@ -769,18 +769,15 @@ fn render(a: &RenderArgs) -> Result<()> {
             for p in &plan.cartoon_mesh().positions {
                 framed.push(*p, texmap_md_scene::cartoon::COIL_RADIUS, 0);
             }
-            for p in plan
-                .polyhedra_mesh()
-                .positions
-                .iter()
-                .chain(&plan.arrows_mesh().positions)
-                .chain(plan.arrow_atoms())
-                .chain(&iso_mesh.positions)
-            {
-                // A point the camera must see: the smallest valid sphere (a radius of 0 is
-                // not a sphere, and the fit would leave the point out).
-                framed.push(*p, 1e-3, 0);
-            }
+            texmap_md_scene::push_framed_points(
+                &mut framed,
+                plan.polyhedra_mesh()
+                    .positions
+                    .iter()
+                    .chain(&plan.arrows_mesh().positions)
+                    .chain(plan.arrow_atoms())
+                    .chain(&iso_mesh.positions),
+            );
             let plan =
                 crate::scene::camera_plan(&a.camera, size, &a.path, &md, &framed, frames.len())
                     .map_err(|e| fail(e, &written))?;

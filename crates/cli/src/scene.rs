@@ -1194,18 +1194,17 @@ pub fn isosurfaces(file: &std::path::Path, m: &MolArgs) -> Result<Option<Isosurf
         mesh.append(&banded(&planes, &values, range, map, &mut colors));
         bar = Some((map, range.0, range.1, crate::args::strip_gz_stem(path)));
     }
-    // A periodic volume follows the atoms' periodic images (md-io's replicate: images from
-    // −(n − 1)/2 to n/2 along each cell vector).
+    // A periodic volume follows the atoms' periodic images (md-io's replicate::images).
     if let (true, Some(n)) = (vol.periodic, m.replicate) {
         let cell: [Vec3; 3] = std::array::from_fn(|a| {
             Vec3::from(vol.steps[a].map(|v| v as f32)) * vol.dims[a] as f32
         });
         let one = mesh.clone();
         mesh = texmap_md_scene::surface::MolMesh::default();
-        let range = |k: usize| -((n[k] as i32 - 1) / 2)..=(n[k] as i32 / 2);
-        for i in range(0) {
-            for j in range(1) {
-                for k in range(2) {
+        let images = texmap_md_io::replicate::images;
+        for i in images(n[0]) {
+            for j in images(n[1]) {
+                for k in images(n[2]) {
                     let mut copy = one.clone();
                     let shift = cell[0] * i as f32 + cell[1] * j as f32 + cell[2] * k as f32;
                     for p in &mut copy.positions {

@@ -80,8 +80,10 @@ impl fmt::Display for ReplicateError {
 
 impl std::error::Error for ReplicateError {}
 
-/// The image offsets along one axis with `n` images: `-(n-1)/2 ..= n/2`.
-fn images(n: usize) -> std::ops::RangeInclusive<i64> {
+/// The image offsets along one axis with `n` images: `-(n-1)/2 ..= n/2` (what [`replicate`]
+/// copies along each cell vector; for other things drawn with the images, such as a periodic
+/// grid's isosurface).
+pub fn images(n: usize) -> std::ops::RangeInclusive<i64> {
     -((n as i64 - 1) / 2)..=n as i64 / 2
 }
 

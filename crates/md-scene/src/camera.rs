@@ -82,6 +82,19 @@ pub fn drawn_bounds(frame: &Frame, scene: &SphereScene) -> Option<(Vec3, Vec3)> 
     (lo.x <= hi.x).then_some((lo, hi))
 }
 
+/// Radius of the spheres [`push_framed_points`] adds: the smallest that [`fit_camera`] counts
+/// (a sphere of radius 0 is not valid, and the fit would leave its point out).
+pub const POINT_RADIUS: f32 = 1e-3;
+
+/// Adds `points` to `scene` (a copy made for [`fit_camera`]) as spheres of [`POINT_RADIUS`]
+/// and material 0, so that the camera also frames what is drawn beside the spheres: the
+/// vertices of polyhedra, arrows, isosurfaces.
+pub fn push_framed_points<'a>(scene: &mut SphereScene, points: impl IntoIterator<Item = &'a Vec3>) {
+    for p in points {
+        scene.push(*p, POINT_RADIUS, 0);
+    }
+}
+
 /// The automatic camera for `frame` drawn as `scene`, and the point it looks at (see the module
 /// docs): perspective with horizontal field of view `hfov_deg`, or orthographic for `None`.
 ///

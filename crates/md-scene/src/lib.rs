@@ -89,7 +89,10 @@ pub mod scalar;
 pub mod style;
 pub mod surface;
 
-pub use camera::{AUTO_VIEW_DIRECTION, FIT_MARGIN, ViewAxis, centre_of, drawn_bounds, fit_camera};
+pub use camera::{
+    AUTO_VIEW_DIRECTION, FIT_MARGIN, POINT_RADIUS, ViewAxis, centre_of, drawn_bounds, fit_camera,
+    push_framed_points,
+};
 pub use camera_plan::{CameraPlan, CameraPlanError, MotionSpec};
 pub use colormap::Colormap;
 pub use legend::{ColorBar, MAX_LABEL_CHARS, draw_atom_label, draw_caption, draw_color_bar};

@@ -91,10 +91,7 @@ pub fn demo_section(out_dir: &Path) -> Result<String, MaterialsError> {
     let mesh = plan.polyhedra_mesh().clone();
     // The camera frames the polyhedra too.
     let mut framed = scene.clone();
-    for p in &mesh.positions {
-        // The smallest valid sphere: a radius of 0 is left out of the fit.
-        framed.push(*p, 1e-3, 0);
-    }
+    texmap_md_scene::push_framed_points(&mut framed, &mesh.positions);
     let (cam, _) = fit_camera(&frame, &framed, ViewAxis::Auto, None, 480, 360).map_err(fail)?;
     let lighting = Lighting::default_for(&cam);
     let mut options = Options::new(Method::Raycast, lighting);
@@ -215,9 +212,7 @@ fn orbital_section(dir: &Path) -> Result<String, MaterialsError> {
     ]);
     scene.push(texmap_core::glam::Vec3::ZERO, 0.5, 0);
     let mut framed = scene.clone();
-    for p in &mesh.positions {
-        framed.push(*p, 1e-3, 0);
-    }
+    texmap_md_scene::push_framed_points(&mut framed, &mesh.positions);
     let (cam, _) = fit_camera(&Frame::new(), &framed, ViewAxis::X, None, 480, 360).map_err(fail)?;
     let options = Options::new(Method::Raycast, Lighting::default_for(&cam));
     draw_and_save(&scene, &mesh, &cam, &options, 0.8, &dir.join("orbital.png"))?;
