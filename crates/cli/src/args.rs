@@ -189,6 +189,22 @@ pub fn parse_replicate(s: &str) -> Result<[usize; 3], String> {
     }
 }
 
+/// Parses `--ellipsoid-shape A,B,C` (three semi-axes > 0, Å) or one A for a sphere.
+pub fn parse_ellipsoid_shape(s: &str) -> Result<[f32; 3], String> {
+    let axes: Vec<f32> = s
+        .split(',')
+        .map(|p| match p.trim().parse::<f32>() {
+            Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+            _ => Err(format!("{:?} is not a semi-axis > 0 (Å)", p.trim())),
+        })
+        .collect::<Result<_, _>>()?;
+    match axes[..] {
+        [a] => Ok([a; 3]),
+        [a, b, c] => Ok([a, b, c]),
+        _ => Err("expected A,B,C (the semi-axes along the particle's x, y, z, Å)".into()),
+    }
+}
+
 /// Parses `--slice NX,NY,NZ:D[:W]` into `[nx, ny, nz, d, w]` (w = 0 without one).
 pub fn parse_slice(s: &str) -> Result<[f64; 5], String> {
     let parts: Vec<&str> = s.split(':').map(str::trim).collect();
@@ -720,6 +736,12 @@ pub enum DrawStyle {
     /// the last N frames. Usually one --rep among others: --rep 'all=ball-stick'
     /// --rep 'resname LI=trails'.
     Trails,
+    /// Each atom as an ellipsoid (OVITO's aspherical particles: LAMMPS atom_style ellipsoid,
+    /// Gay-Berne liquid crystals): the semi-axes are half the shapex shapey shapez properties
+    /// (LAMMPS's diameters) or --ellipsoid-shape A,B,C for every atom, the orientation the
+    /// quatw quati quatj quatk properties (none: the axes along x, y, z). An atom of shape
+    /// 0 0 0 (a LAMMPS sphere) stays a sphere. Tessellated no finer than the picture needs.
+    Ellipsoids,
 }
 
 /// Periodic boundaries (`--pbc`).
@@ -879,6 +901,10 @@ pub struct MolArgs {
     /// The arrows style's shaft radius, Å (the head is 2.5 times as wide).
     #[arg(long, value_name = "Å", default_value_t = 0.1)]
     pub arrow_radius: f32,
+    /// The ellipsoids style's semi-axes for every atom, Å: A,B,C along the particle's own x, y,
+    /// z (its quatw..quatk orientation), instead of the file's shapex shapey shapez.
+    #[arg(long, value_name = "A,B,C", value_parser = parse_ellipsoid_shape)]
+    pub ellipsoid_shape: Option<[f32; 3]>,
     /// The trails style's length in frames drawn (the current one included); default: every
     /// frame drawn so far.
     #[arg(long, value_name = "N")]

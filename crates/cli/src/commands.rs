@@ -484,7 +484,7 @@ fn render(a: &RenderArgs) -> Result<()> {
     let iso_opacity = isosurfaces.as_ref().map_or(1.0, |i| i.opacity);
     if plan.draws_meshes() && quality.is_some() {
         return usage(
-            "the cartoon, surface and polyhedra styles are drawn without --quality's anti-aliasing, ambient occlusion and shadows; drop --quality and its options, or draw those atoms in another style",
+            "the cartoon, surface, polyhedra, arrows and ellipsoids styles are drawn without --quality's anti-aliasing, ambient occlusion and shadows; drop --quality and its options, or draw those atoms in another style",
         );
     }
     let mut surface = texmap_md_scene::surface::MolMesh::default();
@@ -615,7 +615,7 @@ fn render(a: &RenderArgs) -> Result<()> {
     }
     if a.export_mesh.is_some() && !plan.draws_meshes() && isosurfaces.is_none() {
         return usage(
-            "--export-mesh writes the cartoon, surface and polyhedra styles' meshes and --isosurface's: draw some atoms with --style cartoon, surface or polyhedra (or a --rep of them), or give --isosurface",
+            "--export-mesh writes the cartoon, surface, polyhedra, arrows and ellipsoids styles' meshes and --isosurface's: draw some atoms with one of those styles (or a --rep of them), or give --isosurface",
         );
     }
     for (k, &f) in frames.iter().enumerate() {
@@ -742,6 +742,7 @@ fn render(a: &RenderArgs) -> Result<()> {
                 && plan.cartoon_mesh().triangles.is_empty()
                 && plan.polyhedra_mesh().triangles.is_empty()
                 && plan.arrow_atoms().is_empty()
+                && plan.ellipsoids().is_empty()
                 && iso_mesh.triangles.is_empty()
             {
                 let why = if a.mol.reps.is_empty() {
@@ -768,6 +769,9 @@ fn render(a: &RenderArgs) -> Result<()> {
             }
             for p in &plan.cartoon_mesh().positions {
                 framed.push(*p, texmap_md_scene::cartoon::COIL_RADIUS, 0);
+            }
+            for e in plan.ellipsoids() {
+                framed.push(e.center, e.bounding_radius(), e.kind);
             }
             texmap_md_scene::push_framed_points(
                 &mut framed,
@@ -813,9 +817,16 @@ fn render(a: &RenderArgs) -> Result<()> {
             }
             q
         });
+        // The ellipsoids, tessellated for this view.
+        let ellipsoid_mesh = texmap_md_scene::ellipsoids::tessellate(
+            plan.ellipsoids(),
+            Some(&cam),
+            texmap_md_scene::ellipsoids::TOLERANCE_PX,
+        );
         // The meshes drawn over the spheres, each with its opacity.
         let layers = [
             (plan.cartoon_mesh(), 1.0),
+            (&ellipsoid_mesh, 1.0),
             (plan.arrows_mesh(), 1.0),
             (&surface, surface_opacity),
             (plan.polyhedra_mesh(), polyhedra_opacity),
@@ -904,9 +915,15 @@ fn render(a: &RenderArgs) -> Result<()> {
             all.append(plan.polyhedra_mesh());
             all.append(plan.arrows_mesh());
             all.append(&iso_mesh);
+            // The whole model, not the view's share of it.
+            all.append(&texmap_md_scene::ellipsoids::tessellate(
+                plan.ellipsoids(),
+                None,
+                0.0,
+            ));
             if all.triangles.is_empty() {
                 let e = anyhow::anyhow!(
-                    "--export-mesh: frame {f} has no cartoon, surface, polyhedra, arrows or isosurface to write"
+                    "--export-mesh: frame {f} has no cartoon, surface, polyhedra, arrows, ellipsoids or isosurface to write"
                 );
                 return Err(fail(e, &written));
             }

@@ -421,6 +421,7 @@ impl From<DrawStyle> for texmap_md_scene::DrawStyle {
             DrawStyle::Polyhedra => texmap_md_scene::DrawStyle::Polyhedra,
             DrawStyle::Arrows => texmap_md_scene::DrawStyle::Arrows,
             DrawStyle::Trails => texmap_md_scene::DrawStyle::Trails,
+            DrawStyle::Ellipsoids => texmap_md_scene::DrawStyle::Ellipsoids,
         }
     }
 }
@@ -552,6 +553,9 @@ pub fn mol_plan(args: &MolArgs, style: &StyleArgs) -> Result<MolPlan> {
             scale: args.arrow_scale,
             radius: args.arrow_radius,
         },
+        ellipsoids: texmap_md_scene::ellipsoids::EllipsoidOptions {
+            shape: args.ellipsoid_shape,
+        },
         trail_length: args.trail_length,
         bond_orders: args.bond_orders,
         displacement: args.displacements
@@ -651,6 +655,13 @@ pub fn mol_error(e: MolError) -> anyhow::Error {
             format!("--arrow-{what} {value}: expected a finite number > 0")
         }
         MolError::TrailAtoms { .. } => return anyhow::anyhow!("--rep ...=trails: {e}"),
+        MolError::Ellipsoids(texmap_md_scene::ellipsoids::EllipsoidError::BadOption { .. }) => {
+            format!("--ellipsoid-shape: {e}")
+        }
+        MolError::Ellipsoids(e) => {
+            // The frame lacks shapes or holds bad ones: the input's limit.
+            return anyhow::anyhow!("--rep ...=ellipsoids: {e}");
+        }
         MolError::Measure(e) => return anyhow::anyhow!("--measure {e}"),
         MolError::Arrows(e) => {
             // The frame lacks the vectors asked for: the input's limit.

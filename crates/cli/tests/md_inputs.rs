@@ -2176,15 +2176,7 @@ fn arrows_end_where_the_vectors_point() {
         obj.to_str().unwrap(),
     ];
     render_rgb(dir.path(), "v.png", &args);
-    let v: Vec<[f64; 3]> = std::fs::read_to_string(&obj)
-        .unwrap()
-        .lines()
-        .filter_map(|l| l.strip_prefix("v "))
-        .map(|l| {
-            let mut it = l.split_whitespace().map(|x| x.parse::<f64>().unwrap());
-            std::array::from_fn(|_| it.next().unwrap())
-        })
-        .collect();
+    let v = common::obj_vertices(&obj);
     let positions = want["positions"].as_array().unwrap();
     let velocities = want["velocities"].as_array().unwrap();
     assert_eq!(positions.len(), 9);
@@ -2655,4 +2647,146 @@ fn displacements_measure_from_the_reference_given() {
     );
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("frames (0 to"), "{}", stderr(&o));
+}
+
+fn ellipsoid_data(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../md-scene/tests/data/ellipsoids")
+        .join(name)
+        .to_string_lossy()
+        .into_owned()
+}
+
+/// `--style ellipsoids` (md_scene::ellipsoids) on a LAMMPS dump OVITO 3.17 exported: every
+/// vertex of the exported mesh lies on one of the ellipsoids OVITO reads from the file; the
+/// rasteriser draws what the reference ray tracer draws; LAMMPS's own columns (diameters, w
+/// first) give the same picture; files without shapes and bad shapes are clear errors.
+#[test]
+fn ellipsoids_lie_where_ovito_reads_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let reference: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(ellipsoid_data("ovito_read.json")).unwrap())
+            .unwrap();
+    let want = &reference["ovito_export.dump"];
+    let obj = dir.path().join("e.obj");
+    let dump = ellipsoid_data("ovito_export.dump");
+    let base = [dump.as_str(), "--style", "ellipsoids", "--size", "320x240"];
+    let with_obj = [&base[..], &["--export-mesh", obj.to_str().unwrap()]].concat();
+    render_rgb(dir.path(), "picture.png", &with_obj);
+    let vertices = common::obj_vertices(&obj);
+    let f = |v: &serde_json::Value| -> Vec<[f64; 4]> {
+        v.as_array()
+            .unwrap()
+            .iter()
+            .map(|r| {
+                let r = r.as_array().unwrap();
+                std::array::from_fn(|k| r.get(k).map_or(0.0, |x| x.as_f64().unwrap()))
+            })
+            .collect()
+    };
+    let (pos, semi, quat) = (
+        f(&want["positions"]),
+        f(&want["semi_axes"]),
+        f(&want["orientation_xyzw"]),
+    );
+    // |u| of a point in the frame where particle i is the unit sphere (OVITO's x, y, z, w).
+    let u = |p: &[f64; 3], i: usize| {
+        let [x, y, z, w] = quat[i];
+        let d = [p[0] - pos[i][0], p[1] - pos[i][1], p[2] - pos[i][2]];
+        // The inverse rotation of d: conjugate quaternion.
+        let (qx, qy, qz, qw) = (-x, -y, -z, w);
+        let t = [
+            2.0 * (qy * d[2] - qz * d[1]),
+            2.0 * (qz * d[0] - qx * d[2]),
+            2.0 * (qx * d[1] - qy * d[0]),
+        ];
+        let r = [
+            d[0] + qw * t[0] + (qy * t[2] - qz * t[1]),
+            d[1] + qw * t[1] + (qz * t[0] - qx * t[2]),
+            d[2] + qw * t[2] + (qx * t[1] - qy * t[0]),
+        ];
+        ((0..3).map(|k| (r[k] / semi[i][k]).powi(2)).sum::<f64>()).sqrt()
+    };
+    let ellipsoids: Vec<usize> = (0..pos.len()).filter(|&i| semi[i][0] > 0.0).collect();
+    assert_eq!(ellipsoids.len(), 59, "one sphere among 60");
+    let mut hits = vec![0usize; pos.len()];
+    for v in &vertices {
+        let on = ellipsoids
+            .iter()
+            .copied()
+            .find(|&i| (u(v, i) - 1.0).abs() < 1e-4);
+        let i = on.unwrap_or_else(|| panic!("vertex {v:?} is on no ellipsoid"));
+        hits[i] += 1;
+    }
+    assert!(
+        ellipsoids.iter().all(|&i| hits[i] >= 12),
+        "every ellipsoid exported"
+    );
+    // The rasteriser against the reference ray tracer, both drawing the view's mesh.
+    let mut pngs = Vec::new();
+    for method in ["raycast", "reference"] {
+        let args = [&base[..], &["--method", method]].concat();
+        render_rgb(dir.path(), &format!("{method}.png"), &args);
+        pngs.push(dir.path().join(format!("{method}.png")));
+    }
+    let d = mean_abs_diff(&pngs[0], &pngs[1]);
+    assert!(d < 1.0, "mean |raycast - reference| = {d}");
+    assert!(lit(&pngs[0]) > 320 * 240 / 10);
+    // LAMMPS's columns for the same particles: the same picture.
+    let lammps = ellipsoid_data("lammps_columns.dump");
+    let args = [
+        "--style",
+        "ellipsoids",
+        "--size",
+        "320x240",
+        "--method",
+        "raycast",
+    ];
+    render_rgb(
+        dir.path(),
+        "lammps.png",
+        &[&[lammps.as_str()][..], &args].concat(),
+    );
+    let d = mean_abs_diff(&pngs[0], &dir.path().join("lammps.png"));
+    assert!(d < 0.05, "mean |OVITO's columns - LAMMPS's| = {d}");
+    // A file without shapes: exit 1 naming what it lacks; one shape for all draws it.
+    let plain = data("ase_plain.xyz");
+    let o = texmap(&[
+        "render",
+        "--quiet",
+        &plain,
+        "--style",
+        "ellipsoids",
+        "-o",
+        dir.path().join("x.png").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("shapex"), "{}", stderr(&o));
+    assert!(!dir.path().join("x.png").exists());
+    let o = texmap(&[
+        "render",
+        "--quiet",
+        &plain,
+        "--style",
+        "ellipsoids",
+        "--ellipsoid-shape",
+        "1.2,0.6,0.6",
+        "-o",
+        dir.path().join("x.png").to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for bad in ["1,0,1", "1,2", "x"] {
+        let o = texmap(&[
+            "render",
+            "--quiet",
+            &plain,
+            "--style",
+            "ellipsoids",
+            "--ellipsoid-shape",
+            bad,
+            "-o",
+            dir.path().join("y.png").to_str().unwrap(),
+        ]);
+        assert_eq!(o.status.code(), Some(2), "{bad}: {}", stderr(&o));
+    }
 }

@@ -464,14 +464,7 @@ fn a_volume_slice_is_the_grids_plane_in_its_values_colours() {
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let text = std::fs::read_to_string(&obj).unwrap();
-    let v: Vec<[f64; 3]> = text
-        .lines()
-        .filter_map(|l| l.strip_prefix("v "))
-        .map(|l| {
-            let mut it = l.split_whitespace().map(|x| x.parse::<f64>().unwrap());
-            std::array::from_fn(|_| it.next().unwrap())
-        })
-        .collect();
+    let v = common::obj_vertices(&obj);
     // The plane z = 0 (the grid's middle along c), spanning the grid's 5 x 5 Å.
     assert!(v.iter().all(|p| p[2].abs() < 1e-5), "off the plane");
     let span = |k: usize| {

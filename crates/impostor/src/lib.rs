@@ -93,6 +93,7 @@ use texmap_core::camera::Camera;
 use texmap_core::frame::Frame;
 
 pub use options::{Method, Options, PolygonShading, RenderStats, TemplateColoring, TemplateDepth};
+pub use polygon::{LEVELS as ICOSPHERE_LEVELS, Tess, icospheres};
 pub use scene::SphereScene;
 
 /// A rendered frame and its statistics.

@@ -42,17 +42,21 @@ pub const LEVELS: usize = 6;
 /// Vertices per batch before it is drawn.
 const BATCH_VERTS: usize = 1 << 20;
 
-/// One shared tessellation of the unit sphere.
+/// One tessellation of the unit sphere (an icosphere level), shared by every sphere drawn at
+/// that level (and by md-scene's ellipsoids, which map it onto each ellipsoid).
 #[derive(Clone, Debug)]
-pub(crate) struct Tess {
+pub struct Tess {
+    /// Unit vectors.
     pub verts: Vec<Vec3>,
+    /// Counter-clockwise seen from outside.
     pub tris: Vec<[u32; 3]>,
     /// Largest gap between a face and the unit sphere.
     pub sag: f32,
 }
 
-/// The icosphere levels 0..LEVELS.
-pub(crate) fn icospheres() -> Vec<Tess> {
+/// The icosphere levels 0..[`LEVELS`] (level `L` has `20·4^L` triangles), closed and wound
+/// counter-clockwise from outside.
+pub fn icospheres() -> Vec<Tess> {
     // Build the icosahedron (counter-clockwise seen from outside).
     let p = (1.0 + 5f32.sqrt()) * 0.5;
     let mut verts: Vec<Vec3> = [

@@ -32,6 +32,8 @@
 //!   their values (PyMOL's `distance`, `angle`, `dihedral`).
 //! - [`arrows`]: an arrow per atom for its velocity, displacement or a vector property (OVITO's
 //!   vector display), a mesh like the surface's.
+//! - [`ellipsoids`]: aspherical particles (LAMMPS `shapex..`/`quatw..`, one shape for all) as
+//!   ellipsoid meshes tessellated no finer than the view needs (OVITO's aspherical shapes).
 //! - [`polyhedra`]: coordination polyhedra as VESTA draws them (the convex hull of each centre
 //!   atom's bonded neighbours at their nearest periodic images), a mesh like the surface's.
 //! - [`surface`]: molecular surfaces as VMD's QuickSurf draws them (one Gaussian per atom, the
@@ -78,6 +80,7 @@ pub mod camera;
 pub mod camera_plan;
 pub mod cartoon;
 pub mod colormap;
+pub mod ellipsoids;
 pub mod isosurface;
 pub mod legend;
 pub mod measure;

@@ -108,6 +108,7 @@ use texmap_md_io::{
 };
 
 use crate::arrows::{ArrowError, ArrowOptions, ArrowSource};
+use crate::ellipsoids::{Ellipsoid, EllipsoidError, EllipsoidOptions};
 use crate::measure::{
     MEASURE_COLOR, MEASURE_DASHES, MEASURE_RADIUS, Measure, MeasureError, Measured,
 };
@@ -196,6 +197,12 @@ pub enum DrawStyle {
     /// across the box, [`MolOptions::trail_length`] frames long; the atoms themselves are not
     /// drawn.
     Trails,
+    /// Each selected atom as an ellipsoid of its aspherical shape and orientation
+    /// ([`MolOptions::ellipsoids`], [`crate::ellipsoids`]: LAMMPS `shapex..` and `quatw..`, or
+    /// one shape for all), tessellated for the view by the caller from
+    /// [`MolPlan::ellipsoids`]; an atom whose shape is three zeros (a LAMMPS sphere) stays a
+    /// sphere; nothing is bonded.
+    Ellipsoids,
 }
 
 /// The periodic-boundary treatment (frames without a cell are left as they are).
@@ -251,6 +258,8 @@ pub struct MolOptions {
     pub hbonds: Criteria,
     /// The vectors, scale and radius of [`DrawStyle::Arrows`].
     pub arrows: ArrowOptions,
+    /// Where the shapes of [`DrawStyle::Ellipsoids`] come from.
+    pub ellipsoids: EllipsoidOptions,
     /// How many frames of path [`DrawStyle::Trails`] draws (the current one included); `None`:
     /// every frame drawn so far.
     pub trail_length: Option<usize>,
@@ -364,6 +373,7 @@ impl Default for MolOptions {
             reps: Vec::new(),
             hbonds: Criteria::default(),
             arrows: ArrowOptions::default(),
+            ellipsoids: EllipsoidOptions::default(),
             trail_length: None,
             measures: Vec::new(),
             bond_orders: false,
@@ -432,6 +442,8 @@ pub enum MolError {
     HBonds(HBondError),
     /// The arrows' options are bad, or a frame lacks their vectors.
     Arrows(ArrowError),
+    /// The ellipsoids' shape option is bad, or a frame's shapes or orientations are.
+    Ellipsoids(EllipsoidError),
     /// A measurement's atoms are not one per selection in a frame, or make no angle.
     Measure(MeasureError),
     /// An atom the trails follow (picked at the first frame) is past a later frame's atoms.
@@ -458,6 +470,7 @@ impl fmt::Display for MolError {
             MolError::Coordination(e) => write!(f, "coordination: {e}"),
             MolError::HBonds(e) => write!(f, "hydrogen bonds: {e}"),
             MolError::Arrows(e) => write!(f, "arrows: {e}"),
+            MolError::Ellipsoids(e) => write!(f, "ellipsoids: {e}"),
             MolError::Measure(e) => write!(f, "measure: {e}"),
             MolError::TrailAtoms { atom, frame } => write!(
                 f,
@@ -557,6 +570,10 @@ pub struct MolPlan {
     arrow_vectors: Vec<glam::Vec3>,
     arrows: MolMesh,
     arrow_atoms: Vec<glam::Vec3>,
+    /// This frame's shapes and orientations, one per atom, and the last frame's ellipsoids
+    /// ([`DrawStyle::Ellipsoids`]).
+    ellipsoid_shapes: Vec<(glam::Vec3, glam::Quat)>,
+    ellipsoids: Vec<Ellipsoid>,
     /// [`DrawStyle::Trails`]: the atoms followed (picked at the first frame), each one's path
     /// (unwrapped, the last `trail_length` points) and its last position as read.
     trail_atoms: Option<Vec<u32>>,
@@ -598,6 +615,9 @@ impl MolPlan {
         if reps.iter().any(|r| r.draw == DrawStyle::Arrows) {
             options.arrows.check().map_err(MolError::Arrows)?;
         }
+        if reps.iter().any(|r| r.draw == DrawStyle::Ellipsoids) {
+            options.ellipsoids.check().map_err(MolError::Ellipsoids)?;
+        }
         let sticks = reps.iter().any(|r| r.draw != DrawStyle::Spacefill);
         if options.bonds == BondSource::Topology && sticks {
             match &options.topology {
@@ -631,6 +651,8 @@ impl MolPlan {
             arrow_vectors: Vec::new(),
             arrows: MolMesh::default(),
             arrow_atoms: Vec::new(),
+            ellipsoid_shapes: Vec::new(),
+            ellipsoids: Vec::new(),
             trail_atoms: None,
             trail_paths: Vec::new(),
             trail_last: Vec::new(),
@@ -755,6 +777,7 @@ impl MolPlan {
         for v in &mut frame.velocities {
             *v = fit.rotate(v.map(f64::from)).map(|v| v as f32);
         }
+        rotate_orientations(frame, &fit);
         if let Some(cell) = &frame.cell {
             let m = cell.matrix().map(|row| fit.rotate(row));
             frame.cell = texmap_md_io::UnitCell::from_matrix(m)
@@ -776,6 +799,7 @@ impl MolPlan {
                     | DrawStyle::HBonds
                     | DrawStyle::Polyhedra
                     | DrawStyle::Arrows
+                    | DrawStyle::Ellipsoids
             )
         });
         (sticks && self.options.bonds != BondSource::None)
@@ -997,6 +1021,11 @@ impl MolPlan {
                 values: d.iter().map(|v| v.length()).collect(),
             });
         }
+        self.ellipsoid_shapes.clear();
+        if self.draws_ellipsoids() {
+            self.ellipsoid_shapes = crate::ellipsoids::shapes(frame, &self.options.ellipsoids)
+                .map_err(MolError::Ellipsoids)?;
+        }
         self.arrow_vectors.clear();
         if self.draws_arrows() {
             let source = &self.options.arrows.source;
@@ -1066,6 +1095,7 @@ impl MolPlan {
         self.polyhedra = MolMesh::default();
         self.arrows = MolMesh::default();
         self.arrow_atoms.clear();
+        self.ellipsoids.clear();
         let mut drawn = self.draw_reps(builder, frame, &reps, scene);
         self.reps = reps;
         self.measured.clear();
@@ -1226,6 +1256,17 @@ impl MolPlan {
         &self.arrow_atoms
     }
 
+    /// Whether some representation draws ellipsoids ([`DrawStyle::Ellipsoids`]).
+    pub fn draws_ellipsoids(&self) -> bool {
+        self.reps.iter().any(|r| r.draw == DrawStyle::Ellipsoids)
+    }
+
+    /// The last frame's ellipsoids ([`DrawStyle::Ellipsoids`]; empty without them), for
+    /// [`crate::ellipsoids::tessellate`] once the camera is known.
+    pub fn ellipsoids(&self) -> &[Ellipsoid] {
+        &self.ellipsoids
+    }
+
     /// Whether some representation draws coordination polyhedra ([`DrawStyle::Polyhedra`]).
     pub fn draws_polyhedra(&self) -> bool {
         self.reps.iter().any(|r| r.draw == DrawStyle::Polyhedra)
@@ -1247,7 +1288,11 @@ impl MolPlan {
         self.reps.iter().any(|r| {
             matches!(
                 r.draw,
-                DrawStyle::Surface | DrawStyle::Cartoon | DrawStyle::Polyhedra | DrawStyle::Arrows
+                DrawStyle::Surface
+                    | DrawStyle::Cartoon
+                    | DrawStyle::Polyhedra
+                    | DrawStyle::Arrows
+                    | DrawStyle::Ellipsoids
             )
         })
     }
@@ -1348,7 +1393,8 @@ impl MolPlan {
             | DrawStyle::HBonds
             | DrawStyle::Polyhedra
             | DrawStyle::Arrows
-            | DrawStyle::Trails => {}
+            | DrawStyle::Trails
+            | DrawStyle::Ellipsoids => {}
             DrawStyle::BallStick => {
                 for r in &mut scene.radii {
                     *r *= BALL_AND_STICK_RADIUS_SCALE;
@@ -1446,6 +1492,34 @@ impl MolPlan {
             scene.centers.clear();
             scene.radii.clear();
             scene.kinds.clear();
+            scene.bonds.clear();
+            return Ok(());
+        }
+        if rep.draw == DrawStyle::Ellipsoids {
+            // The selected atoms become ellipsoids, LAMMPS's spheres (shape 0) stay spheres.
+            let mut w = 0;
+            for i in 0..scene.centers.len() {
+                if !mask.as_ref().is_none_or(|m| m[i]) {
+                    continue;
+                }
+                let (semi_axes, rotation) = self.ellipsoid_shapes[i];
+                if semi_axes == glam::Vec3::ZERO {
+                    scene.centers[w] = scene.centers[i];
+                    scene.radii[w] = scene.radii[i];
+                    scene.kinds[w] = scene.kinds[i];
+                    w += 1;
+                } else {
+                    self.ellipsoids.push(Ellipsoid {
+                        center: scene.centers[i],
+                        semi_axes,
+                        rotation,
+                        kind: scene.kinds[i],
+                    });
+                }
+            }
+            scene.centers.truncate(w);
+            scene.radii.truncate(w);
+            scene.kinds.truncate(w);
             scene.bonds.clear();
             return Ok(());
         }
@@ -1647,6 +1721,22 @@ impl MolPlan {
 
 /// `kinds` with each atom's colour-rule material where it has one (`u16::MAX`: none; an empty
 /// `rules` changes nothing).
+/// Turns the orientation quaternions a frame holds ([`crate::ellipsoids::ORIENTATION_SOURCES`])
+/// by the fit's rotation, as the positions and velocities turn: `q' = r · q`.
+fn rotate_orientations(frame: &mut Frame, fit: &crate::align::Superposition) {
+    let Some(at) = crate::ellipsoids::orientation_properties(frame) else {
+        return;
+    };
+    let r = glam::DQuat::from_mat3(&glam::DMat3::from_cols_array_2d(&fit.rotation).transpose());
+    for i in 0..frame.n_atoms() {
+        let v = |k: usize| f64::from(frame.properties[at[k]].values[i]);
+        let q = r * glam::DQuat::from_xyzw(v(1), v(2), v(3), v(0));
+        for (k, x) in [q.w, q.x, q.y, q.z].into_iter().enumerate() {
+            frame.properties[at[k]].values[i] = x as f32;
+        }
+    }
+}
+
 fn overlay(kinds: &mut [u16], rules: &[u16]) {
     for (k, &r) in kinds.iter_mut().zip(rules) {
         if r != u16::MAX {

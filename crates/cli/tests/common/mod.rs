@@ -48,3 +48,17 @@ pub fn gltf_validator_reports(files: &[std::path::PathBuf]) -> Option<Vec<serde_
             .collect(),
     )
 }
+
+/// The vertex positions (`v x y z` lines) of an OBJ file.
+#[allow(dead_code)] // not every test binary reads OBJ files
+pub fn obj_vertices(path: &std::path::Path) -> Vec<[f64; 3]> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .filter_map(|l| l.strip_prefix("v "))
+        .map(|l| {
+            let mut it = l.split_whitespace().map(|x| x.parse::<f64>().unwrap());
+            std::array::from_fn(|_| it.next().unwrap())
+        })
+        .collect()
+}
