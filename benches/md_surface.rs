@@ -6,6 +6,8 @@
 //! chain's cartoon (DSSP, spline, sweep). A movie pays them per frame. Volumetric data: the
 //! chain's Gaussian density on a 0.5 Å grid (as a cube file would hold it), its isosurface and
 //! that surface cut into 64 colour bands (`texmap render --isosurface`, `--isosurface-color-by`).
+//! Aspherical particles: 8,000 ellipsoids tessellated for the view and drawn
+//! (`--style ellipsoids`).
 //!
 //! `cargo bench --bench md_surface -- --warm-up-time 2 --measurement-time 10`
 //! (test mode, `cargo test --bench md_surface`, builds the one chain at 1.0 Å and 320x180.)
@@ -18,6 +20,7 @@ use texmap::core::shade::{Lighting, Material};
 use texmap::md_io::volume::Volume;
 use texmap::md_io::{AtomStyle, Frame, Trajectory};
 use texmap::md_scene::cartoon::append_cartoon;
+use texmap::md_scene::ellipsoids::{Ellipsoid, TOLERANCE_PX, tessellate};
 use texmap::md_scene::isosurface::{Side, bands, isosurface};
 use texmap::md_scene::surface::{MolMesh, SurfaceAtoms, SurfaceOptions, draw_mesh};
 
@@ -137,6 +140,60 @@ fn bench(c: &mut Criterion) {
         format!("bands64_3e8m_{}triangles", iso.triangles.len()),
         |b| b.iter(|| bands(&iso, &values, (lo, hi), 64, 0, 64)),
     );
+    // Aspherical particles (`--style ellipsoids`): a Gay-Berne-like liquid of 3:1:1
+    // ellipsoids, 20^3 on a lattice 2.2 Å apart at orientations from a fixed generator, seen
+    // whole: tessellated for the view (0.25 px), then drawn.
+    let side = if test_mode { 6 } else { 20 };
+    let (w, h) = if test_mode { (320, 180) } else { (1920, 1080) };
+    let mut seed = 17u64;
+    let mut next = move || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (seed >> 40) as f32 / (1u64 << 24) as f32
+    };
+    let particles: Vec<Ellipsoid> = (0..side * side * side)
+        .map(|i| {
+            let at = Vec3::new(
+                (i % side) as f32,
+                ((i / side) % side) as f32,
+                (i / side / side) as f32,
+            );
+            let axis = Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5).normalize();
+            Ellipsoid {
+                center: at * 2.2,
+                semi_axes: Vec3::new(1.5, 0.5, 0.5),
+                rotation: glam::Quat::from_axis_angle(axis, next() * 6.0),
+                kind: 0,
+            }
+        })
+        .collect();
+    let centre = Vec3::splat((side - 1) as f32 * 1.1);
+    let radius = centre.length() + 1.5;
+    let camera = Camera::perspective_look_at(
+        centre + Vec3::new(1.0, 0.8, 1.6).normalize() * radius * 2.6,
+        centre,
+        Vec3::Y,
+        45.0,
+        w,
+        h,
+    )
+    .unwrap();
+    let n = particles.len();
+    g.bench_function(format!("ellipsoids_tessellate_{n}_{w}x{h}"), |b| {
+        b.iter(|| tessellate(&particles, Some(&camera), TOLERANCE_PX))
+    });
+    let mesh = tessellate(&particles, Some(&camera), TOLERANCE_PX);
+    eprintln!("{n} ellipsoids: {} triangles", mesh.triangles.len());
+    let lighting = Lighting::default_for(&camera);
+    let materials = [Material::plastic(Vec3::new(0.8, 0.3, 0.3))];
+    let mut image = Image::new(w, h, [0, 0, 0, 255]);
+    g.bench_function(format!("ellipsoids_draw_{n}_{w}x{h}"), |b| {
+        b.iter(|| {
+            image.depth.fill(f32::INFINITY);
+            draw_mesh(&mesh, &materials, &camera, &lighting, 1.0, &mut image).unwrap()
+        })
+    });
     g.finish();
 }
 
