@@ -762,7 +762,7 @@ pub enum PbcArg {
 #[command(next_help_heading = "Molecules")]
 pub struct MolArgs {
     /// Topology giving names, elements, residues and bonds to a trajectory of the same atoms
-    /// (XTC, DCD, TRR, NetCDF carry coordinates only): PDB (CONECT bonds), PDBx/mmCIF (.cif),
+    /// (XTC, DCD, TRR, NetCDF carry coordinates only): PDB (CONECT bonds), PDBx/mmCIF or a crystallographic CIF (.cif),
     /// GRO, a CHARMM/NAMD PSF (.psf: !NBOND bonds), an AMBER prmtop (.prmtop, .parm7: bonds,
     /// chains), or a LAMMPS data file (.data, .lmp, data.*).
     #[arg(long, value_name = "FILE")]

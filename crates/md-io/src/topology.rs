@@ -9,6 +9,8 @@
 //! - **PDB**: the first model's atoms through the PDB reader, plus `CONECT` records (serial
 //!   numbers, hybrid-36 allowed, resolved to atom indices through the model's serials);
 //! - **GRO**: the first frame's atoms (GRO has no bonds);
+//! - **crystallographic CIF** (a `.cif` whose tags say so, as for trajectories): the first
+//!   data block's atoms expanded by its symmetry operations, labels and elements, no bonds;
 //! - **PDBx/mmCIF**: the first model's atoms through the mmCIF reader (the first alternate
 //!   location of each atom, as there: the dropped rows are not reported here, read the file as a
 //!   trajectory to see the warning). No bonds are taken from `_struct_conn`: as for GRO, bonds
@@ -37,7 +39,7 @@
 //! element and are drawn one colour per type, as OVITO does.
 
 use std::collections::HashMap;
-use std::io::{BufRead, BufReader, Read};
+use std::io::{BufRead, BufReader, Read, Seek};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -58,6 +60,9 @@ pub enum TopologyFormat {
     Gro,
     /// PDBx/mmCIF: atoms of the first model, no bonds.
     Mmcif,
+    /// Crystallographic CIF (COD, ICSD, Materials Project): the first data block's atoms,
+    /// expanded by its symmetry operations as the trajectory reader expands them, no bonds.
+    CrystalCif,
     /// LAMMPS data file: `Atoms` and `Bonds` sections.
     LammpsData,
     /// CHARMM/NAMD/X-PLOR PSF: `!NATOM` and `!NBOND` sections (see the `psf` module).
@@ -230,11 +235,35 @@ impl Topology {
 
     /// Reads the topology of `path` as `format`; a gzip file is read decompressed, as by
     /// [`Topology::open`].
+    ///
+    /// A `.cif` named as PDBx/mmCIF is told from a crystallographic CIF by its tags, as
+    /// [`Trajectory::open`] tells them ([`Format::cif_kind`]); `.mmcif` is always mmCIF.
     pub fn open_as(path: impl AsRef<Path>, format: TopologyFormat) -> Result<Topology, Error> {
         let path = path.as_ref();
         let name: Arc<str> = path.display().to_string().into();
         // A topology must be whole: a cut gzip stream is an error.
-        let (file, _) = crate::gz::open(path, &name, false)?;
+        let (mut file, _) = crate::gz::open(path, &name, false)?;
+        let mmcif_named = crate::gz::inner_path(path)
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("mmcif"));
+        let format = if format == TopologyFormat::Mmcif && !mmcif_named {
+            let io = |source| Error::Io {
+                at: Location::file(&name),
+                source,
+            };
+            let mut head = Vec::new();
+            (&mut file)
+                .take(Format::CIF_HEAD)
+                .read_to_end(&mut head)
+                .map_err(io)?;
+            file.rewind().map_err(io)?;
+            match Format::cif_kind(&head) {
+                Format::CrystalCif => TopologyFormat::CrystalCif,
+                _ => TopologyFormat::Mmcif,
+            }
+        } else {
+            format
+        };
         Topology::from_reader(file, format, &name)
     }
 
@@ -278,6 +307,9 @@ impl Topology {
             }
             TopologyFormat::Mmcif => {
                 Topology::first_frame(Trajectory::from_reader(src, Format::Mmcif, name)?)
+            }
+            TopologyFormat::CrystalCif => {
+                Topology::first_frame(Trajectory::from_reader(src, Format::CrystalCif, name)?)
             }
             TopologyFormat::LammpsData => {
                 // The trajectory reader's parse (module `lammps_data`), its frame's labels kept.

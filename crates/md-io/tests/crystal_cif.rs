@@ -511,3 +511,35 @@ fn one_site_as_items() {
     assert_eq!(f.property("occupancy"), Some(&[0.5f32; 4][..]));
     assert_eq!(f.names[3], "Cu1");
 }
+
+/// A crystallographic CIF given as a topology (`--topology cod.cif`) is read as one, not as
+/// PDBx/mmCIF: its expanded cell's elements, in the order the reference program lists them.
+#[test]
+fn a_crystal_cif_is_a_topology_too() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/crystal");
+    let reference: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(format!("{dir}/reference.json")).unwrap())
+            .unwrap();
+    for name in ["cod_1010930.cif", "cod_9004112.cif"] {
+        let t = texmap_md_io::Topology::open(format!("{dir}/{name}"))
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        let want = &reference[name][0];
+        let elements: Vec<&str> = want["elements"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|e| e.as_str().unwrap())
+            .collect();
+        assert_eq!(
+            t.n_atoms(),
+            want["n_atoms"].as_u64().unwrap() as usize,
+            "{name}"
+        );
+        let ours: Vec<&str> = t.elements.iter().map(|e| e.symbol()).collect();
+        let (mut a, mut b) = (ours.clone(), elements.clone());
+        a.sort_unstable();
+        b.sort_unstable();
+        assert_eq!(a, b, "{name}: the same elements");
+        assert!(t.bonds.is_empty());
+    }
+}
