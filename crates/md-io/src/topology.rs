@@ -39,7 +39,7 @@
 //! element and are drawn one colour per type, as OVITO does.
 
 use std::collections::HashMap;
-use std::io::{BufRead, BufReader, Read, Seek};
+use std::io::{BufRead, BufReader, Read};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -243,21 +243,8 @@ impl Topology {
         let name: Arc<str> = path.display().to_string().into();
         // A topology must be whole: a cut gzip stream is an error.
         let (mut file, _) = crate::gz::open(path, &name, false)?;
-        let mmcif_named = crate::gz::inner_path(path)
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("mmcif"));
-        let format = if format == TopologyFormat::Mmcif && !mmcif_named {
-            let io = |source| Error::Io {
-                at: Location::file(&name),
-                source,
-            };
-            let mut head = Vec::new();
-            (&mut file)
-                .take(Format::CIF_HEAD)
-                .read_to_end(&mut head)
-                .map_err(io)?;
-            file.rewind().map_err(io)?;
-            match Format::cif_kind(&head) {
+        let format = if format == TopologyFormat::Mmcif {
+            match crate::trajectory::cif_kind_of(&mut file, path, &name)? {
                 Format::CrystalCif => TopologyFormat::CrystalCif,
                 _ => TopologyFormat::Mmcif,
             }

@@ -150,6 +150,28 @@ pub struct Trajectory<R: Read + Seek = File> {
     cut_at: Option<usize>,
 }
 
+/// Which CIF `file` (at `path`, named `name` in errors) is: a CIF not named `.mmcif` is
+/// PDBx/mmCIF or crystallographic, and its tags tell ([`Format::cif_kind`]) from a larger head
+/// than the magic's (a COD file's atom sites follow its bibliography). The file is rewound.
+pub(crate) fn cif_kind_of(file: &mut File, path: &Path, name: &Arc<str>) -> Result<Format, Error> {
+    let mmcif_named = crate::gz::inner_path(path)
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("mmcif"));
+    if mmcif_named {
+        return Ok(Format::Mmcif);
+    }
+    let io = |source| Error::Io {
+        at: crate::error::Location::file(name),
+        source,
+    };
+    let mut head = Vec::new();
+    file.take(Format::CIF_HEAD)
+        .read_to_end(&mut head)
+        .map_err(io)?;
+    file.rewind().map_err(io)?;
+    Ok(Format::cif_kind(&head))
+}
+
 impl Trajectory<File> {
     /// Opens `path`, telling the format from the extension or else from the first bytes.
     /// A CIF (`.cif`, or first bytes `data_`) is PDBx/mmCIF or crystallographic by its tags
@@ -188,19 +210,8 @@ impl Trajectory<File> {
                 Format::from_magic(&head).ok_or(Error::UnknownFormat { file: name.clone() })?
             }
         };
-        // A CIF not named `.mmcif` is PDBx/mmCIF or crystallographic: its tags tell, from a
-        // larger head than the magic's (a COD file's atom sites follow its bibliography).
-        let mmcif_named = crate::gz::inner_path(path)
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("mmcif"));
-        let format = if format == Format::Mmcif && !mmcif_named {
-            let mut head = Vec::new();
-            (&mut file)
-                .take(Format::CIF_HEAD)
-                .read_to_end(&mut head)
-                .map_err(io)?;
-            file.rewind().map_err(io)?;
-            Format::cif_kind(&head)
+        let format = if format == Format::Mmcif {
+            cif_kind_of(&mut file, path, &name)?
         } else {
             format
         };
