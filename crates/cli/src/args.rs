@@ -62,8 +62,12 @@ pub enum Command {
         /// Trajectory file (XYZ, extended XYZ, PDB, PDBx/mmCIF, GRO, LAMMPS dump, DCD, XTC, TRR,
         /// AMBER NetCDF, SDF/MOL and MOL2 with their bonds, one frame per record, VASP
         /// POSCAR/CONTCAR/XDATCAR, crystallographic CIF, a LAMMPS data file),
-        /// gzip-compressed or not (1abc.cif.gz).
+        /// gzip-compressed or not (1abc.cif.gz). A quoted pattern ('dump.*.lammpstrj') reads
+        /// the files it matches in natural order as one trajectory.
         file: PathBuf,
+        /// More parts of the same trajectory, read after FILE as one (prod2.xtc prod3.xtc).
+        #[arg(value_name = "MORE")]
+        more: Vec<PathBuf>,
         /// Format, when the extension does not tell it.
         #[arg(long)]
         format: Option<String>,
@@ -438,8 +442,15 @@ Examples: --type-color 1=#ff8000 --type-color 2=40,40,255 (LAMMPS types 1 and 2)
 #[derive(Args, Debug)]
 #[command(after_help = RENDER_AFTER_HELP)]
 pub struct RenderArgs {
-    /// Trajectory file (any format `texmap info` reads; gzip-compressed files too).
+    /// Trajectory file (any format `texmap info` reads; gzip-compressed files too). A quoted
+    /// pattern ('dump.*.lammpstrj', as OVITO's file sequences) reads the files it matches in
+    /// natural order (dump.200 before dump.1000) as one trajectory.
     pub file: PathBuf,
+    /// More parts of the same trajectory, read after FILE as one: a run continued in parts
+    /// (texmap render prod1.xtc prod2.xtc --topology system.gro). Frames are numbered across
+    /// the parts; errors name the part and its frame.
+    #[arg(value_name = "MORE")]
+    pub more: Vec<PathBuf>,
     /// Format, when the extension does not tell it.
     #[arg(long)]
     pub format: Option<String>,

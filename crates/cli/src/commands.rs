@@ -9,7 +9,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
 use texmap_core::shade::Lighting;
 use texmap_impostor::{Method, Renderer, SphereScene};
-use texmap_md_io::{Format, Frame as MdFrame, ReadOptions, Trajectory};
+use texmap_md_io::{Format, Frame as MdFrame, ReadOptions, Sequence};
 use texmap_study::harness::{self, HarnessOptions, SceneReport};
 use texmap_study::scenes::{self, NamedScene, SceneId};
 
@@ -40,11 +40,13 @@ pub fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Info {
             file,
+            more,
             format,
             allow_truncated,
             topology,
         } => info(
             &file,
+            &more,
             format.as_deref(),
             allow_truncated,
             topology.as_deref(),
@@ -89,13 +91,13 @@ pub(crate) fn spinner(what: &str) -> ProgressBar {
     pb
 }
 
-pub(crate) fn open_trajectory(file: &Path, format: Option<&str>) -> Result<Trajectory> {
+pub(crate) fn open_trajectory(file: &Path, format: Option<&str>) -> Result<Sequence> {
     open_trajectory_with(file, format, ReadOptions::new())
 }
 
 /// Prints the reader's warnings (once each): what it tolerated under --allow-truncated, and the
 /// alternate locations of PDBx/mmCIF atoms it dropped after the first.
-fn print_warnings(traj: &Trajectory, shown: &mut usize) {
+fn print_warnings(traj: &Sequence, shown: &mut usize) {
     for w in &traj.warnings()[*shown..] {
         if texmap_md_io::is_altloc_warning(w) {
             eprintln!("texmap: warning: {w}");
@@ -110,28 +112,59 @@ fn open_trajectory_with(
     file: &Path,
     format: Option<&str>,
     options: ReadOptions,
-) -> Result<Trajectory> {
-    if !file.exists() {
-        bail!("{}: no such file", file.display());
+) -> Result<Sequence> {
+    open_parts(&[file.to_path_buf()], format, options)
+}
+
+/// The trajectory in `files` (parts read as one; a quoted pattern expanded in natural order).
+fn open_parts(files: &[PathBuf], format: Option<&str>, options: ReadOptions) -> Result<Sequence> {
+    let mut parts = Vec::new();
+    for file in files {
+        let text = file.to_string_lossy();
+        let found = if text.contains(['*', '?']) && !file.exists() {
+            texmap_md_io::sequence::expand(&text)?
+        } else {
+            vec![file.clone()]
+        };
+        for part in found {
+            if !part.exists() {
+                bail!("{}: no such file", part.display());
+            }
+            if part.is_dir() {
+                bail!("{}: is a directory, not a trajectory file", part.display());
+            }
+            parts.push(part);
+        }
     }
-    if file.is_dir() {
-        bail!("{}: is a directory, not a trajectory file", file.display());
+    // A shell sorts an unquoted pattern's names as text (dump.10 before dump.2): kept as
+    // given, but said.
+    let names: Vec<String> = parts.iter().map(|p| p.display().to_string()).collect();
+    if let Some(k) = (1..names.len())
+        .find(|&k| texmap_md_io::sequence::natural_cmp(&names[k - 1], &names[k]).is_gt())
+    {
+        eprintln!(
+            "texmap: warning: the trajectory's parts are read in the order given, and {} comes before {}: a shell sorts names as text; quote the pattern ('dump.*.lammpstrj') to read the files in natural order",
+            names[k - 1],
+            names[k]
+        );
     }
-    match format {
-        Some(name) => {
-            let Some(f) = Format::from_extension(name) else {
+    let format = match format {
+        Some(name) => match Format::from_extension(name) {
+            Some(f) => Some(f),
+            None => {
                 return usage(format!(
                     "--format {name:?}: expected one of xyz, extxyz, pdb, cif, gro, lammpstrj, dcd, xtc, trr, nc, sdf, mol, mol2, vasp, cif-crystal, lammps-data"
                 ));
-            };
-            Ok(Trajectory::open_as_with(file, f, options)?)
-        }
-        None => Ok(Trajectory::open_with(file, options)?),
-    }
+            }
+        },
+        None => None,
+    };
+    Ok(Sequence::open(&parts, format, options)?)
 }
 
 fn info(
     file: &Path,
+    more: &[PathBuf],
     format: Option<&str>,
     allow_truncated: bool,
     topology: Option<&Path>,
@@ -146,7 +179,10 @@ fn info(
         return topology_info(file);
     }
     let options = ReadOptions::new().allow_truncated(allow_truncated);
-    let mut traj = open_trajectory_with(file, format, options)?;
+    let files: Vec<PathBuf> = std::iter::once(file.to_path_buf())
+        .chain(more.iter().cloned())
+        .collect();
+    let mut traj = open_parts(&files, format, options)?;
     let topo = topology.map(crate::scene::open_topology).transpose()?;
     let mut frame = MdFrame::new();
     let frames = traj.n_frames()?;
@@ -185,6 +221,10 @@ fn info(
         "box": bx,
         "first_positions": first,
     });
+    // A trajectory in several files: how many, in the order read.
+    if traj.paths().len() > 1 {
+        obj["files"] = json!(traj.paths().len());
+    }
     // Chains and segments with their atom counts, in order of first appearance: what a user
     // needs to write `chain A` or `segid PROA` selections.
     for (key, labels) in [("chains", &frame.chains), ("segments", &frame.segments)] {
@@ -402,7 +442,10 @@ fn render(a: &RenderArgs) -> Result<()> {
     let background = parse_background(&a.background)?;
     let size = parse_size(&a.camera.size)?;
     let options = ReadOptions::new().allow_truncated(a.allow_truncated);
-    let mut traj = open_trajectory_with(&a.file, a.format.as_deref(), options)?;
+    let files: Vec<PathBuf> = std::iter::once(a.file.clone())
+        .chain(a.more.iter().cloned())
+        .collect();
+    let mut traj = open_parts(&files, a.format.as_deref(), options)?;
     let n = traj.n_frames()?;
     let mut shown = 0;
     print_warnings(&traj, &mut shown);

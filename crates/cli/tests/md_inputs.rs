@@ -2790,3 +2790,73 @@ fn ellipsoids_lie_where_ovito_reads_them() {
         assert_eq!(o.status.code(), Some(2), "{bad}: {}", stderr(&o));
     }
 }
+
+/// A trajectory in several files: OVITO's one-file-per-frame export of a LAMMPS run, as a quoted
+/// pattern, draws the same bytes as the run's one file, smoothed across the files' boundaries
+/// too; XTC parts count their frames together; unquoted (shell-sorted) parts are read as given
+/// with a warning; a pattern matching nothing is an error.
+#[test]
+fn a_trajectory_in_several_files_is_one_trajectory() {
+    let dir = tempfile::tempdir().unwrap();
+    let seq = |name: &str| data(&format!("sequence/{name}"));
+    let pattern = seq("ovito/dump.*.lammpstrj");
+    let o = texmap(&["info", &pattern]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let info: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(
+        (info["frames"].as_u64(), info["files"].as_u64()),
+        (Some(12), Some(12))
+    );
+    let o = texmap(&["info", &seq("part1.xtc"), &seq("part2.xtc")]);
+    let info: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(
+        (info["frames"].as_u64(), info["files"].as_u64()),
+        (Some(12), Some(2))
+    );
+    for (name, input) in [
+        ("whole", seq("source.lammpstrj")),
+        ("parts", pattern.clone()),
+    ] {
+        for smooth in ["0", "2"] {
+            let out = dir.path().join(format!("{name}{smooth}_%02d.png"));
+            let o = texmap(&[
+                "render",
+                "--quiet",
+                &input,
+                "--frames",
+                "5:12:3",
+                "--smooth",
+                smooth,
+                "--size",
+                "200x150",
+                "-o",
+                out.to_str().unwrap(),
+            ]);
+            assert!(o.status.success(), "{}", stderr(&o));
+        }
+    }
+    for smooth in ["0", "2"] {
+        for f in [5, 8, 11] {
+            let read = |name: &str| {
+                std::fs::read(dir.path().join(format!("{name}{smooth}_{f:02}.png"))).unwrap()
+            };
+            assert!(
+                read("whole") == read("parts"),
+                "frame {f}, --smooth {smooth}"
+            );
+        }
+    }
+    // The shell's order: read as given, and said.
+    let mut shell: Vec<String> = (0..12)
+        .map(|k| seq(&format!("ovito/dump.{k}.lammpstrj")))
+        .collect();
+    shell.sort();
+    let mut args = vec!["info"];
+    args.extend(shell.iter().map(String::as_str));
+    let o = texmap(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("quote the pattern"), "{}", stderr(&o));
+    let o = texmap(&["info", dir.path().join("none.*.xtc").to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("no file matches"), "{}", stderr(&o));
+}

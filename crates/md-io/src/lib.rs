@@ -13,6 +13,8 @@
 //!   Any of them may be gzip-compressed (`1abc.cif.gz`, `run.xyz.gz`; topologies too): it is
 //!   inflated once into a temporary file, so the byte offsets of a `.gz` file's errors count
 //!   decompressed bytes, except for damage to the gzip stream itself (compressed offset).
+//! - [`Sequence`] reads a trajectory in several files (a run continued in parts, a LAMMPS
+//!   dump per step: [`sequence::expand`] for `dump.*.lammpstrj`) as one.
 //! - [`Topology`] reads atom names, elements, residues and bonds (PDB, PDBx/mmCIF, GRO, PSF,
 //!   AMBER prmtop, LAMMPS data file) and gives them to the frames of a coordinate-only trajectory of the same
 //!   atoms.
@@ -116,6 +118,7 @@ pub mod replicate;
 mod sdf;
 pub mod secondary;
 pub mod select;
+pub mod sequence;
 pub mod smooth;
 pub mod style;
 mod text;
@@ -134,9 +137,10 @@ pub use format::Format;
 pub use frame::{BOND_AROMATIC, Frame, Label, MAX_COORDINATE, Property, UnitCell};
 pub use mmcif::is_altloc_warning;
 pub use select::{Selection, SelectionError};
+pub use sequence::Sequence;
 pub use style::{Appearance, AtomStyle, Selector, atom_element};
 pub use topology::{Topology, TopologyFormat};
-pub use trajectory::{ReadOptions, Trajectory};
+pub use trajectory::{FrameSource, ReadOptions, Trajectory};
 pub use writer::Writer;
 
 /// molly, the XTC crate our decoder is measured against (benches/md_io.rs); not part of the API.

@@ -15,8 +15,9 @@
 //!   frame's. Frames must have the same atoms in the same order (LAMMPS dumps are sorted by id
 //!   when read); a window that meets another atom count is an error naming both frames.
 //!
-//! [`Smoother`] reads the window's frames from a [`Trajectory`] (random access) and keeps the
-//! positions of the last window, so that consecutive frames read each frame once.
+//! [`Smoother`] reads the window's frames by number from a [`crate::Trajectory`] or a
+//! [`crate::Sequence`] and keeps the positions of the last window, so that consecutive frames
+//! read each frame once.
 //!
 //! ```
 //! use texmap_md_io::smooth::{mean_positions, window};
@@ -33,13 +34,12 @@
 //! ```
 
 use std::collections::VecDeque;
-use std::io::{Read, Seek};
 use std::ops::RangeInclusive;
 
 use crate::error::{Error, Location};
 use crate::frame::Frame;
 use crate::pbc::minimum_image;
-use crate::trajectory::Trajectory;
+use crate::trajectory::FrameSource;
 
 /// The frames averaged into frame `f` of `n_frames` with half-width `half` (see the module
 /// docs); `f..=f` when `half` is 0 or `f` is an end frame.
@@ -107,9 +107,9 @@ impl Smoother {
     /// `frame`, which holds frame `f` of `traj` as read, smoothed over its window of `n_frames`
     /// frames; the neighbours are read from `traj` (which is left at an arbitrary frame). A
     /// neighbour with another atom count is an error naming the trajectory and both frames.
-    pub fn smooth<R: Read + Seek>(
+    pub fn smooth(
         &mut self,
-        traj: &mut Trajectory<R>,
+        traj: &mut impl FrameSource,
         n_frames: usize,
         f: usize,
         frame: &mut Frame,

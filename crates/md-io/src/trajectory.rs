@@ -66,6 +66,24 @@ macro_rules! each_reader {
     };
 }
 
+/// Frames read by number: a [`Trajectory`] or a [`crate::Sequence`] of them, for what reads
+/// around a frame (smoothing's window, [`crate::smooth`]).
+pub trait FrameSource {
+    /// Reads frame `n` into `frame`.
+    fn read_frame(&mut self, n: usize, frame: &mut Frame) -> Result<(), Error>;
+    /// The name errors give.
+    fn name(&self) -> &str;
+}
+
+impl<R: Read + Seek> FrameSource for Trajectory<R> {
+    fn read_frame(&mut self, n: usize, frame: &mut Frame) -> Result<(), Error> {
+        Trajectory::read_frame(self, n, frame)
+    }
+    fn name(&self) -> &str {
+        Trajectory::name(self)
+    }
+}
+
 /// How a [`Trajectory`] treats a file whose end is damaged.
 ///
 /// By default every frame the file announces or starts must be readable: a last frame cut short
@@ -299,6 +317,11 @@ impl<R: Read + Seek> Trajectory<R> {
     /// prints them as warnings.
     pub fn warnings(&self) -> &[Error] {
         &self.warnings
+    }
+
+    /// The warnings kept so far, taken out (a [`crate::Sequence`] keeps a closed part's).
+    pub(crate) fn take_warnings(&mut self) -> Vec<Error> {
+        std::mem::take(&mut self.warnings)
     }
 
     /// `self` with `w` (a cut gzip stream read under `allow_truncated`), if any, as its first
