@@ -509,8 +509,8 @@ pub struct RenderArgs {
     pub export_mesh: Option<PathBuf>,
     /// Anti-alias by supersampling: draw each image at N times its size in each direction and
     /// average each N x N block in linear light (depth: the nearest), with any method, style
-    /// and --quality; N² times the drawing time. 3 smooths the edges of cartoons and surfaces,
-    /// which --quality does not draw.
+    /// and --quality; N² times the drawing time. 3 smooths the edges of cartoons and surfaces
+    /// drawn without --quality.
     #[arg(long, value_name = "N", default_value_t = 1)]
     pub supersample: u32,
     /// A caption at the top left of every image, on a light backdrop, for movies:
@@ -642,7 +642,10 @@ pub enum QualityPreset {
 
 /// Image quality of `texmap render` (ray-cast method, and the reference with the same effects
 /// traced: ⌈√aa⌉² samples per pixel, at least as many AO and soft-shadow rays, outlines by the
-/// same rule on every sample): each flag overrides its preset's value.
+/// same rule on every sample): each flag overrides its preset's value. A frame with a cartoon,
+/// surface, polyhedra, arrows, ellipsoids or an isosurface is traced by the reference with
+/// these effects, whatever the method (slower: seconds a frame), so the meshes cast and
+/// receive the same occlusion and shadows as the atoms.
 #[derive(Args, Clone, Debug, Default)]
 #[command(next_help_heading = "Quality (raycast and reference methods)")]
 pub struct QualityArgs {

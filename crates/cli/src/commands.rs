@@ -438,6 +438,34 @@ fn set_file_number(frame: &mut MdFrame, number: usize) {
     });
 }
 
+/// A frame traced by the reference ray tracer (`trace`: the spheres, whether their bonds are
+/// drawn, the opaque meshes): the spheres with the opaque `layers`, then each transparent
+/// layer traced on its own and laid over the rest as the methods lay it
+/// ([`texmap_md_scene::surface::composite`]).
+fn trace_layers<E: Into<anyhow::Error>>(
+    scene: &SphereScene,
+    bonds: bool,
+    layers: &[(&texmap_md_scene::surface::MolMesh, f32)],
+    trace: impl Fn(
+        &SphereScene,
+        bool,
+        &[&texmap_md_scene::surface::MolMesh],
+    ) -> std::result::Result<texmap_core::frame::Frame, E>,
+) -> Result<texmap_core::frame::Frame> {
+    let opaque: Vec<&texmap_md_scene::surface::MolMesh> =
+        layers.iter().filter(|l| l.1 >= 1.0).map(|l| l.0).collect();
+    let mut base = trace(scene, bonds, &opaque).map_err(Into::into)?;
+    for &(mesh, opacity) in layers.iter().filter(|l| l.1 < 1.0) {
+        if mesh.triangles.is_empty() {
+            continue;
+        }
+        let alone = SphereScene::new(scene.materials.clone());
+        let layer = trace(&alone, false, &[mesh]).map_err(Into::into)?;
+        texmap_md_scene::surface::composite(&mut base, &layer, opacity);
+    }
+    Ok(base)
+}
+
 fn render(a: &RenderArgs) -> Result<()> {
     let background = parse_background(&a.background)?;
     let size = parse_size(&a.camera.size)?;
@@ -518,18 +546,8 @@ fn render(a: &RenderArgs) -> Result<()> {
         ));
     }
     let isosurfaces = crate::scene::isosurfaces(&a.file, &a.mol)?;
-    if isosurfaces.is_some() && quality.is_some() {
-        return usage(
-            "--isosurface is drawn without --quality's anti-aliasing, ambient occlusion and shadows; drop --quality and its options",
-        );
-    }
     let mut iso_mesh = texmap_md_scene::surface::MolMesh::default();
     let iso_opacity = isosurfaces.as_ref().map_or(1.0, |i| i.opacity);
-    if plan.draws_meshes() && quality.is_some() {
-        return usage(
-            "the cartoon, surface, polyhedra, arrows and ellipsoids styles are drawn without --quality's anti-aliasing, ambient occlusion and shadows; drop --quality and its options, or draw those atoms in another style",
-        );
-    }
     let mut surface = texmap_md_scene::surface::MolMesh::default();
     let mut coarser_warned = false;
     let mut smoother = texmap_md_io::smooth::Smoother::new(a.smooth as usize);
@@ -848,18 +866,6 @@ fn render(a: &RenderArgs) -> Result<()> {
             cam
         };
         let lighting = Lighting::default_for(&cam);
-        // This frame's quality options: bonds as drawn, fog over this frame's depth.
-        let quality = quality.map(|mut q| {
-            q.draw_bonds = plan.draws_bonds();
-            if a.quality.fog {
-                q.fog = texmap_quality::Fog::for_scene(
-                    &scene,
-                    &cam,
-                    [background[0], background[1], background[2]],
-                );
-            }
-            q
-        });
         // The ellipsoids, tessellated for this view.
         let ellipsoid_mesh = texmap_md_scene::ellipsoids::tessellate(
             plan.ellipsoids(),
@@ -875,21 +881,52 @@ fn render(a: &RenderArgs) -> Result<()> {
             (plan.polyhedra_mesh(), polyhedra_opacity),
             (&iso_mesh, iso_opacity),
         ];
+        let meshes_drawn = layers.iter().any(|l| !l.0.triangles.is_empty());
+        // This frame's quality options: bonds as drawn, fog over this frame's depth (the
+        // meshes' too).
+        let quality = quality.map(|mut q| {
+            q.draw_bonds = plan.draws_bonds();
+            if a.quality.fog {
+                let mut extent = scene.clone();
+                texmap_md_scene::push_framed_points(
+                    &mut extent,
+                    layers.iter().flat_map(|l| &l.0.positions),
+                );
+                q.fog = texmap_quality::Fog::for_scene(
+                    &extent,
+                    &cam,
+                    [background[0], background[1], background[2]],
+                );
+            }
+            q
+        });
+        if meshes_drawn && quality.is_some() && method_of(a.method).is_some() && k == mine.start {
+            crate::note!(
+                "--quality with a cartoon, surface, polyhedra, arrows, ellipsoids or isosurface: the frame is traced by the reference ray tracer (a BVH over the spheres and the meshes), slower than the sphere methods"
+            );
+        }
         let out = match (method_of(a.method), quality) {
-            (Some(_), Some(q)) => {
+            (Some(_), Some(q)) if !meshes_drawn => {
                 quality_renderer
                     .render(&scene, &cam, &lighting, &q)
                     .map_err(|e| fail(anyhow::anyhow!("{e}"), &written))?
                     .frame
             }
-            (None, Some(q)) => texmap_study::quality::reference_with(
-                &scene,
-                plan.draws_bonds(),
-                &cam,
-                lighting,
-                &q,
-            )
-            .map_err(|e| fail(e.into(), &written))?,
+            (_, Some(q)) => {
+                // Meshes (or --method reference): the reference ray tracer with the quality's
+                // effects; a transparent mesh traced on its own and laid over the rest.
+                trace_layers(
+                    &scene,
+                    plan.draws_bonds(),
+                    &layers,
+                    |spheres, bonds, meshes| {
+                        texmap_study::quality::reference_with(
+                            spheres, bonds, meshes, &cam, lighting, &q,
+                        )
+                    },
+                )
+                .map_err(|e| fail(e, &written))?
+            }
             (Some(m), None) => {
                 let mut o = texmap_impostor::Options::new(m, lighting);
                 o.background = background;
@@ -911,37 +948,22 @@ fn render(a: &RenderArgs) -> Result<()> {
                 }
                 r.frame
             }
-            (None, None) => {
-                // A transparent mesh is traced on its own and laid over the rest as the
-                // methods lay it ([`texmap_md_scene::surface::composite`]).
-                let opaque: Vec<&texmap_md_scene::surface::MolMesh> =
-                    layers.iter().filter(|l| l.1 >= 1.0).map(|l| l.0).collect();
-                let trace =
-                    |spheres: &SphereScene,
-                     bonds,
-                     meshes: &[&texmap_md_scene::surface::MolMesh]| {
-                        harness::render_reference(
-                            &harness::reference_scene_with_meshes(spheres, bonds, meshes),
-                            &harness::reference_materials(&scene),
-                            &cam,
-                            lighting,
-                            background,
-                            1,
-                        )
-                    };
-                let mut base = trace(&scene, plan.draws_bonds(), &opaque)
-                    .map_err(|e| fail(e.into(), &written))?;
-                for &(mesh, opacity) in layers.iter().filter(|l| l.1 < 1.0) {
-                    if mesh.triangles.is_empty() {
-                        continue;
-                    }
-                    let alone = SphereScene::new(scene.materials.clone());
-                    let layer =
-                        trace(&alone, false, &[mesh]).map_err(|e| fail(e.into(), &written))?;
-                    texmap_md_scene::surface::composite(&mut base, &layer, opacity);
-                }
-                base
-            }
+            (None, None) => trace_layers(
+                &scene,
+                plan.draws_bonds(),
+                &layers,
+                |spheres, bonds, meshes| {
+                    harness::render_reference(
+                        &harness::reference_scene_with_meshes(spheres, bonds, meshes),
+                        &harness::reference_materials(&scene),
+                        &cam,
+                        lighting,
+                        background,
+                        1,
+                    )
+                },
+            )
+            .map_err(|e| fail(e, &written))?,
         };
         let mut out = out;
         if ss > 1 {

@@ -1559,8 +1559,6 @@ fn a_molecular_surface_is_drawn_as_the_reference_traces_it() {
     for bad in [
         &["--style", "surface", "--surface-spacing", "0"][..],
         &["--style", "surface", "--surface-scale", "nan"],
-        &["--style", "surface", "--quality", "good"],
-        &["--style", "cartoon", "--ao", "8"],
         &["--rep", "protein=surfaces"],
     ] {
         let out = dir.path().join("bad.png");

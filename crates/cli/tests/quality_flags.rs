@@ -187,3 +187,59 @@ fn the_reference_draws_the_same_quality_settings() {
         "{close} dB vs {far} dB without the effects"
     );
 }
+
+/// Cartoons (and every mesh) take the quality flags: traced by the reference ray tracer with
+/// the spheres, the same bytes whichever method is asked for; ambient occlusion only darkens
+/// (each pixel at most as bright as the plain trace, the grooves between helices darker),
+/// and shadows darken more.
+#[test]
+fn a_cartoon_takes_ambient_occlusion_and_shadows() {
+    let dir = tempfile::tempdir().unwrap();
+    let pdb = data("dssp/3gwiA.pdb.gz");
+    let run = |name: &str, extra: &[&str]| {
+        let out = dir.path().join(name);
+        let mut args = vec![
+            "render",
+            pdb.to_str().unwrap(),
+            "--style",
+            "cartoon",
+            "--size",
+            "240x180",
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        let o = texmap(&args);
+        assert!(
+            o.status.success(),
+            "{extra:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        (rgba(&out), String::from_utf8_lossy(&o.stderr).into_owned())
+    };
+    let (plain, _) = run("plain.png", &["--method", "reference"]);
+    let (ao, said) = run("ao.png", &["--aa", "1", "--ao", "16"]);
+    assert!(said.contains("reference ray tracer"), "{said}");
+    let (ao_ref, _) = run(
+        "ao_ref.png",
+        &["--aa", "1", "--ao", "16", "--method", "reference"],
+    );
+    assert!(ao == ao_ref, "the same trace whichever method is asked for");
+    let (shadowed, _) = run("shadows.png", &["--aa", "1", "--ao", "16", "--shadows"]);
+    let luma = |p: &image::Rgba<u8>| p[0] as i32 * 3 + p[1] as i32 * 6 + p[2] as i32;
+    let (mut brighter, mut darker, mut sum_plain, mut sum_ao, mut sum_shadow) =
+        (0, 0, 0i64, 0i64, 0i64);
+    for ((p, q), r) in plain.pixels().zip(ao.pixels()).zip(shadowed.pixels()) {
+        brighter += (luma(q) > luma(p) + 10) as usize;
+        darker += (luma(q) + 30 < luma(p)) as usize;
+        sum_plain += luma(p) as i64;
+        sum_ao += luma(q) as i64;
+        sum_shadow += luma(r) as i64;
+    }
+    eprintln!(
+        "AO: {darker} pixels darker, {brighter} brighter; mean luma {sum_plain} -> {sum_ao} -> {sum_shadow} (shadows)"
+    );
+    assert_eq!(brighter, 0, "occlusion never brightens");
+    assert!(darker > 200, "{darker} pixels darkened");
+    assert!(sum_shadow < sum_ao && sum_ao < sum_plain);
+}

@@ -26,9 +26,16 @@ use texmap_reftrace::{AmbientOcclusion, RenderOptions};
 
 use crate::chart::{self, Target};
 use crate::error::{StudyError, write_file};
-use crate::harness::{reference_materials, reference_scene_with_bonds};
+use crate::harness::{
+    reference_materials, reference_scene_with_bonds, reference_scene_with_meshes,
+};
 use crate::record::{Record, compare, record, records_to_csv, records_to_json, time_ms};
 use crate::scenes::NamedScene;
+use texmap_md_scene::surface::MolMesh;
+
+/// The least ambient-occlusion distance (Å) of a scene with meshes, when the options give
+/// none: about the gap between packed helices, so that a cartoon's grooves darken.
+pub const MESH_AO_DISTANCE: f32 = 6.0;
 
 /// A named quality setting.
 #[derive(Clone, Debug, PartialEq)]
@@ -45,9 +52,15 @@ pub struct QualitySetting {
 /// the same depth cueing and the same outline rule applied to every sample. A transparent
 /// background is not drawn by the reference (the background colour is used, black for a
 /// transparent one).
+///
+/// `meshes` (cartoons, surfaces, polyhedra, isosurfaces: opaque) are traced with the spheres,
+/// casting and receiving the same occlusion and shadows; without an AO distance in `q`, a
+/// scene with meshes takes at least [`MESH_AO_DISTANCE`] (a cartoon's spheres, if any, are
+/// ligands: their radii say nothing of the distance between helices).
 pub fn reference_with(
     spheres: &SphereScene,
     draw_bonds: bool,
+    meshes: &[&MolMesh],
     camera: &Camera,
     lighting: Lighting,
     q: &QualityOptions,
@@ -56,7 +69,16 @@ pub fn reference_with(
         what: "quality options",
         value: e.to_string(),
     })?;
-    let rscene = reference_scene_with_bonds(spheres, draw_bonds);
+    let meshes: Vec<&MolMesh> = meshes
+        .iter()
+        .copied()
+        .filter(|m| !m.triangles.is_empty())
+        .collect();
+    let rscene = if meshes.is_empty() {
+        reference_scene_with_bonds(spheres, draw_bonds)
+    } else {
+        reference_scene_with_meshes(spheres, draw_bonds, &meshes)
+    };
     let mats = reference_materials(spheres);
     let n = (q.aa as f64).sqrt().ceil().max(1.0) as u32;
     let mut o = RenderOptions::new(lighting, &mats);
@@ -73,7 +95,14 @@ pub fn reference_with(
             .max(1.0) as u32;
         o.ambient_occlusion = Some(AmbientOcclusion {
             samples_per_axis: per_sample.min(texmap_reftrace::MAX_AO_SAMPLES_PER_AXIS),
-            distance: q.ao_distance.unwrap_or_else(|| ao_distance_for(spheres)),
+            distance: q.ao_distance.unwrap_or_else(|| {
+                let d = ao_distance_for(spheres);
+                if meshes.is_empty() {
+                    d
+                } else {
+                    d.max(MESH_AO_DISTANCE)
+                }
+            }),
         });
     }
     o.shadows = q.shadows;
