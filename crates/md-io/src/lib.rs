@@ -100,6 +100,7 @@ mod error;
 mod format;
 mod frame;
 mod gro;
+mod gsd;
 mod gz;
 pub mod hbonds;
 mod lammps;
