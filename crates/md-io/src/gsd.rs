@@ -659,7 +659,8 @@ impl<R: Read + Seek> GsdReader<R> {
         Ok(())
     }
 
-    fn read_frame(&mut self, k: usize, frame: &mut Frame) -> Result<(), Error> {
+    /// Reads frame `k` into `frame`; gives its cell.
+    fn read_frame(&mut self, k: usize, frame: &mut Frame) -> Result<Option<UnitCell>, Error> {
         // Configuration.
         let step = self.own_or_first(k, Chunk::Step);
         let step = self.scalar(k, step, "configuration/step: one integer")?;
@@ -683,7 +684,7 @@ impl<R: Read + Seek> GsdReader<R> {
             Some((d, _)) => d,
             None => 3,
         };
-        frame.cell = Some(self.cell(k, dims == 2)?);
+        let cell = self.cell(k, dims == 2)?;
         // Particles.
         let expected = "a particle count whose positions (12 bytes each) fit in the file";
         let (n, n_entry) = self.count(
@@ -742,7 +743,8 @@ impl<R: Read + Seek> GsdReader<R> {
         for p in &PROPERTIES {
             self.property(frame, k, p, counts)?;
         }
-        self.bonds(k, frame, n)
+        self.bonds(k, frame, n)?;
+        Ok(Some(cell))
     }
 
     /// The cell of frame `k` (see the module doc).
@@ -929,22 +931,11 @@ impl<R: Read + Seek> GsdReader<R> {
     pub fn read_next(&mut self, frame: &mut Frame) -> Result<bool, Error> {
         frame.clear();
         let k = self.next;
-        if k >= self.complete {
-            return match self.truncation() {
-                Some(e) if k == self.complete => Err(e),
-                _ => Ok(false),
-            };
+        if let Some(end) = crate::cursor::past_complete(k, self.complete, || self.truncation()) {
+            return end;
         }
-        match self.read_frame(k, frame) {
-            Ok(()) => {
-                self.next += 1;
-                Ok(true)
-            }
-            Err(e) => {
-                frame.clear();
-                Err(e)
-            }
-        }
+        let read = self.read_frame(k, frame);
+        crate::cursor::settle(read, frame, &mut self.next)
     }
 
     /// Makes `read_next` read frame `n` (a cut frame counts as present).
