@@ -18,6 +18,9 @@ mod support {
     // A shared harness: this binary uses most of it, other crates' campaigns the rest.
     #[allow(dead_code)]
     pub mod campaign;
+    // Shared with the other GSD tests: this binary uses part of it.
+    #[allow(dead_code)]
+    pub mod gsd_index;
 }
 
 use std::io::Cursor;
@@ -434,27 +437,15 @@ fn netcdf_fixture(name: &str, bytes: Vec<u8>) -> Fixture {
     }
 }
 
-/// HOOMD-blue GSD (little-endian, a 256-byte header, an index of 32-byte entries, a namelist):
-/// walked here from the header; the header's fields, the blocks' ends and every chunk's start
-/// and end as boundaries; the header's counts and versions, the fields of the first entries and
-/// of frame 0's position entry, and frame 0's particle count, first coordinate and box as
-/// fields.
+/// HOOMD-blue GSD (little-endian, a 256-byte header, an index of 32-byte entries, a namelist),
+/// walked by tests/support/gsd_index.rs (not by the reader): the header's fields, the blocks'
+/// ends and every chunk's start and end as boundaries; the header's counts and versions, the
+/// fields of the first entries and of frame 0's position entry, and frame 0's particle count,
+/// first coordinate and box as fields.
 fn gsd_fixture(name: &str, bytes: Vec<u8>) -> Fixture {
     let u64_at = |at: usize| u64::from_le_bytes(bytes[at..at + 8].try_into().unwrap()) as usize;
     let (index, slots) = (u64_at(8), u64_at(16));
     let (names_at, segments) = (u64_at(24), u64_at(32));
-    // File format 1.0: one name per 64-byte segment; 2.x: names one after the other.
-    let block = &bytes[names_at..names_at + 64 * segments];
-    let v1 = le32(&bytes, 44) >> 16 == 1;
-    let names: Vec<&[u8]> = if v1 {
-        block
-            .chunks(64)
-            .map(|s| s.split(|c| *c == 0).next().unwrap())
-            .collect()
-    } else {
-        block.split(|c| *c == 0).collect()
-    };
-    let names: Vec<&[u8]> = names.into_iter().take_while(|s| !s.is_empty()).collect();
     let mut boundaries = vec![0, 8, 40, 48, 112, 176, 256];
     boundaries.extend([
         index,
@@ -471,17 +462,12 @@ fn gsd_fixture(name: &str, bytes: Vec<u8>) -> Fixture {
         ("schema version", Field::I32Le(40)),
         ("file format version", Field::I32Le(44)),
     ];
-    let size = |ty: u8| [0, 1, 2, 4, 8, 1, 2, 4, 8, 4, 8, 1][ty as usize];
-    let used: Vec<usize> = (0..slots)
-        .map(|k| index + 32 * k)
-        .filter(|&at| u64_at(at + 16) != 0)
-        .collect();
-    for (k, &at) in used.iter().enumerate() {
-        let (loc, rows, cols) = (u64_at(at + 16), u64_at(at + 8), le32(&bytes, at + 24));
-        boundaries.extend([loc, loc + rows * cols * size(bytes[at + 30])]);
-        let name = names[u16::from_le_bytes([bytes[at + 28], bytes[at + 29]]) as usize];
-        let frame0 = u64_at(at) == 0;
-        if k < 3 || k == used.len() - 1 || (frame0 && name == b"particles/position") {
+    let chunks = support::gsd_index::chunks(&bytes);
+    for (k, c) in chunks.iter().enumerate() {
+        boundaries.extend([c.location, c.location + c.bytes()]);
+        let frame0 = c.frame == 0;
+        if k < 3 || k == chunks.len() - 1 || (frame0 && c.name == "particles/position") {
+            let at = c.entry;
             fields.extend([
                 ("entry frame", Field::I32Le(at)),
                 ("entry N", Field::I32Le(at + 8)),
@@ -491,10 +477,11 @@ fn gsd_fixture(name: &str, bytes: Vec<u8>) -> Fixture {
                 ("entry id and type", Field::I32Le(at + 28)),
             ]);
         }
-        match name {
-            b"particles/N" | b"bonds/N" if frame0 => fields.push(("a count", Field::I32Le(loc))),
-            b"particles/position" if frame0 => fields.push(("x of particle 0", Field::F32Le(loc))),
-            b"configuration/box" if frame0 => fields.push(("box Lx", Field::F32Le(loc))),
+        let loc = c.location;
+        match c.name.as_str() {
+            "particles/N" | "bonds/N" if frame0 => fields.push(("a count", Field::I32Le(loc))),
+            "particles/position" if frame0 => fields.push(("x of particle 0", Field::F32Le(loc))),
+            "configuration/box" if frame0 => fields.push(("box Lx", Field::F32Le(loc))),
             _ => {}
         }
     }

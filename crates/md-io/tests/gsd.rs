@@ -16,7 +16,14 @@ use std::io::{Cursor, Write};
 use std::path::PathBuf;
 
 use serde_json::Value;
+use support::gsd_index::chunk;
 use texmap_md_io::{Element, Error, Format, Frame, ReadOptions, Trajectory};
+
+mod support {
+    // Shared with the damage tests: this binary uses part of it.
+    #[allow(dead_code)]
+    pub mod gsd_index;
+}
 
 const FILES: [&str; 4] = [
     "hoomd_tri.gsd",
@@ -247,49 +254,11 @@ fn the_2d_box_is_a_slab_one_unit_thick() {
     assert!(f.positions.iter().all(|p| p[2] == 0.0));
 }
 
-/// The index entries of a GSD file, walked here from the header: (frame, name, byte of the
-/// entry, location, rows, columns, type).
-fn index(b: &[u8]) -> Vec<(u64, String, usize, usize, u64, u32, u8)> {
-    let u64_at = |at: usize| u64::from_le_bytes(b[at..at + 8].try_into().unwrap());
-    let (loc, n) = (u64_at(8) as usize, u64_at(16) as usize);
-    let (names_at, segments) = (u64_at(24) as usize, u64_at(32) as usize);
-    let names: Vec<String> = b[names_at..names_at + 64 * segments]
-        .split(|c| *c == 0)
-        .take_while(|s| !s.is_empty())
-        .map(|s| String::from_utf8(s.to_vec()).unwrap())
-        .collect();
-    (0..n)
-        .map(|k| loc + 32 * k)
-        .filter(|&at| u64_at(at + 16) != 0)
-        .map(|at| {
-            let id = u16::from_le_bytes([b[at + 28], b[at + 29]]) as usize;
-            let cols = u32::from_le_bytes(b[at + 24..at + 28].try_into().unwrap());
-            (
-                u64_at(at),
-                names[id].clone(),
-                at,
-                u64_at(at + 16) as usize,
-                u64_at(at + 8),
-                cols,
-                b[at + 30],
-            )
-        })
-        .collect()
-}
-
-fn entry(b: &[u8], frame: u64, name: &str) -> (usize, usize) {
-    let e = index(b)
-        .into_iter()
-        .find(|e| e.0 == frame && e.1 == name)
-        .unwrap();
-    (e.2, e.3)
-}
-
 #[test]
 fn a_cut_file_names_the_cut_frame_and_keeps_the_others() {
     let bytes = std::fs::read(path("hoomd_tri.gsd")).unwrap();
     // Cut inside frame 3's positions: frames 0-2 complete.
-    let (_, pos3) = entry(&bytes, 3, "particles/position");
+    let pos3 = chunk(&bytes, 3, "particles/position").location;
     let cut = bytes[..pos3 + 100].to_vec();
     let mut strict =
         Trajectory::from_reader(Cursor::new(cut.clone()), Format::Gsd, "cut.gsd").unwrap();
@@ -324,7 +293,7 @@ fn a_cut_file_names_the_cut_frame_and_keeps_the_others() {
 #[test]
 fn a_chunk_of_the_wrong_shape_or_type_is_located() {
     let good = std::fs::read(path("hoomd_tri.gsd")).unwrap();
-    let (at, _) = entry(&good, 2, "particles/position");
+    let at = chunk(&good, 2, "particles/position").entry;
     // M = 2 instead of 3.
     let mut b = good.clone();
     b[at + 24..at + 28].copy_from_slice(&2u32.to_le_bytes());
@@ -346,7 +315,7 @@ fn a_chunk_of_the_wrong_shape_or_type_is_located() {
     assert!(e.contains("200 × 3 uint32"), "{e}");
     // Frame 0's typeid (which frames 1-3 take) past the three types: reading frame 3 names
     // frame 3 and the byte of the value in frame 0's chunk.
-    let (_, typeid) = entry(&good, 0, "particles/typeid");
+    let typeid = chunk(&good, 0, "particles/typeid").location;
     let mut b = good.clone();
     b[typeid + 4 * 7..typeid + 4 * 8].copy_from_slice(&3u32.to_le_bytes());
     let mut t = Trajectory::from_reader(Cursor::new(b), Format::Gsd, "tid.gsd").unwrap();
@@ -361,7 +330,7 @@ fn a_chunk_of_the_wrong_shape_or_type_is_located() {
 #[test]
 fn a_non_finite_or_absurd_position_names_the_particle() {
     let good = std::fs::read(path("hoomd_tri.gsd")).unwrap();
-    let (_, pos) = entry(&good, 1, "particles/position");
+    let pos = chunk(&good, 1, "particles/position").location;
     for bad in [f32::NAN, f32::INFINITY, 1e30] {
         let mut b = good.clone();
         let at = pos + 12 * 5 + 4;

@@ -8,6 +8,9 @@
 
 mod support {
     pub mod alloc;
+    // Shared with the other GSD tests: this binary uses part of it.
+    #[allow(dead_code)]
+    pub mod gsd_index;
 }
 
 use std::io::Cursor;
@@ -15,6 +18,7 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use support::alloc::{CountingAlloc, measure};
+use support::gsd_index::{chunk, chunks};
 use texmap_md_io::{Error, Format, Frame, ReadOptions, Trajectory};
 
 #[global_allocator]
@@ -183,53 +187,20 @@ fn truncated_last_frame_is_an_error_or_a_warning() {
     cut_frame_is_reported("trr_mda.trr", Format::Trr, trr.len() - 1, 3);
     // GSD (gsd.hoomd, 5 frames): inside frame 3's positions, and inside frame 0's first chunk.
     let gsd = data("gsd/hoomd_tri.gsd");
-    let chunks = gsd_chunks(&gsd);
-    let at = |frame: u64, name: &str| {
-        chunks
-            .iter()
-            .find(|c| c.0 == frame && c.1 == name)
-            .unwrap()
-            .3
-    };
-    let first = chunks.iter().map(|c| c.3).min().unwrap();
-    cut_frame_is_reported(
-        "gsd/hoomd_tri.gsd",
-        Format::Gsd,
-        at(3, "particles/position") + 100,
-        3,
-    );
+    let first = chunks(&gsd).iter().map(|c| c.location).min().unwrap();
+    let pos3 = chunk(&gsd, 3, "particles/position").location;
+    cut_frame_is_reported("gsd/hoomd_tri.gsd", Format::Gsd, pos3 + 100, 3);
     cut_frame_is_reported("gsd/hoomd_tri.gsd", Format::Gsd, first + 2, 0);
-}
-
-/// The chunks of a GSD file, walked here from its header and index (file format 2.x): frame,
-/// name, byte of the index entry, byte of the data.
-fn gsd_chunks(b: &[u8]) -> Vec<(u64, String, usize, usize)> {
-    let u64_at = |at: usize| u64::from_le_bytes(b[at..at + 8].try_into().unwrap()) as usize;
-    let (index, slots, names_at) = (u64_at(8), u64_at(16), u64_at(24));
-    let names: Vec<String> = b[names_at..]
-        .split(|c| *c == 0)
-        .take_while(|s| !s.is_empty())
-        .map(|s| String::from_utf8(s.to_vec()).unwrap())
-        .collect();
-    (0..slots)
-        .map(|k| index + 32 * k)
-        .filter(|&at| u64_at(at + 16) != 0)
-        .map(|at| {
-            let id = u16::from_le_bytes([b[at + 28], b[at + 29]]) as usize;
-            (u64_at(at) as u64, names[id].clone(), at, u64_at(at + 16))
-        })
-        .collect()
 }
 
 #[test]
 fn gsd_counts_claiming_more_than_the_file_holds_are_refused_without_allocating() {
     let good = data("gsd/hoomd_tri.gsd");
-    let chunks = gsd_chunks(&good);
-    let chunk = |name: &str| chunks.iter().find(|c| c.0 == 0 && c.1 == name).unwrap();
     let cap = 64 * good.len() + (1 << 20);
     // (what is changed, byte, value, frame of the error (None: at open), byte of the error)
-    let (n_at, bonds_at) = (chunk("particles/N").3, chunk("bonds/N").3);
-    let position = chunk("particles/position").2;
+    let n_at = chunk(&good, 0, "particles/N").location;
+    let bonds_at = chunk(&good, 0, "bonds/N").location;
+    let position = chunk(&good, 0, "particles/position").entry;
     let cases: [(&str, usize, u64, Option<usize>, usize); 6] = [
         ("index entries", 16, 1 << 40, None, 16),
         ("index entries", 16, u64::MAX, None, 16),
@@ -262,19 +233,15 @@ fn gsd_counts_claiming_more_than_the_file_holds_are_refused_without_allocating()
     // Frame 4 (180 particles, not frame 0's 200) without its position chunk (renamed to
     // bonds/types, which is not read) takes the default (0, 0, 0) per particle: its count of
     // 2^31 - 1 must be refused before anything is sized from it.
-    let frame4 = |name: &str| chunks.iter().find(|c| c.0 == 4 && c.1 == name).unwrap();
-    let id_of = |name: &str| {
-        let at = chunks.iter().find(|c| c.1 == name).unwrap().2;
-        [good[at + 28], good[at + 29]]
-    };
     let mut b = good.clone();
-    let pos4 = frame4("particles/position").2;
-    b[pos4 + 28..pos4 + 30].copy_from_slice(&id_of("bonds/types"));
+    let pos4 = chunk(&good, 4, "particles/position").entry;
+    let other = chunk(&good, 0, "bonds/types").entry;
+    b.copy_within(other + 28..other + 30, pos4 + 28);
     let mut t = Trajectory::from_reader(Cursor::new(b.clone()), Format::Gsd, "d.gsd").unwrap();
     let mut f = Frame::new();
     t.read_frame(4, &mut f).unwrap();
     assert!(f.n_atoms() == 180 && f.positions.iter().all(|p| *p == [0.0; 3]));
-    let n4 = frame4("particles/N").3;
+    let n4 = chunk(&good, 4, "particles/N").location;
     b[n4..n4 + 4].copy_from_slice(&(i32::MAX as u32).to_le_bytes());
     let (r, peak) = measure(|| read_all(&b, Format::Gsd, "d.gsd", ReadOptions::new()));
     let e = r.unwrap_err();
