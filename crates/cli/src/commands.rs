@@ -121,7 +121,7 @@ fn open_trajectory_with(
         Some(name) => {
             let Some(f) = Format::from_extension(name) else {
                 return usage(format!(
-                    "--format {name:?}: expected one of xyz, extxyz, pdb, cif, gro, lammpstrj, dcd, xtc, trr, nc, sdf, mol, mol2, vasp, cif-crystal, lammps-data"
+                    "--format {name:?}: expected one of xyz, extxyz, pdb, cif, gro, lammpstrj, dcd, xtc, trr, nc, gsd, sdf, mol, mol2, vasp, cif-crystal, lammps-data"
                 ));
             };
             Ok(Trajectory::open_as_with(file, f, options)?)
