@@ -37,6 +37,9 @@
 //! | `particles/image` | properties `ix iy iz` | 0 0 0 |
 //! | `bonds/N`, `bonds/group` | [`Frame::bonds`] (pairs ordered, sorted, each once) | 0, 0 0 |
 //!
+//! Elements follow the LAMMPS data reader's rule for type labels, so HOOMD's customary type
+//! `B` is boron (drawn in boron's colour unless styled by type) while `A` has no element.
+//!
 //! A property is in every frame when some frame of the file has its chunk (its values in the
 //! other frames by the rule above), and in none otherwise: a file without orientations gets no
 //! column of unit quaternions. The property names are those the LAMMPS readers give the same
@@ -48,7 +51,7 @@
 //! a1 = (Lx, 0, 0), a2 = (xy·Ly, Ly, 0), a3 = (xz·Lz, yz·Lz, Lz), corner −(a1 + a2 + a3)/2. A
 //! 2-D box (`dimensions` 2) has Lz = 0, which no cell of volume > 0 has: it gets a3 = (0, 0, 1),
 //! a slab one length unit thick around the particles' z = 0 (LAMMPS's 2-D boxes are
-//! −0.5 ≤ z < 0.5 too), and z stays as written.
+//! −0.5 ≤ z < 0.5 too), and z stays as written. Lz = 0 in a 3-D box is an error.
 //!
 //! **Units.** HOOMD has no fixed units (reduced units, or whatever the user chose): positions
 //! and box lengths are read as Å unchanged, so a box of 10 σ is drawn as 10 Å, with diameters
