@@ -25,7 +25,7 @@
 //! | chunk | into | default |
 //! |---|---|---|
 //! | `configuration/step` | [`Frame::step`] | 0 |
-//! | `configuration/dimensions` | checked (2 or 3); a 2-D box may have Lz = 0 | 3 |
+//! | `configuration/dimensions` | checked (2 or 3) | 3 |
 //! | `configuration/box` `Lx Ly Lz xy xz yz` | [`Frame::cell`] (below) | 1 1 1 0 0 0 |
 //! | `particles/N` | the particle count | 0 |
 //! | `particles/types`, `particles/typeid` | [`Frame::types`] and [`Frame::names`]: the type name; [`Frame::elements`] when some type name is an element symbol written as one (`Na`, not `A` or `Colloid`) | `A`, 0 |
@@ -49,9 +49,11 @@
 //!
 //! **The cell.** HOOMD's box is centred on the origin, with tilt factors: edges
 //! a1 = (Lx, 0, 0), a2 = (xy·Ly, Ly, 0), a3 = (xz·Lz, yz·Lz, Lz), corner −(a1 + a2 + a3)/2. A
-//! 2-D box (`dimensions` 2) has Lz = 0, which no cell of volume > 0 has: it gets a3 = (0, 0, 1),
-//! a slab one length unit thick around the particles' z = 0 (LAMMPS's 2-D boxes are
-//! −0.5 ≤ z < 0.5 too), and z stays as written. Lz = 0 in a 3-D box is an error.
+//! 2-D box has Lz = 0 (`gsd.hoomd` then writes `dimensions` 2), which no cell of volume > 0
+//! has: it gets a3 = (0, 0, 1), a slab one length unit thick around the particles' z = 0
+//! (LAMMPS's 2-D boxes are −0.5 ≤ z < 0.5 too), and z stays as written. The slab is made for
+//! Lz = 0 whatever `dimensions` says: gsd.hoomd reads such a box without complaint, and
+//! refusing a file over that inconsistency would help no one.
 //!
 //! **Units.** HOOMD has no fixed units (reduced units, or whatever the user chose): positions
 //! and box lengths are read as Å unchanged, so a box of 10 σ is drawn as 10 Å, with diameters
@@ -674,20 +676,14 @@ impl<R: Read + Seek> GsdReader<R> {
             None => 0,
         });
         let dims = self.own_or_first(k, Chunk::Dimensions);
-        let dims = match self.scalar(k, dims, "configuration/dimensions: one integer")? {
-            Some((d, e)) if d != 2 && d != 3 => {
-                return Err(self.value_error(
-                    k,
-                    e.chunk,
-                    e.location,
-                    "dimensions 2 or 3",
-                    d.to_string(),
-                ));
-            }
-            Some((d, _)) => d,
-            None => 3,
-        };
-        let cell = self.cell(k, dims == 2)?;
+        if let Some((d, e)) = self.scalar(k, dims, "configuration/dimensions: one integer")?
+            && d != 2
+            && d != 3
+        {
+            let what = d.to_string();
+            return Err(self.value_error(k, e.chunk, e.location, "dimensions 2 or 3", what));
+        }
+        let cell = self.cell(k)?;
         // Particles.
         let expected = "a particle count whose positions (12 bytes each) fit in the file";
         let (n, n_entry) = self.count(
@@ -751,7 +747,7 @@ impl<R: Read + Seek> GsdReader<R> {
     }
 
     /// The cell of frame `k` (see the module doc).
-    fn cell(&mut self, k: usize, two_d: bool) -> Result<UnitCell, Error> {
+    fn cell(&mut self, k: usize) -> Result<UnitCell, Error> {
         let expected_box = "configuration/box: 6 float or double values (Lx Ly Lz xy xz yz)";
         let (b, e) = match self.own_or_first(k, Chunk::Box) {
             Some(e) => {
@@ -762,8 +758,7 @@ impl<R: Read + Seek> GsdReader<R> {
             None => ([1.0, 1.0, 1.0, 0.0, 0.0, 0.0], None),
         };
         let [lx, ly, lz, xy, xz, yz] = b;
-        let lz_ok = lz > 0.0 || (two_d && lz == 0.0);
-        let cell = if b.iter().all(|v| v.is_finite()) && lx > 0.0 && ly > 0.0 && lz_ok {
+        let cell = if b.iter().all(|v| v.is_finite()) && lx > 0.0 && ly > 0.0 && lz >= 0.0 {
             let c = if lz == 0.0 { 1.0 } else { lz };
             let m = [[lx, 0.0, 0.0], [xy * ly, ly, 0.0], [xz * c, yz * c, c]];
             UnitCell::from_matrix(m).map(|cell| {
@@ -778,11 +773,7 @@ impl<R: Read + Seek> GsdReader<R> {
         cell.map_err(|x| {
             // (The default box is a valid cell: an error comes from a chunk.)
             let byte = e.map_or(0, |e| e.location);
-            let expected = if two_d {
-                "a box with Lx, Ly > 0, Lz >= 0 (2-D), finite tilts, edges at most 1e7"
-            } else {
-                "a box with Lx, Ly, Lz > 0, finite tilts, edges at most 1e7"
-            };
+            let expected = "a box with Lx, Ly > 0, Lz >= 0, finite tilts, edges at most 1e7";
             self.value_error(k, Chunk::Box, byte, expected, x.to_string())
         })
     }

@@ -244,6 +244,40 @@ fn the_fixtures_exercise_the_default_rule() {
 }
 
 #[test]
+fn a_box_of_lz_0_is_a_slab_whatever_the_dimensions_and_a_negative_one_is_refused() {
+    let good = std::fs::read(path("hoomd_2d.gsd")).unwrap();
+    let dims = chunk(&good, 0, "configuration/dimensions").location;
+    let mut b = good.clone();
+    b[dims] = 3;
+    let mut t = Trajectory::from_reader(Cursor::new(b.clone()), Format::Gsd, "z.gsd").unwrap();
+    let mut f = Frame::new();
+    t.read_frame(0, &mut f).unwrap();
+    assert_eq!(f.cell.unwrap().matrix()[2], [0.0, 0.0, 1.0]);
+    b[dims] = 4;
+    let mut t = Trajectory::from_reader(Cursor::new(b), Format::Gsd, "z.gsd").unwrap();
+    let e = t.read_frame(0, &mut f).unwrap_err().to_string();
+    assert!(
+        e.starts_with(&format!(
+            "z.gsd: frame 0, byte {dims}: expected dimensions 2 or 3"
+        )),
+        "{e}"
+    );
+    // Lz = -1 in frame 1's box.
+    let boxes = chunk(&good, 1, "configuration/box").location;
+    let mut b = good.clone();
+    b[boxes + 8..boxes + 12].copy_from_slice(&(-1.0f32).to_le_bytes());
+    let mut t = Trajectory::from_reader(Cursor::new(b), Format::Gsd, "z.gsd").unwrap();
+    t.read_frame(0, &mut f).unwrap();
+    let e = t.read_frame(1, &mut f).unwrap_err().to_string();
+    assert!(
+        e.starts_with(&format!(
+            "z.gsd: frame 1, byte {boxes}: expected a box with"
+        )),
+        "{e}"
+    );
+}
+
+#[test]
 fn the_2d_box_is_a_slab_one_unit_thick() {
     let mut t = Trajectory::open(path("hoomd_2d.gsd")).unwrap();
     let mut f = Frame::new();
