@@ -153,7 +153,7 @@ fn open_parts(files: &[PathBuf], format: Option<&str>, options: ReadOptions) -> 
             Some(f) => Some(f),
             None => {
                 return usage(format!(
-                    "--format {name:?}: expected one of xyz, extxyz, pdb, cif, gro, lammpstrj, dcd, xtc, trr, nc, sdf, mol, mol2, vasp, cif-crystal, lammps-data"
+                    "--format {name:?}: expected one of xyz, extxyz, pdb, cif, gro, lammpstrj, dcd, xtc, trr, nc, gsd, sdf, mol, mol2, vasp, cif-crystal, lammps-data"
                 ));
             }
         },

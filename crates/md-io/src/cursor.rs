@@ -1,7 +1,7 @@
-//! What the binary readers (DCD, XTC, TRR) share: the coordinate and GROMACS-box checks, and the
-//! frame cursor: their frame index is complete at
-//! open time, and a damaged frame right after the last good one still counts as present, so
-//! that reading it reports the damage instead of a silent end.
+//! What the binary readers (DCD, XTC, TRR, NetCDF, GSD) share: the coordinate and GROMACS-box
+//! checks, and the frame cursor: their frame index is complete at open time, and a damaged frame
+//! right after the last good one still counts as present, so that reading it reports the damage
+//! instead of a silent end.
 
 use std::sync::Arc;
 
@@ -17,6 +17,23 @@ pub(crate) fn seek(next: &mut usize, n: usize, complete: usize, damaged_tail: bo
     } else {
         false
     }
+}
+
+/// What `read_next` answers at frame `k` when it is not one of the `complete` frames: the error
+/// of the first cut frame (`cut` makes it, called only here) at `k == complete`, else the end;
+/// `None` when frame `k` is to be read.
+pub(crate) fn past_complete(
+    k: usize,
+    complete: usize,
+    cut: impl FnOnce() -> Option<Error>,
+) -> Option<Result<bool, Error>> {
+    if k < complete {
+        return None;
+    }
+    Some(match cut() {
+        Some(e) if k == complete => Err(e),
+        _ => Ok(false),
+    })
 }
 
 /// Finish a frame read: on success store the cell and advance; on error leave `frame` empty and

@@ -379,6 +379,14 @@ impl Element {
     }
 }
 
+/// The element a type label names when it is a symbol written as one (`C`, `Ca`; not `CA`, an
+/// aromatic carbon's type, nor `c`): LAMMPS type labels and HOOMD type names, which name
+/// elements only sometimes, so no guessing from a name's first letters as [`guess_element`] does.
+pub(crate) fn element_of_symbol(s: &[u8]) -> Option<Element> {
+    let e = Element::from_symbol(std::str::from_utf8(s).ok()?)?;
+    (e.symbol().as_bytes() == s).then_some(e)
+}
+
 /// Residues in which an atom name's first letter is its element (rule 3 of the module doc).
 const BIO_RESIDUES: &[&str] = &[
     "ALA", "ARG", "ASN", "ASP", "CYS", "GLN", "GLU", "GLY", "HIS", "ILE", "LEU", "LYS", "MET",
@@ -446,6 +454,15 @@ mod tests {
 
     fn el(s: &str) -> Element {
         Element::from_symbol(s).unwrap()
+    }
+
+    #[test]
+    fn type_labels_name_elements_only_as_symbols() {
+        assert_eq!(element_of_symbol(b"Ca").map(|e| e.symbol()), Some("Ca"));
+        assert_eq!(element_of_symbol(b"CA"), None);
+        assert_eq!(element_of_symbol(b"c"), None);
+        assert_eq!(element_of_symbol(b"CT"), None);
+        assert_eq!(element_of_symbol(b"Colloid"), None);
     }
 
     #[test]

@@ -86,7 +86,7 @@
 use std::collections::HashMap;
 use std::io::Read;
 
-use crate::elements::Element;
+use crate::elements::{Element, element_of_symbol};
 use crate::error::Error;
 use crate::frame::{Frame, Label, Property, UnitCell};
 use crate::parse::{fields, parse_f32, parse_f64, parse_i64, trim};
@@ -306,12 +306,6 @@ pub(crate) fn element_of_mass(mass: f64) -> Option<Element> {
         }
     }
     found
-}
-
-/// An element symbol written as one (`C`, `Ca`, not `CA` or `c`).
-fn element_of_symbol(s: &[u8]) -> Option<Element> {
-    let e = Element::from_symbol(std::str::from_utf8(s).ok()?)?;
-    (e.symbol().as_bytes() == s).then_some(e)
 }
 
 /// The columns of the style an `Atoms # style` comment names: `Some(None)` without a comment,
@@ -1077,14 +1071,6 @@ mod tests {
             let want = (!["Bi", "Po", "Cm", "Bk"].contains(&e.symbol())).then_some(e);
             assert_eq!(element_of_mass(e.mass()), want, "{}", e.symbol());
         }
-    }
-
-    #[test]
-    fn symbols_must_be_written_as_symbols() {
-        assert_eq!(element_of_symbol(b"Ca").map(|e| e.symbol()), Some("Ca"));
-        assert_eq!(element_of_symbol(b"CA"), None);
-        assert_eq!(element_of_symbol(b"c"), None);
-        assert_eq!(element_of_symbol(b"CT"), None);
     }
 
     #[test]

@@ -9,7 +9,9 @@
 //!   file's symmetry operations; a `.cif` is told from PDBx/mmCIF by its tags), LAMMPS data files
 //!   (one frame: the atom style's columns, the box, masses and their elements, velocities and
 //!   image flags as properties, the `Bonds` as [`Frame::bonds`]) (and the binary DCD, XTC,
-//!   TRR and AMBER NetCDF) one frame at a time into a reusable [`Frame`], or any frame by index.
+//!   TRR, AMBER NetCDF and HOOMD-blue GSD: particle types, diameters, per-particle properties
+//!   and bonds, by the hoomd schema's rule for what a frame omits) one frame at a time into a
+//!   reusable [`Frame`], or any frame by index.
 //!   Any of them may be gzip-compressed (`1abc.cif.gz`, `run.xyz.gz`; topologies too): it is
 //!   inflated once into a temporary file, so the byte offsets of a `.gz` file's errors count
 //!   decompressed bytes, except for damage to the gzip stream itself (compressed offset).
@@ -31,7 +33,8 @@
 //! - [`elements`] maps atom names to elements, gives van der Waals radii and CPK colours, and
 //!   [`AtomStyle`] resolves each atom's radius and colour with user overrides.
 //!
-//! Positions are in Å whatever the file's units; errors name the file, frame, line and byte.
+//! Positions are in Å whatever the file's units (lengths in units a file does not state, as in a
+//! HOOMD-blue GSD file, are taken as Å); errors name the file, frame, line and byte.
 //!
 //! # What every reader promises
 //! - **Located errors.** Damage is an [`Error`] naming the file and the place (frame, line, byte
@@ -102,6 +105,7 @@ mod error;
 mod format;
 mod frame;
 mod gro;
+mod gsd;
 mod gz;
 pub mod hbonds;
 mod lammps;

@@ -308,7 +308,8 @@ impl<R: Read + Seek> NetcdfReader<R> {
         }
     }
 
-    fn read_frame(&mut self, index: usize, frame: &mut Frame) -> Result<(), Error> {
+    /// Reads record `index` into `frame`; gives its cell.
+    fn read_frame(&mut self, index: usize, frame: &mut Frame) -> Result<Option<UnitCell>, Error> {
         let l = self.layout.clone();
         // Coordinates.
         let off = self.read_record(&l.coords, index)?;
@@ -371,32 +372,22 @@ impl<R: Read + Seek> NetcdfReader<R> {
                         expected: "cell_lengths and cell_angles of a cell with volume > 0",
                         found: e.to_string(),
                     })?;
-                frame.cell = Some(cell);
+                return Ok(Some(cell));
             }
         }
-        Ok(())
+        Ok(None)
     }
 
     /// Reads the next frame (the `Trajectory` contract).
     pub fn read_next(&mut self, frame: &mut Frame) -> Result<bool, Error> {
         frame.clear();
         let index = self.next;
-        if index >= self.layout.complete {
-            return match self.truncation() {
-                Some(e) if index == self.layout.complete => Err(e),
-                _ => Ok(false),
-            };
+        let complete = self.layout.complete;
+        if let Some(end) = crate::cursor::past_complete(index, complete, || self.truncation()) {
+            return end;
         }
-        match self.read_frame(index, frame) {
-            Ok(()) => {
-                self.next += 1;
-                Ok(true)
-            }
-            Err(e) => {
-                frame.clear();
-                Err(e)
-            }
-        }
+        let read = self.read_frame(index, frame);
+        crate::cursor::settle(read, frame, &mut self.next)
     }
 
     /// Makes `read_next` read frame `n` (a cut frame counts as present).

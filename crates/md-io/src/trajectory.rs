@@ -7,6 +7,7 @@ use crate::error::Error;
 use crate::format::Format;
 use crate::frame::Frame;
 use crate::gro::Gro;
+use crate::gsd::GsdReader;
 use crate::lammps::Lammps;
 use crate::lammps_data::LammpsData;
 use crate::mmcif::Mmcif;
@@ -31,6 +32,7 @@ enum Reader<R> {
     Xtc(XtcReader<R>),
     Trr(TrrReader<R>),
     Netcdf(NetcdfReader<R>),
+    Gsd(GsdReader<R>),
     Pdb(TextReader<R, Pdb>),
     Gro(TextReader<R, Gro>),
     Lammps(TextReader<R, Lammps>),
@@ -52,6 +54,7 @@ macro_rules! each_reader {
             Reader::Xtc($r) => $body,
             Reader::Trr($r) => $body,
             Reader::Netcdf($r) => $body,
+            Reader::Gsd($r) => $body,
             Reader::Pdb($r) => $body,
             Reader::Gro($r) => $body,
             Reader::Lammps($r) => $body,
@@ -276,6 +279,7 @@ impl<R: Read + Seek> Trajectory<R> {
             Format::Xtc => Reader::Xtc(XtcReader::new(src, file.clone())?),
             Format::Trr => Reader::Trr(TrrReader::new(src, file.clone())?),
             Format::Netcdf => Reader::Netcdf(NetcdfReader::new(src, file.clone())?),
+            Format::Gsd => Reader::Gsd(GsdReader::new(src, file.clone())?),
             Format::Pdb => Reader::Pdb(TextReader::new(src, Pdb::new(lenient), file.clone())),
             Format::Gro => Reader::Gro(TextReader::new(src, Gro, file.clone())),
             Format::LammpsDump => {

@@ -1,5 +1,5 @@
-//! Damaged DCD / XTC / TRR files, built from good ones written by MDAnalysis and by our own
-//! writers: cut at every byte (so at every record boundary and inside every record) and with
+//! Damaged DCD / XTC / TRR / GSD files, built from good ones written by MDAnalysis, gsd.hoomd
+//! and our own writers: cut at every byte (so at every record boundary and inside every record) and with
 //! bits flipped at every byte. Nothing may panic; every frame before the damage must read back
 //! unchanged; the error for the damaged frame must name the file, the frame and the byte, and a
 //! cut frame is never dropped silently: `n_frames` reports it, unless `allow_truncated` was
@@ -44,6 +44,8 @@ fn cases() -> Vec<(&'static str, Format, Vec<u8>)> {
         ("trr_mda.trr", Format::Trr, data("trr_mda.trr")),
         ("ours.dcd", Format::Dcd, ours(Format::Dcd)),
         ("ours.xtc", Format::Xtc, ours(Format::Xtc)),
+        ("hoomd_2d.gsd", Format::Gsd, data("gsd/hoomd_2d.gsd")),
+        ("hoomd_one.gsd", Format::Gsd, data("gsd/hoomd_one.gsd")),
     ]
 }
 

@@ -7,8 +7,8 @@
 //! the place, under a heap cap of 64 × its size + 1 MiB, without a panic.
 //!
 //! The record boundaries and header fields are found here by walking each format's structure
-//! (Fortran record markers, XTC byte counts, TRR block sizes, line ends, numeric tokens), not by
-//! the readers under test.
+//! (Fortran record markers, XTC byte counts, TRR block sizes, the NetCDF header, the GSD index,
+//! line ends, numeric tokens), not by the readers under test.
 //!
 //! Run with `cargo test -p texmap-md-io --test fuzz_campaign -- --nocapture` to see the table:
 //! mutants per family and per outcome, the slowest run and the largest heap peak.
@@ -18,6 +18,9 @@ mod support {
     // A shared harness: this binary uses most of it, other crates' campaigns the rest.
     #[allow(dead_code)]
     pub mod campaign;
+    // Shared with the other GSD tests: this binary uses part of it.
+    #[allow(dead_code)]
+    pub mod gsd_index;
 }
 
 use std::io::Cursor;
@@ -434,6 +437,65 @@ fn netcdf_fixture(name: &str, bytes: Vec<u8>) -> Fixture {
     }
 }
 
+/// HOOMD-blue GSD (little-endian, a 256-byte header, an index of 32-byte entries, a namelist),
+/// walked by tests/support/gsd_index.rs (not by the reader): the header's fields, the blocks'
+/// ends and every chunk's start and end as boundaries; the header's counts and versions, the
+/// fields of the first entries and of frame 0's position entry, and frame 0's particle count,
+/// first coordinate and box as fields.
+fn gsd_fixture(name: &str, bytes: Vec<u8>) -> Fixture {
+    let u64_at = |at: usize| u64::from_le_bytes(bytes[at..at + 8].try_into().unwrap()) as usize;
+    let (index, slots) = (u64_at(8), u64_at(16));
+    let (names_at, segments) = (u64_at(24), u64_at(32));
+    let mut boundaries = vec![0, 8, 40, 48, 112, 176, 256];
+    boundaries.extend([
+        index,
+        index + 32 * slots,
+        names_at,
+        names_at + 64 * segments,
+    ]);
+    let mut fields = vec![
+        ("index location", Field::I32Le(8)),
+        ("index entries", Field::I32Le(16)),
+        ("index entries (high)", Field::I32Le(20)),
+        ("namelist location", Field::I32Le(24)),
+        ("namelist segments", Field::I32Le(32)),
+        ("schema version", Field::I32Le(40)),
+        ("file format version", Field::I32Le(44)),
+    ];
+    let chunks = support::gsd_index::chunks(&bytes);
+    for (k, c) in chunks.iter().enumerate() {
+        boundaries.extend([c.location, c.location + c.bytes()]);
+        let frame0 = c.frame == 0;
+        if k < 3 || k == chunks.len() - 1 || (frame0 && c.name == "particles/position") {
+            let at = c.entry;
+            fields.extend([
+                ("entry frame", Field::I32Le(at)),
+                ("entry N", Field::I32Le(at + 8)),
+                ("entry location", Field::I32Le(at + 16)),
+                ("entry location (high)", Field::I32Le(at + 20)),
+                ("entry M", Field::I32Le(at + 24)),
+                ("entry id and type", Field::I32Le(at + 28)),
+            ]);
+        }
+        let loc = c.location;
+        match c.name.as_str() {
+            "particles/N" | "bonds/N" if frame0 => fields.push(("a count", Field::I32Le(loc))),
+            "particles/position" if frame0 => fields.push(("x of particle 0", Field::F32Le(loc))),
+            "configuration/box" if frame0 => fields.push(("box Lx", Field::F32Le(loc))),
+            _ => {}
+        }
+    }
+    Fixture {
+        frames: frames_of(Format::Gsd, &bytes),
+        name: name.into(),
+        bytes,
+        boundaries,
+        cuts: Cuts::Declared,
+        fields,
+        text: false,
+    }
+}
+
 /// A text file: every line start as a boundary, its first 16 numeric tokens (counts, box,
 /// coordinates) as fields.
 fn text_fixture(name: &str, format: Format) -> Fixture {
@@ -537,6 +599,19 @@ fn netcdf_campaign() {
         vec![
             netcdf_fixture("amber_mda.ncdf", data("amber_mda.ncdf")),
             netcdf_fixture("amber_scipy_cdf1.nc", data("amber_scipy_cdf1.nc")),
+        ],
+    );
+}
+
+#[test]
+fn gsd_campaign() {
+    campaign(
+        "HOOMD GSD",
+        Format::Gsd,
+        vec![
+            gsd_fixture("hoomd_tri.gsd", data("gsd/hoomd_tri.gsd")),
+            gsd_fixture("hoomd_2d.gsd", data("gsd/hoomd_2d.gsd")),
+            gsd_fixture("hoomd_v1.gsd", data("gsd/hoomd_v1.gsd")),
         ],
     );
 }

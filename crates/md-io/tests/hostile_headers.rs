@@ -1,6 +1,6 @@
 //! Regression tests made from the mutants of real files that broke a reader: a header that
 //! claims 2^31 atoms, a last frame cut short, a damaged PDB atom line, finite but absurd values.
-//! Every mutant starts from a file written by another program (MDAnalysis, see
+//! Every mutant starts from a file written by another program (MDAnalysis, gsd.hoomd, see
 //! tests/data/README-binary.md and README.md) and is changed here byte by byte.
 //!
 //! Memory is measured with a counting global allocator (tests/support/alloc.rs): what a reader
@@ -8,6 +8,9 @@
 
 mod support {
     pub mod alloc;
+    // Shared with the other GSD tests: this binary uses part of it.
+    #[allow(dead_code)]
+    pub mod gsd_index;
 }
 
 use std::io::Cursor;
@@ -15,6 +18,7 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use support::alloc::{CountingAlloc, measure};
+use support::gsd_index::{chunk, chunks};
 use texmap_md_io::{Error, Format, Frame, ReadOptions, Trajectory};
 
 #[global_allocator]
@@ -181,6 +185,73 @@ fn truncated_last_frame_is_an_error_or_a_warning() {
     // TRR: one byte short of the end.
     let trr = data("trr_mda.trr");
     cut_frame_is_reported("trr_mda.trr", Format::Trr, trr.len() - 1, 3);
+    // GSD (gsd.hoomd, 5 frames): inside frame 3's positions, and inside frame 0's first chunk.
+    let gsd = data("gsd/hoomd_tri.gsd");
+    let first = chunks(&gsd).iter().map(|c| c.location).min().unwrap();
+    let pos3 = chunk(&gsd, 3, "particles/position").location;
+    cut_frame_is_reported("gsd/hoomd_tri.gsd", Format::Gsd, pos3 + 100, 3);
+    cut_frame_is_reported("gsd/hoomd_tri.gsd", Format::Gsd, first + 2, 0);
+}
+
+#[test]
+fn gsd_counts_claiming_more_than_the_file_holds_are_refused_without_allocating() {
+    let good = data("gsd/hoomd_tri.gsd");
+    let cap = 64 * good.len() + (1 << 20);
+    // (what is changed, byte, value, frame of the error (None: at open), byte of the error)
+    let n_at = chunk(&good, 0, "particles/N").location;
+    let bonds_at = chunk(&good, 0, "bonds/N").location;
+    let position = chunk(&good, 0, "particles/position").entry;
+    let cases: [(&str, usize, u64, Option<usize>, usize); 6] = [
+        ("index entries", 16, 1 << 40, None, 16),
+        ("index entries", 16, u64::MAX, None, 16),
+        ("namelist segments", 32, 1 << 50, None, 32),
+        ("particles/N", n_at, u32::MAX as u64, Some(0), n_at),
+        ("bonds/N", bonds_at, u32::MAX as u64, Some(0), bonds_at),
+        // Frame 0's positions as 2^40 rows: data past the end before later frames' data.
+        ("position rows", position + 8, 1 << 40, None, position + 16),
+    ];
+    for (what, at, value, frame, byte) in cases {
+        let mut b = good.clone();
+        if what.ends_with("/N") {
+            b[at..at + 4].copy_from_slice(&(value as u32).to_le_bytes());
+        } else {
+            b[at..at + 8].copy_from_slice(&value.to_le_bytes());
+        }
+        let t0 = Instant::now();
+        let (r, peak) = measure(|| read_all(&b, Format::Gsd, "huge.gsd", ReadOptions::new()));
+        let e = r.unwrap_err();
+        assert!(peak <= cap, "{what}: {peak} bytes at peak (cap {cap})");
+        assert!(t0.elapsed() < Duration::from_secs(5), "{what}");
+        let loc = e.location().unwrap();
+        assert_eq!(
+            (loc.frame, loc.byte),
+            (frame, Some(byte as u64)),
+            "{what}: {e}"
+        );
+        assert!(matches!(e, Error::Parse { .. }), "{what}: {e}");
+    }
+    // Frame 4 (180 particles, not frame 0's 200) without its position chunk (renamed to
+    // bonds/types, which is not read) takes the default (0, 0, 0) per particle: its count of
+    // 2^31 - 1 must be refused before anything is sized from it.
+    let mut b = good.clone();
+    let pos4 = chunk(&good, 4, "particles/position").entry;
+    let other = chunk(&good, 0, "bonds/types").entry;
+    b.copy_within(other + 28..other + 30, pos4 + 28);
+    let mut t = Trajectory::from_reader(Cursor::new(b.clone()), Format::Gsd, "d.gsd").unwrap();
+    let mut f = Frame::new();
+    t.read_frame(4, &mut f).unwrap();
+    assert!(f.n_atoms() == 180 && f.positions.iter().all(|p| *p == [0.0; 3]));
+    let n4 = chunk(&good, 4, "particles/N").location;
+    b[n4..n4 + 4].copy_from_slice(&(i32::MAX as u32).to_le_bytes());
+    let (r, peak) = measure(|| read_all(&b, Format::Gsd, "d.gsd", ReadOptions::new()));
+    let e = r.unwrap_err();
+    assert!(peak <= cap, "{peak} bytes at peak (cap {cap})");
+    let loc = e.location().unwrap();
+    assert_eq!((loc.frame, loc.byte), (Some(4), Some(n4 as u64)), "{e}");
+    assert!(
+        e.to_string().contains("a particle count whose positions"),
+        "{e}"
+    );
 }
 
 #[test]
