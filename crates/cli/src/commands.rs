@@ -152,8 +152,10 @@ fn open_parts(files: &[PathBuf], format: Option<&str>, options: ReadOptions) -> 
         Some(name) => match Format::from_extension(name) {
             Some(f) => Some(f),
             None => {
+                let names: Vec<&str> = Format::ALL.iter().map(|f| f.name()).collect();
                 return usage(format!(
-                    "--format {name:?}: expected one of xyz, extxyz, pdb, cif, gro, lammpstrj, dcd, xtc, trr, nc, gsd, sdf, mol, mol2, vasp, cif-crystal, lammps-data"
+                    "--format {name:?}: expected one of {} (or a file extension: lammpstrj, nc, cif, mol, ...)",
+                    names.join(", ")
                 ));
             }
         },
