@@ -36,6 +36,7 @@
 //! | `particles/orientation` (r, a<sub>x</sub>, a<sub>y</sub>, a<sub>z</sub>) | properties `quatw quati quatj quatk` | 1 0 0 0 |
 //! | `particles/image` | properties `ix iy iz` | 0 0 0 |
 //! | `bonds/N`, `bonds/group` | [`Frame::bonds`] (pairs ordered, sorted, each once) | 0, 0 0 |
+//! | `particles/type_shapes` (JSON per type) | properties `shapex shapey shapez` when some type is an `Ellipsoid`: its diameters `2a 2b 2c`, 0 0 0 for other types (LAMMPS's shape columns, for ellipsoids) | none |
 //!
 //! Elements follow the LAMMPS data reader's rule for type labels, so HOOMD's customary type
 //! `B` is boron (drawn in boron's colour unless styled by type) while `A` has no element.
@@ -45,7 +46,8 @@
 //! column of unit quaternions. The property names are those the LAMMPS readers give the same
 //! quantities (`vx`, `charge`, `ix`; a dump's `quatw …`), so arrows (`v`) and colour by property
 //! reach them alike. Type, angle, dihedral, improper, constraint, pair and `log/` chunks,
-//! `type_shapes`, `moment_inertia` and `angmom` are not read.
+//! shapes other than ellipsoids (polyhedra, spheropolygons), `moment_inertia` and `angmom`
+//! are not read.
 //!
 //! **The cell.** HOOMD's box is centred on the origin, with tilt factors: edges
 //! a1 = (Lx, 0, 0), a2 = (xy·Ly, Ly, 0), a3 = (xz·Lz, yz·Lz, Lz), corner −(a1 + a2 + a3)/2. A
@@ -254,10 +256,11 @@ enum Chunk {
     Body,
     BondsN,
     BondsGroup,
+    TypeShapes,
 }
 
 impl Chunk {
-    const ALL: [Chunk; 16] = [
+    const ALL: [Chunk; 17] = [
         Chunk::Step,
         Chunk::Dimensions,
         Chunk::Box,
@@ -274,6 +277,7 @@ impl Chunk {
         Chunk::Body,
         Chunk::BondsN,
         Chunk::BondsGroup,
+        Chunk::TypeShapes,
     ];
 
     fn name(self) -> &'static str {
@@ -294,6 +298,7 @@ impl Chunk {
             Chunk::Body => "particles/body",
             Chunk::BondsN => "bonds/N",
             Chunk::BondsGroup => "bonds/group",
+            Chunk::TypeShapes => "particles/type_shapes",
         }
     }
 }
@@ -338,7 +343,7 @@ pub(crate) struct GsdReader<R> {
     complete: usize,
     cut: Option<Cut>,
     /// Which of [`Chunk::ALL`] some frame of the file has.
-    in_file: [bool; 16],
+    in_file: [bool; Chunk::ALL.len()],
     next: usize,
     buf: Vec<u8>,
     reals: Vec<f32>,
@@ -367,6 +372,35 @@ fn u32_at(b: &[u8], at: usize) -> u32 {
 /// A NUL-padded string field: the bytes before the first NUL.
 fn until_nul(b: &[u8]) -> &[u8] {
     &b[..b.iter().position(|c| *c == 0).unwrap_or(b.len())]
+}
+
+/// The semi-axes of a HOOMD shape description that is an ellipsoid
+/// (`{"type": "Ellipsoid", "a": 1.0, "b": 0.5, "c": 0.5}`, keys in any order), or `None` for
+/// another shape or a description that is not one: the three finite values > 0 of `a`, `b`,
+/// `c` in a JSON object whose `type` is `Ellipsoid`.
+fn ellipsoid_axes(json: &[u8]) -> Option<[f32; 3]> {
+    let text = std::str::from_utf8(json).ok()?;
+    // The value after `"key"` and its colon: a string's contents or a number's text.
+    let value = |key: &str| -> Option<&str> {
+        let quoted = format!("\"{key}\"");
+        let at = text.find(&quoted)? + quoted.len();
+        let rest = text[at..].trim_start().strip_prefix(':')?.trim_start();
+        match rest.strip_prefix('"') {
+            Some(s) => s.split('"').next(),
+            None => rest.split([',', '}', ' ']).next(),
+        }
+    };
+    if value("type")? != "Ellipsoid" {
+        return None;
+    }
+    let axis = |k: &str| {
+        value(k)?
+            .trim()
+            .parse::<f32>()
+            .ok()
+            .filter(|v| v.is_finite() && *v > 0.0)
+    };
+    Some([axis("a")?, axis("b")?, axis("c")?])
 }
 
 fn version(v: u32) -> String {
@@ -853,6 +887,7 @@ impl<R: Read + Seek> GsdReader<R> {
                 self.ints.resize(n as usize, 0);
             }
         }
+        self.type_shapes(k, frame)?;
         let names = &self.type_names;
         frame
             .types
@@ -868,6 +903,51 @@ impl<R: Read + Seek> GsdReader<R> {
                     .iter()
                     .map(|t| elements[*t as usize].unwrap_or(Element::UNKNOWN)),
             );
+        }
+        Ok(())
+    }
+
+    /// The ellipsoids among frame `k`'s type shapes (`particles/type_shapes`, one JSON object
+    /// per type): when some type is `{"type": "Ellipsoid", "a": .., "b": .., "c": ..}`, every
+    /// particle gets the properties `shapex shapey shapez`, its type's diameters `2a 2b 2c`
+    /// (as LAMMPS gives an ellipsoid's shape), 0 0 0 for a type of another shape or none (a
+    /// sphere of its diameter, as LAMMPS's spheres). Called with `self.ints` holding the
+    /// particles' typeids.
+    fn type_shapes(&mut self, k: usize, frame: &mut Frame) -> Result<(), Error> {
+        let Some(e) = self.own_or_first(k, Chunk::TypeShapes) else {
+            return Ok(());
+        };
+        self.load(
+            k,
+            &e,
+            Class::Text,
+            Shape::Table,
+            "particles/type_shapes: NT × M JSON shape descriptions (int8 or char)",
+        )?;
+        let cols = (e.cols as usize).max(1);
+        let axes: Vec<Option<[f32; 3]>> = self
+            .buf
+            .chunks_exact(cols)
+            .map(|row| ellipsoid_axes(until_nul(row)))
+            .collect();
+        if axes.iter().all(Option::is_none) {
+            return Ok(());
+        }
+        for (c, name) in ["shapex", "shapey", "shapez"].into_iter().enumerate() {
+            let values = self
+                .ints
+                .iter()
+                .map(|t| {
+                    axes.get(*t as usize)
+                        .copied()
+                        .flatten()
+                        .map_or(0.0, |a| 2.0 * a[c])
+                })
+                .collect();
+            frame.properties.push(Property {
+                name: name.to_string(),
+                values,
+            });
         }
         Ok(())
     }
@@ -1153,7 +1233,7 @@ struct Index {
     entries: Vec<Entry>,
     complete: usize,
     cut: Option<Cut>,
-    in_file: [bool; 16],
+    in_file: [bool; Chunk::ALL.len()],
 }
 
 /// Reads and checks the index: every used entry's type, name id, frame and size, and where the
@@ -1181,7 +1261,7 @@ fn read_index<R: Read + Seek>(
             source,
         })?;
     let mut entries = Vec::new();
-    let mut in_file = [false; 16];
+    let mut in_file = [false; Chunk::ALL.len()];
     let mut cut: Option<(Cut, u64)> = None;
     let mut last_frame = None;
     // Read in blocks of 4096 entries (128 KiB).
@@ -1303,6 +1383,27 @@ fn read_index<R: Read + Seek>(
 mod tests {
     use super::*;
     use std::io::Cursor;
+
+    #[test]
+    fn ellipsoid_shapes_are_read_from_their_json() {
+        let axes = |j: &str| ellipsoid_axes(j.as_bytes());
+        assert_eq!(
+            axes(r#"{"type": "Ellipsoid", "a": 1.5, "b": 0.6, "c": 0.4}"#),
+            Some([1.5, 0.6, 0.4])
+        );
+        assert_eq!(
+            axes(r#"{"c":3,"a":1,"type":"Ellipsoid","b":2}"#),
+            Some([1.0, 2.0, 3.0])
+        );
+        assert_eq!(axes(r#"{"type": "Sphere", "diameter": 1.0}"#), None);
+        assert_eq!(
+            axes(r#"{"type": "Ellipsoid", "a": 1.0, "b": 0.0, "c": 1.0}"#),
+            None
+        );
+        assert_eq!(axes(r#"{"type": "Ellipsoid", "a": 1.0, "b": 2.0}"#), None);
+        assert_eq!(axes("not json"), None);
+        assert_eq!(ellipsoid_axes(&[0xff, 0xfe, b'{']), None);
+    }
 
     #[test]
     fn refuses_other_files_with_a_located_error() {

@@ -9,7 +9,8 @@
 //! - the shape ([`SHAPE_SOURCES`], the first the frame has): the per-atom properties `shapex
 //!   shapey shapez` (LAMMPS's `compute property/atom`: the three *diameters*, halved here, as
 //!   OVITO halves them), or `c_shape[1] c_shape[2] c_shape[3]` (the semi-axes, as OVITO exports
-//!   its "Aspherical Shape" to a LAMMPS dump); or one shape for every atom
+//!   its "Aspherical Shape" to a LAMMPS dump; md-io gives a HOOMD-blue GSD file's ellipsoid
+//!   `type_shapes` as `shapex..` too); or one shape for every atom
 //!   ([`EllipsoidOptions::shape`], semi-axes in Å). An atom whose three shape values are 0 is a
 //!   sphere in LAMMPS and is drawn as a sphere of its radius, as OVITO does; one with some but
 //!   not all of them 0, or a negative or non-finite one, is an error naming the atom.

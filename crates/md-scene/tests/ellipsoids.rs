@@ -329,3 +329,46 @@ fn alignment_turns_the_orientations_with_the_positions() {
         assert_eq!(a.semi_axes, b.semi_axes);
     }
 }
+
+/// HOOMD-blue's shapes: a GSD file gsd.hoomd wrote, with an ellipsoid type and a sphere type in
+/// `particles/type_shapes` (frame 0 only), read as OVITO 3.17.2 reads it, in both frames.
+#[test]
+fn hoomd_type_shapes_are_read_as_ovito_reads_them() {
+    use texmap_md_io::{Frame, Trajectory};
+    use texmap_md_scene::ellipsoids::{EllipsoidOptions, shapes};
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ellipsoids");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(format!("{dir}/hoomd_read.json")).unwrap())
+            .unwrap();
+    let mut traj = Trajectory::open(format!("{dir}/hoomd_ellipsoids.gsd")).unwrap();
+    let mut frame = Frame::new();
+    for (k, want) in json.as_array().unwrap().iter().enumerate() {
+        assert!(traj.read_next(&mut frame).unwrap());
+        let ours = shapes(&frame, &EllipsoidOptions::default()).unwrap();
+        let num = |v: &serde_json::Value| v.as_f64().unwrap() as f32;
+        let semi = want["semi_axes"].as_array().unwrap();
+        let quat = want["orientation_xyzw"].as_array().unwrap();
+        assert_eq!(ours.len(), semi.len());
+        for (i, (a, q)) in ours.iter().enumerate() {
+            let s = Vec3::new(num(&semi[i][0]), num(&semi[i][1]), num(&semi[i][2]));
+            let r = Quat::from_xyzw(
+                num(&quat[i][0]),
+                num(&quat[i][1]),
+                num(&quat[i][2]),
+                num(&quat[i][3]),
+            );
+            assert!(
+                (*a - s).abs().max_element() < 1e-6,
+                "frame {k} particle {i}: {a} vs {s}"
+            );
+            assert!(
+                q.dot(r.normalize()).abs() > 1.0 - 1e-5,
+                "frame {k} particle {i}"
+            );
+        }
+        assert!(
+            ours.iter().filter(|(a, _)| *a == Vec3::ZERO).count() == 20,
+            "the spheres"
+        );
+    }
+}
