@@ -6,8 +6,8 @@
 //! chain's cartoon (DSSP, spline, sweep). A movie pays them per frame. Volumetric data: the
 //! chain's Gaussian density on a 0.5 Å grid (as a cube file would hold it), its isosurface and
 //! that surface cut into 64 colour bands (`texmap render --isosurface`, `--isosurface-color-by`).
-//! Aspherical particles: 8,000 ellipsoids tessellated for the view and drawn
-//! (`--style ellipsoids`).
+//! Aspherical particles (`--style ellipsoids`): 8,000 ellipsoids drawn as impostors, and as the
+//! meshes tessellated for the view that the reference traces, drawn by the rasteriser.
 //!
 //! `cargo bench --bench md_surface -- --warm-up-time 2 --measurement-time 10`
 //! (test mode, `cargo test --bench md_surface`, builds the one chain at 1.0 Å and 320x180.)
@@ -20,7 +20,7 @@ use texmap::core::shade::{Lighting, Material};
 use texmap::md_io::volume::Volume;
 use texmap::md_io::{AtomStyle, Frame, Trajectory};
 use texmap::md_scene::cartoon::append_cartoon;
-use texmap::md_scene::ellipsoids::{Ellipsoid, TOLERANCE_PX, tessellate};
+use texmap::md_scene::ellipsoids::{Ellipsoid, TOLERANCE_PX, draw, tessellate};
 use texmap::md_scene::isosurface::{Side, bands, isosurface};
 use texmap::md_scene::surface::{MolMesh, SurfaceAtoms, SurfaceOptions, draw_mesh};
 
@@ -180,15 +180,22 @@ fn bench(c: &mut Criterion) {
     )
     .unwrap();
     let n = particles.len();
+    let lighting = Lighting::default_for(&camera);
+    let materials = [Material::plastic(Vec3::new(0.8, 0.3, 0.3))];
+    let mut image = Image::new(w, h, [0, 0, 0, 255]);
+    g.bench_function(format!("ellipsoids_impostors_{n}_{w}x{h}"), |b| {
+        b.iter(|| {
+            image.depth.fill(f32::INFINITY);
+            draw(&particles, &materials, &camera, &lighting, &mut image).unwrap()
+        })
+    });
+    // The meshes the reference traces, as the rasteriser would draw them instead.
     g.bench_function(format!("ellipsoids_tessellate_{n}_{w}x{h}"), |b| {
         b.iter(|| tessellate(&particles, Some(&camera), TOLERANCE_PX))
     });
     let mesh = tessellate(&particles, Some(&camera), TOLERANCE_PX);
     eprintln!("{n} ellipsoids: {} triangles", mesh.triangles.len());
-    let lighting = Lighting::default_for(&camera);
-    let materials = [Material::plastic(Vec3::new(0.8, 0.3, 0.3))];
-    let mut image = Image::new(w, h, [0, 0, 0, 255]);
-    g.bench_function(format!("ellipsoids_draw_{n}_{w}x{h}"), |b| {
+    g.bench_function(format!("ellipsoids_mesh_draw_{n}_{w}x{h}"), |b| {
         b.iter(|| {
             image.depth.fill(f32::INFINITY);
             draw_mesh(&mesh, &materials, &camera, &lighting, 1.0, &mut image).unwrap()

@@ -868,12 +868,18 @@ fn render(a: &RenderArgs) -> Result<()> {
             cam
         };
         let lighting = Lighting::default_for(&cam);
-        // The ellipsoids, tessellated for this view.
-        let ellipsoid_mesh = texmap_md_scene::ellipsoids::tessellate(
-            plan.ellipsoids(),
-            Some(&cam),
-            texmap_md_scene::ellipsoids::TOLERANCE_PX,
-        );
+        // The ellipsoids: impostors for a sphere method; for the reference ray tracer (and
+        // --quality, which traces), meshes tessellated for this view.
+        let traced = method_of(a.method).is_none() || quality.is_some();
+        let ellipsoid_mesh = if traced {
+            texmap_md_scene::ellipsoids::tessellate(
+                plan.ellipsoids(),
+                Some(&cam),
+                texmap_md_scene::ellipsoids::TOLERANCE_PX,
+            )
+        } else {
+            texmap_md_scene::surface::MolMesh::default()
+        };
         // The meshes drawn over the spheres, each with its opacity.
         let layers = [
             (plan.cartoon_mesh(), 1.0),
@@ -935,6 +941,14 @@ fn render(a: &RenderArgs) -> Result<()> {
                 o.draw_bonds = plan.draws_bonds();
                 let mut r = renderer.render(&scene, &cam, &o);
                 skipped_total += r.stats.skipped_invalid;
+                texmap_md_scene::ellipsoids::draw(
+                    plan.ellipsoids(),
+                    &scene.materials,
+                    &cam,
+                    &lighting,
+                    &mut r.frame,
+                )
+                .map_err(|e| fail(e.into(), &written))?;
                 // The opaque meshes first: a transparent one shows what is under it.
                 let opaque = layers.iter().filter(|l| l.1 >= 1.0);
                 for &(mesh, opacity) in opaque.chain(layers.iter().filter(|l| l.1 < 1.0)) {

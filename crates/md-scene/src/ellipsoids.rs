@@ -19,9 +19,17 @@
 //!   ellipsoid's axes along x, y, z). A quaternion of another length is normalised; a zero or
 //!   non-finite one is an error naming the atom.
 //!
+//! # Drawing: exact impostors
+//! [`draw`] draws each ellipsoid as a ray-cast impostor, as the sphere methods draw atoms: a
+//! screen rectangle (the projection of the ellipsoid's exact eye-space bounding box) binned
+//! into tiles by the rasteriser's sprites, each pixel's eye ray intersected with the quadric in
+//! the frame where it is the unit sphere, the nearest hit's depth and exact normal written and
+//! lit, with early depth rejection from the box's nearest depth. Exact silhouettes and depths at
+//! any size, at a cost per covered pixel rather than per triangle.
+//!
 //! # Tessellation, no finer than the view needs
-//! The ellipsoids are drawn as meshes (through the rasteriser, like the surface), each an
-//! icosphere ([`MAX_LEVEL`] + 1 levels, 20 · 4^level triangles) mapped onto the ellipsoid. The
+//! For the reference ray tracer (`--method reference`, `--quality`) and for export the
+//! ellipsoids are meshes, each an icosphere ([`MAX_LEVEL`] + 1 levels, 20 · 4^level triangles) mapped onto the ellipsoid. The
 //! flat triangles of a unit icosphere of level `l` lie within `sag(l)` of the sphere, so the
 //! mapped mesh lies within `sag / (1 − sag) · a_max` of the ellipsoid (`a_max` its longest
 //! semi-axis). [`tessellate`] picks for each ellipsoid the coarsest level that keeps this gap
@@ -56,10 +64,14 @@
 use std::fmt;
 use std::sync::OnceLock;
 
+use glam::Mat3;
 use glam::{Quat, Vec3};
 use texmap_core::camera::Camera;
+use texmap_core::frame::Frame as Image;
+use texmap_core::shade::{Lighting, Material};
 use texmap_impostor::Tess;
 use texmap_md_io::Frame;
+use texmap_raster::{DrawState, Framebuffer, QuadOut, RasterError, Sprite, SpriteQuad};
 
 use crate::surface::MolMesh;
 
@@ -343,6 +355,164 @@ pub fn tessellate(ellipsoids: &[Ellipsoid], camera: Option<&Camera>, tolerance_p
         append_ellipsoid(&mut mesh, e, level);
     }
     mesh
+}
+
+/// One ellipsoid in eye space, for the impostor shader.
+struct EyeEllipsoid {
+    center: Vec3,
+    /// Eye space to the frame where the ellipsoid is the unit sphere (centre subtracted first).
+    to_unit: Mat3,
+    /// The ellipsoid's axes in eye space, and the reciprocal semi-axes: the normal at unit
+    /// point `u` is `axes · (u / semi)`.
+    axes: Mat3,
+    inv_semi: Vec3,
+    material: Material,
+}
+
+/// Draws `ellipsoids` as `camera` sees them over `frame` where they are nearer, as exact
+/// ray-cast impostors (see the module docs), lit as the sphere methods light atoms
+/// (`materials` indexed by kind; a kind past them is grey). Returns how many were drawn (not
+/// culled). A `frame` of another size than the camera's is replaced by a cleared one.
+pub fn draw(
+    ellipsoids: &[Ellipsoid],
+    materials: &[Material],
+    camera: &Camera,
+    lighting: &Lighting,
+    frame: &mut Image,
+) -> Result<usize, RasterError> {
+    let (w, h) = (camera.width() as f32, camera.height() as f32);
+    let (k, near) = (camera.scale(), camera.near());
+    let ortho = camera.is_orthographic();
+    let to_eye = camera.world_to_eye_rotation();
+    let mut eyes = Vec::with_capacity(ellipsoids.len());
+    let mut sprites = Vec::with_capacity(ellipsoids.len());
+    for e in ellipsoids {
+        let semi = e.semi_axes;
+        if !(e.center.is_finite() && semi.is_finite() && semi.min_element() > 0.0) {
+            continue;
+        }
+        let axes = to_eye * Mat3::from_quat(e.rotation.normalize());
+        let m = axes * Mat3::from_diagonal(semi);
+        let c = camera.world_to_eye(e.center);
+        // The exact eye-space box: half-extent along axis i is the length of row i of m.
+        let rows = m.transpose();
+        let half = Vec3::new(
+            rows.x_axis.length(),
+            rows.y_axis.length(),
+            rows.z_axis.length(),
+        );
+        let (nearest, farthest) = (-(c.z + half.z), -(c.z - half.z));
+        if farthest <= near || nearest >= camera.far() {
+            continue;
+        }
+        let (lo, hi) = if ortho {
+            let centre = glam::Vec2::new(w * 0.5 + c.x * k, h * 0.5 - c.y * k);
+            let r = glam::Vec2::new(half.x, half.y) * k;
+            (centre - r, centre + r)
+        } else if nearest > near {
+            // The exact bounds of the projected ellipse: the planes through the eye tangent to
+            // the ellipsoid. With the dual quadric A = M Mᵀ − c cᵀ, the plane x + s z = 0
+            // (screen x = w/2 + k s) touches it where A₀₀ + 2 s A₀₂ + s² A₂₂ = 0; y likewise.
+            // A₂₂ < 0: the ellipsoid lies wholly in front of the eye's plane.
+            let a = m * m.transpose() - Mat3::from_cols(c * c.x, c * c.y, c * c.z);
+            let roots = |aii: f32, ai2: f32| {
+                let a22 = a.z_axis.z;
+                let disc = (ai2 * ai2 - aii * a22).max(0.0).sqrt();
+                let (s0, s1) = ((-ai2 + disc) / a22, (-ai2 - disc) / a22);
+                (s0.min(s1), s0.max(s1))
+            };
+            let (x0, x1) = roots(a.x_axis.x, a.z_axis.x);
+            let (y0, y1) = roots(a.y_axis.y, a.z_axis.y);
+            // One pixel of margin for the roots' rounding.
+            (
+                glam::Vec2::new(w * 0.5 + k * x0 - 1.0, h * 0.5 - k * y1 - 1.0),
+                glam::Vec2::new(w * 0.5 + k * x1 + 1.0, h * 0.5 - k * y0 + 1.0),
+            )
+        } else {
+            // Reaching the near plane: every pixel may see it.
+            (glam::Vec2::ZERO, glam::Vec2::new(w, h))
+        };
+        let lo = lo.floor().max(glam::Vec2::ZERO);
+        let hi = hi.ceil().min(glam::Vec2::new(w, h));
+        if !(lo.x < hi.x && lo.y < hi.y) {
+            continue;
+        }
+        sprites.push(Sprite {
+            min: lo,
+            max: hi,
+            depth_min: nearest.max(near),
+            id: eyes.len() as u32,
+        });
+        eyes.push(EyeEllipsoid {
+            center: c,
+            to_unit: Mat3::from_diagonal(semi.recip()) * axes.transpose(),
+            axes,
+            inv_semi: semi.recip(),
+            material: materials
+                .get(e.kind as usize)
+                .copied()
+                .unwrap_or(Material::plastic(Vec3::splat(0.6))),
+        });
+    }
+    if frame.width() != camera.width() || frame.height() != camera.height() {
+        *frame = Image::new(camera.width(), camera.height(), [0, 0, 0, 255]);
+    }
+    if sprites.is_empty() {
+        return Ok(0);
+    }
+    // Front to back, so that early depth rejection spares what is hidden.
+    sprites.sort_by(|a, b| a.depth_min.total_cmp(&b.depth_min).then(a.id.cmp(&b.id)));
+    let light = lighting.to_eye(camera);
+    let shader = |id: u32, q: &SpriteQuad| -> QuadOut {
+        let e = &eyes[id as usize];
+        let mut out = QuadOut {
+            color: [Vec3::ZERO; 4],
+            depth: [f32::NAN; 4],
+            mask: 0,
+        };
+        for lane in 0..4 {
+            if q.mask & (1 << lane) == 0 {
+                continue;
+            }
+            let (x, y) = (q.x[lane], q.y[lane]);
+            let (origin, dir) = if ortho {
+                let o = Vec3::new((x - w * 0.5) / k, (h * 0.5 - y) / k, 0.0);
+                (o, Vec3::NEG_Z)
+            } else {
+                (Vec3::ZERO, camera.eye_ray_dir(x, y))
+            };
+            let o = e.to_unit * (origin - e.center);
+            let d = e.to_unit * dir;
+            // From the ray's point nearest the centre (`t0`), whose distance from it is taken
+            // as a vector, not as b² − ac: far from the camera's origin those two are large and
+            // nearly equal, and their difference loses the digits the silhouette needs.
+            let a = d.dot(d);
+            let t0 = -o.dot(d) / a;
+            let closest = o + d * t0;
+            let gap = 1.0 - closest.dot(closest);
+            if gap.is_nan() || gap < 0.0 {
+                continue;
+            }
+            let t = t0 - (gap / a).sqrt();
+            let p = origin + dir * t;
+            let depth = -p.z;
+            if !(t > 0.0 && depth > near) {
+                continue;
+            }
+            let u = o + d * t;
+            let n = (e.axes * (u * e.inv_semi)).normalize();
+            let v = if ortho { Vec3::Z } else { -p.normalize() };
+            out.color[lane] = light.shade(&e.material, n, v);
+            out.depth[lane] = depth;
+            out.mask |= 1 << lane;
+        }
+        out
+    };
+    let mut fb = Framebuffer::new(camera.width(), camera.height())?;
+    fb.clear([0, 0, 0, 0]);
+    fb.draw_sprites(&sprites, &shader, &DrawState::default())?;
+    crate::surface::composite(frame, &fb.to_frame(), 1.0);
+    Ok(sprites.len())
 }
 
 #[cfg(test)]

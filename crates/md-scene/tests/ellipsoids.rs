@@ -7,7 +7,7 @@ use texmap_core::camera::Camera;
 use texmap_core::frame::Frame;
 use texmap_core::metrics::psnr;
 use texmap_core::shade::{Lighting, Material};
-use texmap_md_scene::ellipsoids::{Ellipsoid, TOLERANCE_PX, sag, tessellate};
+use texmap_md_scene::ellipsoids::{Ellipsoid, TOLERANCE_PX, draw, sag, tessellate};
 use texmap_md_scene::surface::draw_mesh;
 use texmap_reftrace::{RenderOptions, SceneBuilder, SurfaceMaterial};
 
@@ -81,25 +81,10 @@ fn materials() -> Vec<Material> {
     ]
 }
 
-#[test]
-fn coverage_and_depth_match_the_exact_ellipsoids() {
-    let cam = camera();
-    let particles = particles();
-    let mesh = tessellate(&particles, Some(&cam), TOLERANCE_PX);
-    let bg = [0, 0, 0, 255];
-    let mut drawn = Frame::new(cam.width(), cam.height(), bg);
-    draw_mesh(
-        &mesh,
-        &materials(),
-        &cam,
-        &Lighting::default_for(&cam),
-        1.0,
-        &mut drawn,
-    )
-    .unwrap();
+/// The exact picture of `particles`: per pixel centre the depth of the nearest ellipsoid
+/// (infinite where none) and which it is.
+fn exact_picture(cam: &Camera, particles: &[Ellipsoid]) -> (Vec<f32>, Vec<usize>) {
     let (w, h) = (cam.width() as usize, cam.height() as usize);
-    // The exact picture: coverage and depth of the nearest ellipsoid at each pixel centre,
-    // and which ellipsoid it is.
     let mut exact = vec![f32::INFINITY; w * h];
     let mut nearest = vec![usize::MAX; w * h];
     for y in 0..h {
@@ -116,12 +101,20 @@ fn coverage_and_depth_match_the_exact_ellipsoids() {
             }
         }
     }
-    let covered = exact.iter().filter(|d| d.is_finite()).count();
-    assert!(covered > 10_000, "{covered} pixels");
-    let mut wrong = 0;
-    let mut off_edge = 0;
-    // The drawn point's place against the exact ellipsoid there: |u| in the frame where the
-    // ellipsoid is the unit sphere (1 on it, 1 − sag inside).
+    (exact, nearest)
+}
+
+/// Coverage of `drawn` against the exact picture: (pixels that differ, those of them off a
+/// silhouette), and the drawn points' |u| range in the frame where their exact ellipsoid is the
+/// unit sphere, with the pixels where another ellipsoid's silhouette crosses.
+fn against_exact(
+    cam: &Camera,
+    particles: &[Ellipsoid],
+    drawn: &Frame,
+    (exact, nearest): &(Vec<f32>, Vec<usize>),
+) -> (usize, usize, f32, f32, usize) {
+    let (w, h) = (cam.width() as usize, cam.height() as usize);
+    let (mut wrong, mut off_edge) = (0, 0);
     let (mut inner, mut outer, mut crossings) = (1f32, 1f32, 0);
     for y in 0..h {
         for x in 0..w {
@@ -141,7 +134,6 @@ fn coverage_and_depth_match_the_exact_ellipsoids() {
                 let p = ray.origin + ray.dir * (drawn.depth[i] / ray.dir.dot(cam.forward()));
                 let u = (e.rotation.inverse() * (p - e.center) / e.semi_axes).length();
                 if (u - 1.0).abs() > 0.2 {
-                    // Another ellipsoid's silhouette crosses this one here.
                     crossings += 1;
                 } else {
                     inner = inner.min(u);
@@ -150,8 +142,39 @@ fn coverage_and_depth_match_the_exact_ellipsoids() {
             }
         }
     }
+    (wrong, off_edge, inner, outer, crossings)
+}
+
+#[test]
+fn coverage_and_depth_match_the_exact_ellipsoids() {
+    let cam = camera();
+    let particles = particles();
+    let lighting = Lighting::default_for(&cam);
+    let truth = exact_picture(&cam, &particles);
+    let covered = truth.0.iter().filter(|d| d.is_finite()).count();
+    assert!(covered > 10_000, "{covered} pixels");
+    let bg = [0, 0, 0, 255];
+    // The impostors: exact up to f32 at the silhouette.
+    let mut impostors = Frame::new(cam.width(), cam.height(), bg);
+    let n = draw(&particles, &materials(), &cam, &lighting, &mut impostors).unwrap();
+    assert_eq!(n, particles.len());
+    let (wrong, off_edge, inner, outer, crossings) =
+        against_exact(&cam, &particles, &impostors, &truth);
     eprintln!(
-        "{covered} pixels covered, {wrong} differ ({off_edge} off a silhouette), drawn points at |u| {inner:.4}..{outer:.4} ({crossings} at crossings), {} triangles",
+        "impostors: {covered} pixels covered, {wrong} differ ({off_edge} off a silhouette), points at |u| {inner:.6}..{outer:.6}, {crossings} crossings"
+    );
+    assert_eq!(off_edge, 0);
+    assert!(wrong <= 2, "{wrong} pixels");
+    assert!(crossings <= 2, "{crossings}");
+    assert!(inner > 1.0 - 1e-4 && outer < 1.0 + 1e-4, "{inner}..{outer}");
+    // The view's mesh (what the reference traces): within its level's sag.
+    let mesh = tessellate(&particles, Some(&cam), TOLERANCE_PX);
+    let mut drawn = Frame::new(cam.width(), cam.height(), bg);
+    draw_mesh(&mesh, &materials(), &cam, &lighting, 1.0, &mut drawn).unwrap();
+    let (wrong, off_edge, inner, outer, crossings) =
+        against_exact(&cam, &particles, &drawn, &truth);
+    eprintln!(
+        "mesh: {wrong} pixels differ ({off_edge} off a silhouette), points at |u| {inner:.4}..{outer:.4} ({crossings} at crossings), {} triangles",
         mesh.triangles.len()
     );
     assert_eq!(off_edge, 0);
@@ -164,6 +187,56 @@ fn coverage_and_depth_match_the_exact_ellipsoids() {
     );
     // No finer than needed: far fewer triangles than the finest level for every particle.
     assert!(mesh.triangles.len() < particles.len() * 20_480 / 8);
+    // Both pictures alike where both cover.
+    let db = psnr(&impostors, &drawn).unwrap();
+    eprintln!("impostors against the mesh: {db:.2} dB");
+    assert!(db > 35.0, "{db}");
+    // An orthographic view, and a perspective one from among the particles (some behind the
+    // eye, some through the near plane): the impostors still match.
+    let views = [
+        Camera::orthographic_look_at(
+            Vec3::new(14.0, 10.0, 30.0),
+            Vec3::ZERO,
+            Vec3::Y,
+            24.0,
+            480,
+            360,
+        )
+        .unwrap(),
+        Camera::perspective_look_at(
+            Vec3::new(1.0, 0.5, 2.0),
+            Vec3::new(-3.0, 0.0, -6.0),
+            Vec3::Y,
+            90.0,
+            480,
+            360,
+        )
+        .unwrap()
+        .with_clip(0.05, f32::INFINITY)
+        .unwrap(),
+    ];
+    for (name, cam) in ["orthographic", "inside"].iter().zip(&views) {
+        let truth = exact_picture(cam, &particles);
+        let mut img = Frame::new(cam.width(), cam.height(), bg);
+        draw(
+            &particles,
+            &materials(),
+            cam,
+            &Lighting::default_for(cam),
+            &mut img,
+        )
+        .unwrap();
+        let (wrong, off_edge, inner, outer, _) = against_exact(cam, &particles, &img, &truth);
+        let covered = truth.0.iter().filter(|d| d.is_finite()).count();
+        eprintln!(
+            "{name}: {covered} covered, {wrong} differ ({off_edge} off a silhouette), |u| {inner:.6}..{outer:.6}"
+        );
+        assert!(covered > 5_000 && off_edge == 0 && wrong <= 2, "{name}");
+        assert!(
+            inner > 1.0 - 1e-4 && outer < 1.0 + 1e-4,
+            "{name}: {inner}..{outer}"
+        );
+    }
 }
 
 #[test]
@@ -200,6 +273,19 @@ fn a_round_ellipsoid_is_shaded_as_the_reference_traces_its_sphere() {
     );
     assert!(db > 38.0, "PSNR {db}");
     assert!(drawn.len() - agree < drawn.len() / 300);
+    // The impostors: the reference's spheres up to its own f32.
+    let mut impostors = Frame::new(cam.width(), cam.height(), bg);
+    draw(&spheres, &mats, &cam, &lighting, &mut impostors).unwrap();
+    let db = psnr(&impostors, &reference).unwrap();
+    let agree = (0..drawn.len())
+        .filter(|&i| impostors.covered(i) == reference.covered(i))
+        .count();
+    eprintln!(
+        "impostors: PSNR {db:.2} dB against reftrace's exact spheres; coverage differs at {} pixels",
+        drawn.len() - agree
+    );
+    assert!(db > 55.0, "PSNR {db}");
+    assert!(drawn.len() - agree <= 2);
 }
 
 /// OVITO's reading of `file` (see `data/ellipsoids/gen_ellipsoids.py`): per particle its
