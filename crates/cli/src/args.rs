@@ -499,6 +499,11 @@ pub struct RenderArgs {
     /// Draw the periodic box outline when the file has a box.
     #[arg(long)]
     pub box_outline: bool,
+    /// A coordinate tripod at the bottom left (OVITO's tripod, VESTA's axes): `xyz` the
+    /// Cartesian axes, `cell` the frame's cell vectors a, b, c (x, y, z for a frame without a
+    /// cell); red, green, blue, turned as the camera sees them (after --align too).
+    #[arg(long, value_enum, value_name = "AXES")]
+    pub axes_tripod: Option<TripodArg>,
     /// Also write depth as a one-channel EXR beside each PNG (same name, .exr).
     #[arg(long)]
     pub depth: bool,
@@ -756,6 +761,15 @@ pub enum DrawStyle {
     /// quatw quati quatj quatk properties (none: the axes along x, y, z). An atom of shape
     /// 0 0 0 (a LAMMPS sphere) stays a sphere. Tessellated no finer than the picture needs.
     Ellipsoids,
+}
+
+/// The axes of `--axes-tripod`.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TripodArg {
+    /// The Cartesian x, y, z.
+    Xyz,
+    /// The cell vectors a, b, c.
+    Cell,
 }
 
 /// Periodic boundaries (`--pbc`).

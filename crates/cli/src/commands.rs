@@ -1044,6 +1044,11 @@ fn render(a: &RenderArgs) -> Result<()> {
                 texmap_md_scene::draw_atom_label(rgba, w, h, xy.to_array(), &m.text());
             }
         }
+        if let Some(which) = a.axes_tripod {
+            let (w, h) = (out.width() as usize, out.height() as usize);
+            let axes = crate::scene::tripod_axes(which, md.cell.as_ref(), &shown);
+            texmap_md_scene::draw_axes_tripod(out.color.as_flattened_mut(), w, h, &axes);
+        }
         if let Some(parts) = &label {
             let hbonds = plan.last_hbonds().len();
             let text = crate::scene::label_text(parts, f, &md, traj.name(), hbonds)

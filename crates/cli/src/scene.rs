@@ -1234,6 +1234,35 @@ pub fn isosurfaces(file: &std::path::Path, m: &MolArgs) -> Result<Option<Isosurf
     }))
 }
 
+/// The axes of `--axes-tripod` as `camera` sees them: x, y, z or the cell's a, b, c (x, y, z
+/// without a cell), each a unit direction in eye space, red, green and blue.
+pub fn tripod_axes(
+    which: crate::args::TripodArg,
+    cell: Option<&texmap_md_io::UnitCell>,
+    camera: &texmap_core::camera::Camera,
+) -> Vec<texmap_md_scene::TripodAxis> {
+    let colors = [[220, 40, 40], [30, 150, 30], [40, 80, 230]];
+    let (dirs, labels) = match (which, cell) {
+        (crate::args::TripodArg::Cell, Some(cell)) => {
+            (cell.matrix().map(|r| r.map(|v| v as f32)), ['a', 'b', 'c'])
+        }
+        _ => (
+            [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+            ['x', 'y', 'z'],
+        ),
+    };
+    (0..3)
+        .map(|k| {
+            let d = glam::Vec3::from(dirs[k]).normalize_or_zero();
+            texmap_md_scene::TripodAxis {
+                eye: camera.dir_to_eye(d).to_array(),
+                label: labels[k],
+                color: colors[k],
+            }
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

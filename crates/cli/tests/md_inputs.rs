@@ -2858,3 +2858,62 @@ fn a_trajectory_in_several_files_is_one_trajectory() {
     assert_eq!(o.status.code(), Some(1));
     assert!(stderr(&o).contains("no file matches"), "{}", stderr(&o));
 }
+
+/// `--axes-tripod`: seen down z the x axis points right and y up; seen down x, y points right
+/// and z up (the automatic camera's up); `cell` labels the cell's vectors.
+#[test]
+fn the_axes_tripod_turns_with_the_view() {
+    let dir = tempfile::tempdir().unwrap();
+    let poscar = data("vasp/POSCAR_rutile");
+    // The centroid of the pixels where channel k leads the others by 60, in the tripod's
+    // corner (the panel at the bottom left, 4 px in, 60 px square at this size).
+    let centroid = |img: &image::RgbImage, k: usize| {
+        let (mut sx, mut sy, mut n) = (0.0, 0.0, 0.0);
+        for (x, y, p) in img.enumerate_pixels() {
+            let lead = (0..3)
+                .filter(|&j| j != k)
+                .all(|j| p[k] as i32 > p[j] as i32 + 60);
+            if x < 64 && y >= img.height() - 64 && lead {
+                sx += x as f64 - 34.0;
+                sy += y as f64 - (img.height() - 34) as f64;
+                n += 1.0;
+            }
+        }
+        assert!(n > 10.0, "channel {k}: {n} pixels");
+        (sx / n, sy / n)
+    };
+    let base = [poscar.as_str(), "--size", "320x240", "--axes-tripod", "xyz"];
+    let img = render_rgb(dir.path(), "z.png", &[&base[..], &["--view", "z"]].concat());
+    let (red, green) = (centroid(&img, 0), centroid(&img, 1));
+    assert!(red.0 > 5.0 && red.1.abs() < 4.0, "x right: {red:?}");
+    assert!(green.1 < -5.0 && green.0.abs() < 4.0, "y up: {green:?}");
+    let img = render_rgb(dir.path(), "x.png", &[&base[..], &["--view", "x"]].concat());
+    let (green, blue) = (centroid(&img, 1), centroid(&img, 2));
+    assert!(green.0 > 5.0 && green.1.abs() < 4.0, "y right: {green:?}");
+    assert!(blue.1 < -5.0 && blue.0.abs() < 4.0, "z up: {blue:?}");
+    let plain = render_rgb(
+        dir.path(),
+        "plain.png",
+        &[poscar.as_str(), "--size", "320x240", "--view", "z"],
+    );
+    assert!(img != plain, "the tripod is drawn");
+    let img = render_rgb(
+        dir.path(),
+        "cell.png",
+        &[
+            poscar.as_str(),
+            "--size",
+            "320x240",
+            "--axes-tripod",
+            "cell",
+            "--view",
+            "z",
+        ],
+    );
+    // Rutile's a and b are x and y: the same picture but for the labels.
+    let (red_cell, green_cell) = (centroid(&img, 0), centroid(&img, 1));
+    assert!(
+        red_cell.0 > 5.0 && green_cell.1 < -5.0,
+        "{red_cell:?} {green_cell:?}"
+    );
+}

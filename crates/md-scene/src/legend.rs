@@ -1,5 +1,6 @@
 //! A colour bar legend drawn onto a rendered image (and, with the same font, a one-line caption
-//! at the top left, [`draw_caption`], and atom labels, [`draw_atom_label`]): the colour map from
+//! at the top left, [`draw_caption`], atom labels, [`draw_atom_label`], and a coordinate tripod
+//! at the bottom left, [`draw_axes_tripod`]): the colour map from
 //! the range's maximum (top) to its minimum (bottom) in a thin dark frame, tick labels for the
 //! minimum, the middle and the maximum beside it and a title above, on a light backdrop at the
 //! right edge of the image.
@@ -266,6 +267,97 @@ pub fn draw_atom_label(
     true
 }
 
+/// One axis of [`draw_axes_tripod`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TripodAxis {
+    /// The axis's unit direction in eye space (x right, y up, z toward the viewer):
+    /// `Camera::dir_to_eye` of a world direction.
+    pub eye: [f32; 3],
+    /// Its label (one character: `x`, `a`, ...).
+    pub label: char,
+    /// Its colour, sRGB.
+    pub color: [u8; 3],
+}
+
+/// Draws coordinate axes as a tripod at the bottom left of the image (OVITO's coordinate
+/// tripod, VESTA's axes), on the legend's backdrop: from a common origin a line per axis, its
+/// length on the screen `16s` times the axis's projection (short for an axis toward or away
+/// from the viewer), anti-aliased, `1.5s` wide, in the axis's colour, with its label beyond the
+/// tip; the axis nearest the viewer drawn last. Returns false (nothing drawn) when the image is
+/// too small for it (the panel needs `60s` square and the margin).
+///
+/// ```
+/// use texmap_md_scene::{TripodAxis, draw_axes_tripod};
+/// let (width, height) = (320, 240);
+/// let mut rgba = vec![0u8; width * height * 4];
+/// let axes = [
+///     TripodAxis { eye: [1.0, 0.0, 0.0], label: 'x', color: [220, 40, 40] },
+///     TripodAxis { eye: [0.0, 1.0, 0.0], label: 'y', color: [40, 160, 40] },
+///     TripodAxis { eye: [0.0, 0.0, 1.0], label: 'z', color: [40, 80, 230] },
+/// ];
+/// assert!(draw_axes_tripod(&mut rgba, width, height, &axes));
+/// ```
+pub fn draw_axes_tripod(rgba: &mut [u8], width: usize, height: usize, axes: &[TripodAxis]) -> bool {
+    check_buffer("draw_axes_tripod", rgba, width, height);
+    let s = scale_of(height);
+    let (margin, reach) = (4 * s, 16 * s);
+    // The origin in the middle of a square that holds every tip and label around it.
+    let half = reach + 2 * ADVANCE * s + 2 * s;
+    let side = 2 * half;
+    if side + 2 * margin > width || side + 2 * margin > height {
+        return false;
+    }
+    let panel = Rect {
+        x0: margin,
+        y0: height - margin - side,
+        x1: margin + side,
+        y1: height - margin,
+    };
+    let mut image = Image { rgba, width };
+    image.blend_backdrop(panel);
+    // On a pixel centre, so that an axis along a row or column covers it whole.
+    let origin = [
+        (panel.x0 + half) as f32 + 0.5,
+        (panel.y0 + half) as f32 + 0.5,
+    ];
+    let mut order: Vec<&TripodAxis> = axes
+        .iter()
+        .filter(|a| a.eye.iter().all(|v| v.is_finite()))
+        .collect();
+    order.sort_by(|a, b| a.eye[2].total_cmp(&b.eye[2]));
+    for axis in order {
+        let [x, y, _] = axis.eye;
+        let dir = [x, -y];
+        let tip = [
+            origin[0] + dir[0] * reach as f32,
+            origin[1] + dir[1] * reach as f32,
+        ];
+        image.segment(panel, origin, tip, 1.5 * s as f32, axis.color);
+        // The label centred a glyph's half-width beyond the tip (beside the origin for an axis
+        // that points at the viewer).
+        let len = (dir[0] * dir[0] + dir[1] * dir[1]).sqrt();
+        let unit = if len > 0.2 {
+            [dir[0] / len, dir[1] / len]
+        } else {
+            [
+                std::f32::consts::FRAC_1_SQRT_2,
+                -std::f32::consts::FRAC_1_SQRT_2,
+            ]
+        };
+        let gap = (ADVANCE * s) as f32;
+        let centre = [tip[0] + unit[0] * gap, tip[1] + unit[1] * gap];
+        let x0 = (centre[0] - (GLYPH_WIDTH * s) as f32 / 2.0)
+            .round()
+            .max(0.0) as usize;
+        let y0 = (centre[1] - (CAP_HEIGHT * s) as f32 / 2.0).round().max(0.0) as usize;
+        let mut ink = [0u8; 4];
+        ink[..3].copy_from_slice(&axis.color);
+        ink[3] = 255;
+        image.text_in(x0, y0, s, std::iter::once(axis.label), panel, ink);
+    }
+    true
+}
+
 /// The longest atom label [`draw_atom_label`] draws, in characters.
 pub const MAX_LABEL_CHARS: usize = 40;
 
@@ -469,6 +561,53 @@ impl Image<'_> {
     /// `text` in [`INK`] at scale `s`, the first cell's top left at (`x`, `y`); pixels outside
     /// `clip` are skipped.
     fn text(&mut self, x: usize, y: usize, s: usize, text: impl Iterator<Item = char>, clip: Rect) {
+        self.text_in(x, y, s, text, clip, INK);
+    }
+
+    /// A line from `a` to `b` (pixel coordinates) `width` pixels wide in `color`, anti-aliased
+    /// by each pixel centre's distance from the segment, blended in linear light; pixels outside
+    /// `clip` are left.
+    fn segment(&mut self, clip: Rect, a: [f32; 2], b: [f32; 2], width: f32, color: [u8; 3]) {
+        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+        let len2 = dx * dx + dy * dy;
+        let r = width * 0.5;
+        let lo_x = (a[0].min(b[0]) - r - 1.0).max(clip.x0 as f32) as usize;
+        let hi_x = ((a[0].max(b[0]) + r + 2.0) as usize).min(clip.x1);
+        let lo_y = (a[1].min(b[1]) - r - 1.0).max(clip.y0 as f32) as usize;
+        let hi_y = ((a[1].max(b[1]) + r + 2.0) as usize).min(clip.y1);
+        for y in lo_y..hi_y {
+            for x in lo_x..hi_x {
+                let (px, py) = (x as f32 + 0.5 - a[0], y as f32 + 0.5 - a[1]);
+                let t = if len2 > 0.0 {
+                    ((px * dx + py * dy) / len2).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                let (ex, ey) = (px - t * dx, py - t * dy);
+                let cover = (r + 0.5 - (ex * ex + ey * ey).sqrt()).clamp(0.0, 1.0);
+                if cover <= 0.0 {
+                    continue;
+                }
+                let px = &mut self.rgba[(y * self.width + x) * 4..(y * self.width + x) * 4 + 4];
+                for (c, &over) in px[..3].iter_mut().zip(&color) {
+                    let v = cover * srgb8_to_linear(over) + (1.0 - cover) * srgb8_to_linear(*c);
+                    *c = linear_to_srgb8_exact(v);
+                }
+                px[3] = 255;
+            }
+        }
+    }
+
+    /// [`Image::text`] in the colour `ink`.
+    fn text_in(
+        &mut self,
+        x: usize,
+        y: usize,
+        s: usize,
+        text: impl Iterator<Item = char>,
+        clip: Rect,
+        ink: [u8; 4],
+    ) {
         for (i, ch) in text.enumerate() {
             let glyph = glyph(ch);
             let cell_x = x + i * ADVANCE * s;
@@ -487,7 +626,7 @@ impl Image<'_> {
                                 x1: px + s,
                                 y1: py + s,
                             },
-                            INK,
+                            ink,
                         );
                     }
                 }
@@ -1056,6 +1195,69 @@ mod tests {
         assert_eq!(n, (100 - 4 - 8 + 1) / ADVANCE);
         let mut tiny = vec![0u8; 10 * 10 * 4];
         assert_eq!(draw_caption(&mut tiny, 10, 10, "t"), 0);
+        assert!(tiny.iter().all(|&b| b == 0));
+    }
+
+    #[test]
+    fn the_tripod_points_its_axes_where_they_turn() {
+        let (width, height) = (360, 360);
+        let red = [220, 30, 30];
+        let green = [30, 160, 30];
+        let blue = [30, 60, 230];
+        // The centroid of the pixels where `c`'s strongest channel leads the others by 60
+        // codes, relative to the panel's centre.
+        let centroid = |rgba: &[u8], c: [u8; 3]| {
+            let k = (0..3).max_by_key(|&k| c[k]).unwrap();
+            let (mut sx, mut sy, mut n) = (0.0, 0.0, 0.0);
+            for (i, px) in rgba.chunks_exact(4).enumerate() {
+                let lead = (0..3)
+                    .filter(|&j| j != k)
+                    .all(|j| px[k] as i32 > px[j] as i32 + 60);
+                if lead {
+                    sx += (i % width) as f64;
+                    sy += (i / width) as f64;
+                    n += 1.0;
+                }
+            }
+            // Scale 1: panel 60 px square, 4 px from the left and bottom edges.
+            let (ox, oy) = (4.0 + 30.0, (height - 4 - 30) as f64);
+            (sx / n - ox, sy / n - oy, n as usize)
+        };
+        let draw = |eye: [[f32; 3]; 3]| {
+            let mut rgba = vec![0u8; width * height * 4];
+            let axes = [
+                (eye[0], 'x', red),
+                (eye[1], 'y', green),
+                (eye[2], 'z', blue),
+            ]
+            .map(|(eye, label, color)| TripodAxis { eye, label, color });
+            assert!(draw_axes_tripod(&mut rgba, width, height, &axes));
+            rgba
+        };
+        // Looking down z: x to the right, y up, z at the viewer (a dot and its label).
+        let img = draw([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]);
+        let (rx, ry, rn) = centroid(&img, red);
+        let (gx, gy, gn) = centroid(&img, green);
+        let (_, _, bn) = centroid(&img, blue);
+        assert!(rx > 6.0 && ry.abs() < 3.0 && rn > 20, "x: {rx} {ry} {rn}");
+        assert!(gy < -6.0 && gx.abs() < 3.0 && gn > 20, "y: {gx} {gy} {gn}");
+        assert!(bn > 0 && bn < rn, "z: {bn} pixels");
+        // Turned a quarter about the view axis: x up, y to the left.
+        let img = draw([[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]);
+        let (rx, ry, _) = centroid(&img, red);
+        let (gx, gy, _) = centroid(&img, green);
+        assert!(ry < -6.0 && rx.abs() < 3.0, "x: {rx} {ry}");
+        assert!(gx < -6.0 && gy.abs() < 3.0, "y: {gx} {gy}");
+        // Nothing outside the panel; nothing at all in an image too small.
+        let img = draw([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]);
+        for (i, px) in img.chunks_exact(4).enumerate() {
+            let (x, y) = (i % width, i / width);
+            if x >= 64 || y < height - 64 {
+                assert_eq!(px, [0, 0, 0, 0], "({x}, {y})");
+            }
+        }
+        let mut tiny = vec![0u8; 40 * 40 * 4];
+        assert!(!draw_axes_tripod(&mut tiny, 40, 40, &[]));
         assert!(tiny.iter().all(|&b| b == 0));
     }
 }

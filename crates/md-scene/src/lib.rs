@@ -98,7 +98,10 @@ pub use camera::{
 };
 pub use camera_plan::{CameraPlan, CameraPlanError, MotionSpec};
 pub use colormap::Colormap;
-pub use legend::{ColorBar, MAX_LABEL_CHARS, draw_atom_label, draw_caption, draw_color_bar};
+pub use legend::{
+    ColorBar, MAX_LABEL_CHARS, TripodAxis, draw_atom_label, draw_axes_tripod, draw_caption,
+    draw_color_bar,
+};
 pub use outline::{add_box_outline, cell_corners};
 pub use palette::{MAX_MATERIALS, Palette, type_color};
 pub use plan::{
