@@ -499,6 +499,11 @@ pub struct RenderArgs {
     /// Draw the periodic box outline when the file has a box.
     #[arg(long)]
     pub box_outline: bool,
+    /// Print resolution, dots per inch: written into each PNG (its pHYs chunk, which Word,
+    /// Illustrator, Inkscape and LaTeX read for the printed size), and the pixels of a --size
+    /// given in cm, mm or in (--size 8.5cmx6cm --dpi 300 is 1004x709 pixels).
+    #[arg(long, value_name = "DPI")]
+    pub dpi: Option<f32>,
     /// A coordinate tripod at the bottom left (OVITO's tripod, VESTA's axes): `xyz` the
     /// Cartesian axes, `cell` the frame's cell vectors a, b, c (x, y, z for a frame without a
     /// cell); red, green, blue, turned as the camera sees them (after --align too).
@@ -566,7 +571,8 @@ pub const DEFAULT_FOV: f32 = 40.0;
 /// pose; without --eye/--target/--up it is fitted to what the first frame draws.
 #[derive(Args, Clone, Debug)]
 pub struct ViewArgs {
-    /// Image size WxH in pixels.
+    /// Image size WxH in pixels, or (texmap render, with --dpi) in print units: 8.5cmx6cm,
+    /// 85mmx60mm, 3.3inx2.4in.
     #[arg(long, default_value = "1280x720")]
     pub size: String,
     /// Orthographic projection (parallel rays).

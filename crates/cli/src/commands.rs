@@ -470,7 +470,12 @@ fn trace_layers<E: Into<anyhow::Error>>(
 
 fn render(a: &RenderArgs) -> Result<()> {
     let background = parse_background(&a.background)?;
-    let size = parse_size(&a.camera.size)?;
+    if let Some(dpi) = a.dpi
+        && !(dpi.is_finite() && (1.0..=100_000.0).contains(&dpi))
+    {
+        return usage(format!("--dpi {dpi}: expected 1 to 100000 dots per inch"));
+    }
+    let size = crate::scene::parse_print_size(&a.camera.size, a.dpi)?;
     let options = ReadOptions::new().allow_truncated(a.allow_truncated);
     let files: Vec<PathBuf> = std::iter::once(a.file.clone())
         .chain(a.more.iter().cloned())
@@ -508,7 +513,7 @@ fn render(a: &RenderArgs) -> Result<()> {
         .iter()
         .map(|s| crate::scene::parse_atom_label(s))
         .collect::<Result<Vec<_>>>()?;
-    let mut sink = crate::movie::Sink::new(&a.output, frames.len(), a.fps, a.depth)?;
+    let mut sink = crate::movie::Sink::new(&a.output, frames.len(), a.fps, a.depth, a.dpi)?;
     // This part's frames (all of them unless sharded): positions in `frames`.
     let mine = match shard_spec(a)? {
         None => 0..frames.len(),

@@ -378,7 +378,7 @@ fn render(a: &EnvRenderArgs) -> Result<()> {
     };
     let (w, h) = parse_size(&a.size)?;
     let env = a.env.as_deref().map(load_environment).transpose()?;
-    let mut sink = Sink::new(&a.out, a.frames, a.fps, false)?;
+    let mut sink = Sink::new(&a.out, a.frames, a.fps, false, None)?;
     let pb = crate::commands::progress(a.frames as u64, "envmap");
     // One renderer for every frame: it keeps the maps (a time-sliced cube map redraws only
     // --faces-per-frame faces of the kept one) and recycles the frame buffers.

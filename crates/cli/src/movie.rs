@@ -13,8 +13,12 @@ use crate::output::{frame_path, write_png};
 
 /// What `-o` asks for, decided from its extension before any frame is drawn.
 pub enum Sink {
-    /// PNG images; the path may hold a `%04d` pattern.
-    Frames { pattern: PathBuf, multi: bool },
+    /// PNG images; the path may hold a `%04d` pattern; `dpi` goes into each.
+    Frames {
+        pattern: PathBuf,
+        multi: bool,
+        dpi: Option<f32>,
+    },
     /// One movie; the writer is opened at the first frame, when the image size is known.
     Movie {
         path: PathBuf,
@@ -26,8 +30,8 @@ pub enum Sink {
 
 impl Sink {
     /// The sink for output path `out` and `frames` frames. Extensions other than `.png` and the
-    /// movie formats are refused (a usage error), as is `--depth` with a movie.
-    pub fn new(out: &Path, frames: usize, fps: f64, depth: bool) -> Result<Sink> {
+    /// movie formats are refused (a usage error), as are `--depth` and `--dpi` with a movie.
+    pub fn new(out: &Path, frames: usize, fps: f64, depth: bool, dpi: Option<f32>) -> Result<Sink> {
         let ext = out
             .extension()
             .map(|e| e.to_string_lossy().to_ascii_lowercase());
@@ -36,6 +40,13 @@ impl Sink {
                 return Err(UsageError(format!(
                     "{}: --depth writes one EXR per frame beside PNG frames; it cannot go into a movie \
                      (render PNG frames with --depth, then texmap movie)",
+                    out.display()
+                ))
+                .into());
+            }
+            if dpi.is_some() {
+                return Err(UsageError(format!(
+                    "{}: --dpi is a print resolution for PNG images; a movie has none",
                     out.display()
                 ))
                 .into());
@@ -54,6 +65,7 @@ impl Sink {
             Some("png") => Ok(Sink::Frames {
                 pattern: out.to_path_buf(),
                 multi: frames > 1,
+                dpi,
             }),
             _ => Err(UsageError(format!(
                 "{}: the output's extension decides what is written: .png for images (with %04d for \
@@ -67,9 +79,16 @@ impl Sink {
     /// Write frame number `f` (its index in the trajectory); returns the files written.
     pub fn write(&mut self, f: usize, frame: &Frame, depth: bool) -> Result<Vec<PathBuf>> {
         match self {
-            Sink::Frames { pattern, multi } => {
+            Sink::Frames {
+                pattern,
+                multi,
+                dpi,
+            } => {
                 let path = frame_path(pattern, f, *multi)?;
-                write_png(frame, &path)?;
+                match dpi {
+                    Some(dpi) => crate::output::write_png_dpi(frame, &path, *dpi)?,
+                    None => write_png(frame, &path)?,
+                }
                 let mut out = vec![path.clone()];
                 if depth {
                     let exr = path.with_extension("exr");
@@ -169,7 +188,7 @@ pub fn assemble(dir: &Path, out: &Path, fps: f64) -> Result<()> {
         bail!("{}: no PNG frame in this directory", dir.display());
     }
     let pb = crate::commands::progress(files.len() as u64, "encoding");
-    let mut sink = Sink::new(out, files.len(), fps, false)?;
+    let mut sink = Sink::new(out, files.len(), fps, false, None)?;
     let mut size: Option<(u32, u32)> = None;
     for (k, path) in files.iter().enumerate() {
         let img = image::open(path)
@@ -211,15 +230,17 @@ mod tests {
 
     #[test]
     fn the_extension_decides_and_unknown_ones_are_refused() {
-        let movie = Sink::new(Path::new("m.mp4"), 3, 25.0, false).unwrap();
+        let movie = Sink::new(Path::new("m.mp4"), 3, 25.0, false, None).unwrap();
         assert!(matches!(movie, Sink::Movie { .. }));
-        let frames = Sink::new(Path::new("f%04d.png"), 3, 25.0, false).unwrap();
+        let frames = Sink::new(Path::new("f%04d.png"), 3, 25.0, false, None).unwrap();
         assert!(matches!(frames, Sink::Frames { .. }));
         for bad in ["x.jpg", "noext", "movie.mp4.bak"] {
-            let e = Sink::new(Path::new(bad), 3, 25.0, false).err().unwrap();
+            let e = Sink::new(Path::new(bad), 3, 25.0, false, None)
+                .err()
+                .unwrap();
             assert!(e.downcast_ref::<UsageError>().is_some(), "{bad}: {e}");
         }
-        assert!(Sink::new(Path::new("m.gif"), 3, 25.0, true).is_err());
-        assert!(Sink::new(Path::new("m.gif"), 3, 0.0, false).is_err());
+        assert!(Sink::new(Path::new("m.gif"), 3, 25.0, true, None).is_err());
+        assert!(Sink::new(Path::new("m.gif"), 3, 0.0, false, None).is_err());
     }
 }

@@ -149,6 +149,33 @@ pub fn write_png(frame: &Frame, path: &Path) -> Result<()> {
     })
 }
 
+/// [`write_png`] with the print resolution `dpi` in the PNG's pHYs chunk (pixels per metre,
+/// the unit the PNG specification gives), through the png crate (the image crate writes no
+/// pHYs).
+pub fn write_png_dpi(frame: &Frame, path: &Path, dpi: f32) -> Result<()> {
+    write_atomic(path, |tmp| {
+        let file = std::fs::File::create(tmp)
+            .with_context(|| format!("cannot create {}", tmp.display()))?;
+        let mut enc =
+            png::Encoder::new(std::io::BufWriter::new(file), frame.width(), frame.height());
+        enc.set_color(png::ColorType::Rgba);
+        enc.set_depth(png::BitDepth::Eight);
+        let per_metre = (dpi as f64 / 0.0254).round() as u32;
+        enc.set_pixel_dims(Some(png::PixelDimensions {
+            xppu: per_metre,
+            yppu: per_metre,
+            unit: png::Unit::Meter,
+        }));
+        let mut w = enc
+            .write_header()
+            .with_context(|| format!("cannot write PNG {}", path.display()))?;
+        w.write_image_data(frame.color_bytes())
+            .with_context(|| format!("cannot write PNG {}", path.display()))?;
+        w.finish()
+            .with_context(|| format!("cannot write PNG {}", path.display()))
+    })
+}
+
 /// Write the depth of a frame as a one-channel (`Z`, f32) OpenEXR file; uncovered pixels hold
 /// +infinity, as OpenEXR depth conventions expect for "no surface".
 pub fn write_depth_exr(frame: &Frame, path: &Path) -> Result<()> {

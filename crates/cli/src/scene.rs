@@ -721,6 +721,40 @@ pub fn parse_size(s: &str) -> Result<(u32, u32)> {
     }
 }
 
+/// Parse `--size` for `texmap render`: pixels `WxH`, or print units (`8.5cmx6cm`, `85mmx60mm`,
+/// `3.3inx2.4in`) at `dpi`, each side rounded to the nearest pixel.
+pub fn parse_print_size(s: &str, dpi: Option<f32>) -> Result<(u32, u32)> {
+    let unit = |t: &str| -> Option<(f64, f64)> {
+        let t = t.trim();
+        for (suffix, inches) in [("cm", 1.0 / 2.54), ("mm", 1.0 / 25.4), ("in", 1.0)] {
+            if let Some(v) = t.strip_suffix(suffix) {
+                return v.trim().parse::<f64>().ok().map(|v| (v, inches));
+            }
+        }
+        None
+    };
+    let Some((w, h)) = s.split_once(['x', 'X']) else {
+        return parse_size(s);
+    };
+    let (Some((w, wu)), Some((h, hu))) = (unit(w), unit(h)) else {
+        return parse_size(s);
+    };
+    let Some(dpi) = dpi else {
+        return usage(format!(
+            "--size {s:?}: a size in cm, mm or in needs --dpi (e.g. --dpi 300) to be made pixels"
+        ));
+    };
+    let px = |v: f64, per_inch: f64| (v * per_inch * dpi as f64).round();
+    let (pw, ph) = (px(w, wu), px(h, hu));
+    let max = texmap_core::camera::MAX_IMAGE_SIDE as f64;
+    if !(pw >= 1.0 && ph >= 1.0 && pw <= max && ph <= max) {
+        return usage(format!(
+            "--size {s:?} at --dpi {dpi}: {pw}x{ph} pixels; expected 1 to {max} a side"
+        ));
+    }
+    Ok((pw as u32, ph as u32))
+}
+
 /// Parse `R,G,B` (0–255) into an opaque sRGB colour.
 pub fn parse_background(s: &str) -> Result<[u8; 4]> {
     if s.trim().eq_ignore_ascii_case("transparent") {

@@ -172,7 +172,7 @@ pub fn run_fly(a: FlyArgs) -> Result<()> {
             .with_context(|| format!("view {i} of the orbit"))?;
     }
     let objects = a.view.objects.load(terrain.grid())?;
-    let mut sink = Sink::new(&a.output, views.len(), a.fps, false)?;
+    let mut sink = Sink::new(&a.output, views.len(), a.fps, false, None)?;
     let refr = if sampler.is_none() {
         Some(TerrainReference::with_models(&terrain, objects.placed())?)
     } else {

@@ -2917,3 +2917,81 @@ fn the_axes_tripod_turns_with_the_view() {
         "{red_cell:?} {green_cell:?}"
     );
 }
+
+/// `--dpi`: a size in print units becomes pixels at the resolution, and the PNG carries it in a
+/// pHYs chunk as the PNG specification lays it out (read here from the bytes); without --dpi no
+/// pHYs is written; units without --dpi, and --dpi with a movie, are usage errors.
+#[test]
+fn dpi_sizes_print_units_and_is_written_into_the_png() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = data("topo_mda.gro");
+    let out = dir.path().join("fig.png");
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "render",
+            "--quiet",
+            input.as_str(),
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        texmap(&args)
+    };
+    // The pHYs chunk's (x, y, unit) from the PNG's chunks: length, type, data, CRC.
+    let phys = |bytes: &[u8]| -> Option<(u32, u32, u8)> {
+        let mut at = 8;
+        while at + 8 <= bytes.len() {
+            let len = u32::from_be_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
+            let kind = &bytes[at + 4..at + 8];
+            let data = &bytes[at + 8..at + 8 + len];
+            if kind == b"pHYs" {
+                let x = u32::from_be_bytes(data[0..4].try_into().unwrap());
+                let y = u32::from_be_bytes(data[4..8].try_into().unwrap());
+                return Some((x, y, data[8]));
+            }
+            at += 12 + len;
+        }
+        None
+    };
+    // 254 dpi is 100 pixels a centimetre, 10,000 a metre.
+    let o = run(&["--size", "5cmx40mm", "--dpi", "254"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let img = image::open(&out).unwrap();
+    assert_eq!((img.width(), img.height()), (500, 400));
+    assert_eq!(
+        phys(&std::fs::read(&out).unwrap()),
+        Some((10_000, 10_000, 1))
+    );
+    // Pixels at 300 dpi: the same picture as without --dpi, and the chunk.
+    let o = run(&["--size", "320x240", "--dpi", "300"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let with = image::open(&out).unwrap().to_rgba8();
+    assert_eq!(
+        phys(&std::fs::read(&out).unwrap()),
+        Some((11_811, 11_811, 1))
+    );
+    let o = run(&["--size", "320x240"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(phys(&std::fs::read(&out).unwrap()), None);
+    assert!(with == image::open(&out).unwrap().to_rgba8());
+    for bad in [
+        &["--size", "5cmx4cm"][..],
+        &["--dpi", "0"],
+        &["--dpi", "nan"],
+        &["--size", "500inx500in", "--dpi", "300"],
+    ] {
+        let o = run(bad);
+        assert_eq!(o.status.code(), Some(2), "{bad:?}: {}", stderr(&o));
+    }
+    let movie = dir.path().join("m.apng");
+    let o = texmap(&[
+        "render",
+        "--quiet",
+        input.as_str(),
+        "--dpi",
+        "300",
+        "-o",
+        movie.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+}
