@@ -962,6 +962,13 @@ pub struct MolArgs {
     /// turns it on by itself).
     #[arg(long)]
     pub displacements: bool,
+    /// Give the atoms a property NAME read from FILE, for --color-by NAME and selections
+    /// ('prop NAME > 0.5'), as VMD's user field or PyMOL's alter b=: one number per line (the
+    /// same for every frame) or one row per frame of one number per atom (frame f takes row
+    /// f), separated by spaces or commas; '#' comments; nan for no value. The atoms of FILE
+    /// (the trajectory), not of --add's files. Repeatable: --property rmsf=rmsf.txt.
+    #[arg(long = "property", value_name = "NAME=FILE")]
+    pub properties: Vec<String>,
     /// Measure displacements (--displacements, --color-by displacement, --arrows
     /// displacement) from this reference instead of the first frame drawn: a frame number of
     /// the trajectory (0 for its first) or a structure file of the same atoms (its first

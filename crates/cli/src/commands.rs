@@ -488,6 +488,26 @@ fn render(a: &RenderArgs) -> Result<()> {
         bail!("{}: the file holds no frame", a.file.display());
     }
     let frames = parse_frames(&a.frames, n)?;
+    // --property NAME=FILE: per-atom numbers from files.
+    let mut atom_values = Vec::with_capacity(a.mol.properties.len());
+    for spec in &a.mol.properties {
+        let Some((name, file)) = spec.split_once('=') else {
+            return usage(format!("--property {spec:?}: expected NAME=FILE"));
+        };
+        let name = name.trim();
+        let valid = !name.is_empty()
+            && name
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || matches!(c, '_' | '[' | ']' | '.'));
+        if !valid {
+            return usage(format!(
+                "--property {spec:?}: the name must be letters, digits, _ . [ ] (what selections and --color-by can name)"
+            ));
+        }
+        let values = texmap_md_io::values::AtomValues::open(file.trim())
+            .with_context(|| format!("--property {name}"))?;
+        atom_values.push((name.to_string(), values));
+    }
     // The other files of the scene: each with one frame, or at least as many as the file.
     let mut adds = Vec::with_capacity(a.add.len());
     for file in &a.add {
@@ -712,6 +732,19 @@ fn render(a: &RenderArgs) -> Result<()> {
         print_warnings(&traj, &mut shown);
         plan.label(&mut md, traj.name(), f)
             .map_err(|e| fail(e.into(), &written))?;
+        for (name, values) in &atom_values {
+            let v = values.for_frame(f, md.n_atoms()).map_err(|e| {
+                fail(
+                    anyhow::Error::from(e).context(format!("--property {name}")),
+                    &written,
+                )
+            })?;
+            md.properties.retain(|p| p.name != *name);
+            md.properties.push(texmap_md_io::Property {
+                name: name.clone(),
+                values: v.to_vec(),
+            });
+        }
         if !adds.is_empty() {
             plan.part_bonds(&mut md, true);
             set_file_number(&mut md, 0);

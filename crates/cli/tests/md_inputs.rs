@@ -2995,3 +2995,116 @@ fn dpi_sizes_print_units_and_is_written_into_the_png() {
     ]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
 }
+
+/// `--property NAME=FILE`: numbers numpy wrote (MDAnalysis's RMSF as a column, per-frame
+/// distances as CSV rows) select exactly the atoms numpy selects with them: the picture of
+/// `prop rmsf > m` is the picture of those atoms' indices, in frame 3 with the frame's row too;
+/// a wrong count, a frame past the rows and a bad spec are errors.
+#[test]
+fn per_atom_values_from_files_colour_and_select() {
+    let dir = tempfile::tempdir().unwrap();
+    let values = |name: &str| {
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/data/values")
+            .join(name)
+            .to_string_lossy()
+            .into_owned()
+    };
+    let reference: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(values("values_reference.json")).unwrap())
+            .unwrap();
+    let indices = |key: &str| -> String {
+        let list: Vec<String> = reference[key]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.to_string())
+            .collect();
+        format!("index {}", list.join(" "))
+    };
+    let (xtc, gro) = (data("topo_mda.xtc"), data("topo_mda.gro"));
+    let rmsf = format!("rmsf={}", values("rmsf.txt"));
+    let dist = format!("dist={}", values("dist.csv"));
+    let base = [
+        xtc.as_str(),
+        "--topology",
+        gro.as_str(),
+        "--size",
+        "240x180",
+        "--frames",
+        "3",
+    ];
+    let m = reference["rmsf_threshold"].as_f64().unwrap();
+    let by_value = format!("prop rmsf > {m}");
+    let picked = render_rgb(
+        dir.path(),
+        "picked.png",
+        &[&base[..], &["--property", &rmsf, "--select", &by_value]].concat(),
+    );
+    let by_index = indices("rmsf_above");
+    let listed = render_rgb(
+        dir.path(),
+        "listed.png",
+        &[&base[..], &["--select", &by_index]].concat(),
+    );
+    assert!(picked == listed, "prop rmsf > {m} selects numpy's atoms");
+    let picked = render_rgb(
+        dir.path(),
+        "near.png",
+        &[
+            &base[..],
+            &["--property", &dist, "--select", "prop dist < 6"],
+        ]
+        .concat(),
+    );
+    let by_index = indices("dist_frame3_below_6");
+    let listed = render_rgb(
+        dir.path(),
+        "near_listed.png",
+        &[&base[..], &["--select", &by_index]].concat(),
+    );
+    assert!(picked == listed, "frame 3 takes row 3");
+    // Coloured by it: a colour bar titled with the name.
+    let plain = render_rgb(dir.path(), "plain.png", &base);
+    let coloured = render_rgb(
+        dir.path(),
+        "rmsf.png",
+        &[&base[..], &["--property", &rmsf, "--color-by", "rmsf"]].concat(),
+    );
+    assert!(plain != coloured);
+    // Errors: another atom count (exit 1, naming the file and line), too few rows, bad specs.
+    let short = dir.path().join("short.txt");
+    std::fs::write(&short, "1\n2\n3\n").unwrap();
+    let out = dir.path().join("x.png");
+    let run = |spec: &str, frames: &str| {
+        texmap(&[
+            "render",
+            "--quiet",
+            &xtc,
+            "--topology",
+            &gro,
+            "--frames",
+            frames,
+            "--property",
+            spec,
+            "-o",
+            out.to_str().unwrap(),
+        ])
+    };
+    let o = run(&format!("short={}", short.display()), "0");
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr(&o).contains("short.txt") && stderr(&o).contains("3 values for 66 atoms"),
+        "{}",
+        stderr(&o)
+    );
+    let rows = dir.path().join("rows.txt");
+    std::fs::write(&rows, format!("{}\n", vec!["1"; 66].join(" "))).unwrap();
+    let o = run(&format!("r={}", rows.display()), "0:2");
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("1 rows"), "{}", stderr(&o));
+    for bad in ["noequals", "bad name=x.txt", "=x.txt"] {
+        assert_eq!(run(bad, "0").status.code(), Some(2), "{bad}");
+    }
+    assert!(!out.exists());
+}

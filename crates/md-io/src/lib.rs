@@ -26,6 +26,8 @@
 //!   [`coordination`] counts each atom's neighbours within a cutoff, and [`cna`] classifies
 //!   its crystal structure, as OVITO's analyses do; [`hbonds`] finds hydrogen bonds by
 //!   MDAnalysis's geometric criterion.
+//! - [`values`] reads per-atom numbers from a text file (an analysis result, a column or a row
+//!   per frame) to give the frames as a property.
 //! - [`volume`] reads volumetric data (Gaussian cube; VASP CHGCAR, CHG, PARCHG, LOCPOT, ELFCAR,
 //!   AECCAR) into grids with their atoms ([`volume::read_volumes`]); as trajectories these
 //!   files are one frame, the atoms (`Format::Cube`, `Format::Vasp`).
@@ -129,6 +131,7 @@ mod text;
 mod topology;
 mod trajectory;
 mod trr;
+pub mod values;
 mod vasp;
 pub mod volume;
 mod writer;
