@@ -3034,36 +3034,24 @@ fn per_atom_values_from_files_colour_and_select() {
         "--frames",
         "3",
     ];
+    // The picture of the atoms a property selects against the picture of numpy's indices.
+    let same = |property: &str, select: &str, key: &str| {
+        let args = [&base[..], &["--property", property, "--select", select]].concat();
+        let picked = render_rgb(dir.path(), &format!("{key}.png"), &args);
+        let by_index = indices(key);
+        let args = [&base[..], &["--select", &by_index]].concat();
+        picked == render_rgb(dir.path(), &format!("{key}_listed.png"), &args)
+    };
     let m = reference["rmsf_threshold"].as_f64().unwrap();
     let by_value = format!("prop rmsf > {m}");
-    let picked = render_rgb(
-        dir.path(),
-        "picked.png",
-        &[&base[..], &["--property", &rmsf, "--select", &by_value]].concat(),
+    assert!(
+        same(&rmsf, &by_value, "rmsf_above"),
+        "{by_value} selects numpy's atoms"
     );
-    let by_index = indices("rmsf_above");
-    let listed = render_rgb(
-        dir.path(),
-        "listed.png",
-        &[&base[..], &["--select", &by_index]].concat(),
+    assert!(
+        same(&dist, "prop dist < 6", "dist_frame3_below_6"),
+        "frame 3 takes row 3"
     );
-    assert!(picked == listed, "prop rmsf > {m} selects numpy's atoms");
-    let picked = render_rgb(
-        dir.path(),
-        "near.png",
-        &[
-            &base[..],
-            &["--property", &dist, "--select", "prop dist < 6"],
-        ]
-        .concat(),
-    );
-    let by_index = indices("dist_frame3_below_6");
-    let listed = render_rgb(
-        dir.path(),
-        "near_listed.png",
-        &[&base[..], &["--select", &by_index]].concat(),
-    );
-    assert!(picked == listed, "frame 3 takes row 3");
     // Coloured by it: a colour bar titled with the name.
     let plain = render_rgb(dir.path(), "plain.png", &base);
     let coloured = render_rgb(
