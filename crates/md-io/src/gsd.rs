@@ -31,7 +31,7 @@
 //! | `particles/types`, `particles/typeid` | [`Frame::types`] and [`Frame::names`]: the type name; [`Frame::elements`] when some type name is an element symbol written as one (`Na`, not `A` or `Colloid`) | `A`, 0 |
 //! | `particles/position` | [`Frame::positions`], as written | 0 0 0 |
 //! | `particles/diameter` | [`Frame::radii`], halved | 1 |
-//! | `particles/velocity` | properties `vx vy vz` | 0 0 0 |
+//! | `particles/velocity` | [`Frame::velocities`] | 0 0 0 |
 //! | `particles/mass`, `particles/charge`, `particles/body` | properties `mass`, `charge`, `body` | 1, 0, −1 |
 //! | `particles/orientation` (r, a<sub>x</sub>, a<sub>y</sub>, a<sub>z</sub>) | properties `quatw quati quatj quatk` | 1 0 0 0 |
 //! | `particles/image` | properties `ix iy iz` | 0 0 0 |
@@ -41,11 +41,11 @@
 //! Elements follow the LAMMPS data reader's rule for type labels, so HOOMD's customary type
 //! `B` is boron (drawn in boron's colour unless styled by type) while `A` has no element.
 //!
-//! A property is in every frame when some frame of the file has its chunk (its values in the
-//! other frames by the rule above), and in none otherwise: a file without orientations gets no
-//! column of unit quaternions. The property names are those the LAMMPS readers give the same
-//! quantities (`vx`, `charge`, `ix`; a dump's `quatw …`), so arrows (`v`) and colour by property
-//! reach them alike. Type, angle, dihedral, improper, constraint, pair and `log/` chunks,
+//! A property (and the velocities) is in every frame when some frame of the file has its chunk
+//! (its values in the other frames by the rule above), and in none otherwise: a file without
+//! orientations gets no column of unit quaternions. The property names are those the LAMMPS
+//! readers give the same quantities (`charge`, `ix`; a dump's `quatw …`), so colour by property
+//! and the ellipsoids reach them alike. Type, angle, dihedral, improper, constraint, pair and `log/` chunks,
 //! shapes other than ellipsoids (polyhedra, spheropolygons), `moment_inertia` and `angmom`
 //! are not read.
 //!
@@ -59,8 +59,8 @@
 //!
 //! **Units.** HOOMD has no fixed units (reduced units, or whatever the user chose): positions
 //! and box lengths are read as Å unchanged, so a box of 10 σ is drawn as 10 Å, with diameters
-//! of 1 σ as radii of 0.5 Å. Velocities are properties rather than [`Frame::velocities`]
-//! (Å/ps), as in the LAMMPS data reader: no conversion to Å/ps can be justified.
+//! of 1 σ as radii of 0.5 Å; velocities likewise as Å/ps unchanged (length per time unit, as a
+//! LAMMPS dump in `lj` units is read), so `--arrows velocity` and colour by speed work.
 //!
 //! # Why our own reader
 //! No Rust crate reads GSD, and binding the reference C library (gsd.c) would add a C build
@@ -775,6 +775,20 @@ impl<R: Read + Seek> GsdReader<R> {
         }
         for p in &PROPERTIES {
             self.property(frame, k, p, counts)?;
+        }
+        // The velocity columns are the frame's velocities (read as Å/ps, as positions as Å).
+        let at = ["vx", "vy", "vz"].map(|v| frame.properties.iter().position(|p| p.name == v));
+        if let [Some(x), Some(y), Some(z)] = at {
+            let [vx, vy, vz] = [x, y, z].map(|i| std::mem::take(&mut frame.properties[i].values));
+            frame.velocities = vx
+                .iter()
+                .zip(&vy)
+                .zip(&vz)
+                .map(|((x, y), z)| [*x, *y, *z])
+                .collect();
+            frame
+                .properties
+                .retain(|p| !matches!(p.name.as_str(), "vx" | "vy" | "vz"));
         }
         self.bonds(k, frame, n)?;
         Ok(Some(cell))
