@@ -146,32 +146,14 @@ pub fn frame_files(dir: &Path) -> Result<Vec<PathBuf>> {
             files.push(p);
         }
     }
-    files.sort_by_key(|p| natural_key(&p.file_name().unwrap_or_default().to_string_lossy()));
+    let name = |p: &PathBuf| {
+        p.file_name()
+            .unwrap_or_default()
+            .to_string_lossy()
+            .into_owned()
+    };
+    files.sort_by(|a, b| texmap_md_io::sequence::natural_cmp(&name(a), &name(b)));
     Ok(files)
-}
-
-/// A sort key that compares digit runs as numbers.
-fn natural_key(s: &str) -> Vec<(u8, u128, String)> {
-    let mut key = Vec::new();
-    let mut rest = s;
-    while !rest.is_empty() {
-        let digits = rest
-            .find(|c: char| !c.is_ascii_digit())
-            .unwrap_or(rest.len());
-        if digits > 0 {
-            let (d, r) = rest.split_at(digits);
-            key.push((0, d.parse().unwrap_or(u128::MAX), String::new()));
-            rest = r;
-        } else {
-            let text = rest
-                .find(|c: char| c.is_ascii_digit())
-                .unwrap_or(rest.len());
-            let (t, r) = rest.split_at(text);
-            key.push((1, 0, t.to_string()));
-            rest = r;
-        }
-    }
-    key
 }
 
 /// `texmap movie DIR -o OUT`: every PNG frame of `dir`, in order, into the movie `out`.
@@ -224,7 +206,7 @@ mod tests {
     #[test]
     fn frames_sort_by_their_numbers() {
         let mut v = vec!["f10.png", "f2.png", "f1.png", "a.png", "f02b.png"];
-        v.sort_by_key(|s| natural_key(s));
+        v.sort_by(|a, b| texmap_md_io::sequence::natural_cmp(a, b));
         assert_eq!(v, ["a.png", "f1.png", "f2.png", "f02b.png", "f10.png"]);
     }
 

@@ -668,8 +668,26 @@ impl<R: Read + Seek> GsdReader<R> {
         p: &PropertyChunk,
         counts: (u64, u64),
     ) -> Result<(), Error> {
-        if !self.in_file[p.chunk as usize] {
+        if !self.columns(k, p, counts)? {
             return Ok(());
+        }
+        let cols = p.names.len();
+        for (j, name) in p.names.iter().enumerate() {
+            let values = self.reals.iter().skip(j).step_by(cols).copied().collect();
+            frame.properties.push(Property {
+                name: (*name).to_string(),
+                values,
+            });
+        }
+        Ok(())
+    }
+
+    /// The values of `p`'s chunk for frame `k` of `counts` = (N, frame 0's N) particles into
+    /// `self.reals`, row by row (the chunk by the schema's rule, else the default); false, and
+    /// nothing read, when no frame of the file has the chunk.
+    fn columns(&mut self, k: usize, p: &PropertyChunk, counts: (u64, u64)) -> Result<bool, Error> {
+        if !self.in_file[p.chunk as usize] {
+            return Ok(false);
         }
         let (n, n0) = counts;
         let cols = p.names.len();
@@ -688,14 +706,7 @@ impl<R: Read + Seek> GsdReader<R> {
                 }
             }
         }
-        for (j, name) in p.names.iter().enumerate() {
-            let values = self.reals.iter().skip(j).step_by(cols).copied().collect();
-            frame.properties.push(Property {
-                name: (*name).to_string(),
-                values,
-            });
-        }
-        Ok(())
+        Ok(true)
     }
 
     /// Reads frame `k` into `frame`; gives its cell.
@@ -776,19 +787,10 @@ impl<R: Read + Seek> GsdReader<R> {
         for p in &PROPERTIES {
             self.property(frame, k, p, counts)?;
         }
-        // The velocity columns are the frame's velocities (read as Å/ps, as positions as Å).
-        let at = ["vx", "vy", "vz"].map(|v| frame.properties.iter().position(|p| p.name == v));
-        if let [Some(x), Some(y), Some(z)] = at {
-            let [vx, vy, vz] = [x, y, z].map(|i| std::mem::take(&mut frame.properties[i].values));
-            frame.velocities = vx
-                .iter()
-                .zip(&vy)
-                .zip(&vz)
-                .map(|((x, y), z)| [*x, *y, *z])
-                .collect();
-            frame
-                .properties
-                .retain(|p| !matches!(p.name.as_str(), "vx" | "vy" | "vz"));
+        // The frame's velocities (read as Å/ps, as positions as Å).
+        if self.columns(k, &VELOCITY, counts)? {
+            let v = self.reals.chunks_exact(3).map(|c| [c[0], c[1], c[2]]);
+            frame.velocities.extend(v);
         }
         self.bonds(k, frame, n)?;
         Ok(Some(cell))
@@ -1063,9 +1065,18 @@ struct PropertyChunk {
     expected: &'static str,
 }
 
+/// The velocities: the frame's [`Frame::velocities`], read like a property's columns.
+const VELOCITY: PropertyChunk = PropertyChunk {
+    chunk: Chunk::Velocity,
+    class: Class::Real,
+    names: &["vx", "vy", "vz"],
+    default: &[0.0; 3],
+    expected: "particles/velocity: N × 3 float or double, N = particles/N",
+};
+
 /// The per-particle chunks that become properties, in the schema's order; names as the LAMMPS
 /// readers give the same quantities.
-const PROPERTIES: [PropertyChunk; 6] = [
+const PROPERTIES: [PropertyChunk; 5] = [
     PropertyChunk {
         chunk: Chunk::Mass,
         class: Class::Real,
@@ -1093,13 +1104,6 @@ const PROPERTIES: [PropertyChunk; 6] = [
         names: &["quatw", "quati", "quatj", "quatk"],
         default: &[1.0, 0.0, 0.0, 0.0],
         expected: "particles/orientation: N × 4 float or double, N = particles/N",
-    },
-    PropertyChunk {
-        chunk: Chunk::Velocity,
-        class: Class::Real,
-        names: &["vx", "vy", "vz"],
-        default: &[0.0; 3],
-        expected: "particles/velocity: N × 3 float or double, N = particles/N",
     },
     PropertyChunk {
         chunk: Chunk::Image,
