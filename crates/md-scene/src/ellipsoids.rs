@@ -306,31 +306,6 @@ fn pixels_per_unit(camera: &Camera, depth: f32) -> f32 {
     }
 }
 
-/// Whether the sphere of `radius` around `center` may show in `camera`'s view.
-fn may_show(camera: &Camera, center: Vec3, radius: f32) -> bool {
-    let pe = camera.world_to_eye(center);
-    let depth = -pe.z;
-    if depth + radius < camera.near() || depth - radius > camera.far() {
-        return false;
-    }
-    let (w, h) = (camera.width() as f32 * 0.5, camera.height() as f32 * 0.5);
-    if camera.is_orthographic() {
-        let r = radius * camera.scale();
-        let (x, y) = (pe.x * camera.scale(), pe.y * camera.scale());
-        return x + r >= -w && x - r <= w && y + r >= -h && y - r <= h;
-    }
-    // The four side planes of the view pyramid through the eye, normals inward (right, left,
-    // top, bottom): a sphere wholly on the outer side of one does not show.
-    let k = camera.scale();
-    let sides = [
-        Vec3::new(-k, 0.0, -w),
-        Vec3::new(k, 0.0, -w),
-        Vec3::new(0.0, -k, -h),
-        Vec3::new(0.0, k, -h),
-    ];
-    sides.iter().all(|n| n.dot(pe) / n.length() >= -radius)
-}
-
 /// The meshes of `ellipsoids`. With a camera (a picture), each at the coarsest level that
 /// keeps its silhouette within `tolerance_px` pixels, and those wholly outside the view left
 /// out; without one (a model to export), every ellipsoid at the level that keeps its mesh
@@ -344,7 +319,7 @@ pub fn tessellate(ellipsoids: &[Ellipsoid], camera: Option<&Camera>, tolerance_p
         }
         let level = match camera {
             Some(cam) => {
-                if !may_show(cam, e.center, radius) {
+                if cam.sphere_outside_view(e.center, radius) {
                     continue;
                 }
                 let depth = -cam.world_to_eye(e.center).z - radius;

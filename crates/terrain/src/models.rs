@@ -568,21 +568,6 @@ impl ModelStats {
     }
 }
 
-/// The view frustum's four side planes and the eye plane as unit normals (`n · (p − eye) ≤ 0`
-/// inside).
-fn frustum_normals(cam: &Camera) -> [Vec3; 5] {
-    let k = cam.scale();
-    let tx = 0.5 * cam.width() as f32 / k;
-    let ty = 0.5 * cam.height() as f32 / k;
-    let (f, r, u) = (cam.forward(), cam.right(), cam.up());
-    [r - f * tx, -r - f * tx, u - f * ty, -u - f * ty, -f].map(|n| n.normalize_or_zero())
-}
-
-/// Whether a sphere lies entirely outside one plane of the frustum.
-fn sphere_culled(normals: &[Vec3; 5], eye: Vec3, center: Vec3, radius: f32) -> bool {
-    normals.iter().any(|n| n.dot(center - eye) > radius)
-}
-
 /// Draw placed models into `fb` (not cleared: draw the terrain first) with `sampler`, culling
 /// those outside the frustum. The camera's size must be the framebuffer's.
 pub fn draw_models(
@@ -591,15 +576,13 @@ pub fn draw_models(
     sampler: Sampler,
     fb: &mut Framebuffer,
 ) -> Result<ModelStats, ModelError> {
-    let normals = frustum_normals(camera);
-    let eye = camera.eye();
     let state = DrawState {
         cull: Cull::None,
         ..DrawState::default()
     };
     let mut stats = ModelStats::default();
     for m in models {
-        if m.triangles.is_empty() || sphere_culled(&normals, eye, m.center, m.radius) {
+        if m.triangles.is_empty() || camera.sphere_outside_view(m.center, m.radius) {
             stats.models_culled += 1;
             continue;
         }
@@ -859,7 +842,6 @@ pub fn draw_trees(
             target: (fb.width(), fb.height()),
         }));
     }
-    let normals = frustum_normals(camera);
     let eye = camera.eye();
     let near = camera.near();
     let mut stats = ModelStats::default();
@@ -878,7 +860,7 @@ pub fn draw_trees(
             && t.width > 0.0;
         let center = t.base + Vec3::Y * (0.5 * t.height);
         let radius = 0.5 * Vec2::new(t.width, t.height).length();
-        if !valid || sphere_culled(&normals, eye, center, radius) {
+        if !valid || camera.sphere_outside_view(center, radius) {
             stats.trees_culled += 1;
             continue;
         }

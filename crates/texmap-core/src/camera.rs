@@ -420,6 +420,39 @@ impl Camera {
         self.eye_to_screen(pe).map(|s| (s, -pe.z))
     }
 
+    /// Whether the sphere of `radius` around world point `center` lies wholly outside the view:
+    /// behind the eye's plane, or beyond one side of the image (perspective: the pyramid's side
+    /// planes through the eye; orthographic: the box's sides). Culling may skip such a sphere.
+    /// One only beyond the near or far plane is not reported: the clip planes remove it.
+    pub fn sphere_outside_view(&self, center: Vec3, radius: f32) -> bool {
+        let pe = self.world_to_eye(center);
+        if pe.z > radius {
+            return true;
+        }
+        let (w, h) = (self.width as f32 * 0.5, self.height as f32 * 0.5);
+        match self.projection {
+            Projection::Perspective { .. } => {
+                let k = self.scale;
+                // Outward normals of the right, left, top and bottom planes through the eye.
+                [
+                    Vec3::new(k, 0.0, w),
+                    Vec3::new(-k, 0.0, w),
+                    Vec3::new(0.0, k, h),
+                    Vec3::new(0.0, -k, h),
+                ]
+                .iter()
+                .any(|n| n.dot(pe) > radius * n.length())
+            }
+            Projection::Orthographic { .. } => {
+                let (hx, hy) = (w / self.scale, h / self.scale);
+                pe.x - radius > hx
+                    || -pe.x - radius > hx
+                    || pe.y - radius > hy
+                    || -pe.y - radius > hy
+            }
+        }
+    }
+
     /// The world ray through screen position `(x, y)` in pixels (use `i + 0.5, j + 0.5` for the
     /// centre of pixel (i, j)). Perspective rays start at the eye; orthographic rays start on the
     /// plane through the eye perpendicular to the view direction. The ray parameter `t` equals
@@ -473,6 +506,25 @@ impl Camera {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn spheres_outside_the_view_are_told() {
+        // 90° across 200 px: the side planes are x = ±depth (and y = ±depth/2 for 100 px).
+        let cam =
+            Camera::perspective_look_at(Vec3::ZERO, Vec3::NEG_Z, Vec3::Y, 90.0, 200, 100).unwrap();
+        let out = |x: f32, y: f32, z: f32, r: f32| cam.sphere_outside_view(Vec3::new(x, y, z), r);
+        assert!(!out(0.0, 0.0, -10.0, 1.0));
+        // Beside the right edge: 1.5 from the plane x = 10 (distance 1.5 / √2 ≈ 1.06).
+        assert!(out(11.5, 0.0, -10.0, 1.0));
+        assert!(!out(11.5, 0.0, -10.0, 1.1));
+        assert!(out(0.0, -6.5, -10.0, 1.0) && !out(0.0, -5.5, -10.0, 1.0));
+        // Behind the eye; reaching across its plane.
+        assert!(out(0.0, 0.0, 2.0, 1.0) && !out(0.0, 0.0, 0.5, 1.0));
+        let ortho = Camera::orthographic_look_at(Vec3::ZERO, Vec3::NEG_Z, Vec3::Y, 20.0, 200, 100)
+            .unwrap();
+        let out = |x: f32, r: f32| ortho.sphere_outside_view(Vec3::new(x, 0.0, -5.0), r);
+        assert!(out(11.5, 1.0) && !out(10.5, 1.0) && !out(-10.5, 1.0) && out(-11.5, 1.0));
+    }
 
     fn cam() -> Camera {
         Camera::perspective_look_at(
