@@ -520,8 +520,8 @@ mod tests {
         assert!(out(0.0, -6.5, -10.0, 1.0) && !out(0.0, -5.5, -10.0, 1.0));
         // Behind the eye; reaching across its plane.
         assert!(out(0.0, 0.0, 2.0, 1.0) && !out(0.0, 0.0, 0.5, 1.0));
-        let ortho = Camera::orthographic_look_at(Vec3::ZERO, Vec3::NEG_Z, Vec3::Y, 20.0, 200, 100)
-            .unwrap();
+        let ortho =
+            Camera::orthographic_look_at(Vec3::ZERO, Vec3::NEG_Z, Vec3::Y, 20.0, 200, 100).unwrap();
         let out = |x: f32, r: f32| ortho.sphere_outside_view(Vec3::new(x, 0.0, -5.0), r);
         assert!(out(11.5, 1.0) && !out(10.5, 1.0) && !out(-10.5, 1.0) && out(-11.5, 1.0));
     }
