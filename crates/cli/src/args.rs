@@ -60,7 +60,8 @@ pub enum Command {
     /// file (PSF, AMBER prmtop) its atoms, residues, bonds, chains and segments.
     Info {
         /// Trajectory file (XYZ, extended XYZ, PDB, PDBx/mmCIF, GRO, LAMMPS dump, DCD, XTC, TRR,
-        /// AMBER NetCDF, HOOMD-blue GSD, SDF/MOL and MOL2 with their bonds, one frame per
+        /// AMBER NetCDF, AMBER ASCII mdcrd (with --topology: the file has no atom count) and
+        /// rst7/inpcrd, HOOMD-blue GSD, SDF/MOL and MOL2 with their bonds, one frame per
         /// record, VASP POSCAR/CONTCAR/XDATCAR, crystallographic CIF, a LAMMPS data file),
         /// gzip-compressed or not (1abc.cif.gz). A quoted pattern ('dump.*.lammpstrj') reads
         /// the files it matches in natural order as one trajectory.

@@ -108,6 +108,19 @@ fn print_warnings(traj: &Sequence, shown: &mut usize) {
     *shown = traj.warnings().len();
 }
 
+/// `options` with what a trajectory may need from its topology: the atom count and box angles
+/// an AMBER ASCII trajectory does not hold (other formats ignore them).
+fn with_topology(options: ReadOptions, topology: Option<&texmap_md_io::Topology>) -> ReadOptions {
+    let Some(t) = topology else {
+        return options;
+    };
+    let options = options.atoms(t.n_atoms());
+    match t.box_angles {
+        Some(angles) => options.box_angles(angles),
+        None => options,
+    }
+}
+
 fn open_trajectory_with(
     file: &Path,
     format: Option<&str>,
@@ -184,8 +197,9 @@ fn info(
     let files: Vec<PathBuf> = std::iter::once(file.to_path_buf())
         .chain(more.iter().cloned())
         .collect();
-    let mut traj = open_parts(&files, format, options)?;
     let topo = topology.map(crate::scene::open_topology).transpose()?;
+    let options = with_topology(options, topo.as_ref());
+    let mut traj = open_parts(&files, format, options)?;
     let mut frame = MdFrame::new();
     let frames = traj.n_frames()?;
     print_warnings(&traj, &mut 0);
@@ -476,11 +490,21 @@ fn render(a: &RenderArgs) -> Result<()> {
         return usage(format!("--dpi {dpi}: expected 1 to 100000 dots per inch"));
     }
     let size = crate::scene::parse_print_size(&a.camera.size, a.dpi)?;
+    let topology = a
+        .mol
+        .topology
+        .as_deref()
+        .map(crate::scene::open_topology)
+        .transpose()?;
     let options = ReadOptions::new().allow_truncated(a.allow_truncated);
     let files: Vec<PathBuf> = std::iter::once(a.file.clone())
         .chain(a.more.iter().cloned())
         .collect();
-    let mut traj = open_parts(&files, a.format.as_deref(), options)?;
+    let mut traj = open_parts(
+        &files,
+        a.format.as_deref(),
+        with_topology(options, topology.as_ref()),
+    )?;
     let n = traj.n_frames()?;
     let mut shown = 0;
     print_warnings(&traj, &mut shown);
@@ -554,7 +578,7 @@ fn render(a: &RenderArgs) -> Result<()> {
     }
     let mut quality_renderer = texmap_quality::QualityRenderer::new();
     let mut builder = crate::scene::scene_builder(&a.style)?;
-    let mut plan = crate::scene::mol_plan(&a.mol, &a.style)?;
+    let mut plan = crate::scene::mol_plan(&a.mol, &a.style, topology)?;
     let surface_options = crate::scene::surface_options(&a.mol)?;
     let surface_opacity = a.mol.surface_opacity;
     let polyhedra_opacity = a.mol.polyhedra_opacity;

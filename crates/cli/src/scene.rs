@@ -461,15 +461,15 @@ pub fn surface_options(args: &MolArgs) -> Result<texmap_md_scene::surface::Surfa
 }
 
 /// What `render` does to a frame between reading and drawing ([`MolPlan`]) for the
-/// [`MolArgs`]: the topology file read, the selections and colours parsed.
-pub fn mol_plan(args: &MolArgs, style: &StyleArgs) -> Result<MolPlan> {
+/// [`MolArgs`] and the `--topology` file's `topology` (read by the caller, whose trajectory
+/// may need its atom count): the selections and colours parsed.
+pub fn mol_plan(args: &MolArgs, style: &StyleArgs, topology: Option<Topology>) -> Result<MolPlan> {
     if args.trail_length == Some(0) {
         return Err(crate::args::UsageError(
             "--trail-length 0: expected at least 1 frame (the current one)".into(),
         )
         .into());
     }
-    let topology = args.topology.as_deref().map(open_topology).transpose()?;
     let optional = |flag, text: &Option<String>| {
         text.as_deref()
             .map(|t| parse_selection(flag, t))

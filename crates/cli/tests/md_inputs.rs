@@ -3096,3 +3096,59 @@ fn per_atom_values_from_files_colour_and_select() {
     }
     assert!(!out.exists());
 }
+
+/// An AMBER ASCII trajectory (ParmEd's mdcrd of amber_mda.ncdf's frames, md-io's
+/// tests/data/amber_ascii) read with its prmtop: the atom count and the truncated octahedron's
+/// angles come from the topology, and a frame draws as the NetCDF's same frame does (the
+/// positions differ by the mdcrd's 0.0005 Å rounding). Without a topology: exit 1, naming
+/// --topology.
+#[test]
+fn amber_ascii_trajectory_reads_its_atom_count_from_the_prmtop() {
+    let o = texmap(&[
+        "info",
+        &data("amber_ascii/box.mdcrd"),
+        "--topology",
+        &data("amber_ascii/truncoct.parm7"),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["format"], "mdcrd");
+    assert_eq!(
+        (v["atoms"].as_u64(), v["frames"].as_u64()),
+        (Some(66), Some(5))
+    );
+    let b: Vec<f64> = (0..6).map(|k| v["box"][k].as_f64().unwrap()).collect();
+    assert_eq!(&b[..3], &[18.0, 18.5, 19.0]);
+    assert!(
+        b[3..].iter().all(|a| (a - 109.4712206).abs() < 1e-6),
+        "{b:?}"
+    );
+
+    let o = texmap(&["info", &data("amber_ascii/box.mdcrd")]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("--topology"), "{}", stderr(&o));
+
+    let dir = tempfile::tempdir().unwrap();
+    let draw = |traj: &str, name: &str| {
+        let out = dir.path().join(name);
+        let o = texmap(&[
+            "render",
+            &data(traj),
+            "--topology",
+            &data("prmtop_parmed.prmtop"),
+            "--frames",
+            "2",
+            "--size",
+            "160x120",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{traj}: {}", stderr(&o));
+        out
+    };
+    let a = draw("amber_ascii/nobox.mdcrd", "mdcrd.png");
+    let b = draw("amber_mda.ncdf", "ncdf.png");
+    let d = mean_abs_diff(&a, &b);
+    assert!(lit(&a) > 1000, "{}", lit(&a));
+    assert!(d < 0.5, "mean |difference| {d}");
+}

@@ -46,11 +46,19 @@ pub enum Format {
     /// Gaussian cube file, one frame (the molecule; its grid values are checked, not kept: see
     /// [`crate::volume::read_volumes`]): `.cube`, `.cub`.
     Cube,
+    /// AMBER ASCII trajectory (`10F8.3`, optional box lines), read with the topology's atom
+    /// count ([`crate::ReadOptions::atoms`]): `.mdcrd`, `.trj`, a file named `mdcrd`, and a
+    /// `.crd` whose second line is coordinates; by name: `mdcrd`.
+    AmberTrj,
+    /// AMBER ASCII restart / input coordinates (`6F12.7`, optional velocities and box), one
+    /// frame: `.rst7`, `.inpcrd`, `.restrt`, files named `inpcrd` or `restrt`, and a `.crd`
+    /// whose second line is the atom count; by name: `rst7`.
+    AmberRestart,
 }
 
 impl Format {
     /// Every format, in declaration order.
-    pub const ALL: [Format; 16] = [
+    pub const ALL: [Format; 18] = [
         Format::Xyz,
         Format::Pdb,
         Format::Gro,
@@ -67,6 +75,8 @@ impl Format {
         Format::CrystalCif,
         Format::LammpsData,
         Format::Cube,
+        Format::AmberTrj,
+        Format::AmberRestart,
     ];
 
     /// The format a file extension (case-insensitive, e.g. "xyz", "lammpstrj") or a format's
@@ -90,6 +100,8 @@ impl Format {
             "cif-crystal" => Format::CrystalCif,
             "data" | "lmp" | "lammps-data" => Format::LammpsData,
             "cube" | "cub" => Format::Cube,
+            "mdcrd" | "trj" | "crd" => Format::AmberTrj,
+            "rst7" | "inpcrd" | "restrt" => Format::AmberRestart,
             _ => return None,
         })
     }
@@ -121,6 +133,13 @@ impl Format {
             .is_some();
         if vasp || volumetric {
             return Some(Format::Vasp);
+        }
+        // AMBER's default file names.
+        if name.eq_ignore_ascii_case(b"mdcrd") {
+            return Some(Format::AmberTrj);
+        }
+        if name.eq_ignore_ascii_case(b"inpcrd") || name.eq_ignore_ascii_case(b"restrt") {
+            return Some(Format::AmberRestart);
         }
         // The LAMMPS examples' names: `data.peptide`, `data.lj`.
         (name.len() > 5 && name[..5].eq_ignore_ascii_case(b"data.")).then_some(Format::LammpsData)
@@ -205,10 +224,45 @@ impl Format {
         if looks_like_lammps_data(head) {
             return Some(Format::LammpsData);
         }
+        if let Some(amber) = Format::amber_kind(head) {
+            return Some(amber);
+        }
         if lines.next().is_some_and(is_count) {
             return Some(Format::Gro);
         }
         None
+    }
+
+    /// Which AMBER ASCII file the first bytes show, if either: after the title, an atom count
+    /// (and time) then `6F12.7` coordinates is a restart ([`Format::AmberRestart`]); a line of
+    /// `10F8.3` coordinates is a trajectory ([`Format::AmberTrj`]). A `.crd` file is told by
+    /// this ([`crate::Trajectory::open`]); `None` for anything else.
+    pub fn amber_kind(head: &[u8]) -> Option<Format> {
+        use crate::parse::{fields, parse_f64, parse_usize, span, trim};
+        let mut lines = head.split(|b| *b == b'\n').skip(1);
+        let second = lines.next()?;
+        // Every fixed-width field of `line` a number with a decimal point; the field count.
+        let numbers = |line: &[u8], width: usize| {
+            let t = line
+                .iter()
+                .rposition(|b| !matches!(b, b' ' | b'\t' | b'\r'))
+                .map_or(0, |e| e + 1);
+            let n = t.div_ceil(width);
+            let ok = n > 0
+                && (0..n).all(|k| {
+                    let f = trim(span(line, k * width, (k + 1) * width));
+                    f.contains(&b'.') && parse_f64(f).is_some()
+                });
+            ok.then_some(n)
+        };
+        let words: Vec<&[u8]> = fields(second).collect();
+        if let Some(n) = words.first().and_then(|w| parse_usize(w)) {
+            let time = words.len() == 1 || (words.len() == 2 && parse_f64(words[1]).is_some());
+            let third = lines.next().unwrap_or(&[]);
+            return (n > 0 && time && numbers(third, 12) == Some((3 * n).min(6)))
+                .then_some(Format::AmberRestart);
+        }
+        matches!(numbers(second, 8), Some(3..=10)).then_some(Format::AmberTrj)
     }
 
     /// Which CIF a file is, from its first bytes (`head`; [`crate::Trajectory::open`] gives up
@@ -274,6 +328,8 @@ impl Format {
                 | Format::CrystalCif
                 | Format::LammpsData
                 | Format::Cube
+                | Format::AmberTrj
+                | Format::AmberRestart
         )
     }
 
@@ -296,6 +352,8 @@ impl Format {
             Format::CrystalCif => "cif-crystal",
             Format::LammpsData => "lammps-data",
             Format::Cube => "cube",
+            Format::AmberTrj => "mdcrd",
+            Format::AmberRestart => "rst7",
         }
     }
 }

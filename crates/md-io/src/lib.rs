@@ -8,7 +8,9 @@
 //!   ICSD, Materials Project: each data block a frame, the asymmetric unit expanded by the
 //!   file's symmetry operations; a `.cif` is told from PDBx/mmCIF by its tags), LAMMPS data files
 //!   (one frame: the atom style's columns, the box, masses and their elements, velocities and
-//!   image flags as properties, the `Bonds` as [`Frame::bonds`]) (and the binary DCD, XTC,
+//!   image flags as properties, the `Bonds` as [`Frame::bonds`]), AMBER's ASCII trajectories
+//!   (mdcrd: the atom count comes from the topology, [`ReadOptions::atoms`]) and restarts
+//!   (rst7 / inpcrd, with velocities and box) (and the binary DCD, XTC,
 //!   TRR, AMBER NetCDF and HOOMD-blue GSD: particle types, diameters, per-particle properties
 //!   and bonds, by the hoomd schema's rule for what a frame omits) one frame at a time into a
 //!   reusable [`Frame`], or any frame by index.
@@ -93,6 +95,7 @@
 //! Text formats instead implement the private `TextFormat` trait (src/text.rs) and get
 //! streaming, the line-scan index and error positions from `TextReader`.
 
+mod amber;
 pub mod bonds;
 mod chgcar;
 mod cif;

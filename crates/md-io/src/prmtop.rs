@@ -14,7 +14,10 @@
 //!   times 18.2223, divided back to e);
 //! - `RESIDUE_LABEL` and `RESIDUE_POINTER` (the first atom of each residue, 1-based);
 //! - `BONDS_INC_HYDROGEN` and `BONDS_WITHOUT_HYDROGEN`: triples `3*(i-1) 3*(j-1) type`;
-//! - `RESIDUE_CHAINID` (cpptraj and ParmEd write it when the system has chains): the chains.
+//! - `RESIDUE_CHAINID` (cpptraj and ParmEd write it when the system has chains): the chains;
+//! - `BOX_DIMENSIONS` (beta, a, b, c), for the box angles an AMBER ASCII trajectory leaves out:
+//!   a truncated octahedron's beta (109.4712°) is all three angles, another beta a monoclinic
+//!   box's (90°, beta, 90°).
 //!
 //! **Residue numbers** are 1..NRES in file order, as AMBER itself, VMD and MDAnalysis number
 //! them (`resid 10` selects the tenth residue); a `RESIDUE_NUMBER` section with the numbers of
@@ -140,7 +143,7 @@ impl Section {
 }
 
 /// The sections this reader uses; the others are skipped without parsing their fields.
-const WANTED: [&str; 11] = [
+const WANTED: [&str; 12] = [
     "POINTERS",
     "CHARGE",
     "ATOM_NAME",
@@ -152,6 +155,7 @@ const WANTED: [&str; 11] = [
     "BONDS_INC_HYDROGEN",
     "BONDS_WITHOUT_HYDROGEN",
     "RESIDUE_CHAINID",
+    "BOX_DIMENSIONS",
 ];
 
 /// Splits a data line into `fmt`'s fixed-width fields and appends them to `values`. Blank
@@ -469,6 +473,28 @@ fn assemble(
     );
     topology.chains = chains;
     topology.charges = charges;
+    if let Some(s) = sections.remove("BOX_DIMENSIONS") {
+        let flag_at = at(file, &s.flag);
+        let v = s.reals(file)?;
+        let beta = match v.first() {
+            Some(&b) if v.len() == 4 && b > 0.0 && b < 180.0 => b,
+            _ => {
+                return Err(Error::InvalidValue {
+                    what: format!(
+                        "{flag_at}: %FLAG BOX_DIMENSIONS holds {v:?}, expected 4 numbers: the angle beta (0 to 180 degrees) and the box lengths"
+                    ),
+                });
+            }
+        };
+        // A truncated octahedron has all three angles at arccos(-1/3); any other beta is
+        // a monoclinic box's (alpha = gamma = 90), as cpptraj reads it.
+        const TRUNCOCT: f64 = 109.471_220_634_490_7;
+        topology.box_angles = Some(if (beta - TRUNCOCT).abs() < 0.001 {
+            [TRUNCOCT; 3]
+        } else {
+            [90.0, beta, 90.0]
+        });
+    }
     Ok(topology)
 }
 

@@ -122,6 +122,10 @@ pub struct Topology {
     pub charges: Vec<f32>,
     /// Bonds as atom index pairs `[i, j]` with `i < j`, sorted, each once.
     pub bonds: Vec<[u32; 2]>,
+    /// The periodic box's angles in degrees, when the topology gives them (AMBER prmtop
+    /// `BOX_DIMENSIONS`: a truncated octahedron's 109.47°): for trajectories whose box lines
+    /// hold lengths only ([`crate::ReadOptions::box_angles`]).
+    pub box_angles: Option<[f64; 3]>,
 }
 
 /// A text line being parsed: its number and byte offset, for errors.
@@ -355,6 +359,7 @@ impl Topology {
             segments: Vec::new(),
             charges: Vec::new(),
             bonds,
+            box_angles: None,
         }
     }
 
@@ -377,6 +382,7 @@ impl Topology {
                 .map(<[f32]>::to_vec)
                 .unwrap_or_default(),
             bonds: f.bonds.clone(),
+            box_angles: None,
         }
     }
 
@@ -402,6 +408,7 @@ impl Topology {
             segments: frame.segments.clone(),
             charges: Vec::new(),
             bonds: Vec::new(),
+            box_angles: None,
         }
     }
 

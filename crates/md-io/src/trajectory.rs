@@ -1,5 +1,6 @@
 //! [`Trajectory`]: one reader for every format, streaming or random access.
 
+use crate::amber::{AmberRestart, AmberTrj};
 use crate::crystal_cif::CrystalCif;
 use crate::cube::Cube;
 use crate::dcd::DcdReader;
@@ -43,6 +44,8 @@ enum Reader<R> {
     CrystalCif(TextReader<R, CrystalCif>),
     LammpsData(TextReader<R, LammpsData>),
     Cube(TextReader<R, Cube>),
+    AmberTrj(TextReader<R, AmberTrj>),
+    AmberRestart(TextReader<R, AmberRestart>),
 }
 
 /// Runs `$body` with `$r` bound to the format's reader, whatever the format.
@@ -65,6 +68,8 @@ macro_rules! each_reader {
             Reader::CrystalCif($r) => $body,
             Reader::LammpsData($r) => $body,
             Reader::Cube($r) => $body,
+            Reader::AmberTrj($r) => $body,
+            Reader::AmberRestart($r) => $body,
         }
     };
 }
@@ -122,11 +127,18 @@ impl<R: Read + Seek> FrameSource for Trajectory<R> {
 /// assert_eq!(lenient.warnings().len(), 1);
 /// # Ok::<(), texmap_md_io::Error>(())
 /// ```
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[non_exhaustive]
 pub struct ReadOptions {
     /// Keep the complete frames of a file whose last frame is cut short, with a warning.
     pub allow_truncated: bool,
+    /// The atom count, for a format whose files do not hold it (an AMBER ASCII trajectory,
+    /// [`Format::AmberTrj`]): the topology's. Other formats ignore it.
+    pub atoms: Option<usize>,
+    /// The cell angles (degrees) of a box that a file gives as lengths only (an AMBER ASCII
+    /// trajectory's three-number box line): the run's, from its topology (a truncated
+    /// octahedron's 109.47°, AMBER prmtop `BOX_DIMENSIONS`). Default: right angles.
+    pub box_angles: Option<[f64; 3]>,
 }
 
 impl ReadOptions {
@@ -138,6 +150,18 @@ impl ReadOptions {
     /// Sets the `allow_truncated` field.
     pub fn allow_truncated(mut self, yes: bool) -> ReadOptions {
         self.allow_truncated = yes;
+        self
+    }
+
+    /// Sets the `atoms` field.
+    pub fn atoms(mut self, n: usize) -> ReadOptions {
+        self.atoms = Some(n);
+        self
+    }
+
+    /// Sets the `box_angles` field.
+    pub fn box_angles(mut self, angles: [f64; 3]) -> ReadOptions {
+        self.box_angles = Some(angles);
         self
     }
 }
@@ -193,6 +217,28 @@ pub(crate) fn cif_kind_of(file: &mut File, path: &Path, name: &Arc<str>) -> Resu
     Ok(Format::cif_kind(&head))
 }
 
+/// True for a `.crd` name (a final `.gz` looked through): AMBER's trajectory or restart.
+fn is_crd(path: &Path) -> bool {
+    crate::gz::inner_path(path)
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("crd"))
+}
+
+/// Which file a `.crd` is, by its first lines ([`Format::amber_kind`]); the file is rewound.
+fn crd_kind_of(file: &mut File, name: &Arc<str>) -> Result<Format, Error> {
+    let io = |source| Error::Io {
+        at: crate::error::Location::file(name),
+        source,
+    };
+    let mut head = Vec::new();
+    file.take(4096).read_to_end(&mut head).map_err(io)?;
+    file.rewind().map_err(io)?;
+    Format::amber_kind(&head).ok_or_else(|| Error::Unsupported {
+        file: name.clone(),
+        what: "reading this .crd: it is neither an AMBER restart (title, atom count, 6F12.7 coordinates) nor an AMBER trajectory (title, 10F8.3 coordinates); give --format",
+    })
+}
+
 impl Trajectory<File> {
     /// Opens `path`, telling the format from the extension or else from the first bytes.
     /// A CIF (`.cif`, or first bytes `data_`) is PDBx/mmCIF or crystallographic by its tags
@@ -233,6 +279,8 @@ impl Trajectory<File> {
         };
         let format = if format == Format::Mmcif {
             cif_kind_of(&mut file, path, &name)?
+        } else if is_crd(path) {
+            crd_kind_of(&mut file, &name)?
         } else {
             format
         };
@@ -296,6 +344,17 @@ impl<R: Read + Seek> Trajectory<R> {
                 Reader::LammpsData(TextReader::new(src, LammpsData::default(), file.clone()))
             }
             Format::Cube => Reader::Cube(TextReader::new(src, Cube, file.clone())),
+            Format::AmberTrj => {
+                let n = options.atoms.ok_or_else(|| Error::Unsupported {
+                    file: file.clone(),
+                    what: "reading an AMBER ASCII trajectory without its atom count, which the file does not hold: give the topology (texmap: --topology system.prmtop; the library: ReadOptions::atoms)",
+                })?;
+                let trj = AmberTrj::new(n, options.box_angles);
+                Reader::AmberTrj(TextReader::new(src, trj, file.clone()))
+            }
+            Format::AmberRestart => {
+                Reader::AmberRestart(TextReader::new(src, AmberRestart, file.clone()))
+            }
         };
         Ok(Trajectory {
             reader,

@@ -146,14 +146,10 @@ fn read(format: Format, name: &str, bytes: &[u8], opts: ReadOptions) -> Verdict 
 /// Strict, then lenient: the strict verdict is tallied; the lenient one must not break the
 /// contract, and must agree wherever strict reading succeeded.
 fn run(format: Format) -> impl Fn(&Fixture, &[u8]) -> Verdict {
+    let base = base_options(format);
     move |fx, bytes| {
-        let strict = read(format, &fx.name, bytes, ReadOptions::new());
-        let lenient = read(
-            format,
-            &fx.name,
-            bytes,
-            ReadOptions::new().allow_truncated(true),
-        );
+        let strict = read(format, &fx.name, bytes, base);
+        let lenient = read(format, &fx.name, bytes, base.allow_truncated(true));
         // A cut of a file whose frame ends are known keeps exactly the complete frames under
         // allow_truncated (XTC and TRR cannot open without one complete frame).
         if let Cuts::FrameEnds(ends) = &fx.cuts
@@ -184,8 +180,18 @@ fn run(format: Format) -> impl Fn(&Fixture, &[u8]) -> Verdict {
     }
 }
 
+/// The options a format's fixtures are read with: an AMBER ASCII trajectory needs its
+/// topology's atom count (the fixtures': 66).
+fn base_options(format: Format) -> ReadOptions {
+    if format == Format::AmberTrj {
+        ReadOptions::new().atoms(66)
+    } else {
+        ReadOptions::new()
+    }
+}
+
 fn frames_of(format: Format, bytes: &[u8]) -> usize {
-    Trajectory::from_reader(Cursor::new(bytes), format, "good")
+    Trajectory::from_reader_with(Cursor::new(bytes), format, "good", base_options(format))
         .unwrap()
         .n_frames()
         .unwrap()
@@ -694,4 +700,14 @@ fn crystal_cif_campaign() {
     let files = ["crystal/cod_9001665.cif", "crystal/two_blocks.cif"];
     let fx = files.map(|f| text_fixture(f, Format::CrystalCif));
     campaign("crystallographic CIF", Format::CrystalCif, fx.into());
+}
+
+#[test]
+fn amber_ascii_campaign() {
+    let files = ["amber_ascii/box.mdcrd", "amber_ascii/nobox.mdcrd"];
+    let fx = files.map(|f| text_fixture(f, Format::AmberTrj));
+    campaign("AMBER mdcrd", Format::AmberTrj, fx.into());
+    let files = ["amber_ascii/vel_box.rst7", "amber_ascii/odd.inpcrd"];
+    let fx = files.map(|f| text_fixture(f, Format::AmberRestart));
+    campaign("AMBER restart", Format::AmberRestart, fx.into());
 }

@@ -30,7 +30,21 @@ const FILES: &[(&str, Format)] = &[
     ("crystal/cod_9001665.cif", Format::CrystalCif),
     ("lammps_data/ase_full.data", Format::LammpsData),
     ("lammps_data/mda_full_tri.data", Format::LammpsData),
+    ("amber_ascii/box.mdcrd", Format::AmberTrj),
+    ("amber_ascii/vel_box.rst7", Format::AmberRestart),
+    ("amber_ascii/odd.inpcrd", Format::AmberRestart),
 ];
+
+/// The options a fixture is read with: an AMBER trajectory needs its topology's atom count
+/// (box.mdcrd: 66).
+fn options(format: Format) -> texmap_md_io::ReadOptions {
+    let o = texmap_md_io::ReadOptions::new();
+    if format == Format::AmberTrj {
+        o.atoms(66)
+    } else {
+        o
+    }
+}
 
 fn data(name: &str) -> Vec<u8> {
     std::fs::read(
@@ -148,7 +162,15 @@ fn frame_ends(bytes: &[u8], format: Format) -> Vec<usize> {
             }
             ends.push(bytes.len());
         }
-        Format::LammpsData | Format::Cube => {
+        Format::AmberTrj => {
+            // The title, then per frame 20 coordinate lines (198 numbers) and a box line.
+            let mut l = 1 + 21;
+            while l <= lines.len() {
+                ends.push(line_starts[l]);
+                l += 21;
+            }
+        }
+        Format::LammpsData | Format::Cube | Format::AmberRestart => {
             // One frame: the whole file (a LAMMPS data file's sections may come in any order;
             // a cube's frame is its molecule, its grid values walked to the end).
             ends.push(bytes.len());
@@ -160,7 +182,13 @@ fn frame_ends(bytes: &[u8], format: Format) -> Vec<usize> {
 
 /// Reads until the end or the first error; returns the frames and the error.
 fn read_all(bytes: &[u8], format: Format) -> (Vec<Frame>, Option<Error>) {
-    let mut t = Trajectory::from_reader(Cursor::new(bytes.to_vec()), format, "damaged").unwrap();
+    let mut t = Trajectory::from_reader_with(
+        Cursor::new(bytes.to_vec()),
+        format,
+        "damaged",
+        options(format),
+    )
+    .unwrap();
     let mut out = Vec::new();
     let mut f = Frame::new();
     loop {
@@ -275,9 +303,8 @@ fn error_after_good_frames_then_random_access_still_reaches_them() {
 /// cannot tell from a file written without a final newline.
 #[test]
 fn allow_truncated_streams_every_cut_to_its_complete_frames() {
-    use texmap_md_io::ReadOptions;
-    let lenient = ReadOptions::new().allow_truncated(true);
     for &(name, format) in FILES {
+        let lenient = options(format).allow_truncated(true);
         let good = data(name);
         let (all, _) = read_all(&good, format);
         let ends = frame_ends(&good, format);
