@@ -204,6 +204,8 @@ impl AmberTrj {
 }
 
 impl TextFormat for AmberTrj {
+    const SKIPS_BLANK_LINES: bool = false;
+
     fn read<R: Read>(
         &mut self,
         lines: &mut LineReader<R>,
@@ -285,6 +287,8 @@ impl TextFormat for AmberTrj {
 pub(crate) struct AmberRestart;
 
 impl TextFormat for AmberRestart {
+    const SKIPS_BLANK_LINES: bool = false;
+
     fn read<R: Read>(
         &mut self,
         lines: &mut LineReader<R>,

@@ -264,6 +264,10 @@ pub(crate) trait TextFormat {
     /// record order) but parsing no coordinates; `Ok(false)` when no frame starts there. A frame
     /// `skip` accepts may still fail in `read` (a bad number), never the other way round.
     fn skip<R: Read>(&mut self, lines: &mut LineReader<R>, ctx: &Ctx) -> Result<bool, Error>;
+
+    /// Whether blank lines before a frame are passed over before `read` or `skip` is called
+    /// (false for a format whose first line, a title, may be blank: AMBER's).
+    const SKIPS_BLANK_LINES: bool = true;
 }
 
 /// A text format whose `read` and `skip` are one walk over a frame's records, parsing them into
@@ -371,6 +375,25 @@ pub(crate) fn need_line<'a, R: Read>(
     }
 }
 
+/// Where the next frame starts: past any blank lines when `skip` is set; `None` at the end.
+fn frame_start<R: Read>(
+    lines: &mut LineReader<R>,
+    ctx: &Ctx,
+    skip: bool,
+) -> Result<Option<Pos>, Error> {
+    if skip {
+        return skip_blank(lines, ctx);
+    }
+    let pos = lines.pos();
+    match lines.next_line().map_err(|e| ctx.io(pos, e))? {
+        None => Ok(None),
+        Some((p, _)) => {
+            lines.unread(p);
+            Ok(Some(pos))
+        }
+    }
+}
+
 /// Skips blank lines; returns the first non-blank line's position, or `None` at the end.
 pub(crate) fn skip_blank<R: Read>(
     lines: &mut LineReader<R>,
@@ -454,7 +477,7 @@ impl<R: Read + Seek, F: TextFormat> TextReader<R, F> {
     pub fn read_next(&mut self, frame: &mut Frame) -> Result<bool, Error> {
         let ctx = self.ctx();
         frame.clear();
-        let Some(start) = skip_blank(&mut self.lines, &ctx)? else {
+        let Some(start) = frame_start(&mut self.lines, &ctx, F::SKIPS_BLANK_LINES)? else {
             if self.next == self.starts.len() {
                 self.complete = true;
             }
@@ -559,7 +582,7 @@ impl<R: Read + Seek, F: TextFormat> TextReader<R, F> {
         }
         while self.starts.len() <= n {
             let ctx = self.ctx();
-            let Some(start) = skip_blank(&mut self.lines, &ctx)? else {
+            let Some(start) = frame_start(&mut self.lines, &ctx, F::SKIPS_BLANK_LINES)? else {
                 self.complete = true;
                 return Ok(());
             };

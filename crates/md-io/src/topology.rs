@@ -73,13 +73,18 @@ pub enum TopologyFormat {
 
 impl TopologyFormat {
     /// The format a path names: `.pdb`/`.ent`, `.gro`, `.cif`/`.mmcif`, `.psf`,
-    /// `.prmtop`/`.parm7` (AMBER), `.data`/`.lmp` or `data.*` (LAMMPS). A final `.gz` is looked through (`top.psf.gz` is PSF, read
+    /// `.prmtop`/`.parm7`/`.top` or a file named `prmtop` (AMBER; a `.top` must start as a
+    /// prmtop does, since GROMACS names its topologies so too), `.data`/`.lmp` or `data.*`
+    /// (LAMMPS). A final `.gz` is looked through (`top.psf.gz` is PSF, read
     /// decompressed by [`Topology::open`]).
     pub fn from_path(path: &Path) -> Option<TopologyFormat> {
         let path = crate::gz::inner_path(path);
         let name = path.file_name()?.to_str()?.to_ascii_lowercase();
         if name.starts_with("data.") {
             return Some(TopologyFormat::LammpsData);
+        }
+        if name == "prmtop" {
+            return Some(TopologyFormat::Prmtop);
         }
         let ext = path.extension()?.to_str()?.to_ascii_lowercase();
         Some(match ext.as_str() {
@@ -88,7 +93,7 @@ impl TopologyFormat {
             "cif" | "mmcif" => TopologyFormat::Mmcif,
             "data" | "lmp" => TopologyFormat::LammpsData,
             "psf" => TopologyFormat::Psf,
-            "prmtop" | "parm7" => TopologyFormat::Prmtop,
+            "prmtop" | "parm7" | "top" => TopologyFormat::Prmtop,
             _ => return None,
         })
     }
@@ -247,6 +252,24 @@ impl Topology {
         let name: Arc<str> = path.display().to_string().into();
         // A topology must be whole: a cut gzip stream is an error.
         let (mut file, _) = crate::gz::open(path, &name, false)?;
+        let is_top = crate::gz::inner_path(path)
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("top"));
+        if format == TopologyFormat::Prmtop && is_top {
+            let io = |source| Error::Io {
+                at: Location::file(&name),
+                source,
+            };
+            let mut head = Vec::new();
+            (&mut file).take(64).read_to_end(&mut head).map_err(io)?;
+            std::io::Seek::rewind(&mut file).map_err(io)?;
+            if !(head.starts_with(b"%VERSION") || head.starts_with(b"%FLAG")) {
+                return Err(Error::Unsupported {
+                    file: name,
+                    what: "a .top that is not an AMBER prmtop (no %VERSION or %FLAG line first): GROMACS topologies are not read; give the system's .gro or .pdb",
+                });
+            }
+        }
         let format = if format == TopologyFormat::Mmcif {
             match crate::trajectory::cif_kind_of(&mut file, path, &name)? {
                 Format::CrystalCif => TopologyFormat::CrystalCif,

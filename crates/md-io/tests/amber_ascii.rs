@@ -366,3 +366,54 @@ fn prmtop_box_angles_as_parmed_reads_them() {
     traj.read_frame(0, &mut f).unwrap();
     assert_eq!(f.cell.unwrap().angles(), angles);
 }
+
+/// A blank title (AMBER writes 80 spaces when none is set) is still the title: the frames and
+/// the restart read as with a named one.
+#[test]
+fn blank_titles_are_titles() {
+    let opts = ReadOptions::new().atoms(66);
+    for (name, format) in [
+        ("box.mdcrd", Format::AmberTrj),
+        ("vel_box.rst7", Format::AmberRestart),
+    ] {
+        let text = std::fs::read_to_string(path(name)).unwrap();
+        let (_, rest) = text.split_once('\n').unwrap();
+        let blank = format!("{}\n{rest}", " ".repeat(80));
+        let read_all = |t: &str| {
+            let mut traj = from_text(t, format, opts).unwrap();
+            let mut f = Frame::new();
+            let mut out = Vec::new();
+            while traj.read_next(&mut f).unwrap() {
+                out.push((f.positions.clone(), f.cell, f.velocities.clone()));
+            }
+            out
+        };
+        let (a, b) = (read_all(&text), read_all(&blank));
+        assert!(!a.is_empty());
+        assert_eq!(a, b, "{name}");
+    }
+}
+
+/// AMBER's older `.top` name for a prmtop is read as one when it starts as one does; a
+/// GROMACS `.top` is refused by name, not misread.
+#[test]
+fn top_files_are_prmtops_only_when_they_look_like_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let amber = dir.path().join("system.top");
+    std::fs::copy(path("truncoct.parm7"), &amber).unwrap();
+    let t = texmap_md_io::Topology::open(&amber).unwrap();
+    assert_eq!(t.n_atoms(), 66);
+    let named = dir.path().join("prmtop");
+    std::fs::copy(path("truncoct.parm7"), &named).unwrap();
+    assert_eq!(texmap_md_io::Topology::open(&named).unwrap().n_atoms(), 66);
+    let gromacs = dir.path().join("topol.top");
+    std::fs::write(
+        &gromacs,
+        "; GROMACS\n#include \"amber99sb.ff/forcefield.itp\"\n",
+    )
+    .unwrap();
+    let e = texmap_md_io::Topology::open(&gromacs)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("topol.top") && e.contains("GROMACS"), "{e}");
+}
