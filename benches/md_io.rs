@@ -1,7 +1,8 @@
 //! Trajectory read throughput per format, one core: a 100,000-atom x 100-frame trajectory
 //! (water-like triples in a 100 Å box, drifting per frame) written once per run into a temp dir
-//! with our writers (XYZ, DCD, XTC via molly's compressor) and a small TRR generator here, then
-//! read frame by frame through `Trajectory::read_next` into one reused `Frame`.
+//! with our writers (XYZ, DCD, XTC via molly's compressor) and small TRR and AMBER mdcrd
+//! (`10F8.3` with box lines, read with the atom count a topology would give) generators here,
+//! then read frame by frame through `Trajectory::read_next` into one reused `Frame`.
 //!
 //! Groups: `md_io_read` reports bytes/s (criterion `Throughput::Bytes` = file size);
 //! `md_io_xtc_atoms` reports atoms/s for XTC, our decoder beside molly 0.7 alone (its
@@ -16,7 +17,11 @@ use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use criterion::{BatchSize, Criterion, Throughput, criterion_group};
-use texmap::md_io::{Format, Frame, Label, Trajectory, UnitCell, Writer};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use texmap::md_io::{Format, Frame, Label, ReadOptions, Trajectory, UnitCell, Writer};
+
+/// The run's atom count, for [`read_all`]'s options.
+static N_ATOMS: AtomicUsize = AtomicUsize::new(0);
 
 struct Lcg(u64);
 impl Lcg {
@@ -99,6 +104,27 @@ fn write_trr(path: &Path, n_atoms: usize, n_frames: usize, base: &[[f32; 3]]) {
     w.flush().unwrap();
 }
 
+/// An AMBER ASCII trajectory: a title, then per frame `10F8.3` positions and a box line.
+fn write_mdcrd(path: &Path, n_atoms: usize, n_frames: usize, base: &[[f32; 3]]) {
+    let mut w = BufWriter::new(File::create(path).unwrap());
+    let mut frame = Frame::new();
+    writeln!(w, "bench").unwrap();
+    for k in 0..n_frames {
+        synthetic(n_atoms, k, base, &mut frame);
+        for (i, v) in frame.positions.iter().flatten().enumerate() {
+            write!(w, "{v:8.3}").unwrap();
+            if i % 10 == 9 {
+                writeln!(w).unwrap();
+            }
+        }
+        if (3 * n_atoms) % 10 != 0 {
+            writeln!(w).unwrap();
+        }
+        writeln!(w, "{:8.3}{:8.3}{:8.3}", 100.0, 100.0, 100.0).unwrap();
+    }
+    w.flush().unwrap();
+}
+
 /// Writes the trajectory in every format; returns (format, path, bytes).
 fn write_all(dir: &Path, n_atoms: usize, n_frames: usize) -> Vec<(Format, PathBuf, u64)> {
     let base = base_positions(n_atoms);
@@ -117,6 +143,9 @@ fn write_all(dir: &Path, n_atoms: usize, n_frames: usize) -> Vec<(Format, PathBu
     let trr = dir.join("bench.trr");
     write_trr(&trr, n_atoms, n_frames, &base);
     out.push((Format::Trr, trr, 0));
+    let mdcrd = dir.join("bench.mdcrd");
+    write_mdcrd(&mdcrd, n_atoms, n_frames, &base);
+    out.push((Format::AmberTrj, mdcrd, 0));
     for e in &mut out {
         e.2 = std::fs::metadata(&e.1).unwrap().len();
     }
@@ -125,7 +154,9 @@ fn write_all(dir: &Path, n_atoms: usize, n_frames: usize) -> Vec<(Format, PathBu
 
 /// Reads every frame; returns a checksum so nothing is optimised away.
 fn read_all(path: &Path, frame: &mut Frame) -> f64 {
-    let mut t = Trajectory::open(path).unwrap();
+    // The atom count an AMBER ASCII trajectory's topology gives (other formats ignore it).
+    let opts = ReadOptions::new().atoms(N_ATOMS.load(Ordering::Relaxed));
+    let mut t = Trajectory::open_with(path, opts).unwrap();
     let mut sum = 0.0;
     while t.read_next(frame).unwrap() {
         sum += f64::from(frame.positions[frame.n_atoms() / 2][0]);
@@ -136,6 +167,7 @@ fn read_all(path: &Path, frame: &mut Frame) -> f64 {
 fn bench(c: &mut Criterion) {
     let full = std::env::args().any(|a| a == "--bench");
     let (n_atoms, n_frames) = if full { (100_000, 100) } else { (2_000, 3) };
+    N_ATOMS.store(n_atoms, Ordering::Relaxed);
     let dir = tempfile::tempdir().unwrap();
     let files = write_all(dir.path(), n_atoms, n_frames);
 

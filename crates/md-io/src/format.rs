@@ -20,7 +20,8 @@ pub enum Format {
     Xtc,
     /// GROMACS TRR: `.trr`.
     Trr,
-    /// AMBER NetCDF trajectory (NetCDF-3, classic or 64-bit offset): `.nc`, `.ncdf`.
+    /// AMBER NetCDF trajectory or restart (NetCDF-3, classic or 64-bit offset): `.nc`, `.ncdf`,
+    /// `.ncrst`, and a restart named `.rst7` or `.restrt` whose first bytes are NetCDF's.
     Netcdf,
     /// HOOMD-blue GSD trajectory (GSD file format 1.0 and 2.x, `hoomd` schema): `.gsd`.
     Gsd,
@@ -91,7 +92,7 @@ impl Format {
             "dcd" => Format::Dcd,
             "xtc" => Format::Xtc,
             "trr" => Format::Trr,
-            "nc" | "ncdf" => Format::Netcdf,
+            "nc" | "ncdf" | "ncrst" => Format::Netcdf,
             "gsd" => Format::Gsd,
             "cif" | "mmcif" => Format::Mmcif,
             "sdf" | "sd" | "mol" => Format::Sdf,

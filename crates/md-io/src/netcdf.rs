@@ -17,6 +17,11 @@
 //! degrees, optional `velocities(frame, atom, spatial)` float. A `scale_factor` attribute
 //! multiplies a variable's values (AMBER velocities carry 20.455, which turns them into Å/ps).
 //!
+//! A restart (global `Conventions` `AMBERRESTART`, which pmemd writes with `ntxo = 2`, its
+//! default) is one frame: the same variables without the `frame` dimension, coordinates and
+//! velocities in double precision, `time` a scalar (or a one-element `time(time)`, as ParmEd
+//! writes it).
+//!
 //! # Why our own reader
 //! The `netcdf3` crate reads a whole variable at once (every frame of `coordinates`), which is
 //! the opposite of streaming one frame with memory of one frame; the format is small (the header
@@ -313,35 +318,27 @@ impl<R: Read + Seek> NetcdfReader<R> {
         let l = self.layout.clone();
         // Coordinates.
         let off = self.read_record(&l.coords, index)?;
-        let scale = l.coords.scale.unwrap_or(1.0) as f32;
         frame.positions.clear();
-        frame.positions.extend(self.buf.chunks_exact(12).map(|c| {
-            let f = |k: usize| f32::from_be_bytes([c[k], c[k + 1], c[k + 2], c[k + 3]]) * scale;
-            [f(0), f(4), f(8)]
-        }));
+        vectors(&l.coords, &self.buf, &mut frame.positions);
         if !all_in_bounds(&frame.positions) {
             let bad = first_out_of_bounds(&frame.positions).unwrap_or(0);
             return Err(Error::Parse {
-                at: Location::binary(&self.file, index, off + 12 * bad as u64),
+                at: Location::binary(&self.file, index, off + 3 * l.coords.ty.size() * bad as u64),
                 expected: IN_BOUNDS,
                 found: format!("atom {bad}: {:?}", frame.positions[bad]),
             });
         }
         if let Some(v) = &l.velocities {
             let off = self.read_record(v, index)?;
-            let scale = v.scale.unwrap_or(1.0) as f32;
             frame.velocities.clear();
-            frame.velocities.extend(self.buf.chunks_exact(12).map(|c| {
-                let f = |k: usize| f32::from_be_bytes([c[k], c[k + 1], c[k + 2], c[k + 3]]) * scale;
-                [f(0), f(4), f(8)]
-            }));
+            vectors(v, &self.buf, &mut frame.velocities);
             if let Some(bad) = frame
                 .velocities
                 .iter()
                 .position(|p| !p.iter().all(|x| x.is_finite()))
             {
                 return Err(Error::Parse {
-                    at: Location::binary(&self.file, index, off + 12 * bad as u64),
+                    at: Location::binary(&self.file, index, off + 3 * v.ty.size() * bad as u64),
                     expected: "finite velocities",
                     found: format!("atom {bad}: {:?}", frame.velocities[bad]),
                 });
@@ -406,6 +403,31 @@ impl<R: Read + Seek> NetcdfReader<R> {
         match self.truncation() {
             Some(e) => Err(e),
             None => Ok(self.layout.complete),
+        }
+    }
+}
+
+/// One record of a float or double `(atom, 3)` variable as f32 vectors, times its scale factor.
+fn vectors(v: &Var, buf: &[u8], out: &mut Vec<[f32; 3]>) {
+    let s = v.ty.size() as usize;
+    match v.ty {
+        NcType::Double => {
+            let scale = v.scale.unwrap_or(1.0);
+            out.extend(buf.chunks_exact(3 * s).map(|c| {
+                std::array::from_fn(|k| {
+                    let b: [u8; 8] = c[k * 8..k * 8 + 8].try_into().unwrap_or([0; 8]);
+                    (f64::from_be_bytes(b) * scale) as f32
+                })
+            }));
+        }
+        _ => {
+            let scale = v.scale.unwrap_or(1.0) as f32;
+            out.extend(buf.chunks_exact(3 * s).map(|c| {
+                std::array::from_fn(|k| {
+                    let b: [u8; 4] = c[k * 4..k * 4 + 4].try_into().unwrap_or([0; 4]);
+                    f32::from_be_bytes(b) * scale
+                })
+            }));
         }
     }
 }
@@ -531,25 +553,37 @@ fn read_layout<R: Read>(h: &mut Header<'_, R>) -> Result<Layout, Error> {
         return Err(h.err("a variable named coordinates", "none".into()));
     };
     let dim_name = |d: usize| dims[d].0.as_slice();
+    // A restart (the AMBERRESTART convention) is one frame: no record dimension, so its
+    // variables lack the leading `frame`.
+    let restart = !coords.record;
+    let lead = usize::from(!restart);
+    let numeric = |v: &Var| matches!(v.ty, NcType::Float | NcType::Double);
     let shape_ok = |v: &Var, last: &[u8]| {
-        v.record
-            && v.dims.len() == 3
-            && dim_name(v.dims[1]) == b"atom"
-            && dim_name(v.dims[2]) == last
-            && dims[v.dims[2]].1 == 3
-            && v.ty == NcType::Float
+        v.record == !restart
+            && v.dims.len() == 2 + lead
+            && dim_name(v.dims[lead]) == b"atom"
+            && dim_name(v.dims[lead + 1]) == last
+            && dims[v.dims[lead + 1]].1 == 3
+            && numeric(v)
     };
     if !shape_ok(&coords, b"spatial") {
         return Err(h.err(
-            "coordinates(frame, atom, spatial = 3) of type float",
+            "coordinates(frame, atom, spatial = 3), or (atom, spatial = 3) in a restart, of type float or double",
             format!("{} dimensions of type {:?}", coords.dims.len(), coords.ty),
         ));
     }
     let velocities = find(b"velocities").filter(|v| shape_ok(v, b"spatial"));
-    let numeric = |v: &Var| matches!(v.ty, NcType::Float | NcType::Double);
-    let time = find(b"time").filter(|v| v.record && v.dims.len() == 1 && numeric(v));
+    // A restart's time is a scalar, or (as ParmEd writes it) `time(time = 1)`.
+    let scalar =
+        |v: &Var| v.dims.len() == lead || (restart && v.dims.len() == 1 && v.size == v.ty.size());
+    let time = find(b"time").filter(|v| v.record == !restart && scalar(v) && numeric(v));
     let cell = |n: &[u8]| {
-        find(n).filter(|v| v.record && v.dims.len() == 2 && dims[v.dims[1]].1 == 3 && numeric(v))
+        find(n).filter(|v| {
+            v.record == !restart
+                && v.dims.len() == 1 + lead
+                && dims[v.dims[lead]].1 == 3
+                && numeric(v)
+        })
     };
     let (lengths, angles) = (cell(b"cell_lengths"), cell(b"cell_angles"));
     // One record of every record variable (each padded to 4 bytes, unless it is the only one).
@@ -591,6 +625,12 @@ fn read_layout<R: Read>(h: &mut Header<'_, R>) -> Result<Layout, Error> {
         complete
     } else {
         declared
+    };
+    // A restart's one frame lies inside the file (its variables were checked above).
+    let (declared, complete, recsize) = if restart {
+        (1, 1, 0)
+    } else {
+        (declared, complete, recsize)
     };
     Ok(Layout {
         declared,

@@ -224,6 +224,18 @@ fn is_crd(path: &Path) -> bool {
         .is_some_and(|e| e.eq_ignore_ascii_case("crd"))
 }
 
+/// Whether `file` starts with NetCDF-3's magic number; the file is rewound.
+fn is_netcdf(file: &mut File, name: &Arc<str>) -> Result<bool, Error> {
+    let io = |source| Error::Io {
+        at: crate::error::Location::file(name),
+        source,
+    };
+    let mut head = Vec::new();
+    file.take(4).read_to_end(&mut head).map_err(io)?;
+    file.rewind().map_err(io)?;
+    Ok(matches!(head.as_slice(), b"CDF\x01" | b"CDF\x02"))
+}
+
 /// Which file a `.crd` is, by its first lines ([`Format::amber_kind`]); the file is rewound.
 fn crd_kind_of(file: &mut File, name: &Arc<str>) -> Result<Format, Error> {
     let io = |source| Error::Io {
@@ -281,6 +293,9 @@ impl Trajectory<File> {
             cif_kind_of(&mut file, path, &name)?
         } else if is_crd(path) {
             crd_kind_of(&mut file, &name)?
+        } else if format == Format::AmberRestart && is_netcdf(&mut file, &name)? {
+            // pmemd writes its restarts as NetCDF by default, whatever the name.
+            Format::Netcdf
         } else {
             format
         };

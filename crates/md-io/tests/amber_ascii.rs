@@ -417,3 +417,44 @@ fn top_files_are_prmtops_only_when_they_look_like_one() {
         .to_string();
     assert!(e.contains("topol.top") && e.contains("GROMACS"), "{e}");
 }
+
+/// A NetCDF restart (the AMBERRESTART convention: one frame, doubles, ParmEd's NetCDFRestart
+/// over scipy) holds what the ASCII restart of the same frame holds, as ParmEd reads that;
+/// named `.rst7`, as pmemd may name it, it is still read as NetCDF.
+#[test]
+fn netcdf_restart_holds_the_same_frame() {
+    let r = reference();
+    let pm = &r["vel_box.rst7"]["parmed"];
+    let dir = tempfile::tempdir().unwrap();
+    let renamed = dir.path().join("md.rst7");
+    std::fs::copy(path("vel_box.ncrst"), &renamed).unwrap();
+    for p in [path("vel_box.ncrst"), renamed] {
+        let mut traj = Trajectory::open(&p).unwrap();
+        assert_eq!(traj.format(), Format::Netcdf);
+        assert_eq!(traj.n_frames().unwrap(), 1);
+        let mut f = Frame::new();
+        assert!(traj.read_next(&mut f).unwrap());
+        assert!(!traj.read_next(&mut Frame::new()).unwrap());
+        let close = |got: &[[f32; 3]], want: &Value, tol: f64| {
+            let want = want.as_array().unwrap();
+            assert_eq!(got.len(), want.len());
+            for (g, w) in got.iter().zip(want) {
+                for (a, b) in g.iter().zip(f64s(w)) {
+                    assert!(
+                        (*a as f64 - b).abs() <= tol * b.abs().max(1.0),
+                        "{a} vs {b}"
+                    );
+                }
+            }
+        };
+        close(&f.positions, &pm["positions"], 1e-6);
+        close(&f.velocities, &pm["velocities"], 1e-5);
+        let cell = f.cell.unwrap();
+        let b = f64s(&pm["box"]);
+        for c in 0..3 {
+            assert!((cell.lengths()[c] - b[c]).abs() < 1e-9);
+            assert!((cell.angles()[c] - b[3 + c]).abs() < 1e-9);
+        }
+        assert_eq!(f.time, Some(1234.5));
+    }
+}

@@ -8,6 +8,8 @@ Writes, beside this script:
   ten.mdcrd     10 seeded atoms (30 numbers: the last coordinate line is full), 3 frames with boxes
   vel_box.rst7  ParmEd Rst7: the 66 atoms' frame 0, seeded velocities, box, time
   odd.inpcrd    ParmEd Rst7: 7 seeded atoms (a half line), coordinates only
+  vel_box.ncrst ParmEd NetCDFRestart (AMBERRESTART convention, over scipy's NetCDF-3 writer):
+                the same frame, velocities, box and time as vel_box.rst7
   truncoct.parm7  ParmEd (load_file + box + save) of ../prmtop_parmed.prmtop in a truncated
                 octahedron (IFBOX 2, BOX_DIMENSIONS)
   reference.json
@@ -56,6 +58,15 @@ rst.vels = rng.normal(0.0, 0.5, size=(1, n, 3))
 rst.box = [30.5, 31.25, 32.0, 90.0, 101.5, 90.0]
 rst.time = 1234.5
 rst.write(os.path.join(here, "vel_box.rst7"))
+
+from parmed.amber.netcdffiles import NetCDFRestart
+nc = NetCDFRestart.open_new(os.path.join(here, "vel_box.ncrst"), natom=n, box=True, vels=True,
+                            title="ParmEd NetCDF restart for texmap's tests")
+nc.coordinates = rst.coordinates.reshape(n, 3)
+nc.velocities = rst.vels.reshape(n, 3)
+nc.box = rst.box
+nc.time = rst.time
+nc.close()
 
 odd = Rst7(natom=7, title="seven atoms")
 odd.coordinates = rng.uniform(-9, 9, size=(1, 7, 3))
