@@ -559,7 +559,7 @@ fn read_layout<R: Read>(h: &mut Header<'_, R>) -> Result<Layout, Error> {
     let lead = usize::from(!restart);
     let numeric = |v: &Var| matches!(v.ty, NcType::Float | NcType::Double);
     let shape_ok = |v: &Var, last: &[u8]| {
-        v.record == !restart
+        v.record != restart
             && v.dims.len() == 2 + lead
             && dim_name(v.dims[lead]) == b"atom"
             && dim_name(v.dims[lead + 1]) == last
@@ -576,10 +576,10 @@ fn read_layout<R: Read>(h: &mut Header<'_, R>) -> Result<Layout, Error> {
     // A restart's time is a scalar, or (as ParmEd writes it) `time(time = 1)`.
     let scalar =
         |v: &Var| v.dims.len() == lead || (restart && v.dims.len() == 1 && v.size == v.ty.size());
-    let time = find(b"time").filter(|v| v.record == !restart && scalar(v) && numeric(v));
+    let time = find(b"time").filter(|v| v.record != restart && scalar(v) && numeric(v));
     let cell = |n: &[u8]| {
         find(n).filter(|v| {
-            v.record == !restart
+            v.record != restart
                 && v.dims.len() == 1 + lead
                 && dims[v.dims[lead]].1 == 3
                 && numeric(v)
