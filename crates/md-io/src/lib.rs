@@ -8,7 +8,11 @@
 //!   ICSD, Materials Project: each data block a frame, the asymmetric unit expanded by the
 //!   file's symmetry operations; a `.cif` is told from PDBx/mmCIF by its tags), LAMMPS data files
 //!   (one frame: the atom style's columns, the box, masses and their elements, velocities and
-//!   image flags as properties, the `Bonds` as [`Frame::bonds`]) (and the binary DCD, XTC,
+//!   image flags as properties, the `Bonds` as [`Frame::bonds`]), CHARMM coordinate files
+//!   (`.crd`/`.cor`, standard and `EXT`: segment ids, the WMAIN weighting as the `wmain`
+//!   property; a `.crd` must start with a `*` title, since AMBER writes `.crd` too) and PQR
+//!   (PDB2PQR/APBS: partial charges and radii as the `charge` and `radius` properties, chains,
+//!   MODEL/ENDMDL frames) (and the binary DCD, XTC,
 //!   TRR, AMBER NetCDF and HOOMD-blue GSD: particle types, diameters, per-particle properties
 //!   and bonds, by the hoomd schema's rule for what a frame omits) one frame at a time into a
 //!   reusable [`Frame`], or any frame by index.
@@ -98,6 +102,7 @@ mod chgcar;
 mod cif;
 pub mod cna;
 pub mod coordination;
+mod crd;
 mod crystal_cif;
 mod cube;
 mod cursor;
@@ -118,6 +123,7 @@ mod netcdf;
 pub mod parse;
 pub mod pbc;
 mod pdb;
+mod pqr;
 mod prmtop;
 mod psf;
 pub mod replicate;

@@ -1,5 +1,6 @@
 //! [`Trajectory`]: one reader for every format, streaming or random access.
 
+use crate::crd::Crd;
 use crate::crystal_cif::CrystalCif;
 use crate::cube::Cube;
 use crate::dcd::DcdReader;
@@ -14,6 +15,7 @@ use crate::mmcif::Mmcif;
 use crate::mol2::Mol2;
 use crate::netcdf::NetcdfReader;
 use crate::pdb::Pdb;
+use crate::pqr::Pqr;
 use crate::sdf::Sdf;
 use crate::text::TextReader;
 use crate::trr::TrrReader;
@@ -43,6 +45,8 @@ enum Reader<R> {
     CrystalCif(TextReader<R, CrystalCif>),
     LammpsData(TextReader<R, LammpsData>),
     Cube(TextReader<R, Cube>),
+    CharmmCrd(TextReader<R, Crd>),
+    Pqr(TextReader<R, Pqr>),
 }
 
 /// Runs `$body` with `$r` bound to the format's reader, whatever the format.
@@ -65,6 +69,8 @@ macro_rules! each_reader {
             Reader::CrystalCif($r) => $body,
             Reader::LammpsData($r) => $body,
             Reader::Cube($r) => $body,
+            Reader::CharmmCrd($r) => $body,
+            Reader::Pqr($r) => $body,
         }
     };
 }
@@ -193,10 +199,62 @@ pub(crate) fn cif_kind_of(file: &mut File, path: &Path, name: &Arc<str>) -> Resu
     Ok(Format::cif_kind(&head))
 }
 
+/// How much of a `.crd` file [`crate::Trajectory::open`] reads to tell a CHARMM CRD.
+const CRD_HEAD: u64 = 4096;
+
+/// Checks that `file` (at `path`, named `name` in errors), named as a CHARMM CRD, is one: a
+/// `.crd` may also be an AMBER ASCII trajectory, so a `.crd` must start (after blank lines)
+/// with a `*` title ([`Format::is_charmm_crd`]); a file with nothing but blank lines in its first
+/// [`CRD_HEAD`] bytes is read as CHARMM (an empty file has no frames). `.cor` and a format
+/// told by the content are not checked. The file is rewound.
+pub(crate) fn crd_kind_of(file: &mut File, path: &Path, name: &Arc<str>) -> Result<Format, Error> {
+    let crd_named = crate::gz::inner_path(path)
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("crd"));
+    if !crd_named {
+        return Ok(Format::CharmmCrd);
+    }
+    let io = |source| Error::Io {
+        at: crate::error::Location::file(name),
+        source,
+    };
+    let mut head = Vec::new();
+    file.take(CRD_HEAD).read_to_end(&mut head).map_err(io)?;
+    file.rewind().map_err(io)?;
+    if Format::is_charmm_crd(&head) != Some(false) {
+        return Ok(Format::CharmmCrd);
+    }
+    // Where the first non-blank line starts, for the error.
+    let (mut line, mut byte) = (1u64, 0usize);
+    for l in head.split(|b| *b == b'\n') {
+        if !crate::parse::trim(l).is_empty() {
+            let end = (byte + l.len()).min(head.len());
+            return Err(Error::Parse {
+                at: crate::error::Location {
+                    file: name.clone(),
+                    frame: None,
+                    line: Some(line),
+                    byte: Some(byte as u64),
+                },
+                expected: "a CHARMM coordinate file's title lines starting with '*' (an AMBER \
+                           ASCII trajectory, also named .crd, must be named .mdcrd or given its \
+                           format explicitly, e.g. --format)",
+                found: Error::found(&head[byte..end]),
+            });
+        }
+        line += 1;
+        byte += l.len() + 1;
+    }
+    Ok(Format::CharmmCrd)
+}
+
 impl Trajectory<File> {
     /// Opens `path`, telling the format from the extension or else from the first bytes.
     /// A CIF (`.cif`, or first bytes `data_`) is PDBx/mmCIF or crystallographic by its tags
     /// in its first [`Format::CIF_HEAD`] bytes ([`Format::cif_kind`]); `.mmcif` is mmCIF.
+    /// A `.crd` is a CHARMM coordinate file only when its first non-blank line is a `*` title
+    /// ([`Format::is_charmm_crd`]); otherwise opening it is an error naming that line (an AMBER
+    /// ASCII trajectory should be named `.mdcrd` or opened with [`Trajectory::open_as`]).
     ///
     /// A gzip file (first bytes `1f 8b`, e.g. `1abc.cif.gz`, `run.xyz.gz`) is read decompressed:
     /// its format comes from the name without `.gz`, else from the decompressed first bytes. It
@@ -231,10 +289,10 @@ impl Trajectory<File> {
                 Format::from_magic(&head).ok_or(Error::UnknownFormat { file: name.clone() })?
             }
         };
-        let format = if format == Format::Mmcif {
-            cif_kind_of(&mut file, path, &name)?
-        } else {
-            format
+        let format = match format {
+            Format::Mmcif => cif_kind_of(&mut file, path, &name)?,
+            Format::CharmmCrd => crd_kind_of(&mut file, path, &name)?,
+            other => other,
         };
         Trajectory::from_reader_with(file, format, &name, options).map(|t| t.with_warning(cut))
     }
@@ -296,6 +354,8 @@ impl<R: Read + Seek> Trajectory<R> {
                 Reader::LammpsData(TextReader::new(src, LammpsData::default(), file.clone()))
             }
             Format::Cube => Reader::Cube(TextReader::new(src, Cube, file.clone())),
+            Format::CharmmCrd => Reader::CharmmCrd(TextReader::new(src, Crd, file.clone())),
+            Format::Pqr => Reader::Pqr(TextReader::new(src, Pqr::new(lenient), file.clone())),
         };
         Ok(Trajectory {
             reader,
@@ -350,6 +410,7 @@ impl<R: Read + Seek> Trajectory<R> {
         let taken = match &mut self.reader {
             Reader::Pdb(r) => r.format_mut().take_warnings(),
             Reader::Mmcif(r) => r.format_mut().take_warnings(),
+            Reader::Pqr(r) => r.format_mut().take_warnings(),
             _ => return,
         };
         for w in taken {
