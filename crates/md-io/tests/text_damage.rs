@@ -30,6 +30,8 @@ const FILES: &[(&str, Format)] = &[
     ("crystal/cod_9001665.cif", Format::CrystalCif),
     ("lammps_data/ase_full.data", Format::LammpsData),
     ("lammps_data/mda_full_tri.data", Format::LammpsData),
+    ("mda_two.crd", Format::CharmmCrd),
+    ("parmed_models.pqr", Format::Pqr),
 ];
 
 fn data(name: &str) -> Vec<u8> {
@@ -147,6 +149,29 @@ fn frame_ends(bytes: &[u8], format: Format) -> Vec<usize> {
                 ends.push(line_starts[k + 1]);
             }
             ends.push(bytes.len());
+        }
+        Format::CharmmCrd => {
+            // Title lines starting with '*', the count line (its first number), the atoms.
+            let mut l = 0;
+            while l < lines.len() {
+                while lines[l].starts_with('*') {
+                    l += 1;
+                }
+                let n: usize = lines[l].split_whitespace().next().unwrap().parse().unwrap();
+                l += 1 + n;
+                ends.push(line_starts[l]);
+            }
+        }
+        Format::Pqr => {
+            // ENDMDL ends a model; a file without models is one frame.
+            for (k, l) in lines.iter().enumerate() {
+                if l.starts_with("ENDMDL") {
+                    ends.push(line_starts[k + 1]);
+                }
+            }
+            if ends.is_empty() {
+                ends.push(bytes.len());
+            }
         }
         Format::LammpsData | Format::Cube => {
             // One frame: the whole file (a LAMMPS data file's sections may come in any order;
