@@ -283,15 +283,13 @@ mod tests {
         Ok(out)
     }
 
-    /// A standard atom line, as CHARMM's format writes it.
+    /// A standard atom line, as CHARMM's format writes it: atom and residue numbers, residue
+    /// and atom names, position, segment and residue ids, weighting.
     fn std_line(
-        k: usize,
-        resno: usize,
-        res: &str,
-        name: &str,
+        (k, resno): (usize, usize),
+        (res, name): (&str, &str),
         x: [f64; 3],
-        seg: &str,
-        resid: &str,
+        (seg, resid): (&str, &str),
         w: f64,
     ) -> String {
         format!(
@@ -303,8 +301,14 @@ mod tests {
     #[test]
     fn standard_and_extended_frames() {
         let mut text = String::from("* TWO ATOMS\n*\n    2\n");
-        text += &std_line(1, 1, "TIP3", "OH2", [1.0, 2.0, 3.0], "WAT", "7", 0.5);
-        text += &std_line(2, 1, "TIP3", "H1", [-1.0, -2.5, 0.25], "WAT", "7A", 1.0);
+        text += &std_line((1, 1), ("TIP3", "OH2"), [1.0, 2.0, 3.0], ("WAT", "7"), 0.5);
+        text += &std_line(
+            (2, 1),
+            ("TIP3", "H1"),
+            [-1.0, -2.5, 0.25],
+            ("WAT", "7A"),
+            1.0,
+        );
         text += "* SECOND\n         1  EXT\n";
         text += &format!(
             "{:10}{:10}  {:<8}  {:<8}{:20.10}{:20.10}{:20.10}  {:<8}  {:<8}{:20.10}\n",
@@ -330,7 +334,7 @@ mod tests {
     #[test]
     fn count_larger_than_the_frame_names_the_title_line() {
         let mut text = String::from("* A\n    2\n");
-        text += &std_line(1, 1, "TIP3", "OH2", [1.0, 2.0, 3.0], "WAT", "1", 0.0);
+        text += &std_line((1, 1), ("TIP3", "OH2"), [1.0, 2.0, 3.0], ("WAT", "1"), 0.0);
         text += "* B\n    1\n";
         let e = read(&text).unwrap_err().to_string();
         assert!(e.starts_with("t: frame 0, line 4, byte "), "{e}");
