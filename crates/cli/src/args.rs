@@ -62,7 +62,8 @@ pub enum Command {
         /// Trajectory file (XYZ, extended XYZ, PDB, PDBx/mmCIF, GRO, LAMMPS dump, DCD, XTC, TRR,
         /// AMBER NetCDF, AMBER ASCII mdcrd (with --topology: the file has no atom count) and
         /// rst7/inpcrd, HOOMD-blue GSD, SDF/MOL and MOL2 with their bonds, one frame per
-        /// record, VASP POSCAR/CONTCAR/XDATCAR, crystallographic CIF, a LAMMPS data file),
+        /// record, VASP POSCAR/CONTCAR/XDATCAR, crystallographic CIF, a LAMMPS data file,
+        /// CHARMM .crd/.cor, PQR with charges and radii),
         /// gzip-compressed or not (1abc.cif.gz). A quoted pattern ('dump.*.lammpstrj') reads
         /// the files it matches in natural order as one trajectory.
         file: PathBuf,

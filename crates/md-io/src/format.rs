@@ -55,11 +55,20 @@ pub enum Format {
     /// frame: `.rst7`, `.inpcrd`, `.restrt`, files named `inpcrd` or `restrt`, and a `.crd`
     /// whose second line is the atom count; by name: `rst7`.
     AmberRestart,
+    /// CHARMM coordinate file (card format, standard or `EXT`), one frame per title block
+    /// (concatenated files are frames), with segment ids and the WMAIN weighting: `.cor`, and
+    /// `.crd` when its first non-blank line is a `*` title (AMBER also writes `.crd`: see
+    /// [`crate::Trajectory::open`]); by name: `charmm-crd`.
+    CharmmCrd,
+    /// PQR (PDB2PQR, APBS, MDAnalysis, ParmEd): whitespace-separated PDB-like atom records with
+    /// the partial charge (e) and radius (Å) as the `charge` and `radius` properties;
+    /// MODEL/ENDMDL models are frames: `.pqr`.
+    Pqr,
 }
 
 impl Format {
     /// Every format, in declaration order.
-    pub const ALL: [Format; 18] = [
+    pub const ALL: [Format; 20] = [
         Format::Xyz,
         Format::Pdb,
         Format::Gro,
@@ -78,6 +87,8 @@ impl Format {
         Format::Cube,
         Format::AmberTrj,
         Format::AmberRestart,
+        Format::CharmmCrd,
+        Format::Pqr,
     ];
 
     /// The format a file extension (case-insensitive, e.g. "xyz", "lammpstrj") or a format's
@@ -101,8 +112,10 @@ impl Format {
             "cif-crystal" => Format::CrystalCif,
             "data" | "lmp" | "lammps-data" => Format::LammpsData,
             "cube" | "cub" => Format::Cube,
-            "mdcrd" | "trj" | "crd" => Format::AmberTrj,
+            "mdcrd" | "trj" => Format::AmberTrj,
             "rst7" | "inpcrd" | "restrt" => Format::AmberRestart,
+            "crd" | "cor" | "charmm-crd" => Format::CharmmCrd,
+            "pqr" => Format::Pqr,
             _ => return None,
         })
     }
@@ -150,7 +163,7 @@ impl Format {
     /// them). Binary formats are told by their magic numbers, text formats by their first
     /// lines: `data_` (CIF: PDBx/mmCIF or crystallographic, by [`Format::cif_kind`]) or
     /// `@<TRIPOS>` (MOL2) on the first line that is not a `#`
-    /// comment, `ITEM: TIMESTEP` (LAMMPS), a PDB record name, a fourth line ending in `V2000` or
+    /// comment, a `*` title on the first non-blank line (CHARMM CRD), `ITEM: TIMESTEP` (LAMMPS), a PDB record name, a fourth line ending in `V2000` or
     /// `V3000` (molfile, SD file), an integer first line (XYZ), an `N atoms` line after the title
     /// (LAMMPS data file), an integer second line (GRO).
     pub fn from_magic(head: &[u8]) -> Option<Format> {
@@ -188,6 +201,10 @@ impl Format {
             .find(|l| !l.is_empty() && l[0] != b'#');
         if cif.is_some_and(|l| l.len() >= 5 && l[..5].eq_ignore_ascii_case(b"data_")) {
             return Some(Format::cif_kind(head));
+        }
+        // CHARMM CRD: `*` title lines first, then the atom count.
+        if looks_like_charmm_crd(head) {
+            return Some(Format::CharmmCrd);
         }
         // MOL2: a Tripos record header, after comments and blank lines.
         if cif.is_some_and(|l| l.starts_with(b"@<TRIPOS>")) {
@@ -310,6 +327,17 @@ impl Format {
         }
     }
 
+    /// Whether a file whose first bytes are `head` is a CHARMM CRD: its first non-blank line
+    /// starts with a `*` title (after any indentation). `None` when `head` holds no non-blank
+    /// line. No other format read here starts so; an AMBER ASCII trajectory (also `.crd`) starts
+    /// with a title line of any text, then numbers.
+    pub fn is_charmm_crd(head: &[u8]) -> Option<bool> {
+        head.split(|b| *b == b'\n')
+            .map(crate::parse::trim)
+            .find(|l| !l.is_empty())
+            .map(|l| l[0] == b'*')
+    }
+
     /// How much of a `.cif` file [`crate::Trajectory::open`] reads to tell its kind
     /// ([`Format::cif_kind`]): a COD file's atom sites come after kilobytes of bibliography.
     pub const CIF_HEAD: u64 = 64 * 1024;
@@ -331,6 +359,8 @@ impl Format {
                 | Format::Cube
                 | Format::AmberTrj
                 | Format::AmberRestart
+                | Format::CharmmCrd
+                | Format::Pqr
         )
     }
 
@@ -355,6 +385,8 @@ impl Format {
             Format::Cube => "cube",
             Format::AmberTrj => "mdcrd",
             Format::AmberRestart => "rst7",
+            Format::CharmmCrd => "charmm-crd",
+            Format::Pqr => "pqr",
         }
     }
 }
@@ -384,6 +416,32 @@ fn looks_like_vasp(head: &[u8]) -> bool {
     !words.is_empty()
         && (words.iter().all(|w| parse_usize(w).is_some())
             || words.iter().all(|w| w[0].is_ascii_alphabetic()))
+}
+
+/// True when the first non-blank lines are `*` titles followed by an atom-count line (`N` or
+/// `N  EXT`), or by nothing more in `head`.
+fn looks_like_charmm_crd(head: &[u8]) -> bool {
+    use crate::parse::{fields, parse_usize, trim};
+    if Format::is_charmm_crd(head) != Some(true) {
+        return false;
+    }
+    let mut lines = head.split(|b| *b == b'\n').peekable();
+    while lines.next_if(|l| trim(l).is_empty()).is_some() {}
+    while lines.next_if(|l| trim(l).first() == Some(&b'*')).is_some() {}
+    let Some(count) = lines.next() else {
+        return true;
+    };
+    if lines.peek().is_none() {
+        // A count line cut by the end of `head` (or a file without a final newline): the
+        // titles decide.
+        return true;
+    }
+    let f: Vec<&[u8]> = fields(count).collect();
+    match f[..] {
+        [n] => parse_usize(n).is_some(),
+        [n, ext] => parse_usize(n).is_some() && ext.eq_ignore_ascii_case(b"EXT"),
+        _ => false,
+    }
 }
 
 /// True when a LAMMPS data file's header shows: after the title line, one of the first three
@@ -481,5 +539,28 @@ mod tests {
         );
         assert_eq!(Format::from_extension("mmcif"), Some(Format::Mmcif));
         assert_eq!(Format::from_magic(b"hello\nworld\n"), None);
+        assert_eq!(
+            Format::from_magic(b"\n* TITLE\n*\n    1\n"),
+            Some(Format::CharmmCrd)
+        );
+        assert_eq!(Format::is_charmm_crd(b" \n\n"), None);
+        assert_eq!(
+            Format::from_magic(b"* title\n\n 12 atoms\n"),
+            Some(Format::LammpsData)
+        );
+        assert_eq!(
+            Format::from_magic(b"* A\n* B\n     12345  EXT\n"),
+            Some(Format::CharmmCrd)
+        );
+        assert_eq!(Format::is_charmm_crd(b"AMBER title\n  1.000"), Some(false));
+        assert_eq!(
+            Format::from_path(Path::new("a.cor")),
+            Some(Format::CharmmCrd)
+        );
+        assert_eq!(
+            Format::from_path(Path::new("a.CRD")),
+            Some(Format::CharmmCrd)
+        );
+        assert_eq!(Format::from_path(Path::new("1abc.pqr")), Some(Format::Pqr));
     }
 }

@@ -314,10 +314,11 @@ pub struct Frame {
     pub res_names: Vec<Label>,
     /// Residue numbers (PDB, GRO).
     pub res_ids: Vec<i64>,
-    /// Chain identifiers (PDB column 22, mmCIF `auth_asym_id` else `label_asym_id`); an atom
-    /// whose field is blank has an empty label.
+    /// Chain identifiers (PDB column 22, mmCIF `auth_asym_id` else `label_asym_id`, a PQR's
+    /// chain field); an atom whose field is blank has an empty label.
     pub chains: Vec<Label>,
-    /// Segment identifiers (PDB columns 73-76, PSF `segid`); blank is an empty label.
+    /// Segment identifiers (PDB columns 73-76, PSF `segid`, CHARMM CRD SEGID); blank is an
+    /// empty label.
     pub segments: Vec<Label>,
     /// Per-atom radii in Å from a `radius` column (OVITO convention).
     pub radii: Vec<f32>,
@@ -326,7 +327,8 @@ pub struct Frame {
     /// may hold values outside it ([`crate::AtomStyle`] clamps them for drawing).
     pub colors: Vec<[f32; 3]>,
     /// Named per-atom numbers, in the file's column order: PDB and mmCIF `occupancy` and
-    /// `bfactor`, every LAMMPS dump column not read into another field (`q`, `mass`, `c_pe`,
+    /// `bfactor`, MOL2 and PQR `charge`, PQR `radius` (the electrostatics radius, not drawn),
+    /// CHARMM CRD `wmain`, every LAMMPS dump column not read into another field (`q`, `mass`, `c_pe`,
     /// `v_stress`, `fx`, ...), extended-XYZ real or integer columns of one component. What
     /// OVITO calls particle properties and colours by; see [`Frame::property`].
     pub properties: Vec<Property>,

@@ -10,7 +10,11 @@
 //!   (one frame: the atom style's columns, the box, masses and their elements, velocities and
 //!   image flags as properties, the `Bonds` as [`Frame::bonds`]), AMBER's ASCII trajectories
 //!   (mdcrd: the atom count comes from the topology, [`ReadOptions::atoms`]) and restarts
-//!   (rst7 / inpcrd, with velocities and box) (and the binary DCD, XTC,
+//!   (rst7 / inpcrd, with velocities and box), CHARMM coordinate files
+//!   (`.crd`/`.cor`, standard and `EXT`: segment ids, the WMAIN weighting as the `wmain`
+//!   property; a `.crd` is CHARMM's when it starts with a `*` title, else AMBER's) and PQR
+//!   (PDB2PQR/APBS: partial charges and radii as the `charge` and `radius` properties, chains,
+//!   MODEL/ENDMDL frames) (and the binary DCD, XTC,
 //!   TRR, AMBER NetCDF and HOOMD-blue GSD: particle types, diameters, per-particle properties
 //!   and bonds, by the hoomd schema's rule for what a frame omits) one frame at a time into a
 //!   reusable [`Frame`], or any frame by index.
@@ -101,6 +105,7 @@ mod chgcar;
 mod cif;
 pub mod cna;
 pub mod coordination;
+mod crd;
 mod crystal_cif;
 mod cube;
 mod cursor;
@@ -121,6 +126,7 @@ mod netcdf;
 pub mod parse;
 pub mod pbc;
 mod pdb;
+mod pqr;
 mod prmtop;
 mod psf;
 pub mod replicate;

@@ -296,6 +296,15 @@ pub fn parse_i64(s: &[u8]) -> Option<i64> {
     Some(if neg { -v } else { v })
 }
 
+/// A residue number that may carry an insertion code: an integer (optional sign) and at most
+/// one ASCII letter after it (`36A` -> 36), as PDB2PQR and CHARMM write them; `None` otherwise.
+pub(crate) fn res_number(s: &[u8]) -> Option<i64> {
+    match s {
+        [digits @ .., b] if b.is_ascii_alphabetic() => parse_i64(digits),
+        _ => parse_i64(s),
+    }
+}
+
 /// Parses a non-negative count.
 #[inline]
 pub fn parse_usize(s: &[u8]) -> Option<usize> {
@@ -488,6 +497,11 @@ mod tests {
         assert_eq!(parse_i64(b"9223372036854775808"), None);
         assert_eq!(parse_i64(b"1.0"), None);
         assert_eq!(parse_usize(b"-1"), None);
+        assert_eq!(res_number(b"36A"), Some(36));
+        assert_eq!(res_number(b"-5"), Some(-5));
+        assert_eq!(res_number(b"A"), None);
+        assert_eq!(res_number(b"12AB"), None);
+        assert_eq!(res_number(b""), None);
         assert_eq!(
             fields(b"  a \tbb  c ").collect::<Vec<_>>(),
             vec![&b"a"[..], b"bb", b"c"]

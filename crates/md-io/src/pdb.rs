@@ -112,7 +112,7 @@ fn cols(line: &[u8], a: usize, b: usize) -> &[u8] {
 /// programs write beside them). A line whose name is none of these nor ATOM/HETATM but whose
 /// columns 31-54 hold three numbers is an atom record with a damaged name: an error, not a
 /// silently skipped atom. Other unknown lines (comments of some programs) are skipped.
-const OTHER_RECORDS: [&[u8]; 53] = [
+pub(crate) const OTHER_RECORDS: [&[u8]; 53] = [
     b"HEADER", b"OBSLTE", b"TITLE", b"SPLIT", b"CAVEAT", b"COMPND", b"SOURCE", b"KEYWDS",
     b"EXPDTA", b"NUMMDL", b"MDLTYP", b"AUTHOR", b"REVDAT", b"SPRSDE", b"JRNL", b"REMARK", b"DBREF",
     b"DBREF1", b"DBREF2", b"SEQADV", b"SEQRES", b"MODRES", b"HET", b"HETNAM", b"HETSYN", b"FORMUL",

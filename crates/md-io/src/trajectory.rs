@@ -1,6 +1,7 @@
 //! [`Trajectory`]: one reader for every format, streaming or random access.
 
 use crate::amber::{AmberRestart, AmberTrj};
+use crate::crd::Crd;
 use crate::crystal_cif::CrystalCif;
 use crate::cube::Cube;
 use crate::dcd::DcdReader;
@@ -15,6 +16,7 @@ use crate::mmcif::Mmcif;
 use crate::mol2::Mol2;
 use crate::netcdf::NetcdfReader;
 use crate::pdb::Pdb;
+use crate::pqr::Pqr;
 use crate::sdf::Sdf;
 use crate::text::TextReader;
 use crate::trr::TrrReader;
@@ -46,6 +48,8 @@ enum Reader<R> {
     Cube(TextReader<R, Cube>),
     AmberTrj(TextReader<R, AmberTrj>),
     AmberRestart(TextReader<R, AmberRestart>),
+    CharmmCrd(TextReader<R, Crd>),
+    Pqr(TextReader<R, Pqr>),
 }
 
 /// Runs `$body` with `$r` bound to the format's reader, whatever the format.
@@ -70,6 +74,8 @@ macro_rules! each_reader {
             Reader::Cube($r) => $body,
             Reader::AmberTrj($r) => $body,
             Reader::AmberRestart($r) => $body,
+            Reader::CharmmCrd($r) => $body,
+            Reader::Pqr($r) => $body,
         }
     };
 }
@@ -217,11 +223,57 @@ pub(crate) fn cif_kind_of(file: &mut File, path: &Path, name: &Arc<str>) -> Resu
     Ok(Format::cif_kind(&head))
 }
 
-/// True for a `.crd` name (a final `.gz` looked through): AMBER's trajectory or restart.
-fn is_crd(path: &Path) -> bool {
-    crate::gz::inner_path(path)
+/// How much of a `.crd` file [`crate::Trajectory::open`] reads to tell what it is.
+const CRD_HEAD: u64 = 4096;
+
+/// What `file` (at `path`, named `name` in errors), named as a CHARMM CRD, is: a `.crd` that
+/// starts (after blank lines) with a `*` title is CHARMM's ([`Format::is_charmm_crd`]); else
+/// AMBER's trajectory or restart by its second line ([`Format::amber_kind`]); else an error. A
+/// file with nothing but blank lines in its first [`CRD_HEAD`] bytes is read as CHARMM (an
+/// empty file has no frames). `.cor` and a format told by the content are not checked. The
+/// file is rewound.
+pub(crate) fn crd_kind_of(file: &mut File, path: &Path, name: &Arc<str>) -> Result<Format, Error> {
+    let crd_named = crate::gz::inner_path(path)
         .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("crd"))
+        .is_some_and(|e| e.eq_ignore_ascii_case("crd"));
+    if !crd_named {
+        return Ok(Format::CharmmCrd);
+    }
+    let io = |source| Error::Io {
+        at: crate::error::Location::file(name),
+        source,
+    };
+    let mut head = Vec::new();
+    file.take(CRD_HEAD).read_to_end(&mut head).map_err(io)?;
+    file.rewind().map_err(io)?;
+    if Format::is_charmm_crd(&head) != Some(false) {
+        return Ok(Format::CharmmCrd);
+    }
+    if let Some(amber) = Format::amber_kind(&head) {
+        return Ok(amber);
+    }
+    // Where the first non-blank line starts, for the error.
+    let (mut line, mut byte) = (1u64, 0usize);
+    for l in head.split(|b| *b == b'\n') {
+        if !crate::parse::trim(l).is_empty() {
+            let end = (byte + l.len()).min(head.len());
+            return Err(Error::Parse {
+                at: crate::error::Location {
+                    file: name.clone(),
+                    frame: None,
+                    line: Some(line),
+                    byte: Some(byte as u64),
+                },
+                expected: "a CHARMM coordinate file's title lines starting with '*', or an AMBER \
+                           trajectory or restart (a title, then 10F8.3 coordinates or an atom \
+                           count); else name the format with --format",
+                found: Error::found(&head[byte..end]),
+            });
+        }
+        line += 1;
+        byte += l.len() + 1;
+    }
+    Ok(Format::CharmmCrd)
 }
 
 /// Whether `file` starts with NetCDF-3's magic number; the file is rewound.
@@ -236,25 +288,13 @@ fn is_netcdf(file: &mut File, name: &Arc<str>) -> Result<bool, Error> {
     Ok(matches!(head.as_slice(), b"CDF\x01" | b"CDF\x02"))
 }
 
-/// Which file a `.crd` is, by its first lines ([`Format::amber_kind`]); the file is rewound.
-fn crd_kind_of(file: &mut File, name: &Arc<str>) -> Result<Format, Error> {
-    let io = |source| Error::Io {
-        at: crate::error::Location::file(name),
-        source,
-    };
-    let mut head = Vec::new();
-    file.take(4096).read_to_end(&mut head).map_err(io)?;
-    file.rewind().map_err(io)?;
-    Format::amber_kind(&head).ok_or_else(|| Error::Unsupported {
-        file: name.clone(),
-        what: "reading this .crd: it is neither an AMBER restart (title, atom count, 6F12.7 coordinates) nor an AMBER trajectory (title, 10F8.3 coordinates); give --format",
-    })
-}
-
 impl Trajectory<File> {
     /// Opens `path`, telling the format from the extension or else from the first bytes.
     /// A CIF (`.cif`, or first bytes `data_`) is PDBx/mmCIF or crystallographic by its tags
     /// in its first [`Format::CIF_HEAD`] bytes ([`Format::cif_kind`]); `.mmcif` is mmCIF.
+    /// A `.crd` is a CHARMM coordinate file only when its first non-blank line is a `*` title
+    /// ([`Format::is_charmm_crd`]); otherwise opening it is an error naming that line (an AMBER
+    /// ASCII trajectory should be named `.mdcrd` or opened with [`Trajectory::open_as`]).
     ///
     /// A gzip file (first bytes `1f 8b`, e.g. `1abc.cif.gz`, `run.xyz.gz`) is read decompressed:
     /// its format comes from the name without `.gz`, else from the decompressed first bytes. It
@@ -289,15 +329,12 @@ impl Trajectory<File> {
                 Format::from_magic(&head).ok_or(Error::UnknownFormat { file: name.clone() })?
             }
         };
-        let format = if format == Format::Mmcif {
-            cif_kind_of(&mut file, path, &name)?
-        } else if is_crd(path) {
-            crd_kind_of(&mut file, &name)?
-        } else if format == Format::AmberRestart && is_netcdf(&mut file, &name)? {
+        let format = match format {
+            Format::Mmcif => cif_kind_of(&mut file, path, &name)?,
+            Format::CharmmCrd => crd_kind_of(&mut file, path, &name)?,
             // pmemd writes its restarts as NetCDF by default, whatever the name.
-            Format::Netcdf
-        } else {
-            format
+            Format::AmberRestart if is_netcdf(&mut file, &name)? => Format::Netcdf,
+            other => other,
         };
         Trajectory::from_reader_with(file, format, &name, options).map(|t| t.with_warning(cut))
     }
@@ -370,6 +407,8 @@ impl<R: Read + Seek> Trajectory<R> {
             Format::AmberRestart => {
                 Reader::AmberRestart(TextReader::new(src, AmberRestart, file.clone()))
             }
+            Format::CharmmCrd => Reader::CharmmCrd(TextReader::new(src, Crd, file.clone())),
+            Format::Pqr => Reader::Pqr(TextReader::new(src, Pqr::new(lenient), file.clone())),
         };
         Ok(Trajectory {
             reader,
@@ -424,6 +463,7 @@ impl<R: Read + Seek> Trajectory<R> {
         let taken = match &mut self.reader {
             Reader::Pdb(r) => r.format_mut().take_warnings(),
             Reader::Mmcif(r) => r.format_mut().take_warnings(),
+            Reader::Pqr(r) => r.format_mut().take_warnings(),
             _ => return,
         };
         for w in taken {

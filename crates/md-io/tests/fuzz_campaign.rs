@@ -1,5 +1,6 @@
 //! The fuzz campaign of every md-io reader (harness: tests/support/campaign.rs): each fixture of
-//! tests/data (written by MDAnalysis, ASE, LAMMPS, OVITO, gemmi and the wwPDB; see the READMEs there) and the DCD and
+//! tests/data (written by MDAnalysis, ASE, LAMMPS, OVITO, gemmi, PDB2PQR, ParmEd and the wwPDB;
+//! see the READMEs there) and the DCD and
 //! XTC our writers make, cut at every record boundary and at seeded offsets, with seeded bit
 //! flips and byte replacements, header fields set to extremes, CRLF and NUL for text. Every
 //! mutant is read twice, strict and with `allow_truncated`, through the public API (open,
@@ -710,4 +711,23 @@ fn amber_ascii_campaign() {
     let files = ["amber_ascii/vel_box.rst7", "amber_ascii/odd.inpcrd"];
     let fx = files.map(|f| text_fixture(f, Format::AmberRestart));
     campaign("AMBER restart", Format::AmberRestart, fx.into());
+}
+
+#[test]
+fn charmm_crd_campaign() {
+    let files = ["mda_two.crd", "mda_chains.crd"];
+    let fx = files.map(|f| text_fixture(f, Format::CharmmCrd));
+    campaign("CHARMM CRD", Format::CharmmCrd, fx.into());
+}
+
+#[test]
+fn pqr_campaign() {
+    let files = [
+        "parmed_models.pqr",
+        "pdb2pqr_amber.pqr",
+        "pdb2pqr_chains.pqr",
+        "mda_chains.pqr",
+    ];
+    let fx = files.map(|f| text_fixture(f, Format::Pqr));
+    campaign("PQR", Format::Pqr, fx.into());
 }

@@ -33,6 +33,8 @@ const FILES: &[(&str, Format)] = &[
     ("amber_ascii/box.mdcrd", Format::AmberTrj),
     ("amber_ascii/vel_box.rst7", Format::AmberRestart),
     ("amber_ascii/odd.inpcrd", Format::AmberRestart),
+    ("mda_two.crd", Format::CharmmCrd),
+    ("parmed_models.pqr", Format::Pqr),
 ];
 
 /// The options a fixture is read with: an AMBER trajectory needs its topology's atom count
@@ -168,6 +170,29 @@ fn frame_ends(bytes: &[u8], format: Format) -> Vec<usize> {
             while l <= lines.len() {
                 ends.push(line_starts[l]);
                 l += 21;
+            }
+        }
+        Format::CharmmCrd => {
+            // Title lines starting with '*', the count line (its first number), the atoms.
+            let mut l = 0;
+            while l < lines.len() {
+                while lines[l].starts_with('*') {
+                    l += 1;
+                }
+                let n: usize = lines[l].split_whitespace().next().unwrap().parse().unwrap();
+                l += 1 + n;
+                ends.push(line_starts[l]);
+            }
+        }
+        Format::Pqr => {
+            // ENDMDL ends a model; a file without models is one frame.
+            for (k, l) in lines.iter().enumerate() {
+                if l.starts_with("ENDMDL") {
+                    ends.push(line_starts[k + 1]);
+                }
+            }
+            if ends.is_empty() {
+                ends.push(bytes.len());
             }
         }
         Format::LammpsData | Format::Cube | Format::AmberRestart => {
