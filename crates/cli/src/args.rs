@@ -64,7 +64,7 @@ pub enum Command {
         /// rst7/inpcrd, HOOMD-blue GSD, SDF/MOL and MOL2 with their bonds, one frame per
         /// record, VASP POSCAR/CONTCAR/XDATCAR, crystallographic CIF, a LAMMPS data file,
         /// CHARMM .crd/.cor, PQR with charges and radii),
-        /// gzip-compressed or not (1abc.cif.gz). A quoted pattern ('dump.*.lammpstrj') reads
+        /// gzip- or bzip2-compressed or not (1abc.cif.gz, prod.mdcrd.bz2). A quoted pattern ('dump.*.lammpstrj') reads
         /// the files it matches in natural order as one trajectory.
         file: PathBuf,
         /// More parts of the same trajectory, read after FILE as one (prod2.xtc prod3.xtc).
@@ -444,7 +444,7 @@ Examples: --type-color 1=#ff8000 --type-color 2=40,40,255 (LAMMPS types 1 and 2)
 #[derive(Args, Debug)]
 #[command(after_help = RENDER_AFTER_HELP)]
 pub struct RenderArgs {
-    /// Trajectory file (any format `texmap info` reads; gzip-compressed files too). A quoted
+    /// Trajectory file (any format `texmap info` reads; gzip- or bzip2-compressed files too). A quoted
     /// pattern ('dump.*.lammpstrj', as OVITO's file sequences) reads the files it matches in
     /// natural order (dump.200 before dump.1000) as one trajectory.
     pub file: PathBuf,

@@ -1,11 +1,15 @@
-//! Transparent gzip input: `1abc.cif.gz`, `run.xyz.gz`, `top.psf.gz` read like the plain files.
+//! Transparent compressed input: `1abc.cif.gz`, `run.xyz.gz`, `top.psf.gz`, `prod.mdcrd.bz2`
+//! read like the plain files.
 //!
-//! A file is gzip when its first two bytes are the gzip magic `1f 8b` (RFC 1952 §2.3.1), whatever
-//! its name; a name ending in `.gz` over bytes that are not gzip is an error rather than a guess.
-//! A pipe or device is looked at only when its name ends in `.gz` (bytes read from it to see the
-//! magic could not be put back), and is then inflated without a seek.
-//! The format of what is inside comes from the name without `.gz` (see [`inner_path`]), else
-//! from the decompressed bytes, as for a plain file.
+//! A file is gzip when its first two bytes are the gzip magic `1f 8b` (RFC 1952 §2.3.1), and
+//! bzip2 when its first four are `BZh` and a block-size digit `1`-`9`, whatever its name; a name
+//! ending in `.gz` or `.bz2` over bytes that are not of that kind is an error rather than a
+//! guess. A pipe or device is looked at only when its name ends in `.gz` or `.bz2` (bytes read
+//! from it to see the magic could not be put back), and is then decompressed without a seek.
+//! The format of what is inside comes from the name without `.gz` / `.bz2` (see
+//! [`inner_path`]), else from the decompressed bytes, as for a plain file. Everything below
+//! about gzip holds for bzip2 (every stream of a concatenated file read, `MultiBzDecoder`;
+//! errors say "bzip2").
 //!
 //! The readers need `Read + Seek` (frame index, random access) and [`crate::Trajectory::open`]
 //! returns a `Trajectory<File>`, so the file is decompressed once, streaming, into an anonymous
@@ -32,6 +36,7 @@
 //!
 //! # References
 //! - RFC 1952, GZIP file format specification version 4.3 (member layout, magic, trailer).
+//! - J. Seward, bzip2 and libbzip2 manual, and the bzip2 format's stream header (`BZh1`-`BZh9`).
 
 use std::borrow::Cow;
 use std::fs::File;
@@ -39,6 +44,7 @@ use std::io::{self, BufRead, BufReader, Read, Seek, Write};
 use std::path::Path;
 use std::sync::Arc;
 
+use bzip2::bufread::MultiBzDecoder;
 use flate2::bufread::MultiGzDecoder;
 
 use crate::error::{Error, Location};
@@ -46,14 +52,52 @@ use crate::error::{Error, Location};
 /// The first two bytes of every gzip member (RFC 1952 §2.3.1: ID1, ID2).
 const MAGIC: [u8; 2] = [0x1f, 0x8b];
 
-/// True when `path`'s last extension is `gz` (any case).
-fn has_gz_extension(path: &Path) -> bool {
-    path.extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("gz"))
+/// The compressions read.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Codec {
+    Gzip,
+    Bzip2,
 }
 
-/// `path` without a trailing `.gz` (any case): the name that tells the format of what is inside
-/// (`1abc.pdb.gz` -> `1abc.pdb`). Other paths are given back unchanged.
+impl Codec {
+    /// The codec whose magic `head` starts with.
+    fn of(head: &[u8]) -> Option<Codec> {
+        if head.starts_with(&MAGIC) {
+            return Some(Codec::Gzip);
+        }
+        match head {
+            [b'B', b'Z', b'h', b'1'..=b'9', ..] => Some(Codec::Bzip2),
+            _ => None,
+        }
+    }
+
+    /// The codec a path's last extension names (`gz`, `bz2`; any case).
+    fn of_path(path: &Path) -> Option<Codec> {
+        let e = path.extension()?;
+        if e.eq_ignore_ascii_case("gz") {
+            Some(Codec::Gzip)
+        } else if e.eq_ignore_ascii_case("bz2") {
+            Some(Codec::Bzip2)
+        } else {
+            None
+        }
+    }
+
+    fn name(self) -> &'static str {
+        match self {
+            Codec::Gzip => "gzip",
+            Codec::Bzip2 => "bzip2",
+        }
+    }
+}
+
+/// True when `path`'s last extension names a compression (`gz`, `bz2`; any case).
+fn has_gz_extension(path: &Path) -> bool {
+    Codec::of_path(path).is_some()
+}
+
+/// `path` without a trailing `.gz` or `.bz2` (any case): the name that tells the format of what
+/// is inside (`1abc.pdb.gz` -> `1abc.pdb`). Other paths are given back unchanged.
 pub(crate) fn inner_path(path: &Path) -> Cow<'_, Path> {
     if has_gz_extension(path) {
         Cow::Owned(path.with_extension(""))
@@ -93,38 +137,49 @@ pub(crate) fn open(
         .take(16)
         .read_to_end(&mut head)
         .map_err(io_at(Some(0)))?;
-    if !head.starts_with(&MAGIC) {
-        if has_gz_extension(path) {
-            return Err(Error::Parse {
-                at: Location {
-                    byte: Some(0),
-                    ..Location::file(name)
-                },
-                expected: "the gzip magic bytes 1f 8b (the name ends in .gz, but the file is not gzip)",
-                found: Error::found(&head),
-            });
-        }
+    let codec = Codec::of(&head);
+    let named = Codec::of_path(path);
+    if named.is_some() && codec != named {
+        return Err(Error::Parse {
+            at: Location {
+                byte: Some(0),
+                ..Location::file(name)
+            },
+            expected: match named {
+                Some(Codec::Bzip2) => {
+                    "the bzip2 magic bytes BZh1-BZh9 (the name ends in .bz2, but the file is not bzip2)"
+                }
+                _ => "the gzip magic bytes 1f 8b (the name ends in .gz, but the file is not gzip)",
+            },
+            found: Error::found(&head),
+        });
+    }
+    let Some(codec) = codec else {
         file.rewind().map_err(io_at(Some(0)))?;
         return Ok((file, None));
-    }
+    };
     // The bytes already read go first, so that a pipe named `.gz` needs no seek either.
-    decompress(io::Cursor::new(head).chain(file), name, keep_cut)
+    decompress(io::Cursor::new(head).chain(file), codec, name, keep_cut)
 }
 
 /// Inflates every member of `src` into a new anonymous temporary file, rewound; with
 /// `keep_cut`, a stream that ends early stops there with the cut as a warning.
 fn decompress(
     src: impl Read,
+    codec: Codec,
     name: &Arc<str>,
     keep_cut: bool,
 ) -> Result<(File, Option<Error>), Error> {
-    let mut out = tempfile::tempfile().map_err(|e| temp_error(name, e))?;
+    let mut out = tempfile::tempfile().map_err(|e| temp_error(codec, name, e))?;
     let mut input = Counting {
         inner: BufReader::with_capacity(64 * 1024, src),
         consumed: 0,
         failed: false,
     };
-    let mut decoder = MultiGzDecoder::new(&mut input);
+    let mut decoder: Box<dyn Read + '_> = match codec {
+        Codec::Gzip => Box::new(MultiGzDecoder::new(&mut input)),
+        Codec::Bzip2 => Box::new(MultiBzDecoder::new(&mut input)),
+    };
     let mut buf = vec![0u8; 64 * 1024];
     let mut cut = None;
     loop {
@@ -135,13 +190,20 @@ fn decompress(
             Err(e) => {
                 drop(decoder);
                 let ended_early = e.kind() == io::ErrorKind::UnexpectedEof;
-                let e = stream_error(name, &input, e);
+                let e = stream_error(codec, name, &input, e);
                 match e {
                     // The decoder ran out of input (not a read failure): a cut, not corruption.
                     Error::Parse { at, found, .. } if keep_cut && ended_early && !input.failed => {
                         cut = Some(Error::Parse {
                             at,
-                            expected: "the rest of the gzip stream (the data before the cut is read)",
+                            expected: match codec {
+                                Codec::Gzip => {
+                                    "the rest of the gzip stream (the data before the cut is read)"
+                                }
+                                Codec::Bzip2 => {
+                                    "the rest of the bzip2 stream (the data before the cut is read)"
+                                }
+                            },
                             found,
                         });
                         break;
@@ -150,15 +212,16 @@ fn decompress(
                 }
             }
         };
-        out.write_all(&buf[..n]).map_err(|e| temp_error(name, e))?;
+        out.write_all(&buf[..n])
+            .map_err(|e| temp_error(codec, name, e))?;
     }
-    out.rewind().map_err(|e| temp_error(name, e))?;
+    out.rewind().map_err(|e| temp_error(codec, name, e))?;
     Ok((out, cut))
 }
 
-/// An error of the gzip stream at the compressed offset `input` has reached: the operating
+/// An error of the compressed stream at the offset `input` has reached: the operating
 /// system's read failure as [`Error::Io`], the decoder's complaint as [`Error::Parse`].
-fn stream_error<R>(name: &Arc<str>, input: &Counting<R>, e: io::Error) -> Error {
+fn stream_error<R>(codec: Codec, name: &Arc<str>, input: &Counting<R>, e: io::Error) -> Error {
     let at = Location {
         byte: Some(input.consumed),
         ..Location::file(name)
@@ -169,24 +232,33 @@ fn stream_error<R>(name: &Arc<str>, input: &Counting<R>, e: io::Error) -> Error 
     if e.kind() == io::ErrorKind::UnexpectedEof {
         return Error::Parse {
             at,
-            expected: "the rest of the gzip stream",
+            expected: match codec {
+                Codec::Gzip => "the rest of the gzip stream",
+                Codec::Bzip2 => "the rest of the bzip2 stream",
+            },
             found: "end of file".into(),
         };
     }
     Error::Parse {
         at,
-        expected: "intact gzip data",
+        expected: match codec {
+            Codec::Gzip => "intact gzip data",
+            Codec::Bzip2 => "intact bzip2 data",
+        },
         found: e.to_string(),
     }
 }
 
 /// A failure to write or rewind the temporary file (a full temporary directory, say).
-fn temp_error(name: &Arc<str>, e: io::Error) -> Error {
+fn temp_error(codec: Codec, name: &Arc<str>, e: io::Error) -> Error {
     Error::Io {
         at: Location::file(name),
         source: io::Error::new(
             e.kind(),
-            format!("writing the decompressed gzip data to a temporary file: {e}"),
+            format!(
+                "writing the decompressed {} data to a temporary file: {e}",
+                codec.name()
+            ),
         ),
     }
 }
@@ -241,7 +313,7 @@ mod tests {
         f.write_all(gz).unwrap();
         f.rewind().unwrap();
         let mut out = Vec::new();
-        decompress(f, &"t.gz".into(), false)?
+        decompress(f, Codec::Gzip, &"t.gz".into(), false)?
             .0
             .read_to_end(&mut out)
             .unwrap();

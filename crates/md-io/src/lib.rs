@@ -18,9 +18,9 @@
 //!   TRR, AMBER NetCDF and HOOMD-blue GSD: particle types, diameters, per-particle properties
 //!   and bonds, by the hoomd schema's rule for what a frame omits) one frame at a time into a
 //!   reusable [`Frame`], or any frame by index.
-//!   Any of them may be gzip-compressed (`1abc.cif.gz`, `run.xyz.gz`; topologies too): it is
+//!   Any of them may be gzip- or bzip2-compressed (`1abc.cif.gz`, `prod.mdcrd.bz2`; topologies too): it is
 //!   inflated once into a temporary file, so the byte offsets of a `.gz` file's errors count
-//!   decompressed bytes, except for damage to the gzip stream itself (compressed offset).
+//!   decompressed bytes, except for damage to the compressed stream itself (compressed offset).
 //! - [`Sequence`] reads a trajectory in several files (a run continued in parts, a LAMMPS
 //!   dump per step: [`sequence::expand`] for `dump.*.lammpstrj`) as one.
 //! - [`Topology`] reads atom names, elements, residues and bonds (PDB, PDBx/mmCIF, GRO, PSF,

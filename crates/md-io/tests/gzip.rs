@@ -1,4 +1,4 @@
-//! gzip input: `.gz` copies of fixtures made by GNU gzip (tests/data/gzip.sh) read through
+//! gzip (and bzip2) input: `.gz` copies of fixtures made by GNU gzip (tests/data/gzip.sh) read through
 //! `Trajectory::open*` and `Topology::open*` exactly as the plain files, and damaged copies
 //! (cut, a flipped byte, a misnamed plain file) are errors naming the file and "gzip".
 //!
@@ -363,4 +363,57 @@ fn pipes_stream_without_a_seek_plain_or_named_gz() {
         writer.join().unwrap();
         assert!(got == want, "{name}");
     }
+}
+
+/// bzip2 (the real bzip2 1.0.8, tests/data/gzip.sh): a two-stream `.mdcrd.bz2` reads as the plain
+/// file frame for frame and a `.parm7.bz2` as the plain topology; every cut of the stream is an
+/// error naming "bzip2" at or before its offset, or with `allow_truncated` the plain file's
+/// first frames and a warning; a `.bz2` name over other bytes is an error.
+#[test]
+fn bzip2_reads_as_the_plain_file_and_cuts_are_located() {
+    let opts = ReadOptions::new().atoms(66);
+    let bz = path("amber_ascii/box.mdcrd.bz2");
+    let (want, n) =
+        frames(&mut Trajectory::open_with(path("amber_ascii/box.mdcrd"), opts).unwrap());
+    let mut t = Trajectory::open_with(&bz, opts).unwrap();
+    assert_eq!(t.format(), Format::AmberTrj);
+    let (got, k) = frames(&mut t);
+    assert_eq!((k, &got), (n, &want));
+    let topo_bz = path("amber_ascii/truncoct.parm7.bz2");
+    let plain = File::open(path("amber_ascii/truncoct.parm7")).unwrap();
+    let want_topo =
+        Topology::from_reader(plain, TopologyFormat::Prmtop, &name_of(&topo_bz)).unwrap();
+    assert!(want_topo.box_angles.is_some() && !want_topo.bonds.is_empty());
+    assert!(Topology::open(&topo_bz).unwrap() == want_topo);
+
+    let dir = scratch();
+    let bytes = std::fs::read(&bz).unwrap();
+    let second = (4..bytes.len())
+        .find(|&i| bytes[i..].starts_with(b"BZh9"))
+        .unwrap();
+    let mut kept = std::collections::BTreeSet::new();
+    for cut in (10..bytes.len()).step_by(97).filter(|&c| c != second) {
+        let p = put(&dir, "cut.mdcrd.bz2", &bytes[..cut]);
+        let e = Trajectory::open_with(&p, opts).map(|_| ()).unwrap_err();
+        let Error::Parse { at, .. } = &e else {
+            panic!("cut at {cut}: {e:?}");
+        };
+        assert!(e.to_string().contains("bzip2"), "{e}");
+        assert!(at.byte.unwrap() <= cut as u64, "cut at {cut}: {e}");
+        let mut t = Trajectory::open_with(&p, opts.allow_truncated(true)).unwrap();
+        let (got, k) = frames(&mut t);
+        assert!(got[..] == want[..k], "cut at {cut}: frames differ");
+        assert!(warnings(&t)[0].contains("bzip2"), "cut at {cut}");
+        kept.insert(k);
+    }
+    // bzip2 decodes whole blocks (each stream here is one): a cut inside the first stream
+    // keeps nothing, one inside the second keeps the first stream's complete frames.
+    assert_eq!(kept.into_iter().collect::<Vec<_>>(), [0, 2]);
+    let p = put(
+        &dir,
+        "plain.mdcrd.bz2",
+        &std::fs::read(path("amber_ascii/box.mdcrd")).unwrap(),
+    );
+    let e = Trajectory::open_with(&p, opts).map(|_| ()).unwrap_err();
+    assert!(e.to_string().contains("bzip2 magic"), "{e}");
 }
