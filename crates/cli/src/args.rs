@@ -63,7 +63,7 @@ pub enum Command {
         /// AMBER NetCDF, AMBER ASCII mdcrd (with --topology: the file has no atom count) and
         /// rst7/inpcrd, HOOMD-blue GSD, SDF/MOL and MOL2 with their bonds, one frame per
         /// record, VASP POSCAR/CONTCAR/XDATCAR, crystallographic CIF, a LAMMPS data file,
-        /// CHARMM .crd/.cor, PQR with charges and radii),
+        /// CHARMM .crd/.cor, PQR with charges and radii, AutoDock PDBQT),
         /// gzip- or bzip2-compressed or not (1abc.cif.gz, prod.mdcrd.bz2). A quoted pattern ('dump.*.lammpstrj') reads
         /// the files it matches in natural order as one trajectory.
         file: PathBuf,
@@ -528,8 +528,9 @@ pub struct RenderArgs {
     /// A caption at the top left of every image, on a light backdrop, for movies:
     /// 't = {ns} ns'. {time} is the frame's time in ps, {ns} in ns, {step} its MD step,
     /// {frame} its index in the file, {hbonds} the hydrogen bonds an hbonds representation
-    /// draws in it; a file whose frames carry no time (XYZ, PDB) takes {frame}. ASCII only;
-    /// the text is cut at half the image width.
+    /// draws in it, {title} its title (an XYZ comment, a PDB TITLE, a Vina pose's 'VINA
+    /// RESULT: -7.5 ...'); a file whose frames carry no time (XYZ, PDB) takes {frame}. ASCII
+    /// only; the text is cut at half the image width.
     #[arg(long, value_name = "TEXT")]
     pub label: Option<String>,
     /// Label the atoms SEL picks, as PyMOL's and VMD's labels: each gets TEXT just above it,

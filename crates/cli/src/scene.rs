@@ -122,6 +122,9 @@ pub enum LabelPart {
     Frame,
     /// `{hbonds}`: the hydrogen bonds the hbonds style draws in the frame.
     HBonds,
+    /// `{title}`: the frame's title (an XYZ comment line, a GRO title, a PDB TITLE, a docked
+    /// pose's `REMARK VINA RESULT`), empty when it has none.
+    Title,
 }
 
 /// A `{placeholder}` template split into text and placeholders, each placeholder one of
@@ -165,8 +168,8 @@ fn template<'a>(
 /// `--label`'s template, parsed before any frame is read: braces balanced, every placeholder
 /// `{time}`, `{ns}`, `{step}` or `{frame}`.
 pub fn parse_label(text: &str) -> Result<Vec<LabelPart>> {
-    const NAMES: [&str; 5] = ["time", "ns", "step", "frame", "hbonds"];
-    let hint = "{time} (ps), {ns}, {step}, {frame} or {hbonds}";
+    const NAMES: [&str; 6] = ["time", "ns", "step", "frame", "hbonds", "title"];
+    let hint = "{time} (ps), {ns}, {step}, {frame}, {hbonds} or {title}";
     Ok(template("--label", text, &NAMES, hint)?
         .into_iter()
         .map(|p| match p {
@@ -175,7 +178,8 @@ pub fn parse_label(text: &str) -> Result<Vec<LabelPart>> {
             Err(1) => LabelPart::Ns,
             Err(2) => LabelPart::Step,
             Err(3) => LabelPart::Frame,
-            Err(_) => LabelPart::HBonds,
+            Err(4) => LabelPart::HBonds,
+            Err(_) => LabelPart::Title,
         })
         .collect())
 }
@@ -328,6 +332,7 @@ pub fn label_text(
             }
             LabelPart::Frame => out.push_str(&index.to_string()),
             LabelPart::HBonds => out.push_str(&hbonds.to_string()),
+            LabelPart::Title => out.push_str(frame.comment.trim()),
         }
     }
     Ok(out)

@@ -3152,3 +3152,48 @@ fn amber_ascii_trajectory_reads_its_atom_count_from_the_prmtop() {
     assert!(lit(&a) > 1000, "{}", lit(&a));
     assert!(d < 0.5, "mean |difference| {d}");
 }
+
+/// AutoDock Vina's docked poses (md-io's tests/data/pdbqt: Vina 1.2.7 on Meeko's receptor and
+/// ligand) drawn in their receptor, one pose per frame, each captioned by its Vina score: the
+/// caption differs between poses of different scores and the ligand moves.
+#[test]
+fn vina_poses_render_in_their_receptor_with_their_scores() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("pose_%02d.png");
+    let o = texmap(&[
+        "render",
+        &data("pdbqt/poses.pdbqt"),
+        "--add",
+        &data("pdbqt/receptor.pdbqt"),
+        "--rep",
+        "prop file == 0=ball-stick",
+        "--rep",
+        "prop file == 1=licorice",
+        "--label",
+        "{title}",
+        "--frames",
+        "0:2",
+        "--size",
+        "240x180",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let a = dir.path().join("pose_00.png");
+    let b = dir.path().join("pose_01.png");
+    assert!(lit(&a) > 1000);
+    assert!(mean_abs_diff(&a, &b) > 0.1);
+    // The caption strip at the top left differs (-4.268 against -4.517 kcal/mol).
+    let top = |p: &Path| {
+        let img = image::open(p).unwrap().to_rgb8();
+        image::imageops::crop_imm(&img, 0, 0, 120, 14).to_image()
+    };
+    assert_ne!(top(&a), top(&b));
+    let o = texmap(&["info", &data("pdbqt/poses.pdbqt")]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(
+        (v["format"].as_str(), v["frames"].as_u64()),
+        (Some("pdbqt"), Some(5))
+    );
+}

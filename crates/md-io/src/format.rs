@@ -64,11 +64,14 @@ pub enum Format {
     /// the partial charge (e) and radius (Å) as the `charge` and `radius` properties;
     /// MODEL/ENDMDL models are frames: `.pqr`.
     Pqr,
+    /// AutoDock PDBQT (Vina's docked poses, one MODEL each; Meeko's and Open Babel's receptors
+    /// and ligands): PDB records with partial charges and AutoDock atom types: `.pdbqt`.
+    Pdbqt,
 }
 
 impl Format {
     /// Every format, in declaration order.
-    pub const ALL: [Format; 20] = [
+    pub const ALL: [Format; 21] = [
         Format::Xyz,
         Format::Pdb,
         Format::Gro,
@@ -89,6 +92,7 @@ impl Format {
         Format::AmberRestart,
         Format::CharmmCrd,
         Format::Pqr,
+        Format::Pdbqt,
     ];
 
     /// The format a file extension (case-insensitive, e.g. "xyz", "lammpstrj") or a format's
@@ -116,6 +120,7 @@ impl Format {
             "rst7" | "inpcrd" | "restrt" => Format::AmberRestart,
             "crd" | "cor" | "charmm-crd" => Format::CharmmCrd,
             "pqr" => Format::Pqr,
+            "pdbqt" => Format::Pdbqt,
             _ => return None,
         })
     }
@@ -361,6 +366,7 @@ impl Format {
                 | Format::AmberRestart
                 | Format::CharmmCrd
                 | Format::Pqr
+                | Format::Pdbqt
         )
     }
 
@@ -387,6 +393,7 @@ impl Format {
             Format::AmberRestart => "rst7",
             Format::CharmmCrd => "charmm-crd",
             Format::Pqr => "pqr",
+            Format::Pdbqt => "pdbqt",
         }
     }
 }

@@ -14,7 +14,8 @@
 //!   (`.crd`/`.cor`, standard and `EXT`: segment ids, the WMAIN weighting as the `wmain`
 //!   property; a `.crd` is CHARMM's when it starts with a `*` title, else AMBER's) and PQR
 //!   (PDB2PQR/APBS: partial charges and radii as the `charge` and `radius` properties, chains,
-//!   MODEL/ENDMDL frames) (and the binary DCD, XTC,
+//!   MODEL/ENDMDL frames), AutoDock PDBQT (Vina's poses as frames; charges, AutoDock types and
+//!   the elements they name) (and the binary DCD, XTC,
 //!   TRR, AMBER NetCDF and HOOMD-blue GSD: particle types, diameters, per-particle properties
 //!   and bonds, by the hoomd schema's rule for what a frame omits) one frame at a time into a
 //!   reusable [`Frame`], or any frame by index.

@@ -22,12 +22,21 @@
 //! Elements: columns 77-78 when they hold a symbol, else [`crate::elements::guess_element`] from
 //! the atom and residue names.
 //!
+//! **PDBQT** (AutoDock, Vina, Meeko, Open Babel): the same records, but columns 67-76 hold the
+//! partial charge (the `charge` property) and 78-79 the AutoDock atom type (the atom's type;
+//! its element by [`autodock_element`]: `A` aromatic carbon, `OA` acceptor oxygen, `HD` donor
+//! hydrogen, `Cl`, `Br`, ...), so there is no segment. `ROOT`/`BRANCH`/`TORSDOF` lines (a
+//! flexible ligand's torsion tree) are skipped; each `MODEL` of a docking output is a pose, and
+//! its `REMARK VINA RESULT:` line (score in kcal/mol, RMSD bounds) becomes the frame's title.
+//!
 //! Hybrid-36 (Grosse-Kunstleve, 2007): a field of width w holds decimal numbers up to 10^w - 1,
 //! then base-36 with upper-case digits ("A0000" = 100,000 for w = 5), then lower-case digits.
 //!
 //! # References
 //! - wwPDB, Protein Data Bank Contents Guide: Atomic Coordinate Entry Format v3.3.
 //! - R. W. Grosse-Kunstleve, "Hybrid-36", cctbx iotbx/pdb/hybrid_36 documentation (2007).
+//! - AutoDock 4.2 user guide, "PDBQT format" and its atom types; AutoDock Vina 1.2 and Meeko
+//!   documentation (the torsion tree, `REMARK VINA RESULT`).
 
 use crate::elements::guess_element;
 use crate::error::Error;
@@ -127,12 +136,32 @@ fn has_coordinates(line: &[u8]) -> bool {
         && (0..3).all(|k| parse_f32(trim(cols(line, 31 + 8 * k, 38 + 8 * k))).is_some())
 }
 
+/// The element an AutoDock 4 atom type names: `A` (aromatic carbon), Meeko's `G0`-`G3` and
+/// `CG0`-`CG3` (macrocycle closure carbons) are carbon; `NA`, `NS` nitrogen; `OA`, `OS` and
+/// Meeko's water `W` oxygen; `SA` sulfur; `HD`, `HS` hydrogen; any other a symbol in any case
+/// (`Cl`, `BR`, `Zn`, `Fe`, `Mg`; so `CA` is calcium, as AutoDock has it). `None` for a type
+/// that is none of these (the names decide).
+fn autodock_element(t: &[u8]) -> Option<crate::elements::Element> {
+    use crate::elements::element_of_symbol;
+    let sym: &[u8] = match t {
+        b"A" | b"G0" | b"G1" | b"G2" | b"G3" | b"CG0" | b"CG1" | b"CG2" | b"CG3" => b"C",
+        b"NA" | b"NS" => b"N",
+        b"OA" | b"OS" | b"W" => b"O",
+        b"SA" => b"S",
+        b"HD" | b"HS" => b"H",
+        other => other,
+    };
+    element_of_symbol(sym)
+}
+
 /// PDB frame parser state: the cell of the last CRYST1, and model 1's atom count, which every
 /// later model must repeat ([`ModelCheck`]).
 #[derive(Default)]
 pub(crate) struct Pdb {
     cell: Option<UnitCell>,
     models: ModelCheck,
+    /// AutoDock PDBQT: charge and AD4 type in columns 67-79 instead of segment and element.
+    pdbqt: bool,
 }
 
 /// Record name of a line: its first 6 bytes, trailing spaces removed.
@@ -146,6 +175,15 @@ impl Pdb {
         Pdb {
             cell: None,
             models: ModelCheck::new(lenient),
+            pdbqt: false,
+        }
+    }
+
+    /// A parser of AutoDock PDBQT (see the module doc).
+    pub(crate) fn pdbqt(lenient: bool) -> Pdb {
+        Pdb {
+            pdbqt: true,
+            ..Pdb::new(lenient)
         }
     }
 
@@ -177,7 +215,7 @@ impl Pdb {
         Ok(())
     }
 
-    fn atom(ctx: &Ctx, pos: Pos, line: &[u8], frame: &mut Frame) -> Result<(), Error> {
+    fn atom(&self, ctx: &Ctx, pos: Pos, line: &[u8], frame: &mut Frame) -> Result<(), Error> {
         // Coordinates, columns 31-54.
         let mut p = [0f32; 3];
         for (k, x) in p.iter_mut().enumerate() {
@@ -210,7 +248,11 @@ impl Pdb {
         let chain_f = trim(cols(line, 22, 22));
         let chain = Label::from_utf8(chain_f)
             .ok_or_else(|| ctx.parse(pos, line, chain_f, "a chain identifier in column 22"))?;
-        let seg_f = trim(cols(line, 73, 76));
+        let seg_f = if self.pdbqt {
+            &b""[..]
+        } else {
+            trim(cols(line, 73, 76))
+        };
         let segment = Label::from_utf8(seg_f)
             .ok_or_else(|| ctx.parse(pos, line, seg_f, "a segment identifier in columns 73-76"))?;
         // Occupancy 55-60 and B-factor 61-66; a blank field is NaN until the frame ends.
@@ -229,8 +271,26 @@ impl Pdb {
                     .ok_or_else(|| ctx.parse(pos, line, f, what))?;
             }
         }
-        let elem = std::str::from_utf8(trim(cols(line, 77, 78))).ok();
-        let element = guess_element(&name, Some(&res), elem.filter(|e| !e.is_empty()));
+        let element = if self.pdbqt {
+            // Partial charge 67-76 (Vina and Meeko write it there; MDAnalysis reads 71-76),
+            // AutoDock type 78-79.
+            let q_f = trim(cols(line, 67, 76));
+            let q = parse_f32(q_f)
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| ctx.parse(pos, line, q_f, "a partial charge in columns 67-76"))?;
+            frame.property_mut("charge").push(q);
+            let t_f = trim(cols(line, 78, 79));
+            let ty = Label::from_utf8(t_f)
+                .filter(|t| !t.is_empty())
+                .ok_or_else(|| {
+                    ctx.parse(pos, line, t_f, "an AutoDock atom type in columns 78-79")
+                })?;
+            frame.types.push(ty);
+            autodock_element(t_f).unwrap_or_else(|| guess_element(&name, Some(&res), None))
+        } else {
+            let elem = std::str::from_utf8(trim(cols(line, 77, 78))).ok();
+            guess_element(&name, Some(&res), elem.filter(|e| !e.is_empty()))
+        };
         frame.positions.push(p);
         frame.ids.push(serial);
         frame.names.push(name);
@@ -291,7 +351,7 @@ impl FrameWalk for Pdb {
                 b"ATOM" | b"HETATM" => {
                     n_atoms += 1;
                     if let Some(f) = frame.as_deref_mut() {
-                        Pdb::atom(ctx, pos, line, f)?;
+                        self.atom(ctx, pos, line, f)?;
                     }
                 }
                 b"MODEL" => {
@@ -315,6 +375,17 @@ impl FrameWalk for Pdb {
                 name if !OTHER_RECORDS.contains(&name) && has_coordinates(line) => {
                     let name = cols(line, 1, 6);
                     return Err(ctx.parse(pos, line, name, "ATOM or HETATM in columns 1-6"));
+                }
+                b"REMARK" if self.pdbqt && line.starts_with(b"REMARK VINA RESULT:") => {
+                    // A docked pose's score: its title (`--label '{title}'`).
+                    if let Some(f) = frame.as_deref_mut() {
+                        let t = String::from_utf8_lossy(&line[7..]);
+                        let words: Vec<&str> = t.split_whitespace().collect();
+                        if !f.comment.is_empty() {
+                            f.comment.push(' ');
+                        }
+                        f.comment.push_str(&words.join(" "));
+                    }
                 }
                 b"TITLE" => {
                     if let Some(f) = frame.as_deref_mut() {

@@ -381,6 +381,7 @@ impl<R: Read + Seek> Trajectory<R> {
             Format::Netcdf => Reader::Netcdf(NetcdfReader::new(src, file.clone())?),
             Format::Gsd => Reader::Gsd(GsdReader::new(src, file.clone())?),
             Format::Pdb => Reader::Pdb(TextReader::new(src, Pdb::new(lenient), file.clone())),
+            Format::Pdbqt => Reader::Pdb(TextReader::new(src, Pdb::pdbqt(lenient), file.clone())),
             Format::Gro => Reader::Gro(TextReader::new(src, Gro, file.clone())),
             Format::LammpsDump => {
                 Reader::Lammps(TextReader::new(src, Lammps::default(), file.clone()))

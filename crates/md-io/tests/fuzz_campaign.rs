@@ -731,3 +731,10 @@ fn pqr_campaign() {
     let fx = files.map(|f| text_fixture(f, Format::Pqr));
     campaign("PQR", Format::Pqr, fx.into());
 }
+
+#[test]
+fn pdbqt_campaign() {
+    let files = ["pdbqt/poses.pdbqt", "pdbqt/ligand.pdbqt"];
+    let fx = files.map(|f| text_fixture(f, Format::Pdbqt));
+    campaign("PDBQT", Format::Pdbqt, fx.into());
+}

@@ -35,6 +35,7 @@ const FILES: &[(&str, Format)] = &[
     ("amber_ascii/odd.inpcrd", Format::AmberRestart),
     ("mda_two.crd", Format::CharmmCrd),
     ("parmed_models.pqr", Format::Pqr),
+    ("pdbqt/poses.pdbqt", Format::Pdbqt),
 ];
 
 /// The options a fixture is read with: an AMBER trajectory needs its topology's atom count
@@ -83,7 +84,7 @@ fn frame_ends(bytes: &[u8], format: Format) -> Vec<usize> {
                 ends.push(line_starts[l]);
             }
         }
-        Format::Pdb => {
+        Format::Pdb | Format::Pdbqt => {
             for (k, l) in lines.iter().enumerate() {
                 if l.starts_with("ENDMDL") {
                     ends.push(line_starts[k + 1]);
