@@ -67,11 +67,14 @@ pub enum Format {
     /// AutoDock PDBQT (Vina's docked poses, one MODEL each; Meeko's and Open Babel's receptors
     /// and ligands): PDB records with partial charges and AutoDock atom types: `.pdbqt`.
     Pdbqt,
+    /// NAMD binary coordinates (a count, then x y z as 8-byte floats; either byte order), one
+    /// frame: `.coor`; by name: `namdbin`.
+    NamdBin,
 }
 
 impl Format {
     /// Every format, in declaration order.
-    pub const ALL: [Format; 21] = [
+    pub const ALL: [Format; 22] = [
         Format::Xyz,
         Format::Pdb,
         Format::Gro,
@@ -93,6 +96,7 @@ impl Format {
         Format::CharmmCrd,
         Format::Pqr,
         Format::Pdbqt,
+        Format::NamdBin,
     ];
 
     /// The format a file extension (case-insensitive, e.g. "xyz", "lammpstrj") or a format's
@@ -121,6 +125,7 @@ impl Format {
             "crd" | "cor" | "charmm-crd" => Format::CharmmCrd,
             "pqr" => Format::Pqr,
             "pdbqt" => Format::Pdbqt,
+            "coor" | "namdbin" => Format::NamdBin,
             _ => return None,
         })
     }
@@ -394,6 +399,7 @@ impl Format {
             Format::CharmmCrd => "charmm-crd",
             Format::Pqr => "pqr",
             Format::Pdbqt => "pdbqt",
+            Format::NamdBin => "namdbin",
         }
     }
 }

@@ -16,7 +16,7 @@
 //!   (PDB2PQR/APBS: partial charges and radii as the `charge` and `radius` properties, chains,
 //!   MODEL/ENDMDL frames), AutoDock PDBQT (Vina's poses as frames; charges, AutoDock types and
 //!   the elements they name) (and the binary DCD, XTC,
-//!   TRR, AMBER NetCDF and HOOMD-blue GSD: particle types, diameters, per-particle properties
+//!   TRR, AMBER NetCDF, NAMD's binary `.coor` and HOOMD-blue GSD: particle types, diameters, per-particle properties
 //!   and bonds, by the hoomd schema's rule for what a frame omits) one frame at a time into a
 //!   reusable [`Frame`], or any frame by index.
 //!   Any of them may be gzip- or bzip2-compressed (`1abc.cif.gz`, `prod.mdcrd.bz2`; topologies too): it is
@@ -123,6 +123,7 @@ mod lammps;
 mod lammps_data;
 mod mmcif;
 mod mol2;
+mod namdbin;
 mod netcdf;
 pub mod parse;
 pub mod pbc;

@@ -14,6 +14,7 @@ use crate::lammps::Lammps;
 use crate::lammps_data::LammpsData;
 use crate::mmcif::Mmcif;
 use crate::mol2::Mol2;
+use crate::namdbin::NamdBinReader;
 use crate::netcdf::NetcdfReader;
 use crate::pdb::Pdb;
 use crate::pqr::Pqr;
@@ -46,6 +47,7 @@ enum Reader<R> {
     CrystalCif(TextReader<R, CrystalCif>),
     LammpsData(TextReader<R, LammpsData>),
     Cube(TextReader<R, Cube>),
+    NamdBin(NamdBinReader<R>),
     AmberTrj(TextReader<R, AmberTrj>),
     AmberRestart(TextReader<R, AmberRestart>),
     CharmmCrd(TextReader<R, Crd>),
@@ -72,6 +74,7 @@ macro_rules! each_reader {
             Reader::CrystalCif($r) => $body,
             Reader::LammpsData($r) => $body,
             Reader::Cube($r) => $body,
+            Reader::NamdBin($r) => $body,
             Reader::AmberTrj($r) => $body,
             Reader::AmberRestart($r) => $body,
             Reader::CharmmCrd($r) => $body,
@@ -380,6 +383,7 @@ impl<R: Read + Seek> Trajectory<R> {
             Format::Trr => Reader::Trr(TrrReader::new(src, file.clone())?),
             Format::Netcdf => Reader::Netcdf(NetcdfReader::new(src, file.clone())?),
             Format::Gsd => Reader::Gsd(GsdReader::new(src, file.clone())?),
+            Format::NamdBin => Reader::NamdBin(NamdBinReader::new(src, file.clone())?),
             Format::Pdb => Reader::Pdb(TextReader::new(src, Pdb::new(lenient), file.clone())),
             Format::Pdbqt => Reader::Pdb(TextReader::new(src, Pdb::pdbqt(lenient), file.clone())),
             Format::Gro => Reader::Gro(TextReader::new(src, Gro, file.clone())),

@@ -738,3 +738,33 @@ fn pdbqt_campaign() {
     let fx = files.map(|f| text_fixture(f, Format::Pdbqt));
     campaign("PDBQT", Format::Pdbqt, fx.into());
 }
+
+#[test]
+fn namdbin_campaign() {
+    let fx = ["namd/topo_mda.coor", "namd/topo_mda_be.coor"].map(|name| {
+        let bytes = data(name);
+        let len = bytes.len();
+        let big = name.ends_with("_be.coor");
+        Fixture {
+            frames: frames_of(Format::NamdBin, &bytes),
+            name: name.into(),
+            bytes,
+            boundaries: vec![0, 4, 4 + 24 * 33, len],
+            // The count must match the length: any cut is an error.
+            cuts: Cuts::Declared,
+            fields: vec![(
+                "NATOM",
+                if big {
+                    Field::I32Be(0)
+                } else {
+                    Field::I32Le(0)
+                },
+            )]
+            .into_iter()
+            .chain((!big).then_some(("x[0]", Field::F64Le(4))))
+            .collect(),
+            text: false,
+        }
+    });
+    campaign("NAMD binary", Format::NamdBin, fx.into());
+}
