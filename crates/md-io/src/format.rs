@@ -70,11 +70,15 @@ pub enum Format {
     /// NAMD binary coordinates (a count, then x y z as 8-byte floats; either byte order), one
     /// frame: `.coor`; by name: `namdbin`.
     NamdBin,
+    /// Tinker Cartesian coordinates and archives (index, name, x y z, type, bonded atoms; an
+    /// optional box line per frame), with their bonds: `.txyz`, `.arc`, and a `.xyz` in Tinker's
+    /// layout ([`Format::tinker_xyz`]); by name: `txyz`.
+    Tinker,
 }
 
 impl Format {
     /// Every format, in declaration order.
-    pub const ALL: [Format; 22] = [
+    pub const ALL: [Format; 23] = [
         Format::Xyz,
         Format::Pdb,
         Format::Gro,
@@ -97,6 +101,7 @@ impl Format {
         Format::Pqr,
         Format::Pdbqt,
         Format::NamdBin,
+        Format::Tinker,
     ];
 
     /// The format a file extension (case-insensitive, e.g. "xyz", "lammpstrj") or a format's
@@ -126,6 +131,7 @@ impl Format {
             "pqr" => Format::Pqr,
             "pdbqt" => Format::Pdbqt,
             "coor" | "namdbin" => Format::NamdBin,
+            "txyz" | "arc" => Format::Tinker,
             _ => return None,
         })
     }
@@ -261,6 +267,36 @@ impl Format {
         None
     }
 
+    /// True when the first bytes of a `.xyz` file are in Tinker's layout: a count line, an
+    /// optional box line (six numbers), then an atom line `index name x y z type [bonded ...]`
+    /// (integers where Tinker has them). A plain XYZ file's second line is a free comment and
+    /// its atom lines start with a name, so it does not have this shape.
+    pub fn tinker_xyz(head: &[u8]) -> bool {
+        use crate::parse::{fields, parse_f64, parse_i64};
+        let mut lines = head.split(|b| *b == b'\n');
+        let count = lines.next().and_then(|l| fields(l).next());
+        if count.and_then(parse_i64).is_none_or(|n| n <= 0) {
+            return false;
+        }
+        let atom = |l: &[u8]| {
+            let f: Vec<&[u8]> = fields(l).collect();
+            f.len() >= 6
+                && parse_i64(f[0]).is_some()
+                && parse_f64(f[1]).is_none()
+                && f[2..5].iter().all(|x| parse_f64(x).is_some())
+                && f[5..].iter().all(|x| parse_i64(x).is_some())
+        };
+        let Some(second) = lines.next() else {
+            return false;
+        };
+        if atom(second) {
+            return true;
+        }
+        let six_reals = fields(second).count() == 6
+            && fields(second).all(|x| x.contains(&b'.') && parse_f64(x).is_some());
+        six_reals && lines.next().is_some_and(atom)
+    }
+
     /// Which AMBER ASCII file the first bytes show, if either: after the title, an atom count
     /// (and time) then `6F12.7` coordinates is a restart ([`Format::AmberRestart`]); a line of
     /// `10F8.3` coordinates is a trajectory ([`Format::AmberTrj`]). A `.crd` file is told by
@@ -372,6 +408,7 @@ impl Format {
                 | Format::CharmmCrd
                 | Format::Pqr
                 | Format::Pdbqt
+                | Format::Tinker
         )
     }
 
@@ -400,6 +437,7 @@ impl Format {
             Format::Pqr => "pqr",
             Format::Pdbqt => "pdbqt",
             Format::NamdBin => "namdbin",
+            Format::Tinker => "txyz",
         }
     }
 }

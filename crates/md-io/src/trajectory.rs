@@ -20,6 +20,7 @@ use crate::pdb::Pdb;
 use crate::pqr::Pqr;
 use crate::sdf::Sdf;
 use crate::text::TextReader;
+use crate::tinker::Tinker;
 use crate::trr::TrrReader;
 use crate::vasp::Vasp;
 use crate::xtc::XtcReader;
@@ -48,6 +49,7 @@ enum Reader<R> {
     LammpsData(TextReader<R, LammpsData>),
     Cube(TextReader<R, Cube>),
     NamdBin(NamdBinReader<R>),
+    Tinker(TextReader<R, Tinker>),
     AmberTrj(TextReader<R, AmberTrj>),
     AmberRestart(TextReader<R, AmberRestart>),
     CharmmCrd(TextReader<R, Crd>),
@@ -75,6 +77,7 @@ macro_rules! each_reader {
             Reader::LammpsData($r) => $body,
             Reader::Cube($r) => $body,
             Reader::NamdBin($r) => $body,
+            Reader::Tinker($r) => $body,
             Reader::AmberTrj($r) => $body,
             Reader::AmberRestart($r) => $body,
             Reader::CharmmCrd($r) => $body,
@@ -279,6 +282,18 @@ pub(crate) fn crd_kind_of(file: &mut File, path: &Path, name: &Arc<str>) -> Resu
     Ok(Format::CharmmCrd)
 }
 
+/// Whether `file` is a `.xyz` in Tinker's layout ([`Format::tinker_xyz`]); the file is rewound.
+fn is_tinker(file: &mut File, name: &Arc<str>) -> Result<bool, Error> {
+    let io = |source| Error::Io {
+        at: crate::error::Location::file(name),
+        source,
+    };
+    let mut head = Vec::new();
+    file.take(4096).read_to_end(&mut head).map_err(io)?;
+    file.rewind().map_err(io)?;
+    Ok(Format::tinker_xyz(&head))
+}
+
 /// Whether `file` starts with NetCDF-3's magic number; the file is rewound.
 fn is_netcdf(file: &mut File, name: &Arc<str>) -> Result<bool, Error> {
     let io = |source| Error::Io {
@@ -337,6 +352,8 @@ impl Trajectory<File> {
             Format::CharmmCrd => crd_kind_of(&mut file, path, &name)?,
             // pmemd writes its restarts as NetCDF by default, whatever the name.
             Format::AmberRestart if is_netcdf(&mut file, &name)? => Format::Netcdf,
+            // Tinker writes `.xyz` too.
+            Format::Xyz if is_tinker(&mut file, &name)? => Format::Tinker,
             other => other,
         };
         Trajectory::from_reader_with(file, format, &name, options).map(|t| t.with_warning(cut))
@@ -384,6 +401,7 @@ impl<R: Read + Seek> Trajectory<R> {
             Format::Netcdf => Reader::Netcdf(NetcdfReader::new(src, file.clone())?),
             Format::Gsd => Reader::Gsd(GsdReader::new(src, file.clone())?),
             Format::NamdBin => Reader::NamdBin(NamdBinReader::new(src, file.clone())?),
+            Format::Tinker => Reader::Tinker(TextReader::new(src, Tinker::default(), file.clone())),
             Format::Pdb => Reader::Pdb(TextReader::new(src, Pdb::new(lenient), file.clone())),
             Format::Pdbqt => Reader::Pdb(TextReader::new(src, Pdb::pdbqt(lenient), file.clone())),
             Format::Gro => Reader::Gro(TextReader::new(src, Gro, file.clone())),

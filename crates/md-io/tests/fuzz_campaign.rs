@@ -768,3 +768,10 @@ fn namdbin_campaign() {
     });
     campaign("NAMD binary", Format::NamdBin, fx.into());
 }
+
+#[test]
+fn tinker_campaign() {
+    let files = ["tinker/water_box.arc", "tinker/caffeine.txyz"];
+    let fx = files.map(|f| text_fixture(f, Format::Tinker));
+    campaign("Tinker", Format::Tinker, fx.into());
+}

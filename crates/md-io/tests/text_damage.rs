@@ -36,6 +36,8 @@ const FILES: &[(&str, Format)] = &[
     ("mda_two.crd", Format::CharmmCrd),
     ("parmed_models.pqr", Format::Pqr),
     ("pdbqt/poses.pdbqt", Format::Pdbqt),
+    ("tinker/water_box.arc", Format::Tinker),
+    ("tinker/caffeine.txyz", Format::Tinker),
 ];
 
 /// The options a fixture is read with: an AMBER trajectory needs its topology's atom count
@@ -164,6 +166,19 @@ fn frame_ends(bytes: &[u8], format: Format) -> Vec<usize> {
                 ends.push(line_starts[k + 1]);
             }
             ends.push(bytes.len());
+        }
+        Format::Tinker => {
+            // A count line, a box line when the next starts with a real number, the atoms.
+            let mut l = 0;
+            while l < lines.len() {
+                let n: usize = lines[l].split_whitespace().next().unwrap().parse().unwrap();
+                let boxed = lines[l + 1]
+                    .split_whitespace()
+                    .next()
+                    .is_some_and(|f| f.contains('.'));
+                l += 1 + usize::from(boxed) + n;
+                ends.push(line_starts[l]);
+            }
         }
         Format::AmberTrj => {
             // The title, then per frame 20 coordinate lines (198 numbers) and a box line.
