@@ -74,11 +74,14 @@ pub enum Format {
     /// optional box line per frame), with their bonds: `.txyz`, `.arc`, and a `.xyz` in Tinker's
     /// layout ([`Format::tinker_xyz`]); by name: `txyz`.
     Tinker,
+    /// DL_POLY `CONFIG` / `REVCON` (one frame) and `HISTORY` (DL_POLY 4 and Classic), by
+    /// DL_POLY's file names (any suffix); by name: `dlpoly`.
+    DlPoly,
 }
 
 impl Format {
     /// Every format, in declaration order.
-    pub const ALL: [Format; 23] = [
+    pub const ALL: [Format; 24] = [
         Format::Xyz,
         Format::Pdb,
         Format::Gro,
@@ -102,6 +105,7 @@ impl Format {
         Format::Pdbqt,
         Format::NamdBin,
         Format::Tinker,
+        Format::DlPoly,
     ];
 
     /// The format a file extension (case-insensitive, e.g. "xyz", "lammpstrj") or a format's
@@ -132,6 +136,7 @@ impl Format {
             "pdbqt" => Format::Pdbqt,
             "coor" | "namdbin" => Format::NamdBin,
             "txyz" | "arc" => Format::Tinker,
+            "dlpoly" => Format::DlPoly,
             _ => return None,
         })
     }
@@ -163,6 +168,13 @@ impl Format {
             .is_some();
         if vasp || volumetric {
             return Some(Format::Vasp);
+        }
+        // DL_POLY's file names, with any suffix (`HISTORY_run2`, `REVCON.1`).
+        let dlpoly = [&b"CONFIG"[..], b"REVCON", b"CFGMIN", b"HISTORY"]
+            .iter()
+            .any(|v| name.starts_with(v));
+        if dlpoly {
+            return Some(Format::DlPoly);
         }
         // AMBER's default file names.
         if name.eq_ignore_ascii_case(b"mdcrd") {
@@ -409,6 +421,7 @@ impl Format {
                 | Format::Pqr
                 | Format::Pdbqt
                 | Format::Tinker
+                | Format::DlPoly
         )
     }
 
@@ -438,6 +451,7 @@ impl Format {
             Format::Pdbqt => "pdbqt",
             Format::NamdBin => "namdbin",
             Format::Tinker => "txyz",
+            Format::DlPoly => "dlpoly",
         }
     }
 }

@@ -15,7 +15,8 @@
 //!   property; a `.crd` is CHARMM's when it starts with a `*` title, else AMBER's) and PQR
 //!   (PDB2PQR/APBS: partial charges and radii as the `charge` and `radius` properties, chains,
 //!   MODEL/ENDMDL frames), AutoDock PDBQT (Vina's poses as frames; charges, AutoDock types and
-//!   the elements they name), Tinker `.xyz`/`.arc` with their bonds (and the binary DCD, XTC,
+//!   the elements they name), Tinker `.xyz`/`.arc` with their bonds, DL_POLY CONFIG/HISTORY
+//!   (and the binary DCD, XTC,
 //!   TRR, AMBER NetCDF, NAMD's binary `.coor` and HOOMD-blue GSD: particle types, diameters, per-particle properties
 //!   and bonds, by the hoomd schema's rule for what a frame omits) one frame at a time into a
 //!   reusable [`Frame`], or any frame by index.
@@ -111,6 +112,7 @@ mod crystal_cif;
 mod cube;
 mod cursor;
 mod dcd;
+mod dlpoly;
 pub mod elements;
 mod error;
 mod format;

@@ -5,6 +5,7 @@ use crate::crd::Crd;
 use crate::crystal_cif::CrystalCif;
 use crate::cube::Cube;
 use crate::dcd::DcdReader;
+use crate::dlpoly::DlPoly;
 use crate::error::Error;
 use crate::format::Format;
 use crate::frame::Frame;
@@ -50,6 +51,7 @@ enum Reader<R> {
     Cube(TextReader<R, Cube>),
     NamdBin(NamdBinReader<R>),
     Tinker(TextReader<R, Tinker>),
+    DlPoly(TextReader<R, DlPoly>),
     AmberTrj(TextReader<R, AmberTrj>),
     AmberRestart(TextReader<R, AmberRestart>),
     CharmmCrd(TextReader<R, Crd>),
@@ -78,6 +80,7 @@ macro_rules! each_reader {
             Reader::Cube($r) => $body,
             Reader::NamdBin($r) => $body,
             Reader::Tinker($r) => $body,
+            Reader::DlPoly($r) => $body,
             Reader::AmberTrj($r) => $body,
             Reader::AmberRestart($r) => $body,
             Reader::CharmmCrd($r) => $body,
@@ -402,6 +405,7 @@ impl<R: Read + Seek> Trajectory<R> {
             Format::Gsd => Reader::Gsd(GsdReader::new(src, file.clone())?),
             Format::NamdBin => Reader::NamdBin(NamdBinReader::new(src, file.clone())?),
             Format::Tinker => Reader::Tinker(TextReader::new(src, Tinker::default(), file.clone())),
+            Format::DlPoly => Reader::DlPoly(TextReader::new(src, DlPoly::default(), file.clone())),
             Format::Pdb => Reader::Pdb(TextReader::new(src, Pdb::new(lenient), file.clone())),
             Format::Pdbqt => Reader::Pdb(TextReader::new(src, Pdb::pdbqt(lenient), file.clone())),
             Format::Gro => Reader::Gro(TextReader::new(src, Gro, file.clone())),

@@ -775,3 +775,10 @@ fn tinker_campaign() {
     let fx = files.map(|f| text_fixture(f, Format::Tinker));
     campaign("Tinker", Format::Tinker, fx.into());
 }
+
+#[test]
+fn dlpoly_campaign() {
+    let files = ["dlpoly/HISTORY", "dlpoly/CONFIG"];
+    let fx = files.map(|f| text_fixture(f, Format::DlPoly));
+    campaign("DL_POLY", Format::DlPoly, fx.into());
+}

@@ -38,6 +38,8 @@ const FILES: &[(&str, Format)] = &[
     ("pdbqt/poses.pdbqt", Format::Pdbqt),
     ("tinker/water_box.arc", Format::Tinker),
     ("tinker/caffeine.txyz", Format::Tinker),
+    ("dlpoly/HISTORY", Format::DlPoly),
+    ("dlpoly/CONFIG", Format::DlPoly),
 ];
 
 /// The options a fixture is read with: an AMBER trajectory needs its topology's atom count
@@ -167,6 +169,17 @@ fn frame_ends(bytes: &[u8], format: Format) -> Vec<usize> {
             }
             ends.push(bytes.len());
         }
+        Format::DlPoly if lines[2].starts_with("timestep") => {
+            // The title and header, then per frame a timestep line, 3 cell lines and 4 lines
+            // per atom (name, position, velocity, force: levcfg 2).
+            let n: usize = lines[1].split_whitespace().nth(2).unwrap().parse().unwrap();
+            let mut l = 2 + 4 + 4 * n;
+            while l <= lines.len() {
+                ends.push(line_starts[l]);
+                l += 4 + 4 * n;
+            }
+        }
+        Format::DlPoly => ends.push(bytes.len()),
         Format::Tinker => {
             // A count line, a box line when the next starts with a real number, the atoms.
             let mut l = 0;
