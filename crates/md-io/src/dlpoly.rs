@@ -24,7 +24,7 @@ use crate::elements::guess_element;
 use crate::error::Error;
 use crate::frame::{Frame, Label, UnitCell};
 use crate::parse::{fields, parse_f64, parse_i64, parse_usize, trim};
-use crate::text::{Ctx, LineReader, Pos, TextFormat, need_line};
+use crate::text::{Ctx, FrameWalk, LineReader, Pos, need_line};
 use std::io::Read;
 
 /// The DL_POLY parser: the file header (read with frame 0) and scratch for reordering.
@@ -83,7 +83,7 @@ impl DlPoly {
     }
 
     /// One frame (or, with `frame` None, its structure only).
-    fn walk<R: Read>(
+    fn walk_frame<R: Read>(
         &mut self,
         lines: &mut LineReader<R>,
         ctx: &Ctx,
@@ -252,18 +252,14 @@ impl DlPoly {
     }
 }
 
-impl TextFormat for DlPoly {
-    fn read<R: Read>(
+impl FrameWalk for DlPoly {
+    fn walk<R: Read>(
         &mut self,
         lines: &mut LineReader<R>,
         ctx: &Ctx,
-        frame: &mut Frame,
+        frame: Option<&mut Frame>,
     ) -> Result<bool, Error> {
-        self.walk(lines, ctx, Some(frame))
-    }
-
-    fn skip<R: Read>(&mut self, lines: &mut LineReader<R>, ctx: &Ctx) -> Result<bool, Error> {
-        self.walk(lines, ctx, None)
+        self.walk_frame(lines, ctx, frame)
     }
 
     /// The title may be blank.

@@ -279,6 +279,9 @@ pub(crate) trait FrameWalk {
         ctx: &Ctx,
         frame: Option<&mut Frame>,
     ) -> Result<bool, Error>;
+
+    /// [`TextFormat::SKIPS_BLANK_LINES`].
+    const SKIPS_BLANK_LINES: bool = true;
 }
 
 impl<T: FrameWalk> TextFormat for T {
@@ -294,6 +297,8 @@ impl<T: FrameWalk> TextFormat for T {
     fn skip<R: Read>(&mut self, lines: &mut LineReader<R>, ctx: &Ctx) -> Result<bool, Error> {
         self.walk(lines, ctx, None)
     }
+
+    const SKIPS_BLANK_LINES: bool = T::SKIPS_BLANK_LINES;
 }
 
 /// What the multi-model text formats (PDB, PDBx/mmCIF) check across frames: every model must
