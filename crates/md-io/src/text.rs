@@ -268,6 +268,12 @@ pub(crate) trait TextFormat {
     /// Whether blank lines before a frame are passed over before `read` or `skip` is called
     /// (false for a format whose first line, a title, may be blank: AMBER's).
     const SKIPS_BLANK_LINES: bool = true;
+
+    /// Called when the data ends where frame `ctx.frame` would start (at `at`): a format whose
+    /// header announces more frames (XSF's `ANIMSTEPS`) returns the cut there.
+    fn end(&mut self, _ctx: &Ctx, _at: Pos) -> Result<(), Error> {
+        Ok(())
+    }
 }
 
 /// A text format whose `read` and `skip` are one walk over a frame's records, parsing them into
@@ -279,6 +285,11 @@ pub(crate) trait FrameWalk {
         ctx: &Ctx,
         frame: Option<&mut Frame>,
     ) -> Result<bool, Error>;
+
+    /// As [`TextFormat::end`].
+    fn end(&mut self, _ctx: &Ctx, _at: Pos) -> Result<(), Error> {
+        Ok(())
+    }
 }
 
 impl<T: FrameWalk> TextFormat for T {
@@ -293,6 +304,10 @@ impl<T: FrameWalk> TextFormat for T {
 
     fn skip<R: Read>(&mut self, lines: &mut LineReader<R>, ctx: &Ctx) -> Result<bool, Error> {
         self.walk(lines, ctx, None)
+    }
+
+    fn end(&mut self, ctx: &Ctx, at: Pos) -> Result<(), Error> {
+        FrameWalk::end(self, ctx, at)
     }
 }
 
@@ -478,6 +493,7 @@ impl<R: Read + Seek, F: TextFormat> TextReader<R, F> {
         let ctx = self.ctx();
         frame.clear();
         let Some(start) = frame_start(&mut self.lines, &ctx, F::SKIPS_BLANK_LINES)? else {
+            self.format.end(&ctx, self.lines.pos())?;
             if self.next == self.starts.len() {
                 self.complete = true;
             }
@@ -583,6 +599,7 @@ impl<R: Read + Seek, F: TextFormat> TextReader<R, F> {
         while self.starts.len() <= n {
             let ctx = self.ctx();
             let Some(start) = frame_start(&mut self.lines, &ctx, F::SKIPS_BLANK_LINES)? else {
+                self.format.end(&ctx, self.lines.pos())?;
                 self.complete = true;
                 return Ok(());
             };
