@@ -64,11 +64,16 @@ pub enum Format {
     /// the partial charge (e) and radius (Å) as the `charge` and `radius` properties;
     /// MODEL/ENDMDL models are frames: `.pqr`.
     Pqr,
+    /// XCrySDen XSF and animated AXSF (Quantum ESPRESSO pp.x, ASE, pymatgen, VESTA): each
+    /// structure a frame, with its cell (CRYSTAL, SLAB, POLYMER) and forces as `fx fy fz`
+    /// (eV/Å); its data grids are checked, not kept (see [`crate::volume::read_volumes`]):
+    /// `.xsf`, `.axsf`.
+    Xsf,
 }
 
 impl Format {
     /// Every format, in declaration order.
-    pub const ALL: [Format; 20] = [
+    pub const ALL: [Format; 21] = [
         Format::Xyz,
         Format::Pdb,
         Format::Gro,
@@ -89,6 +94,7 @@ impl Format {
         Format::AmberRestart,
         Format::CharmmCrd,
         Format::Pqr,
+        Format::Xsf,
     ];
 
     /// The format a file extension (case-insensitive, e.g. "xyz", "lammpstrj") or a format's
@@ -116,6 +122,7 @@ impl Format {
             "rst7" | "inpcrd" | "restrt" => Format::AmberRestart,
             "crd" | "cor" | "charmm-crd" => Format::CharmmCrd,
             "pqr" => Format::Pqr,
+            "xsf" | "axsf" => Format::Xsf,
             _ => return None,
         })
     }
@@ -161,9 +168,9 @@ impl Format {
 
     /// The format the first bytes of a file show (give at least 256 bytes when the file has
     /// them). Binary formats are told by their magic numbers, text formats by their first
-    /// lines: `data_` (CIF: PDBx/mmCIF or crystallographic, by [`Format::cif_kind`]) or
-    /// `@<TRIPOS>` (MOL2) on the first line that is not a `#`
-    /// comment, a `*` title on the first non-blank line (CHARMM CRD), `ITEM: TIMESTEP` (LAMMPS), a PDB record name, a fourth line ending in `V2000` or
+    /// lines: `data_` (CIF: PDBx/mmCIF or crystallographic, by [`Format::cif_kind`]),
+    /// `@<TRIPOS>` (MOL2) or an XSF keyword (`CRYSTAL`, `ATOMS`, `ANIMSTEPS`…) on the first
+    /// line that is not a `#` comment, a `*` title on the first non-blank line (CHARMM CRD), `ITEM: TIMESTEP` (LAMMPS), a PDB record name, a fourth line ending in `V2000` or
     /// `V3000` (molfile, SD file), an integer first line (XYZ), an `N atoms` line after the title
     /// (LAMMPS data file), an integer second line (GRO).
     pub fn from_magic(head: &[u8]) -> Option<Format> {
@@ -209,6 +216,10 @@ impl Format {
         // MOL2: a Tripos record header, after comments and blank lines.
         if cif.is_some_and(|l| l.starts_with(b"@<TRIPOS>")) {
             return Some(Format::Mol2);
+        }
+        // XSF: an XCrySDen keyword, after comments and blank lines.
+        if cif.is_some_and(is_xsf_start) {
+            return Some(Format::Xsf);
         }
         let mut lines = head.split(|b| *b == b'\n');
         let first = lines.next().unwrap_or(&[]);
@@ -361,6 +372,7 @@ impl Format {
                 | Format::AmberRestart
                 | Format::CharmmCrd
                 | Format::Pqr
+                | Format::Xsf
         )
     }
 
@@ -387,6 +399,7 @@ impl Format {
             Format::AmberRestart => "rst7",
             Format::CharmmCrd => "charmm-crd",
             Format::Pqr => "pqr",
+            Format::Xsf => "xsf",
         }
     }
 }
@@ -416,6 +429,23 @@ fn looks_like_vasp(head: &[u8]) -> bool {
     !words.is_empty()
         && (words.iter().all(|w| parse_usize(w).is_some())
             || words.iter().all(|w| w[0].is_ascii_alphabetic()))
+}
+
+/// True when `line` (the first that is not blank or a `#` comment) starts an XSF file: one of
+/// XCrySDen's leading keywords, in any case.
+fn is_xsf_start(line: &[u8]) -> bool {
+    const KEYWORDS: [&[u8]; 8] = [
+        b"ANIMSTEPS",
+        b"CRYSTAL",
+        b"SLAB",
+        b"POLYMER",
+        b"MOLECULE",
+        b"ATOMS",
+        b"BEGIN_BLOCK_DATAGRID_3D",
+        b"BEGIN_BLOCK_DATAGRID3D",
+    ];
+    let first = crate::parse::fields(line).next().unwrap_or(b"");
+    KEYWORDS.iter().any(|k| first.eq_ignore_ascii_case(k))
 }
 
 /// True when the first non-blank lines are `*` titles followed by an atom-count line (`N` or
@@ -562,5 +592,14 @@ mod tests {
             Some(Format::CharmmCrd)
         );
         assert_eq!(Format::from_path(Path::new("1abc.pqr")), Some(Format::Pqr));
+        assert_eq!(Format::from_path(Path::new("md.AXSF")), Some(Format::Xsf));
+        assert_eq!(
+            Format::from_magic(b"# pw.x\n\n CRYSTAL\n PRIMVEC\n"),
+            Some(Format::Xsf)
+        );
+        assert_eq!(
+            Format::from_magic(b"ANIMSTEPS 3\nATOMS 1\n"),
+            Some(Format::Xsf)
+        );
     }
 }

@@ -144,6 +144,7 @@ pub mod values;
 mod vasp;
 pub mod volume;
 mod writer;
+mod xsf;
 mod xtc;
 mod xyz;
 

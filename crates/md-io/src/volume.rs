@@ -276,6 +276,8 @@ pub enum VolumeFormat {
     Cube,
     /// VASP volumetric data (a POSCAR block, then grids) holding this quantity.
     Vasp(VaspQuantity),
+    /// XCrySDen XSF / AXSF: `.xsf`, `.axsf` (its `DATAGRID_3D` grids).
+    Xsf,
 }
 
 /// What a VASP volumetric file's values are; the file's name tells (see the module docs).
@@ -339,13 +341,17 @@ impl VaspQuantity {
 }
 
 impl VolumeFormat {
-    /// The format a path names: `.cube` / `.cub` (any case) is a cube file, a VASP name
-    /// ([`VaspQuantity::from_file_name`]) VASP volumetric data; a final `.gz` is looked through.
+    /// The format a path names: `.cube` / `.cub` (any case) is a cube file, `.xsf` / `.axsf`
+    /// an XSF file, a VASP name ([`VaspQuantity::from_file_name`]) VASP volumetric data; a
+    /// final `.gz` is looked through.
     pub fn from_path(path: &Path) -> Option<VolumeFormat> {
         let inner = crate::gz::inner_path(path);
         let ext = inner.extension().and_then(|e| e.to_str()).unwrap_or("");
         if ext.eq_ignore_ascii_case("cube") || ext.eq_ignore_ascii_case("cub") {
             return Some(VolumeFormat::Cube);
+        }
+        if ext.eq_ignore_ascii_case("xsf") || ext.eq_ignore_ascii_case("axsf") {
+            return Some(VolumeFormat::Xsf);
         }
         let name = inner.file_name()?.to_str()?;
         VaspQuantity::from_file_name(name).map(VolumeFormat::Vasp)
@@ -361,8 +367,8 @@ pub fn read_volumes(path: impl AsRef<Path>) -> Result<(Frame, Vec<Volume>), Erro
     let name: Arc<str> = path.display().to_string().into();
     let kind = VolumeFormat::from_path(path).ok_or_else(|| Error::Unsupported {
         file: name.clone(),
-        what: "volumetric data from a file not named .cube / .cub or as VASP names its \
-               volumetric files (CHGCAR, CHG, PARCHG, LOCPOT, ELFCAR, AECCAR0/1/2)",
+        what: "volumetric data from a file not named .cube / .cub, .xsf / .axsf or as VASP \
+               names its volumetric files (CHGCAR, CHG, PARCHG, LOCPOT, ELFCAR, AECCAR0/1/2)",
     })?;
     let (file, _) = crate::gz::open(path, &name, false)?;
     let len = file.metadata().ok().map(|m| m.len());
@@ -410,6 +416,7 @@ fn read_sized<R: Read>(
     let mut frame = Frame::new();
     let sets = match kind {
         VolumeFormat::Cube => crate::cube::read(&mut lines, &ctx, &mut frame, &budget)?,
+        VolumeFormat::Xsf => crate::xsf::read(&mut lines, &ctx, &mut frame, &budget)?,
         VolumeFormat::Vasp(q) => {
             let grids = crate::chgcar::read(&mut lines, &ctx, &mut frame, q, &budget)?;
             let count = grids.len();

@@ -23,6 +23,8 @@ Writes (ase.io.write(..., format="xsf") unless said otherwise)
   property "vect", CONVVEC after the atoms, one BEGIN_BLOCK_DATAGRID_3D holding two grids
   (two periodic functions on the general grid over the cell, a shifted origin), 14 decimals,
   no final newline;
+- ase_grid_small.xsf: Si2 in an orthorhombic cell with the periodic function on a 4 x 3 x 5
+  general grid over the cell (the damage tests' grid file);
 - reference.json: per file the frames ase.io.read(path, index=":") gives (atomic numbers,
   positions, cell when periodic, pbc, forces in eV/Å when the file has them); for the grid
   files what ase.io.xsf.read_xsf(read_data=True) gives (shape, origin, spanning vectors,
@@ -219,7 +221,7 @@ frac = rng.random((5, 3))
 species = ["Fe", "Fe", "O", "O", "O"]
 vect = rng.normal(scale=0.4, size=(5, 3))
 st = Structure(lattice, species, frac, site_properties={"vect": vect.tolist()})
-shape = (7, 6, 8)
+shape = (5, 4, 6)
 grid = XSFGrid(
     data=np.stack([general_grid(periodic_f, shape), general_grid(periodic_g, shape)]),
     lattice=lattice.matrix,
@@ -254,6 +256,24 @@ reference[name] = {
         for k in range(len(bg.labels))
     ],
     "analytic": {"periodic": ["f", "g"]},
+}
+
+# A small crystal grid for the damage tests (the periodic function, 4 x 3 x 5 points).
+small = Atoms("Si2", scaled_positions=[[0, 0, 0], [0.25, 0.25, 0.25]], cell=[3.0, 3.2, 3.4])
+small.pbc = True
+name = "ase_grid_small.xsf"
+write(
+    name,
+    small,
+    format="xsf",
+    data=general_grid(periodic_f, (4, 3, 5)),
+    origin=np.zeros(3),
+    span_vectors=small.cell.array,
+)
+reference[name] = {
+    "frames": frames_of(name),
+    "grids": [grid_reference(name)],
+    "analytic": {"periodic": ["f"]},
 }
 
 with open("reference.json", "w") as f:
