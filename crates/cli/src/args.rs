@@ -63,7 +63,8 @@ pub enum Command {
         /// AMBER NetCDF, AMBER ASCII mdcrd (with --topology: the file has no atom count) and
         /// rst7/inpcrd, HOOMD-blue GSD, SDF/MOL and MOL2 with their bonds, one frame per
         /// record, VASP POSCAR/CONTCAR/XDATCAR, crystallographic CIF, a LAMMPS data file,
-        /// CHARMM .crd/.cor, PQR with charges and radii, AutoDock PDBQT, NAMD binary .coor, Tinker .xyz/.arc, DL_POLY CONFIG/HISTORY),
+        /// CHARMM .crd/.cor, PQR with charges and radii, AutoDock PDBQT, NAMD binary .coor, Tinker .xyz/.arc, DL_POLY CONFIG/HISTORY,
+        /// XCrySDen XSF/AXSF),
         /// gzip- or bzip2-compressed or not (1abc.cif.gz, prod.mdcrd.bz2). A quoted pattern ('dump.*.lammpstrj') reads
         /// the files it matches in natural order as one trajectory.
         file: PathBuf,
@@ -848,10 +849,10 @@ pub struct MolArgs {
     #[arg(long, value_name = "A", default_value_t = 1.0)]
     pub polyhedra_opacity: f32,
     /// Draw the isosurface of volumetric data at this level, as VMD, VESTA and Avogadro do: the
-    /// volume of a Gaussian cube file or a VASP CHGCAR / PARCHG / LOCPOT / ELFCAR given as the
-    /// input (or by --volume). Where the data also runs below −LEVEL (an orbital's negative
+    /// volume of a Gaussian cube file, an XSF file's DATAGRID_3D or a VASP CHGCAR / PARCHG /
+    /// LOCPOT / ELFCAR given as the input (or by --volume). Where the data also runs below −LEVEL (an orbital's negative
     /// lobe) that surface is drawn too, in --isosurface-negative-color (see --isosurface-sign).
-    /// A CHGCAR's density is in e/Å³, a cube file's values as written (often e/bohr³);
+    /// A CHGCAR's density is in e/Å³, a cube or XSF file's values as written (often e/bohr³);
     /// `texmap info FILE` prints each data set's range. Not with --align-to, which would move
     /// the atoms away from the grid.
     #[arg(
@@ -862,7 +863,7 @@ pub struct MolArgs {
     )]
     pub isosurface: Option<f32>,
     /// The volumetric data for --isosurface and --volume-slice when the input is not itself a
-    /// cube or CHGCAR file
+    /// cube, XSF or CHGCAR file
     /// (render a POSCAR or PDB with the density of another file; its grid must be in the same
     /// coordinates).
     #[arg(long, value_name = "FILE")]
@@ -870,7 +871,7 @@ pub struct MolArgs {
     /// Which data set of the volumetric file --isosurface and --volume-slice draw, from 1: a
     /// CHGCAR's 1 is the
     /// total density and 2 the magnetisation (spin-polarised runs); a cube file's the orbitals
-    /// in the order it lists them.
+    /// in the order it lists them; an XSF file's its grids in file order.
     #[arg(long, value_name = "N", default_value_t = 1)]
     pub volume_set: usize,
     /// Which sides --isosurface draws: both (+LEVEL and −LEVEL where the data reaches it),
@@ -885,7 +886,7 @@ pub struct MolArgs {
     pub isosurface_negative_color: String,
     /// Colour the isosurface by the values of another volumetric file at its vertices, as an
     /// electrostatic potential is mapped onto an electron density surface (GaussView's and
-    /// VMD's ESP maps): a cube file or CHGCAR-family file in the same coordinates, through
+    /// VMD's ESP maps): a cube, XSF or CHGCAR-family file in the same coordinates, through
     /// --volume-colormap over --volume-range, with a colour bar.
     #[arg(long, value_name = "FILE", requires = "isosurface")]
     pub isosurface_color_by: Option<PathBuf>,

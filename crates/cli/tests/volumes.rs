@@ -501,3 +501,56 @@ fn a_volume_slice_is_the_grids_plane_in_its_values_colours() {
         field,
     ]);
 }
+
+/// An XSF file (ASE's, md-io's tests/data/xsf/gen_xsf.py): a periodic function on the general
+/// grid over a triclinic crystal's cell, read as a periodic volume (the repeated end planes
+/// dropped), so its isosurface follows the periodic images as a CHGCAR's does; `texmap info`
+/// gives the grid.
+#[test]
+fn an_xsf_grid_is_drawn_as_a_periodic_isosurface() {
+    let xsf = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../md-io/tests/data/xsf/ase_grid_crystal.xsf")
+        .to_str()
+        .unwrap()
+        .to_string();
+    let o = texmap(&["info", xsf.as_str()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["format"], "xsf");
+    assert_eq!(v["atoms"], 2);
+    let set = &v["volumes"][0];
+    assert_eq!(set["name"], "data: grid#1");
+    assert_eq!(set["points"], serde_json::json!([8, 9, 10]));
+    assert_eq!(set["periodic"], true);
+    let dir = tempfile::tempdir().unwrap();
+    let export = |name: &str, extra: &[&str]| {
+        let obj = dir.path().join(name);
+        let png = dir.path().join(format!("{name}.png"));
+        let mut args = vec![
+            "render",
+            "--quiet",
+            xsf.as_str(),
+            "--style",
+            "ball-stick",
+            "--size",
+            "160x120",
+            "--isosurface",
+            "0.8",
+            "--export-mesh",
+            obj.to_str().unwrap(),
+            "-o",
+            png.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        let o = texmap(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        assert!(png.exists());
+        obj_volume_area(&obj)
+    };
+    let (v1, a1, n1) = export("one.obj", &[]);
+    let (v4, a4, n4) = export("four.obj", &["--replicate", "2,2,1"]);
+    assert!(n1 > 50, "{n1} triangles");
+    assert_eq!(n4, 4 * n1);
+    assert!((v4 / v1 - 4.0).abs() < 1e-3, "{v4} vs 4 x {v1}");
+    assert!((a4 / a1 - 4.0).abs() < 1e-3, "{a4} vs 4 x {a1}");
+}

@@ -77,11 +77,16 @@ pub enum Format {
     /// DL_POLY `CONFIG` / `REVCON` (one frame) and `HISTORY` (DL_POLY 4 and Classic), by
     /// DL_POLY's file names (any suffix); by name: `dlpoly`.
     DlPoly,
+    /// XCrySDen XSF and animated AXSF (Quantum ESPRESSO pp.x, ASE, pymatgen, VESTA): each
+    /// structure a frame, with its cell (CRYSTAL, SLAB, POLYMER) and forces as `fx fy fz`
+    /// (eV/Å); its data grids are checked, not kept (see [`crate::volume::read_volumes`]):
+    /// `.xsf`, `.axsf`.
+    Xsf,
 }
 
 impl Format {
     /// Every format, in declaration order.
-    pub const ALL: [Format; 24] = [
+    pub const ALL: [Format; 25] = [
         Format::Xyz,
         Format::Pdb,
         Format::Gro,
@@ -106,6 +111,7 @@ impl Format {
         Format::NamdBin,
         Format::Tinker,
         Format::DlPoly,
+        Format::Xsf,
     ];
 
     /// The format a file extension (case-insensitive, e.g. "xyz", "lammpstrj") or a format's
@@ -137,6 +143,7 @@ impl Format {
             "coor" | "namdbin" => Format::NamdBin,
             "txyz" | "arc" => Format::Tinker,
             "dlpoly" => Format::DlPoly,
+            "xsf" | "axsf" => Format::Xsf,
             _ => return None,
         })
     }
@@ -189,9 +196,9 @@ impl Format {
 
     /// The format the first bytes of a file show (give at least 256 bytes when the file has
     /// them). Binary formats are told by their magic numbers, text formats by their first
-    /// lines: `data_` (CIF: PDBx/mmCIF or crystallographic, by [`Format::cif_kind`]) or
-    /// `@<TRIPOS>` (MOL2) on the first line that is not a `#`
-    /// comment, a `*` title on the first non-blank line (CHARMM CRD), `ITEM: TIMESTEP` (LAMMPS), a PDB record name, a fourth line ending in `V2000` or
+    /// lines: `data_` (CIF: PDBx/mmCIF or crystallographic, by [`Format::cif_kind`]),
+    /// `@<TRIPOS>` (MOL2) or an XSF keyword (`CRYSTAL`, `ATOMS`, `ANIMSTEPS`…) on the first
+    /// line that is not a `#` comment, a `*` title on the first non-blank line (CHARMM CRD), `ITEM: TIMESTEP` (LAMMPS), a PDB record name, a fourth line ending in `V2000` or
     /// `V3000` (molfile, SD file), an integer first line (XYZ), an `N atoms` line after the title
     /// (LAMMPS data file), an integer second line (GRO).
     pub fn from_magic(head: &[u8]) -> Option<Format> {
@@ -237,6 +244,10 @@ impl Format {
         // MOL2: a Tripos record header, after comments and blank lines.
         if cif.is_some_and(|l| l.starts_with(b"@<TRIPOS>")) {
             return Some(Format::Mol2);
+        }
+        // XSF: an XCrySDen keyword, after comments and blank lines.
+        if cif.is_some_and(is_xsf_start) {
+            return Some(Format::Xsf);
         }
         let mut lines = head.split(|b| *b == b'\n');
         let first = lines.next().unwrap_or(&[]);
@@ -422,6 +433,7 @@ impl Format {
                 | Format::Pdbqt
                 | Format::Tinker
                 | Format::DlPoly
+                | Format::Xsf
         )
     }
 
@@ -452,6 +464,7 @@ impl Format {
             Format::NamdBin => "namdbin",
             Format::Tinker => "txyz",
             Format::DlPoly => "dlpoly",
+            Format::Xsf => "xsf",
         }
     }
 }
@@ -481,6 +494,23 @@ fn looks_like_vasp(head: &[u8]) -> bool {
     !words.is_empty()
         && (words.iter().all(|w| parse_usize(w).is_some())
             || words.iter().all(|w| w[0].is_ascii_alphabetic()))
+}
+
+/// True when `line` (the first that is not blank or a `#` comment) starts an XSF file: one of
+/// XCrySDen's leading keywords, in any case.
+fn is_xsf_start(line: &[u8]) -> bool {
+    const KEYWORDS: [&[u8]; 8] = [
+        b"ANIMSTEPS",
+        b"CRYSTAL",
+        b"SLAB",
+        b"POLYMER",
+        b"MOLECULE",
+        b"ATOMS",
+        b"BEGIN_BLOCK_DATAGRID_3D",
+        b"BEGIN_BLOCK_DATAGRID3D",
+    ];
+    let first = crate::parse::fields(line).next().unwrap_or(b"");
+    KEYWORDS.iter().any(|k| first.eq_ignore_ascii_case(k))
 }
 
 /// True when the first non-blank lines are `*` titles followed by an atom-count line (`N` or
@@ -627,5 +657,14 @@ mod tests {
             Some(Format::CharmmCrd)
         );
         assert_eq!(Format::from_path(Path::new("1abc.pqr")), Some(Format::Pqr));
+        assert_eq!(Format::from_path(Path::new("md.AXSF")), Some(Format::Xsf));
+        assert_eq!(
+            Format::from_magic(b"# pw.x\n\n CRYSTAL\n PRIMVEC\n"),
+            Some(Format::Xsf)
+        );
+        assert_eq!(
+            Format::from_magic(b"ANIMSTEPS 3\nATOMS 1\n"),
+            Some(Format::Xsf)
+        );
     }
 }

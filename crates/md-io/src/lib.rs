@@ -15,7 +15,8 @@
 //!   property; a `.crd` is CHARMM's when it starts with a `*` title, else AMBER's) and PQR
 //!   (PDB2PQR/APBS: partial charges and radii as the `charge` and `radius` properties, chains,
 //!   MODEL/ENDMDL frames), AutoDock PDBQT (Vina's poses as frames; charges, AutoDock types and
-//!   the elements they name), Tinker `.xyz`/`.arc` with their bonds, DL_POLY CONFIG/HISTORY
+//!   the elements they name), Tinker `.xyz`/`.arc` with their bonds, DL_POLY CONFIG/HISTORY,
+//!   XCrySDen XSF / AXSF (each structure a frame, with its cell and forces)
 //!   (and the binary DCD, XTC,
 //!   TRR, AMBER NetCDF, NAMD's binary `.coor` and HOOMD-blue GSD: particle types, diameters, per-particle properties
 //!   and bonds, by the hoomd schema's rule for what a frame omits) one frame at a time into a
@@ -37,8 +38,9 @@
 //! - [`values`] reads per-atom numbers from a text file (an analysis result, a column or a row
 //!   per frame) to give the frames as a property.
 //! - [`volume`] reads volumetric data (Gaussian cube; VASP CHGCAR, CHG, PARCHG, LOCPOT, ELFCAR,
-//!   AECCAR) into grids with their atoms ([`volume::read_volumes`]); as trajectories these
-//!   files are one frame, the atoms (`Format::Cube`, `Format::Vasp`).
+//!   AECCAR; XCrySDen XSF `DATAGRID_3D`) into grids with their atoms
+//!   ([`volume::read_volumes`]); as trajectories these files are one frame, the atoms
+//!   (`Format::Cube`, `Format::Vasp`), an XSF / AXSF file one per structure (`Format::Xsf`).
 //! - [`Writer`] writes XYZ and PDB.
 //! - [`elements`] maps atom names to elements, gives van der Waals radii and CPK colours, and
 //!   [`AtomStyle`] resolves each atom's radius and colour with user overrides.
@@ -149,6 +151,7 @@ pub mod values;
 mod vasp;
 pub mod volume;
 mod writer;
+mod xsf;
 mod xtc;
 mod xyz;
 

@@ -268,6 +268,12 @@ pub(crate) trait TextFormat {
     /// Whether blank lines before a frame are passed over before `read` or `skip` is called
     /// (false for a format whose first line, a title, may be blank: AMBER's).
     const SKIPS_BLANK_LINES: bool = true;
+
+    /// Called when the data ends where frame `ctx.frame` would start (at `at`): a format whose
+    /// header announces more frames (XSF's `ANIMSTEPS`) returns the cut there.
+    fn end(&mut self, _ctx: &Ctx, _at: Pos) -> Result<(), Error> {
+        Ok(())
+    }
 }
 
 /// A text format whose `read` and `skip` are one walk over a frame's records, parsing them into
@@ -282,6 +288,11 @@ pub(crate) trait FrameWalk {
 
     /// [`TextFormat::SKIPS_BLANK_LINES`].
     const SKIPS_BLANK_LINES: bool = true;
+
+    /// As [`TextFormat::end`].
+    fn end(&mut self, _ctx: &Ctx, _at: Pos) -> Result<(), Error> {
+        Ok(())
+    }
 }
 
 impl<T: FrameWalk> TextFormat for T {
@@ -299,6 +310,10 @@ impl<T: FrameWalk> TextFormat for T {
     }
 
     const SKIPS_BLANK_LINES: bool = T::SKIPS_BLANK_LINES;
+
+    fn end(&mut self, ctx: &Ctx, at: Pos) -> Result<(), Error> {
+        FrameWalk::end(self, ctx, at)
+    }
 }
 
 /// What the multi-model text formats (PDB, PDBx/mmCIF) check across frames: every model must
@@ -483,6 +498,7 @@ impl<R: Read + Seek, F: TextFormat> TextReader<R, F> {
         let ctx = self.ctx();
         frame.clear();
         let Some(start) = frame_start(&mut self.lines, &ctx, F::SKIPS_BLANK_LINES)? else {
+            self.format.end(&ctx, self.lines.pos())?;
             if self.next == self.starts.len() {
                 self.complete = true;
             }
@@ -588,6 +604,7 @@ impl<R: Read + Seek, F: TextFormat> TextReader<R, F> {
         while self.starts.len() <= n {
             let ctx = self.ctx();
             let Some(start) = frame_start(&mut self.lines, &ctx, F::SKIPS_BLANK_LINES)? else {
+                self.format.end(&ctx, self.lines.pos())?;
                 self.complete = true;
                 return Ok(());
             };

@@ -24,6 +24,7 @@ use crate::text::TextReader;
 use crate::tinker::Tinker;
 use crate::trr::TrrReader;
 use crate::vasp::Vasp;
+use crate::xsf::Xsf;
 use crate::xtc::XtcReader;
 use crate::xyz::Xyz;
 use std::fs::File;
@@ -56,6 +57,7 @@ enum Reader<R> {
     AmberRestart(TextReader<R, AmberRestart>),
     CharmmCrd(TextReader<R, Crd>),
     Pqr(TextReader<R, Pqr>),
+    Xsf(TextReader<R, Xsf>),
 }
 
 /// Runs `$body` with `$r` bound to the format's reader, whatever the format.
@@ -85,6 +87,7 @@ macro_rules! each_reader {
             Reader::AmberRestart($r) => $body,
             Reader::CharmmCrd($r) => $body,
             Reader::Pqr($r) => $body,
+            Reader::Xsf($r) => $body,
         }
     };
 }
@@ -436,6 +439,7 @@ impl<R: Read + Seek> Trajectory<R> {
             }
             Format::CharmmCrd => Reader::CharmmCrd(TextReader::new(src, Crd, file.clone())),
             Format::Pqr => Reader::Pqr(TextReader::new(src, Pqr::new(lenient), file.clone())),
+            Format::Xsf => Reader::Xsf(TextReader::new(src, Xsf::default(), file.clone())),
         };
         Ok(Trajectory {
             reader,

@@ -1,6 +1,6 @@
-//! Volumetric data on a grid: the values a Gaussian cube file or a VASP CHGCAR / PARCHG /
-//! LOCPOT / ELFCAR holds next to its atoms (electron densities, orbitals, potentials), the
-//! input of isosurfaces.
+//! Volumetric data on a grid: the values a Gaussian cube file, a VASP CHGCAR / PARCHG /
+//! LOCPOT / ELFCAR or an XCrySDen XSF file holds next to its atoms (electron densities,
+//! orbitals, potentials), the input of isosurfaces.
 //!
 //! A [`Volume`] is a grid of `nx x ny x nz` points at `origin + i·steps[0] + j·steps[1] +
 //! k·steps[2]` (Å; the steps need not be orthogonal), its values stored with `i` fastest.
@@ -12,7 +12,8 @@
 //! file's cell) and every data set in it, in file order; the name tells the format
 //! ([`VolumeFormat::from_path`]; a `.gz` is read decompressed). [`read_volumes_from`] reads
 //! from memory or a pipe. The same files open as one-frame trajectories (the atoms):
-//! `Format::Cube`, and `Format::Vasp` for the VASP names.
+//! `Format::Cube`, and `Format::Vasp` for the VASP names; an XSF file's structures are
+//! frames (`Format::Xsf`).
 //!
 //! **Gaussian cube** (`.cube`, `.cub`; Gaussian's cubegen, Paul Bourke's description):
 //! 1. two comment lines (the first non-blank one names a single data set, else `values`);
@@ -50,6 +51,18 @@
 //! | `AECCAR0`, `AECCAR1`, `AECCAR2` | the core, proto-atomic valence and self-consistent valence all-electron densities (LAECHG), ρ·V_cell | as CHGCAR | `total density (e/Å³)` |
 //! | `LOCPOT` | the local potential, eV | as written | `local potential (eV)`; ISPIN=2 `local potential, spin up (eV)` and `… spin down (eV)`; non-collinear also `local potential B1 (eV)` to `B3` |
 //! | `ELFCAR` | the electron localisation function, 0 to 1 | as written | `ELF`; ISPIN=2 `ELF, spin up` and `ELF, spin down` |
+//!
+//! **XCrySDen XSF / AXSF** (`.xsf`, `.axsf`: Quantum ESPRESSO pp.x `output_format=5`, ASE,
+//! pymatgen, VESTA; src/xsf.rs gives the whole layout): the frame is the file's last structure
+//! (as ASE's `read_xsf(read_data=True)` gives it), with its cell when periodic; each grid of
+//! every `BEGIN_BLOCK_DATAGRID_3D` block is a volume named `<block>: <grid>`, its values as
+//! written (pp.x writes its atomic units: a density in e/bohr³). XSF grids are *general*: their
+//! n points per axis include both ends, step span/(n−1). A grid over a `CRYSTAL`'s cell (its
+//! spanning vectors the cell vectors, its last plane along each axis a repeat of the first, as
+//! pp.x writes n = N + 1) is read as VESTA reads it: the repeated planes dropped, N points per
+//! axis, steps the cell vectors / N, periodic. Any other grid (a slab's, a molecule's, ASE's
+//! default with spans cell·(n+1)/n) keeps all its points and is not periodic. 2-D grids are
+//! refused.
 //!
 //! # Damage and memory
 //! Errors are the crate's [`Error`]: the file, line and byte offset and what was expected
@@ -276,6 +289,8 @@ pub enum VolumeFormat {
     Cube,
     /// VASP volumetric data (a POSCAR block, then grids) holding this quantity.
     Vasp(VaspQuantity),
+    /// XCrySDen XSF / AXSF: `.xsf`, `.axsf` (its `DATAGRID_3D` grids).
+    Xsf,
 }
 
 /// What a VASP volumetric file's values are; the file's name tells (see the module docs).
@@ -339,13 +354,17 @@ impl VaspQuantity {
 }
 
 impl VolumeFormat {
-    /// The format a path names: `.cube` / `.cub` (any case) is a cube file, a VASP name
-    /// ([`VaspQuantity::from_file_name`]) VASP volumetric data; a final `.gz` is looked through.
+    /// The format a path names: `.cube` / `.cub` (any case) is a cube file, `.xsf` / `.axsf`
+    /// an XSF file, a VASP name ([`VaspQuantity::from_file_name`]) VASP volumetric data; a
+    /// final `.gz` is looked through.
     pub fn from_path(path: &Path) -> Option<VolumeFormat> {
         let inner = crate::gz::inner_path(path);
         let ext = inner.extension().and_then(|e| e.to_str()).unwrap_or("");
         if ext.eq_ignore_ascii_case("cube") || ext.eq_ignore_ascii_case("cub") {
             return Some(VolumeFormat::Cube);
+        }
+        if ext.eq_ignore_ascii_case("xsf") || ext.eq_ignore_ascii_case("axsf") {
+            return Some(VolumeFormat::Xsf);
         }
         let name = inner.file_name()?.to_str()?;
         VaspQuantity::from_file_name(name).map(VolumeFormat::Vasp)
@@ -361,8 +380,8 @@ pub fn read_volumes(path: impl AsRef<Path>) -> Result<(Frame, Vec<Volume>), Erro
     let name: Arc<str> = path.display().to_string().into();
     let kind = VolumeFormat::from_path(path).ok_or_else(|| Error::Unsupported {
         file: name.clone(),
-        what: "volumetric data from a file not named .cube / .cub or as VASP names its \
-               volumetric files (CHGCAR, CHG, PARCHG, LOCPOT, ELFCAR, AECCAR0/1/2)",
+        what: "volumetric data from a file not named .cube / .cub, .xsf / .axsf or as VASP \
+               names its volumetric files (CHGCAR, CHG, PARCHG, LOCPOT, ELFCAR, AECCAR0/1/2)",
     })?;
     let (file, _) = crate::gz::open(path, &name, false)?;
     let len = file.metadata().ok().map(|m| m.len());
@@ -410,6 +429,7 @@ fn read_sized<R: Read>(
     let mut frame = Frame::new();
     let sets = match kind {
         VolumeFormat::Cube => crate::cube::read(&mut lines, &ctx, &mut frame, &budget)?,
+        VolumeFormat::Xsf => crate::xsf::read(&mut lines, &ctx, &mut frame, &budget)?,
         VolumeFormat::Vasp(q) => {
             let grids = crate::chgcar::read(&mut lines, &ctx, &mut frame, q, &budget)?;
             let count = grids.len();

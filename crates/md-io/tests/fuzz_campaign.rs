@@ -685,6 +685,19 @@ fn cube_campaign() {
 }
 
 #[test]
+fn xsf_campaign() {
+    let files = [
+        "xsf/ase_anim_fixed.axsf",
+        "xsf/ase_anim_cell.axsf",
+        "xsf/ase_anim_molecule.axsf",
+        "xsf/ase_grid_small.xsf",
+        "xsf/pmg_grids.xsf",
+    ];
+    let fx = files.map(|f| text_fixture(f, Format::Xsf));
+    campaign("XCrySDen XSF", Format::Xsf, fx.into());
+}
+
+#[test]
 fn lammps_data_campaign() {
     let files = [
         "lammps_data/ase_atomic_tri.data",

@@ -40,6 +40,11 @@ const FILES: &[(&str, Format)] = &[
     ("tinker/caffeine.txyz", Format::Tinker),
     ("dlpoly/HISTORY", Format::DlPoly),
     ("dlpoly/CONFIG", Format::DlPoly),
+    ("xsf/ase_anim_fixed.axsf", Format::Xsf),
+    ("xsf/ase_anim_cell.axsf", Format::Xsf),
+    ("xsf/ase_anim_molecule.axsf", Format::Xsf),
+    ("xsf/ase_grid_small.xsf", Format::Xsf),
+    ("xsf/pmg_grids.xsf", Format::Xsf),
 ];
 
 /// The options a fixture is read with: an AMBER trajectory needs its topology's atom count
@@ -223,6 +228,24 @@ fn frame_ends(bytes: &[u8], format: Format) -> Vec<usize> {
             if ends.is_empty() {
                 ends.push(bytes.len());
             }
+        }
+        Format::Xsf => {
+            // A step ends where the next one's first keyword line shows (`ATOMS k`, `PRIMVEC
+            // k` or `PRIMCOORD k`, k ≥ 2: that line is part of what ends it, its damage the
+            // earlier step's); the last, with its data grids, with the file.
+            let mut seen = std::collections::BTreeSet::new();
+            for (k, l) in lines.iter().enumerate() {
+                let mut w = l.split_whitespace();
+                let key = w.next().unwrap_or("").to_ascii_uppercase();
+                let step: usize = w.next().and_then(|t| t.parse().ok()).unwrap_or(0);
+                if ["ATOMS", "PRIMVEC", "PRIMCOORD"].contains(&key.as_str())
+                    && step >= 2
+                    && seen.insert(step)
+                {
+                    ends.push(line_starts[k + 1]);
+                }
+            }
+            ends.push(bytes.len());
         }
         Format::LammpsData | Format::Cube | Format::AmberRestart => {
             // One frame: the whole file (a LAMMPS data file's sections may come in any order;

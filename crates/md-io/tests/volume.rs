@@ -430,6 +430,11 @@ fn gzip_files_are_read_through() {
             1,
         ),
         ("CHGCAR.gz", chgcar_text(), 2),
+        (
+            "x.xsf.gz",
+            std::fs::read_to_string(dir().join("../xsf/ase_grid_small.xsf")).unwrap(),
+            1,
+        ),
     ] {
         let path = tmp.join(name);
         let mut z = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
