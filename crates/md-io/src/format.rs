@@ -64,7 +64,7 @@ pub enum Format {
     /// the partial charge (e) and radius (Å) as the `charge` and `radius` properties;
     /// MODEL/ENDMDL models are frames: `.pqr`.
     Pqr,
-    /// XCrySDen XSF and animated AXSF (Quantum ESPRESSO pp.x, ASE, pymatgen, VESTA): each
+    /// XCrySDen XSF and animated AXSF (Quantum ESPRESSO pp.x, ASE, pymatgen, XCrySDen): each
     /// structure a frame, with its cell (CRYSTAL, SLAB, POLYMER) and forces as `fx fy fz`
     /// (eV/Å); its data grids are checked, not kept (see [`crate::volume::read_volumes`]):
     /// `.xsf`, `.axsf`.
