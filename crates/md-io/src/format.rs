@@ -77,7 +77,7 @@ pub enum Format {
     /// DL_POLY `CONFIG` / `REVCON` (one frame) and `HISTORY` (DL_POLY 4 and Classic), by
     /// DL_POLY's file names (any suffix); by name: `dlpoly`.
     DlPoly,
-    /// XCrySDen XSF and animated AXSF (Quantum ESPRESSO pp.x, ASE, pymatgen, VESTA): each
+    /// XCrySDen XSF and animated AXSF (Quantum ESPRESSO pp.x, ASE, pymatgen, XCrySDen): each
     /// structure a frame, with its cell (CRYSTAL, SLAB, POLYMER) and forces as `fx fy fz`
     /// (eV/Å); its data grids are checked, not kept (see [`crate::volume::read_volumes`]):
     /// `.xsf`, `.axsf`.

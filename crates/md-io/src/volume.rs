@@ -53,16 +53,16 @@
 //! | `ELFCAR` | the electron localisation function, 0 to 1 | as written | `ELF`; ISPIN=2 `ELF, spin up` and `ELF, spin down` |
 //!
 //! **XCrySDen XSF / AXSF** (`.xsf`, `.axsf`: Quantum ESPRESSO pp.x `output_format=5`, ASE,
-//! pymatgen, VESTA; src/xsf.rs gives the whole layout): the frame is the file's last structure
+//! pymatgen; src/xsf.rs gives the whole layout): the frame is the file's last structure
 //! (as ASE's `read_xsf(read_data=True)` gives it), with its cell when periodic; each grid of
 //! every `BEGIN_BLOCK_DATAGRID_3D` block is a volume named `<block>: <grid>`, its values as
 //! written (pp.x writes its atomic units: a density in e/bohr³). XSF grids are *general*: their
 //! n points per axis include both ends, step span/(n−1). A grid over a `CRYSTAL`'s cell (its
 //! spanning vectors the cell vectors, its last plane along each axis a repeat of the first, as
-//! pp.x writes n = N + 1) is read as VESTA reads it: the repeated planes dropped, N points per
-//! axis, steps the cell vectors / N, periodic. Any other grid (a slab's, a molecule's, ASE's
-//! default with spans cell·(n+1)/n) keeps all its points and is not periodic. 2-D grids are
-//! refused.
+//! pp.x writes n = N + 1) is read as the periodic grid it is: the repeated planes dropped, N
+//! points per axis, steps the cell vectors / N, periodic. Any other grid (a slab's, a
+//! molecule's, ASE's default with spans cell·(n+1)/n) keeps all its points and is not
+//! periodic. 2-D grids are refused.
 //!
 //! # Damage and memory
 //! Errors are the crate's [`Error`]: the file, line and byte offset and what was expected

@@ -1,5 +1,5 @@
 //! XCrySDen structure files, XSF and animated AXSF (`.xsf`, `.axsf`: written by Quantum
-//! ESPRESSO's pp.x `output_format=5` and pwo2xsf, ASE, pymatgen, VESTA, XCrySDen): each
+//! ESPRESSO's pp.x `output_format=5` and pwo2xsf, ASE, pymatgen, XCrySDen): each
 //! structure a frame (`Format::Xsf`), and the 3-D data grids for
 //! [`crate::volume::read_volumes`]. One walk serves both, as for cube files: the trajectory
 //! reader checks (reading) or counts (scanning) a grid's values, so that a damaged or cut grid
@@ -54,15 +54,16 @@
 //!
 //! XSF grids are *general* grids: their points include both ends, point (i, j, k) at
 //! origin + i/(nx−1)·span₁ + j/(ny−1)·span₂ + k/(nz−1)·span₃. A periodic quantity over the
-//! cell is written with nx = N + 1 (pp.x, pmg and VESTA alike), the last plane along each axis
-//! the periodic image of the first. **Periodicity:** when the frame is a `CRYSTAL`, the three
-//! spanning vectors are its cell vectors (to 1e-5 Å per Å) and the last plane along each axis
-//! repeats the first (to 1e-5 of the largest |value|), the grid is read as VESTA reads it:
-//! the repeated planes are dropped, N = n − 1 points per axis remain, the steps are the cell
-//! vectors / N, and the [`Volume`] is periodic (it wraps: point N is point 0). Any other grid
-//! (a slab's, a molecule's, one over part of the cell, or one whose end planes differ, such
-//! as ASE's default, whose spans are cell·(n+1)/n) keeps all its points, steps span/(n−1),
-//! and is not periodic. 2-D grids (`BEGIN_BLOCK_DATAGRID_2D`) are read past by the trajectory
+//! cell is written with nx = N + 1 (pp.x's `xsf_fast_datagrid_3d` does), the last plane along
+//! each axis the periodic image of the first: the specification's "periodic grid" of N points
+//! written as a general one. **Periodicity:** when the frame is a `CRYSTAL`, the three
+//! spanning vectors are its cell vectors (to 1e-5 of their length, at least 1e-5 Å) and the
+//! last plane along each axis repeats the first (to 1e-5 of the largest |value|), the grid is
+//! read as that periodic grid: the repeated planes are dropped, N = n − 1 points per axis
+//! remain, the steps are the cell vectors / N, and the [`Volume`] is periodic (it wraps: point
+//! N is point 0), as a CHGCAR's. Any other grid (a slab's, a molecule's, one over part of the
+//! cell, or one whose end planes differ, such as ASE's default, whose spans are cell·(n+1)/n)
+//! keeps all its points, steps span/(n−1), and is not periodic. 2-D grids (`BEGIN_BLOCK_DATAGRID_2D`) are read past by the trajectory
 //! reader and refused by [`crate::volume::read_volumes`], which reads the atoms of the file's
 //! last structure (as ASE's `read_xsf(read_data=True)` gives them) and every 3-D grid.
 //!
