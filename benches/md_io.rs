@@ -117,7 +117,7 @@ fn write_mdcrd(path: &Path, n_atoms: usize, n_frames: usize, base: &[[f32; 3]]) 
                 writeln!(w).unwrap();
             }
         }
-        if (3 * n_atoms) % 10 != 0 {
+        if !(3 * n_atoms).is_multiple_of(10) {
             writeln!(w).unwrap();
         }
         writeln!(w, "{:8.3}{:8.3}{:8.3}", 100.0, 100.0, 100.0).unwrap();
