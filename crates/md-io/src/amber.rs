@@ -48,7 +48,7 @@ const RST_WIDTH: usize = 12;
 const RST_PER_LINE: usize = 6;
 
 /// How many fixed-width fields a line holds (its length without trailing blanks, rounded up).
-fn field_count(line: &[u8], width: usize) -> usize {
+pub(crate) fn field_count(line: &[u8], width: usize) -> usize {
     let end = line
         .iter()
         .rposition(|b| !matches!(b, b' ' | b'\t' | b'\r'))

@@ -330,11 +330,7 @@ impl Format {
         let second = lines.next()?;
         // Every fixed-width field of `line` a number with a decimal point; the field count.
         let numbers = |line: &[u8], width: usize| {
-            let t = line
-                .iter()
-                .rposition(|b| !matches!(b, b' ' | b'\t' | b'\r'))
-                .map_or(0, |e| e + 1);
-            let n = t.div_ceil(width);
+            let n = crate::amber::field_count(line, width);
             let ok = n > 0
                 && (0..n).all(|k| {
                     let f = trim(span(line, k * width, (k + 1) * width));

@@ -256,13 +256,7 @@ impl Topology {
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("top"));
         if format == TopologyFormat::Prmtop && is_top {
-            let io = |source| Error::Io {
-                at: Location::file(&name),
-                source,
-            };
-            let mut head = Vec::new();
-            (&mut file).take(64).read_to_end(&mut head).map_err(io)?;
-            std::io::Seek::rewind(&mut file).map_err(io)?;
+            let head = crate::trajectory::head(&mut file, &name, 64)?;
             if !(head.starts_with(b"%VERSION") || head.starts_with(b"%FLAG")) {
                 return Err(Error::Unsupported {
                     file: name,

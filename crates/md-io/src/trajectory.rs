@@ -213,6 +213,19 @@ pub struct Trajectory<R: Read + Seek = File> {
     cut_at: Option<usize>,
 }
 
+/// The first `n` bytes of `file` (fewer when it is shorter; `name` is what errors call it), the
+/// file rewound: what the format decisions below look at.
+pub(crate) fn head(file: &mut File, name: &Arc<str>, n: u64) -> Result<Vec<u8>, Error> {
+    let io = |source| Error::Io {
+        at: crate::error::Location::file(name),
+        source,
+    };
+    let mut head = Vec::new();
+    file.take(n).read_to_end(&mut head).map_err(io)?;
+    file.rewind().map_err(io)?;
+    Ok(head)
+}
+
 /// Which CIF `file` (at `path`, named `name` in errors) is: a CIF not named `.mmcif` is
 /// PDBx/mmCIF or crystallographic, and its tags tell ([`Format::cif_kind`]) from a larger head
 /// than the magic's (a COD file's atom sites follow its bibliography). The file is rewound.
@@ -223,16 +236,7 @@ pub(crate) fn cif_kind_of(file: &mut File, path: &Path, name: &Arc<str>) -> Resu
     if mmcif_named {
         return Ok(Format::Mmcif);
     }
-    let io = |source| Error::Io {
-        at: crate::error::Location::file(name),
-        source,
-    };
-    let mut head = Vec::new();
-    file.take(Format::CIF_HEAD)
-        .read_to_end(&mut head)
-        .map_err(io)?;
-    file.rewind().map_err(io)?;
-    Ok(Format::cif_kind(&head))
+    Ok(Format::cif_kind(&head(file, name, Format::CIF_HEAD)?))
 }
 
 /// How much of a `.crd` file [`crate::Trajectory::open`] reads to tell what it is.
@@ -251,13 +255,7 @@ pub(crate) fn crd_kind_of(file: &mut File, path: &Path, name: &Arc<str>) -> Resu
     if !crd_named {
         return Ok(Format::CharmmCrd);
     }
-    let io = |source| Error::Io {
-        at: crate::error::Location::file(name),
-        source,
-    };
-    let mut head = Vec::new();
-    file.take(CRD_HEAD).read_to_end(&mut head).map_err(io)?;
-    file.rewind().map_err(io)?;
+    let head = head(file, name, CRD_HEAD)?;
     if Format::is_charmm_crd(&head) != Some(false) {
         return Ok(Format::CharmmCrd);
     }
@@ -290,35 +288,26 @@ pub(crate) fn crd_kind_of(file: &mut File, path: &Path, name: &Arc<str>) -> Resu
 
 /// Whether `file` is a `.xyz` in Tinker's layout ([`Format::tinker_xyz`]); the file is rewound.
 fn is_tinker(file: &mut File, name: &Arc<str>) -> Result<bool, Error> {
-    let io = |source| Error::Io {
-        at: crate::error::Location::file(name),
-        source,
-    };
-    let mut head = Vec::new();
-    file.take(4096).read_to_end(&mut head).map_err(io)?;
-    file.rewind().map_err(io)?;
-    Ok(Format::tinker_xyz(&head))
+    Ok(Format::tinker_xyz(&head(file, name, 4096)?))
 }
 
 /// Whether `file` starts with NetCDF-3's magic number; the file is rewound.
 fn is_netcdf(file: &mut File, name: &Arc<str>) -> Result<bool, Error> {
-    let io = |source| Error::Io {
-        at: crate::error::Location::file(name),
-        source,
-    };
-    let mut head = Vec::new();
-    file.take(4).read_to_end(&mut head).map_err(io)?;
-    file.rewind().map_err(io)?;
-    Ok(matches!(head.as_slice(), b"CDF\x01" | b"CDF\x02"))
+    Ok(matches!(
+        head(file, name, 4)?.as_slice(),
+        b"CDF\x01" | b"CDF\x02"
+    ))
 }
 
 impl Trajectory<File> {
     /// Opens `path`, telling the format from the extension or else from the first bytes.
     /// A CIF (`.cif`, or first bytes `data_`) is PDBx/mmCIF or crystallographic by its tags
     /// in its first [`Format::CIF_HEAD`] bytes ([`Format::cif_kind`]); `.mmcif` is mmCIF.
-    /// A `.crd` is a CHARMM coordinate file only when its first non-blank line is a `*` title
-    /// ([`Format::is_charmm_crd`]); otherwise opening it is an error naming that line (an AMBER
-    /// ASCII trajectory should be named `.mdcrd` or opened with [`Trajectory::open_as`]).
+    /// A `.crd` is a CHARMM coordinate file when its first non-blank line is a `*` title
+    /// ([`Format::is_charmm_crd`]), else an AMBER trajectory or restart by its second line
+    /// ([`Format::amber_kind`]), else an error naming that line. An AMBER restart name
+    /// (`.rst7`, `.restrt`) over NetCDF bytes is read as NetCDF (pmemd's default restart), and
+    /// a `.xyz` in Tinker's layout as Tinker ([`Format::tinker_xyz`]).
     ///
     /// A gzip file (first bytes `1f 8b`, e.g. `1abc.cif.gz`, `run.xyz.gz`) is read decompressed:
     /// its format comes from the name without `.gz`, else from the decompressed first bytes. It
@@ -339,19 +328,11 @@ impl Trajectory<File> {
     ) -> Result<Trajectory<File>, Error> {
         let path = path.as_ref();
         let name: Arc<str> = path.display().to_string().into();
-        let io = |source| Error::Io {
-            at: crate::error::Location::file(&name),
-            source,
-        };
         let (mut file, cut) = crate::gz::open(path, &name, options.allow_truncated)?;
         let format = match Format::from_path(path) {
             Some(f) => f,
-            None => {
-                let mut head = Vec::with_capacity(512);
-                (&mut file).take(512).read_to_end(&mut head).map_err(io)?;
-                file.rewind().map_err(io)?;
-                Format::from_magic(&head).ok_or(Error::UnknownFormat { file: name.clone() })?
-            }
+            None => Format::from_magic(&head(&mut file, &name, 512)?)
+                .ok_or(Error::UnknownFormat { file: name.clone() })?,
         };
         let format = match format {
             Format::Mmcif => cif_kind_of(&mut file, path, &name)?,
