@@ -28,6 +28,8 @@
 //!   [`geoid`] turns heights above sea level into ellipsoidal heights there (EGM96 and other
 //!   geoid grids from PROJ's `.gtx` or GeoTIFF files); [`qmesh`] writes Cesium's
 //!   quantized-mesh-1.0 terrain (`layer.json` and a tile pyramid) for `CesiumTerrainProvider`.
+//! - [`vector`]: GeoJSON overlays (points, lines, polygons with simplestyle colours) drawn into
+//!   the texture's finest level, placed by their coordinate system.
 //! - [`relief`]: shaded relief (height colours lit by a `gdaldem`-compatible hillshade), the
 //!   texture of a database built without a photo.
 //! - [`models`]: textured OBJ models placed on the terrain by georeference and a built-in tree
@@ -83,6 +85,7 @@ pub mod relief;
 pub mod rtin;
 pub mod stream;
 pub mod tiles3d;
+pub mod vector;
 pub mod view;
 
 pub use error::TerrainError;
