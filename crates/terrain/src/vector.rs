@@ -527,7 +527,8 @@ fn feature_of(v: &Value) -> Result<Feature, String> {
     }
     let mut f = Feature::default();
     if let Some(Value::Object(p)) = obj.get("properties") {
-        for (k, value) in p {
+        // A null property is one the feature does not set (ogr2ogr writes empty fields so).
+        for (k, value) in p.iter().filter(|(_, v)| !v.is_null()) {
             set_key(&mut f.style, k, value).map_err(|e| format!("properties: {e}"))?;
         }
     }
