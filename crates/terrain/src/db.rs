@@ -52,6 +52,17 @@ pub struct TextureEntry {
     pub map_texels: u32,
     pub levels: u32,
     pub placed_by: String,
+    /// Vector overlays drawn into the texture, in drawing order.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub overlays: Vec<OverlayEntry>,
+}
+
+/// A vector overlay drawn into the texture: its file and how many of its features were drawn.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct OverlayEntry {
+    pub source: String,
+    pub features: usize,
+    pub drawn: usize,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -71,7 +82,7 @@ pub struct Manifest {
 }
 
 /// Build options.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct BuildOptions {
     pub max_error: f32,
     pub chunk: u32,
@@ -81,6 +92,11 @@ pub struct BuildOptions {
     /// Contour lines drawn into the texture ([`crate::relief::Contours`]); without a photo the
     /// texture is then the shaded relief (up to 4096² texels), with the lines.
     pub contours: Option<crate::relief::Contours>,
+    /// GeoJSON layers drawn into the texture over the photo and the contours
+    /// ([`crate::vector`]); without a photo the texture is then the shaded relief.
+    pub overlays: Vec<crate::vector::VectorLayer>,
+    /// What the overlays' features take for the style keys they do not set.
+    pub overlay_style: crate::vector::Style,
 }
 
 impl Default for BuildOptions {
@@ -91,6 +107,8 @@ impl Default for BuildOptions {
             map_texels: 256,
             max_texture_levels: 5,
             contours: None,
+            overlays: Vec::new(),
+            overlay_style: crate::vector::Style::default(),
         }
     }
 }
@@ -297,9 +315,10 @@ fn build_into(
     progress: &mut impl FnMut(u64, u64),
 ) -> Result<Manifest, TerrainError> {
     std::fs::create_dir_all(dir).map_err(io(dir))?;
-    // Contours without a photo: drawn over the shaded relief, which becomes the texture.
-    let relief = match (photo, &opts.contours) {
-        (None, Some(_)) => Some(gst::Orthophoto {
+    // Contours or overlays without a photo: drawn over the shaded relief, which becomes the
+    // texture.
+    let relief = match (photo, opts.contours.is_some() || !opts.overlays.is_empty()) {
+        (None, true) => Some(gst::Orthophoto {
             image: crate::relief::relief_image(grid, 4096),
             georef: None,
             source: "shaded relief".into(),
@@ -310,6 +329,18 @@ fn build_into(
     let tex_levels = match photo {
         Some(p) => gst::photo_level_count(p, grid, opts.map_texels, opts.max_texture_levels)?,
         None => 0,
+    };
+    // Placed before the meshing, so that a layer off the terrain fails the build at once.
+    let overlay = match tex_levels {
+        0 => None,
+        _ if opts.overlays.is_empty() => None,
+        l => Some(crate::vector::Overlay::place(
+            &opts.overlays,
+            &opts.overlay_style,
+            grid,
+            opts.map_texels << (l - 1),
+            opts.map_texels,
+        )?),
     };
     let total = 3 + tex_levels as u64;
     let mut levels: Vec<LevelEntry> = Vec::new();
@@ -381,6 +412,7 @@ fn build_into(
                 opts.map_texels,
                 tex_levels,
                 opts.contours.as_ref(),
+                overlay.as_ref(),
                 &write,
                 &read,
                 &mut |_| {
@@ -396,6 +428,16 @@ fn build_into(
                 } else {
                     "stretched".into()
                 },
+                overlays: overlay.as_ref().map_or(Vec::new(), |o| {
+                    o.counts()
+                        .iter()
+                        .map(|(source, drawn, features)| OverlayEntry {
+                            source: source.clone(),
+                            features: *features,
+                            drawn: *drawn,
+                        })
+                        .collect()
+                }),
             })
         }
         None => None,

@@ -464,11 +464,14 @@ pub fn write_pyramid(
     read: &(dyn Fn(MapKey) -> Result<RgbaImage, TerrainError> + Sync),
     progress: &mut dyn FnMut(u32),
 ) -> Result<(), TerrainError> {
-    write_pyramid_with(photo, grid, map_texels, levels, None, write, read, progress)
+    write_pyramid_with(
+        photo, grid, map_texels, levels, None, None, write, read, progress,
+    )
 }
 
-/// [`write_pyramid`] with contour lines drawn into the finest level's texels
-/// ([`crate::relief::Contours`]); the coarser levels average them down like the photo.
+/// [`write_pyramid`] with contour lines ([`crate::relief::Contours`]) and then vector overlays
+/// ([`crate::vector::Overlay`], placed on this pyramid's finest level) drawn into the finest
+/// level's texels; the coarser levels average them down like the photo.
 #[allow(clippy::too_many_arguments)]
 pub fn write_pyramid_with(
     photo: &dyn PhotoSource,
@@ -476,6 +479,7 @@ pub fn write_pyramid_with(
     map_texels: u32,
     levels: u32,
     contours: Option<&crate::relief::Contours>,
+    overlay: Option<&crate::vector::Overlay>,
     write: &(dyn Fn(MapKey, &RgbaImage) -> Result<(), TerrainError> + Sync),
     read: &(dyn Fn(MapKey) -> Result<RgbaImage, TerrainError> + Sync),
     progress: &mut dyn FnMut(u32),
@@ -494,6 +498,13 @@ pub fn write_pyramid_with(
     let size = t << finest;
     let (pw, ph) = photo.size();
     let p = Placement::new(grid, (pw, ph), photo.georef(), photo.source())?;
+    if let Some(o) = overlay.filter(|o| o.size() != size) {
+        return Err(TerrainError::BadParameter {
+            name: "overlay size",
+            value: format!("{} texels for a finest level of {size}", o.size()),
+            expected: "an overlay placed on this pyramid's finest level",
+        });
+    }
     for y in 0..n {
         let rows = p.rows_for(size, y * t, (y + 1) * t);
         let band = match rows {
@@ -507,7 +518,7 @@ pub fn write_pyramid_with(
                 (grid.width() - 1) as f64 / (size - 1).max(1) as f64,
                 (grid.height() - 1) as f64 / (size - 1).max(1) as f64,
             ];
-            let map = RgbaImage::from_fn(t, t, |i, j| {
+            let mut map = RgbaImage::from_fn(t, t, |i, j| {
                 let (gx, gy) = (x * t + i, y * t + j);
                 // `rows_for` covers every row a texel on the photo reads.
                 let px = p.texel(size, gx, gy, |a, b| {
@@ -523,6 +534,9 @@ pub fn write_pyramid_with(
                     }
                 }
             });
+            if let Some(o) = overlay {
+                o.draw(x, y, &mut map);
+            }
             write(
                 MapKey {
                     level: finest,

@@ -127,6 +127,7 @@ fn contours_are_drawn_into_the_relief_texture() {
             map_texels: 64,
             max_texture_levels: 2,
             contours,
+            ..BuildOptions::default()
         };
         let m = db::build(&grid, "ramp", None, &opts, &out, |_, _| {}).unwrap();
         (out, m)
@@ -168,4 +169,93 @@ fn contours_are_drawn_into_the_relief_texture() {
         lit > 100 && lit < checked / 4,
         "{lit} of {checked} texels on a line"
     );
+}
+
+/// GeoJSON overlays go into the finest maps as `vector::Overlay` draws them, are averaged into
+/// the coarser ones, are listed in the manifest; a layer off the terrain fails the build before
+/// anything is left on disk.
+#[test]
+fn overlays_are_drawn_into_the_texture() {
+    use texmap_terrain::vector::{Overlay, Style, read_geojson};
+    let grid = read_dem(data("hillshade_dem_utm.tif"), &ReadOptions::default()).unwrap();
+    let layer = read_geojson(data("vector_wgs84.geojson")).unwrap();
+    let style = Style::default()
+        .with_keys("fill=#0000ff,fill-opacity=1,stroke=none,marker-color=none")
+        .unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    // A plain grey photo stretched over the grid, large enough for three texture levels.
+    let png = dir.path().join("grey.png");
+    image::RgbaImage::from_pixel(300, 300, image::Rgba([128, 128, 128, 255]))
+        .save(&png)
+        .unwrap();
+    let photo = gst::read_photo(&png, None).unwrap();
+    let out = dir.path().join("v.db");
+    let opts = BuildOptions {
+        max_error: 1.0,
+        chunk: 33,
+        map_texels: 64,
+        max_texture_levels: 3,
+        overlays: vec![layer.clone()],
+        overlay_style: style,
+        ..BuildOptions::default()
+    };
+    let m = db::build(&grid, "utm", Some(&photo), &opts, &out, |_, _| {}).unwrap();
+    let tex = m.texture.clone().unwrap();
+    assert_eq!(tex.levels, 3);
+    assert_eq!(tex.overlays.len(), 1);
+    // Drawn: the lake and the forest (filled), the road (its own red stroke); not the trail
+    // (no stroke), the points (no colour) nor the feature without geometry.
+    assert_eq!((tex.overlays[0].features, tex.overlays[0].drawn), (7, 3));
+    let finest = tex.levels - 1;
+    let n = 1u32 << finest;
+    let o = Overlay::place(&[layer.clone()], &style, &grid, 64 * n, 64).unwrap();
+    let (mut same, mut blue) = (0, 0);
+    for my in 0..n {
+        for mx in 0..n {
+            let tile = image::open(out.join(format!("tiles/{finest}/{mx}_{my}.png")))
+                .unwrap()
+                .to_rgba8();
+            let mut drawn = tile.clone();
+            // Drawing the overlay again over the tile changes nothing where it is opaque.
+            o.draw(mx, my, &mut drawn);
+            for (a, b) in tile.pixels().zip(drawn.pixels()) {
+                if a.0 == [0, 0, 255, 255] {
+                    blue += 1;
+                    same += (a == b) as usize;
+                }
+            }
+        }
+    }
+    // The lake and the forest: about a quarter of the 256² texels (tests/vector.rs).
+    assert!(blue > 14_000 && same == blue, "{blue} {same}");
+    let coarse = image::open(out.join("tiles/0/0_0.png")).unwrap().to_rgba8();
+    assert!(
+        coarse
+            .pixels()
+            .filter(|p| p.0[2] > 200 && p.0[0] < 60)
+            .count()
+            > 50
+    );
+    let back = Database::open(&out).unwrap();
+    assert_eq!(back.manifest.texture.unwrap().overlays, tex.overlays);
+
+    // A layer far from the grid: an error naming it, and no database.
+    let far = texmap_terrain::vector::parse_geojson(
+        br#"{"type":"Point","coordinates":[10.0, 50.0]}"#,
+        "far.geojson",
+    )
+    .unwrap();
+    let bad = dir.path().join("bad.db");
+    let opts = BuildOptions {
+        overlays: vec![far],
+        ..opts
+    };
+    let e = db::build(&grid, "utm", Some(&photo), &opts, &bad, |_, _| {})
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("far.geojson") && e.contains("does not overlap"),
+        "{e}"
+    );
+    assert!(!bad.exists());
 }

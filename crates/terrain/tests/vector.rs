@@ -124,7 +124,11 @@ fn lines_cover_gdals_line_and_stay_within_its_touched_texels() {
                             && touched.get_pixel((x + dx) as u32, (y + dy) as u32).0[0] > 0
                     })
                 });
-                assert!(near, "texel {x} {y}: covered {} away from GDAL's line", c[k]);
+                assert!(
+                    near,
+                    "texel {x} {y}: covered {} away from GDAL's line",
+                    c[k]
+                );
             }
         }
     }
@@ -176,9 +180,14 @@ fn the_features_own_styles_win_over_the_layers() {
     o.draw(0, 0, &mut m);
     let red = m.pixels().filter(|p| p.0 == [255, 0, 0, 255]).count();
     let blue = m.pixels().filter(|p| p.0 == [0, 0, 255, 255]).count();
-    let green = m.pixels().filter(|p| p.0 == [0x20, 0x60, 0x20, 255]).count();
-    assert!(red > 200 && blue > 100 && green > 100, "{red} {blue} {green}");
+    let green = m
+        .pixels()
+        .filter(|p| p.0 == [0x20, 0x60, 0x20, 255])
+        .count();
+    assert!(
+        red > 200 && blue > 100 && green > 100,
+        "{red} {blue} {green}"
+    );
     // Drawn over the grid: the lake, the forest, the road, the trail (points have no colour).
     assert_eq!(o.counts()[0].1, 4);
 }
-
