@@ -50,6 +50,21 @@ pub enum TerrainCmd {
         /// The contour lines' width in texels of the finest texture level.
         #[arg(long, value_name = "TEXELS", default_value_t = 1.5)]
         contour_width: f32,
+        /// Draw a GeoJSON file's points, lines and polygons into the texture (roads, rivers,
+        /// boundaries, sites; repeat for several layers, drawn in order). RFC 7946 GeoJSON in
+        /// WGS 84 degrees, a GeoJSON text sequence, or GeoJSON with a "crs" member in UTM or Web
+        /// Mercator (ogr2ogr -f GeoJSON -t_srs EPSG:4326 converts a shapefile or a GeoPackage).
+        /// Features are coloured by their simplestyle properties (stroke, stroke-width, fill,
+        /// fill-opacity, marker-color, marker-size) where they have them; without --photo the
+        /// texture is the shaded relief.
+        #[arg(long, value_name = "FILE")]
+        overlay: Vec<PathBuf>,
+        /// The overlays' style where a feature sets none: simplestyle keys, e.g.
+        /// 'stroke=#ff0000,stroke-width=3,fill=none' (widths in texels of the finest level;
+        /// defaults: stroke=#555555, stroke-width=2, fill=#555555, fill-opacity=0.6,
+        /// marker-color=#7e7e7e, marker-size=medium).
+        #[arg(long, value_name = "KEY=VALUE,...", requires = "overlay")]
+        overlay_style: Option<String>,
         /// Read a PNG as Mapbox Terrain-RGB.
         #[arg(long)]
         terrain_rgb: bool,
@@ -147,6 +162,8 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
             texture_levels,
             contours,
             contour_width,
+            overlay,
+            overlay_style,
             scale,
             offset,
             cell,
@@ -223,6 +240,17 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
                 }
                 Some(m) => return usage(format!("--contours {m}: expected metres > 0")),
             };
+            let overlay_style = match overlay_style {
+                None => texmap_terrain::vector::Style::default(),
+                Some(s) => match texmap_terrain::vector::Style::default().with_keys(&s) {
+                    Ok(s) => s,
+                    Err(e) => return usage(format!("--overlay-style: {e}")),
+                },
+            };
+            let overlays = overlay
+                .iter()
+                .map(texmap_terrain::vector::read_geojson)
+                .collect::<Result<Vec<_>, _>>()?;
             let photo = photo
                 .map(|p| texmap_terrain::photo::open_photo(&p, bands))
                 .transpose()?;
@@ -232,6 +260,8 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
                 chunk,
                 max_texture_levels: texture_levels,
                 contours,
+                overlays,
+                overlay_style,
                 ..BuildOptions::default()
             };
             let m = db::build_with(
@@ -246,6 +276,14 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
                 },
             )?;
             pb.finish_and_clear();
+            for o in m.texture.iter().flat_map(|t| &t.overlays) {
+                crate::note!(
+                    "{}: {} of {} features drawn over the terrain",
+                    o.source,
+                    o.drawn,
+                    o.features
+                );
+            }
             let tris: u64 = m
                 .levels
                 .last()

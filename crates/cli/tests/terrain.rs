@@ -780,6 +780,72 @@ fn contours_drape_the_relief_and_bad_intervals_are_refused() {
     assert!(!dir.path().join("bad.db").exists());
 }
 
+/// `--overlay`: GeoJSON written by ogr2ogr drawn into the relief texture in the style given
+/// (the road in its own red), listed by `terrain info`; a damaged file is a runtime error naming
+/// the feature, a bad style a usage error, and neither leaves a database.
+#[test]
+fn overlays_drape_geojson_and_bad_files_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let db = dir.path().join("roads.db");
+    let build = |extra: &[&str], out: &Path| {
+        let mut args = vec![
+            "terrain",
+            "build",
+            "--dem",
+            data_hillshade(),
+            "--chunk",
+            "33",
+            "--out",
+            out.to_str().unwrap(),
+            "-q",
+        ];
+        args.extend(extra);
+        texmap(&args)
+    };
+    let geojson = data("vector_wgs84.geojson");
+    ok(&build(
+        &[
+            "--overlay",
+            &geojson,
+            "--overlay-style",
+            "fill=#0000ff,fill-opacity=1,stroke-width=3",
+        ],
+        &db,
+    ));
+    let o = texmap(&["terrain", "info", db.to_str().unwrap()]);
+    ok(&o);
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let layer = &v["texture"]["overlays"][0];
+    assert_eq!(
+        (layer["features"].as_u64(), layer["drawn"].as_u64()),
+        (Some(7), Some(6))
+    );
+    let finest = v["texture"]["levels"].as_u64().unwrap() - 1;
+    let tile = image::open(db.join(format!("tiles/{finest}/0_0.png")))
+        .unwrap()
+        .to_rgba8();
+    let count = |c: [u8; 3]| tile.pixels().filter(|p| p.0[..3] == c).count();
+    assert!(count([0, 0, 255]) > 1000 && count([255, 0, 0]) > 50);
+
+    let broken = dir.path().join("broken.geojson");
+    let text = std::fs::read_to_string(&geojson).unwrap();
+    std::fs::write(&broken, text.replacen("\"Polygon\"", "\"Polygan\"", 1)).unwrap();
+    let bad = dir.path().join("bad.db");
+    let o = build(&["--overlay", broken.to_str().unwrap()], &bad);
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("features[0].geometry.type") && err.contains("Polygan"),
+        "{err}"
+    );
+    let o = build(
+        &["--overlay", &geojson, "--overlay-style", "stroke=red"],
+        &bad,
+    );
+    assert_eq!(o.status.code(), Some(2));
+    assert!(!bad.exists());
+}
+
 fn data_hillshade() -> &'static str {
     static PATH: std::sync::OnceLock<String> = std::sync::OnceLock::new();
     PATH.get_or_init(|| data("hillshade_dem_utm.tif"))

@@ -276,20 +276,15 @@ pub fn read_geojson(path: impl AsRef<Path>) -> Result<VectorLayer, TerrainError>
 /// [`read_geojson`] of bytes in memory; `source` names them in errors.
 pub fn parse_geojson(bytes: &[u8], source: &str) -> Result<VectorLayer, TerrainError> {
     let json_err = |e: serde_json::Error| {
-        // Errors raised while converting a feature carry their JSON path; serde_json adds the
-        // line and column of the feature's end.
-        format_err(
-            source,
-            format!("line {} column {}", e.line(), e.column()),
-            {
-                let s = e.to_string();
-                // serde_json appends " at line L column C"; the position is already in `at`.
-                match s.rfind(" at line ") {
-                    Some(i) => s[..i].to_string(),
-                    None => s,
-                }
-            },
-        )
+        let pos = format!("line {} column {}", e.line(), e.column());
+        let msg = e.to_string();
+        // serde_json appends " at line L column C"; the position is already in `at`.
+        let msg = msg.rfind(" at line ").map_or(&msg[..], |i| &msg[..i]);
+        match msg.split_once('\u{1f}') {
+            // A feature that parsed but is not GeoJSON: its path, then what was expected.
+            Some((path, expected)) => format_err(source, format!("{pos}, {path}"), expected),
+            None => format_err(source, pos, format!("JSON ({msg})")),
+        }
     };
     // GeoJSON text sequences: RS-separated (RFC 8142) or newline-delimited features.
     let is_seq = bytes.iter().find(|b| !b.is_ascii_whitespace()) == Some(&0x1e);
@@ -316,7 +311,13 @@ pub fn parse_geojson(bytes: &[u8], source: &str) -> Result<VectorLayer, TerrainE
                     "a Feature in a GeoJSON text sequence",
                 ));
             }
-            features.push(feature_of(&v).map_err(|e| format_err(source, at.clone(), e))?);
+            features.push(feature_of(&v).map_err(|e| {
+                let at = match e.path.is_empty() {
+                    true => at.clone(),
+                    false => format!("{at}, {}", e.path),
+                };
+                format_err(source, at, e.expected)
+            })?);
         }
         return Ok(VectorLayer {
             source: source.to_string(),
@@ -348,7 +349,10 @@ pub fn parse_geojson(bytes: &[u8], source: &str) -> Result<VectorLayer, TerrainE
             obj.insert("type".into(), "Feature".into());
             obj.insert("geometry".into(), top.geometry.unwrap_or(Value::Null));
             obj.insert("properties".into(), top.properties.unwrap_or(Value::Null));
-            vec![feature_of(&Value::Object(obj)).map_err(|e| format_err(source, "Feature", e))?]
+            vec![
+                feature_of(&Value::Object(obj))
+                    .map_err(|e| format_err(source, e.path, e.expected))?,
+            ]
         }
         Some(kind) if GEOMETRIES.contains(&kind) => {
             let mut g = serde_json::Map::new();
@@ -360,8 +364,13 @@ pub fn parse_geojson(bytes: &[u8], source: &str) -> Result<VectorLayer, TerrainE
                 g.insert("geometries".into(), c);
             }
             let mut f = Feature::default();
-            add_geometry(&mut f, &Value::Object(g), kind)
-                .map_err(|e| format_err(source, kind, e))?;
+            add_geometry(&mut f, &Value::Object(g), kind).map_err(|e| {
+                let at = match e.path.is_empty() {
+                    true => kind.to_string(),
+                    false => format!("{kind}, {}", e.path),
+                };
+                format_err(source, at, e.expected)
+            })?;
             vec![f]
         }
         Some(kind) => {
@@ -457,7 +466,10 @@ impl<'de> Visitor<'de> for FeaturesSeed<'_> {
     fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<(), A::Error> {
         while let Some(v) = seq.next_element::<Value>()? {
             let at = format!("features[{}]", self.0.len());
-            let f = feature_of(&v).map_err(|e| de::Error::custom(format!("{at}: {e}")))?;
+            let f = feature_of(&v).map_err(|e| {
+                let e = e.under(&at);
+                de::Error::custom(format!("{}\u{1f}{}", e.path, e.expected))
+            })?;
             self.0.push(f);
         }
         Ok(())
@@ -513,23 +525,55 @@ fn layer_crs(v: &Value) -> Result<LayerCrs, String> {
     }
 }
 
-/// One Feature object into a [`Feature`]; `Err` is the path below `at` and what was expected.
-fn feature_of(v: &Value) -> Result<Feature, String> {
-    let obj = v.as_object().ok_or("a Feature object")?;
+/// What a part of a feature should have been: its JSON path below the feature (`geometry.
+/// coordinates[0][3]`) and what was expected there.
+#[derive(Debug)]
+struct Bad {
+    path: String,
+    expected: String,
+}
+
+impl Bad {
+    fn new(expected: impl Into<String>) -> Bad {
+        Bad {
+            path: String::new(),
+            expected: expected.into(),
+        }
+    }
+
+    /// The same error one level up: `key` (a member name) or `[i]` (an index) before the path.
+    fn under(mut self, key: &str) -> Bad {
+        self.path = match (self.path.is_empty(), self.path.starts_with('[')) {
+            (true, _) => key.to_string(),
+            (false, true) => format!("{key}{}", self.path),
+            (false, false) => format!("{key}.{}", self.path),
+        };
+        self
+    }
+
+    fn index(self, i: usize) -> Bad {
+        self.under(&format!("[{i}]"))
+    }
+}
+
+/// One Feature object into a [`Feature`].
+fn feature_of(v: &Value) -> Result<Feature, Bad> {
+    let obj = v.as_object().ok_or_else(|| Bad::new("a Feature object"))?;
     match obj.get("type").and_then(Value::as_str) {
         Some("Feature") => {}
         other => {
-            return Err(format!(
-                "\"type\": \"Feature\", found {}",
-                other.map_or("no type".to_string(), |t| format!("\"{t}\""))
-            ));
+            return Err(Bad::new(format!(
+                "\"Feature\", found {}",
+                other.map_or("none".to_string(), |t| format!("\"{t}\""))
+            ))
+            .under("type"));
         }
     }
     let mut f = Feature::default();
     if let Some(Value::Object(p)) = obj.get("properties") {
         // A null property is one the feature does not set (ogr2ogr writes empty fields so).
         for (k, value) in p.iter().filter(|(_, v)| !v.is_null()) {
-            set_key(&mut f.style, k, value).map_err(|e| format!("properties: {e}"))?;
+            set_key(&mut f.style, k, value).map_err(|e| Bad::new(e).under("properties"))?;
         }
     }
     match obj.get("geometry") {
@@ -537,73 +581,67 @@ fn feature_of(v: &Value) -> Result<Feature, String> {
         None | Some(Value::Null) => {}
         Some(g) => {
             let kind = g.get("type").and_then(Value::as_str).unwrap_or("");
-            add_geometry(&mut f, g, kind).map_err(|e| format!("geometry: {e}"))?;
+            add_geometry(&mut f, g, kind).map_err(|e| e.under("geometry"))?;
         }
     }
     Ok(f)
 }
 
-fn add_geometry(f: &mut Feature, g: &Value, kind: &str) -> Result<(), String> {
+fn add_geometry(f: &mut Feature, g: &Value, kind: &str) -> Result<(), Bad> {
+    let unknown = || {
+        Bad::new(format!(
+            "a geometry type ({}), found {kind:?}",
+            GEOMETRIES.join(", ")
+        ))
+        .under("type")
+    };
     if kind == "GeometryCollection" {
         let parts = g
             .get("geometries")
             .and_then(Value::as_array)
-            .ok_or("a \"geometries\" array")?;
+            .ok_or_else(|| Bad::new("an array of geometries").under("geometries"))?;
         for (i, p) in parts.iter().enumerate() {
             let k = p.get("type").and_then(Value::as_str).unwrap_or("");
-            add_geometry(f, p, k).map_err(|e| format!("geometries[{i}]: {e}"))?;
+            add_geometry(f, p, k).map_err(|e| e.index(i).under("geometries"))?;
         }
         return Ok(());
     }
-    let c = g.get("coordinates").ok_or_else(|| {
-        if GEOMETRIES.contains(&kind) {
-            "a \"coordinates\" member".to_string()
-        } else {
-            format!(
-                "a geometry type ({}), found {:?}",
-                GEOMETRIES.join(", "),
-                kind
-            )
-        }
-    })?;
-    let at = |i: usize, e: String| format!("coordinates[{i}]{e}");
-    match kind {
-        "Point" => f
-            .points
-            .push(position(c).map_err(|e| format!("coordinates: {e}"))?),
-        "MultiPoint" => {
-            for (i, p) in array(c)?.iter().enumerate() {
-                f.points
-                    .push(position(p).map_err(|e| at(i, format!(": {e}")))?);
-            }
-        }
-        "LineString" => f
-            .lines
-            .push(line(c).map_err(|e| format!("coordinates{e}"))?),
-        "MultiLineString" => {
-            for (i, l) in array(c)?.iter().enumerate() {
-                f.lines.push(line(l).map_err(|e| at(i, e))?);
-            }
-        }
-        "Polygon" => polygon(f, c).map_err(|e| format!("coordinates{e}"))?,
-        "MultiPolygon" => {
-            for (i, p) in array(c)?.iter().enumerate() {
-                polygon(f, p).map_err(|e| at(i, e))?;
-            }
-        }
-        _ => {
-            return Err(format!(
-                "a geometry type ({}), found {kind:?}",
-                GEOMETRIES.join(", ")
-            ));
-        }
+    if !GEOMETRIES.contains(&kind) {
+        return Err(unknown());
     }
-    Ok(())
-}
-
-fn array(v: &Value) -> Result<&Vec<Value>, String> {
-    v.as_array()
-        .ok_or_else(|| format!("coordinates: an array, found {}", short(v)))
+    let c = g
+        .get("coordinates")
+        .ok_or_else(|| Bad::new("a \"coordinates\" member"))?;
+    let each = |c: &Value| -> Result<Vec<Value>, Bad> {
+        c.as_array()
+            .cloned()
+            .ok_or_else(|| Bad::new(format!("an array, found {}", short(c))))
+    };
+    let r = match kind {
+        "Point" => position(c).map(|p| f.points.push(p)),
+        "MultiPoint" => each(c).and_then(|ps| {
+            for (i, p) in ps.iter().enumerate() {
+                f.points.push(position(p).map_err(|e| e.index(i))?);
+            }
+            Ok(())
+        }),
+        "LineString" => line(c).map(|l| f.lines.push(l)),
+        "MultiLineString" => each(c).and_then(|ls| {
+            for (i, l) in ls.iter().enumerate() {
+                f.lines.push(line(l).map_err(|e| e.index(i))?);
+            }
+            Ok(())
+        }),
+        "Polygon" => polygon(f, c),
+        "MultiPolygon" => each(c).and_then(|ps| {
+            for (i, p) in ps.iter().enumerate() {
+                polygon(f, p).map_err(|e| e.index(i))?;
+            }
+            Ok(())
+        }),
+        _ => return Err(unknown()),
+    };
+    r.map_err(|e| e.under("coordinates"))
 }
 
 fn short(v: &Value) -> String {
@@ -614,50 +652,51 @@ fn short(v: &Value) -> String {
     }
 }
 
-fn position(v: &Value) -> Result<Position, String> {
+fn position(v: &Value) -> Result<Position, Bad> {
     let a = v.as_array();
     let x = a.and_then(|a| a.first()).and_then(Value::as_f64);
     let y = a.and_then(|a| a.get(1)).and_then(Value::as_f64);
     match (x, y) {
         (Some(x), Some(y)) => Ok([x, y]),
-        _ => Err(format!("a position [x, y], found {}", short(v))),
+        _ => Err(Bad::new(format!("a position [x, y], found {}", short(v)))),
     }
 }
 
-/// A line string's positions; `Err` starts with the path below the coordinates.
-fn line(v: &Value) -> Result<Vec<Position>, String> {
+/// A line string's positions.
+fn line(v: &Value) -> Result<Vec<Position>, Bad> {
     let a = v
         .as_array()
-        .ok_or_else(|| format!(": an array of positions, found {}", short(v)))?;
+        .ok_or_else(|| Bad::new(format!("an array of positions, found {}", short(v))))?;
     let pts = a
         .iter()
         .enumerate()
-        .map(|(i, p)| position(p).map_err(|e| format!("[{i}]: {e}")))
+        .map(|(i, p)| position(p).map_err(|e| e.index(i)))
         .collect::<Result<Vec<_>, _>>()?;
     if pts.len() < 2 {
-        return Err(format!(
-            ": at least 2 positions in a line string, found {}",
+        return Err(Bad::new(format!(
+            "at least 2 positions in a line string, found {}",
             pts.len()
-        ));
+        )));
     }
     Ok(pts)
 }
 
 /// A polygon's rings into `f.rings` (closed if the file left them open).
-fn polygon(f: &mut Feature, v: &Value) -> Result<(), String> {
+fn polygon(f: &mut Feature, v: &Value) -> Result<(), Bad> {
     let rings = v
         .as_array()
-        .ok_or_else(|| format!(": an array of rings, found {}", short(v)))?;
+        .ok_or_else(|| Bad::new(format!("an array of rings, found {}", short(v))))?;
     for (i, r) in rings.iter().enumerate() {
-        let mut pts = line(r).map_err(|e| format!("[{i}]{e}"))?;
+        let mut pts = line(r).map_err(|e| e.index(i))?;
         if pts.first() != pts.last() {
             pts.push(pts[0]);
         }
         if pts.len() < 4 {
-            return Err(format!(
-                "[{i}]: a linear ring of at least 4 positions (3 corners and the first again), found {}",
+            return Err(Bad::new(format!(
+                "a linear ring of at least 4 positions (3 corners and the first again), found {}",
                 pts.len()
-            ));
+            ))
+            .index(i));
         }
         f.rings.push(pts);
     }
