@@ -969,6 +969,8 @@ impl Overlay {
         let (x0, y0) = ((mx * t) as i64, (my * t) as i64);
         let mut dist = vec![f32::INFINITY; (t * t) as usize];
         let mut xs: Vec<f64> = Vec::new();
+        let mut band: Vec<(f64, f64, usize)> = Vec::new();
+        let mut active: Vec<(f64, usize)> = Vec::new();
         for &id in ids {
             let s = &self.shapes[id as usize];
             // The texels the shape's bounds reach, within this map.
@@ -996,15 +998,32 @@ impl Overlay {
                     }
                 });
             }
+            // Fills: the edges spanning this map's rows, by their lowest y, swept down the rows
+            // (an edge crosses row y when lo ≤ y < hi).
+            band.clear();
+            active.clear();
+            if s.fill.is_some() {
+                for (k, e) in s.edges.iter().enumerate() {
+                    let (lo, hi) = (e[0][1].min(e[1][1]), e[0][1].max(e[1][1]));
+                    if lo < hi && hi > ja as f64 && lo <= jb as f64 {
+                        band.push((lo, hi, k));
+                    }
+                }
+                band.sort_by(|a, b| a.0.total_cmp(&b.0));
+            }
+            let mut entered = 0;
             for j in ja..=jb {
                 let yc = j as f64;
                 if s.fill.is_some() {
+                    while entered < band.len() && band[entered].0 <= yc {
+                        active.push((band[entered].1, band[entered].2));
+                        entered += 1;
+                    }
+                    active.retain(|&(hi, _)| hi > yc);
                     xs.clear();
-                    for e in &s.edges {
-                        let (a, b) = (e[0], e[1]);
-                        if (a[1] > yc) != (b[1] > yc) {
-                            xs.push(a[0] + (yc - a[1]) * (b[0] - a[0]) / (b[1] - a[1]));
-                        }
+                    for &(_, k) in &active {
+                        let [a, b] = s.edges[k];
+                        xs.push(a[0] + (yc - a[1]) * (b[0] - a[0]) / (b[1] - a[1]));
                     }
                     xs.sort_by(f64::total_cmp);
                 }
