@@ -78,6 +78,9 @@ pub enum PathError {
     },
     /// A file with no views.
     Empty { file: String },
+    /// A track that cannot be flown as a whole (no fix over the grid, a grid without a
+    /// georeference, too many frames).
+    Track { file: String, message: String },
 }
 
 impl std::fmt::Display for PathError {
@@ -101,6 +104,7 @@ impl std::fmt::Display for PathError {
                 message,
             } => write!(f, "{file}: element {index}: {message}"),
             PathError::Empty { file } => write!(f, "{file}: no views in the path file"),
+            PathError::Track { file, message } => write!(f, "{file}: {message}"),
         }
     }
 }

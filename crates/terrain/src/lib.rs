@@ -34,6 +34,8 @@
 //!   texture of a database built without a photo.
 //! - [`models`]: textured OBJ models placed on the terrain by georeference and a built-in tree
 //!   billboard, drawn after the terrain with the same samplers and depth-tested against it.
+//! - [`track`]: recorded flights (GPX tracks and routes, IGC flight logs) replayed as flight
+//!   paths: the track's clock, heading along the track, a coordinated turn's bank.
 //! - [`flight`]: flight paths — CSV/JSON path files (a bad line is named), orbits, and the
 //!   built-in study path (look-down, low, grazing, turn, slow pass).
 //!
@@ -85,6 +87,7 @@ pub mod relief;
 pub mod rtin;
 pub mod stream;
 pub mod tiles3d;
+pub mod track;
 pub mod vector;
 pub mod view;
 
