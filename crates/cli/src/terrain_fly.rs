@@ -23,10 +23,22 @@ use crate::movie::Sink;
 pub struct FlyArgs {
     /// Database directory (from `texmap terrain build`).
     pub dir: PathBuf,
-    /// Path file: CSV (x,y,altitude,heading,pitch[,roll[,fov]] per line, optional header) or a
-    /// JSON array of {x, y, altitude, heading, pitch, roll?, fov?}.
+    /// Path file: CSV (x,y,altitude,heading,pitch[,roll[,fov]] per line, optional header), a
+    /// JSON array of {x, y, altitude, heading, pitch, roll?, fov?}, or a recorded flight: a GPX
+    /// track (.gpx: GPS units, Strava, gpxpy, ogr2ogr) or an IGC flight log (.igc: gliding and
+    /// paragliding loggers), flown looking along the track and banking in its turns.
     #[arg(long, conflicts_with = "orbit")]
     pub path: Option<PathBuf>,
+    /// A GPX/IGC track replayed on its own clock: SPEEDUP track seconds per movie second (one
+    /// frame every SPEEDUP/--fps seconds of the track); without it one frame per fix.
+    #[arg(long, value_name = "SPEEDUP")]
+    pub speedup: Option<f64>,
+    /// Pitch of the views along a GPX/IGC track, degrees (negative looks down).
+    #[arg(long, allow_hyphen_values = true, default_value_t = -10.0)]
+    pub track_pitch: f64,
+    /// Metres added to a GPX/IGC track's altitudes (a view from above the pilot's eye).
+    #[arg(long, allow_hyphen_values = true, default_value_t = 0.0)]
+    pub above: f64,
     /// Orbit instead of a path: FRAMES[,RADIUS[,HEIGHT[,PITCH]]] — FRAMES views on a circle around
     /// the grid's centre looking at it; radius and height above the ground as fractions of the
     /// grid's smaller extent (defaults 0.3 and 0.1), pitch in degrees (default −25).
@@ -162,7 +174,44 @@ pub fn run_fly(a: FlyArgs) -> Result<()> {
         height,
         ..FlightCamera::over(terrain.grid())
     };
+    let is_track = a
+        .path
+        .as_deref()
+        .is_some_and(texmap_terrain::track::is_track);
+    if !is_track && (a.speedup.is_some() || a.above != 0.0 || a.track_pitch != -10.0) {
+        return usage("--speedup, --track-pitch and --above apply to a GPX or IGC --path");
+    }
     let views = match (&a.path, &a.orbit) {
+        (Some(p), _) if is_track => {
+            use texmap_terrain::track;
+            if !(a.above.is_finite() && a.track_pitch.abs() < 90.0) {
+                return usage("--track-pitch: expected within ±90 degrees; --above: metres");
+            }
+            let t = track::read_track(p)?;
+            let opts = track::TrackOptions {
+                speedup: a.speedup,
+                fps: a.fps,
+                pitch_deg: a.track_pitch,
+                above: a.above,
+            };
+            let v = track::track_views(&t, terrain.grid(), &template, &opts)?;
+            if v.outside > 0 {
+                crate::note!(
+                    "{}: {} of {} frames left out: their eye lies outside the grid",
+                    p.display(),
+                    v.outside,
+                    v.outside + v.views.len()
+                );
+            }
+            if v.lifted > 0 {
+                crate::note!(
+                    "{}: {} eyes lifted to 2 m above the ground",
+                    p.display(),
+                    v.lifted
+                );
+            }
+            v.views
+        }
         (Some(p), _) => flight::read_path_for(p, &template, terrain.grid())?,
         (None, Some(o)) => parse_orbit(o, &terrain, &template)?,
         (None, None) => unreachable!("checked above"),
