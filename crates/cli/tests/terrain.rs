@@ -846,6 +846,85 @@ fn overlays_drape_geojson_and_bad_files_are_named() {
     assert!(!bad.exists());
 }
 
+/// `fly --path flight.gpx`: a glider's flight (GPX written by GDAL) replayed at 20x and 5 frames a
+/// second over the relief of its grid: one PNG per frame on the track's clock, those past the
+/// grid's edge left out with a note; a track option on a CSV path is a usage error.
+#[test]
+fn fly_replays_a_gpx_flight() {
+    let dir = tempfile::tempdir().unwrap();
+    let db = dir.path().join("wash.db");
+    ok(&texmap(&[
+        "terrain",
+        "build",
+        "--dem",
+        data_hillshade(),
+        "--contours",
+        "100",
+        "--chunk",
+        "33",
+        "--out",
+        db.to_str().unwrap(),
+        "-q",
+    ]));
+    std::fs::create_dir_all(dir.path().join("f")).unwrap();
+    let pattern = dir.path().join("f/%04d.png");
+    let gpx = data("track_ogr.gpx");
+    let o = texmap(&[
+        "terrain",
+        "fly",
+        db.to_str().unwrap(),
+        "--path",
+        &gpx,
+        "--speedup",
+        "20",
+        "--fps",
+        "5",
+        "--above",
+        "30",
+        "--size",
+        "96x64",
+        "-o",
+        pattern.to_str().unwrap(),
+    ]);
+    ok(&o);
+    // The library's views of the same flight: 70 frames on the clock, some off the grid.
+    let grid = texmap_terrain::dem::read_dem(data_hillshade(), &Default::default()).unwrap();
+    let track = texmap_terrain::track::read_track(Path::new(&gpx)).unwrap();
+    let v = texmap_terrain::track::track_views(
+        &track,
+        &grid,
+        &texmap_terrain::view::FlightCamera::over(&grid),
+        &texmap_terrain::track::TrackOptions {
+            speedup: Some(20.0),
+            fps: 5.0,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let frames = std::fs::read_dir(dir.path().join("f")).unwrap().count();
+    assert_eq!(frames, v.views.len());
+    assert_eq!(v.views.len() + v.outside, 70);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains(&format!("{} of 70 frames left out", v.outside)),
+        "{err}"
+    );
+    let csv = dir.path().join("p.csv");
+    std::fs::write(&csv, "x,y,altitude,heading,pitch\n").unwrap();
+    let o = texmap(&[
+        "terrain",
+        "fly",
+        db.to_str().unwrap(),
+        "--path",
+        csv.to_str().unwrap(),
+        "--speedup",
+        "2",
+        "-o",
+        pattern.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+}
+
 fn data_hillshade() -> &'static str {
     static PATH: std::sync::OnceLock<String> = std::sync::OnceLock::new();
     PATH.get_or_init(|| data("hillshade_dem_utm.tif"))
