@@ -1,6 +1,8 @@
 //! Coordination numbers: how many atoms lie within a cutoff distance of each atom, as OVITO's
 //! Coordination analysis modifier counts them, so that under- and over-coordinated atoms
-//! (surfaces, vacancies, amorphous regions, dangling bonds) can be coloured and selected.
+//! (surfaces, vacancies, amorphous regions, dangling bonds) can be coloured and selected; and
+//! [`clusters`] of atoms joined by such pairs, as OVITO's Cluster analysis finds them
+//! (precipitates, nuclei, droplets, fragments).
 //!
 //! The pairs come from the cell grid of [`crate::bonds`] ([`bonds_with_radii`] with every atom's
 //! radius set so that its bond cutoff is the coordination cutoff): linear in the atoms,
@@ -66,6 +68,17 @@ impl std::error::Error for CoordinationError {}
 
 /// The number of atoms within `cutoff` Å of each atom of `frame` (see the module docs).
 pub fn coordination(frame: &Frame, cutoff: f32) -> Result<Vec<u32>, CoordinationError> {
+    let mut counts = vec![0u32; frame.n_atoms()];
+    for [i, j] in pairs_within(frame, cutoff)? {
+        counts[i as usize] += 1;
+        counts[j as usize] += 1;
+    }
+    Ok(counts)
+}
+
+/// Every pair of atoms within `cutoff` Å (and above the bond finder's floor), under the
+/// minimum image.
+fn pairs_within(frame: &Frame, cutoff: f32) -> Result<Vec<[u32; 2]>, CoordinationError> {
     if !(cutoff > BOND_TOLERANCE && cutoff <= MAX_CUTOFF) {
         return Err(CoordinationError::BadCutoff(cutoff));
     }
@@ -80,10 +93,93 @@ pub fn coordination(frame: &Frame, cutoff: f32) -> Result<Vec<u32>, Coordination
         let width = cell.min_width();
         return Err(CoordinationError::CellTooSmall { width, cutoff });
     }
-    let mut counts = vec![0u32; n];
-    for [i, j] in bonds.pairs {
-        counts[i as usize] += 1;
-        counts[j as usize] += 1;
+    Ok(bonds.pairs)
+}
+
+/// Clusters of atoms joined by neighbour pairs within a cutoff, as OVITO 3.17's Cluster analysis
+/// modifier (cutoff mode, sorted by size) numbers them: every atom's cluster id, 0 the largest
+/// cluster, 1 the next (equal sizes: the one holding the lower atom index first); atoms outside
+/// `only` (when given) are in no cluster, id −1, and join none (OVITO before 3.17 counted from
+/// 1, with 0 for none). An atom without neighbours is a cluster of its own. Pairs as
+/// [`coordination`] finds them (the same cutoff range and the same refusal of a periodic cell
+/// narrower than three cutoffs).
+///
+/// ```
+/// use texmap_md_io::coordination::clusters;
+/// use texmap_md_io::Frame;
+/// let mut frame = Frame::new();
+/// // A chain of three atoms 2 Å apart, and a pair far away.
+/// frame.positions = vec![[0.0, 0.0, 0.0], [20.0, 0.0, 0.0], [2.0, 0.0, 0.0], [4.0, 0.0, 0.0],
+///                        [21.5, 0.0, 0.0]];
+/// let c = clusters(&frame, 2.5, None).unwrap();
+/// assert_eq!(c.ids, [0, 1, 0, 0, 1]);
+/// assert_eq!(c.sizes, [3, 2]);
+/// // Only the atoms a selection picks: the others are in no cluster.
+/// let c = clusters(&frame, 2.5, Some(&[true, true, false, true, true])).unwrap();
+/// assert_eq!(c.ids, [2, 0, -1, 1, 0]);
+/// ```
+pub fn clusters(
+    frame: &Frame,
+    cutoff: f32,
+    only: Option<&[bool]>,
+) -> Result<Clusters, CoordinationError> {
+    let pairs = pairs_within(frame, cutoff)?;
+    let n = frame.n_atoms();
+    let member = |i: usize| only.is_none_or(|m| m.get(i).copied().unwrap_or(false));
+    // Union-find with path halving; the root of a set is its lowest atom index.
+    let mut parent: Vec<u32> = (0..n as u32).collect();
+    fn root(parent: &mut [u32], mut i: u32) -> u32 {
+        while parent[i as usize] != i {
+            let p = parent[parent[i as usize] as usize];
+            parent[i as usize] = p;
+            i = p;
+        }
+        i
     }
-    Ok(counts)
+    for [i, j] in pairs {
+        if member(i as usize) && member(j as usize) {
+            let (a, b) = (root(&mut parent, i), root(&mut parent, j));
+            if a != b {
+                let (lo, hi) = (a.min(b), a.max(b));
+                parent[hi as usize] = lo;
+            }
+        }
+    }
+    let mut size = vec![0usize; n];
+    let mut roots = Vec::new();
+    for i in 0..n {
+        if member(i) {
+            let r = root(&mut parent, i as u32) as usize;
+            if size[r] == 0 {
+                roots.push(r);
+            }
+            size[r] += 1;
+        }
+    }
+    // Largest first; equal sizes by their lowest atom (the root), as found in index order.
+    roots.sort_by(|&a, &b| size[b].cmp(&size[a]).then(a.cmp(&b)));
+    let mut id_of_root = vec![0i32; n];
+    for (k, &r) in roots.iter().enumerate() {
+        id_of_root[r] = k as i32;
+    }
+    let ids = (0..n)
+        .map(|i| {
+            if member(i) {
+                id_of_root[root(&mut parent, i as u32) as usize]
+            } else {
+                -1
+            }
+        })
+        .collect();
+    let sizes = roots.iter().map(|&r| size[r]).collect();
+    Ok(Clusters { ids, sizes })
+}
+
+/// What [`clusters`] finds.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Clusters {
+    /// Per atom: its cluster (0 the largest), −1 when outside the atoms clustered.
+    pub ids: Vec<i32>,
+    /// Atoms per cluster, largest first (`sizes[k]` is cluster `k`).
+    pub sizes: Vec<usize>,
 }
