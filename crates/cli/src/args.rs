@@ -156,6 +156,8 @@ pub enum ColorBy {
     /// --type-color, else the crystal structure type (adaptive CNA: FCC, HCP, BCC, ICO,
     /// other), per frame, in OVITO's colours.
     Cna,
+    /// --type-color, else one distinct colour per cluster (--clusters), the largest first.
+    Cluster,
     /// A number per atom through --colormap.
     Scalar(texmap_md_scene::ScalarSource),
 }
@@ -170,6 +172,7 @@ pub fn parse_color_by(s: &str) -> Result<ColorBy, String> {
         "chain" => ColorBy::Chain,
         "structure" | "secondary" | "ss" => ColorBy::Structure,
         "cna" | "structure-type" => ColorBy::Cna,
+        "cluster" | "clusters" => ColorBy::Cluster,
         "speed" | "velocity" => ColorBy::Scalar(ScalarSource::Speed),
         "residue" | "resid" => ColorBy::Scalar(ScalarSource::Residue),
         "index" => ColorBy::Scalar(ScalarSource::Index),
@@ -1012,6 +1015,18 @@ pub struct MolArgs {
     /// than 3 R is refused (replicate it). R from 0.45 to 20 Å.
     #[arg(long, value_name = "R", value_parser = parse_cutoff)]
     pub coordination: Option<f32>,
+    /// Group atoms into clusters of neighbours within R Å every frame, as OVITO's Cluster
+    /// analysis (sorted by size; ids from 0, the largest, as OVITO 3.17 numbers them), into the
+    /// per-atom number 'cluster': --color-by cluster gives each cluster its own colour, --select
+    /// 'prop cluster == 0' keeps the largest (a precipitate, a droplet, the percolating
+    /// network). Counted after --coordination, under the minimum image (a periodic cell
+    /// narrower than 3 R is refused). R from 0.45 to 20 Å.
+    #[arg(long, value_name = "R", value_parser = parse_cutoff)]
+    pub clusters: Option<f32>,
+    /// Cluster only the atoms this selection picks (e.g. 'element Cu' for precipitates in a
+    /// matrix, 'prop coordination >= 10' for solid-like atoms); the others are in cluster -1.
+    #[arg(long, value_name = "SEL", requires = "clusters")]
+    pub cluster_atoms: Option<String>,
     /// Cut the system open, as OVITO's Slice modifier: 'NX,NY,NZ:D' keeps the atoms behind the
     /// plane n·x = D (n the unit normal: the side n points away from), 'NX,NY,NZ:D:W' the
     /// slab of width W Å centred on it: --slice 1,1,1:20:6 shows one (111) slab of an FCC

@@ -34,6 +34,7 @@ pub fn style_options(args: &StyleArgs) -> StyleOptions {
             ColorBy::Chain => texmap_md_scene::ColorBy::Chain,
             ColorBy::Structure => texmap_md_scene::ColorBy::Structure,
             ColorBy::Cna => texmap_md_scene::ColorBy::Cna,
+            ColorBy::Cluster => texmap_md_scene::ColorBy::Cluster,
             ColorBy::Scalar(_) => texmap_md_scene::ColorBy::Scalar,
         },
         scalar: texmap_md_scene::ScalarColor {
@@ -475,6 +476,12 @@ pub fn mol_plan(args: &MolArgs, style: &StyleArgs, topology: Option<Topology>) -
         )
         .into());
     }
+    if matches!(style.color_by, ColorBy::Cluster) && args.clusters.is_none() {
+        return Err(crate::args::UsageError(
+            "--color-by cluster: give --clusters R (the neighbour cutoff in Å) to find them".into(),
+        )
+        .into());
+    }
     let optional = |flag, text: &Option<String>| {
         text.as_deref()
             .map(|t| parse_selection(flag, t))
@@ -537,6 +544,17 @@ pub fn mol_plan(args: &MolArgs, style: &StyleArgs, topology: Option<Topology>) -
         pbc: args.pbc.into(),
         replicate: args.replicate,
         coordination: args.coordination,
+        clusters: match args.clusters {
+            Some(cutoff) => Some(texmap_md_scene::ClusterOptions {
+                cutoff,
+                atoms: args
+                    .cluster_atoms
+                    .as_deref()
+                    .map(|t| parse_selection("--cluster-atoms", t))
+                    .transpose()?,
+            }),
+            None => None,
+        },
         slice: args.slice.map(|[x, y, z, d, w]| texmap_md_scene::Slice {
             normal: [x, y, z],
             distance: d,
@@ -593,6 +611,7 @@ fn rep_color(rep: &str, text: &str) -> Result<texmap_md_scene::RepColor> {
         Ok(ColorBy::Chain) => texmap_md_scene::ColorBy::Chain,
         Ok(ColorBy::Structure) => texmap_md_scene::ColorBy::Structure,
         Ok(ColorBy::Cna) => texmap_md_scene::ColorBy::Cna,
+        Ok(ColorBy::Cluster) => texmap_md_scene::ColorBy::Cluster,
         _ => {
             return usage(format!(
                 "--rep {rep:?}: {text:?} is not a representation's colouring; use element, type, \
@@ -629,6 +648,7 @@ pub fn mol_error(e: MolError) -> anyhow::Error {
                 SelectionRole::Color => "--color",
                 SelectionRole::Radius => "--radius",
                 SelectionRole::Align => "--align",
+                SelectionRole::Cluster => "--cluster-atoms",
             };
             format!("{flag}: {error}")
         }

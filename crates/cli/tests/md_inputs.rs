@@ -3197,3 +3197,65 @@ fn vina_poses_render_in_their_receptor_with_their_scores() {
         (Some("pdbqt"), Some(5))
     );
 }
+
+/// `--clusters`: the copper precipitate of md-io's clusters fixture (written by OVITO), drawn
+/// alone by `--select 'prop cluster == 0'`, is the same picture, byte for byte, as the atoms of
+/// OVITO's largest cluster selected by index; `--color-by cluster` without `--clusters`, or
+/// `--cluster-atoms` alone, is a usage error.
+#[test]
+fn clusters_select_the_precipitate() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = Path::new(env!("CARGO_MANIFEST_DIR")).join("../md-io/tests/data/clusters");
+    let file = base.join("fecu.xyz").to_string_lossy().into_owned();
+    let v: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(base.join("clusters_reference.json")).unwrap(),
+    )
+    .unwrap();
+    let largest: Vec<String> = v[2]["ids"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .enumerate()
+        .filter(|(_, id)| id.as_i64() == Some(0))
+        .map(|(i, _)| i.to_string())
+        .collect();
+    assert_eq!(largest.len(), 81);
+    let by_index = format!("index {}", largest.join(" "));
+    let render = |select: &str, out: &str| {
+        let out = dir.path().join(out);
+        let o = texmap(&[
+            "render",
+            &file,
+            "--clusters",
+            "2.9",
+            "--cluster-atoms",
+            "element Cu",
+            "--color-by",
+            "cluster",
+            "--select",
+            select,
+            "--size",
+            "200x200",
+            "-q",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        std::fs::read(out).unwrap()
+    };
+    let ours = render("prop cluster == 0", "ours.png");
+    assert_eq!(ours, render(&by_index, "ovito.png"));
+    assert_ne!(ours, render("prop cluster == 1", "second.png"));
+    let o = texmap(&["render", &file, "--color-by", "cluster", "-o", "x.png"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--clusters R"));
+    let o = texmap(&[
+        "render",
+        &file,
+        "--cluster-atoms",
+        "element Cu",
+        "-o",
+        "y.png",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+}

@@ -11,7 +11,8 @@
 //!    ([`texmap_md_io::replicate`]: bonds across inner faces become whole, and every later
 //!    step sees the copies, so `index` counts their atoms too); with
 //!    [`MolOptions::coordination`], each atom's neighbour count as the property
-//!    [`COORDINATION`]; bonds that still cross the (enlarged) box are dropped, so no stick
+//!    [`COORDINATION`], and with [`MolOptions::clusters`] each atom's cluster as [`CLUSTER`];
+//!    bonds that still cross the (enlarged) box are dropped, so no stick
 //!    spans it; with [`MolOptions::displacement`] (after the alignment of step 3), each atom's
 //!    distance from the first frame built as the property [`DISPLACEMENT`];
 //! 3. with [`MolOptions::align`], the frame superposed on a reference: the first frame built,
@@ -218,6 +219,9 @@ pub enum Pbc {
 
 /// The per-atom property [`MolOptions::coordination`] adds to each frame.
 pub const COORDINATION: &str = "coordination";
+/// The per-atom property [`MolOptions::clusters`] adds to each frame (0 the largest cluster, −1
+/// for atoms not clustered).
+pub const CLUSTER: &str = "cluster";
 /// The per-atom property [`MolOptions::displacement`] adds to each frame.
 pub const DISPLACEMENT: &str = "displacement";
 
@@ -245,6 +249,11 @@ pub struct MolOptions {
     /// images, as the per-atom property `coordination` (OVITO's Coordination analysis:
     /// [`texmap_md_io::coordination`]), for colouring and selections (`prop coordination < 12`).
     pub coordination: Option<f32>,
+    /// Group atoms into clusters of neighbours within a cutoff every frame, after the
+    /// coordination, as the per-atom property `cluster` (OVITO's Cluster analysis:
+    /// [`texmap_md_io::coordination::clusters`]), for colouring ([`crate::ColorBy::Cluster`])
+    /// and selections (`prop cluster == 0`: the largest).
+    pub clusters: Option<ClusterOptions>,
     /// Draw only the atoms on one side of a plane or inside a slab (OVITO's Slice modifier as
     /// the last step of a pipeline), placed after the alignment; `None` draws every atom.
     pub slice: Option<Slice>,
@@ -368,6 +377,7 @@ impl Default for MolOptions {
             pbc: Pbc::None,
             replicate: None,
             coordination: None,
+            clusters: None,
             slice: None,
             align: None,
             reps: Vec::new(),
@@ -382,6 +392,15 @@ impl Default for MolOptions {
     }
 }
 
+/// [`MolOptions::clusters`]: the cutoff and the atoms clustered.
+#[derive(Clone, Debug)]
+pub struct ClusterOptions {
+    /// Neighbour cutoff, Å.
+    pub cutoff: f32,
+    /// Only these atoms are clustered (the others are in cluster −1); `None`: every atom.
+    pub atoms: Option<Selection>,
+}
+
 /// Which selection of a [`MolPlan`] failed to evaluate.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SelectionRole {
@@ -393,6 +412,8 @@ pub enum SelectionRole {
     Radius,
     /// [`MolOptions::align`].
     Align,
+    /// [`ClusterOptions::atoms`].
+    Cluster,
 }
 
 /// Why a [`MolPlan`] was refused or a frame could not be built.
@@ -510,6 +531,7 @@ impl fmt::Display for MolError {
             MolError::Selection { role, error } => {
                 let what = match role {
                     SelectionRole::Align => "the alignment selection",
+                    SelectionRole::Cluster => "the selection of clustered atoms",
                     SelectionRole::Select => "the selection of drawn atoms",
                     SelectionRole::Color => "a colour rule's selection",
                     SelectionRole::Radius => "a radius rule's selection",
@@ -950,6 +972,23 @@ impl MolPlan {
             frame.properties.retain(|p| p.name != COORDINATION);
             frame.properties.push(Property {
                 name: COORDINATION.to_string(),
+                values,
+            });
+        }
+        if let Some(c) = &self.options.clusters {
+            let mask = match &c.atoms {
+                Some(sel) => Some(sel.evaluate(frame).map_err(|error| MolError::Selection {
+                    role: SelectionRole::Cluster,
+                    error,
+                })?),
+                None => None,
+            };
+            let found = texmap_md_io::coordination::clusters(frame, c.cutoff, mask.as_deref())
+                .map_err(MolError::Coordination)?;
+            let values = found.ids.into_iter().map(|c| c as f32).collect();
+            frame.properties.retain(|p| p.name != CLUSTER);
+            frame.properties.push(Property {
+                name: CLUSTER.to_string(),
                 values,
             });
         }

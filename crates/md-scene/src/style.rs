@@ -38,6 +38,10 @@ pub enum ColorBy {
     /// The rules, else the crystal structure type adaptive common neighbour analysis gives the
     /// atom ([`texmap_md_io::cna`]), assigned per frame, in OVITO's colours ([`CNA_COLORS`]).
     Cna,
+    /// The rules, else one distinct colour per cluster (the per-atom property
+    /// [`crate::plan::CLUSTER`], [`crate::MolOptions::clusters`]): the palette colour of the
+    /// cluster's id, the largest first; atoms in no cluster take the element colours.
+    Cluster,
 }
 
 /// The colours of [`ColorBy::Cna`], OVITO's: other near-white, FCC green, HCP red, BCC blue,
@@ -434,6 +438,12 @@ impl SceneBuilder {
         } else {
             Vec::new()
         };
+        let cluster = match color_by {
+            ColorBy::Cluster => frame
+                .property(crate::plan::CLUSTER)
+                .filter(|v| v.len() == frame.n_atoms()),
+            _ => None,
+        };
         for (i, &base_color) in base.iter().enumerate().take(frame.n_atoms()) {
             let color = match categories {
                 Some((first, second)) => match self.style.rules_for(frame, i).color {
@@ -455,6 +465,13 @@ impl SceneBuilder {
                 None if scalar => match self.style.rules_for(frame, i).color {
                     Some(c) => c,
                     None => scalar_color(self.scalar.map, range, self.values[i]),
+                },
+                None if cluster.is_some() => match self.style.rules_for(frame, i).color {
+                    Some(c) => c,
+                    None => match cluster.map_or(-1.0, |v| v[i]) {
+                        id if id >= 0.0 => type_color(id as usize),
+                        _ => base_color,
+                    },
                 },
                 None if !crystal.is_empty() => match self.style.rules_for(frame, i).color {
                     Some(c) => c,

@@ -128,3 +128,87 @@ fn the_slice_draws_ovitos_atoms() {
     let under = scene.centers.len();
     assert_eq!(under, 0, "{under} under-coordinated");
 }
+
+/// `MolOptions::clusters` with a selection of the clustered atoms: the copper precipitate in
+/// iron that `--clusters 2.9 --cluster-atoms 'element Cu' --select 'prop cluster == 0'` draws
+/// is exactly OVITO 3.17's largest cluster (md-io's clusters fixture), and `ColorBy::Cluster`
+/// gives each of the largest clusters its own palette colour, the iron the element colour.
+#[test]
+fn the_largest_copper_cluster_is_ovitos() {
+    use texmap_md_scene::{CLUSTER, ClusterOptions, ColorBy, type_color};
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../md-io/tests/data/clusters");
+    let text = std::fs::read_to_string(dir.join("clusters_reference.json")).unwrap();
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let ovito: Vec<i64> = v[2]["ids"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_i64().unwrap())
+        .collect();
+    let read = || {
+        let mut f = Frame::new();
+        assert!(
+            Trajectory::open(dir.join("fecu.xyz"))
+                .unwrap()
+                .read_next(&mut f)
+                .unwrap()
+        );
+        f
+    };
+    let options = |select: Option<&str>| MolOptions {
+        clusters: Some(ClusterOptions {
+            cutoff: 2.9,
+            atoms: Some(Selection::parse("element Cu").unwrap()),
+        }),
+        select: select.map(|s| Selection::parse(s).unwrap()),
+        ..MolOptions::default()
+    };
+    let mut plan = MolPlan::new(options(Some("prop cluster == 0"))).unwrap();
+    let mut builder = SceneBuilder::new(&StyleOptions::default()).unwrap();
+    let (mut frame, mut scene) = (read(), SphereScene::default());
+    plan.build(&mut builder, &mut frame, &mut scene).unwrap();
+    let want: Vec<[f32; 3]> = (0..ovito.len())
+        .filter(|&i| ovito[i] == 0)
+        .map(|i| frame.positions[i])
+        .collect();
+    assert_eq!(want.len(), 81);
+    let got: Vec<[f32; 3]> = scene.centers.iter().map(|c| c.to_array()).collect();
+    assert_eq!(got, want);
+    assert_eq!(frame.property(CLUSTER).unwrap().len(), frame.n_atoms());
+
+    // Colours: cluster k has palette colour k; iron (cluster -1) its element colour.
+    let mut plan = MolPlan::new(options(None)).unwrap();
+    let style = StyleOptions {
+        color_by: ColorBy::Cluster,
+        ..StyleOptions::default()
+    };
+    let mut builder = SceneBuilder::new(&style).unwrap();
+    let (mut frame, mut scene) = (read(), SphereScene::default());
+    plan.build(&mut builder, &mut frame, &mut scene).unwrap();
+    let ids = frame.property(CLUSTER).unwrap().to_vec();
+    // The palette's material of an sRGB colour: quantised to 8 bits, made linear.
+    let linear = |c: [f32; 3]| {
+        c.map(|x| {
+            let x = (x.clamp(0.0, 1.0) * 255.0).round() / 255.0;
+            texmap_core::color::srgb_to_linear(x)
+        })
+    };
+    let mut clustered = 0;
+    for (i, &id) in ids.iter().enumerate() {
+        let want = if id >= 0.0 {
+            clustered += 1;
+            type_color(id as usize)
+        } else {
+            texmap_md_io::atom_element(&frame, i).color()
+        };
+        let got = scene.materials[scene.kinds[i] as usize]
+            .base_color
+            .to_array();
+        let want = linear(want);
+        assert!(
+            (0..3).all(|k| (got[k] - want[k]).abs() < 1e-6),
+            "atom {i}, cluster {id}: {got:?} vs {want:?}"
+        );
+    }
+    assert!(clustered > 200 && clustered < ids.len() / 5, "{clustered}");
+}
