@@ -208,7 +208,7 @@ fn overlays_are_drawn_into_the_texture() {
     assert_eq!((tex.overlays[0].features, tex.overlays[0].drawn), (7, 3));
     let finest = tex.levels - 1;
     let n = 1u32 << finest;
-    let o = Overlay::place(&[layer.clone()], &style, &grid, 64 * n, 64).unwrap();
+    let o = Overlay::place(std::slice::from_ref(&layer), &style, &grid, 64 * n, 64).unwrap();
     let (mut same, mut blue) = (0, 0);
     for my in 0..n {
         for mx in 0..n {
