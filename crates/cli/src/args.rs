@@ -1027,6 +1027,12 @@ pub struct MolArgs {
     /// matrix, 'prop coordination >= 10' for solid-like atoms); the others are in cluster -1.
     #[arg(long, value_name = "SEL", requires = "clusters")]
     pub cluster_atoms: Option<String>,
+    /// Draw each atom with the radius (Å) a per-atom property gives: PQR's 'radius'
+    /// (PDB2PQR/APBS radii), any dump column (texmap info lists them), --property FILE's
+    /// numbers. As a file's radius column: --radius-scale does not apply, ball-and-stick
+    /// scales it. Zero, negative or missing values leave the element's radius.
+    #[arg(long, value_name = "PROPERTY")]
+    pub radius_from: Option<String>,
     /// Cut the system open, as OVITO's Slice modifier: 'NX,NY,NZ:D' keeps the atoms behind the
     /// plane n·x = D (n the unit normal: the side n points away from), 'NX,NY,NZ:D:W' the
     /// slab of width W Å centred on it: --slice 1,1,1:20:6 shows one (111) slab of an FCC

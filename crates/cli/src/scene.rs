@@ -555,6 +555,7 @@ pub fn mol_plan(args: &MolArgs, style: &StyleArgs, topology: Option<Topology>) -
             }),
             None => None,
         },
+        radius_from: args.radius_from.clone(),
         slice: args.slice.map(|[x, y, z, d, w]| texmap_md_scene::Slice {
             normal: [x, y, z],
             distance: d,
@@ -660,6 +661,8 @@ pub fn mol_error(e: MolError) -> anyhow::Error {
             format!("--align: the selection picks {atoms} atom(s) of the first frame: {why}")
         }
         MolError::Coordination(e) => return anyhow::anyhow!("--coordination: {e}"),
+        MolError::Clusters(e) => return anyhow::anyhow!("--clusters: {e}"),
+        MolError::NoRadiusProperty { .. } => return anyhow::anyhow!("--radius-from: {e}"),
         MolError::BadSlice => format!("--slice: {e}"),
         MolError::Replicate(e) => {
             // A frame without a cell, or too many atoms for the copies: the input's limit.

@@ -254,6 +254,11 @@ pub struct MolOptions {
     /// [`texmap_md_io::coordination::clusters`]), for colouring ([`crate::ColorBy::Cluster`])
     /// and selections (`prop cluster == 0`: the largest).
     pub clusters: Option<ClusterOptions>,
+    /// Draw every atom with the radius a per-atom property gives (Å; PQR's `radius`, any
+    /// column of a dump), as a file's `radius` column is drawn; a value of zero or less, or
+    /// not a number, leaves the atom its element's radius. A frame without the property is an
+    /// error naming the properties it has.
+    pub radius_from: Option<String>,
     /// Draw only the atoms on one side of a plane or inside a slab (OVITO's Slice modifier as
     /// the last step of a pipeline), placed after the alignment; `None` draws every atom.
     pub slice: Option<Slice>,
@@ -378,6 +383,7 @@ impl Default for MolOptions {
             replicate: None,
             coordination: None,
             clusters: None,
+            radius_from: None,
             slice: None,
             align: None,
             reps: Vec::new(),
@@ -456,6 +462,14 @@ pub enum MolError {
     Replicate(ReplicateError),
     /// [`MolOptions::coordination`] cannot be counted (the cell is too small for the cutoff).
     Coordination(CoordinationError),
+    /// [`MolOptions::clusters`] cannot be found (the cell is too small for the cutoff).
+    Clusters(CoordinationError),
+    /// [`MolOptions::radius_from`] names a property a frame does not have.
+    NoRadiusProperty {
+        name: String,
+        /// The frame's per-atom properties.
+        available: Vec<String>,
+    },
     /// [`MolOptions::slice`] has a zero or non-finite normal, a non-finite distance or a
     /// negative or non-finite width.
     BadSlice,
@@ -489,6 +503,16 @@ impl fmt::Display for MolError {
             MolError::NoTopology => write!(f, "bonds from the topology need a topology"),
             MolError::Replicate(e) => write!(f, "periodic images: {e}"),
             MolError::Coordination(e) => write!(f, "coordination: {e}"),
+            MolError::Clusters(e) => write!(f, "clusters: {e}"),
+            MolError::NoRadiusProperty { name, available } => write!(
+                f,
+                "radii from '{name}': the frame has no such per-atom property ({})",
+                if available.is_empty() {
+                    "it has none".to_string()
+                } else {
+                    format!("it has {}", available.join(", "))
+                }
+            ),
             MolError::HBonds(e) => write!(f, "hydrogen bonds: {e}"),
             MolError::Arrows(e) => write!(f, "arrows: {e}"),
             MolError::Ellipsoids(e) => write!(f, "ellipsoids: {e}"),
@@ -984,13 +1008,33 @@ impl MolPlan {
                 None => None,
             };
             let found = texmap_md_io::coordination::clusters(frame, c.cutoff, mask.as_deref())
-                .map_err(MolError::Coordination)?;
+                .map_err(MolError::Clusters)?;
             let values = found.ids.into_iter().map(|c| c as f32).collect();
             frame.properties.retain(|p| p.name != CLUSTER);
             frame.properties.push(Property {
                 name: CLUSTER.to_string(),
                 values,
             });
+        }
+        if let Some(name) = &self.options.radius_from {
+            let Some(values) = frame.property(name) else {
+                return Err(MolError::NoRadiusProperty {
+                    name: name.clone(),
+                    available: frame.properties.iter().map(|p| p.name.clone()).collect(),
+                });
+            };
+            // A radius of zero or less (PQR's hydrogens in some force fields) or not a number
+            // is no radius: the atom takes its element's.
+            frame.radii = values
+                .iter()
+                .map(|&r| {
+                    if r.is_finite() && r > 0.0 {
+                        r
+                    } else {
+                        f32::NAN
+                    }
+                })
+                .collect();
         }
         self.donor_h.clear();
         if self.draws_hbonds() {

@@ -212,3 +212,53 @@ fn the_largest_copper_cluster_is_ovitos() {
     }
     assert!(clustered > 200 && clustered < ids.len() / 5, "{clustered}");
 }
+
+/// `MolOptions::radius_from`: the atoms of a PQR file PDB2PQR wrote (AMBER radii, md-io's
+/// fixture) are drawn at the file's radii, and those whose radius is 0 (hydroxyl and polar
+/// hydrogens in AMBER's set) at their element's; a property the frame lacks is an error naming
+/// those it has.
+#[test]
+fn pqr_radii_are_drawn() {
+    use texmap_md_scene::MolError;
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../md-io/tests/data/pdb2pqr_amber.pqr");
+    let read = || {
+        let mut f = Frame::new();
+        assert!(Trajectory::open(&file).unwrap().read_next(&mut f).unwrap());
+        f
+    };
+    let pqr = read();
+    let radii = pqr.property("radius").unwrap().to_vec();
+    let mut plan = MolPlan::new(MolOptions {
+        radius_from: Some("radius".into()),
+        ..MolOptions::default()
+    })
+    .unwrap();
+    let mut builder = SceneBuilder::new(&StyleOptions::default()).unwrap();
+    let (mut frame, mut scene) = (read(), SphereScene::default());
+    plan.build(&mut builder, &mut frame, &mut scene).unwrap();
+    let (mut from_file, mut from_element) = (0, 0);
+    for (i, &r) in radii.iter().enumerate() {
+        if r > 0.0 {
+            from_file += 1;
+            assert_eq!(scene.radii[i], r, "atom {i}");
+        } else {
+            from_element += 1;
+            let e = texmap_md_io::atom_element(&frame, i);
+            assert!((scene.radii[i] - e.vdw_radius()).abs() < 1e-6, "atom {i}");
+        }
+    }
+    assert!(
+        from_file > 100 && from_element > 0,
+        "{from_file} {from_element}"
+    );
+    let mut plan = MolPlan::new(MolOptions {
+        radius_from: Some("sigma".into()),
+        ..MolOptions::default()
+    })
+    .unwrap();
+    let err = plan
+        .build(&mut builder, &mut read(), &mut SphereScene::default())
+        .unwrap_err();
+    assert!(matches!(&err, MolError::NoRadiusProperty { .. }));
+    assert!(err.to_string().contains("it has charge, radius"), "{err}");
+}
