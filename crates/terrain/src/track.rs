@@ -291,7 +291,11 @@ pub fn parse_igc(text: &str, file: &str) -> Result<Track, PathError> {
     for (i, raw) in text.lines().enumerate() {
         let line = raw.trim_end();
         let n = i + 1;
-        if line.len() >= 5 && line[..5].eq_ignore_ascii_case("HFDTE") {
+        if line
+            .as_bytes()
+            .get(..5)
+            .is_some_and(|h| h.eq_ignore_ascii_case(b"HFDTE"))
+        {
             // HFDTEDDMMYY or HFDTEDATE:DDMMYY[,NN]
             let rest = &line[5..];
             let rest = rest.split_once(':').map_or(rest, |(_, r)| r);

@@ -1,7 +1,8 @@
 //! The terrain readers in the fuzz campaign every reader of the project runs (the harness is
 //! md-io's `tests/support/`, shared by path): GeoTIFF files written by GDAL (five sample types,
 //! strips and tiles, LZW, BigTIFF, PixelIsPoint), the ESRI ASCII grid GDAL wrote, and an SRTM
-//! `.hgt` tile and a 16-bit PNG made here. Each mutant — a cut, bit flips, byte replacements,
+//! `.hgt` tile and a 16-bit PNG made here; and the vector overlays and recorded flights (GeoJSON,
+//! GPX, IGC) written by ogr2ogr, gpxpy and aerofiles. Each mutant — a cut, bit flips, byte replacements,
 //! header fields set to extremes — must end in a grid or an error naming the file, never a panic,
 //! under a heap cap of 64x the mutant's size + 1 MiB.
 //!
@@ -184,6 +185,101 @@ fn terrain_readers_survive_the_campaign() {
     let t = run_campaign("16-bit PNG", &fx, &settings, &|_, bytes| {
         std::fs::write(&mutant, bytes).unwrap();
         verdict(dem::png::read_png16(&mutant, 0.1, -10.0, 30.0), &mutant)
+    });
+    report.push_str(&t.report());
+    assert!(t.failures.is_empty(), "{}", t.report());
+    eprintln!("{report}");
+}
+
+/// An error's verdict: located when its text names the file.
+fn located(msg: String, name: &str, kind: &'static str) -> Verdict {
+    if msg.contains(name) {
+        Verdict::Located(kind)
+    } else {
+        Verdict::Broken(format!("an error that names no file: {msg}"))
+    }
+}
+
+/// The vector overlays (GeoJSON written by ogr2ogr in three forms) and the recorded flights
+/// (GPX by gpxpy and GDAL, IGC by aerofiles): each mutant is read and placed on, or flown over,
+/// the grid of their tests (an overlay drawn into every map), ending in a result or an error
+/// naming the file.
+#[test]
+fn overlay_and_track_readers_survive_the_campaign() {
+    use texmap_terrain::track::{self, TrackOptions};
+    use texmap_terrain::vector::{self, Overlay, Style};
+    use texmap_terrain::view::FlightCamera;
+    let grid = dem::read_dem(
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/hillshade_dem_utm.tif"),
+        &Default::default(),
+    )
+    .unwrap();
+    let settings = Settings {
+        seeded_cuts: 24,
+        flips: 128,
+        ..Settings::default()
+    };
+    let mut report = String::new();
+    let text = |n: &str| unchecked(fixture(n, data(n), vec![], true));
+
+    let fx: Vec<Fixture> = [
+        "vector_utm.geojson",
+        "vector_wgs84.geojson",
+        "vector_wgs84.geojsons",
+    ]
+    .iter()
+    .map(|n| text(n))
+    .collect();
+    let t = run_campaign("GeoJSON", &fx, &settings, &|f, bytes| {
+        let layer = match vector::parse_geojson(bytes, &f.name) {
+            Ok(l) => l,
+            Err(e) => return located(e.to_string(), &f.name, "parse"),
+        };
+        match Overlay::place(&[layer], &Style::default(), &grid, 128, 64) {
+            Ok(o) => {
+                for my in 0..2 {
+                    for mx in 0..2 {
+                        let mut m = image::RgbaImage::new(64, 64);
+                        o.draw(mx, my, &mut m);
+                    }
+                }
+                Verdict::Ok { frames: 1 }
+            }
+            Err(e) => located(e.to_string(), &f.name, "place"),
+        }
+    });
+    report.push_str(&t.report());
+    assert!(t.failures.is_empty(), "{}", t.report());
+
+    let fx: Vec<Fixture> = ["track_gpxpy.gpx", "track_ogr.gpx", "track_aerofiles.igc"]
+        .iter()
+        .map(|n| text(n))
+        .collect();
+    let template = FlightCamera {
+        width: 32,
+        height: 24,
+        ..FlightCamera::over(&grid)
+    };
+    let t = run_campaign("GPX / IGC", &fx, &settings, &|f, bytes| {
+        let text = String::from_utf8_lossy(bytes);
+        let parsed = if f.name.ends_with(".igc") {
+            track::parse_igc(&text, &f.name)
+        } else {
+            track::parse_gpx(&text, &f.name)
+        };
+        let t = match parsed {
+            Ok(t) => t,
+            Err(e) => return located(e.to_string(), &f.name, "parse"),
+        };
+        let opts = TrackOptions {
+            speedup: Some(4.0),
+            ..TrackOptions::default()
+        };
+        match track::track_views(&t, &grid, &template, &opts) {
+            Ok(v) if v.views.iter().all(|c| c.camera(&grid).is_ok()) => Verdict::Ok { frames: 1 },
+            Ok(_) => Verdict::Broken("a view that is no camera over the grid".into()),
+            Err(e) => located(e.to_string(), &f.name, "views"),
+        }
     });
     report.push_str(&t.report());
     assert!(t.failures.is_empty(), "{}", t.report());
