@@ -286,12 +286,17 @@ pub fn parse_geojson(bytes: &[u8], source: &str) -> Result<VectorLayer, TerrainE
             None => format_err(source, pos, format!("JSON ({msg})")),
         }
     };
-    // GeoJSON text sequences: RS-separated (RFC 8142) or newline-delimited features.
+    // GeoJSON text sequences: RS-separated (RFC 8142), or newline-delimited features (a first
+    // line that is a whole JSON value, with more after it; a pretty-printed document's first
+    // line is not one).
     let is_seq = bytes.iter().find(|b| !b.is_ascii_whitespace()) == Some(&0x1e);
-    let mut texts = serde_json::Deserializer::from_slice(bytes).into_iter::<IgnoredAny>();
+    let line_end = bytes
+        .iter()
+        .position(|&b| b == b'\n')
+        .unwrap_or(bytes.len());
     let multiple = !is_seq
-        && texts.next().is_some_and(|r| r.is_ok())
-        && texts.next().is_some_and(|r| r.is_ok());
+        && serde_json::from_slice::<IgnoredAny>(&bytes[..line_end]).is_ok()
+        && bytes[line_end..].iter().any(|b| !b.is_ascii_whitespace());
     if is_seq || multiple {
         let cleaned: Vec<u8> = bytes
             .iter()
