@@ -114,9 +114,11 @@ fn pairs_within(frame: &Frame, cutoff: f32) -> Result<Vec<[u32; 2]>, Coordinatio
 /// let c = clusters(&frame, 2.5, None).unwrap();
 /// assert_eq!(c.ids, [0, 1, 0, 0, 1]);
 /// assert_eq!(c.sizes, [3, 2]);
-/// // Only the atoms a selection picks: the others are in no cluster.
+/// // Only the atoms a selection picks: the others are in no cluster. Without the middle atom
+/// // the chain falls apart into two single atoms, smaller than the pair (equal sizes: the lower
+/// // atom index first).
 /// let c = clusters(&frame, 2.5, Some(&[true, true, false, true, true])).unwrap();
-/// assert_eq!(c.ids, [2, 0, -1, 1, 0]);
+/// assert_eq!(c.ids, [1, 0, -1, 2, 0]);
 /// ```
 pub fn clusters(
     frame: &Frame,

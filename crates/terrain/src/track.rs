@@ -45,8 +45,10 @@
 //! let opts = TrackOptions { speedup: Some(10.0), fps: 25.0, ..TrackOptions::default() };
 //! let v = track_views(&track, &grid, &template, &opts)?;
 //! assert_eq!(v.views.len(), 101);
-//! // Northward, level, climbing from 900 to 910 m.
-//! assert!(v.views[50].heading_deg.abs() < 1e-6 && v.views[50].roll_deg.abs() < 1e-9);
+//! // Northward (within the grid's local metres, whose east axis shrinks with latitude), level,
+//! // climbing from 900 to 910 m.
+//! let h = v.views[50].heading_deg; // degrees clockwise from north, in [0, 360)
+//! assert!(h.min(360.0 - h) < 0.1 && v.views[50].roll_deg.abs() < 1e-9);
 //! assert!((v.views[50].altitude - 905.0).abs() < 1e-9);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
