@@ -78,7 +78,7 @@ pub fn coordination(frame: &Frame, cutoff: f32) -> Result<Vec<u32>, Coordination
 
 /// Every pair of atoms within `cutoff` Å (and above the bond finder's floor), under the
 /// minimum image.
-fn pairs_within(frame: &Frame, cutoff: f32) -> Result<Vec<[u32; 2]>, CoordinationError> {
+pub(crate) fn pairs_within(frame: &Frame, cutoff: f32) -> Result<Vec<[u32; 2]>, CoordinationError> {
     if !(cutoff > BOND_TOLERANCE && cutoff <= MAX_CUTOFF) {
         return Err(CoordinationError::BadCutoff(cutoff));
     }

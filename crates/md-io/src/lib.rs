@@ -32,8 +32,10 @@
 //! - [`bonds`] finds bonds by distance (covalent radii, a cell grid, minimum image) and [`pbc`]
 //!   wraps atoms into the box or makes bonded molecules whole across it; [`replicate`] copies a
 //!   frame and its bonds along the cell vectors (periodic images, as OVITO's Replicate);
-//!   [`coordination`] counts each atom's neighbours within a cutoff, and [`cna`] classifies
-//!   its crystal structure, as OVITO's analyses do; [`hbonds`] finds hydrogen bonds by
+//!   [`coordination`] counts each atom's neighbours within a cutoff (and groups them into
+//!   clusters), [`cna`] classifies its crystal structure, [`centrosymmetry`] measures how far
+//!   its neighbours are from opposite pairs and [`strain`] its local deformation against a
+//!   reference configuration, as OVITO's analyses do; [`hbonds`] finds hydrogen bonds by
 //!   MDAnalysis's geometric criterion.
 //! - [`values`] reads per-atom numbers from a text file (an analysis result, a column or a row
 //!   per frame) to give the frames as a property.
@@ -105,6 +107,7 @@
 
 mod amber;
 pub mod bonds;
+pub mod centrosymmetry;
 mod chgcar;
 mod cif;
 pub mod cna;
@@ -128,6 +131,7 @@ mod lammps_data;
 mod mmcif;
 mod mol2;
 mod namdbin;
+mod neighbours;
 mod netcdf;
 pub mod parse;
 pub mod pbc;
@@ -141,6 +145,7 @@ pub mod secondary;
 pub mod select;
 pub mod sequence;
 pub mod smooth;
+pub mod strain;
 pub mod style;
 mod text;
 mod tinker;

@@ -1,0 +1,276 @@
+//! The k nearest neighbours of each atom, from a cell grid: what [`crate::cna`] and
+//! [`crate::centrosymmetry`] examine around every atom.
+//!
+//! The grid has fractional cells in a periodic cell (about [`ATOMS_PER_CELL`] atoms each) and
+//! cells over the bounding box otherwise. A query grows rings of cells around the atom until the
+//! k nearest found are closer than the ring's inner width, or the ring covers the grid. In a
+//! periodic cell each neighbour is taken at its nearest image (rounded fractional differences,
+//! as [`crate::pbc::minimum_image`]), so the cell must be wider than twice the k-th neighbour
+//! distance for the answer to be the true k nearest.
+
+use glam::{DMat3, DVec3};
+
+use crate::frame::UnitCell;
+
+/// Atoms per grid cell on average: cells about as wide as the 14th neighbour distance of FCC
+/// (1.04 a) and BCC (1.31 a), so one ring of cells usually holds the neighbours.
+pub(crate) const ATOMS_PER_CELL: f64 = 4.5;
+
+/// One worker's buffers for [`Grid::nearest`].
+#[derive(Default)]
+pub(crate) struct Scratch {
+    cells: Vec<usize>,
+    found: Vec<([f64; 3], f64)>,
+    /// The nearest neighbours found: vector from the atom, distance; closest first.
+    pub(crate) near: Vec<([f64; 3], f64)>,
+}
+
+/// A cell grid over the atoms (fractional cells in a periodic cell, the bounding box
+/// otherwise) for nearest-neighbour queries.
+pub(crate) struct Grid<'a> {
+    positions: &'a [[f32; 3]],
+    cell: Option<&'a UnitCell>,
+    /// Grid size per axis, and each atom's cell (`usize::MAX`: non-finite atom).
+    dims: [usize; 3],
+    /// Atoms sorted by cell, and where each cell's atoms start (`starts[c]..starts[c + 1]`).
+    order: Vec<u32>,
+    starts: Vec<u32>,
+    /// Cell index per atom.
+    of: Vec<usize>,
+    /// The smallest width of a grid cell (Å) along an axis of more than one cell: a ring of k
+    /// cells around an atom holds every atom within k times this (an axis of one cell is
+    /// covered whole by every ring).
+    width: f64,
+    /// Bounding-box origin and inverse cell size per axis (open frames).
+    lo: [f64; 3],
+    inv: [f64; 3],
+    /// The cell's edges as columns (periodic frames: Cartesian = edges · fractional), and each
+    /// atom's wrapped fractional coordinates.
+    edges: DMat3,
+    frac: Vec<DVec3>,
+}
+
+impl<'a> Grid<'a> {
+    pub(crate) fn new(positions: &'a [[f32; 3]], cell: Option<&'a UnitCell>) -> Grid<'a> {
+        let finite: Vec<usize> = (0..positions.len())
+            .filter(|&i| positions[i].iter().all(|v| v.is_finite()))
+            .collect();
+        let n = finite.len().max(1) as f64;
+        let mut grid = Grid {
+            positions,
+            cell,
+            dims: [1; 3],
+            order: Vec::new(),
+            starts: Vec::new(),
+            of: vec![usize::MAX; positions.len()],
+            width: f64::INFINITY,
+            lo: [0.0; 3],
+            inv: [0.0; 3],
+            edges: DMat3::IDENTITY,
+            frac: Vec::new(),
+        };
+        match cell {
+            Some(c) => {
+                // UnitCell::matrix has the edges as rows.
+                let edges = DMat3::from_cols_array_2d(&c.matrix());
+                let inverse = edges.inverse();
+                grid.edges = edges;
+                grid.frac = positions
+                    .iter()
+                    .map(|p| {
+                        let f = inverse * DVec3::from(p.map(f64::from));
+                        f - f.floor()
+                    })
+                    .collect();
+                let volume = edges.determinant().abs();
+                // Perpendicular widths of the cell; about 4.5 atoms per grid cell, so that the
+                // first ring of cells holds the 14 nearest neighbours of a crystal atom.
+                let target = (ATOMS_PER_CELL * volume / n).cbrt();
+                for a in 0..3 {
+                    let (b, d) = ((a + 1) % 3, (a + 2) % 3);
+                    let area = edges.col(b).cross(edges.col(d)).length();
+                    let w = volume / area.max(f64::MIN_POSITIVE);
+                    grid.dims[a] = ((w / target).floor() as usize).clamp(1, 1024);
+                    if grid.dims[a] > 1 {
+                        grid.width = grid.width.min(w / grid.dims[a] as f64);
+                    }
+                }
+            }
+            None => {
+                // The box of the 0.5th to 99.5th percentile per axis: a few atoms far away (an
+                // evaporated atom) do not stretch the grid; they are kept in the edge cells,
+                // which leaves every ring's guarantee intact (they are at least as far as
+                // those cells).
+                let mut lo = [0.0; 3];
+                let mut hi = [0.0; 3];
+                let mut values: Vec<f64> = Vec::with_capacity(finite.len());
+                for a in 0..3 {
+                    values.clear();
+                    values.extend(finite.iter().map(|&i| positions[i][a] as f64));
+                    if values.is_empty() {
+                        continue;
+                    }
+                    let last = values.len() - 1;
+                    let (k_lo, k_hi) = (last / 200, last - last / 200);
+                    lo[a] = *values.select_nth_unstable_by(k_lo, f64::total_cmp).1;
+                    hi[a] = *values.select_nth_unstable_by(k_hi, f64::total_cmp).1;
+                }
+                let extent = [0, 1, 2].map(|a| (hi[a] - lo[a]).max(1e-3));
+                // ATOMS_PER_CELL per cell: the cell size s solves s³ = A Π max(extent, s) / n,
+                // so that a flat or thin system gets few cells across its thin side rather
+                // than cells far smaller than its atoms' spacing.
+                let mut target = (ATOMS_PER_CELL * extent.iter().product::<f64>() / n)
+                    .cbrt()
+                    .max(1e-3);
+                for _ in 0..60 {
+                    let v: f64 = extent.iter().map(|e| e.max(target)).product();
+                    target = (ATOMS_PER_CELL * v / n).cbrt().max(1e-3);
+                }
+                for (a, e) in extent.into_iter().enumerate() {
+                    grid.dims[a] = ((e / target).ceil() as usize).clamp(1, 1024);
+                    let size = e / grid.dims[a] as f64;
+                    grid.inv[a] = 1.0 / size;
+                    if grid.dims[a] > 1 {
+                        grid.width = grid.width.min(size);
+                    }
+                }
+                grid.lo = lo;
+            }
+        }
+        let total = grid.dims.iter().product::<usize>();
+        let mut count = vec![0u32; total + 1];
+        for &i in &finite {
+            let c = grid.cell_of(i);
+            grid.of[i] = c;
+            count[c + 1] += 1;
+        }
+        for c in 0..total {
+            count[c + 1] += count[c];
+        }
+        let mut next = count.clone();
+        grid.order = vec![0; finite.len()];
+        for &i in &finite {
+            let c = grid.of[i];
+            grid.order[next[c] as usize] = i as u32;
+            next[c] += 1;
+        }
+        grid.starts = count;
+        grid
+    }
+
+    /// The grid coordinates of atom `i`.
+    fn coords(&self, i: usize) -> [usize; 3] {
+        let p = self.positions[i].map(f64::from);
+        match self.cell {
+            Some(_) => {
+                let f = self.frac[i].to_array();
+                [0, 1, 2].map(|a| ((f[a] * self.dims[a] as f64) as usize).min(self.dims[a] - 1))
+            }
+            None => [0, 1, 2].map(|a| {
+                (((p[a] - self.lo[a]) * self.inv[a]).max(0.0) as usize).min(self.dims[a] - 1)
+            }),
+        }
+    }
+
+    fn cell_of(&self, i: usize) -> usize {
+        let [x, y, z] = self.coords(i);
+        (z * self.dims[1] + y) * self.dims[0] + x
+    }
+
+    /// The vector from atom `i` to atom `j` (nearest image in a periodic cell).
+    fn vector(&self, i: usize, j: usize) -> [f64; 3] {
+        match self.cell {
+            Some(_) => {
+                // The fractional difference rounded to the nearest image, as
+                // `pbc::minimum_image` does, from the fractional coordinates kept.
+                let d = self.frac[j] - self.frac[i];
+                (self.edges * (d - d.round())).to_array()
+            }
+            None => [0, 1, 2].map(|a| self.positions[j][a] as f64 - self.positions[i][a] as f64),
+        }
+    }
+
+    /// Atom `i`'s `k` nearest neighbours (vector, distance), closest first, into
+    /// `scratch.near` (fewer when the frame has fewer other atoms; none for a non-finite atom).
+    pub(crate) fn nearest(&self, i: usize, k: usize, scratch: &mut Scratch) {
+        let Scratch { cells, found, near } = scratch;
+        near.clear();
+        if k == 0 || self.of[i] == usize::MAX {
+            return;
+        }
+        let centre = self.coords(i);
+        let max_ring = self.dims.iter().max().copied().unwrap_or(1);
+        for ring in 1..=max_ring.max(1) {
+            // Every cell within `ring` of the centre (wrapped in a periodic cell), once.
+            cells.clear();
+            let span = [0, 1, 2].map(|a| self.offsets(centre[a], a, ring));
+            for dz in span[2].clone() {
+                for dy in span[1].clone() {
+                    for dx in span[0].clone() {
+                        if let Some(c) = self.offset_cell(centre, [dx, dy, dz]) {
+                            cells.push(c);
+                        }
+                    }
+                }
+            }
+            cells.sort_unstable();
+            cells.dedup();
+            found.clear();
+            for &c in cells.iter() {
+                for &j in &self.order[self.starts[c] as usize..self.starts[c + 1] as usize] {
+                    let j = j as usize;
+                    if j == i {
+                        continue;
+                    }
+                    let v = self.vector(i, j);
+                    found.push((v, norm(v)));
+                }
+            }
+            // The nearest k, in order (ties by atom order of the scan).
+            if found.len() > k {
+                found.select_nth_unstable_by(k - 1, |a, b| a.1.total_cmp(&b.1));
+                found.truncate(k);
+            }
+            found.sort_by(|a, b| a.1.total_cmp(&b.1));
+            // The ring holds every atom within `ring` cell widths: enough when the
+            // neighbours needed are that close, or when the ring covers the whole grid.
+            let whole = (0..3).all(|a| 2 * ring + 1 >= self.dims[a]);
+            let enough = found.len() >= k && found[k - 1].1 <= ring as f64 * self.width;
+            if enough || whole {
+                break;
+            }
+        }
+        near.extend_from_slice(found);
+    }
+
+    /// The offsets along axis `a` from grid coordinate `at` within `ring` cells: inside an open
+    /// grid, and at most once around a periodic one.
+    fn offsets(&self, at: usize, a: usize, ring: usize) -> std::ops::RangeInclusive<isize> {
+        let (n, at, r) = (self.dims[a] as isize, at as isize, ring as isize);
+        match self.cell {
+            Some(_) if 2 * r + 1 >= n => 0..=n - 1,
+            Some(_) => -r..=r,
+            None => (-r).max(-at)..=r.min(n - 1 - at),
+        }
+    }
+
+    /// The cell at `offset` from `centre`: wrapped in a periodic cell, `None` outside an open
+    /// grid.
+    fn offset_cell(&self, centre: [usize; 3], offset: [isize; 3]) -> Option<usize> {
+        let mut c = [0usize; 3];
+        for a in 0..3 {
+            let n = self.dims[a] as isize;
+            let v = centre[a] as isize + offset[a];
+            c[a] = match self.cell {
+                Some(_) => v.rem_euclid(n) as usize,
+                None if (0..n).contains(&v) => v as usize,
+                None => return None,
+            };
+        }
+        Some((c[2] * self.dims[1] + c[1]) * self.dims[0] + c[0])
+    }
+}
+
+fn norm(v: [f64; 3]) -> f64 {
+    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
+}
