@@ -105,10 +105,11 @@ pub use legend::{
 pub use outline::{add_box_outline, cell_corners};
 pub use palette::{MAX_MATERIALS, Palette, type_color};
 pub use plan::{
-    Alignment, BALL_AND_STICK_BOND_RADIUS, BALL_AND_STICK_RADIUS_SCALE, BondSource, CLUSTER,
-    COORDINATION, ClusterOptions, DISPLACEMENT, DrawStyle, HBOND_COLOR, HBOND_DASHES, HBOND_RADIUS,
-    LICORICE_RADIUS, MolError, MolOptions, MolPlan, Pbc, RepColor, Representation, SelectionRole,
-    Slice, TRAIL_RADIUS, VALENCE_OFFSET, VALENCE_RADIUS,
+    Alignment, BALL_AND_STICK_BOND_RADIUS, BALL_AND_STICK_RADIUS_SCALE, BondSource, CENTROSYMMETRY,
+    CLUSTER, COORDINATION, CentroOptions, ClusterOptions, D2MIN, DISPLACEMENT, DrawStyle,
+    HBOND_COLOR, HBOND_DASHES, HBOND_RADIUS, LICORICE_RADIUS, MolError, MolOptions, MolPlan, Pbc,
+    RepColor, Representation, SHEAR_STRAIN, SelectionRole, Slice, TRAIL_RADIUS, VALENCE_OFFSET,
+    VALENCE_RADIUS, VOLUMETRIC_STRAIN,
 };
 pub use scalar::{NAN_COLOR, SCALAR_LEVELS, ScalarColor, ScalarSource};
 pub use style::{

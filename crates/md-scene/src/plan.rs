@@ -11,7 +11,11 @@
 //!    ([`texmap_md_io::replicate`]: bonds across inner faces become whole, and every later
 //!    step sees the copies, so `index` counts their atoms too); with
 //!    [`MolOptions::coordination`], each atom's neighbour count as the property
-//!    [`COORDINATION`], and with [`MolOptions::clusters`] each atom's cluster as [`CLUSTER`];
+//!    [`COORDINATION`], with [`MolOptions::clusters`] each atom's cluster as [`CLUSTER`], with
+//!    [`MolOptions::centrosymmetry`] each atom's [`CENTROSYMMETRY`], and with
+//!    [`MolOptions::strain`] its [`SHEAR_STRAIN`], [`VOLUMETRIC_STRAIN`] and [`D2MIN`] against
+//!    the reference configuration (the first frame built at this step, or the one given to
+//!    [`MolPlan::set_displacement_reference`]);
 //!    bonds that still cross the (enlarged) box are dropped, so no stick
 //!    spans it; with [`MolOptions::displacement`] (after the alignment of step 3), each atom's
 //!    distance from the first frame built as the property [`DISPLACEMENT`];
@@ -101,9 +105,11 @@
 use std::fmt;
 
 use texmap_impostor::SphereScene;
+use texmap_md_io::centrosymmetry::{CentroError, CspMode};
 use texmap_md_io::coordination::CoordinationError;
 use texmap_md_io::hbonds::{self, Criteria, HBond, HBondError};
 use texmap_md_io::replicate::ReplicateError;
+use texmap_md_io::strain::StrainError;
 use texmap_md_io::{
     BOND_AROMATIC, Frame, Property, Selection, SelectionError, Topology, atom_element,
 };
@@ -222,6 +228,14 @@ pub const COORDINATION: &str = "coordination";
 /// The per-atom property [`MolOptions::clusters`] adds to each frame (0 the largest cluster, −1
 /// for atoms not clustered).
 pub const CLUSTER: &str = "cluster";
+/// The per-atom property [`MolOptions::centrosymmetry`] adds to each frame (Å²).
+pub const CENTROSYMMETRY: &str = "centrosymmetry";
+/// The per-atom von Mises shear strain [`MolOptions::strain`] adds to each frame.
+pub const SHEAR_STRAIN: &str = "shear_strain";
+/// The per-atom volumetric strain [`MolOptions::strain`] adds to each frame.
+pub const VOLUMETRIC_STRAIN: &str = "volumetric_strain";
+/// The per-atom non-affine squared displacement (Å²) [`MolOptions::strain`] adds to each frame.
+pub const D2MIN: &str = "d2min";
 /// The per-atom property [`MolOptions::displacement`] adds to each frame.
 pub const DISPLACEMENT: &str = "displacement";
 
@@ -254,6 +268,17 @@ pub struct MolOptions {
     /// [`texmap_md_io::coordination::clusters`]), for colouring ([`crate::ColorBy::Cluster`])
     /// and selections (`prop cluster == 0`: the largest).
     pub clusters: Option<ClusterOptions>,
+    /// The centrosymmetry parameter of every atom every frame, after the clusters, as the
+    /// per-atom property `centrosymmetry` (OVITO's Centrosymmetry modifier, LAMMPS's
+    /// `centro/atom`: [`texmap_md_io::centrosymmetry`]), for colouring and for hiding the
+    /// perfect crystal (`prop centrosymmetry > 1`).
+    pub centrosymmetry: Option<CentroOptions>,
+    /// The atomic strain of every atom every frame against the reference configuration, from
+    /// its neighbours within this cutoff (Å) in the reference, after the centrosymmetry, as the
+    /// per-atom properties `shear_strain`, `volumetric_strain` and `d2min` (OVITO's Atomic strain
+    /// modifier: [`texmap_md_io::strain`]). The reference is the first frame built, as it is at
+    /// this step, or the frame given to [`MolPlan::set_displacement_reference`].
+    pub strain: Option<f32>,
     /// Draw every atom with the radius a per-atom property gives (Å; PQR's `radius`, any
     /// column of a dump), as a file's `radius` column is drawn; a value of zero or less, or
     /// not a number, leaves the atom its element's radius. A frame without the property is an
@@ -383,6 +408,8 @@ impl Default for MolOptions {
             replicate: None,
             coordination: None,
             clusters: None,
+            centrosymmetry: None,
+            strain: None,
             radius_from: None,
             slice: None,
             align: None,
@@ -405,6 +432,15 @@ pub struct ClusterOptions {
     pub cutoff: f32,
     /// Only these atoms are clustered (the others are in cluster −1); `None`: every atom.
     pub atoms: Option<Selection>,
+}
+
+/// [`MolOptions::centrosymmetry`]: the neighbours per atom and which of their pairs count.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CentroOptions {
+    /// Nearest neighbours per atom: 12 for FCC (OVITO's default), 8 for BCC.
+    pub neighbours: usize,
+    /// The conventional N/2 smallest pairs, or the minimum-weight matching.
+    pub mode: CspMode,
 }
 
 /// Which selection of a [`MolPlan`] failed to evaluate.
@@ -464,6 +500,11 @@ pub enum MolError {
     Coordination(CoordinationError),
     /// [`MolOptions::clusters`] cannot be found (the cell is too small for the cutoff).
     Clusters(CoordinationError),
+    /// [`MolOptions::centrosymmetry`] has a bad neighbour count.
+    Centrosymmetry(CentroError),
+    /// [`MolOptions::strain`] cannot be computed (a frame of other atoms than the reference,
+    /// the cutoff, a cell too small for it).
+    Strain(StrainError),
     /// [`MolOptions::radius_from`] names a property a frame does not have.
     NoRadiusProperty {
         name: String,
@@ -504,6 +545,8 @@ impl fmt::Display for MolError {
             MolError::Replicate(e) => write!(f, "periodic images: {e}"),
             MolError::Coordination(e) => write!(f, "coordination: {e}"),
             MolError::Clusters(e) => write!(f, "clusters: {e}"),
+            MolError::Centrosymmetry(e) => write!(f, "centrosymmetry: {e}"),
+            MolError::Strain(e) => write!(f, "atomic strain: {e}"),
             MolError::NoRadiusProperty { name, available } => write!(
                 f,
                 "radii from '{name}': the frame has no such per-atom property ({})",
@@ -613,6 +656,8 @@ pub struct MolPlan {
     /// The first frame's positions (for displacements: [`DrawStyle::Arrows`],
     /// [`MolOptions::displacement`]), this frame's arrow vectors and the last frame's arrows.
     arrow_reference: Option<Vec<[f32; 3]>>,
+    /// The reference configuration of [`MolOptions::strain`], as it was before the alignment.
+    strain_reference: Option<Frame>,
     arrow_vectors: Vec<glam::Vec3>,
     arrows: MolMesh,
     arrow_atoms: Vec<glam::Vec3>,
@@ -694,6 +739,7 @@ impl MolPlan {
             polyhedra: MolMesh::default(),
             pairs_listed: false,
             arrow_reference: None,
+            strain_reference: None,
             arrow_vectors: Vec::new(),
             arrows: MolMesh::default(),
             arrow_atoms: Vec::new(),
@@ -956,6 +1002,9 @@ impl MolPlan {
             texmap_md_io::replicate::replicate(frame, &mut pairs, n)
                 .map_err(MolError::Replicate)?;
         }
+        if self.options.strain.is_some() {
+            self.strain_reference = Some(frame.clone());
+        }
         self.align(frame)?;
         self.arrow_reference = Some(frame.positions.clone());
         Ok(())
@@ -993,11 +1042,7 @@ impl MolPlan {
             let counts = texmap_md_io::coordination::coordination(frame, cutoff)
                 .map_err(MolError::Coordination)?;
             let values = counts.into_iter().map(|c| c as f32).collect();
-            frame.properties.retain(|p| p.name != COORDINATION);
-            frame.properties.push(Property {
-                name: COORDINATION.to_string(),
-                values,
-            });
+            set_property(frame, COORDINATION, values);
         }
         if let Some(c) = &self.options.clusters {
             let mask = match &c.atoms {
@@ -1010,11 +1055,23 @@ impl MolPlan {
             let found = texmap_md_io::coordination::clusters(frame, c.cutoff, mask.as_deref())
                 .map_err(MolError::Clusters)?;
             let values = found.ids.into_iter().map(|c| c as f32).collect();
-            frame.properties.retain(|p| p.name != CLUSTER);
-            frame.properties.push(Property {
-                name: CLUSTER.to_string(),
-                values,
-            });
+            set_property(frame, CLUSTER, values);
+        }
+        if let Some(c) = self.options.centrosymmetry {
+            let values = texmap_md_io::centrosymmetry::centrosymmetry(frame, c.neighbours, c.mode)
+                .map_err(MolError::Centrosymmetry)?;
+            set_property(frame, CENTROSYMMETRY, values);
+        }
+        if let Some(cutoff) = self.options.strain {
+            if self.strain_reference.is_none() {
+                self.strain_reference = Some(frame.clone());
+            }
+            let reference = self.strain_reference.as_ref().expect("set above");
+            let s = texmap_md_io::strain::atomic_strain(reference, frame, cutoff)
+                .map_err(MolError::Strain)?;
+            set_property(frame, SHEAR_STRAIN, s.shear);
+            set_property(frame, VOLUMETRIC_STRAIN, s.volumetric);
+            set_property(frame, D2MIN, s.d2min);
         }
         if let Some(name) = &self.options.radius_from {
             let Some(values) = frame.property(name) else {
@@ -1098,11 +1155,7 @@ impl MolPlan {
                 self.arrow_reference.as_deref(),
             )
             .map_err(MolError::Arrows)?;
-            frame.properties.retain(|p| p.name != DISPLACEMENT);
-            frame.properties.push(Property {
-                name: DISPLACEMENT.to_string(),
-                values: d.iter().map(|v| v.length()).collect(),
-            });
+            set_property(frame, DISPLACEMENT, d.iter().map(|v| v.length()).collect());
         }
         self.ellipsoid_shapes.clear();
         if self.draws_ellipsoids() {
@@ -1319,11 +1372,12 @@ impl MolPlan {
         self.reps.iter().any(|r| r.draw == DrawStyle::Arrows)
     }
 
-    /// Whether the frames built measure displacements (the [`DISPLACEMENT`] property, or
-    /// displacement arrows): what [`set_displacement_reference`](Self::set_displacement_reference)
+    /// Whether the frames built measure displacements (the [`DISPLACEMENT`] property,
+    /// displacement arrows, or [`MolOptions::strain`]): what [`set_displacement_reference`](Self::set_displacement_reference)
     /// changes.
     pub fn measures_displacements(&self) -> bool {
         self.options.displacement
+            || self.options.strain.is_some()
             || (self.draws_arrows() && self.options.arrows.source == ArrowSource::Displacement)
     }
 
@@ -2170,4 +2224,13 @@ mod tests {
         assert_eq!(scene.len(), s + 1);
         assert_eq!(scene.centers[0].x, 60.0);
     }
+}
+
+/// `frame`'s per-atom property `name` set to `values` (replacing one of that name).
+fn set_property(frame: &mut Frame, name: &str, values: Vec<f32>) {
+    frame.properties.retain(|p| p.name != name);
+    frame.properties.push(Property {
+        name: name.to_string(),
+        values,
+    });
 }

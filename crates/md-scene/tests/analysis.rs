@@ -2,7 +2,8 @@
 //! `MolOptions::replicate`), against OVITO 3.17: the atoms `prop coordination < 12` keeps of a
 //! jiggled FCC crystal with a vacancy cluster are exactly those OVITO's Coordination analysis
 //! counts fewer than 12 neighbours for (md-io's cna fixture and reference), and replicating the
-//! periodic crystal first changes no atom's count: every copy of an atom has its count.
+//! periodic crystal first changes no atom's count: every copy of an atom has its count. The
+//! slice, clusters, atomic strain and centrosymmetry in a plan, each against OVITO too.
 
 use std::path::Path;
 
@@ -261,4 +262,110 @@ fn pqr_radii_are_drawn() {
         .unwrap_err();
     assert!(matches!(&err, MolError::NoRadiusProperty { .. }));
     assert!(err.to_string().contains("it has charge, radius"), "{err}");
+}
+
+/// `MolOptions::strain` and `MolOptions::centrosymmetry` in a plan, on md-io's strain fixture
+/// (a sheared, bulged copper slab OVITO wrote, and OVITO's values): the reference is the first
+/// frame built, or the frame given to `set_displacement_reference`, and the second frame's
+/// `shear_strain` is OVITO's either way; with `--align` on every atom the frames are
+/// superposed, which changes no strain (it is invariant under the rigid motion); `prop
+/// centrosymmetry > 4` keeps OVITO's defect atoms (the surfaces and the lone atoms).
+#[test]
+fn strain_and_centrosymmetry_in_a_plan_are_ovitos() {
+    use texmap_md_io::centrosymmetry::CspMode;
+    use texmap_md_scene::{Alignment, CENTROSYMMETRY, CentroOptions, SHEAR_STRAIN};
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../md-io/tests/data/strain");
+    let json = |name: &str| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(dir.join(name)).unwrap()).unwrap()
+    };
+    let read = |name: &str| {
+        let mut f = Frame::new();
+        assert!(
+            Trajectory::open(dir.join(name))
+                .unwrap()
+                .read_next(&mut f)
+                .unwrap()
+        );
+        f
+    };
+    let ovito: Vec<f64> = json("strain_reference.json")["shear"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    let check = |frame: &Frame, what: &str| {
+        let got = frame.property(SHEAR_STRAIN).unwrap();
+        let worst = got
+            .iter()
+            .zip(&ovito)
+            .map(|(a, b)| (*a as f64 - b).abs())
+            .fold(0.0, f64::max);
+        assert!(worst < 5e-6, "{what}: worst {worst}");
+    };
+    let options = |align: bool| MolOptions {
+        strain: Some(3.0),
+        align: align.then(|| Alignment::on_first_frame(Selection::parse("all").unwrap())),
+        ..MolOptions::default()
+    };
+    let mut builder = SceneBuilder::new(&StyleOptions::default()).unwrap();
+    let mut scene = SphereScene::default();
+    // The first frame built is the reference: zero strain there, OVITO's in the second.
+    let mut plan = MolPlan::new(options(false)).unwrap();
+    let mut first = read("ref.xyz");
+    plan.build(&mut builder, &mut first, &mut scene).unwrap();
+    assert!(
+        first
+            .property(SHEAR_STRAIN)
+            .unwrap()
+            .iter()
+            .all(|v| v.abs() < 1e-6)
+    );
+    let mut second = read("cur.xyz");
+    plan.build(&mut builder, &mut second, &mut scene).unwrap();
+    check(&second, "first frame as reference");
+    // The reference given, the frames aligned on it.
+    let mut plan = MolPlan::new(options(true)).unwrap();
+    plan.set_displacement_reference(&mut read("ref.xyz"))
+        .unwrap();
+    let mut only = read("cur.xyz");
+    plan.build(&mut builder, &mut only, &mut scene).unwrap();
+    check(&only, "reference given, aligned");
+    // A frame of other atoms than the reference is the build's error.
+    let mut short = read("cur.xyz");
+    short.positions.pop();
+    let e = plan
+        .build(&mut builder, &mut short, &mut scene)
+        .unwrap_err();
+    assert!(e.to_string().starts_with("atomic strain: "), "{e}");
+
+    // Centrosymmetry: the atoms above 4 Å² are OVITO's.
+    let csp = &json("centro_reference.json")[3];
+    assert_eq!(csp["file"], "cur.xyz");
+    let want: Vec<f64> = csp["csp"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    let mut plan = MolPlan::new(MolOptions {
+        centrosymmetry: Some(CentroOptions {
+            neighbours: 12,
+            mode: CspMode::Conventional,
+        }),
+        select: Some(Selection::parse("prop centrosymmetry > 4").unwrap()),
+        ..MolOptions::default()
+    })
+    .unwrap();
+    let mut frame = read("cur.xyz");
+    plan.build(&mut builder, &mut frame, &mut scene).unwrap();
+    let kept: Vec<[f32; 3]> = (0..want.len())
+        .filter(|&i| want[i] > 4.0)
+        .map(|i| frame.positions[i])
+        .collect();
+    // Two (001) surface layers of 8 x 8 x 2 atoms, and the five atoms in the vacuum.
+    assert_eq!(kept.len(), 261);
+    let got: Vec<[f32; 3]> = scene.centers.iter().map(|c| c.to_array()).collect();
+    assert_eq!(got, kept);
+    assert_eq!(frame.property(CENTROSYMMETRY).unwrap().len(), want.len());
 }
