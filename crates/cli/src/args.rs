@@ -977,7 +977,7 @@ pub struct MolArgs {
     #[arg(long = "property", value_name = "NAME=FILE")]
     pub properties: Vec<String>,
     /// Measure displacements (--displacements, --color-by displacement, --arrows
-    /// displacement) from this reference instead of the first frame drawn: a frame number of
+    /// displacement) and --strain from this reference instead of the first frame drawn: a frame number of
     /// the trajectory (0 for its first) or a structure file of the same atoms (its first
     /// frame), OVITO's reference configuration. It is wrapped, unwrapped, replicated and
     /// aligned as the frames are; with --align, the frames are superposed on it.
@@ -1027,6 +1027,29 @@ pub struct MolArgs {
     /// matrix, 'prop coordination >= 10' for solid-like atoms); the others are in cluster -1.
     #[arg(long, value_name = "SEL", requires = "clusters")]
     pub cluster_atoms: Option<String>,
+    /// The centrosymmetry parameter of every atom from its N nearest neighbours (12 for FCC,
+    /// 8 for BCC), as OVITO's Centrosymmetry modifier and LAMMPS's compute centro/atom, into
+    /// the per-atom number 'centrosymmetry' (Å²): about 0 in the perfect crystal, large at
+    /// dislocation cores, stacking faults and surfaces. --color-by centrosymmetry (which turns
+    /// it on with N = 12 by itself), or hide the crystal: --select 'prop centrosymmetry > 4'.
+    /// Nearest images in a periodic cell; N even, 2 to 32.
+    #[arg(long, value_name = "N")]
+    pub centrosymmetry: Option<usize>,
+    /// Sum the centrosymmetry over the pairing of the N neighbours with the least weight
+    /// (OVITO's matching mode, N up to 16) instead of the N/2 smallest pair weights (the
+    /// conventional mode of OVITO and LAMMPS, which can count one neighbour twice).
+    #[arg(long)]
+    pub centrosymmetry_matching: bool,
+    /// The atomic strain of every atom against the reference configuration (the first frame
+    /// drawn, or --displacement-reference), from its neighbours within R Å in the reference, as
+    /// OVITO's Atomic strain modifier: the per-atom numbers 'shear_strain' (von Mises),
+    /// 'volumetric_strain' and 'd2min' (the non-affine squared displacement, Å²) show shear
+    /// bands, slip and plastic events: --color-by shear_strain --color-range 0:0.2. Pick R
+    /// between the first and second neighbour shells (3.0 for copper). Atoms wrapped across
+    /// the box between the frames and a sheared cell are followed; atoms with fewer than three
+    /// neighbours get 0. R from 0.45 to 20 Å.
+    #[arg(long, value_name = "R", value_parser = parse_cutoff)]
+    pub strain: Option<f32>,
     /// Draw each atom with the radius (Å) a per-atom property gives: PQR's 'radius'
     /// (PDB2PQR/APBS radii), any dump column (texmap info lists them), --property FILE's
     /// numbers. As a file's radius column: --radius-scale does not apply, ball-and-stick

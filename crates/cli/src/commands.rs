@@ -691,7 +691,7 @@ fn render(a: &RenderArgs) -> Result<()> {
     if let Some(r) = &a.mol.displacement_reference {
         if !plan.measures_displacements() {
             return usage(format!(
-                "--displacement-reference {r}: nothing measures displacements; add --displacements, --color-by displacement or --arrows displacement"
+                "--displacement-reference {r}: nothing measures displacements; add --displacements, --color-by displacement, --arrows displacement or --strain R"
             ));
         }
         let mut reference = MdFrame::new();

@@ -482,6 +482,32 @@ pub fn mol_plan(args: &MolArgs, style: &StyleArgs, topology: Option<Topology>) -
         )
         .into());
     }
+    let scalar_is = |name: &str| matches!(&style.color_by, ColorBy::Scalar(texmap_md_scene::ScalarSource::Property(p)) if p == name);
+    if args.strain.is_none()
+        && let Some(p) = ["shear_strain", "volumetric_strain", "d2min"]
+            .into_iter()
+            .find(|p| scalar_is(p))
+    {
+        return usage(format!(
+            "--color-by {p}: give --strain R (the neighbour cutoff in Å, 3.0 for copper) to compute it"
+        ));
+    }
+    if args.centrosymmetry_matching && args.centrosymmetry.is_none() && !scalar_is("centrosymmetry")
+    {
+        return usage(
+            "--centrosymmetry-matching: give --centrosymmetry N (or --color-by centrosymmetry)",
+        );
+    }
+    if let Some(n) = args.centrosymmetry {
+        let mode = if args.centrosymmetry_matching {
+            texmap_md_io::centrosymmetry::CspMode::Matching
+        } else {
+            texmap_md_io::centrosymmetry::CspMode::Conventional
+        };
+        if let Err(e) = texmap_md_io::centrosymmetry::check(n, mode) {
+            return usage(format!("--centrosymmetry {n}: {e}"));
+        }
+    }
     let optional = |flag, text: &Option<String>| {
         text.as_deref()
             .map(|t| parse_selection(flag, t))
@@ -555,6 +581,20 @@ pub fn mol_plan(args: &MolArgs, style: &StyleArgs, topology: Option<Topology>) -
             }),
             None => None,
         },
+        centrosymmetry: match args.centrosymmetry {
+            Some(n) => Some(n),
+            None if scalar_is("centrosymmetry") => Some(12),
+            None => None,
+        }
+        .map(|neighbours| texmap_md_scene::CentroOptions {
+            neighbours,
+            mode: if args.centrosymmetry_matching {
+                texmap_md_io::centrosymmetry::CspMode::Matching
+            } else {
+                texmap_md_io::centrosymmetry::CspMode::Conventional
+            },
+        }),
+        strain: args.strain,
         radius_from: args.radius_from.clone(),
         slice: args.slice.map(|[x, y, z, d, w]| texmap_md_scene::Slice {
             normal: [x, y, z],
@@ -582,8 +622,7 @@ pub fn mol_plan(args: &MolArgs, style: &StyleArgs, topology: Option<Topology>) -
         },
         trail_length: args.trail_length,
         bond_orders: args.bond_orders,
-        displacement: args.displacements
-            || matches!(&style.color_by, ColorBy::Scalar(texmap_md_scene::ScalarSource::Property(p)) if p == "displacement"),
+        displacement: args.displacements || scalar_is("displacement"),
         measures: args
             .measures
             .iter()
@@ -662,6 +701,8 @@ pub fn mol_error(e: MolError) -> anyhow::Error {
         }
         MolError::Coordination(e) => return anyhow::anyhow!("--coordination: {e}"),
         MolError::Clusters(e) => return anyhow::anyhow!("--clusters: {e}"),
+        MolError::Centrosymmetry(e) => format!("--centrosymmetry: {e}"),
+        MolError::Strain(e) => return anyhow::anyhow!("--strain: {e}"),
         MolError::NoRadiusProperty { .. } => return anyhow::anyhow!("--radius-from: {e}"),
         MolError::BadSlice => format!("--slice: {e}"),
         MolError::Replicate(e) => {

@@ -3259,3 +3259,100 @@ fn clusters_select_the_precipitate() {
     ]);
     assert_eq!(o.status.code(), Some(2));
 }
+
+/// `--strain` and `--centrosymmetry`: on md-io's strain fixture (a sheared, bulged copper slab
+/// and its reference, written by OVITO), the atoms `--select 'prop shear_strain > 0.045'` draws
+/// against `--displacement-reference` (a file, or frame 0 of a trajectory of both) are the
+/// same picture, byte for byte, as OVITO's atoms above that strain selected by index; so are the
+/// atoms above 2 Å² of OVITO's matching-mode centrosymmetry. Strain colours without `--strain`,
+/// and a bad neighbour count, are usage errors.
+#[test]
+fn strain_and_centrosymmetry_select_ovitos_atoms() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = Path::new(env!("CARGO_MANIFEST_DIR")).join("../md-io/tests/data/strain");
+    let (reference, current) = (base.join("ref.xyz"), base.join("cur.xyz"));
+    let json = |name: &str| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(base.join(name)).unwrap()).unwrap()
+    };
+    // OVITO's atoms above `threshold`, as an index selection (no value near the threshold).
+    let above = |values: &serde_json::Value, threshold: f64| {
+        let v: Vec<f64> = values
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect();
+        assert!(v.iter().all(|x| (x - threshold).abs() > 1e-4 * threshold));
+        let picked: Vec<String> = (0..v.len())
+            .filter(|&i| v[i] > threshold)
+            .map(|i| i.to_string())
+            .collect();
+        assert!(
+            picked.len() > 10 && picked.len() < v.len() / 2,
+            "{}",
+            picked.len()
+        );
+        format!("index {}", picked.join(" "))
+    };
+    let render = |file: &Path, extra: &[&str], select: &str, out: &str| {
+        let out = dir.path().join(out);
+        let mut args = vec!["render", file.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        args.extend_from_slice(&["--select", select, "--size", "200x200", "-q", "-o"]);
+        args.push(out.to_str().unwrap());
+        let o = texmap(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        std::fs::read(out).unwrap()
+    };
+    let strained = above(&json("strain_reference.json")["shear"], 0.045);
+    let strain = [
+        "--strain",
+        "3",
+        "--displacement-reference",
+        reference.to_str().unwrap(),
+    ];
+    let ours = render(&current, &strain, "prop shear_strain > 0.045", "ours.png");
+    assert_eq!(ours, render(&current, &[], &strained, "ovito.png"));
+    // The same two configurations as frames 0 and 1 of one trajectory.
+    let both = dir.path().join("both.xyz");
+    let mut text = std::fs::read(&reference).unwrap();
+    text.extend(std::fs::read(&current).unwrap());
+    std::fs::write(&both, text).unwrap();
+    let framed = [
+        "--frames",
+        "1",
+        "--strain",
+        "3",
+        "--displacement-reference",
+        "0",
+    ];
+    assert_eq!(
+        ours,
+        render(&both, &framed, "prop shear_strain > 0.045", "framed.png")
+    );
+
+    let matching = &json("centro_reference.json")[4];
+    assert_eq!(
+        (matching["file"].as_str(), matching["mode"].as_str()),
+        (Some("cur.xyz"), Some("matching"))
+    );
+    let asymmetric = above(&matching["csp"], 2.0);
+    let csp = ["--centrosymmetry", "12", "--centrosymmetry-matching"];
+    assert_eq!(
+        render(&current, &csp, "prop centrosymmetry > 2", "csp.png"),
+        render(&current, &[], &asymmetric, "ovito_csp.png")
+    );
+
+    for (args, needs) in [
+        (vec!["--color-by", "shear_strain"], "--strain R"),
+        (vec!["--centrosymmetry", "7"], "not an even number"),
+        (vec!["--centrosymmetry-matching"], "--centrosymmetry N"),
+    ] {
+        let mut all = vec!["render", current.to_str().unwrap()];
+        all.extend(args);
+        all.extend(["-o", "x.png"]);
+        let o = texmap(&all);
+        assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+        assert!(stderr(&o).contains(needs), "{}", stderr(&o));
+    }
+}

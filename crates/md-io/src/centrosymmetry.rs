@@ -94,12 +94,7 @@ impl std::error::Error for CentroError {}
 /// docs). Atoms with non-finite coordinates get 0 and are nobody's neighbour.
 pub fn centrosymmetry(frame: &Frame, n: usize, mode: CspMode) -> Result<Vec<f32>, CentroError> {
     use rayon::prelude::*;
-    if n < 2 || n > MAX_NEIGHBOURS || n % 2 != 0 {
-        return Err(CentroError::BadCount(n));
-    }
-    if mode == CspMode::Matching && n > MAX_MATCHING {
-        return Err(CentroError::MatchingTooMany(n));
-    }
+    check(n, mode)?;
     let grid = Grid::new(&frame.positions, frame.cell.as_ref());
     Ok((0..frame.positions.len())
         .into_par_iter()
@@ -121,6 +116,18 @@ pub fn centrosymmetry(frame: &Frame, n: usize, mode: CspMode) -> Result<Vec<f32>
             p as f32
         })
         .collect())
+}
+
+/// Whether [`centrosymmetry`] takes `n` neighbours in `mode` (what it refuses, before any
+/// frame is read).
+pub fn check(n: usize, mode: CspMode) -> Result<(), CentroError> {
+    if !(2..=MAX_NEIGHBOURS).contains(&n) || n % 2 != 0 {
+        return Err(CentroError::BadCount(n));
+    }
+    if mode == CspMode::Matching && n > MAX_MATCHING {
+        return Err(CentroError::MatchingTooMany(n));
+    }
+    Ok(())
 }
 
 /// One worker's buffers.
