@@ -223,7 +223,8 @@ impl<'a> Grid<'a> {
                         continue;
                     }
                     let v = self.vector(i, j);
-                    found.push((v, norm(v)));
+                    // Squared for now; the distances kept are rooted at the end.
+                    found.push((v, v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
                 }
             }
             // The nearest k, in order (ties by atom order of the scan).
@@ -235,12 +236,13 @@ impl<'a> Grid<'a> {
             // The ring holds every atom within `ring` cell widths: enough when the
             // neighbours needed are that close, or when the ring covers the whole grid.
             let whole = (0..3).all(|a| 2 * ring + 1 >= self.dims[a]);
-            let enough = found.len() >= k && found[k - 1].1 <= ring as f64 * self.width;
+            let reach = ring as f64 * self.width;
+            let enough = found.len() >= k && found[k - 1].1 <= reach * reach;
             if enough || whole {
                 break;
             }
         }
-        near.extend_from_slice(found);
+        near.extend(found.iter().map(|&(v, d2)| (v, d2.sqrt())));
     }
 
     /// The offsets along axis `a` from grid coordinate `at` within `ring` cells: inside an open
@@ -269,8 +271,4 @@ impl<'a> Grid<'a> {
         }
         Some((c[2] * self.dims[1] + c[1]) * self.dims[0] + c[0])
     }
-}
-
-fn norm(v: [f64; 3]) -> f64 {
-    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
 }

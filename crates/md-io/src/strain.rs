@@ -166,7 +166,9 @@ pub fn atomic_strain(
             // A plane or a line of neighbours: V is singular (relative to its own scale).
             let scale = v.col(0).x + v.col(1).y + v.col(2).z;
             let det = v.determinant();
-            if list.len() < 3 || !(det.abs() > 1e-10 * scale * scale * scale) {
+            let singular = det.abs().partial_cmp(&(1e-10 * scale * scale * scale))
+                != Some(std::cmp::Ordering::Greater);
+            if list.len() < 3 || singular {
                 return (0.0, 0.0, 0.0, true);
             }
             let f = w * v.inverse();

@@ -2033,6 +2033,15 @@ fn push_tube(scene: &mut SphereScene, trace: &[TracePoint]) {
     scene.bonds.extend((first..last - 1).map(|k| [k, k + 1]));
 }
 
+/// `frame`'s per-atom property `name` set to `values` (replacing one of that name).
+fn set_property(frame: &mut Frame, name: &str, values: Vec<f32>) {
+    frame.properties.retain(|p| p.name != name);
+    frame.properties.push(Property {
+        name: name.to_string(),
+        values,
+    });
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -2224,13 +2233,4 @@ mod tests {
         assert_eq!(scene.len(), s + 1);
         assert_eq!(scene.centers[0].x, 60.0);
     }
-}
-
-/// `frame`'s per-atom property `name` set to `values` (replacing one of that name).
-fn set_property(frame: &mut Frame, name: &str, values: Vec<f32>) {
-    frame.properties.retain(|p| p.name != name);
-    frame.properties.push(Property {
-        name: name.to_string(),
-        values,
-    });
 }

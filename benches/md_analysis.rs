@@ -1,0 +1,151 @@
+//! The per-atom analyses materials users colour by (texmap-md-io `cna`, `centrosymmetry`,
+//! `strain`, `coordination`) on a periodic FCC copper crystal of 32³ unit cells (131,072 atoms,
+//! a = 3.615 Å, seeded thermal noise of 0.05 Å) and the same atoms sheared by 3 % with new
+//! noise (the strain's current frame), 2 threads:
+//! - adaptive CNA (`cna::classify`);
+//! - centrosymmetry from 12 neighbours, conventional and minimum-weight matching;
+//! - atomic strain at a 3.0 Å cutoff (neighbour pairs, F, shear, volumetric, D²min);
+//! - coordination at 3.0 Å.
+//!
+//! Both configurations are written to `target/md_analysis_{ref,cur}.xyz` (extended XYZ) for
+//! the peer, `benches/peers/ovito_analysis.py`, which times OVITO's modifiers on the same atoms
+//! with the same parameters: run it in the same minutes.
+//!
+//! `cargo bench --bench md_analysis -- --warm-up-time 1 --measurement-time 5`
+//! (test mode, `cargo test --bench md_analysis`, uses 8³ cells.)
+
+use std::io::Write;
+
+use criterion::{Criterion, criterion_group};
+use texmap::md_io::centrosymmetry::{CspMode, centrosymmetry};
+use texmap::md_io::{Frame, UnitCell, cna, coordination, strain};
+
+struct Lcg(u64);
+impl Lcg {
+    /// Uniform in [0, 1).
+    fn next(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+    /// Normal, by Box–Muller.
+    fn normal(&mut self) -> f64 {
+        let (u, v) = (1.0 - self.next(), self.next());
+        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+    }
+}
+
+/// The reference crystal of `n`³ cells and its sheared copy.
+fn crystals(n: usize) -> (Frame, Frame) {
+    let a = 3.615;
+    let l = n as f64 * a;
+    let mut rng = Lcg(2026);
+    let base = [
+        [0.0, 0.0, 0.0],
+        [0.5, 0.5, 0.0],
+        [0.5, 0.0, 0.5],
+        [0.0, 0.5, 0.5],
+    ];
+    let mut reference = Frame::new();
+    let mut current = Frame::new();
+    for i in 0..n * n * n {
+        let cell = [i % n, i / n % n, i / (n * n)];
+        for b in base {
+            let p: [f64; 3] =
+                [0, 1, 2].map(|k| (cell[k] as f64 + b[k] + 0.25) * a + 0.05 * rng.normal());
+            reference.positions.push(p.map(|x| x as f32));
+            let mut q = [0, 1, 2].map(|k| p[k] + 0.05 * rng.normal());
+            q[0] += 0.03 * q[1];
+            current.positions.push(q.map(|x| x as f32));
+        }
+    }
+    reference.cell = Some(UnitCell::orthorhombic(l, l, l).unwrap());
+    current.cell =
+        Some(UnitCell::from_matrix([[l, 0.0, 0.0], [0.03 * l, l, 0.0], [0.0, 0.0, l]]).unwrap());
+    for f in [&mut reference, &mut current] {
+        f.names = vec![texmap::md_io::Label::new("Cu").unwrap(); f.positions.len()];
+    }
+    (reference, current)
+}
+
+/// `frame` as extended XYZ (the peer's input).
+fn write_xyz(frame: &Frame, path: &str) {
+    let m = frame.cell.unwrap().matrix();
+    let mut out = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
+    writeln!(out, "{}", frame.positions.len()).unwrap();
+    let lattice: Vec<String> = m.iter().flatten().map(|v| format!("{v:.6}")).collect();
+    writeln!(
+        out,
+        "Lattice=\"{}\" Properties=species:S:1:pos:R:3 pbc=\"T T T\"",
+        lattice.join(" ")
+    )
+    .unwrap();
+    for p in &frame.positions {
+        writeln!(out, "Cu {:.6} {:.6} {:.6}", p[0], p[1], p[2]).unwrap();
+    }
+}
+
+fn bench(c: &mut Criterion) {
+    let test_mode = std::env::args().any(|a| a == "--test");
+    let n = if test_mode { 8 } else { 32 };
+    let (reference, current) = crystals(n);
+    let atoms = reference.positions.len();
+    if !test_mode {
+        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/target");
+        write_xyz(&reference, &format!("{dir}/md_analysis_ref.xyz"));
+        write_xyz(&current, &format!("{dir}/md_analysis_cur.xyz"));
+    }
+    // The analyses see what they should: a thermal FCC crystal, sheared by 3 %.
+    let types = cna::classify(&reference);
+    assert!(
+        types
+            .iter()
+            .filter(|t| **t == cna::StructureType::Fcc)
+            .count()
+            > atoms * 9 / 10
+    );
+    let s = strain::atomic_strain(&reference, &current, 3.0).unwrap();
+    let mean = s.shear.iter().map(|v| *v as f64).sum::<f64>() / atoms as f64;
+    assert!((mean - 0.015).abs() < 0.01, "mean shear strain {mean}");
+
+    let mut g = c.benchmark_group("md_analysis");
+    g.sample_size(10);
+    g.bench_function(format!("cna_{atoms}"), |b| {
+        b.iter(|| cna::classify(&reference).len())
+    });
+    g.bench_function(format!("centrosymmetry_conventional_{atoms}"), |b| {
+        b.iter(|| {
+            centrosymmetry(&reference, 12, CspMode::Conventional)
+                .unwrap()
+                .len()
+        })
+    });
+    g.bench_function(format!("centrosymmetry_matching_{atoms}"), |b| {
+        b.iter(|| {
+            centrosymmetry(&reference, 12, CspMode::Matching)
+                .unwrap()
+                .len()
+        })
+    });
+    g.bench_function(format!("strain_{atoms}"), |b| {
+        b.iter(|| {
+            strain::atomic_strain(&reference, &current, 3.0)
+                .unwrap()
+                .shear
+                .len()
+        })
+    });
+    g.bench_function(format!("coordination_{atoms}"), |b| {
+        b.iter(|| coordination::coordination(&reference, 3.0).unwrap().len())
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+
+fn main() {
+    benches();
+    Criterion::default().configure_from_args().final_summary();
+}

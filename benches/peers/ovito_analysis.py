@@ -1,0 +1,58 @@
+"""The peer of benches/md_analysis.rs: OVITO's modifiers on the same atoms with the same
+parameters, timed in the same minutes. Reads target/md_analysis_{ref,cur}.xyz (written by
+`cargo bench --bench md_analysis`) and prints the median of 10 evaluations per analysis, in ms,
+file reading excluded (both configurations are loaded once; each evaluation is a new pipeline
+over them, so OVITO's caches do not carry over).
+
+    pip install ovito==3.17.2
+    python3 benches/peers/ovito_analysis.py [threads]
+"""
+import os
+import statistics
+import sys
+import time
+
+threads = int(sys.argv[1]) if len(sys.argv) > 1 else 2
+# Read by OVITO when it loads.
+os.environ["OVITO_THREAD_COUNT"] = str(threads)
+
+import ovito  # noqa: E402
+from ovito.io import import_file  # noqa: E402
+from ovito.modifiers import (AtomicStrainModifier, CentroSymmetryModifier,  # noqa: E402
+                             CommonNeighborAnalysisModifier, CoordinationAnalysisModifier)
+from ovito.pipeline import Pipeline, StaticSource  # noqa: E402
+
+here = os.path.dirname(os.path.abspath(__file__))
+target = os.path.join(here, "..", "..", "target")
+
+ref = os.path.join(target, "md_analysis_ref.xyz")
+cur = os.path.join(target, "md_analysis_cur.xyz")
+reference_data = import_file(ref).compute()
+current_data = import_file(cur).compute()
+print(f"{reference_data.particles.count} atoms, OVITO {ovito.version_string}, {threads} threads")
+
+
+def timed(name, data, make_modifier, runs=10):
+    times = []
+    for _ in range(runs):
+        pipe = Pipeline(source=StaticSource(data=data))
+        pipe.modifiers.append(make_modifier())
+        t = time.perf_counter()
+        pipe.compute()
+        times.append((time.perf_counter() - t) * 1000)
+    print(f"{name}: median {statistics.median(times):.1f} ms (min {min(times):.1f})")
+
+
+def strain():
+    m = AtomicStrainModifier(cutoff=3.0, output_nonaffine_squared_displacements=True)
+    m.reference = StaticSource(data=reference_data)
+    return m
+
+
+timed("cna", reference_data, lambda: CommonNeighborAnalysisModifier())
+timed("centrosymmetry_conventional", reference_data,
+      lambda: CentroSymmetryModifier(num_neighbors=12, mode=CentroSymmetryModifier.Mode.Conventional))
+timed("centrosymmetry_matching", reference_data,
+      lambda: CentroSymmetryModifier(num_neighbors=12, mode=CentroSymmetryModifier.Mode.Matching))
+timed("strain", current_data, strain)
+timed("coordination", reference_data, lambda: CoordinationAnalysisModifier(cutoff=3.0))
