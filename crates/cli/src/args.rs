@@ -1050,6 +1050,17 @@ pub struct MolArgs {
     /// neighbours get 0. R from 0.45 to 20 Å.
     #[arg(long, value_name = "R", value_parser = parse_cutoff)]
     pub strain: Option<f32>,
+    /// Compute a per-atom number NAME from a formula every frame, as OVITO's Compute property
+    /// modifier (muparser's syntax), for --color-by NAME and selections ('prop NAME > 1'):
+    /// --compute 'speed=sqrt(vx^2+vy^2+vz^2)', --compute 'ke=0.5*mass*(vx^2+vy^2+vz^2)',
+    /// --compute 'r=sqrt((x-20)^2+(y-20)^2)'. Names: x y z, vx vy vz, index (from 0), id, mass
+    /// (the element's), N, pi and every per-atom property (texmap info lists a file's; bfactor,
+    /// c_pe, coordination, centrosymmetry, shear_strain, an earlier --compute). Operators + - *
+    /// / ^, comparisons, && || !, cond ? a : b; functions sqrt abs exp ln log10 log2 sin cos
+    /// tan asin acos atan atan2 sinh cosh tanh pow fmod min max floor ceil rint sign.
+    /// Repeatable, evaluated in order after the analyses (--coordination, --strain, ...).
+    #[arg(long = "compute", value_name = "NAME=FORMULA")]
+    pub computes: Vec<String>,
     /// Draw each atom with the radius (Å) a per-atom property gives: PQR's 'radius'
     /// (PDB2PQR/APBS radii), any dump column (texmap info lists them), --property FILE's
     /// numbers. As a file's radius column: --radius-scale does not apply, ball-and-stick

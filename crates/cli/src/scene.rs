@@ -595,6 +595,27 @@ pub fn mol_plan(args: &MolArgs, style: &StyleArgs, topology: Option<Topology>) -
             },
         }),
         strain: args.strain,
+        computes: args
+            .computes
+            .iter()
+            .map(|c| {
+                let (name, formula) = c.split_once('=').ok_or_else(|| {
+                    crate::args::UsageError(format!(
+                        "--compute {c:?}: expected NAME=FORMULA, e.g. 'speed=sqrt(vx^2+vy^2+vz^2)'"
+                    ))
+                })?;
+                let name = name.trim();
+                if name.is_empty() || !name.chars().all(|ch| ch.is_alphanumeric() || ch == '_') {
+                    return Err(crate::args::UsageError(format!(
+                        "--compute {c:?}: the name {name:?} must be letters, digits and '_'"
+                    )));
+                }
+                let parsed = texmap_md_io::expr::Expression::parse(formula).map_err(|e| {
+                    crate::args::UsageError(format!("--compute {name}={formula}: {e}"))
+                })?;
+                Ok((name.to_string(), parsed))
+            })
+            .collect::<Result<Vec<_>, _>>()?,
         radius_from: args.radius_from.clone(),
         slice: args.slice.map(|[x, y, z, d, w]| texmap_md_scene::Slice {
             normal: [x, y, z],
@@ -703,6 +724,10 @@ pub fn mol_error(e: MolError) -> anyhow::Error {
         MolError::Clusters(e) => return anyhow::anyhow!("--clusters: {e}"),
         MolError::Centrosymmetry(e) => format!("--centrosymmetry: {e}"),
         MolError::Strain(e) => return anyhow::anyhow!("--strain: {e}"),
+        MolError::Compute { name, error } => {
+            // The formula parsed; the frame lacks a name it uses: the input's, not usage.
+            return anyhow::anyhow!("--compute {name}: {error}");
+        }
         MolError::NoRadiusProperty { .. } => return anyhow::anyhow!("--radius-from: {e}"),
         MolError::BadSlice => format!("--slice: {e}"),
         MolError::Replicate(e) => {

@@ -3356,3 +3356,63 @@ fn strain_and_centrosymmetry_select_ovitos_atoms() {
         assert!(stderr(&o).contains(needs), "{}", stderr(&o));
     }
 }
+
+/// `--compute`: on md-io's expression fixture (a LAMMPS dump OVITO wrote, with OVITO's Compute
+/// property values), the atoms `--compute 'speed=...' --select 'prop speed > 3'` draws are the
+/// same picture, byte for byte, as OVITO's atoms above that speed selected by index, and a
+/// second formula may use the first; a formula that does not parse is a usage error naming the
+/// column, one naming what the file lacks a runtime error listing what it has.
+#[test]
+fn computed_properties_select_ovitos_atoms() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = Path::new(env!("CARGO_MANIFEST_DIR")).join("../md-io/tests/data/expr");
+    let file = base.join("atoms.lammpstrj").to_string_lossy().into_owned();
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(base.join("expr_reference.json")).unwrap())
+            .unwrap();
+    assert_eq!(v[0]["formula"], "sqrt(vx^2 + vy^2 + vz^2)");
+    let speeds: Vec<f64> = v[0]["values"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    assert!(speeds.iter().all(|s| (s - 3.0).abs() > 1e-4));
+    let fast: Vec<String> = (0..speeds.len())
+        .filter(|&i| speeds[i] > 3.0)
+        .map(|i| i.to_string())
+        .collect();
+    assert!(fast.len() > 100 && fast.len() < 500, "{}", fast.len());
+    let render = |extra: &[&str], out: &str| {
+        let out = dir.path().join(out);
+        let mut args = vec!["render", file.as_str(), "--size", "200x200", "-q"];
+        args.extend_from_slice(extra);
+        args.extend(["-o", out.to_str().unwrap()]);
+        let o = texmap(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        std::fs::read(out).unwrap()
+    };
+    let ours = render(
+        &[
+            "--compute",
+            "speed=sqrt(vx^2 + vy^2 + vz^2)",
+            "--compute",
+            "fast=speed > 3",
+            "--select",
+            "prop fast == 1",
+        ],
+        "ours.png",
+    );
+    let by_index = format!("index {}", fast.join(" "));
+    assert_eq!(ours, render(&["--select", &by_index], "ovito.png"));
+    let o = texmap(&["render", &file, "--compute", "s=sqrt(vx^2+", "-o", "x.png"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("column 11"), "{}", stderr(&o));
+    let o = texmap(&["render", &file, "--compute", "s=sqrt(foo)", "-o", "x.png"]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("no 'foo' (it has: x, y, z"),
+        "{}",
+        stderr(&o)
+    );
+}

@@ -35,7 +35,8 @@
 //!   [`coordination`] counts each atom's neighbours within a cutoff (and groups them into
 //!   clusters), [`cna`] classifies its crystal structure, [`centrosymmetry`] measures how far
 //!   its neighbours are from opposite pairs and [`strain`] its local deformation against a
-//!   reference configuration, as OVITO's analyses do; [`hbonds`] finds hydrogen bonds by
+//!   reference configuration, as OVITO's analyses do, and [`expr`] computes a number per atom
+//!   from a formula (OVITO's Compute property); [`hbonds`] finds hydrogen bonds by
 //!   MDAnalysis's geometric criterion.
 //! - [`values`] reads per-atom numbers from a text file (an analysis result, a column or a row
 //!   per frame) to give the frames as a property.
@@ -120,6 +121,7 @@ mod dcd;
 mod dlpoly;
 pub mod elements;
 mod error;
+pub mod expr;
 mod format;
 mod frame;
 mod gro;

@@ -15,7 +15,8 @@
 //!    [`MolOptions::centrosymmetry`] each atom's [`CENTROSYMMETRY`], and with
 //!    [`MolOptions::strain`] its [`SHEAR_STRAIN`], [`VOLUMETRIC_STRAIN`] and [`D2MIN`] against
 //!    the reference configuration (the first frame built at this step, or the one given to
-//!    [`MolPlan::set_displacement_reference`]);
+//!    [`MolPlan::set_displacement_reference`]); then each of [`MolOptions::computes`], in
+//!    order, as the property it names;
 //!    bonds that still cross the (enlarged) box are dropped, so no stick
 //!    spans it; with [`MolOptions::displacement`] (after the alignment of step 3), each atom's
 //!    distance from the first frame built as the property [`DISPLACEMENT`];
@@ -107,6 +108,7 @@ use std::fmt;
 use texmap_impostor::SphereScene;
 use texmap_md_io::centrosymmetry::{CentroError, CspMode};
 use texmap_md_io::coordination::CoordinationError;
+use texmap_md_io::expr::{ExprError, Expression};
 use texmap_md_io::hbonds::{self, Criteria, HBond, HBondError};
 use texmap_md_io::replicate::ReplicateError;
 use texmap_md_io::strain::StrainError;
@@ -279,6 +281,10 @@ pub struct MolOptions {
     /// modifier: [`texmap_md_io::strain`]). The reference is the first frame built, as it is at
     /// this step, or the frame given to [`MolPlan::set_displacement_reference`].
     pub strain: Option<f32>,
+    /// Per-atom properties computed from formulas every frame, after the analyses above, in
+    /// order (a later formula may use an earlier one's name): OVITO's Compute property
+    /// modifier ([`texmap_md_io::expr`]). Each `(name, formula)` sets the property `name`.
+    pub computes: Vec<(String, Expression)>,
     /// Draw every atom with the radius a per-atom property gives (Å; PQR's `radius`, any
     /// column of a dump), as a file's `radius` column is drawn; a value of zero or less, or
     /// not a number, leaves the atom its element's radius. A frame without the property is an
@@ -410,6 +416,7 @@ impl Default for MolOptions {
             clusters: None,
             centrosymmetry: None,
             strain: None,
+            computes: Vec::new(),
             radius_from: None,
             slice: None,
             align: None,
@@ -505,6 +512,13 @@ pub enum MolError {
     /// [`MolOptions::strain`] cannot be computed (a frame of other atoms than the reference,
     /// the cutoff, a cell too small for it).
     Strain(StrainError),
+    /// A formula of [`MolOptions::computes`] names what a frame does not have.
+    Compute {
+        /// The property it computes.
+        name: String,
+        /// Why.
+        error: ExprError,
+    },
     /// [`MolOptions::radius_from`] names a property a frame does not have.
     NoRadiusProperty {
         name: String,
@@ -547,6 +561,7 @@ impl fmt::Display for MolError {
             MolError::Clusters(e) => write!(f, "clusters: {e}"),
             MolError::Centrosymmetry(e) => write!(f, "centrosymmetry: {e}"),
             MolError::Strain(e) => write!(f, "atomic strain: {e}"),
+            MolError::Compute { name, error } => write!(f, "computing '{name}': {error}"),
             MolError::NoRadiusProperty { name, available } => write!(
                 f,
                 "radii from '{name}': the frame has no such per-atom property ({})",
@@ -1072,6 +1087,13 @@ impl MolPlan {
             set_property(frame, SHEAR_STRAIN, s.shear);
             set_property(frame, VOLUMETRIC_STRAIN, s.volumetric);
             set_property(frame, D2MIN, s.d2min);
+        }
+        for (name, formula) in &self.options.computes {
+            let values = formula.evaluate(frame).map_err(|error| MolError::Compute {
+                name: name.clone(),
+                error,
+            })?;
+            set_property(frame, name, values);
         }
         if let Some(name) = &self.options.radius_from {
             let Some(values) = frame.property(name) else {

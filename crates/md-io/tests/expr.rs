@@ -1,0 +1,116 @@
+//! Computed properties (`texmap_md_io::expr`) against OVITO 3.17's Compute property modifier
+//! (muparser) on a LAMMPS dump OVITO wrote (tests/data/expr, gen_expr.py): 600 atoms with
+//! velocities, a `c_pe` column and ids in shuffled order; eleven formulas covering every
+//! operator level, the ternary, the logical operators, functions of one, two and many
+//! arguments, `pi`, `N`, `index` and `id`, the unary minus against `^` and `^`'s associativity,
+//! each written in texmap's names and in OVITO's. Every atom's value must be OVITO's within
+//! f32 precision.
+
+use std::path::Path;
+
+use texmap_md_io::expr::Expression;
+use texmap_md_io::{Frame, Trajectory};
+
+fn data(name: &str) -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/expr")
+        .join(name)
+}
+
+#[test]
+fn every_formula_is_ovitos() {
+    let text = std::fs::read_to_string(data("expr_reference.json")).unwrap();
+    let cases: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let mut frame = Frame::new();
+    assert!(
+        Trajectory::open(data("atoms.lammpstrj"))
+            .unwrap()
+            .read_next(&mut frame)
+            .unwrap()
+    );
+    assert_eq!(frame.n_atoms(), 600);
+    for case in cases.as_array().unwrap() {
+        let formula = case["formula"].as_str().unwrap();
+        let want: Vec<f64> = case["values"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
+        let got = Expression::parse(formula)
+            .unwrap()
+            .evaluate(&frame)
+            .unwrap();
+        let (worst, at) = got
+            .iter()
+            .zip(&want)
+            .enumerate()
+            .map(|(i, (&a, &b))| ((a as f64 - b).abs() / b.abs().max(1.0), i))
+            .fold((0.0, 0), |m, x| if x.0 > m.0 { x } else { m });
+        println!("{formula}: worst relative difference {worst:.1e} at atom {at}");
+        // f32 inputs (7 digits) through a few operations; boolean results exactly.
+        assert!(
+            worst < 2e-5,
+            "{formula} (OVITO: {}): atom {at}: {} vs {}",
+            case["ovito"],
+            got[at],
+            want[at]
+        );
+    }
+}
+
+#[test]
+fn errors_name_the_column_and_the_missing_names() {
+    let e = Expression::parse("sqrt(x) + foo(2)").unwrap_err();
+    assert_eq!(e.column, 11);
+    assert!(e.message.contains("'foo' is not a function"), "{e}");
+    let e = Expression::parse("atan2(x)").unwrap_err();
+    assert!(
+        e.message.contains("atan2 takes 2 argument(s), not 1"),
+        "{e}"
+    );
+    let e = Expression::parse("x $ 2").unwrap_err();
+    assert_eq!(
+        (e.column, e.message.as_str()),
+        (3, "unexpected character '$'")
+    );
+    let e = Expression::parse("x ? 1").unwrap_err();
+    assert!(e.to_string().starts_with("column 6: expected ':'"), "{e}");
+    let e = Expression::parse("(x) (y)").unwrap_err();
+    assert_eq!(e.column, 5);
+    let deep = format!("{}x{}", "(".repeat(200), ")".repeat(200));
+    assert!(
+        Expression::parse(&deep)
+            .unwrap_err()
+            .message
+            .contains("deeper than")
+    );
+    let minus = format!("{}x", "-".repeat(500));
+    assert!(Expression::parse(&minus).is_err());
+    let mut frame = Frame::new();
+    frame.positions = vec![[0.0; 3]; 2];
+    let e = Expression::parse("vx + c_pe")
+        .unwrap()
+        .evaluate(&frame)
+        .unwrap_err();
+    assert!(
+        e.message
+            .starts_with("the frame has no 'vx' (it has: x, y, z, index"),
+        "{e}"
+    );
+}
+
+#[test]
+fn functions_ovito_lacks_follow_their_definitions() {
+    let mut frame = Frame::new();
+    frame.positions = vec![[-1.5, 2.5, 0.0], [2.5, -0.5, 3.0]];
+    let eval = |f: &str| Expression::parse(f).unwrap().evaluate(&frame).unwrap();
+    assert_eq!(eval("floor(x)"), [-2.0, 2.0]);
+    assert_eq!(eval("ceil(y)"), [3.0, -0.0]);
+    assert_eq!(eval("rint(x)"), [-2.0, 2.0]); // ties to even
+    assert_eq!(eval("!z + sign(y)"), [2.0, -1.0]);
+    assert_eq!(eval("-2^2"), [-4.0, -4.0]);
+    assert_eq!(eval("2^-1"), [0.5, 0.5]);
+    assert_eq!(eval("1 < 2 == 1"), [1.0, 1.0]);
+    assert_eq!(eval("z ? 10 : x ? 20 : 30"), [20.0, 10.0]);
+}
