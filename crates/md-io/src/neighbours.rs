@@ -1,5 +1,6 @@
 //! The k nearest neighbours of each atom, from a cell grid: what [`crate::cna`] and
-//! [`crate::centrosymmetry`] examine around every atom.
+//! [`crate::centrosymmetry`] examine around every atom; and the atom nearest to any point, the
+//! site [`crate::wigner_seitz`] assigns an atom to.
 //!
 //! The grid has fractional cells in a periodic cell (about [`ATOMS_PER_CELL`] atoms each) and
 //! cells over the bounding box otherwise. A query grows rings of cells around the atom until the
@@ -47,6 +48,8 @@ pub(crate) struct Grid<'a> {
     /// The cell's edges as columns (periodic frames: Cartesian = edges · fractional), and each
     /// atom's wrapped fractional coordinates.
     edges: DMat3,
+    /// Fractional = inverse · Cartesian (periodic frames).
+    inverse: DMat3,
     frac: Vec<DVec3>,
 }
 
@@ -67,6 +70,7 @@ impl<'a> Grid<'a> {
             lo: [0.0; 3],
             inv: [0.0; 3],
             edges: DMat3::IDENTITY,
+            inverse: DMat3::IDENTITY,
             frac: Vec::new(),
         };
         match cell {
@@ -75,6 +79,7 @@ impl<'a> Grid<'a> {
                 let edges = DMat3::from_cols_array_2d(&c.matrix());
                 let inverse = edges.inverse();
                 grid.edges = edges;
+                grid.inverse = inverse;
                 grid.frac = positions
                     .iter()
                     .map(|p| {
@@ -160,16 +165,84 @@ impl<'a> Grid<'a> {
 
     /// The grid coordinates of atom `i`.
     fn coords(&self, i: usize) -> [usize; 3] {
-        let p = self.positions[i].map(f64::from);
+        match self.cell {
+            Some(_) => self.coords_of(self.frac[i].to_array()),
+            None => self.coords_of(self.positions[i].map(f64::from)),
+        }
+    }
+
+    /// The grid coordinates of a point: wrapped fractional coordinates in a periodic cell,
+    /// Cartesian ones otherwise (outside the grid: its edge cells).
+    fn coords_of(&self, q: [f64; 3]) -> [usize; 3] {
         match self.cell {
             Some(_) => {
-                let f = self.frac[i].to_array();
-                [0, 1, 2].map(|a| ((f[a] * self.dims[a] as f64) as usize).min(self.dims[a] - 1))
+                [0, 1, 2].map(|a| ((q[a] * self.dims[a] as f64) as usize).min(self.dims[a] - 1))
             }
             None => [0, 1, 2].map(|a| {
-                (((p[a] - self.lo[a]) * self.inv[a]).max(0.0) as usize).min(self.dims[a] - 1)
+                (((q[a] - self.lo[a]) * self.inv[a]).max(0.0) as usize).min(self.dims[a] - 1)
             }),
         }
+    }
+
+    /// Every cell within `ring` of `centre` (wrapped in a periodic cell), once, into `cells`.
+    fn ring_cells(&self, centre: [usize; 3], ring: usize, cells: &mut Vec<usize>) {
+        cells.clear();
+        let span = [0, 1, 2].map(|a| self.offsets(centre[a], a, ring));
+        for dz in span[2].clone() {
+            for dy in span[1].clone() {
+                for dx in span[0].clone() {
+                    if let Some(c) = self.offset_cell(centre, [dx, dy, dz]) {
+                        cells.push(c);
+                    }
+                }
+            }
+        }
+        cells.sort_unstable();
+        cells.dedup();
+    }
+
+    /// The atom nearest to the point `p` (Å; at its nearest image in a periodic cell) and its
+    /// distance; equal distances go to the lower index. `None` for a non-finite point or an
+    /// empty grid.
+    pub(crate) fn nearest_to(&self, p: [f64; 3], cells: &mut Vec<usize>) -> Option<(usize, f64)> {
+        if !p.iter().all(|v| v.is_finite()) || self.order.is_empty() {
+            return None;
+        }
+        let q = match self.cell {
+            Some(_) => {
+                let f = self.inverse * DVec3::from(p);
+                (f - f.floor()).to_array()
+            }
+            None => p,
+        };
+        let centre = self.coords_of(q);
+        let max_ring = self.dims.iter().max().copied().unwrap_or(1);
+        let mut best: Option<(usize, f64)> = None;
+        for ring in 1..=max_ring.max(1) {
+            self.ring_cells(centre, ring, cells);
+            for &c in cells.iter() {
+                for &j in &self.order[self.starts[c] as usize..self.starts[c + 1] as usize] {
+                    let j = j as usize;
+                    let v = match self.cell {
+                        Some(_) => {
+                            let d = self.frac[j] - DVec3::from(q);
+                            (self.edges * (d - d.round())).to_array()
+                        }
+                        None => [0, 1, 2].map(|a| self.positions[j][a] as f64 - p[a]),
+                    };
+                    let d2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+                    if best.is_none_or(|(b, bd)| d2 < bd || (d2 == bd && j < b)) {
+                        best = Some((j, d2));
+                    }
+                }
+            }
+            let whole = (0..3).all(|a| 2 * ring + 1 >= self.dims[a]);
+            let reach = ring as f64 * self.width;
+            if whole || best.is_some_and(|(_, d2)| d2 <= reach * reach) {
+                break;
+            }
+        }
+        best.map(|(j, d2)| (j, d2.sqrt()))
     }
 
     fn cell_of(&self, i: usize) -> usize {
@@ -201,20 +274,7 @@ impl<'a> Grid<'a> {
         let centre = self.coords(i);
         let max_ring = self.dims.iter().max().copied().unwrap_or(1);
         for ring in 1..=max_ring.max(1) {
-            // Every cell within `ring` of the centre (wrapped in a periodic cell), once.
-            cells.clear();
-            let span = [0, 1, 2].map(|a| self.offsets(centre[a], a, ring));
-            for dz in span[2].clone() {
-                for dy in span[1].clone() {
-                    for dx in span[0].clone() {
-                        if let Some(c) = self.offset_cell(centre, [dx, dy, dz]) {
-                            cells.push(c);
-                        }
-                    }
-                }
-            }
-            cells.sort_unstable();
-            cells.dedup();
+            self.ring_cells(centre, ring, cells);
             found.clear();
             for &c in cells.iter() {
                 for &j in &self.order[self.starts[c] as usize..self.starts[c + 1] as usize] {
