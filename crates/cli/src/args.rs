@@ -532,7 +532,7 @@ pub struct RenderArgs {
     /// A caption at the top left of every image, on a light backdrop, for movies:
     /// 't = {ns} ns'. {time} is the frame's time in ps, {ns} in ns, {step} its MD step,
     /// {frame} its index in the file, {hbonds} the hydrogen bonds an hbonds representation
-    /// draws in it, {title} its title (an XYZ comment, a PDB TITLE, a Vina pose's 'VINA
+    /// draws in it, {vacancies} and {interstitials} the --wigner-seitz counts, {title} its title (an XYZ comment, a PDB TITLE, a Vina pose's 'VINA
     /// RESULT: -7.5 ...'); a file whose frames carry no time (XYZ, PDB) takes {frame}. ASCII
     /// only; the text is cut at half the image width.
     #[arg(long, value_name = "TEXT")]
@@ -795,6 +795,18 @@ pub enum PbcArg {
     Wrap,
     /// Bonded molecules made whole across the box.
     Unwrap,
+}
+
+/// What `--wigner-seitz` draws.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WignerSeitzArg {
+    /// The reference's sites instead of the atoms, each with 'site_occupancy' (OVITO's
+    /// default): --select 'prop site_occupancy != 1' shows vacancies (0) and interstitial sites
+    /// (2 or more).
+    Sites,
+    /// The atoms, each with the occupancy of its site: --select 'prop site_occupancy > 1'
+    /// shows the interstitial atoms (both atoms of a dumbbell).
+    Atoms,
 }
 
 /// `texmap render` options for molecules: topology, selection, per-selection looks, bonds,
@@ -1061,6 +1073,20 @@ pub struct MolArgs {
     /// Repeatable, evaluated in order after the analyses (--coordination, --strain, ...).
     #[arg(long = "compute", value_name = "NAME=FORMULA")]
     pub computes: Vec<String>,
+    /// Point defects, as OVITO's Wigner-Seitz defect analysis (radiation damage, diffusion):
+    /// each atom is counted on the nearest site of the reference configuration (the first frame
+    /// drawn, or --displacement-reference: the perfect crystal), giving the per-atom numbers
+    /// 'site_occupancy' and 'site'; 0 on a site is a vacancy, 2 or more an interstitial.
+    /// 'sites' (the default) draws the reference's sites instead of the atoms, 'atoms' the
+    /// atoms. --label '{vacancies} vacancies, {interstitials} interstitials' captions the
+    /// counts; --defect-table FILE.csv lists them per frame. A box that changes shape is mapped
+    /// onto the reference's first.
+    #[arg(long, value_enum, value_name = "sites|atoms", num_args = 0..=1, default_missing_value = "sites")]
+    pub wigner_seitz: Option<WignerSeitzArg>,
+    /// Also write the --wigner-seitz counts as a CSV table, one row per frame: frame,
+    /// vacancies, interstitials. Written whole or not at all.
+    #[arg(long, value_name = "FILE.csv", requires = "wigner_seitz")]
+    pub defect_table: Option<PathBuf>,
     /// Draw each atom with the radius (Å) a per-atom property gives: PQR's 'radius'
     /// (PDB2PQR/APBS radii), any dump column (texmap info lists them), --property FILE's
     /// numbers. As a file's radius column: --radius-scale does not apply, ball-and-stick

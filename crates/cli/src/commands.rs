@@ -652,6 +652,19 @@ fn render(a: &RenderArgs) -> Result<()> {
             "--label {hbonds} counts the hydrogen bonds the hbonds style draws: add a representation of them, as --rep 'protein or water=hbonds'",
         );
     }
+    if label.as_ref().is_some_and(|parts| {
+        parts.iter().any(|p| {
+            matches!(
+                p,
+                crate::scene::LabelPart::Vacancies | crate::scene::LabelPart::Interstitials
+            )
+        })
+    }) && a.mol.wigner_seitz.is_none()
+    {
+        return usage(
+            "--label {vacancies} and {interstitials} count the point defects --wigner-seitz finds: add --wigner-seitz",
+        );
+    }
     let mut hbond_table = match &a.mol.hbond_table {
         None => None,
         Some(_) if !plan.draws_hbonds() => {
@@ -667,6 +680,19 @@ fn render(a: &RenderArgs) -> Result<()> {
         Some(p) => {
             let mut t = crate::output::AtomicFile::create(p)?;
             t.write("frame,donor,hydrogen,acceptor,donor_atom,hydrogen_atom,acceptor_atom,distance,angle\n")?;
+            Some(t)
+        }
+    };
+    let mut defect_table = match &a.mol.defect_table {
+        None => None,
+        Some(_) if mine.len() != frames.len() => {
+            return usage(
+                "--defect-table with --shard (or a Slurm array): every part would write the same table; write it in a run of its own",
+            );
+        }
+        Some(p) => {
+            let mut t = crate::output::AtomicFile::create(p)?;
+            t.write("frame,vacancies,interstitials\n")?;
             Some(t)
         }
     };
@@ -691,7 +717,7 @@ fn render(a: &RenderArgs) -> Result<()> {
     if let Some(r) = &a.mol.displacement_reference {
         if !plan.measures_displacements() {
             return usage(format!(
-                "--displacement-reference {r}: nothing measures displacements; add --displacements, --color-by displacement, --arrows displacement or --strain R"
+                "--displacement-reference {r}: nothing measures displacements; add --displacements, --color-by displacement, --arrows displacement, --strain R or --wigner-seitz"
             ));
         }
         let mut reference = MdFrame::new();
@@ -797,6 +823,13 @@ fn render(a: &RenderArgs) -> Result<()> {
             t.write(&hbond_rows(f, plan.last_hbonds(), &md))
                 .map_err(|e| fail(e, &written))?;
         }
+        if let Some(t) = &mut defect_table
+            && mine.contains(&k)
+            && let Some((vacancies, interstitials)) = plan.last_defects()
+        {
+            t.write(&format!("{f},{vacancies},{interstitials}\n"))
+                .map_err(|e| fail(e, &written))?;
+        }
         if let Some(t) = &mut measure_table
             && mine.contains(&k)
         {
@@ -883,7 +916,12 @@ fn render(a: &RenderArgs) -> Result<()> {
                 } else {
                     format!(": no --rep selects any of frame {f}'s atoms")
                 };
-                let e = anyhow::anyhow!("no atom to draw{why}");
+                let hint = if md.cell.is_some() && !a.box_outline {
+                    " (a movie whose first frame has nothing selected yet, such as defects to come, can frame the cell instead: add --box-outline)"
+                } else {
+                    ""
+                };
+                let e = anyhow::anyhow!("no atom to draw{why}{hint}");
                 return Err(fail(e, &written));
             }
             // The camera frames the surface's atoms too, at the surface's radii.
@@ -1113,8 +1151,9 @@ fn render(a: &RenderArgs) -> Result<()> {
         }
         if let Some(parts) = &label {
             let hbonds = plan.last_hbonds().len();
-            let text = crate::scene::label_text(parts, f, &md, traj.name(), hbonds)
-                .map_err(|e| fail(e, &written))?;
+            let text =
+                crate::scene::label_text(parts, f, &md, traj.name(), hbonds, plan.last_defects())
+                    .map_err(|e| fail(e, &written))?;
             let (w, h) = (out.width() as usize, out.height() as usize);
             texmap_md_scene::draw_caption(out.color.as_flattened_mut(), w, h, &text);
         }
@@ -1130,6 +1169,9 @@ fn render(a: &RenderArgs) -> Result<()> {
         t.commit()?;
     }
     if let Some(t) = measure_table {
+        t.commit()?;
+    }
+    if let Some(t) = defect_table {
         t.commit()?;
     }
     if builder.merged_colors() > 0 {

@@ -123,6 +123,9 @@ pub enum LabelPart {
     Frame,
     /// `{hbonds}`: the hydrogen bonds the hbonds style draws in the frame.
     HBonds,
+    /// `{vacancies}`, `{interstitials}`: the `--wigner-seitz` counts of the frame.
+    Vacancies,
+    Interstitials,
     /// `{title}`: the frame's title (an XYZ comment line, a GRO title, a PDB TITLE, a docked
     /// pose's `REMARK VINA RESULT`), empty when it has none.
     Title,
@@ -169,8 +172,18 @@ fn template<'a>(
 /// `--label`'s template, parsed before any frame is read: braces balanced, every placeholder
 /// `{time}`, `{ns}`, `{step}` or `{frame}`.
 pub fn parse_label(text: &str) -> Result<Vec<LabelPart>> {
-    const NAMES: [&str; 6] = ["time", "ns", "step", "frame", "hbonds", "title"];
-    let hint = "{time} (ps), {ns}, {step}, {frame}, {hbonds} or {title}";
+    const NAMES: [&str; 8] = [
+        "time",
+        "ns",
+        "step",
+        "frame",
+        "hbonds",
+        "title",
+        "vacancies",
+        "interstitials",
+    ];
+    let hint =
+        "{time} (ps), {ns}, {step}, {frame}, {hbonds}, {vacancies}, {interstitials} or {title}";
     Ok(template("--label", text, &NAMES, hint)?
         .into_iter()
         .map(|p| match p {
@@ -180,7 +193,9 @@ pub fn parse_label(text: &str) -> Result<Vec<LabelPart>> {
             Err(2) => LabelPart::Step,
             Err(3) => LabelPart::Frame,
             Err(4) => LabelPart::HBonds,
-            Err(_) => LabelPart::Title,
+            Err(5) => LabelPart::Title,
+            Err(6) => LabelPart::Vacancies,
+            Err(_) => LabelPart::Interstitials,
         })
         .collect())
 }
@@ -302,13 +317,15 @@ fn compact(v: f64, decimals: usize) -> String {
 /// The `--label` text of frame `index` of `file`. Errors when it asks for a time or step the
 /// frame does not carry.
 /// The caption of frame `index` of `file`; `hbonds` is the count of hydrogen bonds drawn (the
-/// caller refuses `{hbonds}` without an hbonds representation).
+/// caller refuses `{hbonds}` without an hbonds representation), `defects` the vacancies and
+/// interstitials (the caller refuses them without `--wigner-seitz`).
 pub fn label_text(
     parts: &[LabelPart],
     index: usize,
     frame: &Frame,
     file: &str,
     hbonds: usize,
+    defects: Option<(usize, usize)>,
 ) -> Result<String> {
     let missing = |what: &str, placeholder: &str| {
         anyhow::anyhow!(
@@ -333,6 +350,8 @@ pub fn label_text(
             }
             LabelPart::Frame => out.push_str(&index.to_string()),
             LabelPart::HBonds => out.push_str(&hbonds.to_string()),
+            LabelPart::Vacancies => out.push_str(&defects.map_or(0, |d| d.0).to_string()),
+            LabelPart::Interstitials => out.push_str(&defects.map_or(0, |d| d.1).to_string()),
             LabelPart::Title => out.push_str(frame.comment.trim()),
         }
     }
@@ -595,6 +614,10 @@ pub fn mol_plan(args: &MolArgs, style: &StyleArgs, topology: Option<Topology>) -
             },
         }),
         strain: args.strain,
+        wigner_seitz: args.wigner_seitz.map(|w| match w {
+            crate::args::WignerSeitzArg::Sites => texmap_md_scene::WsOutput::Sites,
+            crate::args::WignerSeitzArg::Atoms => texmap_md_scene::WsOutput::Atoms,
+        }),
         computes: args
             .computes
             .iter()
@@ -724,6 +747,7 @@ pub fn mol_error(e: MolError) -> anyhow::Error {
         MolError::Clusters(e) => return anyhow::anyhow!("--clusters: {e}"),
         MolError::Centrosymmetry(e) => format!("--centrosymmetry: {e}"),
         MolError::Strain(e) => return anyhow::anyhow!("--strain: {e}"),
+        MolError::WignerSeitz(e) => return anyhow::anyhow!("--wigner-seitz: {e}"),
         MolError::Compute { name, error } => {
             // The formula parsed; the frame lacks a name it uses: the input's, not usage.
             return anyhow::anyhow!("--compute {name}: {error}");

@@ -64,7 +64,10 @@ impl fmt::Display for WignerSeitzError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             WignerSeitzError::NoSites => {
-                write!(f, "the reference configuration has no atoms to serve as sites")
+                write!(
+                    f,
+                    "the reference configuration has no atoms to serve as sites"
+                )
             }
         }
     }

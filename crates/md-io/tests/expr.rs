@@ -114,3 +114,53 @@ fn functions_ovito_lacks_follow_their_definitions() {
     assert_eq!(eval("1 < 2 == 1"), [1.0, 1.0]);
     assert_eq!(eval("z ? 10 : x ? 20 : 30"), [20.0, 10.0]);
 }
+
+/// Formulas typed wrong in every way (random strings over the language's characters, and
+/// random cuts of valid formulas) are refused or evaluated, never a panic; the values of what
+/// parses have one per atom.
+#[test]
+fn random_formulas_never_panic() {
+    let pieces = [
+        "x", "vx", "c_pe", "index", "N", "pi", "1", "2.5", "1e3", ".5", "+", "-", "*", "/", "^",
+        "<", "<=", "==", "!=", "&&", "||", "!", "?", ":", "(", ")", ",", "sqrt(", "min(", "atan2(",
+        "fmod(", " ", "v_s[1]", "[", "]", "$", "é",
+    ];
+    let valid = "atan2(y - 15, x - 15) * 180 / pi + (c_pe < -3.5 ? 2 : -x^2) && !vx";
+    let mut frame = Frame::new();
+    frame.positions = vec![[1.0, 2.0, 3.0], [0.0, -1.0, 0.5]];
+    frame.velocities = vec![[0.5, 0.0, 0.0]; 2];
+    let mut seed = 11u64;
+    let mut next = |n: usize| {
+        seed = seed
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (seed >> 33) as usize % n
+    };
+    let (mut parsed, mut refused) = (0, 0);
+    for case in 0..20_000 {
+        let text: String = if case % 2 == 0 {
+            (0..1 + next(12))
+                .map(|_| pieces[next(pieces.len())])
+                .collect()
+        } else {
+            let (a, b) = (next(valid.len()), next(valid.len()));
+            valid[a.min(b)..a.max(b)].to_string()
+        };
+        match Expression::parse(&text) {
+            Ok(e) => {
+                parsed += 1;
+                if let Ok(v) = e.evaluate(&frame) {
+                    assert_eq!(v.len(), 2, "{text}");
+                }
+            }
+            Err(e) => {
+                refused += 1;
+                assert!(e.column <= text.chars().count() + 1, "{text}: {e}");
+            }
+        }
+    }
+    assert!(
+        parsed > 1000 && refused > 1000,
+        "{parsed} parsed, {refused} refused"
+    );
+}

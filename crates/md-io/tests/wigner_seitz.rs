@@ -49,7 +49,10 @@ fn every_site_and_atom_is_ovitos() {
     let per_atom: Vec<i64> = sites.iter().map(|&s| occupancy[s as usize]).collect();
     assert_eq!(per_atom, integers(&want["atom_occupancy"]));
     assert_eq!(ws.vacancies as i64, want["vacancies"].as_i64().unwrap());
-    assert_eq!(ws.interstitials as i64, want["interstitials"].as_i64().unwrap());
+    assert_eq!(
+        ws.interstitials as i64,
+        want["interstitials"].as_i64().unwrap()
+    );
     // Six Frenkel pairs, the dumbbell and the replacement sequence (one each), two sputtered.
     assert_eq!((ws.vacancies, ws.interstitials), (10, 8));
 }
@@ -59,7 +62,12 @@ fn the_perfect_crystal_has_no_defects_and_an_empty_reference_is_refused() {
     let reference = read("ref.xyz");
     let ws = wigner_seitz(&reference, &reference).unwrap();
     assert_eq!((ws.vacancies, ws.interstitials), (0, 0));
-    assert!(ws.site.iter().enumerate().all(|(i, s)| *s == Some(i as u32)));
+    assert!(
+        ws.site
+            .iter()
+            .enumerate()
+            .all(|(i, s)| *s == Some(i as u32))
+    );
     let e = wigner_seitz(&Frame::new(), &reference).unwrap_err();
     assert!(e.to_string().contains("no atoms to serve as sites"));
 }

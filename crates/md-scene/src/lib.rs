@@ -108,8 +108,8 @@ pub use plan::{
     Alignment, BALL_AND_STICK_BOND_RADIUS, BALL_AND_STICK_RADIUS_SCALE, BondSource, CENTROSYMMETRY,
     CLUSTER, COORDINATION, CentroOptions, ClusterOptions, D2MIN, DISPLACEMENT, DrawStyle,
     HBOND_COLOR, HBOND_DASHES, HBOND_RADIUS, LICORICE_RADIUS, MolError, MolOptions, MolPlan, Pbc,
-    RepColor, Representation, SHEAR_STRAIN, SelectionRole, Slice, TRAIL_RADIUS, VALENCE_OFFSET,
-    VALENCE_RADIUS, VOLUMETRIC_STRAIN,
+    RepColor, Representation, SHEAR_STRAIN, SITE, SITE_OCCUPANCY, SelectionRole, Slice,
+    TRAIL_RADIUS, VALENCE_OFFSET, VALENCE_RADIUS, VOLUMETRIC_STRAIN, WsOutput,
 };
 pub use scalar::{NAN_COLOR, SCALAR_LEVELS, ScalarColor, ScalarSource};
 pub use style::{

@@ -15,8 +15,9 @@
 //!    [`MolOptions::centrosymmetry`] each atom's [`CENTROSYMMETRY`], and with
 //!    [`MolOptions::strain`] its [`SHEAR_STRAIN`], [`VOLUMETRIC_STRAIN`] and [`D2MIN`] against
 //!    the reference configuration (the first frame built at this step, or the one given to
-//!    [`MolPlan::set_displacement_reference`]); then each of [`MolOptions::computes`], in
-//!    order, as the property it names;
+//!    [`MolPlan::set_displacement_reference`]), with [`MolOptions::wigner_seitz`] its point
+//!    defects ([`WsOutput`]: the atoms with their sites' occupancy, or the sites instead of
+//!    the atoms); then each of [`MolOptions::computes`], in order, as the property it names;
 //!    bonds that still cross the (enlarged) box are dropped, so no stick
 //!    spans it; with [`MolOptions::displacement`] (after the alignment of step 3), each atom's
 //!    distance from the first frame built as the property [`DISPLACEMENT`];
@@ -112,6 +113,7 @@ use texmap_md_io::expr::{ExprError, Expression};
 use texmap_md_io::hbonds::{self, Criteria, HBond, HBondError};
 use texmap_md_io::replicate::ReplicateError;
 use texmap_md_io::strain::StrainError;
+use texmap_md_io::wigner_seitz::WignerSeitzError;
 use texmap_md_io::{
     BOND_AROMATIC, Frame, Property, Selection, SelectionError, Topology, atom_element,
 };
@@ -238,6 +240,12 @@ pub const SHEAR_STRAIN: &str = "shear_strain";
 pub const VOLUMETRIC_STRAIN: &str = "volumetric_strain";
 /// The per-atom non-affine squared displacement (Å²) [`MolOptions::strain`] adds to each frame.
 pub const D2MIN: &str = "d2min";
+/// The per-atom property [`MolOptions::wigner_seitz`] adds: the occupancy of the atom's site
+/// (or, drawing the sites, of the site).
+pub const SITE_OCCUPANCY: &str = "site_occupancy";
+/// The per-atom property [`MolOptions::wigner_seitz`] adds: the index of the atom's site in the
+/// reference (or, drawing the sites, the site's own).
+pub const SITE: &str = "site";
 /// The per-atom property [`MolOptions::displacement`] adds to each frame.
 pub const DISPLACEMENT: &str = "displacement";
 
@@ -285,6 +293,12 @@ pub struct MolOptions {
     /// order (a later formula may use an earlier one's name): OVITO's Compute property
     /// modifier ([`texmap_md_io::expr`]). Each `(name, formula)` sets the property `name`.
     pub computes: Vec<(String, Expression)>,
+    /// Point defects against the reference configuration every frame, after the strain
+    /// (OVITO's Wigner-Seitz defect analysis: [`texmap_md_io::wigner_seitz`]): the reference
+    /// is the first frame built, as it is at this step, or the frame given to
+    /// [`MolPlan::set_displacement_reference`]. [`MolPlan::last_defects`] counts vacancies and
+    /// interstitials; see [`WsOutput`] for what is drawn.
+    pub wigner_seitz: Option<WsOutput>,
     /// Draw every atom with the radius a per-atom property gives (Å; PQR's `radius`, any
     /// column of a dump), as a file's `radius` column is drawn; a value of zero or less, or
     /// not a number, leaves the atom its element's radius. A frame without the property is an
@@ -417,6 +431,7 @@ impl Default for MolOptions {
             centrosymmetry: None,
             strain: None,
             computes: Vec::new(),
+            wigner_seitz: None,
             radius_from: None,
             slice: None,
             align: None,
@@ -439,6 +454,19 @@ pub struct ClusterOptions {
     pub cutoff: f32,
     /// Only these atoms are clustered (the others are in cluster −1); `None`: every atom.
     pub atoms: Option<Selection>,
+}
+
+/// What [`MolOptions::wigner_seitz`] draws.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WsOutput {
+    /// The frame's atoms, each with the properties [`SITE_OCCUPANCY`] (the occupancy of the
+    /// site it sits on: `prop site_occupancy > 1` keeps the interstitial atoms, both atoms of a
+    /// dumbbell) and [`SITE`] (the site's index in the reference).
+    Atoms,
+    /// The reference's sites instead of the atoms (OVITO's default output), each with
+    /// [`SITE_OCCUPANCY`] (the atoms on it: `prop site_occupancy == 0` keeps the vacancies) and
+    /// [`SITE`]; the frame's own atoms, bonds and earlier per-atom properties are not drawn.
+    Sites,
 }
 
 /// [`MolOptions::centrosymmetry`]: the neighbours per atom and which of their pairs count.
@@ -512,6 +540,8 @@ pub enum MolError {
     /// [`MolOptions::strain`] cannot be computed (a frame of other atoms than the reference,
     /// the cutoff, a cell too small for it).
     Strain(StrainError),
+    /// [`MolOptions::wigner_seitz`] has no sites (an empty reference).
+    WignerSeitz(WignerSeitzError),
     /// A formula of [`MolOptions::computes`] names what a frame does not have.
     Compute {
         /// The property it computes.
@@ -561,6 +591,7 @@ impl fmt::Display for MolError {
             MolError::Clusters(e) => write!(f, "clusters: {e}"),
             MolError::Centrosymmetry(e) => write!(f, "centrosymmetry: {e}"),
             MolError::Strain(e) => write!(f, "atomic strain: {e}"),
+            MolError::WignerSeitz(e) => write!(f, "Wigner-Seitz analysis: {e}"),
             MolError::Compute { name, error } => write!(f, "computing '{name}': {error}"),
             MolError::NoRadiusProperty { name, available } => write!(
                 f,
@@ -671,8 +702,11 @@ pub struct MolPlan {
     /// The first frame's positions (for displacements: [`DrawStyle::Arrows`],
     /// [`MolOptions::displacement`]), this frame's arrow vectors and the last frame's arrows.
     arrow_reference: Option<Vec<[f32; 3]>>,
-    /// The reference configuration of [`MolOptions::strain`], as it was before the alignment.
-    strain_reference: Option<Frame>,
+    /// The reference configuration of [`MolOptions::strain`] and
+    /// [`MolOptions::wigner_seitz`], as it was before the alignment.
+    configuration: Option<Frame>,
+    /// The last frame's vacancies and interstitials ([`MolOptions::wigner_seitz`]).
+    last_defects: Option<(usize, usize)>,
     arrow_vectors: Vec<glam::Vec3>,
     arrows: MolMesh,
     arrow_atoms: Vec<glam::Vec3>,
@@ -754,7 +788,8 @@ impl MolPlan {
             polyhedra: MolMesh::default(),
             pairs_listed: false,
             arrow_reference: None,
-            strain_reference: None,
+            configuration: None,
+            last_defects: None,
             arrow_vectors: Vec::new(),
             arrows: MolMesh::default(),
             arrow_atoms: Vec::new(),
@@ -1017,8 +1052,8 @@ impl MolPlan {
             texmap_md_io::replicate::replicate(frame, &mut pairs, n)
                 .map_err(MolError::Replicate)?;
         }
-        if self.options.strain.is_some() {
-            self.strain_reference = Some(frame.clone());
+        if self.options.strain.is_some() || self.options.wigner_seitz.is_some() {
+            self.configuration = Some(frame.clone());
         }
         self.align(frame)?;
         self.arrow_reference = Some(frame.positions.clone());
@@ -1077,16 +1112,47 @@ impl MolPlan {
                 .map_err(MolError::Centrosymmetry)?;
             set_property(frame, CENTROSYMMETRY, values);
         }
+        if (self.options.strain.is_some() || self.options.wigner_seitz.is_some())
+            && self.configuration.is_none()
+        {
+            self.configuration = Some(frame.clone());
+        }
         if let Some(cutoff) = self.options.strain {
-            if self.strain_reference.is_none() {
-                self.strain_reference = Some(frame.clone());
-            }
-            let reference = self.strain_reference.as_ref().expect("set above");
+            let reference = self.configuration.as_ref().expect("set above");
             let s = texmap_md_io::strain::atomic_strain(reference, frame, cutoff)
                 .map_err(MolError::Strain)?;
             set_property(frame, SHEAR_STRAIN, s.shear);
             set_property(frame, VOLUMETRIC_STRAIN, s.volumetric);
             set_property(frame, D2MIN, s.d2min);
+        }
+        self.last_defects = None;
+        if let Some(output) = self.options.wigner_seitz {
+            let reference = self.configuration.as_ref().expect("set above");
+            let ws = texmap_md_io::wigner_seitz::wigner_seitz(reference, frame)
+                .map_err(MolError::WignerSeitz)?;
+            self.last_defects = Some((ws.vacancies, ws.interstitials));
+            let occupancy: Vec<f32> = ws.occupancy.iter().map(|&o| o as f32).collect();
+            match output {
+                WsOutput::Atoms => {
+                    let on_site = |s: &Option<u32>| s.map_or(f32::NAN, |s| occupancy[s as usize]);
+                    set_property(frame, SITE_OCCUPANCY, ws.site.iter().map(on_site).collect());
+                    let index = |s: &Option<u32>| s.map_or(f32::NAN, |s| s as f32);
+                    set_property(frame, SITE, ws.site.iter().map(index).collect());
+                }
+                WsOutput::Sites => {
+                    // The sites take the atoms' place: the reference's atoms at their
+                    // positions, with this frame's time; bonds between the atoms go.
+                    let mut sites = reference.clone();
+                    sites.time = frame.time;
+                    sites.step = frame.step;
+                    sites.comment = std::mem::take(&mut frame.comment);
+                    set_property(&mut sites, SITE_OCCUPANCY, occupancy);
+                    let index = (0..sites.n_atoms()).map(|i| i as f32).collect();
+                    set_property(&mut sites, SITE, index);
+                    *frame = sites;
+                    self.pairs.clear();
+                }
+            }
         }
         for (name, formula) in &self.options.computes {
             let values = formula.evaluate(frame).map_err(|error| MolError::Compute {
@@ -1307,6 +1373,12 @@ impl MolPlan {
         &self.hbonds
     }
 
+    /// The last frame's vacancies and interstitials ([`MolOptions::wigner_seitz`]; `None`
+    /// without it).
+    pub fn last_defects(&self) -> Option<(usize, usize)> {
+        self.last_defects
+    }
+
     /// The last frame's measurements ([`MolOptions::measures`], in order): points, values and
     /// where their labels go.
     pub fn last_measurements(&self) -> &[Measured] {
@@ -1400,6 +1472,7 @@ impl MolPlan {
     pub fn measures_displacements(&self) -> bool {
         self.options.displacement
             || self.options.strain.is_some()
+            || self.options.wigner_seitz.is_some()
             || (self.draws_arrows() && self.options.arrows.source == ArrowSource::Displacement)
     }
 
