@@ -50,13 +50,15 @@ pub enum TerrainCmd {
         /// The contour lines' width in texels of the finest texture level.
         #[arg(long, value_name = "TEXELS", default_value_t = 1.5)]
         contour_width: f32,
-        /// Draw a GeoJSON file's points, lines and polygons into the texture (roads, rivers,
-        /// boundaries, sites; repeat for several layers, drawn in order). RFC 7946 GeoJSON in
-        /// WGS 84 degrees, a GeoJSON text sequence, or GeoJSON with a "crs" member in UTM or Web
-        /// Mercator (ogr2ogr -f GeoJSON -t_srs EPSG:4326 converts a shapefile or a GeoPackage).
-        /// Features are coloured by their simplestyle properties (stroke, stroke-width, fill,
-        /// fill-opacity, marker-color, marker-size) where they have them; without --photo the
-        /// texture is the shaded relief.
+        /// Draw a vector layer's points, lines and polygons into the texture (roads, rivers,
+        /// boundaries, sites; repeat for several layers, drawn in order): an ESRI shapefile
+        /// (x.shp, placed by the x.prj beside it: degrees, UTM or Web Mercator of WGS 84, ETRS89
+        /// or NAD83), RFC 7946 GeoJSON in WGS 84 degrees, a GeoJSON text sequence, or GeoJSON
+        /// with a "crs" member in UTM or Web Mercator (ogr2ogr -f GeoJSON -t_srs EPSG:4326
+        /// converts a GeoPackage or another system). GeoJSON features are coloured by their
+        /// simplestyle properties (stroke, stroke-width, fill, fill-opacity, marker-color,
+        /// marker-size) where they have them, shapefile features by --overlay-style; without
+        /// --photo the texture is the shaded relief.
         #[arg(long, value_name = "FILE")]
         overlay: Vec<PathBuf>,
         /// The overlays' style where a feature sets none: simplestyle keys, e.g.
@@ -249,7 +251,7 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
             };
             let overlays = overlay
                 .iter()
-                .map(texmap_terrain::vector::read_geojson)
+                .map(texmap_terrain::vector::read_vector)
                 .collect::<Result<Vec<_>, _>>()?;
             let photo = photo
                 .map(|p| texmap_terrain::photo::open_photo(&p, bands))

@@ -85,6 +85,7 @@ pub mod photo;
 pub mod qmesh;
 pub mod relief;
 pub mod rtin;
+pub mod shapefile;
 pub mod stream;
 pub mod tiles3d;
 pub mod track;

@@ -266,6 +266,20 @@ impl Style {
     }
 }
 
+/// Read a vector layer: an ESRI shapefile (`.shp`, [`crate::shapefile`]) or GeoJSON in any of
+/// the forms of the module docs.
+pub fn read_vector(path: impl AsRef<Path>) -> Result<VectorLayer, TerrainError> {
+    let path = path.as_ref();
+    let shp = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("shp"));
+    if shp {
+        crate::shapefile::read_shapefile(path)
+    } else {
+        read_geojson(path)
+    }
+}
+
 /// Read a GeoJSON file (see the module docs for the forms read).
 pub fn read_geojson(path: impl AsRef<Path>) -> Result<VectorLayer, TerrainError> {
     let path = path.as_ref();
@@ -506,6 +520,12 @@ fn layer_crs(v: &Value) -> Result<LayerCrs, String> {
             "a \"crs\" naming an EPSG code (\"urn:ogc:def:crs:EPSG::4326\" or \"EPSG:32633\"), found {v}"
         )
     })?;
+    layer_crs_of_epsg(code)
+}
+
+/// The layer system of an EPSG code (900913, the old Web Mercator code, as 3857), or why it is
+/// not one texmap places.
+pub(crate) fn layer_crs_of_epsg(code: u32) -> Result<LayerCrs, String> {
     let code = if code == 900913 { 3857 } else { code };
     let epsg = u16::try_from(code).ok();
     let georef = |crs| Georef {
