@@ -251,6 +251,43 @@ fn overlay_and_track_readers_survive_the_campaign() {
     report.push_str(&t.report());
     assert!(t.failures.is_empty(), "{}", t.report());
 
+    // Shapefiles: the geometry parsed, placed as the UTM layer its .prj names, drawn.
+    let fx: Vec<Fixture> = [
+        "shp_utm_area.shp",
+        "shp_z_area.shp",
+        "shp_utm_line.shp",
+        "shp_utm_point.shp",
+    ]
+    .iter()
+    .map(|n| unchecked(fixture(n, data(n), vec![], false)))
+    .collect();
+    let utm = vector::read_vector(
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/shp_utm_line.shp"),
+    )
+    .unwrap()
+    .crs;
+    let t = run_campaign("shapefile", &fx, &settings, &|f, bytes| {
+        let features = match texmap_terrain::shapefile::parse_shp(bytes, &f.name) {
+            Ok(l) => l,
+            Err(e) => return located(e.to_string(), &f.name, "parse"),
+        };
+        let layer = vector::VectorLayer {
+            source: f.name.clone(),
+            crs: utm,
+            features,
+        };
+        match Overlay::place(&[layer], &Style::default(), &grid, 128, 64) {
+            Ok(o) => {
+                let mut m = image::RgbaImage::new(64, 64);
+                o.draw(1, 1, &mut m);
+                Verdict::Ok { frames: 1 }
+            }
+            Err(e) => located(e.to_string(), &f.name, "place"),
+        }
+    });
+    report.push_str(&t.report());
+    assert!(t.failures.is_empty(), "{}", t.report());
+
     let fx: Vec<Fixture> = ["track_gpxpy.gpx", "track_ogr.gpx", "track_aerofiles.igc"]
         .iter()
         .map(|n| text(n))
