@@ -1073,6 +1073,12 @@ pub struct MolArgs {
     /// Repeatable, evaluated in order after the analyses (--coordination, --strain, ...).
     #[arg(long = "compute", value_name = "NAME=FORMULA")]
     pub computes: Vec<String>,
+    /// Keep a per-atom number at its value in the first frame drawn, as OVITO's Freeze
+    /// property: colours then follow the atoms. --compute 'x0=x' --freeze x0 --color-by x0
+    /// colours a crystal by where each atom started (shear, mixing, diffusion);
+    /// --freeze coordination keeps the first frame's counts. After --compute. Repeatable.
+    #[arg(long = "freeze", value_name = "NAME")]
+    pub freeze: Vec<String>,
     /// Point defects, as OVITO's Wigner-Seitz defect analysis (radiation damage, diffusion):
     /// each atom is counted on the nearest site of the reference configuration (the first frame
     /// drawn, or --displacement-reference: the perfect crystal), giving the per-atom numbers

@@ -614,6 +614,7 @@ pub fn mol_plan(args: &MolArgs, style: &StyleArgs, topology: Option<Topology>) -
             },
         }),
         strain: args.strain,
+        freeze: args.freeze.clone(),
         wigner_seitz: args.wigner_seitz.map(|w| match w {
             crate::args::WignerSeitzArg::Sites => texmap_md_scene::WsOutput::Sites,
             crate::args::WignerSeitzArg::Atoms => texmap_md_scene::WsOutput::Atoms,
@@ -753,6 +754,9 @@ pub fn mol_error(e: MolError) -> anyhow::Error {
             return anyhow::anyhow!("--compute {name}: {error}");
         }
         MolError::NoRadiusProperty { .. } => return anyhow::anyhow!("--radius-from: {e}"),
+        MolError::NoFreezeProperty { .. } | MolError::FreezeAtoms { .. } => {
+            return anyhow::anyhow!("--freeze: {e}");
+        }
         MolError::BadSlice => format!("--slice: {e}"),
         MolError::Replicate(e) => {
             // A frame without a cell, or too many atoms for the copies: the input's limit.

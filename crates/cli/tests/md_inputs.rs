@@ -3512,3 +3512,66 @@ fn wigner_seitz_finds_ovitos_defects() {
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("add --wigner-seitz"), "{}", stderr(&o));
 }
+
+/// `--freeze`: over a trajectory of md-io's strain fixture (a copper slab, then the same atoms
+/// sheared and wrapped), `--compute 'x0=x' --freeze x0 --select 'prop x0 < 11'` keeps, in both
+/// frames, the atoms whose x was below 11 Å in the first, which the test reads from the file
+/// itself: the pictures are those of the same atoms selected by index, byte for byte. Without
+/// `--freeze` the second frame's selection follows the atoms' new x, and differs. A frozen name
+/// the frame lacks is an error naming what it has.
+#[test]
+fn frozen_properties_follow_the_atoms() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = Path::new(env!("CARGO_MANIFEST_DIR")).join("../md-io/tests/data/strain");
+    let first = std::fs::read_to_string(base.join("ref.xyz")).unwrap();
+    let both = dir.path().join("both.xyz");
+    std::fs::write(
+        &both,
+        first.clone() + &std::fs::read_to_string(base.join("cur.xyz")).unwrap(),
+    )
+    .unwrap();
+    let both = both.to_string_lossy().into_owned();
+    let xs: Vec<f64> = first
+        .lines()
+        .skip(2)
+        .map(|l| l.split_whitespace().nth(1).unwrap().parse().unwrap())
+        .collect();
+    assert!(xs.iter().all(|x| (x - 11.0).abs() > 1e-3));
+    let picked: Vec<String> = (0..xs.len())
+        .filter(|&i| xs[i] < 11.0)
+        .map(|i| i.to_string())
+        .collect();
+    assert!(picked.len() > 200 && picked.len() < xs.len() / 2);
+    let render = |extra: &[&str], stem: &str| {
+        let out = dir.path().join(format!("{stem}%d.png"));
+        let mut args = vec!["render", both.as_str(), "--size", "160x120", "-q"];
+        args.extend_from_slice(extra);
+        args.extend(["-o", out.to_str().unwrap()]);
+        let o = texmap(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        [0, 1].map(|k| std::fs::read(dir.path().join(format!("{stem}{k}.png"))).unwrap())
+    };
+    let frozen = render(
+        &[
+            "--compute",
+            "x0=x",
+            "--freeze",
+            "x0",
+            "--select",
+            "prop x0 < 11",
+        ],
+        "frozen",
+    );
+    let by_index = format!("index {}", picked.join(" "));
+    assert_eq!(frozen, render(&["--select", &by_index], "index"));
+    let moving = render(&["--compute", "x0=x", "--select", "prop x0 < 11"], "moving");
+    assert_eq!(moving[0], frozen[0]);
+    assert_ne!(moving[1], frozen[1]);
+    let o = texmap(&["render", &both, "--freeze", "x0", "-o", "x.png"]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("--freeze: freezing 'x0'"),
+        "{}",
+        stderr(&o)
+    );
+}

@@ -17,7 +17,8 @@
 //!    the reference configuration (the first frame built at this step, or the one given to
 //!    [`MolPlan::set_displacement_reference`]), with [`MolOptions::wigner_seitz`] its point
 //!    defects ([`WsOutput`]: the atoms with their sites' occupancy, or the sites instead of
-//!    the atoms); then each of [`MolOptions::computes`], in order, as the property it names;
+//!    the atoms); then each of [`MolOptions::computes`], in order, as the property it names,
+//!    and [`MolOptions::freeze`]'s properties set to their values at the first frame built;
 //!    bonds that still cross the (enlarged) box are dropped, so no stick
 //!    spans it; with [`MolOptions::displacement`] (after the alignment of step 3), each atom's
 //!    distance from the first frame built as the property [`DISPLACEMENT`];
@@ -299,6 +300,11 @@ pub struct MolOptions {
     /// [`MolPlan::set_displacement_reference`]. [`MolPlan::last_defects`] counts vacancies and
     /// interstitials; see [`WsOutput`] for what is drawn.
     pub wigner_seitz: Option<WsOutput>,
+    /// Per-atom properties frozen at the first frame built (OVITO's Freeze property), after
+    /// [`MolOptions::computes`]: every later frame gets the values the first had, atom by atom,
+    /// so that colours follow the atoms (a crystal coloured by where each atom started shows
+    /// how it deformed or mixed: compute `x0 = x`, freeze `x0`, colour by it).
+    pub freeze: Vec<String>,
     /// Draw every atom with the radius a per-atom property gives (Å; PQR's `radius`, any
     /// column of a dump), as a file's `radius` column is drawn; a value of zero or less, or
     /// not a number, leaves the atom its element's radius. A frame without the property is an
@@ -432,6 +438,7 @@ impl Default for MolOptions {
             strain: None,
             computes: Vec::new(),
             wigner_seitz: None,
+            freeze: Vec::new(),
             radius_from: None,
             slice: None,
             align: None,
@@ -549,6 +556,20 @@ pub enum MolError {
         /// Why.
         error: ExprError,
     },
+    /// [`MolOptions::freeze`] names a property the first frame does not have.
+    NoFreezeProperty {
+        name: String,
+        /// The frame's per-atom properties.
+        available: Vec<String>,
+    },
+    /// A frame holds another number of atoms than the first, whose values are frozen.
+    FreezeAtoms {
+        name: String,
+        /// Atoms of the first frame.
+        first: usize,
+        /// Atoms of this frame.
+        frame: usize,
+    },
     /// [`MolOptions::radius_from`] names a property a frame does not have.
     NoRadiusProperty {
         name: String,
@@ -592,6 +613,19 @@ impl fmt::Display for MolError {
             MolError::Centrosymmetry(e) => write!(f, "centrosymmetry: {e}"),
             MolError::Strain(e) => write!(f, "atomic strain: {e}"),
             MolError::WignerSeitz(e) => write!(f, "Wigner-Seitz analysis: {e}"),
+            MolError::NoFreezeProperty { name, available } => write!(
+                f,
+                "freezing '{name}': the first frame has no such per-atom property ({})",
+                if available.is_empty() {
+                    "it has none".to_string()
+                } else {
+                    format!("it has {}", available.join(", "))
+                }
+            ),
+            MolError::FreezeAtoms { name, first, frame } => write!(
+                f,
+                "freezing '{name}': the first frame has {first} atoms and this one {frame}"
+            ),
             MolError::Compute { name, error } => write!(f, "computing '{name}': {error}"),
             MolError::NoRadiusProperty { name, available } => write!(
                 f,
@@ -707,6 +741,8 @@ pub struct MolPlan {
     configuration: Option<Frame>,
     /// The last frame's vacancies and interstitials ([`MolOptions::wigner_seitz`]).
     last_defects: Option<(usize, usize)>,
+    /// The values of [`MolOptions::freeze`]'s properties at the first frame built.
+    frozen: Vec<Vec<f32>>,
     arrow_vectors: Vec<glam::Vec3>,
     arrows: MolMesh,
     arrow_atoms: Vec<glam::Vec3>,
@@ -790,6 +826,7 @@ impl MolPlan {
             arrow_reference: None,
             configuration: None,
             last_defects: None,
+            frozen: Vec::new(),
             arrow_vectors: Vec::new(),
             arrows: MolMesh::default(),
             arrow_atoms: Vec::new(),
@@ -1160,6 +1197,26 @@ impl MolPlan {
                 error,
             })?;
             set_property(frame, name, values);
+        }
+        for (k, name) in self.options.freeze.iter().enumerate() {
+            if self.frozen.len() <= k {
+                let Some(values) = frame.property(name) else {
+                    return Err(MolError::NoFreezeProperty {
+                        name: name.clone(),
+                        available: frame.properties.iter().map(|p| p.name.clone()).collect(),
+                    });
+                };
+                self.frozen.push(values.to_vec());
+            }
+            let values = &self.frozen[k];
+            if values.len() != frame.n_atoms() {
+                return Err(MolError::FreezeAtoms {
+                    name: name.clone(),
+                    first: values.len(),
+                    frame: frame.n_atoms(),
+                });
+            }
+            set_property(frame, name, values.clone());
         }
         if let Some(name) = &self.options.radius_from {
             let Some(values) = frame.property(name) else {
