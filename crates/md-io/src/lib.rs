@@ -35,7 +35,8 @@
 //!   [`coordination`] counts each atom's neighbours within a cutoff (and groups them into
 //!   clusters), [`cna`] classifies its crystal structure, [`centrosymmetry`] measures how far
 //!   its neighbours are from opposite pairs and [`strain`] its local deformation against a
-//!   reference configuration, [`wigner_seitz`] its vacancies and interstitials, as OVITO's
+//!   reference configuration, [`wigner_seitz`] its vacancies and interstitials, [`voronoi`] its Voronoi
+//!   cell (volume, coordination, index), as OVITO's
 //!   analyses do, and [`expr`] computes a number per atom
 //!   from a formula (OVITO's Compute property); [`hbonds`] finds hydrogen bonds by
 //!   MDAnalysis's geometric criterion.
@@ -158,6 +159,7 @@ mod trr;
 pub mod values;
 mod vasp;
 pub mod volume;
+pub mod voronoi;
 pub mod wigner_seitz;
 mod writer;
 mod xsf;
