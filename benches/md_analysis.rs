@@ -5,6 +5,7 @@
 //! - adaptive CNA (`cna::classify`);
 //! - centrosymmetry from 12 neighbours, conventional and minimum-weight matching;
 //! - atomic strain at a 3.0 Å cutoff (neighbour pairs, F, shear, volumetric, D²min);
+//! - Voronoi cells (volume, faces, index);
 //! - coordination at 3.0 Å.
 //!
 //! Both configurations are written to `target/md_analysis_{ref,cur}.xyz` (extended XYZ) for
@@ -18,7 +19,7 @@ use std::io::Write;
 
 use criterion::{Criterion, criterion_group};
 use texmap::md_io::centrosymmetry::{CspMode, centrosymmetry};
-use texmap::md_io::{Frame, UnitCell, cna, coordination, strain};
+use texmap::md_io::{Frame, UnitCell, cna, coordination, strain, voronoi};
 
 struct Lcg(u64);
 impl Lcg {
@@ -109,6 +110,13 @@ fn bench(c: &mut Criterion) {
     let s = strain::atomic_strain(&reference, &current, 3.0).unwrap();
     let mean = s.shear.iter().map(|v| *v as f64).sum::<f64>() / atoms as f64;
     assert!((mean - 0.015).abs() < 0.01, "mean shear strain {mean}");
+    let cells = voronoi::voronoi(&reference).unwrap();
+    let total: f64 = cells.volume.iter().map(|v| *v as f64).sum();
+    let box_volume = reference.cell.unwrap().volume();
+    assert!(
+        (total - box_volume).abs() < 1e-4 * box_volume,
+        "{total} of {box_volume}"
+    );
 
     let mut g = c.benchmark_group("md_analysis");
     g.sample_size(10);
@@ -136,6 +144,9 @@ fn bench(c: &mut Criterion) {
                 .shear
                 .len()
         })
+    });
+    g.bench_function(format!("voronoi_{atoms}"), |b| {
+        b.iter(|| voronoi::voronoi(&reference).unwrap().volume.len())
     });
     g.bench_function(format!("coordination_{atoms}"), |b| {
         b.iter(|| coordination::coordination(&reference, 3.0).unwrap().len())

@@ -19,7 +19,8 @@ os.environ["OVITO_THREAD_COUNT"] = str(threads)
 import ovito  # noqa: E402
 from ovito.io import import_file  # noqa: E402
 from ovito.modifiers import (AtomicStrainModifier, CentroSymmetryModifier,  # noqa: E402
-                             CommonNeighborAnalysisModifier, CoordinationAnalysisModifier)
+                             CommonNeighborAnalysisModifier, CoordinationAnalysisModifier,
+                             VoronoiAnalysisModifier)
 from ovito.pipeline import Pipeline, StaticSource  # noqa: E402
 
 here = os.path.dirname(os.path.abspath(__file__))
@@ -55,4 +56,5 @@ timed("centrosymmetry_conventional", reference_data,
 timed("centrosymmetry_matching", reference_data,
       lambda: CentroSymmetryModifier(num_neighbors=12, mode=CentroSymmetryModifier.Mode.Matching))
 timed("strain", current_data, strain)
+timed("voronoi", reference_data, lambda: VoronoiAnalysisModifier(compute_indices=True))
 timed("coordination", reference_data, lambda: CoordinationAnalysisModifier(cutoff=3.0))

@@ -1093,6 +1093,13 @@ pub struct MolArgs {
     /// vacancies, interstitials. Written whole or not at all.
     #[arg(long, value_name = "FILE.csv", requires = "wigner_seitz")]
     pub defect_table: Option<PathBuf>,
+    /// Every atom's Voronoi cell every frame, as OVITO's Voronoi analysis: the per-atom numbers
+    /// 'voronoi_volume' (Å³), 'voronoi_faces' (the Voronoi coordination) and 'voronoi_n3' ..
+    /// 'voronoi_n6' (faces with 3 to 6 edges: the Voronoi index). --select 'prop voronoi_n5 ==
+    /// 12 and prop voronoi_faces == 12' keeps the icosahedral atoms of a metallic glass,
+    /// --color-by voronoi_volume shows free volume. Needs a periodic cell.
+    #[arg(long)]
+    pub voronoi: bool,
     /// Draw each atom with the radius (Å) a per-atom property gives: PQR's 'radius'
     /// (PDB2PQR/APBS radii), any dump column (texmap info lists them), --property FILE's
     /// numbers. As a file's radius column: --radius-scale does not apply, ball-and-stick

@@ -615,6 +615,7 @@ pub fn mol_plan(args: &MolArgs, style: &StyleArgs, topology: Option<Topology>) -
         }),
         strain: args.strain,
         freeze: args.freeze.clone(),
+        voronoi: args.voronoi,
         wigner_seitz: args.wigner_seitz.map(|w| match w {
             crate::args::WignerSeitzArg::Sites => texmap_md_scene::WsOutput::Sites,
             crate::args::WignerSeitzArg::Atoms => texmap_md_scene::WsOutput::Atoms,
@@ -749,6 +750,7 @@ pub fn mol_error(e: MolError) -> anyhow::Error {
         MolError::Centrosymmetry(e) => format!("--centrosymmetry: {e}"),
         MolError::Strain(e) => return anyhow::anyhow!("--strain: {e}"),
         MolError::WignerSeitz(e) => return anyhow::anyhow!("--wigner-seitz: {e}"),
+        MolError::Voronoi(e) => return anyhow::anyhow!("--voronoi: {e}"),
         MolError::Compute { name, error } => {
             // The formula parsed; the frame lacks a name it uses: the input's, not usage.
             return anyhow::anyhow!("--compute {name}: {error}");

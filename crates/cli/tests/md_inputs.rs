@@ -3575,3 +3575,51 @@ fn frozen_properties_follow_the_atoms() {
         stderr(&o)
     );
 }
+
+/// `--voronoi`: on md-io's Voronoi fixture (a dense disordered packing OVITO wrote, with OVITO's
+/// Voronoi analysis), the atoms `--select 'prop voronoi_faces >= 15'` draws are OVITO's atoms
+/// with 15 faces or more, byte for byte; a frame without a periodic cell is refused.
+#[test]
+fn voronoi_selects_ovitos_atoms() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = Path::new(env!("CARGO_MANIFEST_DIR")).join("../md-io/tests/data/voronoi");
+    let file = base.join("glass.xyz").to_string_lossy().into_owned();
+    let v: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(base.join("voronoi_reference.json")).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(v[1]["file"], "glass.xyz");
+    let many: Vec<String> = v[1]["faces"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .enumerate()
+        .filter(|(_, f)| f.as_u64().unwrap() >= 15)
+        .map(|(i, _)| i.to_string())
+        .collect();
+    assert!(many.len() > 100 && many.len() < 600, "{}", many.len());
+    let render = |extra: &[&str], out: &str| {
+        let out = dir.path().join(out);
+        let mut args = vec!["render", file.as_str(), "--size", "160x120", "-q"];
+        args.extend_from_slice(extra);
+        args.extend(["-o", out.to_str().unwrap()]);
+        let o = texmap(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        std::fs::read(out).unwrap()
+    };
+    let ours = render(
+        &["--voronoi", "--select", "prop voronoi_faces >= 15"],
+        "ours.png",
+    );
+    let by_index = format!("index {}", many.join(" "));
+    assert_eq!(ours, render(&["--select", &by_index], "ovito.png"));
+    let open = dir.path().join("open.xyz");
+    std::fs::write(&open, "2\nno cell\nAr 0 0 0\nAr 3 0 0\n").unwrap();
+    let o = texmap(&["render", open.to_str().unwrap(), "--voronoi", "-o", "x.png"]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("--voronoi: the frame has no periodic cell"),
+        "{}",
+        stderr(&o)
+    );
+}

@@ -226,7 +226,7 @@ impl<'a> Grid<'a> {
                     let v = match self.cell {
                         Some(_) => {
                             let d = self.frac[j] - DVec3::from(q);
-                            (self.edges * (d - d.round())).to_array()
+                            (self.edges * (d - round(d))).to_array()
                         }
                         None => [0, 1, 2].map(|a| self.positions[j][a] as f64 - p[a]),
                     };
@@ -257,7 +257,7 @@ impl<'a> Grid<'a> {
                 // The fractional difference rounded to the nearest image, as
                 // `pbc::minimum_image` does, from the fractional coordinates kept.
                 let d = self.frac[j] - self.frac[i];
-                (self.edges * (d - d.round())).to_array()
+                (self.edges * (d - round(d))).to_array()
             }
             None => [0, 1, 2].map(|a| self.positions[j][a] as f64 - self.positions[i][a] as f64),
         }
@@ -331,4 +331,12 @@ impl<'a> Grid<'a> {
         }
         Some((c[2] * self.dims[1] + c[1]) * self.dims[0] + c[0])
     }
+}
+
+/// Each component rounded to the nearest integer (ties to even) without a libm call: adding and
+/// subtracting 1.5 · 2⁵² leaves no fractional bits (fractional coordinate differences are far
+/// below 2⁵¹).
+fn round(d: DVec3) -> DVec3 {
+    const MAGIC: f64 = 6_755_399_441_055_744.0;
+    (d + MAGIC) - MAGIC
 }

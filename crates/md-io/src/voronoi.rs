@@ -103,18 +103,25 @@ pub fn voronoi(frame: &Frame) -> Result<Voronoi, VoronoiError> {
         .map_init(
             || (Scratch::default(), Cell::default()),
             |(scratch, cell), i| {
-                let mut k = 32.min(n - 1);
+                let mut k = 24.min(n - 1);
                 loop {
                     grid.nearest(i, k, scratch);
                     let near = &scratch.near;
                     let reach = near.last().map_or(f64::INFINITY, |x| x.1);
                     cell.reset(reach.max(1e-3));
+                    let mut complete = false;
                     for (v, d) in near.iter() {
+                        // Nearest first: once a plane lies beyond the cell's farthest vertex,
+                        // so do all the others.
+                        if 0.5 * d > cell.radius() {
+                            complete = true;
+                            break;
+                        }
                         if *d > 0.0 {
                             cell.clip(DVec3::from(*v) / *d, 0.5 * d);
                         }
                     }
-                    let complete = cell.radius() * 2.0 < reach;
+                    let complete = complete || cell.radius() * 2.0 < reach;
                     if complete || k >= (n - 1).min(MAX_NEIGHBOURS) {
                         return cell.measure();
                     }
@@ -140,7 +147,9 @@ struct Cell {
     faces: Vec<(Vec<usize>, f64)>,
     // Scratch.
     side: Vec<i8>,
-    cut: std::collections::HashMap<(usize, usize), usize>,
+    /// The edges cut by the current plane (lower vertex, higher vertex) and the new vertex on
+    /// each: a handful per plane, searched in order.
+    cut: Vec<(usize, usize, usize)>,
     on_plane: Vec<usize>,
     next_faces: Vec<(Vec<usize>, f64)>,
 }
@@ -206,15 +215,20 @@ impl Cell {
                     }
                 }
                 if (sa < 0 && sb > 0) || (sa > 0 && sb < 0) {
-                    let key = (a.min(b), a.max(b));
-                    let vertices = &mut self.vertices;
-                    let index = *self.cut.entry(key).or_insert_with(|| {
-                        let (pa, pb) = (vertices[a], vertices[b]);
-                        let (da, db) = (normal.dot(pa) - h, normal.dot(pb) - h);
-                        let t = da / (da - db);
-                        vertices.push(pa + (pb - pa) * t);
-                        vertices.len() - 1
-                    });
+                    let (lo, hi) = (a.min(b), a.max(b));
+                    let index = match self.cut.iter().find(|c| c.0 == lo && c.1 == hi) {
+                        Some(c) => c.2,
+                        None => {
+                            // From the lower vertex, so both faces get the same point.
+                            let (pa, pb) = (self.vertices[lo], self.vertices[hi]);
+                            let (da, db) = (normal.dot(pa) - h, normal.dot(pb) - h);
+                            let t = da / (da - db);
+                            self.vertices.push(pa + (pb - pa) * t);
+                            let index = self.vertices.len() - 1;
+                            self.cut.push((lo, hi, index));
+                            index
+                        }
+                    };
                     kept.push(index);
                     self.on_plane.push(index);
                 }
@@ -236,9 +250,18 @@ impl Cell {
             let u = normal.any_orthonormal_vector();
             let w = normal.cross(u);
             let vertices = &self.vertices;
+            // A pseudo-angle in [0, 4), increasing with the angle (no trigonometry).
             let angle = |v: usize| {
                 let d = vertices[v] - centre;
-                d.dot(w).atan2(d.dot(u))
+                let (x, y) = (d.dot(u), d.dot(w));
+                let p = y / (x.abs() + y.abs()).max(f64::MIN_POSITIVE);
+                if x < 0.0 {
+                    2.0 - p
+                } else if y < 0.0 {
+                    4.0 + p
+                } else {
+                    p
+                }
             };
             let mut ring = self.on_plane.clone();
             // Counter-clockwise about the outward normal.

@@ -109,7 +109,8 @@ pub use plan::{
     CLUSTER, COORDINATION, CentroOptions, ClusterOptions, D2MIN, DISPLACEMENT, DrawStyle,
     HBOND_COLOR, HBOND_DASHES, HBOND_RADIUS, LICORICE_RADIUS, MolError, MolOptions, MolPlan, Pbc,
     RepColor, Representation, SHEAR_STRAIN, SITE, SITE_OCCUPANCY, SelectionRole, Slice,
-    TRAIL_RADIUS, VALENCE_OFFSET, VALENCE_RADIUS, VOLUMETRIC_STRAIN, WsOutput,
+    TRAIL_RADIUS, VALENCE_OFFSET, VALENCE_RADIUS, VOLUMETRIC_STRAIN, VORONOI_FACES, VORONOI_INDEX,
+    VORONOI_VOLUME, WsOutput,
 };
 pub use scalar::{NAN_COLOR, SCALAR_LEVELS, ScalarColor, ScalarSource};
 pub use style::{

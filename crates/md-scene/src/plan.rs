@@ -17,7 +17,8 @@
 //!    the reference configuration (the first frame built at this step, or the one given to
 //!    [`MolPlan::set_displacement_reference`]), with [`MolOptions::wigner_seitz`] its point
 //!    defects ([`WsOutput`]: the atoms with their sites' occupancy, or the sites instead of
-//!    the atoms); then each of [`MolOptions::computes`], in order, as the property it names,
+//!    the atoms), with [`MolOptions::voronoi`] each atom's Voronoi cell; then each of
+//!    [`MolOptions::computes`], in order, as the property it names,
 //!    and [`MolOptions::freeze`]'s properties set to their values at the first frame built;
 //!    bonds that still cross the (enlarged) box are dropped, so no stick
 //!    spans it; with [`MolOptions::displacement`] (after the alignment of step 3), each atom's
@@ -114,6 +115,7 @@ use texmap_md_io::expr::{ExprError, Expression};
 use texmap_md_io::hbonds::{self, Criteria, HBond, HBondError};
 use texmap_md_io::replicate::ReplicateError;
 use texmap_md_io::strain::StrainError;
+use texmap_md_io::voronoi::VoronoiError;
 use texmap_md_io::wigner_seitz::WignerSeitzError;
 use texmap_md_io::{
     BOND_AROMATIC, Frame, Property, Selection, SelectionError, Topology, atom_element,
@@ -247,6 +249,12 @@ pub const SITE_OCCUPANCY: &str = "site_occupancy";
 /// The per-atom property [`MolOptions::wigner_seitz`] adds: the index of the atom's site in the
 /// reference (or, drawing the sites, the site's own).
 pub const SITE: &str = "site";
+/// The per-atom Voronoi cell volume (Å³) [`MolOptions::voronoi`] adds.
+pub const VORONOI_VOLUME: &str = "voronoi_volume";
+/// The per-atom Voronoi face count (the Voronoi coordination) [`MolOptions::voronoi`] adds.
+pub const VORONOI_FACES: &str = "voronoi_faces";
+/// The per-atom counts of Voronoi faces with 3, 4, 5 and 6 edges [`MolOptions::voronoi`] adds.
+pub const VORONOI_INDEX: [&str; 4] = ["voronoi_n3", "voronoi_n4", "voronoi_n5", "voronoi_n6"];
 /// The per-atom property [`MolOptions::displacement`] adds to each frame.
 pub const DISPLACEMENT: &str = "displacement";
 
@@ -300,6 +308,11 @@ pub struct MolOptions {
     /// [`MolPlan::set_displacement_reference`]. [`MolPlan::last_defects`] counts vacancies and
     /// interstitials; see [`WsOutput`] for what is drawn.
     pub wigner_seitz: Option<WsOutput>,
+    /// Every atom's Voronoi cell every frame, after the Wigner–Seitz analysis (OVITO's Voronoi
+    /// analysis: [`texmap_md_io::voronoi`]), as the properties [`VORONOI_VOLUME`],
+    /// [`VORONOI_FACES`] and [`VORONOI_INDEX`] (`prop voronoi_n5 == 12 and prop voronoi_faces
+    /// == 12`: the icosahedra of a metallic glass). Needs a periodic cell.
+    pub voronoi: bool,
     /// Per-atom properties frozen at the first frame built (OVITO's Freeze property), after
     /// [`MolOptions::computes`]: every later frame gets the values the first had, atom by atom,
     /// so that colours follow the atoms (a crystal coloured by where each atom started shows
@@ -438,6 +451,7 @@ impl Default for MolOptions {
             strain: None,
             computes: Vec::new(),
             wigner_seitz: None,
+            voronoi: false,
             freeze: Vec::new(),
             radius_from: None,
             slice: None,
@@ -547,6 +561,8 @@ pub enum MolError {
     /// [`MolOptions::strain`] cannot be computed (a frame of other atoms than the reference,
     /// the cutoff, a cell too small for it).
     Strain(StrainError),
+    /// [`MolOptions::voronoi`] on a frame without a periodic cell, or with bad atoms.
+    Voronoi(VoronoiError),
     /// [`MolOptions::wigner_seitz`] has no sites (an empty reference).
     WignerSeitz(WignerSeitzError),
     /// A formula of [`MolOptions::computes`] names what a frame does not have.
@@ -613,6 +629,7 @@ impl fmt::Display for MolError {
             MolError::Centrosymmetry(e) => write!(f, "centrosymmetry: {e}"),
             MolError::Strain(e) => write!(f, "atomic strain: {e}"),
             MolError::WignerSeitz(e) => write!(f, "Wigner-Seitz analysis: {e}"),
+            MolError::Voronoi(e) => write!(f, "Voronoi analysis: {e}"),
             MolError::NoFreezeProperty { name, available } => write!(
                 f,
                 "freezing '{name}': the first frame has no such per-atom property ({})",
@@ -1189,6 +1206,18 @@ impl MolPlan {
                     *frame = sites;
                     self.pairs.clear();
                 }
+            }
+        }
+        if self.options.voronoi {
+            let v = texmap_md_io::voronoi::voronoi(frame).map_err(MolError::Voronoi)?;
+            set_property(frame, VORONOI_VOLUME, v.volume);
+            set_property(
+                frame,
+                VORONOI_FACES,
+                v.faces.iter().map(|&f| f as f32).collect(),
+            );
+            for (k, name) in VORONOI_INDEX.iter().enumerate() {
+                set_property(frame, name, v.index.iter().map(|i| i[k] as f32).collect());
             }
         }
         for (name, formula) in &self.options.computes {
