@@ -17,6 +17,18 @@ fn data(name: &str) -> String {
         .to_string()
 }
 
+/// md-io's fixture directory `dir` (tests/data/<dir>: files OVITO wrote and its values).
+fn ovito_data(dir: &str) -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../md-io/tests/data")
+        .join(dir)
+}
+
+/// A JSON file of reference values.
+fn read_json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
@@ -3205,12 +3217,9 @@ fn vina_poses_render_in_their_receptor_with_their_scores() {
 #[test]
 fn clusters_select_the_precipitate() {
     let dir = tempfile::tempdir().unwrap();
-    let base = Path::new(env!("CARGO_MANIFEST_DIR")).join("../md-io/tests/data/clusters");
+    let base = ovito_data("clusters");
     let file = base.join("fecu.xyz").to_string_lossy().into_owned();
-    let v: serde_json::Value = serde_json::from_str(
-        &std::fs::read_to_string(base.join("clusters_reference.json")).unwrap(),
-    )
-    .unwrap();
+    let v = read_json(&base.join("clusters_reference.json"));
     let largest: Vec<String> = v[2]["ids"]
         .as_array()
         .unwrap()
@@ -3269,11 +3278,9 @@ fn clusters_select_the_precipitate() {
 #[test]
 fn strain_and_centrosymmetry_select_ovitos_atoms() {
     let dir = tempfile::tempdir().unwrap();
-    let base = Path::new(env!("CARGO_MANIFEST_DIR")).join("../md-io/tests/data/strain");
+    let base = ovito_data("strain");
     let (reference, current) = (base.join("ref.xyz"), base.join("cur.xyz"));
-    let json = |name: &str| -> serde_json::Value {
-        serde_json::from_str(&std::fs::read_to_string(base.join(name)).unwrap()).unwrap()
-    };
+    let json = |name: &str| read_json(&base.join(name));
     // OVITO's atoms above `threshold`, as an index selection (no value near the threshold).
     let above = |values: &serde_json::Value, threshold: f64| {
         let v: Vec<f64> = values
@@ -3365,11 +3372,9 @@ fn strain_and_centrosymmetry_select_ovitos_atoms() {
 #[test]
 fn computed_properties_select_ovitos_atoms() {
     let dir = tempfile::tempdir().unwrap();
-    let base = Path::new(env!("CARGO_MANIFEST_DIR")).join("../md-io/tests/data/expr");
+    let base = ovito_data("expr");
     let file = base.join("atoms.lammpstrj").to_string_lossy().into_owned();
-    let v: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(base.join("expr_reference.json")).unwrap())
-            .unwrap();
+    let v = read_json(&base.join("expr_reference.json"));
     assert_eq!(v[0]["formula"], "sqrt(vx^2 + vy^2 + vz^2)");
     let speeds: Vec<f64> = v[0]["values"]
         .as_array()
@@ -3426,16 +3431,14 @@ fn computed_properties_select_ovitos_atoms() {
 #[test]
 fn wigner_seitz_finds_ovitos_defects() {
     let dir = tempfile::tempdir().unwrap();
-    let base = Path::new(env!("CARGO_MANIFEST_DIR")).join("../md-io/tests/data/wigner_seitz");
+    let base = ovito_data("wigner_seitz");
     let reference = base.join("ref.xyz").to_string_lossy().into_owned();
     let both = dir.path().join("both.xyz");
     let mut text = std::fs::read(base.join("ref.xyz")).unwrap();
     text.extend(std::fs::read(base.join("cur.xyz")).unwrap());
     std::fs::write(&both, text).unwrap();
     let both = both.to_string_lossy().into_owned();
-    let v: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(base.join("ws_reference.json")).unwrap())
-            .unwrap();
+    let v = read_json(&base.join("ws_reference.json"));
     let defective: Vec<String> = v["occupancy"]
         .as_array()
         .unwrap()
@@ -3522,7 +3525,7 @@ fn wigner_seitz_finds_ovitos_defects() {
 #[test]
 fn frozen_properties_follow_the_atoms() {
     let dir = tempfile::tempdir().unwrap();
-    let base = Path::new(env!("CARGO_MANIFEST_DIR")).join("../md-io/tests/data/strain");
+    let base = ovito_data("strain");
     let first = std::fs::read_to_string(base.join("ref.xyz")).unwrap();
     let both = dir.path().join("both.xyz");
     std::fs::write(
@@ -3582,12 +3585,9 @@ fn frozen_properties_follow_the_atoms() {
 #[test]
 fn voronoi_selects_ovitos_atoms() {
     let dir = tempfile::tempdir().unwrap();
-    let base = Path::new(env!("CARGO_MANIFEST_DIR")).join("../md-io/tests/data/voronoi");
+    let base = ovito_data("voronoi");
     let file = base.join("glass.xyz").to_string_lossy().into_owned();
-    let v: serde_json::Value = serde_json::from_str(
-        &std::fs::read_to_string(base.join("voronoi_reference.json")).unwrap(),
-    )
-    .unwrap();
+    let v = read_json(&base.join("voronoi_reference.json"));
     assert_eq!(v[1]["file"], "glass.xyz");
     let many: Vec<String> = v[1]["faces"]
         .as_array()

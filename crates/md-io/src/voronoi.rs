@@ -5,7 +5,9 @@
 //! (`⟨0, 0, 12, 0⟩`) and crystals show their cells (FCC's rhombic dodecahedron `⟨0, 12, 0, 0⟩`).
 //!
 //! Per atom: a cube around it is clipped by the bisector plane of each neighbour, nearest first
-//! (neighbours at their nearest periodic image, from the cell grid CNA uses); the cell is
+//! (neighbours at their nearest periodic image, from the cell grid CNA uses, so the periodic cell
+//! must be wider than twice the largest Voronoi cell's radius, as any box of a few atomic
+//! spacings is); the cell is
 //! complete when its farthest vertex is closer than half the distance to the next neighbour not
 //! yet used (no farther atom's plane can reach it), otherwise more neighbours are taken. A vertex
 //! within 10⁻⁹ Å of a plane lies on it, so a plane through a vertex adds no sliver face. The

@@ -6,37 +6,24 @@
 //! each written in texmap's names and in OVITO's. Every atom's value must be OVITO's within
 //! f32 precision.
 
-use std::path::Path;
-
+use texmap_md_io::Frame;
 use texmap_md_io::expr::Expression;
-use texmap_md_io::{Frame, Trajectory};
 
-fn data(name: &str) -> std::path::PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data/expr")
-        .join(name)
+mod support {
+    pub mod ovito;
 }
+use support::ovito::*;
+
+const DATA: Fixtures = Fixtures("expr");
 
 #[test]
 fn every_formula_is_ovitos() {
-    let text = std::fs::read_to_string(data("expr_reference.json")).unwrap();
-    let cases: serde_json::Value = serde_json::from_str(&text).unwrap();
-    let mut frame = Frame::new();
-    assert!(
-        Trajectory::open(data("atoms.lammpstrj"))
-            .unwrap()
-            .read_next(&mut frame)
-            .unwrap()
-    );
+    let cases = DATA.json("expr_reference.json");
+    let frame = DATA.frame("atoms.lammpstrj");
     assert_eq!(frame.n_atoms(), 600);
     for case in cases.as_array().unwrap() {
         let formula = case["formula"].as_str().unwrap();
-        let want: Vec<f64> = case["values"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|v| v.as_f64().unwrap())
-            .collect();
+        let want = numbers(&case["values"]);
         let got = Expression::parse(formula)
             .unwrap()
             .evaluate(&frame)

@@ -5,36 +5,15 @@
 //! bulged and wrapped back into its sheared cell (atoms cross the periodic faces between the two
 //! files). Every atom's values must be OVITO's within the precision of f32 coordinates.
 
-use std::path::Path;
-
 use texmap_md_io::centrosymmetry::{CspMode, centrosymmetry};
 use texmap_md_io::strain::atomic_strain;
-use texmap_md_io::{Frame, Trajectory};
 
-fn data(name: &str) -> std::path::PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data/strain")
-        .join(name)
+mod support {
+    pub mod ovito;
 }
+use support::ovito::*;
 
-fn read(name: &str) -> Frame {
-    let mut frame = Frame::new();
-    assert!(
-        Trajectory::open(data(name))
-            .unwrap()
-            .read_next(&mut frame)
-            .unwrap()
-    );
-    frame
-}
-
-fn numbers(v: &serde_json::Value) -> Vec<f64> {
-    v.as_array()
-        .unwrap()
-        .iter()
-        .map(|x| x.as_f64().unwrap())
-        .collect()
-}
+const DATA: Fixtures = Fixtures("strain");
 
 /// The largest difference between ours and theirs, and where.
 fn worst(ours: &[f32], theirs: &[f64]) -> (f64, usize) {
@@ -48,9 +27,8 @@ fn worst(ours: &[f32], theirs: &[f64]) -> (f64, usize) {
 
 #[test]
 fn strain_is_ovitos_atom_for_atom() {
-    let text = std::fs::read_to_string(data("strain_reference.json")).unwrap();
-    let want: serde_json::Value = serde_json::from_str(&text).unwrap();
-    let (reference, current) = (read("ref.xyz"), read("cur.xyz"));
+    let want = DATA.json("strain_reference.json");
+    let (reference, current) = (DATA.frame("ref.xyz"), DATA.frame("cur.xyz"));
     let cutoff = want["cutoff"].as_f64().unwrap() as f32;
     let s = atomic_strain(&reference, &current, cutoff).unwrap();
     let invalid: Vec<bool> = want["invalid"]
@@ -87,7 +65,7 @@ fn strain_is_ovitos_atom_for_atom() {
 
 #[test]
 fn strain_refuses_other_atoms_and_a_bad_cutoff() {
-    let (reference, mut current) = (read("ref.xyz"), read("cur.xyz"));
+    let (reference, mut current) = (DATA.frame("ref.xyz"), DATA.frame("cur.xyz"));
     assert!(atomic_strain(&reference, &reference, 0.2).is_err());
     current.positions.pop();
     let e = atomic_strain(&reference, &current, 3.0).unwrap_err();
@@ -99,8 +77,7 @@ fn strain_refuses_other_atoms_and_a_bad_cutoff() {
 
 #[test]
 fn centrosymmetry_is_ovitos_in_both_modes() {
-    let text = std::fs::read_to_string(data("centro_reference.json")).unwrap();
-    let cases: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let cases = DATA.json("centro_reference.json");
     for case in cases.as_array().unwrap() {
         let file = case["file"].as_str().unwrap();
         let n = case["neighbours"].as_u64().unwrap() as usize;
@@ -109,7 +86,7 @@ fn centrosymmetry_is_ovitos_in_both_modes() {
             _ => CspMode::Conventional,
         };
         let want = numbers(&case["csp"]);
-        let csp = centrosymmetry(&read(file), n, mode).unwrap();
+        let csp = centrosymmetry(&DATA.frame(file), n, mode).unwrap();
         let (e, at) = worst(&csp, &want);
         let rel = e / want[at].abs().max(1.0);
         println!("{file}, {n} neighbours, {mode:?}: worst {e:.2e} Å² at atom {at}");
@@ -126,7 +103,7 @@ fn centrosymmetry_is_ovitos_in_both_modes() {
 fn the_matching_never_sums_more_than_the_conventional_pairs_allow() {
     // The conventional sum takes the N/2 smallest weights with no constraint: it is a lower
     // bound of any pairing, so of the matching.
-    let frame = read("cur.xyz");
+    let frame = DATA.frame("cur.xyz");
     let c = centrosymmetry(&frame, 12, CspMode::Conventional).unwrap();
     let m = centrosymmetry(&frame, 12, CspMode::Matching).unwrap();
     assert!(c.iter().zip(&m).all(|(c, m)| *c <= m * (1.0 + 1e-6) + 1e-9));
@@ -141,7 +118,7 @@ fn the_matching_never_sums_more_than_the_conventional_pairs_allow() {
 
 #[test]
 fn centrosymmetry_refuses_odd_and_oversized_counts() {
-    let frame = read("ref.xyz");
+    let frame = DATA.frame("ref.xyz");
     for n in [0, 7, 34] {
         assert!(centrosymmetry(&frame, n, CspMode::Conventional).is_err());
     }

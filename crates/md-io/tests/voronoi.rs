@@ -4,37 +4,24 @@
 //! corners, and a dense disordered packing. Volumes must be OVITO's within f32 coordinates,
 //! and face counts and Voronoi indices OVITO's atom for atom; the cells tile the periodic cell.
 
-use std::path::Path;
-
+use texmap_md_io::Frame;
 use texmap_md_io::voronoi::voronoi;
-use texmap_md_io::{Frame, Trajectory};
 
-fn data(name: &str) -> std::path::PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data/voronoi")
-        .join(name)
+mod support {
+    pub mod ovito;
 }
+use support::ovito::*;
+
+const DATA: Fixtures = Fixtures("voronoi");
 
 #[test]
 fn every_cell_is_ovitos() {
-    let text = std::fs::read_to_string(data("voronoi_reference.json")).unwrap();
-    let cases: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let cases = DATA.json("voronoi_reference.json");
     for case in cases.as_array().unwrap() {
         let file = case["file"].as_str().unwrap();
-        let mut frame = Frame::new();
-        assert!(
-            Trajectory::open(data(file))
-                .unwrap()
-                .read_next(&mut frame)
-                .unwrap()
-        );
+        let frame = DATA.frame(file);
         let v = voronoi(&frame).unwrap();
-        let volumes: Vec<f64> = case["volume"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|x| x.as_f64().unwrap())
-            .collect();
+        let volumes = numbers(&case["volume"]);
         let (worst, at) = v
             .volume
             .iter()

@@ -4,41 +4,20 @@
 //! the box expanded by 1 % and every atom wrapped. Every site's occupancy, every atom's site and
 //! both counts must be OVITO's exactly.
 
-use std::path::Path;
-
+use texmap_md_io::Frame;
 use texmap_md_io::wigner_seitz::wigner_seitz;
-use texmap_md_io::{Frame, Trajectory};
 
-fn data(name: &str) -> std::path::PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data/wigner_seitz")
-        .join(name)
+mod support {
+    pub mod ovito;
 }
+use support::ovito::*;
 
-fn read(name: &str) -> Frame {
-    let mut frame = Frame::new();
-    assert!(
-        Trajectory::open(data(name))
-            .unwrap()
-            .read_next(&mut frame)
-            .unwrap()
-    );
-    frame
-}
-
-fn integers(v: &serde_json::Value) -> Vec<i64> {
-    v.as_array()
-        .unwrap()
-        .iter()
-        .map(|x| x.as_i64().unwrap())
-        .collect()
-}
+const DATA: Fixtures = Fixtures("wigner_seitz");
 
 #[test]
 fn every_site_and_atom_is_ovitos() {
-    let text = std::fs::read_to_string(data("ws_reference.json")).unwrap();
-    let want: serde_json::Value = serde_json::from_str(&text).unwrap();
-    let (reference, current) = (read("ref.xyz"), read("cur.xyz"));
+    let want = DATA.json("ws_reference.json");
+    let (reference, current) = (DATA.frame("ref.xyz"), DATA.frame("cur.xyz"));
     assert_eq!((reference.n_atoms(), current.n_atoms()), (2000, 1998));
     let ws = wigner_seitz(&reference, &current).unwrap();
     let occupancy: Vec<i64> = ws.occupancy.iter().map(|&o| o as i64).collect();
@@ -59,7 +38,7 @@ fn every_site_and_atom_is_ovitos() {
 
 #[test]
 fn the_perfect_crystal_has_no_defects_and_an_empty_reference_is_refused() {
-    let reference = read("ref.xyz");
+    let reference = DATA.frame("ref.xyz");
     let ws = wigner_seitz(&reference, &reference).unwrap();
     assert_eq!((ws.vacancies, ws.interstitials), (0, 0));
     assert!(
