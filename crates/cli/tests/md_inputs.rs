@@ -24,6 +24,17 @@ fn ovito_data(dir: &str) -> std::path::PathBuf {
         .join(dir)
 }
 
+/// Runs `texmap render ARGS -q -o DIR/OUT`, which must succeed, and returns the PNG's bytes.
+fn render_png(dir: &Path, args: &[&str], out: &str) -> Vec<u8> {
+    let out = dir.join(out);
+    let mut all = vec!["render", "-q"];
+    all.extend_from_slice(args);
+    all.extend(["-o", out.to_str().unwrap()]);
+    let o = texmap(&all);
+    assert!(o.status.success(), "{}", stderr(&o));
+    std::fs::read(out).unwrap()
+}
+
 /// A JSON file of reference values.
 fn read_json(path: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
@@ -3302,14 +3313,14 @@ fn strain_and_centrosymmetry_select_ovitos_atoms() {
         format!("index {}", picked.join(" "))
     };
     let render = |file: &Path, extra: &[&str], select: &str, out: &str| {
-        let out = dir.path().join(out);
-        let mut args = vec!["render", file.to_str().unwrap()];
-        args.extend_from_slice(extra);
-        args.extend_from_slice(&["--select", select, "--size", "200x200", "-q", "-o"]);
-        args.push(out.to_str().unwrap());
-        let o = texmap(&args);
-        assert!(o.status.success(), "{}", stderr(&o));
-        std::fs::read(out).unwrap()
+        let head = [
+            file.to_str().unwrap(),
+            "--select",
+            select,
+            "--size",
+            "200x200",
+        ];
+        render_png(dir.path(), &[&head[..], extra].concat(), out)
     };
     let strained = above(&json("strain_reference.json")["shear"], 0.045);
     let strain = [
@@ -3389,13 +3400,11 @@ fn computed_properties_select_ovitos_atoms() {
         .collect();
     assert!(fast.len() > 100 && fast.len() < 500, "{}", fast.len());
     let render = |extra: &[&str], out: &str| {
-        let out = dir.path().join(out);
-        let mut args = vec!["render", file.as_str(), "--size", "200x200", "-q"];
-        args.extend_from_slice(extra);
-        args.extend(["-o", out.to_str().unwrap()]);
-        let o = texmap(&args);
-        assert!(o.status.success(), "{}", stderr(&o));
-        std::fs::read(out).unwrap()
+        render_png(
+            dir.path(),
+            &[&[file.as_str(), "--size", "200x200"], extra].concat(),
+            out,
+        )
     };
     let ours = render(
         &[
@@ -3453,13 +3462,7 @@ fn wigner_seitz_finds_ovitos_defects() {
         "ten vacancies, eight sites holding two"
     );
     let render = |args: &[&str], out: &str| {
-        let out = dir.path().join(out);
-        let mut all = vec!["render", "--size", "200x200", "-q"];
-        all.extend_from_slice(args);
-        all.extend(["-o", out.to_str().unwrap()]);
-        let o = texmap(&all);
-        assert!(o.status.success(), "{}", stderr(&o));
-        std::fs::read(out).unwrap()
+        render_png(dir.path(), &[&["--size", "200x200"], args].concat(), out)
     };
     let table = dir.path().join("defects.csv");
     let ours = render(
@@ -3599,13 +3602,11 @@ fn voronoi_selects_ovitos_atoms() {
         .collect();
     assert!(many.len() > 100 && many.len() < 600, "{}", many.len());
     let render = |extra: &[&str], out: &str| {
-        let out = dir.path().join(out);
-        let mut args = vec!["render", file.as_str(), "--size", "160x120", "-q"];
-        args.extend_from_slice(extra);
-        args.extend(["-o", out.to_str().unwrap()]);
-        let o = texmap(&args);
-        assert!(o.status.success(), "{}", stderr(&o));
-        std::fs::read(out).unwrap()
+        render_png(
+            dir.path(),
+            &[&[file.as_str(), "--size", "160x120"], extra].concat(),
+            out,
+        )
     };
     let ours = render(
         &["--voronoi", "--select", "prop voronoi_faces >= 15"],
