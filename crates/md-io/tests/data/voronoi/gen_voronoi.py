@@ -15,24 +15,20 @@ component k counts the faces with k + 1 edges).
 """
 import json
 import os
+import sys
 
 import numpy as np
-from ovito.data import DataCollection, ParticleType
-from ovito.io import export_file, import_file
+from ovito.io import import_file
 from ovito.modifiers import VoronoiAnalysisModifier
 
 here = os.path.dirname(os.path.abspath(__file__))
-COLUMNS = ["Particle Type", "Position.X", "Position.Y", "Position.Z"]
+sys.path.insert(0, os.path.dirname(here))
+import ovito_single  # noqa: E402
+COLUMNS = ovito_single.COLUMNS
 
 
 def write(name, L, positions):
-    data = DataCollection()
-    data.create_cell(np.diag([L, L, L]), pbc=(True, True, True))
-    particles = data.create_particles(count=len(positions))
-    particles.create_property("Position", data=positions)
-    t = particles.create_property("Particle Type", data=np.ones(len(positions), dtype=int))
-    t.types.append(ParticleType(id=1, name="Cu"))
-    export_file(data, os.path.join(here, name), "xyz", columns=COLUMNS)
+    ovito_single.write(os.path.join(here, name), np.diag([L, L, L]), positions, "Cu")
 
 
 a, n = 3.615, 5
