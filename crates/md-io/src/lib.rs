@@ -36,8 +36,8 @@
 //!   clusters), [`cna`] classifies its crystal structure, [`centrosymmetry`] measures how far
 //!   its neighbours are from opposite pairs and [`strain`] its local deformation against a
 //!   reference configuration, [`wigner_seitz`] its vacancies and interstitials, [`voronoi`] its Voronoi
-//!   cell (volume, coordination, index), as OVITO's
-//!   analyses do, and [`expr`] computes a number per atom
+//!   cell (volume, coordination, index), [`orientation`] its lattice orientation (PTM's) and
+//!   [`grains`] the grains of a polycrystal, as OVITO's analyses do, and [`expr`] computes a number per atom
 //!   from a formula (OVITO's Compute property); [`hbonds`] finds hydrogen bonds by
 //!   MDAnalysis's geometric criterion.
 //! - [`values`] reads per-atom numbers from a text file (an analysis result, a column or a row
@@ -126,6 +126,7 @@ mod error;
 pub mod expr;
 mod format;
 mod frame;
+pub mod grains;
 mod gro;
 mod gsd;
 mod gz;
@@ -137,6 +138,7 @@ mod mol2;
 mod namdbin;
 mod neighbours;
 mod netcdf;
+pub mod orientation;
 pub mod parse;
 pub mod pbc;
 mod pdb;
@@ -144,6 +146,7 @@ mod pqr;
 mod prmtop;
 mod psf;
 pub mod replicate;
+pub mod rotation;
 mod sdf;
 pub mod secondary;
 pub mod select;

@@ -21,9 +21,11 @@ pub(crate) const ATOMS_PER_CELL: f64 = 4.5;
 #[derive(Default)]
 pub(crate) struct Scratch {
     cells: Vec<usize>,
-    found: Vec<([f64; 3], f64)>,
+    found: Vec<([f64; 3], f64, u32)>,
     /// The nearest neighbours found: vector from the atom, distance; closest first.
     pub(crate) near: Vec<([f64; 3], f64)>,
+    /// Their atom indices, in the same order.
+    pub(crate) index: Vec<u32>,
 }
 
 /// A cell grid over the atoms (fractional cells in a periodic cell, the bounding box
@@ -266,8 +268,14 @@ impl<'a> Grid<'a> {
     /// Atom `i`'s `k` nearest neighbours (vector, distance), closest first, into
     /// `scratch.near` (fewer when the frame has fewer other atoms; none for a non-finite atom).
     pub(crate) fn nearest(&self, i: usize, k: usize, scratch: &mut Scratch) {
-        let Scratch { cells, found, near } = scratch;
+        let Scratch {
+            cells,
+            found,
+            near,
+            index,
+        } = scratch;
         near.clear();
+        index.clear();
         if k == 0 || self.of[i] == usize::MAX {
             return;
         }
@@ -284,7 +292,7 @@ impl<'a> Grid<'a> {
                     }
                     let v = self.vector(i, j);
                     // Squared for now; the distances kept are rooted at the end.
-                    found.push((v, v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
+                    found.push((v, v[0] * v[0] + v[1] * v[1] + v[2] * v[2], j as u32));
                 }
             }
             // The nearest k, in order (ties by atom order of the scan).
@@ -302,7 +310,8 @@ impl<'a> Grid<'a> {
                 break;
             }
         }
-        near.extend(found.iter().map(|&(v, d2)| (v, d2.sqrt())));
+        near.extend(found.iter().map(|&(v, d2, _)| (v, d2.sqrt())));
+        index.extend(found.iter().map(|f| f.2));
     }
 
     /// The offsets along axis `a` from grid coordinate `at` within `ring` cells: inside an open

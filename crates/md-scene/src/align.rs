@@ -3,9 +3,9 @@
 //! held still while it tumbles and diffuses (what MDAnalysis's `AlignTraj`, VMD's `measure fit`
 //! and PyMOL's `intra_fit` do before a movie).
 //!
-//! The rotation is Horn's (1987) closed form: the unit quaternion that is the eigenvector of the
-//! largest eigenvalue of a symmetric 4x4 matrix built from the two sets' cross-covariance, found
-//! by Jacobi rotations in f64. It is always a proper rotation (never a reflection). The fit is
+//! The rotation is Horn's (1987) closed form ([`texmap_md_io::rotation`]): the unit quaternion
+//! that is the eigenvector of the largest eigenvalue of a symmetric 4x4 matrix built from the two
+//! sets' cross-covariance, found by Jacobi rotations in f64. It is always a proper rotation (never a reflection). The fit is
 //! unweighted, as MDAnalysis's and VMD's defaults are, or weighted ([`superpose_weighted`],
 //! e.g. by mass).
 //!
@@ -58,58 +58,6 @@ fn centroid(p: &[[f64; 3]], w: impl Fn(usize) -> f64, total: f64) -> [f64; 3] {
         }
     }
     c.map(|v| v / total)
-}
-
-/// Eigenvalues and eigenvectors (columns of the returned matrix) of a symmetric 4x4 matrix by
-/// cyclic Jacobi rotations.
-fn jacobi4(mut a: [[f64; 4]; 4]) -> ([f64; 4], [[f64; 4]; 4]) {
-    let mut v = [[0.0; 4]; 4];
-    for (i, row) in v.iter_mut().enumerate() {
-        row[i] = 1.0;
-    }
-    let scale: f64 = a
-        .iter()
-        .flatten()
-        .map(|x| x.abs())
-        .sum::<f64>()
-        .max(f64::MIN_POSITIVE);
-    for _sweep in 0..64 {
-        let off: f64 = (0..4)
-            .flat_map(|i| (0..4).filter(move |&j| j != i).map(move |j| (i, j)))
-            .map(|(i, j)| a[i][j] * a[i][j])
-            .sum();
-        if off.sqrt() <= 1e-15 * scale {
-            break;
-        }
-        for p in 0..3 {
-            for q in p + 1..4 {
-                if a[p][q].abs() <= f64::MIN_POSITIVE {
-                    continue;
-                }
-                let theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
-                let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
-                let t = if theta == 0.0 { 1.0 } else { t };
-                let c = 1.0 / (t * t + 1.0).sqrt();
-                let s = t * c;
-                for row in a.iter_mut() {
-                    let (akp, akq) = (row[p], row[q]);
-                    row[p] = c * akp - s * akq;
-                    row[q] = s * akp + c * akq;
-                }
-                let (rp, rq) = (a[p], a[q]);
-                for k in 0..4 {
-                    a[p][k] = c * rp[k] - s * rq[k];
-                    a[q][k] = s * rp[k] + c * rq[k];
-                }
-                for row in v.iter_mut() {
-                    let (vp, vq) = (row[p], row[q]);
-                    row[p] = c * vp - s * vq;
-                    row[q] = s * vp + c * vq;
-                }
-            }
-        }
-    }
-    ([a[0][0], a[1][1], a[2][2], a[3][3]], v)
 }
 
 /// The superposition of `mobile` onto `reference` (same length, point `i` to point `i`) that
@@ -165,20 +113,7 @@ pub fn superpose_weighted(
             }
         }
     }
-    let [[sxx, sxy, sxz], [syx, syy, syz], [szx, szy, szz]] = s;
-    let n = [
-        [sxx + syy + szz, syz - szy, szx - sxz, sxy - syx],
-        [syz - szy, sxx - syy - szz, sxy + syx, szx + sxz],
-        [szx - sxz, sxy + syx, -sxx + syy - szz, syz + szy],
-        [sxy - syx, szx + sxz, syz + szy, -sxx - syy + szz],
-    ];
-    let (values, vectors) = jacobi4(n);
-    let best = (0..4)
-        .max_by(|&a, &b| values[a].total_cmp(&values[b]))
-        .unwrap_or(0);
-    let q = [0, 1, 2, 3].map(|k| vectors[k][best]);
-    let len = q.iter().map(|v| v * v).sum::<f64>().sqrt();
-    let [q0, q1, q2, q3] = q.map(|v| v / len);
+    let (_, [q0, q1, q2, q3]) = texmap_md_io::rotation::best_rotation(s);
     let rotation = [
         [
             q0 * q0 + q1 * q1 - q2 * q2 - q3 * q3,
