@@ -4,9 +4,10 @@
 //! HCP magnesium, each a periodic cube of Voronoi grains in random orientations with thermal
 //! noise.
 
+use texmap_md_io::Frame;
 use texmap_md_io::cna::{StructureType, classify};
 use texmap_md_io::grains::{GrainOptions, segment};
-use texmap_md_io::orientation::{Symmetry, disorientation, orientations};
+use texmap_md_io::orientation::{LatticeFit, Symmetry, disorientation, orientations};
 
 mod support {
     pub mod ovito;
@@ -22,6 +23,26 @@ fn quaternions(v: &serde_json::Value) -> Vec<[f64; 4]> {
         .map(|q| {
             let q = numbers(q);
             [q[0], q[1], q[2], q[3]]
+        })
+        .collect()
+}
+
+/// Each system's OVITO results, frame, a-CNA types and lattice fits.
+fn systems() -> Vec<(
+    serde_json::Value,
+    Frame,
+    Vec<StructureType>,
+    Vec<Option<LatticeFit>>,
+)> {
+    let refs = DATA.json("grains_reference.json");
+    let cases = refs["systems"].as_array().unwrap().clone();
+    cases
+        .into_iter()
+        .map(|case| {
+            let frame = DATA.frame(case["file"].as_str().unwrap());
+            let types = classify(&frame);
+            let fits = orientations(&frame, &types);
+            (case, frame, types, fits)
         })
         .collect()
 }
@@ -49,12 +70,8 @@ fn disorientations_are_ovitos() {
 
 #[test]
 fn orientations_and_rmsd_are_ptms() {
-    let refs = DATA.json("grains_reference.json");
-    for case in refs["systems"].as_array().unwrap() {
+    for (case, frame, types, fits) in systems() {
         let file = case["file"].as_str().unwrap();
-        let frame = DATA.frame(file);
-        let types = classify(&frame);
-        let fits = orientations(&frame, &types);
         let ptm_types = integers(&case["structure"]);
         let ptm_q = quaternions(&case["orientation"]);
         let ptm_rmsd = numbers(&case["rmsd"]);
@@ -91,12 +108,8 @@ fn orientations_and_rmsd_are_ptms() {
 
 #[test]
 fn grains_are_ovitos() {
-    let refs = DATA.json("grains_reference.json");
-    for case in refs["systems"].as_array().unwrap() {
+    for (case, frame, types, fits) in systems() {
         let file = case["file"].as_str().unwrap();
-        let frame = DATA.frame(file);
-        let types = classify(&frame);
-        let fits = orientations(&frame, &types);
         let ours = segment(&frame, &types, &fits, &GrainOptions::default());
         let theirs = integers(&case["grain"]);
         let ovito_sizes = integers(&case["grain_size"]);
