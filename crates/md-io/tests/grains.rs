@@ -27,13 +27,15 @@ fn quaternions(v: &serde_json::Value) -> Vec<[f64; 4]> {
         .collect()
 }
 
-/// Each system's OVITO results, frame, a-CNA types and lattice fits.
-fn systems() -> Vec<(
-    serde_json::Value,
-    Frame,
-    Vec<StructureType>,
-    Vec<Option<LatticeFit>>,
-)> {
+/// A system: OVITO's results, the frame, its a-CNA types and lattice fits.
+struct System {
+    case: serde_json::Value,
+    frame: Frame,
+    types: Vec<StructureType>,
+    fits: Vec<Option<LatticeFit>>,
+}
+
+fn systems() -> Vec<System> {
     let refs = DATA.json("grains_reference.json");
     let cases = refs["systems"].as_array().unwrap().clone();
     cases
@@ -42,7 +44,12 @@ fn systems() -> Vec<(
             let frame = DATA.frame(case["file"].as_str().unwrap());
             let types = classify(&frame);
             let fits = orientations(&frame, &types);
-            (case, frame, types, fits)
+            System {
+                case,
+                frame,
+                types,
+                fits,
+            }
         })
         .collect()
 }
@@ -70,7 +77,10 @@ fn disorientations_are_ovitos() {
 
 #[test]
 fn orientations_and_rmsd_are_ptms() {
-    for (case, frame, types, fits) in systems() {
+    for System {
+        case, types, fits, ..
+    } in systems()
+    {
         let file = case["file"].as_str().unwrap();
         let ptm_types = integers(&case["structure"]);
         let ptm_q = quaternions(&case["orientation"]);
@@ -108,7 +118,13 @@ fn orientations_and_rmsd_are_ptms() {
 
 #[test]
 fn grains_are_ovitos() {
-    for (case, frame, types, fits) in systems() {
+    for System {
+        case,
+        frame,
+        types,
+        fits,
+    } in systems()
+    {
         let file = case["file"].as_str().unwrap();
         let ours = segment(&frame, &types, &fits, &GrainOptions::default());
         let theirs = integers(&case["grain"]);
