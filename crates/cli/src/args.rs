@@ -158,6 +158,11 @@ pub enum ColorBy {
     Cna,
     /// --type-color, else one distinct colour per cluster (--clusters), the largest first.
     Cluster,
+    /// --type-color, else one distinct colour per grain (--grains), the largest first.
+    Grain,
+    /// --type-color, else the inverse pole figure colour of the lattice orientation along an
+    /// axis.
+    Ipf(texmap_md_scene::IpfAxis),
     /// A number per atom through --colormap.
     Scalar(texmap_md_scene::ScalarSource),
 }
@@ -173,6 +178,10 @@ pub fn parse_color_by(s: &str) -> Result<ColorBy, String> {
         "structure" | "secondary" | "ss" => ColorBy::Structure,
         "cna" | "structure-type" => ColorBy::Cna,
         "cluster" | "clusters" => ColorBy::Cluster,
+        "grain" | "grains" => ColorBy::Grain,
+        "ipf" | "ipf-z" | "orientation" => ColorBy::Ipf(texmap_md_scene::IpfAxis::Z),
+        "ipf-x" => ColorBy::Ipf(texmap_md_scene::IpfAxis::X),
+        "ipf-y" => ColorBy::Ipf(texmap_md_scene::IpfAxis::Y),
         "speed" | "velocity" => ColorBy::Scalar(ScalarSource::Speed),
         "residue" | "resid" => ColorBy::Scalar(ScalarSource::Residue),
         "index" => ColorBy::Scalar(ScalarSource::Index),
@@ -243,6 +252,14 @@ pub fn parse_cutoff(s: &str) -> Result<f32, String> {
     match s.trim().parse::<f32>() {
         Ok(r) if r > 0.45 && r <= texmap_md_io::coordination::MAX_CUTOFF => Ok(r),
         _ => Err(format!("{s:?} is not a cutoff from 0.45 to 20 Å")),
+    }
+}
+
+/// Parses `--grains`' threshold: degrees, above 0 and at most 30.
+pub fn parse_grain_threshold(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(d) if d > 0.0 && d <= 30.0 => Ok(d),
+        _ => Err(format!("{s:?} is not an angle from 0 to 30 degrees")),
     }
 }
 
@@ -386,6 +403,12 @@ pub struct StyleArgs {
             "             analysis in OVITO's colours: FCC green, HCP red, BCC blue, icosahedral yellow,\n",
             "             other white (as OVITO assigns them, recomputed every frame); with --select\n",
             "             'not cna fcc' only the defects, stacking faults and surfaces are drawn\n",
+            "  ipf        --type-color, else the lattice orientation as an inverse pole figure (EBSD's\n",
+            "             IPF-Z: the crystal direction along z; cubic [001] red, [101] green, [111] blue;\n",
+            "             hexagonal [0001] red, [2-1-10] green, [10-10] blue), on the FCC, HCP and BCC\n",
+            "             atoms of cna, as OVITO's PTM orients them; others white. ipf-x, ipf-y: along x, y\n",
+            "  grain      --type-color, else one colour per grain of a polycrystal (--grains), the\n",
+            "             largest first\n",
             "A number per atom, mapped through --colormap over --color-range (default: the range of the\n",
             "first frame's drawn atoms, then fixed, so a colour means one value in every frame) with a\n",
             "colour bar (--no-color-bar to leave it out):\n",
@@ -1100,6 +1123,34 @@ pub struct MolArgs {
     /// --color-by voronoi_volume shows free volume. Needs a periodic cell.
     #[arg(long)]
     pub voronoi: bool,
+    /// Every crystalline atom's lattice orientation every frame, as OVITO's Polyhedral template
+    /// matching gives it (on the FCC, HCP and BCC atoms of adaptive CNA): the per-atom numbers
+    /// 'orientation_x' .. 'orientation_w' (the quaternion from the ideal crystal's axes) and
+    /// 'lattice_rmsd' (the deviation from the ideal crystal, scale-free); NaN for other atoms.
+    /// --color-by lattice_rmsd turns it on; --color-by ipf colours by the orientation.
+    #[arg(long)]
+    pub orientations: bool,
+    /// The grains of a polycrystal every frame, as OVITO's Grain segmentation: crystalline
+    /// atoms (FCC, HCP, BCC) join a grain while their lattice orientation is within DEG
+    /// (default 4) of its mean; grains of fewer than --grain-min-size atoms are dissolved and
+    /// the atoms between grains join the nearest. Gives the per-atom number 'grain' (0 the
+    /// largest, -1 none): --color-by grain, --select 'prop grain == 0', --grain-table
+    /// FILE.csv lists each frame's grains (grain growth over a run).
+    #[arg(long, value_name = "DEG", num_args = 0..=1, default_missing_value = "4", value_parser = parse_grain_threshold)]
+    pub grains: Option<f64>,
+    /// With --grains (or --color-by grain): grains of fewer crystalline atoms are dissolved
+    /// (OVITO's default: 100).
+    #[arg(long, value_name = "N", default_value_t = 100)]
+    pub grain_min_size: usize,
+    /// With --grains: leave the atoms between grains (grain boundaries, dislocation cores,
+    /// surfaces) at grain -1 instead of giving them to the nearest grain.
+    #[arg(long)]
+    pub grain_keep_orphans: bool,
+    /// Also write the grains of every frame as a CSV table, one row per grain: frame, grain,
+    /// atoms, crystalline atoms, structure, and the mean orientation's quaternion. Written whole
+    /// or not at all.
+    #[arg(long, value_name = "FILE.csv")]
+    pub grain_table: Option<PathBuf>,
     /// Draw each atom with the radius (Å) a per-atom property gives: PQR's 'radius'
     /// (PDB2PQR/APBS radii), any dump column (texmap info lists them), --property FILE's
     /// numbers. As a file's radius column: --radius-scale does not apply, ball-and-stick

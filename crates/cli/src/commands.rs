@@ -482,6 +482,25 @@ fn trace_layers<E: Into<anyhow::Error>>(
     Ok(base)
 }
 
+/// A per-frame CSV table for `flag` at `path`, its `header` row written; refused when the run
+/// draws only part of the frames (`whole` false: --shard), where every part would write it.
+fn per_frame_table(
+    path: &Option<PathBuf>,
+    flag: &str,
+    header: &str,
+    whole: bool,
+) -> Result<Option<crate::output::AtomicFile>> {
+    let Some(p) = path else { return Ok(None) };
+    if !whole {
+        return usage(format!(
+            "{flag} with --shard (or a Slurm array): every part would write the same table; write it in a run of its own"
+        ));
+    }
+    let mut t = crate::output::AtomicFile::create(p)?;
+    t.write(&format!("{header}\n"))?;
+    Ok(Some(t))
+}
+
 fn render(a: &RenderArgs) -> Result<()> {
     let background = parse_background(&a.background)?;
     if let Some(dpi) = a.dpi
@@ -665,55 +684,41 @@ fn render(a: &RenderArgs) -> Result<()> {
             "--label {vacancies} and {interstitials} count the point defects --wigner-seitz finds: add --wigner-seitz",
         );
     }
-    let mut hbond_table = match &a.mol.hbond_table {
-        None => None,
-        Some(_) if !plan.draws_hbonds() => {
-            return usage(
-                "--hbond-table lists the hydrogen bonds the hbonds style draws: add a representation of them, as --rep 'protein or water=hbonds'",
-            );
-        }
-        Some(_) if mine.len() != frames.len() => {
-            return usage(
-                "--hbond-table with --shard (or a Slurm array): every part would write the same table; write it in a run of its own",
-            );
-        }
-        Some(p) => {
-            let mut t = crate::output::AtomicFile::create(p)?;
-            t.write("frame,donor,hydrogen,acceptor,donor_atom,hydrogen_atom,acceptor_atom,distance,angle\n")?;
-            Some(t)
-        }
-    };
-    let mut defect_table = match &a.mol.defect_table {
-        None => None,
-        Some(_) if mine.len() != frames.len() => {
-            return usage(
-                "--defect-table with --shard (or a Slurm array): every part would write the same table; write it in a run of its own",
-            );
-        }
-        Some(p) => {
-            let mut t = crate::output::AtomicFile::create(p)?;
-            t.write("frame,vacancies,interstitials\n")?;
-            Some(t)
-        }
-    };
-    let mut measure_table = match &a.mol.measure_table {
-        None => None,
-        Some(_) if a.mol.measures.is_empty() => {
-            return usage(
-                "--measure-table lists the --measure values: add a measurement, as --measure 'index 0; index 5'",
-            );
-        }
-        Some(_) if mine.len() != frames.len() => {
-            return usage(
-                "--measure-table with --shard (or a Slurm array): every part would write the same table; write it in a run of its own",
-            );
-        }
-        Some(p) => {
-            let mut t = crate::output::AtomicFile::create(p)?;
-            t.write("frame,measure,kind,value,atoms,spec\n")?;
-            Some(t)
-        }
-    };
+    if a.mol.hbond_table.is_some() && !plan.draws_hbonds() {
+        return usage(
+            "--hbond-table lists the hydrogen bonds the hbonds style draws: add a representation of them, as --rep 'protein or water=hbonds'",
+        );
+    }
+    if a.mol.measure_table.is_some() && a.mol.measures.is_empty() {
+        return usage(
+            "--measure-table lists the --measure values: add a measurement, as --measure 'index 0; index 5'",
+        );
+    }
+    let whole = mine.len() == frames.len();
+    let mut hbond_table = per_frame_table(
+        &a.mol.hbond_table,
+        "--hbond-table",
+        "frame,donor,hydrogen,acceptor,donor_atom,hydrogen_atom,acceptor_atom,distance,angle",
+        whole,
+    )?;
+    let mut defect_table = per_frame_table(
+        &a.mol.defect_table,
+        "--defect-table",
+        "frame,vacancies,interstitials",
+        whole,
+    )?;
+    let mut measure_table = per_frame_table(
+        &a.mol.measure_table,
+        "--measure-table",
+        "frame,measure,kind,value,atoms,spec",
+        whole,
+    )?;
+    let mut grain_table = per_frame_table(
+        &a.mol.grain_table,
+        "--grain-table",
+        "frame,grain,atoms,crystalline,structure,qx,qy,qz,qw",
+        whole,
+    )?;
     if let Some(r) = &a.mol.displacement_reference {
         if !plan.measures_displacements() {
             return usage(format!(
@@ -829,6 +834,22 @@ fn render(a: &RenderArgs) -> Result<()> {
         {
             t.write(&format!("{f},{vacancies},{interstitials}\n"))
                 .map_err(|e| fail(e, &written))?;
+        }
+        if let Some(t) = &mut grain_table
+            && mine.contains(&k)
+            && let Some(grains) = plan.last_grains()
+        {
+            let mut rows = String::new();
+            for (g, grain) in grains.iter().enumerate() {
+                let [x, y, z, w] = grain.orientation;
+                rows.push_str(&format!(
+                    "{f},{g},{},{},{},{x:.6},{y:.6},{z:.6},{w:.6}\n",
+                    grain.size,
+                    grain.crystalline,
+                    grain.structure.name()
+                ));
+            }
+            t.write(&rows).map_err(|e| fail(e, &written))?;
         }
         if let Some(t) = &mut measure_table
             && mine.contains(&k)
@@ -1172,6 +1193,9 @@ fn render(a: &RenderArgs) -> Result<()> {
         t.commit()?;
     }
     if let Some(t) = defect_table {
+        t.commit()?;
+    }
+    if let Some(t) = grain_table {
         t.commit()?;
     }
     if builder.merged_colors() > 0 {

@@ -35,6 +35,8 @@ pub fn style_options(args: &StyleArgs) -> StyleOptions {
             ColorBy::Structure => texmap_md_scene::ColorBy::Structure,
             ColorBy::Cna => texmap_md_scene::ColorBy::Cna,
             ColorBy::Cluster => texmap_md_scene::ColorBy::Cluster,
+            ColorBy::Grain => texmap_md_scene::ColorBy::Grain,
+            ColorBy::Ipf(axis) => texmap_md_scene::ColorBy::Ipf(axis),
             ColorBy::Scalar(_) => texmap_md_scene::ColorBy::Scalar,
         },
         scalar: texmap_md_scene::ScalarColor {
@@ -511,6 +513,14 @@ pub fn mol_plan(args: &MolArgs, style: &StyleArgs, topology: Option<Topology>) -
             "--color-by {p}: give --strain R (the neighbour cutoff in Å, 3.0 for copper) to compute it"
         ));
     }
+    let grains = args.grains.is_some() || matches!(style.color_by, ColorBy::Grain);
+    if !grains
+        && (args.grain_keep_orphans || args.grain_table.is_some() || args.grain_min_size != 100)
+    {
+        return usage(
+            "--grain-min-size, --grain-keep-orphans and --grain-table are about the grains: add --grains",
+        );
+    }
     if args.centrosymmetry_matching && args.centrosymmetry.is_none() && !scalar_is("centrosymmetry")
     {
         return usage(
@@ -616,6 +626,17 @@ pub fn mol_plan(args: &MolArgs, style: &StyleArgs, topology: Option<Topology>) -
         strain: args.strain,
         freeze: args.freeze.clone(),
         voronoi: args.voronoi,
+        orientations: args.orientations
+            || [
+                "lattice_rmsd",
+                "orientation_x",
+                "orientation_y",
+                "orientation_z",
+                "orientation_w",
+            ]
+            .into_iter()
+            .any(scalar_is),
+        grains: grains.then(|| grain_options(args)),
         wigner_seitz: args.wigner_seitz.map(|w| match w {
             crate::args::WignerSeitzArg::Sites => texmap_md_scene::WsOutput::Sites,
             crate::args::WignerSeitzArg::Atoms => texmap_md_scene::WsOutput::Atoms,
@@ -681,6 +702,17 @@ pub fn mol_plan(args: &MolArgs, style: &StyleArgs, topology: Option<Topology>) -
     .map_err(mol_error)
 }
 
+/// The grain options of `--grains`, `--grain-min-size` and `--grain-keep-orphans`.
+fn grain_options(args: &MolArgs) -> texmap_md_io::grains::GrainOptions {
+    texmap_md_io::grains::GrainOptions {
+        threshold_deg: args
+            .grains
+            .unwrap_or(texmap_md_io::grains::GrainOptions::default().threshold_deg),
+        min_size: args.grain_min_size,
+        adopt_orphans: !args.grain_keep_orphans,
+    }
+}
+
 /// The `:COLOUR` of `--rep SEL=STYLE:COLOUR`: a colouring method without a number, or one
 /// colour.
 fn rep_color(rep: &str, text: &str) -> Result<texmap_md_scene::RepColor> {
@@ -698,10 +730,12 @@ fn rep_color(rep: &str, text: &str) -> Result<texmap_md_scene::RepColor> {
         Ok(ColorBy::Structure) => texmap_md_scene::ColorBy::Structure,
         Ok(ColorBy::Cna) => texmap_md_scene::ColorBy::Cna,
         Ok(ColorBy::Cluster) => texmap_md_scene::ColorBy::Cluster,
+        Ok(ColorBy::Grain) => texmap_md_scene::ColorBy::Grain,
+        Ok(ColorBy::Ipf(axis)) => texmap_md_scene::ColorBy::Ipf(axis),
         _ => {
             return usage(format!(
                 "--rep {rep:?}: {text:?} is not a representation's colouring; use element, type, \
-                 chain, structure, cna, property, #rrggbb or R,G,B (a colouring by a number is the \
+                 chain, structure, cna, cluster, grain, ipf, property, #rrggbb or R,G,B (a colouring by a number is the \
                  scene's: --color-by {text}, and the representations without :COLOUR take it)"
             ));
         }
@@ -720,6 +754,31 @@ fn read_reference(path: &std::path::Path) -> Result<Frame> {
     Ok(frame)
 }
 
+/// The per-atom properties the analyses add, and the flag that adds each.
+const ANALYSIS_PROPERTIES: [(&str, &str); 21] = [
+    ("coordination", "--coordination R"),
+    ("cluster", "--clusters R"),
+    ("centrosymmetry", "--centrosymmetry N"),
+    ("shear_strain", "--strain R"),
+    ("volumetric_strain", "--strain R"),
+    ("d2min", "--strain R"),
+    ("site_occupancy", "--wigner-seitz"),
+    ("site", "--wigner-seitz"),
+    ("voronoi_volume", "--voronoi"),
+    ("voronoi_faces", "--voronoi"),
+    ("voronoi_n3", "--voronoi"),
+    ("voronoi_n4", "--voronoi"),
+    ("voronoi_n5", "--voronoi"),
+    ("voronoi_n6", "--voronoi"),
+    ("orientation_x", "--orientations"),
+    ("orientation_y", "--orientations"),
+    ("orientation_z", "--orientations"),
+    ("orientation_w", "--orientations"),
+    ("lattice_rmsd", "--orientations"),
+    ("grain", "--grains"),
+    ("displacement", "--displacements"),
+];
+
 /// A [`MolError`] as the usage error naming the flag.
 pub fn mol_error(e: MolError) -> anyhow::Error {
     let text = match e {
@@ -728,7 +787,7 @@ pub fn mol_error(e: MolError) -> anyhow::Error {
             "--bonds topology: {topology} has no bonds (use --bonds auto for bonds by distance)"
         ),
         MolError::BadRadius { radius, .. } => format!("--radius: {radius} is not a radius > 0 in Å"),
-        MolError::Selection { role, error } => {
+        MolError::Selection { role, mut error } => {
             let flag = match role {
                 SelectionRole::Select => "--select",
                 SelectionRole::Color => "--color",
@@ -736,6 +795,13 @@ pub fn mol_error(e: MolError) -> anyhow::Error {
                 SelectionRole::Align => "--align",
                 SelectionRole::Cluster => "--cluster-atoms",
             };
+            // A property an analysis computes: name the flag that computes it.
+            if let Some((_, hint)) = ANALYSIS_PROPERTIES
+                .iter()
+                .find(|(p, _)| error.message.starts_with(&format!("this frame has no property '{p}'")))
+            {
+                error.message.push_str(&format!("; {hint} computes it"));
+            }
             format!("{flag}: {error}")
         }
         MolError::Align { atoms, why } if atoms >= 3 => {

@@ -3624,3 +3624,117 @@ fn voronoi_selects_ovitos_atoms() {
         stderr(&o)
     );
 }
+
+/// `--grains`, `--color-by ipf`, `--grain-table`: on md-io's grain fixtures (polycrystals OVITO
+/// wrote, with OVITO's Polyhedral template matching and Grain segmentation). With the orphans
+/// kept out, the atoms `--select 'prop grain == 1'` draws are OVITO's grain-1 atoms that
+/// adaptive CNA calls crystalline, byte for byte; `--color-by ipf` colours every atom as the
+/// inverse pole figure of OVITO's orientation colours it (drawn by `--color` rules); the table
+/// lists OVITO's grain count.
+#[test]
+fn grains_and_orientation_colours_are_ovitos() {
+    use texmap_md_io::orientation::{Symmetry, ipf_colour};
+    let dir = tempfile::tempdir().unwrap();
+    let base = ovito_data("grains");
+    let refs = read_json(&base.join("grains_reference.json"));
+    let case = &refs["systems"][0];
+    assert_eq!(case["file"], "fcc_poly.xyz");
+    let path = base.join("fcc_poly.xyz");
+    let file = path.to_string_lossy().into_owned();
+    let mut frame = texmap_md_io::Frame::new();
+    let mut traj = texmap_md_io::Trajectory::open(&path).unwrap();
+    assert!(traj.read_next(&mut frame).unwrap());
+    let cna = texmap_md_io::cna::classify(&frame);
+    let column = |key: &str| case[key].as_array().unwrap().clone();
+    let (ptm, grain, q) = (column("structure"), column("grain"), column("orientation"));
+    let render = |extra: &[&str], out: &str| {
+        render_png(
+            dir.path(),
+            &[&[file.as_str(), "--size", "200x160"], extra].concat(),
+            out,
+        )
+    };
+
+    let grain1: Vec<usize> = (0..cna.len())
+        .filter(|&i| grain[i] == 1 && cna[i] != texmap_md_io::cna::StructureType::Other)
+        .collect();
+    assert!(grain1.len() > 500, "{}", grain1.len());
+    let ours = render(
+        &[
+            "--grains",
+            "--grain-keep-orphans",
+            "--select",
+            "prop grain == 1",
+        ],
+        "ours.png",
+    );
+    assert_eq!(
+        ours,
+        render(&["--select", &index_ranges(&grain1)], "ovito.png")
+    );
+
+    // The atoms crystalline to both, coloured from OVITO's quaternions (channels in eighths,
+    // as the renderer rounds them).
+    let both: Vec<usize> = (0..cna.len())
+        .filter(|&i| cna[i] != texmap_md_io::cna::StructureType::Other)
+        .filter(|&i| ptm[i].as_i64() == Some(cna[i] as i64))
+        .collect();
+    let mut groups: std::collections::BTreeMap<String, Vec<usize>> = Default::default();
+    for &i in &both {
+        let v: Vec<f64> = q[i]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect();
+        let c = ipf_colour([v[0], v[1], v[2], v[3]], Symmetry::Cubic, [0.0, 0.0, 1.0]);
+        let hex = c.map(|c| ((c * 7.0).round() / 7.0 * 255.0).round() as u8);
+        let hex = format!("#{:02x}{:02x}{:02x}", hex[0], hex[1], hex[2]);
+        groups.entry(hex).or_default().push(i);
+    }
+    let select = index_ranges(&both);
+    let ours = render(&["--select", &select, "--color-by", "ipf"], "ipf.png");
+    let mut rules = vec!["--select".to_string(), select.clone()];
+    for (hex, atoms) in &groups {
+        rules.push("--color".into());
+        rules.push(format!("{}={hex}", index_ranges(atoms)));
+    }
+    let rules: Vec<&str> = rules.iter().map(|s| s.as_str()).collect();
+    assert_eq!(ours, render(&rules, "ipf_ovito.png"));
+
+    let table = dir.path().join("grains.csv");
+    render(
+        &["--grains", "--grain-table", table.to_str().unwrap()],
+        "table.png",
+    );
+    let text = std::fs::read_to_string(&table).unwrap();
+    let rows: Vec<&str> = text.lines().skip(1).collect();
+    assert_eq!(
+        text.lines().next(),
+        Some("frame,grain,atoms,crystalline,structure,qx,qy,qz,qw")
+    );
+    assert_eq!(rows.len(), case["grain_size"].as_array().unwrap().len());
+    assert!(
+        rows.iter()
+            .all(|r| r.starts_with("0,") && r.contains(",fcc,"))
+    );
+}
+
+/// A selection of the atoms `atoms` (ascending), runs as ranges: `index 3:7 9 12:40`.
+fn index_ranges(atoms: &[usize]) -> String {
+    let mut out = String::from("index");
+    let mut k = 0;
+    while k < atoms.len() {
+        let mut end = k;
+        while end + 1 < atoms.len() && atoms[end + 1] == atoms[end] + 1 {
+            end += 1;
+        }
+        if end > k {
+            out.push_str(&format!(" {}:{}", atoms[k], atoms[end]));
+        } else {
+            out.push_str(&format!(" {}", atoms[k]));
+        }
+        k = end + 1;
+    }
+    out
+}

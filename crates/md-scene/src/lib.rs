@@ -106,16 +106,16 @@ pub use outline::{add_box_outline, cell_corners};
 pub use palette::{MAX_MATERIALS, Palette, type_color};
 pub use plan::{
     Alignment, BALL_AND_STICK_BOND_RADIUS, BALL_AND_STICK_RADIUS_SCALE, BondSource, CENTROSYMMETRY,
-    CLUSTER, COORDINATION, CentroOptions, ClusterOptions, D2MIN, DISPLACEMENT, DrawStyle,
-    HBOND_COLOR, HBOND_DASHES, HBOND_RADIUS, LICORICE_RADIUS, MolError, MolOptions, MolPlan, Pbc,
-    RepColor, Representation, SHEAR_STRAIN, SITE, SITE_OCCUPANCY, SelectionRole, Slice,
-    TRAIL_RADIUS, VALENCE_OFFSET, VALENCE_RADIUS, VOLUMETRIC_STRAIN, VORONOI_FACES, VORONOI_INDEX,
-    VORONOI_VOLUME, WsOutput,
+    CLUSTER, COORDINATION, CentroOptions, ClusterOptions, D2MIN, DISPLACEMENT, DrawStyle, GRAIN,
+    HBOND_COLOR, HBOND_DASHES, HBOND_RADIUS, LATTICE_RMSD, LICORICE_RADIUS, MolError, MolOptions,
+    MolPlan, ORIENTATION, Pbc, RepColor, Representation, SHEAR_STRAIN, SITE, SITE_OCCUPANCY,
+    SelectionRole, Slice, TRAIL_RADIUS, VALENCE_OFFSET, VALENCE_RADIUS, VOLUMETRIC_STRAIN,
+    VORONOI_FACES, VORONOI_INDEX, VORONOI_VOLUME, WsOutput,
 };
 pub use scalar::{NAN_COLOR, SCALAR_LEVELS, ScalarColor, ScalarSource};
 pub use style::{
-    CNA_COLORS, ColorBy, RuleKind, STRUCTURE_COLORS, SceneBuilder, StyleError, StyleOptions,
-    StyleWarning, style_from,
+    CNA_COLORS, ColorBy, IpfAxis, RuleKind, STRUCTURE_COLORS, SceneBuilder, StyleError,
+    StyleOptions, StyleWarning, style_from,
 };
 
 #[doc(no_inline)]

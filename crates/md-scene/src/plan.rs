@@ -112,6 +112,7 @@ use texmap_impostor::SphereScene;
 use texmap_md_io::centrosymmetry::{CentroError, CspMode};
 use texmap_md_io::coordination::CoordinationError;
 use texmap_md_io::expr::{ExprError, Expression};
+use texmap_md_io::grains::{Grain, GrainOptions};
 use texmap_md_io::hbonds::{self, Criteria, HBond, HBondError};
 use texmap_md_io::replicate::ReplicateError;
 use texmap_md_io::strain::StrainError;
@@ -255,6 +256,19 @@ pub const VORONOI_VOLUME: &str = "voronoi_volume";
 pub const VORONOI_FACES: &str = "voronoi_faces";
 /// The per-atom counts of Voronoi faces with 3, 4, 5 and 6 edges [`MolOptions::voronoi`] adds.
 pub const VORONOI_INDEX: [&str; 4] = ["voronoi_n3", "voronoi_n4", "voronoi_n5", "voronoi_n6"];
+/// The per-atom lattice orientation quaternion components (x, y, z, w) [`MolOptions::orientations`]
+/// adds: NaN for atoms that are not FCC, HCP or BCC.
+pub const ORIENTATION: [&str; 4] = [
+    "orientation_x",
+    "orientation_y",
+    "orientation_z",
+    "orientation_w",
+];
+/// The per-atom deviation from the ideal lattice (PTM's RMSD) [`MolOptions::orientations`]
+/// adds: NaN for atoms that are not FCC, HCP or BCC.
+pub const LATTICE_RMSD: &str = "lattice_rmsd";
+/// The per-atom grain [`MolOptions::grains`] adds (0 the largest, −1 for atoms in none).
+pub const GRAIN: &str = "grain";
 /// The per-atom property [`MolOptions::displacement`] adds to each frame.
 pub const DISPLACEMENT: &str = "displacement";
 
@@ -313,6 +327,16 @@ pub struct MolOptions {
     /// [`VORONOI_FACES`] and [`VORONOI_INDEX`] (`prop voronoi_n5 == 12 and prop voronoi_faces
     /// == 12`: the icosahedra of a metallic glass). Needs a periodic cell.
     pub voronoi: bool,
+    /// Every crystalline atom's lattice orientation every frame, after the Voronoi cells (the
+    /// orientation and RMSD of OVITO's Polyhedral template matching, on the FCC, HCP and BCC
+    /// atoms of adaptive CNA: [`texmap_md_io::orientation`]), as the properties
+    /// [`ORIENTATION`] and [`LATTICE_RMSD`].
+    pub orientations: bool,
+    /// The grains of a polycrystal every frame, after the orientations (OVITO's Grain
+    /// segmentation: [`texmap_md_io::grains`]), as the property [`GRAIN`], for colouring
+    /// ([`crate::ColorBy::Grain`]) and selections (`prop grain == 0`: the largest);
+    /// [`MolPlan::last_grains`] lists them.
+    pub grains: Option<GrainOptions>,
     /// Per-atom properties frozen at the first frame built (OVITO's Freeze property), after
     /// [`MolOptions::computes`]: every later frame gets the values the first had, atom by atom,
     /// so that colours follow the atoms (a crystal coloured by where each atom started shows
@@ -452,6 +476,8 @@ impl Default for MolOptions {
             computes: Vec::new(),
             wigner_seitz: None,
             voronoi: false,
+            orientations: false,
+            grains: None,
             freeze: Vec::new(),
             radius_from: None,
             slice: None,
@@ -758,6 +784,8 @@ pub struct MolPlan {
     configuration: Option<Frame>,
     /// The last frame's vacancies and interstitials ([`MolOptions::wigner_seitz`]).
     last_defects: Option<(usize, usize)>,
+    /// The last frame's grains ([`MolOptions::grains`]).
+    last_grains: Option<Vec<Grain>>,
     /// The values of [`MolOptions::freeze`]'s properties at the first frame built.
     frozen: Vec<Vec<f32>>,
     arrow_vectors: Vec<glam::Vec3>,
@@ -843,6 +871,7 @@ impl MolPlan {
             arrow_reference: None,
             configuration: None,
             last_defects: None,
+            last_grains: None,
             frozen: Vec::new(),
             arrow_vectors: Vec::new(),
             arrows: MolMesh::default(),
@@ -1220,6 +1249,30 @@ impl MolPlan {
                 set_property(frame, name, v.index.iter().map(|i| i[k] as f32).collect());
             }
         }
+        self.last_grains = None;
+        if self.options.orientations || self.options.grains.is_some() {
+            let types = texmap_md_io::cna::classify(frame);
+            let fits = texmap_md_io::orientation::orientations(frame, &types);
+            if self.options.orientations {
+                for (k, name) in ORIENTATION.iter().enumerate() {
+                    let values = fits
+                        .iter()
+                        .map(|f| f.map_or(f32::NAN, |f| f.orientation[k] as f32));
+                    set_property(frame, name, values.collect());
+                }
+                let values = fits.iter().map(|f| f.map_or(f32::NAN, |f| f.rmsd as f32));
+                set_property(frame, LATTICE_RMSD, values.collect());
+            }
+            if let Some(options) = &self.options.grains {
+                let found = texmap_md_io::grains::segment(frame, &types, &fits, options);
+                set_property(
+                    frame,
+                    GRAIN,
+                    found.grain.iter().map(|&g| g as f32).collect(),
+                );
+                self.last_grains = Some(found.grains);
+            }
+        }
         for (name, formula) in &self.options.computes {
             let values = formula.evaluate(frame).map_err(|error| MolError::Compute {
                 name: name.clone(),
@@ -1463,6 +1516,12 @@ impl MolPlan {
     /// without it).
     pub fn last_defects(&self) -> Option<(usize, usize)> {
         self.last_defects
+    }
+
+    /// The last frame's grains, the largest first ([`MolOptions::grains`]; `None` without
+    /// it).
+    pub fn last_grains(&self) -> Option<&[Grain]> {
+        self.last_grains.as_deref()
     }
 
     /// The last frame's measurements ([`MolOptions::measures`], in order): points, values and

@@ -42,6 +42,36 @@ pub enum ColorBy {
     /// [`crate::plan::CLUSTER`], [`crate::MolOptions::clusters`]): the palette colour of the
     /// cluster's id, the largest first; atoms in no cluster take the element colours.
     Cluster,
+    /// The rules, else one distinct colour per grain (the per-atom property
+    /// [`crate::plan::GRAIN`], [`crate::MolOptions::grains`]), the largest first; atoms in no
+    /// grain take the element colours.
+    Grain,
+    /// The rules, else the inverse pole figure colour of the atom's lattice orientation along
+    /// a sample axis ([`texmap_md_io::orientation::ipf_colour`]: for cubic crystals [001] red,
+    /// [101] green, [111] blue), computed per frame, each channel rounded to eighths so that a
+    /// polycrystal fits the scene's materials; atoms that are not FCC, HCP or BCC take
+    /// [`CNA_COLORS`]' "other".
+    Ipf(IpfAxis),
+}
+
+/// The sample direction an inverse pole figure ([`ColorBy::Ipf`]) looks along, as EBSD maps'
+/// IPF-X, IPF-Y and IPF-Z.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum IpfAxis {
+    X,
+    Y,
+    Z,
+}
+
+impl IpfAxis {
+    /// The unit vector.
+    pub fn vector(self) -> [f64; 3] {
+        match self {
+            IpfAxis::X => [1.0, 0.0, 0.0],
+            IpfAxis::Y => [0.0, 1.0, 0.0],
+            IpfAxis::Z => [0.0, 0.0, 1.0],
+        }
+    }
 }
 
 /// The colours of [`ColorBy::Cna`], OVITO's: other near-white, FCC green, HCP red, BCC blue,
@@ -439,10 +469,14 @@ impl SceneBuilder {
             Vec::new()
         };
         let cluster = match color_by {
-            ColorBy::Cluster => frame
-                .property(crate::plan::CLUSTER)
-                .filter(|v| v.len() == frame.n_atoms()),
+            ColorBy::Cluster => frame.property(crate::plan::CLUSTER),
+            ColorBy::Grain => frame.property(crate::plan::GRAIN),
             _ => None,
+        }
+        .filter(|v| v.len() == frame.n_atoms());
+        let ipf: Vec<[f32; 3]> = match color_by {
+            ColorBy::Ipf(axis) => ipf_colours(frame, axis),
+            _ => Vec::new(),
         };
         for (i, &base_color) in base.iter().enumerate().take(frame.n_atoms()) {
             let color = match categories {
@@ -473,6 +507,10 @@ impl SceneBuilder {
                         _ => base_color,
                     },
                 },
+                None if !ipf.is_empty() => match self.style.rules_for(frame, i).color {
+                    Some(c) => c,
+                    None => ipf[i],
+                },
                 None if !crystal.is_empty() => match self.style.rules_for(frame, i).color {
                     Some(c) => c,
                     None => CNA_COLORS[crystal[i] as usize],
@@ -495,6 +533,22 @@ impl SceneBuilder {
     pub fn refresh_materials(&self, scene: &mut SphereScene) {
         scene.materials = self.palette.materials();
     }
+}
+
+/// Every atom's inverse pole figure colour along `axis` ([`ColorBy::Ipf`]), each channel
+/// rounded to eighths; "other" for atoms without a lattice orientation.
+fn ipf_colours(frame: &Frame, axis: IpfAxis) -> Vec<[f32; 3]> {
+    let types = texmap_md_io::cna::classify(frame);
+    let fits = texmap_md_io::orientation::orientations(frame, &types);
+    fits.iter()
+        .map(|fit| match fit {
+            Some(f) => {
+                texmap_md_io::orientation::ipf_colour(f.orientation, f.symmetry, axis.vector())
+                    .map(|c| (c * 7.0).round() / 7.0)
+            }
+            None => CNA_COLORS[0],
+        })
+        .collect()
 }
 
 #[cfg(test)]
