@@ -25,7 +25,8 @@ use texmap::md_scene::isosurface::{Side, bands, isosurface};
 use texmap::md_scene::surface::{MolMesh, SurfaceAtoms, SurfaceOptions, draw_mesh};
 
 fn bench(c: &mut Criterion) {
-    let test_mode = std::env::args().any(|a| a == "--test");
+    // `cargo bench` passes --bench; `cargo test --benches` runs the small sizes.
+    let test_mode = !std::env::args().any(|a| a == "--bench");
     let path = concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/crates/md-io/tests/data/dssp/3e8mA.pdb.gz"

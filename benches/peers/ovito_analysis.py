@@ -1,5 +1,5 @@
 """The peer of benches/md_analysis.rs: OVITO's modifiers on the same atoms with the same
-parameters, timed in the same minutes. Reads target/md_analysis_{ref,cur}.xyz (written by
+parameters, timed in the same minutes. Reads target/md_analysis_{ref,cur,poly}.xyz (written by
 `cargo bench --bench md_analysis`) and prints the median of 10 evaluations per analysis, in ms,
 file reading excluded (both configurations are loaded once; each evaluation is a new pipeline
 over them, so OVITO's caches do not carry over).
@@ -20,6 +20,7 @@ import ovito  # noqa: E402
 from ovito.io import import_file  # noqa: E402
 from ovito.modifiers import (AtomicStrainModifier, CentroSymmetryModifier,  # noqa: E402
                              CommonNeighborAnalysisModifier, CoordinationAnalysisModifier,
+                             GrainSegmentationModifier, PolyhedralTemplateMatchingModifier,
                              VoronoiAnalysisModifier)
 from ovito.pipeline import Pipeline, StaticSource  # noqa: E402
 
@@ -30,6 +31,7 @@ ref = os.path.join(target, "md_analysis_ref.xyz")
 cur = os.path.join(target, "md_analysis_cur.xyz")
 reference_data = import_file(ref).compute()
 current_data = import_file(cur).compute()
+poly_data = import_file(os.path.join(target, "md_analysis_poly.xyz")).compute()
 print(f"{reference_data.particles.count} atoms, OVITO {ovito.version_string}, {threads} threads")
 
 
@@ -37,7 +39,9 @@ def timed(name, data, make_modifier, runs=10):
     times = []
     for _ in range(runs):
         pipe = Pipeline(source=StaticSource(data=data))
-        pipe.modifiers.append(make_modifier())
+        made = make_modifier()
+        for m in made if isinstance(made, list) else [made]:
+            pipe.modifiers.append(m)
         t = time.perf_counter()
         pipe.compute()
         times.append((time.perf_counter() - t) * 1000)
@@ -58,3 +62,9 @@ timed("centrosymmetry_matching", reference_data,
 timed("strain", current_data, strain)
 timed("voronoi", reference_data, lambda: VoronoiAnalysisModifier(compute_indices=True))
 timed("coordination", reference_data, lambda: CoordinationAnalysisModifier(cutoff=3.0))
+print(f"polycrystal: {poly_data.particles.count} atoms")
+timed("orientations_poly", poly_data,
+      lambda: PolyhedralTemplateMatchingModifier(output_orientation=True, output_rmsd=True))
+timed("grains_poly", poly_data,
+      lambda: [PolyhedralTemplateMatchingModifier(output_orientation=True),
+               GrainSegmentationModifier()])

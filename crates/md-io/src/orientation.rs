@@ -250,6 +250,12 @@ struct Template {
     first_shell: usize,
     /// The cosine of the angle between the anchor and the second neighbour chosen.
     anchor_cos: f64,
+    /// The points' unit directions.
+    unit: Vec<DVec3>,
+    /// The points that stand for their orbits under the template's own rotations (the
+    /// smallest index of each): the nearest neighbour is paired only with these, since
+    /// pairings that differ by such a rotation fit equally well.
+    representatives: Vec<usize>,
     /// The normalised points (centre first) and Σ|t|².
     normalised: Vec<DVec3>,
     g2: f64,
@@ -323,7 +329,11 @@ impl Template {
     ) -> Template {
         let normalised = normalise(&points);
         let g2 = normalised.iter().map(|v| v.length_squared()).sum();
+        let unit: Vec<DVec3> = points.iter().map(|p| p.normalize()).collect();
+        let representatives = orbit_representatives(&points);
         Template {
+            unit,
+            representatives,
             points,
             first_shell,
             anchor_cos,
@@ -361,10 +371,10 @@ impl Template {
         let mut pairing = vec![0usize; n];
         // Every template point for the anchors (not only its shell's: in a distorted shell
         // the nearest neighbour may be the template's second shell).
-        for j in 0..n {
-            let tj = self.points[j].normalize();
+        for &j in &self.representatives {
+            let tj = self.unit[j];
             for k in 0..n {
-                let tk = self.points[k].normalize();
+                let tk = self.unit[k];
                 if k == j || (tj.dot(tk) - cos).abs() > 0.25 {
                     continue;
                 }
@@ -377,8 +387,8 @@ impl Template {
                     let back = turn.transpose() * *u;
                     let mut pick = 0;
                     let mut most = f64::NEG_INFINITY;
-                    for (t, p) in self.points.iter().enumerate() {
-                        let d = back.dot(*p) / p.length();
+                    for (t, p) in self.unit.iter().enumerate() {
+                        let d = back.dot(*p);
                         if d > most {
                             most = d;
                             pick = t;
@@ -423,6 +433,41 @@ impl Template {
     }
 }
 
+/// The smallest index of each orbit of `points` under the rotations that map the set onto
+/// itself.
+fn orbit_representatives(points: &[DVec3]) -> Vec<usize> {
+    let n = points.len();
+    let unit: Vec<DVec3> = points.iter().map(|p| p.normalize()).collect();
+    let image = |r: &DMat3, p: DVec3| (0..n).find(|&i| (*r * p - points[i]).length() < 1e-9);
+    // A second point off the first's axis fixes a rotation.
+    let a = (1..n)
+        .find(|&k| unit[0].cross(unit[k]).length() > 1e-6)
+        .expect("a template spans space");
+    let from = frame_of(unit[0], unit[a]).expect("not parallel");
+    let mut group = Vec::new();
+    for j in 0..n {
+        for k in 0..n {
+            let same_shape = (points[j].length() - points[0].length()).abs() < 1e-9
+                && (points[k].length() - points[a].length()).abs() < 1e-9
+                && (unit[j].dot(unit[k]) - unit[0].dot(unit[a])).abs() < 1e-9;
+            let Some(to) = frame_of(unit[j], unit[k]) else {
+                continue;
+            };
+            let r = to * from.transpose();
+            if same_shape && points.iter().all(|p| image(&r, *p).is_some()) {
+                group.push(r);
+            }
+        }
+    }
+    (0..n)
+        .filter(|&j| {
+            group
+                .iter()
+                .all(|r| image(r, points[j]).is_none_or(|i| i >= j))
+        })
+        .collect()
+}
+
 /// The centre (the origin) and `points`, moved so their barycentre is the origin and scaled
 /// so the points' mean length from it is 1; the centre first.
 fn normalise(points: &[DVec3]) -> Vec<DVec3> {
@@ -447,6 +492,16 @@ fn frame_of(a: DVec3, b: DVec3) -> Option<DMat3> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn templates_have_their_point_groups() {
+        // FCC: one orbit under the cube's 24 rotations; BCC: the two shells; HCP (site A, D3):
+        // the plane's six and the others' six.
+        let reps = |s| Template::of(s).unwrap().representatives.clone();
+        assert_eq!(reps(StructureType::Fcc), vec![0]);
+        assert_eq!(reps(StructureType::Bcc), vec![0, 8]);
+        assert_eq!(reps(StructureType::Hcp), vec![0, 6]);
+    }
 
     #[test]
     fn groups_are_closed() {
