@@ -1146,6 +1146,11 @@ pub struct MolArgs {
     /// surfaces) at grain -1 instead of giving them to the nearest grain.
     #[arg(long)]
     pub grain_keep_orphans: bool,
+    /// With --grains: give the HCP layers of stacking faults and twin boundaries in an FCC
+    /// crystal (or FCC layers in HCP) grains of their own instead of joining them to the grain
+    /// they lie in (OVITO's "handle stacking faults" off).
+    #[arg(long)]
+    pub grain_separate_faults: bool,
     /// Also write the grains of every frame as a CSV table, one row per grain: frame, grain,
     /// atoms, crystalline atoms, structure, and the mean orientation's quaternion. Written whole
     /// or not at all.

@@ -515,10 +515,13 @@ pub fn mol_plan(args: &MolArgs, style: &StyleArgs, topology: Option<Topology>) -
     }
     let grains = args.grains.is_some() || matches!(style.color_by, ColorBy::Grain);
     if !grains
-        && (args.grain_keep_orphans || args.grain_table.is_some() || args.grain_min_size != 100)
+        && (args.grain_keep_orphans
+            || args.grain_separate_faults
+            || args.grain_table.is_some()
+            || args.grain_min_size != 100)
     {
         return usage(
-            "--grain-min-size, --grain-keep-orphans and --grain-table are about the grains: add --grains",
+            "--grain-min-size, --grain-keep-orphans, --grain-separate-faults and --grain-table are about the grains: add --grains",
         );
     }
     if args.centrosymmetry_matching && args.centrosymmetry.is_none() && !scalar_is("centrosymmetry")
@@ -710,6 +713,7 @@ fn grain_options(args: &MolArgs) -> texmap_md_io::grains::GrainOptions {
             .unwrap_or(texmap_md_io::grains::GrainOptions::default().threshold_deg),
         min_size: args.grain_min_size,
         adopt_orphans: !args.grain_keep_orphans,
+        join_stacking_faults: !args.grain_separate_faults,
     }
 }
 

@@ -16,8 +16,13 @@
 //! 4. Grains are numbered by their crystalline atoms, most first (OVITO numbers from 0 too);
 //!    ties go to the grain whose seed came first.
 //!
-//! Unlike OVITO's, an FCC grain's stacking faults (HCP layers) are not joined to it: their
-//! atoms form grains of their own when large enough, and are adopted otherwise.
+//! Stacking faults and twin boundaries (HCP layers in FCC, or FCC layers in HCP) are joined to
+//! the grain they lie in, as OVITO does by default: the commoner of the two phases is the
+//! parent, its seeds come first, and its grains take in an atom of the other phase when the
+//! parent lattice that continues the atom's ([111] along c, [1-10] along a₁) is within the
+//! threshold of the grain's mean. A twin's two sides stay two grains (60° apart); its boundary
+//! layer joins whichever side reaches it first. Without it
+//! ([`GrainOptions::join_stacking_faults`] false) fault layers make grains of their own.
 //!
 //! ```
 //! use texmap_md_io::cna::classify;
@@ -48,7 +53,7 @@
 //! assert!(grains.grain.iter().all(|g| *g >= 0)); // the boundary atoms adopted
 //! ```
 
-use glam::DQuat;
+use glam::{DMat3, DQuat, DVec3};
 
 use crate::cna::StructureType;
 use crate::frame::Frame;
@@ -65,6 +70,11 @@ pub struct GrainOptions {
     /// Give atoms in no grain to the grain of their nearest neighbour that has one (OVITO's
     /// default).
     pub adopt_orphans: bool,
+    /// Let the grains of the commoner of FCC and HCP take in the other's atoms where their
+    /// lattices continue one another: the HCP layers of stacking faults and twin boundaries
+    /// in an FCC crystal (or FCC layers in HCP) join the grain they lie in instead of making
+    /// their own (OVITO's default: "handle stacking faults").
+    pub join_stacking_faults: bool,
 }
 
 impl Default for GrainOptions {
@@ -73,6 +83,7 @@ impl Default for GrainOptions {
             threshold_deg: 4.0,
             min_size: 100,
             adopt_orphans: true,
+            join_stacking_faults: true,
         }
     }
 }
@@ -141,11 +152,31 @@ pub fn segment(
         .collect();
     let neighbours = |i: usize| &lists[i].index[..lists[i].count as usize];
 
-    // 1. Growth from the most perfect atoms.
+    // The parent phase of stacking faults: the commoner of FCC and HCP.
+    let count = |t: StructureType| {
+        (0..n)
+            .filter(|&i| fits[i].is_some() && types[i] == t)
+            .count()
+    };
+    let (parent, minority) = if count(StructureType::Fcc) >= count(StructureType::Hcp) {
+        (StructureType::Fcc, StructureType::Hcp)
+    } else {
+        (StructureType::Hcp, StructureType::Fcc)
+    };
+    let joins = |grain: StructureType, atom: StructureType| {
+        options.join_stacking_faults && grain == parent && atom == minority
+    };
+
+    // 1. Growth from the most perfect atoms, the parent phase's first (so that its grains
+    // reach the faults before the faults seed grains of their own).
     let mut seeds: Vec<usize> = (0..n).filter(|&i| fits[i].is_some()).collect();
     seeds.sort_by(|&a, &b| {
         let (ra, rb) = (fits[a].unwrap().rmsd, fits[b].unwrap().rmsd);
-        ra.total_cmp(&rb).then(a.cmp(&b))
+        let minor = |i: usize| options.join_stacking_faults && types[i] == minority;
+        minor(a)
+            .cmp(&minor(b))
+            .then(ra.total_cmp(&rb))
+            .then(a.cmp(&b))
     });
     let cos_half = (options.threshold_deg.to_radians() / 2.0).cos();
     let mut grain = vec![-1i32; n];
@@ -170,12 +201,15 @@ pub fn segment(
                     continue;
                 }
                 let Some(fb) = fits[b] else { continue };
-                if fb.symmetry != fit.symmetry {
+                // The equivalent of b's orientation nearest the mean: across a fault, b's
+                // orientation as the parent lattice's.
+                let (eq, w) = if joins(types[seed], types[b]) {
+                    across_fault(mean, quat(fb.orientation), fb.symmetry, fit.symmetry)
+                } else if fb.symmetry == fit.symmetry {
+                    nearest_equivalent(mean, quat(fb.orientation), fit.symmetry)
+                } else {
                     continue;
-                }
-                // The equivalent of b's orientation nearest the mean.
-                let qb = quat(fb.orientation);
-                let (eq, w) = nearest_equivalent(mean, qb, fit.symmetry);
+                };
                 if w < cos_half {
                     continue;
                 }
@@ -260,6 +294,38 @@ pub fn segment(
         })
         .collect();
     Grains { grain, grains }
+}
+
+/// For an atom of one close-packed phase (`q`, its `own` symmetry) next to a grain of the
+/// other (`mean`, symmetry `parent`): the orientation of the parent's lattice that continues
+/// the atom's (FCC's [111] along HCP's c, an FCC [1-10] along HCP's a₁), the equivalent nearest
+/// the mean, and cos(angle / 2) to it.
+fn across_fault(mean: DQuat, q: DQuat, own: Symmetry, parent: Symmetry) -> (DQuat, f64) {
+    use std::sync::OnceLock;
+    // The rotation from the hexagonal template's frame to the cubic one's.
+    static HEX_TO_CUBIC: OnceLock<DQuat> = OnceLock::new();
+    let t = *HEX_TO_CUBIC.get_or_init(|| {
+        let frame = |c: DVec3, a: DVec3| {
+            let (c, a) = (c.normalize(), a.normalize());
+            DMat3::from_cols(a, c.cross(a), c)
+        };
+        let m = frame(DVec3::new(1.0, 1.0, 1.0), DVec3::new(1.0, -1.0, 0.0))
+            * frame(DVec3::Z, DVec3::X).transpose();
+        DQuat::from_mat3(&m).normalize()
+    });
+    let convert = if parent == Symmetry::Cubic {
+        t.conjugate()
+    } else {
+        t
+    };
+    let mut best = (DQuat::IDENTITY, f64::NEG_INFINITY);
+    for g in own.rotations() {
+        let candidate = nearest_equivalent(mean, q * *g * convert, parent);
+        if candidate.1 > best.1 {
+            best = candidate;
+        }
+    }
+    best
 }
 
 fn quat(q: [f64; 4]) -> DQuat {

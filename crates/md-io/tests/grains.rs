@@ -215,3 +215,53 @@ fn grains_do_not_depend_on_the_thread_count() {
         .install(run);
     assert!(one == two);
 }
+
+/// Stacking faults and twin boundaries (tests/data/grains/gen_faults.py): with the faults
+/// joined, two intrinsic faults leave one grain and two twin boundaries two grains of OVITO's
+/// FCC atoms (the boundary layers join a side, as OVITO's but not necessarily the same one);
+/// with them separate, each fault's HCP layers are a grain, as OVITO finds.
+#[test]
+fn stacking_faults_join_their_grain_as_in_ovito() {
+    let refs = DATA.json("faults_reference.json");
+    for case in refs.as_array().unwrap() {
+        let file = case["file"].as_str().unwrap();
+        let frame = DATA.frame(file);
+        let types = classify(&frame);
+        let fits = orientations(&frame, &types);
+        for (key, join) in [("faults_joined", true), ("faults_separate", false)] {
+            let options = GrainOptions {
+                join_stacking_faults: join,
+                ..GrainOptions::default()
+            };
+            let ours = segment(&frame, &types, &fits, &options);
+            let theirs = integers(&case[key]["grain"]);
+            let sizes = integers(&case[key]["grain_size"]);
+            let ovito_types = integers(&case[key]["structure"]);
+            assert_eq!(ours.grains.len(), sizes.len(), "{file} {key}");
+            // Our grains map one to one onto OVITO's on the atoms that must agree: all of
+            // them, but for the twin boundary layers when joined.
+            let mut map = vec![None; sizes.len()];
+            let mut agree = 0;
+            let mut checked = 0;
+            for i in 0..theirs.len() {
+                assert_eq!(
+                    types[i] as i64, ovito_types[i],
+                    "{file}: atom {i}'s structure"
+                );
+                if join && types[i] == StructureType::Hcp && file == "twins.xyz" {
+                    continue;
+                }
+                let (g, t) = (ours.grain[i], theirs[i]);
+                assert!(g >= 0 && t >= 0, "{file} {key}: atom {i} in no grain");
+                let m = map[g as usize].get_or_insert(t);
+                checked += 1;
+                agree += (*m == t) as usize;
+            }
+            println!(
+                "{file} {key}: {agree} of {checked} atoms in OVITO's grain, grains {:?} against {sizes:?}",
+                ours.grains.iter().map(|g| g.size).collect::<Vec<_>>()
+            );
+            assert_eq!(agree, checked, "{file} {key}");
+        }
+    }
+}
