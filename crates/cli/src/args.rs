@@ -156,6 +156,9 @@ pub enum ColorBy {
     /// --type-color, else the crystal structure type (adaptive CNA: FCC, HCP, BCC, ICO,
     /// other), per frame, in OVITO's colours.
     Cna,
+    /// --type-color, else the diamond structure type (cubic, hexagonal, their first and
+    /// second neighbours, other), per frame, in OVITO's colours.
+    Diamond,
     /// --type-color, else one distinct colour per cluster (--clusters), the largest first.
     Cluster,
     /// --type-color, else one distinct colour per grain (--grains), the largest first.
@@ -177,6 +180,7 @@ pub fn parse_color_by(s: &str) -> Result<ColorBy, String> {
         "chain" => ColorBy::Chain,
         "structure" | "secondary" | "ss" => ColorBy::Structure,
         "cna" | "structure-type" => ColorBy::Cna,
+        "diamond" => ColorBy::Diamond,
         "cluster" | "clusters" => ColorBy::Cluster,
         "grain" | "grains" => ColorBy::Grain,
         "ipf" | "ipf-z" | "orientation" => ColorBy::Ipf(texmap_md_scene::IpfAxis::Z),
@@ -403,6 +407,10 @@ pub struct StyleArgs {
             "             analysis in OVITO's colours: FCC green, HCP red, BCC blue, icosahedral yellow,\n",
             "             other white (as OVITO assigns them, recomputed every frame); with --select\n",
             "             'not cna fcc' only the defects, stacking faults and surfaces are drawn\n",
+            "  diamond    --type-color, else the diamond structure type (silicon, germanium, carbon,\n",
+            "             ice) in OVITO's colours: cubic blue, hexagonal orange, their first and second\n",
+            "             neighbours (surfaces, defects) lighter; with --select 'not diamond cubic' only\n",
+            "             the defects and surfaces are drawn\n",
             "  ipf        --type-color, else the lattice orientation as an inverse pole figure (EBSD's\n",
             "             IPF-Z: the crystal direction along z; cubic [001] red, [101] green, [111] blue;\n",
             "             hexagonal [0001] red, [2-1-10] green, [10-10] blue), on the FCC, HCP and BCC\n",

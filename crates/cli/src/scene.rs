@@ -34,6 +34,7 @@ pub fn style_options(args: &StyleArgs) -> StyleOptions {
             ColorBy::Chain => texmap_md_scene::ColorBy::Chain,
             ColorBy::Structure => texmap_md_scene::ColorBy::Structure,
             ColorBy::Cna => texmap_md_scene::ColorBy::Cna,
+            ColorBy::Diamond => texmap_md_scene::ColorBy::Diamond,
             ColorBy::Cluster => texmap_md_scene::ColorBy::Cluster,
             ColorBy::Grain => texmap_md_scene::ColorBy::Grain,
             ColorBy::Ipf(axis) => texmap_md_scene::ColorBy::Ipf(axis),
@@ -733,13 +734,14 @@ fn rep_color(rep: &str, text: &str) -> Result<texmap_md_scene::RepColor> {
         Ok(ColorBy::Chain) => texmap_md_scene::ColorBy::Chain,
         Ok(ColorBy::Structure) => texmap_md_scene::ColorBy::Structure,
         Ok(ColorBy::Cna) => texmap_md_scene::ColorBy::Cna,
+        Ok(ColorBy::Diamond) => texmap_md_scene::ColorBy::Diamond,
         Ok(ColorBy::Cluster) => texmap_md_scene::ColorBy::Cluster,
         Ok(ColorBy::Grain) => texmap_md_scene::ColorBy::Grain,
         Ok(ColorBy::Ipf(axis)) => texmap_md_scene::ColorBy::Ipf(axis),
         _ => {
             return usage(format!(
                 "--rep {rep:?}: {text:?} is not a representation's colouring; use element, type, \
-                 chain, structure, cna, cluster, grain, ipf, property, #rrggbb or R,G,B (a colouring by a number is the \
+                 chain, structure, cna, diamond, cluster, grain, ipf, property, #rrggbb or R,G,B (a colouring by a number is the \
                  scene's: --color-by {text}, and the representations without :COLOUR take it)"
             ));
         }

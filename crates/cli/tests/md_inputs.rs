@@ -3738,3 +3738,57 @@ fn index_ranges(atoms: &[usize]) -> String {
     }
     out
 }
+
+/// `--color-by diamond` and `--select 'not diamond cubic'`: on md-io's diamond fixture (a
+/// silicon slab OVITO wrote, with OVITO's Identify diamond structure types), the colours are
+/// OVITO's types in OVITO's colours drawn by `--color` rules, and the selection draws OVITO's
+/// non-cubic atoms (the surfaces' first and second neighbours), byte for byte.
+#[test]
+fn diamond_types_colour_and_select_as_ovitos() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = ovito_data("diamond");
+    let refs = read_json(&base.join("diamond_reference.json"));
+    let case = &refs[2];
+    assert_eq!(case["file"], "slab.xyz");
+    let file = base.join("slab.xyz").to_string_lossy().into_owned();
+    let types: Vec<usize> = case["structure"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| t.as_u64().unwrap() as usize)
+        .collect();
+    let render = |extra: &[&str], out: &str| {
+        render_png(
+            dir.path(),
+            &[&[file.as_str(), "--size", "200x160"], extra].concat(),
+            out,
+        )
+    };
+    let mut rules: Vec<String> = Vec::new();
+    for (t, rgb) in texmap_md_scene::DIAMOND_COLORS.iter().enumerate() {
+        let atoms: Vec<usize> = (0..types.len()).filter(|&i| types[i] == t).collect();
+        if atoms.is_empty() {
+            continue;
+        }
+        let hex = rgb.map(|c| (c * 255.0).round() as u8);
+        rules.push("--color".into());
+        rules.push(format!(
+            "{}=#{:02x}{:02x}{:02x}",
+            index_ranges(&atoms),
+            hex[0],
+            hex[1],
+            hex[2]
+        ));
+    }
+    assert!(rules.len() >= 6, "cubic, first and second neighbours");
+    let rules: Vec<&str> = rules.iter().map(|s| s.as_str()).collect();
+    assert_eq!(
+        render(&["--color-by", "diamond"], "ours.png"),
+        render(&rules, "ovito.png")
+    );
+    let defects: Vec<usize> = (0..types.len()).filter(|&i| types[i] != 1).collect();
+    assert_eq!(
+        render(&["--select", "not diamond cubic"], "sel.png"),
+        render(&["--select", &index_ranges(&defects)], "sel_ovito.png")
+    );
+}

@@ -107,6 +107,150 @@ pub fn counts(types: &[StructureType]) -> [usize; 5] {
     c
 }
 
+/// A diamond-lattice structure type, as OVITO's Identify diamond structure modifier assigns it
+/// (E. Maras et al., "Global transition path search for dislocation formation in Ge on
+/// Si(001)", Comput. Phys. Commun. 205 (2016) 13); the numbers are OVITO's codes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[repr(u8)]
+pub enum DiamondType {
+    Other = 0,
+    Cubic = 1,
+    /// Not itself cubic diamond, but a nearest neighbour of an atom that is.
+    CubicFirstNeighbour = 2,
+    /// A nearest neighbour of a [`DiamondType::CubicFirstNeighbour`] atom.
+    CubicSecondNeighbour = 3,
+    Hexagonal = 4,
+    HexagonalFirstNeighbour = 5,
+    HexagonalSecondNeighbour = 6,
+}
+
+impl DiamondType {
+    /// All types, in code order.
+    pub const ALL: [DiamondType; 7] = [
+        DiamondType::Other,
+        DiamondType::Cubic,
+        DiamondType::CubicFirstNeighbour,
+        DiamondType::CubicSecondNeighbour,
+        DiamondType::Hexagonal,
+        DiamondType::HexagonalFirstNeighbour,
+        DiamondType::HexagonalSecondNeighbour,
+    ];
+
+    /// The lower-case name (`other`, `cubic`, `cubic-1st`, `cubic-2nd`, `hexagonal`,
+    /// `hexagonal-1st`, `hexagonal-2nd`).
+    pub fn name(self) -> &'static str {
+        match self {
+            DiamondType::Other => "other",
+            DiamondType::Cubic => "cubic",
+            DiamondType::CubicFirstNeighbour => "cubic-1st",
+            DiamondType::CubicSecondNeighbour => "cubic-2nd",
+            DiamondType::Hexagonal => "hexagonal",
+            DiamondType::HexagonalFirstNeighbour => "hexagonal-1st",
+            DiamondType::HexagonalSecondNeighbour => "hexagonal-2nd",
+        }
+    }
+}
+
+/// The diamond structure type of every atom of `frame` (silicon, germanium, carbon, ice): an
+/// atom's 4 nearest neighbours and their own 3 others are its 12 second neighbours, which in
+/// cubic diamond sit as an FCC shell and in hexagonal diamond as an HCP one; CNA on them (the
+/// cutoff `(1 + √2) / 2` times their mean distance) gives twelve (4,2,1) for cubic and six
+/// (4,2,1) with six (4,2,2) for hexagonal. Then, in atom order, the other atoms among a
+/// diamond atom's 4 neighbours become its first neighbours, and the other atoms among theirs
+/// its second neighbours (surfaces, defect cores). Neighbours at the nearest image in a
+/// periodic cell; in parallel, the result not depending on the thread count.
+pub fn classify_diamond(frame: &Frame) -> Vec<DiamondType> {
+    use rayon::prelude::*;
+    let n = frame.positions.len();
+    let grid = Grid::new(&frame.positions, frame.cell.as_ref());
+    // Each atom's 4 nearest: vectors and indices (fewer for a frame of fewer atoms).
+    let lists: Vec<([[f64; 3]; 4], [u32; 4], u8)> = (0..n)
+        .into_par_iter()
+        .map_init(Scratch::default, |scratch, i| {
+            grid.nearest(i, 4, scratch);
+            let mut v = [[0.0; 3]; 4];
+            let mut idx = [0u32; 4];
+            for (k, ((near, _), j)) in scratch.near.iter().zip(&scratch.index).enumerate() {
+                v[k] = *near;
+                idx[k] = *j;
+            }
+            (v, idx, scratch.near.len() as u8)
+        })
+        .collect();
+    let mut types: Vec<DiamondType> = (0..n)
+        .into_par_iter()
+        .map(|i| {
+            let (v, idx, count) = &lists[i];
+            if *count < 4 {
+                return DiamondType::Other;
+            }
+            let mut second = [([0.0f64; 3], 0.0f64); 12];
+            let mut found = 0;
+            for k in 0..4 {
+                let (w, _, wn) = &lists[idx[k] as usize];
+                let before = found;
+                for u in &w[..*wn as usize] {
+                    let s = [0, 1, 2].map(|a| v[k][a] + u[a]);
+                    // The way back to the atom itself.
+                    if s.iter().all(|c| c.abs() <= 1e-2) {
+                        continue;
+                    }
+                    if found == 12 {
+                        return DiamondType::Other;
+                    }
+                    second[found] = (s, (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt());
+                    found += 1;
+                }
+                if found - before != 3 {
+                    return DiamondType::Other;
+                }
+            }
+            let mean = second.iter().map(|s| s.1).sum::<f64>() / 12.0;
+            let sigs = signatures(&second, 0.5 * (1.0 + std::f64::consts::SQRT_2) * mean);
+            let count = |s: [u8; 3]| sigs.iter().filter(|x| **x == s).count();
+            match (count([4, 2, 1]), count([4, 2, 2])) {
+                (12, _) => DiamondType::Cubic,
+                (6, 6) => DiamondType::Hexagonal,
+                _ => DiamondType::Other,
+            }
+        })
+        .collect();
+    // First, then second neighbours, in atom order (the first diamond atom to reach an atom
+    // names it).
+    for (from, to) in [
+        (
+            [DiamondType::Cubic, DiamondType::Hexagonal],
+            [
+                DiamondType::CubicFirstNeighbour,
+                DiamondType::HexagonalFirstNeighbour,
+            ],
+        ),
+        (
+            [
+                DiamondType::CubicFirstNeighbour,
+                DiamondType::HexagonalFirstNeighbour,
+            ],
+            [
+                DiamondType::CubicSecondNeighbour,
+                DiamondType::HexagonalSecondNeighbour,
+            ],
+        ),
+    ] {
+        for i in 0..n {
+            let Some(kind) = from.iter().position(|t| *t == types[i]) else {
+                continue;
+            };
+            let (_, idx, count) = &lists[i];
+            for &j in &idx[..*count as usize] {
+                if types[j as usize] == DiamondType::Other {
+                    types[j as usize] = to[kind];
+                }
+            }
+        }
+    }
+    types
+}
+
 /// The type from the neighbour vectors sorted by length (at most [`MAX_NEIGHBOURS`] used).
 fn signature_type(near: &[([f64; 3], f64)]) -> StructureType {
     if near.len() >= 12 {

@@ -10,6 +10,8 @@
 //! atom     := "all" | "none" | "protein" | "nucleic" | "backbone" | "water"
 //!           | "helix" | "sheet" | "betasheet" | "beta_sheet" | "coil"  -- VMD: structure
 //!           | "cna" TYPE+          -- crystal structure: fcc hcp bcc ico other (OVITO's a-CNA)
+//!           | "diamond" TYPE+      -- diamond structure: cubic hexagonal cubic-1st cubic-2nd
+//!                                     hexagonal-1st hexagonal-2nd other (OVITO's)
 //!           | ("name" | "type" | "resname" | "element") WORD+      -- any of the words
 //!           | ("chain" | "chainID" | "segid" | "segname") WORD+
 //!           | ("index" | "serial" | "bynum" | "id" | "resid") RANGE+
@@ -35,7 +37,9 @@
 //! structure is assigned from the frame being selected, so it follows a trajectory.
 //! `cna` selects by the crystal structure type [`crate::cna::classify`] gives each atom, as
 //! OVITO's adaptive common neighbour analysis: `not cna fcc` hides the perfect FCC crystal and
-//! leaves dislocations, stacking faults (`cna hcp`), grain boundaries and surfaces.
+//! leaves dislocations, stacking faults (`cna hcp`), grain boundaries and surfaces. `diamond`
+//! selects by [`crate::cna::classify_diamond`]'s type, as OVITO's Identify diamond structure:
+//! `not diamond cubic` leaves a silicon crystal's defects and surfaces.
 //! `chain` (VMD) and `chainID` (MDAnalysis) match the chain identifier (PDB column 22, mmCIF
 //! `auth_asym_id`); `segid` (MDAnalysis) and `segname` (VMD) the segment (PDB columns 73-76,
 //! PSF). A blank chain or segment is matched by no word.
@@ -73,6 +77,8 @@ struct Cache {
     structure: std::cell::OnceCell<Vec<Option<Structure>>>,
     /// Crystal structure type per atom (`cna`).
     cna: std::cell::OnceCell<Vec<crate::cna::StructureType>>,
+    /// Diamond structure type per atom (`diamond`).
+    diamond: std::cell::OnceCell<Vec<crate::cna::DiamondType>>,
 }
 
 /// Residue names `protein` matches: the 20 amino acids, their common protonation and
@@ -197,6 +203,10 @@ enum Node {
     },
     /// `cna fcc hcp ...`: the atoms of those crystal structure types (bit `t` for type code t).
     Cna {
+        types: u8,
+    },
+    /// `diamond cubic ...`: the atoms of those diamond structure types (bit `t` for code t).
+    Diamond {
         types: u8,
     },
     /// `prop [abs] NAME OP VALUE`: a coordinate or a property compared with a number.
@@ -334,6 +344,7 @@ fn is_reserved(w: &str) -> bool {
             | "beta_sheet"
             | "coil"
             | "cna"
+            | "diamond"
             | "name"
             | "type"
             | "resname"
@@ -489,23 +500,14 @@ impl Parser<'_> {
                 column: t.column,
             }),
             "cna" => {
-                let words = self.words(&t)?;
-                let mut types = 0u8;
-                for w in &words {
-                    match crate::cna::StructureType::from_name(&w.text) {
-                        Some(s) => types |= 1 << s as u8,
-                        None => {
-                            return Err(self.error(
-                                w.column,
-                                format!(
-                                    "cna: '{}' is not a structure type; use fcc, hcp, bcc, ico or other",
-                                    w.text
-                                ),
-                            ));
-                        }
-                    }
-                }
+                let names = crate::cna::StructureType::ALL.map(|s| s.name());
+                let types = self.type_words(&t, &names, "a structure type")?;
                 Ok(Node::Cna { types })
+            }
+            "diamond" => {
+                let names = crate::cna::DiamondType::ALL.map(|d| d.name());
+                let types = self.type_words(&t, &names, "a diamond structure type")?;
+                Ok(Node::Diamond { types })
             }
             "name" | "type" | "resname" | "chain" | "chainid" | "segid" | "segname" => {
                 let words = self.words(&t)?;
@@ -684,6 +686,28 @@ impl Parser<'_> {
     }
 
     /// One or more words after a keyword (up to and/or/')'/the end).
+    /// The words after `kw`, each one of `names` (any case): bit `i` set for `names[i]`.
+    fn type_words(&mut self, kw: &Token, names: &[&str], what: &str) -> Result<u8, SelectionError> {
+        let mut types = 0u8;
+        for w in self.words(kw)? {
+            match names.iter().position(|n| n.eq_ignore_ascii_case(&w.text)) {
+                Some(i) => types |= 1 << i,
+                None => {
+                    return Err(self.error(
+                        w.column,
+                        format!(
+                            "{}: '{}' is not {what}; use {}",
+                            kw.text,
+                            w.text,
+                            names.join(", ")
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(types)
+    }
+
     fn words(&mut self, kw: &Token) -> Result<Vec<Token>, SelectionError> {
         let mut out = Vec::new();
         while let Some(t) = self.peek() {
@@ -928,6 +952,14 @@ impl Selection {
                 let cna = cache.cna.get_or_init(|| crate::cna::classify(frame));
                 out.iter_mut()
                     .zip(cna)
+                    .for_each(|(o, t)| *o = types >> *t as u8 & 1 == 1);
+            }
+            Node::Diamond { types } => {
+                let diamond = cache
+                    .diamond
+                    .get_or_init(|| crate::cna::classify_diamond(frame));
+                out.iter_mut()
+                    .zip(diamond)
                     .for_each(|(o, t)| *o = types >> *t as u8 & 1 == 1);
             }
             Node::Str {

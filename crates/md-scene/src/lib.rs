@@ -114,8 +114,8 @@ pub use plan::{
 };
 pub use scalar::{NAN_COLOR, SCALAR_LEVELS, ScalarColor, ScalarSource};
 pub use style::{
-    CNA_COLORS, ColorBy, IpfAxis, RuleKind, STRUCTURE_COLORS, SceneBuilder, StyleError,
-    StyleOptions, StyleWarning, style_from,
+    CNA_COLORS, ColorBy, DIAMOND_COLORS, IpfAxis, RuleKind, STRUCTURE_COLORS, SceneBuilder,
+    StyleError, StyleOptions, StyleWarning, style_from,
 };
 
 #[doc(no_inline)]

@@ -42,6 +42,9 @@ pub enum ColorBy {
     /// [`crate::plan::CLUSTER`], [`crate::MolOptions::clusters`]): the palette colour of the
     /// cluster's id, the largest first; atoms in no cluster take the element colours.
     Cluster,
+    /// The rules, else the diamond structure type ([`texmap_md_io::cna::classify_diamond`]),
+    /// assigned per frame, in OVITO's colours ([`DIAMOND_COLORS`]).
+    Diamond,
     /// The rules, else one distinct colour per grain (the per-atom property
     /// [`crate::plan::GRAIN`], [`crate::MolOptions::grains`]), the largest first; atoms in no
     /// grain take the element colours.
@@ -83,6 +86,20 @@ pub const CNA_COLORS: [[f32; 3]; 5] = [
     [1.0, 0.4, 0.4],
     [0.4, 0.4, 1.0],
     [0.95, 0.8, 0.2],
+];
+
+/// The colours of [`ColorBy::Diamond`], OVITO's: other near-white, cubic diamond blue and its
+/// first and second neighbours cyan and light green, hexagonal diamond orange and its
+/// neighbours yellow and yellow-green; sRGB in [0, 1], indexed by
+/// [`texmap_md_io::cna::DiamondType`] as `usize`.
+pub const DIAMOND_COLORS: [[f32; 3]; 7] = [
+    [0.95, 0.95, 0.95],
+    [19.0 / 255.0, 160.0 / 255.0, 254.0 / 255.0],
+    [0.0, 254.0 / 255.0, 245.0 / 255.0],
+    [126.0 / 255.0, 254.0 / 255.0, 181.0 / 255.0],
+    [254.0 / 255.0, 137.0 / 255.0, 0.0],
+    [254.0 / 255.0, 220.0 / 255.0, 0.0],
+    [204.0 / 255.0, 229.0 / 255.0, 81.0 / 255.0],
 ];
 
 /// The colours of [`ColorBy::Structure`], VMD's: coil white, helix purple (VMD's alpha-helix
@@ -463,10 +480,16 @@ impl SceneBuilder {
         } else {
             Vec::new()
         };
-        let crystal = if color_by == ColorBy::Cna {
-            texmap_md_io::cna::classify(frame)
-        } else {
-            Vec::new()
+        let crystal: Vec<[f32; 3]> = match color_by {
+            ColorBy::Cna => texmap_md_io::cna::classify(frame)
+                .into_iter()
+                .map(|t| CNA_COLORS[t as usize])
+                .collect(),
+            ColorBy::Diamond => texmap_md_io::cna::classify_diamond(frame)
+                .into_iter()
+                .map(|t| DIAMOND_COLORS[t as usize])
+                .collect(),
+            _ => Vec::new(),
         };
         let cluster = match color_by {
             ColorBy::Cluster => frame.property(crate::plan::CLUSTER),
@@ -513,7 +536,7 @@ impl SceneBuilder {
                 },
                 None if !crystal.is_empty() => match self.style.rules_for(frame, i).color {
                     Some(c) => c,
-                    None => CNA_COLORS[crystal[i] as usize],
+                    None => crystal[i],
                 },
                 None if !structure.is_empty() => {
                     match (structure[i], self.style.rules_for(frame, i).color) {
