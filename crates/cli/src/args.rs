@@ -563,7 +563,7 @@ pub struct RenderArgs {
     /// A caption at the top left of every image, on a light backdrop, for movies:
     /// 't = {ns} ns'. {time} is the frame's time in ps, {ns} in ns, {step} its MD step,
     /// {frame} its index in the file, {hbonds} the hydrogen bonds an hbonds representation
-    /// draws in it, {vacancies} and {interstitials} the --wigner-seitz counts, {title} its title (an XYZ comment, a PDB TITLE, a Vina pose's 'VINA
+    /// draws in it, {vacancies} and {interstitials} the --wigner-seitz counts, {grains} the --grains count, {title} its title (an XYZ comment, a PDB TITLE, a Vina pose's 'VINA
     /// RESULT: -7.5 ...'); a file whose frames carry no time (XYZ, PDB) takes {frame}. ASCII
     /// only; the text is cut at half the image width.
     #[arg(long, value_name = "TEXT")]

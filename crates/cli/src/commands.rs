@@ -684,6 +684,13 @@ fn render(a: &RenderArgs) -> Result<()> {
             "--label {vacancies} and {interstitials} count the point defects --wigner-seitz finds: add --wigner-seitz",
         );
     }
+    if label
+        .as_ref()
+        .is_some_and(|parts| parts.contains(&crate::scene::LabelPart::Grains))
+        && !plan.finds_grains()
+    {
+        return usage("--label {grains} counts the grains --grains finds: add --grains");
+    }
     if a.mol.hbond_table.is_some() && !plan.draws_hbonds() {
         return usage(
             "--hbond-table lists the hydrogen bonds the hbonds style draws: add a representation of them, as --rep 'protein or water=hbonds'",
@@ -1172,9 +1179,16 @@ fn render(a: &RenderArgs) -> Result<()> {
         }
         if let Some(parts) = &label {
             let hbonds = plan.last_hbonds().len();
-            let text =
-                crate::scene::label_text(parts, f, &md, traj.name(), hbonds, plan.last_defects())
-                    .map_err(|e| fail(e, &written))?;
+            let text = crate::scene::label_text(
+                parts,
+                f,
+                &md,
+                traj.name(),
+                hbonds,
+                plan.last_defects(),
+                plan.last_grains().map(|g| g.len()),
+            )
+            .map_err(|e| fail(e, &written))?;
             let (w, h) = (out.width() as usize, out.height() as usize);
             texmap_md_scene::draw_caption(out.color.as_flattened_mut(), w, h, &text);
         }

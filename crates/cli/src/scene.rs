@@ -129,6 +129,8 @@ pub enum LabelPart {
     /// `{vacancies}`, `{interstitials}`: the `--wigner-seitz` counts of the frame.
     Vacancies,
     Interstitials,
+    /// `{grains}`: the `--grains` count of the frame.
+    Grains,
     /// `{title}`: the frame's title (an XYZ comment line, a GRO title, a PDB TITLE, a docked
     /// pose's `REMARK VINA RESULT`), empty when it has none.
     Title,
@@ -175,7 +177,7 @@ fn template<'a>(
 /// `--label`'s template, parsed before any frame is read: braces balanced, every placeholder
 /// `{time}`, `{ns}`, `{step}` or `{frame}`.
 pub fn parse_label(text: &str) -> Result<Vec<LabelPart>> {
-    const NAMES: [&str; 8] = [
+    const NAMES: [&str; 9] = [
         "time",
         "ns",
         "step",
@@ -184,9 +186,9 @@ pub fn parse_label(text: &str) -> Result<Vec<LabelPart>> {
         "title",
         "vacancies",
         "interstitials",
+        "grains",
     ];
-    let hint =
-        "{time} (ps), {ns}, {step}, {frame}, {hbonds}, {vacancies}, {interstitials} or {title}";
+    let hint = "{time} (ps), {ns}, {step}, {frame}, {hbonds}, {vacancies}, {interstitials}, {grains} or {title}";
     Ok(template("--label", text, &NAMES, hint)?
         .into_iter()
         .map(|p| match p {
@@ -198,6 +200,7 @@ pub fn parse_label(text: &str) -> Result<Vec<LabelPart>> {
             Err(4) => LabelPart::HBonds,
             Err(5) => LabelPart::Title,
             Err(6) => LabelPart::Vacancies,
+            Err(8) => LabelPart::Grains,
             Err(_) => LabelPart::Interstitials,
         })
         .collect())
@@ -321,7 +324,8 @@ fn compact(v: f64, decimals: usize) -> String {
 /// frame does not carry.
 /// The caption of frame `index` of `file`; `hbonds` is the count of hydrogen bonds drawn (the
 /// caller refuses `{hbonds}` without an hbonds representation), `defects` the vacancies and
-/// interstitials (the caller refuses them without `--wigner-seitz`).
+/// interstitials (the caller refuses them without `--wigner-seitz`), `grains` the grain count
+/// (refused without `--grains`).
 pub fn label_text(
     parts: &[LabelPart],
     index: usize,
@@ -329,6 +333,7 @@ pub fn label_text(
     file: &str,
     hbonds: usize,
     defects: Option<(usize, usize)>,
+    grains: Option<usize>,
 ) -> Result<String> {
     let missing = |what: &str, placeholder: &str| {
         anyhow::anyhow!(
@@ -355,6 +360,7 @@ pub fn label_text(
             LabelPart::HBonds => out.push_str(&hbonds.to_string()),
             LabelPart::Vacancies => out.push_str(&defects.map_or(0, |d| d.0).to_string()),
             LabelPart::Interstitials => out.push_str(&defects.map_or(0, |d| d.1).to_string()),
+            LabelPart::Grains => out.push_str(&grains.unwrap_or(0).to_string()),
             LabelPart::Title => out.push_str(frame.comment.trim()),
         }
     }

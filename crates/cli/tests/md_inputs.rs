@@ -3718,6 +3718,22 @@ fn grains_and_orientation_colours_are_ovitos() {
         rows.iter()
             .all(|r| r.starts_with("0,") && r.contains(",fcc,"))
     );
+
+    // The caption counts them; without --grains it is refused.
+    let count = format!("{} grains", rows.len());
+    assert_eq!(
+        render(
+            &["--color-by", "grain", "--label", "{grains} grains"],
+            "label.png"
+        ),
+        render(
+            &["--color-by", "grain", "--label", &count],
+            "label_text.png"
+        )
+    );
+    let o = texmap(&["render", &file, "--label", "{grains}", "-o", "x.png"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("add --grains"), "{}", stderr(&o));
 }
 
 /// A selection of the atoms `atoms` (ascending), runs as ranges: `index 3:7 9 12:40`.

@@ -1518,6 +1518,11 @@ impl MolPlan {
         self.last_defects
     }
 
+    /// Whether every frame's grains are found ([`MolOptions::grains`]).
+    pub fn finds_grains(&self) -> bool {
+        self.options.grains.is_some()
+    }
+
     /// The last frame's grains, the largest first ([`MolOptions::grains`]; `None` without
     /// it).
     pub fn last_grains(&self) -> Option<&[Grain]> {
