@@ -7,7 +7,8 @@
 //! - atomic strain at a 3.0 Å cutoff (neighbour pairs, F, shear, volumetric, D²min);
 //! - Voronoi cells (volume, faces, index);
 //! - coordination at 3.0 Å;
-//! - on a polycrystal of the same size (aluminium, 16 Voronoi grains in random orientations,
+//! - on a polycrystal of the same size (aluminium, 16 Voronoi grains in random orientations
+//!   from `texmap_study::materials::polycrystal`,
 //!   thermal noise 0.05 Å; `target/md_analysis_poly.xyz`): lattice orientations (a-CNA and the
 //!   template fit, as OVITO's PTM gives structure and orientation in one pass) and grains
 //!   (the orientations, then the segmentation, as OVITO's PTM followed by Grain segmentation).
@@ -75,92 +76,6 @@ fn crystals(n: usize) -> (Frame, Frame) {
     (reference, current)
 }
 
-/// About `atoms` atoms of FCC aluminium (a = 4.05 Å) in a periodic cube of `grains` Voronoi
-/// grains, each a crystal in a random orientation; of two atoms closer than 2 Å at a boundary
-/// the later is dropped; thermal noise 0.05 Å.
-fn polycrystal(atoms: usize, grains: usize) -> Frame {
-    let a = 4.05f64;
-    let l = (atoms as f64 * a * a * a / 4.0).cbrt();
-    let mut rng = Lcg(7);
-    let seeds: Vec<[f64; 3]> = (0..grains)
-        .map(|_| [rng.next() * l, rng.next() * l, rng.next() * l])
-        .collect();
-    let nearest = |p: [f64; 3]| {
-        let d2 = |s: &[f64; 3]| {
-            (0..3)
-                .map(|k| {
-                    let d = p[k] - s[k];
-                    let d = d - l * (d / l).round();
-                    d * d
-                })
-                .sum::<f64>()
-        };
-        (0..grains)
-            .min_by(|&x, &y| d2(&seeds[x]).total_cmp(&d2(&seeds[y])))
-            .unwrap()
-    };
-    let base = [
-        [0.0, 0.0, 0.0],
-        [0.5, 0.5, 0.0],
-        [0.5, 0.0, 0.5],
-        [0.0, 0.5, 0.5],
-    ];
-    let reach = (l * 0.87 / a).ceil() as i64 + 1;
-    let mut points: Vec<[f64; 3]> = Vec::new();
-    for (g, seed) in seeds.iter().enumerate() {
-        let q = glam::DQuat::from_xyzw(rng.normal(), rng.normal(), rng.normal(), rng.normal())
-            .normalize();
-        for i in -reach..reach {
-            for j in -reach..reach {
-                for k in -reach..reach {
-                    for b in base {
-                        let v = glam::DVec3::new(i as f64 + b[0], j as f64 + b[1], k as f64 + b[2]);
-                        let p = q * (v * a);
-                        // One copy of each site: the cube of side l around the seed.
-                        if (0..3).any(|c| p[c] < -l / 2.0 || p[c] >= l / 2.0) {
-                            continue;
-                        }
-                        let p = [0, 1, 2].map(|c| (p[c] + seed[c]).rem_euclid(l));
-                        if nearest(p) == g {
-                            points.push(p);
-                        }
-                    }
-                }
-            }
-        }
-    }
-    // Thin the boundaries on a cell grid of 2 Å cells or wider.
-    let cells = (l / 2.0).floor() as usize;
-    let cell_of = |p: &[f64; 3]| p.map(|v| ((v / l * cells as f64) as usize).min(cells - 1));
-    let mut grid: std::collections::HashMap<[usize; 3], Vec<usize>> = Default::default();
-    let mut kept = Frame::new();
-    'atom: for (i, p) in points.iter().enumerate() {
-        let c = cell_of(p);
-        for d in 0..27 {
-            let o = [d % 3, d / 3 % 3, d / 9].map(|v| v as i64 - 1);
-            let n = [0, 1, 2].map(|k| (c[k] as i64 + o[k]).rem_euclid(cells as i64) as usize);
-            for &j in grid.get(&n).map(|v| v.as_slice()).unwrap_or(&[]) {
-                let r2: f64 = (0..3)
-                    .map(|k| {
-                        let d = points[j][k] - p[k];
-                        let d = d - l * (d / l).round();
-                        d * d
-                    })
-                    .sum();
-                if r2 < 4.0 {
-                    continue 'atom;
-                }
-            }
-        }
-        grid.entry(c).or_default().push(i);
-        let q = p.map(|v| (v + 0.05 * rng.normal()).rem_euclid(l) as f32);
-        kept.positions.push(q);
-    }
-    kept.cell = Some(UnitCell::orthorhombic(l, l, l).unwrap());
-    kept.names = vec![texmap::md_io::Label::new("Al").unwrap(); kept.positions.len()];
-    kept
-}
-
 /// `frame` as extended XYZ (the peer's input).
 fn write_xyz(frame: &Frame, path: &str) {
     let m = frame.cell.unwrap().matrix();
@@ -193,7 +108,8 @@ fn bench(c: &mut Criterion) {
     let (reference, current) = crystals(n);
     let atoms = reference.positions.len();
     let wanted = if test_mode { 3 } else { 16 };
-    let poly = polycrystal(atoms, wanted);
+    let poly_size = if test_mode { 8_000 } else { atoms };
+    let (poly, _) = texmap::study::materials::polycrystal(poly_size, wanted, 0.05, 7);
     if !test_mode {
         let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/target");
         write_xyz(&reference, &format!("{dir}/md_analysis_ref.xyz"));
