@@ -63,7 +63,8 @@ use crate::orientation::{LatticeFit, Symmetry, fundamental_zone};
 /// How grains are found.
 #[derive(Clone, Debug, PartialEq)]
 pub struct GrainOptions {
-    /// The largest disorientation (degrees) of an atom from its grain's mean orientation.
+    /// The largest disorientation (degrees, 0 to 180) of an atom from its grain's mean
+    /// orientation.
     pub threshold_deg: f64,
     /// Grains of fewer crystalline atoms are dissolved (OVITO's default: 100).
     pub min_size: usize,
@@ -178,9 +179,14 @@ pub fn segment(
             .then(ra.total_cmp(&rb))
             .then(a.cmp(&b))
     });
-    let cos_half = (options.threshold_deg.to_radians() / 2.0).cos();
+    // A threshold that is no angle (NaN) joins nothing.
+    let threshold = match options.threshold_deg {
+        t if t.is_nan() => 0.0,
+        t => t.clamp(0.0, 180.0),
+    };
+    let cos_half = (threshold.to_radians() / 2.0).cos();
     let mut grain = vec![-1i32; n];
-    let mut sums: Vec<DQuat> = Vec::new();
+    let mut means: Vec<DQuat> = Vec::new();
     let mut symmetries: Vec<Symmetry> = Vec::new();
     let mut structures: Vec<StructureType> = Vec::new();
     let mut queue = std::collections::VecDeque::new();
@@ -189,7 +195,7 @@ pub fn segment(
             continue;
         }
         let fit = fits[seed].unwrap();
-        let g = sums.len() as i32;
+        let g = means.len() as i32;
         grain[seed] = g;
         let mut sum = quat(fit.orientation);
         let mut mean = sum;
@@ -219,23 +225,23 @@ pub fn segment(
                 queue.push_back(b);
             }
         }
-        sums.push(mean);
+        means.push(mean);
         symmetries.push(fit.symmetry);
         structures.push(types[seed]);
     }
 
     // 2. Small grains dissolved; 4. the rest numbered by size.
-    let mut crystalline = vec![0usize; sums.len()];
+    let mut crystalline = vec![0usize; means.len()];
     for &g in &grain {
         if g >= 0 {
             crystalline[g as usize] += 1;
         }
     }
-    let mut kept: Vec<usize> = (0..sums.len())
+    let mut kept: Vec<usize> = (0..means.len())
         .filter(|&g| crystalline[g] >= options.min_size.max(1))
         .collect();
     kept.sort_by(|&a, &b| crystalline[b].cmp(&crystalline[a]).then(a.cmp(&b)));
-    let mut number = vec![-1i32; sums.len()];
+    let mut number = vec![-1i32; means.len()];
     for (k, &g) in kept.iter().enumerate() {
         number[g] = k as i32;
     }
@@ -284,7 +290,7 @@ pub fn segment(
         .iter()
         .enumerate()
         .map(|(k, &g)| {
-            let q = sums[g];
+            let q = means[g];
             Grain {
                 size: sizes[k],
                 crystalline: crystalline[g],
@@ -373,5 +379,33 @@ impl PartialOrd for Length {
 impl Ord for Length {
     fn cmp(&self, other: &Length) -> std::cmp::Ordering {
         self.0.total_cmp(&other.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn empty_frames_and_bad_thresholds_give_no_grains() {
+        let empty = Frame::new();
+        let found = segment(&empty, &[], &[], &GrainOptions::default());
+        assert!(found.grain.is_empty() && found.grains.is_empty());
+        // A few atoms of a crystal, one of them not finite, and a threshold that is no angle.
+        let mut frame = Frame::new();
+        for i in 0..4 {
+            frame.positions.push([i as f32 * 2.5, 0.0, 0.0]);
+        }
+        frame.positions.push([f32::NAN, 0.0, 0.0]);
+        let types = crate::cna::classify(&frame);
+        let fits = crate::orientation::orientations(&frame, &types);
+        for threshold_deg in [f64::NAN, -5.0, 1e9] {
+            let options = GrainOptions {
+                threshold_deg,
+                ..GrainOptions::default()
+            };
+            let found = segment(&frame, &types, &fits, &options);
+            assert_eq!(found.grain, vec![-1; 5]);
+        }
     }
 }
