@@ -3734,6 +3734,31 @@ fn grains_and_orientation_colours_are_ovitos() {
     let o = texmap(&["render", &file, "--label", "{grains}", "-o", "x.png"]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("add --grains"), "{}", stderr(&o));
+    // Bad usage: an angle out of range, grain options without --grains.
+    for (args, says) in [
+        (
+            vec!["--grains", "45"],
+            "is not an angle from 0 to 30 degrees",
+        ),
+        (
+            vec!["--grains", "0"],
+            "is not an angle from 0 to 30 degrees",
+        ),
+        (
+            vec!["--grain-table", "g.csv"],
+            "are about the grains: add --grains",
+        ),
+        (
+            vec!["--grain-min-size", "10"],
+            "are about the grains: add --grains",
+        ),
+    ] {
+        let mut all = vec!["render", file.as_str(), "-o", "x.png"];
+        all.extend(args.iter());
+        let o = texmap(&all);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains(says), "{args:?}: {}", stderr(&o));
+    }
 }
 
 /// A selection of the atoms `atoms` (ascending), runs as ranges: `index 3:7 9 12:40`.
