@@ -10,14 +10,16 @@
 //! 1. Its 12 (FCC, HCP) or 14 (BCC) nearest neighbours and the template's, both with the atom
 //!    itself, moved so their barycentre is the origin and scaled so the neighbours' mean
 //!    distance from it is 1 (PTM's normalisation).
-//! 2. Which neighbour is which template point: the nearest neighbour is paired with every
-//!    template point of its shell in turn, and a second neighbour (the one whose angle to the
-//!    first is nearest the shell's first angle: 60° in FCC and HCP, 70.5° in BCC) with every
-//!    template point at a like angle; the rotation those two pairs fix pairs every other
-//!    neighbour with its nearest template direction. Of the pairings that are one-to-one, the
-//!    one of least RMSD wins.
-//! 3. The best rotation for it by Horn's quaternion method ([`crate::rotation`]), and RMSD = √((Σ|t|² − E²/Σ|p|²) / (N + 1)), E its eigenvalue: the
-//!    RMSD after the best scaling, as PTM reports it.
+//! 2. Which neighbour is which template point: the nearest neighbour is paired with one
+//!    template point per orbit of the template's own rotations (FCC 1, BCC 2, HCP 2: pairings
+//!    that differ by such a rotation fit equally well), and a second neighbour (the one of the
+//!    first shell whose angle to the nearest is closest to the shell's first angle: 60° in FCC
+//!    and HCP, 70.5° in BCC) with every template point at a like angle; the rotation those two
+//!    pairs fix pairs every other neighbour with its nearest template direction. Of the
+//!    pairings that are one-to-one, the one of least RMSD wins.
+//! 3. The best rotation for it by Horn's quaternion method ([`crate::rotation`]), and
+//!    RMSD = √((Σ|t|² − E²/Σ|p|²) / (N + 1)), E its eigenvalue: the RMSD after the best
+//!    scaling, as PTM reports it.
 //! 4. The quaternion moved into the fundamental zone: of its equivalents under the lattice's
 //!    proper rotations (24 cubic; 12 hexagonal), the one of largest |w|, with w ≥ 0.
 //!
