@@ -9,7 +9,8 @@
 //! - every per-atom vector is either empty (the file does not have that column) or exactly
 //!   [`Frame::n_atoms`] long, and so is every property's;
 //! - positions (and velocities, radii, colours) are finite: a reader rejects NaN and infinities
-//!   (property values are NaN only where a LAMMPS dump writes `nan` or `inf`);
+//!   (property values are non-finite only where a LAMMPS dump or an extended-XYZ property
+//!   column writes `nan` or `inf`);
 //! - positions lie within ±[`MAX_COORDINATE`] Å and cell lengths are at most that: a finite but
 //!   absurd value (1e38 from a flipped exponent bit, a cell of 1e300) is a damaged file, reported
 //!   by the reader with the file, frame and atom, not a failure later in a renderer's camera;
@@ -361,7 +362,8 @@ pub(crate) fn set_ordered_bonds(frame: &mut Frame, mut bonds: Vec<([u32; 2], u8)
 pub struct Property {
     /// The column's name as the file writes it (`bfactor`, `c_pe`, `v_stress[1]`).
     pub name: String,
-    /// One value per atom: finite, except where a LAMMPS dump writes `nan` or `inf` (NaN).
+    /// One value per atom: finite, except where a LAMMPS dump or an extended-XYZ property column
+    /// writes `nan` (NaN) or `inf` / `-inf` (infinities).
     pub values: Vec<f32>,
 }
 
@@ -488,6 +490,73 @@ impl Frame {
         self.bonds
             .extend(other.bonds.iter().map(|[i, j]| [i + shift, j + shift]));
         self.positions.extend_from_slice(&other.positions);
+    }
+
+    /// Keeps the atoms whose `keep` entry is true, in order, with every per-atom column and
+    /// property; [`Frame::bonds`] between two kept atoms stay (renumbered, with their orders),
+    /// the others go. The cell, time, step and comment stay. `keep` has one entry per atom.
+    ///
+    /// ```
+    /// use texmap_md_io::Frame;
+    /// let mut f = Frame::new();
+    /// f.positions = vec![[0.0; 3], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]];
+    /// f.ids = vec![10, 11, 12];
+    /// f.bonds = vec![[0, 1], [1, 2]];
+    /// f.retain_atoms(&[false, true, true]);
+    /// assert_eq!(f.ids, [11, 12]);
+    /// assert_eq!(f.bonds, [[0, 1]]);
+    /// assert_eq!(f.check(), Ok(()));
+    /// ```
+    ///
+    /// # Panics
+    /// If `keep.len()` is not the number of atoms.
+    pub fn retain_atoms(&mut self, keep: &[bool]) {
+        let n = self.n_atoms();
+        assert_eq!(keep.len(), n, "one keep flag per atom");
+        fn retain<T>(v: &mut Vec<T>, keep: &[bool]) {
+            if v.len() == keep.len() {
+                let mut k = keep.iter();
+                v.retain(|_| *k.next().expect("lengths checked"));
+            }
+        }
+        retain(&mut self.positions, keep);
+        retain(&mut self.velocities, keep);
+        retain(&mut self.names, keep);
+        retain(&mut self.elements, keep);
+        retain(&mut self.types, keep);
+        retain(&mut self.ids, keep);
+        retain(&mut self.res_names, keep);
+        retain(&mut self.res_ids, keep);
+        retain(&mut self.chains, keep);
+        retain(&mut self.segments, keep);
+        retain(&mut self.radii, keep);
+        retain(&mut self.colors, keep);
+        for p in &mut self.properties {
+            retain(&mut p.values, keep);
+        }
+        // New index of each kept atom.
+        let mut index = vec![u32::MAX; n];
+        let mut next = 0u32;
+        for (slot, &k) in index.iter_mut().zip(keep) {
+            if k {
+                *slot = next;
+                next += 1;
+            }
+        }
+        let ordered = self.bond_orders.len() == self.bonds.len() && !self.bond_orders.is_empty();
+        let mut bonds = Vec::with_capacity(self.bonds.len());
+        let mut orders = Vec::new();
+        for (b, [i, j]) in self.bonds.iter().enumerate() {
+            let (a, c) = (index[*i as usize], index[*j as usize]);
+            if a != u32::MAX && c != u32::MAX {
+                bonds.push([a, c]);
+                if ordered {
+                    orders.push(self.bond_orders[b]);
+                }
+            }
+        }
+        self.bonds = bonds;
+        self.bond_orders = orders;
     }
 
     /// The values of the property named `name` (exact match), if the frame has it.

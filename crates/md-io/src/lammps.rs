@@ -15,7 +15,9 @@
 //! Columns may come in any order. Positions come from the first present of `x y z` (wrapped),
 //! `xs ys zs` (scaled), `xu yu zu` (unwrapped), `xsu ysu zsu` (scaled unwrapped); scaled ones
 //! become Cartesian as origin + s·M with the frame's box (f64). Also read: `id`, `type`,
-//! `element` (→ elements; else elements are guessed from non-numeric types), `vx vy vz`,
+//! `element` (→ elements; a name there that is no element symbol, such as a type name `OW`,
+//! names the atoms, its element guessed from it, as OVITO reads it as the type's name; without
+//! the column elements are guessed from non-numeric types), `vx vy vz`,
 //! `radius`, `diameter` (halved), the colour columns below. Every other column (`q`, `mass`,
 //! `c_pe`, `v_stress[1]`, `fx`, `ix`, a partial velocity or colour, ...) is a property named by
 //! its header ([`Frame::property`]), as OVITO imports it: a number per atom, NaN where LAMMPS
@@ -128,13 +130,19 @@ impl Default for Lammps {
     }
 }
 
-/// The value of a field LAMMPS writes for a non-finite number (`nan`, `-nan`, `inf`, `-inf`).
-fn non_finite(f: &[u8]) -> Option<f32> {
+/// The value of a field written for a non-finite number (`nan`, `-nan`, `inf`, `-inf`, as
+/// LAMMPS, ASE and our writers write them): NaN, or an infinity of the written sign.
+pub(crate) fn non_finite(f: &[u8]) -> Option<f32> {
+    let neg = f.first() == Some(&b'-');
     let f = f.strip_prefix(b"-").or(f.strip_prefix(b"+")).unwrap_or(f);
     if f.eq_ignore_ascii_case(b"nan") {
         Some(f32::NAN)
     } else if f.eq_ignore_ascii_case(b"inf") || f.eq_ignore_ascii_case(b"infinity") {
-        Some(f32::INFINITY)
+        Some(if neg {
+            f32::NEG_INFINITY
+        } else {
+            f32::INFINITY
+        })
     } else {
         None
     }
@@ -473,10 +481,28 @@ impl TextFormat for Lammps {
                         frame.types.push(l);
                     }
                     Act::Element => {
-                        let s = std::str::from_utf8(f).unwrap_or("");
-                        let e = Element::from_symbol(s)
-                            .ok_or_else(|| ctx.parse(pos, line, f, "an element symbol"))?;
-                        frame.elements.push(e);
+                        let label = Label::from_utf8(f).ok_or_else(|| {
+                            ctx.parse(pos, line, f, "an element or type name of at most 15 bytes")
+                        })?;
+                        match Element::from_symbol(label.as_str()) {
+                            Some(e) if frame.names.is_empty() => frame.elements.push(e),
+                            known => {
+                                // A name that is no element symbol (a type name such as OW, as
+                                // OVITO reads the column): the atoms' names from here on, the
+                                // element guessed from it; the atoms before are named by their
+                                // symbols.
+                                if frame.names.is_empty() {
+                                    let before = frame.elements.iter().map(|e| {
+                                        Label::new(e.symbol()).expect("a symbol is short")
+                                    });
+                                    frame.names.extend(before);
+                                }
+                                let e = known
+                                    .unwrap_or_else(|| guess_element(label.as_str(), None, None));
+                                frame.elements.push(e);
+                                frame.names.push(label);
+                            }
+                        }
                     }
                     Act::Radius | Act::Diameter => {
                         let r = parse_f32(f)
@@ -536,6 +562,7 @@ impl TextFormat for Lammps {
             permute(&mut frame.colors, perm, &mut self.s3);
             permute(&mut frame.types, perm, &mut self.sl);
             permute(&mut frame.elements, perm, &mut self.se);
+            permute(&mut frame.names, perm, &mut self.sl);
             permute(&mut frame.radii, perm, &mut self.sf);
             permute(&mut frame.ids, perm, &mut self.si);
             for p in &mut frame.properties {

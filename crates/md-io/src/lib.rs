@@ -46,7 +46,9 @@
 //!   AECCAR; XCrySDen XSF `DATAGRID_3D`) into grids with their atoms
 //!   ([`volume::read_volumes`]); as trajectories these files are one frame, the atoms
 //!   (`Format::Cube`, `Format::Vasp`), an XSF / AXSF file one per structure (`Format::Xsf`).
-//! - [`Writer`] writes XYZ and PDB.
+//! - [`Writer`] writes extended XYZ and LAMMPS text dumps (positions, ids, types, velocities,
+//!   radii, colours and every named property, for OVITO, ASE and LAMMPS to read back), PDB,
+//!   DCD and XTC.
 //! - [`elements`] maps atom names to elements, gives van der Waals radii and CPK colours, and
 //!   [`AtomStyle`] resolves each atom's radius and colour with user overrides.
 //!
@@ -133,6 +135,7 @@ mod gz;
 pub mod hbonds;
 mod lammps;
 mod lammps_data;
+mod lammps_dump_writer;
 mod mmcif;
 mod mol2;
 mod namdbin;

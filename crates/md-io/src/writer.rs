@@ -1,20 +1,92 @@
 //! [`Writer`]: one writer for every format that has one.
+//!
+//! - [`Format::Xyz`]: extended XYZ with the species, positions, ids, types, velocities, radii,
+//!   colours and every named property ([`crate::Property`]) as `Properties=` columns, the cell
+//!   as `Lattice=` (read back by ASE, OVITO and our reader).
+//! - [`Format::LammpsDump`]: a LAMMPS text dump as `dump custom` writes it, `ITEM: ATOMS id
+//!   type x y z` then `element`, `vx vy vz`, `radius`, `ColorR ColorG ColorB` and the
+//!   properties when the frame has them (read back by LAMMPS `read_dump`, OVITO, ASE and our
+//!   reader).
+//! - [`Format::Pdb`], [`Format::Dcd`], [`Format::Xtc`]: positions and cell, with PDB's atom
+//!   records.
+//!
+//! Rules the text writers share:
+//! - numbers are written in Rust's shortest round-trip form, so reading them back gives the
+//!   same f32 bits (cell and box numbers are f64, written the same way);
+//! - a property whose every value is an integer below 2^24 in magnitude (where f32 holds
+//!   every integer) is an integer column, written without a decimal point: `I` in extended
+//!   XYZ's `Properties=`, `5` not `5.0` in both formats;
+//! - a NaN property value is written `nan` (and makes its column real), as ASE and LAMMPS write
+//!   it and ASE, OVITO and our readers read it; infinities `inf` and `-inf`;
+//! - what would not read back as written is an [`Error::InvalidFrame`] before anything of the
+//!   frame is written, never a silently changed file: a label with white space, a property name
+//!   the format cannot hold, and for LAMMPS a cell that is not restricted triclinic.
+//!
+//! The per-format details are on the writer types (src/xyz.rs `XyzWriter`,
+//! src/lammps_dump_writer.rs).
 
 use crate::dcd::DcdWriter;
 use crate::error::{Error, Location};
 use crate::format::Format;
 use crate::frame::Frame;
+use crate::lammps_dump_writer::LammpsDumpWriter;
 use crate::pdb::PdbWriter;
 use crate::xtc::XtcWriter;
 use crate::xyz::XyzWriter;
+use std::fmt;
 use std::fs::File;
 use std::io::{BufWriter, Seek, Write};
 use std::path::Path;
 use std::sync::Arc;
 
+/// A number as the text writers write it: shortest round-trip decimal, `nan` for NaN, `inf` /
+/// `-inf` for infinities, integers without a decimal point.
+pub(crate) struct Num(pub f32);
+
+impl fmt::Display for Num {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.0.is_nan() {
+            f.write_str("nan")
+        } else {
+            write!(f, "{}", self.0)
+        }
+    }
+}
+
+/// True when every value is an integer that f32 holds exactly with its neighbours (|v| < 2^24):
+/// a column written as integers.
+pub(crate) fn integer_valued(values: &[f32]) -> bool {
+    values
+        .iter()
+        .all(|v| v.is_finite() && v.fract() == 0.0 && v.abs() < 16_777_216.0)
+}
+
+/// The columns both text writers end an atom's line with, in this order, for the fields the
+/// frame has: velocity (3), radius, colour (3), then every property ([`Num`]).
+pub(crate) fn write_atom_tail(
+    w: &mut impl std::io::Write,
+    frame: &Frame,
+    i: usize,
+) -> std::io::Result<()> {
+    if let Some(v) = frame.velocities.get(i) {
+        write!(w, " {} {} {}", v[0], v[1], v[2])?;
+    }
+    if let Some(r) = frame.radii.get(i) {
+        write!(w, " {r}")?;
+    }
+    if let Some(c) = frame.colors.get(i) {
+        write!(w, " {} {} {}", c[0], c[1], c[2])?;
+    }
+    for p in &frame.properties {
+        write!(w, " {}", Num(p.values[i]))?;
+    }
+    writeln!(w)
+}
+
 /// The per-format writers: a closed set, dispatched by `match`.
 enum WriterKind<W> {
     Xyz(XyzWriter<W>),
+    LammpsDump(LammpsDumpWriter<W>),
     Dcd(DcdWriter<W>),
     Xtc(XtcWriter<W>),
     Pdb(PdbWriter<W>),
@@ -25,6 +97,7 @@ macro_rules! each_writer {
     ($writer:expr, $w:ident => $body:expr) => {
         match $writer {
             WriterKind::Xyz($w) => $body,
+            WriterKind::LammpsDump($w) => $body,
             WriterKind::Dcd($w) => $body,
             WriterKind::Xtc($w) => $body,
             WriterKind::Pdb($w) => $body,
@@ -60,6 +133,7 @@ impl<W: Write + Seek> Writer<W> {
         let file: Arc<str> = name.into();
         let kind = match format {
             Format::Xyz => WriterKind::Xyz(XyzWriter { out }),
+            Format::LammpsDump => WriterKind::LammpsDump(LammpsDumpWriter::new(out)),
             Format::Dcd => WriterKind::Dcd(DcdWriter::new(out, file.clone())),
             Format::Xtc => WriterKind::Xtc(XtcWriter::new(out, file.clone(), 1000.0)?),
             Format::Pdb => WriterKind::Pdb(PdbWriter { out, models: 0 }),
@@ -95,10 +169,11 @@ impl<W: Write + Seek> Writer<W> {
             frame: self.written,
             what,
         })?;
-        // Format limits (e.g. PDB's fixed columns).
+        // Format limits (e.g. PDB's fixed columns, LAMMPS's restricted triclinic box).
         let limits = match &self.kind {
             WriterKind::Pdb(_) => PdbWriter::<W>::check(frame),
             WriterKind::Xyz(_) => XyzWriter::<W>::check(frame),
+            WriterKind::LammpsDump(_) => LammpsDumpWriter::<W>::check(frame),
             _ => Ok(()),
         };
         limits.map_err(|what| Error::InvalidFrame {

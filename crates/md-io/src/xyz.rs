@@ -9,8 +9,9 @@
 //!   `velo`/`vel`/`velocities` (Å/ps, stored as given), `radius`/`radii`, `color`/`colors`
 //!   (R:3, sRGB in [0, 1]), `type` (→ types), `id` (→ ids), `Z` (→ elements); every other real
 //!   or integer column of one component (ASE's `masses`, `initial_charges`, `energies`, ...) is
-//!   a property of that name ([`Frame::property`]); the rest are skipped. Without `Properties`
-//!   the columns are `species:S:1:pos:R:3`.
+//!   a property of that name ([`Frame::property`]), where `nan` and `inf` (as ASE writes
+//!   them) are NaN and infinity; the rest are skipped. Without `Properties` the columns are
+//!   `species:S:1:pos:R:3`.
 //! - `Time=` (ps) and `step=`/`Step=`/`timestep=` when present.
 //!
 //! Elements come from the species by [`crate::elements::guess_element`] (species are normally
@@ -19,10 +20,12 @@
 use crate::elements::{Element, guess_element};
 use crate::error::Error;
 use crate::frame::{Frame, Label, UnitCell};
+use crate::lammps::non_finite;
 use crate::parse::{
     field_f32, fields, next_field, parse_f32, parse_f64, parse_i64, parse_usize, trim,
 };
 use crate::text::{Ctx, LineReader, Pos, TextFormat};
+use crate::writer::{integer_valued, write_atom_tail};
 use std::io::Read;
 
 /// What one atom-line column group holds.
@@ -270,7 +273,9 @@ impl Xyz {
                 }
                 Col::Property(k) => {
                     let f = it.next().unwrap_or(end);
-                    let v = parse_f32(f).ok_or_else(|| ctx.parse(pos, line, f, "a number"))?;
+                    let v = parse_f32(f)
+                        .or_else(|| non_finite(f))
+                        .ok_or_else(|| ctx.parse(pos, line, f, "a number"))?;
                     if frame.properties.len() == k {
                         frame.properties.push(crate::frame::Property {
                             name: self.properties[k].clone(),
@@ -393,29 +398,78 @@ impl TextFormat for Xyz {
     }
 }
 
-/// Writes frames as extended XYZ, which plain XYZ readers also read: the comment line carries
-/// `Properties=` (species, pos, and velo / radius / color when the frame has them), `Lattice=`
-/// when it has a cell, `Time=` and `step=` when known. Numbers are written in Rust's shortest
-/// round-trip form, so reading them back gives the same f32 bits.
+/// Writes frames as extended XYZ, which plain XYZ readers also read (ASE, OVITO, QUIP and our
+/// reader take the columns from `Properties=`).
+///
+/// The comment line carries `Lattice=` when the frame has a cell, then `Properties=` with the
+/// columns in this order: `species:S:1:pos:R:3`, `id:I:1` when the frame has ids, `type:S:1`
+/// when it has types, `velo:R:3`, `radius:R:1`, `color:R:3` when it has velocities, radii,
+/// colours, then each of [`Frame::properties`] in order as `NAME:I:1` when every value is an
+/// integer below 2^24 in magnitude (written without a decimal point), else `NAME:R:1`; then
+/// `Time=` and `step=` when known and `pbc="T T T"` with a cell.
+///
+/// The species of an atom is its name, else its element's symbol, else `X`. Numbers are
+/// written in Rust's shortest round-trip form, so reading them back gives the same f32 bits; a
+/// NaN property value is written `nan` (and makes its column R), infinities `inf` / `-inf`, as
+/// ASE writes them.
+///
+/// [`XyzWriter::check`] refuses what would not read back as written: names or types with white
+/// space (they would shift the columns), an empty type, a property whose name is not letters,
+/// digits and `_`, is written twice, or is one of the columns above (`species`, `pos`, `id`,
+/// `type`, `velo`, `radius`, `color`) or one readers take for another field (`Z`: atomic
+/// numbers, `radii`: radii).
 pub(crate) struct XyzWriter<W> {
     pub out: W,
 }
 
-impl<W: std::io::Write> XyzWriter<W> {
-    /// Why `frame` cannot be written as XYZ, if it cannot: a name with spaces would shift the
-    /// columns of its line.
-    pub fn check(frame: &Frame) -> Result<(), String> {
-        match frame
-            .names
-            .iter()
-            .position(|l| l.bytes().any(|b| b.is_ascii_whitespace()))
-        {
-            Some(i) => Err(format!(
-                "atom {i}'s name '{}' contains white space",
-                frame.names[i]
-            )),
-            None => Ok(()),
+/// The `Properties=` names [`XyzWriter`] writes itself or readers map to another field.
+const XYZ_RESERVED: [&str; 9] = [
+    "species", "pos", "id", "type", "velo", "radius", "color", "Z", "radii",
+];
+
+/// Why property names cannot be written as XYZ columns, if they cannot.
+fn check_xyz_properties(frame: &Frame) -> Result<(), String> {
+    for (k, p) in frame.properties.iter().enumerate() {
+        let name = p.name.as_str();
+        if name.is_empty() || !name.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'_') {
+            return Err(format!(
+                "property '{name}' is not an extended-XYZ column name: letters, digits and _"
+            ));
         }
+        if XYZ_RESERVED.contains(&name) {
+            return Err(format!(
+                "property '{name}' has the name of a column extended XYZ gives another meaning \
+                 ({})",
+                XYZ_RESERVED.join(", ")
+            ));
+        }
+        if frame.properties[..k].iter().any(|q| q.name == name) {
+            return Err(format!("property '{name}' appears twice"));
+        }
+    }
+    Ok(())
+}
+
+/// Why a label column cannot be written as white-space separated fields, if it cannot: the
+/// first label with white space (or, when `empty_ok` is false, an empty one).
+pub(crate) fn check_labels(labels: &[Label], what: &str, empty_ok: bool) -> Result<(), String> {
+    for (i, l) in labels.iter().enumerate() {
+        if l.bytes().any(|b| b.is_ascii_whitespace()) {
+            return Err(format!("atom {i}'s {what} '{l}' contains white space"));
+        }
+        if !empty_ok && l.is_empty() {
+            return Err(format!("atom {i}'s {what} is empty"));
+        }
+    }
+    Ok(())
+}
+
+impl<W: std::io::Write> XyzWriter<W> {
+    /// Why `frame` cannot be written as XYZ, if it cannot (see [`XyzWriter`]).
+    pub fn check(frame: &Frame) -> Result<(), String> {
+        check_labels(&frame.names, "name", true)?;
+        check_labels(&frame.types, "type", false)?;
+        check_xyz_properties(frame)
     }
 
     /// XYZ has no trailer.
@@ -437,6 +491,12 @@ impl<W: std::io::Write> XyzWriter<W> {
             )?;
         }
         write!(w, "Properties=species:S:1:pos:R:3")?;
+        if !frame.ids.is_empty() {
+            write!(w, ":id:I:1")?;
+        }
+        if !frame.types.is_empty() {
+            write!(w, ":type:S:1")?;
+        }
         if !frame.velocities.is_empty() {
             write!(w, ":velo:R:3")?;
         }
@@ -445,6 +505,10 @@ impl<W: std::io::Write> XyzWriter<W> {
         }
         if !frame.colors.is_empty() {
             write!(w, ":color:R:3")?;
+        }
+        for p in &frame.properties {
+            let ty = if integer_valued(&p.values) { 'I' } else { 'R' };
+            write!(w, ":{}:{ty}:1", p.name)?;
         }
         if let Some(t) = frame.time {
             write!(w, " Time={t}")?;
@@ -465,16 +529,13 @@ impl<W: std::io::Write> XyzWriter<W> {
             };
             let p = frame.positions[i];
             write!(w, "{name} {} {} {}", p[0], p[1], p[2])?;
-            if let Some(v) = frame.velocities.get(i) {
-                write!(w, " {} {} {}", v[0], v[1], v[2])?;
+            if let Some(id) = frame.ids.get(i) {
+                write!(w, " {id}")?;
             }
-            if let Some(r) = frame.radii.get(i) {
-                write!(w, " {r}")?;
+            if let Some(t) = frame.types.get(i) {
+                write!(w, " {t}")?;
             }
-            if let Some(c) = frame.colors.get(i) {
-                write!(w, " {} {} {}", c[0], c[1], c[2])?;
-            }
-            writeln!(w)?;
+            write_atom_tail(w, frame, i)?;
         }
         Ok(())
     }
