@@ -1143,14 +1143,12 @@ impl MolPlan {
         Ok(())
     }
 
-    /// Periodic boundaries applied to `frame`, then `scene` built from it: selected atoms
-    /// only, per-selection colours and radii, bonds between drawn atoms (never across the box).
-    pub fn build(
-        &mut self,
-        builder: &mut SceneBuilder,
-        frame: &mut Frame,
-        scene: &mut SphereScene,
-    ) -> Result<(), MolError> {
+    /// `frame` as the plan sees it, before anything is drawn: periodic boundaries applied,
+    /// replicated, every analysis's per-atom properties set (coordination, clusters,
+    /// centrosymmetry, strain, Wigner-Seitz, Voronoi, orientations, grains, computed and frozen
+    /// properties, displacements), radii taken from a property, aligned. [`MolPlan::build`]
+    /// calls it; a program that writes the frames instead of drawing them calls it alone.
+    pub fn prepare(&mut self, frame: &mut Frame) -> Result<(), MolError> {
         let unwrap = self.options.pbc == Pbc::Unwrap && frame.cell.is_some();
         self.find_bonds(
             frame,
@@ -1361,7 +1359,6 @@ impl MolPlan {
         }
         texmap_md_io::pbc::drop_crossing(&mut self.pairs, &frame.positions, frame.cell.as_ref());
         self.last_bond_count = self.pairs.len();
-        let failed = |role| move |error| MolError::Selection { role, error };
         self.align(frame)?;
         self.slice_keep = self
             .options
@@ -1396,6 +1393,20 @@ impl MolPlan {
                 crate::arrows::vectors(frame, source, self.arrow_reference.as_deref())
                     .map_err(MolError::Arrows)?;
         }
+        Ok(())
+    }
+
+    /// Periodic boundaries applied to `frame` and its analyses computed
+    /// ([`MolPlan::prepare`]), then `scene` built from it: selected atoms only, per-selection
+    /// colours and radii, bonds between drawn atoms (never across the box).
+    pub fn build(
+        &mut self,
+        builder: &mut SceneBuilder,
+        frame: &mut Frame,
+        scene: &mut SphereScene,
+    ) -> Result<(), MolError> {
+        self.prepare(frame)?;
+        let failed = |role| move |error| MolError::Selection { role, error };
         // The frame's colour column, for a representation coloured by it when the builder
         // (which drops it otherwise) colours by something else.
         let file_colors = (builder.color_by() != ColorBy::Property
