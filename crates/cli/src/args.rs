@@ -86,6 +86,10 @@ pub enum Command {
     },
     /// Render trajectory frames to PNG (and optionally depth to EXR).
     Render(RenderArgs),
+    /// Write a trajectory's frames to another file, analysed and cut down as texmap render
+    /// would draw them: a selection, every Nth frame, molecules made whole, superposed, with
+    /// the analyses' per-atom numbers as columns (extended XYZ, LAMMPS dump, PDB, DCD, XTC).
+    Convert(crate::convert::ConvertArgs),
     /// Run every method and the reference ray tracer on a scene; write results, images and charts.
     Compare(CompareArgs),
     /// No input needed: simulate a small built-in MD system and render it with every method, build
@@ -1005,6 +1009,63 @@ pub struct MolArgs {
     /// as a stick with a dashed line inside the ring.
     #[arg(long)]
     pub bond_orders: bool,
+    /// Also write the --measure values as a CSV table, one row per measurement and frame:
+    /// frame, measure (0-based, in the order given), kind (distance, angle, dihedral), value
+    /// (Å or degrees), the atoms' 0-based indices joined by spaces, and the spec as given.
+    /// Written whole or not at all.
+    #[arg(long, value_name = "FILE.csv")]
+    pub measure_table: Option<PathBuf>,
+    /// Also write the hydrogen bonds the hbonds style draws as a CSV table, one row per bond and
+    /// frame: frame, donor, hydrogen, acceptor (0-based atom indices, as MDAnalysis's
+    /// results.hbonds), the three atoms as RESNAME RESID:NAME, the donor-acceptor distance (Å)
+    /// and the donor-hydrogen-acceptor angle (degrees). Written whole or not at all.
+    #[arg(long, value_name = "FILE.csv")]
+    pub hbond_table: Option<PathBuf>,
+    /// Draw each atom with the radius (Å) a per-atom property gives: PQR's 'radius'
+    /// (PDB2PQR/APBS radii), any dump column (texmap info lists them), --property FILE's
+    /// numbers. As a file's radius column: --radius-scale does not apply, ball-and-stick
+    /// scales it. Zero, negative or missing values leave the element's radius.
+    #[arg(long, value_name = "PROPERTY")]
+    pub radius_from: Option<String>,
+    /// Cut the system open, as OVITO's Slice modifier: 'NX,NY,NZ:D' keeps the atoms behind the
+    /// plane n·x = D (n the unit normal: the side n points away from), 'NX,NY,NZ:D:W' the
+    /// slab of width W Å centred on it: --slice 1,1,1:20:6 shows one (111) slab of an FCC
+    /// crystal, --slice 0,0,1:0 the lower half of a membrane. Only the drawing is cut, as by a
+    /// Slice at the end of an OVITO pipeline: colourings (cna, coordination, structure) and
+    /// selections see the whole system, so atoms at the cut keep their crystal structure. The
+    /// plane is placed after --align, so it stays put relative to an aligned molecule.
+    #[arg(long, value_name = "NX,NY,NZ:D[:W]", value_parser = parse_slice, allow_hyphen_values = true)]
+    pub slice: Option<[f64; 5]>,
+    /// Keep the atoms --slice would remove instead (the other side, or all but the slab).
+    #[arg(long, requires = "slice")]
+    pub slice_invert: bool,
+    /// A representation, as VMD's: 'SEL=STYLE' draws the atoms SEL selects in STYLE (spacefill,
+    /// ball-stick, licorice, tube, cartoon, surface, hbonds), each with its own radii and bond radius; repeat it
+    /// to draw several in one image: --rep 'protein=tube' --rep 'resname LIG=ball-stick'
+    /// --rep 'water and within 5 of resname LIG=licorice'; --rep 'protein=surface' --rep
+    /// 'resname LIG=ball-stick' shows a ligand in its pocket (surface representations share
+    /// one surface). 'SEL=STYLE:COLOUR' gives it its own
+    /// colouring: element, type, chain, structure, cna, property, or one colour #rrggbb or R,G,B
+    /// (--rep 'protein=tube:structure' --rep 'resname LIG=ball-stick:element'); without one it
+    /// takes --color-by, and --color rules win over both. Replaces --select and --style; an
+    /// atom two representations select is drawn by both.
+    #[arg(
+        long = "rep",
+        value_name = "SEL=STYLE[:COLOUR]",
+        conflicts_with_all = ["select", "draw"]
+    )]
+    pub reps: Vec<String>,
+    /// The analyses, periodic boundaries and alignment applied to every frame.
+    #[command(flatten)]
+    pub analysis: AnalysisArgs,
+}
+
+/// What `texmap render` and `texmap convert` do to every frame before it is drawn or written:
+/// periodic boundaries, periodic images, per-atom analyses (OVITO's modifiers), properties from
+/// files and formulas, alignment, and the per-frame tables of the analyses.
+#[derive(Args, Clone, Debug, Default)]
+#[command(next_help_heading = "Analysis")]
+pub struct AnalysisArgs {
     /// Give every atom the property `displacement`: its distance (Å) from where it was in the
     /// first frame drawn (or --displacement-reference), to the nearest periodic image (OVITO's
     /// Displacements modifier), for
@@ -1026,18 +1087,6 @@ pub struct MolArgs {
     /// aligned as the frames are; with --align, the frames are superposed on it.
     #[arg(long, value_name = "FRAME|FILE")]
     pub displacement_reference: Option<String>,
-    /// Also write the --measure values as a CSV table, one row per measurement and frame:
-    /// frame, measure (0-based, in the order given), kind (distance, angle, dihedral), value
-    /// (Å or degrees), the atoms' 0-based indices joined by spaces, and the spec as given.
-    /// Written whole or not at all.
-    #[arg(long, value_name = "FILE.csv")]
-    pub measure_table: Option<PathBuf>,
-    /// Also write the hydrogen bonds the hbonds style draws as a CSV table, one row per bond and
-    /// frame: frame, donor, hydrogen, acceptor (0-based atom indices, as MDAnalysis's
-    /// results.hbonds), the three atoms as RESNAME RESID:NAME, the donor-acceptor distance (Å)
-    /// and the donor-hydrogen-acceptor angle (degrees). Written whole or not at all.
-    #[arg(long, value_name = "FILE.csv")]
-    pub hbond_table: Option<PathBuf>,
     /// Periodic boundaries: none, wrap (atoms into the box), unwrap (molecules whole).
     #[arg(long, value_enum, default_value_t = PbcArg::None)]
     pub pbc: PbcArg,
@@ -1164,40 +1213,6 @@ pub struct MolArgs {
     /// or not at all.
     #[arg(long, value_name = "FILE.csv")]
     pub grain_table: Option<PathBuf>,
-    /// Draw each atom with the radius (Å) a per-atom property gives: PQR's 'radius'
-    /// (PDB2PQR/APBS radii), any dump column (texmap info lists them), --property FILE's
-    /// numbers. As a file's radius column: --radius-scale does not apply, ball-and-stick
-    /// scales it. Zero, negative or missing values leave the element's radius.
-    #[arg(long, value_name = "PROPERTY")]
-    pub radius_from: Option<String>,
-    /// Cut the system open, as OVITO's Slice modifier: 'NX,NY,NZ:D' keeps the atoms behind the
-    /// plane n·x = D (n the unit normal: the side n points away from), 'NX,NY,NZ:D:W' the
-    /// slab of width W Å centred on it: --slice 1,1,1:20:6 shows one (111) slab of an FCC
-    /// crystal, --slice 0,0,1:0 the lower half of a membrane. Only the drawing is cut, as by a
-    /// Slice at the end of an OVITO pipeline: colourings (cna, coordination, structure) and
-    /// selections see the whole system, so atoms at the cut keep their crystal structure. The
-    /// plane is placed after --align, so it stays put relative to an aligned molecule.
-    #[arg(long, value_name = "NX,NY,NZ:D[:W]", value_parser = parse_slice, allow_hyphen_values = true)]
-    pub slice: Option<[f64; 5]>,
-    /// Keep the atoms --slice would remove instead (the other side, or all but the slab).
-    #[arg(long, requires = "slice")]
-    pub slice_invert: bool,
-    /// A representation, as VMD's: 'SEL=STYLE' draws the atoms SEL selects in STYLE (spacefill,
-    /// ball-stick, licorice, tube, cartoon, surface, hbonds), each with its own radii and bond radius; repeat it
-    /// to draw several in one image: --rep 'protein=tube' --rep 'resname LIG=ball-stick'
-    /// --rep 'water and within 5 of resname LIG=licorice'; --rep 'protein=surface' --rep
-    /// 'resname LIG=ball-stick' shows a ligand in its pocket (surface representations share
-    /// one surface). 'SEL=STYLE:COLOUR' gives it its own
-    /// colouring: element, type, chain, structure, cna, property, or one colour #rrggbb or R,G,B
-    /// (--rep 'protein=tube:structure' --rep 'resname LIG=ball-stick:element'); without one it
-    /// takes --color-by, and --color rules win over both. Replaces --select and --style; an
-    /// atom two representations select is drawn by both.
-    #[arg(
-        long = "rep",
-        value_name = "SEL=STYLE[:COLOUR]",
-        conflicts_with_all = ["select", "draw"]
-    )]
-    pub reps: Vec<String>,
     /// Superpose every frame on the first rendered frame (or on --align-to's structure) by the
     /// least-squares fit of the atoms SEL picks ('backbone', 'name CA', 'protein and not name
     /// H*'), so the molecule holds still while it tumbles and diffuses, as MDAnalysis's

@@ -13,7 +13,9 @@ use texmap_md_io::{Format, Frame as MdFrame, ReadOptions, Sequence};
 use texmap_study::harness::{self, HarnessOptions, SceneReport};
 use texmap_study::scenes::{self, NamedScene, SceneId};
 
-use crate::args::{Cli, Command, CompareArgs, MethodArg, RenderArgs, SceneArg, usage};
+use crate::args::{
+    AnalysisArgs, Cli, Command, CompareArgs, MethodArg, RenderArgs, SceneArg, usage,
+};
 use crate::output::{write_atomic, write_png};
 use crate::scene::{parse_background, parse_size, warning_text};
 
@@ -52,6 +54,7 @@ pub fn run(cli: Cli) -> Result<()> {
             topology.as_deref(),
         ),
         Command::Render(a) => render(&a),
+        Command::Convert(a) => crate::convert::convert(&a),
         Command::Compare(a) => compare(&a),
         Command::Demo {
             out,
@@ -97,7 +100,7 @@ pub(crate) fn open_trajectory(file: &Path, format: Option<&str>) -> Result<Seque
 
 /// Prints the reader's warnings (once each): what it tolerated under --allow-truncated, and the
 /// alternate locations of PDBx/mmCIF atoms it dropped after the first.
-fn print_warnings(traj: &Sequence, shown: &mut usize) {
+pub(crate) fn print_warnings(traj: &Sequence, shown: &mut usize) {
     for w in &traj.warnings()[*shown..] {
         if texmap_md_io::is_altloc_warning(w) {
             eprintln!("texmap: warning: {w}");
@@ -501,39 +504,90 @@ fn per_frame_table(
     Ok(Some(t))
 }
 
-fn render(a: &RenderArgs) -> Result<()> {
-    let background = parse_background(&a.background)?;
-    if let Some(dpi) = a.dpi
-        && !(dpi.is_finite() && (1.0..=100_000.0).contains(&dpi))
-    {
-        return usage(format!("--dpi {dpi}: expected 1 to 100000 dots per inch"));
-    }
-    let size = crate::scene::parse_print_size(&a.camera.size, a.dpi)?;
-    let topology = a
-        .mol
-        .topology
-        .as_deref()
-        .map(crate::scene::open_topology)
-        .transpose()?;
-    let options = ReadOptions::new().allow_truncated(a.allow_truncated);
-    let files: Vec<PathBuf> = std::iter::once(a.file.clone())
-        .chain(a.more.iter().cloned())
+/// A trajectory's topology (if given), its parts opened as one, and the read options used.
+pub(crate) fn open_input(
+    file: &Path,
+    more: &[PathBuf],
+    format: Option<&str>,
+    allow_truncated: bool,
+    topology: Option<&Path>,
+) -> Result<(Option<texmap_md_io::Topology>, Sequence, ReadOptions)> {
+    let topology = topology.map(crate::scene::open_topology).transpose()?;
+    let options = ReadOptions::new().allow_truncated(allow_truncated);
+    let files: Vec<PathBuf> = std::iter::once(file.to_path_buf())
+        .chain(more.iter().cloned())
         .collect();
-    let mut traj = open_parts(
-        &files,
-        a.format.as_deref(),
-        with_topology(options, topology.as_ref()),
-    )?;
-    let n = traj.n_frames()?;
-    let mut shown = 0;
-    print_warnings(&traj, &mut shown);
-    if n == 0 {
-        bail!("{}: the file holds no frame", a.file.display());
+    let traj = open_parts(&files, format, with_topology(options, topology.as_ref()))?;
+    Ok((topology, traj, options))
+}
+
+/// The per-frame tables of the analyses (`--defect-table`, `--grain-table`), shared by
+/// `texmap render` and `texmap convert`.
+pub(crate) struct AnalysisTables {
+    defect: Option<crate::output::AtomicFile>,
+    grain: Option<crate::output::AtomicFile>,
+}
+
+impl AnalysisTables {
+    /// The tables `analysis` asks for, their headers written (`whole`: see [`per_frame_table`]).
+    pub(crate) fn create(analysis: &AnalysisArgs, whole: bool) -> Result<AnalysisTables> {
+        Ok(AnalysisTables {
+            defect: per_frame_table(
+                &analysis.defect_table,
+                "--defect-table",
+                "frame,vacancies,interstitials",
+                whole,
+            )?,
+            grain: per_frame_table(
+                &analysis.grain_table,
+                "--grain-table",
+                "frame,grain,atoms,crystalline,structure,qx,qy,qz,qw",
+                whole,
+            )?,
+        })
     }
-    let frames = parse_frames(&a.frames, n)?;
-    // --property NAME=FILE: per-atom numbers from files.
-    let mut atom_values = Vec::with_capacity(a.mol.properties.len());
-    for spec in &a.mol.properties {
+
+    /// Frame `f`'s rows, from what `plan` found in it.
+    pub(crate) fn write(&mut self, f: usize, plan: &texmap_md_scene::MolPlan) -> Result<()> {
+        if let Some(t) = &mut self.defect
+            && let Some((vacancies, interstitials)) = plan.last_defects()
+        {
+            t.write(&format!("{f},{vacancies},{interstitials}\n"))?;
+        }
+        if let Some(t) = &mut self.grain
+            && let Some(grains) = plan.last_grains()
+        {
+            let mut rows = String::new();
+            for (g, grain) in grains.iter().enumerate() {
+                let [x, y, z, w] = grain.orientation;
+                rows.push_str(&format!(
+                    "{f},{g},{},{},{},{x:.6},{y:.6},{z:.6},{w:.6}\n",
+                    grain.size,
+                    grain.crystalline,
+                    grain.structure.name()
+                ));
+            }
+            t.write(&rows)?;
+        }
+        Ok(())
+    }
+
+    /// Every table moved into place.
+    pub(crate) fn commit(self) -> Result<()> {
+        for t in [self.defect, self.grain].into_iter().flatten() {
+            t.commit()?;
+        }
+        Ok(())
+    }
+}
+
+/// `--property NAME=FILE` values: per-atom numbers from files, by name.
+pub(crate) type AtomValueFiles = Vec<(String, texmap_md_io::values::AtomValues)>;
+
+/// Opens the files of `--property NAME=FILE` options.
+pub(crate) fn atom_value_files(specs: &[String]) -> Result<AtomValueFiles> {
+    let mut atom_values = Vec::with_capacity(specs.len());
+    for spec in specs {
         let Some((name, file)) = spec.split_once('=') else {
             return usage(format!("--property {spec:?}: expected NAME=FILE"));
         };
@@ -551,6 +605,86 @@ fn render(a: &RenderArgs) -> Result<()> {
             .with_context(|| format!("--property {name}"))?;
         atom_values.push((name.to_string(), values));
     }
+    Ok(atom_values)
+}
+
+/// Frame `f`'s `--property` values set on `md` (a property of the same name replaced).
+pub(crate) fn set_atom_values(md: &mut MdFrame, f: usize, values: &AtomValueFiles) -> Result<()> {
+    for (name, file) in values {
+        let v = file
+            .for_frame(f, md.n_atoms())
+            .with_context(|| format!("--property {name}"))?;
+        md.properties.retain(|p| p.name != *name);
+        md.properties.push(texmap_md_io::Property {
+            name: name.clone(),
+            values: v.to_vec(),
+        });
+    }
+    Ok(())
+}
+
+/// `--displacement-reference FRAME|FILE` given to `plan`: a frame of `traj` (the trajectory
+/// `file`) or the first frame of another file.
+pub(crate) fn set_displacement_reference(
+    plan: &mut texmap_md_scene::MolPlan,
+    r: &str,
+    traj: &mut Sequence,
+    file: &Path,
+    options: ReadOptions,
+) -> Result<()> {
+    if !plan.measures_displacements() {
+        return usage(format!(
+            "--displacement-reference {r}: nothing measures displacements; add --displacements, --color-by displacement, --arrows displacement, --strain R or --wigner-seitz"
+        ));
+    }
+    let n = traj.n_frames()?;
+    let mut reference = MdFrame::new();
+    match r.parse::<usize>() {
+        Ok(k) if k < n => {
+            traj.read_frame(k, &mut reference)?;
+            plan.label(&mut reference, traj.name(), k)?;
+        }
+        Ok(k) => {
+            return usage(format!(
+                "--displacement-reference {k}: {} has {n} frames (0 to {})",
+                file.display(),
+                n - 1
+            ));
+        }
+        Err(_) => {
+            let mut t = open_trajectory_with(Path::new(r), None, options)?;
+            t.read_frame(0, &mut reference)?;
+            plan.label(&mut reference, t.name(), 0)?;
+        }
+    }
+    plan.set_displacement_reference(&mut reference)
+        .map_err(crate::scene::mol_error)
+        .with_context(|| format!("--displacement-reference {r}"))
+}
+
+fn render(a: &RenderArgs) -> Result<()> {
+    let background = parse_background(&a.background)?;
+    if let Some(dpi) = a.dpi
+        && !(dpi.is_finite() && (1.0..=100_000.0).contains(&dpi))
+    {
+        return usage(format!("--dpi {dpi}: expected 1 to 100000 dots per inch"));
+    }
+    let size = crate::scene::parse_print_size(&a.camera.size, a.dpi)?;
+    let (topology, mut traj, options) = open_input(
+        &a.file,
+        &a.more,
+        a.format.as_deref(),
+        a.allow_truncated,
+        a.mol.topology.as_deref(),
+    )?;
+    let n = traj.n_frames()?;
+    let mut shown = 0;
+    print_warnings(&traj, &mut shown);
+    if n == 0 {
+        bail!("{}: the file holds no frame", a.file.display());
+    }
+    let frames = parse_frames(&a.frames, n)?;
+    let atom_values = atom_value_files(&a.mol.analysis.properties)?;
     // The other files of the scene: each with one frame, or at least as many as the file.
     let mut adds = Vec::with_capacity(a.add.len());
     for file in &a.add {
@@ -678,7 +812,7 @@ fn render(a: &RenderArgs) -> Result<()> {
                 crate::scene::LabelPart::Vacancies | crate::scene::LabelPart::Interstitials
             )
         })
-    }) && a.mol.wigner_seitz.is_none()
+    }) && a.mol.analysis.wigner_seitz.is_none()
     {
         return usage(
             "--label {vacancies} and {interstitials} count the point defects --wigner-seitz finds: add --wigner-seitz",
@@ -708,52 +842,15 @@ fn render(a: &RenderArgs) -> Result<()> {
         "frame,donor,hydrogen,acceptor,donor_atom,hydrogen_atom,acceptor_atom,distance,angle",
         whole,
     )?;
-    let mut defect_table = per_frame_table(
-        &a.mol.defect_table,
-        "--defect-table",
-        "frame,vacancies,interstitials",
-        whole,
-    )?;
+    let mut analysis_tables = AnalysisTables::create(&a.mol.analysis, whole)?;
     let mut measure_table = per_frame_table(
         &a.mol.measure_table,
         "--measure-table",
         "frame,measure,kind,value,atoms,spec",
         whole,
     )?;
-    let mut grain_table = per_frame_table(
-        &a.mol.grain_table,
-        "--grain-table",
-        "frame,grain,atoms,crystalline,structure,qx,qy,qz,qw",
-        whole,
-    )?;
-    if let Some(r) = &a.mol.displacement_reference {
-        if !plan.measures_displacements() {
-            return usage(format!(
-                "--displacement-reference {r}: nothing measures displacements; add --displacements, --color-by displacement, --arrows displacement, --strain R or --wigner-seitz"
-            ));
-        }
-        let mut reference = MdFrame::new();
-        match r.parse::<usize>() {
-            Ok(k) if k < n => {
-                traj.read_frame(k, &mut reference)?;
-                plan.label(&mut reference, traj.name(), k)?;
-            }
-            Ok(k) => {
-                return usage(format!(
-                    "--displacement-reference {k}: {} has {n} frames (0 to {})",
-                    a.file.display(),
-                    n - 1
-                ));
-            }
-            Err(_) => {
-                let mut t = open_trajectory_with(Path::new(r), None, options)?;
-                t.read_frame(0, &mut reference)?;
-                plan.label(&mut reference, t.name(), 0)?;
-            }
-        }
-        plan.set_displacement_reference(&mut reference)
-            .map_err(crate::scene::mol_error)
-            .with_context(|| format!("--displacement-reference {r}"))?;
+    if let Some(r) = &a.mol.analysis.displacement_reference {
+        set_displacement_reference(&mut plan, r, &mut traj, &a.file, options)?;
     } else if plan.draws_arrows()
         && a.mol.arrows.starts_with("displacement")
         && frames.first().is_some_and(|f| *f != 0)
@@ -794,19 +891,7 @@ fn render(a: &RenderArgs) -> Result<()> {
         print_warnings(&traj, &mut shown);
         plan.label(&mut md, traj.name(), f)
             .map_err(|e| fail(e.into(), &written))?;
-        for (name, values) in &atom_values {
-            let v = values.for_frame(f, md.n_atoms()).map_err(|e| {
-                fail(
-                    anyhow::Error::from(e).context(format!("--property {name}")),
-                    &written,
-                )
-            })?;
-            md.properties.retain(|p| p.name != *name);
-            md.properties.push(texmap_md_io::Property {
-                name: name.clone(),
-                values: v.to_vec(),
-            });
-        }
+        set_atom_values(&mut md, f, &atom_values).map_err(|e| fail(e, &written))?;
         if !adds.is_empty() {
             plan.part_bonds(&mut md, true);
             set_file_number(&mut md, 0);
@@ -835,28 +920,10 @@ fn render(a: &RenderArgs) -> Result<()> {
             t.write(&hbond_rows(f, plan.last_hbonds(), &md))
                 .map_err(|e| fail(e, &written))?;
         }
-        if let Some(t) = &mut defect_table
-            && mine.contains(&k)
-            && let Some((vacancies, interstitials)) = plan.last_defects()
-        {
-            t.write(&format!("{f},{vacancies},{interstitials}\n"))
+        if mine.contains(&k) {
+            analysis_tables
+                .write(f, &plan)
                 .map_err(|e| fail(e, &written))?;
-        }
-        if let Some(t) = &mut grain_table
-            && mine.contains(&k)
-            && let Some(grains) = plan.last_grains()
-        {
-            let mut rows = String::new();
-            for (g, grain) in grains.iter().enumerate() {
-                let [x, y, z, w] = grain.orientation;
-                rows.push_str(&format!(
-                    "{f},{g},{},{},{},{x:.6},{y:.6},{z:.6},{w:.6}\n",
-                    grain.size,
-                    grain.crystalline,
-                    grain.structure.name()
-                ));
-            }
-            t.write(&rows).map_err(|e| fail(e, &written))?;
         }
         if let Some(t) = &mut measure_table
             && mine.contains(&k)
@@ -1206,12 +1273,7 @@ fn render(a: &RenderArgs) -> Result<()> {
     if let Some(t) = measure_table {
         t.commit()?;
     }
-    if let Some(t) = defect_table {
-        t.commit()?;
-    }
-    if let Some(t) = grain_table {
-        t.commit()?;
-    }
+    analysis_tables.commit()?;
     if builder.merged_colors() > 0 {
         eprintln!(
             "texmap: warning: {} more distinct colours than the {} materials a scene holds; each was drawn with the nearest of the first {}",

@@ -407,7 +407,7 @@ pub fn open_topology(path: &std::path::Path) -> Result<Topology> {
 }
 
 /// A parsed selection, or a usage error pointing at the bad token's column.
-fn parse_selection(flag: &str, text: &str) -> Result<Selection> {
+pub(crate) fn parse_selection(flag: &str, text: &str) -> Result<Selection> {
     Selection::parse(text).map_err(|e| crate::args::UsageError(format!("{flag}: {e}")).into())
 }
 
@@ -504,14 +504,14 @@ pub fn mol_plan(args: &MolArgs, style: &StyleArgs, topology: Option<Topology>) -
         )
         .into());
     }
-    if matches!(style.color_by, ColorBy::Cluster) && args.clusters.is_none() {
+    if matches!(style.color_by, ColorBy::Cluster) && args.analysis.clusters.is_none() {
         return Err(crate::args::UsageError(
             "--color-by cluster: give --clusters R (the neighbour cutoff in Å) to find them".into(),
         )
         .into());
     }
     let scalar_is = |name: &str| matches!(&style.color_by, ColorBy::Scalar(texmap_md_scene::ScalarSource::Property(p)) if p == name);
-    if args.strain.is_none()
+    if args.analysis.strain.is_none()
         && let Some(p) = ["shear_strain", "volumetric_strain", "d2min"]
             .into_iter()
             .find(|p| scalar_is(p))
@@ -520,25 +520,27 @@ pub fn mol_plan(args: &MolArgs, style: &StyleArgs, topology: Option<Topology>) -
             "--color-by {p}: give --strain R (the neighbour cutoff in Å, 3.0 for copper) to compute it"
         ));
     }
-    let grains = args.grains.is_some() || matches!(style.color_by, ColorBy::Grain);
+    let grains = args.analysis.grains.is_some() || matches!(style.color_by, ColorBy::Grain);
     if !grains
-        && (args.grain_keep_orphans
-            || args.grain_separate_faults
-            || args.grain_table.is_some()
-            || args.grain_min_size != 100)
+        && (args.analysis.grain_keep_orphans
+            || args.analysis.grain_separate_faults
+            || args.analysis.grain_table.is_some()
+            || args.analysis.grain_min_size != 100)
     {
         return usage(
             "--grain-min-size, --grain-keep-orphans, --grain-separate-faults and --grain-table are about the grains: add --grains",
         );
     }
-    if args.centrosymmetry_matching && args.centrosymmetry.is_none() && !scalar_is("centrosymmetry")
+    if args.analysis.centrosymmetry_matching
+        && args.analysis.centrosymmetry.is_none()
+        && !scalar_is("centrosymmetry")
     {
         return usage(
             "--centrosymmetry-matching: give --centrosymmetry N (or --color-by centrosymmetry)",
         );
     }
-    if let Some(n) = args.centrosymmetry {
-        let mode = if args.centrosymmetry_matching {
+    if let Some(n) = args.analysis.centrosymmetry {
+        let mode = if args.analysis.centrosymmetry_matching {
             texmap_md_io::centrosymmetry::CspMode::Matching
         } else {
             texmap_md_io::centrosymmetry::CspMode::Conventional
@@ -571,11 +573,16 @@ pub fn mol_plan(args: &MolArgs, style: &StyleArgs, topology: Option<Topology>) -
         };
         radii.push((parse_selection("--radius", sel)?, radius));
     }
-    let align = match optional("--align", &args.align)? {
+    let align = match optional("--align", &args.analysis.align)? {
         Some(select) => Some(texmap_md_scene::Alignment {
             select,
-            reference: args.align_to.as_deref().map(read_reference).transpose()?,
-            mass_weighted: args.align_mass,
+            reference: args
+                .analysis
+                .align_to
+                .as_deref()
+                .map(read_reference)
+                .transpose()?,
+            mass_weighted: args.analysis.align_mass,
         }),
         None => None,
     };
@@ -606,13 +613,14 @@ pub fn mol_plan(args: &MolArgs, style: &StyleArgs, topology: Option<Topology>) -
         radii,
         bonds: args.bonds.into(),
         draw: args.draw.into(),
-        pbc: args.pbc.into(),
-        replicate: args.replicate,
-        coordination: args.coordination,
-        clusters: match args.clusters {
+        pbc: args.analysis.pbc.into(),
+        replicate: args.analysis.replicate,
+        coordination: args.analysis.coordination,
+        clusters: match args.analysis.clusters {
             Some(cutoff) => Some(texmap_md_scene::ClusterOptions {
                 cutoff,
                 atoms: args
+                    .analysis
                     .cluster_atoms
                     .as_deref()
                     .map(|t| parse_selection("--cluster-atoms", t))
@@ -620,23 +628,23 @@ pub fn mol_plan(args: &MolArgs, style: &StyleArgs, topology: Option<Topology>) -
             }),
             None => None,
         },
-        centrosymmetry: match args.centrosymmetry {
+        centrosymmetry: match args.analysis.centrosymmetry {
             Some(n) => Some(n),
             None if scalar_is("centrosymmetry") => Some(12),
             None => None,
         }
         .map(|neighbours| texmap_md_scene::CentroOptions {
             neighbours,
-            mode: if args.centrosymmetry_matching {
+            mode: if args.analysis.centrosymmetry_matching {
                 texmap_md_io::centrosymmetry::CspMode::Matching
             } else {
                 texmap_md_io::centrosymmetry::CspMode::Conventional
             },
         }),
-        strain: args.strain,
-        freeze: args.freeze.clone(),
-        voronoi: args.voronoi,
-        orientations: args.orientations
+        strain: args.analysis.strain,
+        freeze: args.analysis.freeze.clone(),
+        voronoi: args.analysis.voronoi,
+        orientations: args.analysis.orientations
             || [
                 "lattice_rmsd",
                 "orientation_x",
@@ -647,11 +655,12 @@ pub fn mol_plan(args: &MolArgs, style: &StyleArgs, topology: Option<Topology>) -
             .into_iter()
             .any(scalar_is),
         grains: grains.then(|| grain_options(args)),
-        wigner_seitz: args.wigner_seitz.map(|w| match w {
+        wigner_seitz: args.analysis.wigner_seitz.map(|w| match w {
             crate::args::WignerSeitzArg::Sites => texmap_md_scene::WsOutput::Sites,
             crate::args::WignerSeitzArg::Atoms => texmap_md_scene::WsOutput::Atoms,
         }),
         computes: args
+            .analysis
             .computes
             .iter()
             .map(|c| {
@@ -699,7 +708,7 @@ pub fn mol_plan(args: &MolArgs, style: &StyleArgs, topology: Option<Topology>) -
         },
         trail_length: args.trail_length,
         bond_orders: args.bond_orders,
-        displacement: args.displacements || scalar_is("displacement"),
+        displacement: args.analysis.displacements || scalar_is("displacement"),
         measures: args
             .measures
             .iter()
@@ -716,11 +725,12 @@ pub fn mol_plan(args: &MolArgs, style: &StyleArgs, topology: Option<Topology>) -
 fn grain_options(args: &MolArgs) -> texmap_md_io::grains::GrainOptions {
     texmap_md_io::grains::GrainOptions {
         threshold_deg: args
+            .analysis
             .grains
             .unwrap_or(texmap_md_io::grains::GrainOptions::default().threshold_deg),
-        min_size: args.grain_min_size,
-        adopt_orphans: !args.grain_keep_orphans,
-        join_stacking_faults: !args.grain_separate_faults,
+        min_size: args.analysis.grain_min_size,
+        adopt_orphans: !args.analysis.grain_keep_orphans,
+        join_stacking_faults: !args.analysis.grain_separate_faults,
     }
 }
 
@@ -767,7 +777,7 @@ fn read_reference(path: &std::path::Path) -> Result<Frame> {
 }
 
 /// The per-atom properties the analyses add, and the flag that adds each.
-const ANALYSIS_PROPERTIES: [(&str, &str); 21] = [
+pub(crate) const ANALYSIS_PROPERTIES: [(&str, &str); 21] = [
     ("coordination", "--coordination R"),
     ("cluster", "--clusters R"),
     ("centrosymmetry", "--centrosymmetry N"),
@@ -1442,7 +1452,7 @@ pub fn isosurfaces(file: &std::path::Path, m: &MolArgs) -> Result<Option<Isosurf
         bar = Some((map, range.0, range.1, crate::args::strip_gz_stem(path)));
     }
     // A periodic volume follows the atoms' periodic images (md-io's replicate::images).
-    if let (true, Some(n)) = (vol.periodic, m.replicate) {
+    if let (true, Some(n)) = (vol.periodic, m.analysis.replicate) {
         let cell: [Vec3; 3] = std::array::from_fn(|a| {
             Vec3::from(vol.steps[a].map(|v| v as f32)) * vol.dims[a] as f32
         });

@@ -1,0 +1,281 @@
+//! `texmap convert`: a trajectory read, analysed and cut down as `texmap render` would draw it,
+//! then written to a file instead of drawn (OVITO's Export File, `gmx trjconv`, VMD's
+//! `animate write`).
+//!
+//! Each frame goes through the same steps as a render's: read, smoothed, labelled from the
+//! topology, `--property` files, then [`texmap_md_scene::MolPlan::prepare`] (periodic
+//! boundaries, replication, the analyses, `--compute`, alignment). `--select` is evaluated on
+//! the prepared frame, so it can name what the analyses computed, and the atoms it picks are
+//! written with the properties `--columns` names (all of them by default).
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+use clap::{Args, FromArgMatches};
+use texmap_md_io::{Format, Frame as MdFrame, Writer};
+
+use crate::args::{AnalysisArgs, MolArgs, StyleArgs, usage};
+
+#[derive(Args, Debug)]
+#[command(after_help = CONVERT_AFTER_HELP)]
+pub struct ConvertArgs {
+    /// Trajectory file (any format `texmap info` reads; gzip- or bzip2-compressed files too; a
+    /// quoted pattern such as 'dump.*.lammpstrj' reads the files it matches in natural order).
+    pub file: PathBuf,
+    /// More parts of the same trajectory, read after FILE as one (prod2.xtc prod3.xtc).
+    #[arg(value_name = "MORE")]
+    pub more: Vec<PathBuf>,
+    /// Format of the input, when the extension does not tell it.
+    #[arg(long)]
+    pub format: Option<String>,
+    /// Read only the complete frames of a file whose last frame is cut short, with a warning.
+    #[arg(long)]
+    pub allow_truncated: bool,
+    /// Topology giving names, elements, residues and bonds to the trajectory's atoms (PDB,
+    /// PDBx/mmCIF, GRO, PSF, AMBER prmtop, LAMMPS data file), as for texmap render.
+    #[arg(long, value_name = "FILE")]
+    pub topology: Option<PathBuf>,
+    /// Frames to write, A:B:STEP (B exclusive, each part optional: "::10", "5:", "3").
+    #[arg(long, default_value = "0:")]
+    pub frames: String,
+    /// Average each atom's position over 2N+1 frames centred on the frame (VMD's trajectory
+    /// smoothing; fewer at the ends), before anything else.
+    #[arg(long, default_value_t = 0, value_name = "N")]
+    pub smooth: u32,
+    /// Write only the atoms SEL selects, in the VMD/MDAnalysis language, evaluated on every
+    /// frame after the analyses (OVITO's Expression selection and Delete selected): 'protein',
+    /// 'not resname SOL', 'not cna fcc' (a crystal's defects), 'prop grain == 0',
+    /// 'prop site_occupancy != 1' (point defects). The atoms keep their ids (their numbers in
+    /// the whole frame, from 1, when the file has none). A .dcd, .xtc or .pdb output holds the
+    /// same atoms in every frame, so there the selection must pick as many atoms in each.
+    #[arg(long, value_name = "SEL")]
+    pub select: Option<String>,
+    /// The per-atom properties to write, in this order (extended XYZ and LAMMPS dump outputs):
+    /// --columns cna,grain,shear_strain. Default: every property the file has and the analyses
+    /// computed (texmap info lists a file's). 'cna' and 'diamond' name the structure types as
+    /// OVITO numbers them (adaptive CNA: 0 other, 1 FCC, 2 HCP, 3 BCC, 4 icosahedral; Identify
+    /// diamond structure: 0 other, 1 cubic, 2-3 its neighbours, 4 hexagonal, 5-6 its), computed
+    /// when asked for. Positions, ids, types, velocities and radii are written whenever the
+    /// frame has them.
+    #[arg(long, value_name = "NAME,...", value_delimiter = ',')]
+    pub columns: Option<Vec<String>>,
+    /// The output file; its extension names the format: .xyz/.extxyz (extended XYZ with every
+    /// column, as OVITO, ASE and QUIP read it), .lammpstrj/.dump (a LAMMPS dump: id type x y z
+    /// and the columns, read by LAMMPS's rerun, OVITO and MDAnalysis), .pdb (multi-MODEL, the
+    /// 'occupancy' and 'bfactor' properties in their columns), .dcd, .xtc (positions and the
+    /// box only). Written whole or not at all.
+    #[arg(short, long, value_name = "FILE")]
+    pub output: PathBuf,
+    #[command(flatten)]
+    pub analysis: AnalysisArgs,
+}
+
+const CONVERT_AFTER_HELP: &str = "\
+Examples:
+  texmap convert md.xtc --topology md.gro --select protein --frames ::10 -o protein.xtc   # a smaller trajectory
+  texmap convert md.xtc --topology md.gro --pbc unwrap --align backbone -o fitted.dcd      # molecules whole, superposed
+  texmap convert dump.lammpstrj --select 'not cna fcc' -o defects.xyz                      # the defects and their structure types
+  texmap convert anneal.lammpstrj --grains --columns grain,lattice_rmsd -o grains.lammpstrj  # OVITO's Grain segmentation, per atom
+  texmap convert cascade.lammpstrj --wigner-seitz atoms --select 'prop site_occupancy != 1' -o defects.xyz
+  texmap convert 1abc.cif --compute 'bfactor=coordination' --coordination 3.5 -o coord.pdb  # a property in the B-factor column (PyMOL, ChimeraX)
+
+The selection and the analyses are those of texmap render; an analysis's property (cna is a
+selection keyword; coordination, grain, centrosymmetry, shear_strain, ... are properties) is
+written as a column of the output.";
+
+/// The output's format, from its extension; only the formats with a writer.
+fn output_format(a: &ConvertArgs) -> Result<Format> {
+    let format = Format::from_path(&a.output);
+    match format {
+        Some(f @ (Format::Xyz | Format::LammpsDump | Format::Pdb | Format::Dcd | Format::Xtc)) => {
+            Ok(f)
+        }
+        _ => usage(format!(
+            "-o {}: expected a .xyz/.extxyz, .lammpstrj/.dump, .pdb, .dcd or .xtc file name",
+            a.output.display()
+        )),
+    }
+}
+
+/// The render options `mol_plan` takes, at their command-line defaults, with the convert's
+/// topology and analyses.
+fn plan_args(a: &ConvertArgs) -> Result<(MolArgs, StyleArgs)> {
+    fn defaults<T: Args + FromArgMatches>() -> Result<T> {
+        let command = T::augment_args(clap::Command::new("texmap"));
+        let matches = command.try_get_matches_from(["texmap"])?;
+        Ok(T::from_arg_matches(&matches)?)
+    }
+    let mut mol: MolArgs = defaults()?;
+    mol.topology = a.topology.clone();
+    mol.analysis = a.analysis.clone();
+    Ok((mol, defaults()?))
+}
+
+pub fn convert(a: &ConvertArgs) -> Result<()> {
+    let format = output_format(a)?;
+    let fixed_atoms = matches!(format, Format::Pdb | Format::Dcd | Format::Xtc);
+    if a.columns.is_some() && !matches!(format, Format::Xyz | Format::LammpsDump) {
+        return usage(format!(
+            "--columns: {} holds no per-atom columns of our choosing; write .xyz or .lammpstrj (a .pdb writes the 'occupancy' and 'bfactor' properties: --compute 'bfactor=NAME')",
+            a.output.display()
+        ));
+    }
+    let (topology, mut traj, options) = crate::commands::open_input(
+        &a.file,
+        &a.more,
+        a.format.as_deref(),
+        a.allow_truncated,
+        a.topology.as_deref(),
+    )?;
+    let n = traj.n_frames()?;
+    let mut shown = 0;
+    crate::commands::print_warnings(&traj, &mut shown);
+    if n == 0 {
+        anyhow::bail!("{}: the file holds no frame", a.file.display());
+    }
+    let frames = crate::commands::parse_frames(&a.frames, n)?;
+    let atom_values = crate::commands::atom_value_files(&a.analysis.properties)?;
+    let select = a
+        .select
+        .as_deref()
+        .map(|s| crate::scene::parse_selection("--select", s))
+        .transpose()?;
+    let (mol, style) = plan_args(a)?;
+    let mut plan = crate::scene::mol_plan(&mol, &style, topology)?;
+    if let Some(r) = &a.analysis.displacement_reference {
+        crate::commands::set_displacement_reference(&mut plan, r, &mut traj, &a.file, options)?;
+    }
+    let mut tables = crate::commands::AnalysisTables::create(&a.analysis, true)?;
+    let mut smoother = texmap_md_io::smooth::Smoother::new(a.smooth as usize);
+    let mut md = MdFrame::new();
+    let pb = crate::commands::progress(frames.len() as u64, "converting");
+    let mut first_atoms: Option<usize> = None;
+    let mut atoms_written = 0usize;
+    crate::output::write_atomic(&a.output, |tmp| {
+        let mut writer = Writer::create(tmp, format)?;
+        for &f in &frames {
+            let at = |e: anyhow::Error| e.context(format!("frame {f}: nothing was written"));
+            traj.read_frame(f, &mut md).map_err(|e| at(e.into()))?;
+            smoother
+                .smooth(&mut traj, n, f, &mut md)
+                .map_err(|e| at(e.into()))?;
+            crate::commands::print_warnings(&traj, &mut shown);
+            plan.label(&mut md, traj.name(), f)
+                .map_err(|e| at(e.into()))?;
+            crate::commands::set_atom_values(&mut md, f, &atom_values).map_err(at)?;
+            plan.prepare(&mut md)
+                .map_err(|e| at(crate::scene::mol_error(e)))?;
+            tables.write(f, &plan).map_err(at)?;
+            if let Some(columns) = &a.columns {
+                structure_columns(&mut md, columns);
+            }
+            if let Some(sel) = &select {
+                if md.ids.is_empty() {
+                    // The kept atoms keep their numbers in the whole frame (1, 2, ...).
+                    md.ids = (1..=md.n_atoms() as i64).collect();
+                }
+                let keep = sel.evaluate(&md).map_err(|error| {
+                    at(crate::scene::mol_error(
+                        texmap_md_scene::MolError::Selection {
+                            role: texmap_md_scene::SelectionRole::Select,
+                            error,
+                        },
+                    ))
+                })?;
+                md.retain_atoms(&keep);
+            }
+            if let Some(columns) = &a.columns {
+                keep_columns(&mut md, columns).map_err(at)?;
+            }
+            let count = md.n_atoms();
+            match first_atoms {
+                None => first_atoms = Some(count),
+                Some(first) if fixed_atoms && count != first => {
+                    return Err(at(anyhow::anyhow!(
+                        "--select picks {count} atoms here and {first} in the first frame written; a {} file holds the same atoms in every frame: write .xyz or .lammpstrj, whose frames may differ, or select by something that does not change",
+                        format.name()
+                    )));
+                }
+                Some(_) => {}
+            }
+            writer
+                .write_frame(&md)
+                .map_err(|e| at(e.into()))
+                .with_context(|| format!("-o {}", a.output.display()))?;
+            atoms_written += count;
+            pb.inc(1);
+        }
+        writer.finish()?;
+        Ok(())
+    })?;
+    pb.finish_and_clear();
+    tables.commit()?;
+    crate::note!(
+        "wrote {} frame(s), {} atoms in all, to {}",
+        frames.len(),
+        atoms_written,
+        a.output.display()
+    );
+    Ok(())
+}
+
+/// The structure types `columns` asks for and the frame does not have yet, as OVITO numbers
+/// them: 'cna' (adaptive CNA: 0 other, 1 FCC, 2 HCP, 3 BCC, 4 icosahedral) and 'diamond'
+/// (0 other, 1 cubic, 2 and 3 its first and second neighbours, 4 hexagonal, 5 and 6 its).
+/// Computed on the whole frame, before --select.
+fn structure_columns(md: &mut MdFrame, columns: &[String]) {
+    let wants = |md: &MdFrame, name: &str| {
+        columns.iter().any(|c| c.trim() == name) && md.property(name).is_none()
+    };
+    for name in ["cna", "diamond"] {
+        if wants(md, name) {
+            let values = if name == "cna" {
+                let types = texmap_md_io::cna::classify(md);
+                types.iter().map(|&t| t as u8 as f32).collect()
+            } else {
+                let types = texmap_md_io::cna::classify_diamond(md);
+                types.iter().map(|&t| t as u8 as f32).collect()
+            };
+            md.properties.push(texmap_md_io::Property {
+                name: name.into(),
+                values,
+            });
+        }
+    }
+}
+
+/// Keeps the properties `columns` names, in that order; a name the frame lacks is an error
+/// listing the ones it has.
+fn keep_columns(md: &mut MdFrame, columns: &[String]) -> Result<()> {
+    let mut kept = Vec::with_capacity(columns.len());
+    for name in columns {
+        let name = name.trim();
+        match md.properties.iter().position(|p| p.name == name) {
+            Some(k) => kept.push(md.properties.swap_remove(k)),
+            None if kept.iter().any(|p: &texmap_md_io::Property| p.name == name) => {}
+            None => {
+                let mut available: Vec<&str> = kept
+                    .iter()
+                    .chain(&md.properties)
+                    .map(|p| p.name.as_str())
+                    .collect();
+                available.sort_unstable();
+                let hint = crate::scene::ANALYSIS_PROPERTIES
+                    .iter()
+                    .find(|(p, _)| *p == name)
+                    .map(|(_, flag)| format!("; {flag} computes it"))
+                    .unwrap_or_default();
+                anyhow::bail!(
+                    "--columns: this frame has no property '{name}' (it has: {}){hint}",
+                    if available.is_empty() {
+                        "none".to_string()
+                    } else {
+                        available.join(", ")
+                    }
+                );
+            }
+        }
+    }
+    md.properties = kept;
+    Ok(())
+}

@@ -1,0 +1,368 @@
+//! `texmap convert` against files other programs wrote: OVITO 3.17.2's exports of the same
+//! analysed, cut-down systems (tests/data/convert/gen_convert.py) and MDAnalysis's XTC with
+//! its GRO (md-io's fixtures), read back through md-io's readers.
+
+use std::path::{Path, PathBuf};
+use std::process::Output;
+
+use texmap_md_io::{Frame, Sequence};
+
+mod common;
+use common::texmap;
+
+fn md_data(name: &str) -> String {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../md-io/tests/data")
+        .join(name);
+    p.to_str().unwrap().to_string()
+}
+
+fn convert_data(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/convert")
+        .join(name)
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// Every frame of `path`.
+fn frames(path: &Path) -> Vec<Frame> {
+    let mut t = Sequence::open(&[path.to_path_buf()], None, Default::default()).unwrap();
+    let n = t.n_frames().unwrap();
+    (0..n)
+        .map(|k| {
+            let mut f = Frame::new();
+            t.read_frame(k, &mut f).unwrap();
+            f
+        })
+        .collect()
+}
+
+fn run_ok(args: &[&str]) {
+    let o = texmap(args);
+    assert!(o.status.success(), "texmap {args:?}: {}", stderr(&o));
+}
+
+/// The grain boundaries of a polycrystal (the atoms adaptive CNA does not call FCC) with their
+/// structure types and coordination numbers: the same atoms, positions and values as OVITO's
+/// export of CNA + Coordination analysis + Delete selected, in a LAMMPS dump and in extended XYZ.
+#[test]
+fn defects_with_their_columns_are_ovitos_export() {
+    let dir = tempfile::tempdir().unwrap();
+    let source = md_data("grains/fcc_poly.xyz");
+    let ovito_dump = &frames(&convert_data("ovito_defects.lammpstrj"))[0];
+    let ovito_xyz = &frames(&convert_data("ovito_defects.xyz"))[0];
+    assert_eq!(ovito_dump.n_atoms(), 3756);
+    for out in ["ours.lammpstrj", "ours.xyz"] {
+        let path = dir.path().join(out);
+        run_ok(&[
+            "convert",
+            &source,
+            "--coordination",
+            "3.2",
+            "--select",
+            "not cna fcc",
+            "--columns",
+            "cna,coordination",
+            "-q",
+            "-o",
+            path.to_str().unwrap(),
+        ]);
+        let ours = frames(&path);
+        assert_eq!(ours.len(), 1);
+        let ours = &ours[0];
+        assert_eq!(ours.n_atoms(), ovito_dump.n_atoms(), "{out}");
+        assert_eq!(ours.positions, ovito_dump.positions, "{out}");
+        assert_eq!(
+            ours.cell.as_ref().unwrap().matrix(),
+            ovito_dump.cell.as_ref().unwrap().matrix()
+        );
+        let names: Vec<&str> = ours.properties.iter().map(|p| p.name.as_str()).collect();
+        assert_eq!(
+            names,
+            ["cna", "coordination"],
+            "{out}: the columns asked for, in order"
+        );
+        assert_eq!(
+            ours.property("cna").unwrap(),
+            ovito_dump.property("StructureType").unwrap(),
+            "{out}"
+        );
+        assert_eq!(
+            ours.property("coordination").unwrap(),
+            ovito_dump.property("Coordination").unwrap(),
+            "{out}"
+        );
+        assert_eq!(
+            ours.property("coordination").unwrap(),
+            ovito_xyz.property("n_neighb").unwrap(),
+            "{out}"
+        );
+        assert!(
+            ours.property("cna").unwrap().iter().all(|&t| t != 1.0),
+            "no FCC atom is left"
+        );
+        // The kept atoms carry their numbers in the whole crystal (the file has no ids).
+        let whole = &frames(Path::new(&source))[0];
+        assert_eq!(ours.ids.len(), ours.n_atoms(), "{out}");
+        for (id, p) in ours.ids.iter().zip(&ours.positions) {
+            assert_eq!(whole.positions[*id as usize - 1], *p, "{out}: atom id {id}");
+        }
+    }
+}
+
+/// Wigner-Seitz point defects: the atoms on sites that hold other than one atom, with the
+/// occupancy, equal OVITO's export of the same analysis after Delete selected.
+#[test]
+fn point_defects_are_ovitos_export() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("defects.xyz");
+    run_ok(&[
+        "convert",
+        &md_data("wigner_seitz/cur.xyz"),
+        "--wigner-seitz",
+        "atoms",
+        "--displacement-reference",
+        &md_data("wigner_seitz/ref.xyz"),
+        "--select",
+        "prop site_occupancy != 1",
+        "--columns",
+        "site_occupancy",
+        "-q",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    let ours = &frames(&out)[0];
+    let ovito = &frames(&convert_data("ovito_ws_defects.xyz"))[0];
+    assert_eq!(ours.n_atoms(), 16);
+    assert_eq!(ours.positions, ovito.positions);
+    assert_eq!(
+        ours.property("site_occupancy").unwrap(),
+        ovito.property("Occupancy").unwrap()
+    );
+}
+
+/// A smaller trajectory for another program: the C-alpha atoms of every second frame of
+/// MDAnalysis's XTC, as XTC, DCD, PDB and a LAMMPS dump; each equals the source's frames cut
+/// down by the GRO's atom names, to the output's precision.
+#[test]
+fn a_selection_of_every_second_frame_in_each_format() {
+    let dir = tempfile::tempdir().unwrap();
+    let xtc = md_data("topo_mda.xtc");
+    let gro = md_data("topo_mda.gro");
+    let source = frames(Path::new(&xtc));
+    let names = &frames(Path::new(&gro))[0].names;
+    let keep: Vec<bool> = names.iter().map(|n| n.as_str() == "CA").collect();
+    let picked = keep.iter().filter(|&&k| k).count();
+    assert!(picked > 0 && picked < keep.len());
+    for (out, tolerance) in [
+        ("ca.xtc", 1.01e-3),
+        ("ca.dcd", 1e-6),
+        ("ca.pdb", 5.01e-4),
+        ("ca.lammpstrj", 1e-6),
+    ] {
+        let path = dir.path().join(out);
+        run_ok(&[
+            "convert",
+            &xtc,
+            "--topology",
+            &gro,
+            "--select",
+            "name CA",
+            "--frames",
+            "::2",
+            "-q",
+            "-o",
+            path.to_str().unwrap(),
+        ]);
+        let got = frames(&path);
+        let expected: Vec<usize> = (0..source.len()).step_by(2).collect();
+        assert_eq!(got.len(), expected.len(), "{out}");
+        for (g, &k) in got.iter().zip(&expected) {
+            let want: Vec<[f32; 3]> = source[k]
+                .positions
+                .iter()
+                .zip(&keep)
+                .filter(|(_, k)| **k)
+                .map(|(p, _)| *p)
+                .collect();
+            assert_eq!(g.n_atoms(), picked, "{out}");
+            for (a, b) in g.positions.iter().zip(&want) {
+                for c in 0..3 {
+                    let scale = b[c].abs().max(1.0);
+                    assert!(
+                        (a[c] - b[c]).abs() <= tolerance * scale,
+                        "{out} frame {k}: {a:?} vs {b:?}"
+                    );
+                }
+            }
+        }
+        if out.ends_with(".pdb") {
+            assert!(got[0].names.iter().all(|n| n.as_str() == "CA"));
+        }
+    }
+}
+
+/// The same input gives the same bytes on one thread and on two (the analyses run in parallel).
+#[test]
+fn output_does_not_depend_on_the_thread_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let source = md_data("grains/fcc_poly.xyz");
+    let mut outputs = Vec::new();
+    for threads in ["1", "2"] {
+        let path = dir.path().join(format!("g{threads}.xyz"));
+        run_ok(&[
+            "--threads",
+            threads,
+            "convert",
+            &source,
+            "--grains",
+            "--orientations",
+            "--coordination",
+            "3.2",
+            "-q",
+            "-o",
+            path.to_str().unwrap(),
+        ]);
+        outputs.push(std::fs::read(&path).unwrap());
+    }
+    assert_eq!(outputs[0], outputs[1]);
+    let text = String::from_utf8_lossy(&outputs[0]);
+    let header = text.lines().nth(1).unwrap();
+    for column in [
+        "coordination:I:1",
+        "orientation_w:R:1",
+        "lattice_rmsd:R:1",
+        "grain:I:1",
+    ] {
+        assert!(header.contains(column), "{column} in {header}");
+    }
+}
+
+/// Bad requests: exit code 2 for usage, 1 for what a frame holds, and never a file left behind.
+#[test]
+fn bad_requests_are_refused_and_leave_no_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let source = md_data("grains/fcc_poly.xyz");
+    let out = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    let cases: [(Vec<String>, i32, &str); 4] = [
+        (
+            vec![source.clone(), "-o".into(), out("x.png")],
+            2,
+            "expected a .xyz/.extxyz, .lammpstrj/.dump, .pdb, .dcd or .xtc file name",
+        ),
+        (
+            vec![
+                source.clone(),
+                "--columns".into(),
+                "cna".into(),
+                "-o".into(),
+                out("x.dcd"),
+            ],
+            2,
+            "--columns",
+        ),
+        (
+            vec![
+                source.clone(),
+                "--columns".into(),
+                "grain".into(),
+                "-o".into(),
+                out("x.xyz"),
+            ],
+            1,
+            "no property 'grain' (it has: none); --grains computes it",
+        ),
+        (
+            vec![
+                md_data("wigner_seitz/cur.xyz"),
+                "--select".into(),
+                "prop coordination > 8".into(),
+                "-o".into(),
+                out("y.xyz"),
+            ],
+            2,
+            "--coordination R computes it",
+        ),
+    ];
+    for (args, code, message) in cases {
+        let mut all = vec!["convert"];
+        all.extend(args.iter().map(String::as_str));
+        let o = texmap(&all);
+        assert_eq!(o.status.code(), Some(code), "{all:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains(message), "{all:?}: {}", stderr(&o));
+    }
+    // A selection whose atom count changes between frames cannot be one XTC: frame 1 fails
+    // and nothing is written.
+    let xtc = out("moving.xtc");
+    let o = texmap(&[
+        "convert",
+        &md_data("topo_mda.xtc"),
+        "--topology",
+        &md_data("topo_mda.gro"),
+        "--select",
+        "prop x > 4",
+        "-o",
+        &xtc,
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(
+        e.contains("frame 1: nothing was written")
+            && e.contains("--select picks 55 atoms here and 53 in the first frame written")
+            && e.contains("holds the same atoms in every frame"),
+        "{e}"
+    );
+    let leftovers: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+}
+
+/// `--columns diamond` writes OVITO's Identify diamond structure type of every atom (silicon
+/// with a vacancy, hexagonal diamond, a slab with free surfaces: md-io's fixtures, OVITO's
+/// types in diamond_reference.json), and `--select` on it keeps the atoms OVITO would.
+#[test]
+fn diamond_column_is_ovitos_structure_type() {
+    let dir = tempfile::tempdir().unwrap();
+    let reference: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(md_data("diamond/diamond_reference.json")).unwrap(),
+    )
+    .unwrap();
+    for entry in reference.as_array().unwrap() {
+        let file = entry["file"].as_str().unwrap();
+        let want: Vec<f32> = entry["structure"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap() as f32)
+            .collect();
+        let out = dir.path().join(format!("{file}.lammpstrj"));
+        run_ok(&[
+            "convert",
+            &md_data(&format!("diamond/{file}")),
+            "--columns",
+            "diamond",
+            "-q",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert_eq!(frames(&out)[0].property("diamond").unwrap(), want, "{file}");
+        // Not cubic diamond: the vacancy's neighbours, the surfaces, all of hexagonal.
+        let out = dir.path().join(format!("{file}.defects.xyz"));
+        run_ok(&[
+            "convert",
+            &md_data(&format!("diamond/{file}")),
+            "--select",
+            "not diamond cubic",
+            "--columns",
+            "diamond",
+            "-q",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        let kept = frames(&out)[0].property("diamond").unwrap().to_vec();
+        let expected: Vec<f32> = want.iter().copied().filter(|&t| t != 1.0).collect();
+        assert_eq!(kept, expected, "{file}");
+    }
+}
