@@ -11,7 +11,11 @@
 //!   from `texmap_study::materials::polycrystal`,
 //!   thermal noise 0.05 Å; `target/md_analysis_poly.xyz`): lattice orientations (a-CNA and the
 //!   template fit, as OVITO's PTM gives structure and orientation in one pass) and grains
-//!   (the orientations, then the segmentation, as OVITO's PTM followed by Grain segmentation).
+//!   (the orientations, then the segmentation, as OVITO's PTM followed by Grain segmentation);
+//!   and the export `texmap convert --select 'not cna fcc' --columns cna -o F.lammpstrj` does
+//!   per frame (a-CNA, the non-FCC atoms kept, written as a LAMMPS dump with their structure
+//!   type to `target/md_analysis_export.lammpstrj`), as OVITO's CNA, Expression selection,
+//!   Delete selected and export_file.
 //!
 //! Both configurations are written to `target/md_analysis_{ref,cur}.xyz` (extended XYZ) for
 //! the peer, `benches/peers/ovito_analysis.py`, which times OVITO's modifiers on the same atoms
@@ -24,7 +28,10 @@ use std::io::Write;
 
 use criterion::{Criterion, criterion_group};
 use texmap::md_io::centrosymmetry::{CspMode, centrosymmetry};
-use texmap::md_io::{Frame, UnitCell, cna, coordination, grains, orientation, strain, voronoi};
+use texmap::md_io::{
+    Format, Frame, Property, UnitCell, Writer, cna, coordination, grains, orientation, strain,
+    voronoi,
+};
 
 struct Lcg(u64);
 impl Lcg {
@@ -193,6 +200,24 @@ fn bench(c: &mut Criterion) {
             grains::segment(&poly, &types, &fits, &grains::GrainOptions::default())
                 .grains
                 .len()
+        })
+    });
+    let export = concat!(env!("CARGO_MANIFEST_DIR"), "/target/md_analysis_export.lammpstrj");
+    g.bench_function(format!("export_defects_poly_{poly_atoms}"), |b| {
+        b.iter(|| {
+            let mut frame = poly.clone();
+            let types = cna::classify(&frame);
+            frame.properties.push(Property {
+                name: "cna".into(),
+                values: types.iter().map(|&t| t as u8 as f32).collect(),
+            });
+            let keep: Vec<bool> = types.iter().map(|&t| t != cna::StructureType::Fcc).collect();
+            frame.ids = (1..=frame.n_atoms() as i64).collect();
+            frame.retain_atoms(&keep);
+            let mut w = Writer::create(export, Format::LammpsDump).unwrap();
+            w.write_frame(&frame).unwrap();
+            w.finish().unwrap();
+            frame.n_atoms()
         })
     });
     g.finish();
