@@ -7,6 +7,8 @@
 //! - atomic strain at a 3.0 Å cutoff (neighbour pairs, F, shear, volumetric, D²min);
 //! - Voronoi cells (volume, faces, index);
 //! - coordination at 3.0 Å;
+//! - the radial distribution function to 8 Å in 200 bins (OVITO: the Coordination analysis
+//!   modifier at that cutoff, whose table it is);
 //! - on a polycrystal of the same size (aluminium, 16 Voronoi grains in random orientations
 //!   from `texmap_study::materials::polycrystal`,
 //!   thermal noise 0.05 Å; `target/md_analysis_poly.xyz`): lattice orientations (a-CNA and the
@@ -29,7 +31,7 @@ use std::io::Write;
 use criterion::{Criterion, criterion_group};
 use texmap::md_io::centrosymmetry::{CspMode, centrosymmetry};
 use texmap::md_io::{
-    Format, Frame, Property, UnitCell, Writer, cna, coordination, grains, orientation, strain,
+    Format, Frame, Property, UnitCell, Writer, cna, coordination, grains, orientation, rdf, strain,
     voronoi,
 };
 
@@ -184,6 +186,9 @@ fn bench(c: &mut Criterion) {
     g.bench_function(format!("voronoi_{atoms}"), |b| {
         b.iter(|| voronoi::voronoi(&reference).unwrap().volume.len())
     });
+    g.bench_function(format!("rdf_8A_200_bins_{atoms}"), |b| {
+        b.iter(|| rdf::rdf(&reference, 8.0, 200, false).unwrap().total.len())
+    });
     g.bench_function(format!("coordination_{atoms}"), |b| {
         b.iter(|| coordination::coordination(&reference, 3.0).unwrap().len())
     });
@@ -202,7 +207,10 @@ fn bench(c: &mut Criterion) {
                 .len()
         })
     });
-    let export = concat!(env!("CARGO_MANIFEST_DIR"), "/target/md_analysis_export.lammpstrj");
+    let export = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/target/md_analysis_export.lammpstrj"
+    );
     g.bench_function(format!("export_defects_poly_{poly_atoms}"), |b| {
         b.iter(|| {
             let mut frame = poly.clone();
@@ -211,7 +219,10 @@ fn bench(c: &mut Criterion) {
                 name: "cna".into(),
                 values: types.iter().map(|&t| t as u8 as f32).collect(),
             });
-            let keep: Vec<bool> = types.iter().map(|&t| t != cna::StructureType::Fcc).collect();
+            let keep: Vec<bool> = types
+                .iter()
+                .map(|&t| t != cna::StructureType::Fcc)
+                .collect();
             frame.ids = (1..=frame.n_atoms() as i64).collect();
             frame.retain_atoms(&keep);
             let mut w = Writer::create(export, Format::LammpsDump).unwrap();

@@ -64,6 +64,8 @@ timed("centrosymmetry_matching", reference_data,
 timed("strain", current_data, strain)
 timed("voronoi", reference_data, lambda: VoronoiAnalysisModifier(compute_indices=True))
 timed("coordination", reference_data, lambda: CoordinationAnalysisModifier(cutoff=3.0))
+timed("rdf_8A_200_bins", reference_data,
+      lambda: CoordinationAnalysisModifier(cutoff=8.0, number_of_bins=200))
 print(f"polycrystal: {poly_data.particles.count} atoms")
 timed("orientations_poly", poly_data,
       lambda: PolyhedralTemplateMatchingModifier(output_orientation=True, output_rmsd=True))

@@ -1208,6 +1208,25 @@ pub struct AnalysisArgs {
     /// they lie in (OVITO's "handle stacking faults" off).
     #[arg(long)]
     pub grain_separate_faults: bool,
+    /// The radial distribution function g(r) out to R Å (OVITO's Coordination analysis table,
+    /// VMD's g(r), MDAnalysis's InterRDF): pairs counted under the minimum image after --pbc
+    /// and --replicate, each frame normalised by its own cell's density, averaged over the
+    /// frames into --rdf-table. R up to half the cell's narrowest width; a cell narrower than
+    /// three R has every pair of its atoms tested (up to 48,000 atoms).
+    #[arg(long, value_name = "R", value_parser = parse_cutoff, requires = "rdf_table")]
+    pub rdf: Option<f32>,
+    /// With --rdf: histogram bins from 0 to R (OVITO's default: 200).
+    #[arg(long, value_name = "N", default_value_t = 200)]
+    pub rdf_bins: usize,
+    /// With --rdf: also the partial g(r) of every pair of atom kinds (their types, else their
+    /// elements: Si-Si, Si-O, O-O), as OVITO's "compute partial RDFs".
+    #[arg(long, requires = "rdf")]
+    pub rdf_partial: bool,
+    /// Write --rdf's g(r), averaged over the frames, as a CSV table: r (the bin's centre, Å),
+    /// g, then with --rdf-partial one column per pair of kinds (g_Si-O). Written whole or not
+    /// at all.
+    #[arg(long, value_name = "FILE.csv", requires = "rdf")]
+    pub rdf_table: Option<PathBuf>,
     /// Also write the grains of every frame as a CSV table, one row per grain: frame, grain,
     /// atoms, crystalline atoms, structure, and the mean orientation's quaternion. Written whole
     /// or not at all.

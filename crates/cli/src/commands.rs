@@ -526,6 +526,64 @@ pub(crate) fn open_input(
 pub(crate) struct AnalysisTables {
     defect: Option<crate::output::AtomicFile>,
     grain: Option<crate::output::AtomicFile>,
+    rdf: Option<(crate::output::AtomicFile, RdfMean)>,
+}
+
+/// `--rdf-table`: the frames' g(r) summed, to be written as their mean.
+#[derive(Default)]
+struct RdfMean {
+    r: Vec<f64>,
+    /// The kind pairs of the partial functions (`Si-O`), the first frame's.
+    kinds: Vec<String>,
+    /// Per bin: the total, then each partial.
+    sums: Vec<Vec<f64>>,
+    frames: usize,
+}
+
+impl RdfMean {
+    fn add(&mut self, f: usize, g: &texmap_md_io::rdf::Rdf) -> Result<()> {
+        let kinds: Vec<String> = g
+            .partial
+            .iter()
+            .map(|p| format!("{}-{}", p.kinds[0], p.kinds[1]))
+            .collect();
+        if self.frames == 0 {
+            self.r = g.r.clone();
+            self.kinds = kinds;
+            self.sums = vec![vec![0.0; 1 + g.partial.len()]; g.r.len()];
+        } else if kinds != self.kinds {
+            bail!(
+                "--rdf-partial: frame {f}'s kinds of atoms ({}) are not the first frame's ({}): a mean of partial g(r) needs the same pairs in every frame",
+                kinds.join(", "),
+                self.kinds.join(", ")
+            );
+        }
+        for (k, row) in self.sums.iter_mut().enumerate() {
+            row[0] += g.total[k];
+            for (v, p) in row[1..].iter_mut().zip(&g.partial) {
+                *v += p.g[k];
+            }
+        }
+        self.frames += 1;
+        Ok(())
+    }
+
+    fn csv(&self) -> String {
+        let mut text = String::from("r,g");
+        for k in &self.kinds {
+            text.push_str(&format!(",g_{k}"));
+        }
+        text.push('\n');
+        let n = self.frames.max(1) as f64;
+        for (r, row) in self.r.iter().zip(&self.sums) {
+            text.push_str(&format!("{r:.6}"));
+            for v in row {
+                text.push_str(&format!(",{:.6}", v / n));
+            }
+            text.push('\n');
+        }
+        text
+    }
 }
 
 impl AnalysisTables {
@@ -544,6 +602,15 @@ impl AnalysisTables {
                 "frame,grain,atoms,crystalline,structure,qx,qy,qz,qw",
                 whole,
             )?,
+            rdf: match &analysis.rdf_table {
+                None => None,
+                Some(_) if !whole => {
+                    return usage(
+                        "--rdf-table with --shard (or a Slurm array): every part would write its own mean; write it in a run of its own",
+                    );
+                }
+                Some(p) => Some((crate::output::AtomicFile::create(p)?, RdfMean::default())),
+            },
         })
     }
 
@@ -569,12 +636,23 @@ impl AnalysisTables {
             }
             t.write(&rows)?;
         }
+        if let Some((_, mean)) = &mut self.rdf
+            && let Some(g) = plan.last_rdf()
+        {
+            mean.add(f, g)?;
+        }
         Ok(())
     }
 
-    /// Every table moved into place.
+    /// Every table moved into place (`--rdf-table`'s mean written first).
     pub(crate) fn commit(self) -> Result<()> {
-        for t in [self.defect, self.grain].into_iter().flatten() {
+        let rdf = self
+            .rdf
+            .map(|(mut t, mean)| t.write(&mean.csv()).map(|()| t));
+        for t in [self.defect, self.grain, rdf.transpose()?]
+            .into_iter()
+            .flatten()
+        {
             t.commit()?;
         }
         Ok(())

@@ -63,9 +63,10 @@ pub struct ConvertArgs {
     /// column, as OVITO, ASE and QUIP read it), .lammpstrj/.dump (a LAMMPS dump: id type x y z
     /// and the columns, read by LAMMPS's rerun, OVITO and MDAnalysis), .pdb (multi-MODEL, the
     /// 'occupancy' and 'bfactor' properties in their columns), .dcd, .xtc (positions and the
-    /// box only). Written whole or not at all.
+    /// box only). Written whole or not at all. Without it, only the analyses' tables are
+    /// written (--rdf-table, --grain-table, --defect-table).
     #[arg(short, long, value_name = "FILE")]
-    pub output: PathBuf,
+    pub output: Option<PathBuf>,
     #[command(flatten)]
     pub analysis: AnalysisArgs,
 }
@@ -78,21 +79,22 @@ Examples:
   texmap convert anneal.lammpstrj --grains --columns grain,lattice_rmsd -o grains.lammpstrj  # OVITO's Grain segmentation, per atom
   texmap convert cascade.lammpstrj --wigner-seitz atoms --select 'prop site_occupancy != 1' -o defects.xyz
   texmap convert 1abc.cif --compute 'bfactor=coordination' --coordination 3.5 -o coord.pdb  # a property in the B-factor column (PyMOL, ChimeraX)
+  texmap convert melt.lammpstrj --frames 100: --rdf 10 --rdf-partial --rdf-table gr.csv    # g(r), total and per pair of types, averaged over frames 100 on
 
 The selection and the analyses are those of texmap render; an analysis's property (cna is a
 selection keyword; coordination, grain, centrosymmetry, shear_strain, ... are properties) is
 written as a column of the output.";
 
 /// The output's format, from its extension; only the formats with a writer.
-fn output_format(a: &ConvertArgs) -> Result<Format> {
-    let format = Format::from_path(&a.output);
+fn output_format(output: &std::path::Path) -> Result<Format> {
+    let format = Format::from_path(output);
     match format {
         Some(f @ (Format::Xyz | Format::LammpsDump | Format::Pdb | Format::Dcd | Format::Xtc)) => {
             Ok(f)
         }
         _ => usage(format!(
             "-o {}: expected a .xyz/.extxyz, .lammpstrj/.dump, .pdb, .dcd or .xtc file name",
-            a.output.display()
+            output.display()
         )),
     }
 }
@@ -112,12 +114,34 @@ fn plan_args(a: &ConvertArgs) -> Result<(MolArgs, StyleArgs)> {
 }
 
 pub fn convert(a: &ConvertArgs) -> Result<()> {
-    let format = output_format(a)?;
-    let fixed_atoms = matches!(format, Format::Pdb | Format::Dcd | Format::Xtc);
-    if a.columns.is_some() && !matches!(format, Format::Xyz | Format::LammpsDump) {
+    let format = match &a.output {
+        Some(out) => Some(output_format(out)?),
+        None => {
+            let tables = [
+                &a.analysis.defect_table,
+                &a.analysis.grain_table,
+                &a.analysis.rdf_table,
+            ];
+            if tables.iter().all(|t| t.is_none()) {
+                return usage(
+                    "nothing to write: give -o FILE, or a table of the analyses (--rdf-table, --grain-table, --defect-table)",
+                );
+            }
+            if a.select.is_some() || a.columns.is_some() {
+                return usage(
+                    "--select and --columns choose what -o FILE holds (the tables see every atom): give -o FILE",
+                );
+            }
+            None
+        }
+    };
+    let fixed_atoms = matches!(format, Some(Format::Pdb | Format::Dcd | Format::Xtc));
+    if let (Some(out), Some(_)) = (&a.output, &a.columns)
+        && !matches!(format, Some(Format::Xyz | Format::LammpsDump))
+    {
         return usage(format!(
             "--columns: {} holds no per-atom columns of our choosing; write .xyz or .lammpstrj (a .pdb writes the 'occupancy' and 'bfactor' properties: --compute 'bfactor=NAME')",
-            a.output.display()
+            out.display()
         ));
     }
     let (topology, mut traj, options) = crate::commands::open_input(
@@ -151,8 +175,7 @@ pub fn convert(a: &ConvertArgs) -> Result<()> {
     let pb = crate::commands::progress(frames.len() as u64, "converting");
     let mut first_atoms: Option<usize> = None;
     let mut atoms_written = 0usize;
-    crate::output::write_atomic(&a.output, |tmp| {
-        let mut writer = Writer::create(tmp, format)?;
+    let mut run = |mut writer: Option<Writer>| -> Result<()> {
         for &f in &frames {
             let at = |e: anyhow::Error| e.context(format!("frame {f}: nothing was written"));
             traj.read_frame(f, &mut md).map_err(|e| at(e.into()))?;
@@ -193,29 +216,40 @@ pub fn convert(a: &ConvertArgs) -> Result<()> {
                 Some(first) if fixed_atoms && count != first => {
                     return Err(at(anyhow::anyhow!(
                         "--select picks {count} atoms here and {first} in the first frame written; a {} file holds the same atoms in every frame: write .xyz or .lammpstrj, whose frames may differ, or select by something that does not change",
-                        format.name()
+                        format.map_or("", |f| f.name())
                     )));
                 }
                 Some(_) => {}
             }
-            writer
-                .write_frame(&md)
-                .map_err(|e| at(e.into()))
-                .with_context(|| format!("-o {}", a.output.display()))?;
-            atoms_written += count;
+            if let (Some(w), Some(out)) = (&mut writer, &a.output) {
+                w.write_frame(&md)
+                    .map_err(|e| at(e.into()))
+                    .with_context(|| format!("-o {}", out.display()))?;
+                atoms_written += count;
+            }
             pb.inc(1);
         }
-        writer.finish()?;
+        if let Some(w) = writer {
+            w.finish()?;
+        }
         Ok(())
-    })?;
+    };
+    match (&a.output, format) {
+        (Some(out), Some(format)) => {
+            crate::output::write_atomic(out, |tmp| run(Some(Writer::create(tmp, format)?)))?
+        }
+        _ => run(None)?,
+    }
     pb.finish_and_clear();
     tables.commit()?;
-    crate::note!(
-        "wrote {} frame(s), {} atoms in all, to {}",
-        frames.len(),
-        atoms_written,
-        a.output.display()
-    );
+    if let Some(out) = &a.output {
+        crate::note!(
+            "wrote {} frame(s), {} atoms in all, to {}",
+            frames.len(),
+            atoms_written,
+            out.display()
+        );
+    }
     Ok(())
 }
 

@@ -539,6 +539,13 @@ pub fn mol_plan(args: &MolArgs, style: &StyleArgs, topology: Option<Topology>) -
             "--centrosymmetry-matching: give --centrosymmetry N (or --color-by centrosymmetry)",
         );
     }
+    let bins = args.analysis.rdf_bins;
+    if !(1..=texmap_md_io::rdf::MAX_BINS).contains(&bins) {
+        return usage(format!(
+            "--rdf-bins {bins}: expected 1 to {}",
+            texmap_md_io::rdf::MAX_BINS
+        ));
+    }
     if let Some(n) = args.analysis.centrosymmetry {
         let mode = if args.analysis.centrosymmetry_matching {
             texmap_md_io::centrosymmetry::CspMode::Matching
@@ -655,6 +662,11 @@ pub fn mol_plan(args: &MolArgs, style: &StyleArgs, topology: Option<Topology>) -
             .into_iter()
             .any(scalar_is),
         grains: grains.then(|| grain_options(args)),
+        rdf: args.analysis.rdf.map(|cutoff| texmap_md_scene::RdfOptions {
+            cutoff,
+            bins: args.analysis.rdf_bins,
+            partial: args.analysis.rdf_partial,
+        }),
         wigner_seitz: args.analysis.wigner_seitz.map(|w| match w {
             crate::args::WignerSeitzArg::Sites => texmap_md_scene::WsOutput::Sites,
             crate::args::WignerSeitzArg::Atoms => texmap_md_scene::WsOutput::Atoms,
@@ -839,6 +851,7 @@ pub fn mol_error(e: MolError) -> anyhow::Error {
         MolError::Strain(e) => return anyhow::anyhow!("--strain: {e}"),
         MolError::WignerSeitz(e) => return anyhow::anyhow!("--wigner-seitz: {e}"),
         MolError::Voronoi(e) => return anyhow::anyhow!("--voronoi: {e}"),
+        MolError::Rdf(e) => return anyhow::anyhow!("--rdf: {e}"),
         MolError::Compute { name, error } => {
             // The formula parsed; the frame lacks a name it uses: the input's, not usage.
             return anyhow::anyhow!("--compute {name}: {error}");

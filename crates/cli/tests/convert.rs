@@ -247,7 +247,36 @@ fn bad_requests_are_refused_and_leave_no_file() {
     let dir = tempfile::tempdir().unwrap();
     let source = md_data("grains/fcc_poly.xyz");
     let out = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
-    let cases: [(Vec<String>, i32, &str); 4] = [
+    let cases: [(Vec<String>, i32, &str); 7] = [
+        (
+            vec![source.clone()],
+            2,
+            "nothing to write: give -o FILE, or a table",
+        ),
+        (
+            vec![
+                source.clone(),
+                "--rdf".into(),
+                "8".into(),
+                "--rdf-table".into(),
+                out("g.csv"),
+                "--select".into(),
+                "all".into(),
+            ],
+            2,
+            "--select and --columns choose what -o FILE holds",
+        ),
+        (
+            vec![
+                md_data("ase_plain.xyz"),
+                "--rdf".into(),
+                "5".into(),
+                "--rdf-table".into(),
+                out("g.csv"),
+            ],
+            1,
+            "--rdf: the frame has no periodic cell",
+        ),
         (
             vec![source.clone(), "-o".into(), out("x.png")],
             2,
@@ -364,5 +393,95 @@ fn diamond_column_is_ovitos_structure_type() {
         let kept = frames(&out)[0].property("diamond").unwrap().to_vec();
         let expected: Vec<f32> = want.iter().copied().filter(|&t| t != 1.0).collect();
         assert_eq!(kept, expected, "{file}");
+    }
+}
+
+/// `--rdf-table` without -o: the mean over the frames of g(r), total and partial, equals the
+/// mean of OVITO's Coordination analysis tables of the same frames (md-io's rdf fixture: a
+/// triclinic Si/O mixture, two frames), to a pair moved across a bin edge by f32 positions and
+/// the table's 6 decimals.
+#[test]
+fn rdf_table_is_the_mean_of_ovitos() {
+    let dir = tempfile::tempdir().unwrap();
+    let table = dir.path().join("gr.csv");
+    let file = md_data("rdf/mixture.xyz");
+    run_ok(&[
+        "convert",
+        &file,
+        "--rdf",
+        "6",
+        "--rdf-bins",
+        "60",
+        "--rdf-partial",
+        "--rdf-table",
+        table.to_str().unwrap(),
+        "-q",
+    ]);
+    let text = std::fs::read_to_string(&table).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next().unwrap(), "r,g,g_O-O,g_O-Si,g_Si-Si");
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 60);
+    let reference: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(md_data("rdf/rdf_reference.json")).unwrap())
+            .unwrap();
+    let entries: Vec<&serde_json::Value> = reference
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|e| e["file"] == "mixture.xyz")
+        .collect();
+    assert_eq!(entries.len(), 2);
+    let frame = &frames(Path::new(&file))[0];
+    let volume = frame.cell.as_ref().unwrap().volume();
+    let (n, n_si, n_o) = (1500.0, 1000.0, 500.0);
+    let column = |e: &serde_json::Value, name: &str| -> Vec<f64> {
+        if name == "total" {
+            return e["total"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|v| v.as_f64().unwrap())
+                .collect();
+        }
+        let k = e["columns"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .position(|c| c == name)
+            .unwrap();
+        e["g"][k]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect()
+    };
+    // Our column, OVITO's name, and the ordered pairs' density for counting.
+    for (col, name, pairs) in [
+        (1, "total", n * n),
+        (2, "O-O", n_o * n_o),
+        (3, "Si-O", 2.0 * n_si * n_o),
+        (4, "Si-Si", n_si * n_si),
+    ] {
+        let mean: Vec<f64> = (0..60)
+            .map(|k| entries.iter().map(|e| column(e, name)[k]).sum::<f64>() / 2.0)
+            .collect();
+        for (k, row) in rows.iter().enumerate() {
+            assert!((row[0] - (k as f64 + 0.5) * 0.1).abs() < 1e-6);
+            let (r0, r1) = (k as f64 * 0.1, (k + 1) as f64 * 0.1);
+            let ideal =
+                4.0 / 3.0 * std::f64::consts::PI * (r1.powi(3) - r0.powi(3)) * pairs / volume;
+            // Pair ends summed over both frames: at most one pair per frame across an edge.
+            let diff = (row[col] - mean[k]).abs() * ideal * 2.0;
+            assert!(
+                diff <= 4.0 + 1e-6 * ideal * 2.0 + 1e-9,
+                "{name} bin {k}: {} vs OVITO {}",
+                row[col],
+                mean[k]
+            );
+        }
     }
 }

@@ -148,6 +148,7 @@ mod pdb;
 mod pqr;
 mod prmtop;
 mod psf;
+pub mod rdf;
 pub mod replicate;
 pub mod rotation;
 mod sdf;

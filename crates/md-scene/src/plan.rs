@@ -337,6 +337,9 @@ pub struct MolOptions {
     /// ([`crate::ColorBy::Grain`]) and selections (`prop grain == 0`: the largest);
     /// [`MolPlan::last_grains`] lists them.
     pub grains: Option<GrainOptions>,
+    /// The radial distribution function every frame, after the periodic images (OVITO's
+    /// Coordination analysis table: [`texmap_md_io::rdf`]); [`MolPlan::last_rdf`] holds it.
+    pub rdf: Option<RdfOptions>,
     /// Per-atom properties frozen at the first frame built (OVITO's Freeze property), after
     /// [`MolOptions::computes`]: every later frame gets the values the first had, atom by atom,
     /// so that colours follow the atoms (a crystal coloured by where each atom started shows
@@ -478,6 +481,7 @@ impl Default for MolOptions {
             voronoi: false,
             orientations: false,
             grains: None,
+            rdf: None,
             freeze: Vec::new(),
             radius_from: None,
             slice: None,
@@ -492,6 +496,18 @@ impl Default for MolOptions {
             displacement: false,
         }
     }
+}
+
+/// [`MolOptions::rdf`]: the histogram's range and bins, and whether the partial functions of
+/// each pair of atom kinds are computed too.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RdfOptions {
+    /// The largest distance, Å.
+    pub cutoff: f32,
+    /// Bins from 0 to the cutoff.
+    pub bins: usize,
+    /// The partial g_ab of each pair of kinds (type labels, else elements) too.
+    pub partial: bool,
 }
 
 /// [`MolOptions::clusters`]: the cutoff and the atoms clustered.
@@ -591,6 +607,8 @@ pub enum MolError {
     Voronoi(VoronoiError),
     /// [`MolOptions::wigner_seitz`] has no sites (an empty reference).
     WignerSeitz(WignerSeitzError),
+    /// [`MolOptions::rdf`] cannot be computed (no cell, the cutoff, the bins).
+    Rdf(texmap_md_io::rdf::RdfError),
     /// A formula of [`MolOptions::computes`] names what a frame does not have.
     Compute {
         /// The property it computes.
@@ -656,6 +674,7 @@ impl fmt::Display for MolError {
             MolError::Strain(e) => write!(f, "atomic strain: {e}"),
             MolError::WignerSeitz(e) => write!(f, "Wigner-Seitz analysis: {e}"),
             MolError::Voronoi(e) => write!(f, "Voronoi analysis: {e}"),
+            MolError::Rdf(e) => write!(f, "radial distribution function: {e}"),
             MolError::NoFreezeProperty { name, available } => write!(
                 f,
                 "freezing '{name}': the first frame has no such per-atom property ({})",
@@ -786,6 +805,7 @@ pub struct MolPlan {
     last_defects: Option<(usize, usize)>,
     /// The last frame's grains ([`MolOptions::grains`]).
     last_grains: Option<Vec<Grain>>,
+    last_rdf: Option<texmap_md_io::rdf::Rdf>,
     /// The values of [`MolOptions::freeze`]'s properties at the first frame built.
     frozen: Vec<Vec<f32>>,
     arrow_vectors: Vec<glam::Vec3>,
@@ -872,6 +892,7 @@ impl MolPlan {
             configuration: None,
             last_defects: None,
             last_grains: None,
+            last_rdf: None,
             frozen: Vec::new(),
             arrow_vectors: Vec::new(),
             arrows: MolMesh::default(),
@@ -1235,6 +1256,12 @@ impl MolPlan {
                 }
             }
         }
+        self.last_rdf = None;
+        if let Some(o) = self.options.rdf {
+            let g = texmap_md_io::rdf::rdf(frame, o.cutoff, o.bins, o.partial)
+                .map_err(MolError::Rdf)?;
+            self.last_rdf = Some(g);
+        }
         if self.options.voronoi {
             let v = texmap_md_io::voronoi::voronoi(frame).map_err(MolError::Voronoi)?;
             set_property(frame, VORONOI_VOLUME, v.volume);
@@ -1538,6 +1565,12 @@ impl MolPlan {
     /// it).
     pub fn last_grains(&self) -> Option<&[Grain]> {
         self.last_grains.as_deref()
+    }
+
+    /// The last frame's radial distribution function ([`MolOptions::rdf`]; `None` without
+    /// it).
+    pub fn last_rdf(&self) -> Option<&texmap_md_io::rdf::Rdf> {
+        self.last_rdf.as_ref()
     }
 
     /// The last frame's measurements ([`MolOptions::measures`], in order): points, values and
