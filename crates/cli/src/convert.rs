@@ -46,8 +46,8 @@ pub struct ConvertArgs {
     /// frame after the analyses (OVITO's Expression selection and Delete selected): 'protein',
     /// 'not resname SOL', 'not cna fcc' (a crystal's defects), 'prop grain == 0',
     /// 'prop site_occupancy != 1' (point defects). The atoms keep their ids (their numbers in
-    /// the whole frame, from 1, when the file has none). A .dcd, .xtc or .pdb output holds the
-    /// same atoms in every frame, so there the selection must pick as many atoms in each.
+    /// the whole frame, from 1, when the file has none). A .gro, .pdb, .dcd or .xtc output
+    /// holds the same atoms in every frame, so there the selection must pick as many in each.
     #[arg(long, value_name = "SEL")]
     pub select: Option<String>,
     /// The per-atom properties to write, in this order (extended XYZ and LAMMPS dump outputs):
@@ -61,9 +61,9 @@ pub struct ConvertArgs {
     pub columns: Option<Vec<String>>,
     /// The output file; its extension names the format: .xyz/.extxyz (extended XYZ with every
     /// column, as OVITO, ASE and QUIP read it), .lammpstrj/.dump (a LAMMPS dump: id type x y z
-    /// and the columns, read by LAMMPS's rerun, OVITO and MDAnalysis), .pdb (multi-MODEL, the
-    /// 'occupancy' and 'bfactor' properties in their columns), .dcd, .xtc (positions and the
-    /// box only). Written whole or not at all. Without it, only the analyses' tables are
+    /// and the columns, read by LAMMPS's rerun, OVITO and MDAnalysis), .gro (GROMACS: residues,
+    /// names, positions to 0.001 nm, velocities, the box), .pdb (multi-MODEL, the 'occupancy'
+    /// and 'bfactor' properties in their columns), .dcd, .xtc (positions and the box only). Written whole or not at all. Without it, only the analyses' tables are
     /// written (--rdf-table, --grain-table, --defect-table).
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
@@ -89,11 +89,16 @@ written as a column of the output.";
 fn output_format(output: &std::path::Path) -> Result<Format> {
     let format = Format::from_path(output);
     match format {
-        Some(f @ (Format::Xyz | Format::LammpsDump | Format::Pdb | Format::Dcd | Format::Xtc)) => {
-            Ok(f)
-        }
+        Some(
+            f @ (Format::Xyz
+            | Format::LammpsDump
+            | Format::Gro
+            | Format::Pdb
+            | Format::Dcd
+            | Format::Xtc),
+        ) => Ok(f),
         _ => usage(format!(
-            "-o {}: expected a .xyz/.extxyz, .lammpstrj/.dump, .pdb, .dcd or .xtc file name",
+            "-o {}: expected a .xyz/.extxyz, .lammpstrj/.dump, .gro, .pdb, .dcd or .xtc file name",
             output.display()
         )),
     }
@@ -135,7 +140,10 @@ pub fn convert(a: &ConvertArgs) -> Result<()> {
             None
         }
     };
-    let fixed_atoms = matches!(format, Some(Format::Pdb | Format::Dcd | Format::Xtc));
+    let fixed_atoms = matches!(
+        format,
+        Some(Format::Gro | Format::Pdb | Format::Dcd | Format::Xtc)
+    );
     if let (Some(out), Some(_)) = (&a.output, &a.columns)
         && !matches!(format, Some(Format::Xyz | Format::LammpsDump))
     {

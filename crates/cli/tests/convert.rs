@@ -145,7 +145,7 @@ fn point_defects_are_ovitos_export() {
 }
 
 /// A smaller trajectory for another program: the C-alpha atoms of every second frame of
-/// MDAnalysis's XTC, as XTC, DCD, PDB and a LAMMPS dump; each equals the source's frames cut
+/// MDAnalysis's XTC, as XTC, DCD, PDB, GRO and a LAMMPS dump; each equals the source's frames cut
 /// down by the GRO's atom names, to the output's precision.
 #[test]
 fn a_selection_of_every_second_frame_in_each_format() {
@@ -162,6 +162,7 @@ fn a_selection_of_every_second_frame_in_each_format() {
         ("ca.dcd", 1e-6),
         ("ca.pdb", 5.01e-4),
         ("ca.lammpstrj", 1e-6),
+        ("ca.gro", 5.01e-3),
     ] {
         let path = dir.path().join(out);
         run_ok(&[
@@ -199,7 +200,7 @@ fn a_selection_of_every_second_frame_in_each_format() {
                 }
             }
         }
-        if out.ends_with(".pdb") {
+        if out.ends_with(".pdb") || out.ends_with(".gro") {
             assert!(got[0].names.iter().all(|n| n.as_str() == "CA"));
         }
     }
@@ -280,7 +281,7 @@ fn bad_requests_are_refused_and_leave_no_file() {
         (
             vec![source.clone(), "-o".into(), out("x.png")],
             2,
-            "expected a .xyz/.extxyz, .lammpstrj/.dump, .pdb, .dcd or .xtc file name",
+            "expected a .xyz/.extxyz, .lammpstrj/.dump, .gro, .pdb, .dcd or .xtc file name",
         ),
         (
             vec![

@@ -209,3 +209,143 @@ impl TextFormat for Gro {
         Ok(true)
     }
 }
+
+/// Writes GROMACS .gro frames as `gmx trjconv` and MDAnalysis do, one after another (a
+/// multi-frame .gro).
+///
+/// Each frame: the title (the frame's comment, else `texmap`, then GROMACS's ` t= <ps>` and
+/// ` step= <n>` when the frame has them, which GROMACS tools and our reader take back), the atom
+/// count, one `%5d%-5s%5s%5d%8.3f%8.3f%8.3f` line per atom (residue number, residue name, atom
+/// name, atom number, position in nm) with `%8.4f` velocities (nm/ps) when the frame has them,
+/// and the box line in nm as `%10.5f`: v1x v2y v3z, then v1y v1z v2x v2z v3x v3y when the cell
+/// is not rectangular; a frame without a cell writes a zero box, which readers take as none.
+///
+/// Residue numbers are [`Frame::res_ids`] (else 1), residue names [`Frame::res_names`] (else
+/// `UNK`), atom names [`Frame::names`] (else the element's symbol), atom numbers
+/// [`Frame::ids`] (else 1, 2, ...); numbers wrap at 100,000 as GROMACS writes them. Positions
+/// keep 0.01 Å (three decimals of nm), velocities 0.001 Å/ps.
+///
+/// [`GroWriter::check`] refuses what the fixed columns cannot hold: a name or residue name
+/// longer than 5 bytes or with white space, a position beyond ±9999.999 nm, a velocity beyond
+/// ±999.9999 nm/ps, a cell not in GROMACS's form (v1 along x, v2 in the xy plane).
+pub(crate) struct GroWriter<W> {
+    pub out: W,
+}
+
+impl<W: std::io::Write> GroWriter<W> {
+    /// Why `frame` cannot be written as .gro, if it cannot (see [`GroWriter`]).
+    pub fn check(frame: &Frame) -> Result<(), String> {
+        for (what, labels) in [("name", &frame.names), ("residue name", &frame.res_names)] {
+            if let Some((i, l)) = labels
+                .iter()
+                .enumerate()
+                .find(|(_, l)| l.len() > 5 || l.bytes().any(|b| b.is_ascii_whitespace()))
+            {
+                return Err(format!(
+                    "atom {i}'s {what} '{l}' does not fit .gro's 5 columns (at most 5 bytes, no white space)"
+                ));
+            }
+        }
+        let fits = |v: &[[f32; 3]], limit: f64| {
+            v.iter()
+                .position(|p| p.iter().any(|x| (*x as f64 / NM).abs() >= limit))
+        };
+        if let Some(i) = fits(&frame.positions, 9999.9995) {
+            return Err(format!(
+                "atom {i}'s position {:?} Å is beyond .gro's %8.3f nm columns",
+                frame.positions[i]
+            ));
+        }
+        if let Some(i) = fits(&frame.velocities, 999.99995) {
+            return Err(format!(
+                "atom {i}'s velocity {:?} Å/ps is beyond .gro's %8.4f nm/ps columns",
+                frame.velocities[i]
+            ));
+        }
+        if let Some(c) = &frame.cell {
+            let m = c.matrix();
+            let tol = 1e-9 * c.lengths().iter().fold(0.0f64, |a, b| a.max(*b));
+            if m[0][1].abs() > tol || m[0][2].abs() > tol || m[1][2].abs() > tol {
+                return Err(format!(
+                    "the cell is not in GROMACS's form (v1 along x, v2 in the xy plane): a = {:?}, b = {:?}, c = {:?}",
+                    m[0], m[1], m[2]
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// A .gro file has no trailer.
+    pub fn finish(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+
+    pub fn write_frame(&mut self, frame: &Frame) -> std::io::Result<()> {
+        let w = &mut self.out;
+        let title = frame.comment.lines().next().unwrap_or("").trim();
+        // A title's own t= and step= would be read before ours: ours replace them.
+        let title: String = match title.find(" t=").or_else(|| title.find("step=")) {
+            Some(k) if frame.time.is_some() || frame.step.is_some() => title[..k].trim().into(),
+            _ => title.into(),
+        };
+        write!(w, "{}", if title.is_empty() { "texmap" } else { &title })?;
+        if let Some(t) = frame.time {
+            write!(w, " t= {t:.5}")?;
+        }
+        if let Some(s) = frame.step {
+            write!(w, " step= {s}")?;
+        }
+        writeln!(w)?;
+        let n = frame.n_atoms();
+        writeln!(w, "{n:5}")?;
+        for i in 0..n {
+            let resid = frame
+                .res_ids
+                .get(i)
+                .copied()
+                .unwrap_or(1)
+                .rem_euclid(100_000);
+            let res = frame
+                .res_names
+                .get(i)
+                .map(|l| l.as_str())
+                .filter(|l| !l.is_empty())
+                .unwrap_or("UNK");
+            let name = match frame.names.get(i).map(|l| l.as_str()) {
+                Some(l) if !l.is_empty() => l,
+                _ => crate::atom_element(frame, i).symbol(),
+            };
+            let id = frame
+                .ids
+                .get(i)
+                .copied()
+                .unwrap_or(i as i64 + 1)
+                .rem_euclid(100_000);
+            let p = frame.positions[i].map(|x| x as f64 / NM);
+            write!(
+                w,
+                "{resid:5}{res:<5}{name:>5}{id:5}{:8.3}{:8.3}{:8.3}",
+                p[0], p[1], p[2]
+            )?;
+            if let Some(v) = frame.velocities.get(i) {
+                let v = v.map(|x| x as f64 / NM);
+                write!(w, "{:8.4}{:8.4}{:8.4}", v[0], v[1], v[2])?;
+            }
+            writeln!(w)?;
+        }
+        match &frame.cell {
+            Some(c) => {
+                let m = c.matrix().map(|r| r.map(|x| x / NM));
+                write!(w, "{:10.5}{:10.5}{:10.5}", m[0][0], m[1][1], m[2][2])?;
+                let off = [m[0][1], m[0][2], m[1][0], m[1][2], m[2][0], m[2][1]];
+                if off.iter().any(|x| *x != 0.0) {
+                    for x in off {
+                        write!(w, "{x:10.5}")?;
+                    }
+                }
+                writeln!(w)
+            }
+            None => writeln!(w, "{:10.5}{:10.5}{:10.5}", 0.0, 0.0, 0.0),
+        }
+    }
+}

@@ -7,6 +7,8 @@
 //!   type x y z` then `element`, `vx vy vz`, `radius`, `ColorR ColorG ColorB` and the
 //!   properties when the frame has them (read back by LAMMPS `read_dump`, OVITO, ASE and our
 //!   reader).
+//! - [`Format::Gro`]: GROMACS .gro as `gmx trjconv` writes it (residues, names, numbers,
+//!   positions to 0.001 nm, velocities, the box; time and step in the title).
 //! - [`Format::Pdb`], [`Format::Dcd`], [`Format::Xtc`]: positions and cell, with PDB's atom
 //!   records.
 //!
@@ -23,12 +25,13 @@
 //!   the format cannot hold, and for LAMMPS a cell that is not restricted triclinic.
 //!
 //! The per-format details are on the writer types (src/xyz.rs `XyzWriter`,
-//! src/lammps_dump_writer.rs).
+//! src/lammps_dump_writer.rs, src/gro.rs `GroWriter`).
 
 use crate::dcd::DcdWriter;
 use crate::error::{Error, Location};
 use crate::format::Format;
 use crate::frame::Frame;
+use crate::gro::GroWriter;
 use crate::lammps_dump_writer::LammpsDumpWriter;
 use crate::pdb::PdbWriter;
 use crate::xtc::XtcWriter;
@@ -87,6 +90,7 @@ pub(crate) fn write_atom_tail(
 enum WriterKind<W> {
     Xyz(XyzWriter<W>),
     LammpsDump(LammpsDumpWriter<W>),
+    Gro(GroWriter<W>),
     Dcd(DcdWriter<W>),
     Xtc(XtcWriter<W>),
     Pdb(PdbWriter<W>),
@@ -98,6 +102,7 @@ macro_rules! each_writer {
         match $writer {
             WriterKind::Xyz($w) => $body,
             WriterKind::LammpsDump($w) => $body,
+            WriterKind::Gro($w) => $body,
             WriterKind::Dcd($w) => $body,
             WriterKind::Xtc($w) => $body,
             WriterKind::Pdb($w) => $body,
@@ -134,6 +139,7 @@ impl<W: Write + Seek> Writer<W> {
         let kind = match format {
             Format::Xyz => WriterKind::Xyz(XyzWriter { out }),
             Format::LammpsDump => WriterKind::LammpsDump(LammpsDumpWriter::new(out)),
+            Format::Gro => WriterKind::Gro(GroWriter { out }),
             Format::Dcd => WriterKind::Dcd(DcdWriter::new(out, file.clone())),
             Format::Xtc => WriterKind::Xtc(XtcWriter::new(out, file.clone(), 1000.0)?),
             Format::Pdb => WriterKind::Pdb(PdbWriter { out, models: 0 }),
@@ -174,6 +180,7 @@ impl<W: Write + Seek> Writer<W> {
             WriterKind::Pdb(_) => PdbWriter::<W>::check(frame),
             WriterKind::Xyz(_) => XyzWriter::<W>::check(frame),
             WriterKind::LammpsDump(_) => LammpsDumpWriter::<W>::check(frame),
+            WriterKind::Gro(_) => GroWriter::<W>::check(frame),
             _ => Ok(()),
         };
         limits.map_err(|what| Error::InvalidFrame {

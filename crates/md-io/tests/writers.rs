@@ -524,3 +524,86 @@ fn lammps_type_names_that_are_no_elements_read_back_as_names() {
     assert_eq!(symbols, ["O", "H", "O", "Na"]);
     assert_eq!(back.positions[3], [0.0; 3]);
 }
+
+/// .gro files written by MDAnalysis (velocities, a triclinic box) and by a writer of five
+/// decimals read, written as GROMACS writes them and read back: names, residues, numbers and the
+/// box unchanged, positions to the written 0.001 nm (0.01 Å), velocities to 0.0001 nm/ps.
+#[test]
+fn gro_files_of_other_programs_read_written_and_read_back() {
+    for name in ["mda_vel.gro", "py_prec5.gro"] {
+        let first = read_file(name);
+        let text = write(Format::Gro, &first);
+        let back = read(Format::Gro, &text);
+        assert_eq!(back.len(), first.len(), "{name}");
+        for (a, b) in first.iter().zip(&back) {
+            assert_eq!(a.names, b.names, "{name}");
+            assert_eq!(a.res_names, b.res_names, "{name}");
+            assert_eq!(a.res_ids, b.res_ids, "{name}");
+            assert_eq!(a.ids, b.ids, "{name}");
+            assert_eq!(a.elements, b.elements, "{name}");
+            assert_eq!(a.velocities.len(), b.velocities.len(), "{name}");
+            for (p, q) in a.positions.iter().zip(&b.positions) {
+                for k in 0..3 {
+                    assert!(
+                        (p[k] - q[k]).abs() <= 0.005 + 1e-5 * p[k].abs(),
+                        "{name}: {p:?} {q:?}"
+                    );
+                }
+            }
+            for (p, q) in a.velocities.iter().zip(&b.velocities) {
+                for k in 0..3 {
+                    assert!(
+                        (p[k] - q[k]).abs() <= 0.0005 + 1e-5 * p[k].abs(),
+                        "{name}: {p:?} {q:?}"
+                    );
+                }
+            }
+            let (ca, cb) = (a.cell.unwrap().matrix(), b.cell.unwrap().matrix());
+            for r in 0..3 {
+                for c in 0..3 {
+                    assert!((ca[r][c] - cb[r][c]).abs() <= 5e-5, "{name}: {ca:?} {cb:?}");
+                }
+            }
+        }
+        // A three-decimal file is written back as it was, but for the title.
+        if name == "mda_vel.gro" {
+            let original = std::fs::read_to_string(data(name)).unwrap();
+            let body = |t: &str| t.lines().skip(1).map(str::to_string).collect::<Vec<_>>();
+            assert_eq!(body(&text), body(&original));
+        }
+    }
+}
+
+/// The exact text of a two-atom .gro frame (GROMACS's columns), and what .gro cannot hold.
+#[test]
+fn gro_text_and_refusals() {
+    let mut f = Frame::new();
+    // 12.345 as f32 is 12.3450003: 1.235 nm.
+    f.positions = vec![[12.345, -0.5, 100.0], [0.0, 1.0, 2.0]];
+    f.names = labels(&["OW", "HW1"]);
+    f.res_names = labels(&["SOL", "SOL"]);
+    f.res_ids = vec![7, 7];
+    f.ids = vec![100_001, 2];
+    f.time = Some(1.5);
+    f.step = Some(30);
+    f.cell = Some(UnitCell::orthorhombic(30.0, 31.0, 32.0).unwrap());
+    let text = write(Format::Gro, std::slice::from_ref(&f));
+    assert_eq!(
+        text,
+        "texmap t= 1.50000 step= 30\n    2\n    7SOL     OW    1   1.235  -0.050  10.000\n    7SOL    HW1    2   0.000   0.100   0.200\n   3.00000   3.10000   3.20000\n"
+    );
+    let back = &read(Format::Gro, &text)[0];
+    assert_eq!(back.time, Some(1.5));
+    assert_eq!(back.step, Some(30));
+    let mut long = f.clone();
+    long.names[1] = Label::new("HW123").unwrap();
+    long.res_names[0] = Label::new("SOLVNT").unwrap();
+    let e = refused(Format::Gro, &long);
+    assert!(e.contains("residue name 'SOLVNT' does not fit"), "{e}");
+    let mut tilted = f.clone();
+    tilted.cell = Some(
+        UnitCell::from_matrix([[30.0, 1.0, 0.0], [0.0, 31.0, 0.0], [0.0, 0.0, 32.0]]).unwrap(),
+    );
+    let e = refused(Format::Gro, &tilted);
+    assert!(e.contains("not in GROMACS's form"), "{e}");
+}
