@@ -1227,6 +1227,24 @@ pub struct AnalysisArgs {
     /// at all.
     #[arg(long, value_name = "FILE.csv", requires = "rdf")]
     pub rdf_table: Option<PathBuf>,
+    /// Give every atom the property 'msd': its squared displacement (Å²) from the first frame
+    /// written or drawn, followed across the periodic boundaries (GROMACS's trjconv -pbc
+    /// nojump, MDAnalysis's NoJump), before --align: --color-by msd shows the mobile atoms,
+    /// --select 'prop msd > 100' keeps them. Frames must be close enough that no atom moves half
+    /// a cell between two of them (mind a large --frames step).
+    #[arg(long)]
+    pub msd: bool,
+    /// Also write the mean squared displacement as a CSV table, one row per frame: frame, time
+    /// (ps, when the file has it), msd (Å², over every atom), then one column per kind of atom
+    /// (their types, else their elements: msd_O, msd_Na): a diffusion coefficient is the slope
+    /// over 6 at long times. Turns on --msd. Written whole or not at all.
+    #[arg(long, value_name = "FILE.csv")]
+    pub msd_table: Option<PathBuf>,
+    /// Also write --align's fit as a CSV table, one row per frame: frame, time (ps, when the
+    /// file has it), rmsd (Å: the aligned atoms' RMSD from the reference after the fit, mass
+    /// weighted with --align-mass), as MDAnalysis's rms.RMSD. Written whole or not at all.
+    #[arg(long, value_name = "FILE.csv", requires = "align")]
+    pub rmsd_table: Option<PathBuf>,
     /// Also write the grains of every frame as a CSV table, one row per grain: frame, grain,
     /// atoms, crystalline atoms, structure, and the mean orientation's quaternion. Written whole
     /// or not at all.

@@ -485,7 +485,8 @@ fn trace_layers<E: Into<anyhow::Error>>(
     Ok(base)
 }
 
-/// A per-frame CSV table for `flag` at `path`, its `header` row written; refused when the run
+/// A per-frame CSV table for `flag` at `path`, its `header` row written (unless empty: a
+/// header known only at the first frame); refused when the run
 /// draws only part of the frames (`whole` false: --shard), where every part would write it.
 fn per_frame_table(
     path: &Option<PathBuf>,
@@ -500,7 +501,9 @@ fn per_frame_table(
         ));
     }
     let mut t = crate::output::AtomicFile::create(p)?;
-    t.write(&format!("{header}\n"))?;
+    if !header.is_empty() {
+        t.write(&format!("{header}\n"))?;
+    }
     Ok(Some(t))
 }
 
@@ -527,6 +530,9 @@ pub(crate) struct AnalysisTables {
     defect: Option<crate::output::AtomicFile>,
     grain: Option<crate::output::AtomicFile>,
     rdf: Option<(crate::output::AtomicFile, RdfMean)>,
+    /// `--msd-table`, and the kinds of its columns (set at the first frame).
+    msd: Option<(crate::output::AtomicFile, Vec<texmap_md_io::Label>)>,
+    rmsd: Option<crate::output::AtomicFile>,
 }
 
 /// `--rdf-table`: the frames' g(r) summed, to be written as their mean.
@@ -602,6 +608,14 @@ impl AnalysisTables {
                 "frame,grain,atoms,crystalline,structure,qx,qy,qz,qw",
                 whole,
             )?,
+            msd: per_frame_table(&analysis.msd_table, "--msd-table", "", whole)?
+                .map(|t| (t, Vec::new())),
+            rmsd: per_frame_table(
+                &analysis.rmsd_table,
+                "--rmsd-table",
+                "frame,time,rmsd",
+                whole,
+            )?,
             rdf: match &analysis.rdf_table {
                 None => None,
                 Some(_) if !whole => {
@@ -614,8 +628,62 @@ impl AnalysisTables {
         })
     }
 
-    /// Frame `f`'s rows, from what `plan` found in it.
-    pub(crate) fn write(&mut self, f: usize, plan: &texmap_md_scene::MolPlan) -> Result<()> {
+    /// Frame `f`'s rows, from what `plan` found in it (`md`, as prepared).
+    pub(crate) fn write(
+        &mut self,
+        f: usize,
+        plan: &texmap_md_scene::MolPlan,
+        md: &MdFrame,
+    ) -> Result<()> {
+        let time = md
+            .time
+            .map(|t| crate::scene::compact(t, 6))
+            .unwrap_or_default();
+        if let Some(t) = &mut self.rmsd
+            && let Some(rmsd) = plan.last_fit_rmsd()
+        {
+            t.write(&format!("{f},{time},{rmsd:.6}\n"))?;
+        }
+        if let Some((t, kinds)) = &mut self.msd
+            && let Some(d2) = md.property(texmap_md_scene::MSD)
+        {
+            let of: Vec<texmap_md_io::Label> = (0..md.n_atoms())
+                .map(|i| texmap_md_io::rdf::atom_kind(md, i))
+                .collect();
+            if kinds.is_empty() {
+                let mut seen: Vec<texmap_md_io::Label> = Vec::new();
+                for k in &of {
+                    if !seen.contains(k) {
+                        seen.push(*k);
+                    }
+                }
+                seen.sort_by(|a, b| a.as_str().cmp(b.as_str()));
+                let mut header = String::from("frame,time,msd");
+                for k in &seen {
+                    header.push_str(&format!(",msd_{k}"));
+                }
+                t.write(&format!("{header}\n"))?;
+                *kinds = seen;
+            }
+            let mean = |pick: &dyn Fn(usize) -> bool| {
+                let (sum, count) = d2
+                    .iter()
+                    .enumerate()
+                    .filter(|(i, _)| pick(*i))
+                    .fold((0.0f64, 0usize), |(s, c), (_, v)| (s + *v as f64, c + 1));
+                if count == 0 {
+                    String::new()
+                } else {
+                    format!("{:.6}", sum / count as f64)
+                }
+            };
+            let mut row = format!("{f},{time},{}", mean(&|_| true));
+            for k in kinds.iter() {
+                row.push(',');
+                row.push_str(&mean(&|i| of[i] == *k));
+            }
+            t.write(&format!("{row}\n"))?;
+        }
         if let Some(t) = &mut self.defect
             && let Some((vacancies, interstitials)) = plan.last_defects()
         {
@@ -649,7 +717,8 @@ impl AnalysisTables {
         let rdf = self
             .rdf
             .map(|(mut t, mean)| t.write(&mean.csv()).map(|()| t));
-        for t in [self.defect, self.grain, rdf.transpose()?]
+        let msd = self.msd.map(|(t, _)| t);
+        for t in [self.defect, self.grain, self.rmsd, msd, rdf.transpose()?]
             .into_iter()
             .flatten()
         {
@@ -1000,7 +1069,7 @@ fn render(a: &RenderArgs) -> Result<()> {
         }
         if mine.contains(&k) {
             analysis_tables
-                .write(f, &plan)
+                .write(f, &plan, &md)
                 .map_err(|e| fail(e, &written))?;
         }
         if let Some(t) = &mut measure_table

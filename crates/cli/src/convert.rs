@@ -64,7 +64,7 @@ pub struct ConvertArgs {
     /// and the columns, read by LAMMPS's rerun, OVITO and MDAnalysis), .gro (GROMACS: residues,
     /// names, positions to 0.001 nm, velocities, the box), .pdb (multi-MODEL, the 'occupancy'
     /// and 'bfactor' properties in their columns), .dcd, .xtc (positions and the box only). Written whole or not at all. Without it, only the analyses' tables are
-    /// written (--rdf-table, --grain-table, --defect-table).
+    /// written (--rdf-table, --msd-table, --rmsd-table, --grain-table, --defect-table).
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
     #[command(flatten)]
@@ -126,10 +126,12 @@ pub fn convert(a: &ConvertArgs) -> Result<()> {
                 &a.analysis.defect_table,
                 &a.analysis.grain_table,
                 &a.analysis.rdf_table,
+                &a.analysis.msd_table,
+                &a.analysis.rmsd_table,
             ];
             if tables.iter().all(|t| t.is_none()) {
                 return usage(
-                    "nothing to write: give -o FILE, or a table of the analyses (--rdf-table, --grain-table, --defect-table)",
+                    "nothing to write: give -o FILE, or a table of the analyses (--rdf-table, --msd-table, --rmsd-table, --grain-table, --defect-table)",
                 );
             }
             if a.select.is_some() || a.columns.is_some() {
@@ -196,7 +198,7 @@ pub fn convert(a: &ConvertArgs) -> Result<()> {
             crate::commands::set_atom_values(&mut md, f, &atom_values).map_err(at)?;
             plan.prepare(&mut md)
                 .map_err(|e| at(crate::scene::mol_error(e)))?;
-            tables.write(f, &plan).map_err(at)?;
+            tables.write(f, &plan, &md).map_err(at)?;
             if let Some(columns) = &a.columns {
                 structure_columns(&mut md, columns);
             }

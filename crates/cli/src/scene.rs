@@ -311,7 +311,7 @@ pub fn draw_atom_labels<'a>(
 }
 
 /// A number with up to `decimals` decimals, trailing zeros dropped: 2.5, 1250, 0.125.
-fn compact(v: f64, decimals: usize) -> String {
+pub(crate) fn compact(v: f64, decimals: usize) -> String {
     let s = format!("{v:.decimals$}");
     if s.contains('.') {
         s.trim_end_matches('0').trim_end_matches('.').to_string()
@@ -662,6 +662,7 @@ pub fn mol_plan(args: &MolArgs, style: &StyleArgs, topology: Option<Topology>) -
             .into_iter()
             .any(scalar_is),
         grains: grains.then(|| grain_options(args)),
+        msd: args.analysis.msd || args.analysis.msd_table.is_some() || scalar_is("msd"),
         rdf: args.analysis.rdf.map(|cutoff| texmap_md_scene::RdfOptions {
             cutoff,
             bins: args.analysis.rdf_bins,
@@ -789,8 +790,9 @@ fn read_reference(path: &std::path::Path) -> Result<Frame> {
 }
 
 /// The per-atom properties the analyses add, and the flag that adds each.
-pub(crate) const ANALYSIS_PROPERTIES: [(&str, &str); 21] = [
+pub(crate) const ANALYSIS_PROPERTIES: [(&str, &str); 22] = [
     ("coordination", "--coordination R"),
+    ("msd", "--msd"),
     ("cluster", "--clusters R"),
     ("centrosymmetry", "--centrosymmetry N"),
     ("shear_strain", "--strain R"),
@@ -852,6 +854,7 @@ pub fn mol_error(e: MolError) -> anyhow::Error {
         MolError::WignerSeitz(e) => return anyhow::anyhow!("--wigner-seitz: {e}"),
         MolError::Voronoi(e) => return anyhow::anyhow!("--voronoi: {e}"),
         MolError::Rdf(e) => return anyhow::anyhow!("--rdf: {e}"),
+        MolError::Msd(e) => return anyhow::anyhow!("--msd: {e}"),
         MolError::Compute { name, error } => {
             // The formula parsed; the frame lacks a name it uses: the input's, not usage.
             return anyhow::anyhow!("--compute {name}: {error}");

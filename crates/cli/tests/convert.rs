@@ -486,3 +486,97 @@ fn rdf_table_is_the_mean_of_ovitos() {
         }
     }
 }
+
+/// A CSV table's rows after its header, as numbers (empty fields NaN), and the header.
+fn table(path: &Path) -> (String, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap().to_string();
+    let rows = lines
+        .map(|l| {
+            l.split(',')
+                .map(|v| v.parse().unwrap_or(f64::NAN))
+                .collect()
+        })
+        .collect();
+    (header, rows)
+}
+
+/// `--msd-table`: the mean squared displacement of random walks that cross the faces of an
+/// 18 Å box many times (written by MDAnalysis, wrapped into the box) equals MDAnalysis's, after
+/// its NoJump transformation, for all atoms and per kind; and `--rmsd-table` equals
+/// MDAnalysis's rms.RMSD, plain and mass-weighted.
+#[test]
+fn msd_and_rmsd_tables_are_mdanalysis() {
+    let dir = tempfile::tempdir().unwrap();
+    let msd = dir.path().join("msd.csv");
+    run_ok(&[
+        "convert",
+        &md_data("dynamics/walk.dcd"),
+        "--topology",
+        &md_data("dynamics/walk.gro"),
+        "--msd-table",
+        msd.to_str().unwrap(),
+        "-q",
+    ]);
+    let (header, rows) = table(&msd);
+    assert_eq!(header, "frame,time,msd,msd_Na,msd_O");
+    let reference: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(md_data("dynamics/msd_reference.json")).unwrap(),
+    )
+    .unwrap();
+    let reference = reference.as_array().unwrap();
+    assert_eq!(rows.len(), reference.len());
+    for (row, r) in rows.iter().zip(reference) {
+        assert_eq!(row[0], r["frame"].as_f64().unwrap());
+        for (col, name) in [(2, "msd"), (3, "msd_NA"), (4, "msd_OW")] {
+            // The kinds are the elements (the GRO has no types): Na, O.
+            let want = r[name].as_f64().unwrap();
+            // f32 positions, 6 decimals in the table.
+            assert!(
+                (row[col] - want).abs() <= 1e-5 * want.max(1.0),
+                "frame {} {name}: {} vs MDAnalysis {want}",
+                row[0],
+                row[col]
+            );
+        }
+    }
+    // By the last frame the walks have gone far beyond half the box (9 Å): the unwrapping
+    // counts, a wrapped displacement would be capped.
+    assert!(rows.last().unwrap()[2] > 50.0);
+
+    let rmsd: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(md_data("dynamics/rmsd_reference.json")).unwrap(),
+    )
+    .unwrap();
+    for (extra, name) in [(None, "rmsd"), (Some("--align-mass"), "rmsd_mass")] {
+        let out = dir.path().join(format!("{name}.csv"));
+        let mut args = vec![
+            "convert".to_string(),
+            md_data("topo_mda.xtc"),
+            "--topology".into(),
+            md_data("topo_mda.gro"),
+            "--align".into(),
+            "all".into(),
+            "--rmsd-table".into(),
+            out.to_str().unwrap().into(),
+            "-q".into(),
+        ];
+        args.extend(extra.map(String::from));
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        run_ok(&args);
+        let (header, rows) = table(&out);
+        assert_eq!(header, "frame,time,rmsd");
+        let want = rmsd[name].as_array().unwrap();
+        assert_eq!(rows.len(), want.len());
+        for (row, w) in rows.iter().zip(want) {
+            let w = w.as_f64().unwrap();
+            assert!(
+                (row[2] - w).abs() <= 2e-6,
+                "{name} frame {}: {} vs MDAnalysis {w}",
+                row[0],
+                row[2]
+            );
+        }
+    }
+}

@@ -144,8 +144,9 @@ impl fmt::Display for RdfError {
 
 impl std::error::Error for RdfError {}
 
-/// The kind of atom `i` for partial RDFs: its type label, else its element symbol.
-fn kind(frame: &Frame, i: usize) -> Label {
+/// The kind of atom `i` for partial RDFs (and per-kind tables): its type label, else its
+/// element symbol.
+pub fn atom_kind(frame: &Frame, i: usize) -> Label {
     match frame.types.get(i) {
         Some(t) => *t,
         None => Label::new(crate::atom_element(frame, i).symbol()).unwrap_or_default(),
@@ -325,7 +326,7 @@ pub fn rdf(frame: &Frame, cutoff: f32, bins: usize, partial: bool) -> Result<Rdf
     // Kinds in label order, and each atom's.
     let mut kinds: BTreeMap<&str, (Label, usize)> = BTreeMap::new();
     let of: Vec<Label> = if partial {
-        (0..n).map(|i| kind(frame, i)).collect()
+        (0..n).map(|i| atom_kind(frame, i)).collect()
     } else {
         Vec::new()
     };

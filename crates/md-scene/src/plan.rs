@@ -269,6 +269,9 @@ pub const ORIENTATION: [&str; 4] = [
 pub const LATTICE_RMSD: &str = "lattice_rmsd";
 /// The per-atom grain [`MolOptions::grains`] adds (0 the largest, −1 for atoms in none).
 pub const GRAIN: &str = "grain";
+/// Each atom's squared displacement (Å²) from the first frame, followed across the periodic
+/// boundaries, that [`MolOptions::msd`] adds.
+pub const MSD: &str = "msd";
 /// The per-atom property [`MolOptions::displacement`] adds to each frame.
 pub const DISPLACEMENT: &str = "displacement";
 
@@ -340,6 +343,10 @@ pub struct MolOptions {
     /// The radial distribution function every frame, after the periodic images (OVITO's
     /// Coordination analysis table: [`texmap_md_io::rdf`]); [`MolPlan::last_rdf`] holds it.
     pub rdf: Option<RdfOptions>,
+    /// Each atom's squared displacement (Å²) from the first frame built, followed across the
+    /// periodic boundaries ([`texmap_md_io::msd`]), as the property [`MSD`], before the
+    /// alignment: the mean squared displacement a diffusion coefficient is read from.
+    pub msd: bool,
     /// Per-atom properties frozen at the first frame built (OVITO's Freeze property), after
     /// [`MolOptions::computes`]: every later frame gets the values the first had, atom by atom,
     /// so that colours follow the atoms (a crystal coloured by where each atom started shows
@@ -482,6 +489,7 @@ impl Default for MolOptions {
             orientations: false,
             grains: None,
             rdf: None,
+            msd: false,
             freeze: Vec::new(),
             radius_from: None,
             slice: None,
@@ -609,6 +617,8 @@ pub enum MolError {
     WignerSeitz(WignerSeitzError),
     /// [`MolOptions::rdf`] cannot be computed (no cell, the cutoff, the bins).
     Rdf(texmap_md_io::rdf::RdfError),
+    /// [`MolOptions::msd`] cannot follow a frame (other atoms than the first's).
+    Msd(texmap_md_io::msd::MsdError),
     /// A formula of [`MolOptions::computes`] names what a frame does not have.
     Compute {
         /// The property it computes.
@@ -675,6 +685,7 @@ impl fmt::Display for MolError {
             MolError::WignerSeitz(e) => write!(f, "Wigner-Seitz analysis: {e}"),
             MolError::Voronoi(e) => write!(f, "Voronoi analysis: {e}"),
             MolError::Rdf(e) => write!(f, "radial distribution function: {e}"),
+            MolError::Msd(e) => write!(f, "mean squared displacement: {e}"),
             MolError::NoFreezeProperty { name, available } => write!(
                 f,
                 "freezing '{name}': the first frame has no such per-atom property ({})",
@@ -806,6 +817,7 @@ pub struct MolPlan {
     /// The last frame's grains ([`MolOptions::grains`]).
     last_grains: Option<Vec<Grain>>,
     last_rdf: Option<texmap_md_io::rdf::Rdf>,
+    msd: texmap_md_io::msd::Tracker,
     /// The values of [`MolOptions::freeze`]'s properties at the first frame built.
     frozen: Vec<Vec<f32>>,
     arrow_vectors: Vec<glam::Vec3>,
@@ -893,6 +905,7 @@ impl MolPlan {
             last_defects: None,
             last_grains: None,
             last_rdf: None,
+            msd: texmap_md_io::msd::Tracker::new(),
             frozen: Vec::new(),
             arrow_vectors: Vec::new(),
             arrows: MolMesh::default(),
@@ -1297,6 +1310,10 @@ impl MolPlan {
                 );
                 self.last_grains = Some(found.grains);
             }
+        }
+        if self.options.msd {
+            let d2 = self.msd.add(frame).map_err(MolError::Msd)?;
+            set_property(frame, MSD, d2.into_iter().map(|v| v as f32).collect());
         }
         for (name, formula) in &self.options.computes {
             let values = formula.evaluate(frame).map_err(|error| MolError::Compute {

@@ -1,0 +1,59 @@
+"""MDAnalysis 2.11.0's mean squared displacement and RMSD: references for `--msd-table` and
+`--rmsd-table` (crates/cli/tests/convert.rs).
+
+Run from this directory: python3 gen_dynamics.py
+
+- walk.gro + walk.dcd (written by MDAnalysis): 300 atoms (200 named OW in residues SOL, 100
+  named NA in residues NA) on Gaussian random walks (0.7 A per axis per frame) in a periodic
+  18 A cube, 40 frames, every position wrapped into the box, so atoms cross the faces many times.
+  msd_reference.json holds, per frame, the mean squared displacement from frame 0 of all atoms,
+  of the OW and of the NA atoms, after MDAnalysis's NoJump transformation unwraps the walk.
+- rmsd_reference.json: MDAnalysis's rms.RMSD of md-io's topo_mda.xtc (with topo_mda.gro) on
+  all atoms against frame 0, unweighted and mass-weighted (results.rmsd's third column).
+"""
+import json
+
+import numpy as np
+import MDAnalysis as mda
+from MDAnalysis.analysis import rms
+from MDAnalysis.transformations import NoJump
+
+rng = np.random.default_rng(61206)
+n_ow, n_na, frames, box = 200, 100, 40, 18.0
+n = n_ow + n_na
+u = mda.Universe.empty(n, n_residues=n, atom_resindex=np.arange(n), trajectory=True)
+u.add_TopologyAttr("name", ["OW"] * n_ow + ["NA"] * n_na)
+u.add_TopologyAttr("resname", ["SOL"] * n_ow + ["NA"] * n_na)
+u.add_TopologyAttr("resid", np.arange(1, n + 1))
+u.dimensions = [box, box, box, 90, 90, 90]
+true = rng.random((n, 3)) * box
+u.atoms.positions = true % box
+u.atoms.write("walk.gro")
+with mda.Writer("walk.dcd", n) as w:
+    for f in range(frames):
+        u.atoms.positions = true % box
+        u.dimensions = [box, box, box, 90, 90, 90]
+        w.write(u.atoms)
+        true = true + rng.normal(0.0, 0.7, size=(n, 3))
+
+walk = mda.Universe("walk.gro", "walk.dcd")
+walk.trajectory.add_transformations(NoJump())
+ow = walk.select_atoms("name OW")
+na = walk.select_atoms("name NA")
+origin = None
+rows = []
+for ts in walk.trajectory:
+    p = walk.atoms.positions.astype(np.float64)
+    if origin is None:
+        origin = p.copy()
+    d2 = ((p - origin) ** 2).sum(axis=1)
+    rows.append({"frame": ts.frame, "msd": d2.mean(), "msd_OW": d2[ow.indices].mean(),
+                 "msd_NA": d2[na.indices].mean()})
+json.dump(rows, open("msd_reference.json", "w"), indent=1)
+print("msd at the last frame:", rows[-1])
+
+topo = mda.Universe("../topo_mda.gro", "../topo_mda.xtc")
+plain = rms.RMSD(topo, select="all").run().results.rmsd[:, 2].tolist()
+mass = rms.RMSD(topo, select="all", weights="mass").run().results.rmsd[:, 2].tolist()
+json.dump({"rmsd": plain, "rmsd_mass": mass}, open("rmsd_reference.json", "w"), indent=1)
+print("rmsd:", plain, mass)
