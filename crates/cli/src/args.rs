@@ -1119,6 +1119,12 @@ pub struct AnalysisArgs {
     /// matrix, 'prop coordination >= 10' for solid-like atoms); the others are in cluster -1.
     #[arg(long, value_name = "SEL", requires = "clusters")]
     pub cluster_atoms: Option<String>,
+    /// Also write the --clusters of every frame as a CSV table, one row per cluster, the largest
+    /// first: frame, cluster, atoms, the centre x, y, z (Å; the mean of its atoms taken whole
+    /// across the cell's faces) and the radius of gyration (Å, unweighted): nucleation and
+    /// growth, the largest cluster over a run. Written whole or not at all.
+    #[arg(long, value_name = "FILE.csv", requires = "clusters")]
+    pub cluster_table: Option<PathBuf>,
     /// The centrosymmetry parameter of every atom from its N nearest neighbours (12 for FCC,
     /// 8 for BCC), as OVITO's Centrosymmetry modifier and LAMMPS's compute centro/atom, into
     /// the per-atom number 'centrosymmetry' (Å²): about 0 in the perfect crystal, large at

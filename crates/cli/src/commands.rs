@@ -533,6 +533,7 @@ pub(crate) struct AnalysisTables {
     /// `--msd-table`, and the kinds of its columns (set at the first frame).
     msd: Option<(crate::output::AtomicFile, Vec<texmap_md_io::Label>)>,
     rmsd: Option<crate::output::AtomicFile>,
+    cluster: Option<crate::output::AtomicFile>,
 }
 
 /// `--rdf-table`: the frames' g(r) summed, to be written as their mean.
@@ -616,6 +617,12 @@ impl AnalysisTables {
                 "frame,time,rmsd",
                 whole,
             )?,
+            cluster: per_frame_table(
+                &analysis.cluster_table,
+                "--cluster-table",
+                "frame,cluster,atoms,x,y,z,rg",
+                whole,
+            )?,
             rdf: match &analysis.rdf_table {
                 None => None,
                 Some(_) if !whole => {
@@ -639,6 +646,23 @@ impl AnalysisTables {
             .time
             .map(|t| crate::scene::compact(t, 6))
             .unwrap_or_default();
+        if let Some(t) = &mut self.cluster
+            && let Some(c) = plan.last_clusters()
+        {
+            let mut rows = String::new();
+            for (k, (size, (p, rg))) in c
+                .sizes
+                .iter()
+                .zip(c.centers.iter().zip(&c.gyration))
+                .enumerate()
+            {
+                rows.push_str(&format!(
+                    "{f},{k},{size},{:.4},{:.4},{:.4},{rg:.4}\n",
+                    p[0], p[1], p[2]
+                ));
+            }
+            t.write(&rows)?;
+        }
         if let Some(t) = &mut self.rmsd
             && let Some(rmsd) = plan.last_fit_rmsd()
         {
@@ -718,9 +742,16 @@ impl AnalysisTables {
             .rdf
             .map(|(mut t, mean)| t.write(&mean.csv()).map(|()| t));
         let msd = self.msd.map(|(t, _)| t);
-        for t in [self.defect, self.grain, self.rmsd, msd, rdf.transpose()?]
-            .into_iter()
-            .flatten()
+        for t in [
+            self.defect,
+            self.grain,
+            self.rmsd,
+            self.cluster,
+            msd,
+            rdf.transpose()?,
+        ]
+        .into_iter()
+        .flatten()
         {
             t.commit()?;
         }

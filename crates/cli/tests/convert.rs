@@ -23,6 +23,20 @@ fn convert_data(name: &str) -> PathBuf {
         .join(name)
 }
 
+/// md-io's fixture `name`, a JSON file of reference values.
+fn json(name: &str) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(md_data(name)).unwrap()).unwrap()
+}
+
+/// A JSON array of numbers.
+fn numbers(v: &serde_json::Value) -> Vec<f64> {
+    v.as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect()
+}
+
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
@@ -355,10 +369,7 @@ fn bad_requests_are_refused_and_leave_no_file() {
 #[test]
 fn diamond_column_is_ovitos_structure_type() {
     let dir = tempfile::tempdir().unwrap();
-    let reference: serde_json::Value = serde_json::from_str(
-        &std::fs::read_to_string(md_data("diamond/diamond_reference.json")).unwrap(),
-    )
-    .unwrap();
+    let reference: serde_json::Value = json("diamond/diamond_reference.json");
     for entry in reference.as_array().unwrap() {
         let file = entry["file"].as_str().unwrap();
         let want: Vec<f32> = entry["structure"]
@@ -425,9 +436,7 @@ fn rdf_table_is_the_mean_of_ovitos() {
         .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
         .collect();
     assert_eq!(rows.len(), 60);
-    let reference: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(md_data("rdf/rdf_reference.json")).unwrap())
-            .unwrap();
+    let reference: serde_json::Value = json("rdf/rdf_reference.json");
     let entries: Vec<&serde_json::Value> = reference
         .as_array()
         .unwrap()
@@ -440,12 +449,7 @@ fn rdf_table_is_the_mean_of_ovitos() {
     let (n, n_si, n_o) = (1500.0, 1000.0, 500.0);
     let column = |e: &serde_json::Value, name: &str| -> Vec<f64> {
         if name == "total" {
-            return e["total"]
-                .as_array()
-                .unwrap()
-                .iter()
-                .map(|v| v.as_f64().unwrap())
-                .collect();
+            return numbers(&e["total"]);
         }
         let k = e["columns"]
             .as_array()
@@ -453,12 +457,7 @@ fn rdf_table_is_the_mean_of_ovitos() {
             .iter()
             .position(|c| c == name)
             .unwrap();
-        e["g"][k]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|v| v.as_f64().unwrap())
-            .collect()
+        numbers(&e["g"][k])
     };
     // Our column, OVITO's name, and the ordered pairs' density for counting.
     for (col, name, pairs) in [
@@ -521,10 +520,7 @@ fn msd_and_rmsd_tables_are_mdanalysis() {
     ]);
     let (header, rows) = table(&msd);
     assert_eq!(header, "frame,time,msd,msd_Na,msd_O");
-    let reference: serde_json::Value = serde_json::from_str(
-        &std::fs::read_to_string(md_data("dynamics/msd_reference.json")).unwrap(),
-    )
-    .unwrap();
+    let reference: serde_json::Value = json("dynamics/msd_reference.json");
     let reference = reference.as_array().unwrap();
     assert_eq!(rows.len(), reference.len());
     for (row, r) in rows.iter().zip(reference) {
@@ -545,10 +541,7 @@ fn msd_and_rmsd_tables_are_mdanalysis() {
     // counts, a wrapped displacement would be capped.
     assert!(rows.last().unwrap()[2] > 50.0);
 
-    let rmsd: serde_json::Value = serde_json::from_str(
-        &std::fs::read_to_string(md_data("dynamics/rmsd_reference.json")).unwrap(),
-    )
-    .unwrap();
+    let rmsd: serde_json::Value = json("dynamics/rmsd_reference.json");
     for (extra, name) in [(None, "rmsd"), (Some("--align-mass"), "rmsd_mass")] {
         let out = dir.path().join(format!("{name}.csv"));
         let mut args = vec![
@@ -579,4 +572,48 @@ fn msd_and_rmsd_tables_are_mdanalysis() {
             );
         }
     }
+}
+
+/// `--cluster-table`: the copper clusters in iron (md-io's cluster fixture, written by OVITO)
+/// have OVITO's sizes, largest first, frame by frame; the precipitate (every site within 6 Å
+/// of (12, 13, 14)) is centred there, with about a solid sphere's radius of gyration
+/// (√(3/5) · 6 = 4.65 Å; the lattice's sites and the solutes touching it make it 4.78).
+#[test]
+fn cluster_table_has_ovitos_sizes_and_the_precipitates_shape() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("c.csv");
+    run_ok(&[
+        "convert",
+        &md_data("clusters/fecu.xyz"),
+        "--clusters",
+        "2.9",
+        "--cluster-atoms",
+        "element Cu",
+        "--cluster-table",
+        out.to_str().unwrap(),
+        "-q",
+    ]);
+    let (header, rows) = table(&out);
+    assert_eq!(header, "frame,cluster,atoms,x,y,z,rg");
+    let reference: serde_json::Value = json("clusters/clusters_reference.json");
+    let fecu = reference
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["file"] == "fecu.xyz")
+        .unwrap();
+    let sizes: Vec<f64> = numbers(&fecu["sizes"]);
+    assert_eq!(rows.iter().map(|r| r[2]).collect::<Vec<_>>(), sizes);
+    assert!(
+        rows.iter()
+            .enumerate()
+            .all(|(k, r)| r[0] == 0.0 && r[1] == k as f64)
+    );
+    let big = &rows[0];
+    for (got, want) in big[3..6].iter().zip([12.0, 13.0, 14.0]) {
+        assert!((got - want).abs() < 0.2, "{big:?}");
+    }
+    assert!((big[6] - (0.6f64).sqrt() * 6.0).abs() < 0.2, "{big:?}");
+    // Single solutes: a radius of gyration of 0.
+    assert!(rows.iter().filter(|r| r[2] == 1.0).all(|r| r[6] == 0.0));
 }

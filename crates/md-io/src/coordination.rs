@@ -138,7 +138,7 @@ pub fn clusters(
         }
         i
     }
-    for [i, j] in pairs {
+    for &[i, j] in &pairs {
         if member(i as usize) && member(j as usize) {
             let (a, b) = (root(&mut parent, i), root(&mut parent, j));
             if a != b {
@@ -164,7 +164,7 @@ pub fn clusters(
     for (k, &r) in roots.iter().enumerate() {
         id_of_root[r] = k as i32;
     }
-    let ids = (0..n)
+    let ids: Vec<i32> = (0..n)
         .map(|i| {
             if member(i) {
                 id_of_root[root(&mut parent, i as u32) as usize]
@@ -174,14 +174,102 @@ pub fn clusters(
         })
         .collect();
     let sizes = roots.iter().map(|&r| size[r]).collect();
-    Ok(Clusters { ids, sizes })
+    let (centers, gyration) = shapes(frame, &pairs, &ids, &roots);
+    Ok(Clusters {
+        ids,
+        sizes,
+        centers,
+        gyration,
+    })
+}
+
+/// Each cluster's centre and radius of gyration, its atoms unwrapped along its pairs from its
+/// lowest atom (`roots[k]` is cluster `k`'s), so that a cluster cut by the cell's faces is
+/// whole.
+fn shapes(
+    frame: &Frame,
+    pairs: &[[u32; 2]],
+    ids: &[i32],
+    roots: &[usize],
+) -> (Vec<[f64; 3]>, Vec<f64>) {
+    let n = ids.len();
+    // Pairs within a cluster, as adjacency lists.
+    let mut starts = vec![0usize; n + 1];
+    let inside = |[i, j]: [u32; 2]| ids[i as usize] >= 0 && ids[i as usize] == ids[j as usize];
+    for &[i, j] in pairs.iter().filter(|p| inside(**p)) {
+        starts[i as usize + 1] += 1;
+        starts[j as usize + 1] += 1;
+    }
+    for i in 0..n {
+        starts[i + 1] += starts[i];
+    }
+    let mut fill = starts.clone();
+    let mut next = vec![0u32; starts[n]];
+    for &[i, j] in pairs.iter().filter(|p| inside(**p)) {
+        next[fill[i as usize]] = j;
+        fill[i as usize] += 1;
+        next[fill[j as usize]] = i;
+        fill[j as usize] += 1;
+    }
+    let at = |i: usize| frame.positions[i].map(f64::from);
+    let mut unwrapped = vec![[0f64; 3]; n];
+    let mut seen = vec![false; n];
+    let mut queue = std::collections::VecDeque::new();
+    let mut centers = Vec::with_capacity(roots.len());
+    let mut gyration = Vec::with_capacity(roots.len());
+    let mut members = Vec::new();
+    for &r in roots {
+        members.clear();
+        unwrapped[r] = at(r);
+        seen[r] = true;
+        queue.push_back(r);
+        while let Some(i) = queue.pop_front() {
+            members.push(i);
+            for &j in &next[starts[i]..starts[i + 1]] {
+                let j = j as usize;
+                if !seen[j] {
+                    seen[j] = true;
+                    let step: [f64; 3] = std::array::from_fn(|k| at(j)[k] - at(i)[k]);
+                    let step = match &frame.cell {
+                        Some(cell) => crate::pbc::minimum_image(cell, step),
+                        None => step,
+                    };
+                    unwrapped[j] = std::array::from_fn(|k| unwrapped[i][k] + step[k]);
+                    queue.push_back(j);
+                }
+            }
+        }
+        let m = members.len() as f64;
+        let c: [f64; 3] =
+            std::array::from_fn(|k| members.iter().map(|&i| unwrapped[i][k]).sum::<f64>() / m);
+        let r2 = members
+            .iter()
+            .map(|&i| {
+                (0..3)
+                    .map(|k| (unwrapped[i][k] - c[k]).powi(2))
+                    .sum::<f64>()
+            })
+            .sum::<f64>()
+            / m;
+        centers.push(c);
+        gyration.push(r2.sqrt());
+    }
+    (centers, gyration)
 }
 
 /// What [`clusters`] finds.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Clusters {
     /// Per atom: its cluster (0 the largest), −1 when outside the atoms clustered.
     pub ids: Vec<i32>,
     /// Atoms per cluster, largest first (`sizes[k]` is cluster `k`).
     pub sizes: Vec<usize>,
+    /// Each cluster's centre (Å): the mean position of its atoms, unwrapped along the cluster's
+    /// pairs from its lowest-index atom, so a cluster cut by the cell's faces is taken whole
+    /// (the centre may lie outside the cell). A cluster that spans the periodic system (it
+    /// percolates) has no single unwrapping: its centre is that of the tree of pairs found.
+    pub centers: Vec<[f64; 3]>,
+    /// Each cluster's radius of gyration (Å): the root mean square distance of its unwrapped
+    /// atoms from the centre (unweighted, as OVITO's with unit masses).
+    pub gyration: Vec<f64>,
 }

@@ -87,3 +87,28 @@ fn every_cluster_is_ovitos() {
         assert!(unique >= 2);
     }
 }
+
+/// A cluster cut by the cell's faces is unwrapped whole: a chain of five atoms 2 Å apart along
+/// x around the face x = 0 of a 20 Å cell (wrapped to 16, 18, 0, 2, 4) has its centre at the
+/// face (x = 20, unwrapped from its first atom at 16) and a radius of gyration of √8 Å
+/// (distances 4, 2, 0, 2, 4 from the centre); a lone atom's is 0 at itself.
+#[test]
+fn cluster_cut_by_the_faces_has_the_centre_and_gyration_of_the_whole() {
+    let mut frame = Frame::new();
+    frame.cell = Some(texmap_md_io::UnitCell::orthorhombic(20.0, 20.0, 20.0).unwrap());
+    frame.positions = vec![
+        [16.0, 5.0, 5.0],
+        [18.0, 5.0, 5.0],
+        [0.0, 5.0, 5.0],
+        [2.0, 5.0, 5.0],
+        [4.0, 5.0, 5.0],
+        [10.0, 15.0, 15.0],
+    ];
+    let c = texmap_md_io::coordination::clusters(&frame, 2.5, None).unwrap();
+    assert_eq!(c.sizes, [5, 1]);
+    let [x, y, z] = c.centers[0];
+    assert!((x - 20.0).abs() < 1e-12 && (y - 5.0).abs() < 1e-12 && (z - 5.0).abs() < 1e-12);
+    assert!((c.gyration[0] - 8f64.sqrt()).abs() < 1e-12);
+    assert_eq!(c.centers[1], [10.0, 15.0, 15.0]);
+    assert_eq!(c.gyration[1], 0.0);
+}

@@ -817,6 +817,7 @@ pub struct MolPlan {
     /// The last frame's grains ([`MolOptions::grains`]).
     last_grains: Option<Vec<Grain>>,
     last_rdf: Option<texmap_md_io::rdf::Rdf>,
+    last_clusters: Option<texmap_md_io::coordination::Clusters>,
     msd: texmap_md_io::msd::Tracker,
     /// The values of [`MolOptions::freeze`]'s properties at the first frame built.
     frozen: Vec<Vec<f32>>,
@@ -905,6 +906,7 @@ impl MolPlan {
             last_defects: None,
             last_grains: None,
             last_rdf: None,
+            last_clusters: None,
             msd: texmap_md_io::msd::Tracker::new(),
             frozen: Vec::new(),
             arrow_vectors: Vec::new(),
@@ -1209,6 +1211,7 @@ impl MolPlan {
             let values = counts.into_iter().map(|c| c as f32).collect();
             set_property(frame, COORDINATION, values);
         }
+        self.last_clusters = None;
         if let Some(c) = &self.options.clusters {
             let mask = match &c.atoms {
                 Some(sel) => Some(sel.evaluate(frame).map_err(|error| MolError::Selection {
@@ -1217,10 +1220,12 @@ impl MolPlan {
                 })?),
                 None => None,
             };
-            let found = texmap_md_io::coordination::clusters(frame, c.cutoff, mask.as_deref())
+            let mut found = texmap_md_io::coordination::clusters(frame, c.cutoff, mask.as_deref())
                 .map_err(MolError::Clusters)?;
-            let values = found.ids.into_iter().map(|c| c as f32).collect();
+            let values = found.ids.iter().map(|&c| c as f32).collect();
             set_property(frame, CLUSTER, values);
+            found.ids = Vec::new();
+            self.last_clusters = Some(found);
         }
         if let Some(c) = self.options.centrosymmetry {
             let values = texmap_md_io::centrosymmetry::centrosymmetry(frame, c.neighbours, c.mode)
@@ -1582,6 +1587,13 @@ impl MolPlan {
     /// it).
     pub fn last_grains(&self) -> Option<&[Grain]> {
         self.last_grains.as_deref()
+    }
+
+    /// The last frame's clusters ([`MolOptions::clusters`]; `None` without it): sizes,
+    /// centres and radii of gyration, the largest first (the per-atom ids are the property
+    /// [`CLUSTER`], not kept here).
+    pub fn last_clusters(&self) -> Option<&texmap_md_io::coordination::Clusters> {
+        self.last_clusters.as_ref()
     }
 
     /// The last frame's radial distribution function ([`MolOptions::rdf`]; `None` without
