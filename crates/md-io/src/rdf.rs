@@ -219,61 +219,53 @@ impl Histogram<'_> {
         // Wrapped Cartesian positions: a neighbour's image is its position plus the shift of
         // the cell offset that reaches it.
         let cart: Vec<DVec3> = self.frac.iter().map(|f| self.edges * *f).collect();
-        let size = self.bins * self.slots;
-        (0..n)
-            .into_par_iter()
-            .fold(
-                || vec![0u64; size],
-                |mut h, i| {
-                    let c = cell_of(self.frac[i]);
-                    let pi = cart[i];
-                    for o in 0..125 {
-                        let off = [o / 25, (o / 5) % 5, o % 5].map(|x| x as isize - 2);
-                        let mut shift = DVec3::ZERO;
-                        let mut nc = [0usize; 3];
-                        for k in 0..3 {
-                            let x = c[k] as isize + off[k];
-                            let d = dims[k] as isize;
-                            nc[k] = x.rem_euclid(d) as usize;
-                            shift[k] = x.div_euclid(d) as f64;
-                        }
-                        let shift = self.edges * shift - pi;
-                        let cell = index(nc);
-                        for &j in &order[starts[cell] as usize..starts[cell + 1] as usize] {
-                            let j = j as usize;
-                            if j != i {
-                                self.add(&mut h, i, j, cart[j] + shift);
-                            }
-                        }
+        self.sum_over_atoms(|h, i| {
+            let c = cell_of(self.frac[i]);
+            let pi = cart[i];
+            for o in 0..125 {
+                let off = [o / 25, (o / 5) % 5, o % 5].map(|x| x as isize - 2);
+                let mut shift = DVec3::ZERO;
+                let mut nc = [0usize; 3];
+                for k in 0..3 {
+                    let x = c[k] as isize + off[k];
+                    let d = dims[k] as isize;
+                    nc[k] = x.rem_euclid(d) as usize;
+                    shift[k] = x.div_euclid(d) as f64;
+                }
+                let shift = self.edges * shift - pi;
+                let cell = index(nc);
+                for &j in &order[starts[cell] as usize..starts[cell + 1] as usize] {
+                    let j = j as usize;
+                    if j != i {
+                        self.add(h, i, j, cart[j] + shift);
                     }
-                    h
-                },
-            )
-            .reduce(
-                || vec![0u64; size],
-                |mut a, b| {
-                    a.iter_mut().zip(b).for_each(|(x, y)| *x += y);
-                    a
-                },
-            )
+                }
+            }
+        })
     }
 
     /// Every ordered pair tested, at its nearest image (a cell under three cutoffs wide).
     fn all_pairs(&self) -> Vec<u64> {
         let n = self.frac.len();
-        let size = self.bins * self.slots;
         let round = |d: DVec3| d - d.round();
-        (0..n)
+        self.sum_over_atoms(|h, i| {
+            for j in (0..n).filter(|&j| j != i) {
+                let d = round(self.frac[j] - self.frac[i]);
+                self.add(h, i, j, self.edges * d);
+            }
+        })
+    }
+
+    /// The histograms of `count(h, i)` run for every atom `i`, in parallel: integer sums, the
+    /// same for any split of the atoms.
+    fn sum_over_atoms(&self, count: impl Fn(&mut [u64], usize) + Sync) -> Vec<u64> {
+        let size = self.bins * self.slots;
+        (0..self.frac.len())
             .into_par_iter()
             .fold(
                 || vec![0u64; size],
                 |mut h, i| {
-                    for j in 0..n {
-                        if j != i {
-                            let d = round(self.frac[j] - self.frac[i]);
-                            self.add(&mut h, i, j, self.edges * d);
-                        }
-                    }
+                    count(&mut h, i);
                     h
                 },
             )
