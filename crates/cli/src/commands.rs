@@ -1045,8 +1045,9 @@ fn render(a: &RenderArgs) -> Result<()> {
     }
     for (k, &f) in frames.iter().enumerate() {
         // A part renders its own frames; the first frame of the whole render is read by every
-        // part, for the camera, and with trails every frame before its own, for their paths.
-        let trail = plan.draws_trails() && k < mine.start;
+        // part, for the camera, and with trails or squared displacements every frame before its
+        // own, for their paths (followed frame by frame across the cell's faces).
+        let trail = (plan.draws_trails() || plan.tracks_msd()) && k < mine.start;
         if !mine.contains(&k) && camera.is_some() && !trail {
             continue;
         }

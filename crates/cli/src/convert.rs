@@ -226,8 +226,13 @@ pub fn convert(a: &ConvertArgs) -> Result<()> {
             match first_atoms {
                 None => first_atoms = Some(count),
                 Some(first) if fixed_atoms && count != first => {
+                    let what = if select.is_some() {
+                        format!("--select picks {count} atoms here")
+                    } else {
+                        format!("this frame has {count} atoms")
+                    };
                     return Err(at(anyhow::anyhow!(
-                        "--select picks {count} atoms here and {first} in the first frame written; a {} file holds the same atoms in every frame: write .xyz or .lammpstrj, whose frames may differ, or select by something that does not change",
+                        "{what} and {first} in the first frame written; a {} file holds the same atoms in every frame: write .xyz or .lammpstrj, whose frames may differ, or select by something that does not change",
                         format.map_or("", |f| f.name())
                     )));
                 }

@@ -89,3 +89,48 @@ fn parts_write_the_frames_of_one_render_byte_for_byte() {
         .unwrap();
     assert_eq!(o.status.code(), Some(2));
 }
+
+/// Squared displacements are followed frame by frame across the cell's faces: a part reads
+/// every frame before its own, so `--color-by msd` colours its frames as one render does
+/// (random walks wrapped into an 18 Å box, md-io's dynamics fixture).
+#[test]
+fn parts_follow_squared_displacements_from_the_first_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |out: &Path, shard: Option<&str>| {
+        std::fs::create_dir_all(out).unwrap();
+        let mut c = Command::new(env!("CARGO_BIN_EXE_texmap"));
+        c.args([
+            "render",
+            &data("dynamics/walk.dcd"),
+            "--topology",
+            &data("dynamics/walk.gro"),
+            "--color-by",
+            "msd",
+            "--color-range",
+            "0:60",
+            "--frames",
+            "0:40:3",
+            "--size",
+            "80x60",
+            "-q",
+            "-o",
+        ])
+        .arg(out.join("f%04d.png"))
+        .env_remove("SLURM_ARRAY_TASK_ID")
+        .env_remove("SLURM_ARRAY_TASK_COUNT");
+        if let Some(s) = shard {
+            c.args(["--shard", s]);
+        }
+        let o = c.output().unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    };
+    let whole = dir.path().join("whole");
+    run(&whole, None);
+    let parts = dir.path().join("parts");
+    for i in ["0/3", "1/3", "2/3"] {
+        run(&parts, Some(i));
+    }
+    let want = files(&whole);
+    assert_eq!(want.len(), 14);
+    assert_eq!(files(&parts), want);
+}

@@ -1608,6 +1608,12 @@ impl MolPlan {
         &self.measured
     }
 
+    /// Whether every frame's squared displacements are followed ([`MolOptions::msd`]): each
+    /// frame must then be built after the one before it.
+    pub fn tracks_msd(&self) -> bool {
+        self.options.msd
+    }
+
     /// Whether some representation draws trails ([`DrawStyle::Trails`]).
     pub fn draws_trails(&self) -> bool {
         self.reps.iter().any(|r| r.draw == DrawStyle::Trails)
