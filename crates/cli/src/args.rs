@@ -287,21 +287,44 @@ pub enum ColormapArg {
     Gray,
 }
 
-/// Parses `--color-range LO:HI` (finite, LO < HI).
-pub fn parse_color_range(s: &str) -> Result<(f32, f32), String> {
+/// Parses `LO:HI` of two finite numbers with LO < HI, the names and example `form` gives
+/// (`"LO:HI", "0:80"`); `low` is the least value allowed.
+fn parse_interval(s: &str, form: (&str, &str), low: f64) -> Result<(f64, f64), String> {
+    let (names, example) = form;
     let (lo, hi) = s
         .split_once(':')
-        .ok_or_else(|| format!("{s:?}: expected LO:HI, e.g. 0:80"))?;
+        .ok_or_else(|| format!("{s:?}: expected {names}, e.g. {example}"))?;
     let num = |t: &str| {
         t.trim()
-            .parse::<f32>()
+            .parse::<f64>()
             .ok()
-            .filter(|v| v.is_finite())
-            .ok_or_else(|| format!("{t:?} is not a finite number"))
+            .filter(|v| v.is_finite() && *v >= low)
+            .ok_or_else(|| match low {
+                f64::NEG_INFINITY => format!("{t:?} is not a finite number"),
+                _ => format!("{t:?} is not a finite number of at least {low}"),
+            })
     };
     let (lo, hi) = (num(lo)?, num(hi)?);
     if lo >= hi {
-        return Err(format!("{s}: LO must be below HI"));
+        let (a, b) = names.split_once(':').unwrap_or((names, names));
+        return Err(format!("{s}: {a} must be below {b}"));
+    }
+    Ok((lo, hi))
+}
+
+/// Parses `--msd-fit FROM:TO` (finite, 0 ≤ FROM < TO).
+pub fn parse_fit_range(s: &str) -> Result<(f64, f64), String> {
+    parse_interval(s, ("FROM:TO", "10:90"), 0.0)
+}
+
+/// Parses `--color-range LO:HI` (finite, LO < HI).
+pub fn parse_color_range(s: &str) -> Result<(f32, f32), String> {
+    let (lo, hi) = parse_interval(s, ("LO:HI", "0:80"), f64::NEG_INFINITY)?;
+    let (lo, hi) = (lo as f32, hi as f32);
+    if !lo.is_finite() || !hi.is_finite() || lo >= hi {
+        return Err(format!(
+            "{s}: LO and HI must be finite and apart in single precision"
+        ));
     }
     Ok((lo, hi))
 }
@@ -1246,6 +1269,24 @@ pub struct AnalysisArgs {
     /// over 6 at long times. Turns on --msd. Written whole or not at all.
     #[arg(long, value_name = "FILE.csv")]
     pub msd_table: Option<PathBuf>,
+    /// Also write the mean squared displacement against lag time, averaged over every time
+    /// origin (MDAnalysis's EinsteinMSD, the curve a diffusion coefficient is read from), as a
+    /// CSV table: lag (frames), time (ps, when the frames' times are evenly spaced), msd (Å²,
+    /// over every atom), then one column per kind of atom (msd_O, msd_Na). Prints each
+    /// column's diffusion coefficient, the slope over 6 fitted over --msd-fit, in 10⁻⁵ cm²/s
+    /// as gmx msd does. Keeps every frame's unwrapped positions (12 bytes per atom per frame,
+    /// up to --msd-memory). Turns on --msd. Written whole or not at all; not with --shard.
+    #[arg(long, value_name = "FILE.csv")]
+    pub msd_lags: Option<PathBuf>,
+    /// The lag times the diffusion coefficient is fitted over, FROM:TO in ps (in frames when the
+    /// frames carry no times); by default 10 % to 90 % of the longest lag, as gmx msd's
+    /// -beginfit and -endfit.
+    #[arg(long, value_name = "FROM:TO", requires = "msd_lags", value_parser = parse_fit_range)]
+    pub msd_fit: Option<(f64, f64)>,
+    /// The most memory --msd-lags may keep positions in, in MB: 12 bytes per atom per frame
+    /// (1,000 frames of 100,000 atoms take 1,145 MB).
+    #[arg(long, value_name = "MB", default_value_t = 4096)]
+    pub msd_memory: usize,
     /// Also write --align's fit as a CSV table, one row per frame: frame, time (ps, when the
     /// file has it), rmsd (Å: the aligned atoms' RMSD from the reference after the fit, mass
     /// weighted with --align-mass), as MDAnalysis's rms.RMSD. Written whole or not at all.

@@ -534,6 +534,122 @@ pub(crate) struct AnalysisTables {
     msd: Option<(crate::output::AtomicFile, Vec<texmap_md_io::Label>)>,
     rmsd: Option<crate::output::AtomicFile>,
     cluster: Option<crate::output::AtomicFile>,
+    msd_lags: Option<MsdLags>,
+}
+
+/// `--msd-lags`: every frame's unwrapped positions, averaged over every time origin at the end.
+struct MsdLags {
+    file: crate::output::AtomicFile,
+    all: texmap_md_io::msd::AllOrigins,
+    /// Each kept frame's time (ps), if it has one.
+    times: Vec<Option<f64>>,
+    /// The kinds of the columns, sorted by name, and each atom's (set at the first frame).
+    kinds: Vec<texmap_md_io::Label>,
+    kind: Vec<usize>,
+    fit: Option<(f64, f64)>,
+}
+
+impl MsdLags {
+    fn add(&mut self, f: usize, unwrapped: &[[f64; 3]], md: &MdFrame) -> Result<()> {
+        if self.all.frames() == 0 {
+            let of: Vec<texmap_md_io::Label> = (0..md.n_atoms())
+                .map(|i| texmap_md_io::rdf::atom_kind(md, i))
+                .collect();
+            let mut seen = of.clone();
+            seen.sort_by(|a, b| a.as_str().cmp(b.as_str()));
+            seen.dedup();
+            self.kind = of
+                .iter()
+                .map(|k| seen.iter().position(|s| s == k).unwrap_or(0))
+                .collect();
+            self.kinds = seen;
+        }
+        if unwrapped.len() != self.kind.len() {
+            bail!(
+                "--msd-lags: frame {f} has {} atoms and the first {}: displacements follow the same atoms",
+                unwrapped.len(),
+                self.kind.len()
+            );
+        }
+        self.all
+            .push(unwrapped)
+            .map_err(|e| anyhow::anyhow!("--msd-lags: frame {f}: {e}"))?;
+        self.times.push(md.time);
+        Ok(())
+    }
+
+    /// The lag times (ps) when every frame has a time and they are evenly spaced.
+    fn lag_times(&self) -> Option<Vec<f64>> {
+        let times: Vec<f64> = self.times.iter().copied().collect::<Option<_>>()?;
+        let t = times.len();
+        if t < 2 {
+            return None;
+        }
+        let dt = (times[t - 1] - times[0]) / (t - 1) as f64;
+        let even = dt > 0.0
+            && times
+                .iter()
+                .enumerate()
+                .all(|(k, x)| (x - times[0] - k as f64 * dt).abs() <= 1e-3 * dt + 1e-6 * x.abs());
+        even.then(|| (0..t).map(|m| m as f64 * dt).collect())
+    }
+
+    /// The table written, each column's diffusion coefficient printed.
+    fn finish(mut self) -> Result<crate::output::AtomicFile> {
+        let lags = self
+            .all
+            .mean(&self.kind, self.kinds.len())
+            .map_err(|e| anyhow::anyhow!("--msd-lags: {e}"))?;
+        let times = self.lag_times();
+        let mut text = String::from("lag,time,msd");
+        for k in &self.kinds {
+            text.push_str(&format!(",msd_{k}"));
+        }
+        text.push('\n');
+        for m in 0..lags.total.len() {
+            let time = times
+                .as_ref()
+                .map(|t| crate::scene::compact(t[m], 6))
+                .unwrap_or_default();
+            text.push_str(&format!("{m},{time},{:.6}", lags.total[m]));
+            for column in &lags.kinds {
+                text.push_str(&format!(",{:.6}", column[m]));
+            }
+            text.push('\n');
+        }
+        self.file.write(&text)?;
+        let (x, unit): (Vec<f64>, &str) = match &times {
+            Some(t) => (t.clone(), "ps"),
+            None => ((0..lags.total.len()).map(|m| m as f64).collect(), "frames"),
+        };
+        let longest = x.last().copied().unwrap_or(0.0);
+        let (from, to) = self.fit.unwrap_or((0.1 * longest, 0.9 * longest));
+        let span = format!(
+            "{}–{}",
+            crate::scene::compact(from, 4),
+            crate::scene::compact(to, 4)
+        );
+        let names = std::iter::once("every atom".to_string())
+            .chain(self.kinds.iter().map(|k| format!("the {k} atoms")));
+        for (name, msd) in names.zip(std::iter::once(&lags.total).chain(&lags.kinds)) {
+            match texmap_md_io::msd::fit_diffusion(&x, msd, from, to) {
+                // Å²/ps over 6 is 10⁻⁴ cm²/s.
+                Some(fit) if times.is_some() => eprintln!(
+                    "texmap: --msd-lags: D = {:.4} × 10⁻⁵ cm²/s for {name} (MSD = 6 D t fitted over {span} ps, {} lags)",
+                    fit.d * 10.0,
+                    fit.points
+                ),
+                Some(fit) => eprintln!(
+                    "texmap: --msd-lags: D = {:.6} Å² per frame for {name} (the frames carry no evenly spaced times; MSD = 6 D t fitted over lags {span} {unit}, {} lags)",
+                    fit.d, fit.points
+                ),
+                None => eprintln!(
+                    "texmap: warning: --msd-lags: fewer than two lags in {span} {unit} to fit a diffusion coefficient for {name} (--msd-fit)"
+                ),
+            }
+        }
+        Ok(self.file)
+    }
 }
 
 /// `--rdf-table`: the frames' g(r) summed, to be written as their mean.
@@ -623,6 +739,24 @@ impl AnalysisTables {
                 "frame,cluster,atoms,x,y,z,rg",
                 whole,
             )?,
+            msd_lags: match &analysis.msd_lags {
+                None => None,
+                Some(_) if !whole => {
+                    return usage(
+                        "--msd-lags with --shard (or a Slurm array): the average over every time origin needs every frame in one run; write it in a run of its own",
+                    );
+                }
+                Some(p) => Some(MsdLags {
+                    file: crate::output::AtomicFile::create(p)?,
+                    all: texmap_md_io::msd::AllOrigins::new(
+                        analysis.msd_memory.saturating_mul(1 << 20),
+                    ),
+                    times: Vec::new(),
+                    kinds: Vec::new(),
+                    kind: Vec::new(),
+                    fit: analysis.msd_fit,
+                }),
+            },
             rdf: match &analysis.rdf_table {
                 None => None,
                 Some(_) if !whole => {
@@ -733,6 +867,11 @@ impl AnalysisTables {
         {
             mean.add(f, g)?;
         }
+        if let Some(lags) = &mut self.msd_lags
+            && let Some(unwrapped) = plan.last_unwrapped()
+        {
+            lags.add(f, unwrapped, md)?;
+        }
         Ok(())
     }
 
@@ -742,7 +881,9 @@ impl AnalysisTables {
             .rdf
             .map(|(mut t, mean)| t.write(&mean.csv()).map(|()| t));
         let msd = self.msd.map(|(t, _)| t);
+        let msd_lags = self.msd_lags.map(MsdLags::finish).transpose()?;
         for t in [
+            msd_lags,
             self.defect,
             self.grain,
             self.rmsd,

@@ -662,7 +662,10 @@ pub fn mol_plan(args: &MolArgs, style: &StyleArgs, topology: Option<Topology>) -
             .into_iter()
             .any(scalar_is),
         grains: grains.then(|| grain_options(args)),
-        msd: args.analysis.msd || args.analysis.msd_table.is_some() || scalar_is("msd"),
+        msd: args.analysis.msd
+            || args.analysis.msd_table.is_some()
+            || args.analysis.msd_lags.is_some()
+            || scalar_is("msd"),
         rdf: args.analysis.rdf.map(|cutoff| texmap_md_scene::RdfOptions {
             cutoff,
             bins: args.analysis.rdf_bins,

@@ -574,6 +574,107 @@ fn msd_and_rmsd_tables_are_mdanalysis() {
     }
 }
 
+/// `--msd-lags`: the mean squared displacement over every time origin of the same random
+/// walks equals MDAnalysis's EinsteinMSD (the direct sum, fft=False) per lag, for all atoms
+/// and per kind, and the diffusion coefficients printed equal a least-squares line through
+/// MDAnalysis's curve over the same window (and the walk's own: 0.7² Å² per axis per ps, so
+/// 6 D = 1.47 Å²/ps). A narrower --msd-fit fits fewer lags; too little memory, or --shard,
+/// is refused and leaves no file.
+#[test]
+fn msd_over_every_origin_is_mdanalysis_einstein_msd() {
+    let dir = tempfile::tempdir().unwrap();
+    let lags = dir.path().join("lags.csv");
+    let walk = [
+        "convert",
+        &md_data("dynamics/walk.dcd"),
+        "--topology",
+        &md_data("dynamics/walk.gro"),
+        "--msd-lags",
+        lags.to_str().unwrap(),
+    ];
+    let o = texmap(&walk);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (header, rows) = table(&lags);
+    assert_eq!(header, "lag,time,msd,msd_Na,msd_O");
+    let reference = json("dynamics/msd_lags_reference.json");
+    let time = numbers(&reference["time"]);
+    assert_eq!(rows.len(), time.len());
+    for (col, name) in [(2, "msd"), (3, "msd_NA"), (4, "msd_OW")] {
+        let want = numbers(&reference[name]);
+        for (m, (row, want)) in rows.iter().zip(&want).enumerate() {
+            assert_eq!(row[0], m as f64);
+            assert!((row[1] - time[m]).abs() < 1e-5, "lag {m}: time {}", row[1]);
+            assert!(
+                (row[col] - want).abs() <= 1e-5 * want.max(1.0),
+                "lag {m} {name}: {} vs MDAnalysis {want}",
+                row[col]
+            );
+        }
+    }
+    // Printed as "D = 2.4526 × 10⁻⁵ cm²/s for every atom (… 32 lags)", then per kind.
+    let printed: Vec<(f64, String)> = stderr(&o)
+        .lines()
+        .filter_map(|l| {
+            let rest = l.split_once("D = ")?.1;
+            let (d, rest) = rest.split_once(' ')?;
+            let lags = rest.rsplit_once(", ")?.1;
+            Some((d.parse().ok()?, lags.to_string()))
+        })
+        .collect();
+    assert_eq!(printed.len(), 3, "{}", stderr(&o));
+    for ((d, lags), name) in printed.iter().zip(["D_msd", "D_msd_Na", "D_msd_OW"]) {
+        let name = name.replace("Na", "NA");
+        let want = reference[name.as_str()].as_f64().unwrap();
+        assert!((d - want).abs() < 1e-3, "{name}: {d} vs {want}");
+        assert_eq!(lags, "32 lags)");
+    }
+    assert!((printed[0].0 - 1.47 / 6.0 * 10.0).abs() < 0.1 * 2.45);
+
+    let mut narrow = walk.to_vec();
+    narrow.extend(["--msd-fit", "5:10"]);
+    let o = texmap(&narrow);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("over 5–10 ps, 6 lags)"),
+        "{}",
+        stderr(&o)
+    );
+
+    // texmap render writes the same table beside its frames.
+    let rendered = dir.path().join("rendered.csv");
+    let frames = dir.path().join("f%04d.png");
+    let render = |extra: &[&str]| {
+        let mut args = vec!["render", walk[1], walk[2], walk[3], "--size", "64x48"];
+        args.extend(["--msd-lags", rendered.to_str().unwrap()]);
+        args.extend(["-o", frames.to_str().unwrap(), "-q"]);
+        args.extend(extra);
+        texmap(&args)
+    };
+    let o = render(&[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(
+        std::fs::read(&rendered).unwrap(),
+        std::fs::read(&lags).unwrap()
+    );
+    std::fs::remove_file(&rendered).unwrap();
+    let o = render(&["--shard", "1/2"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(!rendered.exists());
+
+    std::fs::remove_file(&lags).unwrap();
+    for (extra, code) in [
+        (&["--msd-memory", "0"][..], 1),
+        (&["--msd-fit", "10:5"][..], 2),
+        (&["--msd-fit", "-1:5"][..], 2),
+    ] {
+        let mut args = walk.to_vec();
+        args.extend(extra);
+        let o = texmap(&args);
+        assert_eq!(o.status.code(), Some(code), "{extra:?}: {}", stderr(&o));
+        assert!(!lags.exists(), "{extra:?} left {}", lags.display());
+    }
+}
+
 /// `--cluster-table`: the copper clusters in iron (md-io's cluster fixture, written by OVITO)
 /// have OVITO's sizes, largest first, frame by frame; the precipitate (every site within 6 Å
 /// of (12, 13, 14)) is centred there, with about a solid sphere's radius of gyration

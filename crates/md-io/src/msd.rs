@@ -10,6 +10,10 @@
 //! Unwrapped trajectories (LAMMPS `xu yu zu`) and frames without a cell are followed as they
 //! are.
 //!
+//! [`AllOrigins`] keeps the unwrapped frames and gives the displacement averaged over every
+//! time origin against lag time (MDAnalysis's `EinsteinMSD`), and [`fit_diffusion`] the
+//! diffusion coefficient from its slope.
+//!
 //! ```
 //! use texmap_md_io::msd::Tracker;
 //! use texmap_md_io::{Frame, UnitCell};
@@ -42,6 +46,22 @@ pub enum MsdError {
     },
     /// An atom's position is not finite.
     NotFinite(usize),
+    /// [`AllOrigins`] would keep more than its memory limit.
+    Memory {
+        /// Atoms per frame.
+        atoms: usize,
+        /// Frames kept so far, this one included.
+        frames: usize,
+        /// The limit in bytes.
+        limit: usize,
+    },
+    /// [`AllOrigins::mean`] was given a kind for another number of atoms than the frames'.
+    KindCount {
+        /// The frames' atoms.
+        atoms: usize,
+        /// The kinds given.
+        kinds: usize,
+    },
 }
 
 impl fmt::Display for MsdError {
@@ -52,6 +72,20 @@ impl fmt::Display for MsdError {
                 "this frame has {frame} atoms and the first {first}: displacements follow the same atoms"
             ),
             MsdError::NotFinite(i) => write!(f, "atom {i} has no finite position"),
+            MsdError::Memory {
+                atoms,
+                frames,
+                limit,
+            } => write!(
+                f,
+                "{frames} frames of {atoms} atoms need {} MB for the displacements over every time origin, over the limit of {} MB: take fewer frames (a --frames step) or raise the limit",
+                (frames * atoms * STORED_BYTES).div_ceil(1 << 20),
+                limit >> 20
+            ),
+            MsdError::KindCount { atoms, kinds } => write!(
+                f,
+                "{kinds} kinds given for frames of {atoms} atoms: one kind per atom"
+            ),
         }
     }
 }
@@ -75,6 +109,12 @@ impl Tracker {
     /// A tracker that has seen no frame.
     pub fn new() -> Tracker {
         Tracker::default()
+    }
+
+    /// Each atom's position unwrapped by continuity, as of the last frame given (empty before
+    /// the first).
+    pub fn unwrapped(&self) -> &[[f64; 3]] {
+        &self.unwrapped
     }
 
     /// Follows the atoms to `frame` and returns each atom's squared displacement (Å²) from
@@ -120,5 +160,481 @@ impl Tracker {
             .zip(&self.origin)
             .map(|(u, o)| (0..3).map(|k| (u[k] - o[k]).powi(2)).sum())
             .collect())
+    }
+}
+
+/// Bytes [`AllOrigins`] keeps per atom per frame: the displacement from the atom's first
+/// position as three `f32`.
+pub const STORED_BYTES: usize = 12;
+
+/// The mean squared displacement against lag time, averaged over every time origin: for a lag
+/// of m frames, the mean over all atoms and all origins k of |r(k + m) − r(k)|², as
+/// MDAnalysis's `EinsteinMSD` gives it (the windowed MSD; GROMACS's `gmx msd` takes an origin
+/// every `-trestart` instead). Averaging over origins is what makes a diffusion coefficient
+/// from one trajectory usable: the single-origin curve of [`Tracker`] is one noisy sample.
+///
+/// Frames are given as unwrapped positions ([`Tracker::unwrapped`]) and kept as `f32`
+/// displacements from each atom's first position ([`STORED_BYTES`] per atom per frame, up to
+/// the limit given to [`AllOrigins::new`]); [`AllOrigins::mean`] then needs O(T log T) per atom
+/// for T frames: each coordinate's autocorrelation by FFT (two series to one complex
+/// transform, the power spectra of a kind summed before one inverse transform), the squared
+/// terms by prefix sums (the algorithm of Kneller et al., nMoldyn). The atoms are split into
+/// fixed blocks summed in order, so the result does not depend on the thread count.
+///
+/// ```
+/// use texmap_md_io::msd::AllOrigins;
+/// // One atom moving 1 Å per frame along x: every lag m has squared displacement m².
+/// let mut all = AllOrigins::new(1 << 20);
+/// for f in 0..5 {
+///     all.push(&[[f as f64, 0.0, 0.0]]).unwrap();
+/// }
+/// let lags = all.mean(&[0], 1).unwrap();
+/// for (m, v) in lags.total.iter().enumerate() {
+///     assert!((v - (m * m) as f64).abs() < 1e-9);
+/// }
+/// ```
+#[derive(Clone, Debug)]
+pub struct AllOrigins {
+    atoms: usize,
+    first: Vec<[f64; 3]>,
+    /// Frame-major: frame f's atom i at `f * atoms + i`, less the atom's first position.
+    steps: Vec<[f32; 3]>,
+    frames: usize,
+    limit: usize,
+}
+
+/// [`AllOrigins::mean`]'s result: per lag 0, 1, … T − 1 frames.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LagMsd {
+    /// Over every atom (Å²).
+    pub total: Vec<f64>,
+    /// Over the atoms of each kind (NaN for a kind without atoms).
+    pub kinds: Vec<Vec<f64>>,
+}
+
+/// Atoms per block whose series one task transforms in turn (their frames stay in cache).
+const BLOCK: usize = 32;
+/// Atoms per parallel task: fixed, so the sums' order does not depend on the threads.
+const TASK: usize = 1024;
+
+impl AllOrigins {
+    /// Keeps no frame yet; [`AllOrigins::push`] refuses a frame that would take the kept
+    /// displacements over `limit` bytes.
+    pub fn new(limit: usize) -> AllOrigins {
+        AllOrigins {
+            atoms: 0,
+            first: Vec::new(),
+            steps: Vec::new(),
+            frames: 0,
+            limit,
+        }
+    }
+
+    /// Frames kept.
+    pub fn frames(&self) -> usize {
+        self.frames
+    }
+
+    /// Keeps a frame's unwrapped positions (Å): every frame has the first's atoms in the
+    /// same order.
+    pub fn push(&mut self, unwrapped: &[[f64; 3]]) -> Result<(), MsdError> {
+        if let Some(i) = unwrapped
+            .iter()
+            .position(|p| p.iter().any(|x| !x.is_finite()))
+        {
+            return Err(MsdError::NotFinite(i));
+        }
+        if self.frames == 0 {
+            self.atoms = unwrapped.len();
+            self.first = unwrapped.to_vec();
+        } else if unwrapped.len() != self.atoms {
+            return Err(MsdError::AtomCount {
+                first: self.atoms,
+                frame: unwrapped.len(),
+            });
+        }
+        let bytes = (self.frames + 1).saturating_mul(self.atoms.saturating_mul(STORED_BYTES));
+        if bytes > self.limit {
+            return Err(MsdError::Memory {
+                atoms: self.atoms,
+                frames: self.frames + 1,
+                limit: self.limit,
+            });
+        }
+        self.steps.extend(
+            unwrapped
+                .iter()
+                .zip(&self.first)
+                .map(|(p, o)| std::array::from_fn(|k| (p[k] - o[k]) as f32)),
+        );
+        self.frames += 1;
+        Ok(())
+    }
+
+    /// The mean squared displacement per lag over every atom and over each of `kinds` kinds,
+    /// `kind[i]` (below `kinds`) naming atom i's.
+    pub fn mean(&self, kind: &[usize], kinds: usize) -> Result<LagMsd, MsdError> {
+        use rayon::prelude::*;
+        if kind.len() != self.atoms || kind.iter().any(|&k| k >= kinds) {
+            return Err(MsdError::KindCount {
+                atoms: self.atoms,
+                kinds: kind.len(),
+            });
+        }
+        let t = self.frames;
+        if t == 0 {
+            return Ok(LagMsd {
+                total: Vec::new(),
+                kinds: vec![Vec::new(); kinds],
+            });
+        }
+        // Zero padding to at least 2T keeps the circular correlation from wrapping.
+        let n = (2 * t).next_power_of_two();
+        let forward = rustfft::FftPlanner::<f64>::new().plan_fft_forward(n);
+        let parts: Vec<Sums> = (0..self.atoms.div_ceil(TASK))
+            .into_par_iter()
+            .map(|task| {
+                let atoms = task * TASK..((task + 1) * TASK).min(self.atoms);
+                self.sums(atoms, kind, kinds, n, forward.as_ref())
+            })
+            .collect();
+        let mut total = Sums::new(kinds, n, t);
+        for part in &parts {
+            total.add(part);
+        }
+        let inverse = rustfft::FftPlanner::<f64>::new().plan_fft_inverse(n);
+        let mut counts = vec![0usize; kinds];
+        for &k in kind {
+            counts[k] += 1;
+        }
+        // Per kind and lag: Σ over the kind's series and origins of the squared displacement.
+        let numerators: Vec<Vec<f64>> = (0..kinds)
+            .map(|g| {
+                let power = &total.power[g];
+                let mut buffer: Vec<rustfft::num_complex::Complex<f64>> = (0..n)
+                    .map(|k| {
+                        // The two series packed in one transform: |Z_k|² + |Z_{n−k}|² over 2
+                        // is the sum of their power spectra.
+                        let p = 0.5 * (power[k] + power[(n - k) % n]);
+                        rustfft::num_complex::Complex::new(p, 0.0)
+                    })
+                    .collect();
+                inverse.process(&mut buffer);
+                let squares = &total.squares[g];
+                let mut prefix = vec![0.0f64; t + 1];
+                for (f, s) in squares.iter().enumerate() {
+                    prefix[f + 1] = prefix[f] + s;
+                }
+                (0..t)
+                    .map(|m| {
+                        let correlation = buffer[m].re / n as f64;
+                        let value = prefix[t - m] + (prefix[t] - prefix[m]) - 2.0 * correlation;
+                        value.max(0.0)
+                    })
+                    .collect()
+            })
+            .collect();
+        let per = |sum: &dyn Fn(usize) -> f64, atoms: usize| -> Vec<f64> {
+            (0..t)
+                .map(|m| {
+                    if atoms == 0 {
+                        f64::NAN
+                    } else {
+                        sum(m) / ((t - m) * atoms) as f64
+                    }
+                })
+                .collect()
+        };
+        Ok(LagMsd {
+            total: per(&|m| numerators.iter().map(|g| g[m]).sum(), self.atoms),
+            kinds: (0..kinds)
+                .map(|g| per(&|m| numerators[g][m], counts[g]))
+                .collect(),
+        })
+    }
+
+    /// The power spectra and squared values of `atoms`' coordinate series, summed per kind.
+    fn sums(
+        &self,
+        atoms: std::ops::Range<usize>,
+        kind: &[usize],
+        kinds: usize,
+        n: usize,
+        forward: &dyn rustfft::Fft<f64>,
+    ) -> Sums {
+        use rustfft::num_complex::Complex;
+        let t = self.frames;
+        let mut sums = Sums::new(kinds, n, t);
+        let mut buffer = vec![Complex::new(0.0, 0.0); n];
+        let mut scratch = vec![Complex::new(0.0, 0.0); forward.get_inplace_scratch_len()];
+        let mut series = [vec![0.0f64; t], vec![0.0f64; t]];
+        let mut block = atoms.start;
+        while block < atoms.end {
+            let end = (block + BLOCK).min(atoms.end);
+            for g in 0..kinds {
+                let mut pending = (block..end)
+                    .filter(|&i| kind[i] == g)
+                    .flat_map(|i| (0..3).map(move |axis| (i, axis)))
+                    .peekable();
+                while let Some(a) = pending.next() {
+                    let b = pending.next();
+                    for (slot, which) in [Some(a), b].into_iter().enumerate() {
+                        let out = &mut series[slot];
+                        match which {
+                            Some((i, axis)) => {
+                                for (f, x) in out.iter_mut().enumerate() {
+                                    *x = f64::from(self.steps[f * self.atoms + i][axis]);
+                                }
+                                // Centred: the displacements do not change, the FFT's
+                                // rounding shrinks with the values.
+                                let mean = out.iter().sum::<f64>() / t as f64;
+                                out.iter_mut().for_each(|x| *x -= mean);
+                            }
+                            None => out.fill(0.0),
+                        }
+                    }
+                    for (f, z) in buffer.iter_mut().enumerate() {
+                        *z = if f < t {
+                            Complex::new(series[0][f], series[1][f])
+                        } else {
+                            Complex::new(0.0, 0.0)
+                        };
+                    }
+                    forward.process_with_scratch(&mut buffer, &mut scratch);
+                    for (p, z) in sums.power[g].iter_mut().zip(&buffer) {
+                        *p += z.norm_sqr();
+                    }
+                    for (s, (x, y)) in sums.squares[g]
+                        .iter_mut()
+                        .zip(series[0].iter().zip(&series[1]))
+                    {
+                        *s += x * x + y * y;
+                    }
+                }
+            }
+            block = end;
+        }
+        sums
+    }
+}
+
+/// Per kind: the summed power spectra of its series (`n` bins) and their squared values per
+/// frame.
+struct Sums {
+    power: Vec<Vec<f64>>,
+    squares: Vec<Vec<f64>>,
+}
+
+impl Sums {
+    fn new(kinds: usize, n: usize, t: usize) -> Sums {
+        Sums {
+            power: vec![vec![0.0; n]; kinds],
+            squares: vec![vec![0.0; t]; kinds],
+        }
+    }
+
+    fn add(&mut self, other: &Sums) {
+        for (a, b) in self.power.iter_mut().zip(&other.power) {
+            a.iter_mut().zip(b).for_each(|(a, b)| *a += b);
+        }
+        for (a, b) in self.squares.iter_mut().zip(&other.squares) {
+            a.iter_mut().zip(b).for_each(|(a, b)| *a += b);
+        }
+    }
+}
+
+/// A diffusion coefficient from the slope of the mean squared displacement against time
+/// (Einstein: MSD = 6 D t in three dimensions), fitted by least squares.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Diffusion {
+    /// D in the units of the MSD per unit of time over 6 (Å²/ps gives 10⁻⁴ cm²/s).
+    pub d: f64,
+    /// The fitted line's slope and intercept.
+    pub slope: f64,
+    /// The line's value at time 0.
+    pub intercept: f64,
+    /// Points fitted.
+    pub points: usize,
+}
+
+/// Fits MSD = slope · t + intercept to the points with `from ≤ t ≤ to` and a finite MSD, as
+/// `gmx msd` does between `-beginfit` and `-endfit`; `None` with fewer than two distinct times.
+/// A time within a millionth of the range of either end counts as inside: times read from
+/// single-precision files land a rounding away from the whole values users name.
+pub fn fit_diffusion(time: &[f64], msd: &[f64], from: f64, to: f64) -> Option<Diffusion> {
+    let slack = 1e-6 * from.abs().max(to.abs());
+    let points: Vec<(f64, f64)> = time
+        .iter()
+        .zip(msd)
+        .filter(|(t, m)| **t >= from - slack && **t <= to + slack && m.is_finite())
+        .map(|(t, m)| (*t, *m))
+        .collect();
+    let count = points.len() as f64;
+    if points.len() < 2 {
+        return None;
+    }
+    let mean_t = points.iter().map(|p| p.0).sum::<f64>() / count;
+    let mean_m = points.iter().map(|p| p.1).sum::<f64>() / count;
+    let stt: f64 = points.iter().map(|p| (p.0 - mean_t).powi(2)).sum();
+    if stt <= 0.0 {
+        return None;
+    }
+    let stm: f64 = points.iter().map(|p| (p.0 - mean_t) * (p.1 - mean_m)).sum();
+    let slope = stm / stt;
+    Some(Diffusion {
+        d: slope / 6.0,
+        slope,
+        intercept: mean_m - slope * mean_t,
+        points: points.len(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The definition, every origin and lag summed directly: O(T² N).
+    fn direct(frames: &[Vec<[f64; 3]>], kind: &[usize], kinds: usize) -> LagMsd {
+        let t = frames.len();
+        let atoms = kind.len();
+        let mut sums = vec![vec![0.0f64; t]; kinds];
+        for m in 0..t {
+            for k in 0..t - m {
+                for i in 0..atoms {
+                    let d: f64 = (0..3)
+                        .map(|a| (frames[k + m][i][a] - frames[k][i][a]).powi(2))
+                        .sum();
+                    sums[kind[i]][m] += d;
+                }
+            }
+        }
+        let count = |g: usize| kind.iter().filter(|&&k| k == g).count();
+        LagMsd {
+            total: (0..t)
+                .map(|m| sums.iter().map(|s| s[m]).sum::<f64>() / ((t - m) * atoms) as f64)
+                .collect(),
+            kinds: (0..kinds)
+                .map(|g| {
+                    (0..t)
+                        .map(|m| sums[g][m] / ((t - m) * count(g)) as f64)
+                        .collect()
+                })
+                .collect(),
+        }
+    }
+
+    /// A deterministic walk: atoms of three kinds with different step sizes, drifting away
+    /// from positions hundreds of Å from the origin (the stored f32 displacements and the
+    /// centring must keep the precision).
+    fn walk(atoms: usize, t: usize) -> (Vec<Vec<[f64; 3]>>, Vec<usize>) {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let kind: Vec<usize> = (0..atoms).map(|i| (i * 7) % 3).collect();
+        let mut p: Vec<[f64; 3]> = (0..atoms)
+            .map(|_| std::array::from_fn(|_| 500.0 + 100.0 * next()))
+            .collect();
+        let mut frames = Vec::new();
+        for _ in 0..t {
+            frames.push(p.clone());
+            for (q, k) in p.iter_mut().zip(&kind) {
+                let step = [0.3, 1.0, 2.5][*k];
+                for x in q.iter_mut() {
+                    *x += step * next() + 0.05;
+                }
+            }
+        }
+        (frames, kind)
+    }
+
+    #[test]
+    fn every_origin_as_the_definition_sums_it() {
+        // 2,100 atoms: three parallel tasks, the last one partial; 37 frames: a padded FFT.
+        let (frames, kind) = walk(2100, 37);
+        let mut all = AllOrigins::new(usize::MAX);
+        for f in &frames {
+            all.push(f).unwrap();
+        }
+        let fast = all.mean(&kind, 3).unwrap();
+        let slow = direct(&frames, &kind, 3);
+        for (series, (a, b)) in std::iter::once((&fast.total, &slow.total))
+            .chain(fast.kinds.iter().zip(&slow.kinds))
+            .enumerate()
+        {
+            for (m, (x, y)) in a.iter().zip(b).enumerate() {
+                assert!(
+                    (x - y).abs() <= 1e-5 * y.max(1e-3),
+                    "series {series} lag {m}: {x} against {y}"
+                );
+            }
+        }
+        assert_eq!(fast.total[0], 0.0);
+        // Fixed tasks summed in order: the same bits on one thread as on the pool.
+        let one = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap()
+            .install(|| all.mean(&kind, 3).unwrap());
+        assert_eq!(one, fast);
+        // The kinds' steps differ, so do their curves.
+        assert!(fast.kinds[2][10] > 10.0 * fast.kinds[0][10]);
+    }
+
+    #[test]
+    fn the_same_for_one_frame_two_frames_and_an_empty_kind() {
+        for t in [1, 2] {
+            let (frames, kind) = walk(5, t);
+            let mut all = AllOrigins::new(usize::MAX);
+            for f in &frames {
+                all.push(f).unwrap();
+            }
+            // A fourth kind has no atoms: its column is NaN, not a division by zero.
+            let fast = all.mean(&kind, 4).unwrap();
+            let slow = direct(&frames, &kind, 3);
+            assert_eq!(fast.total.len(), t);
+            for (x, y) in fast.total.iter().zip(&slow.total) {
+                assert!((x - y).abs() <= 1e-6 * y.max(1e-3), "{x} {y}");
+            }
+            assert!(fast.kinds[3].iter().all(|v| v.is_nan()));
+        }
+    }
+
+    #[test]
+    fn refuses_what_it_cannot_keep_or_average() {
+        let mut all = AllOrigins::new(2 * 3 * STORED_BYTES);
+        all.push(&[[0.0; 3]; 3]).unwrap();
+        assert_eq!(
+            all.push(&[[0.0; 3]; 2]),
+            Err(MsdError::AtomCount { first: 3, frame: 2 })
+        );
+        assert_eq!(
+            all.push(&[[0.0, f64::NAN, 0.0]; 3]),
+            Err(MsdError::NotFinite(0))
+        );
+        all.push(&[[1.0; 3]; 3]).unwrap();
+        let e = all.push(&[[2.0; 3]; 3]).unwrap_err();
+        assert!(matches!(e, MsdError::Memory { frames: 3, .. }), "{e}");
+        assert_eq!(all.frames(), 2);
+        assert!(all.mean(&[0, 0], 1).is_err());
+        assert!(all.mean(&[0, 0, 1], 1).is_err());
+        assert_eq!(all.mean(&[0, 0, 0], 1).unwrap().total, vec![0.0, 3.0]);
+    }
+
+    #[test]
+    fn a_line_fitted_gives_its_slope_over_six() {
+        let t: Vec<f64> = (0..50).map(|k| k as f64 * 0.5).collect();
+        let msd: Vec<f64> = t.iter().map(|t| 1.2 * t + 3.0).collect();
+        let fit = fit_diffusion(&t, &msd, 2.0, 20.0).unwrap();
+        assert!((fit.slope - 1.2).abs() < 1e-12 && (fit.intercept - 3.0).abs() < 1e-10);
+        assert!((fit.d - 0.2).abs() < 1e-12);
+        assert_eq!(fit.points, 37);
+        assert!(fit_diffusion(&t, &msd, 2.0, 2.2).is_none());
+        // Ends a rounding away from the times given still count.
+        let near: Vec<f64> = t.iter().map(|t| t * (1.0 + 3e-8)).collect();
+        assert_eq!(fit_diffusion(&near, &msd, 2.0, 20.0).unwrap().points, 37);
     }
 }

@@ -1608,6 +1608,13 @@ impl MolPlan {
         &self.measured
     }
 
+    /// Each atom's position unwrapped across the periodic boundaries as of the last frame
+    /// prepared, before `--align` ([`MolOptions::msd`]; `None` without it): what
+    /// [`texmap_md_io::msd::AllOrigins`] averages over every time origin.
+    pub fn last_unwrapped(&self) -> Option<&[[f64; 3]]> {
+        self.options.msd.then(|| self.msd.unwrapped())
+    }
+
     /// Whether every frame's squared displacements are followed ([`MolOptions::msd`]): each
     /// frame must then be built after the one before it.
     pub fn tracks_msd(&self) -> bool {

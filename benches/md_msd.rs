@@ -1,0 +1,69 @@
+//! The mean squared displacement over every time origin (texmap-md-io `msd::AllOrigins`, what
+//! `--msd-lags` computes) of 10,000 atoms on seeded Gaussian random walks (0.2 Å per axis per
+//! frame) over 1,000 frames, 2 threads: the frames kept, then the average per lag for all atoms
+//! and two kinds.
+//!
+//! The peer, `benches/peers/mdanalysis_msd.py`, times MDAnalysis's `EinsteinMSD` (fft=True,
+//! through tidynamics) on a walk of the same size held in memory: run it in the same minutes.
+//!
+//! `cargo bench --bench md_msd -- --warm-up-time 1 --measurement-time 5`
+//! (test mode, `cargo test --bench md_msd`, uses 500 atoms and 100 frames.)
+
+use criterion::{Criterion, criterion_group};
+use texmap::md_io::msd::AllOrigins;
+
+mod common;
+use common::Lcg;
+
+fn bench(c: &mut Criterion) {
+    let test_mode = !std::env::args().any(|a| a == "--bench");
+    let (atoms, frames) = if test_mode {
+        (500, 100)
+    } else {
+        (10_000, 1000)
+    };
+    let mut rng = Lcg(61206);
+    let mut p: Vec<[f64; 3]> = (0..atoms)
+        .map(|_| std::array::from_fn(|_| 50.0 * rng.next()))
+        .collect();
+    let mut all = AllOrigins::new(usize::MAX);
+    for _ in 0..frames {
+        all.push(&p).unwrap();
+        for q in &mut p {
+            for x in q.iter_mut() {
+                *x += 0.2 * rng.normal();
+            }
+        }
+    }
+    let kind: Vec<usize> = (0..atoms).map(|i| usize::from(i % 3 == 0)).collect();
+    // The walk's own slope: 3 · 0.2² Å² per frame.
+    let lags = all.mean(&kind, 2).unwrap();
+    let slope = lags.total[frames / 10] / (frames / 10) as f64;
+    assert!(
+        (slope - 0.12).abs() < 0.02,
+        "MSD slope {slope} Å² per frame"
+    );
+
+    let mut g = c.benchmark_group("md_msd");
+    g.sample_size(10);
+    g.bench_function(format!("msd_lags_{atoms}_atoms_{frames}_frames"), |b| {
+        b.iter(|| all.mean(&kind, 2).unwrap().total[1])
+    });
+    g.bench_function(format!("keep_{atoms}_atoms_{frames}_frames"), |b| {
+        b.iter(|| {
+            let mut kept = AllOrigins::new(usize::MAX);
+            for _ in 0..frames {
+                kept.push(&p).unwrap();
+            }
+            kept.frames()
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+
+fn main() {
+    benches();
+    Criterion::default().configure_from_args().final_summary();
+}
