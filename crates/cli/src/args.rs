@@ -1099,8 +1099,10 @@ pub struct AnalysisArgs {
     /// Give the atoms a property NAME read from FILE, for --color-by NAME and selections
     /// ('prop NAME > 0.5'), as VMD's user field or PyMOL's alter b=: one number per line (the
     /// same for every frame) or one row per frame of one number per atom (frame f takes row
-    /// f), separated by spaces or commas; '#' comments; nan for no value. The atoms of FILE
-    /// (the trajectory), not of --add's files. Repeatable: --property rmsf=rmsf.txt.
+    /// f), separated by spaces or commas; '#' comments; nan for no value; or a table whose
+    /// header row names a column NAME, one row per atom (a CSV from pandas, or --rmsf-table's).
+    /// The atoms of FILE (the trajectory), not of --add's files. Repeatable: --property
+    /// rmsf=rmsf.csv.
     #[arg(long = "property", value_name = "NAME=FILE")]
     pub properties: Vec<String>,
     /// Measure displacements (--displacements, --color-by displacement, --arrows
@@ -1278,6 +1280,14 @@ pub struct AnalysisArgs {
     /// up to --msd-memory). Turns on --msd. Written whole or not at all; not with --shard.
     #[arg(long, value_name = "FILE.csv")]
     pub msd_lags: Option<PathBuf>,
+    /// Also write each atom's RMS fluctuation about its mean position over the frames written
+    /// or drawn (Å; MDAnalysis's rms.RMSF, gmx rmsf), after --align (give it, or the molecule's
+    /// tumbling counts): a CSV table, one row per atom: atom (from 0), id, name, resname, resid,
+    /// chain, rmsf. `--property rmsf=FILE.csv` reads its column back to colour by
+    /// (`--color-by rmsf`) or select ('prop rmsf > 2'). Written whole or not at all; not with
+    /// --shard.
+    #[arg(long, value_name = "FILE.csv")]
+    pub rmsf_table: Option<PathBuf>,
     /// The lag times the diffusion coefficient is fitted over, FROM:TO in ps (in frames when the
     /// frames carry no times); by default 10 % to 90 % of the longest lag, as gmx msd's
     /// -beginfit and -endfit.

@@ -535,6 +535,28 @@ pub(crate) struct AnalysisTables {
     rmsd: Option<crate::output::AtomicFile>,
     cluster: Option<crate::output::AtomicFile>,
     msd_lags: Option<MsdLags>,
+    /// `--rmsf-table`, the fluctuations so far and each atom's first columns (the first
+    /// frame's).
+    rmsf: Option<(
+        crate::output::AtomicFile,
+        texmap_md_io::rmsf::Fluctuation,
+        Vec<String>,
+    )>,
+}
+
+/// Atom `i`'s first columns in the per-atom tables: its index, id, name, residue name,
+/// residue number and chain (empty where the file has none).
+fn atom_columns(md: &MdFrame, i: usize) -> String {
+    let text = |v: &[texmap_md_io::Label]| v.get(i).map(|l| l.to_string()).unwrap_or_default();
+    let number = |v: &[i64]| v.get(i).map(|n| n.to_string()).unwrap_or_default();
+    format!(
+        "{i},{},{},{},{},{}",
+        number(&md.ids),
+        text(&md.names),
+        text(&md.res_names),
+        number(&md.res_ids),
+        text(&md.chains)
+    )
 }
 
 /// `--msd-lags`: every frame's unwrapped positions, averaged over every time origin at the end.
@@ -739,6 +761,19 @@ impl AnalysisTables {
                 "frame,cluster,atoms,x,y,z,rg",
                 whole,
             )?,
+            rmsf: match &analysis.rmsf_table {
+                None => None,
+                Some(_) if !whole => {
+                    return usage(
+                        "--rmsf-table with --shard (or a Slurm array): the mean position needs every frame in one run; write it in a run of its own",
+                    );
+                }
+                Some(p) => Some((
+                    crate::output::AtomicFile::create(p)?,
+                    texmap_md_io::rmsf::Fluctuation::new(),
+                    Vec::new(),
+                )),
+            },
             msd_lags: match &analysis.msd_lags {
                 None => None,
                 Some(_) if !whole => {
@@ -872,6 +907,14 @@ impl AnalysisTables {
         {
             lags.add(f, unwrapped, md)?;
         }
+        if let Some((_, fluctuation, rows)) = &mut self.rmsf {
+            if fluctuation.frames() == 0 {
+                *rows = (0..md.n_atoms()).map(|i| atom_columns(md, i)).collect();
+            }
+            fluctuation
+                .add(&md.positions)
+                .map_err(|e| anyhow::anyhow!("--rmsf-table: frame {f}: {e}"))?;
+        }
         Ok(())
     }
 
@@ -882,8 +925,19 @@ impl AnalysisTables {
             .map(|(mut t, mean)| t.write(&mean.csv()).map(|()| t));
         let msd = self.msd.map(|(t, _)| t);
         let msd_lags = self.msd_lags.map(MsdLags::finish).transpose()?;
+        let rmsf = self
+            .rmsf
+            .map(|(mut t, fluctuation, rows)| {
+                let mut text = String::from("atom,id,name,resname,resid,chain,rmsf\n");
+                for (row, r) in rows.iter().zip(fluctuation.rmsf()) {
+                    text.push_str(&format!("{row},{r:.6}\n"));
+                }
+                t.write(&text).map(|()| t)
+            })
+            .transpose()?;
         for t in [
             msd_lags,
+            rmsf,
             self.defect,
             self.grain,
             self.rmsd,
@@ -920,7 +974,7 @@ pub(crate) fn atom_value_files(specs: &[String]) -> Result<AtomValueFiles> {
                 "--property {spec:?}: the name must be letters, digits, _ . [ ] (what selections and --color-by can name)"
             ));
         }
-        let values = texmap_md_io::values::AtomValues::open(file.trim())
+        let values = texmap_md_io::values::AtomValues::open_column(file.trim(), name)
             .with_context(|| format!("--property {name}"))?;
         atom_values.push((name.to_string(), values));
     }

@@ -574,6 +574,78 @@ fn msd_and_rmsd_tables_are_mdanalysis() {
     }
 }
 
+/// `--rmsf-table` after `--align all` equals MDAnalysis's rms.RMSF after align.AlignTraj on all
+/// atoms, atom by atom; `--property rmsf=TABLE.csv` reads the column back, so a selection by
+/// it keeps the atoms MDAnalysis's values pick.
+#[test]
+fn rmsf_table_is_mdanalysis_and_reads_back_as_a_property() {
+    let dir = tempfile::tempdir().unwrap();
+    let rmsf = dir.path().join("rmsf.csv");
+    let traj = md_data("topo_mda.xtc");
+    let gro = md_data("topo_mda.gro");
+    run_ok(&[
+        "convert",
+        &traj,
+        "--topology",
+        &gro,
+        "--align",
+        "all",
+        "--rmsf-table",
+        rmsf.to_str().unwrap(),
+        "-q",
+    ]);
+    let text = std::fs::read_to_string(&rmsf).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("atom,id,name,resname,resid,chain,rmsf"));
+    let want = numbers(&json("dynamics/rmsf_reference.json")["rmsf"]);
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), want.len());
+    let first = &frames(Path::new(&gro))[0];
+    for (i, (row, want)) in rows.iter().zip(&want).enumerate() {
+        assert_eq!(row[0], i.to_string());
+        assert_eq!(row[2], first.names[i].to_string());
+        let got: f64 = row[6].parse().unwrap();
+        assert!(
+            // 6 decimals in the table; without --align the values differ by up to 0.09 Å.
+            (got - want).abs() < 2e-6,
+            "atom {i}: {got} vs MDAnalysis {want}"
+        );
+    }
+    let cut = 0.5;
+    let kept = want.iter().filter(|v| **v > cut).count();
+    assert!(kept > 0 && kept < want.len(), "{kept} of {}", want.len());
+    let out = dir.path().join("mobile.xyz");
+    run_ok(&[
+        "convert",
+        &traj,
+        "--topology",
+        &gro,
+        "--property",
+        &format!("rmsf={}", rmsf.display()),
+        "--select",
+        &format!("prop rmsf > {cut}"),
+        "--frames",
+        "0",
+        "-o",
+        out.to_str().unwrap(),
+        "-q",
+    ]);
+    assert_eq!(frames(&out)[0].n_atoms(), kept);
+    // A header without the property's column is named in the error.
+    let o = texmap(&[
+        "convert",
+        &traj,
+        "--topology",
+        &gro,
+        "--property",
+        &format!("bfactor={}", rmsf.display()),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("none named bfactor"), "{}", stderr(&o));
+}
+
 /// `--msd-lags`: the mean squared displacement over every time origin of the same random
 /// walks equals MDAnalysis's EinsteinMSD (the direct sum, fft=False) per lag, for all atoms
 /// and per kind, and the diffusion coefficients printed equal a least-squares line through

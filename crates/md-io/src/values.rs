@@ -12,6 +12,10 @@
 //! - **Rows of several numbers**: one row per frame, one value per atom: frame `f` of the
 //!   trajectory takes row `f`.
 //!
+//! - **A table with a header row** (a CSV as pandas, a spreadsheet or texmap's own per-atom
+//!   tables write it): [`AtomValues::open_column`] takes the column of the name asked for, one
+//!   row per atom, the same for every frame; an empty field is no value (nan).
+//!
 //! Errors name the file and line: a token that is no number, rows of different lengths, and
 //! (from [`AtomValues::for_frame`]) a count that is not the frame's atom count or a frame past
 //! the rows. Memory is the file's numbers (a file is read whole, four bytes a value).
@@ -44,13 +48,96 @@ pub struct AtomValues {
 impl AtomValues {
     /// Reads `path` (see the module docs).
     pub fn open(path: impl AsRef<Path>) -> Result<AtomValues, Error> {
-        let path = path.as_ref();
-        let name: Arc<str> = path.display().to_string().into();
-        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
-            at: Location::file(&name),
-            source,
-        })?;
+        let (name, text) = read(path.as_ref())?;
         AtomValues::parse(&text, &name)
+    }
+
+    /// Reads `path` as [`AtomValues::parse_column`] does.
+    pub fn open_column(path: impl AsRef<Path>, column: &str) -> Result<AtomValues, Error> {
+        let (name, text) = read(path.as_ref())?;
+        AtomValues::parse_column(&text, &name, column)
+    }
+
+    /// Parses `text` (named `name` in errors) as [`AtomValues::parse`] does when its first line
+    /// of data is numbers; when that line is a header of names, takes the column named
+    /// `column` from the rows below it, one per atom (fields split at commas when the header
+    /// has one, else at spaces and tabs).
+    pub fn parse_column(text: &str, name: &str, column: &str) -> Result<AtomValues, Error> {
+        let file: Arc<str> = name.into();
+        let mut data = text
+            .split('\n')
+            .enumerate()
+            .map(|(k, line)| (k + 1, line.split('#').next().unwrap_or("").trim()))
+            .filter(|(_, body)| !body.is_empty() && !body.starts_with('@'));
+        let Some((header_line, header)) = data.next() else {
+            return AtomValues::parse(text, name);
+        };
+        let commas = header.contains(',');
+        let fields = |body: &'_ str| -> Vec<String> {
+            let clean = |t: &str| t.trim().trim_matches('"').to_string();
+            if commas {
+                body.split(',').map(clean).collect()
+            } else {
+                body.split([' ', '\t', '\r'])
+                    .filter(|t| !t.is_empty())
+                    .map(clean)
+                    .collect()
+            }
+        };
+        let names = fields(header);
+        if names.iter().all(|t| t.parse::<f32>().is_ok()) {
+            return AtomValues::parse(text, name);
+        }
+        let at = |line: usize| Location {
+            line: Some(line as u64),
+            ..Location::file(&file)
+        };
+        let Some(index) = names.iter().position(|n| n == column) else {
+            return Err(Error::Parse {
+                at: at(header_line),
+                expected: "a header row naming the property's column (or numbers only)",
+                found: format!("the columns {}, none named {column}", names.join(", ")),
+            });
+        };
+        let mut values = Vec::new();
+        for (line, body) in data {
+            let row = fields(body);
+            let Some(field) = row.get(index) else {
+                return Err(Error::Parse {
+                    at: at(line),
+                    expected: "a field under every column of the header",
+                    found: format!("{} fields, {column} is field {}", row.len(), index + 1),
+                });
+            };
+            let value = if field.is_empty() {
+                f32::NAN
+            } else {
+                match field.parse::<f32>() {
+                    Ok(v) if !v.is_infinite() => v,
+                    _ => {
+                        return Err(Error::Parse {
+                            at: at(line),
+                            expected: "a number (or nothing) in the column",
+                            found: field.clone(),
+                        });
+                    }
+                }
+            };
+            values.push(value);
+        }
+        if values.is_empty() {
+            return Err(Error::Parse {
+                at: at(header_line),
+                expected: "rows below the header, one per atom",
+                found: "no row".into(),
+            });
+        }
+        Ok(AtomValues {
+            file,
+            rows: vec![values],
+            lines: vec![header_line + 1],
+            every_frame: true,
+        })
     }
 
     /// Parses `text`, named `name` in errors (see the module docs).
@@ -168,9 +255,50 @@ impl AtomValues {
     }
 }
 
+/// `path`'s name as errors give it, and its text.
+fn read(path: &Path) -> Result<(Arc<str>, String), Error> {
+    let name: Arc<str> = path.display().to_string().into();
+    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+        at: Location::file(&name),
+        source,
+    })?;
+    Ok((name, text))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_named_column_under_a_header() {
+        let csv = "atom,name,rmsf\n0,CA,0.5\n1,\"CB\",\n2,N,1.25\n";
+        let v = AtomValues::parse_column(csv, "t.csv", "rmsf").unwrap();
+        let got = v.for_frame(5, 3).unwrap();
+        assert_eq!((got[0], got[2]), (0.5, 1.25));
+        assert!(got[1].is_nan(), "an empty field is no value");
+        let spaced = "# from numpy\n atom  rmsf\n 0  2\n 1  3\n";
+        let v = AtomValues::parse_column(spaced, "s.txt", "rmsf").unwrap();
+        assert_eq!(v.for_frame(0, 2).unwrap(), [2.0, 3.0]);
+        // Numbers only: the plain reading, rows per frame included.
+        let v = AtomValues::parse_column("1 2\n3 4\n", "n.txt", "rmsf").unwrap();
+        assert_eq!(v.frames(), Some(2));
+        let e = AtomValues::parse_column(csv, "t.csv", "bfactor")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("t.csv") && e.contains("line 1") && e.contains("atom, name, rmsf"),
+            "{e}"
+        );
+        let e = AtomValues::parse_column("a,rmsf\n0,1\n1\n", "short.csv", "rmsf")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("line 3") && e.contains("1 fields"), "{e}");
+        let e = AtomValues::parse_column("a,rmsf\n0,x\n", "bad.csv", "rmsf")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("line 2") && e.contains('x'), "{e}");
+        assert!(AtomValues::parse_column("a,rmsf\n", "empty.csv", "rmsf").is_err());
+    }
 
     #[test]
     fn columns_rows_comments_and_errors() {

@@ -12,6 +12,8 @@ Run from this directory: python3 gen_dynamics.py
   over every origin) of the same unwrapped walk for all atoms, the OW and the NA atoms, with
   its lag times, and the diffusion coefficient of each (numpy's least-squares line over lag
   times from 10 % to 90 % of the longest, slope / 6, in 10^-5 cm^2/s), as gmx msd fits it.
+- rmsf_reference.json: MDAnalysis's rms.RMSF of every atom of topo_mda.xtc (with topo_mda.gro)
+  after align.AlignTraj superposes all its frames on frame 0 by all atoms, unweighted.
 - rmsd_reference.json: MDAnalysis's rms.RMSD of md-io's topo_mda.xtc (with topo_mda.gro) on
   all atoms against frame 0, unweighted and mass-weighted (results.rmsd's third column).
 """
@@ -19,7 +21,7 @@ import json
 
 import numpy as np
 import MDAnalysis as mda
-from MDAnalysis.analysis import rms
+from MDAnalysis.analysis import align, rms
 from MDAnalysis.analysis.msd import EinsteinMSD
 from MDAnalysis.transformations import NoJump
 
@@ -77,3 +79,10 @@ plain = rms.RMSD(topo, select="all").run().results.rmsd[:, 2].tolist()
 mass = rms.RMSD(topo, select="all", weights="mass").run().results.rmsd[:, 2].tolist()
 json.dump({"rmsd": plain, "rmsd_mass": mass}, open("rmsd_reference.json", "w"), indent=1)
 print("rmsd:", plain, mass)
+
+mobile = mda.Universe("../topo_mda.gro", "../topo_mda.xtc")
+reference = mda.Universe("../topo_mda.gro", "../topo_mda.xtc")
+align.AlignTraj(mobile, reference, select="all", in_memory=True).run()
+fluct = rms.RMSF(mobile.atoms).run().results.rmsf
+json.dump({"rmsf": fluct.tolist()}, open("rmsf_reference.json", "w"), indent=1)
+print("rmsf: atoms", len(fluct), "mean", fluct.mean(), "max", fluct.max())
