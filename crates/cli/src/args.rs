@@ -88,7 +88,8 @@ pub enum Command {
     Render(RenderArgs),
     /// Write a trajectory's frames to another file, analysed and cut down as texmap render
     /// would draw them: a selection, every Nth frame, molecules made whole, superposed, with
-    /// the analyses' per-atom numbers as columns (extended XYZ, LAMMPS dump, PDB, DCD, XTC).
+    /// the analyses' per-atom numbers as columns (extended XYZ, LAMMPS dump, GROMACS .gro,
+    /// PDB, DCD, XTC).
     Convert(crate::convert::ConvertArgs),
     /// Run every method and the reference ray tracer on a scene; write results, images and charts.
     Compare(CompareArgs),
