@@ -1303,6 +1303,23 @@ pub struct AnalysisArgs {
     /// weighted with --align-mass), as MDAnalysis's rms.RMSD. Written whole or not at all.
     #[arg(long, value_name = "FILE.csv", requires = "align")]
     pub rmsd_table: Option<PathBuf>,
+    /// Write the density profile across the cell, averaged over the frames, as a CSV table
+    /// (MDAnalysis's LinearDensity, gmx density, OVITO's Spatial binning): the cell cut into
+    /// --profile-bins slabs along --profile-axis, one row per slab: its centre (Å), number
+    /// (atoms/Å³), mass (g/cm³, the elements' standard weights), charge (e/Å³, when the atoms
+    /// carry charges), then number_<kind> per kind of atom (their types, else elements). For
+    /// interfaces, membranes and confined liquids. Written whole or not at all; not with
+    /// --align (the slabs are the cell's) or --shard.
+    #[arg(long, value_name = "FILE.csv", conflicts_with = "align")]
+    pub profile_table: Option<PathBuf>,
+    /// The edge --profile-table cuts across: x, y, z (an orthorhombic cell's axes) or a, b, c
+    /// (a skewed cell's edge vectors: slabs parallel to the two other edges).
+    #[arg(long, value_name = "AXIS", default_value = "z", value_parser = ["x", "y", "z", "a", "b", "c"], requires = "profile_table")]
+    pub profile_axis: String,
+    /// The number of slabs of --profile-table.
+    #[arg(long, value_name = "N", default_value_t = 100, requires = "profile_table",
+          value_parser = clap::value_parser!(u32).range(1..=1_048_576))]
+    pub profile_bins: u32,
     /// Also write the grains of every frame as a CSV table, one row per grain: frame, grain,
     /// atoms, crystalline atoms, structure, and the mean orientation's quaternion. Written whole
     /// or not at all.

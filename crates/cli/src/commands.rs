@@ -494,17 +494,31 @@ fn per_frame_table(
     header: &str,
     whole: bool,
 ) -> Result<Option<crate::output::AtomicFile>> {
-    let Some(p) = path else { return Ok(None) };
-    if !whole {
-        return usage(format!(
-            "{flag} with --shard (or a Slurm array): every part would write the same table; write it in a run of its own"
-        ));
-    }
-    let mut t = crate::output::AtomicFile::create(p)?;
+    let why = "every part would write the same table";
+    let Some(mut t) = whole_run_table(path, flag, why, whole)? else {
+        return Ok(None);
+    };
     if !header.is_empty() {
         t.write(&format!("{header}\n"))?;
     }
     Ok(Some(t))
+}
+
+/// The file of a table that needs every frame in one run (`whole`): refused for a part of a
+/// render split with --shard, saying `why`.
+fn whole_run_table(
+    path: &Option<PathBuf>,
+    flag: &str,
+    why: &str,
+    whole: bool,
+) -> Result<Option<crate::output::AtomicFile>> {
+    match path {
+        None => Ok(None),
+        Some(_) if !whole => usage(format!(
+            "{flag} with --shard (or a Slurm array): {why}; write it in a run of its own"
+        )),
+        Some(p) => Ok(Some(crate::output::AtomicFile::create(p)?)),
+    }
 }
 
 /// A trajectory's topology (if given), its parts opened as one, and the read options used.
@@ -535,6 +549,7 @@ pub(crate) struct AnalysisTables {
     rmsd: Option<crate::output::AtomicFile>,
     cluster: Option<crate::output::AtomicFile>,
     msd_lags: Option<MsdLags>,
+    profile: Option<(crate::output::AtomicFile, ProfileMean)>,
     /// `--rmsf-table`, the fluctuations so far and each atom's first columns (the first
     /// frame's).
     rmsf: Option<(
@@ -674,6 +689,103 @@ impl MsdLags {
     }
 }
 
+/// `--profile-table`: the frames' density profiles summed, to be written as their mean.
+struct ProfileMean {
+    /// The cell edge (0, 1, 2) and its name as the table's first column.
+    axis: usize,
+    name: String,
+    bins: usize,
+    /// The kinds of the columns, sorted by name (the first frame's).
+    kinds: Vec<texmap_md_io::Label>,
+    /// Per bin: position, number, mass, charge, then each kind.
+    sums: Vec<Vec<f64>>,
+    charges: bool,
+    frames: usize,
+}
+
+impl ProfileMean {
+    fn add(&mut self, f: usize, md: &MdFrame) -> Result<()> {
+        let of: Vec<texmap_md_io::Label> = (0..md.n_atoms())
+            .map(|i| texmap_md_io::rdf::atom_kind(md, i))
+            .collect();
+        if self.frames == 0 {
+            let mut seen = of.clone();
+            seen.sort_by(|a, b| a.as_str().cmp(b.as_str()));
+            seen.dedup();
+            self.kinds = seen;
+        }
+        let mut kind = Vec::with_capacity(of.len());
+        for (i, k) in of.iter().enumerate() {
+            match self.kinds.iter().position(|s| s == k) {
+                Some(p) => kind.push(p),
+                None => bail!(
+                    "--profile-table: frame {f}'s atom {i} is of kind {k}, which the first frame did not have ({}): the columns are the first frame's kinds",
+                    self.kinds
+                        .iter()
+                        .map(|k| k.to_string())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            }
+        }
+        let p = texmap_md_io::profile::density_profile(
+            md,
+            self.axis,
+            self.bins,
+            &kind,
+            self.kinds.len(),
+        )
+        .map_err(|e| anyhow::anyhow!("--profile-table: {e}"))?;
+        if self.frames == 0 {
+            self.charges = p.charge.is_some();
+            self.sums = vec![vec![0.0; 4 + self.kinds.len()]; self.bins];
+        } else if self.charges != p.charge.is_some() {
+            bail!(
+                "--profile-table: frame {f} has charges where the first frame had none, or none where it had them"
+            );
+        }
+        for (b, row) in self.sums.iter_mut().enumerate() {
+            row[0] += p.position[b];
+            row[1] += p.number[b];
+            row[2] += p.mass[b];
+            row[3] += p.charge.as_ref().map_or(0.0, |c| c[b]);
+            for (v, k) in row[4..].iter_mut().zip(&p.kinds) {
+                *v += k[b];
+            }
+        }
+        self.frames += 1;
+        Ok(())
+    }
+
+    fn csv(&self) -> String {
+        let mut text = format!("{},number,mass", self.name);
+        if self.charges {
+            text.push_str(",charge");
+        }
+        for k in &self.kinds {
+            text.push_str(&format!(",number_{k}"));
+        }
+        text.push('\n');
+        let n = self.frames.max(1) as f64;
+        for row in &self.sums {
+            text.push_str(&format!(
+                "{:.4},{:.8},{:.8}",
+                row[0] / n,
+                row[1] / n,
+                row[2] / n
+            ));
+            if self.charges {
+                text.push_str(&format!(",{:.8}", row[3] / n));
+            }
+            for v in &row[4..] {
+                text.push_str(&format!(",{:.8}", v / n));
+            }
+            text.push('\n');
+        }
+        text
+    }
+}
+
 /// `--rdf-table`: the frames' g(r) summed, to be written as their mean.
 #[derive(Default)]
 struct RdfMean {
@@ -761,46 +873,60 @@ impl AnalysisTables {
                 "frame,cluster,atoms,x,y,z,rg",
                 whole,
             )?,
-            rmsf: match &analysis.rmsf_table {
-                None => None,
-                Some(_) if !whole => {
-                    return usage(
-                        "--rmsf-table with --shard (or a Slurm array): the mean position needs every frame in one run; write it in a run of its own",
-                    );
-                }
-                Some(p) => Some((
-                    crate::output::AtomicFile::create(p)?,
-                    texmap_md_io::rmsf::Fluctuation::new(),
-                    Vec::new(),
-                )),
-            },
-            msd_lags: match &analysis.msd_lags {
-                None => None,
-                Some(_) if !whole => {
-                    return usage(
-                        "--msd-lags with --shard (or a Slurm array): the average over every time origin needs every frame in one run; write it in a run of its own",
-                    );
-                }
-                Some(p) => Some(MsdLags {
-                    file: crate::output::AtomicFile::create(p)?,
-                    all: texmap_md_io::msd::AllOrigins::new(
-                        analysis.msd_memory.saturating_mul(1 << 20),
-                    ),
-                    times: Vec::new(),
-                    kinds: Vec::new(),
-                    kind: Vec::new(),
-                    fit: analysis.msd_fit,
-                }),
-            },
-            rdf: match &analysis.rdf_table {
-                None => None,
-                Some(_) if !whole => {
-                    return usage(
-                        "--rdf-table with --shard (or a Slurm array): every part would write its own mean; write it in a run of its own",
-                    );
-                }
-                Some(p) => Some((crate::output::AtomicFile::create(p)?, RdfMean::default())),
-            },
+            profile: whole_run_table(
+                &analysis.profile_table,
+                "--profile-table",
+                "every part would write its own mean",
+                whole,
+            )?
+            .map(|t| {
+                (
+                    t,
+                    ProfileMean {
+                        axis: match analysis.profile_axis.as_str() {
+                            "x" | "a" => 0,
+                            "y" | "b" => 1,
+                            _ => 2,
+                        },
+                        name: analysis.profile_axis.clone(),
+                        bins: analysis.profile_bins as usize,
+                        kinds: Vec::new(),
+                        sums: Vec::new(),
+                        charges: false,
+                        frames: 0,
+                    },
+                )
+            }),
+            rmsf: whole_run_table(
+                &analysis.rmsf_table,
+                "--rmsf-table",
+                "the mean position needs every frame in one run",
+                whole,
+            )?
+            .map(|t| (t, texmap_md_io::rmsf::Fluctuation::new(), Vec::new())),
+            msd_lags: whole_run_table(
+                &analysis.msd_lags,
+                "--msd-lags",
+                "the average over every time origin needs every frame in one run",
+                whole,
+            )?
+            .map(|file| MsdLags {
+                file,
+                all: texmap_md_io::msd::AllOrigins::new(
+                    analysis.msd_memory.saturating_mul(1 << 20),
+                ),
+                times: Vec::new(),
+                kinds: Vec::new(),
+                kind: Vec::new(),
+                fit: analysis.msd_fit,
+            }),
+            rdf: whole_run_table(
+                &analysis.rdf_table,
+                "--rdf-table",
+                "every part would write its own mean",
+                whole,
+            )?
+            .map(|t| (t, RdfMean::default())),
         })
     }
 
@@ -907,6 +1033,9 @@ impl AnalysisTables {
         {
             lags.add(f, unwrapped, md)?;
         }
+        if let Some((_, mean)) = &mut self.profile {
+            mean.add(f, md)?;
+        }
         if let Some((_, fluctuation, rows)) = &mut self.rmsf {
             if fluctuation.frames() == 0 {
                 *rows = (0..md.n_atoms()).map(|i| atom_columns(md, i)).collect();
@@ -925,6 +1054,10 @@ impl AnalysisTables {
             .map(|(mut t, mean)| t.write(&mean.csv()).map(|()| t));
         let msd = self.msd.map(|(t, _)| t);
         let msd_lags = self.msd_lags.map(MsdLags::finish).transpose()?;
+        let profile = self
+            .profile
+            .map(|(mut t, mean)| t.write(&mean.csv()).map(|()| t))
+            .transpose()?;
         let rmsf = self
             .rmsf
             .map(|(mut t, fluctuation, rows)| {
@@ -937,6 +1070,7 @@ impl AnalysisTables {
             .transpose()?;
         for t in [
             msd_lags,
+            profile,
             rmsf,
             self.defect,
             self.grain,

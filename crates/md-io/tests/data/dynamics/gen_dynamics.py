@@ -14,6 +14,10 @@ Run from this directory: python3 gen_dynamics.py
   times from 10 % to 90 % of the longest, slope / 6, in 10^-5 cm^2/s), as gmx msd fits it.
 - rmsf_reference.json: MDAnalysis's rms.RMSF of every atom of topo_mda.xtc (with topo_mda.gro)
   after align.AlignTraj superposes all its frames on frame 0 by all atoms, unweighted.
+- profile_reference.json: MDAnalysis's LinearDensity of the walk along z in 0.25 A bins (72
+  across the 18 A box), grouping by atoms, averaged over the 40 frames: the mass density
+  (g/cm^3) of all atoms and of the OW and NA atoms, with the bins' edges and the masses
+  MDAnalysis guessed.
 - rmsd_reference.json: MDAnalysis's rms.RMSD of md-io's topo_mda.xtc (with topo_mda.gro) on
   all atoms against frame 0, unweighted and mass-weighted (results.rmsd's third column).
 """
@@ -23,6 +27,7 @@ import numpy as np
 import MDAnalysis as mda
 from MDAnalysis.analysis import align, rms
 from MDAnalysis.analysis.msd import EinsteinMSD
+from MDAnalysis.analysis.lineardensity import LinearDensity
 from MDAnalysis.transformations import NoJump
 
 rng = np.random.default_rng(61206)
@@ -86,3 +91,16 @@ align.AlignTraj(mobile, reference, select="all", in_memory=True).run()
 fluct = rms.RMSF(mobile.atoms).run().results.rmsf
 json.dump({"rmsf": fluct.tolist()}, open("rmsf_reference.json", "w"), indent=1)
 print("rmsf: atoms", len(fluct), "mean", fluct.mean(), "max", fluct.max())
+
+profile = {}
+for key, sel in [("mass", "all"), ("mass_OW", "name OW"), ("mass_NA", "name NA")]:
+    walk = mda.Universe("walk.gro", "walk.dcd")
+    walk.add_TopologyAttr("charges", np.zeros(walk.atoms.n_atoms))
+    atoms = walk.select_atoms(sel)
+    density = LinearDensity(atoms, grouping="atoms", binsize=0.25).run()
+    profile[key] = density.results.z.mass_density.tolist()
+    profile["edges"] = density.results.z.hist_bin_edges.tolist()
+    profile["masses_" + key] = sorted(set(atoms.masses.tolist()))
+json.dump(profile, open("profile_reference.json", "w"), indent=1)
+print("profile: bins", len(profile["mass"]), "masses", profile["masses_mass"],
+      "mean mass density", np.mean(profile["mass"]))
