@@ -589,17 +589,7 @@ struct MsdLags {
 impl MsdLags {
     fn add(&mut self, f: usize, unwrapped: &[[f64; 3]], md: &MdFrame) -> Result<()> {
         if self.all.frames() == 0 {
-            let of: Vec<texmap_md_io::Label> = (0..md.n_atoms())
-                .map(|i| texmap_md_io::rdf::atom_kind(md, i))
-                .collect();
-            let mut seen = of.clone();
-            seen.sort_by(|a, b| a.as_str().cmp(b.as_str()));
-            seen.dedup();
-            self.kind = of
-                .iter()
-                .map(|k| seen.iter().position(|s| s == k).unwrap_or(0))
-                .collect();
-            self.kinds = seen;
+            self.kind = kinds_of(md, &mut self.kinds).unwrap_or_default();
         }
         if unwrapped.len() != self.kind.len() {
             bail!(
@@ -689,6 +679,41 @@ impl MsdLags {
     }
 }
 
+/// Each atom's kind (its type, else its element: [`texmap_md_io::rdf::atom_kind`]) as an index
+/// into `kinds`, which is first filled with `md`'s kinds sorted by name when empty (the first
+/// frame sets a table's columns). An atom of a kind not in `kinds` is returned as the error.
+fn kinds_of(
+    md: &MdFrame,
+    kinds: &mut Vec<texmap_md_io::Label>,
+) -> std::result::Result<Vec<usize>, (usize, texmap_md_io::Label)> {
+    let of: Vec<texmap_md_io::Label> = (0..md.n_atoms())
+        .map(|i| texmap_md_io::rdf::atom_kind(md, i))
+        .collect();
+    if kinds.is_empty() {
+        *kinds = of.clone();
+        kinds.sort_by(|a, b| a.as_str().cmp(b.as_str()));
+        kinds.dedup();
+    }
+    of.iter()
+        .enumerate()
+        .map(|(i, k)| kinds.iter().position(|s| s == k).ok_or((i, *k)))
+        .collect()
+}
+
+/// The error of [`kinds_of`] for `flag`'s table at frame `f`.
+fn new_kind(
+    flag: &str,
+    f: usize,
+    (i, k): (usize, texmap_md_io::Label),
+    kinds: &[texmap_md_io::Label],
+) -> anyhow::Error {
+    let known: Vec<String> = kinds.iter().map(|k| k.to_string()).collect();
+    anyhow::anyhow!(
+        "{flag}: frame {f}'s atom {i} is of kind {k}, which the first frame did not have ({}): the columns are the first frame's kinds",
+        known.join(", ")
+    )
+}
+
 /// `--profile-table`: the frames' density profiles summed, to be written as their mean.
 struct ProfileMean {
     /// The cell edge (0, 1, 2) and its name as the table's first column.
@@ -705,29 +730,8 @@ struct ProfileMean {
 
 impl ProfileMean {
     fn add(&mut self, f: usize, md: &MdFrame) -> Result<()> {
-        let of: Vec<texmap_md_io::Label> = (0..md.n_atoms())
-            .map(|i| texmap_md_io::rdf::atom_kind(md, i))
-            .collect();
-        if self.frames == 0 {
-            let mut seen = of.clone();
-            seen.sort_by(|a, b| a.as_str().cmp(b.as_str()));
-            seen.dedup();
-            self.kinds = seen;
-        }
-        let mut kind = Vec::with_capacity(of.len());
-        for (i, k) in of.iter().enumerate() {
-            match self.kinds.iter().position(|s| s == k) {
-                Some(p) => kind.push(p),
-                None => bail!(
-                    "--profile-table: frame {f}'s atom {i} is of kind {k}, which the first frame did not have ({}): the columns are the first frame's kinds",
-                    self.kinds
-                        .iter()
-                        .map(|k| k.to_string())
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                ),
-            }
-        }
+        let kind = kinds_of(md, &mut self.kinds)
+            .map_err(|e| new_kind("--profile-table", f, e, &self.kinds))?;
         let p = texmap_md_io::profile::density_profile(
             md,
             self.axis,
@@ -966,23 +970,14 @@ impl AnalysisTables {
         if let Some((t, kinds)) = &mut self.msd
             && let Some(d2) = md.property(texmap_md_scene::MSD)
         {
-            let of: Vec<texmap_md_io::Label> = (0..md.n_atoms())
-                .map(|i| texmap_md_io::rdf::atom_kind(md, i))
-                .collect();
-            if kinds.is_empty() {
-                let mut seen: Vec<texmap_md_io::Label> = Vec::new();
-                for k in &of {
-                    if !seen.contains(k) {
-                        seen.push(*k);
-                    }
-                }
-                seen.sort_by(|a, b| a.as_str().cmp(b.as_str()));
+            let first = kinds.is_empty();
+            let of = kinds_of(md, kinds).map_err(|e| new_kind("--msd-table", f, e, kinds))?;
+            if first {
                 let mut header = String::from("frame,time,msd");
-                for k in &seen {
+                for k in kinds.iter() {
                     header.push_str(&format!(",msd_{k}"));
                 }
                 t.write(&format!("{header}\n"))?;
-                *kinds = seen;
             }
             let mean = |pick: &dyn Fn(usize) -> bool| {
                 let (sum, count) = d2
@@ -997,9 +992,9 @@ impl AnalysisTables {
                 }
             };
             let mut row = format!("{f},{time},{}", mean(&|_| true));
-            for k in kinds.iter() {
+            for k in 0..kinds.len() {
                 row.push(',');
-                row.push_str(&mean(&|i| of[i] == *k));
+                row.push_str(&mean(&|i| of.get(i) == Some(&k)));
             }
             t.write(&format!("{row}\n"))?;
         }

@@ -718,6 +718,37 @@ fn density_profile_is_mdanalysis_linear_density() {
     assert!(!out.exists());
 }
 
+/// A per-kind table's columns are the first frame's kinds: a later frame with an atom of
+/// another kind (a LAMMPS dump whose atom changed type) is refused, naming frame and atom,
+/// rather than its atom left out of every column.
+#[test]
+fn a_kind_the_first_frame_lacked_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let dump = dir.path().join("types.lammpstrj");
+    let frame = |step: u32, second: u32| {
+        format!(
+            "ITEM: TIMESTEP\n{step}\nITEM: NUMBER OF ATOMS\n2\nITEM: BOX BOUNDS pp pp pp\n0 10\n0 10\n0 10\nITEM: ATOMS id type x y z\n1 1 1 1 1\n2 {second} 5 5 5\n"
+        )
+    };
+    std::fs::write(&dump, frame(0, 1) + &frame(10, 2)).unwrap();
+    for flag in ["--profile-table", "--msd-table"] {
+        let out = dir.path().join("t.csv");
+        let o = texmap(&[
+            "convert",
+            dump.to_str().unwrap(),
+            flag,
+            out.to_str().unwrap(),
+        ]);
+        assert_eq!(o.status.code(), Some(1), "{flag}: {}", stderr(&o));
+        let e = stderr(&o);
+        assert!(
+            e.contains(&format!("{flag}: frame 1's atom 1 is of kind 2")) && e.contains("(1)"),
+            "{e}"
+        );
+        assert!(!out.exists());
+    }
+}
+
 /// `--msd-lags`: the mean squared displacement over every time origin of the same random
 /// walks equals MDAnalysis's EinsteinMSD (the direct sum, fft=False) per lag, for all atoms
 /// and per kind, and the diffusion coefficients printed equal a least-squares line through
