@@ -1289,6 +1289,13 @@ pub struct AnalysisArgs {
     /// --shard.
     #[arg(long, value_name = "FILE.csv")]
     pub rmsf_table: Option<PathBuf>,
+    /// Also write every protein residue's backbone dihedrals per frame as a CSV table (the
+    /// Ramachandran plot's data: MDAnalysis's Ramachandran, gmx rama): frame, time, chain,
+    /// resid, resname, phi, psi, omega (degrees, −180 to 180); an angle that needs a residue
+    /// missing (a terminus, a chain break, a gap longer than a peptide bond) is left empty.
+    /// Written whole or not at all.
+    #[arg(long, value_name = "FILE.csv")]
+    pub dihedral_table: Option<PathBuf>,
     /// The lag times the diffusion coefficient is fitted over, FROM:TO in ps (in frames when the
     /// frames carry no times); by default 10 % to 90 % of the longest lag, as gmx msd's
     /// -beginfit and -endfit.

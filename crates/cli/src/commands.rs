@@ -549,6 +549,7 @@ pub(crate) struct AnalysisTables {
     rmsd: Option<crate::output::AtomicFile>,
     cluster: Option<crate::output::AtomicFile>,
     msd_lags: Option<MsdLags>,
+    dihedral: Option<crate::output::AtomicFile>,
     profile: Option<(crate::output::AtomicFile, ProfileMean)>,
     /// `--rmsf-table`, the fluctuations so far and each atom's first columns (the first
     /// frame's).
@@ -901,6 +902,12 @@ impl AnalysisTables {
                     },
                 )
             }),
+            dihedral: per_frame_table(
+                &analysis.dihedral_table,
+                "--dihedral-table",
+                "frame,time,chain,resid,resname,phi,psi,omega",
+                whole,
+            )?,
             rmsf: whole_run_table(
                 &analysis.rmsf_table,
                 "--rmsf-table",
@@ -1028,6 +1035,26 @@ impl AnalysisTables {
         {
             lags.add(f, unwrapped, md)?;
         }
+        if let Some(t) = &mut self.dihedral {
+            let angle = |a: Option<f64>| a.map(|a| format!("{a:.3}")).unwrap_or_default();
+            let label = |v: &[texmap_md_io::Label], i: usize| {
+                v.get(i).map(|l| l.to_string()).unwrap_or_default()
+            };
+            let mut rows = String::new();
+            for r in texmap_md_io::dihedrals::backbone_dihedrals(md) {
+                let i = r.atoms.start;
+                rows.push_str(&format!(
+                    "{f},{time},{},{},{},{},{},{}\n",
+                    label(&md.chains, i),
+                    md.res_ids.get(i).map(|n| n.to_string()).unwrap_or_default(),
+                    label(&md.res_names, i),
+                    angle(r.phi),
+                    angle(r.psi),
+                    angle(r.omega)
+                ));
+            }
+            t.write(&rows)?;
+        }
         if let Some((_, mean)) = &mut self.profile {
             mean.add(f, md)?;
         }
@@ -1064,6 +1091,7 @@ impl AnalysisTables {
             })
             .transpose()?;
         for t in [
+            self.dihedral,
             msd_lags,
             profile,
             rmsf,

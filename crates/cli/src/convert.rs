@@ -65,7 +65,7 @@ pub struct ConvertArgs {
     /// names, positions to 0.001 nm, velocities, the box), .pdb (multi-MODEL, the 'occupancy'
     /// and 'bfactor' properties in their columns), .dcd, .xtc (positions and the box only).
     /// Written whole or not at all. Without it, only the analyses' tables are written
-    /// (--rdf-table, --msd-table, --msd-lags, --rmsd-table, --rmsf-table, --profile-table, --cluster-table, --grain-table, --defect-table).
+    /// (--rdf-table, --msd-table, --msd-lags, --rmsd-table, --rmsf-table, --profile-table, --dihedral-table, --cluster-table, --grain-table, --defect-table).
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
     #[command(flatten)]
@@ -132,11 +132,12 @@ pub fn convert(a: &ConvertArgs) -> Result<()> {
                 &a.analysis.rmsd_table,
                 &a.analysis.rmsf_table,
                 &a.analysis.profile_table,
+                &a.analysis.dihedral_table,
                 &a.analysis.cluster_table,
             ];
             if tables.iter().all(|t| t.is_none()) {
                 return usage(
-                    "nothing to write: give -o FILE, or a table of the analyses (--rdf-table, --msd-table, --msd-lags, --rmsd-table, --rmsf-table, --profile-table, --cluster-table, --grain-table, --defect-table)",
+                    "nothing to write: give -o FILE, or a table of the analyses (--rdf-table, --msd-table, --msd-lags, --rmsd-table, --rmsf-table, --profile-table, --dihedral-table, --cluster-table, --grain-table, --defect-table)",
                 );
             }
             if a.select.is_some() || a.columns.is_some() {

@@ -749,6 +749,74 @@ fn a_kind_the_first_frame_lacked_is_refused() {
     }
 }
 
+/// `--dihedral-table`: the φ and ψ of a 23-residue protein (PDB 3JQH with noise, written by
+/// MDAnalysis) in every one of 12 frames equal MDAnalysis's Ramachandran for residues 2–22,
+/// and ω its Dihedral over each residue's omega_selection(); the termini leave the angle they
+/// lack empty.
+#[test]
+fn dihedral_table_is_mdanalysis_ramachandran() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("rama.csv");
+    run_ok(&[
+        "convert",
+        &md_data("dihedrals/helix.dcd"),
+        "--topology",
+        &md_data("dihedrals/helix.pdb"),
+        "--dihedral-table",
+        out.to_str().unwrap(),
+        "-q",
+    ]);
+    let text = std::fs::read_to_string(&out).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next(),
+        Some("frame,time,chain,resid,resname,phi,psi,omega")
+    );
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 12 * 23);
+    let reference = json("dihedrals/ramachandran_reference.json");
+    let resids = numbers(&reference["resids"]);
+    let omega_resids = numbers(&reference["omega_resids"]);
+    // Angles on the circle: -180 and 180 are the same.
+    let near = |a: f64, b: f64| ((a - b + 540.0) % 360.0 - 180.0).abs() < 2e-3;
+    for f in 0..12 {
+        let frame: Vec<&Vec<&str>> = rows.iter().filter(|r| r[0] == f.to_string()).collect();
+        assert_eq!(frame.len(), 23);
+        let row = |resid: f64| {
+            frame
+                .iter()
+                .find(|r| r[3].parse::<f64>().unwrap() == resid)
+                .unwrap()
+        };
+        let angles = reference["angles"][f].as_array().unwrap();
+        for (k, resid) in resids.iter().enumerate() {
+            let want = numbers(&angles[k]);
+            let r = row(*resid);
+            for (col, w) in [(5, want[0]), (6, want[1])] {
+                let got: f64 = r[col].parse().unwrap();
+                assert!(
+                    near(got, w),
+                    "frame {f} residue {resid} col {col}: {got} vs {w}"
+                );
+            }
+        }
+        let omega = numbers(&reference["omega"][f]);
+        for (resid, want) in omega_resids.iter().zip(&omega) {
+            let got: f64 = row(*resid)[7].parse().unwrap();
+            assert!(
+                near(got, *want),
+                "frame {f} residue {resid} omega: {got} vs {want}"
+            );
+        }
+        assert_eq!(row(1.0)[5], "", "the first residue has no phi");
+        assert_eq!(
+            (row(23.0)[6], row(23.0)[7]),
+            ("", ""),
+            "the last has no psi, omega"
+        );
+    }
+}
+
 /// `--msd-lags`: the mean squared displacement over every time origin of the same random
 /// walks equals MDAnalysis's EinsteinMSD (the direct sum, fft=False) per lag, for all atoms
 /// and per kind, and the diffusion coefficients printed equal a least-squares line through

@@ -210,6 +210,25 @@ fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
     norm(sub(a, b))
 }
 
+/// The indices of the first `N`, `CA`, `C` and `O` (or `O1`, `OT1`) among `atoms` of `frame`
+/// (which has names), `usize::MAX` for each missing.
+pub(crate) fn backbone_of(frame: &Frame, atoms: Range<usize>) -> [usize; 4] {
+    let mut bb = [usize::MAX; 4];
+    for i in atoms {
+        let k = match frame.names[i].as_str() {
+            "N" => 0,
+            "CA" => 1,
+            "C" => 2,
+            "O" | "O1" | "OT1" => 3,
+            _ => continue,
+        };
+        if bb[k] == usize::MAX {
+            bb[k] = i;
+        }
+    }
+    bb
+}
+
 /// The residues of `frame` with a complete backbone, with their breaks.
 fn backbone_residues(frame: &Frame) -> Vec<BackboneResidue> {
     let mut out: Vec<BackboneResidue> = Vec::new();
@@ -217,19 +236,7 @@ fn backbone_residues(frame: &Frame) -> Vec<BackboneResidue> {
         return out;
     }
     for atoms in residue_ranges(frame) {
-        let mut bb = [usize::MAX; 4];
-        for i in atoms.clone() {
-            let k = match frame.names[i].as_str() {
-                "N" => 0,
-                "CA" => 1,
-                "C" => 2,
-                "O" | "O1" | "OT1" => 3,
-                _ => continue,
-            };
-            if bb[k] == usize::MAX {
-                bb[k] = i;
-            }
-        }
+        let bb = backbone_of(frame, atoms.clone());
         if bb.contains(&usize::MAX)
             || bb
                 .iter()
