@@ -185,7 +185,7 @@ pub fn convert(a: &ConvertArgs) -> Result<()> {
     if let Some(r) = &a.analysis.displacement_reference {
         crate::commands::set_displacement_reference(&mut plan, r, &mut traj, &a.file, options)?;
     }
-    let mut tables = crate::commands::AnalysisTables::create(&a.analysis, true)?;
+    let mut tables = crate::tables::AnalysisTables::create(&a.analysis, true)?;
     let mut smoother = texmap_md_io::smooth::Smoother::new(a.smooth as usize);
     let mut md = MdFrame::new();
     let pb = crate::commands::progress(frames.len() as u64, "converting");

@@ -11,6 +11,7 @@ mod envmap;
 mod movie;
 mod output;
 mod scene;
+mod tables;
 mod terrain;
 mod terrain_fly;
 mod terrain_models;

@@ -1,0 +1,614 @@
+//! The CSV tables of the analyses that `texmap render` and `texmap convert` write beside
+//! their frames: per frame (defects, grains, clusters, MSD, RMSD, dihedrals) or over the whole
+//! run (g(r), the MSD over every time origin, RMSF, density profiles). Each is written under a
+//! temporary name and moved into place at the end, so a failed run leaves none.
+
+use std::path::PathBuf;
+
+use anyhow::{Result, bail};
+use texmap_md_io::Frame as MdFrame;
+
+use crate::args::{AnalysisArgs, usage};
+
+/// A per-frame CSV table for `flag` at `path`, its `header` row written (unless empty: a
+/// header known only at the first frame); refused when the run
+/// draws only part of the frames (`whole` false: --shard), where every part would write it.
+pub(crate) fn per_frame_table(
+    path: &Option<PathBuf>,
+    flag: &str,
+    header: &str,
+    whole: bool,
+) -> Result<Option<crate::output::AtomicFile>> {
+    let why = "every part would write the same table";
+    let Some(mut t) = whole_run_table(path, flag, why, whole)? else {
+        return Ok(None);
+    };
+    if !header.is_empty() {
+        t.write(&format!("{header}\n"))?;
+    }
+    Ok(Some(t))
+}
+
+/// The file of a table that needs every frame in one run (`whole`): refused for a part of a
+/// render split with --shard, saying `why`.
+fn whole_run_table(
+    path: &Option<PathBuf>,
+    flag: &str,
+    why: &str,
+    whole: bool,
+) -> Result<Option<crate::output::AtomicFile>> {
+    match path {
+        None => Ok(None),
+        Some(_) if !whole => usage(format!(
+            "{flag} with --shard (or a Slurm array): {why}; write it in a run of its own"
+        )),
+        Some(p) => Ok(Some(crate::output::AtomicFile::create(p)?)),
+    }
+}
+
+/// The per-frame tables of the analyses (`--defect-table`, `--grain-table`), shared by
+/// `texmap render` and `texmap convert`.
+pub(crate) struct AnalysisTables {
+    defect: Option<crate::output::AtomicFile>,
+    grain: Option<crate::output::AtomicFile>,
+    rdf: Option<(crate::output::AtomicFile, RdfMean)>,
+    /// `--msd-table`, and the kinds of its columns (set at the first frame).
+    msd: Option<(crate::output::AtomicFile, Vec<texmap_md_io::Label>)>,
+    rmsd: Option<crate::output::AtomicFile>,
+    cluster: Option<crate::output::AtomicFile>,
+    msd_lags: Option<MsdLags>,
+    dihedral: Option<crate::output::AtomicFile>,
+    profile: Option<(crate::output::AtomicFile, ProfileMean)>,
+    /// `--rmsf-table`, the fluctuations so far and each atom's first columns (the first
+    /// frame's).
+    rmsf: Option<(
+        crate::output::AtomicFile,
+        texmap_md_io::rmsf::Fluctuation,
+        Vec<String>,
+    )>,
+}
+
+/// Atom `i`'s first columns in the per-atom tables: its index, id, name, residue name,
+/// residue number and chain (empty where the file has none).
+fn atom_columns(md: &MdFrame, i: usize) -> String {
+    let text = |v: &[texmap_md_io::Label]| v.get(i).map(|l| l.to_string()).unwrap_or_default();
+    let number = |v: &[i64]| v.get(i).map(|n| n.to_string()).unwrap_or_default();
+    format!(
+        "{i},{},{},{},{},{}",
+        number(&md.ids),
+        text(&md.names),
+        text(&md.res_names),
+        number(&md.res_ids),
+        text(&md.chains)
+    )
+}
+
+/// `--msd-lags`: every frame's unwrapped positions, averaged over every time origin at the end.
+struct MsdLags {
+    file: crate::output::AtomicFile,
+    all: texmap_md_io::msd::AllOrigins,
+    /// Each kept frame's time (ps), if it has one.
+    times: Vec<Option<f64>>,
+    /// The kinds of the columns, sorted by name, and each atom's (set at the first frame).
+    kinds: Vec<texmap_md_io::Label>,
+    kind: Vec<usize>,
+    fit: Option<(f64, f64)>,
+}
+
+impl MsdLags {
+    fn add(&mut self, f: usize, unwrapped: &[[f64; 3]], md: &MdFrame) -> Result<()> {
+        if self.all.frames() == 0 {
+            // The first frame sets the kinds, so every atom has one.
+            self.kind = kinds_of(md, &mut self.kinds).unwrap_or_default();
+        }
+        self.all
+            .push(unwrapped)
+            .map_err(|e| anyhow::anyhow!("--msd-lags: frame {f}: {e}"))?;
+        self.times.push(md.time);
+        Ok(())
+    }
+
+    /// The lag times (ps) when every frame has a time and they are evenly spaced.
+    fn lag_times(&self) -> Option<Vec<f64>> {
+        let times: Vec<f64> = self.times.iter().copied().collect::<Option<_>>()?;
+        let t = times.len();
+        if t < 2 {
+            return None;
+        }
+        let dt = (times[t - 1] - times[0]) / (t - 1) as f64;
+        let even = dt > 0.0
+            && times
+                .iter()
+                .enumerate()
+                .all(|(k, x)| (x - times[0] - k as f64 * dt).abs() <= 1e-3 * dt + 1e-6 * x.abs());
+        even.then(|| (0..t).map(|m| m as f64 * dt).collect())
+    }
+
+    /// The table written, each column's diffusion coefficient printed.
+    fn finish(mut self) -> Result<crate::output::AtomicFile> {
+        let lags = self
+            .all
+            .mean(&self.kind, self.kinds.len())
+            .map_err(|e| anyhow::anyhow!("--msd-lags: {e}"))?;
+        let times = self.lag_times();
+        let mut text = String::from("lag,time,msd");
+        for k in &self.kinds {
+            text.push_str(&format!(",msd_{k}"));
+        }
+        text.push('\n');
+        for m in 0..lags.total.len() {
+            let time = times
+                .as_ref()
+                .map(|t| crate::scene::compact(t[m], 6))
+                .unwrap_or_default();
+            text.push_str(&format!("{m},{time},{:.6}", lags.total[m]));
+            for column in &lags.kinds {
+                text.push_str(&format!(",{:.6}", column[m]));
+            }
+            text.push('\n');
+        }
+        self.file.write(&text)?;
+        let (x, unit): (Vec<f64>, &str) = match &times {
+            Some(t) => (t.clone(), "ps"),
+            None => ((0..lags.total.len()).map(|m| m as f64).collect(), "frames"),
+        };
+        let longest = x.last().copied().unwrap_or(0.0);
+        let (from, to) = self.fit.unwrap_or((0.1 * longest, 0.9 * longest));
+        let span = format!(
+            "{}–{}",
+            crate::scene::compact(from, 4),
+            crate::scene::compact(to, 4)
+        );
+        let names = std::iter::once("every atom".to_string())
+            .chain(self.kinds.iter().map(|k| format!("the {k} atoms")));
+        for (name, msd) in names.zip(std::iter::once(&lags.total).chain(&lags.kinds)) {
+            match texmap_md_io::msd::fit_diffusion(&x, msd, from, to) {
+                // Å²/ps over 6 is 10⁻⁴ cm²/s.
+                Some(fit) if times.is_some() => eprintln!(
+                    "texmap: --msd-lags: D = {:.4} × 10⁻⁵ cm²/s for {name} (MSD = 6 D t fitted over {span} ps, {} lags)",
+                    fit.d * 10.0,
+                    fit.points
+                ),
+                Some(fit) => eprintln!(
+                    "texmap: --msd-lags: D = {:.6} Å² per frame for {name} (the frames carry no evenly spaced times; MSD = 6 D t fitted over lags {span} {unit}, {} lags)",
+                    fit.d, fit.points
+                ),
+                None => eprintln!(
+                    "texmap: warning: --msd-lags: fewer than two lags in {span} {unit} to fit a diffusion coefficient for {name} (--msd-fit)"
+                ),
+            }
+        }
+        Ok(self.file)
+    }
+}
+
+/// Each atom's kind (its type, else its element: [`texmap_md_io::rdf::atom_kind`]) as an index
+/// into `kinds`, which is first filled with `md`'s kinds sorted by name when empty (the first
+/// frame sets a table's columns). An atom of a kind not in `kinds` is returned as the error.
+fn kinds_of(
+    md: &MdFrame,
+    kinds: &mut Vec<texmap_md_io::Label>,
+) -> std::result::Result<Vec<usize>, (usize, texmap_md_io::Label)> {
+    let of: Vec<texmap_md_io::Label> = (0..md.n_atoms())
+        .map(|i| texmap_md_io::rdf::atom_kind(md, i))
+        .collect();
+    if kinds.is_empty() {
+        *kinds = of.clone();
+        kinds.sort_by(|a, b| a.as_str().cmp(b.as_str()));
+        kinds.dedup();
+    }
+    of.iter()
+        .enumerate()
+        .map(|(i, k)| kinds.iter().position(|s| s == k).ok_or((i, *k)))
+        .collect()
+}
+
+/// The error of [`kinds_of`] for `flag`'s table at frame `f`.
+fn new_kind(
+    flag: &str,
+    f: usize,
+    (i, k): (usize, texmap_md_io::Label),
+    kinds: &[texmap_md_io::Label],
+) -> anyhow::Error {
+    let known: Vec<String> = kinds.iter().map(|k| k.to_string()).collect();
+    anyhow::anyhow!(
+        "{flag}: frame {f}'s atom {i} is of kind {k}, which the first frame did not have ({}): the columns are the first frame's kinds",
+        known.join(", ")
+    )
+}
+
+/// `--profile-table`: the frames' density profiles summed, to be written as their mean.
+struct ProfileMean {
+    /// The cell edge (0, 1, 2) and its name as the table's first column.
+    axis: usize,
+    name: String,
+    bins: usize,
+    /// The kinds of the columns, sorted by name (the first frame's).
+    kinds: Vec<texmap_md_io::Label>,
+    /// Per bin: position, number, mass, charge, then each kind.
+    sums: Vec<Vec<f64>>,
+    charges: bool,
+    frames: usize,
+}
+
+impl ProfileMean {
+    fn add(&mut self, f: usize, md: &MdFrame) -> Result<()> {
+        let kind = kinds_of(md, &mut self.kinds)
+            .map_err(|e| new_kind("--profile-table", f, e, &self.kinds))?;
+        let p = texmap_md_io::profile::density_profile(
+            md,
+            self.axis,
+            self.bins,
+            &kind,
+            self.kinds.len(),
+        )
+        .map_err(|e| anyhow::anyhow!("--profile-table: {e}"))?;
+        if self.frames == 0 {
+            self.charges = p.charge.is_some();
+            self.sums = vec![vec![0.0; 4 + self.kinds.len()]; self.bins];
+        } else if self.charges != p.charge.is_some() {
+            bail!(
+                "--profile-table: frame {f} has charges where the first frame had none, or none where it had them"
+            );
+        }
+        for (b, row) in self.sums.iter_mut().enumerate() {
+            row[0] += p.position[b];
+            row[1] += p.number[b];
+            row[2] += p.mass[b];
+            row[3] += p.charge.as_ref().map_or(0.0, |c| c[b]);
+            for (v, k) in row[4..].iter_mut().zip(&p.kinds) {
+                *v += k[b];
+            }
+        }
+        self.frames += 1;
+        Ok(())
+    }
+
+    fn csv(&self) -> String {
+        let mut text = format!("{},number,mass", self.name);
+        if self.charges {
+            text.push_str(",charge");
+        }
+        for k in &self.kinds {
+            text.push_str(&format!(",number_{k}"));
+        }
+        text.push('\n');
+        let n = self.frames.max(1) as f64;
+        for row in &self.sums {
+            text.push_str(&format!(
+                "{:.4},{:.8},{:.8}",
+                row[0] / n,
+                row[1] / n,
+                row[2] / n
+            ));
+            if self.charges {
+                text.push_str(&format!(",{:.8}", row[3] / n));
+            }
+            for v in &row[4..] {
+                text.push_str(&format!(",{:.8}", v / n));
+            }
+            text.push('\n');
+        }
+        text
+    }
+}
+
+/// `--rdf-table`: the frames' g(r) summed, to be written as their mean.
+#[derive(Default)]
+struct RdfMean {
+    r: Vec<f64>,
+    /// The kind pairs of the partial functions (`Si-O`), the first frame's.
+    kinds: Vec<String>,
+    /// Per bin: the total, then each partial.
+    sums: Vec<Vec<f64>>,
+    frames: usize,
+}
+
+impl RdfMean {
+    fn add(&mut self, f: usize, g: &texmap_md_io::rdf::Rdf) -> Result<()> {
+        let kinds: Vec<String> = g
+            .partial
+            .iter()
+            .map(|p| format!("{}-{}", p.kinds[0], p.kinds[1]))
+            .collect();
+        if self.frames == 0 {
+            self.r = g.r.clone();
+            self.kinds = kinds;
+            self.sums = vec![vec![0.0; 1 + g.partial.len()]; g.r.len()];
+        } else if kinds != self.kinds {
+            bail!(
+                "--rdf-partial: frame {f}'s kinds of atoms ({}) are not the first frame's ({}): a mean of partial g(r) needs the same pairs in every frame",
+                kinds.join(", "),
+                self.kinds.join(", ")
+            );
+        }
+        for (k, row) in self.sums.iter_mut().enumerate() {
+            row[0] += g.total[k];
+            for (v, p) in row[1..].iter_mut().zip(&g.partial) {
+                *v += p.g[k];
+            }
+        }
+        self.frames += 1;
+        Ok(())
+    }
+
+    fn csv(&self) -> String {
+        let mut text = String::from("r,g");
+        for k in &self.kinds {
+            text.push_str(&format!(",g_{k}"));
+        }
+        text.push('\n');
+        let n = self.frames.max(1) as f64;
+        for (r, row) in self.r.iter().zip(&self.sums) {
+            text.push_str(&format!("{r:.6}"));
+            for v in row {
+                text.push_str(&format!(",{:.6}", v / n));
+            }
+            text.push('\n');
+        }
+        text
+    }
+}
+
+impl AnalysisTables {
+    /// The tables `analysis` asks for, their headers written (`whole`: see [`per_frame_table`]).
+    pub(crate) fn create(analysis: &AnalysisArgs, whole: bool) -> Result<AnalysisTables> {
+        Ok(AnalysisTables {
+            defect: per_frame_table(
+                &analysis.defect_table,
+                "--defect-table",
+                "frame,vacancies,interstitials",
+                whole,
+            )?,
+            grain: per_frame_table(
+                &analysis.grain_table,
+                "--grain-table",
+                "frame,grain,atoms,crystalline,structure,qx,qy,qz,qw",
+                whole,
+            )?,
+            msd: per_frame_table(&analysis.msd_table, "--msd-table", "", whole)?
+                .map(|t| (t, Vec::new())),
+            rmsd: per_frame_table(
+                &analysis.rmsd_table,
+                "--rmsd-table",
+                "frame,time,rmsd",
+                whole,
+            )?,
+            cluster: per_frame_table(
+                &analysis.cluster_table,
+                "--cluster-table",
+                "frame,cluster,atoms,x,y,z,rg",
+                whole,
+            )?,
+            profile: whole_run_table(
+                &analysis.profile_table,
+                "--profile-table",
+                "every part would write its own mean",
+                whole,
+            )?
+            .map(|t| {
+                (
+                    t,
+                    ProfileMean {
+                        axis: match analysis.profile_axis.as_str() {
+                            "x" | "a" => 0,
+                            "y" | "b" => 1,
+                            _ => 2,
+                        },
+                        name: analysis.profile_axis.clone(),
+                        bins: analysis.profile_bins as usize,
+                        kinds: Vec::new(),
+                        sums: Vec::new(),
+                        charges: false,
+                        frames: 0,
+                    },
+                )
+            }),
+            dihedral: per_frame_table(
+                &analysis.dihedral_table,
+                "--dihedral-table",
+                "frame,time,chain,resid,resname,phi,psi,omega",
+                whole,
+            )?,
+            rmsf: whole_run_table(
+                &analysis.rmsf_table,
+                "--rmsf-table",
+                "the mean position needs every frame in one run",
+                whole,
+            )?
+            .map(|t| (t, texmap_md_io::rmsf::Fluctuation::new(), Vec::new())),
+            msd_lags: whole_run_table(
+                &analysis.msd_lags,
+                "--msd-lags",
+                "the average over every time origin needs every frame in one run",
+                whole,
+            )?
+            .map(|file| MsdLags {
+                file,
+                all: texmap_md_io::msd::AllOrigins::new(
+                    analysis.msd_memory.saturating_mul(1 << 20),
+                ),
+                times: Vec::new(),
+                kinds: Vec::new(),
+                kind: Vec::new(),
+                fit: analysis.msd_fit,
+            }),
+            rdf: whole_run_table(
+                &analysis.rdf_table,
+                "--rdf-table",
+                "every part would write its own mean",
+                whole,
+            )?
+            .map(|t| (t, RdfMean::default())),
+        })
+    }
+
+    /// Frame `f`'s rows, from what `plan` found in it (`md`, as prepared).
+    pub(crate) fn write(
+        &mut self,
+        f: usize,
+        plan: &texmap_md_scene::MolPlan,
+        md: &MdFrame,
+    ) -> Result<()> {
+        let time = md
+            .time
+            .map(|t| crate::scene::compact(t, 6))
+            .unwrap_or_default();
+        if let Some(t) = &mut self.cluster
+            && let Some(c) = plan.last_clusters()
+        {
+            let mut rows = String::new();
+            for (k, (size, (p, rg))) in c
+                .sizes
+                .iter()
+                .zip(c.centers.iter().zip(&c.gyration))
+                .enumerate()
+            {
+                rows.push_str(&format!(
+                    "{f},{k},{size},{:.4},{:.4},{:.4},{rg:.4}\n",
+                    p[0], p[1], p[2]
+                ));
+            }
+            t.write(&rows)?;
+        }
+        if let Some(t) = &mut self.rmsd
+            && let Some(rmsd) = plan.last_fit_rmsd()
+        {
+            t.write(&format!("{f},{time},{rmsd:.6}\n"))?;
+        }
+        if let Some((t, kinds)) = &mut self.msd
+            && let Some(d2) = md.property(texmap_md_scene::MSD)
+        {
+            let first = kinds.is_empty();
+            let of = kinds_of(md, kinds).map_err(|e| new_kind("--msd-table", f, e, kinds))?;
+            if first {
+                let mut header = String::from("frame,time,msd");
+                for k in kinds.iter() {
+                    header.push_str(&format!(",msd_{k}"));
+                }
+                t.write(&format!("{header}\n"))?;
+            }
+            let mean = |pick: &dyn Fn(usize) -> bool| {
+                let (sum, count) = d2
+                    .iter()
+                    .enumerate()
+                    .filter(|(i, _)| pick(*i))
+                    .fold((0.0f64, 0usize), |(s, c), (_, v)| (s + *v as f64, c + 1));
+                if count == 0 {
+                    String::new()
+                } else {
+                    format!("{:.6}", sum / count as f64)
+                }
+            };
+            let mut row = format!("{f},{time},{}", mean(&|_| true));
+            for k in 0..kinds.len() {
+                row.push(',');
+                row.push_str(&mean(&|i| of.get(i) == Some(&k)));
+            }
+            t.write(&format!("{row}\n"))?;
+        }
+        if let Some(t) = &mut self.defect
+            && let Some((vacancies, interstitials)) = plan.last_defects()
+        {
+            t.write(&format!("{f},{vacancies},{interstitials}\n"))?;
+        }
+        if let Some(t) = &mut self.grain
+            && let Some(grains) = plan.last_grains()
+        {
+            let mut rows = String::new();
+            for (g, grain) in grains.iter().enumerate() {
+                let [x, y, z, w] = grain.orientation;
+                rows.push_str(&format!(
+                    "{f},{g},{},{},{},{x:.6},{y:.6},{z:.6},{w:.6}\n",
+                    grain.size,
+                    grain.crystalline,
+                    grain.structure.name()
+                ));
+            }
+            t.write(&rows)?;
+        }
+        if let Some((_, mean)) = &mut self.rdf
+            && let Some(g) = plan.last_rdf()
+        {
+            mean.add(f, g)?;
+        }
+        if let Some(lags) = &mut self.msd_lags
+            && let Some(unwrapped) = plan.last_unwrapped()
+        {
+            lags.add(f, unwrapped, md)?;
+        }
+        if let Some(t) = &mut self.dihedral {
+            let angle = |a: Option<f64>| a.map(|a| format!("{a:.3}")).unwrap_or_default();
+            let label = |v: &[texmap_md_io::Label], i: usize| {
+                v.get(i).map(|l| l.to_string()).unwrap_or_default()
+            };
+            let mut rows = String::new();
+            for r in texmap_md_io::dihedrals::backbone_dihedrals(md) {
+                let i = r.atoms.start;
+                rows.push_str(&format!(
+                    "{f},{time},{},{},{},{},{},{}\n",
+                    label(&md.chains, i),
+                    md.res_ids.get(i).map(|n| n.to_string()).unwrap_or_default(),
+                    label(&md.res_names, i),
+                    angle(r.phi),
+                    angle(r.psi),
+                    angle(r.omega)
+                ));
+            }
+            t.write(&rows)?;
+        }
+        if let Some((_, mean)) = &mut self.profile {
+            mean.add(f, md)?;
+        }
+        if let Some((_, fluctuation, rows)) = &mut self.rmsf {
+            if fluctuation.frames() == 0 {
+                *rows = (0..md.n_atoms()).map(|i| atom_columns(md, i)).collect();
+            }
+            fluctuation
+                .add(&md.positions)
+                .map_err(|e| anyhow::anyhow!("--rmsf-table: frame {f}: {e}"))?;
+        }
+        Ok(())
+    }
+
+    /// Every table moved into place (`--rdf-table`'s mean written first).
+    pub(crate) fn commit(self) -> Result<()> {
+        let rdf = self
+            .rdf
+            .map(|(mut t, mean)| t.write(&mean.csv()).map(|()| t));
+        let msd = self.msd.map(|(t, _)| t);
+        let msd_lags = self.msd_lags.map(MsdLags::finish).transpose()?;
+        let profile = self
+            .profile
+            .map(|(mut t, mean)| t.write(&mean.csv()).map(|()| t))
+            .transpose()?;
+        let rmsf = self
+            .rmsf
+            .map(|(mut t, fluctuation, rows)| {
+                let mut text = String::from("atom,id,name,resname,resid,chain,rmsf\n");
+                for (row, r) in rows.iter().zip(fluctuation.rmsf()) {
+                    text.push_str(&format!("{row},{r:.6}\n"));
+                }
+                t.write(&text).map(|()| t)
+            })
+            .transpose()?;
+        for t in [
+            self.dihedral,
+            msd_lags,
+            profile,
+            rmsf,
+            self.defect,
+            self.grain,
+            self.rmsd,
+            self.cluster,
+            msd,
+            rdf.transpose()?,
+        ]
+        .into_iter()
+        .flatten()
+        {
+            t.commit()?;
+        }
+        Ok(())
+    }
+}
