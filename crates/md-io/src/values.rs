@@ -85,7 +85,9 @@ impl AtomValues {
             }
         };
         let names = fields(header);
-        if names.iter().all(|t| t.parse::<f32>().is_ok()) {
+        // A header names every column; a line with a number in it is data (and a stray word
+        // among numbers is the plain reading's error, with its line).
+        if names.iter().any(|t| t.parse::<f32>().is_ok()) {
             return AtomValues::parse(text, name);
         }
         let at = |line: usize| Location {
@@ -298,6 +300,11 @@ mod tests {
             .to_string();
         assert!(e.contains("line 2") && e.contains('x'), "{e}");
         assert!(AtomValues::parse_column("a,rmsf\n", "empty.csv", "rmsf").is_err());
+        // A word among numbers is a bad value, not a header.
+        let e = AtomValues::parse_column("1 x\n2 3\n", "typo.txt", "rmsf")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("line 1") && e.contains("numbers"), "{e}");
     }
 
     #[test]
