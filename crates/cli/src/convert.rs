@@ -65,7 +65,8 @@ pub struct ConvertArgs {
     /// names, positions to 0.001 nm, velocities, the box), .pdb (multi-MODEL, the 'occupancy'
     /// and 'bfactor' properties in their columns), .dcd, .xtc (positions and the box only).
     /// Written whole or not at all. Without it, only the analyses' tables are written
-    /// (--rdf-table, --msd-table, --msd-lags, --rmsd-table, --rmsf-table, --profile-table, --dihedral-table, --cluster-table, --grain-table, --defect-table).
+    /// (--rdf-table, --msd-table, --msd-lags, --rmsd-table, --rmsf-table, --profile-table,
+    /// --dihedral-table, --cluster-table, --grain-table, --defect-table).
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
     #[command(flatten)]
@@ -81,6 +82,10 @@ Examples:
   texmap convert cascade.lammpstrj --wigner-seitz atoms --select 'prop site_occupancy != 1' -o defects.xyz
   texmap convert 1abc.cif --compute 'bfactor=coordination' --coordination 3.5 -o coord.pdb  # a property in the B-factor column (PyMOL, ChimeraX)
   texmap convert melt.lammpstrj --frames 100: --rdf 10 --rdf-partial --rdf-table gr.csv    # g(r), total and per pair of types, averaged over frames 100 on
+  texmap convert md.xtc --topology md.gro --msd-lags lags.csv                               # MSD over every time origin; prints D per kind
+  texmap convert md.xtc --topology md.gro --align backbone --rmsf-table rmsf.csv            # flexibility; colour by it: render --property rmsf=rmsf.csv
+  texmap convert slab.lammpstrj --profile-table rho.csv --profile-axis z --profile-bins 200  # density profile across an interface
+  texmap convert md.xtc --topology md.gro --dihedral-table rama.csv                         # phi, psi, omega per residue and frame
 
 The selection and the analyses are those of texmap render; an analysis's property (cna is a
 selection keyword; coordination, grain, centrosymmetry, shear_strain, ... are properties) is

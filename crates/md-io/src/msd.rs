@@ -92,6 +92,27 @@ impl fmt::Display for MsdError {
 
 impl std::error::Error for MsdError {}
 
+/// The checks a frame passes before it is followed: every position finite and, after a first
+/// frame of `first` atoms, as many atoms.
+pub(crate) fn check_frame<T: Copy + Into<f64>>(
+    positions: &[[T; 3]],
+    first: Option<usize>,
+) -> Result<(), MsdError> {
+    if let Some(i) = positions
+        .iter()
+        .position(|p| p.iter().any(|x| !(*x).into().is_finite()))
+    {
+        return Err(MsdError::NotFinite(i));
+    }
+    match first {
+        Some(first) if first != positions.len() => Err(MsdError::AtomCount {
+            first,
+            frame: positions.len(),
+        }),
+        _ => Ok(()),
+    }
+}
+
 /// Each atom's position unwrapped by continuity since the first frame (see the module docs).
 #[derive(Clone, Debug, Default)]
 pub struct Tracker {
@@ -121,13 +142,10 @@ impl Tracker {
     /// the first frame given.
     pub fn add(&mut self, frame: &Frame) -> Result<Vec<f64>, MsdError> {
         let n = frame.n_atoms();
-        if let Some(i) = frame
-            .positions
-            .iter()
-            .position(|p| p.iter().any(|x| !x.is_finite()))
-        {
-            return Err(MsdError::NotFinite(i));
-        }
+        check_frame(
+            &frame.positions,
+            (self.frames > 0).then_some(self.origin.len()),
+        )?;
         let now: Vec<[f64; 3]> = frame.positions.iter().map(|p| p.map(f64::from)).collect();
         self.frames += 1;
         if self.frames == 1 {
@@ -135,13 +153,6 @@ impl Tracker {
             self.unwrapped = now.clone();
             self.last = now;
             return Ok(vec![0.0; n]);
-        }
-        if n != self.origin.len() {
-            self.frames -= 1;
-            return Err(MsdError::AtomCount {
-                first: self.origin.len(),
-                frame: n,
-            });
         }
         for ((u, last), p) in self.unwrapped.iter_mut().zip(&mut self.last).zip(&now) {
             let step: [f64; 3] = std::array::from_fn(|k| p[k] - last[k]);
@@ -238,20 +249,10 @@ impl AllOrigins {
     /// Keeps a frame's unwrapped positions (Å): every frame has the first's atoms in the
     /// same order.
     pub fn push(&mut self, unwrapped: &[[f64; 3]]) -> Result<(), MsdError> {
-        if let Some(i) = unwrapped
-            .iter()
-            .position(|p| p.iter().any(|x| !x.is_finite()))
-        {
-            return Err(MsdError::NotFinite(i));
-        }
+        check_frame(unwrapped, (self.frames > 0).then_some(self.atoms))?;
         if self.frames == 0 {
             self.atoms = unwrapped.len();
             self.first = unwrapped.to_vec();
-        } else if unwrapped.len() != self.atoms {
-            return Err(MsdError::AtomCount {
-                first: self.atoms,
-                frame: unwrapped.len(),
-            });
         }
         let bytes = (self.frames + 1).saturating_mul(self.atoms.saturating_mul(STORED_BYTES));
         if bytes > self.limit {

@@ -43,20 +43,10 @@ impl Fluctuation {
 
     /// Adds a frame's positions (Å): every frame has the first's atoms in the same order.
     pub fn add(&mut self, positions: &[[f32; 3]]) -> Result<(), MsdError> {
-        if let Some(i) = positions
-            .iter()
-            .position(|p| p.iter().any(|x| !x.is_finite()))
-        {
-            return Err(MsdError::NotFinite(i));
-        }
+        crate::msd::check_frame(positions, (self.frames > 0).then_some(self.mean.len()))?;
         if self.frames == 0 {
             self.mean = vec![[0.0; 3]; positions.len()];
             self.squares = vec![0.0; positions.len()];
-        } else if positions.len() != self.mean.len() {
-            return Err(MsdError::AtomCount {
-                first: self.mean.len(),
-                frame: positions.len(),
-            });
         }
         self.frames += 1;
         let n = self.frames as f64;
