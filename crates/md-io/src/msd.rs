@@ -55,6 +55,9 @@ pub enum MsdError {
         /// The limit in bytes.
         limit: usize,
     },
+    /// An atom's weight (a mass for [`crate::vacf::Velocities::density_of_states`]) is not
+    /// positive and finite.
+    Weight(usize),
     /// [`AllOrigins::mean`] was given a kind for another number of atoms than the frames'.
     KindCount {
         /// The frames' atoms.
@@ -69,19 +72,20 @@ impl fmt::Display for MsdError {
         match self {
             MsdError::AtomCount { first, frame } => write!(
                 f,
-                "this frame has {frame} atoms and the first {first}: displacements follow the same atoms"
+                "this frame has {frame} atoms and the first {first}: every frame must hold the same atoms"
             ),
-            MsdError::NotFinite(i) => write!(f, "atom {i} has no finite position"),
+            MsdError::NotFinite(i) => write!(f, "atom {i} has a coordinate that is not finite"),
             MsdError::Memory {
                 atoms,
                 frames,
                 limit,
             } => write!(
                 f,
-                "{frames} frames of {atoms} atoms need {} MB for the displacements over every time origin, over the limit of {} MB: take fewer frames (a --frames step) or raise the limit",
+                "{frames} frames of {atoms} atoms need {} MB kept for the average over every time origin, over the limit of {} MB: take fewer frames (a --frames step) or raise the limit",
                 (frames * atoms * STORED_BYTES).div_ceil(1 << 20),
                 limit >> 20
             ),
+            MsdError::Weight(i) => write!(f, "atom {i}'s mass is not positive and finite"),
             MsdError::KindCount { atoms, kinds } => write!(
                 f,
                 "{kinds} kinds given for frames of {atoms} atoms: one kind per atom"
@@ -206,12 +210,9 @@ pub const STORED_BYTES: usize = 12;
 /// ```
 #[derive(Clone, Debug)]
 pub struct AllOrigins {
-    atoms: usize,
     first: Vec<[f64; 3]>,
-    /// Frame-major: frame f's atom i at `f * atoms + i`, less the atom's first position.
-    steps: Vec<[f32; 3]>,
-    frames: usize,
-    limit: usize,
+    /// Each frame's displacements from the first.
+    store: crate::correlate::Store,
 }
 
 /// [`AllOrigins::mean`]'s result: per lag 0, 1, … T − 1 frames.
@@ -223,225 +224,91 @@ pub struct LagMsd {
     pub kinds: Vec<Vec<f64>>,
 }
 
-/// Atoms per block whose series one task transforms in turn (their frames stay in cache).
-const BLOCK: usize = 32;
-/// Atoms per parallel task: fixed, so the sums' order does not depend on the threads.
-const TASK: usize = 1024;
-
 impl AllOrigins {
     /// Keeps no frame yet; [`AllOrigins::push`] refuses a frame that would take the kept
     /// displacements over `limit` bytes.
     pub fn new(limit: usize) -> AllOrigins {
         AllOrigins {
-            atoms: 0,
             first: Vec::new(),
-            steps: Vec::new(),
-            frames: 0,
-            limit,
+            store: crate::correlate::Store::new(limit),
         }
     }
 
     /// Frames kept.
     pub fn frames(&self) -> usize {
-        self.frames
+        self.store.frames
     }
 
     /// Keeps a frame's unwrapped positions (Å): every frame has the first's atoms in the
     /// same order.
     pub fn push(&mut self, unwrapped: &[[f64; 3]]) -> Result<(), MsdError> {
-        check_frame(unwrapped, (self.frames > 0).then_some(self.atoms))?;
-        if self.frames == 0 {
-            self.atoms = unwrapped.len();
+        if self.store.frames == 0 {
+            check_frame(unwrapped, None)?;
             self.first = unwrapped.to_vec();
         }
-        let bytes = (self.frames + 1).saturating_mul(self.atoms.saturating_mul(STORED_BYTES));
-        if bytes > self.limit {
-            return Err(MsdError::Memory {
-                atoms: self.atoms,
-                frames: self.frames + 1,
-                limit: self.limit,
-            });
-        }
-        self.steps.extend(
-            unwrapped
-                .iter()
-                .zip(&self.first)
-                .map(|(p, o)| std::array::from_fn(|k| (p[k] - o[k]) as f32)),
-        );
-        self.frames += 1;
-        Ok(())
+        let first = &self.first;
+        self.store.push(unwrapped, |i, p| {
+            std::array::from_fn(|k| (p[k] - first[i][k]) as f32)
+        })
     }
 
     /// The mean squared displacement per lag over every atom and over each of `kinds` kinds,
     /// `kind[i]` (below `kinds`) naming atom i's.
     pub fn mean(&self, kind: &[usize], kinds: usize) -> Result<LagMsd, MsdError> {
-        use rayon::prelude::*;
-        if kind.len() != self.atoms || kind.iter().any(|&k| k >= kinds) {
-            return Err(MsdError::KindCount {
-                atoms: self.atoms,
-                kinds: kind.len(),
-            });
-        }
-        let t = self.frames;
+        self.store.check_kinds(kind, kinds)?;
+        let t = self.store.frames;
         if t == 0 {
             return Ok(LagMsd {
                 total: Vec::new(),
                 kinds: vec![Vec::new(); kinds],
             });
         }
-        // Zero padding to at least 2T keeps the circular correlation from wrapping.
-        let n = (2 * t).next_power_of_two();
-        let forward = rustfft::FftPlanner::<f64>::new().plan_fft_forward(n);
-        let parts: Vec<Sums> = (0..self.atoms.div_ceil(TASK))
-            .into_par_iter()
-            .map(|task| {
-                let atoms = task * TASK..((task + 1) * TASK).min(self.atoms);
-                self.sums(atoms, kind, kinds, n, forward.as_ref())
-            })
-            .collect();
-        let mut total = Sums::new(kinds, n, t);
-        for part in &parts {
-            total.add(part);
-        }
-        let inverse = rustfft::FftPlanner::<f64>::new().plan_fft_inverse(n);
+        // Centred: the displacements do not change, the FFT's rounding shrinks with the values.
+        let spectra = self.store.spectra(kind, kinds, true, None);
         let mut counts = vec![0usize; kinds];
         for &k in kind {
             counts[k] += 1;
         }
-        // Per kind and lag: Σ over the kind's series and origins of the squared displacement.
-        let numerators: Vec<Vec<f64>> = (0..kinds)
-            .map(|g| {
-                let power = &total.power[g];
-                let mut buffer: Vec<rustfft::num_complex::Complex<f64>> = (0..n)
-                    .map(|k| {
-                        // The two series packed in one transform: |Z_k|² + |Z_{n−k}|² over 2
-                        // is the sum of their power spectra.
-                        let p = 0.5 * (power[k] + power[(n - k) % n]);
-                        rustfft::num_complex::Complex::new(p, 0.0)
-                    })
-                    .collect();
-                inverse.process(&mut buffer);
-                let squares = &total.squares[g];
+        // Per kind and lag: Σ over the kind's series and origins of the squared displacement,
+        // Σ (x(k + m) − x(k))² = Σ x(k + m)² + Σ x(k)² − 2 Σ x(k) x(k + m).
+        let numerators: Vec<Vec<f64>> = spectra
+            .correlations()
+            .iter()
+            .zip(&spectra.squares)
+            .map(|(correlation, squares)| {
                 let mut prefix = vec![0.0f64; t + 1];
                 for (f, s) in squares.iter().enumerate() {
                     prefix[f + 1] = prefix[f] + s;
                 }
                 (0..t)
                     .map(|m| {
-                        let correlation = buffer[m].re / n as f64;
-                        let value = prefix[t - m] + (prefix[t] - prefix[m]) - 2.0 * correlation;
+                        let value = prefix[t - m] + (prefix[t] - prefix[m]) - 2.0 * correlation[m];
                         value.max(0.0)
                     })
                     .collect()
             })
             .collect();
-        let per = |sum: &dyn Fn(usize) -> f64, atoms: usize| -> Vec<f64> {
-            (0..t)
-                .map(|m| {
-                    if atoms == 0 {
-                        f64::NAN
-                    } else {
-                        sum(m) / ((t - m) * atoms) as f64
-                    }
-                })
-                .collect()
-        };
         Ok(LagMsd {
-            total: per(&|m| numerators.iter().map(|g| g[m]).sum(), self.atoms),
+            total: per_origin(&|m| numerators.iter().map(|g| g[m]).sum(), t, kind.len()),
             kinds: (0..kinds)
-                .map(|g| per(&|m| numerators[g][m], counts[g]))
+                .map(|g| per_origin(&|m| numerators[g][m], t, counts[g]))
                 .collect(),
         })
     }
+}
 
-    /// The power spectra and squared values of `atoms`' coordinate series, summed per kind.
-    fn sums(
-        &self,
-        atoms: std::ops::Range<usize>,
-        kind: &[usize],
-        kinds: usize,
-        n: usize,
-        forward: &dyn rustfft::Fft<f64>,
-    ) -> Sums {
-        use rustfft::num_complex::Complex;
-        let t = self.frames;
-        let mut sums = Sums::new(kinds, n, t);
-        let mut buffer = vec![Complex::new(0.0, 0.0); n];
-        let mut scratch = vec![Complex::new(0.0, 0.0); forward.get_inplace_scratch_len()];
-        let mut series = [vec![0.0f64; t], vec![0.0f64; t]];
-        let mut block = atoms.start;
-        while block < atoms.end {
-            let end = (block + BLOCK).min(atoms.end);
-            for g in 0..kinds {
-                let mut pending = (block..end)
-                    .filter(|&i| kind[i] == g)
-                    .flat_map(|i| (0..3).map(move |axis| (i, axis)))
-                    .peekable();
-                while let Some(a) = pending.next() {
-                    let b = pending.next();
-                    for (slot, which) in [Some(a), b].into_iter().enumerate() {
-                        let out = &mut series[slot];
-                        match which {
-                            Some((i, axis)) => {
-                                for (f, x) in out.iter_mut().enumerate() {
-                                    *x = f64::from(self.steps[f * self.atoms + i][axis]);
-                                }
-                                // Centred: the displacements do not change, the FFT's
-                                // rounding shrinks with the values.
-                                let mean = out.iter().sum::<f64>() / t as f64;
-                                out.iter_mut().for_each(|x| *x -= mean);
-                            }
-                            None => out.fill(0.0),
-                        }
-                    }
-                    for (f, z) in buffer.iter_mut().enumerate() {
-                        *z = if f < t {
-                            Complex::new(series[0][f], series[1][f])
-                        } else {
-                            Complex::new(0.0, 0.0)
-                        };
-                    }
-                    forward.process_with_scratch(&mut buffer, &mut scratch);
-                    for (p, z) in sums.power[g].iter_mut().zip(&buffer) {
-                        *p += z.norm_sqr();
-                    }
-                    for (s, (x, y)) in sums.squares[g]
-                        .iter_mut()
-                        .zip(series[0].iter().zip(&series[1]))
-                    {
-                        *s += x * x + y * y;
-                    }
-                }
+/// Per lag m < t: `sum(m)` averaged over the `t − m` origins and `atoms` atoms (NaN without
+/// atoms).
+pub(crate) fn per_origin(sum: &dyn Fn(usize) -> f64, t: usize, atoms: usize) -> Vec<f64> {
+    (0..t)
+        .map(|m| {
+            if atoms == 0 {
+                f64::NAN
+            } else {
+                sum(m) / ((t - m) * atoms) as f64
             }
-            block = end;
-        }
-        sums
-    }
-}
-
-/// Per kind: the summed power spectra of its series (`n` bins) and their squared values per
-/// frame.
-struct Sums {
-    power: Vec<Vec<f64>>,
-    squares: Vec<Vec<f64>>,
-}
-
-impl Sums {
-    fn new(kinds: usize, n: usize, t: usize) -> Sums {
-        Sums {
-            power: vec![vec![0.0; n]; kinds],
-            squares: vec![vec![0.0; t]; kinds],
-        }
-    }
-
-    fn add(&mut self, other: &Sums) {
-        for (a, b) in self.power.iter_mut().zip(&other.power) {
-            a.iter_mut().zip(b).for_each(|(a, b)| *a += b);
-        }
-        for (a, b) in self.squares.iter_mut().zip(&other.squares) {
-            a.iter_mut().zip(b).for_each(|(a, b)| *a += b);
-        }
-    }
+        })
+        .collect()
 }
 
 /// A diffusion coefficient from the slope of the mean squared displacement against time
