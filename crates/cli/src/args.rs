@@ -256,6 +256,14 @@ pub fn parse_slice(s: &str) -> Result<[f64; 5], String> {
     }
 }
 
+/// Parses a finite number above 0.
+pub fn parse_positive(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!("{s:?} is not a number above 0")),
+    }
+}
+
 /// Parses `--coordination`: a cutoff in Å from 0.45 (exclusive) to 20.
 pub fn parse_cutoff(s: &str) -> Result<f32, String> {
     match s.trim().parse::<f32>() {
@@ -1301,10 +1309,36 @@ pub struct AnalysisArgs {
     /// -beginfit and -endfit.
     #[arg(long, value_name = "FROM:TO", requires = "msd_lags", value_parser = parse_fit_range)]
     pub msd_fit: Option<(f64, f64)>,
-    /// The most memory --msd-lags may keep positions in, in MB: 12 bytes per atom per frame
-    /// (1,000 frames of 100,000 atoms take 1,145 MB).
+    /// The most memory --msd-lags may keep positions in, and --vacf-table and --vdos-table
+    /// velocities, in MB: 12 bytes per atom per frame each (1,000 frames of 100,000 atoms take
+    /// 1,145 MB).
     #[arg(long, value_name = "MB", default_value_t = 4096)]
     pub msd_memory: usize,
+    /// Also write the velocity autocorrelation function averaged over every time origin as a
+    /// CSV table (gmx velacc, LAMMPS's compute vacf): lag (frames), time (ps, when the frames'
+    /// times are evenly spaced), vacf (Å²/ps², ⟨v(0)·v(t)⟩ over every atom), then one column
+    /// per kind of atom (vacf_O, vacf_H). Prints each column's Green–Kubo diffusion
+    /// coefficient, ⅓ ∫ C(t) dt up to --vacf-integrate, in 10⁻⁵ cm²/s. Needs velocities in the
+    /// frames: a .trr written with nstvout, a LAMMPS dump with vx vy vz, AMBER NetCDF or GSD
+    /// with velocities, a .gro with them. Keeps every frame's velocities (up to --msd-memory).
+    /// Written whole or not at all; not with --shard, nor --align (it turns the velocities
+    /// with the fit, frame by frame).
+    #[arg(long, value_name = "FILE.csv", conflicts_with = "align")]
+    pub vacf_table: Option<PathBuf>,
+    /// The upper limit τ (ps; frames when the frames carry no times) of --vacf-table's
+    /// Green–Kubo integral: where C(t) has decayed, since the longer lags add noise. By
+    /// default the lag of half the frames.
+    #[arg(long, value_name = "TAU", requires = "vacf_table", value_parser = parse_positive)]
+    pub vacf_integrate: Option<f64>,
+    /// Also write the vibrational density of states, the spectrum of the velocities (gmx dos),
+    /// as a CSV table: frequency (THz), wavenumber (cm⁻¹), vdos (over every atom, each
+    /// weighted by its mass as gmx dos weighs it; unweighted when an atom has no element),
+    /// then one column per kind of atom (vdos_O, vdos_H); every column integrates to 3 over
+    /// the frequencies (three degrees of freedom per atom). The frequency step is 1 / (n Δt),
+    /// n the power of two at or above twice the frames. Needs velocities and evenly spaced
+    /// frame times. Written whole or not at all; not with --shard or --align.
+    #[arg(long, value_name = "FILE.csv", conflicts_with = "align")]
+    pub vdos_table: Option<PathBuf>,
     /// Also write --align's fit as a CSV table, one row per frame: frame, time (ps, when the
     /// file has it), rmsd (Å: the aligned atoms' RMSD from the reference after the fit, mass
     /// weighted with --align-mass), as MDAnalysis's rms.RMSD. Written whole or not at all.

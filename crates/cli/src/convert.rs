@@ -65,7 +65,7 @@ pub struct ConvertArgs {
     /// names, positions to 0.001 nm, velocities, the box), .pdb (multi-MODEL, the 'occupancy'
     /// and 'bfactor' properties in their columns), .dcd, .xtc (positions and the box only).
     /// Written whole or not at all. Without it, only the analyses' tables are written
-    /// (--rdf-table, --msd-table, --msd-lags, --rmsd-table, --rmsf-table, --profile-table,
+    /// (--rdf-table, --msd-table, --msd-lags, --vacf-table, --vdos-table, --rmsd-table, --rmsf-table, --profile-table,
     /// --dihedral-table, --cluster-table, --grain-table, --defect-table).
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
@@ -84,6 +84,7 @@ Examples:
   texmap convert melt.lammpstrj --frames 100: --rdf 10 --rdf-partial --rdf-table gr.csv    # g(r), total and per pair of types, averaged over frames 100 on
   texmap convert md.xtc --topology md.gro --msd-lags lags.csv                               # MSD over every time origin; prints D per kind
   texmap convert md.xtc --topology md.gro --align backbone --rmsf-table rmsf.csv            # flexibility; colour by it: render --property rmsf=rmsf.csv
+  texmap convert md.trr --topology md.gro --vacf-table vacf.csv --vdos-table vdos.csv       # velocity autocorrelation (Green-Kubo D) and its spectrum
   texmap convert slab.lammpstrj --profile-table rho.csv --profile-axis z --profile-bins 200  # density profile across an interface
   texmap convert md.xtc --topology md.gro --dihedral-table rama.csv                         # phi, psi, omega per residue and frame
 
@@ -134,6 +135,8 @@ pub fn convert(a: &ConvertArgs) -> Result<()> {
                 &a.analysis.rdf_table,
                 &a.analysis.msd_table,
                 &a.analysis.msd_lags,
+                &a.analysis.vacf_table,
+                &a.analysis.vdos_table,
                 &a.analysis.rmsd_table,
                 &a.analysis.rmsf_table,
                 &a.analysis.profile_table,
@@ -142,7 +145,7 @@ pub fn convert(a: &ConvertArgs) -> Result<()> {
             ];
             if tables.iter().all(|t| t.is_none()) {
                 return usage(
-                    "nothing to write: give -o FILE, or a table of the analyses (--rdf-table, --msd-table, --msd-lags, --rmsd-table, --rmsf-table, --profile-table, --dihedral-table, --cluster-table, --grain-table, --defect-table)",
+                    "nothing to write: give -o FILE, or a table of the analyses (--rdf-table, --msd-table, --msd-lags, --vacf-table, --vdos-table, --rmsd-table, --rmsf-table, --profile-table, --dihedral-table, --cluster-table, --grain-table, --defect-table)",
                 );
             }
             if a.select.is_some() || a.columns.is_some() {

@@ -1,6 +1,7 @@
 //! The CSV tables of the analyses that `texmap render` and `texmap convert` write beside
 //! their frames: per frame (defects, grains, clusters, MSD, RMSD, dihedrals) or over the whole
-//! run (g(r), the MSD over every time origin, RMSF, density profiles). Each is written under a
+//! run (g(r), the MSD and the velocity autocorrelation over every time origin, the vibrational
+//! density of states, RMSF, density profiles). Each is written under a
 //! temporary name and moved into place at the end, so a failed run leaves none.
 
 use std::path::PathBuf;
@@ -57,6 +58,7 @@ pub(crate) struct AnalysisTables {
     rmsd: Option<crate::output::AtomicFile>,
     cluster: Option<crate::output::AtomicFile>,
     msd_lags: Option<MsdLags>,
+    velocities: Option<VelocityTables>,
     dihedral: Option<crate::output::AtomicFile>,
     profile: Option<(crate::output::AtomicFile, ProfileMean)>,
     /// `--rmsf-table`, the fluctuations so far and each atom's first columns (the first
@@ -108,50 +110,18 @@ impl MsdLags {
         Ok(())
     }
 
-    /// The lag times (ps) when every frame has a time and they are evenly spaced.
-    fn lag_times(&self) -> Option<Vec<f64>> {
-        let times: Vec<f64> = self.times.iter().copied().collect::<Option<_>>()?;
-        let t = times.len();
-        if t < 2 {
-            return None;
-        }
-        let dt = (times[t - 1] - times[0]) / (t - 1) as f64;
-        let even = dt > 0.0
-            && times
-                .iter()
-                .enumerate()
-                .all(|(k, x)| (x - times[0] - k as f64 * dt).abs() <= 1e-3 * dt + 1e-6 * x.abs());
-        even.then(|| (0..t).map(|m| m as f64 * dt).collect())
-    }
-
     /// The table written, each column's diffusion coefficient printed.
     fn finish(mut self) -> Result<crate::output::AtomicFile> {
         let lags = self
             .all
             .mean(&self.kind, self.kinds.len())
             .map_err(|e| anyhow::anyhow!("--msd-lags: {e}"))?;
-        let times = self.lag_times();
-        let mut text = String::from("lag,time,msd");
-        for k in &self.kinds {
-            text.push_str(&format!(",msd_{k}"));
-        }
-        text.push('\n');
-        for m in 0..lags.total.len() {
-            let time = times
-                .as_ref()
-                .map(|t| crate::scene::compact(t[m], 6))
-                .unwrap_or_default();
-            text.push_str(&format!("{m},{time},{:.6}", lags.total[m]));
-            for column in &lags.kinds {
-                text.push_str(&format!(",{:.6}", column[m]));
-            }
-            text.push('\n');
-        }
+        let times = even_lag_times(&self.times);
+        let (text, x, unit) =
+            lag_table("msd", &self.kinds, &times, &lags.total, &lags.kinds, |v| {
+                format!("{v:.6}")
+            });
         self.file.write(&text)?;
-        let (x, unit): (Vec<f64>, &str) = match &times {
-            Some(t) => (t.clone(), "ps"),
-            None => ((0..lags.total.len()).map(|m| m as f64).collect(), "frames"),
-        };
         let longest = x.last().copied().unwrap_or(0.0);
         let (from, to) = self.fit.unwrap_or((0.1 * longest, 0.9 * longest));
         let span = format!(
@@ -179,6 +149,188 @@ impl MsdLags {
             }
         }
         Ok(self.file)
+    }
+}
+
+/// The lag times (ps) of frames at `times` when every frame has a time and they are evenly
+/// spaced.
+fn even_lag_times(times: &[Option<f64>]) -> Option<Vec<f64>> {
+    let times: Vec<f64> = times.iter().copied().collect::<Option<_>>()?;
+    let t = times.len();
+    if t < 2 {
+        return None;
+    }
+    let dt = (times[t - 1] - times[0]) / (t - 1) as f64;
+    let even = dt > 0.0
+        && times
+            .iter()
+            .enumerate()
+            .all(|(k, x)| (x - times[0] - k as f64 * dt).abs() <= 1e-3 * dt + 1e-6 * x.abs());
+    even.then(|| (0..t).map(|m| m as f64 * dt).collect())
+}
+
+/// A table of `name` per lag (`total` over every atom, then one column per kind of `kinds`),
+/// each value written by `value`, with each lag's time when `times` has them; also the lags'
+/// abscissae and their unit (ps, else frames).
+fn lag_table(
+    name: &str,
+    kinds: &[texmap_md_io::Label],
+    times: &Option<Vec<f64>>,
+    total: &[f64],
+    columns: &[Vec<f64>],
+    value: impl Fn(f64) -> String,
+) -> (String, Vec<f64>, &'static str) {
+    let mut text = format!("lag,time,{name}");
+    for k in kinds {
+        text.push_str(&format!(",{name}_{k}"));
+    }
+    text.push('\n');
+    for m in 0..total.len() {
+        let time = times
+            .as_ref()
+            .map(|t| crate::scene::compact(t[m], 6))
+            .unwrap_or_default();
+        text.push_str(&format!("{m},{time},{}", value(total[m])));
+        for column in columns {
+            text.push(',');
+            text.push_str(&value(column[m]));
+        }
+        text.push('\n');
+    }
+    match times {
+        Some(t) => (text, t.clone(), "ps"),
+        None => (text, (0..total.len()).map(|m| m as f64).collect(), "frames"),
+    }
+}
+
+/// `--vacf-table` and `--vdos-table`: every frame's velocities, correlated at the end.
+struct VelocityTables {
+    vacf: Option<crate::output::AtomicFile>,
+    vdos: Option<crate::output::AtomicFile>,
+    all: texmap_md_io::vacf::Velocities,
+    times: Vec<Option<f64>>,
+    kinds: Vec<texmap_md_io::Label>,
+    kind: Vec<usize>,
+    /// Each atom's mass, or `None` when an atom has no element (the spectrum is then unweighted):
+    /// the index of the first such atom.
+    mass: std::result::Result<Vec<f64>, usize>,
+    integrate: Option<f64>,
+}
+
+impl VelocityTables {
+    fn flags(&self) -> &'static str {
+        match (&self.vacf, &self.vdos) {
+            (Some(_), None) => "--vacf-table",
+            (None, Some(_)) => "--vdos-table",
+            _ => "--vacf-table/--vdos-table",
+        }
+    }
+
+    fn add(&mut self, f: usize, md: &MdFrame) -> Result<()> {
+        let flags = self.flags();
+        if md.velocities.is_empty() {
+            bail!(
+                "{flags}: frame {f} has no velocities (write them: a .trr with nstvout, a LAMMPS dump with vx vy vz, AMBER's ntwv)"
+            );
+        }
+        if self.all.frames() == 0 {
+            self.kind = kinds_of(md, &mut self.kinds).unwrap_or_default();
+            let mass: Vec<f64> = (0..md.n_atoms())
+                .map(|i| texmap_md_io::atom_element(md, i).mass())
+                .collect();
+            self.mass = match mass.iter().position(|m| *m <= 0.0) {
+                Some(i) => Err(i),
+                None => Ok(mass),
+            };
+        }
+        self.all
+            .push(&md.velocities)
+            .map_err(|e| anyhow::anyhow!("{flags}: frame {f}: {e}"))?;
+        self.times.push(md.time);
+        Ok(())
+    }
+
+    /// The tables written (the Green–Kubo coefficients printed), in the order vacf, vdos.
+    fn finish(mut self) -> Result<Vec<crate::output::AtomicFile>> {
+        let times = even_lag_times(&self.times);
+        let mut done = Vec::new();
+        if let Some(mut file) = self.vacf.take() {
+            let c = self
+                .all
+                .autocorrelation(&self.kind, self.kinds.len())
+                .map_err(|e| anyhow::anyhow!("--vacf-table: {e}"))?;
+            let (text, x, unit) = lag_table("vacf", &self.kinds, &times, &c.total, &c.kinds, |v| {
+                format!("{v:.8e}")
+            });
+            file.write(&text)?;
+            // By default up to lag ⌊T/2⌋.
+            let to = self
+                .integrate
+                .unwrap_or(x.get(x.len() / 2).copied().unwrap_or(0.0));
+            let names = std::iter::once("every atom".to_string())
+                .chain(self.kinds.iter().map(|k| format!("the {k} atoms")));
+            for (name, column) in names.zip(std::iter::once(&c.total).chain(&c.kinds)) {
+                let upto = crate::scene::compact(to, 4);
+                match texmap_md_io::vacf::green_kubo(&x, column, to) {
+                    // Å²/ps is 10⁻⁴ cm²/s.
+                    Some(d) if times.is_some() => eprintln!(
+                        "texmap: --vacf-table: D = {:.4} × 10⁻⁵ cm²/s for {name} (Green–Kubo, ⅓ ∫ C(t) dt over 0–{upto} ps)",
+                        d * 10.0
+                    ),
+                    Some(d) => eprintln!(
+                        "texmap: --vacf-table: ⅓ ∫ C dt = {d:.6} Å²/ps² × frames for {name} over lags 0–{upto} {unit} (the frames carry no evenly spaced times)"
+                    ),
+                    None => eprintln!(
+                        "texmap: warning: --vacf-table: fewer than two lags in 0–{upto} {unit} to integrate for {name} (--vacf-integrate)"
+                    ),
+                }
+            }
+            done.push(file);
+        }
+        if let Some(mut file) = self.vdos.take() {
+            let Some(t) = &times else {
+                bail!(
+                    "--vdos-table: the frames' times are missing or not evenly spaced, so the spectrum has no frequency axis (the frames written: {})",
+                    self.times.len()
+                );
+            };
+            let dt = t[1];
+            let mass = match &self.mass {
+                Ok(m) => m.clone(),
+                Err(i) => {
+                    eprintln!(
+                        "texmap: warning: --vdos-table: atom {i} has no element, so no mass: the spectrum over every atom is unweighted"
+                    );
+                    vec![1.0; self.kind.len()]
+                }
+            };
+            let g = self
+                .all
+                .density_of_states(&self.kind, self.kinds.len(), &mass, dt)
+                .map_err(|e| anyhow::anyhow!("--vdos-table: {e}"))?;
+            let mut text = String::from("frequency,wavenumber,vdos");
+            for k in &self.kinds {
+                text.push_str(&format!(",vdos_{k}"));
+            }
+            text.push('\n');
+            // 1 THz is 10¹² / c cm⁻¹, c = 29,979,245,800 cm/s.
+            const CM_PER_THZ: f64 = 1e12 / 29_979_245_800.0;
+            for (k, nu) in g.frequency.iter().enumerate() {
+                text.push_str(&format!(
+                    "{},{},{:.8e}",
+                    crate::scene::compact(*nu, 8),
+                    crate::scene::compact(nu * CM_PER_THZ, 8),
+                    g.total[k]
+                ));
+                for column in &g.kinds {
+                    text.push_str(&format!(",{:.8e}", column[k]));
+                }
+                text.push('\n');
+            }
+            file.write(&text)?;
+            done.push(file);
+        }
+        Ok(done)
     }
 }
 
@@ -433,6 +585,23 @@ impl AnalysisTables {
                 kind: Vec::new(),
                 fit: analysis.msd_fit,
             }),
+            velocities: {
+                let why = "the average over every time origin needs every frame in one run";
+                let vacf = whole_run_table(&analysis.vacf_table, "--vacf-table", why, whole)?;
+                let vdos = whole_run_table(&analysis.vdos_table, "--vdos-table", why, whole)?;
+                (vacf.is_some() || vdos.is_some()).then(|| VelocityTables {
+                    vacf,
+                    vdos,
+                    all: texmap_md_io::vacf::Velocities::new(
+                        analysis.msd_memory.saturating_mul(1 << 20),
+                    ),
+                    times: Vec::new(),
+                    kinds: Vec::new(),
+                    kind: Vec::new(),
+                    mass: Ok(Vec::new()),
+                    integrate: analysis.vacf_integrate,
+                })
+            },
             rdf: whole_run_table(
                 &analysis.rdf_table,
                 "--rdf-table",
@@ -537,6 +706,9 @@ impl AnalysisTables {
         {
             lags.add(f, unwrapped, md)?;
         }
+        if let Some(v) = &mut self.velocities {
+            v.add(f, md)?;
+        }
         if let Some(t) = &mut self.dihedral {
             let angle = |a: Option<f64>| a.map(|a| format!("{a:.3}")).unwrap_or_default();
             let label = |v: &[texmap_md_io::Label], i: usize| {
@@ -578,6 +750,11 @@ impl AnalysisTables {
             .map(|(mut t, mean)| t.write(&mean.csv()).map(|()| t));
         let msd = self.msd.map(|(t, _)| t);
         let msd_lags = self.msd_lags.map(MsdLags::finish).transpose()?;
+        let velocities = self
+            .velocities
+            .map(VelocityTables::finish)
+            .transpose()?
+            .unwrap_or_default();
         let profile = self
             .profile
             .map(|(mut t, mean)| t.write(&mean.csv()).map(|()| t))
@@ -606,6 +783,7 @@ impl AnalysisTables {
         ]
         .into_iter()
         .flatten()
+        .chain(velocities)
         {
             t.commit()?;
         }

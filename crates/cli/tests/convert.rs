@@ -918,6 +918,126 @@ fn msd_over_every_origin_is_mdanalysis_einstein_msd() {
     }
 }
 
+/// `--vacf-table` and `--vdos-table` of Langevin dynamics written by MDAnalysis as a .trr with
+/// velocities (md-io's dynamics/gen_vacf.py): the autocorrelation per lag equals tidynamics'
+/// over every origin, the printed Green–Kubo coefficients numpy's trapezoid of it, the spectrum
+/// numpy's transform of the padded series (mass-weighted over every atom), its peaks the
+/// springs' 3 and 10 THz; render writes the same tables; a trajectory without velocities, an
+/// aligned run and a split run are refused and leave no file.
+#[test]
+fn vacf_and_vdos_tables_are_tidynamics_and_numpys() {
+    let dir = tempfile::tempdir().unwrap();
+    let vacf = dir.path().join("vacf.csv");
+    let vdos = dir.path().join("vdos.csv");
+    let run = [
+        "convert",
+        &md_data("dynamics/vel.trr"),
+        "--topology",
+        &md_data("dynamics/vel.gro"),
+        "--vacf-table",
+        vacf.to_str().unwrap(),
+        "--vdos-table",
+        vdos.to_str().unwrap(),
+    ];
+    let o = texmap(&run);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let reference = json("dynamics/vacf_reference.json");
+    let columns = [("all", 2), ("HW", 3), ("NA", 4), ("OW", 5)];
+
+    let (header, rows) = table(&vacf);
+    assert_eq!(header, "lag,time,vacf,vacf_H,vacf_Na,vacf_O");
+    let time = numbers(&reference["lag_time"]);
+    assert_eq!(rows.len(), time.len());
+    for (name, col) in columns {
+        let want = numbers(&reference["vacf"][name]);
+        let scale = want[0];
+        for (m, (row, want)) in rows.iter().zip(&want).enumerate() {
+            assert_eq!(row[0], m as f64);
+            assert!((row[1] - time[m]).abs() < 1e-5, "lag {m}: time {}", row[1]);
+            assert!(
+                (row[col] - want).abs() <= 1e-6 * scale,
+                "lag {m} {name}: {} vs tidynamics {want}",
+                row[col]
+            );
+        }
+    }
+    // "D = 4.5315 × 10⁻⁵ cm²/s for every atom (Green–Kubo, ⅓ ∫ C(t) dt over 0–1.6 ps)".
+    let printed: Vec<f64> = stderr(&o)
+        .lines()
+        .filter(|l| l.contains("Green–Kubo"))
+        .filter_map(|l| l.split_once("D = ")?.1.split_once(' ')?.0.parse().ok())
+        .collect();
+    assert_eq!(printed.len(), 4, "{}", stderr(&o));
+    for ((name, _), d) in columns.iter().zip(&printed) {
+        let want = reference["d_green_kubo"][name].as_f64().unwrap();
+        assert!((d - want).abs() < 2e-4, "{name}: D {d} vs numpy {want}");
+    }
+
+    let (header, rows) = table(&vdos);
+    assert_eq!(header, "frequency,wavenumber,vdos,vdos_H,vdos_Na,vdos_O");
+    let frequency = numbers(&reference["frequency"]);
+    assert_eq!(rows.len(), frequency.len());
+    for (name, col) in columns {
+        let want = numbers(&reference["vdos"][name]);
+        let top = want.iter().cloned().fold(0.0, f64::max);
+        for (k, (row, want)) in rows.iter().zip(&want).enumerate() {
+            assert!((row[0] - frequency[k]).abs() < 1e-6 * frequency[k].max(1.0));
+            assert!((row[1] / row[0].max(1e-30) - 33.356_41).abs() < 1e-4 || k == 0);
+            assert!(
+                (row[col] - want).abs() <= 1e-6 * top,
+                "bin {k} {name}: {} vs numpy {want}",
+                row[col]
+            );
+        }
+    }
+    for (name, col, thz) in [("HW", 3, 10.0), ("OW", 5, 3.0)] {
+        let peak = (1..rows.len())
+            .max_by(|&a, &b| rows[a][col].total_cmp(&rows[b][col]))
+            .unwrap();
+        let want = reference["peak_thz"][name].as_f64().unwrap();
+        assert!((rows[peak][0] - want).abs() < 1e-6, "{name} peak");
+        assert!(
+            (rows[peak][0] - thz).abs() < 0.1,
+            "{name}: {} THz",
+            rows[peak][0]
+        );
+    }
+
+    // texmap render writes the same tables beside its frames.
+    let (rv, rd) = (dir.path().join("rv.csv"), dir.path().join("rd.csv"));
+    let frames = dir.path().join("f%04d.png");
+    let mut args = vec!["render", run[1], run[2], run[3], "--size", "48x32", "-q"];
+    args.extend(["--frames", "::1", "-o", frames.to_str().unwrap()]);
+    args.extend(["--vacf-table", rv.to_str().unwrap()]);
+    args.extend(["--vdos-table", rd.to_str().unwrap()]);
+    let o = texmap(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(std::fs::read(&rv).unwrap(), std::fs::read(&vacf).unwrap());
+    assert_eq!(std::fs::read(&rd).unwrap(), std::fs::read(&vdos).unwrap());
+
+    std::fs::remove_file(&vacf).unwrap();
+    std::fs::remove_file(&vdos).unwrap();
+    let walk = md_data("dynamics/walk.dcd");
+    let walk_top = md_data("dynamics/walk.gro");
+    for (swap, extra, code, says) in [
+        (true, &[][..], 1, "frame 0 has no velocities"),
+        (false, &["--align", "all"][..], 2, "--align"),
+        (false, &["--shard", "1/2"][..], 2, "--shard"),
+        (false, &["--vacf-integrate", "0"][..], 2, "above 0"),
+    ] {
+        let mut args = run.to_vec();
+        if swap {
+            args[1] = &walk;
+            args[3] = &walk_top;
+        }
+        args.extend(extra);
+        let o = texmap(&args);
+        assert_eq!(o.status.code(), Some(code), "{extra:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains(says), "{extra:?}: {}", stderr(&o));
+        assert!(!vacf.exists() && !vdos.exists(), "{extra:?} left a table");
+    }
+}
+
 /// `--cluster-table`: the copper clusters in iron (md-io's cluster fixture, written by OVITO)
 /// have OVITO's sizes, largest first, frame by frame; the precipitate (every site within 6 Å
 /// of (12, 13, 14)) is centred there, with about a solid sphere's radius of gyration

@@ -261,9 +261,12 @@ mod tests {
             let total = sums.iter().sum::<f64>() / (origins * kind.len() as f64);
             let scale = fast.total[0];
             assert!((fast.total[m] - total).abs() < 1e-9 * scale, "lag {m}");
-            for g in 0..3 {
-                let want = sums[g] / (origins * count(g));
-                assert!((fast.kinds[g][m] - want).abs() < 1e-9 * scale, "kind {g} lag {m}");
+            for (g, sum) in sums.iter().enumerate() {
+                let want = sum / (origins * count(g));
+                assert!(
+                    (fast.kinds[g][m] - want).abs() < 1e-9 * scale,
+                    "kind {g} lag {m}"
+                );
             }
         }
         // The same bits on one thread.
@@ -304,7 +307,8 @@ mod tests {
             }
             p
         };
-        let columns: [(&[f64], &dyn Fn(usize) -> bool); 2] =
+        type Pick<'a> = &'a dyn Fn(usize) -> bool;
+        let columns: [(&[f64], Pick); 2] =
             [(&g.total, &|_| true), (&g.kinds[1], &|i| kind[i] == 1)];
         for (column, pick) in columns {
             let raw: Vec<f64> = (0..=n / 2).map(|k| direct(pick, k)).collect();
@@ -312,7 +316,10 @@ mod tests {
             let area = step * (raw.iter().sum::<f64>() - 0.5 * (raw[0] + raw[n / 2]));
             for (k, (got, want)) in column.iter().zip(&raw).enumerate() {
                 let want = 3.0 * want / area;
-                assert!((got - want).abs() < 1e-9 * (1.0 + want), "bin {k}: {got} {want}");
+                assert!(
+                    (got - want).abs() < 1e-9 * (1.0 + want),
+                    "bin {k}: {got} {want}"
+                );
             }
         }
         // Kind 2's oscillation, 0.7 rad per frame: its peak.
@@ -320,7 +327,10 @@ mod tests {
         let peak = (1..g.frequency.len())
             .max_by(|&a, &b| g.kinds[2][a].total_cmp(&g.kinds[2][b]))
             .unwrap();
-        assert!((g.frequency[peak] - omega).abs() <= g.frequency[1], "{peak}");
+        assert!(
+            (g.frequency[peak] - omega).abs() <= g.frequency[1],
+            "{peak}"
+        );
     }
 
     #[test]
