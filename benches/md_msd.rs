@@ -1,7 +1,9 @@
 //! The mean squared displacement over every time origin (texmap-md-io `msd::AllOrigins`, what
 //! `--msd-lags` computes) of 10,000 atoms on seeded Gaussian random walks (0.2 Å per axis per
 //! frame) over 1,000 frames, 2 threads: the frames kept, then the average per lag for all atoms
-//! and two kinds.
+//! and two kinds. Then the velocity autocorrelation (`vacf::Velocities`, what `--vacf-table`
+//! computes) and the vibrational density of states (`--vdos-table`) of 10,000 atoms'
+//! Ornstein–Uhlenbeck velocities over 1,000 frames, for all atoms and two kinds.
 //!
 //! The peer, `benches/peers/mdanalysis_msd.py`, times MDAnalysis's `EinsteinMSD` (fft=True,
 //! through tidynamics) on a walk of the same size held in memory: run it in the same minutes.
@@ -11,6 +13,7 @@
 
 use criterion::{Criterion, criterion_group};
 use texmap::md_io::msd::AllOrigins;
+use texmap::md_io::vacf::Velocities;
 
 mod common;
 use common::Lcg;
@@ -56,6 +59,34 @@ fn bench(c: &mut Criterion) {
                 kept.push(&p).unwrap();
             }
             kept.frames()
+        })
+    });
+
+    // Velocities relaxing with a correlation time of 1 / (1 − 0.9) = 10 frames.
+    let mut v = vec![[0.0f32; 3]; atoms];
+    let mut velocities = Velocities::new(usize::MAX);
+    for _ in 0..frames {
+        for w in &mut v {
+            for x in w.iter_mut() {
+                *x = 0.9 * *x + rng.normal() as f32;
+            }
+        }
+        velocities.push(&v).unwrap();
+    }
+    let c = velocities.autocorrelation(&kind, 2).unwrap();
+    // Ornstein–Uhlenbeck: C(m) / C(0) = 0.9^m.
+    let ratio = c.total[5] / c.total[0];
+    assert!((ratio - 0.9f64.powi(5)).abs() < 0.03, "C(5)/C(0) = {ratio}");
+    let mass: Vec<f64> = kind.iter().map(|k| [12.0, 1.0][*k]).collect();
+    g.bench_function(format!("vacf_{atoms}_atoms_{frames}_frames"), |b| {
+        b.iter(|| velocities.autocorrelation(&kind, 2).unwrap().total[1])
+    });
+    g.bench_function(format!("vdos_{atoms}_atoms_{frames}_frames"), |b| {
+        b.iter(|| {
+            velocities
+                .density_of_states(&kind, 2, &mass, 0.01)
+                .unwrap()
+                .total[1]
         })
     });
     g.finish();

@@ -28,8 +28,8 @@ pub(crate) struct Store {
     limit: usize,
 }
 
-/// Per kind: the summed one-series power spectra (`n` bins, both halves) and the summed squared
-/// values per frame.
+/// Per kind: the summed squared transforms of its packed pairs of series (`n` bins; see
+/// [`Spectra::power_of`]) and the summed squared values per frame.
 pub(crate) struct Spectra {
     /// Transform length.
     pub n: usize,
@@ -162,11 +162,8 @@ impl Store {
                         };
                     }
                     forward.process_with_scratch(&mut buffer, &mut scratch);
-                    // The two series packed in one transform: (|Z_k|² + |Z_{n−k}|²) / 2 is the
-                    // sum of their power spectra.
-                    let power = &mut sums.power[g];
-                    for k in 0..n {
-                        power[k] += 0.5 * (buffer[k].norm_sqr() + buffer[(n - k) % n].norm_sqr());
+                    for (p, z) in sums.power[g].iter_mut().zip(&buffer) {
+                        *p += z.norm_sqr();
                     }
                     for (s, (x, y)) in sums.squares[g]
                         .iter_mut()
@@ -201,15 +198,22 @@ impl Spectra {
         }
     }
 
+    /// Kind g's summed power spectrum of its series, bin k of `n`: two real series packed in
+    /// one transform Z, (|Z_k|² + |Z_{n−k}|²) / 2 is the sum of their power spectra.
+    pub fn power_of(&self, g: usize, k: usize) -> f64 {
+        let p = &self.power[g];
+        0.5 * (p[k] + p[(self.n - k) % self.n])
+    }
+
     /// Per kind and lag m < T: the sum over the kind's series and origins k of
     /// `x(k) · x(k + m)`.
     pub fn correlations(&self) -> Vec<Vec<f64>> {
         let inverse = rustfft::FftPlanner::<f64>::new().plan_fft_inverse(self.n);
-        self.power
-            .iter()
-            .map(|power| {
-                let mut buffer: Vec<Complex<f64>> =
-                    power.iter().map(|&p| Complex::new(p, 0.0)).collect();
+        (0..self.power.len())
+            .map(|g| {
+                let mut buffer: Vec<Complex<f64>> = (0..self.n)
+                    .map(|k| Complex::new(self.power_of(g, k), 0.0))
+                    .collect();
                 inverse.process(&mut buffer);
                 buffer[..self.t]
                     .iter()

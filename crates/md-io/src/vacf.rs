@@ -157,18 +157,15 @@ impl Velocities {
         }
         let total = normalised(
             (0..bins)
-                .map(|k| spectra.power.iter().map(|p| p[k]).sum())
+                .map(|k| (0..kinds).map(|g| spectra.power_of(g, k)).sum())
                 .collect(),
         );
-        let per_kind = spectra
-            .power
-            .iter()
-            .zip(&counts)
-            .map(|(p, &c)| {
-                if c == 0 {
+        let per_kind = (0..kinds)
+            .map(|g| {
+                if counts[g] == 0 {
                     vec![f64::NAN; bins]
                 } else {
-                    normalised(p[..bins].to_vec())
+                    normalised((0..bins).map(|k| spectra.power_of(g, k)).collect())
                 }
             })
             .collect();
