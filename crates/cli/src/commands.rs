@@ -237,6 +237,7 @@ fn info(
         "atoms": frame.n_atoms(),
         "frames": frames,
         "box": bx,
+        "pbc": frame.cell.as_ref().map(|c| c.periodic()),
         "first_positions": first,
     });
     // A trajectory in several files: how many, in the order read.

@@ -3619,7 +3619,7 @@ fn voronoi_selects_ovitos_atoms() {
     let o = texmap(&["render", open.to_str().unwrap(), "--voronoi", "-o", "x.png"]);
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     assert!(
-        stderr(&o).contains("--voronoi: the frame has no periodic cell"),
+        stderr(&o).contains("--voronoi: the frame has no cell periodic along all three edges"),
         "{}",
         stderr(&o)
     );

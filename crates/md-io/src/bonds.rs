@@ -199,6 +199,8 @@ struct Grid {
     reach: Vec<u8>,
     /// The box edges (rows) for periodic images, `None` for an open grid.
     edges: Option<[[f32; 3]; 3]>,
+    /// The axes the grid wraps around (none for an open grid).
+    periodic: [bool; 3],
 }
 
 /// The sorted-atom arrays of one block of cells, filled by one task.
@@ -426,6 +428,7 @@ impl Grid {
             r,
             idx: order,
             reach: sreach,
+            periodic: [edges.is_some(); 3],
             edges,
         }
     }
@@ -521,13 +524,13 @@ impl Grid {
                         let wrapped = q[k].rem_euclid(dk);
                         if wrapped != q[k] {
                             match &self.edges {
-                                Some(m) => {
+                                Some(m) if self.periodic[k] => {
                                     let w = ((q[k] - wrapped) / dk) as f32;
                                     for (t, sh) in shift.iter_mut().enumerate() {
                                         *sh += w * m[k][t];
                                     }
                                 }
-                                None => inside = false,
+                                _ => inside = false,
                             }
                         }
                         nb[k] = wrapped as usize;
@@ -615,10 +618,13 @@ pub fn bonds_with_radii(positions: &[[f32; 3]], radii: &[f32], cell: Option<Unit
         // The density's edge, but never fewer than 3 cells where the cutoff allows 3.
         let dims = widths.map(|w| {
             let by_cutoff = (w / cutoff).floor() as usize;
-            ((w / e).floor() as usize).max(by_cutoff.min(3)).min(1024)
+            ((w / e).floor() as usize)
+                .max(by_cutoff.min(3))
+                .clamp(1, 1024)
         });
-        // At least 3 cells per axis, so that the neighbours of a cell are distinct cells.
-        if dims.iter().any(|d| *d < 3) {
+        // At least 3 cells along each periodic axis, so that the neighbours of a cell are
+        // distinct cells.
+        if dims.iter().zip(c.periodic()).any(|(d, p)| p && *d < 3) {
             return None;
         }
         Some((c, inv, dims, widths))
@@ -638,6 +644,7 @@ pub fn bonds_with_radii(positions: &[[f32; 3]], radii: &[f32], cell: Option<Unit
         Some((c, inv, dims, widths)) => {
             let o = c.origin();
             let m = c.matrix();
+            let periodic = c.periodic();
             let size = o.iter().map(|v| v.abs()).fold(0.0, f64::max)
                 + m.iter().flatten().map(|v| v.abs()).sum::<f64>();
             let cell_width: [f64; 3] = std::array::from_fn(|k| widths[k] / dims[k] as f64);
@@ -647,10 +654,12 @@ pub fn bonds_with_radii(positions: &[[f32; 3]], radii: &[f32], cell: Option<Unit
                 .zip(radii)
                 .map(|(p, &ra)| {
                     let d = [p[0] as f64 - o[0], p[1] as f64 - o[1], p[2] as f64 - o[2]];
-                    // Fractional f = d · M⁻¹ (rows of M are the edges), wrapped into [0, 1).
+                    // Fractional f = d · M⁻¹ (rows of M are the edges), wrapped into [0, 1)
+                    // along the periodic axes (along the others, outside the box is in the
+                    // edge cells, at least as far as their atoms).
                     let f: [f64; 3] = std::array::from_fn(|k| {
                         let x = d[0] * inv[0][k] + d[1] * inv[1][k] + d[2] * inv[2][k];
-                        x - x.floor()
+                        if periodic[k] { x - x.floor() } else { x }
                     });
                     let ci: [usize; 3] =
                         std::array::from_fn(|k| cell_of(f[k] * dims[k] as f64, dims[k]));
@@ -663,7 +672,9 @@ pub fn bonds_with_radii(positions: &[[f32; 3]], radii: &[f32], cell: Option<Unit
                 })
                 .unzip();
             let edges = m.map(|r| r.map(|v| v as f32));
-            Grid::build(&cells, &reach, &wrapped, radii, dims, Some(edges))
+            let mut grid = Grid::build(&cells, &reach, &wrapped, radii, dims, Some(edges));
+            grid.periodic = periodic;
+            grid
         }
         None => {
             // The bounding box (min and max are exact, so any split gives the same box).

@@ -90,7 +90,7 @@ pub(crate) fn pairs_within(frame: &Frame, cutoff: f32) -> Result<Vec<[u32; 2]>, 
         && !bonds.periodic
         && n >= 2
     {
-        let width = cell.min_width();
+        let width = cell.min_periodic_width();
         return Err(CoordinationError::CellTooSmall { width, cutoff });
     }
     Ok(bonds.pairs)

@@ -114,10 +114,17 @@ impl PartialEq<&str> for Label {
     }
 }
 
-/// A periodic cell: three edge vectors (the rows of [`UnitCell::matrix`], in Å) and an origin.
+/// A simulation cell: three edge vectors (the rows of [`UnitCell::matrix`], in Å), an origin,
+/// and whether the system repeats along each edge ([`UnitCell::periodic`]).
 ///
 /// Lengths a, b, c (Å) and angles α = ∠(b,c), β = ∠(a,c), γ = ∠(a,b) (degrees) are kept beside
 /// the matrix so that a cell read as lengths and angles writes back exactly.
+///
+/// A cell is periodic along all three edges unless the file says otherwise: LAMMPS's `ff`,
+/// `ss`, `fs`, `fm`… boundaries (a slab, a nanoparticle, a cascade with a free surface),
+/// extended XYZ's `pbc="T T F"`, XSF's SLAB, POLYMER and MOLECULE. Along an edge that is not
+/// periodic no atom has an image: nearest images ([`crate::pbc::minimum_image`]), wrapping,
+/// bonds and neighbours (CNA, coordination, g(r)…) see the atoms as they are, as OVITO does.
 ///
 /// # Guarantees
 /// Lengths are finite and > 0, angles in (0°, 180°), the volume is > 0 (right-handed edges).
@@ -127,6 +134,7 @@ pub struct UnitCell {
     angles: [f64; 3],
     matrix: [[f64; 3]; 3],
     origin: [f64; 3],
+    periodic: [bool; 3],
 }
 
 fn cos_deg(a: f64) -> f64 {
@@ -191,6 +199,7 @@ impl UnitCell {
             angles,
             matrix,
             origin: [0.0; 3],
+            periodic: [true; 3],
         })
     }
 
@@ -229,6 +238,7 @@ impl UnitCell {
             angles,
             matrix,
             origin: [0.0; 3],
+            periodic: [true; 3],
         })
     }
 
@@ -236,6 +246,22 @@ impl UnitCell {
     pub fn with_origin(mut self, origin: [f64; 3]) -> UnitCell {
         self.origin = origin;
         self
+    }
+
+    /// The same cell, periodic along edge k where `periodic[k]`.
+    pub fn with_periodic(mut self, periodic: [bool; 3]) -> UnitCell {
+        self.periodic = periodic;
+        self
+    }
+
+    /// Whether the system repeats along each edge a, b, c (see the type's docs).
+    pub fn periodic(&self) -> [bool; 3] {
+        self.periodic
+    }
+
+    /// True when the system repeats along all three edges.
+    pub fn is_fully_periodic(&self) -> bool {
+        self.periodic == [true; 3]
     }
 
     /// Edge lengths a, b, c in Å.
@@ -271,6 +297,20 @@ impl UnitCell {
         [(1, 2), (2, 0), (0, 1)]
             .map(|(a, b)| volume / m[a].cross(m[b]).length())
             .into_iter()
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// The narrowest perpendicular width between opposite faces across which the system
+    /// repeats (Å): how far a cutoff may reach before an atom meets its own image. Infinite
+    /// when no edge is periodic.
+    pub fn min_periodic_width(&self) -> f64 {
+        let m = self.matrix.map(glam::DVec3::from_array);
+        let volume = self.volume();
+        [(1, 2), (2, 0), (0, 1)]
+            .into_iter()
+            .zip(self.periodic)
+            .filter(|(_, p)| *p)
+            .map(|((a, b), _)| volume / m[a].cross(m[b]).length())
             .fold(f64::INFINITY, f64::min)
     }
 

@@ -237,7 +237,7 @@ pub fn hydrogen_bonds(
         && !pairs.periodic
         && atoms.len() >= 2
     {
-        let width = cell.min_width();
+        let width = cell.min_periodic_width();
         return Err(HBondError::CellTooSmall {
             width,
             cutoff: distance,

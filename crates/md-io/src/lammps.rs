@@ -11,6 +11,8 @@
 //! `ylo = ylo_bound − min(0, yz)`, `yhi = yhi_bound − max(0, yz)`; edges a = (xhi−xlo, 0, 0),
 //! b = (xy, yhi−ylo, 0), c = (xz, yz, zhi−zlo), origin (xlo, ylo, zlo). `BOX BOUNDS abc origin`
 //! (general triclinic, LAMMPS 2024+) gives each edge vector followed by one origin component.
+//! The three boundary flags that end the line say which edges are periodic: `pp` is, `ff`,
+//! `ss`, `fs`, `fm`… (fixed, shrink-wrapped) are not ([`UnitCell::periodic`]).
 //!
 //! Columns may come in any order. Positions come from the first present of `x y z` (wrapped),
 //! `xs ys zs` (scaled), `xu yu zu` (unwrapped), `xsu ysu zsu` (scaled unwrapped); scaled ones
@@ -111,6 +113,19 @@ fn color_component(name: &[u8]) -> Option<usize> {
     match rest {
         [c] => b"rgb".iter().position(|k| k.eq_ignore_ascii_case(c)),
         _ => None,
+    }
+}
+
+/// The periodicity of each axis from the boundary flags ending a `BOX BOUNDS` line: `pp` is
+/// periodic; `ff`, `ss`, `fs`, `fm`, … (fixed, shrink-wrapped, shrink-wrapped with a minimum)
+/// are not. A line without three flags (dumps older than LAMMPS 2012) is periodic.
+fn boundary(spec: &[u8]) -> [bool; 3] {
+    let flags: Vec<&[u8]> = fields(spec)
+        .filter(|f| f.len() == 2 && f.iter().all(|c| b"pfsm".contains(c)))
+        .collect();
+    match flags.as_slice() {
+        [.., a, b, c] => [*a, *b, *c].map(|f| f == b"pp"),
+        _ => [true; 3],
     }
 }
 
@@ -291,7 +306,8 @@ impl Lammps {
                     Some(b"xy") => 1,
                     _ => 0,
                 };
-                cell = Lammps::boxes(lines, ctx, kind)?;
+                let periodic = boundary(spec);
+                cell = Lammps::boxes(lines, ctx, kind)?.map(|c| c.with_periodic(periodic));
             } else if let Some(spec) = item.strip_prefix(b"ATOMS") {
                 let spec = trim(spec);
                 let Some(n) = n else {

@@ -25,7 +25,8 @@
 //!   (non-orthogonal) simulation boxes") gives it: `xlo_bound = xlo + min(0, xy, xz, xy+xz)`,
 //!   `xhi_bound = xhi + max(0, xy, xz, xy+xz)`, `ylo_bound = ylo + min(0, yz)`,
 //!   `yhi_bound = yhi + max(0, yz)`, `zlo_bound = zlo`, `zhi_bound = zhi`, each line followed by
-//!   its tilt factor; a cell with all three tilts zero writes `ITEM: BOX BOUNDS pp pp pp` and
+//!   its tilt factor (the boundary flags `pp` for a periodic edge, `ff` for another); a cell
+//!   with all three tilts zero writes `ITEM: BOX BOUNDS pp pp pp` and
 //!   `lo hi` lines. A frame without a cell writes the atoms' extent as a shrink-wrapped,
 //!   non-periodic box, `ITEM: BOX BOUNDS ss ss ss` (as LAMMPS writes one; `0 0` for no atoms).
 //! - **id**: [`Frame::ids`] as given, else 1..=n.
@@ -206,13 +207,15 @@ impl<W: Write> LammpsDumpWriter<W> {
         match &frame.cell {
             Some(cell) => {
                 let b = box_bounds(cell).map_err(std::io::Error::other)?;
+                // Periodic edges `pp`, the others fixed `ff`.
+                let [x, y, z] = cell.periodic().map(|p| if p { "pp" } else { "ff" });
                 if b.iter().all(|l| l[2] == 0.0) {
-                    writeln!(w, "ITEM: BOX BOUNDS pp pp pp")?;
+                    writeln!(w, "ITEM: BOX BOUNDS {x} {y} {z}")?;
                     for l in b {
                         writeln!(w, "{} {}", l[0], l[1])?;
                     }
                 } else {
-                    writeln!(w, "ITEM: BOX BOUNDS xy xz yz pp pp pp")?;
+                    writeln!(w, "ITEM: BOX BOUNDS xy xz yz {x} {y} {z}")?;
                     for l in b {
                         writeln!(w, "{} {} {}", l[0], l[1], l[2])?;
                     }

@@ -53,6 +53,10 @@ pub(crate) struct Grid<'a> {
     /// Fractional = inverse · Cartesian (periodic frames).
     inverse: DMat3,
     frac: Vec<DVec3>,
+    /// Per axis: the cell repeats along it (none without a cell).
+    periodic: [bool; 3],
+    /// 1 along the periodic axes, 0 along the others: what whole edges are taken off.
+    wrap: DVec3,
 }
 
 impl<'a> Grid<'a> {
@@ -74,6 +78,8 @@ impl<'a> Grid<'a> {
             edges: DMat3::IDENTITY,
             inverse: DMat3::IDENTITY,
             frac: Vec::new(),
+            periodic: [false; 3],
+            wrap: DVec3::ZERO,
         };
         match cell {
             Some(c) => {
@@ -82,11 +88,16 @@ impl<'a> Grid<'a> {
                 let inverse = edges.inverse();
                 grid.edges = edges;
                 grid.inverse = inverse;
+                grid.periodic = c.periodic();
+                grid.wrap = DVec3::from(c.periodic().map(|p| if p { 1.0 } else { 0.0 }));
+                // Wrapped along the periodic axes; along the others an atom outside the cell
+                // falls in the edge cells (at least as far as those cells' atoms).
+                let wrap = grid.wrap;
                 grid.frac = positions
                     .iter()
                     .map(|p| {
                         let f = inverse * DVec3::from(p.map(f64::from));
-                        f - f.floor()
+                        f - f.floor() * wrap
                     })
                     .collect();
                 let volume = edges.determinant().abs();
@@ -177,9 +188,8 @@ impl<'a> Grid<'a> {
     /// Cartesian ones otherwise (outside the grid: its edge cells).
     fn coords_of(&self, q: [f64; 3]) -> [usize; 3] {
         match self.cell {
-            Some(_) => {
-                [0, 1, 2].map(|a| ((q[a] * self.dims[a] as f64) as usize).min(self.dims[a] - 1))
-            }
+            Some(_) => [0, 1, 2]
+                .map(|a| ((q[a] * self.dims[a] as f64).max(0.0) as usize).min(self.dims[a] - 1)),
             None => [0, 1, 2].map(|a| {
                 (((q[a] - self.lo[a]) * self.inv[a]).max(0.0) as usize).min(self.dims[a] - 1)
             }),
@@ -213,7 +223,7 @@ impl<'a> Grid<'a> {
         let q = match self.cell {
             Some(_) => {
                 let f = self.inverse * DVec3::from(p);
-                (f - f.floor()).to_array()
+                (f - f.floor() * self.wrap).to_array()
             }
             None => p,
         };
@@ -228,7 +238,7 @@ impl<'a> Grid<'a> {
                     let v = match self.cell {
                         Some(_) => {
                             let d = self.frac[j] - DVec3::from(q);
-                            (self.edges * (d - round(d))).to_array()
+                            (self.edges * (d - round(d) * self.wrap)).to_array()
                         }
                         None => [0, 1, 2].map(|a| self.positions[j][a] as f64 - p[a]),
                     };
@@ -238,7 +248,7 @@ impl<'a> Grid<'a> {
                     }
                 }
             }
-            let whole = (0..3).all(|a| 2 * ring + 1 >= self.dims[a]);
+            let whole = self.covers(centre, ring);
             let reach = ring as f64 * self.width;
             if whole || best.is_some_and(|(_, d2)| d2 <= reach * reach) {
                 break;
@@ -259,7 +269,7 @@ impl<'a> Grid<'a> {
                 // The fractional difference rounded to the nearest image, as
                 // `pbc::minimum_image` does, from the fractional coordinates kept.
                 let d = self.frac[j] - self.frac[i];
-                (self.edges * (d - round(d))).to_array()
+                (self.edges * (d - round(d) * self.wrap)).to_array()
             }
             None => [0, 1, 2].map(|a| self.positions[j][a] as f64 - self.positions[i][a] as f64),
         }
@@ -303,7 +313,7 @@ impl<'a> Grid<'a> {
             found.sort_by(|a, b| a.1.total_cmp(&b.1));
             // The ring holds every atom within `ring` cell widths: enough when the
             // neighbours needed are that close, or when the ring covers the whole grid.
-            let whole = (0..3).all(|a| 2 * ring + 1 >= self.dims[a]);
+            let whole = self.covers(centre, ring);
             let reach = ring as f64 * self.width;
             let enough = found.len() >= k && found[k - 1].1 <= reach * reach;
             if enough || whole {
@@ -314,28 +324,41 @@ impl<'a> Grid<'a> {
         index.extend(found.iter().map(|f| f.2));
     }
 
-    /// The offsets along axis `a` from grid coordinate `at` within `ring` cells: inside an open
-    /// grid, and at most once around a periodic one.
+    /// True when the cells within `ring` of `centre` are the whole grid: around a periodic
+    /// axis, 2·ring + 1 cells; along an open one, every cell on both sides.
+    fn covers(&self, centre: [usize; 3], ring: usize) -> bool {
+        (0..3).all(|a| {
+            let n = self.dims[a];
+            if self.periodic[a] {
+                2 * ring + 1 >= n
+            } else {
+                ring >= centre[a].max(n - 1 - centre[a])
+            }
+        })
+    }
+
+    /// The offsets along axis `a` from grid coordinate `at` within `ring` cells: inside the grid
+    /// along an open axis, and at most once around a periodic one.
     fn offsets(&self, at: usize, a: usize, ring: usize) -> std::ops::RangeInclusive<isize> {
         let (n, at, r) = (self.dims[a] as isize, at as isize, ring as isize);
-        match self.cell {
-            Some(_) if 2 * r + 1 >= n => 0..=n - 1,
-            Some(_) => -r..=r,
-            None => (-r).max(-at)..=r.min(n - 1 - at),
+        match self.periodic[a] {
+            true if 2 * r + 1 >= n => 0..=n - 1,
+            true => -r..=r,
+            false => (-r).max(-at)..=r.min(n - 1 - at),
         }
     }
 
-    /// The cell at `offset` from `centre`: wrapped in a periodic cell, `None` outside an open
-    /// grid.
+    /// The cell at `offset` from `centre`: wrapped around the periodic axes, `None` outside the
+    /// grid along an open one.
     fn offset_cell(&self, centre: [usize; 3], offset: [isize; 3]) -> Option<usize> {
         let mut c = [0usize; 3];
         for a in 0..3 {
             let n = self.dims[a] as isize;
             let v = centre[a] as isize + offset[a];
-            c[a] = match self.cell {
-                Some(_) => v.rem_euclid(n) as usize,
-                None if (0..n).contains(&v) => v as usize,
-                None => return None,
+            c[a] = match self.periodic[a] {
+                true => v.rem_euclid(n) as usize,
+                false if (0..n).contains(&v) => v as usize,
+                false => return None,
             };
         }
         Some((c[2] * self.dims[1] + c[1]) * self.dims[0] + c[0])

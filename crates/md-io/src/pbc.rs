@@ -38,14 +38,21 @@ fn to_cart(m: &[[f64; 3]; 3], f: [f64; 3]) -> [f64; 3] {
     std::array::from_fn(|k| f[0] * m[0][k] + f[1] * m[1][k] + f[2] * m[2][k])
 }
 
-/// The nearest periodic image of displacement `d` (Å) in `cell`.
+/// The nearest periodic image of displacement `d` (Å) in `cell`: whole edges taken off along
+/// the periodic edges only.
 pub fn minimum_image(cell: &UnitCell, d: [f64; 3]) -> [f64; 3] {
     let m = cell.matrix();
-    let f = to_frac(&m, d).map(|x| x - x.round());
+    let p = cell.periodic();
+    let mut f = to_frac(&m, d);
+    for k in 0..3 {
+        if p[k] {
+            f[k] -= f[k].round();
+        }
+    }
     to_cart(&m, f)
 }
 
-/// Moves every atom of `frame` into its cell (no-op without a cell).
+/// Moves every atom of `frame` into its cell along the periodic edges (no-op without a cell).
 pub fn wrap(frame: &mut Frame) {
     let Some(cell) = frame.cell else { return };
     let m = cell.matrix();
@@ -53,7 +60,11 @@ pub fn wrap(frame: &mut Frame) {
     for p in &mut frame.positions {
         let d = [p[0] as f64 - o[0], p[1] as f64 - o[1], p[2] as f64 - o[2]];
         let f = to_frac(&m, d);
-        let shift = to_cart(&m, f.map(|x| x.floor()));
+        let periodic = cell.periodic();
+        let shift = to_cart(
+            &m,
+            std::array::from_fn(|k| if periodic[k] { f[k].floor() } else { 0.0 }),
+        );
         for k in 0..3 {
             p[k] = (d[k] - shift[k] + o[k]) as f32;
         }

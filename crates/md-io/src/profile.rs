@@ -106,6 +106,7 @@ pub fn density_profile(
     let m = cell.matrix().map(DVec3::from_array);
     let inverse = DMat3::from_cols(m[0], m[1], m[2]).inverse();
     let origin = DVec3::from_array(cell.origin());
+    let periodic = cell.periodic()[axis];
     let charges = frame
         .property("charge")
         .or_else(|| frame.property("q"))
@@ -120,7 +121,9 @@ pub fn density_profile(
             return Err(ProfileError::NotFinite(i));
         }
         let s = (inverse * (p - origin))[axis];
-        let s = s - s.floor();
+        // Wrapped into the cell across a periodic edge; across an open one an atom outside
+        // the cell counts in the nearest end slab.
+        let s = if periodic { s - s.floor() } else { s.max(0.0) };
         let b = ((s * bins as f64) as usize).min(bins - 1);
         number[b] += 1.0;
         mass[b] += crate::atom_element(frame, i).mass();

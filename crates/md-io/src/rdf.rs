@@ -167,6 +167,8 @@ struct Histogram<'a> {
     frac: Vec<DVec3>,
     /// The cell's edges as columns: Cartesian = edges · fractional.
     edges: DMat3,
+    /// The axes the cell repeats along.
+    periodic: [bool; 3],
     /// Each atom's kind (empty without partials), and the number of kinds.
     kind_of: &'a [usize],
     kinds: usize,
@@ -226,11 +228,21 @@ impl Histogram<'_> {
                 let off = [o / 25, (o / 5) % 5, o % 5].map(|x| x as isize - 2);
                 let mut shift = DVec3::ZERO;
                 let mut nc = [0usize; 3];
+                let mut inside = true;
                 for k in 0..3 {
                     let x = c[k] as isize + off[k];
                     let d = dims[k] as isize;
-                    nc[k] = x.rem_euclid(d) as usize;
-                    shift[k] = x.div_euclid(d) as f64;
+                    if self.periodic[k] {
+                        nc[k] = x.rem_euclid(d) as usize;
+                        shift[k] = x.div_euclid(d) as f64;
+                    } else if (0..d).contains(&x) {
+                        nc[k] = x as usize;
+                    } else {
+                        inside = false;
+                    }
+                }
+                if !inside {
+                    continue;
                 }
                 let shift = self.edges * shift - pi;
                 let cell = index(nc);
@@ -247,7 +259,8 @@ impl Histogram<'_> {
     /// Every ordered pair tested, at its nearest image (a cell under three cutoffs wide).
     fn all_pairs(&self) -> Vec<u64> {
         let n = self.frac.len();
-        let round = |d: DVec3| d - d.round();
+        let wrap = DVec3::from(self.periodic.map(|p| if p { 1.0 } else { 0.0 }));
+        let round = |d: DVec3| d - d.round() * wrap;
         self.sum_over_atoms(|h, i| {
             for j in (0..n).filter(|&j| j != i) {
                 let d = round(self.frac[j] - self.frac[i]);
@@ -300,14 +313,19 @@ pub fn rdf(frame: &Frame, cutoff: f32, bins: usize, partial: bool) -> Result<Rdf
     let volume = cell.volume();
     // Perpendicular width along each cell vector: the volume over the opposite face's area.
     let widths = [(1, 2), (2, 0), (0, 1)].map(|(a, b)| volume / m[a].cross(m[b]).length());
-    let width = widths.iter().copied().fold(f64::INFINITY, f64::min);
+    // Only a periodic axis limits the cutoff: along the others no atom has an image.
+    let periodic = cell.periodic();
+    let width = (0..3)
+        .filter(|&k| periodic[k])
+        .map(|k| widths[k])
+        .fold(f64::INFINITY, f64::min);
     if 2.0 * cut > width {
         return Err(RdfError::CutoffTooLong { width, cutoff });
     }
-    let narrow = widths.iter().any(|&w| w < 3.0 * cut);
-    // Cells at least half a cutoff wide (at least 6 per axis when the cell is three cutoffs
-    // wide), at most 512 per axis.
-    let dims = widths.map(|w| ((2.0 * w / cut).floor() as usize).min(512));
+    let narrow = width < 3.0 * cut;
+    // Cells at least half a cutoff wide (at least 6 per periodic axis when the cell is three
+    // cutoffs wide), at most 512 per axis.
+    let dims = widths.map(|w| ((2.0 * w / cut).floor() as usize).clamp(1, 512));
     if narrow && n > MAX_ALL_PAIRS_ATOMS {
         return Err(RdfError::TooManyPairs {
             atoms: n,
@@ -336,12 +354,13 @@ pub fn rdf(frame: &Frame, cutoff: f32, bins: usize, partial: bool) -> Result<Rdf
         .iter()
         .map(|p| {
             let f = inverse * DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
-            f - f.floor()
+            f - f.floor() * DVec3::from(periodic.map(|p| if p { 1.0 } else { 0.0 }))
         })
         .collect();
     let histogram = Histogram {
         frac,
         edges,
+        periodic,
         kind_of: &kind_of,
         kinds: n_kinds,
         cut2: cut * cut,

@@ -222,7 +222,8 @@ pub fn replicate(
     frame.cell = Some(
         UnitCell::from_matrix(grown)
             .expect("whole multiples of a valid cell's edges form a valid cell")
-            .with_origin(origin),
+            .with_origin(origin)
+            .with_periodic(cell.periodic()),
     );
     Ok(())
 }

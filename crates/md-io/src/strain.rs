@@ -139,6 +139,13 @@ pub fn atomic_strain(
         (None, None) => None,
     };
     let cells = cells.map(|(h0, h)| (h0, h0.inverse(), h, h.inverse()));
+    // Whole edges come off along the periodic edges only (the reference's, else the current
+    // frame's).
+    let periodic = reference
+        .cell
+        .or(current.cell)
+        .map_or([false; 3], |c| c.periodic());
+    let wrap = DVec3::from(periodic.map(|p| if p { 1.0 } else { 0.0 }));
     let at = |f: &Frame, i: u32| DVec3::from(f.positions[i as usize].map(f64::from));
     let per_atom: Vec<(f32, f32, f32, bool)> = (0..n)
         .into_par_iter()
@@ -151,9 +158,9 @@ pub fn atomic_strain(
                     None => (d0, d),
                     Some((h0, h0_inv, h, h_inv)) => {
                         let f0 = *h0_inv * d0;
-                        let f0 = f0 - f0.round();
+                        let f0 = f0 - f0.round() * wrap;
                         let f = *h_inv * d;
-                        (*h0 * f0, *h * (f - (f - f0).round()))
+                        (*h0 * f0, *h * (f - (f - f0).round() * wrap))
                     }
                 }
             });

@@ -62,8 +62,8 @@ impl fmt::Display for VoronoiError {
         match self {
             VoronoiError::NotPeriodic => write!(
                 f,
-                "the frame has no periodic cell: the Voronoi cells of an open system's outer \
-                 atoms are unbounded"
+                "the frame has no cell periodic along all three edges: the Voronoi cells of \
+                 the atoms at an open surface are unbounded"
             ),
             VoronoiError::BadAtoms(why) => write!(f, "{why}"),
         }
@@ -80,7 +80,7 @@ const ON_PLANE: f64 = 1e-9;
 /// The Voronoi cell of every atom of a periodic `frame` (see the module docs).
 pub fn voronoi(frame: &Frame) -> Result<Voronoi, VoronoiError> {
     use rayon::prelude::*;
-    if frame.cell.is_none() {
+    if !frame.cell.is_some_and(|c| c.is_fully_periodic()) {
         return Err(VoronoiError::NotPeriodic);
     }
     let n = frame.n_atoms();

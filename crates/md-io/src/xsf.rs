@@ -16,7 +16,8 @@
 //! 2. The dimensionality (optional, once, before the first structure): `CRYSTAL` (periodic in
 //!    3-D), `SLAB` (2-D: along the first two cell vectors), `POLYMER` (1-D: along the first),
 //!    `MOLECULE` (0-D, written in the periodic form or, as pymatgen writes it, with `ATOMS`).
-//!    None at all is a molecule in `ATOMS` blocks. The keyword is kept as every frame's
+//!    None at all is a molecule in `ATOMS` blocks. The cell is periodic along the vectors the
+//!    keyword names ([`crate::UnitCell::periodic`]). The keyword is kept as every frame's
 //!    [`Frame::comment`] (`CRYSTAL`, `SLAB`, `POLYMER`, `MOLECULE`; empty without one).
 //! 3. A structure (a frame):
 //!    - periodic: `PRIMVEC [k]` and three lines of the lattice vectors a, b, c (rows, Å; the
@@ -614,7 +615,14 @@ impl Xsf {
             f.comment.push_str(header.kind.keyword());
             f.step = step;
             if periodic {
-                f.cell = cell;
+                // A slab repeats along a and b, a polymer along a, a molecule along none.
+                let along = match header.kind {
+                    Kind::Slab => [true, true, false],
+                    Kind::Polymer => [true, false, false],
+                    Kind::Molecule => [false; 3],
+                    Kind::Crystal | Kind::Atoms => [true; 3],
+                };
+                f.cell = cell.map(|c| c.with_periodic(along));
             }
         }
         let mut atoms = Atoms {

@@ -4,6 +4,9 @@
 //! `name x y z` (further columns ignored). When the comment line is extended XYZ (key=value pairs
 //! as written by ASE, OVITO, QUIP), these keys are used:
 //! - `Lattice="ax ay az bx by bz cx cy cz"`: the cell edge vectors (rows), Å;
+//! - `pbc="T T F"`: which of them are periodic (T/F, True/False or 1/0, as ASE writes them;
+//!   all three without the key) ([`UnitCell::periodic`]: a slab, a cluster in a box);
+//! - `Origin="x y z"`: the cell's corner, Å (OVITO writes it);
 //! - `Properties=name:type:count:...` with type S (string), R (real), I (integer), L (logical):
 //!   the columns of the atom lines. Known names: `species` (→ names and elements), `pos`,
 //!   `velo`/`vel`/`velocities` (Å/ps, stored as given), `radius`/`radii`, `color`/`colors`
@@ -134,6 +137,8 @@ impl Xyz {
     ) -> Result<(), Error> {
         self.cols.clear();
         self.properties.clear();
+        let mut periodic = [true; 3];
+        let mut origin = None;
         for (key, value) in key_values(line) {
             if key.eq_ignore_ascii_case(b"Lattice") {
                 let mut m = [0.0f64; 9];
@@ -156,12 +161,38 @@ impl Xyz {
                 ])
                 .map_err(|_| ctx.parse(pos, line, value, "a Lattice with volume > 0"))?;
                 frame.cell = Some(cell);
+            } else if key.eq_ignore_ascii_case(b"Origin") {
+                let v: Vec<Option<f64>> = fields(value).map(parse_f64).collect();
+                match v.as_slice() {
+                    [Some(x), Some(y), Some(z)] if [x, y, z].iter().all(|v| v.is_finite()) => {
+                        origin = Some([*x, *y, *z])
+                    }
+                    _ => return Err(ctx.parse(pos, line, value, "3 numbers in Origin")),
+                }
+            } else if key.eq_ignore_ascii_case(b"pbc") {
+                let flags: Vec<Option<bool>> = fields(value)
+                    .map(|f| match f.to_ascii_lowercase().as_slice() {
+                        b"t" | b"true" | b"1" => Some(true),
+                        b"f" | b"false" | b"0" => Some(false),
+                        _ => None,
+                    })
+                    .collect();
+                match flags.as_slice() {
+                    [Some(a), Some(b), Some(c)] => periodic = [*a, *b, *c],
+                    _ => return Err(ctx.parse(pos, line, value, "pbc as three of T and F")),
+                }
             } else if key.eq_ignore_ascii_case(b"Properties") {
                 self.parse_properties(ctx, pos, line, value)?;
             } else if key.eq_ignore_ascii_case(b"Time") {
                 frame.time = parse_f64(value);
             } else if key.eq_ignore_ascii_case(b"step") || key.eq_ignore_ascii_case(b"timestep") {
                 frame.step = parse_i64(value);
+            }
+        }
+        if let Some(cell) = &mut frame.cell {
+            *cell = cell.with_periodic(periodic);
+            if let Some(o) = origin {
+                *cell = cell.with_origin(o);
             }
         }
         if self.cols.is_empty() {
@@ -401,12 +432,13 @@ impl TextFormat for Xyz {
 /// Writes frames as extended XYZ, which plain XYZ readers also read (ASE, OVITO, QUIP and our
 /// reader take the columns from `Properties=`).
 ///
-/// The comment line carries `Lattice=` when the frame has a cell, then `Properties=` with the
+/// The comment line carries `Lattice=` (and `Origin=`, as OVITO writes it, when the corner is
+/// not at zero) when the frame has a cell, then `Properties=` with the
 /// columns in this order: `species:S:1:pos:R:3`, `id:I:1` when the frame has ids, `type:S:1`
 /// when it has types, `velo:R:3`, `radius:R:1`, `color:R:3` when it has velocities, radii,
 /// colours, then each of [`Frame::properties`] in order as `NAME:I:1` when every value is an
 /// integer below 2^24 in magnitude (written without a decimal point), else `NAME:R:1`; then
-/// `Time=` and `step=` when known and `pbc="T T T"` with a cell.
+/// `Time=` and `step=` when known and `pbc="T T F"` (the cell's periodic edges) with a cell.
 ///
 /// The species of an atom is its name, else its element's symbol, else `X`. Numbers are
 /// written in Rust's shortest round-trip form, so reading them back gives the same f32 bits; a
@@ -489,6 +521,10 @@ impl<W: std::io::Write> XyzWriter<W> {
                 "Lattice=\"{} {} {} {} {} {} {} {} {}\" ",
                 m[0][0], m[0][1], m[0][2], m[1][0], m[1][1], m[1][2], m[2][0], m[2][1], m[2][2]
             )?;
+            let o = c.origin();
+            if o != [0.0; 3] {
+                write!(w, "Origin=\"{} {} {}\" ", o[0], o[1], o[2])?;
+            }
         }
         write!(w, "Properties=species:S:1:pos:R:3")?;
         if !frame.ids.is_empty() {
@@ -516,8 +552,9 @@ impl<W: std::io::Write> XyzWriter<W> {
         if let Some(s) = frame.step {
             write!(w, " step={s}")?;
         }
-        if frame.cell.is_some() {
-            write!(w, " pbc=\"T T T\"")?;
+        if let Some(cell) = &frame.cell {
+            let [a, b, c] = cell.periodic().map(|p| if p { 'T' } else { 'F' });
+            write!(w, " pbc=\"{a} {b} {c}\"")?;
         }
         writeln!(w)?;
         // Atom lines.

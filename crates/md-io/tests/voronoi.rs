@@ -76,7 +76,7 @@ fn open_frames_and_bad_atoms_are_refused() {
         voronoi(&frame)
             .unwrap_err()
             .to_string()
-            .contains("no periodic cell")
+            .contains("no cell periodic along all three edges")
     );
     frame.cell = Some(texmap_md_io::UnitCell::orthorhombic(5.0, 5.0, 5.0).unwrap());
     frame.positions[1][2] = f32::NAN;

@@ -1041,9 +1041,10 @@ impl MolPlan {
         rotate_orientations(frame, &fit);
         if let Some(cell) = &frame.cell {
             let m = cell.matrix().map(|row| fit.rotate(row));
-            frame.cell = texmap_md_io::UnitCell::from_matrix(m)
-                .ok()
-                .map(|c| c.with_origin(fit.apply(cell.origin())));
+            frame.cell = texmap_md_io::UnitCell::from_matrix(m).ok().map(|c| {
+                c.with_origin(fit.apply(cell.origin()))
+                    .with_periodic(cell.periodic())
+            });
         }
         Ok(())
     }

@@ -37,10 +37,12 @@ fn images_within(cell: &UnitCell, nearest: DVec3, cutoff: f64, mut found: impl F
         return;
     }
     let m = cell.matrix().map(DVec3::from_array);
-    let k = (cutoff / cell.min_width()).ceil().clamp(1.0, 3.0) as i32;
-    for a in -k..=k {
-        for b in -k..=k {
-            for e in -k..=k {
+    let k = (cutoff / cell.min_periodic_width()).ceil().clamp(1.0, 3.0) as i32;
+    // No images across an edge that is not periodic.
+    let [ka, kb, ke] = cell.periodic().map(|p| if p { k } else { 0 });
+    for a in -ka..=ka {
+        for b in -kb..=kb {
+            for e in -ke..=ke {
                 if (a, b, e) == (0, 0, 0) {
                     continue;
                 }
@@ -74,7 +76,14 @@ pub fn pairs_in_narrow_cell(frame: &texmap_md_io::Frame, cell: &UnitCell) -> Vec
     let m = cell.matrix().map(DVec3::from_array);
     let volume = cell.volume();
     let widths = [(1, 2), (2, 0), (0, 1)].map(|(a, b)| volume / m[a].cross(m[b]).length());
-    let copies = widths.map(|w| ((3.0 * cutoff / w).ceil() as usize + 1).max(1));
+    let periodic = cell.periodic();
+    let copies: [usize; 3] = std::array::from_fn(|k| {
+        if periodic[k] {
+            ((3.0 * cutoff / widths[k]).ceil() as usize + 1).max(1)
+        } else {
+            1
+        }
+    });
     let mut copy = texmap_md_io::Frame::new();
     copy.positions = frame.positions.clone();
     copy.elements = elements;
