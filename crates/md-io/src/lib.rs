@@ -156,6 +156,7 @@ pub mod rdf;
 pub mod replicate;
 pub mod rmsf;
 pub mod rotation;
+pub mod sasa;
 mod sdf;
 pub mod secondary;
 pub mod select;
