@@ -81,12 +81,20 @@ struct Cache {
     diamond: std::cell::OnceCell<Vec<crate::cna::DiamondType>>,
 }
 
-/// Residue names `protein` matches: the 20 amino acids, their common protonation and
-/// terminal variants (AMBER, CHARMM, GROMACS spellings) and selenomethionine.
+/// Residue names `protein` matches: MDAnalysis 2.11's, the 20 amino acids with their
+/// protonation and terminal variants in the AMBER (HID, CYX, NALA, CALA), CHARMM (HSD, HSE) and
+/// GROMOS/OPLS spellings of GROMACS topologies (LYSH, HISB, CYSH, ASPH), the ACE and NME caps,
+/// selenomethionine and a few modified residues (HYP, ORN, DAB).
 pub const PROTEIN_RESIDUES: &[&str] = &[
     "ALA", "ARG", "ASN", "ASP", "CYS", "GLN", "GLU", "GLY", "HIS", "ILE", "LEU", "LYS", "MET",
-    "PHE", "PRO", "SER", "THR", "TRP", "TYR", "VAL", "ASH", "GLH", "HID", "HIE", "HIP", "HSD",
-    "HSE", "HSP", "LYN", "CYX", "CYM", "MSE", "NALA", "CALA",
+    "PHE", "PRO", "SER", "THR", "TRP", "TYR", "VAL", "ACE", "ALAD", "ARGN", "ASF", "ASH", "ASN1",
+    "ASPH", "CALA", "CARG", "CASF", "CASN", "CASP", "CCYS", "CCYX", "CGLN", "CGLU", "CGLY", "CHID",
+    "CHIE", "CHIP", "CILE", "CLEU", "CLYS", "CME", "CMET", "CPHE", "CPRO", "CSER", "CTHR", "CTRP",
+    "CTYR", "CVAL", "CYM", "CYS1", "CYS2", "CYSH", "CYX", "DAB", "GLH", "GLUH", "HID", "HIE",
+    "HIP", "HIS1", "HIS2", "HISA", "HISB", "HISD", "HISE", "HISH", "HSD", "HSE", "HSP", "HYP",
+    "LYN", "LYSH", "MSE", "NALA", "NARG", "NASN", "NASP", "NCYS", "NCYX", "NGLN", "NGLU", "NGLY",
+    "NHID", "NHIE", "NHIP", "NILE", "NLEU", "NLYS", "NME", "NMET", "NPHE", "NPRO", "NSER", "NTHR",
+    "NTRP", "NTYR", "NVAL", "ORN", "PGLU", "QLN",
 ];
 
 /// Residue names `nucleic` matches: DNA and RNA nucleotides in the PDB, AMBER and CHARMM

@@ -194,3 +194,28 @@ fn psf_written_by_parmed_matches_mdanalysis_and_gives_the_pdb_elements() {
     assert_eq!(labels(&f.names), strings(&r["names"]));
     assert_eq!(f.segments, t.segments);
 }
+
+/// A GROMACS OPLS-AA topology names its residues as GROMOS did (LYSH, HISB, CYSH): MDAnalysis
+/// 2.11 selects the 3,341 atoms of adenylate kinase as `protein` and guesses their elements as
+/// H 1,685, C 1,040, O 320, N 289, S 7 (`u.select_atoms('protein')`, `DefaultGuesser
+/// .guess_types(p.names)` on hbonds/adk_top.gro.gz). "CA" in LYSH is its α carbon, not calcium.
+#[test]
+fn gromos_residue_names_are_protein_with_organic_elements() {
+    let top = Topology::open(path("hbonds/adk_top.gro.gz")).unwrap();
+    let mut frame = Frame::new();
+    let mut t = Trajectory::open(path("hbonds/adk_0_9.xtc")).unwrap();
+    assert!(t.read_next(&mut frame).unwrap());
+    top.apply(&mut frame, "adk_0_9.xtc", 0).unwrap();
+    let protein = texmap_md_io::select::Selection::parse("protein")
+        .unwrap()
+        .evaluate(&frame)
+        .unwrap();
+    let mut counts = std::collections::BTreeMap::new();
+    for i in (0..frame.n_atoms()).filter(|&i| protein[i]) {
+        *counts
+            .entry(texmap_md_io::atom_element(&frame, i).symbol())
+            .or_insert(0) += 1;
+    }
+    let want = [("C", 1040), ("H", 1685), ("N", 289), ("O", 320), ("S", 7)];
+    assert_eq!(counts.into_iter().collect::<Vec<_>>(), want);
+}
