@@ -16,7 +16,8 @@ use criterion::{Criterion, criterion_group};
 use texmap::md_io::UnitCell;
 use texmap::md_io::bonds::{bonds_by_distance, bonds_with_radii};
 use texmap::md_io::hbonds::{Criteria, donor_hydrogens, hydrogen_bonds};
-use texmap::md_io::{Frame, Topology, Trajectory};
+
+mod common;
 
 struct Lcg(u64);
 impl Lcg {
@@ -88,15 +89,7 @@ fn bench(c: &mut Criterion) {
 }
 
 fn bench_hbonds(c: &mut Criterion) {
-    let dir = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/crates/md-io/tests/data/hbonds"
-    );
-    let top = Topology::open(format!("{dir}/adk_top.gro.gz")).unwrap();
-    let mut traj = Trajectory::open(format!("{dir}/adk_0_9.xtc")).unwrap();
-    let mut frame = Frame::new();
-    assert!(traj.read_next(&mut frame).unwrap());
-    top.apply(&mut frame, "adk_0_9.xtc", 0).unwrap();
+    let frame = common::adk_frame();
     let dh = donor_hydrogens(&frame, &bonds_by_distance(&frame, true).pairs);
     let found = hydrogen_bonds(&frame, &dh, None, Criteria::default()).unwrap();
     assert!(found.len() > 13_000, "{}", found.len());

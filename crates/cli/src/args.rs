@@ -264,6 +264,14 @@ pub fn parse_positive(s: &str) -> Result<f64, String> {
     }
 }
 
+/// Parses `--sasa-probe`: a radius from 0 to 10 Å.
+pub fn parse_probe(s: &str) -> Result<f32, String> {
+    match s.trim().parse::<f32>() {
+        Ok(r) if (0.0..=10.0).contains(&r) => Ok(r),
+        _ => Err(format!("{s:?} is not a probe radius from 0 to 10 Å")),
+    }
+}
+
 /// Parses `--coordination`: a cutoff in Å from 0.45 (exclusive) to 20.
 pub fn parse_cutoff(s: &str) -> Result<f32, String> {
     match s.trim().parse::<f32>() {
@@ -1153,6 +1161,31 @@ pub struct AnalysisArgs {
     /// matrix, 'prop coordination >= 10' for solid-like atoms); the others are in cluster -1.
     #[arg(long, value_name = "SEL", requires = "clusters")]
     pub cluster_atoms: Option<String>,
+    /// Every atom's solvent-accessible surface area every frame (Å², Shrake–Rupley with 960
+    /// points, as MDTraj's shrake_rupley, VMD's measure sasa and PyMOL's get_area compute it;
+    /// MDTraj's radii: Bondi's for H C N O P S, ionic for Na K Mg Ca Cl), into the per-atom
+    /// number 'sasa': --color-by sasa shows the exposed atoms, --select 'prop sasa > 20' keeps
+    /// them. SEL picks the atoms measured, which alone bury each other: '--sasa protein'
+    /// measures the protein without its water (the default, every atom, buries a solvated
+    /// protein in its solvent). Under the minimum image in a periodic cell (narrower than three
+    /// sphere diameters is refused: replicate it); give --pbc unwrap so molecules are whole.
+    #[arg(long, value_name = "SEL", num_args = 0..=1, default_missing_value = "all")]
+    pub sasa: Option<String>,
+    /// The probe radius of --sasa, Å (1.4: water).
+    #[arg(long, value_name = "R", default_value_t = texmap_md_io::sasa::PROBE, requires = "sasa",
+          value_parser = parse_probe)]
+    pub sasa_probe: f32,
+    /// Also write the --sasa total of every frame as a CSV table: frame, time (ps, when the file
+    /// has it), sasa (Å², the sum over the measured atoms), as a protein's folding or unfolding
+    /// shows in it (gmx sasa's total). Written whole or not at all.
+    #[arg(long, value_name = "FILE.csv", requires = "sasa")]
+    pub sasa_table: Option<PathBuf>,
+    /// Also write the --sasa of every residue in every frame as a CSV table: frame, time,
+    /// chain, resid, resname, sasa (Å², the sum over the residue's measured atoms): which
+    /// residues are exposed, as MDTraj's shrake_rupley(mode='residue') gives it. Written whole
+    /// or not at all.
+    #[arg(long, value_name = "FILE.csv", requires = "sasa")]
+    pub sasa_residue_table: Option<PathBuf>,
     /// Also write the --clusters of every frame as a CSV table, one row per cluster, the largest
     /// first: frame, cluster, atoms, the centre x, y, z (Å; the mean of its atoms taken whole
     /// across the cell's faces) and the radius of gyration (Å, unweighted): nucleation and

@@ -635,6 +635,20 @@ pub fn mol_plan(args: &MolArgs, style: &StyleArgs, topology: Option<Topology>) -
             }),
             None => None,
         },
+        sasa: match (&args.analysis.sasa, scalar_is("sasa")) {
+            (Some(sel), _) => Some(texmap_md_scene::SasaOptions {
+                atoms: match sel.trim() {
+                    "all" => None,
+                    t => Some(parse_selection("--sasa", t)?),
+                },
+                probe: args.analysis.sasa_probe,
+            }),
+            (None, true) => Some(texmap_md_scene::SasaOptions {
+                atoms: None,
+                probe: texmap_md_io::sasa::PROBE,
+            }),
+            (None, false) => None,
+        },
         centrosymmetry: match args.analysis.centrosymmetry {
             Some(n) => Some(n),
             None if scalar_is("centrosymmetry") => Some(12),
@@ -793,8 +807,9 @@ fn read_reference(path: &std::path::Path) -> Result<Frame> {
 }
 
 /// The per-atom properties the analyses add, and the flag that adds each.
-pub(crate) const ANALYSIS_PROPERTIES: [(&str, &str); 22] = [
+pub(crate) const ANALYSIS_PROPERTIES: [(&str, &str); 23] = [
     ("coordination", "--coordination R"),
+    ("sasa", "--sasa"),
     ("msd", "--msd"),
     ("cluster", "--clusters R"),
     ("centrosymmetry", "--centrosymmetry N"),
@@ -833,6 +848,7 @@ pub fn mol_error(e: MolError) -> anyhow::Error {
                 SelectionRole::Radius => "--radius",
                 SelectionRole::Align => "--align",
                 SelectionRole::Cluster => "--cluster-atoms",
+                SelectionRole::Sasa => "--sasa",
             };
             // A property an analysis computes: name the flag that computes it.
             if let Some((_, hint)) = ANALYSIS_PROPERTIES
@@ -852,6 +868,10 @@ pub fn mol_error(e: MolError) -> anyhow::Error {
         }
         MolError::Coordination(e) => return anyhow::anyhow!("--coordination: {e}"),
         MolError::Clusters(e) => return anyhow::anyhow!("--clusters: {e}"),
+        MolError::Sasa(texmap_md_io::sasa::SasaError::BadProbe(p)) => {
+            format!("--sasa-probe {p}: expected a radius from 0 to 10 Å")
+        }
+        MolError::Sasa(e) => return anyhow::anyhow!("--sasa: {e}"),
         MolError::Centrosymmetry(e) => format!("--centrosymmetry: {e}"),
         MolError::Strain(e) => return anyhow::anyhow!("--strain: {e}"),
         MolError::WignerSeitz(e) => return anyhow::anyhow!("--wigner-seitz: {e}"),

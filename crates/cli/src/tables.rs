@@ -59,6 +59,8 @@ pub(crate) struct AnalysisTables {
     cluster: Option<crate::output::AtomicFile>,
     msd_lags: Option<MsdLags>,
     velocities: Option<VelocityTables>,
+    sasa: Option<crate::output::AtomicFile>,
+    sasa_residues: Option<crate::output::AtomicFile>,
     dihedral: Option<crate::output::AtomicFile>,
     profile: Option<(crate::output::AtomicFile, ProfileMean)>,
     /// `--rmsf-table`, the fluctuations so far and each atom's first columns (the first
@@ -83,6 +85,41 @@ fn atom_columns(md: &MdFrame, i: usize) -> String {
         number(&md.res_ids),
         text(&md.chains)
     )
+}
+
+/// Frame `f`'s `--sasa-residue-table` rows: each residue with a measured atom (consecutive
+/// atoms of one chain, residue number and name), the sum of its atoms' `area`.
+fn residue_sums(f: usize, time: &str, md: &MdFrame, area: &[f32]) -> String {
+    let label =
+        |v: &[texmap_md_io::Label], i: usize| v.get(i).map(|l| l.to_string()).unwrap_or_default();
+    let key = |i: usize| {
+        (
+            label(&md.chains, i),
+            md.res_ids.get(i).copied(),
+            label(&md.res_names, i),
+        )
+    };
+    let mut rows = String::new();
+    let mut i = 0;
+    while i < area.len() {
+        let k = key(i);
+        let mut j = i;
+        let mut sum = 0.0f64;
+        let mut measured = false;
+        while j < area.len() && key(j) == k {
+            if area[j].is_finite() {
+                sum += f64::from(area[j]);
+                measured = true;
+            }
+            j += 1;
+        }
+        if measured {
+            let resid = k.1.map(|r| r.to_string()).unwrap_or_default();
+            rows.push_str(&format!("{f},{time},{},{resid},{},{sum:.3}\n", k.0, k.2));
+        }
+        i = j;
+    }
+    rows
 }
 
 /// `--msd-lags`: every frame's unwrapped positions, averaged over every time origin at the end.
@@ -585,6 +622,18 @@ impl AnalysisTables {
                 kind: Vec::new(),
                 fit: analysis.msd_fit,
             }),
+            sasa: per_frame_table(
+                &analysis.sasa_table,
+                "--sasa-table",
+                "frame,time,sasa",
+                whole,
+            )?,
+            sasa_residues: per_frame_table(
+                &analysis.sasa_residue_table,
+                "--sasa-residue-table",
+                "frame,time,chain,resid,resname,sasa",
+                whole,
+            )?,
             velocities: {
                 let why = "the average over every time origin needs every frame in one run";
                 let vacf = whole_run_table(&analysis.vacf_table, "--vacf-table", why, whole)?;
@@ -709,6 +758,15 @@ impl AnalysisTables {
         if let Some(v) = &mut self.velocities {
             v.add(f, md)?;
         }
+        if let Some(area) = md.property(texmap_md_scene::SASA) {
+            let measured = || area.iter().filter(|a| a.is_finite()).map(|a| f64::from(*a));
+            if let Some(t) = &mut self.sasa {
+                t.write(&format!("{f},{time},{:.3}\n", measured().sum::<f64>()))?;
+            }
+            if let Some(t) = &mut self.sasa_residues {
+                t.write(&residue_sums(f, &time, md, area))?;
+            }
+        }
         if let Some(t) = &mut self.dihedral {
             let angle = |a: Option<f64>| a.map(|a| format!("{a:.3}")).unwrap_or_default();
             let label = |v: &[texmap_md_io::Label], i: usize| {
@@ -771,6 +829,8 @@ impl AnalysisTables {
             .transpose()?;
         for t in [
             self.dihedral,
+            self.sasa,
+            self.sasa_residues,
             msd_lags,
             profile,
             rmsf,

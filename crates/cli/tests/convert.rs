@@ -1038,6 +1038,82 @@ fn vacf_and_vdos_tables_are_tidynamics_and_numpys() {
     }
 }
 
+/// `--sasa`: the solvent-accessible area per residue of a wwPDB chain equals MDTraj's
+/// shrake_rupley(mode='residue') (md-io's sasa fixture), within a point of each atom's sphere;
+/// `--sasa protein` measures MDAnalysis's solvated peptide without its water as MDTraj measures
+/// the protein sliced out; the per-frame total is the residues' sum; the property colours a
+/// render; a bad probe is a usage error and leaves no table.
+#[test]
+fn sasa_tables_are_mdtrajs() {
+    let dir = tempfile::tempdir().unwrap();
+    let reference = json("sasa/sasa_reference.json");
+    let (total, residues) = (dir.path().join("t.csv"), dir.path().join("r.csv"));
+    for (file, key, select) in [
+        ("dssp/3gwiA.pdb.gz", "3gwiA.pdb.gz", "all"),
+        ("select_mda.pdb", "select_mda.pdb protein", "protein"),
+    ] {
+        let o = texmap(&[
+            "convert",
+            &md_data(file),
+            "--sasa",
+            select,
+            "--sasa-table",
+            total.to_str().unwrap(),
+            "--sasa-residue-table",
+            residues.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let (header, rows) = table(&residues);
+        assert_eq!(header, "frame,time,chain,resid,resname,sasa");
+        let want = numbers(&reference[key]["residues"]);
+        assert_eq!(rows.len(), want.len(), "{file}");
+        for (k, (row, w)) in rows.iter().zip(&want).enumerate() {
+            // One point of a 3.1 Å sphere is 0.126 Å²; a residue's atoms may each be one off.
+            assert!(
+                (row[5] - w).abs() < 0.6,
+                "{file} residue {k}: {} vs MDTraj {w}",
+                row[5]
+            );
+        }
+        let (header, rows_total) = table(&total);
+        assert_eq!(header, "frame,time,sasa");
+        let want_total = reference[key]["total"].as_f64().unwrap();
+        let sum: f64 = rows.iter().map(|r| r[5]).sum();
+        assert!((rows_total[0][2] - sum).abs() < 0.01 * rows.len() as f64);
+        assert!(
+            (rows_total[0][2] - want_total).abs() < 1e-4 * want_total,
+            "{file}"
+        );
+    }
+    // The property colours a render and selects atoms.
+    let png = dir.path().join("s.png");
+    let o = texmap(&[
+        "render",
+        &md_data("dssp/3gwiA.pdb.gz"),
+        "--color-by",
+        "sasa",
+        "--select",
+        "prop sasa > 20",
+        "--size",
+        "64x48",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    std::fs::remove_file(&total).unwrap();
+    let o = texmap(&[
+        "convert",
+        &md_data("dssp/3gwiA.pdb.gz"),
+        "--sasa",
+        "--sasa-probe",
+        "-1",
+        "--sasa-table",
+        total.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(!total.exists());
+}
+
 /// `--cluster-table`: the copper clusters in iron (md-io's cluster fixture, written by OVITO)
 /// have OVITO's sizes, largest first, frame by frame; the precipitate (every site within 6 Å
 /// of (12, 13, 14)) is centred there, with about a solid sphere's radius of gyration

@@ -132,7 +132,8 @@ pub fn sphere_points(n: usize) -> Vec<[f64; 3]> {
 }
 
 /// Every atom's solvent-accessible surface area (Å²) with a probe of radius `probe` (Å), over
-/// the atoms `mask` keeps (all without one); the others get NaN.
+/// the atoms `mask` keeps (all without one) that have an element; the others (virtual sites,
+/// dummies) get NaN and bury nothing.
 pub fn sasa(frame: &Frame, mask: Option<&[bool]>, probe: f32) -> Result<Vec<f32>, SasaError> {
     if !(probe.is_finite() && (0.0..=10.0).contains(&probe)) {
         return Err(SasaError::BadProbe(probe));
@@ -146,7 +147,10 @@ pub fn sasa(frame: &Frame, mask: Option<&[bool]>, probe: f32) -> Result<Vec<f32>
             mask: m.len(),
         });
     }
-    let counted: Vec<usize> = (0..n).filter(|&i| mask.is_none_or(|m| m[i])).collect();
+    // Atoms without an element (virtual sites such as TIP4P's MW, dummies) have no surface.
+    let counted: Vec<usize> = (0..n)
+        .filter(|&i| mask.is_none_or(|m| m[i]) && !crate::atom_element(frame, i).is_unknown())
+        .collect();
     if let Some(&i) = counted
         .iter()
         .find(|&&i| !frame.positions[i].iter().all(|v| v.is_finite()))

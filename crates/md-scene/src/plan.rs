@@ -236,6 +236,10 @@ pub const COORDINATION: &str = "coordination";
 /// The per-atom property [`MolOptions::clusters`] adds to each frame (0 the largest cluster, −1
 /// for atoms not clustered).
 pub const CLUSTER: &str = "cluster";
+
+/// The per-atom property [`MolOptions::sasa`] adds to each frame: the solvent-accessible area
+/// in Å² (NaN for atoms not measured).
+pub const SASA: &str = "sasa";
 /// The per-atom property [`MolOptions::centrosymmetry`] adds to each frame (Å²).
 pub const CENTROSYMMETRY: &str = "centrosymmetry";
 /// The per-atom von Mises shear strain [`MolOptions::strain`] adds to each frame.
@@ -304,6 +308,11 @@ pub struct MolOptions {
     /// [`texmap_md_io::coordination::clusters`]), for colouring ([`crate::ColorBy::Cluster`])
     /// and selections (`prop cluster == 0`: the largest).
     pub clusters: Option<ClusterOptions>,
+    /// Every atom's solvent-accessible surface area every frame, after the clusters, as the
+    /// per-atom property [`SASA`] (Å²; Shrake–Rupley as MDTraj's, VMD's `measure sasa`:
+    /// [`texmap_md_io::sasa`]), for colouring (`--color-by sasa`) and selections
+    /// (`prop sasa > 30`: the exposed residues' atoms).
+    pub sasa: Option<SasaOptions>,
     /// The centrosymmetry parameter of every atom every frame, after the clusters, as the
     /// per-atom property `centrosymmetry` (OVITO's Centrosymmetry modifier, LAMMPS's
     /// `centro/atom`: [`texmap_md_io::centrosymmetry`]), for colouring and for hiding the
@@ -481,6 +490,7 @@ impl Default for MolOptions {
             replicate: None,
             coordination: None,
             clusters: None,
+            sasa: None,
             centrosymmetry: None,
             strain: None,
             computes: Vec::new(),
@@ -527,6 +537,16 @@ pub struct ClusterOptions {
     pub atoms: Option<Selection>,
 }
 
+/// [`MolOptions::sasa`]: which atoms are measured, and the probe.
+#[derive(Clone, Debug)]
+pub struct SasaOptions {
+    /// Only these atoms are measured and bury each other (a protein without its water); the
+    /// others get NaN. `None`: every atom.
+    pub atoms: Option<Selection>,
+    /// The probe's radius, Å ([`texmap_md_io::sasa::PROBE`]: water).
+    pub probe: f32,
+}
+
 /// What [`MolOptions::wigner_seitz`] draws.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum WsOutput {
@@ -562,6 +582,8 @@ pub enum SelectionRole {
     Align,
     /// [`ClusterOptions::atoms`].
     Cluster,
+    /// [`SasaOptions::atoms`].
+    Sasa,
 }
 
 /// Why a [`MolPlan`] was refused or a frame could not be built.
@@ -606,6 +628,8 @@ pub enum MolError {
     Coordination(CoordinationError),
     /// [`MolOptions::clusters`] cannot be found (the cell is too small for the cutoff).
     Clusters(CoordinationError),
+    /// [`MolOptions::sasa`] cannot be computed (the probe, the cell too small, bad atoms).
+    Sasa(texmap_md_io::sasa::SasaError),
     /// [`MolOptions::centrosymmetry`] has a bad neighbour count.
     Centrosymmetry(CentroError),
     /// [`MolOptions::strain`] cannot be computed (a frame of other atoms than the reference,
@@ -680,6 +704,7 @@ impl fmt::Display for MolError {
             MolError::Replicate(e) => write!(f, "periodic images: {e}"),
             MolError::Coordination(e) => write!(f, "coordination: {e}"),
             MolError::Clusters(e) => write!(f, "clusters: {e}"),
+            MolError::Sasa(e) => write!(f, "solvent-accessible surface: {e}"),
             MolError::Centrosymmetry(e) => write!(f, "centrosymmetry: {e}"),
             MolError::Strain(e) => write!(f, "atomic strain: {e}"),
             MolError::WignerSeitz(e) => write!(f, "Wigner-Seitz analysis: {e}"),
@@ -752,6 +777,7 @@ impl fmt::Display for MolError {
                 let what = match role {
                     SelectionRole::Align => "the alignment selection",
                     SelectionRole::Cluster => "the selection of clustered atoms",
+                    SelectionRole::Sasa => "the selection of atoms measured for their surface",
                     SelectionRole::Select => "the selection of drawn atoms",
                     SelectionRole::Color => "a colour rule's selection",
                     SelectionRole::Radius => "a radius rule's selection",
@@ -1227,6 +1253,18 @@ impl MolPlan {
             set_property(frame, CLUSTER, values);
             found.ids = Vec::new();
             self.last_clusters = Some(found);
+        }
+        if let Some(s) = &self.options.sasa {
+            let mask = match &s.atoms {
+                Some(sel) => Some(sel.evaluate(frame).map_err(|error| MolError::Selection {
+                    role: SelectionRole::Sasa,
+                    error,
+                })?),
+                None => None,
+            };
+            let values = texmap_md_io::sasa::sasa(frame, mask.as_deref(), s.probe)
+                .map_err(MolError::Sasa)?;
+            set_property(frame, SASA, values);
         }
         if let Some(c) = self.options.centrosymmetry {
             let values = texmap_md_io::centrosymmetry::centrosymmetry(frame, c.neighbours, c.mode)

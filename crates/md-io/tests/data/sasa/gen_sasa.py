@@ -6,7 +6,8 @@ For three wwPDB protein chains of md-io's DSSP fixtures (../dssp/1ahsA, 2cviA, 3
 atoms as deposited) and for MDAnalysis's solvated peptide (../select_mda.pdb, with its water
 and ions, hydrogens included), sasa_reference.json holds every atom's solvent-accessible area in
 A^2 (mdtraj.shrake_rupley, probe 0.14 nm, 960 points, mode 'atom', its default radii, times
-100), the atoms' elements as MDTraj read them, and the per-residue sums (mode 'residue').
+100), the atoms' elements as MDTraj read them, and the per-residue sums (mode 'residue');
+and the peptide's residues measured alone (its protein atoms sliced out: no water, no ions).
 """
 import json
 import os
@@ -28,6 +29,16 @@ for name in files:
         "total": float(atom.sum()),
     }
     print(name, t.n_atoms, round(float(atom.sum()), 2), sorted(set(out[os.path.basename(name)]["elements"])))
+# The peptide alone (its water and ions neither measured nor burying it).
+t = md.load(os.path.join(here, "../select_mda.pdb"))
+protein = t.atom_slice(t.topology.select("protein"))
+residue = md.shrake_rupley(protein, probe_radius=0.14, n_sphere_points=960, mode="residue")[0] * 100.0
+out["select_mda.pdb protein"] = {
+    "residues": [round(float(x), 3) for x in residue],
+    "resids": [r.resSeq for r in protein.topology.residues],
+    "total": float(residue.sum()),
+}
+print("protein alone", protein.n_atoms, round(float(residue.sum()), 2))
 with open(os.path.join(here, "sasa_reference.json"), "w") as f:
     json.dump(out, f)
     f.write("\n")
