@@ -1161,6 +1161,26 @@ pub struct AnalysisArgs {
     /// matrix, 'prop coordination >= 10' for solid-like atoms); the others are in cluster -1.
     #[arg(long, value_name = "SEL", requires = "clusters")]
     pub cluster_atoms: Option<String>,
+    /// Also write the size and shape of --gyration-select's atoms every frame as a CSV table
+    /// (MDAnalysis's radius_of_gyration and asphericity, gmx gyrate): frame, time (ps, when the
+    /// file has it), rg (Å), rg_x, rg_y, rg_z (about the axes through the centre) and
+    /// asphericity (the gyration tensor's relative shape anisotropy: 0 a sphere, 1 a rod),
+    /// mass-weighted unless --gyration-unweighted. The atoms are taken as they are after --pbc:
+    /// give --pbc unwrap for a molecule the trajectory wrapped. Written whole or not at all.
+    #[arg(long, value_name = "FILE.csv")]
+    pub gyration_table: Option<PathBuf>,
+    /// The atoms --gyration-table measures (e.g. 'protein', 'resname POPC').
+    #[arg(
+        long,
+        value_name = "SEL",
+        default_value = "all",
+        requires = "gyration_table"
+    )]
+    pub gyration_select: String,
+    /// Weigh every atom of --gyration-table alike instead of by its mass (for atoms without
+    /// elements, or the geometric size).
+    #[arg(long, requires = "gyration_table")]
+    pub gyration_unweighted: bool,
     /// Every atom's solvent-accessible surface area every frame (Å², Shrake–Rupley with 960
     /// points, as MDTraj's shrake_rupley, VMD's measure sasa and PyMOL's get_area compute it;
     /// MDTraj's radii: Bondi's for H C N O P S, ionic for Na K Mg Ca Cl), into the per-atom

@@ -66,8 +66,8 @@ pub struct ConvertArgs {
     /// and 'bfactor' properties in their columns), .dcd, .xtc (positions and the box only).
     /// Written whole or not at all. Without it, only the analyses' tables are written
     /// (--rdf-table, --msd-table, --msd-lags, --vacf-table, --vdos-table, --rmsd-table, --rmsf-table, --profile-table,
-    /// --dihedral-table, --sasa-table, --sasa-residue-table, --cluster-table, --grain-table,
-    /// --defect-table).
+    /// --dihedral-table, --sasa-table, --sasa-residue-table, --gyration-table, --cluster-table,
+    /// --grain-table, --defect-table).
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
     #[command(flatten)]
@@ -88,6 +88,7 @@ Examples:
   texmap convert md.trr --topology md.gro --vacf-table vacf.csv --vdos-table vdos.csv       # velocity autocorrelation (Green-Kubo D) and its spectrum
   texmap convert slab.lammpstrj --profile-table rho.csv --profile-axis z --profile-bins 200  # density profile across an interface
   texmap convert md.xtc --topology md.gro --sasa protein --sasa-residue-table exposed.csv   # solvent-accessible area per residue and frame (MDTraj's shrake_rupley)
+  texmap convert md.xtc --topology md.gro --pbc unwrap --gyration-table rg.csv --gyration-select protein  # compactness over time
   texmap convert md.xtc --topology md.gro --dihedral-table rama.csv                         # phi, psi, omega per residue and frame
 
 The selection and the analyses are those of texmap render; an analysis's property (cna is a
@@ -140,6 +141,7 @@ pub fn convert(a: &ConvertArgs) -> Result<()> {
                 &a.analysis.vacf_table,
                 &a.analysis.vdos_table,
                 &a.analysis.sasa_table,
+                &a.analysis.gyration_table,
                 &a.analysis.sasa_residue_table,
                 &a.analysis.rmsd_table,
                 &a.analysis.rmsf_table,
@@ -149,7 +151,7 @@ pub fn convert(a: &ConvertArgs) -> Result<()> {
             ];
             if tables.iter().all(|t| t.is_none()) {
                 return usage(
-                    "nothing to write: give -o FILE, or a table of the analyses (--rdf-table, --msd-table, --msd-lags, --vacf-table, --vdos-table, --rmsd-table, --rmsf-table, --profile-table, --dihedral-table, --sasa-table, --sasa-residue-table, --cluster-table, --grain-table, --defect-table)",
+                    "nothing to write: give -o FILE, or a table of the analyses (--rdf-table, --msd-table, --msd-lags, --vacf-table, --vdos-table, --rmsd-table, --rmsf-table, --profile-table, --dihedral-table, --sasa-table, --sasa-residue-table, --gyration-table, --cluster-table, --grain-table, --defect-table)",
                 );
             }
             if a.select.is_some() || a.columns.is_some() {

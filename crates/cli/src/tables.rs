@@ -60,6 +60,12 @@ pub(crate) struct AnalysisTables {
     msd_lags: Option<MsdLags>,
     velocities: Option<VelocityTables>,
     sasa: Option<crate::output::AtomicFile>,
+    /// `--gyration-table`, its atoms and whether by mass.
+    gyration: Option<(
+        crate::output::AtomicFile,
+        texmap_md_io::select::Selection,
+        bool,
+    )>,
     sasa_residues: Option<crate::output::AtomicFile>,
     dihedral: Option<crate::output::AtomicFile>,
     profile: Option<(crate::output::AtomicFile, ProfileMean)>,
@@ -85,6 +91,44 @@ fn atom_columns(md: &MdFrame, i: usize) -> String {
         number(&md.res_ids),
         text(&md.chains)
     )
+}
+
+/// Frame `f`'s `--gyration-table` row: the size and shape of `sel`'s atoms of `md`.
+fn gyration_row(
+    f: usize,
+    time: &str,
+    md: &MdFrame,
+    sel: &texmap_md_io::select::Selection,
+    by_mass: bool,
+) -> Result<String> {
+    let pick = sel
+        .evaluate(md)
+        .map_err(|e| anyhow::anyhow!("--gyration-select: frame {f}: {e}"))?;
+    let atoms: Vec<usize> = (0..md.n_atoms()).filter(|&i| pick[i]).collect();
+    if atoms.is_empty() {
+        bail!("--gyration-select: frame {f} has none of the atoms it picks");
+    }
+    let mut weights = Vec::with_capacity(atoms.len());
+    for &i in &atoms {
+        let w = if by_mass {
+            texmap_md_io::atom_element(md, i).mass()
+        } else {
+            1.0
+        };
+        if w <= 0.0 {
+            bail!(
+                "--gyration-table: atom {i} of frame {f} has no element, so no mass (give --gyration-unweighted)"
+            );
+        }
+        weights.push(w);
+    }
+    let positions: Vec<[f32; 3]> = atoms.iter().map(|&i| md.positions[i]).collect();
+    let g = texmap_md_io::shape::gyration(&positions, &weights)
+        .ok_or_else(|| anyhow::anyhow!("--gyration-table: frame {f}: a position is not finite"))?;
+    Ok(format!(
+        "{f},{time},{:.6},{:.6},{:.6},{:.6},{:.6}\n",
+        g.rg, g.about[0], g.about[1], g.about[2], g.asphericity
+    ))
 }
 
 /// Frame `f`'s `--sasa-residue-table` rows: each residue with a measured atom (consecutive
@@ -628,6 +672,19 @@ impl AnalysisTables {
                 "frame,time,sasa",
                 whole,
             )?,
+            gyration: match per_frame_table(
+                &analysis.gyration_table,
+                "--gyration-table",
+                "frame,time,rg,rg_x,rg_y,rg_z,asphericity",
+                whole,
+            )? {
+                Some(t) => {
+                    let sel = texmap_md_io::select::Selection::parse(&analysis.gyration_select)
+                        .map_err(|e| crate::args::UsageError(format!("--gyration-select: {e}")))?;
+                    Some((t, sel, !analysis.gyration_unweighted))
+                }
+                None => None,
+            },
             sasa_residues: per_frame_table(
                 &analysis.sasa_residue_table,
                 "--sasa-residue-table",
@@ -758,6 +815,9 @@ impl AnalysisTables {
         if let Some(v) = &mut self.velocities {
             v.add(f, md)?;
         }
+        if let Some((t, sel, by_mass)) = &mut self.gyration {
+            t.write(&gyration_row(f, &time, md, sel, *by_mass)?)?;
+        }
         if let Some(area) = md.property(texmap_md_scene::SASA) {
             let measured = || area.iter().filter(|a| a.is_finite()).map(|a| f64::from(*a));
             if let Some(t) = &mut self.sasa {
@@ -831,6 +891,7 @@ impl AnalysisTables {
             self.dihedral,
             self.sasa,
             self.sasa_residues,
+            self.gyration.map(|(t, _, _)| t),
             msd_lags,
             profile,
             rmsf,

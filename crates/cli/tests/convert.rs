@@ -1114,6 +1114,74 @@ fn sasa_tables_are_mdtrajs() {
     assert!(!total.exists());
 }
 
+/// `--gyration-table`: the radius of gyration and the asphericity of a protein and its CA atoms
+/// over 12 frames equal MDAnalysis's (radius_of_gyration, asphericity; md-io's
+/// dihedrals/gen_gyration.py), mass-weighted and not, with gmx gyrate's radii about the axes;
+/// a selection that picks nothing is refused and leaves no table.
+#[test]
+fn gyration_table_is_mdanalysis() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("rg.csv");
+    let reference = json("dihedrals/gyration_reference.json");
+    for (select, weighted) in [("protein", true), ("name CA", true), ("protein", false)] {
+        let mut args = vec![
+            "convert".to_string(),
+            md_data("dihedrals/helix.dcd"),
+            "--topology".into(),
+            md_data("dihedrals/helix.pdb"),
+            "--gyration-table".into(),
+            out.to_str().unwrap().into(),
+            "--gyration-select".into(),
+            select.into(),
+        ];
+        if !weighted {
+            args.push("--gyration-unweighted".into());
+        }
+        let args: Vec<&str> = args.iter().map(|a| a.as_str()).collect();
+        let o = texmap(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let (header, rows) = table(&out);
+        assert_eq!(header, "frame,time,rg,rg_x,rg_y,rg_z,asphericity");
+        let want = reference[select]["frames"].as_array().unwrap();
+        assert_eq!(rows.len(), want.len());
+        for (f, (row, w)) in rows.iter().zip(want).enumerate() {
+            let rg = if weighted { &w["rg"] } else { &w["unweighted"] };
+            assert!(
+                (row[2] - rg.as_f64().unwrap()).abs() < 1e-4,
+                "{select} frame {f}"
+            );
+            if weighted {
+                for (k, about) in numbers(&w["about"]).iter().enumerate() {
+                    assert!(
+                        (row[3 + k] - about).abs() < 1e-4,
+                        "{select} frame {f} axis {k}"
+                    );
+                }
+                let kappa = w["asphericity"].as_f64().unwrap();
+                assert!(
+                    (row[6] - kappa).abs() < 1e-5,
+                    "{select} frame {f}: {}",
+                    row[6]
+                );
+            }
+        }
+    }
+    std::fs::remove_file(&out).unwrap();
+    let o = texmap(&[
+        "convert",
+        &md_data("dihedrals/helix.dcd"),
+        "--topology",
+        &md_data("dihedrals/helix.pdb"),
+        "--gyration-table",
+        out.to_str().unwrap(),
+        "--gyration-select",
+        "resname HOH",
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("none of the atoms"), "{}", stderr(&o));
+    assert!(!out.exists());
+}
+
 /// `--cluster-table`: the copper clusters in iron (md-io's cluster fixture, written by OVITO)
 /// have OVITO's sizes, largest first, frame by frame; the precipitate (every site within 6 Å
 /// of (12, 13, 14)) is centred there, with about a solid sphere's radius of gyration
