@@ -54,7 +54,8 @@ pub struct Cli {
 #[derive(Subcommand, Debug)]
 #[allow(clippy::large_enum_variant)] // parsed once per run: boxing RenderArgs would buy nothing
 pub enum Command {
-    /// Print a trajectory's format, atom and frame counts, box, chains and segments (with their
+    /// Print a trajectory's format, atom and frame counts, box and its periodic edges ('pbc':
+    /// false along a LAMMPS `ff`/`ss` or extended XYZ `F` edge), chains and segments (with their
     /// atom counts), per-atom properties, the first frame's secondary structure (DSSP: helix,
     /// strand, coil) and first positions as one JSON object; for a topology
     /// file (PSF, AMBER prmtop) its atoms, residues, bonds, chains and segments.
