@@ -387,27 +387,24 @@ pub(crate) fn element_of_symbol(s: &[u8]) -> Option<Element> {
     (e.symbol().as_bytes() == s).then_some(e)
 }
 
-/// Residues in which an atom name's first letter is its element (rule 3 of the module doc):
-/// every residue `protein` selects ([`crate::select::PROTEIN_RESIDUES`]: "CA" in a GROMOS
-/// LYSH is its α carbon, not calcium), nucleotides, caps and water.
-const BIO_RESIDUES: &[&str] = &[
-    "ALA", "ARG", "ASN", "ASP", "CYS", "GLN", "GLU", "GLY", "HIS", "ILE", "LEU", "LYS", "MET",
-    "PHE", "PRO", "SER", "THR", "TRP", "TYR", "VAL", "HID", "HIE", "HIP", "HSD", "HSE", "HSP",
-    "CYX", "CYM", "ASH", "GLH", "LYN", "MSE", "SEC", "ACE", "NME", "NMA", "NH2", "A", "C", "G",
-    "U", "T", "DA", "DC", "DG", "DT", "DU", "RA", "RC", "RG", "RU", "ADE", "CYT", "GUA", "URA",
-    "THY", "HOH", "WAT", "SOL", "TIP3", "TIP4", "TIP5", "SPC", "T3P", "T4P", "H2O", "ALAD", "ARGN",
-    "ASF", "ASN1", "ASPH", "CALA", "CARG", "CASF", "CASN", "CASP", "CCYS", "CCYX", "CGLN", "CGLU",
-    "CGLY", "CHID", "CHIE", "CHIP", "CILE", "CLEU", "CLYS", "CME", "CMET", "CPHE", "CPRO", "CSER",
-    "CTHR", "CTRP", "CTYR", "CVAL", "CYS1", "CYS2", "CYSH", "DAB", "GLUH", "HIS1", "HIS2", "HISA",
-    "HISB", "HISD", "HISE", "HISH", "HYP", "LYSH", "NALA", "NARG", "NASN", "NASP", "NCYS", "NCYX",
-    "NGLN", "NGLU", "NGLY", "NHID", "NHIE", "NHIP", "NILE", "NLEU", "NLYS", "NMET", "NPHE", "NPRO",
-    "NSER", "NTHR", "NTRP", "NTYR", "NVAL", "ORN", "PGLU", "QLN",
+/// Residues besides the protein's ([`crate::select::PROTEIN_RESIDUES`]) in which an atom
+/// name's first letter is its element (rule 3 of the module doc): nucleotides, caps and
+/// water.
+const OTHER_BIO_RESIDUES: &[&str] = &[
+    "SEC", "NMA", "NH2", "A", "C", "G", "U", "T", "DA", "DC", "DG", "DT", "DU", "RA", "RC", "RG",
+    "RU", "ADE", "CYT", "GUA", "URA", "THY", "HOH", "WAT", "SOL", "TIP3", "TIP4", "TIP5", "SPC",
+    "T3P", "T4P", "H2O",
 ];
 
-/// True when `res` is a standard biomolecular residue (rule 3 of the module doc).
+/// True when `res` is a standard biomolecular residue (rule 3 of the module doc): every
+/// residue `protein` selects ("CA" in a GROMOS LYSH is its α carbon, not calcium), nucleotides,
+/// caps and water.
 pub fn is_bio_residue(res: &str) -> bool {
     let r = res.trim();
-    BIO_RESIDUES.iter().any(|b| b.eq_ignore_ascii_case(r))
+    crate::select::PROTEIN_RESIDUES
+        .iter()
+        .chain(OTHER_BIO_RESIDUES)
+        .any(|b| b.eq_ignore_ascii_case(r))
 }
 
 /// The element of an atom from its name, its residue (if the format has residues) and an

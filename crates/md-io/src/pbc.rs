@@ -76,27 +76,7 @@ pub fn wrap(frame: &mut Frame) {
 pub fn unwrap(frame: &mut Frame, bonds: &[[u32; 2]]) {
     let Some(cell) = frame.cell else { return };
     let n = frame.n_atoms();
-    // Adjacency in CSR form.
-    let mut start = vec![0u32; n + 1];
-    for b in bonds {
-        if (b[0] as usize) < n && (b[1] as usize) < n {
-            start[b[0] as usize + 1] += 1;
-            start[b[1] as usize + 1] += 1;
-        }
-    }
-    for k in 0..n {
-        start[k + 1] += start[k];
-    }
-    let mut fill = start.clone();
-    let mut adj = vec![0u32; start[n] as usize];
-    for b in bonds {
-        if (b[0] as usize) < n && (b[1] as usize) < n {
-            for (a, c) in [(b[0], b[1]), (b[1], b[0])] {
-                adj[fill[a as usize] as usize] = c;
-                fill[a as usize] += 1;
-            }
-        }
-    }
+    let (start, adj) = adjacency(n, bonds);
     let mut seen = vec![false; n];
     let mut queue = std::collections::VecDeque::new();
     for root in 0..n {
@@ -120,6 +100,32 @@ pub fn unwrap(frame: &mut Frame, bonds: &[[u32; 2]]) {
             }
         }
     }
+}
+
+/// Each of `n` atoms' partners in `pairs` (both ways; pairs naming an atom past `n` left out), in
+/// CSR form: atom a's are `list[start[a]..start[a + 1]]`, in the pairs' order.
+pub(crate) fn adjacency<'a>(
+    n: usize,
+    pairs: impl IntoIterator<Item = &'a [u32; 2]> + Clone,
+) -> (Vec<u32>, Vec<u32>) {
+    let inside = |b: &&[u32; 2]| (b[0] as usize) < n && (b[1] as usize) < n;
+    let mut start = vec![0u32; n + 1];
+    for b in pairs.clone().into_iter().filter(inside) {
+        start[b[0] as usize + 1] += 1;
+        start[b[1] as usize + 1] += 1;
+    }
+    for k in 0..n {
+        start[k + 1] += start[k];
+    }
+    let mut fill = start.clone();
+    let mut list = vec![0u32; start[n] as usize];
+    for b in pairs.into_iter().filter(inside) {
+        for (a, c) in [(b[0], b[1]), (b[1], b[0])] {
+            list[fill[a as usize] as usize] = c;
+            fill[a as usize] += 1;
+        }
+    }
+    (start, list)
 }
 
 /// The bonds of `pairs` whose atoms are at their nearest image of each other in `positions`

@@ -195,24 +195,8 @@ pub fn sasa(frame: &Frame, mask: Option<&[bool]>, probe: f32) -> Result<Vec<f32>
         })
         .flatten()
         .collect();
-    // Neighbour lists (CSR).
     let m = positions.len();
-    let mut start = vec![0u32; m + 1];
-    for p in pairs.pairs.iter().chain(&close) {
-        start[p[0] as usize + 1] += 1;
-        start[p[1] as usize + 1] += 1;
-    }
-    for k in 0..m {
-        start[k + 1] += start[k];
-    }
-    let mut fill = start.clone();
-    let mut list = vec![0u32; start[m] as usize];
-    for p in pairs.pairs.iter().chain(&close) {
-        for (a, b) in [(p[0], p[1]), (p[1], p[0])] {
-            list[fill[a as usize] as usize] = b;
-            fill[a as usize] += 1;
-        }
-    }
+    let (start, list) = crate::pbc::adjacency(m, pairs.pairs.iter().chain(&close));
     let points = sphere_points(POINTS);
     let cell = if pairs.periodic { frame.cell } else { None };
     let areas: Vec<f32> = (0..m)
