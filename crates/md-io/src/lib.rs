@@ -37,14 +37,15 @@
 //!   its neighbours are from opposite pairs and [`strain`] its local deformation against a
 //!   reference configuration, [`wigner_seitz`] its vacancies and interstitials, [`voronoi`] its Voronoi
 //!   cell (volume, coordination, index), [`orientation`] its lattice orientation (PTM's) and
-//!   [`grains`] the grains of a polycrystal, [`rdf`] the radial distribution functions of a frame, as OVITO's analyses do, [`msd`] each atom's squared displacement followed across the periodic boundaries and the mean over every time origin with its diffusion coefficient, [`vacf`] the velocity autocorrelation, its Green–Kubo diffusion coefficient and the vibrational density of states, [`rmsf`] each atom's fluctuation about its mean position, [`shape`] the radius of gyration and shape anisotropy of a group, [`sasa`] solvent-accessible surface areas, [`dihedrals`] the backbone's φ, ψ and ω, [`profile`] density profiles along a cell axis, and [`expr`] computes a number per atom
+//!   [`grains`] the grains of a polycrystal, [`rdf`] the radial distribution functions of a frame, as OVITO's analyses do, [`msd`] each atom's squared displacement followed across the periodic boundaries and the mean over every time origin with its diffusion coefficient, [`vacf`] the velocity autocorrelation, its Green–Kubo diffusion coefficient and the vibrational density of states, [`rmsf`] each atom's fluctuation about its mean position, [`shape`] the radius of gyration and shape anisotropy of a group, [`sasa`] solvent-accessible surface areas, [`dihedrals`] the backbone's φ, ψ and ω, [`profile`] density profiles along a cell axis, [`density`] number densities on a 3-D grid averaged over frames (MDAnalysis's DensityAnalysis, VMD's volmap), and [`expr`] computes a number per atom
 //!   from a formula (OVITO's Compute property); [`hbonds`] finds hydrogen bonds by
 //!   MDAnalysis's geometric criterion.
 //! - [`values`] reads per-atom numbers from a text file (an analysis result, a column or a row
 //!   per frame) to give the frames as a property.
 //! - [`volume`] reads volumetric data (Gaussian cube; VASP CHGCAR, CHG, PARCHG, LOCPOT, ELFCAR,
-//!   AECCAR; XCrySDen XSF `DATAGRID_3D`) into grids with their atoms
-//!   ([`volume::read_volumes`]); as trajectories these files are one frame, the atoms
+//!   AECCAR; XCrySDen XSF `DATAGRID_3D`; OpenDX from APBS, VMD and MDAnalysis) into grids
+//!   with their atoms ([`volume::read_volumes`]) and writes OpenDX ([`volume::write_dx`]); as
+//!   trajectories these files are one frame, the atoms
 //!   (`Format::Cube`, `Format::Vasp`), an XSF / AXSF file one per structure (`Format::Xsf`).
 //! - [`Writer`] writes extended XYZ and LAMMPS text dumps (positions, ids, types, velocities,
 //!   radii, colours and every named property, for OVITO, ASE and LAMMPS to read back), PDB,
@@ -123,8 +124,10 @@ mod crystal_cif;
 mod cube;
 mod cursor;
 mod dcd;
+pub mod density;
 pub mod dihedrals;
 mod dlpoly;
+mod dx;
 pub mod elements;
 mod error;
 pub mod expr;

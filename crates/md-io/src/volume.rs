@@ -64,6 +64,19 @@
 //! molecule's, ASE's default with spans cell·(n+1)/n) keeps all its points and is not
 //! periodic. 2-D grids are refused.
 //!
+//! **OpenDX** (`.dx`: APBS's electrostatic potentials in kT/e, VMD's `volmap` and
+//! MDAnalysis's `DensityAnalysis` densities, GridDataFormats, PyMOL's and Chimera's exports):
+//! `#` comment lines; `object 1 class gridpositions counts nx ny nz`, `origin x y z` and three
+//! `delta` lines (the steps along the first, second and third count's axis, Å; they may be
+//! skewed); `object 2 class gridconnections counts …` (the same counts); `object 3 class array
+//! type <t> rank 0 items <nx·ny·nz> data follows`; the values as text, x outermost and z
+//! fastest (C order, transposed into the volume's layout), any number per line; then
+//! `attribute`, `component` and `object "<name>" class field` lines (the name is the
+//! volume's, else `values`). A DX grid is not periodic and the file has no atoms. Binary
+//! (`ieee`, `binary`) arrays, values in another file, vector fields (rank ≥ 1) and grids that
+//! are not 3-D are refused at their line. [`write_dx`] writes the layout GridDataFormats
+//! writes.
+//!
 //! # Damage and memory
 //! Errors are the crate's [`Error`]: the file, line and byte offset and what was expected
 //! there, as the trajectory readers give them. A file that ends inside a data set is an
@@ -291,6 +304,8 @@ pub enum VolumeFormat {
     Vasp(VaspQuantity),
     /// XCrySDen XSF / AXSF: `.xsf`, `.axsf` (its `DATAGRID_3D` grids).
     Xsf,
+    /// OpenDX: `.dx` (APBS potentials, VMD volmap and MDAnalysis densities; no atoms).
+    Dx,
 }
 
 /// What a VASP volumetric file's values are; the file's name tells (see the module docs).
@@ -355,7 +370,7 @@ impl VaspQuantity {
 
 impl VolumeFormat {
     /// The format a path names: `.cube` / `.cub` (any case) is a cube file, `.xsf` / `.axsf`
-    /// an XSF file, a VASP name ([`VaspQuantity::from_file_name`]) VASP volumetric data; a
+    /// an XSF file, `.dx` an OpenDX file, a VASP name ([`VaspQuantity::from_file_name`]) VASP volumetric data; a
     /// final `.gz` is looked through.
     pub fn from_path(path: &Path) -> Option<VolumeFormat> {
         let inner = crate::gz::inner_path(path);
@@ -365,6 +380,9 @@ impl VolumeFormat {
         }
         if ext.eq_ignore_ascii_case("xsf") || ext.eq_ignore_ascii_case("axsf") {
             return Some(VolumeFormat::Xsf);
+        }
+        if ext.eq_ignore_ascii_case("dx") {
+            return Some(VolumeFormat::Dx);
         }
         let name = inner.file_name()?.to_str()?;
         VaspQuantity::from_file_name(name).map(VolumeFormat::Vasp)
@@ -380,8 +398,9 @@ pub fn read_volumes(path: impl AsRef<Path>) -> Result<(Frame, Vec<Volume>), Erro
     let name: Arc<str> = path.display().to_string().into();
     let kind = VolumeFormat::from_path(path).ok_or_else(|| Error::Unsupported {
         file: name.clone(),
-        what: "volumetric data from a file not named .cube / .cub, .xsf / .axsf or as VASP \
-               names its volumetric files (CHGCAR, CHG, PARCHG, LOCPOT, ELFCAR, AECCAR0/1/2)",
+        what: "volumetric data from a file not named .cube / .cub, .xsf / .axsf, .dx or as \
+               VASP names its volumetric files (CHGCAR, CHG, PARCHG, LOCPOT, ELFCAR, \
+               AECCAR0/1/2)",
     })?;
     let (file, _) = crate::gz::open(path, &name, false)?;
     let len = file.metadata().ok().map(|m| m.len());
@@ -430,6 +449,7 @@ fn read_sized<R: Read>(
     let sets = match kind {
         VolumeFormat::Cube => crate::cube::read(&mut lines, &ctx, &mut frame, &budget)?,
         VolumeFormat::Xsf => crate::xsf::read(&mut lines, &ctx, &mut frame, &budget)?,
+        VolumeFormat::Dx => crate::dx::read(&mut lines, &ctx, &budget)?,
         VolumeFormat::Vasp(q) => {
             let grids = crate::chgcar::read(&mut lines, &ctx, &mut frame, q, &budget)?;
             let count = grids.len();
@@ -451,6 +471,29 @@ fn read_sized<R: Read>(
         }
     };
     Ok((frame, sets))
+}
+
+/// Writes `v` as an OpenDX file (`.dx`) that VMD, PyMOL, Chimera, APBS tools and
+/// GridDataFormats read: `comments` first (one `#` line each), then the grid and its values
+/// (see the module docs). A periodic volume's points are written as they are.
+///
+/// ```
+/// use texmap_md_io::volume::{read_volumes_from, write_dx, Volume, VolumeFormat};
+/// let steps = [[0.5, 0.0, 0.0], [0.0, 0.5, 0.0], [0.0, 0.0, 0.5]];
+/// let data = (0..12).map(|n| n as f32 * 0.25).collect();
+/// let v = Volume::new([1.0, 2.0, 3.0], steps, [3, 2, 2], data, false, "density").unwrap();
+/// let mut text = Vec::new();
+/// write_dx(&v, &["made by texmap"], &mut text).unwrap();
+/// let (_, back) = read_volumes_from(&text[..], VolumeFormat::Dx, "d.dx")?;
+/// assert_eq!(back[0], v);
+/// # Ok::<(), texmap_md_io::Error>(())
+/// ```
+pub fn write_dx(
+    v: &Volume,
+    comments: &[&str],
+    out: &mut impl std::io::Write,
+) -> std::io::Result<()> {
+    crate::dx::write(v, comments, out)
 }
 
 /// What the file's size allows: a reader sizes nothing from a count beyond it.

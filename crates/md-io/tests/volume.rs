@@ -734,3 +734,346 @@ fn a_pyscf_potential_interpolates_to_pyscfs_exact_values() {
         "largest interpolation error {worst} hartree/e"
     );
 }
+
+// OpenDX files and densities averaged over frames.
+
+fn dynamics() -> PathBuf {
+    dir().join("../dynamics")
+}
+
+/// The positions of the atoms named `name` in ../dynamics/walk.dcd (names from walk.gro),
+/// frame by frame.
+fn walk_positions(name: &str) -> Vec<Vec<[f32; 3]>> {
+    let mut f = Frame::new();
+    let mut gro = Trajectory::open(dynamics().join("walk.gro")).unwrap();
+    gro.read_frame(0, &mut f).unwrap();
+    let pick: Vec<usize> = (0..f.n_atoms())
+        .filter(|&i| f.names[i] == name)
+        .collect();
+    let mut dcd = Trajectory::open(dynamics().join("walk.dcd")).unwrap();
+    let n = dcd.n_frames().unwrap();
+    (0..n)
+        .map(|k| {
+            dcd.read_frame(k, &mut f).unwrap();
+            pick.iter().map(|&i| f.positions[i]).collect()
+        })
+        .collect()
+}
+
+/// MDAnalysis's DensityAnalysis of the walk's OW and NA atoms, written by GridDataFormats
+/// (gen_dx.py): our reader gives its grid, and our `DensityMap` of the same frames the same
+/// grid and every cell's value (counts equal: a position in another cell would move two
+/// values by 1/(frames · cell volume), 400x the tolerance), and counts the NA positions
+/// that later frames put outside the grid, which MDAnalysis drops.
+#[test]
+fn mdanalysis_densities_read_from_its_dx_files_and_equal_ours() {
+    use texmap_md_io::density::DensityMap;
+    let text = std::fs::read_to_string(dir().join("density_reference.json")).unwrap();
+    let reference: Value = serde_json::from_str(&text).unwrap();
+    for (key, file, name) in [
+        ("ow", "density_ow.dx", "OW"),
+        ("na", "density_na.dx.gz", "NA"),
+    ] {
+        let r = &reference[key];
+        let (atoms, sets) = read_volumes(dir().join(file)).unwrap();
+        assert_eq!((atoms.n_atoms(), sets.len()), (0, 1), "{file}");
+        let theirs = &sets[0];
+        assert_eq!(theirs.name, "density");
+        assert!(!theirs.periodic);
+        let cells: Vec<usize> = f64s(&r["cells"]).iter().map(|&c| c as usize).collect();
+        assert_eq!(theirs.dims.to_vec(), cells, "{file}");
+        for a in 0..3 {
+            // GridDataFormats writes the origin with 6 decimals.
+            close(theirs.origin[a], f64s(&r["origin"])[a], 1e-6, "origin");
+            close(theirs.steps[a][a], f64s(&r["grid_delta"])[a], 1e-9, "delta");
+        }
+        let sum: f64 = theirs.data.iter().map(|&v| v as f64).sum();
+        close_rel(sum, r["sum"].as_f64().unwrap(), "sum");
+
+        let frames = walk_positions(name);
+        let delta = r["delta"].as_f64().unwrap();
+        let mut map =
+            DensityMap::around(&frames[0], delta, r["padding"].as_f64().unwrap()).unwrap();
+        let outside: u64 = frames.iter().map(|p| map.add(p.iter().copied())).sum();
+        assert_eq!(outside, r["outside"].as_u64().unwrap(), "{key}");
+        assert_eq!(map.outside(), outside);
+        assert_eq!(map.frames() as u64, r["frames"].as_u64().unwrap());
+        let (lo, hi) = map.bounds();
+        for a in 0..3 {
+            close(lo[a], f64s(&r["lo"])[a], 1e-5, "lower edge");
+            close(hi[a], f64s(&r["hi"])[a], 1e-5, "upper edge");
+        }
+        let ours = map.to_volume("density");
+        assert_eq!(ours.dims, theirs.dims);
+        for a in 0..3 {
+            close(ours.origin[a], theirs.origin[a], 1e-5, "origin");
+        }
+        let unit = 1.0 / (frames.len() as f64 * delta.powi(3));
+        for (i, (a, b)) in ours.data.iter().zip(&theirs.data).enumerate() {
+            close(
+                *a as f64,
+                *b as f64,
+                unit / 400.0,
+                &format!("{key} cell {i}"),
+            );
+        }
+        let counted = ours.data.iter().map(|&v| v as f64).sum::<f64>() / unit;
+        close(
+            counted,
+            r["counted"].as_f64().unwrap(),
+            1e-3,
+            "positions counted",
+        );
+    }
+}
+
+/// Our OpenDX file reads back to the same volume (values to the bit), and GridDataFormats,
+/// which MDAnalysis, APBS tools and PyMOL users read DX files with, reads it as we wrote it
+/// (SKIPPED without python3 and gridData).
+#[test]
+fn written_dx_files_read_back_here_and_in_griddataformats() {
+    use texmap_md_io::density::DensityMap;
+    use texmap_md_io::volume::write_dx;
+    let frames = walk_positions("OW");
+    let mut map = DensityMap::around(&frames[0], 0.7, 1.0).unwrap();
+    for p in &frames {
+        map.add(p.iter().copied());
+    }
+    let mut v = map.to_volume("OW density");
+    // Values that need an exponent, and a negative one, round-trip too.
+    v.data[5] = 1.25e-9;
+    v.data[6] = -3.5e8;
+    let mut text = Vec::new();
+    write_dx(&v, &["texmap test", "second comment"], &mut text).unwrap();
+    let (_, back) = read_volumes_from(&text[..], VolumeFormat::Dx, "ours.dx").unwrap();
+    assert_eq!(back[0].data, v.data);
+    assert_eq!(back[0].dims, v.dims);
+    for a in 0..3 {
+        close(back[0].origin[a], v.origin[a], 5e-8, "origin");
+        assert_eq!(back[0].steps[a], v.steps[a]);
+    }
+    let tmp = std::env::temp_dir().join(format!("texmap-dx-{}.dx", std::process::id()));
+    std::fs::write(&tmp, &text).unwrap();
+    let has_griddata = std::process::Command::new("python3")
+        .args(["-c", "import gridData"])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !has_griddata {
+        std::fs::remove_file(&tmp).unwrap();
+        eprintln!("SKIPPED: python3 with gridData (GridDataFormats) is not available");
+        return;
+    }
+    let script = "import sys, gridData\n\
+                  g = gridData.Grid(sys.argv[1])\n\
+                  d = g.delta if g.delta.ndim == 1 else g.delta.diagonal()\n\
+                  print(*g.grid.shape, *g.origin, *d, g.grid[1, 2, 3], g.grid.sum())";
+    let out = std::process::Command::new("python3")
+        .args(["-c", script])
+        .arg(&tmp)
+        .output()
+        .unwrap();
+    std::fs::remove_file(&tmp).unwrap();
+    assert!(
+        out.status.success(),
+        "gridData could not read our file: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let got: Vec<f64> = String::from_utf8_lossy(&out.stdout)
+        .split_whitespace()
+        .map(|t| t.parse().unwrap())
+        .collect();
+    assert_eq!(got[..3], v.dims.map(|d| d as f64));
+    for a in 0..3 {
+        close(got[3 + a], v.origin[a], 5e-8, "gridData origin");
+        close(got[6 + a], v.steps[a][a], 1e-12, "gridData delta");
+    }
+    // gridData reads the shortest decimal that gives our f32, in f64.
+    let x = v.at(1, 2, 3) as f64;
+    close(got[9], x, 1e-7 * x.abs(), "gridData value");
+    let sum: f64 = v.data.iter().map(|&x| x as f64).sum();
+    close_rel(got[10], sum, "gridData sum");
+}
+
+/// f(i, j, k) = i + 10 j + 100 k − 0.5 on a 3 x 2 x 2 grid, in the C order DX files use.
+fn dx_values() -> Vec<f64> {
+    let mut v = Vec::new();
+    for i in 0..3 {
+        for j in 0..2 {
+            for k in 0..2 {
+                v.push(i as f64 + 10.0 * j as f64 + 100.0 * k as f64 - 0.5);
+            }
+        }
+    }
+    v
+}
+
+/// The layout APBS writes (its comments, `%e` values, unquoted type, its field name).
+fn apbs_text() -> String {
+    let values: Vec<String> = dx_values().iter().map(|v| format!("{v:.6e}")).collect();
+    let rows: Vec<String> = values.chunks(3).map(|c| c.join(" ")).collect();
+    format!(
+        "# Data from APBS 3.4.1\n#\n# POTENTIAL (kT/e)\n#\n\
+         object 1 class gridpositions counts 3 2 2\n\
+         origin -1.000000e+00 -5.000000e-01 2.500000e-01\n\
+         delta 5.000000e-01 0.000000e+00 0.000000e+00\n\
+         delta 0.000000e+00 5.000000e-01 0.000000e+00\n\
+         delta 0.000000e+00 0.000000e+00 2.500000e-01\n\
+         object 2 class gridconnections counts 3 2 2\n\
+         object 3 class array type double rank 0 items 12 data follows\n\
+         {}\n\
+         attribute \"dep\" string \"positions\"\n\
+         object \"regular positions regular connections\" class field\n\
+         component \"positions\" value 1\ncomponent \"connections\" value 2\n\
+         component \"data\" value 3\n",
+        rows.join("\n")
+    )
+}
+
+#[test]
+fn dx_layouts_of_apbs_and_vmd_read_in_c_order_with_skewed_steps() {
+    let (atoms, sets) = read(&apbs_text(), VolumeFormat::Dx, "pot.dx").unwrap();
+    assert_eq!((atoms.n_atoms(), sets.len()), (0, 1));
+    let v = &sets[0];
+    assert_eq!(v.dims, [3, 2, 2]);
+    assert_eq!(v.origin, [-1.0, -0.5, 0.25]);
+    assert_eq!(v.name, "regular positions regular connections");
+    for i in 0..3 {
+        for j in 0..2 {
+            for k in 0..2 {
+                let want = i as f64 + 10.0 * j as f64 + 100.0 * k as f64 - 0.5;
+                assert_eq!(v.at(i, j, k) as f64, want, "({i}, {j}, {k})");
+            }
+        }
+    }
+    assert_eq!(v.point(1, 1, 1), [-0.5, 0.0, 0.5]);
+    // VMD's volmap: one value per line, skewed steps, no trailer at all.
+    let values: Vec<String> = dx_values().iter().map(|v| v.to_string()).collect();
+    let vmd = format!(
+        "# Data calculated by the VMD volmap function\n\
+         object 1 class gridpositions counts 3 2 2\norigin 0 0 0\n\
+         delta 0.5 0 0\ndelta 0.25 0.5 0\ndelta 0 0.1 0.4\n\
+         object 2 class gridconnections counts 3 2 2\n\
+         object 3 class array type float rank 0 items 12 data follows\n{}\n",
+        values.join("\n")
+    );
+    let w = &read(&vmd, VolumeFormat::Dx, "vmd.dx").unwrap().1[0];
+    assert_eq!(w.name, "values");
+    assert_eq!(w.data, v.data);
+    assert_eq!(w.point(1, 1, 1), [0.75, 0.6, 0.4]);
+    assert_eq!(
+        VolumeFormat::from_path(Path::new("apbs.pqr.dx")),
+        Some(VolumeFormat::Dx)
+    );
+    assert_eq!(
+        VolumeFormat::from_path(Path::new("map.DX.gz")),
+        Some(VolumeFormat::Dx)
+    );
+}
+
+#[test]
+fn dx_files_we_do_not_read_are_errors_naming_the_line() {
+    let apbs = apbs_text();
+    let array = "object 3 class array type double rank 0 items 12 data follows";
+    let cases: Vec<(String, &str, &[&str])> = vec![
+        (
+            apbs.replace(
+                array,
+                "object 3 class array type float rank 0 items 12 ieee msb data follows",
+            ),
+            "x.dx: frame 0, line 11",
+            &["binary"],
+        ),
+        (
+            apbs.replace(
+                array,
+                "object 3 class array type float rank 1 shape 3 items 12 data follows",
+            ),
+            "x.dx: frame 0, line 11",
+            &["rank 0"],
+        ),
+        (
+            apbs.replace(
+                array,
+                "object 3 class array type double rank 0 items 13 data follows",
+            ),
+            "x.dx: frame 0, line 11",
+            &["as many items"],
+        ),
+        (
+            apbs.replace(
+                array,
+                "object 3 class array type double rank 0 items 12 data file pot.bin",
+            ),
+            "x.dx: frame 0, line 11",
+            &["data follows"],
+        ),
+        (
+            apbs.replace("gridpositions counts 3 2 2", "gridpositions counts 3 2"),
+            "x.dx: frame 0, line 5",
+            &["three point counts"],
+        ),
+        (
+            apbs.replace(
+                "gridconnections counts 3 2 2",
+                "gridconnections counts 3 2 3",
+            ),
+            "x.dx: frame 0, line 10",
+            &["gridconnections counts equal"],
+        ),
+        (
+            apbs.replace("origin -1.000000e+00", "origin nan"),
+            "x.dx: frame 0, line 6",
+            &["origin"],
+        ),
+        (
+            apbs.replace("attribute", "1.0\nattribute"),
+            "x.dx: frame 0, line 16",
+            &["after the data"],
+        ),
+        (
+            apbs.replace("object 1 class", "object 1 klass"),
+            "x.dx: frame 0, line 5",
+            &["class"],
+        ),
+        (
+            apbs.replace("delta 0.000000e+00 0.000000e+00 2.500000e-01\n", ""),
+            "x.dx",
+            &["three delta lines"],
+        ),
+    ];
+    for (text, place, parts) in cases {
+        error_names(&text, VolumeFormat::Dx, place, parts);
+    }
+    // A cut inside the values: the data set, the values expected and found.
+    let cut: String = apbs.lines().take(13).collect::<Vec<_>>().join("\n");
+    let e = read(&cut, VolumeFormat::Dx, "cut.dx").unwrap_err();
+    assert!(matches!(e, Error::Truncated { .. }), "{e}");
+    assert!(
+        e.to_string().contains("12 values") && e.to_string().contains("found 6"),
+        "{e}"
+    );
+    // Every cut is an error or the whole grid (a cut in the trailer, or inside the last value,
+    // which still parses).
+    let bytes = apbs.as_bytes();
+    let whole = read(&apbs, VolumeFormat::Dx, "x.dx").unwrap().1[0]
+        .data
+        .clone();
+    for n in 0..bytes.len() {
+        let text = String::from_utf8_lossy(&bytes[..n]).into_owned();
+        if let Ok((_, sets)) = read(&text, VolumeFormat::Dx, "x.dx") {
+            let got = &sets[0].data;
+            let last = whole.len() - 1;
+            assert_eq!(got[..last], whole[..last], "cut at {n}");
+        }
+    }
+    // Hostile counts are refused before anything is reserved for them.
+    for counts in ["100000 100000 100000", "1000 1000 1000"] {
+        let text = apbs.replace(
+            "gridpositions counts 3 2 2",
+            &format!("gridpositions counts {counts}"),
+        );
+        let (r, peak) = measure(|| read(&text, VolumeFormat::Dx, "hostile.dx"));
+        assert!(r.is_err(), "{counts}");
+        assert!(peak < 2 << 20, "{peak} bytes for counts {counts}");
+    }
+}
