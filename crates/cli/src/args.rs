@@ -265,6 +265,14 @@ pub fn parse_positive(s: &str) -> Result<f64, String> {
     }
 }
 
+/// Parses a length that may be 0 (a margin): a finite number ≥ 0.
+pub fn parse_non_negative(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
+        _ => Err(format!("{s:?} is not a number of 0 or more")),
+    }
+}
+
 /// Parses `--sasa-probe`: a radius from 0 to 10 Å.
 pub fn parse_probe(s: &str) -> Result<f32, String> {
     match s.trim().parse::<f32>() {
@@ -941,10 +949,12 @@ pub struct MolArgs {
     pub polyhedra_opacity: f32,
     /// Draw the isosurface of volumetric data at this level, as VMD, VESTA and Avogadro do: the
     /// volume of a Gaussian cube file, an XSF file's DATAGRID_3D or a VASP CHGCAR / PARCHG /
-    /// LOCPOT / ELFCAR given as the input (or by --volume). Where the data also runs below −LEVEL (an orbital's negative
-    /// lobe) that surface is drawn too, in --isosurface-negative-color (see --isosurface-sign).
-    /// A CHGCAR's density is in e/Å³, a cube or XSF file's values as written (often e/bohr³);
-    /// `texmap info FILE` prints each data set's range. Not with --align-to, which would move
+    /// LOCPOT / ELFCAR given as the input, or of --volume (also an OpenDX file: an APBS
+    /// potential, a --density-map). Where the data also runs below −LEVEL (an orbital's
+    /// negative lobe, a negative potential) that surface is drawn too, in
+    /// --isosurface-negative-color (see --isosurface-sign). A CHGCAR's density is in e/Å³, a
+    /// cube or XSF file's values as written (often e/bohr³), APBS's in kT/e, a density map's
+    /// in atoms/Å³; `texmap info FILE` prints each data set's range. Not with --align-to, which would move
     /// the atoms away from the grid.
     #[arg(
         long,
@@ -954,9 +964,9 @@ pub struct MolArgs {
     )]
     pub isosurface: Option<f32>,
     /// The volumetric data for --isosurface and --volume-slice when the input is not itself a
-    /// cube, XSF or CHGCAR file
-    /// (render a POSCAR or PDB with the density of another file; its grid must be in the same
-    /// coordinates).
+    /// cube, XSF or CHGCAR file: render a POSCAR or PDB with the density of another file, an
+    /// OpenDX file's (.dx: APBS's electrostatic potential, VMD's volmap, MDAnalysis's or
+    /// --density-map's densities). Its grid must be in the same coordinates.
     #[arg(long, value_name = "FILE")]
     pub volume: Option<PathBuf>,
     /// Which data set of the volumetric file --isosurface and --volume-slice draw, from 1: a
@@ -977,7 +987,7 @@ pub struct MolArgs {
     pub isosurface_negative_color: String,
     /// Colour the isosurface by the values of another volumetric file at its vertices, as an
     /// electrostatic potential is mapped onto an electron density surface (GaussView's and
-    /// VMD's ESP maps): a cube, XSF or CHGCAR-family file in the same coordinates, through
+    /// VMD's ESP maps): a cube, XSF, OpenDX (APBS) or CHGCAR-family file in the same coordinates, through
     /// --volume-colormap over --volume-range, with a colour bar.
     #[arg(long, value_name = "FILE", requires = "isosurface")]
     pub isosurface_color_by: Option<PathBuf>,
@@ -1351,6 +1361,32 @@ pub struct AnalysisArgs {
     /// --shard.
     #[arg(long, value_name = "FILE.csv")]
     pub rmsf_table: Option<PathBuf>,
+    /// Also write where the atoms of --density-select spend their time, as a 3-D map: the
+    /// number density (atoms per Å³) in cells --density-delta wide, averaged over the frames
+    /// written or drawn, after --align (superpose the protein first to see the water and ions
+    /// that stay around it), as MDAnalysis's DensityAnalysis and VMD's volmap density compute
+    /// it. An OpenDX file that VMD, PyMOL, Chimera and `texmap render --volume FILE.dx
+    /// --isosurface LEVEL` draw (bulk water has 0.0334 oxygens per Å³). The grid spans the
+    /// first frame's selected atoms and --density-padding beyond them; positions that later
+    /// leave it are not counted, and their number is reported. Written whole or not at all;
+    /// not with --shard.
+    #[arg(long, value_name = "FILE.dx")]
+    pub density_map: Option<PathBuf>,
+    /// The atoms whose density --density-map writes: 'name OW', 'resname SOL and name OW',
+    /// 'name NA CL', 'resname LIG' (re-evaluated every frame, so 'around' works).
+    #[arg(
+        long,
+        value_name = "SEL",
+        default_value = "all",
+        requires = "density_map"
+    )]
+    pub density_select: String,
+    /// --density-map's cell width (Å).
+    #[arg(long, value_name = "Å", default_value_t = 1.0, requires = "density_map", value_parser = parse_positive)]
+    pub density_delta: f64,
+    /// How far --density-map's grid reaches beyond the first frame's selected atoms (Å).
+    #[arg(long, value_name = "Å", default_value_t = 2.0, requires = "density_map", allow_negative_numbers = true, value_parser = parse_non_negative)]
+    pub density_padding: f64,
     /// Also write every protein residue's backbone dihedrals per frame as a CSV table (the
     /// Ramachandran plot's data: MDAnalysis's Ramachandran, gmx rama): frame, time, chain,
     /// resid, resname, phi, psi, omega (degrees, −180 to 180); an angle that needs a residue

@@ -179,6 +179,31 @@ fn open_parts(files: &[PathBuf], format: Option<&str>, options: ReadOptions) -> 
     Ok(Sequence::open(&parts, format, options)?)
 }
 
+/// Each data set of volumetric file `file`: its grid and range, what --isosurface and
+/// --volume-set choose from.
+fn volumes_json(file: &Path) -> Result<serde_json::Value> {
+    let (_, sets) = texmap_md_io::volume::read_volumes(file)?;
+    let sets: Vec<_> = sets
+        .iter()
+        .enumerate()
+        .map(|(i, v)| {
+            let (lo, hi) = v.range().unwrap_or((0.0, 0.0));
+            json!({
+                "set": i + 1,
+                "name": v.name,
+                "points": v.dims,
+                "origin": v.origin,
+                "steps": v.steps,
+                "periodic": v.periodic,
+                "min": lo,
+                "max": hi,
+                "integral": v.integral(),
+            })
+        })
+        .collect();
+    Ok(json!(sets))
+}
+
 fn info(
     file: &Path,
     more: &[PathBuf],
@@ -194,6 +219,19 @@ fn info(
         )
     {
         return topology_info(file);
+    }
+    // An OpenDX file holds a grid and no atoms.
+    if format.is_none()
+        && texmap_md_io::volume::VolumeFormat::from_path(file)
+            == Some(texmap_md_io::volume::VolumeFormat::Dx)
+    {
+        let obj = json!({
+            "file": file.display().to_string(),
+            "format": "OpenDX",
+            "volumes": volumes_json(file)?,
+        });
+        println!("{obj}");
+        return Ok(());
     }
     let options = ReadOptions::new().allow_truncated(allow_truncated);
     let files: Vec<PathBuf> = std::iter::once(file.to_path_buf())
@@ -263,26 +301,7 @@ fn info(
     // Volumetric data (a cube file, a CHGCAR): each data set's grid and range, what
     // --isosurface and --volume-set choose from.
     if format.is_none() && texmap_md_io::volume::VolumeFormat::from_path(file).is_some() {
-        let (_, sets) = texmap_md_io::volume::read_volumes(file)?;
-        let sets: Vec<_> = sets
-            .iter()
-            .enumerate()
-            .map(|(i, v)| {
-                let (lo, hi) = v.range().unwrap_or((0.0, 0.0));
-                json!({
-                    "set": i + 1,
-                    "name": v.name,
-                    "points": v.dims,
-                    "origin": v.origin,
-                    "steps": v.steps,
-                    "periodic": v.periodic,
-                    "min": lo,
-                    "max": hi,
-                    "integral": v.integral(),
-                })
-            })
-            .collect();
-        obj["volumes"] = json!(sets);
+        obj["volumes"] = volumes_json(file)?;
     }
     // Per-atom numbers a --color-by can name.
     if !frame.properties.is_empty() {

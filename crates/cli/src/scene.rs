@@ -1392,7 +1392,7 @@ pub fn isosurfaces(file: &std::path::Path, m: &MolArgs) -> Result<Option<Isosurf
     let path = m.volume.as_deref().unwrap_or(file);
     let (_, sets) = texmap_md_io::volume::read_volumes(path).with_context(|| {
         format!(
-            "--isosurface and --volume-slice read volumetric data from {} (a Gaussian cube file, an XSF file, or a VASP CHGCAR, PARCHG, LOCPOT or ELFCAR; another file's with --volume)",
+            "--isosurface and --volume-slice read volumetric data from {} (a Gaussian cube file, an XSF file, an OpenDX file, or a VASP CHGCAR, PARCHG, LOCPOT or ELFCAR; another file's with --volume)",
             path.display()
         )
     })?;
@@ -1449,7 +1449,7 @@ pub fn isosurfaces(file: &std::path::Path, m: &MolArgs) -> Result<Option<Isosurf
             Some(by_path) => {
                 let (_, by) = texmap_md_io::volume::read_volumes(by_path).with_context(|| {
                     format!(
-                        "--isosurface-color-by reads volumetric data from {} (a Gaussian cube file, an XSF file, or a VASP CHGCAR, PARCHG, LOCPOT or ELFCAR)",
+                        "--isosurface-color-by reads volumetric data from {} (a Gaussian cube file, an XSF file, an OpenDX file, or a VASP CHGCAR, PARCHG, LOCPOT or ELFCAR)",
                         by_path.display()
                     )
                 })?;

@@ -76,6 +76,92 @@ pub(crate) struct AnalysisTables {
         texmap_md_io::rmsf::Fluctuation,
         Vec<String>,
     )>,
+    density: Option<DensityTable>,
+}
+
+/// `--density-map`: its file, atoms and grid (set at the first frame).
+struct DensityTable {
+    file: crate::output::AtomicFile,
+    select: texmap_md_io::select::Selection,
+    text: String,
+    delta: f64,
+    padding: f64,
+    map: Option<texmap_md_io::density::DensityMap>,
+    first: usize,
+    positions: u64,
+}
+
+impl DensityTable {
+    /// Frame `f`'s selected positions into the map (the grid set around them at the first).
+    fn add(&mut self, f: usize, md: &MdFrame) -> Result<()> {
+        let pick = self
+            .select
+            .evaluate(md)
+            .map_err(|e| anyhow::anyhow!("--density-select: frame {f}: {e}"))?;
+        let positions: Vec<[f32; 3]> = (0..md.n_atoms())
+            .filter(|&i| pick[i])
+            .map(|i| md.positions[i])
+            .collect();
+        let map = match &mut self.map {
+            Some(m) => m,
+            None => {
+                let m = texmap_md_io::density::DensityMap::around(
+                    &positions,
+                    self.delta,
+                    self.padding,
+                )
+                .map_err(|e| {
+                    anyhow::anyhow!(
+                        "--density-map: the grid around frame {f}'s atoms of --density-select '{}': {e}",
+                        self.text
+                    )
+                })?;
+                self.first = f;
+                self.map.insert(m)
+            }
+        };
+        map.add(positions.iter().copied());
+        self.positions += positions.len() as u64;
+        Ok(())
+    }
+
+    /// The map written as OpenDX; what was left outside the grid reported.
+    fn finish(mut self) -> Result<crate::output::AtomicFile> {
+        let Some(map) = self.map else {
+            bail!("--density-map: no frame was written or drawn, so there is no density");
+        };
+        let v = map.to_volume("density");
+        let [nx, ny, nz] = v.dims;
+        let intro = format!(
+            "texmap --density-map: number density (atoms/A^3) of '{}'",
+            self.text
+        );
+        let grid = format!(
+            "mean over {} frames; {} A cells around frame {}'s atoms, {} A padding",
+            map.frames(),
+            crate::scene::compact(self.delta, 6),
+            self.first,
+            crate::scene::compact(self.padding, 6)
+        );
+        let mut text = Vec::new();
+        texmap_md_io::volume::write_dx(&v, &[&intro, &grid], &mut text)?;
+        self.file.write(&String::from_utf8_lossy(&text))?;
+        let (_, top) = v.range().unwrap_or((0.0, 0.0));
+        crate::note!(
+            "--density-map: {nx}x{ny}x{nz} cells over {} frames, the densest {top:.4} atoms/Å³ ({:.2}x bulk water's oxygens)",
+            map.frames(),
+            top / 0.0334
+        );
+        if map.outside() > 0 {
+            eprintln!(
+                "texmap: warning: --density-map: {} of {} positions fell outside the grid set around frame {}'s atoms and were not counted (a larger --density-padding takes them in)",
+                map.outside(),
+                self.positions,
+                self.first
+            );
+        }
+        Ok(self.file)
+    }
 }
 
 /// Atom `i`'s first columns in the per-atom tables: its index, id, name, residue name,
@@ -650,6 +736,25 @@ impl AnalysisTables {
                 whole,
             )?
             .map(|t| (t, texmap_md_io::rmsf::Fluctuation::new(), Vec::new())),
+            density: match whole_run_table(
+                &analysis.density_map,
+                "--density-map",
+                "the mean over the frames needs every frame in one run",
+                whole,
+            )? {
+                Some(file) => Some(DensityTable {
+                    file,
+                    select: texmap_md_io::select::Selection::parse(&analysis.density_select)
+                        .map_err(|e| crate::args::UsageError(format!("--density-select: {e}")))?,
+                    text: analysis.density_select.clone(),
+                    delta: analysis.density_delta,
+                    padding: analysis.density_padding,
+                    map: None,
+                    first: 0,
+                    positions: 0,
+                }),
+                None => None,
+            },
             msd_lags: whole_run_table(
                 &analysis.msd_lags,
                 "--msd-lags",
@@ -858,6 +963,9 @@ impl AnalysisTables {
                 .add(&md.positions)
                 .map_err(|e| anyhow::anyhow!("--rmsf-table: frame {f}: {e}"))?;
         }
+        if let Some(d) = &mut self.density {
+            d.add(f, md)?;
+        }
         Ok(())
     }
 
@@ -887,7 +995,9 @@ impl AnalysisTables {
                 t.write(&text).map(|()| t)
             })
             .transpose()?;
+        let density = self.density.map(DensityTable::finish).transpose()?;
         for t in [
+            density,
             self.dihedral,
             self.sasa,
             self.sasa_residues,

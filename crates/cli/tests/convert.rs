@@ -1225,3 +1225,91 @@ fn cluster_table_has_ovitos_sizes_and_the_precipitates_shape() {
     // Single solutes: a radius of gyration of 0.
     assert!(rows.iter().filter(|r| r[2] == 1.0).all(|r| r[6] == 0.0));
 }
+
+/// `--density-map` is MDAnalysis's DensityAnalysis (md-io's tests/data/volume/gen_dx.py wrote
+/// its OpenDX file): the same grid and every cell's density, and the NA positions that left
+/// the grid of frame 0's atoms counted as MDAnalysis's numpy count gives them; `texmap info`
+/// and `--volume ... --isosurface` read the map back; bad values are usage errors.
+#[test]
+fn density_map_is_mdanalysis_density_analysis() {
+    let dir = tempfile::tempdir().unwrap();
+    let map = dir.path().join("na.dx");
+    let (dcd, gro) = (md_data("dynamics/walk.dcd"), md_data("dynamics/walk.gro"));
+    let args = [
+        "convert",
+        &dcd,
+        "--topology",
+        &gro,
+        "--density-map",
+        map.to_str().unwrap(),
+        "--density-select",
+        "name NA",
+        "--density-padding",
+        "0",
+    ];
+    let o = texmap(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let reference = json("volume/density_reference.json");
+    let outside = reference["na"]["outside"].as_u64().unwrap();
+    assert!(
+        stderr(&o).contains(&format!("{outside} of 4000 positions fell outside")),
+        "{}",
+        stderr(&o)
+    );
+    let ours = &texmap_md_io::volume::read_volumes(&map).unwrap().1[0];
+    let theirs = &texmap_md_io::volume::read_volumes(md_data("volume/density_na.dx.gz"))
+        .unwrap()
+        .1[0];
+    assert_eq!(ours.dims, theirs.dims);
+    for a in 0..3 {
+        assert!((ours.origin[a] - theirs.origin[a]).abs() < 1e-5);
+        assert_eq!(ours.steps[a], theirs.steps[a]);
+    }
+    // One position in another cell moves two values by 1 / (40 frames · 1 Å³).
+    for (i, (a, b)) in ours.data.iter().zip(&theirs.data).enumerate() {
+        assert!((a - b).abs() < 1e-5, "cell {i}: {a} vs MDAnalysis {b}");
+    }
+    let info = texmap(&["info", map.to_str().unwrap()]);
+    assert!(info.status.success(), "{}", stderr(&info));
+    let v: serde_json::Value = serde_json::from_slice(&info.stdout).unwrap();
+    assert_eq!(v["format"], "OpenDX");
+    assert_eq!(numbers(&v["volumes"][0]["points"]), [18.0, 18.0, 18.0]);
+    let png = dir.path().join("iso.png");
+    run_ok(&[
+        "render",
+        &gro,
+        "--volume",
+        map.to_str().unwrap(),
+        "--isosurface",
+        "0.1",
+        "--size",
+        "96x72",
+        "-o",
+        png.to_str().unwrap(),
+        "-q",
+    ]);
+    assert!(png.exists());
+    // Usage: a negative margin, a cell width of 0 (exit 2); nothing selected (exit 1).
+    for (flag, value, code) in [
+        ("--density-padding", "-1", 2),
+        ("--density-delta", "0", 2),
+        ("--density-select", "name XX", 1),
+    ] {
+        let mut a = args.to_vec();
+        let at = a.iter().position(|x| *x == flag).unwrap_or(a.len());
+        if at < a.len() {
+            a[at + 1] = value;
+        } else {
+            a.extend([flag, value]);
+        }
+        let o = texmap(&a);
+        assert_eq!(
+            o.status.code(),
+            Some(code),
+            "{flag} {value}: {}",
+            stderr(&o)
+        );
+        assert!(stderr(&o).contains("density"), "{}", stderr(&o));
+        assert!(!map.with_extension("dx.tmp").exists());
+    }
+}

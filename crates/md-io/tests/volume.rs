@@ -747,9 +747,7 @@ fn walk_positions(name: &str) -> Vec<Vec<[f32; 3]>> {
     let mut f = Frame::new();
     let mut gro = Trajectory::open(dynamics().join("walk.gro")).unwrap();
     gro.read_frame(0, &mut f).unwrap();
-    let pick: Vec<usize> = (0..f.n_atoms())
-        .filter(|&i| f.names[i] == name)
-        .collect();
+    let pick: Vec<usize> = (0..f.n_atoms()).filter(|&i| f.names[i] == name).collect();
     let mut dcd = Trajectory::open(dynamics().join("walk.dcd")).unwrap();
     let n = dcd.n_frames().unwrap();
     (0..n)
