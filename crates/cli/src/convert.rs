@@ -91,7 +91,7 @@ Examples:
   texmap convert md.xtc --topology md.gro --pbc unwrap --gyration-table rg.csv --gyration-select protein  # compactness over time
   texmap convert md.xtc --topology md.gro --dihedral-table rama.csv                         # phi, psi, omega per residue and frame
   texmap convert md.xtc --topology md.gro --align protein --density-map water.dx --density-select 'name OW'  # where water stays (VMD volmap);
-  texmap render md.pdb --volume water.dx --isosurface 0.05 -o sites.png                     # drawn over the protein
+  texmap render md.xtc --topology md.gro --frames 0 --volume water.dx --isosurface 0.05 -o sites.png  # over the frame it was aligned to
 
 The selection and the analyses are those of texmap render; an analysis's property (cna is a
 selection keyword; coordination, grain, centrosymmetry, shear_strain, ... are properties) is
