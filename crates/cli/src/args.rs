@@ -943,6 +943,15 @@ pub struct MolArgs {
     /// VMD's Transparent material (one layer: the surface's back is not seen through its front).
     #[arg(long, value_name = "A", default_value_t = 1.0)]
     pub surface_opacity: f32,
+    /// Colour the molecular surface (--style surface, or a --rep's) by volumetric data at its
+    /// vertices, as PyMOL and VMD colour a surface by an APBS electrostatic potential: an
+    /// OpenDX file (APBS's pqr.dx, a --density-map) or a cube, XSF or CHGCAR-family file in
+    /// the structure's coordinates (its first data set), through --volume-colormap over
+    /// --volume-range (fixed at the first frame), with a colour bar. `--volume-range 5:-5`
+    /// draws an APBS potential in kT/e as PyMOL does: negative red, positive blue. Surface
+    /// outside the grid is grey.
+    #[arg(long, value_name = "FILE")]
+    pub surface_color_by: Option<PathBuf>,
     /// The polyhedra style's opacity, 0.05 to 1: below 1 the polyhedra's fronts are laid over
     /// what lies behind them (the centre atoms, when another --rep draws them), as the surface's.
     #[arg(long, value_name = "A", default_value_t = 1.0)]
@@ -1003,7 +1012,7 @@ pub struct MolArgs {
         conflicts_with = "align_to"
     )]
     pub volume_slices: Vec<String>,
-    /// The colour map of --isosurface-color-by and --volume-slice.
+    /// The colour map of --isosurface-color-by, --surface-color-by and --volume-slice.
     #[arg(long, value_enum, default_value_t = ColormapArg::Coolwarm)]
     pub volume_colormap: ColormapArg,
     /// The values at the two ends of --volume-colormap, LO:HI (default: ±the largest

@@ -693,6 +693,7 @@ fn render(a: &RenderArgs) -> Result<()> {
     let mut iso_mesh = texmap_md_scene::surface::MolMesh::default();
     let iso_opacity = isosurfaces.as_ref().map_or(1.0, |i| i.opacity);
     let mut surface = texmap_md_scene::surface::MolMesh::default();
+    let mut surface_coloring = crate::scene::surface_coloring(&a.mol)?;
     let mut coarser_warned = false;
     let mut smoother = texmap_md_io::smooth::Smoother::new(a.smooth as usize);
     let mut md = MdFrame::new();
@@ -905,6 +906,17 @@ fn render(a: &RenderArgs) -> Result<()> {
                     )
                 });
             }
+            if let Some(c) = &mut surface_coloring {
+                surface = pb
+                    .suspend(|| c.apply(&surface, &mut scene.materials, &a.mol))
+                    .map_err(|e| fail(e, &written))?;
+            }
+        }
+        if surface_coloring.is_some() && camera.is_none() && !plan.draws_surface() {
+            let e = crate::args::UsageError(
+                "--surface-color-by colours the molecular surface: draw one with --style surface or --rep 'protein=surface'".into(),
+            );
+            return Err(fail(e.into(), &written));
         }
         if camera.is_none() {
             // First frame: the camera, and warnings about the style flags.
@@ -1160,6 +1172,10 @@ fn render(a: &RenderArgs) -> Result<()> {
         // A mapped isosurface's bar, unless the atoms' own takes the place.
         if let Some(iso) = &isosurfaces {
             iso.draw_color_bar(a.style.no_color_bar || atom_bar, &mut out);
+        }
+        if let Some(bar) = surface_coloring.as_ref().and_then(|c| c.bar()) {
+            let iso_bar = isosurfaces.as_ref().is_some_and(|i| i.bar.is_some());
+            bar.draw_color_bar(a.style.no_color_bar || atom_bar || iso_bar, &mut out);
         }
         if !atom_labels.is_empty() {
             let at = format!("frame {f} of {}", traj.name());

@@ -1259,6 +1259,101 @@ impl Isosurfaces {
     }
 }
 
+/// `--surface-color-by`: the molecular surface coloured by a volume's values at its vertices.
+pub struct SurfaceColoring {
+    volume: texmap_md_io::volume::Volume,
+    path: std::path::PathBuf,
+    map: Colormap,
+    /// The colour map's ends: `--volume-range`, else set at the first frame coloured.
+    range: Option<(f32, f32)>,
+    off_grid_warned: bool,
+}
+
+/// `--surface-color-by`'s volume (its first data set), read once; `None` without the flag.
+pub fn surface_coloring(m: &MolArgs) -> Result<Option<SurfaceColoring>> {
+    let Some(path) = &m.surface_color_by else {
+        return Ok(None);
+    };
+    let range = m.volume_range.as_deref().map(parse_iso_range).transpose()?;
+    let (_, mut sets) = texmap_md_io::volume::read_volumes(path).with_context(|| {
+        format!(
+            "--surface-color-by reads volumetric data from {} (an OpenDX file such as APBS's, a Gaussian cube file, an XSF file, or a VASP CHGCAR, PARCHG, LOCPOT or ELFCAR)",
+            path.display()
+        )
+    })?;
+    if sets.is_empty() {
+        return usage(format!(
+            "--surface-color-by {}: the file holds no data set",
+            path.display()
+        ));
+    }
+    Ok(Some(SurfaceColoring {
+        volume: sets.swap_remove(0),
+        path: path.clone(),
+        map: colormap(m.volume_colormap),
+        range,
+        off_grid_warned: false,
+    }))
+}
+
+impl SurfaceColoring {
+    /// `surface` cut into colour bands of the volume's values at its vertices, its kinds past
+    /// `materials`, to which the bands' materials are appended. Warns once when part of the
+    /// surface lies outside the grid (drawn grey).
+    pub fn apply(
+        &mut self,
+        surface: &texmap_md_scene::surface::MolMesh,
+        materials: &mut Vec<texmap_core::shade::Material>,
+        m: &MolArgs,
+    ) -> Result<texmap_md_scene::surface::MolMesh> {
+        let values: Vec<f64> = surface
+            .positions
+            .iter()
+            .map(|p| {
+                self.volume
+                    .interpolate(p.as_dvec3().to_array())
+                    .unwrap_or(f64::NAN)
+            })
+            .collect();
+        let what = format!("--surface-color-by {}", self.path.display());
+        let range = match self.range {
+            Some(r) => r,
+            None => *self.range.insert(volume_range(&values, m, &what)?),
+        };
+        let off = values.iter().filter(|v| v.is_nan()).count();
+        if off > 0 && !self.off_grid_warned {
+            self.off_grid_warned = true;
+            eprintln!(
+                "texmap: warning: {off} of the surface's {} vertices lie outside {}'s grid: their triangles are drawn grey",
+                values.len(),
+                self.path.display()
+            );
+        }
+        let mut colors = Vec::new();
+        let mut mesh = banded(surface, &values, range, self.map, &mut colors);
+        let base = materials.len() as u16;
+        for k in &mut mesh.kinds {
+            *k += base;
+        }
+        materials.extend(colors.iter().map(|c| {
+            let v = texmap_core::color::srgb8_to_linear_rgb([c[0], c[1], c[2], 255]);
+            texmap_core::shade::Material::plastic(v)
+        }));
+        Ok(mesh)
+    }
+
+    /// The colour bar (once a frame was coloured), titled by the file's name.
+    pub fn bar(&self) -> Option<Isosurfaces> {
+        let (lo, hi) = self.range?;
+        Some(Isosurfaces {
+            mesh: Default::default(),
+            colors: Vec::new(),
+            opacity: 1.0,
+            bar: Some((self.map, lo, hi, crate::args::strip_gz_stem(&self.path))),
+        })
+    }
+}
+
 /// Parses `--volume-range LO:HI` (finite, LO ≠ HI; HI < LO reverses the map).
 fn parse_iso_range(s: &str) -> Result<(f32, f32)> {
     let bad = || {

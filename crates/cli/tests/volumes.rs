@@ -554,3 +554,73 @@ fn an_xsf_grid_is_drawn_as_a_periodic_isosurface() {
     assert!((v4 / v1 - 4.0).abs() < 1e-3, "{v4} vs 4 x {v1}");
     assert!((a4 / a1 - 4.0).abs() < 1e-3, "{a4} vs 4 x {a1}");
 }
+
+/// --surface-color-by: a molecular surface coloured by an OpenDX potential, as PyMOL colours
+/// one by APBS's map. The potential is linear (trilinear interpolation is exact for it), so
+/// every exported face lies in the colour band of the field at its corners; reversed with
+/// --volume-range HI:LO; without a surface to colour, a usage error.
+#[test]
+fn a_molecular_surface_is_coloured_by_a_dx_potential() {
+    use texmap_md_io::volume::{Volume, write_dx};
+    let dir = tempfile::tempdir().unwrap();
+    let pqr = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../md-io/tests/data/pdb2pqr_amber.pqr")
+        .to_str()
+        .unwrap()
+        .to_string();
+    // The atoms span 0.5..57 Å; the grid 1.6 Å apart from -10 to 70 Å along each axis.
+    let field = |p: [f64; 3]| 0.2 * (p[0] - 20.0) - 0.1 * (p[1] - 20.0);
+    let (n, step, start) = (51usize, 1.6, -10.0);
+    let mut data = Vec::with_capacity(n * n * n);
+    for k in 0..n {
+        for j in 0..n {
+            for i in 0..n {
+                let p = [i, j, k].map(|c| start + c as f64 * step);
+                data.push(field(p) as f32);
+            }
+        }
+    }
+    let steps = [[step, 0.0, 0.0], [0.0, step, 0.0], [0.0, 0.0, step]];
+    let v = Volume::new([start; 3], steps, [n; 3], data, false, "potential").unwrap();
+    let dx = dir.path().join("pot.dx");
+    let mut text = Vec::new();
+    write_dx(&v, &["a linear potential"], &mut text).unwrap();
+    std::fs::write(&dx, text).unwrap();
+    for (range, lo, hi) in [("-3:3", -3.0, 3.0), ("3:-3", 3.0, -3.0)] {
+        let obj = dir.path().join("s.obj");
+        let png = dir.path().join("picture.png");
+        let o = texmap(&[
+            "render",
+            "--quiet",
+            &pqr,
+            "--style",
+            "surface",
+            "--surface-color-by",
+            dx.to_str().unwrap(),
+            "--volume-range",
+            range,
+            "--size",
+            "160x120",
+            "--export-mesh",
+            obj.to_str().unwrap(),
+            "-o",
+            png.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        assert!(!stderr(&o).contains("outside"), "{}", stderr(&o));
+        let text = std::fs::read_to_string(&obj).unwrap();
+        let faces = assert_banded(&text, &obj, field, (lo, hi));
+        assert!(faces > 5000, "{faces} faces");
+    }
+    let o = texmap(&[
+        "render",
+        "--quiet",
+        &pqr,
+        "--surface-color-by",
+        dx.to_str().unwrap(),
+        "-o",
+        dir.path().join("x.png").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--style surface"), "{}", stderr(&o));
+}
