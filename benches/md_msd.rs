@@ -3,15 +3,19 @@
 //! frame) over 1,000 frames, 2 threads: the frames kept, then the average per lag for all atoms
 //! and two kinds. Then the velocity autocorrelation (`vacf::Velocities`, what `--vacf-table`
 //! computes) and the vibrational density of states (`--vdos-table`) of 10,000 atoms'
-//! Ornstein–Uhlenbeck velocities over 1,000 frames, for all atoms and two kinds.
+//! Ornstein–Uhlenbeck velocities over 1,000 frames, for all atoms and two kinds. And the 3-D
+//! density map of the random walk's 10,000 atoms over its 1,000 frames (`density::DensityMap`,
+//! what `--density-map` computes: 1 Å cells, 2 Å around the first frame's atoms), one thread.
 //!
 //! The peer, `benches/peers/mdanalysis_msd.py`, times MDAnalysis's `EinsteinMSD` (fft=True,
-//! through tidynamics) on a walk of the same size held in memory: run it in the same minutes.
+//! through tidynamics) on a walk of the same size held in memory: run it in the same minutes;
+//! `benches/peers/mdanalysis_density.py` times MDAnalysis's `DensityAnalysis` on the walk.
 //!
 //! `cargo bench --bench md_msd -- --warm-up-time 1 --measurement-time 5`
 //! (test mode, `cargo test --bench md_msd`, uses 500 atoms and 100 frames.)
 
 use criterion::{Criterion, criterion_group};
+use texmap::md_io::density::DensityMap;
 use texmap::md_io::msd::AllOrigins;
 use texmap::md_io::vacf::Velocities;
 
@@ -30,8 +34,10 @@ fn bench(c: &mut Criterion) {
         .map(|_| std::array::from_fn(|_| 50.0 * rng.next()))
         .collect();
     let mut all = AllOrigins::new(usize::MAX);
+    let mut walk: Vec<Vec<[f32; 3]>> = Vec::with_capacity(frames);
     for _ in 0..frames {
         all.push(&p).unwrap();
+        walk.push(p.iter().map(|q| q.map(|x| x as f32)).collect());
         for q in &mut p {
             for x in q.iter_mut() {
                 *x += 0.2 * rng.normal();
@@ -89,6 +95,24 @@ fn bench(c: &mut Criterion) {
                 .total[1]
         })
     });
+    g.bench_function(format!("density_map_{atoms}_atoms_{frames}_frames"), |b| {
+        b.iter(|| {
+            let mut map = DensityMap::around(&walk[0], 1.0, 2.0).unwrap();
+            for frame in &walk {
+                map.add(frame.iter().copied());
+            }
+            map.outside()
+        })
+    });
+    // Every position is counted once, inside the grid or outside it.
+    let mut map = DensityMap::around(&walk[0], 1.0, 2.0).unwrap();
+    for frame in &walk {
+        map.add(frame.iter().copied());
+    }
+    let v = map.to_volume("walk");
+    let inside = v.integral() * frames as f64;
+    let total = (atoms * frames) as f64;
+    assert!((inside + map.outside() as f64 - total).abs() < 1e-6 * total);
     g.finish();
 }
 
