@@ -945,7 +945,7 @@ pub struct MolArgs {
     pub surface_opacity: f32,
     /// Colour the molecular surface (--style surface, or a --rep's) by volumetric data at its
     /// vertices, as PyMOL and VMD colour a surface by an APBS electrostatic potential: an
-    /// OpenDX file (APBS's pqr.dx, a --density-map) or a cube, XSF or CHGCAR-family file in
+    /// OpenDX file (APBS's pqr.dx, a --density-map), a CCP4/MRC map, or a cube, XSF or CHGCAR-family file in
     /// the structure's coordinates (its first data set), through --volume-colormap over
     /// --volume-range (fixed at the first frame), with a colour bar. `--volume-range 5:-5`
     /// draws an APBS potential in kT/e as PyMOL does: negative red, positive blue. Surface
@@ -959,7 +959,7 @@ pub struct MolArgs {
     /// Draw the isosurface of volumetric data at this level, as VMD, VESTA and Avogadro do: the
     /// volume of a Gaussian cube file, an XSF file's DATAGRID_3D or a VASP CHGCAR / PARCHG /
     /// LOCPOT / ELFCAR given as the input, or of --volume (also an OpenDX file: an APBS
-    /// potential, a --density-map). Where the data also runs below −LEVEL (an orbital's
+    /// potential, a --density-map; or a CCP4/MRC map: a cryo-EM density). Where the data also runs below −LEVEL (an orbital's
     /// negative lobe, a negative potential) that surface is drawn too, in
     /// --isosurface-negative-color (see --isosurface-sign). A CHGCAR's density is in e/Å³, a
     /// cube or XSF file's values as written (often e/bohr³), APBS's in kT/e, a density map's
@@ -975,7 +975,8 @@ pub struct MolArgs {
     /// The volumetric data for --isosurface and --volume-slice when the input is not itself a
     /// cube, XSF or CHGCAR file: render a POSCAR or PDB with the density of another file, an
     /// OpenDX file's (.dx: APBS's electrostatic potential, VMD's volmap, MDAnalysis's or
-    /// --density-map's densities). Its grid must be in the same coordinates.
+    /// --density-map's densities) or a CCP4/MRC map's (.mrc, .map, .ccp4: a cryo-EM map with
+    /// its fitted model). Its grid must be in the same coordinates.
     #[arg(long, value_name = "FILE")]
     pub volume: Option<PathBuf>,
     /// Which data set of the volumetric file --isosurface and --volume-slice draw, from 1: a

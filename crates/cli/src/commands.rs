@@ -220,14 +220,16 @@ fn info(
     {
         return topology_info(file);
     }
-    // An OpenDX file holds a grid and no atoms.
-    if format.is_none()
-        && texmap_md_io::volume::VolumeFormat::from_path(file)
-            == Some(texmap_md_io::volume::VolumeFormat::Dx)
-    {
+    // An OpenDX file or a CCP4/MRC map holds a grid and no atoms.
+    let grid_only = match texmap_md_io::volume::VolumeFormat::from_path(file) {
+        Some(texmap_md_io::volume::VolumeFormat::Dx) => Some("OpenDX"),
+        Some(texmap_md_io::volume::VolumeFormat::Mrc) => Some("CCP4/MRC"),
+        _ => None,
+    };
+    if let (None, Some(kind)) = (format, grid_only) {
         let obj = json!({
             "file": file.display().to_string(),
-            "format": "OpenDX",
+            "format": kind,
             "volumes": volumes_json(file)?,
         });
         println!("{obj}");

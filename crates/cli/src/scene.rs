@@ -1277,7 +1277,7 @@ pub fn surface_coloring(m: &MolArgs) -> Result<Option<SurfaceColoring>> {
     let range = m.volume_range.as_deref().map(parse_iso_range).transpose()?;
     let (_, mut sets) = texmap_md_io::volume::read_volumes(path).with_context(|| {
         format!(
-            "--surface-color-by reads volumetric data from {} (an OpenDX file such as APBS's, a Gaussian cube file, an XSF file, or a VASP CHGCAR, PARCHG, LOCPOT or ELFCAR)",
+            "--surface-color-by reads volumetric data from {} (an OpenDX file such as APBS's, a CCP4/MRC map, a Gaussian cube file, an XSF file, or a VASP CHGCAR, PARCHG, LOCPOT or ELFCAR)",
             path.display()
         )
     })?;
@@ -1487,7 +1487,7 @@ pub fn isosurfaces(file: &std::path::Path, m: &MolArgs) -> Result<Option<Isosurf
     let path = m.volume.as_deref().unwrap_or(file);
     let (_, sets) = texmap_md_io::volume::read_volumes(path).with_context(|| {
         format!(
-            "--isosurface and --volume-slice read volumetric data from {} (a Gaussian cube file, an XSF file, an OpenDX file, or a VASP CHGCAR, PARCHG, LOCPOT or ELFCAR; another file's with --volume)",
+            "--isosurface and --volume-slice read volumetric data from {} (a Gaussian cube file, an XSF file, an OpenDX file, a CCP4/MRC map, or a VASP CHGCAR, PARCHG, LOCPOT or ELFCAR; another file's with --volume)",
             path.display()
         )
     })?;
@@ -1544,7 +1544,7 @@ pub fn isosurfaces(file: &std::path::Path, m: &MolArgs) -> Result<Option<Isosurf
             Some(by_path) => {
                 let (_, by) = texmap_md_io::volume::read_volumes(by_path).with_context(|| {
                     format!(
-                        "--isosurface-color-by reads volumetric data from {} (a Gaussian cube file, an XSF file, an OpenDX file, or a VASP CHGCAR, PARCHG, LOCPOT or ELFCAR)",
+                        "--isosurface-color-by reads volumetric data from {} (a Gaussian cube file, an XSF file, an OpenDX file, a CCP4/MRC map, or a VASP CHGCAR, PARCHG, LOCPOT or ELFCAR)",
                         by_path.display()
                     )
                 })?;

@@ -261,6 +261,30 @@ fn info_gives_the_grid_and_the_range() {
     let (lo, hi) = (want["min"].as_f64().unwrap(), want["max"].as_f64().unwrap());
     assert!((set["min"].as_f64().unwrap() - lo).abs() < 1e-6);
     assert!((set["max"].as_f64().unwrap() - hi).abs() < 1e-6);
+    // A CCP4/MRC map (written by mrcfile) has a grid and no atoms; drawn beside a structure.
+    let map =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../md-io/tests/data/volume/emd_float.mrc");
+    let o = texmap(&["info", map.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["format"], "CCP4/MRC");
+    assert_eq!(v["volumes"][0]["points"], serde_json::json!([20, 24, 28]));
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("map.png");
+    let o = texmap(&[
+        "render",
+        "--quiet",
+        cube().as_str(),
+        "--volume",
+        map.to_str().unwrap(),
+        "--isosurface",
+        "1.5",
+        "--size",
+        "96x72",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
 }
 
 /// A CHGCAR (pymatgen's, md-io's tests/data/volume/gen_volume.py) is periodic: its

@@ -43,7 +43,7 @@
 //! - [`values`] reads per-atom numbers from a text file (an analysis result, a column or a row
 //!   per frame) to give the frames as a property.
 //! - [`volume`] reads volumetric data (Gaussian cube; VASP CHGCAR, CHG, PARCHG, LOCPOT, ELFCAR,
-//!   AECCAR; XCrySDen XSF `DATAGRID_3D`; OpenDX from APBS, VMD and MDAnalysis) into grids
+//!   AECCAR; XCrySDen XSF `DATAGRID_3D`; OpenDX from APBS, VMD and MDAnalysis; CCP4/MRC maps of cryo-EM and crystallography) into grids
 //!   with their atoms ([`volume::read_volumes`]) and writes OpenDX ([`volume::write_dx`]); as
 //!   trajectories these files are one frame, the atoms
 //!   (`Format::Cube`, `Format::Vasp`), an XSF / AXSF file one per structure (`Format::Xsf`).
@@ -143,6 +143,7 @@ mod lammps_data;
 mod lammps_dump_writer;
 mod mmcif;
 mod mol2;
+mod mrc;
 pub mod msd;
 mod namdbin;
 mod neighbours;

@@ -77,6 +77,20 @@
 //! are not 3-D are refused at their line. [`write_dx`] writes the layout GridDataFormats
 //! writes.
 //!
+//! **CCP4 / MRC maps** (`.mrc`, `.map`, `.ccp4`, `.rec`: EMDB's cryo-EM maps, CCP4's
+//! crystallographic maps, tomograms; MRC2014 as mrcfile writes it): a 1024-byte header in
+//! either byte order (MACHST, else whichever order reads as a sane header), an extended header
+//! of NSYMBT bytes (skipped), then NC·NR·NS values, columns fastest, of MODE 0 (int8), 1
+//! (int16), 2 (float32), 6 (uint16) or 12 (float16). MAPC, MAPR and MAPS say which axis the
+//! columns, rows and sections run along; the values are reordered onto x, y, z. The steps are
+//! the cell's edges (CELLA, and CELLB's angles: a along x, b in the xy plane) over the
+//! sampling MX, MY, MZ; the first point lies at ORIGIN plus NXSTART, NYSTART, NZSTART steps
+//! along their axes, as GridDataFormats places it (files set one or the other). The first
+//! non-empty label names the volume (else `density`). A map is not taken as periodic; the file
+//! has no atoms. Complex and 4-bit modes, a header whose counts, sampling, cell or axes make
+//! no sense, and a non-finite value are refused at their byte; with the file's length known,
+//! a map longer than the file is refused before any value is read.
+//!
 //! # Damage and memory
 //! Errors are the crate's [`Error`]: the file, line and byte offset and what was expected
 //! there, as the trajectory readers give them. A file that ends inside a data set is an
@@ -306,6 +320,9 @@ pub enum VolumeFormat {
     Xsf,
     /// OpenDX: `.dx` (APBS potentials, VMD volmap and MDAnalysis densities; no atoms).
     Dx,
+    /// CCP4 / MRC maps: `.mrc`, `.map`, `.ccp4`, `.rec` (cryo-EM, crystallographic and
+    /// tomographic densities; no atoms).
+    Mrc,
 }
 
 /// What a VASP volumetric file's values are; the file's name tells (see the module docs).
@@ -370,7 +387,8 @@ impl VaspQuantity {
 
 impl VolumeFormat {
     /// The format a path names: `.cube` / `.cub` (any case) is a cube file, `.xsf` / `.axsf`
-    /// an XSF file, `.dx` an OpenDX file, a VASP name ([`VaspQuantity::from_file_name`]) VASP volumetric data; a
+    /// an XSF file, `.dx` an OpenDX file, `.mrc` / `.map` / `.ccp4` / `.rec` a CCP4/MRC map,
+    /// a VASP name ([`VaspQuantity::from_file_name`]) VASP volumetric data; a
     /// final `.gz` is looked through.
     pub fn from_path(path: &Path) -> Option<VolumeFormat> {
         let inner = crate::gz::inner_path(path);
@@ -383,6 +401,12 @@ impl VolumeFormat {
         }
         if ext.eq_ignore_ascii_case("dx") {
             return Some(VolumeFormat::Dx);
+        }
+        if ["mrc", "map", "ccp4", "rec"]
+            .iter()
+            .any(|e| ext.eq_ignore_ascii_case(e))
+        {
+            return Some(VolumeFormat::Mrc);
         }
         let name = inner.file_name()?.to_str()?;
         VaspQuantity::from_file_name(name).map(VolumeFormat::Vasp)
@@ -398,9 +422,9 @@ pub fn read_volumes(path: impl AsRef<Path>) -> Result<(Frame, Vec<Volume>), Erro
     let name: Arc<str> = path.display().to_string().into();
     let kind = VolumeFormat::from_path(path).ok_or_else(|| Error::Unsupported {
         file: name.clone(),
-        what: "volumetric data from a file not named .cube / .cub, .xsf / .axsf, .dx or as \
-               VASP names its volumetric files (CHGCAR, CHG, PARCHG, LOCPOT, ELFCAR, \
-               AECCAR0/1/2)",
+        what: "volumetric data from a file not named .cube / .cub, .xsf / .axsf, .dx, \
+               .mrc / .map / .ccp4 / .rec or as VASP names its volumetric files (CHGCAR, \
+               CHG, PARCHG, LOCPOT, ELFCAR, AECCAR0/1/2)",
     })?;
     let (file, _) = crate::gz::open(path, &name, false)?;
     let len = file.metadata().ok().map(|m| m.len());
@@ -439,6 +463,9 @@ fn read_sized<R: Read>(
     file: Arc<str>,
     budget: Budget,
 ) -> Result<(Frame, Vec<Volume>), Error> {
+    if kind == VolumeFormat::Mrc {
+        return Ok((Frame::new(), crate::mrc::read(src, file, budget.len)?));
+    }
     let ctx = Ctx {
         file,
         frame: 0,
@@ -450,6 +477,7 @@ fn read_sized<R: Read>(
         VolumeFormat::Cube => crate::cube::read(&mut lines, &ctx, &mut frame, &budget)?,
         VolumeFormat::Xsf => crate::xsf::read(&mut lines, &ctx, &mut frame, &budget)?,
         VolumeFormat::Dx => crate::dx::read(&mut lines, &ctx, &budget)?,
+        VolumeFormat::Mrc => unreachable!("read above"),
         VolumeFormat::Vasp(q) => {
             let grids = crate::chgcar::read(&mut lines, &ctx, &mut frame, q, &budget)?;
             let count = grids.len();
@@ -499,7 +527,7 @@ pub fn write_dx(
 /// What the file's size allows: a reader sizes nothing from a count beyond it.
 pub(crate) struct Budget {
     /// The file's length in bytes, when known.
-    len: Option<u64>,
+    pub(crate) len: Option<u64>,
 }
 
 impl Budget {

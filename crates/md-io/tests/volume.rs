@@ -1075,3 +1075,145 @@ fn dx_files_we_do_not_read_are_errors_naming_the_line() {
         assert!(peak < 2 << 20, "{peak} bytes for counts {counts}");
     }
 }
+
+// CCP4 / MRC maps.
+
+/// Maps written by mrcfile (gen_mrc.py) read as GridDataFormats reads them: the same grid
+/// shape, origin (ORIGIN plus NSTART along the axes MAPC/MAPR/MAPS name) and voxel size,
+/// and every value, for float32, big-endian int16 with permuted axes and an extended header,
+/// uint16 and float16.
+#[test]
+fn mrcfile_maps_read_as_griddataformats_reads_them() {
+    let text = std::fs::read_to_string(dir().join("mrc_reference.json")).unwrap();
+    let reference: Value = serde_json::from_str(&text).unwrap();
+    for name in [
+        "emd_float.mrc",
+        "ccp4_int16_be.map",
+        "uint16_half.mrc",
+        "half_float.mrc",
+    ] {
+        let r = &reference[name];
+        let (atoms, sets) = read_volumes(dir().join(name)).unwrap();
+        assert_eq!((atoms.n_atoms(), sets.len()), (0, 1), "{name}");
+        let v = &sets[0];
+        let shape: Vec<usize> = f64s(&r["shape"]).iter().map(|&n| n as usize).collect();
+        assert_eq!(v.dims.to_vec(), shape, "{name}");
+        for a in 0..3 {
+            close(v.origin[a], f64s(&r["origin"])[a], 1e-6, name);
+            for b in 0..3 {
+                let want = if a == b { f64s(&r["delta"])[a] } else { 0.0 };
+                close(v.steps[a][b], want, 1e-9, name);
+            }
+        }
+        let values = f64s(&r["values"]);
+        let [nx, ny, nz] = v.dims;
+        for i in 0..nx {
+            for j in 0..ny {
+                for k in 0..nz {
+                    let want = values[(i * ny + j) * nz + k];
+                    // serde_json parses the shortest decimal to within an ulp of f64.
+                    let got = v.at(i, j, k) as f64;
+                    close(
+                        got,
+                        want,
+                        1e-12 * want.abs(),
+                        &format!("{name} ({i}, {j}, {k})"),
+                    );
+                }
+            }
+        }
+    }
+    let (_, sets) = read_volumes(dir().join("emd_float.mrc")).unwrap();
+    assert_eq!(
+        sets[0].name,
+        "texmap test map: f(x, y, z) at the grid points"
+    );
+    // f at a point between the grid's points, by trilinear interpolation.
+    let f = |p: [f64; 3]| (0.3 * p[0]).sin() + 0.05 * p[1] * p[1] - 0.1 * p[2] + 0.02 * p[0] * p[2];
+    let p = [20.0, 10.0, 15.0];
+    close(
+        sets[0].interpolate(p).unwrap(),
+        f(p),
+        0.05,
+        "interpolated f",
+    );
+}
+
+/// An oblique cell's axes (γ = 60°): b in the xy plane at 60° from a.
+#[test]
+fn an_oblique_mrc_cell_gives_skewed_steps() {
+    let mut bytes = std::fs::read(dir().join("emd_float.mrc")).unwrap();
+    bytes[60..64].copy_from_slice(&60.0f32.to_le_bytes());
+    let (_, sets) = read_volumes_from(&bytes[..], VolumeFormat::Mrc, "oblique.mrc").unwrap();
+    let s = sets[0].steps;
+    close(s[1][0], 1.5 * 0.5, 1e-9, "b step x");
+    close(s[1][1], 1.5 * 3f64.sqrt() / 2.0, 1e-9, "b step y");
+    assert_eq!(s[0], [1.25, 0.0, 0.0]);
+    close(s[2][2], 0.75, 1e-9, "c step z");
+}
+
+/// Every cut of a map is an error (with the file's length known, before any value is read;
+/// streamed, at the cut); hostile and wrong header fields are errors naming their byte.
+#[test]
+fn damaged_mrc_maps_are_errors_naming_the_byte() {
+    let whole = std::fs::read(dir().join("ccp4_int16_be.map")).unwrap();
+    let tmp = std::env::temp_dir().join(format!("texmap-mrc-{}", std::process::id()));
+    std::fs::create_dir_all(&tmp).unwrap();
+    let path = tmp.join("cut.map");
+    for n in (0..whole.len()).step_by(7).chain([whole.len() - 1]) {
+        std::fs::write(&path, &whole[..n]).unwrap();
+        let e = read_volumes(&path).unwrap_err();
+        assert!(matches!(e, Error::Truncated { .. }), "cut at {n}: {e}");
+        let e = read_volumes_from(&whole[..n], VolumeFormat::Mrc, "cut.map").unwrap_err();
+        assert!(
+            matches!(e, Error::Truncated { .. }),
+            "streamed cut at {n}: {e}"
+        );
+    }
+    std::fs::remove_dir_all(&tmp).unwrap();
+    let float = std::fs::read(dir().join("emd_float.mrc")).unwrap();
+    let patched = |at: usize, bytes: [u8; 4]| {
+        let mut b = float.clone();
+        b[at..at + 4].copy_from_slice(&bytes);
+        b
+    };
+    let cases = [
+        (patched(12, 3i32.to_le_bytes()), "byte 12", "MODE"),
+        (patched(64, 2i32.to_le_bytes()), "byte 64", "MAPC"),
+        (patched(4, 0i32.to_le_bytes()), "byte 4", "counts"),
+        (patched(40, (-1.0f32).to_le_bytes()), "byte 40", "lengths"),
+        (patched(196, f32::NAN.to_le_bytes()), "byte 196", "ORIGIN"),
+        (
+            patched(1024 + 400, f32::INFINITY.to_le_bytes()),
+            "byte 1424",
+            "finite",
+        ),
+        (patched(92, (-8i32).to_le_bytes()), "byte 92", "NSYMBT"),
+        (patched(92, 1_000_000i32.to_le_bytes()), "byte", "NSYMBT"),
+    ];
+    for (bytes, place, what) in cases {
+        let e = read_volumes_from(&bytes[..], VolumeFormat::Mrc, "bad.mrc")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(place) && e.contains(what), "{e}");
+    }
+    // Counts of 2^20 along each axis: refused before anything is reserved for them.
+    let mut huge = float.clone();
+    for k in 0..3 {
+        huge[4 * k..4 * k + 4].copy_from_slice(&(1i32 << 20).to_le_bytes());
+    }
+    let (r, peak) = measure(|| read_volumes_from(&huge[..], VolumeFormat::Mrc, "huge.mrc"));
+    assert!(r.is_err());
+    assert!(peak < 2 << 20, "{peak} bytes");
+    // 2^9 each (2^27 points, allowed) on a short stream: read as far as it goes.
+    for k in 0..3 {
+        huge[4 * k..4 * k + 4].copy_from_slice(&(1i32 << 9).to_le_bytes());
+    }
+    let (r, peak) = measure(|| read_volumes_from(&huge[..], VolumeFormat::Mrc, "huge.mrc"));
+    assert!(matches!(r, Err(Error::Truncated { .. })));
+    assert!(peak < 4 << 20, "{peak} bytes");
+    assert_eq!(
+        VolumeFormat::from_path(Path::new("emd_1234.map.gz")),
+        Some(VolumeFormat::Mrc)
+    );
+}
