@@ -52,6 +52,17 @@ pub(crate) fn read<R: Read>(
                 }
                 g.steps
                     .push(vector(ctx, pos, line, &f, "delta x y z: a grid step (Å)")?);
+                if g.steps.len() == 3 {
+                    let det = crate::volume::det3([g.steps[0], g.steps[1], g.steps[2]]);
+                    if det == 0.0 || !det.is_finite() {
+                        return Err(ctx.parse(
+                            pos,
+                            line,
+                            line,
+                            "three delta lines that span a volume (independent steps)",
+                        ));
+                    }
+                }
             }
             _ => {
                 return Err(ctx.parse(

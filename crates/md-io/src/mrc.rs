@@ -260,6 +260,14 @@ pub(crate) fn read<R: Read>(
         [cx, cy, (c * c - cx * cx - cy * cy).max(0.0).sqrt()],
     ];
     let steps: [[f64; 3]; 3] = std::array::from_fn(|x| lattice[x].map(|v| v / sampling[x] as f64));
+    let det = crate::volume::det3(steps);
+    if det == 0.0 || !det.is_finite() {
+        return Err(bad(
+            52,
+            "cell angles that span a volume",
+            format!("{} {} {}", angles[0], angles[1], angles[2]),
+        ));
+    }
     // ORIGIN plus the first point's index along each axis (NXSTART of the column axis, …),
     // as GridDataFormats places a map.
     let mut start = [0.0f64; 3];

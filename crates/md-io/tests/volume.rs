@@ -1217,3 +1217,47 @@ fn damaged_mrc_maps_are_errors_naming_the_byte() {
         Some(VolumeFormat::Mrc)
     );
 }
+
+/// Every byte of a small MRC map and an APBS-layout DX file replaced by a few values: each
+/// read is a located error or a grid, never a panic, and holds at most 64x the file's bytes
+/// + 1 MiB of heap.
+#[test]
+fn replaced_bytes_of_mrc_and_dx_files_are_errors_or_grids() {
+    let mrc = std::fs::read(dir().join("ccp4_int16_be.map")).unwrap();
+    let dx = apbs_text().into_bytes();
+    for (bytes, kind, name) in [
+        (mrc, VolumeFormat::Mrc, "m.map"),
+        (dx, VolumeFormat::Dx, "p.dx"),
+    ] {
+        let (mut read_ok, mut errors) = (0, 0);
+        for i in 0..bytes.len() {
+            for v in [0u8, 0x7f, 0xff, b'9', b' '] {
+                if bytes[i] == v {
+                    continue;
+                }
+                let mut b = bytes.clone();
+                b[i] = v;
+                let (r, peak) = measure(|| read_volumes_from(&b[..], kind, name));
+                assert!(
+                    peak < 64 * b.len() + (1 << 20),
+                    "{name}: byte {i} = {v}: {peak} bytes of heap"
+                );
+                match r {
+                    Ok((_, sets)) => {
+                        assert_eq!(sets.len(), 1);
+                        read_ok += 1;
+                    }
+                    Err(e) => {
+                        assert!(e.to_string().starts_with(name), "{e}");
+                        errors += 1;
+                    }
+                }
+            }
+        }
+        eprintln!("{name}: {read_ok} mutants read, {errors} errors");
+        assert!(
+            read_ok > 0 && errors > 0,
+            "{name}: {read_ok} read, {errors} errors"
+        );
+    }
+}
