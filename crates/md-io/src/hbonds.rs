@@ -289,3 +289,91 @@ pub fn hydrogen_bonds(
     found.sort_unstable_by_key(|b| (b.donor, b.hydrogen, b.acceptor));
     Ok(found)
 }
+
+/// How long hydrogen bonds last: the autocorrelation C(τ) of their existence, as MDAnalysis's
+/// `HydrogenBondAnalysis.lifetime` computes it (`lib.correlations`). `frames` lists each
+/// frame's bonds as (hydrogen, acceptor) pairs (the donor follows from the hydrogen; the pair
+/// is taken unordered, as MDAnalysis's `frozenset`). C(τ) is the mean, over every time origin
+/// t whose frame has a bond and with t + τ a frame, of the share of t's bonds present at every
+/// frame from t to t + τ; C(0) = 1. With `intermittency` k, a bond absent for up to k
+/// consecutive frames between two frames that have it counts as present in them (MDAnalysis's
+/// `correct_intermittency`). Returns C(0) … C(min(`tau_max`, frames − 1)); NaN at a lag no
+/// origin reaches (no bond at all). Linear in the bonds over the frames plus frames × lags.
+///
+/// ```
+/// use texmap_md_io::hbonds::lifetime;
+/// // One bond present in frames 0–2, gone in 3, back in 4; another only in frame 0.
+/// let frames = vec![vec![[1, 9], [2, 8]], vec![[1, 9]], vec![[9, 1]], vec![], vec![[1, 9]]];
+/// let c = lifetime(&frames, 2, 0);
+/// // Lag 1: origin 0 keeps 1 of 2, origin 1 keeps 1 of 1, origin 2 keeps 0 of 1, origin 4
+/// // has no frame 5: (1/2 + 1 + 0) / 3.
+/// assert_eq!(c[1], 0.5);
+/// // With the one-frame gap forgiven, lag 2 from origins 0, 1, 2: (1/2 + 1 + 1) / 3.
+/// assert!((lifetime(&frames, 2, 1)[2] - 2.5 / 3.0).abs() < 1e-12);
+/// ```
+pub fn lifetime(frames: &[Vec<[u32; 2]>], tau_max: usize, intermittency: usize) -> Vec<f64> {
+    let n = frames.len();
+    if n == 0 {
+        return Vec::new();
+    }
+    let tau_max = tau_max.min(n - 1);
+    // Each bond's frames, in order.
+    let mut ids = std::collections::HashMap::new();
+    let mut present: Vec<Vec<usize>> = Vec::new();
+    for (f, bonds) in frames.iter().enumerate() {
+        for &[h, a] in bonds {
+            let key = (h.min(a), h.max(a));
+            let id = *ids.entry(key).or_insert_with(|| {
+                present.push(Vec::new());
+                present.len() - 1
+            });
+            if present[id].last() != Some(&f) {
+                present[id].push(f);
+            }
+        }
+    }
+    // Per origin: its bonds, and how many survive each lag (a histogram of the continuous
+    // run each bond has from it, then summed from the top).
+    let lags = tau_max + 1;
+    let mut count = vec![0u32; n];
+    let mut runs = vec![0u32; n * lags];
+    for frames_of in &present {
+        let mut k = 0;
+        while k < frames_of.len() {
+            // A run of consecutive frames, gaps of up to `intermittency` bridged.
+            let start = frames_of[k];
+            let mut end = start;
+            k += 1;
+            while k < frames_of.len() && frames_of[k] - end <= intermittency + 1 {
+                end = frames_of[k];
+                k += 1;
+            }
+            for t in start..=end {
+                count[t] += 1;
+                runs[t * lags + (end - t).min(tau_max)] += 1;
+            }
+        }
+    }
+    let mut sum = vec![0.0f64; lags];
+    let mut origins = vec![0usize; lags];
+    for t in 0..n {
+        if count[t] == 0 {
+            continue;
+        }
+        let mut surviving = 0u32;
+        for tau in (0..lags).rev() {
+            surviving += runs[t * lags + tau];
+            if t + tau < n {
+                sum[tau] += surviving as f64 / count[t] as f64;
+                origins[tau] += 1;
+            }
+        }
+    }
+    let mut c: Vec<f64> = sum
+        .iter()
+        .zip(&origins)
+        .map(|(s, &o)| if o == 0 { f64::NAN } else { s / o as f64 })
+        .collect();
+    c[0] = 1.0;
+    c
+}

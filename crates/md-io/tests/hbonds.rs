@@ -254,3 +254,46 @@ fn a_mask_keeps_only_bonds_within_it_and_bad_criteria_are_refused() {
     let e = hydrogen_bonds(&small, &dh, None, c).unwrap_err();
     assert!(e.to_string().contains("--replicate"), "{e}");
 }
+
+/// `hbonds::lifetime` is MDAnalysis's hydrogen-bond lifetime autocorrelation
+/// (lib.correlations' correct_intermittency and autocorrelation, gen_lifetime.py) on 80
+/// synthetic bonds switching on and off over 200 frames, continuous and with gaps of up to 2
+/// frames forgiven, at every lag to 30.
+#[test]
+fn lifetime_is_mdanalysis_autocorrelation() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/hbonds/lifetime_reference.json");
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    let frames: Vec<Vec<[u32; 2]>> = r["frames"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| {
+            f.as_array()
+                .unwrap()
+                .iter()
+                .map(|p| [0, 1].map(|k| p[k].as_u64().unwrap() as u32))
+                .collect()
+        })
+        .collect();
+    for inter in [0usize, 2] {
+        let want: Vec<f64> = r[format!("intermittency_{inter}")]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
+        let got = texmap_md_io::hbonds::lifetime(&frames, 30, inter);
+        assert_eq!(got.len(), want.len());
+        for (tau, (g, w)) in got.iter().zip(&want).enumerate() {
+            assert!(
+                (g - w).abs() < 1e-12,
+                "intermittency {inter}, lag {tau}: {g} vs {w}"
+            );
+        }
+    }
+    // Fewer frames than lags: the curve stops at the last frame; no frames, no curve.
+    assert_eq!(texmap_md_io::hbonds::lifetime(&frames[..5], 30, 0).len(), 5);
+    assert!(texmap_md_io::hbonds::lifetime(&[], 30, 0).is_empty());
+}
