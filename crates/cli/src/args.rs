@@ -1082,6 +1082,32 @@ pub struct MolArgs {
     /// and the donor-hydrogen-acceptor angle (degrees). Written whole or not at all.
     #[arg(long, value_name = "FILE.csv")]
     pub hbond_table: Option<PathBuf>,
+    /// Also write how long the hydrogen bonds the hbonds style draws last, as a CSV table (MDAnalysis's
+    /// HydrogenBondAnalysis.lifetime): lag (frames drawn), time (ps, when the frames' times
+    /// are evenly spaced), c: of the bonds at a frame, the share present at every frame up to
+    /// the lag, averaged over every frame as the origin (a bond is its hydrogen and acceptor).
+    /// Prints the lifetime, ∫ C dτ by the trapezoid rule up to --hbond-lifetime-max (longer
+    /// when C has not decayed there). Written whole or not at all; not with --shard.
+    #[arg(long, value_name = "FILE.csv")]
+    pub hbond_lifetime: Option<PathBuf>,
+    /// The longest lag of --hbond-lifetime, in frames drawn (MDAnalysis's tau_max).
+    #[arg(
+        long,
+        value_name = "FRAMES",
+        default_value_t = 20,
+        requires = "hbond_lifetime"
+    )]
+    pub hbond_lifetime_max: usize,
+    /// --hbond-lifetime counts a bond absent for up to N consecutive frames between two
+    /// frames that have it as unbroken (MDAnalysis's intermittency; 0, the default, is the
+    /// continuous lifetime).
+    #[arg(
+        long,
+        value_name = "N",
+        default_value_t = 0,
+        requires = "hbond_lifetime"
+    )]
+    pub hbond_intermittency: usize,
     /// Draw each atom with the radius (Å) a per-atom property gives: PQR's 'radius'
     /// (PDB2PQR/APBS radii), any dump column (texmap info lists them), --property FILE's
     /// numbers. As a file's radius column: --radius-scale does not apply, ball-and-stick

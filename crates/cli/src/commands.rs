@@ -768,10 +768,15 @@ fn render(a: &RenderArgs) -> Result<()> {
     {
         return usage("--label {grains} counts the grains --grains finds: add --grains");
     }
-    if a.mol.hbond_table.is_some() && !plan.draws_hbonds() {
-        return usage(
-            "--hbond-table lists the hydrogen bonds the hbonds style draws: add a representation of them, as --rep 'protein or water=hbonds'",
-        );
+    for (given, flag) in [
+        (a.mol.hbond_table.is_some(), "--hbond-table"),
+        (a.mol.hbond_lifetime.is_some(), "--hbond-lifetime"),
+    ] {
+        if given && !plan.draws_hbonds() {
+            return usage(format!(
+                "{flag} follows the hydrogen bonds the hbonds style draws: add a representation of them, as --rep 'protein or water=hbonds'"
+            ));
+        }
     }
     if a.mol.measure_table.is_some() && a.mol.measures.is_empty() {
         return usage(
@@ -783,6 +788,12 @@ fn render(a: &RenderArgs) -> Result<()> {
         &a.mol.hbond_table,
         "--hbond-table",
         "frame,donor,hydrogen,acceptor,donor_atom,hydrogen_atom,acceptor_atom,distance,angle",
+        whole,
+    )?;
+    let mut hbond_lifetime = crate::tables::HBondLifetime::create(
+        &a.mol.hbond_lifetime,
+        a.mol.hbond_lifetime_max,
+        a.mol.hbond_intermittency,
         whole,
     )?;
     let mut analysis_tables = AnalysisTables::create(&a.mol.analysis, whole)?;
@@ -863,6 +874,9 @@ fn render(a: &RenderArgs) -> Result<()> {
         {
             t.write(&hbond_rows(f, plan.last_hbonds(), &md))
                 .map_err(|e| fail(e, &written))?;
+        }
+        if let Some(l) = &mut hbond_lifetime {
+            l.add(plan.last_hbonds(), md.time);
         }
         if mine.contains(&k) {
             analysis_tables
@@ -1228,6 +1242,9 @@ fn render(a: &RenderArgs) -> Result<()> {
     let movie = sink.finish()?;
     if let Some(t) = hbond_table {
         t.commit()?;
+    }
+    if let Some(l) = hbond_lifetime {
+        l.finish()?.commit()?;
     }
     if let Some(t) = measure_table {
         t.commit()?;

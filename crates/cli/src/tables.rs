@@ -370,6 +370,79 @@ fn lag_table(
     }
 }
 
+/// `--hbond-lifetime`: every frame's hydrogen bonds (hydrogen, acceptor), correlated at the
+/// end.
+pub(crate) struct HBondLifetime {
+    file: crate::output::AtomicFile,
+    frames: Vec<Vec<[u32; 2]>>,
+    times: Vec<Option<f64>>,
+    tau_max: usize,
+    intermittency: usize,
+}
+
+impl HBondLifetime {
+    /// The table `path` asks for (`whole`: see [`per_frame_table`]).
+    pub(crate) fn create(
+        path: &Option<PathBuf>,
+        tau_max: usize,
+        intermittency: usize,
+        whole: bool,
+    ) -> Result<Option<HBondLifetime>> {
+        let why = "the average over every time origin needs every frame in one run";
+        Ok(
+            whole_run_table(path, "--hbond-lifetime", why, whole)?.map(|file| HBondLifetime {
+                file,
+                frames: Vec::new(),
+                times: Vec::new(),
+                tau_max,
+                intermittency,
+            }),
+        )
+    }
+
+    /// One frame's bonds.
+    pub(crate) fn add(&mut self, hbonds: &[texmap_md_io::hbonds::HBond], time: Option<f64>) {
+        self.frames
+            .push(hbonds.iter().map(|h| [h.hydrogen, h.acceptor]).collect());
+        self.times.push(time);
+    }
+
+    /// The table written, the lifetime printed.
+    pub(crate) fn finish(mut self) -> Result<crate::output::AtomicFile> {
+        if self.frames.len() < 2 {
+            bail!(
+                "--hbond-lifetime: {} frame(s) drawn: a lifetime needs two or more",
+                self.frames.len()
+            );
+        }
+        let c = texmap_md_io::hbonds::lifetime(&self.frames, self.tau_max, self.intermittency);
+        if c.get(1).is_none_or(|v| v.is_nan()) {
+            bail!(
+                "--hbond-lifetime: none of the {} frames drawn has a hydrogen bond",
+                self.frames.len()
+            );
+        }
+        let times = even_lag_times(&self.times);
+        let (text, x, unit) = lag_table("c", &[], &times, &c, &[], |v| format!("{v:.6}"));
+        self.file.write(&text)?;
+        let area: f64 = (1..c.len())
+            .map(|k| 0.5 * (c[k] + c[k - 1]) * (x[k] - x[k - 1]))
+            .sum();
+        let last = c[c.len() - 1];
+        crate::note!(
+            "--hbond-lifetime: lifetime ∫C dτ = {} {unit} over lags 0–{} {unit} (C there {last:.3}{})",
+            crate::scene::compact(area, 4),
+            crate::scene::compact(x[c.len() - 1], 4),
+            if last > 0.05 {
+                ": not yet decayed, so the bonds live longer; raise --hbond-lifetime-max"
+            } else {
+                ""
+            }
+        );
+        Ok(self.file)
+    }
+}
+
 /// `--vacf-table` and `--vdos-table`: every frame's velocities, correlated at the end.
 struct VelocityTables {
     vacf: Option<crate::output::AtomicFile>,

@@ -1933,6 +1933,7 @@ fn the_hydrogen_bond_table_is_mdanalysis_s_list() {
     let dir = tempfile::tempdir().unwrap();
     let (xtc, gro) = (data("hbonds/adk_0_9.xtc"), data("hbonds/adk_top.gro.gz"));
     let table = dir.path().join("hb.csv");
+    let lifetime = dir.path().join("lifetime.csv");
     let frames = dir.path().join("f%02d.png");
     let run = |rep: &str| {
         texmap(&[
@@ -1947,6 +1948,8 @@ fn the_hydrogen_bond_table_is_mdanalysis_s_list() {
             rep,
             "--hbond-table",
             table.to_str().unwrap(),
+            "--hbond-lifetime",
+            lifetime.to_str().unwrap(),
             "-o",
             frames.to_str().unwrap(),
         ])
@@ -1954,7 +1957,7 @@ fn the_hydrogen_bond_table_is_mdanalysis_s_list() {
     let o = run("all=licorice");
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("--hbond-table"), "{}", stderr(&o));
-    assert!(!table.exists());
+    assert!(!table.exists() && !lifetime.exists());
     let o = run("all=hbonds");
     assert!(o.status.success(), "{}", stderr(&o));
     let text = std::fs::read_to_string(&table).unwrap();
@@ -2017,6 +2020,50 @@ fn the_hydrogen_bond_table_is_mdanalysis_s_list() {
         }
         assert!(got[k].len() > 13_000);
     }
+    // --hbond-lifetime over the two frames: C(1) is the share of frame 0's (hydrogen, acceptor)
+    // pairs still bonded in frame 1, of the table's bonds exactly, and of MDAnalysis's within
+    // the ties at the cutoff.
+    let pairs = |s: &std::collections::BTreeSet<(u32, u32, u32)>| {
+        s.iter()
+            .map(|&(_, h, a)| (h, a))
+            .collect::<std::collections::BTreeSet<_>>()
+    };
+    type Pairs = std::collections::BTreeSet<(u32, u32)>;
+    fn kept(a: &Pairs, b: &Pairs) -> f64 {
+        a.intersection(b).count() as f64 / a.len() as f64
+    }
+    let ours = kept(&pairs(&got[0]), &pairs(&got[1]));
+    let text = std::fs::read_to_string(&lifetime).unwrap();
+    let rows: Vec<&str> = text.lines().collect();
+    assert_eq!(rows[0], "lag,time,c");
+    assert!(
+        rows[1].starts_with("0,") && rows[1].ends_with(",1.000000"),
+        "{text}"
+    );
+    let c1: f64 = rows[2].rsplit(',').next().unwrap().parse().unwrap();
+    assert!((c1 - ours).abs() < 1e-6, "C(1) {c1} vs the table's {ours}");
+    let theirs: Vec<Pairs> = v["frames"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| {
+            let flat: Vec<u32> = f["dha"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|x| x.as_u64().unwrap() as u32)
+                .collect();
+            flat.chunks(3).map(|c| (c[1], c[2])).collect()
+        })
+        .collect();
+    let mda = kept(&theirs[0], &theirs[1]);
+    assert!(
+        (c1 - mda).abs() < 4.0 / theirs[0].len() as f64,
+        "C(1) {c1} vs MDAnalysis's {mda}"
+    );
+    // Frames 0 and 9 of the run: the water has moved on, a few dozen of the protein's bonds
+    // hold.
+    assert!(c1 > 0.0 && c1 < 0.05, "C(1) {c1}");
     // `--label {hbonds}` writes the count the table lists (the caption drawn byte for byte as
     // the literal number); without an hbonds representation it is a usage error.
     let caption = |label: &str, rep: &str, out: &str| {
