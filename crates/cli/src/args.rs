@@ -804,6 +804,18 @@ pub enum BondsArg {
 }
 
 /// How molecules are drawn (`--style`).
+/// How `--contacts-table` counts a frame's native pairs.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum ContactsMethodArg {
+    /// No longer than in the reference (MDAnalysis's hard_cut).
+    #[default]
+    Hard,
+    /// Within the radius (MDAnalysis's radius_cut).
+    Radius,
+    /// The sigmoid of Best, Hummer and Eaton (MDAnalysis's soft_cut).
+    Soft,
+}
+
 /// Which sides of the data `--isosurface` draws.
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum IsoSignArg {
@@ -1216,6 +1228,28 @@ pub struct AnalysisArgs {
     /// give --pbc unwrap for a molecule the trajectory wrapped. Written whole or not at all.
     #[arg(long, value_name = "FILE.csv")]
     pub gyration_table: Option<PathBuf>,
+    /// Also write the fraction of native contacts every frame as a CSV table (MDAnalysis's
+    /// contacts.Contacts: the folding coordinate Q): frame, time (ps, when the file has it),
+    /// q. The native contacts are the pairs of the two --contacts groups within
+    /// --contacts-radius in the first frame written or drawn (every pair MDAnalysis counts:
+    /// both orders, and an atom with itself, when the groups overlap); distances to the nearest
+    /// periodic image. Written whole or not at all.
+    #[arg(long, value_name = "FILE.csv", requires = "contacts")]
+    pub contacts_table: Option<PathBuf>,
+    /// The two groups of --contacts-table, 'SEL_A;SEL_B': 'name N;name O' (backbone),
+    /// 'resname ASP GLU and name OD1 OD2 OE1 OE2;resname LYS ARG and name NZ NH1 NH2' (salt
+    /// bridges), 'name CA;name CA'.
+    #[arg(long, value_name = "SEL_A;SEL_B", requires = "contacts_table")]
+    pub contacts: Option<String>,
+    /// The native contacts' radius (Å; MDAnalysis's default 4.5).
+    #[arg(long, value_name = "Å", default_value_t = 4.5, requires = "contacts_table", value_parser = parse_positive)]
+    pub contacts_radius: f64,
+    /// How a frame's pairs count, r0 being a pair's distance in the first frame: hard (r ≤ r0,
+    /// MDAnalysis's default hard_cut: any stretch breaks a contact), radius (r ≤
+    /// --contacts-radius, radius_cut) or soft (1 / (1 + exp(5 (r − 1.8 r0))), Best, Hummer and
+    /// Eaton's soft_cut).
+    #[arg(long, value_enum, default_value_t = ContactsMethodArg::Hard, requires = "contacts_table")]
+    pub contacts_method: ContactsMethodArg,
     /// The atoms --gyration-table measures (e.g. 'protein', 'resname POPC').
     #[arg(
         long,

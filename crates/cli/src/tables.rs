@@ -77,6 +77,91 @@ pub(crate) struct AnalysisTables {
         Vec<String>,
     )>,
     density: Option<DensityTable>,
+    contacts: Option<ContactsTable>,
+}
+
+/// `--contacts-table`: its file, groups and method, and the native contacts (set at the
+/// first frame).
+struct ContactsTable {
+    file: crate::output::AtomicFile,
+    groups: [texmap_md_io::select::Selection; 2],
+    radius: f64,
+    method: texmap_md_io::contacts::Method,
+    native: Option<texmap_md_io::contacts::NativeContacts>,
+}
+
+impl ContactsTable {
+    fn create(analysis: &AnalysisArgs, whole: bool) -> Result<Option<ContactsTable>> {
+        let Some(file) = per_frame_table(
+            &analysis.contacts_table,
+            "--contacts-table",
+            "frame,time,q",
+            whole,
+        )?
+        else {
+            return Ok(None);
+        };
+        let spec = analysis.contacts.as_deref().unwrap_or_default();
+        let Some((a, b)) = spec.split_once(';') else {
+            return usage(format!(
+                "--contacts {spec:?}: expected two selections, 'SEL_A;SEL_B' (e.g. 'name N;name O')"
+            ));
+        };
+        let parse = |s: &str| {
+            texmap_md_io::select::Selection::parse(s.trim())
+                .map_err(|e| crate::args::UsageError(format!("--contacts {s:?}: {e}")))
+        };
+        Ok(Some(ContactsTable {
+            file,
+            groups: [parse(a)?, parse(b)?],
+            radius: analysis.contacts_radius,
+            method: match analysis.contacts_method {
+                crate::args::ContactsMethodArg::Hard => texmap_md_io::contacts::Method::HardCut,
+                crate::args::ContactsMethodArg::Radius => texmap_md_io::contacts::Method::RadiusCut,
+                crate::args::ContactsMethodArg::Soft => texmap_md_io::contacts::Method::SOFT,
+            },
+            native: None,
+        }))
+    }
+
+    /// Frame `f`'s row (the native contacts found in it when it is the first).
+    fn add(&mut self, f: usize, time: &str, md: &MdFrame) -> Result<()> {
+        let native = match &self.native {
+            Some(n) => n,
+            None => {
+                let mut groups = [Vec::new(), Vec::new()];
+                for (g, sel) in groups.iter_mut().zip(&self.groups) {
+                    let pick = sel
+                        .evaluate(md)
+                        .map_err(|e| anyhow::anyhow!("--contacts: frame {f}: {e}"))?;
+                    g.extend((0..md.n_atoms()).filter(|&i| pick[i]));
+                }
+                let n = texmap_md_io::contacts::NativeContacts::new(
+                    &md.positions,
+                    md.cell.as_ref(),
+                    &groups[0],
+                    &groups[1],
+                    self.radius,
+                )
+                .map_err(|e| anyhow::anyhow!("--contacts: frame {f}: {e}"))?;
+                if n.pairs().is_empty() {
+                    bail!(
+                        "--contacts: frame {f} has no pair of the two groups within {} Å, so no native contacts (a larger --contacts-radius?)",
+                        self.radius
+                    );
+                }
+                crate::note!(
+                    "--contacts-table: {} native contacts in frame {f}",
+                    n.pairs().len()
+                );
+                self.native.insert(n)
+            }
+        };
+        let q = native
+            .q(&md.positions, md.cell.as_ref(), self.method)
+            .map_err(|e| anyhow::anyhow!("--contacts-table: frame {f}: {e}"))?;
+        self.file.write(&format!("{f},{time},{q:.6}\n"))
+    }
 }
 
 /// `--density-map`: its file, atoms and grid (set at the first frame).
@@ -809,6 +894,7 @@ impl AnalysisTables {
                 whole,
             )?
             .map(|t| (t, texmap_md_io::rmsf::Fluctuation::new(), Vec::new())),
+            contacts: ContactsTable::create(analysis, whole)?,
             density: match whole_run_table(
                 &analysis.density_map,
                 "--density-map",
@@ -1039,6 +1125,9 @@ impl AnalysisTables {
         if let Some(d) = &mut self.density {
             d.add(f, md)?;
         }
+        if let Some(c) = &mut self.contacts {
+            c.add(f, &time, md)?;
+        }
         Ok(())
     }
 
@@ -1070,6 +1159,7 @@ impl AnalysisTables {
             .transpose()?;
         let density = self.density.map(DensityTable::finish).transpose()?;
         for t in [
+            self.contacts.map(|c| c.file),
             density,
             self.dihedral,
             self.sasa,

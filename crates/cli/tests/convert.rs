@@ -1313,3 +1313,72 @@ fn density_map_is_mdanalysis_density_analysis() {
         assert!(!map.with_extension("dx.tmp").exists());
     }
 }
+
+/// `--contacts-table` is MDAnalysis's contacts.Contacts (md-io's
+/// tests/data/dihedrals/gen_contacts.py): the backbone N–O contacts of frame 0 within 3.5 Å by
+/// the hard cut (no longer than in frame 0) and by the radius, and the CA–CA contacts within
+/// 4.5 Å by the soft cut (self pairs included, as MDAnalysis counts them), Q per frame of the
+/// noisy helix; a --contacts without two
+/// selections is a usage error.
+#[test]
+fn contacts_table_is_mdanalysis_native_contacts() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("q.csv");
+    let reference = json("dihedrals/contacts_reference.json");
+    for (key, method) in [
+        ("backbone_hbonds", "hard"),
+        ("backbone_radius", "radius"),
+        ("ca_soft", "soft"),
+    ] {
+        let r = &reference[key];
+        let groups = format!(
+            "{};{}",
+            r["select_a"].as_str().unwrap(),
+            r["select_b"].as_str().unwrap()
+        );
+        let radius = r["radius"].as_f64().unwrap().to_string();
+        let o = texmap(&[
+            "convert",
+            &md_data("dihedrals/helix.dcd"),
+            "--topology",
+            &md_data("dihedrals/helix.pdb"),
+            "--contacts-table",
+            out.to_str().unwrap(),
+            "--contacts",
+            &groups,
+            "--contacts-radius",
+            &radius,
+            "--contacts-method",
+            method,
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let native = r["native"].as_u64().unwrap();
+        assert!(
+            stderr(&o).contains(&format!("{native} native contacts")),
+            "{}",
+            stderr(&o)
+        );
+        let (header, rows) = table(&out);
+        assert_eq!(header, "frame,time,q");
+        let want = numbers(&r["q"]);
+        assert_eq!(rows.len(), want.len());
+        for (f, (row, w)) in rows.iter().zip(&want).enumerate() {
+            assert!(
+                (row[2] - w).abs() < 2e-6,
+                "{key} frame {f}: {} vs MDAnalysis {w}",
+                row[2]
+            );
+        }
+    }
+    let o = texmap(&[
+        "convert",
+        &md_data("dihedrals/helix.dcd"),
+        "--topology",
+        &md_data("dihedrals/helix.pdb"),
+        "--contacts-table",
+        out.to_str().unwrap(),
+        "--contacts",
+        "name CA",
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+}
