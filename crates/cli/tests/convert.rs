@@ -1325,6 +1325,22 @@ fn contacts_table_is_mdanalysis_native_contacts() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("q.csv");
     let reference = json("dihedrals/contacts_reference.json");
+    let (dcd, pdb) = (
+        md_data("dihedrals/helix.dcd"),
+        md_data("dihedrals/helix.pdb"),
+    );
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "convert",
+            &dcd,
+            "--topology",
+            &pdb,
+            "--contacts-table",
+            out.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        texmap(&args)
+    };
     for (key, method) in [
         ("backbone_hbonds", "hard"),
         ("backbone_radius", "radius"),
@@ -1337,13 +1353,7 @@ fn contacts_table_is_mdanalysis_native_contacts() {
             r["select_b"].as_str().unwrap()
         );
         let radius = r["radius"].as_f64().unwrap().to_string();
-        let o = texmap(&[
-            "convert",
-            &md_data("dihedrals/helix.dcd"),
-            "--topology",
-            &md_data("dihedrals/helix.pdb"),
-            "--contacts-table",
-            out.to_str().unwrap(),
+        let o = run(&[
             "--contacts",
             &groups,
             "--contacts-radius",
@@ -1370,15 +1380,6 @@ fn contacts_table_is_mdanalysis_native_contacts() {
             );
         }
     }
-    let o = texmap(&[
-        "convert",
-        &md_data("dihedrals/helix.dcd"),
-        "--topology",
-        &md_data("dihedrals/helix.pdb"),
-        "--contacts-table",
-        out.to_str().unwrap(),
-        "--contacts",
-        "name CA",
-    ]);
+    let o = run(&["--contacts", "name CA"]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
 }
