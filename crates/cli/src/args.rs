@@ -827,22 +827,28 @@ pub enum IsoSignArg {
 
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum DrawStyle {
-    /// Atoms at their radii, no bonds.
+    /// Atoms at their radii, no bonds (VMD's VDW, PyMOL's spheres).
     #[default]
+    #[value(alias = "vdw", alias = "spheres")]
     Spacefill,
-    /// Atoms at 0.3 of their radii, bonds as sticks of 0.2 Å.
+    /// Atoms at 0.3 of their radii, bonds as sticks of 0.2 Å (VMD's CPK).
+    #[value(alias = "cpk", alias = "ball-and-stick")]
     BallStick,
-    /// Bonds as sticks of 0.3 Å, atoms as 0.3 Å joints.
+    /// Bonds as sticks of 0.3 Å, atoms as 0.3 Å joints (PyMOL's sticks).
+    #[value(alias = "sticks")]
     Licorice,
     /// Protein and nucleic-acid backbones as a smooth 0.3 Å tube through the CA (P) atoms of
-    /// each chain (VMD's Tube); ligands, ions and water as licorice.
+    /// each chain (VMD's Tube and Trace); ligands, ions and water as licorice.
+    #[value(alias = "trace")]
     Tube,
     /// Protein backbones as a cartoon (VMD's NewCartoon): helices as ribbons, strands as arrows,
     /// coil as a thin tube, from the secondary structure of each frame; nucleic acids as a tube
     /// through the P atoms with a rung to each base; ligands, ions and water as licorice.
+    #[value(alias = "newcartoon")]
     Cartoon,
     /// A molecular surface around the atoms (VMD's QuickSurf: the isosurface of one Gaussian per
     /// atom, an isolated atom's at its radius), coloured by the atom nearest under it.
+    #[value(alias = "quicksurf", alias = "surf")]
     Surface,
     /// The hydrogen bonds among the atoms as dashed lines from hydrogen to acceptor (VMD's
     /// HBonds), found every frame by MDAnalysis's criterion (see --hbond-distance); needs

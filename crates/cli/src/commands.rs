@@ -949,6 +949,9 @@ fn render(a: &RenderArgs) -> Result<()> {
             if let Some(w) = crate::scene::unnamed_warning(&plan, &md, traj.name()) {
                 pb.suspend(|| eprintln!("texmap: warning: {w}"));
             }
+            for w in crate::scene::empty_rep_warnings(&a.mol, &md, f) {
+                pb.suspend(|| eprintln!("texmap: warning: {w}"));
+            }
             let hydrogens =
                 (0..md.n_atoms()).any(|i| texmap_md_io::atom_element(&md, i).symbol() == "H");
             if plan.draws_hbonds() && !hydrogens {

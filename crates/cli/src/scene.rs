@@ -602,7 +602,7 @@ pub fn mol_plan(args: &MolArgs, style: &StyleArgs, topology: Option<Topology>) -
         };
         let draw = <DrawStyle as clap::ValueEnum>::from_str(style, true).map_err(|_| {
             crate::args::UsageError(format!(
-                "--rep {r:?}: {style:?} is not a style; use spacefill, ball-stick, licorice, tube, cartoon, surface or hbonds"
+                "--rep {r:?}: {style:?} is not a style; use spacefill, ball-stick, licorice, tube, cartoon, surface, hbonds, polyhedra, arrows, trails or ellipsoids (VMD's and PyMOL's names work too: vdw, spheres, cpk, sticks, trace, newcartoon, quicksurf)"
             ))
         })?;
         reps.push(texmap_md_scene::Representation {
@@ -923,6 +923,43 @@ pub fn mol_error(e: MolError) -> anyhow::Error {
         }
     };
     crate::args::UsageError(text).into()
+}
+
+/// The once-per-run warnings for `--rep`s whose selection picks none of `frame`'s atoms (a
+/// residue named `NA+` in the file, `NA` on the command line), with the names of the
+/// frame's residues when the selection names residues.
+pub fn empty_rep_warnings(args: &MolArgs, frame: &Frame, f: usize) -> Vec<String> {
+    let mut out = Vec::new();
+    for r in &args.reps {
+        let Ok((sel, _)) = sel_value("--rep", r) else {
+            continue;
+        };
+        let Ok(selection) = Selection::parse(sel) else {
+            continue;
+        };
+        if selection
+            .evaluate(frame)
+            .is_ok_and(|pick| !pick.contains(&true))
+        {
+            let mut hint = String::new();
+            if sel.contains("resname") && !frame.res_names.is_empty() {
+                let mut names: Vec<String> =
+                    frame.res_names.iter().map(|l| l.to_string()).collect();
+                names.sort();
+                names.dedup();
+                let shown: Vec<&str> = names.iter().take(30).map(String::as_str).collect();
+                hint = format!(
+                    " (the residue names are {}{})",
+                    shown.join(" "),
+                    if names.len() > 30 { " …" } else { "" }
+                );
+            }
+            out.push(format!(
+                "--rep {r:?} selects none of frame {f}'s atoms, so it draws nothing{hint}"
+            ));
+        }
+    }
+    out
 }
 
 /// The once-per-run warning for atoms that have nothing to be told apart by.

@@ -3880,3 +3880,49 @@ fn diamond_types_colour_and_select_as_ovitos() {
         render(&["--select", &index_ranges(&defects)], "sel_ovito.png")
     );
 }
+
+/// VMD's and PyMOL's style names are understood (NewCartoon, VDW, sticks); a --rep whose
+/// selection picks no atom (the file's sodium residues are `NA+`, not `NA`) warns with the
+/// residue names there are, and the same image is drawn once the name is right.
+#[test]
+fn style_aliases_and_a_rep_that_selects_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = (dir.path().join("a.png"), dir.path().join("b.png"));
+    let o = render_adk_frame0(
+        "96x72",
+        &[
+            "--rep",
+            "protein=NewCartoon",
+            "--rep",
+            "resname NA=VDW",
+            "-o",
+            a.to_str().unwrap(),
+        ],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("\"resname NA=VDW\" selects none of frame 0's atoms")
+            && stderr(&o).contains(" NA+ "),
+        "{}",
+        stderr(&o)
+    );
+    let o = render_adk_frame0(
+        "96x72",
+        &[
+            "--rep",
+            "protein=cartoon",
+            "--rep",
+            "resname NA+=spacefill",
+            "-o",
+            b.to_str().unwrap(),
+        ],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!stderr(&o).contains("selects none"), "{}", stderr(&o));
+    assert!(std::fs::read(&a).unwrap() != std::fs::read(&b).unwrap());
+    let o = render_adk_frame0(
+        "96x72",
+        &["--rep", "protein=newcartoon", "-o", b.to_str().unwrap()],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+}
