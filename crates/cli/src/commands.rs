@@ -949,6 +949,11 @@ fn render(a: &RenderArgs) -> Result<()> {
             if let Some(w) = crate::scene::unnamed_warning(&plan, &md, traj.name()) {
                 pb.suspend(|| eprintln!("texmap: warning: {w}"));
             }
+            if a.mol.analysis.pbc != crate::args::PbcArg::Unwrap
+                && let Some(w) = crate::scene::split_chain_warning(&md, f)
+            {
+                pb.suspend(|| eprintln!("texmap: warning: {w}"));
+            }
             for w in crate::scene::empty_rep_warnings(&a.mol, &md, f) {
                 pb.suspend(|| eprintln!("texmap: warning: {w}"));
             }

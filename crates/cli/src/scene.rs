@@ -962,6 +962,41 @@ pub fn empty_rep_warnings(args: &MolArgs, frame: &Frame, f: usize) -> Vec<String
     out
 }
 
+/// The once-per-run hint for a protein chain the periodic box cuts (`--pbc none` or `wrap`):
+/// consecutive CA atoms of one chain farther apart as written than through the box's faces.
+pub fn split_chain_warning(frame: &Frame, f: usize) -> Option<String> {
+    let cell = frame.cell.as_ref()?;
+    let is_ca = |i: usize| frame.names.get(i).is_some_and(|n| *n == "CA");
+    let chain = |i: usize| frame.chains.get(i);
+    let mut cuts = 0;
+    let mut prev: Option<usize> = None;
+    for i in (0..frame.n_atoms()).filter(|&i| is_ca(i)) {
+        if let Some(p) = prev
+            && chain(p) == chain(i)
+            && frame
+                .res_ids
+                .get(i)
+                .zip(frame.res_ids.get(p))
+                .is_some_and(|(a, b)| *a == b + 1)
+        {
+            let d: [f64; 3] = std::array::from_fn(|k| {
+                frame.positions[i][k] as f64 - frame.positions[p][k] as f64
+            });
+            let m = texmap_md_io::pbc::minimum_image(cell, d);
+            let len = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+            if len(d) > len(m) + 1.0 {
+                cuts += 1;
+            }
+        }
+        prev = Some(i);
+    }
+    (cuts > 0).then(|| {
+        format!(
+            "frame {f}: a protein chain crosses a face of the periodic box {cuts} time(s), so it is drawn in pieces; --pbc unwrap makes bonded molecules whole (VMD's pbc join)"
+        )
+    })
+}
+
 /// The once-per-run warning for atoms that have nothing to be told apart by.
 pub fn unnamed_warning(plan: &MolPlan, frame: &Frame, file: &str) -> Option<String> {
     plan.atoms_unnamed(frame).then(|| {

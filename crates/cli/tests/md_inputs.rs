@@ -3883,7 +3883,8 @@ fn diamond_types_colour_and_select_as_ovitos() {
 
 /// VMD's and PyMOL's style names are understood (NewCartoon, VDW, sticks); a --rep whose
 /// selection picks no atom (the file's sodium residues are `NA+`, not `NA`) warns with the
-/// residue names there are, and the same image is drawn once the name is right.
+/// residue names there are, and the same image is drawn once the name is right; a protein
+/// chain cut by the periodic box is pointed to --pbc unwrap.
 #[test]
 fn style_aliases_and_a_rep_that_selects_nothing() {
     let dir = tempfile::tempdir().unwrap();
@@ -3920,9 +3921,23 @@ fn style_aliases_and_a_rep_that_selects_nothing() {
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(!stderr(&o).contains("selects none"), "{}", stderr(&o));
     assert!(std::fs::read(&a).unwrap() != std::fs::read(&b).unwrap());
+    // The protein crosses the box's faces in this frame: a hint, gone with --pbc unwrap.
+    assert!(
+        stderr(&o).contains("crosses a face of the periodic box 4 time(s)"),
+        "{}",
+        stderr(&o)
+    );
     let o = render_adk_frame0(
         "96x72",
-        &["--rep", "protein=newcartoon", "-o", b.to_str().unwrap()],
+        &[
+            "--rep",
+            "protein=newcartoon",
+            "--pbc",
+            "unwrap",
+            "-o",
+            b.to_str().unwrap(),
+        ],
     );
     assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!stderr(&o).contains("periodic box"), "{}", stderr(&o));
 }
