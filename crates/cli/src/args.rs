@@ -927,7 +927,8 @@ pub struct MolArgs {
     /// 'protein or within 5 of resname LIG', 'byres around 5 resname LIG' (whole residues),
     /// 'same resname as within 3 of name NA', 'helix', 'not cna fcc' (crystal defects), 'prop bfactor > 50' (VMD: 'beta > 50'),
     /// 'prop abs charge > 0.5'. within/around/byres/same...as take the rest of the expression,
-    /// as MDAnalysis reads it: parenthesise to end them sooner.
+    /// as MDAnalysis reads it: parenthesise to end them sooner. within and around reach through
+    /// the periodic box, as MDAnalysis's do.
     #[arg(long, value_name = "SEL")]
     pub select: Option<String>,
     /// Colour of the atoms SEL selects, #rrggbb or R,G,B: --color 'resname SOL=#4080ff';
@@ -1102,10 +1103,10 @@ pub struct MolArgs {
     pub hbond_table: Option<PathBuf>,
     /// Also write how long the hydrogen bonds the hbonds style draws last, as a CSV table (MDAnalysis's
     /// HydrogenBondAnalysis.lifetime): lag (frames drawn), time (ps, when the frames' times
-    /// are evenly spaced), c: of the bonds at a frame, the share present at every frame up to
-    /// the lag, averaged over every frame as the origin (a bond is its hydrogen and acceptor).
-    /// Prints the lifetime, ∫ C dτ by the trapezoid rule up to --hbond-lifetime-max (longer
-    /// when C has not decayed there). Written whole or not at all; not with --shard.
+    /// are evenly spaced), survival: of the bonds at a frame, the share present at every frame
+    /// up to the lag, averaged over every frame as the origin (a bond is its hydrogen and
+    /// acceptor). Prints the lifetime, ∫ S dτ by the trapezoid rule up to --hbond-lifetime-max
+    /// (longer when S has not decayed there). Written whole or not at all; not with --shard.
     #[arg(long, value_name = "FILE.csv")]
     pub hbond_lifetime: Option<PathBuf>,
     /// The longest lag of --hbond-lifetime, in frames drawn (MDAnalysis's tau_max).
@@ -1242,6 +1243,35 @@ pub struct AnalysisArgs {
     /// periodic image. Written whole or not at all.
     #[arg(long, value_name = "FILE.csv", requires = "contacts")]
     pub contacts_table: Option<PathBuf>,
+    /// Also write how long atoms stay in --survival-select, a selection evaluated every frame
+    /// (water in a protein's first shell: 'name OW and around 3.5 protein'), as a CSV table:
+    /// lag (frames), time (ps, when the frames' times are evenly spaced), survival: of the
+    /// atoms selected at a frame, the share selected at every frame up to the lag, averaged
+    /// over every frame as the origin (the waterdynamics MDAKit's SurvivalProbability). Prints
+    /// the residence time ∫ S dτ up to --survival-max. Written whole or not at all; not with
+    /// --shard.
+    #[arg(long, value_name = "FILE.csv", requires = "survival_select")]
+    pub survival_table: Option<PathBuf>,
+    /// The atoms whose stay --survival-table measures (a selection re-evaluated every frame).
+    #[arg(long, value_name = "SEL", requires = "survival_table")]
+    pub survival_select: Option<String>,
+    /// The longest lag of --survival-table, in frames (the MDAKit's tau_max).
+    #[arg(
+        long,
+        value_name = "FRAMES",
+        default_value_t = 20,
+        requires = "survival_table"
+    )]
+    pub survival_max: usize,
+    /// --survival-table counts an atom absent for up to N consecutive frames between two frames
+    /// that select it as staying (the MDAKit's intermittency; 0 is the continuous survival).
+    #[arg(
+        long,
+        value_name = "N",
+        default_value_t = 0,
+        requires = "survival_table"
+    )]
+    pub survival_intermittency: usize,
     /// The two groups of --contacts-table, 'SEL_A;SEL_B': 'name N;name O' (backbone),
     /// 'resname ASP GLU and name OD1 OD2 OE1 OE2;resname LYS ARG and name NZ NH1 NH2' (salt
     /// bridges), 'name CA;name CA'.

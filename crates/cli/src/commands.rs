@@ -790,11 +790,12 @@ fn render(a: &RenderArgs) -> Result<()> {
         "frame,donor,hydrogen,acceptor,donor_atom,hydrogen_atom,acceptor_atom,distance,angle",
         whole,
     )?;
-    let mut hbond_lifetime = crate::tables::HBondLifetime::create(
+    let mut hbond_lifetime = crate::tables::SurvivalTable::create(
         &a.mol.hbond_lifetime,
-        a.mol.hbond_lifetime_max,
-        a.mol.hbond_intermittency,
+        "--hbond-lifetime",
+        (a.mol.hbond_lifetime_max, a.mol.hbond_intermittency),
         whole,
+        None,
     )?;
     let mut analysis_tables = AnalysisTables::create(&a.mol.analysis, whole)?;
     let mut measure_table = per_frame_table(
@@ -876,7 +877,7 @@ fn render(a: &RenderArgs) -> Result<()> {
                 .map_err(|e| fail(e, &written))?;
         }
         if let Some(l) = &mut hbond_lifetime {
-            l.add(plan.last_hbonds(), md.time);
+            l.add_hbonds(plan.last_hbonds(), md.time);
         }
         if mine.contains(&k) {
             analysis_tables

@@ -67,7 +67,7 @@ pub struct ConvertArgs {
     /// Written whole or not at all. Without it, only the analyses' tables are written
     /// (--rdf-table, --msd-table, --msd-lags, --vacf-table, --vdos-table, --rmsd-table, --rmsf-table, --profile-table,
     /// --dihedral-table, --sasa-table, --sasa-residue-table, --gyration-table, --cluster-table,
-    /// --grain-table, --defect-table, --density-map, --contacts-table).
+    /// --grain-table, --defect-table, --density-map, --contacts-table, --survival-table).
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
     #[command(flatten)]
@@ -90,6 +90,7 @@ Examples:
   texmap convert md.xtc --topology md.gro --sasa protein --sasa-residue-table exposed.csv   # solvent-accessible area per residue and frame (MDTraj's shrake_rupley)
   texmap convert md.xtc --topology md.gro --pbc unwrap --gyration-table rg.csv --gyration-select protein  # compactness over time
   texmap convert md.xtc --topology md.gro --dihedral-table rama.csv                         # phi, psi, omega per residue and frame
+  texmap convert md.xtc --topology md.gro --survival-table sp.csv --survival-select 'name OW and around 3.5 protein'  # water residence
   texmap convert md.xtc --topology md.gro --contacts-table q.csv --contacts 'name CA;name CA' --contacts-radius 8  # native contacts Q(t)
   texmap convert md.xtc --topology md.gro --align protein --density-map water.dx --density-select 'name OW'  # where water stays (VMD volmap);
   texmap render md.xtc --topology md.gro --frames 0 --volume water.dx --isosurface 0.05 -o sites.png  # over the frame it was aligned to
@@ -153,10 +154,11 @@ pub fn convert(a: &ConvertArgs) -> Result<()> {
                 &a.analysis.cluster_table,
                 &a.analysis.density_map,
                 &a.analysis.contacts_table,
+                &a.analysis.survival_table,
             ];
             if tables.iter().all(|t| t.is_none()) {
                 return usage(
-                    "nothing to write: give -o FILE, or a table of the analyses (--rdf-table, --msd-table, --msd-lags, --vacf-table, --vdos-table, --rmsd-table, --rmsf-table, --profile-table, --dihedral-table, --sasa-table, --sasa-residue-table, --gyration-table, --cluster-table, --grain-table, --defect-table, --density-map, --contacts-table)",
+                    "nothing to write: give -o FILE, or a table of the analyses (--rdf-table, --msd-table, --msd-lags, --vacf-table, --vdos-table, --rmsd-table, --rmsf-table, --profile-table, --dihedral-table, --sasa-table, --sasa-residue-table, --gyration-table, --cluster-table, --grain-table, --defect-table, --density-map, --contacts-table, --survival-table)",
                 );
             }
             if a.select.is_some() || a.columns.is_some() {

@@ -78,6 +78,7 @@ pub(crate) struct AnalysisTables {
     )>,
     density: Option<DensityTable>,
     contacts: Option<ContactsTable>,
+    survival: Option<SurvivalTable>,
 }
 
 /// `--contacts-table`: its file, groups and method, and the native contacts (set at the
@@ -455,71 +456,112 @@ fn lag_table(
     }
 }
 
-/// `--hbond-lifetime`: every frame's hydrogen bonds (hydrogen, acceptor), correlated at the
-/// end.
-pub(crate) struct HBondLifetime {
+/// A survival table (`--hbond-lifetime`, `--survival-table`): every frame's members,
+/// correlated at the end.
+pub(crate) struct SurvivalTable {
+    flag: &'static str,
+    /// What a member is, for the messages ("hydrogen bond", "atom").
+    member: &'static str,
     file: crate::output::AtomicFile,
-    frames: Vec<Vec<[u32; 2]>>,
+    frames: Vec<Vec<u64>>,
     times: Vec<Option<f64>>,
     tau_max: usize,
     intermittency: usize,
+    /// `--survival-select`: the set, evaluated every frame.
+    select: Option<texmap_md_io::select::Selection>,
 }
 
-impl HBondLifetime {
+impl SurvivalTable {
     /// The table `path` asks for (`whole`: see [`per_frame_table`]).
     pub(crate) fn create(
         path: &Option<PathBuf>,
-        tau_max: usize,
-        intermittency: usize,
+        flag: &'static str,
+        (tau_max, intermittency): (usize, usize),
         whole: bool,
-    ) -> Result<Option<HBondLifetime>> {
+        select: Option<texmap_md_io::select::Selection>,
+    ) -> Result<Option<SurvivalTable>> {
         let why = "the average over every time origin needs every frame in one run";
         Ok(
-            whole_run_table(path, "--hbond-lifetime", why, whole)?.map(|file| HBondLifetime {
+            whole_run_table(path, flag, why, whole)?.map(|file| SurvivalTable {
+                flag,
+                member: if select.is_some() {
+                    "atom"
+                } else {
+                    "hydrogen bond"
+                },
                 file,
                 frames: Vec::new(),
                 times: Vec::new(),
                 tau_max,
                 intermittency,
+                select,
             }),
         )
     }
 
-    /// One frame's bonds.
-    pub(crate) fn add(&mut self, hbonds: &[texmap_md_io::hbonds::HBond], time: Option<f64>) {
-        self.frames
-            .push(hbonds.iter().map(|h| [h.hydrogen, h.acceptor]).collect());
+    /// One frame's hydrogen bonds.
+    pub(crate) fn add_hbonds(&mut self, hbonds: &[texmap_md_io::hbonds::HBond], time: Option<f64>) {
+        self.frames.push(
+            hbonds
+                .iter()
+                .map(|h| texmap_md_io::hbonds::bond_key(h.hydrogen, h.acceptor))
+                .collect(),
+        );
         self.times.push(time);
+    }
+
+    /// Frame `f`'s atoms of the selection.
+    fn add_selected(&mut self, f: usize, md: &MdFrame) -> Result<()> {
+        let Some(sel) = &self.select else {
+            return Ok(());
+        };
+        let pick = sel
+            .evaluate(md)
+            .map_err(|e| anyhow::anyhow!("--survival-select: frame {f}: {e}"))?;
+        self.frames.push(
+            (0..md.n_atoms())
+                .filter(|&i| pick[i])
+                .map(|i| i as u64)
+                .collect(),
+        );
+        self.times.push(md.time);
+        Ok(())
     }
 
     /// The table written, the lifetime printed.
     pub(crate) fn finish(mut self) -> Result<crate::output::AtomicFile> {
+        let flag = self.flag;
         if self.frames.len() < 2 {
             bail!(
-                "--hbond-lifetime: {} frame(s) drawn: a lifetime needs two or more",
+                "{flag}: {} frame(s): a survival curve needs two or more",
                 self.frames.len()
             );
         }
-        let c = texmap_md_io::hbonds::lifetime(&self.frames, self.tau_max, self.intermittency);
+        let c = texmap_md_io::survival::survival_probability(
+            &self.frames,
+            self.tau_max,
+            self.intermittency,
+        );
         if c.get(1).is_none_or(|v| v.is_nan()) {
             bail!(
-                "--hbond-lifetime: none of the {} frames drawn has a hydrogen bond",
+                "{flag}: no {} in any of the {} frames",
+                self.member,
                 self.frames.len()
             );
         }
         let times = even_lag_times(&self.times);
-        let (text, x, unit) = lag_table("c", &[], &times, &c, &[], |v| format!("{v:.6}"));
+        let (text, x, unit) = lag_table("survival", &[], &times, &c, &[], |v| format!("{v:.6}"));
         self.file.write(&text)?;
         let area: f64 = (1..c.len())
             .map(|k| 0.5 * (c[k] + c[k - 1]) * (x[k] - x[k - 1]))
             .sum();
         let last = c[c.len() - 1];
         crate::note!(
-            "--hbond-lifetime: lifetime ∫C dτ = {} {unit} over lags 0–{} {unit} (C there {last:.3}{})",
+            "{flag}: lifetime ∫S dτ = {} {unit} over lags 0–{} {unit} (S there {last:.3}{})",
             crate::scene::compact(area, 4),
             crate::scene::compact(x[c.len() - 1], 4),
             if last > 0.05 {
-                ": not yet decayed, so the bonds live longer; raise --hbond-lifetime-max"
+                ": not yet decayed, so the lifetime is longer; raise the longest lag"
             } else {
                 ""
             }
@@ -895,6 +937,20 @@ impl AnalysisTables {
             )?
             .map(|t| (t, texmap_md_io::rmsf::Fluctuation::new(), Vec::new())),
             contacts: ContactsTable::create(analysis, whole)?,
+            survival: SurvivalTable::create(
+                &analysis.survival_table,
+                "--survival-table",
+                (analysis.survival_max, analysis.survival_intermittency),
+                whole,
+                analysis
+                    .survival_select
+                    .as_deref()
+                    .map(|s| {
+                        texmap_md_io::select::Selection::parse(s)
+                            .map_err(|e| crate::args::UsageError(format!("--survival-select: {e}")))
+                    })
+                    .transpose()?,
+            )?,
             density: match whole_run_table(
                 &analysis.density_map,
                 "--density-map",
@@ -1128,6 +1184,9 @@ impl AnalysisTables {
         if let Some(c) = &mut self.contacts {
             c.add(f, &time, md)?;
         }
+        if let Some(t) = &mut self.survival {
+            t.add_selected(f, md)?;
+        }
         Ok(())
     }
 
@@ -1158,7 +1217,9 @@ impl AnalysisTables {
             })
             .transpose()?;
         let density = self.density.map(DensityTable::finish).transpose()?;
+        let survival = self.survival.map(SurvivalTable::finish).transpose()?;
         for t in [
+            survival,
             self.contacts.map(|c| c.file),
             density,
             self.dihedral,

@@ -1383,3 +1383,44 @@ fn contacts_table_is_mdanalysis_native_contacts() {
     let o = run(&["--contacts", "name CA"]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
 }
+
+/// `--survival-table` is the waterdynamics MDAKit's SurvivalProbability (md-io's
+/// tests/data/dynamics/gen_survival.py): the OW atoms within 2 Å of an NA atom, selected every
+/// frame through the periodic box, continuous and with gaps of 2 frames forgiven, at every lag
+/// to 10.
+#[test]
+fn survival_table_is_the_waterdynamics_survival_probability() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("sp.csv");
+    let reference = json("dynamics/survival_reference.json");
+    for inter in ["0", "2"] {
+        let o = texmap(&[
+            "convert",
+            &md_data("dynamics/walk.dcd"),
+            "--topology",
+            &md_data("dynamics/walk.gro"),
+            "--survival-table",
+            out.to_str().unwrap(),
+            "--survival-select",
+            reference["select"].as_str().unwrap(),
+            "--survival-max",
+            "10",
+            "--survival-intermittency",
+            inter,
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        assert!(stderr(&o).contains("lifetime ∫S dτ"), "{}", stderr(&o));
+        let (header, rows) = table(&out);
+        assert_eq!(header, "lag,time,survival");
+        let want = numbers(&reference[format!("intermittency_{inter}")]);
+        assert_eq!(rows.len(), want.len());
+        for (lag, (row, w)) in rows.iter().zip(&want).enumerate() {
+            assert_eq!(row[0], lag as f64);
+            assert!(
+                (row[2] - w).abs() < 2e-6,
+                "intermittency {inter}, lag {lag}: {} vs {w}",
+                row[2]
+            );
+        }
+    }
+}

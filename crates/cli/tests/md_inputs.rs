@@ -2035,7 +2035,7 @@ fn the_hydrogen_bond_table_is_mdanalysis_s_list() {
     let ours = kept(&pairs(&got[0]), &pairs(&got[1]));
     let text = std::fs::read_to_string(&lifetime).unwrap();
     let rows: Vec<&str> = text.lines().collect();
-    assert_eq!(rows[0], "lag,time,c");
+    assert_eq!(rows[0], "lag,time,survival");
     assert!(
         rows[1].starts_with("0,") && rows[1].ends_with(",1.000000"),
         "{text}"

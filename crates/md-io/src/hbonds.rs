@@ -293,12 +293,11 @@ pub fn hydrogen_bonds(
 /// How long hydrogen bonds last: the autocorrelation C(τ) of their existence, as MDAnalysis's
 /// `HydrogenBondAnalysis.lifetime` computes it (`lib.correlations`). `frames` lists each
 /// frame's bonds as (hydrogen, acceptor) pairs (the donor follows from the hydrogen; the pair
-/// is taken unordered, as MDAnalysis's `frozenset`). C(τ) is the mean, over every time origin
-/// t whose frame has a bond and with t + τ a frame, of the share of t's bonds present at every
-/// frame from t to t + τ; C(0) = 1. With `intermittency` k, a bond absent for up to k
-/// consecutive frames between two frames that have it counts as present in them (MDAnalysis's
-/// `correct_intermittency`). Returns C(0) … C(min(`tau_max`, frames − 1)); NaN at a lag no
-/// origin reaches (no bond at all). Linear in the bonds over the frames plus frames × lags.
+/// is taken unordered, as MDAnalysis's `frozenset`); the curve is
+/// [`crate::survival::survival_probability`]'s over those pairs: C(τ) is the mean, over every
+/// time origin t whose frame has a bond and with t + τ a frame, of the share of t's bonds
+/// present at every frame from t to t + τ; C(0) = 1. With `intermittency` k, a bond absent for
+/// up to k consecutive frames between two frames that have it counts as present in them.
 ///
 /// ```
 /// use texmap_md_io::hbonds::lifetime;
@@ -312,68 +311,15 @@ pub fn hydrogen_bonds(
 /// assert!((lifetime(&frames, 2, 1)[2] - 2.5 / 3.0).abs() < 1e-12);
 /// ```
 pub fn lifetime(frames: &[Vec<[u32; 2]>], tau_max: usize, intermittency: usize) -> Vec<f64> {
-    let n = frames.len();
-    if n == 0 {
-        return Vec::new();
-    }
-    let tau_max = tau_max.min(n - 1);
-    // Each bond's frames, in order.
-    let mut ids = std::collections::HashMap::new();
-    let mut present: Vec<Vec<usize>> = Vec::new();
-    for (f, bonds) in frames.iter().enumerate() {
-        for &[h, a] in bonds {
-            let key = (h.min(a), h.max(a));
-            let id = *ids.entry(key).or_insert_with(|| {
-                present.push(Vec::new());
-                present.len() - 1
-            });
-            if present[id].last() != Some(&f) {
-                present[id].push(f);
-            }
-        }
-    }
-    // Per origin: its bonds, and how many survive each lag (a histogram of the continuous
-    // run each bond has from it, then summed from the top).
-    let lags = tau_max + 1;
-    let mut count = vec![0u32; n];
-    let mut runs = vec![0u32; n * lags];
-    for frames_of in &present {
-        let mut k = 0;
-        while k < frames_of.len() {
-            // A run of consecutive frames, gaps of up to `intermittency` bridged.
-            let start = frames_of[k];
-            let mut end = start;
-            k += 1;
-            while k < frames_of.len() && frames_of[k] - end <= intermittency + 1 {
-                end = frames_of[k];
-                k += 1;
-            }
-            for t in start..=end {
-                count[t] += 1;
-                runs[t * lags + (end - t).min(tau_max)] += 1;
-            }
-        }
-    }
-    let mut sum = vec![0.0f64; lags];
-    let mut origins = vec![0usize; lags];
-    for t in 0..n {
-        if count[t] == 0 {
-            continue;
-        }
-        let mut surviving = 0u32;
-        for tau in (0..lags).rev() {
-            surviving += runs[t * lags + tau];
-            if t + tau < n {
-                sum[tau] += surviving as f64 / count[t] as f64;
-                origins[tau] += 1;
-            }
-        }
-    }
-    let mut c: Vec<f64> = sum
+    let keys: Vec<Vec<u64>> = frames
         .iter()
-        .zip(&origins)
-        .map(|(s, &o)| if o == 0 { f64::NAN } else { s / o as f64 })
+        .map(|bonds| bonds.iter().map(|&[h, a]| bond_key(h, a)).collect())
         .collect();
-    c[0] = 1.0;
-    c
+    crate::survival::survival_probability(&keys, tau_max, intermittency)
+}
+
+/// A hydrogen bond's key for [`crate::survival::survival_probability`]: its hydrogen and
+/// acceptor, unordered, packed into a u64.
+pub fn bond_key(hydrogen: u32, acceptor: u32) -> u64 {
+    (u64::from(hydrogen.min(acceptor)) << 32) | u64::from(hydrogen.max(acceptor))
 }

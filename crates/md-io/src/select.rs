@@ -56,8 +56,9 @@
 //! `same residue as` select whole residues (consecutive atoms of one residue number, name,
 //! chain and segment); `same resname as around 3 resname NA` every atom whose residue name one
 //! of the picked atoms has.
-//! `within`/`around` use plain distances (no periodic images) through a cell grid, so they cost
-//! time linear in the atoms.
+//! `within`/`around` reach through the periodic box when the frame has one (MDAnalysis's default
+//! `periodic=True`; a water by the far face is next to an ion by the near one), else use plain
+//! distances; both through a cell grid, so they cost time linear in the atoms.
 //!
 //! A selection is parsed once ([`Selection::parse`]) and evaluated per frame
 //! ([`Selection::evaluate`]). A parse error points at the column of the bad token; evaluating a
@@ -1130,7 +1131,13 @@ impl Selection {
             } => {
                 let mut reference = vec![false; n];
                 self.eval(of, frame, cache, &mut reference)?;
-                within(&frame.positions, &reference, *distance, out);
+                within(
+                    &frame.positions,
+                    &reference,
+                    *distance,
+                    frame.cell.as_ref(),
+                    out,
+                );
                 if !include_reference {
                     out.iter_mut().zip(&reference).for_each(|(v, r)| *v &= !r);
                 }
@@ -1154,18 +1161,80 @@ fn split_comparison(text: &str) -> Option<(String, CmpOp, String)> {
     (!left.is_empty() && !right.is_empty()).then(|| (left.to_string(), op, right.to_string()))
 }
 
-/// `out[i]` = some reference atom lies within `d` of atom `i` (plain distances). The reference
-/// atoms are sorted into a dense grid of cells of side ≥ `d` over their bounding box grown by `d`;
-/// an atom outside that box is rejected at once, one inside looks at 27 cells.
-fn within(pos: &[[f32; 3]], reference: &[bool], d: f64, out: &mut [bool]) {
+/// `out[i]` = some reference atom lies within `d` of atom `i`, through the periodic images
+/// when `cell` repeats along some edge (MDAnalysis's default `periodic=True`), else by plain
+/// distances. With a cell, the positions are wrapped into it and each reference atom stands
+/// with its images in the 26 neighbouring cells (along the periodic edges) that come within
+/// `d` of a wrapped position; a cutoff of half the cell's narrowest periodic width or more
+/// compares every pair through the nearest image instead.
+fn within(
+    pos: &[[f32; 3]],
+    reference: &[bool],
+    d: f64,
+    cell: Option<&crate::frame::UnitCell>,
+    out: &mut [bool],
+) {
+    let refs = (0..pos.len()).filter(|&i| reference[i]);
+    let Some(cell) = cell.filter(|c| c.periodic().contains(&true)) else {
+        let query: Vec<[f64; 3]> = pos.iter().map(|p| p.map(f64::from)).collect();
+        let points: Vec<[f64; 3]> = refs.map(|i| query[i]).collect();
+        return within_points(&query, &points, d, out);
+    };
+    let mut frame = Frame::new();
+    frame.positions = pos.to_vec();
+    frame.cell = Some(*cell);
+    if 2.0 * d >= cell.min_periodic_width() {
+        let refs: Vec<usize> = refs.collect();
+        for (i, o) in out.iter_mut().enumerate() {
+            *o = refs.iter().any(|&r| {
+                let v: [f64; 3] = std::array::from_fn(|k| (pos[r][k] - pos[i][k]) as f64);
+                let m = crate::pbc::minimum_image(cell, v);
+                m[0] * m[0] + m[1] * m[1] + m[2] * m[2] <= d * d
+            });
+        }
+        return;
+    }
+    crate::pbc::wrap(&mut frame);
+    let query: Vec<[f64; 3]> = frame.positions.iter().map(|p| p.map(f64::from)).collect();
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for q in &query {
+        for k in 0..3 {
+            lo[k] = lo[k].min(q[k] - d);
+            hi[k] = hi[k].max(q[k] + d);
+        }
+    }
+    let m = cell.matrix();
+    let periodic = cell.periodic();
+    let steps = |k: usize| if periodic[k] { -1..=1 } else { 0..=0 };
+    let mut points = Vec::new();
+    for r in refs {
+        for a in steps(0) {
+            for b in steps(1) {
+                for c in steps(2) {
+                    let p: [f64; 3] = std::array::from_fn(|k| {
+                        query[r][k] + a as f64 * m[0][k] + b as f64 * m[1][k] + c as f64 * m[2][k]
+                    });
+                    if (0..3).all(|k| p[k] >= lo[k] && p[k] <= hi[k]) {
+                        points.push(p);
+                    }
+                }
+            }
+        }
+    }
+    within_points(&query, &points, d, out);
+}
+
+/// `out[i]` = some point of `refs` lies within `d` of `query[i]` (plain distances). The
+/// reference points are sorted into a dense grid of cells of side ≥ `d` over their bounding box
+/// grown by `d`; a query outside that box is rejected at once, one inside looks at 27 cells.
+fn within_points(query: &[[f64; 3]], refs: &[[f64; 3]], d: f64, out: &mut [bool]) {
     out.fill(false);
-    let refs: Vec<usize> = (0..pos.len()).filter(|&i| reference[i]).collect();
     if refs.is_empty() {
         return;
     }
-    let p64 = |i: usize| pos[i].map(f64::from);
+    let p64 = |i: usize| refs[i];
     let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-    for &r in &refs {
+    for r in 0..refs.len() {
         let p = p64(r);
         for k in 0..3 {
             lo[k] = lo[k].min(p[k] - d);
@@ -1188,7 +1257,7 @@ fn within(pos: &[[f32; 3]], reference: &[bool], d: f64, out: &mut [bool]) {
     let flat = |c: [usize; 3]| (c[2] * dims[1] + c[1]) * dims[0] + c[0];
     // Counting sort of the reference atoms by cell.
     let mut start = vec![0u32; dims.iter().product::<usize>() + 1];
-    for &r in &refs {
+    for r in 0..refs.len() {
         start[flat(cell_of(p64(r))) + 1] += 1;
     }
     for i in 1..start.len() {
@@ -1196,14 +1265,13 @@ fn within(pos: &[[f32; 3]], reference: &[bool], d: f64, out: &mut [bool]) {
     }
     let mut fill = start.clone();
     let mut sorted = vec![0u32; refs.len()];
-    for &r in &refs {
+    for r in 0..refs.len() {
         let c = flat(cell_of(p64(r)));
         sorted[fill[c] as usize] = r as u32;
         fill[c] += 1;
     }
     let d2 = d * d;
-    for (v, p) in out.iter_mut().zip(pos) {
-        let p = p.map(f64::from);
+    for (v, &p) in out.iter_mut().zip(query) {
         if (0..3).any(|k| p[k] < lo[k] || p[k] > hi[k]) {
             continue;
         }
@@ -1350,13 +1418,41 @@ mod tests {
         let reference: Vec<bool> = (0..2000).map(|i| i % 37 == 0).collect();
         for d in [0.0, 0.7, 2.5, 6.0] {
             let mut got = vec![false; 2000];
-            within(&f.positions, &reference, d, &mut got);
+            within(&f.positions, &reference, d, None, &mut got);
             for (i, (&g, p)) in got.iter().zip(&f.positions).enumerate() {
                 let want = f.positions.iter().zip(&reference).any(|(q, &is_ref)| {
                     let s: f64 = (0..3).map(|k| (p[k] as f64 - q[k] as f64).powi(2)).sum();
                     is_ref && s <= d * d
                 });
                 assert_eq!(g, want, "atom {i} at d = {d}");
+            }
+        }
+        // Periodic: a triclinic cell with its origin off zero, some positions outside it, one
+        // edge open; against every pair through the nearest image (and a cutoff past half the
+        // cell's width, which takes the all-pairs path).
+        for p in f.positions.iter_mut().step_by(5) {
+            p[0] += 23.0;
+            p[2] -= 9.0;
+        }
+        for open in [false, true] {
+            let cell = crate::frame::UnitCell::from_lengths_angles(
+                [20.0, 21.0, 22.0],
+                [80.0, 95.0, 105.0],
+            )
+            .unwrap()
+            .with_origin([1.0, -2.0, 0.5])
+            .with_periodic([true, true, !open]);
+            for d in [0.7, 2.5, 6.0, 11.0] {
+                let mut got = vec![false; 2000];
+                within(&f.positions, &reference, d, Some(&cell), &mut got);
+                for (i, (&g, p)) in got.iter().zip(&f.positions).enumerate() {
+                    let want = f.positions.iter().zip(&reference).any(|(q, &is_ref)| {
+                        let v: [f64; 3] = std::array::from_fn(|k| q[k] as f64 - p[k] as f64);
+                        let m = crate::pbc::minimum_image(&cell, v);
+                        is_ref && m[0] * m[0] + m[1] * m[1] + m[2] * m[2] <= d * d
+                    });
+                    assert_eq!(g, want, "atom {i} at d = {d}, open c: {open}");
+                }
             }
         }
     }
