@@ -1,7 +1,8 @@
 //! Selection speed on a million atoms: `cargo bench -p texmap-md-io --bench select`.
 //!
 //! A synthetic system of 1,000,000 atoms: 25,000 alanines (10 atoms each, 250k atoms), 249,900
-//! waters (OW HW1 HW2), and 100 ligand atoms (resname LIG), at seeded positions in a 200 Å cube.
+//! waters (OW HW1 HW2), and 100 ligand atoms (resname LIG), at seeded positions in a 200 Å cube;
+//! then `within`/`around` again with that cube as the periodic box.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use texmap_md_io::{Element, Frame, Label, Selection};
@@ -57,9 +58,19 @@ fn bench(c: &mut Criterion) {
         "protein and not name H*",
         "element O and not water",
         "within 5 of resname LIG",
+        "water and around 3.5 protein",
     ] {
         let sel = Selection::parse(text).unwrap();
         g.bench_function(text, |b| b.iter(|| sel.evaluate(&frame).unwrap()));
+    }
+    // The same system in a periodic 200 Å box: within/around through its faces.
+    let mut boxed = frame.clone();
+    boxed.cell = Some(texmap_md_io::UnitCell::orthorhombic(200.0, 200.0, 200.0).unwrap());
+    for text in ["within 5 of resname LIG", "water and around 3.5 protein"] {
+        let sel = Selection::parse(text).unwrap();
+        g.bench_function(format!("{text} (periodic box)"), |b| {
+            b.iter(|| sel.evaluate(&boxed).unwrap())
+        });
     }
     g.finish();
 }

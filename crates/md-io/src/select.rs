@@ -1176,9 +1176,8 @@ fn within(
 ) {
     let refs = (0..pos.len()).filter(|&i| reference[i]);
     let Some(cell) = cell.filter(|c| c.periodic().contains(&true)) else {
-        let query: Vec<[f64; 3]> = pos.iter().map(|p| p.map(f64::from)).collect();
-        let points: Vec<[f64; 3]> = refs.map(|i| query[i]).collect();
-        return within_points(&query, &points, d, out);
+        let points: Vec<[f64; 3]> = refs.map(|i| pos[i].map(f64::from)).collect();
+        return within_points(pos, &points, d, out);
     };
     let mut frame = Frame::new();
     frame.positions = pos.to_vec();
@@ -1195,12 +1194,12 @@ fn within(
         return;
     }
     crate::pbc::wrap(&mut frame);
-    let query: Vec<[f64; 3]> = frame.positions.iter().map(|p| p.map(f64::from)).collect();
+    let query = frame.positions;
     let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
     for q in &query {
         for k in 0..3 {
-            lo[k] = lo[k].min(q[k] - d);
-            hi[k] = hi[k].max(q[k] + d);
+            lo[k] = lo[k].min(q[k] as f64 - d);
+            hi[k] = hi[k].max(q[k] as f64 + d);
         }
     }
     let m = cell.matrix();
@@ -1212,7 +1211,10 @@ fn within(
             for b in steps(1) {
                 for c in steps(2) {
                     let p: [f64; 3] = std::array::from_fn(|k| {
-                        query[r][k] + a as f64 * m[0][k] + b as f64 * m[1][k] + c as f64 * m[2][k]
+                        query[r][k] as f64
+                            + a as f64 * m[0][k]
+                            + b as f64 * m[1][k]
+                            + c as f64 * m[2][k]
                     });
                     if (0..3).all(|k| p[k] >= lo[k] && p[k] <= hi[k]) {
                         points.push(p);
@@ -1227,7 +1229,7 @@ fn within(
 /// `out[i]` = some point of `refs` lies within `d` of `query[i]` (plain distances). The
 /// reference points are sorted into a dense grid of cells of side ≥ `d` over their bounding box
 /// grown by `d`; a query outside that box is rejected at once, one inside looks at 27 cells.
-fn within_points(query: &[[f64; 3]], refs: &[[f64; 3]], d: f64, out: &mut [bool]) {
+fn within_points(query: &[[f32; 3]], refs: &[[f64; 3]], d: f64, out: &mut [bool]) {
     out.fill(false);
     if refs.is_empty() {
         return;
@@ -1271,7 +1273,24 @@ fn within_points(query: &[[f64; 3]], refs: &[[f64; 3]], d: f64, out: &mut [bool]
         fill[c] += 1;
     }
     let d2 = d * d;
-    for (v, &p) in out.iter_mut().zip(query) {
+    // First the box test, in f32 on bounds rounded outwards (a query it keeps still gets the
+    // exact test), a pass without branches: most queries of a small reference stop here.
+    let lo32 = lo.map(|v| (v as f32).next_down());
+    let hi32 = hi.map(|v| (v as f32).next_up());
+    for (v, p) in out.iter_mut().zip(query) {
+        *v = (p[0] >= lo32[0])
+            & (p[0] <= hi32[0])
+            & (p[1] >= lo32[1])
+            & (p[1] <= hi32[1])
+            & (p[2] >= lo32[2])
+            & (p[2] <= hi32[2]);
+    }
+    for (v, p) in out.iter_mut().zip(query) {
+        if !*v {
+            continue;
+        }
+        *v = false;
+        let p = p.map(f64::from);
         if (0..3).any(|k| p[k] < lo[k] || p[k] > hi[k]) {
             continue;
         }
