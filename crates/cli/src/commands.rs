@@ -1200,7 +1200,9 @@ fn render(a: &RenderArgs) -> Result<()> {
         }
         if let Some(bar) = surface_coloring.as_ref().and_then(|c| c.bar()) {
             let iso_bar = isosurfaces.as_ref().is_some_and(|i| i.bar.is_some());
-            bar.draw_color_bar(a.style.no_color_bar || atom_bar || iso_bar, &mut out);
+            if !(a.style.no_color_bar || atom_bar || iso_bar) {
+                crate::scene::draw_volume_bar(&bar, &mut out);
+            }
         }
         if !atom_labels.is_empty() {
             let at = format!("frame {f} of {}", traj.name());

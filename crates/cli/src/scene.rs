@@ -1301,34 +1301,45 @@ impl Isosurfaces {
         for k in &mut mesh.kinds {
             *k += base as u16;
         }
-        let lin = |c: &[u8; 3]| {
-            let v = texmap_core::color::srgb8_to_linear_rgb([c[0], c[1], c[2], 255]);
-            texmap_core::shade::Material::plastic(v)
-        };
-        (mesh, self.colors.iter().map(lin).collect())
+        (mesh, band_materials(&self.colors))
     }
 
     /// Draws the colour bar of a mapped surface onto `image` (unless `off`).
     pub fn draw_color_bar(&self, off: bool, image: &mut texmap_core::frame::Frame) {
-        let Some((map, min, max, title)) = &self.bar else {
-            return;
-        };
-        if off {
-            return;
+        if let Some(bar) = &self.bar
+            && !off
+        {
+            draw_volume_bar(bar, image);
         }
-        let (w, h) = (image.width() as usize, image.height() as usize);
-        texmap_md_scene::draw_color_bar(
-            image.color.as_flattened_mut(),
-            w,
-            h,
-            &texmap_md_scene::ColorBar {
-                map: *map,
-                min: *min,
-                max: *max,
-                title,
-            },
-        );
     }
+}
+
+/// The plastic materials of sRGB colours (a mapped surface's bands).
+fn band_materials(colors: &[[u8; 3]]) -> Vec<texmap_core::shade::Material> {
+    colors
+        .iter()
+        .map(|c| {
+            let v = texmap_core::color::srgb8_to_linear_rgb([c[0], c[1], c[2], 255]);
+            texmap_core::shade::Material::plastic(v)
+        })
+        .collect()
+}
+
+/// Draws a mapped surface's colour bar onto `image`.
+pub fn draw_volume_bar(bar: &IsoBar, image: &mut texmap_core::frame::Frame) {
+    let (map, min, max, title) = bar;
+    let (w, h) = (image.width() as usize, image.height() as usize);
+    texmap_md_scene::draw_color_bar(
+        image.color.as_flattened_mut(),
+        w,
+        h,
+        &texmap_md_scene::ColorBar {
+            map: *map,
+            min: *min,
+            max: *max,
+            title,
+        },
+    );
 }
 
 /// `--surface-color-by`: the molecular surface coloured by a volume's values at its vertices.
@@ -1407,22 +1418,14 @@ impl SurfaceColoring {
         for k in &mut mesh.kinds {
             *k += base;
         }
-        materials.extend(colors.iter().map(|c| {
-            let v = texmap_core::color::srgb8_to_linear_rgb([c[0], c[1], c[2], 255]);
-            texmap_core::shade::Material::plastic(v)
-        }));
+        materials.extend(band_materials(&colors));
         Ok(mesh)
     }
 
     /// The colour bar (once a frame was coloured), titled by the file's name.
-    pub fn bar(&self) -> Option<Isosurfaces> {
+    pub fn bar(&self) -> Option<IsoBar> {
         let (lo, hi) = self.range?;
-        Some(Isosurfaces {
-            mesh: Default::default(),
-            colors: Vec::new(),
-            opacity: 1.0,
-            bar: Some((self.map, lo, hi, crate::args::strip_gz_stem(&self.path))),
-        })
+        Some((self.map, lo, hi, crate::args::strip_gz_stem(&self.path)))
     }
 }
 

@@ -54,10 +54,16 @@ pub fn minimum_image(cell: &UnitCell, d: [f64; 3]) -> [f64; 3] {
 
 /// Moves every atom of `frame` into its cell along the periodic edges (no-op without a cell).
 pub fn wrap(frame: &mut Frame) {
-    let Some(cell) = frame.cell else { return };
+    if let Some(cell) = frame.cell {
+        wrap_positions(&cell, &mut frame.positions);
+    }
+}
+
+/// Moves every position into `cell` along its periodic edges.
+pub fn wrap_positions(cell: &UnitCell, positions: &mut [[f32; 3]]) {
     let m = cell.matrix();
     let o = cell.origin();
-    for p in &mut frame.positions {
+    for p in positions {
         let d = [p[0] as f64 - o[0], p[1] as f64 - o[1], p[2] as f64 - o[2]];
         let f = to_frac(&m, d);
         let periodic = cell.periodic();

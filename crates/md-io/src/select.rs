@@ -1179,9 +1179,6 @@ fn within(
         let points: Vec<[f64; 3]> = refs.map(|i| pos[i].map(f64::from)).collect();
         return within_points(pos, &points, d, out);
     };
-    let mut frame = Frame::new();
-    frame.positions = pos.to_vec();
-    frame.cell = Some(*cell);
     if 2.0 * d >= cell.min_periodic_width() {
         let refs: Vec<usize> = refs.collect();
         for (i, o) in out.iter_mut().enumerate() {
@@ -1193,8 +1190,8 @@ fn within(
         }
         return;
     }
-    crate::pbc::wrap(&mut frame);
-    let query = frame.positions;
+    let mut query = pos.to_vec();
+    crate::pbc::wrap_positions(cell, &mut query);
     let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
     for q in &query {
         for k in 0..3 {
