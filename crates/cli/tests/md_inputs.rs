@@ -1988,15 +1988,22 @@ fn the_hydrogen_bond_table_is_mdanalysis_s_list() {
     )
     .unwrap();
     let v: serde_json::Value = serde_json::from_str(&gz).unwrap();
-    for (k, frame) in v["frames"].as_array().unwrap().iter().enumerate() {
-        let flat: Vec<u32> = frame["dha"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|x| x.as_u64().unwrap() as u32)
-            .collect();
-        let want: std::collections::BTreeSet<_> =
-            flat.chunks(3).map(|c| (c[0], c[1], c[2])).collect();
+    // MDAnalysis's (donor, hydrogen, acceptor) triples, per frame.
+    let mda_triples: Vec<std::collections::BTreeSet<(u32, u32, u32)>> = v["frames"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|frame| {
+            let flat: Vec<u32> = frame["dha"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|x| x.as_u64().unwrap() as u32)
+                .collect();
+            flat.chunks(3).map(|c| (c[0], c[1], c[2])).collect()
+        })
+        .collect();
+    for (k, want) in mda_triples.iter().enumerate() {
         // A triple one side lists and the other does not must be a tie at a cutoff: a
         // donor-acceptor distance of 3.00 Å in the file (the XTC's 0.01 Å grid makes them),
         // which the f32 rounding of the positions decides (md-io's tests/hbonds.rs).
@@ -2004,7 +2011,7 @@ fn the_hydrogen_bond_table_is_mdanalysis_s_list() {
         let mut md = texmap_md_io::Frame::new();
         traj.read_frame(k, &mut md).unwrap();
         let cell = md.cell.unwrap();
-        let differ: Vec<_> = got[k].symmetric_difference(&want).collect();
+        let differ: Vec<_> = got[k].symmetric_difference(want).collect();
         assert!(differ.len() <= 3, "frame {k}: {} differ", differ.len());
         for &(d, _, a) in differ {
             let (p, q) = (md.positions[d as usize], md.positions[a as usize]);
@@ -2042,20 +2049,7 @@ fn the_hydrogen_bond_table_is_mdanalysis_s_list() {
     );
     let c1: f64 = rows[2].rsplit(',').next().unwrap().parse().unwrap();
     assert!((c1 - ours).abs() < 1e-6, "C(1) {c1} vs the table's {ours}");
-    let theirs: Vec<Pairs> = v["frames"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|f| {
-            let flat: Vec<u32> = f["dha"]
-                .as_array()
-                .unwrap()
-                .iter()
-                .map(|x| x.as_u64().unwrap() as u32)
-                .collect();
-            flat.chunks(3).map(|c| (c[1], c[2])).collect()
-        })
-        .collect();
+    let theirs: Vec<Pairs> = mda_triples.iter().map(pairs).collect();
     let mda = kept(&theirs[0], &theirs[1]);
     assert!(
         (c1 - mda).abs() < 4.0 / theirs[0].len() as f64,
