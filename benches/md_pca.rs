@@ -1,0 +1,83 @@
+//! Principal component analysis (texmap-md-io `pca::Pca`, what `texmap convert --pca-table`
+//! computes) of adenylate kinase's CA atoms (214: 642 coordinates, the covariance matrix) and
+//! backbone atoms (855: 2,565 coordinates, the 1,000 x 1,000 matrix of the frames' products)
+//! over 1,000 frames, each frame the crystal positions moved along five seeded collective modes
+//! plus 0.3 Å of noise: the frames kept, then the variances, five components and every frame's
+//! projections. 2 threads (the covariance products are shared, the eigensolver is one thread).
+//!
+//! The peer, `benches/peers/mdanalysis_pca.py`, times MDAnalysis's `analysis.pca.PCA` plus
+//! `transform` on frames of the same sizes held in memory: run it in the same minutes.
+//!
+//! `cargo bench --bench md_pca -- --warm-up-time 1 --measurement-time 10`
+//! (test mode, `cargo test --bench md_pca`, uses 100 frames.)
+
+use criterion::{Criterion, criterion_group};
+use texmap::md_io::pca::Pca;
+use texmap::md_io::select::Selection;
+
+mod common;
+use common::{Lcg, adk_frame};
+
+fn bench(c: &mut Criterion) {
+    let test_mode = !std::env::args().any(|a| a == "--bench");
+    let frames = if test_mode { 100 } else { 1000 };
+    let adk = adk_frame();
+    let mut g = c.benchmark_group("md_pca");
+    g.sample_size(10);
+    for sel in ["name CA", "backbone"] {
+        let pick = Selection::parse(sel).unwrap().indices(&adk).unwrap();
+        let base: Vec<[f64; 3]> = pick
+            .iter()
+            .map(|&i| adk.positions[i].map(f64::from))
+            .collect();
+        let mut rng = Lcg(61207);
+        let modes: Vec<Vec<[f64; 3]>> = (0..5)
+            .map(|_| {
+                base.iter()
+                    .map(|_| std::array::from_fn(|_| rng.normal()))
+                    .collect()
+            })
+            .collect();
+        let walk: Vec<Vec<[f32; 3]>> = (0..frames)
+            .map(|t| {
+                let phase = std::f64::consts::TAU * t as f64 / frames as f64;
+                let amp: Vec<f64> = (0..5)
+                    .map(|m| (phase * (m + 1) as f64).sin() / (m + 1) as f64)
+                    .collect();
+                base.iter()
+                    .enumerate()
+                    .map(|(i, b)| {
+                        std::array::from_fn(|a| {
+                            let moved: f64 = (0..5).map(|m| amp[m] * modes[m][i][a]).sum();
+                            (b[a] + moved + 0.3 * rng.normal()) as f32
+                        })
+                    })
+                    .collect()
+            })
+            .collect();
+        let run = || {
+            let mut pca = Pca::new(usize::MAX);
+            for f in &walk {
+                pca.add(f).unwrap();
+            }
+            pca.solve(5).unwrap()
+        };
+        let name = format!(
+            "{}_{}_atoms_{frames}_frames",
+            sel.replace(' ', "_"),
+            base.len()
+        );
+        g.bench_function(name, |b| b.iter(run));
+        // The five modes carry most of the motion: the components find them.
+        let c = run();
+        assert!(c.cumulated(4) > 0.5, "{sel}: {}", c.cumulated(4));
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+
+fn main() {
+    benches();
+    Criterion::default().configure_from_args().final_summary();
+}
