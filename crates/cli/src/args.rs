@@ -1171,6 +1171,8 @@ pub struct MolArgs {
 /// files and formulas, alignment, and the per-frame tables of the analyses.
 #[derive(Args, Clone, Debug, Default)]
 #[command(next_help_heading = "Analysis")]
+#[command(group(clap::ArgGroup::new("pca_out").multiple(true)
+    .args(["pca_table", "pca_projection", "pca_vectors", "pca_extremes"])))]
 pub struct AnalysisArgs {
     /// Give every atom the property `displacement`: its distance (Å) from where it was in the
     /// first frame drawn (or --displacement-reference), to the nearest periodic image (OVITO's
@@ -1272,6 +1274,56 @@ pub struct AnalysisArgs {
         requires = "survival_table"
     )]
     pub survival_intermittency: usize,
+    /// Also write the principal components of --pca-select's motion as a CSV table
+    /// (MDAnalysis's analysis.pca.PCA, gmx covar): component, variance (Å², an eigenvalue of
+    /// the positions' covariance over the frames), fraction of the total, cumulated fraction,
+    /// and for the first --pca-components the cosine content of the frames' projection (Hess:
+    /// near 1 the run only diffused along it, so it is not yet sampled). Give --align with the
+    /// same atoms, or the tumbling is the first component; --pbc unwrap keeps them whole.
+    /// Written whole or not at all; not with --shard.
+    #[arg(long, value_name = "FILE.csv")]
+    pub pca_table: Option<PathBuf>,
+    /// Also write every frame's projection onto the first --pca-components principal
+    /// components (Å; MDAnalysis's PCA.transform, gmx anaeig -proj): frame, time, pc1, pc2, …
+    /// Plot pc1 against pc2 for the conformational landscape.
+    #[arg(long, value_name = "FILE.csv")]
+    pub pca_projection: Option<PathBuf>,
+    /// Also write the first --pca-components principal components per atom, one row per
+    /// atom of the frame (empty outside --pca-select): atom, id, name, resname, resid, chain,
+    /// the mean position (mean_x, mean_y, mean_z, Å) and pc1x, pc1y, pc1z, pc2x, … (unit
+    /// vectors over all the atoms). For a porcupine plot read a component back: render
+    /// --property pc1x=FILE.csv --property pc1y=FILE.csv --property pc1z=FILE.csv
+    /// --rep 'name CA=arrows' --arrows pc1.
+    #[arg(long, value_name = "FILE.csv")]
+    pub pca_vectors: Option<PathBuf>,
+    /// Also write --pca-select's atoms moving along principal component --pca-mode, from its
+    /// smallest projection in the run to its largest, as a trajectory of --pca-extreme-frames
+    /// frames (gmx anaeig -extr; .pdb, .xtc, .dcd, .gro, .xyz or .lammpstrj by the name):
+    /// `texmap render` makes it a movie of the motion.
+    #[arg(long, value_name = "FILE")]
+    pub pca_extremes: Option<PathBuf>,
+    /// The atoms the principal component analysis takes (evaluated at the first frame;
+    /// 'name CA' by default, 'backbone', 'protein and not name H*').
+    #[arg(
+        long,
+        value_name = "SEL",
+        default_value = "name CA",
+        requires = "pca_out"
+    )]
+    pub pca_select: String,
+    /// How many principal components --pca-projection, --pca-vectors and the cosine content
+    /// of --pca-table take.
+    #[arg(long, value_name = "K", default_value_t = 10, requires = "pca_out",
+          value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub pca_components: u32,
+    /// The principal component --pca-extremes moves along (1 is the largest).
+    #[arg(long, value_name = "K", default_value_t = 1, requires = "pca_extremes",
+          value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub pca_mode: u32,
+    /// Frames of --pca-extremes (2: the two extremes only).
+    #[arg(long, value_name = "N", default_value_t = 20, requires = "pca_extremes",
+          value_parser = clap::value_parser!(u32).range(2..=100_000))]
+    pub pca_extreme_frames: u32,
     /// The two groups of --contacts-table, 'SEL_A;SEL_B': 'name N;name O' (backbone),
     /// 'resname ASP GLU and name OD1 OD2 OE1 OE2;resname LYS ARG and name NZ NH1 NH2' (salt
     /// bridges), 'name CA;name CA'.

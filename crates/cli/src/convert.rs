@@ -67,7 +67,8 @@ pub struct ConvertArgs {
     /// Written whole or not at all. Without it, only the analyses' tables are written
     /// (--rdf-table, --msd-table, --msd-lags, --vacf-table, --vdos-table, --rmsd-table, --rmsf-table, --profile-table,
     /// --dihedral-table, --sasa-table, --sasa-residue-table, --gyration-table, --cluster-table,
-    /// --grain-table, --defect-table, --density-map, --contacts-table, --survival-table).
+    /// --grain-table, --defect-table, --density-map, --contacts-table, --survival-table,
+    /// --pca-table, --pca-projection, --pca-vectors, --pca-extremes).
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
     #[command(flatten)]
@@ -91,6 +92,8 @@ Examples:
   texmap convert md.xtc --topology md.gro --pbc unwrap --gyration-table rg.csv --gyration-select protein  # compactness over time
   texmap convert md.xtc --topology md.gro --dihedral-table rama.csv                         # phi, psi, omega per residue and frame
   texmap convert md.xtc --topology md.gro --survival-table sp.csv --survival-select 'name OW and around 3.5 protein'  # water residence
+  texmap convert md.xtc --topology md.gro --pbc unwrap --align 'name CA' --pca-table pca.csv --pca-projection proj.csv  # principal components (gmx covar)
+  texmap convert md.xtc --topology md.gro --pbc unwrap --align 'name CA' --pca-extremes pc1.pdb && texmap render pc1.pdb --style tube -o pc1.mp4  # PC1's motion as a movie
   texmap convert md.xtc --topology md.gro --contacts-table q.csv --contacts 'name CA;name CA' --contacts-radius 8  # native contacts Q(t)
   texmap convert md.xtc --topology md.gro --align protein --density-map water.dx --density-select 'name OW'  # where water stays (VMD volmap);
   texmap render md.xtc --topology md.gro --frames 0 --volume water.dx --isosurface 0.05 -o sites.png  # over the frame it was aligned to
@@ -99,8 +102,8 @@ The selection and the analyses are those of texmap render; an analysis's propert
 selection keyword; coordination, grain, centrosymmetry, shear_strain, ... are properties) is
 written as a column of the output.";
 
-/// The output's format, from its extension; only the formats with a writer.
-fn output_format(output: &std::path::Path) -> Result<Format> {
+/// The format of `flag`'s `output`, from its extension; only the formats with a writer.
+pub(crate) fn output_format(flag: &str, output: &std::path::Path) -> Result<Format> {
     let format = Format::from_path(output);
     match format {
         Some(
@@ -112,7 +115,7 @@ fn output_format(output: &std::path::Path) -> Result<Format> {
             | Format::Xtc),
         ) => Ok(f),
         _ => usage(format!(
-            "-o {}: expected a .xyz/.extxyz, .lammpstrj/.dump, .gro, .pdb, .dcd or .xtc file name",
+            "{flag} {}: expected a .xyz/.extxyz, .lammpstrj/.dump, .gro, .pdb, .dcd or .xtc file name",
             output.display()
         )),
     }
@@ -134,7 +137,7 @@ fn plan_args(a: &ConvertArgs) -> Result<(MolArgs, StyleArgs)> {
 
 pub fn convert(a: &ConvertArgs) -> Result<()> {
     let format = match &a.output {
-        Some(out) => Some(output_format(out)?),
+        Some(out) => Some(output_format("-o", out)?),
         None => {
             let tables = [
                 &a.analysis.defect_table,
@@ -155,10 +158,14 @@ pub fn convert(a: &ConvertArgs) -> Result<()> {
                 &a.analysis.density_map,
                 &a.analysis.contacts_table,
                 &a.analysis.survival_table,
+                &a.analysis.pca_table,
+                &a.analysis.pca_projection,
+                &a.analysis.pca_vectors,
+                &a.analysis.pca_extremes,
             ];
             if tables.iter().all(|t| t.is_none()) {
                 return usage(
-                    "nothing to write: give -o FILE, or a table of the analyses (--rdf-table, --msd-table, --msd-lags, --vacf-table, --vdos-table, --rmsd-table, --rmsf-table, --profile-table, --dihedral-table, --sasa-table, --sasa-residue-table, --gyration-table, --cluster-table, --grain-table, --defect-table, --density-map, --contacts-table, --survival-table)",
+                    "nothing to write: give -o FILE, or a table of the analyses (--rdf-table, --msd-table, --msd-lags, --vacf-table, --vdos-table, --rmsd-table, --rmsf-table, --profile-table, --dihedral-table, --sasa-table, --sasa-residue-table, --gyration-table, --cluster-table, --grain-table, --defect-table, --density-map, --contacts-table, --survival-table, --pca-table, --pca-projection, --pca-vectors, --pca-extremes)",
                 );
             }
             if a.select.is_some() || a.columns.is_some() {

@@ -79,6 +79,7 @@ pub(crate) struct AnalysisTables {
     density: Option<DensityTable>,
     contacts: Option<ContactsTable>,
     survival: Option<SurvivalTable>,
+    pca: Option<PcaTables>,
 }
 
 /// `--contacts-table`: its file, groups and method, and the native contacts (set at the
@@ -570,6 +571,233 @@ impl SurvivalTable {
     }
 }
 
+/// `--pca-table`, `--pca-projection`, `--pca-vectors`, `--pca-extremes`: the selected atoms'
+/// positions every frame, analysed at the end.
+struct PcaTables {
+    table: Option<crate::output::AtomicFile>,
+    projection: Option<crate::output::AtomicFile>,
+    vectors: Option<crate::output::AtomicFile>,
+    extremes: Option<(PathBuf, texmap_md_io::Format)>,
+    select: texmap_md_io::select::Selection,
+    components: usize,
+    /// `--pca-mode` (0-based) and `--pca-extreme-frames`.
+    mode: usize,
+    extreme_frames: usize,
+    /// The first frame: the selected atoms, its atom count, each atom's first columns, the
+    /// selected atoms alone (the extremes' template).
+    atoms: Vec<usize>,
+    n_atoms: usize,
+    rows: Vec<String>,
+    template: MdFrame,
+    pca: texmap_md_io::pca::Pca,
+    frames: Vec<usize>,
+    times: Vec<Option<f64>>,
+}
+
+impl PcaTables {
+    fn create(analysis: &AnalysisArgs, whole: bool) -> Result<Option<PcaTables>> {
+        let why = "the covariance needs every frame in one run";
+        let table = whole_run_table(&analysis.pca_table, "--pca-table", why, whole)?;
+        let projection = whole_run_table(&analysis.pca_projection, "--pca-projection", why, whole)?;
+        let vectors = whole_run_table(&analysis.pca_vectors, "--pca-vectors", why, whole)?;
+        let extremes = match &analysis.pca_extremes {
+            Some(_) if !whole => {
+                return usage(format!(
+                    "--pca-extremes with --shard (or a Slurm array): {why}; write it in a run of its own"
+                ));
+            }
+            Some(p) => Some((
+                p.clone(),
+                crate::convert::output_format("--pca-extremes", p)?,
+            )),
+            None => None,
+        };
+        if table.is_none() && projection.is_none() && vectors.is_none() && extremes.is_none() {
+            return Ok(None);
+        }
+        let components = analysis.pca_components as usize;
+        let mode = analysis.pca_mode as usize - 1;
+        if extremes.is_some() && mode >= components {
+            return usage(format!(
+                "--pca-mode {}: past the --pca-components {components} computed (raise it)",
+                mode + 1
+            ));
+        }
+        Ok(Some(PcaTables {
+            table,
+            projection,
+            vectors,
+            extremes,
+            select: texmap_md_io::select::Selection::parse(&analysis.pca_select)
+                .map_err(|e| crate::args::UsageError(format!("--pca-select: {e}")))?,
+            components,
+            mode,
+            extreme_frames: analysis.pca_extreme_frames as usize,
+            atoms: Vec::new(),
+            n_atoms: 0,
+            rows: Vec::new(),
+            template: MdFrame::new(),
+            pca: texmap_md_io::pca::Pca::new(analysis.msd_memory.saturating_mul(1 << 20)),
+            frames: Vec::new(),
+            times: Vec::new(),
+        }))
+    }
+
+    /// Frame `f`'s positions of the atoms selected at the first.
+    fn add(&mut self, f: usize, md: &MdFrame) -> Result<()> {
+        if self.frames.is_empty() {
+            let pick = self
+                .select
+                .evaluate(md)
+                .map_err(|e| anyhow::anyhow!("--pca-select: frame {f}: {e}"))?;
+            self.atoms = (0..md.n_atoms()).filter(|&i| pick[i]).collect();
+            if self.atoms.is_empty() {
+                bail!("--pca-select: frame {f} has none of the atoms it picks");
+            }
+            self.n_atoms = md.n_atoms();
+            self.rows = (0..md.n_atoms()).map(|i| atom_columns(md, i)).collect();
+            self.template = md.clone();
+            self.template.retain_atoms(&pick);
+        } else if md.n_atoms() != self.n_atoms {
+            bail!(
+                "--pca-select: frame {f} has {} atoms and the first {}: every frame must hold the same atoms",
+                md.n_atoms(),
+                self.n_atoms
+            );
+        }
+        let positions: Vec<[f32; 3]> = self.atoms.iter().map(|&i| md.positions[i]).collect();
+        self.pca
+            .add(&positions)
+            .map_err(|e| anyhow::anyhow!("--pca-select: frame {f}: {e}"))?;
+        self.frames.push(f);
+        self.times.push(md.time);
+        Ok(())
+    }
+
+    /// The tables written and the extremes' trajectory, the leading variances printed.
+    fn finish(mut self) -> Result<Vec<crate::output::AtomicFile>> {
+        let c = self
+            .pca
+            .solve(self.components)
+            .map_err(|e| anyhow::anyhow!("principal components of --pca-select: {e}"))?;
+        let k = c.vectors.len();
+        let cosine: Vec<f64> = (0..k)
+            .map(|j| {
+                let p: Vec<f64> = c.projections.iter().map(|p| p[j]).collect();
+                texmap_md_io::pca::cosine_content(&p, j)
+            })
+            .collect();
+        if let Some(t) = &mut self.table {
+            let mut text = String::from("component,variance,fraction,cumulated,cosine_content\n");
+            for (j, v) in c.variance.iter().enumerate() {
+                let fraction = if c.total_variance > 0.0 {
+                    v / c.total_variance
+                } else {
+                    0.0
+                };
+                text.push_str(&format!(
+                    "{},{v:.6},{fraction:.6},{:.6},{}\n",
+                    j + 1,
+                    c.cumulated(j),
+                    cosine.get(j).map(|x| format!("{x:.6}")).unwrap_or_default()
+                ));
+            }
+            t.write(&text)?;
+        }
+        if let Some(t) = &mut self.projection {
+            let mut text = String::from("frame,time");
+            for j in 0..k {
+                text.push_str(&format!(",pc{}", j + 1));
+            }
+            text.push('\n');
+            for ((f, time), p) in self.frames.iter().zip(&self.times).zip(&c.projections) {
+                let time = time
+                    .map(|t| crate::scene::compact(t, 6))
+                    .unwrap_or_default();
+                text.push_str(&format!("{f},{time}"));
+                for x in p {
+                    text.push_str(&format!(",{x:.6}"));
+                }
+                text.push('\n');
+            }
+            t.write(&text)?;
+        }
+        if let Some(t) = &mut self.vectors {
+            let mut text = String::from("atom,id,name,resname,resid,chain,mean_x,mean_y,mean_z");
+            for j in 0..k {
+                let n = j + 1;
+                text.push_str(&format!(",pc{n}x,pc{n}y,pc{n}z"));
+            }
+            text.push('\n');
+            let mut at = self.atoms.iter().enumerate().peekable();
+            for (i, row) in self.rows.iter().enumerate() {
+                text.push_str(row);
+                match at.next_if(|(_, a)| **a == i) {
+                    Some((s, _)) => {
+                        for x in c.mean[s] {
+                            text.push_str(&format!(",{x:.4}"));
+                        }
+                        for v in &c.vectors {
+                            for x in v[s] {
+                                text.push_str(&format!(",{x:.6}"));
+                            }
+                        }
+                    }
+                    None => text.push_str(&",".repeat(3 + 3 * k)),
+                }
+                text.push('\n');
+            }
+            t.write(&text)?;
+        }
+        if let Some((path, format)) = &self.extremes {
+            let mut frame = self.template.clone();
+            crate::output::write_atomic(path, |tmp| {
+                let mut w = texmap_md_io::Writer::create(tmp, *format)?;
+                for (i, positions) in c
+                    .along(self.mode, self.extreme_frames)
+                    .into_iter()
+                    .enumerate()
+                {
+                    frame.positions = positions;
+                    frame.time = Some(i as f64);
+                    w.write_frame(&frame)?;
+                }
+                w.finish()?;
+                Ok(())
+            })?;
+        }
+        let shown: Vec<String> = (0..c.variance.len().min(3))
+            .map(|j| {
+                format!(
+                    "PC{} {} Å² ({:.1} %)",
+                    j + 1,
+                    crate::scene::compact(c.variance[j], 4),
+                    100.0 * c.variance[j] / c.total_variance.max(f64::MIN_POSITIVE)
+                )
+            })
+            .collect();
+        crate::note!(
+            "principal components of {} atoms over {} frames: {}; the first {} carry {:.1} %",
+            self.atoms.len(),
+            self.frames.len(),
+            shown.join(", "),
+            k.min(c.variance.len()),
+            100.0 * c.cumulated(k.saturating_sub(1))
+        );
+        if let Some(j) = cosine.iter().take(3).position(|x| *x > 0.7) {
+            eprintln!(
+                "texmap: warning: PC{}'s projection has a cosine content of {:.2}: the run diffused along it rather than sampling it (Hess 2002); a longer run is needed before reading it as a motion",
+                j + 1,
+                cosine[j]
+            );
+        }
+        Ok([self.table, self.projection, self.vectors]
+            .into_iter()
+            .flatten()
+            .collect())
+    }
+}
+
 /// `--vacf-table` and `--vdos-table`: every frame's velocities, correlated at the end.
 struct VelocityTables {
     vacf: Option<crate::output::AtomicFile>,
@@ -937,6 +1165,7 @@ impl AnalysisTables {
             )?
             .map(|t| (t, texmap_md_io::rmsf::Fluctuation::new(), Vec::new())),
             contacts: ContactsTable::create(analysis, whole)?,
+            pca: PcaTables::create(analysis, whole)?,
             survival: SurvivalTable::create(
                 &analysis.survival_table,
                 "--survival-table",
@@ -1187,6 +1416,9 @@ impl AnalysisTables {
         if let Some(t) = &mut self.survival {
             t.add_selected(f, md)?;
         }
+        if let Some(p) = &mut self.pca {
+            p.add(f, md)?;
+        }
         Ok(())
     }
 
@@ -1218,6 +1450,11 @@ impl AnalysisTables {
             .transpose()?;
         let density = self.density.map(DensityTable::finish).transpose()?;
         let survival = self.survival.map(SurvivalTable::finish).transpose()?;
+        let pca = self
+            .pca
+            .map(PcaTables::finish)
+            .transpose()?
+            .unwrap_or_default();
         for t in [
             survival,
             self.contacts.map(|c| c.file),
@@ -1239,6 +1476,7 @@ impl AnalysisTables {
         .into_iter()
         .flatten()
         .chain(velocities)
+        .chain(pca)
         {
             t.commit()?;
         }

@@ -1424,3 +1424,230 @@ fn survival_table_is_the_waterdynamics_survival_probability() {
         }
     }
 }
+
+/// `--pca-table`, `--pca-projection`, `--pca-vectors` and `--pca-extremes` after `--align` on
+/// the same atoms equal MDAnalysis's align.AlignTraj + analysis.pca.PCA (md-io's
+/// data/pca/gen_pca.py: a bending, twisting helix, 80 frames, turned and moved at random),
+/// on the CA atoms (the covariance matrix) and the backbone (the frames' products): every
+/// variance, the cumulated fraction, the cosine content, every frame's projection, the
+/// components (up to sign) and the mean; the extremes run from the smallest projection on PC1
+/// to the largest, and the vectors read back as properties (a porcupine plot's input).
+#[test]
+fn pca_tables_are_mdanalysis_pca() {
+    let dir = tempfile::tempdir().unwrap();
+    let reference = json("pca/pca_reference.json");
+    let (xtc, pdb) = (md_data("pca/helix_pca.xtc"), md_data("dihedrals/helix.pdb"));
+    let path = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    let (t, p, v, x) = (
+        path("pca.csv"),
+        path("proj.csv"),
+        path("vec.csv"),
+        path("pc1.pdb"),
+    );
+    for sel in ["name CA", "backbone"] {
+        let r = &reference[format!("aligned {sel}")];
+        run_ok(&[
+            "convert",
+            &xtc,
+            "--topology",
+            &pdb,
+            "--align",
+            sel,
+            "--pca-select",
+            sel,
+            "--pca-components",
+            "3",
+            "--pca-table",
+            &t,
+            "--pca-projection",
+            &p,
+            "--pca-vectors",
+            &v,
+            "--pca-extremes",
+            &x,
+            "-q",
+        ]);
+        let variance = numbers(&r["variance"]);
+        let top = variance[0];
+        let (header, rows) = table(Path::new(&t));
+        assert_eq!(
+            header,
+            "component,variance,fraction,cumulated,cosine_content"
+        );
+        assert_eq!(rows.len(), variance.len().min(80), "{sel}");
+        let cumulated = numbers(&r["cumulated_variance"]);
+        let cosine = numbers(&r["cosine_content"]);
+        for (k, row) in rows.iter().enumerate() {
+            assert_eq!(row[0], (k + 1) as f64);
+            // Six decimals in the table; the two XTC decoders may differ in a last f32 bit.
+            assert!(
+                (row[1] - variance[k]).abs() < 2e-6 + 1e-7 * top,
+                "{sel} {k}"
+            );
+            assert!((row[3] - cumulated[k]).abs() < 2e-6, "{sel} {k}");
+            if k < 3 {
+                assert!((row[4] - cosine[k]).abs() < 2e-6, "{sel} {k}: {}", row[4]);
+            } else {
+                assert!(
+                    row[4].is_nan(),
+                    "{sel}: no cosine content past the components"
+                );
+            }
+        }
+        // The components, up to sign, and the mean, in the atoms' rows.
+        let (header, rows) = table(Path::new(&v));
+        assert!(
+            header.ends_with(",mean_x,mean_y,mean_z,pc1x,pc1y,pc1z,pc2x,pc2y,pc2z,pc3x,pc3y,pc3z")
+        );
+        assert_eq!(rows.len(), 185);
+        let picked: Vec<&Vec<f64>> = rows.iter().filter(|r| !r[6].is_nan()).collect();
+        assert_eq!(picked.len() as u64, r["atoms"].as_u64().unwrap(), "{sel}");
+        let mean = numbers(&r["mean"]);
+        let mut signs = [0.0; 3];
+        for (k, sign) in signs.iter_mut().enumerate() {
+            let want = numbers(&r["components"][k]);
+            let got: Vec<f64> = picked
+                .iter()
+                .flat_map(|row| row[9 + 3 * k..12 + 3 * k].to_vec())
+                .collect();
+            let dot: f64 = got.iter().zip(&want).map(|(a, b)| a * b).sum();
+            assert!((dot.abs() - 1.0).abs() < 1e-4, "{sel} pc{}: {dot}", k + 1);
+            *sign = dot.signum();
+        }
+        let got_mean: Vec<f64> = picked.iter().flat_map(|row| row[6..9].to_vec()).collect();
+        for (a, b) in got_mean.iter().zip(&mean) {
+            assert!((a - b).abs() < 2e-4, "{sel}: mean {a} vs {b}");
+        }
+        // Every frame's projection.
+        let (header, rows) = table(Path::new(&p));
+        assert_eq!(header, "frame,time,pc1,pc2,pc3");
+        let want = r["projections"].as_array().unwrap();
+        assert_eq!(rows.len(), want.len());
+        for (f, (row, w)) in rows.iter().zip(want).enumerate() {
+            assert_eq!(row[0], f as f64);
+            for k in 0..3 {
+                let w = signs[k] * w[k].as_f64().unwrap();
+                assert!(
+                    (row[2 + k] - w).abs() < 1e-5 * top.sqrt(),
+                    "{sel} frame {f} pc{}",
+                    k + 1
+                );
+            }
+        }
+        // The extremes: 20 structures of the selected atoms from PC1's smallest projection to
+        // its largest (coordinates to 0.001 Å in the PDB file).
+        let (lo, hi) = rows
+            .iter()
+            .fold((f64::MAX, f64::MIN), |(a, b), r| (a.min(r[2]), b.max(r[2])));
+        let moved = frames(Path::new(&x));
+        assert_eq!(moved.len(), 20);
+        let pc1: Vec<f64> = picked.iter().flat_map(|row| row[9..12].to_vec()).collect();
+        for (structure, t) in [(&moved[0], lo), (&moved[19], hi)] {
+            assert_eq!(structure.n_atoms(), picked.len());
+            let proj: f64 = structure
+                .positions
+                .iter()
+                .flatten()
+                .zip(&got_mean)
+                .zip(&pc1)
+                .map(|((p, m), v)| (f64::from(*p) - m) * v)
+                .sum();
+            assert!((proj - t).abs() < 0.01, "{sel}: {proj} vs {t}");
+        }
+    }
+    // The vectors read back as properties: the CA atoms have them, the others none (NaN).
+    let out = dir.path().join("ca.xyz");
+    run_ok(&[
+        "convert",
+        &pdb,
+        "--property",
+        &format!("pc1x={v}"),
+        "--select",
+        "prop pc1x > -2",
+        "-o",
+        out.to_str().unwrap(),
+        "-q",
+    ]);
+    assert_eq!(frames(&out)[0].n_atoms(), 92);
+}
+
+/// The principal component analysis refuses what it cannot do, before or after the frames,
+/// and leaves none of its files.
+#[test]
+fn pca_bad_requests_are_refused_and_leave_no_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let (xtc, pdb) = (md_data("pca/helix_pca.xtc"), md_data("dihedrals/helix.pdb"));
+    let t = dir.path().join("pca.csv");
+    let ts = t.to_str().unwrap();
+    let bad_ext = dir.path().join("pc1.png");
+    let cases: [(&[&str], i32, &str); 6] = [
+        (
+            &[
+                "--pca-table",
+                ts,
+                "--pca-extremes",
+                bad_ext.to_str().unwrap(),
+            ],
+            2,
+            "--pca-extremes",
+        ),
+        (
+            &[
+                "--pca-table",
+                ts,
+                "--pca-extremes",
+                "x.pdb",
+                "--pca-components",
+                "2",
+                "--pca-mode",
+                "3",
+            ],
+            2,
+            "--pca-mode 3",
+        ),
+        (&["--pca-select", "name CA"], 2, "pca"),
+        (
+            &["--pca-table", ts, "--pca-select", "resname XYZ"],
+            1,
+            "none of the atoms",
+        ),
+        (
+            &["--pca-table", ts, "--frames", "0"],
+            1,
+            "at least two frames",
+        ),
+        (
+            &["--pca-table", ts, "--pca-select", "name CA and"],
+            2,
+            "--pca-select",
+        ),
+    ];
+    for (extra, code, message) in cases {
+        let mut args = vec!["convert", &xtc, "--topology", &pdb];
+        args.extend(extra);
+        let o = texmap(&args);
+        assert_eq!(o.status.code(), Some(code), "{extra:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains(message), "{extra:?}: {}", stderr(&o));
+        let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+        assert!(left.is_empty(), "{extra:?} left {left:?}");
+    }
+    // A render split over a Slurm array cannot hold every frame.
+    let o = texmap(&[
+        "render",
+        &xtc,
+        "--topology",
+        &pdb,
+        "--pca-table",
+        ts,
+        "--shard",
+        "0/2",
+        "-o",
+        dir.path().join("f%02d.png").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("--pca-table with --shard"),
+        "{}",
+        stderr(&o)
+    );
+}
