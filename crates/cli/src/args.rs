@@ -1274,6 +1274,23 @@ pub struct AnalysisArgs {
         requires = "survival_table"
     )]
     pub survival_intermittency: usize,
+    /// Also write the secondary structure of every frame as a CSV table (MDAnalysis's
+    /// analysis.dssp.DSSP, gmx dssp's -o): frame, time, helix, strand, coil (how many residues
+    /// of each) and ss, one code per residue with a backbone in file order (H helix, E strand,
+    /// a dash coil; DSSP's hydrogen bonds, every frame). Give --pbc unwrap for a protein the
+    /// trajectory wrapped. Written whole or not at all.
+    #[arg(long, value_name = "FILE.csv")]
+    pub dssp_table: Option<PathBuf>,
+    /// Also write each residue's share of the frames in each class as a CSV table: chain,
+    /// resid, resname, helix, strand, coil (fractions of the frames): a residue's helicity
+    /// over the run.
+    #[arg(long, value_name = "FILE.csv")]
+    pub dssp_residue_table: Option<PathBuf>,
+    /// Also draw the secondary structure of every residue in every frame as a chart, PNG or
+    /// SVG by the name (VMD's Timeline, gmx dssp's map): residues up, frames across (their
+    /// times when the file has them), helices purple, strands yellow, coil white.
+    #[arg(long, value_name = "FILE.png|FILE.svg")]
+    pub dssp_timeline: Option<PathBuf>,
     /// Also write the principal components of --pca-select's motion as a CSV table
     /// (MDAnalysis's analysis.pca.PCA, gmx covar): component, variance (Å², an eigenvalue of
     /// the positions' covariance over the frames), fraction of the total, cumulated fraction,

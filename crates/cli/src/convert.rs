@@ -68,7 +68,8 @@ pub struct ConvertArgs {
     /// (--rdf-table, --msd-table, --msd-lags, --vacf-table, --vdos-table, --rmsd-table, --rmsf-table, --profile-table,
     /// --dihedral-table, --sasa-table, --sasa-residue-table, --gyration-table, --cluster-table,
     /// --grain-table, --defect-table, --density-map, --contacts-table, --survival-table,
-    /// --pca-table, --pca-projection, --pca-vectors, --pca-extremes).
+    /// --pca-table, --pca-projection, --pca-vectors, --pca-extremes, --dssp-table,
+    /// --dssp-residue-table, --dssp-timeline).
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
     #[command(flatten)]
@@ -94,6 +95,7 @@ Examples:
   texmap convert md.xtc --topology md.gro --survival-table sp.csv --survival-select 'name OW and around 3.5 protein'  # water residence
   texmap convert md.xtc --topology md.gro --pbc unwrap --align 'name CA' --pca-table pca.csv --pca-projection proj.csv  # principal components (gmx covar)
   texmap convert md.xtc --topology md.gro --pbc unwrap --align 'name CA' --pca-extremes pc1.pdb && texmap render pc1.pdb --style tube -o pc1.mp4  # PC1's motion as a movie
+  texmap convert md.xtc --topology md.gro --pbc unwrap --dssp-table ss.csv --dssp-timeline ss.png  # secondary structure per frame and its timeline (gmx dssp)
   texmap convert md.xtc --topology md.gro --contacts-table q.csv --contacts 'name CA;name CA' --contacts-radius 8  # native contacts Q(t)
   texmap convert md.xtc --topology md.gro --align protein --density-map water.dx --density-select 'name OW'  # where water stays (VMD volmap);
   texmap render md.xtc --topology md.gro --frames 0 --volume water.dx --isosurface 0.05 -o sites.png  # over the frame it was aligned to
@@ -162,10 +164,13 @@ pub fn convert(a: &ConvertArgs) -> Result<()> {
                 &a.analysis.pca_projection,
                 &a.analysis.pca_vectors,
                 &a.analysis.pca_extremes,
+                &a.analysis.dssp_table,
+                &a.analysis.dssp_residue_table,
+                &a.analysis.dssp_timeline,
             ];
             if tables.iter().all(|t| t.is_none()) {
                 return usage(
-                    "nothing to write: give -o FILE, or a table of the analyses (--rdf-table, --msd-table, --msd-lags, --vacf-table, --vdos-table, --rmsd-table, --rmsf-table, --profile-table, --dihedral-table, --sasa-table, --sasa-residue-table, --gyration-table, --cluster-table, --grain-table, --defect-table, --density-map, --contacts-table, --survival-table, --pca-table, --pca-projection, --pca-vectors, --pca-extremes)",
+                    "nothing to write: give -o FILE, or a table of the analyses (--rdf-table, --msd-table, --msd-lags, --vacf-table, --vdos-table, --rmsd-table, --rmsf-table, --profile-table, --dihedral-table, --sasa-table, --sasa-residue-table, --gyration-table, --cluster-table, --grain-table, --defect-table, --density-map, --contacts-table, --survival-table, --pca-table, --pca-projection, --pca-vectors, --pca-extremes, --dssp-table, --dssp-residue-table, --dssp-timeline)",
                 );
             }
             if a.select.is_some() || a.columns.is_some() {

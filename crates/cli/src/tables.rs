@@ -80,6 +80,7 @@ pub(crate) struct AnalysisTables {
     contacts: Option<ContactsTable>,
     survival: Option<SurvivalTable>,
     pca: Option<PcaTables>,
+    dssp: Option<DsspTables>,
 }
 
 /// `--contacts-table`: its file, groups and method, and the native contacts (set at the
@@ -568,6 +569,170 @@ impl SurvivalTable {
             }
         );
         Ok(self.file)
+    }
+}
+
+/// `--dssp-table`, `--dssp-residue-table` and `--dssp-timeline`: every frame's secondary
+/// structure.
+struct DsspTables {
+    table: Option<crate::output::AtomicFile>,
+    residues: Option<crate::output::AtomicFile>,
+    timeline: Option<PathBuf>,
+    /// The first frame's residues with a backbone: chain, resid, resname.
+    labels: Vec<(String, i64, String)>,
+    /// Per residue, the frames it was coil, helix, strand.
+    counts: Vec<[u32; 3]>,
+    /// Every frame's classes (kept for the timeline only).
+    classes: Vec<Vec<texmap_md_io::secondary::Structure>>,
+    frames: Vec<usize>,
+    times: Vec<Option<f64>>,
+}
+
+impl DsspTables {
+    fn create(analysis: &AnalysisArgs, whole: bool) -> Result<Option<DsspTables>> {
+        let why = "every part would write its own";
+        let table = per_frame_table(
+            &analysis.dssp_table,
+            "--dssp-table",
+            "frame,time,helix,strand,coil,ss",
+            whole,
+        )?;
+        let residues = whole_run_table(
+            &analysis.dssp_residue_table,
+            "--dssp-residue-table",
+            why,
+            whole,
+        )?;
+        let timeline = match &analysis.dssp_timeline {
+            Some(_) if !whole => {
+                return usage(format!(
+                    "--dssp-timeline with --shard (or a Slurm array): {why}; draw it in a run of its own"
+                ));
+            }
+            Some(p) => match p
+                .extension()
+                .and_then(|e| e.to_str())
+                .map(str::to_ascii_lowercase)
+                .as_deref()
+            {
+                Some("png" | "svg") => Some(p.clone()),
+                _ => {
+                    return usage(format!(
+                        "--dssp-timeline {}: expected a .png or .svg file name",
+                        p.display()
+                    ));
+                }
+            },
+            None => None,
+        };
+        Ok(
+            (table.is_some() || residues.is_some() || timeline.is_some()).then(|| DsspTables {
+                table,
+                residues,
+                timeline,
+                labels: Vec::new(),
+                counts: Vec::new(),
+                classes: Vec::new(),
+                frames: Vec::new(),
+                times: Vec::new(),
+            }),
+        )
+    }
+
+    /// Frame `f`'s assignment.
+    fn add(&mut self, f: usize, time: &str, md: &MdFrame) -> Result<()> {
+        let ss = texmap_md_io::secondary::assign(md);
+        if self.frames.is_empty() {
+            if ss.residues().is_empty() {
+                bail!(
+                    "--dssp: frame {f} has no residue with the backbone atoms N, CA, C and O (a protein's), so no secondary structure"
+                );
+            }
+            let text = |v: &[texmap_md_io::Label], i: usize| {
+                v.get(i).map(|l| l.to_string()).unwrap_or_default()
+            };
+            self.labels = ss
+                .residues()
+                .iter()
+                .map(|r| {
+                    let i = r.atoms.start;
+                    (text(&md.chains, i), r.res_id, text(&md.res_names, i))
+                })
+                .collect();
+            self.counts = vec![[0; 3]; self.labels.len()];
+        } else if ss.residues().len() != self.labels.len() {
+            bail!(
+                "--dssp: frame {f} has {} residues with a backbone and the first {}: every frame must hold the same residues",
+                ss.residues().len(),
+                self.labels.len()
+            );
+        }
+        for (n, c) in self.counts.iter_mut().zip(ss.classes()) {
+            n[*c as usize] += 1;
+        }
+        if let Some(t) = &mut self.table {
+            let [coil, helix, strand] = ss.counts();
+            t.write(&format!(
+                "{f},{time},{helix},{strand},{coil},{}\n",
+                ss.codes()
+            ))?;
+        }
+        if self.timeline.is_some() {
+            self.classes.push(ss.classes().to_vec());
+        }
+        self.frames.push(f);
+        self.times.push(md.time);
+        Ok(())
+    }
+
+    /// The per-residue table written, the timeline drawn.
+    fn finish(mut self) -> Result<Vec<crate::output::AtomicFile>> {
+        let n = self.frames.len().max(1) as f64;
+        if let Some(t) = &mut self.residues {
+            let mut text = String::from("chain,resid,resname,helix,strand,coil\n");
+            for ((chain, resid, resname), [coil, helix, strand]) in
+                self.labels.iter().zip(&self.counts)
+            {
+                text.push_str(&format!(
+                    "{chain},{resid},{resname},{:.4},{:.4},{:.4}\n",
+                    f64::from(*helix) / n,
+                    f64::from(*strand) / n,
+                    f64::from(*coil) / n
+                ));
+            }
+            t.write(&text)?;
+        }
+        if let Some(path) = &self.timeline {
+            // Times when every frame has one and they increase, else the frame numbers.
+            let timed = self.times.iter().all(Option::is_some)
+                && self.times.windows(2).all(|w| w[1] > w[0]);
+            let (x, label): (Vec<f64>, &str) = if timed {
+                (self.times.iter().flatten().copied().collect(), "time (ps)")
+            } else {
+                (self.frames.iter().map(|&f| f as f64).collect(), "frame")
+            };
+            let resids: Vec<i64> = self.labels.iter().map(|l| l.1).collect();
+            let svg = path
+                .extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("svg"));
+            crate::output::write_atomic(path, |tmp| {
+                use texmap_study::chart::{TIMELINE_SIZE, Target, structure_timeline};
+                if svg {
+                    let mut text = String::new();
+                    structure_timeline(&x, label, &resids, &self.classes, Target::Svg(&mut text))?;
+                    std::fs::write(tmp, text)?;
+                } else {
+                    let (w, h) = TIMELINE_SIZE;
+                    let mut rgb = vec![0u8; 3 * w as usize * h as usize];
+                    structure_timeline(&x, label, &resids, &self.classes, Target::Rgb(&mut rgb))?;
+                    image::RgbImage::from_raw(w, h, rgb)
+                        .expect("the chart's size")
+                        .save_with_format(tmp, image::ImageFormat::Png)?;
+                }
+                Ok(())
+            })?;
+        }
+        Ok([self.table, self.residues].into_iter().flatten().collect())
     }
 }
 
@@ -1166,6 +1331,7 @@ impl AnalysisTables {
             .map(|t| (t, texmap_md_io::rmsf::Fluctuation::new(), Vec::new())),
             contacts: ContactsTable::create(analysis, whole)?,
             pca: PcaTables::create(analysis, whole)?,
+            dssp: DsspTables::create(analysis, whole)?,
             survival: SurvivalTable::create(
                 &analysis.survival_table,
                 "--survival-table",
@@ -1419,6 +1585,9 @@ impl AnalysisTables {
         if let Some(p) = &mut self.pca {
             p.add(f, md)?;
         }
+        if let Some(d) = &mut self.dssp {
+            d.add(f, &time, md)?;
+        }
         Ok(())
     }
 
@@ -1455,6 +1624,11 @@ impl AnalysisTables {
             .map(PcaTables::finish)
             .transpose()?
             .unwrap_or_default();
+        let dssp = self
+            .dssp
+            .map(DsspTables::finish)
+            .transpose()?
+            .unwrap_or_default();
         for t in [
             survival,
             self.contacts.map(|c| c.file),
@@ -1477,6 +1651,7 @@ impl AnalysisTables {
         .flatten()
         .chain(velocities)
         .chain(pca)
+        .chain(dssp)
         {
             t.commit()?;
         }

@@ -1651,3 +1651,117 @@ fn pca_bad_requests_are_refused_and_leave_no_file() {
         stderr(&o)
     );
 }
+
+/// `--dssp-table` equals MDAnalysis's DSSP frame by frame (md-io's
+/// data/dssp/gen_trajectory.py) on the fraying helix (80 frames) and on adenylate kinase in
+/// water made whole by `--pbc unwrap` (helices and a sheet); `--dssp-residue-table` holds the
+/// same frames' shares per residue and `--dssp-timeline` draws them.
+#[test]
+fn dssp_tables_are_mdanalysis_dssp() {
+    let dir = tempfile::tempdir().unwrap();
+    let reference = json("dssp/trajectory_reference.json");
+    for (key, traj, top, extra) in [
+        ("helix", "pca/helix_pca.xtc", "dihedrals/helix.pdb", None),
+        (
+            "adk",
+            "hbonds/adk_0_9.xtc",
+            "hbonds/adk_top.gro.gz",
+            Some("unwrap"),
+        ),
+    ] {
+        let (ss, res, png) = (
+            dir.path().join(format!("{key}.csv")),
+            dir.path().join(format!("{key}_res.csv")),
+            dir.path().join(format!("{key}.png")),
+        );
+        let (traj, top) = (md_data(traj), md_data(top));
+        let mut args = vec![
+            "convert",
+            &traj,
+            "--topology",
+            &top,
+            "--dssp-table",
+            ss.to_str().unwrap(),
+            "--dssp-residue-table",
+            res.to_str().unwrap(),
+            "--dssp-timeline",
+            png.to_str().unwrap(),
+            "-q",
+        ];
+        if let Some(pbc) = extra {
+            args.extend(["--pbc", pbc]);
+        }
+        run_ok(&args);
+        let r = &reference[key];
+        let want: Vec<&str> = r["frames"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_str().unwrap())
+            .collect();
+        let text = std::fs::read_to_string(&ss).unwrap();
+        let mut lines = text.lines();
+        assert_eq!(lines.next(), Some("frame,time,helix,strand,coil,ss"));
+        let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+        assert_eq!(rows.len(), want.len(), "{key}");
+        for (f, (row, want)) in rows.iter().zip(&want).enumerate() {
+            assert_eq!(row[0], f.to_string());
+            assert_eq!(row[5], *want, "{key} frame {f}");
+            let count = |c: char| want.chars().filter(|x| *x == c).count().to_string();
+            assert_eq!(
+                row[2..5],
+                [count('H'), count('E'), count('-')],
+                "{key} frame {f}"
+            );
+        }
+        // Each residue's shares over the frames, in MDAnalysis's residue order.
+        let (header, shares) = table(&res);
+        assert_eq!(header, "chain,resid,resname,helix,strand,coil");
+        let resids = numbers(&r["resids"]);
+        assert_eq!(shares.len(), resids.len());
+        for (k, (row, resid)) in shares.iter().zip(&resids).enumerate() {
+            assert_eq!(row[1], *resid);
+            for (col, c) in [(3, 'H'), (4, 'E'), (5, '-')] {
+                let n = want.iter().filter(|s| s.as_bytes()[k] as char == c).count();
+                let share = n as f64 / want.len() as f64;
+                assert!((row[col] - share).abs() < 6e-5, "{key} residue {resid} {c}");
+            }
+        }
+        let img = image::open(&png).unwrap().to_rgb8();
+        let purple = img.pixels().filter(|p| p.0 == [166, 0, 166]).count();
+        assert!(purple > 10_000, "{key}: {purple} helix pixels");
+        if key == "adk" {
+            assert!(
+                img.pixels().any(|p| p.0 == [255, 255, 0]),
+                "adk's strands drawn"
+            );
+        }
+    }
+    // Without a protein backbone there is nothing to assign; a timeline needs an image name.
+    let walk = md_data("dynamics/walk.gro");
+    let o = texmap(&[
+        "convert",
+        &walk,
+        "--dssp-table",
+        dir.path().join("none.csv").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("no residue with the backbone"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!dir.path().join("none.csv").exists());
+    let o = texmap(&[
+        "convert",
+        &walk,
+        "--dssp-timeline",
+        dir.path().join("ss.pdf").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("expected a .png or .svg"),
+        "{}",
+        stderr(&o)
+    );
+}

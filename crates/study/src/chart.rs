@@ -704,6 +704,122 @@ pub fn scatter(
     )
 }
 
+/// Size of [`structure_timeline`] in pixels.
+pub const TIMELINE_SIZE: (u32, u32) = (1200, 640);
+
+/// A secondary-structure timeline (VMD's Timeline, the map of `gmx dssp`): the residues up the
+/// y axis (labelled by `resids`), the frames along x (labelled by `x`, one value per frame: the
+/// frame numbers or their times), each cell in VMD's Structure colours (helix purple, strand
+/// yellow, coil white; md-scene's `STRUCTURE_COLORS`). `classes[f][r]` is residue `r`'s class
+/// in frame `f`; a residue's run of frames in one class is one rectangle.
+pub fn structure_timeline(
+    x: &[f64],
+    x_label: &str,
+    resids: &[i64],
+    classes: &[Vec<texmap_md_io::secondary::Structure>],
+    target: Target,
+) -> Result<(), StudyError> {
+    use texmap_md_io::secondary::Structure;
+    let colour = |c: Structure| match c {
+        Structure::Coil => RGBColor(255, 255, 255),
+        Structure::Helix => RGBColor(166, 0, 166),
+        Structure::Strand => RGBColor(255, 255, 0),
+    };
+    // Per residue, the runs (first frame, end frame, class) of one class.
+    let mut runs: Vec<(usize, usize, usize, Structure)> = Vec::new();
+    for r in 0..resids.len() {
+        let mut f = 0;
+        while f < classes.len() {
+            let c = classes[f][r];
+            let end = f + classes[f..].iter().take_while(|row| row[r] == c).count();
+            if c != Structure::Coil {
+                runs.push((r, f, end, c));
+            }
+            f = end;
+        }
+    }
+    let (nf, nr) = (classes.len().max(1) as f64, resids.len().max(1) as f64);
+    // Tick labels: the x value or residue number of the cell starting at an axis position
+    // (cells span [i, i + 1)); none between cells' starts.
+    let cell = |v: f64| (v >= 0.0 && (v - v.round()).abs() < 1e-9).then_some(v.round() as usize);
+    let x_at = |v: &f64| {
+        let t = cell(*v).and_then(|i| x.get(i));
+        t.map(|t| format!("{}", (t * 1000.0).round() / 1000.0))
+            .unwrap_or_default()
+    };
+    let resid_at = |v: &f64| {
+        let r = cell(*v).and_then(|i| resids.get(i));
+        r.map(|r| r.to_string()).unwrap_or_default()
+    };
+    fn draw<DB: DrawingBackend>(
+        root: DrawingArea<DB, Shift>,
+        (nf, nr): (f64, f64),
+        runs: &[(usize, usize, usize, texmap_md_io::secondary::Structure)],
+        colour: &dyn Fn(texmap_md_io::secondary::Structure) -> RGBColor,
+        x_label: &str,
+        [x_at, resid_at]: [&dyn Fn(&f64) -> String; 2],
+    ) -> Result<(), String> {
+        use texmap_md_io::secondary::Structure;
+        let e = |err: DrawingAreaErrorKind<DB::ErrorType>| err.to_string();
+        root.fill(&WHITE).map_err(e)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption("secondary structure (DSSP)", ("sans-serif", 22))
+            .margin(16)
+            .x_label_area_size(44)
+            .y_label_area_size(60)
+            // Room on the right for the legend, so that it covers no cell.
+            .build_cartesian_2d(0.0..nf * 1.15, 0.0..nr)
+            .map_err(e)?;
+        chart
+            .configure_mesh()
+            .disable_mesh()
+            .x_desc(x_label)
+            .y_desc("residue")
+            .x_label_formatter(x_at)
+            .y_label_formatter(resid_at)
+            .label_style(("sans-serif", 14))
+            .draw()
+            .map_err(e)?;
+        chart
+            .draw_series(runs.iter().map(|&(r, f0, f1, c)| {
+                Rectangle::new(
+                    [(f0 as f64, r as f64), (f1 as f64, r as f64 + 1.0)],
+                    colour(c).filled(),
+                )
+            }))
+            .map_err(e)?;
+        for c in [Structure::Helix, Structure::Strand, Structure::Coil] {
+            let fill = colour(c);
+            chart
+                .draw_series(std::iter::empty::<Rectangle<(f64, f64)>>())
+                .map_err(e)?
+                .label(c.name())
+                .legend(move |(x, y)| {
+                    // Outlined, so that coil's white box shows.
+                    EmptyElement::at((x, y))
+                        + Rectangle::new([(0, -6), (14, 6)], ShapeStyle::from(fill).filled())
+                        + Rectangle::new([(0, -6), (14, 6)], BLACK.stroke_width(1))
+                });
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 14))
+            .draw()
+            .map_err(e)?;
+        root.present().map_err(e)
+    }
+    draw_on(
+        "structure_timeline",
+        target,
+        TIMELINE_SIZE,
+        |a| draw(a, (nf, nr), &runs, &colour, x_label, [&x_at, &resid_at]),
+        |a| draw(a, (nf, nr), &runs, &colour, x_label, [&x_at, &resid_at]),
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -730,6 +846,38 @@ mod tests {
         let ticks = lin.ticks(&(23.7..61.2));
         assert_eq!(ticks, [25.0, 30.0, 35.0, 40.0, 45.0, 50.0, 55.0, 60.0]);
         assert_eq!(lin.label(0.1 + 0.2), "0.3");
+    }
+
+    #[test]
+    fn structure_timeline_colours_the_runs() {
+        use texmap_md_io::secondary::Structure::{Coil, Helix, Strand};
+        // 40 frames of 10 residues: 0-4 helix throughout, 5-7 strand in the second half.
+        let classes: Vec<Vec<_>> = (0..40)
+            .map(|f| {
+                (0..10)
+                    .map(|r| match r {
+                        0..5 => Helix,
+                        5..8 if f >= 20 => Strand,
+                        _ => Coil,
+                    })
+                    .collect()
+            })
+            .collect();
+        let x: Vec<f64> = (0..40).map(|f| f as f64 * 2.5).collect();
+        let resids: Vec<i64> = (11..21).collect();
+        let (w, h) = TIMELINE_SIZE;
+        let mut rgb = vec![0u8; 3 * (w * h) as usize];
+        structure_timeline(&x, "time (ps)", &resids, &classes, Target::Rgb(&mut rgb)).unwrap();
+        let count = |c: [u8; 3]| rgb.chunks_exact(3).filter(|p| *p == c).count();
+        let (purple, yellow) = (count([166, 0, 166]), count([255, 255, 0]));
+        // Helix cells: 5 residues x 40 frames; strand: 3 x 20, so 10/3 as many pixels (the
+        // legend's two boxes aside).
+        assert!(purple > 20_000, "{purple}");
+        let ratio = purple as f64 / yellow as f64;
+        assert!((ratio - 10.0 / 3.0).abs() < 0.2, "{ratio}");
+        let mut svg = String::new();
+        structure_timeline(&x, "time (ps)", &resids, &classes, Target::Svg(&mut svg)).unwrap();
+        assert!(svg.contains("helix") && svg.contains("strand") && svg.contains("time (ps)"));
     }
 
     fn rec(method: &str, scene: &str, ms: f64, psnr: f64) -> Record {
