@@ -1077,24 +1077,11 @@ pub struct MolArgs {
     /// frame drawn so far.
     #[arg(long, value_name = "N")]
     pub trail_length: Option<usize>,
-    /// Measure and draw, as PyMOL's distance, angle and dihedral: 'SEL; SEL' (a distance, Å),
-    /// 'SEL; SEL; SEL' (the angle at the middle atom) or four (the dihedral about the middle
-    /// bond, IUPAC's sign), each SEL picking exactly one atom in every frame: yellow dashes
-    /// through the atoms (nearest periodic images) and the value as a label. Repeatable:
-    /// --measure 'resid 10 and name OG; resname LIG and name O1'.
-    #[arg(long = "measure", value_name = "SEL; SEL[; SEL[; SEL]]")]
-    pub measures: Vec<String>,
     /// Draw the bond orders an SDF/MOL or MOL2 file gives (PyMOL's valence mode) in the
     /// ball-stick and licorice styles: double bonds as two sticks, triple as three, aromatic
     /// as a stick with a dashed line inside the ring.
     #[arg(long)]
     pub bond_orders: bool,
-    /// Also write the --measure values as a CSV table, one row per measurement and frame:
-    /// frame, measure (0-based, in the order given), kind (distance, angle, dihedral), value
-    /// (Å or degrees), the atoms' 0-based indices joined by spaces, and the spec as given.
-    /// Written whole or not at all.
-    #[arg(long, value_name = "FILE.csv")]
-    pub measure_table: Option<PathBuf>,
     /// Also write the hydrogen bonds the hbonds style draws as a CSV table, one row per bond and
     /// frame: frame, donor, hydrogen, acceptor (0-based atom indices, as MDAnalysis's
     /// results.hbonds), the three atoms as RESNAME RESID:NAME, the donor-acceptor distance (Å)
@@ -1164,6 +1151,43 @@ pub struct MolArgs {
     /// The analyses, periodic boundaries and alignment applied to every frame.
     #[command(flatten)]
     pub analysis: AnalysisArgs,
+}
+
+impl AnalysisArgs {
+    /// Every output of the analyses (tables, maps, charts) by its flag, and whether it was given.
+    pub fn outputs(&self) -> Vec<(&'static str, bool)> {
+        [
+            ("--rdf-table", &self.rdf_table),
+            ("--msd-table", &self.msd_table),
+            ("--msd-lags", &self.msd_lags),
+            ("--vacf-table", &self.vacf_table),
+            ("--vdos-table", &self.vdos_table),
+            ("--rmsd-table", &self.rmsd_table),
+            ("--rmsf-table", &self.rmsf_table),
+            ("--profile-table", &self.profile_table),
+            ("--dihedral-table", &self.dihedral_table),
+            ("--sasa-table", &self.sasa_table),
+            ("--sasa-residue-table", &self.sasa_residue_table),
+            ("--gyration-table", &self.gyration_table),
+            ("--cluster-table", &self.cluster_table),
+            ("--grain-table", &self.grain_table),
+            ("--defect-table", &self.defect_table),
+            ("--density-map", &self.density_map),
+            ("--contacts-table", &self.contacts_table),
+            ("--survival-table", &self.survival_table),
+            ("--pca-table", &self.pca_table),
+            ("--pca-projection", &self.pca_projection),
+            ("--pca-vectors", &self.pca_vectors),
+            ("--pca-extremes", &self.pca_extremes),
+            ("--dssp-table", &self.dssp_table),
+            ("--dssp-residue-table", &self.dssp_residue_table),
+            ("--dssp-timeline", &self.dssp_timeline),
+            ("--measure-table", &self.measure_table),
+        ]
+        .into_iter()
+        .map(|(flag, path)| (flag, path.is_some()))
+        .collect()
+    }
 }
 
 /// What `texmap render` and `texmap convert` do to every frame before it is drawn or written:
@@ -1274,6 +1298,20 @@ pub struct AnalysisArgs {
         requires = "survival_table"
     )]
     pub survival_intermittency: usize,
+    /// Measure, as PyMOL's distance, angle and dihedral: 'SEL; SEL' (a distance, Å),
+    /// 'SEL; SEL; SEL' (the angle at the middle atom) or four (the dihedral about the middle
+    /// bond, IUPAC's sign), each SEL picking exactly one atom in every frame, through the
+    /// nearest periodic images. texmap render draws it (yellow dashes through the atoms, the
+    /// value as a label); --measure-table lists the values. Repeatable:
+    /// --measure 'resid 10 and name OG; resname LIG and name O1'.
+    #[arg(long = "measure", value_name = "SEL; SEL[; SEL[; SEL]]")]
+    pub measures: Vec<String>,
+    /// Also write the --measure values as a CSV table, one row per measurement and frame:
+    /// frame, measure (0-based, in the order given), kind (distance, angle, dihedral), value
+    /// (Å or degrees), the atoms' 0-based indices joined by spaces, and the spec as given.
+    /// Written whole or not at all.
+    #[arg(long, value_name = "FILE.csv")]
+    pub measure_table: Option<PathBuf>,
     /// Also write the secondary structure of every frame as a CSV table (MDAnalysis's
     /// analysis.dssp.DSSP, gmx dssp's -o): frame, time, helix, strand, coil (how many residues
     /// of each) and ss, one code per residue with a backbone in file order (H helix, E strand,

@@ -778,11 +778,6 @@ fn render(a: &RenderArgs) -> Result<()> {
             ));
         }
     }
-    if a.mol.measure_table.is_some() && a.mol.measures.is_empty() {
-        return usage(
-            "--measure-table lists the --measure values: add a measurement, as --measure 'index 0; index 5'",
-        );
-    }
     let whole = mine.len() == frames.len();
     let mut hbond_table = per_frame_table(
         &a.mol.hbond_table,
@@ -798,12 +793,6 @@ fn render(a: &RenderArgs) -> Result<()> {
         None,
     )?;
     let mut analysis_tables = AnalysisTables::create(&a.mol.analysis, whole)?;
-    let mut measure_table = per_frame_table(
-        &a.mol.measure_table,
-        "--measure-table",
-        "frame,measure,kind,value,atoms,spec",
-        whole,
-    )?;
     if let Some(r) = &a.mol.analysis.displacement_reference {
         set_displacement_reference(&mut plan, r, &mut traj, &a.file, options)?;
     } else if plan.draws_arrows()
@@ -883,27 +872,6 @@ fn render(a: &RenderArgs) -> Result<()> {
             analysis_tables
                 .write(f, &plan, &md)
                 .map_err(|e| fail(e, &written))?;
-        }
-        if let Some(t) = &mut measure_table
-            && mine.contains(&k)
-        {
-            let mut rows = String::new();
-            for (m, (got, spec)) in plan
-                .last_measurements()
-                .iter()
-                .zip(&a.mol.measures)
-                .enumerate()
-            {
-                let kind = ["distance", "angle", "dihedral"][got.atoms.len() - 2];
-                let atoms: Vec<String> = got.atoms.iter().map(|i| i.to_string()).collect();
-                let spec = spec.replace('"', "\"\"");
-                rows += &format!(
-                    "{f},{m},{kind},{:.6},{},\"{spec}\"\n",
-                    got.value,
-                    atoms.join(" ")
-                );
-            }
-            t.write(&rows).map_err(|e| fail(e, &written))?;
         }
         if a.box_outline
             && let Some(cell) = &md.cell
@@ -1256,9 +1224,6 @@ fn render(a: &RenderArgs) -> Result<()> {
     }
     if let Some(l) = hbond_lifetime {
         l.finish()?.commit()?;
-    }
-    if let Some(t) = measure_table {
-        t.commit()?;
     }
     analysis_tables.commit()?;
     if builder.merged_colors() > 0 {

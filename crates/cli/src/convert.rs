@@ -64,12 +64,9 @@ pub struct ConvertArgs {
     /// and the columns, read by LAMMPS's rerun, OVITO and MDAnalysis), .gro (GROMACS: residues,
     /// names, positions to 0.001 nm, velocities, the box), .pdb (multi-MODEL, the 'occupancy'
     /// and 'bfactor' properties in their columns), .dcd, .xtc (positions and the box only).
-    /// Written whole or not at all. Without it, only the analyses' tables are written
-    /// (--rdf-table, --msd-table, --msd-lags, --vacf-table, --vdos-table, --rmsd-table, --rmsf-table, --profile-table,
-    /// --dihedral-table, --sasa-table, --sasa-residue-table, --gyration-table, --cluster-table,
-    /// --grain-table, --defect-table, --density-map, --contacts-table, --survival-table,
-    /// --pca-table, --pca-projection, --pca-vectors, --pca-extremes, --dssp-table,
-    /// --dssp-residue-table, --dssp-timeline).
+    /// Written whole or not at all. Without it, only the analyses' outputs are written (the
+    /// --*-table options, --msd-lags, --density-map, --pca-projection, --pca-vectors,
+    /// --pca-extremes, --dssp-timeline).
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
     #[command(flatten)]
@@ -141,37 +138,13 @@ pub fn convert(a: &ConvertArgs) -> Result<()> {
     let format = match &a.output {
         Some(out) => Some(output_format("-o", out)?),
         None => {
-            let tables = [
-                &a.analysis.defect_table,
-                &a.analysis.grain_table,
-                &a.analysis.rdf_table,
-                &a.analysis.msd_table,
-                &a.analysis.msd_lags,
-                &a.analysis.vacf_table,
-                &a.analysis.vdos_table,
-                &a.analysis.sasa_table,
-                &a.analysis.gyration_table,
-                &a.analysis.sasa_residue_table,
-                &a.analysis.rmsd_table,
-                &a.analysis.rmsf_table,
-                &a.analysis.profile_table,
-                &a.analysis.dihedral_table,
-                &a.analysis.cluster_table,
-                &a.analysis.density_map,
-                &a.analysis.contacts_table,
-                &a.analysis.survival_table,
-                &a.analysis.pca_table,
-                &a.analysis.pca_projection,
-                &a.analysis.pca_vectors,
-                &a.analysis.pca_extremes,
-                &a.analysis.dssp_table,
-                &a.analysis.dssp_residue_table,
-                &a.analysis.dssp_timeline,
-            ];
-            if tables.iter().all(|t| t.is_none()) {
-                return usage(
-                    "nothing to write: give -o FILE, or a table of the analyses (--rdf-table, --msd-table, --msd-lags, --vacf-table, --vdos-table, --rmsd-table, --rmsf-table, --profile-table, --dihedral-table, --sasa-table, --sasa-residue-table, --gyration-table, --cluster-table, --grain-table, --defect-table, --density-map, --contacts-table, --survival-table, --pca-table, --pca-projection, --pca-vectors, --pca-extremes, --dssp-table, --dssp-residue-table, --dssp-timeline)",
-                );
+            let tables = a.analysis.outputs();
+            if tables.iter().all(|(_, given)| !given) {
+                let names: Vec<&str> = tables.iter().map(|(flag, _)| *flag).collect();
+                return usage(format!(
+                    "nothing to write: give -o FILE, or a table of the analyses ({})",
+                    names.join(", ")
+                ));
             }
             if a.select.is_some() || a.columns.is_some() {
                 return usage(

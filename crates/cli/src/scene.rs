@@ -740,6 +740,7 @@ pub fn mol_plan(args: &MolArgs, style: &StyleArgs, topology: Option<Topology>) -
         bond_orders: args.bond_orders,
         displacement: args.analysis.displacements || scalar_is("displacement"),
         measures: args
+            .analysis
             .measures
             .iter()
             .map(|m| {

@@ -81,6 +81,8 @@ pub(crate) struct AnalysisTables {
     survival: Option<SurvivalTable>,
     pca: Option<PcaTables>,
     dssp: Option<DsspTables>,
+    /// `--measure-table`, and the specs of its rows.
+    measure: Option<(crate::output::AtomicFile, Vec<String>)>,
 }
 
 /// `--contacts-table`: its file, groups and method, and the native contacts (set at the
@@ -1332,6 +1334,20 @@ impl AnalysisTables {
             contacts: ContactsTable::create(analysis, whole)?,
             pca: PcaTables::create(analysis, whole)?,
             dssp: DsspTables::create(analysis, whole)?,
+            measure: match per_frame_table(
+                &analysis.measure_table,
+                "--measure-table",
+                "frame,measure,kind,value,atoms,spec",
+                whole,
+            )? {
+                Some(_) if analysis.measures.is_empty() => {
+                    return usage(
+                        "--measure-table lists the --measure values: add a measurement, as --measure 'index 0; index 5'",
+                    );
+                }
+                Some(t) => Some((t, analysis.measures.clone())),
+                None => None,
+            },
             survival: SurvivalTable::create(
                 &analysis.survival_table,
                 "--survival-table",
@@ -1588,6 +1604,25 @@ impl AnalysisTables {
         if let Some(d) = &mut self.dssp {
             d.add(f, &time, md)?;
         }
+        if let Some((t, specs)) = &mut self.measure {
+            let mut rows = String::new();
+            for (m, (got, spec)) in plan
+                .last_measurements()
+                .iter()
+                .zip(specs.iter())
+                .enumerate()
+            {
+                let kind = ["distance", "angle", "dihedral"][got.atoms.len() - 2];
+                let atoms: Vec<String> = got.atoms.iter().map(|i| i.to_string()).collect();
+                let spec = spec.replace('"', "\"\"");
+                rows += &format!(
+                    "{f},{m},{kind},{:.6},{},\"{spec}\"\n",
+                    got.value,
+                    atoms.join(" ")
+                );
+            }
+            t.write(&rows)?;
+        }
         Ok(())
     }
 
@@ -1630,6 +1665,7 @@ impl AnalysisTables {
             .transpose()?
             .unwrap_or_default();
         for t in [
+            self.measure.map(|(t, _)| t),
             survival,
             self.contacts.map(|c| c.file),
             density,

@@ -2426,8 +2426,9 @@ fn trails_grow_over_the_frames_and_survive_sharding() {
 /// `--measure`: distances (one to a water far across the box: the nearest image), an angle and
 /// a backbone dihedral on MDAnalysis's solvated adenylate kinase, frame by frame, written by
 /// `--measure-table` as MDAnalysis's calc_bonds / calc_angles / calc_dihedrals give them with
-/// the box (md-io's tests/data/gen_measure.py); the dashes are drawn as the reference ray
-/// tracer traces them; a selection that picks two atoms is an error naming it.
+/// the box (md-io's tests/data/gen_measure.py), and `texmap convert` writes the same table
+/// without drawing; the dashes are drawn as the reference ray tracer traces them; a selection
+/// that picks two atoms is an error naming it.
 #[test]
 fn measurements_are_mdanalysis_values_and_drawn_as_traced() {
     let dir = tempfile::tempdir().unwrap();
@@ -2491,6 +2492,25 @@ fn measurements_are_mdanalysis_values_and_drawn_as_traced() {
         assert_eq!(f[2], kind);
         assert_eq!(f[5], format!("\"{}\"", specs[m]));
     }
+    // texmap convert measures the same frames without drawing them: the same table.
+    let converted = dir.path().join("c.csv");
+    let mut args = vec![
+        "convert",
+        "-q",
+        xtc.as_str(),
+        "--topology",
+        gro.as_str(),
+        "--frames",
+        "0:2",
+        "--measure-table",
+        converted.to_str().unwrap(),
+    ];
+    for s in &specs {
+        args.extend(["--measure", s]);
+    }
+    let o = texmap(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(std::fs::read_to_string(&converted).unwrap(), text);
     // The picture: dashes and labels against the reference ray tracer's dashes (the labels
     // are drawn on both alike).
     run("reference", "t%d.png", None);

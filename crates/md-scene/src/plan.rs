@@ -67,8 +67,9 @@
 //! spheres of its radius at the atoms' centres, hidden inside the atoms.
 //!
 //! # Measurements
-//! [`MolOptions::measures`] are measured in every frame as it is drawn (after the periodic
-//! treatment, the images and the alignment; [`crate::measure`]) and drawn as
+//! [`MolOptions::measures`] are measured in every frame [`MolPlan::prepare`] takes (after the
+//! periodic treatment, the images and the alignment; [`crate::measure`]), so a program that
+//! writes frames has their values too, and [`MolPlan::build`] draws them as
 //! [`crate::measure::MEASURE_DASHES`] yellow dashes per segment of radius
 //! [`crate::measure::MEASURE_RADIUS`], appended after every representation with their own
 //! bond radius; [`MolPlan::last_measurements`] gives their values and label places.
@@ -1481,6 +1482,11 @@ impl MolPlan {
                 crate::arrows::vectors(frame, source, self.arrow_reference.as_deref())
                     .map_err(MolError::Arrows)?;
         }
+        self.measured.clear();
+        for m in &self.options.measures {
+            self.measured
+                .push(m.measure(frame).map_err(MolError::Measure)?);
+        }
         Ok(())
     }
 
@@ -1558,29 +1564,23 @@ impl MolPlan {
         self.arrows = MolMesh::default();
         self.arrow_atoms.clear();
         self.ellipsoids.clear();
-        let mut drawn = self.draw_reps(builder, frame, &reps, scene);
+        let drawn = self.draw_reps(builder, frame, &reps, scene);
         self.reps = reps;
-        self.measured.clear();
-        if drawn.is_ok() && !self.options.measures.is_empty() {
-            drawn = self.draw_measures(builder, frame, scene);
+        if drawn.is_ok() && !self.measured.is_empty() {
+            self.draw_measures(builder, scene);
         }
         builder.refresh_materials(scene);
         drawn
     }
 
-    /// The measurements' dashes appended to `scene`, each bond then with its radius listed.
-    fn draw_measures(
-        &mut self,
-        builder: &mut SceneBuilder,
-        frame: &Frame,
-        scene: &mut SphereScene,
-    ) -> Result<(), MolError> {
+    /// The measurements' dashes ([`MolPlan::prepare`] measured them) appended to `scene`,
+    /// each bond then with its radius listed.
+    fn draw_measures(&self, builder: &mut SceneBuilder, scene: &mut SphereScene) {
         if scene.bond_radii.len() != scene.bonds.len() {
             scene.bond_radii = vec![scene.bond_radius; scene.bonds.len()];
         }
         let kind = builder.kind_of(MEASURE_COLOR);
-        for m in &self.options.measures {
-            let got = m.measure(frame).map_err(MolError::Measure)?;
+        for got in &self.measured {
             for w in got.points.windows(2) {
                 let before = scene.bonds.len();
                 push_dash_line(scene, w[0], w[1], kind, MEASURE_RADIUS, MEASURE_DASHES);
@@ -1589,9 +1589,7 @@ impl MolPlan {
                     .bond_radii
                     .extend(std::iter::repeat_n(MEASURE_RADIUS, added));
             }
-            self.measured.push(got);
         }
-        Ok(())
     }
 
     /// The last frame's cartoon ([`DrawStyle::Cartoon`]; empty without one).
