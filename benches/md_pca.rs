@@ -5,8 +5,12 @@
 //! plus 0.3 Å of noise: the frames kept, then the variances, five components and every frame's
 //! projections. 2 threads (the covariance products are shared, the eigensolver is one thread).
 //!
+//! Then the pairwise RMSD after superposition (`rmsd::rmsd_matrix`, what `--rmsd-matrix`
+//! computes) of the CA atoms over the first 500 frames, 2 threads.
+//!
 //! The peer, `benches/peers/mdanalysis_pca.py`, times MDAnalysis's `analysis.pca.PCA` plus
-//! `transform` on frames of the same sizes held in memory: run it in the same minutes.
+//! `transform` on frames of the same sizes held in memory, and `DistanceMatrix` with a
+//! superposing `rms.rmsd` on 500 frames of 214 atoms: run it in the same minutes.
 //!
 //! `cargo bench --bench md_pca -- --warm-up-time 1 --measurement-time 10`
 //! (test mode, `cargo test --bench md_pca`, uses 100 frames.)
@@ -71,6 +75,13 @@ fn bench(c: &mut Criterion) {
         // The five modes carry most of the motion: the components find them.
         let c = run();
         assert!(c.cumulated(4) > 0.5, "{sel}: {}", c.cumulated(4));
+        if sel == "name CA" {
+            let first = &walk[..frames / 2];
+            let name = format!("rmsd_matrix_{}_atoms_{}_frames", base.len(), first.len());
+            g.bench_function(name, |b| {
+                b.iter(|| texmap::md_io::rmsd::rmsd_matrix(first, usize::MAX).unwrap())
+            });
+        }
     }
     g.finish();
 }

@@ -1183,6 +1183,8 @@ impl AnalysisArgs {
             ("--dssp-residue-table", &self.dssp_residue_table),
             ("--dssp-timeline", &self.dssp_timeline),
             ("--measure-table", &self.measure_table),
+            ("--rmsd-matrix", &self.rmsd_matrix),
+            ("--rmsd-matrix-chart", &self.rmsd_matrix_chart),
         ]
         .into_iter()
         .map(|(flag, path)| (flag, path.is_some()))
@@ -1197,6 +1199,8 @@ impl AnalysisArgs {
 #[command(next_help_heading = "Analysis")]
 #[command(group(clap::ArgGroup::new("pca_out").multiple(true)
     .args(["pca_table", "pca_projection", "pca_vectors", "pca_extremes"])))]
+#[command(group(clap::ArgGroup::new("rmsd_matrix_out").multiple(true)
+    .args(["rmsd_matrix", "rmsd_matrix_chart"])))]
 pub struct AnalysisArgs {
     /// Give every atom the property `displacement`: its distance (Å) from where it was in the
     /// first frame drawn (or --displacement-reference), to the nearest periodic image (OVITO's
@@ -1329,6 +1333,28 @@ pub struct AnalysisArgs {
     /// times when the file has them), helices purple, strands yellow, coil white.
     #[arg(long, value_name = "FILE.png|FILE.svg")]
     pub dssp_timeline: Option<PathBuf>,
+    /// Also write the RMSD between every pair of frames as a CSV matrix (Å; gmx rms -m,
+    /// cpptraj's 2drms, MDAnalysis's DistanceMatrix with a superposing rms.rmsd): a header
+    /// row of frame numbers, then one row per frame, its number first. Each pair of
+    /// --rmsd-matrix-select's atoms is superposed on its own (centred, best rotation,
+    /// unweighted). Blocks of low values are the conformations the run visits. Written whole
+    /// or not at all; not with --shard.
+    #[arg(long, value_name = "FILE.csv")]
+    pub rmsd_matrix: Option<PathBuf>,
+    /// Also draw the pairwise RMSD matrix as a heatmap, PNG or SVG by the name: viridis from
+    /// 0 to the largest RMSD with a colour bar, frames (their times when the file has them)
+    /// along both axes; past 300 frames a cell is the mean of a block of frames.
+    #[arg(long, value_name = "FILE.png|FILE.svg")]
+    pub rmsd_matrix_chart: Option<PathBuf>,
+    /// The atoms --rmsd-matrix superposes (evaluated at the first frame; 'name CA' by
+    /// default).
+    #[arg(
+        long,
+        value_name = "SEL",
+        default_value = "name CA",
+        requires = "rmsd_matrix_out"
+    )]
+    pub rmsd_matrix_select: String,
     /// Also write the principal components of --pca-select's motion as a CSV table
     /// (MDAnalysis's analysis.pca.PCA, gmx covar): component, variance (Å², an eigenvalue of
     /// the positions' covariance over the frames), fraction of the total, cumulated fraction,

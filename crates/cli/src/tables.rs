@@ -81,6 +81,7 @@ pub(crate) struct AnalysisTables {
     survival: Option<SurvivalTable>,
     pca: Option<PcaTables>,
     dssp: Option<DsspTables>,
+    rmsd_matrix: Option<RmsdMatrix>,
     /// `--measure-table`, and the specs of its rows.
     measure: Option<(crate::output::AtomicFile, Vec<String>)>,
 }
@@ -605,28 +606,7 @@ impl DsspTables {
             why,
             whole,
         )?;
-        let timeline = match &analysis.dssp_timeline {
-            Some(_) if !whole => {
-                return usage(format!(
-                    "--dssp-timeline with --shard (or a Slurm array): {why}; draw it in a run of its own"
-                ));
-            }
-            Some(p) => match p
-                .extension()
-                .and_then(|e| e.to_str())
-                .map(str::to_ascii_lowercase)
-                .as_deref()
-            {
-                Some("png" | "svg") => Some(p.clone()),
-                _ => {
-                    return usage(format!(
-                        "--dssp-timeline {}: expected a .png or .svg file name",
-                        p.display()
-                    ));
-                }
-            },
-            None => None,
-        };
+        let timeline = chart_file(&analysis.dssp_timeline, "--dssp-timeline", why, whole)?;
         Ok(
             (table.is_some() || residues.is_some() || timeline.is_some()).then(|| DsspTables {
                 table,
@@ -705,36 +685,177 @@ impl DsspTables {
             t.write(&text)?;
         }
         if let Some(path) = &self.timeline {
-            // Times when every frame has one and they increase, else the frame numbers.
-            let timed = self.times.iter().all(Option::is_some)
-                && self.times.windows(2).all(|w| w[1] > w[0]);
-            let (x, label): (Vec<f64>, &str) = if timed {
-                (self.times.iter().flatten().copied().collect(), "time (ps)")
-            } else {
-                (self.frames.iter().map(|&f| f as f64).collect(), "frame")
-            };
+            let (x, label) = frame_axis(&self.frames, &self.times);
             let resids: Vec<i64> = self.labels.iter().map(|l| l.1).collect();
-            let svg = path
-                .extension()
-                .is_some_and(|e| e.eq_ignore_ascii_case("svg"));
-            crate::output::write_atomic(path, |tmp| {
-                use texmap_study::chart::{TIMELINE_SIZE, Target, structure_timeline};
-                if svg {
-                    let mut text = String::new();
-                    structure_timeline(&x, label, &resids, &self.classes, Target::Svg(&mut text))?;
-                    std::fs::write(tmp, text)?;
-                } else {
-                    let (w, h) = TIMELINE_SIZE;
-                    let mut rgb = vec![0u8; 3 * w as usize * h as usize];
-                    structure_timeline(&x, label, &resids, &self.classes, Target::Rgb(&mut rgb))?;
-                    image::RgbImage::from_raw(w, h, rgb)
-                        .expect("the chart's size")
-                        .save_with_format(tmp, image::ImageFormat::Png)?;
-                }
-                Ok(())
+            write_chart(path, texmap_study::chart::TIMELINE_SIZE, |t| {
+                texmap_study::chart::structure_timeline(&x, label, &resids, &self.classes, t)
             })?;
         }
         Ok([self.table, self.residues].into_iter().flatten().collect())
+    }
+}
+
+/// The file of a chart `flag` asks for: a .png or .svg name, refused for a part of a render
+/// split with --shard (`whole` false), saying `why`.
+fn chart_file(
+    path: &Option<PathBuf>,
+    flag: &str,
+    why: &str,
+    whole: bool,
+) -> Result<Option<PathBuf>> {
+    match path {
+        None => Ok(None),
+        Some(_) if !whole => usage(format!(
+            "{flag} with --shard (or a Slurm array): {why}; draw it in a run of its own"
+        )),
+        Some(p) => match p
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase)
+            .as_deref()
+        {
+            Some("png" | "svg") => Ok(Some(p.clone())),
+            _ => usage(format!(
+                "{flag} {}: expected a .png or .svg file name",
+                p.display()
+            )),
+        },
+    }
+}
+
+/// A chart's axis over the frames: their times (ps) when every frame has one and they
+/// increase, else the frame numbers; with the axis's title.
+fn frame_axis(frames: &[usize], times: &[Option<f64>]) -> (Vec<f64>, &'static str) {
+    let timed = times.iter().all(Option::is_some) && times.windows(2).all(|w| w[1] > w[0]);
+    if timed {
+        (times.iter().flatten().copied().collect(), "time (ps)")
+    } else {
+        (frames.iter().map(|&f| f as f64).collect(), "frame")
+    }
+}
+
+/// Draws a chart of `size` pixels into `path`, SVG or PNG by its extension, whole or not at all.
+fn write_chart(
+    path: &std::path::Path,
+    size: (u32, u32),
+    draw: impl Fn(texmap_study::chart::Target) -> Result<(), texmap_study::StudyError>,
+) -> Result<()> {
+    use texmap_study::chart::Target;
+    let svg = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("svg"));
+    crate::output::write_atomic(path, |tmp| {
+        if svg {
+            let mut text = String::new();
+            draw(Target::Svg(&mut text))?;
+            std::fs::write(tmp, text)?;
+        } else {
+            let (w, h) = size;
+            let mut rgb = vec![0u8; 3 * w as usize * h as usize];
+            draw(Target::Rgb(&mut rgb))?;
+            image::RgbImage::from_raw(w, h, rgb)
+                .expect("the chart's size")
+                .save_with_format(tmp, image::ImageFormat::Png)?;
+        }
+        Ok(())
+    })
+}
+
+/// `--rmsd-matrix` and `--rmsd-matrix-chart`: the selected atoms' positions every frame, the
+/// pairwise RMSD at the end.
+struct RmsdMatrix {
+    table: Option<crate::output::AtomicFile>,
+    chart: Option<PathBuf>,
+    select: texmap_md_io::select::Selection,
+    /// The first frame's selected atoms and atom count.
+    atoms: Vec<usize>,
+    n_atoms: usize,
+    positions: Vec<Vec<[f32; 3]>>,
+    frames: Vec<usize>,
+    times: Vec<Option<f64>>,
+    limit: usize,
+}
+
+impl RmsdMatrix {
+    fn create(analysis: &AnalysisArgs, whole: bool) -> Result<Option<RmsdMatrix>> {
+        let why = "the matrix pairs every frame with every other";
+        let table = whole_run_table(&analysis.rmsd_matrix, "--rmsd-matrix", why, whole)?;
+        let chart = chart_file(
+            &analysis.rmsd_matrix_chart,
+            "--rmsd-matrix-chart",
+            why,
+            whole,
+        )?;
+        if table.is_none() && chart.is_none() {
+            return Ok(None);
+        }
+        Ok(Some(RmsdMatrix {
+            table,
+            chart,
+            select: texmap_md_io::select::Selection::parse(&analysis.rmsd_matrix_select)
+                .map_err(|e| crate::args::UsageError(format!("--rmsd-matrix-select: {e}")))?,
+            atoms: Vec::new(),
+            n_atoms: 0,
+            positions: Vec::new(),
+            frames: Vec::new(),
+            times: Vec::new(),
+            limit: analysis.msd_memory.saturating_mul(1 << 20),
+        }))
+    }
+
+    /// Frame `f`'s positions of the atoms selected at the first.
+    fn add(&mut self, f: usize, md: &MdFrame) -> Result<()> {
+        if self.frames.is_empty() {
+            let pick = self
+                .select
+                .evaluate(md)
+                .map_err(|e| anyhow::anyhow!("--rmsd-matrix-select: frame {f}: {e}"))?;
+            self.atoms = (0..md.n_atoms()).filter(|&i| pick[i]).collect();
+            if self.atoms.is_empty() {
+                bail!("--rmsd-matrix-select: frame {f} has none of the atoms it picks");
+            }
+            self.n_atoms = md.n_atoms();
+        } else if md.n_atoms() != self.n_atoms {
+            bail!(
+                "--rmsd-matrix-select: frame {f} has {} atoms and the first {}: every frame must hold the same atoms",
+                md.n_atoms(),
+                self.n_atoms
+            );
+        }
+        self.positions
+            .push(self.atoms.iter().map(|&i| md.positions[i]).collect());
+        self.frames.push(f);
+        self.times.push(md.time);
+        Ok(())
+    }
+
+    /// The matrix written and drawn.
+    fn finish(mut self) -> Result<Option<crate::output::AtomicFile>> {
+        let m = texmap_md_io::rmsd::rmsd_matrix(&self.positions, self.limit)
+            .map_err(|e| anyhow::anyhow!("--rmsd-matrix: {e}"))?;
+        let n = self.frames.len();
+        if let Some(t) = &mut self.table {
+            let mut text = String::from("frame");
+            for f in &self.frames {
+                text.push_str(&format!(",{f}"));
+            }
+            text.push('\n');
+            for (f, row) in self.frames.iter().zip(m.chunks(n.max(1))) {
+                text.push_str(&f.to_string());
+                for v in row {
+                    text.push_str(&format!(",{v:.4}"));
+                }
+                text.push('\n');
+            }
+            t.write(&text)?;
+        }
+        if let Some(path) = &self.chart {
+            let (x, label) = frame_axis(&self.frames, &self.times);
+            write_chart(path, texmap_study::chart::HEATMAP_SIZE, |t| {
+                texmap_study::chart::matrix_heatmap(&x, label, &m, "RMSD (Å)", t)
+            })?;
+        }
+        Ok(self.table)
     }
 }
 
@@ -1334,6 +1455,7 @@ impl AnalysisTables {
             contacts: ContactsTable::create(analysis, whole)?,
             pca: PcaTables::create(analysis, whole)?,
             dssp: DsspTables::create(analysis, whole)?,
+            rmsd_matrix: RmsdMatrix::create(analysis, whole)?,
             measure: match per_frame_table(
                 &analysis.measure_table,
                 "--measure-table",
@@ -1604,6 +1726,9 @@ impl AnalysisTables {
         if let Some(d) = &mut self.dssp {
             d.add(f, &time, md)?;
         }
+        if let Some(r) = &mut self.rmsd_matrix {
+            r.add(f, md)?;
+        }
         if let Some((t, specs)) = &mut self.measure {
             let mut rows = String::new();
             for (m, (got, spec)) in plan
@@ -1664,7 +1789,13 @@ impl AnalysisTables {
             .map(DsspTables::finish)
             .transpose()?
             .unwrap_or_default();
+        let rmsd_matrix = self
+            .rmsd_matrix
+            .map(RmsdMatrix::finish)
+            .transpose()?
+            .flatten();
         for t in [
+            rmsd_matrix,
             self.measure.map(|(t, _)| t),
             survival,
             self.contacts.map(|c| c.file),

@@ -1765,3 +1765,76 @@ fn dssp_tables_are_mdanalysis_dssp() {
         stderr(&o)
     );
 }
+
+/// `--rmsd-matrix` over every second frame equals MDAnalysis's DistanceMatrix with a
+/// superposing rms.rmsd (md-io's data/pca/gen_rmsd_matrix.py) to the table's four decimals;
+/// `--rmsd-matrix-chart` draws it (PNG and SVG); a chart name of another kind is refused.
+#[test]
+fn rmsd_matrix_is_mdanalysis_distance_matrix() {
+    let dir = tempfile::tempdir().unwrap();
+    let reference = json("pca/rmsd_matrix_reference.json");
+    let (xtc, pdb) = (md_data("pca/helix_pca.xtc"), md_data("dihedrals/helix.pdb"));
+    let (csv, png, svg) = (
+        dir.path().join("m.csv"),
+        dir.path().join("m.png"),
+        dir.path().join("m.svg"),
+    );
+    run_ok(&[
+        "convert",
+        &xtc,
+        "--topology",
+        &pdb,
+        "--frames",
+        "::2",
+        "--rmsd-matrix",
+        csv.to_str().unwrap(),
+        "--rmsd-matrix-chart",
+        png.to_str().unwrap(),
+        "-q",
+    ]);
+    let (header, rows) = table(&csv);
+    let frames: Vec<String> = (0..80).step_by(2).map(|f| f.to_string()).collect();
+    assert_eq!(header, format!("frame,{}", frames.join(",")));
+    let want = numbers(&reference["matrix"]);
+    assert_eq!(rows.len(), 40);
+    for (i, row) in rows.iter().enumerate() {
+        assert_eq!(row[0], (2 * i) as f64);
+        for j in 0..40 {
+            let w = want[40 * i + j];
+            assert!(
+                (row[1 + j] - w).abs() < 6e-5,
+                "({i}, {j}): {} vs {w}",
+                row[1 + j]
+            );
+        }
+    }
+    let img = image::open(&png).unwrap().to_rgb8();
+    assert_eq!(img.dimensions(), (900, 760));
+    run_ok(&[
+        "convert",
+        &xtc,
+        "--topology",
+        &pdb,
+        "--frames",
+        "::4",
+        "--rmsd-matrix-chart",
+        svg.to_str().unwrap(),
+        "--rmsd-matrix-select",
+        "backbone",
+        "-q",
+    ]);
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(text.starts_with("<svg") && text.matches("<rect").count() >= 400);
+    let bad = dir.path().join("m.pdf");
+    let o = texmap(&[
+        "convert",
+        &xtc,
+        "--topology",
+        &pdb,
+        "--rmsd-matrix-chart",
+        bad.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--rmsd-matrix-chart"), "{}", stderr(&o));
+    assert!(!bad.exists());
+}

@@ -161,6 +161,7 @@ pub mod profile;
 mod psf;
 pub mod rdf;
 pub mod replicate;
+pub mod rmsd;
 pub mod rmsf;
 pub mod rotation;
 pub mod sasa;

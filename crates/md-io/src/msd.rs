@@ -58,6 +58,16 @@ pub enum MsdError {
     /// An atom's weight (a mass for [`crate::vacf::Velocities::density_of_states`]) is not
     /// positive and finite.
     Weight(usize),
+    /// A frame-by-frame matrix ([`crate::rmsd::rmsd_matrix`]) would take more than its
+    /// memory limit.
+    Matrix {
+        /// Frames.
+        frames: usize,
+        /// The bytes it would take.
+        bytes: usize,
+        /// The limit in bytes.
+        limit: usize,
+    },
     /// [`AllOrigins::mean`] was given a kind for another number of atoms than the frames'.
     KindCount {
         /// The frames' atoms.
@@ -83,6 +93,16 @@ impl fmt::Display for MsdError {
                 f,
                 "{frames} frames of {atoms} atoms need {} MB kept for the average over every time origin, over the limit of {} MB: take fewer frames (a --frames step) or raise the limit",
                 (frames * atoms * STORED_BYTES).div_ceil(1 << 20),
+                limit >> 20
+            ),
+            MsdError::Matrix {
+                frames,
+                bytes,
+                limit,
+            } => write!(
+                f,
+                "a {frames} x {frames} matrix of the frames needs {} MB, over the limit of {} MB: take fewer frames (a --frames step) or raise the limit",
+                bytes.div_ceil(1 << 20),
                 limit >> 20
             ),
             MsdError::Weight(i) => write!(f, "atom {i}'s mass is not positive and finite"),

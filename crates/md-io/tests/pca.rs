@@ -102,3 +102,23 @@ fn equals_mdanalysis_on_both_paths() {
         }
     }
 }
+
+/// The pairwise RMSD after superposition equals MDAnalysis's DistanceMatrix with rms.rmsd
+/// (center=True, superposition=True) on every second frame's CA atoms (gen_rmsd_matrix.py).
+#[test]
+fn rmsd_matrix_equals_mdanalysis() {
+    let text = std::fs::read_to_string(dir().join("rmsd_matrix_reference.json")).unwrap();
+    let reference: Value = serde_json::from_str(&text).unwrap();
+    let frames: Vec<Vec<[f32; 3]>> = positions("name CA").into_iter().step_by(2).collect();
+    assert_eq!(frames.len() as u64, reference["frames"].as_u64().unwrap());
+    let m = texmap_md_io::rmsd::rmsd_matrix(&frames, usize::MAX).unwrap();
+    let want = floats(&reference["matrix"]);
+    assert_eq!(m.len(), want.len());
+    for (k, (got, want)) in m.iter().zip(&want).enumerate() {
+        // Seven digits in the file; the XTC decoders may differ in a last f32 bit.
+        assert!(
+            (got - want).abs() < 1e-6 * want.max(1.0),
+            "pair {k}: {got} vs {want}"
+        );
+    }
+}

@@ -820,6 +820,140 @@ pub fn structure_timeline(
     )
 }
 
+/// Size of [`matrix_heatmap`] in pixels.
+pub const HEATMAP_SIZE: (u32, u32) = (900, 760);
+
+/// Most cells a side [`matrix_heatmap`] draws: a larger matrix is drawn as the means of
+/// blocks of its cells.
+pub const HEATMAP_CELLS: usize = 300;
+
+/// A square matrix over the frames (the pairwise RMSD of `texmap convert --rmsd-matrix`) as a
+/// heatmap in viridis from 0 to its largest value, with a colour bar titled `value_label`:
+/// frames along both axes, labelled by `x` (one value per frame: frame numbers or times),
+/// frame 0 at the bottom left. `matrix` is row-major `x.len()²`.
+pub fn matrix_heatmap(
+    x: &[f64],
+    x_label: &str,
+    matrix: &[f64],
+    value_label: &str,
+    target: Target,
+) -> Result<(), StudyError> {
+    use texmap_md_scene::Colormap;
+    let n = x.len();
+    if matrix.len() != n * n {
+        return Err(StudyError::BadOption {
+            what: "heatmap matrix length",
+            value: format!("{} (need {})", matrix.len(), n * n),
+        });
+    }
+    // Blocks of `b` frames a side, each drawn as its cells' mean.
+    let b = n.div_ceil(HEATMAP_CELLS).max(1);
+    let cells = n.div_ceil(b);
+    let mut blocks = vec![0.0f64; cells * cells];
+    for (bi, row) in blocks.chunks_mut(cells.max(1)).enumerate() {
+        for (bj, out) in row.iter_mut().enumerate() {
+            let (mut sum, mut count) = (0.0, 0usize);
+            for i in bi * b..((bi + 1) * b).min(n) {
+                for j in bj * b..((bj + 1) * b).min(n) {
+                    sum += matrix[i * n + j];
+                    count += 1;
+                }
+            }
+            *out = sum / count.max(1) as f64;
+        }
+    }
+    let top = matrix
+        .iter()
+        .fold(0.0f64, |m, v| m.max(*v))
+        .max(f64::MIN_POSITIVE);
+    let colour = |v: f64| {
+        let c = Colormap::Viridis.srgb((v / top) as f32);
+        RGBColor(
+            (c[0] * 255.0).round() as u8,
+            (c[1] * 255.0).round() as u8,
+            (c[2] * 255.0).round() as u8,
+        )
+    };
+    let cell = |v: f64| (v >= 0.0 && (v - v.round()).abs() < 1e-9).then_some(v.round() as usize);
+    let x_at = |v: &f64| {
+        let t = cell(*v).and_then(|i| x.get(i));
+        t.map(|t| format!("{}", (t * 1000.0).round() / 1000.0))
+            .unwrap_or_default()
+    };
+    #[allow(clippy::too_many_arguments)]
+    fn draw<DB: DrawingBackend>(
+        root: DrawingArea<DB, Shift>,
+        (n, cells, b): (usize, usize, usize),
+        blocks: &[f64],
+        top: f64,
+        colour: &dyn Fn(f64) -> RGBColor,
+        [x_label, value_label]: [&str; 2],
+        x_at: &dyn Fn(&f64) -> String,
+    ) -> Result<(), String> {
+        let e = |err: DrawingAreaErrorKind<DB::ErrorType>| err.to_string();
+        root.fill(&WHITE).map_err(e)?;
+        let (main, bar) = root.split_horizontally(HEATMAP_SIZE.0 - 130);
+        let mut chart = ChartBuilder::on(&main)
+            .margin(16)
+            .x_label_area_size(44)
+            .y_label_area_size(60)
+            .build_cartesian_2d(0.0..n as f64, 0.0..n as f64)
+            .map_err(e)?;
+        chart
+            .configure_mesh()
+            .disable_mesh()
+            .x_desc(x_label)
+            .y_desc(x_label)
+            .x_label_formatter(x_at)
+            .y_label_formatter(x_at)
+            .label_style(("sans-serif", 14))
+            .draw()
+            .map_err(e)?;
+        let bf = b as f64;
+        chart
+            .draw_series((0..cells * cells).map(|k| {
+                let (i, j) = (k / cells, k % cells);
+                let (x0, y0) = (j as f64 * bf, i as f64 * bf);
+                Rectangle::new(
+                    [(x0, y0), ((x0 + bf).min(n as f64), (y0 + bf).min(n as f64))],
+                    colour(blocks[k]).filled(),
+                )
+            }))
+            .map_err(e)?;
+        // The colour bar: 100 steps from 0 to the largest value.
+        let mut scale = ChartBuilder::on(&bar)
+            .margin_top(16)
+            .margin_bottom(60)
+            .margin_right(16)
+            .y_label_area_size(56)
+            .caption(value_label, ("sans-serif", 14))
+            .build_cartesian_2d(0.0..1.0, 0.0..top)
+            .map_err(e)?;
+        scale
+            .configure_mesh()
+            .disable_mesh()
+            .disable_x_axis()
+            .label_style(("sans-serif", 13))
+            .draw()
+            .map_err(e)?;
+        scale
+            .draw_series((0..100).map(|k| {
+                let (v0, v1) = (top * k as f64 / 100.0, top * (k + 1) as f64 / 100.0);
+                Rectangle::new([(0.0, v0), (1.0, v1)], colour(0.5 * (v0 + v1)).filled())
+            }))
+            .map_err(e)?;
+        root.present().map_err(e)
+    }
+    let labels = [x_label, value_label];
+    draw_on(
+        "matrix_heatmap",
+        target,
+        HEATMAP_SIZE,
+        |a| draw(a, (n, cells, b), &blocks, top, &colour, labels, &x_at),
+        |a| draw(a, (n, cells, b), &blocks, top, &colour, labels, &x_at),
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -878,6 +1012,52 @@ mod tests {
         let mut svg = String::new();
         structure_timeline(&x, "time (ps)", &resids, &classes, Target::Svg(&mut svg)).unwrap();
         assert!(svg.contains("helix") && svg.contains("strand") && svg.contains("time (ps)"));
+    }
+
+    #[test]
+    fn matrix_heatmap_colours_by_value_and_blocks_large_matrices() {
+        // Two states: frames 0-29 and 30-59, 0.5 Å apart within a state and 2 Å across.
+        let n = 60;
+        let m: Vec<f64> = (0..n * n)
+            .map(|k| {
+                let (i, j) = (k / n, k % n);
+                if i == j {
+                    0.0
+                } else if (i < 30) == (j < 30) {
+                    0.5
+                } else {
+                    2.0
+                }
+            })
+            .collect();
+        let x: Vec<f64> = (0..n).map(|f| f as f64).collect();
+        let (w, h) = HEATMAP_SIZE;
+        let mut rgb = vec![0u8; 3 * (w * h) as usize];
+        matrix_heatmap(&x, "frame", &m, "RMSD (Å)", Target::Rgb(&mut rgb)).unwrap();
+        let c = |v: f64| {
+            let c = texmap_md_scene::Colormap::Viridis.srgb((v / 2.0) as f32);
+            c.map(|x| (x * 255.0).round() as u8)
+        };
+        let count = |want: [u8; 3]| rgb.chunks_exact(3).filter(|p| *p == want).count();
+        // The across-state blocks are half the matrix, the within-state ones the other half
+        // (their diagonals aside); the colour bar adds a few pixels of each.
+        let (across, within) = (count(c(2.0)), count(c(0.5)));
+        assert!(across > 50_000, "{across}");
+        assert!(
+            (across as f64 / within as f64 - 1.0).abs() < 0.1,
+            "{across} vs {within}"
+        );
+        // 700 frames are drawn as 234 blocks of 3 a side (HEATMAP_CELLS at most).
+        let n = 700;
+        let big: Vec<f64> = (0..n * n)
+            .map(|k| ((k / n) as f64 - (k % n) as f64).abs())
+            .collect();
+        let x: Vec<f64> = (0..n).map(|f| f as f64 * 10.0).collect();
+        let mut svg = String::new();
+        matrix_heatmap(&x, "time (ps)", &big, "RMSD (Å)", Target::Svg(&mut svg)).unwrap();
+        let rects = svg.matches("<rect").count();
+        assert!(rects < 300 * 300 + 200 && rects > 200 * 200, "{rects}");
+        assert!(matrix_heatmap(&x, "t", &big[1..], "v", Target::Svg(&mut String::new())).is_err());
     }
 
     fn rec(method: &str, scene: &str, ms: f64, psnr: f64) -> Record {
