@@ -761,15 +761,65 @@ fn write_chart(
     })
 }
 
+/// The atoms a selection (`flag`'s) picks at the first frame, followed through the later
+/// frames, which must hold as many atoms.
+struct Picked {
+    flag: &'static str,
+    select: texmap_md_io::select::Selection,
+    atoms: Vec<usize>,
+    n_atoms: usize,
+}
+
+impl Picked {
+    fn new(flag: &'static str, text: &str) -> Result<Picked> {
+        Ok(Picked {
+            flag,
+            select: texmap_md_io::select::Selection::parse(text)
+                .map_err(|e| crate::args::UsageError(format!("{flag}: {e}")))?,
+            atoms: Vec::new(),
+            n_atoms: 0,
+        })
+    }
+
+    /// Frame `f`'s positions of the picked atoms, picking them first when `first`.
+    fn positions(&mut self, f: usize, md: &MdFrame, first: bool) -> Result<Vec<[f32; 3]>> {
+        let flag = self.flag;
+        if first {
+            let pick = self
+                .select
+                .evaluate(md)
+                .map_err(|e| anyhow::anyhow!("{flag}: frame {f}: {e}"))?;
+            self.atoms = (0..md.n_atoms()).filter(|&i| pick[i]).collect();
+            if self.atoms.is_empty() {
+                bail!("{flag}: frame {f} has none of the atoms it picks");
+            }
+            self.n_atoms = md.n_atoms();
+        } else if md.n_atoms() != self.n_atoms {
+            bail!(
+                "{flag}: frame {f} has {} atoms and the first {}: every frame must hold the same atoms",
+                md.n_atoms(),
+                self.n_atoms
+            );
+        }
+        Ok(self.atoms.iter().map(|&i| md.positions[i]).collect())
+    }
+
+    /// The picked atoms as a mask over the first frame's.
+    fn mask(&self) -> Vec<bool> {
+        let mut mask = vec![false; self.n_atoms];
+        for &i in &self.atoms {
+            mask[i] = true;
+        }
+        mask
+    }
+}
+
 /// `--rmsd-matrix` and `--rmsd-matrix-chart`: the selected atoms' positions every frame, the
 /// pairwise RMSD at the end.
 struct RmsdMatrix {
     table: Option<crate::output::AtomicFile>,
     chart: Option<PathBuf>,
-    select: texmap_md_io::select::Selection,
-    /// The first frame's selected atoms and atom count.
-    atoms: Vec<usize>,
-    n_atoms: usize,
+    picked: Picked,
     positions: Vec<Vec<[f32; 3]>>,
     frames: Vec<usize>,
     times: Vec<Option<f64>>,
@@ -792,10 +842,7 @@ impl RmsdMatrix {
         Ok(Some(RmsdMatrix {
             table,
             chart,
-            select: texmap_md_io::select::Selection::parse(&analysis.rmsd_matrix_select)
-                .map_err(|e| crate::args::UsageError(format!("--rmsd-matrix-select: {e}")))?,
-            atoms: Vec::new(),
-            n_atoms: 0,
+            picked: Picked::new("--rmsd-matrix-select", &analysis.rmsd_matrix_select)?,
             positions: Vec::new(),
             frames: Vec::new(),
             times: Vec::new(),
@@ -805,25 +852,8 @@ impl RmsdMatrix {
 
     /// Frame `f`'s positions of the atoms selected at the first.
     fn add(&mut self, f: usize, md: &MdFrame) -> Result<()> {
-        if self.frames.is_empty() {
-            let pick = self
-                .select
-                .evaluate(md)
-                .map_err(|e| anyhow::anyhow!("--rmsd-matrix-select: frame {f}: {e}"))?;
-            self.atoms = (0..md.n_atoms()).filter(|&i| pick[i]).collect();
-            if self.atoms.is_empty() {
-                bail!("--rmsd-matrix-select: frame {f} has none of the atoms it picks");
-            }
-            self.n_atoms = md.n_atoms();
-        } else if md.n_atoms() != self.n_atoms {
-            bail!(
-                "--rmsd-matrix-select: frame {f} has {} atoms and the first {}: every frame must hold the same atoms",
-                md.n_atoms(),
-                self.n_atoms
-            );
-        }
-        self.positions
-            .push(self.atoms.iter().map(|&i| md.positions[i]).collect());
+        let positions = self.picked.positions(f, md, self.frames.is_empty())?;
+        self.positions.push(positions);
         self.frames.push(f);
         self.times.push(md.time);
         Ok(())
@@ -866,15 +896,13 @@ struct PcaTables {
     projection: Option<crate::output::AtomicFile>,
     vectors: Option<crate::output::AtomicFile>,
     extremes: Option<(PathBuf, texmap_md_io::Format)>,
-    select: texmap_md_io::select::Selection,
+    picked: Picked,
     components: usize,
     /// `--pca-mode` (0-based) and `--pca-extreme-frames`.
     mode: usize,
     extreme_frames: usize,
-    /// The first frame: the selected atoms, its atom count, each atom's first columns, the
-    /// selected atoms alone (the extremes' template).
-    atoms: Vec<usize>,
-    n_atoms: usize,
+    /// The first frame: each atom's first columns, the selected atoms alone (the extremes'
+    /// template).
     rows: Vec<String>,
     template: MdFrame,
     pca: texmap_md_io::pca::Pca,
@@ -916,13 +944,10 @@ impl PcaTables {
             projection,
             vectors,
             extremes,
-            select: texmap_md_io::select::Selection::parse(&analysis.pca_select)
-                .map_err(|e| crate::args::UsageError(format!("--pca-select: {e}")))?,
+            picked: Picked::new("--pca-select", &analysis.pca_select)?,
             components,
             mode,
             extreme_frames: analysis.pca_extreme_frames as usize,
-            atoms: Vec::new(),
-            n_atoms: 0,
             rows: Vec::new(),
             template: MdFrame::new(),
             pca: texmap_md_io::pca::Pca::new(analysis.msd_memory.saturating_mul(1 << 20)),
@@ -933,27 +958,13 @@ impl PcaTables {
 
     /// Frame `f`'s positions of the atoms selected at the first.
     fn add(&mut self, f: usize, md: &MdFrame) -> Result<()> {
-        if self.frames.is_empty() {
-            let pick = self
-                .select
-                .evaluate(md)
-                .map_err(|e| anyhow::anyhow!("--pca-select: frame {f}: {e}"))?;
-            self.atoms = (0..md.n_atoms()).filter(|&i| pick[i]).collect();
-            if self.atoms.is_empty() {
-                bail!("--pca-select: frame {f} has none of the atoms it picks");
-            }
-            self.n_atoms = md.n_atoms();
+        let first = self.frames.is_empty();
+        let positions = self.picked.positions(f, md, first)?;
+        if first {
             self.rows = (0..md.n_atoms()).map(|i| atom_columns(md, i)).collect();
             self.template = md.clone();
-            self.template.retain_atoms(&pick);
-        } else if md.n_atoms() != self.n_atoms {
-            bail!(
-                "--pca-select: frame {f} has {} atoms and the first {}: every frame must hold the same atoms",
-                md.n_atoms(),
-                self.n_atoms
-            );
+            self.template.retain_atoms(&self.picked.mask());
         }
-        let positions: Vec<[f32; 3]> = self.atoms.iter().map(|&i| md.positions[i]).collect();
         self.pca
             .add(&positions)
             .map_err(|e| anyhow::anyhow!("--pca-select: frame {f}: {e}"))?;
@@ -1017,7 +1028,7 @@ impl PcaTables {
                 text.push_str(&format!(",pc{n}x,pc{n}y,pc{n}z"));
             }
             text.push('\n');
-            let mut at = self.atoms.iter().enumerate().peekable();
+            let mut at = self.picked.atoms.iter().enumerate().peekable();
             for (i, row) in self.rows.iter().enumerate() {
                 text.push_str(row);
                 match at.next_if(|(_, a)| **a == i) {
@@ -1066,7 +1077,7 @@ impl PcaTables {
             .collect();
         crate::note!(
             "principal components of {} atoms over {} frames: {}; the first {} carry {:.1} %",
-            self.atoms.len(),
+            self.picked.atoms.len(),
             self.frames.len(),
             shown.join(", "),
             k.min(c.variance.len()),
