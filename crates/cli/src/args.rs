@@ -1045,16 +1045,6 @@ pub struct MolArgs {
     /// the atoms inside show through, as the surface style's --surface-opacity).
     #[arg(long, value_name = "A", default_value_t = 1.0)]
     pub isosurface_opacity: f32,
-    /// The hbonds style's largest donor-acceptor distance, Å (MDAnalysis's default 3.0; up to
-    /// 6). A hydrogen bonded to an N or O donates to an N or O acceptor within it when the
-    /// donor-hydrogen-acceptor angle is at least --hbond-angle; distances use the nearest
-    /// periodic image.
-    #[arg(long, value_name = "Å", default_value_t = texmap_md_io::hbonds::DEFAULT_DISTANCE)]
-    pub hbond_distance: f32,
-    /// The hbonds style's smallest donor-hydrogen-acceptor angle, degrees (MDAnalysis's
-    /// default 150; VMD's angle cutoff of 20 is 160 here).
-    #[arg(long, value_name = "DEG", default_value_t = texmap_md_io::hbonds::DEFAULT_ANGLE)]
-    pub hbond_angle: f32,
     /// The arrows style's vectors: `velocity` (the file's, Å/ps), `displacement` (from the
     /// first frame drawn or --displacement-reference, to the nearest periodic image: OVITO's
     /// Displacements) or the stem of
@@ -1082,38 +1072,6 @@ pub struct MolArgs {
     /// as a stick with a dashed line inside the ring.
     #[arg(long)]
     pub bond_orders: bool,
-    /// Also write the hydrogen bonds the hbonds style draws as a CSV table, one row per bond and
-    /// frame: frame, donor, hydrogen, acceptor (0-based atom indices, as MDAnalysis's
-    /// results.hbonds), the three atoms as RESNAME RESID:NAME, the donor-acceptor distance (Å)
-    /// and the donor-hydrogen-acceptor angle (degrees). Written whole or not at all.
-    #[arg(long, value_name = "FILE.csv")]
-    pub hbond_table: Option<PathBuf>,
-    /// Also write how long the hydrogen bonds the hbonds style draws last, as a CSV table (MDAnalysis's
-    /// HydrogenBondAnalysis.lifetime): lag (frames drawn), time (ps, when the frames' times
-    /// are evenly spaced), survival: of the bonds at a frame, the share present at every frame
-    /// up to the lag, averaged over every frame as the origin (a bond is its hydrogen and
-    /// acceptor). Prints the lifetime, ∫ S dτ by the trapezoid rule up to --hbond-lifetime-max
-    /// (longer when S has not decayed there). Written whole or not at all; not with --shard.
-    #[arg(long, value_name = "FILE.csv")]
-    pub hbond_lifetime: Option<PathBuf>,
-    /// The longest lag of --hbond-lifetime, in frames drawn (MDAnalysis's tau_max).
-    #[arg(
-        long,
-        value_name = "FRAMES",
-        default_value_t = 20,
-        requires = "hbond_lifetime"
-    )]
-    pub hbond_lifetime_max: usize,
-    /// --hbond-lifetime counts a bond absent for up to N consecutive frames between two
-    /// frames that have it as unbroken (MDAnalysis's intermittency; 0, the default, is the
-    /// continuous lifetime).
-    #[arg(
-        long,
-        value_name = "N",
-        default_value_t = 0,
-        requires = "hbond_lifetime"
-    )]
-    pub hbond_intermittency: usize,
     /// Draw each atom with the radius (Å) a per-atom property gives: PQR's 'radius'
     /// (PDB2PQR/APBS radii), any dump column (texmap info lists them), --property FILE's
     /// numbers. As a file's radius column: --radius-scale does not apply, ball-and-stick
@@ -1184,6 +1142,8 @@ impl AnalysisArgs {
             ("--dssp-timeline", &self.dssp_timeline),
             ("--measure-table", &self.measure_table),
             ("--rmsd-matrix", &self.rmsd_matrix),
+            ("--hbond-table", &self.hbond_table),
+            ("--hbond-lifetime", &self.hbond_lifetime),
             ("--rmsd-matrix-chart", &self.rmsd_matrix_chart),
         ]
         .into_iter()
@@ -1302,6 +1262,48 @@ pub struct AnalysisArgs {
         requires = "survival_table"
     )]
     pub survival_intermittency: usize,
+    /// The hydrogen bonds' largest donor-acceptor distance (the hbonds style's, --hbonds'), Å (MDAnalysis's default 3.0; up to
+    /// 6). A hydrogen bonded to an N or O donates to an N or O acceptor within it when the
+    /// donor-hydrogen-acceptor angle is at least --hbond-angle; distances use the nearest
+    /// periodic image.
+    #[arg(long, value_name = "Å", default_value_t = texmap_md_io::hbonds::DEFAULT_DISTANCE)]
+    pub hbond_distance: f32,
+    /// The hydrogen bonds' smallest donor-hydrogen-acceptor angle, degrees (MDAnalysis's
+    /// default 150; VMD's angle cutoff of 20 is 160 here).
+    #[arg(long, value_name = "DEG", default_value_t = texmap_md_io::hbonds::DEFAULT_ANGLE)]
+    pub hbond_angle: f32,
+    /// Also write the hydrogen bonds as a CSV table, one row per bond and frame (texmap render:
+    /// those its hbonds style draws; texmap convert: those among --hbonds' atoms): frame, donor, hydrogen, acceptor (0-based atom indices, as MDAnalysis's
+    /// results.hbonds), the three atoms as RESNAME RESID:NAME, the donor-acceptor distance (Å)
+    /// and the donor-hydrogen-acceptor angle (degrees). Written whole or not at all.
+    #[arg(long, value_name = "FILE.csv")]
+    pub hbond_table: Option<PathBuf>,
+    /// Also write how long the hydrogen bonds (as --hbond-table's) last, as a CSV table (MDAnalysis's
+    /// HydrogenBondAnalysis.lifetime): lag (frames drawn), time (ps, when the frames' times
+    /// are evenly spaced), survival: of the bonds at a frame, the share present at every frame
+    /// up to the lag, averaged over every frame as the origin (a bond is its hydrogen and
+    /// acceptor). Prints the lifetime, ∫ S dτ by the trapezoid rule up to --hbond-lifetime-max
+    /// (longer when S has not decayed there). Written whole or not at all; not with --shard.
+    #[arg(long, value_name = "FILE.csv")]
+    pub hbond_lifetime: Option<PathBuf>,
+    /// The longest lag of --hbond-lifetime, in frames drawn (MDAnalysis's tau_max).
+    #[arg(
+        long,
+        value_name = "FRAMES",
+        default_value_t = 20,
+        requires = "hbond_lifetime"
+    )]
+    pub hbond_lifetime_max: usize,
+    /// --hbond-lifetime counts a bond absent for up to N consecutive frames between two
+    /// frames that have it as unbroken (MDAnalysis's intermittency; 0, the default, is the
+    /// continuous lifetime).
+    #[arg(
+        long,
+        value_name = "N",
+        default_value_t = 0,
+        requires = "hbond_lifetime"
+    )]
+    pub hbond_intermittency: usize,
     /// Measure, as PyMOL's distance, angle and dihedral: 'SEL; SEL' (a distance, Å),
     /// 'SEL; SEL; SEL' (the angle at the middle atom) or four (the dihedral about the middle
     /// bond, IUPAC's sign), each SEL picking exactly one atom in every frame, through the

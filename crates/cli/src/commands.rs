@@ -16,7 +16,7 @@ use texmap_study::scenes::{self, NamedScene, SceneId};
 use crate::args::{Cli, Command, CompareArgs, MethodArg, RenderArgs, SceneArg, usage};
 use crate::output::{write_atomic, write_png};
 use crate::scene::{parse_background, parse_size, warning_text};
-use crate::tables::{AnalysisTables, per_frame_table};
+use crate::tables::AnalysisTables;
 
 /// `--quiet`: no progress bars and no notes (warnings and errors still print).
 static QUIET: AtomicBool = AtomicBool::new(false);
@@ -769,8 +769,8 @@ fn render(a: &RenderArgs) -> Result<()> {
         return usage("--label {grains} counts the grains --grains finds: add --grains");
     }
     for (given, flag) in [
-        (a.mol.hbond_table.is_some(), "--hbond-table"),
-        (a.mol.hbond_lifetime.is_some(), "--hbond-lifetime"),
+        (a.mol.analysis.hbond_table.is_some(), "--hbond-table"),
+        (a.mol.analysis.hbond_lifetime.is_some(), "--hbond-lifetime"),
     ] {
         if given && !plan.draws_hbonds() {
             return usage(format!(
@@ -779,19 +779,6 @@ fn render(a: &RenderArgs) -> Result<()> {
         }
     }
     let whole = mine.len() == frames.len();
-    let mut hbond_table = per_frame_table(
-        &a.mol.hbond_table,
-        "--hbond-table",
-        "frame,donor,hydrogen,acceptor,donor_atom,hydrogen_atom,acceptor_atom,distance,angle",
-        whole,
-    )?;
-    let mut hbond_lifetime = crate::tables::SurvivalTable::create(
-        &a.mol.hbond_lifetime,
-        "--hbond-lifetime",
-        (a.mol.hbond_lifetime_max, a.mol.hbond_intermittency),
-        whole,
-        None,
-    )?;
     let mut analysis_tables = AnalysisTables::create(&a.mol.analysis, whole)?;
     if let Some(r) = &a.mol.analysis.displacement_reference {
         set_displacement_reference(&mut plan, r, &mut traj, &a.file, options)?;
@@ -858,15 +845,6 @@ fn render(a: &RenderArgs) -> Result<()> {
             let (mesh, materials) = iso.for_scene(scene.materials.len());
             scene.materials.extend(materials);
             iso_mesh = mesh;
-        }
-        if let Some(t) = &mut hbond_table
-            && mine.contains(&k)
-        {
-            t.write(&hbond_rows(f, plan.last_hbonds(), &md))
-                .map_err(|e| fail(e, &written))?;
-        }
-        if let Some(l) = &mut hbond_lifetime {
-            l.add_hbonds(plan.last_hbonds(), md.time);
         }
         if mine.contains(&k) {
             analysis_tables
@@ -1219,12 +1197,6 @@ fn render(a: &RenderArgs) -> Result<()> {
     }
     pb.finish_and_clear();
     let movie = sink.finish()?;
-    if let Some(t) = hbond_table {
-        t.commit()?;
-    }
-    if let Some(l) = hbond_lifetime {
-        l.finish()?.commit()?;
-    }
     analysis_tables.commit()?;
     if builder.merged_colors() > 0 {
         eprintln!(
@@ -1258,41 +1230,6 @@ fn render(a: &RenderArgs) -> Result<()> {
         None => crate::note!("wrote {} frame(s)", mine.len()),
     }
     Ok(())
-}
-
-/// The `--hbond-table` rows of frame `f` (see the flag).
-fn hbond_rows(f: usize, bonds: &[texmap_md_io::hbonds::HBond], md: &MdFrame) -> String {
-    use std::fmt::Write;
-    let atom = |i: u32| {
-        let i = i as usize;
-        let label = |v: &[texmap_md_io::Label]| v.get(i).map(|l| l.as_str().to_string());
-        let res = label(&md.res_names).unwrap_or_default();
-        let id = md.res_ids.get(i).map(|r| r.to_string()).unwrap_or_default();
-        let name = label(&md.names).unwrap_or_else(|| format!("#{i}"));
-        let text = format!("{res}{id}:{name}");
-        // CSV quoting (RFC 4180) for names that hold a comma or a quote.
-        if text.contains([',', '"', '\n', '\r']) {
-            format!("\"{}\"", text.replace('"', "\"\""))
-        } else {
-            text
-        }
-    };
-    let mut out = String::new();
-    for b in bonds {
-        let _ = writeln!(
-            out,
-            "{f},{},{},{},{},{},{},{:.4},{:.3}",
-            b.donor,
-            b.hydrogen,
-            b.acceptor,
-            atom(b.donor),
-            atom(b.hydrogen),
-            atom(b.acceptor),
-            b.distance,
-            b.angle
-        );
-    }
-    out
 }
 
 fn named_scene(a: &CompareArgs) -> Result<NamedScene> {

@@ -69,6 +69,12 @@ pub struct ConvertArgs {
     /// --pca-extremes, --dssp-timeline).
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
+    /// Find the hydrogen bonds among the atoms SEL picks in every frame (MDAnalysis's
+    /// HydrogenBondAnalysis criterion: --hbond-distance, --hbond-angle; donors from the
+    /// topology's bonds, or bonds by distance) for --hbond-table and --hbond-lifetime:
+    /// 'protein', 'protein or water'.
+    #[arg(long, value_name = "SEL")]
+    pub hbonds: Option<String>,
     #[command(flatten)]
     pub analysis: AnalysisArgs,
 }
@@ -188,6 +194,23 @@ pub fn convert(a: &ConvertArgs) -> Result<()> {
         .transpose()?;
     let (mol, style) = plan_args(a)?;
     let mut plan = crate::scene::mol_plan(&mol, &style, topology)?;
+    let wants_hbonds = a.analysis.hbond_table.is_some() || a.analysis.hbond_lifetime.is_some();
+    match (&a.hbonds, wants_hbonds) {
+        (Some(sel), true) => {
+            plan.set_hbond_select(Some(crate::scene::parse_selection("--hbonds", sel)?))
+        }
+        (Some(_), false) => {
+            return usage(
+                "--hbonds finds the bonds --hbond-table and --hbond-lifetime write: add one",
+            );
+        }
+        (None, true) => {
+            return usage(
+                "--hbond-table and --hbond-lifetime list the hydrogen bonds among --hbonds' atoms: add it, as --hbonds 'protein or water'",
+            );
+        }
+        (None, false) => {}
+    }
     if let Some(r) = &a.analysis.displacement_reference {
         crate::commands::set_displacement_reference(&mut plan, r, &mut traj, &a.file, options)?;
     }

@@ -719,9 +719,10 @@ pub fn mol_plan(args: &MolArgs, style: &StyleArgs, topology: Option<Topology>) -
             invert: args.slice_invert,
         }),
         hbonds: texmap_md_io::hbonds::Criteria {
-            distance: args.hbond_distance,
-            angle: args.hbond_angle,
+            distance: args.analysis.hbond_distance,
+            angle: args.analysis.hbond_angle,
         },
+        hbond_select: None,
         arrows: texmap_md_scene::arrows::ArrowOptions {
             source: match args.arrows.as_str() {
                 "velocity" | "velocities" => texmap_md_scene::arrows::ArrowSource::Velocity,
@@ -850,6 +851,7 @@ pub fn mol_error(e: MolError) -> anyhow::Error {
                 SelectionRole::Align => "--align",
                 SelectionRole::Cluster => "--cluster-atoms",
                 SelectionRole::Sasa => "--sasa",
+                SelectionRole::HBonds => "--hbonds",
             };
             // A property an analysis computes: name the flag that computes it.
             if let Some((_, hint)) = ANALYSIS_PROPERTIES

@@ -82,6 +82,9 @@ pub(crate) struct AnalysisTables {
     pca: Option<PcaTables>,
     dssp: Option<DsspTables>,
     rmsd_matrix: Option<RmsdMatrix>,
+    /// `--hbond-table` and `--hbond-lifetime`: the plan's hydrogen bonds of every frame.
+    hbond: Option<crate::output::AtomicFile>,
+    hbond_lifetime: Option<SurvivalTable>,
     /// `--measure-table`, and the specs of its rows.
     measure: Option<(crate::output::AtomicFile, Vec<String>)>,
 }
@@ -1467,6 +1470,19 @@ impl AnalysisTables {
             pca: PcaTables::create(analysis, whole)?,
             dssp: DsspTables::create(analysis, whole)?,
             rmsd_matrix: RmsdMatrix::create(analysis, whole)?,
+            hbond: per_frame_table(
+                &analysis.hbond_table,
+                "--hbond-table",
+                "frame,donor,hydrogen,acceptor,donor_atom,hydrogen_atom,acceptor_atom,distance,angle",
+                whole,
+            )?,
+            hbond_lifetime: SurvivalTable::create(
+                &analysis.hbond_lifetime,
+                "--hbond-lifetime",
+                (analysis.hbond_lifetime_max, analysis.hbond_intermittency),
+                whole,
+                None,
+            )?,
             measure: match per_frame_table(
                 &analysis.measure_table,
                 "--measure-table",
@@ -1740,6 +1756,12 @@ impl AnalysisTables {
         if let Some(r) = &mut self.rmsd_matrix {
             r.add(f, md)?;
         }
+        if let Some(t) = &mut self.hbond {
+            t.write(&hbond_rows(f, plan.last_hbonds(), md))?;
+        }
+        if let Some(l) = &mut self.hbond_lifetime {
+            l.add_hbonds(plan.last_hbonds(), md.time);
+        }
         if let Some((t, specs)) = &mut self.measure {
             let mut rows = String::new();
             for (m, (got, spec)) in plan
@@ -1805,7 +1827,10 @@ impl AnalysisTables {
             .map(RmsdMatrix::finish)
             .transpose()?
             .flatten();
+        let hbond_lifetime = self.hbond_lifetime.map(SurvivalTable::finish).transpose()?;
         for t in [
+            self.hbond,
+            hbond_lifetime,
             rmsd_matrix,
             self.measure.map(|(t, _)| t),
             survival,
@@ -1835,4 +1860,39 @@ impl AnalysisTables {
         }
         Ok(())
     }
+}
+
+/// The `--hbond-table` rows of frame `f` (see the flag).
+pub(crate) fn hbond_rows(f: usize, bonds: &[texmap_md_io::hbonds::HBond], md: &MdFrame) -> String {
+    use std::fmt::Write;
+    let atom = |i: u32| {
+        let i = i as usize;
+        let label = |v: &[texmap_md_io::Label]| v.get(i).map(|l| l.as_str().to_string());
+        let res = label(&md.res_names).unwrap_or_default();
+        let id = md.res_ids.get(i).map(|r| r.to_string()).unwrap_or_default();
+        let name = label(&md.names).unwrap_or_else(|| format!("#{i}"));
+        let text = format!("{res}{id}:{name}");
+        // CSV quoting (RFC 4180) for names that hold a comma or a quote.
+        if text.contains([',', '"', '\n', '\r']) {
+            format!("\"{}\"", text.replace('"', "\"\""))
+        } else {
+            text
+        }
+    };
+    let mut out = String::new();
+    for b in bonds {
+        let _ = writeln!(
+            out,
+            "{f},{},{},{},{},{},{},{:.4},{:.3}",
+            b.donor,
+            b.hydrogen,
+            b.acceptor,
+            atom(b.donor),
+            atom(b.hydrogen),
+            atom(b.acceptor),
+            b.distance,
+            b.angle
+        );
+    }
+    out
 }

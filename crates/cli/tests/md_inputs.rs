@@ -1926,8 +1926,9 @@ fn hydrogen_bonds_are_drawn_as_dashes_as_the_reference_traces_them() {
 
 /// `--hbond-table` lists, frame by frame, the hydrogen bonds the hbonds style draws: over the
 /// whole solvated adenylate kinase (47,681 atoms, bonds by distance), exactly the bonds
-/// MDAnalysis 2.11's HydrogenBondAnalysis finds in both frames (md-io's tests/data/hbonds).
-/// Without an hbonds representation the flag is a usage error and no table is written.
+/// MDAnalysis 2.11's HydrogenBondAnalysis finds in both frames (md-io's tests/data/hbonds),
+/// and `texmap convert --hbonds all` writes the same tables without drawing. Without an
+/// hbonds representation (or --hbonds) the flag is a usage error and no table is written.
 #[test]
 fn the_hydrogen_bond_table_is_mdanalysis_s_list() {
     let dir = tempfile::tempdir().unwrap();
@@ -2058,6 +2059,37 @@ fn the_hydrogen_bond_table_is_mdanalysis_s_list() {
     // Frames 0 and 9 of the run: the water has moved on, a few dozen of the protein's bonds
     // hold.
     assert!(c1 > 0.0 && c1 < 0.05, "C(1) {c1}");
+    // texmap convert finds the same bonds among --hbonds' atoms without drawing: the same
+    // two files; without --hbonds the tables are a usage error.
+    let (t2, l2) = (dir.path().join("hb2.csv"), dir.path().join("lt2.csv"));
+    let convert = |extra: &[&str]| {
+        let mut args = vec![
+            "convert",
+            "--quiet",
+            &xtc,
+            "--topology",
+            &gro,
+            "--hbond-table",
+            t2.to_str().unwrap(),
+            "--hbond-lifetime",
+            l2.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        texmap(&args)
+    };
+    let o = convert(&["--hbonds", "all"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(
+        std::fs::read_to_string(&t2).unwrap(),
+        std::fs::read_to_string(&table).unwrap()
+    );
+    assert_eq!(std::fs::read_to_string(&l2).unwrap(), text);
+    std::fs::remove_file(&t2).unwrap();
+    std::fs::remove_file(&l2).unwrap();
+    let o = convert(&[]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--hbonds"), "{}", stderr(&o));
+    assert!(!t2.exists() && !l2.exists());
     // `--label {hbonds}` writes the count the table lists (the caption drawn byte for byte as
     // the literal number); without an hbonds representation it is a usage error.
     let caption = |label: &str, rep: &str, out: &str| {

@@ -376,8 +376,14 @@ pub struct MolOptions {
     /// Several representations in one scene (see [`Representation`]); when not empty, they
     /// replace `select` and `draw`.
     pub reps: Vec<Representation>,
-    /// The cutoffs of [`DrawStyle::HBonds`] (MDAnalysis's 3.0 Å and 150° by default).
+    /// The cutoffs of [`DrawStyle::HBonds`] and of `hbond_select` (MDAnalysis's 3.0 Å and 150°
+    /// by default).
     pub hbonds: Criteria,
+    /// The atoms among which [`MolPlan::prepare`] finds the hydrogen bonds of every frame
+    /// ([`MolPlan::last_hbonds`]), for a program that writes frames instead of drawing them;
+    /// [`MolPlan::build`] lists the bonds its [`DrawStyle::HBonds`] representations draw
+    /// instead.
+    pub hbond_select: Option<Selection>,
     /// The vectors, scale and radius of [`DrawStyle::Arrows`].
     pub arrows: ArrowOptions,
     /// Where the shapes of [`DrawStyle::Ellipsoids`] come from.
@@ -507,6 +513,7 @@ impl Default for MolOptions {
             align: None,
             reps: Vec::new(),
             hbonds: Criteria::default(),
+            hbond_select: None,
             arrows: ArrowOptions::default(),
             ellipsoids: EllipsoidOptions::default(),
             trail_length: None,
@@ -585,6 +592,8 @@ pub enum SelectionRole {
     Cluster,
     /// [`SasaOptions::atoms`].
     Sasa,
+    /// [`MolOptions::hbond_select`].
+    HBonds,
 }
 
 /// Why a [`MolPlan`] was refused or a frame could not be built.
@@ -779,6 +788,7 @@ impl fmt::Display for MolError {
                     SelectionRole::Align => "the alignment selection",
                     SelectionRole::Cluster => "the selection of clustered atoms",
                     SelectionRole::Sasa => "the selection of atoms measured for their surface",
+                    SelectionRole::HBonds => "the selection of atoms searched for hydrogen bonds",
                     SelectionRole::Select => "the selection of drawn atoms",
                     SelectionRole::Color => "a colour rule's selection",
                     SelectionRole::Radius => "a radius rule's selection",
@@ -1216,7 +1226,10 @@ impl MolPlan {
         let unwrap = self.options.pbc == Pbc::Unwrap && frame.cell.is_some();
         self.find_bonds(
             frame,
-            self.draws_bonds() || unwrap || self.draws_polyhedra(),
+            self.draws_bonds()
+                || unwrap
+                || self.draws_polyhedra()
+                || self.options.hbond_select.is_some(),
         )?;
         match self.options.pbc {
             Pbc::None => {}
@@ -1408,7 +1421,7 @@ impl MolPlan {
                 .collect();
         }
         self.donor_h.clear();
-        if self.draws_hbonds() {
+        if self.draws_hbonds() || self.options.hbond_select.is_some() {
             // Before bonds across the box are dropped: a water split by a face still donates.
             self.donor_h = if self.options.bonds == BondSource::None {
                 let by_distance = texmap_md_io::bonds::bonds_by_distance(frame, true).pairs;
@@ -1481,6 +1494,15 @@ impl MolPlan {
             self.arrow_vectors =
                 crate::arrows::vectors(frame, source, self.arrow_reference.as_deref())
                     .map_err(MolError::Arrows)?;
+        }
+        if let Some(sel) = &self.options.hbond_select {
+            let mask = sel.evaluate(frame).map_err(|error| MolError::Selection {
+                role: SelectionRole::HBonds,
+                error,
+            })?;
+            self.hbonds =
+                hbonds::hydrogen_bonds(frame, &self.donor_h, Some(&mask), self.options.hbonds)
+                    .map_err(MolError::HBonds)?;
         }
         self.measured.clear();
         for m in &self.options.measures {
@@ -1595,6 +1617,12 @@ impl MolPlan {
     /// The last frame's cartoon ([`DrawStyle::Cartoon`]; empty without one).
     pub fn cartoon_mesh(&self) -> &MolMesh {
         &self.cartoon
+    }
+
+    /// Finds the hydrogen bonds among `select`'s atoms in every frame prepared
+    /// ([`MolOptions::hbond_select`]).
+    pub fn set_hbond_select(&mut self, select: Option<Selection>) {
+        self.options.hbond_select = select;
     }
 
     /// Whether some representation draws hydrogen bonds ([`DrawStyle::HBonds`]).
