@@ -1642,7 +1642,9 @@ pub struct AnalysisArgs {
     pub msd_fit: Option<(f64, f64)>,
     /// The most memory --msd-lags may keep positions in, and --vacf-table and --vdos-table
     /// velocities, in MB: 12 bytes per atom per frame each (1,000 frames of 100,000 atoms take
-    /// 1,145 MB).
+    /// 1,145 MB); also the limit of the frames the principal components keep (12 bytes per
+    /// atom and frame) and of --rmsd-matrix (8 bytes per pair of frames and 24 per atom and
+    /// frame). A run stops at the frame that would pass it.
     #[arg(long, value_name = "MB", default_value_t = 4096)]
     pub msd_memory: usize,
     /// Also write the velocity autocorrelation function averaged over every time origin as a

@@ -856,6 +856,16 @@ impl RmsdMatrix {
     /// Frame `f`'s positions of the atoms selected at the first.
     fn add(&mut self, f: usize, md: &MdFrame) -> Result<()> {
         let positions = self.picked.positions(f, md, self.frames.is_empty())?;
+        // Stop at the memory limit now rather than after reading every frame.
+        let bytes = texmap_md_io::rmsd::matrix_bytes(self.frames.len() + 1, positions.len());
+        if bytes > self.limit {
+            let e = texmap_md_io::msd::MsdError::Matrix {
+                frames: self.frames.len() + 1,
+                bytes,
+                limit: self.limit,
+            };
+            bail!("--rmsd-matrix: frame {f}: {e}");
+        }
         self.positions.push(positions);
         self.frames.push(f);
         self.times.push(md.time);

@@ -1837,4 +1837,19 @@ fn rmsd_matrix_is_mdanalysis_distance_matrix() {
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("--rmsd-matrix-chart"), "{}", stderr(&o));
     assert!(!bad.exists());
+    // Past the memory limit the run stops at the frame that passes it, and writes nothing.
+    std::fs::remove_file(&csv).unwrap();
+    let o = texmap(&[
+        "convert",
+        &xtc,
+        "--topology",
+        &pdb,
+        "--rmsd-matrix",
+        csv.to_str().unwrap(),
+        "--msd-memory",
+        "0",
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("over the limit"), "{}", stderr(&o));
+    assert!(!csv.exists());
 }

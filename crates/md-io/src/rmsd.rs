@@ -33,10 +33,7 @@ pub fn rmsd_matrix(frames: &[Vec<[f32; 3]>], limit: usize) -> Result<Vec<f64>, M
     for p in frames {
         crate::msd::check_frame(p, Some(n))?;
     }
-    let bytes = f
-        .saturating_mul(f)
-        .saturating_mul(8)
-        .saturating_add(f.saturating_mul(n).saturating_mul(24));
+    let bytes = matrix_bytes(f, n);
     if bytes > limit {
         return Err(MsdError::Matrix {
             frames: f,
@@ -66,6 +63,16 @@ pub fn rmsd_matrix(frames: &[Vec<[f32; 3]>], limit: usize) -> Result<Vec<f64>, M
         }
     }
     Ok(m)
+}
+
+/// The bytes [`rmsd_matrix`] takes for `frames` frames of `atoms` atoms: the matrix and the
+/// centred frames (`8 F² + 24 F N`), so that a caller keeping the frames can stop at its limit
+/// before it has read them all.
+pub fn matrix_bytes(frames: usize, atoms: usize) -> usize {
+    frames
+        .saturating_mul(frames)
+        .saturating_mul(8)
+        .saturating_add(frames.saturating_mul(atoms).saturating_mul(24))
 }
 
 /// The positions moved so that their centroid is the origin.
