@@ -803,7 +803,6 @@ pub enum BondsArg {
     None,
 }
 
-/// How molecules are drawn (`--style`).
 /// How `--contacts-table` counts a frame's native pairs.
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum ContactsMethodArg {
@@ -816,6 +815,18 @@ pub enum ContactsMethodArg {
     Soft,
 }
 
+/// How `--rmsd-clusters` groups the frames (gmx cluster's -method).
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum RmsdClusterMethodArg {
+    /// Daura et al.: the frame with the most neighbours within the cutoff and its
+    /// neighbours are a cluster; repeated on the frames left (largest clusters first).
+    #[default]
+    Gromos,
+    /// Single linkage: a frame joins any cluster holding a frame within the cutoff (a slow
+    /// drift chains shapes together).
+    Linkage,
+}
+
 /// Which sides of the data `--isosurface` draws.
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum IsoSignArg {
@@ -825,6 +836,7 @@ pub enum IsoSignArg {
     Negative,
 }
 
+/// How molecules are drawn (`--style`).
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum DrawStyle {
     /// Atoms at their radii, no bonds (VMD's VDW, PyMOL's spheres).
@@ -1145,6 +1157,9 @@ impl AnalysisArgs {
             ("--hbond-table", &self.hbond_table),
             ("--hbond-lifetime", &self.hbond_lifetime),
             ("--rmsd-matrix-chart", &self.rmsd_matrix_chart),
+            ("--rmsd-clusters", &self.rmsd_clusters),
+            ("--rmsd-cluster-table", &self.rmsd_cluster_table),
+            ("--rmsd-cluster-middles", &self.rmsd_cluster_middles),
         ]
         .into_iter()
         .map(|(flag, path)| (flag, path.is_some()))
@@ -1160,7 +1175,10 @@ impl AnalysisArgs {
 #[command(group(clap::ArgGroup::new("pca_out").multiple(true)
     .args(["pca_table", "pca_projection", "pca_vectors", "pca_extremes"])))]
 #[command(group(clap::ArgGroup::new("rmsd_matrix_out").multiple(true)
-    .args(["rmsd_matrix", "rmsd_matrix_chart"])))]
+    .args(["rmsd_matrix", "rmsd_matrix_chart", "rmsd_clusters", "rmsd_cluster_table",
+        "rmsd_cluster_middles"])))]
+#[command(group(clap::ArgGroup::new("rmsd_cluster_out").multiple(true)
+    .args(["rmsd_clusters", "rmsd_cluster_table", "rmsd_cluster_middles"])))]
 pub struct AnalysisArgs {
     /// Give every atom the property `displacement`: its distance (Å) from where it was in the
     /// first frame drawn (or --displacement-reference), to the nearest periodic image (OVITO's
@@ -1348,8 +1366,8 @@ pub struct AnalysisArgs {
     /// along both axes; past 300 frames a cell is the mean of a block of frames.
     #[arg(long, value_name = "FILE.png|FILE.svg")]
     pub rmsd_matrix_chart: Option<PathBuf>,
-    /// The atoms --rmsd-matrix superposes (evaluated at the first frame; 'name CA' by
-    /// default).
+    /// The atoms --rmsd-matrix and --rmsd-clusters superpose (evaluated at the first frame;
+    /// 'name CA' by default).
     #[arg(
         long,
         value_name = "SEL",
@@ -1357,6 +1375,44 @@ pub struct AnalysisArgs {
         requires = "rmsd_matrix_out"
     )]
     pub rmsd_matrix_select: String,
+    /// Also cluster the frames' conformations on their pairwise RMSD (gmx cluster; the
+    /// matrix of --rmsd-matrix, over --rmsd-matrix-select's atoms) and write each frame's
+    /// cluster as CSV: frame, time, cluster (1 the first; gmx cluster -clid). With the gromos
+    /// method clusters are numbered largest first. Pick --rmsd-cluster-cutoff from the
+    /// --rmsd-matrix-chart: inside its blocks, below the RMSD between them. Written whole or
+    /// not at all; not with --shard.
+    #[arg(long, value_name = "FILE.csv")]
+    pub rmsd_clusters: Option<PathBuf>,
+    /// Also write one row per cluster of --rmsd-clusters: cluster, frames, fraction of the
+    /// run, the middle frame (the member with the smallest mean RMSD to the others: the
+    /// structure to show for it) and its time, that mean, the cluster's mean and largest
+    /// RMSD, its first and last frame, and how many times the run enters it.
+    #[arg(long, value_name = "FILE.csv")]
+    pub rmsd_cluster_table: Option<PathBuf>,
+    /// Also write each cluster's middle structure, every atom of its frame, one frame per
+    /// cluster in cluster order (gmx cluster -cl), in the format the name gives (.pdb, .xyz,
+    /// .gro, .xtc, .dcd, ...): the representative conformations to render or compare. Keeps
+    /// every frame's positions until the end (12 bytes per atom and frame, within
+    /// --msd-memory).
+    #[arg(long, value_name = "FILE")]
+    pub rmsd_cluster_middles: Option<PathBuf>,
+    /// How --rmsd-clusters groups the frames.
+    #[arg(
+        long,
+        value_enum,
+        default_value = "gromos",
+        requires = "rmsd_cluster_out"
+    )]
+    pub rmsd_cluster_method: RmsdClusterMethodArg,
+    /// The RMSD (Å) below which two frames are neighbours for --rmsd-clusters (gmx cluster's
+    /// -cutoff, 0.1 nm by default).
+    #[arg(
+        long,
+        value_name = "Å",
+        default_value_t = 1.0,
+        requires = "rmsd_cluster_out"
+    )]
+    pub rmsd_cluster_cutoff: f64,
     /// Also write the principal components of --pca-select's motion as a CSV table
     /// (MDAnalysis's analysis.pca.PCA, gmx covar): component, variance (Å², an eigenvalue of
     /// the positions' covariance over the frames), fraction of the total, cumulated fraction,
@@ -1643,8 +1699,9 @@ pub struct AnalysisArgs {
     /// The most memory --msd-lags may keep positions in, and --vacf-table and --vdos-table
     /// velocities, in MB: 12 bytes per atom per frame each (1,000 frames of 100,000 atoms take
     /// 1,145 MB); also the limit of the frames the principal components keep (12 bytes per
-    /// atom and frame) and of --rmsd-matrix (8 bytes per pair of frames and 24 per atom and
-    /// frame). A run stops at the frame that would pass it.
+    /// atom and frame), of --rmsd-matrix (8 bytes per pair of frames and 24 per atom and
+    /// frame) and of --rmsd-cluster-middles (12 more per atom and frame). A run stops at the
+    /// frame that would pass it.
     #[arg(long, value_name = "MB", default_value_t = 4096)]
     pub msd_memory: usize,
     /// Also write the velocity autocorrelation function averaged over every time origin as a

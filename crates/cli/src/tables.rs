@@ -47,6 +47,23 @@ fn whole_run_table(
     }
 }
 
+/// A trajectory that only a whole run can write, with the format its name gives; refused
+/// under `--shard` for the reason `why`.
+fn whole_run_trajectory(
+    path: &Option<PathBuf>,
+    flag: &str,
+    why: &str,
+    whole: bool,
+) -> Result<Option<(PathBuf, texmap_md_io::Format)>> {
+    match path {
+        None => Ok(None),
+        Some(_) if !whole => usage(format!(
+            "{flag} with --shard (or a Slurm array): {why}; write it in a run of its own"
+        )),
+        Some(p) => Ok(Some((p.clone(), crate::convert::output_format(flag, p)?))),
+    }
+}
+
 /// The per-frame tables of the analyses (`--defect-table`, `--grain-table`), shared by
 /// `texmap render` and `texmap convert`.
 pub(crate) struct AnalysisTables {
@@ -817,13 +834,23 @@ impl Picked {
     }
 }
 
-/// `--rmsd-matrix` and `--rmsd-matrix-chart`: the selected atoms' positions every frame, the
-/// pairwise RMSD at the end.
+/// `--rmsd-matrix`, `--rmsd-matrix-chart` and the `--rmsd-clusters` outputs: the selected
+/// atoms' positions every frame (and every atom's for `--rmsd-cluster-middles`), the pairwise
+/// RMSD and its clusters at the end.
 struct RmsdMatrix {
     table: Option<crate::output::AtomicFile>,
     chart: Option<PathBuf>,
+    clusters: Option<crate::output::AtomicFile>,
+    cluster_table: Option<crate::output::AtomicFile>,
+    middles: Option<(PathBuf, texmap_md_io::Format)>,
+    method: texmap_md_io::conformations::Method,
+    cutoff: f64,
     picked: Picked,
     positions: Vec<Vec<[f32; 3]>>,
+    /// Every atom's positions every frame, for `--rmsd-cluster-middles`, and the first frame
+    /// as the template of the middles written.
+    whole: Vec<Vec<[f32; 3]>>,
+    template: MdFrame,
     frames: Vec<usize>,
     times: Vec<Option<f64>>,
     limit: usize,
@@ -839,32 +866,96 @@ impl RmsdMatrix {
             why,
             whole,
         )?;
-        if table.is_none() && chart.is_none() {
+        let clusters = whole_run_table(&analysis.rmsd_clusters, "--rmsd-clusters", why, whole)?;
+        let cluster_table = whole_run_table(
+            &analysis.rmsd_cluster_table,
+            "--rmsd-cluster-table",
+            why,
+            whole,
+        )?;
+        let middles = whole_run_trajectory(
+            &analysis.rmsd_cluster_middles,
+            "--rmsd-cluster-middles",
+            why,
+            whole,
+        )?;
+        if table.is_none()
+            && chart.is_none()
+            && clusters.is_none()
+            && cluster_table.is_none()
+            && middles.is_none()
+        {
             return Ok(None);
+        }
+        let cutoff = analysis.rmsd_cluster_cutoff;
+        if !(cutoff.is_finite() && cutoff > 0.0) {
+            return usage(format!(
+                "--rmsd-cluster-cutoff {cutoff}: the cutoff is an RMSD in Å above 0"
+            ));
         }
         Ok(Some(RmsdMatrix {
             table,
             chart,
+            clusters,
+            cluster_table,
+            middles,
+            method: match analysis.rmsd_cluster_method {
+                crate::args::RmsdClusterMethodArg::Gromos => {
+                    texmap_md_io::conformations::Method::Gromos
+                }
+                crate::args::RmsdClusterMethodArg::Linkage => {
+                    texmap_md_io::conformations::Method::Linkage
+                }
+            },
+            cutoff,
             picked: Picked::new("--rmsd-matrix-select", &analysis.rmsd_matrix_select)?,
             positions: Vec::new(),
+            whole: Vec::new(),
+            template: MdFrame::new(),
             frames: Vec::new(),
             times: Vec::new(),
             limit: analysis.msd_memory.saturating_mul(1 << 20),
         }))
     }
 
+    /// The flag that asked for the matrix, for messages.
+    fn flag(&self) -> &'static str {
+        if self.table.is_some() || self.chart.is_some() {
+            "--rmsd-matrix"
+        } else {
+            "--rmsd-clusters"
+        }
+    }
+
     /// Frame `f`'s positions of the atoms selected at the first.
     fn add(&mut self, f: usize, md: &MdFrame) -> Result<()> {
-        let positions = self.picked.positions(f, md, self.frames.is_empty())?;
+        let first = self.frames.is_empty();
+        let positions = self.picked.positions(f, md, first)?;
         // Stop at the memory limit now rather than after reading every frame.
-        let bytes = texmap_md_io::rmsd::matrix_bytes(self.frames.len() + 1, positions.len());
+        let kept = if self.middles.is_some() {
+            md.n_atoms()
+        } else {
+            0
+        };
+        let bytes = texmap_md_io::rmsd::matrix_bytes(self.frames.len() + 1, positions.len())
+            .saturating_add(
+                (self.frames.len() + 1)
+                    .saturating_mul(kept)
+                    .saturating_mul(12),
+            );
         if bytes > self.limit {
             let e = texmap_md_io::msd::MsdError::Matrix {
                 frames: self.frames.len() + 1,
                 bytes,
                 limit: self.limit,
             };
-            bail!("--rmsd-matrix: frame {f}: {e}");
+            bail!("{}: frame {f}: {e}", self.flag());
+        }
+        if self.middles.is_some() {
+            if first {
+                self.template = md.clone();
+            }
+            self.whole.push(md.positions.clone());
         }
         self.positions.push(positions);
         self.frames.push(f);
@@ -872,10 +963,11 @@ impl RmsdMatrix {
         Ok(())
     }
 
-    /// The matrix written and drawn.
-    fn finish(mut self) -> Result<Option<crate::output::AtomicFile>> {
+    /// The matrix written and drawn, its clusters written.
+    fn finish(mut self) -> Result<Vec<crate::output::AtomicFile>> {
+        let flag = self.flag();
         let m = texmap_md_io::rmsd::rmsd_matrix(&self.positions, self.limit)
-            .map_err(|e| anyhow::anyhow!("--rmsd-matrix: {e}"))?;
+            .map_err(|e| anyhow::anyhow!("{flag}: {e}"))?;
         let n = self.frames.len();
         if let Some(t) = &mut self.table {
             let mut text = String::from("frame");
@@ -898,7 +990,103 @@ impl RmsdMatrix {
                 texmap_study::chart::matrix_heatmap(&x, label, &m, "RMSD (Å)", t)
             })?;
         }
-        Ok(self.table)
+        if self.clusters.is_some() || self.cluster_table.is_some() || self.middles.is_some() {
+            self.write_clusters(&m)?;
+        }
+        Ok([self.table, self.clusters, self.cluster_table]
+            .into_iter()
+            .flatten()
+            .collect())
+    }
+
+    /// `--rmsd-clusters`, `--rmsd-cluster-table` and `--rmsd-cluster-middles` from the matrix.
+    fn write_clusters(&mut self, m: &[f64]) -> Result<()> {
+        use texmap_md_io::conformations::cluster;
+        let n = self.frames.len();
+        let c = cluster(m, n, self.cutoff, self.method)
+            .map_err(|e| anyhow::anyhow!("--rmsd-clusters: {e}"))?;
+        let time = |k: usize| {
+            self.times[k]
+                .map(|t| crate::scene::compact(t, 6))
+                .unwrap_or_default()
+        };
+        if let Some(t) = &mut self.clusters {
+            let mut text = String::from("frame,time,cluster\n");
+            for (k, id) in c.of_frame.iter().enumerate() {
+                text.push_str(&format!("{},{},{}\n", self.frames[k], time(k), id + 1));
+            }
+            t.write(&text)?;
+        }
+        if let Some(t) = &mut self.cluster_table {
+            let mut text = String::from(
+                "cluster,frames,fraction,middle_frame,middle_time,middle_rmsd,mean_rmsd,max_rmsd,first_frame,last_frame,entries\n",
+            );
+            for (id, cl) in c.clusters.iter().enumerate() {
+                // The run enters a cluster at its first frame and at every frame whose
+                // predecessor lies in another.
+                let entries = cl
+                    .members
+                    .iter()
+                    .filter(|&&k| k == 0 || c.of_frame[k - 1] != id)
+                    .count();
+                text.push_str(&format!(
+                    "{},{},{:.6},{},{},{:.4},{:.4},{:.4},{},{},{entries}\n",
+                    id + 1,
+                    cl.members.len(),
+                    cl.members.len() as f64 / n.max(1) as f64,
+                    self.frames[cl.middle],
+                    time(cl.middle),
+                    cl.middle_rmsd,
+                    cl.mean_rmsd,
+                    cl.max_rmsd,
+                    self.frames[cl.members[0]],
+                    self.frames[*cl.members.last().unwrap_or(&0)],
+                ));
+            }
+            t.write(&text)?;
+        }
+        if let Some((path, format)) = &self.middles {
+            let mut frame = self.template.clone();
+            crate::output::write_atomic(path, |tmp| {
+                let mut w = texmap_md_io::Writer::create(tmp, *format)?;
+                for cl in &c.clusters {
+                    frame.positions.clone_from(&self.whole[cl.middle]);
+                    frame.time = self.times[cl.middle];
+                    w.write_frame(&frame)?;
+                }
+                w.finish()?;
+                Ok(())
+            })?;
+        }
+        let sizes: Vec<String> = c
+            .clusters
+            .iter()
+            .take(5)
+            .map(|cl| {
+                format!(
+                    "{} frames (middle frame {})",
+                    cl.members.len(),
+                    self.frames[cl.middle]
+                )
+            })
+            .collect();
+        let lone = c.clusters.iter().filter(|cl| cl.members.len() == 1).count();
+        crate::note!(
+            "{} clusters of {n} frames at {} Å ({}): {}{}; {} transitions between them",
+            c.clusters.len(),
+            crate::scene::compact(self.cutoff, 4),
+            self.method.name(),
+            sizes.join(", "),
+            if c.clusters.len() > 5 { ", ..." } else { "" },
+            c.transitions()
+        );
+        if n > 1 && lone * 2 > n {
+            eprintln!(
+                "texmap: warning: --rmsd-clusters: {lone} of {n} frames are clusters of their own: the cutoff of {} Å is below most frames' distance to their nearest; raise --rmsd-cluster-cutoff (the --rmsd-matrix-chart shows the distances)",
+                crate::scene::compact(self.cutoff, 4)
+            );
+        }
+        Ok(())
     }
 }
 
@@ -929,18 +1117,7 @@ impl PcaTables {
         let table = whole_run_table(&analysis.pca_table, "--pca-table", why, whole)?;
         let projection = whole_run_table(&analysis.pca_projection, "--pca-projection", why, whole)?;
         let vectors = whole_run_table(&analysis.pca_vectors, "--pca-vectors", why, whole)?;
-        let extremes = match &analysis.pca_extremes {
-            Some(_) if !whole => {
-                return usage(format!(
-                    "--pca-extremes with --shard (or a Slurm array): {why}; write it in a run of its own"
-                ));
-            }
-            Some(p) => Some((
-                p.clone(),
-                crate::convert::output_format("--pca-extremes", p)?,
-            )),
-            None => None,
-        };
+        let extremes = whole_run_trajectory(&analysis.pca_extremes, "--pca-extremes", why, whole)?;
         if table.is_none() && projection.is_none() && vectors.is_none() && extremes.is_none() {
             return Ok(None);
         }
@@ -1836,12 +2013,11 @@ impl AnalysisTables {
             .rmsd_matrix
             .map(RmsdMatrix::finish)
             .transpose()?
-            .flatten();
+            .unwrap_or_default();
         let hbond_lifetime = self.hbond_lifetime.map(SurvivalTable::finish).transpose()?;
         for t in [
             self.hbond,
             hbond_lifetime,
-            rmsd_matrix,
             self.measure.map(|(t, _)| t),
             survival,
             self.contacts.map(|c| c.file),
@@ -1865,6 +2041,7 @@ impl AnalysisTables {
         .chain(velocities)
         .chain(pca)
         .chain(dssp)
+        .chain(rmsd_matrix)
         {
             t.commit()?;
         }

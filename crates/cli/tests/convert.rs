@@ -1853,3 +1853,148 @@ fn rmsd_matrix_is_mdanalysis_distance_matrix() {
     assert!(stderr(&o).contains("over the limit"), "{}", stderr(&o));
     assert!(!csv.exists());
 }
+
+/// `--rmsd-clusters`, `--rmsd-cluster-table` and `--rmsd-cluster-middles` agree with GROMACS
+/// 2022.5's gmx cluster on the same file (md-io's data/conformations/gen_clusters.py), for the
+/// gromos method and single linkage: every frame's cluster names the same frames as gmx's
+/// -clid, the table's sizes, middle frames and mean RMSDs are gmx's cluster.log, and the
+/// middles are those frames' atoms. A cutoff of 0 and a middles name of no format are refused
+/// before anything is read, and a run that stops leaves no file.
+#[test]
+fn rmsd_clusters_are_gmx_cluster() {
+    let dir = tempfile::tempdir().unwrap();
+    let reference = json("conformations/clusters_reference.json");
+    let (xtc, pdb) = (
+        md_data("conformations/states.xtc"),
+        md_data("dihedrals/helix.pdb"),
+    );
+    let input = frames(Path::new(&xtc));
+    let (clid, table_csv, middles) = (
+        dir.path().join("clid.csv"),
+        dir.path().join("clusters.csv"),
+        dir.path().join("middles.pdb"),
+    );
+    for run in reference["runs"].as_array().unwrap() {
+        let method = run["method"].as_str().unwrap();
+        let cutoff = format!("{}", 10.0 * run["cutoff_nm"].as_f64().unwrap());
+        run_ok(&[
+            "convert",
+            &xtc,
+            "--topology",
+            &pdb,
+            "--rmsd-clusters",
+            clid.to_str().unwrap(),
+            "--rmsd-cluster-table",
+            table_csv.to_str().unwrap(),
+            "--rmsd-cluster-middles",
+            middles.to_str().unwrap(),
+            "--rmsd-cluster-method",
+            method,
+            "--rmsd-cluster-cutoff",
+            &cutoff,
+            "-q",
+        ]);
+        let what = format!("{method} at {cutoff} Å");
+        // Each frame's cluster, as sets of frames, is gmx's -clid.
+        let (header, rows) = table(&clid);
+        assert_eq!(header, "frame,time,cluster");
+        assert_eq!(rows.len(), 200);
+        let theirs = numbers(&run["cluster_of_frame"]);
+        let sets = |ids: &[f64]| {
+            let mut by: std::collections::BTreeMap<u64, Vec<usize>> = Default::default();
+            for (f, &c) in ids.iter().enumerate() {
+                by.entry(c as u64).or_default().push(f);
+            }
+            by.into_values().collect::<std::collections::BTreeSet<_>>()
+        };
+        let ours: Vec<f64> = rows.iter().map(|r| r[2]).collect();
+        assert_eq!(sets(&ours), sets(&theirs), "{what}");
+        for (k, r) in rows.iter().enumerate() {
+            assert_eq!(
+                (r[0], r[1]),
+                (k as f64, 5.0 * k as f64),
+                "{what}: frame, time"
+            );
+        }
+        // The table: gmx's sizes (in its order), middles and mean RMSDs (nm, three decimals).
+        let (_, clusters) = table(&table_csv);
+        let gmx = run["clusters"].as_array().unwrap();
+        assert_eq!(clusters.len(), gmx.len(), "{what}");
+        for (k, g) in gmx.iter().enumerate() {
+            let members = numbers(&g["members"]);
+            let id = ours[members[0] as usize];
+            let row = &clusters[id as usize - 1];
+            assert_eq!(row[1], members.len() as f64, "{what}: cluster {}", k + 1);
+            assert_eq!(clusters[k][1], members.len() as f64, "{what}: gmx's order");
+            assert_eq!(row[3], g["middle"].as_f64().unwrap(), "{what}: middle");
+            assert_eq!(row[4], 5.0 * row[3], "{what}: middle time");
+            assert_eq!((row[8], row[9]), (members[0], *members.last().unwrap()));
+            for (col, key) in [(6, "mean_rmsd_nm"), (5, "middle_rmsd_nm")] {
+                let want = g[key].as_f64().map_or(0.0, |nm| 10.0 * nm);
+                assert!((row[col] - want).abs() <= 0.0051, "{what}: {key}");
+            }
+        }
+        let fractions: f64 = clusters.iter().map(|r| r[2]).sum();
+        assert!((fractions - 1.0).abs() < 1e-5);
+        // The middles: one model per cluster, the middle frame's every atom.
+        let written = frames(&middles);
+        assert_eq!(written.len(), gmx.len(), "{what}");
+        for (row, model) in clusters.iter().zip(&written) {
+            let source = &input[row[3] as usize];
+            assert_eq!(model.n_atoms(), 185);
+            for (a, b) in model.positions.iter().zip(&source.positions) {
+                for d in 0..3 {
+                    assert!((a[d] - b[d]).abs() < 6e-4, "{what}: PDB's 3 decimals");
+                }
+            }
+        }
+    }
+    // Refused before reading: no cutoff, a middles name of no format, --shard.
+    for (flag, value, said) in [
+        ("--rmsd-cluster-cutoff", "0", "--rmsd-cluster-cutoff"),
+        ("--rmsd-cluster-middles", "m.nope", "--rmsd-cluster-middles"),
+        ("--shard", "1/2", "--shard"),
+    ] {
+        let bad = dir.path().join("bad.csv");
+        let mut args = vec![
+            "convert",
+            &xtc,
+            "--topology",
+            &pdb,
+            "--rmsd-clusters",
+            bad.to_str().unwrap(),
+            flag,
+            value,
+        ];
+        if flag == "--shard" {
+            args.extend(["-o", "shard.xyz"]);
+        }
+        let o = texmap(&args);
+        assert_eq!(o.status.code(), Some(2), "{flag}: {}", stderr(&o));
+        assert!(stderr(&o).contains(said), "{flag}: {}", stderr(&o));
+        assert!(!bad.exists(), "{flag}");
+    }
+    // Past the memory limit the middles' frames stop the run: no file is left.
+    for p in [&clid, &table_csv, &middles] {
+        std::fs::remove_file(p).unwrap();
+    }
+    let o = texmap(&[
+        "convert",
+        &xtc,
+        "--topology",
+        &pdb,
+        "--rmsd-clusters",
+        clid.to_str().unwrap(),
+        "--rmsd-cluster-middles",
+        middles.to_str().unwrap(),
+        "--msd-memory",
+        "0",
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("--rmsd-clusters: frame 0"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!clid.exists() && !middles.exists());
+}
