@@ -8,14 +8,21 @@
 //! Then the pairwise RMSD after superposition (`rmsd::rmsd_matrix`, what `--rmsd-matrix`
 //! computes) of the CA atoms over the first 500 frames, 2 threads.
 //!
+//! Then the clustering of those CA frames (`conformations::cluster`, what `--rmsd-clusters`
+//! computes once the matrix is there) over all 1,000 frames at 1.5 Å, gromos and single
+//! linkage, one thread.
+//!
 //! The peer, `benches/peers/mdanalysis_pca.py`, times MDAnalysis's `analysis.pca.PCA` plus
 //! `transform` on frames of the same sizes held in memory, and `DistanceMatrix` with a
 //! superposing `rms.rmsd` on 500 frames of 214 atoms: run it in the same minutes.
+//! `benches/peers/gmx_cluster.py` times `gmx cluster` against `texmap convert --rmsd-clusters`
+//! end to end on one XTC file (both read it, fit every pair, cluster, write the clusters).
 //!
 //! `cargo bench --bench md_pca -- --warm-up-time 1 --measurement-time 10`
 //! (test mode, `cargo test --bench md_pca`, uses 100 frames.)
 
 use criterion::{Criterion, criterion_group};
+use texmap::md_io::conformations::{Method, cluster};
 use texmap::md_io::pca::Pca;
 use texmap::md_io::select::Selection;
 
@@ -81,6 +88,16 @@ fn bench(c: &mut Criterion) {
             g.bench_function(name, |b| {
                 b.iter(|| texmap::md_io::rmsd::rmsd_matrix(first, usize::MAX).unwrap())
             });
+            let m = texmap::md_io::rmsd::rmsd_matrix(&walk, usize::MAX).unwrap();
+            for method in [Method::Gromos, Method::Linkage] {
+                // The walk is one slow drift: gromos cuts it into pieces, linkage chains it.
+                let found = cluster(&m, frames, 1.5, method).unwrap();
+                assert_eq!(found.clusters.len() > 1, method == Method::Gromos);
+                let name = format!("{}_{}_atoms_{frames}_frames", method.name(), base.len());
+                g.bench_function(name, |b| {
+                    b.iter(|| cluster(&m, frames, 1.5, method).unwrap())
+                });
+            }
         }
     }
     g.finish();
