@@ -815,6 +815,18 @@ pub enum ContactsMethodArg {
     Soft,
 }
 
+/// `--pca-landscape-axes`: two different components, each from 1.
+fn parse_component_pair(text: &str) -> Result<(u32, u32), String> {
+    let bad = || format!("'{text}': expected two different components 'I,J', each from 1 (1,2)");
+    let (i, j) = text.split_once(',').ok_or_else(bad)?;
+    let i: u32 = i.trim().parse().map_err(|_| bad())?;
+    let j: u32 = j.trim().parse().map_err(|_| bad())?;
+    if i == 0 || j == 0 || i == j {
+        return Err(bad());
+    }
+    Ok((i, j))
+}
+
 /// How `--rmsd-clusters` groups the frames (gmx cluster's -method).
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum RmsdClusterMethodArg {
@@ -1149,6 +1161,8 @@ impl AnalysisArgs {
             ("--pca-projection", &self.pca_projection),
             ("--pca-vectors", &self.pca_vectors),
             ("--pca-extremes", &self.pca_extremes),
+            ("--pca-landscape", &self.pca_landscape),
+            ("--pca-landscape-table", &self.pca_landscape_table),
             ("--dssp-table", &self.dssp_table),
             ("--dssp-residue-table", &self.dssp_residue_table),
             ("--dssp-timeline", &self.dssp_timeline),
@@ -1173,7 +1187,10 @@ impl AnalysisArgs {
 #[derive(Args, Clone, Debug, Default)]
 #[command(next_help_heading = "Analysis")]
 #[command(group(clap::ArgGroup::new("pca_out").multiple(true)
-    .args(["pca_table", "pca_projection", "pca_vectors", "pca_extremes"])))]
+    .args(["pca_table", "pca_projection", "pca_vectors", "pca_extremes", "pca_landscape",
+        "pca_landscape_table"])))]
+#[command(group(clap::ArgGroup::new("pca_landscape_out").multiple(true)
+    .args(["pca_landscape", "pca_landscape_table"])))]
 #[command(group(clap::ArgGroup::new("rmsd_matrix_out").multiple(true)
     .args(["rmsd_matrix", "rmsd_matrix_chart", "rmsd_clusters", "rmsd_cluster_table",
         "rmsd_cluster_middles"])))]
@@ -1410,7 +1427,8 @@ pub struct AnalysisArgs {
         long,
         value_name = "Å",
         default_value_t = 1.0,
-        requires = "rmsd_cluster_out"
+        requires = "rmsd_cluster_out",
+        value_parser = parse_positive
     )]
     pub rmsd_cluster_cutoff: f64,
     /// Also write the principal components of --pca-select's motion as a CSV table
@@ -1463,6 +1481,30 @@ pub struct AnalysisArgs {
     #[arg(long, value_name = "N", default_value_t = 20, requires = "pca_extremes",
           value_parser = clap::value_parser!(u32).range(2..=100_000))]
     pub pca_extreme_frames: u32,
+    /// Also draw the free-energy landscape over two principal components, PNG or SVG by the
+    /// name (gmx sham's Gibbs landscape, the PC1–PC2 map of MD papers): the frames' projections
+    /// binned on a --pca-landscape-bins grid over their range, each bin's ΔG = −RT ln(n / n_max)
+    /// in kJ/mol at --pca-landscape-temperature, 0 (dark) at the most visited, empty bins white.
+    /// Its basins are the conformations the run dwells in; a landscape from a run that has
+    /// not converged (see the cosine content of --pca-table) is not a free energy.
+    #[arg(long, value_name = "FILE.png|FILE.svg")]
+    pub pca_landscape: Option<PathBuf>,
+    /// Also write the landscape as a CSV table, one row per bin: the bin's centre on the two
+    /// components (Å), its frames and ΔG (kJ/mol; empty where no frame fell).
+    #[arg(long, value_name = "FILE.csv")]
+    pub pca_landscape_table: Option<PathBuf>,
+    /// The two components of the landscape, 'I,J' (1 is the largest).
+    #[arg(long, value_name = "I,J", default_value = "1,2", requires = "pca_landscape_out",
+          value_parser = parse_component_pair)]
+    pub pca_landscape_axes: (u32, u32),
+    /// Bins a side of the landscape (gmx sham's -ngrid).
+    #[arg(long, value_name = "N", default_value_t = 32, requires = "pca_landscape_out",
+          value_parser = clap::value_parser!(u32).range(2..=1000))]
+    pub pca_landscape_bins: u32,
+    /// The temperature of the landscape's ΔG, in K.
+    #[arg(long, value_name = "K", default_value_t = 300.0, requires = "pca_landscape_out",
+          value_parser = parse_positive)]
+    pub pca_landscape_temperature: f64,
     /// The two groups of --contacts-table, 'SEL_A;SEL_B': 'name N;name O' (backbone),
     /// 'resname ASP GLU and name OD1 OD2 OE1 OE2;resname LYS ARG and name NZ NH1 NH2' (salt
     /// bridges), 'name CA;name CA'.

@@ -887,12 +887,6 @@ impl RmsdMatrix {
         {
             return Ok(None);
         }
-        let cutoff = analysis.rmsd_cluster_cutoff;
-        if !(cutoff.is_finite() && cutoff > 0.0) {
-            return usage(format!(
-                "--rmsd-cluster-cutoff {cutoff}: the cutoff is an RMSD in Å above 0"
-            ));
-        }
         Ok(Some(RmsdMatrix {
             table,
             chart,
@@ -907,7 +901,7 @@ impl RmsdMatrix {
                     texmap_md_io::conformations::Method::Linkage
                 }
             },
-            cutoff,
+            cutoff: analysis.rmsd_cluster_cutoff,
             picked: Picked::new("--rmsd-matrix-select", &analysis.rmsd_matrix_select)?,
             positions: Vec::new(),
             whole: Vec::new(),
@@ -1097,6 +1091,12 @@ struct PcaTables {
     projection: Option<crate::output::AtomicFile>,
     vectors: Option<crate::output::AtomicFile>,
     extremes: Option<(PathBuf, texmap_md_io::Format)>,
+    /// `--pca-landscape` and `--pca-landscape-table`, over the components `axes` (0-based).
+    landscape: Option<PathBuf>,
+    landscape_table: Option<crate::output::AtomicFile>,
+    axes: (usize, usize),
+    bins: usize,
+    temperature: f64,
     picked: Picked,
     components: usize,
     /// `--pca-mode` (0-based) and `--pca-extreme-frames`.
@@ -1118,7 +1118,20 @@ impl PcaTables {
         let projection = whole_run_table(&analysis.pca_projection, "--pca-projection", why, whole)?;
         let vectors = whole_run_table(&analysis.pca_vectors, "--pca-vectors", why, whole)?;
         let extremes = whole_run_trajectory(&analysis.pca_extremes, "--pca-extremes", why, whole)?;
-        if table.is_none() && projection.is_none() && vectors.is_none() && extremes.is_none() {
+        let landscape = chart_file(&analysis.pca_landscape, "--pca-landscape", why, whole)?;
+        let landscape_table = whole_run_table(
+            &analysis.pca_landscape_table,
+            "--pca-landscape-table",
+            why,
+            whole,
+        )?;
+        if table.is_none()
+            && projection.is_none()
+            && vectors.is_none()
+            && extremes.is_none()
+            && landscape.is_none()
+            && landscape_table.is_none()
+        {
             return Ok(None);
         }
         let components = analysis.pca_components as usize;
@@ -1129,11 +1142,23 @@ impl PcaTables {
                 mode + 1
             ));
         }
+        let (i, j) = analysis.pca_landscape_axes;
+        let axes = (i as usize - 1, j as usize - 1);
+        if (landscape.is_some() || landscape_table.is_some()) && axes.0.max(axes.1) >= components {
+            return usage(format!(
+                "--pca-landscape-axes {i},{j}: past the --pca-components {components} computed (raise it)"
+            ));
+        }
         Ok(Some(PcaTables {
             table,
             projection,
             vectors,
             extremes,
+            landscape,
+            landscape_table,
+            axes,
+            bins: analysis.pca_landscape_bins as usize,
+            temperature: analysis.pca_landscape_temperature,
             picked: Picked::new("--pca-select", &analysis.pca_select)?,
             components,
             mode,
@@ -1255,6 +1280,9 @@ impl PcaTables {
                 Ok(())
             })?;
         }
+        if self.landscape.is_some() || self.landscape_table.is_some() {
+            self.write_landscape(&c)?;
+        }
         let shown: Vec<String> = (0..c.variance.len().min(3))
             .map(|j| {
                 format!(
@@ -1280,10 +1308,66 @@ impl PcaTables {
                 cosine[j]
             );
         }
-        Ok([self.table, self.projection, self.vectors]
-            .into_iter()
+        Ok([
+            self.table,
+            self.projection,
+            self.vectors,
+            self.landscape_table,
+        ]
+        .into_iter()
+        .flatten()
+        .collect())
+    }
+
+    /// `--pca-landscape` and `--pca-landscape-table` from the frames' projections.
+    fn write_landscape(&mut self, c: &texmap_md_io::pca::Components) -> Result<()> {
+        use texmap_md_io::pca::{GAS_CONSTANT, Landscape};
+        let (i, j) = self.axes;
+        if c.vectors.len() <= i.max(j) {
+            bail!(
+                "--pca-landscape-axes {},{}: the motion has only {} components",
+                i + 1,
+                j + 1,
+                c.vectors.len()
+            );
+        }
+        let points: Vec<(f64, f64)> = c.projections.iter().map(|p| (p[i], p[j])).collect();
+        let l = Landscape::new(&points, self.bins, GAS_CONSTANT * self.temperature)
+            .ok_or_else(|| anyhow::anyhow!("--pca-landscape: no finite projections to bin"))?;
+        let (x, y) = (format!("pc{}", i + 1), format!("pc{}", j + 1));
+        if let Some(t) = &mut self.landscape_table {
+            let mut text = format!("{x},{y},frames,free_energy\n");
+            for b in 0..self.bins {
+                for a in 0..self.bins {
+                    let k = b * self.bins + a;
+                    let (cx, cy) = l.centre(a, b);
+                    let g = l.free_energy[k]
+                        .map(|g| format!("{g:.4}"))
+                        .unwrap_or_default();
+                    text.push_str(&format!("{cx:.4},{cy:.4},{},{g}\n", l.counts[k]));
+                }
+            }
+            t.write(&text)?;
+        }
+        if let Some(path) = &self.landscape {
+            let (xl, yl) = (format!("PC{} (Å)", i + 1), format!("PC{} (Å)", j + 1));
+            write_chart(path, texmap_study::chart::HEATMAP_SIZE, |t| {
+                texmap_study::chart::landscape(&l, &xl, &yl, "ΔG (kJ/mol)", t)
+            })?;
+        }
+        let top = l
+            .free_energy
+            .iter()
             .flatten()
-            .collect())
+            .fold(0.0f64, |m, g| m.max(*g));
+        let visited = l.counts.iter().filter(|&&n| n > 0).count();
+        crate::note!(
+            "free-energy landscape on {x}-{y}: {visited} of {} bins visited, ΔG up to {} kJ/mol at {} K",
+            self.bins * self.bins,
+            crate::scene::compact(top, 3),
+            crate::scene::compact(self.temperature, 4)
+        );
+        Ok(())
     }
 }
 

@@ -1998,3 +1998,95 @@ fn rmsd_clusters_are_gmx_cluster() {
     );
     assert!(!clid.exists() && !middles.exists());
 }
+
+/// `--pca-landscape-table` bins the frames' PC1–PC2 projections as NumPy's histogram2d bins
+/// MDAnalysis's (md-io's data/pca/gen_landscape.py: the same frames after the same alignment,
+/// each component's sign as MDAnalysis chose it), with ΔG = −RT ln(n / n_max) at 300 K;
+/// `--pca-landscape` draws it; axes past the components computed are refused.
+#[test]
+fn pca_landscape_is_numpys_histogram_of_the_projections() {
+    let dir = tempfile::tempdir().unwrap();
+    let reference = json("pca/landscape_reference.json");
+    let mda = json("pca/pca_reference.json");
+    let (xtc, pdb) = (md_data("pca/helix_pca.xtc"), md_data("dihedrals/helix.pdb"));
+    let (proj, fel, png) = (
+        dir.path().join("proj.csv"),
+        dir.path().join("fel.csv"),
+        dir.path().join("fel.png"),
+    );
+    run_ok(&[
+        "convert",
+        &xtc,
+        "--topology",
+        &pdb,
+        "--align",
+        "name CA",
+        "--pca-projection",
+        proj.to_str().unwrap(),
+        "--pca-landscape-table",
+        fel.to_str().unwrap(),
+        "--pca-landscape",
+        png.to_str().unwrap(),
+        "--pca-landscape-bins",
+        "12",
+        "-q",
+    ]);
+    // Each component's sign against MDAnalysis's (eigenvectors have none of their own).
+    let (_, p) = table(&proj);
+    let theirs = mda["aligned name CA"]["projections"].as_array().unwrap();
+    let sign: Vec<bool> = (0..2)
+        .map(|k| {
+            let dot: f64 = p
+                .iter()
+                .zip(theirs)
+                .map(|(r, t)| r[2 + k] * t[k].as_f64().unwrap())
+                .sum();
+            dot < 0.0
+        })
+        .collect();
+    let want = &reference["landscapes"][0];
+    assert_eq!(want["bins"], 12);
+    let counts = want["counts"].as_array().unwrap();
+    let energy = want["free_energy"].as_array().unwrap();
+    let (header, rows) = table(&fel);
+    assert_eq!(header, "pc1,pc2,frames,free_energy");
+    assert_eq!(rows.len(), 144);
+    for (k, row) in rows.iter().enumerate() {
+        // Rows go along pc1 first; a flipped component mirrors its bins.
+        let (a, b) = (k % 12, k / 12);
+        let i = if sign[0] { 11 - a } else { a };
+        let j = if sign[1] { 11 - b } else { b };
+        assert_eq!(row[2], counts[i][j].as_f64().unwrap(), "bin ({a}, {b})");
+        match energy[i][j].as_f64() {
+            Some(g) => assert!((row[3] - g).abs() < 6e-5, "{} vs {g}", row[3]),
+            None => assert!(row[3].is_nan(), "an empty bin has no ΔG"),
+        }
+    }
+    // The bin centres span the projections' range.
+    let lo = p.iter().map(|r| r[2]).fold(f64::INFINITY, f64::min);
+    let hi = p.iter().map(|r| r[2]).fold(f64::NEG_INFINITY, f64::max);
+    assert!((rows[0][0] - (lo + (hi - lo) / 24.0)).abs() < 1e-3);
+    let img = image::open(&png).unwrap().to_rgb8();
+    assert_eq!(img.dimensions(), (900, 760));
+    // Axes past the components computed: refused before reading, nothing written.
+    std::fs::remove_file(&fel).unwrap();
+    let o = texmap(&[
+        "convert",
+        &xtc,
+        "--topology",
+        &pdb,
+        "--pca-landscape-table",
+        fel.to_str().unwrap(),
+        "--pca-landscape-axes",
+        "1,4",
+        "--pca-components",
+        "3",
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("--pca-landscape-axes 1,4"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!fel.exists());
+}

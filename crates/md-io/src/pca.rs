@@ -356,6 +356,82 @@ pub fn cosine_content(p: &[f64], k: usize) -> f64 {
     2.0 / t as f64 * simpson(&cos).powi(2) / den
 }
 
+/// The molar gas constant in kJ/(mol K): `kT` of [`Landscape::new`] is `R T`.
+pub const GAS_CONSTANT: f64 = 8.314_462_618e-3;
+
+/// A free-energy landscape over two projections (gmx sham's Gibbs landscape of the PC1–PC2
+/// plane): the frames binned on a `bins x bins` grid spanning the projections' range (equal
+/// widths, the last bin closed on the right, as NumPy's `histogram2d` with that range), and
+/// `ΔG = −kT ln(n / n_max)` per bin, 0 at the most visited and `None` where no frame fell.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Landscape {
+    /// The first projection's range (lowest, highest).
+    pub x: (f64, f64),
+    /// The second's.
+    pub y: (f64, f64),
+    /// Bins along each axis.
+    pub bins: usize,
+    /// Frames per bin, row-major with `x` along a row: `counts[j * bins + i]` holds bin `i`
+    /// along x and `j` along y.
+    pub counts: Vec<u32>,
+    /// `ΔG` per bin in the unit of `kT`, `None` for an empty bin.
+    pub free_energy: Vec<Option<f64>>,
+}
+
+impl Landscape {
+    /// The landscape of the points `(x, y)` (one per frame) on `bins x bins` bins, at `kt`
+    /// (`R T` in kJ/mol gives kJ/mol). `None` when there are no points, a point is not finite,
+    /// `bins` is 0 or `kt` is not positive and finite. A range of zero width is widened by
+    /// ±0.5 about its value, as NumPy widens it.
+    pub fn new(points: &[(f64, f64)], bins: usize, kt: f64) -> Option<Landscape> {
+        if points.is_empty()
+            || bins == 0
+            || !(kt.is_finite() && kt > 0.0)
+            || points.iter().any(|p| !(p.0.is_finite() && p.1.is_finite()))
+        {
+            return None;
+        }
+        let range = |v: &mut dyn Iterator<Item = f64>| {
+            let (lo, hi) = v.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), a| {
+                (lo.min(a), hi.max(a))
+            });
+            if lo == hi {
+                (lo - 0.5, hi + 0.5)
+            } else {
+                (lo, hi)
+            }
+        };
+        let x = range(&mut points.iter().map(|p| p.0));
+        let y = range(&mut points.iter().map(|p| p.1));
+        let bin = |v: f64, (lo, hi): (f64, f64)| {
+            (((v - lo) / (hi - lo) * bins as f64) as usize).min(bins - 1)
+        };
+        let mut counts = vec![0u32; bins * bins];
+        for p in points {
+            counts[bin(p.1, y) * bins + bin(p.0, x)] += 1;
+        }
+        let most = f64::from(counts.iter().copied().max().unwrap_or(1));
+        let free_energy = counts
+            .iter()
+            .map(|&n| (n > 0).then(|| -kt * (f64::from(n) / most).ln()))
+            .collect();
+        Some(Landscape {
+            x,
+            y,
+            bins,
+            counts,
+            free_energy,
+        })
+    }
+
+    /// The centre of bin `i` along x and `j` along y.
+    pub fn centre(&self, i: usize, j: usize) -> (f64, f64) {
+        let at =
+            |(lo, hi): (f64, f64), k: usize| lo + (hi - lo) * (k as f64 + 0.5) / self.bins as f64;
+        (at(self.x, i), at(self.y, j))
+    }
+}
+
 /// Simpson's rule over unit-spaced samples, as SciPy's `integrate.simpson` (1.11 and later).
 fn simpson(y: &[f64]) -> f64 {
     let n = y.len();

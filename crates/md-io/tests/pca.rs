@@ -122,3 +122,59 @@ fn rmsd_matrix_equals_mdanalysis() {
         );
     }
 }
+
+/// The free-energy landscape of MDAnalysis's PC1–PC2 projections equals NumPy's
+/// `histogram2d` of them (edges, every bin's count) and `−RT ln(n / n_max)` at 300 K
+/// (gen_landscape.py), at 12 and 5 bins a side.
+#[test]
+fn landscape_equals_numpy() {
+    use texmap_md_io::pca::{GAS_CONSTANT, Landscape};
+    let text = std::fs::read_to_string(dir().join("landscape_reference.json")).unwrap();
+    let reference: Value = serde_json::from_str(&text).unwrap();
+    let text = std::fs::read_to_string(dir().join("pca_reference.json")).unwrap();
+    let pca: Value = serde_json::from_str(&text).unwrap();
+    let points: Vec<(f64, f64)> = pca["aligned name CA"]["projections"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| (p[0].as_f64().unwrap(), p[1].as_f64().unwrap()))
+        .collect();
+    let kt = GAS_CONSTANT * reference["temperature"].as_f64().unwrap();
+    for r in reference["landscapes"].as_array().unwrap() {
+        let bins = r["bins"].as_u64().unwrap() as usize;
+        let l = Landscape::new(&points, bins, kt).unwrap();
+        let (xe, ye) = (floats(&r["x_edges"]), floats(&r["y_edges"]));
+        assert_eq!((l.x.0, l.x.1), (xe[0], xe[bins]));
+        assert_eq!((l.y.0, l.y.1), (ye[0], ye[bins]));
+        let (cx, cy) = l.centre(2, 3);
+        assert!((cx - 0.5 * (xe[2] + xe[3])).abs() < 1e-12);
+        assert!((cy - 0.5 * (ye[3] + ye[4])).abs() < 1e-12);
+        let counts = r["counts"].as_array().unwrap();
+        let energy = r["free_energy"].as_array().unwrap();
+        for i in 0..bins {
+            for j in 0..bins {
+                let k = j * bins + i;
+                assert_eq!(
+                    u64::from(l.counts[k]),
+                    counts[i][j].as_u64().unwrap(),
+                    "{bins} bins: ({i}, {j})"
+                );
+                match (l.free_energy[k], energy[i][j].as_f64()) {
+                    (Some(g), Some(want)) => assert!((g - want).abs() < 1e-8, "{g} vs {want}"),
+                    (None, None) => {}
+                    other => panic!("{bins} bins: ({i}, {j}): {other:?}"),
+                }
+            }
+        }
+        assert_eq!(l.counts.iter().sum::<u32>(), 80);
+    }
+    // What it refuses: no points, a point not finite, no bins, no temperature.
+    assert!(Landscape::new(&[], 10, kt).is_none());
+    assert!(Landscape::new(&[(0.0, f64::NAN)], 10, kt).is_none());
+    assert!(Landscape::new(&points, 0, kt).is_none());
+    assert!(Landscape::new(&points, 10, 0.0).is_none());
+    // One point: the range widened to ±0.5, ΔG 0 in its bin.
+    let one = Landscape::new(&[(2.0, -1.0)], 4, kt).unwrap();
+    assert_eq!((one.x, one.y), ((1.5, 2.5), (-1.5, -0.5)));
+    assert_eq!(one.free_energy.iter().flatten().count(), 1);
+}

@@ -838,7 +838,6 @@ pub fn matrix_heatmap(
     value_label: &str,
     target: Target,
 ) -> Result<(), StudyError> {
-    use texmap_md_scene::Colormap;
     let n = x.len();
     if matrix.len() != n * n {
         return Err(StudyError::BadOption {
@@ -849,7 +848,7 @@ pub fn matrix_heatmap(
     // Blocks of `b` frames a side, each drawn as its cells' mean.
     let b = n.div_ceil(HEATMAP_CELLS).max(1);
     let cells = n.div_ceil(b);
-    let mut blocks = vec![0.0f64; cells * cells];
+    let mut blocks = vec![None; cells * cells];
     for (bi, row) in blocks.chunks_mut(cells.max(1)).enumerate() {
         for (bj, out) in row.iter_mut().enumerate() {
             let (mut sum, mut count) = (0.0, 0usize);
@@ -859,13 +858,83 @@ pub fn matrix_heatmap(
                     count += 1;
                 }
             }
-            *out = sum / count.max(1) as f64;
+            *out = Some(sum / count.max(1) as f64);
         }
     }
-    let top = matrix
+    let top = matrix.iter().fold(0.0f64, |m, v| m.max(*v));
+    let cell = |v: f64| (v >= 0.0 && (v - v.round()).abs() < 1e-9).then_some(v.round() as usize);
+    let x_at = |v: &f64| {
+        let t = cell(*v).and_then(|i| x.get(i));
+        t.map(|t| format!("{}", (t * 1000.0).round() / 1000.0))
+            .unwrap_or_default()
+    };
+    let grid = Grid {
+        x: 0.0..n as f64,
+        y: 0.0..n as f64,
+        step: (b as f64, b as f64),
+        side: cells,
+        cells: &blocks,
+        top,
+        labels: [x_label, x_label, value_label],
+    };
+    grid_heatmap("matrix_heatmap", &grid, Some(&x_at), target)
+}
+
+/// A free-energy landscape (gmx sham's Gibbs landscape; `texmap convert --pca-landscape`) as a
+/// heatmap at [`HEATMAP_SIZE`]: its two projections along the axes (`x_label`, `y_label`),
+/// each visited bin in viridis from 0 (the most visited, dark) to the largest ΔG, empty bins
+/// white, a colour bar titled `value_label`.
+pub fn landscape(
+    l: &texmap_md_io::pca::Landscape,
+    x_label: &str,
+    y_label: &str,
+    value_label: &str,
+    target: Target,
+) -> Result<(), StudyError> {
+    let top = l
+        .free_energy
         .iter()
-        .fold(0.0f64, |m, v| m.max(*v))
-        .max(f64::MIN_POSITIVE);
+        .flatten()
+        .fold(0.0f64, |m, v| m.max(*v));
+    let bins = l.bins as f64;
+    let grid = Grid {
+        x: l.x.0..l.x.1,
+        y: l.y.0..l.y.1,
+        step: ((l.x.1 - l.x.0) / bins, (l.y.1 - l.y.0) / bins),
+        side: l.bins,
+        cells: &l.free_energy,
+        top,
+        labels: [x_label, y_label, value_label],
+    };
+    grid_heatmap("landscape", &grid, None, target)
+}
+
+/// A square grid of cells to draw as a heatmap.
+struct Grid<'a> {
+    x: std::ops::Range<f64>,
+    y: std::ops::Range<f64>,
+    /// A cell's width and height.
+    step: (f64, f64),
+    /// Cells a side.
+    side: usize,
+    /// Row-major, x along a row, y up; `None` is left white.
+    cells: &'a [Option<f64>],
+    /// The value of the colour bar's top (its bottom is 0).
+    top: f64,
+    /// The x axis's, the y axis's and the colour bar's titles.
+    labels: [&'a str; 3],
+}
+
+/// [`Grid`] in viridis at [`HEATMAP_SIZE`], with a colour bar; both axes labelled by
+/// `format` when given.
+fn grid_heatmap(
+    name: &'static str,
+    grid: &Grid,
+    format: Option<&dyn Fn(&f64) -> String>,
+    target: Target,
+) -> Result<(), StudyError> {
+    use texmap_md_scene::Colormap;
+    let top = grid.top.max(f64::MIN_POSITIVE);
     let colour = |v: f64| {
         let c = Colormap::Viridis.srgb((v / top) as f32);
         RGBColor(
@@ -874,21 +943,12 @@ pub fn matrix_heatmap(
             (c[2] * 255.0).round() as u8,
         )
     };
-    let cell = |v: f64| (v >= 0.0 && (v - v.round()).abs() < 1e-9).then_some(v.round() as usize);
-    let x_at = |v: &f64| {
-        let t = cell(*v).and_then(|i| x.get(i));
-        t.map(|t| format!("{}", (t * 1000.0).round() / 1000.0))
-            .unwrap_or_default()
-    };
-    #[allow(clippy::too_many_arguments)]
     fn draw<DB: DrawingBackend>(
         root: DrawingArea<DB, Shift>,
-        (n, cells, b): (usize, usize, usize),
-        blocks: &[f64],
+        grid: &Grid,
         top: f64,
         colour: &dyn Fn(f64) -> RGBColor,
-        [x_label, value_label]: [&str; 2],
-        x_at: &dyn Fn(&f64) -> String,
+        format: Option<&dyn Fn(&f64) -> String>,
     ) -> Result<(), String> {
         let e = |err: DrawingAreaErrorKind<DB::ErrorType>| err.to_string();
         root.fill(&WHITE).map_err(e)?;
@@ -897,27 +957,31 @@ pub fn matrix_heatmap(
             .margin(16)
             .x_label_area_size(44)
             .y_label_area_size(60)
-            .build_cartesian_2d(0.0..n as f64, 0.0..n as f64)
+            .build_cartesian_2d(grid.x.clone(), grid.y.clone())
             .map_err(e)?;
+        let mut mesh = chart.configure_mesh();
+        mesh.disable_mesh()
+            .x_desc(grid.labels[0])
+            .y_desc(grid.labels[1])
+            .label_style(("sans-serif", 14));
+        if let Some(f) = format {
+            mesh.x_label_formatter(f).y_label_formatter(f);
+        }
+        mesh.draw().map_err(e)?;
+        let (w, h) = grid.step;
+        let side = grid.side;
         chart
-            .configure_mesh()
-            .disable_mesh()
-            .x_desc(x_label)
-            .y_desc(x_label)
-            .x_label_formatter(x_at)
-            .y_label_formatter(x_at)
-            .label_style(("sans-serif", 14))
-            .draw()
-            .map_err(e)?;
-        let bf = b as f64;
-        chart
-            .draw_series((0..cells * cells).map(|k| {
-                let (i, j) = (k / cells, k % cells);
-                let (x0, y0) = (j as f64 * bf, i as f64 * bf);
-                Rectangle::new(
-                    [(x0, y0), ((x0 + bf).min(n as f64), (y0 + bf).min(n as f64))],
-                    colour(blocks[k]).filled(),
-                )
+            .draw_series((0..side * side).filter_map(|k| {
+                let v = grid.cells[k]?;
+                let (i, j) = (k % side, k / side);
+                let (x0, y0) = (grid.x.start + i as f64 * w, grid.y.start + j as f64 * h);
+                Some(Rectangle::new(
+                    [
+                        (x0, y0),
+                        ((x0 + w).min(grid.x.end), (y0 + h).min(grid.y.end)),
+                    ],
+                    colour(v).filled(),
+                ))
             }))
             .map_err(e)?;
         // The colour bar: 100 steps from 0 to the largest value.
@@ -926,7 +990,7 @@ pub fn matrix_heatmap(
             .margin_bottom(60)
             .margin_right(16)
             .y_label_area_size(56)
-            .caption(value_label, ("sans-serif", 14))
+            .caption(grid.labels[2], ("sans-serif", 14))
             .build_cartesian_2d(0.0..1.0, 0.0..top)
             .map_err(e)?;
         scale
@@ -944,13 +1008,12 @@ pub fn matrix_heatmap(
             .map_err(e)?;
         root.present().map_err(e)
     }
-    let labels = [x_label, value_label];
     draw_on(
-        "matrix_heatmap",
+        name,
         target,
         HEATMAP_SIZE,
-        |a| draw(a, (n, cells, b), &blocks, top, &colour, labels, &x_at),
-        |a| draw(a, (n, cells, b), &blocks, top, &colour, labels, &x_at),
+        |a| draw(a, grid, top, &colour, format),
+        |a| draw(a, grid, top, &colour, format),
     )
 }
 
@@ -1058,6 +1121,42 @@ mod tests {
         let rects = svg.matches("<rect").count();
         assert!(rects < 300 * 300 + 200 && rects > 200 * 200, "{rects}");
         assert!(matrix_heatmap(&x, "t", &big[1..], "v", Target::Svg(&mut String::new())).is_err());
+    }
+
+    #[test]
+    fn landscape_colours_visited_bins_and_leaves_empty_ones_white() {
+        use texmap_md_io::pca::Landscape;
+        // 300 frames in one bin, 30 in another, 3 in a third; the other 97 bins empty.
+        let mut points = vec![(0.05, 0.05); 300];
+        points.extend(vec![(0.95, 0.95); 30]);
+        points.extend(vec![(0.55, 0.05); 3]);
+        let l = Landscape::new(&points, 10, 1.0).unwrap();
+        let (w, h) = HEATMAP_SIZE;
+        let mut rgb = vec![0u8; 3 * (w * h) as usize];
+        landscape(
+            &l,
+            "PC1 (Å)",
+            "PC2 (Å)",
+            "ΔG (kJ/mol)",
+            Target::Rgb(&mut rgb),
+        )
+        .unwrap();
+        let top = 100f64.ln();
+        let c = |v: f64| {
+            let c = texmap_md_scene::Colormap::Viridis.srgb((v / top) as f32);
+            c.map(|x| (x * 255.0).round() as u8)
+        };
+        let count = |want: [u8; 3]| rgb.chunks_exact(3).filter(|p| *p == want).count();
+        // Each visited bin is a cell of about 75 x 68 pixels; the bar adds a few rows.
+        let (most, tenth, hundredth) = (count(c(0.0)), count(c(10f64.ln())), count(c(top)));
+        for n in [most, tenth, hundredth] {
+            assert!(n > 4000 && n < 7000, "{most} {tenth} {hundredth}");
+        }
+        // The plot area is mostly white: the empty bins.
+        assert!(count([255, 255, 255]) > 400_000);
+        let mut svg = String::new();
+        landscape(&l, "x", "y", "g", Target::Svg(&mut svg)).unwrap();
+        assert!(svg.matches("<rect").count() < 3 + 100 + 20);
     }
 
     fn rec(method: &str, scene: &str, ms: f64, psnr: f64) -> Record {
