@@ -1171,6 +1171,7 @@ impl AnalysisArgs {
             ("--hbond-table", &self.hbond_table),
             ("--hbond-lifetime", &self.hbond_lifetime),
             ("--rmsd-matrix-chart", &self.rmsd_matrix_chart),
+            ("--ramachandran", &self.ramachandran),
             ("--rmsd-clusters", &self.rmsd_clusters),
             ("--rmsd-cluster-table", &self.rmsd_cluster_table),
             ("--rmsd-cluster-middles", &self.rmsd_cluster_middles),
@@ -1733,6 +1734,23 @@ pub struct AnalysisArgs {
     /// Written whole or not at all.
     #[arg(long, value_name = "FILE.csv")]
     pub dihedral_table: Option<PathBuf>,
+    /// Also draw the Ramachandran plot of --ramachandran-select's residues over every frame,
+    /// PNG or SVG by the name (MDAnalysis's Ramachandran.plot, gmx rama): φ across, ψ up, one
+    /// dot per residue and frame up to 20,000 dots, past them their density on 2° bins as
+    /// −ln(p / p_max) (0, dark, the most visited). Helices gather near (−60°, −45°), strands
+    /// near (−120°, 130°). Not with --shard.
+    #[arg(long, value_name = "FILE.png|FILE.svg")]
+    pub ramachandran: Option<PathBuf>,
+    /// The residues --ramachandran plots: those with an atom in the selection at the first
+    /// frame ('protein' by default; 'not resname GLY PRO' leaves out the two whose regions
+    /// differ).
+    #[arg(
+        long,
+        value_name = "SEL",
+        default_value = "protein",
+        requires = "ramachandran"
+    )]
+    pub ramachandran_select: String,
     /// The lag times the diffusion coefficient is fitted over, FROM:TO in ps (in frames when the
     /// frames carry no times); by default 10 % to 90 % of the longest lag, as gmx msd's
     /// -beginfit and -endfit.

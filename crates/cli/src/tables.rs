@@ -85,6 +85,14 @@ pub(crate) struct AnalysisTables {
     )>,
     sasa_residues: Option<crate::output::AtomicFile>,
     dihedral: Option<crate::output::AtomicFile>,
+    /// `--ramachandran`: the chart, the residues' selection (evaluated at the first frame into
+    /// a mask) and the pairs so far.
+    ramachandran: Option<(
+        PathBuf,
+        texmap_md_io::select::Selection,
+        Option<Vec<bool>>,
+        texmap_study::chart::Ramachandran,
+    )>,
     profile: Option<(crate::output::AtomicFile, ProfileMean)>,
     /// `--rmsf-table`, the fluctuations so far and each atom's first columns (the first
     /// frame's).
@@ -1730,6 +1738,22 @@ impl AnalysisTables {
                 "frame,time,chain,resid,resname,phi,psi,omega",
                 whole,
             )?,
+            ramachandran: match chart_file(
+                &analysis.ramachandran,
+                "--ramachandran",
+                "the plot gathers every frame",
+                whole,
+            )? {
+                Some(path) => Some((
+                    path,
+                    texmap_md_io::select::Selection::parse(&analysis.ramachandran_select).map_err(
+                        |e| crate::args::UsageError(format!("--ramachandran-select: {e}")),
+                    )?,
+                    None,
+                    Default::default(),
+                )),
+                None => None,
+            },
             rmsf: whole_run_table(
                 &analysis.rmsf_table,
                 "--rmsf-table",
@@ -1998,6 +2022,29 @@ impl AnalysisTables {
             }
             t.write(&rows)?;
         }
+        if let Some((_, select, mask, plot)) = &mut self.ramachandran {
+            if mask.is_none() {
+                let picked = select
+                    .evaluate(md)
+                    .map_err(|e| anyhow::anyhow!("--ramachandran-select: frame {f}: {e}"))?;
+                *mask = Some(picked);
+            }
+            let mask = mask.as_deref().unwrap_or_default();
+            if mask.len() != md.n_atoms() {
+                bail!(
+                    "--ramachandran: frame {f} has {} atoms and the first {}: every frame must hold the same atoms",
+                    md.n_atoms(),
+                    mask.len()
+                );
+            }
+            for r in texmap_md_io::dihedrals::backbone_dihedrals(md) {
+                if let (Some(phi), Some(psi)) = (r.phi, r.psi)
+                    && mask[r.atoms.clone()].iter().any(|&m| m)
+                {
+                    plot.add(phi, psi);
+                }
+            }
+        }
         if let Some((_, mean)) = &mut self.profile {
             mean.add(f, md)?;
         }
@@ -2099,6 +2146,19 @@ impl AnalysisTables {
             .transpose()?
             .unwrap_or_default();
         let hbond_lifetime = self.hbond_lifetime.map(SurvivalTable::finish).transpose()?;
+        if let Some((path, _, _, plot)) = &self.ramachandran {
+            if plot.is_empty() {
+                bail!(
+                    "--ramachandran: no residue of --ramachandran-select has both φ and ψ (a protein backbone with N, CA and C named so)"
+                );
+            }
+            write_chart(path, texmap_study::chart::HEATMAP_SIZE, |t| plot.draw(t))?;
+            crate::note!(
+                "Ramachandran plot of {} residue-frames written to {}",
+                plot.len(),
+                path.display()
+            );
+        }
         for t in [
             self.hbond,
             hbond_lifetime,

@@ -2090,3 +2090,95 @@ fn pca_landscape_is_numpys_histogram_of_the_projections() {
     );
     assert!(!fel.exists());
 }
+
+/// `--ramachandran` draws a dot at every residue's (φ, ψ) of `--dihedral-table` (whose angles
+/// equal MDAnalysis's: md_inputs.rs) on adenylate kinase in water, and nowhere else;
+/// `--ramachandran-select 'resname GLY'` keeps the glycines' alone. Refused under --shard and
+/// when no residue has both angles.
+#[test]
+fn ramachandran_plot_has_a_dot_at_every_residues_angles() {
+    let dir = tempfile::tempdir().unwrap();
+    let (xtc, gro) = (
+        md_data("hbonds/adk_0_9.xtc"),
+        md_data("hbonds/adk_top.gro.gz"),
+    );
+    let (png, csv) = (dir.path().join("rama.png"), dir.path().join("rama.csv"));
+    for select in ["protein", "resname GLY"] {
+        run_ok(&[
+            "convert",
+            &xtc,
+            "--topology",
+            &gro,
+            "--ramachandran",
+            png.to_str().unwrap(),
+            "--ramachandran-select",
+            select,
+            "--dihedral-table",
+            csv.to_str().unwrap(),
+            "-q",
+        ]);
+        let text = std::fs::read_to_string(&csv).unwrap();
+        let angles: Vec<(f64, f64, bool)> = text
+            .lines()
+            .skip(1)
+            .filter_map(|l| {
+                let c: Vec<&str> = l.split(',').collect();
+                Some((c[5].parse().ok()?, c[6].parse().ok()?, c[4] == "GLY"))
+            })
+            .collect();
+        assert!(angles.len() > 400, "{}", angles.len());
+        let img = image::open(&png).unwrap().to_rgb8();
+        let (w, h) = img.dimensions();
+        assert_eq!((w, h), (900, 760));
+        // The plot area of study::chart's heatmap layout: x 76..884, y 16..700.
+        let (x0, x1, y0, y1) = (76.0, 884.0, 16.0, 700.0);
+        let at = |phi: f64, psi: f64| {
+            (
+                x0 + (phi + 180.0) / 360.0 * (x1 - x0),
+                y0 + (180.0 - psi) / 360.0 * (y1 - y0),
+            )
+        };
+        let ink = |x: u32, y: u32| img.get_pixel(x, y).0 == [0x1f, 0x3a, 0x93];
+        let kept: Vec<(f64, f64)> = angles
+            .iter()
+            .filter(|a| select == "protein" || a.2)
+            .map(|a| at(a.0, a.1))
+            .collect();
+        for &(x, y) in &kept {
+            assert!(
+                ink(x.round() as u32, y.round() as u32),
+                "{select}: ({x}, {y})"
+            );
+        }
+        // Every inked pixel belongs to the dot (3 px and its edge) of a residue kept.
+        for y in 0..h {
+            for x in 0..w {
+                if ink(x, y) {
+                    let near = kept
+                        .iter()
+                        .any(|&(px, py)| (px - x as f64).hypot(py - y as f64) < 7.0);
+                    assert!(near, "{select}: stray ink at ({x}, {y})");
+                }
+            }
+        }
+    }
+    for args in [
+        vec!["--shard", "1/2", "-o", "rama.xyz"],
+        vec!["--ramachandran-select", "resname SOL"],
+    ] {
+        std::fs::remove_file(&png).ok();
+        let mut all = vec![
+            "convert",
+            &xtc,
+            "--topology",
+            &gro,
+            "--ramachandran",
+            png.to_str().unwrap(),
+        ];
+        all.extend(args.iter().copied());
+        let o = texmap(&all);
+        assert!(!o.status.success(), "{args:?}");
+        assert!(stderr(&o).contains("--ramachandran"), "{}", stderr(&o));
+        assert!(!png.exists(), "{args:?}");
+    }
+}

@@ -909,6 +909,124 @@ pub fn landscape(
     grid_heatmap("landscape", &grid, None, target)
 }
 
+/// Most (φ, ψ) pairs [`Ramachandran`] draws as dots; past them it draws their density.
+pub const RAMACHANDRAN_DOTS: usize = 20_000;
+
+/// Bins a side of [`Ramachandran`]'s density (2° each).
+pub const RAMACHANDRAN_BINS: usize = 180;
+
+/// A Ramachandran plot's data (MDAnalysis's `Ramachandran.plot`, gmx rama): the backbone
+/// dihedral pairs (φ, ψ) in degrees of every residue in every frame, kept as points up to
+/// [`RAMACHANDRAN_DOTS`] and always counted on a 2° grid, so that a long run takes bounded
+/// memory.
+#[derive(Clone, Debug)]
+pub struct Ramachandran {
+    points: Vec<(f64, f64)>,
+    counts: Vec<u32>,
+    total: usize,
+}
+
+impl Default for Ramachandran {
+    fn default() -> Self {
+        Ramachandran {
+            points: Vec::new(),
+            counts: vec![0; RAMACHANDRAN_BINS * RAMACHANDRAN_BINS],
+            total: 0,
+        }
+    }
+}
+
+impl Ramachandran {
+    /// Adds one residue's (φ, ψ) in degrees (−180 to 180; a pair not finite is left out).
+    pub fn add(&mut self, phi: f64, psi: f64) {
+        if !(phi.is_finite() && psi.is_finite()) {
+            return;
+        }
+        let bin = |a: f64| {
+            let k = ((a + 180.0) / 360.0 * RAMACHANDRAN_BINS as f64).floor() as isize;
+            k.clamp(0, RAMACHANDRAN_BINS as isize - 1) as usize
+        };
+        self.counts[bin(psi) * RAMACHANDRAN_BINS + bin(phi)] += 1;
+        if self.points.len() < RAMACHANDRAN_DOTS {
+            self.points.push((phi, psi));
+        }
+        self.total += 1;
+    }
+
+    /// The pairs added.
+    pub fn len(&self) -> usize {
+        self.total
+    }
+
+    /// Whether no pair was added.
+    pub fn is_empty(&self) -> bool {
+        self.total == 0
+    }
+
+    /// The plot at [`HEATMAP_SIZE`]: φ along x and ψ up, −180° to 180°, each pair a dark dot
+    /// while there are at most [`RAMACHANDRAN_DOTS`], else their density on 2° bins as
+    /// `−ln(p / p_max)` in viridis (0, dark, at the most visited; empty bins white).
+    pub fn draw(&self, target: Target) -> Result<(), StudyError> {
+        if self.total > RAMACHANDRAN_DOTS {
+            let most = f64::from(self.counts.iter().copied().max().unwrap_or(1));
+            let cells: Vec<Option<f64>> = self
+                .counts
+                .iter()
+                .map(|&n| (n > 0).then(|| -(f64::from(n) / most).ln()))
+                .collect();
+            let top = cells.iter().flatten().fold(0.0f64, |m, v| m.max(*v));
+            let step = 360.0 / RAMACHANDRAN_BINS as f64;
+            let grid = Grid {
+                x: -180.0..180.0,
+                y: -180.0..180.0,
+                step: (step, step),
+                side: RAMACHANDRAN_BINS,
+                cells: &cells,
+                top,
+                labels: ["φ (°)", "ψ (°)", "−ln(p / p_max)"],
+            };
+            return grid_heatmap("ramachandran", &grid, None, target);
+        }
+        fn draw<DB: DrawingBackend>(
+            root: DrawingArea<DB, Shift>,
+            points: &[(f64, f64)],
+        ) -> Result<(), String> {
+            let e = |err: DrawingAreaErrorKind<DB::ErrorType>| err.to_string();
+            root.fill(&WHITE).map_err(e)?;
+            let mut chart = ChartBuilder::on(&root)
+                .margin(16)
+                .x_label_area_size(44)
+                .y_label_area_size(60)
+                .build_cartesian_2d(-180.0..180.0, -180.0..180.0)
+                .map_err(e)?;
+            chart
+                .configure_mesh()
+                .x_desc("φ (°)")
+                .y_desc("ψ (°)")
+                .x_labels(7)
+                .y_labels(7)
+                .x_label_formatter(&|v| format!("{v:.0}"))
+                .y_label_formatter(&|v| format!("{v:.0}"))
+                .label_style(("sans-serif", 14))
+                .light_line_style(RGBColor(238, 238, 238))
+                .draw()
+                .map_err(e)?;
+            let ink = RGBColor(0x1f, 0x3a, 0x93);
+            chart
+                .draw_series(points.iter().map(|&p| Circle::new(p, 3, ink.filled())))
+                .map_err(e)?;
+            root.present().map_err(e)
+        }
+        draw_on(
+            "ramachandran",
+            target,
+            HEATMAP_SIZE,
+            |a| draw(a, &self.points),
+            |a| draw(a, &self.points),
+        )
+    }
+}
+
 /// A square grid of cells to draw as a heatmap.
 struct Grid<'a> {
     x: std::ops::Range<f64>,
@@ -1157,6 +1275,64 @@ mod tests {
         let mut svg = String::new();
         landscape(&l, "x", "y", "g", Target::Svg(&mut svg)).unwrap();
         assert!(svg.matches("<rect").count() < 3 + 100 + 20);
+    }
+
+    #[test]
+    fn ramachandran_draws_dots_where_the_angles_are_then_their_density() {
+        // A helix's residues (φ −60°, ψ −45°, within ±5°) and a strand's (−120°, 130°).
+        let mut r = Ramachandran::default();
+        for k in 0..40 {
+            let d = (k % 5) as f64 * 2.0 - 4.0;
+            r.add(-60.0 + d, -45.0 - d);
+            r.add(-120.0 - d, 130.0 + d);
+        }
+        r.add(f64::NAN, 0.0);
+        assert_eq!(r.len(), 80);
+        let (w, h) = HEATMAP_SIZE;
+        let mut rgb = vec![255u8; 3 * (w * h) as usize];
+        r.draw(Target::Rgb(&mut rgb)).unwrap();
+        // The plot area: 16 px margin, 60 px of y labels, 44 px of x labels.
+        let (x0, x1, y0, y1) = (76.0, (w - 16) as f64, 16.0, (h - 60) as f64);
+        let pixel = |phi: f64, psi: f64| {
+            let x = x0 + (phi + 180.0) / 360.0 * (x1 - x0);
+            let y = y0 + (180.0 - psi) / 360.0 * (y1 - y0);
+            (x.round() as u32, y.round() as u32)
+        };
+        let ink = |x: u32, y: u32| {
+            let i = 3 * (y * w + x) as usize;
+            rgb[i..i + 3] == [0x1f, 0x3a, 0x93]
+        };
+        let (hx, hy) = pixel(-60.0, -45.0);
+        let (sx, sy) = pixel(-120.0, 130.0);
+        assert!(
+            ink(hx, hy) && ink(sx, sy),
+            "dots at the helix and the strand"
+        );
+        // Every dot lies within 14° of one of the two (5° of spread, the dot's radius).
+        let near = |x: u32, y: u32, (cx, cy): (u32, u32)| {
+            let per_degree = (x1 - x0) / 360.0;
+            (x as f64 - cx as f64).hypot(y as f64 - cy as f64) < 14.0 * per_degree
+        };
+        let mut inked = 0;
+        for y in 0..h {
+            for x in 0..w {
+                if ink(x, y) {
+                    inked += 1;
+                    assert!(near(x, y, (hx, hy)) || near(x, y, (sx, sy)), "({x}, {y})");
+                }
+            }
+        }
+        assert!(inked > 100);
+        // Past RAMACHANDRAN_DOTS pairs: the density, one rectangle per visited 2° bin.
+        let mut many = Ramachandran::default();
+        for k in 0..RAMACHANDRAN_DOTS + 1 {
+            let d = (k % 7) as f64;
+            many.add(-60.0 + d, -45.0 + d);
+        }
+        let mut svg = String::new();
+        many.draw(Target::Svg(&mut svg)).unwrap();
+        let rects = svg.matches("<rect").count();
+        assert!(rects > 4 && rects < 4 + 10 + 110, "{rects}");
     }
 
     fn rec(method: &str, scene: &str, ms: f64, psnr: f64) -> Record {
