@@ -37,7 +37,7 @@
 //!   its neighbours are from opposite pairs and [`strain`] its local deformation against a
 //!   reference configuration, [`wigner_seitz`] its vacancies and interstitials, [`voronoi`] its Voronoi
 //!   cell (volume, coordination, index), [`orientation`] its lattice orientation (PTM's) and
-//!   [`grains`] the grains of a polycrystal, [`rdf`] the radial distribution functions of a frame, as OVITO's analyses do, [`msd`] each atom's squared displacement followed across the periodic boundaries and the mean over every time origin with its diffusion coefficient, [`vacf`] the velocity autocorrelation, its Green–Kubo diffusion coefficient and the vibrational density of states, [`conformations`] clusters the frames' shapes on their pairwise RMSD (gmx cluster's gromos and single linkage), [`rmsf`] each atom's fluctuation about its mean position, [`shape`] the radius of gyration and shape anisotropy of a group, [`contacts`] the fraction of a reference's native contacts a frame keeps, [`survival`] how long members of a changing set stay (water residence, hydrogen-bond lifetimes), [`sasa`] solvent-accessible surface areas, [`dihedrals`] the backbone's φ, ψ and ω, [`profile`] density profiles along a cell axis, [`density`] number densities on a 3-D grid averaged over frames (MDAnalysis's DensityAnalysis, VMD's volmap), and [`expr`] computes a number per atom
+//!   [`grains`] the grains of a polycrystal, [`rdf`] the radial distribution functions of a frame, as OVITO's analyses do, [`msd`] each atom's squared displacement followed across the periodic boundaries and the mean over every time origin with its diffusion coefficient, [`vacf`] the velocity autocorrelation, its Green–Kubo diffusion coefficient and the vibrational density of states, [`conformations`] clusters the frames' shapes on their pairwise RMSD (gmx cluster's gromos and single linkage), [`rmsf`] each atom's fluctuation about its mean position, [`shape`] the radius of gyration and shape anisotropy of a group, [`contacts`] the fraction of a reference's native contacts a frame keeps, [`distance_map`] the residue–residue map of smallest distances and contacts over a run (gmx mdmat), [`survival`] how long members of a changing set stay (water residence, hydrogen-bond lifetimes), [`sasa`] solvent-accessible surface areas, [`dihedrals`] the backbone's φ, ψ and ω, [`profile`] density profiles along a cell axis, [`density`] number densities on a 3-D grid averaged over frames (MDAnalysis's DensityAnalysis, VMD's volmap), and [`expr`] computes a number per atom
 //!   from a formula (OVITO's Compute property); [`hbonds`] finds hydrogen bonds by
 //!   MDAnalysis's geometric criterion.
 //! - [`values`] reads per-atom numbers from a text file (an analysis result, a column or a row
@@ -128,6 +128,7 @@ mod cursor;
 mod dcd;
 pub mod density;
 pub mod dihedrals;
+pub mod distance_map;
 mod dlpoly;
 mod dx;
 mod eigen;

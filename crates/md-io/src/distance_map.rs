@@ -1,0 +1,356 @@
+//! Residue–residue maps over a trajectory, as `gmx mdmat` makes them: the smallest distance
+//! between any atom of one residue and any atom of another, averaged over the frames (the
+//! tertiary structure at a glance: helices pack where the map is dark off its diagonal), and
+//! how often that smallest distance falls below a contact cutoff (a contact map: which
+//! residues touch, and for what share of the run).
+//!
+//! Each frame's distances are taken between the atoms as the frame holds them, to the nearest
+//! periodic image when the frame has a periodic cell (in a skewed cell such as a truncated
+//! octahedron too, as gmx's `pbc_dx` and MDAnalysis's `distance_array` find it), so a molecule
+//! split across the box still gives its true distances. Rows of the map are shared between threads; the map is the same for any thread count.
+//!
+//! ```
+//! use texmap_md_io::distance_map::DistanceMap;
+//! // Three one-atom "residues" on a line, 3 Å apart, then the third moved to 10 Å.
+//! let groups = vec![vec![0], vec![1], vec![2]];
+//! let mut map = DistanceMap::new(groups, 4.5).unwrap();
+//! map.add(&[[0.0, 0.0, 0.0], [3.0, 0.0, 0.0], [6.0, 0.0, 0.0]], None).unwrap();
+//! map.add(&[[0.0, 0.0, 0.0], [3.0, 0.0, 0.0], [10.0, 0.0, 0.0]], None).unwrap();
+//! let mean = map.mean();
+//! assert!((mean[2] - 8.0).abs() < 1e-12); // residues 0 and 2: (6 + 10) / 2
+//! let contacts = map.contact_fraction();
+//! assert_eq!((contacts[1], contacts[5]), (1.0, 0.5)); // 0–1 always, 1–2 in one frame of two
+//! ```
+
+use rayon::prelude::*;
+
+use crate::UnitCell;
+use crate::msd::MsdError;
+
+/// The running residue–residue map of a trajectory.
+#[derive(Clone, Debug)]
+pub struct DistanceMap {
+    groups: Vec<Vec<usize>>,
+    cutoff: f64,
+    /// Per pair above the diagonal (row-major over the full square, the lower half unused):
+    /// the sum of the frames' smallest distances and the frames in contact.
+    sum: Vec<f64>,
+    contacts: Vec<u32>,
+    frames: usize,
+}
+
+impl DistanceMap {
+    /// A map of `groups` (each residue's atom indices, none empty) with contacts below
+    /// `cutoff` Å. `None` when a group is empty or the cutoff is not positive and finite.
+    pub fn new(groups: Vec<Vec<usize>>, cutoff: f64) -> Option<DistanceMap> {
+        if groups.iter().any(Vec::is_empty) || !(cutoff.is_finite() && cutoff > 0.0) {
+            return None;
+        }
+        let n = groups.len();
+        Some(DistanceMap {
+            groups,
+            cutoff,
+            sum: vec![0.0; n * n],
+            contacts: vec![0; n * n],
+            frames: 0,
+        })
+    }
+
+    /// The bytes a map of `residues` residues keeps (12 per pair of residues).
+    pub fn bytes(residues: usize) -> usize {
+        residues.saturating_mul(residues).saturating_mul(12)
+    }
+
+    /// The residues.
+    pub fn residues(&self) -> usize {
+        self.groups.len()
+    }
+
+    /// The frames added.
+    pub fn frames(&self) -> usize {
+        self.frames
+    }
+
+    /// Adds a frame: every atom's position, the cell when the frame has one.
+    pub fn add(&mut self, positions: &[[f32; 3]], cell: Option<&UnitCell>) -> Result<(), MsdError> {
+        let needed = self.groups.iter().flatten().max().map_or(0, |&i| i + 1);
+        if positions.len() < needed {
+            return Err(MsdError::AtomCount {
+                first: needed,
+                frame: positions.len(),
+            });
+        }
+        for g in &self.groups {
+            for &i in g {
+                if !positions[i].iter().all(|v| v.is_finite()) {
+                    return Err(MsdError::NotFinite(i));
+                }
+            }
+        }
+        let image = cell.and_then(Image::new);
+        let n = self.groups.len();
+        let groups = &self.groups;
+        let cut2 = self.cutoff * self.cutoff;
+        self.sum
+            .par_chunks_mut(n.max(1))
+            .zip(self.contacts.par_chunks_mut(n.max(1)))
+            .enumerate()
+            .for_each(|(a, (sum, contacts))| {
+                for b in a + 1..n {
+                    let d2 = smallest(&groups[a], &groups[b], positions, image.as_ref());
+                    sum[b] += d2.sqrt();
+                    if d2 < cut2 {
+                        contacts[b] += 1;
+                    }
+                }
+            });
+        self.frames += 1;
+        Ok(())
+    }
+
+    /// The mean over the frames of each pair's smallest distance (Å), row-major `n x n`,
+    /// symmetric with a zero diagonal (gmx mdmat's `-mean`); zeros before any frame.
+    pub fn mean(&self) -> Vec<f64> {
+        let f = self.frames.max(1) as f64;
+        self.square(|k| self.sum[k] / f)
+    }
+
+    /// The fraction of the frames in which each pair's smallest distance is below the cutoff,
+    /// row-major `n x n`, symmetric, 1 on the diagonal.
+    pub fn contact_fraction(&self) -> Vec<f64> {
+        let f = self.frames.max(1) as f64;
+        let mut m = self.square(|k| f64::from(self.contacts[k]) / f);
+        let n = self.groups.len();
+        for i in 0..n {
+            m[i * n + i] = 1.0;
+        }
+        m
+    }
+
+    /// The full square from the upper half's values.
+    fn square(&self, value: impl Fn(usize) -> f64) -> Vec<f64> {
+        let n = self.groups.len();
+        let mut m = vec![0.0; n * n];
+        for i in 0..n {
+            for j in i + 1..n {
+                let v = value(i * n + j);
+                m[i * n + j] = v;
+                m[j * n + i] = v;
+            }
+        }
+        m
+    }
+}
+
+/// The nearest periodic image: the fractional offset rounded along the periodic edges, then,
+/// when that is longer than half the cell's smallest height (where rounding may miss it in a
+/// skewed cell), the shortest of it and its 26 neighbouring images.
+struct Image {
+    matrix: [[f64; 3]; 3],
+    inverse: [[f64; 3]; 3],
+    periodic: [bool; 3],
+    /// Below this squared length a rounded offset is the nearest image.
+    safe2: f64,
+}
+
+impl Image {
+    fn new(cell: &UnitCell) -> Option<Image> {
+        let periodic = cell.periodic();
+        if !periodic.iter().any(|&p| p) {
+            return None;
+        }
+        let m = cell.matrix();
+        let det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+        if !(det.is_finite() && det.abs() > 1e-12) {
+            return None;
+        }
+        // Rows of `m` are the cell vectors: a position is f · m, so f = d · m⁻¹.
+        let inv = |r: usize, c: usize| {
+            let (r1, r2) = ((c + 1) % 3, (c + 2) % 3);
+            let (c1, c2) = ((r + 1) % 3, (r + 2) % 3);
+            (m[r1][c1] * m[r2][c2] - m[r1][c2] * m[r2][c1]) / det
+        };
+        // The height along edge k: the volume over the area of the face of the other two.
+        let cross = |a: [f64; 3], b: [f64; 3]| {
+            [
+                a[1] * b[2] - a[2] * b[1],
+                a[2] * b[0] - a[0] * b[2],
+                a[0] * b[1] - a[1] * b[0],
+            ]
+        };
+        let height = |k: usize| {
+            let c = cross(m[(k + 1) % 3], m[(k + 2) % 3]);
+            det.abs() / (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt()
+        };
+        let safe = (0..3)
+            .filter(|&k| periodic[k])
+            .map(height)
+            .fold(f64::INFINITY, f64::min)
+            / 2.0;
+        Some(Image {
+            matrix: m,
+            inverse: std::array::from_fn(|r| std::array::from_fn(|c| inv(r, c))),
+            periodic,
+            safe2: safe * safe,
+        })
+    }
+
+    fn apply(&self, d: [f64; 3]) -> [f64; 3] {
+        let mut f: [f64; 3] = std::array::from_fn(|k| {
+            d[0] * self.inverse[0][k] + d[1] * self.inverse[1][k] + d[2] * self.inverse[2][k]
+        });
+        for k in 0..3 {
+            if self.periodic[k] {
+                f[k] -= f[k].round();
+            }
+        }
+        let d: [f64; 3] = std::array::from_fn(|k| {
+            f[0] * self.matrix[0][k] + f[1] * self.matrix[1][k] + f[2] * self.matrix[2][k]
+        });
+        let len2 = |v: [f64; 3]| v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+        if len2(d) <= self.safe2 {
+            return d;
+        }
+        let shifts = |k: usize| if self.periodic[k] { -1..=1 } else { 0..=0 };
+        let mut best = d;
+        for a in shifts(0) {
+            for b in shifts(1) {
+                for c in shifts(2) {
+                    let s = [f64::from(a), f64::from(b), f64::from(c)];
+                    let v = std::array::from_fn(|k| {
+                        d[k] + s[0] * self.matrix[0][k]
+                            + s[1] * self.matrix[1][k]
+                            + s[2] * self.matrix[2][k]
+                    });
+                    if len2(v) < len2(best) {
+                        best = v;
+                    }
+                }
+            }
+        }
+        best
+    }
+}
+
+/// The smallest squared distance between an atom of `a` and one of `b`.
+fn smallest(a: &[usize], b: &[usize], p: &[[f32; 3]], image: Option<&Image>) -> f64 {
+    let mut best = f64::INFINITY;
+    for &i in a {
+        let pi = p[i].map(f64::from);
+        for &j in b {
+            let pj = p[j];
+            let mut d = std::array::from_fn(|k| f64::from(pj[k]) - pi[k]);
+            if let Some(image) = image {
+                d = image.apply(d);
+            }
+            best = best.min(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        }
+    }
+    best
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_nearest_image_counts_across_the_box() {
+        // Two one-atom residues 1 Å and 19 Å apart along x in a 20 Å cubic box: 1 Å both
+        // ways; without the cell, 19 Å.
+        let cell = UnitCell::from_lengths_angles([20.0, 20.0, 20.0], [90.0, 90.0, 90.0]).unwrap();
+        let groups = vec![vec![0], vec![1]];
+        let mut map = DistanceMap::new(groups.clone(), 4.5).unwrap();
+        map.add(&[[0.5, 3.0, 3.0], [19.5, 3.0, 3.0]], Some(&cell))
+            .unwrap();
+        assert!((map.mean()[1] - 1.0).abs() < 1e-5, "{}", map.mean()[1]);
+        assert_eq!(map.contact_fraction()[2], 1.0);
+        let mut open = DistanceMap::new(groups, 4.5).unwrap();
+        open.add(&[[0.5, 3.0, 3.0], [19.5, 3.0, 3.0]], None)
+            .unwrap();
+        assert!((open.mean()[1] - 19.0).abs() < 1e-5);
+        assert_eq!(open.contact_fraction()[1], 0.0);
+    }
+
+    #[test]
+    fn the_image_in_a_skewed_cell_is_the_nearest() {
+        // A truncated octahedron's triclinic cell (GROMACS's) and offsets up to two cells long.
+        let cell =
+            UnitCell::from_lengths_angles([80.0, 80.0, 80.0], [70.53, 109.47, 70.53]).unwrap();
+        let image = Image::new(&cell).unwrap();
+        let mut x = 12345u64;
+        let mut next = || {
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (x >> 11) as f64 / (1u64 << 53) as f64 * 320.0 - 160.0
+        };
+        let m = cell.matrix();
+        let len = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        let mut searched = 0;
+        for _ in 0..1000 {
+            let d = [next(), next(), next()];
+            let ours = image.apply(d);
+            // Brute force over images up to three cells from the rounded one.
+            let rounded = crate::pbc::minimum_image(&cell, d);
+            let mut best = f64::INFINITY;
+            for a in -3..=3 {
+                for b in -3..=3 {
+                    for c in -3..=3 {
+                        let s = [f64::from(a), f64::from(b), f64::from(c)];
+                        let v = std::array::from_fn(|k| {
+                            rounded[k] + s[0] * m[0][k] + s[1] * m[1][k] + s[2] * m[2][k]
+                        });
+                        best = best.min(len(v));
+                    }
+                }
+            }
+            assert!(
+                (len(ours) - best).abs() < 1e-9,
+                "{d:?}: {} vs {best}",
+                len(ours)
+            );
+            if len(rounded) > len(ours) + 1e-9 {
+                searched += 1;
+            }
+        }
+        assert!(
+            searched > 10,
+            "rounding alone misses the nearest image: {searched}"
+        );
+    }
+
+    #[test]
+    fn the_smallest_pair_of_atoms_is_the_distance() {
+        // Residue 0: atoms at x = 0 and 1; residue 1: x = 4 and 9. Smallest 3 Å.
+        let mut map = DistanceMap::new(vec![vec![0, 1], vec![2, 3]], 3.0).unwrap();
+        let p = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [4.0, 0.0, 0.0],
+            [9.0, 0.0, 0.0],
+        ];
+        map.add(&p, None).unwrap();
+        assert!((map.mean()[1] - 3.0).abs() < 1e-12);
+        // Strictly below the cutoff: 3 Å is not a contact at 3 Å.
+        assert_eq!(map.contact_fraction()[1], 0.0);
+        assert_eq!(map.frames(), 1);
+    }
+
+    #[test]
+    fn bad_input_is_refused() {
+        assert!(DistanceMap::new(vec![vec![0], vec![]], 4.5).is_none());
+        assert!(DistanceMap::new(vec![vec![0]], 0.0).is_none());
+        assert!(DistanceMap::new(vec![vec![0]], f64::NAN).is_none());
+        let mut map = DistanceMap::new(vec![vec![0], vec![3]], 4.5).unwrap();
+        assert!(matches!(
+            map.add(&[[0.0; 3]; 2], None),
+            Err(MsdError::AtomCount { first: 4, frame: 2 })
+        ));
+        let mut p = [[0.0f32; 3]; 4];
+        p[3][2] = f32::NAN;
+        assert!(matches!(map.add(&p, None), Err(MsdError::NotFinite(3))));
+        assert_eq!(map.frames(), 0);
+    }
+}
