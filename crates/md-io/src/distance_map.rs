@@ -198,14 +198,11 @@ impl Image {
     }
 
     fn apply(&self, d: [f64; 3]) -> [f64; 3] {
-        let mut f: [f64; 3] = std::array::from_fn(|k| {
-            d[0] * self.inverse[0][k] + d[1] * self.inverse[1][k] + d[2] * self.inverse[2][k]
+        let f: [f64; 3] = std::array::from_fn(|k| {
+            let v =
+                d[0] * self.inverse[0][k] + d[1] * self.inverse[1][k] + d[2] * self.inverse[2][k];
+            if self.periodic[k] { v - v.round() } else { v }
         });
-        for k in 0..3 {
-            if self.periodic[k] {
-                f[k] -= f[k].round();
-            }
-        }
         let d: [f64; 3] = std::array::from_fn(|k| {
             f[0] * self.matrix[0][k] + f[1] * self.matrix[1][k] + f[2] * self.matrix[2][k]
         });
