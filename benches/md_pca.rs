@@ -12,17 +12,23 @@
 //! computes once the matrix is there) over all 1,000 frames at 1.5 Å, gromos and single
 //! linkage, one thread.
 //!
+//! Then one frame of the residue–residue distance and contact map (`distance_map`, what
+//! `--distance-map` and `--contact-map` add per frame) of adenylate kinase's 214 residues
+//! (3,341 protein atoms) in its truncated octahedron, 2 threads.
+//!
 //! The peer, `benches/peers/mdanalysis_pca.py`, times MDAnalysis's `analysis.pca.PCA` plus
 //! `transform` on frames of the same sizes held in memory, and `DistanceMatrix` with a
 //! superposing `rms.rmsd` on 500 frames of 214 atoms: run it in the same minutes.
 //! `benches/peers/gmx_cluster.py` times `gmx cluster` against `texmap convert --rmsd-clusters`
-//! end to end on one XTC file (both read it, fit every pair, cluster, write the clusters).
+//! end to end on one XTC file (both read it, fit every pair, cluster, write the clusters);
+//! `benches/peers/gmx_mdmat.py` times `gmx mdmat` against `texmap convert --distance-map`.
 //!
 //! `cargo bench --bench md_pca -- --warm-up-time 1 --measurement-time 10`
 //! (test mode, `cargo test --bench md_pca`, uses 100 frames.)
 
 use criterion::{Criterion, criterion_group};
 use texmap::md_io::conformations::{Method, cluster};
+use texmap::md_io::distance_map::DistanceMap;
 use texmap::md_io::pca::Pca;
 use texmap::md_io::select::Selection;
 
@@ -100,6 +106,21 @@ fn bench(c: &mut Criterion) {
             }
         }
     }
+    // The residue map of adk's protein atoms, one frame.
+    let protein = Selection::parse("protein").unwrap().evaluate(&adk).unwrap();
+    let groups: Vec<Vec<usize>> = texmap::md_io::secondary::residue_ranges(&adk)
+        .into_iter()
+        .map(|r| r.filter(|&i| protein[i]).collect::<Vec<usize>>())
+        .filter(|g| !g.is_empty())
+        .collect();
+    assert_eq!(groups.len(), 214);
+    g.bench_function("distance_map_214_residues_1_frame", |b| {
+        b.iter(|| {
+            let mut map = DistanceMap::new(groups.clone(), 4.5).unwrap();
+            map.add(&adk.positions, adk.cell.as_ref()).unwrap();
+            map
+        })
+    });
     g.finish();
 }
 

@@ -1172,6 +1172,10 @@ impl AnalysisArgs {
             ("--hbond-lifetime", &self.hbond_lifetime),
             ("--rmsd-matrix-chart", &self.rmsd_matrix_chart),
             ("--ramachandran", &self.ramachandran),
+            ("--distance-map", &self.distance_map),
+            ("--distance-map-chart", &self.distance_map_chart),
+            ("--contact-map", &self.contact_map),
+            ("--contact-map-chart", &self.contact_map_chart),
             ("--rmsd-clusters", &self.rmsd_clusters),
             ("--rmsd-cluster-table", &self.rmsd_cluster_table),
             ("--rmsd-cluster-middles", &self.rmsd_cluster_middles),
@@ -1195,6 +1199,8 @@ impl AnalysisArgs {
 #[command(group(clap::ArgGroup::new("rmsd_matrix_out").multiple(true)
     .args(["rmsd_matrix", "rmsd_matrix_chart", "rmsd_clusters", "rmsd_cluster_table",
         "rmsd_cluster_middles"])))]
+#[command(group(clap::ArgGroup::new("residue_map_out").multiple(true)
+    .args(["distance_map", "distance_map_chart", "contact_map", "contact_map_chart"])))]
 #[command(group(clap::ArgGroup::new("rmsd_cluster_out").multiple(true)
     .args(["rmsd_clusters", "rmsd_cluster_table", "rmsd_cluster_middles"])))]
 pub struct AnalysisArgs {
@@ -1751,6 +1757,39 @@ pub struct AnalysisArgs {
         requires = "ramachandran"
     )]
     pub ramachandran_select: String,
+    /// Also write the residue–residue distance map as a CSV matrix (gmx mdmat's -mean): for
+    /// each pair of --distance-map-select's residues the smallest distance between their
+    /// atoms (Å, to the nearest periodic image), averaged over the frames. A header row of
+    /// residue labels (chain:RESNAME resid), then one row per residue. Not with --shard.
+    #[arg(long, value_name = "FILE.csv")]
+    pub distance_map: Option<PathBuf>,
+    /// Also draw the distance map as a heatmap, PNG or SVG by the name (viridis, dark near):
+    /// helices and sheets show as bands beside and across the diagonal.
+    #[arg(long, value_name = "FILE.png|FILE.svg")]
+    pub distance_map_chart: Option<PathBuf>,
+    /// Also write the contact map as a CSV matrix: for each pair of residues the fraction of
+    /// frames in which their smallest atom distance is below --contact-map-cutoff (1 on the
+    /// diagonal); the same layout as --distance-map.
+    #[arg(long, value_name = "FILE.csv")]
+    pub contact_map: Option<PathBuf>,
+    /// Also draw the contact map as a heatmap, PNG or SVG by the name (yellow: always in
+    /// contact).
+    #[arg(long, value_name = "FILE.png|FILE.svg")]
+    pub contact_map_chart: Option<PathBuf>,
+    /// The residues of --distance-map and --contact-map: those with an atom in the selection
+    /// at the first frame, each with its selected atoms ('protein' by default; 'name CA' for
+    /// the CA–CA map).
+    #[arg(
+        long,
+        value_name = "SEL",
+        default_value = "protein",
+        requires = "residue_map_out"
+    )]
+    pub distance_map_select: String,
+    /// The distance below which two residues are in contact for --contact-map (Å).
+    #[arg(long, value_name = "Å", default_value_t = 4.5, requires = "residue_map_out",
+          value_parser = parse_positive)]
+    pub contact_map_cutoff: f64,
     /// The lag times the diffusion coefficient is fitted over, FROM:TO in ps (in frames when the
     /// frames carry no times); by default 10 % to 90 % of the longest lag, as gmx msd's
     /// -beginfit and -endfit.
@@ -1760,7 +1799,8 @@ pub struct AnalysisArgs {
     /// velocities, in MB: 12 bytes per atom per frame each (1,000 frames of 100,000 atoms take
     /// 1,145 MB); also the limit of the frames the principal components keep (12 bytes per
     /// atom and frame), of --rmsd-matrix (8 bytes per pair of frames and 24 per atom and
-    /// frame) and of --rmsd-cluster-middles (12 more per atom and frame). A run stops at the
+    /// frame), of --rmsd-cluster-middles (12 more per atom and frame) and of --distance-map
+    /// and --contact-map (12 bytes per pair of residues). A run stops at the
     /// frame that would pass it.
     #[arg(long, value_name = "MB", default_value_t = 4096)]
     pub msd_memory: usize,

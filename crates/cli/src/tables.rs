@@ -107,6 +107,7 @@ pub(crate) struct AnalysisTables {
     pca: Option<PcaTables>,
     dssp: Option<DsspTables>,
     rmsd_matrix: Option<RmsdMatrix>,
+    residue_map: Option<ResidueMap>,
     /// `--hbond-table` and `--hbond-lifetime`: the plan's hydrogen bonds of every frame.
     hbond: Option<crate::output::AtomicFile>,
     hbond_lifetime: Option<SurvivalTable>,
@@ -1092,6 +1093,191 @@ impl RmsdMatrix {
     }
 }
 
+/// `--distance-map`, `--contact-map` and their charts: the selected residues' smallest
+/// distances every frame, written at the end.
+struct ResidueMap {
+    distance: Option<crate::output::AtomicFile>,
+    distance_chart: Option<PathBuf>,
+    contact: Option<crate::output::AtomicFile>,
+    contact_chart: Option<PathBuf>,
+    select: texmap_md_io::select::Selection,
+    cutoff: f64,
+    limit: usize,
+    /// Set at the first frame: the map, each residue's label and number, the atom count.
+    map: Option<texmap_md_io::distance_map::DistanceMap>,
+    labels: Vec<String>,
+    resids: Vec<f64>,
+    n_atoms: usize,
+}
+
+impl ResidueMap {
+    fn create(analysis: &AnalysisArgs, whole: bool) -> Result<Option<ResidueMap>> {
+        let why = "the map averages every frame";
+        let distance = whole_run_table(&analysis.distance_map, "--distance-map", why, whole)?;
+        let distance_chart = chart_file(
+            &analysis.distance_map_chart,
+            "--distance-map-chart",
+            why,
+            whole,
+        )?;
+        let contact = whole_run_table(&analysis.contact_map, "--contact-map", why, whole)?;
+        let contact_chart = chart_file(
+            &analysis.contact_map_chart,
+            "--contact-map-chart",
+            why,
+            whole,
+        )?;
+        if distance.is_none()
+            && distance_chart.is_none()
+            && contact.is_none()
+            && contact_chart.is_none()
+        {
+            return Ok(None);
+        }
+        Ok(Some(ResidueMap {
+            distance,
+            distance_chart,
+            contact,
+            contact_chart,
+            select: texmap_md_io::select::Selection::parse(&analysis.distance_map_select)
+                .map_err(|e| crate::args::UsageError(format!("--distance-map-select: {e}")))?,
+            cutoff: analysis.contact_map_cutoff,
+            limit: analysis.msd_memory.saturating_mul(1 << 20),
+            map: None,
+            labels: Vec::new(),
+            resids: Vec::new(),
+            n_atoms: 0,
+        }))
+    }
+
+    /// The flag that asked for the map, for messages.
+    fn flag(&self) -> &'static str {
+        if self.distance.is_some() || self.distance_chart.is_some() {
+            "--distance-map"
+        } else {
+            "--contact-map"
+        }
+    }
+
+    fn add(&mut self, f: usize, md: &MdFrame) -> Result<()> {
+        let flag = self.flag();
+        if self.map.is_none() {
+            let picked = self
+                .select
+                .evaluate(md)
+                .map_err(|e| anyhow::anyhow!("--distance-map-select: frame {f}: {e}"))?;
+            let mut groups = Vec::new();
+            for r in texmap_md_io::secondary::residue_ranges(md) {
+                let atoms: Vec<usize> = r.clone().filter(|&i| picked[i]).collect();
+                if atoms.is_empty() {
+                    continue;
+                }
+                let i = r.start;
+                let chain = md.chains.get(i).map(|c| c.to_string()).unwrap_or_default();
+                let name = md
+                    .res_names
+                    .get(i)
+                    .map(|c| c.to_string())
+                    .unwrap_or_default();
+                let resid = md.res_ids.get(i).copied().unwrap_or_default();
+                self.labels.push(if chain.is_empty() {
+                    format!("{name}{resid}")
+                } else {
+                    format!("{chain}:{name}{resid}")
+                });
+                self.resids.push(resid as f64);
+                groups.push(atoms);
+            }
+            if groups.len() < 2 {
+                bail!(
+                    "{flag}: frame {f}: --distance-map-select picks atoms of {} residue(s): a map needs two (and residue names and numbers)",
+                    groups.len()
+                );
+            }
+            let bytes = texmap_md_io::distance_map::DistanceMap::bytes(groups.len());
+            if bytes > self.limit {
+                bail!(
+                    "{flag}: {} residues need {} MB for the map, over the --msd-memory limit of {} MB: select fewer residues",
+                    groups.len(),
+                    bytes.div_ceil(1 << 20),
+                    self.limit >> 20
+                );
+            }
+            self.n_atoms = md.n_atoms();
+            self.map = texmap_md_io::distance_map::DistanceMap::new(groups, self.cutoff);
+        } else if md.n_atoms() != self.n_atoms {
+            bail!(
+                "{flag}: frame {f} has {} atoms and the first {}: every frame must hold the same atoms",
+                md.n_atoms(),
+                self.n_atoms
+            );
+        }
+        if let Some(map) = &mut self.map {
+            map.add(&md.positions, md.cell.as_ref())
+                .map_err(|e| anyhow::anyhow!("{flag}: frame {f}: {e}"))?;
+        }
+        Ok(())
+    }
+
+    /// The matrices written and drawn.
+    fn finish(mut self) -> Result<Vec<crate::output::AtomicFile>> {
+        let Some(map) = self.map.take() else {
+            bail!("{}: no frame was read", self.flag());
+        };
+        let n = map.residues();
+        let matrix_csv = |m: &[f64], digits: usize| {
+            let mut text = String::from("residue");
+            for l in &self.labels {
+                text.push_str(&format!(",{l}"));
+            }
+            text.push('\n');
+            for (l, row) in self.labels.iter().zip(m.chunks(n)) {
+                text.push_str(l);
+                for v in row {
+                    text.push_str(&format!(",{v:.digits$}"));
+                }
+                text.push('\n');
+            }
+            text
+        };
+        if self.distance.is_some() || self.distance_chart.is_some() {
+            let mean = map.mean();
+            if let Some(t) = &mut self.distance {
+                t.write(&matrix_csv(&mean, 3))?;
+            }
+            if let Some(path) = &self.distance_chart {
+                write_chart(path, texmap_study::chart::HEATMAP_SIZE, |t| {
+                    let label = "smallest distance (Å)";
+                    texmap_study::chart::matrix_heatmap(&self.resids, "residue", &mean, label, t)
+                })?;
+            }
+        }
+        if self.contact.is_some() || self.contact_chart.is_some() {
+            let fraction = map.contact_fraction();
+            if let Some(t) = &mut self.contact {
+                t.write(&matrix_csv(&fraction, 4))?;
+            }
+            if let Some(path) = &self.contact_chart {
+                write_chart(path, texmap_study::chart::HEATMAP_SIZE, |t| {
+                    let label = "contact fraction";
+                    texmap_study::chart::matrix_heatmap(
+                        &self.resids,
+                        "residue",
+                        &fraction,
+                        label,
+                        t,
+                    )
+                })?;
+            }
+        }
+        crate::note!("residue map of {n} residues over {} frames", map.frames());
+        Ok([self.distance, self.contact]
+            .into_iter()
+            .flatten()
+            .collect())
+    }
+}
+
 /// `--pca-table`, `--pca-projection`, `--pca-vectors`, `--pca-extremes`: the selected atoms'
 /// positions every frame, analysed at the end.
 struct PcaTables {
@@ -1765,6 +1951,7 @@ impl AnalysisTables {
             pca: PcaTables::create(analysis, whole)?,
             dssp: DsspTables::create(analysis, whole)?,
             rmsd_matrix: RmsdMatrix::create(analysis, whole)?,
+            residue_map: ResidueMap::create(analysis, whole)?,
             hbond: per_frame_table(
                 &analysis.hbond_table,
                 "--hbond-table",
@@ -2071,6 +2258,9 @@ impl AnalysisTables {
         if let Some(d) = &mut self.dssp {
             d.add(f, &time, md)?;
         }
+        if let Some(r) = &mut self.residue_map {
+            r.add(f, md)?;
+        }
         if let Some(r) = &mut self.rmsd_matrix {
             r.add(f, md)?;
         }
@@ -2146,6 +2336,11 @@ impl AnalysisTables {
             .transpose()?
             .unwrap_or_default();
         let hbond_lifetime = self.hbond_lifetime.map(SurvivalTable::finish).transpose()?;
+        let residue_map = self
+            .residue_map
+            .map(ResidueMap::finish)
+            .transpose()?
+            .unwrap_or_default();
         if let Some((path, _, _, plot)) = &self.ramachandran {
             if plot.is_empty() {
                 bail!(
@@ -2186,6 +2381,7 @@ impl AnalysisTables {
         .chain(pca)
         .chain(dssp)
         .chain(rmsd_matrix)
+        .chain(residue_map)
         {
             t.commit()?;
         }

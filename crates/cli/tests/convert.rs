@@ -2182,3 +2182,91 @@ fn ramachandran_plot_has_a_dot_at_every_residues_angles() {
         assert!(!png.exists(), "{args:?}");
     }
 }
+
+/// `--distance-map` and `--contact-map` on adenylate kinase in water (a truncated
+/// octahedron) equal MDAnalysis's minimum-image distances reduced per residue pair (md-io's
+/// data/distance_map: the same reference gmx mdmat agrees with) to the tables' decimals; the
+/// charts are drawn; a selection of one residue is refused with no file left.
+#[test]
+fn residue_maps_are_mdanalysis_and_gmx_mdmat() {
+    use std::io::Read;
+    let dir = tempfile::tempdir().unwrap();
+    let mut text = String::new();
+    flate2::read::GzDecoder::new(
+        std::fs::File::open(md_data("distance_map/reference.json.gz")).unwrap(),
+    )
+    .read_to_string(&mut text)
+    .unwrap();
+    let reference: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let (xtc, gro) = (
+        md_data("hbonds/adk_0_9.xtc"),
+        md_data("hbonds/adk_top.gro.gz"),
+    );
+    let (dm, cm, dpng, csvg) = (
+        dir.path().join("dm.csv"),
+        dir.path().join("cm.csv"),
+        dir.path().join("dm.png"),
+        dir.path().join("cm.svg"),
+    );
+    run_ok(&[
+        "convert",
+        &xtc,
+        "--topology",
+        &gro,
+        "--distance-map",
+        dm.to_str().unwrap(),
+        "--distance-map-chart",
+        dpng.to_str().unwrap(),
+        "--contact-map",
+        cm.to_str().unwrap(),
+        "--contact-map-chart",
+        csvg.to_str().unwrap(),
+        "-q",
+    ]);
+    let n = reference["residues"].as_u64().unwrap() as usize;
+    for (path, key, tolerance) in [(&dm, "mean", 6e-4), (&cm, "contact_fraction", 6e-5)] {
+        let text = std::fs::read_to_string(path).unwrap();
+        let mut lines = text.lines();
+        let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+        assert_eq!(header.len(), n + 1);
+        assert_eq!(
+            (header[0], header[1], header[n]),
+            ("residue", "MET1", "GLY214")
+        );
+        let rows: Vec<Vec<f64>> = lines
+            .map(|l| l.split(',').skip(1).map(|v| v.parse().unwrap()).collect())
+            .collect();
+        assert_eq!(rows.len(), n);
+        // The reference holds the upper triangle row by row.
+        let want = numbers(&reference[key]);
+        let upper = (0..n).flat_map(|i| (i + 1..n).map(move |j| (i, j)));
+        for ((i, j), w) in upper.zip(&want) {
+            assert_eq!(rows[i][j], rows[j][i], "{key}: symmetric");
+            assert!(
+                (rows[i][j] - w).abs() <= tolerance,
+                "{key} ({i}, {j}): {} vs {w}",
+                rows[i][j]
+            );
+        }
+        assert_eq!(want.len(), n * (n - 1) / 2);
+    }
+    let img = image::open(&dpng).unwrap().to_rgb8();
+    assert_eq!(img.dimensions(), (900, 760));
+    let svg = std::fs::read_to_string(&csvg).unwrap();
+    assert!(svg.matches("<rect").count() > n * n / 2);
+    // One residue is no map.
+    std::fs::remove_file(&dm).unwrap();
+    let o = texmap(&[
+        "convert",
+        &xtc,
+        "--topology",
+        &gro,
+        "--distance-map",
+        dm.to_str().unwrap(),
+        "--distance-map-select",
+        "resid 5",
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("1 residue(s)"), "{}", stderr(&o));
+    assert!(!dm.exists());
+}

@@ -89,7 +89,11 @@ impl DistanceMap {
         }
         let image = cell.and_then(Image::new);
         let n = self.groups.len();
-        let groups = &self.groups;
+        let whole: Vec<Whole> = self
+            .groups
+            .iter()
+            .map(|g| Whole::new(g, positions, image.as_ref()))
+            .collect();
         let cut2 = self.cutoff * self.cutoff;
         self.sum
             .par_chunks_mut(n.max(1))
@@ -97,7 +101,7 @@ impl DistanceMap {
             .enumerate()
             .for_each(|(a, (sum, contacts))| {
                 for b in a + 1..n {
-                    let d2 = smallest(&groups[a], &groups[b], positions, image.as_ref());
+                    let d2 = smallest(&whole[a], &whole[b], image.as_ref());
                     sum[b] += d2.sqrt();
                     if d2 < cut2 {
                         contacts[b] += 1;
@@ -231,18 +235,94 @@ impl Image {
     }
 }
 
-/// The smallest squared distance between an atom of `a` and one of `b`.
-fn smallest(a: &[usize], b: &[usize], p: &[[f32; 3]], image: Option<&Image>) -> f64 {
-    let mut best = f64::INFINITY;
-    for &i in a {
-        let pi = p[i].map(f64::from);
-        for &j in b {
-            let pj = p[j];
-            let mut d = std::array::from_fn(|k| f64::from(pj[k]) - pi[k]);
+/// A residue's atoms made whole about its first atom: each atom at the nearest image of its
+/// offset from it, as coordinates in three arrays (for the vectorised inner loop), with the
+/// largest offset.
+struct Whole {
+    origin: [f64; 3],
+    x: Vec<f64>,
+    y: Vec<f64>,
+    z: Vec<f64>,
+    radius: f64,
+}
+
+impl Whole {
+    fn new(atoms: &[usize], p: &[[f32; 3]], image: Option<&Image>) -> Whole {
+        let origin = p[atoms[0]].map(f64::from);
+        let (mut x, mut y, mut z) = (Vec::new(), Vec::new(), Vec::new());
+        let mut radius = 0.0f64;
+        for &i in atoms {
+            let mut o: [f64; 3] = std::array::from_fn(|k| f64::from(p[i][k]) - origin[k]);
             if let Some(image) = image {
-                d = image.apply(d);
+                o = image.apply(o);
             }
-            best = best.min(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+            radius = radius.max((o[0] * o[0] + o[1] * o[1] + o[2] * o[2]).sqrt());
+            x.push(o[0]);
+            y.push(o[1]);
+            z.push(o[2]);
+        }
+        Whole {
+            origin,
+            x,
+            y,
+            z,
+            radius,
+        }
+    }
+}
+
+/// The smallest squared distance between an atom of `a` and one of `b`, each to the nearest
+/// image of the other. With the two residues made whole, an atom pair's offset is
+/// `t + (b's offset) − (a's offset)` for a periodic image `t` of the offset between their
+/// origins; only images within the residues' radii of the nearest can hold the smallest,
+/// and when the nearest plus both radii is below the cell's safe length it alone can.
+fn smallest(a: &Whole, b: &Whole, image: Option<&Image>) -> f64 {
+    let d: [f64; 3] = std::array::from_fn(|k| b.origin[k] - a.origin[k]);
+    let reach = a.radius + b.radius;
+    let mut best = f64::INFINITY;
+    let mut pairs = |t: [f64; 3]| {
+        for i in 0..a.x.len() {
+            let (tx, ty, tz) = (t[0] - a.x[i], t[1] - a.y[i], t[2] - a.z[i]);
+            let row =
+                b.x.iter()
+                    .zip(&b.y)
+                    .zip(&b.z)
+                    .map(|((x, y), z)| {
+                        let (dx, dy, dz) = (tx + x, ty + y, tz + z);
+                        dx * dx + dy * dy + dz * dz
+                    })
+                    .fold(f64::INFINITY, f64::min);
+            best = best.min(row);
+        }
+    };
+    let Some(image) = image else {
+        pairs(d);
+        return best;
+    };
+    let nearest = image.apply(d);
+    let len = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    let m = len(nearest);
+    if (m + reach).powi(2) < image.safe2 {
+        pairs(nearest);
+        return best;
+    }
+    // Every image of the origins' offset that could hold a closer pair than the nearest's
+    // farthest: within 2 x reach of the nearest.
+    let shifts = |k: usize| if image.periodic[k] { -2..=2 } else { 0..=0 };
+    for u in shifts(0) {
+        for v in shifts(1) {
+            for w in shifts(2) {
+                let s = [f64::from(u), f64::from(v), f64::from(w)];
+                let t: [f64; 3] = std::array::from_fn(|k| {
+                    nearest[k]
+                        + s[0] * image.matrix[0][k]
+                        + s[1] * image.matrix[1][k]
+                        + s[2] * image.matrix[2][k]
+                });
+                if len(t) <= m + 2.0 * reach {
+                    pairs(t);
+                }
+            }
         }
     }
     best
@@ -251,6 +331,84 @@ fn smallest(a: &[usize], b: &[usize], p: &[[f32; 3]], image: Option<&Image>) -> 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A seeded generator of numbers in [0, 1).
+    fn uniform(seed: u64) -> impl FnMut() -> f64 {
+        let mut x = seed;
+        move || {
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (x >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
+    /// Every atom pair to its own nearest image: the definition, slowly.
+    fn brute(a: &[usize], b: &[usize], p: &[[f32; 3]], image: Option<&Image>) -> f64 {
+        let mut best = f64::INFINITY;
+        for &i in a {
+            for &j in b {
+                let mut d = std::array::from_fn(|k| f64::from(p[j][k]) - f64::from(p[i][k]));
+                if let Some(image) = image {
+                    d = image.apply(d);
+                }
+                best = best.min(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+            }
+        }
+        best
+    }
+
+    #[test]
+    fn residues_made_whole_give_every_atom_pairs_nearest_image() {
+        // 60 residues of 8 atoms each, each within 4 Å of its first atom, scattered over a
+        // small skewed cell (and wrapped into it, so residues straddle its faces).
+        let cell =
+            UnitCell::from_lengths_angles([30.0, 34.0, 28.0], [70.53, 109.47, 80.0]).unwrap();
+        let image = Image::new(&cell).unwrap();
+        let m = cell.matrix();
+        let mut next = uniform(99);
+        let mut p = Vec::new();
+        let mut groups = Vec::new();
+        for r in 0..60 {
+            let f = [next(), next(), next()];
+            let c: [f64; 3] =
+                std::array::from_fn(|k| f[0] * m[0][k] + f[1] * m[1][k] + f[2] * m[2][k]);
+            groups.push((8 * r..8 * r + 8).collect::<Vec<usize>>());
+            for _ in 0..8 {
+                let q: [f64; 3] = std::array::from_fn(|k| c[k] + 4.0 * (next() - 0.5));
+                p.push(q);
+            }
+        }
+        let mut frame = crate::Frame::new();
+        frame.positions = p.iter().map(|q| q.map(|v| v as f32)).collect();
+        crate::pbc::wrap_positions(&cell, &mut frame.positions);
+        let whole: Vec<Whole> = groups
+            .iter()
+            .map(|g| Whole::new(g, &frame.positions, Some(&image)))
+            .collect();
+        let mut slow_paths = 0;
+        for a in 0..60 {
+            for b in a + 1..60 {
+                let fast = smallest(&whole[a], &whole[b], Some(&image));
+                let slow = brute(&groups[a], &groups[b], &frame.positions, Some(&image));
+                assert!(
+                    (fast - slow).abs() < 1e-6 * slow.max(1.0),
+                    "({a}, {b}): {fast} vs {slow}"
+                );
+                let d: [f64; 3] = std::array::from_fn(|k| whole[b].origin[k] - whole[a].origin[k]);
+                let n = image.apply(d);
+                let reach = whole[a].radius + whole[b].radius;
+                if ((n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt() + reach).powi(2) >= image.safe2
+                {
+                    slow_paths += 1;
+                }
+            }
+        }
+        assert!(
+            slow_paths > 100,
+            "the search over images is exercised: {slow_paths}"
+        );
+    }
 
     #[test]
     fn the_nearest_image_counts_across_the_box() {
@@ -276,13 +434,8 @@ mod tests {
         let cell =
             UnitCell::from_lengths_angles([80.0, 80.0, 80.0], [70.53, 109.47, 70.53]).unwrap();
         let image = Image::new(&cell).unwrap();
-        let mut x = 12345u64;
-        let mut next = || {
-            x = x
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (x >> 11) as f64 / (1u64 << 53) as f64 * 320.0 - 160.0
-        };
+        let mut unit = uniform(12345);
+        let mut next = || unit() * 320.0 - 160.0;
         let m = cell.matrix();
         let len = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
         let mut searched = 0;
