@@ -1170,6 +1170,7 @@ impl AnalysisArgs {
             ("--rmsd-matrix", &self.rmsd_matrix),
             ("--hbond-table", &self.hbond_table),
             ("--hbond-lifetime", &self.hbond_lifetime),
+            ("--hbond-occupancy", &self.hbond_occupancy),
             ("--rmsd-matrix-chart", &self.rmsd_matrix_chart),
             ("--ramachandran", &self.ramachandran),
             ("--distance-map", &self.distance_map),
@@ -1328,6 +1329,14 @@ pub struct AnalysisArgs {
     /// (longer when S has not decayed there). Written whole or not at all; not with --shard.
     #[arg(long, value_name = "FILE.csv")]
     pub hbond_lifetime: Option<PathBuf>,
+    /// Also write each hydrogen bond's occupancy over the run as a CSV table (VMD's hbonds
+    /// plugin's detailed output, MDAnalysis's count_by_ids): one row per donor, hydrogen and
+    /// acceptor seen (the bonds of --hbond-table), the most present first: the three atom
+    /// indices and labels, frames present, occupancy (the fraction of the frames), the mean
+    /// distance (Å) and angle (degrees) while present. Written whole or not at all; not with
+    /// --shard.
+    #[arg(long, value_name = "FILE.csv")]
+    pub hbond_occupancy: Option<PathBuf>,
     /// The longest lag of --hbond-lifetime, in frames drawn (MDAnalysis's tau_max).
     #[arg(
         long,

@@ -771,6 +771,10 @@ fn render(a: &RenderArgs) -> Result<()> {
     for (given, flag) in [
         (a.mol.analysis.hbond_table.is_some(), "--hbond-table"),
         (a.mol.analysis.hbond_lifetime.is_some(), "--hbond-lifetime"),
+        (
+            a.mol.analysis.hbond_occupancy.is_some(),
+            "--hbond-occupancy",
+        ),
     ] {
         if given && !plan.draws_hbonds() {
             return usage(format!(

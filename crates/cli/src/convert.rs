@@ -194,19 +194,21 @@ pub fn convert(a: &ConvertArgs) -> Result<()> {
         .transpose()?;
     let (mol, style) = plan_args(a)?;
     let mut plan = crate::scene::mol_plan(&mol, &style, topology)?;
-    let wants_hbonds = a.analysis.hbond_table.is_some() || a.analysis.hbond_lifetime.is_some();
+    let wants_hbonds = a.analysis.hbond_table.is_some()
+        || a.analysis.hbond_lifetime.is_some()
+        || a.analysis.hbond_occupancy.is_some();
     match (&a.hbonds, wants_hbonds) {
         (Some(sel), true) => {
             plan.set_hbond_select(Some(crate::scene::parse_selection("--hbonds", sel)?))
         }
         (Some(_), false) => {
             return usage(
-                "--hbonds finds the bonds --hbond-table and --hbond-lifetime write: add one",
+                "--hbonds finds the bonds --hbond-table, --hbond-lifetime and --hbond-occupancy write: add one",
             );
         }
         (None, true) => {
             return usage(
-                "--hbond-table and --hbond-lifetime list the hydrogen bonds among --hbonds' atoms: add it, as --hbonds 'protein or water'",
+                "--hbond-table, --hbond-lifetime and --hbond-occupancy list the hydrogen bonds among --hbonds' atoms: add it, as --hbonds 'protein or water'",
             );
         }
         (None, false) => {}

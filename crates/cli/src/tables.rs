@@ -111,6 +111,7 @@ pub(crate) struct AnalysisTables {
     /// `--hbond-table` and `--hbond-lifetime`: the plan's hydrogen bonds of every frame.
     hbond: Option<crate::output::AtomicFile>,
     hbond_lifetime: Option<SurvivalTable>,
+    hbond_occupancy: Option<(crate::output::AtomicFile, HbondOccupancy)>,
     /// `--measure-table`, and the specs of its rows.
     measure: Option<(crate::output::AtomicFile, Vec<String>)>,
 }
@@ -1958,6 +1959,13 @@ impl AnalysisTables {
                 "frame,donor,hydrogen,acceptor,donor_atom,hydrogen_atom,acceptor_atom,distance,angle",
                 whole,
             )?,
+            hbond_occupancy: whole_run_table(
+                &analysis.hbond_occupancy,
+                "--hbond-occupancy",
+                "the occupancy counts every frame",
+                whole,
+            )?
+            .map(|t| (t, HbondOccupancy::default())),
             hbond_lifetime: SurvivalTable::create(
                 &analysis.hbond_lifetime,
                 "--hbond-lifetime",
@@ -2267,6 +2275,9 @@ impl AnalysisTables {
         if let Some(t) = &mut self.hbond {
             t.write(&hbond_rows(f, plan.last_hbonds(), md))?;
         }
+        if let Some((_, o)) = &mut self.hbond_occupancy {
+            o.add(plan.last_hbonds(), md);
+        }
         if let Some(l) = &mut self.hbond_lifetime {
             l.add_hbonds(plan.last_hbonds(), md.time);
         }
@@ -2336,6 +2347,10 @@ impl AnalysisTables {
             .transpose()?
             .unwrap_or_default();
         let hbond_lifetime = self.hbond_lifetime.map(SurvivalTable::finish).transpose()?;
+        let hbond_occupancy = self
+            .hbond_occupancy
+            .map(|(mut t, o)| t.write(&o.csv()).map(|()| t))
+            .transpose()?;
         let residue_map = self
             .residue_map
             .map(ResidueMap::finish)
@@ -2357,6 +2372,7 @@ impl AnalysisTables {
         for t in [
             self.hbond,
             hbond_lifetime,
+            hbond_occupancy,
             self.measure.map(|(t, _)| t),
             survival,
             self.contacts.map(|c| c.file),
@@ -2389,23 +2405,70 @@ impl AnalysisTables {
     }
 }
 
+/// `--hbond-occupancy`: each bond's frames, summed distance and angle, and its atoms' labels.
+#[derive(Default)]
+struct HbondOccupancy {
+    bonds: std::collections::BTreeMap<(u32, u32, u32), (usize, f64, f64, String)>,
+    frames: usize,
+}
+
+impl HbondOccupancy {
+    fn add(&mut self, bonds: &[texmap_md_io::hbonds::HBond], md: &MdFrame) {
+        for b in bonds {
+            let e = self
+                .bonds
+                .entry((b.donor, b.hydrogen, b.acceptor))
+                .or_insert_with(|| {
+                    let atoms = [b.donor, b.hydrogen, b.acceptor].map(|i| hbond_atom(md, i));
+                    (0, 0.0, 0.0, atoms.join(","))
+                });
+            e.0 += 1;
+            e.1 += f64::from(b.distance);
+            e.2 += f64::from(b.angle);
+        }
+        self.frames += 1;
+    }
+
+    /// The table, the most present bonds first (then by donor, hydrogen, acceptor).
+    fn csv(&self) -> String {
+        let mut rows: Vec<_> = self.bonds.iter().collect();
+        rows.sort_by(|a, b| b.1.0.cmp(&a.1.0).then(a.0.cmp(b.0)));
+        let mut text = String::from(
+            "donor,hydrogen,acceptor,donor_atom,hydrogen_atom,acceptor_atom,frames,occupancy,distance,angle\n",
+        );
+        for ((d, h, a), (n, distance, angle, atoms)) in rows {
+            let k = *n as f64;
+            text.push_str(&format!(
+                "{d},{h},{a},{atoms},{n},{:.6},{:.4},{:.3}\n",
+                k / self.frames.max(1) as f64,
+                distance / k,
+                angle / k
+            ));
+        }
+        text
+    }
+}
+
+/// Atom `i` of `md` as RESNAME RESID:NAME, quoted for CSV when it needs to be.
+fn hbond_atom(md: &MdFrame, i: u32) -> String {
+    let i = i as usize;
+    let label = |v: &[texmap_md_io::Label]| v.get(i).map(|l| l.as_str().to_string());
+    let res = label(&md.res_names).unwrap_or_default();
+    let id = md.res_ids.get(i).map(|r| r.to_string()).unwrap_or_default();
+    let name = label(&md.names).unwrap_or_else(|| format!("#{i}"));
+    let text = format!("{res}{id}:{name}");
+    // CSV quoting (RFC 4180) for names that hold a comma or a quote.
+    if text.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", text.replace('"', "\"\""))
+    } else {
+        text
+    }
+}
+
 /// The `--hbond-table` rows of frame `f` (see the flag).
 pub(crate) fn hbond_rows(f: usize, bonds: &[texmap_md_io::hbonds::HBond], md: &MdFrame) -> String {
     use std::fmt::Write;
-    let atom = |i: u32| {
-        let i = i as usize;
-        let label = |v: &[texmap_md_io::Label]| v.get(i).map(|l| l.as_str().to_string());
-        let res = label(&md.res_names).unwrap_or_default();
-        let id = md.res_ids.get(i).map(|r| r.to_string()).unwrap_or_default();
-        let name = label(&md.names).unwrap_or_else(|| format!("#{i}"));
-        let text = format!("{res}{id}:{name}");
-        // CSV quoting (RFC 4180) for names that hold a comma or a quote.
-        if text.contains([',', '"', '\n', '\r']) {
-            format!("\"{}\"", text.replace('"', "\"\""))
-        } else {
-            text
-        }
-    };
+    let atom = |i: u32| hbond_atom(md, i);
     let mut out = String::new();
     for b in bonds {
         let _ = writeln!(

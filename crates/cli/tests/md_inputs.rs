@@ -2061,7 +2061,11 @@ fn the_hydrogen_bond_table_is_mdanalysis_s_list() {
     assert!(c1 > 0.0 && c1 < 0.05, "C(1) {c1}");
     // texmap convert finds the same bonds among --hbonds' atoms without drawing: the same
     // two files; without --hbonds the tables are a usage error.
-    let (t2, l2) = (dir.path().join("hb2.csv"), dir.path().join("lt2.csv"));
+    let (t2, l2, occ) = (
+        dir.path().join("hb2.csv"),
+        dir.path().join("lt2.csv"),
+        dir.path().join("occ.csv"),
+    );
     let convert = |extra: &[&str]| {
         let mut args = vec![
             "convert",
@@ -2073,6 +2077,8 @@ fn the_hydrogen_bond_table_is_mdanalysis_s_list() {
             t2.to_str().unwrap(),
             "--hbond-lifetime",
             l2.to_str().unwrap(),
+            "--hbond-occupancy",
+            occ.to_str().unwrap(),
         ];
         args.extend(extra);
         texmap(&args)
@@ -2084,12 +2090,54 @@ fn the_hydrogen_bond_table_is_mdanalysis_s_list() {
         std::fs::read_to_string(&table).unwrap()
     );
     assert_eq!(std::fs::read_to_string(&l2).unwrap(), text);
+    // --hbond-occupancy: every bond of the table once, with the frames it is in (MDAnalysis's
+    // count_by_ids over its own per-frame lists, the ties at the cutoff aside), the most
+    // present first.
+    let occupancy = std::fs::read_to_string(&occ).unwrap();
+    let mut lines = occupancy.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        "donor,hydrogen,acceptor,donor_atom,hydrogen_atom,acceptor_atom,frames,occupancy,distance,angle"
+    );
+    let ties: std::collections::BTreeSet<(u32, u32, u32)> = (0..2)
+        .flat_map(|k| {
+            got[k]
+                .symmetric_difference(&mda_triples[k])
+                .copied()
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    let mut seen = std::collections::BTreeSet::new();
+    let mut last = usize::MAX;
+    for line in lines {
+        let f: Vec<&str> = line.split(',').collect();
+        let n = |k: usize| f[k].parse::<u32>().unwrap();
+        let t = (n(0), n(1), n(2));
+        let frames = n(6) as usize;
+        assert!(frames <= last, "sorted by frames: {line}");
+        last = frames;
+        let ours = got.iter().filter(|s| s.contains(&t)).count();
+        assert_eq!(frames, ours, "{line}");
+        let occupancy: f64 = f[7].parse().unwrap();
+        assert!((occupancy - frames as f64 / 2.0).abs() < 1e-9);
+        if !ties.contains(&t) {
+            let theirs = mda_triples.iter().filter(|s| s.contains(&t)).count();
+            assert_eq!(frames, theirs, "MDAnalysis's count for {line}");
+        }
+        let (dist, angle): (f64, f64) = (f[8].parse().unwrap(), f[9].parse().unwrap());
+        assert!(dist <= 3.0 && (150.0..=180.0).contains(&angle), "{line}");
+        seen.insert(t);
+    }
+    let all: std::collections::BTreeSet<_> = got.iter().flatten().copied().collect();
+    assert_eq!(seen, all, "every bond once");
+    assert!(all.len() > got[0].len(), "bonds that come and go");
     std::fs::remove_file(&t2).unwrap();
     std::fs::remove_file(&l2).unwrap();
+    std::fs::remove_file(&occ).unwrap();
     let o = convert(&[]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("--hbonds"), "{}", stderr(&o));
-    assert!(!t2.exists() && !l2.exists());
+    assert!(!t2.exists() && !l2.exists() && !occ.exists());
     // `--label {hbonds}` writes the count the table lists (the caption drawn byte for byte as
     // the literal number); without an hbonds representation it is a usage error.
     let caption = |label: &str, rep: &str, out: &str| {
