@@ -2405,11 +2405,19 @@ impl AnalysisTables {
     }
 }
 
-/// `--hbond-occupancy`: each bond's frames, summed distance and angle, and its atoms' labels.
+/// `--hbond-occupancy`: every bond seen, by donor, hydrogen and acceptor, and the frames.
 #[derive(Default)]
 struct HbondOccupancy {
-    bonds: std::collections::BTreeMap<(u32, u32, u32), (usize, f64, f64, String)>,
+    bonds: std::collections::BTreeMap<(u32, u32, u32), SeenBond>,
     frames: usize,
+}
+
+/// A bond's frames, its summed distance and angle, and its atoms' labels.
+struct SeenBond {
+    frames: usize,
+    distance: f64,
+    angle: f64,
+    atoms: String,
 }
 
 impl HbondOccupancy {
@@ -2418,13 +2426,17 @@ impl HbondOccupancy {
             let e = self
                 .bonds
                 .entry((b.donor, b.hydrogen, b.acceptor))
-                .or_insert_with(|| {
-                    let atoms = [b.donor, b.hydrogen, b.acceptor].map(|i| hbond_atom(md, i));
-                    (0, 0.0, 0.0, atoms.join(","))
+                .or_insert_with(|| SeenBond {
+                    frames: 0,
+                    distance: 0.0,
+                    angle: 0.0,
+                    atoms: [b.donor, b.hydrogen, b.acceptor]
+                        .map(|i| hbond_atom(md, i))
+                        .join(","),
                 });
-            e.0 += 1;
-            e.1 += f64::from(b.distance);
-            e.2 += f64::from(b.angle);
+            e.frames += 1;
+            e.distance += f64::from(b.distance);
+            e.angle += f64::from(b.angle);
         }
         self.frames += 1;
     }
@@ -2432,17 +2444,19 @@ impl HbondOccupancy {
     /// The table, the most present bonds first (then by donor, hydrogen, acceptor).
     fn csv(&self) -> String {
         let mut rows: Vec<_> = self.bonds.iter().collect();
-        rows.sort_by(|a, b| b.1.0.cmp(&a.1.0).then(a.0.cmp(b.0)));
+        rows.sort_by(|a, b| b.1.frames.cmp(&a.1.frames).then(a.0.cmp(b.0)));
         let mut text = String::from(
             "donor,hydrogen,acceptor,donor_atom,hydrogen_atom,acceptor_atom,frames,occupancy,distance,angle\n",
         );
-        for ((d, h, a), (n, distance, angle, atoms)) in rows {
-            let k = *n as f64;
+        for ((d, h, a), b) in rows {
+            let k = b.frames as f64;
             text.push_str(&format!(
-                "{d},{h},{a},{atoms},{n},{:.6},{:.4},{:.3}\n",
+                "{d},{h},{a},{},{},{:.6},{:.4},{:.3}\n",
+                b.atoms,
+                b.frames,
                 k / self.frames.max(1) as f64,
-                distance / k,
-                angle / k
+                b.distance / k,
+                b.angle / k
             ));
         }
         text
