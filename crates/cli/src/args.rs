@@ -120,6 +120,10 @@ pub enum Command {
     /// Environment mapping (Seed 003): a mirror or glass target drawn with sphere, cube or
     /// dual-paraboloid maps; `envmap compare` measures every method against the reference.
     Envmap(crate::envmap::EnvmapArgs),
+    /// Draw a table's columns as a line chart, PNG or SVG: the CSV tables texmap convert
+    /// writes (RMSD, radius of gyration, SASA, hydrogen bonds, secondary structure over time)
+    /// or a GROMACS .xvg file. `texmap plot rmsd.csv --y rmsd -o rmsd.png`.
+    Plot(crate::plot::PlotArgs),
     /// Assemble a directory of PNG frames (in numeric order: f2.png before f10.png) into one
     /// movie: .mp4, .webm, .gif (ffmpeg) or .apng. The last step of a render split into parts.
     Movie {

@@ -64,6 +64,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Terrain { cmd } => crate::terrain::run(cmd),
         Command::Envmap(a) => crate::envmap::run(a),
         Command::Movie { dir, output, fps } => crate::movie::assemble(&dir, &output, fps),
+        Command::Plot(a) => crate::plot::plot(&a),
     }
 }
 

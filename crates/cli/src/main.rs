@@ -10,6 +10,7 @@ mod convert;
 mod envmap;
 mod movie;
 mod output;
+mod plot;
 mod scene;
 mod tables;
 mod terrain;

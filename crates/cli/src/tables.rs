@@ -765,7 +765,7 @@ fn frame_axis(frames: &[usize], times: &[Option<f64>]) -> (Vec<f64>, &'static st
 }
 
 /// Draws a chart of `size` pixels into `path`, SVG or PNG by its extension, whole or not at all.
-fn write_chart(
+pub(crate) fn write_chart(
     path: &std::path::Path,
     size: (u32, u32),
     draw: impl Fn(texmap_study::chart::Target) -> Result<(), texmap_study::StudyError>,

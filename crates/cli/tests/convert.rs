@@ -2270,3 +2270,114 @@ fn residue_maps_are_mdanalysis_and_gmx_mdmat() {
     assert!(stderr(&o).contains("1 residue(s)"), "{}", stderr(&o));
     assert!(!dm.exists());
 }
+
+/// `texmap plot` draws a table texmap convert wrote (`--rmsd-table`): the SVG's polyline has a
+/// point per frame, left to right in frame order, each as high as its RMSD ranks (the largest
+/// highest); it reads gmx cluster's own .xvg file (axis labels from its `@` lines); a column
+/// that does not exist, a cell that is not a number (named by line and column) and an image
+/// name of another kind are refused with nothing written.
+#[test]
+fn plot_draws_convert_tables_and_gmx_xvg_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let (xtc, pdb) = (md_data("pca/helix_pca.xtc"), md_data("dihedrals/helix.pdb"));
+    let csv = dir.path().join("rmsd.csv");
+    run_ok(&[
+        "convert",
+        &xtc,
+        "--topology",
+        &pdb,
+        "--align",
+        "name CA",
+        "--rmsd-table",
+        csv.to_str().unwrap(),
+        "-q",
+    ]);
+    let (_, rows) = table(&csv);
+    let rmsd: Vec<f64> = rows.iter().map(|r| r[2]).collect();
+    let svg = dir.path().join("rmsd.svg");
+    run_ok(&[
+        "plot",
+        csv.to_str().unwrap(),
+        "-o",
+        svg.to_str().unwrap(),
+        "-q",
+    ]);
+    let text = std::fs::read_to_string(&svg).unwrap();
+    // The data's polyline: the one with a point per row.
+    let lines: Vec<Vec<(f64, f64)>> = text
+        .split("<polyline")
+        .skip(1)
+        .map(|p| {
+            let points = p
+                .split("points=\"")
+                .nth(1)
+                .unwrap()
+                .split('"')
+                .next()
+                .unwrap();
+            points
+                .split_whitespace()
+                .map(|xy| {
+                    let (x, y) = xy.split_once(',').unwrap();
+                    (x.parse().unwrap(), y.parse().unwrap())
+                })
+                .collect()
+        })
+        .collect();
+    let data = lines
+        .iter()
+        .find(|l| l.len() == rmsd.len())
+        .expect("a point per frame");
+    assert!(
+        data.windows(2).all(|w| w[1].0 > w[0].0),
+        "frames left to right"
+    );
+    for i in 0..rmsd.len() {
+        for j in 0..rmsd.len() {
+            if rmsd[i] > rmsd[j] + 0.01 {
+                assert!(data[i].1 < data[j].1, "frame {i} above frame {j}");
+            }
+        }
+    }
+    // gmx cluster's -clid file, as GROMACS 2022.5 wrote it.
+    let png = dir.path().join("clid.png");
+    run_ok(&[
+        "plot",
+        &md_data("conformations/gmx_clid.xvg"),
+        "-o",
+        png.to_str().unwrap(),
+        "-q",
+    ]);
+    assert_eq!(
+        image::open(&png).unwrap().to_rgb8().dimensions(),
+        (960, 640)
+    );
+    // Bad requests.
+    let bad = dir.path().join("bad.csv");
+    std::fs::write(&bad, "frame,rmsd\n0,0.5\n1,abc\n").unwrap();
+    let out = dir.path().join("out.png");
+    for (args, code, said) in [
+        (
+            vec![csv.to_str().unwrap(), "--y", "nope"],
+            2,
+            "no column 'nope'",
+        ),
+        (
+            vec![bad.to_str().unwrap()],
+            1,
+            "line 3: column 'rmsd' holds 'abc'",
+        ),
+    ] {
+        let mut all = vec!["plot"];
+        all.extend(args);
+        all.extend(["-o", out.to_str().unwrap()]);
+        let o = texmap(&all);
+        assert_eq!(o.status.code(), Some(code), "{}", stderr(&o));
+        assert!(stderr(&o).contains(said), "{}", stderr(&o));
+        assert!(!out.exists());
+    }
+    let pdf = dir.path().join("out.pdf");
+    let o = texmap(&["plot", csv.to_str().unwrap(), "-o", pdf.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(!pdf.exists());
+}

@@ -300,6 +300,21 @@ fn range(vals: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
     (lo - pad)..(hi + pad)
 }
 
+/// The series' legend in a white box at `position`, as every chart here draws it.
+fn legend<'a, DB: DrawingBackend + 'a, CT: plotters::coord::CoordTranslate>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    position: SeriesLabelPosition,
+) -> Result<(), String> {
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 14))
+        .position(position)
+        .draw()
+        .map_err(|e| e.to_string())
+}
+
 fn chart_err(chart: &str) -> impl Fn(String) -> StudyError + '_ {
     move |message| StudyError::Chart {
         chart: chart.to_string(),
@@ -396,14 +411,7 @@ fn draw_speed_accuracy<DB: DrawingBackend>(
             }))
             .map_err(|e| e.to_string())?;
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 14))
-        .position(SeriesLabelPosition::LowerRight)
-        .draw()
-        .map_err(|e| e.to_string())?;
+    legend(&mut chart, SeriesLabelPosition::LowerRight)?;
     if capped {
         root.draw(&Text::new(
             CAPPED_NOTE,
@@ -480,14 +488,7 @@ fn draw_sweep<DB: DrawingBackend>(
             .map_err(|e| e.to_string())?;
         draw_markers(&mut chart, method, color, &pts, 4, true)?;
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 14))
-        .position(SeriesLabelPosition::UpperLeft)
-        .draw()
-        .map_err(|e| e.to_string())?;
+    legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
     if capped {
         root.draw(&Text::new(
             CAPPED_NOTE,
@@ -683,14 +684,7 @@ pub fn scatter(
                 .draw_series(pts.iter().map(|&p| Circle::new(p, 3, c.filled())))
                 .map_err(e)?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 14))
-            .draw()
-            .map_err(e)?;
+        legend(&mut chart, SeriesLabelPosition::UpperRight)?;
         root.present().map_err(e)
     }
     let names: Vec<&str> = series.iter().map(|s| s.0.as_str()).collect();
@@ -701,6 +695,80 @@ pub fn scatter(
         CHART_SIZE,
         |r| draw(r, labels, &names, &finite, xr.clone(), yr.clone()),
         |r| draw(r, labels, &names, &finite, xr.clone(), yr.clone()),
+    )
+}
+
+/// A line chart of `size` pixels (`texmap plot`: a table's columns against one of them): one
+/// colour per series (the first eight of [`SCATTER_COLOURS`], then again), each a polyline
+/// broken where a `y` is not finite (an empty cell), a legend when there are two or more.
+/// `title` may be empty.
+pub fn lines(
+    [title, x_label, y_label]: [&str; 3],
+    series: &[(String, Vec<(f64, f64)>)],
+    size: (u32, u32),
+    target: Target,
+) -> Result<(), StudyError> {
+    let xr = range(series.iter().flat_map(|s| s.1.iter().map(|p| p.0)));
+    let yr = range(
+        series
+            .iter()
+            .flat_map(|s| s.1.iter().filter(|p| p.0.is_finite()).map(|p| p.1)),
+    );
+    fn draw<DB: DrawingBackend>(
+        root: DrawingArea<DB, Shift>,
+        labels: [&str; 3],
+        series: &[(String, Vec<(f64, f64)>)],
+        xr: std::ops::Range<f64>,
+        yr: std::ops::Range<f64>,
+    ) -> Result<(), String> {
+        let e = |err: DrawingAreaErrorKind<DB::ErrorType>| err.to_string();
+        root.fill(&WHITE).map_err(e)?;
+        let mut builder = ChartBuilder::on(&root);
+        if !labels[0].is_empty() {
+            builder.caption(labels[0], ("sans-serif", 22));
+        }
+        let mut chart = builder
+            .margin(16)
+            .x_label_area_size(44)
+            .y_label_area_size(70)
+            .build_cartesian_2d(xr, yr)
+            .map_err(e)?;
+        chart
+            .configure_mesh()
+            .x_desc(labels[1])
+            .y_desc(labels[2])
+            .label_style(("sans-serif", 14))
+            .light_line_style(RGBColor(238, 238, 238))
+            .draw()
+            .map_err(e)?;
+        for (k, (name, points)) in series.iter().enumerate() {
+            let c = SCATTER_COLOURS[k % SCATTER_COLOURS.len()];
+            let mut first = true;
+            for run in points
+                .split(|p| !(p.0.is_finite() && p.1.is_finite()))
+                .filter(|r| !r.is_empty())
+            {
+                let drawn = chart
+                    .draw_series(LineSeries::new(run.iter().copied(), c.stroke_width(2)))
+                    .map_err(e)?;
+                if std::mem::take(&mut first) {
+                    drawn.label(name.as_str()).legend(move |(x, y)| {
+                        PathElement::new([(x, y), (x + 20, y)], c.stroke_width(3))
+                    });
+                }
+            }
+        }
+        if series.len() > 1 {
+            legend(&mut chart, SeriesLabelPosition::UpperRight)?;
+        }
+        root.present().map_err(e)
+    }
+    draw_on(
+        "lines",
+        target,
+        size,
+        |a| draw(a, [title, x_label, y_label], series, xr.clone(), yr.clone()),
+        |a| draw(a, [title, x_label, y_label], series, xr.clone(), yr.clone()),
     )
 }
 
@@ -801,14 +869,7 @@ pub fn structure_timeline(
                         + Rectangle::new([(0, -6), (14, 6)], BLACK.stroke_width(1))
                 });
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 14))
-            .draw()
-            .map_err(e)?;
+        legend(&mut chart, SeriesLabelPosition::UpperRight)?;
         root.present().map_err(e)
     }
     draw_on(
@@ -1333,6 +1394,38 @@ mod tests {
         many.draw(Target::Svg(&mut svg)).unwrap();
         let rects = svg.matches("<rect").count();
         assert!(rects > 4 && rects < 4 + 10 + 110, "{rects}");
+    }
+
+    #[test]
+    fn lines_run_through_their_points_and_break_at_gaps() {
+        // y = x from 0 to 10, a gap at x = 5; a second series y = 10 − x.
+        let up: Vec<(f64, f64)> = (0..=10)
+            .map(|x| (x as f64, if x == 5 { f64::NAN } else { x as f64 }))
+            .collect();
+        let down: Vec<(f64, f64)> = (0..=10).map(|x| (x as f64, 10.0 - x as f64)).collect();
+        let series = vec![("up".to_string(), up), ("down".to_string(), down)];
+        let mut svg = String::new();
+        lines(["", "x", "y"], &series, (640, 480), Target::Svg(&mut svg)).unwrap();
+        // Two polylines for "up" (the gap), one for "down", and the legend's two lines.
+        let polylines = svg.matches("<polyline").count();
+        assert!(polylines >= 3, "{polylines}");
+        assert!(svg.contains("down"), "a legend");
+        let (w, h) = (640u32, 480u32);
+        let mut rgb = vec![0u8; 3 * (w * h) as usize];
+        lines(["t", "x", "y"], &series[..1], (w, h), Target::Rgb(&mut rgb)).unwrap();
+        let blue = |x: u32, y: u32| {
+            let i = 3 * (y * w + x) as usize;
+            rgb[i..i + 3] == [0x1f, 0x77, 0xb4]
+        };
+        // The line rises left to right: the blue pixels' mean height falls (image y grows
+        // down) from the left quarter to the right quarter.
+        let mean_y = |x0: u32, x1: u32| {
+            let ys: Vec<u32> = (x0..x1)
+                .flat_map(|x| (0..h).filter(move |&y| blue(x, y)))
+                .collect();
+            ys.iter().sum::<u32>() as f64 / ys.len().max(1) as f64
+        };
+        assert!(mean_y(100, 240) > mean_y(440, 600) + 100.0);
     }
 
     fn rec(method: &str, scene: &str, ms: f64, psnr: f64) -> Record {

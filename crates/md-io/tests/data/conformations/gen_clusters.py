@@ -16,6 +16,7 @@ package): python3 gen_clusters.py
   CA group for the fit and the output): every frame's cluster (-clid), and from cluster.log
   each cluster's size, middle structure (the member with the smallest mean RMSD to the
   others) and that mean, the cluster's mean RMSD, and its members, all as frame numbers.
+- gmx_clid.xvg: the first run's -clid file as gmx wrote it (for `texmap plot`'s test).
 
 The runs are chosen so that the answer does not hang on what gmx leaves open: the gromos method
 finds the same clusters however it breaks a tie between the structures with the most
@@ -135,7 +136,7 @@ def tie_free(m, cut):
     return all(set(gromos(m, cut, p)) == first for p in picks)
 
 
-def run_gmx(method, cut_nm):
+def run_gmx(method, cut_nm, keep_clid=None):
     with tempfile.TemporaryDirectory() as d:
         cmd = ["gmx", "-quiet", "cluster", "-f", XTC, "-s", PDB, "-n", NDX, "-method", method,
                "-cutoff", str(cut_nm), "-g", f"{d}/cl.log", "-clid", f"{d}/clid.xvg",
@@ -148,6 +149,9 @@ def run_gmx(method, cut_nm):
             t, c = line.split()
             clid.append((round(float(t) / DT), int(c)))
         log = open(f"{d}/cl.log").read()
+        if keep_clid:
+            with open(f"{d}/clid.xvg") as src, open(keep_clid, "w") as dst:
+                dst.write(src.read())
     assert [f for f, _ in clid] == list(range(FRAMES)), clid[:5]
     clusters = []
     for line in log[log.index("cl. |"):].splitlines()[1:]:
@@ -187,7 +191,8 @@ for method, wanted in RUNS:
             break
     else:
         raise SystemExit(f"{method}: no cutoff from {wanted} nm meets the conditions")
-    clid, clusters, version = run_gmx(method, cut_nm)
+    keep = os.path.join(HERE, "gmx_clid.xvg") if not out["runs"] else None
+    clid, clusters, version = run_gmx(method, cut_nm, keep)
     print(method, cut, "clusters", len(clusters), [c["size"] for c in clusters][:12], "margin", margin)
     out["runs"].append({"method": method, "cutoff_nm": cut_nm, "gmx": version,
                         "cluster_of_frame": clid, "clusters": clusters})
