@@ -1414,8 +1414,8 @@ pub struct AnalysisArgs {
     pub rmsd_matrix_select: String,
     /// Also cluster the frames' conformations on their pairwise RMSD (gmx cluster; the
     /// matrix of --rmsd-matrix, over --rmsd-matrix-select's atoms) and write each frame's
-    /// cluster as CSV: frame, time, cluster (1 the first; gmx cluster -clid). With the gromos
-    /// method clusters are numbered largest first. Pick --rmsd-cluster-cutoff from the
+    /// cluster as CSV: frame, time, cluster (1 the first; gmx cluster -clid; `texmap plot
+    /// clid.csv` draws it). With the gromos method clusters are numbered largest first. Pick --rmsd-cluster-cutoff from the
     /// --rmsd-matrix-chart: inside its blocks, below the RMSD between them. Written whole or
     /// not at all; not with --shard.
     #[arg(long, value_name = "FILE.csv")]

@@ -85,14 +85,7 @@ pub(crate) struct AnalysisTables {
     )>,
     sasa_residues: Option<crate::output::AtomicFile>,
     dihedral: Option<crate::output::AtomicFile>,
-    /// `--ramachandran`: the chart, the residues' selection (evaluated at the first frame into
-    /// a mask) and the pairs so far.
-    ramachandran: Option<(
-        PathBuf,
-        texmap_md_io::select::Selection,
-        Option<Vec<bool>>,
-        texmap_study::chart::Ramachandran,
-    )>,
+    ramachandran: Option<RamachandranPlot>,
     profile: Option<(crate::output::AtomicFile, ProfileMean)>,
     /// `--rmsf-table`, the fluctuations so far and each atom's first columns (the first
     /// frame's).
@@ -1094,6 +1087,77 @@ impl RmsdMatrix {
     }
 }
 
+/// `--ramachandran`: the chart, the residues' selection (a mask over the atoms, set at the
+/// first frame) and the (φ, ψ) pairs so far.
+struct RamachandranPlot {
+    path: PathBuf,
+    select: texmap_md_io::select::Selection,
+    mask: Option<Vec<bool>>,
+    plot: texmap_study::chart::Ramachandran,
+}
+
+impl RamachandranPlot {
+    fn create(analysis: &AnalysisArgs, whole: bool) -> Result<Option<RamachandranPlot>> {
+        let why = "the plot gathers every frame";
+        let Some(path) = chart_file(&analysis.ramachandran, "--ramachandran", why, whole)? else {
+            return Ok(None);
+        };
+        let select = texmap_md_io::select::Selection::parse(&analysis.ramachandran_select)
+            .map_err(|e| crate::args::UsageError(format!("--ramachandran-select: {e}")))?;
+        Ok(Some(RamachandranPlot {
+            path,
+            select,
+            mask: None,
+            plot: Default::default(),
+        }))
+    }
+
+    /// Frame `f`'s selected residues with both angles.
+    fn add(&mut self, f: usize, md: &MdFrame) -> Result<()> {
+        if self.mask.is_none() {
+            let picked = self
+                .select
+                .evaluate(md)
+                .map_err(|e| anyhow::anyhow!("--ramachandran-select: frame {f}: {e}"))?;
+            self.mask = Some(picked);
+        }
+        let mask = self.mask.as_deref().unwrap_or_default();
+        if mask.len() != md.n_atoms() {
+            bail!(
+                "--ramachandran: frame {f} has {} atoms and the first {}: every frame must hold the same atoms",
+                md.n_atoms(),
+                mask.len()
+            );
+        }
+        for r in texmap_md_io::dihedrals::backbone_dihedrals(md) {
+            if let (Some(phi), Some(psi)) = (r.phi, r.psi)
+                && mask[r.atoms.clone()].iter().any(|&m| m)
+            {
+                self.plot.add(phi, psi);
+            }
+        }
+        Ok(())
+    }
+
+    /// The chart drawn.
+    fn finish(&self) -> Result<()> {
+        if self.plot.is_empty() {
+            bail!(
+                "--ramachandran: no residue of --ramachandran-select has both φ and ψ (a protein backbone with N, CA and C named so)"
+            );
+        }
+        write_chart(&self.path, texmap_study::chart::HEATMAP_SIZE, |t| {
+            self.plot.draw(t)
+        })?;
+        crate::note!(
+            "Ramachandran plot of {} residue-frames written to {}",
+            self.plot.len(),
+            self.path.display()
+        );
+        Ok(())
+    }
+}
+
 /// `--distance-map`, `--contact-map` and their charts: the selected residues' smallest
 /// distances every frame, written at the end.
 struct ResidueMap {
@@ -1925,22 +1989,7 @@ impl AnalysisTables {
                 "frame,time,chain,resid,resname,phi,psi,omega",
                 whole,
             )?,
-            ramachandran: match chart_file(
-                &analysis.ramachandran,
-                "--ramachandran",
-                "the plot gathers every frame",
-                whole,
-            )? {
-                Some(path) => Some((
-                    path,
-                    texmap_md_io::select::Selection::parse(&analysis.ramachandran_select).map_err(
-                        |e| crate::args::UsageError(format!("--ramachandran-select: {e}")),
-                    )?,
-                    None,
-                    Default::default(),
-                )),
-                None => None,
-            },
+            ramachandran: RamachandranPlot::create(analysis, whole)?,
             rmsf: whole_run_table(
                 &analysis.rmsf_table,
                 "--rmsf-table",
@@ -2217,28 +2266,8 @@ impl AnalysisTables {
             }
             t.write(&rows)?;
         }
-        if let Some((_, select, mask, plot)) = &mut self.ramachandran {
-            if mask.is_none() {
-                let picked = select
-                    .evaluate(md)
-                    .map_err(|e| anyhow::anyhow!("--ramachandran-select: frame {f}: {e}"))?;
-                *mask = Some(picked);
-            }
-            let mask = mask.as_deref().unwrap_or_default();
-            if mask.len() != md.n_atoms() {
-                bail!(
-                    "--ramachandran: frame {f} has {} atoms and the first {}: every frame must hold the same atoms",
-                    md.n_atoms(),
-                    mask.len()
-                );
-            }
-            for r in texmap_md_io::dihedrals::backbone_dihedrals(md) {
-                if let (Some(phi), Some(psi)) = (r.phi, r.psi)
-                    && mask[r.atoms.clone()].iter().any(|&m| m)
-                {
-                    plot.add(phi, psi);
-                }
-            }
+        if let Some(r) = &mut self.ramachandran {
+            r.add(f, md)?;
         }
         if let Some((_, mean)) = &mut self.profile {
             mean.add(f, md)?;
@@ -2356,18 +2385,8 @@ impl AnalysisTables {
             .map(ResidueMap::finish)
             .transpose()?
             .unwrap_or_default();
-        if let Some((path, _, _, plot)) = &self.ramachandran {
-            if plot.is_empty() {
-                bail!(
-                    "--ramachandran: no residue of --ramachandran-select has both φ and ψ (a protein backbone with N, CA and C named so)"
-                );
-            }
-            write_chart(path, texmap_study::chart::HEATMAP_SIZE, |t| plot.draw(t))?;
-            crate::note!(
-                "Ramachandran plot of {} residue-frames written to {}",
-                plot.len(),
-                path.display()
-            );
+        if let Some(r) = &self.ramachandran {
+            r.finish()?;
         }
         for t in [
             self.hbond,
