@@ -17,7 +17,7 @@
 //! 3. Otherwise other (surfaces, cores of defects, liquids, too few atoms).
 //!
 //! Neighbours are found in a cell grid; in a periodic cell by the nearest image (rounded
-//! fractional differences, as [`crate::pbc::minimum_image`]), so the box must be wider than
+//! fractional differences, exact within half the cell's width), so the box must be wider than
 //! twice the 14th neighbour distance (any box of a few unit cells). Frames without a cell are
 //! open. Atoms are classified in parallel (rayon); the result does not depend on the thread
 //! count.

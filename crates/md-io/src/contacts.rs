@@ -30,7 +30,7 @@
 //! ```
 
 use crate::frame::UnitCell;
-use crate::pbc::minimum_image;
+use crate::pbc::NearestImage;
 
 /// How a frame's pairs count towards Q (see the module docs).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -88,11 +88,11 @@ pub struct NativeContacts {
     radius: f64,
 }
 
-/// The distance between `p` and `q` (Å), through the nearest image when `cell` is given.
-fn distance(cell: Option<&UnitCell>, p: [f32; 3], q: [f32; 3]) -> f64 {
+/// The distance between `p` and `q` (Å), through the nearest image when `image` is given.
+fn distance(image: Option<&NearestImage>, p: [f32; 3], q: [f32; 3]) -> f64 {
     let d: [f64; 3] = std::array::from_fn(|k| q[k] as f64 - p[k] as f64);
-    let d = match cell {
-        Some(c) => minimum_image(c, d),
+    let d = match image {
+        Some(image) => image.apply(d),
         None => d,
     };
     (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
@@ -124,10 +124,11 @@ impl NativeContacts {
         if let Some(&i) = a.iter().chain(b).find(|&&i| i >= positions.len()) {
             return Err(ContactsError::OutOfRange(i));
         }
+        let image = cell.and_then(NearestImage::new);
         let (mut pairs, mut r0) = (Vec::new(), Vec::new());
         for &i in a {
             for &j in b {
-                let r = distance(cell, positions[i], positions[j]);
+                let r = distance(image.as_ref(), positions[i], positions[j]);
                 if r <= radius {
                     pairs.push([i as u32, j as u32]);
                     r0.push(r);
@@ -161,9 +162,10 @@ impl NativeContacts {
         {
             return Err(ContactsError::OutOfRange(*i as usize));
         }
+        let image = cell.and_then(NearestImage::new);
         let mut sum = 0.0;
         for (&[i, j], &r0) in self.pairs.iter().zip(&self.r0) {
-            let r = distance(cell, positions[i as usize], positions[j as usize]);
+            let r = distance(image.as_ref(), positions[i as usize], positions[j as usize]);
             sum += match method {
                 Method::HardCut => f64::from(u8::from(r <= r0)),
                 Method::RadiusCut => f64::from(u8::from(r <= self.radius)),

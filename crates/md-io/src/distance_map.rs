@@ -26,6 +26,7 @@ use rayon::prelude::*;
 
 use crate::UnitCell;
 use crate::msd::MsdError;
+use crate::pbc::NearestImage;
 
 /// The running residue–residue map of a trajectory.
 #[derive(Clone, Debug)]
@@ -87,7 +88,7 @@ impl DistanceMap {
                 }
             }
         }
-        let image = cell.and_then(Image::new);
+        let image = cell.and_then(NearestImage::new);
         let n = self.groups.len();
         let whole: Vec<Whole> = self
             .groups
@@ -146,95 +147,6 @@ impl DistanceMap {
     }
 }
 
-/// The nearest periodic image: the fractional offset rounded along the periodic edges, then,
-/// when that is longer than half the cell's smallest height (where rounding may miss it in a
-/// skewed cell), the shortest of it and its 26 neighbouring images.
-struct Image {
-    matrix: [[f64; 3]; 3],
-    inverse: [[f64; 3]; 3],
-    periodic: [bool; 3],
-    /// Below this squared length a rounded offset is the nearest image.
-    safe2: f64,
-}
-
-impl Image {
-    fn new(cell: &UnitCell) -> Option<Image> {
-        let periodic = cell.periodic();
-        if !periodic.iter().any(|&p| p) {
-            return None;
-        }
-        let m = cell.matrix();
-        let det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
-            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
-        if !(det.is_finite() && det.abs() > 1e-12) {
-            return None;
-        }
-        // Rows of `m` are the cell vectors: a position is f · m, so f = d · m⁻¹.
-        let inv = |r: usize, c: usize| {
-            let (r1, r2) = ((c + 1) % 3, (c + 2) % 3);
-            let (c1, c2) = ((r + 1) % 3, (r + 2) % 3);
-            (m[r1][c1] * m[r2][c2] - m[r1][c2] * m[r2][c1]) / det
-        };
-        // The height along edge k: the volume over the area of the face of the other two.
-        let cross = |a: [f64; 3], b: [f64; 3]| {
-            [
-                a[1] * b[2] - a[2] * b[1],
-                a[2] * b[0] - a[0] * b[2],
-                a[0] * b[1] - a[1] * b[0],
-            ]
-        };
-        let height = |k: usize| {
-            let c = cross(m[(k + 1) % 3], m[(k + 2) % 3]);
-            det.abs() / (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt()
-        };
-        let safe = (0..3)
-            .filter(|&k| periodic[k])
-            .map(height)
-            .fold(f64::INFINITY, f64::min)
-            / 2.0;
-        Some(Image {
-            matrix: m,
-            inverse: std::array::from_fn(|r| std::array::from_fn(|c| inv(r, c))),
-            periodic,
-            safe2: safe * safe,
-        })
-    }
-
-    fn apply(&self, d: [f64; 3]) -> [f64; 3] {
-        let f: [f64; 3] = std::array::from_fn(|k| {
-            let v =
-                d[0] * self.inverse[0][k] + d[1] * self.inverse[1][k] + d[2] * self.inverse[2][k];
-            if self.periodic[k] { v - v.round() } else { v }
-        });
-        let d: [f64; 3] = std::array::from_fn(|k| {
-            f[0] * self.matrix[0][k] + f[1] * self.matrix[1][k] + f[2] * self.matrix[2][k]
-        });
-        let len2 = |v: [f64; 3]| v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
-        if len2(d) <= self.safe2 {
-            return d;
-        }
-        let shifts = |k: usize| if self.periodic[k] { -1..=1 } else { 0..=0 };
-        let mut best = d;
-        for a in shifts(0) {
-            for b in shifts(1) {
-                for c in shifts(2) {
-                    let s = [f64::from(a), f64::from(b), f64::from(c)];
-                    let v = std::array::from_fn(|k| {
-                        d[k] + s[0] * self.matrix[0][k]
-                            + s[1] * self.matrix[1][k]
-                            + s[2] * self.matrix[2][k]
-                    });
-                    if len2(v) < len2(best) {
-                        best = v;
-                    }
-                }
-            }
-        }
-        best
-    }
-}
-
 /// A residue's atoms made whole about its first atom: each atom at the nearest image of its
 /// offset from it, as coordinates in three arrays (for the vectorised inner loop), with the
 /// largest offset.
@@ -247,7 +159,7 @@ struct Whole {
 }
 
 impl Whole {
-    fn new(atoms: &[usize], p: &[[f32; 3]], image: Option<&Image>) -> Whole {
+    fn new(atoms: &[usize], p: &[[f32; 3]], image: Option<&NearestImage>) -> Whole {
         let origin = p[atoms[0]].map(f64::from);
         let (mut x, mut y, mut z) = (Vec::new(), Vec::new(), Vec::new());
         let mut radius = 0.0f64;
@@ -276,7 +188,7 @@ impl Whole {
 /// `t + (b's offset) − (a's offset)` for a periodic image `t` of the offset between their
 /// origins; only images within the residues' radii of the nearest can hold the smallest,
 /// and when the nearest plus both radii is below the cell's safe length it alone can.
-fn smallest(a: &Whole, b: &Whole, image: Option<&Image>) -> f64 {
+fn smallest(a: &Whole, b: &Whole, image: Option<&NearestImage>) -> f64 {
     let d: [f64; 3] = std::array::from_fn(|k| b.origin[k] - a.origin[k]);
     let reach = a.radius + b.radius;
     let mut best = f64::INFINITY;
@@ -344,7 +256,7 @@ mod tests {
     }
 
     /// Every atom pair to its own nearest image: the definition, slowly.
-    fn brute(a: &[usize], b: &[usize], p: &[[f32; 3]], image: Option<&Image>) -> f64 {
+    fn brute(a: &[usize], b: &[usize], p: &[[f32; 3]], image: Option<&NearestImage>) -> f64 {
         let mut best = f64::INFINITY;
         for &i in a {
             for &j in b {
@@ -364,7 +276,7 @@ mod tests {
         // small skewed cell (and wrapped into it, so residues straddle its faces).
         let cell =
             UnitCell::from_lengths_angles([30.0, 34.0, 28.0], [70.53, 109.47, 80.0]).unwrap();
-        let image = Image::new(&cell).unwrap();
+        let image = NearestImage::new(&cell).unwrap();
         let m = cell.matrix();
         let mut next = uniform(99);
         let mut p = Vec::new();
@@ -426,49 +338,6 @@ mod tests {
             .unwrap();
         assert!((open.mean()[1] - 19.0).abs() < 1e-5);
         assert_eq!(open.contact_fraction()[1], 0.0);
-    }
-
-    #[test]
-    fn the_image_in_a_skewed_cell_is_the_nearest() {
-        // A truncated octahedron's triclinic cell (GROMACS's) and offsets up to two cells long.
-        let cell =
-            UnitCell::from_lengths_angles([80.0, 80.0, 80.0], [70.53, 109.47, 70.53]).unwrap();
-        let image = Image::new(&cell).unwrap();
-        let mut unit = uniform(12345);
-        let mut next = || unit() * 320.0 - 160.0;
-        let m = cell.matrix();
-        let len = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-        let mut searched = 0;
-        for _ in 0..1000 {
-            let d = [next(), next(), next()];
-            let ours = image.apply(d);
-            // Brute force over images up to three cells from the rounded one.
-            let rounded = crate::pbc::minimum_image(&cell, d);
-            let mut best = f64::INFINITY;
-            for a in -3..=3 {
-                for b in -3..=3 {
-                    for c in -3..=3 {
-                        let s = [f64::from(a), f64::from(b), f64::from(c)];
-                        let v = std::array::from_fn(|k| {
-                            rounded[k] + s[0] * m[0][k] + s[1] * m[1][k] + s[2] * m[2][k]
-                        });
-                        best = best.min(len(v));
-                    }
-                }
-            }
-            assert!(
-                (len(ours) - best).abs() < 1e-9,
-                "{d:?}: {} vs {best}",
-                len(ours)
-            );
-            if len(rounded) > len(ours) + 1e-9 {
-                searched += 1;
-            }
-        }
-        assert!(
-            searched > 10,
-            "rounding alone misses the nearest image: {searched}"
-        );
     }
 
     #[test]

@@ -49,8 +49,8 @@ use std::fmt;
 
 use crate::bonds::{BOND_TOLERANCE, bonds_with_radii};
 use crate::elements::Element;
-use crate::frame::{Frame, UnitCell};
-use crate::pbc::minimum_image;
+use crate::frame::Frame;
+use crate::pbc::NearestImage;
 use crate::style::atom_element;
 
 /// MDAnalysis's default donor–acceptor cutoff (Å).
@@ -178,12 +178,12 @@ pub fn donor_hydrogens(frame: &Frame, bonds: &[[u32; 2]]) -> Vec<[u32; 2]> {
     out
 }
 
-/// The displacement `to − from` (Å), to its nearest image in `cell`.
+/// The displacement `to − from` (Å), to its nearest image in the cell.
 #[inline]
-fn displacement(cell: Option<&UnitCell>, from: [f32; 3], to: [f32; 3]) -> [f64; 3] {
+fn displacement(image: Option<&NearestImage>, from: [f32; 3], to: [f32; 3]) -> [f64; 3] {
     let d = std::array::from_fn(|k| to[k] as f64 - from[k] as f64);
-    match cell {
-        Some(c) => minimum_image(c, d),
+    match image {
+        Some(image) => image.apply(d),
         None => d,
     }
 }
@@ -243,7 +243,8 @@ pub fn hydrogen_bonds(
             cutoff: distance,
         });
     }
-    let cell = frame.cell.as_ref();
+    let image = frame.cell.as_ref().and_then(NearestImage::new);
+    let cell = image.as_ref();
     let pos = |i: u32| frame.positions[i as usize];
     let hydrogens = |d: u32| {
         let from = dh.partition_point(|p| p[0] < d);

@@ -5,9 +5,10 @@
 //! The grid has fractional cells in a periodic cell (about [`ATOMS_PER_CELL`] atoms each) and
 //! cells over the bounding box otherwise. A query grows rings of cells around the atom until the
 //! k nearest found are closer than the ring's inner width, or the ring covers the grid. In a
-//! periodic cell each neighbour is taken at its nearest image (rounded fractional differences,
-//! as [`crate::pbc::minimum_image`]), so the cell must be wider than twice the k-th neighbour
-//! distance for the answer to be the true k nearest.
+//! periodic cell each neighbour is taken at its nearest image by rounding fractional
+//! differences, which finds it whenever it is closer than half the cell's width (farther, in a
+//! skewed cell, only [`crate::pbc::minimum_image`]'s search does), so the cell must be wider
+//! than twice the k-th neighbour distance for the answer to be the true k nearest.
 
 use glam::{DMat3, DVec3};
 
@@ -266,8 +267,8 @@ impl<'a> Grid<'a> {
     fn vector(&self, i: usize, j: usize) -> [f64; 3] {
         match self.cell {
             Some(_) => {
-                // The fractional difference rounded to the nearest image, as
-                // `pbc::minimum_image` does, from the fractional coordinates kept.
+                // The fractional difference rounded to the nearest image (exact within half
+                // the cell's width), from the fractional coordinates kept.
                 let d = self.frac[j] - self.frac[i];
                 (self.edges * (d - round(d) * self.wrap)).to_array()
             }

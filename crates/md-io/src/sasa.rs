@@ -40,7 +40,7 @@ use rayon::prelude::*;
 use crate::bonds::{BOND_TOLERANCE, MIN_BOND_LENGTH, bonds_with_radii};
 use crate::elements::Element;
 use crate::frame::Frame;
-use crate::pbc::minimum_image;
+use crate::pbc::NearestImage;
 
 /// The probe's radius, Å: a water molecule.
 pub const PROBE: f32 = 1.4;
@@ -198,7 +198,11 @@ pub fn sasa(frame: &Frame, mask: Option<&[bool]>, probe: f32) -> Result<Vec<f32>
     let m = positions.len();
     let (start, list) = crate::pbc::adjacency(m, pairs.pairs.iter().chain(&close));
     let points = sphere_points(POINTS);
-    let cell = if pairs.periodic { frame.cell } else { None };
+    let image = if pairs.periodic {
+        frame.cell.as_ref().and_then(NearestImage::new)
+    } else {
+        None
+    };
     let areas: Vec<f32> = (0..m)
         .into_par_iter()
         .with_min_len(64)
@@ -209,8 +213,8 @@ pub fn sasa(frame: &Frame, mask: Option<&[bool]>, probe: f32) -> Result<Vec<f32>
             for &b in &list[start[a] as usize..start[a + 1] as usize] {
                 let pb = positions[b as usize];
                 let d: [f64; 3] = std::array::from_fn(|k| f64::from(pb[k]) - f64::from(pa[k]));
-                let d = match &cell {
-                    Some(c) => minimum_image(c, d),
+                let d = match &image {
+                    Some(image) => image.apply(d),
                     None => d,
                 };
                 let rb = f64::from(spheres[b as usize]);

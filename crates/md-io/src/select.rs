@@ -1181,10 +1181,11 @@ fn within(
     };
     if 2.0 * d >= cell.min_periodic_width() {
         let refs: Vec<usize> = refs.collect();
+        let image = crate::pbc::NearestImage::new(cell);
         for (i, o) in out.iter_mut().enumerate() {
             *o = refs.iter().any(|&r| {
                 let v: [f64; 3] = std::array::from_fn(|k| (pos[r][k] - pos[i][k]) as f64);
-                let m = crate::pbc::minimum_image(cell, v);
+                let m = image.map_or(v, |image| image.apply(v));
                 m[0] * m[0] + m[1] * m[1] + m[2] * m[2] <= d * d
             });
         }
