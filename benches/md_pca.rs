@@ -16,6 +16,11 @@
 //! `--distance-map` and `--contact-map` add per frame) of adenylate kinase's 214 residues
 //! (3,341 protein atoms) in its truncated octahedron, 2 threads.
 //!
+//! Then one frame of lipid tail order parameters (`order`, what `--order-table` adds per
+//! frame) of md-io's model bilayer (tests/data/order) replicated 4 x 4 in the membrane plane:
+//! 512 lipids, 44,544 atoms, S_CH of 14,336 carbons from 29,696 C–H bonds, and the
+//! united-atom construction of 12,288 carbons; one thread.
+//!
 //! The peer, `benches/peers/mdanalysis_pca.py`, times MDAnalysis's `analysis.pca.PCA` plus
 //! `transform` on frames of the same sizes held in memory, and `DistanceMatrix` with a
 //! superposing `rms.rmsd` on 500 frames of 214 atoms: run it in the same minutes.
@@ -29,6 +34,7 @@
 use criterion::{Criterion, criterion_group};
 use texmap::md_io::conformations::{Method, cluster};
 use texmap::md_io::distance_map::DistanceMap;
+use texmap::md_io::order::{Method as OrderMethod, OrderParameters};
 use texmap::md_io::pca::Pca;
 use texmap::md_io::select::Selection;
 
@@ -121,6 +127,35 @@ fn bench(c: &mut Criterion) {
             map
         })
     });
+    // Lipid order parameters of a 512-lipid bilayer, one frame.
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/crates/md-io/tests/data/order");
+    let mut bilayer = texmap::md_io::Frame::new();
+    texmap::md_io::Trajectory::open(format!("{dir}/bilayer.gro"))
+        .unwrap()
+        .read_frame(0, &mut bilayer)
+        .unwrap();
+    let mut bonds = texmap::md_io::bonds::bonds_by_distance(&bilayer, true).pairs;
+    texmap::md_io::replicate::replicate(&mut bilayer, &mut bonds, [4, 4, 1]).unwrap();
+    let tails = Selection::parse("name C2* C3*")
+        .unwrap()
+        .evaluate(&bilayer)
+        .unwrap();
+    for (name, method) in [
+        ("order_hydrogens_512_lipids_1_frame", OrderMethod::Hydrogens),
+        (
+            "order_united_atom_512_lipids_1_frame",
+            OrderMethod::UnitedAtom,
+        ),
+    ] {
+        let mut order = OrderParameters::new(&bilayer, &tails, &bonds, method, 2).unwrap();
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                order
+                    .add(&bilayer.positions, bilayer.cell.as_ref())
+                    .unwrap()
+            })
+        });
+    }
     g.finish();
 }
 

@@ -1184,6 +1184,7 @@ impl AnalysisArgs {
             ("--rmsd-clusters", &self.rmsd_clusters),
             ("--rmsd-cluster-table", &self.rmsd_cluster_table),
             ("--rmsd-cluster-middles", &self.rmsd_cluster_middles),
+            ("--order-table", &self.order_table),
         ]
         .into_iter()
         .map(|(flag, path)| (flag, path.is_some()))
@@ -1799,6 +1800,32 @@ pub struct AnalysisArgs {
         requires = "residue_map_out"
     )]
     pub distance_map_select: String,
+    /// Write lipid tail order parameters as a CSV table: for each carbon of the --order-select
+    /// atoms, grouped by residue and atom name (one row per carbon of each chain: C22..C218 and
+    /// C32..C316 of POPC), S = <(3 cos²θ − 1) / 2> of its bonds against the --order-normal axis,
+    /// averaged over the lipids and frames, with −S (−S_CD, as papers plot it and NMR gives
+    /// it) and the standard error over the lipids. Columns: resname, atom, sites (lipids),
+    /// vectors (bonds per site), s, minus_s, sem. Bonds come from the topology, else from
+    /// distances at the first frame; bonds across the box are taken to their nearest image.
+    #[arg(long, value_name = "FILE.csv", requires = "order_select")]
+    pub order_table: Option<PathBuf>,
+    /// The atoms --order-table measures: the tail carbons, as
+    /// 'resname POPC and name C2* C3*' (hydrogens come from the bonds), or a Martini lipid's
+    /// beads ('resname POPC' with --order-method bonds).
+    #[arg(long, value_name = "SEL", requires = "order_table")]
+    pub order_select: Option<String>,
+    /// How --order-table finds each carbon's vectors: hydrogens (all-atom force fields such as
+    /// CHARMM36, Slipids, Lipid21: the C–H bonds, S_CH), united-atom (GROMOS, Berger: gmx
+    /// order's construction from the two neighbouring carbons, S_CD) or bonds (coarse-grained
+    /// Martini: each bond between two selected beads, a row per bond such as NC3-PO4).
+    #[arg(long, value_name = "METHOD", default_value = "hydrogens",
+          value_parser = ["hydrogens", "united-atom", "bonds"], requires = "order_table")]
+    pub order_method: String,
+    /// The membrane normal of --order-table: the x, y or z axis (z for a bilayer in the xy
+    /// plane; the sign does not matter).
+    #[arg(long, value_name = "AXIS", default_value = "z", value_parser = ["x", "y", "z"],
+          requires = "order_table")]
+    pub order_normal: String,
     /// The distance below which two residues are in contact for --contact-map (Å).
     #[arg(long, value_name = "Å", default_value_t = 4.5, requires = "residue_map_out",
           value_parser = parse_positive)]

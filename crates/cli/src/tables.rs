@@ -101,6 +101,7 @@ pub(crate) struct AnalysisTables {
     dssp: Option<DsspTables>,
     rmsd_matrix: Option<RmsdMatrix>,
     residue_map: Option<ResidueMap>,
+    order: Option<OrderTable>,
     /// `--hbond-table` and `--hbond-lifetime`: the plan's hydrogen bonds of every frame.
     hbond: Option<crate::output::AtomicFile>,
     hbond_lifetime: Option<SurvivalTable>,
@@ -2002,6 +2003,7 @@ impl AnalysisTables {
             dssp: DsspTables::create(analysis, whole)?,
             rmsd_matrix: RmsdMatrix::create(analysis, whole)?,
             residue_map: ResidueMap::create(analysis, whole)?,
+            order: OrderTable::create(analysis, whole)?,
             hbond: per_frame_table(
                 &analysis.hbond_table,
                 "--hbond-table",
@@ -2298,6 +2300,9 @@ impl AnalysisTables {
         if let Some(r) = &mut self.residue_map {
             r.add(f, md)?;
         }
+        if let Some(o) = &mut self.order {
+            o.add(f, plan, md)?;
+        }
         if let Some(r) = &mut self.rmsd_matrix {
             r.add(f, md)?;
         }
@@ -2388,10 +2393,12 @@ impl AnalysisTables {
         if let Some(r) = &self.ramachandran {
             r.finish()?;
         }
+        let order = self.order.map(OrderTable::finish).transpose()?;
         for t in [
             self.hbond,
             hbond_lifetime,
             hbond_occupancy,
+            order,
             self.measure.map(|(t, _)| t),
             survival,
             self.contacts.map(|c| c.file),
@@ -2421,6 +2428,99 @@ impl AnalysisTables {
             t.commit()?;
         }
         Ok(())
+    }
+}
+
+/// `--order-table`: lipid tail order parameters over the run; the carbons and their bonds are
+/// found at the first frame.
+struct OrderTable {
+    file: crate::output::AtomicFile,
+    select: texmap_md_io::select::Selection,
+    method: texmap_md_io::order::Method,
+    normal: usize,
+    order: Option<texmap_md_io::order::OrderParameters>,
+}
+
+impl OrderTable {
+    fn create(analysis: &AnalysisArgs, whole: bool) -> Result<Option<OrderTable>> {
+        let Some(file) = whole_run_table(
+            &analysis.order_table,
+            "--order-table",
+            "the order parameters average every frame",
+            whole,
+        )?
+        else {
+            return Ok(None);
+        };
+        let select = analysis.order_select.as_deref().unwrap_or_default();
+        Ok(Some(OrderTable {
+            file,
+            select: texmap_md_io::select::Selection::parse(select)
+                .map_err(|e| crate::args::UsageError(format!("--order-select: {e}")))?,
+            method: match analysis.order_method.as_str() {
+                "united-atom" => texmap_md_io::order::Method::UnitedAtom,
+                "bonds" => texmap_md_io::order::Method::Bonds,
+                _ => texmap_md_io::order::Method::Hydrogens,
+            },
+            normal: match analysis.order_normal.as_str() {
+                "x" => 0,
+                "y" => 1,
+                _ => 2,
+            },
+            order: None,
+        }))
+    }
+
+    fn add(&mut self, f: usize, plan: &texmap_md_scene::MolPlan, md: &MdFrame) -> Result<()> {
+        if self.order.is_none() {
+            let picked = self
+                .select
+                .evaluate(md)
+                .map_err(|e| anyhow::anyhow!("--order-select: frame {f}: {e}"))?;
+            let mut bonds: Vec<[u32; 2]> =
+                plan.topology().map(|t| t.bonds.clone()).unwrap_or_default();
+            bonds.extend_from_slice(&md.bonds);
+            if bonds.is_empty() {
+                bonds = texmap_md_io::bonds::bonds_by_distance(md, true).pairs;
+            }
+            self.order = Some(
+                texmap_md_io::order::OrderParameters::new(
+                    md,
+                    &picked,
+                    &bonds,
+                    self.method,
+                    self.normal,
+                )
+                .map_err(|e| anyhow::anyhow!("--order-table: frame {f}: {e}"))?,
+            );
+        }
+        if let Some(order) = &mut self.order {
+            order
+                .add(&md.positions, md.cell.as_ref())
+                .map_err(|e| anyhow::anyhow!("--order-table: frame {f}: {e}"))?;
+        }
+        Ok(())
+    }
+
+    fn finish(mut self) -> Result<crate::output::AtomicFile> {
+        let Some(order) = self.order.take() else {
+            bail!("--order-table: no frame was read");
+        };
+        let mut text = String::from("resname,atom,sites,vectors,s,minus_s,sem\n");
+        let sem = order.standard_error();
+        for ((g, s), e) in order.groups().iter().zip(order.mean()).zip(sem) {
+            let e = if e.is_finite() {
+                format!("{e:.6}")
+            } else {
+                String::new()
+            };
+            text.push_str(&format!(
+                "{},{},{},{},{s:.6},{:.6},{e}\n",
+                g.residue, g.name, g.sites, g.vectors, -s
+            ));
+        }
+        self.file.write(&text)?;
+        Ok(self.file)
     }
 }
 

@@ -2381,3 +2381,94 @@ fn plot_draws_convert_tables_and_gmx_xvg_files() {
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(!pdf.exists());
 }
+
+/// `--order-table` on md-io's model bilayer (data/order: 32 lipids split across the box, GRO +
+/// XTC by MDAnalysis, bonds found by distance): S_CH per carbon equals numpy's to the table's
+/// decimals, the united-atom construction equals `gmx order`'s −S_CD, the Martini-style bond
+/// rows numpy's; bad requests are refused with no file left.
+#[test]
+fn order_table_is_gmx_order_and_numpys() {
+    let dir = tempfile::tempdir().unwrap();
+    let reference = json("order/reference.json");
+    let (xtc, gro) = (md_data("order/bilayer.xtc"), md_data("order/bilayer.gro"));
+    let csv = dir.path().join("order.csv");
+    let rows = |method: &str| -> Vec<(String, Vec<f64>)> {
+        run_ok(&[
+            "convert",
+            &xtc,
+            "--topology",
+            &gro,
+            "--order-table",
+            csv.to_str().unwrap(),
+            "--order-select",
+            "resname DPPC and name C2* C3*",
+            "--order-method",
+            method,
+            "-q",
+        ]);
+        let text = std::fs::read_to_string(&csv).unwrap();
+        let mut lines = text.lines();
+        assert_eq!(
+            lines.next(),
+            Some("resname,atom,sites,vectors,s,minus_s,sem")
+        );
+        lines
+            .map(|l| {
+                let c: Vec<&str> = l.split(',').collect();
+                assert_eq!((c[0], c[2]), ("DPPC", "32"), "{l}");
+                let v = c[4..]
+                    .iter()
+                    .map(|x| x.parse().unwrap_or(f64::NAN))
+                    .collect();
+                (c[1].to_string(), v)
+            })
+            .collect()
+    };
+    let near = |a: f64, b: f64, tolerance: f64| (a - b).abs() <= tolerance;
+    let h = rows("hydrogens");
+    assert_eq!(h.len(), 28);
+    for (name, v) in &h {
+        let want = reference["hydrogens"][name].as_f64().unwrap();
+        let sem = reference["sem"][name].as_f64().unwrap();
+        assert!(
+            near(v[0], want, 6e-7) && v[1] == -v[0],
+            "{name}: {v:?} vs {want}"
+        );
+        assert!(near(v[2], sem, 6e-7), "{name}: {v:?} vs {sem}");
+    }
+    let ua = rows("united-atom");
+    assert_eq!(ua.len(), 24);
+    for (name, v) in &ua {
+        let want = reference["gmx_order"][name].as_f64().unwrap();
+        assert!(near(v[1], want, 2e-4), "{name}: {v:?} vs gmx {want}");
+    }
+    let b = rows("bonds");
+    assert_eq!(b.len(), 26);
+    assert_eq!(b[0].0, "C21-C22");
+    for (name, v) in &b {
+        let want = reference["bonds"][name].as_f64().unwrap();
+        assert!(near(v[0], want, 6e-7), "{name}: {v:?} vs {want}");
+    }
+    // No hydrogens among the carbons' bonds with the united-atom file's selection, no table
+    // without --order-select, a selection of nothing: refused, nothing written.
+    std::fs::remove_file(&csv).unwrap();
+    for (extra, says) in [
+        (&["--order-select", "name P"][..], "bonded hydrogen"),
+        (&["--order-select", "name XYZ"][..], "bonded hydrogen"),
+        (&[][..], "--order-select"),
+    ] {
+        let mut args = vec![
+            "convert",
+            &xtc,
+            "--topology",
+            &gro,
+            "--order-table",
+            csv.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let o = texmap(&args);
+        assert!(!o.status.success(), "{args:?}");
+        assert!(stderr(&o).contains(says), "{args:?}: {}", stderr(&o));
+        assert!(!csv.exists(), "{args:?}");
+    }
+}

@@ -152,6 +152,7 @@ pub mod msd;
 mod namdbin;
 mod neighbours;
 mod netcdf;
+pub mod order;
 pub mod orientation;
 pub mod parse;
 pub mod pbc;

@@ -1,0 +1,131 @@
+//! Lipid tail order parameters against GROMACS 2022.5's `gmx order` and an independent numpy
+//! computation on the same file (data/order/gen_order.py): a model bilayer of 32 two-chain
+//! lipids with ideal hydrogens, 12 frames written by MDAnalysis as GRO + XTC, shifted so that
+//! lipids on the edges are split across the box; bonds found by distance as the CLI finds them.
+
+use std::path::PathBuf;
+
+use serde_json::Value;
+use texmap_md_io::order::{Method, OrderParameters};
+use texmap_md_io::select::Selection;
+use texmap_md_io::{Frame, Trajectory};
+
+fn dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/order")
+}
+
+/// The GRO's frame (names, cell), the XTC's frames' positions and cells, the bonds by distance.
+fn system() -> (Frame, Vec<Frame>, Vec<[u32; 2]>) {
+    let mut gro = Frame::new();
+    Trajectory::open(dir().join("bilayer.gro"))
+        .unwrap()
+        .read_frame(0, &mut gro)
+        .unwrap();
+    let bonds = texmap_md_io::bonds::bonds_by_distance(&gro, true).pairs;
+    let mut xtc = Trajectory::open(dir().join("bilayer.xtc")).unwrap();
+    let frames = (0..xtc.n_frames().unwrap())
+        .map(|k| {
+            let mut f = Frame::new();
+            xtc.read_frame(k, &mut f).unwrap();
+            f
+        })
+        .collect();
+    (gro, frames, bonds)
+}
+
+fn run(method: Method) -> (OrderParameters, Value) {
+    let (gro, frames, bonds) = system();
+    let text = std::fs::read_to_string(dir().join("reference.json")).unwrap();
+    let reference: Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(frames.len() as u64, reference["frames"].as_u64().unwrap());
+    // 32 lipids, each a P and 2 x 14 carbons with 29 hydrogens per chain: 31 bonds per chain.
+    assert_eq!(bonds.len(), 32 * 2 * (13 + 29));
+    let picked = Selection::parse("name C2* C3*")
+        .unwrap()
+        .evaluate(&gro)
+        .unwrap();
+    let mut order = OrderParameters::new(&gro, &picked, &bonds, method, 2).unwrap();
+    for f in &frames {
+        order.add(&f.positions, f.cell.as_ref()).unwrap();
+    }
+    (order, reference)
+}
+
+/// Our value per group name against the reference's table, to `tolerance`.
+fn check(order: &OrderParameters, values: &[f64], table: &Value, sign: f64, tolerance: f64) {
+    let table = table.as_object().unwrap();
+    assert_eq!(order.groups().len(), table.len(), "{:?}", order.groups());
+    for (g, v) in order.groups().iter().zip(values) {
+        assert_eq!(g.residue, "DPPC");
+        assert_eq!(g.sites, 32, "{}", g.name);
+        let want = sign * table[&g.name].as_f64().unwrap();
+        assert!(
+            (v - want).abs() < tolerance,
+            "{}: {v} against {want}",
+            g.name
+        );
+    }
+}
+
+#[test]
+fn hydrogens_equal_numpy_carbon_by_carbon_with_the_spread_over_lipids() {
+    let (order, reference) = run(Method::Hydrogens);
+    let mean = order.mean();
+    check(&order, &mean, &reference["hydrogens"], 1.0, 1e-9);
+    check(
+        &order,
+        &order.standard_error(),
+        &reference["sem"],
+        1.0,
+        1e-9,
+    );
+    // Carbons in chain order, two hydrogens each but the methyls' three.
+    assert_eq!(order.groups()[0].name, "C21");
+    assert_eq!(order.groups()[13].name, "C214");
+    assert_eq!(order.groups()[13].vectors, 3);
+    assert_eq!(order.groups()[12].vectors, 2);
+    // The values vary along the chain (the test is not of a constant).
+    assert!(mean[1] < -0.1 && mean[10].abs() < 0.05, "{mean:?}");
+}
+
+#[test]
+fn united_atom_equals_gmx_order_and_numpy() {
+    let (order, reference) = run(Method::UnitedAtom);
+    let mean = order.mean();
+    // The first and last carbon of each chain have one heavy neighbour: 12 per chain.
+    check(&order, &mean, &reference["united_atom"], 1.0, 1e-9);
+    // gmx order prints −S_CD, computed in single precision from whole lipids.
+    check(&order, &mean, &reference["gmx_order"], -1.0, 2e-4);
+    // The ideal hydrogens give the same values but for the XTC's 0.01 Å rounding.
+    let (h, _) = run(Method::Hydrogens);
+    let hm = h.mean();
+    for (g, v) in order.groups().iter().zip(&mean) {
+        let k = h.groups().iter().position(|x| x.name == g.name).unwrap();
+        assert!(
+            (hm[k] - v).abs() < 0.01,
+            "{}: {} against {v}",
+            g.name,
+            hm[k]
+        );
+    }
+}
+
+#[test]
+fn bonds_equal_numpy_and_lipids_split_across_the_box_count_whole() {
+    let (order, reference) = run(Method::Bonds);
+    check(&order, &order.mean(), &reference["bonds"], 1.0, 1e-9);
+    assert_eq!(order.groups()[0].name, "C21-C22");
+    // Some bonds of the file are split across the box: without the cell they would be long.
+    let (_, frames, bonds) = system();
+    let split = bonds
+        .iter()
+        .filter(|[i, j]| {
+            let (p, q) = (
+                frames[0].positions[*i as usize],
+                frames[0].positions[*j as usize],
+            );
+            (0..3).map(|k| (p[k] - q[k]).powi(2)).sum::<f32>() > 100.0
+        })
+        .count();
+    assert!(split > 10, "{split}");
+}
