@@ -1185,6 +1185,7 @@ impl AnalysisArgs {
             ("--rmsd-cluster-table", &self.rmsd_cluster_table),
             ("--rmsd-cluster-middles", &self.rmsd_cluster_middles),
             ("--order-table", &self.order_table),
+            ("--membrane-table", &self.membrane_table),
         ]
         .into_iter()
         .map(|(flag, path)| (flag, path.is_some()))
@@ -1826,6 +1827,36 @@ pub struct AnalysisArgs {
     #[arg(long, value_name = "AXIS", default_value = "z", value_parser = ["x", "y", "z"],
           requires = "order_table")]
     pub order_normal: String,
+    /// Write a bilayer's thickness and area per lipid per frame as a CSV table: the leaflets
+    /// are found at the first frame as MDAnalysis's LeafletFinder finds them (the
+    /// --membrane-select head atoms joined below --membrane-cutoff, nearest images included;
+    /// the two largest sets), then each frame gives the distance between the leaflets' mean
+    /// head heights along --membrane-normal, through the bilayer (each head's tail, the atom of
+    /// its residue farthest from it, says which way that is, so a bilayer across the box's
+    /// faces is measured through its tails) and the box face's area over each leaflet's
+    /// lipids. Columns: frame, time, upper, lower (lipids), thickness (Å), area (Å²),
+    /// apl_upper, apl_lower (Å²).
+    #[arg(long, value_name = "FILE.csv")]
+    pub membrane_table: Option<PathBuf>,
+    /// The head atoms of --membrane-table, one per lipid ('name P' by default: the phosphates
+    /// of phospholipids; 'name PO4' for Martini, 'name P or name ROH' with cholesterol).
+    #[arg(
+        long,
+        value_name = "SEL",
+        default_value = "name P",
+        requires = "membrane_table"
+    )]
+    pub membrane_select: String,
+    /// The distance below which two head atoms are in one leaflet for --membrane-table (Å;
+    /// MDAnalysis's LeafletFinder default). It must be shorter than the bilayer's thickness
+    /// and longer than the spacing of the heads.
+    #[arg(long, value_name = "Å", default_value_t = 15.0, requires = "membrane_table",
+          value_parser = parse_positive)]
+    pub membrane_cutoff: f64,
+    /// The membrane normal of --membrane-table: the x, y or z axis.
+    #[arg(long, value_name = "AXIS", default_value = "z", value_parser = ["x", "y", "z"],
+          requires = "membrane_table")]
+    pub membrane_normal: String,
     /// The distance below which two residues are in contact for --contact-map (Å).
     #[arg(long, value_name = "Å", default_value_t = 4.5, requires = "residue_map_out",
           value_parser = parse_positive)]

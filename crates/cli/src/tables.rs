@@ -102,6 +102,7 @@ pub(crate) struct AnalysisTables {
     rmsd_matrix: Option<RmsdMatrix>,
     residue_map: Option<ResidueMap>,
     order: Option<OrderTable>,
+    membrane: Option<MembraneTable>,
     /// `--hbond-table` and `--hbond-lifetime`: the plan's hydrogen bonds of every frame.
     hbond: Option<crate::output::AtomicFile>,
     hbond_lifetime: Option<SurvivalTable>,
@@ -2004,6 +2005,7 @@ impl AnalysisTables {
             rmsd_matrix: RmsdMatrix::create(analysis, whole)?,
             residue_map: ResidueMap::create(analysis, whole)?,
             order: OrderTable::create(analysis, whole)?,
+            membrane: MembraneTable::create(analysis, whole)?,
             hbond: per_frame_table(
                 &analysis.hbond_table,
                 "--hbond-table",
@@ -2303,6 +2305,9 @@ impl AnalysisTables {
         if let Some(o) = &mut self.order {
             o.add(f, plan, md)?;
         }
+        if let Some(m) = &mut self.membrane {
+            m.add(f, &time, md)?;
+        }
         if let Some(r) = &mut self.rmsd_matrix {
             r.add(f, md)?;
         }
@@ -2399,6 +2404,7 @@ impl AnalysisTables {
             hbond_lifetime,
             hbond_occupancy,
             order,
+            self.membrane.map(|m| m.file),
             self.measure.map(|(t, _)| t),
             survival,
             self.contacts.map(|c| c.file),
@@ -2521,6 +2527,127 @@ impl OrderTable {
         }
         self.file.write(&text)?;
         Ok(self.file)
+    }
+}
+
+/// `--membrane-table`: the leaflets and each head's tail atom, found at the first frame.
+struct MembraneTable {
+    file: crate::output::AtomicFile,
+    select: texmap_md_io::select::Selection,
+    cutoff: f64,
+    normal: usize,
+    leaflets: Vec<Vec<usize>>,
+    tails: std::collections::HashMap<usize, usize>,
+    n_atoms: usize,
+}
+
+impl MembraneTable {
+    fn create(analysis: &AnalysisArgs, whole: bool) -> Result<Option<MembraneTable>> {
+        let Some(file) = per_frame_table(
+            &analysis.membrane_table,
+            "--membrane-table",
+            "frame,time,upper,lower,thickness,area,apl_upper,apl_lower",
+            whole,
+        )?
+        else {
+            return Ok(None);
+        };
+        Ok(Some(MembraneTable {
+            file,
+            select: texmap_md_io::select::Selection::parse(&analysis.membrane_select)
+                .map_err(|e| crate::args::UsageError(format!("--membrane-select: {e}")))?,
+            cutoff: analysis.membrane_cutoff,
+            normal: match analysis.membrane_normal.as_str() {
+                "x" => 0,
+                "y" => 1,
+                _ => 2,
+            },
+            leaflets: Vec::new(),
+            tails: Default::default(),
+            n_atoms: 0,
+        }))
+    }
+
+    fn add(&mut self, f: usize, time: &str, md: &MdFrame) -> Result<()> {
+        if self.leaflets.is_empty() {
+            let heads = self
+                .select
+                .indices(md)
+                .map_err(|e| anyhow::anyhow!("--membrane-select: frame {f}: {e}"))?;
+            let found = texmap_md_io::membrane::leaflets(
+                &md.positions,
+                &heads,
+                md.cell.as_ref(),
+                self.cutoff,
+            );
+            if found.len() < 2 || found[1].len() < 2 {
+                bail!(
+                    "--membrane-table: frame {f}: the {} head atoms of --membrane-select form {} set(s) within --membrane-cutoff {} Å (the second largest has {} head(s)): no bilayer (a longer cutoff joins heads farther apart, a shorter one keeps the leaflets apart)",
+                    heads.len(),
+                    found.len(),
+                    self.cutoff,
+                    found.get(1).map_or(0, |l| l.len())
+                );
+            }
+            // Each head's tail: the atom of its residue farthest from it (nearest images).
+            let image = md
+                .cell
+                .as_ref()
+                .and_then(texmap_md_io::pbc::NearestImage::new);
+            let mut heads: Vec<usize> = found[..2].iter().flatten().copied().collect();
+            heads.sort_unstable();
+            for r in texmap_md_io::secondary::residue_ranges(md) {
+                let first = heads.partition_point(|&h| h < r.start);
+                let last = heads.partition_point(|&h| h < r.end);
+                for h in &heads[first..last] {
+                    let far = r.clone().max_by(|&a, &b| {
+                        let d = |i: usize| {
+                            let v: [f64; 3] = std::array::from_fn(|k| {
+                                f64::from(md.positions[i][k] - md.positions[*h][k])
+                            });
+                            let v = image.as_ref().map_or(v, |m| m.apply(v));
+                            v[0] * v[0] + v[1] * v[1] + v[2] * v[2]
+                        };
+                        d(a).total_cmp(&d(b))
+                    });
+                    if let Some(t) = far.filter(|&t| t != *h) {
+                        self.tails.insert(*h, t);
+                    }
+                }
+            }
+            self.leaflets = found;
+            self.n_atoms = md.n_atoms();
+        } else if md.n_atoms() != self.n_atoms {
+            bail!(
+                "--membrane-table: frame {f} has {} atoms and the first {}: every frame must hold the same atoms",
+                md.n_atoms(),
+                self.n_atoms
+            );
+        }
+        let m = texmap_md_io::membrane::measure(
+            &md.positions,
+            &self.leaflets,
+            md.cell.as_ref(),
+            self.normal,
+            |h| self.tails.get(&h).copied(),
+        )
+        .map_err(|e| anyhow::anyhow!("--membrane-table: frame {f}: {e}"))?;
+        let num = |v: f64| {
+            if v.is_finite() {
+                format!("{v:.4}")
+            } else {
+                String::new()
+            }
+        };
+        self.file.write(&format!(
+            "{f},{time},{},{},{:.4},{},{},{}\n",
+            m.lipids[0],
+            m.lipids[1],
+            m.thickness,
+            num(m.area),
+            num(m.area_per_lipid[0]),
+            num(m.area_per_lipid[1])
+        ))
     }
 }
 

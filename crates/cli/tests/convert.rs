@@ -2472,3 +2472,49 @@ fn order_table_is_gmx_order_and_numpys() {
         assert!(!csv.exists(), "{args:?}");
     }
 }
+
+/// `--membrane-table` on the same bilayer: 16 lipids a leaflet (MDAnalysis's LeafletFinder's
+/// sets), the thickness through the tails across the box's bottom face equal to the mean P
+/// heights' difference before the shift (to the XTC's rounding), the area per lipid the box's
+/// over 16; at the default 15 Å cutoff the heads (20 Å apart) form no leaflet: refused, no file.
+#[test]
+fn membrane_table_is_leaflet_finders_thickness_and_area() {
+    let dir = tempfile::tempdir().unwrap();
+    let reference = json("order/reference.json");
+    let m = &reference["membrane"];
+    let (xtc, gro) = (md_data("order/bilayer.xtc"), md_data("order/bilayer.gro"));
+    let csv = dir.path().join("membrane.csv");
+    let args = |cutoff: &'static str| {
+        vec![
+            "convert".to_string(),
+            xtc.clone(),
+            "--topology".into(),
+            gro.clone(),
+            "--membrane-table".into(),
+            csv.to_str().unwrap().into(),
+            "--membrane-cutoff".into(),
+            cutoff.into(),
+            "-q".into(),
+        ]
+    };
+    let a = args("25");
+    run_ok(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    let (header, rows) = table(&csv);
+    assert_eq!(
+        header,
+        "frame,time,upper,lower,thickness,area,apl_upper,apl_lower"
+    );
+    let want = numbers(&m["thickness"]);
+    assert_eq!(rows.len(), want.len());
+    for (r, w) in rows.iter().zip(&want) {
+        assert_eq!((r[2], r[3]), (16.0, 16.0));
+        assert!((r[4] - w).abs() < 0.005, "{r:?} vs {w}");
+        assert_eq!((r[5], r[6], r[7]), (6400.0, 400.0, 400.0));
+    }
+    std::fs::remove_file(&csv).unwrap();
+    let a = args("15");
+    let o = texmap(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("no bilayer"), "{}", stderr(&o));
+    assert!(!csv.exists());
+}

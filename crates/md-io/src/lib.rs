@@ -145,6 +145,7 @@ pub mod hbonds;
 mod lammps;
 mod lammps_data;
 mod lammps_dump_writer;
+pub mod membrane;
 mod mmcif;
 mod mol2;
 mod mrc;

@@ -10,9 +10,11 @@ Debian's `gromacs` package): python3 gen_order.py
   ideal tetrahedral angles, C-C 1.53 A, and two hydrogens per carbon (three on the last) at the
   ideal tetrahedral positions (H2nR/H2nS, H3nR/H3nS, H214T...). Every frame draws each chain
   anew: its first bond tilted up to 20 degrees from the normal, its torsions trans (70 %) or
-  gauche +-60 (15 % each), no two atoms that are not bonded within
-  the distance rule of md-io's bond guess (plus 0.2 A), bonded ones 0.2 A inside it. The system is shifted by
-  (25, 25) A in x, y and wrapped into the box, so lipids on the edges are split across it.
+  gauche +-60 (15 % each), each head moved along z by N(0, 1 A); no two atoms that are not
+  bonded within the distance rule of md-io's bond guess (plus 0.2 A), bonded ones 0.2 A inside
+  it. The system is shifted by (25, 25, 20) A and wrapped into the box, so lipids on the edges
+  are split across it and the upper leaflet's heads sit near z = 5 with its tails across the
+  bottom face (the bilayer is 50 A thick through its tails, 30 A through the water).
 - reference.json: computed here, with numpy, from the coordinates as MDAnalysis reads them
   back from the XTC (so at the XTC's 0.01 A precision), for the normal z:
   - `hydrogens`: per carbon name, the mean over lipids, frames and the carbon's hydrogens of
@@ -22,6 +24,10 @@ Debian's `gromacs` package): python3 gen_order.py
     S_CD = 2/3 S_xx + 1/3 S_yy);
   - `bonds`: per bond between two carbons (C21-C22 ...), P2 of the bond;
   - `sem`: for `hydrogens`, the standard error over the 32 lipids of their time averages;
+  - `membrane`: MDAnalysis's LeafletFinder (P atoms, cutoff 25 A, pbc=True) on the shifted
+    file: each leaflet's residue numbers; the residues of the upper leaflet (z = 65 before the
+    shift); per frame the thickness, the mean P height of the upper leaflet minus the lower's
+    in the frames before the shift; the box's xy area.
   - `gmx_order`: when gmx is installed, what `gmx order -d z` writes to its -od file (-S_CD)
     for the inner carbons of each chain, from an index group per chain position (its first
     and last group give no value) and a tpr built with grompp from a topology of massive
@@ -44,6 +50,9 @@ NC = 14
 TET = np.arccos(-1.0 / 3.0)
 CC, CH, PC = 1.53, 1.09, 1.60
 FRAMES = 12
+# The shift applied to every frame before it is wrapped into the box: lipids on the x and y
+# edges and the upper leaflet's tails end up split across the faces.
+SHIFT = np.array([25.0, 25.0, 20.0])
 
 
 def unit(v):
@@ -201,14 +210,16 @@ def build():
     u.dimensions = [BOX, BOX, BOX, 90, 90, 90]
     frames, whole = [], []
     for _ in range(FRAMES):
+        # Each head moved along the normal by N(0, 1 A), its chains with it.
+        moved = [(h + np.array([0.0, 0.0, RNG.normal()]), d) for h, d in heads]
         p = None
         while p is None:
-            p = lipid_positions(heads)
+            p = lipid_positions(moved)
         whole.append(p.copy())
-        p[:, :2] = (p[:, :2] + 25.0) % BOX
+        p = (p + SHIFT) % BOX
         frames.append(p)
     write(u, frames, "bilayer")
-    return per, n_lip, u, whole
+    return per, n_lip, u, whole, heads
 
 
 def write(u, frames, stem):
@@ -280,6 +291,27 @@ def reference(per, n_lip):
     return out
 
 
+def membrane(per, n_lip, whole, heads):
+    """LeafletFinder's leaflets of the P atoms in the shifted file, and per frame the
+    thickness (upper minus lower mean P height) from the frames before the shift."""
+    from MDAnalysis.analysis.leaflet import LeafletFinder
+    u = mda.Universe("bilayer.gro", "bilayer.xtc")
+    found = LeafletFinder(u, "name P", cutoff=25.0, pbc=True)
+    groups = [sorted(int(r) for r in g.resids) for g in found.groups()]
+    m = len(per)
+    upper = [k for k, (_, d) in enumerate(heads) if d < 0]
+    lower = [k for k, (_, d) in enumerate(heads) if d > 0]
+    thickness = [float(np.mean(p[np.array(upper) * m, 2]) - np.mean(p[np.array(lower) * m, 2]))
+                 for p in whole]
+    return {
+        "cutoff": 25.0,
+        "leaflets": groups,
+        "upper_resids": [k + 1 for k in upper],
+        "thickness": thickness,
+        "area": BOX * BOX,
+    }
+
+
 TOP = """[ defaults ]
 1 1 no 1.0 1.0
 [ atomtypes ]
@@ -345,8 +377,9 @@ def gmx_order(per, n_lip, u, whole):
 
 
 def main():
-    per, n_lip, u, whole = build()
+    per, n_lip, u, whole, heads = build()
     ref = reference(per, n_lip)
+    ref["membrane"] = membrane(per, n_lip, whole, heads)
     g = gmx_order(per, n_lip, u, whole)
     if g is not None:
         ref["gmx_order"] = g
