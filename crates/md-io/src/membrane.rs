@@ -189,7 +189,7 @@ pub fn measure(
     let ((a, inward_a), (b, inward_b)) = (side(two[0]), side(two[1]));
     let period = cell.filter(|c| c.periodic()[normal]).map(|c| {
         let m = c.matrix();
-        c.volume() / norm(cross(m[(normal + 1) % 3], m[(normal + 2) % 3]))
+        c.volume() / face(m, normal).length()
     });
     // The offset from the first leaflet to the second along the normal: through the first
     // leaflet's tails when they say which way that is, else the nearest.
@@ -210,7 +210,7 @@ pub fn measure(
     let area = match cell {
         Some(c) => {
             let m = c.matrix();
-            cross(m[(normal + 1) % 3], m[(normal + 2) % 3])[normal].abs()
+            face(m, normal)[normal].abs()
         }
         None => f64::NAN,
     };
@@ -223,16 +223,10 @@ pub fn measure(
     })
 }
 
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn norm(a: [f64; 3]) -> f64 {
-    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
+/// The cross product of the cell's two edges other than `normal`: the face's normal, as long
+/// as the face's area.
+fn face(m: [[f64; 3]; 3], normal: usize) -> glam::DVec3 {
+    glam::DVec3::from_array(m[(normal + 1) % 3]).cross(glam::DVec3::from_array(m[(normal + 2) % 3]))
 }
 
 #[cfg(test)]
