@@ -1185,6 +1185,7 @@ impl AnalysisArgs {
             ("--rmsd-cluster-table", &self.rmsd_cluster_table),
             ("--rmsd-cluster-middles", &self.rmsd_cluster_middles),
             ("--order-table", &self.order_table),
+            ("--order-chart", &self.order_chart),
             ("--membrane-table", &self.membrane_table),
         ]
         .into_iter()
@@ -1805,11 +1806,17 @@ pub struct AnalysisArgs {
     /// atoms, grouped by residue and atom name (one row per carbon of each chain: C22..C218 and
     /// C32..C316 of POPC), S = <(3 cos²θ − 1) / 2> of its bonds against the --order-normal axis,
     /// averaged over the lipids and frames, with −S (−S_CD, as papers plot it and NMR gives
-    /// it) and the standard error over the lipids. Columns: resname, atom, sites (lipids),
-    /// vectors (bonds per site), s, minus_s, sem. Bonds come from the topology, else from
-    /// distances at the first frame; bonds across the box are taken to their nearest image.
+    /// it) and the standard error over the lipids. Columns: resname, atom, chain and position
+    /// (the carbon's chain within its lipid and its place along it, from the bonds among the
+    /// selected atoms), sites (lipids), vectors (bonds per site), s, minus_s, sem. Bonds come
+    /// from the topology, else from distances at the first frame; bonds across the box are
+    /// taken to their nearest image.
     #[arg(long, value_name = "FILE.csv", requires = "order_select")]
     pub order_table: Option<PathBuf>,
+    /// Also draw --order-table's −S against the position along the chain, a line per chain of
+    /// each lipid kind, PNG or SVG by the name: the order profile membrane papers show.
+    #[arg(long, value_name = "FILE.png|FILE.svg", requires = "order_table")]
+    pub order_chart: Option<PathBuf>,
     /// The atoms --order-table measures: the tail carbons, as
     /// 'resname POPC and name C2* C3*' (hydrogens come from the bonds), or a Martini lipid's
     /// beads ('resname POPC' with --order-method bonds).

@@ -92,7 +92,7 @@ Examples:
   texmap convert md.xtc --topology md.gro --align backbone --rmsf-table rmsf.csv            # flexibility; colour by it: render --property rmsf=rmsf.csv
   texmap convert md.trr --topology md.gro --vacf-table vacf.csv --vdos-table vdos.csv       # velocity autocorrelation (Green-Kubo D) and its spectrum
   texmap convert slab.lammpstrj --profile-table rho.csv --profile-axis z --profile-bins 200  # density profile across an interface
-  texmap convert md.xtc --topology md.psf --order-table scd.csv --order-select 'resname POPC and name C2* C3*'  # lipid tail order, -S_CD per carbon
+  texmap convert md.xtc --topology md.psf --order-table scd.csv --order-select 'resname POPC and name C2* C3*' --order-chart scd.png  # lipid tail order, -S_CD per carbon
   texmap convert md.xtc --topology md.gro --membrane-table mem.csv --membrane-select 'name P'  # bilayer thickness and area per lipid per frame
   texmap convert md.xtc --topology md.gro --sasa protein --sasa-residue-table exposed.csv   # solvent-accessible area per residue and frame (MDTraj's shrake_rupley)
   texmap convert md.xtc --topology md.gro --pbc unwrap --gyration-table rg.csv --gyration-select protein  # compactness over time

@@ -2441,6 +2441,7 @@ impl AnalysisTables {
 /// found at the first frame.
 struct OrderTable {
     file: crate::output::AtomicFile,
+    chart: Option<PathBuf>,
     select: texmap_md_io::select::Selection,
     method: texmap_md_io::order::Method,
     normal: usize,
@@ -2461,6 +2462,12 @@ impl OrderTable {
         let select = analysis.order_select.as_deref().unwrap_or_default();
         Ok(Some(OrderTable {
             file,
+            chart: chart_file(
+                &analysis.order_chart,
+                "--order-chart",
+                "the order parameters average every frame",
+                whole,
+            )?,
             select: texmap_md_io::select::Selection::parse(select)
                 .map_err(|e| crate::args::UsageError(format!("--order-select: {e}")))?,
             method: match analysis.order_method.as_str() {
@@ -2512,20 +2519,47 @@ impl OrderTable {
         let Some(order) = self.order.take() else {
             bail!("--order-table: no frame was read");
         };
-        let mut text = String::from("resname,atom,sites,vectors,s,minus_s,sem\n");
+        let mut text = String::from("resname,atom,chain,position,sites,vectors,s,minus_s,sem\n");
         let sem = order.standard_error();
-        for ((g, s), e) in order.groups().iter().zip(order.mean()).zip(sem) {
+        let mean = order.mean();
+        for ((g, s), e) in order.groups().iter().zip(&mean).zip(sem) {
             let e = if e.is_finite() {
                 format!("{e:.6}")
             } else {
                 String::new()
             };
             text.push_str(&format!(
-                "{},{},{},{},{s:.6},{:.6},{e}\n",
-                g.residue, g.name, g.sites, g.vectors, -s
+                "{},{},{},{},{},{},{s:.6},{:.6},{e}\n",
+                g.residue, g.name, g.chain, g.position, g.sites, g.vectors, -s
             ));
         }
         self.file.write(&text)?;
+        if let Some(path) = &self.chart {
+            // A line per lipid kind and chain, in order of first appearance, by position.
+            let mut series: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
+            for (g, s) in order.groups().iter().zip(&mean) {
+                let name = format!("{} chain {}", g.residue, g.chain);
+                let k = match series.iter().position(|(n, _)| *n == name) {
+                    Some(k) => k,
+                    None => {
+                        series.push((name, Vec::new()));
+                        series.len() - 1
+                    }
+                };
+                series[k].1.push((g.position as f64, -s));
+            }
+            for (_, points) in &mut series {
+                points.sort_by(|a, b| a.0.total_cmp(&b.0));
+            }
+            let y = match self.method {
+                texmap_md_io::order::Method::Bonds => "−S (bond order)",
+                _ => "−S_CD",
+            };
+            let size = texmap_study::chart::CHART_SIZE;
+            write_chart(path, size, |t| {
+                texmap_study::chart::lines(["", "position along the chain", y], &series, size, t)
+            })?;
+        }
         Ok(self.file)
     }
 }

@@ -2391,7 +2391,7 @@ fn order_table_is_gmx_order_and_numpys() {
     let dir = tempfile::tempdir().unwrap();
     let reference = json("order/reference.json");
     let (xtc, gro) = (md_data("order/bilayer.xtc"), md_data("order/bilayer.gro"));
-    let csv = dir.path().join("order.csv");
+    let (csv, svg) = (dir.path().join("order.csv"), dir.path().join("order.svg"));
     let rows = |method: &str| -> Vec<(String, Vec<f64>)> {
         run_ok(&[
             "convert",
@@ -2404,19 +2404,29 @@ fn order_table_is_gmx_order_and_numpys() {
             "resname DPPC and name C2* C3*",
             "--order-method",
             method,
+            "--order-chart",
+            svg.to_str().unwrap(),
             "-q",
         ]);
         let text = std::fs::read_to_string(&csv).unwrap();
         let mut lines = text.lines();
         assert_eq!(
             lines.next(),
-            Some("resname,atom,sites,vectors,s,minus_s,sem")
+            Some("resname,atom,chain,position,sites,vectors,s,minus_s,sem")
         );
         lines
             .map(|l| {
                 let c: Vec<&str> = l.split(',').collect();
-                assert_eq!((c[0], c[2]), ("DPPC", "32"), "{l}");
-                let v = c[4..]
+                assert_eq!((c[0], c[4]), ("DPPC", "32"), "{l}");
+                // CHARMM's names: C2n is carbon n of the first chain, C3n of the second.
+                let name = c[1].split('-').next().unwrap();
+                let chain = name[1..2].parse::<usize>().unwrap() - 1;
+                assert_eq!(
+                    (chain.to_string().as_str(), &name[2..]),
+                    (c[2], c[3]),
+                    "{l}"
+                );
+                let v = c[6..]
                     .iter()
                     .map(|x| x.parse().unwrap_or(f64::NAN))
                     .collect();
@@ -2436,6 +2446,24 @@ fn order_table_is_gmx_order_and_numpys() {
         );
         assert!(near(v[2], sem, 6e-7), "{name}: {v:?} vs {sem}");
     }
+    // The chart: a line per chain, a point per carbon.
+    let chart = std::fs::read_to_string(&svg).unwrap();
+    let long = chart
+        .split("<polyline")
+        .skip(1)
+        .filter(|l| {
+            let points = l
+                .split("points=\"")
+                .nth(1)
+                .unwrap()
+                .split('"')
+                .next()
+                .unwrap();
+            points.split_whitespace().count() == 14
+        })
+        .count();
+    assert_eq!(long, 2, "{chart}");
+    assert!(chart.contains("DPPC chain 2"));
     let ua = rows("united-atom");
     assert_eq!(ua.len(), 24);
     for (name, v) in &ua {

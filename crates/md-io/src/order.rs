@@ -71,6 +71,13 @@ pub struct Group {
     /// The vectors per site: the carbon's hydrogens, 2 for the united-atom construction, 1 for
     /// a bond.
     pub vectors: usize,
+    /// Which chain of its lipid the carbon (a bond's first atom) is on, from 1: the chains are
+    /// the sets of selected atoms joined by bonds among them (hydrogens aside), numbered within
+    /// the residue by their first atom (sn-2 before sn-1 in CHARMM's order).
+    pub chain: usize,
+    /// The carbon's place along its chain, from 1: bonds counted from the chain's end of lowest
+    /// atom index (the ester end, as force fields list the atoms).
+    pub position: usize,
 }
 
 /// A site: its group and the atoms its vectors come from (carbon first).
@@ -176,6 +183,8 @@ impl OrderParameters {
                     name,
                     sites: 0,
                     vectors: atoms.len() - 1,
+                    chain: 0,
+                    position: 0,
                 });
             }
             groups[g as usize].sites += 1;
@@ -223,6 +232,15 @@ impl OrderParameters {
         }
         if sites.is_empty() {
             return Err(OrderError::NoSites(method));
+        }
+        let places = chains(frame, selected, n, &partners, &hydrogen);
+        let mut named = vec![false; groups.len()];
+        for site in &sites {
+            let g = site.group as usize;
+            if !named[g] {
+                named[g] = true;
+                (groups[g].chain, groups[g].position) = places[site.atoms[0] as usize];
+            }
         }
         Ok(OrderParameters {
             method,
@@ -345,6 +363,82 @@ impl OrderParameters {
             })
             .collect()
     }
+}
+
+/// Each atom's (chain, position) as [`Group::chain`] and [`Group::position`] define them; (0, 0)
+/// for atoms not selected.
+fn chains<'a>(
+    frame: &Frame,
+    selected: &[bool],
+    n: usize,
+    partners: &impl Fn(usize) -> &'a [u32],
+    hydrogen: &impl Fn(usize) -> bool,
+) -> Vec<(usize, usize)> {
+    let inside = |a: usize| a < n && selected[a] && !hydrogen(a);
+    let next = |a: usize| {
+        partners(a)
+            .iter()
+            .map(|&b| b as usize)
+            .filter(move |&b| inside(b))
+    };
+    let mut place = vec![(0, 0); frame.n_atoms()];
+    let mut component = vec![usize::MAX; frame.n_atoms()];
+    // Components in order of their lowest atom, each walked from its lowest-index end.
+    let mut lowest = Vec::new();
+    let mut queue = std::collections::VecDeque::new();
+    for a in (0..n).filter(|&a| inside(a)) {
+        if component[a] != usize::MAX {
+            continue;
+        }
+        let id = lowest.len();
+        lowest.push(a);
+        let mut members = vec![a];
+        component[a] = id;
+        let mut k = 0;
+        while k < members.len() {
+            for b in next(members[k]) {
+                if component[b] == usize::MAX {
+                    component[b] = id;
+                    members.push(b);
+                }
+            }
+            k += 1;
+        }
+        let start = members
+            .iter()
+            .copied()
+            .filter(|&m| next(m).count() <= 1)
+            .min()
+            .unwrap_or(a);
+        let mut depth = std::collections::HashMap::from([(start, 1usize)]);
+        queue.push_back(start);
+        while let Some(m) = queue.pop_front() {
+            let d = depth[&m];
+            for b in next(m) {
+                depth.entry(b).or_insert_with(|| {
+                    queue.push_back(b);
+                    d + 1
+                });
+            }
+        }
+        for (&m, &d) in &depth {
+            place[m].1 = d;
+        }
+    }
+    // Chains numbered within their residue by their lowest atom.
+    let ranges = crate::secondary::residue_ranges(frame);
+    let residue = |a: usize| ranges.partition_point(|r| r.end <= a);
+    let mut rank = vec![0; lowest.len()];
+    let mut last = (usize::MAX, 0);
+    for (id, &a) in lowest.iter().enumerate() {
+        let r = residue(a);
+        last = if r == last.0 { (r, last.1 + 1) } else { (r, 1) };
+        rank[id] = last.1;
+    }
+    for a in (0..n).filter(|&a| component[a] != usize::MAX) {
+        place[a].0 = rank[component[a]];
+    }
+    place
 }
 
 fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
@@ -480,6 +574,10 @@ mod tests {
             // Hydrogens: the 10 inner carbons; united atom: the same 10.
             assert_eq!(h.groups().len(), 10);
             assert_eq!(ua.groups().len(), 10);
+            // C2 is the second carbon of the one chain, C11 the eleventh.
+            let place = |g: &Group| (g.name.clone(), g.chain, g.position);
+            assert_eq!(place(&h.groups()[0]), ("C2".into(), 1, 2));
+            assert_eq!(place(&ua.groups()[9]), ("C11".into(), 1, 11));
             for ((a, b), (ga, gb)) in sh.iter().zip(&su).zip(h.groups().iter().zip(ua.groups())) {
                 assert_eq!(ga.name, gb.name);
                 assert!((a - b).abs() < 1e-5, "{}: {a} vs {b}", ga.name);

@@ -83,6 +83,12 @@ fn hydrogens_equal_numpy_carbon_by_carbon_with_the_spread_over_lipids() {
     assert_eq!(order.groups()[0].name, "C21");
     assert_eq!(order.groups()[13].name, "C214");
     assert_eq!(order.groups()[13].vectors, 3);
+    // Each carbon's chain and place along it, from the bonds.
+    let place = |k: usize| (order.groups()[k].chain, order.groups()[k].position);
+    assert_eq!(
+        (place(0), place(13), place(14), place(27)),
+        ((1, 1), (1, 14), (2, 1), (2, 14))
+    );
     assert_eq!(order.groups()[12].vectors, 2);
     // The values vary along the chain (the test is not of a constant).
     assert!(mean[0] < -0.25 && mean[10].abs() < 0.1, "{mean:?}");
