@@ -12,8 +12,9 @@
 //! - [`Method::UnitedAtom`] (GROMOS, Berger: CH₂ groups without hydrogens): `gmx order`'s
 //!   construction from the carbon i and its two bonded heavy neighbours i−1, i+1. With z along
 //!   i−1 → i+1, x normal to the plane of the three and y = z × x, S_CD = ⅔·S_xx + ⅓·S_yy, where
-//!   S_aa is P₂ of axis a against the normal: exactly the mean S_CH of two hydrogens placed at
-//!   ideal tetrahedral angles (the tests check it against explicit hydrogens). Carbons with
+//!   S_aa is P₂ of axis a against the normal: for equal C–C lengths exactly the mean S_CH of two
+//!   hydrogens placed at ideal tetrahedral angles (the tests check it against explicit
+//!   hydrogens). Carbons with
 //!   other than two heavy neighbours (chain ends, branches) are left out, as `gmx order` leaves
 //!   out the first and last atoms of its groups; a double bond's carbons are taken as sp³ (`gmx
 //!   order` without `-unsat`).
@@ -277,13 +278,14 @@ impl OrderParameters {
             });
         }
         let image = cell.and_then(NearestImage::new);
-        let vector = |from: u32, to: u32| -> Result<[f64; 3], OrderError> {
+        // The bond from `from` to `to` at its nearest image, refused when of no length.
+        let bond = |from: u32, to: u32| -> Result<([f64; 3], f64), OrderError> {
             let (p, q) = (positions[from as usize], positions[to as usize]);
             let d = std::array::from_fn(|k| f64::from(q[k]) - f64::from(p[k]));
             let d = image.as_ref().map_or(d, |i| i.apply(d));
-            let l = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            let l = norm(d);
             if l > 0.0 && l.is_finite() {
-                Ok(d.map(|x| x / l))
+                Ok((d, l))
             } else {
                 Err(OrderError::Degenerate {
                     atom: from as usize,
@@ -291,19 +293,23 @@ impl OrderParameters {
             }
         };
         let k = self.normal;
-        let mut frame_sum = vec![0.0; self.groups.len()];
-        for (site, sum) in self.sites.iter().zip(&mut self.sums) {
+        // Every site's value first, so that a refused frame leaves the sums as they were.
+        let mut values = Vec::with_capacity(self.sites.len());
+        for site in &self.sites {
             let a = site.atoms[0];
-            let s = match self.method {
+            values.push(match self.method {
                 Method::Hydrogens | Method::Bonds => {
                     let mut s = 0.0;
                     for &h in &site.atoms[1..] {
-                        s += p2(vector(a, h)?[k]);
+                        let (d, l) = bond(a, h)?;
+                        s += p2(d[k] / l);
                     }
                     s / (site.atoms.len() - 1) as f64
                 }
                 Method::UnitedAtom => {
-                    let (prev, next) = (vector(a, site.atoms[1])?, vector(a, site.atoms[2])?);
+                    // z along C(i−1) → C(i+1) as the atoms lie (gmx order's), x normal to the
+                    // three carbons' plane.
+                    let ((prev, _), (next, _)) = (bond(a, site.atoms[1])?, bond(a, site.atoms[2])?);
                     let z = sub(next, prev);
                     let x = cross(prev, next);
                     let (lz, lx) = (norm(z), norm(x));
@@ -315,7 +321,10 @@ impl OrderParameters {
                     let y = cross(z, x);
                     2.0 / 3.0 * p2(x[k]) + 1.0 / 3.0 * p2(y[k])
                 }
-            };
+            });
+        }
+        let mut frame_sum = vec![0.0; self.groups.len()];
+        for ((site, sum), s) in self.sites.iter().zip(&mut self.sums).zip(values) {
             *sum += s;
             frame_sum[site.group as usize] += s;
         }
@@ -672,6 +681,8 @@ mod tests {
             o.add(&[[1.0; 3], [1.0; 3]], None),
             Err(OrderError::Degenerate { atom: 0 })
         );
+        // A refused frame counts for nothing.
+        assert_eq!((o.mean(), o.frames()), (vec![0.25], 2));
         assert_eq!(
             OrderParameters::new(&frame, &[true, false], &[[0, 1]], Method::Bonds, 2).unwrap_err(),
             OrderError::NoSites(Method::Bonds)

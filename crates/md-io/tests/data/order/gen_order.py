@@ -268,8 +268,7 @@ def reference(per, n_lip):
                     continue
                 a = nearest(x[np.arange(n_lip) * m + idx[prev]] - x[ci])
                 b = nearest(x[np.arange(n_lip) * m + idx[nxt]] - x[ci])
-                a /= np.linalg.norm(a, axis=1)[:, None]
-                b /= np.linalg.norm(b, axis=1)[:, None]
+                # z along C(i-1) -> C(i+1) as the atoms lie (not the unit bonds' difference).
                 z = b - a
                 z /= np.linalg.norm(z, axis=1)[:, None]
                 xx = np.cross(a, b)
