@@ -1743,6 +1743,13 @@ pub struct AnalysisArgs {
         requires = "density_map"
     )]
     pub density_select: String,
+    /// The units of --density-map's values: A^-3 (atoms per Å³), nm^-3, molar (mol/L), or
+    /// relative to bulk water's molecules: water (0.997 g/cm³, so 1 is bulk water's oxygen
+    /// density and 2 twice it), SPC, TIP3P, TIP4P (each model's own bulk density) — the units
+    /// MDAnalysis's Density.convert_density takes.
+    #[arg(long, value_name = "UNIT", default_value = "A^-3", requires = "density_map",
+          value_parser = ["A^-3", "nm^-3", "molar", "water", "SPC", "TIP3P", "TIP4P"])]
+    pub density_units: String,
     /// --density-map's cell width (Å).
     #[arg(long, value_name = "Å", default_value_t = 1.0, requires = "density_map", value_parser = parse_positive)]
     pub density_delta: f64,

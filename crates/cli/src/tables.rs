@@ -205,6 +205,8 @@ struct DensityTable {
     map: Option<texmap_md_io::density::DensityMap>,
     first: usize,
     positions: u64,
+    /// `--density-units`: the name and the units in one atom per Å³.
+    units: (String, f64),
 }
 
 impl DensityTable {
@@ -246,10 +248,14 @@ impl DensityTable {
         let Some(map) = self.map else {
             bail!("--density-map: no frame was written or drawn, so there is no density");
         };
-        let v = map.to_volume("density");
+        let mut v = map.to_volume("density");
+        let (unit, factor) = (&self.units.0, self.units.1);
+        for x in &mut v.data {
+            *x = (f64::from(*x) * factor) as f32;
+        }
         let [nx, ny, nz] = v.dims;
         let intro = format!(
-            "texmap --density-map: number density (atoms/A^3) of '{}'",
+            "texmap --density-map: number density ({unit}) of '{}'",
             self.text
         );
         let grid = format!(
@@ -263,10 +269,11 @@ impl DensityTable {
         texmap_md_io::volume::write_dx(&v, &[&intro, &grid], &mut text)?;
         self.file.write(&String::from_utf8_lossy(&text))?;
         let (_, top) = v.range().unwrap_or((0.0, 0.0));
+        let water = texmap_md_io::density::UNITS[3].1;
         crate::note!(
-            "--density-map: {nx}x{ny}x{nz} cells over {} frames, the densest {top:.4} atoms/Å³ ({:.2}x bulk water's oxygens)",
+            "--density-map: {nx}x{ny}x{nz} cells over {} frames, the densest {top:.4} {unit} ({:.2}x bulk water's oxygens)",
             map.frames(),
-            top / 0.0334
+            f64::from(top) / factor * water
         );
         if map.outside() > 0 {
             eprintln!(
@@ -2070,6 +2077,11 @@ impl AnalysisTables {
                     map: None,
                     first: 0,
                     positions: 0,
+                    units: texmap_md_io::density::UNITS
+                        .iter()
+                        .find(|(name, _)| *name == analysis.density_units)
+                        .map(|&(name, factor)| (name.to_string(), factor))
+                        .unwrap_or(("A^-3".into(), 1.0)),
                 }),
                 None => None,
             },

@@ -31,6 +31,27 @@
 
 use crate::volume::Volume;
 
+/// Avogadro's number (CODATA 2018, exact).
+const AVOGADRO: f64 = 6.022_140_76e23;
+
+/// The units a density map may be written in, with the number of those units in one atom per
+/// Å³: per Å³, per nm³, molar (mol/L), and relative to bulk water's molecules — `water` at
+/// 0.997 g/cm³, the water models `SPC` at 0.985, `TIP3P` at 1.002 and `TIP4P` at 1.001, with
+/// 18.016 g/mol (the densities MDAnalysis's `units` module converts with, so a map in `water`
+/// reads 1 where an oxygen's density is bulk water's and 2 where it is twice that).
+pub const UNITS: [(&str, f64); 7] = [
+    ("A^-3", 1.0),
+    ("nm^-3", 1000.0),
+    ("molar", 1e27 / AVOGADRO),
+    ("water", WATER_MOLAR_MASS / (0.997 * AVOGADRO * 1e-24)),
+    ("SPC", WATER_MOLAR_MASS / (0.985 * AVOGADRO * 1e-24)),
+    ("TIP3P", WATER_MOLAR_MASS / (1.002 * AVOGADRO * 1e-24)),
+    ("TIP4P", WATER_MOLAR_MASS / (1.001 * AVOGADRO * 1e-24)),
+];
+
+/// g/mol of water in [`UNITS`].
+const WATER_MOLAR_MASS: f64 = 18.016;
+
 /// Why a [`DensityMap`] cannot be set up.
 #[derive(Clone, Debug, PartialEq)]
 pub enum DensityError {
