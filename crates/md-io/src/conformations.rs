@@ -198,27 +198,19 @@ fn gromos(m: &[f64], n: usize, cutoff: f64) -> Vec<Vec<usize>> {
 
 /// Single linkage: the connected parts, each in frame order, by their first frame.
 fn linkage(m: &[f64], n: usize, cutoff: f64) -> Vec<Vec<usize>> {
-    let mut parent: Vec<usize> = (0..n).collect();
-    fn root(parent: &mut [usize], mut i: usize) -> usize {
-        while parent[i] != i {
-            parent[i] = parent[parent[i]];
-            i = parent[i];
-        }
-        i
-    }
+    // A part's root is its lowest index: its first frame.
+    let mut parts = crate::components::UnionFind::new(n);
     for i in 0..n {
         for j in i + 1..n {
             if m[i * n + j] < cutoff {
-                let (a, b) = (root(&mut parent, i), root(&mut parent, j));
-                // The smaller index is the root, so a part's root is its first frame.
-                parent[a.max(b)] = a.min(b);
+                parts.join(i, j);
             }
         }
     }
     let mut index = vec![usize::MAX; n];
     let mut groups: Vec<Vec<usize>> = Vec::new();
     for i in 0..n {
-        let r = root(&mut parent, i);
+        let r = parts.root(i);
         if index[r] == usize::MAX {
             index[r] = groups.len();
             groups.push(Vec::new());

@@ -128,30 +128,18 @@ pub fn clusters(
     let pairs = pairs_within(frame, cutoff)?;
     let n = frame.n_atoms();
     let member = |i: usize| only.is_none_or(|m| m.get(i).copied().unwrap_or(false));
-    // Union-find with path halving; the root of a set is its lowest atom index.
-    let mut parent: Vec<u32> = (0..n as u32).collect();
-    fn root(parent: &mut [u32], mut i: u32) -> u32 {
-        while parent[i as usize] != i {
-            let p = parent[parent[i as usize] as usize];
-            parent[i as usize] = p;
-            i = p;
-        }
-        i
-    }
+    // The root of a set is its lowest atom index.
+    let mut parts = crate::components::UnionFind::new(n);
     for &[i, j] in &pairs {
         if member(i as usize) && member(j as usize) {
-            let (a, b) = (root(&mut parent, i), root(&mut parent, j));
-            if a != b {
-                let (lo, hi) = (a.min(b), a.max(b));
-                parent[hi as usize] = lo;
-            }
+            parts.join(i as usize, j as usize);
         }
     }
     let mut size = vec![0usize; n];
     let mut roots = Vec::new();
     for i in 0..n {
         if member(i) {
-            let r = root(&mut parent, i as u32) as usize;
+            let r = parts.root(i);
             if size[r] == 0 {
                 roots.push(r);
             }

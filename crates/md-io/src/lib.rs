@@ -117,6 +117,7 @@ pub mod centrosymmetry;
 mod chgcar;
 mod cif;
 pub mod cna;
+mod components;
 pub mod conformations;
 pub mod contacts;
 pub mod coordination;

@@ -114,24 +114,13 @@ pub fn leaflets(
         }
         pairs
     };
-    // Union-find over the heads.
-    let mut parent: Vec<usize> = (0..p.len()).collect();
-    fn root(parent: &mut [usize], mut i: usize) -> usize {
-        while parent[i] != i {
-            parent[i] = parent[parent[i]];
-            i = parent[i];
-        }
-        i
-    }
+    let mut parts = crate::components::UnionFind::new(p.len());
     for [a, b] in pairs {
-        let (ra, rb) = (root(&mut parent, a as usize), root(&mut parent, b as usize));
-        if ra != rb {
-            parent[ra.max(rb)] = ra.min(rb);
-        }
+        parts.join(a as usize, b as usize);
     }
     let mut sets: std::collections::BTreeMap<usize, Vec<usize>> = Default::default();
     for (k, &h) in heads.iter().enumerate() {
-        sets.entry(root(&mut parent, k)).or_default().push(h);
+        sets.entry(parts.root(k)).or_default().push(h);
     }
     let mut out: Vec<Vec<usize>> = sets.into_values().collect();
     for s in &mut out {
