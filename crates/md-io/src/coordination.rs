@@ -155,7 +155,7 @@ pub fn clusters(
     let ids: Vec<i32> = (0..n)
         .map(|i| {
             if member(i) {
-                id_of_root[root(&mut parent, i as u32) as usize]
+                id_of_root[parts.root(i)]
             } else {
                 -1
             }
@@ -206,6 +206,7 @@ fn shapes(
     let mut centers = Vec::with_capacity(roots.len());
     let mut gyration = Vec::with_capacity(roots.len());
     let mut members = Vec::new();
+    let image = frame.cell.as_ref().and_then(crate::pbc::NearestImage::new);
     for &r in roots {
         members.clear();
         unwrapped[r] = at(r);
@@ -218,10 +219,7 @@ fn shapes(
                 if !seen[j] {
                     seen[j] = true;
                     let step: [f64; 3] = std::array::from_fn(|k| at(j)[k] - at(i)[k]);
-                    let step = match &frame.cell {
-                        Some(cell) => crate::pbc::minimum_image(cell, step),
-                        None => step,
-                    };
+                    let step = image.as_ref().map_or(step, |m| m.apply(step));
                     unwrapped[j] = std::array::from_fn(|k| unwrapped[i][k] + step[k]);
                     queue.push_back(j);
                 }

@@ -32,7 +32,7 @@
 use std::fmt;
 
 use crate::frame::Frame;
-use crate::pbc::minimum_image;
+use crate::pbc::NearestImage;
 
 /// Why a frame cannot be followed from the ones before.
 #[derive(Clone, Debug, PartialEq)]
@@ -178,12 +178,10 @@ impl Tracker {
             self.last = now;
             return Ok(vec![0.0; n]);
         }
+        let image = frame.cell.as_ref().and_then(NearestImage::new);
         for ((u, last), p) in self.unwrapped.iter_mut().zip(&mut self.last).zip(&now) {
             let step: [f64; 3] = std::array::from_fn(|k| p[k] - last[k]);
-            let step = match &frame.cell {
-                Some(cell) => minimum_image(cell, step),
-                None => step,
-            };
+            let step = image.as_ref().map_or(step, |m| m.apply(step));
             for k in 0..3 {
                 u[k] += step[k];
             }

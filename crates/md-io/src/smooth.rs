@@ -38,7 +38,7 @@ use std::ops::RangeInclusive;
 
 use crate::error::{Error, Location};
 use crate::frame::Frame;
-use crate::pbc::minimum_image;
+use crate::pbc::NearestImage;
 use crate::trajectory::FrameSource;
 
 /// The frames averaged into frame `f` of `n_frames` with half-width `half` (see the module
@@ -61,16 +61,13 @@ pub fn mean_positions(frame: &mut Frame, others: &[&[[f32; 3]]]) {
         "frames of unequal atom counts"
     );
     let count = (others.len() + 1) as f64;
-    let cell = frame.cell;
+    let image = frame.cell.as_ref().and_then(NearestImage::new);
     for (i, p) in frame.positions.iter_mut().enumerate() {
         let centre = p.map(f64::from);
         let mut sum = [0.0f64; 3];
         for o in others {
             let d = [0, 1, 2].map(|k| f64::from(o[i][k]) - centre[k]);
-            let d = match &cell {
-                Some(c) => minimum_image(c, d),
-                None => d,
-            };
+            let d = image.as_ref().map_or(d, |m| m.apply(d));
             for k in 0..3 {
                 sum[k] += d[k];
             }

@@ -1724,6 +1724,10 @@ impl MolPlan {
             });
         }
         let keep = self.options.trail_length.unwrap_or(usize::MAX).max(1);
+        let image = frame
+            .cell
+            .as_ref()
+            .and_then(texmap_md_io::pbc::NearestImage::new);
         for ((&i, path), last) in atoms
             .iter()
             .zip(&mut self.trail_paths)
@@ -1736,8 +1740,8 @@ impl MolPlan {
                     // The step from the last frame, through the nearest image: the path goes
                     // on across a face of the box instead of jumping back through it.
                     let mut d: [f64; 3] = std::array::from_fn(|k| now[k] as f64 - last[k] as f64);
-                    if let Some(cell) = &frame.cell {
-                        d = texmap_md_io::pbc::minimum_image(cell, d);
+                    if let Some(image) = &image {
+                        d = image.apply(d);
                     }
                     *prev + glam::DVec3::from_array(d).as_vec3()
                 }
