@@ -121,8 +121,9 @@ pub enum Command {
     /// dual-paraboloid maps; `envmap compare` measures every method against the reference.
     Envmap(crate::envmap::EnvmapArgs),
     /// Draw a table's columns as a line chart, PNG or SVG: the CSV tables texmap convert
-    /// writes (RMSD, radius of gyration, SASA, hydrogen bonds, secondary structure over time)
-    /// or a GROMACS .xvg file. `texmap plot rmsd.csv --y rmsd -o rmsd.png`.
+    /// writes (RMSD, radius of gyration, SASA, hydrogen bonds, secondary structure over time),
+    /// a GROMACS .xvg or energy (.edr) file, or a LAMMPS log's thermo output.
+    /// `texmap plot rmsd.csv --y rmsd -o rmsd.png`, `texmap plot ener.edr --y Temperature -o t.png`.
     Plot(crate::plot::PlotArgs),
     /// Assemble a directory of PNG frames (in numeric order: f2.png before f10.png) into one
     /// movie: .mp4, .webm, .gif (ffmpeg) or .apng. The last step of a render split into parts.

@@ -1,31 +1,43 @@
 //! `texmap plot`: a line chart of a table's columns, PNG or SVG — the RMSD, radius of
-//! gyration, SASA or hydrogen-bond count over time that `texmap convert` writes as CSV, or a
-//! GROMACS `.xvg` file (what users otherwise open in xmgrace or matplotlib).
+//! gyration, SASA or hydrogen-bond count over time that `texmap convert` writes as CSV, a
+//! GROMACS `.xvg` file (what users otherwise open in xmgrace or matplotlib), a GROMACS energy
+//! file (`.edr`, what `gmx energy` reads) or a LAMMPS log's thermo output.
 //!
 //! A CSV table has a header row of column names and comma-separated cells (RFC 4180 quotes
 //! allowed); an empty cell is a gap in its line. An `.xvg` file's `#` lines are comments, its
 //! `@` lines give the axis labels and the series' legends, and its rows are numbers separated
-//! by spaces. Columns are chosen by name or by number from 1.
+//! by spaces. An `.edr` file (by its extension or its first bytes) and a LAMMPS log (a file
+//! whose first lines name `LAMMPS (`) are read by md-io's `energy` module: the `.edr` file's
+//! columns are `Time` (ps) and its terms with their units, picked by name as `gmx energy`
+//! names them (`--y Temperature,Pressure`; spaces may be written as `-`, as its menu shows
+//! them) and drawn against the time; the log's columns are its thermo keywords, every run's
+//! table joined, drawn against `Step`. Columns are chosen by name or by number from 1.
 
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
 
+use texmap_md_io::energy::{self, EnergyTable};
+
 use crate::args::usage;
 
 /// `texmap plot FILE --y COL -o OUT.png`.
 #[derive(Args, Clone, Debug)]
 pub struct PlotArgs {
-    /// The table: CSV with a header row (every table texmap convert writes), or a GROMACS .xvg
-    /// file (gmx rms, gyrate, energy, ...).
+    /// The table: CSV with a header row (every table texmap convert writes), a GROMACS .xvg
+    /// file (gmx rms, gyrate, energy, ...), a GROMACS energy file (.edr: every term of gmx
+    /// energy, with its unit) or a LAMMPS log (log.lammps, told by its first line 'LAMMPS (':
+    /// the thermo output of every run, thermo_style multi too).
     pub file: PathBuf,
-    /// The column along x, by name or number from 1 (by default 'time' when the rows' times
-    /// increase, else the first column: frame, lag, residue).
+    /// The column along x, by name or number from 1 (by default Time for an .edr file, Step
+    /// for a LAMMPS log; else 'time' when the rows' times increase, else the first column:
+    /// frame, lag, residue).
     #[arg(long, value_name = "COL")]
     pub x: Option<String>,
     /// The columns drawn against it, comma-separated names or numbers (by default every other
-    /// column of numbers but frame and time): --y rmsd, --y helix,strand,coil, --y 2,3.
+    /// column of numbers but frame, time, Step and CPU; an .edr file's terms must be named):
+    /// --y rmsd, --y helix,strand,coil, --y 2,3, --y Temperature,Pressure, --y Temp,PotEng.
     #[arg(long, value_name = "COL,...", value_delimiter = ',')]
     pub y: Vec<String>,
     /// Also draw each series' running mean over N rows (centred), in its own colour, for a
@@ -35,10 +47,11 @@ pub struct PlotArgs {
     /// The chart's title (none by default).
     #[arg(long, default_value = "")]
     pub title: String,
-    /// The x axis's label (the column's name, or the .xvg file's).
+    /// The x axis's label (the column's name, with its unit: 'Time (ps)'; or the .xvg file's).
     #[arg(long, value_name = "TEXT")]
     pub x_label: Option<String>,
-    /// The y axis's label (the column's name when there is one, or the .xvg file's).
+    /// The y axis's label (the column's name when there is one, with an .edr term's unit:
+    /// 'Temperature (K)'; the terms' shared unit; or the .xvg file's).
     #[arg(long, value_name = "TEXT")]
     pub y_label: Option<String>,
     /// The image size, WxH pixels.
@@ -50,12 +63,17 @@ pub struct PlotArgs {
 }
 
 /// A table read: column names, each column's numbers (NaN for an empty cell) or why it has
-/// none (its first cell that is not a number), the axis labels an .xvg file gives.
+/// none (its first cell that is not a number), the axis labels an .xvg file gives, each
+/// column's unit (empty when unknown) and the column x is by default.
 struct Table {
     names: Vec<String>,
     columns: Vec<std::result::Result<Vec<f64>, String>>,
     x_label: Option<String>,
     y_label: Option<String>,
+    units: Vec<String>,
+    default_x: Option<usize>,
+    /// An .edr file: its terms must be named with --y, as gmx energy asks for them.
+    edr: bool,
 }
 
 impl Table {
@@ -79,19 +97,49 @@ pub fn plot(a: &PlotArgs) -> Result<()> {
             a.output.display()
         ));
     }
-    let text = std::fs::read_to_string(&a.file)
+    let bytes = std::fs::read(&a.file)
         .with_context(|| format!("{}: cannot read the table", a.file.display()))?;
-    let xvg = a
-        .file
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("xvg"));
-    let table = if xvg {
-        read_xvg(&a.file, &text)?
+    let has_extension = |ext: &str| {
+        a.file
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case(ext))
+    };
+    let name = a.file.display().to_string();
+    let table = if has_extension("edr") || energy::is_edr(&bytes) {
+        let t = energy::edr_from_reader(std::io::Cursor::new(&bytes), bytes.len() as u64, &name)?;
+        energy_table(t, true)
+    } else if energy::is_lammps_log(&bytes) {
+        let t = energy::lammps_log_from_bytes(&bytes, &name)?;
+        if t.truncated_rows > 0 {
+            eprintln!(
+                "texmap: warning: {name}: {} row(s) cut short at the end of the file dropped (a run still writing, or killed)",
+                t.truncated_rows
+            );
+        }
+        energy_table(t, false)
     } else {
-        read_csv(&a.file, &text)?
+        let text = String::from_utf8(bytes).map_err(|_| {
+            anyhow::anyhow!(
+                "{}: cannot read the table: not UTF-8 text (nor an .edr file or a LAMMPS log)",
+                a.file.display()
+            )
+        })?;
+        if has_extension("xvg") {
+            read_xvg(&a.file, &text)?
+        } else {
+            read_csv(&a.file, &text)?
+        }
     };
     let column = |spec: &str| -> Result<usize> {
         if let Some(k) = table.names.iter().position(|n| n == spec) {
+            return Ok(k);
+        }
+        // gmx energy's menu writes a term's spaces as '-' (LJ-(SR), Kinetic-En.).
+        if let Some(k) = table
+            .names
+            .iter()
+            .position(|n| n.contains(' ') && n.replace(' ', "-") == spec)
+        {
             return Ok(k);
         }
         match spec.parse::<usize>() {
@@ -103,7 +151,8 @@ pub fn plot(a: &PlotArgs) -> Result<()> {
             )),
         }
     };
-    // By default x is the time when the rows have increasing times, else the first column.
+    // By default x is the file's own (an .edr file's Time, a log's Step), else the time when
+    // the rows have increasing times, else the first column.
     let timed = table.names.iter().position(|n| n == "time").filter(|&k| {
         table.columns[k]
             .as_ref()
@@ -111,14 +160,24 @@ pub fn plot(a: &PlotArgs) -> Result<()> {
     });
     let x = match &a.x {
         Some(spec) => column(spec)?,
-        None => timed.unwrap_or(0),
+        None => table.default_x.or(timed).unwrap_or(0),
     };
     let ys: Vec<usize> = if a.y.is_empty() {
+        if table.edr {
+            return usage(format!(
+                "{}: name the terms to draw with --y (e.g. --y Temperature,Pressure): the terms are {}",
+                a.file.display(),
+                table.names[1..].join(", ")
+            ));
+        }
         (0..table.names.len())
             .filter(|&k| {
                 k != x
                     && table.columns[k].is_ok()
-                    && !matches!(table.names[k].as_str(), "frame" | "time")
+                    && !matches!(
+                        table.names[k].as_str(),
+                        "frame" | "time" | "Step" | "Time" | "CPU"
+                    )
             })
             .collect()
     } else {
@@ -165,16 +224,22 @@ pub fn plot(a: &PlotArgs) -> Result<()> {
         .x_label
         .clone()
         .or(table.x_label.clone())
-        .unwrap_or_else(|| table.names[x].clone());
+        .unwrap_or_else(|| match table.units[x].as_str() {
+            "" => table.names[x].clone(),
+            unit => format!("{} ({unit})", table.names[x]),
+        });
     let y_label = a
         .y_label
         .clone()
         .or(table.y_label.clone())
         .unwrap_or_else(|| {
-            if ys.len() == 1 {
-                table.names[ys[0]].clone()
-            } else {
-                String::new()
+            let unit = &table.units[ys[0]];
+            let shared = ys.iter().all(|&k| table.units[k] == *unit);
+            match (ys.len(), unit.is_empty() || !shared) {
+                (1, true) => table.names[ys[0]].clone(),
+                (1, false) => format!("{} ({unit})", table.names[ys[0]]),
+                (_, false) => unit.clone(),
+                (_, true) => String::new(),
             }
         });
     crate::tables::write_chart(&a.output, size, |t| {
@@ -187,6 +252,21 @@ pub fn plot(a: &PlotArgs) -> Result<()> {
         a.output.display()
     );
     Ok(())
+}
+
+/// An energy file's or log's table as plot's, x by default its `Time` (the .edr's first
+/// column) or `Step`.
+fn energy_table(t: EnergyTable, edr: bool) -> Table {
+    let default_x = if edr { Some(0) } else { t.index("Step") };
+    Table {
+        columns: t.columns.into_iter().map(Ok).collect(),
+        x_label: None,
+        y_label: None,
+        default_x,
+        units: t.units,
+        names: t.names,
+        edr,
+    }
 }
 
 /// The centred running mean over `n` rows (fewer at the ends), skipping gaps.
@@ -283,10 +363,13 @@ fn read_csv(path: &Path, text: &str) -> Result<Table> {
         })
         .collect();
     Ok(Table {
+        units: vec![String::new(); names.len()],
         names,
         columns,
         x_label: None,
         y_label: None,
+        default_x: None,
+        edr: false,
     })
 }
 
@@ -359,9 +442,12 @@ fn read_xvg(path: &Path, text: &str) -> Result<Table> {
         .map(|c| Ok(rows.iter().map(|r| r[c]).collect()))
         .collect();
     Ok(Table {
+        units: vec![String::new(); names.len()],
         names,
         columns,
         x_label,
         y_label,
+        default_x: None,
+        edr: false,
     })
 }

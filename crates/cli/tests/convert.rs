@@ -2328,28 +2328,8 @@ fn plot_draws_convert_tables_and_gmx_xvg_files() {
         svg.to_str().unwrap(),
         "-q",
     ]);
-    let text = std::fs::read_to_string(&svg).unwrap();
     // The data's polyline: the one with a point per row.
-    let lines: Vec<Vec<(f64, f64)>> = text
-        .split("<polyline")
-        .skip(1)
-        .map(|p| {
-            let points = p
-                .split("points=\"")
-                .nth(1)
-                .unwrap()
-                .split('"')
-                .next()
-                .unwrap();
-            points
-                .split_whitespace()
-                .map(|xy| {
-                    let (x, y) = xy.split_once(',').unwrap();
-                    (x.parse().unwrap(), y.parse().unwrap())
-                })
-                .collect()
-        })
-        .collect();
+    let lines = common::svg_polylines(&std::fs::read_to_string(&svg).unwrap());
     let data = lines
         .iter()
         .find(|l| l.len() == rmsd.len())
@@ -2474,19 +2454,9 @@ fn order_table_is_gmx_order_and_numpys() {
     }
     // The chart: a line per chain, a point per carbon.
     let chart = std::fs::read_to_string(&svg).unwrap();
-    let long = chart
-        .split("<polyline")
-        .skip(1)
-        .filter(|l| {
-            let points = l
-                .split("points=\"")
-                .nth(1)
-                .unwrap()
-                .split('"')
-                .next()
-                .unwrap();
-            points.split_whitespace().count() == 14
-        })
+    let long = common::svg_polylines(&chart)
+        .iter()
+        .filter(|l| l.len() == 14)
         .count();
     assert_eq!(long, 2, "{chart}");
     assert!(chart.contains("DPPC chain 2"));

@@ -40,6 +40,8 @@
 //!   [`grains`] the grains of a polycrystal, [`rdf`] the radial distribution functions of a frame, as OVITO's analyses do, [`msd`] each atom's squared displacement followed across the periodic boundaries and the mean over every time origin with its diffusion coefficient, [`vacf`] the velocity autocorrelation, its Green–Kubo diffusion coefficient and the vibrational density of states, [`conformations`] clusters the frames' shapes on their pairwise RMSD (gmx cluster's gromos and single linkage), [`rmsf`] each atom's fluctuation about its mean position, [`shape`] the radius of gyration and shape anisotropy of a group, [`contacts`] the fraction of a reference's native contacts a frame keeps, [`distance_map`] the residue–residue map of smallest distances and contacts over a run (gmx mdmat), [`survival`] how long members of a changing set stay (water residence, hydrogen-bond lifetimes), [`sasa`] solvent-accessible surface areas, [`dihedrals`] the backbone's φ, ψ and ω, [`profile`] density profiles along a cell axis, [`density`] number densities on a 3-D grid averaged over frames (MDAnalysis's DensityAnalysis, VMD's volmap), and [`expr`] computes a number per atom
 //!   from a formula (OVITO's Compute property); [`hbonds`] finds hydrogen bonds by
 //!   MDAnalysis's geometric criterion.
+//! - [`energy`] reads energies over time: GROMACS energy files (`.edr`, every term with its
+//!   unit) and the thermo tables of LAMMPS logs (the runs joined), as named columns.
 //! - [`values`] reads per-atom numbers from a text file (an analysis result, a column or a row
 //!   per frame) to give the frames as a property.
 //! - [`volume`] reads volumetric data (Gaussian cube; VASP CHGCAR, CHG, PARCHG, LOCPOT, ELFCAR,
@@ -134,6 +136,7 @@ mod dlpoly;
 mod dx;
 mod eigen;
 pub mod elements;
+pub mod energy;
 mod error;
 pub mod expr;
 mod format;

@@ -28,7 +28,7 @@ use std::io::Cursor;
 use std::path::PathBuf;
 
 use support::alloc::CountingAlloc;
-use support::campaign::{Cuts, Field, Fixture, Settings, Verdict, run_campaign};
+use support::campaign::{Cuts, Field, Fixture, Settings, Verdict, line_starts, run_campaign};
 use texmap_md_io::{Error, Format, Frame, MAX_COORDINATE, ReadOptions, Trajectory, Writer};
 
 #[global_allocator]
@@ -507,14 +507,7 @@ fn gsd_fixture(name: &str, bytes: Vec<u8>) -> Fixture {
 /// coordinates) as fields.
 fn text_fixture(name: &str, format: Format) -> Fixture {
     let bytes = data(name);
-    let mut boundaries = vec![0];
-    boundaries.extend(
-        bytes
-            .iter()
-            .enumerate()
-            .filter(|(_, b)| **b == b'\n')
-            .map(|(i, _)| i + 1),
-    );
+    let boundaries = line_starts(&bytes);
     let mut fields = Vec::new();
     let mut i = 0;
     while i < bytes.len() && fields.len() < 16 {

@@ -62,3 +62,27 @@ pub fn obj_vertices(path: &std::path::Path) -> Vec<[f64; 3]> {
         })
         .collect()
 }
+
+/// The point lists of an SVG chart's polylines (`texmap plot`'s series, axes and grid).
+#[allow(dead_code)] // not every test binary draws charts
+pub fn svg_polylines(svg: &str) -> Vec<Vec<(f64, f64)>> {
+    svg.split("<polyline")
+        .skip(1)
+        .map(|p| {
+            let points = p
+                .split("points=\"")
+                .nth(1)
+                .unwrap()
+                .split('"')
+                .next()
+                .unwrap();
+            points
+                .split_whitespace()
+                .map(|xy| {
+                    let (x, y) = xy.split_once(',').unwrap();
+                    (x.parse().unwrap(), y.parse().unwrap())
+                })
+                .collect()
+        })
+        .collect()
+}

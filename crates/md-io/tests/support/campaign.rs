@@ -346,6 +346,19 @@ fn mutants(fx: &Fixture, s: &Settings) -> Vec<(&'static str, String, Vec<u8>)> {
     out
 }
 
+/// A text file's record boundaries: 0 and every line start.
+pub fn line_starts(bytes: &[u8]) -> Vec<usize> {
+    let mut starts = vec![0];
+    starts.extend(
+        bytes
+            .iter()
+            .enumerate()
+            .filter(|(_, b)| **b == b'\n')
+            .map(|(i, _)| i + 1),
+    );
+    starts
+}
+
 /// Runs the campaign of one reader over its fixtures.
 pub fn run_campaign(
     reader: &str,
