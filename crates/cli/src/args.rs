@@ -80,7 +80,7 @@ pub enum Command {
         /// file, frame and byte).
         #[arg(long)]
         allow_truncated: bool,
-        /// Topology (PDB, PDBx/mmCIF, GRO, PSF, AMBER prmtop, LAMMPS data file) of the trajectory's atoms: its
+        /// Topology (PDB, PDBx/mmCIF, GRO, PSF, AMBER prmtop, GROMACS .tpr, LAMMPS data file) of the trajectory's atoms: its
         /// atom, residue and bond counts are added, and a different atom count is an error.
         #[arg(long, value_name = "FILE")]
         topology: Option<PathBuf>,
@@ -479,7 +479,7 @@ pub struct StyleArgs {
             "first frame's drawn atoms, then fixed, so a colour means one value in every frame) with a\n",
             "colour bar (--no-color-bar to leave it out):\n",
             "  bfactor, occupancy   PDB columns 61-66 / 55-60, mmCIF B_iso_or_equiv / occupancy\n",
-            "  charge               partial charges of the --topology (PSF, AMBER prmtop, LAMMPS data)\n",
+            "  charge               partial charges of the --topology (PSF, AMBER prmtop, GROMACS tpr, LAMMPS data)\n",
             "  speed                |v| in Å/ps (GRO, TRR, NetCDF, LAMMPS vx vy vz, extended XYZ velo)\n",
             "  residue              the residue's position in the file, 0, 1, 2, ... (a rainbow along chains)\n",
             "  index                the atom index\n",
@@ -801,8 +801,8 @@ pub enum BondsArg {
     /// file's own), else by distance (covalent radii + 0.45 Å, minimum image in a periodic box).
     #[default]
     Auto,
-    /// Only the bonds the files list (PDB CONECT, PSF !NBOND, prmtop BONDS_*, LAMMPS data
-    /// Bonds, SDF/MOL and MOL2 bond blocks).
+    /// Only the bonds the files list (PDB CONECT, PSF !NBOND, prmtop BONDS_*, a .tpr's
+    /// chemical bonds, LAMMPS data Bonds, SDF/MOL and MOL2 bond blocks).
     Topology,
     /// No bonds.
     None,
@@ -948,7 +948,8 @@ pub struct MolArgs {
     /// Topology giving names, elements, residues and bonds to a trajectory of the same atoms
     /// (XTC, DCD, TRR, NetCDF carry coordinates only): PDB (CONECT bonds), PDBx/mmCIF or a crystallographic CIF (.cif),
     /// GRO, a CHARMM/NAMD PSF (.psf: !NBOND bonds), an AMBER prmtop (.prmtop, .parm7: bonds,
-    /// chains), or a LAMMPS data file (.data, .lmp, data.*).
+    /// chains), a GROMACS run input (.tpr: the force field's bonds, masses, charges, molecule
+    /// types as segments), or a LAMMPS data file (.data, .lmp, data.*).
     #[arg(long, value_name = "FILE")]
     pub topology: Option<PathBuf>,
     /// Draw only the atoms SEL selects, in the VMD/MDAnalysis language: 'not resname SOL',

@@ -4035,3 +4035,94 @@ fn style_aliases_and_a_rep_that_selects_nothing() {
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(!stderr(&o).contains("periodic box"), "{}", stderr(&o));
 }
+
+/// A GROMACS run input as the whole input (its starting frame) and as the topology: GROMACS
+/// 2022.5's file of two peptide chains in TIP4P water with ions (md-io's data/tpr/gen_tpr.py;
+/// the reference is `gmx dump` and `gmx editconf` of the same file).
+#[test]
+fn gromacs_tpr_renders_and_converts_as_gromacs_reads_it() {
+    let tpr = data("tpr/peptide.tpr.gz");
+    let mut text = String::new();
+    std::io::Read::read_to_string(
+        &mut flate2::read::GzDecoder::new(
+            std::fs::File::open(data("tpr/reference.json.gz")).unwrap(),
+        ),
+        &mut text,
+    )
+    .unwrap();
+    let r: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let want = &r["peptide.tpr.gz"];
+    let o = texmap(&["info", &tpr]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["format"], "tpr");
+    assert_eq!(v["atoms"], want["n_atoms"]);
+    assert_eq!(v["frames"], 1);
+    // Molecule types are the segments, counted as MDAnalysis's moltypes.
+    let mut counts: Vec<(String, u64)> = Vec::new();
+    for m in want["moltypes"].as_array().unwrap() {
+        let m = m.as_str().unwrap();
+        match counts.iter_mut().find(|(k, _)| k == m) {
+            Some((_, n)) => *n += 1,
+            None => counts.push((m.to_string(), 1)),
+        }
+    }
+    assert_eq!(v["segments"], serde_json::json!(counts));
+    // The protein written as PDB: gmx dump's positions to the PDB's 0.001 Å, gmx editconf's
+    // residue numbers.
+    let dir = tempfile::tempdir().unwrap();
+    let pdb = dir.path().join("protein.pdb");
+    let o = texmap(&[
+        "convert",
+        &tpr,
+        "--select",
+        "segid Protein_chain_A Protein_chain_B",
+        "-o",
+        pdb.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(&pdb).unwrap();
+    let atoms: Vec<&str> = text.lines().filter(|l| l.starts_with("ATOM")).collect();
+    let n = want["moltypes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|m| m.as_str().unwrap().starts_with("Protein"))
+        .count();
+    assert_eq!(atoms.len(), n);
+    for (k, line) in atoms.iter().enumerate() {
+        let x: Vec<f64> = (0..3)
+            .map(|d| line[30 + 8 * d..38 + 8 * d].trim().parse().unwrap())
+            .collect();
+        let p = &want["positions"][k];
+        for d in 0..3 {
+            assert!(
+                (x[d] - p[d].as_f64().unwrap()).abs() <= 6e-4,
+                "atom {k}: {line}"
+            );
+        }
+        let resid: i64 = line[22..26].trim().parse().unwrap();
+        assert_eq!(resid, want["resids"][k].as_i64().unwrap(), "{line}");
+        // Chain A holds residues 1-8 of the PDB, chain B 20-27 (pdb2gmx -chainsep id).
+        assert_eq!(&line[21..22], if resid <= 8 { "A" } else { "B" }, "{line}");
+    }
+    // Drawn with the .tpr's own bonds, molecules made whole across the box.
+    let png = render_png(
+        dir.path(),
+        &[
+            &tpr,
+            "--select",
+            "not segid SOL",
+            "--bonds",
+            "topology",
+            "--pbc",
+            "unwrap",
+            "--style",
+            "licorice",
+            "--size",
+            "96x72",
+        ],
+        "tpr.png",
+    );
+    assert!(png.starts_with(b"\x89PNG"));
+}

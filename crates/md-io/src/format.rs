@@ -82,11 +82,16 @@ pub enum Format {
     /// (eV/Å); its data grids are checked, not kept (see [`crate::volume::read_volumes`]):
     /// `.xsf`, `.axsf`.
     Xsf,
+    /// GROMACS run input (`.tpr`, from `grompp`): its starting frame (positions, velocities,
+    /// box) with the topology it compiles (names, types, residues, molecule types as segments,
+    /// masses, charges and the force field's chemical bonds): see [`crate::read_tpr`]; by
+    /// name: `tpr`.
+    Tpr,
 }
 
 impl Format {
     /// Every format, in declaration order.
-    pub const ALL: [Format; 25] = [
+    pub const ALL: [Format; 26] = [
         Format::Xyz,
         Format::Pdb,
         Format::Gro,
@@ -112,6 +117,7 @@ impl Format {
         Format::Tinker,
         Format::DlPoly,
         Format::Xsf,
+        Format::Tpr,
     ];
 
     /// The format a file extension (case-insensitive, e.g. "xyz", "lammpstrj") or a format's
@@ -144,6 +150,7 @@ impl Format {
             "txyz" | "arc" => Format::Tinker,
             "dlpoly" => Format::DlPoly,
             "xsf" | "axsf" => Format::Xsf,
+            "tpr" => Format::Tpr,
             _ => return None,
         })
     }
@@ -213,6 +220,10 @@ impl Format {
         // DCD: a Fortran record of 84 bytes (either endianness) starting with "CORD".
         if (le(0) == Some(84) || be(0) == Some(84)) && head.get(4..8) == Some(b"CORD") {
             return Some(Format::Dcd);
+        }
+        // GROMACS .tpr: an XDR string "VERSION ..." first (two lengths, then the text).
+        if head.get(8..15) == Some(b"VERSION") {
+            return Some(Format::Tpr);
         }
         // NetCDF-3: "CDF" and the version byte 1 (classic) or 2 (64-bit offset).
         if matches!(head.get(..4), Some(b"CDF\x01" | b"CDF\x02")) {
@@ -461,6 +472,7 @@ impl Format {
             Format::Tinker => "txyz",
             Format::DlPoly => "dlpoly",
             Format::Xsf => "xsf",
+            Format::Tpr => "tpr",
         }
     }
 }

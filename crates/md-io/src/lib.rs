@@ -27,8 +27,9 @@
 //! - [`Sequence`] reads a trajectory in several files (a run continued in parts, a LAMMPS
 //!   dump per step: [`sequence::expand`] for `dump.*.lammpstrj`) as one.
 //! - [`Topology`] reads atom names, elements, residues and bonds (PDB, PDBx/mmCIF, GRO, PSF,
-//!   AMBER prmtop, LAMMPS data file) and gives them to the frames of a coordinate-only trajectory of the same
-//!   atoms.
+//!   AMBER prmtop, GROMACS .tpr, LAMMPS data file) and gives them to the frames of a
+//!   coordinate-only trajectory of the same atoms; [`read_tpr`] also gives a .tpr's starting
+//!   positions, velocities and box.
 //! - [`bonds`] finds bonds by distance (covalent radii, a cell grid, minimum image) and [`pbc`]
 //!   wraps atoms into the box or makes bonded molecules whole across it; [`replicate`] copies a
 //!   frame and its bonds along the cell vectors (periodic images, as OVITO's Replicate);
@@ -185,6 +186,7 @@ pub mod survival;
 mod text;
 mod tinker;
 mod topology;
+mod tpr;
 mod trajectory;
 mod trr;
 pub mod vacf;
@@ -207,6 +209,7 @@ pub use select::{Selection, SelectionError};
 pub use sequence::Sequence;
 pub use style::{Appearance, AtomStyle, Selector, atom_element};
 pub use topology::{Topology, TopologyFormat};
+pub use tpr::{Tpr, read_tpr};
 pub use trajectory::{FrameSource, ReadOptions, Trajectory};
 pub use writer::Writer;
 

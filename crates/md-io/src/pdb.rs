@@ -413,6 +413,8 @@ impl FrameWalk for Pdb {
 
 /// Writes frames as PDB: one MODEL … ENDMDL per frame, a CRYST1 when the frame has a cell,
 /// hybrid-36 serial and residue numbers, element symbols in columns 77-78, END at `finish`.
+/// Segments longer than columns 73-76 keep their first 4 characters (MDAnalysis's and VMD's
+/// rule); names, residue names and chains that do not fit are errors.
 pub(crate) struct PdbWriter<W> {
     pub out: W,
     pub models: usize,
@@ -460,9 +462,6 @@ impl<W: std::io::Write> PdbWriter<W> {
                  structures as XYZ, or rename the chains)",
                 frame.chains[i].as_str()
             ));
-        }
-        if let Some(i) = frame.segments.iter().position(|l| l.len() > 4) {
-            return Err(format!("atom {i}'s segment is longer than 4 characters"));
         }
         for (name, _) in SCALARS {
             let fits = |v: &f32| (-99.995..999.995).contains(v);
@@ -529,7 +528,10 @@ impl<W: std::io::Write> PdbWriter<W> {
             let resid = hy36_encode(resid, 4).unwrap_or_else(|| "****".into());
             let chain = frame.chains.get(i).map_or(" ", |l| l.as_str());
             let chain = if chain.is_empty() { " " } else { chain };
+            // A longer segment (a GROMACS molecule type) keeps its first 4 characters, as
+            // MDAnalysis and VMD write it: the column is informational and 4 wide.
             let seg = frame.segments.get(i).map_or("", |l| l.as_str());
+            let seg = seg.char_indices().nth(4).map_or(seg, |(k, _)| &seg[..k]);
             writeln!(
                 w,
                 "ATOM  {serial}{name:>5} {res:<4}{chain}{resid}    {:8.3}{:8.3}{:8.3}{:6.2}{:6.2}      {seg:<4}{sym:>2}",

@@ -69,6 +69,9 @@ pub enum TopologyFormat {
     Psf,
     /// AMBER prmtop/parm7: atoms, residues, bonds and chains (see the `prmtop` module).
     Prmtop,
+    /// GROMACS run input (.tpr): atoms with masses and charges, residues, molecule types and
+    /// the force field's chemical bonds (see the `tpr` module).
+    Tpr,
 }
 
 impl TopologyFormat {
@@ -93,6 +96,7 @@ impl TopologyFormat {
             "cif" | "mmcif" => TopologyFormat::Mmcif,
             "data" | "lmp" => TopologyFormat::LammpsData,
             "psf" => TopologyFormat::Psf,
+            "tpr" => TopologyFormat::Tpr,
             "prmtop" | "parm7" | "top" => TopologyFormat::Prmtop,
             _ => return None,
         })
@@ -122,9 +126,12 @@ pub struct Topology {
     pub chains: Vec<Label>,
     /// Segment identifiers (PSF `segid`, PDB columns 73-76).
     pub segments: Vec<Label>,
-    /// Partial charges in e (PSF, AMBER prmtop, LAMMPS data styles `full` and `charge`); given
-    /// to frames as their `charge` property.
+    /// Partial charges in e (PSF, AMBER prmtop, GROMACS .tpr, LAMMPS data styles `full` and
+    /// `charge`); given to frames as their `charge` property.
     pub charges: Vec<f32>,
+    /// Masses in u as the force field gives them (GROMACS .tpr: united atoms, heavy hydrogens,
+    /// coarse-grained beads); given to frames as their `mass` property.
+    pub masses: Vec<f32>,
     /// Bonds as atom index pairs `[i, j]` with `i < j`, sorted, each once.
     pub bonds: Vec<[u32; 2]>,
     /// The periodic box's angles in degrees, when the topology gives them (AMBER prmtop
@@ -236,7 +243,7 @@ impl Topology {
         let Some(format) = TopologyFormat::from_path(path) else {
             return Err(Error::Unsupported {
                 file: name,
-                what: "topology format (expected .pdb, .gro, .cif/.mmcif, .psf, .prmtop/.parm7, or a LAMMPS data file: .data, .lmp, data.*)",
+                what: "topology format (expected .pdb, .gro, .cif/.mmcif, .psf, .prmtop/.parm7, .tpr, or a LAMMPS data file: .data, .lmp, data.*)",
             });
         };
         Topology::open_as(path, format)
@@ -335,6 +342,14 @@ impl Topology {
             }
             TopologyFormat::Psf => crate::psf::read_psf(src, &file),
             TopologyFormat::Prmtop => crate::prmtop::read_prmtop(src, &file),
+            TopologyFormat::Tpr => {
+                let mut bytes = Vec::new();
+                src.read_to_end(&mut bytes).map_err(|source| Error::Io {
+                    at: Location::file(&file),
+                    source,
+                })?;
+                Ok(crate::tpr::read_tpr(&bytes, &file)?.topology)
+            }
         }
     }
 
@@ -375,6 +390,7 @@ impl Topology {
             chains: Vec::new(),
             segments: Vec::new(),
             charges: Vec::new(),
+            masses: Vec::new(),
             bonds,
             box_angles: None,
         }
@@ -398,6 +414,7 @@ impl Topology {
                 .property("charge")
                 .map(<[f32]>::to_vec)
                 .unwrap_or_default(),
+            masses: Vec::new(),
             bonds: f.bonds.clone(),
             box_angles: None,
         }
@@ -424,6 +441,7 @@ impl Topology {
             chains: frame.chains.clone(),
             segments: frame.segments.clone(),
             charges: Vec::new(),
+            masses: Vec::new(),
             bonds: Vec::new(),
             box_angles: None,
         }
@@ -502,6 +520,9 @@ impl Topology {
         }
         if !self.charges.is_empty() {
             frame.property_mut("charge").clone_from(&self.charges);
+        }
+        if !self.masses.is_empty() {
+            frame.property_mut("mass").clone_from(&self.masses);
         }
         Ok(())
     }

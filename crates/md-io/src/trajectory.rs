@@ -58,6 +58,7 @@ enum Reader<R> {
     CharmmCrd(TextReader<R, Crd>),
     Pqr(TextReader<R, Pqr>),
     Xsf(TextReader<R, Xsf>),
+    Tpr(crate::tpr::TprReader),
 }
 
 /// Runs `$body` with `$r` bound to the format's reader, whatever the format.
@@ -88,6 +89,7 @@ macro_rules! each_reader {
             Reader::CharmmCrd($r) => $body,
             Reader::Pqr($r) => $body,
             Reader::Xsf($r) => $body,
+            Reader::Tpr($r) => $body,
         }
     };
 }
@@ -388,6 +390,7 @@ impl<R: Read + Seek> Trajectory<R> {
             Format::Netcdf => Reader::Netcdf(NetcdfReader::new(src, file.clone())?),
             Format::Gsd => Reader::Gsd(GsdReader::new(src, file.clone())?),
             Format::NamdBin => Reader::NamdBin(NamdBinReader::new(src, file.clone())?),
+            Format::Tpr => Reader::Tpr(crate::tpr::TprReader::new(src, file.clone())?),
             Format::Tinker => Reader::Tinker(TextReader::new(src, Tinker::default(), file.clone())),
             Format::DlPoly => Reader::DlPoly(TextReader::new(src, DlPoly::default(), file.clone())),
             Format::Pdb => Reader::Pdb(TextReader::new(src, Pdb::new(lenient), file.clone())),

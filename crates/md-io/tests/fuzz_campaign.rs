@@ -776,6 +776,33 @@ fn namdbin_campaign() {
 }
 
 #[test]
+fn tpr_campaign() {
+    // GROMACS 2022's layout (the body's size declared: any cut is an error) and 4.0.7's
+    // (XDR throughout, no size: a cut in the run parameters, which are not read, still reads).
+    let fx = [
+        ("tpr/dummy_2022-rc1.tpr", 52, 212, Cuts::Declared),
+        ("tpr/vsites_4.0.7.tpr", 36, 196, Cuts::Unchecked),
+    ]
+    .map(|(name, natoms, symbols, cuts)| {
+        let bytes = data(name);
+        let len = bytes.len();
+        Fixture {
+            frames: frames_of(Format::Tpr, &bytes),
+            name: name.into(),
+            bytes,
+            boundaries: vec![0, natoms, symbols, len],
+            cuts,
+            fields: vec![
+                ("natoms", Field::I32Be(natoms)),
+                ("symbols", Field::I32Be(symbols)),
+            ],
+            text: false,
+        }
+    });
+    campaign("GROMACS tpr", Format::Tpr, fx.into());
+}
+
+#[test]
 fn tinker_campaign() {
     let files = ["tinker/water_box.arc", "tinker/caffeine.txyz"];
     let fx = files.map(|f| text_fixture(f, Format::Tinker));
