@@ -1273,7 +1273,8 @@ pub struct AnalysisArgs {
     /// (MDAnalysis's radius_of_gyration and asphericity, gmx gyrate): frame, time (ps, when the
     /// file has it), rg (Å), rg_x, rg_y, rg_z (about the axes through the centre) and
     /// asphericity (the gyration tensor's relative shape anisotropy: 0 a sphere, 1 a rod),
-    /// mass-weighted unless --gyration-unweighted. The atoms are taken as they are after --pbc:
+    /// mass-weighted (the masses a .tpr or LAMMPS data file gives, else the elements') unless
+    /// --gyration-unweighted. The atoms are taken as they are after --pbc:
     /// give --pbc unwrap for a molecule the trajectory wrapped. Written whole or not at all.
     #[arg(long, value_name = "FILE.csv")]
     pub gyration_table: Option<PathBuf>,
@@ -1958,7 +1959,8 @@ pub struct AnalysisArgs {
     /// have names (MDAnalysis's AlignTraj with a reference universe).
     #[arg(long, value_name = "FILE", requires = "align")]
     pub align_to: Option<PathBuf>,
-    /// Weight --align's fit by the atoms' masses (their elements' standard atomic weights), as
+    /// Weight --align's fit by the atoms' masses (the topology's or file's masses: a GROMACS
+    /// .tpr, a LAMMPS data file; else their elements' standard atomic weights), as
     /// MDAnalysis's AlignTraj(weights="mass").
     #[arg(long, requires = "align")]
     pub align_mass: bool,

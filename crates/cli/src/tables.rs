@@ -319,17 +319,16 @@ fn gyration_row(
     }
     let mut weights = Vec::with_capacity(atoms.len());
     for &i in &atoms {
-        let w = if by_mass {
-            texmap_md_io::atom_element(md, i).mass()
-        } else {
-            1.0
-        };
-        if w <= 0.0 {
+        let w = if by_mass { mass_of(md, i) } else { Some(1.0) };
+        let Some(w) = w else {
             bail!(
-                "--gyration-table: atom {i} of frame {f} has no element, so no mass (give --gyration-unweighted)"
+                "--gyration-table: atom {i} of frame {f} has no mass: no element, and the files give none (give --gyration-unweighted)"
             );
-        }
+        };
         weights.push(w);
+    }
+    if weights.iter().sum::<f64>() <= 0.0 {
+        bail!("--gyration-table: frame {f}: every atom --gyration-select picks is massless");
     }
     let positions: Vec<[f32; 3]> = atoms.iter().map(|&i| md.positions[i]).collect();
     let g = texmap_md_io::shape::gyration(&positions, &weights)
@@ -1647,7 +1646,7 @@ struct VelocityTables {
     times: Vec<Option<f64>>,
     kinds: Vec<texmap_md_io::Label>,
     kind: Vec<usize>,
-    /// Each atom's mass, or `None` when an atom has no element (the spectrum is then unweighted):
+    /// Each atom's mass, or `None` when an atom has none (no element, no mass in the files) (the spectrum is then unweighted):
     /// the index of the first such atom.
     mass: std::result::Result<Vec<f64>, usize>,
     integrate: Option<f64>,
@@ -1671,12 +1670,10 @@ impl VelocityTables {
         }
         if self.all.frames() == 0 {
             self.kind = kinds_of(md, &mut self.kinds).unwrap_or_default();
-            let mass: Vec<f64> = (0..md.n_atoms())
-                .map(|i| texmap_md_io::atom_element(md, i).mass())
-                .collect();
-            self.mass = match mass.iter().position(|m| *m <= 0.0) {
+            let mass: Vec<Option<f64>> = (0..md.n_atoms()).map(|i| mass_of(md, i)).collect();
+            self.mass = match mass.iter().position(Option::is_none) {
                 Some(i) => Err(i),
-                None => Ok(mass),
+                None => Ok(mass.into_iter().flatten().collect()),
             };
         }
         self.all
@@ -1735,7 +1732,7 @@ impl VelocityTables {
                 Ok(m) => m.clone(),
                 Err(i) => {
                     eprintln!(
-                        "texmap: warning: --vdos-table: atom {i} has no element, so no mass: the spectrum over every atom is unweighted"
+                        "texmap: warning: --vdos-table: atom {i} has no mass (no element, and the files give none): the spectrum over every atom is unweighted"
                     );
                     vec![1.0; self.kind.len()]
                 }
@@ -2791,4 +2788,15 @@ pub(crate) fn hbond_rows(f: usize, bonds: &[texmap_md_io::hbonds::HBond], md: &M
         );
     }
     out
+}
+
+/// Atom `i`'s mass for a mass-weighted analysis: the file's (a massless virtual site's 0
+/// included) or its element's; `None` when it has neither (no element, no mass in the files).
+fn mass_of(md: &MdFrame, i: usize) -> Option<f64> {
+    let given = md
+        .property("mass")
+        .and_then(|m| m.get(i))
+        .is_some_and(|m| m.is_finite());
+    let m = texmap_md_io::atom_mass(md, i);
+    (m > 0.0 || (given && m == 0.0)).then_some(m)
 }

@@ -4125,4 +4125,35 @@ fn gromacs_tpr_renders_and_converts_as_gromacs_reads_it() {
         "tpr.png",
     );
     assert!(png.starts_with(b"\x89PNG"));
+    // Mass-weighted radii of gyration with the .tpr's masses (TIP4P's massless sites
+    // included), as MDAnalysis computes them from the same file.
+    let csv = dir.path().join("rg.csv");
+    for (select, key) in [
+        ("all", "rgyr_all"),
+        ("segid Protein_chain_A Protein_chain_B", "rgyr_protein"),
+    ] {
+        let o = texmap(&[
+            "convert",
+            &tpr,
+            "--gyration-table",
+            csv.to_str().unwrap(),
+            "--gyration-select",
+            select,
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let text = std::fs::read_to_string(&csv).unwrap();
+        let row: Vec<&str> = text.lines().nth(1).unwrap().split(',').collect();
+        let rg: f64 = row[2].parse().unwrap();
+        let want = want[key].as_f64().unwrap();
+        assert!((rg - want).abs() < 2e-4, "{select}: rg {rg} against {want}");
+    }
+    // Beads of no element (type TA, 72 u): their masses come from the .tpr, where element
+    // masses would have none.
+    let o = texmap(&[
+        "convert",
+        &data("tpr/dummy_2022-rc1.tpr"),
+        "--gyration-table",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
 }

@@ -16,7 +16,7 @@
 //! primary := NUMBER | NAME | NAME "(" expr ("," expr)* ")" | "(" expr ")"
 //! ```
 //! Names: `x`, `y`, `z` (position, Å), `vx`, `vy`, `vz` (velocity), `index` (from 0), `id` (the
-//! file's atom id, else index + 1), `mass` (the element's, u), `N` (the atom count), `pi`, and
+//! file's atom id, else index + 1), `mass` (u: the file's mass where it gives one, else the element's), `N` (the atom count), `pi`, and
 //! every per-atom property of the frame by its name ([`Frame::property`]: `bfactor`, `charge`,
 //! `c_pe`, `v_stress[1]`, or one computed earlier). Functions: `sqrt`, `abs`, `exp`, `ln` and
 //! `log` (natural), `log10`, `log2`, `sin`, `cos`, `tan`, `asin`, `acos`, `atan`, `sinh`,
@@ -645,11 +645,7 @@ fn variable(name: &str, frame: &Frame) -> Result<Column, ExprError> {
             Column::Atoms(frame.ids.iter().map(|v| *v as f64).collect())
         }
         "id" => Column::Atoms((0..n).map(|i| i as f64 + 1.0).collect()),
-        "mass" => Column::Atoms(
-            (0..n)
-                .map(|i| crate::atom_element(frame, i).mass())
-                .collect(),
-        ),
+        "mass" => Column::Atoms((0..n).map(|i| crate::atom_mass(frame, i)).collect()),
         "N" => Column::Scalar(n as f64),
         "pi" => Column::Scalar(std::f64::consts::PI),
         _ => {

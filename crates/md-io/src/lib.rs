@@ -207,7 +207,7 @@ pub use frame::{BOND_AROMATIC, Frame, Label, MAX_COORDINATE, Property, UnitCell}
 pub use mmcif::is_altloc_warning;
 pub use select::{Selection, SelectionError};
 pub use sequence::Sequence;
-pub use style::{Appearance, AtomStyle, Selector, atom_element};
+pub use style::{Appearance, AtomStyle, Selector, atom_element, atom_mass};
 pub use topology::{Topology, TopologyFormat};
 pub use tpr::{Tpr, read_tpr};
 pub use trajectory::{FrameSource, ReadOptions, Trajectory};

@@ -43,7 +43,7 @@ pub struct DensityProfile {
     pub position: Vec<f64>,
     /// Atoms per Å³.
     pub number: Vec<f64>,
-    /// g/cm³.
+    /// g/cm³, of the atoms' masses ([`crate::atom_mass`]: the file's, else the element's).
     pub mass: Vec<f64>,
     /// Elementary charges per Å³, when the frame has charges.
     pub charge: Option<Vec<f64>>,
@@ -126,7 +126,7 @@ pub fn density_profile(
         let s = if periodic { s - s.floor() } else { s.max(0.0) };
         let b = ((s * bins as f64) as usize).min(bins - 1);
         number[b] += 1.0;
-        mass[b] += crate::atom_element(frame, i).mass();
+        mass[b] += crate::atom_mass(frame, i);
         if let (Some(sum), Some(q)) = (&mut charge, charges) {
             let q = f64::from(q[i]);
             if q.is_finite() {

@@ -1,4 +1,5 @@
-//! How an atom is drawn: [`atom_element`] (its element, given or guessed) and [`AtomStyle`],
+//! How an atom is drawn: [`atom_element`] (its element, given or guessed), [`atom_mass`] (the
+//! file's mass, else the element's) and [`AtomStyle`],
 //! the user's radius and colour overrides per type, name or element, over the file's own
 //! columns and the element tables of [`crate::elements`].
 
@@ -20,6 +21,31 @@ pub fn atom_element(frame: &Frame, i: usize) -> Element {
                 (None, None) => Element::UNKNOWN,
             }
         }
+    }
+}
+
+/// The mass of atom `i` of `frame` in u: the frame's `mass` property where it holds a finite
+/// number (the masses a GROMACS .tpr, a LAMMPS data file, a HOOMD GSD or a DL_POLY file give:
+/// united atoms, coarse-grained beads, heavy hydrogens, massless virtual sites), else the
+/// standard atomic weight of [`atom_element`]'s element (0 for an unknown element).
+///
+/// ```
+/// use texmap_md_io::{Frame, atom_mass};
+/// let mut f = Frame::new();
+/// f.positions = vec![[0.0; 3]; 2];
+/// f.elements = vec![texmap_md_io::elements::Element::from_symbol("C").unwrap(); 2];
+/// assert!((atom_mass(&f, 0) - 12.011).abs() < 1e-3);
+/// f.properties.push(texmap_md_io::Property {
+///     name: "mass".into(),
+///     values: vec![14.027, f32::NAN], // a united-atom CH2, then no value
+/// });
+/// assert!((atom_mass(&f, 0) - 14.027).abs() < 1e-5);
+/// assert!((atom_mass(&f, 1) - 12.011).abs() < 1e-3);
+/// ```
+pub fn atom_mass(frame: &Frame, i: usize) -> f64 {
+    match frame.property("mass").and_then(|m| m.get(i)) {
+        Some(m) if m.is_finite() => *m as f64,
+        _ => atom_element(frame, i).mass(),
     }
 }
 

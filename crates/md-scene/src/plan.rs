@@ -1041,7 +1041,7 @@ impl MolPlan {
                     let weights = alignment.mass_weighted.then(|| {
                         target_atoms
                             .iter()
-                            .map(|&j| atom_element(target, j).mass())
+                            .map(|&j| texmap_md_io::atom_mass(target, j))
                             .collect::<Vec<f64>>()
                     });
                     if weights
