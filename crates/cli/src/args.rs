@@ -58,7 +58,9 @@ pub enum Command {
     /// false along a LAMMPS `ff`/`ss` or extended XYZ `F` edge), chains and segments (with their
     /// atom counts), per-atom properties, the first frame's secondary structure (DSSP: helix,
     /// strand, coil) and first positions as one JSON object; for a topology
-    /// file (PSF, AMBER prmtop) its atoms, residues, bonds, chains and segments.
+    /// file (PSF, AMBER prmtop) its atoms, residues, bonds, chains and segments; for a GROMACS
+    /// energy file (.edr) or a LAMMPS log its terms with units, rows, time span and each
+    /// term's mean, minimum and maximum.
     Info {
         /// Trajectory file (XYZ, extended XYZ, PDB, PDBx/mmCIF, GRO, LAMMPS dump, DCD, XTC, TRR,
         /// AMBER NetCDF, AMBER ASCII mdcrd (with --topology: the file has no atom count) and

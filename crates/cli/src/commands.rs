@@ -221,6 +221,20 @@ fn info(
     {
         return topology_info(file);
     }
+    // A GROMACS energy file or a LAMMPS log holds energies over time, no atoms.
+    if format.is_none() {
+        let mut head = Vec::new();
+        if let Ok(f) = std::fs::File::open(file) {
+            let _ = std::io::Read::read_to_end(&mut std::io::Read::take(f, 4096), &mut head);
+        }
+        let edr = file
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("edr"))
+            || texmap_md_io::energy::is_edr(&head);
+        if edr || texmap_md_io::energy::is_lammps_log(&head) {
+            return energy_info(file, edr);
+        }
+    }
     // An OpenDX file or a CCP4/MRC map holds a grid and no atoms.
     let grid_only = match texmap_md_io::volume::VolumeFormat::from_path(file) {
         Some(texmap_md_io::volume::VolumeFormat::Dx) => Some("OpenDX"),
@@ -353,6 +367,53 @@ fn topology_info(file: &Path) -> Result<()> {
     }
     if !t.charges.is_empty() {
         obj["properties"] = json!(["charge"]);
+    }
+    println!("{obj}");
+    Ok(())
+}
+
+/// `texmap info` of a GROMACS energy file or a LAMMPS log: its terms (with units) as `gmx
+/// energy`'s menu lists them, the rows and the span of time or steps, and each term's mean,
+/// minimum and maximum over the rows that have it (the averages `gmx energy` prints).
+fn energy_info(file: &Path, edr: bool) -> Result<()> {
+    use texmap_md_io::energy;
+    let t = if edr {
+        energy::read_edr(file)?
+    } else {
+        energy::read_lammps_log(file)?
+    };
+    let x = if edr { "Time" } else { "Step" };
+    let span = t.column(x).map(|c| {
+        let finite: Vec<f64> = c.iter().copied().filter(|v| v.is_finite()).collect();
+        json!([finite.first(), finite.last()])
+    });
+    let terms: Vec<serde_json::Value> = t
+        .names
+        .iter()
+        .zip(&t.units)
+        .zip(&t.columns)
+        .filter(|((name, _), _)| name.as_str() != x)
+        .map(|((name, unit), c)| {
+            let v: Vec<f64> = c.iter().copied().filter(|v| v.is_finite()).collect();
+            let mean = (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64);
+            let min = v.iter().copied().reduce(f64::min);
+            let max = v.iter().copied().reduce(f64::max);
+            json!({ "name": name, "unit": unit, "mean": mean, "min": min, "max": max })
+        })
+        .collect();
+    let mut obj = json!({
+        "file": file.display().to_string(),
+        "format": if edr { "edr" } else { "lammps-log" },
+        "rows": t.n_rows(),
+        "terms": terms,
+    });
+    obj[if edr { "time_ps" } else { "steps" }] = span.unwrap_or(serde_json::Value::Null);
+    if !edr {
+        obj["runs"] = json!(t.runs);
+        obj["skipped_lines"] = json!(t.skipped_lines);
+    }
+    if t.truncated_rows > 0 {
+        obj["truncated_rows"] = json!(t.truncated_rows);
     }
     println!("{obj}");
     Ok(())

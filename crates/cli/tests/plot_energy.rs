@@ -175,3 +175,55 @@ fn plot_refuses_unknown_terms_listing_the_files_terms() {
     assert!(stderr(&o).contains("frame 10, byte"), "{}", stderr(&o));
     assert!(!out.exists());
 }
+
+/// `texmap info` lists an energy file's terms with their units (pyedr's) and each term's mean
+/// over the frames, and a log's thermo keywords over its runs.
+#[test]
+fn info_lists_the_terms_and_their_means() {
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(energy_data("edr_reference.json")).unwrap())
+            .unwrap();
+    let want = &r["water"];
+    let o = run_ok(&["info", &energy_data("water.edr")]);
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["format"], "edr");
+    let names: Vec<&str> = want["names"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|n| n.as_str().unwrap())
+        .filter(|n| *n != "Time")
+        .collect();
+    let terms = v["terms"].as_array().unwrap();
+    assert_eq!(terms.len(), names.len());
+    let times = want["values"]["Time"].as_array().unwrap();
+    assert_eq!(v["rows"].as_u64().unwrap() as usize, times.len());
+    assert_eq!(v["time_ps"][0], times[0]);
+    for (t, name) in terms.iter().zip(&names) {
+        assert_eq!(t["name"], *name);
+        assert_eq!(t["unit"], want["units"][name]);
+        let values: Vec<f64> = want["values"][name]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect();
+        let mean = values.iter().sum::<f64>() / values.len() as f64;
+        let got = t["mean"].as_f64().unwrap();
+        assert!(
+            (got - mean).abs() <= 1e-9 * mean.abs().max(1.0),
+            "{name}: {got} against {mean}"
+        );
+    }
+    let o = run_ok(&["info", &energy_data("melt.log.lammps")]);
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["format"], "lammps-log");
+    assert_eq!(v["runs"], 4);
+    assert!(
+        v["terms"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|t| t["name"] == "Temp")
+    );
+}
