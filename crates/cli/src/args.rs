@@ -954,11 +954,20 @@ pub struct MolArgs {
     /// types as segments), or a LAMMPS data file (.data, .lmp, data.*).
     #[arg(long, value_name = "FILE")]
     pub topology: Option<PathBuf>,
+    /// A GROMACS index file (.ndx, from gmx make_ndx or gmx select -on): its groups become the
+    /// selection keyword 'group NAME' or 'group N' (numbered from 0 as make_ndx lists them; a
+    /// name matches exactly, in any case or by a unique prefix, as GROMACS matches it; quote a
+    /// name with parentheses): --index index.ndx --select 'group Protein_LIG or group 13'.
+    #[arg(long, value_name = "FILE.ndx")]
+    pub index: Option<PathBuf>,
     /// Draw only the atoms SEL selects, in the VMD/MDAnalysis language: 'not resname SOL',
     /// 'name CA', 'element O and resid 1 to 20', 'chain A', 'segid PROA',
     /// 'protein or within 5 of resname LIG', 'byres around 5 resname LIG' (whole residues),
     /// 'same resname as within 3 of name NA', 'helix', 'not cna fcc' (crystal defects), 'prop bfactor > 50' (VMD: 'beta > 50'),
-    /// 'prop abs charge > 0.5'. within/around/byres/same...as take the rest of the expression,
+    /// 'prop abs charge > 0.5', 'mass 30 to 40', 'bonded name CA', 'same fragment as resname LIG',
+    /// 'sphzone 8 resname LIG' (about its centre), 'cyzone 10 5 -5 resname LIG',
+    /// 'isolayer 0 3.5 protein' (a solvation shell), 'group Pocket' (with --index).
+    /// within/around/byres/same...as and the zones take the rest of the expression,
     /// as MDAnalysis reads it: parenthesise to end them sooner. within and around reach through
     /// the periodic box, as MDAnalysis's do.
     #[arg(long, value_name = "SEL")]

@@ -52,8 +52,14 @@ pub fn run(cli: Cli) -> Result<()> {
             allow_truncated,
             topology.as_deref(),
         ),
-        Command::Render(a) => render(&a),
-        Command::Convert(a) => crate::convert::convert(&a),
+        Command::Render(a) => {
+            crate::scene::load_index(a.mol.index.as_deref())?;
+            render(&a)
+        }
+        Command::Convert(a) => {
+            crate::scene::load_index(a.index.as_deref())?;
+            crate::convert::convert(&a)
+        }
         Command::Compare(a) => compare(&a),
         Command::Demo {
             out,

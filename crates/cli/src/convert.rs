@@ -36,6 +36,12 @@ pub struct ConvertArgs {
     /// render.
     #[arg(long, value_name = "FILE")]
     pub topology: Option<PathBuf>,
+    /// A GROMACS index file (.ndx, from gmx make_ndx or gmx select -on): its groups become the
+    /// selection keyword 'group NAME' or 'group N' (numbered from 0 as make_ndx lists them; a
+    /// name matches exactly, in any case or by a unique prefix, as GROMACS matches it; quote a
+    /// name with parentheses): --index index.ndx --select 'group Protein_LIG or group 13'.
+    #[arg(long, value_name = "FILE.ndx")]
+    pub index: Option<PathBuf>,
     /// Frames to write, A:B:STEP (B exclusive, each part optional: "::10", "5:", "3").
     #[arg(long, default_value = "0:")]
     pub frames: String,
@@ -139,6 +145,7 @@ fn plan_args(a: &ConvertArgs) -> Result<(MolArgs, StyleArgs)> {
     }
     let mut mol: MolArgs = defaults()?;
     mol.topology = a.topology.clone();
+    mol.index = a.index.clone();
     mol.analysis = a.analysis.clone();
     Ok((mol, defaults()?))
 }

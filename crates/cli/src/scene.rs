@@ -406,9 +406,33 @@ pub fn open_topology(path: &std::path::Path) -> Result<Topology> {
     Ok(Topology::open(path)?)
 }
 
-/// A parsed selection, or a usage error pointing at the bad token's column.
+/// The groups of `--index FILE.ndx`, for every selection's `group` keyword: read once, before
+/// any selection is parsed (one command per process).
+static INDEX_GROUPS: std::sync::OnceLock<texmap_md_io::ndx::IndexGroups> =
+    std::sync::OnceLock::new();
+
+/// Reads `--index`'s file, when given, for [`parse_selection`].
+pub(crate) fn load_index(path: Option<&std::path::Path>) -> Result<()> {
+    if let Some(path) = path {
+        let groups = texmap_md_io::ndx::IndexGroups::read(path)?;
+        if groups.is_empty() {
+            anyhow::bail!("{}: no '[ name ]' group in this index file", path.display());
+        }
+        let _ = INDEX_GROUPS.set(groups);
+    }
+    Ok(())
+}
+
+/// The `--index` groups, if any.
+pub(crate) fn index_groups() -> Option<&'static texmap_md_io::ndx::IndexGroups> {
+    INDEX_GROUPS.get()
+}
+
+/// A parsed selection (with the `--index` groups), or a usage error pointing at the bad
+/// token's column.
 pub(crate) fn parse_selection(flag: &str, text: &str) -> Result<Selection> {
-    Selection::parse(text).map_err(|e| crate::args::UsageError(format!("{flag}: {e}")).into())
+    Selection::parse_with(text, index_groups())
+        .map_err(|e| crate::args::UsageError(format!("{flag}: {e}")).into())
 }
 
 /// Splits `SEL=VALUE` at its last '='.
@@ -745,7 +769,7 @@ pub fn mol_plan(args: &MolArgs, style: &StyleArgs, topology: Option<Topology>) -
             .measures
             .iter()
             .map(|m| {
-                texmap_md_scene::measure::Measure::parse(m)
+                texmap_md_scene::measure::Measure::parse_with(m, index_groups())
                     .map_err(|e| crate::args::UsageError(format!("--measure {e}")))
             })
             .collect::<Result<Vec<_>, _>>()?,
@@ -937,7 +961,7 @@ pub fn empty_rep_warnings(args: &MolArgs, frame: &Frame, f: usize) -> Vec<String
         let Ok((sel, _)) = sel_value("--rep", r) else {
             continue;
         };
-        let Ok(selection) = Selection::parse(sel) else {
+        let Ok(selection) = Selection::parse_with(sel, index_groups()) else {
             continue;
         };
         if selection

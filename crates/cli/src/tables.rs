@@ -138,10 +138,7 @@ impl ContactsTable {
                 "--contacts {spec:?}: expected two selections, 'SEL_A;SEL_B' (e.g. 'name N;name O')"
             ));
         };
-        let parse = |s: &str| {
-            texmap_md_io::select::Selection::parse(s.trim())
-                .map_err(|e| crate::args::UsageError(format!("--contacts {s:?}: {e}")))
-        };
+        let parse = |s: &str| crate::scene::parse_selection(&format!("--contacts {s:?}"), s.trim());
         Ok(Some(ContactsTable {
             file,
             groups: [parse(a)?, parse(b)?],
@@ -805,8 +802,7 @@ impl Picked {
     fn new(flag: &'static str, text: &str) -> Result<Picked> {
         Ok(Picked {
             flag,
-            select: texmap_md_io::select::Selection::parse(text)
-                .map_err(|e| crate::args::UsageError(format!("{flag}: {e}")))?,
+            select: crate::scene::parse_selection(flag, text)?,
             atoms: Vec::new(),
             n_atoms: 0,
         })
@@ -1053,7 +1049,7 @@ impl RmsdMatrix {
         if let Some((path, format)) = &self.middles {
             let mut frame = self.template.clone();
             crate::output::write_atomic(path, |tmp| {
-                let mut w = texmap_md_io::Writer::create(tmp, *format)?;
+                let mut w = texmap_md_io::Writer::create_as(tmp, *format, path)?;
                 for cl in &c.clusters {
                     frame.positions.clone_from(&self.whole[cl.middle]);
                     frame.time = self.times[cl.middle];
@@ -1110,8 +1106,8 @@ impl RamachandranPlot {
         let Some(path) = chart_file(&analysis.ramachandran, "--ramachandran", why, whole)? else {
             return Ok(None);
         };
-        let select = texmap_md_io::select::Selection::parse(&analysis.ramachandran_select)
-            .map_err(|e| crate::args::UsageError(format!("--ramachandran-select: {e}")))?;
+        let select =
+            crate::scene::parse_selection("--ramachandran-select", &analysis.ramachandran_select)?;
         Ok(Some(RamachandranPlot {
             path,
             select,
@@ -1212,8 +1208,10 @@ impl ResidueMap {
             distance_chart,
             contact,
             contact_chart,
-            select: texmap_md_io::select::Selection::parse(&analysis.distance_map_select)
-                .map_err(|e| crate::args::UsageError(format!("--distance-map-select: {e}")))?,
+            select: crate::scene::parse_selection(
+                "--distance-map-select",
+                &analysis.distance_map_select,
+            )?,
             cutoff: analysis.contact_map_cutoff,
             limit: analysis.msd_memory.saturating_mul(1 << 20),
             map: None,
@@ -1533,7 +1531,7 @@ impl PcaTables {
         if let Some((path, format)) = &self.extremes {
             let mut frame = self.template.clone();
             crate::output::write_atomic(path, |tmp| {
-                let mut w = texmap_md_io::Writer::create(tmp, *format)?;
+                let mut w = texmap_md_io::Writer::create_as(tmp, *format, path)?;
                 for (i, positions) in c
                     .along(self.mode, self.extreme_frames)
                     .into_iter()
@@ -2052,10 +2050,7 @@ impl AnalysisTables {
                 analysis
                     .survival_select
                     .as_deref()
-                    .map(|s| {
-                        texmap_md_io::select::Selection::parse(s)
-                            .map_err(|e| crate::args::UsageError(format!("--survival-select: {e}")))
-                    })
+                    .map(|s| crate::scene::parse_selection("--survival-select", s))
                     .transpose()?,
             )?,
             density: match whole_run_table(
@@ -2066,8 +2061,10 @@ impl AnalysisTables {
             )? {
                 Some(file) => Some(DensityTable {
                     file,
-                    select: texmap_md_io::select::Selection::parse(&analysis.density_select)
-                        .map_err(|e| crate::args::UsageError(format!("--density-select: {e}")))?,
+                    select: crate::scene::parse_selection(
+                        "--density-select",
+                        &analysis.density_select,
+                    )?,
                     text: analysis.density_select.clone(),
                     delta: analysis.density_delta,
                     padding: analysis.density_padding,
@@ -2111,8 +2108,10 @@ impl AnalysisTables {
                 whole,
             )? {
                 Some(t) => {
-                    let sel = texmap_md_io::select::Selection::parse(&analysis.gyration_select)
-                        .map_err(|e| crate::args::UsageError(format!("--gyration-select: {e}")))?;
+                    let sel = crate::scene::parse_selection(
+                        "--gyration-select",
+                        &analysis.gyration_select,
+                    )?;
                     Some((t, sel, !analysis.gyration_unweighted))
                 }
                 None => None,
@@ -2477,8 +2476,7 @@ impl OrderTable {
                 "the order parameters average every frame",
                 whole,
             )?,
-            select: texmap_md_io::select::Selection::parse(select)
-                .map_err(|e| crate::args::UsageError(format!("--order-select: {e}")))?,
+            select: crate::scene::parse_selection("--order-select", select)?,
             method: match analysis.order_method.as_str() {
                 "united-atom" => texmap_md_io::order::Method::UnitedAtom,
                 "bonds" => texmap_md_io::order::Method::Bonds,
@@ -2597,8 +2595,7 @@ impl MembraneTable {
         };
         Ok(Some(MembraneTable {
             file,
-            select: texmap_md_io::select::Selection::parse(&analysis.membrane_select)
-                .map_err(|e| crate::args::UsageError(format!("--membrane-select: {e}")))?,
+            select: crate::scene::parse_selection("--membrane-select", &analysis.membrane_select)?,
             cutoff: analysis.membrane_cutoff,
             normal: match analysis.membrane_normal.as_str() {
                 "x" => 0,

@@ -4157,3 +4157,98 @@ fn gromacs_tpr_renders_and_converts_as_gromacs_reads_it() {
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
 }
+
+#[test]
+fn gromacs_index_groups_select_with_index() {
+    // `gmx select -on`'s groups (tests/data/ndx/select.ndx) picked by `group`: the atoms
+    // written are the group's, in its order, numbered as GROMACS numbered them.
+    let tpr = data("tpr/peptide.tpr.gz");
+    let ndx = data("ndx/select.ndx");
+    let text = std::fs::read_to_string(&ndx).unwrap();
+    let first: Vec<i64> = text
+        .split('[')
+        .nth(1)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .flat_map(|l| l.split_whitespace().map(|w| w.parse::<i64>().unwrap()))
+        .collect();
+    assert_eq!(first.len(), 622);
+    let dir = tempfile::tempdir().unwrap();
+    let gro = dir.path().join("near.gro");
+    let o = texmap(&[
+        "convert",
+        &tpr,
+        "--index",
+        &ndx,
+        "--select",
+        "group near_ions",
+        "-o",
+        gro.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = std::fs::read_to_string(&gro).unwrap();
+    let lines: Vec<&str> = out.lines().collect();
+    assert_eq!(lines[1].trim(), "622");
+    let numbers: Vec<i64> = lines[2..2 + 622]
+        .iter()
+        .map(|l| l[15..20].trim().parse().unwrap())
+        .collect();
+    assert_eq!(numbers, first);
+    // Groups in --rep, --measure and an analysis's selection too.
+    let png = render_png(
+        dir.path(),
+        &[
+            &tpr,
+            "--index",
+            &data("ndx/make_ndx.ndx"),
+            "--rep",
+            "group Protein=licorice",
+            "--rep",
+            "group C-alpha=ball-stick",
+            "--measure",
+            "group C-alpha and resid 1; group C-alpha and resid 3",
+            "--size",
+            "64x48",
+        ],
+        "groups.png",
+    );
+    assert!(png.starts_with(b"\x89PNG"));
+    // A name no group has: a usage error listing the groups by number.
+    let o = texmap(&[
+        "convert",
+        &tpr,
+        "--index",
+        &ndx,
+        "--select",
+        "group Protein",
+        "-o",
+        gro.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("has no group 'Protein'")
+            && stderr(&o).contains("1 name_CA_and_molindex_2"),
+        "{}",
+        stderr(&o)
+    );
+    // A damaged index file: a runtime error naming its line.
+    let bad = dir.path().join("bad.ndx");
+    std::fs::write(&bad, "[ A ]\n1 2 3\n4 five 6\n").unwrap();
+    let o = texmap(&[
+        "convert",
+        &tpr,
+        "--index",
+        bad.to_str().unwrap(),
+        "--select",
+        "group A",
+        "-o",
+        gro.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("bad.ndx: line 3, byte 14"),
+        "{}",
+        stderr(&o)
+    );
+}

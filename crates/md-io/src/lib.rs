@@ -156,6 +156,7 @@ mod mol2;
 mod mrc;
 pub mod msd;
 mod namdbin;
+pub mod ndx;
 mod neighbours;
 mod netcdf;
 pub mod order;

@@ -8,23 +8,34 @@
 //! term     := factor ("and" factor)*
 //! factor   := "not" factor | "(" expr ")" | atom
 //! atom     := "all" | "none" | "protein" | "nucleic" | "backbone" | "water"
+//!           | "nucleicbackbone" | "nucleicbase" | "nucleicsugar"
 //!           | "helix" | "sheet" | "betasheet" | "beta_sheet" | "coil"  -- VMD: structure
 //!           | "cna" TYPE+          -- crystal structure: fcc hcp bcc ico other (OVITO's a-CNA)
 //!           | "diamond" TYPE+      -- diamond structure: cubic hexagonal cubic-1st cubic-2nd
 //!                                     hexagonal-1st hexagonal-2nd other (OVITO's)
 //!           | ("name" | "type" | "resname" | "element") WORD+      -- any of the words
 //!           | ("chain" | "chainID" | "segid" | "segname") WORD+
-//!           | ("index" | "serial" | "bynum" | "id" | "resid") RANGE+
+//!           | ("index" | "serial" | "bynum" | "id" | "resid" | "resindex" | "fragment") RANGE+
+//!           | ("mass" | "charge") FRANGE+                          -- MDAnalysis: mass 10 to 20
+//!           | "group" (WORD | N)                                   -- an index group (.ndx)
+//!           | "bonded" expr                                        -- atoms bonded to expr's
 //!           | "within" NUMBER "of" expr                            -- VMD: includes the expr
 //!           | "around" NUMBER expr                                 -- MDAnalysis: excludes it
+//!           | "sphzone" R expr | "sphlayer" R1 R2 expr              -- about expr's centre
+//!           | "point" X Y Z R                                       -- about a point
+//!           | "cyzone" R ZMAX ZMIN expr | "cylayer" R1 R2 ZMAX ZMIN expr  -- cylinders along z
+//!           | "isolayer" R1 R2 expr                                 -- R1 < nearest distance <= R2
 //!           | "byres" expr                                         -- whole residues
-//!           | "same" FIELD "as" expr  -- FIELD: residue resname resid name type element chain segid
+//!           | "same" FIELD "as" expr  -- FIELD: residue fragment resname resid name type element
+//!                                        chain segid
 //!           | "prop" ["abs"] NAME OP NUMBER                        -- MDAnalysis: prop z > 10
 //!           | ("beta" | "occupancy" | "charge") OP NUMBER          -- VMD: beta > 50
 //! RANGE    := N | N "to" M | N:M | N-M                              -- inclusive
+//! FRANGE   := V | A "to" B | A:B | A-B         -- inclusive; V alone as numpy's isclose
 //! OP       := "<" | "<=" | ">" | ">=" | "==" | "!="                  -- spaces optional
 //! ```
-//! Keywords are case-insensitive; words are compared exactly (atom names are case-sensitive in
+//! Keywords are case-insensitive; a word in double quotes is a word even when it looks like a
+//! keyword or holds parentheses (`group "Near ions"`); words are compared exactly (atom names are case-sensitive in
 //! PDB), except `element`, which takes a chemical symbol in any case. A word may hold the glob
 //! characters `*` (any run) and `?` (one character): `name H*`. `index` counts atoms from 0 in
 //! file order; `serial` and `bynum` from 1 (`bynum` is MDAnalysis's name); `id` is the atom id the
@@ -50,7 +61,31 @@
 //! `isclose`, as MDAnalysis). Comparisons are made in f32, the values' precision, as numpy makes
 //! MDAnalysis's (`prop x == 3.278` holds for the x read as 3.278). An atom whose value is NaN
 //! matches only `!=`.
-//! `within`, `around`, `byres` and `same ... as` take the rest of the expression (up to a
+//! `nucleicbackbone`, `nucleicbase` and `nucleicsugar` are MDAnalysis's: the atoms of a
+//! `nucleic` residue named P C5' C3' O3' O5', the base's ring atoms and substituents (N9 N7 C8
+//! C5 C4 N3 C2 N1 C6 O6 N2 N6 O2 N4 O4 C5M), and C1' C2' C3' C4' O4'.
+//! `mass` takes [`crate::atom_mass`] (the file's masses, else the element's) and `charge` the
+//! `charge` property, as MDAnalysis's float ranges (`charge -1 to 0`, `mass 30:40`); `charge`
+//! followed by a comparison is VMD's form below.
+//! `group NAME` picks an index group ([`crate::ndx`], a GROMACS `.ndx` file) given to
+//! [`Selection::parse_with`]: by name as GROMACS resolves it (exactly, in any case, by a unique
+//! prefix) or by its number from 0; a group naming an atom past the frame's is an error.
+//! `bonded SEL` picks the atoms bonded to SEL's atoms (SEL's own atoms only where bonded to
+//! one another), MDAnalysis's. `fragment N` (VMD) picks the Nth bonded fragment — the atoms the
+//! frame's bonds join, numbered from 0 by their lowest atom, an atom without bonds its own —
+//! and `same fragment as SEL` (both programs) every fragment SEL touches. Without bonds both
+//! see single atoms, and `bonded` picks nothing, as in MDAnalysis.
+//! `resindex` counts residues from 0 in file order (MDAnalysis's).
+//! The geometric keywords are MDAnalysis's, with its periodic images: `sphzone R SEL` picks
+//! the atoms within R of SEL's centre of geometry, `sphlayer R1 R2 SEL` those farther than R1
+//! and within R2, `point X Y Z R` those within R of a point (nearest images when the frame has
+//! a cell); `cyzone R ZMAX ZMIN SEL` those less than R from the z axis through SEL's centre
+//! and between ZMIN and ZMAX above it (strictly), `cylayer R1 R2 ZMAX ZMIN SEL` a tube, with
+//! displacements reduced as MDAnalysis reduces them (the c, b, a edges in turn); a cylinder
+//! wider or taller than the cell is an error, as there. `isolayer R1 R2 SEL` picks the atoms
+//! outside SEL whose nearest SEL atom is farther than R1 and within R2 (a solvation shell).
+//! A centre of no atoms selects nothing.
+//! `within`, `around`, `byres`, `same ... as`, `bonded` and the geometric keywords take the rest of the expression (up to a
 //! closing parenthesis) as MDAnalysis does: `around 4 resname NA and resid 1:15` is
 //! `around 4 (resname NA and resid 1:15)`; parenthesise to end them sooner. `byres` and
 //! `same residue as` select whole residues (consecutive atoms of one residue number, name,
@@ -69,6 +104,7 @@ use std::fmt;
 
 use crate::elements::Element;
 use crate::frame::{Frame, Label};
+use crate::ndx::{FindError, IndexGroups};
 use crate::secondary::Structure;
 
 /// What one evaluation computes at most once, however many keywords need it.
@@ -80,6 +116,45 @@ struct Cache {
     cna: std::cell::OnceCell<Vec<crate::cna::StructureType>>,
     /// Diamond structure type per atom (`diamond`).
     diamond: std::cell::OnceCell<Vec<crate::cna::DiamondType>>,
+    /// Bonded fragment per atom, numbered by their lowest atom (`fragment`).
+    fragments: std::cell::OnceCell<Vec<u32>>,
+}
+
+/// Each atom's bonded fragment: the parts the frame's bonds join (an atom without bonds is a
+/// fragment of its own), numbered from 0 in the order of their lowest atom, as MDAnalysis's
+/// `fragindices` and VMD's `fragment` number them.
+fn fragments(frame: &Frame) -> Vec<u32> {
+    let n = frame.n_atoms();
+    let mut parts = crate::components::UnionFind::new(n);
+    for &[a, b] in &frame.bonds {
+        if (a as usize) < n && (b as usize) < n {
+            parts.join(a as usize, b as usize);
+        }
+    }
+    let mut number = vec![u32::MAX; n];
+    let mut next = 0;
+    (0..n)
+        .map(|i| {
+            let r = parts.root(i);
+            if number[r] == u32::MAX {
+                number[r] = next;
+                next += 1;
+            }
+            number[r]
+        })
+        .collect()
+}
+
+/// Each atom's residue as a 0-based position among [`crate::secondary::residue_ranges`].
+fn residue_indices(frame: &Frame) -> Vec<i64> {
+    let mut out = vec![0; frame.n_atoms()];
+    for (k, r) in crate::secondary::residue_ranges(frame)
+        .into_iter()
+        .enumerate()
+    {
+        out[r].fill(k as i64);
+    }
+    out
 }
 
 /// Residue names `protein` matches: MDAnalysis 2.11's, the 20 amino acids with their
@@ -105,6 +180,14 @@ pub const NUCLEIC_RESIDUES: &[&str] = &[
     "U", "C", "G", "DA5", "DC5", "DG5", "DT5", "DA3", "DC3", "DG3", "DT3", "RA5", "RU5", "RG5",
     "RC5", "RA3", "RU3", "RG3", "RC3",
 ];
+
+/// Atom names of `nucleicbackbone`, `nucleicbase` and `nucleicsugar` (in a `nucleic` residue),
+/// MDAnalysis's.
+const NUCLEIC_BACKBONE: [&str; 5] = ["P", "C5'", "C3'", "O3'", "O5'"];
+const NUCLEIC_BASE: [&str; 16] = [
+    "N9", "N7", "C8", "C5", "C4", "N3", "C2", "N1", "C6", "O6", "N2", "N6", "O2", "N4", "O4", "C5M",
+];
+const NUCLEIC_SUGAR: [&str; 5] = ["C1'", "C2'", "C3'", "C4'", "O4'"];
 
 /// Residue names `water` matches.
 pub const WATER_RESIDUES: &[&str] = &[
@@ -164,6 +247,10 @@ enum NumField {
     Serial,
     Id,
     ResId,
+    /// The residue's 0-based position among the frame's residues (MDAnalysis's `resindex`).
+    ResIndex,
+    /// The 0-based number of the atom's bonded fragment (VMD's `fragment`).
+    Fragment,
 }
 
 /// What `same ... as` compares.
@@ -174,6 +261,8 @@ enum SameField {
     Str(StrField),
     ResId,
     Element,
+    /// Bonded fragments: every atom of a fragment that holds a picked atom.
+    Fragment,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -218,6 +307,45 @@ enum Node {
     Diamond {
         types: u8,
     },
+    /// `group NAME`: the atoms of an index group (0-based).
+    Group {
+        name: String,
+        atoms: std::sync::Arc<[u32]>,
+        column: usize,
+    },
+    /// `bonded SEL`: the atoms bonded to an atom SEL picks.
+    Bonded(Box<Node>),
+    /// `sphzone R SEL`, `sphlayer R1 R2 SEL`, `point X Y Z R`: the atoms whose distance from
+    /// the centre lies in `(inner, outer]` (`inner` below zero: `[0, outer]`).
+    Sphere {
+        centre: Centre,
+        inner: f64,
+        outer: f64,
+    },
+    /// `cyzone R ZMAX ZMIN SEL`, `cylayer R1 R2 ZMAX ZMIN SEL`: the atoms in a cylinder (or
+    /// tube) along z about SEL's centre of geometry.
+    Cylinder {
+        of: Box<Node>,
+        inner: f64,
+        outer: f64,
+        zmax: f64,
+        zmin: f64,
+        column: usize,
+    },
+    /// `isolayer R1 R2 SEL`: the atoms outside SEL whose nearest SEL atom is farther than R1
+    /// and within R2.
+    IsoLayer {
+        of: Box<Node>,
+        inner: f64,
+        outer: f64,
+    },
+    /// `mass RANGE+`, `charge RANGE+` (MDAnalysis's float ranges): inclusive ranges, a single
+    /// value matched as numpy's `isclose`.
+    FloatRange {
+        mass: bool,
+        ranges: Vec<(f64, Option<f64>)>,
+        column: usize,
+    },
     /// `prop [abs] NAME OP VALUE`: a coordinate or a property compared with a number.
     Prop {
         name: String,
@@ -226,6 +354,14 @@ enum Node {
         value: f64,
         column: usize,
     },
+}
+
+/// Where a spherical selection is centred.
+#[derive(Clone, Debug, PartialEq)]
+enum Centre {
+    /// The centre of geometry of the atoms a selection picks (none picked: nothing selected).
+    Of(Box<Node>),
+    Point([f64; 3]),
 }
 
 /// The comparisons of `prop`, as MDAnalysis has them (`==` is numpy's `isclose`).
@@ -298,6 +434,15 @@ struct Token {
     text: String,
     /// 1-based column of its first character.
     column: usize,
+    /// Written in double quotes: a word, never a keyword or a parenthesis.
+    quoted: bool,
+}
+
+impl Token {
+    /// A keyword or operator that ends a list of values (a quoted word never does).
+    fn reserved(&self) -> bool {
+        !self.quoted && is_reserved(&self.text)
+    }
 }
 
 fn tokenize(s: &str) -> Vec<Token> {
@@ -312,6 +457,21 @@ fn tokenize(s: &str) -> Vec<Token> {
             out.push(Token {
                 text: c.to_string(),
                 column: i + 1,
+                quoted: false,
+            });
+            i += 1;
+        } else if c == '"' {
+            // A quoted word runs to the next '"' (or the end): an index group's name with
+            // spaces or parentheses.
+            let start = i;
+            i += 1;
+            while i < chars.len() && chars[i] != '"' {
+                i += 1;
+            }
+            out.push(Token {
+                text: chars[start + 1..i].iter().collect(),
+                column: start + 1,
+                quoted: true,
             });
             i += 1;
         } else {
@@ -323,6 +483,7 @@ fn tokenize(s: &str) -> Vec<Token> {
             out.push(Token {
                 text: chars[start..i].iter().collect(),
                 column: start + 1,
+                quoted: false,
             });
         }
     }
@@ -376,11 +537,27 @@ fn is_reserved(w: &str) -> bool {
             | "beta"
             | "occupancy"
             | "charge"
+            | "mass"
+            | "group"
+            | "bonded"
+            | "fragment"
+            | "resindex"
+            | "sphzone"
+            | "sphlayer"
+            | "isolayer"
+            | "point"
+            | "cyzone"
+            | "cylayer"
+            | "nucleicbackbone"
+            | "nucleicbase"
+            | "nucleicsugar"
     )
 }
 
 struct Parser<'a> {
     text: &'a str,
+    /// The index groups `group` names.
+    groups: Option<&'a IndexGroups>,
     tokens: Vec<Token>,
     pos: usize,
     depth: usize,
@@ -404,7 +581,8 @@ impl Parser<'_> {
     }
 
     fn peek_is(&self, kw: &str) -> bool {
-        self.peek().is_some_and(|t| t.text.eq_ignore_ascii_case(kw))
+        self.peek()
+            .is_some_and(|t| !t.quoted && t.text.eq_ignore_ascii_case(kw))
     }
 
     fn next(&mut self, expected: &str) -> Result<Token, SelectionError> {
@@ -454,6 +632,12 @@ impl Parser<'_> {
     fn factor_inner(&mut self) -> Result<Node, SelectionError> {
         let t =
             self.next("a selection keyword (name, resname, resid, element, index, not, ...)")?;
+        if t.quoted {
+            return Err(self.error(
+                t.column,
+                format!("expected a keyword, found the quoted word \"{}\" (quotes are for a value such as a group's name)", t.text),
+            ));
+        }
         let kw = t.text.to_ascii_lowercase();
         // `beta>=50` written as one word: the comparison is read from the word itself.
         if let Some((left, _, _)) = split_comparison(&kw)
@@ -496,6 +680,90 @@ impl Parser<'_> {
                 words: WATER_RESIDUES.iter().map(|s| s.to_string()).collect(),
                 column: t.column,
             }),
+            "nucleicbackbone" | "nucleicbase" | "nucleicsugar" => {
+                let names: &[&str] = match kw.as_str() {
+                    "nucleicbackbone" => &NUCLEIC_BACKBONE,
+                    "nucleicbase" => &NUCLEIC_BASE,
+                    _ => &NUCLEIC_SUGAR,
+                };
+                Ok(Node::And(
+                    Box::new(Node::Str {
+                        field: StrField::ResName,
+                        words: NUCLEIC_RESIDUES.iter().map(|s| s.to_string()).collect(),
+                        column: t.column,
+                    }),
+                    Box::new(Node::Str {
+                        field: StrField::Name,
+                        words: names.iter().map(|s| s.to_string()).collect(),
+                        column: t.column,
+                    }),
+                ))
+            }
+            "group" => self.group(&t),
+            "bonded" => Ok(Node::Bonded(Box::new(self.rest(&t)?))),
+            "sphzone" | "sphlayer" => {
+                let inner = if kw == "sphlayer" {
+                    self.distance("the inner radius in Å")?
+                } else {
+                    -1.0
+                };
+                let outer = self.distance("the outer radius in Å")?;
+                Ok(Node::Sphere {
+                    centre: Centre::Of(Box::new(self.rest(&t)?)),
+                    inner,
+                    outer,
+                })
+            }
+            "point" => {
+                let mut p = [0.0; 3];
+                for (k, axis) in ["x", "y", "z"].iter().enumerate() {
+                    p[k] = self.number(&format!("the point's {axis} in Å"))?;
+                }
+                let outer = self.distance("the radius in Å")?;
+                Ok(Node::Sphere {
+                    centre: Centre::Point(p),
+                    inner: -1.0,
+                    outer,
+                })
+            }
+            "isolayer" => {
+                let inner = self.distance("the inner distance in Å")?;
+                let outer = self.distance("the outer distance in Å")?;
+                Ok(Node::IsoLayer {
+                    of: Box::new(self.rest(&t)?),
+                    inner,
+                    outer,
+                })
+            }
+            "cyzone" | "cylayer" => {
+                let inner = if kw == "cylayer" {
+                    self.distance("the inner radius in Å")?
+                } else {
+                    -1.0
+                };
+                let outer = self.distance("the outer radius in Å")?;
+                let zmax = self.number("the top of the cylinder (z above the centre, Å)")?;
+                let zmin = self.number("the bottom of the cylinder (z from the centre, Å)")?;
+                Ok(Node::Cylinder {
+                    of: Box::new(self.rest(&t)?),
+                    inner,
+                    outer,
+                    zmax,
+                    zmin,
+                    column: t.column,
+                })
+            }
+            "mass" => self.float_ranges(&t, true),
+            // MDAnalysis's range (`charge -1 to 0`) unless a comparison follows (VMD's).
+            "charge"
+                if self.peek().is_some_and(|n| {
+                    !n.text.starts_with(['<', '>', '=', '!'])
+                        && n.text.parse::<f64>().is_ok()
+                        || float_range(&n.text).is_some()
+                }) =>
+            {
+                self.float_ranges(&t, false)
+            }
             "helix" => Ok(Node::Structure {
                 class: Structure::Helix,
                 column: t.column,
@@ -546,11 +814,13 @@ impl Parser<'_> {
                 }
                 Ok(Node::Element(els))
             }
-            "index" | "serial" | "bynum" | "id" | "resid" | "resnum" => {
+            "index" | "serial" | "bynum" | "id" | "resid" | "resnum" | "resindex" | "fragment" => {
                 let field = match kw.as_str() {
                     "index" => NumField::Index,
                     "serial" | "bynum" => NumField::Serial,
                     "id" => NumField::Id,
+                    "resindex" => NumField::ResIndex,
+                    "fragment" => NumField::Fragment,
                     _ => NumField::ResId,
                 };
                 let ranges = self.ranges(&t)?;
@@ -587,9 +857,10 @@ impl Parser<'_> {
                 column: t.column,
             }),
             "same" => {
-                let f = self.next("what to compare: residue, resname, resid, name, type, element, chain or segid")?;
+                let f = self.next("what to compare: residue, fragment, resname, resid, name, type, element, chain or segid")?;
                 let field = match f.text.to_ascii_lowercase().as_str() {
                     "residue" => SameField::Residue,
+                    "fragment" => SameField::Fragment,
                     "resname" => SameField::Str(StrField::ResName),
                     "resid" | "resnum" => SameField::ResId,
                     "name" => SameField::Str(StrField::Name),
@@ -600,7 +871,7 @@ impl Parser<'_> {
                     _ => {
                         return Err(self.error(
                             f.column,
-                            format!("'same {}': expected residue, resname, resid, name, type, element, chain or segid", f.text),
+                            format!("'same {}': expected residue, fragment, resname, resid, name, type, element, chain or segid", f.text),
                         ));
                     }
                 };
@@ -621,11 +892,135 @@ impl Parser<'_> {
             _ => Err(self.error(
                 t.column,
                 format!(
-                    "unknown keyword '{}': expected name, type, resname, element, resid, index, serial, id, prop, protein, backbone, water, within, around, all, none, not or '('",
+                    "unknown keyword '{}': expected name, type, resname, element, resid, index, serial, id, prop, protein, backbone, water, within, around, group, all, none, not or '('",
                     t.text
                 ),
             )),
         }
+    }
+
+    /// A number after a keyword.
+    fn number(&mut self, what: &str) -> Result<f64, SelectionError> {
+        let t = self.next(what)?;
+        t.text
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite() && v.abs() <= 1e9)
+            .ok_or_else(|| self.error(t.column, format!("expected {what}, found '{}'", t.text)))
+    }
+
+    /// A distance after a keyword: 0 to 1e4 Å.
+    fn distance(&mut self, what: &str) -> Result<f64, SelectionError> {
+        let column = self.peek().map_or(self.end_column(), |t| t.column);
+        let d = self.number(what)?;
+        if !(0.0..=1e4).contains(&d) {
+            return Err(self.error(column, format!("expected {what} (0 to 1e4), found {d}")));
+        }
+        Ok(d)
+    }
+
+    /// `group NAME` or `group N`: an index group by name (as GROMACS resolves it: exactly,
+    /// in any case, by a unique prefix) or by its number from 0.
+    fn group(&mut self, kw: &Token) -> Result<Node, SelectionError> {
+        let w = self.next("an index group's name or number")?;
+        let Some(groups) = self.groups else {
+            return Err(self.error(kw.column, "'group' needs index groups, and none were given (texmap: --index FILE.ndx, a GROMACS index file)"));
+        };
+        let found = match groups.find(&w.text) {
+            Ok(i) => Ok(i),
+            Err(e) => match w.text.parse::<usize>() {
+                Ok(i) if i < groups.len() => Ok(i),
+                _ => Err(e),
+            },
+        };
+        match found {
+            Ok(i) => {
+                let g = groups.get(i);
+                Ok(Node::Group {
+                    name: g.name.clone(),
+                    atoms: g.atoms.clone().into(),
+                    column: w.column,
+                })
+            }
+            Err(FindError::Ambiguous(names)) => Err(self.error(
+                w.column,
+                format!(
+                    "'{}' begins the names of several groups of {}: {}",
+                    w.text,
+                    groups.file,
+                    names.join(", ")
+                ),
+            )),
+            Err(FindError::Unknown) => Err(self.error(
+                w.column,
+                format!(
+                    "{} has no group '{}' (its groups, numbered from 0: {})",
+                    groups.file,
+                    w.text,
+                    groups
+                        .groups()
+                        .iter()
+                        .enumerate()
+                        .map(|(i, g)| format!("{i} {}", g.name))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            )),
+        }
+    }
+
+    /// `mass` / `charge` ranges: `V`, `A to B`, `A:B`, `A-B` (MDAnalysis's float ranges).
+    fn float_ranges(&mut self, kw: &Token, mass: bool) -> Result<Node, SelectionError> {
+        let mut ranges = Vec::new();
+        while let Some(t) = self.peek().cloned() {
+            if t.reserved() {
+                break;
+            }
+            self.pos += 1;
+            let range = match t.text.parse::<f64>().ok().filter(|v| v.is_finite()) {
+                Some(lo) if self.peek_is("to") => {
+                    self.pos += 1;
+                    let hi = self.number("the end of the range")?;
+                    (lo, Some(hi))
+                }
+                Some(v) => (v, None),
+                None => match float_range(&t.text) {
+                    Some((lo, hi)) => (lo, Some(hi)),
+                    None => {
+                        return Err(self.error(
+                            t.column,
+                            format!(
+                                "expected a number or a range (V, A:B, A-B, A to B) after '{}', found '{}'",
+                                kw.text, t.text
+                            ),
+                        ));
+                    }
+                },
+            };
+            if range.1.is_some_and(|hi| hi < range.0) {
+                return Err(self.error(
+                    t.column,
+                    format!(
+                        "range {}..{} is empty (its start is past its end)",
+                        range.0,
+                        range.1.unwrap_or_default()
+                    ),
+                ));
+            }
+            ranges.push(range);
+        }
+        if ranges.is_empty() {
+            let col = self.peek().map_or(self.end_column(), |t| t.column);
+            return Err(self.error(
+                col,
+                format!("expected at least one number after '{}'", kw.text),
+            ));
+        }
+        Ok(Node::FloatRange {
+            mass,
+            ranges,
+            column: kw.column,
+        })
     }
 
     /// The selection after `within ... of`, `around ...`, `byres` and `same ... as`: the rest of
@@ -720,7 +1115,7 @@ impl Parser<'_> {
     fn words(&mut self, kw: &Token) -> Result<Vec<Token>, SelectionError> {
         let mut out = Vec::new();
         while let Some(t) = self.peek() {
-            if is_reserved(&t.text) {
+            if t.reserved() {
                 break;
             }
             out.push(t.clone());
@@ -740,7 +1135,7 @@ impl Parser<'_> {
     fn ranges(&mut self, kw: &Token) -> Result<Vec<(i64, i64)>, SelectionError> {
         let mut out = Vec::new();
         while let Some(t) = self.peek().cloned() {
-            if is_reserved(&t.text) {
+            if t.reserved() {
                 break;
             }
             self.pos += 1;
@@ -829,6 +1224,15 @@ fn glob(pattern: &[u8], s: &[u8]) -> bool {
 impl Selection {
     /// Parse `text`; the error names the column of the first bad token.
     pub fn parse(text: &str) -> Result<Selection, SelectionError> {
+        Selection::parse_with(text, None)
+    }
+
+    /// Parse `text` with index groups for its `group` keyword (a GROMACS `.ndx` file's,
+    /// [`IndexGroups::read`]). The groups' atoms are copied into the selection.
+    pub fn parse_with(
+        text: &str,
+        groups: Option<&IndexGroups>,
+    ) -> Result<Selection, SelectionError> {
         let err = |column, message: &str| SelectionError {
             selection: text.to_string(),
             column,
@@ -842,6 +1246,7 @@ impl Selection {
         }
         let mut p = Parser {
             text,
+            groups,
             tokens: tokenize(text),
             pos: 0,
             depth: 0,
@@ -857,7 +1262,7 @@ impl Selection {
                 format!(
                     "expected 'and', 'or' or the end, found '{}'{}",
                     t.text,
-                    if is_reserved(&t.text) {
+                    if t.reserved() {
                         " (a missing 'and'?)"
                     } else {
                         ""
@@ -1032,6 +1437,20 @@ impl Selection {
                         .iter_mut()
                         .enumerate()
                         .for_each(|(i, v)| *v = hit(i as i64 + 1)),
+                    NumField::Fragment => {
+                        let f = cache.fragments.get_or_init(|| fragments(frame));
+                        for (v, &x) in out.iter_mut().zip(f) {
+                            *v = hit(x as i64);
+                        }
+                    }
+                    NumField::ResIndex => {
+                        if frame.res_ids.len() != n || frame.res_names.len() != n {
+                            return Err(self.missing(*column, "residue numbers and names"));
+                        }
+                        for (v, x) in out.iter_mut().zip(residue_indices(frame)) {
+                            *v = hit(x);
+                        }
+                    }
                     NumField::Id | NumField::ResId => {
                         let (vals, what) = if *field == NumField::Id {
                             (&frame.ids, "atom ids")
@@ -1090,6 +1509,16 @@ impl Selection {
                             out[r].fill(any);
                         }
                     }
+                    SameField::Fragment => {
+                        let f = cache.fragments.get_or_init(|| fragments(frame));
+                        let mut keep = vec![false; n];
+                        for i in (0..n).filter(|&i| picked[i]) {
+                            keep[f[i] as usize] = true;
+                        }
+                        for (o, &x) in out.iter_mut().zip(f) {
+                            *o = keep[x as usize];
+                        }
+                    }
                     SameField::ResId => {
                         if frame.res_ids.len() != n {
                             return Err(self.missing(*column, "residue numbers"));
@@ -1124,6 +1553,159 @@ impl Selection {
                     }
                 }
             }
+            Node::Group {
+                name,
+                atoms,
+                column,
+            } => {
+                out.fill(false);
+                for &a in atoms.iter() {
+                    let Some(o) = out.get_mut(a as usize) else {
+                        return Err(SelectionError {
+                            selection: self.text.clone(),
+                            column: *column,
+                            message: format!(
+                                "index group '{name}' has atom {} but the frame has {n} atoms (an index file of another system?)",
+                                a as u64 + 1
+                            ),
+                        });
+                    };
+                    *o = true;
+                }
+            }
+            Node::Bonded(of) => {
+                let mut picked = vec![false; n];
+                self.eval(of, frame, cache, &mut picked)?;
+                out.fill(false);
+                for &[a, b] in &frame.bonds {
+                    let (a, b) = (a as usize, b as usize);
+                    if a < n && b < n {
+                        out[a] |= picked[b];
+                        out[b] |= picked[a];
+                    }
+                }
+            }
+            Node::Sphere {
+                centre,
+                inner,
+                outer,
+            } => {
+                let c = match centre {
+                    Centre::Point(p) => *p,
+                    Centre::Of(of) => {
+                        let mut picked = vec![false; n];
+                        self.eval(of, frame, cache, &mut picked)?;
+                        match centre_of_geometry(&frame.positions, &picked) {
+                            Some(c) => c,
+                            None => {
+                                out.fill(false);
+                                return Ok(());
+                            }
+                        }
+                    }
+                };
+                let image = frame.cell.as_ref().and_then(crate::pbc::NearestImage::new);
+                let (in2, out2) = (inner * inner, outer * outer);
+                for (o, p) in out.iter_mut().zip(&frame.positions) {
+                    let v: [f64; 3] = std::array::from_fn(|k| p[k] as f64 - c[k]);
+                    let m = image.as_ref().map_or(v, |image| image.apply(v));
+                    let d2 = m[0] * m[0] + m[1] * m[1] + m[2] * m[2];
+                    *o = d2 <= out2 && (*inner < 0.0 || d2 > in2);
+                }
+            }
+            Node::Cylinder {
+                of,
+                inner,
+                outer,
+                zmax,
+                zmin,
+                column,
+            } => {
+                let mut picked = vec![false; n];
+                self.eval(of, frame, cache, &mut picked)?;
+                let Some(c) = centre_of_geometry(&frame.positions, &picked) else {
+                    out.fill(false);
+                    return Ok(());
+                };
+                let cell = frame.cell.as_ref().filter(|c| c.periodic().contains(&true));
+                if let Some(cell) = cell {
+                    let m = cell.matrix();
+                    let len = |k: usize| m[k].iter().map(|x| x * x).sum::<f64>().sqrt();
+                    let limits = [
+                        (2.0 * outer, len(0), "diameter", "a"),
+                        (2.0 * outer, len(1), "diameter", "b"),
+                        (zmax - zmin, len(2), "height", "c"),
+                    ];
+                    for (k, (size, width, what, axis)) in limits.into_iter().enumerate() {
+                        if cell.periodic()[k] && size > width {
+                            return Err(SelectionError {
+                                selection: self.text.clone(),
+                                column: *column,
+                                message: format!(
+                                    "the cylinder's {what} ({size} Å) is larger than the cell's {axis} edge ({width:.3} Å); MDAnalysis refuses it too"
+                                ),
+                            });
+                        }
+                    }
+                }
+                for (o, p) in out.iter_mut().zip(&frame.positions) {
+                    let mut v: [f64; 3] = std::array::from_fn(|k| p[k] as f64 - c[k]);
+                    if let Some(cell) = cell {
+                        // MDAnalysis's reduction: the c, b and a edges in turn, each by its
+                        // diagonal component (exact for orthogonal cells).
+                        let m = cell.matrix();
+                        for k in [2, 1, 0] {
+                            if cell.periodic()[k] {
+                                let s = (v[k] / m[k][k]).round_ties_even();
+                                for (j, vj) in v.iter_mut().enumerate() {
+                                    *vj -= s * m[k][j];
+                                }
+                            }
+                        }
+                    }
+                    let r2 = v[0] * v[0] + v[1] * v[1];
+                    *o = v[2] > *zmin
+                        && v[2] < *zmax
+                        && r2 < outer * outer
+                        && (*inner < 0.0 || r2 > inner * inner);
+                }
+            }
+            Node::IsoLayer { of, inner, outer } => {
+                let mut picked = vec![false; n];
+                self.eval(of, frame, cache, &mut picked)?;
+                let mut near = vec![false; n];
+                within(
+                    &frame.positions,
+                    &picked,
+                    *inner,
+                    frame.cell.as_ref(),
+                    &mut near,
+                );
+                within(&frame.positions, &picked, *outer, frame.cell.as_ref(), out);
+                for ((o, p), w) in out.iter_mut().zip(&picked).zip(&near) {
+                    *o &= !p && !w;
+                }
+            }
+            Node::FloatRange {
+                mass,
+                ranges,
+                column,
+            } => {
+                let values: Vec<f64> = if *mass {
+                    (0..n).map(|i| crate::style::atom_mass(frame, i)).collect()
+                } else {
+                    match frame.property("charge") {
+                        Some(v) if v.len() == n => v.iter().map(|&x| x as f64).collect(),
+                        _ => return Err(self.missing(*column, "charges")),
+                    }
+                };
+                for (o, x) in out.iter_mut().zip(values) {
+                    *o = ranges.iter().any(|&(lo, hi)| match hi {
+                        Some(hi) => x >= lo && x <= hi,
+                        None => (x - lo).abs() <= 1e-8 + 1e-5 * lo.abs(),
+                    });
+                }
+            }
             Node::Within {
                 distance,
                 of,
@@ -1145,6 +1727,31 @@ impl Selection {
         }
         Ok(())
     }
+}
+
+/// The mean position of the picked atoms (plain, without periodic images, as MDAnalysis's
+/// `center_of_geometry`); `None` when none is picked.
+fn centre_of_geometry(positions: &[[f32; 3]], picked: &[bool]) -> Option<[f64; 3]> {
+    let mut sum = [0.0f64; 3];
+    let mut count = 0usize;
+    for (p, _) in positions.iter().zip(picked).filter(|(_, s)| **s) {
+        for k in 0..3 {
+            sum[k] += p[k] as f64;
+        }
+        count += 1;
+    }
+    (count > 0).then(|| sum.map(|s| s / count as f64))
+}
+
+/// `A:B` or `A-B` with two finite numbers (the '-' after a digit or '.', so `-1--0.5` is
+/// -1 to -0.5 and `1e-3` is no range).
+fn float_range(text: &str) -> Option<(f64, f64)> {
+    let b = text.as_bytes();
+    let at = text.find(':').or_else(|| {
+        (1..b.len()).find(|&i| b[i] == b'-' && (b[i - 1].is_ascii_digit() || b[i - 1] == b'.'))
+    })?;
+    let num = |s: &str| s.parse::<f64>().ok().filter(|v| v.is_finite());
+    Some((num(&text[..at])?, num(&text[at + 1..])?))
 }
 
 /// `text` as `LEFT OP RIGHT` at its first comparison symbol, both sides non-empty.
@@ -1385,7 +1992,11 @@ mod tests {
             ("name", 5, "at least one value"),
             ("name CA CB resid", 12, "expected 'and', 'or' or the end"),
             ("", 1, "empty selection"),
-            ("same colour as name CA", 6, "expected residue, resname"),
+            (
+                "same colour as name CA",
+                6,
+                "expected residue, fragment, resname",
+            ),
             ("same residue of name CA", 14, "expected 'as'"),
             ("byres", 6, "a selection after 'byres'"),
             ("name CA or (around 3 )", 22, "a selection after 'around'"),

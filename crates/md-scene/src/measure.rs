@@ -98,6 +98,14 @@ impl std::error::Error for MeasureError {}
 impl Measure {
     /// Parses `SEL; SEL[; SEL[; SEL]]`.
     pub fn parse(spec: &str) -> Result<Measure, MeasureError> {
+        Measure::parse_with(spec, None)
+    }
+
+    /// Parses `SEL; SEL[; SEL[; SEL]]` with index groups for the selections' `group` keyword.
+    pub fn parse_with(
+        spec: &str,
+        groups: Option<&texmap_md_io::ndx::IndexGroups>,
+    ) -> Result<Measure, MeasureError> {
         let parts: Vec<&str> = spec.split(';').map(str::trim).collect();
         if !(2..=4).contains(&parts.len()) || parts.iter().any(|p| p.is_empty()) {
             return Err(MeasureError::Count {
@@ -108,7 +116,7 @@ impl Measure {
         let atoms = parts
             .iter()
             .map(|p| {
-                Selection::parse(p).map_err(|e| MeasureError::Selection {
+                Selection::parse_with(p, groups).map_err(|e| MeasureError::Selection {
                     spec: spec.to_string(),
                     error: e.to_string(),
                 })
