@@ -53,8 +53,9 @@ pub struct ConvertArgs {
     /// frame after the analyses (OVITO's Expression selection and Delete selected): 'protein',
     /// 'not resname SOL', 'not cna fcc' (a crystal's defects), 'prop grain == 0',
     /// 'prop site_occupancy != 1' (point defects). The atoms keep their ids (their numbers in
-    /// the whole frame, from 1, when the file has none). A .gro, .pdb, .dcd or .xtc output
-    /// holds the same atoms in every frame, so there the selection must pick as many in each.
+    /// the whole frame, from 1, when the file has none). A .gro, .pdb, .cif, .dcd or .xtc
+    /// output holds the same atoms in every frame, so there the selection must pick as many in
+    /// each.
     #[arg(long, value_name = "SEL")]
     pub select: Option<String>,
     /// The per-atom properties to write, in this order (extended XYZ and LAMMPS dump outputs):
@@ -70,7 +71,10 @@ pub struct ConvertArgs {
     /// column, as OVITO, ASE and QUIP read it), .lammpstrj/.dump (a LAMMPS dump: id type x y z
     /// and the columns, read by LAMMPS's rerun, OVITO and MDAnalysis), .gro (GROMACS: residues,
     /// names, positions to 0.001 nm, velocities, the box), .pdb (multi-MODEL, the 'occupancy'
-    /// and 'bfactor' properties in their columns), .dcd, .xtc (positions and the box only).
+    /// and 'bfactor' properties in their columns), .cif/.mmcif (PDBx/mmCIF, for ChimeraX, PyMOL,
+    /// VMD and gemmi: frames as models, the 'occupancy' and 'bfactor'
+    /// properties, the first frame's box; no limit on atoms, residue numbers or chain names),
+    /// .dcd, .xtc (positions and the box only). Not compressed: gzip the file afterwards.
     /// Written whole or not at all. Without it, only the analyses' outputs are written (the
     /// --*-table options, --msd-lags, --density-map, --pca-projection, --pca-vectors,
     /// --pca-extremes, --dssp-timeline).
@@ -94,6 +98,7 @@ Examples:
   texmap convert anneal.lammpstrj --grains --columns grain,lattice_rmsd -o grains.lammpstrj  # OVITO's Grain segmentation, per atom
   texmap convert cascade.lammpstrj --wigner-seitz atoms --select 'prop site_occupancy != 1' -o defects.xyz
   texmap convert 1abc.cif --compute 'bfactor=coordination' --coordination 3.5 -o coord.pdb  # a property in the B-factor column (PyMOL, ChimeraX)
+  texmap convert md.xtc --topology md.gro --select 'not water' --frames ::10 -o models.cif   # PDBx/mmCIF models, any size (ChimeraX, PyMOL, gemmi)
   texmap convert melt.lammpstrj --frames 100: --rdf 10 --rdf-partial --rdf-table gr.csv    # g(r), total and per pair of types, averaged over frames 100 on
   texmap convert md.xtc --topology md.gro --msd-lags lags.csv                               # MSD over every time origin; prints D per kind
   texmap convert md.xtc --topology md.gro --align backbone --rmsf-table rmsf.csv            # flexibility; colour by it: render --property rmsf=rmsf.csv
@@ -116,8 +121,22 @@ The selection and the analyses are those of texmap render; an analysis's propert
 selection keyword; coordination, grain, centrosymmetry, shear_strain, ... are properties) is
 written as a column of the output.";
 
-/// The format of `flag`'s `output`, from its extension; only the formats with a writer.
+/// The format of `flag`'s `output`, from its extension; only the formats with a writer. A
+/// `.cif` is written as PDBx/mmCIF (`Format::from_path` names it so; reading tells a
+/// crystallographic CIF by its content). The writers do not compress: a `.gz` or `.bz2` name
+/// is refused rather than given uncompressed bytes that no reader would take for gzip.
 pub(crate) fn output_format(flag: &str, output: &std::path::Path) -> Result<Format> {
+    let compressed = output
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("gz") || e.eq_ignore_ascii_case("bz2"));
+    if compressed {
+        return usage(format!(
+            "{flag} {}: trajectories are written uncompressed; write {} and compress it afterwards",
+            output.display(),
+            output.with_extension("").display()
+        ));
+    }
     let format = Format::from_path(output);
     match format {
         Some(
@@ -125,11 +144,12 @@ pub(crate) fn output_format(flag: &str, output: &std::path::Path) -> Result<Form
             | Format::LammpsDump
             | Format::Gro
             | Format::Pdb
+            | Format::Mmcif
             | Format::Dcd
             | Format::Xtc),
         ) => Ok(f),
         _ => usage(format!(
-            "{flag} {}: expected a .xyz/.extxyz, .lammpstrj/.dump, .gro, .pdb, .dcd or .xtc file name",
+            "{flag} {}: expected a .xyz/.extxyz, .lammpstrj/.dump, .gro, .pdb, .cif/.mmcif, .dcd or .xtc file name",
             output.display()
         )),
     }
@@ -172,13 +192,13 @@ pub fn convert(a: &ConvertArgs) -> Result<()> {
     };
     let fixed_atoms = matches!(
         format,
-        Some(Format::Gro | Format::Pdb | Format::Dcd | Format::Xtc)
+        Some(Format::Gro | Format::Pdb | Format::Mmcif | Format::Dcd | Format::Xtc)
     );
     if let (Some(out), Some(_)) = (&a.output, &a.columns)
         && !matches!(format, Some(Format::Xyz | Format::LammpsDump))
     {
         return usage(format!(
-            "--columns: {} holds no per-atom columns of our choosing; write .xyz or .lammpstrj (a .pdb writes the 'occupancy' and 'bfactor' properties: --compute 'bfactor=NAME')",
+            "--columns: {} holds no per-atom columns of our choosing; write .xyz or .lammpstrj (a .pdb or .cif writes the 'occupancy' and 'bfactor' properties: --compute 'bfactor=NAME')",
             out.display()
         ));
     }
@@ -298,7 +318,7 @@ pub fn convert(a: &ConvertArgs) -> Result<()> {
     };
     match (&a.output, format) {
         (Some(out), Some(format)) => {
-            crate::output::write_atomic(out, |tmp| run(Some(Writer::create(tmp, format)?)))?
+            crate::output::write_atomic(out, |tmp| run(Some(Writer::create_as(tmp, format, out)?)))?
         }
         _ => run(None)?,
     }

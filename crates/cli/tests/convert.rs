@@ -54,6 +54,14 @@ fn frames(path: &Path) -> Vec<Frame> {
         .collect()
 }
 
+/// The values whose `keep` is true (a selection's atoms).
+fn kept<T: Clone>(values: &[T], keep: &[bool]) -> Vec<T> {
+    (values.iter().zip(keep))
+        .filter(|(_, k)| **k)
+        .map(|(v, _)| v.clone())
+        .collect()
+}
+
 fn run_ok(args: &[&str]) {
     let o = texmap(args);
     assert!(o.status.success(), "texmap {args:?}: {}", stderr(&o));
@@ -159,8 +167,9 @@ fn point_defects_are_ovitos_export() {
 }
 
 /// A smaller trajectory for another program: the C-alpha atoms of every second frame of
-/// MDAnalysis's XTC, as XTC, DCD, PDB, GRO and a LAMMPS dump; each equals the source's frames cut
-/// down by the GRO's atom names, to the output's precision.
+/// MDAnalysis's XTC, as XTC, DCD, PDB, PDBx/mmCIF, GRO and a LAMMPS dump; each equals the
+/// source's frames cut down by the GRO's atom names, to the output's precision (mmCIF: bit for
+/// bit, the atoms keeping their numbers in the whole frame).
 #[test]
 fn a_selection_of_every_second_frame_in_each_format() {
     let dir = tempfile::tempdir().unwrap();
@@ -175,6 +184,7 @@ fn a_selection_of_every_second_frame_in_each_format() {
         ("ca.xtc", 1.01e-3),
         ("ca.dcd", 1e-6),
         ("ca.pdb", 5.01e-4),
+        ("ca.cif", 0.0),
         ("ca.lammpstrj", 1e-6),
         ("ca.gro", 5.01e-3),
     ] {
@@ -196,13 +206,7 @@ fn a_selection_of_every_second_frame_in_each_format() {
         let expected: Vec<usize> = (0..source.len()).step_by(2).collect();
         assert_eq!(got.len(), expected.len(), "{out}");
         for (g, &k) in got.iter().zip(&expected) {
-            let want: Vec<[f32; 3]> = source[k]
-                .positions
-                .iter()
-                .zip(&keep)
-                .filter(|(_, k)| **k)
-                .map(|(p, _)| *p)
-                .collect();
+            let want = kept(&source[k].positions, &keep);
             assert_eq!(g.n_atoms(), picked, "{out}");
             for (a, b) in g.positions.iter().zip(&want) {
                 for c in 0..3 {
@@ -214,8 +218,12 @@ fn a_selection_of_every_second_frame_in_each_format() {
                 }
             }
         }
-        if out.ends_with(".pdb") || out.ends_with(".gro") {
+        if out.ends_with(".pdb") || out.ends_with(".gro") || out.ends_with(".cif") {
             assert!(got[0].names.iter().all(|n| n.as_str() == "CA"));
+        }
+        if out.ends_with(".cif") {
+            let ids = kept(&(1..=keep.len() as i64).collect::<Vec<_>>(), &keep);
+            assert!(got.iter().all(|g| g.ids == ids), "{out}: ids");
         }
     }
 }
@@ -295,7 +303,7 @@ fn bad_requests_are_refused_and_leave_no_file() {
         (
             vec![source.clone(), "-o".into(), out("x.png")],
             2,
-            "expected a .xyz/.extxyz, .lammpstrj/.dump, .gro, .pdb, .dcd or .xtc file name",
+            "expected a .xyz/.extxyz, .lammpstrj/.dump, .gro, .pdb, .cif/.mmcif, .dcd or .xtc file name",
         ),
         (
             vec![
@@ -360,6 +368,75 @@ fn bad_requests_are_refused_and_leave_no_file() {
         "{e}"
     );
     let leftovers: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+}
+
+/// `-o x.cif` writes PDBx/mmCIF: a multi-chain structure (protein, DNA, water, ions) reads
+/// back with the same atoms, labels and positions (bit for bit: shortest round-trip decimals),
+/// in a data block named after the output (`--select` and `--frames` into .cif:
+/// `a_selection_of_every_second_frame_in_each_format`).
+#[test]
+fn mmcif_output_reads_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let pdb = md_data("chains_mda.pdb");
+    let out = dir.path().join("chains.cif");
+    run_ok(&["convert", &pdb, "-q", "-o", out.to_str().unwrap()]);
+    let source = &frames(Path::new(&pdb))[0];
+    let back = frames(&out);
+    assert_eq!(back.len(), 1);
+    let atoms = |f: &Frame| {
+        let labels = [&f.names, &f.res_names, &f.chains].map(|l| l.clone());
+        (
+            f.positions.clone(),
+            labels,
+            f.res_ids.clone(),
+            f.ids.clone(),
+            f.elements.clone(),
+        )
+    };
+    assert!(
+        atoms(&back[0]) == atoms(source),
+        "every atom as the PDB has it"
+    );
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert!(
+        text.starts_with("data_chains\n"),
+        "named after -o, not the temporary file"
+    );
+}
+
+/// A label no CIF value can hold (a control character in an atom name) fails the frame,
+/// naming the atom, and leaves no file; a compressed output name is refused before reading.
+#[test]
+fn mmcif_output_refuses_what_would_not_read_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let xyz = dir.path().join("in");
+    std::fs::create_dir(&xyz).unwrap();
+    let xyz = xyz.join("bell.xyz");
+    std::fs::write(&xyz, "2\nbell\nC 0 0 0\nO\x07 1.2 0 0\n").unwrap();
+    let out = dir.path().join("out");
+    std::fs::create_dir(&out).unwrap();
+    let cases = [
+        ("bell.cif", 1, "frame 0: nothing was written"),
+        (
+            "bell.cif",
+            1,
+            "atom 1's name \"O\\u{7}\" holds a control character",
+        ),
+        ("x.cif.gz", 2, "written uncompressed; write"),
+    ];
+    for (name, code, message) in cases {
+        let path = out.join(name);
+        let o = texmap(&[
+            "convert",
+            xyz.to_str().unwrap(),
+            "-o",
+            path.to_str().unwrap(),
+        ]);
+        assert_eq!(o.status.code(), Some(code), "{name}: {}", stderr(&o));
+        assert!(stderr(&o).contains(message), "{name}: {}", stderr(&o));
+    }
+    let leftovers: Vec<_> = std::fs::read_dir(&out).unwrap().collect();
     assert!(leftovers.is_empty(), "{leftovers:?}");
 }
 

@@ -51,8 +51,8 @@
 //!   trajectories these files are one frame, the atoms
 //!   (`Format::Cube`, `Format::Vasp`), an XSF / AXSF file one per structure (`Format::Xsf`).
 //! - [`Writer`] writes extended XYZ and LAMMPS text dumps (positions, ids, types, velocities,
-//!   radii, colours and every named property, for OVITO, ASE and LAMMPS to read back), PDB,
-//!   DCD and XTC.
+//!   radii, colours and every named property, for OVITO, ASE and LAMMPS to read back), GRO,
+//!   PDB, PDBx/mmCIF, DCD and XTC.
 //! - [`elements`] maps atom names to elements, gives van der Waals radii and CPK colours, and
 //!   [`AtomStyle`] resolves each atom's radius and colour with user overrides.
 //!
@@ -152,6 +152,7 @@ mod lammps_data;
 mod lammps_dump_writer;
 pub mod membrane;
 mod mmcif;
+mod mmcif_writer;
 mod mol2;
 mod mrc;
 pub mod msd;

@@ -411,6 +411,21 @@ impl FrameWalk for Pdb {
     }
 }
 
+/// The element a writer gives atom `i`: the frame's, else (unknown or no element column) one
+/// guessed from its name and residue name ([`guess_element`]); may still be unknown.
+pub(crate) fn written_element(frame: &Frame, i: usize) -> crate::elements::Element {
+    frame
+        .elements
+        .get(i)
+        .filter(|e| !e.is_unknown())
+        .copied()
+        .unwrap_or_else(|| {
+            let n = frame.names.get(i).map_or("", |l| l.as_str());
+            let r = frame.res_names.get(i).map(|l| l.as_str());
+            guess_element(n, r, None)
+        })
+}
+
 /// Writes frames as PDB: one MODEL … ENDMDL per frame, a CRYST1 when the frame has a cell,
 /// hybrid-36 serial and residue numbers, element symbols in columns 77-78, END at `finish`.
 /// Segments longer than columns 73-76 keep their first 4 characters (MDAnalysis's and VMD's
@@ -498,16 +513,7 @@ impl<W: std::io::Write> PdbWriter<W> {
             let serial = frame.ids.get(i).copied().unwrap_or(i as i64 + 1);
             // Serials past hybrid-36's range were rejected by `check`; wrap defensively.
             let serial = hy36_encode(serial, 5).unwrap_or_else(|| "*****".into());
-            let element = frame
-                .elements
-                .get(i)
-                .filter(|e| !e.is_unknown())
-                .copied()
-                .unwrap_or_else(|| {
-                    let n = frame.names.get(i).map_or("", |l| l.as_str());
-                    let r = frame.res_names.get(i).map(|l| l.as_str());
-                    guess_element(n, r, None)
-                });
+            let element = written_element(frame, i);
             let sym = if element.is_unknown() {
                 String::new()
             } else {

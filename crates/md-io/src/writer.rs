@@ -11,6 +11,10 @@
 //!   positions to 0.001 nm, velocities, the box; time and step in the title).
 //! - [`Format::Pdb`], [`Format::Dcd`], [`Format::Xtc`]: positions and cell, with PDB's atom
 //!   records.
+//! - [`Format::Mmcif`]: PDBx/mmCIF, frames as the models of one `_atom_site` loop (names,
+//!   residues, chains and elements in the label and auth items, the `occupancy` and `bfactor`
+//!   properties, the first frame's cell), with no limit on atom count, residue numbers or chain
+//!   names (read back by gemmi, ChimeraX, PyMOL, VMD and our reader).
 //!
 //! Rules the text writers share:
 //! - numbers are written in Rust's shortest round-trip form, so reading them back gives the
@@ -25,7 +29,7 @@
 //!   the format cannot hold, and for LAMMPS a cell that is not restricted triclinic.
 //!
 //! The per-format details are on the writer types (src/xyz.rs `XyzWriter`,
-//! src/lammps_dump_writer.rs, src/gro.rs `GroWriter`).
+//! src/lammps_dump_writer.rs, src/gro.rs `GroWriter`, src/mmcif_writer.rs).
 
 use crate::dcd::DcdWriter;
 use crate::error::{Error, Location};
@@ -33,6 +37,7 @@ use crate::format::Format;
 use crate::frame::Frame;
 use crate::gro::GroWriter;
 use crate::lammps_dump_writer::LammpsDumpWriter;
+use crate::mmcif_writer::MmcifWriter;
 use crate::pdb::PdbWriter;
 use crate::xtc::XtcWriter;
 use crate::xyz::XyzWriter;
@@ -94,6 +99,7 @@ enum WriterKind<W> {
     Dcd(DcdWriter<W>),
     Xtc(XtcWriter<W>),
     Pdb(PdbWriter<W>),
+    Mmcif(MmcifWriter<W>),
 }
 
 /// Runs `$body` with `$w` bound to the format's writer, whatever the format.
@@ -106,6 +112,7 @@ macro_rules! each_writer {
             WriterKind::Dcd($w) => $body,
             WriterKind::Xtc($w) => $body,
             WriterKind::Pdb($w) => $body,
+            WriterKind::Mmcif($w) => $body,
         }
     };
 }
@@ -122,8 +129,19 @@ pub struct Writer<W: Write + Seek = BufWriter<File>> {
 impl Writer<BufWriter<File>> {
     /// Creates (or truncates) `path` and writes `format` to it.
     pub fn create(path: impl AsRef<Path>, format: Format) -> Result<Self, Error> {
+        Writer::create_as(path.as_ref(), format, path.as_ref())
+    }
+
+    /// Creates (or truncates) `path`, a temporary file to be renamed `name` once whole, and
+    /// writes `format` to it: errors name `name`, and so does the file's content where the
+    /// format keeps a name (the data block of PDBx/mmCIF).
+    pub fn create_as(
+        path: impl AsRef<Path>,
+        format: Format,
+        name: impl AsRef<Path>,
+    ) -> Result<Self, Error> {
         let path = path.as_ref();
-        let name: Arc<str> = path.display().to_string().into();
+        let name: Arc<str> = name.as_ref().display().to_string().into();
         let f = File::create(path).map_err(|source| Error::Io {
             at: Location::file(&name),
             source,
@@ -143,6 +161,7 @@ impl<W: Write + Seek> Writer<W> {
             Format::Dcd => WriterKind::Dcd(DcdWriter::new(out, file.clone())),
             Format::Xtc => WriterKind::Xtc(XtcWriter::new(out, file.clone(), 1000.0)?),
             Format::Pdb => WriterKind::Pdb(PdbWriter { out, models: 0 }),
+            Format::Mmcif => WriterKind::Mmcif(MmcifWriter::new(out, &file)),
             _ => {
                 return Err(Error::Unsupported {
                     file,
@@ -181,6 +200,7 @@ impl<W: Write + Seek> Writer<W> {
             WriterKind::Xyz(_) => XyzWriter::<W>::check(frame),
             WriterKind::LammpsDump(_) => LammpsDumpWriter::<W>::check(frame),
             WriterKind::Gro(_) => GroWriter::<W>::check(frame),
+            WriterKind::Mmcif(w) => w.check(frame),
             _ => Ok(()),
         };
         limits.map_err(|what| Error::InvalidFrame {
