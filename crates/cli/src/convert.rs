@@ -69,7 +69,10 @@ pub struct ConvertArgs {
     pub columns: Option<Vec<String>>,
     /// The output file; its extension names the format: .xyz/.extxyz (extended XYZ with every
     /// column, as OVITO, ASE and QUIP read it), .lammpstrj/.dump (a LAMMPS dump: id type x y z
-    /// and the columns, read by LAMMPS's rerun, OVITO and MDAnalysis), .gro (GROMACS: residues,
+    /// and the columns, read by LAMMPS's rerun, OVITO and MDAnalysis), .data/.lmp (one frame as
+    /// a LAMMPS data file for read_data: atom style full, molecular, charge or atomic by
+    /// whether the frame has bonds and charges, types with their masses, bonds typed by their
+    /// atoms' types, the cell rotated into LAMMPS's restricted triclinic box), .gro (GROMACS: residues,
     /// names, positions to 0.001 nm, velocities, the box), .pdb (multi-MODEL, the 'occupancy'
     /// and 'bfactor' properties in their columns), .cif/.mmcif (PDBx/mmCIF, for ChimeraX, PyMOL,
     /// VMD and gemmi: frames as models, the 'occupancy' and 'bfactor'
@@ -142,6 +145,7 @@ pub(crate) fn output_format(flag: &str, output: &std::path::Path) -> Result<Form
         Some(
             f @ (Format::Xyz
             | Format::LammpsDump
+            | Format::LammpsData
             | Format::Gro
             | Format::Pdb
             | Format::Mmcif
@@ -149,7 +153,7 @@ pub(crate) fn output_format(flag: &str, output: &std::path::Path) -> Result<Form
             | Format::Xtc),
         ) => Ok(f),
         _ => usage(format!(
-            "{flag} {}: expected a .xyz/.extxyz, .lammpstrj/.dump, .gro, .pdb, .cif/.mmcif, .dcd or .xtc file name",
+            "{flag} {}: expected a .xyz/.extxyz, .lammpstrj/.dump, .data/.lmp, .gro, .pdb, .cif/.mmcif, .dcd or .xtc file name",
             output.display()
         )),
     }

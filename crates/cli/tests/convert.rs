@@ -2619,3 +2619,68 @@ fn membrane_table_is_leaflet_finders_thickness_and_area() {
     assert!(stderr(&o).contains("no bilayer"), "{}", stderr(&o));
     assert!(!csv.exists());
 }
+
+#[test]
+fn lammps_data_output_is_the_file_lammps_read() {
+    // md-io/tests/data/lammps_write: LAMMPS 29 Sep 2021 read these very bytes with read_data
+    // (md-io/tests/lammps_write.rs compares what it made of them with what we wrote).
+    let dir = tempfile::tempdir().unwrap();
+    for (case, args) in [
+        ("nacl", vec![md_data("lammps_write/nacl_primitive.vasp")]),
+        ("cod", vec![md_data("crystal/cod_9001665.cif")]),
+        ("nisb", vec![md_data("crystal/cod_1010930.cif")]),
+        (
+            "peptide",
+            vec![
+                md_data("tpr/peptide.tpr.gz"),
+                "--select".into(),
+                "not name MW and index 0:999".into(),
+            ],
+        ),
+        ("caffeine", vec![md_data("molecules/caffeine_v3000.mol")]),
+    ] {
+        let out = dir.path().join(format!("{case}.data"));
+        let mut all: Vec<&str> = vec!["convert", "-q"];
+        all.extend(args.iter().map(String::as_str));
+        all.extend(["-o", out.to_str().unwrap()]);
+        let o = texmap(&all);
+        assert!(o.status.success(), "{case}: {}", stderr(&o));
+        let got = std::fs::read(&out).unwrap();
+        let want = match std::fs::read(md_data(&format!("lammps_write/written/{case}.data"))) {
+            Ok(w) => w,
+            Err(_) => {
+                let mut w = Vec::new();
+                std::io::Read::read_to_end(
+                    &mut flate2::read::GzDecoder::new(
+                        std::fs::File::open(md_data(&format!(
+                            "lammps_write/written/{case}.data.gz"
+                        )))
+                        .unwrap(),
+                    ),
+                    &mut w,
+                )
+                .unwrap();
+                w
+            }
+        };
+        assert!(
+            got == want,
+            "{case}: the bytes differ from the file LAMMPS read"
+        );
+    }
+    // A data file is one configuration: two frames are refused, and nothing is left.
+    let out = dir.path().join("two.data");
+    let o = texmap(&[
+        "convert",
+        &md_data("topo_mda.xtc"),
+        "--topology",
+        &md_data("topo_mda.gro"),
+        "--frames",
+        "0:2",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("one configuration"), "{}", stderr(&o));
+    assert!(!out.exists());
+}

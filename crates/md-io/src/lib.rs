@@ -149,6 +149,7 @@ mod gz;
 pub mod hbonds;
 mod lammps;
 mod lammps_data;
+mod lammps_data_writer;
 mod lammps_dump_writer;
 pub mod membrane;
 mod mmcif;

@@ -7,6 +7,9 @@
 //!   type x y z` then `element`, `vx vy vz`, `radius`, `ColorR ColorG ColorB` and the
 //!   properties when the frame has them (read back by LAMMPS `read_dump`, OVITO, ASE and our
 //!   reader).
+//! - [`Format::LammpsData`]: one frame as a LAMMPS data file for `read_data` (atom style by
+//!   what the frame has, types with their masses, bonds typed by their atoms' types, the box
+//!   in LAMMPS's restricted form: src/lammps_data_writer.rs).
 //! - [`Format::Gro`]: GROMACS .gro as `gmx trjconv` writes it (residues, names, numbers,
 //!   positions to 0.001 nm, velocities, the box; time and step in the title).
 //! - [`Format::Pdb`], [`Format::Dcd`], [`Format::Xtc`]: positions and cell, with PDB's atom
@@ -36,6 +39,7 @@ use crate::error::{Error, Location};
 use crate::format::Format;
 use crate::frame::Frame;
 use crate::gro::GroWriter;
+use crate::lammps_data_writer::LammpsDataWriter;
 use crate::lammps_dump_writer::LammpsDumpWriter;
 use crate::mmcif_writer::MmcifWriter;
 use crate::pdb::PdbWriter;
@@ -95,6 +99,7 @@ pub(crate) fn write_atom_tail(
 enum WriterKind<W> {
     Xyz(XyzWriter<W>),
     LammpsDump(LammpsDumpWriter<W>),
+    LammpsData(LammpsDataWriter<W>),
     Gro(GroWriter<W>),
     Dcd(DcdWriter<W>),
     Xtc(XtcWriter<W>),
@@ -108,6 +113,7 @@ macro_rules! each_writer {
         match $writer {
             WriterKind::Xyz($w) => $body,
             WriterKind::LammpsDump($w) => $body,
+            WriterKind::LammpsData($w) => $body,
             WriterKind::Gro($w) => $body,
             WriterKind::Dcd($w) => $body,
             WriterKind::Xtc($w) => $body,
@@ -157,6 +163,7 @@ impl<W: Write + Seek> Writer<W> {
         let kind = match format {
             Format::Xyz => WriterKind::Xyz(XyzWriter { out }),
             Format::LammpsDump => WriterKind::LammpsDump(LammpsDumpWriter::new(out)),
+            Format::LammpsData => WriterKind::LammpsData(LammpsDataWriter::new(out)),
             Format::Gro => WriterKind::Gro(GroWriter { out }),
             Format::Dcd => WriterKind::Dcd(DcdWriter::new(out, file.clone())),
             Format::Xtc => WriterKind::Xtc(XtcWriter::new(out, file.clone(), 1000.0)?),
@@ -199,6 +206,7 @@ impl<W: Write + Seek> Writer<W> {
             WriterKind::Pdb(_) => PdbWriter::<W>::check(frame),
             WriterKind::Xyz(_) => XyzWriter::<W>::check(frame),
             WriterKind::LammpsDump(_) => LammpsDumpWriter::<W>::check(frame),
+            WriterKind::LammpsData(w) => w.check(frame),
             WriterKind::Gro(_) => GroWriter::<W>::check(frame),
             WriterKind::Mmcif(w) => w.check(frame),
             _ => Ok(()),
