@@ -1444,8 +1444,8 @@ pub struct AnalysisArgs {
     #[arg(long, value_name = "FILE.csv")]
     pub rmsd_cluster_table: Option<PathBuf>,
     /// Also write each cluster's middle structure, every atom of its frame, one frame per
-    /// cluster in cluster order (gmx cluster -cl), in the format the name gives (.pdb, .xyz,
-    /// .gro, .xtc, .dcd, ...): the representative conformations to render or compare. Keeps
+    /// cluster in cluster order (gmx cluster -cl), in the format the name gives (.pdb, .cif,
+    /// .xyz, .gro, .xtc, .dcd, ...): the representative conformations to render or compare. Keeps
     /// every frame's positions until the end (12 bytes per atom and frame, within
     /// --msd-memory).
     #[arg(long, value_name = "FILE")]
@@ -1492,7 +1492,7 @@ pub struct AnalysisArgs {
     pub pca_vectors: Option<PathBuf>,
     /// Also write --pca-select's atoms moving along principal component --pca-mode, from its
     /// smallest projection in the run to its largest, as a trajectory of --pca-extreme-frames
-    /// frames (gmx anaeig -extr; .pdb, .xtc, .dcd, .gro, .xyz or .lammpstrj by the name):
+    /// frames (gmx anaeig -extr; .pdb, .cif, .xtc, .dcd, .gro, .xyz or .lammpstrj by the name):
     /// `texmap render` makes it a movie of the motion.
     #[arg(long, value_name = "FILE")]
     pub pca_extremes: Option<PathBuf>,
