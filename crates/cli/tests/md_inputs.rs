@@ -4252,3 +4252,65 @@ fn gromacs_index_groups_select_with_index() {
         stderr(&o)
     );
 }
+
+#[test]
+fn ase_trajectories_render_and_convert() {
+    // ASE's .traj (md-io/tests/data/asetraj, written by ASE 3.29): info, a picture with the
+    // calculator's forces as arrows, and extended XYZ with the velocities ASE reads.
+    let traj = data("asetraj/cu_md.traj");
+    let o = texmap(&["info", &traj]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["format"], "ase-traj");
+    assert_eq!(v["frames"], 4);
+    assert_eq!(v["atoms"], 32);
+    let dir = tempfile::tempdir().unwrap();
+    let png = render_png(
+        dir.path(),
+        &[
+            &traj,
+            "--frames",
+            "0",
+            "--rep",
+            "all=arrows",
+            "--arrows",
+            "f",
+            "--size",
+            "64x64",
+        ],
+        "forces.png",
+    );
+    assert!(png.starts_with(b"\x89PNG"));
+    let xyz = dir.path().join("cu.xyz");
+    let o = texmap(&[
+        "convert",
+        &traj,
+        "--frames",
+        "2",
+        "-o",
+        xyz.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let mut text = String::new();
+    std::io::Read::read_to_string(
+        &mut flate2::read::GzDecoder::new(
+            std::fs::File::open(data("asetraj/reference.json.gz")).unwrap(),
+        ),
+        &mut text,
+    )
+    .unwrap();
+    let r: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let want = &r["cu_md.traj"][2]["velocities"];
+    let mut t = texmap_md_io::Trajectory::open(&xyz).unwrap();
+    let mut f = texmap_md_io::Frame::new();
+    t.read_next(&mut f).unwrap();
+    for (i, v) in f.velocities.iter().enumerate() {
+        for k in 0..3 {
+            let w = want[i][k].as_f64().unwrap();
+            assert!(
+                (v[k] as f64 - w).abs() <= 1e-4 * w.abs().max(1.0),
+                "atom {i}"
+            );
+        }
+    }
+}

@@ -87,11 +87,15 @@ pub enum Format {
     /// masses, charges and the force field's chemical bonds): see [`crate::read_tpr`]; by
     /// name: `tpr`.
     Tpr,
+    /// ASE trajectories (ASE's ULM binary format: `ase.io.Trajectory`, its MD drivers and
+    /// optimisers): numbers, positions, cell and pbc, momenta as velocities, the calculator's
+    /// forces and energies: `.traj`; by name: `ase-traj`.
+    AseTraj,
 }
 
 impl Format {
     /// Every format, in declaration order.
-    pub const ALL: [Format; 26] = [
+    pub const ALL: [Format; 27] = [
         Format::Xyz,
         Format::Pdb,
         Format::Gro,
@@ -118,6 +122,7 @@ impl Format {
         Format::DlPoly,
         Format::Xsf,
         Format::Tpr,
+        Format::AseTraj,
     ];
 
     /// The format a file extension (case-insensitive, e.g. "xyz", "lammpstrj") or a format's
@@ -151,6 +156,7 @@ impl Format {
             "dlpoly" => Format::DlPoly,
             "xsf" | "axsf" => Format::Xsf,
             "tpr" => Format::Tpr,
+            "traj" | "ase-traj" => Format::AseTraj,
             _ => return None,
         })
     }
@@ -224,6 +230,10 @@ impl Format {
         // GROMACS .tpr: an XDR string "VERSION ..." first (two lengths, then the text).
         if head.get(8..15) == Some(b"VERSION") {
             return Some(Format::Tpr);
+        }
+        // ASE trajectory: the ULM magic.
+        if head.get(..8) == Some(b"- of Ulm") {
+            return Some(Format::AseTraj);
         }
         // NetCDF-3: "CDF" and the version byte 1 (classic) or 2 (64-bit offset).
         if matches!(head.get(..4), Some(b"CDF\x01" | b"CDF\x02")) {
@@ -473,6 +483,7 @@ impl Format {
             Format::DlPoly => "dlpoly",
             Format::Xsf => "xsf",
             Format::Tpr => "tpr",
+            Format::AseTraj => "ase-traj",
         }
     }
 }

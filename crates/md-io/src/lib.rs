@@ -115,6 +115,7 @@
 //! streaming, the line-scan index and error positions from `TextReader`.
 
 mod amber;
+mod asetraj;
 pub mod bonds;
 pub mod centrosymmetry;
 mod chgcar;

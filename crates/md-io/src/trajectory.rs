@@ -59,6 +59,7 @@ enum Reader<R> {
     Pqr(TextReader<R, Pqr>),
     Xsf(TextReader<R, Xsf>),
     Tpr(crate::tpr::TprReader),
+    AseTraj(crate::asetraj::AseTrajReader<R>),
 }
 
 /// Runs `$body` with `$r` bound to the format's reader, whatever the format.
@@ -90,6 +91,7 @@ macro_rules! each_reader {
             Reader::Pqr($r) => $body,
             Reader::Xsf($r) => $body,
             Reader::Tpr($r) => $body,
+            Reader::AseTraj($r) => $body,
         }
     };
 }
@@ -391,6 +393,9 @@ impl<R: Read + Seek> Trajectory<R> {
             Format::Gsd => Reader::Gsd(GsdReader::new(src, file.clone())?),
             Format::NamdBin => Reader::NamdBin(NamdBinReader::new(src, file.clone())?),
             Format::Tpr => Reader::Tpr(crate::tpr::TprReader::new(src, file.clone())?),
+            Format::AseTraj => {
+                Reader::AseTraj(crate::asetraj::AseTrajReader::new(src, file.clone())?)
+            }
             Format::Tinker => Reader::Tinker(TextReader::new(src, Tinker::default(), file.clone())),
             Format::DlPoly => Reader::DlPoly(TextReader::new(src, DlPoly::default(), file.clone())),
             Format::Pdb => Reader::Pdb(TextReader::new(src, Pdb::new(lenient), file.clone())),

@@ -803,6 +803,29 @@ fn tpr_campaign() {
 }
 
 #[test]
+fn ase_traj_campaign() {
+    // The offsets table sits at the end: any cut is an error. The counts are int64s; their low
+    // halves are set to extremes (item count, table position).
+    let fx = ["asetraj/cu_md.traj", "asetraj/mixed.traj"].map(|name| {
+        let bytes = data(name);
+        let len = bytes.len();
+        Fixture {
+            frames: frames_of(Format::AseTraj, &bytes),
+            name: name.into(),
+            bytes,
+            boundaries: vec![0, 8, 24, 48, len],
+            cuts: Cuts::Declared,
+            fields: vec![
+                ("nitems", Field::I32Le(32)),
+                ("offsets position", Field::I32Le(40)),
+            ],
+            text: false,
+        }
+    });
+    campaign("ASE trajectory", Format::AseTraj, fx.into());
+}
+
+#[test]
 fn tinker_campaign() {
     let files = ["tinker/water_box.arc", "tinker/caffeine.txyz"];
     let fx = files.map(|f| text_fixture(f, Format::Tinker));
