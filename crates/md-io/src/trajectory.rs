@@ -345,6 +345,15 @@ impl Trajectory<File> {
             Format::AmberRestart if is_netcdf(&mut file, &name)? => Format::Netcdf,
             // Tinker writes `.xyz` too.
             Format::Xyz if is_tinker(&mut file, &name)? => Format::Tinker,
+            // Other programs name files `.traj` too: without ASE's ULM magic, the content
+            // tells (else the ASE reader says what it expected).
+            Format::AseTraj => {
+                let head = head(&mut file, &name, 512)?;
+                match Format::from_magic(&head) {
+                    Some(f) if !head.starts_with(b"- of Ulm") => f,
+                    _ => Format::AseTraj,
+                }
+            }
             other => other,
         };
         Trajectory::from_reader_with(file, format, &name, options).map(|t| t.with_warning(cut))
