@@ -16,7 +16,8 @@ use crate::args::usage;
 pub enum TerrainCmd {
     /// Build a terrain database (chunked LoD mesh + GST map pyramid) from an elevation grid.
     Build {
-        /// Elevation grid: GeoTIFF, ESRI ASCII (.asc), SRTM (.hgt) or 16-bit PNG. Several grids
+        /// Elevation grid: GeoTIFF, ESRI ASCII (.asc), SRTM (.hgt), DTED (.dt0, .dt1, .dt2), ESRI
+        /// GridFloat (.flt) or BIL (.bil) with its .hdr and .prj, or 16-bit PNG. Several grids
         /// that tile an area (e.g. `--dem N44W072.hgt N44W071.hgt`) are joined as gdalbuildvrt
         /// joins them: one system, cell size and lattice; the later file wins where they overlap.
         #[arg(long, num_args = 1.., required = true)]
@@ -80,6 +81,10 @@ pub enum TerrainCmd {
         /// Fill no-data from neighbours instead of leaving holes.
         #[arg(long)]
         fill: bool,
+        /// DTED: read records whose checksum does not match their bytes (a producer that wrote
+        /// wrong checksums) instead of refusing the file.
+        #[arg(long)]
+        ignore_checksums: bool,
         /// Output directory (must not exist).
         #[arg(long)]
         out: PathBuf,
@@ -170,6 +175,7 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
             offset,
             cell,
             fill,
+            ignore_checksums,
             out,
         } => {
             let bands = match bands {
@@ -202,6 +208,7 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
                 scale,
                 offset,
                 cell,
+                verify_checksums: !ignore_checksums,
             };
             let names: Vec<String> = dem.iter().map(|p| p.display().to_string()).collect();
             let parts = dem

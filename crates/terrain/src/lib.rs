@@ -5,6 +5,7 @@
 //!
 //! - [`dem`]: elevation grids with their georeference and no-data — GeoTIFF (strips or tiles, chunk
 //!   by chunk, BigTIFF, GeoKeys, PixelIsArea/PixelIsPoint, GDAL no-data), ESRI ASCII, SRTM `.hgt`,
+//!   DTED levels 0–2 (checksums verified), ESRI GridFloat `.flt` and BIL `.bil` (with the `.prj`),
 //!   16-bit and Terrain-RGB PNG; geographic grids become local metres with the latitude-dependent
 //!   spacing.
 //! - [`rtin`]: a right-triangulated irregular network with an *exact* per-triangle error bound

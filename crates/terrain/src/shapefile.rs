@@ -47,9 +47,8 @@ pub fn read_shapefile(path: impl AsRef<Path>) -> Result<VectorLayer, TerrainErro
     };
     let features = parse_shp(&bytes, &source)?;
     let crs = match (&wkt, &prj) {
-        (Some(w), Some(p)) => {
-            crs_of_wkt(w).map_err(|e| format_err(&p.display().to_string(), "the system", e))?
-        }
+        (Some(w), Some(p)) => crs_of_wkt(w, "ogr2ogr")
+            .map_err(|e| format_err(&p.display().to_string(), "the system", e))?,
         _ => {
             let degrees = features.iter().all(|f| {
                 f.points
@@ -241,8 +240,10 @@ fn record(c: &[u8], base: usize) -> Result<Feature, (usize, String)> {
     Ok(feature)
 }
 
-/// The layer system a `.prj`'s WKT names (see the module docs).
-fn crs_of_wkt(wkt: &str) -> Result<LayerCrs, String> {
+/// The layer system a `.prj`'s WKT names (see the module docs; also the `.prj` of an ESRI
+/// `.hdr` raster, [`crate::dem::ehdr`]). A system texmap does not place is refused by name, with
+/// the hint to convert it with `tool` (`ogr2ogr` for vectors, `gdalwarp` for rasters).
+pub(crate) fn crs_of_wkt(wkt: &str, tool: &str) -> Result<LayerCrs, String> {
     let wkt = wkt.trim();
     let head = wkt
         .split('[')
@@ -254,7 +255,7 @@ fn crs_of_wkt(wkt: &str) -> Result<LayerCrs, String> {
     let refuse = || {
         format!(
             "a system texmap places (WGS 84, ETRS89 or NAD83 degrees, their UTM zones, Web \
-             Mercator), found \"{name}\" (convert with ogr2ogr -t_srs EPSG:4326)"
+             Mercator), found \"{name}\" (convert with {tool} -t_srs EPSG:4326)"
         )
     };
     // OGC WKT: the outermost system's AUTHORITY is the last one in the text.
@@ -312,19 +313,34 @@ mod tests {
     #[test]
     fn esri_and_ogc_names_give_the_epsg_codes() {
         let esri_utm = r#"PROJCS["WGS_1984_UTM_Zone_19N",GEOGCS["GCS_WGS_1984",DATUM["D_WGS_1984",SPHEROID["WGS_1984",6378137.0,298.257223563]],PRIMEM["Greenwich",0.0],UNIT["Degree",0.0174532925199433]],PROJECTION["Transverse_Mercator"],UNIT["Meter",1.0]]"#;
-        assert!(matches!(crs_of_wkt(esri_utm), Ok(LayerCrs::Epsg(32619, _))));
+        assert!(matches!(
+            crs_of_wkt(esri_utm, "ogr2ogr"),
+            Ok(LayerCrs::Epsg(32619, _))
+        ));
         let etrs = r#"PROJCS["ETRS_1989_UTM_Zone_33N",GEOGCS["GCS_ETRS_1989"]]"#;
-        assert!(matches!(crs_of_wkt(etrs), Ok(LayerCrs::Epsg(25833, _))));
+        assert!(matches!(
+            crs_of_wkt(etrs, "ogr2ogr"),
+            Ok(LayerCrs::Epsg(25833, _))
+        ));
         let south = r#"PROJCS["WGS 84 / UTM zone 33S",GEOGCS["WGS 84"]]"#;
-        assert!(matches!(crs_of_wkt(south), Ok(LayerCrs::Epsg(32733, _))));
+        assert!(matches!(
+            crs_of_wkt(south, "ogr2ogr"),
+            Ok(LayerCrs::Epsg(32733, _))
+        ));
         let ogc = r#"PROJCS["WGS 84 / UTM zone 19N",GEOGCS["WGS 84",DATUM["WGS_1984",AUTHORITY["EPSG","6326"]],AUTHORITY["EPSG","4326"]],UNIT["metre",1,AUTHORITY["EPSG","9001"]],AUTHORITY["EPSG","32619"]]"#;
-        assert!(matches!(crs_of_wkt(ogc), Ok(LayerCrs::Epsg(32619, _))));
+        assert!(matches!(
+            crs_of_wkt(ogc, "ogr2ogr"),
+            Ok(LayerCrs::Epsg(32619, _))
+        ));
         let wm = r#"PROJCS["WGS_1984_Web_Mercator_Auxiliary_Sphere",GEOGCS["GCS_WGS_1984"]]"#;
-        assert!(matches!(crs_of_wkt(wm), Ok(LayerCrs::Epsg(3857, _))));
+        assert!(matches!(
+            crs_of_wkt(wm, "ogr2ogr"),
+            Ok(LayerCrs::Epsg(3857, _))
+        ));
         let deg = r#"GEOGCS["GCS_WGS_1984",DATUM["D_WGS_1984"]]"#;
-        assert_eq!(crs_of_wkt(deg), Ok(LayerCrs::Lonlat));
+        assert_eq!(crs_of_wkt(deg, "ogr2ogr"), Ok(LayerCrs::Lonlat));
         let lambert = r#"PROJCS["RGF93_Lambert_93",GEOGCS["GCS_RGF_1993"]]"#;
-        let e = crs_of_wkt(lambert).unwrap_err();
+        let e = crs_of_wkt(lambert, "ogr2ogr").unwrap_err();
         assert!(
             e.contains("\"RGF93_Lambert_93\"") && e.contains("ogr2ogr"),
             "{e}"

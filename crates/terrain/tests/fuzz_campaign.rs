@@ -1,6 +1,7 @@
 //! The terrain readers in the fuzz campaign every reader of the project runs (the harness is
 //! md-io's `tests/support/`, shared by path): GeoTIFF files written by GDAL (five sample types,
-//! strips and tiles, LZW, BigTIFF, PixelIsPoint), the ESRI ASCII grid GDAL wrote, and an SRTM
+//! strips and tiles, LZW, BigTIFF, PixelIsPoint), the ESRI ASCII grid GDAL wrote, GDAL's DTED
+//! level 0 cell and 16-bit BIL (its `.hdr` and its samples mutated apart), and an SRTM
 //! `.hgt` tile and a 16-bit PNG made here; and the vector overlays and recorded flights (GeoJSON,
 //! GPX, IGC) written by ogr2ogr, gpxpy and aerofiles. Each mutant — a cut, bit flips, byte replacements,
 //! header fields set to extremes — must end in a grid or an error naming the file, never a panic,
@@ -165,6 +166,86 @@ fn terrain_readers_survive_the_campaign() {
     let t = run_campaign("SRTM hgt", &fx, &small, &|_, bytes| {
         std::fs::write(&hgt_path, bytes).unwrap();
         verdict(dem::hgt::read_hgt(&hgt_path), &hgt_path)
+    });
+    report.push_str(&t.report());
+    assert!(t.failures.is_empty(), "{}", t.report());
+
+    // DTED: GDAL's level 0 cell, checksums verified (every record boundary a cut; the UHL's
+    // line and point counts, ASCII, set to extremes).
+    let dt0 = data("n44w072.dt0");
+    let record = 12 + 2 * 121;
+    let mut fx = fixture(
+        "n44w072.dt0",
+        dt0,
+        vec![
+            ("UHL longitude lines", Field::Text(47, 51)),
+            ("UHL latitude points", Field::Text(51, 55)),
+        ],
+        false,
+    );
+    fx.boundaries = (0..=121)
+        .map(|k| dem::dted::HEADER_LEN + k * record)
+        .chain([80, 728])
+        .collect();
+    let t = run_campaign("DTED", &[fx], &settings, &|_, bytes| {
+        let name = "n44w072.dt0";
+        let r = dem::dted::read_dted_bytes(bytes, name, dem::dted::Checksums::Verify);
+        verdict(r, Path::new(name))
+    });
+    report.push_str(&t.report());
+    assert!(t.failures.is_empty(), "{}", t.report());
+
+    // ESRI .hdr rasters: GDAL's 16-bit BIL, its header text mutated over the true samples (NCOLS
+    // and the row strides set to extremes), then its samples cut and flipped under the true
+    // header.
+    let hdr = data("ramp_i16.hdr");
+    let bil = data("ramp_i16.bil");
+    let text = String::from_utf8(hdr.clone()).unwrap();
+    // The value after a key, as a text field.
+    let value = |key: &str, v: &str| {
+        let k = text.find(key).unwrap();
+        let start = k + text[k..].find(v).unwrap();
+        Field::Text(start, start + v.len())
+    };
+    let fields = vec![
+        ("NCOLS", value("NCOLS", "37")),
+        ("BANDROWBYTES", value("BANDROWBYTES", "74")),
+        ("TOTALROWBYTES", value("TOTALROWBYTES", "74")),
+    ];
+    let mut fx = unchecked(fixture("ramp_i16.hdr", hdr, fields, true));
+    fx.boundaries = campaign::line_starts(&fx.bytes);
+    // An error must name the header or the data file, whichever holds the fault.
+    let either = |r: Result<Grid, TerrainError>| {
+        let named = match &r {
+            Err(e) => ["ramp_i16.hdr", "ramp_i16.bil"]
+                .into_iter()
+                .find(|n| e.to_string().starts_with(&format!("{n}: "))),
+            Ok(_) => Some(""),
+        };
+        match named {
+            Some(n) => verdict(r, Path::new(n)),
+            None => Verdict::Broken(format!("an error that names neither file: {:?}", r.err())),
+        }
+    };
+    let parts = |header: &str, samples: &[u8]| {
+        dem::ehdr::read_ehdr_parts(&dem::ehdr::EhdrParts {
+            header,
+            header_name: "ramp_i16.hdr",
+            data: samples,
+            data_name: "ramp_i16.bil",
+            prj: None,
+            gridfloat: false,
+        })
+    };
+    let t = run_campaign("ESRI .hdr header", &[fx], &settings, &|_, bytes| {
+        either(parts(&String::from_utf8_lossy(bytes), &bil))
+    });
+    report.push_str(&t.report());
+    assert!(t.failures.is_empty(), "{}", t.report());
+    let mut fx = fixture("ramp_i16.bil", bil.clone(), vec![], false);
+    fx.boundaries = (0..29).map(|r| r * 74).collect();
+    let t = run_campaign("ESRI .hdr samples", &[fx], &settings, &|_, bytes| {
+        either(parts(&text, bytes))
     });
     report.push_str(&t.report());
     assert!(t.failures.is_empty(), "{}", t.report());

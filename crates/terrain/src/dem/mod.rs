@@ -16,11 +16,15 @@
 //! conversion happens when vertices are made, so the georeference survives to the export.
 //!
 //! Readers ([`DemFormat`], [`read_dem`]): GeoTIFF ([`geotiff`]), ESRI ASCII grid ([`asc`]),
-//! SRTM `.hgt` ([`hgt`]), 16-bit PNG with a scale and offset and Mapbox Terrain-RGB PNG
-//! ([`png`]); grids that tile an area join into one ([`mosaic`]). Each validates at the file boundary ([`Grid::new`]): at least 2 x 2 samples, at most
-//! [`MAX_SAMPLES`], every value finite or no-data, not all no-data.
+//! SRTM `.hgt` ([`hgt`]), DTED levels 0–2 ([`dted`]), ESRI GridFloat `.flt` and BIL `.bil` with
+//! their `.hdr` and `.prj` ([`ehdr`]), 16-bit PNG with a scale and offset and Mapbox Terrain-RGB
+//! PNG ([`png`]); grids that tile an area join into one ([`mosaic`]). Each validates at the file
+//! boundary ([`Grid::new`]): at least 2 x 2 samples, at most [`MAX_SAMPLES`], every value finite
+//! or no-data, not all no-data.
 
 pub mod asc;
+pub mod dted;
+pub mod ehdr;
 pub mod geotiff;
 pub mod hgt;
 pub mod mosaic;
@@ -454,12 +458,17 @@ impl Grid {
     }
 }
 
-/// The elevation file formats read by [`read_dem`] (chosen by extension).
+/// The elevation file formats read by [`read_dem`] (chosen by extension, or by content when the
+/// extension is not one of theirs).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum DemFormat {
     GeoTiff,
     EsriAscii,
     Hgt,
+    /// DTED levels 0, 1, 2 (`.dt0`, `.dt1`, `.dt2`).
+    Dted,
+    /// ESRI `.hdr` labelled rasters: GridFloat `.flt` and BIL `.bil` (or their `.hdr`).
+    EsriHdr,
     /// 16-bit greyscale PNG: `height = scale · value + offset`.
     Png16,
     /// Mapbox Terrain-RGB: `height = −10000 + 0.1 · (R·65536 + G·256 + B)`.
@@ -477,6 +486,9 @@ pub struct ReadOptions {
     pub offset: f64,
     /// PNG heightmaps (no georeference): metres between samples, default 1.
     pub cell: f64,
+    /// DTED: a record whose checksum does not match its bytes is an error (default `true`);
+    /// `false` reads a file whose producer wrote wrong checksums.
+    pub verify_checksums: bool,
 }
 
 impl Default for ReadOptions {
@@ -486,6 +498,7 @@ impl Default for ReadOptions {
             scale: 1.0,
             offset: 0.0,
             cell: 1.0,
+            verify_checksums: true,
         }
     }
 }
@@ -498,26 +511,59 @@ impl DemFormat {
             "tif" | "tiff" => Some(DemFormat::GeoTiff),
             "asc" => Some(DemFormat::EsriAscii),
             "hgt" => Some(DemFormat::Hgt),
+            "dt0" | "dt1" | "dt2" => Some(DemFormat::Dted),
+            "flt" | "bil" | "hdr" => Some(DemFormat::EsriHdr),
             "png" => Some(DemFormat::Png16),
             _ => None,
         }
     }
+
+    /// The format a file's content says, for a name whose extension is none of the above: a
+    /// DTED cell begins with its user header label `UHL1`; an ESRI `.hdr` raster has its `.hdr`
+    /// beside it.
+    pub fn sniff(path: &Path) -> Option<DemFormat> {
+        use std::io::Read;
+        let mut head = [0u8; 4];
+        let dted = std::fs::File::open(path)
+            .and_then(|mut f| f.read_exact(&mut head))
+            .is_ok()
+            && &head == b"UHL1";
+        if dted {
+            return Some(DemFormat::Dted);
+        }
+        ["hdr", "HDR"]
+            .iter()
+            .any(|e| path.with_extension(e).is_file())
+            .then_some(DemFormat::EsriHdr)
+    }
 }
 
-/// Read an elevation grid, choosing the reader by `opts.format` or the extension.
+/// Read an elevation grid, choosing the reader by `opts.format`, the extension or the content.
 pub fn read_dem(path: impl AsRef<Path>, opts: &ReadOptions) -> Result<Grid, TerrainError> {
     let path = path.as_ref();
     let format = opts
         .format
         .or_else(|| DemFormat::from_path(path))
+        .or_else(|| DemFormat::sniff(path))
         .ok_or_else(|| TerrainError::Unsupported {
             source: path.display().to_string(),
-            what: "unknown extension (expected .tif, .tiff, .asc, .hgt or .png)".into(),
+            what: "unknown extension (expected .tif, .tiff, .asc, .hgt, .dt0, .dt1, .dt2, .flt, \
+                   .bil or .png)"
+                .into(),
         })?;
     match format {
         DemFormat::GeoTiff => geotiff::read_geotiff(path),
         DemFormat::EsriAscii => asc::read_asc(path),
         DemFormat::Hgt => hgt::read_hgt(path),
+        DemFormat::Dted => dted::read_dted_with(
+            path,
+            if opts.verify_checksums {
+                dted::Checksums::Verify
+            } else {
+                dted::Checksums::Ignore
+            },
+        ),
+        DemFormat::EsriHdr => ehdr::read_ehdr(path),
         DemFormat::Png16 => png::read_png16(path, opts.scale, opts.offset, opts.cell),
         DemFormat::TerrainRgb => png::read_terrain_rgb(path, opts.cell),
     }
