@@ -303,7 +303,7 @@ fn bad_requests_are_refused_and_leave_no_file() {
         (
             vec![source.clone(), "-o".into(), out("x.png")],
             2,
-            "expected a .xyz/.extxyz, .lammpstrj/.dump, .gro, .pdb, .cif/.mmcif, .dcd or .xtc file name",
+            "expected a .xyz/.extxyz, .lammpstrj/.dump, .data/.lmp, .gro, .pdb, .cif/.mmcif, .dcd or .xtc file name",
         ),
         (
             vec![
