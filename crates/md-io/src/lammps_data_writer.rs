@@ -31,8 +31,8 @@
 //!   another orientation (a POSCAR's or XSF's lattice vectors) is rotated into it with its
 //!   atoms, as ASE's `Prism` does; tilt factors beyond half an edge along a periodic edge are
 //!   reduced to an equivalent lattice (b − k a, c − k b − l a), which LAMMPS releases before
-//!   2023 require; a tilted box writes `xy xz yz`. A left-handed cell is an error (rotating it
-//!   would mirror the structure). A frame without a cell gets the atoms' bounding box grown by
+//!   2023 require; a tilted box writes `xy xz yz`. (Cells are right-handed by construction, so
+//!   the rotation never mirrors the structure.) A frame without a cell gets the atoms' bounding box grown by
 //!   1 Å on each side (for `boundary f` or `s`).
 //! - **Not written**: velocities (a data file does not state its units, and LAMMPS's are the
 //!   run's: Å/fs for `units real`, Å/ps for `metal`), image flags (the positions carry them),
@@ -82,51 +82,23 @@ struct DataBox {
 /// the same in the restricted cell M′.
 struct Rotation {
     origin: [f64; 3],
-    inverse: [[f64; 3]; 3],
+    cell: [[f64; 3]; 3],
     restricted: [[f64; 3]; 3],
 }
 
 impl Rotation {
     fn apply(&self, p: [f32; 3]) -> [f32; 3] {
         let d: [f64; 3] = std::array::from_fn(|k| p[k] as f64 - self.origin[k]);
-        let f: [f64; 3] = std::array::from_fn(|j| (0..3).map(|k| d[k] * self.inverse[k][j]).sum());
-        std::array::from_fn(|j| {
-            (self.origin[j] + (0..3).map(|k| f[k] * self.restricted[k][j]).sum::<f64>()) as f32
-        })
+        let f = crate::pbc::to_frac(&self.cell, d);
+        let q = crate::pbc::to_cart(&self.restricted, f);
+        std::array::from_fn(|j| (self.origin[j] + q[j]) as f32)
     }
 }
 
-/// The inverse of a 3x3 matrix (rows), or `None` when singular.
-fn inverse(m: [[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
-    let det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
-        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
-    if !(det.is_finite() && det.abs() > 1e-300) {
-        return None;
-    }
-    Some(std::array::from_fn(|r| {
-        std::array::from_fn(|c| {
-            let (r1, r2) = ((c + 1) % 3, (c + 2) % 3);
-            let (c1, c2) = ((r + 1) % 3, (r + 2) % 3);
-            (m[r1][c1] * m[r2][c2] - m[r1][c2] * m[r2][c1]) / det
-        })
-    }))
-}
-
-/// The restricted triclinic form of `cell` with its tilts reduced along periodic edges. (A
-/// [`UnitCell`] is right-handed by construction; the check keeps a mirror image out should
-/// that ever change.)
-fn data_box(cell: &UnitCell) -> Result<DataBox, String> {
+/// The restricted triclinic form of `cell` with its tilts reduced along periodic edges. A
+/// [`UnitCell`] is right-handed with volume by construction, so the rotation never mirrors.
+fn data_box(cell: &UnitCell) -> DataBox {
     let m = cell.matrix();
-    let det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
-        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
-    if det <= 0.0 {
-        return Err(format!(
-            "the cell is left-handed (a = {:?}, b = {:?}, c = {:?}): LAMMPS boxes are right-handed, and rotating this one into a LAMMPS box would mirror the structure",
-            m[0], m[1], m[2]
-        ));
-    }
     let longest = cell.lengths().iter().fold(0.0f64, |a, b| a.max(*b));
     let tol = 1e-10 * longest;
     let restricted = m[0][1].abs() <= tol && m[0][2].abs() <= tol && m[1][2].abs() <= tol;
@@ -142,10 +114,9 @@ fn data_box(cell: &UnitCell) -> Result<DataBox, String> {
         let cy = (dot(m[2], m[1]) - bx * cx) / by;
         let cz = (dot(m[2], m[2]) - cx * cx - cy * cy).max(0.0).sqrt();
         let r = [[la, 0.0, 0.0], [bx, by, 0.0], [cx, cy, cz]];
-        let inverse = inverse(m).ok_or("the cell has no volume")?;
         let rotation = Rotation {
             origin: cell.origin(),
-            inverse,
+            cell: m,
             restricted: r,
         };
         (r, Some(rotation))
@@ -170,12 +141,12 @@ fn data_box(cell: &UnitCell) -> Result<DataBox, String> {
     }
     let o = cell.origin();
     let (xy, xz, yz) = (r[1][0], r[2][0], r[2][1]);
-    Ok(DataBox {
+    DataBox {
         lo: o,
         hi: [o[0] + r[0][0], o[1] + r[1][1], o[2] + r[2][2]],
         tilt: [xy, xz, yz],
         rotate,
-    })
+    }
 }
 
 /// The bounding box of `positions` grown by 1 Å on each side (a frame without a cell).
@@ -224,7 +195,7 @@ struct Plan {
 fn plan(frame: &Frame) -> Result<Plan, String> {
     let n = frame.n_atoms();
     let data_box = match &frame.cell {
-        Some(cell) => data_box(cell)?,
+        Some(cell) => data_box(cell),
         None => bounding_box(&frame.positions),
     };
     let charges = frame
@@ -318,21 +289,9 @@ fn plan(frame: &Frame) -> Result<Plan, String> {
     } else if frame.res_ids.len() == n {
         frame.res_ids.clone()
     } else {
-        let mut parts = crate::components::UnionFind::new(n);
-        for &[a, b] in &frame.bonds {
-            parts.join(a as usize, b as usize);
-        }
-        let mut number = vec![0i64; n];
-        let mut next = 0;
-        (0..n)
-            .map(|i| {
-                let r = parts.root(i);
-                if number[r] == 0 {
-                    next += 1;
-                    number[r] = next;
-                }
-                number[r]
-            })
+        crate::select::fragments(frame)
+            .into_iter()
+            .map(|f| f as i64 + 1)
             .collect()
     };
     // Bond types by the unordered pair of their atoms' labels.
@@ -458,7 +417,7 @@ mod tests {
         // An FCC primitive cell as a POSCAR gives it, and an atom at fractional (0.25, 0.5, 0.75).
         let m = [[0.0, 1.8, 1.8], [1.8, 0.0, 1.8], [1.8, 1.8, 0.0]];
         let cell = UnitCell::from_matrix(m).unwrap();
-        let b = data_box(&cell).unwrap();
+        let b = data_box(&cell);
         let r = b.rotate.as_ref().unwrap();
         let f = [0.25, 0.5, 0.75];
         let p: [f32; 3] =
@@ -484,7 +443,7 @@ mod tests {
         // b = (3, 2, 0) over a = (2, 0, 0): the tilt 3 > 1 becomes 3 - 2 * 2 = -1.
         let cell =
             UnitCell::from_matrix([[2.0, 0.0, 0.0], [3.0, 2.0, 0.0], [0.0, 0.0, 2.0]]).unwrap();
-        let b = data_box(&cell).unwrap();
+        let b = data_box(&cell);
         assert_eq!(b.tilt, [-1.0, 0.0, 0.0]);
     }
 }

@@ -24,7 +24,7 @@ use crate::frame::{Frame, UnitCell};
 
 /// Fractional coordinates of a Cartesian displacement `d` in `cell` (solving f·M = d; M's rows
 /// are the edges, lower-triangular in the usual orientation, general here).
-fn to_frac(m: &[[f64; 3]; 3], d: [f64; 3]) -> [f64; 3] {
+pub(crate) fn to_frac(m: &[[f64; 3]; 3], d: [f64; 3]) -> [f64; 3] {
     // Cramer's rule: f = d · M⁻¹.
     let det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
         - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
@@ -39,7 +39,7 @@ fn to_frac(m: &[[f64; 3]; 3], d: [f64; 3]) -> [f64; 3] {
     [col(0) / det, col(1) / det, col(2) / det]
 }
 
-fn to_cart(m: &[[f64; 3]; 3], f: [f64; 3]) -> [f64; 3] {
+pub(crate) fn to_cart(m: &[[f64; 3]; 3], f: [f64; 3]) -> [f64; 3] {
     std::array::from_fn(|k| f[0] * m[0][k] + f[1] * m[1][k] + f[2] * m[2][k])
 }
 

@@ -123,7 +123,7 @@ struct Cache {
 /// Each atom's bonded fragment: the parts the frame's bonds join (an atom without bonds is a
 /// fragment of its own), numbered from 0 in the order of their lowest atom, as MDAnalysis's
 /// `fragindices` and VMD's `fragment` number them.
-fn fragments(frame: &Frame) -> Vec<u32> {
+pub(crate) fn fragments(frame: &Frame) -> Vec<u32> {
     let n = frame.n_atoms();
     let mut parts = crate::components::UnionFind::new(n);
     for &[a, b] in &frame.bonds {
