@@ -77,7 +77,9 @@ pub struct ConvertArgs {
     /// and 'bfactor' properties in their columns), .cif/.mmcif (PDBx/mmCIF, for ChimeraX, PyMOL,
     /// VMD and gemmi: frames as models, the 'occupancy' and 'bfactor'
     /// properties, the first frame's box; no limit on atoms, residue numbers or chain names),
-    /// .dcd, .xtc (positions and the box only). Not compressed: gzip the file afterwards.
+    /// .dcd, .xtc (positions and the box only), .trr (GROMACS, single precision: positions,
+    /// the box, velocities, and the forces fx fy fz in kJ/(mol Å) as a TRR gives them; frames of
+    /// a TRR without positions are skipped and counted). Not compressed: gzip the file afterwards.
     /// Written whole or not at all. Without it, only the analyses' outputs are written (the
     /// --*-table options, --msd-lags, --density-map, --pca-projection, --pca-vectors,
     /// --pca-extremes, --dssp-timeline).
@@ -150,10 +152,11 @@ pub(crate) fn output_format(flag: &str, output: &std::path::Path) -> Result<Form
             | Format::Pdb
             | Format::Mmcif
             | Format::Dcd
-            | Format::Xtc),
+            | Format::Xtc
+            | Format::Trr),
         ) => Ok(f),
         _ => usage(format!(
-            "{flag} {}: expected a .xyz/.extxyz, .lammpstrj/.dump, .data/.lmp, .gro, .pdb, .cif/.mmcif, .dcd or .xtc file name",
+            "{flag} {}: expected a .xyz/.extxyz, .lammpstrj/.dump, .data/.lmp, .gro, .pdb, .cif/.mmcif, .dcd, .xtc or .trr file name",
             output.display()
         )),
     }
@@ -196,7 +199,7 @@ pub fn convert(a: &ConvertArgs) -> Result<()> {
     };
     let fixed_atoms = matches!(
         format,
-        Some(Format::Gro | Format::Pdb | Format::Mmcif | Format::Dcd | Format::Xtc)
+        Some(Format::Gro | Format::Pdb | Format::Mmcif | Format::Dcd | Format::Xtc | Format::Trr)
     );
     if let (Some(out), Some(_)) = (&a.output, &a.columns)
         && !matches!(format, Some(Format::Xyz | Format::LammpsDump))
@@ -256,10 +259,18 @@ pub fn convert(a: &ConvertArgs) -> Result<()> {
     let pb = crate::commands::progress(frames.len() as u64, "converting");
     let mut first_atoms: Option<usize> = None;
     let mut atoms_written = 0usize;
+    let mut without_positions = 0usize;
     let mut run = |mut writer: Option<Writer>| -> Result<()> {
         for &f in &frames {
             let at = |e: anyhow::Error| e.context(format!("frame {f}: nothing was written"));
             traj.read_frame(f, &mut md).map_err(|e| at(e.into()))?;
+            if md.n_atoms() == 0 && traj.format() == Format::Trr {
+                // mdrun writes frames of only velocities or forces when nstvout or nstfout
+                // differ from nstxout: without positions there is nothing to analyse or write.
+                without_positions += 1;
+                pb.inc(1);
+                continue;
+            }
             smoother
                 .smooth(&mut traj, n, f, &mut md)
                 .map_err(|e| at(e.into()))?;
@@ -328,10 +339,16 @@ pub fn convert(a: &ConvertArgs) -> Result<()> {
     }
     pb.finish_and_clear();
     tables.commit()?;
+    if without_positions > 0 {
+        crate::note!(
+            "skipped {without_positions} frame(s) of {} without positions (TRR frames of only velocities or forces: mdrun's nstvout or nstfout differs from nstxout)",
+            a.file.display()
+        );
+    }
     if let Some(out) = &a.output {
         crate::note!(
             "wrote {} frame(s), {} atoms in all, to {}",
-            frames.len(),
+            frames.len() - without_positions,
             atoms_written,
             out.display()
         );

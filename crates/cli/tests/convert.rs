@@ -303,7 +303,7 @@ fn bad_requests_are_refused_and_leave_no_file() {
         (
             vec![source.clone(), "-o".into(), out("x.png")],
             2,
-            "expected a .xyz/.extxyz, .lammpstrj/.dump, .data/.lmp, .gro, .pdb, .cif/.mmcif, .dcd or .xtc file name",
+            "expected a .xyz/.extxyz, .lammpstrj/.dump, .data/.lmp, .gro, .pdb, .cif/.mmcif, .dcd, .xtc or .trr file name",
         ),
         (
             vec![
@@ -403,6 +403,57 @@ fn mmcif_output_reads_back() {
         text.starts_with("data_chains\n"),
         "named after -o, not the temporary file"
     );
+}
+
+/// A GROMACS TRR of mixed blocks (mdrun's positions every 10 steps, velocities every 20, forces
+/// every 5) cut to its first 71 waters: the frames with positions keep their velocities and forces, the
+/// force-only frames are skipped and said to be, and the rewrite is what our writer gives the
+/// same frames (md-io's trr_writer tests hold it against GROMACS and MDAnalysis).
+#[test]
+fn trr_output_keeps_velocities_and_forces() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = md_data("trr_write/md.trr");
+    let out = dir.path().join("ow.trr");
+    let o = texmap(&[
+        "convert",
+        &src,
+        "--select",
+        "index 0 to 212",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("skipped 2 frame(s)") && stderr(&o).contains("wrote 3 frame(s)"),
+        "{}",
+        stderr(&o)
+    );
+    let source: Vec<Frame> = frames(Path::new(&src))
+        .into_iter()
+        .filter(|f| f.n_atoms() > 0)
+        .collect();
+    let back = frames(&out);
+    assert_eq!(back.len(), 3);
+    for (b, s) in back.iter().zip(&source) {
+        let keep: Vec<bool> = (0..s.n_atoms()).map(|i| i < 213).collect();
+        assert_eq!(b.n_atoms(), 213);
+        assert_eq!((b.step, b.time), (s.step, s.time));
+        assert_eq!(b.velocities.len(), kept(&s.velocities, &keep).len());
+        for name in ["fx", "fy", "fz"] {
+            let (got, want) = (
+                b.property(name).unwrap(),
+                kept(s.property(name).unwrap(), &keep),
+            );
+            for (g, w) in got.iter().zip(&want) {
+                assert!(g.to_bits().abs_diff(w.to_bits()) <= 1, "{name}: {g} vs {w}");
+            }
+        }
+        for (g, w) in b.positions.iter().zip(kept(&s.positions, &keep)) {
+            for d in 0..3 {
+                assert!((g[d] - w[d]).abs() <= w[d].abs() * 2.5e-7, "{g:?} vs {w:?}");
+            }
+        }
+    }
 }
 
 /// A label no CIF value can hold (a control character in an atom name) fails the frame,

@@ -52,7 +52,7 @@
 //!   (`Format::Cube`, `Format::Vasp`), an XSF / AXSF file one per structure (`Format::Xsf`).
 //! - [`Writer`] writes extended XYZ and LAMMPS text dumps (positions, ids, types, velocities,
 //!   radii, colours and every named property, for OVITO, ASE and LAMMPS to read back), GRO,
-//!   PDB, PDBx/mmCIF, DCD and XTC.
+//!   PDB, PDBx/mmCIF, DCD, XTC and TRR.
 //! - [`elements`] maps atom names to elements, gives van der Waals radii and CPK colours, and
 //!   [`AtomStyle`] resolves each atom's radius and colour with user overrides.
 //!
@@ -193,6 +193,7 @@ mod topology;
 mod tpr;
 mod trajectory;
 mod trr;
+mod trr_writer;
 pub mod vacf;
 pub mod values;
 mod vasp;

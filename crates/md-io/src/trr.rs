@@ -13,7 +13,9 @@
 //! ```
 //! `real` is f32 or f64: 4 or 8 = box_size / 9 (or x_size, v_size, f_size / (3 natoms)).
 //! The frame index is built at open time from the headers alone (one seek per frame). Lengths
-//! are converted to Å (×10, in the file's precision, then rounded to f32); forces are skipped.
+//! are converted to Å (×10, in the file's precision, then rounded to f32), velocities to Å/ps;
+//! forces become the per-atom properties `fx fy fz` in kJ/(mol·Å) (÷10, the unit MDAnalysis
+//! gives them), the names ASE and LAMMPS dumps use, so `--arrows f` draws them.
 //!
 //! # References
 //! - GROMACS `trrio.cpp` (`do_trr_frame_header`, `do_trr_frame_data`) and xdrfile `trr_header`
@@ -24,7 +26,7 @@ use std::sync::Arc;
 
 use crate::cursor::{IN_BOUNDS, all_finite, all_in_bounds, cell_of, first_out_of_bounds};
 use crate::error::{Error, Location};
-use crate::frame::Frame;
+use crate::frame::{Frame, Property};
 
 /// Magic number of every TRR frame.
 pub const MAGIC: i32 = 1993;
@@ -81,7 +83,7 @@ pub struct TrrFrameInfo {
     pub has_positions: bool,
     /// The frame has velocities (else `velocities` was left empty).
     pub has_velocities: bool,
-    /// The frame has forces (not returned).
+    /// The frame has forces (else `forces` was left empty).
     pub has_forces: bool,
     /// True for a double-precision frame.
     pub double: bool,
@@ -99,6 +101,8 @@ pub struct TrrReader<R> {
     pos: u64,
     /// The frame `read_next` reads.
     next: usize,
+    /// `read_next`'s buffer of forces, before they become properties.
+    forces: Vec<[f32; 3]>,
 }
 
 fn be_u32(b: &[u8], at: usize) -> u32 {
@@ -288,6 +292,7 @@ impl<R: Read + Seek> TrrReader<R> {
             buf: Vec::new(),
             pos: u64::MAX,
             next: 0,
+            forces: Vec::new(),
         })
     }
 
@@ -303,13 +308,14 @@ impl<R: Read + Seek> TrrReader<R> {
         self.frames.len()
     }
 
-    /// Reads frame `index`: positions (Å) and velocities (Å/ps) into the vectors (left empty
-    /// when the frame lacks them), the rest returned.
+    /// Reads frame `index`: positions (Å), velocities (Å/ps) and forces (kJ/(mol·Å)) into the
+    /// vectors (left empty when the frame lacks them), the rest returned.
     pub fn read_frame(
         &mut self,
         index: usize,
         positions: &mut Vec<[f32; 3]>,
         velocities: &mut Vec<[f32; 3]>,
+        forces: &mut Vec<[f32; 3]>,
     ) -> Result<TrrFrameInfo, Error> {
         let Some(&(offset, h)) = self.frames.get(index) else {
             if index == self.frames.len()
@@ -371,10 +377,11 @@ impl<R: Read + Seek> TrrReader<R> {
             None
         };
         p += h.box_size + h.vir_size + h.pres_size;
-        // Positions and velocities, nm → Å.
-        for (size, out, what) in [
-            (h.x_size, &mut *positions, IN_BOUNDS),
-            (h.v_size, &mut *velocities, "finite velocities"),
+        // Positions and velocities, nm → Å; forces, per nm → per Å.
+        for (size, out, what, per_nm) in [
+            (h.x_size, &mut *positions, IN_BOUNDS, false),
+            (h.v_size, &mut *velocities, "finite velocities", false),
+            (h.f_size, &mut *forces, "finite forces", true),
         ] {
             out.clear();
             if size == 0 {
@@ -382,9 +389,9 @@ impl<R: Read + Seek> TrrReader<R> {
             }
             let bytes = &self.buf[p..p + size];
             if r == 8 {
-                convert::<8>(bytes, out);
+                convert::<8>(bytes, per_nm, out);
             } else {
-                convert::<4>(bytes, out);
+                convert::<4>(bytes, per_nm, out);
             }
             let ok = if what == IN_BOUNDS {
                 all_in_bounds(out)
@@ -426,15 +433,28 @@ impl<R: Read + Seek> TrrReader<R> {
         if index >= self.frames.len() && self.tail.is_none() {
             return Ok(false);
         }
+        let mut forces = std::mem::take(&mut self.forces);
         let r = self
-            .read_frame(index, &mut frame.positions, &mut frame.velocities)
+            .read_frame(
+                index,
+                &mut frame.positions,
+                &mut frame.velocities,
+                &mut forces,
+            )
             .and_then(|info| {
                 let offset = self.frames[index].0;
                 frame.step = Some(info.step);
                 frame.time = Some(info.time);
                 if !info.has_positions {
-                    // Velocities without positions would break the frame's invariant.
+                    // Velocities or forces without positions would break the frame's invariant.
                     frame.velocities.clear();
+                } else if info.has_forces {
+                    for (d, name) in ["fx", "fy", "fz"].into_iter().enumerate() {
+                        frame.properties.push(Property {
+                            name: name.into(),
+                            values: forces.iter().map(|f| f[d]).collect(),
+                        });
+                    }
                 }
                 match info.box_vectors {
                     Some(m) => cell_of(
@@ -446,6 +466,7 @@ impl<R: Read + Seek> TrrReader<R> {
                     None => Ok(None),
                 }
             });
+        self.forces = forces;
         crate::cursor::settle(r, frame, &mut self.next)
     }
 
@@ -471,18 +492,20 @@ impl<R: Read + Seek> TrrReader<R> {
     }
 }
 
-/// Big-endian reals (4 or 8 bytes) in nm to f32 triples in Å (precision chosen outside the
-/// loop, output written in place: no per-atom push).
-fn convert<const REAL: usize>(bytes: &[u8], out: &mut Vec<[f32; 3]>) {
+/// Big-endian reals (4 or 8 bytes) to f32 triples: lengths in nm to Å (×10), or, with
+/// `per_nm`, quantities per nm to per Å (÷10, correctly rounded: 0.1 has no exact binary
+/// form). Precision chosen outside the loop, output written in place: no per-atom push.
+fn convert<const REAL: usize>(bytes: &[u8], per_nm: bool, out: &mut Vec<[f32; 3]>) {
     out.resize(bytes.len() / (3 * REAL), [0.0; 3]);
     for (o, c) in out.iter_mut().zip(bytes.chunks_exact(3 * REAL)) {
         *o = std::array::from_fn(|d| {
             let b = &c[d * REAL..];
             if REAL == 8 {
                 let v = f64::from_be_bytes([b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7]]);
-                (v * 10.0) as f32
+                (if per_nm { v / 10.0 } else { v * 10.0 }) as f32
             } else {
-                f32::from_be_bytes([b[0], b[1], b[2], b[3]]) * 10.0
+                let v = f32::from_be_bytes([b[0], b[1], b[2], b[3]]);
+                if per_nm { v / 10.0 } else { v * 10.0 }
             }
         });
     }
@@ -576,7 +599,7 @@ mod tests {
             let mut r = TrrReader::new(Cursor::new(bytes), name()).unwrap();
             assert_eq!(r.frame_count(), 4);
             assert_eq!(r.n_atoms(), n);
-            let (mut p, mut v) = (Vec::new(), Vec::new());
+            let (mut p, mut v, mut f) = (Vec::new(), Vec::new(), Vec::new());
             let want = |vals: &[f64]| -> Vec<[f32; 3]> {
                 vals.chunks(3)
                     .map(|c| {
@@ -590,7 +613,7 @@ mod tests {
                     })
                     .collect()
             };
-            let i = r.read_frame(2, &mut p, &mut v).unwrap();
+            let i = r.read_frame(2, &mut p, &mut v, &mut f).unwrap();
             assert_eq!(
                 (i.step, i.double, i.has_positions, i.has_velocities),
                 (20, double, false, true)
@@ -598,15 +621,39 @@ mod tests {
             assert!(p.is_empty());
             assert_eq!(v, want(&v0));
             assert_eq!(i.box_vectors.unwrap()[2], [5.0, 2.5, 40.0]);
-            let i = r.read_frame(0, &mut p, &mut v).unwrap();
+            assert!(f.is_empty());
+            let i = r.read_frame(0, &mut p, &mut v, &mut f).unwrap();
             assert!(i.has_forces);
             assert_eq!(p, want(&x0));
             assert_eq!(v, want(&v0));
-            let i = r.read_frame(1, &mut p, &mut v).unwrap();
+            // Forces per nm become per Å: divided by 10, correctly rounded.
+            let per_a: Vec<[f32; 3]> = f0
+                .chunks(3)
+                .map(|c| {
+                    std::array::from_fn(|d| {
+                        if double {
+                            (c[d] / 10.0) as f32
+                        } else {
+                            (c[d] as f32) / 10.0
+                        }
+                    })
+                })
+                .collect();
+            assert_eq!(f, per_a);
+            assert_eq!(f[0], [0.2, 0.2125, 0.225]);
+            // The frame carries them as fx fy fz.
+            let mut fr = Frame::new();
+            assert!(r.seek_frame(0).unwrap());
+            assert!(r.read_next(&mut fr).unwrap());
+            assert_eq!(fr.property("fy").unwrap()[1], per_a[1][1]);
+            assert_eq!(fr.properties.len(), 3);
+            assert!(r.read_next(&mut fr).unwrap());
+            assert!(fr.properties.is_empty(), "frame 1 has no forces");
+            let i = r.read_frame(1, &mut p, &mut v, &mut Vec::new()).unwrap();
             assert_eq!(i.box_vectors, None);
             assert!(v.is_empty());
             assert_eq!(p, want(&x0));
-            let i = r.read_frame(3, &mut p, &mut v).unwrap();
+            let i = r.read_frame(3, &mut p, &mut v, &mut Vec::new()).unwrap();
             assert!(p.is_empty() && v.is_empty() && i.has_forces);
             let tol = if double { 1e-12 } else { 1e-6 };
             assert!(
@@ -635,10 +682,12 @@ mod tests {
                     assert_eq!(r.frame_count(), complete, "cut at {cut}");
                     let (mut p, mut v) = (Vec::new(), Vec::new());
                     for f in 0..complete {
-                        r.read_frame(f, &mut p, &mut v).unwrap();
+                        r.read_frame(f, &mut p, &mut v, &mut Vec::new()).unwrap();
                     }
                     if cut > 0 && !ends.contains(&(cut as u64)) {
-                        let e = r.read_frame(complete, &mut p, &mut v).unwrap_err();
+                        let e = r
+                            .read_frame(complete, &mut p, &mut v, &mut Vec::new())
+                            .unwrap_err();
                         let at = e.location().unwrap();
                         assert_eq!(
                             (at.frame, at.byte),
@@ -660,7 +709,7 @@ mod tests {
                 if let Ok(mut r) = TrrReader::new(Cursor::new(b), name()) {
                     let (mut p, mut v) = (Vec::new(), Vec::new());
                     for f in 0..r.frame_count() + 1 {
-                        let _ = r.read_frame(f, &mut p, &mut v);
+                        let _ = r.read_frame(f, &mut p, &mut v, &mut Vec::new());
                     }
                 }
             }
@@ -677,7 +726,7 @@ mod tests {
         let mut r = TrrReader::new(Cursor::new(bytes), name()).unwrap();
         assert_eq!(r.frame_count(), 1);
         let e = r
-            .read_frame(1, &mut Vec::new(), &mut Vec::new())
+            .read_frame(1, &mut Vec::new(), &mut Vec::new(), &mut Vec::new())
             .unwrap_err();
         let at = e.location().unwrap();
         assert_eq!(

@@ -14,6 +14,8 @@
 //!   positions to 0.001 nm, velocities, the box; time and step in the title).
 //! - [`Format::Pdb`], [`Format::Dcd`], [`Format::Xtc`]: positions and cell, with PDB's atom
 //!   records.
+//! - [`Format::Trr`]: GROMACS TRR in single precision, per frame the box, positions,
+//!   velocities and the forces `fx fy fz` the frame has (src/trr_writer.rs).
 //! - [`Format::Mmcif`]: PDBx/mmCIF, frames as the models of one `_atom_site` loop (names,
 //!   residues, chains and elements in the label and auth items, the `occupancy` and `bfactor`
 //!   properties, the first frame's cell), with no limit on atom count, residue numbers or chain
@@ -43,6 +45,7 @@ use crate::lammps_data_writer::LammpsDataWriter;
 use crate::lammps_dump_writer::LammpsDumpWriter;
 use crate::mmcif_writer::MmcifWriter;
 use crate::pdb::PdbWriter;
+use crate::trr_writer::TrrWriter;
 use crate::xtc::XtcWriter;
 use crate::xyz::XyzWriter;
 use std::fmt;
@@ -105,6 +108,7 @@ enum WriterKind<W> {
     Xtc(XtcWriter<W>),
     Pdb(PdbWriter<W>),
     Mmcif(MmcifWriter<W>),
+    Trr(TrrWriter<W>),
 }
 
 /// Runs `$body` with `$w` bound to the format's writer, whatever the format.
@@ -119,6 +123,7 @@ macro_rules! each_writer {
             WriterKind::Xtc($w) => $body,
             WriterKind::Pdb($w) => $body,
             WriterKind::Mmcif($w) => $body,
+            WriterKind::Trr($w) => $body,
         }
     };
 }
@@ -169,6 +174,7 @@ impl<W: Write + Seek> Writer<W> {
             Format::Xtc => WriterKind::Xtc(XtcWriter::new(out, file.clone(), 1000.0)?),
             Format::Pdb => WriterKind::Pdb(PdbWriter { out, models: 0 }),
             Format::Mmcif => WriterKind::Mmcif(MmcifWriter::new(out, &file)),
+            Format::Trr => WriterKind::Trr(TrrWriter::new(out)),
             _ => {
                 return Err(Error::Unsupported {
                     file,
@@ -209,6 +215,7 @@ impl<W: Write + Seek> Writer<W> {
             WriterKind::LammpsData(w) => w.check(frame),
             WriterKind::Gro(_) => GroWriter::<W>::check(frame),
             WriterKind::Mmcif(w) => w.check(frame),
+            WriterKind::Trr(w) => w.check(frame),
             _ => Ok(()),
         };
         limits.map_err(|what| Error::InvalidFrame {
