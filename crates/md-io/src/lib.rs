@@ -52,7 +52,7 @@
 //!   (`Format::Cube`, `Format::Vasp`), an XSF / AXSF file one per structure (`Format::Xsf`).
 //! - [`Writer`] writes extended XYZ and LAMMPS text dumps (positions, ids, types, velocities,
 //!   radii, colours and every named property, for OVITO, ASE and LAMMPS to read back), GRO,
-//!   PDB, PDBx/mmCIF, DCD, XTC and TRR.
+//!   PDB, PDBx/mmCIF, DCD, XTC, TRR and AMBER NetCDF.
 //! - [`elements`] maps atom names to elements, gives van der Waals radii and CPK colours, and
 //!   [`AtomStyle`] resolves each atom's radius and colour with user overrides.
 //!
@@ -162,6 +162,7 @@ mod namdbin;
 pub mod ndx;
 mod neighbours;
 mod netcdf;
+mod netcdf_writer;
 pub mod order;
 pub mod orientation;
 pub mod parse;

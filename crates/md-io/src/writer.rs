@@ -20,6 +20,10 @@
 //!   residues, chains and elements in the label and auth items, the `occupancy` and `bfactor`
 //!   properties, the first frame's cell), with no limit on atom count, residue numbers or chain
 //!   names (read back by gemmi, ChimeraX, PyMOL, VMD and our reader).
+//! - [`Format::Netcdf`]: an AMBER NetCDF trajectory (64-bit offset NetCDF-3, the AMBER
+//!   convention 1.0): time, f32 coordinates, the cell as lengths and angles, velocities with
+//!   AMBER's `scale_factor` 20.455; no forces (src/netcdf_writer.rs; read back by MDAnalysis,
+//!   the netCDF-C library and our reader).
 //!
 //! Rules the text writers share:
 //! - numbers are written in Rust's shortest round-trip form, so reading them back gives the
@@ -44,6 +48,7 @@ use crate::gro::GroWriter;
 use crate::lammps_data_writer::LammpsDataWriter;
 use crate::lammps_dump_writer::LammpsDumpWriter;
 use crate::mmcif_writer::MmcifWriter;
+use crate::netcdf_writer::NetcdfWriter;
 use crate::pdb::PdbWriter;
 use crate::trr_writer::TrrWriter;
 use crate::xtc::XtcWriter;
@@ -108,6 +113,7 @@ enum WriterKind<W> {
     Xtc(XtcWriter<W>),
     Pdb(PdbWriter<W>),
     Mmcif(MmcifWriter<W>),
+    Netcdf(NetcdfWriter<W>),
     Trr(TrrWriter<W>),
 }
 
@@ -123,6 +129,7 @@ macro_rules! each_writer {
             WriterKind::Xtc($w) => $body,
             WriterKind::Pdb($w) => $body,
             WriterKind::Mmcif($w) => $body,
+            WriterKind::Netcdf($w) => $body,
             WriterKind::Trr($w) => $body,
         }
     };
@@ -174,6 +181,7 @@ impl<W: Write + Seek> Writer<W> {
             Format::Xtc => WriterKind::Xtc(XtcWriter::new(out, file.clone(), 1000.0)?),
             Format::Pdb => WriterKind::Pdb(PdbWriter { out, models: 0 }),
             Format::Mmcif => WriterKind::Mmcif(MmcifWriter::new(out, &file)),
+            Format::Netcdf => WriterKind::Netcdf(NetcdfWriter::new(out)),
             Format::Trr => WriterKind::Trr(TrrWriter::new(out)),
             _ => {
                 return Err(Error::Unsupported {
@@ -215,6 +223,7 @@ impl<W: Write + Seek> Writer<W> {
             WriterKind::LammpsData(w) => w.check(frame),
             WriterKind::Gro(_) => GroWriter::<W>::check(frame),
             WriterKind::Mmcif(w) => w.check(frame),
+            WriterKind::Netcdf(w) => w.check(frame),
             WriterKind::Trr(w) => w.check(frame),
             _ => Ok(()),
         };
