@@ -52,7 +52,7 @@
 //!   (`Format::Cube`, `Format::Vasp`), an XSF / AXSF file one per structure (`Format::Xsf`).
 //! - [`Writer`] writes extended XYZ and LAMMPS text dumps (positions, ids, types, velocities,
 //!   radii, colours and every named property, for OVITO, ASE and LAMMPS to read back), GRO,
-//!   PDB, PDBx/mmCIF, DCD, XTC, TRR and AMBER NetCDF.
+//!   PDB, PDBx/mmCIF, DCD, XTC, TRR, AMBER NetCDF and VASP POSCAR / XDATCAR.
 //! - [`elements`] maps atom names to elements, gives van der Waals radii and CPK colours, and
 //!   [`AtomStyle`] resolves each atom's radius and colour with user overrides.
 //!
@@ -198,6 +198,7 @@ mod trr_writer;
 pub mod vacf;
 pub mod values;
 mod vasp;
+mod vasp_writer;
 pub mod volume;
 pub mod voronoi;
 pub mod wigner_seitz;

@@ -20,6 +20,10 @@
 //!   residues, chains and elements in the label and auth items, the `occupancy` and `bfactor`
 //!   properties, the first frame's cell), with no limit on atom count, residue numbers or chain
 //!   names (read back by gemmi, ChimeraX, PyMOL, VMD and our reader).
+//! - [`Format::Vasp`]: a VASP 5 POSCAR (one frame: cell, element species as runs in atom
+//!   order, Direct coordinates, velocities) or, for a file named `XDATCAR*`, an XDATCAR with
+//!   the header repeated when the cell changes (read back by ASE, pymatgen, phonopy, OVITO and
+//!   our reader: src/vasp_writer.rs).
 //! - [`Format::Netcdf`]: an AMBER NetCDF trajectory (64-bit offset NetCDF-3, the AMBER
 //!   convention 1.0): time, f32 coordinates, the cell as lengths and angles, velocities with
 //!   AMBER's `scale_factor` 20.455; no forces (src/netcdf_writer.rs; read back by MDAnalysis,
@@ -51,6 +55,7 @@ use crate::mmcif_writer::MmcifWriter;
 use crate::netcdf_writer::NetcdfWriter;
 use crate::pdb::PdbWriter;
 use crate::trr_writer::TrrWriter;
+use crate::vasp_writer::{VaspWriter, is_xdatcar};
 use crate::xtc::XtcWriter;
 use crate::xyz::XyzWriter;
 use std::fmt;
@@ -114,6 +119,7 @@ enum WriterKind<W> {
     Pdb(PdbWriter<W>),
     Mmcif(MmcifWriter<W>),
     Netcdf(NetcdfWriter<W>),
+    Vasp(VaspWriter<W>),
     Trr(TrrWriter<W>),
 }
 
@@ -130,6 +136,7 @@ macro_rules! each_writer {
             WriterKind::Pdb($w) => $body,
             WriterKind::Mmcif($w) => $body,
             WriterKind::Netcdf($w) => $body,
+            WriterKind::Vasp($w) => $body,
             WriterKind::Trr($w) => $body,
         }
     };
@@ -169,7 +176,8 @@ impl Writer<BufWriter<File>> {
 }
 
 impl<W: Write + Seek> Writer<W> {
-    /// Writes `format` to `out`; `name` is what errors call the file.
+    /// Writes `format` to `out`; `name` is what errors call the file (for [`Format::Vasp`] its
+    /// file name also chooses an XDATCAR, `XDATCAR*` or `*.xdatcar`, over a POSCAR).
     pub fn new(out: W, format: Format, name: &str) -> Result<Self, Error> {
         let file: Arc<str> = name.into();
         let kind = match format {
@@ -182,6 +190,7 @@ impl<W: Write + Seek> Writer<W> {
             Format::Pdb => WriterKind::Pdb(PdbWriter { out, models: 0 }),
             Format::Mmcif => WriterKind::Mmcif(MmcifWriter::new(out, &file)),
             Format::Netcdf => WriterKind::Netcdf(NetcdfWriter::new(out)),
+            Format::Vasp => WriterKind::Vasp(VaspWriter::new(out, is_xdatcar(&file))),
             Format::Trr => WriterKind::Trr(TrrWriter::new(out)),
             _ => {
                 return Err(Error::Unsupported {
@@ -224,6 +233,7 @@ impl<W: Write + Seek> Writer<W> {
             WriterKind::Gro(_) => GroWriter::<W>::check(frame),
             WriterKind::Mmcif(w) => w.check(frame),
             WriterKind::Netcdf(w) => w.check(frame),
+            WriterKind::Vasp(w) => w.check(frame),
             WriterKind::Trr(w) => w.check(frame),
             _ => Ok(()),
         };
