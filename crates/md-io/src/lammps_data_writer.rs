@@ -71,23 +71,23 @@ impl Style {
 /// The box `read_data` reads: `[lo, hi]` per axis and the tilts `xy xz yz`, plus the map of a
 /// position into it (the rotation into the restricted form, `None` when the cell is already in
 /// it).
-struct DataBox {
-    lo: [f64; 3],
-    hi: [f64; 3],
-    tilt: [f64; 3],
-    rotate: Option<Rotation>,
+pub(crate) struct DataBox {
+    pub lo: [f64; 3],
+    pub hi: [f64; 3],
+    pub tilt: [f64; 3],
+    pub rotate: Option<Rotation>,
 }
 
 /// p ↦ origin + ((p − origin) · M⁻¹) · M′: the fractional coordinates in the old cell M are
 /// the same in the restricted cell M′.
-struct Rotation {
+pub(crate) struct Rotation {
     origin: [f64; 3],
     cell: [[f64; 3]; 3],
     restricted: [[f64; 3]; 3],
 }
 
 impl Rotation {
-    fn apply(&self, p: [f32; 3]) -> [f32; 3] {
+    pub fn apply(&self, p: [f32; 3]) -> [f32; 3] {
         let d: [f64; 3] = std::array::from_fn(|k| p[k] as f64 - self.origin[k]);
         let f = crate::pbc::to_frac(&self.cell, d);
         let q = crate::pbc::to_cart(&self.restricted, f);
@@ -97,7 +97,7 @@ impl Rotation {
 
 /// The restricted triclinic form of `cell` with its tilts reduced along periodic edges. A
 /// [`UnitCell`] is right-handed with volume by construction, so the rotation never mirrors.
-fn data_box(cell: &UnitCell) -> DataBox {
+pub(crate) fn data_box(cell: &UnitCell) -> DataBox {
     let m = cell.matrix();
     let longest = cell.lengths().iter().fold(0.0f64, |a, b| a.max(*b));
     let tol = 1e-10 * longest;
@@ -150,7 +150,7 @@ fn data_box(cell: &UnitCell) -> DataBox {
 }
 
 /// The bounding box of `positions` grown by 1 Å on each side (a frame without a cell).
-fn bounding_box(positions: &[[f32; 3]]) -> DataBox {
+pub(crate) fn bounding_box(positions: &[[f32; 3]]) -> DataBox {
     let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
     for p in positions {
         for k in 0..3 {

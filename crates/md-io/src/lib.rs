@@ -52,7 +52,7 @@
 //!   (`Format::Cube`, `Format::Vasp`), an XSF / AXSF file one per structure (`Format::Xsf`).
 //! - [`Writer`] writes extended XYZ and LAMMPS text dumps (positions, ids, types, velocities,
 //!   radii, colours and every named property, for OVITO, ASE and LAMMPS to read back), GRO,
-//!   PDB, PDBx/mmCIF, DCD, XTC, TRR, AMBER NetCDF and VASP POSCAR / XDATCAR.
+//!   PDB, PDBx/mmCIF, DCD, XTC, TRR, AMBER NetCDF, HOOMD-blue GSD and VASP POSCAR / XDATCAR.
 //! - [`elements`] maps atom names to elements, gives van der Waals radii and CPK colours, and
 //!   [`AtomStyle`] resolves each atom's radius and colour with user overrides.
 //!
@@ -146,6 +146,7 @@ mod frame;
 pub mod grains;
 mod gro;
 mod gsd;
+mod gsd_writer;
 mod gz;
 pub mod hbonds;
 mod lammps;

@@ -16,6 +16,9 @@
 //!   records.
 //! - [`Format::Trr`]: GROMACS TRR in single precision, per frame the box, positions,
 //!   velocities and the forces `fx fy fz` the frame has (src/trr_writer.rs).
+//! - [`Format::Gsd`]: HOOMD-blue GSD (file format 2.0, hoomd schema 1.4): the box in HOOMD's
+//!   centred form with the positions wrapped into it and their images, types, velocities,
+//!   diameters, masses, charges, orientations and bonds (src/gsd_writer.rs).
 //! - [`Format::Mmcif`]: PDBx/mmCIF, frames as the models of one `_atom_site` loop (names,
 //!   residues, chains and elements in the label and auth items, the `occupancy` and `bfactor`
 //!   properties, the first frame's cell), with no limit on atom count, residue numbers or chain
@@ -49,6 +52,7 @@ use crate::error::{Error, Location};
 use crate::format::Format;
 use crate::frame::Frame;
 use crate::gro::GroWriter;
+use crate::gsd_writer::GsdWriter;
 use crate::lammps_data_writer::LammpsDataWriter;
 use crate::lammps_dump_writer::LammpsDumpWriter;
 use crate::mmcif_writer::MmcifWriter;
@@ -121,6 +125,7 @@ enum WriterKind<W> {
     Netcdf(NetcdfWriter<W>),
     Vasp(VaspWriter<W>),
     Trr(TrrWriter<W>),
+    Gsd(GsdWriter<W>),
 }
 
 /// Runs `$body` with `$w` bound to the format's writer, whatever the format.
@@ -138,6 +143,7 @@ macro_rules! each_writer {
             WriterKind::Netcdf($w) => $body,
             WriterKind::Vasp($w) => $body,
             WriterKind::Trr($w) => $body,
+            WriterKind::Gsd($w) => $body,
         }
     };
 }
@@ -192,6 +198,7 @@ impl<W: Write + Seek> Writer<W> {
             Format::Netcdf => WriterKind::Netcdf(NetcdfWriter::new(out)),
             Format::Vasp => WriterKind::Vasp(VaspWriter::new(out, is_xdatcar(&file))),
             Format::Trr => WriterKind::Trr(TrrWriter::new(out)),
+            Format::Gsd => WriterKind::Gsd(GsdWriter::new(out)),
             _ => {
                 return Err(Error::Unsupported {
                     file,
@@ -235,6 +242,7 @@ impl<W: Write + Seek> Writer<W> {
             WriterKind::Netcdf(w) => w.check(frame),
             WriterKind::Vasp(w) => w.check(frame),
             WriterKind::Trr(w) => w.check(frame),
+            WriterKind::Gsd(w) => w.check(frame),
             _ => Ok(()),
         };
         limits.map_err(|what| Error::InvalidFrame {

@@ -244,9 +244,9 @@ fn gmx_reads_a_file_written_now() {
         .filter_map(|s| s.trim().parse().ok())
         .collect();
     assert_eq!(nums.len(), 3, "{x0}");
-    for d in 0..3 {
-        let want = f64::from(frames[0].positions[0][d]) / 10.0;
-        assert!((nums[d] - want).abs() < 1e-5, "{x0} against {want}");
+    for (got, p) in nums.iter().zip(frames[0].positions[0]) {
+        let want = f64::from(p) / 10.0;
+        assert!((got - want).abs() < 1e-5, "{x0} against {want}");
     }
 }
 
