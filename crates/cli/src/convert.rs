@@ -79,7 +79,14 @@ pub struct ConvertArgs {
     /// properties, the first frame's box; no limit on atoms, residue numbers or chain names),
     /// .dcd, .xtc (positions and the box only), .trr (GROMACS, single precision: positions,
     /// the box, velocities, and the forces fx fy fz in kJ/(mol Å) as a TRR gives them; frames of
-    /// a TRR without positions are skipped and counted). Not compressed: gzip the file afterwards.
+    /// a TRR without positions are skipped and counted), .nc/.ncdf (AMBER NetCDF for cpptraj,
+    /// MDAnalysis, MDTraj, VMD: time, coordinates, the box as lengths and angles, velocities in
+    /// AMBER's units with its scale_factor; no forces), .gsd (HOOMD-blue: the box in HOOMD's
+    /// centred form, atoms wrapped into it with their images, types, velocities, diameters,
+    /// masses, charges, orientations, bonds), POSCAR/.vasp (VASP 5, one frame: Direct
+    /// coordinates, each run of one element its own species group in the input's order,
+    /// velocities) or XDATCAR (a VASP trajectory; the header repeated when the cell changes).
+    /// Not compressed: gzip the file afterwards.
     /// Written whole or not at all. Without it, only the analyses' outputs are written (the
     /// --*-table options, --msd-lags, --density-map, --pca-projection, --pca-vectors,
     /// --pca-extremes, --dssp-timeline).
@@ -153,13 +160,25 @@ pub(crate) fn output_format(flag: &str, output: &std::path::Path) -> Result<Form
             | Format::Mmcif
             | Format::Dcd
             | Format::Xtc
-            | Format::Trr),
-        ) => Ok(f),
+            | Format::Trr
+            | Format::Netcdf
+            | Format::Vasp
+            | Format::Gsd),
+        ) if !is_restart(output) => Ok(f),
         _ => usage(format!(
-            "{flag} {}: expected a .xyz/.extxyz, .lammpstrj/.dump, .data/.lmp, .gro, .pdb, .cif/.mmcif, .dcd, .xtc or .trr file name",
+            "{flag} {}: expected a .xyz/.extxyz, .lammpstrj/.dump, .data/.lmp, .gro, .pdb, .cif/.mmcif, .dcd, .xtc, .trr, .nc/.ncdf, .gsd, POSCAR/.vasp or XDATCAR file name",
             output.display()
         )),
     }
+}
+
+/// An AMBER restart name (`.ncrst`): read as NetCDF, but the writer writes trajectories, which
+/// AMBER would not take for a restart.
+fn is_restart(output: &std::path::Path) -> bool {
+    output
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("ncrst"))
 }
 
 /// The render options `mol_plan` takes, at their command-line defaults, with the convert's
@@ -199,7 +218,15 @@ pub fn convert(a: &ConvertArgs) -> Result<()> {
     };
     let fixed_atoms = matches!(
         format,
-        Some(Format::Gro | Format::Pdb | Format::Mmcif | Format::Dcd | Format::Xtc | Format::Trr)
+        Some(
+            Format::Gro
+                | Format::Pdb
+                | Format::Mmcif
+                | Format::Dcd
+                | Format::Xtc
+                | Format::Trr
+                | Format::Netcdf
+        )
     );
     if let (Some(out), Some(_)) = (&a.output, &a.columns)
         && !matches!(format, Some(Format::Xyz | Format::LammpsDump))

@@ -303,7 +303,7 @@ fn bad_requests_are_refused_and_leave_no_file() {
         (
             vec![source.clone(), "-o".into(), out("x.png")],
             2,
-            "expected a .xyz/.extxyz, .lammpstrj/.dump, .data/.lmp, .gro, .pdb, .cif/.mmcif, .dcd, .xtc or .trr file name",
+            "expected a .xyz/.extxyz, .lammpstrj/.dump, .data/.lmp, .gro, .pdb, .cif/.mmcif, .dcd, .xtc, .trr, .nc/.ncdf, .gsd, POSCAR/.vasp or XDATCAR file name",
         ),
         (
             vec![
@@ -454,6 +454,64 @@ fn trr_output_keeps_velocities_and_forces() {
             }
         }
     }
+}
+
+/// The trajectory formats of AMBER, HOOMD-blue and VASP: every frame of a triclinic LAMMPS
+/// dump comes back from each (md-io's netcdf_writer, gsd_writer and vasp_writer tests hold the
+/// files against MDAnalysis, netCDF-C, gsd.hoomd, ASE and pymatgen); a POSCAR takes one frame,
+/// and an AMBER restart name is refused rather than given a trajectory.
+#[test]
+fn amber_hoomd_and_vasp_trajectories_read_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = md_data("lmp_tri.lammpstrj");
+    let source = frames(Path::new(&src));
+    assert!(source.len() > 1);
+    for name in ["run.nc", "run.gsd", "XDATCAR"] {
+        let out = dir.path().join(name);
+        run_ok(&["convert", &src, "-q", "-o", out.to_str().unwrap()]);
+        let back = frames(&out);
+        assert_eq!(back.len(), source.len(), "{name}");
+        for (b, s) in back.iter().zip(&source) {
+            assert_eq!(b.n_atoms(), s.n_atoms(), "{name}");
+            let (vb, vs) = (b.cell.unwrap().volume(), s.cell.unwrap().volume());
+            assert!((vb - vs).abs() < 1e-4 * vs, "{name}: volume {vb} vs {vs}");
+            // Every format keeps the distances between atoms (GSD moves the box to HOOMD's
+            // centred form and wraps atoms into it: compare through the minimum image).
+            let cell = b.cell.unwrap();
+            for (i, j) in [(0, 1), (2, 7), (5, s.n_atoms() - 1)] {
+                let d = |f: &Frame, c: &texmap_md_io::UnitCell| {
+                    let v: [f64; 3] = std::array::from_fn(|k| {
+                        f64::from(f.positions[i][k]) - f64::from(f.positions[j][k])
+                    });
+                    let m = texmap_md_io::pbc::minimum_image(c, v);
+                    (m[0] * m[0] + m[1] * m[1] + m[2] * m[2]).sqrt()
+                };
+                let (db, ds) = (d(b, &cell), d(s, &s.cell.unwrap()));
+                assert!(
+                    (db - ds).abs() < 1e-3,
+                    "{name}: atoms {i} {j}: {db} vs {ds}"
+                );
+            }
+        }
+    }
+    let poscar = dir.path().join("POSCAR");
+    let o = texmap(&["convert", &src, "-o", poscar.to_str().unwrap()]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("XDATCAR"), "{}", stderr(&o));
+    assert!(!poscar.exists(), "no partial POSCAR");
+    run_ok(&[
+        "convert",
+        &src,
+        "-q",
+        "--frames",
+        "1",
+        "-o",
+        poscar.to_str().unwrap(),
+    ]);
+    assert_eq!(frames(&poscar)[0].n_atoms(), source[1].n_atoms());
+    let rst = dir.path().join("x.ncrst");
+    let o = texmap(&["convert", &src, "-o", rst.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
 }
 
 /// A label no CIF value can hold (a control character in an atom name) fails the frame,
