@@ -432,6 +432,36 @@ fn trr_output_keeps_velocities_and_forces() {
         .into_iter()
         .filter(|f| f.n_atoms() > 0)
         .collect();
+    // Rendering a force-only frame with a topology says what the frame is and how to keep the
+    // frames with positions.
+    let top = dir.path().join("top.pdb");
+    run_ok(&[
+        "convert",
+        &src,
+        "-q",
+        "--frames",
+        "0",
+        "-o",
+        top.to_str().unwrap(),
+    ]);
+    let png = dir.path().join("f.png");
+    let o = texmap(&[
+        "render",
+        &src,
+        "--topology",
+        top.to_str().unwrap(),
+        "--frames",
+        "1",
+        "-q",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr(&o).contains("frame 1 has no positions") && stderr(&o).contains("-o positions.trr"),
+        "{}",
+        stderr(&o)
+    );
     let back = frames(&out);
     assert_eq!(back.len(), 3);
     for (b, s) in back.iter().zip(&source) {

@@ -181,6 +181,16 @@ impl fmt::Display for Error {
             Error::InvalidValue { what } => write!(f, "invalid value: {what}"),
             Error::TopologyMismatch {
                 topology,
+                trajectory,
+                frame,
+                frame_atoms: 0,
+                ..
+            } => write!(
+                f,
+                "{trajectory}: frame {frame} has no positions, so the topology {topology} has nothing to name (a GROMACS TRR holds such frames, of only velocities or forces, when nstvout or nstfout differs from nstxout; `texmap convert {trajectory} -o positions.trr` keeps the frames with positions)"
+            ),
+            Error::TopologyMismatch {
+                topology,
                 topology_atoms,
                 trajectory,
                 frame,
