@@ -17,9 +17,14 @@ pub enum TerrainCmd {
     /// Build a terrain database (chunked LoD mesh + GST map pyramid) from an elevation grid.
     Build {
         /// Elevation grid: GeoTIFF, ESRI ASCII (.asc), SRTM (.hgt), DTED (.dt0, .dt1, .dt2), ESRI
-        /// GridFloat (.flt) or BIL (.bil) with its .hdr and .prj, or 16-bit PNG. Several grids
-        /// that tile an area (e.g. `--dem N44W072.hgt N44W071.hgt`) are joined as gdalbuildvrt
-        /// joins them: one system, cell size and lattice; the later file wins where they overlap.
+        /// GridFloat (.flt) or BIL (.bil) with its .hdr and .prj, 16-bit PNG, or Mapbox Terrain-RGB
+        /// or Terrarium PNG (--terrain-rgb, --terrarium). Several grids that tile an area (e.g.
+        /// `--dem N44W072.hgt N44W071.hgt`) are joined as gdalbuildvrt joins them: one system,
+        /// cell size and lattice; the later file wins where they overlap, and samples no file
+        /// covers are no-data. Web-map elevation tiles stored as Z/X/Y.png (`--dem
+        /// tiles/12/1205/1539.png tiles/12/1206/1539.png`, or a directory of them) are placed in
+        /// Web Mercator (EPSG:3857) by their address, XYZ scheme, the tile's bounds the outer
+        /// edges of its pixels; tiles of one zoom only.
         #[arg(long, num_args = 1.., required = true)]
         dem: Vec<PathBuf>,
         /// Orthophoto (PNG, JPEG or GeoTIFF), placed by its georeference or stretched. A GeoTIFF in
@@ -68,10 +73,25 @@ pub enum TerrainCmd {
         /// marker-color=#7e7e7e, marker-size=medium).
         #[arg(long, value_name = "KEY=VALUE,...", requires = "overlay")]
         overlay_style: Option<String>,
-        /// Read a PNG as Mapbox Terrain-RGB.
+        /// Read a PNG as Mapbox Terrain-RGB: height = −10000 + 0.1·(R·65536 + G·256 + B) m.
         #[arg(long)]
         terrain_rgb: bool,
-        /// 16-bit PNG: metres per unit, offset, and metres between samples.
+        /// Read a PNG as Terrarium (AWS Terrain Tiles, Mapzen): height = R·256 + G + B/256 −
+        /// 32768 m.
+        #[arg(long, conflicts_with = "terrain_rgb")]
+        terrarium: bool,
+        /// With --terrain-rgb or --terrarium and one --dem file: its tile address Z/X/Y (e.g.
+        /// 12/1205/1539), for a file whose path does not end in Z/X/Y.png. A tile is n x n
+        /// pixels, n a power of two, or n + 1 (backfilled: the extra row and column lie one pixel
+        /// beyond the tile's east and south edges).
+        #[arg(long, value_name = "Z/X/Y")]
+        tile: Option<String>,
+        /// With --terrain-rgb or --terrarium: tile rows count from the south (TMS), not from the
+        /// north (XYZ, the web-map default).
+        #[arg(long)]
+        tms: bool,
+        /// 16-bit PNG: metres per unit, offset, and metres between samples (also for a
+        /// Terrain-RGB or Terrarium image without a tile address).
         #[arg(long, default_value_t = 1.0)]
         scale: f64,
         #[arg(long, default_value_t = 0.0)]
@@ -166,6 +186,9 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
             max_error,
             chunk,
             terrain_rgb,
+            terrarium,
+            tile,
+            tms,
             texture_levels,
             contours,
             contour_width,
@@ -203,19 +226,37 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
             if !(max_error.is_finite() && max_error >= 0.0) {
                 return usage(format!("--max-error {max_error}: expected metres ≥ 0"));
             }
+            let format = if terrarium {
+                Some(DemFormat::Terrarium)
+            } else {
+                terrain_rgb.then_some(DemFormat::TerrainRgb)
+            };
+            if (tile.is_some() || tms) && format.is_none() {
+                return usage("--tile and --tms apply to --terrain-rgb and --terrarium");
+            }
+            let tile = match tile {
+                None => None,
+                Some(t) if dem.len() == 1 => Some(
+                    dem::png::TileAddress::parse(&t).or_else(|e| usage(format!("--tile: {e}")))?,
+                ),
+                Some(_) => {
+                    return usage(
+                        "--tile places one --dem file; several tiles are placed by their \
+                         Z/X/Y.png paths",
+                    );
+                }
+            };
             let opts = ReadOptions {
-                format: terrain_rgb.then_some(DemFormat::TerrainRgb),
+                format,
                 scale,
                 offset,
                 cell,
+                tile,
+                tms,
                 verify_checksums: !ignore_checksums,
             };
-            let names: Vec<String> = dem.iter().map(|p| p.display().to_string()).collect();
-            let parts = dem
-                .iter()
-                .zip(&names)
-                .map(|(p, n)| Ok((n.clone(), dem::read_dem(p, &opts)?)))
-                .collect::<Result<Vec<_>, texmap_terrain::TerrainError>>()?;
+            let parts = dem::read_dems(&dem, &opts)?;
+            let names: Vec<String> = parts.iter().map(|p| p.0.clone()).collect();
             let (mut grid, overlaps) = dem::mosaic::mosaic(parts)?;
             for o in &overlaps {
                 crate::note!(

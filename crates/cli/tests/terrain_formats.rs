@@ -1,7 +1,10 @@
 //! `texmap terrain build` and `info` on a DTED cell and an ESRI GridFloat that GDAL wrote
 //! (crates/terrain/tests/data/dem_formats.sh): the databases report the grids' size,
 //! georeference and no-data; a DTED record whose checksum fails is a runtime error naming it,
-//! read anyway with --ignore-checksums.
+//! read anyway with --ignore-checksums. Web-map Terrarium tiles (z/x/y PNGs that numpy encoded
+//! from GDAL's EPSG:3857 reprojection of the SRTM tile, crates/terrain/tests/data/xyz_tiles.sh)
+//! join into one Web Mercator grid placed where gdalbuildvrt places them; bad addresses and mixed
+//! zooms are runtime errors naming the files.
 
 use std::io::Read;
 use std::path::{Path, PathBuf};
@@ -134,4 +137,136 @@ fn a_gridfloat_builds_a_database() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert!(err.contains("lone.hdr"), "{err}");
+}
+
+fn xyz(name: &str) -> PathBuf {
+    data("xyz").join(name)
+}
+
+#[test]
+fn web_map_tiles_build_a_web_mercator_database() {
+    let dir = tempfile::tempdir().unwrap();
+    let tiles = ["10/308/370.png", "10/309/370.png", "10/309/371.png"]
+        .map(|t| xyz("terrarium").join(t).to_str().unwrap().to_string());
+    let db = dir.path().join("tiles.db");
+    let mut args = vec![
+        "terrain",
+        "build",
+        "--terrarium",
+        "--out",
+        db.to_str().unwrap(),
+        "-q",
+    ];
+    args.push("--dem");
+    args.extend(tiles.iter().map(String::as_str));
+    ok(&texmap(&args));
+    let j = info(&db);
+    // gdalbuildvrt of the three tiles: 512 x 512, corner (-7983694.730330089, 5557277.704445455),
+    // 152.87405657035197 m pixels; 10/308/371 is missing, its 256² samples no-data.
+    let gdal: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(xyz("joined_terrarium.gdalinfo.json")).unwrap(),
+    )
+    .unwrap();
+    let t: Vec<f64> = serde_json::from_value(gdal["geoTransform"].clone()).unwrap();
+    assert_eq!(size(&j), (Some(512), Some(512)));
+    assert_eq!(j["nodata"], 256 * 256);
+    let g = &j["georef"];
+    assert_eq!(
+        (g["crs"].as_str(), g["epsg"].as_u64()),
+        (Some("projected"), Some(3857))
+    );
+    for (key, want) in [
+        ("origin_x", t[0] + 0.5 * t[1]),
+        ("origin_y", t[3] + 0.5 * t[5]),
+        ("dx", t[1]),
+        ("dy", t[5]),
+    ] {
+        let ours = g[key].as_f64().unwrap();
+        assert!((ours - want).abs() < 1e-6, "{key}: {ours}, GDAL {want}");
+    }
+    // The same tiles as Terrain-RGB: mutually exclusive flags are a usage error.
+    let o = texmap(&[
+        "terrain",
+        "build",
+        "--terrarium",
+        "--terrain-rgb",
+        "--dem",
+        &tiles[0],
+        "--out",
+        dir.path().join("x.db").to_str().unwrap(),
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
+#[test]
+fn bad_tile_addresses_and_mixed_zooms_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let tile = xyz("terrarium/10/308/370.png");
+    let put = |rel: &str| {
+        let p = dir.path().join(rel);
+        std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+        std::fs::copy(&tile, &p).unwrap();
+        p.to_str().unwrap().to_string()
+    };
+    let run = |dems: &[&str], extra: &[&str]| {
+        let out = dir.path().join("bad.db");
+        let mut args = vec![
+            "terrain",
+            "build",
+            "--terrarium",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        args.push("--dem");
+        args.extend(dems);
+        let o = texmap(&args);
+        (
+            o.status.code(),
+            String::from_utf8_lossy(&o.stderr).to_string(),
+        )
+    };
+    // x ≥ 2^z: a runtime error naming the file.
+    let bad = put("10/1024/370.png");
+    let (code, err) = run(&[&bad], &[]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("10/1024/370.png") && err.contains("tile address"),
+        "{err}"
+    );
+    // Mixed zooms: both files named.
+    let z11 = put("11/616/740.png");
+    let (code, err) = run(&[tile.to_str().unwrap(), &z11], &[]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("11/616/740.png") && err.contains("10/308/370.png"),
+        "{err}"
+    );
+    // --tile: a malformed address, or several files, are usage errors; a good one places a file
+    // whose path has none.
+    let (code, err) = run(&[tile.to_str().unwrap()], &["--tile", "10/308"]);
+    assert_eq!(code, Some(2), "{err}");
+    let (code, err) = run(&[tile.to_str().unwrap(), &z11], &["--tile", "10/308/370"]);
+    assert_eq!(code, Some(2), "{err}");
+    let plain = dir.path().join("plain.png");
+    std::fs::copy(&tile, &plain).unwrap();
+    let db = dir.path().join("plain.db");
+    ok(&texmap(&[
+        "terrain",
+        "build",
+        "--terrarium",
+        "--tile",
+        "10/308/370",
+        "--dem",
+        plain.to_str().unwrap(),
+        "--out",
+        db.to_str().unwrap(),
+        "-q",
+    ]));
+    assert_eq!(info(&db)["georef"]["epsg"], 3857);
 }

@@ -4,13 +4,19 @@
 //! `dem_formats_gdal_samples.txt`); the DTED cells' heights are the `.hgt` tile's sample for
 //! sample; damaged files are errors naming the file and the place, never a panic or a partial
 //! grid. (The mutation campaign over the same fixtures is in tests/fuzz_campaign.rs.)
+//!
+//! Web-map elevation tiles (tests/data/xyz_tiles.sh): Terrain-RGB tiles that rio-rgbify (Mapbox's
+//! encoder) and Terrarium tiles that numpy encoded from GDAL's reprojection of the SRTM tile onto
+//! zoom-10 XYZ tiles in EPSG:3857 are placed, tile by tile and joined, where GDAL placed them
+//! (`xyz/*.gdalinfo.json`), with GDAL's heights to within the encodings' steps.
 
 use std::io::Read;
 use std::path::{Path, PathBuf};
 
 use texmap_terrain::TerrainError;
 use texmap_terrain::dem::dted::{self, Checksums};
-use texmap_terrain::dem::{CrsKind, DemFormat, Grid, ReadOptions, ehdr, read_dem};
+use texmap_terrain::dem::png::{TileAddress, terrain_rgb_height, terrarium_height};
+use texmap_terrain::dem::{CrsKind, DemFormat, Grid, ReadOptions, ehdr, read_dem, read_dems};
 
 fn data(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -502,4 +508,270 @@ fn damaged_hdr_rasters_are_errors_never_panics() {
     };
     let e = err_naming(ehdr::read_ehdr_parts(&p), "ramp_i16.prj");
     assert!(e.contains("gdalwarp -t_srs"), "{e}");
+}
+
+fn xyz(name: &str) -> PathBuf {
+    data("xyz").join(name)
+}
+
+fn gdal_json(name: &str) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(xyz(name)).unwrap()).unwrap()
+}
+
+/// `grid`'s georeference against gdalinfo's of `json` (corner and pixel size; ours is sample
+/// centres, half a pixel in), to 1e-6 m, and its size.
+fn placed_as_gdal(grid: &Grid, json: &str) {
+    let info = gdal_json(json);
+    let size: [u32; 2] = serde_json::from_value(info["size"].clone()).unwrap();
+    assert_eq!([grid.width(), grid.height()], size, "{json}");
+    let t: [f64; 6] = serde_json::from_value(info["geoTransform"].clone()).unwrap();
+    let r = grid.georef();
+    assert_eq!((r.crs, r.epsg), (CrsKind::Projected, Some(3857)), "{json}");
+    assert!(r.is_web_mercator());
+    for (ours, gdal, what) in [
+        (r.origin_x, t[0] + 0.5 * t[1], "x of sample (0, 0)"),
+        (r.origin_y, t[3] + 0.5 * t[5], "y of sample (0, 0)"),
+        (r.dx, t[1], "column step"),
+        (r.dy, t[5], "row step"),
+    ] {
+        assert!(
+            (ours - gdal).abs() <= 1e-6,
+            "{json}: {what}: ours {ours}, GDAL {gdal}"
+        );
+    }
+}
+
+/// GDAL's float heights (before encoding) at the listed samples of tile `tile` ("10_X_Y"),
+/// shifted by `(dc, dr)` samples into `grid`, within `tol`.
+fn heights_as_gdal(grid: &Grid, tile: &str, (dc, dr): (u32, u32), tol: f64) -> usize {
+    let samples = std::fs::read_to_string(xyz("gdal_samples.txt")).unwrap();
+    let mut count = 0;
+    for line in samples
+        .lines()
+        .filter(|l| l.split(' ').next() == Some(tile))
+    {
+        let f: Vec<&str> = line.split(' ').collect();
+        let (col, row): (u32, u32) = (f[1].parse().unwrap(), f[2].parse().unwrap());
+        let v: f64 = f[3].parse().unwrap();
+        let ours = grid.at(col + dc, row + dr) as f64;
+        assert!(
+            (ours - v).abs() <= tol,
+            "{tile} ({col}, {row}): ours {ours}, GDAL {v}, tolerance {tol}"
+        );
+        count += 1;
+    }
+    assert_eq!(count, 64, "{tile}: samples listed");
+    count
+}
+
+fn tile_opts(format: DemFormat) -> ReadOptions {
+    ReadOptions {
+        format: Some(format),
+        ..ReadOptions::default()
+    }
+}
+
+#[test]
+fn rgb_encodings_decode_the_published_examples() {
+    // Mapbox: height = -10000 + ((R * 256 * 256 + G * 256 + B) * 0.1).
+    for (rgb, h) in [
+        ((1, 134, 160), 0.0),
+        // 1916.6 m: 119166 tenths above -10000 = 1·65536 + 209·256 + 126.
+        ((1, 209, 126), 1916.6),
+        ((0, 0, 0), -10000.0),
+        ((255, 255, 255), 1667721.5),
+    ] {
+        let v = terrain_rgb_height(rgb.0, rgb.1, rgb.2);
+        assert!((v - h).abs() < 1e-6, "Terrain-RGB {rgb:?}: {v}, want {h}");
+    }
+    // Terrarium: height = (R * 256 + G + B / 256) - 32768.
+    for (rgb, h) in [
+        ((128, 0, 0), 0.0),
+        ((135, 124, 128), 1916.5),
+        ((127, 255, 0), -1.0),
+        ((0, 0, 0), -32768.0),
+        ((255, 255, 255), 32767.0 + 255.0 / 256.0),
+    ] {
+        assert_eq!(
+            terrarium_height(rgb.0, rgb.1, rgb.2),
+            h,
+            "Terrarium {rgb:?}"
+        );
+    }
+}
+
+#[test]
+fn web_map_tiles_are_placed_and_decoded_as_gdal_and_rio_rgbify_made_them() {
+    // Terrain-RGB (rio-rgbify truncates to 0.1 m: one step) and Terrarium (numpy floors to
+    // 1/256 m: one step), plus f32's rounding of the height.
+    let cases = [
+        (
+            "terrain_rgb",
+            DemFormat::TerrainRgb,
+            0.1 + 1e-3,
+            ["10_308_371", "10_309_371", ""],
+        ),
+        (
+            "terrarium",
+            DemFormat::Terrarium,
+            1.0 / 256.0 + 1e-3,
+            ["10_308_370", "10_309_370", "10_309_371"],
+        ),
+    ];
+    for (dir, format, tol, tiles) in cases {
+        for tile in tiles.iter().filter(|t| !t.is_empty()) {
+            let [_, x, y]: [&str; 3] = tile.split('_').collect::<Vec<_>>().try_into().unwrap();
+            let path = xyz(&format!("{dir}/10/{x}/{y}.png"));
+            let grid = read_dem(&path, &tile_opts(format)).unwrap_or_else(|e| panic!("{e}"));
+            placed_as_gdal(&grid, &format!("{tile}.gdalinfo.json"));
+            heights_as_gdal(&grid, tile, (0, 0), tol);
+            // The same file elsewhere, placed by --tile.
+            let copy = tempfile::tempdir().unwrap();
+            let elsewhere = copy.path().join("tile.png");
+            std::fs::copy(&path, &elsewhere).unwrap();
+            let opts = ReadOptions {
+                tile: Some(TileAddress::parse(&format!("10/{x}/{y}")).unwrap()),
+                ..tile_opts(format)
+            };
+            let placed = read_dem(&elsewhere, &opts).unwrap();
+            assert_eq!(placed.georef(), grid.georef());
+            // Without an address: the old local grid with --cell.
+            let local = read_dem(
+                &elsewhere,
+                &ReadOptions {
+                    cell: 30.0,
+                    ..tile_opts(format)
+                },
+            )
+            .unwrap();
+            assert_eq!(local.georef().crs, CrsKind::Local);
+            assert_eq!(local.georef().dx, 30.0);
+            assert_eq!(local.heights(), grid.heights());
+            // TMS numbering: row 2^10 - 1 - y from the south is the same tile.
+            let tms = ReadOptions {
+                tile: Some(
+                    TileAddress::parse(&format!("10/{x}/{}", 1023 - y.parse::<u32>().unwrap()))
+                        .unwrap(),
+                ),
+                tms: true,
+                ..tile_opts(format)
+            };
+            assert_eq!(read_dem(&elsewhere, &tms).unwrap().georef(), grid.georef());
+        }
+    }
+}
+
+#[test]
+fn web_map_tiles_join_as_gdalbuildvrt_joins_them() {
+    use texmap_terrain::dem::mosaic::mosaic;
+    // Two Terrain-RGB tiles side by side: 512 x 256.
+    let rgb = read_dems(
+        &[
+            xyz("terrain_rgb/10/308/371.png"),
+            xyz("terrain_rgb/10/309/371.png"),
+        ],
+        &tile_opts(DemFormat::TerrainRgb),
+    )
+    .unwrap();
+    let (joined, overlaps) = mosaic(rgb).unwrap();
+    assert!(overlaps.is_empty());
+    placed_as_gdal(&joined, "joined_rgb.gdalinfo.json");
+    heights_as_gdal(&joined, "10_308_371", (0, 0), 0.101);
+    heights_as_gdal(&joined, "10_309_371", (256, 0), 0.101);
+    assert_eq!(joined.nodata_count(), 0);
+    // Three Terrarium tiles in an L, read from their directory: 10/308/371 is missing, its
+    // 256 x 256 samples no-data (as gdalbuildvrt leaves them).
+    let parts = read_dems(&[xyz("terrarium")], &tile_opts(DemFormat::Terrarium)).unwrap();
+    assert_eq!(parts.len(), 3);
+    let (joined, _) = mosaic(parts).unwrap();
+    placed_as_gdal(&joined, "joined_terrarium.gdalinfo.json");
+    let tol = 1.0 / 256.0 + 1e-3;
+    heights_as_gdal(&joined, "10_308_370", (0, 0), tol);
+    heights_as_gdal(&joined, "10_309_370", (256, 0), tol);
+    heights_as_gdal(&joined, "10_309_371", (256, 256), tol);
+    assert_eq!(joined.nodata_count(), 256 * 256);
+    assert!(joined.at(0, 256).is_nan() && joined.at(255, 511).is_nan());
+}
+
+#[test]
+fn bad_tiles_are_errors_naming_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let tile = xyz("terrarium/10/308/370.png");
+    let put = |rel: &str| {
+        let p = dir.path().join(rel);
+        std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+        std::fs::copy(&tile, &p).unwrap();
+        p
+    };
+    let opts = tile_opts(DemFormat::Terrarium);
+    // Addresses no tile has.
+    for rel in [
+        "10/1024/370.png",
+        "10/308/1024.png",
+        "31/0/0.png",
+        "0/0/1.png",
+    ] {
+        let p = put(rel);
+        let e = err_naming(read_dem(&p, &opts), rel);
+        assert!(e.contains("tile address"), "{e}");
+    }
+    // Mixed zooms: both files named, nothing read.
+    let z11 = put("11/616/740.png");
+    let e = read_dems(&[tile.clone(), z11.clone()], &opts)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("11/616/740.png") && e.contains("10/308/370.png"),
+        "{e}"
+    );
+    assert!(e.contains("zoom 11") && e.contains("zoom 10"), "{e}");
+    // Images of the wrong kind: 16-bit greyscale, 8-bit greyscale, 16-bit RGB.
+    let grey16 = dir.path().join("10/308/369.png");
+    image::ImageBuffer::<image::Luma<u16>, _>::from_pixel(256, 256, image::Luma([1000u16]))
+        .save(&grey16)
+        .unwrap();
+    let grey8 = dir.path().join("10/308/368.png");
+    image::GrayImage::from_pixel(256, 256, image::Luma([10]))
+        .save(&grey8)
+        .unwrap();
+    let rgb16 = dir.path().join("10/308/367.png");
+    image::ImageBuffer::<image::Rgb<u16>, _>::from_pixel(256, 256, image::Rgb([1u16, 2, 3]))
+        .save(&rgb16)
+        .unwrap();
+    for (p, format) in [
+        (&grey16, DemFormat::Terrarium),
+        (&grey8, DemFormat::TerrainRgb),
+        (&rgb16, DemFormat::TerrainRgb),
+    ] {
+        let e = err_naming(read_dem(p, &tile_opts(format)), p.to_str().unwrap());
+        assert!(e.contains("8-bit RGB"), "{e}");
+    }
+    // A tile that is no power of two a side cannot be placed; a backfilled 257 can.
+    let odd = dir.path().join("10/308/366.png");
+    image::RgbImage::from_pixel(300, 300, image::Rgb([128, 0, 0]))
+        .save(&odd)
+        .unwrap();
+    let e = err_naming(read_dem(&odd, &opts), "366.png");
+    assert!(e.contains("power of two"), "{e}");
+    let backfilled = dir.path().join("10/308/365.png");
+    image::RgbImage::from_pixel(257, 257, image::Rgb([128, 0, 0]))
+        .save(&backfilled)
+        .unwrap();
+    let g = read_dem(&backfilled, &opts).unwrap();
+    let t = TileAddress::parse("10/308/365").unwrap();
+    let (west, _, _, north) = t.bounds();
+    assert_eq!(g.georef().dx, t.side() / 256.0);
+    assert!((g.georef().origin_x - (west + 0.5 * t.side() / 256.0)).abs() < 1e-6);
+    assert!((g.georef().origin_y - (north - 0.5 * t.side() / 256.0)).abs() < 1e-6);
+    // --tile for several files, and a directory without tiles.
+    let several = ReadOptions {
+        tile: Some(t),
+        ..opts
+    };
+    assert!(read_dems(&[tile.clone(), tile.clone()], &several).is_err());
+    let empty = tempfile::tempdir().unwrap();
+    let e = read_dems(&[empty.path().to_path_buf()], &opts)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains(empty.path().to_str().unwrap()), "{e}");
 }

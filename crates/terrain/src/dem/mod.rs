@@ -17,8 +17,10 @@
 //!
 //! Readers ([`DemFormat`], [`read_dem`]): GeoTIFF ([`geotiff`]), ESRI ASCII grid ([`asc`]),
 //! SRTM `.hgt` ([`hgt`]), DTED levels 0–2 ([`dted`]), ESRI GridFloat `.flt` and BIL `.bil` with
-//! their `.hdr` and `.prj` ([`ehdr`]), 16-bit PNG with a scale and offset and Mapbox Terrain-RGB
-//! PNG ([`png`]); grids that tile an area join into one ([`mosaic`]). Each validates at the file
+//! their `.hdr` and `.prj` ([`ehdr`]), 16-bit PNG with a scale and offset, and Mapbox Terrain-RGB
+//! and Terrarium PNG ([`png`]), the last two placed in Web Mercator when they are web-map tiles
+//! addressed `Z/X/Y.png` ([`png::TileAddress`]); grids that tile an area join into one
+//! ([`mosaic`], [`read_dems`]: web-map tiles of one zoom only). Each validates at the file
 //! boundary ([`Grid::new`]): at least 2 x 2 samples, at most [`MAX_SAMPLES`], every value finite
 //! or no-data, not all no-data.
 
@@ -473,6 +475,8 @@ pub enum DemFormat {
     Png16,
     /// Mapbox Terrain-RGB: `height = −10000 + 0.1 · (R·65536 + G·256 + B)`.
     TerrainRgb,
+    /// Terrarium (AWS Terrain Tiles, Mapzen): `height = R·256 + G + B/256 − 32768`.
+    Terrarium,
 }
 
 /// Options for the readers that need outside information.
@@ -484,8 +488,14 @@ pub struct ReadOptions {
     pub scale: f64,
     /// PNG heightmaps: height of PNG value 0, default 0.
     pub offset: f64,
-    /// PNG heightmaps (no georeference): metres between samples, default 1.
+    /// PNG heightmaps (no georeference): metres between samples, default 1. Not used for a
+    /// Terrain-RGB or Terrarium tile with an address.
     pub cell: f64,
+    /// Terrain-RGB and Terrarium: the file's tile address, instead of the one its path spells
+    /// (`.../Z/X/Y.png`).
+    pub tile: Option<png::TileAddress>,
+    /// Terrain-RGB and Terrarium: tile addresses count rows from the south (TMS), not the north.
+    pub tms: bool,
     /// DTED: a record whose checksum does not match its bytes is an error (default `true`);
     /// `false` reads a file whose producer wrote wrong checksums.
     pub verify_checksums: bool,
@@ -498,6 +508,8 @@ impl Default for ReadOptions {
             scale: 1.0,
             offset: 0.0,
             cell: 1.0,
+            tile: None,
+            tms: false,
             verify_checksums: true,
         }
     }
@@ -565,8 +577,82 @@ pub fn read_dem(path: impl AsRef<Path>, opts: &ReadOptions) -> Result<Grid, Terr
         ),
         DemFormat::EsriHdr => ehdr::read_ehdr(path),
         DemFormat::Png16 => png::read_png16(path, opts.scale, opts.offset, opts.cell),
-        DemFormat::TerrainRgb => png::read_terrain_rgb(path, opts.cell),
+        DemFormat::TerrainRgb => read_rgb(path, png::RgbEncoding::TerrainRgb, opts),
+        DemFormat::Terrarium => read_rgb(path, png::RgbEncoding::Terrarium, opts),
     }
+}
+
+/// The tile address of `path` under `opts` (given, or spelled by the path; TMS rows flipped), for
+/// the RGB-encoded formats.
+fn tile_address(path: &Path, opts: &ReadOptions) -> Result<Option<png::TileAddress>, TerrainError> {
+    let t = match opts.tile {
+        Some(t) => Some(t),
+        None => png::TileAddress::from_path(path).transpose()?,
+    };
+    Ok(t.map(|t| if opts.tms { t.flip_y() } else { t }))
+}
+
+fn read_rgb(
+    path: &Path,
+    encoding: png::RgbEncoding,
+    opts: &ReadOptions,
+) -> Result<Grid, TerrainError> {
+    png::read_rgb_tile(path, encoding, tile_address(path, opts)?, opts.cell)
+}
+
+/// Read several elevation files for [`mosaic::mosaic`], each named by its path. A directory
+/// stands for the web-map tiles under it ([`png::tiles_in_dir`]). Terrain-RGB and Terrarium
+/// tiles must all be of one zoom: a tile of another zoom than the first is an error naming both
+/// files, before any is read (a mosaic never resamples).
+pub fn read_dems(
+    paths: &[std::path::PathBuf],
+    opts: &ReadOptions,
+) -> Result<Vec<(String, Grid)>, TerrainError> {
+    let mut files = Vec::with_capacity(paths.len());
+    for p in paths {
+        if p.is_dir() {
+            files.extend(png::tiles_in_dir(p)?);
+        } else {
+            files.push(p.clone());
+        }
+    }
+    if opts.tile.is_some() && files.len() > 1 {
+        return Err(TerrainError::BadParameter {
+            name: "tile",
+            value: format!("{} files", files.len()),
+            expected: "one file: several tiles are placed by their Z/X/Y paths",
+        });
+    }
+    if matches!(
+        opts.format,
+        Some(DemFormat::TerrainRgb | DemFormat::Terrarium)
+    ) {
+        let mut first: Option<(&Path, u8)> = None;
+        for f in &files {
+            let Some(t) = tile_address(f, opts)? else {
+                continue;
+            };
+            match first {
+                None => first = Some((f, t.z)),
+                Some((p0, z0)) if z0 != t.z => {
+                    return Err(TerrainError::Unsupported {
+                        source: f.display().to_string(),
+                        what: format!(
+                            "a zoom {} tile joined to {} of zoom {z0}: a mosaic joins tiles of \
+                             one zoom (it never resamples)",
+                            t.z,
+                            p0.display()
+                        ),
+                    });
+                }
+                Some(_) => {}
+            }
+        }
+    }
+    files
+        .iter()
+        .map(|f| Ok((f.display().to_string(), read_dem(f, opts)?)))
+        .collect()
 }
 
 #[cfg(test)]
