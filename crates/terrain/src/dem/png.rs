@@ -270,6 +270,42 @@ impl RgbEncoding {
     }
 }
 
+/// Heights no terrain reaches: below the Challenger Deep (−10,935 m) or above Everest
+/// (8,849 m), with a margin.
+const PLAUSIBLE: std::ops::RangeInclusive<f32> = -11_500.0..=9_000.0;
+
+/// Refuses a tile most of whose heights no terrain reaches: the sign of a tile read in the other
+/// encoding (a Terrarium tile read as Terrain-RGB decodes to ~840 km, a Terrain-RGB tile read as
+/// Terrarium to ~−32 km), which would otherwise build a database of absurd heights.
+fn check_plausible(
+    source: &str,
+    encoding: RgbEncoding,
+    heights: &[f32],
+) -> Result<(), TerrainError> {
+    let outside = heights.iter().filter(|h| !PLAUSIBLE.contains(h)).count();
+    if outside * 2 <= heights.len() {
+        return Ok(());
+    }
+    let (lo, hi) = heights
+        .iter()
+        .fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &h| {
+            (a.min(h), b.max(h))
+        });
+    let other = match encoding {
+        RgbEncoding::TerrainRgb => "a Terrarium tile (--terrarium)",
+        RgbEncoding::Terrarium => "a Mapbox Terrain-RGB tile (--terrain-rgb)",
+    };
+    Err(format_err(
+        source,
+        format!(
+            "{outside} of {} samples decode as {} to heights no terrain reaches ({lo} to {hi} m)",
+            heights.len(),
+            encoding.name()
+        ),
+        format!("heights between -11500 and 9000 m for most samples: is this {other}?"),
+    ))
+}
+
 /// Read a Mapbox Terrain-RGB PNG as a `Local` grid with `cell` metres between samples.
 pub fn read_terrain_rgb(path: &Path, cell: f64) -> Result<Grid, TerrainError> {
     read_rgb_tile(path, RgbEncoding::TerrainRgb, None, cell)
@@ -313,10 +349,11 @@ pub fn read_rgb_tile(
         None => Georef::local(cell),
     };
     super::check_size(&source, w as u64, h as u64)?;
-    let heights = rgb
+    let heights: Vec<f32> = rgb
         .pixels()
         .map(|p| encoding.height(p[0], p[1], p[2]) as f32)
         .collect();
+    check_plausible(&source, encoding, &heights)?;
     Grid::new(&source, w, h, heights, georef)
 }
 
@@ -369,6 +406,31 @@ mod tests {
         assert_eq!(terrarium_height(135, 124, 128), 1916.5);
         assert_eq!(terrarium_height(0, 0, 0), -32768.0);
         assert_eq!(terrarium_height(127, 255, 192), -0.25);
+    }
+
+    #[test]
+    fn a_tile_read_in_the_other_encoding_is_refused() {
+        // A Terrarium tile of heights near 500 m (R 129, G 244) read as Terrain-RGB decodes to
+        // ~840 km; read as Terrarium it is fine.
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("t.png");
+        image::RgbImage::from_pixel(4, 4, image::Rgb([129, 244, 0]))
+            .save(&p)
+            .unwrap();
+        let g = read_terrarium(&p, 10.0).unwrap();
+        assert_eq!(g.at(1, 1), 500.0);
+        let e = read_terrain_rgb(&p, 10.0).unwrap_err().to_string();
+        assert!(
+            e.contains("16 of 16 samples") && e.contains("a Terrarium tile (--terrarium)"),
+            "{e}"
+        );
+        // A Terrain-RGB tile at 0 m (1, 134, 160) read as Terrarium: about -32 km.
+        image::RgbImage::from_pixel(4, 4, image::Rgb([1, 134, 160]))
+            .save(&p)
+            .unwrap();
+        assert_eq!(read_terrain_rgb(&p, 10.0).unwrap().at(0, 0), 0.0);
+        let e = read_terrarium(&p, 10.0).unwrap_err().to_string();
+        assert!(e.contains("--terrain-rgb"), "{e}");
     }
 
     #[test]
