@@ -111,6 +111,9 @@ Examples:
   texmap convert cascade.lammpstrj --wigner-seitz atoms --select 'prop site_occupancy != 1' -o defects.xyz
   texmap convert 1abc.cif --compute 'bfactor=coordination' --coordination 3.5 -o coord.pdb  # a property in the B-factor column (PyMOL, ChimeraX)
   texmap convert md.xtc --topology md.gro --select 'not water' --frames ::10 -o models.cif   # PDBx/mmCIF models, any size (ChimeraX, PyMOL, gemmi)
+  texmap convert md.trr --topology md.tpr --select protein -o prot.trr                       # velocities and forces kept (GROMACS TRR)
+  texmap convert dump.lammpstrj -o run.gsd                                                    # HOOMD-blue GSD; or run.nc (AMBER NetCDF), XDATCAR (VASP)
+  texmap convert relaxed.cif --frames 0 -o POSCAR                                             # one structure for VASP
   texmap convert melt.lammpstrj --frames 100: --rdf 10 --rdf-partial --rdf-table gr.csv    # g(r), total and per pair of types, averaged over frames 100 on
   texmap convert md.xtc --topology md.gro --msd-lags lags.csv                               # MSD over every time origin; prints D per kind
   texmap convert md.xtc --topology md.gro --align backbone --rmsf-table rmsf.csv            # flexibility; colour by it: render --property rmsf=rmsf.csv
