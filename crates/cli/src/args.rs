@@ -58,7 +58,7 @@ pub enum Command {
     /// false along a LAMMPS `ff`/`ss` or extended XYZ `F` edge), chains and segments (with their
     /// atom counts), per-atom properties, the first frame's secondary structure (DSSP: helix,
     /// strand, coil) and first positions as one JSON object; for a topology
-    /// file (PSF, AMBER prmtop) its atoms, residues, bonds, chains and segments; for a GROMACS
+    /// file (PSF, AMBER prmtop, GROMACS .top) its atoms, residues, bonds, chains and segments; for a GROMACS
     /// energy file (.edr) or a LAMMPS log its terms with units, rows, time span and each
     /// term's mean, minimum and maximum.
     Info {
@@ -82,7 +82,7 @@ pub enum Command {
         /// file, frame and byte).
         #[arg(long)]
         allow_truncated: bool,
-        /// Topology (PDB, PDBx/mmCIF, GRO, PSF, AMBER prmtop, GROMACS .tpr, LAMMPS data file) of the trajectory's atoms: its
+        /// Topology (PDB, PDBx/mmCIF, GRO, PSF, AMBER prmtop, GROMACS .tpr or .top, LAMMPS data file) of the trajectory's atoms: its
         /// atom, residue and bond counts are added, and a different atom count is an error.
         #[arg(long, value_name = "FILE")]
         topology: Option<PathBuf>,
@@ -481,7 +481,7 @@ pub struct StyleArgs {
             "first frame's drawn atoms, then fixed, so a colour means one value in every frame) with a\n",
             "colour bar (--no-color-bar to leave it out):\n",
             "  bfactor, occupancy   PDB columns 61-66 / 55-60, mmCIF B_iso_or_equiv / occupancy\n",
-            "  charge               partial charges of the --topology (PSF, AMBER prmtop, GROMACS tpr, LAMMPS data)\n",
+            "  charge               partial charges of the --topology (PSF, AMBER prmtop, GROMACS tpr/top, LAMMPS data)\n",
             "  speed                |v| in Å/ps (GRO, TRR, NetCDF, LAMMPS vx vy vz, extended XYZ velo)\n",
             "  residue              the residue's position in the file, 0, 1, 2, ... (a rainbow along chains)\n",
             "  index                the atom index\n",
@@ -803,8 +803,8 @@ pub enum BondsArg {
     /// file's own), else by distance (covalent radii + 0.45 Å, minimum image in a periodic box).
     #[default]
     Auto,
-    /// Only the bonds the files list (PDB CONECT, PSF !NBOND, prmtop BONDS_*, a .tpr's
-    /// chemical bonds, LAMMPS data Bonds, SDF/MOL and MOL2 bond blocks).
+    /// Only the bonds the files list (PDB CONECT, PSF !NBOND, prmtop BONDS_*, a .tpr's or
+    /// GROMACS .top's chemical bonds, LAMMPS data Bonds, SDF/MOL and MOL2 bond blocks).
     Topology,
     /// No bonds.
     None,
@@ -951,7 +951,8 @@ pub struct MolArgs {
     /// (XTC, DCD, TRR, NetCDF carry coordinates only): PDB (CONECT bonds), PDBx/mmCIF or a crystallographic CIF (.cif),
     /// GRO, a CHARMM/NAMD PSF (.psf: !NBOND bonds), an AMBER prmtop (.prmtop, .parm7: bonds,
     /// chains), a GROMACS run input (.tpr: the force field's bonds, masses, charges, molecule
-    /// types as segments), or a LAMMPS data file (.data, .lmp, data.*).
+    /// types as segments) or topology (.top with its #included .itp files, the same), or a
+    /// LAMMPS data file (.data, .lmp, data.*).
     #[arg(long, value_name = "FILE")]
     pub topology: Option<PathBuf>,
     /// A GROMACS index file (.ndx, from gmx make_ndx or gmx select -on): its groups become the

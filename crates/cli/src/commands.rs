@@ -222,7 +222,7 @@ fn info(
     if format.is_none()
         && matches!(
             TopologyFormat::from_path(file),
-            Some(TopologyFormat::Psf | TopologyFormat::Prmtop)
+            Some(TopologyFormat::Psf | TopologyFormat::Prmtop | TopologyFormat::GromacsTop)
         )
     {
         return topology_info(file);
@@ -351,12 +351,23 @@ fn info(
     Ok(())
 }
 
-/// `texmap info` of a file that holds a topology and no coordinates (PSF, AMBER prmtop): atoms,
-/// residues, bonds, chains and segments, and the properties it gives frames.
+/// `texmap info` of a file that holds a topology and no coordinates (PSF, AMBER prmtop, GROMACS
+/// .top): atoms, residues, bonds, chains and segments, and the properties it gives frames.
 fn topology_info(file: &Path) -> Result<()> {
     let t = crate::scene::open_topology(file)?;
+    // A .top is AMBER's when it starts as a prmtop does (as the reader tells them).
+    let mut head = Vec::new();
+    if let Ok(f) = std::fs::File::open(file) {
+        let _ = std::io::Read::read_to_end(&mut std::io::Read::take(f, 8), &mut head);
+    }
+    let amber = head.starts_with(b"%VERSION") || head.starts_with(b"%FLAG");
+    let top = file
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("top"));
     let format = match texmap_md_io::TopologyFormat::from_path(file) {
         Some(texmap_md_io::TopologyFormat::Psf) => "psf",
+        Some(texmap_md_io::TopologyFormat::GromacsTop) => "gromacs-top",
+        _ if top && !amber => "gromacs-top",
         _ => "prmtop",
     };
     let mut obj = json!({

@@ -4314,3 +4314,47 @@ fn ase_trajectories_render_and_convert() {
         }
     }
 }
+
+#[test]
+fn a_gromacs_topology_names_a_gro_as_its_tpr_does() {
+    // md-io's tests/data/gromacs_top/amber (gen_top.py): grompp's preprocessed topology of two
+    // chains in water and the .tpr grompp made of it give a .gro the same atoms and bonds.
+    let gro = data("gromacs_top/amber/conf.gro.gz");
+    let top = data("gromacs_top/amber/processed.top.gz");
+    let tpr = data("gromacs_top/amber/topol.tpr.gz");
+    let info = |topology: &str| -> serde_json::Value {
+        let o = texmap(&["info", &gro, "--topology", topology]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let mut v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        v["topology"]["file"] = serde_json::Value::Null;
+        v
+    };
+    let (a, b) = (info(&top), info(&tpr));
+    assert!(a["topology"]["bonds"].as_u64().unwrap() > 2000, "{a}");
+    assert_eq!(a, b);
+    // A selection by molecule type (segid) picks the same atoms, named the same.
+    let dir = tempfile::tempdir().unwrap();
+    let ca = |topology: &str, out: &str| -> Vec<String> {
+        let out = dir.path().join(out);
+        let o = texmap(&[
+            "convert",
+            &gro,
+            "--topology",
+            topology,
+            "--select",
+            "segid Protein_chain_A and name CA",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        std::fs::read_to_string(out)
+            .unwrap()
+            .lines()
+            .filter(|l| l.starts_with("ATOM") || l.starts_with("HETATM"))
+            .map(str::to_string)
+            .collect()
+    };
+    let from_top = ca(&top, "top.pdb");
+    assert_eq!(from_top.len(), 4, "{from_top:?}");
+    assert_eq!(from_top, ca(&tpr, "tpr.pdb"));
+}

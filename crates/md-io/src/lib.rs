@@ -27,7 +27,7 @@
 //! - [`Sequence`] reads a trajectory in several files (a run continued in parts, a LAMMPS
 //!   dump per step: [`sequence::expand`] for `dump.*.lammpstrj`) as one.
 //! - [`Topology`] reads atom names, elements, residues and bonds (PDB, PDBx/mmCIF, GRO, PSF,
-//!   AMBER prmtop, GROMACS .tpr, LAMMPS data file) and gives them to the frames of a
+//!   AMBER prmtop, GROMACS .tpr and .top, LAMMPS data file) and gives them to the frames of a
 //!   coordinate-only trajectory of the same atoms; [`read_tpr`] also gives a .tpr's starting
 //!   positions, velocities and box.
 //! - [`bonds`] finds bonds by distance (covalent radii, a cell grid, minimum image) and [`pbc`]
@@ -145,6 +145,7 @@ mod format;
 mod frame;
 pub mod grains;
 mod gro;
+mod gromacs_top;
 mod gsd;
 mod gsd_writer;
 mod gz;
@@ -212,6 +213,7 @@ pub use elements::Element;
 pub use error::{Error, Location};
 pub use format::Format;
 pub use frame::{BOND_AROMATIC, Frame, Label, MAX_COORDINATE, Property, UnitCell};
+pub use gromacs_top::{GromacsTopOptions, read_gromacs_top};
 pub use mmcif::is_altloc_warning;
 pub use select::{Selection, SelectionError};
 pub use sequence::Sequence;

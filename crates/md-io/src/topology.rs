@@ -19,6 +19,9 @@
 //!   `!NBOND` section (module `psf`: elements from names, checked against the masses);
 //! - **AMBER prmtop** (`.prmtop`, `.parm7`): atoms, types, elements from `ATOMIC_NUMBER`,
 //!   residues, chains (`RESIDUE_CHAINID`) and both bond sections (module `prmtop`);
+//! - **GROMACS topology** (`.top` that is not an AMBER prmtop, `.itp`): the preprocessed
+//!   topology with its `#include`s, filled as from the `.tpr` grompp makes of it (module
+//!   `gromacs_top`; defines through [`crate::read_gromacs_top`]);
 //! - **LAMMPS data file** (`.data`, `.lmp`, or a name starting `data.`): read by the trajectory
 //!   reader of [`Format::LammpsData`] (module `lammps_data`: the atom styles, told by the
 //!   `Atoms # style` comment or, without one, by the column count: 7 columns is `full`, 5
@@ -72,14 +75,19 @@ pub enum TopologyFormat {
     /// GROMACS run input (.tpr): atoms with masses and charges, residues, molecule types and
     /// the force field's chemical bonds (see the `tpr` module).
     Tpr,
+    /// GROMACS topology (.top with its #included .itp files): atoms with masses and charges,
+    /// residues, molecule types and chemical bonds, as from the .tpr grompp makes of it (see
+    /// the `gromacs_top` module).
+    GromacsTop,
 }
 
 impl TopologyFormat {
     /// The format a path names: `.pdb`/`.ent`, `.gro`, `.cif`/`.mmcif`, `.psf`,
-    /// `.prmtop`/`.parm7`/`.top` or a file named `prmtop` (AMBER; a `.top` must start as a
-    /// prmtop does, since GROMACS names its topologies so too), `.data`/`.lmp` or `data.*`
-    /// (LAMMPS). A final `.gz` is looked through (`top.psf.gz` is PSF, read
-    /// decompressed by [`Topology::open`]).
+    /// `.prmtop`/`.parm7`/`.top` or a file named `prmtop` (AMBER; [`Topology::open_as`] reads
+    /// a `.top` that does not start as a prmtop does as a GROMACS topology, since GROMACS names
+    /// its topologies so too), `.itp` (GROMACS), `.tpr`, `.data`/`.lmp` or `data.*` (LAMMPS).
+    /// A final `.gz` is looked through (`top.psf.gz` is PSF, read decompressed by
+    /// [`Topology::open`]).
     pub fn from_path(path: &Path) -> Option<TopologyFormat> {
         let path = crate::gz::inner_path(path);
         let name = path.file_name()?.to_str()?.to_ascii_lowercase();
@@ -98,6 +106,7 @@ impl TopologyFormat {
             "psf" => TopologyFormat::Psf,
             "tpr" => TopologyFormat::Tpr,
             "prmtop" | "parm7" | "top" => TopologyFormat::Prmtop,
+            "itp" => TopologyFormat::GromacsTop,
             _ => return None,
         })
     }
@@ -243,7 +252,7 @@ impl Topology {
         let Some(format) = TopologyFormat::from_path(path) else {
             return Err(Error::Unsupported {
                 file: name,
-                what: "topology format (expected .pdb, .gro, .cif/.mmcif, .psf, .prmtop/.parm7, .tpr, or a LAMMPS data file: .data, .lmp, data.*)",
+                what: "topology format (expected .pdb, .gro, .cif/.mmcif, .psf, .prmtop/.parm7, .tpr, .top/.itp (GROMACS), or a LAMMPS data file: .data, .lmp, data.*)",
             });
         };
         Topology::open_as(path, format)
@@ -262,14 +271,15 @@ impl Topology {
         let is_top = crate::gz::inner_path(path)
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("top"));
-        if format == TopologyFormat::Prmtop && is_top {
+        // A .top is AMBER's when it starts as a prmtop does, else GROMACS's.
+        let mut format = format;
+        if matches!(format, TopologyFormat::Prmtop | TopologyFormat::GromacsTop) && is_top {
             let head = crate::trajectory::head(&mut file, &name, 64)?;
-            if !(head.starts_with(b"%VERSION") || head.starts_with(b"%FLAG")) {
-                return Err(Error::Unsupported {
-                    file: name,
-                    what: "a .top that is not an AMBER prmtop (no %VERSION or %FLAG line first): GROMACS topologies are not read; give the system's .gro or .pdb",
-                });
-            }
+            format = if head.starts_with(b"%VERSION") || head.starts_with(b"%FLAG") {
+                TopologyFormat::Prmtop
+            } else {
+                TopologyFormat::GromacsTop
+            };
         }
         let format = if format == TopologyFormat::Mmcif {
             match crate::trajectory::cif_kind_of(&mut file, path, &name)? {
@@ -282,7 +292,8 @@ impl Topology {
         Topology::from_reader(file, format, &name)
     }
 
-    /// Reads `src` (named `name` in errors) as `format`.
+    /// Reads `src` (named `name` in errors) as `format`. A GROMACS topology's `#include`s are
+    /// looked for beside the path `name`, then in GROMACS's data directories.
     ///
     /// ```
     /// use texmap_md_io::{Topology, TopologyFormat};
@@ -342,6 +353,11 @@ impl Topology {
             }
             TopologyFormat::Psf => crate::psf::read_psf(src, &file),
             TopologyFormat::Prmtop => crate::prmtop::read_prmtop(src, &file),
+            TopologyFormat::GromacsTop => crate::gromacs_top::read_top(
+                src,
+                &file,
+                &crate::gromacs_top::GromacsTopOptions::default(),
+            ),
             TopologyFormat::Tpr => {
                 let mut bytes = Vec::new();
                 src.read_to_end(&mut bytes).map_err(|source| Error::Io {
