@@ -961,6 +961,11 @@ pub struct MolArgs {
     /// name with parentheses): --index index.ndx --select 'group Protein_LIG or group 13'.
     #[arg(long, value_name = "FILE.ndx")]
     pub index: Option<PathBuf>,
+    /// Preprocessor defines for a GROMACS --topology .top, as in the run's .mdp ('define =
+    /// -DPOSRES -DHEAVY_H'): --define HEAVY_H --define POSRES (or NAME=VALUE). Give the ones
+    /// grompp was given, or masses and bonds that depend on them differ from the run's.
+    #[arg(long, value_name = "NAME")]
+    pub define: Vec<String>,
     /// Draw only the atoms SEL selects, in the VMD/MDAnalysis language: 'not resname SOL',
     /// 'name CA', 'element O and resid 1 to 20', 'chain A', 'segid PROA',
     /// 'protein or within 5 of resname LIG', 'byres around 5 resname LIG' (whole residues),

@@ -54,10 +54,12 @@ pub fn run(cli: Cli) -> Result<()> {
         ),
         Command::Render(a) => {
             crate::scene::load_index(a.mol.index.as_deref())?;
+            crate::scene::set_defines(&a.mol.define);
             render(&a)
         }
         Command::Convert(a) => {
             crate::scene::load_index(a.index.as_deref())?;
+            crate::scene::set_defines(&a.define);
             crate::convert::convert(&a)
         }
         Command::Compare(a) => compare(&a),

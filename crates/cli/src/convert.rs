@@ -42,6 +42,11 @@ pub struct ConvertArgs {
     /// name with parentheses): --index index.ndx --select 'group Protein_LIG or group 13'.
     #[arg(long, value_name = "FILE.ndx")]
     pub index: Option<PathBuf>,
+    /// Preprocessor defines for a GROMACS --topology .top, as in the run's .mdp ('define =
+    /// -DPOSRES -DHEAVY_H'): --define HEAVY_H --define POSRES (or NAME=VALUE). Give the ones
+    /// grompp was given, or masses and bonds that depend on them differ from the run's.
+    #[arg(long, value_name = "NAME")]
+    pub define: Vec<String>,
     /// Frames to write, A:B:STEP (B exclusive, each part optional: "::10", "5:", "3").
     #[arg(long, default_value = "0:")]
     pub frames: String,
@@ -195,6 +200,7 @@ fn plan_args(a: &ConvertArgs) -> Result<(MolArgs, StyleArgs)> {
     let mut mol: MolArgs = defaults()?;
     mol.topology = a.topology.clone();
     mol.index = a.index.clone();
+    mol.define = a.define.clone();
     mol.analysis = a.analysis.clone();
     Ok((mol, defaults()?))
 }

@@ -403,7 +403,33 @@ pub fn open_topology(path: &std::path::Path) -> Result<Topology> {
     if !path.exists() {
         anyhow::bail!("{}: no such file", path.display());
     }
-    Ok(Topology::open(path)?)
+    let defines = TOP_DEFINES.get().cloned().unwrap_or_default();
+    if !defines.is_empty() {
+        let name = path.to_string_lossy().to_ascii_lowercase();
+        let name = name.strip_suffix(".gz").unwrap_or(&name);
+        if !(name.ends_with(".top") || name.ends_with(".itp")) {
+            return crate::args::usage(format!(
+                "--define {}: defines preprocess a GROMACS topology (.top, .itp); {} is not one",
+                defines[0],
+                path.display()
+            ));
+        }
+    }
+    let options = texmap_md_io::GromacsTopOptions {
+        defines,
+        ..Default::default()
+    };
+    Ok(Topology::open_with(path, &options)?)
+}
+
+/// `--define`'s names, for every GROMACS topology the command opens (one command per process).
+static TOP_DEFINES: std::sync::OnceLock<Vec<String>> = std::sync::OnceLock::new();
+
+/// Keeps `--define`'s names for [`open_topology`].
+pub(crate) fn set_defines(defines: &[String]) {
+    if !defines.is_empty() {
+        let _ = TOP_DEFINES.set(defines.to_vec());
+    }
 }
 
 /// The groups of `--index FILE.ndx`, for every selection's `group` keyword: read once, before

@@ -4358,3 +4358,79 @@ fn a_gromacs_topology_names_a_gro_as_its_tpr_does() {
     assert_eq!(from_top.len(), 4, "{from_top:?}");
     assert_eq!(from_top, ca(&tpr, "tpr.pdb"));
 }
+
+/// `--define` preprocesses a GROMACS topology as grompp's `define = -D...` does: md-io's
+/// hand-written topology redefines the water hydrogens' type under HEAVY (4.032 u instead of
+/// 1.008) and gives the ETH carbon C2 the charge CHARGE_C2; a define for a topology that is no
+/// GROMACS one is a usage error.
+#[test]
+fn define_preprocesses_a_gromacs_topology() {
+    let dir = tempfile::tempdir().unwrap();
+    let top = data("gromacs_top/hand/system.top");
+    // 16 atoms: two ETH (C1 C2 D), three waters, one ion.
+    let xyz = dir.path().join("hand.xyz");
+    let mut text = String::from("16\nhand-written\n");
+    for i in 0..16 {
+        text += &format!("X {} 0 0\n", 2.0 * i as f32);
+    }
+    std::fs::write(&xyz, text).unwrap();
+    let masses = |defines: &[&str]| -> (Vec<f64>, Vec<f64>) {
+        let out = dir.path().join("out.xyz");
+        let mut args = vec![
+            "convert",
+            xyz.to_str().unwrap(),
+            "--topology",
+            &top,
+            "-q",
+            "--select",
+            "name HW1 or name C2",
+            "--columns",
+            "mass,charge",
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        for d in defines {
+            args.extend(["--define", d]);
+        }
+        let o = texmap(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let text = std::fs::read_to_string(&out).unwrap();
+        let rows: Vec<Vec<f64>> = text
+            .lines()
+            .skip(2)
+            .map(|l| {
+                let w: Vec<&str> = l.split_whitespace().collect();
+                w[w.len() - 2..]
+                    .iter()
+                    .map(|v| v.parse().unwrap())
+                    .collect()
+            })
+            .collect();
+        (
+            rows.iter().map(|r| r[0]).collect(),
+            rows.iter().map(|r| r[1]).collect(),
+        )
+    };
+    // Two C2 then three HW1, in atom order.
+    let (m, q) = masses(&[]);
+    assert_eq!(m, [12.011, 12.011, 1.008, 1.008, 1.008]);
+    assert_eq!(q[..2], [0.18, 0.18]);
+    let (m, q) = masses(&["HEAVY", "CHARGE_C2=0.25"]);
+    assert_eq!(m, [12.011, 12.011, 4.032, 4.032, 4.032]);
+    assert_eq!(q[..2], [0.25, 0.25]);
+    let gro = data("mda_vel.gro");
+    let o = texmap(&["info", &gro]);
+    assert!(o.status.success());
+    let o = texmap(&[
+        "convert",
+        &gro,
+        "--topology",
+        &gro,
+        "--define",
+        "POSRES",
+        "-o",
+        dir.path().join("x.xyz").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--define POSRES"), "{}", stderr(&o));
+}

@@ -247,6 +247,15 @@ impl Topology {
     /// A gzip file (`top.psf.gz`, `1abc.cif.gz`) is read decompressed, as by
     /// [`Trajectory::open`]: byte offsets in its errors count decompressed bytes.
     pub fn open(path: impl AsRef<Path>) -> Result<Topology, Error> {
+        Topology::open_with(path, &crate::gromacs_top::GromacsTopOptions::default())
+    }
+
+    /// [`Topology::open`], with the defines and include directories a GROMACS topology is
+    /// preprocessed with (grompp's `define = -DPOSRES`; unused by the other formats).
+    pub fn open_with(
+        path: impl AsRef<Path>,
+        gromacs: &crate::gromacs_top::GromacsTopOptions,
+    ) -> Result<Topology, Error> {
         let path = path.as_ref();
         let name: Arc<str> = path.display().to_string().into();
         let Some(format) = TopologyFormat::from_path(path) else {
@@ -255,7 +264,7 @@ impl Topology {
                 what: "topology format (expected .pdb, .gro, .cif/.mmcif, .psf, .prmtop/.parm7, .tpr, .top/.itp (GROMACS), or a LAMMPS data file: .data, .lmp, data.*)",
             });
         };
-        Topology::open_as(path, format)
+        Topology::open_as_with(path, format, gromacs)
     }
 
     /// Reads the topology of `path` as `format`; a gzip file is read decompressed, as by
@@ -264,6 +273,18 @@ impl Topology {
     /// A `.cif` named as PDBx/mmCIF is told from a crystallographic CIF by its tags, as
     /// [`Trajectory::open`] tells them ([`Format::cif_kind`]); `.mmcif` is always mmCIF.
     pub fn open_as(path: impl AsRef<Path>, format: TopologyFormat) -> Result<Topology, Error> {
+        Topology::open_as_with(
+            path,
+            format,
+            &crate::gromacs_top::GromacsTopOptions::default(),
+        )
+    }
+
+    fn open_as_with(
+        path: impl AsRef<Path>,
+        format: TopologyFormat,
+        gromacs: &crate::gromacs_top::GromacsTopOptions,
+    ) -> Result<Topology, Error> {
         let path = path.as_ref();
         let name: Arc<str> = path.display().to_string().into();
         // A topology must be whole: a cut gzip stream is an error.
@@ -289,6 +310,9 @@ impl Topology {
         } else {
             format
         };
+        if format == TopologyFormat::GromacsTop {
+            return crate::gromacs_top::read_top(file, &name, gromacs);
+        }
         Topology::from_reader(file, format, &name)
     }
 
