@@ -1194,6 +1194,8 @@ impl AnalysisArgs {
             ("--hbond-table", &self.hbond_table),
             ("--hbond-lifetime", &self.hbond_lifetime),
             ("--hbond-occupancy", &self.hbond_occupancy),
+            ("--saltbridge-table", &self.saltbridge_table),
+            ("--saltbridge-occupancy", &self.saltbridge_occupancy),
             ("--rmsd-matrix-chart", &self.rmsd_matrix_chart),
             ("--ramachandran", &self.ramachandran),
             ("--distance-map", &self.distance_map),
@@ -1228,6 +1230,8 @@ impl AnalysisArgs {
         "rmsd_cluster_middles"])))]
 #[command(group(clap::ArgGroup::new("residue_map_out").multiple(true)
     .args(["distance_map", "distance_map_chart", "contact_map", "contact_map_chart"])))]
+#[command(group(clap::ArgGroup::new("saltbridge_out").multiple(true)
+    .args(["saltbridge_table", "saltbridge_occupancy"])))]
 #[command(group(clap::ArgGroup::new("rmsd_cluster_out").multiple(true)
     .args(["rmsd_clusters", "rmsd_cluster_table", "rmsd_cluster_middles"])))]
 pub struct AnalysisArgs {
@@ -1382,6 +1386,46 @@ pub struct AnalysisArgs {
         requires = "hbond_lifetime"
     )]
     pub hbond_intermittency: usize,
+    /// Also write the salt bridges as a CSV table, one row per bridge and frame (VMD's Salt
+    /// Bridges plugin, saltbr): an acidic residue (ASP, GLU) and a basic one (ARG, LYS; HIS with
+    /// --saltbridge-his) form one when any oxygen of the acid's side chain (OD1 OD2 / OE1 OE2)
+    /// and any nitrogen of the base's (NH1 NH2 NE / NZ / ND1 NE2) are within
+    /// --saltbridge-cutoff, through the nearest periodic image; the termini do not count.
+    /// Columns: frame, time (ps, when the file has it), acid and base (RESNAME RESID), their
+    /// chains, distance (Å, between the oxygens' and the nitrogens' centroids: what saltbr
+    /// writes per bridge) and min_distance (Å, the shortest O-N distance). Only the frames a
+    /// bridge is formed in have its row (saltbr lists every frame of a bridge formed once).
+    /// Among --saltbridge-select's atoms. Written whole or not at all; not with --shard.
+    #[arg(long, value_name = "FILE.csv")]
+    pub saltbridge_table: Option<PathBuf>,
+    /// Also write each salt bridge's occupancy over the run as a CSV table (as --hbond-occupancy
+    /// for hydrogen bonds): one row per acid-base residue pair formed in some frame (the
+    /// bridges of --saltbridge-table), the most present first: acid, base, their chains,
+    /// frames present, occupancy (the fraction of the frames), the mean centroid distance and
+    /// the mean shortest O-N distance (Å) while present. Written whole or not at all; not with
+    /// --shard.
+    #[arg(long, value_name = "FILE.csv")]
+    pub saltbridge_occupancy: Option<PathBuf>,
+    /// The salt bridges' largest oxygen-nitrogen distance, Å (VMD saltbr's default 3.2; up to
+    /// 8; 4.0 is the other common choice, as Barlow and Thornton's).
+    #[arg(long, value_name = "Å", default_value_t = texmap_md_io::saltbridges::DEFAULT_CUTOFF,
+          requires = "saltbridge_out")]
+    pub saltbridge_cutoff: f32,
+    /// The atoms among which --saltbridge-table and --saltbridge-occupancy look for salt
+    /// bridges (saltbr's selection; 'protein' by default, 'chain A or chain B' for the bridges
+    /// of two chains).
+    #[arg(
+        long,
+        value_name = "SEL",
+        default_value = "protein",
+        requires = "saltbridge_out"
+    )]
+    pub saltbridge_select: String,
+    /// Count histidines (every spelling: HIS, HSD, HSE, HSP, HID, HIE, HIP, HISA, HISB, HISH...)
+    /// as basic for the salt bridges, through ND1 and NE2. Off by default, since a file's
+    /// histidine names rarely say which are charged (VMD's basic macro takes HIS and HSP).
+    #[arg(long, requires = "saltbridge_out")]
+    pub saltbridge_his: bool,
     /// Measure, as PyMOL's distance, angle and dihedral: 'SEL; SEL' (a distance, Å),
     /// 'SEL; SEL; SEL' (the angle at the middle atom) or four (the dihedral about the middle
     /// bond, IUPAC's sign), each SEL picking exactly one atom in every frame, through the

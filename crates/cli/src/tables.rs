@@ -109,6 +109,7 @@ pub(crate) struct AnalysisTables {
     hbond_occupancy: Option<(crate::output::AtomicFile, HbondOccupancy)>,
     /// `--measure-table`, and the specs of its rows.
     measure: Option<(crate::output::AtomicFile, Vec<String>)>,
+    saltbridges: Option<SaltBridgeTables>,
 }
 
 /// `--contacts-table`: its file, groups and method, and the native contacts (set at the
@@ -2002,6 +2003,7 @@ impl AnalysisTables {
             )?
             .map(|t| (t, texmap_md_io::rmsf::Fluctuation::new(), Vec::new())),
             contacts: ContactsTable::create(analysis, whole)?,
+            saltbridges: SaltBridgeTables::create(analysis, whole)?,
             pca: PcaTables::create(analysis, whole)?,
             dssp: DsspTables::create(analysis, whole)?,
             rmsd_matrix: RmsdMatrix::create(analysis, whole)?,
@@ -2298,6 +2300,9 @@ impl AnalysisTables {
         if let Some(c) = &mut self.contacts {
             c.add(f, &time, md)?;
         }
+        if let Some(b) = &mut self.saltbridges {
+            b.add(f, &time, md)?;
+        }
         if let Some(t) = &mut self.survival {
             t.add_selected(f, md)?;
         }
@@ -2394,6 +2399,11 @@ impl AnalysisTables {
             .transpose()?
             .unwrap_or_default();
         let hbond_lifetime = self.hbond_lifetime.map(SurvivalTable::finish).transpose()?;
+        let saltbridges = self
+            .saltbridges
+            .map(SaltBridgeTables::finish)
+            .transpose()?
+            .unwrap_or_default();
         let hbond_occupancy = self
             .hbond_occupancy
             .map(|(mut t, o)| t.write(&o.csv()).map(|()| t))
@@ -2438,6 +2448,7 @@ impl AnalysisTables {
         .chain(dssp)
         .chain(rmsd_matrix)
         .chain(residue_map)
+        .chain(saltbridges)
         {
             t.commit()?;
         }
@@ -2796,4 +2807,164 @@ fn mass_of(md: &MdFrame, i: usize) -> Option<f64> {
         .is_some_and(|m| m.is_finite());
     let m = texmap_md_io::atom_mass(md, i);
     (m > 0.0 || (given && m == 0.0)).then_some(m)
+}
+
+/// `--saltbridge-table` and `--saltbridge-occupancy`: the salt bridges of every frame among
+/// `--saltbridge-select`'s atoms.
+struct SaltBridgeTables {
+    table: Option<crate::output::AtomicFile>,
+    occupancy: Option<crate::output::AtomicFile>,
+    select: texmap_md_io::select::Selection,
+    cutoff: f32,
+    histidine: bool,
+    /// Every pair seen, by the acid's and the base's first atoms.
+    seen: std::collections::BTreeMap<(usize, usize), SeenSaltBridge>,
+    frames: usize,
+}
+
+/// A salt bridge's labels (acid, base, their chains, as CSV fields), frames present and summed
+/// distances.
+struct SeenSaltBridge {
+    labels: String,
+    frames: usize,
+    distance: f64,
+    min_distance: f64,
+}
+
+impl SaltBridgeTables {
+    fn create(analysis: &AnalysisArgs, whole: bool) -> Result<Option<SaltBridgeTables>> {
+        let table = per_frame_table(
+            &analysis.saltbridge_table,
+            "--saltbridge-table",
+            "frame,time,acid,base,acid_chain,base_chain,distance,min_distance",
+            whole,
+        )?;
+        let occupancy = whole_run_table(
+            &analysis.saltbridge_occupancy,
+            "--saltbridge-occupancy",
+            "the occupancy counts every frame",
+            whole,
+        )?;
+        if table.is_none() && occupancy.is_none() {
+            return Ok(None);
+        }
+        let cutoff = analysis.saltbridge_cutoff;
+        if !(cutoff > texmap_md_io::bonds::BOND_TOLERANCE
+            && cutoff <= texmap_md_io::saltbridges::MAX_CUTOFF)
+        {
+            return usage(format!(
+                "--saltbridge-cutoff {cutoff}: expected an oxygen-nitrogen distance above 0.45 and at most {} Å",
+                texmap_md_io::saltbridges::MAX_CUTOFF
+            ));
+        }
+        Ok(Some(SaltBridgeTables {
+            table,
+            occupancy,
+            select: crate::scene::parse_selection(
+                "--saltbridge-select",
+                &analysis.saltbridge_select,
+            )?,
+            cutoff,
+            histidine: analysis.saltbridge_his,
+            seen: Default::default(),
+            frames: 0,
+        }))
+    }
+
+    fn add(&mut self, f: usize, time: &str, md: &MdFrame) -> Result<()> {
+        use std::fmt::Write;
+        let mut mask = vec![false; md.n_atoms()];
+        for i in self
+            .select
+            .indices(md)
+            .map_err(|e| anyhow::anyhow!("--saltbridge-select: frame {f}: {e}"))?
+        {
+            if let Some(m) = mask.get_mut(i) {
+                *m = true;
+            }
+        }
+        let groups = texmap_md_io::saltbridges::charged_groups(md, Some(&mask), self.histidine);
+        if self.frames == 0 && (groups.acids.is_empty() || groups.bases.is_empty()) {
+            eprintln!(
+                "texmap: warning: frame {f}: --saltbridge-select keeps {} acidic (ASP, GLU) and {} basic (ARG, LYS{}) side chains, so there can be no salt bridges",
+                groups.acids.len(),
+                groups.bases.len(),
+                if self.histidine { ", HIS" } else { "" }
+            );
+        }
+        let found = texmap_md_io::saltbridges::salt_bridges(md, &groups, self.cutoff)
+            .map_err(|e| anyhow::anyhow!("--saltbridge-table: frame {f}: {e}"))?;
+        let residue = |i: usize| {
+            let label = |v: &[texmap_md_io::Label]| {
+                v.get(i).map(|l| l.as_str().to_string()).unwrap_or_default()
+            };
+            let id = md.res_ids.get(i).map(|r| r.to_string()).unwrap_or_default();
+            (
+                csv_field(&format!("{}{id}", label(&md.res_names))),
+                csv_field(&label(&md.chains)),
+            )
+        };
+        let mut rows = String::new();
+        for b in &found {
+            let (acid, base) = (groups.acids[b.acid].residue, groups.bases[b.base].residue);
+            let e = self.seen.entry((acid, base)).or_insert_with(|| {
+                let ((a, ac), (r, rc)) = (residue(acid), residue(base));
+                SeenSaltBridge {
+                    labels: format!("{a},{r},{ac},{rc}"),
+                    frames: 0,
+                    distance: 0.0,
+                    min_distance: 0.0,
+                }
+            });
+            e.frames += 1;
+            e.distance += f64::from(b.distance);
+            e.min_distance += f64::from(b.min_distance);
+            let _ = writeln!(
+                rows,
+                "{f},{time},{},{:.4},{:.4}",
+                e.labels, b.distance, b.min_distance
+            );
+        }
+        if let Some(t) = &mut self.table {
+            t.write(&rows)?;
+        }
+        self.frames += 1;
+        Ok(())
+    }
+
+    /// The tables, the occupancy's rows written: the most present bridges first (then by the
+    /// acid's and the base's atoms).
+    fn finish(self) -> Result<Vec<crate::output::AtomicFile>> {
+        let mut out: Vec<crate::output::AtomicFile> = self.table.into_iter().collect();
+        if let Some(mut t) = self.occupancy {
+            let mut rows: Vec<_> = self.seen.iter().collect();
+            rows.sort_by(|a, b| b.1.frames.cmp(&a.1.frames).then(a.0.cmp(b.0)));
+            let mut text = String::from(
+                "acid,base,acid_chain,base_chain,frames,occupancy,distance,min_distance\n",
+            );
+            for (_, b) in rows {
+                let k = b.frames as f64;
+                text.push_str(&format!(
+                    "{},{},{:.6},{:.4},{:.4}\n",
+                    b.labels,
+                    b.frames,
+                    k / self.frames.max(1) as f64,
+                    b.distance / k,
+                    b.min_distance / k
+                ));
+            }
+            t.write(&text)?;
+            out.push(t);
+        }
+        Ok(out)
+    }
+}
+
+/// `text` as a CSV field, quoted (RFC 4180) when it holds a comma or a quote.
+fn csv_field(text: &str) -> String {
+    if text.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", text.replace('"', "\"\""))
+    } else {
+        text.to_string()
+    }
 }

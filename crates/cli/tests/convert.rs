@@ -2823,3 +2823,117 @@ fn lammps_data_output_is_the_file_lammps_read() {
     assert!(stderr(&o).contains("one configuration"), "{}", stderr(&o));
     assert!(!out.exists());
 }
+
+/// `--saltbridge-table` and `--saltbridge-occupancy` on adenylate kinase in water (a
+/// truncated octahedron, two frames) list the salt bridges of md-io's saltbridges reference
+/// (VMD saltbr's criterion computed with MDAnalysis's distances: `gen_saltbridges.py`), at
+/// 3.2 Å and at 4.0 Å with histidines, both distances to the tables' decimals; the occupancy
+/// counts the frames. A cutoff out of range is refused with no file left.
+#[test]
+fn salt_bridge_tables_are_mdanalysis_distances() {
+    use std::io::Read;
+    let dir = tempfile::tempdir().unwrap();
+    let (xtc, gro) = (
+        md_data("hbonds/adk_0_9.xtc"),
+        md_data("hbonds/adk_top.gro.gz"),
+    );
+    let mut top = String::new();
+    flate2::read::GzDecoder::new(std::fs::File::open(&gro).unwrap())
+        .read_to_string(&mut top)
+        .unwrap();
+    // RESNAME RESID of atom i, from the GRO's fixed columns.
+    let lines: Vec<&str> = top.lines().collect();
+    let residue = |i: u64| {
+        let l = lines[i as usize + 2];
+        format!("{}{}", l[5..10].trim(), l[0..5].trim())
+    };
+    let reference = json("saltbridges/reference.json");
+    let (table, occ) = (dir.path().join("sb.csv"), dir.path().join("occ.csv"));
+    for run in reference["runs"].as_array().unwrap() {
+        let cutoff = run["cutoff"].as_f64().unwrap().to_string();
+        let mut args = vec![
+            "convert",
+            &xtc,
+            "--topology",
+            &gro,
+            "--saltbridge-table",
+            table.to_str().unwrap(),
+            "--saltbridge-occupancy",
+            occ.to_str().unwrap(),
+            "--saltbridge-cutoff",
+            &cutoff,
+            "-q",
+        ];
+        if run["histidine"].as_bool().unwrap() {
+            args.push("--saltbridge-his");
+        }
+        run_ok(&args);
+        let text = std::fs::read_to_string(&table).unwrap();
+        let mut rows = text.lines();
+        assert_eq!(
+            rows.next(),
+            Some("frame,time,acid,base,acid_chain,base_chain,distance,min_distance")
+        );
+        let got: Vec<Vec<&str>> = rows.map(|l| l.split(',').collect()).collect();
+        let mut want = Vec::new();
+        let mut present = std::collections::BTreeMap::new();
+        for (f, frame) in run["frames"].as_array().unwrap().iter().enumerate() {
+            for r in frame.as_array().unwrap() {
+                let (a, b) = (
+                    residue(r[0].as_u64().unwrap()),
+                    residue(r[1].as_u64().unwrap()),
+                );
+                *present.entry((a.clone(), b.clone())).or_insert(0) += 1;
+                want.push((f, a, b, r[2].as_f64().unwrap(), r[3].as_f64().unwrap()));
+            }
+        }
+        assert_eq!(got.len(), want.len(), "cutoff {cutoff}:\n{text}");
+        for (g, (f, a, b, d, m)) in got.iter().zip(&want) {
+            assert_eq!(
+                (g[0], g[2], g[3], g[4], g[5]),
+                (f.to_string().as_str(), a.as_str(), b.as_str(), "", ""),
+                "cutoff {cutoff}"
+            );
+            assert!(!g[1].is_empty(), "the XTC has times");
+            let (gd, gm): (f64, f64) = (g[6].parse().unwrap(), g[7].parse().unwrap());
+            assert!(
+                (gd - d).abs() < 1e-4 && (gm - m).abs() < 1e-4,
+                "{g:?} {d} {m}"
+            );
+        }
+        if run["histidine"].as_bool().unwrap() {
+            assert!(got.iter().any(|g| g[3].starts_with("HISB")), "{text}");
+        } else {
+            assert!(!got.iter().any(|g| g[3].starts_with("HIS")), "{text}");
+        }
+        let text = std::fs::read_to_string(&occ).unwrap();
+        let mut rows = text.lines();
+        assert_eq!(
+            rows.next(),
+            Some("acid,base,acid_chain,base_chain,frames,occupancy,distance,min_distance")
+        );
+        let got: Vec<Vec<&str>> = rows.map(|l| l.split(',').collect()).collect();
+        assert_eq!(got.len(), present.len());
+        let frames: Vec<u32> = got.iter().map(|g| g[4].parse().unwrap()).collect();
+        assert!(frames.windows(2).all(|w| w[0] >= w[1]), "{text}");
+        for g in &got {
+            let n = present[&(g[0].to_string(), g[1].to_string())];
+            assert_eq!(g[4], n.to_string(), "{g:?}");
+            assert_eq!(g[5], format!("{:.6}", f64::from(n) / 2.0));
+        }
+    }
+    std::fs::remove_file(&table).unwrap();
+    let o = texmap(&[
+        "convert",
+        &xtc,
+        "--topology",
+        &gro,
+        "--saltbridge-table",
+        table.to_str().unwrap(),
+        "--saltbridge-cutoff",
+        "9",
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--saltbridge-cutoff"), "{}", stderr(&o));
+    assert!(!table.exists());
+}

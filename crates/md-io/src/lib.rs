@@ -180,6 +180,7 @@ pub mod replicate;
 pub mod rmsd;
 pub mod rmsf;
 pub mod rotation;
+pub mod saltbridges;
 pub mod sasa;
 mod sdf;
 pub mod secondary;

@@ -297,3 +297,194 @@ fn lifetime_is_mdanalysis_autocorrelation() {
     assert_eq!(texmap_md_io::hbonds::lifetime(&frames[..5], 30, 0).len(), 5);
     assert!(texmap_md_io::hbonds::lifetime(&[], 30, 0).is_empty());
 }
+
+// Salt bridges (`saltbridges`), here rather than in a test binary of their own.
+
+fn saltbridge_reference() -> serde_json::Value {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/saltbridges/reference.json");
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+/// Salt bridges by VMD's saltbr criterion against the same criterion computed with
+/// MDAnalysis 2.11's `distance_array` and `minimize_vectors` (periodic minimum image) on the
+/// solvated adenylate kinase (triclinic box, GROMACS's LYSH and HISB), two frames, at 3.2 Å
+/// without histidines and 4.0 Å with (`tests/data/saltbridges/gen_saltbridges.py`): the same
+/// pairs, both distances to 1e-3 Å; again with the system moved by half the box and wrapped.
+#[test]
+fn saltbridges_match_mdanalysis_distances_on_a_solvated_protein() {
+    use texmap_md_io::saltbridges::{charged_groups, salt_bridges};
+    let r = saltbridge_reference();
+    let top = Topology::open(data("adk_top.gro.gz")).unwrap();
+    let protein = texmap_md_io::select::Selection::parse("protein").unwrap();
+    for (run, shifted) in r["runs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|run| [(run, false), (run, true)])
+    {
+        let cutoff = run["cutoff"].as_f64().unwrap() as f32;
+        let his = run["histidine"].as_bool().unwrap();
+        let mut traj = Trajectory::open(data("adk_0_9.xtc")).unwrap();
+        let mut frame = Frame::new();
+        let mut k = 0;
+        while traj.read_next(&mut frame).unwrap() {
+            top.apply(&mut frame, "adk_0_9.xtc", k).unwrap();
+            assert!(!frame.cell.unwrap().is_orthorhombic());
+            let mut mask = vec![false; frame.n_atoms()];
+            for i in protein.indices(&frame).unwrap() {
+                mask[i] = true;
+            }
+            // Every other pass, the frame moved by half the box and wrapped, so that the
+            // protein lies across the faces: the same bridges through the nearest images.
+            if shifted {
+                let m = frame.cell.unwrap().matrix();
+                for q in &mut frame.positions {
+                    for k in 0..3 {
+                        q[k] += ((m[0][k] + m[1][k] + m[2][k]) / 2.0) as f32;
+                    }
+                }
+                texmap_md_io::pbc::wrap(&mut frame);
+            }
+            let groups = charged_groups(&frame, Some(&mask), his);
+            assert_eq!(groups.acids.len() as u64, run["acids"].as_u64().unwrap());
+            assert_eq!(groups.bases.len() as u64, run["bases"].as_u64().unwrap());
+            let got: Vec<(usize, usize, f32, f32)> = salt_bridges(&frame, &groups, cutoff)
+                .unwrap()
+                .iter()
+                .map(|b| {
+                    (
+                        groups.acids[b.acid].residue,
+                        groups.bases[b.base].residue,
+                        b.distance,
+                        b.min_distance,
+                    )
+                })
+                .collect();
+            let want: Vec<(usize, usize, f64, f64)> = run["frames"][k]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|row| {
+                    (
+                        row[0].as_u64().unwrap() as usize,
+                        row[1].as_u64().unwrap() as usize,
+                        row[2].as_f64().unwrap(),
+                        row[3].as_f64().unwrap(),
+                    )
+                })
+                .collect();
+            let got_pairs: Vec<(usize, usize)> = got.iter().map(|t| (t.0, t.1)).collect();
+            let want_pairs: Vec<(usize, usize)> = want.iter().map(|t| (t.0, t.1)).collect();
+            assert_eq!(
+                got_pairs, want_pairs,
+                "cutoff {cutoff}, frame {k}, shifted {shifted}"
+            );
+            assert!(got.len() >= 16, "{}", got.len());
+            for (g, w) in got.iter().zip(&want) {
+                assert!(
+                    (f64::from(g.2) - w.2).abs() < 1e-3 && (f64::from(g.3) - w.3).abs() < 1e-3,
+                    "cutoff {cutoff}, frame {k}, shifted {shifted}: {g:?} vs {w:?}"
+                );
+            }
+            k += 1;
+        }
+        assert_eq!(k, 2);
+    }
+}
+
+/// An aspartate (OD1, OD2) and an arginine (NH1, NH2, NE) with NH1 `gap` Å beyond OD1 along
+/// x, starting at `x0`.
+fn asp_arg(x0: f32, gap: f32) -> Frame {
+    let mut frame = Frame::new();
+    let l = |s: &str| Label::new(s).unwrap();
+    frame.names = ["CG", "OD1", "OD2", "CZ", "NH1", "NH2", "NE"]
+        .map(l)
+        .to_vec();
+    frame.res_names = ["ASP", "ASP", "ASP", "ARG", "ARG", "ARG", "ARG"]
+        .map(l)
+        .to_vec();
+    frame.res_ids = vec![7, 7, 7, 9, 9, 9, 9];
+    let o1 = x0 + 1.0;
+    let n1 = o1 + gap;
+    frame.positions = vec![
+        [x0, 0.0, 0.0],
+        [o1, 1.0, 0.0],
+        [o1 - 0.5, 2.0, 0.0],
+        [n1 + 1.0, 1.0, 1.0],
+        [n1, 1.0, 0.0],
+        [n1 + 1.5, 0.0, 1.2],
+        [n1 + 1.6, 2.0, 1.6],
+    ];
+    frame
+}
+
+#[test]
+fn a_salt_bridge_is_in_or_out_by_the_cutoff_and_found_across_the_box() {
+    use texmap_md_io::saltbridges::{SaltBridgeError, charged_groups, salt_bridges};
+    let frame = asp_arg(5.0, 3.3);
+    let groups = charged_groups(&frame, None, false);
+    assert_eq!(groups.acids[0].atoms, [1, 2]);
+    assert_eq!(groups.bases[0].atoms, [4, 5, 6]);
+    assert!(salt_bridges(&frame, &groups, 3.2).unwrap().is_empty());
+    let b = salt_bridges(&frame, &groups, 3.5).unwrap();
+    assert_eq!(b.len(), 1);
+    assert!((b[0].min_distance - 3.3).abs() < 1e-5, "{b:?}");
+    // The centroids: O (o1 - 0.25, 1.5, 0), N (n1 + 1.033.., 1, 0.933..).
+    let p = &frame.positions;
+    let c = |ids: &[usize]| -> [f64; 3] {
+        std::array::from_fn(|k| {
+            ids.iter().map(|&i| f64::from(p[i][k])).sum::<f64>() / ids.len() as f64
+        })
+    };
+    let (o, n) = (c(&[1, 2]), c(&[4, 5, 6]));
+    let want = ((0..3).map(|k| (o[k] - n[k]).powi(2)).sum::<f64>()).sqrt();
+    assert!(
+        (f64::from(b[0].distance) - want).abs() < 1e-5,
+        "{b:?} {want}"
+    );
+    // A mask without the arginine's nitrogens: no base.
+    let mask = [true, true, true, true, false, false, false];
+    assert!(charged_groups(&frame, Some(&mask), false).bases.is_empty());
+
+    // Across the face x = 0 of a 20 Å box: the aspartate at x −3..−1.5, written wrapped.
+    let mut wrapped = asp_arg(-3.0, 3.0);
+    for q in &mut wrapped.positions {
+        if q[0] < 0.0 {
+            q[0] += 20.0;
+        }
+    }
+    let groups = charged_groups(&wrapped, None, false);
+    assert!(salt_bridges(&wrapped, &groups, 3.2).unwrap().is_empty());
+    wrapped.cell = Some(UnitCell::orthorhombic(20.0, 20.0, 20.0).unwrap());
+    let b = salt_bridges(&wrapped, &groups, 3.2).unwrap();
+    assert_eq!(b.len(), 1);
+    assert!((b[0].min_distance - 3.0).abs() < 1e-4, "{b:?}");
+    let unwrapped = asp_arg(-3.0, 3.0);
+    let open = salt_bridges(&unwrapped, &groups, 3.2).unwrap();
+    assert!(
+        (b[0].distance - open[0].distance).abs() < 1e-4,
+        "{b:?} {open:?}"
+    );
+
+    // Histidine only when asked; bad cutoffs and a small cell are refused.
+    let mut his = asp_arg(5.0, 3.0);
+    for (i, name) in ["CG", "ND1", "NE2", "CE1"].iter().enumerate() {
+        his.names[3 + i] = Label::new(name).unwrap();
+        his.res_names[3 + i] = Label::new("HSD").unwrap();
+    }
+    assert!(charged_groups(&his, None, false).bases.is_empty());
+    let g = charged_groups(&his, None, true);
+    assert_eq!(g.bases[0].atoms, [4, 5]);
+    assert_eq!(salt_bridges(&his, &g, 3.2).unwrap().len(), 1);
+    for c in [0.0, 0.45, -1.0, 8.5, f32::NAN] {
+        assert!(matches!(
+            salt_bridges(&frame, &groups, c),
+            Err(SaltBridgeError::BadCutoff(_))
+        ));
+    }
+    let mut small = frame.clone();
+    small.cell = Some(UnitCell::orthorhombic(9.0, 9.0, 9.0).unwrap());
+    let e = salt_bridges(&small, &groups, 3.2).unwrap_err();
+    assert!(e.to_string().contains("--replicate"), "{e}");
+}
