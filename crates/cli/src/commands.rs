@@ -357,19 +357,9 @@ fn info(
 /// .top): atoms, residues, bonds, chains and segments, and the properties it gives frames.
 fn topology_info(file: &Path) -> Result<()> {
     let t = crate::scene::open_topology(file)?;
-    // A .top is AMBER's when it starts as a prmtop does (as the reader tells them).
-    let mut head = Vec::new();
-    if let Ok(f) = std::fs::File::open(file) {
-        let _ = std::io::Read::read_to_end(&mut std::io::Read::take(f, 8), &mut head);
-    }
-    let amber = head.starts_with(b"%VERSION") || head.starts_with(b"%FLAG");
-    let top = file
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("top"));
-    let format = match texmap_md_io::TopologyFormat::from_path(file) {
+    let format = match texmap_md_io::Topology::format_of(file)? {
         Some(texmap_md_io::TopologyFormat::Psf) => "psf",
         Some(texmap_md_io::TopologyFormat::GromacsTop) => "gromacs-top",
-        _ if top && !amber => "gromacs-top",
         _ => "prmtop",
     };
     let mut obj = json!({
@@ -384,8 +374,13 @@ fn topology_info(file: &Path) -> Result<()> {
             obj[key] = json!(label_counts(labels));
         }
     }
-    if !t.charges.is_empty() {
-        obj["properties"] = json!(["charge"]);
+    let properties: Vec<&str> = [("charge", &t.charges), ("mass", &t.masses)]
+        .into_iter()
+        .filter(|(_, v)| !v.is_empty())
+        .map(|(name, _)| name)
+        .collect();
+    if !properties.is_empty() {
+        obj["properties"] = json!(properties);
     }
     println!("{obj}");
     Ok(())

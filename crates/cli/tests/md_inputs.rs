@@ -4357,6 +4357,18 @@ fn a_gromacs_topology_names_a_gro_as_its_tpr_does() {
     let from_top = ca(&top, "top.pdb");
     assert_eq!(from_top.len(), 4, "{from_top:?}");
     assert_eq!(from_top, ca(&tpr, "tpr.pdb"));
+    // The topology alone, gzipped: told from an AMBER prmtop by its content, with the charges
+    // and masses it gives frames.
+    let o = texmap(&["info", &top]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let t: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(t["format"], "gromacs-top", "{t}");
+    assert_eq!(
+        t["properties"],
+        serde_json::json!(["charge", "mass"]),
+        "{t}"
+    );
+    assert_eq!(t["bonds"], a["topology"]["bonds"], "{t}");
 }
 
 /// `--define` preprocesses a GROMACS topology as grompp's `define = -D...` does: md-io's

@@ -267,6 +267,29 @@ impl Topology {
         Topology::open_as_with(path, format, gromacs)
     }
 
+    /// The format [`Topology::open`] reads `path` as: [`TopologyFormat::from_path`], with a
+    /// `.top` (gzipped too) told AMBER's or GROMACS's by its first line.
+    pub fn format_of(path: impl AsRef<Path>) -> Result<Option<TopologyFormat>, Error> {
+        let path = path.as_ref();
+        let format = TopologyFormat::from_path(path);
+        let is_top = crate::gz::inner_path(path)
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("top"));
+        if !is_top {
+            return Ok(format);
+        }
+        let name: Arc<str> = path.display().to_string().into();
+        let (mut file, _) = crate::gz::open(path, &name, false)?;
+        let head = crate::trajectory::head(&mut file, &name, 64)?;
+        Ok(Some(
+            if head.starts_with(b"%VERSION") || head.starts_with(b"%FLAG") {
+                TopologyFormat::Prmtop
+            } else {
+                TopologyFormat::GromacsTop
+            },
+        ))
+    }
+
     /// Reads the topology of `path` as `format`; a gzip file is read decompressed, as by
     /// [`Topology::open`].
     ///
