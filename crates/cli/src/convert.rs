@@ -90,7 +90,11 @@ pub struct ConvertArgs {
     /// centred form, atoms wrapped into it with their images, types, velocities, diameters,
     /// masses, charges, orientations, bonds), POSCAR/.vasp (VASP 5, one frame: Direct
     /// coordinates, each run of one element its own species group in the input's order,
-    /// velocities) or XDATCAR (a VASP trajectory; the header repeated when the cell changes).
+    /// velocities), XDATCAR (a VASP trajectory; the header repeated when the cell changes) or
+    /// .sdf/.sd/.mol (MDL SD file for RDKit, Open Babel, PyMOL, ChimeraX and docking tools: one
+    /// molfile record per frame, elements, positions, bonds with their orders, integer
+    /// 'charge' values as formal charges; bonds the input lacks come from --topology, else from
+    /// distances, without orders).
     /// Not compressed: gzip the file afterwards.
     /// Written whole or not at all. Without it, only the analyses' outputs are written (the
     /// --*-table options, --msd-lags, --density-map, --pca-projection, --pca-vectors,
@@ -171,13 +175,20 @@ pub(crate) fn output_format(flag: &str, output: &std::path::Path) -> Result<Form
             | Format::Trr
             | Format::Netcdf
             | Format::Vasp
-            | Format::Gsd),
+            | Format::Gsd
+            | Format::Sdf),
         ) if !is_restart(output) => Ok(f),
         _ => usage(format!(
-            "{flag} {}: expected a .xyz/.extxyz, .lammpstrj/.dump, .data/.lmp, .gro, .pdb, .cif/.mmcif, .dcd, .xtc, .trr, .nc/.ncdf, .gsd, POSCAR/.vasp or XDATCAR file name",
+            "{flag} {}: expected a .xyz/.extxyz, .lammpstrj/.dump, .data/.lmp, .gro, .pdb, .cif/.mmcif, .dcd, .xtc, .trr, .nc/.ncdf, .gsd, .sdf/.sd/.mol, POSCAR/.vasp or XDATCAR file name",
             output.display()
         )),
     }
+}
+
+/// Whether no atom number repeats (an empty list: the writer numbers atoms 1, 2, ...).
+fn unique_ids(ids: &[i64]) -> bool {
+    let mut seen = std::collections::HashSet::with_capacity(ids.len());
+    ids.iter().all(|id| seen.insert(*id))
 }
 
 /// An AMBER restart name (`.ncrst`): read as NetCDF, but the writer writes trajectories, which
@@ -296,6 +307,7 @@ pub fn convert(a: &ConvertArgs) -> Result<()> {
     let mut first_atoms: Option<usize> = None;
     let mut atoms_written = 0usize;
     let mut without_positions = 0usize;
+    let mut conect_note_shown = false;
     let mut run = |mut writer: Option<Writer>| -> Result<()> {
         for &f in &frames {
             let at = |e: anyhow::Error| e.context(format!("frame {f}: nothing was written"));
@@ -317,6 +329,37 @@ pub fn convert(a: &ConvertArgs) -> Result<()> {
             plan.prepare(&mut md)
                 .map_err(|e| at(crate::scene::mol_error(e)))?;
             tables.write(f, &plan, &md).map_err(at)?;
+            // A PDB keeps the topology's bonds as CONECT records (the frame's own, an SDF's or
+            // a MOL2's, when it has them); --select keeps those among the atoms it keeps. Not
+            // when the atoms' numbers repeat (a GRO's wrap at 100,000): CONECT names atoms by
+            // number, so the file is written without them, as before, and says so.
+            if format == Some(Format::Pdb)
+                && md.bonds.is_empty()
+                && let Some(t) = plan.topology()
+                && !t.bonds.is_empty()
+            {
+                if unique_ids(&md.ids) {
+                    md.bonds.clone_from(&t.bonds);
+                    md.bond_orders.clear();
+                } else if !conect_note_shown {
+                    conect_note_shown = true;
+                    crate::note!(
+                        "{}: the atoms' numbers repeat (a GRO numbers past 99,999 from 0 again), so the topology's bonds are not written as CONECT records, which name atoms by number",
+                        a.file.display()
+                    );
+                }
+            }
+            // An SD file is a molecule with its bonds: those the frame lists (an SDF's, a
+            // MOL2's), else the topology's, else those of the positions by distance (a PDBQT
+            // pose, an XYZ), without orders (written single); --select keeps those among the
+            // atoms it keeps.
+            if format == Some(Format::Sdf) && md.bonds.is_empty() {
+                md.bond_orders.clear();
+                match plan.topology().filter(|t| !t.bonds.is_empty()) {
+                    Some(t) => md.bonds.clone_from(&t.bonds),
+                    None => md.bonds = texmap_md_io::bonds::bonds_by_distance(&md, false).pairs,
+                }
+            }
             if let Some(columns) = &a.columns {
                 structure_columns(&mut md, columns);
             }

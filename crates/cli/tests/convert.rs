@@ -303,7 +303,7 @@ fn bad_requests_are_refused_and_leave_no_file() {
         (
             vec![source.clone(), "-o".into(), out("x.png")],
             2,
-            "expected a .xyz/.extxyz, .lammpstrj/.dump, .data/.lmp, .gro, .pdb, .cif/.mmcif, .dcd, .xtc, .trr, .nc/.ncdf, .gsd, POSCAR/.vasp or XDATCAR file name",
+            "expected a .xyz/.extxyz, .lammpstrj/.dump, .data/.lmp, .gro, .pdb, .cif/.mmcif, .dcd, .xtc, .trr, .nc/.ncdf, .gsd, .sdf/.sd/.mol, POSCAR/.vasp or XDATCAR file name",
         ),
         (
             vec![
@@ -2936,4 +2936,93 @@ fn salt_bridge_tables_are_mdanalysis_distances() {
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("--saltbridge-cutoff"), "{}", stderr(&o));
     assert!(!table.exists());
+}
+
+/// A PDB keeps the topology's bonds as CONECT records: md-io's committed file (whose CONECT
+/// lines are MDAnalysis's, byte for byte), read back with the PSF's bonds; with --select, the
+/// bonds among the atoms kept, numbered as written.
+#[test]
+fn pdb_output_keeps_the_topology_bonds_as_conect_records() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("x.pdb");
+    let (gro, psf) = (md_data("topo_mda.gro"), md_data("psf_parmed.psf"));
+    run_ok(&[
+        "convert",
+        &gro,
+        "--topology",
+        &psf,
+        "-q",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    let text = std::fs::read_to_string(&out).unwrap();
+    let committed = std::fs::read_to_string(md_data("pdb_conect/peptide_psf.pdb")).unwrap();
+    assert_eq!(text, committed);
+    let bonds = |p: &str| texmap_md_io::Topology::open(p).unwrap().bonds;
+    let all = bonds(&psf);
+    assert_eq!(all.len(), 53);
+    assert_eq!(bonds(out.to_str().unwrap()), all);
+    // The peptide alone (atoms 0-29): its bonds, none to the waters.
+    let sel = dir.path().join("ala.pdb");
+    let sel_s = sel.to_str().unwrap();
+    run_ok(&[
+        "convert",
+        &gro,
+        "--topology",
+        &psf,
+        "--select",
+        "resname ALA",
+        "-q",
+        "-o",
+        sel_s,
+    ]);
+    let kept: Vec<[u32; 2]> = all.iter().copied().filter(|b| b[1] < 30).collect();
+    assert!(kept.len() > 20 && kept.len() < all.len(), "{kept:?}");
+    assert_eq!(bonds(sel_s), kept);
+    // Without a topology with bonds, no CONECT records (the files of before).
+    let plain = dir.path().join("plain.pdb");
+    run_ok(&["convert", &gro, "-q", "-o", plain.to_str().unwrap()]);
+    assert!(!std::fs::read_to_string(&plain).unwrap().contains("CONECT"));
+}
+
+/// An SD file of docked poses and of a MOL2 library is md-io's committed file (checked there
+/// against RDKit) byte for byte: the PDBQT poses with their bonds by distance, the MOL2's with
+/// their orders. From a GRO with a PSF topology, --select keeps the topology's bonds among the
+/// atoms it keeps.
+#[test]
+fn sdf_output_is_the_committed_file_with_bonds() {
+    let dir = tempfile::tempdir().unwrap();
+    for (src, committed) in [
+        ("pdbqt/poses.pdbqt", "sdf_write/vina_poses.sdf"),
+        ("molecules/library.mol2", "sdf_write/library_mol2.sdf"),
+    ] {
+        let out = dir.path().join("out.sdf");
+        run_ok(&["convert", &md_data(src), "-q", "-o", out.to_str().unwrap()]);
+        let text = std::fs::read_to_string(&out).unwrap();
+        assert!(
+            text == std::fs::read_to_string(md_data(committed)).unwrap(),
+            "{src}: {text}"
+        );
+    }
+    let (gro, psf) = (md_data("topo_mda.gro"), md_data("psf_parmed.psf"));
+    let out = dir.path().join("ala.sdf");
+    run_ok(&[
+        "convert",
+        &gro,
+        "--topology",
+        &psf,
+        "--select",
+        "resname ALA",
+        "-q",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    let all = texmap_md_io::Topology::open(&psf).unwrap().bonds;
+    let kept: Vec<[u32; 2]> = all.iter().copied().filter(|b| b[1] < 30).collect();
+    let written = frames(&out);
+    assert_eq!(written.len(), 1);
+    assert_eq!(written[0].n_atoms(), 30);
+    assert!(kept.len() > 20 && kept.len() < all.len(), "{kept:?}");
+    assert_eq!(written[0].bonds, kept);
+    assert_eq!(written[0].bond_orders, vec![1; kept.len()]);
 }

@@ -183,6 +183,7 @@ pub mod rotation;
 pub mod saltbridges;
 pub mod sasa;
 mod sdf;
+mod sdf_writer;
 pub mod secondary;
 pub mod select;
 pub mod sequence;

@@ -29,11 +29,39 @@
 //! flexible ligand's torsion tree) are skipped; each `MODEL` of a docking output is a pose, and
 //! its `REMARK VINA RESULT:` line (score in kcal/mol, RMSD bounds) becomes the frame's title.
 //!
+//! **Writing** (`PdbWriter`): every atom is an `ATOM` record (the writer does not tell
+//! standard residues from hetero groups), so the wwPDB rule of `CONECT` records for the bonds
+//! of `HETATM` records only would write none. All of the frame's bonds ([`Frame::bonds`]: an
+//! SDF/MOL2 ligand's, or the topology's that `texmap convert` gives a PDB) are written instead,
+//! as MDAnalysis (`bonds="all"`) and Open Babel do: a reader that ignores `CONECT` guesses
+//! bonds anyway, and one that reads them (ours, MDAnalysis, gemmi, RDKit with
+//! `proximityBonding=False`) gets exactly the frame's bonds, a protein's backbone included
+//! (with `HETATM` bonds only, our reader would lose it).
+//! - Layout: `CONECT`, the atom's serial in columns 7-11 and up to four bonded serials in
+//!   12-31 (`CONECT%5d%5d%5d%5d%5d`, no padding), one line per bonded atom in file order with
+//!   its partners in file order, more lines for more than four; each bond is listed from both
+//!   atoms. Serials past 99,999 are hybrid-36, as in the `ATOM` records they name (our reader
+//!   and cctbx read them; a reader without hybrid-36 cannot read those atoms either).
+//! - Orders ([`Frame::bond_orders`]): a double or triple bond repeats its partner two or three
+//!   times, the convention RDKit (checked), gemmi (kept), PyMOL and Open Babel read as bond
+//!   order; aromatic and unknown orders are written once, as single bonds (PDB has no aromatic
+//!   bond: kekulize first to keep them). MDAnalysis and our reader take the repeats as one bond.
+//! - Place: one set of records for the file, the first frame's (bonds are topology), written
+//!   in the first model just before its `ENDMDL`, as RDKit's writer places them. wwPDB entries
+//!   put them after the last model, but RDKit's reader (and others reading the first model
+//!   only) stops at the first `ENDMDL` and would see no bonds there; MDAnalysis, gemmi and our
+//!   reader take `CONECT` records wherever they are.
+//! - Refused (an error naming the frame, nothing dropped): a later frame whose bonds or written
+//!   orders differ from the first's (one `CONECT` set cannot hold both: write one file per
+//!   molecule, or SDF), and a bonded atom whose serial another atom shares (a GRO's numbers
+//!   wrap at 100,000), which `CONECT` could not tell apart.
+//!
 //! Hybrid-36 (Grosse-Kunstleve, 2007): a field of width w holds decimal numbers up to 10^w - 1,
 //! then base-36 with upper-case digits ("A0000" = 100,000 for w = 5), then lower-case digits.
 //!
 //! # References
-//! - wwPDB, Protein Data Bank Contents Guide: Atomic Coordinate Entry Format v3.3.
+//! - wwPDB, Protein Data Bank Contents Guide: Atomic Coordinate Entry Format v3.3
+//!   (section 10, `CONECT`).
 //! - R. W. Grosse-Kunstleve, "Hybrid-36", cctbx iotbx/pdb/hybrid_36 documentation (2007).
 //! - AutoDock 4.2 user guide, "PDBQT format" and its atom types; AutoDock Vina 1.2 and Meeko
 //!   documentation (the torsion tree, `REMARK VINA RESULT`).
@@ -429,10 +457,32 @@ pub(crate) fn written_element(frame: &Frame, i: usize) -> crate::elements::Eleme
 /// Writes frames as PDB: one MODEL … ENDMDL per frame, a CRYST1 when the frame has a cell,
 /// hybrid-36 serial and residue numbers, element symbols in columns 77-78, END at `finish`.
 /// Segments longer than columns 73-76 keep their first 4 characters (MDAnalysis's and VMD's
-/// rule); names, residue names and chains that do not fit are errors.
+/// rule); names, residue names and chains that do not fit are errors. The first frame's bonds
+/// are written as `CONECT` records before its ENDMDL (see the module doc).
 pub(crate) struct PdbWriter<W> {
     pub out: W,
     pub models: usize,
+    /// The first frame's bonds and how many times each is written (its order, see
+    /// [`conect_multiplicity`]); later frames must have the same.
+    bonds: Option<(Vec<[u32; 2]>, Vec<u8>)>,
+}
+
+/// How many times a bond of order `order` is listed in `CONECT` records: 2 and 3 for double
+/// and triple bonds, once for the rest (single, aromatic, unknown).
+fn conect_multiplicity(frame: &Frame) -> Vec<u8> {
+    if frame.bond_orders.len() != frame.bonds.len() {
+        return vec![1; frame.bonds.len()];
+    }
+    frame
+        .bond_orders
+        .iter()
+        .map(|o| if matches!(o, 2 | 3) { *o } else { 1 })
+        .collect()
+}
+
+/// The serial number the writer gives atom `i`: its id, else `i + 1`.
+fn written_serial(frame: &Frame, i: usize) -> i64 {
+    frame.ids.get(i).copied().unwrap_or(i as i64 + 1)
 }
 
 /// Largest and smallest coordinate that fit `%8.3f`.
@@ -440,8 +490,64 @@ const PDB_MAX: f32 = 9999.999;
 const PDB_MIN: f32 = -999.999;
 
 impl<W: std::io::Write> PdbWriter<W> {
+    pub fn new(out: W) -> Self {
+        PdbWriter {
+            out,
+            models: 0,
+            bonds: None,
+        }
+    }
+
     /// Why `frame` cannot be written as PDB, if it cannot.
-    pub fn check(frame: &Frame) -> Result<(), String> {
+    pub fn check(&self, frame: &Frame) -> Result<(), String> {
+        Self::check_atoms(frame)?;
+        match &self.bonds {
+            Some((bonds, mult)) => {
+                if *bonds != frame.bonds || *mult != conect_multiplicity(frame) {
+                    return Err(format!(
+                        "its bonds differ from the first frame's ({} bonds here, {} there): a PDB \
+                         file's CONECT records are one set of bonds for all its models; write \
+                         each molecule to its own file",
+                        frame.bonds.len(),
+                        bonds.len()
+                    ));
+                }
+                Ok(())
+            }
+            None => Self::check_serials(frame),
+        }
+    }
+
+    /// Whether `CONECT` records can name `frame`'s bonded atoms: their serials must be unique.
+    fn check_serials(frame: &Frame) -> Result<(), String> {
+        if frame.bonds.is_empty() || frame.ids.is_empty() {
+            return Ok(());
+        }
+        let mut count: std::collections::HashMap<i64, u32> =
+            std::collections::HashMap::with_capacity(frame.ids.len());
+        for id in &frame.ids {
+            *count.entry(*id).or_default() += 1;
+        }
+        for i in frame.bonds.iter().flatten().map(|&i| i as usize) {
+            let s = written_serial(frame, i);
+            if count.get(&s).is_some_and(|&c| c > 1) {
+                let other = (0..frame.ids.len())
+                    .find(|&j| j != i && frame.ids[j] == s)
+                    .unwrap_or(i);
+                return Err(format!(
+                    "atoms {} and {} share the serial number {s} and atom {i} is bonded: \
+                     CONECT records name atoms by serial and could not tell them apart \
+                     (write .cif, or number the atoms uniquely)",
+                    i.min(other),
+                    i.max(other)
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Why `frame`'s atoms cannot be written as PDB, if they cannot.
+    fn check_atoms(frame: &Frame) -> Result<(), String> {
         if let Some(i) = frame
             .positions
             .iter()
@@ -496,6 +602,14 @@ impl<W: std::io::Write> PdbWriter<W> {
     }
 
     pub fn write_frame(&mut self, frame: &Frame) -> std::io::Result<()> {
+        let conect = if self.bonds.is_none() {
+            let mult = conect_multiplicity(frame);
+            let records = conect_records(frame, &mult);
+            self.bonds = Some((frame.bonds.clone(), mult));
+            records
+        } else {
+            String::new()
+        };
         let w = &mut self.out;
         self.models += 1;
         if let Some(c) = &frame.cell {
@@ -510,7 +624,7 @@ impl<W: std::io::Write> PdbWriter<W> {
         let occupancy = frame.property("occupancy");
         let bfactor = frame.property("bfactor");
         for (i, p) in frame.positions.iter().enumerate() {
-            let serial = frame.ids.get(i).copied().unwrap_or(i as i64 + 1);
+            let serial = written_serial(frame, i);
             // Serials past hybrid-36's range were rejected by `check`; wrap defensively.
             let serial = hy36_encode(serial, 5).unwrap_or_else(|| "*****".into());
             let element = written_element(frame, i);
@@ -548,12 +662,43 @@ impl<W: std::io::Write> PdbWriter<W> {
                 bfactor.map_or(0.0, |v| v[i])
             )?;
         }
+        w.write_all(conect.as_bytes())?;
         writeln!(w, "ENDMDL")
     }
 
     pub fn finish(&mut self) -> std::io::Result<()> {
         writeln!(self.out, "END")
     }
+}
+
+/// The `CONECT` records of `frame`'s bonds, each bond listed `mult` times from both atoms: one
+/// line per atom in file order, up to four partners a line in file order.
+fn conect_records(frame: &Frame, mult: &[u8]) -> String {
+    use std::fmt::Write as _;
+    let mut pairs: Vec<[u32; 2]> = Vec::with_capacity(frame.bonds.len() * 2);
+    for (&[i, j], &m) in frame.bonds.iter().zip(mult) {
+        for _ in 0..m {
+            pairs.push([i, j]);
+            pairs.push([j, i]);
+        }
+    }
+    pairs.sort_unstable();
+    // Serials were checked to fit 5 hybrid-36 columns; wrap defensively as the atoms do.
+    let serial = |i: u32| {
+        hy36_encode(written_serial(frame, i as usize), 5).unwrap_or_else(|| "*****".into())
+    };
+    let mut out = String::with_capacity(pairs.len() / 4 * 32 + pairs.len() * 3);
+    for group in pairs.chunk_by(|a, b| a[0] == b[0]) {
+        for line in group.chunks(4) {
+            out.push_str("CONECT");
+            out.push_str(&serial(line[0][0]));
+            for p in line {
+                out.push_str(&serial(p[1]));
+            }
+            let _ = writeln!(out);
+        }
+    }
+    out
 }
 
 #[cfg(test)]

@@ -31,6 +31,9 @@
 //!   convention 1.0): time, f32 coordinates, the cell as lengths and angles, velocities with
 //!   AMBER's `scale_factor` 20.455; no forces (src/netcdf_writer.rs; read back by MDAnalysis,
 //!   the netCDF-C library and our reader).
+//! - [`Format::Sdf`]: MDL SD file, one molfile record per frame (V2000, V3000 past 999 atoms
+//!   or bonds): elements, positions to 4 decimals, bonds with their orders, formal charges,
+//!   step, time (src/sdf_writer.rs; read back by RDKit, Open Babel and our reader).
 //!
 //! Rules the text writers share:
 //! - numbers are written in Rust's shortest round-trip form, so reading them back gives the
@@ -58,6 +61,7 @@ use crate::lammps_dump_writer::LammpsDumpWriter;
 use crate::mmcif_writer::MmcifWriter;
 use crate::netcdf_writer::NetcdfWriter;
 use crate::pdb::PdbWriter;
+use crate::sdf_writer::SdfWriter;
 use crate::trr_writer::TrrWriter;
 use crate::vasp_writer::{VaspWriter, is_xdatcar};
 use crate::xtc::XtcWriter;
@@ -126,6 +130,7 @@ enum WriterKind<W> {
     Vasp(VaspWriter<W>),
     Trr(TrrWriter<W>),
     Gsd(GsdWriter<W>),
+    Sdf(SdfWriter<W>),
 }
 
 /// Runs `$body` with `$w` bound to the format's writer, whatever the format.
@@ -144,6 +149,7 @@ macro_rules! each_writer {
             WriterKind::Vasp($w) => $body,
             WriterKind::Trr($w) => $body,
             WriterKind::Gsd($w) => $body,
+            WriterKind::Sdf($w) => $body,
         }
     };
 }
@@ -193,12 +199,13 @@ impl<W: Write + Seek> Writer<W> {
             Format::Gro => WriterKind::Gro(GroWriter { out }),
             Format::Dcd => WriterKind::Dcd(DcdWriter::new(out, file.clone())),
             Format::Xtc => WriterKind::Xtc(XtcWriter::new(out, file.clone(), 1000.0)?),
-            Format::Pdb => WriterKind::Pdb(PdbWriter { out, models: 0 }),
+            Format::Pdb => WriterKind::Pdb(PdbWriter::new(out)),
             Format::Mmcif => WriterKind::Mmcif(MmcifWriter::new(out, &file)),
             Format::Netcdf => WriterKind::Netcdf(NetcdfWriter::new(out)),
             Format::Vasp => WriterKind::Vasp(VaspWriter::new(out, is_xdatcar(&file))),
             Format::Trr => WriterKind::Trr(TrrWriter::new(out)),
             Format::Gsd => WriterKind::Gsd(GsdWriter::new(out)),
+            Format::Sdf => WriterKind::Sdf(SdfWriter::new(out, &file)),
             _ => {
                 return Err(Error::Unsupported {
                     file,
@@ -233,7 +240,7 @@ impl<W: Write + Seek> Writer<W> {
         })?;
         // Format limits (e.g. PDB's fixed columns, LAMMPS's restricted triclinic box).
         let limits = match &self.kind {
-            WriterKind::Pdb(_) => PdbWriter::<W>::check(frame),
+            WriterKind::Pdb(w) => w.check(frame),
             WriterKind::Xyz(_) => XyzWriter::<W>::check(frame),
             WriterKind::LammpsDump(_) => LammpsDumpWriter::<W>::check(frame),
             WriterKind::LammpsData(w) => w.check(frame),

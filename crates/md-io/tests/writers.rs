@@ -607,3 +607,545 @@ fn gro_text_and_refusals() {
     let e = refused(Format::Gro, &tilted);
     assert!(e.contains("not in GROMACS's form"), "{e}");
 }
+
+// SDF writer (src/sdf_writer.rs): the committed files of tests/data/sdf_write are what the
+// writer writes now, our reader reads them back, and RDKit read them as rdkit_reference.json
+// records (gen_rdkit_reference.py there).
+
+/// Glycine as a zwitterion (NH3+, COO-) with step and time, then a Mg2+ ion, then an atom of
+/// no element bonded to a carbon by a bond of unknown order.
+fn sdf_charged_frames() -> Vec<Frame> {
+    let mut gly = Frame::new();
+    let atoms: [(&str, [f32; 3], f32); 10] = [
+        ("N", [-1.4526, 0.3198, 0.0011], 1.0),
+        ("C", [0.0, 0.4563, -0.0218], 0.0),
+        ("C", [0.6116, -0.9304, 0.0121], 0.0),
+        ("O", [1.8586, -0.9857, 0.0102], 0.0),
+        ("O", [-0.1434, -1.9202, 0.0372], -1.0),
+        ("H", [-1.8477, 1.2719, -0.0146], 0.0),
+        ("H", [-1.7529, -0.1576, 0.8554], 0.0),
+        ("H", [-1.7761, -0.1908, -0.8261], 0.0),
+        ("H", [0.3179, 1.0063, -0.9084], 0.0),
+        ("H", [0.3411, 1.0395, 0.8316], 0.0),
+    ];
+    for (e, p, _) in atoms {
+        gly.positions.push(p);
+        gly.elements.push(element(e));
+    }
+    gly.properties.push(property("charge", &atoms.map(|a| a.2)));
+    gly.bonds = vec![
+        [0, 1],
+        [0, 5],
+        [0, 6],
+        [0, 7],
+        [1, 2],
+        [1, 8],
+        [1, 9],
+        [2, 3],
+        [2, 4],
+    ];
+    gly.bond_orders = vec![1, 1, 1, 1, 1, 1, 1, 2, 1];
+    gly.comment = "glycine zwitterion\nsecond comment line".into();
+    gly.step = Some(42);
+    gly.time = Some(0.5);
+    let mut mg = Frame::new();
+    mg.positions.push([0.0, 0.0, 0.0]);
+    mg.elements.push(element("Mg"));
+    mg.properties.push(property("charge", &[2.0]));
+    mg.comment = "magnesium".into();
+    let mut dummy = Frame::new();
+    dummy.positions = vec![[0.0, 0.0, 0.0], [-1.5, 2.25, 99999.99]];
+    dummy.elements = vec![element("C"), Element::UNKNOWN];
+    dummy.names = labels(&["C1", "LP"]);
+    dummy.bonds = vec![[0, 1]];
+    dummy.bond_orders = vec![0];
+    vec![gly, mg, dummy]
+}
+
+/// A chain of 1000 carbons (999 bonds, no orders): past V2000's 999 atoms, so V3000.
+fn sdf_chain_frame() -> Frame {
+    let mut f = Frame::new();
+    for i in 0..1000 {
+        let x = i as f32 * 1.2574;
+        f.positions
+            .push([x, if i % 2 == 0 { 0.0 } else { 0.8890 }, -0.25]);
+        f.elements.push(element("C"));
+    }
+    f.bonds = (0..999).map(|i| [i, i + 1]).collect();
+    f.comment = "C1000".into();
+    f
+}
+
+/// Each committed SD file of tests/data/sdf_write and the frames it was written from.
+fn sdf_sources() -> Vec<(&'static str, Vec<Frame>)> {
+    let mut out = Vec::new();
+    for (name, src) in [
+        ("imatinib_confs.sdf", "molecules/imatinib_confs.sdf"),
+        ("library_sdf.sdf", "molecules/library.sdf"),
+        ("caffeine_v3000.sdf", "molecules/caffeine_v3000.mol"),
+        ("imatinib_poses_mol2.sdf", "molecules/imatinib_poses.mol2"),
+        ("library_mol2.sdf", "molecules/library.mol2"),
+        ("vina_poses.sdf", "pdbqt/poses.pdbqt"),
+    ] {
+        let mut frames = read_file(src);
+        if src.ends_with(".pdbqt") {
+            // PDBQT lists no bonds: those by distance, as texmap convert gives an SD file.
+            for f in &mut frames {
+                f.bonds = texmap_md_io::bonds::bonds_by_distance(f, false).pairs;
+            }
+        }
+        out.push((name, frames));
+    }
+    out.push(("charged.sdf", sdf_charged_frames()));
+    out.push(("chain_v3000.sdf", vec![sdf_chain_frame()]));
+    out
+}
+
+/// The element symbol the writer gives atom `i`.
+fn sdf_symbol(f: &Frame, i: usize) -> String {
+    match f.elements.get(i) {
+        Some(e) if !e.is_unknown() => e.symbol().to_string(),
+        _ => "*".to_string(),
+    }
+}
+
+/// The bond types the file holds: the orders, 1 without them.
+fn sdf_orders(f: &Frame) -> Vec<u8> {
+    if f.bond_orders.is_empty() {
+        vec![1; f.bonds.len()]
+    } else {
+        f.bond_orders.clone()
+    }
+}
+
+/// The title line: the comment's first line, else the stem of the file name ("out").
+fn sdf_title(f: &Frame) -> String {
+    let t = f.comment.lines().next().unwrap_or("").trim_end();
+    if t.is_empty() { "out" } else { t }.to_string()
+}
+
+/// Positions within the 4 written decimals plus the f32 rounding of the value read back.
+fn sdf_close(a: [f32; 3], b: [f64; 3], what: &str) {
+    for k in 0..3 {
+        let tol = 5.1e-5 + 2.0 * f32::EPSILON as f64 * b[k].abs();
+        assert!((a[k] as f64 - b[k]).abs() <= tol, "{what}: {a:?} vs {b:?}");
+    }
+}
+
+#[test]
+fn sdf_files_written_now_are_the_committed_ones_and_read_back() {
+    for (name, frames) in sdf_sources() {
+        let text = write(Format::Sdf, &frames);
+        let path = data("sdf_write").join(name);
+        if std::env::var_os("TEXMAP_REGENERATE_SDF").is_some() {
+            std::fs::write(&path, &text).unwrap();
+        }
+        let committed = std::fs::read_to_string(&path).unwrap();
+        assert!(committed == text, "{name}: the writer's bytes changed");
+        let back = read(Format::Sdf, &text);
+        assert_eq!(back.len(), frames.len(), "{name}");
+        for (k, (a, b)) in frames.iter().zip(&back).enumerate() {
+            let case = format!("{name} record {k}");
+            assert!(!a.positions.is_empty() || b.positions.is_empty(), "{case}");
+            assert_eq!(a.n_atoms(), b.n_atoms(), "{case}");
+            for i in 0..a.n_atoms() {
+                assert_eq!(sdf_symbol(a, i), sdf_symbol(b, i), "{case} atom {i}");
+                let p = a.positions[i].map(|x| x as f64);
+                sdf_close(b.positions[i], p, &case);
+            }
+            assert_eq!(a.bonds, b.bonds, "{case}");
+            assert_eq!(sdf_orders(a), b.bond_orders, "{case}");
+            assert_eq!(sdf_title(a), b.comment, "{case}");
+        }
+    }
+    // The V2000/V3000 choice, charges and data items where they belong.
+    let charged = std::fs::read_to_string(data("sdf_write/charged.sdf")).unwrap();
+    assert!(charged.contains(" N   0  3  0") && charged.contains("M  CHG  2   1   1   5  -1\n"));
+    assert!(charged.contains("> <step>\n42\n\n> <time>\n0.5\n\n$$$$\n"));
+    let chain = std::fs::read_to_string(data("sdf_write/chain_v3000.sdf")).unwrap();
+    assert!(chain.contains("999 V3000\n") && chain.contains("M  V30 COUNTS 1000 999 0 0 0\n"));
+    let vina = std::fs::read_to_string(data("sdf_write/vina_poses.sdf")).unwrap();
+    assert!(
+        vina.contains("> <minimizedAffinity>\n-4.268\n\n$$$$\n"),
+        "{vina}"
+    );
+}
+
+/// The committed SD files as RDKit read them (rdkit_reference.json) against the frames they
+/// were written from.
+fn sdf_check_rdkit(reference: &serde_json::Value) {
+    use serde_json::Value;
+    let sources = sdf_sources();
+    let files = reference.as_object().unwrap();
+    assert_eq!(files.len(), sources.len());
+    for (name, frames) in &sources {
+        let records = files[*name].as_array().unwrap();
+        assert_eq!(records.len(), frames.len(), "{name}");
+        for (k, (r, f)) in records.iter().zip(frames).enumerate() {
+            let case = format!("{name} record {k}");
+            assert_eq!(r["name"], Value::from(sdf_title(f)), "{case}");
+            let symbols: Vec<String> = (0..f.n_atoms()).map(|i| sdf_symbol(f, i)).collect();
+            assert_eq!(r["symbols"], serde_json::json!(symbols), "{case}");
+            let coords = r["coords"].as_array().unwrap();
+            assert_eq!(coords.len(), f.n_atoms(), "{case}");
+            for (c, p) in coords.iter().zip(&f.positions) {
+                let c: Vec<f64> = c
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .map(|v| v.as_f64().unwrap())
+                    .collect();
+                // RDKit's f64 of the written text against our f32: 4 decimals.
+                for k in 0..3 {
+                    assert!((c[k] - p[k] as f64).abs() <= 5.1e-5, "{case}: {c:?} {p:?}");
+                }
+            }
+            let bonds: Vec<[u32; 3]> = f
+                .bonds
+                .iter()
+                .zip(sdf_orders(f))
+                .map(|(b, o)| [b[0], b[1], o as u32])
+                .collect();
+            assert_eq!(r["bonds"], serde_json::json!(bonds), "{case}");
+            let q: Vec<i64> = match f.property("charge") {
+                Some(q) if q.iter().all(|v| v.fract() == 0.0) => {
+                    q.iter().map(|&v| v as i64).collect()
+                }
+                _ => vec![0; f.n_atoms()],
+            };
+            assert_eq!(r["charges"], serde_json::json!(q), "{case}");
+            // Every record passes RDKit's sanitizer with the charges written (an atom of no
+            // element is a query atom there) but tetramethylammonium: our SDF and MOL2 readers
+            // do not keep its N's formal charge +1, and a neutral N of four bonds is refused.
+            let sane = sdf_title(f) != "tetramethylammonium";
+            assert_eq!(r["sanitized"], Value::Bool(sane), "{case}");
+            if sane {
+                assert_eq!(r["sanitized_charges"], serde_json::json!(q), "{case}");
+            }
+            let props = r["props"].as_object().unwrap();
+            assert_eq!(
+                props.get("step").and_then(Value::as_str),
+                f.step.map(|s| s.to_string()).as_deref(),
+                "{case}"
+            );
+        }
+    }
+}
+
+#[test]
+fn sdf_files_read_by_rdkit_are_the_frames_written() {
+    let text = std::fs::read_to_string(data("sdf_write/rdkit_reference.json")).unwrap();
+    sdf_check_rdkit(&serde_json::from_str(&text).unwrap());
+}
+
+/// RDKit itself on the files written now, where python3 has rdkit.
+#[test]
+fn sdf_rdkit_reads_files_written_now() {
+    let probe = std::process::Command::new("python3")
+        .args(["-c", "import rdkit"])
+        .output();
+    if !probe.is_ok_and(|o| o.status.success()) {
+        eprintln!(
+            "SKIPPED: no python3 with rdkit (pip install rdkit); the committed reference covers it"
+        );
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    for (name, frames) in sdf_sources() {
+        std::fs::write(dir.path().join(name), write(Format::Sdf, &frames)).unwrap();
+    }
+    let out = dir.path().join("reference.json");
+    let o = std::process::Command::new("python3")
+        .arg(data("sdf_write/gen_rdkit_reference.py"))
+        .arg(dir.path())
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let now: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    sdf_check_rdkit(&now);
+}
+
+#[test]
+fn sdf_text_of_a_small_frame_and_refusals() {
+    let mut f = Frame::new();
+    f.positions = vec![[0.0, -0.0, 1.23456], [-1.5, 2.25, 100.0]];
+    f.elements = vec![element("N"), Element::UNKNOWN];
+    f.properties.push(property("charge", &[1.0, 0.0]));
+    f.bonds = vec![[0, 1]];
+    f.bond_orders = vec![2];
+    f.comment = "ion\r\nsecond line".into();
+    f.step = Some(7);
+    let expected = "ion\n  texmap            3D\n\n\
+        \x20 2  1  0  0  0  0  0  0  0  0999 V2000\n\
+        \x20   0.0000    0.0000    1.2346 N   0  3  0  0  0  0  0  0  0  0  0  0\n\
+        \x20  -1.5000    2.2500  100.0000 *   0  0  0  0  0  0  0  0  0  0  0  0\n\
+        \x20 1  2  2  0\nM  CHG  1   1   1\nM  END\n> <step>\n7\n\n$$$$\n";
+    assert_eq!(write(Format::Sdf, std::slice::from_ref(&f)), expected);
+    // Partial charges are no formal charges: not written.
+    f.properties[0].values = vec![0.5, -0.5];
+    let text = write(Format::Sdf, std::slice::from_ref(&f));
+    assert!(
+        !text.contains("M  CHG") && text.contains(" N   0  0  0"),
+        "{text}"
+    );
+    // Coordinates past V2000's columns (or touching fields, which RDKit misreads): V3000;
+    // nothing is refused.
+    for (k, x) in [(0, 100000.0), (1, -1000.0), (2, 10000.0), (0, -3.0e6)] {
+        let mut g = f.clone();
+        g.properties[0].values = vec![1.0, 0.0];
+        g.positions[1][k] = x;
+        let text = write(Format::Sdf, std::slice::from_ref(&g));
+        assert!(
+            text.contains(" V3000\n") && text.contains("M  V30 1 N 0.0000 0.0000 1.2346 0 CHG=1\n"),
+            "{text}"
+        );
+        assert!(text.lines().all(|l| l.len() <= 80), "{text}");
+        let back = read(Format::Sdf, &text).remove(0);
+        assert_eq!(back.positions[1][k], x, "{text}");
+        assert_eq!((back.bonds, back.bond_orders), (g.bonds.clone(), vec![2]));
+    }
+    let mut g = f.clone();
+    g.positions[1] = [99999.99, 9999.99, -999.99];
+    assert!(write(Format::Sdf, std::slice::from_ref(&g)).contains(" V2000\n"));
+}
+
+// ---- PDB CONECT records (fixtures and references in tests/data/pdb_conect) ----
+
+fn conect_lines(text: &str) -> Vec<&str> {
+    text.lines().filter(|l| l.starts_with("CONECT")).collect()
+}
+
+/// The bonds our PDB topology reader (CONECT) makes of `text`.
+fn pdb_topology_bonds(text: &str) -> Vec<[u32; 2]> {
+    texmap_md_io::Topology::from_reader(
+        Cursor::new(text.as_bytes().to_vec()),
+        texmap_md_io::TopologyFormat::Pdb,
+        "out.pdb",
+    )
+    .unwrap()
+    .bonds
+}
+
+/// Aspirin from an SDF (bonds with orders), and the solvated peptide of topo_mda.gro with the
+/// PSF's bonds, as `texmap convert` gives them to the PDB writer.
+fn conect_frames() -> (Frame, Frame) {
+    let ligand = read_file("molecules/library.sdf").swap_remove(0);
+    assert_eq!(ligand.bonds.len(), 21);
+    let mut peptide = read_file("topo_mda.gro").swap_remove(0);
+    let t = texmap_md_io::Topology::open(data("psf_parmed.psf")).unwrap();
+    t.apply(&mut peptide, "topo_mda.gro", 0).unwrap();
+    peptide.bonds = t.bonds.clone();
+    assert_eq!(peptide.bonds.len(), 53);
+    (ligand, peptide)
+}
+
+#[test]
+fn pdb_conect_round_trip_through_our_reader_and_the_committed_files() {
+    let (ligand, peptide) = conect_frames();
+    for (f, file) in [(&ligand, "aspirin.pdb"), (&peptide, "peptide_psf.pdb")] {
+        let text = write(Format::Pdb, std::slice::from_ref(f));
+        // The references of gen_pdb_conect.py were read from these very bytes.
+        let committed = std::fs::read_to_string(data("pdb_conect").join(file)).unwrap();
+        assert_eq!(text, committed, "{file}");
+        assert_eq!(pdb_topology_bonds(&text), f.bonds, "{file}");
+        // The atoms read back as written: the CONECT lines make no frame and no atom.
+        let back = read(Format::Pdb, &text);
+        assert_eq!(back.len(), 1);
+        assert_eq!(back[0].n_atoms(), f.n_atoms());
+    }
+    // Double bonds repeat their partner: C2=O3 is listed twice from both atoms.
+    let text = write(Format::Pdb, std::slice::from_ref(&ligand));
+    assert!(text.contains("CONECT    2    1    3    3    4\n"), "{text}");
+    assert!(text.contains("CONECT    3    2    2\n"), "{text}");
+    // The same bonds with no orders list each partner once.
+    let mut single = ligand.clone();
+    single.bond_orders.clear();
+    let text = write(Format::Pdb, &[single]);
+    assert!(text.contains("CONECT    3    2\n"), "{text}");
+    assert_eq!(pdb_topology_bonds(&text), ligand.bonds);
+}
+
+#[test]
+fn pdb_conect_matches_rdkit_mdanalysis_and_gemmi_references() {
+    let (ligand, peptide) = conect_frames();
+    let text = std::fs::read_to_string(data("pdb_conect/reference.json")).unwrap();
+    let r: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let pairs = |v: &serde_json::Value| -> Vec<[u32; 2]> {
+        v.as_array()
+            .unwrap()
+            .iter()
+            .map(|b| [b[0].as_u64().unwrap() as u32, b[1].as_u64().unwrap() as u32])
+            .collect()
+    };
+    let with_orders = |v: &serde_json::Value| -> Vec<(u32, u32, u8)> {
+        v.as_array()
+            .unwrap()
+            .iter()
+            .map(|b| {
+                let o = b[2].as_f64().unwrap() as u8;
+                (
+                    b[0].as_u64().unwrap() as u32,
+                    b[1].as_u64().unwrap() as u32,
+                    o,
+                )
+            })
+            .collect()
+    };
+    let ours: Vec<(u32, u32, u8)> = ligand
+        .bonds
+        .iter()
+        .zip(&ligand.bond_orders)
+        .map(|(b, o)| (b[0], b[1], *o))
+        .collect();
+    let a = &r["aspirin"];
+    // RDKit reads the SDF's bonds and orders from our CONECT records, and so does it the SDF.
+    assert_eq!(with_orders(&a["rdkit"]["bonds"]), ours);
+    assert_eq!(with_orders(&a["sdf_rdkit_bonds"]), ours);
+    assert_eq!(a["rdkit"]["n_atoms"], 21);
+    assert_eq!(pairs(&a["mdanalysis_bonds"]), ligand.bonds);
+    // gemmi keeps the partners as listed: the double bond C2=O3 twice.
+    assert_eq!(a["gemmi_conect"]["2"], serde_json::json!([1, 3, 3, 4]));
+    assert_eq!(a["gemmi_conect"].as_object().unwrap().len(), 21);
+    let p = &r["peptide"];
+    assert_eq!(pairs(&p["psf_bonds"]), peptide.bonds);
+    assert_eq!(pairs(&p["mdanalysis_bonds"]), peptide.bonds);
+    let rd: Vec<[u32; 2]> = with_orders(&p["rdkit"]["bonds"])
+        .into_iter()
+        .map(|(i, j, _)| [i, j])
+        .collect();
+    assert_eq!(rd, peptide.bonds);
+    // Byte for byte the CONECT lines MDAnalysis's PDBWriter writes for the same atoms and bonds.
+    let mda: Vec<&str> = p["mdanalysis_conect_lines"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|l| l.as_str().unwrap())
+        .collect();
+    let text = write(Format::Pdb, &[peptide]);
+    assert_eq!(conect_lines(&text), mda);
+}
+
+#[test]
+fn pdb_conect_read_live_by_rdkit() {
+    let probe = std::process::Command::new("python3")
+        .args(["-c", "import rdkit"])
+        .output();
+    if !probe.is_ok_and(|o| o.status.success()) {
+        eprintln!("SKIPPED: no python3 with rdkit (pip install rdkit); reference.json covers it");
+        return;
+    }
+    let (ligand, _) = conect_frames();
+    // Two models: RDKit reads the first, whose block holds the CONECT records.
+    let text = write(Format::Pdb, &[ligand.clone(), ligand.clone()]);
+    let dir = std::env::temp_dir().join(format!("texmap_conect_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("ligand.pdb");
+    std::fs::write(&path, &text).unwrap();
+    let script = "import sys\nfrom rdkit import Chem\n\
+        m = Chem.MolFromPDBFile(sys.argv[1], removeHs=False, proximityBonding=False, sanitize=False)\n\
+        print(m.GetNumAtoms())\n\
+        for b in sorted(sorted((b.GetBeginAtomIdx(), b.GetEndAtomIdx())) + [int(b.GetBondTypeAsDouble())] for b in m.GetBonds()):\n\
+        \x20   print(*b)\n";
+    let o = std::process::Command::new("python3")
+        .args(["-c", script])
+        .arg(&path)
+        .output()
+        .unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out = String::from_utf8(o.stdout).unwrap();
+    let mut expected = String::from("21\n");
+    for (b, o) in ligand.bonds.iter().zip(&ligand.bond_orders) {
+        expected.push_str(&format!("{} {} {o}\n", b[0], b[1]));
+    }
+    assert_eq!(out, expected);
+}
+
+#[test]
+fn pdb_conect_layout_models_serials_and_refusals() {
+    // Atom 0 bonded to six atoms (two lines), a triple bond 0-1, an aromatic bond 2-3 (once),
+    // hybrid-36 serials past 99,999.
+    let mut f = Frame::new();
+    f.positions = vec![[0.0; 3]; 8];
+    f.elements = vec![element("C"); 8];
+    f.ids = vec![1, 2, 3, 99_999, 100_000, 100_001, 7, 8];
+    f.bonds = vec![
+        [0, 1],
+        [0, 2],
+        [0, 3],
+        [0, 4],
+        [0, 5],
+        [0, 6],
+        [2, 3],
+        [6, 7],
+    ];
+    f.bond_orders = vec![3, 1, 1, 1, 1, 1, 4, 0];
+    let text = write(Format::Pdb, &[f.clone(), f.clone()]);
+    let expected_conect = [
+        "CONECT    1    2    2    2    3",
+        "CONECT    199999A0000A0001    7",
+        "CONECT    2    1    1    1",
+        "CONECT    3    199999",
+        "CONECT99999    1    3",
+        "CONECTA0000    1",
+        "CONECTA0001    1",
+        "CONECT    7    1    8",
+        "CONECT    8    7",
+    ];
+    assert_eq!(conect_lines(&text), expected_conect);
+    // One set, in the first model before its ENDMDL; the second model has none.
+    let first_end = text.find("ENDMDL").unwrap();
+    let model2 = text.find("MODEL        2").unwrap();
+    assert!(text[..first_end].ends_with("CONECT    8    7\n"), "{text}");
+    assert!(!text[model2..].contains("CONECT"), "{text}");
+    assert!(text.ends_with("ENDMDL\nEND\n"), "{text}");
+    assert_eq!(pdb_topology_bonds(&text), f.bonds);
+    // Every CONECT line fits 31 columns: serial 7-11, partners 12-31.
+    assert!(conect_lines(&text).iter().all(|l| l.len() <= 31));
+    // No bonds: no CONECT records (the files of before).
+    let mut none = f.clone();
+    none.bonds.clear();
+    none.bond_orders.clear();
+    assert!(!write(Format::Pdb, &[none.clone()]).contains("CONECT"));
+
+    // A later frame with other bonds (or orders) is refused, naming it.
+    let refused_second = |a: &Frame, b: &Frame| -> String {
+        let mut w = Writer::new(Cursor::new(Vec::new()), Format::Pdb, "out.pdb").unwrap();
+        w.write_frame(a).unwrap();
+        w.write_frame(b).unwrap_err().to_string()
+    };
+    let mut other = f.clone();
+    other.bonds.pop();
+    other.bond_orders.pop();
+    let e = refused_second(&f, &other);
+    assert!(e.contains("frame 1") && e.contains("bonds differ"), "{e}");
+    let mut reordered = f.clone();
+    reordered.bond_orders[0] = 2;
+    let e = refused_second(&f, &reordered);
+    assert!(e.contains("bonds differ"), "{e}");
+    let e = refused_second(&none, &f);
+    assert!(e.contains("bonds differ"), "{e}");
+    // Orders written the same way (aromatic or none as single) are the same bonds.
+    let mut same = f.clone();
+    same.bond_orders[6] = 1;
+    let mut w = Writer::new(Cursor::new(Vec::new()), Format::Pdb, "out.pdb").unwrap();
+    w.write_frame(&f).unwrap();
+    w.write_frame(&same).unwrap();
+    // A bonded atom whose serial another atom shares (GRO numbers wrapping) is refused; an
+    // unbonded one is not.
+    let mut dup = f.clone();
+    dup.ids[7] = 3;
+    let mut w = Writer::new(Cursor::new(Vec::new()), Format::Pdb, "out.pdb").unwrap();
+    let e = w.write_frame(&dup).unwrap_err().to_string();
+    assert!(
+        e.contains("atoms 2 and 7 share the serial number 3") && e.contains("CONECT"),
+        "{e}"
+    );
+    dup.bonds.pop();
+    dup.bond_orders.pop();
+    dup.bonds.retain(|b| *b != [2, 3] && *b != [0, 2]);
+    dup.bond_orders.truncate(dup.bonds.len());
+    write(Format::Pdb, &[dup]);
+}
