@@ -395,7 +395,7 @@ fn blank_titles_are_titles() {
 }
 
 /// AMBER's older `.top` name for a prmtop is read as one when it starts as one does; a
-/// GROMACS `.top` is refused by name, not misread.
+/// GROMACS `.top` is read as GROMACS's, not misread as a prmtop.
 #[test]
 fn top_files_are_prmtops_only_when_they_look_like_one() {
     let dir = tempfile::tempdir().unwrap();
@@ -409,13 +409,23 @@ fn top_files_are_prmtops_only_when_they_look_like_one() {
     let gromacs = dir.path().join("topol.top");
     std::fs::write(
         &gromacs,
-        "; GROMACS\n#include \"amber99sb.ff/forcefield.itp\"\n",
+        "; GROMACS\n[ atomtypes ]\nNA 11 22.99 0.0 A 0.33 0.01\n\
+         [ moleculetype ]\nNA 1\n[ atoms ]\n1 NA 1 NA NA 1 1.0\n\
+         [ system ]\nions\n[ molecules ]\nNA 3\n",
     )
     .unwrap();
+    let t = texmap_md_io::Topology::open(&gromacs).unwrap();
+    assert_eq!(t.n_atoms(), 3);
+    assert_eq!(t.charges, [1.0; 3]);
+    // Damaged, it is a GROMACS topology's error, naming the file.
+    std::fs::write(&gromacs, "; GROMACS\n[ system ]\nnothing\n").unwrap();
     let e = texmap_md_io::Topology::open(&gromacs)
         .unwrap_err()
         .to_string();
-    assert!(e.contains("topol.top") && e.contains("GROMACS"), "{e}");
+    assert!(
+        e.contains("topol.top") && e.contains("[ molecules ]"),
+        "{e}"
+    );
 }
 
 /// A NetCDF restart (the AMBERRESTART convention: one frame, doubles, ParmEd's NetCDFRestart
