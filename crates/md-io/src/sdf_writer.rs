@@ -48,7 +48,7 @@
 use std::fmt::Write as _;
 use std::io::{self, Write};
 
-use crate::elements::{Element, guess_element};
+use crate::elements::Element;
 use crate::frame::{BOND_AROMATIC, Frame};
 
 /// Writes frames as SD file records (see the module doc).
@@ -89,16 +89,7 @@ fn v30(s: &mut String, text: &str) {
 
 /// The element symbol written for atom `i`.
 fn symbol(frame: &Frame, i: usize) -> &'static str {
-    let e = frame
-        .elements
-        .get(i)
-        .filter(|e| !e.is_unknown())
-        .copied()
-        .unwrap_or_else(|| {
-            let n = frame.names.get(i).map_or("", |l| l.as_str());
-            let r = frame.res_names.get(i).map(|l| l.as_str());
-            guess_element(n, r, None)
-        });
+    let e = crate::pdb::written_element(frame, i);
     if e == Element::UNKNOWN {
         "*"
     } else {

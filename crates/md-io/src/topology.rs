@@ -241,6 +241,16 @@ impl<R: Read> Lines<R> {
     }
 }
 
+/// What a `.top` file whose first bytes are `head` is: AMBER's prmtop when it starts as one
+/// does (`%VERSION` or `%FLAG`), else GROMACS's topology.
+fn top_format(head: &[u8]) -> TopologyFormat {
+    if head.starts_with(b"%VERSION") || head.starts_with(b"%FLAG") {
+        TopologyFormat::Prmtop
+    } else {
+        TopologyFormat::GromacsTop
+    }
+}
+
 impl Topology {
     /// Reads the topology of `path`, its format told by the name (see [`TopologyFormat`]).
     ///
@@ -281,13 +291,7 @@ impl Topology {
         let name: Arc<str> = path.display().to_string().into();
         let (mut file, _) = crate::gz::open(path, &name, false)?;
         let head = crate::trajectory::head(&mut file, &name, 64)?;
-        Ok(Some(
-            if head.starts_with(b"%VERSION") || head.starts_with(b"%FLAG") {
-                TopologyFormat::Prmtop
-            } else {
-                TopologyFormat::GromacsTop
-            },
-        ))
+        Ok(Some(top_format(&head)))
     }
 
     /// Reads the topology of `path` as `format`; a gzip file is read decompressed, as by
@@ -319,11 +323,7 @@ impl Topology {
         let mut format = format;
         if matches!(format, TopologyFormat::Prmtop | TopologyFormat::GromacsTop) && is_top {
             let head = crate::trajectory::head(&mut file, &name, 64)?;
-            format = if head.starts_with(b"%VERSION") || head.starts_with(b"%FLAG") {
-                TopologyFormat::Prmtop
-            } else {
-                TopologyFormat::GromacsTop
-            };
+            format = top_format(&head);
         }
         let format = if format == TopologyFormat::Mmcif {
             match crate::trajectory::cif_kind_of(&mut file, path, &name)? {
