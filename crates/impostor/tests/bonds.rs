@@ -4,7 +4,7 @@
 //! orthographic, thick bonds with visible caps, a near plane cutting bonds, bonds behind the eye,
 //! invalid bonds counted, and the same bytes for 1 and 2 threads.
 
-mod common;
+use crate::common;
 
 use texmap_core::camera::Camera;
 use texmap_core::frame::Frame;

@@ -1,6 +1,6 @@
 //! The polygon baseline against the f64 ray-sphere reference.
 
-mod common;
+use crate::common;
 
 use common::{random_scene, reference};
 use texmap_core::camera::Camera;

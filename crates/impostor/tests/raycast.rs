@@ -1,6 +1,6 @@
 //! The exact method against an independent f64 ray–sphere reference.
 
-mod common;
+use crate::common;
 
 use common::{random_scene, reference};
 use texmap_core::camera::Camera;

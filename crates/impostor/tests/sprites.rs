@@ -1,6 +1,6 @@
 //! The sprite methods (Seed 002 LUT, Seed 004 template) against the f64 ray-sphere reference.
 
-mod common;
+use crate::common;
 
 use common::{random_scene, reference};
 use texmap_core::camera::Camera;

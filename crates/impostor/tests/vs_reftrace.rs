@@ -3,7 +3,7 @@
 //! silhouette error ≤ 0.5 px, at several fields of view, orthographic too, and with the eye
 //! inside the cloud.
 
-mod common;
+use crate::common;
 
 use common::random_scene;
 use texmap_core::camera::Camera;

@@ -8,7 +8,7 @@ use texmap_md_io::{Frame, Trajectory};
 use texmap_md_scene::cartoon::{ARROW, COIL_RADIUS, HELIX, STRAND, append_cartoon};
 use texmap_md_scene::surface::MolMesh;
 
-mod common;
+use crate::common;
 
 fn read(name: &str) -> Frame {
     let path = format!(

@@ -11,7 +11,7 @@ use texmap_md_scene::surface::{
     MAX_VOXELS, MolMesh, SurfaceAtoms, SurfaceError, SurfaceOptions, draw_mesh,
 };
 
-mod common;
+use crate::common;
 
 fn one_atom(c: Vec3, r: f32) -> SurfaceAtoms {
     let mut a = SurfaceAtoms::default();
