@@ -43,7 +43,7 @@ fn check(scene: &SphereScene, cam: &Camera, what: &str) {
     let p = psnr(&out.frame, &refr).unwrap();
     let d = depth_error(&out.frame, &refr).unwrap();
     let s = silhouette_error(&out.frame, &refr).unwrap();
-    // Reported for the docs (`cargo test --test vs_reftrace -- --nocapture`).
+    // Reported for the docs (`cargo test -p texmap-impostor --test suite vs_reftrace:: -- --nocapture`).
     eprintln!(
         "{what}: PSNR {p:.2} dB, depth mean {:.3e} max {:.3e} (range {range:.3}), silhouette {:.4} px",
         d.mean_abs, d.max_abs, s.mean_displacement_px
