@@ -62,7 +62,7 @@ pub enum Command {
     /// energy file (.edr) or a LAMMPS log its terms with units, rows, time span and each
     /// term's mean, minimum and maximum.
     Info {
-        /// Trajectory file (XYZ, extended XYZ, PDB, PDBx/mmCIF, GRO, LAMMPS dump, DCD, XTC, TRR,
+        /// Trajectory file (XYZ, extended XYZ, PDB, PDBx/mmCIF and BinaryCIF (.bcif), GRO, LAMMPS dump, DCD, XTC, TRR,
         /// AMBER NetCDF, AMBER ASCII mdcrd (with --topology: the file has no atom count) and
         /// rst7/inpcrd, HOOMD-blue GSD, SDF/MOL and MOL2 with their bonds, one frame per
         /// record, VASP POSCAR/CONTCAR/XDATCAR, crystallographic CIF, a LAMMPS data file,
@@ -82,7 +82,7 @@ pub enum Command {
         /// file, frame and byte).
         #[arg(long)]
         allow_truncated: bool,
-        /// Topology (PDB, PDBx/mmCIF, GRO, PSF, AMBER prmtop, GROMACS .tpr or .top, LAMMPS data file) of the trajectory's atoms: its
+        /// Topology (PDB, PDBx/mmCIF or BinaryCIF, GRO, PSF, AMBER prmtop, GROMACS .tpr or .top, LAMMPS data file) of the trajectory's atoms: its
         /// atom, residue and bond counts are added, and a different atom count is an error.
         #[arg(long, value_name = "FILE")]
         topology: Option<PathBuf>,
@@ -948,7 +948,7 @@ pub enum WignerSeitzArg {
 #[command(next_help_heading = "Molecules")]
 pub struct MolArgs {
     /// Topology giving names, elements, residues and bonds to a trajectory of the same atoms
-    /// (XTC, DCD, TRR, NetCDF carry coordinates only): PDB (CONECT bonds), PDBx/mmCIF or a crystallographic CIF (.cif),
+    /// (XTC, DCD, TRR, NetCDF carry coordinates only): PDB (CONECT bonds), PDBx/mmCIF or a crystallographic CIF (.cif), BinaryCIF (.bcif),
     /// GRO, a CHARMM/NAMD PSF (.psf: !NBOND bonds), an AMBER prmtop (.prmtop, .parm7: bonds,
     /// chains), a GROMACS run input (.tpr: the force field's bonds, masses, charges, molecule
     /// types as segments) or topology (.top with its #included .itp files, the same), or a

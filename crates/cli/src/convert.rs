@@ -32,7 +32,7 @@ pub struct ConvertArgs {
     #[arg(long)]
     pub allow_truncated: bool,
     /// Topology giving names, elements, residues and bonds to the trajectory's atoms (PDB,
-    /// PDBx/mmCIF, GRO, PSF, AMBER prmtop, GROMACS .tpr or .top, LAMMPS data file), as for texmap
+    /// PDBx/mmCIF or BinaryCIF, GRO, PSF, AMBER prmtop, GROMACS .tpr or .top, LAMMPS data file), as for texmap
     /// render.
     #[arg(long, value_name = "FILE")]
     pub topology: Option<PathBuf>,

@@ -27,6 +27,10 @@ pub enum Format {
     Gsd,
     /// PDBx/mmCIF, the Protein Data Bank's archive format; models are frames: `.cif`, `.mmcif`.
     Mmcif,
+    /// BinaryCIF, PDBx/mmCIF's binary encoding (the RCSB PDB's and PDBe's `.bcif`, Mol*'s),
+    /// read as PDBx/mmCIF is: `.bcif`, or a MessagePack map whose first key is `encoder`,
+    /// `version` or `dataBlocks`.
+    Bcif,
     /// MDL molfile / SD file (V2000 and V3000), records are frames, with bonds: `.sdf`,
     /// `.sd`, `.mol`.
     Sdf,
@@ -95,7 +99,7 @@ pub enum Format {
 
 impl Format {
     /// Every format, in declaration order.
-    pub const ALL: [Format; 27] = [
+    pub const ALL: [Format; 28] = [
         Format::Xyz,
         Format::Pdb,
         Format::Gro,
@@ -123,6 +127,7 @@ impl Format {
         Format::Xsf,
         Format::Tpr,
         Format::AseTraj,
+        Format::Bcif,
     ];
 
     /// The format a file extension (case-insensitive, e.g. "xyz", "lammpstrj") or a format's
@@ -140,6 +145,7 @@ impl Format {
             "nc" | "ncdf" | "ncrst" => Format::Netcdf,
             "gsd" => Format::Gsd,
             "cif" | "mmcif" => Format::Mmcif,
+            "bcif" => Format::Bcif,
             "sdf" | "sd" | "mol" => Format::Sdf,
             "mol2" => Format::Mol2,
             "vasp" | "poscar" | "contcar" | "xdatcar" => Format::Vasp,
@@ -209,7 +215,8 @@ impl Format {
 
     /// The format the first bytes of a file show (give at least 256 bytes when the file has
     /// them). Binary formats are told by their magic numbers, text formats by their first
-    /// lines: `data_` (CIF: PDBx/mmCIF or crystallographic, by [`Format::cif_kind`]),
+    /// lines: `data_` (CIF: PDBx/mmCIF or crystallographic, by [`Format::cif_kind`]), a
+    /// MessagePack map keyed `encoder`, `version` or `dataBlocks` (BinaryCIF),
     /// `@<TRIPOS>` (MOL2) or an XSF keyword (`CRYSTAL`, `ATOMS`, `ANIMSTEPS`…) on the first
     /// line that is not a `#` comment, a `*` title on the first non-blank line (CHARMM CRD), `ITEM: TIMESTEP` (LAMMPS), a PDB record name, a fourth line ending in `V2000` or
     /// `V3000` (molfile, SD file), an integer first line (XYZ), an `N atoms` line after the title
@@ -238,6 +245,10 @@ impl Format {
         // NetCDF-3: "CDF" and the version byte 1 (classic) or 2 (64-bit offset).
         if matches!(head.get(..4), Some(b"CDF\x01" | b"CDF\x02")) {
             return Some(Format::Netcdf);
+        }
+        // BinaryCIF: a MessagePack map whose first key is one of the file's.
+        if crate::bcif::is_bcif(head) {
+            return Some(Format::Bcif);
         }
         // GSD: the little-endian magic number 0x65DF65DF65DF65DF.
         if head.get(..8) == Some(&crate::gsd::MAGIC.to_le_bytes()[..]) {
@@ -484,6 +495,7 @@ impl Format {
             Format::Xsf => "xsf",
             Format::Tpr => "tpr",
             Format::AseTraj => "ase-traj",
+            Format::Bcif => "bcif",
         }
     }
 }
@@ -652,6 +664,14 @@ mod tests {
             Some(Format::Mmcif)
         );
         assert_eq!(Format::from_extension("mmcif"), Some(Format::Mmcif));
+        assert_eq!(
+            Format::from_path(Path::new("1abc.bcif.gz")),
+            Some(Format::Bcif)
+        );
+        assert_eq!(
+            Format::from_magic(b"\x83\xa7encoder\xa4x"),
+            Some(Format::Bcif)
+        );
         assert_eq!(Format::from_magic(b"hello\nworld\n"), None);
         assert_eq!(
             Format::from_magic(b"\n* TITLE\n*\n    1\n"),

@@ -2,7 +2,7 @@
 //! file formats, streaming frames, and element tables (radius, colour).
 //!
 //! - [`Trajectory`] reads XYZ / extended XYZ, PDB, PDBx/mmCIF (the first data block's
-//!   `_atom_site`, models as frames), GRO and LAMMPS text dumps, MDL SDF/MOL and Tripos MOL2
+//!   `_atom_site`, models as frames; the text and its BinaryCIF encoding, `.bcif`), GRO and LAMMPS text dumps, MDL SDF/MOL and Tripos MOL2
 //!   (records as frames, with the bonds they list: [`Frame::bonds`]), VASP POSCAR/CONTCAR
 //!   and XDATCAR (the ionic steps as frames, a changing cell too), crystallographic CIF (COD,
 //!   ICSD, Materials Project: each data block a frame, the asymmetric unit expanded by the
@@ -26,7 +26,7 @@
 //!   decompressed bytes, except for damage to the compressed stream itself (compressed offset).
 //! - [`Sequence`] reads a trajectory in several files (a run continued in parts, a LAMMPS
 //!   dump per step: [`sequence::expand`] for `dump.*.lammpstrj`) as one.
-//! - [`Topology`] reads atom names, elements, residues and bonds (PDB, PDBx/mmCIF, GRO, PSF,
+//! - [`Topology`] reads atom names, elements, residues and bonds (PDB, PDBx/mmCIF and BinaryCIF, GRO, PSF,
 //!   AMBER prmtop, GROMACS .tpr and .top, LAMMPS data file) and gives them to the frames of a
 //!   coordinate-only trajectory of the same atoms; [`read_tpr`] also gives a .tpr's starting
 //!   positions, velocities and box.
@@ -116,6 +116,7 @@
 
 mod amber;
 mod asetraj;
+mod bcif;
 pub mod bonds;
 pub mod centrosymmetry;
 mod chgcar;

@@ -78,7 +78,7 @@ use std::io::Read;
 use crate::cif::classify;
 use crate::cif::{Kind, Lexer, Tok, cell_number, cell_of, cell_parameters, strip_esd};
 use crate::elements::guess_element;
-use crate::error::Error;
+use crate::error::{Error, Location};
 use crate::frame::{Frame, Label, UnitCell};
 use crate::parse::{parse_f32, parse_i64};
 use crate::text::{Ctx, FrameWalk, LineReader, ModelCheck, Pos};
@@ -94,9 +94,9 @@ enum Flow {
     LoopEnd,
 }
 
-/// An `_atom_site` column the reader uses.
+/// An `_atom_site` column the reader uses (the text and the BinaryCIF front-ends alike).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Role {
+pub(crate) enum Role {
     X,
     Y,
     Z,
@@ -116,7 +116,7 @@ enum Role {
 }
 
 /// The role of `_atom_site.<item>` (the item in lower case).
-fn role(item: &[u8]) -> Role {
+pub(crate) fn role(item: &[u8]) -> Role {
     match item {
         b"cartn_x" => Role::X,
         b"cartn_y" => Role::Y,
@@ -150,17 +150,22 @@ enum Interest {
     Atom(Role),
 }
 
+/// The `_cell` items read, in the order a, b, c, α, β, γ.
+pub(crate) const CELL_ITEMS: [&str; 6] = [
+    "length_a",
+    "length_b",
+    "length_c",
+    "angle_alpha",
+    "angle_beta",
+    "angle_gamma",
+];
+
 fn interest(tag: &[u8]) -> Interest {
     let t = tag.to_ascii_lowercase();
-    const CELL: [&[u8]; 6] = [
-        b"_cell.length_a",
-        b"_cell.length_b",
-        b"_cell.length_c",
-        b"_cell.angle_alpha",
-        b"_cell.angle_beta",
-        b"_cell.angle_gamma",
-    ];
-    if let Some(k) = CELL.iter().position(|c| *c == t.as_slice()) {
+    let cell = t
+        .strip_prefix(b"_cell.")
+        .and_then(|item| CELL_ITEMS.iter().position(|c| c.as_bytes() == item));
+    if let Some(k) = cell {
         Interest::Cell(k)
     } else if t == b"_struct.title" {
         Interest::Title
@@ -172,7 +177,65 @@ fn interest(tag: &[u8]) -> Interest {
 }
 
 /// What the warning for dropped alternate locations expected (see [`is_altloc_warning`]).
-const ALTLOC_EXPECTED: &str = "one conformation per atom (label_alt_id: the first is kept)";
+pub(crate) const ALTLOC_EXPECTED: &str =
+    "one conformation per atom (label_alt_id: the first is kept)";
+
+/// The warning for a frame that lost `dropped` rows of other alternate locations; `first` says
+/// where the first of them is (the location's byte, or a row number).
+pub(crate) fn altloc_warning(at: Location, dropped: usize, first: &str) -> Error {
+    Error::Parse {
+        at,
+        expected: ALTLOC_EXPECTED,
+        found: format!("{dropped} rows of other alternate locations, dropped ({first})"),
+    }
+}
+
+/// What a model whose atom count differs from model 1's is checked against.
+pub(crate) const MODEL_EXPECTED: &str = "as many _atom_site rows as model 1 (frame 0)";
+
+/// What a set of `_atom_site` columns must have: each item once, and the three coordinates.
+pub(crate) const COLUMNS_EXPECTED: &str = "the _atom_site.Cartn_x, Cartn_y and Cartn_z columns";
+
+/// What is wrong with a set of `_atom_site` columns ([`check_roles`]).
+pub(crate) enum RolesProblem {
+    /// Column `k` (0-based) repeats an item an earlier column has.
+    Repeated(usize),
+    /// No `Cartn_<axis>` column (the name is given).
+    Missing(&'static str),
+}
+
+/// Checks the roles of a loop's or category's `_atom_site` columns: each item used at most
+/// once, and `Cartn_x/y/z` present.
+pub(crate) fn check_roles(roles: &[Role]) -> Result<(), RolesProblem> {
+    for (k, r) in roles.iter().enumerate() {
+        if *r != Role::Other && roles[..k].contains(r) {
+            return Err(RolesProblem::Repeated(k));
+        }
+    }
+    for (axis, r) in ["Cartn_x", "Cartn_y", "Cartn_z"]
+        .into_iter()
+        .zip([Role::X, Role::Y, Role::Z])
+    {
+        if !roles.contains(&r) {
+            return Err(RolesProblem::Missing(axis));
+        }
+    }
+    Ok(())
+}
+
+/// The cell the six `_cell` values (a, b, c, α, β, γ) give, as lengths and angles: `None`
+/// without the three lengths, and for the 1 Å x 1 Å x 1 Å placeholder of NMR entries (or zero
+/// lengths), dropped as the PDB reader drops it.
+pub(crate) fn cell_values(values: [Option<f64>; 6]) -> Option<([f64; 3], [f64; 3])> {
+    let (lengths, angles) = cell_parameters(values)?;
+    if (lengths == [1.0; 3] && angles == [90.0; 3]) || lengths == [0.0; 3] {
+        return None;
+    }
+    Some((lengths, angles))
+}
+
+/// What a `_cell` that gives no cell was expected to be.
+pub(crate) const CELL_EXPECTED: &str = "a _cell with lengths > 0 and a volume > 0";
 
 /// Whether a [`crate::Trajectory::warnings`] entry is the PDBx/mmCIF reader's note of dropped
 /// alternate locations (given whatever the options), rather than something tolerated under
@@ -183,7 +246,7 @@ pub fn is_altloc_warning(w: &Error) -> bool {
 
 /// FNV-1a: the keys of the alternate-location filter (names, residue ids), in the read and in
 /// the scan alike.
-fn fnv(b: &[u8]) -> u64 {
+pub(crate) fn fnv(b: &[u8]) -> u64 {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
     for &x in b {
         h = (h ^ x as u64).wrapping_mul(0x0000_0100_0000_01b3);
@@ -207,9 +270,9 @@ impl Hasher for KeyHasher {
     }
 }
 
-/// The first-conformation rule of the module doc, one residue at a time.
+/// The first-conformation rule of the module doc, one residue at a time; `P` is where a row is.
 #[derive(Default)]
-struct AltFilter {
+struct AltFilter<P> {
     /// The current residue (chain, number, insertion code) and its first residue name.
     residue: Option<u64>,
     comp: u64,
@@ -217,10 +280,10 @@ struct AltFilter {
     names: HashSet<u64, BuildHasherDefault<KeyHasher>>,
     /// Rows dropped in this frame, and where the first one starts.
     dropped: usize,
-    first_dropped: Option<Pos>,
+    first_dropped: Option<P>,
 }
 
-impl AltFilter {
+impl<P: Copy> AltFilter<P> {
     fn reset(&mut self) {
         self.residue = None;
         self.names.clear();
@@ -229,7 +292,7 @@ impl AltFilter {
     }
 
     /// Whether to keep a row; `alt` when it has an alternate location.
-    fn keep(&mut self, residue: u64, comp: u64, name: u64, alt: bool, at: Pos) -> bool {
+    fn keep(&mut self, residue: u64, comp: u64, name: u64, alt: bool, at: P) -> bool {
         if self.residue != Some(residue) || (!alt && comp != self.comp) {
             self.residue = Some(residue);
             self.comp = comp;
@@ -252,6 +315,32 @@ impl AltFilter {
     }
 }
 
+/// One `_atom_site` row's values as a frame takes them: what a front-end (the text parser
+/// here, the BinaryCIF reader in `crate::bcif`) hands [`AtomSites::push`]. Labels and numbers
+/// are filled only when a frame is read; the keys always.
+#[derive(Default)]
+pub(crate) struct Site {
+    pub xyz: [f32; 3],
+    pub id: Option<i64>,
+    pub symbol: Option<Label>,
+    /// `[label, auth]` pairs, as [`Role`]'s.
+    pub atom: [Option<Label>; 2],
+    pub comp: [Option<Label>; 2],
+    pub seq: [Option<i64>; 2],
+    pub asym: [Option<Label>; 2],
+    /// Occupancy and B-factor (`None` when missing).
+    pub scalar: [Option<f32>; 2],
+    /// Keys for the alternate-location filter (`[label, auth]`): [`fnv`] of the value's text,
+    /// 0 when missing.
+    pub atom_key: [u64; 2],
+    pub comp_key: [u64; 2],
+    pub seq_key: [u64; 2],
+    pub asym_key: [u64; 2],
+    pub ins_key: u64,
+    /// The row has an alternate location (`label_alt_id` not missing).
+    pub alt: bool,
+}
+
 /// The `_atom_site` row being read: values parsed as they arrive.
 #[derive(Default)]
 struct Row {
@@ -260,22 +349,98 @@ struct Row {
     /// Where its first value is, and whether that value starts its line.
     start: Pos,
     starts_line: bool,
-    xyz: [f32; 3],
-    id: Option<i64>,
-    symbol: Option<Label>,
-    atom: [Option<Label>; 2],
-    comp: [Option<Label>; 2],
-    seq: [Option<i64>; 2],
-    asym: [Option<Label>; 2],
-    /// Occupancy and B-factor (`None` when missing).
-    scalar: [Option<f32>; 2],
-    /// Keys for the alternate-location filter (`[label, auth]`, 0 when missing).
-    atom_key: [u64; 2],
-    comp_key: [u64; 2],
-    seq_key: [u64; 2],
-    asym_key: [u64; 2],
-    ins_key: u64,
-    alt: bool,
+    site: Site,
+}
+
+/// Turns `_atom_site` rows into a frame, for both front-ends: which optional columns exist,
+/// the alternate-location filter and the atoms kept. `P` is where a row is (a text position,
+/// a BinaryCIF row number), for the warning of dropped rows.
+#[derive(Default)]
+pub(crate) struct AtomSites<P> {
+    /// Which optional columns exist: id, atom name, residue name, residue number, chain.
+    has: [bool; 5],
+    /// Whether there are occupancy and B-factor columns.
+    has_scalar: [bool; 2],
+    filter: AltFilter<P>,
+    /// Atoms kept in the frame so far.
+    pub n_atoms: usize,
+}
+
+impl<P: Copy> AtomSites<P> {
+    /// Notes which optional columns `roles` has (the columns in file order).
+    pub fn set_columns(&mut self, roles: &[Role]) {
+        let has = |r: Role| roles.contains(&r);
+        let any = |f: fn(usize) -> Role| has(f(0)) || has(f(1));
+        self.has = [
+            has(Role::Id),
+            any(Role::Atom),
+            any(Role::Comp),
+            any(Role::Seq),
+            any(Role::Asym),
+        ];
+        self.has_scalar = [has(Role::Scalar(0)), has(Role::Scalar(1))];
+    }
+
+    /// Starts a frame: no atom kept, no row dropped.
+    pub fn start_frame(&mut self) {
+        self.filter.reset();
+        self.n_atoms = 0;
+    }
+
+    /// The rows of other alternate locations dropped in this frame, and where the first is.
+    pub fn dropped(&self) -> Option<(usize, P)> {
+        self.filter
+            .first_dropped
+            .map(|at| (self.filter.dropped, at))
+    }
+
+    /// A whole row (at `at`): through the alternate-location filter into the frame (counted
+    /// only, without a frame).
+    pub fn push(&mut self, row: &Site, at: P, frame: Option<&mut Frame>) {
+        // auth_* wins over label_* where both are given, for the labels and for the keys.
+        let pick = |k: [u64; 2]| if k[1] != 0 { k[1] } else { k[0] };
+        let residue = [pick(row.asym_key), pick(row.seq_key), row.ins_key]
+            .iter()
+            .fold(fnv(b""), |h, k| {
+                (h ^ k).wrapping_mul(0x0000_0100_0000_01b3).rotate_left(17)
+            });
+        let (comp, name) = (pick(row.comp_key), pick(row.atom_key));
+        if !self.filter.keep(residue, comp, name, row.alt, at) {
+            return;
+        }
+        self.n_atoms += 1;
+        let Some(f) = frame else {
+            return;
+        };
+        let name = row.atom[1].or(row.atom[0]).unwrap_or_default();
+        let res = row.comp[1].or(row.comp[0]);
+        let symbol = row.symbol.as_ref().map(|s| s.as_str());
+        let [has_id, has_name, has_res, has_seq, has_chain] = self.has;
+        if has_id {
+            f.ids.push(row.id.unwrap_or(f.n_atoms() as i64 + 1));
+        }
+        f.positions.push(row.xyz);
+        f.elements
+            .push(guess_element(&name, res.as_deref(), symbol));
+        if has_name {
+            f.names.push(name);
+        }
+        if has_res {
+            f.res_names.push(res.unwrap_or_default());
+        }
+        if has_seq {
+            f.res_ids.push(row.seq[1].or(row.seq[0]).unwrap_or(0));
+        }
+        if has_chain {
+            f.chains
+                .push(row.asym[1].or(row.asym[0]).unwrap_or_default());
+        }
+        for (k, (name, _, missing)) in SCALAR_NAMES.iter().enumerate() {
+            if self.has_scalar[k] {
+                f.property_mut(name).push(row.scalar[k].unwrap_or(*missing));
+            }
+        }
+    }
 }
 
 /// Where the parser is in the file.
@@ -300,13 +465,13 @@ enum Phase {
 
 /// The properties of the `Role::Scalar` columns: name, what a bad value should have been, the
 /// value of a missing one (`?` or `.`), as MDAnalysis and the PDB reader fill blanks.
-const SCALAR_NAMES: [(&str, &str, f32); 2] = [
+pub(crate) const SCALAR_NAMES: [(&str, &str, f32); 2] = [
     ("occupancy", "a number for _atom_site.occupancy", 1.0),
     ("bfactor", "a number for _atom_site.B_iso_or_equiv", 0.0),
 ];
 
 /// `Cartn_x/y/z` errors, by axis.
-const NOT_A_COORDINATE: [&str; 3] = [
+pub(crate) const NOT_A_COORDINATE: [&str; 3] = [
     "a number for _atom_site.Cartn_x",
     "a number for _atom_site.Cartn_y",
     "a number for _atom_site.Cartn_z",
@@ -326,10 +491,6 @@ struct Parser {
     phase: Phase,
     /// The `_atom_site` columns (empty until the loop's header is read).
     cols: Vec<Role>,
-    /// Which optional columns exist: id, atom name, residue name, residue number, chain.
-    has: [bool; 5],
-    /// Whether the loop has the occupancy and B-factor columns.
-    has_scalar: [bool; 2],
     /// `_cell` values and where the first one is; the cell built from them.
     cell_values: [Option<f64>; 6],
     cell_at: Option<Pos>,
@@ -346,11 +507,10 @@ struct Parser {
     pairs: Vec<(Role, Pos)>,
     pair_values: Vec<(Kind, Vec<u8>, Pos)>,
     row: Row,
-    /// The frame's model number, first row and atoms kept.
+    /// The frame's model number and first row; the rows made into atoms.
     model: Option<i64>,
     first_row: Option<Pos>,
-    n_atoms: usize,
-    filter: AltFilter,
+    sites: AtomSites<Pos>,
 }
 
 impl Mmcif {
@@ -371,23 +531,15 @@ impl Mmcif {
     /// alternate locations, the cell and (frame 0) the title. `Ok(false)` for a loop without rows.
     fn finish(&mut self, ctx: &Ctx, end: Pos, frame: Option<&mut Frame>) -> Result<bool, Error> {
         let p = &mut self.p;
-        if p.n_atoms == 0 {
+        if p.sites.n_atoms == 0 {
             return Ok(false);
         }
         let at = p.first_row.unwrap_or(end);
-        let expected = "as many _atom_site rows as model 1 (frame 0)";
-        self.models.check(ctx, at, p.n_atoms, expected)?;
-        if let Some(first) = p.filter.first_dropped {
-            let expected = ALTLOC_EXPECTED;
-            let w = Error::Parse {
-                at: ctx.at(first),
-                expected,
-                found: format!(
-                    "{} rows of other alternate locations, dropped (the first here)",
-                    p.filter.dropped
-                ),
-            };
-            self.models.warn(ctx.frame, expected, w);
+        self.models
+            .check(ctx, at, p.sites.n_atoms, MODEL_EXPECTED)?;
+        if let Some((dropped, first)) = p.sites.dropped() {
+            let w = altloc_warning(ctx.at(first), dropped, "the first here");
+            self.models.warn(ctx.frame, ALTLOC_EXPECTED, w);
         }
         if let Some(f) = frame {
             f.cell = p.cell;
@@ -429,9 +581,8 @@ impl FrameWalk for Mmcif {
         }
         self.p.model = None;
         self.p.first_row = None;
-        self.p.n_atoms = 0;
         self.p.row = Row::default();
-        self.p.filter.reset();
+        self.p.sites.start_frame();
         loop {
             let p = lines.pos();
             let Some((pos, line)) = lines.next_line().map_err(|e| ctx.io(p, e))? else {
@@ -611,60 +762,37 @@ impl Parser {
     /// Sets up the `_atom_site` columns from their roles (with where each tag is), and the cell
     /// from the `_cell` values read so far. `at` is where the loop (or first pair) starts.
     fn columns(&mut self, roles: &[(Role, Pos)], at: Pos, ctx: &Ctx) -> Result<(), Error> {
-        for (k, (r, pos)) in roles.iter().enumerate() {
-            if *r != Role::Other && roles[..k].iter().any(|(q, _)| q == r) {
+        let cols: Vec<Role> = roles.iter().map(|(r, _)| *r).collect();
+        match check_roles(&cols) {
+            Ok(()) => {}
+            Err(RolesProblem::Repeated(k)) => {
                 return Err(Error::Parse {
-                    at: ctx.at(*pos),
+                    at: ctx.at(roles[k].1),
                     expected: "each _atom_site tag once",
                     found: format!("the same item again in column {}", k + 1),
                 });
             }
-        }
-        let has = |r: Role| roles.iter().any(|(q, _)| *q == r);
-        for (axis, r) in
-            ["Cartn_x", "Cartn_y", "Cartn_z"]
-                .into_iter()
-                .zip([Role::X, Role::Y, Role::Z])
-        {
-            if !has(r) {
+            Err(RolesProblem::Missing(axis)) => {
                 return Err(Error::Parse {
                     at: ctx.at(at),
-                    expected: "the _atom_site.Cartn_x, Cartn_y and Cartn_z columns",
+                    expected: COLUMNS_EXPECTED,
                     found: format!("no _atom_site.{axis} among the loop's tags"),
                 });
             }
         }
-        self.cols = roles.iter().map(|(r, _)| *r).collect();
-        let any = |f: fn(usize) -> Role| has(f(0)) || has(f(1));
-        self.has = [
-            has(Role::Id),
-            any(Role::Atom),
-            any(Role::Comp),
-            any(Role::Seq),
-            any(Role::Asym),
-        ];
-        self.has_scalar = [has(Role::Scalar(0)), has(Role::Scalar(1))];
+        self.sites.set_columns(&cols);
+        self.cols = cols;
         self.cell = self.unit_cell(ctx)?;
         Ok(())
     }
 
     /// The cell of the `_cell` values, `None` without lengths or for the 1 Å placeholder.
     fn unit_cell(&self, ctx: &Ctx) -> Result<Option<UnitCell>, Error> {
-        let Some((lengths, angles)) = cell_parameters(self.cell_values) else {
+        let Some((lengths, angles)) = cell_values(self.cell_values) else {
             return Ok(None);
         };
-        if (lengths == [1.0; 3] && angles == [90.0; 3]) || lengths == [0.0; 3] {
-            return Ok(None);
-        }
         let at = self.cell_at.unwrap_or_default();
-        cell_of(
-            lengths,
-            angles,
-            ctx,
-            at,
-            "a _cell with lengths > 0 and a volume > 0",
-        )
-        .map(Some)
+        cell_of(lengths, angles, ctx, at, CELL_EXPECTED).map(Some)
     }
 
     /// A token of the `_atom_site` rows.
@@ -760,7 +888,7 @@ impl Parser {
                     Role::Y => 1,
                     _ => 2,
                 };
-                row.xyz[axis] = match tok.missing() {
+                row.site.xyz[axis] = match tok.missing() {
                     true => None,
                     false => parse_f32(strip_esd(tok.text)),
                 }
@@ -769,36 +897,36 @@ impl Parser {
             Role::Id if read && !tok.missing() => {
                 let id = parse_i64(tok.text)
                     .ok_or_else(|| tok.error(ctx, "an integer _atom_site.id"))?;
-                row.id = Some(id);
+                row.site.id = Some(id);
             }
-            Role::Symbol => row.symbol = label(&tok, "an element symbol in type_symbol")?,
-            Role::AltId => row.alt = !tok.missing(),
-            Role::InsCode => row.ins_key = key(&tok),
+            Role::Symbol => row.site.symbol = label(&tok, "an element symbol in type_symbol")?,
+            Role::AltId => row.site.alt = !tok.missing(),
+            Role::InsCode => row.site.ins_key = key(&tok),
             Role::Asym(k) => {
-                row.asym_key[k] = key(&tok);
-                row.asym[k] = label(&tok, "a chain name of at most 15 bytes")?;
+                row.site.asym_key[k] = key(&tok);
+                row.site.asym[k] = label(&tok, "a chain name of at most 15 bytes")?;
             }
             Role::Atom(k) => {
-                row.atom_key[k] = key(&tok);
-                row.atom[k] = label(&tok, "an atom name of at most 15 bytes")?;
+                row.site.atom_key[k] = key(&tok);
+                row.site.atom[k] = label(&tok, "an atom name of at most 15 bytes")?;
             }
             Role::Comp(k) => {
-                row.comp_key[k] = key(&tok);
-                row.comp[k] = label(&tok, "a residue name of at most 15 bytes")?;
+                row.site.comp_key[k] = key(&tok);
+                row.site.comp[k] = label(&tok, "a residue name of at most 15 bytes")?;
             }
             Role::Seq(k) => {
-                row.seq_key[k] = key(&tok);
+                row.site.seq_key[k] = key(&tok);
                 if read && !tok.missing() {
                     let s = parse_i64(tok.text)
                         .ok_or_else(|| tok.error(ctx, "an integer residue number (seq_id)"))?;
-                    row.seq[k] = Some(s);
+                    row.site.seq[k] = Some(s);
                 }
             }
             Role::Scalar(k) if read && !tok.missing() => {
                 let v = parse_f32(strip_esd(tok.text))
                     .filter(|v| v.is_finite())
                     .ok_or_else(|| tok.error(ctx, SCALAR_NAMES[k].1))?;
-                row.scalar[k] = Some(v);
+                row.site.scalar[k] = Some(v);
             }
             Role::Model => {
                 let m = (!tok.missing())
@@ -840,49 +968,7 @@ impl Parser {
     fn end_row(&mut self, frame: Option<&mut Frame>) {
         let row = std::mem::take(&mut self.row);
         self.first_row.get_or_insert(row.start);
-        // auth_* wins over label_* where both are given, for the labels and for the keys.
-        let pick = |k: [u64; 2]| if k[1] != 0 { k[1] } else { k[0] };
-        let residue = [pick(row.asym_key), pick(row.seq_key), row.ins_key]
-            .iter()
-            .fold(fnv(b""), |h, k| {
-                (h ^ k).wrapping_mul(0x0000_0100_0000_01b3).rotate_left(17)
-            });
-        let (comp, name) = (pick(row.comp_key), pick(row.atom_key));
-        if !self.filter.keep(residue, comp, name, row.alt, row.start) {
-            return;
-        }
-        self.n_atoms += 1;
-        let Some(f) = frame else {
-            return;
-        };
-        let name = row.atom[1].or(row.atom[0]).unwrap_or_default();
-        let res = row.comp[1].or(row.comp[0]);
-        let symbol = row.symbol.as_ref().map(|s| s.as_str());
-        let [has_id, has_name, has_res, has_seq, has_chain] = self.has;
-        if has_id {
-            f.ids.push(row.id.unwrap_or(f.n_atoms() as i64 + 1));
-        }
-        f.positions.push(row.xyz);
-        f.elements
-            .push(guess_element(&name, res.as_deref(), symbol));
-        if has_name {
-            f.names.push(name);
-        }
-        if has_res {
-            f.res_names.push(res.unwrap_or_default());
-        }
-        if has_seq {
-            f.res_ids.push(row.seq[1].or(row.seq[0]).unwrap_or(0));
-        }
-        if has_chain {
-            f.chains
-                .push(row.asym[1].or(row.asym[0]).unwrap_or_default());
-        }
-        for (k, (name, _, missing)) in SCALAR_NAMES.iter().enumerate() {
-            if self.has_scalar[k] {
-                f.property_mut(name).push(row.scalar[k].unwrap_or(*missing));
-            }
-        }
+        self.sites.push(&row.site, row.start, frame);
     }
 }
 

@@ -359,7 +359,19 @@ impl ModelCheck {
         n_atoms: usize,
         expected: &'static str,
     ) -> Result<(), Error> {
-        if ctx.frame == 0 {
+        self.check_at(ctx.frame, || ctx.at(pos), n_atoms, expected)
+    }
+
+    /// [`ModelCheck::check`] for frame `frame`, the error (or warning) located by `at` (a
+    /// binary format has no lines: the BinaryCIF reader's rows).
+    pub fn check_at(
+        &mut self,
+        frame: usize,
+        at: impl FnOnce() -> Location,
+        n_atoms: usize,
+        expected: &'static str,
+    ) -> Result<(), Error> {
+        if frame == 0 {
             self.first = Some(n_atoms);
             return Ok(());
         }
@@ -370,14 +382,14 @@ impl ModelCheck {
             return Ok(());
         }
         let e = Error::Parse {
-            at: ctx.at(pos),
+            at: at(),
             expected,
             found: format!("{n_atoms} atoms, model 1 has {first}"),
         };
         if !self.lenient {
             return Err(e);
         }
-        self.warn(ctx.frame, expected, e);
+        self.warn(frame, expected, e);
         Ok(())
     }
 }

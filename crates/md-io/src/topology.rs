@@ -14,7 +14,8 @@
 //! - **PDBx/mmCIF**: the first model's atoms through the mmCIF reader (the first alternate
 //!   location of each atom, as there: the dropped rows are not reported here, read the file as a
 //!   trajectory to see the warning). No bonds are taken from `_struct_conn`: as for GRO, bonds
-//!   come from the distance-based finder ([`crate::bonds`]);
+//!   come from the distance-based finder ([`crate::bonds`]); its BinaryCIF encoding (`.bcif`)
+//!   alike, through the BinaryCIF reader;
 //! - **PSF** (CHARMM, NAMD, X-PLOR): atoms with segment-free residues, types and masses, and the
 //!   `!NBOND` section (module `psf`: elements from names, checked against the masses);
 //! - **AMBER prmtop** (`.prmtop`, `.parm7`): atoms, types, elements from `ATOMIC_NUMBER`,
@@ -63,6 +64,8 @@ pub enum TopologyFormat {
     Gro,
     /// PDBx/mmCIF: atoms of the first model, no bonds.
     Mmcif,
+    /// BinaryCIF (PDBx/mmCIF's binary encoding): as [`TopologyFormat::Mmcif`].
+    Bcif,
     /// Crystallographic CIF (COD, ICSD, Materials Project): the first data block's atoms,
     /// expanded by its symmetry operations as the trajectory reader expands them, no bonds.
     CrystalCif,
@@ -82,7 +85,7 @@ pub enum TopologyFormat {
 }
 
 impl TopologyFormat {
-    /// The format a path names: `.pdb`/`.ent`, `.gro`, `.cif`/`.mmcif`, `.psf`,
+    /// The format a path names: `.pdb`/`.ent`, `.gro`, `.cif`/`.mmcif`, `.bcif`, `.psf`,
     /// `.prmtop`/`.parm7`/`.top` or a file named `prmtop` (AMBER; [`Topology::open_as`] reads
     /// a `.top` that does not start as a prmtop does as a GROMACS topology, since GROMACS names
     /// its topologies so too), `.itp` (GROMACS), `.tpr`, `.data`/`.lmp` or `data.*` (LAMMPS).
@@ -102,6 +105,7 @@ impl TopologyFormat {
             "pdb" | "ent" => TopologyFormat::Pdb,
             "gro" => TopologyFormat::Gro,
             "cif" | "mmcif" => TopologyFormat::Mmcif,
+            "bcif" => TopologyFormat::Bcif,
             "data" | "lmp" => TopologyFormat::LammpsData,
             "psf" => TopologyFormat::Psf,
             "tpr" => TopologyFormat::Tpr,
@@ -271,7 +275,7 @@ impl Topology {
         let Some(format) = TopologyFormat::from_path(path) else {
             return Err(Error::Unsupported {
                 file: name,
-                what: "topology format (expected .pdb, .gro, .cif/.mmcif, .psf, .prmtop/.parm7, .tpr, .top/.itp (GROMACS), or a LAMMPS data file: .data, .lmp, data.*)",
+                what: "topology format (expected .pdb, .gro, .cif/.mmcif, .bcif, .psf, .prmtop/.parm7, .tpr, .top/.itp (GROMACS), or a LAMMPS data file: .data, .lmp, data.*)",
             });
         };
         Topology::open_as_with(path, format, gromacs)
@@ -380,6 +384,9 @@ impl Topology {
             }
             TopologyFormat::Mmcif => {
                 Topology::first_frame(Trajectory::from_reader(src, Format::Mmcif, name)?)
+            }
+            TopologyFormat::Bcif => {
+                Topology::first_frame(Trajectory::from_reader(src, Format::Bcif, name)?)
             }
             TopologyFormat::CrystalCif => {
                 Topology::first_frame(Trajectory::from_reader(src, Format::CrystalCif, name)?)

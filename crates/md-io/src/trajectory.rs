@@ -60,6 +60,7 @@ enum Reader<R> {
     Xsf(TextReader<R, Xsf>),
     Tpr(crate::tpr::TprReader),
     AseTraj(crate::asetraj::AseTrajReader<R>),
+    Bcif(crate::bcif::BcifReader),
 }
 
 /// Runs `$body` with `$r` bound to the format's reader, whatever the format.
@@ -92,6 +93,7 @@ macro_rules! each_reader {
             Reader::Xsf($r) => $body,
             Reader::Tpr($r) => $body,
             Reader::AseTraj($r) => $body,
+            Reader::Bcif($r) => $body,
         }
     };
 }
@@ -414,6 +416,7 @@ impl<R: Read + Seek> Trajectory<R> {
                 Reader::Lammps(TextReader::new(src, Lammps::default(), file.clone()))
             }
             Format::Mmcif => Reader::Mmcif(TextReader::new(src, Mmcif::new(lenient), file.clone())),
+            Format::Bcif => Reader::Bcif(crate::bcif::BcifReader::new(src, file.clone(), lenient)?),
             Format::Sdf => Reader::Sdf(TextReader::new(src, Sdf, file.clone())),
             Format::Mol2 => Reader::Mol2(TextReader::new(src, Mol2::default(), file.clone())),
             Format::Vasp => Reader::Vasp(TextReader::new(src, Vasp::default(), file.clone())),
@@ -487,11 +490,12 @@ impl<R: Read + Seek> Trajectory<R> {
         }
     }
 
-    /// Gathers the PDB and mmCIF parsers' warnings.
+    /// Gathers the PDB, mmCIF and BinaryCIF parsers' warnings.
     fn gather(&mut self) {
         let taken = match &mut self.reader {
             Reader::Pdb(r) => r.format_mut().take_warnings(),
             Reader::Mmcif(r) => r.format_mut().take_warnings(),
+            Reader::Bcif(r) => r.take_warnings(),
             Reader::Pqr(r) => r.format_mut().take_warnings(),
             _ => return,
         };

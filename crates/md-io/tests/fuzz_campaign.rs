@@ -637,6 +637,32 @@ fn mmcif_campaign() {
     campaign("PDBx/mmCIF", Format::Mmcif, fx.into());
 }
 
+/// BinaryCIF from three writers (biotite compressed, biotite with every encoding, Mol*'s
+/// cif2bcif): a cut is always an error (the document is one MessagePack value), a flip an error
+/// or a file read whole.
+#[test]
+fn bcif_campaign() {
+    let files = [
+        "bcif/biotite_gemmi_multi.bcif",
+        "bcif/biotite_gemmi_multi_encodings.bcif",
+        "bcif/molstar_gemmi_multi.bcif",
+    ];
+    let fx = files.map(|name| {
+        let bytes = data(name);
+        let n = bytes.len();
+        Fixture {
+            name: name.to_string(),
+            boundaries: (0..60).map(|k| k * n / 60).collect(),
+            bytes,
+            frames: 3,
+            cuts: Cuts::Declared,
+            fields: Vec::new(),
+            text: false,
+        }
+    });
+    campaign("BinaryCIF", Format::Bcif, fx.into());
+}
+
 #[test]
 fn gro_campaign() {
     let files = ["mda_vel.gro", "py_prec5.gro"];

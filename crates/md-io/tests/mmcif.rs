@@ -3,6 +3,11 @@
 //! mmcif_reference.json), the .cif against the .pdb it came from through our two readers, and
 //! hand-written files for the CIF syntax and for each error. (Selections on the .cif against
 //! MDAnalysis: tests/select.rs.)
+//!
+//! BinaryCIF: the .cif fixtures encoded by two other programs, biotite 1.6.0 and Mol* 5.6.1's
+//! cif2bcif (tests/data/bcif/gen_bcif.py), read into the frames the .cif gives, field by
+//! field; biotite's own decoding of each .bcif (bcif_reference.json) as a second reference;
+//! gzip. (Damaged BinaryCIF: `bcif_campaign` in tests/fuzz_campaign.rs.)
 
 use std::io::Cursor;
 use std::path::PathBuf;
@@ -443,4 +448,203 @@ fn files_are_told_by_extension_and_content() {
     let p = dir.path().join("noext");
     std::fs::copy(data("1uqc.cif"), &p).unwrap();
     assert_eq!(Trajectory::open(&p).unwrap().format(), Format::Mmcif);
+}
+
+// ---------------------------------------------------------------------------------------------
+// BinaryCIF
+
+/// The BinaryCIF fixtures and the .cif each was made from.
+const BCIF: [(&str, &str); 8] = [
+    ("bcif/biotite_gemmi_multi.bcif", "gemmi_multi.cif"),
+    ("bcif/biotite_3jqh.bcif", "3jqh.cif"),
+    ("bcif/biotite_1uqc.bcif", "1uqc.cif"),
+    ("bcif/biotite_gemmi_topo_plain.bcif", "gemmi_topo.cif"),
+    ("bcif/biotite_gemmi_multi_encodings.bcif", "gemmi_multi.cif"),
+    ("bcif/molstar_gemmi_multi.bcif", "gemmi_multi.cif"),
+    ("bcif/molstar_3jqh.bcif", "3jqh.cif"),
+    ("bcif/molstar_1uqc.bcif", "1uqc.cif"),
+];
+
+/// The file whose Cartn_z is IntervalQuantization-encoded: 2^16 steps over the column's range.
+const QUANTISED: &str = "bcif/biotite_gemmi_multi_encodings.bcif";
+
+/// Every frame of a file opened by path, its frame count and its warnings.
+fn read_all(name: &str) -> (Trajectory, Vec<Frame>, Vec<String>) {
+    let mut t = Trajectory::open(data(name)).unwrap();
+    let frames = stream(&mut t);
+    assert_eq!(t.n_frames().unwrap(), frames.len(), "{name}");
+    let warnings = t.warnings().iter().map(|w| w.to_string()).collect();
+    (t, frames, warnings)
+}
+
+/// The count in a dropped-alternate-locations warning.
+fn dropped(w: &str) -> usize {
+    let at = w.find(" rows of other alternate locations").unwrap();
+    let head = &w[..at];
+    head[head.rfind('\'').unwrap() + 1..].parse().unwrap()
+}
+
+/// Every field our reader gives from the .bcif is the one it gives from the .cif the .bcif was
+/// made from: names, elements, residues, chains, ids, the occupancy and bfactor properties,
+/// cell, title and the alternate-location warnings. Positions are the same f32 bit for bit
+/// (the writers keep the decimals: FixedPoint of 10^3, Float64, Float32 of the same decimal:
+/// see src/bcif.rs, # Numbers), except the IntervalQuantization column, within one step
+/// (biotite 1.6's encoder takes the step at or above the value, not the nearest).
+#[test]
+fn bcif_gives_the_frames_of_its_cif() {
+    for (bcif, cif) in BCIF {
+        let (t, b, bw) = read_all(bcif);
+        assert_eq!(t.format(), Format::Bcif, "{bcif}");
+        let (_, c, cw) = read_all(cif);
+        assert_eq!(b.len(), c.len(), "{bcif}: frames");
+        // The quantised axis: a step, plus the f32 rounding of values below 256 Å.
+        let z: Vec<f32> = c
+            .iter()
+            .flat_map(|f| f.positions.iter().map(|p| p[2]))
+            .collect();
+        let (lo, hi) = z
+            .iter()
+            .fold((f32::MAX, f32::MIN), |(a, b), &v| (a.min(v), b.max(v)));
+        let tol = (hi - lo) as f64 / 65535.0 + 256.0 * f32::EPSILON as f64;
+        for (k, (mut fb, fc)) in b.into_iter().zip(c).enumerate() {
+            if bcif == QUANTISED {
+                for (i, (pb, pc)) in fb.positions.iter_mut().zip(&fc.positions).enumerate() {
+                    let (got, want) = (pb[2] as f64, pc[2] as f64);
+                    assert!(
+                        (got - want).abs() <= tol,
+                        "{bcif} frame {k} atom {i} z: expected {want}, actual {got}, tolerance {tol}"
+                    );
+                    pb[2] = pc[2];
+                }
+            }
+            assert_eq!(fb, fc, "{bcif} frame {k}");
+        }
+        // The same alternate locations dropped, each frame's warning naming the .bcif.
+        assert_eq!(bw.len(), cw.len(), "{bcif}: {bw:?} {cw:?}");
+        for (wb, wc) in bw.iter().zip(&cw) {
+            assert!(wb.starts_with(&format!("{}: frame ", t.name())), "{wb}");
+            assert!(
+                wb.contains(", found '") && wb.contains("_atom_site row"),
+                "{wb}"
+            );
+            assert_eq!(dropped(wb), dropped(wc), "{wb} / {wc}");
+        }
+    }
+}
+
+/// Our reading against biotite's decoding of each .bcif (its BinaryCIFFile, not its structure
+/// parser): row count, model numbers, every atom name (files without alternate locations), the
+/// first and last rows' coordinates, cell and title. Coordinates: our f32 is biotite's decoded
+/// double (or float32) rounded to f32, bit for bit, the IntervalQuantization column too (both
+/// compute min + k (max − min) / (numSteps − 1)).
+#[test]
+fn bcif_matches_biotites_decoding() {
+    let reference: Value =
+        serde_json::from_str(&std::fs::read_to_string(data("bcif/bcif_reference.json")).unwrap())
+            .unwrap();
+    let files = reference["files"].as_object().unwrap();
+    assert_eq!(files.len(), BCIF.len());
+    for (file, r) in files {
+        let name = format!("bcif/{file}");
+        let (_, frames, warnings) = read_all(&name);
+        let models: Vec<i64> = (r["models"].as_array().unwrap().iter())
+            .map(|m| m.as_i64().unwrap())
+            .collect();
+        let mut distinct = models.clone();
+        distinct.dedup();
+        assert_eq!(frames.len(), distinct.len(), "{name}: models");
+        let kept: usize = frames.iter().map(|f| f.n_atoms()).sum();
+        let lost: usize = warnings.iter().map(|w| dropped(w)).sum();
+        assert_eq!(
+            kept + lost,
+            r["rows"].as_u64().unwrap() as usize,
+            "{name}: rows"
+        );
+        if lost == 0 {
+            let names: Vec<&str> = frames.iter().flat_map(|f| labels(&f.names)).collect();
+            let want: Vec<&str> = (r["names"].as_array().unwrap().iter())
+                .map(|n| n.as_str().unwrap())
+                .collect();
+            assert_eq!(names, want, "{name}: names");
+        }
+        let ends = [
+            ("first", frames[0].positions[0]),
+            ("last", *frames.last().unwrap().positions.last().unwrap()),
+        ];
+        for (which, got) in ends {
+            for (axis, want) in r[which].as_array().unwrap().iter().enumerate() {
+                let want = want.as_f64().unwrap() as f32;
+                assert_eq!(got[axis], want, "{name} {which} row, axis {axis}");
+            }
+        }
+        let cell: Vec<f64> = (r["cell"].as_array().unwrap().iter())
+            .map(|v| v.as_f64().unwrap())
+            .collect();
+        match frames[0].cell {
+            Some(c) => assert_eq!([c.lengths(), c.angles()].concat(), cell, "{name}: cell"),
+            // The NMR placeholder is dropped, as from the .cif.
+            None => assert_eq!(cell, [1.0, 1.0, 1.0, 90.0, 90.0, 90.0], "{name}"),
+        }
+        assert_eq!(
+            frames[0].comment,
+            r["title"].as_str().unwrap(),
+            "{name}: title"
+        );
+    }
+}
+
+#[test]
+fn bcif_gz_topologies_and_content_sniffing() {
+    // gzip: the same frames as the plain file (cif2bcif's own gzip).
+    let (t, gz, _) = read_all("bcif/molstar_3jqh.bcif.gz");
+    assert_eq!(t.format(), Format::Bcif);
+    let (_, plain, _) = read_all("bcif/molstar_3jqh.bcif");
+    assert_eq!(gz, plain);
+    // A topology, from the name (.bcif and .bcif.gz), equals the .cif's.
+    let cif = Topology::open(data("gemmi_topo.cif")).unwrap();
+    let bcif = Topology::open(data("bcif/biotite_gemmi_topo_plain.bcif")).unwrap();
+    assert_eq!(
+        TopologyFormat::from_path(&data("x.bcif.gz")),
+        Some(TopologyFormat::Bcif)
+    );
+    assert_eq!(bcif.n_atoms(), 66);
+    assert_eq!(
+        (&bcif.names, &bcif.res_names, &bcif.res_ids),
+        (&cif.names, &cif.res_names, &cif.res_ids)
+    );
+    assert_eq!(
+        (&bcif.elements, &bcif.ids, &bcif.chains),
+        (&cif.elements, &cif.ids, &cif.chains)
+    );
+    let gz = Topology::open(data("bcif/molstar_3jqh.bcif.gz")).unwrap();
+    assert_eq!(gz.names, Topology::open(data("3jqh.cif")).unwrap().names);
+    // It labels the XTC of the same atoms.
+    let mut traj = Trajectory::open(data("topo_mda.xtc")).unwrap();
+    let mut f = Frame::new();
+    traj.read_next(&mut f).unwrap();
+    bcif.apply(&mut f, traj.name(), 0).unwrap();
+    assert_eq!(f.names, cif.names);
+    // Told by content without the extension; a .bcif that is not one says what it expected.
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("noext");
+    std::fs::copy(data("bcif/molstar_gemmi_multi.bcif"), &p).unwrap();
+    assert_eq!(Trajectory::open(&p).unwrap().format(), Format::Bcif);
+    let p = dir.path().join("text.bcif");
+    std::fs::copy(data("gemmi_multi.cif"), &p).unwrap();
+    let e = Trajectory::open(&p).err().unwrap().to_string();
+    assert!(
+        e.starts_with(&format!(
+            "{}: byte 0: expected a BinaryCIF file",
+            p.display()
+        )),
+        "{e}"
+    );
+    // Random access across models.
+    let mut t = Trajectory::open(data("bcif/molstar_gemmi_multi.bcif")).unwrap();
+    let all = stream(&mut t);
+    for k in [2, 0, 1, 2] {
+        t.read_frame(k, &mut f).unwrap();
+        assert_eq!(f, all[k], "frame {k}");
+    }
+    assert!(!t.read_next(&mut f).unwrap());
 }
