@@ -17,6 +17,7 @@ mod terrain;
 mod terrain_fly;
 mod terrain_models;
 mod terrain_view;
+mod terrain_viewshed;
 
 use std::process::ExitCode;
 

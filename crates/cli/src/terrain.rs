@@ -1,4 +1,4 @@
-//! `texmap terrain build | info | export | maps | render | fly | compare`: glue between files, texmap-terrain and the terminal.
+//! `texmap terrain build | info | export | maps | render | viewshed | fly | compare`: glue between files, texmap-terrain and the terminal.
 
 use std::path::PathBuf;
 
@@ -170,6 +170,8 @@ pub enum TerrainCmd {
     },
     /// Draw the database from an aircraft (flight view) with a Seed 000 sampler.
     Render(crate::terrain_view::RenderArgs),
+    /// What an observer on the terrain sees (viewshed, as gdal_viewshed): a GeoTIFF mask.
+    Viewshed(crate::terrain_viewshed::ViewshedArgs),
     /// Fly a path file (or an orbit) over the database: PNG frames or a movie, with a progress bar.
     Fly(crate::terrain_fly::FlyArgs),
     /// Every sampler against the supersampled ray-traced reference along a flight path: CSV,
@@ -472,6 +474,7 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
             Ok(())
         }
         TerrainCmd::Render(a) => crate::terrain_view::run(a),
+        TerrainCmd::Viewshed(a) => crate::terrain_viewshed::run(a),
         TerrainCmd::Fly(a) => crate::terrain_fly::run_fly(a),
         TerrainCmd::Compare(a) => crate::terrain_fly::run_compare(a),
         TerrainCmd::Maps {

@@ -157,12 +157,37 @@ pub struct RenderArgs {
     pub stats: bool,
 }
 
-fn parse_pair<T: std::str::FromStr>(s: &str, sep: char, what: &str) -> Result<(T, T)> {
+pub(crate) fn parse_pair<T: std::str::FromStr>(s: &str, sep: char, what: &str) -> Result<(T, T)> {
     let mut it = s.split(sep).map(|t| t.trim().parse::<T>());
     match (it.next(), it.next(), it.next()) {
         (Some(Ok(a)), Some(Ok(b)), None) => Ok((a, b)),
         _ => usage(format!(
             "{what} {s}: expected two numbers separated by '{sep}'"
+        )),
+    }
+}
+
+/// The grid coordinates of `text`, a WGS 84 `LON,LAT` given as `flag` (`instead` names the option
+/// that takes the grid's own coordinates, for the error on a grid with no place on the globe).
+pub(crate) fn lonlat_point(
+    g: &texmap_terrain::dem::Georef,
+    text: &str,
+    flag: &str,
+    instead: &str,
+) -> Result<(f64, f64)> {
+    let (lon, lat) = parse_pair::<f64>(text, ',', flag)?;
+    if !(lon.abs() <= 180.0 && lat.abs() <= 90.0) {
+        return usage(format!(
+            "{flag} {text}: expected longitude in −180..180 and latitude in −90..90"
+        ));
+    }
+    match texmap_terrain::geodesy::Placement::of(g) {
+        Some(p) => Ok(p.xy(lon, lat)),
+        None => usage(format!(
+            "{flag} {text}: the grid has no place on the globe ({:?}{}): give {instead} in its \
+             own coordinates",
+            g.crs,
+            g.epsg.map(|c| format!(", EPSG:{c}")).unwrap_or_default()
         )),
     }
 }
@@ -207,26 +232,12 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let mut view = FlightCamera::over(terrain.grid());
     let eye = match (&a.eye, &a.eye_lonlat) {
         (Some(e), _) => Some(parse_pair::<f64>(e, ',', "--eye")?),
-        (None, Some(e)) => {
-            let (lon, lat) = parse_pair::<f64>(e, ',', "--eye-lonlat")?;
-            if !(lon.abs() <= 180.0 && lat.abs() <= 90.0) {
-                return usage(format!(
-                    "--eye-lonlat {e}: expected longitude in −180..180 and latitude in −90..90"
-                ));
-            }
-            let g = terrain.grid().georef();
-            match texmap_terrain::geodesy::Placement::of(g) {
-                Some(p) => Some(p.xy(lon, lat)),
-                None => {
-                    return usage(format!(
-                        "--eye-lonlat {e}: the grid has no place on the globe ({:?}{}): give \
-                         --eye X,Y in its own coordinates",
-                        g.crs,
-                        g.epsg.map(|c| format!(", EPSG:{c}")).unwrap_or_default()
-                    ));
-                }
-            }
-        }
+        (None, Some(e)) => Some(lonlat_point(
+            terrain.grid().georef(),
+            e,
+            "--eye-lonlat",
+            "--eye X,Y",
+        )?),
         (None, None) => None,
     };
     if let Some((x, y)) = eye {

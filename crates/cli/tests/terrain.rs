@@ -929,3 +929,145 @@ fn data_hillshade() -> &'static str {
     static PATH: std::sync::OnceLock<String> = std::sync::OnceLock::new();
     PATH.get_or_init(|| data("hillshade_dem_utm.tif"))
 }
+
+/// `terrain viewshed` on a DEM and on a database: a GeoTIFF mask equal to gdal_viewshed's
+/// (terrain/tests/data/viewshed/gen.sh), the share of cells seen on stderr, a picture; bad
+/// observers and options are usage errors (exit 2) that leave no file behind.
+#[test]
+fn viewshed_writes_gdals_mask_and_refuses_bad_observers() {
+    use texmap_terrain::dem::read_dem;
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("vs.tif");
+    let png = dir.path().join("vs.png");
+    let dem = data("viewshed/dem_utm.tif");
+    let o = texmap(&[
+        "terrain",
+        "viewshed",
+        &dem,
+        "--observer",
+        "316135,4904505",
+        "--method",
+        "gdal",
+        "-o",
+        out.to_str().unwrap(),
+        "--png",
+        png.to_str().unwrap(),
+    ]);
+    ok(&o);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("% of the 30720 cells visible"), "{err}");
+    let ours = read_dem(&out, &Default::default()).unwrap();
+    let gdal = read_dem(data("viewshed/summit.tif"), &Default::default()).unwrap();
+    assert_eq!(
+        ours.heights(),
+        gdal.heights(),
+        "the mask gdal_viewshed wrote"
+    );
+    assert_eq!(ours.georef(), gdal.georef());
+    let img = image::open(&png).unwrap();
+    assert_eq!(
+        (img.width(), img.height()),
+        (960, 800),
+        "192 x 160 cells, 5 pixels each"
+    );
+
+    // A database: the same viewshed as its source grid, the observer in degrees.
+    let db = relief_db(dir.path(), "vs.db");
+    let (from_db, from_tif) = (dir.path().join("db.tif"), dir.path().join("tif.tif"));
+    for (input, o) in [
+        (db.to_str().unwrap().to_string(), &from_db),
+        (data_hillshade().to_string(), &from_tif),
+    ] {
+        ok(&texmap(&[
+            "terrain",
+            "viewshed",
+            &input,
+            "--observer-lonlat=-71.3033,44.2706",
+            "--max-distance",
+            "2000",
+            "--mode",
+            "ground",
+            "-q",
+            "-o",
+            o.to_str().unwrap(),
+        ]));
+    }
+    assert_eq!(
+        std::fs::read(&from_db).unwrap(),
+        std::fs::read(&from_tif).unwrap()
+    );
+    let needed = read_dem(&from_db, &Default::default()).unwrap();
+    assert!(needed.nodata_count() > 0, "beyond 2 km: no-data");
+    assert!(needed.heights().iter().all(|h| h.is_nan() || *h >= 0.0));
+
+    // Usage errors: exit 2, the problem named, no file written.
+    let bad = dir.path().join("bad.tif");
+    let run = |args: &[&str]| {
+        let mut v = vec!["terrain", "viewshed"];
+        v.extend_from_slice(args);
+        v.extend_from_slice(&["-o", bad.to_str().unwrap()]);
+        texmap(&v)
+    };
+    let ramp = data("ramp_i16_lzw.tif");
+    for (args, says) in [
+        (
+            vec![dem.as_str(), "--observer", "1e9,1e9"],
+            "outside the 192 x 160 grid",
+        ),
+        (vec![dem.as_str(), "--observer-cell", "192,0"], "outside"),
+        (
+            vec![dem.as_str(), "--observer", "316135"],
+            "expected two numbers",
+        ),
+        (
+            vec![dem.as_str(), "--observer", "a,b"],
+            "expected two numbers",
+        ),
+        (vec![ramp.as_str(), "--observer-cell", "5,3"], "no-data"),
+        (
+            vec![dem.as_str(), "--observer-cell", "1,1", "--method", "fast"],
+            "--method fast",
+        ),
+        (
+            vec![
+                dem.as_str(),
+                "--observer-cell",
+                "1,1",
+                "--max-distance",
+                "0",
+            ],
+            "--max-distance",
+        ),
+        (vec![dem.as_str()], "--observer"),
+    ] {
+        let o = run(&args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(says), "{args:?}: {err}");
+    }
+    // An output that is not a GeoTIFF, and a missing input (a runtime failure: exit 1).
+    let o = texmap(&[
+        "terrain",
+        "viewshed",
+        &dem,
+        "--observer-cell",
+        "1,1",
+        "-o",
+        "x.png",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let o = run(&[
+        dir.path().join("nope.tif").to_str().unwrap(),
+        "--observer-cell",
+        "1,1",
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("nope.tif"));
+    assert!(!bad.exists(), "no partial output");
+    let leftovers: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().contains("partial"))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+}

@@ -41,6 +41,18 @@ pub enum TerrainError {
     },
     /// The output exists already (a build never overwrites a database).
     Exists { path: PathBuf },
+    /// A viewshed's observer at `(x, y)` (map coordinates, or a sample's column and row) falls at
+    /// sample `(col, row)`, outside the `width x height` grid.
+    ObserverOutside {
+        x: f64,
+        y: f64,
+        col: f64,
+        row: f64,
+        width: u32,
+        height: u32,
+    },
+    /// A viewshed's observer stands on a no-data sample: there is no ground to stand on.
+    ObserverNoData { col: u32, row: u32 },
     /// A mesh could not be written.
     Mesh(texmap_mesh::MeshError),
 }
@@ -86,6 +98,25 @@ impl std::fmt::Display for TerrainError {
                 f,
                 "{}: exists already (choose a new output directory)",
                 path.display()
+            ),
+            TerrainError::ObserverOutside {
+                x,
+                y,
+                col,
+                row,
+                width,
+                height,
+            } => write!(
+                f,
+                "observer ({x}, {y}) is at sample ({col:.2}, {row:.2}), outside the {width} x \
+                 {height} grid (expected columns 0..={} and rows 0..={})",
+                width.saturating_sub(1),
+                height.saturating_sub(1)
+            ),
+            TerrainError::ObserverNoData { col, row } => write!(
+                f,
+                "observer stands on sample ({col}, {row}), which is no-data: there is no ground \
+                 to stand on (choose another point, or fill the grid's holes)"
             ),
             TerrainError::Mesh(e) => write!(f, "{e}"),
         }

@@ -37,6 +37,10 @@
 //!   billboard, drawn after the terrain with the same samplers and depth-tested against it.
 //! - [`track`]: recorded flights (GPX tracks and routes, IGC flight logs) replayed as flight
 //!   paths: the track's clock, heading along the track, a coordinated turn's bank.
+//! - [`viewshed`]: what an observer on the terrain sees — `gdal_viewshed`'s reference-plane
+//!   sweep (bit for bit GDAL 3.6's, or with the cells next to the observer seen as they are) and
+//!   exact sight lines, with curvature and refraction; written as GeoTIFF by
+//!   [`dem::geotiff_writer`].
 //! - [`flight`]: flight paths — CSV/JSON path files (a bad line is named), orbits, and the
 //!   built-in study path (look-down, low, grazing, turn, slow pass).
 //!
@@ -92,5 +96,6 @@ pub mod tiles3d;
 pub mod track;
 pub mod vector;
 pub mod view;
+pub mod viewshed;
 
 pub use error::TerrainError;

@@ -22,12 +22,15 @@
 //! addressed `Z/X/Y.png` ([`png::TileAddress`]); grids that tile an area join into one
 //! ([`mosaic`], [`read_dems`]: web-map tiles of one zoom only). Each validates at the file
 //! boundary ([`Grid::new`]): at least 2 x 2 samples, at most [`MAX_SAMPLES`], every value finite
-//! or no-data, not all no-data.
+//! or no-data, not all no-data. [`geotiff_writer`] writes a grid (or a mask computed from one, such
+//! as a [`crate::viewshed`]) back as a GeoTIFF that GDAL and [`geotiff`] read with the same
+//! georeference.
 
 pub mod asc;
 pub mod dted;
 pub mod ehdr;
 pub mod geotiff;
+pub mod geotiff_writer;
 pub mod hgt;
 pub mod mosaic;
 pub mod png;
