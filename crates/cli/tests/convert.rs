@@ -7,7 +7,7 @@ use std::process::Output;
 
 use texmap_md_io::{Frame, Sequence};
 
-mod common;
+use crate::common;
 use common::texmap;
 
 fn md_data(name: &str) -> String {

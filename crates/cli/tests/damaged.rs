@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
-mod common;
+use crate::common;
 use common::texmap;
 
 fn data(name: &str) -> Vec<u8> {

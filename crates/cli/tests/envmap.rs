@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-mod common;
+use crate::common;
 use common::texmap;
 
 /// `texmap envmap --size 160x120 -o dir/name extra...`; the image's RGB bytes.

@@ -5,9 +5,7 @@
 
 use texmap_md_io::cna::{DiamondType, classify_diamond};
 
-mod support {
-    pub mod ovito;
-}
+use crate::support;
 use support::ovito::*;
 
 const DATA: Fixtures = Fixtures("diamond");

@@ -5,24 +5,16 @@
 //! allocation: by hand, and through the fuzz campaign's harness (tests/support/campaign.rs, as
 //! the trajectory readers in tests/fuzz_campaign.rs).
 
-mod support {
-    pub mod alloc;
-    // The shared fuzz harness: this binary uses part of it.
-    #[allow(dead_code)]
-    pub mod campaign;
-}
+use crate::support;
 
 use std::io::Cursor;
 use std::path::PathBuf;
 
 use serde_json::Value;
-use support::alloc::{CountingAlloc, measure};
+use support::alloc::measure;
 use support::campaign::{Cuts, Field, Fixture, Settings, Verdict, line_starts, run_campaign};
 use texmap_md_io::Error;
 use texmap_md_io::energy::{self, EnergyTable};
-
-#[global_allocator]
-static ALLOC: CountingAlloc = CountingAlloc;
 
 fn path(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))

@@ -9,9 +9,7 @@
 use texmap_md_io::Frame;
 use texmap_md_io::expr::Expression;
 
-mod support {
-    pub mod ovito;
-}
+use crate::support;
 use support::ovito::*;
 
 const DATA: Fixtures = Fixtures("expr");

@@ -11,28 +11,16 @@
 //! (Fortran record markers, XTC byte counts, TRR block sizes, the NetCDF header, the GSD index,
 //! line ends, numeric tokens), not by the readers under test.
 //!
-//! Run with `cargo test -p texmap-md-io --test fuzz_campaign -- --nocapture` to see the table:
+//! Run with `cargo test -p texmap-md-io --test suite fuzz_campaign:: -- --nocapture` to see the table:
 //! mutants per family and per outcome, the slowest run and the largest heap peak.
 
-mod support {
-    pub mod alloc;
-    // A shared harness: this binary uses most of it, other crates' campaigns the rest.
-    #[allow(dead_code)]
-    pub mod campaign;
-    // Shared with the other GSD tests: this binary uses part of it.
-    #[allow(dead_code)]
-    pub mod gsd_index;
-}
+use crate::support;
 
 use std::io::Cursor;
 use std::path::PathBuf;
 
-use support::alloc::CountingAlloc;
 use support::campaign::{Cuts, Field, Fixture, Settings, Verdict, line_starts, run_campaign};
 use texmap_md_io::{Error, Format, Frame, MAX_COORDINATE, ReadOptions, Trajectory, Writer};
-
-#[global_allocator]
-static ALLOC: CountingAlloc = CountingAlloc;
 
 fn data(name: &str) -> Vec<u8> {
     std::fs::read(

@@ -9,9 +9,7 @@ use texmap_md_io::cna::{StructureType, classify};
 use texmap_md_io::grains::{GrainOptions, segment};
 use texmap_md_io::orientation::{LatticeFit, Symmetry, disorientation, orientations};
 
-mod support {
-    pub mod ovito;
-}
+use crate::support;
 use support::ovito::*;
 
 const DATA: Fixtures = Fixtures("grains");

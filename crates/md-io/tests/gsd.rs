@@ -19,11 +19,7 @@ use serde_json::Value;
 use support::gsd_index::chunk;
 use texmap_md_io::{Element, Error, Format, Frame, ReadOptions, Trajectory};
 
-mod support {
-    // Shared with the damage tests: this binary uses part of it.
-    #[allow(dead_code)]
-    pub mod gsd_index;
-}
+use crate::support;
 
 const FILES: [&str; 4] = [
     "hoomd_tri.gsd",

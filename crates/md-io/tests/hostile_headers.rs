@@ -6,23 +6,15 @@
 //! Memory is measured with a counting global allocator (tests/support/alloc.rs): what a reader
 //! allocates for a file must be bounded by what the file can hold, whatever its header says.
 
-mod support {
-    pub mod alloc;
-    // Shared with the other GSD tests: this binary uses part of it.
-    #[allow(dead_code)]
-    pub mod gsd_index;
-}
+use crate::support;
 
 use std::io::Cursor;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-use support::alloc::{CountingAlloc, measure};
+use support::alloc::measure;
 use support::gsd_index::{chunk, chunks};
 use texmap_md_io::{Error, Format, Frame, ReadOptions, Trajectory};
-
-#[global_allocator]
-static ALLOC: CountingAlloc = CountingAlloc;
 
 fn data(name: &str) -> Vec<u8> {
     std::fs::read(

@@ -18,9 +18,7 @@ use texmap_md_io::elements::guess_element;
 use texmap_md_io::replicate::replicate;
 use texmap_md_io::{Element, Error, Format, Frame, Label, Property, Topology, Trajectory, Writer};
 
-mod support {
-    pub mod fixtures;
-}
+use crate::support;
 
 /// Writes `frames` as mmCIF to `path`.
 fn write_file(path: &Path, frames: &[Frame]) {

@@ -22,9 +22,7 @@ use serde_json::Value;
 use support::fixtures::{data, stream};
 use texmap_md_io::{Error, Format, Frame, Trajectory, UnitCell, Writer};
 
-mod support {
-    pub mod fixtures;
-}
+use crate::support;
 
 /// A file of tests/data/netcdf_write.
 fn here(name: &str) -> PathBuf {

@@ -8,9 +8,7 @@
 use texmap_md_io::centrosymmetry::{CspMode, centrosymmetry};
 use texmap_md_io::strain::atomic_strain;
 
-mod support {
-    pub mod ovito;
-}
+use crate::support;
 use support::ovito::*;
 
 const DATA: Fixtures = Fixtures("strain");

@@ -19,9 +19,7 @@ use texmap_md_io::{
     Element, Error, Format, Frame, Label, Trajectory, UnitCell, Writer, atom_element,
 };
 
-mod support {
-    pub mod fixtures;
-}
+use crate::support;
 
 /// Output file name and input (a file of tests/data).
 const CASES: [(&str, &str); 9] = [

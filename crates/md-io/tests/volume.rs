@@ -9,20 +9,15 @@
 //! - Damage: every cut and replaced bytes of a small cube and CHGCAR, under a heap cap; hostile
 //!   headers; error messages that name the file and the line.
 
-mod support {
-    pub mod alloc;
-}
+use crate::support;
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use serde_json::Value;
-use support::alloc::{CountingAlloc, measure};
+use support::alloc::measure;
 use texmap_md_io::volume::{VaspQuantity, Volume, VolumeFormat, read_volumes, read_volumes_from};
 use texmap_md_io::{Error, Format, Frame, Trajectory};
-
-#[global_allocator]
-static ALLOC: CountingAlloc = CountingAlloc;
 
 const BOHR: f64 = 0.529177210903;
 

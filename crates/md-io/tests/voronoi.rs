@@ -7,9 +7,7 @@
 use texmap_md_io::Frame;
 use texmap_md_io::voronoi::voronoi;
 
-mod support {
-    pub mod ovito;
-}
+use crate::support;
 use support::ovito::*;
 
 const DATA: Fixtures = Fixtures("voronoi");

@@ -12,20 +12,15 @@
 //!   labels, 2-D grids, sections read past) and damage: cuts, non-numbers, counts larger than
 //!   the data, hostile counts under a heap cap, every cut and replaced byte of a grid file.
 
-mod support {
-    pub mod alloc;
-}
+use crate::support;
 
 use std::io::Cursor;
 use std::path::PathBuf;
 
 use serde_json::Value;
-use support::alloc::{CountingAlloc, measure};
+use support::alloc::measure;
 use texmap_md_io::volume::{Volume, VolumeFormat, read_volumes, read_volumes_from};
 use texmap_md_io::{Error, Format, Frame, Trajectory};
-
-#[global_allocator]
-static ALLOC: CountingAlloc = CountingAlloc;
 
 /// eV per Hartree (CODATA 2018), as the reader uses it.
 const HARTREE: f64 = 27.211386245988;

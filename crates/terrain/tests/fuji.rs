@@ -9,7 +9,7 @@ use std::path::PathBuf;
 use texmap_terrain::dem::png::terrain_rgb_height;
 use texmap_terrain::rtin::{ErrorMap, extract};
 
-mod common;
+use crate::common;
 use common::true_error;
 
 fn fuji() -> (Vec<f32>, u32) {

@@ -7,23 +7,13 @@
 //! header fields set to extremes — must end in a grid or an error naming the file, never a panic,
 //! under a heap cap of 64x the mutant's size + 1 MiB.
 //!
-//! `cargo test -p texmap-terrain --test fuzz_campaign -- --nocapture` prints the table.
-
-#[path = "../../md-io/tests/support/alloc.rs"]
-mod alloc;
-#[allow(dead_code)] // the md-io campaign uses the rest
-#[path = "../../md-io/tests/support/campaign.rs"]
-mod campaign;
+//! `cargo test -p texmap-terrain --test suite fuzz_campaign:: -- --nocapture` prints the table.
 
 use std::path::{Path, PathBuf};
 
-use alloc::CountingAlloc;
-use campaign::{Cuts, Field, Fixture, Settings, Verdict, run_campaign};
+use crate::campaign::{Cuts, Field, Fixture, Settings, Verdict, run_campaign};
 use texmap_terrain::TerrainError;
 use texmap_terrain::dem::{self, Grid};
-
-#[global_allocator]
-static ALLOC: CountingAlloc = CountingAlloc;
 
 fn data(name: &str) -> Vec<u8> {
     std::fs::read(
@@ -213,7 +203,7 @@ fn terrain_readers_survive_the_campaign() {
         ("TOTALROWBYTES", value("TOTALROWBYTES", "74")),
     ];
     let mut fx = unchecked(fixture("ramp_i16.hdr", hdr, fields, true));
-    fx.boundaries = campaign::line_starts(&fx.bytes);
+    fx.boundaries = crate::campaign::line_starts(&fx.bytes);
     // An error must name the header or the data file, whichever holds the fault.
     let either = |r: Result<Grid, TerrainError>| {
         let named = match &r {

@@ -11,7 +11,7 @@ use std::path::PathBuf;
 use texmap_terrain::dem::{CrsKind, ReadOptions, read_dem};
 use texmap_terrain::rtin::{ErrorMap, extract, pad_to_rtin};
 
-mod common;
+use crate::common;
 use common::true_error;
 
 fn data(name: &str) -> PathBuf {

@@ -1,6 +1,6 @@
 """What ASE and MDAnalysis read from files OUR writers wrote (round trip, recorded at dev time).
 
-    mkdir -p /tmp/rt && MDTEXT_WRITE_ROUNDTRIP=/tmp/rt cargo test -p texmap-md-io --test text_access
+    mkdir -p /tmp/rt && MDTEXT_WRITE_ROUNDTRIP=/tmp/rt cargo test -p texmap-md-io --test suite text_access::
     python3 gen_roundtrip.py /tmp/rt      # writes roundtrip_reference.json here
 
 ours.xyz: our XYZ writer on the frames of ase_ext.xyz, read by ASE (extxyz).

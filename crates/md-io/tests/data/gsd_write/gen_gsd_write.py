@@ -2,7 +2,7 @@
 
 The files tri.gsd, vel.gsd and nacl.gsd are our writer's rewrites of ../gsd/hoomd_tri.gsd (written
 by gsd.hoomd), ../mda_vel.gro (MDAnalysis) and ../lammps_write/nacl_primitive.vasp (ASE):
-    TEXMAP_BLESS=1 cargo test -p texmap-md-io --test gsd_writer rewriting
+    TEXMAP_BLESS=1 cargo test -p texmap-md-io --test suite gsd_writer::rewriting
 then, from this directory, with the gsd package (pip install gsd; 5.0.1 here):
     python3 gen_gsd_write.py
 writes gsd_hoomd.json.gz: per file, per frame, what gsd.hoomd.open reads back, in the layout of

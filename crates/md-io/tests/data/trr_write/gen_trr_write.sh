@@ -4,7 +4,7 @@
 #                    1.9 nm box, 20 steps of MD; positions every 10 steps, velocities every 20,
 #                    forces every 5, so frames hold different blocks (steps 5 and 15 forces only).
 #   written.trr      our writer's rewrite of md.trr's frames with positions
-#                    (TEXMAP_BLESS=1 cargo test -p texmap-md-io --test trr_writer).
+#                    (TEXMAP_BLESS=1 cargo test -p texmap-md-io --test suite trr_writer::).
 #   gmx_check.txt    what `gmx check` counts in written.trr.
 #   mdanalysis.json.gz  what MDAnalysis 2.11's TRRReader reads from written.trr.
 set -euo pipefail
@@ -48,7 +48,7 @@ gmx -quiet grompp -f md.mdp -c box.gro -p topol.top -o md.tpr
 gmx -quiet mdrun -s md.tpr -deffnm md -nt 1
 cp md.trr "$here/md.trr"
 cd "$here"
-TEXMAP_BLESS=1 cargo test -q -p texmap-md-io --test trr_writer rewriting
+TEXMAP_BLESS=1 cargo test -q -p texmap-md-io --test suite trr_writer::rewriting
 gmx -quiet check -f written.trr 2>&1 | sed -n '/^Item/,/^Box/p' > gmx_check.txt
 python3 gen_trr_write.py
 rm -rf "$work"

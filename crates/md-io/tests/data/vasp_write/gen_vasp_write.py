@@ -5,7 +5,7 @@ The files (POSCAR_*, XDATCAR_* in this directory) are our writer's output for re
 tests/data; the test writes them again and compares the bytes. To make them afresh (after a
 deliberate change of the writer), from crates/md-io:
 
-    VASP_WRITE_REGENERATE=1 cargo test -p texmap-md-io --test vasp_writer
+    VASP_WRITE_REGENERATE=1 cargo test -p texmap-md-io --test suite vasp_writer::
     python3 tests/data/vasp_write/gen_vasp_write.py   # ASE 3.29, pymatgen 2026.10, phonopy 4.10
 
     POSCAR_cod        crystal/cod_9001665.cif (P-1, triclinic; species in the CIF's order)
