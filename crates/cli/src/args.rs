@@ -62,7 +62,7 @@ pub enum Command {
     /// energy file (.edr) or a LAMMPS log its terms with units, rows, time span and each
     /// term's mean, minimum and maximum.
     Info {
-        /// Trajectory file (XYZ, extended XYZ, PDB, PDBx/mmCIF and BinaryCIF (.bcif), GRO, LAMMPS dump, DCD, XTC, TRR,
+        /// Trajectory file (XYZ, extended XYZ, PDB, PDBx/mmCIF and BinaryCIF (.bcif), GRO, LAMMPS dump (text or binary .bin), DCD, XTC, TRR,
         /// AMBER NetCDF, AMBER ASCII mdcrd (with --topology: the file has no atom count) and
         /// rst7/inpcrd, HOOMD-blue GSD, SDF/MOL and MOL2 with their bonds, one frame per
         /// record, VASP POSCAR/CONTCAR/XDATCAR, crystallographic CIF, a LAMMPS data file,
@@ -82,6 +82,12 @@ pub enum Command {
         /// file, frame and byte).
         #[arg(long)]
         allow_truncated: bool,
+        /// Column names of a LAMMPS binary dump (.bin) from an older LAMMPS, which does not
+        /// name them (no magic header, or format revision 1), as the dump custom command lists
+        /// them ('id type x y z vx vy vz'); a newer dump names its own. Without them such a file of 5 or 8 values per
+        /// atom is read as dump atom's default ('id type xs ys zs [ix iy iz]').
+        #[arg(long, value_name = "NAMES")]
+        lammps_columns: Option<String>,
         /// Topology (PDB, PDBx/mmCIF or BinaryCIF, GRO, PSF, AMBER prmtop, GROMACS .tpr or .top, LAMMPS data file) of the trajectory's atoms: its
         /// atom, residue and bond counts are added, and a different atom count is an error.
         #[arg(long, value_name = "FILE")]
@@ -567,6 +573,12 @@ pub struct RenderArgs {
     /// (default: a cut frame is an error naming the file, frame and byte).
     #[arg(long)]
     pub allow_truncated: bool,
+    /// Column names of a LAMMPS binary dump (.bin) from an older LAMMPS, which does not
+    /// name them (no magic header, or format revision 1), as the dump custom command lists
+    /// them ('id type x y z vx vy vz'); a newer dump names its own. Without them such a file of 5 or 8 values per
+    /// atom is read as dump atom's default ('id type xs ys zs [ix iy iz]').
+    #[arg(long, value_name = "NAMES")]
+    pub lammps_columns: Option<String>,
     /// Frames to render, A:B:STEP (B exclusive, each part optional: "::10", "5:", "3").
     #[arg(long, default_value = "0:")]
     pub frames: String,

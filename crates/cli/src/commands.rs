@@ -44,12 +44,13 @@ pub fn run(cli: Cli) -> Result<()> {
             more,
             format,
             allow_truncated,
+            lammps_columns,
             topology,
         } => info(
             &file,
             &more,
             format.as_deref(),
-            allow_truncated,
+            read_options(allow_truncated, lammps_columns.as_deref()),
             topology.as_deref(),
         ),
         Command::Render(a) => {
@@ -117,6 +118,15 @@ pub(crate) fn print_warnings(traj: &Sequence, shown: &mut usize) {
         }
     }
     *shown = traj.warnings().len();
+}
+
+/// The read options of the input flags: --allow-truncated, --lammps-columns.
+fn read_options(allow_truncated: bool, lammps_columns: Option<&str>) -> ReadOptions {
+    let options = ReadOptions::new().allow_truncated(allow_truncated);
+    match lammps_columns {
+        Some(names) => options.lammps_columns(names),
+        None => options,
+    }
 }
 
 /// `options` with what a trajectory may need from its topology: the atom count and box angles
@@ -217,7 +227,7 @@ fn info(
     file: &Path,
     more: &[PathBuf],
     format: Option<&str>,
-    allow_truncated: bool,
+    options: ReadOptions,
     topology: Option<&Path>,
 ) -> Result<()> {
     use texmap_md_io::TopologyFormat;
@@ -258,7 +268,6 @@ fn info(
         println!("{obj}");
         return Ok(());
     }
-    let options = ReadOptions::new().allow_truncated(allow_truncated);
     let files: Vec<PathBuf> = std::iter::once(file.to_path_buf())
         .chain(more.iter().cloned())
         .collect();
@@ -588,14 +597,19 @@ pub(crate) fn open_input(
     more: &[PathBuf],
     format: Option<&str>,
     allow_truncated: bool,
+    lammps_columns: Option<&str>,
     topology: Option<&Path>,
 ) -> Result<(Option<texmap_md_io::Topology>, Sequence, ReadOptions)> {
     let topology = topology.map(crate::scene::open_topology).transpose()?;
-    let options = ReadOptions::new().allow_truncated(allow_truncated);
+    let options = read_options(allow_truncated, lammps_columns);
     let files: Vec<PathBuf> = std::iter::once(file.to_path_buf())
         .chain(more.iter().cloned())
         .collect();
-    let traj = open_parts(&files, format, with_topology(options, topology.as_ref()))?;
+    let traj = open_parts(
+        &files,
+        format,
+        with_topology(options.clone(), topology.as_ref()),
+    )?;
     Ok((topology, traj, options))
 }
 
@@ -693,6 +707,7 @@ fn render(a: &RenderArgs) -> Result<()> {
         &a.more,
         a.format.as_deref(),
         a.allow_truncated,
+        a.lammps_columns.as_deref(),
         a.mol.topology.as_deref(),
     )?;
     let n = traj.n_frames()?;
@@ -706,7 +721,7 @@ fn render(a: &RenderArgs) -> Result<()> {
     // The other files of the scene: each with one frame, or at least as many as the file.
     let mut adds = Vec::with_capacity(a.add.len());
     for file in &a.add {
-        let mut t = open_trajectory_with(file, None, options)?;
+        let mut t = open_trajectory_with(file, None, options.clone())?;
         let k = t.n_frames()?;
         print_warnings(&t, &mut shown);
         if k != 1 && k < n {

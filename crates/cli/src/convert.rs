@@ -31,6 +31,12 @@ pub struct ConvertArgs {
     /// Read only the complete frames of a file whose last frame is cut short, with a warning.
     #[arg(long)]
     pub allow_truncated: bool,
+    /// Column names of a LAMMPS binary dump (.bin) from an older LAMMPS, which does not
+    /// name them (no magic header, or format revision 1), as the dump custom command lists
+    /// them ('id type x y z vx vy vz'); a newer dump names its own. Without them such a file of 5 or 8 values per
+    /// atom is read as dump atom's default ('id type xs ys zs [ix iy iz]').
+    #[arg(long, value_name = "NAMES")]
+    pub lammps_columns: Option<String>,
     /// Topology giving names, elements, residues and bonds to the trajectory's atoms (PDB,
     /// PDBx/mmCIF or BinaryCIF, GRO, PSF, AMBER prmtop, GROMACS .tpr or .top, LAMMPS data file), as for texmap
     /// render.
@@ -261,6 +267,7 @@ pub fn convert(a: &ConvertArgs) -> Result<()> {
         &a.more,
         a.format.as_deref(),
         a.allow_truncated,
+        a.lammps_columns.as_deref(),
         a.topology.as_deref(),
     )?;
     let n = traj.n_frames()?;

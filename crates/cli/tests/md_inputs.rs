@@ -4446,3 +4446,43 @@ fn define_preprocesses_a_gromacs_topology() {
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("--define POSRES"), "{}", stderr(&o));
 }
+
+#[test]
+fn lammps_binary_dump_informs_renders_and_converts_as_its_text_dump() {
+    // LAMMPS wrote both of the same frames (md-io's tests/data/lammps_bin/gen.sh; the text with
+    // every float at %.17g): a triclinic box, 2 MPI ranks' chunks, a changing atom count.
+    let (bin, text) = (
+        data("lammps_bin/tri_np2.bin"),
+        data("lammps_bin/tri_np2.lammpstrj"),
+    );
+    let info = |file: &str| {
+        let o = texmap(&["info", file]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        serde_json::from_slice::<serde_json::Value>(&o.stdout).unwrap()
+    };
+    let (mut b, t) = (info(&bin), info(&text));
+    assert_eq!(
+        b["format"], "lammps-bin",
+        "told by its magic header, not its name"
+    );
+    b["format"] = t["format"].clone();
+    assert_eq!(b, t);
+    let dir = tempfile::tempdir().unwrap();
+    let args = |f: &str| vec![f.to_string(), "--frames".into(), "0:1".into()];
+    let png = |f: &str, out: &str| {
+        let a = args(f);
+        let a: Vec<&str> = a.iter().map(String::as_str).collect();
+        render_png(dir.path(), &a, out)
+    };
+    assert!(
+        png(&bin, "bin.png") == png(&text, "text.png"),
+        "the same image"
+    );
+    let convert = |f: &str, out: &str| {
+        let out = dir.path().join(out);
+        let o = texmap(&["convert", "-q", f, "-o", out.to_str().unwrap()]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        std::fs::read_to_string(out).unwrap()
+    };
+    assert_eq!(convert(&bin, "bin.xyz"), convert(&text, "text.xyz"));
+}

@@ -193,7 +193,7 @@ fn read_exact_at<R: Read>(
 }
 
 #[inline(always)]
-fn u32_at(b: &[u8], endian: Endian) -> u32 {
+pub(crate) fn u32_at(b: &[u8], endian: Endian) -> u32 {
     let a = [b[0], b[1], b[2], b[3]];
     match endian {
         Endian::Little => u32::from_le_bytes(a),
@@ -202,7 +202,7 @@ fn u32_at(b: &[u8], endian: Endian) -> u32 {
 }
 
 #[inline(always)]
-fn u64_at(b: &[u8], endian: Endian) -> u64 {
+pub(crate) fn u64_at(b: &[u8], endian: Endian) -> u64 {
     let a = [b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7]];
     match endian {
         Endian::Little => u64::from_le_bytes(a),

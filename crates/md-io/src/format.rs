@@ -14,6 +14,11 @@ pub enum Format {
     Gro,
     /// LAMMPS text dump: `.lammpstrj`, `.lammpsdump`, `.dump`.
     LammpsDump,
+    /// LAMMPS binary dump (`dump atom` / `dump custom` to a `.bin` file), read as the text dump
+    /// of the same data is. `.bin` names many formats, so the content tells: the magic header
+    /// (`DUMPCUSTOM`, `DUMPATOM`) or, from an older LAMMPS, a plausible first frame header; by
+    /// name: `lammps-bin`.
+    LammpsBin,
     /// CHARMM/NAMD DCD: `.dcd`.
     Dcd,
     /// GROMACS compressed XTC: `.xtc`.
@@ -99,7 +104,7 @@ pub enum Format {
 
 impl Format {
     /// Every format, in declaration order.
-    pub const ALL: [Format; 28] = [
+    pub const ALL: [Format; 29] = [
         Format::Xyz,
         Format::Pdb,
         Format::Gro,
@@ -128,6 +133,7 @@ impl Format {
         Format::Tpr,
         Format::AseTraj,
         Format::Bcif,
+        Format::LammpsBin,
     ];
 
     /// The format a file extension (case-insensitive, e.g. "xyz", "lammpstrj") or a format's
@@ -139,6 +145,7 @@ impl Format {
             "pdb" | "ent" => Format::Pdb,
             "gro" => Format::Gro,
             "lammpstrj" | "lammpsdump" | "dump" | "lammps-dump" => Format::LammpsDump,
+            "lammps-bin" => Format::LammpsBin,
             "dcd" => Format::Dcd,
             "xtc" => Format::Xtc,
             "trr" => Format::Trr,
@@ -214,7 +221,8 @@ impl Format {
     }
 
     /// The format the first bytes of a file show (give at least 256 bytes when the file has
-    /// them). Binary formats are told by their magic numbers, text formats by their first
+    /// them). Binary formats are told by their magic numbers (a LAMMPS binary dump from an
+    /// older LAMMPS, which has none, by its first frame header), text formats by their first
     /// lines: `data_` (CIF: PDBx/mmCIF or crystallographic, by [`Format::cif_kind`]), a
     /// MessagePack map keyed `encoder`, `version` or `dataBlocks` (BinaryCIF),
     /// `@<TRIPOS>` (MOL2) or an XSF keyword (`CRYSTAL`, `ATOMS`, `ANIMSTEPS`…) on the first
@@ -259,6 +267,10 @@ impl Format {
             Some(1995) => return Some(Format::Xtc),
             Some(1993) => return Some(Format::Trr),
             _ => {}
+        }
+        // LAMMPS binary dump: its magic header, or a first frame header that fits.
+        if crate::lammps_bin::sniff(head) {
+            return Some(Format::LammpsBin);
         }
         // CIF (PDBx/mmCIF or crystallographic): a data block header, after comments and blank
         // lines.
@@ -472,6 +484,7 @@ impl Format {
             Format::Pdb => "pdb",
             Format::Gro => "gro",
             Format::LammpsDump => "lammps-dump",
+            Format::LammpsBin => "lammps-bin",
             Format::Dcd => "dcd",
             Format::Xtc => "xtc",
             Format::Trr => "trr",

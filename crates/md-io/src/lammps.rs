@@ -58,9 +58,9 @@ use crate::parse::{
 use crate::text::{Ctx, LineReader, Pos, TextFormat, need_line};
 use std::io::Read;
 
-/// What one atom column is read into.
+/// What one atom column is read into (the binary dump reader, src/lammps_bin.rs, shares it).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Act {
+pub(crate) enum Act {
     Id,
     Type,
     Element,
@@ -76,30 +76,165 @@ enum Act {
 
 /// How the position columns are expressed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum PosKind {
+pub(crate) enum PosKind {
     Cartesian,
     Scaled,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Units {
+/// The unit style a dump names (`ITEM: UNITS`), as far as it changes what is read.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) enum Units {
+    #[default]
     Unknown,
     Real,
     Metal,
 }
 
-/// LAMMPS dump parser state: column actions and the scratch buffers of the sort by id.
-pub(crate) struct Lammps {
-    acts: Vec<Act>,
-    /// The names of the `Act::Property` columns, in column order.
-    properties: Vec<String>,
-    units: Units,
+impl Units {
+    /// The units a unit style's name gives.
+    pub(crate) fn from_name(name: &[u8]) -> Units {
+        match name {
+            b"real" => Units::Real,
+            b"metal" => Units::Metal,
+            _ => Units::Unknown,
+        }
+    }
+
+    /// A dump's `TIME` in ps: as written in `metal` (ps), from fs in `real`; none without units.
+    pub(crate) fn time_ps(self, time: Option<f64>) -> Option<f64> {
+        match (time, self) {
+            (Some(t), Units::Metal) => Some(t),
+            (Some(t), Units::Real) => Some(t * 1e-3),
+            _ => None,
+        }
+    }
+
+    /// What a velocity is multiplied by to be in Å/ps (Å/fs in `real`).
+    pub(crate) fn velocity_scale(self) -> f32 {
+        if self == Units::Real { 1000.0 } else { 1.0 }
+    }
+}
+
+/// The box a dump's header describes (`BOX BOUNDS` and its binary twin).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum BoxKind {
+    /// `lo hi` per axis.
+    Orthogonal,
+    /// The bounding box's `lo hi` and a tilt factor per axis (`xy xz yz`).
+    Restricted,
+    /// Each edge vector followed by one origin component (`abc origin`, LAMMPS 2024+).
+    General,
+}
+
+/// The cell of a dump's box: per axis `[lo, hi, tilt, _]` (restricted triclinic; tilt 0 when
+/// orthogonal) or `[a_k, b_k, c_k, origin_k]` rows (general); `None` for a degenerate box
+/// (e.g. a 2-D run with zero thickness).
+pub(crate) fn cell_from_bounds(rows: [[f64; 4]; 3], kind: BoxKind) -> Option<UnitCell> {
+    let cell = match kind {
+        BoxKind::General => {
+            // General triclinic: edge vectors and origin components.
+            let m = [
+                [rows[0][0], rows[0][1], rows[0][2]],
+                [rows[1][0], rows[1][1], rows[1][2]],
+                [rows[2][0], rows[2][1], rows[2][2]],
+            ];
+            UnitCell::from_matrix(m).map(|c| c.with_origin([rows[0][3], rows[1][3], rows[2][3]]))
+        }
+        BoxKind::Orthogonal | BoxKind::Restricted => {
+            // Restricted triclinic: remove the tilt from the bounding box (LAMMPS manual).
+            let (xy, xz, yz) = if kind == BoxKind::Restricted {
+                (rows[0][2], rows[1][2], rows[2][2])
+            } else {
+                (0.0, 0.0, 0.0)
+            };
+            let xlo = rows[0][0] - 0f64.min(xy).min(xz).min(xy + xz);
+            let xhi = rows[0][1] - 0f64.max(xy).max(xz).max(xy + xz);
+            let ylo = rows[1][0] - 0f64.min(yz);
+            let yhi = rows[1][1] - 0f64.max(yz);
+            let (zlo, zhi) = (rows[2][0], rows[2][1]);
+            let m = [
+                [xhi - xlo, 0.0, 0.0],
+                [xy, yhi - ylo, 0.0],
+                [xz, yz, zhi - zlo],
+            ];
+            UnitCell::from_matrix(m).map(|c| c.with_origin([xlo, ylo, zlo]))
+        }
+    };
+    cell.ok()
+}
+
+/// The atoms of a frame put in `id` order (LAMMPS writes them in processor order), with the
+/// scratch buffers reused from frame to frame.
+#[derive(Default)]
+pub(crate) struct IdSort {
     perm: Vec<(i64, u32)>,
     s3: Vec<[f32; 3]>,
     sl: Vec<Label>,
     se: Vec<Element>,
     si: Vec<i64>,
     sf: Vec<f32>,
+}
+
+impl IdSort {
+    /// Sorts every per-atom vector of `frame` by its ids (nothing to do when they are sorted
+    /// or absent).
+    pub(crate) fn sort(&mut self, frame: &mut Frame) {
+        if frame.ids.is_sorted() {
+            return;
+        }
+        // Unique ids that fill a range (LAMMPS's 1..N) go straight to their slots, O(N); others
+        // (a thresholded subset, duplicates) are sorted as (id, index) pairs: the same order.
+        self.perm.clear();
+        let (lo, hi) = frame
+            .ids
+            .iter()
+            .fold((i64::MAX, i64::MIN), |(lo, hi), &id| {
+                (lo.min(id), hi.max(id))
+            });
+        let n = frame.ids.len();
+        if hi
+            .checked_sub(lo)
+            .is_some_and(|span| span as u64 == n as u64 - 1)
+        {
+            self.perm.resize(n, (0, u32::MAX));
+            let mut unique = true;
+            for (k, &id) in frame.ids.iter().enumerate() {
+                let slot = &mut self.perm[(id - lo) as usize];
+                unique &= slot.1 == u32::MAX;
+                *slot = (id, k as u32);
+            }
+            if !unique {
+                self.perm.clear();
+            }
+        }
+        if self.perm.is_empty() {
+            self.perm
+                .extend(frame.ids.iter().enumerate().map(|(k, id)| (*id, k as u32)));
+            self.perm.sort_unstable();
+        }
+        let perm = &self.perm;
+        permute(&mut frame.positions, perm, &mut self.s3);
+        permute(&mut frame.velocities, perm, &mut self.s3);
+        permute(&mut frame.colors, perm, &mut self.s3);
+        permute(&mut frame.types, perm, &mut self.sl);
+        permute(&mut frame.elements, perm, &mut self.se);
+        permute(&mut frame.names, perm, &mut self.sl);
+        permute(&mut frame.radii, perm, &mut self.sf);
+        permute(&mut frame.ids, perm, &mut self.si);
+        for p in &mut frame.properties {
+            permute(&mut p.values, perm, &mut self.sf);
+        }
+    }
+}
+
+/// LAMMPS dump parser state: column actions and the scratch buffers of the sort by id.
+#[derive(Default)]
+pub(crate) struct Lammps {
+    acts: Vec<Act>,
+    /// The names of the `Act::Property` columns, in column order.
+    properties: Vec<String>,
+    units: Units,
+    sort: IdSort,
 }
 
 /// The colour component (0 = R, 1 = G, 2 = B) an OVITO-style colour column name gives:
@@ -126,22 +261,6 @@ fn boundary(spec: &[u8]) -> [bool; 3] {
     match flags.as_slice() {
         [.., a, b, c] => [*a, *b, *c].map(|f| f == b"pp"),
         _ => [true; 3],
-    }
-}
-
-impl Default for Lammps {
-    fn default() -> Self {
-        Lammps {
-            acts: Vec::new(),
-            properties: Vec::new(),
-            units: Units::Unknown,
-            perm: Vec::new(),
-            s3: Vec::new(),
-            sl: Vec::new(),
-            se: Vec::new(),
-            si: Vec::new(),
-            sf: Vec::new(),
-        }
     }
 }
 
@@ -200,53 +319,20 @@ impl Lammps {
     fn boxes<R: Read>(
         lines: &mut LineReader<R>,
         ctx: &Ctx,
-        kind: u8,
+        kind: BoxKind,
     ) -> Result<Option<UnitCell>, Error> {
         let mut rows = [[0f64; 4]; 3];
-        let width = if kind == 0 {
-            2
-        } else if kind == 1 {
-            3
-        } else {
-            4
+        let width = match kind {
+            BoxKind::Orthogonal => 2,
+            BoxKind::Restricted => 3,
+            BoxKind::General => 4,
         };
         for row in &mut rows {
             let (pos, line) = need_line(lines, ctx, "3 box bound lines")?;
             *row = Lammps::bounds(ctx, pos, line, width)?;
         }
-        let cell = match kind {
-            2 => {
-                // General triclinic: edge vectors and origin components.
-                let m = [
-                    [rows[0][0], rows[0][1], rows[0][2]],
-                    [rows[1][0], rows[1][1], rows[1][2]],
-                    [rows[2][0], rows[2][1], rows[2][2]],
-                ];
-                UnitCell::from_matrix(m)
-                    .map(|c| c.with_origin([rows[0][3], rows[1][3], rows[2][3]]))
-            }
-            _ => {
-                // Restricted triclinic: remove the tilt from the bounding box (LAMMPS manual).
-                let (xy, xz, yz) = if kind == 1 {
-                    (rows[0][2], rows[1][2], rows[2][2])
-                } else {
-                    (0.0, 0.0, 0.0)
-                };
-                let xlo = rows[0][0] - 0f64.min(xy).min(xz).min(xy + xz);
-                let xhi = rows[0][1] - 0f64.max(xy).max(xz).max(xy + xz);
-                let ylo = rows[1][0] - 0f64.min(yz);
-                let yhi = rows[1][1] - 0f64.max(yz);
-                let (zlo, zhi) = (rows[2][0], rows[2][1]);
-                let m = [
-                    [xhi - xlo, 0.0, 0.0],
-                    [xy, yhi - ylo, 0.0],
-                    [xz, yz, zhi - zlo],
-                ];
-                UnitCell::from_matrix(m).map(|c| c.with_origin([xlo, ylo, zlo]))
-            }
-        };
         // A degenerate box (e.g. a 2-D run with zero thickness) is reported as no cell.
-        Ok(cell.ok())
+        Ok(cell_from_bounds(rows, kind))
     }
 
     /// Reads the ITEM sections up to and including `ITEM: ATOMS`; `None` at a clean end.
@@ -288,11 +374,7 @@ impl Lammps {
                 time = Some(parse_f64(t).ok_or_else(|| ctx.parse(pos, line, t, "a time"))?);
             } else if item == b"UNITS" {
                 let (_, line) = need_line(lines, ctx, "the units")?;
-                self.units = match trim(line) {
-                    b"real" => Units::Real,
-                    b"metal" => Units::Metal,
-                    _ => Units::Unknown,
-                };
+                self.units = Units::from_name(trim(line));
             } else if item == b"NUMBER OF ATOMS" {
                 let (pos, line) = need_line(lines, ctx, "the number of atoms")?;
                 let t = trim(line);
@@ -300,11 +382,10 @@ impl Lammps {
                     parse_usize(t).ok_or_else(|| ctx.parse(pos, line, t, "the number of atoms"))?,
                 );
             } else if let Some(spec) = item.strip_prefix(b"BOX BOUNDS") {
-                // 0: orthogonal, 1: restricted triclinic (tilts), 2: general triclinic.
                 let kind = match fields(spec).next() {
-                    Some(b"abc") => 2,
-                    Some(b"xy") => 1,
-                    _ => 0,
+                    Some(b"abc") => BoxKind::General,
+                    Some(b"xy") => BoxKind::Restricted,
+                    _ => BoxKind::Orthogonal,
                 };
                 let periodic = boundary(spec);
                 cell = Lammps::boxes(lines, ctx, kind)?.map(|c| c.with_periodic(periodic));
@@ -324,11 +405,7 @@ impl Lammps {
                 }
                 if let Some(f) = frame.as_deref_mut() {
                     f.cell = cell;
-                    f.time = match (time, self.units) {
-                        (Some(t), Units::Metal) => Some(t),
-                        (Some(t), Units::Real) => Some(t * 1e-3),
-                        _ => None,
-                    };
+                    f.time = self.units.time_ps(time);
                 }
                 return Ok(Some(Header { n, cell, pos_kind }));
             } else {
@@ -344,77 +421,85 @@ impl Lammps {
 
     /// Maps the ATOMS column names to actions.
     fn columns(&mut self, ctx: &Ctx, pos: Pos, line: &[u8], spec: &[u8]) -> Result<PosKind, Error> {
-        self.acts.clear();
-        self.properties.clear();
-        const SETS: [(&[&[u8]; 3], PosKind); 4] = [
-            (&[b"x", b"y", b"z"], PosKind::Cartesian),
-            (&[b"xs", b"ys", b"zs"], PosKind::Scaled),
-            (&[b"xu", b"yu", b"zu"], PosKind::Cartesian),
-            (&[b"xsu", b"ysu", b"zsu"], PosKind::Scaled),
-        ];
-        let Some(&(set, kind)) = SETS
-            .iter()
-            .find(|(set, _)| set.iter().all(|c| fields(spec).any(|n| n == *c)))
-        else {
-            return Err(ctx.parse(
+        plan_columns(spec, &mut self.acts, &mut self.properties).ok_or_else(|| {
+            ctx.parse(
                 pos,
                 line,
                 spec,
                 "position columns x y z, xs ys zs, xu yu zu or xsu ysu zsu",
-            ));
-        };
-        for name in fields(spec) {
-            let act = match name {
-                b"id" => Act::Id,
-                b"type" => Act::Type,
-                b"element" => Act::Element,
-                b"vx" => Act::Vel(0),
-                b"vy" => Act::Vel(1),
-                b"vz" => Act::Vel(2),
-                b"radius" => Act::Radius,
-                b"diameter" => Act::Diameter,
-                c => match (set.iter().position(|s| *s == c), color_component(c)) {
-                    (Some(k), _) => Act::Pos(k),
-                    (None, Some(k)) => Act::Color(k),
-                    (None, None) => Act::Skip,
-                },
-            };
-            // Only the first column of a kind counts.
-            let act = if act != Act::Skip && self.acts.contains(&act) {
-                Act::Skip
-            } else {
-                act
-            };
-            self.acts.push(act);
-        }
-        // A partial velocity or colour is not one: those columns are properties.
-        let vel = (0..3).filter(|k| self.acts.contains(&Act::Vel(*k))).count();
-        let rgb = (0..3)
-            .filter(|k| self.acts.contains(&Act::Color(*k)))
-            .count();
-        for a in &mut self.acts {
-            let partial = match a {
-                Act::Vel(_) => vel != 3,
-                Act::Color(_) => rgb != 3,
-                _ => false,
-            };
-            if partial {
-                *a = Act::Skip;
-            }
-        }
-        // Every other column, named once, is a property.
-        for (a, name) in self.acts.iter_mut().zip(fields(spec)) {
-            if *a != Act::Skip {
-                continue;
-            }
-            let name = String::from_utf8_lossy(name).into_owned();
-            if !self.properties.contains(&name) {
-                *a = Act::Property(self.properties.len());
-                self.properties.push(name);
-            }
-        }
-        Ok(kind)
+            )
+        })
     }
+}
+
+/// Maps a dump's column names (`spec`, separated by white space) to `acts`, one per column,
+/// and names the property columns in `properties`; the positions' kind, or `None` when no set
+/// of three position columns is complete.
+pub(crate) fn plan_columns(
+    spec: &[u8],
+    acts: &mut Vec<Act>,
+    properties: &mut Vec<String>,
+) -> Option<PosKind> {
+    acts.clear();
+    properties.clear();
+    const SETS: [(&[&[u8]; 3], PosKind); 4] = [
+        (&[b"x", b"y", b"z"], PosKind::Cartesian),
+        (&[b"xs", b"ys", b"zs"], PosKind::Scaled),
+        (&[b"xu", b"yu", b"zu"], PosKind::Cartesian),
+        (&[b"xsu", b"ysu", b"zsu"], PosKind::Scaled),
+    ];
+    let &(set, kind) = SETS
+        .iter()
+        .find(|(set, _)| set.iter().all(|c| fields(spec).any(|n| n == *c)))?;
+    for name in fields(spec) {
+        let act = match name {
+            b"id" => Act::Id,
+            b"type" => Act::Type,
+            b"element" => Act::Element,
+            b"vx" => Act::Vel(0),
+            b"vy" => Act::Vel(1),
+            b"vz" => Act::Vel(2),
+            b"radius" => Act::Radius,
+            b"diameter" => Act::Diameter,
+            c => match (set.iter().position(|s| *s == c), color_component(c)) {
+                (Some(k), _) => Act::Pos(k),
+                (None, Some(k)) => Act::Color(k),
+                (None, None) => Act::Skip,
+            },
+        };
+        // Only the first column of a kind counts.
+        let act = if act != Act::Skip && acts.contains(&act) {
+            Act::Skip
+        } else {
+            act
+        };
+        acts.push(act);
+    }
+    // A partial velocity or colour is not one: those columns are properties.
+    let vel = (0..3).filter(|k| acts.contains(&Act::Vel(*k))).count();
+    let rgb = (0..3).filter(|k| acts.contains(&Act::Color(*k))).count();
+    for a in acts.iter_mut() {
+        let partial = match a {
+            Act::Vel(_) => vel != 3,
+            Act::Color(_) => rgb != 3,
+            _ => false,
+        };
+        if partial {
+            *a = Act::Skip;
+        }
+    }
+    // Every other column, named once, is a property.
+    for (a, name) in acts.iter_mut().zip(fields(spec)) {
+        if *a != Act::Skip {
+            continue;
+        }
+        let name = String::from_utf8_lossy(name).into_owned();
+        if !properties.contains(&name) {
+            *a = Act::Property(properties.len());
+            properties.push(name);
+        }
+    }
+    Some(kind)
 }
 
 impl TextFormat for Lammps {
@@ -431,11 +516,7 @@ impl TextFormat for Lammps {
         let (has_vel, has_id, has_type) = (has(Act::Vel(0)), has(Act::Id), has(Act::Type));
         let has_el = has(Act::Element);
         let has_color = has(Act::Color(0));
-        let vel_scale = if self.units == Units::Real {
-            1000.0
-        } else {
-            1.0
-        };
+        let vel_scale = self.units.velocity_scale();
         frame.positions.reserve(h.n.min(ctx.reserve));
         for name in &self.properties {
             frame.properties.push(crate::frame::Property {
@@ -567,23 +648,8 @@ impl TextFormat for Lammps {
             }
         }
         // Sort atoms by id (processor order → id order).
-        if has_id && !frame.ids.is_sorted() {
-            self.perm.clear();
-            self.perm
-                .extend(frame.ids.iter().enumerate().map(|(k, id)| (*id, k as u32)));
-            self.perm.sort_unstable();
-            let perm = &self.perm;
-            permute(&mut frame.positions, perm, &mut self.s3);
-            permute(&mut frame.velocities, perm, &mut self.s3);
-            permute(&mut frame.colors, perm, &mut self.s3);
-            permute(&mut frame.types, perm, &mut self.sl);
-            permute(&mut frame.elements, perm, &mut self.se);
-            permute(&mut frame.names, perm, &mut self.sl);
-            permute(&mut frame.radii, perm, &mut self.sf);
-            permute(&mut frame.ids, perm, &mut self.si);
-            for p in &mut frame.properties {
-                permute(&mut p.values, perm, &mut self.sf);
-            }
+        if has_id {
+            self.sort.sort(frame);
         }
         Ok(true)
     }

@@ -2,7 +2,7 @@
 //! file formats, streaming frames, and element tables (radius, colour).
 //!
 //! - [`Trajectory`] reads XYZ / extended XYZ, PDB, PDBx/mmCIF (the first data block's
-//!   `_atom_site`, models as frames; the text and its BinaryCIF encoding, `.bcif`), GRO and LAMMPS text dumps, MDL SDF/MOL and Tripos MOL2
+//!   `_atom_site`, models as frames; the text and its BinaryCIF encoding, `.bcif`), GRO and LAMMPS dumps (text, and binary `.bin` read to the same frames), MDL SDF/MOL and Tripos MOL2
 //!   (records as frames, with the bonds they list: [`Frame::bonds`]), VASP POSCAR/CONTCAR
 //!   and XDATCAR (the ionic steps as frames, a changing cell too), crystallographic CIF (COD,
 //!   ICSD, Materials Project: each data block a frame, the asymmetric unit expanded by the
@@ -152,6 +152,7 @@ mod gsd_writer;
 mod gz;
 pub mod hbonds;
 mod lammps;
+mod lammps_bin;
 mod lammps_data;
 mod lammps_data_writer;
 mod lammps_dump_writer;

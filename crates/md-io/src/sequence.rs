@@ -67,7 +67,7 @@ impl Sequence {
                 what: "a trajectory sequence needs at least one file".into(),
             });
         };
-        let traj = open_part(first, format, options)?;
+        let traj = open_part(first, format, options.clone())?;
         let name: Arc<str> = match paths.len() {
             1 => traj.name().into(),
             n => format!("{} (+{} more files)", traj.name(), n - 1).into(),
@@ -113,7 +113,7 @@ impl Sequence {
             if let Some((_, mut closed, _)) = self.open.take() {
                 self.warnings.append(&mut closed.take_warnings());
             }
-            let traj = open_part(&self.paths[k], self.format, self.options)?;
+            let traj = open_part(&self.paths[k], self.format, self.options.clone())?;
             self.open = Some((k, traj, 0));
         }
         let (_, traj, at) = self.open.as_mut().expect("opened above");

@@ -43,6 +43,7 @@ enum Reader<R> {
     Pdb(TextReader<R, Pdb>),
     Gro(TextReader<R, Gro>),
     Lammps(TextReader<R, Lammps>),
+    LammpsBin(crate::lammps_bin::LammpsBinReader<R>),
     Mmcif(TextReader<R, Mmcif>),
     Sdf(TextReader<R, Sdf>),
     Mol2(TextReader<R, Mol2>),
@@ -76,6 +77,7 @@ macro_rules! each_reader {
             Reader::Pdb($r) => $body,
             Reader::Gro($r) => $body,
             Reader::Lammps($r) => $body,
+            Reader::LammpsBin($r) => $body,
             Reader::Mmcif($r) => $body,
             Reader::Sdf($r) => $body,
             Reader::Mol2($r) => $body,
@@ -151,7 +153,7 @@ impl<R: Read + Seek> FrameSource for Trajectory<R> {
 /// assert_eq!(lenient.warnings().len(), 1);
 /// # Ok::<(), texmap_md_io::Error>(())
 /// ```
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 #[non_exhaustive]
 pub struct ReadOptions {
     /// Keep the complete frames of a file whose last frame is cut short, with a warning.
@@ -163,6 +165,13 @@ pub struct ReadOptions {
     /// trajectory's three-number box line): the run's, from its topology (a truncated
     /// octahedron's 109.47°, AMBER prmtop `BOX_DIMENSIONS`). Default: right angles.
     pub box_angles: Option<[f64; 3]>,
+    /// The column names of a LAMMPS binary dump that does not hold them (from an older LAMMPS:
+    /// no magic header, or format revision 1), one per value of an atom, separated by white
+    /// space, as `dump custom` lists them: `"id type x y z vx vy vz c_pe"`, OVITO's column
+    /// mapping for such files. A file that names its columns ignores them, as other formats
+    /// do. Without them such a file of 5 or 8 values per atom is read as `dump atom`'s default
+    /// columns (see [`Format::LammpsBin`]).
+    pub lammps_columns: Option<Arc<str>>,
 }
 
 impl ReadOptions {
@@ -186,6 +195,12 @@ impl ReadOptions {
     /// Sets the `box_angles` field.
     pub fn box_angles(mut self, angles: [f64; 3]) -> ReadOptions {
         self.box_angles = Some(angles);
+        self
+    }
+
+    /// Sets the `lammps_columns` field.
+    pub fn lammps_columns(mut self, names: &str) -> ReadOptions {
+        self.lammps_columns = Some(names.into());
         self
     }
 }
@@ -415,6 +430,11 @@ impl<R: Read + Seek> Trajectory<R> {
             Format::LammpsDump => {
                 Reader::Lammps(TextReader::new(src, Lammps::default(), file.clone()))
             }
+            Format::LammpsBin => Reader::LammpsBin(crate::lammps_bin::LammpsBinReader::new(
+                src,
+                file.clone(),
+                options.lammps_columns.clone(),
+            )?),
             Format::Mmcif => Reader::Mmcif(TextReader::new(src, Mmcif::new(lenient), file.clone())),
             Format::Bcif => Reader::Bcif(crate::bcif::BcifReader::new(src, file.clone(), lenient)?),
             Format::Sdf => Reader::Sdf(TextReader::new(src, Sdf, file.clone())),
@@ -456,7 +476,7 @@ impl<R: Read + Seek> Trajectory<R> {
 
     /// The options the file was opened with.
     pub fn options(&self) -> ReadOptions {
-        self.options
+        self.options.clone()
     }
 
     /// What was tolerated under `allow_truncated` ([`ReadOptions`]) so far (a dropped cut frame,

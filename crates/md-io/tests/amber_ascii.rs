@@ -51,7 +51,7 @@ fn trajectories_as_mdanalysis_and_parmed_read_them() {
         let n = mda["n_atoms"].as_u64().unwrap() as usize;
         let frames = mda["positions"].as_array().unwrap();
         let opts = ReadOptions::new().atoms(n);
-        let mut traj = Trajectory::open_with(path(name), opts).unwrap();
+        let mut traj = Trajectory::open_with(path(name), opts.clone()).unwrap();
         assert_eq!(traj.format(), Format::AmberTrj);
         assert_eq!(traj.n_frames().unwrap(), frames.len(), "{name}");
         let mut f = Frame::new();
@@ -106,7 +106,7 @@ fn trajectories_as_mdanalysis_and_parmed_read_them() {
 fn three_number_box_takes_the_runs_angles() {
     let beta = 109.471_220_634_490_7;
     let opts = ReadOptions::new().atoms(66).box_angles([beta; 3]);
-    let mut traj = Trajectory::open_with(path("box.mdcrd"), opts).unwrap();
+    let mut traj = Trajectory::open_with(path("box.mdcrd"), opts.clone()).unwrap();
     let mut f = Frame::new();
     traj.read_frame(2, &mut f).unwrap();
     let cell = f.cell.unwrap();
@@ -198,14 +198,17 @@ fn formats_by_name_and_content() {
         ("odd.inpcrd", "noname2", Format::AmberRestart),
     ] {
         let p = copy(from, to);
-        let mut t = Trajectory::open_with(&p, opts).unwrap();
+        let mut t = Trajectory::open_with(&p, opts.clone()).unwrap();
         assert_eq!(t.format(), want, "{to}");
         assert!(t.n_frames().unwrap() >= 1, "{to}");
     }
     // A .crd that is neither.
     let p = dir.path().join("other.crd");
     std::fs::write(&p, "title\nnot numbers at all\n").unwrap();
-    let e = Trajectory::open_with(&p, opts).err().unwrap().to_string();
+    let e = Trajectory::open_with(&p, opts.clone())
+        .err()
+        .unwrap()
+        .to_string();
     assert!(e.contains("other.crd") && e.contains("--format"), "{e}");
 }
 
@@ -238,18 +241,18 @@ fn damage_is_reported_where_it_is() {
     // Title + 5 frames of 20 coordinate lines and a box line; cut frame 3 after 4 lines.
     let cut = lines[..1 + 3 * 21 + 4].join("\n") + "\n";
     let opts = ReadOptions::new().atoms(66);
-    let mut t = from_text(&cut, Format::AmberTrj, opts).unwrap();
+    let mut t = from_text(&cut, Format::AmberTrj, opts.clone()).unwrap();
     let e = t.n_frames().unwrap_err().to_string();
     assert!(e.starts_with("t.mdcrd: frame 3, line 69"), "{e}");
     assert!(e.contains("16 more coordinate lines"), "{e}");
-    let mut t = from_text(&cut, Format::AmberTrj, opts.allow_truncated(true)).unwrap();
+    let mut t = from_text(&cut, Format::AmberTrj, opts.clone().allow_truncated(true)).unwrap();
     assert_eq!(t.n_frames().unwrap(), 3);
     assert_eq!(t.warnings().len(), 1);
 
     let mut bad: Vec<String> = lines.iter().map(|l| l.to_string()).collect();
     bad[30].replace_range(16..24, "********");
     let bad = bad.join("\n") + "\n";
-    let mut t = from_text(&bad, Format::AmberTrj, opts).unwrap();
+    let mut t = from_text(&bad, Format::AmberTrj, opts.clone()).unwrap();
     let mut f = Frame::new();
     assert!(t.read_next(&mut f).unwrap());
     let e = t.read_next(&mut f).unwrap_err().to_string();
@@ -361,7 +364,7 @@ fn prmtop_box_angles_as_parmed_reads_them() {
     // IFBOX 1 with beta 90: a rectangular box.
     assert_eq!(plain.box_angles, Some([90.0; 3]));
     let opts = ReadOptions::new().atoms(topo.n_atoms()).box_angles(angles);
-    let mut traj = Trajectory::open_with(path("box.mdcrd"), opts).unwrap();
+    let mut traj = Trajectory::open_with(path("box.mdcrd"), opts.clone()).unwrap();
     let mut f = Frame::new();
     traj.read_frame(0, &mut f).unwrap();
     assert_eq!(f.cell.unwrap().angles(), angles);
@@ -380,7 +383,7 @@ fn blank_titles_are_titles() {
         let (_, rest) = text.split_once('\n').unwrap();
         let blank = format!("{}\n{rest}", " ".repeat(80));
         let read_all = |t: &str| {
-            let mut traj = from_text(t, format, opts).unwrap();
+            let mut traj = from_text(t, format, opts.clone()).unwrap();
             let mut f = Frame::new();
             let mut out = Vec::new();
             while traj.read_next(&mut f).unwrap() {

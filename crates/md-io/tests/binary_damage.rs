@@ -1,9 +1,10 @@
-//! Damaged DCD / XTC / TRR / GSD files, built from good ones written by MDAnalysis, gsd.hoomd
-//! and our own writers: cut at every byte (so at every record boundary and inside every record) and with
-//! bits flipped at every byte. Nothing may panic; every frame before the damage must read back
-//! unchanged; the error for the damaged frame must name the file, the frame and the byte, and a
-//! cut frame is never dropped silently: `n_frames` reports it, unless `allow_truncated` was
-//! asked for, which keeps the complete frames and gives the same error as a warning.
+//! Damaged DCD / XTC / TRR / GSD / LAMMPS binary dump files, built from good ones written by
+//! MDAnalysis, gsd.hoomd, LAMMPS and our own writers: cut at every byte (so at every record
+//! boundary and inside every record) and with bits flipped at every byte. Nothing may panic;
+//! every frame before the damage must read back unchanged; the error for the damaged frame must
+//! name the file, the frame and the byte, and a cut frame is never dropped silently: `n_frames`
+//! reports it, unless `allow_truncated` was asked for, which keeps the complete frames and gives
+//! the same error as a warning.
 
 use std::io::Cursor;
 use std::path::PathBuf;
@@ -46,6 +47,16 @@ fn cases() -> Vec<(&'static str, Format, Vec<u8>)> {
         ("ours.xtc", Format::Xtc, ours(Format::Xtc)),
         ("hoomd_2d.gsd", Format::Gsd, data("gsd/hoomd_2d.gsd")),
         ("hoomd_one.gsd", Format::Gsd, data("gsd/hoomd_one.gsd")),
+        (
+            "tri_np2.bin",
+            Format::LammpsBin,
+            data("lammps_bin/tri_np2.bin"),
+        ),
+        (
+            "atom_np1.bin",
+            Format::LammpsBin,
+            data("lammps_bin/atom_np1.bin"),
+        ),
     ]
 }
 

@@ -9,7 +9,8 @@
 //!
 //! The record boundaries and header fields are found here by walking each format's structure
 //! (Fortran record markers, XTC byte counts, TRR block sizes, the NetCDF header, the GSD index,
-//! line ends, numeric tokens), not by the readers under test.
+//! LAMMPS binary dump headers and chunks, line ends, numeric tokens), not by the readers under
+//! test.
 //!
 //! Run with `cargo test -p texmap-md-io --test suite fuzz_campaign:: -- --nocapture` to see the table:
 //! mutants per family and per outcome, the slowest run and the largest heap peak.
@@ -20,6 +21,7 @@ use std::io::Cursor;
 use std::path::PathBuf;
 
 use support::campaign::{Cuts, Field, Fixture, Settings, Verdict, line_starts, run_campaign};
+use support::lammps_bin::{Layout, rewrite, walk, walk_bare};
 use texmap_md_io::{Error, Format, Frame, MAX_COORDINATE, ReadOptions, Trajectory, Writer};
 
 fn data(name: &str) -> Vec<u8> {
@@ -137,8 +139,8 @@ fn read(format: Format, name: &str, bytes: &[u8], opts: ReadOptions) -> Verdict 
 fn run(format: Format) -> impl Fn(&Fixture, &[u8]) -> Verdict {
     let base = base_options(format);
     move |fx, bytes| {
-        let strict = read(format, &fx.name, bytes, base);
-        let lenient = read(format, &fx.name, bytes, base.allow_truncated(true));
+        let strict = read(format, &fx.name, bytes, base.clone());
+        let lenient = read(format, &fx.name, bytes, base.clone().allow_truncated(true));
         // A cut of a file whose frame ends are known keeps exactly the complete frames under
         // allow_truncated (XTC and TRR cannot open without one complete frame).
         if let Cuts::FrameEnds(ends) = &fx.cuts
@@ -491,6 +493,105 @@ fn gsd_fixture(name: &str, bytes: Vec<u8>) -> Fixture {
     }
 }
 
+/// LAMMPS binary dump as LAMMPS writes it (revision 2, walked by tests/support/lammps_bin.rs,
+/// not by the reader): every header field's start, each chunk's count and values and each
+/// frame's end as boundaries; the header fields of the first and last frame (the low half of
+/// the i64 ones), the first chunk's count and first value as fields.
+fn lammps_bin_fixture(name: &str, bytes: Vec<u8>) -> Fixture {
+    let frames = walk(&bytes);
+    let mut boundaries = vec![0];
+    let mut ends = vec![0];
+    for f in &frames {
+        boundaries.extend([
+            f.start,
+            f.endian,
+            f.step,
+            f.natoms,
+            f.triclinic,
+            f.box_at,
+            f.size_one,
+            f.units,
+            f.time_flag,
+            f.columns,
+            f.nchunk,
+            f.end,
+        ]);
+        for &(count, values, _) in &f.chunks {
+            boundaries.extend([count, values]);
+        }
+        ends.push(f.end);
+    }
+    let mut fields = Vec::new();
+    for f in [&frames[0], frames.last().unwrap()] {
+        fields.extend([
+            ("magic length", Field::I32Le(f.start)),
+            ("endian flag", Field::I32Le(f.endian)),
+            ("revision", Field::I32Le(f.revision)),
+            ("timestep", Field::I32Le(f.step)),
+            ("natoms", Field::I32Le(f.natoms)),
+            ("triclinic flag", Field::I32Le(f.triclinic)),
+            ("boundary xlo", Field::I32Le(f.boundary)),
+            ("box xlo", Field::F64Le(f.box_at)),
+            ("box xhi", Field::F64Le(f.box_at + 8)),
+            ("size_one", Field::I32Le(f.size_one)),
+            ("units length", Field::I32Le(f.units)),
+            ("columns length", Field::I32Le(f.columns)),
+            ("nchunk", Field::I32Le(f.nchunk)),
+        ]);
+        if let Some(t) = f.time {
+            fields.push(("time", Field::F64Le(t)));
+        }
+        if let Some(&(count, values, n)) = f.chunks.first() {
+            fields.push(("chunk 0 count", Field::I32Le(count)));
+            if n > 0 {
+                fields.push(("atom 0 first value", Field::F64Le(values)));
+            }
+        }
+    }
+    Fixture {
+        frames: frames_of(Format::LammpsBin, &bytes),
+        name: name.into(),
+        bytes,
+        boundaries,
+        cuts: Cuts::FrameEnds(ends),
+        fields,
+        text: false,
+    }
+}
+
+/// A LAMMPS binary dump in an older LAMMPS's layout (no magic header, no names: `dump atom`'s
+/// default columns are assumed), little-endian: each frame's chunk count and end as boundaries,
+/// frame 0's header fields as fields.
+fn lammps_bin_bare_fixture(name: &str, bytes: Vec<u8>) -> Fixture {
+    let frames = walk_bare(&bytes);
+    let mut boundaries = vec![0];
+    let mut ends = vec![0];
+    for &(end, nchunk) in &frames {
+        boundaries.extend([nchunk, nchunk + 4, end]);
+        ends.push(end);
+    }
+    let fields = vec![
+        ("timestep", Field::I32Le(0)),
+        ("natoms", Field::I32Le(8)),
+        ("triclinic flag", Field::I32Le(16)),
+        ("boundary xlo", Field::I32Le(20)),
+        ("box xlo", Field::F64Le(44)),
+        ("size_one", Field::I32Le(frames[0].1 - 4)),
+        ("nchunk", Field::I32Le(frames[0].1)),
+        ("chunk 0 count", Field::I32Le(frames[0].1 + 4)),
+        ("atom 0 xs", Field::F64Le(frames[0].1 + 8 + 16)),
+    ];
+    Fixture {
+        frames: frames_of(Format::LammpsBin, &bytes),
+        name: name.into(),
+        bytes,
+        boundaries,
+        cuts: Cuts::FrameEnds(ends),
+        fields,
+        text: false,
+    }
+}
+
 /// A text file: every line start as a boundary, its first 16 numeric tokens (counts, box,
 /// coordinates) as fields.
 fn text_fixture(name: &str, format: Format) -> Fixture {
@@ -576,6 +677,37 @@ fn trr_campaign() {
         "TRR",
         Format::Trr,
         vec![trr_fixture("trr_mda.trr", data("trr_mda.trr"))],
+    );
+}
+
+/// LAMMPS binary dumps written by LAMMPS (tests/data/lammps_bin/gen.sh): 2 chunks per frame,
+/// a triclinic box with a changing atom count (one frame empty), dump atom's scaled columns;
+/// and dump atom's frames in an older LAMMPS's layout, both byte orders.
+#[test]
+fn lammps_bin_campaign() {
+    let bin = |name: &str| data(&format!("lammps_bin/{name}"));
+    let atom = bin("atom_np1.bin");
+    let bare_le = rewrite(&atom, Layout::Bare, false);
+    let bare_be = rewrite(&atom, Layout::Bare, true);
+    let mut be = lammps_bin_bare_fixture("atom_np1_bare_be.bin", bare_le.clone());
+    // The same boundaries serve the big-endian twin (same sizes); its fields are big-endian.
+    be.bytes = bare_be;
+    be.fields = vec![
+        ("natoms", Field::I32Be(12)),
+        ("triclinic flag", Field::I32Be(16)),
+        ("size_one", Field::I32Be(be.boundaries[1] - 4)),
+        ("nchunk", Field::I32Be(be.boundaries[1])),
+    ];
+    campaign(
+        "LAMMPS binary dump",
+        Format::LammpsBin,
+        vec![
+            lammps_bin_fixture("custom_np2.bin", bin("custom_np2.bin")),
+            lammps_bin_fixture("tri_np2.bin", bin("tri_np2.bin")),
+            lammps_bin_fixture("atom_np1.bin", atom),
+            lammps_bin_bare_fixture("atom_np1_bare.bin", bare_le),
+            be,
+        ],
     );
 }
 

@@ -229,7 +229,7 @@ fn allow_truncated_keeps_the_complete_frames_of_a_cut_gz() {
         let mut seen = std::collections::BTreeSet::new();
         for cut in (20..gz.len()).step_by(gz.len() / 40) {
             let p = put(&dir, fixture, &gz[..cut]);
-            let mut t = Trajectory::open_with(&p, lenient).unwrap();
+            let mut t = Trajectory::open_with(&p, lenient.clone()).unwrap();
             let (got, k) = frames(&mut t);
             assert!(k <= n, "{fixture} cut at {cut}");
             assert!(
@@ -252,7 +252,7 @@ fn allow_truncated_keeps_the_complete_frames_of_a_cut_gz() {
         );
         // Only the trailer missing: every frame inflated, the cut still reported.
         let p = put(&dir, fixture, &gz[..gz.len() - 4]);
-        let mut t = Trajectory::open_with(&p, lenient).unwrap();
+        let mut t = Trajectory::open_with(&p, lenient.clone()).unwrap();
         assert_eq!(frames(&mut t).1, n);
         assert!(warnings(&t)[0].contains("gzip"));
     }
@@ -374,8 +374,8 @@ fn bzip2_reads_as_the_plain_file_and_cuts_are_located() {
     let opts = ReadOptions::new().atoms(66);
     let bz = path("amber_ascii/box.mdcrd.bz2");
     let (want, n) =
-        frames(&mut Trajectory::open_with(path("amber_ascii/box.mdcrd"), opts).unwrap());
-    let mut t = Trajectory::open_with(&bz, opts).unwrap();
+        frames(&mut Trajectory::open_with(path("amber_ascii/box.mdcrd"), opts.clone()).unwrap());
+    let mut t = Trajectory::open_with(&bz, opts.clone()).unwrap();
     assert_eq!(t.format(), Format::AmberTrj);
     let (got, k) = frames(&mut t);
     assert_eq!((k, &got), (n, &want));
@@ -394,13 +394,15 @@ fn bzip2_reads_as_the_plain_file_and_cuts_are_located() {
     let mut kept = std::collections::BTreeSet::new();
     for cut in (10..bytes.len()).step_by(97).filter(|&c| c != second) {
         let p = put(&dir, "cut.mdcrd.bz2", &bytes[..cut]);
-        let e = Trajectory::open_with(&p, opts).map(|_| ()).unwrap_err();
+        let e = Trajectory::open_with(&p, opts.clone())
+            .map(|_| ())
+            .unwrap_err();
         let Error::Parse { at, .. } = &e else {
             panic!("cut at {cut}: {e:?}");
         };
         assert!(e.to_string().contains("bzip2"), "{e}");
         assert!(at.byte.unwrap() <= cut as u64, "cut at {cut}: {e}");
-        let mut t = Trajectory::open_with(&p, opts.allow_truncated(true)).unwrap();
+        let mut t = Trajectory::open_with(&p, opts.clone().allow_truncated(true)).unwrap();
         let (got, k) = frames(&mut t);
         assert!(got[..] == want[..k], "cut at {cut}: frames differ");
         assert!(warnings(&t)[0].contains("bzip2"), "cut at {cut}");
@@ -414,6 +416,8 @@ fn bzip2_reads_as_the_plain_file_and_cuts_are_located() {
         "plain.mdcrd.bz2",
         &std::fs::read(path("amber_ascii/box.mdcrd")).unwrap(),
     );
-    let e = Trajectory::open_with(&p, opts).map(|_| ()).unwrap_err();
+    let e = Trajectory::open_with(&p, opts.clone())
+        .map(|_| ())
+        .unwrap_err();
     assert!(e.to_string().contains("bzip2 magic"), "{e}");
 }

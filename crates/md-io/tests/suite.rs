@@ -9,6 +9,7 @@ mod support {
     pub mod campaign;
     pub mod fixtures;
     pub mod gsd_index;
+    pub mod lammps_bin;
     pub mod ovito;
 }
 

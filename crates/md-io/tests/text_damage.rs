@@ -388,7 +388,7 @@ fn allow_truncated_streams_every_cut_to_its_complete_frames() {
         let mut errors = Vec::new();
         for cut in 1..good.len() {
             let src = Cursor::new(good[..cut].to_vec());
-            let mut t = Trajectory::from_reader_with(src, format, "cut", lenient).unwrap();
+            let mut t = Trajectory::from_reader_with(src, format, "cut", lenient.clone()).unwrap();
             let complete = ends.iter().filter(|e| **e <= cut).count();
             let mut f = Frame::new();
             let mut got = 0;
