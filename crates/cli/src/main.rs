@@ -15,6 +15,7 @@ mod scene;
 mod tables;
 mod terrain;
 mod terrain_fly;
+mod terrain_grid;
 mod terrain_models;
 mod terrain_view;
 mod terrain_viewshed;

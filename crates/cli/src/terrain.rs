@@ -1,4 +1,4 @@
-//! `texmap terrain build | info | export | maps | render | viewshed | fly | compare`: glue between files, texmap-terrain and the terminal.
+//! `texmap terrain build | info | export | maps | render | viewshed | grid | fly | compare`: glue between files, texmap-terrain and the terminal.
 
 use std::path::PathBuf;
 
@@ -18,13 +18,14 @@ pub enum TerrainCmd {
     Build {
         /// Elevation grid: GeoTIFF, ESRI ASCII (.asc), SRTM (.hgt), DTED (.dt0, .dt1, .dt2), ESRI
         /// GridFloat (.flt) or BIL (.bil) with its .hdr and .prj, 16-bit PNG, or Mapbox Terrain-RGB
-        /// or Terrarium PNG (--terrain-rgb, --terrarium). Several grids that tile an area (e.g.
-        /// `--dem N44W072.hgt N44W071.hgt`) are joined as gdalbuildvrt joins them: one system,
-        /// cell size and lattice; the later file wins where they overlap, and samples no file
-        /// covers are no-data. Web-map elevation tiles stored as Z/X/Y.png (`--dem
-        /// tiles/12/1205/1539.png tiles/12/1206/1539.png`, or a directory of them) are placed in
-        /// Web Mercator (EPSG:3857) by their address, XYZ scheme, the tile's bounds the outer
-        /// edges of its pixels; tiles of one zoom only.
+        /// or Terrarium PNG (--terrain-rgb, --terrarium); or a lidar point cloud, LAS or LAZ
+        /// (`--dem survey.laz`, several tiles one cloud), gridded as --lidar-* says. Several grids
+        /// that tile an area (e.g. `--dem N44W072.hgt N44W071.hgt`) are joined as gdalbuildvrt
+        /// joins them: one system, cell size and lattice; the later file wins where they overlap,
+        /// and samples no file covers are no-data. Web-map elevation tiles stored as Z/X/Y.png
+        /// (`--dem tiles/12/1205/1539.png tiles/12/1206/1539.png`, or a directory of them) are
+        /// placed in Web Mercator (EPSG:3857) by their address, XYZ scheme, the tile's bounds the
+        /// outer edges of its pixels; tiles of one zoom only.
         #[arg(long, num_args = 1.., required = true)]
         dem: Vec<PathBuf>,
         /// Orthophoto (PNG, JPEG or GeoTIFF), placed by its georeference or stretched. A GeoTIFF in
@@ -108,6 +109,8 @@ pub enum TerrainCmd {
         /// Output directory (must not exist).
         #[arg(long)]
         out: PathBuf,
+        #[command(flatten)]
+        lidar: crate::terrain_grid::LidarArgs,
     },
     /// Print a grid's or a database's size, georeference, height range, no-data count, levels and
     /// triangles per level as one JSON object.
@@ -172,6 +175,8 @@ pub enum TerrainCmd {
     Render(crate::terrain_view::RenderArgs),
     /// What an observer on the terrain sees (viewshed, as gdal_viewshed): a GeoTIFF mask.
     Viewshed(crate::terrain_viewshed::ViewshedArgs),
+    /// Grid lidar point clouds (LAS, LAZ) into a DEM GeoTIFF, as PDAL's writers.gdal does.
+    Grid(crate::terrain_grid::GridArgs),
     /// Fly a path file (or an orbit) over the database: PNG frames or a movie, with a progress bar.
     Fly(crate::terrain_fly::FlyArgs),
     /// Every sampler against the supersampled ray-traced reference along a flight path: CSV,
@@ -202,6 +207,7 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
             fill,
             ignore_checksums,
             out,
+            lidar,
         } => {
             let bands = match bands {
                 None => None,
@@ -256,8 +262,9 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
                 tile,
                 tms,
                 verify_checksums: !ignore_checksums,
+                ..ReadOptions::default()
             };
-            let parts = dem::read_dems(&dem, &opts)?;
+            let parts = crate::terrain_grid::read_dems(&dem, opts, &lidar)?;
             let names: Vec<String> = parts.iter().map(|p| p.0.clone()).collect();
             let (mut grid, overlaps) = dem::mosaic::mosaic(parts)?;
             for o in &overlaps {
@@ -475,6 +482,7 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
         }
         TerrainCmd::Render(a) => crate::terrain_view::run(a),
         TerrainCmd::Viewshed(a) => crate::terrain_viewshed::run(a),
+        TerrainCmd::Grid(a) => crate::terrain_grid::run(a),
         TerrainCmd::Fly(a) => crate::terrain_fly::run_fly(a),
         TerrainCmd::Compare(a) => crate::terrain_fly::run_compare(a),
         TerrainCmd::Maps {

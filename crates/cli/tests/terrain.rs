@@ -1,5 +1,6 @@
 //! `texmap terrain ...` end to end on DEMs GDAL wrote (crates/terrain/tests/data): what a script
-//! sees — files, JSON, exit codes.
+//! sees — files, JSON, exit codes; and lidar point clouds gridded to GeoTIFF and built into
+//! databases.
 
 use std::path::{Path, PathBuf};
 use std::process::Output;
@@ -1070,4 +1071,123 @@ fn viewshed_writes_gdals_mask_and_refuses_bad_observers() {
         .filter(|e| e.file_name().to_string_lossy().contains("partial"))
         .collect();
     assert!(leftovers.is_empty(), "{leftovers:?}");
+}
+
+#[test]
+fn lidar_clouds_grid_to_geotiffs_and_build_databases() {
+    use texmap_terrain::dem::lidar::{LidarMethod, LidarOptions, read_lidar};
+    use texmap_terrain::dem::{ReadOptions, read_dem};
+    let dir = tempfile::tempdir().unwrap();
+    let laz = data("lidar/lidar_12.laz");
+    // `terrain grid` writes the grid the library makes, with its georeference.
+    let tif = dir.path().join("dem.tif");
+    let tif_s = tif.to_str().unwrap();
+    let o = texmap(&[
+        "terrain",
+        "grid",
+        &laz,
+        "-o",
+        tif_s,
+        "--lidar-cell",
+        "10",
+        "--lidar-method",
+        "idw",
+    ]);
+    ok(&o);
+    let back = read_dem(&tif, &ReadOptions::default()).unwrap();
+    let opts = LidarOptions {
+        cell: Some(10.0),
+        method: LidarMethod::Idw,
+        ..LidarOptions::default()
+    };
+    let (direct, _, _) = read_lidar(&[PathBuf::from(&laz)], &opts).unwrap();
+    let (a, b) = (back.georef(), direct.georef());
+    assert_eq!((a.crs, a.epsg, a.dx, a.dy), (b.crs, b.epsg, b.dx, b.dy));
+    assert!((a.origin_x - b.origin_x).abs() < 1e-6 && (a.origin_y - b.origin_y).abs() < 1e-6);
+    let bits =
+        |g: &texmap_terrain::dem::Grid| g.heights().iter().map(|h| h.to_bits()).collect::<Vec<_>>();
+    assert_eq!(
+        bits(&back),
+        bits(&direct),
+        "the GeoTIFF holds the grid's f32 heights"
+    );
+    assert_eq!(back.nodata_count(), 6);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("1803 gridded: ground (class 2)"), "{err}");
+    assert!(
+        err.contains("30 x 24 cells of 10 m, the idw of the points"),
+        "{err}"
+    );
+
+    // `terrain build --dem x.laz`: a database of the gridded cloud, holes filled.
+    let db = dir.path().join("area.db");
+    let o = texmap(&[
+        "terrain",
+        "build",
+        "--dem",
+        &data("lidar/lidar_14.laz"),
+        "--lidar-fill",
+        "2",
+        "--out",
+        db.to_str().unwrap(),
+    ]);
+    ok(&o);
+    let o = texmap(&["terrain", "info", db.to_str().unwrap()]);
+    ok(&o);
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(
+        (v["width"].as_u64(), v["height"].as_u64()),
+        (Some(30), Some(24))
+    );
+    assert_eq!(v["nodata"], 0);
+    assert_eq!(v["georef"]["epsg"], 32619);
+
+    // Bad options are usage errors (exit 2); a damaged file is a runtime error naming it (1).
+    let las = data("lidar/lidar_12.las");
+    let png = dir.path().join("x.png");
+    for bad in [
+        vec!["terrain", "grid", &las, "-o", png.to_str().unwrap()],
+        vec![
+            "terrain",
+            "grid",
+            &las,
+            "-o",
+            tif_s,
+            "--lidar-method",
+            "median",
+        ],
+        vec!["terrain", "grid", &las, "-o", tif_s, "--lidar-cell", "0"],
+        vec![
+            "terrain",
+            "grid",
+            &las,
+            "-o",
+            tif_s,
+            "--lidar-classes",
+            "2,x",
+        ],
+        vec!["terrain", "grid", &las, "-o", tif_s, "--lidar-fill", "1000"],
+        vec!["terrain", "grid", &las, "-o", tif_s, "--lidar-radius", "-1"],
+        vec!["terrain", "grid", "-o", tif_s],
+    ] {
+        let o = texmap(&bad);
+        assert_eq!(o.status.code(), Some(2), "{bad:?}");
+    }
+    let o = texmap(&[
+        "terrain",
+        "build",
+        "--dem",
+        &data("hillshade_dem_utm.tif"),
+        "--lidar-cell",
+        "2",
+        "--out",
+        dir.path().join("x.db").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let cut = dir.path().join("cut.laz");
+    let bytes = std::fs::read(&laz).unwrap();
+    std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
+    let o = texmap(&["terrain", "grid", cut.to_str().unwrap(), "-o", tif_s]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("cut.laz"));
 }

@@ -240,6 +240,44 @@ fn record(c: &[u8], base: usize) -> Result<Feature, (usize, String)> {
     Ok(feature)
 }
 
+/// The EPSG code of a WKT's outermost system, when it names one: WKT 1's `AUTHORITY["EPSG","32619"]`
+/// or WKT 2's `ID["EPSG",32619]` as a direct child of the outermost system (a unit's, datum's or
+/// ellipsoid's code does not count). Also the LAS reader's, for a point cloud's WKT record
+/// ([`crate::dem::las`]).
+pub(crate) fn wkt_epsg(wkt: &str) -> Option<u32> {
+    let wkt = wkt.trim().trim_end_matches('\0').trim_end();
+    // The keyword `AUTHORITY[` or `ID[` that starts a word (`ELLIPSOID[` ends in `ID[`) one
+    // bracket deep: a child of the outermost system, not of its datum, unit or ellipsoid.
+    let bytes = wkt.as_bytes();
+    let (mut depth, mut quoted, mut at) = (0i32, false, None);
+    for (i, &b) in bytes.iter().enumerate() {
+        match b {
+            b'"' => quoted = !quoted,
+            b'[' | b'(' if !quoted => depth += 1,
+            b']' | b')' if !quoted => depth -= 1,
+            _ if !quoted && depth == 1 => {
+                let word =
+                    i == 0 || !(bytes[i - 1].is_ascii_alphanumeric() || bytes[i - 1] == b'_');
+                let rest = &bytes[i..];
+                if word && (rest.starts_with(b"AUTHORITY[") || rest.starts_with(b"ID[")) {
+                    at = Some(i);
+                }
+            }
+            _ => {}
+        }
+    }
+    let rest = &wkt[at?..];
+    let open = rest.find('[')?;
+    let close = rest.find(']')?;
+    let mut fields = rest[open + 1..close].split(',');
+    let authority = fields.next()?.trim().trim_matches('"');
+    let code = fields.next()?.trim().trim_matches('"').trim();
+    authority
+        .eq_ignore_ascii_case("EPSG")
+        .then(|| code.parse().ok())
+        .flatten()
+}
+
 /// The layer system a `.prj`'s WKT names (see the module docs; also the `.prj` of an ESRI
 /// `.hdr` raster, [`crate::dem::ehdr`]). A system texmap does not place is refused by name, with
 /// the hint to convert it with `tool` (`ogr2ogr` for vectors, `gdalwarp` for rasters).
@@ -258,17 +296,8 @@ pub(crate) fn crs_of_wkt(wkt: &str, tool: &str) -> Result<LayerCrs, String> {
              Mercator), found \"{name}\" (convert with {tool} -t_srs EPSG:4326)"
         )
     };
-    // OGC WKT: the outermost system's AUTHORITY is the last one in the text.
-    if let Some(i) = wkt.rfind("AUTHORITY[") {
-        let rest = &wkt[i..];
-        let code: Option<u32> = rest.split('"').nth(3).and_then(|c| c.trim().parse().ok());
-        // Only when the AUTHORITY closes the whole system (not a unit's or datum's).
-        let closes = rest
-            .find(']')
-            .is_some_and(|j| rest[j + 1..].trim().trim_end_matches(']').is_empty());
-        if let (Some(code), true) = (code, closes) {
-            return layer_crs_of_epsg(code).map_err(|_| refuse());
-        }
+    if let Some(code) = wkt_epsg(wkt) {
+        return layer_crs_of_epsg(code).map_err(|_| refuse());
     }
     let upper = name.to_ascii_uppercase().replace([' ', '-'], "_");
     let datum = if upper.contains("WGS_1984") || upper.contains("WGS_84") || upper.contains("WGS84")
@@ -337,6 +366,14 @@ mod tests {
             crs_of_wkt(wm, "ogr2ogr"),
             Ok(LayerCrs::Epsg(3857, _))
         ));
+        // WKT 2 (PROJ's and pyproj's default): the outermost ID, not the ellipsoid's.
+        let wkt2 = r#"PROJCRS["WGS 84 / UTM zone 19N",BASEGEOGCRS["WGS 84",DATUM["World Geodetic System 1984",ELLIPSOID["WGS 84",6378137,298.257223563,LENGTHUNIT["metre",1]]],ID["EPSG",4326]],CONVERSION["UTM zone 19N",METHOD["Transverse Mercator",ID["EPSG",9807]]],ID["EPSG",32619]]"#;
+        assert_eq!(wkt_epsg(wkt2), Some(32619));
+        assert_eq!(wkt_epsg(ogc), Some(32619));
+        assert_eq!(wkt_epsg(esri_utm), None);
+        let ellipsoid_only =
+            r#"GEOGCRS["x",ELLIPSOID["WGS 84",6378137,298.257223563,ID["EPSG",7030]]]"#;
+        assert_eq!(wkt_epsg(ellipsoid_only), None);
         let deg = r#"GEOGCS["GCS_WGS_1984",DATUM["D_WGS_1984"]]"#;
         assert_eq!(crs_of_wkt(deg, "ogr2ogr"), Ok(LayerCrs::Lonlat));
         let lambert = r#"PROJCS["RGF93_Lambert_93",GEOGCS["GCS_RGF_1993"]]"#;

@@ -9,6 +9,10 @@
 //! encoder) and Terrarium tiles that numpy encoded from GDAL's reprojection of the SRTM tile onto
 //! zoom-10 XYZ tiles in EPSG:3857 are placed, tile by tile and joined, where GDAL placed them
 //! (`xyz/*.gdalinfo.json`), with GDAL's heights to within the encodings' steps.
+//!
+//! Lidar point clouds (tests/data/lidar/gen_lidar.py): LAS 1.2 and 1.4 and LAZ that laspy and
+//! LASzip wrote, read as laspy reads them and gridded as gdal_grid and PDAL's rule (numpy) grid
+//! them.
 
 use std::io::Read;
 use std::path::{Path, PathBuf};
@@ -774,4 +778,629 @@ fn bad_tiles_are_errors_naming_the_file() {
         .unwrap_err()
         .to_string();
     assert!(e.contains(empty.path().to_str().unwrap()), "{e}");
+}
+
+// Lidar point clouds (tests/data/lidar/gen_lidar.py): a survey over the SRTM terrain written by
+// laspy as LAS 1.2 (format 1, GeoKeys) and 1.4 (format 6, WKT) and by LASzip as LAZ, read as
+// laspy reads them (lidar_laspy.json) and gridded as gdal_grid (lidar_gdal_*.asc) and PDAL's
+// rule in numpy (lidar_numpy.txt) grid them.
+
+use texmap_terrain::dem::las::{CrsRecord, LasPoint, LasReader};
+use texmap_terrain::dem::lidar::{
+    self, ClassSet, Cloud, LidarMethod, LidarOptions, Selection, grid_cloud, read_lidar,
+};
+
+const LIDAR: [&str; 4] = [
+    "lidar/lidar_12.las",
+    "lidar/lidar_14.las",
+    "lidar/lidar_12.laz",
+    "lidar/lidar_14.laz",
+];
+
+fn all_points(path: &Path) -> Vec<LasPoint> {
+    let mut r = LasReader::open(path).unwrap_or_else(|e| panic!("{e}"));
+    let (mut all, mut batch) = (Vec::new(), Vec::new());
+    while r.read_batch(&mut batch).unwrap_or_else(|e| panic!("{e}")) > 0 {
+        all.extend_from_slice(&batch);
+    }
+    all
+}
+
+fn cell10(method: LidarMethod) -> LidarOptions {
+    LidarOptions {
+        cell: Some(10.0),
+        method,
+        ..LidarOptions::default()
+    }
+}
+
+/// The same size, georeference and sample bits (no-data included, which `==` on NaN misses).
+fn same_grid(a: &Grid, b: &Grid) -> bool {
+    let bits = |g: &Grid| g.heights().iter().map(|h| h.to_bits()).collect::<Vec<_>>();
+    (a.width(), a.height(), a.georef()) == (b.width(), b.height(), b.georef()) && bits(a) == bits(b)
+}
+
+fn grid_of(paths: &[PathBuf], opts: &LidarOptions) -> Grid {
+    read_lidar(paths, opts).unwrap_or_else(|e| panic!("{e}")).0
+}
+
+#[test]
+fn lidar_files_read_as_laspy_reads_them() {
+    let text = std::fs::read_to_string(data("lidar/lidar_laspy.json")).unwrap();
+    let refs: serde_json::Value = serde_json::from_str(&text).unwrap();
+    for name in LIDAR {
+        let path = data(name);
+        let want = &refs[name.trim_start_matches("lidar/")];
+        let r = LasReader::open(&path).unwrap();
+        let h = r.header().clone();
+        let f = |v: &serde_json::Value| v.as_f64().unwrap();
+        assert_eq!(
+            format!("{}.{}", h.version.0, h.version.1),
+            want["version"].as_str().unwrap(),
+            "{name}"
+        );
+        assert_eq!(
+            h.point_format as u64,
+            want["point_format"].as_u64().unwrap()
+        );
+        assert_eq!(
+            h.compressed,
+            want["compressed"].as_bool().unwrap(),
+            "{name}"
+        );
+        assert_eq!(
+            h.point_count,
+            want["point_count"].as_u64().unwrap(),
+            "{name}"
+        );
+        for k in 0..3 {
+            // The header's doubles as stored (serde_json's parsing of laspy's shortest
+            // round-trip digits may be an ulp off: 1e-9 is a thousandth of a scale step).
+            for (got, key) in [
+                (h.scale[k], "scales"),
+                (h.offset[k], "offsets"),
+                (h.min[k], "mins"),
+                (h.max[k], "maxs"),
+            ] {
+                let exp = f(&want[key][k]);
+                assert!(
+                    (got - exp).abs() <= 1e-9,
+                    "{name} {key}[{k}]: expected {exp}, got {got}, tolerance 1e-9"
+                );
+            }
+        }
+        // pyproj's reading of the GeoKeys (LAS 1.2), the WKT 1 VLR (1.4) and the WKT 2 EVLR
+        // (the 1.4 LAZ).
+        assert_eq!(h.crs, CrsKind::Projected, "{name}");
+        assert_eq!(h.epsg.map(u64::from), want["epsg"].as_u64(), "{name}");
+        let record = if name.contains("_12") {
+            CrsRecord::GeoKeys
+        } else {
+            CrsRecord::Wkt
+        };
+        assert_eq!(h.crs_record, record, "{name}");
+
+        let pts = all_points(&path);
+        assert_eq!(pts.len() as u64, h.point_count);
+        // The first and last points: laspy's `X·scale + offset` in float64, the same operations
+        // as ours, so the same doubles (a tolerance of 1e-9 m would hide nothing real).
+        for (p, key) in [(pts[0], "first"), (pts[pts.len() - 1], "last")] {
+            let w = &want[key];
+            for (got, field) in [(p.x, "x"), (p.y, "y"), (p.z, "z")] {
+                let exp = f(&w[field]);
+                assert!(
+                    (got - exp).abs() <= 1e-9,
+                    "{name} {key} {field}: expected {exp}, got {got}, tolerance 1e-9"
+                );
+            }
+            assert_eq!(p.class as u64, w["class"].as_u64().unwrap());
+            assert_eq!(p.return_number as u64, w["return_number"].as_u64().unwrap());
+            assert_eq!(
+                p.number_of_returns as u64,
+                w["number_of_returns"].as_u64().unwrap()
+            );
+            assert_eq!(p.withheld, w["withheld"].as_bool().unwrap());
+        }
+        // Every point: the sums of the stored integers, the classes, withheld and last returns.
+        let raw = |v: f64, k: usize| ((v - h.offset[k]) / h.scale[k]).round() as i64;
+        for (k, key) in ["sum_X", "sum_Y", "sum_Z"].iter().enumerate() {
+            let sum: i64 = pts.iter().map(|p| raw([p.x, p.y, p.z][k], k)).sum();
+            assert_eq!(sum, want[key].as_i64().unwrap(), "{name} {key}");
+        }
+        let mut classes = std::collections::BTreeMap::new();
+        for p in &pts {
+            *classes.entry(p.class.to_string()).or_insert(0u64) += 1;
+        }
+        for (c, n) in want["classes"].as_object().unwrap() {
+            assert_eq!(classes.get(c), n.as_u64().as_ref(), "{name} class {c}");
+        }
+        assert_eq!(classes.len(), want["classes"].as_object().unwrap().len());
+        let withheld = pts.iter().filter(|p| p.withheld).count() as u64;
+        let last = pts.iter().filter(|p| p.is_last_return()).count() as u64;
+        assert_eq!(withheld, want["withheld"].as_u64().unwrap(), "{name}");
+        assert_eq!(last, want["last_returns"].as_u64().unwrap(), "{name}");
+    }
+}
+
+/// An ESRI ASCII grid's header and values as doubles (the f32 reader would round GDAL's six
+/// decimals).
+fn asc_f64(path: &Path) -> (Vec<(String, f64)>, Vec<f64>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let head: Vec<(String, f64)> = (0..6)
+        .map(|_| {
+            let mut it = lines.next().unwrap().split_whitespace();
+            (
+                it.next().unwrap().to_ascii_lowercase(),
+                it.next().unwrap().parse().unwrap(),
+            )
+        })
+        .collect();
+    let values = lines
+        .flat_map(|l| l.split_whitespace())
+        .map(|v| v.parse::<f64>().unwrap())
+        .collect();
+    (head, values)
+}
+
+/// lidar_numpy.txt: per cell (row, col) the count, mean, min, max, idw, window-filled mean and
+/// whether a point lies on the radius.
+fn numpy_cells() -> Vec<(usize, usize, u32, [f64; 5], bool)> {
+    let text = std::fs::read_to_string(data("lidar/lidar_numpy.txt")).unwrap();
+    text.lines()
+        .filter(|l| !l.starts_with('#'))
+        .map(|l| {
+            let v: Vec<&str> = l.split_whitespace().collect();
+            let f = |i: usize| v[i].parse::<f64>().unwrap();
+            (
+                v[0].parse().unwrap(),
+                v[1].parse().unwrap(),
+                v[2].parse().unwrap(),
+                [f(3), f(4), f(5), f(6), f(7)],
+                v[8] == "1",
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn lidar_grids_match_gdal_grid_and_pdals_rule() {
+    let cells = numpy_cells();
+    let las = [data("lidar/lidar_12.las")];
+    // f32 samples of heights near 1,850 m are 1.2e-4 apart: half a step plus the references'
+    // printed digits (1e-9 numpy, 1e-6 GDAL) stays under 1e-4.
+    let tol = 1e-4;
+    let mut report = String::new();
+    for (k, (method, gdal)) in [
+        (LidarMethod::Mean, "average"),
+        (LidarMethod::Min, "minimum"),
+        (LidarMethod::Max, "maximum"),
+        (LidarMethod::Idw, "invdist"),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let g = grid_of(&las, &cell10(method));
+        assert_eq!((g.width(), g.height()), (30, 24));
+        // GDAL's lattice: -txe/-tye at the cells' edges, so its corner is half a cell from our
+        // first sample's centre.
+        let (head, gv) = asc_f64(&data(&format!("lidar/lidar_gdal_{gdal}.asc")));
+        let hv = |k: &str| head.iter().find(|(n, _)| n == k).unwrap().1;
+        let geo = g.georef();
+        assert_eq!(geo.origin_x, hv("xllcorner") + 5.0);
+        assert_eq!(geo.origin_y, hv("yllcorner") + 24.0 * 10.0 - 5.0);
+        assert_eq!((geo.dx, geo.dy), (hv("cellsize"), -hv("cellsize")));
+        let (mut same_np, mut same_gdal, mut boundary) = (0, 0, 0);
+        let (mut worst_np, mut worst_gdal, mut differ) = (0f64, 0f64, 0);
+        for &(row, col, count, ref v, on_radius) in &cells {
+            let ours = g.at(col as u32, row as u32) as f64;
+            let np = v[k];
+            assert_eq!(ours.is_nan(), count == 0, "{gdal} ({col}, {row})");
+            if count == 0 {
+                assert!(np.is_nan());
+                same_np += 1;
+            } else {
+                assert!(
+                    (ours - np).abs() <= tol,
+                    "{gdal} ({col}, {row}): PDAL's rule (numpy) {np}, ours {ours}, tolerance {tol}"
+                );
+                worst_np = worst_np.max((ours - np).abs());
+                same_np += 1;
+            }
+            let gd = gv[row * 30 + col];
+            let gd = if gd == -9999.0 { f64::NAN } else { gd };
+            if on_radius {
+                // A point exactly R from the centre: GDAL counts it (≤), PDAL does not (<).
+                boundary += 1;
+                differ += ((ours - gd).abs() > tol) as u32;
+                continue;
+            }
+            if ours.is_nan() {
+                assert!(
+                    gd.is_nan(),
+                    "{gdal} ({col}, {row}): GDAL {gd}, ours no-data"
+                );
+            } else {
+                assert!(
+                    (ours - gd).abs() <= tol,
+                    "{gdal} ({col}, {row}): gdal_grid {gd}, ours {ours}, tolerance {tol}"
+                );
+                worst_gdal = worst_gdal.max((ours - gd).abs());
+            }
+            same_gdal += 1;
+        }
+        report.push_str(&format!(
+            "{gdal}: {same_np}/{} cells as PDAL's rule (largest difference {worst_np:.1e} m), \
+             {same_gdal} as gdal_grid ({worst_gdal:.1e} m), {boundary} with a point on the radius \
+             ({differ} of them differing from gdal_grid's)\n",
+            cells.len()
+        ));
+        assert_eq!(
+            boundary, 12,
+            "three points on cell centres, four diagonal neighbours each"
+        );
+    }
+    // PDAL's window_size = 2 fill of the mean grid.
+    let g = grid_of(
+        &las,
+        &LidarOptions {
+            fill: 2,
+            ..cell10(LidarMethod::Mean)
+        },
+    );
+    let mut filled = 0;
+    for &(row, col, count, ref v, _) in &cells {
+        let ours = g.at(col as u32, row as u32) as f64;
+        assert!(
+            (ours - v[4]).abs() <= tol,
+            "fill2 ({col}, {row}): numpy {}, ours {ours}",
+            v[4]
+        );
+        filled += (count == 0) as u32;
+    }
+    assert_eq!(filled, 6, "the building's and the pond's empty cells");
+    assert_eq!(g.nodata_count(), 0);
+    eprintln!("{report}");
+}
+
+#[test]
+fn lidar_las_and_laz_of_one_survey_grid_alike() {
+    let grids: Vec<Grid> = LIDAR
+        .iter()
+        .map(|n| grid_of(&[data(n)], &cell10(LidarMethod::Idw)))
+        .collect();
+    for (g, n) in grids.iter().zip(LIDAR) {
+        assert!(
+            same_grid(g, &grids[0]),
+            "{n} grids otherwise than {}",
+            LIDAR[0]
+        );
+    }
+    // Two files are one cloud: the survey twice over gives the same means, min and max.
+    let twice = [data(LIDAR[0]), data(LIDAR[3])];
+    for m in [LidarMethod::Mean, LidarMethod::Min, LidarMethod::Max] {
+        let one = grid_of(&[data(LIDAR[0])], &cell10(m));
+        let two = grid_of(&twice, &cell10(m));
+        for (a, b) in one.heights().iter().zip(two.heights()) {
+            assert!(
+                a.is_nan() && b.is_nan() || (a - b).abs() <= 1e-4,
+                "{a} vs {b}"
+            );
+        }
+    }
+    // read_dem and read_dems: by extension, and the files as one grid named by both.
+    let g = read_dem(
+        data(LIDAR[2]),
+        &ReadOptions {
+            lidar: cell10(LidarMethod::Idw),
+            ..ReadOptions::default()
+        },
+    )
+    .unwrap();
+    assert!(same_grid(&g, &grids[0]));
+    let parts = read_dems(
+        &twice,
+        &ReadOptions {
+            lidar: cell10(LidarMethod::Mean),
+            ..ReadOptions::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(parts.len(), 1);
+    assert!(parts[0].0.contains("lidar_12.las + ") && parts[0].0.ends_with("lidar_14.laz"));
+    assert_eq!(
+        DemFormat::from_path(Path::new("a.LAZ")),
+        Some(DemFormat::Las)
+    );
+}
+
+#[test]
+fn lidar_points_are_chosen_by_class_return_and_withheld_flag() {
+    let las = [data("lidar/lidar_14.las")];
+    let default = LidarOptions::default();
+    let (cloud, r) = lidar::read_cloud(&las, &default).unwrap();
+    // 1,808 ground points, 5 of them withheld.
+    assert_eq!(r.selection, Selection::Ground);
+    assert_eq!((r.points_read, r.withheld, r.points_used), (2436, 5, 1803));
+    assert_eq!(cloud.len(), 1803);
+    // The default cell: 1,803 points over about 300 x 240 m, two per cell: 8.9 m, so 10.
+    let (_, _, g) = read_lidar(&las, &default).unwrap();
+    assert!(g.cell_auto);
+    assert_eq!(g.cell, 10.0);
+    assert_eq!(g.radius, 10.0 * std::f64::consts::SQRT_2);
+    // Ground and water: the pond's cells get heights.
+    let water = LidarOptions {
+        classes: Some(ClassSet::parse("2,9").unwrap()),
+        ..cell10(LidarMethod::Mean)
+    };
+    let (_, r2, g2) = read_lidar(&las, &water).unwrap();
+    assert_eq!(r2.points_used, 1843);
+    let (_, _, g1) = read_lidar(&las, &cell10(LidarMethod::Mean)).unwrap();
+    assert!(
+        g2.empty_cells < g1.empty_cells,
+        "{} vs {}",
+        g2.empty_cells,
+        g1.empty_cells
+    );
+    // Last returns: the ground points are last returns; vegetation (1 of 2) is not.
+    let all = LidarOptions {
+        classes: Some(ClassSet::of(&(0..=255).collect::<Vec<u8>>())),
+        last_returns: true,
+        ..cell10(LidarMethod::Mean)
+    };
+    let (_, r3) = lidar::read_cloud(&las, &all).unwrap();
+    assert_eq!(r3.points_used, 1986 - 5);
+    // No class asked for is present: an error listing the classes found.
+    let none = LidarOptions {
+        classes: Some(ClassSet::of(&[17])),
+        ..default
+    };
+    let e = lidar::read_cloud(&las, &none).unwrap_err().to_string();
+    assert!(
+        e.contains("lidar_14.las") && e.contains("class 2: 1808"),
+        "{e}"
+    );
+
+    // A survey without ground: every class but noise (7, 18).
+    let dir = tempfile::tempdir().unwrap();
+    let mut bytes = std::fs::read(&las[0]).unwrap();
+    let h = LasReader::open(&las[0]).unwrap().header().clone();
+    for i in 0..h.point_count as usize {
+        let c = h.offset_to_points as usize + i * h.record_len as usize + 16;
+        if bytes[c] == 2 {
+            bytes[c] = 1;
+        }
+    }
+    let p = dir.path().join("unclassified.las");
+    std::fs::write(&p, &bytes).unwrap();
+    let (cloud, r) = lidar::read_cloud(&[p], &default).unwrap();
+    assert_eq!(r.selection, Selection::AllButNoise);
+    assert_eq!(cloud.len(), 2436 - 5 - 12 - 6);
+    assert!(cloud.z.iter().all(|&z| z > 1700.0 && z < 1960.0));
+}
+
+/// A LAS 1.2 file of point format 0 with `points` `(x, y, z, class)` at scale 0.01, and a GeoKey
+/// directory naming `epsg` when given.
+fn write_las(points: &[(f64, f64, f64, u8)], epsg: Option<u16>) -> Vec<u8> {
+    let (scale, off): (f64, [f64; 3]) = (0.01, [300000.0, 4900000.0, 0.0]);
+    let vlr: Vec<u8> = match epsg {
+        None => Vec::new(),
+        Some(code) => {
+            // GTModelType projected and ProjectedCSType, or geographic and GeographicType.
+            let (model, key) = if code == 4326 { (2, 2048) } else { (1, 3072) };
+            let keys: [u16; 12] = [1, 1, 0, 2, 1024, 0, 1, model, key, 0, 1, code];
+            let mut v = vec![0u8; 54];
+            v[2..17].copy_from_slice(b"LASF_Projection");
+            v[18..20].copy_from_slice(&34735u16.to_le_bytes());
+            v[20..22].copy_from_slice(&24u16.to_le_bytes());
+            v.extend(keys.iter().flat_map(|k| k.to_le_bytes()));
+            v
+        }
+    };
+    let mut h = vec![0u8; 227];
+    h[..4].copy_from_slice(b"LASF");
+    h[24] = 1;
+    h[25] = 2;
+    h[94..96].copy_from_slice(&227u16.to_le_bytes());
+    h[96..100].copy_from_slice(&((227 + vlr.len()) as u32).to_le_bytes());
+    h[100..104].copy_from_slice(&(epsg.is_some() as u32).to_le_bytes());
+    h[104] = 0;
+    h[105..107].copy_from_slice(&20u16.to_le_bytes());
+    h[107..111].copy_from_slice(&(points.len() as u32).to_le_bytes());
+    for k in 0..3 {
+        h[131 + 8 * k..139 + 8 * k].copy_from_slice(&scale.to_le_bytes());
+        h[155 + 8 * k..163 + 8 * k].copy_from_slice(&off[k].to_le_bytes());
+    }
+    let fold = |f: fn(&(f64, f64, f64, u8)) -> f64| {
+        points
+            .iter()
+            .map(f)
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+                (a.min(v), b.max(v))
+            })
+    };
+    let (bx, by, bz) = (fold(|p| p.0), fold(|p| p.1), fold(|p| p.2));
+    for (k, v) in [bx.1, bx.0, by.1, by.0, bz.1, bz.0].iter().enumerate() {
+        h[179 + 8 * k..187 + 8 * k].copy_from_slice(&v.to_le_bytes());
+    }
+    h.extend(vlr);
+    for &(x, y, z, c) in points {
+        for (k, v) in [x, y, z].iter().enumerate() {
+            h.extend((((v - off[k]) / scale).round() as i32).to_le_bytes());
+        }
+        h.extend([0, 0, 0x09, c, 0, 0, 0, 0]);
+    }
+    h
+}
+
+#[test]
+fn lidar_tiles_grid_as_one_survey() {
+    // The survey cut into a west and an east tile at x = 316150: the two grid as the whole.
+    let pts: Vec<(f64, f64, f64, u8)> = all_points(&data("lidar/lidar_12.las"))
+        .iter()
+        .filter(|p| !p.withheld)
+        .map(|p| (p.x, p.y, p.z, p.class))
+        .collect();
+    let dir = tempfile::tempdir().unwrap();
+    let (west, east): (Vec<_>, Vec<_>) = pts.iter().partition(|p| p.0 < 316150.0);
+    let paths = [dir.path().join("w.las"), dir.path().join("e.las")];
+    std::fs::write(&paths[0], write_las(&west, Some(32619))).unwrap();
+    std::fs::write(&paths[1], write_las(&east, Some(32619))).unwrap();
+    let whole = grid_of(&[data("lidar/lidar_12.las")], &cell10(LidarMethod::Mean));
+    let tiles = grid_of(&paths, &cell10(LidarMethod::Mean));
+    assert_eq!(tiles.georef(), whole.georef());
+    // The same points summed in another order: within f32 rounding.
+    for (a, b) in whole.heights().iter().zip(tiles.heights()) {
+        assert!(
+            a.is_nan() && b.is_nan() || (a - b).abs() <= 1e-4,
+            "{a} vs {b}"
+        );
+    }
+    // Each tile alone shares the lattice: the two join in a mosaic without resampling.
+    let w = grid_of(&paths[..1], &cell10(LidarMethod::Mean));
+    let e = grid_of(&paths[1..], &cell10(LidarMethod::Mean));
+    let (m, _) = texmap_terrain::dem::mosaic::mosaic(vec![("w".into(), w), ("e".into(), e)])
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(m.georef().origin_x, whole.georef().origin_x);
+    // A tile in another system is refused, naming it; one without a system grids locally.
+    std::fs::write(&paths[1], write_las(&east, Some(32618))).unwrap();
+    let e = read_lidar(&paths, &cell10(LidarMethod::Mean))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("e.las") && e.contains("EPSG:32618"), "{e}");
+    let local = dir.path().join("local.las");
+    std::fs::write(&local, write_las(&east, None)).unwrap();
+    let g = grid_of(&[local], &cell10(LidarMethod::Mean));
+    assert_eq!((g.georef().crs, g.georef().epsg), (CrsKind::Local, None));
+    // A cloud in degrees is refused.
+    let deg = dir.path().join("deg.las");
+    std::fs::write(&deg, write_las(&east, Some(4326))).unwrap();
+    let e = read_lidar(&[deg], &cell10(LidarMethod::Mean))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("deg.las") && e.contains("degrees"), "{e}");
+}
+
+#[test]
+fn lidar_grids_are_the_same_bytes_for_any_thread_count() {
+    // 300 000 points over 400 x 300 m, cells of 0.5 m (sums over many points per cell).
+    let mut cloud = Cloud::default();
+    let mut s = 0x5eed_u64;
+    let mut rnd = || {
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (s >> 11) as f64 / (1u64 << 53) as f64
+    };
+    for _ in 0..300_000 {
+        let (x, y) = (500_000.0 + rnd() * 400.0, 4_000_000.0 + rnd() * 300.0);
+        cloud.push(x, y, 100.0 + 0.01 * x.sin() * 1000.0 + rnd());
+    }
+    for method in [LidarMethod::Mean, LidarMethod::Idw] {
+        let opts = LidarOptions {
+            cell: Some(0.5),
+            method,
+            fill: 3,
+            ..LidarOptions::default()
+        };
+        let run = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| grid_cloud(&cloud, "synthetic", CrsKind::Projected, Some(32633), &opts))
+                .unwrap()
+                .0
+        };
+        let one = run(1);
+        for t in [2, 3, 8] {
+            let g = run(t);
+            let bits = |g: &Grid| g.heights().iter().map(|h| h.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&g), bits(&one), "{method:?} with {t} threads");
+        }
+    }
+}
+
+#[test]
+fn hostile_lidar_headers_are_errors_naming_the_place() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = std::fs::read(data("lidar/lidar_12.las")).unwrap();
+    let set = |at: usize, v: &[u8]| {
+        let mut b = good.clone();
+        b[at..at + v.len()].copy_from_slice(v);
+        b
+    };
+    let cases: Vec<(&str, Vec<u8>, &str)> = vec![
+        // 10^12 points claimed by a 1 KB file: refused before anything is sized from it.
+        (
+            "count",
+            {
+                let mut b = set(107, &u32::MAX.to_le_bytes());
+                b.truncate(1024);
+                b
+            },
+            "the file ends at byte 1024",
+        ),
+        ("signature", set(0, b"LASG"), "signature"),
+        ("version", set(24, &[2, 0]), "version 2.0"),
+        ("offset", set(96, &u32::MAX.to_le_bytes()), "byte 96"),
+        ("format", set(104, &[11]), "format 11"),
+        ("record", set(105, &10u16.to_le_bytes()), "byte 105"),
+        ("scale", set(131, &0f64.to_le_bytes()), "byte 131"),
+        ("vlrs", set(100, &u32::MAX.to_le_bytes()), "VLR 1 at byte"),
+        (
+            "bounds",
+            set(187, &317000.0f64.to_le_bytes()),
+            "bounding box",
+        ),
+        (
+            "x",
+            {
+                let off = u32::from_le_bytes(good[96..100].try_into().unwrap()) as usize;
+                set(off + 28 * 100, &i32::MAX.to_le_bytes())
+            },
+            "point 100 at byte",
+        ),
+    ];
+    for (what, bytes, expect) in cases {
+        let p = dir.path().join(format!("{what}.las"));
+        std::fs::write(&p, &bytes).unwrap();
+        let (r, peak) = crate::alloc::measure(|| {
+            read_lidar(std::slice::from_ref(&p), &cell10(LidarMethod::Mean))
+        });
+        let e = r
+            .err()
+            .unwrap_or_else(|| panic!("{what}: no error"))
+            .to_string();
+        assert!(
+            e.contains(&format!("{what}.las")) && e.contains(expect),
+            "{what}: {e}"
+        );
+        assert!(
+            peak < 8 << 20,
+            "{what}: {peak} bytes of heap for a {}-byte file",
+            bytes.len()
+        );
+    }
+    // LAZ: the chunk table cut off, and a layer size of a 1.4 chunk set to 4 GB.
+    let laz = std::fs::read(data("lidar/lidar_12.laz")).unwrap();
+    let p = dir.path().join("cut.laz");
+    std::fs::write(&p, &laz[..laz.len() - 20]).unwrap();
+    let e = LasReader::open(&p).err().unwrap().to_string();
+    assert!(e.contains("cut.laz") && e.contains("chunk table"), "{e}");
+    let laz14 = std::fs::read(data("lidar/lidar_14.laz")).unwrap();
+    let h = LasReader::open(data("lidar/lidar_14.laz"))
+        .unwrap()
+        .header()
+        .clone();
+    let mut b = laz14.clone();
+    // First chunk: the 8-byte table offset, a raw point, the point count, then layer sizes.
+    let z_layer = h.offset_to_points as usize + 8 + h.record_len as usize + 4 + 4;
+    b[z_layer..z_layer + 4].copy_from_slice(&u32::MAX.to_le_bytes());
+    let p = dir.path().join("layer.laz");
+    std::fs::write(&p, &b).unwrap();
+    let (r, peak) = crate::alloc::measure(|| LasReader::open(&p).map(|_| ()));
+    let e = r.unwrap_err().to_string();
+    assert!(e.contains("layer.laz") && e.contains("LAZ chunk 0"), "{e}");
+    assert!(peak < 8 << 20, "{peak}");
 }

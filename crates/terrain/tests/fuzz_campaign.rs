@@ -3,9 +3,11 @@
 //! strips and tiles, LZW, BigTIFF, PixelIsPoint), the ESRI ASCII grid GDAL wrote, GDAL's DTED
 //! level 0 cell and 16-bit BIL (its `.hdr` and its samples mutated apart), and an SRTM
 //! `.hgt` tile and a 16-bit PNG made here; and the vector overlays and recorded flights (GeoJSON,
-//! GPX, IGC) written by ogr2ogr, gpxpy and aerofiles. Each mutant — a cut, bit flips, byte replacements,
-//! header fields set to extremes — must end in a grid or an error naming the file, never a panic,
-//! under a heap cap of 64x the mutant's size + 1 MiB.
+//! GPX, IGC) written by ogr2ogr, gpxpy and aerofiles; and the lidar point clouds (LAS 1.2 and
+//! 1.4 by laspy, LAZ by LASzip), read and gridded. Each mutant — a cut, bit flips, byte
+//! replacements, header fields set to extremes — must end in a grid or an error naming the file,
+//! never a panic, under a heap cap of 64x the mutant's size + 1 MiB (+ 4 MiB for LAZ, whose
+//! decoder's models take 2.5 MB for any file).
 //!
 //! `cargo test -p texmap-terrain --test suite fuzz_campaign:: -- --nocapture` prints the table.
 
@@ -389,6 +391,97 @@ fn overlay_and_track_readers_survive_the_campaign() {
             Err(e) => located(e.to_string(), &f.name, "views"),
         }
     });
+    report.push_str(&t.report());
+    assert!(t.failures.is_empty(), "{}", t.report());
+    eprintln!("{report}");
+}
+
+/// Lidar point clouds (tests/data/lidar): LAS 1.2 and 1.4 that laspy wrote and their LAZ by
+/// LASzip, each mutant read and gridded (the default classes and cell) into a grid or an error
+/// naming the file. The work runs on this thread (a one-thread rayon pool that is this thread),
+/// so the heap cap counts the gridding's allocations too.
+#[test]
+fn lidar_readers_survive_the_campaign() {
+    let dir = tempfile::tempdir().unwrap();
+    let settings = Settings {
+        seeded_cuts: 16,
+        flips: 64,
+        ..Settings::default()
+    };
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .use_current_thread()
+        .build()
+        .unwrap();
+    let mut fixtures = Vec::new();
+    for name in [
+        "lidar_12.las",
+        "lidar_14.las",
+        "lidar_12.laz",
+        "lidar_14.laz",
+    ] {
+        let bytes = data(&format!("lidar/{name}"));
+        let u32_at = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
+        let (offset, record) = (
+            u32_at(96),
+            u16::from_le_bytes([bytes[105], bytes[106]]) as usize,
+        );
+        let mut fields = vec![
+            ("legacy point count", Field::I32Le(107)),
+            ("offset to point data", Field::I32Le(96)),
+            ("VLR count", Field::I32Le(100)),
+            ("x scale", Field::F64Le(131)),
+            ("min x", Field::F64Le(187)),
+        ];
+        if name.ends_with(".laz") {
+            fields.push(("chunk table offset", Field::I32Le(offset)));
+        }
+        if name.contains("_14") {
+            fields.push(("64-bit point count", Field::I32Le(247)));
+            fields.push(("first EVLR offset", Field::I32Le(235)));
+        }
+        let mut fx = fixture(name, bytes.clone(), fields, false);
+        // The header's end, the points' start and every 200th point record (uncompressed).
+        fx.boundaries = vec![4, 94, 227, offset];
+        if name.ends_with(".las") {
+            fx.boundaries
+                .extend((offset..bytes.len()).step_by(200 * record));
+        }
+        fixtures.push(fx);
+    }
+    let run = |f: &Fixture, bytes: &[u8]| {
+        let path = dir.path().join(&f.name);
+        std::fs::write(&path, bytes).unwrap();
+        verdict(
+            pool.install(|| dem::read_dem(&path, &dem::ReadOptions::default())),
+            &path,
+        )
+    };
+    let (las, laz): (Vec<Fixture>, Vec<Fixture>) =
+        fixtures.into_iter().partition(|f| f.name.ends_with(".las"));
+    let t = run_campaign("LAS", &las, &settings, &run);
+    let mut report = t.report();
+    assert!(t.failures.is_empty(), "{}", t.report());
+    // The LASzip decoder's context models take about 2.5 MB whatever the file (256 models of
+    // 256 symbols for each of three point fields of format 1): the cap is that much above the
+    // usual one. The undamaged file's peak is printed beside the table.
+    let clean = data("lidar/lidar_12.laz");
+    let path = dir.path().join("clean.laz");
+    std::fs::write(&path, &clean).unwrap();
+    let (g, peak) = crate::alloc::measure(|| {
+        pool.install(|| dem::read_dem(&path, &dem::ReadOptions::default()))
+    });
+    assert!(g.is_ok());
+    report.push_str(&format!(
+        "undamaged lidar_12.laz ({} bytes): heap peak {} bytes\n",
+        clean.len(),
+        peak
+    ));
+    let laz_settings = Settings {
+        mem_extra: 4 << 20,
+        ..settings
+    };
+    let t = run_campaign("LAZ", &laz, &laz_settings, &run);
     report.push_str(&t.report());
     assert!(t.failures.is_empty(), "{}", t.report());
     eprintln!("{report}");

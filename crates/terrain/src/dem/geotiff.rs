@@ -603,58 +603,93 @@ fn f64_vec<R: std::io::Read + std::io::Seek>(
     }
 }
 
-/// Interpret the GeoTIFF tags; `None` when the file has no georeference at all.
-fn read_georef<R: std::io::Read + std::io::Seek>(
-    dec: &mut Decoder<R>,
-    source: &str,
-) -> Result<Option<Georef>, TerrainError> {
-    // GeoKeys: model type and raster type.
-    let mut model = None;
-    let mut raster_type = 1u16;
-    let mut epsg = None;
-    if let Some(keys) = dec
-        .find_tag_unsigned_vec::<u16>(Tag::GeoKeyDirectoryTag)
-        .map_err(tiff_err(source, "tag 34735 GeoKeyDirectory"))?
-    {
+/// The keys of a GeoKey directory that place a grid or a point cloud: GeoTIFF's tag 34735, and the
+/// same array of `u16` in a LAS file's `LASF_Projection` record 34735 ([`super::las`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct GeoKeys {
+    /// `GTModelTypeGeoKey` (1024): 1 projected, 2 geographic, 3 geocentric.
+    pub model: Option<u16>,
+    /// `GTRasterTypeGeoKey` (1025): 1 `RasterPixelIsArea` (the default), 2 `RasterPixelIsPoint`.
+    pub raster_type: u16,
+    /// `ProjectedCSTypeGeoKey` (3072) or `GeographicTypeGeoKey` (2048), when an EPSG code.
+    pub epsg: Option<u16>,
+    /// The code came from `ProjectedCSTypeGeoKey` (3072).
+    pub projected_key: bool,
+}
+
+impl Default for GeoKeys {
+    fn default() -> Self {
+        GeoKeys {
+            model: None,
+            raster_type: 1,
+            epsg: None,
+            projected_key: false,
+        }
+    }
+}
+
+impl GeoKeys {
+    /// Read a key directory: a 4-value header (version, revision, minor revision, key count),
+    /// then `(KeyID, TIFFTagLocation, Count, Value)` per key. Keys whose value lives in another
+    /// tag (location ≠ 0) are passed over; user-defined (32767) and undefined (0) codes are none.
+    pub fn parse(keys: &[u16], source: &str, at: &str) -> Result<GeoKeys, TerrainError> {
         if keys.len() < 4 {
-            return Err(format_err(
-                source,
-                "tag 34735 GeoKeyDirectory",
-                "a 4-value header",
-            ));
+            return Err(format_err(source, at, "a 4-value header"));
         }
         let count = keys[3] as usize;
         if keys.len() < 4 + 4 * count {
             return Err(format_err(
                 source,
-                "tag 34735 GeoKeyDirectory",
+                at,
                 format!("{count} keys of 4 values, got {} values", keys.len()),
             ));
         }
+        let mut g = GeoKeys::default();
         for k in keys[4..4 + 4 * count].chunks_exact(4) {
             // (KeyID, TIFFTagLocation, Count, Value): location 0 = the value is inline.
             if k[1] != 0 {
                 continue;
             }
             match k[0] {
-                1024 => model = Some(k[3]),
-                1025 => raster_type = k[3],
-                2048 | 3072 if k[3] != 32767 && k[3] != 0 => epsg = Some(k[3]),
+                1024 => g.model = Some(k[3]),
+                1025 => g.raster_type = k[3],
+                2048 | 3072 if k[3] != 32767 && k[3] != 0 => {
+                    g.epsg = Some(k[3]);
+                    g.projected_key = k[0] == 3072;
+                }
                 _ => {}
             }
         }
+        Ok(g)
     }
-    let crs = match model {
-        Some(1) => CrsKind::Projected,
-        Some(2) => CrsKind::Geographic,
-        Some(3) => {
-            return Err(TerrainError::Unsupported {
+
+    /// The kind of system the model type names (no model type: `Local`, as GDAL reads it).
+    pub fn crs(&self, source: &str) -> Result<CrsKind, TerrainError> {
+        match self.model {
+            Some(1) => Ok(CrsKind::Projected),
+            Some(2) => Ok(CrsKind::Geographic),
+            Some(3) => Err(TerrainError::Unsupported {
                 source: source.into(),
                 what: "GTModelTypeGeoKey 3 (geocentric)".into(),
-            });
+            }),
+            _ => Ok(CrsKind::Local),
         }
-        _ => CrsKind::Local,
+    }
+}
+
+/// Interpret the GeoTIFF tags; `None` when the file has no georeference at all.
+fn read_georef<R: std::io::Read + std::io::Seek>(
+    dec: &mut Decoder<R>,
+    source: &str,
+) -> Result<Option<Georef>, TerrainError> {
+    let keys = match dec
+        .find_tag_unsigned_vec::<u16>(Tag::GeoKeyDirectoryTag)
+        .map_err(tiff_err(source, "tag 34735 GeoKeyDirectory"))?
+    {
+        Some(k) => GeoKeys::parse(&k, source, "tag 34735 GeoKeyDirectory")?,
+        None => GeoKeys::default(),
     };
+    let (crs, epsg, raster_type) = (keys.crs(source)?, keys.epsg, keys.raster_type);
     // Raster space of pixel centres: PixelIsArea counts corners, PixelIsPoint centres.
     let half = match raster_type {
         1 => 0.5,

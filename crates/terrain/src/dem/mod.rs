@@ -20,7 +20,9 @@
 //! their `.hdr` and `.prj` ([`ehdr`]), 16-bit PNG with a scale and offset, and Mapbox Terrain-RGB
 //! and Terrarium PNG ([`png`]), the last two placed in Web Mercator when they are web-map tiles
 //! addressed `Z/X/Y.png` ([`png::TileAddress`]); grids that tile an area join into one
-//! ([`mosaic`], [`read_dems`]: web-map tiles of one zoom only). Each validates at the file
+//! ([`mosaic`], [`read_dems`]: web-map tiles of one zoom only). Airborne lidar point clouds, LAS
+//! 1.0–1.4 and LAZ ([`las`]), are gridded into a grid as PDAL's `writers.gdal` grids them
+//! ([`lidar`]; several files are one cloud). Each validates at the file
 //! boundary ([`Grid::new`]): at least 2 x 2 samples, at most [`MAX_SAMPLES`], every value finite
 //! or no-data, not all no-data. [`geotiff_writer`] writes a grid (or a mask computed from one, such
 //! as a [`crate::viewshed`]) back as a GeoTIFF that GDAL and [`geotiff`] read with the same
@@ -32,6 +34,8 @@ pub mod ehdr;
 pub mod geotiff;
 pub mod geotiff_writer;
 pub mod hgt;
+pub mod las;
+pub mod lidar;
 pub mod mosaic;
 pub mod png;
 
@@ -480,6 +484,8 @@ pub enum DemFormat {
     TerrainRgb,
     /// Terrarium (AWS Terrain Tiles, Mapzen): `height = R·256 + G + B/256 − 32768`.
     Terrarium,
+    /// A lidar point cloud, LAS or LAZ (`.las`, `.laz`), gridded by [`lidar`].
+    Las,
 }
 
 /// Options for the readers that need outside information.
@@ -502,6 +508,8 @@ pub struct ReadOptions {
     /// DTED: a record whose checksum does not match its bytes is an error (default `true`);
     /// `false` reads a file whose producer wrote wrong checksums.
     pub verify_checksums: bool,
+    /// LAS and LAZ point clouds: how they are gridded.
+    pub lidar: lidar::LidarOptions,
 }
 
 impl Default for ReadOptions {
@@ -514,6 +522,7 @@ impl Default for ReadOptions {
             tile: None,
             tms: false,
             verify_checksums: true,
+            lidar: lidar::LidarOptions::default(),
         }
     }
 }
@@ -529,22 +538,24 @@ impl DemFormat {
             "dt0" | "dt1" | "dt2" => Some(DemFormat::Dted),
             "flt" | "bil" | "hdr" => Some(DemFormat::EsriHdr),
             "png" => Some(DemFormat::Png16),
+            "las" | "laz" => Some(DemFormat::Las),
             _ => None,
         }
     }
 
     /// The format a file's content says, for a name whose extension is none of the above: a
-    /// DTED cell begins with its user header label `UHL1`; an ESRI `.hdr` raster has its `.hdr`
-    /// beside it.
+    /// DTED cell begins with its user header label `UHL1`, a LAS or LAZ file with `LASF`; an
+    /// ESRI `.hdr` raster has its `.hdr` beside it.
     pub fn sniff(path: &Path) -> Option<DemFormat> {
         use std::io::Read;
         let mut head = [0u8; 4];
-        let dted = std::fs::File::open(path)
+        let read = std::fs::File::open(path)
             .and_then(|mut f| f.read_exact(&mut head))
-            .is_ok()
-            && &head == b"UHL1";
-        if dted {
-            return Some(DemFormat::Dted);
+            .is_ok();
+        match &head {
+            b"UHL1" if read => return Some(DemFormat::Dted),
+            b"LASF" if read => return Some(DemFormat::Las),
+            _ => {}
         }
         ["hdr", "HDR"]
             .iter()
@@ -563,7 +574,7 @@ pub fn read_dem(path: impl AsRef<Path>, opts: &ReadOptions) -> Result<Grid, Terr
         .ok_or_else(|| TerrainError::Unsupported {
             source: path.display().to_string(),
             what: "unknown extension (expected .tif, .tiff, .asc, .hgt, .dt0, .dt1, .dt2, .flt, \
-                   .bil or .png)"
+                   .bil, .png, .las or .laz)"
                 .into(),
         })?;
     match format {
@@ -582,7 +593,17 @@ pub fn read_dem(path: impl AsRef<Path>, opts: &ReadOptions) -> Result<Grid, Terr
         DemFormat::Png16 => png::read_png16(path, opts.scale, opts.offset, opts.cell),
         DemFormat::TerrainRgb => read_rgb(path, png::RgbEncoding::TerrainRgb, opts),
         DemFormat::Terrarium => read_rgb(path, png::RgbEncoding::Terrarium, opts),
+        DemFormat::Las => lidar::read_lidar(&[path.to_path_buf()], &opts.lidar).map(|r| r.0),
     }
+}
+
+/// Whether `path` is a lidar point cloud under `opts` (by the forced format, the extension or
+/// the content).
+fn is_lidar(path: &Path, opts: &ReadOptions) -> bool {
+    opts.format
+        .or_else(|| DemFormat::from_path(path))
+        .or_else(|| DemFormat::sniff(path))
+        == Some(DemFormat::Las)
 }
 
 /// The tile address of `path` under `opts` (given, or spelled by the path; TMS rows flipped), for
@@ -606,7 +627,9 @@ fn read_rgb(
 /// Read several elevation files for [`mosaic::mosaic`], each named by its path. A directory
 /// stands for the web-map tiles under it ([`png::tiles_in_dir`]). Terrain-RGB and Terrarium
 /// tiles must all be of one zoom: a tile of another zoom than the first is an error naming both
-/// files, before any is read (a mosaic never resamples).
+/// files, before any is read (a mosaic never resamples). Lidar point clouds are one cloud,
+/// gridded together ([`lidar::read_lidar`]) in the place of the first of them, named
+/// `a.laz + b.laz`.
 pub fn read_dems(
     paths: &[std::path::PathBuf],
     opts: &ReadOptions,
@@ -652,10 +675,21 @@ pub fn read_dems(
             }
         }
     }
-    files
+    let lidar: Vec<std::path::PathBuf> = files
         .iter()
-        .map(|f| Ok((f.display().to_string(), read_dem(f, opts)?)))
-        .collect()
+        .filter(|f| is_lidar(f, opts))
+        .cloned()
+        .collect();
+    let mut out = Vec::with_capacity(files.len());
+    for f in &files {
+        if !lidar.contains(f) {
+            out.push((f.display().to_string(), read_dem(f, opts)?));
+        } else if lidar.first() == Some(f) {
+            let (grid, cloud, _) = lidar::read_lidar(&lidar, &opts.lidar)?;
+            out.push((cloud.source, grid));
+        }
+    }
+    Ok(out)
 }
 
 #[cfg(test)]
