@@ -34,6 +34,9 @@ fn every_geotiff_layout_reads_the_ramp_and_gdals_georeference() {
         ("ramp_i32_point", CrsKind::Projected),
         ("ramp_f32_geo", CrsKind::Geographic),
         ("ramp_f64", CrsKind::Projected),
+        // compression.sh: ZSTD with predictors 2 (integers) and 3 (floats)
+        ("ramp_i16_zstd", CrsKind::Projected),
+        ("ramp_f32_zstd", CrsKind::Geographic),
     ] {
         let g = read_dem(data(&format!("{name}.tif")), &ReadOptions::default()).unwrap();
         assert_eq!((g.width(), g.height()), (37, 29), "{name}");

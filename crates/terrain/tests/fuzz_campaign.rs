@@ -96,6 +96,10 @@ fn terrain_readers_survive_the_campaign() {
         "ramp_i32_point.tif",
         "ramp_f32_geo.tif",
         "ramp_f64.tif",
+        "ramp_i16_zstd.tif",
+        "ramp_f32_zstd.tif",
+        "photo_rgb_webp.tif",
+        "photo_rgb_jpeg.tif",
     ]
     .iter()
     .map(|n| {

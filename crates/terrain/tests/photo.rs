@@ -29,6 +29,8 @@ fn rows_read_by_band_equal_the_whole_image() {
         ("relief_planar_u16.tif", Some([4, 2, 1])),
         ("relief_planar_u16.tif", None),
         ("photo_4band.tif", Some([2, 3, 1])),
+        ("photo_rgb_webp.tif", None),
+        ("photo_rgb_jpeg.tif", None),
     ] {
         let whole = gst::read_photo(&data(file), bands).unwrap();
         let rows = TiffPhoto::open(&data(file), bands).unwrap();
@@ -54,6 +56,80 @@ fn rows_read_by_band_equal_the_whole_image() {
     let reds: Vec<u8> = img.pixels().map(|px| px.0[0]).collect();
     assert_eq!(reds.iter().min(), Some(&0));
     assert_eq!(reds.iter().max(), Some(&255));
+}
+
+/// GDAL's COG compressions for photos (`tests/data/compression.sh`): lossless WebP decodes to the
+/// uncompressed photo's bytes; JPEG in YCbCr (4:2:0) to within two levels of GDAL's own
+/// decoding (libjpeg's and zune-jpeg's upsampling and IDCT round differently) and above 38 dB
+/// PSNR against the photo it was made from.
+#[test]
+fn webp_and_ycbcr_jpeg_photos_decode_as_gdal_decodes_them() {
+    let plain = gst::read_photo(&data("photo_rgb.tif"), None).unwrap();
+    let webp = gst::read_photo(&data("photo_rgb_webp.tif"), None).unwrap();
+    assert!(webp.image == plain.image);
+    assert_eq!(webp.georef, plain.georef);
+    let jpeg = gst::read_photo(&data("photo_rgb_jpeg.tif"), None).unwrap();
+    let gdal = gst::read_photo(&data("photo_rgb_jpeg_gdal.tif"), None).unwrap();
+    assert_eq!(jpeg.georef, plain.georef);
+    assert_eq!(jpeg.image.dimensions(), gdal.image.dimensions());
+    let diff = |a: &RgbaImage, b: &RgbaImage| {
+        let d: Vec<i32> = a
+            .as_raw()
+            .iter()
+            .zip(b.as_raw())
+            .map(|(&x, &y)| (x as i32 - y as i32).abs())
+            .collect();
+        let mse = d.iter().map(|&x| (x * x) as f64).sum::<f64>() / d.len() as f64;
+        (*d.iter().max().unwrap(), mse)
+    };
+    let (max_gdal, _) = diff(&jpeg.image, &gdal.image);
+    assert!(
+        max_gdal <= 2,
+        "JPEG decode differs from GDAL's by {max_gdal}"
+    );
+    let (_, mse) = diff(&jpeg.image, &plain.image);
+    let psnr = 10.0 * (255.0f64 * 255.0 / mse.max(1e-9)).log10();
+    assert!(psnr > 38.0, "JPEG against its source: {psnr:.1} dB");
+}
+
+/// JPEG and WebP decoders size their output from the stream's own header: a damaged one claiming
+/// 16384² pixels in a 16x16 tile is a located error, found before anything is allocated for it.
+#[test]
+fn a_codec_header_claiming_a_huge_frame_is_refused_before_allocation() {
+    let dir = tempfile::tempdir().unwrap();
+    let jpeg = std::fs::read(data("photo_rgb_jpeg.tif")).unwrap();
+    // The first tile's start-of-frame segment (FF C0, length, precision, height, width).
+    let sof = jpeg.windows(2).position(|w| w == [0xFF, 0xC0]).unwrap();
+    let mut big = jpeg.clone();
+    big[sof + 5..sof + 9].copy_from_slice(&[0x3F, 0xFF, 0x3F, 0xFF]);
+    let vp8l = std::fs::read(data("photo_rgb_webp.tif")).unwrap();
+    let at = vp8l.windows(4).position(|w| w == b"VP8L").unwrap();
+    let mut big_webp = vp8l.clone();
+    // 14 bits of width − 1, 14 of height − 1, after the signature byte.
+    let v = u32::from_le_bytes(big_webp[at + 9..at + 13].try_into().unwrap()) | 0x0FFF_FFFF;
+    big_webp[at + 9..at + 13].copy_from_slice(&v.to_le_bytes());
+    for (name, bytes, claim) in [
+        (
+            "big.tif",
+            big,
+            "JPEG frame within the 16x16 chunk, its header claims 16383x16383",
+        ),
+        (
+            "bigw.tif",
+            big_webp,
+            "WebP frame within the 16x16 chunk, its header claims 16384x16384",
+        ),
+    ] {
+        let path = dir.path().join(name);
+        std::fs::write(&path, bytes).unwrap();
+        let (r, peak) = crate::alloc::measure(|| gst::read_photo(&path, None).map(|_| ()));
+        let e = r.unwrap_err().to_string();
+        assert!(
+            e.contains(name) && e.contains("chunk 0") && e.contains(claim),
+            "{e}"
+        );
+        assert!(peak < 1 << 20, "{name}: {peak} bytes");
+    }
 }
 
 /// `write_pyramid` into memory.

@@ -4,8 +4,9 @@
 //! and copied into the grid, so only one chunk's buffer is alive beside the result: a grid larger
 //! than the crate's default 256 MiB whole-image decode limit loads, and the limit applies per chunk
 //! ([`read_geotiff_limited`] lets a test shrink it). Sample types: 8/16/32/64-bit signed and
-//! unsigned integers, 32- and 64-bit floats; compression (LZW, Deflate, PackBits), predictors 2 and 3
-//! and BigTIFF are the `tiff` crate's. Interleaved (`PlanarConfiguration` 1) and planar (2) layouts.
+//! unsigned integers, 32- and 64-bit floats; compression (LZW, Deflate, PackBits, ZSTD, WebP,
+//! JPEG, the last in YCbCr as GDAL writes photo COGs), predictors 2 and 3 and BigTIFF are the
+//! `tiff` crate's (LERC is not). Interleaved (`PlanarConfiguration` 1) and planar (2) layouts.
 //!
 //! Georeference (GeoTIFF 1.1, OGC 19-008):
 //! - `ModelPixelScale` (33550) `(Sx, Sy, Sz)` with `ModelTiepoint` (33922) `(I, J, K, X, Y, Z)`:
@@ -244,6 +245,11 @@ pub struct RasterReader {
     compression: u16,
     expansion: u64,
     sample_bytes: u64,
+    /// Photometric YCbCr (6), interleaved: the decoder hands out Y, Cb, Cr, converted to RGB here.
+    ycbcr: bool,
+    /// JPEG and WebP chunks: the file (opened again) and each chunk's offset, so that the frame
+    /// size a chunk's own header claims is checked before its codec allocates for it.
+    peek: Option<(std::fs::File, Vec<u64>)>,
 }
 
 /// One decoded chunk: its rectangle in the image (clipped to it) and one plane per wanted band.
@@ -366,7 +372,8 @@ impl RasterReader {
         }
         // What each stored chunk can decode to: its byte count times the largest expansion of its
         // compression (none 1x; PackBits 64x: two bytes per 128-byte run; Deflate 1032x; LZW at
-        // most 4096 bytes per 12-bit code). A chunk whose claimed size exceeds it is damage, found
+        // most 4096 bytes per 12-bit code; ZSTD 32768x: an RLE block of 128 KiB from 4 bytes; WebP
+        // and JPEG are bounded alike). A chunk whose claimed size exceeds it is damage, found
         // before the decoder sizes a buffer for it.
         let counts = dec
             .get_tag_u64_vec(match chunk_type {
@@ -385,9 +392,27 @@ impl RasterReader {
             1 => 1,
             32773 => 64,
             8 | 32946 => 1032,
-            _ => 2731, // LZW: 4096 bytes from 12 bits
+            50000 | 50001 => 32768,
+            _ => 2731, // LZW: 4096 bytes from 12 bits; JPEG's least code per 8x8 block is larger
         };
         let sample_bytes = (bits as u64).div_ceil(8).max(1);
+        let photometric: Option<u16> = dec
+            .find_tag_unsigned(Tag::PhotometricInterpretation)
+            .map_err(tiff_err(&source, "tag 262 PhotometricInterpretation"))?;
+        let ycbcr = photometric == Some(6) && !planar && spp >= 3 && bits == 8;
+        // JPEG (7) and WebP (50001) decoders size their output from the stream's own header, not
+        // from the decode limit: those headers are read first (`check_codec_frame`).
+        let peek = if matches!(compression, 7 | 50001) {
+            let offsets = dec
+                .get_tag_u64_vec(match chunk_type {
+                    ChunkType::Tile => Tag::TileOffsets,
+                    ChunkType::Strip => Tag::StripOffsets,
+                })
+                .map_err(tiff_err(&source, "tags 273/324 StripOffsets/TileOffsets"))?;
+            Some((std::fs::File::open(path).map_err(io(path))?, offsets))
+        } else {
+            None
+        };
         Ok(RasterReader {
             source,
             dec,
@@ -408,6 +433,8 @@ impl RasterReader {
             compression,
             expansion,
             sample_bytes,
+            ycbcr,
+            peek,
         })
     }
 
@@ -490,12 +517,20 @@ impl RasterReader {
                     ),
                 ));
             }
+            if let Some((file, offsets)) = &mut self.peek {
+                let offset = offsets.get(index as usize).copied().unwrap_or(0);
+                check_codec_frame(file, offset, stored, self.compression, (self.cw, self.ch))
+                    .map_err(|what| format_err(&source, &at, what))?;
+            }
             let data = self.dec.read_chunk(index).map_err(tiff_err(&source, &at))?;
-            let vals = to_f32(data).ok_or_else(|| TerrainError::Unsupported {
+            let mut vals = to_f32(data).ok_or_else(|| TerrainError::Unsupported {
                 source: source.clone(),
                 what: format!("{at}: sample type (need integer or 32/64-bit float samples)"),
             })?;
             let stride = if self.planar { 1 } else { spp as usize };
+            if self.ycbcr {
+                ycbcr_to_rgb(&mut vals, stride);
+            }
             let need = dw as usize * dh as usize * stride;
             if vals.len() < need {
                 return Err(format_err(
@@ -573,6 +608,106 @@ pub fn read_raster(
         nodata: r.nodata,
         band_count: r.band_count,
     })
+}
+
+/// The frame size in a JPEG (7) or WebP (50001) chunk's own header, which its decoder allocates
+/// for before the TIFF decode limit applies, must fit the chunk (`chunk`: tile or strip width and
+/// height): a damaged header claiming 16384² pixels is refused here, not allocated.
+fn check_codec_frame(
+    file: &mut std::fs::File,
+    offset: u64,
+    stored: u64,
+    compression: u16,
+    chunk: (u32, u32),
+) -> Result<(), String> {
+    use std::io::{Read, Seek, SeekFrom};
+    let mut head = Vec::new();
+    file.seek(SeekFrom::Start(offset))
+        .and_then(|_| {
+            file.take(stored.min(1 << 16))
+                .read_to_end(&mut head)
+                .map(|_| ())
+        })
+        .map_err(|e| format!("the chunk's bytes at offset {offset}: {e}"))?;
+    let le16 = |i: usize| {
+        head.get(i..i + 2)
+            .map(|b| u16::from_le_bytes([b[0], b[1]]) as u32)
+    };
+    let be16 = |i: usize| {
+        head.get(i..i + 2)
+            .map(|b| u16::from_be_bytes([b[0], b[1]]) as u32)
+    };
+    let le24 = |i: usize| {
+        head.get(i..i + 3)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], 0]))
+    };
+    let frame = if compression == 7 {
+        // Segments from SOI to the first start-of-frame marker (C0-CF but C4 DHT, C8, CC DAC).
+        let mut i = 2;
+        let mut found = None;
+        while head.get(..2) == Some(&[0xFF, 0xD8][..]) && i + 4 <= head.len() {
+            if head[i] != 0xFF {
+                break;
+            }
+            let marker = head[i + 1];
+            if marker == 0xFF {
+                i += 1; // fill byte
+                continue;
+            }
+            if (0xC0..=0xCF).contains(&marker) && !matches!(marker, 0xC4 | 0xC8 | 0xCC) {
+                found = be16(i + 7).zip(be16(i + 5));
+                break;
+            }
+            let Some(len) = be16(i + 2) else { break };
+            i += 2 + len as usize;
+        }
+        found.ok_or("a JPEG stream with a frame header (SOF) in its first 64 KiB")?
+    } else {
+        if head.get(..4) != Some(b"RIFF") || head.get(8..12) != Some(b"WEBP") {
+            return Err("a WebP stream (RIFF ... WEBP)".into());
+        }
+        match head.get(12..16) {
+            Some(b"VP8 ") => le16(26)
+                .zip(le16(28))
+                .map(|(w, h)| (w & 0x3FFF, h & 0x3FFF)),
+            Some(b"VP8L") => head.get(21..25).map(|b| {
+                let v = u32::from_le_bytes([b[0], b[1], b[2], b[3]]);
+                ((v & 0x3FFF) + 1, ((v >> 14) & 0x3FFF) + 1)
+            }),
+            Some(b"VP8X") => le24(24).zip(le24(27)).map(|(w, h)| (w + 1, h + 1)),
+            _ => None,
+        }
+        .ok_or("a WebP VP8, VP8L or VP8X frame header")?
+    };
+    if frame.0 > chunk.0 || frame.1 > chunk.1 {
+        return Err(format!(
+            "a {} frame within the {}x{} chunk, its header claims {}x{}",
+            if compression == 7 { "JPEG" } else { "WebP" },
+            chunk.0,
+            chunk.1,
+            frame.0,
+            frame.1
+        ));
+    }
+    Ok(())
+}
+
+/// Y, Cb, Cr (the first three of every `stride` samples) to R, G, B in place, by the JFIF
+/// equations (ITU-R BT.601 luma weights over the full 0–255 range), which are also TIFF's defaults
+/// (`YCbCrCoefficients` 0.299/0.587/0.114, `ReferenceBlackWhite` 0/255, 128/255, 128/255) and the
+/// conversion libjpeg makes when GDAL reads a YCbCr JPEG TIFF.
+fn ycbcr_to_rgb(vals: &mut [f32], stride: usize) {
+    for px in vals.chunks_exact_mut(stride) {
+        let (y, cb, cr) = (px[0], px[1] - 128.0, px[2] - 128.0);
+        let rgb = [
+            y + 1.402 * cr,
+            y - 0.344_136 * cb - 0.714_136 * cr,
+            y + 1.772 * cb,
+        ];
+        for (dst, v) in px.iter_mut().zip(rgb) {
+            *dst = v.round().clamp(0.0, 255.0);
+        }
+    }
 }
 
 fn to_f32(d: DecodingResult) -> Option<Vec<f32>> {
