@@ -245,19 +245,24 @@ pub fn read_dems(
     Ok(vec![(cloud.source, grid)])
 }
 
-pub fn run(a: GridArgs) -> Result<()> {
-    let opts = a.lidar.options()?;
-    let tif = a
-        .output
+/// A usage error unless `output` ends in `.tif` or `.tiff` (the commands that write a GeoTIFF).
+pub(crate) fn require_geotiff(output: &Path) -> Result<()> {
+    let tif = output
         .extension()
         .and_then(|e| e.to_str())
         .is_some_and(|e| matches!(e.to_ascii_lowercase().as_str(), "tif" | "tiff"));
     if !tif {
         return usage(format!(
             "{}: the output must end in .tif or .tiff (a GeoTIFF)",
-            a.output.display()
+            output.display()
         ));
     }
+    Ok(())
+}
+
+pub fn run(a: GridArgs) -> Result<()> {
+    let opts = a.lidar.options()?;
+    require_geotiff(&a.output)?;
     if let Some(p) = a.input.iter().find(|p| p.is_file() && !is_lidar(p)) {
         return usage(format!(
             "{}: not a LAS or LAZ file (.las, .laz); `terrain build --dem` takes raster grids",

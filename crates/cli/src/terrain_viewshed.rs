@@ -14,6 +14,7 @@ use texmap_terrain::viewshed::{
 };
 
 use crate::args::{UsageError, usage};
+use crate::terrain_grid::require_geotiff;
 use crate::terrain_view::{lonlat_point, parse_pair};
 
 const VIEWSHED_AFTER_HELP: &str = "\
@@ -143,17 +144,7 @@ pub fn run(a: ViewshedArgs) -> Result<()> {
     {
         return usage(format!("--max-distance {d}: expected metres > 0"));
     }
-    let tif = a
-        .output
-        .extension()
-        .and_then(|e| e.to_str())
-        .is_some_and(|e| matches!(e.to_ascii_lowercase().as_str(), "tif" | "tiff"));
-    if !tif {
-        return usage(format!(
-            "{}: the output must end in .tif or .tiff (a GeoTIFF)",
-            a.output.display()
-        ));
-    }
+    require_geotiff(&a.output)?;
     // Parse the observer's syntax before reading anything.
     let cell = a
         .observer_cell

@@ -11,21 +11,11 @@ mod reference;
 #[path = "smooth.rs"]
 mod smooth;
 
-/// Every `.rs` file in tests/ is a module of this binary (with `autotests = false`, Cargo would
-/// otherwise leave a new file unbuilt and its tests silently unrun).
+#[path = "../../../tests/support/listed.rs"]
+mod listed;
+
+/// Every `.rs` file in tests/ is a module of this binary.
 #[test]
 fn listed() {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests");
-    let suite = include_str!("suite.rs");
-    for entry in std::fs::read_dir(&dir).unwrap() {
-        let name = entry.unwrap().file_name().into_string().unwrap();
-        if let Some(module) = name.strip_suffix(".rs")
-            && module != "suite"
-        {
-            assert!(
-                suite.contains(&format!("#[path = \"{name}\"]\nmod {module};")),
-                "tests/{name} is not a module of tests/suite.rs: add it there"
-            );
-        }
-    }
+    listed::every_file_is_a_module(env!("CARGO_MANIFEST_DIR"), include_str!("suite.rs"));
 }

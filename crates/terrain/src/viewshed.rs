@@ -453,6 +453,14 @@ enum Near {
 /// The sweep's extrapolation of the horizon height `za` one cell further along a line through the
 /// eye: `za` lies `i − 1` cells from the observer, the result `i` (`za` itself next to it).
 #[inline]
+/// Store a cell's class, horizon height and (when heights are kept) the height it would need.
+fn put(c: usize, cell: (Seen, f64, f32), seen: &mut [Seen], horizon: &mut [f64], need: &mut [f32]) {
+    (seen[c], horizon[c]) = (cell.0, cell.1);
+    if !need.is_empty() {
+        need[c] = cell.2;
+    }
+}
+
 fn line(i: usize, za: f64, eye: f64) -> f64 {
     if i == 1 {
         za
@@ -667,40 +675,33 @@ impl<'a> Scene<'a> {
     /// half-lines.
     fn first_row(&self, first: &mut [f64], seen: &mut [Seen], need: &mut [f32]) {
         let (oc, r) = (self.oc, self.or);
-        let heights = !need.is_empty();
-        first[oc] = self.ground;
-        seen[oc] = Seen::Visible;
-        if heights {
-            need[oc] = self.base(oc, r) as f32;
-        }
-        for s in [-1isize, 1] {
-            let mut prev = oc;
-            for i in 1.. {
-                let c = oc as isize + s * i as isize;
-                if c < 0 || c as usize >= self.w {
-                    break;
-                }
-                let c = c as usize;
-                let r2 = self.r2(c, r);
-                let a = self.adjusted(c, r, r2);
-                let (class, horizon, n) = if i == 1 {
-                    // Beside the observer: seen, whatever the range (as GDAL).
-                    if a.is_nan() {
-                        (Seen::NoData, self.ground, f32::NAN)
-                    } else {
-                        (Seen::Visible, a, self.base(c, r) as f32)
-                    }
+        let cell = (Seen::Visible, self.ground, self.base(oc, r) as f32);
+        put(oc, cell, seen, first, need);
+        for (i, c, prev) in self.outward() {
+            let r2 = self.r2(c, r);
+            let a = self.adjusted(c, r, r2);
+            let cell = if i == 1 {
+                // Beside the observer: seen, whatever the range (as GDAL).
+                if a.is_nan() {
+                    (Seen::NoData, self.ground, f32::NAN)
                 } else {
-                    self.settle(c, r, r2, a, line(i, first[prev], self.eye))
-                };
-                seen[c] = class;
-                first[c] = horizon;
-                if heights {
-                    need[c] = n;
+                    (Seen::Visible, a, self.base(c, r) as f32)
                 }
-                prev = c;
-            }
+            } else {
+                self.settle(c, r, r2, a, line(i, first[prev], self.eye))
+            };
+            put(c, cell, seen, first, need);
         }
+    }
+
+    /// The columns of a row outward from the observer's, the left half-line then the right:
+    /// `(i, c, prev)`, column `c` being `i` columns from the observer's and `prev` the column
+    /// before it on its half-line.
+    fn outward(&self) -> impl Iterator<Item = (usize, usize, usize)> {
+        let (oc, w) = (self.oc, self.w);
+        let left = (1..=oc).map(move |i| (i, oc - i, oc - i + 1));
+        let right = (1..w - oc).map(move |i| (i, oc + i, oc + i - 1));
+        left.chain(right)
     }
 
     /// Row `r` (not the observer's) from the horizon heights `last` of the row before it (one row
@@ -715,7 +716,6 @@ impl<'a> Scene<'a> {
         need: &mut [f32],
     ) {
         let (oc, eye) = (self.oc, self.eye);
-        let heights = !need.is_empty();
         let j = r.abs_diff(self.or);
         // The observer's column: the line through the cell before it.
         let r2 = self.r2(oc, r);
@@ -725,37 +725,20 @@ impl<'a> Scene<'a> {
         } else {
             line(j, last[oc], eye)
         };
-        let (class, horizon, n) = self.settle(oc, r, r2, a, z);
-        (seen[oc], this[oc]) = (class, horizon);
-        if heights {
-            need[oc] = n;
-        }
-        for s in [-1isize, 1] {
-            let mut prev = oc;
-            for i in 1.. {
-                let c = oc as isize + s * i as isize;
-                if c < 0 || c as usize >= self.w {
-                    break;
-                }
-                let c = c as usize;
-                let r2 = self.r2(c, r);
-                let a = self.adjusted(c, r, r2);
-                let z = if i == 1 && j == 1 {
-                    self.near(rule, last[oc], a)
-                } else if i >= j {
-                    // Seen past column i − 1, between rows j − 1 and j.
-                    edge(j, i, last[prev], this[prev], eye)
-                } else {
-                    // Seen past row j − 1, between columns i − 1 and i.
-                    edge(i, j, last[prev], last[c], eye)
-                };
-                let (class, horizon, n) = self.settle(c, r, r2, a, z);
-                (seen[c], this[c]) = (class, horizon);
-                if heights {
-                    need[c] = n;
-                }
-                prev = c;
-            }
+        put(oc, self.settle(oc, r, r2, a, z), seen, this, need);
+        for (i, c, prev) in self.outward() {
+            let r2 = self.r2(c, r);
+            let a = self.adjusted(c, r, r2);
+            let z = if i == 1 && j == 1 {
+                self.near(rule, last[oc], a)
+            } else if i >= j {
+                // Seen past column i − 1, between rows j − 1 and j.
+                edge(j, i, last[prev], this[prev], eye)
+            } else {
+                // Seen past row j − 1, between columns i − 1 and i.
+                edge(i, j, last[prev], last[c], eye)
+            };
+            put(c, self.settle(c, r, r2, a, z), seen, this, need);
         }
     }
 
