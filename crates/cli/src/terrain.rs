@@ -17,7 +17,9 @@ pub enum TerrainCmd {
     /// Build a terrain database (chunked LoD mesh + GST map pyramid) from an elevation grid.
     Build {
         /// Elevation grid: GeoTIFF, ESRI ASCII (.asc), SRTM (.hgt), DTED (.dt0, .dt1, .dt2), ESRI
-        /// GridFloat (.flt) or BIL (.bil) with its .hdr and .prj, 16-bit PNG, or Mapbox Terrain-RGB
+        /// GridFloat (.flt) or BIL (.bil) with its .hdr and .prj, gridded XYZ text (.xyz: `x y z`
+        /// lines as gdal_translate -of XYZ and many agencies' DGM tiles write them, any order,
+        /// unlisted samples no-data, a .prj beside it), 16-bit PNG, or Mapbox Terrain-RGB
         /// or Terrarium PNG (--terrain-rgb, --terrarium); or a lidar point cloud, LAS or LAZ
         /// (`--dem survey.laz`, several tiles one cloud), gridded as --lidar-* says. Several grids
         /// that tile an area (e.g. `--dem N44W072.hgt N44W071.hgt`) are joined as gdalbuildvrt

@@ -60,22 +60,19 @@ fn same_place(a: &Grid, at: (f64, f64), b: &Grid, at_b: (f64, f64), tol: f64) {
     );
 }
 
-/// `grid` (read from `file`) against GDAL's reading: size, georeference (GDAL's geoTransform
-/// gives pixel corners, ours sample centres half a pixel in), the share of valid samples, the
-/// statistics, and the values at the listed samples (GDAL's raw value, the no-data marker where
-/// GDAL reports no-data).
-fn matches_gdal(grid: &Grid, file: &str, crs: CrsKind, epsg: Option<u16>) {
-    let info: serde_json::Value = serde_json::from_str(
-        &std::fs::read_to_string(data(&format!("{file}.gdalinfo.json"))).unwrap(),
-    )
-    .unwrap();
+/// `grid`'s size and sample centres against gdalinfo's (`info`) for `file`: GDAL's geoTransform
+/// gives pixel corners, ours sample centres half a pixel in. gdalinfo prints 16 significant
+/// digits: the tolerance is that rounding's, 1e-9 of a degree (0.1 mm) or of a metre.
+fn placed_like_gdal(grid: &Grid, info: &serde_json::Value, file: &str) {
     let size: [u32; 2] = serde_json::from_value(info["size"].clone()).unwrap();
     assert_eq!([grid.width(), grid.height()], size, "{file}");
-    let t: [f64; 6] = serde_json::from_value(info["geoTransform"].clone()).unwrap();
+    let mut t: [f64; 6] = serde_json::from_value(info["geoTransform"].clone()).unwrap();
+    assert_eq!((t[2], t[4]), (0.0, 0.0), "{file}: GDAL reports no rotation");
+    if t[5] > 0.0 {
+        // GDAL keeps a file's south-first rows (a positive row step); ours are north first.
+        (t[3], t[5]) = (t[3] + size[1] as f64 * t[5], -t[5]);
+    }
     let r = grid.georef();
-    assert_eq!((r.crs, r.epsg), (crs, epsg), "{file}");
-    // gdalinfo prints 16 significant digits: the tolerance is that rounding's, 1e-9 of a degree
-    // (0.1 mm) or of a metre.
     for (ours, gdal, what) in [
         (r.origin_x, t[0] + 0.5 * t[1], "x of sample (0, 0)"),
         (r.origin_y, t[3] + 0.5 * t[5], "y of sample (0, 0)"),
@@ -88,7 +85,20 @@ fn matches_gdal(grid: &Grid, file: &str, crs: CrsKind, epsg: Option<u16>) {
             "{file}: {what}: ours {ours}, GDAL {gdal}, tolerance {tol}"
         );
     }
-    assert_eq!((t[2], t[4]), (0.0, 0.0), "{file}: GDAL reports no rotation");
+}
+
+/// `grid` (read from `file`) against GDAL's reading: size, georeference (GDAL's geoTransform
+/// gives pixel corners, ours sample centres half a pixel in), the share of valid samples, the
+/// statistics, and the values at the listed samples (GDAL's raw value, the no-data marker where
+/// GDAL reports no-data).
+fn matches_gdal(grid: &Grid, file: &str, crs: CrsKind, epsg: Option<u16>) {
+    let info: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(data(&format!("{file}.gdalinfo.json"))).unwrap(),
+    )
+    .unwrap();
+    let r = grid.georef();
+    assert_eq!((r.crs, r.epsg), (crs, epsg), "{file}");
+    placed_like_gdal(grid, &info, file);
     let band = &info["bands"][0];
     let nodata = band["noDataValue"].as_f64();
     // Statistics over the valid samples: GDAL prints the mean to 3 decimals and the valid
@@ -1403,4 +1413,148 @@ fn hostile_lidar_headers_are_errors_naming_the_place() {
     let e = r.unwrap_err().to_string();
     assert!(e.contains("layer.laz") && e.contains("LAZ chunk 0"), "{e}");
     assert!(peak < 8 << 20, "{peak}");
+}
+
+// Gridded XYZ text (tests/data/xyz.sh): GDAL's XYZ driver wrote the ramps and a window of the SRTM
+// tile; GDAL's reading of each is `<file>.gdalinfo.json` and `xyz_gdal_samples.txt`.
+
+/// GDAL's placing of `file` (from `<file>.gdalinfo.json`) against `grid`'s.
+fn xyz_placed_as_gdal(grid: &Grid, file: &str) {
+    let info = std::fs::read_to_string(data(&format!("{file}.gdalinfo.json"))).unwrap();
+    placed_like_gdal(grid, &serde_json::from_str(&info).unwrap(), file);
+}
+
+/// `file`'s samples in xyz_gdal_samples.txt, as `(col, row, GDAL's value)`.
+fn xyz_gdal_samples(file: &str) -> Vec<(u32, u32, f64)> {
+    let text = std::fs::read_to_string(data("xyz_gdal_samples.txt")).unwrap();
+    let v: Vec<(u32, u32, f64)> = text
+        .lines()
+        .map(|l| l.split(' ').collect::<Vec<_>>())
+        .filter(|f| f[0] == file)
+        .map(|f| {
+            (
+                f[1].parse().unwrap(),
+                f[2].parse().unwrap(),
+                f[3].parse().unwrap(),
+            )
+        })
+        .collect();
+    assert_eq!(v.len(), 60, "{file}");
+    v
+}
+
+#[test]
+fn gridded_xyz_reads_as_gdal_reads_it_with_holes_as_no_data() {
+    // The ramps: the GeoTIFFs' samples bit for bit, where GDAL placed them. GDAL's XYZ writer
+    // writes the GeoTIFF's no-data marker (-32768) or nan as a value; both read as no-data here,
+    // as heights in GDAL (the format declares no no-data).
+    for (file, tif, system) in [
+        // ramp_i16.prj, beside it for ramp_i16.bil, gives UTM 54N.
+        (
+            "ramp_i16.xyz",
+            "ramp_i16_lzw.tif",
+            (CrsKind::Projected, Some(32654)),
+        ),
+        (
+            "ramp_geo.xyz",
+            "ramp_f32_geo.tif",
+            (CrsKind::Geographic, Some(4326)),
+        ),
+    ] {
+        let g = read(&data(file));
+        let t = read(&data(tif));
+        xyz_placed_as_gdal(&g, file);
+        assert_eq!((g.georef().crs, g.georef().epsg), system, "{file}");
+        assert!(
+            g.heights()
+                .iter()
+                .zip(t.heights())
+                .all(|(a, b)| a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan())),
+            "{file}: heights differ from {tif}'s"
+        );
+        assert_eq!(g.nodata_count(), 1, "{file}");
+        for (col, row, v) in xyz_gdal_samples(file) {
+            let ours = g.at(col, row);
+            if (col, row) == (5, 3) {
+                assert!(ours.is_nan() && (v == -32768.0 || v.is_nan()), "{file}");
+            } else {
+                assert_eq!(ours as f64, v, "{file} ({col}, {row})");
+            }
+        }
+    }
+    // A spreadsheet's export: header names GDAL does not know, semicolons, decimal commas.
+    let comma = read(&data("ramp_comma.xyz"));
+    let ramp = read(&data("ramp_i16.xyz"));
+    assert_eq!((comma.width(), comma.height()), (37, 29));
+    assert_eq!(comma.georef().origin_x, ramp.georef().origin_x + 0.5);
+    for (a, b) in comma.heights().iter().zip(ramp.heights()) {
+        assert!(a == &(b + 0.25) || (a.is_nan() && b.is_nan()));
+    }
+    // Real heights south row first, a tenth of the lines left out: the SRTM window where listed,
+    // no-data where not (GDAL reads those as 0, which no sample of this window is).
+    let g = read(&data("srtm_gaps.xyz"));
+    xyz_placed_as_gdal(&g, "srtm_gaps.xyz");
+    let hgt = hgt();
+    same_place(&g, (0.0, 0.0), &hgt, (800.0, 850.0), 1e-9);
+    let mut holes = 0;
+    for row in 0..64 {
+        for col in 0..64 {
+            let (ours, want) = (g.at(col, row), hgt.at(800 + col, 850 + row));
+            if want as i32 % 10 == 7 {
+                assert!(ours.is_nan(), "({col}, {row}): {ours}, listed as {want}");
+                holes += 1;
+            } else {
+                assert_eq!(ours, want, "({col}, {row})");
+            }
+        }
+    }
+    assert_eq!(g.nodata_count(), holes);
+    assert_eq!(4096 - holes, 3705, "the lines srtm_gaps.xyz lists");
+    for (col, row, v) in xyz_gdal_samples("srtm_gaps.xyz") {
+        let ours = g.at(col, 63 - row); // GDAL's rows run south to north here
+        if v == 0.0 {
+            assert!(ours.is_nan(), "({col}, {row})");
+        } else {
+            assert_eq!(ours as f64, v, "({col}, {row})");
+        }
+    }
+}
+
+#[test]
+fn xyz_files_that_are_not_grids_are_errors_naming_the_line() {
+    use texmap_terrain::dem::xyz::read_xyz_str;
+    let local = (CrsKind::Local, None);
+    let grid = "0 0 1\n10 0 2\n0 10 3\n10 10 4\n";
+    let g = read_xyz_str(grid, "g.xyz", local).unwrap();
+    assert_eq!(
+        (g.width(), g.height(), g.at(0, 0), g.at(1, 1)),
+        (2, 2, 3.0, 2.0)
+    );
+    for (text, want) in [
+        // x = 14.5 among 0, 10, 20, 30: the smallest step, evened, leaves 10 a third off.
+        (
+            "0 0 1\n10 0 2\n20 0 3\n30 0 4\n14.5 10 5\n0 10 6\n",
+            "line 2",
+        ),
+        // A second line for one sample.
+        ("0 0 1\n10 0 2\n0 10 3\n10 10 4\n0 0 9\n", "line 5"),
+        // Not a number; too few columns.
+        ("x y z\n0 0 1\n10 0 2\n0 ten 3\n10 10 4\n", "line 4"),
+        ("0 0 1\n10 0 2\n0 10\n10 10 4\n", "line 3"),
+        // An infinite height.
+        ("0 0 1\n10 0 2\n0 10 1e39\n10 10 4\n", "line 3"),
+        // Four points a kilometre apart at 1 m: scattered points, not a grid.
+        (
+            "0 0 1\n1000 0 2\n0 1000 3\n1000 1000 4\n1 0 5\n",
+            "scattered",
+        ),
+        // One column.
+        ("0 0 1\n0 10 2\n0 20 3\n0 30 4\n", "two distinct x"),
+        ("0 0 1\n", "at least 4"),
+    ] {
+        let e = read_xyz_str(text, "bad.xyz", local)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("bad.xyz") && e.contains(want), "{text:?}: {e}");
+    }
 }

@@ -141,6 +141,35 @@ fn terrain_readers_survive_the_campaign() {
     report.push_str(&t.report());
     assert!(t.failures.is_empty(), "{}", t.report());
 
+    // Gridded XYZ (text: the first line's x set to extremes, which stretches the lattice).
+    let fx: Vec<Fixture> = ["ramp_i16.xyz", "ramp_geo.xyz"]
+        .iter()
+        .map(|n| {
+            let bytes = data(n);
+            let text = String::from_utf8(bytes.clone()).unwrap();
+            let start = text.find(|c: char| c.is_ascii_digit()).unwrap();
+            let end = start + text[start..].find([' ', ';']).unwrap();
+            unchecked(fixture(
+                n,
+                bytes,
+                vec![("x", Field::Text(start, end))],
+                true,
+            ))
+        })
+        .collect();
+    let t = run_campaign("XYZ", &fx, &settings, &|_, bytes| {
+        let name = "ramp.xyz";
+        match std::str::from_utf8(bytes) {
+            Ok(s) => verdict(
+                dem::xyz::read_xyz_str(s, name, (dem::CrsKind::Local, None)),
+                Path::new(name),
+            ),
+            Err(_) => Verdict::Located("not UTF-8"),
+        }
+    });
+    report.push_str(&t.report());
+    assert!(t.failures.is_empty(), "{}", t.report());
+
     // SRTM .hgt: 1201² big-endian i16 with voids; the size is the whole header, so every cut is
     // an error.
     let mut hgt = Vec::with_capacity(1201 * 1201 * 2);

@@ -100,17 +100,24 @@ pub fn read_ehdr(path: &Path) -> Result<Grid, TerrainError> {
     })
 }
 
-/// Decode an ESRI `.hdr` raster held in memory.
-pub fn read_ehdr_parts(p: &EhdrParts) -> Result<Grid, TerrainError> {
-    let h = parse_header(p.header, p.header_name, p.gridfloat)?;
-    h.check_length(p.data.len() as u64, p.data_name)?;
-    let (crs, epsg) = match p.prj {
-        Some((wkt, name)) => match crate::shapefile::crs_of_wkt(wkt, "gdalwarp")
+/// The system a `.prj` (ESRI or OGC WKT 1, named `name`) gives a grid beside it.
+pub(crate) fn crs_of_prj(wkt: &str, name: &str) -> Result<(CrsKind, Option<u16>), TerrainError> {
+    Ok(
+        match crate::shapefile::crs_of_wkt(wkt, "gdalwarp")
             .map_err(|e| format_err(name, "the system", e))?
         {
             LayerCrs::Lonlat => (CrsKind::Geographic, Some(4326)),
             LayerCrs::Epsg(code, _) => (CrsKind::Projected, Some(code)),
         },
+    )
+}
+
+/// Decode an ESRI `.hdr` raster held in memory.
+pub fn read_ehdr_parts(p: &EhdrParts) -> Result<Grid, TerrainError> {
+    let h = parse_header(p.header, p.header_name, p.gridfloat)?;
+    h.check_length(p.data.len() as u64, p.data_name)?;
+    let (crs, epsg) = match p.prj {
+        Some((wkt, name)) => crs_of_prj(wkt, name)?,
         None => (CrsKind::Local, None),
     };
     let georef = Georef {

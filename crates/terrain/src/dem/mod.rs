@@ -19,8 +19,8 @@
 //! SRTM `.hgt` ([`hgt`]), DTED levels 0–2 ([`dted`]), ESRI GridFloat `.flt` and BIL `.bil` with
 //! their `.hdr` and `.prj` ([`ehdr`]), 16-bit PNG with a scale and offset, and Mapbox Terrain-RGB
 //! and Terrarium PNG ([`png`]), the last two placed in Web Mercator when they are web-map tiles
-//! addressed `Z/X/Y.png` ([`png::TileAddress`]); grids that tile an area join into one
-//! ([`mosaic`], [`read_dems`]: web-map tiles of one zoom only). Airborne lidar point clouds, LAS
+//! addressed `Z/X/Y.png` ([`png::TileAddress`]), and gridded XYZ text ([`xyz`]); grids that tile
+//! an area join into one ([`mosaic`], [`read_dems`]: web-map tiles of one zoom only). Airborne lidar point clouds, LAS
 //! 1.0–1.4 and LAZ ([`las`]), are gridded into a grid as PDAL's `writers.gdal` grids them
 //! ([`lidar`]; several files are one cloud). Each validates at the file
 //! boundary ([`Grid::new`]): at least 2 x 2 samples, at most [`MAX_SAMPLES`], every value finite
@@ -38,6 +38,7 @@ pub mod las;
 pub mod lidar;
 pub mod mosaic;
 pub mod png;
+pub mod xyz;
 
 use crate::error::TerrainError;
 use serde::{Deserialize, Serialize};
@@ -486,6 +487,8 @@ pub enum DemFormat {
     Terrarium,
     /// A lidar point cloud, LAS or LAZ (`.las`, `.laz`), gridded by [`lidar`].
     Las,
+    /// Gridded XYZ text (`.xyz`): an `x y z` line per sample ([`xyz`]).
+    Xyz,
 }
 
 /// Options for the readers that need outside information.
@@ -539,6 +542,7 @@ impl DemFormat {
             "flt" | "bil" | "hdr" => Some(DemFormat::EsriHdr),
             "png" => Some(DemFormat::Png16),
             "las" | "laz" => Some(DemFormat::Las),
+            "xyz" => Some(DemFormat::Xyz),
             _ => None,
         }
     }
@@ -574,7 +578,7 @@ pub fn read_dem(path: impl AsRef<Path>, opts: &ReadOptions) -> Result<Grid, Terr
         .ok_or_else(|| TerrainError::Unsupported {
             source: path.display().to_string(),
             what: "unknown extension (expected .tif, .tiff, .asc, .hgt, .dt0, .dt1, .dt2, .flt, \
-                   .bil, .png, .las or .laz)"
+                   .bil, .png, .las, .laz or .xyz)"
                 .into(),
         })?;
     match format {
@@ -594,6 +598,7 @@ pub fn read_dem(path: impl AsRef<Path>, opts: &ReadOptions) -> Result<Grid, Terr
         DemFormat::TerrainRgb => read_rgb(path, png::RgbEncoding::TerrainRgb, opts),
         DemFormat::Terrarium => read_rgb(path, png::RgbEncoding::Terrarium, opts),
         DemFormat::Las => lidar::read_lidar(&[path.to_path_buf()], &opts.lidar).map(|r| r.0),
+        DemFormat::Xyz => xyz::read_xyz(path),
     }
 }
 
