@@ -67,7 +67,8 @@ pub enum Command {
         /// rst7/inpcrd, HOOMD-blue GSD, SDF/MOL and MOL2 with their bonds, one frame per
         /// record, VASP POSCAR/CONTCAR/XDATCAR, crystallographic CIF, a LAMMPS data file,
         /// CHARMM .crd/.cor, PQR with charges and radii, AutoDock PDBQT, NAMD binary .coor, Tinker .xyz/.arc, DL_POLY CONFIG/HISTORY,
-        /// XCrySDen XSF/AXSF),
+        /// XCrySDen XSF/AXSF, Quantum ESPRESSO pw.x output (.pwo, or .out: every ionic step)
+        /// and input (.pwi, or .in)),
         /// gzip- or bzip2-compressed or not (1abc.cif.gz, prod.mdcrd.bz2). A quoted pattern ('dump.*.lammpstrj') reads
         /// the files it matches in natural order as one trajectory.
         file: PathBuf,

@@ -96,6 +96,17 @@ pub enum Format {
     /// masses, charges and the force field's chemical bonds): see [`crate::read_tpr`]; by
     /// name: `tpr`.
     Tpr,
+    /// Quantum ESPRESSO pw.x output: every ionic step of an scf, relax, vc-relax, md or vc-md
+    /// run that has results a frame (as ASE counts them), with its cell, the species labels,
+    /// forces (`fx fy fz`, eV/Å), energy and stress (in the comment, eV and eV/Å³), step and
+    /// time: `.pwo`, or an `.out` whose first lines hold pw.x's `Program PWSCF` banner; by
+    /// name: `espresso-out`.
+    EspressoOut,
+    /// Quantum ESPRESSO pw.x input: one frame from `ATOMIC_SPECIES`, `ATOMIC_POSITIONS` and the
+    /// cell of `ibrav` 1, 2, 3, 4, 6, 8 with `celldm` or `A, B, C`, or of `CELL_PARAMETERS`
+    /// (ibrav 0): `.pwi`, or an `.in` whose first line that is not a comment opens the
+    /// `&CONTROL` or `&SYSTEM` namelist; by name: `espresso-in`.
+    EspressoIn,
     /// ASE trajectories (ASE's ULM binary format: `ase.io.Trajectory`, its MD drivers and
     /// optimisers): numbers, positions, cell and pbc, momenta as velocities, the calculator's
     /// forces and energies: `.traj`; by name: `ase-traj`.
@@ -104,7 +115,7 @@ pub enum Format {
 
 impl Format {
     /// Every format, in declaration order.
-    pub const ALL: [Format; 29] = [
+    pub const ALL: [Format; 31] = [
         Format::Xyz,
         Format::Pdb,
         Format::Gro,
@@ -134,6 +145,8 @@ impl Format {
         Format::AseTraj,
         Format::Bcif,
         Format::LammpsBin,
+        Format::EspressoOut,
+        Format::EspressoIn,
     ];
 
     /// The format a file extension (case-insensitive, e.g. "xyz", "lammpstrj") or a format's
@@ -170,6 +183,8 @@ impl Format {
             "xsf" | "axsf" => Format::Xsf,
             "tpr" => Format::Tpr,
             "traj" | "ase-traj" => Format::AseTraj,
+            "pwo" | "espresso-out" => Format::EspressoOut,
+            "pwi" | "espresso-in" => Format::EspressoIn,
             _ => return None,
         })
     }
@@ -226,7 +241,8 @@ impl Format {
     /// lines: `data_` (CIF: PDBx/mmCIF or crystallographic, by [`Format::cif_kind`]), a
     /// MessagePack map keyed `encoder`, `version` or `dataBlocks` (BinaryCIF),
     /// `@<TRIPOS>` (MOL2) or an XSF keyword (`CRYSTAL`, `ATOMS`, `ANIMSTEPS`…) on the first
-    /// line that is not a `#` comment, a `*` title on the first non-blank line (CHARMM CRD), `ITEM: TIMESTEP` (LAMMPS), a PDB record name, a fourth line ending in `V2000` or
+    /// line that is not a `#` comment, pw.x's `Program PWSCF` banner (Quantum ESPRESSO output)
+    /// or a first `&CONTROL` / `&SYSTEM` namelist (its input), a `*` title on the first non-blank line (CHARMM CRD), `ITEM: TIMESTEP` (LAMMPS), a PDB record name, a fourth line ending in `V2000` or
     /// `V3000` (molfile, SD file), an integer first line (XYZ), an `N atoms` line after the title
     /// (LAMMPS data file), an integer second line (GRO).
     pub fn from_magic(head: &[u8]) -> Option<Format> {
@@ -292,6 +308,13 @@ impl Format {
         // XSF: an XCrySDen keyword, after comments and blank lines.
         if cif.is_some_and(is_xsf_start) {
             return Some(Format::Xsf);
+        }
+        // Quantum ESPRESSO: pw.x's banner, or an input's first namelist.
+        if crate::espresso::is_output(head) {
+            return Some(Format::EspressoOut);
+        }
+        if crate::espresso::is_input(head) {
+            return Some(Format::EspressoIn);
         }
         let mut lines = head.split(|b| *b == b'\n');
         let first = lines.next().unwrap_or(&[]);
@@ -474,6 +497,8 @@ impl Format {
                 | Format::Tinker
                 | Format::DlPoly
                 | Format::Xsf
+                | Format::EspressoOut
+                | Format::EspressoIn
         )
     }
 
@@ -509,6 +534,8 @@ impl Format {
             Format::Tpr => "tpr",
             Format::AseTraj => "ase-traj",
             Format::Bcif => "bcif",
+            Format::EspressoOut => "espresso-out",
+            Format::EspressoIn => "espresso-in",
         }
     }
 }

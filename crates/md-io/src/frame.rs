@@ -607,6 +607,14 @@ impl Frame {
             .map(|p| p.values.as_slice())
     }
 
+    /// Reserves room for `n` more positions, names and elements (a reader's atoms; the caller
+    /// bounds `n`, see [`crate::text::MAX_RESERVE`]).
+    pub(crate) fn reserve_named(&mut self, n: usize) {
+        self.positions.reserve(n);
+        self.names.reserve(n);
+        self.elements.reserve(n);
+    }
+
     /// The values of the property `name`, a new empty one added if the frame has none yet.
     pub(crate) fn property_mut(&mut self, name: &str) -> &mut Vec<f32> {
         let k = match self.properties.iter().position(|p| p.name == name) {

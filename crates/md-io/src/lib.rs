@@ -16,7 +16,10 @@
 //!   (PDB2PQR/APBS: partial charges and radii as the `charge` and `radius` properties, chains,
 //!   MODEL/ENDMDL frames), AutoDock PDBQT (Vina's poses as frames; charges, AutoDock types and
 //!   the elements they name), Tinker `.xyz`/`.arc` with their bonds, DL_POLY CONFIG/HISTORY,
-//!   XCrySDen XSF / AXSF (each structure a frame, with its cell and forces)
+//!   XCrySDen XSF / AXSF (each structure a frame, with its cell and forces), Quantum ESPRESSO
+//!   pw.x output (every ionic step of scf, relax, vc-relax, md, vc-md runs a frame, as ASE
+//!   counts them: cell, forces, energy and stress) and input (its ibrav or CELL_PARAMETERS
+//!   cell)
 //!   (and the binary DCD, XTC,
 //!   TRR, AMBER NetCDF, NAMD's binary `.coor` and HOOMD-blue GSD: particle types, diameters, per-particle properties
 //!   and bonds, by the hoomd schema's rule for what a frame omits) one frame at a time into a
@@ -141,6 +144,7 @@ mod eigen;
 pub mod elements;
 pub mod energy;
 mod error;
+mod espresso;
 pub mod expr;
 mod format;
 mod frame;

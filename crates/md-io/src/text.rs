@@ -400,10 +400,20 @@ pub(crate) fn need_line<'a, R: Read>(
     ctx: &Ctx,
     expected: &str,
 ) -> Result<(Pos, &'a [u8]), Error> {
+    need_line_with(lines, ctx, &|| expected.to_string())
+}
+
+/// [`need_line`], what was expected written only when the data ends (a count of lines still
+/// due, which would cost a `format!` a line).
+pub(crate) fn need_line_with<'a, R: Read>(
+    lines: &'a mut LineReader<R>,
+    ctx: &Ctx,
+    expected: &dyn Fn() -> String,
+) -> Result<(Pos, &'a [u8]), Error> {
     let p = lines.pos();
     match lines.next_line().map_err(|e| ctx.io(p, e))? {
         Some(l) => Ok(l),
-        None => Err(ctx.truncated(p, expected.to_string())),
+        None => Err(ctx.truncated(p, expected())),
     }
 }
 

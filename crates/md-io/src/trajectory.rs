@@ -59,6 +59,8 @@ enum Reader<R> {
     CharmmCrd(TextReader<R, Crd>),
     Pqr(TextReader<R, Pqr>),
     Xsf(TextReader<R, Xsf>),
+    EspressoOut(TextReader<R, crate::espresso::PwOut>),
+    EspressoIn(TextReader<R, crate::espresso::PwIn>),
     Tpr(crate::tpr::TprReader),
     AseTraj(crate::asetraj::AseTrajReader<R>),
     Bcif(crate::bcif::BcifReader),
@@ -93,6 +95,8 @@ macro_rules! each_reader {
             Reader::CharmmCrd($r) => $body,
             Reader::Pqr($r) => $body,
             Reader::Xsf($r) => $body,
+            Reader::EspressoOut($r) => $body,
+            Reader::EspressoIn($r) => $body,
             Reader::Tpr($r) => $body,
             Reader::AseTraj($r) => $body,
             Reader::Bcif($r) => $body,
@@ -461,6 +465,12 @@ impl<R: Read + Seek> Trajectory<R> {
             Format::CharmmCrd => Reader::CharmmCrd(TextReader::new(src, Crd, file.clone())),
             Format::Pqr => Reader::Pqr(TextReader::new(src, Pqr::new(lenient), file.clone())),
             Format::Xsf => Reader::Xsf(TextReader::new(src, Xsf::default(), file.clone())),
+            Format::EspressoOut => {
+                Reader::EspressoOut(TextReader::new(src, Default::default(), file.clone()))
+            }
+            Format::EspressoIn => {
+                Reader::EspressoIn(TextReader::new(src, Default::default(), file.clone()))
+            }
         };
         Ok(Trajectory {
             reader,

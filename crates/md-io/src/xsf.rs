@@ -773,9 +773,7 @@ impl Xsf {
 
 fn reserve(atoms: &mut Atoms, n: usize) {
     if let Some(f) = atoms.frame.as_deref_mut() {
-        f.positions.reserve(n);
-        f.elements.reserve(n);
-        f.names.reserve(n);
+        f.reserve_named(n);
     }
 }
 

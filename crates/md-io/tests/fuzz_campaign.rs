@@ -978,6 +978,27 @@ fn tinker_campaign() {
     campaign("Tinker", Format::Tinker, fx.into());
 }
 
+/// pw.x 6.7's outputs (a relax, a vc-relax, an md and a vc-md run) and inputs (hexagonal and bcc lattices
+/// with crystal positions, ibrav 0 with alat positions).
+#[test]
+fn espresso_campaign() {
+    let files = [
+        "espresso/si_relax.pwo",
+        "espresso/si_vcrelax.pwo",
+        "espresso/si_md.pwo",
+        "espresso/si_vcmd.pwo",
+    ];
+    let fx = files.map(|f| text_fixture(f, Format::EspressoOut));
+    campaign("Quantum ESPRESSO output", Format::EspressoOut, fx.into());
+    let files = [
+        "espresso/ibrav4_hex.pwi",
+        "espresso/ibrav3_bcc.pwi",
+        "espresso/si_md.pwi",
+    ];
+    let fx = files.map(|f| text_fixture(f, Format::EspressoIn));
+    campaign("Quantum ESPRESSO input", Format::EspressoIn, fx.into());
+}
+
 #[test]
 fn dlpoly_campaign() {
     let files = ["dlpoly/HISTORY", "dlpoly/CONFIG"];

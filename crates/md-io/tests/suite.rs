@@ -52,6 +52,8 @@ mod dlpoly;
 mod elements;
 #[path = "energy.rs"]
 mod energy;
+#[path = "espresso.rs"]
+mod espresso;
 #[path = "expr.rs"]
 mod expr;
 #[path = "fuzz_campaign.rs"]

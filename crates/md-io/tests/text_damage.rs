@@ -45,6 +45,8 @@ const FILES: &[(&str, Format)] = &[
     ("xsf/ase_anim_molecule.axsf", Format::Xsf),
     ("xsf/ase_grid_small.xsf", Format::Xsf),
     ("xsf/pmg_grids.xsf", Format::Xsf),
+    ("espresso/si_md.pwo", Format::EspressoOut),
+    ("espresso/ibrav4_hex.pwi", Format::EspressoIn),
 ];
 
 /// The options a fixture is read with: an AMBER trajectory needs its topology's atom count
@@ -247,7 +249,21 @@ fn frame_ends(bytes: &[u8], format: Format) -> Vec<usize> {
             }
             ends.push(bytes.len());
         }
-        Format::LammpsData | Format::Cube | Format::AmberRestart => {
+        Format::EspressoOut => {
+            // A step ends where the next one's configuration starts: in molecular dynamics its
+            // `Entering Dynamics` line (the positions after the last step, which have no
+            // results, follow the last such line: no frame of their own); an scf run is one
+            // frame, the whole file.
+            for (k, l) in lines.iter().enumerate() {
+                if l.trim_start().starts_with("Entering Dynamics") {
+                    ends.push(line_starts[k]);
+                }
+            }
+            if ends.is_empty() {
+                ends.push(bytes.len());
+            }
+        }
+        Format::LammpsData | Format::Cube | Format::AmberRestart | Format::EspressoIn => {
             // One frame: the whole file (a LAMMPS data file's sections may come in any order;
             // a cube's frame is its molecule, its grid values walked to the end).
             ends.push(bytes.len());

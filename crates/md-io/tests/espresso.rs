@@ -1,0 +1,534 @@
+//! Quantum ESPRESSO pw.x outputs and inputs written and run by pw.x 6.7 (tests/data/espresso/
+//! gen.sh), compared with ASE 3.29's reading of the same files (gen_reference.py) and, for the
+//! inputs ASE does not read (ibrav ≠ 0, alat positions with a cell in angstrom), with the
+//! geometry pw.x itself printed for them.
+//!
+//! Tolerances. Positions are f32 in a [`Frame`]: below 16 Å an f32 rounds to within 4.8e-7 Å,
+//! and ASE's espresso units differ from pw.x's (used here) by 4.6e-10 relative, so 1e-6 Å
+//! bounds both. Cells are f64: 1e-8 Å (the units' difference times 10 Å, with margin). Forces
+//! are f32: 1e-6 eV/Å plus 1e-7 relative. Energies: 1e-9 relative (the Rydbergs differ by
+//! 1.9e-10); stresses 3e-9 relative (Ry/bohr³: the bohrs' difference three times over). An input against pw.x's header is bounded by the header's printed digits: crystal
+//! axes with 6 decimals of alat, positions with 7 (so 5e-7 alat and 5e-8 alat, plus f32), alat
+//! at most twice the longest cell vector for the lattices read here.
+
+use crate::support;
+
+use std::io::Cursor;
+use std::path::PathBuf;
+
+use serde_json::Value;
+use support::alloc::measure;
+use texmap_md_io::{Error, Format, Frame, ReadOptions, Trajectory};
+
+fn path(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/espresso")
+        .join(name)
+}
+
+fn reference() -> Value {
+    serde_json::from_str(&std::fs::read_to_string(path("reference.json")).unwrap()).unwrap()
+}
+
+const OUTPUTS: [&str; 10] = [
+    "si_relax",
+    "si_md",
+    "si_vcrelax",
+    "si_vcmd",
+    "ibrav0_alat",
+    "ibrav1_bohr",
+    "ibrav3_bcc",
+    "ibrav4_hex",
+    "ibrav6_tet",
+    "ibrav8_ortho",
+];
+
+fn rows(v: &Value) -> Vec<[f64; 3]> {
+    v.as_array()
+        .unwrap()
+        .iter()
+        .map(|r| std::array::from_fn(|c| r[c].as_f64().unwrap()))
+        .collect()
+}
+
+fn read_all(t: &mut Trajectory<impl std::io::Read + std::io::Seek>) -> Vec<Frame> {
+    let mut out = Vec::new();
+    let mut f = Frame::new();
+    while t.read_next(&mut f).unwrap() {
+        out.push(f.clone());
+    }
+    out
+}
+
+/// The comment's `key=value` number.
+fn comment_number(f: &Frame, key: &str) -> Option<f64> {
+    f.comment
+        .split(' ')
+        .find_map(|kv| kv.strip_prefix(&format!("{key}=")))
+        .map(|v| v.parse().unwrap())
+}
+
+/// The comment's `stress="…"` as ASE's Voigt order (xx yy zz yz xz xy).
+fn comment_stress(f: &Frame) -> Option<[f64; 6]> {
+    let s = f.comment.split("stress=\"").nth(1)?.split('"').next()?;
+    let v: Vec<f64> = s.split(' ').map(|x| x.parse().unwrap()).collect();
+    assert_eq!(v.len(), 9, "{}", f.comment);
+    assert_eq!(
+        [v[1], v[2], v[5]],
+        [v[3], v[6], v[7]],
+        "symmetric: {}",
+        f.comment
+    );
+    Some([v[0], v[4], v[8], v[5], v[2], v[1]])
+}
+
+/// Largest |a - b| over matching components, asserting the shapes agree.
+fn max_dev(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
+    assert_eq!(a.len(), b.len());
+    a.iter()
+        .zip(b)
+        .flat_map(|(x, y)| (0..3).map(move |c| (x[c] - y[c]).abs()))
+        .fold(0.0, f64::max)
+}
+
+fn positions(f: &Frame) -> Vec<[f64; 3]> {
+    f.positions.iter().map(|p| p.map(f64::from)).collect()
+}
+
+fn cell(f: &Frame) -> Vec<[f64; 3]> {
+    f.cell.unwrap().matrix().to_vec()
+}
+
+/// Compares our frame with ASE's, within the module's tolerances; returns the largest
+/// deviations: positions and cell (Å), forces (eV/Å), energy (relative).
+fn compare(name: &str, k: usize, f: &Frame, w: &Value) -> [f64; 4] {
+    let mut worst = [0.0f64; 4];
+    let symbols: Vec<&str> = f.elements.iter().map(|e| e.symbol()).collect();
+    let want: Vec<&str> = w["symbols"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s.as_str().unwrap())
+        .collect();
+    assert_eq!(symbols, want, "{name} frame {k}");
+    let dp = max_dev(&positions(f), &rows(&w["positions"]));
+    assert!(
+        dp <= 1e-6,
+        "{name} frame {k}: positions off by {dp} Å (tolerance 1e-6)"
+    );
+    let dc = max_dev(&cell(f), &rows(&w["cell"]));
+    assert!(
+        dc <= 1e-8,
+        "{name} frame {k}: cell off by {dc} Å (tolerance 1e-8)"
+    );
+    worst[0] = dp;
+    worst[1] = dc;
+    match w["forces"].as_array() {
+        None => assert!(f.property("fx").is_none(), "{name} frame {k}: no forces"),
+        Some(_) => {
+            for (i, fw) in rows(&w["forces"]).iter().enumerate() {
+                for (c, key) in ["fx", "fy", "fz"].iter().enumerate() {
+                    let got = f64::from(f.property(key).unwrap()[i]);
+                    let tol = 1e-6 + 1e-7 * fw[c].abs();
+                    worst[2] = worst[2].max((got - fw[c]).abs());
+                    assert!(
+                        (got - fw[c]).abs() <= tol,
+                        "{name} frame {k} atom {i} {key}: {got} vs ASE {} (tolerance {tol})",
+                        fw[c]
+                    );
+                }
+            }
+        }
+    }
+    match w["energy"].as_f64() {
+        None => assert_eq!(comment_number(f, "energy"), None, "{name} frame {k}"),
+        Some(e) => {
+            let got = comment_number(f, "energy").unwrap();
+            worst[3] = (got - e).abs() / e.abs();
+            assert!(
+                (got - e).abs() <= 1e-9 * e.abs(),
+                "{name} frame {k}: energy {got} eV vs ASE {e} (tolerance 1e-9 relative)"
+            );
+        }
+    }
+    match w["stress"].as_array() {
+        None => assert_eq!(comment_stress(f), None, "{name} frame {k}"),
+        Some(s) => {
+            let got = comment_stress(f).unwrap();
+            for (c, x) in s.iter().enumerate() {
+                let x = x.as_f64().unwrap();
+                assert!(
+                    (got[c] - x).abs() <= 3e-9 * x.abs() + 1e-15,
+                    "{name} frame {k}: stress {got:?} vs ASE {s:?}"
+                );
+            }
+        }
+    }
+    worst
+}
+
+/// Every frame of every output as ASE reads it: the same count (ASE's rule: a relax's final
+/// coordinates are no frame, a vc-relax's final scf is one, md's positions after the last step
+/// are none), positions, cells, elements, forces, energies and stress.
+#[test]
+fn outputs_as_ase_reads_them() {
+    let r = reference();
+    let mut worst = [0.0f64; 4];
+    let mut total = 0;
+    for name in OUTPUTS {
+        let want = &r["outputs"][name]["frames"];
+        let file = path(&format!("{name}.pwo"));
+        let mut t = Trajectory::open(&file).unwrap();
+        assert_eq!(t.format(), Format::EspressoOut, "{name}");
+        let frames = want.as_array().unwrap();
+        assert_eq!(t.n_frames().unwrap(), frames.len(), "{name}: frame count");
+        let got = read_all(&mut t);
+        assert_eq!(got.len(), frames.len(), "{name}: frames streamed");
+        assert!(t.warnings().is_empty(), "{name}: {:?}", t.warnings());
+        for (k, (f, w)) in got.iter().zip(frames).enumerate() {
+            let d = compare(name, k, f, w);
+            for (w, d) in worst.iter_mut().zip(d) {
+                *w = w.max(d);
+            }
+            total += 1;
+            assert_eq!(f.check(), Ok(()), "{name} frame {k}");
+            assert_eq!(f.step, Some(k as i64), "{name} frame {k}: step");
+            // Random access gives the streamed frame.
+            let mut g = Frame::new();
+            t.read_frame(k, &mut g).unwrap();
+            assert_eq!(&g, f, "{name} frame {k} by index");
+        }
+    }
+    println!(
+        "{total} frames as ASE reads them; largest deviations: positions {:.1e} Å, cells \
+         {:.1e} Å, forces {:.1e} eV/Å, energies {:.1e} relative",
+        worst[0], worst[1], worst[2], worst[3]
+    );
+    let count = |name: &str| r["outputs"][name]["frames"].as_array().unwrap().len();
+    assert_eq!(
+        ["si_relax", "si_md", "si_vcrelax", "si_vcmd"].map(count),
+        [4, 4, 8, 3],
+        "ASE's counts the module doc describes"
+    );
+}
+
+/// What ASE does not keep: the species labels as names, the md's times and steps, the
+/// vc-relax's changing cell and its final scf repeating the last step's geometry.
+#[test]
+fn labels_times_and_the_final_scf() {
+    let mut t = Trajectory::open(path("si_md.pwo")).unwrap();
+    let md = read_all(&mut t);
+    for f in &md {
+        let names: Vec<&str> = f.names.iter().map(|l| l.as_str()).collect();
+        assert_eq!(names, ["Si1", "Si2"]);
+    }
+    let times: Vec<Option<f64>> = md.iter().map(|f| f.time).collect();
+    assert_eq!(times, [Some(0.0), Some(0.001), Some(0.0019), Some(0.0029)]);
+    let mut t = Trajectory::open(path("si_vcrelax.pwo")).unwrap();
+    let vc = read_all(&mut t);
+    assert_eq!(vc.len(), 8);
+    assert_ne!(vc[0].cell, vc[1].cell, "the cell changes");
+    assert_eq!(vc[6].positions, vc[7].positions, "the final scf's geometry");
+    assert_eq!(vc[6].cell, vc[7].cell);
+    assert_ne!(
+        comment_number(&vc[6], "energy"),
+        comment_number(&vc[7], "energy")
+    );
+    // vc-md: the times as pw.x prints them with each step (before the step's move, unlike md).
+    let mut t = Trajectory::open(path("si_vcmd.pwo")).unwrap();
+    let vcmd = read_all(&mut t);
+    let times: Vec<Option<f64>> = vcmd.iter().map(|f| f.time).collect();
+    assert_eq!(times, [None, Some(0.0), Some(0.00097)]);
+    let volumes: Vec<f64> = vcmd.iter().map(|f| f.cell.unwrap().volume()).collect();
+    assert!(
+        volumes.is_sorted() && volumes[0] < volumes[2],
+        "{volumes:?}"
+    );
+    // The relax: frame 0 is the input geometry, never an md time.
+    let mut t = Trajectory::open(path("si_relax.pwo")).unwrap();
+    assert!(read_all(&mut t).iter().all(|f| f.time.is_none()));
+}
+
+/// Two runs in one file (outputs concatenated): each banner starts a run, as ASE reads it.
+#[test]
+fn concatenated_runs() {
+    let r = reference();
+    let mut bytes = std::fs::read(path("si_md.pwo")).unwrap();
+    bytes.extend(std::fs::read(path("si_relax.pwo")).unwrap());
+    let mut t =
+        Trajectory::from_reader(Cursor::new(bytes), Format::EspressoOut, "two.pwo").unwrap();
+    let want = r["concatenated"].as_array().unwrap();
+    assert_eq!(t.n_frames().unwrap(), want.len());
+    let got = read_all(&mut t);
+    for (k, (f, w)) in got.iter().zip(want).enumerate() {
+        compare("concatenated", k, f, w);
+    }
+    let steps: Vec<i64> = got.iter().map(|f| f.step.unwrap()).collect();
+    assert_eq!(steps, [0, 1, 2, 3, 0, 1, 2, 3]);
+}
+
+/// Each input as pw.x read it: the geometry the run's header printed (ASE's frame 0 of the
+/// output), within the printed digits; and as ASE reads the input where it does.
+#[test]
+fn inputs_as_pwx_and_ase_read_them() {
+    let r = reference();
+    let mut read_by_ase = 0;
+    let mut worst = [0.0f64; 4];
+    for name in OUTPUTS.into_iter().chain(["si_vcmd_stopped"]) {
+        let mut t = Trajectory::open(path(&format!("{name}.pwi"))).unwrap();
+        assert_eq!(t.format(), Format::EspressoIn, "{name}");
+        assert_eq!(t.n_frames().unwrap(), 1, "{name}");
+        let f = read_all(&mut t).remove(0);
+        assert_eq!(f.check(), Ok(()), "{name}");
+        // pw.x's header: axes with 6 decimals of alat, positions with 7.
+        let header = &r["outputs"][name]["frames"][0];
+        let want_cell = rows(&header["cell"]);
+        let longest = want_cell
+            .iter()
+            .map(|v| v.iter().map(|x| x * x).sum::<f64>().sqrt())
+            .fold(0.0, f64::max);
+        let alat_bound = 2.0 * longest;
+        let dc = max_dev(&cell(&f), &want_cell);
+        assert!(dc <= 5e-7 * alat_bound, "{name}: cell off pw.x's by {dc} Å");
+        worst[0] = worst[0].max(dc);
+        let dp = max_dev(&positions(&f), &rows(&header["positions"]));
+        assert!(
+            dp <= 5e-8 * alat_bound + 1e-6,
+            "{name}: positions off pw.x's by {dp} Å"
+        );
+        worst[1] = worst[1].max(dp);
+        let symbols: Vec<&str> = f.elements.iter().map(|e| e.symbol()).collect();
+        assert!(symbols.iter().all(|s| *s == "Si"), "{name}: {symbols:?}");
+        // ASE's reading, where it reads the file.
+        if let Some(w) = r["inputs"][name]["frame"].as_object() {
+            read_by_ase += 1;
+            let dp = max_dev(&positions(&f), &rows(&w["positions"]));
+            assert!(dp <= 1e-6, "{name}: positions off ASE's by {dp} Å");
+            let dc = max_dev(&cell(&f), &rows(&w["cell"]));
+            assert!(dc <= 1e-8, "{name}: cell off ASE's by {dc} Å");
+            worst[2] = worst[2].max(dc);
+            worst[3] = worst[3].max(dp);
+        }
+    }
+    assert_eq!(read_by_ase, 2, "ASE reads ibrav0_alat and si_vcrelax");
+    println!(
+        "inputs against pw.x's header: cells {:.1e} Å, positions {:.1e} Å; against ASE: cells \
+         {:.1e} Å, positions {:.1e} Å",
+        worst[0], worst[1], worst[2], worst[3]
+    );
+    // Labels of one element.
+    let mut t = Trajectory::open(path("ibrav6_tet.pwi")).unwrap();
+    let f = read_all(&mut t).remove(0);
+    let names: Vec<&str> = f.names.iter().map(|l| l.as_str()).collect();
+    assert_eq!(names, ["Si1", "Si2"]);
+}
+
+/// An output cut anywhere keeps the frames before the cut under `allow_truncated`, with a
+/// warning; strictly the cut is an error naming the frame. A run that ends without `JOB DONE.`
+/// is cut even when its last step's results are whole.
+#[test]
+fn cut_outputs() {
+    let text = std::fs::read_to_string(path("si_relax.pwo")).unwrap();
+    let lines: Vec<&str> = text.split_inclusive('\n').collect();
+    let find = |from: usize, needle: &str| {
+        from + lines[from..]
+            .iter()
+            .position(|l| l.contains(needle))
+            .unwrap()
+    };
+    let cut_at = |n: usize| lines[..n].concat();
+    let step1 = find(0, "ATOMIC_POSITIONS") + 1;
+    let scf2 = find(step1, "End of self-consistent calculation");
+    let energy2 = find(step1, "!    total energy");
+    let final_coords = find(0, "Begin final coordinates");
+    let job_done = find(0, "JOB DONE.");
+    // (lines kept, frames kept, the frame the strict error names, what it says)
+    let cases = [
+        (scf2 - 2, 1, 1, "the step's results"),
+        (energy2, 1, 1, "the step's '!    total energy' line"),
+        (energy2 + 3, 1, 1, "the step's forces"),
+        (final_coords, 4, 4, "JOB DONE"),
+        (job_done, 4, 4, "JOB DONE"),
+    ];
+    for (n, frames, bad, what) in cases {
+        let cut = cut_at(n);
+        let mut t =
+            Trajectory::from_reader(Cursor::new(cut.clone()), Format::EspressoOut, "cut.pwo")
+                .unwrap();
+        let e = t.n_frames().unwrap_err();
+        let msg = e.to_string();
+        assert!(matches!(e, Error::Truncated { .. }), "{n}: {msg}");
+        assert!(
+            msg.starts_with(&format!("cut.pwo: frame {bad}, line")),
+            "{n}: {msg}"
+        );
+        assert!(msg.contains(what), "{n}: {msg}");
+        let opts = ReadOptions::new().allow_truncated(true);
+        let mut t =
+            Trajectory::from_reader_with(Cursor::new(cut), Format::EspressoOut, "cut.pwo", opts)
+                .unwrap();
+        assert_eq!(t.n_frames().unwrap(), frames, "{n}");
+        assert_eq!(read_all(&mut t).len(), frames, "{n}");
+        assert_eq!(t.warnings().len(), 1, "{n}: {:?}", t.warnings());
+    }
+    // pw.x's own error ends the run: the cut names it.
+    let failed = cut_at(scf2 - 2)
+        + "\n %%%%%%%%%%%%%%\n     Error in routine c_bands (1):\n     too many bands are not converged\n";
+    let mut t =
+        Trajectory::from_reader(Cursor::new(failed), Format::EspressoOut, "failed.pwo").unwrap();
+    let e = t.n_frames().unwrap_err().to_string();
+    assert!(e.contains("pw.x stopped with an error at line"), "{e}");
+    assert!(e.contains("Error in routine c_bands"), "{e}");
+}
+
+/// A real run that pw.x stopped with an error in step 2's scf (si_vcmd_stopped.pwo: the cell
+/// blew up): strictly a cut at frame 2 that names pw.x's error; under `allow_truncated` the two
+/// complete frames, as ASE reads the file.
+#[test]
+fn a_run_pwx_stopped() {
+    let r = reference();
+    let file = path("si_vcmd_stopped.pwo");
+    let mut t = Trajectory::open(&file).unwrap();
+    let e = t.n_frames().unwrap_err();
+    let msg = e.to_string();
+    assert!(matches!(e, Error::Truncated { .. }), "{msg}");
+    assert!(
+        msg.contains("si_vcmd_stopped.pwo: frame 2, line 494"),
+        "{msg}"
+    );
+    assert!(
+        msg.contains("pw.x stopped with an error at line 489: Error in routine electrons (1):"),
+        "{msg}"
+    );
+    let opts = ReadOptions::new().allow_truncated(true);
+    let mut t = Trajectory::open_with(&file, opts).unwrap();
+    let want = r["outputs"]["si_vcmd_stopped"]["frames"]
+        .as_array()
+        .unwrap();
+    assert_eq!(t.n_frames().unwrap(), want.len());
+    let got = read_all(&mut t);
+    assert_eq!(got.len(), 2);
+    for (k, (f, w)) in got.iter().zip(want).enumerate() {
+        compare("si_vcmd_stopped", k, f, w);
+    }
+    assert_eq!(t.warnings().len(), 1);
+}
+
+/// Damage is an error naming the file, frame, line and what was expected; counts in the file
+/// are not trusted to size anything.
+#[test]
+fn damage_is_located() {
+    let out = std::fs::read_to_string(path("si_relax.pwo")).unwrap();
+    let input = std::fs::read_to_string(path("ibrav4_hex.pwi")).unwrap();
+    let err = |text: String, format: Format| -> String {
+        let mut t = Trajectory::from_reader(Cursor::new(text), format, "bad").unwrap();
+        t.n_frames().unwrap_err().to_string()
+    };
+    // An unsupported ibrav is named.
+    let e = err(input.replace("ibrav = 4", "ibrav = 5"), Format::EspressoIn);
+    assert!(e.starts_with("bad: frame 0, line 6, byte"), "{e}");
+    assert!(e.contains("found 'ibrav = 5'"), "{e}");
+    let e = err(input.replace("{crystal}", "crystal_sg"), Format::EspressoIn);
+    assert!(e.contains("crystal_sg"), "{e}");
+    let e = err(input.replace("1/3  2/3", "1/3  2/x"), Format::EspressoIn);
+    assert!(e.starts_with("bad: frame 0, line 15"), "{e}");
+    assert!(e.contains("found '2/x'"), "{e}");
+    let e = err(input.replace("celldm(3) = 1.6,", ""), Format::EspressoIn);
+    assert!(
+        e.contains("celldm(3) (c/a) or C > 0 in &SYSTEM for ibrav = 4"),
+        "{e}"
+    );
+    let e = err(input.replace("  Si  2/3", "  Ge  2/3"), Format::EspressoIn);
+    assert!(
+        e.contains("a species label of the ATOMIC_SPECIES card, found 'Ge'"),
+        "{e}"
+    );
+    let e = err(
+        input.replace("celldm(1) = 7.3D0", "celldm(1) = 7.3D0, A = 3.9"),
+        Format::EspressoIn,
+    );
+    assert!(e.contains("not both"), "{e}");
+    // A damaged output line is named.
+    let e = err(
+        out.replacen(
+            "     atom    2 type  1   force =",
+            "     atom    2 type  1   force = x",
+            1,
+        ),
+        Format::EspressoOut,
+    );
+    assert!(e.starts_with("bad: frame 0, line"), "{e}");
+    assert!(e.contains("a force line"), "{e}");
+    let e = err(
+        out.replacen("celldm(1)=  10.200000", "celldm(1)= -10.200000", 1),
+        Format::EspressoOut,
+    );
+    assert!(e.contains("celldm(1) > 0"), "{e}");
+    // A step without the energy its run's first step printed (the line damaged) is named at the
+    // next step's first line.
+    let second = out.match_indices("!    total energy").nth(1).unwrap().0;
+    let mut damaged = out.clone();
+    damaged.replace_range(second..second + 1, "?");
+    let e = err(damaged, Format::EspressoOut);
+    assert!(e.starts_with("bad: frame 1, line"), "{e}");
+    assert!(
+        e.contains("'!    total energy' line before the next step"),
+        "{e}"
+    );
+    assert!(e.contains("found 'ATOMIC_POSITIONS (alat)'"), "{e}");
+    // Not a pw.x output at all.
+    let e = err("hello\nworld\n".into(), Format::EspressoOut);
+    assert!(e.starts_with("bad: frame 0, line 1, byte 0"), "{e}");
+    assert!(e.contains("Program PWSCF"), "{e}");
+    // Hostile counts: a billion atoms in the header and in the input, read from a small file.
+    let hostile_out = out.replace(
+        "number of atoms/cell      =            2",
+        "number of atoms/cell      =   1000000000",
+    );
+    let hostile_in = input.replace("nat = 2", "nat = 1000000000");
+    for (text, format) in [
+        (hostile_out, Format::EspressoOut),
+        (hostile_in, Format::EspressoIn),
+    ] {
+        let len = text.len();
+        let (e, peak) = measure(|| err(text, format));
+        assert!(e.starts_with("bad: frame 0, line"), "{e}");
+        assert!(
+            peak < 64 * len + (1 << 20),
+            "heap peak {peak} for a {len}-byte file"
+        );
+    }
+}
+
+/// A file is told by its content where its name does not say: pw.x's banner in an `.out`, a
+/// first namelist in an `.in`; an `.in` or `.out` of another program is not taken.
+#[test]
+fn told_by_content() {
+    let dir = tempfile::tempdir().unwrap();
+    let copy = |from: &str, to: &str| {
+        let p = dir.path().join(to);
+        std::fs::copy(path(from), &p).unwrap();
+        p
+    };
+    let t = Trajectory::open(copy("si_md.pwo", "run.out")).unwrap();
+    assert_eq!(t.format(), Format::EspressoOut);
+    let t = Trajectory::open(copy("si_md.pwi", "run.in")).unwrap();
+    assert_eq!(t.format(), Format::EspressoIn);
+    for (name, text) in [
+        ("in.lammps.in", "units real\natom_style full\n"),
+        ("g09.out", " Entering Gaussian System, Link 0=g09\n"),
+        ("ph.in", "&inputph\n  tr2_ph = 1.0d-14\n/\n"),
+    ] {
+        let p = dir.path().join(name);
+        std::fs::write(&p, text).unwrap();
+        let e = Trajectory::open(&p).err().unwrap();
+        assert!(matches!(e, Error::UnknownFormat { .. }), "{name}: {e}");
+    }
+    assert_eq!(Format::from_extension("pwo"), Some(Format::EspressoOut));
+    assert_eq!(
+        Format::from_extension("espresso-in"),
+        Some(Format::EspressoIn)
+    );
+    assert_eq!(Format::from_extension("in"), None);
+    assert_eq!(Format::from_extension("out"), None);
+}
