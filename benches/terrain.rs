@@ -9,11 +9,16 @@
 //! `target/fuji-513.f32` so the peer harness can time martini on the very same samples:
 //! `node bench.mjs <that file> 513 10`.
 //!
+//! `laz_read_*` decodes LASzip's 110,017-point, three-chunk survey
+//! (`crates/terrain/tests/data/lidar/lidar_chunked_12.laz`) on one and on two threads: the
+//! chunks are decoded side by side, so the ratio is the parallel decoding's gain.
+//!
 //!     cargo bench --bench terrain
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
 use texmap_terrain::chunks;
+use texmap_terrain::dem::las::LasReader;
 use texmap_terrain::dem::{Georef, Grid};
 use texmap_terrain::greedy::greedy;
 use texmap_terrain::rtin::{ErrorMap, extract};
@@ -161,6 +166,20 @@ fn bench(c: &mut Criterion) {
     g.bench_function("full_quadtree_4097_2cores", |b| {
         b.iter(|| two.install(|| chunks::build(black_box(&grid), 5.0, 257).unwrap()))
     });
+    let laz = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/crates/terrain/tests/data/lidar/lidar_chunked_12.laz"
+    );
+    let read_all = || {
+        let mut r = LasReader::open(laz).unwrap();
+        let (mut batch, mut n) = (Vec::new(), 0);
+        while r.read_batch(&mut batch).unwrap() > 0 {
+            n += batch.len();
+        }
+        n
+    };
+    g.bench_function("laz_read_110k_1core", |b| b.iter(|| one.install(read_all)));
+    g.bench_function("laz_read_110k_2cores", |b| b.iter(|| two.install(read_all)));
     g.finish();
 }
 

@@ -74,7 +74,10 @@ pub struct EnvRenderArgs {
     #[arg(long, default_value = "builtin")]
     pub scene: String,
     /// Latitude-longitude environment image (PNG, EXR or Radiance .hdr as HDRI libraries serve
-    /// them, width = 2 x height); default: a built-in sky.
+    /// them, width = 2 x height; its centre is the −z direction, its top +y); default: a built-in
+    /// sky. A cube map or skybox converts with ffmpeg, whose equirectangular layout is this one:
+    /// `ffmpeg -i cube3x2.png -vf v360=c3x2:e env.png` (faces in ffmpeg's order r l u d f b, f
+    /// becoming −z).
     #[arg(long, value_name = "FILE")]
     pub env: Option<PathBuf>,
     #[arg(long, value_enum, default_value = "sphere-dynamic")]

@@ -932,6 +932,48 @@ fn lidar_files_read_as_laspy_reads_them() {
     }
 }
 
+/// LAZ of three LASzip chunks (tests/data/lidar/gen_chunked.py), point-wise (LAS 1.2 format 1)
+/// and layered (1.4 format 6): decoded a window of whole chunks at a time, the chunks side by
+/// side, to laspy's points, the same for any thread count (the window is two chunks a thread).
+#[test]
+fn chunked_laz_decodes_in_parallel_as_laspy_reads_it() {
+    let text = std::fs::read_to_string(data("lidar/lidar_chunked_laspy.json")).unwrap();
+    let refs: serde_json::Value = serde_json::from_str(&text).unwrap();
+    for name in ["lidar_chunked_12.laz", "lidar_chunked_14.laz"] {
+        let want = &refs[name];
+        let path = data(&format!("lidar/{name}"));
+        assert_eq!(want["chunk_points"].as_array().unwrap().len(), 3, "{name}");
+        let read = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| all_points(&path))
+        };
+        let pts = read(1);
+        assert_eq!(pts.len() as u64, want["point_count"].as_u64().unwrap());
+        let h = LasReader::open(&path).unwrap().header().clone();
+        let raw = |v: f64, k: usize| ((v - h.offset[k]) / h.scale[k]).round() as i64;
+        for (k, key) in ["sum_X", "sum_Y", "sum_Z"].iter().enumerate() {
+            let sum: i64 = pts.iter().map(|p| raw([p.x, p.y, p.z][k], k)).sum();
+            assert_eq!(sum, want[key].as_i64().unwrap(), "{name} {key}");
+        }
+        for s in want["samples"].as_array().unwrap() {
+            let s = s.as_array().unwrap();
+            let p = pts[s[0].as_u64().unwrap() as usize];
+            for (got, exp) in [(p.x, &s[1]), (p.y, &s[2]), (p.z, &s[3])] {
+                assert!((got - exp.as_f64().unwrap()).abs() <= 1e-9, "{name} {s:?}");
+            }
+            assert_eq!(p.class as u64, s[4].as_u64().unwrap(), "{name} {s:?}");
+        }
+        let vegetation = pts.iter().filter(|p| p.class == 5).count() as u64;
+        assert_eq!(vegetation, want["classes"]["5"].as_u64().unwrap(), "{name}");
+        for threads in [2, 3] {
+            assert!(read(threads) == pts, "{name}: {threads} threads");
+        }
+    }
+}
+
 /// An ESRI ASCII grid's header and values as doubles (the f32 reader would round GDAL's six
 /// decimals).
 fn asc_f64(path: &Path) -> (Vec<(String, f64)>, Vec<f64>) {

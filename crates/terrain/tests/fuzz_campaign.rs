@@ -452,6 +452,9 @@ fn lidar_readers_survive_the_campaign() {
         "lidar_14.las",
         "lidar_12.laz",
         "lidar_14.laz",
+        // Three chunks each: decoded in parallel windows.
+        "lidar_chunked_12.laz",
+        "lidar_chunked_14.laz",
     ] {
         let bytes = data(&format!("lidar/{name}"));
         let u32_at = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;

@@ -28,7 +28,11 @@
 //! present and inside the file, its chunk sizes adding up to the compressed bytes and its chunks
 //! to the header's point count, and for the layered chunks of formats 6–10 every chunk's layer
 //! sizes inside the chunk. The crate sizes its buffers from those numbers, so one flipped bit
-//! in them would otherwise allocate gigabytes or panic.
+//! in them would otherwise allocate gigabytes or panic. A file of several chunks of at most
+//! 262,144 points each (LASzip writes 50,000) is decoded a window of whole chunks at a time, two
+//! chunks for each rayon thread, the chunks side by side (the crate's `ParLasZipDecompressor`);
+//! the points come out in the file's order, so what is made from them does not depend on the
+//! thread count. Other files are decoded serially, a batch at a time.
 //!
 //! **Nothing is sized from a claim**: the header's point count, VLR and EVLR counts and lengths
 //! and the chunk table are checked against the file's length before anything is read or
@@ -149,10 +153,32 @@ pub struct LasReader {
 enum Body {
     Plain(BufReader<File>),
     Laz {
-        dec: Box<laz::LasZipDecompressor<'static, BufReader<File>>>,
+        dec: LazStream,
         /// `(first point, points, first byte)` of every chunk.
         chunks: Vec<(u64, u64, u64)>,
     },
+}
+
+/// A LASzip stream decoded one batch at a time, or (several chunks of at most [`PAR_CHUNK`]
+/// points) a window of [`par_window`] whole chunks at a time, the chunks decoded side by side.
+enum LazStream {
+    Serial(Box<laz::LasZipDecompressor<'static, BufReader<File>>>),
+    Parallel {
+        dec: Box<laz::ParLasZipDecompressor<BufReader<File>>>,
+        /// The decoded records of the current window, and how many of its bytes are served.
+        window: Vec<u8>,
+        served: usize,
+    },
+}
+
+/// The most points a chunk may hold for the chunks to be decoded in parallel (LASzip writes
+/// 50,000): a window's records are allocated whole, so a chunk table claiming more is decoded
+/// serially, a batch at a time.
+const PAR_CHUNK: u64 = 1 << 18;
+
+/// Chunks decoded per parallel window: two for each worker thread.
+fn par_window() -> usize {
+    2 * rayon::current_num_threads()
 }
 
 fn u16_at(b: &[u8], at: usize) -> u16 {
@@ -561,7 +587,10 @@ impl LasReader {
                 path: self.source.clone().into(),
                 source: e,
             })?,
-            Body::Laz { dec, chunks } => {
+            Body::Laz {
+                dec: LazStream::Serial(dec),
+                chunks,
+            } => {
                 if let Err(e) = dec.decompress_many(raw) {
                     let k = chunk_of(chunks, self.next);
                     return Err(format_err(
@@ -575,6 +604,41 @@ impl LasReader {
                         format!("LASzip-compressed points ({e})"),
                     ));
                 }
+            }
+            Body::Laz {
+                dec:
+                    LazStream::Parallel {
+                        dec,
+                        window,
+                        served,
+                    },
+                chunks,
+            } => {
+                if *served == window.len() {
+                    // The next window: whole chunks from the one holding the next point (windows
+                    // and batches both end at chunk ends, so it starts one).
+                    let k = chunk_of(chunks, self.next);
+                    let end = (k + par_window()).min(chunks.len());
+                    let points: u64 = chunks[k..end].iter().map(|c| c.1).sum();
+                    window.resize(points as usize * rl, 0);
+                    *served = 0;
+                    if let Err(e) = dec.decompress_many(window) {
+                        window.clear();
+                        return Err(format_err(
+                            &self.source,
+                            format!(
+                                "points {}..{} (LAZ chunks {k}..{} from byte {})",
+                                self.next,
+                                self.next + points,
+                                end - 1,
+                                chunks[k].2
+                            ),
+                            format!("LASzip-compressed points ({e})"),
+                        ));
+                    }
+                }
+                raw.copy_from_slice(&window[*served..*served + n * rl]);
+                *served += n * rl;
             }
         }
         let h = &self.header;
@@ -936,10 +1000,18 @@ fn open_laz(
         }
     }
     reader.seek(SeekFrom::Start(start)).map_err(io(path))?;
-    let dec = laz::LasZipDecompressor::new(reader, laz_vlr)
-        .map_err(|e| bad(at, format!("a LASzip stream the decompressor opens ({e})")))?;
-    Ok(Body::Laz {
-        dec: Box::new(dec),
-        chunks,
-    })
+    let opened =
+        |e: laz::LasZipError| bad(at, format!("a LASzip stream the decompressor opens ({e})"));
+    let dec = if chunks.len() > 1 && chunks.iter().all(|c| c.1 <= PAR_CHUNK) {
+        LazStream::Parallel {
+            dec: Box::new(laz::ParLasZipDecompressor::new(reader, laz_vlr).map_err(opened)?),
+            window: Vec::new(),
+            served: 0,
+        }
+    } else {
+        LazStream::Serial(Box::new(
+            laz::LasZipDecompressor::new(reader, laz_vlr).map_err(opened)?,
+        ))
+    };
+    Ok(Body::Laz { dec, chunks })
 }
