@@ -128,7 +128,7 @@ fn missing_and_garbage_files_are_errors_naming_the_file() {
     std::fs::write(&p, b"II*\0garbage").unwrap();
     let e = read_dem(&p, &ReadOptions::default()).unwrap_err();
     assert!(e.to_string().contains("junk.tif"), "{e}");
-    let p = dir.path().join("x.xyz");
+    let p = dir.path().join("x.abc");
     std::fs::write(&p, b"1").unwrap();
     assert!(
         read_dem(&p, &ReadOptions::default())
@@ -136,6 +136,13 @@ fn missing_and_garbage_files_are_errors_naming_the_file() {
             .to_string()
             .contains("unknown extension")
     );
+    // A known extension over garbage: the reader's located error.
+    let p = dir.path().join("x.xyz");
+    std::fs::write(&p, b"1").unwrap();
+    let e = read_dem(&p, &ReadOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("x.xyz") && e.contains("line 1"), "{e}");
 }
 
 #[test]
