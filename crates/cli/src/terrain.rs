@@ -24,19 +24,26 @@ pub enum TerrainCmd {
         /// (`--dem survey.laz`, several tiles one cloud), gridded as --lidar-* says. Several grids
         /// that tile an area (e.g. `--dem N44W072.hgt N44W071.hgt`) are joined as gdalbuildvrt
         /// joins them: one system, cell size and lattice; the later file wins where they overlap,
-        /// and samples no file covers are no-data. Web-map elevation tiles stored as Z/X/Y.png
+        /// and samples no file covers are no-data. A GDAL VRT (`--dem dem.vrt`, as gdalbuildvrt
+        /// or gdal_translate -of VRT write them) is read as GDAL composites it. Web-map elevation
+        /// tiles stored as Z/X/Y.png
         /// (`--dem tiles/12/1205/1539.png tiles/12/1206/1539.png`, or a directory of them) are
         /// placed in Web Mercator (EPSG:3857) by their address, XYZ scheme, the tile's bounds the
         /// outer edges of its pixels; tiles of one zoom only.
         #[arg(long, num_args = 1.., required = true)]
         dem: Vec<PathBuf>,
-        /// Orthophoto (PNG, JPEG or GeoTIFF), placed by its georeference or stretched. A GeoTIFF in
-        /// another system than the DEM's is reprojected (WGS 84 degrees, UTM of WGS 84, ETRS89
-        /// or NAD83, Web Mercator EPSG:3857). Without a photo the views are textured with shaded
-        /// relief (height colours lit like `gdaldem hillshade`).
-        #[arg(long)]
-        photo: Option<PathBuf>,
-        /// GeoTIFF photo bands for red, green, blue (1-based), e.g. 3,2,1.
+        /// Orthophoto (PNG, JPEG, GeoTIFF or GDAL VRT), placed by its georeference or stretched.
+        /// A photo in another system than the DEM's is reprojected (WGS 84 degrees, UTM of WGS
+        /// 84, ETRS89 or NAD83, Web Mercator EPSG:3857). Several photo tiles (`--photo
+        /// tiles/*.tif`, or a directory of GeoTIFFs) are mosaicked as gdalbuildvrt would: each
+        /// placed by its own georeference, later wins where they overlap, and a tile's no-data
+        /// (GDAL_NODATA in every band) and transparent pixels (an alpha band, as gdalwarp
+        /// -dstalpha writes) show the tile below; a tile in another system than the first is
+        /// reprojected into the mosaic. Where no photo covers the DEM, and without a photo at
+        /// all, the texture is shaded relief (height colours lit like `gdaldem hillshade`).
+        #[arg(long, num_args = 1..)]
+        photo: Vec<PathBuf>,
+        /// Photo bands for red, green, blue (1-based), e.g. 3,2,1 (each tile's, in a mosaic).
         #[arg(long)]
         bands: Option<String>,
         /// Maximum vertical error of the finest level, metres.
@@ -117,7 +124,8 @@ pub enum TerrainCmd {
     /// Print a grid's or a database's size, georeference, height range, no-data count, levels and
     /// triangles per level as one JSON object.
     Info {
-        /// A database directory or an elevation file.
+        /// A database directory or an elevation file (a GDAL VRT also reports its bands and
+        /// sources).
         path: PathBuf,
     },
     /// Export the whole terrain at an error as .glb (texture embedded) or .obj (+ .mtl, .png), or
@@ -312,9 +320,10 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
                 .iter()
                 .map(texmap_terrain::vector::read_vector)
                 .collect::<Result<Vec<_>, _>>()?;
-            let photo = photo
-                .map(|p| texmap_terrain::photo::open_photo(&p, bands))
-                .transpose()?;
+            let photo = match photo.is_empty() {
+                true => None,
+                false => Some(texmap_terrain::photo::open_photos(&photo, bands)?),
+            };
             let pb = crate::commands::progress(1, "building");
             let bo = BuildOptions {
                 max_error,
@@ -374,7 +383,12 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
                 })
             } else {
                 let grid = dem::read_dem(&path, &ReadOptions::default())?;
-                db::grid_info(&grid, &path.display().to_string())
+                let mut info = db::grid_info(&grid, &path.display().to_string());
+                if dem::vrt::is_vrt(&path) {
+                    let v = dem::vrt::Vrt::open(&path, dem::vrt::Use::Elevation)?;
+                    info["vrt"] = v.summary();
+                }
+                info
             };
             println!("{}", serde_json::to_string(&v)?);
             Ok(())

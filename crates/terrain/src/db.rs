@@ -5,7 +5,8 @@
 //! DIR/grid.f32                 the heights, little-endian f32 row-major (NaN = no-data): exports at any error
 //! DIR/chunks/D/IX_IY.bin       "TMCK", u32 version, u32 vertices, u32 triangles, u32 surface triangles,
 //!                              positions (3 f32), uvs (2 f32), triangles (3 u32), little-endian
-//! DIR/tiles/L/X_Y.png          GST maps, T x T RGBA
+//! DIR/tiles/L/X_Y.png          GST maps, T x T RGBA: the photo, and the grid's shaded relief where
+//!                              no photo covers (gst::Drawn::relief_under)
 //! ```
 //! A build writes everything into a sibling temporary directory and renames it to `DIR` at the
 //! end, so an interrupted or failed build never leaves a half-written database (the temporary is
@@ -411,8 +412,11 @@ fn build_into(
                 grid,
                 opts.map_texels,
                 tex_levels,
-                opts.contours.as_ref(),
-                overlay.as_ref(),
+                &gst::Drawn {
+                    relief_under: true,
+                    contours: opts.contours.as_ref(),
+                    overlay: overlay.as_ref(),
+                },
                 &write,
                 &read,
                 &mut |_| {

@@ -3,9 +3,13 @@
 //!
 //! **Placement.** The texture spans the DEM's extent from the centre of sample (0, 0) (`u, v = 0`)
 //! to that of the last sample (`u, v = 1`), the same `[0, 1]²` the chunk vertices' texture
-//! coordinates use. A photo with a georeference (a GeoTIFF) is sampled where it lies; texels
-//! outside it are transparent (alpha 0) and no overlap at all is an error. A photo without one
-//! (PNG, JPEG, a plain TIFF) is stretched over the extent.
+//! coordinates use. A photo with a georeference (a GeoTIFF, a VRT, a mosaic of tiles) is sampled
+//! where it lies; texels outside it are transparent (alpha 0) and no overlap at all is an error.
+//! A photo without one (PNG, JPEG, a plain TIFF) is stretched over the extent. Colours are
+//! interpolated weighted by their alpha (premultiplied), so that the transparent pixels of a
+//! photo's no-data, alpha band or mosaic gaps lend no colour to the texels beside them; a
+//! database draws the grid's shaded relief under the texels the photo does not fully cover
+//! ([`Drawn::relief_under`]), the texture a database without a photo has.
 //!
 //! **Reprojection.** A photo in another coordinate system than the grid's is reprojected on the
 //! fly: each texel's grid coordinates go through longitude and latitude into the photo's system
@@ -46,44 +50,22 @@ pub struct Orthophoto {
     pub source: String,
 }
 
-/// Read an orthophoto: PNG or JPEG through `image`, TIFF through the GeoTIFF reader with `bands`
-/// (1-based, default 1,2,3 or band 1 as grey).
+/// Read an orthophoto whole: PNG or JPEG through `image`; a TIFF or a GDAL VRT through
+/// [`crate::photo::TiffPhoto`] and [`crate::photo::VrtPhoto`] (the same pixels as their rows) with
+/// `bands` (1-based, default 1,2,3 or band 1 as grey).
 pub fn read_photo(path: &Path, bands: Option<[u16; 3]>) -> Result<Orthophoto, TerrainError> {
     let source = path.display().to_string();
-    if crate::photo::is_tiff(path) {
-        let band_count = crate::dem::geotiff::band_count(path)?;
-        let pick = crate::photo::pick_bands(bands, band_count)?;
-        let r = crate::dem::geotiff::read_raster(path, Some(&pick), 1 << 28)?;
-        let n = r.width as usize * r.height as usize;
-        let scale: Vec<(f32, f32)> = r
-            .bands
-            .iter()
-            .map(|b| {
-                if r.bits <= 8 {
-                    (0.0, 1.0)
-                } else {
-                    let lo = b.iter().copied().fold(f32::INFINITY, f32::min);
-                    let hi = b.iter().copied().fold(f32::NEG_INFINITY, f32::max);
-                    (lo, if hi > lo { 255.0 / (hi - lo) } else { 0.0 })
-                }
-            })
-            .collect();
-        let mut img = RgbaImage::new(r.width, r.height);
-        for i in 0..n {
-            let c = |k: usize| {
-                ((r.bands[k][i] - scale[k].0) * scale[k].1)
-                    .round()
-                    .clamp(0.0, 255.0) as u8
-            };
-            img.put_pixel(
-                (i % r.width as usize) as u32,
-                (i / r.width as usize) as u32,
-                Rgba([c(0), c(1), c(2), 255]),
-            );
-        }
+    let rows: Option<Box<dyn PhotoSource>> = if crate::photo::is_tiff(path) {
+        Some(Box::new(crate::photo::TiffPhoto::open(path, bands)?))
+    } else if crate::dem::vrt::is_vrt(path) {
+        Some(Box::new(crate::photo::VrtPhoto::open(path, bands)?))
+    } else {
+        None
+    };
+    if let Some(p) = rows {
         return Ok(Orthophoto {
-            image: img,
-            georef: r.georef,
+            image: p.rows(0, p.size().1)?,
+            georef: p.georef(),
             source,
         });
     }
@@ -117,12 +99,11 @@ pub struct Pyramid {
 
 /// Bilinear sample at continuous pixel position `(x, y)` (pixel corners at integers) of a
 /// `w x h` image whose pixel `(i, j)` is `px(i, j)`, clamped at the image's edges.
-fn bilinear(w: i64, h: i64, px: impl Fn(u32, u32) -> [u8; 4], x: f64, y: f64) -> [f64; 4] {
+fn bilinear(w: i64, h: i64, px: impl Fn(u32, u32) -> [f64; 4], x: f64, y: f64) -> [f64; 4] {
     let (fx, fy) = (x - 0.5, y - 0.5);
     let (x0, y0) = (fx.floor(), fy.floor());
     let (ax, ay) = (fx - x0, fy - y0);
-    let px =
-        |i: i64, j: i64| px(i.clamp(0, w - 1) as u32, j.clamp(0, h - 1) as u32).map(|c| c as f64);
+    let px = |i: i64, j: i64| px(i.clamp(0, w - 1) as u32, j.clamp(0, h - 1) as u32);
     let (x0, y0) = (x0 as i64, y0 as i64);
     let (a, b, c, d) = (
         px(x0, y0),
@@ -135,9 +116,11 @@ fn bilinear(w: i64, h: i64, px: impl Fn(u32, u32) -> [u8; 4], x: f64, y: f64) ->
     })
 }
 
-/// Where a photo lies over a grid: texture coordinates `(u, v)` over the DEM extent to photo
-/// pixel positions (see the module docs).
-struct Placement {
+/// Where a photo lies over a lattice (a grid's samples, or a photo mosaic's pixels): texture
+/// coordinates `(u, v)` over the lattice's extent, from the centre of its first sample to that of
+/// its last, to photo pixel positions (see the module docs).
+#[derive(Debug)]
+pub(crate) struct Placement {
     grid: Georef,
     gw: f64,
     gh: f64,
@@ -164,16 +147,18 @@ fn crs_name(g: &Georef) -> String {
 }
 
 impl Placement {
-    fn new(
-        grid: &Grid,
+    /// The photo of `size` pixels at `georef` over the `lattice.1 x lattice.2` samples of
+    /// `lattice.0`; an error when none of it lies there.
+    pub(crate) fn new(
+        lattice: (&Georef, u32, u32),
         size: (u32, u32),
         georef: Option<Georef>,
         source: &str,
     ) -> Result<Placement, TerrainError> {
         let mut p = Placement {
-            grid: *grid.georef(),
-            gw: (grid.width() - 1) as f64,
-            gh: (grid.height() - 1) as f64,
+            grid: *lattice.0,
+            gw: lattice.1.saturating_sub(1) as f64,
+            gh: lattice.2.saturating_sub(1) as f64,
             photo: georef,
             pw: size.0 as f64,
             ph: size.1 as f64,
@@ -341,7 +326,7 @@ impl Placement {
     }
 
     /// Photo pixel position (continuous, pixel corners at integers) of texture coordinates.
-    fn to_photo(&self, u: f64, v: f64) -> (f64, f64) {
+    pub(crate) fn to_photo(&self, u: f64, v: f64) -> (f64, f64) {
         match (&self.photo, &self.lattice) {
             (Some(_), Some((k, nodes))) => {
                 let k = *k;
@@ -366,28 +351,34 @@ impl Placement {
     }
 
     /// The texel of a `size`-sided texture at `(tx, ty)`: the photo sampled bilinearly through
-    /// `px`, transparent outside the photo.
-    fn texel(&self, size: u32, tx: u32, ty: u32, px: impl Fn(u32, u32) -> [u8; 4]) -> Rgba<u8> {
+    /// `px` with its colours weighted by their alpha (premultiplied, so that a transparent pixel
+    /// lends a texel none of its colour), transparent outside the photo; not rounded.
+    fn texel(&self, size: u32, tx: u32, ty: u32, px: impl Fn(u32, u32) -> [u8; 4]) -> [f64; 4] {
         let inv = 1.0 / (size - 1).max(1) as f64;
         let (x, y) = self.to_photo(tx as f64 * inv, ty as f64 * inv);
         let inside = x >= 0.0 && y >= 0.0 && x <= self.pw && y <= self.ph;
         if !inside {
-            return Rgba([0, 0, 0, 0]);
+            return [0.0; 4];
         }
-        let c = bilinear(self.pw as i64, self.ph as i64, px, x, y);
-        Rgba([
-            c[0].round() as u8,
-            c[1].round() as u8,
-            c[2].round() as u8,
-            c[3].round() as u8,
-        ])
+        let premultiplied = |i, j| {
+            let [r, g, b, a] = px(i, j);
+            // An opaque pixel is its colour exactly (a / 255 = 1).
+            let k = a as f64 / 255.0;
+            [r as f64 * k, g as f64 * k, b as f64 * k, a as f64]
+        };
+        bilinear(self.pw as i64, self.ph as i64, premultiplied, x, y)
     }
 
     /// The photo rows bilinear reads for texture rows `ty0..ty1` of a `size`-sided texture
     /// (`None` when none of them lies on the photo).
     fn rows_for(&self, size: u32, ty0: u32, ty1: u32) -> Option<(u32, u32)> {
         let inv = 1.0 / (size - 1).max(1) as f64;
-        let (v0, v1) = (ty0 as f64 * inv, (ty1 - 1) as f64 * inv);
+        self.rows_between(ty0 as f64 * inv, (ty1 - 1) as f64 * inv)
+    }
+
+    /// The photo rows bilinear reads for texture coordinates `v0..=v1` (`None` when none of them
+    /// lies on the photo).
+    pub(crate) fn rows_between(&self, v0: f64, v1: f64) -> Option<(u32, u32)> {
         let (lo, hi) = match &self.lattice {
             // Bilinear positions lie between their cell's nodes: bound by the nodes of the
             // lattice rows the texture rows fall in.
@@ -422,13 +413,36 @@ impl Placement {
     }
 }
 
+/// A grid's samples as the lattice a photo is placed over.
+fn lattice(grid: &Grid) -> (&Georef, u32, u32) {
+    (grid.georef(), grid.width(), grid.height())
+}
+
 /// Resample `photo` over the grid's extent into a `size x size` texture (see the module docs).
+/// Where the photo is transparent its texels are too, their colours premultiplied by alpha.
 pub fn place(photo: &Orthophoto, grid: &Grid, size: u32) -> Result<RgbaImage, TerrainError> {
     let img = &photo.image;
-    let p = Placement::new(grid, img.dimensions(), photo.georef, &photo.source)?;
+    let p = Placement::new(lattice(grid), img.dimensions(), photo.georef, &photo.source)?;
     Ok(RgbaImage::from_fn(size, size, |tx, ty| {
-        p.texel(size, tx, ty, |i, j| img.get_pixel(i, j).0)
+        Rgba(round(p.texel(size, tx, ty, |i, j| img.get_pixel(i, j).0)))
     }))
+}
+
+fn round(c: [f64; 4]) -> [u8; 4] {
+    c.map(|v| v.round() as u8)
+}
+
+/// What a pyramid's finest level draws besides the photo ([`write_pyramid_with`]).
+#[derive(Clone, Copy, Default)]
+pub struct Drawn<'a> {
+    /// The grid's shaded relief ([`crate::relief::relief_texel`], one sample per texel) under
+    /// the photo, where the photo does not cover: beyond it, and at its no-data and transparent
+    /// pixels (composited under the premultiplied texel: `C + relief·(1 − A/255)`, opaque).
+    pub relief_under: bool,
+    /// Contour lines ([`crate::relief::Contours`]), over the photo.
+    pub contours: Option<&'a crate::relief::Contours>,
+    /// Vector overlays ([`crate::vector::Overlay`], placed on this pyramid's finest level), last.
+    pub overlay: Option<&'a crate::vector::Overlay>,
 }
 
 /// Box-average four `T x T` child maps (north-west, north-east, south-west, south-east) into
@@ -464,22 +478,22 @@ pub fn write_pyramid(
     read: &(dyn Fn(MapKey) -> Result<RgbaImage, TerrainError> + Sync),
     progress: &mut dyn FnMut(u32),
 ) -> Result<(), TerrainError> {
+    let drawn = Drawn::default();
     write_pyramid_with(
-        photo, grid, map_texels, levels, None, None, write, read, progress,
+        photo, grid, map_texels, levels, &drawn, write, read, progress,
     )
 }
 
-/// [`write_pyramid`] with contour lines ([`crate::relief::Contours`]) and then vector overlays
-/// ([`crate::vector::Overlay`], placed on this pyramid's finest level) drawn into the finest
-/// level's texels; the coarser levels average them down like the photo.
+/// [`write_pyramid`] with the shaded relief under the photo, contour lines and then vector
+/// overlays drawn into the finest level's texels ([`Drawn`]); the coarser levels average them
+/// down like the photo.
 #[allow(clippy::too_many_arguments)]
 pub fn write_pyramid_with(
     photo: &dyn PhotoSource,
     grid: &Grid,
     map_texels: u32,
     levels: u32,
-    contours: Option<&crate::relief::Contours>,
-    overlay: Option<&crate::vector::Overlay>,
+    drawn: &Drawn,
     write: &(dyn Fn(MapKey, &RgbaImage) -> Result<(), TerrainError> + Sync),
     read: &(dyn Fn(MapKey) -> Result<RgbaImage, TerrainError> + Sync),
     progress: &mut dyn FnMut(u32),
@@ -497,7 +511,14 @@ pub fn write_pyramid_with(
     let n = 1u32 << finest;
     let size = t << finest;
     let (pw, ph) = photo.size();
-    let p = Placement::new(grid, (pw, ph), photo.georef(), photo.source())?;
+    let p = Placement::new(lattice(grid), (pw, ph), photo.georef(), photo.source())?;
+    let Drawn {
+        relief_under,
+        contours,
+        overlay,
+    } = *drawn;
+    let shade =
+        relief_under.then(|| crate::relief::Hillshade::new(grid, crate::relief::Light::default()));
     if let Some(o) = overlay.filter(|o| o.size() != size) {
         return Err(TerrainError::BadParameter {
             name: "overlay size",
@@ -521,10 +542,24 @@ pub fn write_pyramid_with(
             let mut map = RgbaImage::from_fn(t, t, |i, j| {
                 let (gx, gy) = (x * t + i, y * t + j);
                 // `rows_for` covers every row a texel on the photo reads.
-                let px = p.texel(size, gx, gy, |a, b| {
+                let c = p.texel(size, gx, gy, |a, b| {
                     band.get_pixel_checked(a, b.wrapping_sub(r0))
                         .map_or([0; 4], |px| px.0)
                 });
+                let px = match &shade {
+                    Some(shade) if c[3] < 255.0 => {
+                        let under = crate::relief::relief_texel(grid, shade, size, gx, gy);
+                        let k = 1.0 - c[3] / 255.0;
+                        let c = [0, 1, 2].map(|i| c[i] + under[i] as f64 * k);
+                        Rgba([
+                            c[0].round() as u8,
+                            c[1].round() as u8,
+                            c[2].round() as u8,
+                            255,
+                        ])
+                    }
+                    _ => Rgba(round(c)),
+                };
                 match contours {
                     None => px,
                     Some(c) => {
@@ -631,7 +666,7 @@ pub fn photo_level_count(
     map_texels: u32,
     max_levels: u32,
 ) -> Result<u32, TerrainError> {
-    let p = Placement::new(grid, photo.size(), photo.georef(), photo.source())?;
+    let p = Placement::new(lattice(grid), photo.size(), photo.georef(), photo.source())?;
     let (a, b) = (p.to_photo(0.0, 0.0), p.to_photo(1.0, 1.0));
     let across = (b.0 - a.0).abs().max((b.1 - a.1).abs()).min(1e9) as u32;
     let side = grid.width().max(grid.height()).max(across);
@@ -826,7 +861,7 @@ mod tests {
         };
         for (g, photo, size) in [(geo, utm, (6000, 8000)), (utm_grid, merc, (40_000, 40_000))] {
             let grid = Grid::new("g", 1001, 1001, vec![0.0; 1001 * 1001], g).unwrap();
-            let p = Placement::new(&grid, size, Some(photo), "photo").unwrap();
+            let p = Placement::new(lattice(&grid), size, Some(photo), "photo").unwrap();
             let (k, _) = p.lattice.as_ref().expect("reprojected");
             let from = crate::geodesy::Placement::of(&g).unwrap();
             let to = crate::geodesy::Placement::of(&photo).unwrap();

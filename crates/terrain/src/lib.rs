@@ -6,17 +6,19 @@
 //! - [`dem`]: elevation grids with their georeference and no-data — GeoTIFF (strips or tiles, chunk
 //!   by chunk, BigTIFF, GeoKeys, PixelIsArea/PixelIsPoint, GDAL no-data), ESRI ASCII, SRTM `.hgt`,
 //!   DTED levels 0–2 (checksums verified), ESRI GridFloat `.flt` and BIL `.bil` (with the `.prj`),
-//!   16-bit and Terrain-RGB PNG; geographic grids become local metres with the latitude-dependent
-//!   spacing.
+//!   16-bit and Terrain-RGB PNG, GDAL VRTs composited from their sources as GDAL composites them
+//!   ([`dem::vrt`]); geographic grids become local metres with the latitude-dependent spacing.
 //! - [`rtin`]: a right-triangulated irregular network with an *exact* per-triangle error bound
 //!   (every grid sample within the maximum error of the mesh), holes where the data has none.
 //! - [`chunks`]: a chunked level-of-detail quadtree cut from one error map, each chunk with its
 //!   geometric error (for selection by screen-space error) and skirts sized 5x that error.
 //! - [`photo`]: orthophotos as row sources — a GeoTIFF of any size read a band of rows at a time
-//!   (any band count, 16-bit bands stretched), PNG and JPEG whole.
-//! - [`gst`]: the orthophoto placed by georeference (or stretched), cut into a pyramid of 256²
-//!   maps written map by map; Seed 000 Eq. (5)–(7) decide which maps are resident in a budgeted
-//!   cache with counters.
+//!   (any band count, 16-bit bands stretched, no-data and alpha bands transparent), a GDAL VRT
+//!   and a mosaic of several tiles (as `gdalbuildvrt` mosaics them, later tiles winning, each
+//!   tile's rows read only while the rows asked for cross it), PNG and JPEG whole.
+//! - [`gst`]: the orthophoto placed by georeference (or stretched), the shaded relief under it
+//!   where it does not cover, cut into a pyramid of 256² maps written map by map; Seed 000
+//!   Eq. (5)–(7) decide which maps are resident in a budgeted cache with counters.
 //! - [`db`]: the database directory (JSON manifest, chunks, tiles, the grid), built atomically, and
 //!   the whole-terrain mesh at any error for glTF/OBJ export (through `texmap-mesh`).
 //! - [`view`]: the flight view — an aircraft camera (eye, altitude, heading, pitch, roll), chunks

@@ -41,15 +41,17 @@ fn build_reopen_export_glb() {
     let d = Database::open(&out).unwrap();
     let g2 = d.grid().unwrap();
     assert_eq!(g2.georef(), grid.georef());
-    // The photo covers columns 18..=36 (x from 500540 m): the texture is opaque only there.
+    // The photo covers columns 18..=36 (x from 500540 m); west of it the texture is the grid's
+    // shaded relief, as without a photo.
     let tex = d.texture(4096).unwrap().unwrap();
     let w = tex.width();
     let u_of_col = |c: f64| c / 36.0;
     let tx = |c: f64| (u_of_col(c) * (w - 1) as f64).round() as u32;
+    let shade = texmap_terrain::relief::Hillshade::new(&grid, Default::default());
     assert_eq!(
-        tex.get_pixel(tx(5.0), w / 2)[3],
-        0,
-        "west of the photo: transparent"
+        tex.get_pixel(tx(5.0), w / 2).0,
+        texmap_terrain::relief::relief_texel(&grid, &shade, w, tx(5.0), w / 2),
+        "west of the photo: the shaded relief"
     );
     let p = tex.get_pixel(tx(30.0), w / 2);
     assert_eq!(p[3], 255);

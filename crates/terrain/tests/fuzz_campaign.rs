@@ -4,7 +4,8 @@
 //! level 0 cell and 16-bit BIL (its `.hdr` and its samples mutated apart), and an SRTM
 //! `.hgt` tile and a 16-bit PNG made here; and the vector overlays and recorded flights (GeoJSON,
 //! GPX, IGC) written by ogr2ogr, gpxpy and aerofiles; and the lidar point clouds (LAS 1.2 and
-//! 1.4 by laspy, LAZ by LASzip), read and gridded. Each mutant — a cut, bit flips, byte
+//! 1.4 by laspy, LAZ by LASzip), read and gridded; and GDAL VRTs (gdalbuildvrt's mosaics of
+//! DEM pieces and of photo tiles, beside intact copies of their sources). Each mutant — a cut, bit flips, byte
 //! replacements, header fields set to extremes — must end in a grid or an error naming the file,
 //! never a panic, under a heap cap of 64x the mutant's size + 1 MiB (+ 4 MiB for LAZ, whose
 //! decoder's models take 2.5 MB for any file).
@@ -518,6 +519,100 @@ fn lidar_readers_survive_the_campaign() {
         ..settings
     };
     let t = run_campaign("LAZ", &laz, &laz_settings, &run);
+    report.push_str(&t.report());
+    assert!(t.failures.is_empty(), "{}", t.report());
+    eprintln!("{report}");
+}
+
+/// GDAL VRTs written by gdalbuildvrt (tests/data/mosaic.sh, photo_mosaic.sh): the mosaic of three
+/// DEM pieces read as a grid, and the -addalpha mosaic of three photo tiles read as a photo, 32
+/// rows at a time. Each mutant is the VRT's text beside intact copies of its sources (header
+/// numbers, rectangles and no-data values set to extremes; lines cut), ending in a result or an
+/// error naming the VRT.
+#[test]
+fn vrt_readers_survive_the_campaign() {
+    use texmap_terrain::gst::PhotoSource;
+    let dir = tempfile::tempdir().unwrap();
+    let sources = [
+        "mosaic_nw.tif",
+        "mosaic_ne.tif",
+        "mosaic_s.tif",
+        "mosaic_photo_a.tif",
+        "mosaic_photo_b.tif",
+        "mosaic_photo_c.tif",
+    ];
+    for name in sources {
+        std::fs::write(dir.path().join(name), data(name)).unwrap();
+    }
+    let settings = Settings {
+        seeded_cuts: 24,
+        flips: 256,
+        ..Settings::default()
+    };
+    // The value after the first `key` following `after`, as a text field.
+    let field = |text: &str, after: &str, key: &str| {
+        let from = text.find(after).unwrap();
+        let start = from + text[from..].find(key).unwrap() + key.len();
+        let end = start + text[start..].find(['"', '<']).unwrap();
+        Field::Text(start, end)
+    };
+    let fx = |name: &str| {
+        let bytes = data(name);
+        let text = String::from_utf8(bytes.clone()).unwrap();
+        let fields = vec![
+            ("rasterXSize", field(&text, "<VRTDataset", "rasterXSize=\"")),
+            ("rasterYSize", field(&text, "<VRTDataset", "rasterYSize=\"")),
+            (
+                "GeoTransform",
+                field(&text, "<GeoTransform>", "<GeoTransform>"),
+            ),
+            ("SrcRect xSize", field(&text, "<SrcRect", "xSize=\"")),
+            (
+                "second DstRect xOff",
+                field(&text, "</ComplexSource>", "<DstRect xOff=\""),
+            ),
+            (
+                "second DstRect ySize",
+                field(&text, "</ComplexSource>", "ySize=\""),
+            ),
+            ("SourceBand", field(&text, "<SourceBand>", "<SourceBand>")),
+            ("NODATA", field(&text, "<NODATA>", "<NODATA>")),
+        ];
+        let mut f = unchecked(fixture(name, bytes, fields, true));
+        f.boundaries = crate::campaign::line_starts(&f.bytes);
+        f
+    };
+    let path = dir.path().join("mutant.vrt");
+    let t = run_campaign(
+        "GDAL VRT (DEM)",
+        &[fx("mosaic.vrt")],
+        &settings,
+        &|_, bytes| {
+            std::fs::write(&path, bytes).unwrap();
+            verdict(dem::read_dem(&path, &dem::ReadOptions::default()), &path)
+        },
+    );
+    let mut report = t.report();
+    assert!(t.failures.is_empty(), "{}", t.report());
+    let t = run_campaign(
+        "GDAL VRT (photo)",
+        &[fx("mosaic_photo.vrt")],
+        &settings,
+        &|_, bytes| {
+            std::fs::write(&path, bytes).unwrap();
+            let read = texmap_terrain::photo::VrtPhoto::open(&path, None).and_then(|p| {
+                let h = p.size().1;
+                for y in (0..h).step_by(32) {
+                    p.rows(y, (y + 32).min(h))?;
+                }
+                Ok(())
+            });
+            match read {
+                Ok(()) => Verdict::Ok { frames: 1 },
+                Err(e) => located(e.to_string(), "mutant.vrt", "read"),
+            }
+        },
+    );
     report.push_str(&t.report());
     assert!(t.failures.is_empty(), "{}", t.report());
     eprintln!("{report}");

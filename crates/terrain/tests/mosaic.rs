@@ -1,5 +1,7 @@
 //! Grids joined into one, against GDAL's mosaic of the same pieces (`gdalbuildvrt`,
-//! tests/data/mosaic.sh) and against the SRTM tile the pieces were cut from.
+//! tests/data/mosaic.sh) and against the SRTM tile the pieces were cut from; GDAL VRTs over the
+//! pieces read as grids against GDAL's translation of each (`dem::vrt`), and damaged or hostile
+//! VRTs refused by file and element.
 
 use std::path::PathBuf;
 
@@ -149,5 +151,224 @@ fn grids_that_do_not_tile_are_refused_by_name() {
         for p in parts {
             assert!(e.contains(p), "{p}: {e}");
         }
+    }
+}
+
+/// Heights equal (no-data in the same places) and the same georeference as GDAL's reading.
+fn assert_same_grid(ours: &Grid, gdal: &Grid, what: &str) {
+    assert_eq!(
+        (ours.width(), ours.height()),
+        (gdal.width(), gdal.height()),
+        "{what}"
+    );
+    let (a, b) = (ours.georef(), gdal.georef());
+    assert_eq!((a.crs, a.epsg), (b.crs, b.epsg), "{what}");
+    for (x, y) in [
+        (a.origin_x, b.origin_x),
+        (a.origin_y, b.origin_y),
+        (a.dx, b.dx),
+        (a.dy, b.dy),
+    ] {
+        assert!((x - y).abs() < 1e-9, "{what}: {a:?} vs {b:?}");
+    }
+    for (i, (x, y)) in ours.heights().iter().zip(gdal.heights()).enumerate() {
+        assert!(
+            x == y || (x.is_nan() && y.is_nan()),
+            "{what} sample {i}: {x} vs GDAL {y}"
+        );
+    }
+}
+
+/// gdalbuildvrt's mosaic, a SimpleSource window, a source halved by nearest neighbour, a scaled
+/// ComplexSource (Float32) and a VRT within a VRT: each read equals GDAL's translation of it
+/// sample for sample, with its georeference.
+#[test]
+fn gdal_vrts_read_as_gdal_translates_them() {
+    for name in [
+        "mosaic",
+        "mosaic_window",
+        "mosaic_half",
+        "mosaic_scaled",
+        "mosaic_nested",
+    ] {
+        let ours = read(&format!("{name}.vrt"));
+        let gdal = read(&format!("{name}_gdal.tif"));
+        assert_same_grid(&ours, &gdal, name);
+        eprintln!(
+            "{name}.vrt: {} x {} samples, {} no-data, equal to GDAL's",
+            ours.width(),
+            ours.height(),
+            ours.nodata_count()
+        );
+    }
+    // gdalbuildvrt's VRT and the --dem list of the same pieces are one grid.
+    let (joined, _) = mosaic(pieces()).unwrap();
+    assert_same_grid(&read("mosaic.vrt"), &joined, "mosaic.vrt vs mosaic()");
+    // The scaled source: heights times 0.0005, as f32.
+    let (scaled, ne) = (read("mosaic_scaled.vrt"), read("mosaic_ne.tif"));
+    let (a, b) = (scaled.heights()[0], ne.heights()[0]);
+    assert_eq!(a, (b as f64 * 0.0005) as f32);
+}
+
+/// A VRT in a directory of its own, beside copies of the pieces, from `xml`.
+fn vrt_file(dir: &std::path::Path, name: &str, xml: &str) -> PathBuf {
+    for p in ["mosaic_nw.tif", "mosaic_ne.tif", "mosaic_s.tif"] {
+        std::fs::copy(data(p), dir.join(p)).unwrap();
+    }
+    let path = dir.join(name);
+    std::fs::write(&path, xml).unwrap();
+    path
+}
+
+/// mosaic.vrt's text with `from` replaced by `to`.
+fn mutated(from: &str, to: &str) -> String {
+    let xml = std::fs::read_to_string(data("mosaic.vrt")).unwrap();
+    assert!(xml.contains(from), "{from}");
+    xml.replacen(from, to, 1)
+}
+
+#[test]
+fn damaged_and_hostile_vrts_are_refused_by_file_and_element() {
+    let dir = tempfile::tempdir().unwrap();
+    let xml = std::fs::read_to_string(data("mosaic.vrt")).unwrap();
+    let line_of = |s: &str| xml[..xml.find(s).unwrap()].matches('\n').count() + 1;
+    let source_line = format!("line {}", line_of("<ComplexSource>"));
+    let huge = xml.replacen(
+        "rasterXSize=\"109\" rasterYSize=\"69\"",
+        "rasterXSize=\"1000000\" rasterYSize=\"1000000\"",
+        1,
+    );
+    let cases: Vec<(&str, String, Vec<String>)> = vec![
+        (
+            "missing.vrt",
+            mutated("mosaic_ne.tif", "mosaic_gone.tif"),
+            vec![
+                "missing.vrt".into(),
+                "<SourceFilename>".into(),
+                "mosaic_gone.tif".into(),
+            ],
+        ),
+        (
+            "bad_xml.vrt",
+            mutated("</ComplexSource>", "</ComplexSourc>"),
+            vec![
+                "bad_xml.vrt".into(),
+                format!("line {}, column", line_of("</ComplexSource>")),
+                "well-formed XML".into(),
+            ],
+        ),
+        (
+            "outside.vrt",
+            mutated(
+                "<SrcRect xOff=\"0\" yOff=\"0\" xSize=\"60\"",
+                "<SrcRect xOff=\"30\" yOff=\"0\" xSize=\"60\"",
+            ),
+            vec![
+                "outside.vrt".into(),
+                source_line.clone(),
+                "<SrcRect> inside the 60 x 40 pixels".into(),
+            ],
+        ),
+        (
+            "huge.vrt",
+            huge,
+            vec![
+                "huge.vrt".into(),
+                "line 1, <VRTDataset> rasterXSize, rasterYSize".into(),
+                "1000000 x 1000000".into(),
+            ],
+        ),
+        (
+            "padded.vrt",
+            xml.replacen(
+                "rasterXSize=\"109\" rasterYSize=\"69\"",
+                "rasterXSize=\"30000\" rasterYSize=\"30000\"",
+                1,
+            ),
+            vec![
+                "padded.vrt".into(),
+                "line 1, <VRTDataset> rasterXSize".into(),
+                "a raster its sources back".into(),
+                "30000 x 30000".into(),
+            ],
+        ),
+        (
+            "self.vrt",
+            mutated("mosaic_ne.tif", "self.vrt"),
+            vec![
+                "self.vrt".into(),
+                "<SourceFilename>".into(),
+                "references itself".into(),
+            ],
+        ),
+        (
+            "derived.vrt",
+            mutated(
+                "<VRTRasterBand dataType=\"Int16\" band=\"1\">",
+                "<VRTRasterBand dataType=\"Int16\" band=\"1\" subClass=\"VRTDerivedRasterBand\">",
+            ),
+            vec![
+                "derived.vrt".into(),
+                format!("line {}, <VRTRasterBand>", line_of("<VRTRasterBand")),
+                "VRTDerivedRasterBand".into(),
+                "gdal_translate".into(),
+            ],
+        ),
+        (
+            "warped.vrt",
+            mutated("<VRTDataset ", "<VRTDataset subClass=\"VRTWarpedDataset\" "),
+            vec![
+                "warped.vrt".into(),
+                "line 1, <VRTDataset>".into(),
+                "VRTWarpedDataset".into(),
+            ],
+        ),
+        (
+            "vrt_path.vrt",
+            mutated(
+                "<SourceFilename relativeToVRT=\"1\">mosaic_ne.tif",
+                "<SourceFilename relativeToVRT=\"0\">vrt://mosaic_ne.tif?bands=1",
+            ),
+            vec![
+                "vrt_path.vrt".into(),
+                "<SourceFilename>".into(),
+                "vrt://".into(),
+            ],
+        ),
+        (
+            "pixel_function.vrt",
+            mutated(
+                "<ColorInterp>Gray</ColorInterp>",
+                "<PixelFunctionType>sum</PixelFunctionType>",
+            ),
+            vec![
+                "pixel_function.vrt".into(),
+                "<PixelFunctionType>: a pixel function".into(),
+                "SimpleSource and ComplexSource".into(),
+            ],
+        ),
+        (
+            "band.vrt",
+            mutated("<SourceBand>1</SourceBand>", "<SourceBand>2</SourceBand>"),
+            vec![
+                "band.vrt".into(),
+                "<SourceBand> 2".into(),
+                "has 1 band(s)".into(),
+            ],
+        ),
+    ];
+    for (name, xml, parts) in cases {
+        let path = vrt_file(dir.path(), name, &xml);
+        let (r, peak) = crate::alloc::measure(|| read_dem(&path, &ReadOptions::default()));
+        let e = match r {
+            Ok(g) => panic!("{name}: read as {} x {}", g.width(), g.height()),
+            Err(e) => e.to_string(),
+        };
+        eprintln!("{e}");
+        for p in &parts {
+            assert!(e.contains(p.as_str()), "{name}: {p:?} not in: {e}");
+        }
+        // Refused before anything is sized from the claims.
+        assert!(peak < 1 << 20, "{name}: {peak} bytes");
     }
 }

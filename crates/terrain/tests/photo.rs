@@ -2,6 +2,10 @@
 //! (`gst::write_pyramid`), against the whole-image reader (`gst::read_photo`) and the whole-level
 //! pyramid (`gst::pyramid(gst::place(..))`): the same bytes. The photos are GDAL-written GeoTIFFs
 //! (tiled, planar, 16-bit) over the real SRTM tile N44W072 (`tests/data/relief_photos.sh`).
+//! Several photo tiles mosaicked (`photo::VrtPhoto::mosaic`, `--photo a.tif b.tif`) and GDAL's
+//! VRT of them against GDAL's own mosaic (`gdalbuildvrt -addalpha`, then `gdal_translate`) and
+//! against `gdalwarp` of the tiles onto a texel lattice when one is in another system
+//! (`tests/data/photo_mosaic.sh`).
 
 use image::RgbaImage;
 use std::collections::HashMap;
@@ -10,7 +14,7 @@ use std::sync::Mutex;
 use texmap_terrain::db::{self, BuildOptions, Database};
 use texmap_terrain::dem::{self, Grid};
 use texmap_terrain::gst::{self, MapKey, PhotoSource};
-use texmap_terrain::photo::{TiffPhoto, open_photo};
+use texmap_terrain::photo::{TiffPhoto, VrtPhoto, open_photo, open_photos};
 
 fn data(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -210,16 +214,20 @@ fn a_database_built_from_rows_equals_one_built_from_the_whole_photo() {
     // One texel per DEM sample at least: 1201 samples -> 64·2^5 = 2048, 6 levels.
     assert_eq!(ta.levels, 6);
     assert_eq!(ta.placed_by, "georeference");
-    for level in 0..ta.levels {
-        let n = 1 << level;
-        for y in 0..n {
-            for x in 0..n {
+    assert_same_tiles(&a, &b, ta.levels);
+}
+
+/// Every map tile of the databases `a` and `b` (`levels` levels) byte for byte.
+fn assert_same_tiles(a: &std::path::Path, b: &std::path::Path, levels: u32) {
+    for level in 0..levels {
+        for y in 0..1u32 << level {
+            for x in 0..1u32 << level {
                 let f = format!("tiles/{level}/{x}_{y}.png");
                 let (fa, fb) = (
                     std::fs::read(a.join(&f)).unwrap(),
                     std::fs::read(b.join(&f)).unwrap(),
                 );
-                assert!(fa == fb, "{f}");
+                assert!(fa == fb, "{f} differs between {a:?} and {b:?}");
             }
         }
     }
@@ -280,4 +288,343 @@ fn damaged_photos_are_named_errors() {
     let grid = Grid::new("far", 3, 3, vec![1.0; 9], dem::Georef::local(1.0)).unwrap();
     let relief = TiffPhoto::open(&data("relief_tiled.tif"), None).unwrap();
     assert!(gst::photo_level_count(&relief, &grid, 256, 5).is_err());
+}
+
+/// The mosaic's tiles (tests/data/photo_mosaic.sh), in mosaic order.
+fn tiles(names: &[&str]) -> Vec<PathBuf> {
+    names
+        .iter()
+        .map(|n| data(&format!("mosaic_photo_{n}.tif")))
+        .collect()
+}
+
+fn whole(p: &dyn PhotoSource) -> RgbaImage {
+    p.rows(0, p.size().1).unwrap()
+}
+
+/// Tiles on one lattice, mosaicked from the files (`--photo a b c`) and from GDAL's VRT of them:
+/// each pixel the top tile's that covers it (c over b over a; b's no-data holes and c's
+/// transparent pixels let the tile below show), and GDAL's translation of the VRT pixel for
+/// pixel, but where GDAL invents opaque black: in b's hole over no other tile (gdalbuildvrt
+/// -addalpha's alpha band writes 255 over a tile's no-data; we leave it transparent).
+#[test]
+fn several_photos_and_their_vrt_mosaic_as_gdal_mosaics_them() {
+    let mosaic = VrtPhoto::mosaic(&tiles(&["a", "b", "c"]), None).unwrap();
+    let vrt = VrtPhoto::open(&data("mosaic_photo.vrt"), None).unwrap();
+    let gdal = TiffPhoto::open(&data("mosaic_photo_gdal.tif"), None).unwrap();
+    assert_eq!(mosaic.size(), (320, 240));
+    assert_eq!(vrt.size(), gdal.size());
+    let (m, g) = (mosaic.georef().unwrap(), gdal.georef().unwrap());
+    assert_eq!((m.crs, m.epsg), (g.crs, g.epsg));
+    for (x, y) in [
+        (m.origin_x, g.origin_x),
+        (m.origin_y, g.origin_y),
+        (m.dx, g.dx),
+        (m.dy, g.dy),
+    ] {
+        assert!((x - y).abs() < 1e-12, "{m:?} vs {g:?}");
+    }
+    assert_eq!(vrt.georef(), mosaic.georef());
+    let (ours, from_vrt, reference) = (whole(&mosaic), whole(&vrt), whole(&gdal));
+    assert!(ours == from_vrt, "the --photo mosaic and the VRT differ");
+    // The tiles themselves, at their places on the lattice (columns, rows).
+    let own: Vec<(RgbaImage, u32, u32)> = [("c", 60, 110), ("b", 150, 0), ("a", 0, 0)]
+        .into_iter()
+        .map(|(n, x, y)| {
+            (
+                whole(&TiffPhoto::open(&data(&format!("mosaic_photo_{n}.tif")), None).unwrap()),
+                x,
+                y,
+            )
+        })
+        .collect();
+    let (mut equal, mut invented, mut through, mut clear) = (0, 0, 0, 0);
+    for (x, y, px) in ours.enumerate_pixels() {
+        let mut covering = own.iter().filter_map(|(t, ox, oy)| {
+            t.get_pixel_checked(x.wrapping_sub(*ox), y.wrapping_sub(*oy))
+        });
+        let under = covering.clone().find(|p| p.0[3] == 255);
+        // A tile's pixel that does not cover, with a tile below that does: fall-through.
+        if covering.next().is_some_and(|p| p.0[3] == 0) && under.is_some() {
+            through += 1;
+        }
+        assert_eq!(
+            *px,
+            under.copied().unwrap_or(image::Rgba([0; 4])),
+            "pixel ({x}, {y})"
+        );
+        let r = reference.get_pixel(x, y);
+        if px == r {
+            equal += 1;
+        } else {
+            // Only GDAL's opaque black where our mosaic is clear.
+            assert_eq!((px.0, r.0), ([0; 4], [0, 0, 0, 255]), "pixel ({x}, {y})");
+            invented += 1;
+        }
+        if px.0[3] == 0 {
+            clear += 1;
+        }
+    }
+    eprintln!(
+        "mosaic of 3 tiles: {equal} of {} pixels equal to GDAL's, {invented} opaque black in \
+         GDAL's (b's hole over no tile), {through} fall through to a lower tile, {clear} clear",
+        320 * 240
+    );
+    assert!(
+        invented > 100 && through > 1000 && clear > invented,
+        "{invented} {through} {clear}"
+    );
+    assert_eq!(equal + invented, 320 * 240);
+    // Read a band of rows at a time, top to bottom and out of order: the same pixels.
+    for p in [&mosaic as &dyn PhotoSource, &vrt] {
+        for (y0, y1) in [(0, 37), (30, 111), (100, 240), (5, 6), (0, 240)] {
+            let band = p.rows(y0, y1).unwrap();
+            let want = image::imageops::crop_imm(&ours, 0, y0, 320, y1 - y0).to_image();
+            assert!(band == want, "rows {y0}..{y1}");
+        }
+    }
+}
+
+/// A grid in degrees over the tiles (sample centres -71.40..-71.18 E, 44.38..44.20 N), heights a
+/// ramp, whose 257² texel lattice `ref_mosaic_photo.png` was warped onto.
+fn mosaic_grid() -> Grid {
+    let (w, h) = (97u32, 81u32);
+    let heights = (0..w * h)
+        .map(|i| 300.0 + 9.0 * (i % w) as f32 + 4.0 * (i / w) as f32)
+        .collect();
+    let georef = dem::Georef {
+        crs: dem::CrsKind::Geographic,
+        epsg: Some(4326),
+        origin_x: -71.40,
+        origin_y: 44.38,
+        dx: 0.22 / 96.0,
+        dy: -0.18 / 80.0,
+    };
+    Grid::new("mosaic grid", w, h, heights, georef).unwrap()
+}
+
+/// With a tile in UTM 19N among tiles in degrees, the mosaic reprojects it and the texture placed
+/// on a grid in degrees agrees with gdalwarp of the four tiles onto the same texel lattice:
+/// texels where only the three tiles in degrees show within one code (as a single photo's
+/// placement, tests/reproject.rs), texels where the UTM tile shows (resampled twice: into the
+/// mosaic, then onto the texels; gdalwarp once) within a stated tolerance.
+#[test]
+fn a_tile_in_another_system_is_reprojected_into_the_mosaic_as_gdalwarp_places_it() {
+    let grid = mosaic_grid();
+    let mosaic = VrtPhoto::mosaic(&tiles(&["a", "b", "c", "d_utm"]), None).unwrap();
+    // The UTM tile's outline (its transparent margin too) reaches past the others'.
+    let (w, h) = mosaic.size();
+    assert!(w > 320 && h > 240 && w < 330 && h < 250, "{w} x {h}");
+    let photo = gst::Orthophoto {
+        image: whole(&mosaic),
+        georef: mosaic.georef(),
+        source: "mosaic".into(),
+    };
+    let ours = gst::place(&photo, &grid, 257).unwrap();
+    let gdal = image::open(data("ref_mosaic_photo.png"))
+        .unwrap()
+        .to_rgba8();
+    assert_eq!(gdal.dimensions(), (257, 257));
+    // Where the UTM tile lies on the texture, two texels around its outline included (the
+    // tile placed alone, as a single photo).
+    let alone = gst::read_photo(&data("mosaic_photo_d_utm.tif"), None).unwrap();
+    let alone = gst::place(&alone, &grid, 257).unwrap();
+    let near = |img: &RgbaImage, x: u32, y: u32, hit: &dyn Fn(u8) -> bool| {
+        (x.saturating_sub(2)..(x + 3).min(257))
+            .any(|i| (y.saturating_sub(2)..(y + 3).min(257)).any(|j| hit(img.get_pixel(i, j).0[3])))
+    };
+    // Where the tiles' coverage ends (their outlines, b's no-data holes, c's pentagon): placed
+    // alone, their texels there are partly transparent.
+    let edges: Vec<RgbaImage> = ["a", "b", "c"]
+        .iter()
+        .map(|n| {
+            let p = gst::read_photo(&data(&format!("mosaic_photo_{n}.tif")), None).unwrap();
+            gst::place(&p, &grid, 257).unwrap()
+        })
+        .collect();
+    #[derive(Default, Debug)]
+    struct Tally {
+        texels: usize,
+        sum: u64,
+        max: u8,
+        over_8: usize,
+    }
+    let (mut same, mut edge, mut warped) = (Tally::default(), Tally::default(), Tally::default());
+    let mut warped_edge = Tally::default();
+    let mut one_side = 0usize;
+    for ((x, y, a), b) in ours.enumerate_pixels().zip(gdal.pixels()) {
+        match (a.0[3], b.0[3]) {
+            (255, 255) => {
+                let t = if near(&alone, x, y, &|a| a > 0) {
+                    if near(&alone, x, y, &|a| a < 255) {
+                        &mut warped_edge
+                    } else {
+                        &mut warped
+                    }
+                } else if edges.iter().any(|e| near(e, x, y, &|a| a > 0 && a < 255)) {
+                    &mut edge
+                } else {
+                    &mut same
+                };
+                t.texels += 1;
+                for k in 0..3 {
+                    let d = a.0[k].abs_diff(b.0[k]);
+                    t.sum += d as u64;
+                    t.max = t.max.max(d);
+                    if d > 8 {
+                        t.over_8 += 1;
+                    }
+                }
+            }
+            (0, 0) => {}
+            _ => one_side += 1,
+        }
+    }
+    let mean = |t: &Tally| t.sum as f64 / (3 * t.texels.max(1)) as f64;
+    eprintln!(
+        "texels of the tiles in degrees: {} (mean |diff| {:.3}, max {}); by their transparent \
+         edges: {} (mean {:.3}, max {}, {} channels above 8); of the UTM tile: {} (mean {:.3}, \
+         max {}, {} channels above 8), by its edge {} (mean {:.3}, max {}, {} channels above 8); \
+         {one_side} texels one side only",
+        same.texels,
+        mean(&same),
+        same.max,
+        edge.texels,
+        mean(&edge),
+        edge.max,
+        edge.over_8,
+        warped.texels,
+        mean(&warped),
+        warped.max,
+        warped.over_8,
+        warped_edge.texels,
+        mean(&warped_edge),
+        warped_edge.max,
+        warped_edge.over_8
+    );
+    assert!(
+        same.texels > 30_000 && mean(&same) < 0.05 && same.max <= 1,
+        "{same:?}"
+    );
+    // Along a later tile's transparent edge gdalwarp darkens the texels it blends over the tiles
+    // below (the same relief on both sides); ours keep the relief.
+    assert!(
+        mean(&edge) < 1.0 && edge.over_8 * 20 < 3 * edge.texels,
+        "{edge:?}"
+    );
+    // The UTM tile, resampled twice here and once by gdalwarp: within 12 codes inside it.
+    assert!(
+        warped.texels > 4_000 && mean(&warped) < 1.0 && warped.max <= 12,
+        "{warped:?}"
+    );
+    assert!(mean(&warped_edge) < 2.0, "{warped_edge:?}");
+    assert!(one_side < 1_000, "{one_side} texels on one side only");
+}
+
+/// A database built from the mosaic: where no tile covers (b's hole over no tile, the corners
+/// outside c's pentagon) the texture is the grid's shaded relief, nowhere transparent; the same
+/// bytes for any thread count; and reading a band of the mosaic's rows holds only the tiles
+/// under them.
+#[test]
+fn a_mosaic_database_shows_the_relief_where_no_tile_covers_for_any_thread_count() {
+    let grid = mosaic_grid();
+    let dir = tempfile::tempdir().unwrap();
+    let opts = BuildOptions {
+        max_error: 5.0,
+        chunk: 33,
+        map_texels: 64,
+        max_texture_levels: 8,
+        ..Default::default()
+    };
+    let files = tiles(&["a", "b", "c", "d_utm"]);
+    let build = |threads: usize, name: &str| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let out = dir.path().join(name);
+        let photo = open_photos(&files, None).unwrap();
+        pool.install(|| {
+            db::build_with(
+                &grid,
+                "mosaic",
+                Some(photo.as_ref()),
+                &opts,
+                &out,
+                |_, _| {},
+            )
+        })
+        .unwrap();
+        out
+    };
+    let (one, three) = (build(1, "one"), build(3, "three"));
+    let d = Database::open(&one).unwrap();
+    let t = d.manifest.texture.clone().unwrap();
+    assert_eq!(t.placed_by, "georeference");
+    assert_same_tiles(&one, &three, t.levels);
+    let tex = d.texture(1 << 20).unwrap().unwrap();
+    let size = tex.width();
+    assert!(tex.pixels().all(|p| p.0[3] == 255), "no transparent texel");
+    let shade = texmap_terrain::relief::Hillshade::new(&grid, Default::default());
+    let texel = |lon: f64, lat: f64| {
+        let u = (lon + 71.40) / 0.22;
+        let v = (44.38 - lat) / 0.18;
+        let s = (size - 1) as f64;
+        ((u * s).round() as u32, (v * s).round() as u32)
+    };
+    // b's hole over no tile, and west of c's pentagon below tile a: the relief.
+    for (lon, lat) in [(-71.19, 44.35), (-71.395, 44.215)] {
+        let (x, y) = texel(lon, lat);
+        let relief = texmap_terrain::relief::relief_texel(&grid, &shade, size, x, y);
+        assert_eq!(tex.get_pixel(x, y).0, relief, "({lon}, {lat})");
+    }
+    // Tile a's pixels there, not the relief.
+    let (x, y) = texel(-71.39, 44.37);
+    let relief = texmap_terrain::relief::relief_texel(&grid, &shade, size, x, y);
+    assert_ne!(tex.get_pixel(x, y).0, relief);
+    // Streaming: eight rows of the mosaic read the strips of the two tiles under them; the whole
+    // mosaic, every tile.
+    let peak = |y1: u32| {
+        let mosaic = VrtPhoto::mosaic(&files, None).unwrap();
+        let (band, peak) = crate::alloc::measure(|| mosaic.rows(0, y1).map(|b| b.len()));
+        assert_eq!(band.unwrap(), mosaic.size().0 as usize * y1 as usize * 4);
+        peak
+    };
+    let (band, all) = (peak(8), peak(240));
+    eprintln!("heap peak reading rows 0..8 of the mosaic: {band} bytes; rows 0..240: {all}");
+    assert!(band * 4 < all, "{band} vs {all} bytes");
+}
+
+/// Photos that make no mosaic are refused by name: one without a georeference, and photos of two
+/// areas (the tiles in degrees and a photo in UTM 54N, in Japan); a directory stands for the
+/// GeoTIFFs in it, in the order of their names.
+#[test]
+fn photos_that_make_no_mosaic_are_refused_and_a_directory_is_its_tiles() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("plain.png");
+    RgbaImage::new(8, 8).save(&png).unwrap();
+    let e = VrtPhoto::mosaic(&[data("mosaic_photo_a.tif"), png], None)
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(
+        e.contains("plain.png") && e.contains("without a georeference"),
+        "{e}"
+    );
+    let e = VrtPhoto::mosaic(&[data("mosaic_photo_a.tif"), data("photo_rgb.tif")], None)
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(
+        e.contains("photo_rgb.tif") && e.contains("do the photos cover one area"),
+        "{e}"
+    );
+    // Named so that the directory's order is the mosaic's.
+    for (n, to) in [("a", "1.tif"), ("b", "2.tif"), ("c", "3.tif")] {
+        std::fs::copy(data(&format!("mosaic_photo_{n}.tif")), dir.path().join(to)).unwrap();
+    }
+    std::fs::remove_file(dir.path().join("plain.png")).unwrap();
+    let from_dir = open_photos(&[dir.path().to_path_buf()], None).unwrap();
+    let listed = VrtPhoto::mosaic(&tiles(&["a", "b", "c"]), None).unwrap();
+    assert!(whole(from_dir.as_ref()) == whole(&listed));
 }

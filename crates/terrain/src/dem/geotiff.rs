@@ -236,6 +236,9 @@ pub struct RasterReader {
     want: Vec<u16>,
     pub georef: Option<Georef>,
     pub nodata: Option<f64>,
+    /// The alpha band (0-based), when `ExtraSamples` (338) marks one: 2 unassociated (as
+    /// `gdalwarp -dstalpha` writes it) or 1 associated.
+    pub alpha: Option<u16>,
     chunk_type: ChunkType,
     cw: u32,
     ch: u32,
@@ -250,6 +253,46 @@ pub struct RasterReader {
     /// JPEG and WebP chunks: the file (opened again) and each chunk's offset, so that the frame
     /// size a chunk's own header claims is checked before its codec allocates for it.
     peek: Option<(std::fs::File, Vec<u64>)>,
+}
+
+/// Rows of a TIFF read by bands: each row of chunks is decoded once, by the caller's `decode`
+/// into whatever it keeps (8-bit RGBA for a photo, `f32` planes for a VRT's source), and kept
+/// until a request starts below it, since readers ask for overlapping bands top to bottom.
+pub(crate) struct ChunkRows<T> {
+    pub reader: RasterReader,
+    cache: std::collections::BTreeMap<u32, T>,
+}
+
+impl<T> ChunkRows<T> {
+    pub fn new(reader: RasterReader) -> ChunkRows<T> {
+        ChunkRows {
+            reader,
+            cache: std::collections::BTreeMap::new(),
+        }
+    }
+
+    /// Visit the decoded chunk rows under image rows `y0..y1` (`y0 < y1 ≤ height`) top to
+    /// bottom: `visit(rows, top)` with `top` the image row of the chunk row's first row.
+    pub fn visit(
+        &mut self,
+        y0: u32,
+        y1: u32,
+        decode: impl Fn(&mut RasterReader, u32) -> Result<T, TerrainError>,
+        mut visit: impl FnMut(&T, u32),
+    ) -> Result<(), TerrainError> {
+        let ch = self.reader.chunk_rows();
+        let (cr0, cr1) = (y0 / ch, y1.saturating_sub(1) / ch);
+        // Rows above this band are not asked for again by a top-to-bottom reader.
+        self.cache.retain(|&cr, _| cr >= cr0);
+        for cr in cr0..=cr1 {
+            if !self.cache.contains_key(&cr) {
+                let rows = decode(&mut self.reader, cr)?;
+                self.cache.insert(cr, rows);
+            }
+            visit(&self.cache[&cr], cr * ch);
+        }
+        Ok(())
+    }
 }
 
 /// One decoded chunk: its rectangle in the image (clipped to it) and one plane per wanted band.
@@ -336,6 +379,16 @@ impl RasterReader {
             }
             None => None,
         };
+        // ExtraSamples lists the last bands: the first alpha among them is the photo's.
+        let extra = dec
+            .find_tag_unsigned_vec::<u16>(Tag::ExtraSamples)
+            .map_err(tiff_err(&source, "tag 338 ExtraSamples"))?
+            .unwrap_or_default();
+        let alpha = extra
+            .iter()
+            .position(|&e| e == 1 || e == 2)
+            .and_then(|i| (spp as usize).checked_sub(extra.len() - i))
+            .map(|b| b as u16);
 
         let (cw, ch) = dec.chunk_dimensions();
         let chunk_type = dec.get_chunk_type();
@@ -424,6 +477,7 @@ impl RasterReader {
             want,
             georef,
             nodata,
+            alpha,
             chunk_type,
             cw,
             ch,
@@ -460,6 +514,21 @@ impl RasterReader {
                 .flat_map(|r| (0..self.across).map(move |c| r * self.across + c))
                 .collect(),
         }
+    }
+
+    /// Decode the chunks of chunk row `cr` (image rows from `cr · chunk_rows()`, at full
+    /// width), handing each to `put` in file order.
+    pub fn read_chunk_row(
+        &mut self,
+        cr: u32,
+        mut put: impl FnMut(&ChunkPlanes),
+    ) -> Result<(), TerrainError> {
+        let y0 = cr.saturating_mul(self.chunk_rows());
+        let y1 = y0.saturating_add(self.chunk_rows()).min(self.height);
+        for chunk in self.chunks_in_rows(y0, y1) {
+            put(&self.read_chunk(chunk)?);
+        }
+        Ok(())
     }
 
     /// Decode stored chunk `chunk` (`0..chunk_count()`): its wanted bands, clipped to the image.

@@ -19,8 +19,10 @@
 //! SRTM `.hgt` ([`hgt`]), DTED levels 0–2 ([`dted`]), ESRI GridFloat `.flt` and BIL `.bil` with
 //! their `.hdr` and `.prj` ([`ehdr`]), 16-bit PNG with a scale and offset, and Mapbox Terrain-RGB
 //! and Terrarium PNG ([`png`]), the last two placed in Web Mercator when they are web-map tiles
-//! addressed `Z/X/Y.png` ([`png::TileAddress`]), and gridded XYZ text ([`xyz`]); grids that tile
-//! an area join into one ([`mosaic`], [`read_dems`]: web-map tiles of one zoom only). Airborne lidar point clouds, LAS
+//! addressed `Z/X/Y.png` ([`png::TileAddress`]), gridded XYZ text ([`xyz`]), and GDAL VRTs as
+//! `gdalbuildvrt` and `gdal_translate -of VRT` write them ([`vrt`], which also reads photo VRTs
+//! and lays out photo mosaics for [`crate::photo`]); grids that tile an area join into one
+//! ([`mosaic`], [`read_dems`]: web-map tiles of one zoom only). Airborne lidar point clouds, LAS
 //! 1.0–1.4 and LAZ ([`las`]), are gridded into a grid as PDAL's `writers.gdal` grids them
 //! ([`lidar`]; several files are one cloud). Each validates at the file
 //! boundary ([`Grid::new`]): at least 2 x 2 samples, at most [`MAX_SAMPLES`], every value finite
@@ -38,6 +40,7 @@ pub mod las;
 pub mod lidar;
 pub mod mosaic;
 pub mod png;
+pub mod vrt;
 pub mod xyz;
 
 use crate::error::TerrainError;
@@ -489,6 +492,8 @@ pub enum DemFormat {
     Las,
     /// Gridded XYZ text (`.xyz`): an `x y z` line per sample ([`xyz`]).
     Xyz,
+    /// A GDAL virtual raster (`.vrt`): band 1 composited from its sources ([`vrt`]).
+    Vrt,
 }
 
 /// Options for the readers that need outside information.
@@ -543,6 +548,7 @@ impl DemFormat {
             "png" => Some(DemFormat::Png16),
             "las" | "laz" => Some(DemFormat::Las),
             "xyz" => Some(DemFormat::Xyz),
+            "vrt" => Some(DemFormat::Vrt),
             _ => None,
         }
     }
@@ -559,6 +565,7 @@ impl DemFormat {
         match &head {
             b"UHL1" if read => return Some(DemFormat::Dted),
             b"LASF" if read => return Some(DemFormat::Las),
+            b"<VRT" if read => return Some(DemFormat::Vrt),
             _ => {}
         }
         ["hdr", "HDR"]
@@ -578,7 +585,7 @@ pub fn read_dem(path: impl AsRef<Path>, opts: &ReadOptions) -> Result<Grid, Terr
         .ok_or_else(|| TerrainError::Unsupported {
             source: path.display().to_string(),
             what: "unknown extension (expected .tif, .tiff, .asc, .hgt, .dt0, .dt1, .dt2, .flt, \
-                   .bil, .png, .las, .laz or .xyz)"
+                   .bil, .png, .las, .laz, .xyz or .vrt)"
                 .into(),
         })?;
     match format {
@@ -599,6 +606,7 @@ pub fn read_dem(path: impl AsRef<Path>, opts: &ReadOptions) -> Result<Grid, Terr
         DemFormat::Terrarium => read_rgb(path, png::RgbEncoding::Terrarium, opts),
         DemFormat::Las => lidar::read_lidar(&[path.to_path_buf()], &opts.lidar).map(|r| r.0),
         DemFormat::Xyz => xyz::read_xyz(path),
+        DemFormat::Vrt => vrt::read_vrt(path),
     }
 }
 
