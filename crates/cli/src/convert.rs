@@ -83,14 +83,16 @@ pub struct ConvertArgs {
     /// and the columns, read by LAMMPS's rerun, OVITO and MDAnalysis), .data/.lmp (one frame as
     /// a LAMMPS data file for read_data: atom style full, molecular, charge or atomic by
     /// whether the frame has bonds and charges, types with their masses, bonds typed by their
-    /// atoms' types, the cell rotated into LAMMPS's restricted triclinic box), .gro (GROMACS: residues,
+    /// atoms' types, the Velocities a data file had (not a trajectory's: warned), the cell
+    /// rotated into LAMMPS's restricted triclinic box), .gro (GROMACS: residues,
     /// names, positions to 0.001 nm, velocities, the box), .pdb (multi-MODEL, the 'occupancy'
     /// and 'bfactor' properties in their columns), .cif/.mmcif (PDBx/mmCIF, for ChimeraX, PyMOL,
     /// VMD and gemmi: frames as models, the 'occupancy' and 'bfactor'
     /// properties, the first frame's box; no limit on atoms, residue numbers or chain names),
     /// .dcd, .xtc (positions and the box only), .trr (GROMACS, single precision: positions,
     /// the box, velocities, and the forces fx fy fz in kJ/(mol Å) as a TRR gives them; frames of
-    /// a TRR without positions are skipped and counted), .nc/.ncdf (AMBER NetCDF for cpptraj,
+    /// a TRR without positions, which no frame can carry, are skipped with a warning naming the
+    /// velocities and forces they held), .nc/.ncdf (AMBER NetCDF for cpptraj,
     /// MDAnalysis, MDTraj, VMD: time, coordinates, the box as lengths and angles, velocities in
     /// AMBER's units with its scale_factor; no forces), .gsd (HOOMD-blue: the box in HOOMD's
     /// centred form, atoms wrapped into it with their images, types, velocities, diameters,
@@ -313,16 +315,21 @@ pub fn convert(a: &ConvertArgs) -> Result<()> {
     let pb = crate::commands::progress(frames.len() as u64, "converting");
     let mut first_atoms: Option<usize> = None;
     let mut atoms_written = 0usize;
-    let mut without_positions = 0usize;
+    let mut without_positions = Dropped::default();
+    let mut velocities_dropped = Dropped::default();
     let mut conect_note_shown = false;
     let mut run = |mut writer: Option<Writer>| -> Result<()> {
         for &f in &frames {
             let at = |e: anyhow::Error| e.context(format!("frame {f}: nothing was written"));
             traj.read_frame(f, &mut md).map_err(|e| at(e.into()))?;
-            if md.n_atoms() == 0 && traj.format() == Format::Trr {
+            if let Some(w) = traj.without_positions() {
                 // mdrun writes frames of only velocities or forces when nstvout or nstfout
-                // differ from nstxout: without positions there is nothing to analyse or write.
-                without_positions += 1;
+                // differ from nstxout: without positions there is nothing to analyse or write,
+                // and what they held is named at the end.
+                without_positions.frames += 1;
+                without_positions.atoms = without_positions.atoms.max(w.atoms);
+                without_positions.velocities += usize::from(w.velocities);
+                without_positions.forces += usize::from(w.forces);
                 pb.inc(1);
                 continue;
             }
@@ -404,6 +411,14 @@ pub fn convert(a: &ConvertArgs) -> Result<()> {
                 }
                 Some(_) => {}
             }
+            if format == Some(Format::LammpsData)
+                && !md.velocities.is_empty()
+                && md.property("vx").is_none()
+            {
+                // A data file's velocities are in the run's units, which it does not state.
+                velocities_dropped.frames += 1;
+                velocities_dropped.atoms = velocities_dropped.atoms.max(count);
+            }
             if let (Some(w), Some(out)) = (&mut writer, &a.output) {
                 w.write_frame(&md)
                     .map_err(|e| at(e.into()))
@@ -425,21 +440,47 @@ pub fn convert(a: &ConvertArgs) -> Result<()> {
     }
     pb.finish_and_clear();
     tables.commit()?;
-    if without_positions > 0 {
+    let w = without_positions;
+    if w.frames > 0 {
+        let wrote = if a.output.is_some() {
+            "not written"
+        } else {
+            "not analysed"
+        };
         crate::note!(
-            "skipped {without_positions} frame(s) of {} without positions (TRR frames of only velocities or forces: mdrun's nstvout or nstfout differs from nstxout)",
-            a.file.display()
+            "warning: {} frame(s) of {} have no positions (TRR frames of only velocities or forces: mdrun's nstvout or nstfout differs from nstxout), so their velocities ({} frame(s)) and forces ({} frame(s)) of {} atoms were {wrote}; write those steps with positions (nstxout) to keep them",
+            w.frames,
+            a.file.display(),
+            w.velocities,
+            w.forces,
+            w.atoms
+        );
+    }
+    if velocities_dropped.frames > 0 {
+        crate::note!(
+            "warning: the velocities (Å/ps) of {} atoms were not written: a LAMMPS data file's velocities are in its run's units, which it does not state (a data file's own velocities, the properties vx vy vz, are written)",
+            velocities_dropped.atoms
         );
     }
     if let Some(out) = &a.output {
         crate::note!(
             "wrote {} frame(s), {} atoms in all, to {}",
-            frames.len() - without_positions,
+            frames.len() - w.frames,
             atoms_written,
             out.display()
         );
     }
     Ok(())
+}
+
+/// Frames, and atoms in the largest of them, whose data the output does not receive (and of
+/// TRR frames without positions, how many held velocities and forces).
+#[derive(Default, Clone, Copy)]
+struct Dropped {
+    frames: usize,
+    atoms: usize,
+    velocities: usize,
+    forces: usize,
 }
 
 /// The structure types `columns` asks for and the frame does not have yet, as OVITO numbers

@@ -424,7 +424,7 @@ fn trr_output_keeps_velocities_and_forces() {
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(
-        stderr(&o).contains("skipped 2 frame(s)") && stderr(&o).contains("wrote 3 frame(s)"),
+        stderr(&o).contains("2 frame(s) of") && stderr(&o).contains("wrote 3 frame(s)"),
         "{}",
         stderr(&o)
     );
@@ -484,6 +484,68 @@ fn trr_output_keeps_velocities_and_forces() {
             }
         }
     }
+}
+
+/// mdrun's argon run with positions every 10 steps, velocities every 5 and forces every 2
+/// (md-io/tests/data/trr_mixed): TRR -> TRR keeps the three frames with positions whole, and
+/// the velocities and forces of the ten without, which no frame can carry, are named in one
+/// warning with the counts `gmx dump` gives (2 frames of velocities, 8 of forces, 8 atoms).
+#[test]
+fn trr_frames_without_positions_are_named_not_dropped_in_silence() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = md_data("trr_mixed/argon.trr");
+    let out = dir.path().join("b.trr");
+    let o = texmap(&["convert", &src, "-o", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert_eq!(err.matches("warning:").count(), 1, "{err}");
+    assert!(
+        err.contains("10 frame(s) of")
+            && err.contains(
+                "velocities (2 frame(s)) and forces (8 frame(s)) of 8 atoms were not written"
+            )
+            && err.contains("wrote 3 frame(s)"),
+        "{err}"
+    );
+    let back = frames(&out);
+    let steps: Vec<Option<i64>> = back.iter().map(|f| f.step).collect();
+    assert_eq!(steps, [Some(0), Some(10), Some(20)]);
+    for f in &back {
+        assert_eq!((f.n_atoms(), f.velocities.len()), (8, 8));
+        assert!(f.property("fx").is_some());
+    }
+}
+
+/// A LAMMPS data file's Velocities (ASE's) come back in the data file written from it; a
+/// trajectory's velocities (Å/ps), which a data file cannot state the units of, are named in
+/// a warning.
+#[test]
+fn lammps_data_output_keeps_a_data_files_velocities() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = md_data("lammps_data/ase_atomic_tri.data");
+    let out = dir.path().join("out.data");
+    let o = texmap(&["convert", &src, "-o", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!stderr(&o).contains("warning"), "{}", stderr(&o));
+    let (a, b) = (&frames(Path::new(&src))[0], &frames(&out)[0]);
+    for k in ["vx", "vy", "vz"] {
+        assert_eq!(a.property(k), b.property(k), "{k}");
+    }
+    let gro = dir.path().join("v.data");
+    let o = texmap(&[
+        "convert",
+        &md_data("mda_vel.gro"),
+        "--frames",
+        "0",
+        "-o",
+        gro.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("warning: the velocities (Å/ps) of"),
+        "{}",
+        stderr(&o)
+    );
 }
 
 /// The trajectory formats of AMBER, HOOMD-blue and VASP: every frame of a triclinic LAMMPS

@@ -53,7 +53,9 @@
 //! a1 = (Lx, 0, 0), a2 = (xy·Ly, Ly, 0), a3 = (xz·Lz, yz·Lz, Lz), corner −(a1 + a2 + a3)/2. A
 //! 2-D box has Lz = 0 (`gsd.hoomd` then writes `dimensions` 2), which no cell of volume > 0
 //! has: it gets a3 = (0, 0, 1), a slab one length unit thick around the particles' z = 0
-//! (LAMMPS's 2-D boxes are −0.5 ≤ z < 0.5 too), and z stays as written. The slab is made for
+//! (LAMMPS's 2-D boxes are −0.5 ≤ z < 0.5 too), open along z ([`UnitCell::periodic`]: no atom
+//! has an image across the slab, so neighbour searches stay in the plane, and our GSD writer
+//! writes the box back as 2-D), and z stays as written. The slab is made for
 //! Lz = 0 whatever `dimensions` says: gsd.hoomd reads such a box without complaint, and
 //! refusing a file over that inconsistency would help no one.
 //!
@@ -813,7 +815,8 @@ impl<R: Read + Seek> GsdReader<R> {
             let m = [[lx, 0.0, 0.0], [xy * ly, ly, 0.0], [xz * c, yz * c, c]];
             UnitCell::from_matrix(m).map(|cell| {
                 let o = std::array::from_fn(|i| -0.5 * (m[0][i] + m[1][i] + m[2][i]));
-                cell.with_origin(o)
+                // A 2-D box's slab has no images along z.
+                cell.with_origin(o).with_periodic([true, true, lz != 0.0])
             })
         } else {
             Err(Error::InvalidValue {

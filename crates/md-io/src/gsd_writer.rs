@@ -13,13 +13,13 @@
 //! | chunk | from | written |
 //! |---|---|---|
 //! | `configuration/step` (u64) | [`Frame::step`], else the frame's index | every frame |
-//! | `configuration/dimensions` (u8) | 3 | frame 0 |
+//! | `configuration/dimensions` (u8) | 2 for a planar frame 0 (below), else 3 | frame 0 |
 //! | `configuration/box` (6 f32) | the cell (below) | every frame |
 //! | `particles/N` (u32) | the atom count | every frame |
 //! | `particles/types`, `particles/typeid` | [`Frame::types`], else element symbols, else names, else `A`; numbered in order of first appearance | frame 0, and a later frame whose values differ |
 //! | `particles/position` (N×3 f32) | positions in the box (below) | every frame |
 //! | `particles/image` (N×3 i32) | the periodic images the wrapping moved each atom by, plus the frame's `ix iy iz` | every frame |
-//! | `particles/velocity` (N×3 f32) | [`Frame::velocities`] | every frame that has them |
+//! | `particles/velocity` (N×3 f32) | [`Frame::velocities`], turned with the box | every frame that has them |
 //! | `particles/diameter`, `mass`, `charge` (f32) | twice [`Frame::radii`]; the properties `mass`, `charge` | frame 0, and a later frame whose values differ |
 //! | `particles/orientation` (N×4 f32) | the properties `quatw quati quatj quatk` | every frame that has them |
 //! | `particles/body` (i32) | the property `body` | as `mass` |
@@ -36,6 +36,12 @@
 //! shifted by the box's centre and wrapped into it, since HOOMD requires every particle inside
 //! its box: the periodic images moved are added to `particles/image`, so unwrapping gives the
 //! positions back. A frame without a cell gets its atoms' bounding box grown by 1 Å each side.
+//!
+//! **2-D.** A file is 2-D, as HOOMD's 2-D simulations and `gsd.hoomd` write it (`dimensions` 2,
+//! every box's Lz, xz, yz 0), when frame 0 is planar: its cell is open along its third edge
+//! ([`crate::UnitCell::periodic`], as our reader gives a 2-D box), that edge is perpendicular
+//! to the other two and every atom lies in the box's mid-plane (z = 0 once centred). Positions
+//! are then not wrapped along z, so a GSD read and written back keeps its dimensionality.
 //!
 //! # Refused
 //! A label with a NUL byte (the type list is NUL-separated), more than 2³² − 1 atoms, bonds or
@@ -77,6 +83,8 @@ pub struct GsdWriter<W> {
     /// Frame 0's bytes of the chunks stored once (types, diameters, bonds, ...), by name.
     first: HashMap<&'static str, Vec<u8>>,
     buf: Vec<u8>,
+    /// Frame 0 was planar: the file is 2-D.
+    two_d: bool,
 }
 
 /// Names of a frame's particle types, and each atom's type id.
@@ -152,6 +160,19 @@ fn hoomd_box(frame: &Frame) -> HoomdBox {
     }
 }
 
+/// Whether `frame` is planar (a 2-D file): a cell open along its third edge, that edge
+/// perpendicular to the other two (no xz, yz tilt) and every atom in the box's mid-plane.
+fn planar(frame: &Frame, hb: &HoomdBox) -> bool {
+    let open_c = frame.cell.is_some_and(|c| !c.periodic()[2]);
+    let upright = hb.data_box.tilt[1] == 0.0 && hb.data_box.tilt[2] == 0.0;
+    open_c
+        && upright
+        && frame.positions.iter().all(|p| {
+            let p = hb.data_box.rotate.as_ref().map_or(*p, |r| r.apply(*p));
+            (p[2] as f64 - hb.centre[2]) as f32 == 0.0
+        })
+}
+
 impl<W: Write + Seek> GsdWriter<W> {
     /// A GSD writer on `out` (positioned at its start).
     pub fn new(out: W) -> Self {
@@ -163,6 +184,7 @@ impl<W: Write + Seek> GsdWriter<W> {
             frames: 0,
             first: HashMap::new(),
             buf: Vec::new(),
+            two_d: false,
         }
     }
 
@@ -253,10 +275,18 @@ impl<W: Write + Seek> GsdWriter<W> {
         let n = frame.n_atoms();
         let step = frame.step.unwrap_or(self.frames as i64) as u64;
         self.chunk("configuration/step", U64, 1, 1, &step.to_le_bytes())?;
+        let mut hb = hoomd_box(frame);
         if self.frames == 0 {
-            self.chunk("configuration/dimensions", U8, 1, 1, &[3])?;
+            self.two_d = planar(frame, &hb);
+            let dims = if self.two_d { 2 } else { 3 };
+            self.chunk("configuration/dimensions", U8, 1, 1, &[dims])?;
         }
-        let hb = hoomd_box(frame);
+        if self.two_d {
+            // HOOMD's 2-D box: Lz, xz, yz are 0.
+            for k in [2, 4, 5] {
+                hb.params[k] = 0.0;
+            }
+        }
         let mut b = std::mem::take(&mut self.buf);
         b.clear();
         for v in hb.params {
@@ -274,7 +304,10 @@ impl<W: Write + Seek> GsdWriter<W> {
             // Fractions of the box measured from its corner (lo).
             let d: [f64; 3] = std::array::from_fn(|k| p[k] as f64 - hb.data_box.lo[k]);
             let f = crate::pbc::to_frac(&hb.m, d);
-            let shift = f.map(|x| if x.is_finite() { x.floor() } else { 0.0 });
+            let mut shift = f.map(|x| if x.is_finite() { x.floor() } else { 0.0 });
+            if self.two_d {
+                shift[2] = 0.0;
+            }
             for k in 0..3 {
                 let q = p[k] as f64
                     - hb.centre[k]
@@ -288,8 +321,16 @@ impl<W: Write + Seek> GsdWriter<W> {
         self.chunk("particles/image", I32, n as u64, 3, &img)?;
         if !frame.velocities.is_empty() {
             b.clear();
-            for v in frame.velocities.as_flattened() {
-                b.extend_from_slice(&v.to_le_bytes());
+            for &v in &frame.velocities {
+                // Turned with the box, as the positions are.
+                let v = hb
+                    .data_box
+                    .rotate
+                    .as_ref()
+                    .map_or(v, |r| r.apply_vector(v.map(f64::from)).map(|x| x as f32));
+                for c in v {
+                    b.extend_from_slice(&c.to_le_bytes());
+                }
             }
             self.chunk("particles/velocity", F32, n as u64, 3, &b)?;
         }

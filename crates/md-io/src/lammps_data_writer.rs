@@ -5,7 +5,7 @@
 //! # What is written
 //! One frame (a data file is one configuration: a second frame is an error), as `write_data`
 //! lays it out: a title line (the frame's comment, or "LAMMPS data file written by texmap"),
-//! the counts, the box, `Masses`, `Atoms # STYLE` and `Bonds`.
+//! the counts, the box, `Masses`, `Atoms # STYLE`, `Velocities` and `Bonds`.
 //!
 //! - **Atom style**, from what the frame has: `full` (id mol type q x y z) with bonds and
 //!   charges, `molecular` (id mol type x y z) with bonds only, `charge` (id type q x y z) with
@@ -34,9 +34,14 @@
 //!   2023 require; a tilted box writes `xy xz yz`. (Cells are right-handed by construction, so
 //!   the rotation never mirrors the structure.) A frame without a cell gets the atoms' bounding box grown by
 //!   1 Å on each side (for `boundary f` or `s`).
-//! - **Not written**: velocities (a data file does not state its units, and LAMMPS's are the
-//!   run's: Å/fs for `units real`, Å/ps for `metal`), image flags (the positions carry them),
-//!   angles, dihedrals, impropers, coefficients.
+//! - **Velocities**: the properties `vx vy vz` (a data file's `Velocities` as our reader gives
+//!   them, in the run's units, unconverted), turned with the box when it is rotated, so a data
+//!   file read and written back keeps its velocities. [`Frame::velocities`] (Å/ps, from a
+//!   trajectory) are not written: a data file does not state its units, and LAMMPS's are the
+//!   run's (Å/fs for `units real`, Å/ps for `metal`), so no conversion can be chosen here
+//!   (`texmap convert` warns when it drops them).
+//! - **Not written**: image flags (the positions carry them), angles, dihedrals, impropers,
+//!   coefficients.
 //!
 //! # References
 //! - LAMMPS documentation, `read_data` (header, sections, the Atoms line of each style) and
@@ -89,10 +94,25 @@ pub(crate) struct Rotation {
 impl Rotation {
     pub fn apply(&self, p: [f32; 3]) -> [f32; 3] {
         let d: [f64; 3] = std::array::from_fn(|k| p[k] as f64 - self.origin[k]);
-        let f = crate::pbc::to_frac(&self.cell, d);
-        let q = crate::pbc::to_cart(&self.restricted, f);
+        let q = self.apply_vector(d);
         std::array::from_fn(|j| (self.origin[j] + q[j]) as f32)
     }
+
+    /// The rotation of a vector (a velocity, a displacement): `apply` without the origin.
+    pub fn apply_vector(&self, v: [f64; 3]) -> [f64; 3] {
+        let f = crate::pbc::to_frac(&self.cell, v);
+        crate::pbc::to_cart(&self.restricted, f)
+    }
+}
+
+/// The properties `vx vy vz` (a data file's velocities, in the run's units), if the frame has
+/// all three.
+fn data_velocities(frame: &Frame) -> Option<[&[f32]; 3]> {
+    Some([
+        frame.property("vx")?,
+        frame.property("vy")?,
+        frame.property("vz")?,
+    ])
 }
 
 /// The restricted triclinic form of `cell` with its tilts reduced along periodic edges. A
@@ -207,6 +227,16 @@ fn plan(frame: &Frame) -> Result<Plan, String> {
         .and_then(|c| c.iter().position(|q| !q.is_finite()))
     {
         return Err(format!("atom {i}'s charge is not a number"));
+    }
+    if let Some(v) = data_velocities(frame)
+        && let Some((d, i)) =
+            (0..3).find_map(|d| v[d].iter().position(|x| !x.is_finite()).map(|i| (d, i)))
+    {
+        return Err(format!(
+            "atom {i}'s velocity {} is {}: read_data takes finite numbers",
+            ["vx", "vy", "vz"][d],
+            v[d][i]
+        ));
     }
     let bonded = !frame.bonds.is_empty();
     let style = match (bonded, charges.is_some()) {
@@ -397,6 +427,18 @@ impl<W: Write> LammpsDataWriter<W> {
                 write!(w, " {}", Num(q[i]))?;
             }
             writeln!(w, " {} {} {}", p[0], p[1], p[2])?;
+        }
+        if let Some([vx, vy, vz]) = data_velocities(frame) {
+            writeln!(w, "\nVelocities\n")?;
+            for i in 0..frame.n_atoms() {
+                let v = [vx[i], vy[i], vz[i]];
+                // Turned with the box, as the positions are (an f64 rotation, rounded once).
+                let v = b
+                    .rotate
+                    .as_ref()
+                    .map_or(v, |r| r.apply_vector(v.map(f64::from)).map(|x| x as f32));
+                writeln!(w, "{} {} {} {}", i + 1, v[0], v[1], v[2])?;
+            }
         }
         if !frame.bonds.is_empty() {
             writeln!(w, "\nBonds\n")?;

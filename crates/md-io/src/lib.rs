@@ -229,6 +229,7 @@ pub use style::{Appearance, AtomStyle, Selector, atom_element, atom_mass};
 pub use topology::{Topology, TopologyFormat};
 pub use tpr::{Tpr, read_tpr};
 pub use trajectory::{FrameSource, ReadOptions, Trajectory};
+pub use trr::WithoutPositions;
 pub use writer::Writer;
 
 /// molly, the XTC crate our decoder is measured against (benches/md_io.rs); not part of the API.

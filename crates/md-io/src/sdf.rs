@@ -18,12 +18,18 @@
 //!
 //! Each atom's name is its element symbol (molfiles have no atom names; PyMOL names them so
 //! too), its id its number in the file. Bonds go to [`Frame::bonds`] (sorted, each once) with
-//! their types in [`Frame::bond_orders`] (1-3, 4 aromatic, a query type 0); charges
-//! (`M  CHG`), isotopes and the data items are not kept. A symbol that is no element (`R#`, `*`, `A`, a list) is an unknown element.
+//! their types in [`Frame::bond_orders`] (1-3, 4 aromatic, a query type 0). Formal charges
+//! become the `charge` property (in e, integers; the property MOL2's and PQR's partial charges
+//! fill) when some atom of the record is charged: in V2000 the `M  CHG` lines, which replace
+//! every atom line's charge code (columns 37-39: 1-3 for +3..+1, 5-7 for -1..-3) as the CTfile
+//! specification and RDKit have it, else those codes; in V3000 the atom's `CHG=`. Isotopes,
+//! radicals and the data items are not kept. A symbol that is no element (`R#`, `*`, `A`, a
+//! list) is an unknown element.
 //!
 //! # Damage
 //! Errors name the file, frame, line and byte: a counts line without two counts, an atom line
-//! whose coordinates are not numbers, a bond naming an atom the record does not have (or one
+//! whose coordinates or charge code are not numbers, an `M  CHG` line that is not a count
+//! and as many atom number and charge pairs of the record, a bond naming an atom the record does not have (or one
 //! atom twice), a record cut before its `M  END` (a truncation, so `allow_truncated` keeps the
 //! records before it), and the marks of a damaged record end: a `$$$$` before `M  END`, or an
 //! `M  END` or counts line before `$$$$` (two records are never read as one). Counts reserve room for at most as many atoms as the file's size allows.
@@ -36,7 +42,7 @@ use std::io::Read;
 use crate::elements::Element;
 use crate::error::Error;
 use crate::frame::{Frame, Label};
-use crate::parse::{fields, parse_f64, parse_usize, span, trim};
+use crate::parse::{fields, parse_f64, parse_i64, parse_usize, span, trim};
 use crate::text::{Ctx, FrameWalk, LineReader, Pos};
 
 /// The SD file / molfile parser.
@@ -130,18 +136,36 @@ impl FrameWalk for Sdf {
         if let Some(f) = frame.as_deref_mut() {
             f.comment = title.unwrap_or_default();
         }
+        let mut charges = Vec::new();
         let bonds = if v3000 {
-            v3000_table(lines, ctx, frame.as_deref_mut())?
+            v3000_table(lines, ctx, frame.as_deref_mut(), &mut charges)?
         } else {
-            v2000_table(lines, ctx, frame.as_deref_mut(), n_atoms, n_bonds)?
+            v2000_table(
+                lines,
+                ctx,
+                frame.as_deref_mut(),
+                n_atoms,
+                n_bonds,
+                &mut charges,
+            )?
         };
         // Properties up to M  END, then data items up to $$$$ (or the end of a molfile).
         // A damaged 'M  END' or '$$$$' must not merge two records into one: the other record's
         // marks met first are errors.
+        let mut chg_seen = false;
         loop {
             let (pos, line) = need(lines, ctx, || "the properties block's 'M  END'".into())?;
             if line.starts_with(b"M  END") {
                 break;
+            }
+            if !v3000 && let Some(rest) = line.strip_prefix(b"M  CHG") {
+                // The first M  CHG line of a record replaces every atom line's charge code.
+                if !chg_seen {
+                    charges.fill(0);
+                    chg_seen = true;
+                }
+                m_chg(rest, &mut charges)
+                    .ok_or_else(|| ctx.parse(pos, line, line, M_CHG_EXPECTED))?;
             }
             if trim(line) == b"$$$$" {
                 return Err(ctx.parse(pos, line, line, "'M  END' closing the properties block"));
@@ -162,8 +186,44 @@ impl FrameWalk for Sdf {
         }
         if let Some(f) = frame {
             crate::frame::set_ordered_bonds(f, bonds);
+            if charges.iter().any(|&q| q != 0) {
+                f.properties.push(crate::frame::Property {
+                    name: "charge".into(),
+                    values: charges.iter().map(|&q| q as f32).collect(),
+                });
+            }
         }
         Ok(true)
+    }
+}
+
+const M_CHG_EXPECTED: &str =
+    "'M  CHG' with a count of 1-8 and as many atom numbers of this record and charges";
+
+/// The pairs of an `M  CHG` line (`rest`: the text after `M  CHG`) into `charges`; `None`
+/// when it is not a count of 1-8 and that many atom numbers of the record and charges.
+fn m_chg(rest: &[u8], charges: &mut [i32]) -> Option<()> {
+    let mut w = fields(rest);
+    let n = parse_usize(w.next()?).filter(|n| (1..=8).contains(n))?;
+    for _ in 0..n {
+        let atom = parse_usize(w.next()?).filter(|&a| a >= 1 && a <= charges.len())?;
+        let q = parse_i64(w.next()?).and_then(|q| i32::try_from(q).ok())?;
+        charges[atom - 1] = q;
+    }
+    w.next().is_none().then_some(())
+}
+
+/// The charge of a V2000 atom line's charge code (columns 37-39; blank is 0): 1-3 are +3..+1,
+/// 5-7 are -1..-3, 4 a doublet radical (no charge); `None` for anything else.
+fn charge_code(f: &[u8]) -> Option<i32> {
+    if f.is_empty() {
+        return Some(0);
+    }
+    match parse_usize(f)? {
+        c @ 1..=3 => Some(4 - c as i32),
+        c @ 5..=7 => Some(4 - c as i32),
+        0 | 4 => Some(0),
+        _ => None,
     }
 }
 
@@ -183,7 +243,9 @@ fn v2000_table<R: Read>(
     mut frame: Option<&mut Frame>,
     n_atoms: usize,
     n_bonds: usize,
+    charges: &mut Vec<i32>,
 ) -> Result<Vec<([u32; 2], u8)>, Error> {
+    charges.reserve(n_atoms.min(ctx.reserve));
     if let Some(f) = frame.as_deref_mut() {
         f.positions.reserve(n_atoms.min(ctx.reserve));
     }
@@ -200,6 +262,11 @@ fn v2000_table<R: Read>(
         if symbol.is_empty() {
             return Err(ctx.parse(pos, line, line, "an element symbol in columns 32-34"));
         }
+        let code = trim(span(line, 36, 39));
+        charges.push(
+            charge_code(code)
+                .ok_or_else(|| ctx.parse(pos, line, code, "a charge code 0-7 in columns 37-39"))?,
+        );
         if let Some(f) = frame.as_deref_mut() {
             push_atom(f, xyz, symbol, i as i64 + 1);
         }
@@ -251,6 +318,7 @@ fn v3000_table<R: Read>(
     lines: &mut LineReader<R>,
     ctx: &Ctx,
     mut frame: Option<&mut Frame>,
+    charges: &mut Vec<i32>,
 ) -> Result<Vec<([u32; 2], u8)>, Error> {
     let mut text = Vec::new();
     // Errors point at the logical line's start: a joined line is no slice of the file.
@@ -306,6 +374,16 @@ fn v3000_table<R: Read>(
                     ) else {
                         return Err(at(pos, &text, what));
                     };
+                    // The atom's CHG=, among the keywords after the atom-atom mapping.
+                    let mut q = 0;
+                    for w in fields(&text).skip(6) {
+                        if let Some(v) = w.strip_prefix(b"CHG=") {
+                            q = parse_i64(v)
+                                .and_then(|q| i32::try_from(q).ok())
+                                .ok_or_else(|| at(pos, &text, "CHG= with an integer charge"))?;
+                        }
+                    }
+                    charges.push(q);
                     index_of.push((idx, k as u32));
                     if let Some(f) = frame.as_deref_mut() {
                         push_atom(f, [x, y, z], symbol, idx as i64);

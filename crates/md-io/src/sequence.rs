@@ -90,6 +90,11 @@ impl Sequence {
         &self.paths
     }
 
+    /// [`Trajectory::without_positions`] of the frame read last.
+    pub fn without_positions(&self) -> Option<crate::WithoutPositions> {
+        self.open.as_ref().and_then(|o| o.1.without_positions())
+    }
+
     /// The first part's format.
     pub fn format(&self) -> Format {
         self.first_format

@@ -549,6 +549,16 @@ impl<R: Read + Seek> Trajectory<R> {
         }
     }
 
+    /// For the frame read last, when it was a TRR frame without positions (left with no atoms):
+    /// the velocities and forces it held, which no [`Frame`] can carry without positions. A
+    /// converter names them in a warning instead of dropping them in silence.
+    pub fn without_positions(&self) -> Option<crate::WithoutPositions> {
+        match &self.reader {
+            Reader::Trr(r) => r.without_positions(),
+            _ => None,
+        }
+    }
+
     /// The file's format.
     pub fn format(&self) -> Format {
         self.format

@@ -16,6 +16,10 @@
 //! are converted to Å (×10, in the file's precision, then rounded to f32), velocities to Å/ps;
 //! forces become the per-atom properties `fx fy fz` in kJ/(mol·Å) (÷10, the unit MDAnalysis
 //! gives them), the names ASE and LAMMPS dumps use, so `--arrows f` draws them.
+//! A frame without positions (mdrun writes frames of only velocities or only forces when
+//! `nstvout` or `nstfout` differ from `nstxout`) is read as a frame of no atoms, since a
+//! [`Frame`]'s atoms are its positions; [`crate::Trajectory::without_positions`] then says
+//! which blocks it held and for how many atoms, so that a converter names what it drops.
 //!
 //! # References
 //! - GROMACS `trrio.cpp` (`do_trr_frame_header`, `do_trr_frame_data`) and xdrfile `trr_header`
@@ -103,6 +107,21 @@ pub struct TrrReader<R> {
     next: usize,
     /// `read_next`'s buffer of forces, before they become properties.
     forces: Vec<[f32; 3]>,
+    /// What the frame `read_next` read last held, when it had no positions.
+    without_positions: Option<WithoutPositions>,
+}
+
+/// What a TRR frame without positions holds (mdrun writes such frames when `nstvout` or
+/// `nstfout` differ from `nstxout`): [`crate::Trajectory::without_positions`] tells it for the
+/// frame just read, which a [`Frame`] cannot carry (its atoms are its positions).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct WithoutPositions {
+    /// Atoms of the frame's blocks.
+    pub atoms: usize,
+    /// The frame has velocities.
+    pub velocities: bool,
+    /// The frame has forces.
+    pub forces: bool,
 }
 
 fn be_u32(b: &[u8], at: usize) -> u32 {
@@ -293,6 +312,7 @@ impl<R: Read + Seek> TrrReader<R> {
             pos: u64::MAX,
             next: 0,
             forces: Vec::new(),
+            without_positions: None,
         })
     }
 
@@ -429,6 +449,7 @@ impl<R: Read + Seek> TrrReader<R> {
     /// last frame; on error the frame is left empty and the reader stays at the damaged frame.
     pub fn read_next(&mut self, frame: &mut Frame) -> Result<bool, Error> {
         frame.clear();
+        self.without_positions = None;
         let index = self.next;
         if index >= self.frames.len() && self.tail.is_none() {
             return Ok(false);
@@ -446,7 +467,14 @@ impl<R: Read + Seek> TrrReader<R> {
                 frame.step = Some(info.step);
                 frame.time = Some(info.time);
                 if !info.has_positions {
-                    // Velocities or forces without positions would break the frame's invariant.
+                    // Velocities or forces without positions would break the frame's
+                    // invariant: the frame has no atoms, and `without_positions` says what
+                    // it held.
+                    self.without_positions = Some(WithoutPositions {
+                        atoms: frame.velocities.len().max(forces.len()),
+                        velocities: info.has_velocities,
+                        forces: info.has_forces,
+                    });
                     frame.velocities.clear();
                 } else if info.has_forces {
                     for (d, name) in ["fx", "fy", "fz"].into_iter().enumerate() {
@@ -468,6 +496,11 @@ impl<R: Read + Seek> TrrReader<R> {
             });
         self.forces = forces;
         crate::cursor::settle(r, frame, &mut self.next)
+    }
+
+    /// What the frame read last held when it had no positions (else `None`).
+    pub fn without_positions(&self) -> Option<WithoutPositions> {
+        self.without_positions
     }
 
     /// Makes `read_next` read frame `n`; `Ok(false)` if there is no frame `n` (a damaged frame

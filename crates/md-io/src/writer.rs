@@ -8,8 +8,9 @@
 //!   properties when the frame has them (read back by LAMMPS `read_dump`, OVITO, ASE and our
 //!   reader).
 //! - [`Format::LammpsData`]: one frame as a LAMMPS data file for `read_data` (atom style by
-//!   what the frame has, types with their masses, bonds typed by their atoms' types, the box
-//!   in LAMMPS's restricted form: src/lammps_data_writer.rs).
+//!   what the frame has, types with their masses, a data file's `Velocities` (the properties
+//!   `vx vy vz`), bonds typed by their atoms' types, the box in LAMMPS's restricted form:
+//!   src/lammps_data_writer.rs).
 //! - [`Format::Gro`]: GROMACS .gro as `gmx trjconv` writes it (residues, names, numbers,
 //!   positions to 0.001 nm, velocities, the box; time and step in the title).
 //! - [`Format::Pdb`], [`Format::Dcd`], [`Format::Xtc`]: positions and cell, with PDB's atom
@@ -17,8 +18,9 @@
 //! - [`Format::Trr`]: GROMACS TRR in single precision, per frame the box, positions,
 //!   velocities and the forces `fx fy fz` the frame has (src/trr_writer.rs).
 //! - [`Format::Gsd`]: HOOMD-blue GSD (file format 2.0, hoomd schema 1.4): the box in HOOMD's
-//!   centred form with the positions wrapped into it and their images, types, velocities,
-//!   diameters, masses, charges, orientations and bonds (src/gsd_writer.rs).
+//!   centred form with the positions wrapped into it and their images (2-D, `dimensions` 2,
+//!   for a planar frame in a cell open along its third edge, as a 2-D GSD reads), types,
+//!   velocities, diameters, masses, charges, orientations and bonds (src/gsd_writer.rs).
 //! - [`Format::Mmcif`]: PDBx/mmCIF, frames as the models of one `_atom_site` loop (names,
 //!   residues, chains and elements in the label and auth items, the `occupancy` and `bfactor`
 //!   properties, the first frame's cell), with no limit on atom count, residue numbers or chain

@@ -7,6 +7,8 @@
 //! - `vel`: MDAnalysis's triclinic GRO with velocities (atoms outside the box, wrapped in with
 //!   their images).
 //! - `nacl`: ASE's primitive NaCl POSCAR, a cell in general orientation (rotated into HOOMD's).
+//! - `twod`: gsd.hoomd's 2-D file (../gsd/hoomd_2d.gsd: `dimensions` 2, Lz 0, a tilted box)
+//!   rewritten: still 2-D, as gsd.hoomd reads it, with the original's box and positions.
 
 use std::io::{Cursor, Read};
 use std::path::PathBuf;
@@ -19,10 +21,11 @@ fn data(name: &str) -> PathBuf {
         .join(name)
 }
 
-const CASES: [(&str, &str); 3] = [
+const CASES: [(&str, &str); 4] = [
     ("tri", "gsd/hoomd_tri.gsd"),
     ("vel", "mda_vel.gro"),
     ("nacl", "lammps_write/nacl_primitive.vasp"),
+    ("twod", "gsd/hoomd_2d.gsd"),
 ];
 
 fn frames(path: &std::path::Path) -> Vec<Frame> {
@@ -67,14 +70,21 @@ fn rewriting_the_inputs_gives_the_committed_files() {
     }
 }
 
-/// gsd.hoomd reads from our rewrite of hoomd_tri.gsd exactly what it reads from the original.
+/// gsd.hoomd reads from our rewrites of hoomd_tri.gsd and of the 2-D hoomd_2d.gsd exactly what
+/// it reads from the originals, the dimensionality included.
 #[test]
 fn gsd_hoomd_reads_our_rewrite_as_the_original() {
+    for (case, original, n) in [("tri", "hoomd_tri.gsd", 5), ("twod", "hoomd_2d.gsd", 3)] {
+        rewrite_reads_as_original(case, original, n);
+    }
+}
+
+fn rewrite_reads_as_original(case: &str, original: &str, n: usize) {
     let ours = json_gz(&data("gsd_write/gsd_hoomd.json.gz"));
-    let original = json_gz(&data("gsd/reference.json.gz"));
-    let original = &original["hoomd_tri.gsd"]["frames"];
-    let ours = &ours["tri"]["frames"];
-    assert_eq!(ours.as_array().unwrap().len(), 5);
+    let all = json_gz(&data("gsd/reference.json.gz"));
+    let original = &all[original]["frames"];
+    let ours = &ours[case]["frames"];
+    assert_eq!(ours.as_array().unwrap().len(), n, "{case}");
     for (k, (o, g)) in ours
         .as_array()
         .unwrap()
@@ -84,6 +94,7 @@ fn gsd_hoomd_reads_our_rewrite_as_the_original() {
     {
         for key in [
             "step",
+            "dimensions",
             "box",
             "N",
             "position",
@@ -95,7 +106,7 @@ fn gsd_hoomd_reads_our_rewrite_as_the_original() {
             "image",
             "body",
         ] {
-            assert_eq!(o[key], g[key], "frame {k}: {key}");
+            assert_eq!(o[key], g[key], "{case} frame {k}: {key}");
         }
         // Bonds: the original lists one bond twice (both orders), which a frame holds once.
         let bonds = |v: &serde_json::Value| -> Vec<[u64; 2]> {
@@ -112,7 +123,7 @@ fn gsd_hoomd_reads_our_rewrite_as_the_original() {
             b.dedup();
             b
         };
-        assert_eq!(bonds(o), bonds(g), "frame {k}: bonds");
+        assert_eq!(bonds(o), bonds(g), "{case} frame {k}: bonds");
         assert_eq!(o["bonds_N"].as_u64().unwrap() as usize, bonds(o).len());
         // Types are numbered in order of first appearance: compare each particle's name.
         let names = |v: &serde_json::Value| -> Vec<String> {
@@ -129,7 +140,7 @@ fn gsd_hoomd_reads_our_rewrite_as_the_original() {
                 .map(|i| types[i.as_u64().unwrap() as usize].to_string())
                 .collect()
         };
-        assert_eq!(names(o), names(g), "frame {k}: particle types");
+        assert_eq!(names(o), names(g), "{case} frame {k}: particle types");
     }
 }
 
@@ -283,4 +294,34 @@ fn what_the_schema_cannot_hold_is_refused_naming_the_frame() {
         e.contains("bad.gsd") && e.contains("frame 0") && e.contains("step -5"),
         "{e}"
     );
+}
+
+/// A cell rotated into HOOMD's form turns the velocities with the positions: a velocity along
+/// the cell's first edge is along HOOMD's a1 = (Lx, 0, 0) in the file.
+#[test]
+fn velocities_turn_with_a_rotated_box() {
+    let mut f = frames(&data("lammps_write/nacl_primitive.vasp")).remove(0);
+    let a = f.cell.unwrap().matrix()[0];
+    assert!(
+        a[1] != 0.0 || a[2] != 0.0,
+        "the cell is not in HOOMD's form"
+    );
+    f.velocities = vec![a.map(|x| x as f32); f.n_atoms()];
+    let back = Trajectory::from_reader(Cursor::new(written(&[f])), Format::Gsd, "r.gsd")
+        .and_then(|mut t| {
+            let mut g = Frame::new();
+            t.read_next(&mut g).map(|_| g)
+        })
+        .unwrap();
+    let len = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+    for v in &back.velocities {
+        let want = [len, 0.0, 0.0];
+        for k in 0..3 {
+            // An f64 rotation of f32 values of ~8, rounded to f32: within 2e-6.
+            assert!(
+                (v[k] as f64 - want[k]).abs() <= 2e-6,
+                "{v:?} vs {want:?}, tolerance 2e-6"
+            );
+        }
+    }
 }

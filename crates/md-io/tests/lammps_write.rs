@@ -195,17 +195,36 @@ fn what_a_data_file_cannot_hold_is_refused() {
     );
 }
 
-/// LAMMPS itself on a file written now, where `lmp` is installed (Debian: apt install lammps).
-#[test]
-fn lammps_reads_a_file_written_now() {
+/// LAMMPS's `read_data in.data` then `write_data out.data` in `dir` with `atom_style`: the
+/// file LAMMPS wrote, or `None` without `lmp` on PATH (Debian: apt install lammps).
+fn lammps_rewrite(dir: &std::path::Path, atom_style: &str) -> Option<Frame> {
     if std::process::Command::new("lmp")
         .arg("-h")
         .output()
         .is_err()
     {
         eprintln!("SKIPPED: no lmp on PATH (apt install lammps); the committed files cover it");
-        return;
+        return None;
     }
+    std::fs::write(
+        dir.join("in.lmp"),
+        format!(
+            "units metal\natom_style {atom_style}\nboundary p p p\nread_data in.data\nwrite_data out.data nocoeff\n"
+        ),
+    )
+    .unwrap();
+    let o = std::process::Command::new("lmp")
+        .args(["-in", "in.lmp", "-log", "none"])
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stdout));
+    Some(read(&dir.join("out.data")))
+}
+
+/// LAMMPS itself on a file written now, where `lmp` is installed.
+#[test]
+fn lammps_reads_a_file_written_now() {
     let dir = tempfile::tempdir().unwrap();
     // The P-1 crystal with charges: atom style charge.
     let mut f = read(&data("../crystal/cod_9001665.cif"));
@@ -218,19 +237,9 @@ fn lammps_reads_a_file_written_now() {
     assert!(text.contains("Atoms # charge"));
     let ours = dir.path().join("in.data");
     std::fs::write(&ours, &text).unwrap();
-    let script = dir.path().join("in.lmp");
-    std::fs::write(
-        &script,
-        "units metal\natom_style charge\nboundary p p p\nread_data in.data\nwrite_data out.data nocoeff\n",
-    )
-    .unwrap();
-    let o = std::process::Command::new("lmp")
-        .args(["-in", "in.lmp", "-log", "none"])
-        .current_dir(dir.path())
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stdout));
-    let back = read(&dir.path().join("out.data"));
+    let Some(back) = lammps_rewrite(dir.path(), "charge") else {
+        return;
+    };
     let mine = read(&ours);
     assert_eq!(back.property("charge"), mine.property("charge"));
     let (pa, pb) = (unwrapped(&mine), unwrapped(&back));
@@ -239,4 +248,56 @@ fn lammps_reads_a_file_written_now() {
             assert!((pa[i][k] - pb[i][k]).abs() <= 2e-5, "atom {i}");
         }
     }
+}
+
+/// The velocities of a data file (ASE's, with a `Velocities` section) read and written back:
+/// the same numbers, bit for bit, and LAMMPS (where `lmp` is installed) reads our file and its
+/// `write_data` gives them back.
+#[test]
+fn a_data_files_velocities_are_written_back() {
+    let src = data("../lammps_data/ase_atomic_tri.data");
+    let f = read(&src);
+    let v = |f: &Frame| ["vx", "vy", "vz"].map(|k| f.property(k).map(<[f32]>::to_vec));
+    assert!(v(&f)[0].is_some(), "the input has velocities");
+    let text = written(std::slice::from_ref(&f)).unwrap();
+    assert!(text.contains("\nVelocities\n\n1 "), "{text}");
+    let dir = tempfile::tempdir().unwrap();
+    let ours = dir.path().join("in.data");
+    std::fs::write(&ours, &text).unwrap();
+    assert_eq!(v(&read(&ours)), v(&f));
+    if let Some(back) = lammps_rewrite(dir.path(), "atomic") {
+        assert_eq!(v(&back), v(&f));
+    }
+}
+
+/// A cell rotated into LAMMPS's form turns the velocities with the positions: a velocity set
+/// to the vector from atom 0 to atom 1 is still that vector in the file.
+#[test]
+fn velocities_turn_with_a_rotated_box() {
+    let mut f = read(&data("nacl_primitive.vasp"));
+    let d: Vec<f32> = (0..3)
+        .map(|k| f.positions[1][k] - f.positions[0][k])
+        .collect();
+    for (k, name) in ["vx", "vy", "vz"].into_iter().enumerate() {
+        f.properties.push(texmap_md_io::Property {
+            name: name.into(),
+            values: vec![d[k]; f.n_atoms()],
+        });
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("r.data");
+    std::fs::write(&path, written(std::slice::from_ref(&f)).unwrap()).unwrap();
+    let g = read(&path);
+    let vx = g.property("vx").unwrap();
+    let (vy, vz) = (g.property("vy").unwrap(), g.property("vz").unwrap());
+    let moved = [vx[0], vy[0], vz[0]];
+    let want: [f32; 3] = std::array::from_fn(|k| g.positions[1][k] - g.positions[0][k]);
+    // f32 positions of a few Å, rotated in f64 and rounded: a few ulp of 5 Å.
+    for k in 0..3 {
+        assert!(
+            (moved[k] - want[k]).abs() <= 4e-6,
+            "velocity {moved:?}, atom 0 to 1 {want:?}, tolerance 4e-6"
+        );
+    }
+    assert!(moved[1] != d[1] || moved[2] != d[2], "the box was rotated");
 }

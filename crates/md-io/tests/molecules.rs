@@ -81,6 +81,62 @@ fn sd_files_read_as_rdkit_wrote_them() {
     assert_eq!(sizes, [21, 24, 33, 7, 17]);
 }
 
+/// Formal charges as RDKit 2026.09.1 reads them (`Chem.MolFromMolFile(path, sanitize=False)`,
+/// `GetFormalCharge()` per atom): the atom lines' charge codes, `M  CHG` lines replacing
+/// every code of their record, V3000's `CHG=`, and the library's acetate and
+/// tetramethylammonium. They become the `charge` property, absent from uncharged records.
+#[test]
+fn formal_charges_read_as_rdkit_reads_them() {
+    let atoms = "    0.0000    0.0000    0.0000 N   0  3  0  0  0  0  0  0  0  0  0  0\n    1.4000    0.0000    0.0000 C   0  0  0  0  0  0  0  0  0  0  0  0\n    2.1000    1.2000    0.0000 O   0  ";
+    let v2000 = |o_code: &str, props: &str| {
+        format!(
+            "q\n\n  made by hand\n  3  2  0  0  0  0  0  0  0  0999 V2000\n{atoms}{o_code}  0  0  0  0  0  0  0  0  0  0\n  1  2  1  0\n  2  3  1  0\n{props}M  END\n$$$$\n"
+        )
+    };
+    let v3000 = "q\n\n  made by hand\n  0  0  0     0  0            999 V3000\nM  V30 BEGIN CTAB\nM  V30 COUNTS 3 2 0 0 0\nM  V30 BEGIN ATOM\nM  V30 1 N 0 0 0 0 CHG=1\nM  V30 2 C 1.4 0 0 0\nM  V30 3 O 2.1 1.2 0 0 CHG=-1\nM  V30 END ATOM\nM  V30 BEGIN BOND\nM  V30 1 1 1 2\nM  V30 2 1 2 3\nM  V30 END BOND\nM  V30 END CTAB\nM  END\n$$$$\n";
+    for (what, text, rdkit) in [
+        ("codes", v2000("5", ""), [1.0, 0.0, -1.0]),
+        (
+            "M  CHG over codes",
+            v2000("0", "M  CHG  1   3  -2\n"),
+            [0.0, 0.0, -2.0],
+        ),
+        ("V3000", v3000.to_string(), [1.0, 0.0, -1.0]),
+    ] {
+        let src = std::io::Cursor::new(text.into_bytes());
+        let mut t = Trajectory::from_reader(src, Format::Sdf, "q.sdf").unwrap();
+        let mut f = Frame::new();
+        assert!(t.read_next(&mut f).unwrap(), "{what}");
+        assert_eq!(f.property("charge"), Some(&rdkit[..]), "{what}");
+    }
+    let library = frames("library.sdf");
+    let charged: Vec<(usize, Vec<(usize, f32)>)> = library
+        .iter()
+        .enumerate()
+        .filter_map(|(k, f)| {
+            let q = f.property("charge")?;
+            Some((
+                k,
+                q.iter()
+                    .copied()
+                    .enumerate()
+                    .filter(|q| q.1 != 0.0)
+                    .collect(),
+            ))
+        })
+        .collect();
+    assert_eq!(charged, [(3, vec![(3, -1.0)]), (4, vec![(1, 1.0)])]);
+    // A damaged M  CHG line is an error at its line, not a charge dropped.
+    let sdf = std::fs::read_to_string(data("library.sdf")).unwrap();
+    let (n, e) = read(
+        &sdf.replacen("M  CHG  1   4  -1", "M  CHG  2   4  -1", 1),
+        Format::Sdf,
+    );
+    assert_eq!(n, 3);
+    let e = e.unwrap().to_string();
+    assert!(e.contains("frame 3") && e.contains("M  CHG"), "{e}");
+}
+
 #[test]
 fn mol2_reads_as_mdanalysis_reads_it() {
     let r = reference();

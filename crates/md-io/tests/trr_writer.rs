@@ -272,3 +272,53 @@ fn frames_the_format_cannot_hold_are_refused_naming_the_frame() {
     let bytes = w.finish().unwrap().into_inner();
     assert_eq!(records(&bytes).len(), 2);
 }
+
+/// The blocks of every frame of `trr_mixed/argon.trr` as `gmx dump` lists them
+/// (gmx_dump_blocks.txt, written by gen.sh there): atoms, and whether x, v and f are present.
+fn gmx_dump_blocks() -> Vec<(usize, [bool; 3])> {
+    let text = std::fs::read_to_string(
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/trr_mixed/gmx_dump_blocks.txt"),
+    )
+    .unwrap();
+    let mut out: Vec<(usize, [bool; 3])> = Vec::new();
+    for line in text.lines() {
+        let t = line.trim();
+        if let Some(n) = t.strip_prefix("natoms=") {
+            let n = n.split_whitespace().next().unwrap().parse().unwrap();
+            out.push((n, [false; 3]));
+        } else if let Some(k) = ["x (", "v (", "f ("].iter().position(|p| t.starts_with(p)) {
+            out.last_mut().unwrap().1[k] = true;
+        }
+    }
+    out
+}
+
+/// mdrun's frames of only velocities or only forces (nstxout 10, nstvout 5, nstfout 2): a
+/// frame without positions has no atoms, and `without_positions` says what it held, as
+/// `gmx dump` lists it, so that a converter can name what it cannot write.
+#[test]
+fn frames_without_positions_say_what_they_held() {
+    let blocks = gmx_dump_blocks();
+    assert_eq!(blocks.len(), 13);
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/trr_mixed/argon.trr");
+    let mut t = Trajectory::open(&path).unwrap();
+    let mut f = Frame::new();
+    for (k, &(n, [x, v, force])) in blocks.iter().enumerate() {
+        assert!(t.read_next(&mut f).unwrap(), "frame {k}");
+        if x {
+            assert_eq!(f.n_atoms(), n, "frame {k}");
+            assert_eq!(f.velocities.len(), if v { n } else { 0 }, "frame {k}");
+            assert_eq!(f.property("fx").is_some(), force, "frame {k}");
+            assert_eq!(t.without_positions(), None, "frame {k}");
+        } else {
+            assert_eq!(f.n_atoms(), 0, "frame {k}");
+            let want = texmap_md_io::WithoutPositions {
+                atoms: n,
+                velocities: v,
+                forces: force,
+            };
+            assert_eq!(t.without_positions(), Some(want), "frame {k}");
+        }
+    }
+    assert!(!t.read_next(&mut f).unwrap());
+}

@@ -1,7 +1,8 @@
 """What gsd.hoomd reads from our GSD writer's files (crates/md-io/tests/gsd_writer.rs).
 
-The files tri.gsd, vel.gsd and nacl.gsd are our writer's rewrites of ../gsd/hoomd_tri.gsd (written
-by gsd.hoomd), ../mda_vel.gro (MDAnalysis) and ../lammps_write/nacl_primitive.vasp (ASE):
+The files tri.gsd, vel.gsd, nacl.gsd and twod.gsd are our writer's rewrites of ../gsd/hoomd_tri.gsd
+(written by gsd.hoomd), ../mda_vel.gro (MDAnalysis), ../lammps_write/nacl_primitive.vasp (ASE)
+and ../gsd/hoomd_2d.gsd (gsd.hoomd, 2-D):
     TEXMAP_BLESS=1 cargo test -p texmap-md-io --test suite gsd_writer::rewriting
 then, from this directory, with the gsd package (pip install gsd; 5.0.1 here):
     python3 gen_gsd_write.py
@@ -56,7 +57,7 @@ def read(path):
     return {"frames": out}
 
 
-ref = {case: read(f"{case}.gsd") for case in ["tri", "vel", "nacl"]}
+ref = {case: read(f"{case}.gsd") for case in ["tri", "vel", "nacl", "twod"]}
 text = json.dumps(short(ref), separators=(",", ":")).encode()
 with open("gsd_hoomd.json.gz", "wb") as fh:
     fh.write(gzip.compress(text, compresslevel=9, mtime=0))
