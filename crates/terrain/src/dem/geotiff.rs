@@ -689,61 +689,74 @@ fn check_codec_frame(
     compression: u16,
     chunk: (u32, u32),
 ) -> Result<(), String> {
-    use std::io::{Read, Seek, SeekFrom};
-    let mut head = Vec::new();
-    file.seek(SeekFrom::Start(offset))
-        .and_then(|_| {
-            file.take(stored.min(1 << 16))
-                .read_to_end(&mut head)
-                .map(|_| ())
-        })
-        .map_err(|e| format!("the chunk's bytes at offset {offset}: {e}"))?;
-    let le16 = |i: usize| {
-        head.get(i..i + 2)
-            .map(|b| u16::from_le_bytes([b[0], b[1]]) as u32)
+    // Only the header bytes are read: the marker segments' heads up to the JPEG frame header
+    // (within the chunk's first 64 KiB), or WebP's first 30 bytes.
+    let limit = stored.min(1 << 16);
+    let mut peek = |at: u64, n: u64| -> Result<Vec<u8>, String> {
+        use std::io::{Read, Seek, SeekFrom};
+        let mut b = Vec::new();
+        file.seek(SeekFrom::Start(offset + at))
+            .and_then(|_| {
+                (&mut *file)
+                    .take(n.min(limit.saturating_sub(at)))
+                    .read_to_end(&mut b)
+            })
+            .map_err(|e| format!("the chunk's bytes at offset {}: {e}", offset + at))?;
+        Ok(b)
     };
-    let be16 = |i: usize| {
-        head.get(i..i + 2)
+    let be16 = |b: &[u8], i: usize| {
+        b.get(i..i + 2)
             .map(|b| u16::from_be_bytes([b[0], b[1]]) as u32)
     };
-    let le24 = |i: usize| {
-        head.get(i..i + 3)
+    let le16 = |b: &[u8], i: usize| {
+        b.get(i..i + 2)
+            .map(|b| u16::from_le_bytes([b[0], b[1]]) as u32)
+    };
+    let le24 = |b: &[u8], i: usize| {
+        b.get(i..i + 3)
             .map(|b| u32::from_le_bytes([b[0], b[1], b[2], 0]))
     };
     let frame = if compression == 7 {
-        // Segments from SOI to the first start-of-frame marker (C0-CF but C4 DHT, C8, CC DAC).
-        let mut i = 2;
+        // Segments from SOI to the first start-of-frame marker (C0-CF but C4 DHT, C8, CC DAC),
+        // each read as its marker, length and (for a frame header) precision, height, width.
         let mut found = None;
-        while head.get(..2) == Some(&[0xFF, 0xD8][..]) && i + 4 <= head.len() {
-            if head[i] != 0xFF {
-                break;
+        if peek(0, 2)? == [0xFF, 0xD8] {
+            let mut i = 2;
+            while i + 4 <= limit {
+                let m = peek(i, 9)?;
+                if m[0] != 0xFF {
+                    break;
+                }
+                let marker = m[1];
+                if marker == 0xFF {
+                    i += 1; // fill byte
+                    continue;
+                }
+                if (0xC0..=0xCF).contains(&marker) && !matches!(marker, 0xC4 | 0xC8 | 0xCC) {
+                    found = be16(&m, 7).zip(be16(&m, 5));
+                    break;
+                }
+                let Some(len) = be16(&m, 2) else { break };
+                i += 2 + len as u64;
             }
-            let marker = head[i + 1];
-            if marker == 0xFF {
-                i += 1; // fill byte
-                continue;
-            }
-            if (0xC0..=0xCF).contains(&marker) && !matches!(marker, 0xC4 | 0xC8 | 0xCC) {
-                found = be16(i + 7).zip(be16(i + 5));
-                break;
-            }
-            let Some(len) = be16(i + 2) else { break };
-            i += 2 + len as usize;
         }
         found.ok_or("a JPEG stream with a frame header (SOF) in its first 64 KiB")?
     } else {
+        let head = peek(0, 30)?;
         if head.get(..4) != Some(b"RIFF") || head.get(8..12) != Some(b"WEBP") {
             return Err("a WebP stream (RIFF ... WEBP)".into());
         }
         match head.get(12..16) {
-            Some(b"VP8 ") => le16(26)
-                .zip(le16(28))
+            Some(b"VP8 ") => le16(&head, 26)
+                .zip(le16(&head, 28))
                 .map(|(w, h)| (w & 0x3FFF, h & 0x3FFF)),
             Some(b"VP8L") => head.get(21..25).map(|b| {
                 let v = u32::from_le_bytes([b[0], b[1], b[2], b[3]]);
                 ((v & 0x3FFF) + 1, ((v >> 14) & 0x3FFF) + 1)
             }),
-            Some(b"VP8X") => le24(24).zip(le24(27)).map(|(w, h)| (w + 1, h + 1)),
+            Some(b"VP8X") => le24(&head, 24)
+                .zip(le24(&head, 27))
+                .map(|(w, h)| (w + 1, h + 1)),
             _ => None,
         }
         .ok_or("a WebP VP8, VP8L or VP8X frame header")?
