@@ -143,6 +143,7 @@ fn bench_streamed(c: &mut Criterion) {
         image: img,
         georef: None,
         source: "bench".into(),
+        stretch: None,
     };
     let opts = BuildOptions {
         max_error: 0.5,

@@ -46,6 +46,19 @@ pub enum TerrainCmd {
         /// Photo bands for red, green, blue (1-based), e.g. 3,2,1 (each tile's, in a mosaic).
         #[arg(long)]
         bands: Option<String>,
+        /// How the photo's samples become 8-bit colours: 'auto' (8-bit bands as they are, wider
+        /// ones from each band's lowest to its highest sample), 'minmax', 'percent:2,98' (each
+        /// band from its 2nd to its 98th percentile, QGIS's cumulative count cut: a 16-bit
+        /// Sentinel-2 or Landsat scene whose clouds and glints would leave the land dark under
+        /// minmax), or 'range:0,3000' (gdal_translate -scale; six numbers give one pair per
+        /// band). The ranges used are printed and kept in the manifest: pass them as range: to a
+        /// neighbouring database so that the colours match.
+        #[arg(long, default_value = "auto", value_name = "RULE")]
+        stretch: texmap_terrain::photo::Stretch,
+        /// After the stretch, t^(1/GAMMA) (gdal_translate -exponent 1/GAMMA): above 1 brightens
+        /// the shadows, as QGIS's gamma does.
+        #[arg(long, default_value_t = 1.0, value_name = "GAMMA")]
+        gamma: f64,
         /// Maximum vertical error of the finest level, metres.
         #[arg(long, default_value_t = 1.0)]
         max_error: f32,
@@ -200,6 +213,8 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
             dem,
             photo,
             bands,
+            stretch,
+            gamma,
             max_error,
             chunk,
             terrain_rgb,
@@ -241,6 +256,9 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
                     }
                 }
             };
+            if !(gamma.is_finite() && gamma > 0.0) {
+                return usage(format!("--gamma {gamma}: expected a number above 0"));
+            }
             if !(max_error.is_finite() && max_error >= 0.0) {
                 return usage(format!("--max-error {max_error}: expected metres ≥ 0"));
             }
@@ -322,7 +340,32 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
                 .collect::<Result<Vec<_>, _>>()?;
             let photo = match photo.is_empty() {
                 true => None,
-                false => Some(texmap_terrain::photo::open_photos(&photo, bands)?),
+                false => {
+                    let opts = texmap_terrain::photo::PhotoOptions {
+                        bands,
+                        stretch,
+                        gamma,
+                    };
+                    let p = texmap_terrain::photo::open_photos(&photo, &opts)?;
+                    if let Some(a) = p.stretch() {
+                        let [r, g, b] = a.ranges;
+                        let all: Vec<String> =
+                            a.ranges.as_flattened().iter().map(f64::to_string).collect();
+                        let all = all.join(",");
+                        crate::note!(
+                            "photo colours: {} (red {}–{}, green {}–{}, blue {}–{}; --stretch range:{all}), gamma {}",
+                            a.rule,
+                            r[0],
+                            r[1],
+                            g[0],
+                            g[1],
+                            b[0],
+                            b[1],
+                            a.gamma
+                        );
+                    }
+                    Some(p)
+                }
             };
             let pb = crate::commands::progress(1, "building");
             let bo = BuildOptions {

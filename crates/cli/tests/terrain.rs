@@ -1191,3 +1191,79 @@ fn lidar_clouds_grid_to_geotiffs_and_build_databases() {
     assert_eq!(o.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&o.stderr).contains("cut.laz"));
 }
+
+#[test]
+fn a_16_bit_photo_is_stretched_by_percentiles_and_the_ranges_carry_to_the_next_build() {
+    let dir = tempfile::tempdir().unwrap();
+    let build = |name: &str, extra: &[&str]| {
+        let db = dir.path().join(name);
+        let (dem, photo) = (data("sat_dem.tif"), data("sat_u16.tif"));
+        let mut args = vec!["terrain", "build", "--dem", &dem, "--photo", &photo];
+        args.extend_from_slice(extra);
+        let db_s = db.to_str().unwrap().to_string();
+        args.extend_from_slice(&["--out", &db_s]);
+        let o = texmap(&args);
+        (o, db)
+    };
+    // 2-98 % with a gamma: the ranges are numpy's percentiles (tests/data/stretch.py), printed
+    // as the --stretch that reproduces them, and kept in the manifest.
+    let (o, a) = build("a.db", &["--stretch", "percent:2,98", "--gamma", "1.5"]);
+    ok(&o);
+    let err = String::from_utf8_lossy(&o.stderr);
+    let again = "--stretch range:582,1162,788,1572,734,2036";
+    assert!(err.contains(again), "{err}");
+    let info = texmap(&["terrain", "info", a.to_str().unwrap()]);
+    ok(&info);
+    let j: serde_json::Value = serde_json::from_slice(&info.stdout).unwrap();
+    let s = &j["texture"]["stretch"];
+    assert_eq!(s["rule"], "percent:2,98", "{j}");
+    assert_eq!(s["gamma"], 1.5, "{j}");
+    assert_eq!(
+        s["ranges"],
+        serde_json::json!([[582.0, 1162.0], [788.0, 1572.0], [734.0, 2036.0]])
+    );
+    // The printed ranges give a neighbouring build the same texture, map for map.
+    let range = again.trim_start_matches("--stretch ");
+    let (o, b) = build("b.db", &["--stretch", range, "--gamma", "1.5"]);
+    ok(&o);
+    let maps = |db: &Path| {
+        let mut files: Vec<PathBuf> = walk(&db.join("tiles"));
+        files.sort();
+        files
+            .iter()
+            .map(|f| std::fs::read(f).unwrap())
+            .collect::<Vec<_>>()
+    };
+    let (ma, mb) = (maps(&a), maps(&b));
+    assert!(!ma.is_empty());
+    assert!(
+        ma == mb,
+        "the range build's maps differ from the percentile build's"
+    );
+    // Bad rules and gammas are usage errors (exit 2) naming the option.
+    for bad in [
+        &["--stretch", "percent:98,2"][..],
+        &["--stretch", "histogram"][..],
+        &["--gamma", "0"][..],
+    ] {
+        let (o, db) = build("bad.db", bad);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{bad:?}: {err}");
+        assert!(err.contains(bad[0]), "{bad:?}: {err}");
+        assert!(!db.exists());
+    }
+}
+
+/// Every file under `dir`, recursively.
+fn walk(dir: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_dir() {
+            out.extend(walk(&p));
+        } else {
+            out.push(p);
+        }
+    }
+    out
+}

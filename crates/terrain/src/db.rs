@@ -56,6 +56,11 @@ pub struct TextureEntry {
     /// Vector overlays drawn into the texture, in drawing order.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub overlays: Vec<OverlayEntry>,
+    /// How the photo's samples became colours, when they were mapped (wider than 8 bits, or a
+    /// `--stretch`): the ranges mapped to 0 and 255, to pass as `--stretch range:...` to a
+    /// neighbouring database so that its colours match.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stretch: Option<crate::photo::Applied>,
 }
 
 /// A vector overlay drawn into the texture: its file and how many of its features were drawn.
@@ -323,6 +328,7 @@ fn build_into(
             image: crate::relief::relief_image(grid, 4096),
             georef: None,
             source: "shaded relief".into(),
+            stretch: None,
         }),
         _ => None,
     };
@@ -432,6 +438,7 @@ fn build_into(
                 } else {
                     "stretched".into()
                 },
+                stretch: p.stretch(),
                 overlays: overlay.as_ref().map_or(Vec::new(), |o| {
                     o.counts()
                         .iter()

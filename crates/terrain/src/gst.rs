@@ -22,7 +22,8 @@
 //! conversion here are an error that names both and the `gdalwarp` command to use; a side with no
 //! code is taken to be in the other's system.
 //! Multispectral GeoTIFFs choose three bands (`--bands 3,2,1`); samples wider than 8 bits are
-//! stretched linearly from each band's minimum to its maximum.
+//! stretched linearly from each band's minimum to its maximum, or between percentiles or given
+//! values with a gamma ([`crate::photo::PhotoOptions`]).
 //!
 //! **Pyramid.** Level `L` is `T·2^L` texels a side (`T` texels per map, 256 by default) and holds
 //! `2^L x 2^L` maps of `T x T`; the finest level is resampled bilinearly from the photo and each
@@ -37,6 +38,7 @@
 
 use crate::dem::{Georef, Grid};
 use crate::error::{TerrainError, format_err, io};
+use crate::photo::PhotoOptions;
 use image::{Rgba, RgbaImage};
 use std::collections::HashMap;
 use std::path::Path;
@@ -48,17 +50,19 @@ pub struct Orthophoto {
     pub image: RgbaImage,
     pub georef: Option<Georef>,
     pub source: String,
+    /// The stretch its colours were made with, when they were mapped from other samples.
+    pub stretch: Option<crate::photo::Applied>,
 }
 
 /// Read an orthophoto whole: PNG or JPEG through `image`; a TIFF or a GDAL VRT through
-/// [`crate::photo::TiffPhoto`] and [`crate::photo::VrtPhoto`] (the same pixels as their rows) with
-/// `bands` (1-based, default 1,2,3 or band 1 as grey).
-pub fn read_photo(path: &Path, bands: Option<[u16; 3]>) -> Result<Orthophoto, TerrainError> {
+/// [`crate::photo::TiffPhoto`] and [`crate::photo::VrtPhoto`] (the same pixels as their rows),
+/// its bands and colours by `opts` ([`crate::photo::PhotoOptions`]).
+pub fn read_photo(path: &Path, opts: &PhotoOptions) -> Result<Orthophoto, TerrainError> {
     let source = path.display().to_string();
     let rows: Option<Box<dyn PhotoSource>> = if crate::photo::is_tiff(path) {
-        Some(Box::new(crate::photo::TiffPhoto::open(path, bands)?))
+        Some(Box::new(crate::photo::TiffPhoto::open(path, opts)?))
     } else if crate::dem::vrt::is_vrt(path) {
-        Some(Box::new(crate::photo::VrtPhoto::open(path, bands)?))
+        Some(Box::new(crate::photo::VrtPhoto::open(path, opts)?))
     } else {
         None
     };
@@ -66,6 +70,7 @@ pub fn read_photo(path: &Path, bands: Option<[u16; 3]>) -> Result<Orthophoto, Te
         return Ok(Orthophoto {
             image: p.rows(0, p.size().1)?,
             georef: p.georef(),
+            stretch: p.stretch(),
             source,
         });
     }
@@ -75,10 +80,12 @@ pub fn read_photo(path: &Path, bands: Option<[u16; 3]>) -> Result<Orthophoto, Te
         .map_err(io(path))?
         .decode()
         .map_err(|e| format_err(&source, "image data", format!("a PNG or JPEG ({e})")))?;
+    let (image, stretch) = crate::photo::decoded_to_rgba(img, opts, &source)?;
     Ok(Orthophoto {
-        image: img.to_rgba8(),
+        image,
         georef: None,
         source,
+        stretch,
     })
 }
 
@@ -613,6 +620,11 @@ pub trait PhotoSource: Sync {
     fn source(&self) -> &str;
     /// Rows `y0..y1` (`y0 < y1 ≤ height`) at full width, 8-bit RGBA.
     fn rows(&self, y0: u32, y1: u32) -> Result<RgbaImage, TerrainError>;
+    /// The stretch its colours were made with, when they were mapped from other samples
+    /// (wider than 8 bits, or by a `--stretch`).
+    fn stretch(&self) -> Option<crate::photo::Applied> {
+        None
+    }
 }
 
 impl PhotoSource for Orthophoto {
@@ -624,6 +636,9 @@ impl PhotoSource for Orthophoto {
     }
     fn source(&self) -> &str {
         &self.source
+    }
+    fn stretch(&self) -> Option<crate::photo::Applied> {
+        self.stretch.clone()
     }
     fn rows(&self, y0: u32, y1: u32) -> Result<RgbaImage, TerrainError> {
         Ok(image::imageops::crop_imm(&self.image, 0, y0, self.image.width(), y1 - y0).to_image())

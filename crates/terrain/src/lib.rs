@@ -13,9 +13,10 @@
 //! - [`chunks`]: a chunked level-of-detail quadtree cut from one error map, each chunk with its
 //!   geometric error (for selection by screen-space error) and skirts sized 5x that error.
 //! - [`photo`]: orthophotos as row sources — a GeoTIFF of any size read a band of rows at a time
-//!   (any band count, 16-bit bands stretched, no-data and alpha bands transparent), a GDAL VRT
-//!   and a mosaic of several tiles (as `gdalbuildvrt` mosaics them, later tiles winning, each
-//!   tile's rows read only while the rows asked for cross it), PNG and JPEG whole.
+//!   (any band count, wide samples stretched min-max or between percentiles with a gamma, no-data
+//!   and alpha bands transparent), a GDAL VRT and a mosaic of several tiles (as `gdalbuildvrt`
+//!   mosaics them, later tiles winning, each tile's rows read only while the rows asked for cross
+//!   it), PNG and JPEG whole.
 //! - [`gst`]: the orthophoto placed by georeference (or stretched), the shaded relief under it
 //!   where it does not cover, cut into a pyramid of 256² maps written map by map; Seed 000
 //!   Eq. (5)–(7) decide which maps are resident in a budgeted cache with counters.

@@ -7,9 +7,23 @@
 //! [`TiffPhoto`] decodes the stored chunks (strips or tiles) under the rows asked for and keeps
 //! the last row of chunks, because the pyramid writer asks for overlapping bands top to bottom.
 //! Bands are chosen as [`crate::gst::read_photo`] chooses them (`--bands 3,2,1`; by default 1, 2, 3, or
-//! band 1 as grey), and samples wider than 8 bits are stretched linearly from each band's minimum
-//! to its maximum over the photo's covered pixels, found in one pass over the file when it is
-//! opened — the same 8-bit values `read_photo` makes from the whole image.
+//! band 1 as grey) — the same 8-bit values `read_photo` makes from the whole image.
+//!
+//! **Colours** ([`PhotoOptions`], `--stretch`, `--gamma`). 8-bit bands are taken as they are;
+//! samples wider than 8 bits are mapped linearly from each band's lowest to its highest sample
+//! over the photo's covered pixels ([`Stretch::Auto`]), found in one pass over the file when it
+//! is opened. A 16-bit satellite scene (Sentinel-2 and Landsat reflectance) has clouds, glints
+//! and snow far brighter than its land, which that leaves dark, so a [`Stretch::Percent`] maps
+//! each band's low and high percentiles instead (QGIS's "cumulative count cut", 2–98 % there): a
+//! second pass counts the samples in a histogram per band, exact (one bin per value) for
+//! whole-number samples spanning fewer than 65,536 values, else 65,536 bins over the band's
+//! range with each percentile taken at its bin's centre (within half a bin). The percentiles are
+//! ranks in the sorted covered samples, rounded down at the low end and up at the high one —
+//! numpy's `percentile(method="lower")` and `"higher"`. [`Stretch::Range`] gives the ranges
+//! (`gdal_translate -scale`), and a gamma follows the stretch (`t^(1/γ)`, `gdal_translate
+//! -exponent 1/γ`). The ranges used are reported ([`Applied`], kept in a database's manifest),
+//! so that a neighbouring database built with them as a `Range` gets the same colours; a
+//! percentile stretch of each alone would not. A mosaic is stretched as one photo.
 //!
 //! **Coverage.** A pixel is transparent (alpha 0, colour 0) where the photo does not cover:
 //! where its alpha band (TIFF `ExtraSamples` 1 or 2, as `gdalwarp -dstalpha` writes it; a VRT's
@@ -61,6 +75,129 @@ pub(crate) fn pick_bands(
     }
 }
 
+/// How a photo's samples become 8-bit colours (`--stretch`; see the module docs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Stretch {
+    /// 8-bit bands as they are, wider samples from each band's lowest to its highest.
+    Auto,
+    /// Every band, 8-bit ones too, from its lowest to its highest sample.
+    MinMax,
+    /// Each band from its `lo`-th to its `hi`-th percentile (QGIS's "cumulative count cut", 2
+    /// and 98 by default there): numpy's `percentile(method="lower")` and `"higher"` of the
+    /// covered samples.
+    Percent(f64, f64),
+    /// Each band from a given sample value to another (`gdal_translate -scale_N`).
+    Range([(f64, f64); 3]),
+}
+
+impl std::str::FromStr for Stretch {
+    type Err = String;
+
+    /// `auto`, `minmax`, `percent:LO,HI` (e.g. `percent:2,98`), `range:MIN,MAX` for every band
+    /// or `range:R0,R1,G0,G1,B0,B1`.
+    fn from_str(s: &str) -> Result<Stretch, String> {
+        let (kind, args) = s.split_once(':').unwrap_or((s, ""));
+        let numbers = || -> Result<Vec<f64>, String> {
+            args.split(',')
+                .map(|t| {
+                    t.trim()
+                        .parse::<f64>()
+                        .ok()
+                        .filter(|v| v.is_finite())
+                        .ok_or_else(|| format!("'{}' is not a number", t.trim()))
+                })
+                .collect()
+        };
+        let expected = "auto, minmax, percent:LO,HI (e.g. percent:2,98) or range:MIN,MAX \
+                        (or range:R0,R1,G0,G1,B0,B1)";
+        match (kind.trim(), args.is_empty()) {
+            ("auto", true) => Ok(Stretch::Auto),
+            ("minmax", true) => Ok(Stretch::MinMax),
+            ("percent", false) => match numbers()?[..] {
+                [lo, hi] if (0.0..hi).contains(&lo) && hi <= 100.0 => Ok(Stretch::Percent(lo, hi)),
+                _ => Err(format!(
+                    "{s}: expected two percentiles 0 ≤ LO < HI ≤ 100, e.g. percent:2,98"
+                )),
+            },
+            ("range", false) => {
+                let v = numbers()?;
+                let pairs: [(f64, f64); 3] = match v[..] {
+                    [a, b] => [(a, b); 3],
+                    [a, b, c, d, e, f] => [(a, b), (c, d), (e, f)],
+                    _ => {
+                        return Err(format!(
+                            "{s}: expected MIN,MAX or six numbers, one pair per band"
+                        ));
+                    }
+                };
+                if pairs.iter().any(|(a, b)| a >= b) {
+                    return Err(format!("{s}: each MIN must be below its MAX"));
+                }
+                Ok(Stretch::Range(pairs))
+            }
+            _ => Err(format!("{s}: expected {expected}")),
+        }
+    }
+}
+
+/// How to read a photo: the bands for red, green and blue, and how their samples become 8-bit
+/// colours (see the module docs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PhotoOptions {
+    /// 1-based band numbers for red, green and blue; by default 1, 2, 3, or band 1 as grey.
+    pub bands: Option<[u16; 3]>,
+    pub stretch: Stretch,
+    /// After the stretch, `t ↦ t^(1/gamma)` on `t ∈ [0, 1]` (`gdal_translate -exponent
+    /// 1/gamma`): above 1 brightens the shadows, as QGIS's gamma does.
+    pub gamma: f64,
+}
+
+impl Default for PhotoOptions {
+    fn default() -> PhotoOptions {
+        PhotoOptions {
+            bands: None,
+            stretch: Stretch::Auto,
+            gamma: 1.0,
+        }
+    }
+}
+
+impl PhotoOptions {
+    /// The default colours with `bands` chosen.
+    pub fn bands(bands: Option<[u16; 3]>) -> PhotoOptions {
+        PhotoOptions {
+            bands,
+            ..PhotoOptions::default()
+        }
+    }
+
+    /// Whether samples of `bits` bits are mapped (else taken as they are, 8-bit).
+    fn maps(&self, bits: u32) -> bool {
+        bits > 8 || self.stretch != Stretch::Auto || self.gamma != 1.0
+    }
+
+    fn check(&self, source: &str) -> Result<(), TerrainError> {
+        if !(self.gamma.is_finite() && self.gamma > 0.0) {
+            return Err(TerrainError::Unsupported {
+                source: source.into(),
+                what: format!("photo gamma {}: expected a number above 0", self.gamma),
+            });
+        }
+        Ok(())
+    }
+}
+
+/// The stretch a photo's colours were made with: each channel's sample values mapped to 0 and
+/// 255, the rule that chose them, and the gamma.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Applied {
+    /// `minmax`, `percent:LO,HI` or `range`.
+    pub rule: String,
+    /// Per channel (red, green, blue), the samples mapped to 0 and to 255.
+    pub ranges: [[f64; 2]; 3],
+    pub gamma: f64,
+}
+
 /// How raw samples of three chosen bands (and an alpha band) become 8-bit RGBA (see the module
 /// docs).
 #[derive(Clone, Copy, Debug)]
@@ -69,6 +206,8 @@ struct Rgba8 {
     scale: [(f32, f32); 3],
     /// Per channel, its band's no-data value.
     nodata: [Option<f32>; 3],
+    /// `1 / gamma`, when the gamma is not 1.
+    exponent: Option<f32>,
 }
 
 impl Rgba8 {
@@ -76,6 +215,7 @@ impl Rgba8 {
         Rgba8 {
             scale: [(0.0, 1.0); 3],
             nodata: nodata.map(|v| v.map(|v| v as f32)),
+            exponent: None,
         }
     }
 
@@ -94,47 +234,192 @@ impl Rgba8 {
         let c = |k: usize| {
             let (lo, s) = self.scale[k];
             let v = if rgb[k].is_nan() { lo } else { rgb[k] };
-            ((v - lo) * s).round().clamp(0.0, 255.0) as u8
+            let v = match self.exponent {
+                None => (v - lo) * s,
+                Some(e) => ((v - lo) * s / 255.0).clamp(0.0, 1.0).powf(e) * 255.0,
+            };
+            v.round().clamp(0.0, 255.0) as u8
         };
         Rgba([c(0), c(1), c(2), 255])
     }
 
-    /// Stretch each channel from the lowest to the highest of `ranges` (see [`Ranges`]).
-    fn stretch(&mut self, ranges: &Ranges) {
-        for k in 0..3 {
-            let (lo, hi) = ranges.0[k];
+    /// Map each channel's `ranges` (lowest, highest) to 0 and 255, then apply `gamma`.
+    fn stretch(&mut self, ranges: [(f64, f64); 3], gamma: f64) {
+        for (k, (lo, hi)) in ranges.into_iter().enumerate() {
             self.scale[k] = if hi > lo {
-                (lo, 255.0 / (hi - lo))
+                (lo as f32, (255.0 / (hi - lo)) as f32)
             } else {
-                (if lo.is_finite() { lo } else { 0.0 }, 0.0)
+                (if lo.is_finite() { lo as f32 } else { 0.0 }, 0.0)
             };
         }
+        self.exponent = (gamma != 1.0).then_some((1.0 / gamma) as f32);
     }
 }
 
-/// Each channel's lowest and highest sample over the covered pixels seen.
-struct Ranges([(f32, f32); 3]);
+/// Each channel's lowest and highest sample over the covered pixels seen, and whether they
+/// were all whole numbers.
+struct Ranges {
+    bounds: [(f32, f32); 3],
+    integral: [bool; 3],
+}
 
 impl Ranges {
     fn new() -> Ranges {
-        Ranges([(f32::INFINITY, f32::NEG_INFINITY); 3])
+        Ranges {
+            bounds: [(f32::INFINITY, f32::NEG_INFINITY); 3],
+            integral: [true; 3],
+        }
     }
 
     /// The pixels of `planes` (three colour planes, then an alpha plane if `alpha`) that
     /// `convert` does not hide.
     fn add(&mut self, planes: &[Vec<f32>], alpha: bool, convert: &Rgba8) {
-        for i in 0..planes[0].len() {
-            let (rgb, a) = sample(planes, alpha, i);
-            if convert.hidden(rgb, a) {
-                continue;
-            }
-            for (r, v) in self.0.iter_mut().zip(rgb) {
-                if !v.is_nan() {
-                    *r = (r.0.min(v), r.1.max(v));
-                }
+        covered(planes, alpha, convert, |k, v| {
+            let r = &mut self.bounds[k];
+            *r = (r.0.min(v), r.1.max(v));
+            self.integral[k] &= v.fract() == 0.0;
+        });
+    }
+
+    fn f64(&self) -> [(f64, f64); 3] {
+        self.bounds.map(|(lo, hi)| (lo as f64, hi as f64))
+    }
+}
+
+/// Each sample (channel `k`, value) of the pixels of `planes` (three colour planes, then an
+/// alpha plane if `alpha`) that `convert` does not hide, NaN samples left out.
+fn covered(planes: &[Vec<f32>], alpha: bool, convert: &Rgba8, mut f: impl FnMut(usize, f32)) {
+    for i in 0..planes[0].len() {
+        let (rgb, a) = sample(planes, alpha, i);
+        if convert.hidden(rgb, a) {
+            continue;
+        }
+        for (k, v) in rgb.into_iter().enumerate() {
+            if !v.is_nan() {
+                f(k, v);
             }
         }
     }
+}
+
+/// Bins of a histogram over one channel's range: exact (one per value) for whole-number samples
+/// spanning fewer than this many values, else this many over the range.
+const HISTOGRAM_BINS: usize = 1 << 16;
+
+/// Per-channel histograms of the covered samples, for percentiles (see [`Stretch::Percent`]).
+struct Histograms {
+    lo: [f64; 3],
+    /// Per channel, whether each bin is one sample value.
+    exact: [bool; 3],
+    /// Bin width per channel: 1 when exact.
+    width: [f64; 3],
+    counts: [Vec<u64>; 3],
+}
+
+impl Histograms {
+    fn new(r: &Ranges) -> Histograms {
+        let mut lo = [0.0; 3];
+        let mut width = [1.0; 3];
+        let mut exact = [true; 3];
+        let counts = std::array::from_fn(|k| {
+            let (a, b) = r.bounds[k];
+            if b.partial_cmp(&a).is_none_or(|o| o.is_lt()) {
+                return Vec::new();
+            }
+            lo[k] = a as f64;
+            let span = b as f64 - a as f64;
+            if r.integral[k] && span < HISTOGRAM_BINS as f64 {
+                vec![0; span as usize + 1]
+            } else {
+                width[k] = span / HISTOGRAM_BINS as f64;
+                exact[k] = false;
+                vec![0; HISTOGRAM_BINS]
+            }
+        });
+        Histograms {
+            lo,
+            exact,
+            width,
+            counts,
+        }
+    }
+
+    fn add(&mut self, planes: &[Vec<f32>], alpha: bool, convert: &Rgba8) {
+        covered(planes, alpha, convert, |k, v| {
+            let n = self.counts[k].len();
+            if n > 0 {
+                let b = ((v as f64 - self.lo[k]) / self.width[k]).floor();
+                self.counts[k][(b.max(0.0) as usize).min(n - 1)] += 1;
+            }
+        });
+    }
+
+    /// Channel `k`'s `p`-th percentile, rounded down (`higher`: up) to a sample's rank as
+    /// numpy's `method="lower"` (`"higher"`) does; an inexact bin stands for its centre.
+    fn percentile(&self, k: usize, p: f64, higher: bool) -> f64 {
+        let counts = &self.counts[k];
+        let n: u64 = counts.iter().sum();
+        if n == 0 {
+            return 0.0;
+        }
+        let at = (p / 100.0) * (n - 1) as f64;
+        let rank = if higher { at.ceil() } else { at.floor() } as u64;
+        let mut seen = 0;
+        for (b, &c) in counts.iter().enumerate() {
+            seen += c;
+            if seen > rank {
+                let centre = if self.exact[k] { 0.0 } else { 0.5 };
+                return self.lo[k] + self.width[k] * (b as f64 + centre);
+            }
+        }
+        self.lo[k] + self.width[k] * counts.len() as f64
+    }
+}
+
+/// The conversion of a photo's samples to 8-bit RGBA by `opts`, for samples of `bits` bits with
+/// the bands' `nodata` and an alpha plane if `alpha`: `pass` hands every chunk of the photo's
+/// planes to its argument, once per call (never for 8-bit photos with the default colours; once
+/// for a min-max stretch, twice for percentiles, whose histograms need the ranges).
+fn fit(
+    opts: &PhotoOptions,
+    nodata: [Option<f64>; 3],
+    bits: u32,
+    alpha: bool,
+    mut pass: impl FnMut(&mut dyn FnMut(&[Vec<f32>])) -> Result<(), TerrainError>,
+) -> Result<(Rgba8, Option<Applied>), TerrainError> {
+    let mut convert = Rgba8::new(nodata);
+    if !opts.maps(bits) {
+        return Ok((convert, None));
+    }
+    let (fixed, percent) = match opts.stretch {
+        Stretch::Range(r) => (Some(r), None),
+        Stretch::Auto if bits <= 8 => (Some([(0.0, 255.0); 3]), None),
+        Stretch::Auto | Stretch::MinMax => (None, None),
+        Stretch::Percent(lo, hi) => (None, Some((lo, hi))),
+    };
+    let (rule, bounds) = match fixed {
+        Some(r) => ("range".to_string(), r),
+        None => {
+            let mut r = Ranges::new();
+            pass(&mut |p| r.add(p, alpha, &convert))?;
+            match percent {
+                None => ("minmax".to_string(), r.f64()),
+                Some((lo, hi)) => {
+                    let mut h = Histograms::new(&r);
+                    pass(&mut |p| h.add(p, alpha, &convert))?;
+                    let at = |k| (h.percentile(k, lo, false), h.percentile(k, hi, true));
+                    (format!("percent:{lo},{hi}"), std::array::from_fn(at))
+                }
+            }
+        }
+    };
+    convert.stretch(bounds, opts.gamma);
+    let applied = Applied {
+        rule,
+        ranges: bounds.map(|(a, b)| if b >= a { [a, b] } else { [0.0, 0.0] }),
+        gamma: opts.gamma,
+    };
+    Ok((convert, Some(applied)))
 }
 
 /// The pixel `i` of `planes` (three colour planes, then an alpha plane if `alpha`).
@@ -154,6 +439,8 @@ struct Head {
     convert: Rgba8,
     /// Its reader also reads an alpha band (the fourth plane).
     alpha: bool,
+    /// The stretch its colours were made with, when they were mapped.
+    applied: Option<Applied>,
 }
 
 /// A GeoTIFF orthophoto read by rows (see the module docs).
@@ -164,10 +451,12 @@ pub struct TiffPhoto {
 
 impl TiffPhoto {
     /// Open a TIFF photo: header, georeference, band choice, and (for samples wider than
-    /// 8 bits) one pass for each band's range.
-    pub fn open(path: &Path, bands: Option<[u16; 3]>) -> Result<TiffPhoto, TerrainError> {
+    /// 8 bits, or another stretch than `auto`) one pass for each band's range, and another for
+    /// percentiles.
+    pub fn open(path: &Path, opts: &PhotoOptions) -> Result<TiffPhoto, TerrainError> {
+        opts.check(&path.display().to_string())?;
         let band_count = crate::dem::geotiff::band_count(path)?;
-        let pick = pick_bands(bands, band_count)?;
+        let pick = pick_bands(opts.bands, band_count)?;
         let head = RasterReader::open(path, Some(&pick), CHUNK_LIMIT)?;
         let alpha = head.alpha.filter(|a| !pick.contains(a));
         let mut reader = match alpha {
@@ -176,14 +465,18 @@ impl TiffPhoto {
             }
             None => head,
         };
-        let mut convert = Rgba8::new([reader.nodata; 3]);
-        if reader.bits > 8 {
-            let mut ranges = Ranges::new();
-            for c in 0..reader.chunk_count() {
-                ranges.add(&reader.read_chunk(c)?.planes, alpha.is_some(), &convert);
-            }
-            convert.stretch(&ranges);
-        }
+        let (convert, applied) = fit(
+            opts,
+            [reader.nodata; 3],
+            reader.bits as u32,
+            alpha.is_some(),
+            |f| {
+                for c in 0..reader.chunk_count() {
+                    f(&reader.read_chunk(c)?.planes);
+                }
+                Ok(())
+            },
+        )?;
         Ok(TiffPhoto {
             head: Head {
                 source: path.display().to_string(),
@@ -192,6 +485,7 @@ impl TiffPhoto {
                 georef: reader.georef,
                 convert,
                 alpha: alpha.is_some(),
+                applied,
             },
             rows: Mutex::new(ChunkRows::new(reader)),
         })
@@ -225,6 +519,9 @@ impl PhotoSource for TiffPhoto {
     }
     fn source(&self) -> &str {
         &self.head.source
+    }
+    fn stretch(&self) -> Option<Applied> {
+        self.head.applied.clone()
     }
 
     fn rows(&self, y0: u32, y1: u32) -> Result<RgbaImage, TerrainError> {
@@ -262,19 +559,28 @@ pub struct VrtPhoto {
 impl VrtPhoto {
     /// Open a `.vrt` as a photo, its bands chosen as a TIFF's are (`bands`, 1-based; by default
     /// 1, 2, 3, or band 1 as grey); a band with `ColorInterp` Alpha is its alpha.
-    pub fn open(path: &Path, bands: Option<[u16; 3]>) -> Result<VrtPhoto, TerrainError> {
-        VrtPhoto::new(Vrt::open(path, crate::dem::vrt::Use::Photo)?, bands)
+    pub fn open(path: &Path, opts: &PhotoOptions) -> Result<VrtPhoto, TerrainError> {
+        opts.check(&path.display().to_string())?;
+        VrtPhoto::new(Vrt::open(path, crate::dem::vrt::Use::Photo)?, opts)
     }
 
     /// The mosaic of several photos, as `gdalbuildvrt` would make it ([`Vrt::mosaic`]): each
-    /// photo's `bands`.
-    pub fn mosaic(paths: &[PathBuf], bands: Option<[u16; 3]>) -> Result<VrtPhoto, TerrainError> {
-        VrtPhoto::new(Vrt::mosaic(paths, bands)?, None)
+    /// photo's `opts.bands`, the mosaic's colours stretched as one photo's.
+    pub fn mosaic(paths: &[PathBuf], opts: &PhotoOptions) -> Result<VrtPhoto, TerrainError> {
+        opts.check(&format!("{} photos", paths.len()))?;
+        let vrt = Vrt::mosaic(paths, opts.bands)?;
+        VrtPhoto::new(
+            vrt,
+            &PhotoOptions {
+                bands: None,
+                ..*opts
+            },
+        )
     }
 
-    fn new(vrt: Vrt, bands: Option<[u16; 3]>) -> Result<VrtPhoto, TerrainError> {
+    fn new(vrt: Vrt, opts: &PhotoOptions) -> Result<VrtPhoto, TerrainError> {
         let n = vrt.bands.len();
-        let pick = pick_bands(bands, n.min(u16::MAX as usize) as u16)?.map(|b| b as usize);
+        let pick = pick_bands(opts.bands, n.min(u16::MAX as usize) as u16)?.map(|b| b as usize);
         if let Some(&b) = pick.iter().find(|&&b| b >= n) {
             return Err(TerrainError::Unsupported {
                 source: vrt.source.clone(),
@@ -288,21 +594,20 @@ impl VrtPhoto {
             .filter(|a| !pick.contains(a));
         let mut want = pick.to_vec();
         want.extend(alpha);
-        let mut convert = Rgba8::new(pick.map(|b| vrt.bands[b].nodata));
+        let nodata = pick.map(|b| vrt.bands[b].nodata);
         let wide = pick
             .iter()
             .any(|&b| vrt.bands[b].data_type != DataType::Byte);
         let (source, width, height, georef) =
             (vrt.source.clone(), vrt.width, vrt.height, vrt.georef);
         let mut reader = VrtReader::new(vrt, want);
-        if wide {
-            let mut ranges = Ranges::new();
+        let bits = if wide { 16 } else { 8 };
+        let (convert, applied) = fit(opts, nodata, bits, alpha.is_some(), |f| {
             for y in (0..height).step_by(PASS_ROWS as usize) {
-                let planes = reader.rows(y, (y + PASS_ROWS).min(height))?;
-                ranges.add(&planes, alpha.is_some(), &convert);
+                f(&reader.rows(y, (y + PASS_ROWS).min(height))?);
             }
-            convert.stretch(&ranges);
-        }
+            Ok(())
+        })?;
         Ok(VrtPhoto {
             head: Head {
                 source,
@@ -311,6 +616,7 @@ impl VrtPhoto {
                 georef,
                 convert,
                 alpha: alpha.is_some(),
+                applied,
             },
             reader: Mutex::new(reader),
         })
@@ -326,6 +632,9 @@ impl PhotoSource for VrtPhoto {
     }
     fn source(&self) -> &str {
         &self.head.source
+    }
+    fn stretch(&self) -> Option<Applied> {
+        self.head.applied.clone()
     }
 
     fn rows(&self, y0: u32, y1: u32) -> Result<RgbaImage, TerrainError> {
@@ -353,16 +662,13 @@ pub(crate) fn is_tiff(path: &Path) -> bool {
 
 /// Open an orthophoto for a pyramid build: a TIFF or a VRT by rows ([`TiffPhoto`],
 /// [`VrtPhoto`]), a PNG or JPEG whole.
-pub fn open_photo(
-    path: &Path,
-    bands: Option<[u16; 3]>,
-) -> Result<Box<dyn PhotoSource>, TerrainError> {
+pub fn open_photo(path: &Path, opts: &PhotoOptions) -> Result<Box<dyn PhotoSource>, TerrainError> {
     if is_tiff(path) {
-        Ok(Box::new(TiffPhoto::open(path, bands)?))
+        Ok(Box::new(TiffPhoto::open(path, opts)?))
     } else if crate::dem::vrt::is_vrt(path) {
-        Ok(Box::new(VrtPhoto::open(path, bands)?))
+        Ok(Box::new(VrtPhoto::open(path, opts)?))
     } else {
-        let p: Orthophoto = read_photo(path, bands)?;
+        let p: Orthophoto = read_photo(path, opts)?;
         Ok(Box::new(p))
     }
 }
@@ -371,7 +677,7 @@ pub fn open_photo(
 /// winning); a directory stands for the GeoTIFFs and VRTs in it, in the order of their names.
 pub fn open_photos(
     paths: &[PathBuf],
-    bands: Option<[u16; 3]>,
+    opts: &PhotoOptions,
 ) -> Result<Box<dyn PhotoSource>, TerrainError> {
     let mut files = Vec::with_capacity(paths.len());
     for p in paths {
@@ -406,7 +712,60 @@ pub fn open_photos(
             value: "none".into(),
             expected: "at least one photo",
         }),
-        [one] => open_photo(one, bands),
-        _ => Ok(Box::new(VrtPhoto::mosaic(&files, bands)?)),
+        [one] => open_photo(one, opts),
+        _ => Ok(Box::new(VrtPhoto::mosaic(&files, opts)?)),
     }
+}
+
+/// A PNG's or JPEG's decoded pixels as 8-bit RGBA by `opts` (bands are not chosen: red, green
+/// and blue are the image's, or its grey), and the stretch applied, if its colours were mapped.
+pub(crate) fn decoded_to_rgba(
+    img: image::DynamicImage,
+    opts: &PhotoOptions,
+    source: &str,
+) -> Result<(RgbaImage, Option<Applied>), TerrainError> {
+    opts.check(source)?;
+    let bits = match img.color() {
+        image::ColorType::Rgb32F | image::ColorType::Rgba32F => 32,
+        c if c.bytes_per_pixel() / c.channel_count() >= 2 => 16,
+        _ => 8,
+    };
+    if !opts.maps(bits) {
+        return Ok((img.to_rgba8(), None));
+    }
+    let (w, h) = (img.width(), img.height());
+    let has_alpha = img.color().has_alpha();
+    let values: Vec<f32> = match bits {
+        32 => img.to_rgba32f().into_raw(),
+        16 => img
+            .to_rgba16()
+            .into_raw()
+            .into_iter()
+            .map(f32::from)
+            .collect(),
+        _ => img
+            .to_rgba8()
+            .into_raw()
+            .into_iter()
+            .map(f32::from)
+            .collect(),
+    };
+    drop(img);
+    let mut planes: Vec<Vec<f32>> = (0..4)
+        .map(|_| Vec::with_capacity(values.len() / 4))
+        .collect();
+    for px in values.chunks_exact(4) {
+        for (plane, &v) in planes.iter_mut().zip(px) {
+            plane.push(v);
+        }
+    }
+    let (convert, applied) = fit(opts, [None; 3], bits, has_alpha, |f| {
+        f(&planes);
+        Ok(())
+    })?;
+    let out = RgbaImage::from_fn(w, h, |x, y| {
+        let (rgb, a) = sample(&planes, has_alpha, (y as usize) * w as usize + x as usize);
+        convert.pixel(rgb, a)
+    });
+    Ok((out, applied))
 }

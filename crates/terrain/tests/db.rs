@@ -4,6 +4,7 @@ use std::path::PathBuf;
 use texmap_terrain::db::{self, BuildOptions, Database};
 use texmap_terrain::dem::{ReadOptions, read_dem};
 use texmap_terrain::gst;
+use texmap_terrain::photo::PhotoOptions;
 
 fn data(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -14,7 +15,7 @@ fn data(name: &str) -> PathBuf {
 #[test]
 fn build_reopen_export_glb() {
     let grid = read_dem(data("ramp_i16_lzw.tif"), &ReadOptions::default()).unwrap();
-    let photo = gst::read_photo(&data("photo_rgb.tif"), None).unwrap();
+    let photo = gst::read_photo(&data("photo_rgb.tif"), &PhotoOptions::bands(None)).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("db");
     let opts = BuildOptions {
@@ -88,7 +89,7 @@ fn build_reopen_export_glb() {
 fn photo_outside_the_grid_is_an_error() {
     let grid = read_dem(data("ramp_f32_geo.tif"), &ReadOptions::default()).unwrap();
     // The UTM photo's coordinates are nowhere near 138° E 36° N in degrees.
-    let photo = gst::read_photo(&data("photo_rgb.tif"), None).unwrap();
+    let photo = gst::read_photo(&data("photo_rgb.tif"), &PhotoOptions::bands(None)).unwrap();
     let e = gst::place(&photo, &grid, 16).unwrap_err();
     assert!(e.to_string().contains("does not overlap"), "{e}");
 }
@@ -98,7 +99,7 @@ fn a_failed_build_leaves_nothing_behind() {
     // The photo does not overlap: the build fails after the chunks are written, and neither the
     // database nor its temporary directory remains.
     let grid = read_dem(data("ramp_f32_geo.tif"), &ReadOptions::default()).unwrap();
-    let photo = gst::read_photo(&data("photo_rgb.tif"), None).unwrap();
+    let photo = gst::read_photo(&data("photo_rgb.tif"), &PhotoOptions::bands(None)).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("db");
     let opts = BuildOptions {
@@ -190,7 +191,7 @@ fn overlays_are_drawn_into_the_texture() {
     image::RgbaImage::from_pixel(300, 300, image::Rgba([128, 128, 128, 255]))
         .save(&png)
         .unwrap();
-    let photo = gst::read_photo(&png, None).unwrap();
+    let photo = gst::read_photo(&png, &PhotoOptions::bands(None)).unwrap();
     let out = dir.path().join("v.db");
     let opts = BuildOptions {
         max_error: 1.0,

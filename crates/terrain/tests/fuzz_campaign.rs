@@ -17,6 +17,7 @@ use std::path::{Path, PathBuf};
 use crate::campaign::{Cuts, Field, Fixture, Settings, Verdict, run_campaign};
 use texmap_terrain::TerrainError;
 use texmap_terrain::dem::{self, Grid};
+use texmap_terrain::photo::PhotoOptions;
 
 fn data(name: &str) -> Vec<u8> {
     std::fs::read(
@@ -117,6 +118,30 @@ fn terrain_readers_survive_the_campaign() {
     let t = run_campaign("GeoTIFF", &tiffs, &settings, &|_, bytes| {
         std::fs::write(&path, bytes).unwrap();
         verdict(dem::geotiff::read_geotiff(&path), &path)
+    });
+    report.push_str(&t.report());
+    assert!(t.failures.is_empty(), "{}", t.report());
+
+    // 16-bit and float satellite scenes read as photos stretched between percentiles: the
+    // histograms meet whatever samples a mutant decodes to (NaN, infinities, any range).
+    let scenes: Vec<Fixture> = ["sat_u16.tif", "sat_f32.tif"]
+        .iter()
+        .map(|n| {
+            let ifd = vec![("first IFD offset", Field::I32Le(4))];
+            unchecked(fixture(n, data(n), ifd, false))
+        })
+        .collect();
+    let percent = PhotoOptions {
+        stretch: texmap_terrain::photo::Stretch::Percent(2.0, 98.0),
+        gamma: 1.5,
+        ..PhotoOptions::default()
+    };
+    let t = run_campaign("GeoTIFF photo, 2-98 %", &scenes, &settings, &|_, bytes| {
+        std::fs::write(&path, bytes).unwrap();
+        match texmap_terrain::gst::read_photo(&path, &percent) {
+            Ok(_) => Verdict::Ok { frames: 1 },
+            Err(e) => located(e.to_string(), "mutant.tif", "read"),
+        }
     });
     report.push_str(&t.report());
     assert!(t.failures.is_empty(), "{}", t.report());
@@ -600,13 +625,14 @@ fn vrt_readers_survive_the_campaign() {
         &settings,
         &|_, bytes| {
             std::fs::write(&path, bytes).unwrap();
-            let read = texmap_terrain::photo::VrtPhoto::open(&path, None).and_then(|p| {
-                let h = p.size().1;
-                for y in (0..h).step_by(32) {
-                    p.rows(y, (y + 32).min(h))?;
-                }
-                Ok(())
-            });
+            let read = texmap_terrain::photo::VrtPhoto::open(&path, &PhotoOptions::bands(None))
+                .and_then(|p| {
+                    let h = p.size().1;
+                    for y in (0..h).step_by(32) {
+                        p.rows(y, (y + 32).min(h))?;
+                    }
+                    Ok(())
+                });
             match read {
                 Ok(()) => Verdict::Ok { frames: 1 },
                 Err(e) => located(e.to_string(), "mutant.vrt", "read"),

@@ -30,6 +30,7 @@ fn hills(n: u32) -> Grid {
 
 fn photo() -> Orthophoto {
     Orthophoto {
+        stretch: None,
         image: image::RgbaImage::from_fn(512, 512, |x, y| {
             image::Rgba([(x / 2) as u8, (y / 2) as u8, ((x ^ y) & 0xff) as u8, 255])
         }),

@@ -14,7 +14,7 @@ use std::sync::Mutex;
 use texmap_terrain::db::{self, BuildOptions, Database};
 use texmap_terrain::dem::{self, Grid};
 use texmap_terrain::gst::{self, MapKey, PhotoSource};
-use texmap_terrain::photo::{TiffPhoto, VrtPhoto, open_photo, open_photos};
+use texmap_terrain::photo::{PhotoOptions, TiffPhoto, VrtPhoto, open_photo, open_photos};
 
 fn data(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -36,8 +36,8 @@ fn rows_read_by_band_equal_the_whole_image() {
         ("photo_rgb_webp.tif", None),
         ("photo_rgb_jpeg.tif", None),
     ] {
-        let whole = gst::read_photo(&data(file), bands).unwrap();
-        let rows = TiffPhoto::open(&data(file), bands).unwrap();
+        let whole = gst::read_photo(&data(file), &PhotoOptions::bands(bands)).unwrap();
+        let rows = TiffPhoto::open(&data(file), &PhotoOptions::bands(bands)).unwrap();
         assert_eq!(rows.size(), whole.image.dimensions(), "{file}");
         assert_eq!(rows.georef(), whole.georef, "{file}");
         let h = whole.image.height();
@@ -55,7 +55,11 @@ fn rows_read_by_band_equal_the_whole_image() {
         }
     }
     // The 16-bit bands are stretched, so the 8-bit values span the range.
-    let p = TiffPhoto::open(&data("relief_planar_u16.tif"), Some([4, 2, 1])).unwrap();
+    let p = TiffPhoto::open(
+        &data("relief_planar_u16.tif"),
+        &PhotoOptions::bands(Some([4, 2, 1])),
+    )
+    .unwrap();
     let img = p.rows(0, 240).unwrap();
     let reds: Vec<u8> = img.pixels().map(|px| px.0[0]).collect();
     assert_eq!(reds.iter().min(), Some(&0));
@@ -68,12 +72,13 @@ fn rows_read_by_band_equal_the_whole_image() {
 /// PSNR against the photo it was made from.
 #[test]
 fn webp_and_ycbcr_jpeg_photos_decode_as_gdal_decodes_them() {
-    let plain = gst::read_photo(&data("photo_rgb.tif"), None).unwrap();
-    let webp = gst::read_photo(&data("photo_rgb_webp.tif"), None).unwrap();
+    let plain = gst::read_photo(&data("photo_rgb.tif"), &PhotoOptions::bands(None)).unwrap();
+    let webp = gst::read_photo(&data("photo_rgb_webp.tif"), &PhotoOptions::bands(None)).unwrap();
     assert!(webp.image == plain.image);
     assert_eq!(webp.georef, plain.georef);
-    let jpeg = gst::read_photo(&data("photo_rgb_jpeg.tif"), None).unwrap();
-    let gdal = gst::read_photo(&data("photo_rgb_jpeg_gdal.tif"), None).unwrap();
+    let jpeg = gst::read_photo(&data("photo_rgb_jpeg.tif"), &PhotoOptions::bands(None)).unwrap();
+    let gdal =
+        gst::read_photo(&data("photo_rgb_jpeg_gdal.tif"), &PhotoOptions::bands(None)).unwrap();
     assert_eq!(jpeg.georef, plain.georef);
     assert_eq!(jpeg.image.dimensions(), gdal.image.dimensions());
     let diff = |a: &RgbaImage, b: &RgbaImage| {
@@ -126,7 +131,9 @@ fn a_codec_header_claiming_a_huge_frame_is_refused_before_allocation() {
     ] {
         let path = dir.path().join(name);
         std::fs::write(&path, bytes).unwrap();
-        let (r, peak) = crate::alloc::measure(|| gst::read_photo(&path, None).map(|_| ()));
+        let (r, peak) = crate::alloc::measure(|| {
+            gst::read_photo(&path, &PhotoOptions::bands(None)).map(|_| ())
+        });
         let e = r.unwrap_err().to_string();
         assert!(
             e.contains(name) && e.contains("chunk 0") && e.contains(claim),
@@ -159,8 +166,8 @@ fn pyramid_by_maps(
 fn the_pyramid_written_map_by_map_is_the_whole_level_pyramid() {
     let grid = srtm();
     // Placed by its georeference: it covers part of the tile, the rest is transparent.
-    let whole = gst::read_photo(&data("relief_tiled.tif"), None).unwrap();
-    let rows = TiffPhoto::open(&data("relief_tiled.tif"), None).unwrap();
+    let whole = gst::read_photo(&data("relief_tiled.tif"), &PhotoOptions::bands(None)).unwrap();
+    let rows = TiffPhoto::open(&data("relief_tiled.tif"), &PhotoOptions::bands(None)).unwrap();
     let (t, levels) = (64, 5);
     let reference = gst::pyramid(gst::place(&whole, &grid, t << (levels - 1)).unwrap(), t);
     for source in [&whole as &dyn PhotoSource, &rows] {
@@ -180,6 +187,7 @@ fn the_pyramid_written_map_by_map_is_the_whole_level_pyramid() {
     }
     // Stretched (no georeference): the whole photo over the whole extent.
     let stretched = gst::Orthophoto {
+        stretch: None,
         georef: None,
         ..whole
     };
@@ -202,8 +210,16 @@ fn a_database_built_from_rows_equals_one_built_from_the_whole_photo() {
         max_texture_levels: 8,
         ..Default::default()
     };
-    let whole = gst::read_photo(&data("relief_planar_u16.tif"), Some([1, 2, 3])).unwrap();
-    let rows = open_photo(&data("relief_planar_u16.tif"), Some([1, 2, 3])).unwrap();
+    let whole = gst::read_photo(
+        &data("relief_planar_u16.tif"),
+        &PhotoOptions::bands(Some([1, 2, 3])),
+    )
+    .unwrap();
+    let rows = open_photo(
+        &data("relief_planar_u16.tif"),
+        &PhotoOptions::bands(Some([1, 2, 3])),
+    )
+    .unwrap();
     let a = dir.path().join("a");
     let b = dir.path().join("b");
     db::build(&grid, "srtm", Some(&whole), &opts, &a, |_, _| {}).unwrap();
@@ -237,6 +253,7 @@ fn assert_same_tiles(a: &std::path::Path, b: &std::path::Path, levels: u32) {
 fn the_level_count_follows_the_photo_when_it_is_finer_than_the_grid() {
     let grid = srtm(); // 1201 samples a side
     let stretched = gst::Orthophoto {
+        stretch: None,
         image: RgbaImage::new(5000, 3000),
         georef: None,
         source: "big".into(),
@@ -252,7 +269,7 @@ fn the_level_count_follows_the_photo_when_it_is_finer_than_the_grid() {
         5
     );
     // The georeferenced relief covers 0.3° of the 1° tile at 320 pixels: 1067 across the extent.
-    let relief = TiffPhoto::open(&data("relief_tiled.tif"), None).unwrap();
+    let relief = TiffPhoto::open(&data("relief_tiled.tif"), &PhotoOptions::bands(None)).unwrap();
     assert_eq!(gst::photo_level_count(&relief, &grid, 256, 9).unwrap(), 4);
 }
 
@@ -263,7 +280,7 @@ fn damaged_photos_are_named_errors() {
     // Cut inside the tile data: the header opens, a band of rows fails, naming the file.
     let cut = dir.path().join("cut.tif");
     std::fs::write(&cut, &bytes[..bytes.len() * 2 / 3]).unwrap();
-    let p = TiffPhoto::open(&cut, None).unwrap();
+    let p = TiffPhoto::open(&cut, &PhotoOptions::bands(None)).unwrap();
     let mut errors = 0;
     for y in (0..240).step_by(16) {
         if let Err(e) = p.rows(y, y + 16) {
@@ -274,19 +291,25 @@ fn damaged_photos_are_named_errors() {
     }
     assert!(errors > 0);
     // Band 0 and a band the file lacks.
-    let e = TiffPhoto::open(&data("relief_tiled.tif"), Some([0, 1, 2]))
-        .err()
-        .unwrap()
-        .to_string();
+    let e = TiffPhoto::open(
+        &data("relief_tiled.tif"),
+        &PhotoOptions::bands(Some([0, 1, 2])),
+    )
+    .err()
+    .unwrap()
+    .to_string();
     assert!(e.contains("1-based"), "{e}");
-    let e = TiffPhoto::open(&data("relief_tiled.tif"), Some([4, 1, 2]))
-        .err()
-        .unwrap()
-        .to_string();
+    let e = TiffPhoto::open(
+        &data("relief_tiled.tif"),
+        &PhotoOptions::bands(Some([4, 1, 2])),
+    )
+    .err()
+    .unwrap()
+    .to_string();
     assert!(e.contains("band") && e.contains('4'), "{e}");
     // A photo beside the grid: no overlap.
     let grid = Grid::new("far", 3, 3, vec![1.0; 9], dem::Georef::local(1.0)).unwrap();
-    let relief = TiffPhoto::open(&data("relief_tiled.tif"), None).unwrap();
+    let relief = TiffPhoto::open(&data("relief_tiled.tif"), &PhotoOptions::bands(None)).unwrap();
     assert!(gst::photo_level_count(&relief, &grid, 256, 5).is_err());
 }
 
@@ -309,9 +332,9 @@ fn whole(p: &dyn PhotoSource) -> RgbaImage {
 /// -addalpha's alpha band writes 255 over a tile's no-data; we leave it transparent).
 #[test]
 fn several_photos_and_their_vrt_mosaic_as_gdal_mosaics_them() {
-    let mosaic = VrtPhoto::mosaic(&tiles(&["a", "b", "c"]), None).unwrap();
-    let vrt = VrtPhoto::open(&data("mosaic_photo.vrt"), None).unwrap();
-    let gdal = TiffPhoto::open(&data("mosaic_photo_gdal.tif"), None).unwrap();
+    let mosaic = VrtPhoto::mosaic(&tiles(&["a", "b", "c"]), &PhotoOptions::bands(None)).unwrap();
+    let vrt = VrtPhoto::open(&data("mosaic_photo.vrt"), &PhotoOptions::bands(None)).unwrap();
+    let gdal = TiffPhoto::open(&data("mosaic_photo_gdal.tif"), &PhotoOptions::bands(None)).unwrap();
     assert_eq!(mosaic.size(), (320, 240));
     assert_eq!(vrt.size(), gdal.size());
     let (m, g) = (mosaic.georef().unwrap(), gdal.georef().unwrap());
@@ -332,7 +355,13 @@ fn several_photos_and_their_vrt_mosaic_as_gdal_mosaics_them() {
         .into_iter()
         .map(|(n, x, y)| {
             (
-                whole(&TiffPhoto::open(&data(&format!("mosaic_photo_{n}.tif")), None).unwrap()),
+                whole(
+                    &TiffPhoto::open(
+                        &data(&format!("mosaic_photo_{n}.tif")),
+                        &PhotoOptions::bands(None),
+                    )
+                    .unwrap(),
+                ),
                 x,
                 y,
             )
@@ -411,11 +440,16 @@ fn mosaic_grid() -> Grid {
 #[test]
 fn a_tile_in_another_system_is_reprojected_into_the_mosaic_as_gdalwarp_places_it() {
     let grid = mosaic_grid();
-    let mosaic = VrtPhoto::mosaic(&tiles(&["a", "b", "c", "d_utm"]), None).unwrap();
+    let mosaic = VrtPhoto::mosaic(
+        &tiles(&["a", "b", "c", "d_utm"]),
+        &PhotoOptions::bands(None),
+    )
+    .unwrap();
     // The UTM tile's outline (its transparent margin too) reaches past the others'.
     let (w, h) = mosaic.size();
     assert!(w > 320 && h > 240 && w < 330 && h < 250, "{w} x {h}");
     let photo = gst::Orthophoto {
+        stretch: None,
         image: whole(&mosaic),
         georef: mosaic.georef(),
         source: "mosaic".into(),
@@ -427,7 +461,8 @@ fn a_tile_in_another_system_is_reprojected_into_the_mosaic_as_gdalwarp_places_it
     assert_eq!(gdal.dimensions(), (257, 257));
     // Where the UTM tile lies on the texture, two texels around its outline included (the
     // tile placed alone, as a single photo).
-    let alone = gst::read_photo(&data("mosaic_photo_d_utm.tif"), None).unwrap();
+    let alone =
+        gst::read_photo(&data("mosaic_photo_d_utm.tif"), &PhotoOptions::bands(None)).unwrap();
     let alone = gst::place(&alone, &grid, 257).unwrap();
     let near = |img: &RgbaImage, x: u32, y: u32, hit: &dyn Fn(u8) -> bool| {
         (x.saturating_sub(2)..(x + 3).min(257))
@@ -438,7 +473,11 @@ fn a_tile_in_another_system_is_reprojected_into_the_mosaic_as_gdalwarp_places_it
     let edges: Vec<RgbaImage> = ["a", "b", "c"]
         .iter()
         .map(|n| {
-            let p = gst::read_photo(&data(&format!("mosaic_photo_{n}.tif")), None).unwrap();
+            let p = gst::read_photo(
+                &data(&format!("mosaic_photo_{n}.tif")),
+                &PhotoOptions::bands(None),
+            )
+            .unwrap();
             gst::place(&p, &grid, 257).unwrap()
         })
         .collect();
@@ -543,7 +582,7 @@ fn a_mosaic_database_shows_the_relief_where_no_tile_covers_for_any_thread_count(
             .build()
             .unwrap();
         let out = dir.path().join(name);
-        let photo = open_photos(&files, None).unwrap();
+        let photo = open_photos(&files, &PhotoOptions::bands(None)).unwrap();
         pool.install(|| {
             db::build_with(
                 &grid,
@@ -585,7 +624,7 @@ fn a_mosaic_database_shows_the_relief_where_no_tile_covers_for_any_thread_count(
     // Streaming: eight rows of the mosaic read the strips of the two tiles under them; the whole
     // mosaic, every tile.
     let peak = |y1: u32| {
-        let mosaic = VrtPhoto::mosaic(&files, None).unwrap();
+        let mosaic = VrtPhoto::mosaic(&files, &PhotoOptions::bands(None)).unwrap();
         let (band, peak) = crate::alloc::measure(|| mosaic.rows(0, y1).map(|b| b.len()));
         assert_eq!(band.unwrap(), mosaic.size().0 as usize * y1 as usize * 4);
         peak
@@ -603,18 +642,24 @@ fn photos_that_make_no_mosaic_are_refused_and_a_directory_is_its_tiles() {
     let dir = tempfile::tempdir().unwrap();
     let png = dir.path().join("plain.png");
     RgbaImage::new(8, 8).save(&png).unwrap();
-    let e = VrtPhoto::mosaic(&[data("mosaic_photo_a.tif"), png], None)
-        .err()
-        .unwrap()
-        .to_string();
+    let e = VrtPhoto::mosaic(
+        &[data("mosaic_photo_a.tif"), png],
+        &PhotoOptions::bands(None),
+    )
+    .err()
+    .unwrap()
+    .to_string();
     assert!(
         e.contains("plain.png") && e.contains("without a georeference"),
         "{e}"
     );
-    let e = VrtPhoto::mosaic(&[data("mosaic_photo_a.tif"), data("photo_rgb.tif")], None)
-        .err()
-        .unwrap()
-        .to_string();
+    let e = VrtPhoto::mosaic(
+        &[data("mosaic_photo_a.tif"), data("photo_rgb.tif")],
+        &PhotoOptions::bands(None),
+    )
+    .err()
+    .unwrap()
+    .to_string();
     assert!(
         e.contains("photo_rgb.tif") && e.contains("do the photos cover one area"),
         "{e}"
@@ -624,7 +669,192 @@ fn photos_that_make_no_mosaic_are_refused_and_a_directory_is_its_tiles() {
         std::fs::copy(data(&format!("mosaic_photo_{n}.tif")), dir.path().join(to)).unwrap();
     }
     std::fs::remove_file(dir.path().join("plain.png")).unwrap();
-    let from_dir = open_photos(&[dir.path().to_path_buf()], None).unwrap();
-    let listed = VrtPhoto::mosaic(&tiles(&["a", "b", "c"]), None).unwrap();
+    let from_dir = open_photos(&[dir.path().to_path_buf()], &PhotoOptions::bands(None)).unwrap();
+    let listed = VrtPhoto::mosaic(&tiles(&["a", "b", "c"]), &PhotoOptions::bands(None)).unwrap();
     assert!(whole(from_dir.as_ref()) == whole(&listed));
+}
+
+/// numpy's percentiles of `tests/data/stretch.py`'s scenes, per band `[low, high]`.
+fn numpy_ranges(key: &str) -> [[f64; 2]; 3] {
+    let text = std::fs::read_to_string(data("sat_percentiles.json")).unwrap();
+    let all: HashMap<String, [[f64; 2]; 3]> = serde_json::from_str(&text).unwrap();
+    all[key]
+}
+
+/// Our 8-bit rendering of `file` by `opts` against GDAL's `gdal_translate -scale` of it
+/// (`expected`), over the covered pixels: the largest difference in levels, and the
+/// transparent pixels, which must be exactly the scene's no-data wedge.
+fn against_gdal(file: &str, opts: &PhotoOptions, expected: &str) -> (u8, Option<[[f64; 2]; 3]>) {
+    let ours = gst::read_photo(&data(file), opts).unwrap();
+    let gdal = gst::read_photo(&data(expected), &PhotoOptions::default())
+        .unwrap()
+        .image;
+    assert_eq!(ours.image.dimensions(), gdal.dimensions());
+    let mut worst = 0;
+    for (x, y, p) in ours.image.enumerate_pixels() {
+        let wedge = x + y < 30;
+        assert_eq!(
+            p[3],
+            if wedge { 0 } else { 255 },
+            "{file} alpha at ({x}, {y})"
+        );
+        if !wedge {
+            let q = gdal.get_pixel(x, y);
+            for k in 0..3 {
+                worst = worst.max(p[k].abs_diff(q[k]));
+            }
+        }
+    }
+    (worst, ours.stretch.map(|a| a.ranges))
+}
+
+#[test]
+fn percentile_stretch_takes_numpys_percentiles_and_gdals_scaling() {
+    use texmap_terrain::photo::Stretch;
+    let percent = |lo, hi, gamma| PhotoOptions {
+        bands: None,
+        stretch: Stretch::Percent(lo, hi),
+        gamma,
+    };
+    // 16-bit samples: exact histograms, so numpy's percentiles to the sample.
+    let (worst, ranges) = against_gdal(
+        "sat_u16.tif",
+        &percent(2.0, 98.0, 1.0),
+        "sat_u16_p2_98_gdal.tif",
+    );
+    assert_eq!(ranges, Some(numpy_ranges("sat_u16 2,98")));
+    assert!(worst <= 1, "2-98 %: {worst} levels from GDAL");
+    let (worst, ranges) = against_gdal(
+        "sat_u16.tif",
+        &percent(1.0, 99.0, 2.0),
+        "sat_u16_p1_99_gamma2_gdal.tif",
+    );
+    assert_eq!(ranges, Some(numpy_ranges("sat_u16 1,99")));
+    assert!(worst <= 1, "1-99 %, gamma 2: {worst} levels from GDAL");
+    // Float reflectance: 65,536 bins over the range, each percentile within half a bin.
+    let (worst, ranges) = against_gdal(
+        "sat_f32.tif",
+        &percent(2.0, 98.0, 1.0),
+        "sat_f32_p2_98_gdal.tif",
+    );
+    let (ranges, numpy) = (ranges.unwrap(), numpy_ranges("sat_f32 2,98"));
+    let minmax = numpy_ranges("sat_u16 minmax");
+    for k in 0..3 {
+        let half_bin = (minmax[k][1] - minmax[k][0]) / 1e4 / 131_072.0;
+        for e in 0..2 {
+            let d = (ranges[k][e] - numpy[k][e]).abs();
+            assert!(
+                d <= half_bin * 1.01,
+                "band {k}: {ranges:?} against {numpy:?}"
+            );
+        }
+    }
+    assert!(worst <= 1, "float 2-98 %: {worst} levels from GDAL");
+    // The same scene through gdalbuildvrt's VRT, and as a mosaic of one, gives the same pixels.
+    let tif = gst::read_photo(&data("sat_u16.tif"), &percent(2.0, 98.0, 1.0)).unwrap();
+    let vrt = gst::read_photo(&data("sat_u16.vrt"), &percent(2.0, 98.0, 1.0)).unwrap();
+    assert_eq!(vrt.stretch, tif.stretch);
+    assert!(vrt.image == tif.image);
+    // A 16-bit PNG (a window of the scene, without no-data).
+    let png = gst::read_photo(&data("sat_u16_crop.png"), &percent(2.0, 98.0, 1.0)).unwrap();
+    let applied = png.stretch.unwrap();
+    assert_eq!(applied.ranges, numpy_ranges("sat_u16_crop.png 2,98"));
+    assert_eq!(applied.rule, "percent:2,98");
+    let crop = image::open(data("sat_u16_crop.png")).unwrap().to_rgb16();
+    for (x, y, p) in png.image.enumerate_pixels() {
+        let q = crop.get_pixel(x, y);
+        for k in 0..3 {
+            let [lo, hi] = applied.ranges[k];
+            let want = ((q[k] as f64 - lo) * 255.0 / (hi - lo))
+                .round()
+                .clamp(0.0, 255.0);
+            assert!((p[k] as f64 - want).abs() <= 1.0, "PNG ({x}, {y})");
+        }
+    }
+}
+
+#[test]
+fn range_stretch_is_gdal_translates_scale_and_auto_is_minmax() {
+    use texmap_terrain::photo::Stretch;
+    let range = PhotoOptions {
+        stretch: "range:0,3000".parse::<Stretch>().unwrap(),
+        ..PhotoOptions::default()
+    };
+    let (worst, ranges) = against_gdal("sat_u16.tif", &range, "sat_u16_range_gdal.tif");
+    assert_eq!(ranges, Some([[0.0, 3000.0]; 3]));
+    assert!(worst <= 1, "range 0-3000: {worst} levels from GDAL");
+    // 16-bit samples by default: each band's lowest to highest covered sample; the clouds'
+    // brightness leaves the land in the lowest tenth of the levels.
+    let auto = gst::read_photo(&data("sat_u16.tif"), &PhotoOptions::default()).unwrap();
+    let applied = auto.stretch.unwrap();
+    assert_eq!(applied.rule, "minmax");
+    assert_eq!(applied.ranges, numpy_ranges("sat_u16 minmax"));
+    // 8-bit photos stay as they are unless asked.
+    let plain = gst::read_photo(&data("photo_rgb.tif"), &PhotoOptions::default()).unwrap();
+    assert!(plain.stretch.is_none());
+}
+
+#[test]
+fn percentile_stretch_of_an_8_bit_photo_matches_sorting() {
+    use texmap_terrain::photo::Stretch;
+    let plain = gst::read_photo(&data("photo_rgb.tif"), &PhotoOptions::default()).unwrap();
+    let opts = PhotoOptions {
+        stretch: Stretch::Percent(5.0, 95.0),
+        ..PhotoOptions::default()
+    };
+    let stretched = gst::read_photo(&data("photo_rgb.tif"), &opts).unwrap();
+    let ranges = stretched.stretch.unwrap().ranges;
+    for (k, range) in ranges.iter().enumerate() {
+        let mut v: Vec<u8> = plain.image.pixels().map(|p| p[k]).collect();
+        v.sort_unstable();
+        let at = 0.05 * (v.len() - 1) as f64;
+        let high = 0.95 * (v.len() - 1) as f64;
+        assert_eq!(
+            *range,
+            [
+                v[at.floor() as usize] as f64,
+                v[high.ceil() as usize] as f64
+            ],
+            "band {k}"
+        );
+    }
+}
+
+#[test]
+fn bad_stretches_and_gammas_are_refused() {
+    use texmap_terrain::photo::Stretch;
+    for bad in [
+        "percent:98,2",
+        "percent:2",
+        "percent:-1,50",
+        "percent:2,101",
+        "range:5,5",
+        "range:0,1,2",
+        "range:a,b",
+        "range:0,nan",
+        "gamma",
+        "minmax:1",
+        "",
+    ] {
+        assert!(bad.parse::<Stretch>().is_err(), "{bad}");
+    }
+    for (ok, want) in [
+        ("percent:2,98", Stretch::Percent(2.0, 98.0)),
+        ("minmax", Stretch::MinMax),
+        ("range:0,3000", Stretch::Range([(0.0, 3000.0); 3])),
+        (
+            "range:1,2,3,4,5,6",
+            Stretch::Range([(1.0, 2.0), (3.0, 4.0), (5.0, 6.0)]),
+        ),
+    ] {
+        assert_eq!(ok.parse::<Stretch>().unwrap(), want);
+    }
+    for gamma in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+        let opts = PhotoOptions {
+            gamma,
+            ..PhotoOptions::default()
+        };
+        let e = gst::read_photo(&data("sat_u16.tif"), &opts).unwrap_err();
+        assert!(e.to_string().contains("gamma"), "{e}");
+    }
 }

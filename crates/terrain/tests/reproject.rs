@@ -9,6 +9,7 @@ use texmap_terrain::dem::{CrsKind, Georef, ReadOptions, read_dem};
 use texmap_terrain::error::TerrainError;
 use texmap_terrain::geodesy::Placement;
 use texmap_terrain::gst::{self, Orthophoto, read_photo};
+use texmap_terrain::photo::PhotoOptions;
 
 fn data(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -20,7 +21,7 @@ fn data(name: &str) -> PathBuf {
 /// absolute difference over the RGB of texels both give, texels where exactly one gives).
 fn against_gdal(dem: &str, photo: &str, reference: &str) -> (usize, f64, u8, usize) {
     let grid = read_dem(data(dem), &ReadOptions::default()).unwrap();
-    let photo = read_photo(&data(photo), None).unwrap();
+    let photo = read_photo(&data(photo), &PhotoOptions::bands(None)).unwrap();
     let ours = gst::place(&photo, &grid, 129).unwrap();
     let gdal = image::open(data(reference)).unwrap().to_rgba8();
     assert_eq!(gdal.dimensions(), (129, 129));
@@ -81,7 +82,7 @@ fn taking_the_photo_in_the_grids_system_would_misplace_it() {
     // What placement without reprojection did: the UTM 18N photo's numbers read as UTM 19N
     // put it ~470 km west of the grid, so there is no overlap and the error says so.
     let grid = read_dem(data("hillshade_dem_utm.tif"), &ReadOptions::default()).unwrap();
-    let mut photo = read_photo(&data("photo_utm18.tif"), None).unwrap();
+    let mut photo = read_photo(&data("photo_utm18.tif"), &PhotoOptions::bands(None)).unwrap();
     let g = photo.georef.unwrap();
     assert_eq!(g.epsg, Some(32618));
     photo.georef = Some(Georef {
@@ -95,9 +96,10 @@ fn taking_the_photo_in_the_grids_system_would_misplace_it() {
 #[test]
 fn unknown_pairs_of_systems_are_refused_by_name() {
     let grid = read_dem(data("hillshade_dem_utm.tif"), &ReadOptions::default()).unwrap();
-    let photo = read_photo(&data("photo_utm18.tif"), None).unwrap();
+    let photo = read_photo(&data("photo_utm18.tif"), &PhotoOptions::bands(None)).unwrap();
     // Swiss LV95: no conversion here.
     let swiss = Orthophoto {
+        stretch: None,
         georef: Some(Georef {
             crs: CrsKind::Projected,
             epsg: Some(2056),

@@ -29,6 +29,7 @@ fn build(
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("db");
     let photo = Orthophoto {
+        stretch: None,
         image: photo,
         georef: None,
         source: "procedural".into(),
@@ -361,6 +362,7 @@ fn big_database() {
             }
         });
     let photo = Orthophoto {
+        stretch: None,
         image: image::RgbaImage::from_raw(p, p, raw).unwrap(),
         georef: None,
         source: "procedural".into(),

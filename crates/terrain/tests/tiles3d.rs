@@ -10,6 +10,7 @@ use texmap_terrain::db::{self, BuildOptions, Database};
 use texmap_terrain::dem::{ReadOptions, read_dem};
 use texmap_terrain::geodesy::ecef;
 use texmap_terrain::geoid::Geoid;
+use texmap_terrain::photo::PhotoOptions;
 use texmap_terrain::tiles3d::{TilesetOptions, write_tileset, write_tileset_with};
 
 fn data(name: &str) -> PathBuf {
@@ -231,7 +232,7 @@ fn tile_textures_are_the_databases_texels() {
     };
     // A photo placed by its georeference (UTM 54N, as the grid).
     let grid = read_dem(data("ramp_i16_lzw.tif"), &ReadOptions::default()).unwrap();
-    let photo = gst::read_photo(&data("photo_rgb.tif"), None).unwrap();
+    let photo = gst::read_photo(&data("photo_rgb.tif"), &PhotoOptions::bands(None)).unwrap();
     let d = built(
         dir.path(),
         "photo.db",

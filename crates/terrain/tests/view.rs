@@ -489,6 +489,7 @@ fn database_view_puts_the_photo_where_it_belongs() {
         })
     });
     let photo = texmap_terrain::gst::Orthophoto {
+        stretch: None,
         image: photo,
         georef: None,
         source: "test photo".into(),
