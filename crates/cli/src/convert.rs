@@ -12,7 +12,7 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use clap::{Args, FromArgMatches};
-use texmap_md_io::{Format, Frame as MdFrame, Writer};
+use texmap_md_io::{Dropped, Format, Frame as MdFrame, Per, Writer};
 
 use crate::args::{AnalysisArgs, MolArgs, StyleArgs, usage};
 
@@ -89,7 +89,8 @@ pub struct ConvertArgs {
     /// and 'bfactor' properties in their columns), .cif/.mmcif (PDBx/mmCIF, for ChimeraX, PyMOL,
     /// VMD and gemmi: frames as models, the 'occupancy' and 'bfactor'
     /// properties, the first frame's box; no limit on atoms, residue numbers or chain names),
-    /// .dcd, .xtc (positions and the box only), .trr (GROMACS, single precision: positions,
+    /// .dcd, .xtc (positions, the box, steps and times; a .dcd's times are its steps × its
+    /// time step), .trr (GROMACS, single precision: positions,
     /// the box, velocities, and the forces fx fy fz in kJ/(mol Å) as a TRR gives them; frames of
     /// a TRR without positions, which no frame can carry, are skipped with a warning naming the
     /// velocities and forces they held), .nc/.ncdf (AMBER NetCDF for cpptraj,
@@ -103,6 +104,10 @@ pub struct ConvertArgs {
     /// molfile record per frame, elements, positions, bonds with their orders, integer
     /// 'charge' values as formal charges; bonds the input lacks come from --topology, else from
     /// distances, without orders).
+    /// Data the output has no place for (velocities in a .dcd, a property other than
+    /// occupancy and bfactor in a .pdb, partial charges in an .sdf, bonds in a .xyz, the box
+    /// in an .sdf, ...) is named in a warning at the end, one per kind, with the formats that
+    /// keep it.
     /// Not compressed: gzip the file afterwards.
     /// Written whole or not at all. Without it, only the analyses' outputs are written (the
     /// --*-table options, --msd-lags, --density-map, --pca-projection, --pca-vectors,
@@ -315,8 +320,8 @@ pub fn convert(a: &ConvertArgs) -> Result<()> {
     let pb = crate::commands::progress(frames.len() as u64, "converting");
     let mut first_atoms: Option<usize> = None;
     let mut atoms_written = 0usize;
-    let mut without_positions = Dropped::default();
-    let mut velocities_dropped = Dropped::default();
+    let mut without_positions = Skipped::default();
+    let mut lost = std::collections::BTreeMap::<Dropped, Lost>::new();
     let mut conect_note_shown = false;
     let mut run = |mut writer: Option<Writer>| -> Result<()> {
         for &f in &frames {
@@ -411,15 +416,19 @@ pub fn convert(a: &ConvertArgs) -> Result<()> {
                 }
                 Some(_) => {}
             }
-            if format == Some(Format::LammpsData)
-                && !md.velocities.is_empty()
-                && md.property("vx").is_none()
-            {
-                // A data file's velocities are in the run's units, which it does not state.
-                velocities_dropped.frames += 1;
-                velocities_dropped.atoms = velocities_dropped.atoms.max(count);
-            }
             if let (Some(w), Some(out)) = (&mut writer, &a.output) {
+                // What the format has no place for, named once at the end.
+                for kind in w.dropped(&md) {
+                    let l = lost.entry(kind).or_insert_with_key(|kind| Lost {
+                        reason: w.why_dropped(kind),
+                        kept_by: kind.kept_by(&md),
+                        output: w.output_name(),
+                        ..Lost::default()
+                    });
+                    l.frames += 1;
+                    l.atoms = l.atoms.max(count);
+                    l.bonds = l.bonds.max(md.bonds.len());
+                }
                 w.write_frame(&md)
                     .map_err(|e| at(e.into()))
                     .with_context(|| format!("-o {}", out.display()))?;
@@ -456,11 +465,39 @@ pub fn convert(a: &ConvertArgs) -> Result<()> {
             w.atoms
         );
     }
-    if velocities_dropped.frames > 0 {
+    // A trajectory of coordinates is read with its topology: the atoms' names, residues and
+    // bonds it has no place for are one note, not a warning each.
+    let coordinates_only = matches!(
+        format,
+        Some(Format::Dcd | Format::Xtc | Format::Trr | Format::Netcdf)
+    );
+    let topological = |k: &Dropped| {
+        coordinates_only
+            && matches!(
+                k,
+                Dropped::Names
+                    | Dropped::Types
+                    | Dropped::Residues
+                    | Dropped::Chains
+                    | Dropped::Segments
+                    | Dropped::Bonds
+                    | Dropped::BondOrders
+            )
+    };
+    let topology: Vec<String> = lost
+        .keys()
+        .filter(|k| topological(k))
+        .map(Dropped::what)
+        .collect();
+    if let (false, Some(out)) = (topology.is_empty(), &a.output) {
         crate::note!(
-            "warning: the velocities (Å/ps) of {} atoms were not written: a LAMMPS data file's velocities are in its run's units, which it does not state (a data file's own velocities, the properties vx vy vz, are written)",
-            velocities_dropped.atoms
+            "note: {} holds coordinates, not {}: read it with its topology (the --topology file, or this conversion again with --frames 0 -o topology.pdb)",
+            out.display(),
+            topology.join(", ")
         );
+    }
+    for (kind, l) in lost.iter().filter(|(k, _)| !topological(k)) {
+        crate::note!("warning: {}", l.message(kind));
     }
     if let Some(out) = &a.output {
         crate::note!(
@@ -473,14 +510,64 @@ pub fn convert(a: &ConvertArgs) -> Result<()> {
     Ok(())
 }
 
-/// Frames, and atoms in the largest of them, whose data the output does not receive (and of
-/// TRR frames without positions, how many held velocities and forces).
+/// TRR frames without positions, which no frame can carry: how many, the atoms in the largest,
+/// and how many held velocities and forces.
 #[derive(Default, Clone, Copy)]
-struct Dropped {
+struct Skipped {
     frames: usize,
     atoms: usize,
     velocities: usize,
     forces: usize,
+}
+
+/// One kind of data the output does not hold ([`Writer::dropped`]), over the frames written:
+/// how many frames carried it, the atoms and bonds of the largest, why the output lost it and
+/// which outputs keep it (as the first frame that carried it tells).
+#[derive(Default)]
+struct Lost {
+    frames: usize,
+    atoms: usize,
+    bonds: usize,
+    reason: String,
+    kept_by: Vec<&'static str>,
+    output: &'static str,
+}
+
+impl Lost {
+    /// "the per-atom property 'grain' of 4000 atoms (10 frames) was not written: a .gro file
+    /// has no place for it (.xyz, .lammpstrj keep it)".
+    fn message(&self, kind: &Dropped) -> String {
+        let frames = match self.frames {
+            1 => "1 frame".to_string(),
+            n => format!("{n} frames"),
+        };
+        let counted = match kind.per() {
+            Per::Atom => format!("of {} atoms ({frames})", self.atoms),
+            Per::Bond => format!("of {} bonds ({frames})", self.bonds),
+            Per::Frame => format!("of {frames}"),
+        };
+        let (was, it) = if kind.singular() {
+            ("was", "it")
+        } else {
+            ("were", "them")
+        };
+        let others: Vec<&str> = self
+            .kept_by
+            .iter()
+            .copied()
+            .filter(|o| *o != self.output)
+            .collect();
+        let keep = if others.is_empty() {
+            String::new()
+        } else {
+            format!(" ({} keep {it})", others.join(", "))
+        };
+        format!(
+            "{} {counted} {was} not written: {}{keep}",
+            kind.what(),
+            self.reason
+        )
+    }
 }
 
 /// The structure types `columns` asks for and the frame does not have yet, as OVITO numbers

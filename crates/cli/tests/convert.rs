@@ -542,9 +542,137 @@ fn lammps_data_output_keeps_a_data_files_velocities() {
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(
-        stderr(&o).contains("warning: the velocities (Å/ps) of"),
+        stderr(&o).contains("warning: the velocities of 11 atoms (1 frame) were not written: a LAMMPS data file's velocities are in its run's units"),
         "{}",
         stderr(&o)
+    );
+}
+
+/// A MOL2's partial charges (Gasteiger's, as Open Babel writes them) have no place in an SD
+/// file, which holds integer formal charges: the conversion names them in one warning, with
+/// the formats that keep them, and the SD file read back indeed has no charges.
+#[test]
+fn mol2_partial_charges_written_as_sdf_are_named_in_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = md_data("molecules/library.mol2");
+    let input = frames(Path::new(&src));
+    let n: usize = input.iter().map(|f| f.n_atoms()).max().unwrap();
+    assert!(
+        input.iter().all(|f| f
+            .property("charge")
+            .is_some_and(|q| q.iter().any(|v| v.fract() != 0.0))),
+        "the fixture has partial charges in every molecule"
+    );
+    let out = dir.path().join("library.sdf");
+    let o = texmap(&["convert", &src, "-o", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    let line = err
+        .lines()
+        .find(|l| l.contains("partial charges"))
+        .unwrap_or_else(|| panic!("no warning names the charges: {err}"));
+    assert_eq!(err.matches("partial charges").count(), 1, "{err}");
+    assert_eq!(
+        line,
+        format!(
+            "texmap: warning: the partial charges ('charge') of {n} atoms ({} frames) were not written: an SD file holds integer formal charges only (.xyz, .lammpstrj, .data, .gsd keep them)",
+            input.len()
+        )
+    );
+    let back = frames(&out);
+    assert_eq!(back.len(), input.len());
+    assert!(back.iter().all(|f| f.property("charge").is_none()));
+    // The same charges written where they are kept: no warning about them, and they come back.
+    let xyz = dir.path().join("library.xyz");
+    let o = texmap(&[
+        "convert",
+        &src,
+        "--frames",
+        "0",
+        "-o",
+        xyz.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!stderr(&o).contains("charge"), "{}", stderr(&o));
+    assert_eq!(
+        frames(&xyz)[0].property("charge"),
+        input[0].property("charge")
+    );
+}
+
+/// Converting to a format that holds everything the input has prints no warning, and the
+/// output reads back with the input's columns; converting the same input to a format without
+/// them names each one.
+#[test]
+fn nothing_dropped_means_no_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    for (src, name) in [
+        ("ase_props.xyz", "same.xyz"),
+        ("lmp_tri.lammpstrj", "same.lammpstrj"),
+        ("mda_vel.gro", "same.gro"),
+    ] {
+        let src = md_data(src);
+        let out = dir.path().join(name);
+        let o = texmap(&["convert", &src, "-o", out.to_str().unwrap()]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        assert!(!stderr(&o).contains("warning"), "{name}: {}", stderr(&o));
+        let (a, b) = (frames(Path::new(&src)), frames(&out));
+        assert_eq!(a.len(), b.len(), "{name}");
+        for (a, b) in a.iter().zip(&b) {
+            let names = |f: &Frame| {
+                f.properties
+                    .iter()
+                    .map(|p| p.name.clone())
+                    .collect::<Vec<_>>()
+            };
+            assert_eq!(names(a), names(b), "{name}");
+            assert_eq!(a.velocities.len(), b.velocities.len(), "{name}");
+        }
+    }
+    // The extended XYZ's properties in a .gro: one warning each, naming it.
+    let src = md_data("ase_props.xyz");
+    let input = &frames(Path::new(&src))[0];
+    assert!(!input.properties.is_empty());
+    let gro = dir.path().join("props.gro");
+    let o = texmap(&["convert", &src, "-o", gro.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    for p in &input.properties {
+        let named = format!(
+            "warning: the per-atom property '{}' of {} atoms (1 frame) was not written: a .gro file has no place for it",
+            p.name,
+            input.n_atoms()
+        );
+        assert_eq!(err.matches(&named).count(), 1, "{}: {err}", p.name);
+    }
+    // Nothing else of the fixture (species, positions, cell) is lost in a .gro.
+    assert_eq!(
+        err.matches("warning:").count(),
+        input.properties.len(),
+        "{err}"
+    );
+    // A coordinate trajectory is read with its topology: the names and residues a .dcd has no
+    // place for are one note, not a warning each; its lost times are still a warning.
+    let dcd = dir.path().join("md.dcd");
+    let o = texmap(&[
+        "convert",
+        &md_data("topo_mda.xtc"),
+        "--topology",
+        &md_data("topo_mda.gro"),
+        "-o",
+        dcd.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert_eq!(
+        err.matches("holds coordinates, not the atom names, the residues (names and numbers): read it with its topology").count(),
+        1,
+        "{err}"
+    );
+    assert!(!err.contains("warning: the atom names"), "{err}");
+    assert!(
+        err.contains("warning: the time of 4 frames was not written"),
+        "{err}"
     );
 }
 

@@ -973,6 +973,21 @@ impl<W: Write + Seek> DcdWriter<W> {
         r.map_err(|e| io_error(&self.file, Some(frame), 8, e))
     }
 
+    /// Whether a frame of step `step`, written next, reads back with that step: a DCD stores
+    /// the first step (ISTART, at least 0) and the steps between frames (NSAVC, from the first
+    /// two frames), so later frames keep theirs only when evenly spaced.
+    pub(crate) fn keeps_step(&self, step: i64) -> bool {
+        let istart = self.first.0.unwrap_or(0).clamp(0, i64::from(i32::MAX));
+        match self.n_written {
+            0 => (0..=i64::from(i32::MAX)).contains(&step),
+            1 => match self.first.0 {
+                Some(s0) if s0 == istart && step > s0 && step - s0 <= i64::from(i32::MAX) => true,
+                _ => step == istart + 1,
+            },
+            k => step == istart + k as i64 * self.nsavc,
+        }
+    }
+
     /// Appends a [`Frame`] (the `Writer` contract): positions, cell lengths and angles, step
     /// and time. Everything else in the frame has no place in DCD.
     pub fn write_frame(&mut self, frame: &Frame) -> io::Result<()> {

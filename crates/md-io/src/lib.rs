@@ -55,7 +55,9 @@
 //!   (`Format::Cube`, `Format::Vasp`), an XSF / AXSF file one per structure (`Format::Xsf`).
 //! - [`Writer`] writes extended XYZ and LAMMPS text dumps (positions, ids, types, velocities,
 //!   radii, colours and every named property, for OVITO, ASE and LAMMPS to read back), GRO,
-//!   PDB, PDBx/mmCIF, DCD, XTC, TRR, AMBER NetCDF, HOOMD-blue GSD and VASP POSCAR / XDATCAR.
+//!   PDB, PDBx/mmCIF, DCD, XTC, TRR, AMBER NetCDF, HOOMD-blue GSD, VASP POSCAR / XDATCAR and
+//!   MDL SD files; [`Writer::dropped`] names what of a frame the format has no place for
+//!   ([`Dropped`]: velocities, forces, a property, bonds, the cell, ...).
 //! - [`elements`] maps atom names to elements, gives van der Waals radii and CPK colours, and
 //!   [`AtomStyle`] resolves each atom's radius and colour with user overrides.
 //!
@@ -139,6 +141,7 @@ pub mod density;
 pub mod dihedrals;
 pub mod distance_map;
 mod dlpoly;
+mod dropped;
 mod dx;
 mod eigen;
 pub mod elements;
@@ -217,6 +220,7 @@ mod xsf;
 mod xtc;
 mod xyz;
 
+pub use dropped::{Dropped, Per};
 pub use elements::Element;
 pub use error::{Error, Location};
 pub use format::Format;

@@ -192,6 +192,8 @@ pub(crate) struct MmcifWriter<W> {
     /// Models written, and the atom count of the first.
     models: usize,
     atoms: usize,
+    /// The first frame's cell, the only one written.
+    pub(crate) first_cell: Option<crate::UnitCell>,
 }
 
 impl<W: Write> MmcifWriter<W> {
@@ -201,6 +203,7 @@ impl<W: Write> MmcifWriter<W> {
             out,
             block: block_name(name),
             models: 0,
+            first_cell: None,
             atoms: 0,
         }
     }
@@ -279,6 +282,7 @@ impl<W: Write> MmcifWriter<W> {
         if self.models == 0 {
             self.header(Some(frame))?;
             self.atoms = frame.n_atoms();
+            self.first_cell = frame.cell;
         }
         self.models += 1;
         let model = self.models;

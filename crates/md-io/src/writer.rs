@@ -49,10 +49,15 @@
 //!   frame is written, never a silently changed file: a label with white space, a property name
 //!   the format cannot hold, and for LAMMPS a cell that is not restricted triclinic.
 //!
+//! What a format has no place for is not an error: [`Writer::dropped`] names it before the frame
+//! is written (src/dropped.rs has the table of what each output keeps), so that a caller can
+//! say what the file will lack.
+//!
 //! The per-format details are on the writer types (src/xyz.rs `XyzWriter`,
 //! src/lammps_dump_writer.rs, src/gro.rs `GroWriter`, src/mmcif_writer.rs).
 
 use crate::dcd::DcdWriter;
+use crate::dropped::{Dropped, Output};
 use crate::error::{Error, Location};
 use crate::format::Format;
 use crate::frame::Frame;
@@ -162,6 +167,7 @@ pub struct Writer<W: Write + Seek = BufWriter<File>> {
     kind: WriterKind<W>,
     file: Arc<str>,
     format: Format,
+    output: Output,
     written: usize,
 }
 
@@ -194,6 +200,11 @@ impl<W: Write + Seek> Writer<W> {
     /// file name also chooses an XDATCAR, `XDATCAR*` or `*.xdatcar`, over a POSCAR).
     pub fn new(out: W, format: Format, name: &str) -> Result<Self, Error> {
         let file: Arc<str> = name.into();
+        let unsupported = || Error::Unsupported {
+            file: file.clone(),
+            what: "writing this format",
+        };
+        let output = Output::of(format, is_xdatcar(&file)).ok_or_else(unsupported)?;
         let kind = match format {
             Format::Xyz => WriterKind::Xyz(XyzWriter { out }),
             Format::LammpsDump => WriterKind::LammpsDump(LammpsDumpWriter::new(out)),
@@ -208,17 +219,13 @@ impl<W: Write + Seek> Writer<W> {
             Format::Trr => WriterKind::Trr(TrrWriter::new(out)),
             Format::Gsd => WriterKind::Gsd(GsdWriter::new(out)),
             Format::Sdf => WriterKind::Sdf(SdfWriter::new(out, &file)),
-            _ => {
-                return Err(Error::Unsupported {
-                    file,
-                    what: "writing this format",
-                });
-            }
+            _ => return Err(unsupported()),
         };
         Ok(Writer {
             kind,
             file,
             format,
+            output,
             written: 0,
         })
     }
@@ -231,6 +238,48 @@ impl<W: Write + Seek> Writer<W> {
     /// Frames written so far.
     pub fn frames_written(&self) -> usize {
         self.written
+    }
+
+    /// What of `frame` this file will not hold when `frame` is the next one written: each kind
+    /// of data the frame carries that the format has no place for (velocities in a .dcd, a
+    /// property other than `occupancy` and `bfactor` in a .pdb, partial charges in an .sdf, a
+    /// cell that differs from the first frame's in a .cif, ...), in a fixed order, each once;
+    /// empty when the file keeps everything. Call it before [`Writer::write_frame`]. The table
+    /// of what each format keeps is in src/dropped.rs. Counts and precision are not reported
+    /// (see there).
+    ///
+    /// ```
+    /// use std::io::Cursor;
+    /// use texmap_md_io::{Dropped, Format, Frame, Writer};
+    /// let mut f = Frame::new();
+    /// f.positions = vec![[0.0; 3]];
+    /// f.velocities = vec![[1.0, 0.0, 0.0]];
+    /// let dcd = Writer::new(Cursor::new(Vec::new()), Format::Dcd, "out.dcd").unwrap();
+    /// assert_eq!(dcd.dropped(&f), [Dropped::Velocities]);
+    /// let xyz = Writer::new(Cursor::new(Vec::new()), Format::Xyz, "out.xyz").unwrap();
+    /// assert!(xyz.dropped(&f).is_empty());
+    /// ```
+    pub fn dropped(&self, frame: &Frame) -> Vec<Dropped> {
+        let mut state = crate::dropped::State::default();
+        match &self.kind {
+            WriterKind::Mmcif(w) if self.written > 0 => {
+                state.first_cell = Some(w.first_cell.as_ref());
+            }
+            WriterKind::Dcd(w) => state.step_kept = frame.step.map(|s| w.keeps_step(s)),
+            _ => {}
+        }
+        crate::dropped::dropped(self.output, frame, state)
+    }
+
+    /// Why this file does not hold `kind` (one of [`Writer::dropped`]'s), as the end of a
+    /// sentence: "a .gro file has no place for them".
+    pub fn why_dropped(&self, kind: &Dropped) -> String {
+        crate::dropped::reason(self.output, kind)
+    }
+
+    /// The file name users know this output by: `.xyz`, `.gro`, `POSCAR`, `XDATCAR`, ...
+    pub fn output_name(&self) -> &'static str {
+        self.output.name()
     }
 
     /// Appends one frame, after checking it ([`Frame::check`]).

@@ -1,6 +1,8 @@
 //! Our extended-XYZ and LAMMPS dump writers: round trips through our readers, the LAMMPS
 //! manual's box bounds computed by hand, exact expected texts, refused frames, and files written
-//! by LAMMPS, OVITO and ASE read, written again and read back.
+//! by LAMMPS, OVITO and ASE read, written again and read back; and for every output, what
+//! `Writer::dropped` names against what a frame carrying everything does not give back when
+//! the file is read.
 
 use std::io::Cursor;
 use std::path::PathBuf;
@@ -1149,4 +1151,411 @@ fn pdb_conect_layout_models_serials_and_refusals() {
     dup.bonds.retain(|b| *b != [2, 3] && *b != [0, 2]);
     dup.bond_orders.truncate(dup.bonds.len());
     write(Format::Pdb, &[dup]);
+}
+
+// What each writer drops (`Writer::dropped`), checked against the files: a frame carrying every
+// kind of data is written to each output and read back with our readers, and the kinds that
+// did not come back must be exactly the ones `dropped` names.
+
+/// Every output, as a file name that chooses it (a VASP name chooses POSCAR or XDATCAR).
+const OUTPUTS: [(Format, &str); 14] = [
+    (Format::Xyz, "out.xyz"),
+    (Format::LammpsDump, "out.lammpstrj"),
+    (Format::LammpsData, "out.data"),
+    (Format::Gro, "out.gro"),
+    (Format::Pdb, "out.pdb"),
+    (Format::Mmcif, "out.cif"),
+    (Format::Dcd, "out.dcd"),
+    (Format::Xtc, "out.xtc"),
+    (Format::Trr, "out.trr"),
+    (Format::Netcdf, "out.nc"),
+    (Format::Gsd, "out.gsd"),
+    (Format::Vasp, "POSCAR"),
+    (Format::Vasp, "XDATCAR"),
+    (Format::Sdf, "out.sdf"),
+];
+
+/// A frame carrying everything a [`Frame`] holds: velocities, forces, image flags, charges
+/// (partial when `partial`, else formal), masses, occupancies, B-factors, a custom property,
+/// names, types, residues, chains, segments, radii, colours, bonds with orders (one aromatic
+/// when `partial`), the cell, time and step. Its atoms lie inside the cell (a GSD wraps atoms
+/// into its box and adds the images it moved them by) and every value fits every format's
+/// columns.
+fn carrying_everything(partial: bool) -> Frame {
+    let mut f = Frame::new();
+    f.positions = vec![
+        [1.5, 2.25, 3.0],
+        [2.75, 2.5, 3.5],
+        [8.0, 9.5, 10.25],
+        [8.75, 10.0, 11.0],
+    ];
+    f.velocities = vec![
+        [0.5, -1.25, 2.0],
+        [-0.75, 0.25, 1.5],
+        [1.0, 1.0, -1.0],
+        [0.125, -0.5, 0.75],
+    ];
+    f.cell = Some(UnitCell::orthorhombic(20.0, 21.0, 22.0).unwrap());
+    f.time = Some(1.5);
+    f.step = Some(10);
+    f.names = labels(&["C1", "O1", "N1", "H1"]);
+    f.elements = ["C", "O", "N", "H"].map(element).to_vec();
+    f.types = labels(&["1", "2", "1", "3"]);
+    f.ids = vec![1, 2, 3, 4];
+    f.res_names = labels(&["ALA", "ALA", "LIG", "LIG"]);
+    f.res_ids = vec![1, 1, 2, 2];
+    f.chains = labels(&["A", "A", "B", "B"]);
+    f.segments = labels(&["PROT", "PROT", "LIG", "LIG"]);
+    f.radii = vec![0.75, 0.5, 0.625, 0.25];
+    f.colors = vec![
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [0.5, 0.5, 0.5],
+    ];
+    let charge: [f32; 4] = if partial {
+        [-0.375, 0.5, 0.25, -0.375]
+    } else {
+        [-1.0, 1.0, 0.0, 0.0]
+    };
+    f.properties = vec![
+        property("charge", &charge),
+        property("mass", &[12.0, 16.0, 12.0, 1.0]),
+        property("fx", &[0.5, -0.25, 1.0, 2.0]),
+        property("fy", &[1.5, 0.75, -1.0, 0.5]),
+        property("fz", &[-0.5, 0.25, 0.125, 1.0]),
+        property("ix", &[0.0, 1.0, -1.0, 0.0]),
+        property("iy", &[0.0, 0.0, 2.0, 0.0]),
+        property("iz", &[1.0, 0.0, 0.0, -1.0]),
+        property("occupancy", &[1.0, 0.5, 0.25, 1.0]),
+        property("bfactor", &[10.5, 20.25, 30.0, 40.75]),
+        property("grain", &[0.0, 1.0, 1.0, 2.0]),
+    ];
+    f.bonds = vec![[0, 1], [2, 3]];
+    f.bond_orders = if partial { vec![2, 4] } else { vec![2, 1] };
+    f
+}
+
+/// Writes `frames` to memory as `name` chooses, with what `dropped` named before each frame.
+fn write_noting_dropped(
+    format: Format,
+    name: &str,
+    frames: &[Frame],
+) -> (Vec<u8>, Vec<Vec<texmap_md_io::Dropped>>) {
+    let mut w = Writer::new(Cursor::new(Vec::new()), format, name).unwrap();
+    let mut dropped = Vec::new();
+    for f in frames {
+        dropped.push(w.dropped(f));
+        w.write_frame(f).unwrap_or_else(|e| panic!("{name}: {e}"));
+    }
+    (w.finish().unwrap().into_inner(), dropped)
+}
+
+fn read_bytes(format: Format, name: &str, bytes: Vec<u8>) -> Vec<Frame> {
+    let mut t = Trajectory::from_reader(Cursor::new(bytes), format, name)
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
+    let mut out = Vec::new();
+    let mut f = Frame::new();
+    while t
+        .read_next(&mut f)
+        .unwrap_or_else(|e| panic!("{name}: {e}"))
+    {
+        out.push(f.clone());
+    }
+    out
+}
+
+/// What a file holds that our frame readers leave out, read from its bytes into `back`: a
+/// PDB's CONECT bonds (our PDB topology reader's), with the orders their repetition gives (a
+/// double bond listed twice from each atom, as Open Babel reads them), and an SD file's
+/// `step` and `time` data items.
+fn beyond_the_frame_reader(format: Format, bytes: &[u8], back: &mut Frame) {
+    let text = String::from_utf8_lossy(bytes);
+    match format {
+        Format::Pdb => {
+            let t = texmap_md_io::Topology::from_reader(
+                Cursor::new(bytes.to_vec()),
+                texmap_md_io::TopologyFormat::Pdb,
+                "out.pdb",
+            )
+            .unwrap();
+            back.bonds = t.bonds.clone();
+            // Each CONECT partner of atom serial a, counted per bond (serial = index + 1 here).
+            let mut count = std::collections::HashMap::<[u32; 2], u8>::new();
+            for l in text.lines().filter(|l| l.starts_with("CONECT")) {
+                let serial = |k: usize| {
+                    l.get(6 + 5 * k..11 + 5 * k)
+                        .map(|f| f.trim().parse::<u32>().unwrap())
+                };
+                let a = serial(0).unwrap() - 1;
+                for k in 1..=4 {
+                    if let Some(b) = serial(k) {
+                        *count.entry([a, b - 1]).or_default() += 1;
+                    }
+                }
+            }
+            back.bond_orders = t.bonds.iter().map(|b| count[b]).collect();
+        }
+        Format::Sdf => {
+            let item = |name: &str| {
+                let mut lines = text.lines();
+                lines.find(|l| l.trim() == format!("> <{name}>"))?;
+                lines.next().map(|v| v.trim().to_string())
+            };
+            back.step = item("step").map(|v| v.parse().unwrap());
+            back.time = item("time").map(|v| v.parse().unwrap());
+        }
+        _ => {}
+    }
+}
+
+/// Whether `b` gives `a` back within `tol` (absolute, plus 1e-5 relative: the text writers'
+/// fixed decimals, PDB's 2 for occupancy and B-factor, GRO's 0.001 Å/ps for velocities; TRR's
+/// and NetCDF's unit conversions round within a few ulp).
+fn within(a: &[f32], b: &[f32], tol: f32) -> bool {
+    a.len() == b.len()
+        && a.iter()
+            .zip(b)
+            .all(|(x, y)| (x - y).abs() <= tol + 1e-5 * x.abs().max(y.abs()))
+}
+
+/// The kinds of data `w` carries that `r`, the frame read back, does not give back, by our
+/// own comparison of the two frames.
+fn lost(w: &Frame, r: &Frame) -> Vec<texmap_md_io::Dropped> {
+    use texmap_md_io::Dropped as D;
+    let mut lost = Vec::new();
+    let prop = |name: &str, tol: f32| match (w.property(name), r.property(name)) {
+        (Some(a), Some(b)) => within(a, b, tol),
+        _ => false,
+    };
+    if !within(
+        w.velocities.as_flattened(),
+        r.velocities.as_flattened(),
+        1e-3,
+    ) {
+        lost.push(D::Velocities);
+    }
+    let group = |names: &[&str]| names.iter().all(|n| prop(n, 1e-5));
+    if !group(&["fx", "fy", "fz"]) {
+        lost.push(D::Forces);
+    }
+    if !group(&["ix", "iy", "iz"]) {
+        lost.push(D::ImageFlags);
+    }
+    for p in &w.properties {
+        if !matches!(p.name.as_str(), "fx" | "fy" | "fz" | "ix" | "iy" | "iz")
+            && !prop(&p.name, 0.006)
+        {
+            lost.push(D::Property(p.name.clone()));
+        }
+    }
+    if r.bonds != w.bonds {
+        lost.push(D::Bonds);
+    } else if r.bond_orders != w.bond_orders {
+        lost.push(D::BondOrders);
+    }
+    let cell_back = match (w.cell, r.cell) {
+        (Some(a), Some(b)) => (0..3).all(|k| {
+            (a.lengths()[k] - b.lengths()[k]).abs() < 1e-3
+                && (a.angles()[k] - b.angles()[k]).abs() < 1e-3
+        }),
+        _ => false,
+    };
+    if !cell_back {
+        lost.push(D::Cell);
+    }
+    if r.names != w.names {
+        lost.push(D::Names);
+    }
+    if r.types != w.types {
+        lost.push(D::Types);
+    }
+    if r.res_names != w.res_names || r.res_ids != w.res_ids {
+        lost.push(D::Residues);
+    }
+    if r.chains != w.chains {
+        lost.push(D::Chains);
+    }
+    if r.segments != w.segments {
+        lost.push(D::Segments);
+    }
+    if !within(&w.radii, &r.radii, 0.0) {
+        lost.push(D::Radii);
+    }
+    if !within(w.colors.as_flattened(), r.colors.as_flattened(), 0.0) {
+        lost.push(D::Colors);
+    }
+    if !matches!((w.time, r.time), (Some(a), Some(b)) if (a - b).abs() < 1e-4) {
+        lost.push(D::Time);
+    }
+    if r.step != w.step {
+        lost.push(D::Step);
+    }
+    lost.sort();
+    lost
+}
+
+/// What `dropped` named for each frame of `frames` written as `name`, and what did not come
+/// back when the file was read; `dropped`'s partial charges are compared as the `charge`
+/// property (which is what `lost` sees).
+fn named_and_lost(
+    format: Format,
+    name: &str,
+    frames: &[Frame],
+) -> Vec<(Vec<texmap_md_io::Dropped>, Vec<texmap_md_io::Dropped>)> {
+    use texmap_md_io::Dropped as D;
+    let (bytes, dropped) = write_noting_dropped(format, name, frames);
+    let mut back = read_bytes(format, name, bytes.clone());
+    assert_eq!(back.len(), frames.len(), "{name}: frames read back");
+    let mut out = Vec::new();
+    for ((w, r), dropped) in frames.iter().zip(&mut back).zip(dropped) {
+        beyond_the_frame_reader(format, &bytes, r);
+        let mut named: Vec<D> = dropped
+            .iter()
+            .map(|d| match d {
+                D::PartialCharges => D::Property("charge".into()),
+                d => d.clone(),
+            })
+            .collect();
+        named.sort();
+        out.push((named, lost(w, r)));
+    }
+    out
+}
+
+#[test]
+fn dropped_names_exactly_what_does_not_come_back_from_each_output() {
+    use texmap_md_io::Dropped as D;
+    let mut wrong = Vec::new();
+    for partial in [true, false] {
+        let frame = carrying_everything(partial);
+        let mut lost_by = Vec::new();
+        for (format, name) in OUTPUTS {
+            let (named, lost) = named_and_lost(format, name, std::slice::from_ref(&frame))
+                .pop()
+                .unwrap();
+            if named != lost {
+                wrong.push(format!(
+                    "{name} (partial charges: {partial}):\n  named by dropped: {named:?}\n  not read back:    {lost:?}"
+                ));
+            }
+            lost_by.push((name, lost));
+        }
+        // Whatever some output drops, `kept_by` lists exactly the outputs that give it back.
+        let mut kinds: Vec<&D> = lost_by.iter().flat_map(|(_, lost)| lost).collect();
+        kinds.sort();
+        kinds.dedup();
+        for d in kinds {
+            let kept_by = d.kept_by(&frame);
+            assert!(!kept_by.is_empty(), "{d:?}: kept by no output");
+            for (name, lost) in &lost_by {
+                let known = if name.contains('.') { &name[3..] } else { name };
+                if kept_by.contains(&known) == lost.contains(d) {
+                    wrong.push(format!(
+                        "{d:?}: kept_by {kept_by:?}, and {known} {} it",
+                        if lost.contains(d) { "loses" } else { "keeps" }
+                    ));
+                }
+            }
+        }
+    }
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+    // The SD file names partial charges as such, and keeps formal ones.
+    let sdf = Writer::new(Cursor::new(Vec::new()), Format::Sdf, "out.sdf").unwrap();
+    assert!(
+        sdf.dropped(&carrying_everything(true))
+            .contains(&D::PartialCharges)
+    );
+    let formal = sdf.dropped(&carrying_everything(false));
+    assert!(
+        !formal
+            .iter()
+            .any(|d| matches!(d, D::PartialCharges) || *d == D::Property("charge".into()))
+    );
+    assert_eq!(
+        D::PartialCharges.kept_by(&carrying_everything(true)),
+        [".xyz", ".lammpstrj", ".data", ".gsd"]
+    );
+}
+
+/// The cases where what is kept depends on the values or on earlier frames, each checked
+/// against the file read back as above.
+#[test]
+fn dropped_follows_values_and_earlier_frames() {
+    use texmap_md_io::Dropped as D;
+    let base = carrying_everything(false);
+    let with = |edit: &dyn Fn(&mut Frame)| {
+        let mut f = base.clone();
+        edit(&mut f);
+        f
+    };
+    let cell_b = UnitCell::orthorhombic(25.0, 21.0, 22.0).unwrap();
+    // An output, its frames, and per frame the kinds the case is about that it drops.
+    type Case = (Format, &'static str, Vec<Frame>, Vec<Vec<D>>);
+    let cases: Vec<Case> = vec![
+        // A .cif holds the first frame's cell: a later, other cell is lost.
+        (
+            Format::Mmcif,
+            "out.cif",
+            vec![base.clone(), base.clone(), with(&|f| f.cell = Some(cell_b))],
+            vec![vec![], vec![], vec![D::Cell]],
+        ),
+        // A DCD keeps evenly spaced steps.
+        (
+            Format::Dcd,
+            "out.dcd",
+            [0, 10, 20, 35]
+                .map(|s| with(&|f| f.step = Some(s)))
+                .to_vec(),
+            vec![vec![], vec![], vec![], vec![D::Step]],
+        ),
+        // A PDB segment column holds 4 characters; CONECT repeats no aromatic bond.
+        (
+            Format::Pdb,
+            "out.pdb",
+            vec![with(&|f| {
+                f.segments = labels(&["PROTEIN", "PROTEIN", "LIG", "LIG"]);
+                f.bond_orders = vec![4, 1];
+            })],
+            vec![vec![D::Segments, D::BondOrders]],
+        ),
+        // A data file's Masses are positive; its Velocities are the properties vx vy vz,
+        // never Å/ps.
+        (
+            Format::LammpsData,
+            "out.data",
+            vec![with(&|f| {
+                let mass = f.properties.iter_mut().find(|p| p.name == "mass").unwrap();
+                mass.values[3] = 0.0;
+                for v in ["vx", "vy", "vz"] {
+                    f.properties.push(property(v, &[0.5, 1.0, -1.0, 2.0]));
+                }
+            })],
+            vec![vec![D::Velocities, D::Property("mass".into())]],
+        ),
+        // A GSD orientation needs all four quaternion components.
+        (
+            Format::Gsd,
+            "out.gsd",
+            vec![with(&|f| f.properties.push(property("quatw", &[1.0; 4])))],
+            vec![vec![D::Property("quatw".into())]],
+        ),
+    ];
+    for (format, name, frames, expected) in cases {
+        let about: Vec<&D> = expected.iter().flatten().collect();
+        let results = named_and_lost(format, name, &frames);
+        for (k, ((named, lost), want)) in results.into_iter().zip(&expected).enumerate() {
+            for d in &about {
+                assert_eq!(
+                    named.contains(d),
+                    want.contains(d),
+                    "{name} frame {k}: {d:?} in {named:?}"
+                );
+            }
+            assert_eq!(
+                named, lost,
+                "{name} frame {k}: named by dropped (left), not read back (right)"
+            );
+        }
+    }
 }
