@@ -20,6 +20,7 @@ Examples:
   texmap terrain grid survey.laz -o dem.tif
   texmap terrain grid tiles/*.laz -o dem.tif --lidar-cell 1 --lidar-method idw --lidar-fill 3
   texmap terrain grid survey.las -o dsm.tif --lidar-classes 1,2,3,4,5,6 --lidar-method max
+  texmap terrain grid survey.laz -o density.tif --lidar-classes 2 --lidar-method count   # gaps in the ground
   texmap terrain build --dem survey.laz --lidar-cell 2 --out area.db
 
 The cells are squares of --lidar-cell metres aligned to multiples of it (so tiles gridded apart
@@ -41,7 +42,10 @@ pub struct LidarArgs {
     pub lidar_cell: Option<f64>,
     /// A cell's height from the points within the radius of its centre (PDAL writers.gdal's
     /// output_type): mean, min (the ground under low vegetation), max (a surface model: canopy
-    /// and roofs) or idw (inverse-distance weighted), e.g. --lidar-method idw.
+    /// and roofs) or idw (inverse-distance weighted), e.g. --lidar-method idw. For quality
+    /// control, `terrain grid` also writes count (points per cell: the survey's density and its
+    /// gaps) and stdev (the population standard deviation of their heights: roughness, or
+    /// objects left among the ground points); these are not heights, so not for a database.
     #[arg(long, value_name = "METHOD", default_value = "mean")]
     pub lidar_method: String,
     /// The ASPRS classes to grid, e.g. --lidar-classes 2,9 (ground and water). Default: ground
@@ -138,8 +142,8 @@ pub struct GridArgs {
     /// LAS or LAZ files (.las, .laz), gridded together as one cloud (a survey's tiles).
     #[arg(required = true, num_args = 1..)]
     pub input: Vec<PathBuf>,
-    /// Output GeoTIFF (.tif or .tiff): float32 heights, empty cells nan (GDAL's no-data tag), in
-    /// the cloud's coordinate system.
+    /// Output GeoTIFF (.tif or .tiff): float32 heights (or counts, standard deviations), empty
+    /// cells nan (GDAL's no-data tag; a count is 0 there), in the cloud's coordinate system.
     #[arg(short, long)]
     pub output: PathBuf,
     #[command(flatten)]
@@ -237,6 +241,19 @@ pub fn read_dems(
         lidar: lidar.options()?,
         ..opts
     };
+    if !opts.lidar.method.is_height() {
+        return usage(format!(
+            "--lidar-method {}: a grid of the points' {}, not of heights, is no terrain; write it \
+             with texmap terrain grid CLOUD -o {}.tif --lidar-method {0}",
+            opts.lidar.method.name(),
+            if opts.lidar.method == LidarMethod::Count {
+                "counts"
+            } else {
+                "standard deviations"
+            },
+            opts.lidar.method.name()
+        ));
+    }
     if clouds < paths.len() {
         // Clouds and grids together: the clouds are one grid joined to the others.
         return dem::read_dems(paths, &opts).map_err(lidar_error);

@@ -1119,6 +1119,44 @@ fn lidar_clouds_grid_to_geotiffs_and_build_databases() {
         "{err}"
     );
 
+    // A density grid for quality control: the points' counts, 0 where none reaches (numpy's
+    // counts by PDAL's rule, lidar/stats_numpy.py); not a terrain, so `build` refuses it.
+    let density = dir.path().join("density.tif");
+    let o = texmap(&[
+        "terrain",
+        "grid",
+        &laz,
+        "-o",
+        density.to_str().unwrap(),
+        "--lidar-cell",
+        "10",
+        "--lidar-method",
+        "count",
+    ]);
+    ok(&o);
+    let counts = read_dem(&density, &ReadOptions::default()).unwrap();
+    let numpy: Vec<f32> = std::fs::read_to_string(data("lidar/lidar_numpy_stats.txt"))
+        .unwrap()
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .map(|l| l.split_whitespace().nth(2).unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(counts.heights(), &numpy[..]);
+    let o = texmap(&[
+        "terrain",
+        "build",
+        "--dem",
+        &laz,
+        "--lidar-method",
+        "count",
+        "--out",
+        dir.path().join("count.db").to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("texmap terrain grid"), "{err}");
+    assert!(!dir.path().join("count.db").exists());
+
     // `terrain build --dem x.laz`: a database of the gridded cloud, holes filled.
     let db = dir.path().join("area.db");
     let o = texmap(&[

@@ -1015,6 +1015,45 @@ fn numpy_cells() -> Vec<(usize, usize, u32, [f64; 5], bool)> {
         .collect()
 }
 
+/// Counts and population standard deviations per cell of the ground points by PDAL's rule, in
+/// numpy on laspy's reading (lidar/stats_numpy.py): the quality-control grids.
+#[test]
+fn lidar_count_and_stdev_grids_match_pdals_rule() {
+    let text = std::fs::read_to_string(data("lidar/lidar_numpy_stats.txt")).unwrap();
+    let cells: Vec<(u32, u32, f64, f64)> = text
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .map(|l| {
+            let v: Vec<f64> = l.split_whitespace().map(|t| t.parse().unwrap()).collect();
+            (v[0] as u32, v[1] as u32, v[2], v[3])
+        })
+        .collect();
+    assert_eq!(cells.len(), 30 * 24);
+    assert!(
+        cells.iter().any(|c| c.2 == 0.0),
+        "the fixture has empty cells"
+    );
+    for las in [data("lidar/lidar_12.las"), data("lidar/lidar_14.laz")] {
+        let count = grid_of(std::slice::from_ref(&las), &cell10(LidarMethod::Count));
+        let stdev = grid_of(std::slice::from_ref(&las), &cell10(LidarMethod::Stdev));
+        for &(row, col, n, sd) in &cells {
+            assert_eq!(count.at(col, row) as f64, n, "count ({col}, {row})");
+            let ours = stdev.at(col, row) as f64;
+            if n == 0.0 {
+                assert!(ours.is_nan(), "stdev ({col}, {row}): {ours} without points");
+            } else {
+                // f32 of a few metres: 2.4e-7 apart, numpy's printed 1e-9.
+                assert!(
+                    (ours - sd).abs() <= 1e-6,
+                    "stdev ({col}, {row}): {ours}, numpy {sd}"
+                );
+            }
+        }
+    }
+    assert!(!LidarMethod::Count.is_height() && !LidarMethod::Stdev.is_height());
+    assert_eq!(LidarMethod::by_name("stdev"), Some(LidarMethod::Stdev));
+}
+
 #[test]
 fn lidar_grids_match_gdal_grid_and_pdals_rule() {
     let cells = numpy_cells();

@@ -23,7 +23,10 @@
 //! Euclidean distance in x and y; `R` = `c·√2` by default, PDAL's `radius`), and the cell takes
 //! their mean, lowest or highest height, or their inverse-distance weighted mean `Σ(z/dᵖ) /
 //! Σ(1/dᵖ)` (power `p` = 1, PDAL's default; a point exactly on the centre gives the cell its
-//! height, the first such point in file order). A cell no point reaches is no-data, unless
+//! height, the first such point in file order). Two statistics are grids for quality control,
+//! not terrains: the number of points (`count`, the survey's density; 0 where none reaches) and
+//! the population standard deviation of their heights (`stdev`: roughness, or objects left
+//! among the ground points). A cell no point reaches is no-data, unless
 //! [`LidarOptions::fill`] = `N` > 0 fills it as PDAL's `window_size` does: the mean of the
 //! non-empty cells within `N` cells of it (a square window), weighted by one over their
 //! Chebyshev distance in cells (filled cells are not sources). `terrain build --fill` fills the
@@ -78,10 +81,21 @@ pub enum LidarMethod {
     Max,
     /// Inverse-distance weighted (`idw`, `invdist`).
     Idw,
+    /// How many points (PDAL `count`, `gdal_grid -a count`): the survey's density, 0 where no
+    /// point reaches. Not a height: a grid for quality control, not a terrain.
+    Count,
+    /// The population standard deviation of their heights (PDAL `stdev`): roughness, and
+    /// vegetation or buildings left among the ground points. Not a height either.
+    Stdev,
 }
 
 impl LidarMethod {
-    pub const NAMES: [&'static str; 4] = ["mean", "min", "max", "idw"];
+    pub const NAMES: [&'static str; 6] = ["mean", "min", "max", "idw", "count", "stdev"];
+
+    /// Whether the cells hold heights (a terrain), not a statistic of the points.
+    pub fn is_height(self) -> bool {
+        !matches!(self, LidarMethod::Count | LidarMethod::Stdev)
+    }
 
     pub fn by_name(name: &str) -> Option<LidarMethod> {
         match name.to_ascii_lowercase().as_str() {
@@ -89,6 +103,8 @@ impl LidarMethod {
             "min" | "minimum" => Some(LidarMethod::Min),
             "max" | "maximum" => Some(LidarMethod::Max),
             "idw" | "invdist" => Some(LidarMethod::Idw),
+            "count" => Some(LidarMethod::Count),
+            "stdev" | "std" => Some(LidarMethod::Stdev),
             _ => None,
         }
     }
@@ -99,6 +115,8 @@ impl LidarMethod {
             LidarMethod::Min => "min",
             LidarMethod::Max => "max",
             LidarMethod::Idw => "idw",
+            LidarMethod::Count => "count",
+            LidarMethod::Stdev => "stdev",
         }
     }
 }
@@ -664,6 +682,12 @@ pub fn grid_cloud(
         LidarMethod::Min => gather::<Min>(&pts, opts.power, &mut values, &mut counts),
         LidarMethod::Max => gather::<Max>(&pts, opts.power, &mut values, &mut counts),
         LidarMethod::Idw => gather::<Idw>(&pts, opts.power, &mut values, &mut counts),
+        LidarMethod::Count => gather::<Count>(&pts, opts.power, &mut values, &mut counts),
+        LidarMethod::Stdev => gather::<Stdev>(&pts, opts.power, &mut values, &mut counts),
+    }
+    if opts.method == LidarMethod::Count {
+        // A count is a value everywhere: no point is 0 points.
+        values.iter_mut().for_each(|v| *v = v.max(0.0));
     }
     drop((px, py, pz, start));
     let empty_cells = counts.iter().filter(|&&c| c == 0).count() as u64;
@@ -802,6 +826,38 @@ impl Accumulate for Idw {
     }
     fn value(&self) -> f64 {
         self.exact.unwrap_or(self.num / self.den)
+    }
+}
+
+/// How many points.
+#[derive(Default)]
+struct Count(u32);
+impl Accumulate for Count {
+    fn add(&mut self, _: f64, _: f64, _: f64) {
+        self.0 += 1;
+    }
+    fn value(&self) -> f64 {
+        self.0 as f64
+    }
+}
+
+/// The population standard deviation, by Welford's update (mean and sum of squared deviations),
+/// which loses no digits to heights far from zero.
+#[derive(Default)]
+struct Stdev {
+    n: u32,
+    mean: f64,
+    m2: f64,
+}
+impl Accumulate for Stdev {
+    fn add(&mut self, z: f64, _: f64, _: f64) {
+        self.n += 1;
+        let d = z - self.mean;
+        self.mean += d / self.n as f64;
+        self.m2 += d * (z - self.mean);
+    }
+    fn value(&self) -> f64 {
+        (self.m2 / self.n as f64).sqrt()
     }
 }
 
