@@ -83,7 +83,8 @@ pub struct ConvertArgs {
     /// and the columns, read by LAMMPS's rerun, OVITO and MDAnalysis), .data/.lmp (one frame as
     /// a LAMMPS data file for read_data: atom style full, molecular, charge or atomic by
     /// whether the frame has bonds and charges, types with their masses, bonds typed by their
-    /// atoms' types, the Velocities a data file had (not a trajectory's: warned), the cell
+    /// atoms' types, the Velocities a data file had (not a trajectory's: warned), image flags
+    /// (ix iy iz) in the Atoms lines, the cell
     /// rotated into LAMMPS's restricted triclinic box), .gro (GROMACS: residues,
     /// names, positions to 0.001 nm, velocities, the box), .pdb (multi-MODEL, the 'occupancy'
     /// and 'bfactor' properties in their columns), .cif/.mmcif (PDBx/mmCIF, for ChimeraX, PyMOL,

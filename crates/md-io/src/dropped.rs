@@ -12,7 +12,7 @@
 //! |---|---|
 //! | velocities ([`Frame::velocities`]) | .xyz, .lammpstrj, .gro, .trr, .nc, .gsd, POSCAR (a LAMMPS data file writes the properties `vx vy vz` as its `Velocities`, never Å/ps) |
 //! | forces (the properties `fx fy fz`, all three) | .xyz, .lammpstrj, .trr |
-//! | image flags (the properties `ix iy iz`, all three) | .xyz, .lammpstrj, .gsd |
+//! | image flags (the properties `ix iy iz`, all three) | .xyz, .lammpstrj, .gsd; .data when they are whole numbers and the frame has a cell |
 //! | any other property | .xyz, .lammpstrj; `occupancy`, `bfactor` also .pdb, .cif; `charge` also .data, .gsd and, when every value is an integer in -15..=15 (formal charges), .sdf; `mass` also .gsd and .data (when every value is positive: its `Masses`); `vx vy vz` also .data; `body` and `quatw quati quatj quatk` also .gsd |
 //! | partial charges (`charge` values an SD file cannot hold as formal charges) | as `charge` above, but not .sdf |
 //! | bonds | .data, .pdb (CONECT), .gsd, .sdf |
@@ -204,7 +204,7 @@ pub(crate) fn keeps(output: Output, kind: &Dropped) -> bool {
             matches!(output, Xyz | LammpsDump | Gro | Trr | Netcdf | Gsd | Poscar)
         }
         Dropped::Forces => matches!(output, Xyz | LammpsDump | Trr),
-        Dropped::ImageFlags => matches!(output, Xyz | LammpsDump | Gsd),
+        Dropped::ImageFlags => matches!(output, Xyz | LammpsDump | LammpsData | Gsd),
         Dropped::Property(name) => keeps_property(output, name),
         Dropped::PartialCharges => matches!(output, Xyz | LammpsDump | LammpsData | Gsd),
         Dropped::Bonds => matches!(output, LammpsData | Pdb | Gsd | Sdf),
@@ -279,7 +279,13 @@ pub(crate) fn dropped(output: Output, frame: &Frame, state: State) -> Vec<Droppe
             table(&Dropped::Velocities),
         ),
         (Dropped::Forces, forces, table(&Dropped::Forces)),
-        (Dropped::ImageFlags, images, table(&Dropped::ImageFlags)),
+        (
+            Dropped::ImageFlags,
+            images,
+            table(&Dropped::ImageFlags)
+                && (output != Output::LammpsData
+                    || crate::lammps_data_writer::data_images(frame).is_some()),
+        ),
     ];
     for p in &frame.properties {
         let name = p.name.as_str();

@@ -40,8 +40,11 @@
 //!   trajectory) are not written: a data file does not state its units, and LAMMPS's are the
 //!   run's (Å/fs for `units real`, Å/ps for `metal`), so no conversion can be chosen here
 //!   (`texmap convert` warns when it drops them).
-//! - **Not written**: image flags (the positions carry them), angles, dihedrals, impropers,
-//!   coefficients.
+//! - **Image flags**: the properties `ix iy iz` (a data file's or a dump's), when the frame has
+//!   all three as whole numbers and a cell, as the Atoms lines' three last columns, so that
+//!   molecules stay whole across the box's faces for `read_data`; a reduced tilt changes the
+//!   lattice they count in, and they are recomputed for it (the same periodic image).
+//! - **Not written**: angles, dihedrals, impropers, coefficients.
 //!
 //! # References
 //! - LAMMPS documentation, `read_data` (header, sections, the Atoms line of each style) and
@@ -81,6 +84,23 @@ pub(crate) struct DataBox {
     pub hi: [f64; 3],
     pub tilt: [f64; 3],
     pub rotate: Option<Rotation>,
+    /// The multiples taken off by the tilt reduction: `c −= k₁·b`, then `b −= k_b·a` and
+    /// `c −= k_c·a` ([`DataBox::image`]).
+    reduced: [f64; 3],
+}
+
+impl DataBox {
+    /// Image flags `n` in the cell's lattice as flags in the written (reduced) lattice: the same
+    /// periodic image, `n_a·a + n_b·b + n_c·c`, with `b = b′ + k_b·a` and `c = c′ + k₁·b′ +
+    /// (k_c + k₁·k_b)·a`. A rotation keeps fractional coordinates, and with them the flags.
+    pub fn image(&self, n: [f64; 3]) -> [f64; 3] {
+        let [k1, kb, kc] = self.reduced;
+        [
+            n[0] + kb * n[1] + (kc + k1 * kb) * n[2],
+            n[1] + k1 * n[2],
+            n[2],
+        ]
+    }
 }
 
 /// p ↦ origin + ((p − origin) · M⁻¹) · M′: the fractional coordinates in the old cell M are
@@ -103,6 +123,19 @@ impl Rotation {
         let f = crate::pbc::to_frac(&self.cell, v);
         crate::pbc::to_cart(&self.restricted, f)
     }
+}
+
+/// The image flags `ix iy iz`, if the frame has all three as whole numbers and a cell for them
+/// to count (see the module docs).
+pub(crate) fn data_images(frame: &Frame) -> Option<[&[f32]; 3]> {
+    frame.cell?;
+    let flags = [
+        frame.property("ix")?,
+        frame.property("iy")?,
+        frame.property("iz")?,
+    ];
+    let whole = |v: &f32| v.fract() == 0.0 && v.abs() <= 1e9;
+    flags.iter().all(|f| f.iter().all(whole)).then_some(flags)
 }
 
 /// The properties `vx vy vz` (a data file's velocities, in the run's units), if the frame has
@@ -144,11 +177,13 @@ pub(crate) fn data_box(cell: &UnitCell) -> DataBox {
     // Tilts beyond half an edge, along a periodic edge, become an equivalent lattice's.
     let periodic = cell.periodic();
     let reduce = |tilt: f64, edge: f64| (tilt / edge).round();
+    let mut reduced = [0.0; 3];
     if periodic[1] {
         let k = reduce(r[2][1], r[1][1]);
         if r[2][1].abs() > 0.5 * r[1][1] + tol && k != 0.0 {
             r[2][0] -= k * r[1][0];
             r[2][1] -= k * r[1][1];
+            reduced[0] = k;
         }
     }
     if periodic[0] {
@@ -156,6 +191,7 @@ pub(crate) fn data_box(cell: &UnitCell) -> DataBox {
             let k = reduce(r[row][0], r[0][0]);
             if r[row][0].abs() > 0.5 * r[0][0] + tol && k != 0.0 {
                 r[row][0] -= k * r[0][0];
+                reduced[row] = k;
             }
         }
     }
@@ -166,6 +202,7 @@ pub(crate) fn data_box(cell: &UnitCell) -> DataBox {
         hi: [o[0] + r[0][0], o[1] + r[1][1], o[2] + r[2][2]],
         tilt: [xy, xz, yz],
         rotate,
+        reduced,
     }
 }
 
@@ -185,6 +222,7 @@ pub(crate) fn bounding_box(positions: &[[f32; 3]]) -> DataBox {
         lo: lo.map(|v| v - 1.0),
         hi: hi.map(|v| v + 1.0),
         tilt: [0.0; 3],
+        reduced: [0.0; 3],
         rotate: None,
     }
 }
@@ -416,6 +454,7 @@ impl<W: Write> LammpsDataWriter<W> {
             }
         }
         writeln!(w, "\nAtoms # {}\n", plan.style.name())?;
+        let images = data_images(frame);
         for (i, &p) in frame.positions.iter().enumerate() {
             let p = b.rotate.as_ref().map_or(p, |r| r.apply(p));
             write!(w, "{}", i + 1)?;
@@ -426,7 +465,12 @@ impl<W: Write> LammpsDataWriter<W> {
             if let Some(q) = &plan.charges {
                 write!(w, " {}", Num(q[i]))?;
             }
-            writeln!(w, " {} {} {}", p[0], p[1], p[2])?;
+            write!(w, " {} {} {}", p[0], p[1], p[2])?;
+            if let Some([ix, iy, iz]) = images {
+                let n = b.image([ix[i], iy[i], iz[i]].map(f64::from));
+                write!(w, " {} {} {}", n[0] as i64, n[1] as i64, n[2] as i64)?;
+            }
+            writeln!(w)?;
         }
         if let Some([vx, vy, vz]) = data_velocities(frame) {
             writeln!(w, "\nVelocities\n")?;

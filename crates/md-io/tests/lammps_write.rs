@@ -301,3 +301,67 @@ fn velocities_turn_with_a_rotated_box() {
     }
     assert!(moved[1] != d[1] || moved[2] != d[2], "the box was rotated");
 }
+
+/// Image flags are written in the Atoms lines, and recomputed for the lattice a large tilt is
+/// reduced to: every atom's unwrapped position (position + flags · cell) is the same in our
+/// file as read back and in the file LAMMPS's `read_data`/`write_data` makes of it.
+#[test]
+fn image_flags_survive_a_reduced_tilt_and_lammps() {
+    // xy = 7 > 10/2, yz = -6 < -9/2 and then xz = 10 > 5: all three tilts reduced.
+    let cell = UnitCell::from_matrix([[10.0, 0.0, 0.0], [7.0, 9.0, 0.0], [3.0, -6.0, 8.0]])
+        .unwrap()
+        .with_origin([-1.0, 2.0, 0.5]);
+    let m = cell.matrix();
+    let mut f = Frame::new();
+    let mut flags = [Vec::new(), Vec::new(), Vec::new()];
+    for i in 0..24u32 {
+        // Fractional positions inside the cell, flags from -2 to 2.
+        let s = [
+            0.05 + 0.037 * i as f64,
+            0.9 - 0.031 * i as f64,
+            (0.13 * i as f64).fract(),
+        ];
+        let p: [f32; 3] = std::array::from_fn(|k| {
+            (cell.origin()[k] + s[0] * m[0][k] + s[1] * m[1][k] + s[2] * m[2][k]) as f32
+        });
+        f.positions.push(p);
+        f.types
+            .push(texmap_md_io::Label::new(if i % 2 == 0 { "1" } else { "2" }).unwrap());
+        for (k, fl) in flags.iter_mut().enumerate() {
+            fl.push(((i as i32 * (k as i32 + 2)) % 5 - 2) as f32);
+        }
+    }
+    f.cell = Some(cell);
+    f.properties.push(texmap_md_io::Property {
+        name: "mass".into(),
+        values: vec![39.95; f.positions.len()],
+    });
+    for (name, values) in ["ix", "iy", "iz"].into_iter().zip(flags) {
+        f.properties.push(texmap_md_io::Property {
+            name: name.into(),
+            values,
+        });
+    }
+    let want = unwrapped(&f);
+    let text = written(std::slice::from_ref(&f)).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let ours = dir.path().join("in.data");
+    std::fs::write(&ours, &text).unwrap();
+    let mine = read(&ours);
+    let tilts = mine.cell.unwrap().matrix();
+    assert!(tilts[1][0].abs() <= 5.0 && tilts[2][0].abs() <= 5.0 && tilts[2][1].abs() <= 4.5);
+    let close = |got: &[[f64; 3]], who: &str| {
+        for (i, (a, b)) in want.iter().zip(got).enumerate() {
+            for k in 0..3 {
+                assert!(
+                    (a[k] - b[k]).abs() <= 1e-4,
+                    "{who}: atom {i} {a:?} against {b:?}"
+                );
+            }
+        }
+    };
+    close(&unwrapped(&mine), "ours");
+    if let Some(back) = lammps_rewrite(dir.path(), "atomic") {
+        close(&unwrapped(&back), "LAMMPS");
+    }
+}
