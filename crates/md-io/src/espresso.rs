@@ -47,6 +47,14 @@
 //!   unknown.
 //! - Forces from `Forces acting on atoms (cartesian axes, Ry/au)` as the properties `fx fy fz`
 //!   in eV/Å (the names a LAMMPS dump's force columns have: `--arrows f` draws them).
+//! - Magnetic moments of a spin-polarised run (`nspin = 2`) from `Magnetic moment per site` as
+//!   the property `magmom` (μB; the name the ASE .traj reader gives them): the `magn:` column
+//!   of pw.x 6.7's lines (`atom:    1    charge:    6.2918    magn:    3.3015    constr:
+//!   0.0000`), or `magn=` of later versions' (`atom      1 (R=0.190)  charge=  6.3520  magn=
+//!   2.2160`). pw.x prints a block after each step's scf (and every `report` iterations when
+//!   asked): the step's last block is its moments. ASE 3.29 takes each line's last field, in
+//!   6.7's format the constraint (`constr:`), so its moments of these files are all 0. An
+//!   input's `starting_magnetization(i)` is a starting guess, not a moment: not read.
 //! - The energy (`!    total energy`, the first of the step, as ASE takes it) in eV and the
 //!   stress (`total   stress`, its Ry/bohr³ columns) in eV/Å³ with ASE's sign (the negative
 //!   of pw.x's), in the frame's comment as extended XYZ writes them: `energy=-212.3134
@@ -61,36 +69,66 @@
 //! # The input
 //! Namelists (`&CONTROL`, `&SYSTEM`, … closed by `/`; `key = value` pairs separated by commas
 //! or line ends, `!` comments, quoted strings, reals with a Fortran exponent such as `1.0d-8`)
-//! then cards. From `&SYSTEM`: `ibrav`, `celldm(1..3)` (bohr; b/a, c/a) or `A`, `B`, `C` (Å),
-//! `nat`, `ntyp`. Cards: `ATOMIC_SPECIES` (ntyp lines: label, mass, pseudopotential file; the
+//! then cards. From `&SYSTEM`: `ibrav`, `celldm(1..6)` (celldm(1) in bohr; b/a, c/a and
+//! cosines) or `A`, `B`, `C` (Å) with `cosAB`, `cosAC`, `cosBC`, `nat`, `ntyp`. Cards: `ATOMIC_SPECIES` (ntyp lines: label, mass, pseudopotential file; the
 //! element from the label as above, else from the file's name, `Fe.pbe-….UPF`),
 //! `ATOMIC_POSITIONS` (nat lines in alat, bohr, angstrom or crystal units; none is alat, pw.x's
 //! deprecated default; `crystal_sg` is refused; coordinates may be expressions as pw.x allows:
 //! `1/3`, `2*0.25`, `(1+2)/3^2`), `CELL_PARAMETERS` (3 lines in alat, bohr or angstrom; none is
 //! bohr without a lattice parameter, else alat, as pw.x and ASE read it). Other cards
-//! (`K_POINTS`, `OCCUPATIONS`, `CONSTRAINTS`, …) are read past. The cell by `ibrav`, as pw.x's
-//! `latgen` builds it (a = alat, vectors as rows):
+//! (`K_POINTS`, `OCCUPATIONS`, `CONSTRAINTS`, …) are read past. The cell by `ibrav`, as pw.x
+//! 6.7's `latgen` builds it (INPUT_PW, `ibrav`; vectors as rows; a = celldm(1) or A, b = a
+//! celldm(2) or B, c = a celldm(3) or C; cos α, cos β, cos γ the cosines of the angles between
+//! b and c, a and c, a and b):
 //!
 //! | ibrav | lattice | v1, v2, v3 |
 //! |---|---|---|
 //! | 0 | from `CELL_PARAMETERS` | |
-//! | 1 | simple cubic | a(1,0,0), a(0,1,0), a(0,0,1) |
+//! | 1 | simple cubic | (a,0,0), (0,a,0), (0,0,a) |
 //! | 2 | face-centred cubic | (a/2)(−1,0,1), (a/2)(0,1,1), (a/2)(−1,1,0) |
 //! | 3 | body-centred cubic | (a/2)(1,1,1), (a/2)(−1,1,1), (a/2)(−1,−1,1) |
-//! | 4 | hexagonal | a(1,0,0), a(−1/2,√3/2,0), a(0,0,c/a) |
-//! | 6 | simple tetragonal | a(1,0,0), a(0,1,0), a(0,0,c/a) |
-//! | 8 | simple orthorhombic | a(1,0,0), a(0,b/a,0), a(0,0,c/a) |
+//! | −3 | bcc, more symmetric axes | (a/2)(−1,1,1), (a/2)(1,−1,1), (a/2)(1,1,−1) |
+//! | 4 | hexagonal | (a,0,0), (−a/2,a√3/2,0), (0,0,c) |
+//! | 5 | trigonal R, 3-fold axis z | a(tx,−ty,tz), a(0,2ty,tz), a(−tx,−ty,tz) |
+//! | −5 | trigonal R, 3-fold axis (111) | (u,v,v), (v,u,v), (v,v,u) |
+//! | 6 | simple tetragonal | (a,0,0), (0,a,0), (0,0,c) |
+//! | 7 | body-centred tetragonal | (a/2,−a/2,c/2), (a/2,a/2,c/2), (−a/2,−a/2,c/2) |
+//! | 8 | simple orthorhombic | (a,0,0), (0,b,0), (0,0,c) |
+//! | 9 | base-centred orthorhombic (C) | (a/2,b/2,0), (−a/2,b/2,0), (0,0,c) |
+//! | −9 | the same, other axes | (a/2,−b/2,0), (a/2,b/2,0), (0,0,c) |
+//! | 91 | base-centred orthorhombic (A) | (a,0,0), (0,b/2,−c/2), (0,b/2,c/2) |
+//! | 10 | face-centred orthorhombic | (a/2,0,c/2), (a/2,b/2,0), (0,b/2,c/2) |
+//! | 11 | body-centred orthorhombic | (a/2,b/2,c/2), (−a/2,b/2,c/2), (−a/2,−b/2,c/2) |
+//! | 12 | monoclinic, unique axis c | (a,0,0), (b cos γ,b sin γ,0), (0,0,c) |
+//! | −12 | monoclinic, unique axis b | (a,0,0), (0,b,0), (c cos β,0,c sin β) |
+//! | 13 | base-centred monoclinic, axis c | (a/2,0,−c/2), (b cos γ,b sin γ,0), (a/2,0,c/2) |
+//! | −13 | base-centred monoclinic, axis b | (a/2,b/2,0), (−a/2,b/2,0), (c cos β,0,c sin β) |
+//! | 14 | triclinic | (a,0,0), (b cos γ,b sin γ,0), (c cos β, c(cos α − cos β cos γ)/sin γ, c√(1 + 2 cos α cos β cos γ − cos²α − cos²β − cos²γ)/sin γ) |
 //!
-//! Any other ibrav is an error naming it (give the cell as `CELL_PARAMETERS` with ibrav = 0).
+//! With celldm(4) = cos γ: tx = √((1−cos γ)/2), ty = √((1−cos γ)/6), tz = √((1+2 cos γ)/3);
+//! u = a(√(1+2 cos γ) − 2√(1−cos γ))/3, v = a(√(1+2 cos γ) + √(1−cos γ))/3. The cosines are
+//! celldm(4) (cos γ) for ±5, 12, 13; celldm(5) (cos β) for −12, −13; celldm(4, 5, 6) (cos α,
+//! cos β, cos γ) for 14; 0 when not given. With A, pw.x's `abc2celldm` fills those slots from
+//! cosAB (±5, 12, 13), cosAC (−12, −13) or cosBC, cosAC, cosAB (14), and the lattice reads
+//! nothing else: a cosine meant for another lattice is ignored, as pw.x ignores it. pw.x's
+//! bounds are errors at the parameter's token (at `ibrav` when it is missing): b/a, c/a > 0
+//! where used, cos γ in (−1/2, 1) for ±5, every cosine used in (−1, 1), and for 14 a positive
+//! volume. Any other ibrav is an error naming it. (−13 is pw.x 6.7's definition: until QE
+//! 6.4.1 its v1 and v2 were today's −v2 and v1, and pw.x 6.7 warns `BEWARE: axis for
+//! ibrav=-13 changed` in its output.)
+//!
 //! With ibrav = 0 and a cell in bohr or angstrom, alat is the first vector's length (pw.x's
 //! rule; ASE refuses alat positions then). Both celldm and A, or a lattice parameter with a
 //! cell in bohr or angstrom, are refused, as pw.x refuses them.
 //!
 //! # Units
-//! pw.x 6.7 converts with its own constants (QE `Modules/constants.f90`, CODATA 2006): bohr =
-//! 0.52917720859 Å, Ry = 13.60569193 eV; so does ASE's espresso module (`create_units('2006')`).
-//! They are used here too, so that positions given in Å come back as given (the crate's other
-//! readers use CODATA 2018, `crate::cube::BOHR`; the two differ by 6·10⁻¹⁰ relative).
+//! Bohr and Rydberg are ASE's espresso module's (`create_units('2006')`, CODATA 2006): bohr =
+//! 0.52917720859 Å, Ry = 13.60569193 eV, so that energies, forces and stresses agree with
+//! ASE's reading to rounding. pw.x 6.7 itself uses CODATA 2018 (QE 6.7 `Modules/constants.f90`:
+//! bohr 0.529177210903 Å, as its data file shows: an A of 5.3 Å is 10.01554846052 bohr there),
+//! and so does the crate's `crate::cube::BOHR`: a length pw.x gives in bohr reads here 4.4·10⁻⁹
+//! relative shorter than pw.x meant it, an energy 8.8·10⁻⁸ relative smaller. Lengths given in
+//! Å (positions, `A`, `CELL_PARAMETERS angstrom`) come back as given either way.
 //!
 //! # Damage and memory
 //! Errors name the file, frame, line and byte and what was expected there. Nothing is sized
@@ -106,11 +144,12 @@
 //! A run that stopped with pw.x's `Error in routine` message says so in that error.
 //!
 //! # References
-//! - Quantum ESPRESSO 6.7 `PW/Doc/INPUT_PW` (namelists, cards, ibrav conventions, units) and
-//!   `Modules/latgen.f90`; the outputs read here were written by pw.x 6.7MaX.
+//! - Quantum ESPRESSO 6.7 `PW/Doc/INPUT_PW` (namelists, cards, ibrav conventions, units),
+//!   `Modules/latgen.f90` (`latgen_lib`, `abc2celldm`) and `PW/src/report_mag.f90`; the outputs
+//!   read here were written by pw.x 6.7MaX.
 //! - ASE 3.29 `ase/io/espresso.py` (`read_espresso_out`, `read_espresso_in`), what the tests
-//!   compare with; it reads ibrav = 0 inputs only, so other lattices are checked against the
-//!   geometry pw.x prints for them.
+//!   compare with; it reads ibrav = 0 inputs only, so every other lattice is checked against
+//!   the geometry pw.x printed for it and the one in its data file (all digits).
 
 use crate::elements::Element;
 use crate::error::Error;
@@ -506,8 +545,10 @@ enum Mark {
     Forces,
     /// `total   stress`.
     Stress,
-    /// `Magnetic moment per site`, `End of self-consistent calculation`, `End of band
-    /// structure calculation`: results not read.
+    /// `Magnetic moment per site` (a spin-polarised run's moments).
+    Moments,
+    /// `End of self-consistent calculation`, `End of band structure calculation`: results not
+    /// read.
     Result,
     /// `Molecular Dynamics Calculation`: the first step of a molecular-dynamics run.
     Md,
@@ -555,7 +596,7 @@ fn mark(line: &[u8]) -> Mark {
         Some(b'E') if is(b"Error in routine") => Mark::Failed,
         Some(b'F') if is(b"Forces acting on atoms") => Mark::Forces,
         Some(b't') if is(b"total   stress") => Mark::Stress,
-        Some(b'M') if is(b"Magnetic moment per site") => Mark::Result,
+        Some(b'M') if is(b"Magnetic moment per site") => Mark::Moments,
         Some(b'M') if is(b"Molecular Dynamics Calculation") => Mark::Md,
         Some(b'J') if t == b"JOB DONE." => Mark::Done,
         _ => Mark::Other,
@@ -1125,6 +1166,7 @@ fn results<R: Read>(
     };
     let mut energy = None;
     let mut stress = None;
+    let mut moments: Option<Vec<f32>> = None;
     loop {
         let p = lines.pos();
         let Some((pos, line)) = lines.next_line().map_err(|e| ctx.io(p, e))? else {
@@ -1159,6 +1201,12 @@ fn results<R: Read>(
                     tail.blocks.stress = true;
                 }
             }
+            Mark::Moments => {
+                // pw.x prints them after each scf of the step (every `report` iterations, and
+                // at convergence): the step's last block holds its moments.
+                tail.blocks.any = true;
+                moments = Some(moment_block(lines, ctx, nat)?);
+            }
             Mark::Result => tail.blocks.any = true,
             Mark::Md => tail.md = true,
             Mark::Done => tail.done = true,
@@ -1169,6 +1217,9 @@ fn results<R: Read>(
         }
     }
     if let Some(f) = frame {
+        if let Some(m) = moments {
+            *f.property_mut("magmom") = m;
+        }
         let mut comment = Vec::new();
         if let Some(e) = energy {
             comment.push(format!("energy={e}"));
@@ -1242,6 +1293,45 @@ fn forces<R: Read>(
         i += 1;
     }
     Ok(())
+}
+
+/// The `nat` lines after `Magnetic moment per site:`, the moments (μB) of a spin-polarised run:
+/// `atom:    1    charge:    6.2918    magn:    3.3015    constr:    0.0000` (pw.x 6.7) or
+/// `atom      1 (R=0.190)  charge=  6.3520  magn=  2.2160` (pw.x 6.8 and later).
+fn moment_block<R: Read>(
+    lines: &mut LineReader<R>,
+    ctx: &Ctx,
+    nat: usize,
+) -> Result<Vec<f32>, Error> {
+    const MOMENT: &str = "a moment line: atom n … magn: m (or magn= m), one per atom";
+    let mut out = Vec::with_capacity(nat.min(ctx.reserve));
+    while out.len() < nat {
+        let (pos, line) = need_line_with(lines, ctx, &|| {
+            format!("{} more lines of the magnetic moments", nat - out.len())
+        })?;
+        let t = trim(line);
+        if t.is_empty() && out.is_empty() {
+            continue;
+        }
+        if !t.starts_with(b"atom") {
+            return Err(ctx.parse(pos, line, t, MOMENT));
+        }
+        let f: Vec<&[u8]> = fields(t).collect();
+        let k = f
+            .iter()
+            .position(|x| x.starts_with(b"magn:") || x.starts_with(b"magn="))
+            .ok_or_else(|| ctx.parse(pos, line, t, MOMENT))?;
+        let value = match &f[k][5..] {
+            b"" => f.get(k + 1).copied().unwrap_or(b""),
+            glued => glued,
+        };
+        let m = fortran_f64(value)
+            .map(|m| m as f32)
+            .filter(|m| m.is_finite())
+            .ok_or_else(|| ctx.parse(pos, line, value, MOMENT))?;
+        out.push(m);
+    }
+    Ok(out)
 }
 
 /// The three lines after `total   stress  (Ry/bohr**3)  (kbar)  P= …`: the stress tensor (its
@@ -1628,6 +1718,36 @@ fn real(ctx: &Ctx, system: &System, key: &[u8]) -> Result<Option<f64>, Error> {
     }
 }
 
+/// The lattices pw.x 6.7 builds from `ibrav` (QE `Modules/latgen.f90`), by name.
+fn lattice_name(ibrav: i64) -> Option<&'static str> {
+    Some(match ibrav {
+        1 => "simple cubic",
+        2 => "face-centred cubic",
+        3 | -3 => "body-centred cubic",
+        4 => "hexagonal",
+        5 | -5 => "trigonal R",
+        6 => "simple tetragonal",
+        7 => "body-centred tetragonal",
+        8 => "simple orthorhombic",
+        9 | -9 => "base-centred orthorhombic (C)",
+        91 => "base-centred orthorhombic (A)",
+        10 => "face-centred orthorhombic",
+        11 => "body-centred orthorhombic",
+        12 | -12 => "monoclinic",
+        13 | -13 => "base-centred monoclinic",
+        14 => "triclinic",
+        _ => return None,
+    })
+}
+
+/// One of pw.x's cell parameters celldm(2..6) for the lattice: its value (0 when not given, as
+/// pw.x's default) and the token that gave it, if one did.
+#[derive(Clone, Copy)]
+struct Param<'a> {
+    value: f64,
+    from: Option<&'a Value>,
+}
+
 /// The cell (rows, Å), the lattice parameter alat (Å) for positions in alat units and the
 /// cell checked, from ibrav and its parameters or `CELL_PARAMETERS`.
 fn lattice(
@@ -1639,17 +1759,43 @@ fn lattice(
     let Some(ibrav) = system.get(&b"ibrav"[..]) else {
         return Err(ctx.parse(system_pos, b"&SYSTEM", b"&SYSTEM", "ibrav in &SYSTEM"));
     };
-    let celldm = |i: usize| real(ctx, system, format!("celldm({i})").as_bytes());
-    let (c1, c2, c3) = (celldm(1)?, celldm(2)?, celldm(3)?);
-    let (a, b, c) = (
-        real(ctx, system, b"a")?,
-        real(ctx, system, b"b")?,
-        real(ctx, system, b"c")?,
-    );
-    let given = |v: Option<f64>| v.filter(|x| *x != 0.0);
     let n = parse_i64(&ibrav.text)
         .ok_or_else(|| ctx.parse(ibrav.pos, &ibrav.text, &ibrav.text, "ibrav: an integer"))?;
-    if given(c1).is_some() && given(a).is_some() {
+    // Every real of &SYSTEM the lattice may use, read (and so checked) whether used or not.
+    let mut given = BTreeMap::new();
+    for key in [
+        "celldm(1)",
+        "celldm(2)",
+        "celldm(3)",
+        "celldm(4)",
+        "celldm(5)",
+        "celldm(6)",
+        "a",
+        "b",
+        "c",
+        "cosab",
+        "cosac",
+        "cosbc",
+    ] {
+        if let Some(v) = real(ctx, system, key.as_bytes())? {
+            given.insert(key, (v, &system[key.as_bytes()]));
+        }
+    }
+    let param = |key: &str| {
+        given.get(key).map_or(
+            Param {
+                value: 0.0,
+                from: None,
+            },
+            |&(value, v)| Param {
+                value,
+                from: Some(v),
+            },
+        )
+    };
+    let nonzero = |key: &str| given.get(key).map(|g| g.0).filter(|x| *x != 0.0);
+    let (c1, abc) = (nonzero("celldm(1)"), nonzero("a"));
+    if c1.is_some() && abc.is_some() {
         return Err(ctx.parse(
             system_pos,
             b"&SYSTEM",
@@ -1657,12 +1803,8 @@ fn lattice(
             "celldm(1) or A in &SYSTEM, not both (pw.x refuses both)",
         ));
     }
-    // alat (Å), b/a, c/a.
-    let alat = given(c1).map(|x| x * BOHR).or(given(a));
-    let (ba, ca) = match given(a) {
-        Some(a) => (b.map(|b| b / a), c.map(|c| c / a)),
-        None => (c2, c3),
-    };
+    // alat (Å).
+    let alat = c1.map(|x| x * BOHR).or(abc);
     if n == 0 {
         let Some((Card { pos, line, units }, m)) = cell else {
             return Err(ctx.parse(
@@ -1707,10 +1849,9 @@ fn lattice(
             "no CELL_PARAMETERS with ibrav ≠ 0 (pw.x builds the cell from ibrav and refuses both)",
         ));
     }
-    const IBRAV: &str = "ibrav 0, 1, 2, 3, 4, 6 or 8 (0 with CELL_PARAMETERS; simple cubic, fcc, \
-                         bcc, hexagonal, simple tetragonal, simple orthorhombic): another lattice \
-                         can be given as CELL_PARAMETERS with ibrav = 0";
-    if !matches!(n, 1 | 2 | 3 | 4 | 6 | 8) {
+    const IBRAV: &str = "ibrav 0 (with CELL_PARAMETERS), 1, 2, 3, -3, 4, 5, -5, 6, 7, 8, 9, -9, \
+                         91, 10, 11, 12, -12, 13, -13 or 14 (the lattices of pw.x 6.7)";
+    let Some(name) = lattice_name(n) else {
         return Err(error_at(
             ctx,
             ibrav.pos,
@@ -1719,7 +1860,7 @@ fn lattice(
             IBRAV,
             format!("ibrav = {n}"),
         ));
-    }
+    };
     let Some(a) = alat.filter(|a| *a > 0.0) else {
         return Err(ctx.parse(
             ibrav.pos,
@@ -1728,31 +1869,199 @@ fn lattice(
             "celldm(1) or A > 0 in &SYSTEM: the lattice parameter ibrav needs",
         ));
     };
-    let ratio = |r: Option<f64>, expected: &'static str| {
-        r.filter(|r| *r > 0.0)
-            .ok_or_else(|| ctx.parse(ibrav.pos, &ibrav.text, &ibrav.text, expected))
+    // celldm(2..6) as pw.x's abc2celldm makes them from A, B, C, cosAB, cosAC, cosBC: b/a, c/a,
+    // then the cosines in the slots this ibrav reads (celldm(4) = cos γ for 5, -5, 12, 13;
+    // celldm(5) = cos β for -12, -13; cos α, cos β, cos γ for 14); other slots are 0.
+    let p: [Param; 5] = if abc.is_some() {
+        let ratio = |key: &str| {
+            let q = param(key);
+            Param {
+                value: q.value / a,
+                ..q
+            }
+        };
+        let zero = Param {
+            value: 0.0,
+            from: None,
+        };
+        let (c4, c5, c6) = match n {
+            14 => (param("cosbc"), param("cosac"), param("cosab")),
+            -12 | -13 => (zero, param("cosac"), zero),
+            5 | -5 | 12 | 13 => (param("cosab"), zero, zero),
+            _ => (zero, zero, zero),
+        };
+        [ratio("b"), ratio("c"), c4, c5, c6]
+    } else {
+        std::array::from_fn(|k| {
+            param(
+                [
+                    "celldm(2)",
+                    "celldm(3)",
+                    "celldm(4)",
+                    "celldm(5)",
+                    "celldm(6)",
+                ][k],
+            )
+        })
     };
+    // A parameter the lattice needs, within pw.x's bounds, or the error at its token (at ibrav
+    // when it is not given).
+    let need = |k: usize, ok: fn(f64) -> bool, expected: &'static str| -> Result<f64, Error> {
+        let q = p[k - 2];
+        if ok(q.value) {
+            return Ok(q.value);
+        }
+        Err(match q.from {
+            Some(v) => ctx.parse(v.pos, &v.text, &v.text, expected),
+            None => error_at(
+                ctx,
+                ibrav.pos,
+                &ibrav.text,
+                &ibrav.text,
+                expected,
+                format!("ibrav = {n} ({name}) without it"),
+            ),
+        })
+    };
+    const B: &str = "celldm(2) (b/a) or B > 0 in &SYSTEM, which this ibrav needs";
+    const C: &str = "celldm(3) (c/a) or C > 0 in &SYSTEM, which this ibrav needs";
+    let positive = |x: f64| x > 0.0;
+    let cosine = |x: f64| x.abs() < 1.0;
+    let ba = || need(2, positive, B);
+    let ca = || need(3, positive, C);
     let h = a / 2.0;
+    // The vectors of QE's latgen (INPUT_PW, `ibrav`), in Å.
     let m = match n {
         1 => [[a, 0.0, 0.0], [0.0, a, 0.0], [0.0, 0.0, a]],
         2 => [[-h, 0.0, h], [0.0, h, h], [-h, h, 0.0]],
         3 => [[h, h, h], [-h, h, h], [-h, -h, h]],
+        -3 => [[-h, h, h], [h, -h, h], [h, h, -h]],
         4 => {
-            let ca = ratio(ca, "celldm(3) (c/a) or C > 0 in &SYSTEM for ibrav = 4")?;
+            let c = a * ca()?;
             [
                 [a, 0.0, 0.0],
                 [-h, a * 3f64.sqrt() / 2.0, 0.0],
-                [0.0, 0.0, a * ca],
+                [0.0, 0.0, c],
             ]
         }
-        6 => {
-            let ca = ratio(ca, "celldm(3) (c/a) or C > 0 in &SYSTEM for ibrav = 6")?;
-            [[a, 0.0, 0.0], [0.0, a, 0.0], [0.0, 0.0, a * ca]]
+        5 | -5 => {
+            let g = need(
+                4,
+                |x| x > -0.5 && x < 1.0,
+                "celldm(4) (cos γ; cosAB with A) in (-1/2, 1) for ibrav = 5 or -5",
+            )?;
+            if n == 5 {
+                // Three-fold axis along z.
+                let tx = ((1.0 - g) / 2.0).sqrt();
+                let ty = ((1.0 - g) / 6.0).sqrt();
+                let tz = ((1.0 + 2.0 * g) / 3.0).sqrt();
+                [
+                    [a * tx, -a * ty, a * tz],
+                    [0.0, 2.0 * a * ty, a * tz],
+                    [-a * tx, -a * ty, a * tz],
+                ]
+            } else {
+                // Three-fold axis along (1,1,1).
+                let (t1, t2) = ((1.0 + 2.0 * g).sqrt(), (1.0 - g).sqrt());
+                let u = a * (t1 - 2.0 * t2) / 3.0;
+                let v = a * (t1 + t2) / 3.0;
+                [[u, v, v], [v, u, v], [v, v, u]]
+            }
+        }
+        6 => [[a, 0.0, 0.0], [0.0, a, 0.0], [0.0, 0.0, a * ca()?]],
+        7 => {
+            let hc = h * ca()?;
+            [[h, -h, hc], [h, h, hc], [-h, -h, hc]]
+        }
+        8 => [[a, 0.0, 0.0], [0.0, a * ba()?, 0.0], [0.0, 0.0, a * ca()?]],
+        9 | -9 => {
+            let (hb, c) = (h * ba()?, a * ca()?);
+            if n == 9 {
+                [[h, hb, 0.0], [-h, hb, 0.0], [0.0, 0.0, c]]
+            } else {
+                [[h, -hb, 0.0], [h, hb, 0.0], [0.0, 0.0, c]]
+            }
+        }
+        91 => {
+            let (hb, hc) = (h * ba()?, h * ca()?);
+            [[a, 0.0, 0.0], [0.0, hb, -hc], [0.0, hb, hc]]
+        }
+        10 => {
+            let (hb, hc) = (h * ba()?, h * ca()?);
+            [[h, 0.0, hc], [h, hb, 0.0], [0.0, hb, hc]]
+        }
+        11 => {
+            let (hb, hc) = (h * ba()?, h * ca()?);
+            [[h, hb, hc], [-h, hb, hc], [-h, -hb, hc]]
+        }
+        12 | 13 => {
+            let (b, c) = (a * ba()?, a * ca()?);
+            let g = need(
+                4,
+                cosine,
+                "celldm(4) (cos γ; cosAB with A) in (-1, 1) for ibrav = 12 or 13",
+            )?;
+            let v2 = [b * g, b * (1.0 - g * g).sqrt(), 0.0];
+            if n == 12 {
+                [[a, 0.0, 0.0], v2, [0.0, 0.0, c]]
+            } else {
+                [[h, 0.0, -c / 2.0], v2, [h, 0.0, c / 2.0]]
+            }
+        }
+        -12 | -13 => {
+            let (b, c) = (a * ba()?, a * ca()?);
+            let beta = need(
+                5,
+                cosine,
+                "celldm(5) (cos β; cosAC with A) in (-1, 1) for ibrav = -12 or -13",
+            )?;
+            let v3 = [c * beta, 0.0, c * (1.0 - beta * beta).sqrt()];
+            if n == -12 {
+                [[a, 0.0, 0.0], [0.0, b, 0.0], v3]
+            } else {
+                [[h, b / 2.0, 0.0], [-h, b / 2.0, 0.0], v3]
+            }
         }
         _ => {
-            let ba = ratio(ba, "celldm(2) (b/a) or B > 0 in &SYSTEM for ibrav = 8")?;
-            let ca = ratio(ca, "celldm(3) (c/a) or C > 0 in &SYSTEM for ibrav = 8")?;
-            [[a, 0.0, 0.0], [0.0, a * ba, 0.0], [0.0, 0.0, a * ca]]
+            // 14, triclinic.
+            let (b, c) = (a * ba()?, a * ca()?);
+            let al = need(
+                4,
+                cosine,
+                "celldm(4) (cos α; cosBC with A) in (-1, 1) for ibrav = 14",
+            )?;
+            let be = need(
+                5,
+                cosine,
+                "celldm(5) (cos β; cosAC with A) in (-1, 1) for ibrav = 14",
+            )?;
+            let ga = need(
+                6,
+                cosine,
+                "celldm(6) (cos γ; cosAB with A) in (-1, 1) for ibrav = 14",
+            )?;
+            let sin_ga = (1.0 - ga * ga).sqrt();
+            let term = 1.0 + 2.0 * al * be * ga - al * al - be * be - ga * ga;
+            if term < 0.0 {
+                return Err(error_at(
+                    ctx,
+                    ibrav.pos,
+                    &ibrav.text,
+                    &ibrav.text,
+                    "cosines of the three angles of a cell with volume > 0 (1 + 2 cos α cos β \
+                     cos γ − cos²α − cos²β − cos²γ > 0) for ibrav = 14",
+                    format!("cos α {al}, cos β {be}, cos γ {ga}"),
+                ));
+            }
+            [
+                [a, 0.0, 0.0],
+                [b * ga, b * sin_ga, 0.0],
+                [
+                    c * be,
+                    c * (al - be * ga) / sin_ga,
+                    c * (term / (1.0 - ga * ga)).sqrt(),
+                ],
+            ]
         }
     };
     Ok((m, a, cell_of(ctx, ibrav.pos, &ibrav.text, m)?))

@@ -1,15 +1,20 @@
 //! Quantum ESPRESSO pw.x outputs and inputs written and run by pw.x 6.7 (tests/data/espresso/
 //! gen.sh), compared with ASE 3.29's reading of the same files (gen_reference.py) and, for the
 //! inputs ASE does not read (ibrav ≠ 0, alat positions with a cell in angstrom), with the
-//! geometry pw.x itself printed for them.
+//! geometry pw.x itself printed for them and, for the lattices of the scf runs that left their
+//! data file, the geometry in that file with all its digits. Magnetic moments, which ASE reads
+//! wrongly from pw.x 6.7's lines, are compared with the file's numbers read by plain text
+//! matching.
 //!
 //! Tolerances. Positions are f32 in a [`Frame`]: below 16 Å an f32 rounds to within 4.8e-7 Å,
-//! and ASE's espresso units differ from pw.x's (used here) by 4.6e-10 relative, so 1e-6 Å
-//! bounds both. Cells are f64: 1e-8 Å (the units' difference times 10 Å, with margin). Forces
-//! are f32: 1e-6 eV/Å plus 1e-7 relative. Energies: 1e-9 relative (the Rydbergs differ by
-//! 1.9e-10); stresses 3e-9 relative (Ry/bohr³: the bohrs' difference three times over). An input against pw.x's header is bounded by the header's printed digits: crystal
-//! axes with 6 decimals of alat, positions with 7 (so 5e-7 alat and 5e-8 alat, plus f32), alat
-//! at most twice the longest cell vector for the lattices read here.
+//! and ASE's espresso units differ from the CODATA 2006 constants used here (the module doc's
+//! Units) by 4.6e-10 relative, so 1e-6 Å bounds both. Cells are f64: 1e-8 Å (the units'
+//! difference times 10 Å, with margin). Forces are f32: 1e-6 eV/Å plus 1e-7 relative.
+//! Energies: 1e-9 relative (the Rydbergs differ by 1.9e-10); stresses 3e-9 relative
+//! (Ry/bohr³: the bohrs' difference three times over). An input against pw.x's header is
+//! bounded by the header's printed digits: crystal axes with 6 decimals of alat, positions with
+//! 7 (so 5e-7 alat and 5e-8 alat, plus f32), alat at most twice the longest cell vector for the
+//! lattices read here.
 
 use crate::support;
 
@@ -30,7 +35,7 @@ fn reference() -> Value {
     serde_json::from_str(&std::fs::read_to_string(path("reference.json")).unwrap()).unwrap()
 }
 
-const OUTPUTS: [&str; 10] = [
+const OUTPUTS: [&str; 25] = [
     "si_relax",
     "si_md",
     "si_vcrelax",
@@ -41,6 +46,21 @@ const OUTPUTS: [&str; 10] = [
     "ibrav4_hex",
     "ibrav6_tet",
     "ibrav8_ortho",
+    "ibrav5_trig",
+    "ibravm5_trig111",
+    "ibravm3_bcc",
+    "ibrav7_bct",
+    "ibrav9_baseco",
+    "ibravm9_baseco",
+    "ibrav91_aco",
+    "ibrav10_fco",
+    "ibrav11_bco",
+    "ibrav12_mono",
+    "ibravm12_mono",
+    "ibrav13_cmono",
+    "ibravm13_cmono",
+    "ibrav14_tri",
+    "fe_relax_mag",
 ];
 
 fn rows(v: &Value) -> Vec<[f64; 3]> {
@@ -298,7 +318,15 @@ fn inputs_as_pwx_and_ase_read_them() {
         );
         worst[1] = worst[1].max(dp);
         let symbols: Vec<&str> = f.elements.iter().map(|e| e.symbol()).collect();
-        assert!(symbols.iter().all(|s| *s == "Si"), "{name}: {symbols:?}");
+        let want: Vec<&str> = header["symbols"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|s| s.as_str().unwrap())
+            .collect();
+        assert_eq!(symbols, want, "{name}");
+        // starting_magnetization is no moment.
+        assert!(f.property("magmom").is_none(), "{name}");
         // ASE's reading, where it reads the file.
         if let Some(w) = r["inputs"][name]["frame"].as_object() {
             read_by_ase += 1;
@@ -321,6 +349,278 @@ fn inputs_as_pwx_and_ase_read_them() {
     let f = read_all(&mut t).remove(0);
     let names: Vec<&str> = f.names.iter().map(|l| l.as_str()).collect();
     assert_eq!(names, ["Si1", "Si2"]);
+}
+
+/// Every lattice pw.x 6.7 builds from ibrav (from celldm(1..6) or from A, B, C and the cosines)
+/// as pw.x built it: the cell and Cartesian positions of its data file
+/// (data-file-schema.xml, all digits, converted to Å with pw.x's own bohr). Tolerances: cells
+/// are f64; a lattice given by A, B, C (Å) is pw.x's to rounding and latgen's 13-digit √2 and
+/// √3 (1e-13 relative), one given by celldm (bohr) differs by the ratio of pw.x 6.7's bohr
+/// (CODATA 2018) to the one read here (ASE's, CODATA 2006), 4.4e-9: 5e-9 of the longest vector
+/// plus 1e-12 Å; positions are f32: 1e-6 Å.
+#[test]
+fn every_lattice_as_pwx_built_it() {
+    let r = reference();
+    let mut worst = [0.0f64; 2];
+    let mut worst_abc = 0.0f64;
+    let mut lattices = Vec::new();
+    for (name, input) in r["inputs"].as_object().unwrap() {
+        let Some(xml) = input.get("xml") else {
+            continue;
+        };
+        let mut t = Trajectory::open(path(&format!("{name}.pwi"))).unwrap();
+        let f = read_all(&mut t).remove(0);
+        let want = rows(&xml["cell"]);
+        let longest = want
+            .iter()
+            .map(|v| v.iter().map(|x| x * x).sum::<f64>().sqrt())
+            .fold(0.0, f64::max);
+        let tol = 5e-9 * longest + 1e-12;
+        let dc = max_dev(&cell(&f), &want);
+        assert!(
+            dc <= tol,
+            "{name}: cell off pw.x's by {dc} Å (tolerance {tol})"
+        );
+        // By A, B, C (Å): no bohr between the input and the cell.
+        let by_abc = std::fs::read_to_string(path(&format!("{name}.pwi")))
+            .unwrap()
+            .contains(" A = ");
+        if by_abc {
+            assert!(dc <= 1e-12 * longest, "{name}: {dc} Å");
+            worst_abc = worst_abc.max(dc);
+        }
+        let dp = max_dev(&positions(&f), &rows(&xml["positions"]));
+        assert!(
+            dp <= 1e-6,
+            "{name}: positions off pw.x's by {dp} Å (tolerance 1e-6)"
+        );
+        worst = [worst[0].max(dc), worst[1].max(dp)];
+        let ibrav = std::fs::read_to_string(path(&format!("{name}.pwi")))
+            .unwrap()
+            .split("ibrav = ")
+            .nth(1)
+            .unwrap()
+            .split(',')
+            .next()
+            .unwrap()
+            .to_string();
+        lattices.push(ibrav.parse::<i64>().unwrap());
+    }
+    lattices.sort();
+    assert_eq!(
+        lattices,
+        [-13, -12, -9, -5, -3, 5, 7, 9, 10, 11, 12, 13, 14, 91],
+        "every ibrav the older fixtures leave out"
+    );
+    println!(
+        "{} lattices as pw.x built them; largest deviations: cells {:.1e} Å ({:.1e} Å by A, B, \
+         C), positions {:.1e} Å",
+        lattices.len(),
+        worst[0],
+        worst_abc,
+        worst[1]
+    );
+}
+
+/// pw.x's abc2celldm: with A, the cosines go to the celldm slot each lattice reads (cos α, cos β,
+/// cos γ as celldm(4..6) for ibrav 14; cosAC as celldm(5) for -12 and -13; cosAB as celldm(4)
+/// for ±5, 12, 13), and a cosine the lattice does not read is ignored as pw.x ignores it.
+#[test]
+fn cosines_as_celldm() {
+    let read = |text: String| {
+        let mut t =
+            Trajectory::from_reader(Cursor::new(text), Format::EspressoIn, "x.pwi").unwrap();
+        read_all(&mut t).remove(0)
+    };
+    const BOHR: f64 = 0.529_177_208_59;
+    let cases = [
+        (
+            "ibrav14_tri",
+            "A = 4.1, B = 4.6, C = 5.2, cosAB = 0.1, cosAC = 0.2, cosBC = 0.3",
+            format!(
+                "celldm(1) = {}, celldm(2) = {}, celldm(3) = {}, celldm(4) = 0.3, celldm(5) = 0.2, celldm(6) = 0.1",
+                4.1 / BOHR,
+                4.6 / 4.1,
+                5.2 / 4.1
+            ),
+        ),
+        (
+            "ibravm13_cmono",
+            "A = 4.2, B = 4.0, C = 5.0, cosAC = 0.3",
+            format!(
+                "celldm(1) = {}, celldm(2) = {}, celldm(3) = {}, celldm(5) = 0.3, cosAB = 0.7",
+                4.2 / BOHR,
+                4.0 / 4.2,
+                5.0 / 4.2
+            ),
+        ),
+        (
+            "ibrav12_mono",
+            "A = 4.0, B = 4.5, C = 5.0, cosAB = 0.2",
+            format!(
+                "celldm(1) = {}, celldm(2) = {}, celldm(3) = {}, celldm(4) = 0.2, celldm(5) = 0.9",
+                4.0 / BOHR,
+                4.5 / 4.0,
+                5.0 / 4.0
+            ),
+        ),
+    ];
+    for (name, abc, celldm) in cases {
+        let text = std::fs::read_to_string(path(&format!("{name}.pwi"))).unwrap();
+        assert!(text.contains(abc), "{name}");
+        let by_abc = read(text.clone());
+        let by_celldm = read(text.replace(abc, &celldm));
+        let d = max_dev(&cell(&by_abc), &cell(&by_celldm));
+        assert!(d <= 1e-12, "{name}: {d} Å");
+    }
+}
+
+/// Cell parameters out of pw.x's bounds are errors at their token (or at ibrav when missing).
+#[test]
+fn lattice_parameters_out_of_bounds() {
+    let err = |name: &str, from: &str, to: &str| -> String {
+        let text = std::fs::read_to_string(path(&format!("{name}.pwi"))).unwrap();
+        assert!(text.contains(from), "{name}: {from}");
+        let mut t = Trajectory::from_reader(
+            Cursor::new(text.replace(from, to)),
+            Format::EspressoIn,
+            "bad",
+        )
+        .unwrap();
+        t.n_frames().unwrap_err().to_string()
+    };
+    let e = err("ibrav12_mono", "cosAB = 0.2", "cosAB = 1.0");
+    assert!(e.starts_with("bad: frame 0, line 6, byte"), "{e}");
+    assert!(
+        e.contains("cosAB with A) in (-1, 1) for ibrav = 12 or 13, found '1.0'"),
+        "{e}"
+    );
+    let e = err("ibrav5_trig", "celldm(4) = 0.3", "celldm(4) = -0.6");
+    assert!(
+        e.contains("in (-1/2, 1) for ibrav = 5 or -5, found '-0.6'"),
+        "{e}"
+    );
+    let e = err("ibravm12_mono", "celldm(5) = -0.25", "celldm(5) = 1d0");
+    assert!(e.contains("for ibrav = -12 or -13, found '1d0'"), "{e}");
+    let e = err(
+        "ibrav14_tri",
+        "cosAB = 0.1, cosAC = 0.2, cosBC = 0.3",
+        "cosAB = -0.9, cosAC = -0.9, cosBC = -0.9",
+    );
+    assert!(e.contains("cell with volume > 0"), "{e}");
+    assert!(
+        e.contains("found 'cos α -0.9, cos β -0.9, cos γ -0.9'"),
+        "{e}"
+    );
+    let e = err("ibrav7_bct", "celldm(3) = 1.4", "celldm(2) = 1.4");
+    assert!(
+        e.contains("found 'ibrav = 7 (body-centred tetragonal) without it'"),
+        "{e}"
+    );
+    let e = err("ibravm9_baseco", "B = 4.4", "B = -4.4");
+    assert!(e.contains("celldm(2) (b/a) or B > 0"), "{e}");
+    assert!(e.contains("found '-4.4'"), "{e}");
+    let e = err("ibrav10_fco", "C = 6.0", "C = x");
+    assert!(e.contains("expected a real number, found 'x'"), "{e}");
+}
+
+/// A spin-polarised run's moments (`Magnetic moment per site`, the last block of each step) as
+/// the property `magmom` (μB), against the numbers read from the file by plain text matching
+/// (gen_reference.py). ASE 3.29 takes the last field of pw.x 6.7's lines, the constraint
+/// column (`constr:    0.0000`), so its moments are all 0 and are not the reference here.
+#[test]
+fn magnetic_moments() {
+    let r = reference();
+    let out = &r["outputs"]["fe_relax_mag"];
+    let want = out["magn"].as_array().unwrap();
+    let mut t = Trajectory::open(path("fe_relax_mag.pwo")).unwrap();
+    let frames = read_all(&mut t);
+    assert_eq!(
+        frames.len(),
+        3,
+        "relax stopped at nstep = 3: its last positions have no results"
+    );
+    for (k, f) in frames.iter().enumerate() {
+        let got = f.property("magmom").unwrap();
+        let w: Vec<f64> = want[k]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect();
+        assert_eq!(got.len(), w.len());
+        for (g, w) in got.iter().zip(&w) {
+            // f32 of a 4-decimal number below 8: within 4.8e-7.
+            assert!(
+                (f64::from(*g) - w).abs() <= 5e-7,
+                "frame {k}: {got:?} vs {w:?}"
+            );
+        }
+        let ase: Vec<f64> = out["frames"][k]["magmoms"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect();
+        assert!(ase.iter().all(|m| *m == 0.0), "ASE's reading: {ase:?}");
+    }
+    assert_ne!(frames[0].property("magmom"), frames[2].property("magmom"));
+    // The input's starting_magnetization(1) is no moment.
+    let mut t = Trajectory::open(path("fe_relax_mag.pwi")).unwrap();
+    assert!(read_all(&mut t)[0].property("magmom").is_none());
+    // A run without spin: no moments.
+    let mut t = Trajectory::open(path("si_relax.pwo")).unwrap();
+    assert!(
+        read_all(&mut t)
+            .iter()
+            .all(|f| f.property("magmom").is_none())
+    );
+    // pw.x 6.8's format of the same lines reads alike.
+    let text = std::fs::read_to_string(path("fe_relax_mag.pwo")).unwrap();
+    let newer: String = text
+        .split_inclusive('\n')
+        .map(|l| match l.trim_start().strip_prefix("atom:") {
+            Some(rest) if l.contains("magn:") => {
+                let f: Vec<&str> = rest.split_whitespace().collect();
+                format!(
+                    "     atom {:>6} (R=0.190)  charge={:>8}  magn={:>8}\n",
+                    f[0], f[2], f[4]
+                )
+            }
+            _ => l.to_string(),
+        })
+        .collect();
+    assert!(newer.contains("(R=0.190)  charge=  6.2918  magn=  3.3015"));
+    let mut t =
+        Trajectory::from_reader(Cursor::new(newer), Format::EspressoOut, "newer.pwo").unwrap();
+    let again = read_all(&mut t);
+    for (f, g) in frames.iter().zip(&again) {
+        assert_eq!(f.property("magmom"), g.property("magmom"));
+    }
+    // Damage in a moment line, and a block cut short.
+    let bad = text.replacen("magn:    3.3081", "magn:    3.3x81", 1);
+    let mut t = Trajectory::from_reader(Cursor::new(bad), Format::EspressoOut, "bad").unwrap();
+    let e = t.n_frames().unwrap_err().to_string();
+    assert!(e.starts_with("bad: frame 1, line 468, byte"), "{e}");
+    assert!(e.contains("a moment line"), "{e}");
+    assert!(e.contains("found '3.3x81'"), "{e}");
+    let cut_at = text.find("     atom:    2    charge:    6.2892").unwrap();
+    let opts = ReadOptions::new().allow_truncated(true);
+    let mut t = Trajectory::from_reader_with(
+        Cursor::new(text[..cut_at].to_string()),
+        Format::EspressoOut,
+        "cut",
+        opts,
+    )
+    .unwrap();
+    assert_eq!(t.n_frames().unwrap(), 1);
+    assert!(
+        t.warnings()[0]
+            .to_string()
+            .contains("more lines of the magnetic moments"),
+        "{:?}",
+        t.warnings()
+    );
 }
 
 /// An output cut anywhere keeps the frames before the cut under `allow_truncated`, with a
@@ -424,18 +724,24 @@ fn damage_is_located() {
         let mut t = Trajectory::from_reader(Cursor::new(text), format, "bad").unwrap();
         t.n_frames().unwrap_err().to_string()
     };
-    // An unsupported ibrav is named.
-    let e = err(input.replace("ibrav = 4", "ibrav = 5"), Format::EspressoIn);
-    assert!(e.starts_with("bad: frame 0, line 6, byte"), "{e}");
-    assert!(e.contains("found 'ibrav = 5'"), "{e}");
+    // An ibrav pw.x does not know is named.
+    for bad in ["15", "-7", "92"] {
+        let e = err(
+            input.replace("ibrav = 4", &format!("ibrav = {bad}")),
+            Format::EspressoIn,
+        );
+        assert!(e.starts_with("bad: frame 0, line 6, byte"), "{e}");
+        assert!(e.contains(&format!("found 'ibrav = {bad}'")), "{e}");
+    }
     let e = err(input.replace("{crystal}", "crystal_sg"), Format::EspressoIn);
     assert!(e.contains("crystal_sg"), "{e}");
     let e = err(input.replace("1/3  2/3", "1/3  2/x"), Format::EspressoIn);
     assert!(e.starts_with("bad: frame 0, line 15"), "{e}");
     assert!(e.contains("found '2/x'"), "{e}");
     let e = err(input.replace("celldm(3) = 1.6,", ""), Format::EspressoIn);
+    assert!(e.starts_with("bad: frame 0, line 6, byte"), "{e}");
     assert!(
-        e.contains("celldm(3) (c/a) or C > 0 in &SYSTEM for ibrav = 4"),
+        e.contains("expected celldm(3) (c/a) or C > 0 in &SYSTEM, which this ibrav needs, found 'ibrav = 4 (hexagonal) without it'"),
         "{e}"
     );
     let e = err(input.replace("  Si  2/3", "  Ge  2/3"), Format::EspressoIn);

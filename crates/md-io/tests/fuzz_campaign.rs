@@ -978,8 +978,9 @@ fn tinker_campaign() {
     campaign("Tinker", Format::Tinker, fx.into());
 }
 
-/// pw.x 6.7's outputs (a relax, a vc-relax, an md and a vc-md run) and inputs (hexagonal and bcc lattices
-/// with crystal positions, ibrav 0 with alat positions).
+/// pw.x 6.7's outputs (a relax, a vc-relax, an md and a vc-md run, a spin-polarised relax with
+/// magnetic moments) and inputs (hexagonal, bcc and triclinic lattices with crystal positions,
+/// ibrav 0 with alat positions).
 #[test]
 fn espresso_campaign() {
     let files = [
@@ -987,6 +988,7 @@ fn espresso_campaign() {
         "espresso/si_vcrelax.pwo",
         "espresso/si_md.pwo",
         "espresso/si_vcmd.pwo",
+        "espresso/fe_relax_mag.pwo",
     ];
     let fx = files.map(|f| text_fixture(f, Format::EspressoOut));
     campaign("Quantum ESPRESSO output", Format::EspressoOut, fx.into());
@@ -994,6 +996,7 @@ fn espresso_campaign() {
         "espresso/ibrav4_hex.pwi",
         "espresso/ibrav3_bcc.pwi",
         "espresso/si_md.pwi",
+        "espresso/ibrav14_tri.pwi",
     ];
     let fx = files.map(|f| text_fixture(f, Format::EspressoIn));
     campaign("Quantum ESPRESSO input", Format::EspressoIn, fx.into());
