@@ -259,6 +259,10 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
             if !(gamma.is_finite() && gamma > 0.0) {
                 return usage(format!("--gamma {gamma}: expected a number above 0"));
             }
+            if photo.is_empty() && (stretch != texmap_terrain::photo::Stretch::Auto || gamma != 1.0)
+            {
+                return usage("--stretch and --gamma make a --photo's colours: give the photo");
+            }
             if !(max_error.is_finite() && max_error >= 0.0) {
                 return usage(format!("--max-error {max_error}: expected metres ≥ 0"));
             }

@@ -1278,6 +1278,23 @@ fn a_16_bit_photo_is_stretched_by_percentiles_and_the_ranges_carry_to_the_next_b
         ma == mb,
         "the range build's maps differ from the percentile build's"
     );
+    // Without a photo there are no colours to stretch.
+    let o = texmap(&[
+        "terrain",
+        "build",
+        "--dem",
+        &data("sat_dem.tif"),
+        "--stretch",
+        "percent:2,98",
+        "--out",
+        dir.path().join("relief.db").to_str().unwrap(),
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
     // Bad rules and gammas are usage errors (exit 2) naming the option.
     for bad in [
         &["--stretch", "percent:98,2"][..],
