@@ -438,6 +438,7 @@ pub(crate) fn reason(output: Output, kind: &Dropped) -> String {
     match (output, kind) {
         (Output::LammpsData, Dropped::Velocities) => "a LAMMPS data file's velocities are in its run's units, which it does not state; a data file's own velocities, the properties vx vy vz, are written".into(),
         (Output::Sdf, Dropped::PartialCharges) => "an SD file holds integer formal charges only".into(),
+        (Output::LammpsData, Dropped::ImageFlags) => "a LAMMPS data file's image flags are whole numbers of periodic cells, and these are not, or the frame has no cell".into(),
         (Output::Mmcif, Dropped::Cell) => "a PDBx/mmCIF file holds the first frame's cell only".into(),
         (Output::Pdb, Dropped::BondOrders) => "a PDB file's CONECT records repeat double and triple bonds only (aromatic and unknown orders are written as single bonds)".into(),
         (Output::Dcd, Dropped::Time) => "a DCD file has no time per frame (readers compute step × the header's time step)".into(),
