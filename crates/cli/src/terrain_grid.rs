@@ -18,6 +18,7 @@ use crate::args::{UsageError, usage};
 const GRID_AFTER_HELP: &str = "\
 Examples:
   texmap terrain grid survey.laz -o dem.tif
+  texmap terrain grid survey.laz -o dem.tif --cog   # for QGIS, TiTiler, GDAL /vsicurl/ over HTTP
   texmap terrain grid tiles/*.laz -o dem.tif --lidar-cell 1 --lidar-method idw --lidar-fill 3
   texmap terrain grid survey.las -o dsm.tif --lidar-classes 1,2,3,4,5,6 --lidar-method max
   texmap terrain grid survey.laz -o density.tif --lidar-classes 2 --lidar-method count   # gaps in the ground
@@ -30,7 +31,9 @@ height set to this lattice. gdal_grid -a average:radius1=R:radius2=R (minimum, m
 invdist:power=1) on the same points and nodes gives the same heights but where a point lies
 exactly R from a centre, which GDAL counts. Several files are one cloud: the cells along a
 tile's edge see the points across it. Without a GeoKey directory or WKT record in the files the
-grid is in a local frame.";
+grid is in a local frame. --cog writes what `gdal_translate -of COG -co COMPRESS=DEFLATE
+-co PREDICTOR=FLOATING_POINT -co RESAMPLING=AVERAGE` writes: overviews halving until one tile
+holds the grid, each the average of the level before, empty cells left out.";
 
 /// How lidar point clouds are gridded (`terrain grid`, and `terrain build --dem x.laz`).
 #[derive(Args, Debug, Clone)]
@@ -146,6 +149,10 @@ pub struct GridArgs {
     /// cells nan (GDAL's no-data tag; a count is 0 there), in the cloud's coordinate system.
     #[arg(short, long)]
     pub output: PathBuf,
+    /// Write a Cloud-Optimized GeoTIFF (512x512 tiles, overviews averaging the heights), so QGIS,
+    /// TiTiler or GDAL's /vsicurl/ read over HTTP only the tiles and zoom level they show.
+    #[arg(long)]
+    pub cog: bool,
     #[command(flatten)]
     pub lidar: LidarArgs,
 }
@@ -277,6 +284,14 @@ pub(crate) fn require_geotiff(output: &Path) -> Result<()> {
     Ok(())
 }
 
+/// The layout `--cog` asks for (the commands that write a GeoTIFF).
+pub(crate) fn geotiff_options(cog: bool) -> dem::geotiff_writer::GeoTiffOptions {
+    dem::geotiff_writer::GeoTiffOptions {
+        cog,
+        ..Default::default()
+    }
+}
+
 pub fn run(a: GridArgs) -> Result<()> {
     let opts = a.lidar.options()?;
     require_geotiff(&a.output)?;
@@ -287,7 +302,7 @@ pub fn run(a: GridArgs) -> Result<()> {
         ));
     }
     let (grid, _) = grid_noting(&a.input, &opts)?;
-    dem::geotiff_writer::write_grid(&a.output, &grid)?;
+    dem::geotiff_writer::write_grid_with(&a.output, &grid, &geotiff_options(a.cog))?;
     crate::note!("wrote {}", a.output.display());
     Ok(())
 }

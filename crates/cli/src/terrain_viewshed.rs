@@ -14,7 +14,7 @@ use texmap_terrain::viewshed::{
 };
 
 use crate::args::{UsageError, usage};
-use crate::terrain_grid::require_geotiff;
+use crate::terrain_grid::{geotiff_options, require_geotiff};
 use crate::terrain_view::{lonlat_point, parse_pair};
 
 const VIEWSHED_AFTER_HELP: &str = "\
@@ -27,7 +27,9 @@ Examples:
 The output has the input grid's size and georeference (gdal_viewshed cuts it to --max-distance's
 square): 255 visible, 0 hidden, 0 beyond --max-distance or on no-data (--visible, --invisible,
 --out-of-range change them); with --mode dem or ground, the float32 elevation or height above the
-ground a target needs to be seen (nan beyond the range and on no-data).";
+ground a target needs to be seen (nan beyond the range and on no-data). --cog lays the file out
+as `gdal_translate -of COG -co COMPRESS=DEFLATE` does: a mask with -co PREDICTOR=YES
+-co RESAMPLING=NEAREST, heights with -co PREDICTOR=FLOATING_POINT -co RESAMPLING=AVERAGE.";
 
 /// Compute the viewshed of an observer standing on a grid or database.
 #[derive(Args, Debug)]
@@ -100,10 +102,32 @@ pub struct ViewshedArgs {
     /// Output GeoTIFF (.tif or .tiff).
     #[arg(short, long)]
     pub output: PathBuf,
+    /// Write a Cloud-Optimized GeoTIFF (512x512 tiles, overviews: masks nearest, heights
+    /// averaged), so QGIS, TiTiler or GDAL's /vsicurl/ read over HTTP only what they show.
+    #[arg(long)]
+    pub cog: bool,
     /// Also a PNG picture: the shaded relief, visible cells yellow, hidden ones dark, cells beyond
     /// the range grey, the observer red (at most 4096 pixels a side).
     #[arg(long)]
     pub png: Option<PathBuf>,
+}
+
+/// `vs` as a Cloud-Optimized GeoTIFF: as `Viewshed::write_geotiff` writes it in strips.
+fn write_cog(
+    vs: &texmap_terrain::viewshed::Viewshed,
+    output: &std::path::Path,
+    values: &MaskValues,
+) -> Result<(), TerrainError> {
+    use dem::geotiff_writer::{Samples, write_geotiff_with};
+    let opts = geotiff_options(true);
+    let (w, h, g) = (vs.width, vs.height, &vs.georef);
+    match &vs.heights {
+        Some(z) => {
+            let nodata = z.iter().any(|v| v.is_nan()).then_some(f64::NAN);
+            write_geotiff_with(output, w, h, Samples::F32(z), g, nodata, &opts)
+        }
+        None => write_geotiff_with(output, w, h, Samples::U8(&vs.mask(values)), g, None, &opts),
+    }
 }
 
 /// Observer and parameter errors are the caller's to fix: usage errors (exit code 2).
@@ -189,7 +213,11 @@ pub fn run(a: ViewshedArgs) -> Result<()> {
         .map_err(viewshed_error)?;
     pb.finish_and_clear();
     let secs = t0.elapsed().as_secs_f64();
-    vs.write_geotiff(&a.output, &values)?;
+    if a.cog {
+        write_cog(&vs, &a.output, &values)?;
+    } else {
+        vs.write_geotiff(&a.output, &values)?;
+    }
     if let Some(p) = &a.png {
         let img = vs.image(&grid, 4096);
         crate::output::write_atomic(p, |tmp| {

@@ -1322,3 +1322,78 @@ fn walk(dir: &Path) -> Vec<PathBuf> {
     }
     out
 }
+
+/// `--cog` on `terrain grid` and `terrain viewshed`: Cloud-Optimized GeoTIFFs (GDAL's ghost area
+/// after the header; gdalinfo's LAYOUT=COG when GDAL is installed) holding the same samples as
+/// the strip files; the help says what a COG is for.
+#[test]
+fn grid_and_viewshed_write_cloud_optimized_geotiffs() {
+    use texmap_terrain::dem::read_dem;
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let path = |n: &str| d.join(n).to_string_lossy().into_owned();
+    let laz = data("lidar/lidar_12.laz");
+    let dem = data("viewshed/dem_utm.tif");
+    let grid = |out: &str, cog: bool| {
+        let mut a = vec!["terrain", "grid", &laz, "-o", out, "--lidar-cell", "10"];
+        if cog {
+            a.push("--cog");
+        }
+        ok(&texmap(&a));
+    };
+    let viewshed = |out: &str, cog: bool| {
+        let mut a = vec!["terrain", "viewshed", &dem, "--observer", "316135,4904505"];
+        a.extend(["--method", "gdal", "-o", out]);
+        if cog {
+            a.push("--cog");
+        }
+        ok(&texmap(&a));
+    };
+    grid(&path("g.tif"), false);
+    grid(&path("g_cog.tif"), true);
+    viewshed(&path("v.tif"), false);
+    viewshed(&path("v_cog.tif"), true);
+    let gdal = std::process::Command::new("gdalinfo")
+        .arg("--version")
+        .output()
+        .is_ok();
+    if !gdal {
+        eprintln!("SKIPPED gdalinfo LAYOUT=COG check: gdalinfo is not installed");
+    }
+    for (strips, cog) in [("g.tif", "g_cog.tif"), ("v.tif", "v_cog.tif")] {
+        let (a, b) = (d.join(strips), d.join(cog));
+        let (a, b) = (
+            read_dem(&a, &Default::default()).unwrap(),
+            read_dem(&b, &Default::default()).unwrap(),
+        );
+        let bits = |g: &texmap_terrain::dem::Grid| {
+            g.heights().iter().map(|h| h.to_bits()).collect::<Vec<_>>()
+        };
+        assert!(bits(&a) == bits(&b), "{cog}: samples differ from {strips}");
+        assert_eq!(a.georef(), b.georef(), "{cog}");
+        let bytes = std::fs::read(d.join(cog)).unwrap();
+        assert!(
+            bytes[8..].starts_with(b"GDAL_STRUCTURAL_METADATA_SIZE="),
+            "{cog}"
+        );
+        if gdal {
+            let o = std::process::Command::new("gdalinfo")
+                .arg(d.join(cog))
+                .output()
+                .unwrap();
+            let text = String::from_utf8_lossy(&o.stdout);
+            assert!(
+                text.contains("LAYOUT=COG") && text.contains("Block=512x512"),
+                "{text}"
+            );
+        }
+    }
+    for cmd in ["grid", "viewshed"] {
+        let o = texmap(&["terrain", cmd, "--help"]);
+        let help = String::from_utf8_lossy(&o.stdout);
+        assert!(
+            help.contains("--cog") && help.contains("Cloud-Optimized"),
+            "{help}"
+        );
+    }
+}

@@ -1639,3 +1639,353 @@ fn xyz_files_that_are_not_grids_are_errors_naming_the_line() {
         assert!(e.contains("bad.xyz") && e.contains(want), "{text:?}: {e}");
     }
 }
+
+// ---- Cloud-Optimized GeoTIFFs (dem::geotiff_writer with GeoTiffOptions::cog) -----------------
+
+/// A seeded 1101 x 1301 UTM grid (odd sizes: GDAL's overviews then weight partly covered
+/// pixels) with a fifth of its samples and a block no-data, and a byte mask from the same seed.
+fn cog_test_grid() -> (Grid, Vec<u8>) {
+    use texmap_terrain::dem::Georef;
+    let (w, h) = (1101u32, 1301u32);
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut next = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut heights = Vec::with_capacity((w * h) as usize);
+    let mut mask = Vec::with_capacity((w * h) as usize);
+    for r in 0..h {
+        for c in 0..w {
+            let z = 100.0 + 30.0 * (c as f64 / 37.0).sin() + 20.0 * (r as f64 / 23.0).cos();
+            let z = z + 5.0 * next();
+            let hole = next() < 0.2 || ((400..700).contains(&r) && (300..800).contains(&c));
+            heights.push(if hole { f32::NAN } else { z as f32 });
+            mask.push(if next() < 0.5 { 255 } else { 0 });
+        }
+    }
+    let georef = Georef {
+        crs: CrsKind::Projected,
+        epsg: Some(32619),
+        origin_x: 500_015.0,
+        origin_y: 4_899_985.0,
+        dx: 30.0,
+        dy: -30.0,
+    };
+    (Grid::new("cog", w, h, heights, georef).unwrap(), mask)
+}
+
+/// The IFDs of a little-endian classic TIFF, read by hand (independent of the writer): each
+/// IFD's offset and its tags' values as integers (ASCII and DOUBLE values left out).
+fn tiff_ifds(bytes: &[u8]) -> Vec<(u64, std::collections::BTreeMap<u16, Vec<u64>>)> {
+    let u16_at = |o: usize| u16::from_le_bytes([bytes[o], bytes[o + 1]]);
+    let u32_at = |o: usize| u32::from_le_bytes(bytes[o..o + 4].try_into().unwrap());
+    assert_eq!(&bytes[..4], b"II\x2a\x00", "a little-endian classic TIFF");
+    let mut ifds = Vec::new();
+    let mut at = u32_at(4) as usize;
+    while at != 0 {
+        let n = u16_at(at) as usize;
+        let mut tags = std::collections::BTreeMap::new();
+        for i in 0..n {
+            let e = at + 2 + 12 * i;
+            let (tag, ty, count) = (u16_at(e), u16_at(e + 2), u32_at(e + 4) as usize);
+            let size = match ty {
+                3 => 2,
+                4 => 4,
+                _ => continue,
+            };
+            let base = if size * count <= 4 {
+                e + 8
+            } else {
+                u32_at(e + 8) as usize
+            };
+            let v = (0..count)
+                .map(|k| match size {
+                    2 => u16_at(base + 2 * k) as u64,
+                    _ => u32_at(base + 4 * k) as u64,
+                })
+                .collect();
+            tags.insert(tag, v);
+        }
+        ifds.push((at as u64, tags));
+        at = u32_at(at + 2 + 12 * n) as usize;
+    }
+    ifds
+}
+
+/// A COG read back by our reader is the grid sample for sample with the strip file's
+/// georeference; its layout follows the COG rules (read by hand from the file); 1 and 2 threads
+/// write the same bytes; a bad block size is an error that leaves no file.
+#[test]
+fn cog_reads_back_sample_for_sample_with_the_cog_layout() {
+    use texmap_terrain::dem::geotiff_writer::{
+        GeoTiffOptions, Samples, write_geotiff_with, write_grid, write_grid_with,
+    };
+    let (grid, mask) = cog_test_grid();
+    let dir = tempfile::tempdir().unwrap();
+    let (cog, strips) = (dir.path().join("cog.tif"), dir.path().join("strips.tif"));
+    write_grid_with(&cog, &grid, &GeoTiffOptions::cog()).unwrap();
+    write_grid(&strips, &grid).unwrap();
+    let (back, strip_back) = (read(&cog), read(&strips));
+    assert_eq!((back.width(), back.height()), (grid.width(), grid.height()));
+    for (i, (a, b)) in back.heights().iter().zip(grid.heights()).enumerate() {
+        assert!(a.to_bits() == b.to_bits(), "sample {i}: {a} vs {b}");
+    }
+    assert_eq!(back.georef(), strip_back.georef());
+
+    // The layout, file by file.
+    let masked = dir.path().join("mask.tif");
+    write_geotiff_with(
+        &masked,
+        grid.width(),
+        grid.height(),
+        Samples::U8(&mask),
+        grid.georef(),
+        None,
+        &GeoTiffOptions::cog(),
+    )
+    .unwrap();
+    for (file, predictor) in [(&cog, 3), (&masked, 2)] {
+        let bytes = std::fs::read(file).unwrap();
+        let ghost = b"GDAL_STRUCTURAL_METADATA_SIZE=";
+        assert_eq!(&bytes[8..8 + ghost.len()], ghost, "{}", file.display());
+        let ifds = tiff_ifds(&bytes);
+        let sizes: Vec<(u64, u64)> = ifds.iter().map(|(_, t)| (t[&256][0], t[&257][0])).collect();
+        assert_eq!(sizes, [(1101, 1301), (550, 650), (275, 325)]);
+        let first_tile = ifds
+            .iter()
+            .flat_map(|(_, t)| t[&324].clone())
+            .min()
+            .unwrap();
+        for (level, (at, t)) in ifds.iter().enumerate() {
+            assert!(
+                *at < first_tile,
+                "IFD {level} at {at} after a tile at {first_tile}"
+            );
+            assert_eq!(
+                t.get(&254),
+                (level > 0).then(|| vec![1]).as_ref(),
+                "NewSubfileType"
+            );
+            assert_eq!((t[&322][0], t[&323][0], t[&317][0]), (512, 512, predictor));
+            let tiles = 1101u64.div_ceil(512 << level) * 1301u64.div_ceil(512 << level);
+            assert_eq!(t[&324].len() as u64, tiles.max(1));
+            // Each tile between its leader (its size) and trailer (its last 4 bytes again).
+            for (&o, &n) in t[&324].iter().zip(&t[&325]) {
+                let (o, n) = (o as usize, n as usize);
+                assert_eq!(bytes[o - 4..o], (n as u32).to_le_bytes());
+                assert_eq!(bytes[o + n - 4..o + n], bytes[o + n..o + n + 4]);
+            }
+        }
+        // The smallest overview's tiles first, the full resolution's last.
+        for pair in ifds.windows(2) {
+            let coarse_last = pair[1].1[&324].iter().max().unwrap();
+            let fine_first = pair[0].1[&324].iter().min().unwrap();
+            assert!(coarse_last < fine_first, "{}", file.display());
+        }
+    }
+
+    // The same bytes for 1 and 2 threads.
+    let mut files = Vec::new();
+    for threads in [1, 2] {
+        let p = dir.path().join(format!("t{threads}.tif"));
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| write_grid_with(&p, &grid, &GeoTiffOptions::cog()).unwrap());
+        files.push(std::fs::read(&p).unwrap());
+    }
+    assert!(
+        files[0] == files[1],
+        "1 and 2 threads wrote different bytes"
+    );
+
+    // A block size that is not a multiple of 16 is refused, leaving nothing behind.
+    let bad = dir.path().join("bad.tif");
+    let opts = GeoTiffOptions {
+        cog: true,
+        block_size: 100,
+    };
+    let e = write_grid_with(&bad, &grid, &opts).unwrap_err();
+    assert!(e.to_string().contains("block_size"), "{e}");
+    assert!(!bad.exists());
+}
+
+/// gdalinfo reads our COG with 512 x 512 blocks, GDAL's overview sizes, LAYOUT=COG and the
+/// strip file's georeference; each overview level is the one GDAL's COG driver makes from the
+/// strip file (`-co RESAMPLING=AVERAGE` for heights, `NEAREST` for a byte mask), read by GDAL
+/// from both files. SKIPPED without GDAL.
+#[test]
+fn cog_overviews_match_gdal_cog_driver() {
+    use std::process::Command;
+    use texmap_terrain::dem::geotiff_writer::{
+        GeoTiffOptions, Samples, write_geotiff, write_geotiff_with, write_grid, write_grid_with,
+    };
+    // "GDAL 3.6.2, released 2023/01/02": the COG driver is GDAL 3.1's.
+    let version = Command::new("gdalinfo").arg("--version").output();
+    let Some(version) = version
+        .ok()
+        .map(|o| String::from_utf8_lossy(&o.stdout).into_owned())
+    else {
+        eprintln!("SKIPPED COG check against GDAL: gdalinfo is not installed");
+        return;
+    };
+    let number = version.split([' ', ',']).nth(1).unwrap_or("");
+    let mut parts = number.split('.').map(|p| p.parse::<u32>().unwrap_or(0));
+    if (parts.next().unwrap_or(0), parts.next().unwrap_or(0)) < (3, 1) {
+        eprintln!("SKIPPED COG check against GDAL: {version} has no COG driver (3.1)");
+        return;
+    }
+    let run = |args: &[&std::ffi::OsStr]| {
+        let o = Command::new(args[0]).args(&args[1..]).output().unwrap();
+        assert!(
+            o.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        o.stdout
+    };
+    let info = |p: &Path| -> serde_json::Value {
+        serde_json::from_slice(&run(&["gdalinfo".as_ref(), "-json".as_ref(), p.as_ref()])).unwrap()
+    };
+    // Overview `k` of `p` as GDAL reads it, raw little-endian samples.
+    let overview = |p: &Path, k: usize, out: &Path| -> Vec<u8> {
+        let k = k.to_string();
+        run(&[
+            "gdal_translate".as_ref(),
+            "-q".as_ref(),
+            "-ovr".as_ref(),
+            k.as_ref(),
+            "-of".as_ref(),
+            "ENVI".as_ref(),
+            p.as_ref(),
+            out.as_ref(),
+        ]);
+        std::fs::read(out).unwrap()
+    };
+    let (grid, mask) = cog_test_grid();
+    // The grid whole, and a hole-free even-sized part of it (GDAL's fast 2x2 path).
+    let mut solid = Vec::new();
+    for r in 0..1024usize {
+        for c in 0..1536usize {
+            let v = grid.heights()[r * 1101 + c % 1101];
+            solid.push(if v.is_nan() {
+                50.0 + (r + c) as f32 * 0.25
+            } else {
+                v
+            });
+        }
+    }
+    let solid = Grid::new("solid", 1536, 1024, solid, *grid.georef()).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    for (name, g) in [("holes", &grid), ("solid", &solid)] {
+        let (ours, strips, theirs) = (
+            d.join(format!("{name}_ours.tif")),
+            d.join(format!("{name}_strips.tif")),
+            d.join(format!("{name}_gdal.tif")),
+        );
+        write_grid_with(&ours, g, &GeoTiffOptions::cog()).unwrap();
+        write_grid(&strips, g).unwrap();
+        run(&[
+            "gdal_translate".as_ref(),
+            "-q".as_ref(),
+            "-of".as_ref(),
+            "COG".as_ref(),
+            "-co".as_ref(),
+            "RESAMPLING=AVERAGE".as_ref(),
+            strips.as_ref(),
+            theirs.as_ref(),
+        ]);
+        let (i_ours, i_strips, i_theirs) = (info(&ours), info(&strips), info(&theirs));
+        let band = &i_ours["bands"][0];
+        assert_eq!(band["block"], serde_json::json!([512, 512]), "{name}");
+        assert_eq!(
+            band["overviews"].as_array().map(|o| o.len()),
+            i_theirs["bands"][0]["overviews"]
+                .as_array()
+                .map(|o| o.len())
+        );
+        for (a, b) in band["overviews"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .zip(i_theirs["bands"][0]["overviews"].as_array().unwrap())
+        {
+            assert_eq!(a["size"], b["size"], "{name}: overview sizes");
+        }
+        assert_eq!(i_ours["geoTransform"], i_strips["geoTransform"], "{name}");
+        assert_eq!(
+            i_ours["coordinateSystem"], i_strips["coordinateSystem"],
+            "{name}"
+        );
+        assert_eq!(
+            i_ours["metadata"]["IMAGE_STRUCTURE"]["LAYOUT"], "COG",
+            "{name}"
+        );
+        assert_eq!(
+            band["noDataValue"], i_strips["bands"][0]["noDataValue"],
+            "{name}"
+        );
+        // GDAL sums in f64 and rounds once, as we do, except its 2x2 fast path without no-data,
+        // which sums four f32 in f32: up to 2 ulp apart.
+        let levels = band["overviews"].as_array().unwrap().len();
+        let mut worst = 0f64;
+        for k in 0..levels {
+            let a = overview(&ours, k, &d.join(format!("{name}_o{k}.bin")));
+            let b = overview(&theirs, k, &d.join(format!("{name}_g{k}.bin")));
+            assert_eq!(a.len(), b.len(), "{name} overview {k}");
+            for (i, (x, y)) in a.chunks_exact(4).zip(b.chunks_exact(4)).enumerate() {
+                let x = f32::from_le_bytes(x.try_into().unwrap());
+                let y = f32::from_le_bytes(y.try_into().unwrap());
+                let tol = 2.0 * f32::EPSILON as f64 * (y.abs() as f64);
+                let diff = (x as f64 - y as f64).abs();
+                assert!(
+                    x.is_nan() == y.is_nan() && (x.is_nan() || diff <= tol),
+                    "{name} overview {k} sample {i}: ours {x}, GDAL {y}, tolerance {tol}"
+                );
+                if !x.is_nan() {
+                    worst = worst.max(diff / y.abs() as f64);
+                }
+            }
+        }
+        eprintln!(
+            "COG overviews vs GDAL 3.6 ({name}): {levels} levels, largest relative difference {worst:e}"
+        );
+    }
+    // The mask: nearest, byte for byte.
+    let (ours, strips, theirs) = (
+        d.join("m_ours.tif"),
+        d.join("m_strips.tif"),
+        d.join("m_gdal.tif"),
+    );
+    let (w, h) = (grid.width(), grid.height());
+    write_geotiff_with(
+        &ours,
+        w,
+        h,
+        Samples::U8(&mask),
+        grid.georef(),
+        None,
+        &GeoTiffOptions::cog(),
+    )
+    .unwrap();
+    write_geotiff(&strips, w, h, Samples::U8(&mask), grid.georef(), None).unwrap();
+    run(&[
+        "gdal_translate".as_ref(),
+        "-q".as_ref(),
+        "-of".as_ref(),
+        "COG".as_ref(),
+        "-co".as_ref(),
+        "RESAMPLING=NEAREST".as_ref(),
+        strips.as_ref(),
+        theirs.as_ref(),
+    ]);
+    for k in 0..2 {
+        let a = overview(&ours, k, &d.join(format!("m_o{k}.bin")));
+        let b = overview(&theirs, k, &d.join(format!("m_g{k}.bin")));
+        assert!(a == b, "mask overview {k} differs from GDAL's");
+    }
+}
