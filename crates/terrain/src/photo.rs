@@ -14,10 +14,12 @@
 //! over the photo's covered pixels ([`Stretch::Auto`]), found in one pass over the file when it
 //! is opened. A 16-bit satellite scene (Sentinel-2 and Landsat reflectance) has clouds, glints
 //! and snow far brighter than its land, which that leaves dark, so a [`Stretch::Percent`] maps
-//! each band's low and high percentiles instead (QGIS's "cumulative count cut", 2–98 % there): a
-//! second pass counts the samples in a histogram per band, exact (one bin per value) for
-//! whole-number samples spanning fewer than 65,536 values, else 65,536 bins over the band's
-//! range with each percentile taken at its bin's centre (within half a bin). The percentiles are
+//! each band's low and high percentiles instead (QGIS's "cumulative count cut", 2–98 % there),
+//! from a histogram per band: one bin per value, counted in the same pass as the ranges, while
+//! every sample is a whole number from −32768 to 65535 (8- and 16-bit integer bands); else a
+//! second pass counts them, exact for whole-number samples spanning fewer than 65,536 values,
+//! else in 65,536 bins over the band's range with each percentile taken at its bin's centre
+//! (within half a bin). The percentiles are
 //! ranks in the sorted covered samples, rounded down at the low end and up at the high one —
 //! numpy's `percentile(method="lower")` and `"higher"`. [`Stretch::Range`] gives the ranges
 //! (`gdal_translate -scale`), and a gamma follows the stretch (`t^(1/γ)`, `gdal_translate
@@ -261,13 +263,56 @@ impl Rgba8 {
 struct Ranges {
     bounds: [(f32, f32); 3],
     integral: [bool; 3],
+    /// Per channel, a count of each whole value seen, kept while every sample is one from
+    /// [`DIRECT_LOW`] to [`DIRECT_HIGH`] (8- and 16-bit integer bands always are): the
+    /// percentiles' histogram made in the same pass, so that they need no second one.
+    direct: Option<[Direct; 3]>,
+}
+
+/// The lowest and highest sample [`Ranges::direct`] counts: Int16's and UInt16's.
+const DIRECT_LOW: i32 = -32768;
+const DIRECT_HIGH: i32 = 65535;
+
+/// Counts of whole values from `lo`, grown as values outside arrive (by at least its length, so
+/// that growing costs O(1) a sample on average; at most 98,304 bins).
+#[derive(Default)]
+struct Direct {
+    lo: i32,
+    counts: Vec<u64>,
+}
+
+impl Direct {
+    fn add(&mut self, v: i32) {
+        let len = self.counts.len() as i32;
+        if len == 0 {
+            self.lo = v;
+            self.counts.push(0);
+        } else if v < self.lo || v >= self.lo + len {
+            let lo = if v < self.lo {
+                (v - len).max(DIRECT_LOW)
+            } else {
+                self.lo
+            };
+            let hi = if v >= self.lo + len {
+                (v + len).min(DIRECT_HIGH)
+            } else {
+                self.lo + len - 1
+            };
+            let mut grown = vec![0; (hi - lo + 1) as usize];
+            grown[(self.lo - lo) as usize..][..len as usize].copy_from_slice(&self.counts);
+            (self.lo, self.counts) = (lo, grown);
+        }
+        self.counts[(v - self.lo) as usize] += 1;
+    }
 }
 
 impl Ranges {
-    fn new() -> Ranges {
+    /// Ranges, counting whole values too when `direct` (for percentiles).
+    fn new(direct: bool) -> Ranges {
         Ranges {
             bounds: [(f32::INFINITY, f32::NEG_INFINITY); 3],
             integral: [true; 3],
+            direct: direct.then(Default::default),
         }
     }
 
@@ -277,7 +322,15 @@ impl Ranges {
         covered(planes, alpha, convert, |k, v| {
             let r = &mut self.bounds[k];
             *r = (r.0.min(v), r.1.max(v));
-            self.integral[k] &= v.fract() == 0.0;
+            let whole = v.fract() == 0.0;
+            self.integral[k] &= whole;
+            if let Some(d) = &mut self.direct {
+                if whole && (DIRECT_LOW as f32..=DIRECT_HIGH as f32).contains(&v) {
+                    d[k].add(v as i32);
+                } else {
+                    self.direct = None;
+                }
+            }
         });
     }
 
@@ -317,6 +370,16 @@ struct Histograms {
 }
 
 impl Histograms {
+    /// The exact histograms [`Ranges::direct`] counted.
+    fn direct(d: [Direct; 3]) -> Histograms {
+        Histograms {
+            lo: std::array::from_fn(|k| d[k].lo as f64),
+            exact: [true; 3],
+            width: [1.0; 3],
+            counts: d.map(|d| d.counts),
+        }
+    }
+
     fn new(r: &Ranges) -> Histograms {
         let mut lo = [0.0; 3];
         let mut width = [1.0; 3];
@@ -400,13 +463,19 @@ fn fit(
     let (rule, bounds) = match fixed {
         Some(r) => ("range".to_string(), r),
         None => {
-            let mut r = Ranges::new();
+            let mut r = Ranges::new(percent.is_some());
             pass(&mut |p| r.add(p, alpha, &convert))?;
             match percent {
                 None => ("minmax".to_string(), r.f64()),
                 Some((lo, hi)) => {
-                    let mut h = Histograms::new(&r);
-                    pass(&mut |p| h.add(p, alpha, &convert))?;
+                    let h = match r.direct.take() {
+                        Some(counts) => Histograms::direct(counts),
+                        None => {
+                            let mut h = Histograms::new(&r);
+                            pass(&mut |p| h.add(p, alpha, &convert))?;
+                            h
+                        }
+                    };
                     let at = |k| (h.percentile(k, lo, false), h.percentile(k, hi, true));
                     (format!("percent:{lo},{hi}"), std::array::from_fn(at))
                 }
