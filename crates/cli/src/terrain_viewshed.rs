@@ -112,24 +112,6 @@ pub struct ViewshedArgs {
     pub png: Option<PathBuf>,
 }
 
-/// `vs` as a Cloud-Optimized GeoTIFF: as `Viewshed::write_geotiff` writes it in strips.
-fn write_cog(
-    vs: &texmap_terrain::viewshed::Viewshed,
-    output: &std::path::Path,
-    values: &MaskValues,
-) -> Result<(), TerrainError> {
-    use dem::geotiff_writer::{Samples, write_geotiff_with};
-    let opts = geotiff_options(true);
-    let (w, h, g) = (vs.width, vs.height, &vs.georef);
-    match &vs.heights {
-        Some(z) => {
-            let nodata = z.iter().any(|v| v.is_nan()).then_some(f64::NAN);
-            write_geotiff_with(output, w, h, Samples::F32(z), g, nodata, &opts)
-        }
-        None => write_geotiff_with(output, w, h, Samples::U8(&vs.mask(values)), g, None, &opts),
-    }
-}
-
 /// Observer and parameter errors are the caller's to fix: usage errors (exit code 2).
 fn viewshed_error(e: TerrainError) -> anyhow::Error {
     match e {
@@ -213,11 +195,8 @@ pub fn run(a: ViewshedArgs) -> Result<()> {
         .map_err(viewshed_error)?;
     pb.finish_and_clear();
     let secs = t0.elapsed().as_secs_f64();
-    if a.cog {
-        write_cog(&vs, &a.output, &values)?;
-    } else {
-        vs.write_geotiff(&a.output, &values)?;
-    }
+    let layout = geotiff_options(a.cog);
+    vs.write_geotiff_with(&a.output, &values, &layout)?;
     if let Some(p) = &a.png {
         let img = vs.image(&grid, 4096);
         crate::output::write_atomic(p, |tmp| {

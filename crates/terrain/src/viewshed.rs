@@ -257,32 +257,37 @@ impl Viewshed {
     }
 
     /// Write the viewshed as a GeoTIFF on the grid's georeference: the needed heights (float32,
-    /// no-data `nan`) when it has them, the mask (bytes) otherwise.
+    /// no-data `nan`) when it has them, the mask (bytes) otherwise; in strips.
     pub fn write_geotiff(
         &self,
         path: &std::path::Path,
         values: &MaskValues,
     ) -> Result<(), TerrainError> {
-        use crate::dem::geotiff_writer::{Samples, write_geotiff};
+        self.write_geotiff_with(path, values, &Default::default())
+    }
+
+    /// [`Viewshed::write_geotiff`] laid out by `options` (strips, or a Cloud-Optimized GeoTIFF).
+    pub fn write_geotiff_with(
+        &self,
+        path: &std::path::Path,
+        values: &MaskValues,
+        options: &crate::dem::geotiff_writer::GeoTiffOptions,
+    ) -> Result<(), TerrainError> {
+        use crate::dem::geotiff_writer::{Samples, write_geotiff_with};
+        let (w, h, g) = (self.width, self.height, &self.georef);
         match &self.heights {
-            Some(h) => {
-                let nodata = h.iter().any(|v| v.is_nan()).then_some(f64::NAN);
-                write_geotiff(
-                    path,
-                    self.width,
-                    self.height,
-                    Samples::F32(h),
-                    &self.georef,
-                    nodata,
-                )
+            Some(z) => {
+                let nodata = z.iter().any(|v| v.is_nan()).then_some(f64::NAN);
+                write_geotiff_with(path, w, h, Samples::F32(z), g, nodata, options)
             }
-            None => write_geotiff(
+            None => write_geotiff_with(
                 path,
-                self.width,
-                self.height,
+                w,
+                h,
                 Samples::U8(&self.mask(values)),
-                &self.georef,
+                g,
                 None,
+                options,
             ),
         }
     }
