@@ -499,6 +499,24 @@ fn sample(planes: &[Vec<f32>], alpha: bool, i: usize) -> ([f32; 3], Option<f32>)
     )
 }
 
+/// The [`PhotoSource`] methods a photo answers from its [`Head`] (`self.head`).
+macro_rules! head_getters {
+    () => {
+        fn size(&self) -> (u32, u32) {
+            (self.head.width, self.head.height)
+        }
+        fn georef(&self) -> Option<Georef> {
+            self.head.georef
+        }
+        fn source(&self) -> &str {
+            &self.head.source
+        }
+        fn stretch(&self) -> Option<Applied> {
+            self.head.applied.clone()
+        }
+    };
+}
+
 /// What a photo read by rows knows of itself besides its rows.
 struct Head {
     source: String,
@@ -580,18 +598,7 @@ impl TiffPhoto {
 }
 
 impl PhotoSource for TiffPhoto {
-    fn size(&self) -> (u32, u32) {
-        (self.head.width, self.head.height)
-    }
-    fn georef(&self) -> Option<Georef> {
-        self.head.georef
-    }
-    fn source(&self) -> &str {
-        &self.head.source
-    }
-    fn stretch(&self) -> Option<Applied> {
-        self.head.applied.clone()
-    }
+    head_getters!();
 
     fn rows(&self, y0: u32, y1: u32) -> Result<RgbaImage, TerrainError> {
         let width = self.head.width;
@@ -693,18 +700,7 @@ impl VrtPhoto {
 }
 
 impl PhotoSource for VrtPhoto {
-    fn size(&self) -> (u32, u32) {
-        (self.head.width, self.head.height)
-    }
-    fn georef(&self) -> Option<Georef> {
-        self.head.georef
-    }
-    fn source(&self) -> &str {
-        &self.head.source
-    }
-    fn stretch(&self) -> Option<Applied> {
-        self.head.applied.clone()
-    }
+    head_getters!();
 
     fn rows(&self, y0: u32, y1: u32) -> Result<RgbaImage, TerrainError> {
         let h = &self.head;

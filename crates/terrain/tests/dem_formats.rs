@@ -1847,6 +1847,15 @@ fn cog_overviews_match_gdal_cog_driver() {
         );
         o.stdout
     };
+    // GDAL's own COG of `strips` with `resampling`, as `theirs`.
+    let gdal_cog = |strips: &Path, theirs: &Path, resampling: &str| {
+        let co = format!("RESAMPLING={resampling}");
+        let args = ["-q", "-of", "COG", "-co", &co];
+        let mut all: Vec<&std::ffi::OsStr> = vec!["gdal_translate".as_ref()];
+        all.extend(args.iter().map(|a| std::ffi::OsStr::new(*a)));
+        all.extend([strips.as_os_str(), theirs.as_os_str()]);
+        run(&all);
+    };
     let info = |p: &Path| -> serde_json::Value {
         serde_json::from_slice(&run(&["gdalinfo".as_ref(), "-json".as_ref(), p.as_ref()])).unwrap()
     };
@@ -1889,16 +1898,7 @@ fn cog_overviews_match_gdal_cog_driver() {
         );
         write_grid_with(&ours, g, &GeoTiffOptions::cog()).unwrap();
         write_grid(&strips, g).unwrap();
-        run(&[
-            "gdal_translate".as_ref(),
-            "-q".as_ref(),
-            "-of".as_ref(),
-            "COG".as_ref(),
-            "-co".as_ref(),
-            "RESAMPLING=AVERAGE".as_ref(),
-            strips.as_ref(),
-            theirs.as_ref(),
-        ]);
+        gdal_cog(&strips, &theirs, "AVERAGE");
         let (i_ours, i_strips, i_theirs) = (info(&ours), info(&strips), info(&theirs));
         let band = &i_ours["bands"][0];
         assert_eq!(band["block"], serde_json::json!([512, 512]), "{name}");
@@ -1973,16 +1973,7 @@ fn cog_overviews_match_gdal_cog_driver() {
     )
     .unwrap();
     write_geotiff(&strips, w, h, Samples::U8(&mask), grid.georef(), None).unwrap();
-    run(&[
-        "gdal_translate".as_ref(),
-        "-q".as_ref(),
-        "-of".as_ref(),
-        "COG".as_ref(),
-        "-co".as_ref(),
-        "RESAMPLING=NEAREST".as_ref(),
-        strips.as_ref(),
-        theirs.as_ref(),
-    ]);
+    gdal_cog(&strips, &theirs, "NEAREST");
     for k in 0..2 {
         let a = overview(&ours, k, &d.join(format!("m_o{k}.bin")));
         let b = overview(&theirs, k, &d.join(format!("m_g{k}.bin")));
