@@ -809,6 +809,8 @@ pub struct DcdWriter<W> {
     n_written: usize,
     first: (Option<i64>, Option<f64>),
     nsavc: i64,
+    /// The header's DELTA (AKMA units) as last written.
+    delta: f32,
     buf: Vec<u8>,
 }
 
@@ -831,6 +833,7 @@ impl<W: Write + Seek> DcdWriter<W> {
             n_written: 0,
             first: (None, None),
             nsavc: 1,
+            delta: (1.0 / AKMA_PS) as f32,
             buf: Vec::new(),
         }
     }
@@ -845,7 +848,7 @@ impl<W: Write + Seek> DcdWriter<W> {
         let mut icntrl = [0u32; 20];
         icntrl[1] = first_step.clamp(0, i32::MAX as i64) as u32; // ISTART
         icntrl[2] = 1; // NSAVC
-        icntrl[9] = ((1.0 / AKMA_PS) as f32).to_bits(); // DELTA: 1 ps until known
+        icntrl[9] = self.delta.to_bits(); // DELTA: 1 ps until known
         icntrl[10] = 1; // unit cell in every frame
         icntrl[19] = 24; // CHARMM version
         for v in icntrl {
@@ -876,6 +879,7 @@ impl<W: Write + Seek> DcdWriter<W> {
         time: Option<f64>,
     ) -> Result<(), Error> {
         let frame = self.n_written;
+        let new_delta = self.delta_after(step, time);
         let invalid = |what: String| Error::InvalidFrame {
             file: self.file.clone(),
             frame,
@@ -941,20 +945,24 @@ impl<W: Write + Seek> DcdWriter<W> {
         self.n_written += 1;
         // Keep the header current.
         let mut patch: Vec<(u64, u32)> = Vec::with_capacity(4);
-        if frame == 1 {
+        if frame == 0 {
+            // The time step a lone frame implies (time / step), until a second frame tells.
+            if let Some(delta) = new_delta {
+                self.delta = delta;
+                patch.push((icntrl_at(9), delta.to_bits()));
+            }
+        } else if frame == 1 {
             // Steps per frame and time step from the first two frames.
-            if let ((Some(s0), t0), Some(s1)) = (self.first, step)
+            if let (Some(s0), Some(s1)) = (self.first.0, step)
                 && s1 > s0
                 && s1 - s0 <= i64::from(i32::MAX)
             {
                 self.nsavc = s1 - s0;
                 patch.push((icntrl_at(2), self.nsavc as u32));
-                if let (Some(t0), Some(t1)) = (t0, time) {
-                    let delta = ((t1 - t0) / self.nsavc as f64 / AKMA_PS) as f32;
-                    if delta.is_finite() && delta > 0.0 {
-                        patch.push((icntrl_at(9), delta.to_bits()));
-                    }
-                }
+            }
+            if let Some(delta) = new_delta {
+                self.delta = delta;
+                patch.push((icntrl_at(9), delta.to_bits()));
             }
         }
         let nstep = (self.n_written as i64 * self.nsavc).min(i64::from(i32::MAX));
@@ -986,6 +994,50 @@ impl<W: Write + Seek> DcdWriter<W> {
             },
             k => step == istart + k as i64 * self.nsavc,
         }
+    }
+
+    /// The header's DELTA (AKMA units) after writing a frame of `step` and `time` next, if that
+    /// frame changes it: the first frame sets time / step (a step above 0), the second
+    /// (time₁ − time₀) / (step₁ − step₀); later frames and frames without both leave it.
+    fn delta_after(&self, step: Option<i64>, time: Option<f64>) -> Option<f32> {
+        let (s, t) = (step?, time?);
+        let per_step = match (self.n_written, self.first) {
+            (0, _) if s > 0 && s <= i64::from(i32::MAX) => t / s as f64,
+            (1, (Some(s0), Some(t0))) if s > s0 && s - s0 <= i64::from(i32::MAX) => {
+                (t - t0) / (s - s0) as f64
+            }
+            _ => return None,
+        };
+        let delta = (per_step / AKMA_PS) as f32;
+        (delta.is_finite() && delta > 0.0).then_some(delta)
+    }
+
+    /// Whether a frame of `step` and `time`, written next, reads back with that time: readers
+    /// compute step × DELTA, so a DCD keeps times proportional to the steps. The second frame
+    /// sets DELTA for the first as well, so its time counts as kept only when the first frame's
+    /// still reads back. Times within 10⁻⁶ relative (DELTA is an f32) count as kept.
+    pub(crate) fn keeps_time(&self, step: Option<i64>, time: f64) -> bool {
+        let k = self.n_written as i64;
+        let istart = match self.n_written {
+            0 => step.unwrap_or(0),
+            _ => self.first.0.unwrap_or(0),
+        }
+        .clamp(0, i64::from(i32::MAX));
+        let read_step = match step {
+            Some(s) if !self.keeps_step(s) => return false,
+            Some(s) => s,
+            None => istart + k * self.nsavc,
+        };
+        let delta = self.delta_after(step, Some(time)).unwrap_or(self.delta);
+        let reads_back = |s: i64, t: f64| {
+            let back = s as f64 * (f64::from(delta) * AKMA_PS);
+            (back - t).abs() <= 1e-6 * t.abs().max(back.abs())
+        };
+        reads_back(read_step, time)
+            && match (self.n_written, self.first) {
+                (1, (s0, Some(t0))) => reads_back(s0.unwrap_or(0).max(0), t0),
+                _ => true,
+            }
     }
 
     /// Appends a [`Frame`] (the `Writer` contract): positions, cell lengths and angles, step

@@ -19,13 +19,13 @@
 //! | bond orders | .sdf; .pdb when every order is 1, 2 or 3 (CONECT repeats a double or triple bond, as Open Babel reads it; our PDB reader reads the bonds only) |
 //! | the cell | every output but .sdf; a .cif holds the first frame's only |
 //! | atom names | .xyz, .gro, .pdb, .cif |
-//! | atom types | .xyz, .lammpstrj, .data, .gsd |
+//! | atom types | .xyz, .gsd; .lammpstrj and .data when every type is a number (labels are numbered 1, 2, …, the dump's element column or the data file's `Masses` comments keeping the label) |
 //! | residues (names and numbers) | .gro, .pdb, .cif |
 //! | chains | .pdb, .cif |
 //! | segments | .pdb when each has at most 4 characters |
 //! | radii | .xyz, .lammpstrj, .gsd (diameters) |
 //! | colours | .xyz, .lammpstrj |
-//! | time | .xyz, .gro, .xtc, .trr, .nc, .sdf (a data item); not .dcd, whose readers compute step × the header's time step |
+//! | time | .xyz, .gro, .xtc, .trr, .nc, .sdf (a data item); .dcd when the times are proportional to the steps (readers compute step × the header's time step) |
 //! | step | .xyz, .lammpstrj, .gro, .xtc, .trr, .gsd, .sdf (a data item); .dcd when the steps are evenly spaced from a first step of at least 0 |
 //!
 //! Bond orders are named only when the bonds themselves are kept (without bonds there is
@@ -217,7 +217,7 @@ pub(crate) fn keeps(output: Output, kind: &Dropped) -> bool {
         Dropped::Segments => matches!(output, Pdb),
         Dropped::Radii => matches!(output, Xyz | LammpsDump | Gsd),
         Dropped::Colors => matches!(output, Xyz | LammpsDump),
-        Dropped::Time => matches!(output, Xyz | Gro | Xtc | Trr | Netcdf | Sdf),
+        Dropped::Time => matches!(output, Xyz | Gro | Dcd | Xtc | Trr | Netcdf | Sdf),
         Dropped::Step => matches!(output, Xyz | LammpsDump | Gro | Dcd | Xtc | Trr | Gsd | Sdf),
     }
 }
@@ -254,11 +254,13 @@ fn group(output: Output, name: &str) -> Option<&'static [&'static str]> {
 }
 
 /// What the writer's state adds to the table: for a .cif after its first frame, that frame's
-/// cell (the only one the file holds); for a DCD, whether it gives the frame's step back.
+/// cell (the only one the file holds); for a DCD, whether it gives the frame's step and time
+/// back.
 #[derive(Default)]
 pub(crate) struct State<'a> {
     pub first_cell: Option<Option<&'a crate::UnitCell>>,
     pub step_kept: Option<bool>,
+    pub time_kept: Option<bool>,
 }
 
 /// What of `frame` writing it to `output` loses, with the writer's `state`: the kinds the
@@ -329,7 +331,19 @@ pub(crate) fn dropped(output: Output, frame: &Frame, state: State) -> Vec<Droppe
             table(&Dropped::Cell) && state.first_cell.is_none_or(|c| c == frame.cell.as_ref()),
         ),
         (Dropped::Names, some(&frame.names), table(&Dropped::Names)),
-        (Dropped::Types, some(&frame.types), table(&Dropped::Types)),
+        (
+            Dropped::Types,
+            some(&frame.types),
+            table(&Dropped::Types)
+                && match output {
+                    Output::LammpsDump => frame
+                        .types
+                        .iter()
+                        .all(crate::lammps_dump_writer::is_type_number),
+                    Output::LammpsData => crate::lammps_data_writer::types_are_numbers(frame),
+                    _ => true,
+                },
+        ),
         (
             Dropped::Residues,
             some(&frame.res_names) || !frame.res_ids.is_empty(),
@@ -355,7 +369,11 @@ pub(crate) fn dropped(output: Output, frame: &Frame, state: State) -> Vec<Droppe
             !frame.colors.is_empty(),
             table(&Dropped::Colors),
         ),
-        (Dropped::Time, frame.time.is_some(), table(&Dropped::Time)),
+        (
+            Dropped::Time,
+            frame.time.is_some(),
+            table(&Dropped::Time) && state.time_kept != Some(false),
+        ),
         (
             Dropped::Step,
             frame.step.is_some(),
@@ -441,8 +459,10 @@ pub(crate) fn reason(output: Output, kind: &Dropped) -> String {
         (Output::LammpsData, Dropped::ImageFlags) => "a LAMMPS data file's image flags are whole numbers of periodic cells, and these are not, or the frame has no cell".into(),
         (Output::Mmcif, Dropped::Cell) => "a PDBx/mmCIF file holds the first frame's cell only".into(),
         (Output::Pdb, Dropped::BondOrders) => "a PDB file's CONECT records repeat double and triple bonds only (aromatic and unknown orders are written as single bonds)".into(),
-        (Output::Dcd, Dropped::Time) => "a DCD file has no time per frame (readers compute step × the header's time step)".into(),
+        (Output::Dcd, Dropped::Time) => "a DCD file has no time per frame: readers compute step × one time step, so only times proportional to the steps come back".into(),
         (Output::Dcd, Dropped::Step) => "a DCD file holds evenly spaced steps only (the first step and the spacing of the first two frames)".into(),
+        (Output::LammpsDump, Dropped::Types) => "LAMMPS types are numbers: the labels were numbered 1, 2, … and written as the element column, which readers take as names".into(),
+        (Output::LammpsData, Dropped::Types) => "LAMMPS types are numbers: the labels were numbered 1, 2, … and written as the Masses lines' comments (the Type Labels section of LAMMPS 2022 and later is not written: earlier versions reject it)".into(),
         (Output::Pdb, Dropped::Segments) => "a PDB file's segment column holds 4 characters".into(),
         (Output::LammpsData, Dropped::Property(name)) if name == "mass" => "a LAMMPS data file's Masses are positive, one per type (the section is left out)".into(),
         (_, Dropped::Property(name)) if group(output, name).is_some() => {

@@ -127,6 +127,22 @@ impl Rotation {
 
 /// The image flags `ix iy iz`, if the frame has all three as whole numbers and a cell for them
 /// to count (see the module docs).
+/// A type label of a frame of `n` atoms as the data file's type number, when it is one: a
+/// positive integer up to 16 n (a larger one would make `read_data` reserve that many types).
+fn type_number(l: &Label, n: usize) -> Option<usize> {
+    l.as_str()
+        .parse::<usize>()
+        .ok()
+        .filter(|&t| t > 0 && t <= n.max(1) * 16)
+}
+
+/// Whether the frame's types are written as they are (each a type number); otherwise they are
+/// numbered 1, 2, … and a label survives only as its `Masses` line's comment.
+pub(crate) fn types_are_numbers(frame: &Frame) -> bool {
+    let n = frame.n_atoms();
+    frame.types.iter().all(|t| type_number(t, n).is_some())
+}
+
 pub(crate) fn data_images(frame: &Frame) -> Option<[&[f32]; 3]> {
     frame.cell?;
     let flags = [
@@ -295,15 +311,7 @@ fn plan(frame: &Frame) -> Result<Plan, String> {
             Label::new("1").unwrap_or_default()
         }
     };
-    let numeric: Option<Vec<usize>> = (0..n)
-        .map(|i| {
-            let l = label(i);
-            l.as_str()
-                .parse::<usize>()
-                .ok()
-                .filter(|&t| t > 0 && t <= n.max(1) * 16)
-        })
-        .collect();
+    let numeric: Option<Vec<usize>> = (0..n).map(|i| type_number(&label(i), n)).collect();
     let (types, mut labels) = match numeric {
         Some(types) if n > 0 => {
             let count = types.iter().copied().max().unwrap_or(1);

@@ -117,7 +117,7 @@ pub(crate) fn box_bounds(cell: &UnitCell) -> Result<[[f64; 3]; 3], String> {
 }
 
 /// Whether a type label is a LAMMPS type number (a positive integer).
-fn is_type_number(l: &Label) -> bool {
+pub(crate) fn is_type_number(l: &Label) -> bool {
     parse_i64(l.as_bytes()).is_some_and(|t| t > 0)
 }
 

@@ -23,7 +23,9 @@
 //! fill) when some atom of the record is charged: in V2000 the `M  CHG` lines, which replace
 //! every atom line's charge code (columns 37-39: 1-3 for +3..+1, 5-7 for -1..-3) as the CTfile
 //! specification and RDKit have it, else those codes; in V3000 the atom's `CHG=`. Isotopes,
-//! radicals and the data items are not kept. A symbol that is no element (`R#`, `*`, `A`, a
+//! radicals and the data items are not kept, except `step` and `time` (ps), which our SD
+//! writer writes and which become [`Frame::step`] and [`Frame::time`] (a value that is no
+//! number is left out). A symbol that is no element (`R#`, `*`, `A`, a
 //! list) is an unknown element.
 //!
 //! # Damage
@@ -171,6 +173,8 @@ impl FrameWalk for Sdf {
                 return Err(ctx.parse(pos, line, line, "'M  END' closing the properties block"));
             }
         }
+        // The data items: `step` and `time` are kept (the first value line of each).
+        let (mut item, mut step, mut time) = (None, None, None);
         loop {
             let p = lines.pos();
             match lines.next_line().map_err(|e| ctx.io(p, e))? {
@@ -181,10 +185,17 @@ impl FrameWalk for Sdf {
                     if t == b"M  END" || t.ends_with(b"V2000") || t.ends_with(b"V3000") {
                         return Err(ctx.parse(pos, line, line, "'$$$$' ending the record first"));
                     }
+                    match item.take() {
+                        Some(StepOrTime::Step) => step = parse_i64(t),
+                        Some(StepOrTime::Time) => time = parse_f64(t).filter(|v| v.is_finite()),
+                        None => item = data_header(line),
+                    }
                 }
             }
         }
         if let Some(f) = frame {
+            f.step = step;
+            f.time = time;
             crate::frame::set_ordered_bonds(f, bonds);
             if charges.iter().any(|&q| q != 0) {
                 f.properties.push(crate::frame::Property {
@@ -194,6 +205,27 @@ impl FrameWalk for Sdf {
             }
         }
         Ok(true)
+    }
+}
+
+/// The data items a frame keeps.
+#[derive(Clone, Copy)]
+enum StepOrTime {
+    Step,
+    Time,
+}
+
+/// Which kept item a data header line opens: `> <step>` or `> <time>`, also with the extra
+/// space, a registry number or a `DT` field number other programs add (`>  <time> (1)`).
+fn data_header(line: &[u8]) -> Option<StepOrTime> {
+    let rest = line.strip_prefix(b">")?;
+    let open = rest.iter().position(|&b| b == b'<')?;
+    let name = &rest[open + 1..];
+    let close = name.iter().position(|&b| b == b'>')?;
+    match &name[..close] {
+        b"step" => Some(StepOrTime::Step),
+        b"time" => Some(StepOrTime::Time),
+        _ => None,
     }
 }
 

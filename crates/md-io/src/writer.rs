@@ -265,7 +265,10 @@ impl<W: Write + Seek> Writer<W> {
             WriterKind::Mmcif(w) if self.written > 0 => {
                 state.first_cell = Some(w.first_cell.as_ref());
             }
-            WriterKind::Dcd(w) => state.step_kept = frame.step.map(|s| w.keeps_step(s)),
+            WriterKind::Dcd(w) => {
+                state.step_kept = frame.step.map(|s| w.keeps_step(s));
+                state.time_kept = frame.time.map(|t| w.keeps_time(frame.step, t));
+            }
             _ => {}
         }
         crate::dropped::dropped(self.output, frame, state)

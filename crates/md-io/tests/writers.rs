@@ -758,6 +758,7 @@ fn sdf_files_written_now_are_the_committed_ones_and_read_back() {
             assert_eq!(a.bonds, b.bonds, "{case}");
             assert_eq!(sdf_orders(a), b.bond_orders, "{case}");
             assert_eq!(sdf_title(a), b.comment, "{case}");
+            assert_eq!((a.step, a.time), (b.step, b.time), "{case}: data items");
         }
     }
     // The V2000/V3000 choice, charges and data items where they belong.
@@ -771,6 +772,28 @@ fn sdf_files_written_now_are_the_committed_ones_and_read_back() {
         vina.contains("> <minimizedAffinity>\n-4.268\n\n$$$$\n"),
         "{vina}"
     );
+}
+
+/// RDKit's `SDWriter` (2026.09) writes data items as `>  <name>  (1) `: the step and time
+/// of such a record are read, another item and a value that is no number are not.
+#[test]
+fn sdf_step_and_time_items_written_by_rdkit_are_read() {
+    let record = |step: &str, time: &str| {
+        format!(
+            "ethanol\n     RDKit          2D\n\n  3  2  0  0  0  0  0  0  0  0999 V2000\n\
+             \x20   0.0000    0.0000    0.0000 C   0  0  0  0  0  0  0  0  0  0  0  0\n\
+             \x20   1.2990    0.7500    0.0000 C   0  0  0  0  0  0  0  0  0  0  0  0\n\
+             \x20   2.5981   -0.0000    0.0000 O   0  0  0  0  0  0  0  0  0  0  0  0\n\
+             \x20 1  2  1  0\n  2  3  1  0\nM  END\n>  <step>  (1) \n{step}\n\n\
+             >  <time>  (1) \n{time}\n\n>  <note>  (1) \nx\n\n$$$$\n"
+        )
+    };
+    let text = record("7", "0.25") + &record("n/a", "late");
+    let back = read(Format::Sdf, &text);
+    assert_eq!(back.len(), 2);
+    assert_eq!((back[0].step, back[0].time), (Some(7), Some(0.25)));
+    assert_eq!((back[1].step, back[1].time), (None, None));
+    assert_eq!(back[0].positions[2], [2.5981, -0.0, 0.0]);
 }
 
 /// The committed SD files as RDKit read them (rdkit_reference.json) against the frames they
@@ -1267,46 +1290,34 @@ fn read_bytes(format: Format, name: &str, bytes: Vec<u8>) -> Vec<Frame> {
 
 /// What a file holds that our frame readers leave out, read from its bytes into `back`: a
 /// PDB's CONECT bonds (our PDB topology reader's), with the orders their repetition gives (a
-/// double bond listed twice from each atom, as Open Babel reads them), and an SD file's
-/// `step` and `time` data items.
+/// double bond listed twice from each atom, as Open Babel reads them).
 fn beyond_the_frame_reader(format: Format, bytes: &[u8], back: &mut Frame) {
-    let text = String::from_utf8_lossy(bytes);
-    match format {
-        Format::Pdb => {
-            let t = texmap_md_io::Topology::from_reader(
-                Cursor::new(bytes.to_vec()),
-                texmap_md_io::TopologyFormat::Pdb,
-                "out.pdb",
-            )
-            .unwrap();
-            back.bonds = t.bonds.clone();
-            // Each CONECT partner of atom serial a, counted per bond (serial = index + 1 here).
-            let mut count = std::collections::HashMap::<[u32; 2], u8>::new();
-            for l in text.lines().filter(|l| l.starts_with("CONECT")) {
-                let serial = |k: usize| {
-                    l.get(6 + 5 * k..11 + 5 * k)
-                        .map(|f| f.trim().parse::<u32>().unwrap())
-                };
-                let a = serial(0).unwrap() - 1;
-                for k in 1..=4 {
-                    if let Some(b) = serial(k) {
-                        *count.entry([a, b - 1]).or_default() += 1;
-                    }
-                }
-            }
-            back.bond_orders = t.bonds.iter().map(|b| count[b]).collect();
-        }
-        Format::Sdf => {
-            let item = |name: &str| {
-                let mut lines = text.lines();
-                lines.find(|l| l.trim() == format!("> <{name}>"))?;
-                lines.next().map(|v| v.trim().to_string())
-            };
-            back.step = item("step").map(|v| v.parse().unwrap());
-            back.time = item("time").map(|v| v.parse().unwrap());
-        }
-        _ => {}
+    if format != Format::Pdb {
+        return;
     }
+    let text = String::from_utf8_lossy(bytes);
+    let t = texmap_md_io::Topology::from_reader(
+        Cursor::new(bytes.to_vec()),
+        texmap_md_io::TopologyFormat::Pdb,
+        "out.pdb",
+    )
+    .unwrap();
+    back.bonds = t.bonds.clone();
+    // Each CONECT partner of atom serial a, counted per bond (serial = index + 1 here).
+    let mut count = std::collections::HashMap::<[u32; 2], u8>::new();
+    for l in text.lines().filter(|l| l.starts_with("CONECT")) {
+        let serial = |k: usize| {
+            l.get(6 + 5 * k..11 + 5 * k)
+                .map(|f| f.trim().parse::<u32>().unwrap())
+        };
+        let a = serial(0).unwrap() - 1;
+        for k in 1..=4 {
+            if let Some(b) = serial(k) {
+                *count.entry([a, b - 1]).or_default() += 1;
+            }
+        }
+    }
+    back.bond_orders = t.bonds.iter().map(|b| count[b]).collect();
 }
 
 /// Whether `b` gives `a` back within `tol` (absolute, plus 1e-5 relative: the text writers'
@@ -1385,10 +1396,10 @@ fn lost(w: &Frame, r: &Frame) -> Vec<texmap_md_io::Dropped> {
     if !within(w.colors.as_flattened(), r.colors.as_flattened(), 0.0) {
         lost.push(D::Colors);
     }
-    if !matches!((w.time, r.time), (Some(a), Some(b)) if (a - b).abs() < 1e-4) {
+    if w.time.is_some() && !matches!((w.time, r.time), (Some(a), Some(b)) if (a - b).abs() < 1e-4) {
         lost.push(D::Time);
     }
-    if r.step != w.step {
+    if w.step.is_some() && r.step != w.step {
         lost.push(D::Step);
     }
     lost.sort();
@@ -1509,6 +1520,37 @@ fn dropped_follows_values_and_earlier_frames() {
                 .to_vec(),
             vec![vec![], vec![], vec![], vec![D::Step]],
         ),
+        // A DCD keeps times proportional to the steps (readers compute step × one time
+        // step): from step 0, from a later step (a lone first frame sets the time step too),
+        // and not a time off the line or one without a step to scale.
+        (
+            Format::Dcd,
+            "out.dcd",
+            [(0, 0.0), (10, 0.02), (20, 0.04), (30, 0.07)]
+                .map(|(s, t)| with(&|f| (f.step, f.time) = (Some(s), Some(t))))
+                .to_vec(),
+            vec![vec![], vec![], vec![], vec![D::Time]],
+        ),
+        (
+            Format::Dcd,
+            "out.dcd",
+            vec![with(&|f| (f.step, f.time) = (Some(500), Some(1.0)))],
+            vec![vec![]],
+        ),
+        (
+            Format::Dcd,
+            "out.dcd",
+            [(500, 1.0), (1000, 2.0), (1500, 3.0)]
+                .map(|(s, t)| with(&|f| (f.step, f.time) = (Some(s), Some(t))))
+                .to_vec(),
+            vec![vec![], vec![], vec![]],
+        ),
+        (
+            Format::Dcd,
+            "out.dcd",
+            vec![with(&|f| (f.step, f.time) = (None, Some(2.5)))],
+            vec![vec![D::Time]],
+        ),
         // A PDB segment column holds 4 characters; CONECT repeats no aromatic bond.
         (
             Format::Pdb,
@@ -1532,6 +1574,25 @@ fn dropped_follows_values_and_earlier_frames() {
                 }
             })],
             vec![vec![D::Velocities, D::Property("mass".into())]],
+        ),
+        // LAMMPS types are numbers: labels are numbered (a GSD and an .xyz keep them).
+        (
+            Format::LammpsDump,
+            "out.lammpstrj",
+            vec![with(&|f| f.types = labels(&["CT", "OW", "CT", "HW"]))],
+            vec![vec![D::Types]],
+        ),
+        (
+            Format::LammpsData,
+            "out.data",
+            vec![with(&|f| f.types = labels(&["CT", "OW", "CT", "HW"]))],
+            vec![vec![D::Types]],
+        ),
+        (
+            Format::Gsd,
+            "out.gsd",
+            vec![with(&|f| f.types = labels(&["CT", "OW", "CT", "HW"]))],
+            vec![vec![]],
         ),
         // A GSD orientation needs all four quaternion components.
         (
@@ -1558,4 +1619,13 @@ fn dropped_follows_values_and_earlier_frames() {
             );
         }
     }
+    // Times not proportional to the steps (a run whose clock started before step 0): the
+    // first frame's time reads back only until the second frame sets the time step, so the
+    // loss is named with the second frame.
+    let offset =
+        [(100, 5.0), (110, 5.2)].map(|(s, t)| with(&|f| (f.step, f.time) = (Some(s), Some(t))));
+    let results = named_and_lost(Format::Dcd, "out.dcd", &offset);
+    let time = |v: &Vec<D>| v.contains(&D::Time);
+    assert!(!time(&results[0].0) && time(&results[0].1), "{results:?}");
+    assert!(time(&results[1].0) && time(&results[1].1), "{results:?}");
 }
