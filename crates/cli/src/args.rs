@@ -637,7 +637,9 @@ pub struct RenderArgs {
     /// 't = {ns} ns'. {time} is the frame's time in ps, {ns} in ns, {step} its MD step,
     /// {frame} its index in the file, {hbonds} the hydrogen bonds an hbonds representation
     /// draws in it, {vacancies} and {interstitials} the --wigner-seitz counts, {grains} the --grains count, {title} its title (an XYZ comment, a PDB TITLE, a Vina pose's 'VINA
-    /// RESULT: -7.5 ...'); a file whose frames carry no time (XYZ, PDB) takes {frame}. ASCII
+    /// RESULT: -7.5 ...'), and {KEY} the value of KEY=... in the frame's comment, with N decimals
+    /// as {KEY:.N}: 'E = {energy:.3} eV' for extended XYZ, ASE trajectories and pw.x outputs; a
+    /// file whose frames carry no time (XYZ, PDB) takes {frame}. ASCII
     /// only; the text is cut at half the image width.
     #[arg(long, value_name = "TEXT")]
     pub label: Option<String>,

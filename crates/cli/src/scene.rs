@@ -134,6 +134,27 @@ pub enum LabelPart {
     /// `{title}`: the frame's title (an XYZ comment line, a GRO title, a PDB TITLE, a docked
     /// pose's `REMARK VINA RESULT`), empty when it has none.
     Title,
+    /// `{KEY}` or `{KEY:.N}`: the value of `KEY=...` in the frame's comment, as extended XYZ
+    /// writes a frame's scalars (ASE's `energy=`, and what our ASE trajectory and pw.x readers
+    /// put there), a number with N decimals when `.N` is given.
+    Key {
+        name: String,
+        decimals: Option<usize>,
+    },
+}
+
+/// A `{KEY}` or `{KEY:.N}` placeholder's key and decimals, when `text` is one: a key starts
+/// with a letter or `_` and holds letters, digits, `_`, `-` and `.`; N is at most 12.
+fn comment_key(text: &str) -> Option<(&str, Option<usize>)> {
+    let (name, decimals) = match text.split_once(":.") {
+        Some((name, n)) => (name, Some(n.parse::<usize>().ok().filter(|n| *n <= 12)?)),
+        None => (text, None),
+    };
+    let mut chars = name.chars();
+    let first = chars.next()?;
+    ((first.is_ascii_alphabetic() || first == '_')
+        && chars.all(|c| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.')))
+    .then_some((name, decimals))
 }
 
 /// A `{placeholder}` template split into text and placeholders, each placeholder one of
@@ -175,7 +196,8 @@ fn template<'a>(
 }
 
 /// `--label`'s template, parsed before any frame is read: braces balanced, every placeholder
-/// `{time}`, `{ns}`, `{step}` or `{frame}`.
+/// one of the names below or a comment key (`{energy}`, `{energy:.3}`), which each frame must
+/// then have.
 pub fn parse_label(text: &str) -> Result<Vec<LabelPart>> {
     const NAMES: [&str; 9] = [
         "time",
@@ -188,8 +210,22 @@ pub fn parse_label(text: &str) -> Result<Vec<LabelPart>> {
         "interstitials",
         "grains",
     ];
-    let hint = "{time} (ps), {ns}, {step}, {frame}, {hbonds}, {vacancies}, {interstitials}, {grains} or {title}";
-    Ok(template("--label", text, &NAMES, hint)?
+    let hint = "{time} (ps), {ns}, {step}, {frame}, {hbonds}, {vacancies}, {interstitials}, {grains}, {title}, \
+                or {KEY} / {KEY:.N} for a KEY=value of the frame's comment (extended XYZ: {energy:.3})";
+    // The comment keys the template names, as further names after the fixed ones.
+    let mut names: Vec<&str> = NAMES.to_vec();
+    let mut rest = text;
+    while let Some(open) = rest.find('{') {
+        let Some(close) = rest[open..].find('}') else {
+            break;
+        };
+        let name = &rest[open + 1..open + close];
+        if !names.contains(&name) && comment_key(name).is_some() {
+            names.push(name);
+        }
+        rest = &rest[open + close + 1..];
+    }
+    Ok(template("--label", text, &names, hint)?
         .into_iter()
         .map(|p| match p {
             Ok(t) => LabelPart::Text(t.to_string()),
@@ -200,8 +236,15 @@ pub fn parse_label(text: &str) -> Result<Vec<LabelPart>> {
             Err(4) => LabelPart::HBonds,
             Err(5) => LabelPart::Title,
             Err(6) => LabelPart::Vacancies,
+            Err(7) => LabelPart::Interstitials,
             Err(8) => LabelPart::Grains,
-            Err(_) => LabelPart::Interstitials,
+            Err(k) => {
+                let (name, decimals) = comment_key(names[k]).unwrap_or((names[k], None));
+                LabelPart::Key {
+                    name: name.to_string(),
+                    decimals,
+                }
+            }
         })
         .collect())
 }
@@ -362,6 +405,31 @@ pub fn label_text(
             LabelPart::Interstitials => out.push_str(&defects.map_or(0, |d| d.1).to_string()),
             LabelPart::Grains => out.push_str(&grains.unwrap_or(0).to_string()),
             LabelPart::Title => out.push_str(frame.comment.trim()),
+            LabelPart::Key { name, decimals } => {
+                let Some(value) = frame.comment_value(name) else {
+                    let keys: Vec<&str> = frame.comment_pairs().map(|(k, _)| k).collect();
+                    let has = if keys.is_empty() {
+                        "no KEY=value pairs".to_string()
+                    } else {
+                        format!("the keys {}", keys.join(", "))
+                    };
+                    // Most often a mistyped placeholder: a usage error (exit 2).
+                    return crate::args::usage(format!(
+                        "--label {{{name}}}: frame {index} of {file} has no {name}= in its comment (it has {has}); the fixed placeholders are {{time}}, {{ns}}, {{step}}, {{frame}}, {{hbonds}}, {{vacancies}}, {{interstitials}}, {{grains}} and {{title}}"
+                    ));
+                };
+                match decimals {
+                    None => out.push_str(value),
+                    Some(n) => {
+                        let v: f64 = value.trim().parse().map_err(|_| {
+                            anyhow::anyhow!(
+                                "--label {{{name}:.{n}}}: frame {index} of {file} has {name}={value:?}, not a number"
+                            )
+                        })?;
+                        out.push_str(&format!("{v:.n$}"));
+                    }
+                }
+            }
         }
     }
     Ok(out)

@@ -785,6 +785,79 @@ fn label_captions_each_frame_with_its_time() {
     }
 }
 
+/// `--label '{energy:.4}'`: a key of the frame's comment, here the energy our ASE trajectory
+/// reader puts there, captions each frame with ASE's own `get_potential_energy()` (md-io's
+/// asetraj/reference.json.gz) to 4 decimals; a key no frame has is a usage error listing the
+/// keys it has, and a value that is no number with `:.N` a runtime error.
+#[test]
+fn label_takes_comment_keys_such_as_ase_energies() {
+    let traj = data("asetraj/cu_md.traj");
+    let mut gz = String::new();
+    std::io::Read::read_to_string(
+        &mut flate2::read::GzDecoder::new(
+            std::fs::File::open(data("asetraj/reference.json.gz")).unwrap(),
+        ),
+        &mut gz,
+    )
+    .unwrap();
+    let v: serde_json::Value = serde_json::from_str(&gz).unwrap();
+    let energies: Vec<f64> = v["cu_md.traj"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f["energy"].as_f64().unwrap())
+        .collect();
+    let dir = tempfile::tempdir().unwrap();
+    let render = |label: Option<&str>, name: &str| {
+        let out = dir.path().join(name);
+        let mut args = vec![
+            "render",
+            "--quiet",
+            &traj,
+            "--frames",
+            "0:3",
+            "--size",
+            "240x180",
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        if let Some(l) = label {
+            args.extend(["--label", l]);
+        }
+        texmap(&args)
+    };
+    for (label, name) in [
+        (None, "plain-%d.png"),
+        (Some("E = {energy:.4} eV"), "e-%d.png"),
+    ] {
+        let o = render(label, name);
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    for (f, e) in energies.iter().take(3).enumerate() {
+        let read = |name: &str| {
+            image::open(dir.path().join(format!("{name}-{f}.png")))
+                .unwrap()
+                .to_rgba8()
+        };
+        let mut want = read("plain");
+        let text = format!("E = {e:.4} eV");
+        let (w, h) = want.dimensions();
+        texmap_md_scene::draw_caption(&mut want, w as usize, h as usize, &text);
+        assert!(read("e") == want, "frame {f}: {text}");
+    }
+    let o = render(Some("{enrgy}"), "bad-%d.png");
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("has no enrgy= in its comment (it has the keys energy"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!dir.path().join("bad-0.png").exists());
+    let o = render(Some("{stress:.2}"), "nan-%d.png");
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("not a number"), "{}", stderr(&o));
+}
+
 /// `--rep SEL=STYLE`: one representation is `--select SEL --style STYLE` byte for byte; a second
 /// adds its atoms (here residues 420-432 as balls and sticks over the tube); a style that does not exist, a missing '=', or --rep with --select are usage errors.
 /// 3GWI chain A rendered at 320x240 down z with `extra` flags into `dir/name`.

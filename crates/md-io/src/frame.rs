@@ -418,6 +418,29 @@ impl Frame {
         self.positions.len()
     }
 
+    /// The comment's `key=value` pairs, as extended XYZ writes a frame's scalars (ASE's
+    /// `info`, `energy=-12.3 config_type="bulk"`; our ASE trajectory and pw.x readers put the
+    /// energy there too): every pair, in order, quotes taken off the values.
+    ///
+    /// ```
+    /// let mut f = texmap_md_io::Frame::new();
+    /// f.comment = r#"Lattice="5 0 0 0 5 0 0 0 5" energy=-12.5 config_type="bulk Si" pbc="T T T""#.into();
+    /// assert_eq!(f.comment_value("energy"), Some("-12.5"));
+    /// assert_eq!(f.comment_value("config_type"), Some("bulk Si"));
+    /// assert_eq!(f.comment_value("Energy"), None);
+    /// ```
+    pub fn comment_pairs(&self) -> impl Iterator<Item = (&str, &str)> {
+        crate::xyz::key_values(self.comment.as_bytes())
+            .filter_map(|(k, v)| Some((std::str::from_utf8(k).ok()?, std::str::from_utf8(v).ok()?)))
+    }
+
+    /// The value of `key` (case as written) among [`Frame::comment_pairs`].
+    pub fn comment_value(&self, key: &str) -> Option<&str> {
+        self.comment_pairs()
+            .find(|(k, _)| *k == key)
+            .map(|(_, v)| v)
+    }
+
     /// Empties every buffer, keeping its capacity.
     pub fn clear(&mut self) {
         self.positions.clear();

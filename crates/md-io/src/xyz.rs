@@ -82,7 +82,7 @@ fn short_key(b: &[u8]) -> u32 {
 }
 
 /// Splits an extended-XYZ comment into key=value pairs (values may be "double quoted").
-fn key_values(line: &[u8]) -> impl Iterator<Item = (&[u8], &[u8])> {
+pub(crate) fn key_values(line: &[u8]) -> impl Iterator<Item = (&[u8], &[u8])> {
     let mut i = 0;
     std::iter::from_fn(move || {
         loop {
