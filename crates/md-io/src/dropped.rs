@@ -37,7 +37,8 @@
 //! Precision (PDB's 3 decimals, XTC's 0.001 nm, GRO's fixed columns), atom ids (renumbered
 //! 1, 2, ... by .data, .sdf and the outputs without ids), elements (written by most outputs as
 //! symbols, in .xyz and .gro as the names, from which readers guess them), the title line, and
-//! the cell's origin and open edges.
+//! the cell's origin and open edges, and the comment's `KEY=value` pairs (an energy, a stress),
+//! which .xyz writes again and the other outputs have no place for.
 
 use crate::format::Format;
 use crate::frame::Frame;

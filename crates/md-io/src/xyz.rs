@@ -13,9 +13,15 @@
 //!   (R:3, sRGB in [0, 1]), `type` (→ types), `id` (→ ids), `Z` (→ elements); every other real
 //!   or integer column of one component (ASE's `masses`, `initial_charges`, `energies`, ...) is
 //!   a property of that name ([`Frame::property`]), where `nan` and `inf` (as ASE writes
-//!   them) are NaN and infinity; the rest are skipped. Without `Properties` the columns are
-//!   `species:S:1:pos:R:3`.
+//!   them) are NaN and infinity; a real or integer column of 2 to 9 components is one property
+//!   per component, `fx fy fz` for ASE's `forces:R:3` (the names LAMMPS dumps give forces),
+//!   else `NAME[1]` .. `NAME[n]` (`momenta[1]`, as LAMMPS names a vector compute's columns);
+//!   the rest (strings, logicals, wider columns) are skipped. Without `Properties` the columns
+//!   are `species:S:1:pos:R:3`.
 //! - `Time=` (ps) and `step=`/`Step=`/`timestep=` when present.
+//!
+//! The comment line stays the frame's [`Frame::comment`], so its other pairs (ASE's `energy=`,
+//! `stress="…"`, `config_type=`) are at hand through [`Frame::comment_value`].
 //!
 //! Elements come from the species by [`crate::elements::guess_element`] (species are normally
 //! symbols, so "Ca" and "CA" are calcium).
@@ -45,6 +51,54 @@ enum Col {
     /// A real or integer column of one component: property `k` of `Xyz::properties`.
     Property(usize),
     Skip(usize),
+}
+
+/// The most components a vector column is read as properties with (ASE's widest are 9: a
+/// per-atom stress tensor); wider columns are skipped.
+const MAX_VECTOR: usize = 9;
+
+/// The property name of component `k` (from 0) of the vector column `name` of `n` components:
+/// `fx fy fz` for ASE's `forces:R:3` (the names LAMMPS dumps give forces), else `name[k+1]`
+/// (as LAMMPS names a vector compute's columns).
+fn component(name: &str, k: usize, n: usize) -> String {
+    if name == "forces" && n == 3 {
+        ["fx", "fy", "fz"][k].to_string()
+    } else {
+        format!("{name}[{}]", k + 1)
+    }
+}
+
+/// The columns [`XyzWriter`] writes for the frame's properties, in order: `(name, first
+/// property, components)`: `forces` for `fx fy fz` in a row, `NAME` for `NAME[1]` ..
+/// `NAME[n]` in a row (n ≥ 2), else each property alone.
+fn property_columns(frame: &Frame) -> Vec<(String, usize, usize)> {
+    let props = &frame.properties;
+    let mut out = Vec::new();
+    let mut k = 0;
+    while k < props.len() {
+        let name = props[k].name.as_str();
+        let forces = props[k..]
+            .iter()
+            .map(|p| p.name.as_str())
+            .take(3)
+            .eq(["fx", "fy", "fz"]);
+        let run = name.strip_suffix("[1]").map(|base| {
+            let n = props[k..]
+                .iter()
+                .enumerate()
+                .take_while(|(j, p)| p.name == format!("{base}[{}]", j + 1))
+                .count();
+            (base, n)
+        });
+        let (col, n) = match run {
+            _ if forces => ("forces".to_string(), 3),
+            Some((base, n)) if n >= 2 => (base.to_string(), n),
+            _ => (name.to_string(), 1),
+        };
+        out.push((col, k, n));
+        k += n;
+    }
+    out
 }
 
 /// XYZ frame parser state: the columns of the current frame and a species → element cache.
@@ -201,6 +255,16 @@ impl Xyz {
         Ok(())
     }
 
+    /// The column of property `name`: a new property, or skipped when the name came before.
+    fn property_col(&mut self, name: String) -> Col {
+        if self.properties.contains(&name) {
+            Col::Skip(1)
+        } else {
+            self.properties.push(name);
+            Col::Property(self.properties.len() - 1)
+        }
+    }
+
     fn parse_properties(
         &mut self,
         ctx: &Ctx,
@@ -228,13 +292,16 @@ impl Xyz {
                 b"id" if ty == b"I" && count == 1 => Col::Id,
                 b"Z" if ty == b"I" && count == 1 => Col::Z,
                 _ if (ty == b"R" || ty == b"I") && count == 1 => {
-                    let name = String::from_utf8_lossy(name).into_owned();
-                    if self.properties.contains(&name) {
-                        Col::Skip(1)
-                    } else {
-                        self.properties.push(name);
-                        Col::Property(self.properties.len() - 1)
+                    self.property_col(String::from_utf8_lossy(name).into_owned())
+                }
+                _ if (ty == b"R" || ty == b"I") && count <= MAX_VECTOR => {
+                    // A vector column: ASE's forces as fx fy fz, any other as name[1]..name[n].
+                    let name = String::from_utf8_lossy(name);
+                    for k in 0..count - 1 {
+                        let col = self.property_col(component(&name, k, count));
+                        self.cols.push(col);
                     }
+                    self.property_col(component(&name, count - 1, count))
                 }
                 _ => Col::Skip(count),
             };
@@ -437,8 +504,12 @@ impl TextFormat for Xyz {
 /// columns in this order: `species:S:1:pos:R:3`, `id:I:1` when the frame has ids, `type:S:1`
 /// when it has types, `velo:R:3`, `radius:R:1`, `color:R:3` when it has velocities, radii,
 /// colours, then each of [`Frame::properties`] in order as `NAME:I:1` when every value is an
-/// integer below 2^24 in magnitude (written without a decimal point), else `NAME:R:1`; then
-/// `Time=` and `step=` when known and `pbc="T T F"` (the cell's periodic edges) with a cell.
+/// integer below 2^24 in magnitude (written without a decimal point), else `NAME:R:1`, except
+/// that `fx fy fz` in a row are ASE's `forces:R:3` and `NAME[1]` .. `NAME[n]` in a row one
+/// `NAME:R:n` column, as the reader reads them; then `Time=` and `step=` when known,
+/// `pbc="T T F"` (the cell's periodic edges) with a cell, and the frame's comment's other
+/// `KEY=value` pairs (an energy, a stress, ASE's `info`), so that a training set for a
+/// machine-learned potential keeps its energies.
 ///
 /// The species of an atom is its name, else its element's symbol, else `X`. Numbers are
 /// written in Rust's shortest round-trip form, so reading them back gives the same f32 bits; a
@@ -454,6 +525,24 @@ pub(crate) struct XyzWriter<W> {
     pub out: W,
 }
 
+/// The keys of the frame's comment [`XyzWriter`] writes again after its own (`energy=`,
+/// `stress="…"`, `config_type=`: a frame's scalars as ASE writes them): every pair with a value
+/// and a key other than those the writer writes or readers take for a field.
+fn carried_pairs(frame: &Frame) -> impl Iterator<Item = (&str, &str)> {
+    const OWN: [&str; 7] = [
+        "Lattice",
+        "Origin",
+        "Properties",
+        "Time",
+        "step",
+        "timestep",
+        "pbc",
+    ];
+    frame
+        .comment_pairs()
+        .filter(|(k, v)| !v.is_empty() && !OWN.iter().any(|o| o.eq_ignore_ascii_case(k)))
+}
+
 /// The `Properties=` names [`XyzWriter`] writes itself or readers map to another field.
 const XYZ_RESERVED: [&str; 9] = [
     "species", "pos", "id", "type", "velo", "radius", "color", "Z", "radii",
@@ -461,8 +550,9 @@ const XYZ_RESERVED: [&str; 9] = [
 
 /// Why property names cannot be written as XYZ columns, if they cannot.
 fn check_xyz_properties(frame: &Frame) -> Result<(), String> {
-    for (k, p) in frame.properties.iter().enumerate() {
-        let name = p.name.as_str();
+    let columns = property_columns(frame);
+    for (k, (name, _, _)) in columns.iter().enumerate() {
+        let name = name.as_str();
         if name.is_empty() || !name.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'_') {
             return Err(format!(
                 "property '{name}' is not an extended-XYZ column name: letters, digits and _"
@@ -475,7 +565,7 @@ fn check_xyz_properties(frame: &Frame) -> Result<(), String> {
                 XYZ_RESERVED.join(", ")
             ));
         }
-        if frame.properties[..k].iter().any(|q| q.name == name) {
+        if columns[..k].iter().any(|q| q.0 == name) {
             return Err(format!("property '{name}' appears twice"));
         }
     }
@@ -542,9 +632,14 @@ impl<W: std::io::Write> XyzWriter<W> {
         if !frame.colors.is_empty() {
             write!(w, ":color:R:3")?;
         }
-        for p in &frame.properties {
-            let ty = if integer_valued(&p.values) { 'I' } else { 'R' };
-            write!(w, ":{}:{ty}:1", p.name)?;
+        for (name, k, n) in property_columns(frame) {
+            let props = &frame.properties[k..k + n];
+            let ty = if props.iter().all(|p| integer_valued(&p.values)) {
+                'I'
+            } else {
+                'R'
+            };
+            write!(w, ":{name}:{ty}:{n}")?;
         }
         if let Some(t) = frame.time {
             write!(w, " Time={t}")?;
@@ -555,6 +650,13 @@ impl<W: std::io::Write> XyzWriter<W> {
         if let Some(cell) = &frame.cell {
             let [a, b, c] = cell.periodic().map(|p| if p { 'T' } else { 'F' });
             write!(w, " pbc=\"{a} {b} {c}\"")?;
+        }
+        for (key, value) in carried_pairs(frame) {
+            if value.contains([' ', '\t']) {
+                write!(w, " {key}=\"{value}\"")?;
+            } else {
+                write!(w, " {key}={value}")?;
+            }
         }
         writeln!(w)?;
         // Atom lines.

@@ -395,3 +395,105 @@ fn pdb_writer_keeps_chains_and_segments() {
     let e = w.write_frame(&frame).unwrap_err().to_string();
     assert!(e.contains("chain \"AA\""), "{e}");
 }
+
+/// A machine-learning training set as ASE 3.29 writes it (tests/data/gen_ase_forces.py):
+/// `forces:R:3` and `momenta:R:3` columns and the energy, stress and a string in the comment.
+/// Read, the forces are `fx fy fz` and the momenta `momenta[1..3]`, equal to ASE's values
+/// (ase_forces.json); written back, the columns are `forces:R:3` and `momenta:R:3` again with
+/// the comment's pairs, and ASE reads our file to the same energy, forces, stress, momenta and
+/// info (live when python3 has ASE, else SKIPPED).
+#[test]
+fn ase_training_sets_keep_forces_vectors_and_energies_both_ways() {
+    let reference: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(data("ase_forces.json")).unwrap()).unwrap();
+    let frames_ref = reference["frames"].as_array().unwrap();
+    let (frames, ours) = ours(Format::Xyz, "ase_forces.xyz");
+    assert_eq!(frames.len(), frames_ref.len());
+    let close = |a: f64, b: f64, what: &str| {
+        assert!(
+            (a - b).abs() <= 1e-7 * b.abs().max(1.0),
+            "{what}: {a} against ASE's {b}"
+        );
+    };
+    for (f, r) in frames.iter().zip(frames_ref) {
+        for (name, key, k) in [
+            ("fx", "forces", 0),
+            ("fy", "forces", 1),
+            ("fz", "forces", 2),
+            ("momenta[1]", "momenta", 0),
+            ("momenta[2]", "momenta", 1),
+            ("momenta[3]", "momenta", 2),
+        ] {
+            let ours = f.property(name).unwrap_or_else(|| panic!("{name}"));
+            for (i, v) in ours.iter().enumerate() {
+                close(*v as f64, r[key][i][k].as_f64().unwrap(), name);
+            }
+        }
+        let energy: f64 = f.comment_value("energy").unwrap().parse().unwrap();
+        close(energy, r["energy"].as_f64().unwrap(), "energy");
+        assert_eq!(f.comment_value("config_type"), r["config_type"].as_str());
+    }
+    let text = String::from_utf8(ours.clone()).unwrap();
+    let header = text.lines().nth(1).unwrap();
+    assert!(
+        header.contains("Properties=species:S:1:pos:R:3:momenta:R:3:forces:R:3 ")
+            && header
+                .contains(" config_type=\"bulk md\" energy=-12.5 free_energy=-12.75 stress=\""),
+        "{header}"
+    );
+    // Read back by us: the same frames, the same comment values (the comment line's text is
+    // ours: pairs in our order, numbers in our form).
+    let mut t =
+        Trajectory::from_reader(Cursor::new(ours.clone()), Format::Xyz, "ours.xyz").unwrap();
+    let mut back = stream(&mut t);
+    let mut want = frames.clone();
+    for (b, w) in back.iter_mut().zip(&mut want) {
+        for key in ["energy", "free_energy", "stress", "config_type"] {
+            assert_eq!(b.comment_value(key), w.comment_value(key), "{key}");
+        }
+        (b.comment, w.comment) = (String::new(), String::new());
+    }
+    assert_eq!(back, want);
+    // Read by ASE.
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("ours.xyz");
+    std::fs::write(&path, &ours).unwrap();
+    let script = "import json, sys\nfrom ase.io import read\nprint(json.dumps([{'energy': a.get_potential_energy(), 'forces': a.get_forces().tolist(), 'momenta': a.get_momenta().tolist(), 'stress': a.get_stress(voigt=False).tolist(), 'config_type': a.info['config_type']} for a in read(sys.argv[1], ':')]))";
+    let out = match std::process::Command::new("python3")
+        .args(["-c", script, path.to_str().unwrap()])
+        .output()
+    {
+        Ok(o) if o.status.success() => o,
+        Ok(o) => {
+            let e = String::from_utf8_lossy(&o.stderr);
+            assert!(e.contains("No module named"), "ASE failed on our file: {e}");
+            println!("SKIPPED: python3 has no ASE");
+            return;
+        }
+        Err(_) => {
+            println!("SKIPPED: python3 not found");
+            return;
+        }
+    };
+    let ase: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    for (a, r) in ase.as_array().unwrap().iter().zip(frames_ref) {
+        close(
+            a["energy"].as_f64().unwrap(),
+            r["energy"].as_f64().unwrap(),
+            "energy",
+        );
+        assert_eq!(a["config_type"], r["config_type"]);
+        for key in ["forces", "momenta", "stress"] {
+            for (x, y) in a[key]
+                .as_array()
+                .unwrap()
+                .iter()
+                .zip(r[key].as_array().unwrap())
+            {
+                for k in 0..3 {
+                    close(x[k].as_f64().unwrap(), y[k].as_f64().unwrap(), key);
+                }
+            }
+        }
+    }
+}
