@@ -52,6 +52,11 @@ pub enum EnvmapCmd {
         #[arg(long, value_name = "SECONDS", default_value_t = texmap_study::envmap::STALENESS_DT)]
         staleness_dt: f32,
     },
+    #[command(
+        about = crate::envmap_bake::ABOUT,
+        long_about = crate::envmap_bake::LONG_ABOUT
+    )]
+    Bake(crate::envmap_bake::BakeArgs),
 }
 
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -161,6 +166,7 @@ pub fn run(a: EnvmapArgs) -> Result<()> {
             staleness_frames,
             staleness_dt,
         }) => compare(&out, &size, samples, staleness_frames, staleness_dt),
+        Some(EnvmapCmd::Bake(b)) => crate::envmap_bake::run(&b),
         None => render(&a.render),
     }
 }
@@ -204,7 +210,7 @@ fn compare(
 }
 
 /// A lat-long environment from a PNG (sRGB), EXR or Radiance HDR (linear) file.
-fn load_environment(path: &Path) -> Result<Environment> {
+pub(crate) fn load_environment(path: &Path) -> Result<Environment> {
     let ext = path
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
@@ -264,7 +270,26 @@ fn build(
         Some(ior) => Surface::Refractive { ior },
         None => Surface::Mirror,
     };
+    let s = build_scene(&a.scene, surface, env, t)?;
     if a.scene == "builtin" {
+        return Ok((s, tunnel_camera(w, h)?));
+    }
+    // Orbit the target at three bounding radii.
+    let r = s.radius().max(1e-3);
+    let ang = 0.4 + t * 0.5;
+    let eye = s.centre() + Vec3::new(ang.sin() * 3.0 * r, 0.8 * r, ang.cos() * 3.0 * r);
+    let cam = Camera::perspective_look_at(eye, s.centre(), Vec3::Y, 50.0, w, h)?;
+    Ok((s, cam))
+}
+
+/// The scene of `--scene` (`builtin` or a mesh file) at time `t`, with the `--env` environment.
+pub(crate) fn build_scene(
+    scene: &str,
+    surface: Surface,
+    env: &Option<Environment>,
+    t: f32,
+) -> Result<EnvScene> {
+    if scene == "builtin" {
         let s = tunnel_scene(TunnelParams {
             time: t,
             detail: 1,
@@ -279,9 +304,9 @@ fn build(
             )?,
             None => s,
         };
-        return Ok((s, tunnel_camera(w, h)?));
+        return Ok(s);
     }
-    let path = Path::new(&a.scene);
+    let path = Path::new(scene);
     let ext = path
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
@@ -291,8 +316,7 @@ fn build(
         "gltf" | "glb" => texmap_mesh::read_gltf(path)?,
         _ => {
             return usage(format!(
-                "--scene {:?}: expected builtin, or a .obj, .gltf or .glb file",
-                a.scene
+                "--scene {scene:?}: expected builtin, or a .obj, .gltf or .glb file"
             ));
         }
     };
@@ -313,7 +337,7 @@ fn build(
             material: Material::matte(palette[i % palette.len()]),
         })
         .collect();
-    let s = EnvScene::new(
+    EnvScene::new(
         objects,
         Target {
             shape: TargetShape::Mesh(first),
@@ -322,13 +346,7 @@ fn build(
         env.clone().unwrap_or(Environment::Sky),
         tunnel_lighting(),
     )
-    .with_context(|| format!("{}", path.display()))?;
-    // Orbit the target at three bounding radii.
-    let r = s.radius().max(1e-3);
-    let ang = 0.4 + t * 0.5;
-    let eye = s.centre() + Vec3::new(ang.sin() * 3.0 * r, 0.8 * r, ang.cos() * 3.0 * r);
-    let cam = Camera::perspective_look_at(eye, s.centre(), Vec3::Y, 50.0, w, h)?;
-    Ok((s, cam))
+    .with_context(|| format!("{}", path.display()))
 }
 
 fn render(a: &EnvRenderArgs) -> Result<()> {

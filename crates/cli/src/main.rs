@@ -8,6 +8,7 @@ mod args;
 mod commands;
 mod convert;
 mod envmap;
+mod envmap_bake;
 mod movie;
 mod output;
 mod plot;

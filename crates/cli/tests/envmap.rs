@@ -195,3 +195,172 @@ fn a_radiance_hdr_environment_reads_as_opencv_decodes_it() {
     let builtin = envmap(dir.path(), "sky.png", &[]);
     assert!(psnr(&a, &builtin) < 30.0);
 }
+
+fn ffmpeg_available() -> bool {
+    std::process::Command::new("ffmpeg")
+        .arg("-version")
+        .output()
+        .is_ok_and(|o| o.status.success())
+}
+
+/// `texmap envmap bake -q extra... -o out`, which must succeed.
+fn bake(out: &Path, extra: &[&str]) {
+    let mut args = vec!["envmap", "bake", "-q", "-o", out.to_str().unwrap()];
+    args.extend(extra);
+    let o = texmap(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+/// ffmpeg's v360 turning our c3x2 into an equirect agrees with our own equirect of the same
+/// probe: ffmpeg reads the faces by its own table, so a face in the wrong place or orientation
+/// would differ by tens of levels over a whole face.
+#[test]
+fn bake_c3x2_through_ffmpeg_matches_our_equirect() {
+    if !ffmpeg_available() {
+        eprintln!("SKIPPED: ffmpeg not found");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let (c3x2, ours, theirs) = (
+        dir.path().join("a.png"),
+        dir.path().join("e.png"),
+        dir.path().join("b.png"),
+    );
+    let n = 64;
+    let common = ["--size", "64", "--time", "0.5"];
+    bake(&c3x2, &[&common[..], &["--layout", "c3x2"]].concat());
+    bake(&ours, &[&common[..], &["--layout", "equirect"]].concat());
+    let o = std::process::Command::new("ffmpeg")
+        .args(["-loglevel", "error", "-y", "-i"])
+        .arg(&c3x2)
+        .args(["-vf", &format!("v360=c3x2:e:w={}:h={}", 4 * n, 2 * n)])
+        .arg(&theirs)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let a = image::open(&ours).unwrap().to_rgb8();
+    let b = image::open(&theirs).unwrap().to_rgb8();
+    assert_eq!(a.dimensions(), (4 * n, 2 * n));
+    assert_eq!(a.dimensions(), b.dimensions());
+    let mad = a
+        .as_raw()
+        .iter()
+        .zip(b.as_raw())
+        .map(|(x, y)| (*x as f64 - *y as f64).abs())
+        .sum::<f64>()
+        / a.as_raw().len() as f64;
+    // Both resample bilinearly, ffmpeg on the 8-bit sRGB codes and we in linear light, so
+    // edges differ by a few levels. Measured (ffmpeg 5.1): 0.93 levels of 255; the c3x2 image
+    // mirrored left-right before ffmpeg reads it: 47.
+    assert!(
+        mad < 2.0,
+        "mean absolute difference {mad:.3} levels, bound 2"
+    );
+}
+
+/// Read an EXR's RGB as floats.
+fn read_exr(path: &Path) -> (usize, usize, Vec<[f32; 3]>) {
+    let img = exr::prelude::read_first_rgba_layer_from_file(
+        path,
+        |res, _| (res.width(), vec![[0.0f32; 3]; res.width() * res.height()]),
+        |(w, px), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+            px[pos.y() * *w + pos.x()] = [r, g, b];
+        },
+    )
+    .unwrap();
+    let size = img.layer_data.size;
+    (
+        size.width(),
+        size.height(),
+        img.layer_data.channel_data.pixels.1,
+    )
+}
+
+/// The EXR files hold the library's floats bit for bit, the faces under their px..nz names, and
+/// `--frame 12` is `--time 0.5` (frames 1/24 s apart, as `texmap envmap --frames`).
+#[test]
+fn bake_exr_holds_the_librarys_floats() {
+    use texmap_envmap::address::Face;
+    use texmap_envmap::bake::{BakeOptions, Layout, bake as bake_probe, face_name};
+    use texmap_envmap::scene::{TunnelParams, tunnel_scene};
+
+    let dir = tempfile::tempdir().unwrap();
+    let n = 32u32;
+    let scene = tunnel_scene(TunnelParams {
+        time: 0.5,
+        ..Default::default()
+    })
+    .unwrap();
+    let at = texmap_envmap::glam::Vec3::new(0.5, -0.25, -2.0);
+    let probe = bake_probe(
+        &scene,
+        &BakeOptions {
+            at: Some(at),
+            size: n,
+        },
+    )
+    .unwrap();
+    let bits = |v: &[[f32; 3]]| -> Vec<u32> { v.iter().flatten().map(|c| c.to_bits()).collect() };
+    let lib_bits = |v: &[texmap_envmap::glam::Vec3]| -> Vec<u32> {
+        v.iter()
+            .flat_map(|c| c.to_array())
+            .map(f32::to_bits)
+            .collect()
+    };
+    let cross = dir.path().join("cross.exr");
+    bake(
+        &cross,
+        &["--size", "32", "--frame", "12", "--at", "0.5,-0.25,-2"],
+    );
+    let (w, h, px) = read_exr(&cross);
+    let want = probe.layout(Layout::Cross).remove(0);
+    assert_eq!((w as u32, h as u32), (want.width, want.height));
+    assert_eq!(bits(&px), lib_bits(&want.texels));
+    let pattern = dir.path().join("faces/probe_{face}.exr");
+    bake(
+        &pattern,
+        &[
+            "--size",
+            "32",
+            "--time",
+            "0.5",
+            "--at",
+            "0.5,-0.25,-2",
+            "--layout",
+            "faces",
+        ],
+    );
+    for face in Face::ALL {
+        let path = dir
+            .path()
+            .join(format!("faces/probe_{}.exr", face_name(face)));
+        let (w, h, px) = read_exr(&path);
+        assert_eq!((w as u32, h as u32), (n, n));
+        assert_eq!(bits(&px), lib_bits(probe.face(face)), "{face:?}");
+    }
+}
+
+#[test]
+fn bad_bake_options_are_usage_errors_and_write_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name).to_str().unwrap().to_owned();
+    for (args, what) in [
+        (vec!["--size", "0", "-o", &p("a.png")], "--size"),
+        (vec!["--layout", "faces", "-o", &p("f.exr")], "{face}"),
+        (vec!["-o", &p("probe.jpg")], ".exr"),
+        (vec!["-o", &p("probe_{face}.exr")], "{face}"),
+        (vec!["--at", "1,2", "-o", &p("a.exr")], "--at"),
+    ] {
+        let mut all = vec!["envmap", "bake"];
+        if !args.contains(&"--size") {
+            all.extend(["--size", "8"]);
+        }
+        all.extend(args.iter().copied());
+        let o = texmap(&all);
+        assert_eq!(o.status.code(), Some(2), "{args:?}");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.contains(what), "{args:?}: {err}");
+        let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+        assert!(left.is_empty(), "{args:?} left {left:?}");
+    }
+}

@@ -13,6 +13,7 @@
 //! | `Paraboloid` | two paraboloids, objects mapped like the sphere map | every frame |
 //!
 //! - [`address`]: direction ⇄ map coordinates for the three layouts, both ways;
+//! - [`bake`]: a probe baked by the cube map's update, as OpenGL faces, cross, c3x2 or lat-long;
 //! - [`environment`]: the background at infinity (a lat-long image or the built-in sky);
 //! - [`maps`]: map storage, static construction, filtered lookups, dynamic updates (with the
 //!   rim-straddling triangles split, never smeared);
@@ -44,6 +45,7 @@
 pub use glam;
 
 pub mod address;
+pub mod bake;
 pub mod environment;
 pub mod error;
 pub mod maps;

@@ -4,6 +4,8 @@
 //! file in this directory is a module listed below ([`listed`] fails when one is not); the
 //! helper modules they share are declared here once.
 
+#[path = "bake.rs"]
+mod bake;
 #[path = "behaviour.rs"]
 mod behaviour;
 #[path = "time_slicing.rs"]
