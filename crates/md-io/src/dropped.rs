@@ -27,6 +27,7 @@
 //! | colours | .xyz, .lammpstrj |
 //! | time | .xyz, .gro, .xtc, .trr, .nc, .sdf (a data item); .dcd when the times are proportional to the steps (readers compute step × the header's time step) |
 //! | step | .xyz, .lammpstrj, .gro, .xtc, .trr, .gsd, .sdf (a data item); .dcd when the steps are evenly spaced from a first step of at least 0 |
+//! | the comment's `KEY=value` pairs that are no field (ASE's `energy=`, `stress=`, `info`; what our pw.x and ASE trajectory readers put there) | .xyz (after its own keys); as the title line: .gro, .sdf (the name line), .data, POSCAR, and XDATCAR while the frames' lines equal the first's |
 //!
 //! Bond orders are named only when the bonds themselves are kept (without bonds there is
 //! nothing to order). tests/writers.rs checks the table against the files: a frame carrying
@@ -36,9 +37,9 @@
 //! # Not reported
 //! Precision (PDB's 3 decimals, XTC's 0.001 nm, GRO's fixed columns), atom ids (renumbered
 //! 1, 2, ... by .data, .sdf and the outputs without ids), elements (written by most outputs as
-//! symbols, in .xyz and .gro as the names, from which readers guess them), the title line, and
-//! the cell's origin and open edges, and the comment's `KEY=value` pairs (an energy, a stress),
-//! which .xyz writes again and the other outputs have no place for.
+//! symbols, in .xyz and .gro as the names, from which readers guess them), the title line (but
+//! for its `KEY=value` pairs), and
+//! the cell's origin and open edges.
 
 use crate::format::Format;
 use crate::frame::Frame;
@@ -83,6 +84,9 @@ pub enum Dropped {
     Time,
     /// [`Frame::step`].
     Step,
+    /// The `KEY=value` pairs of [`Frame::comment`] that are no field of the frame (an energy, a
+    /// stress, ASE's `info`: [`Frame::comment_pairs`] but for the cell, columns, time and step).
+    CommentValues,
 }
 
 /// What a [`Dropped`] kind is counted in: atoms, bonds or frames.
@@ -220,6 +224,9 @@ pub(crate) fn keeps(output: Output, kind: &Dropped) -> bool {
         Dropped::Colors => matches!(output, Xyz | LammpsDump),
         Dropped::Time => matches!(output, Xyz | Gro | Dcd | Xtc | Trr | Netcdf | Sdf),
         Dropped::Step => matches!(output, Xyz | LammpsDump | Gro | Dcd | Xtc | Trr | Gsd | Sdf),
+        // The title lines: .gro's and .sdf's per frame, a data file's and a POSCAR's one frame,
+        // an XDATCAR's first.
+        Dropped::CommentValues => matches!(output, Xyz | LammpsData | Gro | Poscar | Xdatcar | Sdf),
     }
 }
 
@@ -256,12 +263,13 @@ fn group(output: Output, name: &str) -> Option<&'static [&'static str]> {
 
 /// What the writer's state adds to the table: for a .cif after its first frame, that frame's
 /// cell (the only one the file holds); for a DCD, whether it gives the frame's step and time
-/// back.
+/// back; for an XDATCAR, whether the frame's comment is the first's.
 #[derive(Default)]
 pub(crate) struct State<'a> {
     pub first_cell: Option<Option<&'a crate::UnitCell>>,
     pub step_kept: Option<bool>,
     pub time_kept: Option<bool>,
+    pub comment_kept: Option<bool>,
 }
 
 /// What of `frame` writing it to `output` loses, with the writer's `state`: the kinds the
@@ -380,6 +388,11 @@ pub(crate) fn dropped(output: Output, frame: &Frame, state: State) -> Vec<Droppe
             frame.step.is_some(),
             table(&Dropped::Step) && state.step_kept != Some(false),
         ),
+        (
+            Dropped::CommentValues,
+            crate::xyz::carried_pairs(frame).next().is_some(),
+            table(&Dropped::CommentValues) && state.comment_kept != Some(false),
+        ),
     ]);
     kinds
         .into_iter()
@@ -416,6 +429,9 @@ impl Dropped {
             Dropped::Colors => "the colours".into(),
             Dropped::Time => "the time".into(),
             Dropped::Step => "the step numbers".into(),
+            Dropped::CommentValues => {
+                "the comment line's KEY=value pairs (an energy, a stress)".into()
+            }
         }
     }
 
@@ -428,7 +444,7 @@ impl Dropped {
     pub fn per(&self) -> Per {
         match self {
             Dropped::Bonds | Dropped::BondOrders => Per::Bond,
-            Dropped::Cell | Dropped::Time | Dropped::Step => Per::Frame,
+            Dropped::Cell | Dropped::Time | Dropped::Step | Dropped::CommentValues => Per::Frame,
             _ => Per::Atom,
         }
     }

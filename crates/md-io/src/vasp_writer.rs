@@ -249,6 +249,18 @@ pub(crate) struct VaspWriter<W> {
     first: Option<First>,
 }
 
+impl<W> VaspWriter<W> {
+    /// Whether `frame`'s comment line reads back from this file when written next: each POSCAR
+    /// and an XDATCAR's first frame write their own; an XDATCAR's later frames repeat the
+    /// first's.
+    pub(crate) fn keeps_comment(&self, frame: &Frame) -> bool {
+        match &self.first {
+            Some(first) if self.xdatcar => comment(frame, &first.elements) == first.comment,
+            _ => true,
+        }
+    }
+}
+
 /// True when a file named `name` (a path) is an XDATCAR: its file name starts with `XDATCAR`
 /// or ends with `.xdatcar`, in any case.
 pub(crate) fn is_xdatcar(name: &str) -> bool {

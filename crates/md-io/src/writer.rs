@@ -265,6 +265,7 @@ impl<W: Write + Seek> Writer<W> {
             WriterKind::Mmcif(w) if self.written > 0 => {
                 state.first_cell = Some(w.first_cell.as_ref());
             }
+            WriterKind::Vasp(w) => state.comment_kept = Some(w.keeps_comment(frame)),
             WriterKind::Dcd(w) => {
                 state.step_kept = frame.step.map(|s| w.keeps_step(s));
                 state.time_kept = frame.time.map(|t| w.keeps_time(frame.step, t));

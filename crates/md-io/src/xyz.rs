@@ -528,7 +528,7 @@ pub(crate) struct XyzWriter<W> {
 /// The keys of the frame's comment [`XyzWriter`] writes again after its own (`energy=`,
 /// `stress="…"`, `config_type=`: a frame's scalars as ASE writes them): every pair with a value
 /// and a key other than those the writer writes or readers take for a field.
-fn carried_pairs(frame: &Frame) -> impl Iterator<Item = (&str, &str)> {
+pub(crate) fn carried_pairs(frame: &Frame) -> impl Iterator<Item = (&str, &str)> {
     const OWN: [&str; 7] = [
         "Lattice",
         "Origin",

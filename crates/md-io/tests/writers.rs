@@ -1201,7 +1201,7 @@ const OUTPUTS: [(Format, &str); 14] = [
 /// A frame carrying everything a [`Frame`] holds: velocities, forces, image flags, charges
 /// (partial when `partial`, else formal), masses, occupancies, B-factors, a custom property,
 /// names, types, residues, chains, segments, radii, colours, bonds with orders (one aromatic
-/// when `partial`), the cell, time and step. Its atoms lie inside the cell (a GSD wraps atoms
+/// when `partial`), the cell, time, step and an energy and a string in the comment. Its atoms lie inside the cell (a GSD wraps atoms
 /// into its box and adds the images it moved them by) and every value fits every format's
 /// columns.
 fn carrying_everything(partial: bool) -> Frame {
@@ -1221,6 +1221,7 @@ fn carrying_everything(partial: bool) -> Frame {
     f.cell = Some(UnitCell::orthorhombic(20.0, 21.0, 22.0).unwrap());
     f.time = Some(1.5);
     f.step = Some(10);
+    f.comment = "energy=-3.5 config_type=\"bulk md\"".into();
     f.names = labels(&["C1", "O1", "N1", "H1"]);
     f.elements = ["C", "O", "N", "H"].map(element).to_vec();
     f.types = labels(&["1", "2", "1", "3"]);
@@ -1402,6 +1403,12 @@ fn lost(w: &Frame, r: &Frame) -> Vec<texmap_md_io::Dropped> {
     if w.step.is_some() && r.step != w.step {
         lost.push(D::Step);
     }
+    if w.comment_pairs().count() > 0
+        && w.comment_pairs()
+            .any(|(k, v)| r.comment_value(k) != Some(v))
+    {
+        lost.push(D::CommentValues);
+    }
     lost.sort();
     lost
 }
@@ -1574,6 +1581,17 @@ fn dropped_follows_values_and_earlier_frames() {
                 }
             })],
             vec![vec![D::Velocities, D::Property("mass".into())]],
+        ),
+        // An XDATCAR's title line is its first frame's: a later frame's energy is lost.
+        (
+            Format::Vasp,
+            "XDATCAR",
+            vec![
+                base.clone(),
+                base.clone(),
+                with(&|f| f.comment = "energy=-4.25".into()),
+            ],
+            vec![vec![], vec![], vec![D::CommentValues]],
         ),
         // LAMMPS types are numbers: labels are numbered (a GSD and an .xyz keep them).
         (
