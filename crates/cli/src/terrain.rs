@@ -1,4 +1,4 @@
-//! `texmap terrain build | info | export | maps | render | viewshed | grid | fly | compare`: glue between files, texmap-terrain and the terminal.
+//! `texmap terrain build | info | export | maps | render | viewshed | dem | grid | fly | compare`: glue between files, texmap-terrain and the terminal.
 
 use std::path::PathBuf;
 
@@ -198,6 +198,9 @@ pub enum TerrainCmd {
     Render(crate::terrain_view::RenderArgs),
     /// What an observer on the terrain sees (viewshed, as gdal_viewshed): a GeoTIFF mask.
     Viewshed(crate::terrain_viewshed::ViewshedArgs),
+    /// gdaldem's products of a DEM (hillshade, slope, aspect, color-relief, tri, tpi, roughness)
+    /// as GeoTIFFs equal to GDAL's.
+    Dem(crate::terrain_dem::DemArgs),
     /// Grid lidar point clouds (LAS, LAZ) into a DEM GeoTIFF, as PDAL's writers.gdal does.
     Grid(crate::terrain_grid::GridArgs),
     /// Fly a path file (or an orbit) over the database: PNG frames or a movie, with a progress bar.
@@ -205,6 +208,19 @@ pub enum TerrainCmd {
     /// Every sampler against the supersampled ray-traced reference along a flight path: CSV,
     /// JSON, Markdown summary and SVG charts, and Seed 000's bank claims counted.
     Compare(crate::terrain_fly::CompareArgs),
+}
+
+/// One note per grid that overlaps the ones before it in a mosaic (whose heights win there).
+pub(crate) fn note_overlaps(overlaps: &[dem::mosaic::Overlap]) {
+    for o in overlaps {
+        crate::note!(
+            "{} overlaps the grids before it on {} samples (largest difference {} m): its \
+             heights are kept there",
+            o.later,
+            o.samples,
+            o.max_difference
+        );
+    }
 }
 
 pub fn run(cmd: TerrainCmd) -> Result<()> {
@@ -299,15 +315,7 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
             let parts = crate::terrain_grid::read_dems(&dem, opts, &lidar)?;
             let names: Vec<String> = parts.iter().map(|p| p.0.clone()).collect();
             let (mut grid, overlaps) = dem::mosaic::mosaic(parts)?;
-            for o in &overlaps {
-                crate::note!(
-                    "{} overlaps the grids before it on {} samples (largest difference {} m): its \
-                     heights are kept there",
-                    o.later,
-                    o.samples,
-                    o.max_difference
-                );
-            }
+            note_overlaps(&overlaps);
             if fill {
                 grid.fill_nodata();
             }
@@ -545,6 +553,7 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
         }
         TerrainCmd::Render(a) => crate::terrain_view::run(a),
         TerrainCmd::Viewshed(a) => crate::terrain_viewshed::run(a),
+        TerrainCmd::Dem(a) => crate::terrain_dem::run(a),
         TerrainCmd::Grid(a) => crate::terrain_grid::run(a),
         TerrainCmd::Fly(a) => crate::terrain_fly::run_fly(a),
         TerrainCmd::Compare(a) => crate::terrain_fly::run_compare(a),

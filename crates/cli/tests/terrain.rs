@@ -1397,3 +1397,94 @@ fn grid_and_viewshed_write_cloud_optimized_geotiffs() {
         );
     }
 }
+
+/// `terrain dem slope`: a float32 GeoTIFF with the input's georeference and gdaldem's no-data
+/// (checked by our reader, and by gdalinfo when it is installed); a bad colour-file line is a
+/// runtime error (exit 1) naming the file and the line, and leaves no output file.
+#[test]
+fn dem_products_keep_the_georeference_and_name_a_bad_colour_line() {
+    use texmap_terrain::dem::read_dem;
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("slope.tif");
+    let dem = data("hillshade_dem_utm.tif");
+    let o = texmap(&[
+        "terrain",
+        "dem",
+        "slope",
+        &dem,
+        "-o",
+        out.to_str().unwrap(),
+        "--compute-edges",
+    ]);
+    ok(&o);
+    let input = read_dem(&dem, &Default::default()).unwrap();
+    let slope = read_dem(&out, &Default::default()).unwrap();
+    assert_eq!(slope.georef(), input.georef());
+    assert_eq!(
+        (slope.width(), slope.height()),
+        (input.width(), input.height())
+    );
+    assert!(slope.heights().iter().all(|s| (0.0..90.0).contains(s)));
+    match std::process::Command::new("gdalinfo")
+        .args(["-json", out.to_str().unwrap()])
+        .output()
+    {
+        Ok(g) if g.status.success() => {
+            let ours: serde_json::Value = serde_json::from_slice(&g.stdout).unwrap();
+            let theirs = std::process::Command::new("gdalinfo")
+                .args(["-json", &dem])
+                .output()
+                .unwrap();
+            let theirs: serde_json::Value = serde_json::from_slice(&theirs.stdout).unwrap();
+            assert_eq!(ours["geoTransform"], theirs["geoTransform"]);
+            assert_eq!(ours["stac"]["proj:epsg"], theirs["stac"]["proj:epsg"]);
+            assert_eq!(ours["stac"]["proj:epsg"], 32619);
+            assert_eq!(ours["bands"][0]["type"], "Float32");
+            assert_eq!(ours["bands"][0]["noDataValue"], -9999.0);
+        }
+        _ => eprintln!("SKIPPED gdalinfo georeference check: gdalinfo is not installed"),
+    }
+
+    // A colour file whose third line has two channels: exit 1, file and line named, no output.
+    let colors = dir.path().join("colors.txt");
+    std::fs::write(&colors, "0% 0 0 0\n# a comment\n1000 10 20\n100% white\n").unwrap();
+    let tint = dir.path().join("tint.tif");
+    let o = texmap(&[
+        "terrain",
+        "dem",
+        "color-relief",
+        colors.to_str().unwrap(),
+        &dem,
+        "-o",
+        tint.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("colors.txt: line 3"), "{err}");
+    assert!(!tint.exists(), "no output file");
+    // Usage errors: exit 2, nothing written.
+    for args in [
+        vec!["slope", dem.as_str(), "--alg", "Sobel"],
+        vec!["hillshade", dem.as_str(), "-z", "0"],
+        vec!["tri", dem.as_str(), "--alg", "Nope"],
+        vec!["slope", dem.as_str(), "--scale", "-1"],
+    ] {
+        let mut v = vec!["terrain", "dem"];
+        v.extend_from_slice(&args);
+        v.extend_from_slice(&["-o", tint.to_str().unwrap()]);
+        let o = texmap(&v);
+        assert_eq!(
+            o.status.code(),
+            Some(2),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    }
+    assert!(!tint.exists(), "no output file");
+    let leftovers: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().contains("partial"))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+}

@@ -82,6 +82,7 @@
 pub mod chunks;
 pub mod db;
 pub mod dem;
+pub mod dem_products;
 pub mod error;
 pub mod flight;
 pub mod geodesy;

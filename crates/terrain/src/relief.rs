@@ -181,8 +181,10 @@ impl<'a> Hillshade<'a> {
         // a b c / d e f / g h i, row − 1 on top.
         let (a, c) = (corner(-1, -1, d, b), corner(1, -1, f, b));
         let (g, i) = (corner(-1, 1, d, hh), corner(1, 1, f, hh));
-        let de = ((c + 2.0 * f + i) - (a + 2.0 * d + g)) / (8.0 * self.east[row as usize]);
-        let ds = ((g + 2.0 * hh + i) - (a + 2.0 * b + c)) / (8.0 * self.south);
+        let (dcol, drow) =
+            crate::dem_products::horn_differences(&[a, b, c, d, centre, f, g, hh, i]);
+        let de = dcol / (8.0 * self.east[row as usize]);
+        let ds = drow / (8.0 * self.south);
         // Normal (east, north, up) = (−dz/de, dz/ds, 1), normalised.
         let n = [-de, ds, 1.0];
         let len = (n[0] * n[0] + n[1] * n[1] + 1.0).sqrt();

@@ -25,6 +25,8 @@ mod db;
 mod dem;
 #[path = "dem_formats.rs"]
 mod dem_formats;
+#[path = "dem_products.rs"]
+mod dem_products;
 #[path = "fuji.rs"]
 mod fuji;
 #[path = "fuzz_campaign.rs"]

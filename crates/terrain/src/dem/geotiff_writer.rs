@@ -1,7 +1,9 @@
 //! Writing a raster as a GeoTIFF that GDAL and our own reader ([`super::geotiff`]) read back with
 //! the same georeference: 32-bit float samples (a [`Grid`], or heights computed from one) or bytes
-//! (a visibility mask), Deflate-compressed, either in strips ([`write_grid`], [`write_geotiff`])
-//! or as a Cloud-Optimized GeoTIFF ([`write_grid_with`], [`write_geotiff_with`] with
+//! (a visibility mask, a hillshade) or RGB(A) pixels of bytes (a colour relief; the alpha
+//! unassociated, `ExtraSamples` 2, as `gdaldem color-relief -alpha` writes it),
+//! Deflate-compressed, either in strips ([`write_grid`], [`write_geotiff`]) or as a
+//! Cloud-Optimized GeoTIFF ([`write_grid_with`], [`write_geotiff_with`] with
 //! [`GeoTiffOptions::cog`]).
 //!
 //! The georeference is written as the reader interprets it (GeoTIFF 1.1, OGC 19-008):
@@ -33,8 +35,8 @@
 //!   table: cubic overshoots at cliffs and has no use for a mask's two values. Heights are
 //!   averaged as GDAL's `AVERAGE` (`-co RESAMPLING=AVERAGE`): a pixel covers `src/dst` source
 //!   pixels, the partly covered ones at odd sizes weighted by the part covered, no-data samples
-//!   (`NaN` for `nan`) left out, `f64` sums rounded once to `f32`; masks take GDAL's `NEAREST`
-//!   (source index `⌊i·src/dst + 0.5⌋`). tests/dem_formats.rs compares every level with GDAL's:
+//!   (`NaN` for `nan`) left out, `f64` sums rounded once to `f32`; masks and colours take
+//!   GDAL's `NEAREST` (source index `⌊i·src/dst + 0.5⌋`). tests/dem_formats.rs compares every level with GDAL's:
 //!   the same bits with no-data; at most 2 ulp apart without (GDAL's 2 x 2 shortcut then sums in
 //!   `f32`).
 //! - Overview IFDs carry `NewSubfileType` 1 and the no-data tag but, as GDAL writes them, no
@@ -70,13 +72,20 @@ pub enum Samples<'a> {
     F32(&'a [f32]),
     /// Bytes (a mask).
     U8(&'a [u8]),
+    /// RGB bytes, interleaved (a colour relief): 3 a pixel.
+    Rgb8(&'a [u8]),
+    /// RGBA bytes, interleaved, the alpha unassociated: 4 a pixel.
+    Rgba8(&'a [u8]),
 }
 
 impl Samples<'_> {
+    /// Pixels (whole ones: a trailing part of a pixel is not counted).
     fn len(&self) -> usize {
         match self {
             Samples::F32(v) => v.len(),
             Samples::U8(v) => v.len(),
+            Samples::Rgb8(v) => v.len() / 3,
+            Samples::Rgba8(v) => v.len() / 4,
         }
     }
 
@@ -84,6 +93,17 @@ impl Samples<'_> {
         match self {
             Samples::F32(_) => 4,
             Samples::U8(_) => 1,
+            Samples::Rgb8(_) => 3,
+            Samples::Rgba8(_) => 4,
+        }
+    }
+
+    /// Whether the slice holds exactly `len()` whole pixels.
+    fn whole(&self) -> bool {
+        match self {
+            Samples::Rgb8(v) => v.len() % 3 == 0,
+            Samples::Rgba8(v) => v.len() % 4 == 0,
+            _ => true,
         }
     }
 }
@@ -175,7 +195,11 @@ pub fn write_geotiff_with(
     options: &GeoTiffOptions,
 ) -> Result<(), TerrainError> {
     let source = path.display().to_string();
-    if width == 0 || height == 0 || samples.len() as u64 != width as u64 * height as u64 {
+    if width == 0
+        || height == 0
+        || !samples.whole()
+        || samples.len() as u64 != width as u64 * height as u64
+    {
         return Err(TerrainError::BadParameter {
             name: "samples",
             value: format!("{} for {width} x {height}", samples.len()),
@@ -203,6 +227,19 @@ pub fn write_geotiff_with(
                     let levels = cog_levels_u8(v, width, height, block);
                     let fill = nodata.map_or(0, |n| n as u8);
                     write_cog(out, &levels, block, fill, &tags, nodata, false)
+                }
+                Samples::Rgb8(v) => {
+                    let px: Vec<[u8; 3]> = v.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect();
+                    let levels = cog_levels(&px, width, height, block, nearest);
+                    write_cog(out, &levels, block, [0; 3], &tags, nodata, false)
+                }
+                Samples::Rgba8(v) => {
+                    let px: Vec<[u8; 4]> = v
+                        .chunks_exact(4)
+                        .map(|p| [p[0], p[1], p[2], p[3]])
+                        .collect();
+                    let levels = cog_levels(&px, width, height, block, nearest);
+                    write_cog(out, &levels, block, [0; 4], &tags, nodata, false)
                 }
             };
             return written.map_err(io(path));
@@ -356,6 +393,26 @@ fn encode<W: Write + Seek, K: TiffKind>(
             write_geo_tags(img.encoder(), tags, nodata).map_err(&err)?;
             img.write_data(v).map_err(&err)
         }
+        Samples::Rgb8(v) => {
+            let mut enc = enc.with_predictor(Predictor::Horizontal);
+            let mut img = enc
+                .new_image::<colortype::RGB8>(width, height)
+                .map_err(&err)?;
+            write_geo_tags(img.encoder(), tags, nodata).map_err(&err)?;
+            img.write_data(v).map_err(&err)
+        }
+        Samples::Rgba8(v) => {
+            let mut enc = enc.with_predictor(Predictor::Horizontal);
+            let mut img = enc
+                .new_image::<colortype::RGBA8>(width, height)
+                .map_err(&err)?;
+            // ExtraSamples: the fourth sample is unassociated alpha (GDAL's -alpha output).
+            img.encoder()
+                .write_tag(Tag::ExtraSamples, &[2u16][..])
+                .map_err(&err)?;
+            write_geo_tags(img.encoder(), tags, nodata).map_err(&err)?;
+            img.write_data(v).map_err(&err)
+        }
     }
 }
 
@@ -399,6 +456,8 @@ trait CogSample: Copy + Send + Sync {
     const FORMAT: u16;
     /// TIFF `Predictor` (317): 2 horizontal differencing, 3 floating point.
     const PREDICTOR: u16;
+    /// Samples a pixel (`SamplesPerPixel`, 277): 1, or 3 (RGB) and 4 (RGBA) bytes.
+    const SAMPLES: u16 = 1;
     /// The sample as little-endian bytes into `out` (`BYTES` long).
     fn put(self, out: &mut [u8]);
 }
@@ -418,6 +477,17 @@ impl CogSample for u8 {
     const PREDICTOR: u16 = 2;
     fn put(self, out: &mut [u8]) {
         out[0] = self;
+    }
+}
+
+/// An RGB or RGBA byte pixel, its samples interleaved.
+impl<const N: usize> CogSample for [u8; N] {
+    const BYTES: usize = N;
+    const FORMAT: u16 = 1;
+    const PREDICTOR: u16 = 2;
+    const SAMPLES: u16 = N as u16;
+    fn put(self, out: &mut [u8]) {
+        out.copy_from_slice(&self);
     }
 }
 
@@ -521,7 +591,7 @@ fn average_f32(src: &[f32], sw: u32, sh: u32, dw: u32, dh: u32, nodata: Option<f
 
 /// GDAL 3.6's `NEAREST` resampling from `src` (`sw x sh`) to `dw x dh`: destination pixel `i`
 /// takes source index `⌊i·sw/dw + 0.5⌋`.
-fn nearest_u8(src: &[u8], sw: u32, sh: u32, dw: u32, dh: u32) -> Vec<u8> {
+fn nearest<T: Copy>(src: &[T], sw: u32, sh: u32, dw: u32, dh: u32) -> Vec<T> {
     let pick = |s: u32, d: u32| -> Vec<usize> {
         let r = s as f64 / d as f64;
         (0..d)
@@ -538,11 +608,12 @@ fn nearest_u8(src: &[u8], sw: u32, sh: u32, dw: u32, dh: u32) -> Vec<u8> {
 }
 
 /// Apply TIFF predictor `predictor` to one row of a tile, in place (`scratch` is reused).
-/// - 2: each byte sample minus the one before it (TIFF 6.0 §14).
+/// - 2: each byte sample minus the same sample of the pixel before it (TIFF 6.0 §14): `stride`
+///   bytes back (the samples a pixel).
 /// - 3: the floating-point predictor (Adobe Photoshop TIFF Technical Note 3): the row's samples
 ///   split into byte planes, most significant first, then each byte minus the one before it
 ///   across the whole row, as libtiff's `fpDiff` does.
-fn predict_row(predictor: u16, bytes: usize, row: &mut [u8], scratch: &mut Vec<u8>) {
+fn predict_row(predictor: u16, bytes: usize, stride: usize, row: &mut [u8], scratch: &mut Vec<u8>) {
     if predictor == 3 {
         let n = row.len() / bytes;
         scratch.clear();
@@ -553,8 +624,8 @@ fn predict_row(predictor: u16, bytes: usize, row: &mut [u8], scratch: &mut Vec<u
             }
         }
     }
-    for i in (1..row.len()).rev() {
-        row[i] = row[i].wrapping_sub(row[i - 1]);
+    for i in (stride..row.len()).rev() {
+        row[i] = row[i].wrapping_sub(row[i - stride]);
     }
 }
 
@@ -582,7 +653,12 @@ fn compress_tiles<T: CogSample>(level: &Level<T>, block: u32, fill: T) -> Vec<Ve
                     };
                     v.put(out);
                 }
-                predict_row(T::PREDICTOR, T::BYTES, row, &mut scratch);
+                let stride = if T::SAMPLES > 1 {
+                    T::SAMPLES as usize
+                } else {
+                    1
+                };
+                predict_row(T::PREDICTOR, T::BYTES, stride, row, &mut scratch);
             }
             let mut z = flate2::write::ZlibEncoder::new(
                 Vec::with_capacity(raw.len() / 2),
@@ -757,17 +833,23 @@ fn write_cog<T: CogSample, W: Write>(
         }
         e.push((256, Value::Long(vec![l.width])));
         e.push((257, Value::Long(vec![l.height])));
-        e.push((258, Value::Short(vec![8 * T::BYTES as u16])));
+        let spp = T::SAMPLES as usize;
+        let bits = 8 * (T::BYTES / spp) as u16;
+        e.push((258, Value::Short(vec![bits; spp])));
         e.push((259, Value::Short(vec![8]))); // Deflate
-        e.push((262, Value::Short(vec![1]))); // BlackIsZero
-        e.push((277, Value::Short(vec![1])));
+        // BlackIsZero, or RGB.
+        e.push((262, Value::Short(vec![if spp >= 3 { 2 } else { 1 }])));
+        e.push((277, Value::Short(vec![T::SAMPLES])));
         e.push((284, Value::Short(vec![1])));
         e.push((317, Value::Short(vec![T::PREDICTOR])));
         e.push((322, Value::Long(vec![block])));
         e.push((323, Value::Long(vec![block])));
         e.push((324, Value::Offsets(offsets)));
         e.push((325, Value::Offsets(counts)));
-        e.push((339, Value::Short(vec![T::FORMAT])));
+        if spp == 4 {
+            e.push((338, Value::Short(vec![2]))); // ExtraSamples: unassociated alpha
+        }
+        e.push((339, Value::Short(vec![T::FORMAT; spp])));
         // GDAL writes the georeference on the full resolution only, the no-data value on all.
         if level == 0 {
             match &tags.placement {
@@ -897,7 +979,7 @@ fn cog_levels_f32(
 
 /// [`cog_levels`] of bytes: `nearest`.
 fn cog_levels_u8(samples: &[u8], width: u32, height: u32, block: u32) -> Vec<Level<'_, u8>> {
-    cog_levels(samples, width, height, block, nearest_u8)
+    cog_levels(samples, width, height, block, nearest)
 }
 
 #[cfg(test)]
