@@ -404,7 +404,7 @@ pub fn label_text(
             LabelPart::Vacancies => out.push_str(&defects.map_or(0, |d| d.0).to_string()),
             LabelPart::Interstitials => out.push_str(&defects.map_or(0, |d| d.1).to_string()),
             LabelPart::Grains => out.push_str(&grains.unwrap_or(0).to_string()),
-            LabelPart::Title => out.push_str(frame.comment.trim()),
+            LabelPart::Title => out.push_str(frame.comment.lines().next().unwrap_or("").trim()),
             LabelPart::Key { name, decimals } => {
                 let Some(value) = frame.comment_value(name) else {
                     let keys: Vec<&str> = frame.comment_pairs().map(|(k, _)| k).collect();

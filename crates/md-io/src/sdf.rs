@@ -23,9 +23,12 @@
 //! fill) when some atom of the record is charged: in V2000 the `M  CHG` lines, which replace
 //! every atom line's charge code (columns 37-39: 1-3 for +3..+1, 5-7 for -1..-3) as the CTfile
 //! specification and RDKit have it, else those codes; in V3000 the atom's `CHG=`. Isotopes,
-//! radicals and the data items are not kept, except `step` and `time` (ps), which our SD
-//! writer writes and which become [`Frame::step`] and [`Frame::time`] (a value that is no
-//! number is left out). A symbol that is no element (`R#`, `*`, `A`, a
+//! radicals are not kept. Data items: `step` and `time` (ps), which our SD writer writes,
+//! become [`Frame::step`] and [`Frame::time`] (a value that is no number is left out); every
+//! other item whose name is a key (letters, digits, `_`, `-`, `.`: GNINA's `minimizedAffinity`
+//! and `CNNscore`, RDKit properties) and whose value is one line becomes a `KEY=value` pair on
+//! the comment's second line, for [`Frame::comment_value`] and `--label '{minimizedAffinity}'`
+//! (items named otherwise, and values of several lines, are left out). A symbol that is no element (`R#`, `*`, `A`, a
 //! list) is an unknown element.
 //!
 //! # Damage
@@ -39,6 +42,7 @@
 //! # References
 //! - BIOVIA, "CTfile Formats" (2020): the V2000 and V3000 connection tables, SD files.
 
+use std::fmt::Write as _;
 use std::io::Read;
 
 use crate::elements::Element;
@@ -173,11 +177,15 @@ impl FrameWalk for Sdf {
                 return Err(ctx.parse(pos, line, line, "'M  END' closing the properties block"));
             }
         }
-        // The data items: `step` and `time` are kept (the first value line of each).
+        // The data items: `step` and `time` into the frame, other items as comment pairs (an
+        // item's value when it is one line; a multi-line value is left out).
         let (mut item, mut step, mut time) = (None, None, None);
+        let mut pairs: Vec<(String, String)> = Vec::new();
+        // An item's one-line value read, and whether more lines followed it.
+        let mut pending: Option<(String, String, bool)> = None;
         loop {
             let p = lines.pos();
-            match lines.next_line().map_err(|e| ctx.io(p, e))? {
+            let line = match lines.next_line().map_err(|e| ctx.io(p, e))? {
                 None => break,
                 Some((_, line)) if trim(line) == b"$$$$" => break,
                 Some((pos, line)) => {
@@ -185,17 +193,43 @@ impl FrameWalk for Sdf {
                     if t == b"M  END" || t.ends_with(b"V2000") || t.ends_with(b"V3000") {
                         return Err(ctx.parse(pos, line, line, "'$$$$' ending the record first"));
                     }
-                    match item.take() {
-                        Some(StepOrTime::Step) => step = parse_i64(t),
-                        Some(StepOrTime::Time) => time = parse_f64(t).filter(|v| v.is_finite()),
-                        None => item = data_header(line),
-                    }
+                    t
                 }
+            };
+            if let Some((key, value, more)) = pending.take() {
+                match (line.is_empty(), more) {
+                    (true, false) => pairs.push((key, value)),
+                    (true, true) => {}
+                    (false, _) => pending = Some((key, value, true)),
+                }
+                continue;
             }
+            match item.take() {
+                Some(Item::Step) => step = parse_i64(line),
+                Some(Item::Time) => time = parse_f64(line).filter(|v| v.is_finite()),
+                Some(Item::Other(key)) if !line.is_empty() => {
+                    let value = String::from_utf8_lossy(line).into_owned();
+                    // A value with a double quote cannot be a pair's: left out as a long one.
+                    pending = Some((key, value, line.contains(&b'"')));
+                }
+                Some(Item::Other(_)) => {}
+                None => item = data_header(line),
+            }
+        }
+        if let Some((key, value, false)) = pending {
+            pairs.push((key, value));
         }
         if let Some(f) = frame {
             f.step = step;
             f.time = time;
+            for (k, (key, value)) in pairs.iter().enumerate() {
+                f.comment.push(if k == 0 { '\n' } else { ' ' });
+                if value.contains([' ', '\t']) {
+                    let _ = write!(f.comment, "{key}=\"{value}\"");
+                } else {
+                    let _ = write!(f.comment, "{key}={value}");
+                }
+            }
             crate::frame::set_ordered_bonds(f, bonds);
             if charges.iter().any(|&q| q != 0) {
                 f.properties.push(crate::frame::Property {
@@ -209,22 +243,32 @@ impl FrameWalk for Sdf {
 }
 
 /// The data items a frame keeps.
-#[derive(Clone, Copy)]
-enum StepOrTime {
+enum Item {
     Step,
     Time,
+    /// Another item whose name is a comment key.
+    Other(String),
 }
 
-/// Which kept item a data header line opens: `> <step>` or `> <time>`, also with the extra
-/// space, a registry number or a `DT` field number other programs add (`>  <time> (1)`).
-fn data_header(line: &[u8]) -> Option<StepOrTime> {
+/// Which kept item a data header line opens: `> <step>`, `> <time>` or another item named as
+/// a comment key is (a letter or `_`, then letters, digits, `_`, `-`, `.`), also with the extra
+/// space, a registry number or a `DT` field number other programs add (`>  <time>  (1)`).
+fn data_header(line: &[u8]) -> Option<Item> {
     let rest = line.strip_prefix(b">")?;
     let open = rest.iter().position(|&b| b == b'<')?;
     let name = &rest[open + 1..];
     let close = name.iter().position(|&b| b == b'>')?;
-    match &name[..close] {
-        b"step" => Some(StepOrTime::Step),
-        b"time" => Some(StepOrTime::Time),
+    let name = &name[..close];
+    let key = name
+        .first()
+        .is_some_and(|b| b.is_ascii_alphabetic() || *b == b'_')
+        && name
+            .iter()
+            .all(|b| b.is_ascii_alphanumeric() || matches!(b, b'_' | b'-' | b'.'));
+    match name {
+        b"step" => Some(Item::Step),
+        b"time" => Some(Item::Time),
+        _ if key => Some(Item::Other(String::from_utf8_lossy(name).into_owned())),
         _ => None,
     }
 }

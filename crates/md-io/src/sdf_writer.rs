@@ -36,7 +36,9 @@
 //!   bonds by distance, when the frame has none.)
 //! - **Data items** after `M  END`: `> <step>` and `> <time>` (ps) when the frame has them,
 //!   and, for a docked pose whose title is AutoDock Vina's `VINA RESULT: score ...` (our PDBQT
-//!   reader's), `> <minimizedAffinity>` with the score in kcal/mol, as smina and GNINA name it.
+//!   reader's), `> <minimizedAffinity>` with the score in kcal/mol, as smina and GNINA name it;
+//!   and one item per `KEY=value` pair on the comment's lines after the title (the data items
+//!   our reader keeps there).
 //!
 //! Not written: cells, velocities, atom names, residues, chains, ids, other properties,
 //! isotopes, stereo flags.
@@ -251,7 +253,23 @@ impl<W: Write> SdfWriter<W> {
         if let Some(time) = frame.time {
             let _ = write!(s, "> <time>\n{time}\n\n");
         }
-        if let Some(score) = vina_score(&title) {
+        // The comment's pairs after its title line (our reader's data items), then a Vina
+        // score from the title.
+        let mut written: Vec<&str> = vec!["step", "time"];
+        let rest = frame.comment.split_once('\n').map_or("", |(_, r)| r);
+        for (key, value) in crate::xyz::key_values(rest.as_bytes()) {
+            let (Ok(key), Ok(value)) = (std::str::from_utf8(key), std::str::from_utf8(value))
+            else {
+                continue;
+            };
+            if !value.is_empty() && !written.contains(&key) {
+                let _ = write!(s, "> <{key}>\n{value}\n\n");
+                written.push(key);
+            }
+        }
+        if let Some(score) = vina_score(&title)
+            && !written.contains(&"minimizedAffinity")
+        {
             let _ = write!(s, "> <minimizedAffinity>\n{score}\n\n");
         }
         s.push_str("$$$$\n");

@@ -135,19 +135,20 @@ fn short_key(b: &[u8]) -> u32 {
     }
 }
 
-/// Splits an extended-XYZ comment into key=value pairs (values may be "double quoted").
+/// Splits an extended-XYZ comment into key=value pairs (values may be "double quoted"); any
+/// ASCII white space separates them (a frame's comment may hold several lines).
 pub(crate) fn key_values(line: &[u8]) -> impl Iterator<Item = (&[u8], &[u8])> {
     let mut i = 0;
     std::iter::from_fn(move || {
         loop {
-            while i < line.len() && (line[i] == b' ' || line[i] == b'\t') {
+            while i < line.len() && line[i].is_ascii_whitespace() {
                 i += 1;
             }
             if i >= line.len() {
                 return None;
             }
             let ks = i;
-            while i < line.len() && !matches!(line[i], b'=' | b' ' | b'\t') {
+            while i < line.len() && line[i] != b'=' && !line[i].is_ascii_whitespace() {
                 i += 1;
             }
             let key = &line[ks..i];
@@ -170,7 +171,7 @@ pub(crate) fn key_values(line: &[u8]) -> impl Iterator<Item = (&[u8], &[u8])> {
                 v
             } else {
                 let vs = i;
-                while i < line.len() && line[i] != b' ' && line[i] != b'\t' {
+                while i < line.len() && !line[i].is_ascii_whitespace() {
                     i += 1;
                 }
                 &line[vs..i]

@@ -757,8 +757,18 @@ fn sdf_files_written_now_are_the_committed_ones_and_read_back() {
             }
             assert_eq!(a.bonds, b.bonds, "{case}");
             assert_eq!(sdf_orders(a), b.bond_orders, "{case}");
-            assert_eq!(sdf_title(a), b.comment, "{case}");
+            assert_eq!(
+                sdf_title(a),
+                b.comment.lines().next().unwrap_or(""),
+                "{case}"
+            );
             assert_eq!((a.step, a.time), (b.step, b.time), "{case}: data items");
+            // The data items read (pairs after the title line) come back.
+            if a.comment.contains('\n') {
+                for (key, value) in a.comment_pairs() {
+                    assert_eq!(b.comment_value(key), Some(value), "{case}: item {key}");
+                }
+            }
         }
     }
     // The V2000/V3000 choice, charges and data items where they belong.
@@ -794,6 +804,29 @@ fn sdf_step_and_time_items_written_by_rdkit_are_read() {
     assert_eq!((back[0].step, back[0].time), (Some(7), Some(0.25)));
     assert_eq!((back[1].step, back[1].time), (None, None));
     assert_eq!(back[0].positions[2], [2.5981, -0.0, 0.0]);
+    // Another item is a pair on the comment's second line, after the title.
+    assert_eq!(back[0].comment, "ethanol\nnote=x");
+    assert_eq!(back[0].comment_value("note"), Some("x"));
+    // A docked pose as GNINA writes its items: kept through our writer and reader; a value of
+    // two lines and an item whose name is no key are left out.
+    let gnina = "lig\n     RDKit          3D\n\n  1  0  0  0  0  0  0  0  0  0999 V2000\n\
+                 \x20   1.0000    2.0000    3.0000 C   0  0  0  0  0  0  0  0  0  0  0  0\n\
+                 M  END\n> <minimizedAffinity>\n-7.52\n\n> <CNNscore>\n0.81\n\n\
+                 > <Molecular Formula>\nC\n\n> <remark>\nline one\nline two\n\n\
+                 > <pose_name>\nbest pose\n\n$$$$\n";
+    let f = &read(Format::Sdf, gnina)[0];
+    assert_eq!(
+        f.comment,
+        "lig\nminimizedAffinity=-7.52 CNNscore=0.81 pose_name=\"best pose\""
+    );
+    let again = write(Format::Sdf, std::slice::from_ref(f));
+    assert!(
+        again.contains(
+            "M  END\n> <minimizedAffinity>\n-7.52\n\n> <CNNscore>\n0.81\n\n> <pose_name>\nbest pose\n\n$$$$\n"
+        ),
+        "{again}"
+    );
+    assert_eq!(read(Format::Sdf, &again)[0].comment, f.comment);
 }
 
 /// The committed SD files as RDKit read them (rdkit_reference.json) against the frames they
