@@ -96,6 +96,15 @@ pub enum TerrainCmd {
         /// marker-color=#7e7e7e, marker-size=medium).
         #[arg(long, value_name = "KEY=VALUE,...", requires = "overlay")]
         overlay_style: Option<String>,
+        /// Colour the shaded relief's heights by a gdaldem color-relief colour file (lines
+        /// 'height R G B [A]', 'P% R G B', 'nv R G B' or a named colour; linear between entries,
+        /// as gdaldem's default) instead of the built-in green–brown–white ramp, still lit by the
+        /// same hillshade. Percentages are of the DEM's height range; no-data takes the nv colour
+        /// (grey without one); alpha is ignored. The resolved table is kept in the manifest, so
+        /// views, streamed textures and exports of the database use it. Without --photo the
+        /// texture is then the shaded relief; with one, the parts it does not cover.
+        #[arg(long, value_name = "FILE")]
+        relief_colors: Option<PathBuf>,
         /// Read a PNG as Mapbox Terrain-RGB: height = −10000 + 0.1·(R·65536 + G·256 + B) m.
         #[arg(long)]
         terrain_rgb: bool,
@@ -242,6 +251,7 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
             contour_width,
             overlay,
             overlay_style,
+            relief_colors,
             scale,
             offset,
             cell,
@@ -339,6 +349,16 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
                 }
                 Some(m) => return usage(format!("--contours {m}: expected metres > 0")),
             };
+            // Read before the build, so that a bad file leaves nothing behind.
+            let tint = match &relief_colors {
+                None => texmap_terrain::relief::Tint::Ramp,
+                Some(path) => {
+                    let table = texmap_terrain::dem_products::ColorTable::read(path)?;
+                    texmap_terrain::relief::Tint::Table(texmap_terrain::relief::TintTable::resolve(
+                        &table, &grid,
+                    ))
+                }
+            };
             let overlay_style = match overlay_style {
                 None => texmap_terrain::vector::Style::default(),
                 Some(s) => match texmap_terrain::vector::Style::default().with_keys(&s) {
@@ -387,6 +407,7 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
                 contours,
                 overlays,
                 overlay_style,
+                tint,
                 ..BuildOptions::default()
             };
             let m = db::build_with(
@@ -425,7 +446,7 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
             let v = if path.is_dir() {
                 let d = Database::open(&path)?;
                 let m = &d.manifest;
-                json!({
+                let mut v = json!({
                     "database": path.display().to_string(), "width": m.width, "height": m.height, "georef": m.georef,
                     "height_min": m.height_min, "height_max": m.height_max, "nodata": m.nodata, "max_error": m.max_error,
                     "chunk": m.chunk,
@@ -435,7 +456,11 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
                         "max_geometric_error": l.chunks.iter().map(|c| c.geometric_error).fold(0.0f32, f32::max),
                     })).collect::<Vec<_>>(),
                     "texture": m.texture,
-                })
+                });
+                if let Some(t) = &m.relief_tint {
+                    v["relief_tint"] = json!(t);
+                }
+                v
             } else {
                 let grid = dem::read_dem(&path, &ReadOptions::default())?;
                 let mut info = db::grid_info(&grid, &path.display().to_string());
@@ -534,7 +559,7 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
             // views draw.
             let tex = match d.texture(4096)? {
                 Some(t) => t,
-                None => texmap_terrain::relief::relief_image(&grid, 4096),
+                None => d.tint().image(&grid, 4096),
             };
             let tex = Some(tex);
             if glb {

@@ -162,10 +162,12 @@ pub fn run(a: ViewshedArgs) -> Result<()> {
         .as_deref()
         .map(|s| parse_pair::<f64>(s, ',', "--observer"))
         .transpose()?;
-    let grid = if a.input.is_dir() {
-        Database::open(&a.input)?.grid_mapped()?
+    let (grid, tint) = if a.input.is_dir() {
+        let db = Database::open(&a.input)?;
+        (db.grid_mapped()?, db.tint())
     } else {
-        dem::read_dem(&a.input, &ReadOptions::default())?
+        let grid = dem::read_dem(&a.input, &ReadOptions::default())?;
+        (grid, texmap_terrain::relief::Tint::Ramp)
     };
     let observer = match (cell, map, &a.observer_lonlat) {
         (Some((col, row)), _, _) => Observer::Cell { col, row },
@@ -198,7 +200,7 @@ pub fn run(a: ViewshedArgs) -> Result<()> {
     let layout = geotiff_options(a.cog);
     vs.write_geotiff_with(&a.output, &values, &layout)?;
     if let Some(p) = &a.png {
-        let img = vs.image(&grid, 4096);
+        let img = vs.image_tinted(&grid, &tint, 4096);
         crate::output::write_atomic(p, |tmp| {
             img.save_with_format(tmp, image::ImageFormat::Png)
                 .with_context(|| format!("cannot write {}", p.display()))

@@ -1488,3 +1488,69 @@ fn dem_products_keep_the_georeference_and_name_a_bad_colour_line() {
         .collect();
     assert!(leftovers.is_empty(), "{leftovers:?}");
 }
+
+/// `terrain build --relief-colors`: the resolved table is in the manifest `terrain info`
+/// prints, and the relief-only database gets the tinted texture; a bad line in the file exits
+/// 1 naming `colors.txt: line N`, and no database directory is left.
+#[test]
+fn relief_colors_tint_the_build_and_a_bad_file_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let colors = dir.path().join("colors.txt");
+    std::fs::write(
+        &colors,
+        "# hypsometric\n0% 0 0 0\n100% 255 255 255\nnv red\n",
+    )
+    .unwrap();
+    let db = dir.path().join("db");
+    ok(&texmap(&[
+        "terrain",
+        "build",
+        "--dem",
+        &data("ramp_i16_lzw.tif"),
+        "--relief-colors",
+        colors.to_str().unwrap(),
+        "--out",
+        db.to_str().unwrap(),
+        "-q",
+    ]));
+    let o = texmap(&["terrain", "info", db.to_str().unwrap()]);
+    ok(&o);
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let tint = &v["relief_tint"];
+    let entries = tint["entries"].as_array().expect("relief_tint entries");
+    assert_eq!(entries.len(), 2, "{tint}");
+    assert_eq!(entries[0][0], v["height_min"].as_f64().unwrap());
+    assert_eq!(entries[1][0], v["height_max"].as_f64().unwrap());
+    assert_eq!(entries[1][1], serde_json::json!([255, 255, 255, 255]));
+    assert_eq!(tint["nodata"], serde_json::json!([255, 0, 0, 255]));
+    assert_eq!(v["texture"]["placed_by"], "stretched");
+    // Without the option: no tint in the manifest.
+    let plain = relief_db(dir.path(), "plain");
+    let o = texmap(&["terrain", "info", plain.to_str().unwrap()]);
+    ok(&o);
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(v.get("relief_tint").is_none(), "{v}");
+
+    std::fs::write(&colors, "0% 0 0 0\n\n50% 10 20\n100% white\n").unwrap();
+    let bad = dir.path().join("bad");
+    let o = texmap(&[
+        "terrain",
+        "build",
+        "--dem",
+        &data("ramp_i16_lzw.tif"),
+        "--relief-colors",
+        colors.to_str().unwrap(),
+        "--out",
+        bad.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("colors.txt: line 3"), "{err}");
+    assert!(!bad.exists(), "no database directory");
+    let left: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().contains("bad"))
+        .collect();
+    assert!(left.is_empty(), "{left:?}");
+}

@@ -85,6 +85,10 @@ pub struct Manifest {
     pub chunk: u32,
     pub levels: Vec<LevelEntry>,
     pub texture: Option<TextureEntry>,
+    /// The shaded relief's colour table ([`crate::relief::TintTable`], from `--relief-colors`);
+    /// absent: the built-in ramp.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub relief_tint: Option<crate::relief::TintTable>,
 }
 
 /// Build options.
@@ -103,6 +107,9 @@ pub struct BuildOptions {
     pub overlays: Vec<crate::vector::VectorLayer>,
     /// What the overlays' features take for the style keys they do not set.
     pub overlay_style: crate::vector::Style,
+    /// The shaded relief's height colours ([`crate::relief::Tint`]), saved in the manifest; a
+    /// table without a photo makes the texture the shaded relief (up to 4096² texels).
+    pub tint: crate::relief::Tint,
 }
 
 impl Default for BuildOptions {
@@ -115,6 +122,7 @@ impl Default for BuildOptions {
             contours: None,
             overlays: Vec::new(),
             overlay_style: crate::vector::Style::default(),
+            tint: crate::relief::Tint::Ramp,
         }
     }
 }
@@ -321,11 +329,15 @@ fn build_into(
     progress: &mut impl FnMut(u64, u64),
 ) -> Result<Manifest, TerrainError> {
     std::fs::create_dir_all(dir).map_err(io(dir))?;
-    // Contours or overlays without a photo: drawn over the shaded relief, which becomes the
-    // texture.
-    let relief = match (photo, opts.contours.is_some() || !opts.overlays.is_empty()) {
+    // Contours, overlays or a tint table without a photo: drawn over the shaded relief, which
+    // becomes the texture.
+    let tinted = opts.tint != crate::relief::Tint::Ramp;
+    let relief = match (
+        photo,
+        opts.contours.is_some() || !opts.overlays.is_empty() || tinted,
+    ) {
         (None, true) => Some(gst::Orthophoto {
-            image: crate::relief::relief_image(grid, 4096),
+            image: opts.tint.image(grid, 4096),
             georef: None,
             source: "shaded relief".into(),
             stretch: None,
@@ -419,7 +431,7 @@ fn build_into(
                 opts.map_texels,
                 tex_levels,
                 &gst::Drawn {
-                    relief_under: true,
+                    relief_under: Some(&opts.tint),
                     contours: opts.contours.as_ref(),
                     overlay: overlay.as_ref(),
                 },
@@ -467,6 +479,10 @@ fn build_into(
         chunk: opts.chunk,
         levels,
         texture,
+        relief_tint: match &opts.tint {
+            crate::relief::Tint::Ramp => None,
+            crate::relief::Tint::Table(t) => Some(t.clone()),
+        },
     };
     let json = serde_json::to_vec_pretty(&manifest)
         .map_err(|e| format_err(source, "manifest", e.to_string()))?;
@@ -483,6 +499,14 @@ pub struct Database {
 }
 
 impl Database {
+    /// The shaded relief's tint: the manifest's table, or the built-in ramp.
+    pub fn tint(&self) -> crate::relief::Tint {
+        self.manifest
+            .relief_tint
+            .clone()
+            .map_or(crate::relief::Tint::Ramp, crate::relief::Tint::Table)
+    }
+
     pub fn open(dir: &Path) -> Result<Database, TerrainError> {
         let path = dir.join("manifest.json");
         let text = std::fs::read_to_string(&path).map_err(io(&path))?;
@@ -501,6 +525,16 @@ impl Database {
                     manifest.version
                 ),
             });
+        }
+        // The relief tint's guarantee: entries by ascending height.
+        if let Some(t) = &manifest.relief_tint
+            && !t.entries.is_sorted_by(|a, b| a.0 <= b.0)
+        {
+            return Err(format_err(
+                &path.display().to_string(),
+                "relief_tint",
+                "colour entries by ascending height",
+            ));
         }
         Ok(Database {
             dir: dir.to_path_buf(),

@@ -415,7 +415,7 @@ fn shade(s: Shading, l: &Light, x: f64, y: f64, aspect: f64) -> f64 {
 type Kernel<'k> = dyn Fn(&[f32; 9], (f64, f64)) -> f32 + Sync + 'k;
 
 /// A colour file's entry at a height.
-type Level = (f64, [u8; 4]);
+pub(crate) type Level = (f64, [u8; 4]);
 
 /// Compute `product` over `grid`.
 ///
@@ -702,7 +702,7 @@ impl ColorTable {
 
     /// The entries with levels as heights of `grid` (percentages of its range), sorted by
     /// height (stably: equal heights keep the file's order), and the no-data colour.
-    fn resolve(&self, grid: &Grid) -> (Vec<Level>, Option<[u8; 4]>) {
+    pub(crate) fn resolve(&self, grid: &Grid) -> (Vec<Level>, Option<[u8; 4]>) {
         let (lo, hi) = grid.height_range();
         let (lo, hi) = (lo as f64, hi as f64);
         let mut nodata = None;
@@ -722,7 +722,12 @@ impl ColorTable {
 }
 
 /// The colour of height `v` (`NaN`: no-data) among sorted `levels`.
-fn colour_of(levels: &[Level], nodata: Option<[u8; 4]>, m: ColorMatch, v: f64) -> [u8; 4] {
+pub(crate) fn colour_of(
+    levels: &[Level],
+    nodata: Option<[u8; 4]>,
+    m: ColorMatch,
+    v: f64,
+) -> [u8; 4] {
     if v.is_nan() {
         // No-data without an `nv` entry is coloured as a height below every entry.
         return match (nodata, m) {

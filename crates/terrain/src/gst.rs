@@ -442,10 +442,11 @@ fn round(c: [f64; 4]) -> [u8; 4] {
 /// What a pyramid's finest level draws besides the photo ([`write_pyramid_with`]).
 #[derive(Clone, Copy, Default)]
 pub struct Drawn<'a> {
-    /// The grid's shaded relief ([`crate::relief::relief_texel`], one sample per texel) under
-    /// the photo, where the photo does not cover: beyond it, and at its no-data and transparent
-    /// pixels (composited under the premultiplied texel: `C + relief·(1 − A/255)`, opaque).
-    pub relief_under: bool,
+    /// The grid's shaded relief in this tint ([`crate::relief::Tint::texel`], one sample per
+    /// texel) under the photo, where the photo does not cover: beyond it, and at its no-data and
+    /// transparent pixels (composited under the premultiplied texel: `C + relief·(1 − A/255)`,
+    /// opaque).
+    pub relief_under: Option<&'a crate::relief::Tint>,
     /// Contour lines ([`crate::relief::Contours`]), over the photo.
     pub contours: Option<&'a crate::relief::Contours>,
     /// Vector overlays ([`crate::vector::Overlay`], placed on this pyramid's finest level), last.
@@ -524,8 +525,12 @@ pub fn write_pyramid_with(
         contours,
         overlay,
     } = *drawn;
-    let shade =
-        relief_under.then(|| crate::relief::Hillshade::new(grid, crate::relief::Light::default()));
+    let shade = relief_under.map(|tint| {
+        (
+            tint,
+            crate::relief::Hillshade::new(grid, crate::relief::Light::default()),
+        )
+    });
     if let Some(o) = overlay.filter(|o| o.size() != size) {
         return Err(TerrainError::BadParameter {
             name: "overlay size",
@@ -554,8 +559,8 @@ pub fn write_pyramid_with(
                         .map_or([0; 4], |px| px.0)
                 });
                 let px = match &shade {
-                    Some(shade) if c[3] < 255.0 => {
-                        let under = crate::relief::relief_texel(grid, shade, size, gx, gy);
+                    Some((tint, shade)) if c[3] < 255.0 => {
+                        let under = tint.texel(grid, shade, size, gx, gy);
                         let k = 1.0 - c[3] / 255.0;
                         let c = [0, 1, 2].map(|i| c[i] + under[i] as f64 * k);
                         Rgba([

@@ -12,6 +12,18 @@
 //! The colour of a texel is its height's colour on a green–brown–white ramp times
 //! `0.35 + 0.9 · shade` (a flat sample, shade `sin 45°`, keeps 99 % of its colour; a slope facing
 //! away from the light falls to 35 %), each channel clipped to 255.
+//!
+//! # Tints
+//! The height colour comes from a [`Tint`]: the built-in ramp, or a table of `(height, colour)`
+//! entries resolved from a `gdaldem color-relief` colour file ([`TintTable::resolve`]:
+//! percentages taken of the grid's height range once, at build time) and interpolated linearly
+//! between them, as `gdaldem color-relief` does by default (the interpolation is
+//! [`crate::dem_products`]'s, one mechanism). The table is saved in the database manifest, so a
+//! reopened database, its streamed textures and its exports colour every texel alike without the
+//! file. The shade factor is the same for both tints. A no-data sample has no shade: it takes
+//! the file's `nv` colour where the file has one, and the ramp's opaque grey otherwise. The relief
+//! is opaque: an entry's alpha is ignored (a translucent texel would show the relief through
+//! itself where it is composited under a photo).
 
 use crate::dem::Grid;
 
@@ -209,51 +221,131 @@ pub fn height_colour(t: f32) -> [f32; 3] {
     [0, 1, 2].map(|i| a[i] + (b[i] - a[i]) * f)
 }
 
-/// The shaded-relief sRGB colour of sample `(col, row)`: its height colour times
-/// `0.35 + 0.9 · shade`; no-data is opaque grey.
-pub fn relief_colour(grid: &Grid, shade: &Hillshade, col: u32, row: u32) -> [u8; 4] {
-    let Some(s) = shade.at(col, row) else {
-        return [128, 128, 128, 255];
-    };
-    let (lo, hi) = grid.height_range();
-    let span = (hi - lo).max(f32::MIN_POSITIVE);
-    let base = height_colour((grid.at(col, row) - lo) / span);
-    let k = (0.35 + 0.9 * s) as f32;
-    let c = |v: f32| (v * k).round().clamp(0.0, 255.0) as u8;
-    [c(base[0]), c(base[1]), c(base[2]), 255]
+/// The colour of a no-data sample in the built-in ramp's relief (and in a table's without `nv`).
+const NODATA_GREY: [u8; 4] = [128, 128, 128, 255];
+
+/// How a shaded relief colours heights (module doc, *Tints*).
+#[derive(Clone, Debug, PartialEq, Default)]
+pub enum Tint {
+    /// The built-in green–brown–white ramp over the grid's height range ([`height_colour`]).
+    #[default]
+    Ramp,
+    /// A resolved colour file, interpolated linearly.
+    Table(TintTable),
 }
 
-/// The texel `(x, y)` of the grid's shaded relief at `side` texels a side: the colour of the
-/// nearest sample ([`relief_image`] and the tiles of a 3D Tiles export share it).
-pub fn relief_texel(grid: &Grid, shade: &Hillshade, side: u32, x: u32, y: u32) -> [u8; 4] {
-    let nearest = |t: u32, n: u32| {
-        let i = ((t as f64 + 0.5) / side as f64 * (n - 1) as f64).round() as u32;
-        i.min(n - 1)
-    };
-    relief_colour(
-        grid,
-        shade,
-        nearest(x, grid.width()),
-        nearest(y, grid.height()),
-    )
+/// A colour file's entries resolved against one grid: heights in metres, sorted, and the
+/// no-data colour. Stored in the database manifest as `relief_tint`.
+///
+/// # Guarantees
+/// Made by [`TintTable::resolve`]: `entries` sorted by height (stably), every height finite.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct TintTable {
+    /// `(height, [r, g, b, a])`, ascending heights.
+    pub entries: Vec<(f64, [u8; 4])>,
+    /// The `nv` entry's colour.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub nodata: Option<[u8; 4]>,
 }
 
-/// The shaded relief of the whole grid as an sRGB image, nearest sample per texel: the side is at
-/// most `max_side` and at most the grid's larger side (at least 1). Rows are coloured in parallel
-/// (each texel on its own: the same bytes for any thread count).
-pub fn relief_image(grid: &Grid, max_side: u32) -> image::RgbaImage {
-    use rayon::prelude::*;
-    let side = max_side.min(grid.width().max(grid.height())).max(1);
-    let shade = Hillshade::new(grid, Light::default());
-    let mut raw = vec![0u8; side as usize * side as usize * 4];
-    raw.par_chunks_mut(side as usize * 4)
-        .enumerate()
-        .for_each(|(y, line)| {
-            for (x, px) in line.chunks_exact_mut(4).enumerate() {
-                px.copy_from_slice(&relief_texel(grid, &shade, side, x as u32, y as u32));
+impl TintTable {
+    /// `table`'s entries with percentages resolved against `grid`'s valid height range.
+    pub fn resolve(table: &crate::dem_products::ColorTable, grid: &Grid) -> TintTable {
+        let (entries, nodata) = table.resolve(grid);
+        TintTable { entries, nodata }
+    }
+
+    /// The table's colour of height `v` (linear between entries, the end entries' beyond them;
+    /// no entries at all: transparent black, as gdaldem).
+    pub fn colour(&self, v: f64) -> [u8; 4] {
+        if self.entries.is_empty() {
+            return [0; 4];
+        }
+        crate::dem_products::colour_of(
+            &self.entries,
+            self.nodata,
+            crate::dem_products::ColorMatch::Linear,
+            v,
+        )
+    }
+}
+
+impl Tint {
+    /// The shaded-relief sRGB colour of sample `(col, row)`: its height colour times
+    /// `0.35 + 0.9 · shade`, opaque; no-data is the table's `nv` colour or opaque grey.
+    pub fn colour(&self, grid: &Grid, shade: &Hillshade, col: u32, row: u32) -> [u8; 4] {
+        let Some(s) = shade.at(col, row) else {
+            return match self {
+                Tint::Table(TintTable {
+                    nodata: Some(c), ..
+                }) => [c[0], c[1], c[2], 255],
+                _ => NODATA_GREY,
+            };
+        };
+        let base = match self {
+            Tint::Ramp => {
+                let (lo, hi) = grid.height_range();
+                let span = (hi - lo).max(f32::MIN_POSITIVE);
+                height_colour((grid.at(col, row) - lo) / span)
             }
-        });
-    image::RgbaImage::from_raw(side, side, raw).expect("side² RGBA texels")
+            Tint::Table(t) => {
+                let c = t.colour(grid.at(col, row) as f64);
+                [c[0] as f32, c[1] as f32, c[2] as f32]
+            }
+        };
+        let k = (0.35 + 0.9 * s) as f32;
+        let c = |v: f32| (v * k).round().clamp(0.0, 255.0) as u8;
+        [c(base[0]), c(base[1]), c(base[2]), 255]
+    }
+
+    /// The texel `(x, y)` of the grid's shaded relief at `side` texels a side: the colour of the
+    /// nearest sample ([`Tint::image`], the relief under a photo and the tiles of a 3D Tiles
+    /// export share it).
+    pub fn texel(&self, grid: &Grid, shade: &Hillshade, side: u32, x: u32, y: u32) -> [u8; 4] {
+        let nearest = |t: u32, n: u32| {
+            let i = ((t as f64 + 0.5) / side as f64 * (n - 1) as f64).round() as u32;
+            i.min(n - 1)
+        };
+        self.colour(
+            grid,
+            shade,
+            nearest(x, grid.width()),
+            nearest(y, grid.height()),
+        )
+    }
+
+    /// The shaded relief of the whole grid as an sRGB image, nearest sample per texel: the side
+    /// is at most `max_side` and at most the grid's larger side (at least 1). Rows are coloured
+    /// in parallel (each texel on its own: the same bytes for any thread count).
+    pub fn image(&self, grid: &Grid, max_side: u32) -> image::RgbaImage {
+        use rayon::prelude::*;
+        let side = max_side.min(grid.width().max(grid.height())).max(1);
+        let shade = Hillshade::new(grid, Light::default());
+        let mut raw = vec![0u8; side as usize * side as usize * 4];
+        raw.par_chunks_mut(side as usize * 4)
+            .enumerate()
+            .for_each(|(y, line)| {
+                for (x, px) in line.chunks_exact_mut(4).enumerate() {
+                    px.copy_from_slice(&self.texel(grid, &shade, side, x as u32, y as u32));
+                }
+            });
+        image::RgbaImage::from_raw(side, side, raw).expect("side² RGBA texels")
+    }
+}
+
+/// [`Tint::colour`] with the built-in ramp.
+pub fn relief_colour(grid: &Grid, shade: &Hillshade, col: u32, row: u32) -> [u8; 4] {
+    Tint::Ramp.colour(grid, shade, col, row)
+}
+
+/// [`Tint::texel`] with the built-in ramp.
+pub fn relief_texel(grid: &Grid, shade: &Hillshade, side: u32, x: u32, y: u32) -> [u8; 4] {
+    Tint::Ramp.texel(grid, shade, side, x, y)
+}
+
+/// [`Tint::image`] with the built-in ramp.
+pub fn relief_image(grid: &Grid, max_side: u32) -> image::RgbaImage {
+    Tint::Ramp.image(grid, max_side)
 }
 
 #[cfg(test)]

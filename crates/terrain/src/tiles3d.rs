@@ -38,7 +38,7 @@ use crate::dem::Grid;
 use crate::error::{TerrainError, io};
 use crate::geodesy::{Placement, ecef};
 use crate::geoid::Geoid;
-use crate::relief::{Hillshade, Light, relief_texel};
+use crate::relief::{Hillshade, Light, Tint};
 
 /// The default largest texture side per tile.
 pub const MAX_TILE_TEXTURE: u32 = 1024;
@@ -132,6 +132,7 @@ pub fn write_tileset_with(
     })?;
     let grid = db.grid_mapped()?;
     let shade = Hillshade::new(&grid, Light::default());
+    let tint = db.tint();
     let source = match &m.texture {
         Some(t) => Source::Photo {
             db,
@@ -141,6 +142,7 @@ pub fn write_tileset_with(
         None => Source::Relief {
             grid: &grid,
             shade: &shade,
+            tint: &tint,
         },
     };
     let max_texture = max_texture.max(1);
@@ -299,6 +301,7 @@ enum Source<'a> {
     Relief {
         grid: &'a Grid,
         shade: &'a Hillshade<'a>,
+        tint: &'a Tint,
     },
 }
 
@@ -358,11 +361,11 @@ fn tile_texture(
             }
             (side, r, img)
         }
-        Source::Relief { grid, shade } => {
+        Source::Relief { grid, shade, tint } => {
             let side = grid.width().max(grid.height());
             let r @ (x0, y0, cw, ch) = rect(side);
             let img = image::RgbaImage::from_fn(cw, ch, |x, y| {
-                image::Rgba(relief_texel(grid, shade, side, x0 + x, y0 + y))
+                image::Rgba(tint.texel(grid, shade, side, x0 + x, y0 + y))
             });
             (side, r, img)
         }

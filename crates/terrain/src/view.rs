@@ -823,7 +823,9 @@ impl FlightTerrain {
             let grid = db.grid_mapped()?;
             let texture = match db.texture(max_texture_side)? {
                 Some(img) => texture_from_rgba(&img)?,
-                None => height_texture(&grid, max_texture_side.clamp(1, 2048))?,
+                None => {
+                    texture_from_rgba(&db.tint().image(&grid, max_texture_side.clamp(1, 2048)))?
+                }
             };
             let chunks: Vec<Vec<ChunkEntry>> = m.levels.iter().map(|l| l.chunks.clone()).collect();
             let bounds = boxes(&chunks);
@@ -851,7 +853,9 @@ impl FlightTerrain {
             let tree = crate::chunks::build(&grid, m.max_error, m.chunk)?;
             let texture = match db.texture(max_texture_side)? {
                 Some(img) => texture_from_rgba(&img)?,
-                None => height_texture(&grid, max_texture_side.clamp(1, 2048))?,
+                None => {
+                    texture_from_rgba(&db.tint().image(&grid, max_texture_side.clamp(1, 2048)))?
+                }
             };
             FlightTerrain::new(grid, tree, texture)
         };

@@ -301,7 +301,21 @@ impl Viewshed {
     /// # Panics
     /// If `grid` is not the viewshed's size.
     pub fn image(&self, grid: &Grid, max_side: u32) -> image::RgbaImage {
-        use crate::relief::{Hillshade, Light, relief_colour};
+        self.image_tinted(grid, &crate::relief::Tint::Ramp, max_side)
+    }
+
+    /// As [`Viewshed::image`], the relief coloured by `tint` (a database's
+    /// [`crate::db::Database::tint`]).
+    ///
+    /// # Panics
+    /// If `grid` is not the viewshed's size.
+    pub fn image_tinted(
+        &self,
+        grid: &Grid,
+        tint: &crate::relief::Tint,
+        max_side: u32,
+    ) -> image::RgbaImage {
+        use crate::relief::{Hillshade, Light};
         use rayon::prelude::*;
         assert_eq!((grid.width(), grid.height()), (self.width, self.height));
         let (w, h) = (self.width as f64, self.height as f64);
@@ -328,7 +342,7 @@ impl Viewshed {
                 let row = (((y as f64 + 0.5) / scale) as u32).min(self.height - 1);
                 for (x, px) in line.chunks_exact_mut(4).enumerate() {
                     let col = (((x as f64 + 0.5) / scale) as u32).min(self.width - 1);
-                    let base = relief_colour(grid, &shade, col, row);
+                    let base = tint.colour(grid, &shade, col, row);
                     let mix = |a: [u8; 4], b: [f32; 3], t: f32| -> [u8; 4] {
                         let m = |i: usize| (a[i] as f32 * (1.0 - t) + b[i] * t).round() as u8;
                         [m(0), m(1), m(2), 255]

@@ -262,3 +262,144 @@ fn overlays_are_drawn_into_the_texture() {
     );
     assert!(!bad.exists());
 }
+
+/// A gdaldem colour file tints the relief where the photo does not cover: each texel west of
+/// the photo is the file's colour of its nearest sample's height, interpolated here by hand
+/// (gdaldem's linear rule, channels rounded as `⌊0.45 + c⌋`), times the hillshade factor
+/// `0.35 + 0.9·shade`. The resolved table is in the manifest: a reopened database colours the
+/// same texels without the file, and a database built without it keeps the built-in ramp.
+#[test]
+fn relief_colors_tint_the_relief_texture() {
+    use texmap_terrain::dem_products::ColorTable;
+    use texmap_terrain::relief::{Hillshade, Tint, TintTable, relief_texel};
+    let grid = read_dem(data("ramp_i16_lzw.tif"), &ReadOptions::default()).unwrap();
+    let photo = gst::read_photo(&data("photo_rgb.tif"), &PhotoOptions::bands(None)).unwrap();
+    let (lo, hi) = grid.height_range();
+    let (lo, hi) = (lo as f64, hi as f64);
+    // One absolute height (inside the range) between two percentages.
+    let mid = lo + 0.3 * (hi - lo);
+    let text = format!("0% 0 0 0\n{mid} 200 100 0\n100% 255 255 255\nnv 0 0 255\n");
+    let table = ColorTable::parse(&text, "colors.txt").unwrap();
+    let tint = Tint::Table(TintTable::resolve(&table, &grid));
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("db");
+    let opts = BuildOptions {
+        max_error: 0.5,
+        chunk: 17,
+        map_texels: 16,
+        max_texture_levels: 3,
+        tint: tint.clone(),
+        ..Default::default()
+    };
+    let m = db::build(&grid, "ramp", Some(&photo), &opts, &out, |_, _| {}).unwrap();
+    let saved = m.relief_tint.clone().expect("the table is in the manifest");
+    assert_eq!(Tint::Table(saved), tint);
+
+    // The colour file's linear interpolation, by hand.
+    let stops = [
+        (lo, [0.0, 0.0, 0.0]),
+        (mid, [200.0, 100.0, 0.0]),
+        (hi, [255.0; 3]),
+    ];
+    let by_hand = |v: f64| -> [f64; 3] {
+        let i = stops.iter().position(|s| s.0 >= v).unwrap_or(2).max(1);
+        let (a, b) = (stops[i - 1], stops[i]);
+        let t = ((v - a.0) / (b.0 - a.0)).clamp(0.0, 1.0);
+        [0, 1, 2].map(|k| (0.45 + a.1[k] + t * (b.1[k] - a.1[k])).floor())
+    };
+    let shade = Hillshade::new(&grid, Default::default());
+    let d = Database::open(&out).unwrap();
+    let tex = d.texture(4096).unwrap().unwrap();
+    let w = tex.width();
+    assert_eq!(w, 64, "the finest level: 16 · 2² texels");
+    let nearest =
+        |t: u32, n: u32| (((t as f64 + 0.5) / w as f64 * (n - 1) as f64).round() as u32).min(n - 1);
+    // The photo covers columns 18..=36: texels west of column 15 are all relief.
+    let west = (15.0 / 36.0 * (w - 1) as f64) as u32;
+    let (mut checked, mut unlike_ramp) = (0, 0);
+    for y in 0..tex.height() {
+        for x in 0..west {
+            let (col, row) = (nearest(x, grid.width()), nearest(y, grid.height()));
+            let got = tex.get_pixel(x, y).0;
+            let want = match shade.at(col, row) {
+                None => [0.0, 0.0, 255.0],
+                Some(s) => {
+                    let k = 0.35 + 0.9 * s;
+                    by_hand(grid.at(col, row) as f64).map(|c| (c * k).round().min(255.0))
+                }
+            };
+            // 1 level: the texture scales the colour by `k` in f32, the reference in f64, and
+            // a product within an ulp of a half rounds either way.
+            for i in 0..3 {
+                assert!(
+                    (got[i] as f64 - want[i]).abs() <= 1.0,
+                    "texel ({x}, {y}) channel {i}: expected {want:?}, got {got:?}, tolerance 1"
+                );
+            }
+            assert_eq!(got[3], 255);
+            if got != relief_texel(&grid, &shade, w, x, y) {
+                unlike_ramp += 1;
+            }
+            checked += 1;
+        }
+    }
+    assert!(checked > 1000, "{checked} texels checked");
+    assert!(
+        unlike_ramp > checked / 2,
+        "{unlike_ramp} of {checked} unlike the ramp"
+    );
+
+    // Reopened, without the file: the manifest's table colours the same texels, and the maps a
+    // streamed texture reads are the ones the texture was assembled from.
+    let again = Database::open(&out).unwrap();
+    assert_eq!(again.tint(), tint);
+    let g2 = again.grid().unwrap();
+    let shade2 = Hillshade::new(&g2, Default::default());
+    for (x, y) in [(0, 0), (3, 40), (west - 1, 63), (10, 20)] {
+        assert_eq!(
+            again.tint().texel(&g2, &shade2, w, x, y),
+            tex.get_pixel(x, y).0,
+            "texel ({x}, {y})"
+        );
+    }
+    let finest = m.texture.as_ref().unwrap().levels - 1;
+    for (mx, my) in [(0, 0), (0, 3), (1, 2)] {
+        let map = again
+            .map(gst::MapKey {
+                level: finest,
+                x: mx,
+                y: my,
+            })
+            .unwrap();
+        for (i, j, px) in map.enumerate_pixels() {
+            assert_eq!(*px, *tex.get_pixel(mx * 16 + i, my * 16 + j));
+        }
+    }
+
+    // The no-data sample takes the nv colour; without a table it is the ramp's grey.
+    let (nc, nr) = (0..grid.height())
+        .flat_map(|r| (0..grid.width()).map(move |c| (c, r)))
+        .find(|&(c, r)| grid.at(c, r).is_nan())
+        .unwrap();
+    assert_eq!(tint.colour(&grid, &shade, nc, nr), [0, 0, 255, 255]);
+    assert_eq!(
+        Tint::Ramp.colour(&grid, &shade, nc, nr),
+        [128, 128, 128, 255]
+    );
+
+    // Without a photo the tinted relief is the texture; without a table the manifest has no
+    // tint and a relief-only database no texture, as before.
+    let bare = dir.path().join("bare");
+    let m = db::build(&grid, "ramp", None, &opts, &bare, |_, _| {}).unwrap();
+    assert_eq!(m.texture.as_ref().unwrap().placed_by, "stretched");
+    assert!(m.relief_tint.is_some());
+    let plain = dir.path().join("plain");
+    let plain_opts = BuildOptions {
+        tint: Tint::Ramp,
+        ..opts
+    };
+    let m = db::build(&grid, "ramp", None, &plain_opts, &plain, |_, _| {}).unwrap();
+    assert!(m.texture.is_none() && m.relief_tint.is_none());
+    let json = std::fs::read_to_string(plain.join("manifest.json")).unwrap();
+    assert!(!json.contains("relief_tint"), "{json}");
+}
