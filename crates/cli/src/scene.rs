@@ -150,11 +150,7 @@ fn comment_key(text: &str) -> Option<(&str, Option<usize>)> {
         Some((name, n)) => (name, Some(n.parse::<usize>().ok().filter(|n| *n <= 12)?)),
         None => (text, None),
     };
-    let mut chars = name.chars();
-    let first = chars.next()?;
-    ((first.is_ascii_alphabetic() || first == '_')
-        && chars.all(|c| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.')))
-    .then_some((name, decimals))
+    Frame::is_comment_key(name.as_bytes()).then_some((name, decimals))
 }
 
 /// A `{placeholder}` template split into text and placeholders, each placeholder one of

@@ -1065,12 +1065,7 @@ fn viewshed_writes_gdals_mask_and_refuses_bad_observers() {
     assert_eq!(o.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&o.stderr).contains("nope.tif"));
     assert!(!bad.exists(), "no partial output");
-    let leftovers: Vec<_> = std::fs::read_dir(dir.path())
-        .unwrap()
-        .filter_map(|e| e.ok())
-        .filter(|e| e.file_name().to_string_lossy().contains("partial"))
-        .collect();
-    assert!(leftovers.is_empty(), "{leftovers:?}");
+    assert_no_partial_files(dir.path());
 }
 
 #[test]
@@ -1481,12 +1476,7 @@ fn dem_products_keep_the_georeference_and_name_a_bad_colour_line() {
         );
     }
     assert!(!tint.exists(), "no output file");
-    let leftovers: Vec<_> = std::fs::read_dir(dir.path())
-        .unwrap()
-        .filter_map(|e| e.ok())
-        .filter(|e| e.file_name().to_string_lossy().contains("partial"))
-        .collect();
-    assert!(leftovers.is_empty(), "{leftovers:?}");
+    assert_no_partial_files(dir.path());
 }
 
 /// `terrain build --relief-colors`: the resolved table is in the manifest `terrain info`
@@ -1553,4 +1543,15 @@ fn relief_colors_tint_the_build_and_a_bad_file_is_named() {
         .filter(|e| e.file_name().to_string_lossy().contains("bad"))
         .collect();
     assert!(left.is_empty(), "{left:?}");
+}
+
+/// No temporary `*partial*` file is left in `dir` (outputs are written under such a name and
+/// renamed only when complete).
+fn assert_no_partial_files(dir: &Path) {
+    let leftovers: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().contains("partial"))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
 }

@@ -434,6 +434,17 @@ impl Frame {
             .filter_map(|(k, v)| Some((std::str::from_utf8(k).ok()?, std::str::from_utf8(v).ok()?)))
     }
 
+    /// Whether `name` can be a key of [`Frame::comment_pairs`] that tools name things by: a
+    /// letter or `_`, then letters, digits, `_`, `-` and `.` (`energy`, `minimizedAffinity`,
+    /// `c_pe.1`).
+    pub fn is_comment_key(name: &[u8]) -> bool {
+        name.first()
+            .is_some_and(|b| b.is_ascii_alphabetic() || *b == b'_')
+            && name
+                .iter()
+                .all(|b| b.is_ascii_alphanumeric() || matches!(b, b'_' | b'-' | b'.'))
+    }
+
     /// The value of `key` (case as written) among [`Frame::comment_pairs`].
     pub fn comment_value(&self, key: &str) -> Option<&str> {
         self.comment_pairs()

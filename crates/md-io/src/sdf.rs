@@ -259,12 +259,7 @@ fn data_header(line: &[u8]) -> Option<Item> {
     let name = &rest[open + 1..];
     let close = name.iter().position(|&b| b == b'>')?;
     let name = &name[..close];
-    let key = name
-        .first()
-        .is_some_and(|b| b.is_ascii_alphabetic() || *b == b'_')
-        && name
-            .iter()
-            .all(|b| b.is_ascii_alphanumeric() || matches!(b, b'_' | b'-' | b'.'));
+    let key = Frame::is_comment_key(name);
     match name {
         b"step" => Some(Item::Step),
         b"time" => Some(Item::Time),

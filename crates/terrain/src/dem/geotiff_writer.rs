@@ -376,44 +376,64 @@ fn encode<W: Write + Seek, K: TiffKind>(
     let err = tiff_err(source);
     let enc = enc.map_err(&err)?;
     let mut enc = enc.with_compression(Compression::Deflate(DeflateLevel::Balanced));
+    // Horizontal differencing makes long runs of one byte value (a mask) runs of zeros.
+    let pred = Predictor::Horizontal;
     match samples {
         Samples::F32(v) => {
-            let mut img = enc
-                .new_image::<colortype::Gray32Float>(width, height)
-                .map_err(&err)?;
-            write_geo_tags(img.encoder(), tags, nodata).map_err(&err)?;
-            img.write_data(v).map_err(&err)
+            image::<_, _, colortype::Gray32Float>(&mut enc, width, height, v, false, tags, nodata)
         }
-        Samples::U8(v) => {
-            // Horizontal differencing makes long runs of one mask value runs of zeros.
-            let mut enc = enc.with_predictor(Predictor::Horizontal);
-            let mut img = enc
-                .new_image::<colortype::Gray8>(width, height)
-                .map_err(&err)?;
-            write_geo_tags(img.encoder(), tags, nodata).map_err(&err)?;
-            img.write_data(v).map_err(&err)
-        }
-        Samples::Rgb8(v) => {
-            let mut enc = enc.with_predictor(Predictor::Horizontal);
-            let mut img = enc
-                .new_image::<colortype::RGB8>(width, height)
-                .map_err(&err)?;
-            write_geo_tags(img.encoder(), tags, nodata).map_err(&err)?;
-            img.write_data(v).map_err(&err)
-        }
-        Samples::Rgba8(v) => {
-            let mut enc = enc.with_predictor(Predictor::Horizontal);
-            let mut img = enc
-                .new_image::<colortype::RGBA8>(width, height)
-                .map_err(&err)?;
-            // ExtraSamples: the fourth sample is unassociated alpha (GDAL's -alpha output).
-            img.encoder()
-                .write_tag(Tag::ExtraSamples, &[2u16][..])
-                .map_err(&err)?;
-            write_geo_tags(img.encoder(), tags, nodata).map_err(&err)?;
-            img.write_data(v).map_err(&err)
-        }
+        Samples::U8(v) => image::<_, _, colortype::Gray8>(
+            &mut enc.with_predictor(pred),
+            width,
+            height,
+            v,
+            false,
+            tags,
+            nodata,
+        ),
+        Samples::Rgb8(v) => image::<_, _, colortype::RGB8>(
+            &mut enc.with_predictor(pred),
+            width,
+            height,
+            v,
+            false,
+            tags,
+            nodata,
+        ),
+        Samples::Rgba8(v) => image::<_, _, colortype::RGBA8>(
+            &mut enc.with_predictor(pred),
+            width,
+            height,
+            v,
+            true,
+            tags,
+            nodata,
+        ),
     }
+    .map_err(&err)
+}
+
+/// One strip image of colour type `C` with the geo tags; `alpha`: the last sample is
+/// unassociated alpha (ExtraSamples 2, GDAL's -alpha output).
+#[allow(clippy::too_many_arguments)] // the image's parts, each used once
+fn image<W: Write + Seek, K: TiffKind, C: colortype::ColorType>(
+    enc: &mut TiffEncoder<W, K>,
+    width: u32,
+    height: u32,
+    data: &[C::Inner],
+    alpha: bool,
+    tags: &GeoTags,
+    nodata: Option<f64>,
+) -> tiff::TiffResult<()>
+where
+    [C::Inner]: tiff::encoder::TiffValue,
+{
+    let mut img = enc.new_image::<C>(width, height)?;
+    if alpha {
+        img.encoder().write_tag(Tag::ExtraSamples, &[2u16][..])?;
+    }
+    write_geo_tags(img.encoder(), tags, nodata)?;
+    img.write_data(data)
 }
 
 fn write_geo_tags<W: Write + Seek, K: TiffKind>(
