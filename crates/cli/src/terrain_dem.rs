@@ -35,7 +35,7 @@ Examples:
 Each mode equals `gdaldem MODE` of GDAL 3.6.2 with the same options (crates/terrain/tests/
 dem_products.rs compares them: the same values, a hillshade at most one grey level apart on about
 one sample in 4000; --exact departs from GDAL 3.6.2, which matches only the lowest entry). Several DEM tiles are joined into one grid first, as `terrain
-build --dem` joins them. Spacing: --scale has gdaldem's -s meaning (vertical units per horizontal
+build --dem` joins them; a database directory from `terrain build` gives its full-resolution grid. Spacing: --scale has gdaldem's -s meaning (vertical units per horizontal
 unit); without it a projected grid takes 1 and a geographic (degree) grid takes the true metres
 per degree at each row's latitude, so slopes are right without -s 111120 (give --scale 111120 for
 gdaldem's own output on such a grid). --cog writes a Cloud-Optimized GeoTIFF as the other terrain
@@ -71,7 +71,8 @@ pub enum DemMode {
 /// What every mode takes.
 #[derive(Args, Debug)]
 pub struct CommonArgs {
-    /// Elevation files (any format `terrain build --dem` reads); several tiles are joined.
+    /// Elevation files (any format `terrain build --dem` reads); several tiles are joined. Or
+    /// one database directory from `terrain build`: its full-resolution grid.
     #[arg(required = true, value_name = "DEM")]
     pub input: Vec<PathBuf>,
     /// Output GeoTIFF (.tif or .tiff), on the DEM's lattice and georeference.
@@ -307,8 +308,18 @@ pub fn run(a: DemArgs) -> Result<()> {
     Ok(())
 }
 
-/// The DEM files read and joined into one grid, as `terrain build --dem` joins them.
+/// The DEM files read and joined into one grid, as `terrain build --dem` joins them, or the
+/// grid of a database directory from `terrain build` (mapped, as `terrain viewshed` reads it).
 fn read_joined(paths: &[PathBuf]) -> Result<Grid> {
+    if let Some(dir) = paths.iter().find(|p| p.is_dir()) {
+        if paths.len() > 1 {
+            return usage(format!(
+                "{}: a database directory is read alone; give it without other DEMs",
+                dir.display()
+            ));
+        }
+        return Ok(texmap_terrain::db::Database::open(dir)?.grid_mapped()?);
+    }
     let parts = dem::read_dems(paths, &ReadOptions::default())?;
     let (grid, overlaps) = dem::mosaic::mosaic(parts)?;
     crate::terrain::note_overlaps(&overlaps);

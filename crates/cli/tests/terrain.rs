@@ -1479,6 +1479,58 @@ fn dem_products_keep_the_georeference_and_name_a_bad_colour_line() {
     assert_no_partial_files(dir.path());
 }
 
+/// `terrain dem` on a database directory reads its full-resolution grid: the slope and colour
+/// relief are byte for byte those of the DEM the database was built from. A database given with
+/// other DEMs is refused (exit 2) with nothing written.
+#[test]
+fn dem_products_of_a_database_equal_those_of_its_source_dem() {
+    let dir = tempfile::tempdir().unwrap();
+    let db = relief_db(dir.path(), "src.db");
+    let colors = dir.path().join("colors.txt");
+    std::fs::write(
+        &colors,
+        "0% 0 0 80\n50% 40 160 40\n100% white\nnv 0 0 0 0\n",
+    )
+    .unwrap();
+    for mode in [
+        vec!["slope"],
+        vec!["color-relief", colors.to_str().unwrap()],
+    ] {
+        let (from_db, from_tif) = (dir.path().join("db.tif"), dir.path().join("tif.tif"));
+        for (input, out) in [
+            (db.to_str().unwrap().to_string(), &from_db),
+            (data_hillshade().to_string(), &from_tif),
+        ] {
+            let mut v = vec!["terrain", "dem"];
+            v.extend_from_slice(&mode);
+            v.extend_from_slice(&[input.as_str(), "-q", "-o", out.to_str().unwrap()]);
+            ok(&texmap(&v));
+        }
+        assert_eq!(
+            std::fs::read(&from_db).unwrap(),
+            std::fs::read(&from_tif).unwrap(),
+            "{mode:?}"
+        );
+    }
+    let out = dir.path().join("both.tif");
+    let o = texmap(&[
+        "terrain",
+        "dem",
+        "slope",
+        db.to_str().unwrap(),
+        data_hillshade(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("src.db: a database directory is read alone"),
+        "{err}"
+    );
+    assert!(!out.exists());
+}
+
 /// `terrain build --relief-colors`: the resolved table is in the manifest `terrain info`
 /// prints, and the relief-only database gets the tinted texture; a bad line in the file exits
 /// 1 naming `colors.txt: line N`, and no database directory is left.
