@@ -339,3 +339,78 @@ fn products_do_not_depend_on_the_thread_count() {
     };
     assert_eq!(run(1), run(3));
 }
+
+/// The colour relief's GeoTIFFs read back by another decoder (the `tiff` crate): in strips (RGB)
+/// and as a COG with 16-pixel tiles (RGBA, so tiles and overviews on a small grid), the full
+/// image is the product's bytes, the alpha is declared unassociated (ExtraSamples 2, as GDAL
+/// writes `-alpha`), the COG has its overviews, and the georeference tags place the pixels as
+/// the source GeoTIFF does (GDAL wrote it as PixelIsPoint, centres at whole arc-seconds; ours
+/// are PixelIsArea, so the tie point is the first pixel's corner, half a pixel up and left).
+#[test]
+fn color_relief_geotiffs_read_back_with_their_georeference() {
+    use texmap_terrain::dem::geotiff_writer::GeoTiffOptions;
+    use tiff::decoder::{Decoder, DecodingResult};
+    use tiff::tags::Tag;
+    let table = ColorTable::read(&data("gdaldem_colors.txt")).unwrap();
+    let grid = input("geo");
+    let dir = tempfile::tempdir().unwrap();
+    let georef_tags = |d: &mut Decoder<std::fs::File>| {
+        [Tag::ModelPixelScaleTag, Tag::ModelTiepointTag].map(|t| d.get_tag_f64_vec(t).unwrap())
+    };
+    let raster_type = |d: &mut Decoder<std::fs::File>| {
+        let keys = d.get_tag_u16_vec(Tag::GeoKeyDirectoryTag).unwrap();
+        keys[4..]
+            .chunks_exact(4)
+            .find(|k| k[0] == 1025)
+            .map_or(1, |k| k[3])
+    };
+    let mut source = Decoder::new(std::fs::File::open(data("gdaldem_geo.tif")).unwrap()).unwrap();
+    let [scale, tie] = georef_tags(&mut source);
+    assert_eq!(
+        raster_type(&mut source),
+        2,
+        "GDAL wrote the crop as PixelIsPoint"
+    );
+    let (dx, dy) = (scale[0], -scale[1]);
+    let corner = vec![0.0, 0.0, 0.0, tie[3] - dx / 2.0, tie[4] - dy / 2.0, 0.0];
+    for (alpha, cog) in [(false, false), (true, true), (true, false), (false, true)] {
+        let product = color_relief(&grid, &table, ColorMatch::Linear, alpha);
+        let path = dir.path().join(format!("cr_{alpha}_{cog}.tif"));
+        let options = GeoTiffOptions {
+            cog,
+            block_size: if cog { 16 } else { 512 },
+        };
+        product.write_geotiff(&path, &grid, &options).unwrap();
+        let mut d = Decoder::new(std::fs::File::open(&path).unwrap()).unwrap();
+        let case = format!("alpha {alpha}, cog {cog}");
+        assert_eq!(
+            d.dimensions().unwrap(),
+            (grid.width(), grid.height()),
+            "{case}"
+        );
+        let want = match (&product.samples, alpha) {
+            (ProductSamples::Rgba8(v), true) => {
+                assert_eq!(d.colortype().unwrap(), tiff::ColorType::RGBA(8), "{case}");
+                assert_eq!(d.get_tag_u32_vec(Tag::ExtraSamples).unwrap(), [2], "{case}");
+                v.clone()
+            }
+            (ProductSamples::Rgb8(v), false) => {
+                assert_eq!(d.colortype().unwrap(), tiff::ColorType::RGB(8), "{case}");
+                v.clone()
+            }
+            _ => panic!("{case}: unexpected sample layout"),
+        };
+        assert_eq!(raster_type(&mut d), 1, "{case}: PixelIsArea");
+        let [our_scale, our_tie] = georef_tags(&mut d);
+        assert_eq!(our_scale, scale, "{case}");
+        assert_eq!(our_tie, corner, "{case}");
+        let DecodingResult::U8(got) = d.read_image().unwrap() else {
+            panic!("{case}: 8-bit samples expected")
+        };
+        assert!(
+            got == want,
+            "{case}: the decoded image differs from the product"
+        );
+        assert_eq!(d.more_images(), cog, "{case}: overviews only in the COG");
+    }
+}
