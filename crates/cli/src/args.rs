@@ -93,6 +93,13 @@ pub enum Command {
         /// atom, residue and bond counts are added, and a different atom count is an error.
         #[arg(long, value_name = "FILE")]
         topology: Option<PathBuf>,
+        /// A periodic cell for frames whose file holds none (plain XYZ, CP2K, ORCA, xtb), or to
+        /// replace the file's: A,B,C in Å (right angles) or A,B,C,ALPHA,BETA,GAMMA (degrees), as
+        /// VMD's 'pbc set {A B C}'; or a CP2K cell file (PROJECT-1.cell), each frame's cell found by
+        /// its step (the 'i =' of CP2K's .xyz comment lines; a step the file lacks is an error).
+        /// --pbc, --replicate and --box-outline then work on such trajectories.
+        #[arg(long, value_name = "A,B,C[,ANGLES]|FILE.cell")]
+        cell: Option<String>,
     },
     /// Render trajectory frames to PNG (and optionally depth to EXR).
     Render(RenderArgs),
@@ -970,6 +977,13 @@ pub struct MolArgs {
     /// LAMMPS data file (.data, .lmp, data.*).
     #[arg(long, value_name = "FILE")]
     pub topology: Option<PathBuf>,
+    /// A periodic cell for frames whose file holds none (plain XYZ, CP2K, ORCA, xtb), or to
+    /// replace the file's: A,B,C in Å (right angles) or A,B,C,ALPHA,BETA,GAMMA (degrees), as
+    /// VMD's 'pbc set {A B C}'; or a CP2K cell file (PROJECT-1.cell), each frame's cell found by
+    /// its step (the 'i =' of CP2K's .xyz comment lines; a step the file lacks is an error).
+    /// --pbc, --replicate and --box-outline then work on such trajectories.
+    #[arg(long, value_name = "A,B,C[,ANGLES]|FILE.cell")]
+    pub cell: Option<String>,
     /// A GROMACS index file (.ndx, from gmx make_ndx or gmx select -on): its groups become the
     /// selection keyword 'group NAME' or 'group N' (numbered from 0 as make_ndx lists them; a
     /// name matches exactly, in any case or by a unique prefix, as GROMACS matches it; quote a

@@ -46,12 +46,14 @@ pub fn run(cli: Cli) -> Result<()> {
             allow_truncated,
             lammps_columns,
             topology,
+            cell,
         } => info(
             &file,
             &more,
             format.as_deref(),
             read_options(allow_truncated, lammps_columns.as_deref()),
             topology.as_deref(),
+            cell.as_deref(),
         ),
         Command::Render(a) => {
             crate::scene::load_index(a.mol.index.as_deref())?;
@@ -229,6 +231,7 @@ fn info(
     format: Option<&str>,
     options: ReadOptions,
     topology: Option<&Path>,
+    cell: Option<&str>,
 ) -> Result<()> {
     use texmap_md_io::TopologyFormat;
     if format.is_none()
@@ -273,7 +276,9 @@ fn info(
         .collect();
     let topo = topology.map(crate::scene::open_topology).transpose()?;
     let options = with_topology(options, topo.as_ref());
+    let cells = cell.map(cell_override).transpose()?;
     let mut traj = open_parts(&files, format, options)?;
+    traj.set_cells(cells);
     let mut frame = MdFrame::new();
     let frames = traj.n_frames()?;
     print_warnings(&traj, &mut 0);
@@ -599,18 +604,50 @@ pub(crate) fn open_input(
     allow_truncated: bool,
     lammps_columns: Option<&str>,
     topology: Option<&Path>,
+    cell: Option<&str>,
 ) -> Result<(Option<texmap_md_io::Topology>, Sequence, ReadOptions)> {
     let topology = topology.map(crate::scene::open_topology).transpose()?;
+    let cells = cell.map(cell_override).transpose()?;
     let options = read_options(allow_truncated, lammps_columns);
     let files: Vec<PathBuf> = std::iter::once(file.to_path_buf())
         .chain(more.iter().cloned())
         .collect();
-    let traj = open_parts(
+    let mut traj = open_parts(
         &files,
         format,
         with_topology(options.clone(), topology.as_ref()),
     )?;
+    traj.set_cells(cells);
     Ok((topology, traj, options))
+}
+
+/// `--cell SPEC`: A,B,C[,ALPHA,BETA,GAMMA] (Å, degrees) for every frame, or a CP2K `.cell`
+/// file's cells by step.
+pub(crate) fn cell_override(spec: &str) -> Result<texmap_md_io::cells::CellOverride> {
+    use texmap_md_io::cells::{CellOverride, CellTable};
+    let numbers: Option<Vec<f64>> = spec.split(',').map(|p| p.trim().parse().ok()).collect();
+    match numbers {
+        Some(v) if v.len() == 3 || v.len() == 6 => {
+            let angles = if v.len() == 6 {
+                [v[3], v[4], v[5]]
+            } else {
+                [90.0; 3]
+            };
+            match texmap_md_io::UnitCell::from_lengths_angles([v[0], v[1], v[2]], angles) {
+                Ok(cell) => Ok(CellOverride::Fixed(cell)),
+                Err(e) => usage(format!("--cell {spec}: {e}")),
+            }
+        }
+        Some(_) => usage(format!(
+            "--cell {spec}: expected A,B,C or A,B,C,ALPHA,BETA,GAMMA (Å, degrees), or a CP2K .cell file"
+        )),
+        None if Path::new(spec).is_file() => Ok(CellOverride::Steps(
+            CellTable::read(spec).context("--cell")?.into(),
+        )),
+        None => usage(format!(
+            "--cell {spec}: no such file, and not A,B,C or A,B,C,ALPHA,BETA,GAMMA (Å, degrees)"
+        )),
+    }
 }
 
 /// `--property NAME=FILE` values: per-atom numbers from files, by name.
@@ -709,6 +746,7 @@ fn render(a: &RenderArgs) -> Result<()> {
         a.allow_truncated,
         a.lammps_columns.as_deref(),
         a.mol.topology.as_deref(),
+        a.mol.cell.as_deref(),
     )?;
     let n = traj.n_frames()?;
     let mut shown = 0;

@@ -42,6 +42,13 @@ pub struct ConvertArgs {
     /// render.
     #[arg(long, value_name = "FILE")]
     pub topology: Option<PathBuf>,
+    /// A periodic cell for frames whose file holds none (plain XYZ, CP2K, ORCA, xtb), or to
+    /// replace the file's: A,B,C in Å (right angles) or A,B,C,ALPHA,BETA,GAMMA (degrees), as
+    /// VMD's 'pbc set {A B C}'; or a CP2K cell file (PROJECT-1.cell), each frame's cell found by
+    /// its step (the 'i =' of CP2K's .xyz comment lines; a step the file lacks is an error).
+    /// --pbc and the analyses that need a box then work on such trajectories.
+    #[arg(long, value_name = "A,B,C[,ANGLES]|FILE.cell")]
+    pub cell: Option<String>,
     /// A GROMACS index file (.ndx, from gmx make_ndx or gmx select -on): its groups become the
     /// selection keyword 'group NAME' or 'group N' (numbered from 0 as make_ndx lists them; a
     /// name matches exactly, in any case or by a unique prefix, as GROMACS matches it; quote a
@@ -277,6 +284,7 @@ pub fn convert(a: &ConvertArgs) -> Result<()> {
         a.allow_truncated,
         a.lammps_columns.as_deref(),
         a.topology.as_deref(),
+        a.cell.as_deref(),
     )?;
     let n = traj.n_frames()?;
     let mut shown = 0;

@@ -4559,3 +4559,103 @@ fn lammps_binary_dump_informs_renders_and_converts_as_its_text_dump() {
     };
     assert_eq!(convert(&bin, "bin.xyz"), convert(&text, "text.xyz"));
 }
+
+/// `--cell FILE.cell` on CP2K's NPT run (md-io's tests/data/cp2k): `convert --pbc wrap` puts
+/// every atom where ASE's `wrap()` does with the cell of the frame's step, the written extended
+/// XYZ carries that cell as its Lattice, and `info` reports the first step's box. A fixed
+/// `--cell A,B,C` is the box of every frame; a bad `--cell` is a usage error (exit 2), a step
+/// the cell file lacks a runtime error (exit 1) naming the frame and step, with no output.
+#[test]
+fn cp2k_positions_take_their_cells_from_the_cell_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let pos = data("cp2k/ar_npt-pos-1.xyz");
+    let cell = data("cp2k/ar_npt-1.cell");
+    let out = dir.path().join("wrapped.xyz");
+    let o = texmap(&[
+        "convert",
+        &pos,
+        "--cell",
+        &cell,
+        "--pbc",
+        "wrap",
+        "-q",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let reference = read_json(&ovito_data("cp2k/reference.json"));
+    let table = texmap_md_io::cells::CellTable::read(&cell).unwrap();
+    let mut t = texmap_md_io::Trajectory::open(&out).unwrap();
+    let mut f = texmap_md_io::Frame::new();
+    let mut k = 0;
+    while t.read_next(&mut f).unwrap() {
+        let step = f.step.expect("the step is written back");
+        let want = table.at_step(step).unwrap().1;
+        let got = f.cell.as_ref().expect("the Lattice is written");
+        for (a, b) in got
+            .matrix()
+            .iter()
+            .flatten()
+            .zip(want.matrix().iter().flatten())
+        {
+            assert!((a - b).abs() < 1e-6, "frame {k}: {got:?} against {want:?}");
+        }
+        let ase = reference["npt_wrapped"][k].as_array().unwrap();
+        for (p, q) in f.positions.iter().zip(ase) {
+            for d in 0..3 {
+                let q = q[d].as_f64().unwrap();
+                // ASE and we wrap the same f64 positions: equal to the f32 of the output
+                // (a coordinate exactly on a face could go either way; none is here).
+                assert!(
+                    (p[d] as f64 - q).abs() < 1e-5,
+                    "frame {k}: {p:?} against ASE's"
+                );
+            }
+        }
+        k += 1;
+    }
+    assert_eq!(k, 11);
+
+    let o = texmap(&["info", &pos, "--cell", "10,11,12,90,100,90"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let info: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let bx: Vec<f64> = info["box"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    for (a, b) in bx.iter().zip([10.0, 11.0, 12.0, 90.0, 100.0, 90.0]) {
+        assert!((a - b).abs() < 1e-9, "{bx:?}");
+    }
+
+    let bad = dir.path().join("bad.xyz");
+    for spec in ["1,2", "10,10,10,90,90,200", "no-such.cell"] {
+        let o = texmap(&["convert", &pos, "--cell", spec, "-o", bad.to_str().unwrap()]);
+        assert_eq!(o.status.code(), Some(2), "{spec}: {}", stderr(&o));
+        assert!(
+            stderr(&o).contains(&format!("--cell {spec}")),
+            "{}",
+            stderr(&o)
+        );
+    }
+    // A cell file cut after step 4: frame 2 (step 8) has no cell.
+    let short = dir.path().join("short.cell");
+    let text = std::fs::read_to_string(&cell).unwrap();
+    std::fs::write(&short, text.lines().take(6).collect::<Vec<_>>().join("\n")).unwrap();
+    let o = texmap(&[
+        "convert",
+        &pos,
+        "--cell",
+        short.to_str().unwrap(),
+        "-o",
+        bad.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("frame 2: step 8 is not in"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!bad.exists(), "no partial output");
+}

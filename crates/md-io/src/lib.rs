@@ -123,6 +123,7 @@ mod amber;
 mod asetraj;
 mod bcif;
 pub mod bonds;
+pub mod cells;
 pub mod centrosymmetry;
 mod chgcar;
 mod cif;

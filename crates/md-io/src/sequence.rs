@@ -29,6 +29,7 @@ use std::fs::File;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+use crate::cells::CellOverride;
 use crate::error::{Error, Location};
 use crate::format::Format;
 use crate::frame::Frame;
@@ -51,6 +52,8 @@ pub struct Sequence {
     warnings: Vec<Error>,
     /// The first part's format.
     first_format: Format,
+    /// A cell given to every frame read ([`Sequence::set_cells`]).
+    cells: Option<CellOverride>,
 }
 
 impl Sequence {
@@ -82,7 +85,33 @@ impl Sequence {
             open: Some((0, traj, 0)),
             cursor: (0, 0),
             warnings: Vec::new(),
+            cells: None,
         })
+    }
+
+    /// Gives every frame read from now on a cell from outside the files: a fixed box, or a
+    /// CP2K `.cell` file's cell at the frame's step (see [`crate::cells`]). A frame the
+    /// override cannot place is an error naming the frame.
+    pub fn set_cells(&mut self, cells: Option<CellOverride>) {
+        self.cells = cells;
+    }
+
+    /// Sets frame `n`'s cell from the override, if one is set.
+    fn place(&self, n: usize, frame: &mut Frame) -> Result<(), Error> {
+        match &self.cells {
+            Some(c) => c.apply(frame, n, &self.name),
+            None => Ok(()),
+        }
+    }
+
+    /// The sequence's frame number of frame `local` of part `k` (whose earlier parts' counts
+    /// are known: they were read through).
+    fn global(&self, k: usize, local: usize) -> usize {
+        self.counts[..k]
+            .iter()
+            .map(|c| c.unwrap_or(0))
+            .sum::<usize>()
+            + local
     }
 
     /// The parts, in order.
@@ -173,7 +202,7 @@ impl Sequence {
         traj.read_frame(local, frame)?;
         *at = local + 1;
         self.cursor = (k, local + 1);
-        Ok(())
+        self.place(n, frame)
     }
 
     /// Reads the next frame into `frame`, going on to the next part when one ends;
@@ -197,8 +226,14 @@ impl Sequence {
             };
             if got {
                 self.cursor.1 += 1;
+                if self.cells.is_some() {
+                    let n = self.global(k, local);
+                    self.place(n, frame)?;
+                }
                 return Ok(true);
             }
+            // Part k ended after `local` frames: its count, for frame numbers of later parts.
+            self.counts[k].get_or_insert(local);
             self.cursor = (k + 1, 0);
         }
         frame.clear();

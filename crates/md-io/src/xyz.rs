@@ -20,6 +20,12 @@
 //!   are `species:S:1:pos:R:3`.
 //! - `Time=` (ps) and `step=`/`Step=`/`timestep=` when present.
 //!
+//! CP2K's comment lines (`i =        0, time =        0.000, E =       -17.1706942181` in an MD
+//! run's `-pos-1.xyz`, `-vel-1.xyz` and `-frc-1.xyz`; `i = 3, E = ...` in an optimisation's) are
+//! recognised by their first key `i`: it is the step, `time` is in fs (the frame's time is in
+//! ps), and `E` (Hartree) stays a comment pair as ASE reads it (`{E}` in a caption). Such a file
+//! holds no cell: CP2K writes it to `PROJECT-1.cell` ([`crate::cells::CellTable`]).
+//!
 //! The comment line stays the frame's [`Frame::comment`], so its other pairs (ASE's `energy=`,
 //! `stress="…"`, `config_type=`) are at hand through [`Frame::comment_value`].
 //!
@@ -152,6 +158,15 @@ pub(crate) fn key_values(line: &[u8]) -> impl Iterator<Item = (&[u8], &[u8])> {
                 i += 1;
             }
             let key = &line[ks..i];
+            // `key = value,` as CP2K writes its comment lines (ASE's parser allows the spaces).
+            let mut j = i;
+            while j < line.len() && line[j].is_ascii_whitespace() {
+                j += 1;
+            }
+            let spaced = j > i && !key.is_empty() && line.get(j) == Some(&b'=');
+            if spaced {
+                i = j;
+            }
             if i >= line.len() || line[i] != b'=' {
                 // A bare word: not a pair.
                 if key.is_empty() {
@@ -160,6 +175,11 @@ pub(crate) fn key_values(line: &[u8]) -> impl Iterator<Item = (&[u8], &[u8])> {
                 continue;
             }
             i += 1;
+            if spaced {
+                while i < line.len() && line[i].is_ascii_whitespace() {
+                    i += 1;
+                }
+            }
             let value = if line.get(i) == Some(&b'"') {
                 i += 1;
                 let vs = i;
@@ -174,7 +194,10 @@ pub(crate) fn key_values(line: &[u8]) -> impl Iterator<Item = (&[u8], &[u8])> {
                 while i < line.len() && !line[i].is_ascii_whitespace() {
                     i += 1;
                 }
-                &line[vs..i]
+                match &line[vs..i] {
+                    [v @ .., b','] if spaced => v,
+                    v => v,
+                }
             };
             return Some((key, value));
         }
@@ -194,7 +217,17 @@ impl Xyz {
         self.properties.clear();
         let mut periodic = [true; 3];
         let mut origin = None;
+        // CP2K's `i = STEP, time = FS, E = HARTREE` (or `i = STEP, E = ...` of an optimisation).
+        let mut cp2k = None;
         for (key, value) in key_values(line) {
+            if *cp2k.get_or_insert(key == b"i") {
+                match key {
+                    b"i" => frame.step = parse_i64(value),
+                    b"time" => frame.time = parse_f64(value).map(|fs| fs / 1000.0),
+                    _ => {}
+                }
+                continue;
+            }
             if key.eq_ignore_ascii_case(b"Lattice") {
                 let mut m = [0.0f64; 9];
                 let mut k = 0;

@@ -38,6 +38,8 @@ mod cna;
 mod conformations;
 #[path = "coordination.rs"]
 mod coordination;
+#[path = "cp2k.rs"]
+mod cp2k;
 #[path = "crd_pqr.rs"]
 mod crd_pqr;
 #[path = "crystal_cif.rs"]
