@@ -268,3 +268,41 @@ fn spaced_pairs_leave_extended_xyz_alone() {
     assert_eq!((f.step, f.time), (Some(9), Some(0.25)));
     assert_eq!(f.comment_value("energy"), Some("-2"));
 }
+
+/// The `.cell` file cut at every byte: never a panic; the whole lines before the cut are the
+/// table, and a cut inside a line is an error naming that line, unless only the volume's last
+/// digits were cut (the cell vectors whole, the volume still within its check).
+#[test]
+fn cell_file_cut_at_every_byte() {
+    let bytes = std::fs::read(path("ar_npt-1.cell")).unwrap();
+    let full = CellTable::parse(Cursor::new(&bytes), "c.cell").unwrap();
+    let mut errors = 0;
+    for cut in 0..bytes.len() {
+        let head = &bytes[..cut];
+        let whole_lines = head.iter().filter(|&&b| b == b'\n').count();
+        match CellTable::parse(Cursor::new(head), "c.cell") {
+            Ok(t) => {
+                // Rows: whole data lines (the header is line 1), plus a last line cut only in
+                // its volume.
+                let rows = t.len();
+                assert!(
+                    rows == whole_lines.saturating_sub(1) || rows == whole_lines,
+                    "cut {cut}: {rows} rows after {whole_lines} lines"
+                );
+                for step in 0..rows as i64 {
+                    assert_eq!(t.at_step(step).unwrap().1, full.at_step(step).unwrap().1);
+                }
+            }
+            Err(Error::Parse { at, .. }) => {
+                errors += 1;
+                let line = at.line.unwrap_or(0);
+                assert!(
+                    line == whole_lines as u64 + 1 || (whole_lines <= 1 && at.line.is_none()),
+                    "cut {cut}: error at line {line} after {whole_lines} whole lines"
+                );
+            }
+            Err(e) => panic!("cut {cut}: {e}"),
+        }
+    }
+    assert!(errors > bytes.len() / 2, "{errors} errors");
+}
