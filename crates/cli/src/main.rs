@@ -15,6 +15,7 @@ mod plot;
 mod scene;
 mod tables;
 mod terrain;
+mod terrain_contour;
 mod terrain_dem;
 mod terrain_fly;
 mod terrain_grid;

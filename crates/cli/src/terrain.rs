@@ -210,6 +210,8 @@ pub enum TerrainCmd {
     /// gdaldem's products of a DEM (hillshade, slope, aspect, color-relief, tri, tpi, roughness)
     /// as GeoTIFFs equal to GDAL's.
     Dem(crate::terrain_dem::DemArgs),
+    /// Vector contour lines of a DEM as GeoJSON or a shapefile, line for line gdal_contour's.
+    Contour(crate::terrain_contour::ContourArgs),
     /// Grid lidar point clouds (LAS, LAZ) into a DEM GeoTIFF, as PDAL's writers.gdal does.
     Grid(crate::terrain_grid::GridArgs),
     /// Fly a path file (or an orbit) over the database: PNG frames or a movie, with a progress bar.
@@ -579,6 +581,7 @@ pub fn run(cmd: TerrainCmd) -> Result<()> {
         TerrainCmd::Render(a) => crate::terrain_view::run(a),
         TerrainCmd::Viewshed(a) => crate::terrain_viewshed::run(a),
         TerrainCmd::Dem(a) => crate::terrain_dem::run(a),
+        TerrainCmd::Contour(a) => crate::terrain_contour::run(a),
         TerrainCmd::Grid(a) => crate::terrain_grid::run(a),
         TerrainCmd::Fly(a) => crate::terrain_fly::run_fly(a),
         TerrainCmd::Compare(a) => crate::terrain_fly::run_compare(a),

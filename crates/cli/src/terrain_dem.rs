@@ -310,7 +310,7 @@ pub fn run(a: DemArgs) -> Result<()> {
 
 /// The DEM files read and joined into one grid, as `terrain build --dem` joins them, or the
 /// grid of a database directory from `terrain build` (mapped, as `terrain viewshed` reads it).
-fn read_joined(paths: &[PathBuf]) -> Result<Grid> {
+pub(crate) fn read_joined(paths: &[PathBuf]) -> Result<Grid> {
     if let Some(dir) = paths.iter().find(|p| p.is_dir()) {
         if paths.len() > 1 {
             return usage(format!(

@@ -1607,3 +1607,124 @@ fn assert_no_partial_files(dir: &Path) {
         .collect();
     assert!(leftovers.is_empty(), "{leftovers:?}");
 }
+
+#[test]
+fn contour_writes_gdals_lines_and_refuses_bad_levels() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("c.geojson");
+    let out_s = out.to_str().unwrap();
+    // The same lines as gdal_contour's (crates/terrain/tests/data/gdal_contour.sh).
+    let o = texmap(&[
+        "terrain",
+        "contour",
+        &data("contour_rings.asc"),
+        "-i",
+        "10",
+        "--attr",
+        "-o",
+        out_s,
+    ]);
+    ok(&o);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("10 lines"), "{err}");
+    let ours: serde_json::Value = serde_json::from_slice(&std::fs::read(&out).unwrap()).unwrap();
+    let gdal: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(data("gdal_contour/rings_i10.geojson")).unwrap())
+            .unwrap();
+    let props = |v: &serde_json::Value| {
+        v["features"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|f| f["properties"].clone())
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(props(&ours), props(&gdal));
+    assert_no_partial_files(dir.path());
+    // A shapefile by its extension (gdal_contour's default format), .prj included for degrees.
+    let shp = dir.path().join("c.shp");
+    ok(&texmap(&[
+        "terrain",
+        "contour",
+        &data("gdaldem_geo.tif"),
+        "-i",
+        "100",
+        "--attr",
+        "-o",
+        shp.to_str().unwrap(),
+    ]));
+    for ext in ["shp", "shx", "dbf", "prj"] {
+        assert!(shp.with_extension(ext).exists(), ".{ext}");
+    }
+    // An output format we do not write is bad usage.
+    let o = texmap(&[
+        "terrain",
+        "contour",
+        &data("gdaldem_geo.tif"),
+        "-i",
+        "100",
+        "-o",
+        dir.path().join("c.gpkg").to_str().unwrap(),
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+
+    // A bad level list is bad usage (exit 2) and writes nothing.
+    let bad = dir.path().join("bad.geojson");
+    for levels in ["100,abc", "", "100,inf"] {
+        let o = texmap(&[
+            "terrain",
+            "contour",
+            &data("contour_rings.asc"),
+            "--levels",
+            levels,
+            "-o",
+            bad.to_str().unwrap(),
+        ]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "--levels {levels:?}: {err}");
+        assert!(err.contains("level"), "{err}");
+        assert!(!bad.exists());
+    }
+    // No levels, two kinds of levels, a zero interval: exit 2 as well.
+    for args in [
+        &[][..],
+        &["-i", "10", "--exp-base", "2"][..],
+        &["-i", "0"][..],
+    ] {
+        let mut a = vec!["terrain", "contour", "-o", bad.to_str().unwrap()];
+        let dem = data("contour_rings.asc");
+        a.push(&dem);
+        a.extend_from_slice(args);
+        let o = texmap(&a);
+        assert_eq!(
+            o.status.code(),
+            Some(2),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        assert!(!bad.exists());
+    }
+
+    // An unreadable DEM exits 1 and names the file.
+    let junk = dir.path().join("junk.tif");
+    std::fs::write(&junk, b"not a tiff").unwrap();
+    let o = texmap(&[
+        "terrain",
+        "contour",
+        junk.to_str().unwrap(),
+        "-i",
+        "10",
+        "-o",
+        bad.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("junk.tif"), "{err}");
+    assert!(!bad.exists());
+    assert_no_partial_files(dir.path());
+}

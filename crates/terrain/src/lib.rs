@@ -44,6 +44,8 @@
 //!   sweep (bit for bit GDAL 3.6's, or with the cells next to the observer seen as they are) and
 //!   exact sight lines, with curvature and refraction; written as GeoTIFF by
 //!   [`dem::geotiff_writer`].
+//! - [`contour_lines`]: vector contour lines of a grid as GeoJSON or shapefiles, equal to
+//!   `gdal_contour`'s.
 //! - [`flight`]: flight paths — CSV/JSON path files (a bad line is named), orbits, and the
 //!   built-in study path (look-down, low, grazing, turn, slow pass).
 //!
@@ -80,6 +82,7 @@
 //! ```
 
 pub mod chunks;
+pub mod contour_lines;
 pub mod db;
 pub mod dem;
 pub mod dem_products;

@@ -17,6 +17,8 @@ mod campaign;
 #[global_allocator]
 static ALLOC: alloc::CountingAlloc = alloc::CountingAlloc;
 
+#[path = "contour_lines.rs"]
+mod contour_lines;
 #[path = "crack.rs"]
 mod crack;
 #[path = "db.rs"]

@@ -259,7 +259,7 @@ pub fn write_geotiff_with(
 
 /// Run `write` on a buffered temporary file beside `path`, then sync it and rename it to `path`;
 /// on any failure the temporary file is removed.
-fn write_atomically(
+pub(crate) fn write_atomically(
     path: &Path,
     write: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> Result<(), TerrainError>,
 ) -> Result<(), TerrainError> {
