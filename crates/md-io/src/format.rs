@@ -107,6 +107,18 @@ pub enum Format {
     /// (ibrav 0): `.pwi`, or an `.in` whose first line that is not a comment opens the
     /// `&CONTROL` or `&SYSTEM` namelist; by name: `espresso-in`.
     EspressoIn,
+    /// VASP's `vasprun.xml`: every ionic step (`<calculation>`) a frame, as ASE counts them,
+    /// with its cell, the elements of `<atominfo>`, forces (`fx fy fz`, eV/Å), energy, free
+    /// energy and stress (in the comment, eV and eV/Å³, as ASE reports them), step and, in
+    /// molecular dynamics, time: files named `vasprun*.xml`, or a `.xml` whose first element is
+    /// `<modeling>`; by name: `vasp-xml`.
+    VaspXml,
+    /// VASP's `OUTCAR`: every ionic step (each `POSITION … TOTAL-FORCE` table with its energy)
+    /// a frame, as ASE counts them, with its cell, the POTCARs' elements, forces (`fx fy fz`,
+    /// eV/Å), energy, free energy and stress (in the comment), step and time: files named
+    /// `OUTCAR*`, or a file whose first line is VASP's banner (`vasp.6.4.1 …`); by name:
+    /// `vasp-out`.
+    Outcar,
     /// ASE trajectories (ASE's ULM binary format: `ase.io.Trajectory`, its MD drivers and
     /// optimisers): numbers, positions, cell and pbc, momenta as velocities, the calculator's
     /// forces and energies: `.traj`; by name: `ase-traj`.
@@ -115,7 +127,7 @@ pub enum Format {
 
 impl Format {
     /// Every format, in declaration order.
-    pub const ALL: [Format; 31] = [
+    pub const ALL: [Format; 33] = [
         Format::Xyz,
         Format::Pdb,
         Format::Gro,
@@ -147,6 +159,8 @@ impl Format {
         Format::LammpsBin,
         Format::EspressoOut,
         Format::EspressoIn,
+        Format::VaspXml,
+        Format::Outcar,
     ];
 
     /// The format a file extension (case-insensitive, e.g. "xyz", "lammpstrj") or a format's
@@ -185,12 +199,15 @@ impl Format {
             "traj" | "ase-traj" => Format::AseTraj,
             "pwo" | "espresso-out" => Format::EspressoOut,
             "pwi" | "espresso-in" => Format::EspressoIn,
+            "vasp-xml" => Format::VaspXml,
+            "vasp-out" | "outcar" => Format::Outcar,
             _ => return None,
         })
     }
 
-    /// The format a path's extension names, else VASP for the names VASP gives its files
-    /// (`POSCAR`, `CONTCAR`, `XDATCAR` and any suffix: `CONTCAR.2`; the volumetric `CHGCAR`,
+    /// The format a path's extension names, else VASP's run outputs by their names (`OUTCAR`
+    /// and any suffix: `OUTCAR.relax`; `vasprun*.xml`), else VASP for the names VASP gives its
+    /// files (`POSCAR`, `CONTCAR`, `XDATCAR` and any suffix: `CONTCAR.2`; the volumetric `CHGCAR`,
     /// `CHG`, `PARCHG`, `LOCPOT`, `ELFCAR`, `AECCAR0/1/2` as
     /// [`crate::volume::VaspQuantity::from_file_name`] tells them: `run1.CHGCAR`,
     /// `PARCHG.0012.ALLK`, read as one frame, the structure), else a LAMMPS data file for
@@ -207,6 +224,14 @@ impl Format {
         }
         // VASP's fixed file names, with any suffix (`POSCAR_relaxed`, `CONTCAR.2`).
         let name = inner.file_name()?.to_str()?.as_bytes();
+        let starts = |p: &[u8]| name.len() >= p.len() && name[..p.len()].eq_ignore_ascii_case(p);
+        if starts(b"OUTCAR") {
+            return Some(Format::Outcar);
+        }
+        let xml = name.len() >= 4 && name[name.len() - 4..].eq_ignore_ascii_case(b".xml");
+        if starts(b"vasprun") && xml {
+            return Some(Format::VaspXml);
+        }
         let vasp = [&b"POSCAR"[..], b"CONTCAR", b"XDATCAR"]
             .iter()
             .any(|v| name.len() >= v.len() && name[..v.len()].eq_ignore_ascii_case(v));
@@ -315,6 +340,13 @@ impl Format {
         }
         if crate::espresso::is_input(head) {
             return Some(Format::EspressoIn);
+        }
+        // VASP's run outputs: an XML document rooted at `<modeling>`, VASP's banner.
+        if crate::vasp_out::is_vasprun(head) {
+            return Some(Format::VaspXml);
+        }
+        if crate::vasp_out::is_outcar(head) {
+            return Some(Format::Outcar);
         }
         let mut lines = head.split(|b| *b == b'\n');
         let first = lines.next().unwrap_or(&[]);
@@ -499,6 +531,8 @@ impl Format {
                 | Format::Xsf
                 | Format::EspressoOut
                 | Format::EspressoIn
+                | Format::VaspXml
+                | Format::Outcar
         )
     }
 
@@ -536,6 +570,8 @@ impl Format {
             Format::Bcif => "bcif",
             Format::EspressoOut => "espresso-out",
             Format::EspressoIn => "espresso-in",
+            Format::VaspXml => "vasp-xml",
+            Format::Outcar => "vasp-out",
         }
     }
 }

@@ -19,7 +19,8 @@
 //!   XCrySDen XSF / AXSF (each structure a frame, with its cell and forces), Quantum ESPRESSO
 //!   pw.x output (every ionic step of scf, relax, vc-relax, md, vc-md runs a frame, as ASE
 //!   counts them: cell, forces, energy and stress) and input (its ibrav or CELL_PARAMETERS
-//!   cell)
+//!   cell), VASP's vasprun.xml and OUTCAR (every ionic step a frame, as ASE counts them: cell,
+//!   forces, energy, free energy and stress)
 //!   (and the binary DCD, XTC,
 //!   TRR, AMBER NetCDF, NAMD's binary `.coor` and HOOMD-blue GSD: particle types, diameters, per-particle properties
 //!   and bonds, by the hoomd schema's rule for what a frame omits) one frame at a time into a
@@ -212,6 +213,7 @@ mod trr_writer;
 pub mod vacf;
 pub mod values;
 mod vasp;
+mod vasp_out;
 mod vasp_writer;
 pub mod volume;
 pub mod voronoi;

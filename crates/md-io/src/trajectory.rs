@@ -61,6 +61,8 @@ enum Reader<R> {
     Xsf(TextReader<R, Xsf>),
     EspressoOut(TextReader<R, crate::espresso::PwOut>),
     EspressoIn(TextReader<R, crate::espresso::PwIn>),
+    VaspXml(TextReader<R, crate::vasp_out::VaspXml>),
+    Outcar(TextReader<R, crate::vasp_out::Outcar>),
     Tpr(crate::tpr::TprReader),
     AseTraj(crate::asetraj::AseTrajReader<R>),
     Bcif(crate::bcif::BcifReader),
@@ -97,6 +99,8 @@ macro_rules! each_reader {
             Reader::Xsf($r) => $body,
             Reader::EspressoOut($r) => $body,
             Reader::EspressoIn($r) => $body,
+            Reader::VaspXml($r) => $body,
+            Reader::Outcar($r) => $body,
             Reader::Tpr($r) => $body,
             Reader::AseTraj($r) => $body,
             Reader::Bcif($r) => $body,
@@ -470,6 +474,12 @@ impl<R: Read + Seek> Trajectory<R> {
             }
             Format::EspressoIn => {
                 Reader::EspressoIn(TextReader::new(src, Default::default(), file.clone()))
+            }
+            Format::VaspXml => {
+                Reader::VaspXml(TextReader::new(src, Default::default(), file.clone()))
+            }
+            Format::Outcar => {
+                Reader::Outcar(TextReader::new(src, Default::default(), file.clone()))
             }
         };
         Ok(Trajectory {

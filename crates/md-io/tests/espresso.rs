@@ -23,6 +23,7 @@ use std::path::PathBuf;
 
 use serde_json::Value;
 use support::alloc::measure;
+use support::dft::{cell, comment_number, comment_stress, max_dev, positions, read_all, rows};
 use texmap_md_io::{Error, Format, Frame, ReadOptions, Trajectory};
 
 fn path(name: &str) -> PathBuf {
@@ -62,62 +63,6 @@ const OUTPUTS: [&str; 25] = [
     "ibrav14_tri",
     "fe_relax_mag",
 ];
-
-fn rows(v: &Value) -> Vec<[f64; 3]> {
-    v.as_array()
-        .unwrap()
-        .iter()
-        .map(|r| std::array::from_fn(|c| r[c].as_f64().unwrap()))
-        .collect()
-}
-
-fn read_all(t: &mut Trajectory<impl std::io::Read + std::io::Seek>) -> Vec<Frame> {
-    let mut out = Vec::new();
-    let mut f = Frame::new();
-    while t.read_next(&mut f).unwrap() {
-        out.push(f.clone());
-    }
-    out
-}
-
-/// The comment's `key=value` number.
-fn comment_number(f: &Frame, key: &str) -> Option<f64> {
-    f.comment
-        .split(' ')
-        .find_map(|kv| kv.strip_prefix(&format!("{key}=")))
-        .map(|v| v.parse().unwrap())
-}
-
-/// The comment's `stress="…"` as ASE's Voigt order (xx yy zz yz xz xy).
-fn comment_stress(f: &Frame) -> Option<[f64; 6]> {
-    let s = f.comment.split("stress=\"").nth(1)?.split('"').next()?;
-    let v: Vec<f64> = s.split(' ').map(|x| x.parse().unwrap()).collect();
-    assert_eq!(v.len(), 9, "{}", f.comment);
-    assert_eq!(
-        [v[1], v[2], v[5]],
-        [v[3], v[6], v[7]],
-        "symmetric: {}",
-        f.comment
-    );
-    Some([v[0], v[4], v[8], v[5], v[2], v[1]])
-}
-
-/// Largest |a - b| over matching components, asserting the shapes agree.
-fn max_dev(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
-    assert_eq!(a.len(), b.len());
-    a.iter()
-        .zip(b)
-        .flat_map(|(x, y)| (0..3).map(move |c| (x[c] - y[c]).abs()))
-        .fold(0.0, f64::max)
-}
-
-fn positions(f: &Frame) -> Vec<[f64; 3]> {
-    f.positions.iter().map(|p| p.map(f64::from)).collect()
-}
-
-fn cell(f: &Frame) -> Vec<[f64; 3]> {
-    f.cell.unwrap().matrix().to_vec()
-}
 
 /// Compares our frame with ASE's, within the module's tolerances; returns the largest
 /// deviations: positions and cell (Å), forces (eV/Å), energy (relative).
@@ -172,9 +117,9 @@ fn compare(name: &str, k: usize, f: &Frame, w: &Value) -> [f64; 4] {
         }
     }
     match w["stress"].as_array() {
-        None => assert_eq!(comment_stress(f), None, "{name} frame {k}"),
+        None => assert_eq!(comment_stress(f, true), None, "{name} frame {k}"),
         Some(s) => {
-            let got = comment_stress(f).unwrap();
+            let got = comment_stress(f, true).unwrap();
             for (c, x) in s.iter().enumerate() {
                 let x = x.as_f64().unwrap();
                 assert!(

@@ -1002,6 +1002,16 @@ fn espresso_campaign() {
     campaign("Quantum ESPRESSO input", Format::EspressoIn, fx.into());
 }
 
+/// VASP's run outputs: the vasprun.xml and the OUTCAR of a relaxation of bcc Li (three ionic
+/// steps, the cell changing; pymatgen's test files).
+#[test]
+fn vasp_out_campaign() {
+    let fx = text_fixture("vasp_out/vasprun_li_relax.xml", Format::VaspXml);
+    campaign("VASP vasprun.xml", Format::VaspXml, vec![fx]);
+    let fx = text_fixture("vasp_out/OUTCAR_li_relax", Format::Outcar);
+    campaign("VASP OUTCAR", Format::Outcar, vec![fx]);
+}
+
 #[test]
 fn dlpoly_campaign() {
     let files = ["dlpoly/HISTORY", "dlpoly/CONFIG"];

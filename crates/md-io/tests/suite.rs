@@ -7,6 +7,7 @@
 mod support {
     pub mod alloc;
     pub mod campaign;
+    pub mod dft;
     pub mod fixtures;
     pub mod gsd_index;
     pub mod lammps_bin;
@@ -138,6 +139,8 @@ mod tpr;
 mod trr_writer;
 #[path = "vasp.rs"]
 mod vasp;
+#[path = "vasp_out.rs"]
+mod vasp_out;
 #[path = "vasp_writer.rs"]
 mod vasp_writer;
 #[path = "volume.rs"]
