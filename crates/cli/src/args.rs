@@ -68,7 +68,8 @@ pub enum Command {
         /// record, VASP POSCAR/CONTCAR/XDATCAR, crystallographic CIF, a LAMMPS data file,
         /// CHARMM .crd/.cor, PQR with charges and radii, AutoDock PDBQT, NAMD binary .coor, Tinker .xyz/.arc, DL_POLY CONFIG/HISTORY,
         /// XCrySDen XSF/AXSF, Quantum ESPRESSO pw.x output (.pwo, or .out: every ionic step)
-        /// and input (.pwi, or .in)),
+        /// and input (.pwi, or .in), VASP vasprun.xml and OUTCAR (every ionic step), CP2K's
+        /// -pos-1.xyz (step, time and energy; the cell with --cell)),
         /// gzip- or bzip2-compressed or not (1abc.cif.gz, prod.mdcrd.bz2). A quoted pattern ('dump.*.lammpstrj') reads
         /// the files it matches in natural order as one trajectory.
         file: PathBuf,
