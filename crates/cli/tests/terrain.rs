@@ -20,6 +20,17 @@ fn ok(o: &Output) {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
 
+/// Asserts that `texmap` exited with `code` (2: bad usage, 1: a runtime failure), showing its
+/// stderr otherwise.
+fn exits(o: &Output, code: i32) {
+    assert_eq!(
+        o.status.code(),
+        Some(code),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
 #[test]
 fn build_info_maps_export_and_render() {
     let dir = tempfile::tempdir().unwrap();
@@ -116,12 +127,7 @@ fn bad_input_gets_exit_codes_scripts_can_trust() {
         "--out",
         db_s,
     ]);
-    assert_eq!(
-        o.status.code(),
-        Some(1),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    exits(&o, 1);
     // A missing DEM names the file.
     let missing = dir.path().join("nope.tif");
     let o = texmap(&[
@@ -1284,12 +1290,7 @@ fn a_16_bit_photo_is_stretched_by_percentiles_and_the_ranges_carry_to_the_next_b
         "--out",
         dir.path().join("relief.db").to_str().unwrap(),
     ]);
-    assert_eq!(
-        o.status.code(),
-        Some(2),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    exits(&o, 2);
     // Bad rules and gammas are usage errors (exit 2) naming the option.
     for bad in [
         &["--stretch", "percent:98,2"][..],
@@ -1666,12 +1667,7 @@ fn contour_writes_gdals_lines_and_refuses_bad_levels() {
         "-o",
         dir.path().join("c.gpkg").to_str().unwrap(),
     ]);
-    assert_eq!(
-        o.status.code(),
-        Some(2),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    exits(&o, 2);
 
     // A bad level list is bad usage (exit 2) and writes nothing.
     let bad = dir.path().join("bad.geojson");

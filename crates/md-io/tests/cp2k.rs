@@ -8,6 +8,7 @@
 //! a [`Frame`] (below 32 Å an f32 is within 2e-6 Å of the printed value); the `.cell` file
 //! prints 10 decimals, so its vectors are within 5e-11 Å of the restart's (plus the f64 parse).
 
+use crate::support::dft::rows;
 use crate::support::fixtures;
 
 use std::io::Cursor;
@@ -24,25 +25,6 @@ fn path(name: &str) -> PathBuf {
 
 fn reference() -> Value {
     serde_json::from_str(&std::fs::read_to_string(path("reference.json")).unwrap()).unwrap()
-}
-
-fn f64s(v: &Value) -> Vec<f64> {
-    v.as_array()
-        .unwrap()
-        .iter()
-        .map(|x| x.as_f64().unwrap())
-        .collect()
-}
-
-fn vec3s(v: &Value) -> Vec<[f64; 3]> {
-    v.as_array()
-        .unwrap()
-        .iter()
-        .map(|p| {
-            let p = f64s(p);
-            [p[0], p[1], p[2]]
-        })
-        .collect()
 }
 
 fn frames(name: &str) -> Vec<Frame> {
@@ -79,7 +61,7 @@ fn comment_lines_give_step_time_and_energy_as_ase_reads_them() {
             let e: f64 = f.comment_value("E").unwrap().parse().unwrap();
             assert_eq!(e, info["E"].as_f64().unwrap(), "{file} frame {k}");
             assert!(f.cell.is_none(), "{file}: CP2K's .xyz holds no cell");
-            let want = vec3s(&t["positions"]);
+            let want = rows(&t["positions"]);
             assert_eq!(f.positions.len(), want.len());
             for (p, q) in f.positions.iter().zip(&want) {
                 for d in 0..3 {
@@ -101,7 +83,7 @@ fn cell_file_agrees_with_the_restart_file() {
     assert_eq!(table.steps(), (0, 40));
     let (time, cell) = table.at_step(40).unwrap();
     assert_eq!(time, 200.0);
-    let want = vec3s(&r["restart"]["cell"]);
+    let want = rows(&r["restart"]["cell"]);
     for (row, w) in cell.matrix().iter().zip(&want) {
         for d in 0..3 {
             assert!((row[d] - w[d]).abs() < 6e-11, "{row:?} against {w:?}");
@@ -109,7 +91,7 @@ fn cell_file_agrees_with_the_restart_file() {
     }
     let last = frames("ar_npt-pos-1.xyz").pop().unwrap();
     assert_eq!(last.step, Some(40));
-    for (p, q) in last.positions.iter().zip(vec3s(&r["restart"]["positions"])) {
+    for (p, q) in last.positions.iter().zip(rows(&r["restart"]["positions"])) {
         for d in 0..3 {
             assert!((p[d] as f64 - q[d]).abs() < 2e-6);
         }
@@ -132,7 +114,7 @@ fn frames_get_the_cell_of_their_step() {
         assert_eq!(step, 4 * k as i64);
         assert_eq!(f.cell.as_ref(), Some(table.at_step(step).unwrap().1));
         let cell = f.cell.unwrap();
-        let wrapped = vec3s(&r["npt_wrapped"][k]);
+        let wrapped = rows(&r["npt_wrapped"][k]);
         for (p, q) in f.positions.iter().zip(&wrapped) {
             let w = wrap(&cell, [p[0] as f64, p[1] as f64, p[2] as f64]);
             // A coordinate at a face can wrap to either side: compare modulo the cell.
